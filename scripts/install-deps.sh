@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs everything vmap needs on Debian 12 (bookworm) from Debian's own packages.
+# Usage: scripts/install-deps.sh [--with-browser]
+#   --with-browser  also installs Chromium, used by the report tests.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  libopencv-dev                 # OpenCV 4.6 with the FFmpeg video backend and USAC (MAGSAC)
+  libtorch-dev                  # LibTorch 1.13 (CPU) for the deep matchers
+  libopenblas0-openmp           # without it LibTorch uses the reference BLAS and runs 30-50x slower
+  libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev libeigen3-dev
+  libgtest-dev libgmock-dev googletest libbenchmark-dev
+  ffmpeg                        # only used by tests to craft broken videos
+)
+if [[ "${1:-}" == "--with-browser" ]]; then
+  packages+=(chromium)
+fi
+
+sudo_cmd=()
+if [[ $(id -u) -ne 0 ]]; then sudo_cmd=(sudo); fi
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "install-deps: installing ${missing[*]}"
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+else
+  echo "install-deps: all packages present"
+fi

@@ -1,0 +1,181 @@
+// End-to-end tests of the vmap binary: real sequences in every layout, and every kind of bad input.
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "vmap/mapping/map_io.h"
+#include "vmap/testing/synthetic_scene.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+using testing::RunVmap;
+
+namespace {
+
+fs::path Shared() { return testing::SharedDir(); }
+
+#define REQUIRE_SHARED()                                          \
+  if (Shared().empty()) GTEST_SKIP() << "../shared is not present"
+
+std::string Quote(const fs::path& p) { return "'" + p.string() + "'"; }
+
+}  // namespace
+
+TEST(Cli, BuildsAndReadsBackAMapFromAVideo) {
+  REQUIRE_SHARED();
+  testing::TempDir tmp;
+  std::string out;
+  const fs::path map_dir = tmp.path() / "map";
+  ASSERT_EQ(RunVmap("build " + Quote(Shared() / "data/lab_floor/lab_floor.mp4") + " -o " + Quote(map_dir) +
+                        " --last 239",
+                    &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("frames (n)      240"), std::string::npos) << out;
+  const VisualMap map = ReadMap(map_dir);
+  EXPECT_EQ(map.num_frames, 240);
+  EXPECT_GE(map.key_images.size(), 2u);
+  EXPECT_EQ(map.links.size(), map.key_images.size() - 1);
+  for (const KeyImage& k : map.key_images) {
+    const cv::Mat image = cv::imread((map_dir / k.image_file).string());
+    EXPECT_EQ(image.size(), cv::Size(640, 480));
+  }
+  const auto options = nlohmann::json::parse(map.options_json);
+  EXPECT_EQ(options["matcher"]["type"], "orb");
+  EXPECT_EQ(options["verifier"]["method"], "magsac");
+  EXPECT_EQ(options["source"]["last"], 239);
+  ASSERT_EQ(RunVmap("info " + Quote(map_dir), &out), 0) << out;
+  EXPECT_NE(out.find("key images (m)  " + std::to_string(map.key_images.size())), std::string::npos) << out;
+  // No temporary directories left next to the map.
+  EXPECT_EQ(std::distance(fs::directory_iterator(tmp.path()), fs::directory_iterator()), 1);
+}
+
+TEST(Cli, EveryDatasetLayoutBuilds) {
+  REQUIRE_SHARED();
+  struct Case {
+    std::string input, extra;
+    int frames;
+  };
+  for (const Case& c : {Case{"data/rccar_room/images", "", 329}, Case{"data/redkitchen", "--last 299", 300},
+                        Case{"data/kitti07", "", 160}}) {
+    testing::TempDir tmp;
+    std::string out;
+    ASSERT_EQ(RunVmap("build " + Quote(Shared() / c.input) + " -o " + Quote(tmp.path() / "m") + " " + c.extra, &out),
+              0)
+        << c.input << "\n"
+        << out;
+    const VisualMap map = ReadMap(tmp.path() / "m");
+    EXPECT_EQ(map.num_frames, c.frames) << c.input;
+    EXPECT_GE(map.key_images.size(), 2u) << c.input;
+    EXPECT_LT(map.key_images.size(), static_cast<size_t>(c.frames)) << c.input;
+    EXPECT_GE(map.key_images[1].timestamp, 0.0) << c.input;
+  }
+}
+
+TEST(Cli, SweepWritesThePapersTable) {
+  REQUIRE_SHARED();
+  testing::TempDir tmp;
+  std::string out;
+  ASSERT_EQ(RunVmap("sweep " + Quote(Shared() / "data/rccar_room/images") + " --last 99 --thresholds 0.1:0.9:0.2 -o " +
+                        Quote(tmp.path() / "sweep") + " --maps",
+                    &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("Best tau by Q"), std::string::npos) << out;
+  std::ifstream in(tmp.path() / "sweep/sweep.json");
+  const auto json = nlohmann::json::parse(in);
+  ASSERT_EQ(json["rows"].size(), 5u);
+  EXPECT_EQ(json["features_extracted"], 100);
+  int previous = 0;
+  for (const auto& row : json["rows"]) {
+    EXPECT_GE(row["key_images"].get<int>(), previous);
+    previous = row["key_images"].get<int>();
+    const VisualMap map = ReadMap(tmp.path() / "sweep" / row["map"].get<std::string>());
+    EXPECT_EQ(static_cast<int>(map.key_images.size()), row["key_images"].get<int>());
+  }
+  EXPECT_TRUE(fs::exists(tmp.path() / "sweep/sweep.csv"));
+  EXPECT_TRUE(fs::exists(tmp.path() / "sweep/sweep.md"));
+}
+
+TEST(Cli, OneFrameSequenceIsAMapWithOneKeyImage) {
+  testing::TempDir tmp;
+  testing::SyntheticOptions options;
+  options.num_frames = 1;
+  testing::WriteImageFolder(testing::RenderSyntheticSequence(options), tmp.path() / "in");
+  std::string out;
+  ASSERT_EQ(RunVmap("build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "m"), &out), 0) << out;
+  const VisualMap map = ReadMap(tmp.path() / "m");
+  EXPECT_EQ(map.key_images.size(), 1u);
+  EXPECT_TRUE(map.links.empty());
+}
+
+TEST(Cli, BadInputGivesAClearErrorAndWritesNothing) {
+  testing::TempDir tmp;
+  testing::SyntheticOptions options;
+  options.num_frames = 4;
+  testing::WriteImageFolder(testing::RenderSyntheticSequence(options), tmp.path() / "in");
+  fs::create_directories(tmp.path() / "empty");
+  std::ofstream(tmp.path() / "broken.mp4") << std::string(4096, '\x42');
+  struct Case {
+    std::string arguments;
+    std::string expected;  // part of the message
+  };
+  const std::string in = Quote(tmp.path() / "in");
+  const std::string out_dir = " -o " + Quote(tmp.path() / "out");
+  const std::vector<Case> cases = {
+      {"build " + Quote(tmp.path() / "nothing_here") + out_dir, "nothing_here' does not exist"},
+      {"build " + Quote(tmp.path() / "empty") + out_dir, "holds no images"},
+      {"build " + Quote(tmp.path() / "broken.mp4") + out_dir, "cannot open video"},
+      {"build " + in + out_dir + " --tau 0", "outside (0, 1]"},
+      {"build " + in + out_dir + " --tau 1.5", "outside (0, 1]"},
+      {"build " + in + out_dir + " --verifier lmeds", "unknown verifier 'lmeds'"},
+      {"build " + in + out_dir + " --matcher sift", "unknown matcher 'sift'"},
+      {"build " + in + out_dir + " --similarity cosine", "unknown similarity"},
+      {"build " + in + out_dir + " --format tum", "rgb.txt"},
+      {"build " + in + out_dir + " --stride 0", "--stride"},
+      {"build " + in + out_dir + " --first 10", "leaves none"},
+      {"info " + Quote(tmp.path() / "in"), "map.json is missing"},
+  };
+  for (const Case& c : cases) {
+    std::string output;
+    EXPECT_EQ(RunVmap(c.arguments, &output), 2) << c.arguments << "\n" << output;
+    EXPECT_NE(output.find(c.expected), std::string::npos) << c.arguments << "\n" << output;
+    EXPECT_FALSE(fs::exists(tmp.path() / "out")) << c.arguments;
+  }
+  // Nothing half-written was left next to the output either.
+  for (const auto& entry : fs::directory_iterator(tmp.path())) {
+    EXPECT_EQ(entry.path().filename().string().find(".out."), std::string::npos) << entry.path();
+  }
+}
+
+TEST(Cli, TruncatedVideoIsAClearError) {
+  REQUIRE_SHARED();
+  testing::TempDir tmp;
+  std::ifstream in(Shared() / "data/lab_floor/lab_floor.mp4", std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::ofstream(tmp.path() / "cut.mp4", std::ios::binary) << bytes.substr(0, bytes.size() / 3);
+  std::string out;
+  EXPECT_EQ(RunVmap("build " + Quote(tmp.path() / "cut.mp4") + " -o " + Quote(tmp.path() / "m"), &out), 2) << out;
+  EXPECT_NE(out.find("cut.mp4"), std::string::npos) << out;
+  EXPECT_NE(out.find("truncated"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(tmp.path() / "m"));
+}
+
+TEST(Cli, DifferentFrameSizesWarnOrFailWhenStrict) {
+  testing::TempDir tmp;
+  testing::SyntheticOptions options;
+  options.num_frames = 5;
+  testing::WriteImageFolder(testing::RenderSyntheticSequence(options), tmp.path() / "in");
+  cv::imwrite((tmp.path() / "in/frame_3.png").string(), cv::Mat(100, 150, CV_8UC3, cv::Scalar(90, 90, 90)));
+  std::string out;
+  EXPECT_EQ(RunVmap("build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "m"), &out), 0) << out;
+  EXPECT_NE(out.find("resizing it"), std::string::npos) << out;
+  EXPECT_EQ(RunVmap("build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "m2") + " --strict", &out), 2)
+      << out;
+  EXPECT_NE(out.find("frame_3.png"), std::string::npos) << out;
+}
+
+}  // namespace vmap

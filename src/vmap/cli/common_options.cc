@@ -1,0 +1,62 @@
+#include "vmap/cli/common_options.h"
+
+namespace vmap::cli {
+
+void AddMatcherOptions(CLI::App* command, MatcherOptions& options) {
+  command->add_option("--matcher", options.type, "Feature matcher: orb or loftr")->capture_default_str();
+  auto& orb = options.orb;
+  command->add_option("--orb-features", orb.num_features, "ORB: features per image")->capture_default_str();
+  command->add_option("--orb-scale-factor", orb.scale_factor, "ORB: pyramid scale factor")->capture_default_str();
+  command->add_option("--orb-levels", orb.num_levels, "ORB: pyramid levels")->capture_default_str();
+  command->add_option("--orb-fast-threshold", orb.fast_threshold, "ORB: FAST threshold")->capture_default_str();
+  command->add_option("--orb-edge-threshold", orb.edge_threshold, "ORB: border without features (px)")
+      ->capture_default_str();
+  command->add_flag("!--no-cross-check", orb.cross_check, "ORB: keep one-way best matches too");
+  command->add_option("--ratio", orb.ratio, "ORB: Lowe's ratio test (0 = off), e.g. 0.8")->capture_default_str();
+  auto& loftr = options.loftr;
+  command->add_option("--loftr-model", loftr.model, "LoFTR preset: outdoor, indoor or coarse")
+      ->capture_default_str();
+  command->add_option("--weights", loftr.weights, "LoFTR weights file (see `vmap weights`)");
+  command->add_option("--device", loftr.device, "LoFTR device: cpu or cuda")->capture_default_str();
+  command->add_option("--loftr-size", loftr.longest_side, "LoFTR: longest image side fed to the network")
+      ->capture_default_str();
+  command->add_option("--loftr-threshold", loftr.threshold, "LoFTR: coarse confidence threshold (default: preset's)");
+}
+
+VerifierOptions VerifierFlags::Resolve() const {
+  VerifierOptions resolved = options;
+  resolved.method = ParseVerifierMethod(method);
+  resolved.Check();
+  return resolved;
+}
+
+void AddVerifierOptions(CLI::App* command, VerifierFlags& flags) {
+  command->add_option("--verifier", flags.method, "Fundamental matrix estimator: magsac, ransac, usac, accurate")
+      ->capture_default_str();
+  command->add_option("--threshold", flags.options.threshold, "Verifier inlier threshold in pixels")
+      ->capture_default_str();
+  command->add_option("--confidence", flags.options.confidence, "Verifier confidence")->capture_default_str();
+  command->add_option("--max-iters", flags.options.max_iterations, "Verifier maximum iterations")
+      ->capture_default_str();
+  command->add_option("--seed", flags.options.seed, "Verifier random seed (same seed, same map)")
+      ->capture_default_str();
+}
+
+FrameSourceOptions SourceFlags::Resolve() const {
+  FrameSourceOptions resolved = options;
+  resolved.format = ParseSourceFormat(format);
+  resolved.Check();
+  return resolved;
+}
+
+void AddSourceOptions(CLI::App* command, SourceFlags& flags) {
+  command->add_option("--format", flags.format, "Input layout: auto, video, images, tum, euroc, kitti")
+      ->capture_default_str();
+  command->add_option("--first", flags.options.first, "First frame (0-based)")->capture_default_str();
+  command->add_option("--last", flags.options.last, "Last frame, inclusive (-1 = end)")->capture_default_str();
+  command->add_option("--stride", flags.options.stride, "Use every N-th frame")->capture_default_str();
+  command->add_option("--resize", flags.options.resize, "Resize frames: WxH, or the longest side (e.g. 640)");
+  command->add_flag("--strict", flags.options.strict, "Frames of a different size are an error, not a warning");
+}
+
+}  // namespace vmap::cli

@@ -1,0 +1,134 @@
+// vmap match IMAGE0 IMAGE1: one pair through a matcher and the verifier, to try a matcher on one's own
+// images and to compare matches across implementations.
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "vmap/cli/commands.h"
+#include "vmap/cli/common_options.h"
+#include "vmap/core/atomic_output.h"
+#include "vmap/core/error.h"
+
+namespace vmap::cli {
+
+namespace {
+
+struct MatchFlags {
+  std::string image0, image1, json_path;
+  bool list = false;
+  MatcherOptions matcher;
+  VerifierFlags verifier;
+};
+
+cv::Mat ReadGray(const std::string& path) {
+  // IMREAD_GRAYSCALE, not cvtColor: the decoder's conversion is what the reference implementations see.
+  cv::Mat gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (gray.empty()) throw InputError("cannot read image '" + path + "'; check the path and that it is an image");
+  return gray;
+}
+
+double Seconds(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void RunMatch(const MatchFlags& flags) {
+  const VerifierOptions verifier = flags.verifier.Resolve();
+  const cv::Mat gray0 = ReadGray(flags.image0), gray1 = ReadGray(flags.image1);
+  auto start = std::chrono::steady_clock::now();
+  const std::unique_ptr<Matcher> matcher = CreateMatcher(flags.matcher);
+  const double load_s = Seconds(start);
+
+  start = std::chrono::steady_clock::now();
+  const auto features0 = matcher->Extract(gray0);
+  const auto features1 = matcher->Extract(gray1);
+  const double extract_s = Seconds(start);
+  start = std::chrono::steady_clock::now();
+  const TentativeMatches matches = matcher->Match(*features0, *features1);
+  const double match_s = Seconds(start);
+
+  start = std::chrono::steady_clock::now();
+  FundamentalResult fundamental;
+  if (static_cast<int>(matches.size()) >= verifier.min_matches) {
+    fundamental = EstimateFundamental(matches.points0, matches.points1, verifier);
+  }
+  const double verify_s = Seconds(start);
+  const double similarity =
+      matches.size() == 0 ? 0.0 : double(fundamental.num_inliers) / double(matches.size());
+
+  std::printf("matcher     %s %s\n", matcher->name().c_str(), matcher->DescribeOptionsJson().c_str());
+  std::printf("images      %s (%dx%d), %s (%dx%d)\n", flags.image0.c_str(), gray0.cols, gray0.rows,
+              flags.image1.c_str(), gray1.cols, gray1.rows);
+  std::printf("tentative   %zu\n", matches.size());
+  std::printf("verified    %d (%s, S = %.4f)\n", fundamental.num_inliers,
+              fundamental.success ? "F found" : "no F: too few matches or no model", similarity);
+  if (fundamental.success) {
+    for (int r = 0; r < 3; ++r) {
+      std::printf("%s [% .9e % .9e % .9e]\n", r == 0 ? "F          " : "           ", fundamental.F(r, 0),
+                  fundamental.F(r, 1), fundamental.F(r, 2));
+    }
+  }
+  std::printf("time        load %.3f s, extract %.3f s (2 images), match %.3f s, verify %.3f s\n", load_s, extract_s,
+              match_s, verify_s);
+  if (flags.list) {
+    std::printf("# x0 y0 x1 y1 score inlier\n");
+    for (size_t k = 0; k < matches.size(); ++k) {
+      std::printf("%.3f %.3f %.3f %.3f %.6g %d\n", matches.points0[k].x, matches.points0[k].y, matches.points1[k].x,
+                  matches.points1[k].y, matches.scores.empty() ? 0.0 : matches.scores[k],
+                  fundamental.success ? int(fundamental.inlier_mask[k]) : 0);
+    }
+  }
+
+  if (!flags.json_path.empty()) {
+    nlohmann::json j;
+    j["image0"] = {{"path", flags.image0}, {"width", gray0.cols}, {"height", gray0.rows}};
+    j["image1"] = {{"path", flags.image1}, {"width", gray1.cols}, {"height", gray1.rows}};
+    j["matcher"] = {{"type", matcher->name()}, {"options", nlohmann::json::parse(matcher->DescribeOptionsJson())}};
+    j["verifier"] = {{"method", VerifierMethodName(verifier.method)},
+                     {"threshold", verifier.threshold},
+                     {"confidence", verifier.confidence},
+                     {"seed", verifier.seed}};
+    j["num_tentative"] = matches.size();
+    j["num_verified"] = fundamental.num_inliers;
+    j["verified"] = fundamental.success;
+    j["similarity"] = similarity;
+    if (fundamental.success) {
+      j["F"] = nlohmann::json::array();
+      for (int r = 0; r < 3; ++r) j["F"].push_back({fundamental.F(r, 0), fundamental.F(r, 1), fundamental.F(r, 2)});
+    } else {
+      j["F"] = nullptr;
+    }
+    auto& list = j["matches"] = nlohmann::json::array();
+    for (size_t k = 0; k < matches.size(); ++k) {
+      list.push_back({{"x0", matches.points0[k].x},
+                      {"y0", matches.points0[k].y},
+                      {"x1", matches.points1[k].x},
+                      {"y1", matches.points1[k].y},
+                      {"score", matches.scores.empty() ? 0.0f : matches.scores[k]},
+                      {"inlier", fundamental.success && fundamental.inlier_mask[k] != 0}});
+    }
+    j["time_s"] = {{"load", load_s}, {"extract", extract_s}, {"match", match_s}, {"verify", verify_s}};
+    WriteFileAtomically(flags.json_path, j.dump(1) + "\n");
+  }
+}
+
+}  // namespace
+
+void AddMatchCommand(CLI::App& app) {
+  auto flags = std::make_shared<MatchFlags>();
+  CLI::App* command = app.add_subcommand(
+      "match", "Match one image pair: tentative matches (in original image pixels, with confidence), the verified "
+               "subset and F");
+  command->add_option("image0", flags->image0, "First image")->required();
+  command->add_option("image1", flags->image1, "Second image")->required();
+  command->add_option("--json", flags->json_path, "Also write every match, the inlier mask and F to this JSON file");
+  command->add_flag("--list", flags->list, "Print every match: x0 y0 x1 y1 score inlier");
+  AddMatcherOptions(command, flags->matcher);
+  AddVerifierOptions(command, flags->verifier);
+  command->callback([flags] { RunMatch(*flags); });
+}
+
+}  // namespace vmap::cli

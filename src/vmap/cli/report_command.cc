@@ -1,0 +1,31 @@
+// vmap report MAP_DIR: writes report.html (summary, key-image strip, match figures, plots) into a map.
+
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "vmap/cli/commands.h"
+#include "vmap/report/html_report.h"
+
+namespace vmap::cli {
+
+void AddReportCommand(CLI::App& app) {
+  auto map_directory = std::make_shared<std::string>();
+  auto options = std::make_shared<MapReportOptions>();
+  CLI::App* command = app.add_subcommand(
+      "report", "Write report.html into a map directory: summary, key images, match figures and plots (offline page)");
+  command->add_option("map", *map_directory, "Map directory written by `vmap build`")->required();
+  command->add_option("--thumbnail-width", options->thumbnail_width, "Width of the key-image thumbnails in pixels")
+      ->capture_default_str()
+      ->check(CLI::Range(32, 4096));
+  command->add_option("--figure-width", options->figure_width, "Width of the match figures in pixels")
+      ->capture_default_str()
+      ->check(CLI::Range(64, 8192));
+  command->callback([map_directory, options] {
+    WriteMapReport(*map_directory, *options);
+    std::cout << "report          " << (std::filesystem::path(*map_directory) / kReportFileName).string() << "\n";
+  });
+}
+
+}  // namespace vmap::cli

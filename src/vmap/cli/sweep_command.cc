@@ -1,0 +1,85 @@
+// vmap sweep INPUT --thresholds 0.1:0.9:0.1: the paper's table, every tau in one pass over the input.
+
+#include <filesystem>
+#include <iostream>
+
+#include <spdlog/spdlog.h>
+
+#include "vmap/cli/commands.h"
+#include "vmap/cli/common_options.h"
+#include "vmap/cli/map_options.h"
+#include "vmap/core/atomic_output.h"
+#include "vmap/core/error.h"
+#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/map_io.h"
+#include "vmap/report/summary.h"
+
+namespace vmap::cli {
+namespace fs = std::filesystem;
+
+namespace {
+
+struct SweepFlags {
+  std::string input;
+  std::string thresholds = "0.1:0.9:0.1";
+  std::string output;
+  bool write_maps = false;
+  std::string report;
+  SourceFlags source;
+  MatcherOptions matcher;
+  VerifierFlags verifier;
+  KeyImageFlags key_images;
+};
+
+void RunSweep(const SweepFlags& flags) {
+  const std::vector<double> taus = ParseThresholds(flags.thresholds);
+  const FrameSourceOptions source_options = flags.source.Resolve();
+  MapBuilderOptions options = flags.key_images.Resolve();
+  options.verifier = flags.verifier.Resolve();
+  options.show_progress = spdlog::should_log(spdlog::level::info);
+  if (flags.write_maps && flags.output.empty()) throw InputError("--maps needs -o DIR to write the maps into");
+  const std::unique_ptr<Matcher> matcher = CreateMatcher(flags.matcher);
+  const std::unique_ptr<FrameSource> source = OpenFrameSource(flags.input, source_options);
+  const std::string options_json = DescribeOptions(*matcher, options, source_options);
+
+  std::unique_ptr<AtomicOutputDirectory> directory;
+  if (!flags.output.empty()) directory = std::make_unique<AtomicOutputDirectory>(flags.output);
+  std::vector<VisualMap> maps;
+  SweepResult sweep = SweepThresholds(*source, *matcher, options, taus, flags.write_maps ? &maps : nullptr,
+                                      flags.write_maps ? directory->path() : fs::path(), options_json);
+  if (directory) {
+    for (size_t i = 0; i < maps.size(); ++i) {
+      WriteMapFiles(maps[i], sweep.rows[i].map_directory);
+      // Recorded relative to the sweep directory, which is renamed into place below.
+      sweep.rows[i].map_directory = fs::path(sweep.rows[i].map_directory).filename().string();
+    }
+    WriteFileAtomically(directory->path() / "sweep.md", SweepToMarkdown(sweep));
+    WriteFileAtomically(directory->path() / "sweep.csv", SweepToCsv(sweep));
+    WriteFileAtomically(directory->path() / "sweep.json", SweepToJson(sweep));
+    directory->Commit();
+  }
+  std::cout << SweepToMarkdown(sweep);
+  if (directory) std::cout << "\nwritten to " << flags.output << " (sweep.md, sweep.csv, sweep.json)\n";
+  WriteSweepReportIfAsked(flags.report, sweep, flags.output);
+}
+
+}  // namespace
+
+void AddSweepCommand(CLI::App& app) {
+  auto flags = std::make_shared<SweepFlags>();
+  CLI::App* command =
+      app.add_subcommand("sweep", "Build maps for a range of thresholds tau in one pass (the paper's tables)");
+  command->add_option("input", flags->input, "Video file, image folder, TUM RGB-D, EuRoC or KITTI sequence")
+      ->required();
+  command->add_option("--thresholds", flags->thresholds, "start:stop:step or a list a,b,c")->capture_default_str();
+  command->add_option("-o,--output", flags->output, "Directory for sweep.md, sweep.csv and sweep.json");
+  command->add_flag("--maps", flags->write_maps, "Also write each tau's map into the output directory");
+  command->add_option("--report", flags->report, "Write an HTML report of the sweep into this directory");
+  AddSourceOptions(command, flags->source);
+  AddMatcherOptions(command, flags->matcher);
+  AddVerifierOptions(command, flags->verifier);
+  AddKeyImageOptions(command, flags->key_images, /*with_tau=*/false);
+  command->callback([flags] { RunSweep(*flags); });
+}
+
+}  // namespace vmap::cli

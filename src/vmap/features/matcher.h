@@ -1,0 +1,44 @@
+#pragma once
+// The matcher interface. Features of an image are computed once (Extract) and reused for every pair the
+// image takes part in: the current key image is never re-extracted for each new frame.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace vmap {
+
+// Whatever a matcher computes per image (ORB keypoints and descriptors, LoFTR backbone features...).
+class ImageFeatures {
+ public:
+  virtual ~ImageFeatures() = default;
+  // |D| of the paper for the literal "feature-ratio" similarity: the features detected in this image.
+  virtual int num_features() const = 0;
+  // The size of the image the features were extracted from (coordinates refer to it).
+  virtual cv::Size image_size() const = 0;
+};
+
+// Tentative correspondences between two images, in pixel coordinates of the images given to Extract
+// (OpenCV convention: pixel centres at integer coordinates).
+struct TentativeMatches {
+  std::vector<cv::Point2f> points0;
+  std::vector<cv::Point2f> points1;
+  std::vector<float> scores;  // matcher confidence per match (higher is better); may be empty
+  size_t size() const { return points0.size(); }
+};
+
+class Matcher {
+ public:
+  virtual ~Matcher() = default;
+  virtual std::string name() const = 0;
+  // `gray` is 8-bit single-channel. Never returns null; an image without features gives num_features() == 0.
+  virtual std::shared_ptr<const ImageFeatures> Extract(const cv::Mat& gray) const = 0;
+  // Features must come from this matcher's Extract.
+  virtual TentativeMatches Match(const ImageFeatures& features0, const ImageFeatures& features1) const = 0;
+  // The matcher's settings, recorded in map.json.
+  virtual std::string DescribeOptionsJson() const = 0;
+};
+
+}  // namespace vmap

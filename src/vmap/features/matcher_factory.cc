@@ -1,0 +1,26 @@
+#include "vmap/features/matcher_factory.h"
+
+#include "vmap/core/error.h"
+#ifdef VMAP_WITH_TORCH
+#include "vmap/neural/loftr_matcher.h"
+#endif
+
+namespace vmap {
+
+void MatcherOptions::Check() const {
+  if (type == "orb") orb.Check();
+  else if (type == "loftr") loftr.Check();
+  else throw InputError("unknown matcher '" + type + "'; use orb or loftr");
+}
+
+std::unique_ptr<Matcher> CreateMatcher(const MatcherOptions& options) {
+  options.Check();
+  if (options.type == "orb") return CreateOrbMatcher(options.orb);
+#ifdef VMAP_WITH_TORCH
+  return CreateLoftrMatcher(options.loftr);
+#else
+  throw InputError("this vmap was built without LibTorch (VMAP_WITH_TORCH=OFF); rebuild with it for --matcher loftr");
+#endif
+}
+
+}  // namespace vmap

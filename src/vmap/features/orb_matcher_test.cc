@@ -1,0 +1,80 @@
+#include "vmap/features/orb_matcher.h"
+
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <gtest/gtest.h>
+
+#include "vmap/core/error.h"
+#include "vmap/testing/synthetic_scene.h"
+
+namespace vmap {
+
+TEST(BinaryMatching, EqualsOpenCvBruteForceWithCrossCheck) {
+  cv::RNG rng(3);
+  cv::Mat a(300, 32, CV_8U), b(280, 32, CV_8U);
+  rng.fill(a, cv::RNG::UNIFORM, 0, 256);
+  rng.fill(b, cv::RNG::UNIFORM, 0, 256);
+  // Make half of b noisy copies of rows of a so that there are real matches.
+  for (int i = 0; i < 140; ++i) {
+    a.row(i * 2).copyTo(b.row(i));
+    b.at<uchar>(i, i % 32) ^= 0x5;
+  }
+  cv::BFMatcher reference(cv::NORM_HAMMING, /*crossCheck=*/true);
+  std::vector<cv::DMatch> expected;
+  reference.match(a, b, expected);
+  const auto ours = MatchBinaryDescriptors(a, b, /*cross_check=*/true, 0.0);
+  ASSERT_EQ(ours.size(), expected.size());
+  for (size_t k = 0; k < ours.size(); ++k) {
+    EXPECT_EQ(ours[k].first, expected[k].queryIdx);
+    EXPECT_EQ(ours[k].second, expected[k].trainIdx);
+  }
+}
+
+TEST(BinaryMatching, RatioTestRejectsAmbiguousMatches) {
+  cv::Mat a = cv::Mat::zeros(1, 32, CV_8U);
+  cv::Mat b = cv::Mat::zeros(2, 32, CV_8U);
+  b.at<uchar>(0, 0) = 0x1;  // distance 1
+  b.at<uchar>(1, 0) = 0x3;  // distance 2: ambiguous at ratio 0.5
+  EXPECT_EQ(MatchBinaryDescriptors(a, b, false, 0.0).size(), 1u);
+  EXPECT_TRUE(MatchBinaryDescriptors(a, b, false, 0.5).empty());
+  EXPECT_EQ(MatchBinaryDescriptors(a, b, false, 0.8).size(), 1u);  // 1 < 0.8 * 2
+}
+
+TEST(OrbMatcher, MatchesNeighbouringFramesOfASyntheticScene) {
+  testing::SyntheticOptions options;
+  options.num_frames = 3;
+  const auto sequence = testing::RenderSyntheticSequence(options);
+  const auto matcher = CreateOrbMatcher({});
+  cv::Mat gray0, gray1;
+  cv::cvtColor(sequence.frames[0], gray0, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(sequence.frames[2], gray1, cv::COLOR_BGR2GRAY);
+  const auto f0 = matcher->Extract(gray0);
+  const auto f1 = matcher->Extract(gray1);
+  EXPECT_GT(f0->num_features(), 300);
+  EXPECT_LE(f0->num_features(), 500);  // OpenCV's default budget
+  const TentativeMatches matches = matcher->Match(*f0, *f1);
+  EXPECT_GT(matches.size(), 150u);
+  EXPECT_EQ(matches.points0.size(), matches.points1.size());
+}
+
+TEST(OrbMatcher, BlackImageHasNoFeaturesAndNoMatches) {
+  const auto matcher = CreateOrbMatcher({});
+  const auto black = matcher->Extract(cv::Mat::zeros(240, 320, CV_8U));
+  EXPECT_EQ(black->num_features(), 0);
+  EXPECT_EQ(matcher->Match(*black, *black).size(), 0u);
+}
+
+TEST(OrbMatcher, OptionsAreChecked) {
+  OrbMatcherOptions options;
+  options.num_features = 0;
+  EXPECT_THROW(options.Check(), InputError);
+  options = {};
+  options.scale_factor = 1.0;
+  EXPECT_THROW(options.Check(), InputError);
+  options = {};
+  options.ratio = 1.5;
+  EXPECT_THROW(options.Check(), InputError);
+}
+
+}  // namespace vmap

@@ -1,0 +1,103 @@
+#include "vmap/geometry/fundamental.h"
+
+#include <cmath>
+
+#include <opencv2/calib3d.hpp>
+
+#include "vmap/core/error.h"
+
+namespace vmap {
+
+VerifierMethod ParseVerifierMethod(const std::string& name) {
+  if (name == "magsac") return VerifierMethod::kMagsac;
+  if (name == "ransac") return VerifierMethod::kRansac;
+  if (name == "usac") return VerifierMethod::kUsac;
+  if (name == "accurate") return VerifierMethod::kAccurate;
+  throw InputError("unknown verifier '" + name + "'; use magsac, ransac, usac or accurate");
+}
+
+std::string VerifierMethodName(VerifierMethod method) {
+  switch (method) {
+    case VerifierMethod::kMagsac: return "magsac";
+    case VerifierMethod::kRansac: return "ransac";
+    case VerifierMethod::kUsac: return "usac";
+    case VerifierMethod::kAccurate: return "accurate";
+  }
+  return "magsac";
+}
+
+void VerifierOptions::Check() const {
+  if (!(threshold > 0.0)) throw InputError("--threshold (verifier, pixels) must be > 0 (default 0.5)");
+  if (!(confidence > 0.0 && confidence < 1.0)) throw InputError("--confidence must be in (0, 1) (default 0.999)");
+  if (max_iterations < 1) throw InputError("--max-iters must be >= 1 (default 100000)");
+  if (min_matches < 8) throw InputError("min_matches must be >= 8: the 8-point algorithm needs 8 matches");
+}
+
+
+FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0,
+                                      const std::vector<cv::Point2f>& points1, const VerifierOptions& options) {
+  FundamentalResult result;
+  CV_Assert(points0.size() == points1.size());
+  if (static_cast<int>(points0.size()) < options.min_matches) return result;
+  cv::Mat F;
+  std::vector<unsigned char> mask;
+  if (options.method == VerifierMethod::kRansac) {
+    // FM_RANSAC draws from a fixed-seed generator inside OpenCV: repeatable.
+    F = cv::findFundamentalMat(points0, points1, cv::FM_RANSAC, options.threshold, options.confidence,
+                               options.max_iterations, mask);
+  } else {
+    // The presets of OpenCV 4.6's flag-based call (usac::setParameters), with the seed made explicit.
+    cv::UsacParams params;
+    params.confidence = options.confidence;
+    params.maxIterations = options.max_iterations;
+    params.threshold = options.threshold;
+    params.randomGeneratorState = options.seed;
+    params.isParallel = false;
+    params.sampler = cv::SAMPLING_UNIFORM;
+    params.neighborsSearch = cv::NEIGH_GRID;
+    switch (options.method) {
+      case VerifierMethod::kMagsac:
+        params.score = cv::SCORE_METHOD_MAGSAC;
+        params.loMethod = cv::LOCAL_OPTIM_SIGMA;
+        params.loSampleSize = 50;
+        params.loIterations = 10;
+        break;
+      case VerifierMethod::kAccurate:
+        params.score = cv::SCORE_METHOD_MSAC;
+        params.loMethod = cv::LOCAL_OPTIM_GC;
+        params.loSampleSize = 20;
+        params.loIterations = 25;
+        break;
+      default:  // USAC_DEFAULT
+        params.score = cv::SCORE_METHOD_MSAC;
+        params.loMethod = cv::LOCAL_OPTIM_INNER_AND_ITER_LO;
+        params.loSampleSize = 21;  // the fundamental-matrix default of the preset
+        params.loIterations = 15;
+        break;
+    }
+    F = cv::findFundamentalMat(points0, points1, mask, params);
+  }
+  // OpenCV may return several stacked 3x3 solutions (7-point); the first is the chosen one.
+  if (F.empty() || F.rows < 3 || F.cols != 3 || mask.size() != points0.size()) return result;
+  result.inlier_mask = std::move(mask);
+  for (unsigned char m : result.inlier_mask) result.num_inliers += m ? 1 : 0;
+  if (result.num_inliers < options.min_matches) {
+    result.inlier_mask.clear();
+    result.num_inliers = 0;
+    return result;
+  }
+  F.rowRange(0, 3).convertTo(cv::Mat(3, 3, CV_64F, result.F.val), CV_64F);
+  result.success = true;
+  return result;
+}
+
+double SampsonDistance(const cv::Matx33d& F, const cv::Point2f& p0, const cv::Point2f& p1) {
+  const cv::Vec3d x0(p0.x, p0.y, 1.0), x1(p1.x, p1.y, 1.0);
+  const cv::Vec3d Fx0 = F * x0;
+  const cv::Vec3d Ftx1 = F.t() * x1;
+  const double e = x1.dot(Fx0);
+  const double denominator = Fx0[0] * Fx0[0] + Fx0[1] * Fx0[1] + Ftx1[0] * Ftx1[0] + Ftx1[1] * Ftx1[1];
+  return denominator > 0 ? std::abs(e) / std::sqrt(denominator) : 0.0;
+}
+
+}  // namespace vmap

@@ -1,0 +1,42 @@
+#pragma once
+// Geometric verification of tentative matches with a fundamental matrix (OpenCV RANSAC / USAC).
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace vmap {
+
+enum class VerifierMethod { kMagsac, kRansac, kUsac, kAccurate };
+
+// "magsac" (USAC_MAGSAC), "ransac" (FM_RANSAC), "usac" (USAC_DEFAULT), "accurate" (USAC_ACCURATE).
+VerifierMethod ParseVerifierMethod(const std::string& name);
+std::string VerifierMethodName(VerifierMethod method);
+
+struct VerifierOptions {
+  // Defaults follow Kornia's LoFTR + MAGSAC tutorial, which the paper's code most likely followed.
+  VerifierMethod method = VerifierMethod::kMagsac;
+  double threshold = 0.5;      // pixels (epipolar distance for RANSAC, MAGSAC's sigma bound)
+  double confidence = 0.999;
+  int max_iterations = 100000;
+  int seed = 0;                // the random generator's state: the same input gives the same inliers
+  int min_matches = 8;         // fewer tentative matches than this means matching failed
+
+  void Check() const;  // throws InputError naming the bad option
+};
+
+struct FundamentalResult {
+  bool success = false;         // a model was found from at least min_matches tentative matches
+  cv::Matx33d F = cv::Matx33d::zeros();
+  std::vector<unsigned char> inlier_mask;  // one per tentative match; empty when !success
+  int num_inliers = 0;
+};
+
+FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0,
+                                      const std::vector<cv::Point2f>& points1, const VerifierOptions& options);
+
+// Symmetric epipolar (Sampson) distance of x1 <-> x0 under F (x1^T F x0 = 0), in pixels.
+double SampsonDistance(const cv::Matx33d& F, const cv::Point2f& p0, const cv::Point2f& p1);
+
+}  // namespace vmap

@@ -1,0 +1,146 @@
+#include "vmap/mapping/key_image_selector.h"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "vmap/core/error.h"
+
+namespace vmap {
+
+SimilarityMode ParseSimilarityMode(const std::string& name) {
+  if (name == "inlier-ratio") return SimilarityMode::kInlierRatio;
+  if (name == "feature-ratio") return SimilarityMode::kFeatureRatio;
+  throw InputError("unknown similarity '" + name + "'; use inlier-ratio or feature-ratio");
+}
+
+std::string SimilarityModeName(SimilarityMode mode) {
+  return mode == SimilarityMode::kInlierRatio ? "inlier-ratio" : "feature-ratio";
+}
+
+void KeyImageOptions::Check() const {
+  if (!(tau > 0.0 && tau <= 1.0)) {
+    throw InputError(fmt::format("threshold tau = {} is outside (0, 1]; the paper uses 0.1 to 0.9", tau));
+  }
+}
+
+PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features0,
+                           const ImageFeatures& features1, const VerifierOptions& verifier,
+                           SimilarityMode similarity) {
+  PairComparison result;
+  const TentativeMatches matches = matcher.Match(features0, features1);
+  result.num_tentative = static_cast<int>(matches.size());
+  const FundamentalResult fundamental = EstimateFundamental(matches.points0, matches.points1, verifier);
+  result.correspondences.reserve(matches.size());
+  if (fundamental.success) {
+    result.matched = true;
+    result.F = fundamental.F;
+    result.num_verified = fundamental.num_inliers;
+    for (size_t i = 0; i < matches.size(); ++i) {
+      if (fundamental.inlier_mask[i]) result.correspondences.push_back({matches.points0[i], matches.points1[i]});
+    }
+  }
+  for (size_t i = 0; i < matches.size(); ++i) {
+    if (!fundamental.success || !fundamental.inlier_mask[i]) {
+      result.correspondences.push_back({matches.points0[i], matches.points1[i]});
+    }
+  }
+  if (result.matched) {
+    const int denominator = similarity == SimilarityMode::kInlierRatio
+                                ? result.num_tentative
+                                : std::max(features0.num_features(), features1.num_features());
+    result.similarity = denominator > 0 ? static_cast<double>(result.num_verified) / denominator : 0.0;
+  }
+  return result;
+}
+
+KeyImageSelector::KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image)
+    : options_(options), compare_(std::move(compare)), on_key_image_(std::move(on_key_image)) {
+  options_.Check();
+}
+
+bool KeyImageSelector::Passes(const PairComparison& comparison) const {
+  return comparison.matched && comparison.similarity >= options_.tau;
+}
+
+void KeyImageSelector::AddKeyImage(const FrameRecord& record, const std::string& reason) {
+  KeyImage key;
+  key.frame_index = record.frame->index;
+  key.source_index = record.frame->source_index;
+  key.timestamp = record.frame->timestamp;
+  key.source_name = record.frame->source_name;
+  key.num_features = record.features->num_features();
+  key.reason = reason;
+  if (on_key_image_) on_key_image_(record, key);
+  spdlog::debug("tau {:.2f}: key image {} = frame {} ({})", options_.tau, key_images_.size(), key.frame_index,
+                reason);
+  key_images_.push_back(std::move(key));
+  key_ = record;
+  previous_.reset();
+}
+
+void KeyImageSelector::AddLink(const PairComparison& comparison, bool broken) {
+  Link link;
+  link.from_key = static_cast<int>(key_images_.size()) - 2;
+  link.to_key = static_cast<int>(key_images_.size()) - 1;
+  link.broken = broken;
+  link.similarity = comparison.similarity;
+  link.num_tentative = comparison.num_tentative;
+  link.num_verified = comparison.num_verified;
+  link.has_fundamental = comparison.matched;
+  link.F = comparison.F;
+  link.correspondences = comparison.correspondences;
+  links_.push_back(std::move(link));
+}
+
+void KeyImageSelector::Add(const FrameRecord& record) {
+  if (finished_) throw std::logic_error("KeyImageSelector::Add after Finish");
+  ++num_frames_;
+  if (!key_) {
+    AddKeyImage(record, "first frame");
+    return;
+  }
+  // Compare the frame with the key image; on failure the previous frame becomes the key image and the
+  // frame is compared again with it, so no frame is skipped.
+  for (;;) {
+    PairComparison comparison = compare_(*key_, record);
+    evaluations_.push_back({key_->frame->index, record.frame->index, comparison.similarity,
+                            comparison.num_tentative, comparison.num_verified, comparison.matched});
+    if (Passes(comparison)) {
+      previous_ = record;
+      previous_comparison_ = std::move(comparison);
+      return;
+    }
+    const std::string why = comparison.matched
+                                ? fmt::format("S(frame {}, frame {}) = {:.3f} < tau", key_->frame->index,
+                                              record.frame->index, comparison.similarity)
+                                : fmt::format("matching frame {} with key frame {} failed ({} tentative matches)",
+                                              record.frame->index, key_->frame->index, comparison.num_tentative);
+    if (!previous_) {
+      // The very next frame after the key image fails: it becomes a key image and the link is broken.
+      AddKeyImage(record, why + "; link broken");
+      AddLink(comparison, /*broken=*/true);
+      return;
+    }
+    const FrameRecord promoted = *previous_;
+    PairComparison promoted_comparison = std::move(previous_comparison_);
+    AddKeyImage(promoted, why);
+    AddLink(promoted_comparison, /*broken=*/false);
+  }
+}
+
+void KeyImageSelector::Finish() {
+  if (finished_) return;
+  finished_ = true;
+  if (options_.final_key && previous_) {
+    const FrameRecord last = *previous_;
+    PairComparison comparison = std::move(previous_comparison_);
+    AddKeyImage(last, "final frame");
+    AddLink(comparison, /*broken=*/false);
+  }
+  key_.reset();
+  previous_.reset();
+}
+
+}  // namespace vmap

@@ -1,0 +1,91 @@
+#pragma once
+// The key-image selection of García-Pintos et al. (2023), Algorithm 1, one frame at a time, so that a
+// sequence of any length streams through it and a threshold sweep runs every tau in one pass.
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "vmap/features/matcher.h"
+#include "vmap/geometry/fundamental.h"
+#include "vmap/mapping/visual_map.h"
+
+namespace vmap {
+
+enum class SimilarityMode {
+  kInlierRatio,   // |D| = tentative matches: S = verified / tentative (reproduces the paper's tables)
+  kFeatureRatio,  // |D| = features detected: S = verified / max(|D_i|, |D_j|) (the paper's literal text)
+};
+SimilarityMode ParseSimilarityMode(const std::string& name);  // "inlier-ratio", "feature-ratio"
+std::string SimilarityModeName(SimilarityMode mode);
+
+struct KeyImageOptions {
+  double tau = 0.5;                       // similarity threshold in (0, 1]
+  SimilarityMode similarity = SimilarityMode::kInlierRatio;
+  bool final_key = true;                  // the last frame becomes the final key image (the route's goal)
+
+  void Check() const;  // throws InputError naming the bad option
+};
+
+// One processed frame with its features, as the selector sees it.
+struct FrameRecord {
+  std::shared_ptr<const Frame> frame;
+  std::shared_ptr<const ImageFeatures> features;
+};
+
+// The outcome of comparing a key image with a frame: S and everything a link keeps.
+struct PairComparison {
+  bool matched = false;     // enough tentative matches and a fundamental matrix
+  double similarity = 0.0;
+  int num_tentative = 0;
+  int num_verified = 0;
+  cv::Matx33d F = cv::Matx33d::zeros();
+  std::vector<Correspondence> correspondences;  // verified first, then rejected
+};
+
+// Matches two images and verifies the matches: the S(I_i, I_j) of the paper.
+PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features0,
+                           const ImageFeatures& features1, const VerifierOptions& verifier,
+                           SimilarityMode similarity);
+
+class KeyImageSelector {
+ public:
+  using CompareFn = std::function<PairComparison(const FrameRecord& key, const FrameRecord& frame)>;
+  // Called once for every new key image, e.g. to write its image file (may set image_file).
+  using KeyImageFn = std::function<void(const FrameRecord& record, KeyImage& key)>;
+
+  KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image = nullptr);
+
+  // Frames must arrive in order. The first frame becomes the first key image.
+  void Add(const FrameRecord& record);
+  // Ends the sequence: adds the final key image when asked to.
+  void Finish();
+
+  const std::vector<KeyImage>& key_images() const { return key_images_; }
+  const std::vector<Link>& links() const { return links_; }
+  const std::vector<Evaluation>& evaluations() const { return evaluations_; }
+  int num_frames() const { return num_frames_; }
+  // The frames whose features the selector still holds (the key image and the previous frame).
+  int current_key_frame() const { return key_ ? key_->frame->index : -1; }
+
+ private:
+  bool Passes(const PairComparison& comparison) const;
+  void AddKeyImage(const FrameRecord& record, const std::string& reason);
+  void AddLink(const PairComparison& comparison, bool broken);
+
+  KeyImageOptions options_;
+  CompareFn compare_;
+  KeyImageFn on_key_image_;
+  std::optional<FrameRecord> key_;
+  std::optional<FrameRecord> previous_;         // the last frame that passed against the key image
+  PairComparison previous_comparison_;          // key vs previous_
+  std::vector<KeyImage> key_images_;
+  std::vector<Link> links_;
+  std::vector<Evaluation> evaluations_;
+  int num_frames_ = 0;
+  bool finished_ = false;
+};
+
+}  // namespace vmap

@@ -1,0 +1,271 @@
+#include "vmap/mapping/map_builder.h"
+
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+#include <spdlog/spdlog.h>
+
+#include "vmap/core/error.h"
+#include "vmap/core/progress.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+
+void MapBuilderOptions::Check() const {
+  key_images.Check();
+  verifier.Check();
+  if (prefetch_frames < 1) throw InputError("prefetch_frames must be >= 1");
+}
+
+namespace {
+
+// Reads frames and extracts their features on a worker thread, a few frames ahead of the consumer.
+class FeaturePipeline {
+ public:
+  FeaturePipeline(FrameSource& source, const Matcher& matcher, int depth)
+      : source_(source), matcher_(matcher), depth_(depth), worker_([this] { Run(); }) {}
+
+  ~FeaturePipeline() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    changed_.notify_all();
+    worker_.join();
+  }
+
+  // The next frame with its features, or nullopt at the end. Rethrows the worker's error.
+  std::optional<FrameRecord> Next() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [this] { return !queue_.empty() || done_; });
+    if (!queue_.empty()) {
+      FrameRecord record = std::move(queue_.front());
+      queue_.pop_front();
+      changed_.notify_all();
+      return record;
+    }
+    if (error_) std::rethrow_exception(error_);
+    return std::nullopt;
+  }
+
+  long extracted() const { return extracted_; }
+
+ private:
+  void Run() {
+    try {
+      for (;;) {
+        {
+          std::unique_lock<std::mutex> lock(mutex_);
+          changed_.wait(lock, [this] { return stop_ || static_cast<int>(queue_.size()) < depth_; });
+          if (stop_) break;
+        }
+        std::optional<Frame> frame = source_.Next();
+        if (!frame) break;
+        FrameRecord record;
+        record.features = matcher_.Extract(frame->gray);
+        record.frame = std::make_shared<const Frame>(std::move(*frame));
+        ++extracted_;
+        std::lock_guard<std::mutex> lock(mutex_);
+        queue_.push_back(std::move(record));
+        changed_.notify_all();
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      error_ = std::current_exception();
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    done_ = true;
+    changed_.notify_all();
+  }
+
+  FrameSource& source_;
+  const Matcher& matcher_;
+  const int depth_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<FrameRecord> queue_;
+  bool stop_ = false;
+  bool done_ = false;
+  std::exception_ptr error_;
+  std::atomic<long> extracted_{0};
+  std::thread worker_;  // last: starts after every other member exists
+};
+
+std::string KeyImageFileName(int frame_index) { return fmt::format("keys/{:06d}.png", frame_index); }
+
+KeyImageSelector::KeyImageFn KeyImageWriter(const fs::path& directory) {
+  if (directory.empty()) return nullptr;
+  fs::create_directories(directory / "keys");
+  return [directory](const FrameRecord& record, KeyImage& key) {
+    key.image_file = KeyImageFileName(key.frame_index);
+    // Fast PNG compression: lossless key images, written while the build runs.
+    if (!cv::imwrite((directory / key.image_file).string(), ColorImage(*record.frame),
+                     {cv::IMWRITE_PNG_COMPRESSION, 1})) {
+      throw InputError("cannot write key image '" + (directory / key.image_file).string() + "'");
+    }
+  };
+}
+
+VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source, const MapBuilderOptions& options,
+                     const std::string& options_json, double seconds) {
+  VisualMap map;
+  map.input = source.info();
+  map.options_json = options_json;
+  map.num_frames = selector.num_frames();
+  map.skipped_frames = source.skipped_frames();
+  map.key_images = selector.key_images();
+  map.links = selector.links();
+  map.evaluations = selector.evaluations();
+  map.seconds = seconds;
+  map.quality = ComputeStatistics(map, options.quality_mean).quality;
+  return map;
+}
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+std::vector<double> ParseThresholds(const std::string& text) {
+  std::vector<double> taus;
+  double start, stop, step;
+  char extra;
+  if (std::sscanf(text.c_str(), "%lf:%lf:%lf%c", &start, &stop, &step, &extra) == 3) {
+    if (!(step > 0) || stop < start) {
+      throw InputError("--thresholds '" + text + "' must be start:stop:step with step > 0 and stop >= start");
+    }
+    // Count steps with a tolerance so that 0.1:0.9:0.1 includes 0.9.
+    const int count = static_cast<int>(std::floor((stop - start) / step + 1e-9)) + 1;
+    for (int i = 0; i < count; ++i) taus.push_back(std::round((start + i * step) * 1e9) / 1e9);
+  } else {
+    std::stringstream list(text);
+    std::string item;
+    while (std::getline(list, item, ',')) {
+      try {
+        size_t used = 0;
+        taus.push_back(std::stod(item, &used));
+        if (used != item.size()) throw std::invalid_argument(item);
+      } catch (const std::exception&) {
+        throw InputError("--thresholds '" + text + "' is not start:stop:step (0.1:0.9:0.1) or a list (0.2,0.5)");
+      }
+    }
+  }
+  if (taus.empty()) throw InputError("--thresholds '" + text + "' gives no threshold");
+  for (double tau : taus) {
+    KeyImageOptions check;
+    check.tau = tau;
+    check.Check();
+  }
+  return taus;
+}
+
+namespace {
+
+// Runs one selector per tau over one pass of the source; directories[i] receives tau i's key images.
+SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
+                         const std::vector<double>& taus, const std::vector<fs::path>& directories,
+                         std::vector<VisualMap>* maps, const std::string& options_json) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  SweepResult result;
+  result.options_json = options_json;
+
+  // A pair compared under several taus is matched once: comparisons of the current frame, by key frame.
+  std::map<int, PairComparison> comparisons_of_frame;
+  int cached_frame = -1;
+  auto compare = [&](const FrameRecord& key, const FrameRecord& frame) -> PairComparison {
+    if (frame.frame->index != cached_frame) {
+      comparisons_of_frame.clear();
+      cached_frame = frame.frame->index;
+    }
+    auto it = comparisons_of_frame.find(key.frame->index);
+    if (it == comparisons_of_frame.end()) {
+      ++result.pairs_matched;
+      it = comparisons_of_frame
+               .emplace(key.frame->index, ComparePair(matcher, *key.features, *frame.features, options.verifier,
+                                                      options.key_images.similarity))
+               .first;
+    }
+    return it->second;
+  };
+
+  std::vector<std::unique_ptr<KeyImageSelector>> selectors;
+  for (size_t i = 0; i < taus.size(); ++i) {
+    KeyImageOptions key_options = options.key_images;
+    key_options.tau = taus[i];
+    selectors.push_back(std::make_unique<KeyImageSelector>(key_options, compare, KeyImageWriter(directories[i])));
+  }
+
+  {
+    FeaturePipeline pipeline(source, matcher, options.prefetch_frames);
+    ProgressOptions progress_options;
+    progress_options.enabled = options.show_progress;
+    ProgressLine progress(taus.size() == 1 ? "build" : "sweep", source.info().expected_frames, "frames",
+                          progress_options);
+    long done = 0;
+    while (std::optional<FrameRecord> record = pipeline.Next()) {
+      for (auto& selector : selectors) selector->Add(*record);
+      progress.Update(++done);
+    }
+    progress.Finish();
+    result.features_extracted = pipeline.extracted();
+  }
+
+  const double seconds = SecondsSince(start);
+  result.input = source.info();
+  result.seconds = seconds;
+  for (size_t i = 0; i < selectors.size(); ++i) {
+    selectors[i]->Finish();
+    VisualMap map = CollectMap(*selectors[i], source, options, options_json, seconds);
+    const MapStatistics stats = ComputeStatistics(map, options.quality_mean);
+    result.num_frames = map.num_frames;
+    SweepRow row;
+    row.tau = taus[i];
+    row.num_key_images = stats.num_key_images;
+    row.key_image_percent = stats.num_frames > 0 ? 100.0 * stats.num_key_images / stats.num_frames : 0.0;
+    row.min_verified = stats.min_verified;
+    row.max_verified = stats.max_verified;
+    row.mean_verified = stats.mean_verified;
+    row.mean_similarity = stats.mean_similarity;
+    row.quality = stats.quality;
+    row.broken_links = stats.broken_links;
+    row.map_directory = directories[i].string();
+    result.rows.push_back(row);
+    if (result.best_row < 0 || row.quality > result.rows[result.best_row].quality) {
+      result.best_row = static_cast<int>(i);
+    }
+    if (maps) maps->push_back(std::move(map));
+  }
+  return result;
+}
+
+}  // namespace
+
+VisualMap BuildMap(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
+                   const fs::path& directory, const std::string& options_json) {
+  std::vector<VisualMap> maps;
+  RunSelectors(source, matcher, options, {options.key_images.tau}, {directory}, &maps, options_json);
+  return std::move(maps.front());
+}
+
+SweepResult SweepThresholds(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
+                            const std::vector<double>& taus, std::vector<VisualMap>* maps,
+                            const fs::path& maps_directory, const std::string& options_json) {
+  std::vector<fs::path> directories;
+  for (double tau : taus) {
+    directories.push_back(maps_directory.empty() ? fs::path() : maps_directory / fmt::format("tau_{:.2f}", tau));
+  }
+  return RunSelectors(source, matcher, options, taus, directories, maps, options_json);
+}
+
+}  // namespace vmap

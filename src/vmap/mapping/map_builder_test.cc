@@ -1,0 +1,184 @@
+#include "vmap/mapping/map_builder.h"
+
+#include <opencv2/imgproc.hpp>
+
+#include <gtest/gtest.h>
+
+#include "vmap/core/error.h"
+#include "vmap/features/orb_matcher.h"
+#include "vmap/testing/synthetic_scene.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+
+namespace {
+
+// A source over frames held in memory.
+class MemorySource : public FrameSource {
+ public:
+  explicit MemorySource(const std::vector<cv::Mat>& frames) : frames_(frames) {
+    info_.path = "memory";
+    info_.expected_frames = static_cast<long>(frames.size());
+  }
+  std::optional<Frame> Next() override {
+    if (next_ >= frames_.size()) return std::nullopt;
+    Frame frame;
+    frame.index = frame.source_index = static_cast<int>(next_);
+    frame.color = frames_[next_];
+    cv::cvtColor(frame.color, frame.gray, cv::COLOR_BGR2GRAY);
+    frame.source_name = "frame" + std::to_string(next_++);
+    return frame;
+  }
+  const SequenceInfo& info() const override { return info_; }
+
+ private:
+  std::vector<cv::Mat> frames_;
+  size_t next_ = 0;
+  SequenceInfo info_;
+};
+
+// Counts Extract calls, to prove no frame is extracted twice.
+class CountingMatcher : public Matcher {
+ public:
+  explicit CountingMatcher(std::unique_ptr<Matcher> inner) : inner_(std::move(inner)) {}
+  std::string name() const override { return inner_->name(); }
+  std::shared_ptr<const ImageFeatures> Extract(const cv::Mat& gray) const override {
+    ++extracted;
+    return inner_->Extract(gray);
+  }
+  TentativeMatches Match(const ImageFeatures& a, const ImageFeatures& b) const override {
+    ++matched;
+    return inner_->Match(a, b);
+  }
+  std::string DescribeOptionsJson() const override { return inner_->DescribeOptionsJson(); }
+  mutable std::atomic<int> extracted{0};
+  mutable std::atomic<int> matched{0};
+
+ private:
+  std::unique_ptr<Matcher> inner_;
+};
+
+const testing::SyntheticSequence& Sequence() {
+  static const testing::SyntheticSequence sequence = [] {
+    testing::SyntheticOptions options;
+    options.num_frames = 50;
+    options.step = 0.06;
+    options.yaw_per_frame = 0.004;
+    return testing::RenderSyntheticSequence(options);
+  }();
+  return sequence;
+}
+
+MapBuilderOptions Options(double tau) {
+  MapBuilderOptions options;
+  options.key_images.tau = tau;
+  options.show_progress = false;
+  options.verifier.threshold = 1.0;
+  return options;
+}
+
+}  // namespace
+
+TEST(MapBuilder, KeyImagesRespondToTau) {
+  const auto matcher = CreateOrbMatcher({});
+  std::vector<int> counts;
+  for (double tau : {0.2, 0.5, 0.7, 0.85}) {
+    MemorySource source(Sequence().frames);
+    const VisualMap map = BuildMap(source, *matcher, Options(tau));
+    EXPECT_EQ(map.num_frames, 50);
+    EXPECT_EQ(map.key_images.front().frame_index, 0);
+    EXPECT_EQ(map.key_images.back().frame_index, 49);  // the final key image
+    EXPECT_EQ(map.links.size(), map.key_images.size() - 1);
+    for (const Link& link : map.links) {
+      EXPECT_FALSE(link.broken);
+      EXPECT_GE(link.similarity, tau);  // every link passed the test
+    }
+    counts.push_back(static_cast<int>(map.key_images.size()));
+  }
+  // A stricter threshold never gives fewer key images, and the range spans real differences.
+  for (size_t i = 1; i < counts.size(); ++i) EXPECT_GE(counts[i], counts[i - 1]);
+  EXPECT_GT(counts.back(), counts.front() + 3) << counts.front() << " .. " << counts.back();
+}
+
+TEST(MapBuilder, VerifiedFundamentalAgreesWithTheTrueMotion) {
+  const auto matcher = CreateOrbMatcher({});
+  MemorySource source(Sequence().frames);
+  const VisualMap map = BuildMap(source, *matcher, Options(0.6));
+  ASSERT_GE(map.links.size(), 2u);
+  for (const Link& link : map.links) {
+    ASSERT_TRUE(link.has_fundamental);
+    const int i = map.key_images[link.from_key].frame_index, j = map.key_images[link.to_key].frame_index;
+    const cv::Matx33d F_true = testing::TrueFundamental(Sequence().K, Sequence().poses[i], Sequence().poses[j]);
+    // The verified matches satisfy the TRUE epipolar geometry, and the estimated F agrees with it on them.
+    double true_error = 0;
+    for (int k = 0; k < link.num_verified; ++k) {
+      true_error += SampsonDistance(F_true, link.correspondences[k].p0, link.correspondences[k].p1);
+    }
+    EXPECT_LT(true_error / link.num_verified, 1.5) << "link " << i << "-" << j;
+    EXPECT_GE(link.num_verified, 30);
+    EXPECT_EQ(static_cast<int>(link.correspondences.size()), link.num_tentative);
+  }
+}
+
+TEST(MapBuilder, SweepExtractsEachFrameOnceAndEqualsSeparateBuilds) {
+  const std::vector<double> taus = {0.3, 0.6, 0.9};
+  CountingMatcher matcher(CreateOrbMatcher({}));
+  MemorySource source(Sequence().frames);
+  std::vector<VisualMap> maps;
+  const SweepResult sweep = SweepThresholds(source, matcher, Options(0.5), taus, &maps);
+  EXPECT_EQ(matcher.extracted.load(), 50);
+  EXPECT_EQ(sweep.features_extracted, 50);
+  ASSERT_EQ(sweep.rows.size(), 3u);
+  for (size_t i = 0; i < taus.size(); ++i) {
+    MemorySource again(Sequence().frames);
+    const auto single_matcher = CreateOrbMatcher({});
+    const VisualMap single = BuildMap(again, *single_matcher, Options(taus[i]));
+    ASSERT_EQ(single.key_images.size(), maps[i].key_images.size()) << taus[i];
+    for (size_t k = 0; k < single.key_images.size(); ++k) {
+      EXPECT_EQ(single.key_images[k].frame_index, maps[i].key_images[k].frame_index);
+    }
+    EXPECT_DOUBLE_EQ(single.quality, sweep.rows[i].quality);
+    EXPECT_EQ(sweep.rows[i].num_key_images, static_cast<int>(single.key_images.size()));
+  }
+  const int best = sweep.best_row;
+  for (const SweepRow& row : sweep.rows) EXPECT_LE(row.quality, sweep.rows[best].quality);
+}
+
+TEST(MapBuilder, SameInputSameMap) {
+  const auto matcher = CreateOrbMatcher({});
+  MemorySource a(Sequence().frames), b(Sequence().frames);
+  const VisualMap first = BuildMap(a, *matcher, Options(0.7));
+  const VisualMap second = BuildMap(b, *matcher, Options(0.7));
+  ASSERT_EQ(first.links.size(), second.links.size());
+  for (size_t i = 0; i < first.links.size(); ++i) {
+    EXPECT_EQ(first.links[i].num_verified, second.links[i].num_verified);
+    EXPECT_EQ(cv::norm(cv::Mat(first.links[i].F), cv::Mat(second.links[i].F)), 0.0);
+  }
+}
+
+TEST(MapBuilder, BlackFramesGiveBrokenLinksNotCrashes) {
+  std::vector<cv::Mat> frames(Sequence().frames.begin(), Sequence().frames.begin() + 6);
+  frames[3] = cv::Mat::zeros(frames[0].size(), CV_8UC3);
+  const auto matcher = CreateOrbMatcher({});
+  MemorySource source(frames);
+  const VisualMap map = BuildMap(source, *matcher, Options(0.5));
+  int broken = 0;
+  for (const Link& link : map.links) broken += link.broken ? 1 : 0;
+  EXPECT_EQ(broken, 2);  // into the black frame and out of it
+  std::vector<int> keys;
+  for (const KeyImage& k : map.key_images) keys.push_back(k.frame_index);
+  EXPECT_EQ(keys, (std::vector<int>{0, 2, 3, 4, 5}));
+}
+
+TEST(MapBuilder, ParsesThresholdRanges) {
+  const std::vector<double> taus = ParseThresholds("0.1:0.9:0.1");
+  ASSERT_EQ(taus.size(), 9u);
+  EXPECT_DOUBLE_EQ(taus.front(), 0.1);
+  EXPECT_DOUBLE_EQ(taus.back(), 0.9);
+  EXPECT_EQ(ParseThresholds("0.2,0.5").size(), 2u);
+  EXPECT_THROW(ParseThresholds("0.1:1.5:0.2"), InputError);
+  EXPECT_THROW(ParseThresholds("abc"), InputError);
+  EXPECT_THROW(ParseThresholds("0.5:0.1:0.1"), InputError);
+}
+
+}  // namespace vmap

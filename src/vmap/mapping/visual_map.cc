@@ -1,0 +1,55 @@
+#include "vmap/mapping/visual_map.h"
+
+#include <algorithm>
+#include <numeric>
+
+#include "vmap/core/error.h"
+
+namespace vmap {
+
+QualityMean ParseQualityMean(const std::string& name) {
+  if (name == "arithmetic") return QualityMean::kArithmetic;
+  if (name == "harmonic") return QualityMean::kHarmonic;
+  throw InputError("unknown quality mean '" + name + "'; use arithmetic or harmonic");
+}
+
+std::string QualityMeanName(QualityMean mean) {
+  return mean == QualityMean::kArithmetic ? "arithmetic" : "harmonic";
+}
+
+double MapQuality(int num_frames, int num_key_images, const std::vector<double>& link_similarities,
+                  QualityMean mean) {
+  if (num_frames <= 0) return 0.0;
+  const double compression = 1.0 - static_cast<double>(num_key_images) / num_frames;
+  const double similarity =
+      link_similarities.empty()
+          ? 0.0
+          : std::accumulate(link_similarities.begin(), link_similarities.end(), 0.0) / link_similarities.size();
+  if (mean == QualityMean::kArithmetic) return 0.5 * (compression + similarity);
+  return compression + similarity > 0 ? 2.0 * compression * similarity / (compression + similarity) : 0.0;
+}
+
+MapStatistics ComputeStatistics(const VisualMap& map, QualityMean mean) {
+  MapStatistics s;
+  s.num_frames = map.num_frames;
+  s.num_key_images = static_cast<int>(map.key_images.size());
+  std::vector<double> similarities;
+  long total_verified = 0;
+  for (const Link& l : map.links) {
+    similarities.push_back(l.similarity);
+    total_verified += l.num_verified;
+    s.broken_links += l.broken ? 1 : 0;
+  }
+  if (!map.links.empty()) {
+    auto [lo, hi] = std::minmax_element(map.links.begin(), map.links.end(),
+                                        [](const Link& a, const Link& b) { return a.num_verified < b.num_verified; });
+    s.min_verified = lo->num_verified;
+    s.max_verified = hi->num_verified;
+    s.mean_verified = static_cast<double>(total_verified) / map.links.size();
+    s.mean_similarity = std::accumulate(similarities.begin(), similarities.end(), 0.0) / similarities.size();
+  }
+  s.quality = MapQuality(s.num_frames, s.num_key_images, similarities, mean);
+  return s;
+}
+
+}  // namespace vmap

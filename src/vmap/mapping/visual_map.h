@@ -1,0 +1,86 @@
+#pragma once
+// The visual map: key images and the links between consecutive key images (García-Pintos et al. 2023).
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "vmap/sources/frame_source.h"
+
+namespace vmap {
+
+struct KeyImage {
+  int frame_index = 0;        // index in the processed sequence
+  int source_index = 0;       // index in the input
+  double timestamp = -1.0;    // seconds; -1 when the input has none
+  std::string source_name;    // image file name or "frame_000123"
+  std::string image_file;     // relative to the map directory, e.g. "keys/000012.png"
+  int num_features = 0;
+  std::string reason;         // why it was chosen (first frame, similarity drop, matching failed, final frame)
+};
+
+struct Correspondence {
+  cv::Point2f p0;  // in the link's first key image
+  cv::Point2f p1;  // in the link's second key image
+};
+
+// Two consecutive key images and what ties them together.
+struct Link {
+  int from_key = 0;    // index into VisualMap::key_images
+  int to_key = 0;
+  bool broken = false;           // the second key image did not pass the test against the first
+  double similarity = 0.0;       // S of the paper
+  int num_tentative = 0;         // matches that entered verification
+  int num_verified = 0;          // inliers of F
+  bool has_fundamental = false;
+  cv::Matx33d F = cv::Matx33d::zeros();  // x_to^T F x_from = 0, in pixels
+  // The tentative matches, verified ones first: [0, num_verified) are inliers, the rest were rejected.
+  std::vector<Correspondence> correspondences;
+};
+
+// One comparison S(key, frame) made while building: what a user looks at to choose tau.
+struct Evaluation {
+  int key_frame = 0;
+  int frame = 0;
+  double similarity = 0.0;
+  int num_tentative = 0;
+  int num_verified = 0;
+  bool matched = false;  // matching and verification succeeded (S is meaningful)
+};
+
+struct MapStatistics {
+  int num_frames = 0;           // n
+  int num_key_images = 0;       // m
+  int min_verified = 0;         // over links
+  int max_verified = 0;
+  double mean_verified = 0.0;
+  double mean_similarity = 0.0;
+  double quality = 0.0;         // Q
+  int broken_links = 0;
+};
+
+struct VisualMap {
+  SequenceInfo input;
+  std::string options_json;  // every option used, as JSON text
+  int num_frames = 0;
+  int skipped_frames = 0;    // corrupt frames skipped while reading
+  std::vector<KeyImage> key_images;
+  std::vector<Link> links;
+  std::vector<Evaluation> evaluations;
+  double quality = 0.0;
+  double seconds = 0.0;      // wall time of the build
+};
+
+enum class QualityMean { kArithmetic, kHarmonic };
+QualityMean ParseQualityMean(const std::string& name);   // "arithmetic", "harmonic"
+std::string QualityMeanName(QualityMean mean);
+
+// Q(M) = mean of (1 - m/n) and the mean similarity of consecutive key images (arithmetic by default:
+// the paper's formula and tables; its text says harmonic). With no link the mean similarity is 0.
+double MapQuality(int num_frames, int num_key_images, const std::vector<double>& link_similarities,
+                  QualityMean mean);
+
+MapStatistics ComputeStatistics(const VisualMap& map, QualityMean mean);
+
+}  // namespace vmap

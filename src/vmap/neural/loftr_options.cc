@@ -1,0 +1,22 @@
+#include "vmap/neural/loftr_options.h"
+
+#include "vmap/core/error.h"
+
+namespace vmap {
+
+void LoftrMatcherOptions::Check() const {
+  if (model != "outdoor" && model != "indoor" && model != "coarse") {
+    throw InputError("unknown LoFTR model '" + model + "'; use outdoor, indoor or coarse");
+  }
+  if (device != "cpu" && device != "cuda") {
+    throw InputError("unknown device '" + device + "'; use cpu or cuda");
+  }
+  if (longest_side < 32) {
+    throw InputError("--loftr-size " + std::to_string(longest_side) + " is too small; use at least 32 (default 640)");
+  }
+  if (threshold > 1.0) {
+    throw InputError("--loftr-threshold must be in (0, 1]");
+  }
+}
+
+}  // namespace vmap

@@ -1,0 +1,21 @@
+#pragma once
+// Options of the LoFTR matcher. This header does not include LibTorch, so any stage may use it.
+
+#include <string>
+
+namespace vmap {
+
+struct LoftrMatcherOptions {
+  std::string model = "coarse";  // preset: "outdoor", "indoor" or "coarse"
+  std::string weights;           // file; empty searches the weights directories (see `vmap weights`)
+  std::string device = "cpu";    // "cpu" or "cuda"
+  int longest_side = 640;        // images are resized to this longest side (multiple of the coarse stride)
+  double threshold = -1;         // coarse confidence threshold; < 0 uses the preset's
+  // Keep freed memory in the heap instead of returning large blocks to the OS (mallopt, process-wide):
+  // LoFTR's activations are re-allocated for every frame and page-fault when they come from fresh mmaps.
+  bool tune_malloc = true;
+
+  void Check() const;  // throws InputError naming the bad option
+};
+
+}  // namespace vmap

@@ -1,0 +1,177 @@
+#include "vmap/neural/weights_store.h"
+
+#include <cstdlib>
+#include <filesystem>
+#include <system_error>
+
+#include <unistd.h>
+#include <sys/wait.h>
+
+#include "vmap/core/error.h"
+#include "vmap/neural/sha1.h"
+
+namespace fs = std::filesystem;
+
+namespace vmap::neural {
+
+namespace {
+
+const char kCoarseSharedFile[] = "weights/loftr_coarse/loftr_coarse_teacher.pt";
+
+std::string Env(const char* name) {
+  const char* value = std::getenv(name);
+  return value ? std::string(value) : std::string();
+}
+
+bool IsFile(const std::string& path) {
+  std::error_code error;
+  return fs::is_regular_file(path, error);
+}
+
+// Runs argv without a shell (no quoting issues with paths); returns the exit status, -1 if it could not start.
+int RunProgram(const std::vector<std::string>& argv) {
+  const pid_t pid = fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    std::vector<char*> args;
+    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    execvp(args[0], args.data());
+    _exit(127);
+  }
+  int status = 0;
+  if (waitpid(pid, &status, 0) < 0) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+bool ProgramInstalled(const std::string& name) {
+  for (const char* dir : {"/usr/bin/", "/bin/", "/usr/local/bin/"}) {
+    if (access((std::string(dir) + name).c_str(), X_OK) == 0) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+const std::vector<KnownWeights>& KnownWeightFiles() {
+  static const std::vector<KnownWeights> files{
+      {"outdoor", "outdoor_ds.ckpt", "https://cmp.felk.cvut.cz/~mishkdmy/models/loftr_outdoor.ckpt",
+       "a8c45b0ab725f933c45f001effae25f22a4574dd",
+       "official LoFTR outdoor_ds.ckpt (zju3dv/LoFTR, Apache-2.0), 46 MB, mirrored by Kornia"},
+      {"indoor", "indoor_ds_new.ckpt", "https://cmp.felk.cvut.cz/~mishkdmy/models/loftr_indoor_ds_new.ckpt",
+       "e7cb02c2c629d50e24ec9ecacf4981904979907b",
+       "official LoFTR indoor_ds_new.ckpt (zju3dv/LoFTR, Apache-2.0), 46 MB, mirrored by Kornia"},
+      {"coarse", "loftr_coarse_teacher.pt", "", "",
+       "Coarse-LoFTR student (Kolkir/Coarse_LoFTR_TRT, Apache-2.0) as a plain state dict; ships in "
+       "shared/weights/loftr_coarse"},
+  };
+  return files;
+}
+
+const KnownWeights& KnownWeightsFor(const std::string& preset) {
+  for (const auto& known : KnownWeightFiles()) {
+    if (known.preset == preset) return known;
+  }
+  throw InputError("unknown LoFTR model '" + preset + "'; use outdoor, indoor or coarse");
+}
+
+std::string WeightsCacheDir() {
+  if (auto dir = Env(kWeightsDirEnv); !dir.empty()) return dir;
+  if (auto xdg = Env("XDG_CACHE_HOME"); !xdg.empty()) return xdg + "/vmap/weights";
+  if (auto home = Env("HOME"); !home.empty()) return home + "/.cache/vmap/weights";
+  return ".vmap-weights";
+}
+
+std::vector<std::string> WeightsSearchPaths(const std::string& preset) {
+  const auto& known = KnownWeightsFor(preset);
+  std::vector<std::string> paths{WeightsCacheDir() + "/" + known.file_name};
+  if (preset == "coarse") {
+    paths.push_back(std::string("../shared/") + kCoarseSharedFile);
+#ifdef VMAP_DEFAULT_SHARED_DIR
+    paths.push_back(std::string(VMAP_DEFAULT_SHARED_DIR) + "/" + kCoarseSharedFile);
+#endif
+  }
+  return paths;
+}
+
+std::string LocateWeights(const std::string& preset, const std::string& explicit_path) {
+  if (!explicit_path.empty()) {
+    if (IsFile(explicit_path)) return explicit_path;
+    throw InputError("LoFTR weights file '" + explicit_path + "' (--weights) does not exist");
+  }
+  const auto paths = WeightsSearchPaths(preset);
+  for (const auto& path : paths) {
+    if (IsFile(path)) return path;
+  }
+  std::string message = "no weights for --loftr-model " + preset + "; searched:";
+  for (const auto& path : paths) message += "\n  " + path;
+  const auto& known = KnownWeightsFor(preset);
+  if (!known.url.empty()) {
+    message += "\nGet them with `vmap weights --download " + preset + "` (" + known.url +
+               "), or pass a file with --weights. The cache directory can be moved with $" + kWeightsDirEnv + ".";
+  } else {
+    message += "\nPass the file with --weights, or copy it into the cache with `vmap weights --import FILE --model " +
+               preset + "`.";
+  }
+  throw InputError(message);
+}
+
+std::string ImportWeights(const std::string& source, const std::string& preset, const std::string& expected_blob_id,
+                          const std::string& cache_dir) {
+  const auto& known = KnownWeightsFor(preset);
+  if (!IsFile(source)) throw InputError("cannot import '" + source + "': no such file");
+  if (!expected_blob_id.empty()) {
+    const std::string actual = GitBlobId(source);
+    if (actual != expected_blob_id) {
+      throw InputError("'" + source + "' is not the expected " + preset + " weights: its git blob id is " + actual +
+                       ", expected " + expected_blob_id + ". The file is corrupt, truncated or another version.");
+    }
+  }
+  std::error_code error;
+  fs::create_directories(cache_dir, error);
+  if (error) throw InputError("cannot create the weights cache directory '" + cache_dir + "': " + error.message());
+  const std::string target = cache_dir + "/" + known.file_name;
+  const std::string temporary = target + ".part" + std::to_string(getpid());
+  fs::copy_file(source, temporary, fs::copy_options::overwrite_existing, error);
+  if (!error) fs::rename(temporary, target, error);
+  if (error) {
+    fs::remove(temporary);
+    throw InputError("cannot write '" + target + "': " + error.message());
+  }
+  return target;
+}
+
+std::string DownloadWeights(const std::string& preset, const std::string& cache_dir, bool verify) {
+  const auto& known = KnownWeightsFor(preset);
+  if (known.url.empty()) {
+    throw InputError("there is no download for --loftr-model " + preset + ": " + known.description);
+  }
+  std::error_code error;
+  fs::create_directories(cache_dir, error);
+  if (error) throw InputError("cannot create the weights cache directory '" + cache_dir + "': " + error.message());
+  const std::string download = cache_dir + "/" + known.file_name + ".download";
+  int status;
+  if (ProgramInstalled("curl")) {
+    status = RunProgram({"curl", "--fail", "--location", "--silent", "--show-error", "--output", download, known.url});
+  } else if (ProgramInstalled("wget")) {
+    status = RunProgram({"wget", "--quiet", "--output-document", download, known.url});
+  } else {
+    throw InputError("neither curl nor wget is installed; download " + known.url + " yourself and run `vmap weights "
+                     "--import FILE --model " + preset + "`");
+  }
+  if (status != 0) {
+    fs::remove(download, error);
+    throw InputError("downloading " + known.url + " failed (exit status " + std::to_string(status) +
+                     "); check the network, or fetch the file yourself and use `vmap weights --import`");
+  }
+  try {
+    const std::string cached = ImportWeights(download, preset, verify ? known.git_blob_id : "", cache_dir);
+    fs::remove(download, error);
+    return cached;
+  } catch (...) {
+    fs::remove(download, error);
+    throw;
+  }
+}
+
+}  // namespace vmap::neural

@@ -1,0 +1,44 @@
+#pragma once
+// Where LoFTR weights are found, and how they get there (`vmap weights`). No LibTorch here.
+//
+// Search order for a preset, unless --weights names a file:
+//   1. the cache directory: $VMAP_WEIGHTS_DIR if set, else $XDG_CACHE_HOME/vmap/weights, else ~/.cache/vmap/weights;
+//   2. coarse only: the Coarse-LoFTR student of the shared data folder (../shared/weights/loftr_coarse relative to
+//      the working directory, then the data folder vmap was built with).
+
+#include <string>
+#include <vector>
+
+namespace vmap::neural {
+
+inline constexpr char kWeightsDirEnv[] = "VMAP_WEIGHTS_DIR";
+
+struct KnownWeights {
+  std::string preset;       // "outdoor", "indoor", "coarse"
+  std::string file_name;    // name in the cache directory
+  std::string url;          // empty when there is nothing to download
+  std::string git_blob_id;  // of a published copy; empty when unknown
+  std::string description;
+};
+
+const std::vector<KnownWeights>& KnownWeightFiles();
+const KnownWeights& KnownWeightsFor(const std::string& preset);  // throws InputError for unknown presets
+
+std::string WeightsCacheDir();
+std::vector<std::string> WeightsSearchPaths(const std::string& preset);
+
+// The file to load: `explicit_path` if given (it must exist), else the first existing search path.
+// Throws InputError naming every place searched and how to get the weights.
+std::string LocateWeights(const std::string& preset, const std::string& explicit_path);
+
+// Copies `source` into `cache_dir` as the preset's file, after checking its git blob id against
+// `expected_blob_id` (skipped when empty). The copy appears atomically (temporary file + rename); on a
+// mismatch nothing is written and InputError gives both ids. Returns the cached path.
+std::string ImportWeights(const std::string& source, const std::string& preset, const std::string& expected_blob_id,
+                          const std::string& cache_dir);
+
+// Downloads the preset's file with curl or wget (whichever is installed) and imports it with its known id;
+// `verify` false skips the id check. Throws InputError when no tool is installed or the download fails.
+std::string DownloadWeights(const std::string& preset, const std::string& cache_dir, bool verify);
+
+}  // namespace vmap::neural

@@ -1,0 +1,815 @@
+#include "vmap/report/html_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "vmap/core/atomic_output.h"
+#include "vmap/core/error.h"
+#include "vmap/mapping/map_io.h"
+#include "vmap/report/html_util.h"
+#include "vmap/report/svg_plot.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+using nlohmann::json;
+using report::FormatExact;
+using report::FormatFixed;
+using report::HtmlEscape;
+using report::PlotSeries;
+using report::SvgPlot;
+using report::UrlPath;
+
+namespace {
+
+constexpr const char* kBlue = "#1f77b4";
+constexpr const char* kOrange = "#e07b00";
+constexpr const char* kGreen = "#2a9d3a";
+constexpr const char* kRed = "#d62728";
+constexpr const char* kGrey = "#8a8a8a";
+
+// Any request to the network (or to anything but files next to the page) is refused by the browser.
+constexpr const char* kContentSecurityPolicy =
+    "default-src 'none'; img-src 'self' data:; media-src 'self'; style-src 'unsafe-inline'; "
+    "script-src 'unsafe-inline'";
+
+constexpr const char* kStyle = R"css(
+:root { --fg: #1d1d1f; --muted: #666; --line: #ddd; --accent: #1f77b4; --bad: #c62828; --good: #2a9d3a; }
+* { box-sizing: border-box; }
+body { margin: 0; font: 14px/1.45 system-ui, -apple-system, "Segoe UI", Roboto, "Helvetica Neue", Arial, sans-serif;
+       color: var(--fg); background: #fafafa; }
+header { background: #20262e; color: #fff; padding: 18px 28px; }
+header h1 { margin: 0 0 4px; font-size: 22px; }
+header p { margin: 0; color: #c9d1d9; word-break: break-all; }
+nav { position: sticky; top: 0; z-index: 2; background: #fff; border-bottom: 1px solid var(--line); padding: 8px 28px; }
+nav a { margin-right: 18px; color: var(--accent); text-decoration: none; }
+main { padding: 8px 28px 40px; max-width: 1600px; }
+section { margin-top: 22px; }
+h2 { font-size: 18px; margin: 0 0 10px; border-bottom: 2px solid var(--line); padding-bottom: 4px; }
+.cards { display: flex; flex-wrap: wrap; gap: 10px; margin-bottom: 12px; }
+.card { background: #fff; border: 1px solid var(--line); border-radius: 6px; padding: 8px 14px; min-width: 120px; }
+.card .value { font-size: 20px; font-weight: 600; }
+.card .label { color: var(--muted); font-size: 12px; }
+table { border-collapse: collapse; background: #fff; }
+th, td { border: 1px solid var(--line); padding: 4px 10px; text-align: left; vertical-align: top; }
+td.num, th.num { text-align: right; font-variant-numeric: tabular-nums; }
+table.summary th { width: 220px; background: #f3f3f3; font-weight: 600; }
+tr.best td { background: #e8f5e9; font-weight: 600; }
+tr.broken td { background: #fdecea; }
+.plot { max-width: 100%; height: auto; background: #fff; border: 1px solid var(--line); border-radius: 6px; }
+.note { color: var(--muted); margin: 6px 0; }
+.strip { display: grid; grid-template-columns: repeat(auto-fill, minmax(168px, 1fr)); gap: 8px; }
+.strip figure { margin: 0; background: #fff; border: 1px solid var(--line); border-radius: 4px; overflow: hidden; }
+.strip img { display: block; width: 100%; height: auto; background: #eee; }
+.strip figcaption { padding: 3px 6px; font-size: 12px; color: var(--muted); }
+.strip figcaption b { color: var(--fg); }
+.links { display: grid; grid-template-columns: repeat(auto-fill, minmax(520px, 1fr)); gap: 12px; }
+.match-figure { margin: 0; background: #fff; border: 1px solid var(--line); border-radius: 4px; overflow: hidden; }
+.match-figure img { display: block; width: 100%; height: auto; background: #eee; }
+.match-figure figcaption { padding: 4px 8px; font-size: 13px; }
+.match-figure.broken { border: 3px solid var(--bad); }
+.match-figure.broken figcaption { background: var(--bad); color: #fff; font-weight: 600; }
+.legend-verified { color: var(--good); font-weight: 600; }
+.legend-rejected { color: #0040ff; font-weight: 600; }
+.route { display: flex; gap: 18px; align-items: flex-start; flex-wrap: wrap; }
+.route figure { margin: 0; width: 480px; max-width: 100%; }
+.route img, .route video { display: block; width: 100%; height: auto; background: #eee; border: 1px solid var(--line); }
+.route .controls { display: flex; gap: 8px; align-items: center; margin-top: 6px; }
+.route input[type=range] { flex: 1; }
+button { font: inherit; padding: 4px 14px; }
+pre { background: #fff; border: 1px solid var(--line); padding: 10px; overflow: auto; font-size: 12px; }
+footer { color: var(--muted); padding: 0 28px 20px; font-size: 12px; }
+)css";
+
+// Plays the key images in order (the route preview) and, when the page is opened as report.html#selfcheck,
+// loads every image and records what it found in a <pre id="vmap-selfcheck"> for automated checks.
+constexpr const char* kScript = R"js(
+(function () {
+  'use strict';
+  var player = document.getElementById('route-image');
+  if (player) {
+    var thumbs = Array.prototype.slice.call(document.querySelectorAll('.strip figure img'));
+    var slider = document.getElementById('route-slider');
+    var label = document.getElementById('route-label');
+    var button = document.getElementById('route-play');
+    var current = 0, timer = null;
+    var show = function (i) {
+      if (!thumbs.length) return;
+      current = (i + thumbs.length) % thumbs.length;
+      player.src = thumbs[current].getAttribute('src');
+      slider.value = String(current);
+      label.textContent = thumbs[current].getAttribute('data-label');
+    };
+    var stop = function () { if (timer) { clearInterval(timer); timer = null; button.textContent = 'Play'; } };
+    button.addEventListener('click', function () {
+      if (timer) { stop(); return; }
+      button.textContent = 'Pause';
+      timer = setInterval(function () { show(current + 1); }, 400);
+    });
+    slider.addEventListener('input', function () { stop(); show(parseInt(slider.value, 10)); });
+    show(0);
+  }
+  if (location.hash !== '#selfcheck') return;
+  var images = Array.prototype.slice.call(document.images);
+  images.forEach(function (img) { img.loading = 'eager'; });
+  var videos = Array.prototype.slice.call(document.querySelectorAll('video'));
+  var waits = images.map(function (img) {
+    if (img.complete && img.naturalWidth > 0) return Promise.resolve();
+    return new Promise(function (done) {
+      img.addEventListener('load', done);
+      img.addEventListener('error', done);
+      if (img.decode) img.decode().then(done, done);
+    });
+  }).concat(videos.map(function (video) {
+    if (video.readyState >= 2) return Promise.resolve();
+    return new Promise(function (done) {
+      video.addEventListener('loadeddata', done);
+      video.addEventListener('error', done);
+      video.preload = 'auto';
+      video.load();
+    });
+  }));
+  Promise.all(waits).then(function () {
+    var broken = images.filter(function (img) { return !(img.naturalWidth > 0); })
+                       .map(function (img) { return img.getAttribute('src'); });
+    var result = document.createElement('pre');
+    result.id = 'vmap-selfcheck';
+    result.textContent = JSON.stringify({
+      images: images.length,
+      broken: broken,
+      videos: videos.length,
+      broken_videos: videos.filter(function (v) { return !(v.readyState >= 2 && v.videoWidth > 0); })
+                           .map(function (v) { return v.getAttribute('src'); }),
+      match_figures: document.querySelectorAll('figure.match-figure').length,
+      key_images: document.querySelectorAll('.strip figure').length,
+      plots: document.querySelectorAll('svg.plot').length
+    });
+    document.body.appendChild(result);
+  });
+})();
+)js";
+
+std::string PageStart(const std::string& title, const std::string& heading, const std::string& subtitle,
+                      const std::vector<std::pair<std::string, std::string>>& nav) {
+  std::ostringstream html;
+  html << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+       << "<meta http-equiv=\"Content-Security-Policy\" content=\"" << kContentSecurityPolicy << "\">\n"
+       << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
+       << "<meta name=\"generator\" content=\"vmap " << VMAP_VERSION << "\">\n"
+       << "<title>" << HtmlEscape(title) << "</title>\n<style>" << kStyle << "</style>\n</head>\n<body>\n"
+       << "<header><h1>" << HtmlEscape(heading) << "</h1><p>" << HtmlEscape(subtitle) << "</p></header>\n<nav>";
+  for (const auto& [anchor, text] : nav) html << "<a href=\"#" << anchor << "\">" << HtmlEscape(text) << "</a>";
+  html << "</nav>\n<main>\n";
+  return html.str();
+}
+
+std::string PageEnd() {
+  return std::string("</main>\n<footer>Written by vmap ") + VMAP_VERSION +
+         ". This page works offline: everything it shows is in this file and the folder next to it.</footer>\n"
+         "<script>" + kScript + "</script>\n</body>\n</html>\n";
+}
+
+// The first value named `name` anywhere in the options (they may be grouped per stage).
+const json* FindOption(const json& node, const std::string& name) {
+  if (node.is_object()) {
+    auto it = node.find(name);
+    if (it != node.end()) return &*it;
+    for (const auto& [key, value] : node.items()) {
+      if (const json* found = FindOption(value, name)) return found;
+    }
+  }
+  return nullptr;
+}
+
+json ParseOptions(const std::string& text) {
+  try {
+    json options = json::parse(text.empty() ? "{}" : text);
+    return options.is_object() ? options : json::object();
+  } catch (const json::exception&) {
+    return json::object();
+  }
+}
+
+// An option as one line: a grouped option (matcher, verifier) reads "orb (features 2000, ...)".
+std::string OptionText(const json& options, const std::string& name) {
+  const json* value = FindOption(options, name);
+  if (!value || value->is_null()) return "not recorded";
+  if (value->is_string()) return value->get<std::string>();
+  if (!value->is_object()) return value->dump();
+  std::string headline;
+  for (const char* key : {"name", "method", "type", "matcher"}) {
+    auto it = value->find(key);
+    if (it != value->end() && it->is_string()) {
+      headline = it->get<std::string>();
+      break;
+    }
+  }
+  std::string details;
+  for (const auto& [key, item] : value->items()) {
+    if (item.is_structured() || (item.is_string() && item.get<std::string>() == headline)) continue;
+    details += (details.empty() ? "" : ", ") + key + " " + (item.is_string() ? item.get<std::string>() : item.dump());
+  }
+  if (headline.empty()) return details.empty() ? value->dump() : details;
+  return details.empty() ? headline : headline + " (" + details + ")";
+}
+
+std::string TimestampText(double seconds) { return seconds < 0 ? "" : FormatFixed(seconds, 2) + " s"; }
+
+std::string SizeText(const cv::Size& size) {
+  return size.area() > 0 ? std::to_string(size.width) + " x " + std::to_string(size.height) : "unknown";
+}
+
+std::string DurationText(double seconds) {
+  if (seconds < 60) return FormatFixed(seconds, 1) + " s";
+  const int minutes = static_cast<int>(seconds / 60);
+  return std::to_string(minutes) + " min " + FormatFixed(seconds - 60.0 * minutes, 0) + " s";
+}
+
+std::string Card(const std::string& value, const std::string& label) {
+  return "<div class=\"card\"><div class=\"value\">" + HtmlEscape(value) + "</div><div class=\"label\">" +
+         HtmlEscape(label) + "</div></div>";
+}
+
+std::string Row(const std::string& name, const std::string& value_html) {
+  return "<tr><th>" + HtmlEscape(name) + "</th><td>" + value_html + "</td></tr>\n";
+}
+
+std::string Numbered(int index) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "%06d.jpg", index);
+  return name;
+}
+
+void WriteJpeg(const fs::path& file, const cv::Mat& image, int quality) {
+  if (!cv::imwrite(file.string(), image, {cv::IMWRITE_JPEG_QUALITY, quality})) {
+    throw InputError("cannot write '" + file.string() + "'; check that the map directory is writable");
+  }
+}
+
+cv::Mat ScaledToWidth(const cv::Mat& image, int width) {
+  if (width <= 0 || image.cols <= width) return image;
+  cv::Mat scaled;
+  const int height = std::max(1, static_cast<int>(std::lround(static_cast<double>(image.rows) * width / image.cols)));
+  cv::resize(image, scaled, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+  return scaled;
+}
+
+bool IsInside(const fs::path& child, const fs::path& parent) {
+  auto c = child.begin();
+  for (auto p = parent.begin(); p != parent.end(); ++p, ++c) {
+    if (p->empty() && std::next(p) == parent.end()) break;  // trailing separator
+    if (c == child.end() || *c != *p) return false;
+  }
+  return true;
+}
+
+// The S(key, frame) plot: one line per key image over the frames compared with it, tau, the key images
+// and the similarity of each link at the frame that became the next key image.
+std::string SimilarityPlot(const VisualMap& map, const json& options) {
+  SvgPlot plot("similarity-plot", "frame index", "similarity S(key, frame)");
+  plot.SetIntegerX(true);
+  double y_high = 1.0;
+  std::map<int, std::vector<const Evaluation*>> by_key;
+  std::vector<int> key_order;
+  for (const Evaluation& e : map.evaluations) {
+    if (!by_key.count(e.key_frame)) key_order.push_back(e.key_frame);
+    by_key[e.key_frame].push_back(&e);
+    y_high = std::max(y_high, e.similarity);
+  }
+  for (const Link& l : map.links) y_high = std::max(y_high, l.similarity);
+  plot.SetYRange(0.0, y_high);
+  const int last_frame = std::max(map.num_frames - 1, 1);
+  plot.SetXRange(0.0, last_frame);
+
+  PlotSeries lines;
+  lines.name = "S(key, frame)";
+  lines.color = kBlue;
+  lines.css_class = "evaluations";
+  PlotSeries failed;
+  failed.kind = PlotSeries::Kind::kCrosses;
+  failed.name = "matching failed";
+  failed.color = kRed;
+  failed.css_class = "failed";
+  failed.segments.emplace_back();
+  for (int key_frame : key_order) {
+    std::vector<const Evaluation*>& evaluations = by_key[key_frame];
+    std::stable_sort(evaluations.begin(), evaluations.end(),
+                     [](const Evaluation* a, const Evaluation* b) { return a->frame < b->frame; });
+    std::vector<cv::Point2d> points;
+    for (const Evaluation* e : evaluations) {
+      points.emplace_back(e->frame, e->similarity);
+      if (!e->matched) failed.segments[0].emplace_back(e->frame, e->similarity);
+    }
+    lines.segments.push_back(std::move(points));
+    lines.segment_attributes.push_back("data-key-frame=\"" + std::to_string(key_frame) + "\"");
+  }
+
+  PlotSeries keys;
+  keys.kind = PlotSeries::Kind::kVerticalRules;
+  keys.name = "key image";
+  keys.color = kGrey;
+  keys.css_class = "key-images";
+  keys.segments.emplace_back();
+  for (const KeyImage& k : map.key_images) keys.segments[0].emplace_back(k.frame_index, 0.0);
+
+  PlotSeries links, broken;
+  links.kind = broken.kind = PlotSeries::Kind::kMarkers;
+  links.name = "link S (next key image)";
+  links.color = kGreen;
+  links.css_class = "links";
+  broken.name = "broken link";
+  broken.color = kRed;
+  broken.css_class = "broken-links";
+  broken.marker_radius = 5.0;
+  for (size_t i = 0; i < map.links.size(); ++i) {
+    const Link& l = map.links[i];
+    PlotSeries& target = l.broken ? broken : links;
+    target.segments.push_back({cv::Point2d(map.key_images[l.to_key].frame_index, l.similarity)});
+    target.segment_attributes.push_back("data-link=\"" + std::to_string(i) + "\"");
+    target.point_titles.push_back(LinkTitle(map, static_cast<int>(i)) + ": S = " + FormatFixed(l.similarity, 3));
+  }
+
+  plot.Add(keys);
+  if (!lines.segments.empty()) plot.Add(lines);
+  if (!failed.segments[0].empty()) plot.Add(failed);
+  if (const json* tau = FindOption(options, "tau"); tau && tau->is_number()) {
+    PlotSeries rule;
+    rule.kind = PlotSeries::Kind::kHorizontalRule;
+    rule.name = "tau = " + FormatExact(tau->get<double>());
+    rule.color = kOrange;
+    rule.css_class = "tau";
+    rule.segments.push_back({cv::Point2d(0.0, tau->get<double>())});
+    rule.segment_attributes.push_back("data-tau=\"" + FormatExact(tau->get<double>()) + "\"");
+    plot.Add(rule);
+  }
+  if (!links.segments.empty()) plot.Add(links);
+  if (!broken.segments.empty()) plot.Add(broken);
+  return plot.Render();
+}
+
+std::string VerifiedPlot(const VisualMap& map) {
+  SvgPlot plot("verified-plot", "frame index of the link's second key image", "verified matches");
+  plot.SetSize(960, 260);
+  plot.SetIntegerX(true);
+  plot.SetIntegerY(true);
+  plot.SetXRange(0.0, std::max(map.num_frames - 1, 1));
+  PlotSeries line;
+  line.name = "verified matches per link";
+  line.color = kGreen;
+  line.css_class = "verified";
+  line.segments.emplace_back();
+  PlotSeries tentative = line;
+  tentative.name = "tentative matches";
+  tentative.color = kGrey;
+  tentative.css_class = "tentative";
+  double high = 10.0;
+  for (const Link& l : map.links) {
+    const double x = map.key_images[l.to_key].frame_index;
+    line.segments[0].emplace_back(x, l.num_verified);
+    tentative.segments[0].emplace_back(x, l.num_tentative);
+    high = std::max<double>(high, l.num_tentative);
+  }
+  plot.SetYRange(0.0, high);
+  PlotSeries dots = line;
+  dots.kind = PlotSeries::Kind::kMarkers;
+  dots.name.clear();
+  dots.marker_radius = 2.5;
+  plot.Add(tentative);
+  plot.Add(line);
+  plot.Add(dots);
+  return plot.Render();
+}
+
+// The key images in order as a short video: H.264 in MP4 where OpenCV's FFmpeg has an encoder for it, else
+// VP9 in WebM; both play in current browsers. Without either, the page keeps only the step-through player.
+class RouteVideo {
+ public:
+  RouteVideo(const fs::path& directory, const cv::Size& frame_size, double fps)
+      // H.264 with 4:2:0 sampling needs even sides.
+      : size_(std::max(2, frame_size.width & ~1), std::max(2, frame_size.height & ~1)) {
+    const std::pair<const char*, int> candidates[] = {{"route.mp4", cv::VideoWriter::fourcc('a', 'v', 'c', '1')},
+                                                      {"route.webm", cv::VideoWriter::fourcc('V', 'P', '9', '0')}};
+    for (const auto& [name, fourcc] : candidates) {
+      try {
+        if (writer_.open((directory / name).string(), cv::CAP_FFMPEG, fourcc, fps, size_)) {
+          file_name_ = name;
+          path_ = directory / name;
+          return;
+        }
+      } catch (const cv::Exception&) {
+      }
+      std::error_code ignored;
+      fs::remove(directory / name, ignored);
+    }
+  }
+
+  void Add(const cv::Mat& image, const std::string& label) {
+    if (!writer_.isOpened()) return;
+    cv::Mat frame;
+    cv::resize(image, frame, size_, 0, 0, cv::INTER_AREA);
+    const double scale = std::clamp(size_.width / 700.0, 0.35, 1.0);
+    cv::putText(frame, label, cv::Point(7, size_.height - 9), cv::FONT_HERSHEY_SIMPLEX, scale, cv::Scalar::all(0), 3,
+                cv::LINE_AA);
+    cv::putText(frame, label, cv::Point(7, size_.height - 9), cv::FONT_HERSHEY_SIMPLEX, scale,
+                cv::Scalar::all(255), 1, cv::LINE_AA);
+    writer_.write(frame);
+    ++frames_;
+  }
+
+  // Closes the file; false (and no file) when nothing usable was written.
+  bool Finish() {
+    if (!writer_.isOpened()) return false;
+    writer_.release();
+    std::error_code ec;
+    if (frames_ > 0 && fs::file_size(path_, ec) > 0 && !ec) return true;
+    fs::remove(path_, ec);
+    return false;
+  }
+
+  const std::string& file_name() const { return file_name_; }
+  const cv::Size& size() const { return size_; }
+
+ private:
+  cv::Size size_;
+  cv::VideoWriter writer_;
+  std::string file_name_;
+  fs::path path_;
+  int frames_ = 0;
+};
+
+}  // namespace
+
+fs::path KeyImagePath(const fs::path& map_directory, const KeyImage& key) {
+  const fs::path relative(key.image_file);
+  bool safe = !key.image_file.empty() && !relative.is_absolute() && !relative.has_root_name() &&
+              !relative.has_root_directory();
+  for (const auto& part : relative) safe = safe && part != "..";
+  if (!safe) {
+    throw InputError("map '" + map_directory.string() + "': key image path '" + key.image_file +
+                     "' points outside the map directory; rebuild the map with `vmap build`");
+  }
+  const fs::path file = map_directory / relative;
+  if (!fs::exists(file)) {
+    throw InputError("map '" + map_directory.string() + "' is incomplete: key image '" + file.string() +
+                     "' is missing; rebuild the map with `vmap build`");
+  }
+  // A symbolic link inside the map could still lead elsewhere.
+  std::error_code ec;
+  const fs::path real_file = fs::canonical(file, ec);
+  const fs::path real_directory = fs::canonical(map_directory, ec);
+  if (ec || !IsInside(real_file, real_directory)) {
+    throw InputError("map '" + map_directory.string() + "': key image '" + key.image_file +
+                     "' resolves outside the map directory; rebuild the map with `vmap build`");
+  }
+  return file;
+}
+
+cv::Mat ReadKeyImage(const fs::path& map_directory, const KeyImage& key) {
+  const fs::path file = KeyImagePath(map_directory, key);
+  cv::Mat image = cv::imread(file.string(), cv::IMREAD_COLOR);
+  if (image.empty()) {
+    throw InputError("key image '" + file.string() + "' cannot be decoded; rebuild the map with `vmap build`");
+  }
+  return image;
+}
+
+std::string LinkTitle(const VisualMap& map, int link_index) {
+  const Link& l = map.links.at(link_index);
+  return "key " + std::to_string(l.from_key) + " (frame " + std::to_string(map.key_images.at(l.from_key).frame_index) +
+         ") -> key " + std::to_string(l.to_key) + " (frame " + std::to_string(map.key_images.at(l.to_key).frame_index) +
+         ")";
+}
+
+cv::Mat DrawMapLink(const fs::path& map_directory, const VisualMap& map, int link_index,
+                    const MatchFigureOptions& options) {
+  if (link_index < 0 || link_index >= static_cast<int>(map.links.size())) {
+    throw InputError("link " + std::to_string(link_index) + " does not exist: map '" + map_directory.string() +
+                     "' has " + std::to_string(map.links.size()) + " links" +
+                     (map.links.empty() ? "" : " (0 to " + std::to_string(map.links.size() - 1) + ")"));
+  }
+  const Link& link = map.links[link_index];
+  MatchFigureOptions with_title = options;
+  if (with_title.title.empty()) with_title.title = "link " + std::to_string(link_index) + ": " + LinkTitle(map, link_index);
+  return DrawMatchFigure(ReadKeyImage(map_directory, map.key_images[link.from_key]),
+                         ReadKeyImage(map_directory, map.key_images[link.to_key]), link, with_title);
+}
+
+void WriteMapReport(const fs::path& map_directory) { WriteMapReport(map_directory, MapReportOptions{}); }
+
+void WriteMapReport(const fs::path& map_directory, const MapReportOptions& report_options) {
+  const VisualMap map = ReadMap(map_directory);
+  // Every image path is checked before anything is written.
+  for (const KeyImage& k : map.key_images) KeyImagePath(map_directory, k);
+  const json options = ParseOptions(map.options_json);
+  const MapStatistics stats = ComputeStatistics(
+      map, OptionText(options, "quality_mean") == "harmonic" ? QualityMean::kHarmonic : QualityMean::kArithmetic);
+
+  AtomicOutputDirectory assets(map_directory / kReportAssetsDirectory);
+  fs::create_directories(assets.path() / "keys");
+  fs::create_directories(assets.path() / "links");
+  const std::string assets_url = std::string(kReportAssetsDirectory) + "/";
+
+  // Key images are decoded once each; consecutive links share one, so keep the last two.
+  std::map<int, cv::Mat> cache;
+  auto key_image = [&](int index) -> const cv::Mat& {
+    auto it = cache.find(index);
+    if (it != cache.end()) return it->second;
+    while (cache.size() >= 2) cache.erase(cache.begin());
+    return cache[index] = ReadKeyImage(map_directory, map.key_images[index]);
+  };
+
+  std::vector<cv::Size> thumb_sizes;
+  std::unique_ptr<RouteVideo> video;
+  for (size_t i = 0; i < map.key_images.size(); ++i) {
+    const cv::Mat thumb = ScaledToWidth(key_image(static_cast<int>(i)), report_options.thumbnail_width);
+    WriteJpeg(assets.path() / "keys" / Numbered(static_cast<int>(i)), thumb, report_options.jpeg_quality);
+    thumb_sizes.push_back(thumb.size());
+    if (i == 0 && report_options.route_video && map.key_images.size() > 1) {
+      video = std::make_unique<RouteVideo>(assets.path(), thumb.size(), report_options.route_fps);
+    }
+    if (video) {
+      video->Add(thumb, "key " + std::to_string(i) + "  frame " + std::to_string(map.key_images[i].frame_index));
+    }
+  }
+  std::string video_file;
+  cv::Size video_size;
+  if (video && video->Finish()) {
+    video_file = video->file_name();
+    video_size = video->size();
+  }
+  std::vector<cv::Size> figure_sizes;
+  for (size_t i = 0; i < map.links.size(); ++i) {
+    const Link& l = map.links[i];
+    MatchFigureOptions figure_options;
+    figure_options.max_width = report_options.figure_width;
+    figure_options.title = "link " + std::to_string(i) + ": " + LinkTitle(map, static_cast<int>(i));
+    const cv::Mat figure = DrawMatchFigure(key_image(l.from_key), key_image(l.to_key), l, figure_options);
+    WriteJpeg(assets.path() / "links" / Numbered(static_cast<int>(i)), figure, report_options.jpeg_quality);
+    figure_sizes.push_back(figure.size());
+  }
+
+  const int n = map.num_frames, m = static_cast<int>(map.key_images.size());
+  const std::string input_name = map.input.path.empty() ? map_directory.filename().string() : map.input.path;
+  std::ostringstream html;
+  html << PageStart("vmap report: " + input_name, "Visual map of " + input_name,
+                    std::to_string(m) + " key images from " + std::to_string(n) + " frames, Q = " +
+                        FormatFixed(map.quality, 3),
+                    {{"summary", "Summary"},
+                     {"similarity", "Similarity"},
+                     {"key-images", "Key images"},
+                     {"route-preview", "Route preview"},
+                     {"links", "Match figures"},
+                     {"options", "Options"}});
+
+  // Summary.
+  html << "<section id=\"summary\"><h2>Summary</h2>\n<div class=\"cards\">"
+       << Card(std::to_string(n), "frames (n)") << Card(std::to_string(m), "key images (m)")
+       << Card(n > 0 ? FormatFixed(100.0 * m / n, 1) + " %" : "n/a", "of the frames")
+       << Card(FormatFixed(map.quality, 3), "quality Q") << Card(FormatFixed(stats.mean_similarity, 3), "mean S")
+       << Card(std::to_string(stats.broken_links), "broken links") << "</div>\n<table class=\"summary\">\n";
+  html << Row("Input", HtmlEscape(map.input.path))
+       << Row("Format", HtmlEscape(SourceFormatName(map.input.format)))
+       << Row("Frame size", HtmlEscape(SizeText(map.input.frame_size)) +
+                                (map.input.native_size != map.input.frame_size && map.input.native_size.area() > 0
+                                     ? " (native " + HtmlEscape(SizeText(map.input.native_size)) + ")"
+                                     : ""))
+       << (map.input.fps > 0 ? Row("Frame rate", FormatFixed(map.input.fps, 2) + " fps") : "")
+       << Row("Matcher", HtmlEscape(OptionText(options, "matcher")))
+       << Row("Verifier", HtmlEscape(OptionText(options, "verifier")))
+       << Row("Threshold \u03c4", HtmlEscape(OptionText(options, "tau")))
+       << Row("Frames n", std::to_string(n) +
+                              (map.skipped_frames > 0 ? " (" + std::to_string(map.skipped_frames) +
+                                                            " unreadable frames skipped)"
+                                                      : ""))
+       << Row("Key images m", std::to_string(m) + (n > 0 ? " (" + FormatFixed(100.0 * m / n, 1) + " % of the frames)" : ""))
+       << Row("Links", std::to_string(map.links.size()) + ", " + std::to_string(stats.broken_links) + " broken")
+       << Row("Verified matches per link",
+              map.links.empty() ? std::string("no links")
+                                : "min " + std::to_string(stats.min_verified) + ", max " +
+                                      std::to_string(stats.max_verified) + ", mean " +
+                                      FormatFixed(stats.mean_verified, 1))
+       << Row("Mean similarity of links", FormatFixed(stats.mean_similarity, 3))
+       << Row("Quality Q", FormatFixed(map.quality, 4))
+       << Row("Build time", DurationText(map.seconds) +
+                                (map.seconds > 0 && n > 0 ? " (" + FormatFixed(n / map.seconds, 1) + " frames/s)" : ""))
+       << "</table>\n</section>\n";
+
+  // Plots.
+  html << "<section id=\"similarity\"><h2>Similarity along the sequence</h2>\n";
+  if (map.evaluations.empty()) {
+    html << "<p class=\"note\">This map records no per-frame similarities; only its links are shown. Rebuild it "
+            "with a current vmap to see S for every frame.</p>\n";
+  } else {
+    html << "<p class=\"note\">Each blue line follows S(key, frame) from one key image over the frames compared "
+            "with it; a new key image is chosen where S drops below &tau;. A lower &tau; gives fewer key images "
+            "with fewer shared matches.</p>\n";
+  }
+  html << SimilarityPlot(map, options);
+  if (!map.links.empty()) html << VerifiedPlot(map);
+  html << "</section>\n";
+
+  // Key-image strip.
+  html << "<section id=\"key-images\"><h2>Key images (" << m << ")</h2>\n<div class=\"strip\">\n";
+  for (int i = 0; i < m; ++i) {
+    const KeyImage& k = map.key_images[i];
+    const std::string timestamp = TimestampText(k.timestamp);
+    const std::string label = "key " + std::to_string(i) + " | frame " + std::to_string(k.frame_index) +
+                              (timestamp.empty() ? "" : " | t = " + timestamp);
+    html << "<figure id=\"key-" << i << "\" title=\"" << HtmlEscape(k.source_name + (k.reason.empty() ? "" : ": " + k.reason))
+         << "\"><img loading=\"lazy\" decoding=\"async\" src=\"" << UrlPath(assets_url + "keys/" + Numbered(i))
+         << "\" width=\"" << thumb_sizes[i].width << "\" height=\"" << thumb_sizes[i].height << "\" alt=\"key image "
+         << i << "\" data-label=\"" << HtmlEscape(label) << "\"><figcaption><b>#" << i << "</b> frame "
+         << k.frame_index << (timestamp.empty() ? "" : " &middot; " + HtmlEscape(timestamp)) << "</figcaption></figure>\n";
+  }
+  html << "</div>\n</section>\n";
+
+  html << "<section id=\"route-preview\"><h2>Route preview</h2>\n<div class=\"route\">\n";
+  if (!video_file.empty()) {
+    html << "<figure><video id=\"route-video\" src=\"" << UrlPath(assets_url + video_file) << "\" width=\""
+         << video_size.width << "\" height=\"" << video_size.height
+         << "\" controls muted loop playsinline preload=\"metadata\"></video><figcaption class=\"note\">The key images "
+            "in order, " << FormatExact(report_options.route_fps) << " per second (" << HtmlEscape(video_file)
+         << "): what a robot following this map expects to see.</figcaption></figure>\n";
+  }
+  if (m > 0) {
+    html << "<figure><img id=\"route-image\" alt=\"key image\" width=\"" << thumb_sizes[0].width << "\" height=\""
+         << thumb_sizes[0].height << "\" src=\"" << UrlPath(assets_url + "keys/" + Numbered(0))
+         << "\"><figcaption><div class=\"controls\"><button id=\"route-play\" type=\"button\">Play</button>"
+         << "<input id=\"route-slider\" type=\"range\" min=\"0\" max=\"" << m - 1 << "\" value=\"0\" "
+         << "aria-label=\"key image\"></div><span id=\"route-label\" class=\"note\"></span></figcaption></figure>\n";
+  }
+  html << "</div>\n</section>\n";
+
+  // Match figures.
+  html << "<section id=\"links\"><h2>Match figures (" << map.links.size() << " links)</h2>\n"
+       << "<p class=\"note\">Consecutive key images side by side: <span class=\"legend-verified\">verified matches "
+          "as green lines</span>, <span class=\"legend-rejected\">rejected tentative matches as blue points</span>. "
+          "Broken links (the second key image failed the test against the first) have a red frame.</p>\n"
+       << "<div class=\"links\">\n";
+  for (size_t i = 0; i < map.links.size(); ++i) {
+    const Link& l = map.links[i];
+    html << "<figure class=\"match-figure" << (l.broken ? " broken" : "") << "\" id=\"link-" << i
+         << "\" data-from=\"" << l.from_key << "\" data-to=\"" << l.to_key << "\"><img loading=\"lazy\" "
+         << "decoding=\"async\" src=\"" << UrlPath(assets_url + "links/" + Numbered(static_cast<int>(i)))
+         << "\" width=\"" << figure_sizes[i].width << "\" height=\"" << figure_sizes[i].height << "\" alt=\"link " << i
+         << "\"><figcaption>" << (l.broken ? "BROKEN &middot; " : "") << "Link " << i << ": "
+         << HtmlEscape(LinkTitle(map, static_cast<int>(i))) << " &middot; S = " << FormatFixed(l.similarity, 3)
+         << " &middot; " << l.num_verified << " verified of " << l.num_tentative << " tentative</figcaption></figure>\n";
+  }
+  if (map.links.empty()) html << "<p class=\"note\">This map has a single key image: there are no links.</p>\n";
+  html << "</div>\n</section>\n";
+
+  html << "<section id=\"options\"><h2>Options</h2>\n<details><summary>Every option used to build this map"
+       << "</summary><pre>" << HtmlEscape(options.dump(2)) << "</pre></details>\n</section>\n";
+  html << PageEnd();
+
+  assets.Commit();
+  WriteFileAtomically(map_directory / kReportFileName, html.str());
+}
+
+namespace {
+
+// Where the page in `report_directory` should point for a map written at `map_directory`.
+std::string MapLink(const std::string& map_directory, const fs::path& report_directory) {
+  fs::path target(map_directory);
+  if (target.is_relative() && fs::exists(report_directory / target)) target = report_directory / target;
+  std::error_code ec;
+  const fs::path absolute_target = fs::weakly_canonical(fs::absolute(target), ec);
+  const fs::path absolute_base = fs::weakly_canonical(fs::absolute(report_directory), ec);
+  fs::path relative = absolute_target.lexically_relative(absolute_base);
+  if (relative.empty()) relative = absolute_target;
+  const fs::path page = fs::exists(absolute_target / kReportFileName) ? relative / kReportFileName
+                                                                       : relative / kMapFileName;
+  return UrlPath(page.generic_string());
+}
+
+}  // namespace
+
+void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
+  const json options = ParseOptions(sweep.options_json);
+  std::error_code ec;
+  fs::create_directories(directory, ec);
+  if (!fs::is_directory(directory)) {
+    throw InputError("cannot create the report directory '" + directory.string() + "'; choose another --report path");
+  }
+  const std::string input_name = sweep.input.path.empty() ? std::string("the input") : sweep.input.path;
+  const bool has_best = sweep.best_row >= 0 && sweep.best_row < static_cast<int>(sweep.rows.size());
+  std::ostringstream html;
+  html << PageStart("vmap sweep: " + input_name, "Threshold sweep of " + input_name,
+                    std::to_string(sweep.rows.size()) + " thresholds over " + std::to_string(sweep.num_frames) +
+                        " frames" + (has_best ? ", best tau = " + FormatExact(sweep.rows[sweep.best_row].tau) : ""),
+                    {{"summary", "Summary"}, {"table", "Table"}, {"plots", "Plots"}, {"options", "Options"}});
+
+  html << "<section id=\"summary\"><h2>Summary</h2>\n<div class=\"cards\">"
+       << Card(std::to_string(sweep.num_frames), "frames (n)") << Card(std::to_string(sweep.rows.size()), "thresholds")
+       << (has_best ? Card(FormatExact(sweep.rows[sweep.best_row].tau), "best tau (highest Q)") +
+                          Card(FormatFixed(sweep.rows[sweep.best_row].quality, 3), "best Q")
+                    : "")
+       << "</div>\n<table class=\"summary\">\n"
+       << Row("Input", HtmlEscape(sweep.input.path)) << Row("Format", HtmlEscape(SourceFormatName(sweep.input.format)))
+       << Row("Frame size", HtmlEscape(SizeText(sweep.input.frame_size)))
+       << Row("Matcher", HtmlEscape(OptionText(options, "matcher")))
+       << Row("Verifier", HtmlEscape(OptionText(options, "verifier")))
+       << Row("Features extracted", std::to_string(sweep.features_extracted))
+       << Row("Pairs matched", std::to_string(sweep.pairs_matched)) << Row("Time", DurationText(sweep.seconds))
+       << "</table>\n</section>\n";
+
+  html << "<section id=\"table\"><h2>Key images and quality per threshold</h2>\n<table class=\"sweep\">\n<thead><tr>"
+          "<th class=\"num\">&tau;</th><th class=\"num\">key images m</th><th class=\"num\">% of frames</th>"
+          "<th class=\"num\">min</th><th class=\"num\">max</th><th class=\"num\">mean verified</th>"
+          "<th class=\"num\">mean S</th><th class=\"num\">Q</th><th class=\"num\">broken links</th><th>map</th>"
+          "</tr></thead>\n<tbody>\n";
+  for (size_t i = 0; i < sweep.rows.size(); ++i) {
+    const SweepRow& r = sweep.rows[i];
+    const bool best = has_best && static_cast<int>(i) == sweep.best_row;
+    html << "<tr class=\"" << (best ? "best" : (r.broken_links > 0 ? "broken" : "")) << "\" data-tau=\""
+         << FormatExact(r.tau) << "\"><td class=\"num\">" << (best ? "&#9733; " : "") << FormatExact(r.tau)
+         << "</td><td class=\"num\">" << r.num_key_images << "</td><td class=\"num\">"
+         << FormatFixed(r.key_image_percent, 1) << "</td><td class=\"num\">" << r.min_verified
+         << "</td><td class=\"num\">" << r.max_verified << "</td><td class=\"num\">" << FormatFixed(r.mean_verified, 1)
+         << "</td><td class=\"num\">" << FormatFixed(r.mean_similarity, 3) << "</td><td class=\"num\">"
+         << FormatFixed(r.quality, 4) << "</td><td class=\"num\">" << r.broken_links << "</td><td>";
+    if (!r.map_directory.empty()) {
+      html << "<a class=\"map-link\" href=\"" << HtmlEscape(MapLink(r.map_directory, directory)) << "\">"
+           << HtmlEscape(fs::path(r.map_directory).filename().string()) << "</a>";
+    }
+    html << "</td></tr>\n";
+  }
+  html << "</tbody></table>\n"
+       << (has_best ? "<p class=\"note\">&#9733; marks the threshold with the highest Q.</p>\n" : "") << "</section>\n";
+
+  // Plots against tau.
+  SvgPlot keys_plot("keys-plot", "threshold tau", "key images m");
+  keys_plot.SetSize(720, 320);
+  keys_plot.SetIntegerY(true);
+  SvgPlot quality_plot("quality-plot", "threshold tau", "value");
+  quality_plot.SetSize(720, 320);
+  PlotSeries keys_line, quality_line, similarity_line, compression_line;
+  keys_line.name = "key images m";
+  keys_line.color = kBlue;
+  keys_line.css_class = "key-images";
+  quality_line.name = "Q";
+  quality_line.color = kGreen;
+  quality_line.css_class = "quality";
+  similarity_line.name = "mean S";
+  similarity_line.color = kOrange;
+  similarity_line.css_class = "similarity";
+  compression_line.name = "1 - m/n";
+  compression_line.color = kGrey;
+  compression_line.css_class = "compression";
+  for (PlotSeries* s : {&keys_line, &quality_line, &similarity_line, &compression_line}) s->segments.emplace_back();
+  double y_high = 1.0;
+  for (const SweepRow& r : sweep.rows) {
+    keys_line.segments[0].emplace_back(r.tau, r.num_key_images);
+    quality_line.segments[0].emplace_back(r.tau, r.quality);
+    similarity_line.segments[0].emplace_back(r.tau, r.mean_similarity);
+    compression_line.segments[0].emplace_back(
+        r.tau, sweep.num_frames > 0 ? 1.0 - static_cast<double>(r.num_key_images) / sweep.num_frames : 0.0);
+    y_high = std::max({y_high, r.quality, r.mean_similarity});
+  }
+  quality_plot.SetYRange(0.0, y_high);
+  auto markers_of = [](PlotSeries line) {
+    line.kind = PlotSeries::Kind::kMarkers;
+    line.name.clear();
+    line.css_class += "-points";
+    return line;
+  };
+  keys_plot.Add(keys_line);
+  keys_plot.Add(markers_of(keys_line));
+  quality_plot.Add(compression_line);
+  quality_plot.Add(similarity_line);
+  quality_plot.Add(quality_line);
+  quality_plot.Add(markers_of(quality_line));
+  if (has_best) {
+    const SweepRow& best = sweep.rows[sweep.best_row];
+    PlotSeries best_keys;
+    best_keys.kind = PlotSeries::Kind::kMarkers;
+    best_keys.name = "best tau = " + FormatExact(best.tau);
+    best_keys.color = kRed;
+    best_keys.css_class = "best";
+    best_keys.marker_radius = 6.0;
+    best_keys.segments.push_back({cv::Point2d(best.tau, best.num_key_images)});
+    keys_plot.Add(best_keys);
+    best_keys.segments = {{cv::Point2d(best.tau, best.quality)}};
+    quality_plot.Add(best_keys);
+  }
+  html << "<section id=\"plots\"><h2>Key images and quality against &tau;</h2>\n" << keys_plot.Render()
+       << quality_plot.Render()
+       << "<p class=\"note\">Q is the mean of the compression 1 - m/n and the mean similarity of consecutive key "
+          "images; the best threshold balances few key images against well-connected ones.</p>\n</section>\n";
+
+  html << "<section id=\"options\"><h2>Options</h2>\n<details><summary>Every option used for the sweep</summary><pre>"
+       << HtmlEscape(options.dump(2)) << "</pre></details>\n</section>\n";
+  html << PageEnd();
+  WriteFileAtomically(directory / kReportFileName, html.str());
+}
+
+}  // namespace vmap

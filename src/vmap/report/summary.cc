@@ -1,0 +1,88 @@
+#include "vmap/report/summary.h"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+namespace vmap {
+
+std::string FormatMapSummary(const VisualMap& map, QualityMean mean) {
+  const MapStatistics s = ComputeStatistics(map, mean);
+  std::string text;
+  text += fmt::format("input           {} ({})\n", map.input.path, SourceFormatName(map.input.format));
+  text += fmt::format("frames (n)      {}", s.num_frames);
+  if (map.skipped_frames > 0) text += fmt::format("  ({} undecodable frames skipped)", map.skipped_frames);
+  text += "\n";
+  text += fmt::format("key images (m)  {} ({:.1f}% of frames)\n", s.num_key_images,
+                      s.num_frames > 0 ? 100.0 * s.num_key_images / s.num_frames : 0.0);
+  if (!map.links.empty()) {
+    text += fmt::format("verified matches between consecutive key images  min {}  max {}  mean {:.1f}\n",
+                        s.min_verified, s.max_verified, s.mean_verified);
+    text += fmt::format("mean similarity {:.3f}", s.mean_similarity);
+    if (s.broken_links > 0) text += fmt::format("  ({} broken links)", s.broken_links);
+    text += "\n";
+  }
+  text += fmt::format("quality Q       {:.4f} ({} mean)\n", s.quality, QualityMeanName(mean));
+  if (map.seconds > 0) {
+    text += fmt::format("time            {:.2f} s ({:.1f} frames/s)\n", map.seconds, s.num_frames / map.seconds);
+  }
+  return text;
+}
+
+std::string SweepToMarkdown(const SweepResult& sweep) {
+  std::string text = fmt::format("Threshold sweep of {} ({} frames, {:.1f} s)\n\n", sweep.input.path, sweep.num_frames,
+                                 sweep.seconds);
+  text += "| tau | key images | % frames | min matches | max matches | mean matches | mean S | Q |\n";
+  text += "|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (size_t i = 0; i < sweep.rows.size(); ++i) {
+    const SweepRow& r = sweep.rows[i];
+    const bool best = static_cast<int>(i) == sweep.best_row;
+    text += fmt::format("| {}{:.2f}{} | {} | {:.1f} | {} | {} | {:.1f} | {:.3f} | {}{:.4f}{} |\n", best ? "**" : "",
+                        r.tau, best ? "**" : "", r.num_key_images, r.key_image_percent, r.min_verified,
+                        r.max_verified, r.mean_verified, r.mean_similarity, best ? "**" : "", r.quality,
+                        best ? "**" : "");
+  }
+  if (sweep.best_row >= 0) text += fmt::format("\nBest tau by Q: {:.2f}\n", sweep.rows[sweep.best_row].tau);
+  return text;
+}
+
+std::string SweepToCsv(const SweepResult& sweep) {
+  std::string text = "tau,key_images,key_image_percent,min_matches,max_matches,mean_matches,mean_similarity,quality,"
+                     "broken_links,best\n";
+  for (size_t i = 0; i < sweep.rows.size(); ++i) {
+    const SweepRow& r = sweep.rows[i];
+    text += fmt::format("{:.4f},{},{:.4f},{},{},{:.4f},{:.6f},{:.6f},{},{}\n", r.tau, r.num_key_images,
+                        r.key_image_percent, r.min_verified, r.max_verified, r.mean_verified, r.mean_similarity,
+                        r.quality, r.broken_links, static_cast<int>(i) == sweep.best_row ? 1 : 0);
+  }
+  return text;
+}
+
+std::string SweepToJson(const SweepResult& sweep) {
+  nlohmann::json doc;
+  doc["format"] = "vmap-sweep";
+  doc["schema_version"] = 1;
+  doc["input"] = {{"path", sweep.input.path}, {"format", SourceFormatName(sweep.input.format)}};
+  doc["options"] = sweep.options_json.empty() ? nlohmann::json::object() : nlohmann::json::parse(sweep.options_json);
+  doc["num_frames"] = sweep.num_frames;
+  doc["seconds"] = sweep.seconds;
+  doc["features_extracted"] = sweep.features_extracted;
+  doc["pairs_matched"] = sweep.pairs_matched;
+  doc["best_tau"] = sweep.best_row >= 0 ? nlohmann::json(sweep.rows[sweep.best_row].tau) : nlohmann::json(nullptr);
+  nlohmann::json rows = nlohmann::json::array();
+  for (const SweepRow& r : sweep.rows) {
+    rows.push_back({{"tau", r.tau},
+                    {"key_images", r.num_key_images},
+                    {"key_image_percent", r.key_image_percent},
+                    {"min_matches", r.min_verified},
+                    {"max_matches", r.max_verified},
+                    {"mean_matches", r.mean_verified},
+                    {"mean_similarity", r.mean_similarity},
+                    {"quality", r.quality},
+                    {"broken_links", r.broken_links},
+                    {"map", r.map_directory.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.map_directory)}});
+  }
+  doc["rows"] = rows;
+  return doc.dump(1) + "\n";
+}
+
+}  // namespace vmap

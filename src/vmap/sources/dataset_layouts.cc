@@ -1,0 +1,179 @@
+// Readers of the list-based layouts: image folders, TUM RGB-D (rgb.txt), EuRoC (cam0/data.csv) and
+// KITTI odometry (image_0/ + times.txt).
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <spdlog/spdlog.h>
+
+#include "vmap/core/error.h"
+#include "vmap/sources/internal.h"
+
+namespace vmap::internal {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<std::string> ImagesIn(const fs::path& directory) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(directory)) {
+    if (entry.is_regular_file() && IsImageFile(entry.path().string())) names.push_back(entry.path().filename().string());
+  }
+  std::sort(names.begin(), names.end(), NaturalLess);
+  return names;
+}
+
+std::string Trim(const std::string& s) {
+  const auto begin = s.find_first_not_of(" \t\r\n");
+  if (begin == std::string::npos) return "";
+  return s.substr(begin, s.find_last_not_of(" \t\r\n") - begin + 1);
+}
+
+void RequireExists(const fs::path& image, const std::string& list, int line) {
+  if (!fs::exists(image)) {
+    throw InputError("'" + list + "' line " + std::to_string(line) + " names '" + image.string() +
+                     "', which does not exist; fix or remove that line");
+  }
+}
+
+// "timestamps.txt" beside an image folder (or in its parent): "file_name seconds" per line.
+std::map<std::string, double> ReadTimestampsFile(const fs::path& directory) {
+  std::map<std::string, double> stamps;
+  for (const fs::path& candidate : {directory / "timestamps.txt", directory.parent_path() / "timestamps.txt"}) {
+    std::ifstream in(candidate);
+    if (!in) continue;
+    std::string line;
+    while (std::getline(in, line)) {
+      line = Trim(line);
+      if (line.empty() || line[0] == '#') continue;
+      std::istringstream fields(line);
+      std::string name;
+      double seconds;
+      if (fields >> name >> seconds) stamps[fs::path(name).filename().string()] = seconds;
+    }
+    if (!stamps.empty()) break;
+  }
+  return stamps;
+}
+
+}  // namespace
+
+std::vector<ImageEntry> ListImageFolder(const std::string& directory_text) {
+  fs::path directory(directory_text);
+  if (!fs::is_directory(directory)) {
+    throw InputError("'" + directory_text + "' is not a folder; --format images needs a folder of images");
+  }
+  std::vector<std::string> names = ImagesIn(directory);
+  if (names.empty()) {
+    // A sequence folder often keeps its frames one level down (images/, rgb/, frames/).
+    for (const char* sub : {"images", "rgb", "frames", "image", "imgs"}) {
+      if (fs::is_directory(directory / sub) && !ImagesIn(directory / sub).empty()) {
+        spdlog::info("reading the images in {}", (directory / sub).string());
+        directory /= sub;
+        names = ImagesIn(directory);
+        break;
+      }
+    }
+  }
+  if (names.empty()) {
+    throw InputError("'" + directory_text +
+                     "' holds no images (.png, .jpg, .bmp, .tif, ...) and is not a TUM (rgb.txt), EuRoC "
+                     "(mav0/cam0/data.csv) or KITTI (image_0/ + times.txt) sequence; point to the folder with the "
+                     "frames, or pass --format");
+  }
+  const std::map<std::string, double> stamps = ReadTimestampsFile(directory);
+  const bool use_stamps = !stamps.empty() && std::all_of(names.begin(), names.end(), [&](const std::string& n) {
+    return stamps.count(n) > 0;
+  });
+  std::vector<ImageEntry> entries;
+  entries.reserve(names.size());
+  for (const std::string& name : names) {
+    entries.push_back({(directory / name).string(), use_stamps ? stamps.at(name) : -1.0});
+  }
+  return entries;
+}
+
+std::vector<ImageEntry> ListTum(const std::string& rgb_txt) {
+  std::ifstream in(rgb_txt);
+  if (!in) throw InputError("cannot read '" + rgb_txt + "'; a TUM RGB-D sequence needs rgb.txt");
+  const fs::path base = fs::path(rgb_txt).parent_path();
+  std::vector<ImageEntry> entries;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    line = Trim(line);
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    double stamp;
+    std::string file;
+    if (!(fields >> stamp >> file)) {
+      throw InputError("'" + rgb_txt + "' line " + std::to_string(number) +
+                       " is not 'timestamp filename' (TUM RGB-D format); fix that line");
+    }
+    RequireExists(base / file, rgb_txt, number);
+    entries.push_back({(base / file).string(), stamp});
+  }
+  if (entries.empty()) throw InputError("'" + rgb_txt + "' lists no images; the sequence is empty");
+  return entries;
+}
+
+std::vector<ImageEntry> ListEuroc(const std::string& data_csv) {
+  std::ifstream in(data_csv);
+  if (!in) throw InputError("cannot read '" + data_csv + "'; an EuRoC sequence needs mav0/cam0/data.csv");
+  const fs::path images = fs::path(data_csv).parent_path() / "data";
+  std::vector<ImageEntry> entries;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    line = Trim(line);
+    if (line.empty() || line[0] == '#') continue;
+    const auto comma = line.find(',');
+    if (comma == std::string::npos) {
+      throw InputError("'" + data_csv + "' line " + std::to_string(number) +
+                       " is not 'timestamp_ns,filename' (EuRoC format); fix that line");
+    }
+    long long nanoseconds = 0;
+    try {
+      nanoseconds = std::stoll(line.substr(0, comma));
+    } catch (const std::exception&) {
+      throw InputError("'" + data_csv + "' line " + std::to_string(number) + " has no integer timestamp");
+    }
+    const std::string file = Trim(line.substr(comma + 1));
+    RequireExists(images / file, data_csv, number);
+    entries.push_back({(images / file).string(), nanoseconds * 1e-9});
+  }
+  if (entries.empty()) throw InputError("'" + data_csv + "' lists no images; the sequence is empty");
+  return entries;
+}
+
+std::vector<ImageEntry> ListKitti(const std::string& sequence_directory) {
+  const fs::path sequence(sequence_directory);
+  fs::path images = sequence / "image_0";
+  if (!fs::is_directory(images)) images = sequence / "image_2";
+  if (!fs::is_directory(images)) {
+    throw InputError("'" + sequence_directory + "' is not a KITTI odometry sequence: it has no image_0/ folder");
+  }
+  const std::vector<std::string> names = ImagesIn(images);
+  if (names.empty()) throw InputError("'" + images.string() + "' holds no images; the sequence is empty");
+  std::vector<double> times;
+  std::ifstream in(sequence / "times.txt");
+  double t;
+  while (in >> t) times.push_back(t);
+  if (!times.empty() && times.size() != names.size()) {
+    spdlog::warn("{} has {} times for {} images; ignoring the timestamps", (sequence / "times.txt").string(),
+                 times.size(), names.size());
+    times.clear();
+  }
+  std::vector<ImageEntry> entries;
+  for (size_t i = 0; i < names.size(); ++i) {
+    entries.push_back({(images / names[i]).string(), times.empty() ? -1.0 : times[i]});
+  }
+  return entries;
+}
+
+}  // namespace vmap::internal

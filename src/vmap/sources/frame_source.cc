@@ -1,0 +1,187 @@
+#include "vmap/sources/frame_source.h"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
+
+#include "vmap/core/error.h"
+#include "vmap/sources/internal.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+
+SourceFormat ParseSourceFormat(const std::string& name) {
+  if (name == "auto") return SourceFormat::kAuto;
+  if (name == "video") return SourceFormat::kVideo;
+  if (name == "images") return SourceFormat::kImageFolder;
+  if (name == "tum") return SourceFormat::kTum;
+  if (name == "euroc") return SourceFormat::kEuroc;
+  if (name == "kitti") return SourceFormat::kKitti;
+  throw InputError("unknown format '" + name + "'; use auto, video, images, tum, euroc or kitti");
+}
+
+std::string SourceFormatName(SourceFormat format) {
+  switch (format) {
+    case SourceFormat::kAuto: return "auto";
+    case SourceFormat::kVideo: return "video";
+    case SourceFormat::kImageFolder: return "images";
+    case SourceFormat::kTum: return "tum";
+    case SourceFormat::kEuroc: return "euroc";
+    case SourceFormat::kKitti: return "kitti";
+  }
+  return "auto";
+}
+
+void FrameSourceOptions::Check() const {
+  if (first < 0) throw InputError("--first must be >= 0 (got " + std::to_string(first) + ")");
+  if (last >= 0 && last < first) {
+    throw InputError("--last " + std::to_string(last) + " is before --first " + std::to_string(first));
+  }
+  if (stride < 1) throw InputError("--stride must be >= 1 (got " + std::to_string(stride) + ")");
+  if (!resize.empty()) internal::TargetSize(cv::Size(640, 480), resize);  // validates the text
+}
+
+bool NaturalLess(const std::string& a, const std::string& b) {
+  size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    if (std::isdigit(static_cast<unsigned char>(a[i])) && std::isdigit(static_cast<unsigned char>(b[j]))) {
+      size_t i_end = i, j_end = j;
+      while (i_end < a.size() && std::isdigit(static_cast<unsigned char>(a[i_end]))) ++i_end;
+      while (j_end < b.size() && std::isdigit(static_cast<unsigned char>(b[j_end]))) ++j_end;
+      // Compare digit runs as numbers without overflow: skip leading zeros, then length, then digits.
+      size_t i_nz = i, j_nz = j;
+      while (i_nz + 1 < i_end && a[i_nz] == '0') ++i_nz;
+      while (j_nz + 1 < j_end && b[j_nz] == '0') ++j_nz;
+      if (i_end - i_nz != j_end - j_nz) return i_end - i_nz < j_end - j_nz;
+      const int cmp = a.compare(i_nz, i_end - i_nz, b, j_nz, j_end - j_nz);
+      if (cmp != 0) return cmp < 0;
+      if (i_end - i != j_end - j) return i_end - i < j_end - j;  // "01" after "1"
+      i = i_end;
+      j = j_end;
+    } else {
+      if (a[i] != b[j]) return a[i] < b[j];
+      ++i;
+      ++j;
+    }
+  }
+  return a.size() - i < b.size() - j;
+}
+
+cv::Mat ColorImage(const Frame& frame) {
+  if (!frame.color.empty()) return frame.color;
+  if (!frame.source_path.empty()) {
+    cv::Mat color = cv::imread(frame.source_path, cv::IMREAD_COLOR);
+    if (!color.empty()) {
+      if (color.size() != frame.gray.size()) cv::resize(color, color, frame.gray.size(), 0, 0, cv::INTER_AREA);
+      return color;
+    }
+  }
+  cv::Mat color;
+  cv::cvtColor(frame.gray, color, cv::COLOR_GRAY2BGR);
+  return color;
+}
+
+namespace internal {
+
+bool IsImageFile(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  static const char* kExtensions[] = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm",
+                                      ".pbm", ".webp", ".jp2", ".exr", ".hdr", ".pnm", ".ras", ".sr"};
+  return std::any_of(std::begin(kExtensions), std::end(kExtensions), [&](const char* e) { return ext == e; });
+}
+
+bool IsVideoFile(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  static const char* kExtensions[] = {".mp4", ".avi", ".mkv", ".mov", ".m4v", ".webm", ".mpg",
+                                      ".mpeg", ".wmv", ".flv", ".ts", ".mts", ".3gp", ".ogv"};
+  return std::any_of(std::begin(kExtensions), std::end(kExtensions), [&](const char* e) { return ext == e; });
+}
+
+cv::Size TargetSize(const cv::Size& native, const std::string& resize) {
+  if (resize.empty()) return native;
+  int width = 0, height = 0;
+  char extra = 0;
+  if (std::sscanf(resize.c_str(), "%dx%d%c", &width, &height, &extra) == 2) {
+    if (width < 16 || height < 16) throw InputError("--resize " + resize + " is too small; use at least 16x16");
+    return {width, height};
+  }
+  int longest = 0;
+  if (std::sscanf(resize.c_str(), "%d%c", &longest, &extra) == 1) {
+    if (longest < 16) throw InputError("--resize " + resize + " is too small; use a longest side of at least 16");
+    const double scale = static_cast<double>(longest) / std::max(native.width, native.height);
+    return {std::max(1, static_cast<int>(std::lround(native.width * scale))),
+            std::max(1, static_cast<int>(std::lround(native.height * scale)))};
+  }
+  throw InputError("--resize '" + resize + "' is not WxH (e.g. 640x480) or a longest side (e.g. 640)");
+}
+
+void FitFrame(Frame& frame, const cv::Size& target, const cv::Size& first_native, const FrameSourceOptions& options,
+              int* warnings) {
+  const cv::Size native = frame.gray.size();
+  if (native != first_native) {
+    const std::string message = "frame " + std::to_string(frame.source_index) + " (" + frame.source_name + ") is " +
+                                std::to_string(native.width) + "x" + std::to_string(native.height) +
+                                " but the first frame is " + std::to_string(first_native.width) + "x" +
+                                std::to_string(first_native.height);
+    if (options.strict) throw InputError(message + "; frames of one sequence must have one size (--strict)");
+    if ((*warnings)++ < 5) spdlog::warn("{}; resizing it to the first frame's size", message);
+  }
+  if (native == target) return;
+  const int interpolation = target.area() < native.area() ? cv::INTER_AREA : cv::INTER_LINEAR;
+  cv::resize(frame.gray, frame.gray, target, 0, 0, interpolation);
+  if (!frame.color.empty()) cv::resize(frame.color, frame.color, target, 0, 0, interpolation);
+}
+
+}  // namespace internal
+
+std::unique_ptr<FrameSource> OpenFrameSource(const std::string& path, const FrameSourceOptions& options) {
+  options.Check();
+  std::error_code ec;
+  if (!fs::exists(path, ec)) {
+    throw InputError("input '" + path + "' does not exist; give a video file, an image folder, or a TUM/EuRoC/KITTI sequence");
+  }
+  const fs::path p(path);
+  SourceFormat format = options.format;
+  if (format == SourceFormat::kAuto) {
+    if (fs::is_directory(p)) {
+      if (fs::exists(p / "rgb.txt")) format = SourceFormat::kTum;
+      else if (fs::exists(p / "mav0/cam0/data.csv") || fs::exists(p / "cam0/data.csv")) format = SourceFormat::kEuroc;
+      else if (fs::is_directory(p / "image_0") || fs::is_directory(p / "image_2")) format = SourceFormat::kKitti;
+      else format = SourceFormat::kImageFolder;
+    } else if (p.filename() == "rgb.txt") {
+      format = SourceFormat::kTum;
+    } else if (p.filename() == "data.csv") {
+      format = SourceFormat::kEuroc;
+    } else {
+      format = SourceFormat::kVideo;  // anything else that is a file: let FFmpeg try
+    }
+  }
+  switch (format) {
+    case SourceFormat::kVideo:
+      if (fs::is_directory(p)) throw InputError("input '" + path + "' is a folder, not a video; drop --format video");
+      return internal::OpenVideo(path, options);
+    case SourceFormat::kImageFolder:
+      return internal::OpenImageList(internal::ListImageFolder(path), path, format, options);
+    case SourceFormat::kTum:
+      return internal::OpenImageList(
+          internal::ListTum(fs::is_directory(p) ? (p / "rgb.txt").string() : path), path, format, options);
+    case SourceFormat::kEuroc: {
+      std::string csv = path;
+      if (fs::is_directory(p)) csv = fs::exists(p / "mav0/cam0/data.csv") ? (p / "mav0/cam0/data.csv").string()
+                                                                            : (p / "cam0/data.csv").string();
+      return internal::OpenImageList(internal::ListEuroc(csv), path, format, options);
+    }
+    case SourceFormat::kKitti:
+      return internal::OpenImageList(internal::ListKitti(path), path, format, options);
+    case SourceFormat::kAuto: break;
+  }
+  throw InputError("cannot tell the layout of '" + path + "'; pass --format");
+}
+
+}  // namespace vmap

@@ -1,0 +1,72 @@
+#pragma once
+// Frame sources: a sequence of images streamed one at a time from a video file, an image folder, or a
+// dataset layout (TUM RGB-D, EuRoC, KITTI odometry). Memory stays flat however long the sequence is.
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+namespace vmap {
+
+enum class SourceFormat { kAuto, kVideo, kImageFolder, kTum, kEuroc, kKitti };
+
+// "auto", "video", "images", "tum", "euroc", "kitti".
+SourceFormat ParseSourceFormat(const std::string& name);
+std::string SourceFormatName(SourceFormat format);
+
+struct FrameSourceOptions {
+  SourceFormat format = SourceFormat::kAuto;
+  // Frames [first, last] of the sequence (0-based, inclusive; last < 0 means to the end), every stride-th.
+  int first = 0;
+  int last = -1;
+  int stride = 1;
+  // Resize: "" keeps the native size, "640x480" a fixed size, "640" the longest side (aspect kept).
+  std::string resize;
+  // Frames whose size differs from the first frame's are resized to it with a warning; with strict, an error.
+  bool strict = false;
+
+  void Check() const;  // throws InputError naming the bad option
+};
+
+struct Frame {
+  int index = 0;             // position in the processed sequence: 0, 1, 2, ...
+  int source_index = 0;      // position in the input (differs with first/stride)
+  double timestamp = -1.0;   // seconds, from the dataset or the video; -1 when the format has none
+  std::string source_name;   // the image file name, or "frame_000123" for video
+  std::string source_path;   // the image file, empty for video
+  cv::Mat gray;              // 8-bit, one channel: what the matchers see
+  cv::Mat color;             // 8-bit BGR when the input is colour; may be empty (then use gray)
+};
+
+struct SequenceInfo {
+  std::string path;            // as given by the user
+  SourceFormat format = SourceFormat::kAuto;
+  long expected_frames = -1;   // frames that will be delivered (after first/last/stride); -1 if unknown
+  cv::Size native_size;        // the first frame's size as stored
+  cv::Size frame_size;         // the size of delivered frames
+  double fps = 0.0;            // video only
+};
+
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  // The next frame, or nullopt at the end. Throws InputError on input that cannot be read at all.
+  virtual std::optional<Frame> Next() = 0;
+  virtual const SequenceInfo& info() const = 0;
+  // Frames that could not be decoded and were skipped so far (a corrupt frame inside a video).
+  virtual int skipped_frames() const { return 0; }
+};
+
+// Detects the layout of `path` (or uses options.format) and opens it. Throws InputError with a message
+// that names the path and says what to do when it cannot.
+std::unique_ptr<FrameSource> OpenFrameSource(const std::string& path, const FrameSourceOptions& options = {});
+
+// The frame as a BGR image (re-reads a colour image file when the frame only kept the grey one).
+cv::Mat ColorImage(const Frame& frame);
+
+// "img2" < "img10": digit runs compare as numbers.
+bool NaturalLess(const std::string& a, const std::string& b);
+
+}  // namespace vmap

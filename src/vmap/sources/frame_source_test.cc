@@ -1,0 +1,271 @@
+#include "vmap/sources/frame_source.h"
+
+#include <fstream>
+#include <iomanip>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "vmap/core/error.h"
+#include "vmap/testing/synthetic_scene.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+
+namespace {
+
+const testing::SyntheticSequence& Sequence() {
+  static const testing::SyntheticSequence sequence = [] {
+    testing::SyntheticOptions options;
+    options.num_frames = 12;
+    return testing::RenderSyntheticSequence(options);
+  }();
+  return sequence;
+}
+
+std::vector<Frame> ReadAll(FrameSource& source) {
+  std::vector<Frame> frames;
+  while (auto frame = source.Next()) frames.push_back(std::move(*frame));
+  return frames;
+}
+
+std::string OpenError(const std::string& path, const FrameSourceOptions& options = {}) {
+  try {
+    auto source = OpenFrameSource(path, options);
+    ReadAll(*source);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Frames written as an MJPEG AVI: every frame is a JPEG, so one can be damaged on its own.
+fs::path WriteMjpegVideo(const fs::path& path, const std::vector<cv::Mat>& frames) {
+  cv::VideoWriter writer(path.string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10.0,
+                         frames[0].size());
+  EXPECT_TRUE(writer.isOpened());
+  for (const cv::Mat& f : frames) writer.write(f);
+  writer.release();
+  return path;
+}
+
+}  // namespace
+
+TEST(NaturalSort, DigitRunsCompareAsNumbers) {
+  EXPECT_TRUE(NaturalLess("img2.png", "img10.png"));
+  EXPECT_FALSE(NaturalLess("img10.png", "img2.png"));
+  EXPECT_TRUE(NaturalLess("a1b2", "a1b10"));
+  EXPECT_TRUE(NaturalLess("frame_9", "frame_10"));
+  EXPECT_TRUE(NaturalLess("1", "01"));  // equal value: shorter first, so the order is total
+  EXPECT_FALSE(NaturalLess("same", "same"));
+  EXPECT_TRUE(NaturalLess("x99999999999999999999999", "x100000000000000000000000"));
+}
+
+TEST(ImageFolder, ReadsInNaturalOrder) {
+  testing::TempDir tmp;
+  testing::WriteImageFolder(Sequence(), tmp.path());
+  auto source = OpenFrameSource(tmp.path().string());
+  EXPECT_EQ(source->info().format, SourceFormat::kImageFolder);
+  EXPECT_EQ(source->info().expected_frames, 12);
+  const auto frames = ReadAll(*source);
+  ASSERT_EQ(frames.size(), 12u);
+  EXPECT_EQ(frames[1].source_name, "frame_2.png");
+  EXPECT_EQ(frames[9].source_name, "frame_10.png");
+  cv::Mat expected;
+  cv::cvtColor(Sequence().frames[9], expected, cv::COLOR_BGR2GRAY);
+  EXPECT_LE(cv::norm(frames[9].gray, expected, cv::NORM_INF), 1.0);
+  EXPECT_EQ(ColorImage(frames[9]).channels(), 3);
+}
+
+TEST(ImageFolder, FirstLastStrideAndResize) {
+  testing::TempDir tmp;
+  testing::WriteImageFolder(Sequence(), tmp.path());
+  FrameSourceOptions options;
+  options.first = 2;
+  options.last = 9;
+  options.stride = 3;
+  options.resize = "160";
+  auto source = OpenFrameSource(tmp.path().string(), options);
+  EXPECT_EQ(source->info().expected_frames, 3);
+  const auto frames = ReadAll(*source);
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_EQ(frames[0].source_index, 2);
+  EXPECT_EQ(frames[2].source_index, 8);
+  EXPECT_EQ(frames[2].index, 2);
+  EXPECT_EQ(frames[0].gray.size(), cv::Size(160, 120));
+  options = {};
+  options.resize = "100x50";
+  auto resized = OpenFrameSource(tmp.path().string(), options);
+  EXPECT_EQ(resized->Next()->gray.size(), cv::Size(100, 50));
+  options.resize = "big";
+  EXPECT_THROW(options.Check(), InputError);
+}
+
+TEST(ImageFolder, FramesOfAnotherSizeAreResizedOrRejectedWhenStrict) {
+  testing::TempDir tmp;
+  testing::WriteImageFolder(Sequence(), tmp.path());
+  cv::Mat odd;
+  cv::resize(Sequence().frames[4], odd, cv::Size(200, 100));
+  cv::imwrite((tmp.path() / "frame_5.png").string(), odd);
+  auto source = OpenFrameSource(tmp.path().string());
+  const auto frames = ReadAll(*source);
+  ASSERT_EQ(frames.size(), 12u);
+  EXPECT_EQ(frames[4].gray.size(), frames[0].gray.size());
+  FrameSourceOptions strict;
+  strict.strict = true;
+  const std::string error = OpenError(tmp.path().string(), strict);
+  EXPECT_NE(error.find("frame_5.png"), std::string::npos) << error;
+  EXPECT_NE(error.find("200x100"), std::string::npos) << error;
+}
+
+TEST(ImageFolder, UnknownLayoutsAndEmptyFoldersAreClearErrors) {
+  testing::TempDir tmp;
+  EXPECT_NE(OpenError(tmp.path().string()).find("holds no images"), std::string::npos);
+  std::ofstream(tmp.path() / "notes.txt") << "hello";
+  EXPECT_NE(OpenError(tmp.path().string()).find("--format"), std::string::npos);
+  EXPECT_NE(OpenError((tmp.path() / "missing").string()).find("does not exist"), std::string::npos);
+}
+
+TEST(ImageFolder, UndecodableImageIsSkippedAndCounted) {
+  testing::TempDir tmp;
+  testing::WriteImageFolder(Sequence(), tmp.path());
+  std::ofstream(tmp.path() / "frame_3.png", std::ios::trunc) << "not a png";
+  auto source = OpenFrameSource(tmp.path().string());
+  EXPECT_EQ(ReadAll(*source).size(), 11u);
+  EXPECT_EQ(source->skipped_frames(), 1);
+}
+
+TEST(Tum, ReadsRgbTxtWithTimestamps) {
+  testing::TempDir tmp;
+  testing::WriteImageFolder(Sequence(), tmp.path() / "rgb");
+  {
+    std::ofstream list(tmp.path() / "rgb.txt");
+    list << "# color images\n# timestamp filename\n" << std::fixed << std::setprecision(6);
+    for (int i = 0; i < 5; ++i) list << 1305031102.175304 + i / 30.0 << " rgb/frame_" << i + 1 << ".png\n";
+  }
+  auto source = OpenFrameSource(tmp.path().string());
+  EXPECT_EQ(source->info().format, SourceFormat::kTum);
+  const auto frames = ReadAll(*source);
+  ASSERT_EQ(frames.size(), 5u);
+  EXPECT_NEAR(frames[3].timestamp - frames[0].timestamp, 0.1, 1e-6);
+
+  std::ofstream(tmp.path() / "rgb.txt", std::ios::app) << "1305031103.0 rgb/missing.png\n";
+  const std::string error = OpenError(tmp.path().string());
+  EXPECT_NE(error.find("line 8"), std::string::npos) << error;
+  EXPECT_NE(error.find("missing.png"), std::string::npos) << error;
+}
+
+TEST(Euroc, ReadsDataCsv) {
+  testing::TempDir tmp;
+  const fs::path cam = tmp.path() / "mav0" / "cam0";
+  fs::create_directories(cam / "data");
+  std::ofstream csv(cam / "data.csv");
+  csv << "#timestamp [ns],filename\n";
+  for (int i = 0; i < 4; ++i) {
+    const long long ns = 1403636579763555584LL + i * 50000000LL;
+    cv::imwrite((cam / "data" / (std::to_string(ns) + ".png")).string(), Sequence().frames[i]);
+    csv << ns << "," << ns << ".png\n";
+  }
+  csv.close();
+  auto source = OpenFrameSource(tmp.path().string());
+  EXPECT_EQ(source->info().format, SourceFormat::kEuroc);
+  const auto frames = ReadAll(*source);
+  ASSERT_EQ(frames.size(), 4u);
+  EXPECT_NEAR(frames[2].timestamp - frames[0].timestamp, 0.1, 1e-6);
+}
+
+TEST(Kitti, ReadsImage0AndTimes) {
+  testing::TempDir tmp;
+  fs::create_directories(tmp.path() / "image_0");
+  std::ofstream times(tmp.path() / "times.txt");
+  for (int i = 0; i < 3; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06d.png", i);
+    cv::imwrite((tmp.path() / "image_0" / name).string(), Sequence().frames[i]);
+    times << 1.036e-01 * i << "\n";
+  }
+  times.close();
+  auto source = OpenFrameSource(tmp.path().string());
+  EXPECT_EQ(source->info().format, SourceFormat::kKitti);
+  const auto frames = ReadAll(*source);
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_NEAR(frames[2].timestamp, 0.2072, 1e-9);
+}
+
+TEST(Video, ReadsEveryFrameWithTimestamps) {
+  testing::TempDir tmp;
+  const fs::path video = WriteMjpegVideo(tmp.path() / "clip.avi", Sequence().frames);
+  auto source = OpenFrameSource(video.string());
+  EXPECT_EQ(source->info().format, SourceFormat::kVideo);
+  const auto frames = ReadAll(*source);
+  ASSERT_EQ(frames.size(), 12u);
+  EXPECT_NEAR(frames[5].timestamp, 0.5, 1e-6);
+  EXPECT_EQ(frames[5].source_name, "frame_000005");
+  EXPECT_EQ(frames[5].color.channels(), 3);
+  EXPECT_EQ(source->skipped_frames(), 0);
+}
+
+TEST(Video, CorruptFrameInTheMiddleIsSkippedAndCounted) {
+  testing::TempDir tmp;
+  const fs::path video = WriteMjpegVideo(tmp.path() / "clip.avi", Sequence().frames);
+  // Destroy the start-of-image marker of the 7th JPEG: that frame cannot be decoded.
+  std::fstream file(video, std::ios::in | std::ios::out | std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  size_t pos = 0;
+  for (int k = 0; k < 7; ++k) pos = bytes.find("\xFF\xD8\xFF", pos + 1);
+  ASSERT_NE(pos, std::string::npos);
+  for (size_t i = pos; i < pos + 600; ++i) bytes[i] = 0;
+  file.seekp(0);
+  file.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  file.close();
+  auto source = OpenFrameSource(video.string());
+  const auto frames = ReadAll(*source);
+  EXPECT_GE(frames.size(), 10u);
+  EXPECT_LT(frames.size(), 12u);
+  EXPECT_EQ(source->skipped_frames(), 12 - static_cast<int>(frames.size()));
+}
+
+TEST(Video, GarbageOrTruncatedFilesAreClearErrors) {
+  testing::TempDir tmp;
+  std::ofstream(tmp.path() / "noise.mp4") << std::string(5000, 'x');
+  const std::string error = OpenError((tmp.path() / "noise.mp4").string());
+  EXPECT_NE(error.find("noise.mp4"), std::string::npos) << error;
+  EXPECT_NE(error.find("cannot open video"), std::string::npos) << error;
+}
+
+TEST(SharedData, LabFloorVideo) {
+  const fs::path shared = testing::SharedDir();
+  if (shared.empty()) GTEST_SKIP() << "../shared is not present";
+  FrameSourceOptions options;
+  options.last = 59;
+  auto source = OpenFrameSource((shared / "data/lab_floor/lab_floor.mp4").string(), options);
+  const auto frames = ReadAll(*source);
+  ASSERT_EQ(frames.size(), 60u);
+  EXPECT_EQ(frames[0].gray.size(), cv::Size(640, 480));
+  EXPECT_NEAR(frames[30].timestamp, 1.0, 1e-3);  // 30 fps
+}
+
+TEST(SharedData, EveryLayoutOpens) {
+  const fs::path shared = testing::SharedDir();
+  if (shared.empty()) GTEST_SKIP() << "../shared is not present";
+  struct Case {
+    std::string path;
+    SourceFormat format;
+    long frames;
+  };
+  for (const Case& c : {Case{"data/rccar_room/images", SourceFormat::kImageFolder, 329},
+                        Case{"data/rccar_room", SourceFormat::kImageFolder, 329},
+                        Case{"data/redkitchen", SourceFormat::kTum, 1000},
+                        Case{"data/kitti07", SourceFormat::kKitti, 160}}) {
+    auto source = OpenFrameSource((shared / c.path).string());
+    EXPECT_EQ(source->info().format, c.format) << c.path;
+    EXPECT_EQ(source->info().expected_frames, c.frames) << c.path;
+    const auto first = source->Next();
+    ASSERT_TRUE(first.has_value());
+    EXPECT_GE(first->timestamp, 0.0) << c.path << ": timestamps are kept";
+  }
+}
+
+}  // namespace vmap

@@ -1,0 +1,83 @@
+// A frame source over a list of image files (image folder, TUM, EuRoC, KITTI).
+
+#include <filesystem>
+
+#include <opencv2/imgcodecs.hpp>
+#include <spdlog/spdlog.h>
+
+#include "vmap/core/error.h"
+#include "vmap/sources/internal.h"
+
+namespace vmap::internal {
+namespace {
+
+class ImageListSource : public FrameSource {
+ public:
+  ImageListSource(std::vector<ImageEntry> entries, const std::string& path, SourceFormat format,
+                  const FrameSourceOptions& options)
+      : entries_(std::move(entries)), options_(options) {
+    info_.path = path;
+    info_.format = format;
+    next_ = options.first;
+    end_ = options.last >= 0 ? std::min<long>(options.last + 1, entries_.size()) : static_cast<long>(entries_.size());
+    if (next_ >= end_) {
+      throw InputError("'" + path + "' has " + std::to_string(entries_.size()) + " frames; --first " +
+                       std::to_string(options.first) + " leaves none");
+    }
+    info_.expected_frames = (end_ - next_ + options.stride - 1) / options.stride;
+  }
+
+  std::optional<Frame> Next() override {
+    while (next_ < end_) {
+      const long index = next_;
+      next_ += options_.stride;
+      const ImageEntry& entry = entries_[index];
+      Frame frame;
+      // Grey straight from the decoder, as the matchers' reference implementations read images.
+      frame.gray = cv::imread(entry.path, cv::IMREAD_GRAYSCALE);
+      if (frame.gray.empty()) {
+        ++skipped_;
+        spdlog::warn("cannot decode '{}' (corrupt or not an image); skipping it", entry.path);
+        continue;
+      }
+      frame.index = delivered_++;
+      frame.source_index = static_cast<int>(index);
+      frame.timestamp = entry.timestamp;
+      frame.source_path = entry.path;
+      frame.source_name = std::filesystem::path(entry.path).filename().string();
+      if (frame.index == 0) {
+        info_.native_size = frame.gray.size();
+        info_.frame_size = TargetSize(info_.native_size, options_.resize);
+      }
+      FitFrame(frame, info_.frame_size, info_.native_size, options_, &size_warnings_);
+      return frame;
+    }
+    if (delivered_ == 0) {
+      throw InputError("none of the " + std::to_string(entries_.size()) + " images of '" + info_.path +
+                       "' could be decoded; check the files");
+    }
+    return std::nullopt;
+  }
+
+  const SequenceInfo& info() const override { return info_; }
+  int skipped_frames() const override { return skipped_; }
+
+ private:
+  std::vector<ImageEntry> entries_;
+  FrameSourceOptions options_;
+  SequenceInfo info_;
+  long next_ = 0;
+  long end_ = 0;
+  int delivered_ = 0;
+  int skipped_ = 0;
+  int size_warnings_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<FrameSource> OpenImageList(std::vector<ImageEntry> entries, const std::string& path,
+                                           SourceFormat format, const FrameSourceOptions& options) {
+  return std::make_unique<ImageListSource>(std::move(entries), path, format, options);
+}
+
+}  // namespace vmap::internal

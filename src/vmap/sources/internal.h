@@ -1,0 +1,40 @@
+#pragma once
+// Pieces shared by the frame source implementations (not part of the public interface).
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "vmap/sources/frame_source.h"
+
+namespace vmap::internal {
+
+// One image of a list-based layout (image folder, TUM, EuRoC, KITTI).
+struct ImageEntry {
+  std::string path;
+  double timestamp = -1.0;
+};
+
+// Parsed layouts. Each throws InputError naming the file and line when it is malformed, and checks that
+// every listed image exists.
+std::vector<ImageEntry> ListImageFolder(const std::string& directory);
+std::vector<ImageEntry> ListTum(const std::string& rgb_txt);
+std::vector<ImageEntry> ListEuroc(const std::string& data_csv);
+std::vector<ImageEntry> ListKitti(const std::string& sequence_directory);
+
+std::unique_ptr<FrameSource> OpenImageList(std::vector<ImageEntry> entries, const std::string& path,
+                                           SourceFormat format, const FrameSourceOptions& options);
+std::unique_ptr<FrameSource> OpenVideo(const std::string& path, const FrameSourceOptions& options);
+
+// Size frames are delivered at, given the first frame's native size and the --resize option.
+cv::Size TargetSize(const cv::Size& native, const std::string& resize);
+
+// Brings a decoded frame to the sequence's frame size: the --resize target, or the first frame's size for
+// a frame that differs (a warning, or an error with strict).
+void FitFrame(Frame& frame, const cv::Size& target, const cv::Size& first_native, const FrameSourceOptions& options,
+              int* warnings);
+
+bool IsImageFile(const std::string& path);
+bool IsVideoFile(const std::string& path);
+
+}  // namespace vmap::internal
