@@ -39,11 +39,12 @@ int main(int argc, char** argv) {
   std::string which = "all";
   int reps = 0;
   bool tune_malloc = true;
+  int threads = 0;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--model") && i + 1 < argc) which = argv[++i];
     else if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--no-tune-malloc")) tune_malloc = false;
-    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) torch::set_num_threads(std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) threads = std::atoi(argv[++i]);
     else {
       std::fprintf(stderr, "usage: %s [--model coarse|outdoor|all] [--reps N] [--no-tune-malloc] [--threads N]\n",
                    argv[0]);
@@ -58,6 +59,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "cannot read the rccar pair under %s\n", pair.c_str());
     return 1;
   }
+  if (threads > 0) torch::set_num_threads(threads);
   std::printf("torch threads %d, malloc tuning %s, GLIBC_TUNABLES=%s\n", torch::get_num_threads(),
               tune_malloc ? "on" : "off", std::getenv("GLIBC_TUNABLES") ? std::getenv("GLIBC_TUNABLES") : "");
   std::printf("%-8s %-8s %6s %12s %12s %10s %10s %8s\n", "model", "size", "reps", "pair_s", "frame_s", "extract_s",
@@ -69,6 +71,7 @@ int main(int argc, char** argv) {
       options.model = model;
       options.longest_side = size.width;
       options.tune_malloc = tune_malloc;
+      options.num_threads = threads;
       if (model == "coarse") {
         options.weights = shared + "/weights/loftr_coarse/loftr_coarse_teacher.pt";
       } else {

@@ -12,6 +12,7 @@ MapBuilderOptions KeyImageFlags::Resolve() const {
   options.key_images.similarity = ParseSimilarityMode(similarity);
   options.key_images.final_key = final_key;
   options.quality_mean = ParseQualityMean(quality);
+  options.extraction_threads = threads;
   options.key_images.Check();
   return options;
 }
@@ -27,6 +28,8 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau) 
   command->add_option("--quality", flags.quality, "Mean used by the quality Q: arithmetic or harmonic")
       ->capture_default_str();
   command->add_flag("!--no-final-key", flags.final_key, "Do not make the last frame a key image");
+  command->add_option("--threads", flags.threads, "Feature-extraction threads (0 = one per core)")
+      ->capture_default_str();
 }
 
 std::string DescribeOptions(const Matcher& matcher, const MapBuilderOptions& options,

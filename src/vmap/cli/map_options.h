@@ -11,12 +11,13 @@
 
 namespace vmap::cli {
 
-// --tau, --similarity, --quality, --no-final-key.
+// --tau, --similarity, --quality, --no-final-key, --threads.
 struct KeyImageFlags {
   double tau = 0.5;
   std::string similarity = "inlier-ratio";
   std::string quality = "arithmetic";
   bool final_key = true;
+  int threads = 0;
   MapBuilderOptions Resolve() const;
 };
 void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau = true);

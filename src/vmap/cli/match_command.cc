@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 #include <nlohmann/json.hpp>
@@ -26,6 +27,8 @@ struct MatchFlags {
 
 cv::Mat ReadGray(const std::string& path) {
   // IMREAD_GRAYSCALE, not cvtColor: the decoder's conversion is what the reference implementations see.
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) throw InputError("image '" + path + "' does not exist");
   cv::Mat gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
   if (gray.empty()) throw InputError("cannot read image '" + path + "'; check the path and that it is an image");
   return gray;

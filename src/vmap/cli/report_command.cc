@@ -22,6 +22,7 @@ void AddReportCommand(CLI::App& app) {
   command->add_option("--figure-width", options->figure_width, "Width of the match figures in pixels")
       ->capture_default_str()
       ->check(CLI::Range(64, 8192));
+  command->add_flag("!--no-video", options->route_video, "Skip report/route.mp4, the video of the key images in order");
   command->callback([map_directory, options] {
     WriteMapReport(*map_directory, *options);
     std::cout << "report          " << (std::filesystem::path(*map_directory) / kReportFileName).string() << "\n";

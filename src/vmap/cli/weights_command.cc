@@ -96,7 +96,9 @@ void Run(const WeightsFlags& flags) {
 #endif
     const std::string path = neural::ImportWeights(flags.import_file, flags.model, expected, cache);
     std::printf("imported %s -> %s (%s)\n", flags.import_file.c_str(), path.c_str(),
-                expected.empty() ? "no known git blob id to check" : ("git blob id " + expected + " verified").c_str());
+                flags.no_verify        ? "git blob id NOT checked (--no-verify)"
+                : expected.empty()     ? "no published git blob id for this model; structure checked"
+                                       : ("git blob id " + expected + " verified").c_str());
     acted = true;
   }
   if (!flags.verify_file.empty()) {

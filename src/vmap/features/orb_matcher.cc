@@ -134,11 +134,14 @@ std::vector<std::pair<int, int>> MatchBinaryDescriptors(const cv::Mat& query, co
       } else if (d < second) {
         second = d;
       }
-      // Ties keep the lower index, as BFMatcher does.
-      if (d < best_distance_for_train[j]) {
-        best_distance_for_train[j] = d;
-        best_query_for_train[j] = i;
-      }
+    }
+    // Branch-free so that it vectorises; strict '<' keeps the lowest query index on ties, as BFMatcher.
+    int* column_best = best_distance_for_train.data();
+    int* column_arg = best_query_for_train.data();
+    for (int j = 0; j < nt; ++j) {
+      const bool better = distances[j] < column_best[j];
+      column_best[j] = better ? distances[j] : column_best[j];
+      column_arg[j] = better ? i : column_arg[j];
     }
     best_train[i] = arg;
     best_distance[i] = best;

@@ -19,7 +19,10 @@ struct MapBuilderOptions {
   VerifierOptions verifier;
   QualityMean quality_mean = QualityMean::kArithmetic;
   bool show_progress = true;   // a progress line on a terminal
-  int prefetch_frames = 4;     // frames read and extracted ahead of matching
+  int prefetch_frames = 6;     // frames read and extracted ahead of matching
+  int extraction_threads = 0;  // threads extracting features; 0 = one per core
+
+  int ExtractionThreads() const;
 
   void Check() const;  // throws InputError naming the bad option
 };

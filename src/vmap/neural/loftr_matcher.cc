@@ -65,6 +65,7 @@ class LoftrMatcher : public Matcher {
       cv::resize(gray, resized, net_size, 0, 0, shrinking ? cv::INTER_AREA : cv::INTER_LINEAR);
     }
     if (!resized.isContinuous()) resized = resized.clone();
+    UseThreads();
     torch::InferenceMode guard;
     // uint8 -> float then / 255 (not * (1/255)): bit-identical to the reference input.
     auto image = torch::from_blob(resized.data, {1, 1, resized.rows, resized.cols}, torch::kUInt8)
@@ -77,6 +78,7 @@ class LoftrMatcher : public Matcher {
     const auto* f0 = dynamic_cast<const LoftrFeatures*>(&features0);
     const auto* f1 = dynamic_cast<const LoftrFeatures*>(&features1);
     if (!f0 || !f1) throw std::invalid_argument("LoftrMatcher::Match: features from another matcher");
+    UseThreads();
     torch::InferenceMode guard;
     const auto out = model_.Match(f0->net(), f1->net());
     const bool fine = model_.config().has_fine;
@@ -113,11 +115,19 @@ class LoftrMatcher : public Matcher {
                      {"border_removal", c.border_removal},
                      {"coarse_stride", c.coarse_stride},
                      {"fine_level", c.has_fine},
-                     {"temp_bug_fix", c.temp_bug_fix}};
+                     {"temp_bug_fix", c.temp_bug_fix},
+                     {"threads", options_.num_threads}};
     return j.dump();
   }
 
  private:
+  // OpenMP thread counts belong to the calling thread, so they are set on every call, not once.
+  void UseThreads() const {
+    if (options_.num_threads > 0 && at::get_num_threads() != options_.num_threads) {
+      at::set_num_threads(options_.num_threads);
+    }
+  }
+
   // Longest side scaled to options_.longest_side, both sides rounded to whole coarse cells.
   cv::Size NetworkSize(cv::Size original) const {
     const int stride = model_.config().coarse_stride;

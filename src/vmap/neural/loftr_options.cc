@@ -14,6 +14,7 @@ void LoftrMatcherOptions::Check() const {
   if (longest_side < 32) {
     throw InputError("--loftr-size " + std::to_string(longest_side) + " is too small; use at least 32 (default 640)");
   }
+  if (num_threads < 0) throw InputError("--loftr-threads must be >= 0 (0 = LibTorch's default)");
   if (threshold > 1.0) {
     throw InputError("--loftr-threshold must be in (0, 1]");
   }

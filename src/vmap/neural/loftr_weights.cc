@@ -8,6 +8,7 @@
 #include <torch/serialize.h>
 
 #include "vmap/core/error.h"
+#include "vmap/neural/checkpoint_reader.h"
 
 namespace vmap::neural {
 
@@ -88,6 +89,26 @@ void CollectTensors(const c10::Dict<c10::IValue, c10::IValue>& dict, const std::
 
 }  // namespace
 
+// Lightning checkpoints (the official files) hold an OrderedDict and Python objects LibTorch's unpickler
+// cannot build; they go through the checkpoint reader, which keeps only what a state dict needs.
+static StateDict ReadWithCheckpointReader(const std::string& path, const std::string& first_error, size_t file_size) {
+  StateDict weights;
+  try {
+    weights = ReadCheckpointTensors(path);
+  } catch (const std::exception& e) {
+    throw InputError("cannot read LoFTR weights file '" + path + "' (" + std::to_string(file_size) +
+                     " bytes): it is not a complete torch.save zip archive (" + first_error + "; " + e.what() +
+                     "). Download it again (see `vmap weights`)");
+  }
+  StateDict stripped;
+  for (auto& [key, tensor] : weights) {
+    const bool prefixed = key.rfind(kLightningPrefix, 0) == 0;
+    stripped[prefixed ? key.substr(sizeof(kLightningPrefix) - 1) : key] = tensor;
+  }
+  if (stripped.empty()) throw InputError("LoFTR weights file '" + path + "' holds no tensors");
+  return stripped;
+}
+
 StateDict ReadStateDict(const std::string& path) {
   const std::vector<char> bytes = ReadBytes(path);
   c10::IValue root;
@@ -95,10 +116,7 @@ StateDict ReadStateDict(const std::string& path) {
     root = torch::pickle_load(bytes);
   } catch (const std::exception& e) {
     std::string reason = e.what();
-    reason = reason.substr(0, reason.find('\n'));
-    throw InputError("cannot read LoFTR weights file '" + path + "' (" + std::to_string(bytes.size()) +
-                     " bytes): it is not a complete torch.save zip archive (" + reason +
-                     "). Download it again (see `vmap weights`)");
+    return ReadWithCheckpointReader(path, reason.substr(0, reason.find('\n')), bytes.size());
   }
   if (!root.isGenericDict()) {
     throw InputError("LoFTR weights file '" + path + "' holds a " + root.tagKind() +
@@ -108,11 +126,7 @@ StateDict ReadStateDict(const std::string& path) {
   for (const char* nested : {"state_dict", "model_state_dict"}) {
     auto it = dict.find(c10::IValue(std::string(nested)));
     if (it == dict.end()) continue;
-    if (it->value().isNone()) {
-      throw InputError("LoFTR weights file '" + path + "': '" + nested +
-                       "' is stored as a Python OrderedDict, which LibTorch cannot read; re-save it as a plain "
-                       "dict (torch.save(dict(ckpt['" + nested + "']), path)) or see `vmap weights`");
-    }
+    if (it->value().isNone()) return ReadWithCheckpointReader(path, "OrderedDict", bytes.size());
     if (!it->value().isGenericDict()) {
       throw InputError("LoFTR weights file '" + path + "': '" + nested + "' is not a dict of tensors");
     }

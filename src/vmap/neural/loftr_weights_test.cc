@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <caffe2/serialize/inline_container.h>
 #include <torch/serialize.h>
 
 #include "vmap/core/error.h"
@@ -106,6 +107,114 @@ TEST(LoftrWeights, ReadsLightningCheckpointLayout) {
   }
   CheckStateDict(loaded, LoftrPreset("outdoor"), path);
   CheckStateDict(loaded, LoftrPreset("indoor"), path);
+}
+
+// A pickle program shaped like a PyTorch-Lightning checkpoint, written opcode by opcode: the state dict is a
+// collections.OrderedDict with a _metadata attribute, beside objects of classes LibTorch does not know.
+class LightningPickle {
+ public:
+  void Raw(const std::string& bytes) { code_ += bytes; }
+  void Op(char op) { code_ += op; }
+  void String(const std::string& s) {
+    Op('X');
+    Int32(static_cast<uint32_t>(s.size()));
+    code_ += s;
+  }
+  void Int(int64_t v) {
+    Op('J');
+    Int32(static_cast<uint32_t>(v));
+  }
+  void Global(const std::string& module, const std::string& name) { code_ += "c" + module + "\n" + name + "\n"; }
+  void Tensor(const torch::Tensor& t, const std::string& record) {
+    Global("torch._utils", "_rebuild_tensor_v2");
+    Op('(');
+    Op('(');
+    String("storage");
+    Global("torch", t.scalar_type() == torch::kInt64 ? "LongStorage" : "FloatStorage");
+    String(record);
+    String("cpu");
+    Int(t.numel());
+    Op('t');
+    Op('Q');
+    Int(0);
+    Op('(');
+    for (auto d : t.sizes()) Int(d);
+    Op('t');
+    Op('(');
+    for (auto d : t.strides()) Int(d);
+    Op('t');
+    Op('\x89');  // requires_grad False
+    Global("collections", "OrderedDict");
+    Op(')');
+    Op('R');
+    Op('t');
+    Op('R');
+  }
+  const std::string& code() const { return code_; }
+
+ private:
+  void Int32(uint32_t v) {
+    for (int i = 0; i < 4; ++i) code_ += static_cast<char>((v >> (8 * i)) & 0xff);
+  }
+  std::string code_;
+};
+
+TEST(LoftrWeights, ReadsLightningCheckpointWithOrderedDict) {
+  SKIP_WITHOUT_SHARED();
+  auto weights = ReadStateDict(SharedDir() + "/weights/loftr_coarse/loftr_coarse_teacher.pt");
+  const std::string path = TempPath("ordered.ckpt");
+  {
+    caffe2::serialize::PyTorchStreamWriter writer(path);
+    LightningPickle p;
+    p.Raw("\x80\x02");
+    p.Op('}');
+    p.Op('(');
+    p.String("epoch");
+    p.Int(29);
+    p.String("callbacks");
+    p.Global("pytorch_lightning.callbacks.model_checkpoint", "ModelCheckpoint");
+    p.Op(')');
+    p.Op('\x81');  // NEWOBJ of a class LibTorch cannot build
+    p.Op('}');
+    p.String("best_model_score");
+    p.Int(1);
+    p.Op('s');
+    p.Op('b');
+    p.String("state_dict");
+    p.Global("collections", "OrderedDict");
+    p.Op(')');
+    p.Op('R');
+    p.Op('(');
+    int record = 0;
+    std::vector<torch::Tensor> keep;
+    for (const auto& [key, t] : weights) {
+      auto c = t.contiguous();
+      keep.push_back(c);
+      p.String("matcher." + key);
+      p.Tensor(c, std::to_string(record));
+      writer.writeRecord("data/" + std::to_string(record), c.data_ptr(), c.numel() * c.element_size());
+      ++record;
+    }
+    p.Op('u');
+    p.Op('}');  // the OrderedDict's attributes: {'_metadata': OrderedDict()}
+    p.String("_metadata");
+    p.Global("collections", "OrderedDict");
+    p.Op(')');
+    p.Op('R');
+    p.Op('s');
+    p.Op('b');
+    p.Op('u');
+    p.Op('.');
+    writer.writeRecord("data.pkl", p.code().data(), p.code().size());
+    writer.writeEndOfFile();
+  }
+  auto loaded = ReadStateDict(path);
+  ASSERT_EQ(loaded.size(), weights.size());
+  for (const auto& [key, t] : weights) {
+    ASSERT_TRUE(loaded.count(key)) << key;
+    EXPECT_TRUE(torch::equal(loaded.at(key), t)) << key;
+  }
+  CheckStateDict(loaded, LoftrPreset("coarse"), path);
 }
 
 TEST(LoftrWeights, WrongPresetListsKeysAndNamesTheRightOne) {

@@ -64,6 +64,7 @@ td.num, th.num { text-align: right; font-variant-numeric: tabular-nums; }
 table.summary th { width: 220px; background: #f3f3f3; font-weight: 600; }
 tr.best td { background: #e8f5e9; font-weight: 600; }
 tr.broken td { background: #fdecea; }
+.plots { display: flex; flex-wrap: wrap; gap: 12px; }
 .plot { max-width: 100%; height: auto; background: #fff; border: 1px solid var(--line); border-radius: 6px; }
 .note { color: var(--muted); margin: 6px 0; }
 .strip { display: grid; grid-template-columns: repeat(auto-fill, minmax(168px, 1fr)); gap: 8px; }
@@ -343,7 +344,7 @@ std::string SimilarityPlot(const VisualMap& map, const json& options) {
   if (const json* tau = FindOption(options, "tau"); tau && tau->is_number()) {
     PlotSeries rule;
     rule.kind = PlotSeries::Kind::kHorizontalRule;
-    rule.name = "tau = " + FormatExact(tau->get<double>());
+    rule.name = "\u03c4 = " + FormatExact(tau->get<double>());
     rule.color = kOrange;
     rule.css_class = "tau";
     rule.segments.push_back({cv::Point2d(0.0, tau->get<double>())});
@@ -635,6 +636,7 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
   if (!video_file.empty()) {
     html << "<figure><video id=\"route-video\" src=\"" << UrlPath(assets_url + video_file) << "\" width=\""
          << video_size.width << "\" height=\"" << video_size.height
+         << "\" poster=\"" << UrlPath(assets_url + "keys/" + Numbered(0))
          << "\" controls muted loop playsinline preload=\"metadata\"></video><figcaption class=\"note\">The key images "
             "in order, " << FormatExact(report_options.route_fps) << " per second (" << HtmlEscape(video_file)
          << "): what a robot following this map expects to see.</figcaption></figure>\n";
@@ -677,6 +679,11 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
 
 namespace {
 
+// "0.30" as in the paper's tables; a finer threshold keeps all its digits.
+std::string TauText(double tau) {
+  return std::abs(tau * 100 - std::round(tau * 100)) < 1e-9 ? FormatFixed(tau, 2) : FormatExact(tau);
+}
+
 // Where the page in `report_directory` should point for a map written at `map_directory`.
 std::string MapLink(const std::string& map_directory, const fs::path& report_directory) {
   fs::path target(map_directory);
@@ -705,12 +712,12 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
   std::ostringstream html;
   html << PageStart("vmap sweep: " + input_name, "Threshold sweep of " + input_name,
                     std::to_string(sweep.rows.size()) + " thresholds over " + std::to_string(sweep.num_frames) +
-                        " frames" + (has_best ? ", best tau = " + FormatExact(sweep.rows[sweep.best_row].tau) : ""),
+                        " frames" + (has_best ? ", best \u03c4 = " + TauText(sweep.rows[sweep.best_row].tau) : ""),
                     {{"summary", "Summary"}, {"table", "Table"}, {"plots", "Plots"}, {"options", "Options"}});
 
   html << "<section id=\"summary\"><h2>Summary</h2>\n<div class=\"cards\">"
        << Card(std::to_string(sweep.num_frames), "frames (n)") << Card(std::to_string(sweep.rows.size()), "thresholds")
-       << (has_best ? Card(FormatExact(sweep.rows[sweep.best_row].tau), "best tau (highest Q)") +
+       << (has_best ? Card(TauText(sweep.rows[sweep.best_row].tau), "best \u03c4 (highest Q)") +
                           Card(FormatFixed(sweep.rows[sweep.best_row].quality, 3), "best Q")
                     : "")
        << "</div>\n<table class=\"summary\">\n"
@@ -731,7 +738,7 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
     const SweepRow& r = sweep.rows[i];
     const bool best = has_best && static_cast<int>(i) == sweep.best_row;
     html << "<tr class=\"" << (best ? "best" : (r.broken_links > 0 ? "broken" : "")) << "\" data-tau=\""
-         << FormatExact(r.tau) << "\"><td class=\"num\">" << (best ? "&#9733; " : "") << FormatExact(r.tau)
+         << FormatExact(r.tau) << "\"><td class=\"num\">" << (best ? "&#9733; " : "") << TauText(r.tau)
          << "</td><td class=\"num\">" << r.num_key_images << "</td><td class=\"num\">"
          << FormatFixed(r.key_image_percent, 1) << "</td><td class=\"num\">" << r.min_verified
          << "</td><td class=\"num\">" << r.max_verified << "</td><td class=\"num\">" << FormatFixed(r.mean_verified, 1)
@@ -744,13 +751,16 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
     html << "</td></tr>\n";
   }
   html << "</tbody></table>\n"
-       << (has_best ? "<p class=\"note\">&#9733; marks the threshold with the highest Q.</p>\n" : "") << "</section>\n";
+       << (has_best ? "<p class=\"note\">&#9733; marks the threshold with the highest Q. Broken links are shaded red. "
+                      "A map without a page links to its map.json: <code>vmap report DIR</code> makes its page.</p>\n"
+                    : "")
+       << "</section>\n";
 
   // Plots against tau.
-  SvgPlot keys_plot("keys-plot", "threshold tau", "key images m");
+  SvgPlot keys_plot("keys-plot", "threshold \u03c4", "key images m");
   keys_plot.SetSize(720, 320);
   keys_plot.SetIntegerY(true);
-  SvgPlot quality_plot("quality-plot", "threshold tau", "value");
+  SvgPlot quality_plot("quality-plot", "threshold \u03c4", "value");
   quality_plot.SetSize(720, 320);
   PlotSeries keys_line, quality_line, similarity_line, compression_line;
   keys_line.name = "key images m";
@@ -762,7 +772,7 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
   similarity_line.name = "mean S";
   similarity_line.color = kOrange;
   similarity_line.css_class = "similarity";
-  compression_line.name = "1 - m/n";
+  compression_line.name = "1 \u2212 m/n";
   compression_line.color = kGrey;
   compression_line.css_class = "compression";
   for (PlotSeries* s : {&keys_line, &quality_line, &similarity_line, &compression_line}) s->segments.emplace_back();
@@ -792,7 +802,7 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
     const SweepRow& best = sweep.rows[sweep.best_row];
     PlotSeries best_keys;
     best_keys.kind = PlotSeries::Kind::kMarkers;
-    best_keys.name = "best tau = " + FormatExact(best.tau);
+    best_keys.name = "best \u03c4 = " + FormatExact(best.tau);
     best_keys.color = kRed;
     best_keys.css_class = "best";
     best_keys.marker_radius = 6.0;
@@ -801,8 +811,8 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
     best_keys.segments = {{cv::Point2d(best.tau, best.quality)}};
     quality_plot.Add(best_keys);
   }
-  html << "<section id=\"plots\"><h2>Key images and quality against &tau;</h2>\n" << keys_plot.Render()
-       << quality_plot.Render()
+  html << "<section id=\"plots\"><h2>Key images and quality against &tau;</h2>\n<div class=\"plots\">"
+       << keys_plot.Render() << quality_plot.Render() << "</div>\n"
        << "<p class=\"note\">Q is the mean of the compression 1 - m/n and the mean similarity of consecutive key "
           "images; the best threshold balances few key images against well-connected ones.</p>\n</section>\n";
 

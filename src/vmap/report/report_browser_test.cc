@@ -223,7 +223,7 @@ TEST_F(ReportBrowserTest, ReportOfARealMapBuiltFromSharedData) {
   TempDir temp;
   const fs::path dir = temp.path() / "rccar_map";
   const std::string command = Quoted(VMAP_BINARY) + " build " + Quoted(images.string()) + " -o " +
-                              Quoted(dir.string()) + " --stride 3 --report -q > " +
+                              Quoted(dir.string()) + " --stride 3 --last 119 --report -q > " +
                               Quoted((temp.path() / "build.log").string()) + " 2>&1";
   ASSERT_EQ(std::system(command.c_str()), 0) << ReadText(temp.path() / "build.log");
   const VisualMap map = ReadMap(dir);
