@@ -112,6 +112,50 @@ TEST(Cli, OneFrameSequenceIsAMapWithOneKeyImage) {
   EXPECT_TRUE(map.links.empty());
 }
 
+TEST(Cli, VerboseLogSaysWhyEachKeyImageWasChosenAndQuietSaysNothing) {
+  testing::TempDir tmp;
+  testing::SyntheticOptions options;
+  options.num_frames = 30;
+  options.step = 0.08;
+  testing::WriteImageFolder(testing::RenderSyntheticSequence(options), tmp.path() / "in");
+  std::string out;
+  ASSERT_EQ(RunVmap("build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "m") + " --tau 0.8 -v", &out), 0)
+      << out;
+  EXPECT_NE(out.find("key image 0 = frame 0 (first frame)"), std::string::npos) << out;
+  EXPECT_NE(out.find("< tau"), std::string::npos) << out;
+  EXPECT_NE(out.find("(final frame)"), std::string::npos) << out;
+  ASSERT_EQ(RunVmap("-q build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "m"), &out), 0) << out;
+  EXPECT_EQ(out.find("[debug]"), std::string::npos) << out;
+  EXPECT_EQ(out.find("\r"), std::string::npos) << "no progress line when not on a terminal";
+}
+
+TEST(Cli, ProgressLineOnATerminalOnly) {
+  if (std::system("command -v script >/dev/null 2>&1") != 0) GTEST_SKIP() << "util-linux `script` is missing";
+  testing::TempDir tmp;
+  testing::SyntheticOptions options;
+  options.num_frames = 40;
+  testing::WriteImageFolder(testing::RenderSyntheticSequence(options), tmp.path() / "in");
+  // `script` gives the binary a pseudo-terminal, as an interactive user would.
+  auto on_terminal = [&](const std::string& flags) {
+    std::ofstream(tmp.path() / "run.sh") << "'" << VMAP_BINARY << "' " << flags << " build '"
+                                         << (tmp.path() / "in").string() << "' -o '" << (tmp.path() / "m").string()
+                                         << "'\n";
+    FILE* pipe = popen(("script -qec 'sh " + (tmp.path() / "run.sh").string() + "' /dev/null").c_str(), "r");
+    std::string text;
+    char buffer[4096];
+    size_t n;
+    while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) text.append(buffer, n);
+    pclose(pipe);
+    return text;
+  };
+  const std::string interactive = on_terminal("");
+  EXPECT_NE(interactive.find("/40 frames"), std::string::npos) << interactive;
+  EXPECT_NE(interactive.find("frames/s"), std::string::npos) << interactive;
+  const std::string quiet = on_terminal("--quiet");
+  EXPECT_EQ(quiet.find("/40 frames"), std::string::npos) << quiet;
+  EXPECT_NE(quiet.find("key images (m)"), std::string::npos) << quiet;
+}
+
 TEST(Cli, BadInputGivesAClearErrorAndWritesNothing) {
   testing::TempDir tmp;
   testing::SyntheticOptions options;

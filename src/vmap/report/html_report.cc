@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -518,9 +520,10 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
   fs::create_directories(assets.path() / "links");
   const std::string assets_url = std::string(kReportAssetsDirectory) + "/";
 
-  // Key images are decoded once each; consecutive links share one, so keep the last two.
+  // Consecutive links share a key image: keep the last two decoded. (cv::Mat copies share the pixels, so a
+  // returned image stays valid after it leaves the cache.)
   std::map<int, cv::Mat> cache;
-  auto key_image = [&](int index) -> const cv::Mat& {
+  auto key_image = [&](int index) -> cv::Mat {
     auto it = cache.find(index);
     if (it != cache.end()) return it->second;
     while (cache.size() >= 2) cache.erase(cache.begin());
@@ -552,7 +555,9 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
     MatchFigureOptions figure_options;
     figure_options.max_width = report_options.figure_width;
     figure_options.title = "link " + std::to_string(i) + ": " + LinkTitle(map, static_cast<int>(i));
-    const cv::Mat figure = DrawMatchFigure(key_image(l.from_key), key_image(l.to_key), l, figure_options);
+    const cv::Mat from = key_image(l.from_key);
+    const cv::Mat to = key_image(l.to_key);
+    const cv::Mat figure = DrawMatchFigure(from, to, l, figure_options);
     WriteJpeg(assets.path() / "links" / Numbered(static_cast<int>(i)), figure, report_options.jpeg_quality);
     figure_sizes.push_back(figure.size());
   }

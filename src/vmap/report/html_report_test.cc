@@ -126,6 +126,23 @@ TEST(MapReportTest, SimilarityPlotShowsEveryEvaluationTauAndTheLinks) {
             static_cast<int>(map.key_images.size()));
 }
 
+TEST(MapReportTest, MapWithOneKeyImageAndNoLinksStillGetsAPage) {
+  TempDir temp;
+  report_test::SyntheticMapOptions options;
+  options.num_frames = 1;
+  options.broken_links.clear();
+  const VisualMap map = report_test::WriteSyntheticMap(temp.path(), options);
+  ASSERT_EQ(map.key_images.size(), 1u);
+  ASSERT_TRUE(map.links.empty());
+  WriteMapReport(temp.path());
+  const std::string html = ReadText(temp.path() / kReportFileName);
+  EXPECT_EQ(report_test::CountOccurrences(html, "<figure class=\"match-figure"), 0);
+  EXPECT_EQ(report_test::CountOccurrences(html, "<figure id=\"key-"), 1);
+  EXPECT_NE(html.find("there are no links"), std::string::npos);
+  EXPECT_EQ(html.find("<video"), std::string::npos);  // one image is no route
+  EXPECT_NE(html.find("</html>"), std::string::npos);
+}
+
 TEST(MapReportTest, RewritingReplacesTheReportAndLeavesNoTemporaryFiles) {
   TempDir temp;
   const fs::path dir = temp.path() / "map";

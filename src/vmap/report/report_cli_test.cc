@@ -80,6 +80,11 @@ TEST_F(ReportCliTest, ReportWritesIntoTheMapOrExplainsWhatIsMissing) {
   ASSERT_EQ(ok.status, 0) << ok.output;
   EXPECT_TRUE(fs::exists(map / kReportFileName));
   EXPECT_NE(ok.output.find("report.html"), std::string::npos);
+  EXPECT_TRUE(fs::exists(map / "report/route.mp4"));
+  const CommandResult no_video = Vmap("report --no-video '" + map.string() + "'", temp.path());
+  ASSERT_EQ(no_video.status, 0) << no_video.output;
+  EXPECT_FALSE(fs::exists(map / "report/route.mp4"));
+  EXPECT_EQ(ReadText(map / kReportFileName).find("<video"), std::string::npos);
 
   fs::remove(map / "correspondences.bin");
   const CommandResult broken = Vmap("report '" + map.string() + "'", temp.path());
