@@ -12,6 +12,7 @@
 #include "vmap/core/error.h"
 #include "vmap/mapping/map_builder.h"
 #include "vmap/mapping/map_io.h"
+#include "vmap/report/html_report.h"
 #include "vmap/report/summary.h"
 
 namespace vmap::cli {
@@ -50,6 +51,12 @@ void RunSweep(const SweepFlags& flags) {
   if (directory) {
     for (size_t i = 0; i < maps.size(); ++i) {
       WriteMapFiles(maps[i], sweep.rows[i].map_directory);
+      if (!flags.report.empty()) {
+        // Each tau's map gets its own page, so the sweep page links to pages rather than to map.json.
+        MapReportOptions report_options;
+        report_options.route_video = false;
+        WriteMapReport(sweep.rows[i].map_directory, report_options);
+      }
       // Recorded relative to the sweep directory, which is renamed into place below.
       sweep.rows[i].map_directory = fs::path(sweep.rows[i].map_directory).filename().string();
     }
