@@ -21,7 +21,8 @@ void AddMatcherOptions(CLI::App* command, MatcherOptions& options) {
   command->add_option("--loftr-size", loftr.longest_side, "LoFTR: longest image side fed to the network")
       ->capture_default_str();
   command->add_option("--loftr-threshold", loftr.threshold, "LoFTR: coarse confidence threshold (default: preset's)");
-  command->add_option("--loftr-threads", loftr.num_threads, "LoFTR: LibTorch threads per call (0 = LibTorch default)");
+  command->add_option("--loftr-threads", loftr.num_threads, "LoFTR: LibTorch threads per call (0 = LibTorch default)")
+      ->capture_default_str();
 }
 
 VerifierOptions VerifierFlags::Resolve() const {

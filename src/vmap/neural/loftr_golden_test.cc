@@ -27,8 +27,6 @@ constexpr double kFp16Rtol = 1.0 / 2048.0;
 #define SKIP_WITHOUT_SHARED()                                                                    \
   if (!testing::SharedDataPresent()) GTEST_SKIP() << "no shared data at " << SharedDir() << "/golden"
 
-torch::Tensor F64(const torch::Tensor& t) { return t.to(torch::kCPU).to(torch::kFloat64); }
-
 // The reference's dual softmax recomputed from its own stored transformer outputs (README: bit-exact with
 // the stored conf_matrix), for the pairs whose full matrix was trimmed from the shared copy.
 torch::Tensor ReferenceConf(const torch::Tensor& feat0, const torch::Tensor& feat1, double temperature) {

@@ -9,22 +9,14 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/testing/synthetic_scene.h"
+
 #include "vmap/mapping/visual_map.h"
 
 namespace vmap::report_test {
 
-// A fresh directory under the system temp folder, removed with everything in it at destruction.
-class TempDir {
- public:
-  TempDir();
-  ~TempDir();
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
+// The project-wide temporary directory of the tests.
+using TempDir = vmap::testing::TempDir;
 
 struct SyntheticMapOptions {
   int num_frames = 40;

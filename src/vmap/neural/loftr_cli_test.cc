@@ -1,0 +1,105 @@
+// `vmap match` and `vmap weights` end to end, through the built binary.
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "vmap/neural/golden_util.h"
+
+namespace vmap::neural {
+namespace {
+
+using testing::LoadTensorDict;
+using testing::SharedDir;
+namespace fs = std::filesystem;
+
+#define SKIP_WITHOUT_SHARED()                                                                    \
+  if (!testing::SharedDataPresent()) GTEST_SKIP() << "no shared data at " << SharedDir() << "/golden"
+
+struct Result {
+  int status;
+  std::string output;
+};
+
+// `environment` is prepended to the command line (VAR=value ...).
+Result RunVmap(const std::string& arguments, const std::string& environment = "") {
+  const std::string command = environment + std::string(VMAP_BINARY) + " " + arguments + " 2>&1";
+  Result result{-1, ""};
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return result;
+  char buffer[4096];
+  while (size_t n = fread(buffer, 1, sizeof(buffer), pipe)) result.output.append(buffer, n);
+  const int status = pclose(pipe);
+  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+fs::path TempDir(const std::string& name) {
+  auto dir = fs::temp_directory_path() / ("vmap_cli_test_" + std::to_string(getpid()) + "_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+TEST(VmapMatch, WritesReferenceMatchesAndVerification) {
+  SKIP_WITHOUT_SHARED();
+  const std::string pair = SharedDir() + "/golden/loftr_coarse/rccar_000000_000006";
+  const auto dir = TempDir("match");
+  const std::string json_path = (dir / "m.json").string();
+  const auto r = RunVmap("match " + pair + "/input0.png " + pair + "/input1.png --matcher loftr --weights " +
+                     SharedDir() + "/weights/loftr_coarse/loftr_coarse_teacher.pt --json " + json_path);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("tentative   86"), std::string::npos) << r.output;
+  std::ifstream file(json_path);
+  const auto j = nlohmann::json::parse(file);
+  const auto g = LoadTensorDict(pair + "/golden.pt");
+  ASSERT_EQ(j["matches"].size(), static_cast<size_t>(g.at("mkpts0_c").size(0)));
+  EXPECT_EQ(j["num_tentative"].get<int>(), 86);
+  for (size_t k = 0; k < j["matches"].size(); ++k) {
+    const auto& m = j["matches"][k];
+    EXPECT_EQ(m["x0"].get<float>(), g.at("mkpts0_c")[k][0].item<float>());
+    EXPECT_EQ(m["y1"].get<float>(), g.at("mkpts1_c")[k][1].item<float>());
+  }
+  int inliers = 0;
+  for (const auto& m : j["matches"]) inliers += m["inlier"].get<bool>();
+  EXPECT_EQ(inliers, j["num_verified"].get<int>());
+  EXPECT_EQ(j["verified"].get<bool>(), !j["F"].is_null());
+  fs::remove_all(dir);
+}
+
+TEST(VmapMatch, BadInputExitsWithStatus2) {
+  SKIP_WITHOUT_SHARED();
+  const std::string pair = SharedDir() + "/golden/loftr_coarse/rccar_000000_000006";
+  auto r = RunVmap("match " + pair + "/input0.png /nonexistent.png --matcher loftr");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("/nonexistent.png"), std::string::npos) << r.output;
+  r = RunVmap("match " + pair + "/input0.png " + pair + "/input1.png --matcher loftr --loftr-model outdoor --weights " +
+          SharedDir() + "/weights/loftr_coarse/loftr_coarse_teacher.pt");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("--loftr-model coarse"), std::string::npos) << r.output;
+}
+
+TEST(VmapWeights, ImportsIntoCacheAndReportsIt) {
+  SKIP_WITHOUT_SHARED();
+  const auto cache = TempDir("cache");
+  const std::string env = std::string("VMAP_WEIGHTS_DIR=") + cache.string() + " ";
+  const std::string student = SharedDir() + "/weights/loftr_coarse/loftr_coarse_teacher.pt";
+  // A file of the wrong architecture is refused and nothing enters the cache.
+  EXPECT_NE(RunVmap("weights --import " + student + " --model outdoor --no-verify", env).status, 0);
+  EXPECT_FALSE(fs::exists(cache / "outdoor_ds.ckpt"));
+  // The student goes in, and `vmap weights` then lists the cached copy as the one used.
+  const auto imported = RunVmap("weights --import " + student + " --model coarse", env);
+  ASSERT_EQ(imported.status, 0) << imported.output;
+  EXPECT_TRUE(fs::exists(cache / "loftr_coarse_teacher.pt"));
+  const std::string listing = RunVmap("weights", env).output;
+  EXPECT_NE(listing.find("[used]    " + (cache / "loftr_coarse_teacher.pt").string()), std::string::npos) << listing;
+  EXPECT_NE(listing.find("vmap weights --download outdoor"), std::string::npos) << listing;
+  fs::remove_all(cache);
+}
+
+}  // namespace
+}  // namespace vmap::neural
