@@ -100,6 +100,30 @@ TEST(Cli, SweepWritesThePapersTable) {
   EXPECT_TRUE(fs::exists(tmp.path() / "sweep/sweep.md"));
 }
 
+TEST(Cli, LoftrBuildsAMapEndToEnd) {
+#ifndef VMAP_WITH_TORCH
+  GTEST_SKIP() << "built without LibTorch";
+#endif
+  REQUIRE_SHARED();
+  testing::TempDir tmp;
+  std::string out;
+  ASSERT_EQ(RunVmap("build " + Quote(Shared() / "data/rccar_room/images") + " --last 39 --matcher loftr -o " +
+                        Quote(tmp.path() / "m"),
+                    &out),
+            0)
+      << out;
+  const VisualMap map = ReadMap(tmp.path() / "m");
+  EXPECT_EQ(map.num_frames, 40);
+  EXPECT_GE(map.key_images.size(), 2u);
+  EXPECT_EQ(nlohmann::json::parse(map.options_json)["matcher"]["type"], "loftr");
+  for (const Link& link : map.links) {
+    EXPECT_EQ(static_cast<int>(link.correspondences.size()), link.num_tentative);
+    if (link.has_fundamental) EXPECT_GE(link.num_verified, 8);
+  }
+  ASSERT_EQ(RunVmap("info " + Quote(tmp.path() / "m"), &out), 0) << out;
+  EXPECT_NE(out.find("matcher         loftr"), std::string::npos) << out;
+}
+
 TEST(Cli, OneFrameSequenceIsAMapWithOneKeyImage) {
   testing::TempDir tmp;
   testing::SyntheticOptions options;

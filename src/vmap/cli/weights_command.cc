@@ -79,6 +79,13 @@ void Run(const WeightsFlags& flags) {
       const std::string path = neural::DownloadWeights(preset, cache, !flags.no_verify);
       std::printf("  saved %s (%s)\n", path.c_str(),
                   flags.no_verify ? "git blob id NOT checked" : ("git blob id " + known.git_blob_id + " verified").c_str());
+#ifdef VMAP_WITH_TORCH
+      if (flags.no_verify) {
+        // The mirror may hold other bytes than the published copy; the layout is then the check left.
+        const auto presets = LoftrPresetsFittingFile(path);
+        std::printf("  fits %s\n", presets.empty() ? "no LoFTR preset: do not use it" : Join(presets).c_str());
+      }
+#endif
     }
     acted = true;
   }

@@ -69,6 +69,8 @@ class KeyImageSelector {
   int num_frames() const { return num_frames_; }
   // The frames whose features the selector still holds (the key image and the previous frame).
   int current_key_frame() const { return key_ ? key_->frame->index : -1; }
+  // The current key image, or null before the first frame and after Finish.
+  const FrameRecord* current_key() const { return key_ ? &*key_ : nullptr; }
 
  private:
   bool Passes(const PairComparison& comparison) const;

@@ -7,6 +7,7 @@
 #include <condition_variable>
 #include <deque>
 #include <exception>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -36,13 +37,26 @@ int MapBuilderOptions::ExtractionThreads() const {
 
 namespace {
 
-// Decodes frames on one thread and extracts their features on `workers` threads, a few frames ahead of
-// the consumer, which receives them in order. Decoding is sequential by nature; extraction is not, and
-// is the largest cost per frame (ORB: ~5 ms at 640x480), so it gets every core left.
+using CompareFn = std::function<PairComparison(const FrameRecord& key, const FrameRecord& frame)>;
+
+// A frame with its features and the comparisons already made with the key images current when it was
+// extracted (by key frame index).
+struct PipelineItem {
+  FrameRecord record;
+  std::map<int, PairComparison> comparisons;
+};
+
+// Decodes frames on one thread and, on `workers` threads, extracts their features and compares them with
+// the current key images, a few frames ahead of the consumer, which receives them in order.
+//
+// Why compare ahead: a frame is compared with the same key image as the frames before it until S drops,
+// so those comparisons do not depend on each other and can run in parallel. Only the frames in flight
+// when a key image changes are compared again, by the consumer. ComparePair is deterministic, so the map
+// is the same whatever the threads do.
 class FeaturePipeline {
  public:
-  FeaturePipeline(FrameSource& source, const Matcher& matcher, int depth, int workers)
-      : source_(source), matcher_(matcher), depth_(std::max(depth, workers + 1)) {
+  FeaturePipeline(FrameSource& source, const Matcher& matcher, int depth, int workers, CompareFn compare)
+      : source_(source), matcher_(matcher), compare_(std::move(compare)), depth_(std::max(depth, workers + 1)) {
     reader_ = std::thread([this] { Guard([this] { ReadFrames(); }); });
     for (int i = 0; i < workers; ++i) workers_.emplace_back([this] { Guard([this] { ExtractFeatures(); }); });
   }
@@ -57,18 +71,25 @@ class FeaturePipeline {
     for (std::thread& worker : workers_) worker.join();
   }
 
-  // The next frame with its features, or nullopt at the end. Rethrows a worker's error.
-  std::optional<FrameRecord> Next() {
+  // The key images that frames extracted from now on are compared with.
+  void SetCurrentKeys(std::vector<FrameRecord> keys) {
+    auto shared = std::make_shared<const std::vector<FrameRecord>>(std::move(keys));
+    std::lock_guard<std::mutex> lock(mutex_);
+    current_keys_ = std::move(shared);
+  }
+
+  // The next frame, or nullopt at the end. Rethrows a worker's error.
+  std::optional<PipelineItem> Next() {
     std::unique_lock<std::mutex> lock(mutex_);
     changed_.wait(lock, [this] { return error_ || ready_.count(next_out_) || AllDone(); });
     if (error_) std::rethrow_exception(error_);
     auto it = ready_.find(next_out_);
     if (it == ready_.end()) return std::nullopt;
-    FrameRecord record = std::move(it->second);
+    PipelineItem item = std::move(it->second);
     ready_.erase(it);
     ++next_out_;
     changed_.notify_all();
-    return record;
+    return item;
   }
 
   long extracted() const { return extracted_; }
@@ -110,33 +131,44 @@ class FeaturePipeline {
 
   void ExtractFeatures() {
     for (;;) {
-      std::pair<long, Frame> item;
+      std::pair<long, Frame> decoded;
+      std::shared_ptr<const std::vector<FrameRecord>> keys;
       {
         std::unique_lock<std::mutex> lock(mutex_);
         changed_.wait(lock, [this] { return stop_ || !decoded_.empty() || reader_done_; });
         if (stop_ || decoded_.empty()) return;
-        item = std::move(decoded_.front());
+        decoded = std::move(decoded_.front());
         decoded_.pop_front();
         ++extracting_;
+        keys = current_keys_;
       }
-      FrameRecord record;
-      record.features = matcher_.Extract(item.second.gray);
-      record.frame = std::make_shared<const Frame>(std::move(item.second));
+      PipelineItem item;
+      item.record.features = matcher_.Extract(decoded.second.gray);
+      item.record.frame = std::make_shared<const Frame>(std::move(decoded.second));
       ++extracted_;
+      if (keys) {
+        for (const FrameRecord& key : *keys) {
+          if (!item.comparisons.count(key.frame->index)) {
+            item.comparisons.emplace(key.frame->index, compare_(key, item.record));
+          }
+        }
+      }
       std::lock_guard<std::mutex> lock(mutex_);
       --extracting_;
-      ready_.emplace(item.first, std::move(record));
+      ready_.emplace(decoded.first, std::move(item));
       changed_.notify_all();
     }
   }
 
   FrameSource& source_;
   const Matcher& matcher_;
+  const CompareFn compare_;
   const int depth_;
   std::mutex mutex_;
   std::condition_variable changed_;
+  std::shared_ptr<const std::vector<FrameRecord>> current_keys_;
   std::deque<std::pair<long, Frame>> decoded_;  // read, waiting for a worker
-  std::map<long, FrameRecord> ready_;           // extracted, waiting for the consumer
+  std::map<long, PipelineItem> ready_;          // extracted, waiting for the consumer
   int extracting_ = 0;
   long next_out_ = 0;
   bool reader_done_ = false;
@@ -149,18 +181,63 @@ class FeaturePipeline {
 
 std::string KeyImageFileName(int frame_index) { return fmt::format("keys/{:06d}.png", frame_index); }
 
-KeyImageSelector::KeyImageFn KeyImageWriter(const fs::path& directory) {
-  if (directory.empty()) return nullptr;
-  fs::create_directories(directory / "keys");
-  return [directory](const FrameRecord& record, KeyImage& key) {
-    key.image_file = KeyImageFileName(key.frame_index);
-    // Fast PNG compression: lossless key images, written while the build runs.
-    if (!cv::imwrite((directory / key.image_file).string(), ColorImage(*record.frame),
-                     {cv::IMWRITE_PNG_COMPRESSION, 1})) {
-      throw InputError("cannot write key image '" + (directory / key.image_file).string() + "'");
+// Writes key images on a thread of its own: PNG encoding (~20 ms per 640x480 image) would otherwise stall
+// the consumer, and with it the whole pipeline.
+class KeyImageFileWriter {
+ public:
+  KeyImageFileWriter() : thread_([this] { Run(); }) {}
+  ~KeyImageFileWriter() { Finish(); }
+
+  // A callback for KeyImageSelector that writes each key image into directory/keys/; null without a directory.
+  KeyImageSelector::KeyImageFn CallbackFor(const fs::path& directory) {
+    if (directory.empty()) return nullptr;
+    fs::create_directories(directory / "keys");
+    return [this, directory](const FrameRecord& record, KeyImage& key) {
+      key.image_file = KeyImageFileName(key.frame_index);
+      std::lock_guard<std::mutex> lock(mutex_);
+      queue_.emplace_back(directory / key.image_file, record.frame);
+      changed_.notify_all();
+    };
+  }
+
+  // Waits for every image to be written; rethrows the first failure.
+  void Finish() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (finished_) return;
+      finished_ = true;
     }
-  };
-}
+    changed_.notify_all();
+    thread_.join();
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  void Run() {
+    for (;;) {
+      std::pair<fs::path, std::shared_ptr<const Frame>> job;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        changed_.wait(lock, [this] { return finished_ || !queue_.empty(); });
+        if (queue_.empty()) return;
+        job = std::move(queue_.front());
+        queue_.pop_front();
+      }
+      if (error_) continue;
+      // Fast PNG compression: lossless key images at little cost.
+      if (!cv::imwrite(job.first.string(), ColorImage(*job.second), {cv::IMWRITE_PNG_COMPRESSION, 1})) {
+        error_ = std::make_exception_ptr(InputError("cannot write key image '" + job.first.string() + "'"));
+      }
+    }
+  }
+
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<std::pair<fs::path, std::shared_ptr<const Frame>>> queue_;
+  bool finished_ = false;
+  std::exception_ptr error_;  // written by the thread, read after join
+  std::thread thread_;        // last: starts after every other member exists
+};
 
 VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source, const MapBuilderOptions& options,
                      const std::string& options_json, double seconds) {
@@ -227,52 +304,69 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
   SweepResult result;
   result.options_json = options_json;
 
-  // A pair compared under several taus is matched once: comparisons of the current frame, by key frame.
-  std::map<int, PairComparison> comparisons_of_frame;
-  int cached_frame = -1;
+  std::atomic<long> pairs_matched{0};
+  const CompareFn compare_pair = [&](const FrameRecord& key, const FrameRecord& frame) {
+    ++pairs_matched;
+    return ComparePair(matcher, *key.features, *frame.features, options.verifier, options.key_images.similarity);
+  };
+  // The comparisons of the current frame, by key frame: made ahead by the pipeline, or here when a key
+  // image changed meanwhile. A pair compared under several taus is matched once.
+  std::map<int, PairComparison>* comparisons_of_frame = nullptr;
   auto compare = [&](const FrameRecord& key, const FrameRecord& frame) -> PairComparison {
-    if (frame.frame->index != cached_frame) {
-      comparisons_of_frame.clear();
-      cached_frame = frame.frame->index;
-    }
-    auto it = comparisons_of_frame.find(key.frame->index);
-    if (it == comparisons_of_frame.end()) {
-      ++result.pairs_matched;
-      it = comparisons_of_frame
-               .emplace(key.frame->index, ComparePair(matcher, *key.features, *frame.features, options.verifier,
-                                                      options.key_images.similarity))
-               .first;
+    auto it = comparisons_of_frame->find(key.frame->index);
+    if (it == comparisons_of_frame->end()) {
+      it = comparisons_of_frame->emplace(key.frame->index, compare_pair(key, frame)).first;
     }
     return it->second;
   };
 
+  KeyImageFileWriter image_writer;
   std::vector<std::unique_ptr<KeyImageSelector>> selectors;
   for (size_t i = 0; i < taus.size(); ++i) {
     KeyImageOptions key_options = options.key_images;
     key_options.tau = taus[i];
-    selectors.push_back(std::make_unique<KeyImageSelector>(key_options, compare, KeyImageWriter(directories[i])));
+    selectors.push_back(
+        std::make_unique<KeyImageSelector>(key_options, compare, image_writer.CallbackFor(directories[i])));
   }
 
   {
-    FeaturePipeline pipeline(source, matcher, options.prefetch_frames, options.ExtractionThreads());
+    FeaturePipeline pipeline(source, matcher, options.prefetch_frames, options.ExtractionThreads(), compare_pair);
     ProgressOptions progress_options;
     progress_options.enabled = options.show_progress;
     ProgressLine progress(taus.size() == 1 ? "build" : "sweep", source.info().expected_frames, "frames",
                           progress_options);
     long done = 0;
-    while (std::optional<FrameRecord> record = pipeline.Next()) {
-      for (auto& selector : selectors) selector->Add(*record);
+    std::vector<int> published_keys;
+    while (std::optional<PipelineItem> item = pipeline.Next()) {
+      comparisons_of_frame = &item->comparisons;
+      for (auto& selector : selectors) selector->Add(item->record);
+      // Tell the workers which key images the coming frames will be compared with.
+      std::vector<FrameRecord> keys;
+      std::vector<int> key_frames;
+      for (const auto& selector : selectors) {
+        const FrameRecord* key = selector->current_key();
+        if (key && std::find(key_frames.begin(), key_frames.end(), key->frame->index) == key_frames.end()) {
+          keys.push_back(*key);
+          key_frames.push_back(key->frame->index);
+        }
+      }
+      if (key_frames != published_keys) {
+        pipeline.SetCurrentKeys(std::move(keys));
+        published_keys = std::move(key_frames);
+      }
       progress.Update(++done);
     }
     progress.Finish();
     result.features_extracted = pipeline.extracted();
   }
+  result.pairs_matched = pairs_matched;
+  for (auto& selector : selectors) selector->Finish();  // the final key images
+  image_writer.Finish();
 
   const double seconds = SecondsSince(start);
   result.input = source.info();
   result.seconds = seconds;
   for (size_t i = 0; i < selectors.size(); ++i) {
-    selectors[i]->Finish();
     VisualMap map = CollectMap(*selectors[i], source, options, options_json, seconds);
     const MapStatistics stats = ComputeStatistics(map, options.quality_mean);
     result.num_frames = map.num_frames;

@@ -181,6 +181,82 @@ TEST(FullOutdoorGolden, RandomBatchNormStatisticsRccar) {
   RunFullGolden(root + "/rccar_000000_000006", root + "/bn_override_fp16.pt", false);
 }
 
+// Border removal (2 cells outdoor, none indoor) only drops matches whose cell touches the border band.
+TEST(LoftrBorderRemoval, DropsExactlyTheBorderBand) {
+  SKIP_WITHOUT_SHARED();
+  const std::string dir = SharedDir() + "/golden/loftr_full_random/rccar_000000_000006";
+  auto weights = ReadStateDict(SharedDir() + "/golden/loftr_full_random/weights_fp16.pt");
+  auto small = [&](const std::string& png) {
+    return torch::upsample_bilinear2d(ReadNetworkInput(png), {240, 320}, false);
+  };
+  LoftrConfig with_border = LoftrPreset("outdoor");
+  LoftrConfig without_border = with_border;
+  without_border.border_removal = LoftrPreset("indoor").border_removal;
+  ASSERT_EQ(without_border.border_removal, 0);
+  LoftrModel model(with_border, weights, torch::kCPU), open_model(without_border, weights, torch::kCPU);
+  model.set_threshold(0.0);
+  open_model.set_threshold(0.0);
+  auto f0 = model.Extract(small(dir + "/input0.png")), f1 = model.Extract(small(dir + "/input1.png"));
+  auto inner = model.Match(f0, f1), all = open_model.Match(f0, f1);
+  ASSERT_GT(inner.i_ids.size(0), 0);
+  ASSERT_GT(all.i_ids.size(0), inner.i_ids.size(0));
+  const int64_t h = f0.coarse_h, w = f0.coarse_w, b = with_border.border_removal;
+  auto in_band = [&](int64_t id) {
+    const int64_t y = id / w, x = id % w;
+    return y < b || y >= h - b || x < b || x >= w - b;
+  };
+  std::set<std::pair<int64_t, int64_t>> kept;
+  for (int64_t k = 0; k < inner.i_ids.size(0); ++k) kept.insert({inner.i_ids[k].item<int64_t>(), inner.j_ids[k].item<int64_t>()});
+  size_t outside_band = 0;
+  for (int64_t k = 0; k < all.i_ids.size(0); ++k) {
+    const int64_t i = all.i_ids[k].item<int64_t>(), j = all.j_ids[k].item<int64_t>();
+    const bool inside = !in_band(i) && !in_band(j);
+    outside_band += inside;
+    EXPECT_EQ(kept.count({i, j}) == 1, inside) << i << " -> " << j;
+  }
+  EXPECT_EQ(outside_band, kept.size());
+}
+
+// Every architecture value of the outdoor and indoor presets against the reference configs.
+TEST(LoftrPresets, EqualReferenceConfigs) {
+  SKIP_WITHOUT_SHARED();
+  const auto configs = LoadJson(SharedDir() + "/golden/loftr_full_random/config.json");
+  for (const std::string name : {"outdoor", "indoor"}) {
+    const auto& ref = configs[name == "outdoor" ? "outdoor_ds" : "indoor_ds_new"]["loftr_config"];
+    const LoftrConfig c = LoftrPreset(name);
+    SCOPED_TRACE(name);
+    EXPECT_EQ(c.backbone, BackboneKind::kResNetFpn8_2);
+    EXPECT_EQ(ref["resolution"][0].get<int>(), c.coarse_stride);
+    EXPECT_EQ(ref["resolution"][1].get<int>(), c.fine_stride);
+    EXPECT_EQ(ref["resnetfpn"]["initial_dim"].get<int>(), c.initial_dim);
+    EXPECT_EQ(ref["resnetfpn"]["block_dims"].get<std::vector<int>>(), c.block_dims);
+    EXPECT_EQ(ref["coarse"]["d_model"].get<int>(), c.d_model);
+    EXPECT_EQ(ref["coarse"]["nhead"].get<int>(), c.nhead);
+    EXPECT_EQ(ref["coarse"]["layer_names"].size(), static_cast<size_t>(2 * c.num_coarse_layer_pairs));
+    EXPECT_EQ(ref["coarse"]["temp_bug_fix"].get<bool>(), c.temp_bug_fix);
+    EXPECT_EQ(ref["match_coarse"]["thr"].get<double>(), c.threshold);
+    EXPECT_EQ(ref["match_coarse"]["border_rm"].get<int>(), c.border_removal);
+    EXPECT_EQ(ref["match_coarse"]["dsmax_temperature"].get<double>(), c.temperature);
+    EXPECT_EQ(ref["match_coarse"]["match_type"].get<std::string>(), "dual_softmax");
+    EXPECT_EQ(ref["fine_window_size"].get<int>(), c.fine_window);
+    EXPECT_EQ(ref["fine_concat_coarse_feat"].get<bool>(), c.fine_concat_coarse_feat);
+    EXPECT_EQ(ref["fine"]["d_model"].get<int>(), c.fine_d_model);
+    EXPECT_EQ(ref["fine"]["nhead"].get<int>(), c.fine_nhead);
+    EXPECT_EQ(ref["fine"]["layer_names"].size(), static_cast<size_t>(2 * c.num_fine_layer_pairs));
+    EXPECT_EQ(c.layer_norm_eps, 1e-5);
+  }
+  const auto student = LoadJson(SharedDir() + "/golden/loftr_coarse/rccar_000000_000006/golden.json");
+  const LoftrConfig c = LoftrPreset("coarse");
+  EXPECT_EQ(student["config"]["resolution"][0].get<int>(), c.coarse_stride);
+  EXPECT_EQ(student["config"]["resnetfpn"]["block_dims"].get<std::vector<int>>(), c.block_dims);
+  EXPECT_EQ(student["config"]["resnetfpn"]["initial_dim"].get<int>(), c.initial_dim);
+  EXPECT_EQ(student["config"]["coarse"]["nhead"].get<int>(), c.nhead);
+  EXPECT_EQ(student["config"]["coarse"]["layer_names"].size(), static_cast<size_t>(2 * c.num_coarse_layer_pairs));
+  EXPECT_EQ(student["config"]["coarse"]["temp_bug_fix"].get<bool>(), c.temp_bug_fix);
+  EXPECT_EQ(student["linear_attention_eps"].get<double>(), c.attention_eps);
+  EXPECT_FALSE(c.has_fine);
+}
+
 // The positional encoding of both variants against the reference's values at a few positions:
 // buggy (outdoor, student) frequencies are exp(-k), fixed ones 10000^(-k/(d/2)).
 TEST(PositionalEncoding, MatchesReferenceFirstRows) {

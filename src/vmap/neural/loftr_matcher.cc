@@ -107,7 +107,8 @@ class LoftrMatcher : public Matcher {
 
   std::string DescribeOptionsJson() const override {
     const auto& c = model_.config();
-    nlohmann::json j{{"model", c.preset},
+    nlohmann::json j{{"type", "loftr"},
+                     {"model", c.preset},
                      {"weights", weights_path_},
                      {"device", options_.device},
                      {"longest_side", options_.longest_side},

@@ -16,7 +16,8 @@ void LoftrMatcherOptions::Check() const {
   }
   if (num_threads < 0) throw InputError("--loftr-threads must be >= 0 (0 = LibTorch's default)");
   if (threshold > 1.0) {
-    throw InputError("--loftr-threshold must be in (0, 1]");
+    // 0 is allowed: it keeps every mutual nearest neighbour (used to reproduce the random-weight golden).
+    throw InputError("--loftr-threshold must be in [0, 1] (negative: the preset's)");
   }
 }
 

@@ -107,6 +107,7 @@ TEST(LoftrWeights, ReadsLightningCheckpointLayout) {
   }
   CheckStateDict(loaded, LoftrPreset("outdoor"), path);
   CheckStateDict(loaded, LoftrPreset("indoor"), path);
+  fs::remove_all(fs::path(path).parent_path());
 }
 
 // A pickle program shaped like a PyTorch-Lightning checkpoint, written opcode by opcode: the state dict is a
@@ -215,6 +216,7 @@ TEST(LoftrWeights, ReadsLightningCheckpointWithOrderedDict) {
     EXPECT_TRUE(torch::equal(loaded.at(key), t)) << key;
   }
   CheckStateDict(loaded, LoftrPreset("coarse"), path);
+  fs::remove_all(fs::path(path).parent_path());
 }
 
 TEST(LoftrWeights, WrongPresetListsKeysAndNamesTheRightOne) {
@@ -258,6 +260,7 @@ TEST(LoftrWeights, TruncatedAndForeignFilesGiveClearErrors) {
   WriteBytes(list_path, torch::pickle_save(c10::IValue(c10::List<int64_t>({1, 2}))));
   EXPECT_NE(ExpectInputError([&] { ReadStateDict(list_path); }).find("not a dict"), std::string::npos);
   EXPECT_NE(ExpectInputError([&] { ReadStateDict(TempPath("absent.pt")); }).find("cannot open"), std::string::npos);
+  fs::remove_all(fs::path(text_path).parent_path());
 }
 
 }  // namespace
