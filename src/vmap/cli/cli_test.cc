@@ -187,6 +187,8 @@ TEST(Cli, BadInputGivesAClearErrorAndWritesNothing) {
   testing::WriteImageFolder(testing::RenderSyntheticSequence(options), tmp.path() / "in");
   fs::create_directories(tmp.path() / "empty");
   std::ofstream(tmp.path() / "broken.mp4") << std::string(4096, '\x42');
+  fs::create_directories(tmp.path() / "corrupt");
+  for (const char* name : {"a.png", "b.png", "c.png"}) std::ofstream(tmp.path() / "corrupt" / name) << "not an image";
   struct Case {
     std::string arguments;
     std::string expected;  // part of the message
@@ -197,6 +199,7 @@ TEST(Cli, BadInputGivesAClearErrorAndWritesNothing) {
       {"build " + Quote(tmp.path() / "nothing_here") + out_dir, "nothing_here' does not exist"},
       {"build " + Quote(tmp.path() / "empty") + out_dir, "holds no images"},
       {"build " + Quote(tmp.path() / "broken.mp4") + out_dir, "cannot open video"},
+      {"build " + Quote(tmp.path() / "corrupt") + out_dir, "none of the 3 images"},
       {"build " + in + out_dir + " --tau 0", "outside (0, 1]"},
       {"build " + in + out_dir + " --tau 1.5", "outside (0, 1]"},
       {"build " + in + out_dir + " --verifier lmeds", "unknown verifier 'lmeds'"},

@@ -186,7 +186,8 @@ std::string KeyImageFileName(int frame_index) { return fmt::format("keys/{:06d}.
 class KeyImageFileWriter {
  public:
   KeyImageFileWriter() : thread_([this] { Run(); }) {}
-  ~KeyImageFileWriter() { Finish(); }
+  // Never throws: when the build failed, a write error no longer matters.
+  ~KeyImageFileWriter() { Join(); }
 
   // A callback for KeyImageSelector that writes each key image into directory/keys/; null without a directory.
   KeyImageSelector::KeyImageFn CallbackFor(const fs::path& directory) {
@@ -202,17 +203,20 @@ class KeyImageFileWriter {
 
   // Waits for every image to be written; rethrows the first failure.
   void Finish() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (finished_) return;
-      finished_ = true;
-    }
-    changed_.notify_all();
-    thread_.join();
+    Join();
     if (error_) std::rethrow_exception(error_);
   }
 
  private:
+  void Join() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      finished_ = true;
+    }
+    changed_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+
   void Run() {
     for (;;) {
       std::pair<fs::path, std::shared_ptr<const Frame>> job;

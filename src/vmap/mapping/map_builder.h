@@ -55,7 +55,7 @@ struct SweepResult {
   int best_row = -1;           // highest Q
   double seconds = 0.0;
   long features_extracted = 0; // one per frame: no frame is extracted twice
-  long pairs_matched = 0;
+  long pairs_matched = 0;      // pairs matched and verified, including a few made ahead and not needed
 };
 
 // Parses "0.1:0.9:0.1" (start:stop:step, inclusive) or "0.2,0.5,0.8".
