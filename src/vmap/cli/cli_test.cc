@@ -118,7 +118,9 @@ TEST(Cli, LoftrBuildsAMapEndToEnd) {
   EXPECT_EQ(nlohmann::json::parse(map.options_json)["matcher"]["type"], "loftr");
   for (const Link& link : map.links) {
     EXPECT_EQ(static_cast<int>(link.correspondences.size()), link.num_tentative);
-    if (link.has_fundamental) EXPECT_GE(link.num_verified, 8);
+    if (link.has_fundamental) {
+      EXPECT_GE(link.num_verified, 8);
+    }
   }
   ASSERT_EQ(RunVmap("info " + Quote(tmp.path() / "m"), &out), 0) << out;
   EXPECT_NE(out.find("matcher         loftr"), std::string::npos) << out;
