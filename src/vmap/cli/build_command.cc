@@ -40,7 +40,7 @@ void RunBuild(const BuildFlags& flags) {
 
   const fs::path output = flags.output.empty() ? fs::path(fs::path(flags.input).filename().stem().string() + "_map")
                                                : fs::path(flags.output);
-  AtomicOutputDirectory directory(output);
+  AtomicOutputDirectory directory(output, kMapFileName);
   const std::string options_json = DescribeOptions(*matcher, options, source_options);
   const VisualMap map = BuildMap(*source, *matcher, options, directory.path(), options_json);
   WriteMapFiles(map, directory.path());

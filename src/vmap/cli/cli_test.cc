@@ -224,6 +224,23 @@ TEST(Cli, BadInputGivesAClearErrorAndWritesNothing) {
   }
 }
 
+TEST(Cli, ReplacesAnOlderMapButNeverAFolderOfTheUser) {
+  testing::TempDir tmp;
+  testing::SyntheticOptions options;
+  options.num_frames = 5;
+  testing::WriteImageFolder(testing::RenderSyntheticSequence(options), tmp.path() / "in");
+  std::string out;
+  const std::string build = "build " + Quote(tmp.path() / "in") + " -o ";
+  ASSERT_EQ(RunVmap(build + Quote(tmp.path() / "m"), &out), 0) << out;
+  ASSERT_EQ(RunVmap(build + Quote(tmp.path() / "m") + " --tau 0.9", &out), 0) << out;
+  EXPECT_NEAR(nlohmann::json::parse(ReadMap(tmp.path() / "m").options_json)["tau"].get<double>(), 0.9, 1e-12);
+  fs::create_directories(tmp.path() / "documents");
+  std::ofstream(tmp.path() / "documents" / "notes.txt") << "keep me";
+  EXPECT_EQ(RunVmap(build + Quote(tmp.path() / "documents"), &out), 2) << out;
+  EXPECT_NE(out.find("will not replace it"), std::string::npos) << out;
+  EXPECT_TRUE(fs::exists(tmp.path() / "documents" / "notes.txt"));
+}
+
 TEST(Cli, TruncatedVideoIsAClearError) {
   REQUIRE_SHARED();
   testing::TempDir tmp;

@@ -44,7 +44,7 @@ void RunSweep(const SweepFlags& flags) {
   const std::string options_json = DescribeOptions(*matcher, options, source_options);
 
   std::unique_ptr<AtomicOutputDirectory> directory;
-  if (!flags.output.empty()) directory = std::make_unique<AtomicOutputDirectory>(flags.output);
+  if (!flags.output.empty()) directory = std::make_unique<AtomicOutputDirectory>(flags.output, "sweep.json");
   std::vector<VisualMap> maps;
   SweepResult sweep = SweepThresholds(*source, *matcher, options, taus, flags.write_maps ? &maps : nullptr,
                                       flags.write_maps ? directory->path() : fs::path(), options_json);

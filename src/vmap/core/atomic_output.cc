@@ -41,15 +41,17 @@ void WriteFileAtomically(const fs::path& path, std::string_view content) {
   fs::rename(temp, path);
 }
 
-AtomicOutputDirectory::AtomicOutputDirectory(fs::path final_path, bool overwrite)
+AtomicOutputDirectory::AtomicOutputDirectory(fs::path final_path, const std::string& ownership_marker)
     : final_path_(std::move(final_path)) {
   if (final_path_.filename().empty()) final_path_ = final_path_.parent_path();  // "out/" -> "out"
   if (fs::exists(final_path_)) {
-    if (!overwrite) {
-      throw InputError("output '" + final_path_.string() + "' already exists; remove it or pass --overwrite");
-    }
     if (!fs::is_directory(final_path_)) {
       throw InputError("output '" + final_path_.string() + "' exists and is not a directory; choose another path");
+    }
+    const bool empty = fs::directory_iterator(final_path_) == fs::directory_iterator();
+    if (!empty && !ownership_marker.empty() && !fs::exists(final_path_ / ownership_marker)) {
+      throw InputError("output '" + final_path_.string() + "' exists and is not vmap's (it has no " +
+                       ownership_marker + "); vmap will not replace it: choose another output directory");
     }
   }
   const fs::path parent = final_path_.has_parent_path() ? final_path_.parent_path() : fs::path(".");

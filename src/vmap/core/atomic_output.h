@@ -15,8 +15,11 @@ void WriteFileAtomically(const std::filesystem::path& path, std::string_view con
 // work happens in a hidden temporary sibling, removed if the object is destroyed uncommitted.
 class AtomicOutputDirectory {
  public:
-  // `overwrite`: replace an existing directory at `final_path` on Commit(); otherwise refuse.
-  explicit AtomicOutputDirectory(std::filesystem::path final_path, bool overwrite = true);
+  // An existing directory at `final_path` is replaced on Commit() only when it is empty or holds the file
+  // `ownership_marker` (e.g. "map.json": an older map), so that a mistyped -o never deletes a user's
+  // folder. kReplaceAnything is for directories vmap owns outright (a map's report assets).
+  AtomicOutputDirectory(std::filesystem::path final_path, const std::string& ownership_marker);
+  static constexpr const char* kReplaceAnything = "";
   ~AtomicOutputDirectory();
   AtomicOutputDirectory(const AtomicOutputDirectory&) = delete;
   AtomicOutputDirectory& operator=(const AtomicOutputDirectory&) = delete;

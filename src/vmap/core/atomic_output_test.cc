@@ -19,7 +19,7 @@ TEST(AtomicOutput, DirectoryAppearsOnlyOnCommit) {
   testing::TempDir tmp;
   const fs::path target = tmp.path() / "map";
   {
-    AtomicOutputDirectory dir(target);
+    AtomicOutputDirectory dir(target, "marker");
     std::ofstream(dir.path() / "a.txt") << "hello";
     EXPECT_FALSE(fs::exists(target));
     dir.Commit();
@@ -33,8 +33,9 @@ TEST(AtomicOutput, UncommittedDirectoryLeavesNothingAndKeepsTheOldOne) {
   const fs::path target = tmp.path() / "map";
   fs::create_directories(target);
   std::ofstream(target / "old.txt") << "old";
+  std::ofstream(target / "marker") << "";
   {
-    AtomicOutputDirectory dir(target);
+    AtomicOutputDirectory dir(target, "marker");
     std::ofstream(dir.path() / "new.txt") << "new";
     // destroyed without Commit: as if the build failed half-way
   }
@@ -48,7 +49,8 @@ TEST(AtomicOutput, CommitReplacesAnOlderDirectory) {
   const fs::path target = tmp.path() / "map";
   fs::create_directories(target);
   std::ofstream(target / "old.txt") << "old";
-  AtomicOutputDirectory dir(target);
+  std::ofstream(target / "marker") << "";
+  AtomicOutputDirectory dir(target, "marker");
   std::ofstream(dir.path() / "new.txt") << "new";
   dir.Commit();
   EXPECT_FALSE(fs::exists(target / "old.txt"));
@@ -58,7 +60,20 @@ TEST(AtomicOutput, CommitReplacesAnOlderDirectory) {
 TEST(AtomicOutput, RefusesToReplaceAFile) {
   testing::TempDir tmp;
   std::ofstream(tmp.path() / "file") << "x";
-  EXPECT_THROW(AtomicOutputDirectory(tmp.path() / "file"), InputError);
+  EXPECT_THROW(AtomicOutputDirectory(tmp.path() / "file", "marker"), InputError);
+}
+
+TEST(AtomicOutput, NeverReplacesADirectoryItDoesNotOwn) {
+  testing::TempDir tmp;
+  const fs::path target = tmp.path() / "documents";
+  fs::create_directories(target);
+  std::ofstream(target / "thesis.tex") << "precious";
+  EXPECT_THROW(AtomicOutputDirectory(target, "map.json"), InputError);
+  EXPECT_EQ(ReadAll(target / "thesis.tex"), "precious");
+  // An empty directory may be used.
+  fs::create_directories(tmp.path() / "empty");
+  AtomicOutputDirectory empty(tmp.path() / "empty", "map.json");
+  empty.Commit();
 }
 
 TEST(AtomicOutput, WriteFileAtomicallyWritesContentAndNoTemporaries) {

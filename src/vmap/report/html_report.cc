@@ -515,7 +515,7 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
   const MapStatistics stats = ComputeStatistics(
       map, OptionText(options, "quality_mean") == "harmonic" ? QualityMean::kHarmonic : QualityMean::kArithmetic);
 
-  AtomicOutputDirectory assets(map_directory / kReportAssetsDirectory);
+  AtomicOutputDirectory assets(map_directory / kReportAssetsDirectory, AtomicOutputDirectory::kReplaceAnything);
   fs::create_directories(assets.path() / "keys");
   fs::create_directories(assets.path() / "links");
   const std::string assets_url = std::string(kReportAssetsDirectory) + "/";
