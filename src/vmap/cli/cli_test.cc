@@ -202,6 +202,7 @@ TEST(Cli, BadInputGivesAClearErrorAndWritesNothing) {
       {"build " + Quote(tmp.path() / "empty") + out_dir, "holds no images"},
       {"build " + Quote(tmp.path() / "broken.mp4") + out_dir, "cannot open video"},
       {"build " + Quote(tmp.path() / "corrupt") + out_dir, "none of the 3 images"},
+      {"build " + Quote(tmp.path() / "in" / "frame_1.png") + out_dir, "is a single image"},
       {"build " + in + out_dir + " --tau 0", "outside (0, 1]"},
       {"build " + in + out_dir + " --tau 1.5", "outside (0, 1]"},
       {"build " + in + out_dir + " --verifier lmeds", "unknown verifier 'lmeds'"},

@@ -67,8 +67,6 @@ class KeyImageSelector {
   const std::vector<Link>& links() const { return links_; }
   const std::vector<Evaluation>& evaluations() const { return evaluations_; }
   int num_frames() const { return num_frames_; }
-  // The frames whose features the selector still holds (the key image and the previous frame).
-  int current_key_frame() const { return key_ ? key_->frame->index : -1; }
   // The current key image, or null before the first frame and after Finish.
   const FrameRecord* current_key() const { return key_ ? &*key_ : nullptr; }
 

@@ -95,14 +95,6 @@ bool IsImageFile(const std::string& path) {
   return std::any_of(std::begin(kExtensions), std::end(kExtensions), [&](const char* e) { return ext == e; });
 }
 
-bool IsVideoFile(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  static const char* kExtensions[] = {".mp4", ".avi", ".mkv", ".mov", ".m4v", ".webm", ".mpg",
-                                      ".mpeg", ".wmv", ".flv", ".ts", ".mts", ".3gp", ".ogv"};
-  return std::any_of(std::begin(kExtensions), std::end(kExtensions), [&](const char* e) { return ext == e; });
-}
-
 cv::Size TargetSize(const cv::Size& native, const std::string& resize) {
   if (resize.empty()) return native;
   int width = 0, height = 0;
@@ -154,6 +146,8 @@ std::unique_ptr<FrameSource> OpenFrameSource(const std::string& path, const Fram
       else if (fs::exists(p / "mav0/cam0/data.csv") || fs::exists(p / "cam0/data.csv")) format = SourceFormat::kEuroc;
       else if (fs::is_directory(p / "image_0") || fs::is_directory(p / "image_2")) format = SourceFormat::kKitti;
       else format = SourceFormat::kImageFolder;
+    } else if (internal::IsImageFile(path)) {
+      throw InputError("input '" + path + "' is a single image; pass the folder that holds the sequence's images");
     } else if (p.filename() == "rgb.txt") {
       format = SourceFormat::kTum;
     } else if (p.filename() == "data.csv") {

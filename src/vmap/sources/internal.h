@@ -35,6 +35,5 @@ void FitFrame(Frame& frame, const cv::Size& target, const cv::Size& first_native
               int* warnings);
 
 bool IsImageFile(const std::string& path);
-bool IsVideoFile(const std::string& path);
 
 }  // namespace vmap::internal
