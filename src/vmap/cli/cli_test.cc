@@ -22,6 +22,14 @@ fs::path Shared() { return testing::SharedDir(); }
 
 std::string Quote(const fs::path& p) { return "'" + p.string() + "'"; }
 
+// A synthetic sequence of `num_frames` written as an image folder at `directory`.
+void WriteSyntheticInput(const fs::path& directory, int num_frames, double step = testing::SyntheticOptions().step) {
+  testing::SyntheticOptions options;
+  options.num_frames = num_frames;
+  options.step = step;
+  testing::WriteImageFolder(testing::RenderSyntheticSequence(options), directory);
+}
+
 }  // namespace
 
 TEST(Cli, BuildsAndReadsBackAMapFromAVideo) {
@@ -128,9 +136,7 @@ TEST(Cli, LoftrBuildsAMapEndToEnd) {
 
 TEST(Cli, OneFrameSequenceIsAMapWithOneKeyImage) {
   testing::TempDir tmp;
-  testing::SyntheticOptions options;
-  options.num_frames = 1;
-  testing::WriteImageFolder(testing::RenderSyntheticSequence(options), tmp.path() / "in");
+  WriteSyntheticInput(tmp.path() / "in", 1);
   std::string out;
   ASSERT_EQ(RunVmap("build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "m"), &out), 0) << out;
   const VisualMap map = ReadMap(tmp.path() / "m");
@@ -140,10 +146,7 @@ TEST(Cli, OneFrameSequenceIsAMapWithOneKeyImage) {
 
 TEST(Cli, VerboseLogSaysWhyEachKeyImageWasChosenAndQuietSaysNothing) {
   testing::TempDir tmp;
-  testing::SyntheticOptions options;
-  options.num_frames = 30;
-  options.step = 0.08;
-  testing::WriteImageFolder(testing::RenderSyntheticSequence(options), tmp.path() / "in");
+  WriteSyntheticInput(tmp.path() / "in", 30, 0.08);
   std::string out;
   ASSERT_EQ(RunVmap("build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "m") + " --tau 0.8 -v", &out), 0)
       << out;
@@ -158,9 +161,7 @@ TEST(Cli, VerboseLogSaysWhyEachKeyImageWasChosenAndQuietSaysNothing) {
 TEST(Cli, ProgressLineOnATerminalOnly) {
   if (std::system("command -v script >/dev/null 2>&1") != 0) GTEST_SKIP() << "util-linux `script` is missing";
   testing::TempDir tmp;
-  testing::SyntheticOptions options;
-  options.num_frames = 40;
-  testing::WriteImageFolder(testing::RenderSyntheticSequence(options), tmp.path() / "in");
+  WriteSyntheticInput(tmp.path() / "in", 40);
   // `script` gives the binary a pseudo-terminal, as an interactive user would.
   auto on_terminal = [&](const std::string& flags) {
     std::ofstream(tmp.path() / "run.sh") << "'" << VMAP_BINARY << "' " << flags << " build '"
@@ -184,9 +185,7 @@ TEST(Cli, ProgressLineOnATerminalOnly) {
 
 TEST(Cli, BadInputGivesAClearErrorAndWritesNothing) {
   testing::TempDir tmp;
-  testing::SyntheticOptions options;
-  options.num_frames = 4;
-  testing::WriteImageFolder(testing::RenderSyntheticSequence(options), tmp.path() / "in");
+  WriteSyntheticInput(tmp.path() / "in", 4);
   fs::create_directories(tmp.path() / "empty");
   std::ofstream(tmp.path() / "broken.mp4") << std::string(4096, '\x42');
   fs::create_directories(tmp.path() / "corrupt");
@@ -227,9 +226,7 @@ TEST(Cli, BadInputGivesAClearErrorAndWritesNothing) {
 
 TEST(Cli, ReplacesAnOlderMapButNeverAFolderOfTheUser) {
   testing::TempDir tmp;
-  testing::SyntheticOptions options;
-  options.num_frames = 5;
-  testing::WriteImageFolder(testing::RenderSyntheticSequence(options), tmp.path() / "in");
+  WriteSyntheticInput(tmp.path() / "in", 5);
   std::string out;
   const std::string build = "build " + Quote(tmp.path() / "in") + " -o ";
   ASSERT_EQ(RunVmap(build + Quote(tmp.path() / "m"), &out), 0) << out;
@@ -257,9 +254,7 @@ TEST(Cli, TruncatedVideoIsAClearError) {
 
 TEST(Cli, DifferentFrameSizesWarnOrFailWhenStrict) {
   testing::TempDir tmp;
-  testing::SyntheticOptions options;
-  options.num_frames = 5;
-  testing::WriteImageFolder(testing::RenderSyntheticSequence(options), tmp.path() / "in");
+  WriteSyntheticInput(tmp.path() / "in", 5);
   cv::imwrite((tmp.path() / "in/frame_3.png").string(), cv::Mat(100, 150, CV_8UC3, cv::Scalar(90, 90, 90)));
   std::string out;
   EXPECT_EQ(RunVmap("build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "m"), &out), 0) << out;

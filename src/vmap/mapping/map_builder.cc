@@ -1,15 +1,16 @@
 #include "vmap/mapping/map_builder.h"
 
-#include <chrono>
-#include <cmath>
 #include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <deque>
 #include <exception>
 #include <functional>
 #include <map>
 #include <mutex>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -71,7 +72,7 @@ class FeaturePipeline {
     for (std::thread& worker : workers_) worker.join();
   }
 
-  // The key images that frames extracted from now on are compared with.
+  // The key images (distinct) that frames extracted from now on are compared with.
   void SetCurrentKeys(std::vector<FrameRecord> keys) {
     auto shared = std::make_shared<const std::vector<FrameRecord>>(std::move(keys));
     std::lock_guard<std::mutex> lock(mutex_);
@@ -147,11 +148,7 @@ class FeaturePipeline {
       item.record.frame = std::make_shared<const Frame>(std::move(decoded.second));
       ++extracted_;
       if (keys) {
-        for (const FrameRecord& key : *keys) {
-          if (!item.comparisons.count(key.frame->index)) {
-            item.comparisons.emplace(key.frame->index, compare_(key, item.record));
-          }
-        }
+        for (const FrameRecord& key : *keys) item.comparisons.emplace(key.frame->index, compare_(key, item.record));
       }
       std::lock_guard<std::mutex> lock(mutex_);
       --extracting_;
@@ -340,19 +337,16 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
     ProgressLine progress(taus.size() == 1 ? "build" : "sweep", source.info().expected_frames, "frames",
                           progress_options);
     long done = 0;
-    std::vector<int> published_keys;
+    std::set<int> published_keys;
     while (std::optional<PipelineItem> item = pipeline.Next()) {
       comparisons_of_frame = &item->comparisons;
       for (auto& selector : selectors) selector->Add(item->record);
       // Tell the workers which key images the coming frames will be compared with.
+      std::set<int> key_frames;
       std::vector<FrameRecord> keys;
-      std::vector<int> key_frames;
       for (const auto& selector : selectors) {
         const FrameRecord* key = selector->current_key();
-        if (key && std::find(key_frames.begin(), key_frames.end(), key->frame->index) == key_frames.end()) {
-          keys.push_back(*key);
-          key_frames.push_back(key->frame->index);
-        }
+        if (key && key_frames.insert(key->frame->index).second) keys.push_back(*key);
       }
       if (key_frames != published_keys) {
         pipeline.SetCurrentKeys(std::move(keys));
