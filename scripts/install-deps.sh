@@ -7,6 +7,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
   libopencv-dev                 # OpenCV 4.6 with the FFmpeg video backend and USAC (MAGSAC)
+  libavformat-dev libavcodec-dev libswscale-dev libavutil-dev  # FFmpeg: vmap decodes videos itself
   libtorch-dev                  # LibTorch 1.13 (CPU) for the deep matchers
   libopenblas0-openmp           # without it LibTorch uses the reference BLAS and runs 30-50x slower
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev libeigen3-dev

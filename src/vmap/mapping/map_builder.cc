@@ -40,6 +40,12 @@ namespace {
 
 using CompareFn = std::function<PairComparison(const FrameRecord& key, const FrameRecord& frame)>;
 
+// A key image the workers compare frames with, and the lowest tau of the selectors that hold it.
+struct CurrentKey {
+  FrameRecord record;
+  double min_tau = 1.0;
+};
+
 // A frame with its features and the comparisons already made with the key images current when it was
 // extracted (by key frame index).
 struct PipelineItem {
@@ -54,6 +60,12 @@ struct PipelineItem {
 // so those comparisons do not depend on each other and can run in parallel. Only the frames in flight
 // when a key image changes are compared again, by the consumer. ComparePair is deterministic, so the map
 // is the same whatever the threads do.
+//
+// A key image is retired as soon as a worker sees a frame j fail against it: every selector holding it
+// leaves it at frame j at the latest, for frame j-1 (or for j itself when j-1 is that key: a broken link).
+// Later frames are compared with that successor at once, as the consumer will ask, instead of with the old
+// key at low S, where MAGSAC needs the most iterations (up to 60 ms a pair on lab_floor) only for the
+// result to be thrown away, and the consumer then redoing the comparisons one by one while the workers wait.
 class FeaturePipeline {
  public:
   FeaturePipeline(FrameSource& source, const Matcher& matcher, int depth, int workers, CompareFn compare)
@@ -72,9 +84,10 @@ class FeaturePipeline {
     for (std::thread& worker : workers_) worker.join();
   }
 
-  // The key images (distinct) that frames extracted from now on are compared with.
-  void SetCurrentKeys(std::vector<FrameRecord> keys) {
-    auto shared = std::make_shared<const std::vector<FrameRecord>>(std::move(keys));
+  // The key images (distinct) that frames extracted from now on are compared with, each with the lowest
+  // tau of the selectors holding it: a frame below that similarity makes all of them leave the key.
+  void SetCurrentKeys(std::vector<CurrentKey> keys) {
+    auto shared = std::make_shared<const std::vector<CurrentKey>>(std::move(keys));
     std::lock_guard<std::mutex> lock(mutex_);
     current_keys_ = std::move(shared);
   }
@@ -89,6 +102,8 @@ class FeaturePipeline {
     PipelineItem item = std::move(it->second);
     ready_.erase(it);
     ++next_out_;
+    // A successor is a frame at most a pipeline's depth behind the consumer; keep a margin.
+    recent_.erase(recent_.begin(), recent_.lower_bound(static_cast<int>(next_out_) - 2 * depth_));
     changed_.notify_all();
     return item;
   }
@@ -133,7 +148,7 @@ class FeaturePipeline {
   void ExtractFeatures() {
     for (;;) {
       std::pair<long, Frame> decoded;
-      std::shared_ptr<const std::vector<FrameRecord>> keys;
+      std::shared_ptr<const std::vector<CurrentKey>> keys;
       {
         std::unique_lock<std::mutex> lock(mutex_);
         changed_.wait(lock, [this] { return stop_ || !decoded_.empty() || reader_done_; });
@@ -147,8 +162,21 @@ class FeaturePipeline {
       item.record.features = matcher_.Extract(decoded.second.gray);
       item.record.frame = std::make_shared<const Frame>(std::move(decoded.second));
       ++extracted_;
+      const int frame_index = item.record.frame->index;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        recent_.emplace(frame_index, item.record);
+      }
       if (keys) {
-        for (const FrameRecord& key : *keys) item.comparisons.emplace(key.frame->index, compare_(key, item.record));
+        for (const CurrentKey& current : *keys) {
+          const std::optional<FrameRecord> key = ResolveKey(current.record, frame_index);
+          if (!key) continue;  // its successor is not extracted yet: the consumer will compare
+          const int key_index = key->frame->index;
+          if (item.comparisons.count(key_index)) continue;
+          const PairComparison& comparison =
+              item.comparisons.emplace(key_index, compare_(*key, item.record)).first->second;
+          if (!comparison.matched || comparison.similarity < current.min_tau) Retire(key_index, frame_index);
+        }
       }
       std::lock_guard<std::mutex> lock(mutex_);
       --extracting_;
@@ -157,13 +185,43 @@ class FeaturePipeline {
     }
   }
 
+  // The key image `frame_index` will be compared with when the consumer reaches it, as far as the workers
+  // know: `key`, or the successor of a key that an earlier frame failed against. Nullopt when that successor
+  // is not extracted yet.
+  std::optional<FrameRecord> ResolveKey(const FrameRecord& key, int frame_index) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    int index = key.frame->index;
+    for (auto it = retired_.find(index); it != retired_.end() && it->second.at_frame < frame_index;
+         it = retired_.find(index)) {
+      index = it->second.successor;
+    }
+    if (index == key.frame->index) return key;
+    auto record = recent_.find(index);
+    if (record == recent_.end()) return std::nullopt;
+    return record->second;
+  }
+
+  // Frame `frame_index` failed against the key image `key_index`.
+  void Retire(int key_index, int frame_index) {
+    const int successor = frame_index - 1 == key_index ? frame_index : frame_index - 1;
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto [it, inserted] = retired_.emplace(key_index, Retirement{frame_index, successor});
+    if (!inserted && frame_index < it->second.at_frame) it->second = Retirement{frame_index, successor};
+  }
+
   FrameSource& source_;
   const Matcher& matcher_;
   const CompareFn compare_;
   const int depth_;
   std::mutex mutex_;
   std::condition_variable changed_;
-  std::shared_ptr<const std::vector<FrameRecord>> current_keys_;
+  std::shared_ptr<const std::vector<CurrentKey>> current_keys_;
+  struct Retirement {
+    int at_frame;   // the first frame seen to fail against the key
+    int successor;  // the frame that replaces the key
+  };
+  std::map<int, Retirement> retired_;    // by key frame index
+  std::map<int, FrameRecord> recent_;    // extracted frames a successor may be taken from, by frame index
   std::deque<std::pair<long, Frame>> decoded_;  // read, waiting for a worker
   std::map<long, PipelineItem> ready_;          // extracted, waiting for the consumer
   int extracting_ = 0;
@@ -337,20 +395,25 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
     ProgressLine progress(taus.size() == 1 ? "build" : "sweep", source.info().expected_frames, "frames",
                           progress_options);
     long done = 0;
-    std::set<int> published_keys;
+    std::map<int, double> published_keys;  // key frame index -> min tau, as the workers know them
     while (std::optional<PipelineItem> item = pipeline.Next()) {
       comparisons_of_frame = &item->comparisons;
       for (auto& selector : selectors) selector->Add(item->record);
       // Tell the workers which key images the coming frames will be compared with.
-      std::set<int> key_frames;
-      std::vector<FrameRecord> keys;
-      for (const auto& selector : selectors) {
-        const FrameRecord* key = selector->current_key();
-        if (key && key_frames.insert(key->frame->index).second) keys.push_back(*key);
+      std::map<int, CurrentKey> keys;  // by key frame index
+      for (size_t i = 0; i < selectors.size(); ++i) {
+        const FrameRecord* key = selectors[i]->current_key();
+        if (!key) continue;
+        auto [it, inserted] = keys.emplace(key->frame->index, CurrentKey{*key, taus[i]});
+        if (!inserted) it->second.min_tau = std::min(it->second.min_tau, taus[i]);
       }
-      if (key_frames != published_keys) {
-        pipeline.SetCurrentKeys(std::move(keys));
-        published_keys = std::move(key_frames);
+      std::map<int, double> min_taus;
+      for (const auto& [index, key] : keys) min_taus.emplace(index, key.min_tau);
+      if (min_taus != published_keys) {
+        std::vector<CurrentKey> current;
+        for (auto& [index, key] : keys) current.push_back(std::move(key));
+        pipeline.SetCurrentKeys(std::move(current));
+        published_keys = std::move(min_taus);
       }
       progress.Update(++done);
     }

@@ -247,6 +247,30 @@ TEST(SharedData, LabFloorVideo) {
   EXPECT_NEAR(frames[30].timestamp, 1.0, 1e-3);  // 30 fps
 }
 
+// vmap decodes videos with FFmpeg itself; its frames and timestamps must be those of cv::VideoCapture, so
+// that a video and the same frames read through OpenCV give the same map.
+TEST(SharedData, VideoFramesEqualOpenCvCapture) {
+  const fs::path shared = testing::SharedDir();
+  if (shared.empty()) GTEST_SKIP() << "../shared is not present";
+  const std::string path = (shared / "data/lab_floor/lab_floor.mp4").string();
+  FrameSourceOptions options;
+  options.last = 39;
+  auto source = OpenFrameSource(path, options);
+  cv::VideoCapture capture(path, cv::CAP_FFMPEG);
+  ASSERT_TRUE(capture.isOpened());
+  EXPECT_EQ(source->info().expected_frames, 40);
+  EXPECT_NEAR(source->info().fps, capture.get(cv::CAP_PROP_FPS), 1e-9);
+  int compared = 0;
+  while (auto frame = source->Next()) {
+    cv::Mat expected;
+    ASSERT_TRUE(capture.read(expected));
+    EXPECT_EQ(cv::norm(frame->color, expected, cv::NORM_INF), 0.0) << "frame " << frame->index;
+    EXPECT_NEAR(frame->timestamp, capture.get(cv::CAP_PROP_POS_MSEC) / 1000.0, 1e-9) << "frame " << frame->index;
+    ++compared;
+  }
+  EXPECT_EQ(compared, 40);
+}
+
 TEST(SharedData, EveryLayoutOpens) {
   const fs::path shared = testing::SharedDir();
   if (shared.empty()) GTEST_SKIP() << "../shared is not present";
