@@ -1,9 +1,9 @@
 // Frames per second of `vmap build` (ORB + MAGSAC) on a video, next to decode-only and decode + ORB
 // detection, all measured in the same run so the figures compare.
 //
-//   build_bench [VIDEO] [--repeat N]     (default: ../shared/data/lab_floor/lab_floor.mp4, 3 repeats)
+//   build_bench [VIDEO] [--repeat N]     (default: ../shared/data/lab_floor/lab_floor.mp4, 5 repeats)
 //
-// Prints the median of the repeats for each stage.
+// Prints the median of the repeats for each stage, and their range.
 
 #include <unistd.h>
 
@@ -25,27 +25,29 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
+struct Rates {
+  std::vector<double> values;
+  double Median() const {
+    std::vector<double> sorted = values;
+    std::sort(sorted.begin(), sorted.end());
+    return sorted[sorted.size() / 2];
+  }
+  double Min() const { return *std::min_element(values.begin(), values.end()); }
+  double Max() const { return *std::max_element(values.begin(), values.end()); }
+};
 
 template <typename Fn>
-double FramesPerSecond(int repeat, Fn&& run) {
-  std::vector<double> rates;
-  for (int r = 0; r < repeat; ++r) {
-    const auto start = Clock::now();
-    const long frames = run();
-    rates.push_back(frames / std::chrono::duration<double>(Clock::now() - start).count());
-  }
-  return Median(rates);
+void Measure(Rates* rates, Fn&& run) {
+  const auto start = Clock::now();
+  const long frames = run();
+  rates->values.push_back(frames / std::chrono::duration<double>(Clock::now() - start).count());
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string video = std::string(VMAP_SHARED_DIR) + "/data/lab_floor/lab_floor.mp4";
-  int repeat = 3;
+  int repeat = 5;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::atoi(argv[++i]);
     else video = argv[i];
@@ -57,40 +59,48 @@ int main(int argc, char** argv) {
   cv::setNumThreads(1);  // as the vmap binary does: vmap parallelises across frames itself
   const auto matcher = vmap::CreateOrbMatcher({});
 
-  const double decode = FramesPerSecond(repeat, [&] {
-    auto source = vmap::OpenFrameSource(video);
-    long n = 0;
-    while (source->Next()) ++n;
-    return n;
-  });
-  const double detect = FramesPerSecond(repeat, [&] {
-    auto source = vmap::OpenFrameSource(video);
-    long n = 0;
-    while (auto frame = source->Next()) {
-      matcher->Extract(frame->gray);
-      ++n;
-    }
-    return n;
-  });
   vmap::MapBuilderOptions options;
   options.show_progress = false;
   long key_images = 0;
-  const double build = FramesPerSecond(repeat, [&] {
-    auto source = vmap::OpenFrameSource(video);
-    // Key images are written as in `vmap build`: that is part of the work.
-    const std::filesystem::path directory =
-        std::filesystem::temp_directory_path() / ("build_bench_" + std::to_string(getpid()));
-    const vmap::VisualMap map = vmap::BuildMap(*source, *matcher, options, directory);
-    std::filesystem::remove_all(directory);
-    key_images = static_cast<long>(map.key_images.size());
-    return static_cast<long>(map.num_frames);
-  });
+  // The three stages are measured one after the other within each repeat, so that a change in the machine's
+  // load (it is shared) touches all of them alike.
+  Rates decode, detect, build;
+  for (int r = 0; r < repeat; ++r) {
+    Measure(&decode, [&] {
+      auto source = vmap::OpenFrameSource(video);
+      long n = 0;
+      while (source->Next()) ++n;
+      return n;
+    });
+    Measure(&detect, [&] {
+      auto source = vmap::OpenFrameSource(video);
+      long n = 0;
+      while (auto frame = source->Next()) {
+        matcher->Extract(frame->gray);
+        ++n;
+      }
+      return n;
+    });
+    Measure(&build, [&] {
+      auto source = vmap::OpenFrameSource(video);
+      // Key images are written as in `vmap build`: that is part of the work.
+      const std::filesystem::path directory =
+          std::filesystem::temp_directory_path() / ("build_bench_" + std::to_string(getpid()));
+      const vmap::VisualMap map = vmap::BuildMap(*source, *matcher, options, directory);
+      std::filesystem::remove_all(directory);
+      key_images = static_cast<long>(map.key_images.size());
+      return static_cast<long>(map.num_frames);
+    });
+  }
 
-  std::printf("video: %s (median of %d runs)\n", video.c_str(), repeat);
-  std::printf("%-40s %8.1f frames/s\n", "decode only", decode);
-  std::printf("%-40s %8.1f frames/s\n", "decode + ORB detection (one thread)", detect);
-  std::printf("%-40s %8.1f frames/s  (%ld key images, tau %.2f)\n", "vmap build (ORB + MAGSAC, end to end)", build,
-              key_images, options.key_images.tau);
-  std::printf("build / (decode + detection) = %.2f\n", build / detect);
+  std::printf("video: %s (median of %d runs, [min-max])\n", video.c_str(), repeat);
+  auto print = [](const char* stage, const Rates& rates) {
+    std::printf("%-40s %8.1f frames/s  [%.1f-%.1f]\n", stage, rates.Median(), rates.Min(), rates.Max());
+  };
+  print("decode only", decode);
+  print("decode + ORB detection (one thread)", detect);
+  print("vmap build (ORB + MAGSAC, end to end)", build);
+  std::printf("%ld key images at tau %.2f; build / (decode + detection) = %.2f\n", key_images,
+              options.key_images.tau, build.Median() / detect.Median());
   return 0;
 }

@@ -169,13 +169,19 @@ class FeaturePipeline {
       }
       if (keys) {
         for (const CurrentKey& current : *keys) {
-          const std::optional<FrameRecord> key = ResolveKey(current.record, frame_index);
-          if (!key) continue;  // its successor is not extracted yet: the consumer will compare
-          const int key_index = key->frame->index;
-          if (item.comparisons.count(key_index)) continue;
-          const PairComparison& comparison =
-              item.comparisons.emplace(key_index, compare_(*key, item.record)).first->second;
-          if (!comparison.matched || comparison.similarity < current.min_tau) Retire(key_index, frame_index);
+          // Compare as the consumer will: with the key, with its successor when the frame fails against
+          // it (or when an earlier frame turns out to have failed meanwhile), and so on, until the key in
+          // force is one already compared, the frame itself, or a successor not extracted yet (the consumer
+          // then compares).
+          for (;;) {
+            const std::optional<FrameRecord> key = ResolveKey(current.record, frame_index);
+            if (!key) break;
+            const int key_index = key->frame->index;
+            if (key_index == frame_index || item.comparisons.count(key_index)) break;
+            const PairComparison& comparison =
+                item.comparisons.emplace(key_index, compare_(*key, item.record)).first->second;
+            if (!comparison.matched || comparison.similarity < current.min_tau) Retire(key_index, frame_index);
+          }
         }
       }
       std::lock_guard<std::mutex> lock(mutex_);
@@ -185,13 +191,13 @@ class FeaturePipeline {
     }
   }
 
-  // The key image `frame_index` will be compared with when the consumer reaches it, as far as the workers
-  // know: `key`, or the successor of a key that an earlier frame failed against. Nullopt when that successor
-  // is not extracted yet.
+  // The key image `frame_index` is to be compared with next, as far as the workers know: `key`, or the
+  // successor of a key that this frame or an earlier one failed against. Nullopt when that successor is not
+  // extracted yet.
   std::optional<FrameRecord> ResolveKey(const FrameRecord& key, int frame_index) {
     std::lock_guard<std::mutex> lock(mutex_);
     int index = key.frame->index;
-    for (auto it = retired_.find(index); it != retired_.end() && it->second.at_frame < frame_index;
+    for (auto it = retired_.find(index); it != retired_.end() && it->second.at_frame <= frame_index;
          it = retired_.find(index)) {
       index = it->second.successor;
     }
