@@ -1,5 +1,6 @@
 #include "vmap/sources/frame_source.h"
 
+#include <cstdlib>
 #include <fstream>
 #include <iomanip>
 
@@ -207,6 +208,29 @@ TEST(Video, ReadsEveryFrameWithTimestamps) {
   EXPECT_EQ(source->skipped_frames(), 0);
 }
 
+TEST(Video, FirstLastAndStrideSelectTheSameFramesAsAFullRead) {
+  testing::TempDir tmp;
+  const fs::path video = WriteMjpegVideo(tmp.path() / "clip.avi", Sequence().frames);
+  auto full = OpenFrameSource(video.string());
+  const auto all = ReadAll(*full);
+  FrameSourceOptions options;
+  options.first = 1;
+  options.last = 10;
+  options.stride = 4;
+  auto source = OpenFrameSource(video.string(), options);
+  EXPECT_EQ(source->info().expected_frames, 3);
+  const auto frames = ReadAll(*source);
+  ASSERT_EQ(frames.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    const Frame& expected = all[1 + 4 * k];
+    EXPECT_EQ(frames[k].index, k);
+    EXPECT_EQ(frames[k].source_index, expected.source_index);
+    EXPECT_EQ(frames[k].source_name, expected.source_name);
+    EXPECT_DOUBLE_EQ(frames[k].timestamp, expected.timestamp);
+    EXPECT_EQ(cv::norm(frames[k].color, expected.color, cv::NORM_INF), 0.0);
+  }
+}
+
 TEST(Video, CorruptFrameInTheMiddleIsSkippedAndCounted) {
   testing::TempDir tmp;
   const fs::path video = WriteMjpegVideo(tmp.path() / "clip.avi", Sequence().frames);
@@ -269,6 +293,32 @@ TEST(SharedData, VideoFramesEqualOpenCvCapture) {
     ++compared;
   }
   EXPECT_EQ(compared, 40);
+}
+
+// Phones store portrait video sideways with a display rotation; frames must come out upright, as
+// cv::VideoCapture delivers them.
+TEST(SharedData, RotatedVideosAreDeliveredUpright) {
+  const fs::path shared = testing::SharedDir();
+  if (shared.empty()) GTEST_SKIP() << "../shared is not present";
+  if (std::system("ffmpeg -version > /dev/null 2>&1") != 0) GTEST_SKIP() << "ffmpeg (scripts/install-deps.sh) is missing";
+  testing::TempDir tmp;
+  for (int degrees : {90, 180, 270}) {
+    const fs::path rotated = tmp.path() / ("rotated_" + std::to_string(degrees) + ".mp4");
+    const std::string command = "ffmpeg -nostdin -loglevel error -y -i \"" +
+                                (shared / "data/lab_floor/lab_floor.mp4").string() +
+                                "\" -frames:v 5 -c copy -metadata:s:v:0 rotate=" + std::to_string(degrees) + " \"" +
+                                rotated.string() + "\"";
+    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+    auto source = OpenFrameSource(rotated.string());
+    cv::VideoCapture capture(rotated.string(), cv::CAP_FFMPEG);
+    const auto frame = source->Next();
+    cv::Mat expected;
+    ASSERT_TRUE(frame.has_value() && capture.read(expected));
+    EXPECT_EQ(frame->color.size(), degrees == 180 ? cv::Size(640, 480) : cv::Size(480, 640)) << degrees;
+    ASSERT_EQ(frame->color.size(), expected.size()) << degrees;
+    EXPECT_EQ(cv::norm(frame->color, expected, cv::NORM_INF), 0.0) << degrees;
+    EXPECT_EQ(frame->gray.size(), frame->color.size());
+  }
 }
 
 TEST(SharedData, EveryLayoutOpens) {
