@@ -10,7 +10,6 @@
 #include <functional>
 #include <map>
 #include <mutex>
-#include <set>
 #include <sstream>
 #include <thread>
 
@@ -46,8 +45,7 @@ struct CurrentKey {
   double min_tau = 1.0;
 };
 
-// A frame with its features and the comparisons already made with the key images current when it was
-// extracted (by key frame index).
+// A frame with its features and the comparisons the workers already made for it (by key frame index).
 struct PipelineItem {
   FrameRecord record;
   std::map<int, PairComparison> comparisons;
@@ -57,15 +55,17 @@ struct PipelineItem {
 // the current key images, a few frames ahead of the consumer, which receives them in order.
 //
 // Why compare ahead: a frame is compared with the same key image as the frames before it until S drops,
-// so those comparisons do not depend on each other and can run in parallel. Only the frames in flight
-// when a key image changes are compared again, by the consumer. ComparePair is deterministic, so the map
-// is the same whatever the threads do.
+// so those comparisons do not depend on each other and can run in parallel.
 //
-// A key image is retired as soon as a worker sees a frame j fail against it: every selector holding it
-// leaves it at frame j at the latest, for frame j-1 (or for j itself when j-1 is that key: a broken link).
-// Later frames are compared with that successor at once, as the consumer will ask, instead of with the old
-// key at low S, where MAGSAC needs the most iterations (up to 60 ms a pair on lab_floor) only for the
-// result to be thrown away, and the consumer then redoing the comparisons one by one while the workers wait.
+// Key changes are followed by the workers too. A key image is retired as soon as a worker sees a frame j
+// fail against it: every selector holding it leaves it at frame j at the latest, for frame j-1 (or for j
+// itself when j-1 is that key: a broken link). Frame j and the later ones are compared with that successor
+// at once, as the consumer will ask, instead of with the old key at low S, where MAGSAC needs the most
+// iterations (up to 60 ms a pair on lab_floor) only for the result to be thrown away, and the consumer then
+// redoing the comparisons one by one while the workers wait.
+//
+// The consumer compares whatever the workers did not guess. ComparePair is deterministic, so the map is the
+// same whatever the threads do.
 class FeaturePipeline {
  public:
   FeaturePipeline(FrameSource& source, const Matcher& matcher, int depth, int workers, CompareFn compare)
