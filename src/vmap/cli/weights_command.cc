@@ -8,9 +8,7 @@
 #include "vmap/core/error.h"
 #include "vmap/neural/sha1.h"
 #include "vmap/neural/weights_store.h"
-#ifdef VMAP_WITH_TORCH
-#include "vmap/neural/loftr_matcher.h"
-#endif
+#include "vmap/neural/torch_plugin.h"
 
 namespace vmap::cli {
 
@@ -60,7 +58,7 @@ void Verify(const std::string& path) {
   std::printf("  known copy   %s\n", known_as.empty() ? "no (not byte-identical to a known published copy)"
                                                       : ("yes: " + known_as).c_str());
 #ifdef VMAP_WITH_TORCH
-  const auto presets = LoftrPresetsFittingFile(path);
+  const auto presets = TorchPlugin().loftr_presets_fitting_file(path);
   std::printf("  fits         %s\n", presets.empty() ? "no LoFTR preset" : Join(presets).c_str());
   if (presets.empty()) throw InputError("'" + path + "' is not usable as LoFTR weights");
 #endif
@@ -82,7 +80,7 @@ void Run(const WeightsFlags& flags) {
 #ifdef VMAP_WITH_TORCH
       if (flags.no_verify) {
         // The mirror may hold other bytes than the published copy; the layout is then the check left.
-        const auto presets = LoftrPresetsFittingFile(path);
+        const auto presets = TorchPlugin().loftr_presets_fitting_file(path);
         std::printf("  fits %s\n", presets.empty() ? "no LoFTR preset: do not use it" : Join(presets).c_str());
       }
 #endif
@@ -95,7 +93,7 @@ void Run(const WeightsFlags& flags) {
     const std::string expected = flags.no_verify ? "" : known.git_blob_id;
 #ifdef VMAP_WITH_TORCH
     // Without a known id the structure is the only check available before the file enters the cache.
-    const auto presets = LoftrPresetsFittingFile(flags.import_file);
+    const auto presets = TorchPlugin().loftr_presets_fitting_file(flags.import_file);
     if (std::find(presets.begin(), presets.end(), flags.model) == presets.end()) {
       throw InputError("'" + flags.import_file + "' does not fit --model " + flags.model +
                        (presets.empty() ? std::string(" (nor any LoFTR preset)") : " (it fits " + Join(presets) + ")"));

@@ -1,9 +1,7 @@
 #include "vmap/features/matcher_factory.h"
 
 #include "vmap/core/error.h"
-#ifdef VMAP_WITH_TORCH
-#include "vmap/neural/loftr_matcher.h"
-#endif
+#include "vmap/neural/torch_plugin.h"
 
 namespace vmap {
 
@@ -17,7 +15,7 @@ std::unique_ptr<Matcher> CreateMatcher(const MatcherOptions& options) {
   options.Check();
   if (options.type == "orb") return CreateOrbMatcher(options.orb);
 #ifdef VMAP_WITH_TORCH
-  return CreateLoftrMatcher(options.loftr);
+  return TorchPlugin().create_loftr_matcher(options.loftr);
 #else
   throw InputError("this vmap was built without LibTorch (VMAP_WITH_TORCH=OFF); rebuild with it for --matcher loftr");
 #endif

@@ -1,0 +1,57 @@
+#include "vmap/neural/torch_plugin.h"
+
+#include <dlfcn.h>
+
+#include <filesystem>
+#include <mutex>
+
+#include "vmap/core/error.h"
+
+// Defined where the plugin's objects are linked in (the plugin itself, the neural tests); weak, so that
+// the binary links without them and loads the plugin instead.
+extern "C" const vmap::TorchPluginApi* vmap_torch_plugin_api() __attribute__((weak));
+
+namespace vmap {
+namespace {
+
+std::filesystem::path PluginPath() {
+  std::error_code error;
+  const std::filesystem::path executable = std::filesystem::read_symlink("/proc/self/exe", error);
+  return (error ? std::filesystem::path(".") : executable.parent_path()) / "libvmap_torch.so";
+}
+
+const TorchPluginApi* LoadPlugin() {
+  if (vmap_torch_plugin_api) return vmap_torch_plugin_api();
+  const std::string path = PluginPath().string();
+  // Never closed: matchers and features made by the plugin may live until the process ends.
+  void* library = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (!library) {
+    throw InputError("LoFTR needs LibTorch, through '" + path + "', which cannot be loaded (" + dlerror() +
+                     "); build vmap with -DVMAP_WITH_TORCH=ON (scripts/build.sh does) and keep libvmap_torch.so "
+                     "beside the vmap binary");
+  }
+  using Entry = const TorchPluginApi* (*)();
+  const auto entry = reinterpret_cast<Entry>(dlsym(library, "vmap_torch_plugin_api"));
+  if (!entry) throw InputError("'" + path + "' is not a vmap LibTorch plugin (no vmap_torch_plugin_api); rebuild vmap");
+  return entry();
+}
+
+}  // namespace
+
+const TorchPluginApi& TorchPlugin() {
+  // Loaded once per process; a failure is reported again to every caller.
+  static std::once_flag once;
+  static const TorchPluginApi* api = nullptr;
+  static std::string failure;
+  std::call_once(once, [] {
+    try {
+      api = LoadPlugin();
+    } catch (const InputError& error) {
+      failure = error.what();
+    }
+  });
+  if (!api) throw InputError(failure);
+  return *api;
+}
+
+}  // namespace vmap
