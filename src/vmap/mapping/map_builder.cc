@@ -148,7 +148,6 @@ class FeaturePipeline {
   void ExtractFeatures() {
     for (;;) {
       std::pair<long, Frame> decoded;
-      std::shared_ptr<const std::vector<CurrentKey>> keys;
       {
         std::unique_lock<std::mutex> lock(mutex_);
         changed_.wait(lock, [this] { return stop_ || !decoded_.empty() || reader_done_; });
@@ -156,16 +155,17 @@ class FeaturePipeline {
         decoded = std::move(decoded_.front());
         decoded_.pop_front();
         ++extracting_;
-        keys = current_keys_;
       }
       PipelineItem item;
       item.record.features = matcher_.Extract(decoded.second.gray);
       item.record.frame = std::make_shared<const Frame>(std::move(decoded.second));
       ++extracted_;
       const int frame_index = item.record.frame->index;
+      std::shared_ptr<const std::vector<CurrentKey>> keys;
       {
         std::lock_guard<std::mutex> lock(mutex_);
         recent_.emplace(frame_index, item.record);
+        keys = current_keys_;  // taken after extraction: the freshest the consumer has published
       }
       if (keys) {
         for (const CurrentKey& current : *keys) {
@@ -401,11 +401,11 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
     ProgressLine progress(taus.size() == 1 ? "build" : "sweep", source.info().expected_frames, "frames",
                           progress_options);
     long done = 0;
-    std::map<int, double> published_keys;  // key frame index -> min tau, as the workers know them
     while (std::optional<PipelineItem> item = pipeline.Next()) {
       comparisons_of_frame = &item->comparisons;
       for (auto& selector : selectors) selector->Add(item->record);
-      // Tell the workers which key images the coming frames will be compared with.
+      // Tell the workers which key images the coming frames will be compared with (a handful of
+      // shared pointers: cheaper to publish every frame than to track changes).
       std::map<int, CurrentKey> keys;  // by key frame index
       for (size_t i = 0; i < selectors.size(); ++i) {
         const FrameRecord* key = selectors[i]->current_key();
@@ -413,14 +413,9 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
         auto [it, inserted] = keys.emplace(key->frame->index, CurrentKey{*key, taus[i]});
         if (!inserted) it->second.min_tau = std::min(it->second.min_tau, taus[i]);
       }
-      std::map<int, double> min_taus;
-      for (const auto& [index, key] : keys) min_taus.emplace(index, key.min_tau);
-      if (min_taus != published_keys) {
-        std::vector<CurrentKey> current;
-        for (auto& [index, key] : keys) current.push_back(std::move(key));
-        pipeline.SetCurrentKeys(std::move(current));
-        published_keys = std::move(min_taus);
-      }
+      std::vector<CurrentKey> current;
+      for (auto& [index, key] : keys) current.push_back(std::move(key));
+      pipeline.SetCurrentKeys(std::move(current));
       progress.Update(++done);
     }
     progress.Finish();

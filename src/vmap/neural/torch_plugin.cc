@@ -3,7 +3,8 @@
 #include <dlfcn.h>
 
 #include <filesystem>
-#include <mutex>
+#include <string>
+#include <utility>
 
 #include "vmap/core/error.h"
 
@@ -40,18 +41,16 @@ const TorchPluginApi* LoadPlugin() {
 
 const TorchPluginApi& TorchPlugin() {
   // Loaded once per process; a failure is reported again to every caller.
-  static std::once_flag once;
-  static const TorchPluginApi* api = nullptr;
-  static std::string failure;
-  std::call_once(once, [] {
+  using Loaded = std::pair<const TorchPluginApi*, std::string>;  // the entry points, or why they are missing
+  static const Loaded loaded = []() -> Loaded {
     try {
-      api = LoadPlugin();
+      return {LoadPlugin(), ""};
     } catch (const InputError& error) {
-      failure = error.what();
+      return {nullptr, error.what()};
     }
-  });
-  if (!api) throw InputError(failure);
-  return *api;
+  }();
+  if (!loaded.first) throw InputError(loaded.second);
+  return *loaded.first;
 }
 
 }  // namespace vmap
