@@ -1,0 +1,23 @@
+#pragma once
+// Mutual nearest-neighbour matching of float descriptors (the deep detectors' descriptors: XFeat, ALIKED).
+
+#include <utility>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace vmap {
+
+struct FloatMatch {
+  int query = 0;           // row in `query`
+  int train = 0;           // row in `train`
+  float similarity = 0.f;  // dot product of the two rows (cosine similarity for unit rows)
+};
+
+// Keeps the pairs (i, j) where j is i's most similar train row, i is j's most similar query row, and their
+// similarity is at least `min_similarity`. Rows are CV_32F descriptors of the same width, expected to be
+// L2-normalised (then the dot product is the cosine similarity). Ties go to the lowest index. The similarity
+// matrix is computed block by block (one matrix product per block), so memory stays small for any size.
+std::vector<FloatMatch> MatchFloatDescriptors(const cv::Mat& query, const cv::Mat& train, float min_similarity);
+
+}  // namespace vmap

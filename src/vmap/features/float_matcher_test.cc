@@ -1,0 +1,88 @@
+#include "vmap/features/float_matcher.h"
+
+#include <random>
+
+#include <gtest/gtest.h>
+
+namespace vmap {
+namespace {
+
+cv::Mat RandomUnitRows(int rows, int cols, std::mt19937& random) {
+  std::normal_distribution<float> normal;
+  cv::Mat m(rows, cols, CV_32F);
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) m.at<float>(r, c) = normal(random);
+    cv::normalize(m.row(r), m.row(r));
+  }
+  return m;
+}
+
+// The definition, written plainly: full similarity matrix, argmax both ways (first index on ties).
+std::vector<FloatMatch> PlainMutualNearest(const cv::Mat& q, const cv::Mat& t, float min_similarity) {
+  cv::Mat s = q * t.t();
+  std::vector<FloatMatch> out;
+  for (int i = 0; i < q.rows; ++i) {
+    int best_j = 0;
+    for (int j = 1; j < t.rows; ++j) if (s.at<float>(i, j) > s.at<float>(i, best_j)) best_j = j;
+    int best_i = 0;
+    for (int k = 1; k < q.rows; ++k) if (s.at<float>(k, best_j) > s.at<float>(best_i, best_j)) best_i = k;
+    if (best_i == i && s.at<float>(i, best_j) >= min_similarity) out.push_back({i, best_j, s.at<float>(i, best_j)});
+  }
+  return out;
+}
+
+TEST(MatchFloatDescriptors, FindsPermutedNoisyCopies) {
+  std::mt19937 random(3);
+  const cv::Mat train = RandomUnitRows(700, 64, random);
+  // Query = rows of train in another order, with a little noise, plus unrelated rows.
+  std::vector<int> order(train.rows);
+  for (int i = 0; i < train.rows; ++i) order[i] = i;
+  std::shuffle(order.begin(), order.end(), random);
+  cv::Mat query(600, 64, CV_32F);
+  cv::Mat noise = RandomUnitRows(600, 64, random);
+  for (int i = 0; i < 500; ++i) {
+    cv::Mat row = train.row(order[i]) + 0.05f * noise.row(i);
+    cv::normalize(row, query.row(i));
+  }
+  RandomUnitRows(100, 64, random).copyTo(query.rowRange(500, 600));
+
+  const std::vector<FloatMatch> matches = MatchFloatDescriptors(query, train, 0.9f);
+  ASSERT_EQ(matches.size(), 500u);  // the unrelated rows stay below 0.9 (random 64-d unit vectors: |cos| ~ 0.12)
+  for (const FloatMatch& m : matches) {
+    ASSERT_LT(m.query, 500);
+    EXPECT_EQ(m.train, order[m.query]);
+    EXPECT_GE(m.similarity, 0.9f);
+  }
+}
+
+TEST(MatchFloatDescriptors, AgreesWithThePlainDefinitionAcrossBlocksAndThresholds) {
+  std::mt19937 random(7);
+  for (int rows : {1, 255, 256, 257, 600}) {
+    const cv::Mat q = RandomUnitRows(rows, 32, random);
+    const cv::Mat t = RandomUnitRows(300, 32, random);
+    for (float threshold : {-1.f, 0.3f, 0.5f}) {
+      const auto expected = PlainMutualNearest(q, t, threshold);
+      const auto got = MatchFloatDescriptors(q, t, threshold);
+      ASSERT_EQ(got.size(), expected.size()) << rows << " rows, threshold " << threshold;
+      for (size_t k = 0; k < got.size(); ++k) {
+        EXPECT_EQ(got[k].query, expected[k].query);
+        EXPECT_EQ(got[k].train, expected[k].train);
+        EXPECT_NEAR(got[k].similarity, expected[k].similarity, 1e-5f);
+      }
+    }
+  }
+}
+
+TEST(MatchFloatDescriptors, TiesGoToTheLowestIndexAndEmptyInputsGiveNothing) {
+  cv::Mat q = (cv::Mat_<float>(2, 2) << 1, 0, 1, 0);  // two identical query rows
+  cv::Mat t = (cv::Mat_<float>(3, 2) << 0, 1, 1, 0, 1, 0);
+  const auto matches = MatchFloatDescriptors(q, t, 0.5f);
+  ASSERT_EQ(matches.size(), 1u);
+  EXPECT_EQ(matches[0].query, 0);
+  EXPECT_EQ(matches[0].train, 1);
+  EXPECT_TRUE(MatchFloatDescriptors(cv::Mat(), t, 0.f).empty());
+  EXPECT_TRUE(MatchFloatDescriptors(q, cv::Mat(0, 2, CV_32F), 0.f).empty());
+}
+
+}  // namespace
+}  // namespace vmap
