@@ -7,15 +7,21 @@
 
 #include "vmap/cli/commands.h"
 #include "vmap/report/html_report.h"
+#include "vmap/report/localization_report.h"
 
 namespace vmap::cli {
 
 void AddReportCommand(CLI::App& app) {
   auto map_directory = std::make_shared<std::string>();
   auto options = std::make_shared<MapReportOptions>();
+  auto run_output = std::make_shared<std::string>();
   CLI::App* command = app.add_subcommand(
-      "report", "Write report.html into a map directory: summary, key images, match figures and plots (offline page)");
-  command->add_option("map", *map_directory, "Map directory written by `vmap build`")->required();
+      "report", "Write report.html into a map directory: summary, key images, match figures and plots (offline "
+                "page); or, given the --json file of `vmap localize`, the report of that localization run");
+  command->add_option("map", *map_directory, "Map directory written by `vmap build`, or a `vmap localize --json` file")
+      ->required();
+  command->add_option("-o,--output", *run_output,
+                      "Localization runs: directory for report.html (default: <run file name>_report beside it)");
   command->add_option("--thumbnail-width", options->thumbnail_width, "Width of the key-image thumbnails in pixels")
       ->capture_default_str()
       ->check(CLI::Range(32, 4096));
@@ -23,7 +29,15 @@ void AddReportCommand(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(64, 8192));
   command->add_flag("!--no-video", options->route_video, "Skip report/route.mp4, the video of the key images in order");
-  command->callback([map_directory, options] {
+  command->callback([map_directory, options, run_output] {
+    const std::filesystem::path target(*map_directory);
+    if (std::filesystem::is_regular_file(target)) {
+      const std::filesystem::path output =
+          run_output->empty() ? target.parent_path() / (target.stem().string() + "_report") : std::filesystem::path(*run_output);
+      WriteLocalizationReport(target, output);
+      std::cout << "report          " << (output / kReportFileName).string() << "\n";
+      return;
+    }
     WriteMapReport(*map_directory, *options);
     std::cout << "report          " << (std::filesystem::path(*map_directory) / kReportFileName).string() << "\n";
   });

@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -18,6 +19,11 @@ class ImageFeatures {
   virtual int num_features() const = 0;
   // The size of the image the features were extracted from (coordinates refer to it).
   virtual cv::Size image_size() const = 0;
+  // Optional: one descriptor row per feature, for ranking key images by shared descriptors (vmap localize).
+  // CV_8U rows are binary descriptors compared by Hamming distance (ORB); CV_32F rows are L2-normalised
+  // descriptors compared by dot product (XFeat, ALIKED). Empty for a matcher without per-feature
+  // descriptors (LoFTR): localization then ranks key images by their downsampled pixels instead.
+  virtual cv::Mat descriptors() const { return {}; }
 };
 
 // Tentative correspondences between two images, in pixel coordinates of the images given to Extract
@@ -39,6 +45,11 @@ class Matcher {
   virtual TentativeMatches Match(const ImageFeatures& features0, const ImageFeatures& features1) const = 0;
   // The matcher's settings, recorded in map.json.
   virtual std::string DescribeOptionsJson() const = 0;
+  // Optional: features as bytes and back, so that vmap localize extracts a map's key images once and keeps
+  // them in a cache. Bytes are read back only by the same matcher with the same options (the cache checks).
+  // A matcher that cannot do it returns "" and null; its key images are then extracted at every start.
+  virtual std::string SerializeFeatures(const ImageFeatures& features) const { return {}; }
+  virtual std::shared_ptr<const ImageFeatures> DeserializeFeatures(std::string_view bytes) const { return nullptr; }
 };
 
 }  // namespace vmap

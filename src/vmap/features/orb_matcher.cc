@@ -30,10 +30,23 @@ namespace {
 class OrbFeatures : public ImageFeatures {
  public:
   std::vector<cv::KeyPoint> keypoints;
-  cv::Mat descriptors;  // CV_8U, 32 bytes per row
+  cv::Mat binary_descriptors;  // CV_8U, 32 bytes per row
   cv::Size size;
   int num_features() const override { return static_cast<int>(keypoints.size()); }
   cv::Size image_size() const override { return size; }
+  cv::Mat descriptors() const override { return binary_descriptors; }
+};
+
+// Serialised features: a header, then per keypoint x, y, size, angle, response (float32) and octave (int32),
+// then the descriptor rows. Little-endian (x86/ARM), read back only by this build's matcher.
+constexpr char kOrbFeaturesMagic[8] = {'v', 'm', 'a', 'p', 'O', 'R', 'B', '1'};
+struct OrbFeaturesHeader {
+  char magic[8];
+  int32_t width, height, count, descriptor_bytes;
+};
+struct SerializedKeyPoint {
+  float x, y, size, angle, response;
+  int32_t octave;
 };
 
 class OrbMatcher : public Matcher {
@@ -49,8 +62,8 @@ class OrbMatcher : public Matcher {
                                            cv::ORB::HARRIS_SCORE, 31, options_.fast_threshold);
     auto features = std::make_shared<OrbFeatures>();
     features->size = gray.size();
-    orb->detectAndCompute(gray, cv::noArray(), features->keypoints, features->descriptors);
-    if (features->descriptors.empty()) features->keypoints.clear();
+    orb->detectAndCompute(gray, cv::noArray(), features->keypoints, features->binary_descriptors);
+    if (features->binary_descriptors.empty()) features->keypoints.clear();
     return features;
   }
 
@@ -58,8 +71,8 @@ class OrbMatcher : public Matcher {
     const auto& a = static_cast<const OrbFeatures&>(features0);
     const auto& b = static_cast<const OrbFeatures&>(features1);
     TentativeMatches matches;
-    if (a.descriptors.empty() || b.descriptors.empty()) return matches;
-    const auto pairs = MatchBinaryDescriptors(a.descriptors, b.descriptors, options_.cross_check, options_.ratio);
+    if (a.binary_descriptors.empty() || b.binary_descriptors.empty()) return matches;
+    const auto pairs = MatchBinaryDescriptors(a.binary_descriptors, b.binary_descriptors, options_.cross_check, options_.ratio);
     matches.points0.reserve(pairs.size());
     matches.points1.reserve(pairs.size());
     for (const auto& [i, j] : pairs) {
@@ -79,6 +92,54 @@ class OrbMatcher : public Matcher {
                           {"cross_check", options_.cross_check},
                           {"ratio", options_.ratio}}
         .dump();
+  }
+
+  std::string SerializeFeatures(const ImageFeatures& features) const override {
+    const auto& f = static_cast<const OrbFeatures&>(features);
+    OrbFeaturesHeader header{};
+    std::memcpy(header.magic, kOrbFeaturesMagic, sizeof(header.magic));
+    header.width = f.size.width;
+    header.height = f.size.height;
+    header.count = static_cast<int32_t>(f.keypoints.size());
+    header.descriptor_bytes = f.binary_descriptors.empty() ? 0 : f.binary_descriptors.cols;
+    std::string bytes(reinterpret_cast<const char*>(&header), sizeof(header));
+    for (const cv::KeyPoint& k : f.keypoints) {
+      const SerializedKeyPoint record{k.pt.x, k.pt.y, k.size, k.angle, k.response, k.octave};
+      bytes.append(reinterpret_cast<const char*>(&record), sizeof(record));
+    }
+    for (int r = 0; r < f.binary_descriptors.rows; ++r) {
+      bytes.append(reinterpret_cast<const char*>(f.binary_descriptors.ptr(r)), f.binary_descriptors.cols);
+    }
+    return bytes;
+  }
+
+  std::shared_ptr<const ImageFeatures> DeserializeFeatures(std::string_view bytes) const override {
+    OrbFeaturesHeader header;
+    if (bytes.size() < sizeof(header)) return nullptr;
+    std::memcpy(&header, bytes.data(), sizeof(header));
+    if (std::memcmp(header.magic, kOrbFeaturesMagic, sizeof(header.magic)) != 0 || header.count < 0 ||
+        header.descriptor_bytes < 0 || header.width < 0 || header.height < 0 ||
+        (header.count > 0 && header.descriptor_bytes == 0)) {
+      return nullptr;
+    }
+    const size_t expected = sizeof(header) + static_cast<size_t>(header.count) * sizeof(SerializedKeyPoint) +
+                            static_cast<size_t>(header.count) * header.descriptor_bytes;
+    if (bytes.size() != expected) return nullptr;
+    auto features = std::make_shared<OrbFeatures>();
+    features->size = cv::Size(header.width, header.height);
+    const char* cursor = bytes.data() + sizeof(header);
+    features->keypoints.resize(header.count);
+    for (cv::KeyPoint& k : features->keypoints) {
+      SerializedKeyPoint record;
+      std::memcpy(&record, cursor, sizeof(record));
+      cursor += sizeof(record);
+      k = cv::KeyPoint(record.x, record.y, record.size, record.angle, record.response, record.octave);
+    }
+    if (header.count > 0) {
+      features->binary_descriptors.create(header.count, header.descriptor_bytes, CV_8U);
+      std::memcpy(features->binary_descriptors.data, cursor, static_cast<size_t>(header.count) * header.descriptor_bytes);
+    }
+    return features;
   }
 
  private:

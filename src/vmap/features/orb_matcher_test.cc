@@ -119,4 +119,31 @@ TEST(OrbMatcher, OptionsAreChecked) {
   EXPECT_THROW(options.Check(), InputError);
 }
 
+TEST(OrbFeatures, SerialiseAndReadBackExactly) {
+  testing::SyntheticOptions options;
+  options.num_frames = 2;
+  const auto sequence = testing::RenderSyntheticSequence(options);
+  const auto matcher = CreateOrbMatcher({});
+  cv::Mat gray;
+  cv::cvtColor(sequence.frames[0], gray, cv::COLOR_BGR2GRAY);
+  const auto features = matcher->Extract(gray);
+  const std::string bytes = matcher->SerializeFeatures(*features);
+  const auto back = matcher->DeserializeFeatures(bytes);
+  ASSERT_TRUE(back);
+  EXPECT_EQ(back->num_features(), features->num_features());
+  EXPECT_EQ(back->image_size(), features->image_size());
+  EXPECT_EQ(cv::norm(back->descriptors(), features->descriptors(), cv::NORM_HAMMING), 0.0);
+  const auto a = matcher->Match(*features, *features), b = matcher->Match(*back, *features);
+  EXPECT_EQ(a.points0, b.points0);
+  EXPECT_EQ(a.points1, b.points1);
+  // Bytes that are not ORB features are refused, not misread.
+  EXPECT_FALSE(matcher->DeserializeFeatures(bytes.substr(0, bytes.size() - 1)));
+  EXPECT_FALSE(matcher->DeserializeFeatures("not features"));
+  // An image without features round-trips too.
+  const auto empty = matcher->Extract(cv::Mat::zeros(240, 320, CV_8U));
+  const auto empty_back = matcher->DeserializeFeatures(matcher->SerializeFeatures(*empty));
+  ASSERT_TRUE(empty_back);
+  EXPECT_EQ(empty_back->num_features(), 0);
+}
+
 }  // namespace vmap

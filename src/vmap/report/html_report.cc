@@ -17,6 +17,7 @@
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
 #include "vmap/mapping/map_io.h"
+#include "vmap/report/html_page.h"
 #include "vmap/report/html_util.h"
 #include "vmap/report/svg_plot.h"
 
@@ -160,6 +161,11 @@ constexpr const char* kScript = R"js(
 })();
 )js";
 
+}  // namespace
+
+// The page frame and small pieces shared with the localization report (html_page.h).
+namespace report {
+
 std::string PageStart(const std::string& title, const std::string& heading, const std::string& subtitle,
                       const std::vector<std::pair<std::string, std::string>>& nav) {
   std::ostringstream html;
@@ -264,6 +270,24 @@ cv::Mat ScaledToWidth(const cv::Mat& image, int width) {
   cv::resize(image, scaled, cv::Size(width, height), 0, 0, cv::INTER_AREA);
   return scaled;
 }
+
+}  // namespace report
+
+using report::Card;
+using report::DurationText;
+using report::FindOption;
+using report::Numbered;
+using report::OptionText;
+using report::PageEnd;
+using report::PageStart;
+using report::ParseOptions;
+using report::Row;
+using report::ScaledToWidth;
+using report::SizeText;
+using report::TimestampText;
+using report::WriteJpeg;
+
+namespace {
 
 bool IsInside(const fs::path& child, const fs::path& parent) {
   auto c = child.begin();

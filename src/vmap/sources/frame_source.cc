@@ -147,7 +147,10 @@ std::unique_ptr<FrameSource> OpenFrameSource(const std::string& path, const Fram
       else if (fs::is_directory(p / "image_0") || fs::is_directory(p / "image_2")) format = SourceFormat::kKitti;
       else format = SourceFormat::kImageFolder;
     } else if (internal::IsImageFile(path)) {
-      throw InputError("input '" + path + "' is a single image; pass the folder that holds the sequence's images");
+      if (!options.allow_single_image) {
+        throw InputError("input '" + path + "' is a single image; pass the folder that holds the sequence's images");
+      }
+      return internal::OpenImageList({{path, -1.0}}, path, SourceFormat::kImageFolder, options);
     } else if (p.filename() == "rgb.txt") {
       format = SourceFormat::kTum;
     } else if (p.filename() == "data.csv") {

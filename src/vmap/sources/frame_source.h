@@ -26,6 +26,9 @@ struct FrameSourceOptions {
   std::string resize;
   // Frames whose size differs from the first frame's are resized to it with a warning; with strict, an error.
   bool strict = false;
+  // A single image file is a sequence of one frame (vmap localize takes one query image); otherwise it is an
+  // error, since one frame makes no map.
+  bool allow_single_image = false;
 
   void Check() const;  // throws InputError naming the bad option
 };

@@ -1,0 +1,191 @@
+// Localization measured against truth (README "Localization"): the bracket test and the ranking recall.
+//
+//   localize_accuracy SEQUENCE [--last N] [--tau T] [--ranking auto|votes|thumbnails] [--candidates K]
+//
+// Builds a map of the even frames of SEQUENCE (`vmap build --stride 2`, default options) in a temporary
+// folder and localizes the odd frames against it:
+//  - streaming (tracking, relocalizing when lost): the share of odd frames localized at one of the two key
+//    images that bracket it in the input (KeysAround), and the status counts;
+//  - every frame relocalized from scratch (Localizer::Reset before each): the same share, the time per
+//    relocalization, and the recall of both rankings (a bracketing key image among the first 1 / K ranked);
+//  - progress: where the estimate is the bracketing segment, the mean absolute difference between the
+//    estimated progress and the frame's position between the two key images in input frames.
+// Every figure comes from one run, so they compare; the machine's load changes the times.
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include "vmap/features/matcher_factory.h"
+#include "vmap/localization/key_image_ranking.h"
+#include "vmap/localization/localization_map.h"
+#include "vmap/localization/localize_sequence.h"
+#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/map_io.h"
+
+namespace fs = std::filesystem;
+using namespace vmap;
+
+namespace {
+
+std::string MapOptionsJson(const Matcher& matcher, const MapBuilderOptions& options) {
+  nlohmann::json doc;
+  doc["matcher"] = nlohmann::json::parse(matcher.DescribeOptionsJson());
+  doc["verifier"] = {{"method", VerifierMethodName(options.verifier.method)},
+                     {"threshold", options.verifier.threshold},
+                     {"confidence", options.verifier.confidence},
+                     {"max_iterations", options.verifier.max_iterations},
+                     {"seed", options.verifier.seed},
+                     {"min_matches", options.verifier.min_matches}};
+  doc["similarity"] = SimilarityModeName(options.key_images.similarity);
+  doc["tau"] = options.key_images.tau;
+  return doc.dump();
+}
+
+bool Brackets(const VisualMap& map, int source_index, int key) {
+  const auto [before, after] = KeysAround(map, source_index);
+  return key >= 0 && (key == before || key == after);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: localize_accuracy SEQUENCE [--last N] [--tau T] [--ranking R] [--candidates K]\n");
+    return 2;
+  }
+  const std::string input = argv[1];
+  int last = -1, candidates = 5;
+  double tau = 0.5;
+  std::string ranking = "auto";
+  for (int i = 2; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--last")) last = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--tau")) tau = std::atof(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--ranking")) ranking = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--candidates")) candidates = std::atoi(argv[i + 1]);
+  }
+  cv::setNumThreads(1);
+  const fs::path map_directory = fs::temp_directory_path() / ("vmap_localize_accuracy_" + std::to_string(getpid()));
+  fs::remove_all(map_directory);
+  fs::create_directories(map_directory);
+
+  // The map: even frames.
+  const auto matcher = CreateMatcher({});
+  MapBuilderOptions build_options;
+  build_options.key_images.tau = tau;
+  build_options.show_progress = false;
+  FrameSourceOptions even;
+  even.stride = 2;
+  even.last = last;
+  {
+    auto source = OpenFrameSource(input, even);
+    const VisualMap built = BuildMap(*source, *matcher, build_options, map_directory,
+                                     MapOptionsJson(*matcher, build_options));
+    WriteMapFiles(built, map_directory);
+  }
+  LocalizationMap opened = OpenLocalizationMap(map_directory, {});
+  const VisualMap& map = opened.map;
+  std::printf("%s: map of %d even frames, %zu key images (tau %.2f)\n", input.c_str(), map.num_frames,
+              map.key_images.size(), tau);
+
+  LocalizerOptions options = MapLocalizerOptions(map);
+  options.ranking.method = ParseRankingMethod(ranking);
+  options.relocalization_candidates = candidates;
+  FrameSourceOptions odd = even;
+  odd.first = 1;
+
+  // 1. Streaming.
+  {
+    Localizer localizer(map, opened.keys, *opened.matcher, options);
+    auto source = OpenFrameSource(input, odd);
+    long bracketed = 0, progress_count = 0;
+    double progress_error = 0.0;
+    std::vector<std::string> misses;
+    LocalizeSequenceOptions run_options;
+    run_options.show_progress = false;
+    const LocalizationSummary s = LocalizeSequence(
+        *source, *opened.matcher, localizer, run_options, [&](const Frame& frame, const LocalizationResult& r) {
+          if (Brackets(map, frame.source_index, r.key)) {
+            ++bracketed;
+          } else if (misses.size() < 12) {
+            const auto [before, after] = KeysAround(map, frame.source_index);
+            misses.push_back(std::to_string(frame.source_index) + ":" + LocalizationStatusName(r.status) + ":key " +
+                             std::to_string(r.key) + " (bracket " + std::to_string(before) + "," +
+                             std::to_string(after) + ")");
+          }
+          const auto [before, after] = KeysAround(map, frame.source_index);
+          if (r.key == before && r.next_key == after && before != after && std::isfinite(r.progress)) {
+            const double a = map.key_images[before].source_index, b = map.key_images[after].source_index;
+            progress_error += std::abs(r.progress - (frame.source_index - a) / (b - a));
+            ++progress_count;
+          }
+        });
+    std::printf("streaming: %ld odd frames, bracketed %ld (%.1f%%); tracking %ld, relocalized %ld, lost %ld; "
+                "%.1f frames/s, %.1f ms localizing per frame\n",
+                s.frames, bracketed, 100.0 * bracketed / std::max(1L, s.frames), s.tracking, s.relocalized, s.lost,
+                s.frames_per_second, 1000 * s.mean_localize_seconds);
+    std::printf("progress: mean |estimate - truth| %.3f over %ld frames on their bracketing segment\n",
+                progress_count ? progress_error / progress_count : 0.0, progress_count);
+    for (const std::string& m : misses) std::printf("  miss %s\n", m.c_str());
+  }
+
+  // 2. Every frame relocalized from scratch, and both rankings' recall.
+  {
+    Localizer localizer(map, opened.keys, *opened.matcher, options);
+    LocalizerOptions thumb_options = options;
+    KeyImageRanking votes(opened.keys.features, opened.keys.thumbnails, {});
+    RankingOptions thumbnail_ranking;
+    thumbnail_ranking.method = RankingMethod::kThumbnails;
+    KeyImageRanking thumbnails(opened.keys.features, opened.keys.thumbnails, thumbnail_ranking);
+    auto source = OpenFrameSource(input, odd);
+    long frames = 0, bracketed = 0, localized = 0;
+    long top1[2] = {0, 0}, topk[2] = {0, 0};
+    double seconds = 0.0, worst = 0.0, rank_seconds[2] = {0.0, 0.0};
+    while (auto frame = source->Next()) {
+      const auto features = opened.matcher->Extract(frame->gray);
+      localizer.Reset();
+      const LocalizationResult r = localizer.Localize(*frame, *features);
+      ++frames;
+      localized += r.status != LocalizationStatus::kLost;
+      bracketed += Brackets(map, frame->source_index, r.key);
+      seconds += r.seconds;
+      worst = std::max(worst, r.seconds);
+      const cv::Mat thumbnail = ThumbnailDescriptor(frame->gray, thumb_options.ranking.thumbnail_width);
+      const KeyImageRanking* rankings[2] = {&votes, &thumbnails};
+      for (int m = 0; m < 2; ++m) {
+        const auto start = std::chrono::steady_clock::now();
+        const auto ranked = rankings[m]->Rank(*features, thumbnail);
+        rank_seconds[m] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        for (int i = 0; i < std::min<int>(candidates, ranked.size()); ++i) {
+          if (Brackets(map, frame->source_index, ranked[i].key)) {
+            top1[m] += i == 0;
+            ++topk[m];
+            break;
+          }
+        }
+      }
+    }
+    std::printf("relocalization only: %ld frames, localized %ld, bracketed %ld (%.1f%%); %.1f ms per frame, "
+                "worst %.1f ms\n",
+                frames, localized, bracketed, 100.0 * bracketed / std::max(1L, frames), 1000 * seconds / frames,
+                1000 * worst);
+    const char* names[2] = {"votes", "thumbnails"};
+    for (int m = 0; m < 2; ++m) {
+      std::printf("ranking %-10s: bracketing key first %.1f%%, among the first %d %.1f%%; %.2f ms per query\n",
+                  names[m], 100.0 * top1[m] / frames, candidates, 100.0 * topk[m] / frames,
+                  1000 * rank_seconds[m] / frames);
+    }
+  }
+  fs::remove_all(map_directory);
+  return 0;
+}

@@ -1,0 +1,64 @@
+#include "vmap/features/matcher_options_json.h"
+
+#include <gtest/gtest.h>
+
+#include "vmap/core/error.h"
+#include "vmap/features/orb_matcher.h"
+
+namespace vmap {
+namespace {
+
+TEST(MatcherOptionsFromJson, RebuildsTheOrbOptionsAMapRecorded) {
+  OrbMatcherOptions orb;
+  orb.num_features = 1200;
+  orb.scale_factor = 1.3;
+  orb.num_levels = 6;
+  orb.edge_threshold = 19;
+  orb.fast_threshold = 12;
+  orb.cross_check = false;
+  orb.ratio = 0.8;
+  const auto matcher = CreateOrbMatcher(orb);
+  const MatcherOptions back = MatcherOptionsFromJson(matcher->DescribeOptionsJson(), "map.json");
+  EXPECT_EQ(back.type, "orb");
+  EXPECT_EQ(back.orb.num_features, 1200);
+  EXPECT_DOUBLE_EQ(back.orb.scale_factor, 1.3);
+  EXPECT_EQ(back.orb.num_levels, 6);
+  EXPECT_EQ(back.orb.edge_threshold, 19);
+  EXPECT_EQ(back.orb.fast_threshold, 12);
+  EXPECT_FALSE(back.orb.cross_check);
+  EXPECT_DOUBLE_EQ(back.orb.ratio, 0.8);
+  // The rebuilt matcher records the same options.
+  EXPECT_EQ(CreateOrbMatcher(back.orb)->DescribeOptionsJson(), matcher->DescribeOptionsJson());
+}
+
+TEST(MatcherOptionsFromJson, ReadsLoftrOptionsAndDropsAWeightsFileThatIsNotHere) {
+  const MatcherOptions options = MatcherOptionsFromJson(
+      R"({"type": "loftr", "model": "outdoor", "weights": "/nowhere/outdoor_ds.ckpt", "device": "cpu",
+          "longest_side": 480, "threshold": 0.3, "threads": 2, "coarse_stride": 8})",
+      "map.json");
+  EXPECT_EQ(options.type, "loftr");
+  EXPECT_EQ(options.loftr.model, "outdoor");
+  EXPECT_EQ(options.loftr.weights, "");
+  EXPECT_EQ(options.loftr.longest_side, 480);
+  EXPECT_DOUBLE_EQ(options.loftr.threshold, 0.3);
+  EXPECT_EQ(options.loftr.num_threads, 2);
+}
+
+TEST(MatcherOptionsFromJson, UnknownOrMissingMatchersAreClearErrors) {
+  auto message = [](const std::string& json) {
+    try {
+      MatcherOptionsFromJson(json, "m/map.json");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(message(R"({"type": "sift"})").find("built with the matcher 'sift'"), std::string::npos);
+  EXPECT_NE(message("{}").find("does not record its matcher"), std::string::npos);
+  EXPECT_NE(message(R"({"type": "orb", "num_features": "many"})").find("num_features has the wrong type"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"type": "orb", "num_features": 0})").find("--orb-features"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace vmap

@@ -1,0 +1,219 @@
+#include "vmap/localization/key_image_store.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <cstring>
+#include <exception>
+#include <fstream>
+#include <mutex>
+#include <thread>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+#include <spdlog/spdlog.h>
+
+#include "vmap/core/atomic_output.h"
+#include "vmap/core/error.h"
+#include "vmap/localization/key_image_ranking.h"
+#include "vmap/mapping/map_io.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+
+namespace {
+
+// Bump when the layout below changes: older caches are then recomputed.
+constexpr char kCacheMagic[16] = {'v', 'm', 'a', 'p', '-', 'l', 'o', 'c', 'a', 'l', 'i', 'z', 'e', '-', 'v', '1'};
+
+// FNV-1a, 64 bits: the cache needs to notice a change, not to resist an adversary.
+uint64_t Fnv1a(std::string_view bytes, uint64_t hash = 0xcbf29ce484222325ull) {
+  for (unsigned char c : bytes) {
+    hash ^= c;
+    hash *= 0x100000001b3ull;
+  }
+  return hash;
+}
+
+std::string ReadWholeFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return {};
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+uint64_t Fingerprint(const fs::path& map_directory, const Matcher& matcher, const KeyImageStoreOptions& options) {
+  uint64_t hash = Fnv1a(std::string_view(kCacheMagic, sizeof(kCacheMagic)));
+  hash = Fnv1a(ReadWholeFile(map_directory / kMapFileName), hash);
+  hash = Fnv1a(matcher.DescribeOptionsJson(), hash);
+  return Fnv1a(std::to_string(options.thumbnail_width), hash);
+}
+
+template <typename T>
+void Append(std::string& out, const T& value) {
+  out.append(reinterpret_cast<const char*>(&value), sizeof(value));
+}
+
+// Reads the cache file; false when it is absent, stale or malformed (then it is recomputed).
+class Reader {
+ public:
+  explicit Reader(std::string bytes) : bytes_(std::move(bytes)) {}
+  template <typename T>
+  bool Read(T& value) {
+    if (bytes_.size() - position_ < sizeof(T)) return false;
+    std::memcpy(&value, bytes_.data() + position_, sizeof(T));
+    position_ += sizeof(T);
+    return true;
+  }
+  bool View(uint64_t size, std::string_view& view) {
+    if (bytes_.size() - position_ < size) return false;
+    view = std::string_view(bytes_.data() + position_, size);
+    position_ += size;
+    return true;
+  }
+  bool AtEnd() const { return position_ == bytes_.size(); }
+
+ private:
+  std::string bytes_;
+  size_t position_ = 0;
+};
+
+bool ReadCache(const fs::path& file, uint64_t fingerprint, const Matcher& matcher, size_t num_keys,
+               KeyImageStore& store) {
+  Reader reader(ReadWholeFile(file));
+  std::string_view magic;
+  uint64_t stored_fingerprint = 0;
+  uint32_t stored_keys = 0;
+  if (!reader.View(sizeof(kCacheMagic), magic) || magic != std::string_view(kCacheMagic, sizeof(kCacheMagic))) {
+    return false;
+  }
+  if (!reader.Read(stored_fingerprint) || stored_fingerprint != fingerprint) return false;
+  if (!reader.Read(stored_keys) || stored_keys != num_keys) return false;
+  std::vector<std::shared_ptr<const ImageFeatures>> features;
+  std::vector<cv::Mat> thumbnails;
+  for (size_t k = 0; k < num_keys; ++k) {
+    uint32_t thumbnail_size = 0;
+    uint64_t features_size = 0;
+    std::string_view thumbnail_bytes, feature_bytes;
+    if (!reader.Read(thumbnail_size) || !reader.View(uint64_t{thumbnail_size} * sizeof(float), thumbnail_bytes)) {
+      return false;
+    }
+    if (!reader.Read(features_size) || !reader.View(features_size, feature_bytes)) return false;
+    cv::Mat thumbnail(1, static_cast<int>(thumbnail_size), CV_32F);
+    if (thumbnail_size > 0) std::memcpy(thumbnail.data, thumbnail_bytes.data(), thumbnail_bytes.size());
+    std::shared_ptr<const ImageFeatures> f = matcher.DeserializeFeatures(feature_bytes);
+    if (!f) return false;
+    features.push_back(std::move(f));
+    thumbnails.push_back(thumbnail);
+  }
+  if (!reader.AtEnd()) return false;
+  store.features = std::move(features);
+  store.thumbnails = std::move(thumbnails);
+  return true;
+}
+
+// The cache's bytes, or "" when the matcher cannot serialise its features.
+std::string EncodeCache(uint64_t fingerprint, const Matcher& matcher, const KeyImageStore& store) {
+  std::string out(kCacheMagic, sizeof(kCacheMagic));
+  Append(out, fingerprint);
+  Append(out, static_cast<uint32_t>(store.features.size()));
+  for (size_t k = 0; k < store.features.size(); ++k) {
+    const std::string bytes = matcher.SerializeFeatures(*store.features[k]);
+    if (bytes.empty()) return {};
+    const cv::Mat& thumbnail = store.thumbnails[k];
+    CV_Assert(thumbnail.type() == CV_32F && thumbnail.isContinuous());
+    Append(out, static_cast<uint32_t>(thumbnail.total()));
+    out.append(reinterpret_cast<const char*>(thumbnail.data), thumbnail.total() * sizeof(float));
+    Append(out, static_cast<uint64_t>(bytes.size()));
+    out.append(bytes);
+  }
+  return out;
+}
+
+void ComputeKeyImages(const fs::path& map_directory, const VisualMap& map, const Matcher& matcher,
+                      const KeyImageStoreOptions& options, KeyImageStore& store) {
+  const size_t n = map.key_images.size();
+  store.features.assign(n, nullptr);
+  store.thumbnails.assign(n, cv::Mat());
+  std::atomic<size_t> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  auto work = [&] {
+    try {
+      for (size_t k = next++; k < n; k = next++) {
+        const fs::path file = map_directory / map.key_images[k].image_file;
+        // Grey straight from the decoder, as the image sources read frames.
+        const cv::Mat gray = cv::imread(file.string(), cv::IMREAD_GRAYSCALE);
+        if (gray.empty()) {
+          throw InputError("key image '" + file.string() + "' cannot be decoded; rebuild the map with `vmap build`");
+        }
+        store.features[k] = matcher.Extract(gray);
+        store.thumbnails[k] = ThumbnailDescriptor(gray, options.thumbnail_width);
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (!error) error = std::current_exception();
+      next = n;
+    }
+  };
+  const int threads = std::max(1, std::min<int>(static_cast<int>(n), options.extraction_threads > 0
+                                                                         ? options.extraction_threads
+                                                                         : static_cast<int>(std::thread::hardware_concurrency())));
+  std::vector<std::thread> workers;
+  for (int i = 1; i < threads; ++i) workers.emplace_back(work);
+  work();
+  for (std::thread& t : workers) t.join();
+  if (error) std::rethrow_exception(error);
+}
+
+}  // namespace
+
+std::string KeyImageCacheStateName(KeyImageCacheState state) {
+  switch (state) {
+    case KeyImageCacheState::kOff: return "off";
+    case KeyImageCacheState::kHit: return "hit";
+    case KeyImageCacheState::kWritten: return "written";
+    case KeyImageCacheState::kNotWritten: return "not written";
+    case KeyImageCacheState::kUnsupported: return "unsupported";
+  }
+  return "off";
+}
+
+void KeyImageStoreOptions::Check() const {
+  if (thumbnail_width < 8 || thumbnail_width > 512) {
+    throw InputError(fmt::format("thumbnail width {} is outside [8, 512] (default 48)", thumbnail_width));
+  }
+  if (extraction_threads < 0) throw InputError("key-image extraction threads must be >= 0 (0 = one per core)");
+}
+
+KeyImageStore LoadKeyImageStore(const fs::path& map_directory, const VisualMap& map, const Matcher& matcher,
+                                const KeyImageStoreOptions& options) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  KeyImageStore store;
+  const fs::path cache_file = map_directory / kLocalizationCacheFileName;
+  const uint64_t fingerprint = options.use_cache ? Fingerprint(map_directory, matcher, options) : 0;
+  if (options.use_cache && ReadCache(cache_file, fingerprint, matcher, map.key_images.size(), store)) {
+    store.cache = KeyImageCacheState::kHit;
+  } else {
+    ComputeKeyImages(map_directory, map, matcher, options, store);
+    if (options.use_cache) {
+      const std::string bytes = EncodeCache(fingerprint, matcher, store);
+      if (bytes.empty()) {
+        store.cache = KeyImageCacheState::kUnsupported;
+      } else {
+        try {
+          WriteFileAtomically(cache_file, bytes);
+          store.cache = KeyImageCacheState::kWritten;
+        } catch (const std::exception& e) {
+          spdlog::info("key-image cache not written ({}); the features are computed at every start", e.what());
+          store.cache = KeyImageCacheState::kNotWritten;
+        }
+      }
+    }
+  }
+  store.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return store;
+}
+
+}  // namespace vmap

@@ -1,0 +1,55 @@
+#pragma once
+// The key images of a map as localization needs them: the matcher's features and the thumbnail of each,
+// computed once per map and kept in a cache file inside the map directory.
+//
+// The cache, MAP/localization_cache.bin, is written atomically. It starts with a fingerprint of map.json's
+// bytes, the matcher's recorded options (Matcher::DescribeOptionsJson) and the thumbnail width, and is
+// used only when all three are unchanged: a rebuilt map, another matcher setting or a newer cache format
+// makes it stale, and it is then recomputed and replaced. A map directory that cannot be written is not an
+// error (the features are then computed at every start). Matchers that cannot serialise their features
+// (Matcher::SerializeFeatures returns "") get no cache.
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "vmap/features/matcher.h"
+#include "vmap/mapping/visual_map.h"
+
+namespace vmap {
+
+inline constexpr const char* kLocalizationCacheFileName = "localization_cache.bin";
+
+enum class KeyImageCacheState {
+  kOff,          // not asked to use a cache
+  kHit,          // read from a valid cache
+  kWritten,      // computed, and the cache written
+  kNotWritten,   // computed; the cache could not be written (read-only map directory)
+  kUnsupported,  // computed; the matcher cannot serialise its features
+};
+std::string KeyImageCacheStateName(KeyImageCacheState state);
+
+struct KeyImageStoreOptions {
+  bool use_cache = true;
+  int thumbnail_width = 48;    // ThumbnailDescriptor width (the ranking's)
+  int extraction_threads = 0;  // threads extracting key-image features on a cache miss; 0 = one per core
+
+  void Check() const;  // throws InputError naming the bad option
+};
+
+struct KeyImageStore {
+  std::vector<std::shared_ptr<const ImageFeatures>> features;  // one per key image, in map order
+  std::vector<cv::Mat> thumbnails;                            // ThumbnailDescriptor of each key image
+  KeyImageCacheState cache = KeyImageCacheState::kOff;
+  double seconds = 0.0;                                        // time to load or compute them
+};
+
+// Reads (or computes and caches) the features of every key image of `map`, read from `map_directory`.
+// Throws InputError naming the file when a key image cannot be decoded.
+KeyImageStore LoadKeyImageStore(const std::filesystem::path& map_directory, const VisualMap& map,
+                                const Matcher& matcher, const KeyImageStoreOptions& options);
+
+}  // namespace vmap

@@ -1,0 +1,30 @@
+#pragma once
+// A map opened for localization: the map, the matcher it was built with (rebuilt from map.json), and its
+// key images' features (cached; see key_image_store.h).
+
+#include <filesystem>
+#include <memory>
+
+#include "vmap/features/matcher.h"
+#include "vmap/localization/key_image_store.h"
+#include "vmap/localization/localizer.h"
+#include "vmap/mapping/visual_map.h"
+
+namespace vmap {
+
+struct LocalizationMap {
+  std::filesystem::path directory;
+  VisualMap map;
+  std::unique_ptr<Matcher> matcher;  // the map's matcher, with the map's options
+  KeyImageStore keys;
+};
+
+// Reads the map (ReadMap), creates its matcher (MatcherOptionsFromJson) and loads its key images.
+// Throws InputError naming the file and the fix when any of it fails.
+LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, const KeyImageStoreOptions& options);
+
+// Localizer options that follow the map: its verifier (iterations capped, see MapVerifierOptions) and its
+// definition of S; the rest are LocalizerOptions' defaults.
+LocalizerOptions MapLocalizerOptions(const VisualMap& map);
+
+}  // namespace vmap

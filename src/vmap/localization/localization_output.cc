@@ -1,0 +1,256 @@
+#include "vmap/localization/localization_output.h"
+
+#include <cmath>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "vmap/core/error.h"
+
+namespace vmap {
+
+namespace {
+using nlohmann::json;
+
+int KeyFrame(const VisualMap& map, int key) {
+  return key >= 0 && key < static_cast<int>(map.key_images.size()) ? map.key_images[key].frame_index : -1;
+}
+
+// NaN and infinity are unknown: null in JSON.
+json Number(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
+
+std::string CsvNumber(double value) { return std::isfinite(value) ? fmt::format("{:.6g}", value) : std::string(); }
+
+// A CSV field: quoted when it holds a separator, a quote or a line break.
+std::string CsvText(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += c;
+  }
+  return quoted + "\"";
+}
+
+LocalizationStatus ParseStatus(const std::string& name, const std::filesystem::path& file) {
+  if (name == "tracking") return LocalizationStatus::kTracking;
+  if (name == "relocalized") return LocalizationStatus::kRelocalized;
+  if (name == "lost") return LocalizationStatus::kLost;
+  throw InputError("'" + file.string() + "' has a frame with the unknown status '" + name + "'");
+}
+
+double NumberOr(const json& object, const char* name, double fallback) {
+  auto it = object.find(name);
+  return it != object.end() && it->is_number() ? it->get<double>() : fallback;
+}
+
+}  // namespace
+
+std::string DescribeLocalizerOptions(const LocalizerOptions& options) {
+  json doc = {{"min_verified", options.min_verified},
+              {"min_similarity", options.min_similarity},
+              {"lookahead", options.lookahead},
+              {"max_lost_frames", options.max_lost_frames},
+              {"relocalization_candidates", options.relocalization_candidates},
+              {"ranking",
+               {{"method", RankingMethodName(options.ranking.method)},
+                {"max_hamming_fraction", options.ranking.max_hamming_fraction},
+                {"min_cosine", options.ranking.min_cosine},
+                {"max_descriptors_per_key", options.ranking.max_descriptors_per_key},
+                {"thumbnail_width", options.ranking.thumbnail_width}}},
+              {"verifier",
+               {{"method", VerifierMethodName(options.verifier.method)},
+                {"threshold", options.verifier.threshold},
+                {"confidence", options.verifier.confidence},
+                {"max_iterations", options.verifier.max_iterations},
+                {"seed", options.verifier.seed},
+                {"min_matches", options.verifier.min_matches}}},
+              {"similarity", SimilarityModeName(options.similarity)},
+              {"route", options.route}};
+  return doc.dump();
+}
+
+std::string LocalizationCsvHeader() {
+  return "frame,source_index,timestamp,source_name,status,key,next_key,key_frame,next_key_frame,similarity,verified,"
+         "tentative,next_similarity,next_verified,next_tentative,heading_px,progress,comparisons,seconds,"
+         "F00,F01,F02,F10,F11,F12,F20,F21,F22\n";
+}
+
+std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r) {
+  std::string row = fmt::format(
+      "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.6f}", r.frame_index, r.source_index,
+      r.timestamp >= 0 ? fmt::format("{:.6f}", r.timestamp) : std::string(), CsvText(r.source_name),
+      LocalizationStatusName(r.status), r.key, r.next_key, KeyFrame(map, r.key), KeyFrame(map, r.next_key),
+      r.to_key.key >= 0 ? CsvNumber(r.to_key.similarity) : "", r.to_key.num_verified, r.to_key.num_tentative,
+      r.to_next.key >= 0 ? CsvNumber(r.to_next.similarity) : "", r.to_next.num_verified, r.to_next.num_tentative,
+      CsvNumber(r.heading_px), CsvNumber(r.progress), r.comparisons, r.seconds);
+  for (int i = 0; i < 9; ++i) {
+    row += ',';
+    if (r.to_next.matched) row += fmt::format("{:.9g}", r.to_next.F(i / 3, i % 3));
+  }
+  return row + "\n";
+}
+
+std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run) {
+  const LocalizationRunInfo& info = run.info;
+  const LocalizationSummary& s = run.summary;
+  json doc;
+  doc["format"] = "vmap-localization";
+  doc["schema_version"] = kLocalizationSchemaVersion;
+  doc["vmap_version"] = VMAP_VERSION;
+  doc["map"] = {{"directory", info.map_directory},
+                {"key_images", map.key_images.size()},
+                {"matcher", info.matcher},
+                {"input", map.input.path}};
+  doc["query"] = {{"path", info.query},
+                  {"format", SourceFormatName(info.query_format)},
+                  {"first", info.source.first},
+                  {"last", info.source.last},
+                  {"stride", info.source.stride},
+                  {"resize", info.source.resize},
+                  {"frame_size", {info.frame_size.width, info.frame_size.height}}};
+  doc["ranking"] = info.ranking;
+  doc["key_image_cache"] = info.cache;
+  doc["key_image_seconds"] = info.key_image_seconds;
+  doc["options"] = json::parse(info.options_json.empty() ? "{}" : info.options_json);
+  const double n = s.frames > 0 ? static_cast<double>(s.frames) : 1.0;
+  doc["summary"] = {{"frames", s.frames},
+                    {"tracking", s.tracking},
+                    {"relocalized", s.relocalized},
+                    {"lost", s.lost},
+                    {"share_tracking", s.tracking / n},
+                    {"share_relocalized", s.relocalized / n},
+                    {"share_lost", s.lost / n},
+                    {"skipped_frames", s.skipped_frames},
+                    {"seconds", s.seconds},
+                    {"frames_per_second", s.frames_per_second},
+                    {"mean_localize_seconds", s.mean_localize_seconds},
+                    {"max_localize_seconds", s.max_localize_seconds},
+                    {"mean_extract_seconds", s.mean_extract_seconds},
+                    {"comparisons", s.comparisons}};
+  json frames = json::array();
+  for (const LocalizationResult& r : run.frames) {
+    json F = nullptr;
+    if (r.to_next.matched) {
+      F = json::array();
+      for (int i = 0; i < 9; ++i) F.push_back(r.to_next.F(i / 3, i % 3));
+    }
+    json candidates = json::array();
+    for (const RelocalizationCandidate& c : r.candidates) {
+      candidates.push_back({{"key", c.key}, {"score", c.score}, {"accepted", c.accepted},
+                            {"similarity", c.similarity}, {"verified", c.num_verified}});
+    }
+    frames.push_back({{"frame", r.frame_index},
+                      {"source_index", r.source_index},
+                      {"timestamp", r.timestamp >= 0 ? json(r.timestamp) : json(nullptr)},
+                      {"source_name", r.source_name},
+                      {"status", LocalizationStatusName(r.status)},
+                      {"key", r.key},
+                      {"next_key", r.next_key},
+                      {"key_frame", KeyFrame(map, r.key)},
+                      {"next_key_frame", KeyFrame(map, r.next_key)},
+                      {"similarity", r.to_key.key >= 0 ? Number(r.to_key.similarity) : json(nullptr)},
+                      {"verified", r.to_key.num_verified},
+                      {"tentative", r.to_key.num_tentative},
+                      {"next_similarity", r.to_next.key >= 0 ? Number(r.to_next.similarity) : json(nullptr)},
+                      {"next_verified", r.to_next.num_verified},
+                      {"next_tentative", r.to_next.num_tentative},
+                      {"heading_px", Number(r.heading_px)},
+                      {"progress", Number(r.progress)},
+                      {"F", F},
+                      {"candidates", candidates},
+                      {"comparisons", r.comparisons},
+                      {"seconds", r.seconds}});
+  }
+  doc["frames"] = std::move(frames);
+  return doc.dump(1) + "\n";
+}
+
+LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError("cannot read '" + file.string() + "'; give the --json file of `vmap localize`");
+  json doc;
+  try {
+    doc = json::parse(in);
+  } catch (const json::parse_error&) {
+    throw InputError("'" + file.string() + "' is not valid JSON; give the --json file of `vmap localize`");
+  }
+  if (!doc.is_object() || doc.value("format", "") != "vmap-localization") {
+    throw InputError("'" + file.string() + "' is not a localization run (no format \"vmap-localization\")");
+  }
+  if (doc.value("schema_version", 0) > kLocalizationSchemaVersion) {
+    throw InputError("'" + file.string() + "' was written by a newer vmap; update vmap");
+  }
+  LocalizationRun run;
+  try {
+    const json& map = doc.at("map");
+    run.info.map_directory = map.value("directory", "");
+    run.info.matcher = map.value("matcher", "");
+    const json& query = doc.at("query");
+    run.info.query = query.value("path", "");
+    run.info.query_format = ParseSourceFormat(query.value("format", "auto"));
+    run.info.source.first = query.value("first", 0);
+    run.info.source.last = query.value("last", -1);
+    run.info.source.stride = query.value("stride", 1);
+    run.info.source.resize = query.value("resize", "");
+    if (query.contains("frame_size") && query["frame_size"].size() == 2) {
+      run.info.frame_size = {query["frame_size"][0].get<int>(), query["frame_size"][1].get<int>()};
+    }
+    run.info.ranking = doc.value("ranking", "");
+    run.info.cache = doc.value("key_image_cache", "");
+    run.info.key_image_seconds = doc.value("key_image_seconds", 0.0);
+    run.info.options_json = doc.contains("options") ? doc["options"].dump() : "{}";
+    const json& s = doc.at("summary");
+    run.summary.frames = s.value("frames", 0L);
+    run.summary.tracking = s.value("tracking", 0L);
+    run.summary.relocalized = s.value("relocalized", 0L);
+    run.summary.lost = s.value("lost", 0L);
+    run.summary.skipped_frames = s.value("skipped_frames", 0);
+    run.summary.seconds = s.value("seconds", 0.0);
+    run.summary.frames_per_second = s.value("frames_per_second", 0.0);
+    run.summary.mean_localize_seconds = s.value("mean_localize_seconds", 0.0);
+    run.summary.max_localize_seconds = s.value("max_localize_seconds", 0.0);
+    run.summary.mean_extract_seconds = s.value("mean_extract_seconds", 0.0);
+    run.summary.comparisons = s.value("comparisons", 0L);
+    for (const json& f : doc.at("frames")) {
+      LocalizationResult r;
+      r.frame_index = f.at("frame").get<int>();
+      r.source_index = f.value("source_index", r.frame_index);
+      r.timestamp = NumberOr(f, "timestamp", -1.0);
+      r.source_name = f.value("source_name", "");
+      r.status = ParseStatus(f.at("status").get<std::string>(), file);
+      r.key = f.value("key", -1);
+      r.next_key = f.value("next_key", -1);
+      r.to_key.key = r.key;
+      r.to_key.similarity = NumberOr(f, "similarity", 0.0);
+      r.to_key.num_verified = f.value("verified", 0);
+      r.to_key.num_tentative = f.value("tentative", 0);
+      r.to_next.key = r.next_key;
+      r.to_next.similarity = NumberOr(f, "next_similarity", 0.0);
+      r.to_next.num_verified = f.value("next_verified", 0);
+      r.to_next.num_tentative = f.value("next_tentative", 0);
+      if (f.contains("F") && f["F"].is_array() && f["F"].size() == 9) {
+        r.to_next.matched = true;
+        for (int i = 0; i < 9; ++i) r.to_next.F(i / 3, i % 3) = f["F"][i].get<double>();
+      }
+      r.heading_px = NumberOr(f, "heading_px", std::nan(""));
+      r.progress = NumberOr(f, "progress", std::nan(""));
+      if (f.contains("candidates") && f["candidates"].is_array()) {
+        for (const json& c : f["candidates"]) {
+          r.candidates.push_back({c.value("key", -1), c.value("score", 0.0), c.value("accepted", false),
+                                  c.value("similarity", 0.0), c.value("verified", 0)});
+        }
+      }
+      r.comparisons = f.value("comparisons", 0);
+      r.seconds = f.value("seconds", 0.0);
+      run.frames.push_back(std::move(r));
+    }
+  } catch (const json::exception&) {
+    throw InputError("'" + file.string() + "' is not of the documented form of a localization run; write it again "
+                     "with `vmap localize --json`");
+  }
+  return run;
+}
+
+}  // namespace vmap

@@ -1,0 +1,56 @@
+#pragma once
+// The record of a localization run: CSV (one row per frame) and JSON (the run, a summary and every frame),
+// and reading the JSON back (for `vmap report`).
+//
+// Per frame, in both: frame, source_index, timestamp, source_name, status, key, next_key, key_frame and
+// next_key_frame (their frame indices in the map), similarity / verified / tentative against `key`,
+// next_similarity / next_verified / next_tentative against `next_key`, heading_px, progress, comparisons,
+// seconds, and F from the frame to the next key image (x_next^T F x_frame = 0; CSV columns F00..F22, JSON a
+// row-major list; empty / null when there is none). Unknown numbers are empty in CSV and null in JSON.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "vmap/localization/localize_sequence.h"
+#include "vmap/localization/localizer.h"
+#include "vmap/mapping/visual_map.h"
+
+namespace vmap {
+
+inline constexpr int kLocalizationSchemaVersion = 1;
+
+// What a run was: the inputs and settings, recorded in the JSON.
+struct LocalizationRunInfo {
+  std::string map_directory;
+  std::string query;                // the query's path as given
+  SourceFormat query_format = SourceFormat::kAuto;
+  FrameSourceOptions source;        // first, last, stride, resize
+  cv::Size frame_size;              // of the query frames as localized
+  std::string matcher;              // the map's matcher
+  std::string ranking;              // the ranking in use
+  std::string cache;                // KeyImageCacheStateName
+  double key_image_seconds = 0.0;   // loading or computing the key images' features
+  std::string options_json = "{}";  // the localizer's options
+};
+
+struct LocalizationRun {
+  LocalizationRunInfo info;
+  LocalizationSummary summary;
+  std::vector<LocalizationResult> frames;
+};
+
+// The localizer's options as JSON text (for LocalizationRunInfo::options_json).
+std::string DescribeLocalizerOptions(const LocalizerOptions& options);
+
+std::string LocalizationCsvHeader();
+// One CSV row (with the newline) for `result`, localized against `map`.
+std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& result);
+
+// The JSON document of a run (frames listed in order).
+std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run);
+
+// Reads a run written by LocalizationRunJson. Throws InputError naming the file when it is not one.
+LocalizationRun ReadLocalizationRun(const std::filesystem::path& file);
+
+}  // namespace vmap

@@ -1,0 +1,139 @@
+#include "vmap/localization/localization_output.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "vmap/core/atomic_output.h"
+#include "vmap/core/error.h"
+#include "vmap/testing/synthetic_scene.h"
+
+namespace vmap {
+namespace {
+
+VisualMap TwoKeyMap() {
+  VisualMap map;
+  for (int f : {0, 40}) {
+    KeyImage k;
+    k.frame_index = k.source_index = f;
+    map.key_images.push_back(k);
+  }
+  return map;
+}
+
+LocalizationRun SampleRun() {
+  LocalizationRun run;
+  run.info.map_directory = "map";
+  run.info.query = "query, with a comma.mp4";
+  run.info.query_format = SourceFormat::kVideo;
+  run.info.frame_size = {640, 480};
+  run.info.matcher = "orb";
+  run.info.ranking = "votes";
+  LocalizationResult tracked;
+  tracked.frame_index = 0;
+  tracked.source_index = 3;
+  tracked.timestamp = 0.1;
+  tracked.source_name = "frame_000003";
+  tracked.status = LocalizationStatus::kRelocalized;
+  tracked.key = 0;
+  tracked.next_key = 1;
+  tracked.to_key = {0, true, true, 0.75, 200, 150, cv::Matx33d::zeros(), 1.5};
+  tracked.to_next = {1, true, true, 0.5, 100, 50, cv::Matx33d(1, 2, 3, 4, 5, 6, 7, 8, 9), -2.0};
+  tracked.heading_px = -2.0;
+  tracked.progress = 0.25;
+  tracked.candidates = {{0, 120.0, true, 0.75, 150}, {1, 80.0, true, 0.5, 50}};
+  LocalizationResult lost;
+  lost.frame_index = 1;
+  lost.source_index = 4;
+  lost.status = LocalizationStatus::kLost;
+  lost.heading_px = std::nan("");
+  lost.progress = std::nan("");
+  run.frames = {tracked, lost};
+  run.summary.frames = 2;
+  run.summary.relocalized = 1;
+  run.summary.lost = 1;
+  run.summary.seconds = 0.5;
+  run.summary.frames_per_second = 4.0;
+  return run;
+}
+
+TEST(LocalizationOutput, CsvHasTheNamedColumnsAndOneRowPerFrame) {
+  const VisualMap map = TwoKeyMap();
+  const LocalizationRun run = SampleRun();
+  std::string csv = LocalizationCsvHeader();
+  for (const LocalizationResult& r : run.frames) csv += LocalizationCsvRow(map, r);
+  std::istringstream lines(csv);
+  std::string header, row0, row1, extra;
+  std::getline(lines, header);
+  std::getline(lines, row0);
+  std::getline(lines, row1);
+  EXPECT_FALSE(std::getline(lines, extra));
+  for (const char* column : {"frame", "source_index", "status", "key", "next_key", "similarity", "verified",
+                             "next_similarity", "next_verified", "heading_px", "progress", "F00", "F22"}) {
+    EXPECT_NE(("," + header + ",").find(std::string(",") + column + ","), std::string::npos) << column;
+  }
+  auto count = [](const std::string& s) { return std::count(s.begin(), s.end(), ','); };
+  EXPECT_EQ(count(row0), count(header));
+  EXPECT_EQ(count(row1), count(header));
+  EXPECT_EQ(row0.rfind("0,3,0.100000,frame_000003,relocalized,0,1,0,40,0.75,150,200,0.5,50,100,-2,0.25,", 0), 0u)
+      << row0;
+  EXPECT_NE(row0.find(",1,2,3,4,5,6,7,8,9"), std::string::npos) << row0;
+  // Unknown values are empty, not "nan".
+  EXPECT_EQ(row1.find("nan"), std::string::npos) << row1;
+  EXPECT_EQ(row1.rfind("1,4,,frame,lost,-1,-1,-1,-1,,0,0,,0,0,,,", 0), std::string::npos) << row1;
+  EXPECT_NE(row1.find(",lost,-1,-1,-1,-1,,0,0,,0,0,,,"), std::string::npos) << row1;
+}
+
+TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
+  const VisualMap map = TwoKeyMap();
+  const LocalizationRun run = SampleRun();
+  ::vmap::testing::TempDir tmp;
+  const auto file = tmp.path() / "run.json";
+  WriteFileAtomically(file, LocalizationRunJson(map, run));
+  const auto doc = nlohmann::json::parse(std::ifstream(file));
+  EXPECT_EQ(doc["format"], "vmap-localization");
+  EXPECT_DOUBLE_EQ(doc["summary"]["share_lost"].get<double>(), 0.5);
+  EXPECT_TRUE(doc["frames"][1]["heading_px"].is_null());
+  EXPECT_EQ(doc["frames"][0]["key_frame"], 0);
+  EXPECT_EQ(doc["frames"][0]["next_key_frame"], 40);
+  const LocalizationRun back = ReadLocalizationRun(file);
+  EXPECT_EQ(back.info.query, run.info.query);
+  EXPECT_EQ(back.info.query_format, SourceFormat::kVideo);
+  EXPECT_EQ(back.info.frame_size, cv::Size(640, 480));
+  EXPECT_EQ(back.summary.frames, 2);
+  EXPECT_EQ(back.summary.lost, 1);
+  ASSERT_EQ(back.frames.size(), 2u);
+  const LocalizationResult& r = back.frames[0];
+  EXPECT_EQ(r.status, LocalizationStatus::kRelocalized);
+  EXPECT_EQ(r.source_index, 3);
+  EXPECT_EQ(r.key, 0);
+  EXPECT_EQ(r.next_key, 1);
+  EXPECT_DOUBLE_EQ(r.to_key.similarity, 0.75);
+  EXPECT_EQ(r.to_next.num_verified, 50);
+  EXPECT_EQ(r.to_next.F, cv::Matx33d(1, 2, 3, 4, 5, 6, 7, 8, 9));
+  EXPECT_DOUBLE_EQ(r.progress, 0.25);
+  ASSERT_EQ(r.candidates.size(), 2u);
+  EXPECT_EQ(r.candidates[1].num_verified, 50);
+  EXPECT_EQ(back.frames[1].status, LocalizationStatus::kLost);
+  EXPECT_TRUE(std::isnan(back.frames[1].heading_px));
+}
+
+TEST(LocalizationOutput, ReadingSomethingElseIsAClearError) {
+  ::vmap::testing::TempDir tmp;
+  EXPECT_THROW(ReadLocalizationRun(tmp.path() / "missing.json"), InputError);
+  WriteFileAtomically(tmp.path() / "map.json", "{\"format\": \"vmap-map\"}");
+  try {
+    ReadLocalizationRun(tmp.path() / "map.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is not a localization run"), std::string::npos) << e.what();
+  }
+  WriteFileAtomically(tmp.path() / "broken.json", "{\"format\": \"vmap-localization\", \"frames\": 3}");
+  EXPECT_THROW(ReadLocalizationRun(tmp.path() / "broken.json"), InputError);
+}
+
+}  // namespace
+}  // namespace vmap

@@ -1,0 +1,57 @@
+#include "vmap/localization/localization_test_util.h"
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "vmap/mapping/map_io.h"
+
+namespace vmap::testing {
+
+MemorySource::MemorySource(std::vector<cv::Mat> frames, std::vector<int> source_indices)
+    : frames_(std::move(frames)), source_indices_(std::move(source_indices)) {
+  info_.path = "memory";
+  info_.format = SourceFormat::kImageFolder;
+  info_.expected_frames = static_cast<long>(frames_.size());
+  if (!frames_.empty()) info_.native_size = info_.frame_size = frames_.front().size();
+}
+
+std::optional<Frame> MemorySource::Next() {
+  if (next_ >= frames_.size()) return std::nullopt;
+  Frame frame;
+  frame.index = static_cast<int>(next_);
+  frame.source_index = next_ < source_indices_.size() ? source_indices_[next_] : static_cast<int>(next_);
+  const cv::Mat& image = frames_[next_];
+  if (image.channels() == 3) {
+    frame.color = image;
+    cv::cvtColor(image, frame.gray, cv::COLOR_BGR2GRAY);
+  } else {
+    frame.gray = image;
+  }
+  frame.source_name = "frame" + std::to_string(frame.source_index);
+  ++next_;
+  return frame;
+}
+
+std::string MapOptionsJson(const Matcher& matcher, const MapBuilderOptions& options) {
+  nlohmann::json doc;
+  doc["matcher"] = nlohmann::json::parse(matcher.DescribeOptionsJson());
+  doc["verifier"] = {{"method", VerifierMethodName(options.verifier.method)},
+                     {"threshold", options.verifier.threshold},
+                     {"confidence", options.verifier.confidence},
+                     {"max_iterations", options.verifier.max_iterations},
+                     {"seed", options.verifier.seed},
+                     {"min_matches", options.verifier.min_matches}};
+  doc["similarity"] = SimilarityModeName(options.key_images.similarity);
+  doc["tau"] = options.key_images.tau;
+  return doc.dump();
+}
+
+VisualMap BuildMapDirectory(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
+                            const std::filesystem::path& directory) {
+  std::filesystem::create_directories(directory);
+  VisualMap map = BuildMap(source, matcher, options, directory, MapOptionsJson(matcher, options));
+  WriteMapFiles(map, directory);
+  return map;
+}
+
+}  // namespace vmap::testing

@@ -1,0 +1,38 @@
+#pragma once
+// Test helpers of the localization stage: frames held in memory as a source, and maps built in-process
+// into a directory, as `vmap build` writes them.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "vmap/features/matcher.h"
+#include "vmap/mapping/map_builder.h"
+#include "vmap/sources/frame_source.h"
+
+namespace vmap::testing {
+
+// Frames (BGR or grey) as a source; frame i has source index `source_indices[i]` (default: i).
+class MemorySource : public FrameSource {
+ public:
+  explicit MemorySource(std::vector<cv::Mat> frames, std::vector<int> source_indices = {});
+  std::optional<Frame> Next() override;
+  const SequenceInfo& info() const override { return info_; }
+
+ private:
+  std::vector<cv::Mat> frames_;
+  std::vector<int> source_indices_;
+  size_t next_ = 0;
+  SequenceInfo info_;
+};
+
+// The options text `vmap build` records (matcher, verifier, similarity, tau), enough for localization.
+std::string MapOptionsJson(const Matcher& matcher, const MapBuilderOptions& options);
+
+// Builds a map of `source` with `matcher` into `directory` (created), key images and map files included.
+VisualMap BuildMapDirectory(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
+                            const std::filesystem::path& directory);
+
+}  // namespace vmap::testing

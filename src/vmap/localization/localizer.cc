@@ -1,0 +1,297 @@
+#include "vmap/localization/localizer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "vmap/core/error.h"
+
+namespace vmap {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return kNaN;
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  if (values.size() % 2 == 1) return values[mid];
+  const double upper = values[mid];
+  return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + mid));
+}
+
+// Which of two accepted comparisons is the better match: more verified matches, then higher S.
+bool Better(const KeyComparison& a, const KeyComparison& b) {
+  if (!a.accepted) return false;
+  if (!b.accepted) return true;
+  static const int mode = getenv("VMAP_BETTER") ? atoi(getenv("VMAP_BETTER")) : 0;
+  if (mode == 1) return a.similarity > b.similarity;
+  if (mode == 2) return a.similarity * a.num_verified > b.similarity * b.num_verified;
+  if (a.num_verified != b.num_verified) return a.num_verified > b.num_verified;
+  return a.similarity > b.similarity;
+}
+
+}  // namespace
+
+std::string LocalizationStatusName(LocalizationStatus status) {
+  switch (status) {
+    case LocalizationStatus::kTracking: return "tracking";
+    case LocalizationStatus::kRelocalized: return "relocalized";
+    case LocalizationStatus::kLost: return "lost";
+  }
+  return "lost";
+}
+
+void LocalizerOptions::Check() const {
+  if (min_verified < 8) {
+    throw InputError(fmt::format("--min-verified {} is below 8, the fewest matches F can be verified with "
+                                 "(default 20)", min_verified));
+  }
+  if (!(min_similarity >= 0.0 && min_similarity <= 1.0)) {
+    throw InputError(fmt::format("--min-similarity {} is outside [0, 1] (default 0.3)", min_similarity));
+  }
+  if (lookahead < 1 || lookahead > 2) throw InputError(fmt::format("lookahead {} is not 1 or 2 (default 2)", lookahead));
+  if (max_lost_frames < 0) throw InputError(fmt::format("--max-lost {} must be >= 0 (default 5)", max_lost_frames));
+  if (relocalization_candidates < 1) {
+    throw InputError(fmt::format("--candidates {} must be >= 1 (default 5)", relocalization_candidates));
+  }
+  ranking.Check();
+  verifier.Check();
+}
+
+std::pair<int, int> KeysAround(const VisualMap& map, int source_index) {
+  int before = -1, after = -1;
+  for (int k = 0; k < static_cast<int>(map.key_images.size()); ++k) {
+    const int s = map.key_images[k].source_index;
+    if (s <= source_index && (before < 0 || s >= map.key_images[before].source_index)) before = k;
+    if (s >= source_index && (after < 0 || s < map.key_images[after].source_index)) after = k;
+  }
+  return {before, after};
+}
+
+VerifierOptions MapVerifierOptions(const VisualMap& map, int max_iterations) {
+  VerifierOptions options;
+  const auto doc = nlohmann::json::parse(map.options_json.empty() ? "{}" : map.options_json, nullptr, false);
+  if (doc.is_object() && doc.contains("verifier") && doc["verifier"].is_object()) {
+    const auto& v = doc["verifier"];
+    try {
+      if (v.contains("method")) options.method = ParseVerifierMethod(v["method"].get<std::string>());
+      options.threshold = v.value("threshold", options.threshold);
+      options.confidence = v.value("confidence", options.confidence);
+      options.max_iterations = v.value("max_iterations", options.max_iterations);
+      options.seed = v.value("seed", options.seed);
+      options.min_matches = v.value("min_matches", options.min_matches);
+    } catch (const nlohmann::json::exception&) {
+      throw InputError("the map's options.verifier is not of the documented form; rebuild the map");
+    }
+  }
+  options.max_iterations = std::min(options.max_iterations, max_iterations);
+  options.Check();
+  return options;
+}
+
+SimilarityMode MapSimilarityMode(const VisualMap& map) {
+  const auto doc = nlohmann::json::parse(map.options_json.empty() ? "{}" : map.options_json, nullptr, false);
+  if (doc.is_object() && doc.contains("similarity") && doc["similarity"].is_string()) {
+    return ParseSimilarityMode(doc["similarity"].get<std::string>());
+  }
+  return SimilarityMode::kInlierRatio;
+}
+
+Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matcher& matcher, LocalizerOptions options)
+    : map_(map), keys_(keys), matcher_(matcher), options_(std::move(options)) {
+  options_.Check();
+  const int num_keys = static_cast<int>(map_.key_images.size());
+  if (num_keys == 0) throw InputError("the map has no key images; nothing to localize against");
+  if (static_cast<int>(keys_.features.size()) != num_keys || static_cast<int>(keys_.thumbnails.size()) != num_keys) {
+    throw InputError("the key-image features do not belong to this map; load them with LoadKeyImageStore");
+  }
+  route_ = options_.route;
+  if (route_.empty()) {
+    for (int k = 0; k < num_keys; ++k) route_.push_back(k);
+  }
+  route_position_of_key_.assign(num_keys, -1);
+  for (size_t p = 0; p < route_.size(); ++p) {
+    const int k = route_[p];
+    if (k < 0 || k >= num_keys) {
+      throw InputError(fmt::format("route names key image {}, but the map has key images 0 to {}", k, num_keys - 1));
+    }
+    if (route_position_of_key_[k] >= 0) throw InputError(fmt::format("route visits key image {} twice", k));
+    route_position_of_key_[k] = static_cast<int>(p);
+  }
+  // Only the route's key images take part in the ranking.
+  std::vector<std::shared_ptr<const ImageFeatures>> features;
+  std::vector<cv::Mat> thumbnails;
+  for (int k : route_) {
+    features.push_back(keys_.features[k]);
+    thumbnails.push_back(keys_.thumbnails[k]);
+  }
+  ranking_ = std::make_unique<KeyImageRanking>(features, thumbnails, options_.ranking);
+}
+
+Localizer::~Localizer() = default;
+
+void Localizer::Reset() {
+  position_ = -1;
+  lost_in_a_row_ = 0;
+}
+
+KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
+  const PairComparison pair = ComparePair(matcher_, features, *keys_.features[key], options_.verifier,
+                                          options_.similarity);
+  KeyComparison c;
+  c.key = key;
+  c.matched = pair.matched;
+  c.similarity = pair.similarity;
+  c.num_tentative = pair.num_tentative;
+  c.num_verified = pair.num_verified;
+  c.F = pair.F;
+  c.accepted = pair.matched && pair.num_verified >= options_.min_verified && pair.similarity >= options_.min_similarity;
+  std::vector<double> dx;
+  dx.reserve(pair.num_verified);
+  for (int i = 0; i < pair.num_verified; ++i) dx.push_back(pair.correspondences[i].p0.x - pair.correspondences[i].p1.x);
+  c.median_dx = pair.matched ? Median(std::move(dx)) : kNaN;
+  return c;
+}
+
+LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& features) {
+  const auto start = std::chrono::steady_clock::now();
+  LocalizationResult result = has_estimate() ? Track(features) : Relocalize(frame, features);
+  result.frame_index = frame.index;
+  result.source_index = frame.source_index;
+  result.timestamp = frame.timestamp;
+  result.source_name = frame.source_name;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+// Fills key, next_key, their comparisons, heading and progress for the estimate at route `position`,
+// comparing whatever `known` does not hold yet.
+void Localizer::Describe(LocalizationResult& result, int position, std::vector<KeyComparison>& known,
+                         const ImageFeatures& features) const {
+  auto comparison = [&](int key) -> const KeyComparison& {
+    for (const KeyComparison& c : known) {
+      if (c.key == key) return c;
+    }
+    known.push_back(Compare(features, key));
+    ++result.comparisons;
+    return known.back();
+  };
+  result.route_position = position;
+  result.key = route_[position];
+  result.to_key = comparison(result.key);
+  const bool at_end = position + 1 >= static_cast<int>(route_.size());
+  result.next_key = at_end ? -1 : route_[position + 1];
+  result.to_next = at_end ? KeyComparison() : comparison(result.next_key);
+  const KeyComparison& target = at_end ? result.to_key : result.to_next;
+  result.heading_px = target.matched ? target.median_dx : kNaN;
+  if (at_end) {
+    result.progress = result.to_key.accepted ? 0.0 : kNaN;
+  } else {
+    const int v_key = result.to_key.accepted ? result.to_key.num_verified : 0;
+    const int v_next = result.to_next.accepted ? result.to_next.num_verified : 0;
+    result.progress = v_key + v_next > 0 ? static_cast<double>(v_next) / (v_key + v_next) : kNaN;
+  }
+}
+
+LocalizationResult Localizer::Track(const ImageFeatures& features) {
+  LocalizationResult result;
+  std::vector<KeyComparison> known;
+  const int last = static_cast<int>(route_.size()) - 1;
+  auto compare_at = [&](int position) -> KeyComparison {
+    for (const KeyComparison& c : known) {
+      if (c.key == route_[position]) return c;
+    }
+    known.push_back(Compare(features, route_[position]));
+    ++result.comparisons;
+    return known.back();
+  };
+  int position = position_;
+  const KeyComparison at_key = compare_at(position);
+  KeyComparison best = at_key;
+  int best_position = position;
+  // Move on while the key image ahead is the better match, at most `lookahead` key images.
+  for (int step = 1; step <= options_.lookahead && position + step <= last; ++step) {
+    const KeyComparison ahead = compare_at(position + step);
+    if (!Better(ahead, best)) {
+      // A frame that verifies against nothing so far may still have passed the next key image quickly.
+      if (best.accepted || step > 1) break;
+      continue;
+    }
+    best = ahead;
+    best_position = position + step;
+  }
+  if (!best.accepted) {
+    result.status = LocalizationStatus::kLost;
+    ++lost_in_a_row_;
+    Describe(result, position, known, features);
+    if (lost_in_a_row_ > options_.max_lost_frames) Reset();
+    return result;
+  }
+  lost_in_a_row_ = 0;
+  position_ = best_position;
+  result.status = LocalizationStatus::kTracking;
+  Describe(result, position_, known, features);
+  return result;
+}
+
+LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures& features) {
+  LocalizationResult result;
+  std::vector<KeyComparison> known;
+  const cv::Mat thumbnail = ranking_->method() == RankingMethod::kThumbnails
+                                ? ThumbnailDescriptor(frame.gray, options_.ranking.thumbnail_width)
+                                : cv::Mat();
+  const std::vector<RankedKey> ranked = ranking_->Rank(features, thumbnail);
+  KeyComparison best;
+  int best_position = -1;
+  const int count = std::min<int>(options_.relocalization_candidates, static_cast<int>(ranked.size()));
+  for (int i = 0; i < count; ++i) {
+    const int position = ranked[i].key;  // the ranking holds the route's key images in route order
+    KeyComparison c = Compare(features, route_[position]);
+    ++result.comparisons;
+    known.push_back(c);
+    result.candidates.push_back({route_[position], ranked[i].score, c.accepted, c.similarity, c.num_verified});
+    if (Better(c, best)) {
+      best = c;
+      best_position = position;
+    }
+  }
+  if (best_position < 0) {
+    result.status = LocalizationStatus::kLost;
+    return result;  // no estimate: key and next_key stay -1
+  }
+  // The frame is near the best key image: on the segment before it or after it, whichever neighbour on the
+  // route is the better match.
+  int position = best_position;
+  if (position > 0) {
+    auto find = [&](int key) -> const KeyComparison* {
+      for (const KeyComparison& c : known) {
+        if (c.key == key) return &c;
+      }
+      return nullptr;
+    };
+    if (!find(route_[position - 1])) {
+      known.push_back(Compare(features, route_[position - 1]));
+      ++result.comparisons;
+    }
+    const bool has_next = position + 1 < static_cast<int>(route_.size());
+    if (has_next && !find(route_[position + 1])) {
+      known.push_back(Compare(features, route_[position + 1]));
+      ++result.comparisons;
+    }
+    const KeyComparison& before = *find(route_[position - 1]);
+    if (before.accepted && (!has_next || Better(before, *find(route_[position + 1])))) position -= 1;
+  }
+  position_ = position;
+  lost_in_a_row_ = 0;
+  result.status = LocalizationStatus::kRelocalized;
+  Describe(result, position_, known, features);
+  return result;
+}
+
+}  // namespace vmap

@@ -1,0 +1,165 @@
+#pragma once
+// Localization against a visual map (stage 2 of García-Pintos et al. 2023) and the guidance a controller
+// needs to servo to the next key image (stages 3-4), one frame at a time.
+//
+// The map is followed along a route: an ordered list of key images (by default all of them, in the order
+// of the teach run). The estimate is a position on that route: the frame is on the segment from `key`
+// (the key image last reached) to `next_key` (the one ahead).
+//
+// - Relocalization (at the start, and after the estimate was dropped): every key image of the route is
+//   ranked cheaply (KeyImageRanking), the best few are verified like the map's own links (the map's matcher
+//   and fundamental-matrix verifier), and the best verified one, with the better of its two neighbours on
+//   the route, gives the segment.
+// - Tracking: the frame is compared with `key` and `next_key`; when `next_key` is the better match the
+//   estimate moves on (and then one key image further is compared too, to move on twice when the robot went
+//   fast): the key-image switching of teach-and-repeat systems. A frame that verifies against neither is
+//   lost; after `max_lost_frames` lost frames in a row the estimate is dropped and the next frames are
+//   relocalized.
+//
+// "Better match" and "verified" are measured by the verified matches (inliers of F) and S, as in the map.
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "vmap/features/matcher.h"
+#include "vmap/geometry/fundamental.h"
+#include "vmap/localization/key_image_ranking.h"
+#include "vmap/localization/key_image_store.h"
+#include "vmap/mapping/key_image_selector.h"
+#include "vmap/mapping/visual_map.h"
+#include "vmap/sources/frame_source.h"
+
+namespace vmap {
+
+struct LocalizerOptions {
+  // A frame is localized at a key image when matching and verification succeed with at least
+  // `min_verified` verified matches and S >= `min_similarity` (S as the map defines it).
+  int min_verified = 20;
+  double min_similarity = 0.3;
+  // Key images compared beyond `next_key` when the frame has passed it (1 or 2: the "next one or two").
+  int lookahead = 2;
+  // Lost frames in a row, while tracking, after which the estimate is dropped and frames are relocalized.
+  int max_lost_frames = 5;
+  // Best-ranked key images verified when relocalizing.
+  int relocalization_candidates = 5;
+  RankingOptions ranking;
+  // The map's verifier (MapVerifierOptions reads it from map.json), except that localization caps its
+  // iterations (see MapVerifierOptions): a frame that shares little with a key image must fail fast.
+  VerifierOptions verifier;
+  SimilarityMode similarity = SimilarityMode::kInlierRatio;
+  // Key-image indices to follow, in order (RouteKeys gives one); empty = every key image in map order.
+  std::vector<int> route;
+  // Hook for the camera model (coming with the geometry stage): with intrinsics, heading in degrees and the
+  // relative pose (R, unit t) to `next_key` are filled in. Until then the heading is in pixels only.
+
+  void Check() const;  // throws InputError naming the bad option
+};
+
+enum class LocalizationStatus {
+  kTracking,     // verified against the key image(s) of the current estimate
+  kRelocalized,  // found again by ranking and verifying (first frame, or after the estimate was dropped)
+  kLost,         // not verified against the map; key/next_key keep the last estimate (-1 when there is none)
+};
+std::string LocalizationStatusName(LocalizationStatus status);  // "tracking", "relocalized", "lost"
+
+// The frame compared with one key image.
+struct KeyComparison {
+  int key = -1;             // key-image index in the map; -1: not compared
+  bool matched = false;     // matching and verification succeeded
+  bool accepted = false;    // matched, with at least min_verified verified matches and S >= min_similarity
+  double similarity = 0.0;  // S
+  int num_tentative = 0;
+  int num_verified = 0;
+  cv::Matx33d F = cv::Matx33d::zeros();  // x_key^T F x_frame = 0 (pixels); zero when !matched
+  // Verified matches: median horizontal displacement, x in the frame minus x in the key image (pixels).
+  double median_dx = 0.0;
+};
+
+// A key image the ranking proposed when relocalizing, and how its verification went.
+struct RelocalizationCandidate {
+  int key = -1;
+  double score = 0.0;  // the ranking's score (RankedKey::score)
+  bool accepted = false;
+  double similarity = 0.0;
+  int num_verified = 0;
+};
+
+struct LocalizationResult {
+  int frame_index = 0;
+  int source_index = 0;
+  double timestamp = -1.0;
+  std::string source_name;
+  LocalizationStatus status = LocalizationStatus::kLost;
+  int key = -1;             // the key image the frame is at (the last reached), -1 when unknown
+  int next_key = -1;        // the key image ahead on the route; -1 at the route's end or when unknown
+  int route_position = -1;  // index of `key` in the route
+  KeyComparison to_key;     // the frame against `key`
+  KeyComparison to_next;    // against `next_key`: its F maps the frame to the next key image
+  // Heading correction for a controller: the median horizontal displacement of the verified matches to the
+  // target key image (`next_key`, or `key` at the route's end), x in the frame minus x in the key image, in
+  // pixels. Positive: the scene appears to the right of where the key image has it, i.e. the robot points
+  // left of the key image's heading and should turn right (clockwise seen from above). NaN when unknown.
+  double heading_px = 0.0;
+  // Progress along the segment key -> next_key in [0, 1]: v_next / (v_key + v_next) with v the verified
+  // matches to each (0 at `key`, 1 at `next_key`, 0.5 where both share as much). NaN when unknown.
+  double progress = 0.0;
+  std::vector<RelocalizationCandidate> candidates;  // relocalization only: those verified, best-ranked first
+  int comparisons = 0;                // pairs matched and verified for this frame
+  double seconds = 0.0;               // time spent localizing this frame (features excluded)
+};
+
+class Localizer {
+ public:
+  // `keys` must hold the features of `map`'s key images computed by `matcher` (LoadKeyImageStore).
+  // The map, the store and the matcher must outlive the localizer.
+  Localizer(const VisualMap& map, const KeyImageStore& keys, const Matcher& matcher, LocalizerOptions options);
+  ~Localizer();
+  Localizer(const Localizer&) = delete;
+  Localizer& operator=(const Localizer&) = delete;
+
+  // Localizes the next frame of the stream. `features` come from the map's matcher on frame.gray (they may
+  // be extracted on another thread: see LocalizeSequence).
+  LocalizationResult Localize(const Frame& frame, const ImageFeatures& features);
+
+  // Forgets the estimate: the next frame is relocalized.
+  void Reset();
+  bool has_estimate() const { return position_ >= 0; }
+  const std::vector<int>& route() const { return route_; }
+  RankingMethod ranking_method() const { return ranking_->method(); }
+
+ private:
+  KeyComparison Compare(const ImageFeatures& features, int key) const;
+  LocalizationResult Track(const ImageFeatures& features);
+  LocalizationResult Relocalize(const Frame& frame, const ImageFeatures& features);
+  void Describe(LocalizationResult& result, int position, std::vector<KeyComparison>& known,
+                const ImageFeatures& features) const;
+
+  const VisualMap& map_;
+  const KeyImageStore& keys_;
+  const Matcher& matcher_;
+  LocalizerOptions options_;
+  std::vector<int> route_;
+  std::vector<int> route_position_of_key_;  // -1 for key images off the route
+  std::unique_ptr<KeyImageRanking> ranking_;
+  int position_ = -1;  // route position of `key`; -1: no estimate
+  int lost_in_a_row_ = 0;
+};
+
+// The key images on either side of position `source_index` of the map's input (KeyImage::source_index):
+// the last key image at or before it and the first at or after it; -1 where there is none. A frame of the
+// teach run's path between two key images is rightly localized at either (the bracket test of the README).
+std::pair<int, int> KeysAround(const VisualMap& map, int source_index);
+
+// The verifier of the map (options.verifier in map.json), with at most `max_iterations` iterations.
+// Why capped: a frame compared with a key image it barely overlaps has a low inlier ratio, for which MAGSAC
+// runs up to the map's 100,000 iterations (about a second); such a pair fails the acceptance test anyway.
+VerifierOptions MapVerifierOptions(const VisualMap& map, int max_iterations = 5000);
+// S as the map defines it (options.similarity in map.json).
+SimilarityMode MapSimilarityMode(const VisualMap& map);
+
+}  // namespace vmap

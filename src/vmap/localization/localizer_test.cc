@@ -1,0 +1,287 @@
+#include "vmap/localization/localizer.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "vmap/core/error.h"
+#include "vmap/features/orb_matcher.h"
+#include "vmap/localization/localization_map.h"
+#include "vmap/localization/localization_test_util.h"
+#include "vmap/localization/localize_sequence.h"
+#include "vmap/testing/synthetic_scene.h"
+
+namespace vmap {
+namespace {
+
+// A synthetic drive: textured planes seen by a camera moving sideways with a little yaw.
+const ::vmap::testing::SyntheticSequence& Drive() {
+  static const auto sequence = [] {
+    ::vmap::testing::SyntheticOptions options;
+    options.num_frames = 60;
+    options.step = 0.05;
+    options.yaw_per_frame = 0.003;
+    return ::vmap::testing::RenderSyntheticSequence(options);
+  }();
+  return sequence;
+}
+
+std::vector<cv::Mat> Frames(int first, int stride, int last = -1) {
+  std::vector<cv::Mat> frames;
+  const int end = last >= 0 ? last + 1 : static_cast<int>(Drive().frames.size());
+  for (int i = first; i < end; i += stride) frames.push_back(Drive().frames[i]);
+  return frames;
+}
+
+std::vector<int> Indices(int first, int stride, int last = -1) {
+  std::vector<int> indices;
+  const int end = last >= 0 ? last + 1 : static_cast<int>(Drive().frames.size());
+  for (int i = first; i < end; i += stride) indices.push_back(i);
+  return indices;
+}
+
+// The map of the even frames, built once for all tests of this file.
+struct EvenMap {
+  ::vmap::testing::TempDir directory;
+  LocalizationMap opened;
+  EvenMap() {
+    const auto matcher = CreateOrbMatcher({});
+    MapBuilderOptions options;
+    options.show_progress = false;
+    ::vmap::testing::MemorySource source(Frames(0, 2), Indices(0, 2));
+    ::vmap::testing::BuildMapDirectory(source, *matcher, options, directory.path() / "map");
+    opened = OpenLocalizationMap(directory.path() / "map", {});
+  }
+};
+
+const EvenMap& Map() {
+  static const EvenMap map;
+  return map;
+}
+
+Frame MakeFrame(const cv::Mat& image, int index, int source_index) {
+  Frame frame;
+  frame.index = index;
+  frame.source_index = source_index;
+  cv::cvtColor(image, frame.gray, cv::COLOR_BGR2GRAY);
+  frame.color = image;
+  return frame;
+}
+
+LocalizationResult LocalizeImage(Localizer& localizer, const cv::Mat& image, int index, int source_index) {
+  const Frame frame = MakeFrame(image, index, source_index);
+  const auto features = Map().opened.matcher->Extract(frame.gray);
+  return localizer.Localize(frame, *features);
+}
+
+bool Brackets(const VisualMap& map, int source_index, int key) {
+  const auto [before, after] = KeysAround(map, source_index);
+  return key >= 0 && (key == before || key == after);
+}
+
+TEST(Localizer, TheMapHasSeveralKeyImages) {
+  // The tests below are only meaningful with a route of several segments.
+  EXPECT_GE(Map().opened.map.key_images.size(), 4u);
+}
+
+TEST(Localizer, EveryOddFrameIsLocalizedBetweenTheKeyImagesAroundIt) {
+  const LocalizationMap& m = Map().opened;
+  Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m.map));
+  ::vmap::testing::MemorySource source(Frames(1, 2), Indices(1, 2));
+  LocalizeSequenceOptions run;
+  run.show_progress = false;
+  std::vector<LocalizationResult> results;
+  const LocalizationSummary summary =
+      LocalizeSequence(source, *m.matcher, localizer, run, [&](const Frame&, const LocalizationResult& r) {
+        results.push_back(r);
+      });
+  ASSERT_EQ(summary.frames, 30);
+  EXPECT_EQ(results.front().status, LocalizationStatus::kRelocalized);
+  EXPECT_EQ(summary.relocalized, 1);
+  EXPECT_EQ(summary.lost, 0);
+  EXPECT_EQ(summary.tracking, 29);
+  int previous_key = 0;
+  for (const LocalizationResult& r : results) {
+    EXPECT_TRUE(Brackets(m.map, r.source_index, r.key)) << "frame " << r.source_index << " at key " << r.key;
+    EXPECT_GE(r.key, previous_key) << "the estimate only moves forwards along a forward drive";
+    previous_key = r.key;
+    EXPECT_EQ(r.next_key, r.key + 1 < static_cast<int>(m.map.key_images.size()) ? r.key + 1 : -1);
+    EXPECT_TRUE(r.to_key.accepted);
+    EXPECT_EQ(r.to_key.key, r.key);
+    if (r.next_key >= 0) {
+      // F maps the frame to the next key image: its verified matches satisfy it (checked through S > 0).
+      EXPECT_TRUE(r.to_next.matched);
+      EXPECT_NE(cv::norm(r.to_next.F), 0.0);
+      EXPECT_TRUE(std::isfinite(r.progress));
+      EXPECT_GE(r.progress, 0.0);
+      EXPECT_LE(r.progress, 1.0);
+    }
+  }
+}
+
+TEST(Localizer, ProgressGrowsAlongASegment) {
+  const LocalizationMap& m = Map().opened;
+  Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m.map));
+  // Correlate the estimated progress with the true position between the two key images.
+  std::vector<double> estimated, truth;
+  const auto frames = Frames(1, 2);
+  const auto indices = Indices(1, 2);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const LocalizationResult r = LocalizeImage(localizer, frames[i], static_cast<int>(i), indices[i]);
+    const auto [before, after] = KeysAround(m.map, indices[i]);
+    if (r.key != before || r.next_key != after || !std::isfinite(r.progress)) continue;
+    const double a = m.map.key_images[before].source_index, b = m.map.key_images[after].source_index;
+    estimated.push_back(r.progress);
+    truth.push_back((indices[i] - a) / (b - a));
+  }
+  ASSERT_GE(estimated.size(), 10u);
+  cv::Mat e(estimated), t(truth), mean_e, std_e, mean_t, std_t;
+  cv::meanStdDev(e, mean_e, std_e);
+  cv::meanStdDev(t, mean_t, std_t);
+  const double covariance = cv::mean((e - mean_e.at<double>(0)).mul(t - mean_t.at<double>(0)))[0];
+  EXPECT_GT(covariance / (std_e.at<double>(0) * std_t.at<double>(0)), 0.5);
+}
+
+TEST(Localizer, RelocalizesAFrameFromTheMiddleAfterReset) {
+  const LocalizationMap& m = Map().opened;
+  Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m.map));
+  for (int source_index : {37, 11, 53, 25}) {
+    localizer.Reset();
+    ASSERT_FALSE(localizer.has_estimate());
+    const LocalizationResult r = LocalizeImage(localizer, Drive().frames[source_index], 0, source_index);
+    EXPECT_EQ(r.status, LocalizationStatus::kRelocalized);
+    EXPECT_TRUE(Brackets(m.map, source_index, r.key)) << "frame " << source_index << " at key " << r.key;
+    EXPECT_FALSE(r.candidates.empty());
+    EXPECT_TRUE(localizer.has_estimate());
+  }
+}
+
+TEST(Localizer, AnUnrelatedImageIsLostAndTheEstimateIsDroppedAfterMaxLostFrames) {
+  const LocalizationMap& m = Map().opened;
+  LocalizerOptions options = MapLocalizerOptions(m.map);
+  options.max_lost_frames = 2;
+  Localizer localizer(m.map, m.keys, *m.matcher, options);
+  // Noise shares no scene point with the map.
+  cv::Mat noise(Drive().frames[0].size(), CV_8UC3);
+  cv::RNG rng(3);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 255);
+  LocalizationResult r = LocalizeImage(localizer, noise, 0, 0);
+  EXPECT_EQ(r.status, LocalizationStatus::kLost);
+  EXPECT_EQ(r.key, -1);
+  EXPECT_EQ(r.next_key, -1);
+  EXPECT_FALSE(localizer.has_estimate());
+
+  r = LocalizeImage(localizer, Drive().frames[21], 1, 21);
+  EXPECT_EQ(r.status, LocalizationStatus::kRelocalized);
+  const int key = r.key;
+  for (int i = 0; i < 2; ++i) {
+    r = LocalizeImage(localizer, noise, 2 + i, 0);
+    EXPECT_EQ(r.status, LocalizationStatus::kLost);
+    EXPECT_EQ(r.key, key) << "a lost frame keeps the last estimate";
+    EXPECT_TRUE(localizer.has_estimate());
+  }
+  r = LocalizeImage(localizer, noise, 4, 0);
+  EXPECT_EQ(r.status, LocalizationStatus::kLost);
+  EXPECT_FALSE(localizer.has_estimate()) << "dropped after max_lost_frames + 1 lost frames in a row";
+  r = LocalizeImage(localizer, Drive().frames[23], 5, 23);
+  EXPECT_EQ(r.status, LocalizationStatus::kRelocalized);
+  EXPECT_TRUE(Brackets(m.map, 23, r.key));
+}
+
+TEST(Localizer, FollowsAReversedRouteWhenTheFramesComeBackwards) {
+  const LocalizationMap& m = Map().opened;
+  LocalizerOptions options = MapLocalizerOptions(m.map);
+  for (int k = static_cast<int>(m.map.key_images.size()) - 1; k >= 0; --k) options.route.push_back(k);
+  Localizer localizer(m.map, m.keys, *m.matcher, options);
+  int previous_key = static_cast<int>(m.map.key_images.size());
+  int frame_index = 0;
+  for (int source_index = 59; source_index > 0; source_index -= 2) {
+    const LocalizationResult r = LocalizeImage(localizer, Drive().frames[source_index], frame_index++, source_index);
+    EXPECT_NE(r.status, LocalizationStatus::kLost) << "frame " << source_index;
+    EXPECT_TRUE(Brackets(m.map, source_index, r.key)) << "frame " << source_index << " at key " << r.key;
+    EXPECT_LE(r.key, previous_key);
+    previous_key = r.key;
+    if (r.next_key >= 0) {
+      EXPECT_EQ(r.next_key, r.key - 1);
+    }
+  }
+}
+
+TEST(Localizer, HeadingIsTheHorizontalShiftOfTheSceneInPixels) {
+  // A map of one key image: the frame is at the route's end and the heading refers to that key image.
+  ::vmap::testing::TempDir directory;
+  const auto matcher = CreateOrbMatcher({});
+  MapBuilderOptions build;
+  build.show_progress = false;
+  const cv::Mat key_image = Drive().frames[30];
+  ::vmap::testing::MemorySource source(std::vector<cv::Mat>{key_image});
+  ::vmap::testing::BuildMapDirectory(source, *matcher, build, directory.path() / "map");
+  const LocalizationMap m = OpenLocalizationMap(directory.path() / "map", {});
+  ASSERT_EQ(m.map.key_images.size(), 1u);
+  for (double shift : {-14.0, 9.0}) {
+    Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m.map));
+    cv::Mat shifted;
+    const cv::Matx23d translation(1, 0, shift, 0, 1, 0);
+    cv::warpAffine(key_image, shifted, translation, key_image.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+    const Frame frame = MakeFrame(shifted, 0, 0);
+    const LocalizationResult r = localizer.Localize(frame, *m.matcher->Extract(frame.gray));
+    ASSERT_EQ(r.status, LocalizationStatus::kRelocalized);
+    EXPECT_EQ(r.key, 0);
+    EXPECT_EQ(r.next_key, -1);
+    EXPECT_NEAR(r.heading_px, shift, 1.0) << "the scene moved " << shift << " px to the right";
+  }
+}
+
+TEST(Localizer, SameInputSameResults) {
+  const LocalizationMap& m = Map().opened;
+  std::vector<LocalizationResult> runs[2];
+  for (auto& results : runs) {
+    Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m.map));
+    for (int source_index : {9, 11, 13, 41, 43}) {
+      results.push_back(LocalizeImage(localizer, Drive().frames[source_index], 0, source_index));
+    }
+  }
+  for (size_t i = 0; i < runs[0].size(); ++i) {
+    EXPECT_EQ(runs[0][i].key, runs[1][i].key);
+    EXPECT_EQ(runs[0][i].to_key.num_verified, runs[1][i].to_key.num_verified);
+    EXPECT_EQ(runs[0][i].to_next.num_verified, runs[1][i].to_next.num_verified);
+    EXPECT_EQ(runs[0][i].heading_px, runs[1][i].heading_px);
+  }
+}
+
+TEST(Localizer, OptionsAreChecked) {
+  const LocalizationMap& m = Map().opened;
+  auto with = [&](auto change) {
+    LocalizerOptions options = MapLocalizerOptions(m.map);
+    change(options);
+    return options;
+  };
+  EXPECT_THROW(with([](LocalizerOptions& o) { o.min_verified = 5; }).Check(), InputError);
+  EXPECT_THROW(with([](LocalizerOptions& o) { o.min_similarity = 1.5; }).Check(), InputError);
+  EXPECT_THROW(with([](LocalizerOptions& o) { o.lookahead = 3; }).Check(), InputError);
+  EXPECT_THROW(with([](LocalizerOptions& o) { o.max_lost_frames = -1; }).Check(), InputError);
+  EXPECT_THROW(with([](LocalizerOptions& o) { o.relocalization_candidates = 0; }).Check(), InputError);
+  EXPECT_NO_THROW(with([](LocalizerOptions&) {}).Check());
+  // A route must name existing key images, once each.
+  LocalizerOptions bad_route = MapLocalizerOptions(m.map);
+  bad_route.route = {0, 99};
+  EXPECT_THROW(Localizer(m.map, m.keys, *m.matcher, bad_route), InputError);
+  bad_route.route = {0, 1, 0};
+  EXPECT_THROW(Localizer(m.map, m.keys, *m.matcher, bad_route), InputError);
+}
+
+TEST(Localizer, KeysAroundFollowsTheInputIndices) {
+  VisualMap map;
+  for (int s : {0, 10, 20}) {
+    KeyImage k;
+    k.source_index = s;
+    map.key_images.push_back(k);
+  }
+  EXPECT_EQ(KeysAround(map, 5), std::make_pair(0, 1));
+  EXPECT_EQ(KeysAround(map, 10), std::make_pair(1, 1));
+  EXPECT_EQ(KeysAround(map, 25), std::make_pair(2, -1));
+}
+
+}  // namespace
+}  // namespace vmap

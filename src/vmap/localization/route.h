@@ -1,0 +1,46 @@
+#pragma once
+// Route planning on a map (stage 3): the key images to follow from one key image to another.
+//
+// A link joins two consecutive key images of the teach run. It is followed forwards (in the teach run's
+// direction) always: the teach run drove it. A broken link (its second key image did not pass the test
+// against the first) is still followed forwards, with a warning: there is no verified visual guidance
+// between its two key images, and the robot has to relocalize after it.
+// A link is followed backwards (the robot retracing the teach run in reverse, e.g. reversing with the camera
+// facing as in the teach run) only when the map shows that its two key images see the same scene: the link
+// is not broken and has at least `min_backward_verified` verified matches. Verification is symmetric (the
+// same matches and F, transposed), so such a link guides the robot either way; a broken or weak link blocks
+// a backward route.
+
+#include <string>
+#include <vector>
+
+#include "vmap/mapping/visual_map.h"
+
+namespace vmap {
+
+struct RouteOptions {
+  int min_backward_verified = 20;  // verified matches a link needs to be followed backwards
+
+  void Check() const;  // throws InputError naming the bad option
+};
+
+struct RouteStep {
+  int from_key = 0;
+  int to_key = 0;
+  int link = 0;           // index into VisualMap::links
+  bool backwards = false; // against the teach run's direction
+  bool broken = false;    // the link is broken (forwards only)
+};
+
+struct Route {
+  std::vector<int> keys;          // key images in the order to follow, `from` first and `to` last
+  std::vector<RouteStep> steps;   // keys.size() - 1 steps
+  std::vector<std::string> warnings;
+};
+
+// The route with the fewest steps from key image `from` to `to`. Throws InputError naming the key image or
+// the link that makes it impossible (a key image that does not exist, a link that cannot be followed
+// backwards, key images no link joins).
+Route PlanRoute(const VisualMap& map, int from, int to, const RouteOptions& options = {});
+
+}  // namespace vmap

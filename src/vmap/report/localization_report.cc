@@ -1,0 +1,301 @@
+#include "vmap/report/localization_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+#include "vmap/core/atomic_output.h"
+#include "vmap/core/error.h"
+#include "vmap/mapping/map_io.h"
+#include "vmap/report/html_page.h"
+#include "vmap/report/html_report.h"
+#include "vmap/report/html_util.h"
+#include "vmap/report/svg_plot.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+using report::FormatFixed;
+using report::HtmlEscape;
+using report::PlotSeries;
+using report::SvgPlot;
+using report::UrlPath;
+
+namespace {
+
+constexpr const char* kBlue = "#1f77b4";
+constexpr const char* kOrange = "#e07b00";
+constexpr const char* kGreen = "#2a9d3a";
+constexpr const char* kRed = "#d62728";
+
+// The frames to show: the first frame of every lost streak (at most a quarter of the pairs), the first
+// relocalized frame, and the rest spread evenly over the run.
+std::vector<int> ChooseFrames(const std::vector<LocalizationResult>& frames, int count) {
+  std::set<int> chosen;
+  const int n = static_cast<int>(frames.size());
+  if (n == 0 || count <= 0) return {};
+  for (int i = 0; i < n && static_cast<int>(chosen.size()) < std::max(1, count / 4); ++i) {
+    const bool starts_streak = frames[i].status == LocalizationStatus::kLost &&
+                               (i == 0 || frames[i - 1].status != LocalizationStatus::kLost);
+    if (starts_streak) chosen.insert(i);
+  }
+  for (int i = 0; i < n; ++i) {
+    if (frames[i].status == LocalizationStatus::kRelocalized) {
+      chosen.insert(i);
+      break;
+    }
+  }
+  const int remaining = count - static_cast<int>(chosen.size());
+  for (int j = 0; j < remaining && static_cast<int>(chosen.size()) < std::min(count, n); ++j) {
+    chosen.insert(remaining > 1 ? static_cast<int>(std::lround(static_cast<double>(j) * (n - 1) / (remaining - 1)))
+                                : n / 2);
+  }
+  return {chosen.begin(), chosen.end()};
+}
+
+cv::Mat ToHeight(const cv::Mat& image, int height) {
+  if (image.rows == height) return image;
+  cv::Mat scaled;
+  const int width = std::max(1, static_cast<int>(std::lround(static_cast<double>(image.cols) * height / image.rows)));
+  cv::resize(image, scaled, cv::Size(width, height), 0, 0, height < image.rows ? cv::INTER_AREA : cv::INTER_LINEAR);
+  return scaled;
+}
+
+// The frame, its key image and the next key image side by side, each labelled; red frame when lost.
+cv::Mat DrawPair(const cv::Mat& frame, const cv::Mat& key, const cv::Mat& next, const LocalizationResult& r,
+                 int width) {
+  const int height = frame.rows;
+  std::vector<cv::Mat> panels = {frame};
+  std::vector<std::string> labels = {fmt::format("frame {} ({})", r.frame_index, LocalizationStatusName(r.status))};
+  if (!key.empty()) {
+    panels.push_back(ToHeight(key, height));
+    labels.push_back(fmt::format("key {}  S {:.2f}  {} verified", r.key, r.to_key.similarity, r.to_key.num_verified));
+  }
+  if (!next.empty()) {
+    panels.push_back(ToHeight(next, height));
+    labels.push_back(
+        fmt::format("next {}  S {:.2f}  {} verified", r.next_key, r.to_next.similarity, r.to_next.num_verified));
+  }
+  const int gap = 6;
+  int total = 0;
+  for (const cv::Mat& p : panels) total += p.cols + gap;
+  cv::Mat canvas(height, total - gap, CV_8UC3, cv::Scalar(255, 255, 255));
+  int x = 0;
+  for (size_t i = 0; i < panels.size(); ++i) {
+    cv::Mat roi = canvas(cv::Rect(x, 0, panels[i].cols, height));
+    if (panels[i].channels() == 1) cv::cvtColor(panels[i], roi, cv::COLOR_GRAY2BGR);
+    else panels[i].copyTo(roi);
+    const double scale = std::max(0.4, height / 600.0);
+    const int baseline_y = static_cast<int>(22 * scale) + 4;
+    cv::rectangle(canvas, cv::Rect(x, 0, panels[i].cols, baseline_y + 6), cv::Scalar(0, 0, 0), cv::FILLED);
+    cv::putText(canvas, labels[i], cv::Point(x + 6, baseline_y), cv::FONT_HERSHEY_SIMPLEX, 0.6 * scale,
+                cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+    x += panels[i].cols + gap;
+  }
+  if (r.status == LocalizationStatus::kLost) {
+    cv::rectangle(canvas, cv::Rect(0, 0, canvas.cols, canvas.rows), cv::Scalar(40, 40, 214), 6);
+  }
+  return report::ScaledToWidth(canvas, width);
+}
+
+std::string KeyPlot(const LocalizationRun& run, int num_keys) {
+  SvgPlot plot("key-plot", "frame index", "key image");
+  plot.SetIntegerX(true);
+  plot.SetIntegerY(true);
+  plot.SetYRange(-1.0, std::max(1, num_keys - 1));
+  PlotSeries line, tracking, relocalized, lost;
+  line.name = "";
+  line.color = "#9ab7d3";
+  line.css_class = "key-line";
+  tracking.kind = relocalized.kind = PlotSeries::Kind::kMarkers;
+  lost.kind = PlotSeries::Kind::kCrosses;
+  tracking.name = "tracking";
+  tracking.color = kBlue;
+  tracking.css_class = "tracking";
+  tracking.marker_radius = 2.0;
+  relocalized.name = "relocalized";
+  relocalized.color = kOrange;
+  relocalized.css_class = "relocalized";
+  lost.name = "lost (at the last estimate; -1: none)";
+  lost.color = kRed;
+  lost.css_class = "lost";
+  tracking.segments.emplace_back();
+  relocalized.segments.emplace_back();
+  lost.segments.emplace_back();
+  std::vector<cv::Point2d> segment;
+  for (const LocalizationResult& r : run.frames) {
+    const cv::Point2d p(r.frame_index, r.key);
+    switch (r.status) {
+      case LocalizationStatus::kTracking: tracking.segments[0].push_back(p); break;
+      case LocalizationStatus::kRelocalized: relocalized.segments[0].push_back(p); break;
+      case LocalizationStatus::kLost: lost.segments[0].push_back(p); break;
+    }
+    if (r.status == LocalizationStatus::kLost) {
+      if (!segment.empty()) line.segments.push_back(std::move(segment));
+      segment.clear();
+    } else {
+      segment.push_back(p);
+    }
+  }
+  if (!segment.empty()) line.segments.push_back(std::move(segment));
+  plot.Add(std::move(line));
+  plot.Add(std::move(tracking));
+  plot.Add(std::move(relocalized));
+  plot.Add(std::move(lost));
+  return plot.Render();
+}
+
+std::string SimilarityPlot(const LocalizationRun& run) {
+  SvgPlot plot("localization-similarity-plot", "frame index", "similarity S");
+  plot.SetIntegerX(true);
+  plot.SetYRange(0.0, 1.0);
+  PlotSeries to_key, to_next, lost;
+  to_key.name = "S(frame, key)";
+  to_key.color = kBlue;
+  to_key.css_class = "to-key";
+  to_next.name = "S(frame, next key)";
+  to_next.color = kGreen;
+  to_next.css_class = "to-next";
+  lost.kind = PlotSeries::Kind::kCrosses;
+  lost.name = "lost";
+  lost.color = kRed;
+  lost.css_class = "lost";
+  lost.segments.emplace_back();
+  std::vector<cv::Point2d> a, b;
+  for (const LocalizationResult& r : run.frames) {
+    if (r.status == LocalizationStatus::kLost) {
+      lost.segments[0].emplace_back(r.frame_index, 0.0);
+      if (!a.empty()) to_key.segments.push_back(std::move(a));
+      if (!b.empty()) to_next.segments.push_back(std::move(b));
+      a.clear();
+      b.clear();
+      continue;
+    }
+    a.emplace_back(r.frame_index, r.to_key.similarity);
+    if (r.next_key >= 0) b.emplace_back(r.frame_index, r.to_next.similarity);
+  }
+  if (!a.empty()) to_key.segments.push_back(std::move(a));
+  if (!b.empty()) to_next.segments.push_back(std::move(b));
+  plot.Add(std::move(to_key));
+  plot.Add(std::move(to_next));
+  plot.Add(std::move(lost));
+  return plot.Render();
+}
+
+}  // namespace
+
+void LocalizationReportOptions::Check() const {
+  if (pairs < 0 || pairs > 200) throw InputError(fmt::format("report pairs = {} is outside [0, 200]", pairs));
+  if (pair_width < 64 || pair_width > 8192) {
+    throw InputError(fmt::format("report pair width {} is outside [64, 8192]", pair_width));
+  }
+  if (jpeg_quality < 1 || jpeg_quality > 100) throw InputError("report JPEG quality must be in [1, 100]");
+}
+
+void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, const fs::path& map_directory,
+                             const fs::path& directory, const LocalizationReportOptions& options) {
+  options.Check();
+  for (const KeyImage& k : map.key_images) KeyImagePath(map_directory, k);
+  fs::create_directories(directory);
+  AtomicOutputDirectory assets(directory / kReportAssetsDirectory, AtomicOutputDirectory::kReplaceAnything);
+  fs::create_directories(assets.path() / "frames");
+
+  // The chosen frames, read again from the query (streamed: only the chosen ones are kept).
+  const std::vector<int> chosen = ChooseFrames(run.frames, options.pairs);
+  std::vector<std::pair<int, cv::Size>> written;  // run.frames index, image size
+  if (!chosen.empty()) {
+    FrameSourceOptions source_options = run.info.source;
+    source_options.format = run.info.query_format;
+    source_options.allow_single_image = true;
+    const std::unique_ptr<FrameSource> source = OpenFrameSource(run.info.query, source_options);
+    size_t next = 0;
+    while (next < chosen.size()) {
+      std::optional<Frame> frame = source->Next();
+      if (!frame) break;
+      while (next < chosen.size() && run.frames[chosen[next]].frame_index < frame->index) ++next;
+      if (next == chosen.size() || run.frames[chosen[next]].frame_index != frame->index) continue;
+      const LocalizationResult& r = run.frames[chosen[next]];
+      const bool known_key = r.key >= 0 && r.key < static_cast<int>(map.key_images.size());
+      const bool known_next = r.next_key >= 0 && r.next_key < static_cast<int>(map.key_images.size());
+      const cv::Mat key = known_key ? ReadKeyImage(map_directory, map.key_images[r.key]) : cv::Mat();
+      const cv::Mat next_key = known_next ? ReadKeyImage(map_directory, map.key_images[r.next_key]) : cv::Mat();
+      const cv::Mat pair = DrawPair(ColorImage(*frame), key, next_key, r, options.pair_width);
+      report::WriteJpeg(assets.path() / "frames" / report::Numbered(r.frame_index), pair, options.jpeg_quality);
+      written.emplace_back(chosen[next], pair.size());
+      ++next;
+    }
+  }
+
+  const LocalizationSummary& s = run.summary;
+  const double n = s.frames > 0 ? static_cast<double>(s.frames) : 1.0;
+  const std::string assets_url = std::string(kReportAssetsDirectory) + "/";
+  std::ostringstream html;
+  html << report::PageStart("vmap localization: " + run.info.query, "Localization of " + run.info.query,
+                            "against the map " + run.info.map_directory + " (" +
+                                std::to_string(map.key_images.size()) + " key images)",
+                            {{"summary", "Summary"}, {"keys", "Key image over time"},
+                             {"similarity", "Similarity"}, {"frames", "Frames and key images"}});
+  html << "<section id=\"summary\"><h2>Summary</h2>\n<div class=\"cards\">"
+       << report::Card(std::to_string(s.frames), "frames")
+       << report::Card(FormatFixed(100.0 * s.tracking / n, 1) + " %", "tracking")
+       << report::Card(FormatFixed(100.0 * s.relocalized / n, 1) + " %", "relocalized")
+       << report::Card(FormatFixed(100.0 * s.lost / n, 1) + " %", "lost")
+       << report::Card(FormatFixed(s.frames_per_second, 1), "frames/s") << "</div>\n<table class=\"summary\">\n"
+       << report::Row("Map", HtmlEscape(run.info.map_directory))
+       << report::Row("Query", HtmlEscape(run.info.query) + " (" + HtmlEscape(SourceFormatName(run.info.query_format)) +
+                                   ", " + HtmlEscape(report::SizeText(run.info.frame_size)) + ")")
+       << report::Row("Matcher", HtmlEscape(run.info.matcher))
+       << report::Row("Relocalization ranking", HtmlEscape(run.info.ranking))
+       << report::Row("Frames", fmt::format("{}: {} tracking, {} relocalized, {} lost", s.frames, s.tracking,
+                                            s.relocalized, s.lost))
+       << report::Row("Time", report::DurationText(s.seconds) + " (" + FormatFixed(s.frames_per_second, 1) +
+                                  " frames/s; " + FormatFixed(1000.0 * s.mean_localize_seconds, 1) +
+                                  " ms localizing and " + FormatFixed(1000.0 * s.mean_extract_seconds, 1) +
+                                  " ms extracting per frame)")
+       << report::Row("Key images", FormatFixed(run.info.key_image_seconds, 2) + " s to load (cache: " +
+                                        HtmlEscape(run.info.cache) + ")")
+       << "</table>\n</section>\n";
+  html << "<section id=\"keys\"><h2>Key image over time</h2>\n<p class=\"note\">The key image each frame was "
+          "localized at (the last one reached on the route): tracking in blue, relocalization in orange, lost "
+          "frames as red crosses.</p>\n"
+       << KeyPlot(run, static_cast<int>(map.key_images.size())) << "</section>\n";
+  html << "<section id=\"similarity\"><h2>Similarity</h2>\n<p class=\"note\">S of each frame against its key image "
+          "and against the next one; the estimate moves on when the next key image becomes the better match.</p>\n"
+       << SimilarityPlot(run) << "</section>\n";
+  html << "<section id=\"frames\"><h2>Frames and key images</h2>\n<p class=\"note\">A few frames of the query beside "
+          "the key image they were localized at and the next key image (lost frames in a red frame).</p>\n"
+       << "<div class=\"links\">\n";
+  for (const auto& [index, size] : written) {
+    const LocalizationResult& r = run.frames[index];
+    html << "<figure class=\"match-figure" << (r.status == LocalizationStatus::kLost ? " broken" : "")
+         << "\" id=\"frame-" << r.frame_index << "\"><img loading=\"lazy\" decoding=\"async\" src=\""
+         << UrlPath(assets_url + "frames/" + report::Numbered(r.frame_index)) << "\" width=\"" << size.width
+         << "\" height=\"" << size.height << "\" alt=\"frame " << r.frame_index << "\"><figcaption>Frame "
+         << r.frame_index << " (" << HtmlEscape(r.source_name) << "): " << LocalizationStatusName(r.status)
+         << (r.key >= 0 ? fmt::format(" &middot; key {} (S = {})", r.key, FormatFixed(r.to_key.similarity, 3)) : "")
+         << (r.next_key >= 0 ? fmt::format(" &middot; next {} (S = {})", r.next_key, FormatFixed(r.to_next.similarity, 3))
+                             : "")
+         << "</figcaption></figure>\n";
+  }
+  if (written.empty()) html << "<p class=\"note\">No frames to show.</p>\n";
+  html << "</div>\n</section>\n" << report::PageEnd();
+  assets.Commit();
+  WriteFileAtomically(directory / kReportFileName, html.str());
+}
+
+void WriteLocalizationReport(const fs::path& run_file, const fs::path& directory,
+                             const LocalizationReportOptions& options) {
+  const LocalizationRun run = ReadLocalizationRun(run_file);
+  fs::path map_directory = run.info.map_directory;
+  if (!fs::exists(map_directory / kMapFileName) && map_directory.is_relative()) {
+    const fs::path beside = run_file.parent_path() / map_directory;
+    if (fs::exists(beside / kMapFileName)) map_directory = beside;
+  }
+  const VisualMap map = ReadMap(map_directory);
+  WriteLocalizationReport(run, map, map_directory, directory, options);
+}
+
+}  // namespace vmap

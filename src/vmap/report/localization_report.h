@@ -1,0 +1,37 @@
+#pragma once
+// The HTML report of a localization run (`vmap localize --report DIR`, or `vmap report RUN.json`): one page
+// that opens offline, in the style of the map report.
+//
+//   DIR/report.html               the page: summary, key image over time (with the status of every frame),
+//                                 S against the key image and the next one, and a few frames beside the key
+//                                 image they were localized at
+//   DIR/report/frames/NNNNNN.jpg  those pairs (NNNNNN = frame index)
+// The images folder and then the page are replaced atomically.
+
+#include <filesystem>
+
+#include "vmap/localization/localization_output.h"
+#include "vmap/mapping/visual_map.h"
+
+namespace vmap {
+
+struct LocalizationReportOptions {
+  int pairs = 8;               // frames shown beside their key image (spread over the run, lost ones first)
+  int pair_width = 960;        // width of each pair in pixels
+  int jpeg_quality = 85;
+
+  void Check() const;  // throws InputError naming the bad option
+};
+
+// `map` is the map the run localized against, read from `map_directory`; the query frames shown are read
+// again from the run's query. Throws InputError when a file cannot be read or written.
+void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map,
+                             const std::filesystem::path& map_directory, const std::filesystem::path& directory,
+                             const LocalizationReportOptions& options = {});
+
+// Reads the run (ReadLocalizationRun) and its map, and writes the report into `directory`. The map directory
+// recorded in the run is taken as it is, or relative to the run file's folder when it is not found as it is.
+void WriteLocalizationReport(const std::filesystem::path& run_file, const std::filesystem::path& directory,
+                             const LocalizationReportOptions& options = {});
+
+}  // namespace vmap
