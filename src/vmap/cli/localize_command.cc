@@ -63,6 +63,7 @@ void RunLocalize(const LocalizeFlags& flags) {
   options.max_lost_frames = flags.localizer.max_lost_frames;
   options.relocalization_candidates = flags.localizer.relocalization_candidates;
   options.lookahead = flags.localizer.lookahead;
+  options.step_back = flags.localizer.step_back;
   options.ranking = flags.localizer.ranking;
   options.ranking.method = ParseRankingMethod(flags.ranking);
   if (flags.from >= 0 || flags.to >= 0) {
@@ -145,6 +146,7 @@ void AddLocalizeCommand(CLI::App& app) {
       ->capture_default_str();
   command->add_option("--lookahead", o.lookahead, "Key images beyond the next compared while tracking (1 or 2)")
       ->capture_default_str();
+  command->add_flag("!--no-step-back", o.step_back, "Never move the estimate back to the previous key image");
   command->add_option("--ranking", flags->ranking, "Relocalization ranking: auto, votes or thumbnails")
       ->capture_default_str();
   command->add_option("--from", flags->from, "Follow the route from this key image (default: the first)");

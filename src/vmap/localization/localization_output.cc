@@ -51,6 +51,7 @@ std::string DescribeLocalizerOptions(const LocalizerOptions& options) {
   json doc = {{"min_verified", options.min_verified},
               {"min_similarity", options.min_similarity},
               {"lookahead", options.lookahead},
+              {"step_back", options.step_back},
               {"max_lost_frames", options.max_lost_frames},
               {"relocalization_candidates", options.relocalization_candidates},
               {"ranking",

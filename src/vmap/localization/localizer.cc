@@ -26,12 +26,11 @@ double Median(std::vector<double> values) {
 }
 
 // Which of two accepted comparisons is the better match: more verified matches, then higher S.
+// Measured on the bracket test (README): S first, S times verified, and a 10 % or 25 % margin before moving
+// on all localized fewer odd frames of redkitchen between their key images than verified matches alone.
 bool Better(const KeyComparison& a, const KeyComparison& b) {
   if (!a.accepted) return false;
   if (!b.accepted) return true;
-  static const int mode = getenv("VMAP_BETTER") ? atoi(getenv("VMAP_BETTER")) : 0;
-  if (mode == 1) return a.similarity > b.similarity;
-  if (mode == 2) return a.similarity * a.num_verified > b.similarity * b.num_verified;
   if (a.num_verified != b.num_verified) return a.num_verified > b.num_verified;
   return a.similarity > b.similarity;
 }
@@ -225,6 +224,24 @@ LocalizationResult Localizer::Track(const ImageFeatures& features) {
     }
     best = ahead;
     best_position = position + step;
+  }
+  // Not moved on, and nearer `key` than `next_key`: the frame may be behind `key` (a robot that reversed, a
+  // hand-held camera swinging back, a relocalization one key image too far). Move back when the previous key
+  // image is the better match. Checked only near `key`, where it can be true, to spare a comparison.
+  if (options_.step_back && best_position == position && position > 0) {
+    const KeyComparison* next = nullptr;
+    for (const KeyComparison& c : known) {
+      if (position < last && c.key == route_[position + 1]) next = &c;
+    }
+    const int v_key = at_key.accepted ? at_key.num_verified : 0;
+    const int v_next = next && next->accepted ? next->num_verified : 0;
+    if (3 * v_next < v_key + v_next || v_key == 0) {
+      const KeyComparison behind = compare_at(position - 1);
+      if (Better(behind, best)) {
+        best = behind;
+        best_position = position - 1;
+      }
+    }
   }
   if (!best.accepted) {
     result.status = LocalizationStatus::kLost;

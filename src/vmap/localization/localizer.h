@@ -12,7 +12,8 @@
 //   the route, gives the segment.
 // - Tracking: the frame is compared with `key` and `next_key`; when `next_key` is the better match the
 //   estimate moves on (and then one key image further is compared too, to move on twice when the robot went
-//   fast): the key-image switching of teach-and-repeat systems. A frame that verifies against neither is
+//   fast): the key-image switching of teach-and-repeat systems. Near `key`, the key image before it is
+//   compared too, and the estimate moves back when that is the better match. A frame that verifies against none is
 //   lost; after `max_lost_frames` lost frames in a row the estimate is dropped and the next frames are
 //   relocalized.
 //
@@ -43,6 +44,10 @@ struct LocalizerOptions {
   double min_similarity = 0.3;
   // Key images compared beyond `next_key` when the frame has passed it (1 or 2: the "next one or two").
   int lookahead = 2;
+  // While tracking, also compare the key image before `key` when the frame is nearer `key` than `next_key`
+  // (fewer than a third of their verified matches are with `next_key`), and move back when it is the better
+  // match: the frame may be behind `key`. Off: the estimate only moves forwards (a robot that never reverses).
+  bool step_back = true;
   // Lost frames in a row, while tracking, after which the estimate is dropped and frames are relocalized.
   int max_lost_frames = 5;
   // Best-ranked key images verified when relocalizing.

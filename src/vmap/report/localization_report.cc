@@ -48,11 +48,14 @@ std::vector<int> ChooseFrames(const std::vector<LocalizationResult>& frames, int
       break;
     }
   }
-  const int remaining = count - static_cast<int>(chosen.size());
-  for (int j = 0; j < remaining && static_cast<int>(chosen.size()) < std::min(count, n); ++j) {
+  const int wanted = std::min(count, n);
+  const int remaining = wanted - static_cast<int>(chosen.size());
+  for (int j = 0; j < remaining; ++j) {
     chosen.insert(remaining > 1 ? static_cast<int>(std::lround(static_cast<double>(j) * (n - 1) / (remaining - 1)))
                                 : n / 2);
   }
+  // Spread picks that fell on frames already chosen go to the first frames not shown yet.
+  for (int i = 0; i < n && static_cast<int>(chosen.size()) < wanted; ++i) chosen.insert(i);
   return {chosen.begin(), chosen.end()};
 }
 

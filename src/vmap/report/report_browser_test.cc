@@ -18,6 +18,7 @@
 
 #include "vmap/mapping/map_io.h"
 #include "vmap/report/html_report.h"
+#include "vmap/report/localization_report.h"
 #include "vmap/report/report_test_util.h"
 
 namespace vmap {
@@ -233,6 +234,40 @@ TEST_F(ReportBrowserTest, ReportOfARealMapBuiltFromSharedData) {
   EXPECT_EQ(check["match_figures"].get<size_t>(), map.links.size());
   EXPECT_EQ(check["key_images"].get<size_t>(), map.key_images.size());
   ExpectScreenshotNotBlank(dir / kReportFileName, temp.path());
+}
+
+TEST_F(ReportBrowserTest, LocalizationReportLoadsOffline) {
+  // A run whose query frames are the map's own key images (an image folder), localized one by one.
+  TempDir temp;
+  const fs::path dir = temp.path() / "map";
+  const VisualMap map = report_test::WriteSyntheticMap(dir);
+  LocalizationRun run;
+  run.info.map_directory = dir.string();
+  run.info.query = (dir / "keys").string();
+  run.info.query_format = SourceFormat::kImageFolder;
+  for (int i = 0; i < static_cast<int>(map.key_images.size()); ++i) {
+    LocalizationResult r;
+    r.frame_index = r.source_index = i;
+    r.status = i == 0 ? LocalizationStatus::kRelocalized : i == 2 ? LocalizationStatus::kLost
+                                                                  : LocalizationStatus::kTracking;
+    r.key = i == 2 ? 1 : i;
+    r.next_key = r.key + 1 < static_cast<int>(map.key_images.size()) ? r.key + 1 : -1;
+    r.to_key.similarity = 0.8;
+    r.to_next.similarity = 0.4;
+    run.frames.push_back(r);
+    ++run.summary.frames;
+  }
+  const fs::path out = temp.path() / "run_report";
+  LocalizationReportOptions options;
+  options.pairs = 3;
+  WriteLocalizationReport(run, map, dir, out, options);
+  const nlohmann::json check = SelfCheck(out / kReportFileName, temp.path());
+  ASSERT_TRUE(check.contains("images"));
+  EXPECT_EQ(check["broken"], nlohmann::json::array());
+  EXPECT_EQ(check["images"].get<int>(), 3);
+  EXPECT_EQ(check["match_figures"].get<int>(), 3);
+  EXPECT_EQ(check["plots"].get<int>(), 2);
+  ExpectScreenshotNotBlank(out / kReportFileName, temp.path());
 }
 
 }  // namespace

@@ -1,0 +1,164 @@
+// Speed of `vmap localize` (README "Localization"): tracking frames per second with ORB at 640x480 beside
+// decode-only and decode + ORB on one thread, and the time of one relocalization against a map of about
+// 300 key images. Each repeat measures the stages one after the other, so that the machine's changing load
+// touches them alike; the medians and ranges are printed.
+//
+//   localize_bench [--repeat N]
+//
+// Tracking: a map of ../shared/data/lab_floor/lab_floor.mp4 (default options), the same video localized
+// against it (the repeat run is the teach run: what is measured is the work per frame while tracking).
+// Relocalization: a map whose key images are every third frame of ../shared/data/redkitchen (frames 0-899,
+// tau 1.0 makes every frame a key image), queried with frames between them, the estimate reset before each.
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include "vmap/features/matcher_factory.h"
+#include "vmap/localization/localization_map.h"
+#include "vmap/localization/localize_sequence.h"
+#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/map_io.h"
+
+namespace fs = std::filesystem;
+using namespace vmap;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+struct Samples {
+  std::vector<double> values;
+  double Median() const {
+    std::vector<double> sorted = values;
+    std::sort(sorted.begin(), sorted.end());
+    return sorted.empty() ? 0.0 : sorted[sorted.size() / 2];
+  }
+  double Min() const { return values.empty() ? 0.0 : *std::min_element(values.begin(), values.end()); }
+  double Max() const { return values.empty() ? 0.0 : *std::max_element(values.begin(), values.end()); }
+};
+
+std::string MapOptionsJson(const Matcher& matcher, const MapBuilderOptions& options) {
+  nlohmann::json doc;
+  doc["matcher"] = nlohmann::json::parse(matcher.DescribeOptionsJson());
+  doc["verifier"] = {{"method", VerifierMethodName(options.verifier.method)},
+                     {"threshold", options.verifier.threshold},
+                     {"confidence", options.verifier.confidence},
+                     {"max_iterations", options.verifier.max_iterations},
+                     {"seed", options.verifier.seed},
+                     {"min_matches", options.verifier.min_matches}};
+  doc["similarity"] = SimilarityModeName(options.key_images.similarity);
+  return doc.dump();
+}
+
+void BuildInto(const std::string& input, FrameSourceOptions source_options, double tau, const fs::path& directory) {
+  const auto matcher = CreateMatcher({});
+  MapBuilderOptions options;
+  options.key_images.tau = tau;
+  options.show_progress = false;
+  fs::create_directories(directory);
+  auto source = OpenFrameSource(input, source_options);
+  const VisualMap map = BuildMap(*source, *matcher, options, directory, MapOptionsJson(*matcher, options));
+  WriteMapFiles(map, directory);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int repeat = 5;
+  for (int i = 1; i + 1 < argc; ++i) {
+    if (!std::strcmp(argv[i], "--repeat")) repeat = std::atoi(argv[++i]);
+  }
+  const std::string shared = VMAP_SHARED_DIR;
+  const std::string video = shared + "/data/lab_floor/lab_floor.mp4";
+  const std::string kitchen = shared + "/data/redkitchen";
+  if (!fs::exists(video) || !fs::exists(kitchen)) {
+    std::fprintf(stderr, "localize_bench: ../shared/data is missing\n");
+    return 2;
+  }
+  cv::setNumThreads(1);  // as the vmap binary does
+  const fs::path work = fs::temp_directory_path() / ("vmap_localize_bench_" + std::to_string(getpid()));
+  fs::remove_all(work);
+  BuildInto(video, {}, 0.5, work / "lab_floor");
+  FrameSourceOptions every_third;
+  every_third.stride = 3;
+  every_third.last = 899;
+  BuildInto(kitchen, every_third, 1.0, work / "kitchen300");
+
+  LocalizationMap lab = OpenLocalizationMap(work / "lab_floor", {});
+  LocalizationMap kitchen_map = OpenLocalizationMap(work / "kitchen300", {});
+  std::printf("tracking map: %zu key images of lab_floor.mp4 (640x480); relocalization map: %zu key images\n",
+              lab.map.key_images.size(), kitchen_map.map.key_images.size());
+
+  Samples decode, extract, track, relocalize_median, relocalize_max;
+  long tracked = 0, frames = 0, relocalized = 0, queries = 0;
+  for (int r = 0; r < repeat; ++r) {
+    {  // decode only
+      auto source = OpenFrameSource(video);
+      const auto start = Clock::now();
+      long n = 0;
+      while (source->Next()) ++n;
+      decode.values.push_back(n / std::chrono::duration<double>(Clock::now() - start).count());
+    }
+    {  // decode + ORB, one thread
+      auto source = OpenFrameSource(video);
+      const auto start = Clock::now();
+      long n = 0;
+      while (auto frame = source->Next()) {
+        lab.matcher->Extract(frame->gray);
+        ++n;
+      }
+      extract.values.push_back(n / std::chrono::duration<double>(Clock::now() - start).count());
+    }
+    {  // vmap localize end to end: decode and extraction on the workers, tracking on this thread
+      auto source = OpenFrameSource(video);
+      Localizer localizer(lab.map, lab.keys, *lab.matcher, MapLocalizerOptions(lab.map));
+      LocalizeSequenceOptions options;
+      options.show_progress = false;
+      const LocalizationSummary s = LocalizeSequence(*source, *lab.matcher, localizer, options, nullptr);
+      track.values.push_back(s.frames_per_second);
+      tracked += s.tracking;
+      frames += s.frames;
+    }
+    {  // relocalization from scratch against the 300-key map
+      FrameSourceOptions between = every_third;
+      between.first = 1;
+      between.stride = 15;
+      auto source = OpenFrameSource(kitchen, between);
+      Localizer localizer(kitchen_map.map, kitchen_map.keys, *kitchen_map.matcher,
+                          MapLocalizerOptions(kitchen_map.map));
+      Samples seconds;
+      while (auto frame = source->Next()) {
+        const auto features = kitchen_map.matcher->Extract(frame->gray);
+        localizer.Reset();
+        const LocalizationResult result = localizer.Localize(*frame, *features);
+        seconds.values.push_back(result.seconds);
+        relocalized += result.status == LocalizationStatus::kRelocalized;
+        ++queries;
+      }
+      relocalize_median.values.push_back(seconds.Median());
+      relocalize_max.values.push_back(seconds.Max());
+    }
+  }
+  std::printf("| stage | median [range] |\n|---|---|\n");
+  std::printf("| decode only (one thread), frames/s | %.0f [%.0f-%.0f] |\n", decode.Median(), decode.Min(), decode.Max());
+  std::printf("| decode + ORB (one thread), frames/s | %.0f [%.0f-%.0f] |\n", extract.Median(), extract.Min(),
+              extract.Max());
+  std::printf("| vmap localize, tracking, frames/s | %.0f [%.0f-%.0f] |\n", track.Median(), track.Min(), track.Max());
+  std::printf("| relocalization, 300-key map, median s per frame | %.3f [%.3f-%.3f] |\n", relocalize_median.Median(),
+              relocalize_median.Min(), relocalize_median.Max());
+  std::printf("| relocalization, slowest frame of a repeat, s | %.3f [%.3f-%.3f] |\n", relocalize_max.Median(),
+              relocalize_max.Min(), relocalize_max.Max());
+  std::printf("tracking share %.1f%%; relocalized %ld of %ld queries\n", 100.0 * tracked / std::max(1L, frames),
+              relocalized, queries);
+  fs::remove_all(work);
+  return 0;
+}

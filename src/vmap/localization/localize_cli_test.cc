@@ -1,0 +1,248 @@
+// End-to-end tests of `vmap localize`, `vmap route` and the report of a run, on the shared sequences; and the
+// bracket test against truth (README "Localization") on subsets of kitti07 and redkitchen.
+
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "vmap/features/orb_matcher.h"
+#include "vmap/localization/localization_map.h"
+#include "vmap/localization/localization_output.h"
+#include "vmap/localization/localization_test_util.h"
+#include "vmap/localization/localize_sequence.h"
+#include "vmap/mapping/map_io.h"
+#include "vmap/report/html_report.h"
+#include "vmap/testing/synthetic_scene.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+using ::vmap::testing::RunVmap;
+namespace {
+
+fs::path Shared() { return ::vmap::testing::SharedDir(); }
+
+#define REQUIRE_SHARED() \
+  if (Shared().empty()) GTEST_SKIP() << "../shared is not present"
+
+std::string Quote(const fs::path& p) { return "'" + p.string() + "'"; }
+
+std::vector<std::string> Lines(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// A map of the first 240 frames of lab_floor.mp4, built once by the binary for the tests of this file.
+const fs::path& LabMap() {
+  static ::vmap::testing::TempDir directory;
+  static const fs::path map = [] {
+    const fs::path path = directory.path() / "lab_map";
+    std::string out;
+    EXPECT_EQ(RunVmap("build " + Quote(Shared() / "data/lab_floor/lab_floor.mp4") + " -o " + Quote(path) +
+                          " --last 239 -q",
+                      &out),
+              0)
+        << out;
+    return path;
+  }();
+  return map;
+}
+
+TEST(LocalizeCli, LocalizesARepeatOfTheTeachRunAndWritesCsvAndJson) {
+  REQUIRE_SHARED();
+  ::vmap::testing::TempDir tmp;
+  std::string out;
+  const fs::path csv = tmp.path() / "run.csv", json = tmp.path() / "run.json";
+  ASSERT_EQ(RunVmap("localize " + Quote(LabMap()) + " " + Quote(Shared() / "data/lab_floor/lab_floor.mp4") +
+                        " --first 1 --last 239 --stride 4 --csv " + Quote(csv) + " --json " + Quote(json),
+                    &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("frames          60"), std::string::npos) << out;
+  const std::vector<std::string> rows = Lines(csv);
+  ASSERT_EQ(rows.size(), 61u);
+  EXPECT_EQ(rows[0].rfind("frame,source_index,timestamp,source_name,status,key,next_key,", 0), 0u) << rows[0];
+  const auto doc = nlohmann::json::parse(std::ifstream(json));
+  EXPECT_EQ(doc["summary"]["frames"], 60);
+  const double shares = doc["summary"]["share_tracking"].get<double>() +
+                        doc["summary"]["share_relocalized"].get<double>() + doc["summary"]["share_lost"].get<double>();
+  EXPECT_NEAR(shares, 1.0, 1e-9);
+  EXPECT_LE(doc["summary"]["lost"].get<int>(), 3) << "the teach run itself must localize";
+  // Each frame is between the key images around it in the teach run.
+  const VisualMap map = ReadMap(LabMap());
+  int bracketed = 0;
+  for (const auto& frame : doc["frames"]) {
+    const auto [before, after] = KeysAround(map, frame["source_index"].get<int>());
+    const int key = frame["key"].get<int>();
+    bracketed += key >= 0 && (key == before || key == after);
+  }
+  EXPECT_GE(bracketed, 57) << "at least 95 % of 60";
+  // The key-image cache was written into the map; the next run reads it.
+  EXPECT_TRUE(fs::exists(LabMap() / kLocalizationCacheFileName));
+  ASSERT_EQ(RunVmap("localize " + Quote(LabMap()) + " " + Quote(Shared() / "data/lab_floor/lab_floor.mp4") +
+                        " --last 3",
+                    &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("cache: hit"), std::string::npos) << out;
+}
+
+TEST(LocalizeCli, ASingleImageIsRelocalized) {
+  REQUIRE_SHARED();
+  ::vmap::testing::TempDir tmp;
+  FrameSourceOptions options;
+  options.first = 150;
+  options.last = 150;
+  const auto source = OpenFrameSource((Shared() / "data/lab_floor/lab_floor.mp4").string(), options);
+  const auto frame = source->Next();
+  ASSERT_TRUE(frame);
+  const fs::path image = tmp.path() / "query.png";
+  ASSERT_TRUE(cv::imwrite(image.string(), frame->color));
+  std::string out;
+  const fs::path json = tmp.path() / "one.json";
+  ASSERT_EQ(RunVmap("localize " + Quote(LabMap()) + " " + Quote(image) + " --json " + Quote(json), &out), 0) << out;
+  EXPECT_NE(out.find("status          relocalized"), std::string::npos) << out;
+  const auto doc = nlohmann::json::parse(std::ifstream(json));
+  ASSERT_EQ(doc["frames"].size(), 1u);
+  const auto [before, after] = KeysAround(ReadMap(LabMap()), 150);
+  const int key = doc["frames"][0]["key"].get<int>();
+  EXPECT_TRUE(key == before || key == after) << "key " << key << ", expected " << before << " or " << after;
+  // `vmap build` still refuses a single image: one frame makes no map.
+  EXPECT_EQ(RunVmap("build " + Quote(image) + " -o " + Quote(tmp.path() / "m"), &out), 2) << out;
+}
+
+TEST(LocalizeCli, ADifferentSceneDoesNotLocalize) {
+  // desk.mp4 films a desk, not the lab floor: no frame may be localized against the lab-floor map.
+  REQUIRE_SHARED();
+  ::vmap::testing::TempDir tmp;
+  std::string out;
+  const fs::path json = tmp.path() / "desk.json";
+  ASSERT_EQ(RunVmap("localize " + Quote(LabMap()) + " " + Quote(Shared() / "data/lab_floor/desk.mp4") +
+                        " --last 59 --stride 3 -q --json " + Quote(json),
+                    &out),
+            0)
+      << out;
+  const auto doc = nlohmann::json::parse(std::ifstream(json));
+  EXPECT_EQ(doc["summary"]["frames"], 20);
+  EXPECT_EQ(doc["summary"]["lost"], 20);
+  for (const auto& frame : doc["frames"]) {
+    EXPECT_EQ(frame["key"], -1);
+    EXPECT_EQ(frame["candidates"].size(), 5u) << "every lost frame verified the best-ranked key images";
+  }
+}
+
+TEST(LocalizeCli, RouteForwardsAndBackwards) {
+  REQUIRE_SHARED();
+  const VisualMap map = ReadMap(LabMap());
+  ASSERT_GE(map.key_images.size(), 4u);
+  std::string out;
+  ASSERT_EQ(RunVmap("route " + Quote(LabMap()) + " --from 0 --to 3", &out), 0) << out;
+  EXPECT_NE(out.find("keys            0 1 2 3\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("| forwards |"), std::string::npos) << out;
+  ASSERT_EQ(RunVmap("route " + Quote(LabMap()) + " --from 3 --to 1", &out), 0) << out;
+  EXPECT_NE(out.find("keys            3 2 1\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("| backwards |"), std::string::npos) << out;
+  ASSERT_EQ(RunVmap("route " + Quote(LabMap()) + " --from 0 --to 99", &out), 2) << out;
+  EXPECT_NE(out.find("key image 99 does not exist"), std::string::npos) << out;
+  // A localization that follows the route backwards.
+  ASSERT_EQ(RunVmap("localize " + Quote(LabMap()) + " " + Quote(Shared() / "data/lab_floor/lab_floor.mp4") +
+                        " --from 3 --to 0 --last 5",
+                    &out),
+            0)
+      << out;
+}
+
+TEST(LocalizeCli, ReportOfARun) {
+  REQUIRE_SHARED();
+  ::vmap::testing::TempDir tmp;
+  std::string out;
+  const fs::path json = tmp.path() / "run.json";
+  ASSERT_EQ(RunVmap("localize " + Quote(LabMap()) + " " + Quote(Shared() / "data/lab_floor/lab_floor.mp4") +
+                        " --last 99 --stride 5 -q --json " + Quote(json),
+                    &out),
+            0)
+      << out;
+  ASSERT_EQ(RunVmap("report " + Quote(json), &out), 0) << out;
+  const fs::path report = tmp.path() / "run_report";
+  ASSERT_TRUE(fs::exists(report / kReportFileName)) << out;
+  std::ifstream in(report / kReportFileName);
+  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(html.find("id=\"key-plot\""), std::string::npos);
+  EXPECT_NE(html.find("id=\"localization-similarity-plot\""), std::string::npos);
+  int pictures = 0;
+  for (const auto& entry : fs::directory_iterator(report / "report/frames")) {
+    const cv::Mat image = cv::imread(entry.path().string());
+    EXPECT_FALSE(image.empty()) << entry.path();
+    ++pictures;
+  }
+  EXPECT_EQ(pictures, 8);
+  // A file that is not a run is refused with a message.
+  EXPECT_EQ(RunVmap("report " + Quote(LabMap() / "map.json"), &out), 2) << out;
+  EXPECT_NE(out.find("is not a localization run"), std::string::npos) << out;
+}
+
+TEST(LocalizeCli, EvalCorridorRuns) {
+  // The owners judge ../shared/eval/pepper_corridor as a repeat run against a teach run not here: only check
+  // that its 320x240 grey PNGs go through (a map of its even frames, its odd frames localized).
+  const fs::path corridor = Shared() / "eval/pepper_corridor/images";
+  if (Shared().empty() || !fs::exists(corridor)) GTEST_SKIP() << "../shared/eval/pepper_corridor is not present";
+  ::vmap::testing::TempDir tmp;
+  std::string out;
+  ASSERT_EQ(RunVmap("build " + Quote(corridor) + " --stride 2 --last 99 -q -o " + Quote(tmp.path() / "map"), &out), 0)
+      << out;
+  const fs::path csv = tmp.path() / "run.csv";
+  ASSERT_EQ(RunVmap("localize " + Quote(tmp.path() / "map") + " " + Quote(corridor) +
+                        " --first 1 --stride 2 --last 99 -q --csv " + Quote(csv),
+                    &out),
+            0)
+      << out;
+  EXPECT_EQ(Lines(csv).size(), 51u);
+}
+
+// The bracket test on a subset: a map of the even frames, and each odd frame localized at one of the two key
+// images around it (the README has the full sequences).
+double BracketShare(const std::string& sequence, int last) {
+  ::vmap::testing::TempDir tmp;
+  const auto matcher = CreateOrbMatcher({});
+  MapBuilderOptions build;
+  build.show_progress = false;
+  FrameSourceOptions even;
+  even.stride = 2;
+  even.last = last;
+  {
+    const auto source = OpenFrameSource((Shared() / sequence).string(), even);
+    ::vmap::testing::BuildMapDirectory(*source, *matcher, build, tmp.path() / "map");
+  }
+  const LocalizationMap opened = OpenLocalizationMap(tmp.path() / "map", {});
+  Localizer localizer(opened.map, opened.keys, *opened.matcher, MapLocalizerOptions(opened.map));
+  FrameSourceOptions odd = even;
+  odd.first = 1;
+  const auto source = OpenFrameSource((Shared() / sequence).string(), odd);
+  LocalizeSequenceOptions run;
+  run.show_progress = false;
+  long bracketed = 0;
+  const LocalizationSummary summary =
+      LocalizeSequence(*source, *opened.matcher, localizer, run, [&](const Frame& frame, const LocalizationResult& r) {
+        const auto [before, after] = KeysAround(opened.map, frame.source_index);
+        bracketed += r.key >= 0 && (r.key == before || r.key == after);
+      });
+  EXPECT_EQ(summary.frames, (last + 1) / 2);
+  return static_cast<double>(bracketed) / summary.frames;
+}
+
+TEST(LocalizationTruth, OddFramesOfKitti07AreBetweenTheirKeyImages) {
+  REQUIRE_SHARED();
+  EXPECT_GE(BracketShare("data/kitti07", 99), 0.95);
+}
+
+TEST(LocalizationTruth, OddFramesOfRedkitchenAreBetweenTheirKeyImages) {
+  REQUIRE_SHARED();
+  EXPECT_GE(BracketShare("data/redkitchen", 199), 0.95);
+}
+
+}  // namespace
+}  // namespace vmap
