@@ -10,6 +10,8 @@
 // Relocalization: a map whose key images are every third frame of ../shared/data/redkitchen (frames 0-899,
 // tau 1.0 makes every frame a key image), queried with frames between them, the estimate reset before each.
 
+#include <sys/resource.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -70,6 +72,20 @@ void BuildInto(const std::string& input, FrameSourceOptions source_options, doub
   WriteMapFiles(map, directory);
 }
 
+// CPU seconds of the whole process, and of the calling thread: unlike wall time, they hardly change with
+// the load other programs put on the machine.
+double ProcessCpuSeconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_utime.tv_sec + usage.ru_stime.tv_sec + 1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
+
+double ThreadCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -99,6 +115,7 @@ int main(int argc, char** argv) {
               lab.map.key_images.size(), kitchen_map.map.key_images.size());
 
   Samples decode, extract, track, relocalize_median, relocalize_max;
+  Samples extract_cpu, track_cpu, track_main_cpu, relocalize_cpu;  // milliseconds per frame
   long tracked = 0, frames = 0, relocalized = 0, queries = 0;
   for (int r = 0; r < repeat; ++r) {
     {  // decode only
@@ -111,20 +128,25 @@ int main(int argc, char** argv) {
     {  // decode + ORB, one thread
       auto source = OpenFrameSource(video);
       const auto start = Clock::now();
+      const double cpu = ProcessCpuSeconds();
       long n = 0;
       while (auto frame = source->Next()) {
         lab.matcher->Extract(frame->gray);
         ++n;
       }
       extract.values.push_back(n / std::chrono::duration<double>(Clock::now() - start).count());
+      extract_cpu.values.push_back(1000 * (ProcessCpuSeconds() - cpu) / n);
     }
     {  // vmap localize end to end: decode and extraction on the workers, tracking on this thread
       auto source = OpenFrameSource(video);
       Localizer localizer(lab.map, lab.keys, *lab.matcher, MapLocalizerOptions(lab.map));
       LocalizeSequenceOptions options;
       options.show_progress = false;
+      const double cpu = ProcessCpuSeconds(), main_cpu = ThreadCpuSeconds();
       const LocalizationSummary s = LocalizeSequence(*source, *lab.matcher, localizer, options, nullptr);
       track.values.push_back(s.frames_per_second);
+      track_cpu.values.push_back(1000 * (ProcessCpuSeconds() - cpu) / s.frames);
+      track_main_cpu.values.push_back(1000 * (ThreadCpuSeconds() - main_cpu) / s.frames);
       tracked += s.tracking;
       frames += s.frames;
     }
@@ -135,16 +157,19 @@ int main(int argc, char** argv) {
       auto source = OpenFrameSource(kitchen, between);
       Localizer localizer(kitchen_map.map, kitchen_map.keys, *kitchen_map.matcher,
                           MapLocalizerOptions(kitchen_map.map));
-      Samples seconds;
+      Samples seconds, cpu_seconds;
       while (auto frame = source->Next()) {
         const auto features = kitchen_map.matcher->Extract(frame->gray);
         localizer.Reset();
+        const double cpu = ThreadCpuSeconds();
         const LocalizationResult result = localizer.Localize(*frame, *features);
+        cpu_seconds.values.push_back(ThreadCpuSeconds() - cpu);
         seconds.values.push_back(result.seconds);
         relocalized += result.status == LocalizationStatus::kRelocalized;
         ++queries;
       }
       relocalize_median.values.push_back(seconds.Median());
+      relocalize_cpu.values.push_back(1000 * cpu_seconds.Median());
       relocalize_max.values.push_back(seconds.Max());
     }
   }
@@ -157,6 +182,14 @@ int main(int argc, char** argv) {
               relocalize_median.Min(), relocalize_median.Max());
   std::printf("| relocalization, slowest frame of a repeat, s | %.3f [%.3f-%.3f] |\n", relocalize_max.Median(),
               relocalize_max.Min(), relocalize_max.Max());
+  std::printf("| decode + ORB (one thread), CPU ms per frame | %.1f [%.1f-%.1f] |\n", extract_cpu.Median(),
+              extract_cpu.Min(), extract_cpu.Max());
+  std::printf("| vmap localize, tracking, CPU ms per frame, all threads | %.1f [%.1f-%.1f] |\n", track_cpu.Median(),
+              track_cpu.Min(), track_cpu.Max());
+  std::printf("| vmap localize, tracking, CPU ms per frame, localizer thread | %.1f [%.1f-%.1f] |\n",
+              track_main_cpu.Median(), track_main_cpu.Min(), track_main_cpu.Max());
+  std::printf("| relocalization, 300-key map, median CPU ms per frame | %.1f [%.1f-%.1f] |\n", relocalize_cpu.Median(),
+              relocalize_cpu.Min(), relocalize_cpu.Max());
   std::printf("tracking share %.1f%%; relocalized %ld of %ld queries\n", 100.0 * tracked / std::max(1L, frames),
               relocalized, queries);
   fs::remove_all(work);

@@ -17,6 +17,7 @@
 #include "vmap/localization/localization_output.h"
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/localization/route.h"
+#include "vmap/mapping/map_io.h"
 #include "vmap/report/localization_report.h"
 
 namespace vmap::cli {
@@ -51,32 +52,31 @@ void RunLocalize(const LocalizeFlags& flags) {
   run_options.show_progress = spdlog::should_log(spdlog::level::info);
   run_options.Check();
 
-  KeyImageStoreOptions store_options;
-  store_options.use_cache = flags.cache;
-  store_options.thumbnail_width = flags.localizer.ranking.thumbnail_width;
-  LocalizationMap opened = OpenLocalizationMap(flags.map, store_options);
-  const VisualMap& map = opened.map;
-
-  LocalizerOptions options = MapLocalizerOptions(map);
-  options.min_verified = flags.localizer.min_verified;
-  options.min_similarity = flags.localizer.min_similarity;
-  options.max_lost_frames = flags.localizer.max_lost_frames;
-  options.relocalization_candidates = flags.localizer.relocalization_candidates;
-  options.lookahead = flags.localizer.lookahead;
-  options.step_back = flags.localizer.step_back;
-  options.ranking = flags.localizer.ranking;
+  // Everything that can fail fast does, before the key images are loaded (which may take seconds).
+  LocalizerOptions options = flags.localizer;
   options.ranking.method = ParseRankingMethod(flags.ranking);
-  if (flags.from >= 0 || flags.to >= 0) {
-    const int last = static_cast<int>(map.key_images.size()) - 1;
-    options.route = PlanRoute(map, flags.from >= 0 ? flags.from : 0, flags.to >= 0 ? flags.to : last).keys;
-  }
   options.Check();
-
+  const VisualMap header = ReadMap(flags.map);
+  if (flags.from >= 0 || flags.to >= 0) {
+    const int last = static_cast<int>(header.key_images.size()) - 1;
+    options.route = PlanRoute(header, flags.from >= 0 ? flags.from : 0, flags.to >= 0 ? flags.to : last).keys;
+  }
   // Frames are compared with key images at the map's size unless told otherwise.
-  if (source_options.resize.empty() && !map.input.frame_size.empty()) {
-    source_options.resize = fmt::format("{}x{}", map.input.frame_size.width, map.input.frame_size.height);
+  if (source_options.resize.empty() && !header.input.frame_size.empty()) {
+    source_options.resize = fmt::format("{}x{}", header.input.frame_size.width, header.input.frame_size.height);
   }
   const std::unique_ptr<FrameSource> source = OpenFrameSource(flags.query, source_options);
+
+  KeyImageStoreOptions store_options;
+  store_options.use_cache = flags.cache;
+  store_options.thumbnail_width = options.ranking.thumbnail_width;
+  LocalizationMap opened = OpenLocalizationMap(flags.map, store_options);
+  const VisualMap& map = opened.map;
+  // The map's verifier and definition of S.
+  const LocalizerOptions from_map = MapLocalizerOptions(map);
+  options.verifier = from_map.verifier;
+  options.similarity = from_map.similarity;
+  options.Check();
   Localizer localizer(map, opened.keys, *opened.matcher, options);
 
   LocalizationRun run;

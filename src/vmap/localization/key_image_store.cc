@@ -46,6 +46,8 @@ uint64_t Fingerprint(const fs::path& map_directory, const Matcher& matcher, cons
   uint64_t hash = Fnv1a(std::string_view(kCacheMagic, sizeof(kCacheMagic)));
   hash = Fnv1a(ReadWholeFile(map_directory / kMapFileName), hash);
   hash = Fnv1a(matcher.DescribeOptionsJson(), hash);
+  // Another vmap or OpenCV may extract differently.
+  hash = Fnv1a(std::string(VMAP_VERSION) + " " + CV_VERSION, hash);
   return Fnv1a(std::to_string(options.thumbnail_width), hash);
 }
 

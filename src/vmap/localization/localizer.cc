@@ -26,8 +26,9 @@ double Median(std::vector<double> values) {
 }
 
 // Which of two accepted comparisons is the better match: more verified matches, then higher S.
-// Measured on the bracket test (README): S first, S times verified, and a 10 % or 25 % margin before moving
-// on all localized fewer odd frames of redkitchen between their key images than verified matches alone.
+// Measured on the bracket test (README): S first, S times verified, a 10 % or 25 % margin before moving on,
+// and moving on only when S is higher too localized no more odd frames of redkitchen between their key
+// images than verified matches alone.
 bool Better(const KeyComparison& a, const KeyComparison& b) {
   if (!a.accepted) return false;
   if (!b.accepted) return true;
@@ -155,12 +156,13 @@ KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
   dx.reserve(pair.num_verified);
   for (int i = 0; i < pair.num_verified; ++i) dx.push_back(pair.correspondences[i].p0.x - pair.correspondences[i].p1.x);
   c.median_dx = pair.matched ? Median(std::move(dx)) : kNaN;
+  // HOOK(camera): heading in degrees and relative pose from the verified matches and c.F (see localizer.h).
   return c;
 }
 
 LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& features) {
   const auto start = std::chrono::steady_clock::now();
-  LocalizationResult result = has_estimate() ? Track(features) : Relocalize(frame, features);
+  LocalizationResult result = has_estimate() ? Track(frame, features) : Relocalize(frame, features);
   result.frame_index = frame.index;
   result.source_index = frame.source_index;
   result.timestamp = frame.timestamp;
@@ -189,6 +191,7 @@ void Localizer::Describe(LocalizationResult& result, int position, std::vector<K
   result.to_next = at_end ? KeyComparison() : comparison(result.next_key);
   const KeyComparison& target = at_end ? result.to_key : result.to_next;
   result.heading_px = target.matched ? target.median_dx : kNaN;
+  // HOOK(camera): with intrinsics, the heading in degrees and the pose to `target` from target.F here.
   if (at_end) {
     result.progress = result.to_key.accepted ? 0.0 : kNaN;
   } else {
@@ -198,7 +201,7 @@ void Localizer::Describe(LocalizationResult& result, int position, std::vector<K
   }
 }
 
-LocalizationResult Localizer::Track(const ImageFeatures& features) {
+LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& features) {
   LocalizationResult result;
   std::vector<KeyComparison> known;
   const int last = static_cast<int>(route_.size()) - 1;
@@ -244,7 +247,15 @@ LocalizationResult Localizer::Track(const ImageFeatures& features) {
     }
   }
   if (!best.accepted) {
+    // Lost against the estimate: the frame may be elsewhere on the route (the robot turned back, skipped
+    // ahead, or the estimate was wrong). Look for it over the whole route at once; keep the estimate when
+    // that fails too.
+    LocalizationResult found = Relocalize(frame, features);
+    found.comparisons += result.comparisons;
+    if (found.status == LocalizationStatus::kRelocalized) return found;
     result.status = LocalizationStatus::kLost;
+    result.candidates = std::move(found.candidates);
+    result.comparisons = found.comparisons;
     ++lost_in_a_row_;
     Describe(result, position, known, features);
     if (lost_in_a_row_ > options_.max_lost_frames) Reset();

@@ -13,9 +13,9 @@
 // - Tracking: the frame is compared with `key` and `next_key`; when `next_key` is the better match the
 //   estimate moves on (and then one key image further is compared too, to move on twice when the robot went
 //   fast): the key-image switching of teach-and-repeat systems. Near `key`, the key image before it is
-//   compared too, and the estimate moves back when that is the better match. A frame that verifies against none is
-//   lost; after `max_lost_frames` lost frames in a row the estimate is dropped and the next frames are
-//   relocalized.
+//   compared too, and the estimate moves back when that is the better match. A frame that verifies against
+//   none of them is relocalized at once (the robot may have turned back or skipped ahead); when that fails
+//   too it is lost and the estimate is kept, and after `max_lost_frames` lost frames in a row it is dropped.
 //
 // "Better match" and "verified" are measured by the verified matches (inliers of F) and S, as in the map.
 
@@ -48,7 +48,8 @@ struct LocalizerOptions {
   // (fewer than a third of their verified matches are with `next_key`), and move back when it is the better
   // match: the frame may be behind `key`. Off: the estimate only moves forwards (a robot that never reverses).
   bool step_back = true;
-  // Lost frames in a row, while tracking, after which the estimate is dropped and frames are relocalized.
+  // Lost frames in a row (each one also failed to relocalize) after which the estimate is dropped: key and
+  // next_key then read -1 until a frame is relocalized.
   int max_lost_frames = 5;
   // Best-ranked key images verified when relocalizing.
   int relocalization_candidates = 5;
@@ -59,16 +60,19 @@ struct LocalizerOptions {
   SimilarityMode similarity = SimilarityMode::kInlierRatio;
   // Key-image indices to follow, in order (RouteKeys gives one); empty = every key image in map order.
   std::vector<int> route;
-  // Hook for the camera model (coming with the geometry stage): with intrinsics, heading in degrees and the
-  // relative pose (R, unit t) to `next_key` are filled in. Until then the heading is in pixels only.
+  // HOOK(camera): the camera model of the geometry stage (intrinsics from the dataset or --camera, stored
+  // in map.json) goes here as an optional member. With it, Localizer::Compare (where the verified matches
+  // are at hand) adds to KeyComparison the heading in degrees (median over the verified matches of the
+  // difference of atan((x - cx) / fx) in the frame and in the key image) and the relative pose (R, unit t)
+  // from E = K^T F K, and Localizer::Describe copies the target's into the result. Until then: pixels only.
 
   void Check() const;  // throws InputError naming the bad option
 };
 
 enum class LocalizationStatus {
   kTracking,     // verified against the key image(s) of the current estimate
-  kRelocalized,  // found again by ranking and verifying (first frame, or after the estimate was dropped)
-  kLost,         // not verified against the map; key/next_key keep the last estimate (-1 when there is none)
+  kRelocalized,  // found by ranking and verifying the whole route (first frame, or the estimate failed)
+  kLost,         // verified against no key image; key/next_key keep the last estimate (-1 when there is none)
 };
 std::string LocalizationStatusName(LocalizationStatus status);  // "tracking", "relocalized", "lost"
 
@@ -110,6 +114,7 @@ struct LocalizationResult {
   // pixels. Positive: the scene appears to the right of where the key image has it, i.e. the robot points
   // left of the key image's heading and should turn right (clockwise seen from above). NaN when unknown.
   double heading_px = 0.0;
+  // HOOK(camera): heading_deg and the relative pose (R, unit t) to the target key image come here.
   // Progress along the segment key -> next_key in [0, 1]: v_next / (v_key + v_next) with v the verified
   // matches to each (0 at `key`, 1 at `next_key`, 0.5 where both share as much). NaN when unknown.
   double progress = 0.0;
@@ -139,7 +144,7 @@ class Localizer {
 
  private:
   KeyComparison Compare(const ImageFeatures& features, int key) const;
-  LocalizationResult Track(const ImageFeatures& features);
+  LocalizationResult Track(const Frame& frame, const ImageFeatures& features);
   LocalizationResult Relocalize(const Frame& frame, const ImageFeatures& features);
   void Describe(LocalizationResult& result, int position, std::vector<KeyComparison>& known,
                 const ImageFeatures& features) const;

@@ -1,0 +1,194 @@
+// A teach run and a repeat run of one place, judged with ground truth (README "Localization").
+//
+//   localize_repeat TUM_SEQUENCE --teach FIRST:LAST --repeat FIRST:LAST [--stride N]
+//                   [--max-distance M] [--max-angle DEG]
+//
+// Builds a map of the teach frames (default options) and localizes the repeat frames against it. The
+// sequence's groundtruth.txt (TUM: timestamp tx ty tz qx qy qz qw, camera to world) judges each repeat frame:
+//  - it is coverable when some key image was taken within --max-distance metres (default 0.5) with a viewing
+//    direction within --max-angle degrees (default 30) of it;
+//  - a localized frame is right when its key image or the next one is within those bounds, wrong otherwise.
+// Prints the counts, and the stretches of repeat frames that were lost although coverable.
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include "vmap/features/matcher_factory.h"
+#include "vmap/localization/localization_map.h"
+#include "vmap/localization/localize_sequence.h"
+#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/map_io.h"
+
+namespace fs = std::filesystem;
+using namespace vmap;
+
+namespace {
+
+struct Pose {
+  cv::Vec3d position;
+  cv::Vec3d forward;  // the camera's viewing direction (its z axis) in the world
+};
+
+// groundtruth.txt by timestamp.
+std::map<double, Pose> ReadGroundTruth(const fs::path& file) {
+  std::map<double, Pose> poses;
+  std::ifstream in(file);
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    double t, x, y, z, qx, qy, qz, qw;
+    if (!(fields >> t >> x >> y >> z >> qx >> qy >> qz >> qw)) continue;
+    // Third column of the rotation matrix of the unit quaternion.
+    const cv::Vec3d forward(2 * (qx * qz + qy * qw), 2 * (qy * qz - qx * qw), 1 - 2 * (qx * qx + qy * qy));
+    poses[t] = {{x, y, z}, forward};
+  }
+  return poses;
+}
+
+const Pose* PoseAt(const std::map<double, Pose>& poses, double t) {
+  auto it = poses.lower_bound(t - 1e-3);
+  if (it == poses.end() || std::abs(it->first - t) > 0.02) return nullptr;
+  return &it->second;
+}
+
+bool Near(const Pose& a, const Pose& b, double max_distance, double max_angle_deg) {
+  const double cosine = a.forward.dot(b.forward) / (cv::norm(a.forward) * cv::norm(b.forward));
+  return cv::norm(a.position - b.position) <= max_distance &&
+         std::acos(std::clamp(cosine, -1.0, 1.0)) * 180.0 / M_PI <= max_angle_deg;
+}
+
+std::pair<int, int> Range(const char* text) {
+  int first = 0, last = -1;
+  std::sscanf(text, "%d:%d", &first, &last);
+  return {first, last};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: localize_repeat TUM_SEQUENCE --teach A:B --repeat C:D [--stride N]\n");
+    return 2;
+  }
+  const fs::path sequence = argv[1];
+  std::pair<int, int> teach{0, 499}, repeat{500, 999};
+  int stride = 1;
+  double max_distance = 0.5, max_angle = 30.0;
+  std::string ranking = "auto";
+  int descriptors = RankingOptions().max_descriptors_per_key, candidates = LocalizerOptions().relocalization_candidates;
+  for (int i = 2; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--teach")) teach = Range(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--repeat")) repeat = Range(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--stride")) stride = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--max-distance")) max_distance = std::atof(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--max-angle")) max_angle = std::atof(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--ranking")) ranking = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--descriptors")) descriptors = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--candidates")) candidates = std::atoi(argv[i + 1]);
+  }
+  cv::setNumThreads(1);
+  const auto poses = ReadGroundTruth(sequence / "groundtruth.txt");
+  if (poses.empty()) {
+    std::fprintf(stderr, "localize_repeat: no poses in %s\n", (sequence / "groundtruth.txt").c_str());
+    return 2;
+  }
+  const fs::path map_directory = fs::temp_directory_path() / ("vmap_localize_repeat_" + std::to_string(getpid()));
+  fs::remove_all(map_directory);
+  fs::create_directories(map_directory);
+  {
+    const auto matcher = CreateMatcher({});
+    MapBuilderOptions options;
+    options.show_progress = false;
+    FrameSourceOptions source_options;
+    source_options.first = teach.first;
+    source_options.last = teach.second;
+    auto source = OpenFrameSource(sequence.string(), source_options);
+    nlohmann::json doc;
+    doc["matcher"] = nlohmann::json::parse(matcher->DescribeOptionsJson());
+    const VisualMap built = BuildMap(*source, *matcher, options, map_directory, doc.dump());
+    WriteMapFiles(built, map_directory);
+  }
+  LocalizationMap opened = OpenLocalizationMap(map_directory, {});
+  const VisualMap& map = opened.map;
+  std::printf("teach frames %d-%d: %zu key images; repeat frames %d-%d (stride %d); near = within %.2f m and %.0f deg\n",
+              teach.first, teach.second, map.key_images.size(), repeat.first, repeat.second, stride, max_distance,
+              max_angle);
+
+  LocalizerOptions localizer_options = MapLocalizerOptions(map);
+  localizer_options.ranking.method = ParseRankingMethod(ranking);
+  localizer_options.ranking.max_descriptors_per_key = descriptors;
+  localizer_options.relocalization_candidates = candidates;
+  Localizer localizer(map, opened.keys, *opened.matcher, localizer_options);
+  FrameSourceOptions repeat_options;
+  repeat_options.first = repeat.first;
+  repeat_options.last = repeat.second;
+  repeat_options.stride = stride;
+  auto source = OpenFrameSource(sequence.string(), repeat_options);
+  LocalizeSequenceOptions run;
+  run.show_progress = false;
+  long coverable = 0, right = 0, wrong = 0, lost_coverable = 0, lost_uncoverable = 0, ranked_near = 0, lost_tracking = 0;
+  std::vector<std::pair<int, int>> lost_stretches;  // coverable frames lost, as [first, last] runs
+  std::vector<std::string> wrongs;
+  const LocalizationSummary summary = LocalizeSequence(
+      *source, *opened.matcher, localizer, run, [&](const Frame& frame, const LocalizationResult& r) {
+        const Pose* pose = PoseAt(poses, frame.timestamp);
+        if (!pose) return;
+        auto key_near = [&](int key) {
+          if (key < 0) return false;
+          const Pose* key_pose = PoseAt(poses, map.key_images[key].timestamp);
+          return key_pose && Near(*pose, *key_pose, max_distance, max_angle);
+        };
+        bool can = false;
+        for (int k = 0; k < static_cast<int>(map.key_images.size()) && !can; ++k) can = key_near(k);
+        coverable += can;
+        if (r.status == LocalizationStatus::kLost) {
+          if (can) {
+            ++lost_coverable;
+            lost_tracking += r.candidates.empty();
+            // Did the ranking propose a key image taken near this frame (then verification refused it)?
+            bool proposed = false;
+            for (const RelocalizationCandidate& c : r.candidates) proposed = proposed || key_near(c.key);
+            ranked_near += proposed;
+            if (!lost_stretches.empty() && lost_stretches.back().second >= frame.source_index - stride) {
+              lost_stretches.back().second = frame.source_index;
+            } else {
+              lost_stretches.push_back({frame.source_index, frame.source_index});
+            }
+          } else {
+            ++lost_uncoverable;
+          }
+        } else if (key_near(r.key) || key_near(r.next_key)) {
+          ++right;
+        } else {
+          ++wrong;
+          if (wrongs.size() < 10) {
+            wrongs.push_back(std::to_string(frame.source_index) + "->key " + std::to_string(r.key) + " (frame " +
+                             std::to_string(map.key_images[r.key].source_index) + ")");
+          }
+        }
+      });
+  std::printf("repeat frames %ld: coverable %ld; localized right %ld, wrong %ld; lost %ld (coverable %ld, not "
+              "coverable %ld); tracking %ld, relocalized %ld; %.1f frames/s\n",
+              summary.frames, coverable, right, wrong, summary.lost, lost_coverable, lost_uncoverable,
+              summary.tracking, summary.relocalized, summary.frames_per_second);
+  std::printf("lost though coverable: %ld while tracking (before the estimate is dropped), %ld relocalizing: the "
+              "ranking proposed a key image near the frame for %ld (verification refused it), none for %ld\n",
+              lost_tracking, lost_coverable - lost_tracking, ranked_near, lost_coverable - lost_tracking - ranked_near);
+  for (const auto& [a, b] : lost_stretches) std::printf("  lost though coverable: frames %d-%d\n", a, b);
+  for (const std::string& w : wrongs) std::printf("  wrong: %s\n", w.c_str());
+  fs::remove_all(map_directory);
+  return 0;
+}
