@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
+#include <functional>
 #include <exception>
 #include <map>
 #include <mutex>
@@ -28,16 +29,19 @@ namespace {
 struct ExtractedFrame {
   Frame frame;
   std::shared_ptr<const ImageFeatures> features;
+  std::vector<KeyComparison> ahead;  // comparisons made on the worker
   double extract_seconds = 0.0;
 };
+
+using CompareAheadFn = std::function<std::vector<KeyComparison>(const ImageFeatures& features)>;
 
 // Workers take the next frame from the source (one at a time: decoding is sequential) and extract its
 // features outside the lock; the consumer receives the frames in order. At most `depth` frames are in
 // flight, so memory does not grow with the sequence.
 class ExtractionPipeline {
  public:
-  ExtractionPipeline(FrameSource& source, const Matcher& matcher, int workers, int depth)
-      : source_(source), matcher_(matcher), depth_(std::max(depth, workers)) {
+  ExtractionPipeline(FrameSource& source, const Matcher& matcher, int workers, int depth, CompareAheadFn ahead)
+      : source_(source), matcher_(matcher), ahead_(std::move(ahead)), depth_(std::max(depth, workers)) {
     for (int i = 0; i < workers; ++i) threads_.emplace_back([this] { Work(); });
   }
 
@@ -95,6 +99,7 @@ class ExtractionPipeline {
         const auto start = std::chrono::steady_clock::now();
         item.features = matcher_.Extract(frame->gray);
         item.extract_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (ahead_) item.ahead = ahead_(*item.features);
         item.frame = std::move(*frame);
         {
           std::lock_guard<std::mutex> lock(mutex_);
@@ -112,6 +117,7 @@ class ExtractionPipeline {
 
   FrameSource& source_;
   const Matcher& matcher_;
+  const CompareAheadFn ahead_;
   const long depth_;
   std::vector<std::thread> threads_;
   std::mutex mutex_;         // everything below but next_in_
@@ -139,10 +145,30 @@ LocalizationSummary LocalizeSequence(FrameSource& source, const Matcher& matcher
   progress_options.enabled = options.show_progress;
   ProgressLine progress("localize", source.info().expected_frames, "frames", progress_options);
   double extract_seconds = 0.0, localize_seconds = 0.0;
+  // The key images the workers compare new frames with: those of the latest estimate.
+  std::mutex likely_mutex;
+  std::vector<int> likely_keys = localizer.LikelyKeys();
+  CompareAheadFn ahead;
+  if (options.compare_ahead) {
+    ahead = [&](const ImageFeatures& features) {
+      std::vector<int> keys;
+      {
+        std::lock_guard<std::mutex> lock(likely_mutex);
+        keys = likely_keys;
+      }
+      std::vector<KeyComparison> comparisons;
+      for (int key : keys) comparisons.push_back(localizer.Compare(features, key));
+      return comparisons;
+    };
+  }
   {
-    ExtractionPipeline pipeline(source, matcher, options.ExtractionThreads(), options.prefetch_frames);
+    ExtractionPipeline pipeline(source, matcher, options.ExtractionThreads(), options.prefetch_frames, ahead);
     while (std::optional<ExtractedFrame> item = pipeline.Next()) {
-      const LocalizationResult result = localizer.Localize(item->frame, *item->features);
+      const LocalizationResult result = localizer.Localize(item->frame, *item->features, std::move(item->ahead));
+      {
+        std::lock_guard<std::mutex> lock(likely_mutex);
+        likely_keys = localizer.LikelyKeys();
+      }
       ++summary.frames;
       switch (result.status) {
         case LocalizationStatus::kTracking: ++summary.tracking; break;

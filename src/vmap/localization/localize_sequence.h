@@ -1,7 +1,11 @@
 #pragma once
 // Localizes a stream of frames against a map: frames are decoded and their features extracted on worker
-// threads, a few frames ahead, while the calling thread runs the Localizer on them in order. Memory stays
-// flat: only the frames in flight are held, and each result goes to the caller as soon as it is known.
+// threads, a few frames ahead, while the calling thread runs the Localizer on them in order. The workers
+// also compare each frame with the key images of the latest estimate (Localizer::LikelyKeys), since most
+// frames are compared with the same two key images as the frame before: the calling thread then only
+// decides, and compares what the workers did not guess. The results are the same as without (comparisons
+// are deterministic). Memory stays flat: only the frames in flight are held, and each result goes to the
+// caller as soon as it is known.
 
 #include <functional>
 
@@ -17,6 +21,7 @@ struct LocalizeSequenceOptions {
   // both cores while ORB's matching and verification keep the calling thread busy.
   int extraction_threads = 0;
   int prefetch_frames = 4;   // frames extracted ahead of the localizer
+  bool compare_ahead = true; // workers compare frames with the likely key images (see above)
   bool show_progress = true; // a progress line on a terminal
 
   int ExtractionThreads() const;

@@ -160,9 +160,16 @@ KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
   return c;
 }
 
-LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& features) {
+LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& features,
+                                      std::vector<KeyComparison> ahead) {
   const auto start = std::chrono::steady_clock::now();
+  comparisons_.clear();
+  for (KeyComparison& c : ahead) {
+    if (c.key >= 0 && c.key < static_cast<int>(keys_.features.size())) comparisons_.push_back({std::move(c), false});
+  }
   LocalizationResult result = has_estimate() ? Track(frame, features) : Relocalize(frame, features);
+  result.comparisons = static_cast<int>(
+      std::count_if(comparisons_.begin(), comparisons_.end(), [](const Memo& m) { return m.used; }));
   result.frame_index = frame.index;
   result.source_index = frame.source_index;
   result.timestamp = frame.timestamp;
@@ -171,24 +178,32 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   return result;
 }
 
-// Fills key, next_key, their comparisons, heading and progress for the estimate at route `position`,
-// comparing whatever `known` does not hold yet.
-void Localizer::Describe(LocalizationResult& result, int position, std::vector<KeyComparison>& known,
-                         const ImageFeatures& features) const {
-  auto comparison = [&](int key) -> const KeyComparison& {
-    for (const KeyComparison& c : known) {
-      if (c.key == key) return c;
+std::vector<int> Localizer::LikelyKeys() const {
+  if (!has_estimate()) return {};
+  std::vector<int> keys = {route_[position_]};
+  if (position_ + 1 < static_cast<int>(route_.size())) keys.push_back(route_[position_ + 1]);
+  return keys;
+}
+
+KeyComparison Localizer::CompareOnce(const ImageFeatures& features, int key) {
+  for (Memo& m : comparisons_) {
+    if (m.comparison.key == key) {
+      m.used = true;
+      return m.comparison;
     }
-    known.push_back(Compare(features, key));
-    ++result.comparisons;
-    return known.back();
-  };
+  }
+  comparisons_.push_back({Compare(features, key), true});
+  return comparisons_.back().comparison;
+}
+
+// Fills key, next_key, their comparisons, heading and progress for the estimate at route `position`.
+void Localizer::Describe(LocalizationResult& result, int position, const ImageFeatures& features) {
   result.route_position = position;
   result.key = route_[position];
-  result.to_key = comparison(result.key);
+  result.to_key = CompareOnce(features, result.key);
   const bool at_end = position + 1 >= static_cast<int>(route_.size());
   result.next_key = at_end ? -1 : route_[position + 1];
-  result.to_next = at_end ? KeyComparison() : comparison(result.next_key);
+  result.to_next = at_end ? KeyComparison() : CompareOnce(features, result.next_key);
   const KeyComparison& target = at_end ? result.to_key : result.to_next;
   result.heading_px = target.matched ? target.median_dx : kNaN;
   // HOOK(camera): with intrinsics, the heading in degrees and the pose to `target` from target.F here.
@@ -203,17 +218,9 @@ void Localizer::Describe(LocalizationResult& result, int position, std::vector<K
 
 LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& features) {
   LocalizationResult result;
-  std::vector<KeyComparison> known;
   const int last = static_cast<int>(route_.size()) - 1;
-  auto compare_at = [&](int position) -> KeyComparison {
-    for (const KeyComparison& c : known) {
-      if (c.key == route_[position]) return c;
-    }
-    known.push_back(Compare(features, route_[position]));
-    ++result.comparisons;
-    return known.back();
-  };
-  int position = position_;
+  auto compare_at = [&](int position) { return CompareOnce(features, route_[position]); };
+  const int position = position_;
   const KeyComparison at_key = compare_at(position);
   KeyComparison best = at_key;
   int best_position = position;
@@ -232,12 +239,9 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   // hand-held camera swinging back, a relocalization one key image too far). Move back when the previous key
   // image is the better match. Checked only near `key`, where it can be true, to spare a comparison.
   if (options_.step_back && best_position == position && position > 0) {
-    const KeyComparison* next = nullptr;
-    for (const KeyComparison& c : known) {
-      if (position < last && c.key == route_[position + 1]) next = &c;
-    }
+    const KeyComparison next = position < last ? compare_at(position + 1) : KeyComparison();
     const int v_key = at_key.accepted ? at_key.num_verified : 0;
-    const int v_next = next && next->accepted ? next->num_verified : 0;
+    const int v_next = next.accepted ? next.num_verified : 0;
     if (3 * v_next < v_key + v_next || v_key == 0) {
       const KeyComparison behind = compare_at(position - 1);
       if (Better(behind, best)) {
@@ -251,26 +255,23 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     // ahead, or the estimate was wrong). Look for it over the whole route at once; keep the estimate when
     // that fails too.
     LocalizationResult found = Relocalize(frame, features);
-    found.comparisons += result.comparisons;
     if (found.status == LocalizationStatus::kRelocalized) return found;
     result.status = LocalizationStatus::kLost;
     result.candidates = std::move(found.candidates);
-    result.comparisons = found.comparisons;
     ++lost_in_a_row_;
-    Describe(result, position, known, features);
+    Describe(result, position, features);
     if (lost_in_a_row_ > options_.max_lost_frames) Reset();
     return result;
   }
   lost_in_a_row_ = 0;
   position_ = best_position;
   result.status = LocalizationStatus::kTracking;
-  Describe(result, position_, known, features);
+  Describe(result, position_, features);
   return result;
 }
 
 LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures& features) {
   LocalizationResult result;
-  std::vector<KeyComparison> known;
   const cv::Mat thumbnail = ranking_->method() == RankingMethod::kThumbnails
                                 ? ThumbnailDescriptor(frame.gray, options_.ranking.thumbnail_width)
                                 : cv::Mat();
@@ -280,9 +281,7 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
   const int count = std::min<int>(options_.relocalization_candidates, static_cast<int>(ranked.size()));
   for (int i = 0; i < count; ++i) {
     const int position = ranked[i].key;  // the ranking holds the route's key images in route order
-    KeyComparison c = Compare(features, route_[position]);
-    ++result.comparisons;
-    known.push_back(c);
+    const KeyComparison c = CompareOnce(features, route_[position]);
     result.candidates.push_back({route_[position], ranked[i].score, c.accepted, c.similarity, c.num_verified});
     if (Better(c, best)) {
       best = c;
@@ -297,28 +296,15 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
   // route is the better match.
   int position = best_position;
   if (position > 0) {
-    auto find = [&](int key) -> const KeyComparison* {
-      for (const KeyComparison& c : known) {
-        if (c.key == key) return &c;
-      }
-      return nullptr;
-    };
-    if (!find(route_[position - 1])) {
-      known.push_back(Compare(features, route_[position - 1]));
-      ++result.comparisons;
-    }
+    const KeyComparison before = CompareOnce(features, route_[position - 1]);
     const bool has_next = position + 1 < static_cast<int>(route_.size());
-    if (has_next && !find(route_[position + 1])) {
-      known.push_back(Compare(features, route_[position + 1]));
-      ++result.comparisons;
-    }
-    const KeyComparison& before = *find(route_[position - 1]);
-    if (before.accepted && (!has_next || Better(before, *find(route_[position + 1])))) position -= 1;
+    const KeyComparison after = has_next ? CompareOnce(features, route_[position + 1]) : KeyComparison();
+    if (before.accepted && (!has_next || Better(before, after))) position -= 1;
   }
   position_ = position;
   lost_in_a_row_ = 0;
   result.status = LocalizationStatus::kRelocalized;
-  Describe(result, position_, known, features);
+  Describe(result, position_, features);
   return result;
 }
 

@@ -119,7 +119,7 @@ struct LocalizationResult {
   // matches to each (0 at `key`, 1 at `next_key`, 0.5 where both share as much). NaN when unknown.
   double progress = 0.0;
   std::vector<RelocalizationCandidate> candidates;  // relocalization only: those verified, best-ranked first
-  int comparisons = 0;                // pairs matched and verified for this frame
+  int comparisons = 0;                // key images the frame was compared with (some maybe ahead, on workers)
   double seconds = 0.0;               // time spent localizing this frame (features excluded)
 };
 
@@ -133,8 +133,18 @@ class Localizer {
   Localizer& operator=(const Localizer&) = delete;
 
   // Localizes the next frame of the stream. `features` come from the map's matcher on frame.gray (they may
-  // be extracted on another thread: see LocalizeSequence).
-  LocalizationResult Localize(const Frame& frame, const ImageFeatures& features);
+  // be extracted on another thread: see LocalizeSequence). `ahead` may hold comparisons of this frame that
+  // were already made (Compare, on another thread, with the LikelyKeys of an earlier state): they are used
+  // instead of comparing again, which gives the same result.
+  LocalizationResult Localize(const Frame& frame, const ImageFeatures& features,
+                              std::vector<KeyComparison> ahead = {});
+
+  // The key images the next frame will most likely be compared with: `key` and `next_key` of the current
+  // estimate (none without an estimate).
+  std::vector<int> LikelyKeys() const;
+  // The frame's features against key image `key`, as Localize compares them. Thread-safe (const, and the
+  // matcher's Match and the verifier are), so frames can be compared ahead on other threads.
+  KeyComparison Compare(const ImageFeatures& features, int key) const;
 
   // Forgets the estimate: the next frame is relocalized.
   void Reset();
@@ -143,11 +153,11 @@ class Localizer {
   RankingMethod ranking_method() const { return ranking_->method(); }
 
  private:
-  KeyComparison Compare(const ImageFeatures& features, int key) const;
+  // Each key image is compared with a frame at most once per Localize call.
+  KeyComparison CompareOnce(const ImageFeatures& features, int key);
   LocalizationResult Track(const Frame& frame, const ImageFeatures& features);
   LocalizationResult Relocalize(const Frame& frame, const ImageFeatures& features);
-  void Describe(LocalizationResult& result, int position, std::vector<KeyComparison>& known,
-                const ImageFeatures& features) const;
+  void Describe(LocalizationResult& result, int position, const ImageFeatures& features);
 
   const VisualMap& map_;
   const KeyImageStore& keys_;
@@ -158,6 +168,11 @@ class Localizer {
   std::unique_ptr<KeyImageRanking> ranking_;
   int position_ = -1;  // route position of `key`; -1: no estimate
   int lost_in_a_row_ = 0;
+  struct Memo {
+    KeyComparison comparison;
+    bool used = false;  // counted in LocalizationResult::comparisons
+  };
+  std::vector<Memo> comparisons_;  // of the frame being localized
 };
 
 // The key images on either side of position `source_index` of the map's input (KeyImage::source_index):

@@ -250,6 +250,32 @@ TEST(Localizer, SameInputSameResults) {
   }
 }
 
+TEST(Localizer, ComparingAheadOnTheWorkersChangesNothing) {
+  const LocalizationMap& m = Map().opened;
+  std::vector<LocalizationResult> runs[2];
+  for (int i = 0; i < 2; ++i) {
+    Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m.map));
+    ::vmap::testing::MemorySource source(Frames(1, 2), Indices(1, 2));
+    LocalizeSequenceOptions run;
+    run.show_progress = false;
+    run.compare_ahead = i == 1;
+    LocalizeSequence(source, *m.matcher, localizer, run,
+                     [&](const Frame&, const LocalizationResult& r) { runs[i].push_back(r); });
+  }
+  ASSERT_EQ(runs[0].size(), runs[1].size());
+  for (size_t f = 0; f < runs[0].size(); ++f) {
+    const LocalizationResult &a = runs[0][f], &b = runs[1][f];
+    EXPECT_EQ(a.status, b.status);
+    EXPECT_EQ(a.key, b.key);
+    EXPECT_EQ(a.next_key, b.next_key);
+    EXPECT_EQ(a.to_key.num_verified, b.to_key.num_verified);
+    EXPECT_EQ(a.to_next.num_verified, b.to_next.num_verified);
+    EXPECT_EQ(a.to_next.F, b.to_next.F);
+    EXPECT_EQ(a.heading_px, b.heading_px);
+    EXPECT_EQ(a.comparisons, b.comparisons);
+  }
+}
+
 TEST(Localizer, OptionsAreChecked) {
   const LocalizationMap& m = Map().opened;
   auto with = [&](auto change) {

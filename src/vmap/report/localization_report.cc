@@ -291,11 +291,15 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
 
 void WriteLocalizationReport(const fs::path& run_file, const fs::path& directory,
                              const LocalizationReportOptions& options) {
-  const LocalizationRun run = ReadLocalizationRun(run_file);
+  LocalizationRun run = ReadLocalizationRun(run_file);
   fs::path map_directory = run.info.map_directory;
   if (!fs::exists(map_directory / kMapFileName) && map_directory.is_relative()) {
     const fs::path beside = run_file.parent_path() / map_directory;
     if (fs::exists(beside / kMapFileName)) map_directory = beside;
+  }
+  const fs::path query = run.info.query;
+  if (!fs::exists(query) && query.is_relative() && fs::exists(run_file.parent_path() / query)) {
+    run.info.query = (run_file.parent_path() / query).string();
   }
   const VisualMap map = ReadMap(map_directory);
   WriteLocalizationReport(run, map, map_directory, directory, options);

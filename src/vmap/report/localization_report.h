@@ -30,7 +30,8 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map,
                              const LocalizationReportOptions& options = {});
 
 // Reads the run (ReadLocalizationRun) and its map, and writes the report into `directory`. The map directory
-// recorded in the run is taken as it is, or relative to the run file's folder when it is not found as it is.
+// and the query recorded in the run are taken as they are, or relative to the run file's folder when they
+// are not found as they are.
 void WriteLocalizationReport(const std::filesystem::path& run_file, const std::filesystem::path& directory,
                              const LocalizationReportOptions& options = {});
 
