@@ -15,6 +15,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "vmap/core/atomic_output.h"
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/mapping/map_io.h"
 #include "vmap/report/html_util.h"
@@ -265,15 +266,6 @@ cv::Mat ScaledToWidth(const cv::Mat& image, int width) {
   return scaled;
 }
 
-bool IsInside(const fs::path& child, const fs::path& parent) {
-  auto c = child.begin();
-  for (auto p = parent.begin(); p != parent.end(); ++p, ++c) {
-    if (p->empty() && std::next(p) == parent.end()) break;  // trailing separator
-    if (c == child.end() || *c != *p) return false;
-  }
-  return true;
-}
-
 // The S(key, frame) plot: one line per key image over the frames compared with it, tau, the key images
 // and the similarity of each link at the frame that became the next key image.
 std::string SimilarityPlot(const VisualMap& map, const json& options) {
@@ -451,33 +443,34 @@ class RouteVideo {
 }  // namespace
 
 fs::path KeyImagePath(const fs::path& map_directory, const KeyImage& key) {
-  const fs::path relative(key.image_file);
-  bool safe = !key.image_file.empty() && !relative.is_absolute() && !relative.has_root_name() &&
-              !relative.has_root_directory();
-  for (const auto& part : relative) safe = safe && part != "..";
-  if (!safe) {
+  if (!IsPlainRelativePath(key.image_file)) {
     throw InputError("map '" + map_directory.string() + "': key image path '" + key.image_file +
                      "' points outside the map directory; rebuild the map with `vmap build`");
   }
-  const fs::path file = map_directory / relative;
-  if (!fs::exists(file)) {
-    throw InputError("map '" + map_directory.string() + "' is incomplete: key image '" + file.string() +
-                     "' is missing; rebuild the map with `vmap build`");
+  std::string why_not;
+  if (!ContainedFile::Open(map_directory, key.image_file, &why_not)) {
+    const fs::path file = map_directory / key.image_file;
+    if (why_not == "is missing") {
+      throw InputError("map '" + map_directory.string() + "' is incomplete: key image '" + file.string() +
+                       "' is missing; rebuild the map with `vmap build`");
+    }
+    throw InputError("map '" + map_directory.string() + "': key image '" + key.image_file + "' " +
+                     (why_not.rfind("resolves outside", 0) == 0 ? std::string("resolves outside the map directory")
+                                                                 : why_not) +
+                     "; rebuild the map with `vmap build`");
   }
-  // A symbolic link inside the map could still lead elsewhere.
-  std::error_code ec;
-  const fs::path real_file = fs::canonical(file, ec);
-  const fs::path real_directory = fs::canonical(map_directory, ec);
-  if (ec || !IsInside(real_file, real_directory)) {
-    throw InputError("map '" + map_directory.string() + "': key image '" + key.image_file +
-                     "' resolves outside the map directory; rebuild the map with `vmap build`");
-  }
-  return file;
+  return map_directory / key.image_file;
 }
 
 cv::Mat ReadKeyImage(const fs::path& map_directory, const KeyImage& key) {
   const fs::path file = KeyImagePath(map_directory, key);
-  cv::Mat image = cv::imread(file.string(), cv::IMREAD_COLOR);
+  cv::Mat image;
+  try {
+    image = cv::imread(file.string(), cv::IMREAD_COLOR);
+  } catch (const cv::Exception& error) {
+    throw InputError("key image '" + file.string() + "' cannot be decoded (" + error.what() +
+                     "); rebuild the map with `vmap build`");
+  }
   if (image.empty()) {
     throw InputError("key image '" + file.string() + "' cannot be decoded; rebuild the map with `vmap build`");
   }
@@ -515,7 +508,8 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
   const MapStatistics stats = ComputeStatistics(
       map, OptionText(options, "quality_mean") == "harmonic" ? QualityMean::kHarmonic : QualityMean::kArithmetic);
 
-  AtomicOutputDirectory assets(map_directory / kReportAssetsDirectory, AtomicOutputDirectory::kReplaceAnything);
+  // Inside a map that ReadMap has just recognised as vmap's: the old report/ is vmap's too.
+  AtomicOutputDirectory assets(map_directory / kReportAssetsDirectory, OutputPolicy::InsideVmapOutput());
   fs::create_directories(assets.path() / "keys");
   fs::create_directories(assets.path() / "links");
   const std::string assets_url = std::string(kReportAssetsDirectory) + "/";
