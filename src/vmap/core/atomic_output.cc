@@ -7,10 +7,12 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <mutex>
 #include <random>
 #include <set>
+#include <thread>
 
 #include <spdlog/spdlog.h>
 
@@ -34,9 +36,14 @@ TemporaryRegistry& Temporaries() {
   return *registry;
 }
 
-void Register(const fs::path& path) {
+// Creates a temporary and registers it in one step under the registry's lock, so that an interruption
+// never finds one created and not yet registered (it would stay behind).
+template <typename Create>
+auto CreateRegistered(const fs::path& path, Create&& create) -> decltype(create()) {
   std::lock_guard<std::mutex> lock(Temporaries().mutex);
-  Temporaries().paths.insert(path);
+  auto created = create();
+  if (created) Temporaries().paths.insert(path);
+  return created;
 }
 
 void RemoveAndUnregister(const fs::path& path) {
@@ -119,11 +126,12 @@ int RemoveTemporaryOutputsForExit() {
   Temporaries().mutex.lock();
   int removed = 0;
   for (const fs::path& path : Temporaries().paths) {
-    // Another thread may still be writing into a directory: a retry takes what appeared meanwhile.
+    // Another thread may still be writing into a directory: a retry takes what appeared meanwhile. Once the
+    // directory itself is gone, nothing recreates it (only the constructor does, under the lock held here).
     std::error_code ec;
-    for (int attempt = 0; attempt < 5; ++attempt) {
+    for (int attempt = 0; attempt < 1000 && fs::exists(fs::symlink_status(path, ec)); ++attempt) {
+      if (attempt > 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
       fs::remove_all(path, ec);
-      if (!fs::exists(fs::symlink_status(path, ec))) break;
     }
     ++removed;
   }
@@ -137,14 +145,16 @@ void WriteFileAtomically(const fs::path& path, std::string_view content) {
   int fd = -1;
   for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
     temp = TemporarySibling(path, "tmp");
-    fd = open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    fd = CreateRegistered(temp, [&] {
+      const int opened = open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+      return opened >= 0 ? opened + 1 : 0;  // 0: not created
+    }) - 1;
     if (fd < 0 && errno != EEXIST) break;
   }
   if (fd < 0) {
     throw InputError("cannot write '" + path.string() + "' (" + ErrnoText() +
                      "); check that its directory exists and is writable, or choose another output path");
   }
-  Register(temp);
   const auto fail = [&](const std::string& what) {
     const std::string reason = ErrnoText();
     close(fd);
@@ -195,12 +205,17 @@ AtomicOutputDirectory::AtomicOutputDirectory(fs::path final_path, OutputPolicy p
   }
   CheckReplaceable();
   const fs::path parent = final_path_.has_parent_path() ? final_path_.parent_path() : fs::path(".");
-  std::error_code ec;
-  fs::create_directories(parent, ec);
   RemoveStaleTemporaries(final_path_);
   for (int attempt = 0; attempt < 100 && temp_path_.empty(); ++attempt) {
     const fs::path candidate = TemporarySibling(final_path_, "partial");
-    if (mkdir(candidate.c_str(), 0777) == 0) {
+    // The parent is created under the registry's lock too: when it lies in another temporary output (a
+    // sweep's map), an interruption that removed that one must not see it recreated.
+    const auto create = [&] {
+      std::error_code ec;
+      fs::create_directories(parent, ec);
+      return mkdir(candidate.c_str(), 0777) == 0;
+    };
+    if (CreateRegistered(candidate, create)) {
       temp_path_ = candidate;
     } else if (errno != EEXIST) {
       throw InputError("cannot create a directory next to '" + final_path_.string() + "' (" + ErrnoText() +
@@ -208,7 +223,6 @@ AtomicOutputDirectory::AtomicOutputDirectory(fs::path final_path, OutputPolicy p
     }
   }
   if (temp_path_.empty()) throw InputError("cannot create a temporary directory next to '" + final_path_.string() + "'");
-  Register(temp_path_);
 }
 
 AtomicOutputDirectory::~AtomicOutputDirectory() {
@@ -216,6 +230,17 @@ AtomicOutputDirectory::~AtomicOutputDirectory() {
 }
 
 void AtomicOutputDirectory::CheckReplaceable() const {
+  // The input first: replacing it would be the worst loss, whatever else the folder is.
+  for (const fs::path& input : policy_.inputs) {
+    if (IsSameOrInside(input, final_path_)) {
+      Refuse(final_path_, "is or holds the input '" + input.string() +
+                              "', which replacing it would delete; write the output somewhere else");
+    }
+    if (IsSameOrInside(final_path_, input)) {
+      Refuse(final_path_, "lies inside the input '" + input.string() +
+                              "'; write the output somewhere else than into the input");
+    }
+  }
   std::error_code ec;
   const fs::file_status status = fs::symlink_status(final_path_, ec);
   if (ec && status.type() != fs::file_type::not_found) {
@@ -246,16 +271,7 @@ void AtomicOutputDirectory::CheckReplaceable() const {
       }
     }
   }
-  for (const fs::path& input : policy_.inputs) {
-    if (IsSameOrInside(input, final_path_)) {
-      Refuse(final_path_, "is or holds the input '" + input.string() +
-                              "', which replacing it would delete; write the output somewhere else");
-    }
-    if (IsSameOrInside(final_path_, input)) {
-      Refuse(final_path_, "lies inside the input '" + input.string() +
-                              "'; write the output somewhere else than into the input");
-    }
-  }
+
 }
 
 void AtomicOutputDirectory::Commit() {

@@ -48,7 +48,9 @@ class AtomicOutputDirectory {
   AtomicOutputDirectory(const AtomicOutputDirectory&) = delete;
   AtomicOutputDirectory& operator=(const AtomicOutputDirectory&) = delete;
 
-  // The directory to write into now.
+  // The directory to write into now. Create what goes inside it with create_directory, never
+  // create_directories: an interruption removes this directory from another thread, and a recursive creation
+  // racing with that removal would bring it back, to stay behind.
   const std::filesystem::path& path() const { return temp_path_; }
   const std::filesystem::path& final_path() const { return final_path_; }
 

@@ -14,6 +14,13 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A library's exception text on one line (OpenCV's ends with a line break).
+inline std::string LibraryMessage(const std::exception& error) {
+  std::string text = error.what();
+  text.erase(text.find_last_not_of(" \t\r\n") + 1);
+  return text;
+}
+
 // What a stage was doing, on which file, and what the user can do about a failure.
 struct ErrorContext {
   std::string what;  // "cannot decode frame 12 ('a.png')"
@@ -35,7 +42,7 @@ auto RethrowAsInputError(Describe&& describe, Work&& work) -> decltype(work()) {
     throw InputError(context.what + " (out of memory); " + context.fix);
   } catch (const std::exception& error) {
     const ErrorContext context = describe();
-    throw InputError(context.what + " (" + error.what() + "); " + context.fix);
+    throw InputError(context.what + " (" + LibraryMessage(error) + "); " + context.fix);
   }
 }
 

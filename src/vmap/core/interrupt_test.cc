@@ -19,9 +19,17 @@ long CountEntries(const fs::path& directory) {
   return std::distance(fs::directory_iterator(directory), fs::directory_iterator());
 }
 
+// Signal dispositions as a command started from a terminal has them, whatever this test runner inherited (a
+// shell starts background jobs with SIGINT ignored); and a deadline, so that a failure cannot hang the test.
+void StartAsFromATerminal() {
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) signal(signal_number, SIG_DFL);
+  alarm(20);
+}
+
 // In the child process of a death test: start writing an output, then receive `signal_number` from outside
 // (kill(), as a shell or a service manager sends it) and wait to be ended.
 [[noreturn]] void WriteAndReceive(const fs::path& target, int signal_number) {
+  StartAsFromATerminal();
   InstallInterruptHandling();
   AtomicOutputDirectory directory(target, OutputPolicy{});
   std::ofstream(directory.path() / "half.txt") << "half";
@@ -55,6 +63,7 @@ TEST(InterruptDeathTest, ASignalIgnoredAtStartStaysIgnored) {
   // As under nohup: SIGHUP ignored before vmap starts.
   EXPECT_EXIT(
       {
+        StartAsFromATerminal();
         signal(SIGHUP, SIG_IGN);
         InstallInterruptHandling();
         kill(getpid(), SIGHUP);
@@ -68,6 +77,7 @@ TEST(InterruptDeathTest, NothingIsRemovedAfterACommit) {
   testing::TempDir tmp;
   EXPECT_EXIT(
       {
+        StartAsFromATerminal();
         InstallInterruptHandling();
         AtomicOutputDirectory directory(tmp.path() / "map", OutputPolicy{});
         std::ofstream(directory.path() / "complete.txt") << "complete";

@@ -271,7 +271,9 @@ class KeyImageFileWriter {
   // A callback for KeyImageSelector that writes each key image into directory/keys/; null without a directory.
   KeyImageSelector::KeyImageFn CallbackFor(const fs::path& directory) {
     if (directory.empty()) return nullptr;
-    fs::create_directories(directory / "keys");
+    // Not create_directories: `directory` is or lies in a temporary output, and once an interruption has
+    // removed that, nothing may bring it back (AtomicOutputDirectory::path()). It must exist.
+    fs::create_directory(directory / "keys");
     return [this, directory](const FrameRecord& record, KeyImage& key) {
       key.image_file = KeyImageFileName(key.frame_index);
       std::lock_guard<std::mutex> lock(mutex_);
@@ -510,6 +512,9 @@ SweepResult SweepThresholds(FrameSource& source, const Matcher& matcher, const M
                                    "decimals, so give thresholds at least 0.01 apart",
                                    directories.back().filename().string()));
     }
+  }
+  for (const fs::path& directory : directories) {
+    if (!directory.empty()) fs::create_directory(directory);  // inside maps_directory, which must exist
   }
   return RunSelectors(source, matcher, options, taus, directories, maps, options_json);
 }

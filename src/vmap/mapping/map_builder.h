@@ -30,8 +30,8 @@ struct MapBuilderOptions {
   void Check() const;  // throws InputError naming the bad option
 };
 
-// Builds one map. When `directory` is not empty, each key image is written there as keys/NNNNNN.png as
-// soon as it is chosen (the caller writes map.json with WriteMapFiles).
+// Builds one map. When `directory` (which must exist) is not empty, each key image is written there as
+// keys/NNNNNN.png as soon as it is chosen (the caller writes map.json with WriteMapFiles).
 // `options_json` is recorded verbatim in the map.
 VisualMap BuildMap(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
                    const std::filesystem::path& directory = {}, const std::string& options_json = "{}");

@@ -269,8 +269,9 @@ ContainedFile OpenMapFile(const fs::path& directory, const std::string& relative
   if (file) return std::move(*file);
   const fs::path path = directory / relative;
   if (why_not == "is missing") {
-    throw InputError("map '" + directory.string() + "' is incomplete: " + what + " '" + path.string() +
-                     "' is missing; rebuild the map with `vmap build`");
+    throw InputError("map '" + directory.string() + "' is incomplete: " +
+                     (what.empty() ? path.string() : what + " '" + path.string() + "'") +
+                     " is missing; rebuild the map with `vmap build`");
   }
   // A field of map.json names the file, or the file is one of the map's own (correspondences.bin).
   const std::string named = field.empty() ? relative : field + " '" + relative + "'";
@@ -385,7 +386,7 @@ void ReadLinks(const json& doc, const Fields& fields, const fs::path& directory,
   if (links.empty()) return;
 
   const fs::path binary_file = directory / kCorrespondencesFileName;
-  const ContainedFile binary = OpenMapFile(directory, kCorrespondencesFileName, "file", file, "");
+  const ContainedFile binary = OpenMapFile(directory, kCorrespondencesFileName, "", file, "");
   // The size first, against what the links say: a file that does not belong to this map.json (or a sparse
   // file of gigabytes) is refused before anything is read.
   const std::uint64_t expected_bytes = static_cast<std::uint64_t>(records_referenced) * kRecordBytes;

@@ -468,7 +468,7 @@ cv::Mat ReadKeyImage(const fs::path& map_directory, const KeyImage& key) {
   try {
     image = cv::imread(file.string(), cv::IMREAD_COLOR);
   } catch (const cv::Exception& error) {
-    throw InputError("key image '" + file.string() + "' cannot be decoded (" + error.what() +
+    throw InputError("key image '" + file.string() + "' cannot be decoded (" + LibraryMessage(error) +
                      "); rebuild the map with `vmap build`");
   }
   if (image.empty()) {
@@ -510,8 +510,8 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
 
   // Inside a map that ReadMap has just recognised as vmap's: the old report/ is vmap's too.
   AtomicOutputDirectory assets(map_directory / kReportAssetsDirectory, OutputPolicy::InsideVmapOutput());
-  fs::create_directories(assets.path() / "keys");
-  fs::create_directories(assets.path() / "links");
+  fs::create_directory(assets.path() / "keys");  // not create_directories: see AtomicOutputDirectory::path()
+  fs::create_directory(assets.path() / "links");
   const std::string assets_url = std::string(kReportAssetsDirectory) + "/";
 
   // Consecutive links share a key image: keep the last two decoded. (cv::Mat copies share the pixels, so a

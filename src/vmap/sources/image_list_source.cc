@@ -38,7 +38,7 @@ class ImageListSource : public FrameSource {
         frame.gray = cv::imread(entry.path, cv::IMREAD_GRAYSCALE);
       } catch (const cv::Exception& error) {
         // OpenCV refuses some files outright, e.g. a header announcing more than 2^30 pixels.
-        Skip(entry, std::string("cannot decode it (") + error.what() + ")");
+        Skip(entry, "cannot decode it (" + LibraryMessage(error) + ")");
         continue;
       }
       if (frame.gray.empty()) {
