@@ -42,8 +42,9 @@ void RunDraw(const DrawFlags& flags) {
   const VisualMap map = ReadMap(flags.map_directory);
   // The figure must not overwrite what it is drawn from (the map's files).
   const std::filesystem::path map_directory(flags.map_directory);
-  for (const std::string& file : {std::string(kMapFileName), std::string(kCorrespondencesFileName),
-                                  std::string("keys"), std::string(kReportFileName), std::string(kReportAssetsDirectory)}) {
+  const std::vector<std::string> map_files = {kMapFileName, kCorrespondencesFileName, "keys", kReportFileName,
+                                              kReportAssetsDirectory};
+  for (const std::string& file : map_files) {
     if (IsSameOrInside(output, map_directory / file)) {
       throw InputError("output '" + flags.output + "' would overwrite the map's own '" + file +
                        "'; write the figure somewhere else");

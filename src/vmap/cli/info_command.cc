@@ -22,12 +22,13 @@ void AddInfoCommand(CLI::App& app) {
       auto it = object.find(name);
       return it != object.end() && it->is_string() ? it->get<std::string>() : std::string("?");
     };
-    const QualityMean mean = text(options, "quality_mean") == "harmonic" ? QualityMean::kHarmonic : QualityMean::kArithmetic;
+    const QualityMean mean =
+        text(options, "quality_mean") == "harmonic" ? QualityMean::kHarmonic : QualityMean::kArithmetic;
     std::cout << FormatMapSummary(map, mean);
     const auto matcher = options.find("matcher"), verifier = options.find("verifier"), tau = options.find("tau");
     if (matcher != options.end() && matcher->is_object() && verifier != options.end() && verifier->is_object()) {
-      std::cout << "matcher         " << text(*matcher, "type") << ", verifier " << text(*verifier, "method") << ", tau "
-                << (tau != options.end() && tau->is_number() ? tau->get<double>() : 0.0) << ", similarity "
+      std::cout << "matcher         " << text(*matcher, "type") << ", verifier " << text(*verifier, "method")
+                << ", tau " << (tau != options.end() && tau->is_number() ? tau->get<double>() : 0.0) << ", similarity "
                 << text(options, "similarity") << "\n";
     }
   });

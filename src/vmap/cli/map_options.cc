@@ -30,7 +30,7 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau) 
   command->add_option("--quality", flags.quality, "Mean used by the quality Q: arithmetic or harmonic")
       ->capture_default_str();
   command->add_flag("!--no-final-key", flags.final_key, "Do not make the last frame a key image");
-  command->add_option("--threads", flags.threads, "Feature-extraction threads (0 = one per core)")
+  command->add_option("--threads", flags.threads, "Feature-extraction threads, 0 to 256 (0 = one per core)")
       ->capture_default_str();
 }
 

@@ -35,7 +35,8 @@ cv::Mat ReadGray(const std::string& path) {
   try {
     gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
   } catch (const cv::Exception& e) {
-    throw InputError("cannot read image '" + path + "' (" + LibraryMessage(e) + "); check that it is an image of a usable size");
+    throw InputError("cannot read image '" + path + "' (" + LibraryMessage(e) +
+                     "); check that it is an image of a usable size");
   }
   if (gray.empty()) throw InputError("cannot read image '" + path + "'; check the path and that it is an image");
   const std::string size_problem = FrameSizeProblem(gray.size());

@@ -330,7 +330,8 @@ TEST(Promises, SigintOrSigtermLeaveNothingBehindAndTheOldOutputIntact) {
     process.Signal(c.signal_number);
     EXPECT_EQ(process.Wait(), 128 + c.signal_number) << ReadText(tmp.path() / "log.txt");
     EXPECT_NE(ReadText(tmp.path() / "log.txt").find("vmap: interrupted"), std::string::npos);
-    EXPECT_EQ(EntriesStartingWith(tmp.path(), "."), std::vector<std::string>()) << c.arguments[0] << " left a temporary";
+    EXPECT_EQ(EntriesStartingWith(tmp.path(), "."), std::vector<std::string>())
+        << c.arguments[0] << " left a temporary";
   }
   EXPECT_EQ(ReadText(tmp.path() / "m/map.json"), old_map) << "the old map is intact";
   EXPECT_FALSE(fs::exists(tmp.path() / "s"));
@@ -441,7 +442,8 @@ TEST(Promises, LibraryErrorsBecomeVmapErrorsNamingTheFile) {
   fs::copy(tmp.path() / "m", tmp.path() / "damaged", fs::copy_options::recursive);
   const VisualMap map = ReadMap(tmp.path() / "m");
   {
-    std::fstream key(tmp.path() / "damaged" / map.key_images[0].image_file, std::ios::in | std::ios::out | std::ios::binary);
+    std::fstream key(tmp.path() / "damaged" / map.key_images[0].image_file,
+                     std::ios::in | std::ios::out | std::ios::binary);
     key.seekp(40);
     key.write(std::string(200, '\x55').data(), 200);
   }

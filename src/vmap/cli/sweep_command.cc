@@ -52,7 +52,9 @@ void RunSweep(const SweepFlags& flags) {
   // The outputs are claimed before any work: each is refused here when it is not vmap's or holds the input.
   // --report DIR is the -o folder, or a sweep folder of its own (its sweep files and the page).
   std::unique_ptr<AtomicOutputDirectory> directory, report_directory;
-  if (!flags.output.empty()) directory = std::make_unique<AtomicOutputDirectory>(flags.output, SweepOutputPolicy(flags.input));
+  if (!flags.output.empty()) {
+    directory = std::make_unique<AtomicOutputDirectory>(flags.output, SweepOutputPolicy(flags.input));
+  }
   const bool report_in_output = directory && !flags.report.empty() && SamePath(flags.report, flags.output);
   if (!flags.report.empty() && !report_in_output) {
     if (directory && (IsSameOrInside(flags.report, flags.output) || IsSameOrInside(flags.output, flags.report))) {
@@ -87,7 +89,8 @@ void RunSweep(const SweepFlags& flags) {
     // The per-tau maps are linked from the page: give their final paths.
     SweepResult linked = sweep;
     for (SweepRow& row : linked.rows) {
-      if (!row.map_directory.empty()) row.map_directory = fs::absolute(fs::path(flags.output) / row.map_directory).string();
+      if (row.map_directory.empty()) continue;
+      row.map_directory = fs::absolute(fs::path(flags.output) / row.map_directory).string();
     }
     WriteSweepFiles(linked, report_directory->path());
     WriteSweepReport(linked, report_directory->path());

@@ -171,8 +171,8 @@ class FeaturePipeline {
       const Frame& frame = decoded.second;
       item.record.features = RethrowAsInputError(
           [&] {
-            return ErrorContext{"the " + matcher_.name() + " matcher failed on frame " + std::to_string(frame.source_index) +
-                                    " (" + frame.source_name + ")",
+            return ErrorContext{"the " + matcher_.name() + " matcher failed on frame " +
+                                    std::to_string(frame.source_index) + " (" + frame.source_name + ")",
                                 "check the frame, or try other matcher options"};
           },
           [&] { return matcher_.Extract(frame.gray); });

@@ -431,7 +431,9 @@ void ReadEvaluations(const json& doc, const Fields& fields, VisualMap* map) {
   }
   const long last_frame = map->num_frames - 1;
   // Checked with the cheap predicates first; the message is only built for a value that fails.
-  const auto field = [&](int c, size_t i) { return "evaluations." + std::string(names[c]) + "[" + std::to_string(i) + "]"; };
+  const auto field = [&](int c, size_t i) {
+    return "evaluations." + std::string(names[c]) + "[" + std::to_string(i) + "]";
+  };
   const size_t n = columns[0]->size();
   map->evaluations.reserve(n);
   for (size_t i = 0; i < n; ++i) {
@@ -444,7 +446,9 @@ void ReadEvaluations(const json& doc, const Fields& fields, VisualMap* map) {
     if (!Fields::IntegerIn(key_frame, 0, last_frame)) fields.Integer(key_frame, field(0, i), 0, last_frame);
     if (!Fields::IntegerIn(frame, 0, last_frame)) fields.Integer(frame, field(1, i), 0, last_frame);
     if (!Fields::NumberIn(similarity, 0.0, 1.0)) fields.Number(similarity, field(2, i), 0.0, 1.0);
-    if (!Fields::IntegerIn(tentative, 0, kMaxMatchesPerLink)) fields.Integer(tentative, field(3, i), 0, kMaxMatchesPerLink);
+    if (!Fields::IntegerIn(tentative, 0, kMaxMatchesPerLink)) {
+      fields.Integer(tentative, field(3, i), 0, kMaxMatchesPerLink);
+    }
     const long tentative_count = tentative.get<long>();
     if (!Fields::IntegerIn(verified, 0, tentative_count)) fields.Integer(verified, field(4, i), 0, tentative_count);
     if (!matched.is_boolean()) fields.Bool(matched, field(5, i));

@@ -17,6 +17,7 @@
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/file_name_encoding.h"
 #include "vmap/mapping/map_io.h"
 #include "vmap/report/html_util.h"
 #include "vmap/report/svg_plot.h"
@@ -245,6 +246,10 @@ std::string Card(const std::string& value, const std::string& label) {
 std::string Row(const std::string& name, const std::string& value_html) {
   return "<tr><th>" + HtmlEscape(name) + "</th><td>" + value_html + "</td></tr>\n";
 }
+
+// A file name or path as the page shows it: the page is UTF-8, so a name that is not is shown percent-encoded,
+// as map.json stores it.
+std::string Displayable(const std::string& name) { return IsValidUtf8(name) ? name : EncodeFileName(name); }
 
 std::string Numbered(int index) {
   char name[32];
@@ -557,7 +562,8 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
   }
 
   const int n = map.num_frames, m = static_cast<int>(map.key_images.size());
-  const std::string input_name = map.input.path.empty() ? map_directory.filename().string() : map.input.path;
+  const std::string input_name =
+      map.input.path.empty() ? map_directory.filename().string() : Displayable(map.input.path);
   std::ostringstream html;
   html << PageStart("vmap report: " + input_name, "Visual map of " + input_name,
                     std::to_string(m) + " key images from " + std::to_string(n) + " frames, Q = " +
@@ -575,7 +581,7 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
        << Card(n > 0 ? FormatFixed(100.0 * m / n, 1) + " %" : "n/a", "of the frames")
        << Card(FormatFixed(map.quality, 3), "quality Q") << Card(FormatFixed(stats.mean_similarity, 3), "mean S")
        << Card(std::to_string(stats.broken_links), "broken links") << "</div>\n<table class=\"summary\">\n";
-  html << Row("Input", HtmlEscape(map.input.path))
+  html << Row("Input", HtmlEscape(Displayable(map.input.path)))
        << Row("Format", HtmlEscape(SourceFormatName(map.input.format)))
        << Row("Frame size", HtmlEscape(SizeText(map.input.frame_size)) +
                                 (map.input.native_size != map.input.frame_size && map.input.native_size.area() > 0
@@ -623,7 +629,7 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
     const std::string timestamp = TimestampText(k.timestamp);
     const std::string label = "key " + std::to_string(i) + " | frame " + std::to_string(k.frame_index) +
                               (timestamp.empty() ? "" : " | t = " + timestamp);
-    html << "<figure id=\"key-" << i << "\" title=\"" << HtmlEscape(k.source_name + (k.reason.empty() ? "" : ": " + k.reason))
+    html << "<figure id=\"key-" << i << "\" title=\"" << HtmlEscape(Displayable(k.source_name) + (k.reason.empty() ? "" : ": " + k.reason))
          << "\"><img loading=\"lazy\" decoding=\"async\" src=\"" << UrlPath(assets_url + "keys/" + Numbered(i))
          << "\" width=\"" << thumb_sizes[i].width << "\" height=\"" << thumb_sizes[i].height << "\" alt=\"key image "
          << i << "\" data-label=\"" << HtmlEscape(label) << "\"><figcaption><b>#" << i << "</b> frame "
@@ -706,7 +712,7 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
   if (!fs::is_directory(directory)) {
     throw InputError("cannot create the report directory '" + directory.string() + "'; choose another --report path");
   }
-  const std::string input_name = sweep.input.path.empty() ? std::string("the input") : sweep.input.path;
+  const std::string input_name = sweep.input.path.empty() ? std::string("the input") : Displayable(sweep.input.path);
   const bool has_best = sweep.best_row >= 0 && sweep.best_row < static_cast<int>(sweep.rows.size());
   std::ostringstream html;
   html << PageStart("vmap sweep: " + input_name, "Threshold sweep of " + input_name,
@@ -720,7 +726,7 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
                           Card(FormatFixed(sweep.rows[sweep.best_row].quality, 3), "best Q")
                     : "")
        << "</div>\n<table class=\"summary\">\n"
-       << Row("Input", HtmlEscape(sweep.input.path)) << Row("Format", HtmlEscape(SourceFormatName(sweep.input.format)))
+       << Row("Input", HtmlEscape(Displayable(sweep.input.path))) << Row("Format", HtmlEscape(SourceFormatName(sweep.input.format)))
        << Row("Frame size", HtmlEscape(SizeText(sweep.input.frame_size)))
        << Row("Matcher", HtmlEscape(OptionText(options, "matcher")))
        << Row("Verifier", HtmlEscape(OptionText(options, "verifier")))
