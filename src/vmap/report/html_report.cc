@@ -707,10 +707,11 @@ std::string MapLink(const std::string& map_directory, const fs::path& report_dir
 
 void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
   const json options = ParseOptions(sweep.options_json);
+  // Not created here: the CLI writes into a temporary output (AtomicOutputDirectory), which an interruption
+  // removes and nothing may bring back.
   std::error_code ec;
-  fs::create_directories(directory, ec);
-  if (!fs::is_directory(directory)) {
-    throw InputError("cannot create the report directory '" + directory.string() + "'; choose another --report path");
+  if (!fs::is_directory(directory, ec)) {
+    throw InputError("the report directory '" + directory.string() + "' does not exist; choose another --report path");
   }
   const std::string input_name = sweep.input.path.empty() ? std::string("the input") : Displayable(sweep.input.path);
   const bool has_best = sweep.best_row >= 0 && sweep.best_row < static_cast<int>(sweep.rows.size());
