@@ -35,12 +35,13 @@ void RunBuild(const BuildFlags& flags) {
   options.verifier = flags.verifier.Resolve();
   options.show_progress = spdlog::should_log(spdlog::level::info);
   options.Check();
-  const std::unique_ptr<Matcher> matcher = CreateMatcher(flags.matcher);
-  const std::unique_ptr<FrameSource> source = OpenFrameSource(flags.input, source_options);
-
+  flags.matcher.Check();
   const fs::path output = flags.output.empty() ? fs::path(fs::path(flags.input).filename().stem().string() + "_map")
                                                : fs::path(flags.output);
-  AtomicOutputDirectory directory(output, kMapFileName);
+  // Before any work: an output that is not vmap's, or that holds the input, is refused here.
+  AtomicOutputDirectory directory(output, MapOutputPolicy(flags.input));
+  const std::unique_ptr<Matcher> matcher = CreateMatcher(flags.matcher);
+  const std::unique_ptr<FrameSource> source = OpenFrameSource(flags.input, source_options);
   const std::string options_json = DescribeOptions(*matcher, options, source_options);
   const VisualMap map = BuildMap(*source, *matcher, options, directory.path(), options_json);
   WriteMapFiles(map, directory.path());

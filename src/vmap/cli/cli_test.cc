@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "vmap/geometry/fundamental.h"
 #include "vmap/mapping/map_io.h"
 #include "vmap/testing/synthetic_scene.h"
 
@@ -124,12 +125,22 @@ TEST(Cli, LoftrBuildsAMapEndToEnd) {
   EXPECT_EQ(map.num_frames, 40);
   EXPECT_GE(map.key_images.size(), 2u);
   EXPECT_EQ(nlohmann::json::parse(map.options_json)["matcher"]["type"], "loftr");
+  // A link that is not broken passed the test: it has an F, verified by at least 8 matches that satisfy it
+  // (within twice the verifier's 0.5 px threshold).
+  int verified_links = 0;
   for (const Link& link : map.links) {
     EXPECT_EQ(static_cast<int>(link.correspondences.size()), link.num_tentative);
-    if (link.has_fundamental) {
-      EXPECT_GE(link.num_verified, 8);
+    if (link.broken) continue;
+    ++verified_links;
+    EXPECT_TRUE(link.has_fundamental);
+    EXPECT_GE(link.num_verified, 8);
+    ASSERT_LE(link.num_verified, static_cast<int>(link.correspondences.size()));
+    for (int k = 0; k < link.num_verified; ++k) {
+      const Correspondence& c = link.correspondences[k];
+      EXPECT_LT(SampsonDistance(link.F, c.p0, c.p1), 1.0) << "link " << link.from_key << ", match " << k;
     }
   }
+  EXPECT_GE(verified_links, 1);
   ASSERT_EQ(RunVmap("info " + Quote(tmp.path() / "m"), &out), 0) << out;
   EXPECT_NE(out.find("matcher         loftr"), std::string::npos) << out;
 }

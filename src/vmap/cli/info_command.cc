@@ -16,13 +16,20 @@ void AddInfoCommand(CLI::App& app) {
   command->add_option("map", *directory, "Map directory written by `vmap build`")->required();
   command->callback([directory] {
     const VisualMap map = ReadMap(*directory);
+    // ReadMap checked that the options are a JSON object; their members are read whatever their types.
     const auto options = nlohmann::json::parse(map.options_json);
-    const QualityMean mean = ParseQualityMean(options.value("quality_mean", std::string("arithmetic")));
+    auto text = [](const nlohmann::json& object, const char* name) {
+      auto it = object.find(name);
+      return it != object.end() && it->is_string() ? it->get<std::string>() : std::string("?");
+    };
+    const QualityMean mean =
+        text(options, "quality_mean") == "harmonic" ? QualityMean::kHarmonic : QualityMean::kArithmetic;
     std::cout << FormatMapSummary(map, mean);
-    if (options.contains("matcher") && options.contains("verifier")) {
-      std::cout << "matcher         " << options["matcher"].value("type", "?") << ", verifier "
-                << options["verifier"].value("method", "?") << ", tau " << options.value("tau", 0.0) << ", similarity "
-                << options.value("similarity", "?") << "\n";
+    const auto matcher = options.find("matcher"), verifier = options.find("verifier"), tau = options.find("tau");
+    if (matcher != options.end() && matcher->is_object() && verifier != options.end() && verifier->is_object()) {
+      std::cout << "matcher         " << text(*matcher, "type") << ", verifier " << text(*verifier, "method")
+                << ", tau " << (tau != options.end() && tau->is_number() ? tau->get<double>() : 0.0) << ", similarity "
+                << text(options, "similarity") << "\n";
     }
   });
 }

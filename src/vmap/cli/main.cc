@@ -8,9 +8,13 @@
 
 #include "vmap/cli/commands.h"
 #include "vmap/core/error.h"
+#include "vmap/core/interrupt.h"
 #include "vmap/core/logging.h"
 
 int main(int argc, char** argv) {
+  // First, while this is the only thread: an interrupted command removes its unfinished outputs and exits
+  // with 128 + the signal (see interrupt.h).
+  vmap::InstallInterruptHandling();
   CLI::App app{"vmap: visual maps for vision-only robot navigation (key images linked by fundamental matrices)"};
   app.set_version_flag("--version", std::string("vmap ") + VMAP_VERSION);
   app.require_subcommand(1);
@@ -33,19 +37,23 @@ int main(int argc, char** argv) {
   // vmap runs frames in parallel itself; OpenCV's own threads inside ORB then only add contention
   // (measured: 5.1 ms per 640x480 frame on one thread, 7.2 ms with two).
   cv::setNumThreads(1);
+  // Every failure ends as "vmap: error: ..." with status 2; 0 is success, --help and --version included.
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);  // --help, --version
+    std::fprintf(stderr, "vmap: error: %s; see `vmap --help` or `vmap COMMAND --help`\n", e.what());
+    return 2;
   } catch (const vmap::InputError& e) {
     std::fprintf(stderr, "vmap: error: %s\n", e.what());
     return 2;
-  } catch (const cv::Exception& e) {
-    std::fprintf(stderr, "vmap: OpenCV error: %s\n", e.what());
-    return 1;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "vmap: error: out of memory; try a smaller input or smaller options (--resize)\n");
+    return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "vmap: error: %s\n", e.what());
-    return 1;
+    // A library error that no stage turned into vmap's: still an error message, and a bug to report.
+    std::fprintf(stderr, "vmap: error: %s (an unexpected error: please report it)\n", e.what());
+    return 2;
   }
   return 0;
 }

@@ -2,7 +2,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "vmap/mapping/map_io.h"
 #include "vmap/report/html_report.h"
+#include "vmap/report/summary.h"
 
 namespace vmap::cli {
 
@@ -28,7 +30,7 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau) 
   command->add_option("--quality", flags.quality, "Mean used by the quality Q: arithmetic or harmonic")
       ->capture_default_str();
   command->add_flag("!--no-final-key", flags.final_key, "Do not make the last frame a key image");
-  command->add_option("--threads", flags.threads, "Feature-extraction threads (0 = one per core)")
+  command->add_option("--threads", flags.threads, "Feature-extraction threads, 0 to 256 (0 = one per core)")
       ->capture_default_str();
 }
 
@@ -55,16 +57,26 @@ void WriteReportIfAsked(bool asked, const std::filesystem::path& map_directory) 
   if (asked) WriteMapReport(map_directory);
 }
 
-void WriteSweepReportIfAsked(const std::string& report_directory, const SweepResult& sweep,
-                             const std::string& sweep_directory) {
-  if (report_directory.empty()) return;
-  SweepResult linked = sweep;
-  // The per-tau maps are linked from the report: make their paths valid from the report's directory.
-  for (SweepRow& row : linked.rows) {
-    if (row.map_directory.empty() || sweep_directory.empty()) continue;
-    row.map_directory = std::filesystem::absolute(std::filesystem::path(sweep_directory) / row.map_directory).string();
-  }
-  WriteSweepReport(linked, report_directory);
+OutputPolicy MapOutputPolicy(const std::string& input) {
+  OutputPolicy policy;
+  policy.why_not_ours = WhyNotAVmapMap;
+  policy.kind = "a vmap map";
+  policy.inputs = {input};
+  return policy;
+}
+
+OutputPolicy SweepOutputPolicy(const std::string& input) {
+  OutputPolicy policy;
+  policy.why_not_ours = WhyNotAVmapSweep;
+  policy.kind = "a vmap sweep";
+  policy.inputs = {input};
+  return policy;
+}
+
+void WriteSweepFiles(const SweepResult& sweep, const std::filesystem::path& directory) {
+  WriteFileAtomically(directory / "sweep.md", SweepToMarkdown(sweep));
+  WriteFileAtomically(directory / "sweep.csv", SweepToCsv(sweep));
+  WriteFileAtomically(directory / kSweepJsonFileName, SweepToJson(sweep));
 }
 
 }  // namespace vmap::cli

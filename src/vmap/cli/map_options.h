@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "vmap/core/atomic_output.h"
 #include "vmap/features/matcher.h"
 #include "vmap/mapping/map_builder.h"
 
@@ -28,9 +29,13 @@ std::string DescribeOptions(const Matcher& matcher, const MapBuilderOptions& opt
 
 // Writes report.html into a map directory when asked (and when this vmap has the report stage).
 void WriteReportIfAsked(bool asked, const std::filesystem::path& map_directory);
-// Writes a sweep's report.html into `report_directory` when it is not empty; the per-tau maps in
-// `sweep_directory` (if written) are linked from it.
-void WriteSweepReportIfAsked(const std::string& report_directory, const SweepResult& sweep,
-                             const std::string& sweep_directory);
+
+// What `-o` may replace: an empty folder or a map (a sweep) that vmap wrote, never one that is, holds or lies
+// inside the input.
+OutputPolicy MapOutputPolicy(const std::string& input);
+OutputPolicy SweepOutputPolicy(const std::string& input);
+
+// Writes sweep.md, sweep.csv and sweep.json into `directory`.
+void WriteSweepFiles(const SweepResult& sweep, const std::filesystem::path& directory);
 
 }  // namespace vmap::cli

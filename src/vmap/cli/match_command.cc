@@ -12,7 +12,9 @@
 #include "vmap/cli/commands.h"
 #include "vmap/cli/common_options.h"
 #include "vmap/core/atomic_output.h"
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/file_name_encoding.h"
 
 namespace vmap::cli {
 
@@ -29,8 +31,19 @@ cv::Mat ReadGray(const std::string& path) {
   // IMREAD_GRAYSCALE, not cvtColor: the decoder's conversion is what the reference implementations see.
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error)) throw InputError("image '" + path + "' does not exist");
-  cv::Mat gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  cv::Mat gray;
+  try {
+    gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  } catch (const cv::Exception& e) {
+    throw InputError("cannot read image '" + path + "' (" + LibraryMessage(e) +
+                     "); check that it is an image of a usable size");
+  }
   if (gray.empty()) throw InputError("cannot read image '" + path + "'; check the path and that it is an image");
+  const std::string size_problem = FrameSizeProblem(gray.size());
+  if (!size_problem.empty()) {
+    throw InputError("image '" + path + "' is " + std::to_string(gray.cols) + "x" + std::to_string(gray.rows) + ", " +
+                     size_problem + "; give images of a usable size");
+  }
   return gray;
 }
 
@@ -40,6 +53,13 @@ double Seconds(std::chrono::steady_clock::time_point start) {
 
 void RunMatch(const MatchFlags& flags) {
   const VerifierOptions verifier = flags.verifier.Resolve();
+  flags.matcher.Check();
+  for (const std::string& image : {flags.image0, flags.image1}) {
+    if (!flags.json_path.empty() && IsSameOrInside(flags.json_path, image)) {
+      throw InputError("--json " + flags.json_path + " would overwrite the input image '" + image +
+                       "'; write it somewhere else");
+    }
+  }
   const cv::Mat gray0 = ReadGray(flags.image0), gray1 = ReadGray(flags.image1);
   auto start = std::chrono::steady_clock::now();
   const std::unique_ptr<Matcher> matcher = CreateMatcher(flags.matcher);
@@ -87,8 +107,9 @@ void RunMatch(const MatchFlags& flags) {
 
   if (!flags.json_path.empty()) {
     nlohmann::json j;
-    j["image0"] = {{"path", flags.image0}, {"width", gray0.cols}, {"height", gray0.rows}};
-    j["image1"] = {{"path", flags.image1}, {"width", gray1.cols}, {"height", gray1.rows}};
+    // Paths percent-encoded where they are not UTF-8, as in map.json (file_name_encoding.h).
+    j["image0"] = {{"path", EncodeFileName(flags.image0)}, {"width", gray0.cols}, {"height", gray0.rows}};
+    j["image1"] = {{"path", EncodeFileName(flags.image1)}, {"width", gray1.cols}, {"height", gray1.rows}};
     j["matcher"] = {{"type", matcher->name()}, {"options", nlohmann::json::parse(matcher->DescribeOptionsJson())}};
     j["verifier"] = {{"method", VerifierMethodName(verifier.method)},
                      {"threshold", verifier.threshold},

@@ -9,6 +9,7 @@
 #include "vmap/cli/common_options.h"
 #include "vmap/cli/map_options.h"
 #include "vmap/core/atomic_output.h"
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/mapping/map_builder.h"
 #include "vmap/mapping/map_io.h"
@@ -32,19 +33,39 @@ struct SweepFlags {
   KeyImageFlags key_images;
 };
 
+// Whether two output paths name the same folder (neither need exist yet).
+bool SamePath(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  return fs::weakly_canonical(fs::absolute(a), ec) == fs::weakly_canonical(fs::absolute(b), ec);
+}
+
 void RunSweep(const SweepFlags& flags) {
   const std::vector<double> taus = ParseThresholds(flags.thresholds);
   const FrameSourceOptions source_options = flags.source.Resolve();
   MapBuilderOptions options = flags.key_images.Resolve();
   options.verifier = flags.verifier.Resolve();
   options.show_progress = spdlog::should_log(spdlog::level::info);
+  options.Check();
+  flags.matcher.Check();
   if (flags.write_maps && flags.output.empty()) throw InputError("--maps needs -o DIR to write the maps into");
+
+  // The outputs are claimed before any work: each is refused here when it is not vmap's or holds the input.
+  // --report DIR is the -o folder, or a sweep folder of its own (its sweep files and the page).
+  std::unique_ptr<AtomicOutputDirectory> directory, report_directory;
+  if (!flags.output.empty()) {
+    directory = std::make_unique<AtomicOutputDirectory>(flags.output, SweepOutputPolicy(flags.input));
+  }
+  const bool report_in_output = directory && !flags.report.empty() && SamePath(flags.report, flags.output);
+  if (!flags.report.empty() && !report_in_output) {
+    if (directory && (IsSameOrInside(flags.report, flags.output) || IsSameOrInside(flags.output, flags.report))) {
+      throw InputError("--report " + flags.report + " must be the -o folder or lie outside it");
+    }
+    report_directory = std::make_unique<AtomicOutputDirectory>(flags.report, SweepOutputPolicy(flags.input));
+  }
+
   const std::unique_ptr<Matcher> matcher = CreateMatcher(flags.matcher);
   const std::unique_ptr<FrameSource> source = OpenFrameSource(flags.input, source_options);
   const std::string options_json = DescribeOptions(*matcher, options, source_options);
-
-  std::unique_ptr<AtomicOutputDirectory> directory;
-  if (!flags.output.empty()) directory = std::make_unique<AtomicOutputDirectory>(flags.output, "sweep.json");
   std::vector<VisualMap> maps;
   SweepResult sweep = SweepThresholds(*source, *matcher, options, taus, flags.write_maps ? &maps : nullptr,
                                       flags.write_maps ? directory->path() : fs::path(), options_json);
@@ -60,14 +81,23 @@ void RunSweep(const SweepFlags& flags) {
       // Recorded relative to the sweep directory, which is renamed into place below.
       sweep.rows[i].map_directory = fs::path(sweep.rows[i].map_directory).filename().string();
     }
-    WriteFileAtomically(directory->path() / "sweep.md", SweepToMarkdown(sweep));
-    WriteFileAtomically(directory->path() / "sweep.csv", SweepToCsv(sweep));
-    WriteFileAtomically(directory->path() / "sweep.json", SweepToJson(sweep));
+    WriteSweepFiles(sweep, directory->path());
+    if (report_in_output) WriteSweepReport(sweep, directory->path());
     directory->Commit();
+  }
+  if (report_directory) {
+    // The per-tau maps are linked from the page: give their final paths.
+    SweepResult linked = sweep;
+    for (SweepRow& row : linked.rows) {
+      if (row.map_directory.empty()) continue;
+      row.map_directory = fs::absolute(fs::path(flags.output) / row.map_directory).string();
+    }
+    WriteSweepFiles(linked, report_directory->path());
+    WriteSweepReport(linked, report_directory->path());
+    report_directory->Commit();
   }
   std::cout << SweepToMarkdown(sweep);
   if (directory) std::cout << "\nwritten to " << flags.output << " (sweep.md, sweep.csv, sweep.json)\n";
-  WriteSweepReportIfAsked(flags.report, sweep, flags.output);
 }
 
 }  // namespace

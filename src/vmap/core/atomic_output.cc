@@ -1,10 +1,22 @@
 #include "vmap/core/atomic_output.h"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <stdio.h>  // renameat2, RENAME_EXCHANGE (glibc >= 2.28)
+#include <sys/stat.h>
 #include <unistd.h>
 
-#include <fstream>
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <mutex>
 #include <random>
+#include <set>
+#include <thread>
 
+#include <spdlog/spdlog.h>
+
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 
 namespace vmap {
@@ -12,79 +24,291 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A unique sibling name; the pid and a random suffix keep concurrent runs apart.
+// The temporaries this process created and has not yet committed or removed.
+struct TemporaryRegistry {
+  std::mutex mutex;
+  std::set<fs::path> paths;
+};
+
+// Never destroyed: an interrupted process cleans up from another thread while main() may be returning.
+TemporaryRegistry& Temporaries() {
+  static TemporaryRegistry* registry = new TemporaryRegistry;
+  return *registry;
+}
+
+// Creates a temporary and registers it in one step under the registry's lock, so that an interruption
+// never finds one created and not yet registered (it would stay behind).
+template <typename Create>
+auto CreateRegistered(const fs::path& path, Create&& create) -> decltype(create()) {
+  std::lock_guard<std::mutex> lock(Temporaries().mutex);
+  auto created = create();
+  if (created) Temporaries().paths.insert(path);
+  return created;
+}
+
+void RemoveAndUnregister(const fs::path& path) {
+  std::error_code ignored;
+  fs::remove_all(path, ignored);
+  std::lock_guard<std::mutex> lock(Temporaries().mutex);
+  Temporaries().paths.erase(path);
+}
+
+constexpr const char* kTemporaryTags[] = {"partial", "old", "tmp"};
+
+// ".NAME.TAG-PID-N": the pid says whose it is (see RemoveStaleTemporaries), N keeps one process's apart.
 fs::path TemporarySibling(const fs::path& path, const char* tag) {
-  std::random_device rd;
+  static std::mutex mutex;
+  static std::mt19937 random{std::random_device{}()};
+  unsigned suffix;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    suffix = random() % 1000000;
+  }
   const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
   return parent / ("." + path.filename().string() + "." + tag + "-" + std::to_string(getpid()) + "-" +
-                   std::to_string(rd() % 1000000));
+                   std::to_string(suffix));
+}
+
+bool AllDigits(const std::string& text) {
+  return !text.empty() && text.size() <= 18 &&
+         text.find_first_not_of("0123456789") == std::string::npos;
+}
+
+// The pid in a temporary's name ".NAME.TAG-PID-N" of `name`, or 0 when `file_name` is not one.
+long TemporaryOwner(const std::string& file_name, const std::string& name) {
+  const std::string prefix = "." + name + ".";
+  if (file_name.compare(0, prefix.size(), prefix) != 0) return 0;
+  const std::string rest = file_name.substr(prefix.size());
+  for (const char* tag : kTemporaryTags) {
+    const std::string tag_prefix = std::string(tag) + "-";
+    if (rest.compare(0, tag_prefix.size(), tag_prefix) != 0) continue;
+    const std::string numbers = rest.substr(tag_prefix.size());
+    const size_t dash = numbers.find('-');
+    if (dash == std::string::npos) return 0;
+    const std::string pid = numbers.substr(0, dash), suffix = numbers.substr(dash + 1);
+    if (!AllDigits(pid) || !AllDigits(suffix)) return 0;
+    return std::stol(pid);
+  }
+  return 0;
+}
+
+// Whether a process with this pid exists (ours included; EPERM means it exists and is another user's).
+bool ProcessRuns(long pid) {
+  if (pid <= 0 || pid > 0x7fffffffL) return true;  // not a pid we can ask about: leave it alone
+  return kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH;
+}
+
+std::string ErrnoText() { return std::strerror(errno); }
+
+[[noreturn]] void Refuse(const fs::path& path, const std::string& why_and_fix) {
+  throw InputError("output '" + path.string() + "' " + why_and_fix);
 }
 
 }  // namespace
 
-void WriteFileAtomically(const fs::path& path, std::string_view content) {
-  const fs::path temp = TemporarySibling(path, "tmp");
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) {
-      throw InputError("cannot write '" + path.string() +
-                       "': the directory does not exist or is not writable; choose another output path");
-    }
-    out.write(content.data(), static_cast<std::streamsize>(content.size()));
-    out.flush();
-    if (!out) {
-      std::error_code ignored;
-      fs::remove(temp, ignored);
-      throw InputError("writing '" + path.string() + "' failed (disk full?)");
+void RemoveStaleTemporaries(const fs::path& path) {
+  const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  const std::string name = path.filename().string();
+  std::error_code ec;
+  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
+    const long pid = TemporaryOwner(it->path().filename().string(), name);
+    if (pid == 0 || ProcessRuns(pid)) continue;
+    std::error_code removed;
+    fs::remove_all(it->path(), removed);
+    if (!removed) {
+      spdlog::info("removed '{}', left behind by vmap process {}, which was killed", it->path().string(), pid);
     }
   }
-  fs::rename(temp, path);
 }
 
-AtomicOutputDirectory::AtomicOutputDirectory(fs::path final_path, const std::string& ownership_marker)
-    : final_path_(std::move(final_path)) {
-  if (final_path_.filename().empty()) final_path_ = final_path_.parent_path();  // "out/" -> "out"
-  if (fs::exists(final_path_)) {
-    if (!fs::is_directory(final_path_)) {
-      throw InputError("output '" + final_path_.string() + "' exists and is not a directory; choose another path");
+int RemoveTemporaryOutputsForExit() {
+  // Locked for good: nothing new is created or committed while the process ends.
+  Temporaries().mutex.lock();
+  int removed = 0;
+  for (const fs::path& path : Temporaries().paths) {
+    // Another thread may still be writing into a directory: a retry takes what appeared meanwhile. Once the
+    // directory itself is gone, nothing recreates it (only the constructor does, under the lock held here).
+    std::error_code ec;
+    for (int attempt = 0; attempt < 1000 && fs::exists(fs::symlink_status(path, ec)); ++attempt) {
+      if (attempt > 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      fs::remove_all(path, ec);
     }
-    const bool empty = fs::directory_iterator(final_path_) == fs::directory_iterator();
-    if (!empty && !ownership_marker.empty() && !fs::exists(final_path_ / ownership_marker)) {
-      throw InputError("output '" + final_path_.string() + "' exists and is not vmap's (it has no " +
-                       ownership_marker + "); vmap will not replace it: choose another output directory");
-    }
+    ++removed;
   }
+  Temporaries().paths.clear();
+  return removed;
+}
+
+void WriteFileAtomically(const fs::path& path, std::string_view content) {
+  RemoveStaleTemporaries(path);
+  fs::path temp;
+  int fd = -1;
+  for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
+    temp = TemporarySibling(path, "tmp");
+    fd = CreateRegistered(temp, [&] {
+      const int opened = open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+      return opened >= 0 ? opened + 1 : 0;  // 0: not created
+    }) - 1;
+    if (fd < 0 && errno != EEXIST) break;
+  }
+  if (fd < 0) {
+    throw InputError("cannot write '" + path.string() + "' (" + ErrnoText() +
+                     "); check that its directory exists and is writable, or choose another output path");
+  }
+  const auto fail = [&](const std::string& what) {
+    const std::string reason = ErrnoText();
+    close(fd);
+    RemoveAndUnregister(temp);
+    throw InputError(what + " '" + path.string() + "' failed (" + reason + "); check the free space and the "
+                     "permissions of its directory");
+  };
+  for (size_t written = 0; written < content.size();) {
+    const ssize_t n = write(fd, content.data() + written, content.size() - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) fail("writing");
+    written += static_cast<size_t>(n);
+  }
+  if (close(fd) != 0) {
+    fd = -1;
+    const std::string reason = ErrnoText();
+    RemoveAndUnregister(temp);
+    throw InputError("writing '" + path.string() + "' failed (" + reason + "); check the free space");
+  }
+  std::unique_lock<std::mutex> lock(Temporaries().mutex);
+  if (rename(temp.c_str(), path.c_str()) != 0) {
+    const std::string reason = ErrnoText();
+    lock.unlock();
+    RemoveAndUnregister(temp);
+    throw InputError("cannot replace '" + path.string() + "' (" + reason + "); check that it is not a folder and "
+                     "that its directory is writable");
+  }
+  Temporaries().paths.erase(temp);
+}
+
+OutputPolicy OutputPolicy::InsideVmapOutput() {
+  OutputPolicy policy;
+  policy.why_not_ours = [](const fs::path&) { return std::string(); };
+  return policy;
+}
+
+AtomicOutputDirectory::AtomicOutputDirectory(fs::path final_path, OutputPolicy policy)
+    : final_path_(std::move(final_path)), policy_(std::move(policy)) {
+  // "out/", "." and ".." name the directory itself.
+  const fs::path name = final_path_.filename();
+  if (name.empty() || name == "." || name == "..") {
+    std::error_code ec;
+    final_path_ = fs::absolute(final_path_, ec).lexically_normal();
+    if (final_path_.filename().empty()) final_path_ = final_path_.parent_path();
+  }
+  if (final_path_.filename().empty() || !final_path_.has_relative_path()) {
+    Refuse(final_path_, "is the root of the file system; choose a directory to write into");
+  }
+  CheckReplaceable();
   const fs::path parent = final_path_.has_parent_path() ? final_path_.parent_path() : fs::path(".");
-  std::error_code ec;
-  fs::create_directories(parent, ec);
-  temp_path_ = TemporarySibling(final_path_, "partial");
-  if (!fs::create_directory(temp_path_, ec) || ec) {
-    throw InputError("cannot create a directory next to '" + final_path_.string() + "' (" + ec.message() +
-                     "); check that '" + parent.string() + "' is writable");
+  RemoveStaleTemporaries(final_path_);
+  for (int attempt = 0; attempt < 100 && temp_path_.empty(); ++attempt) {
+    const fs::path candidate = TemporarySibling(final_path_, "partial");
+    // The parent is created under the registry's lock too: when it lies in another temporary output (a
+    // sweep's map), an interruption that removed that one must not see it recreated.
+    const auto create = [&] {
+      std::error_code ec;
+      fs::create_directories(parent, ec);
+      return mkdir(candidate.c_str(), 0777) == 0;
+    };
+    if (CreateRegistered(candidate, create)) {
+      temp_path_ = candidate;
+    } else if (errno != EEXIST) {
+      throw InputError("cannot create a directory next to '" + final_path_.string() + "' (" + ErrnoText() +
+                       "); check that '" + parent.string() + "' exists and is writable");
+    }
   }
+  if (temp_path_.empty()) throw InputError("cannot create a temporary directory next to '" + final_path_.string() + "'");
 }
 
 AtomicOutputDirectory::~AtomicOutputDirectory() {
-  if (!committed_) {
-    std::error_code ignored;
-    fs::remove_all(temp_path_, ignored);
+  if (!committed_ && !temp_path_.empty()) RemoveAndUnregister(temp_path_);
+}
+
+void AtomicOutputDirectory::CheckReplaceable() const {
+  // The input first: replacing it would be the worst loss, whatever else the folder is.
+  for (const fs::path& input : policy_.inputs) {
+    if (IsSameOrInside(input, final_path_)) {
+      Refuse(final_path_, "is or holds the input '" + input.string() +
+                              "', which replacing it would delete; write the output somewhere else");
+    }
+    if (IsSameOrInside(final_path_, input)) {
+      Refuse(final_path_, "lies inside the input '" + input.string() +
+                              "'; write the output somewhere else than into the input");
+    }
   }
+  std::error_code ec;
+  const fs::file_status status = fs::symlink_status(final_path_, ec);
+  if (ec && status.type() != fs::file_type::not_found) {
+    Refuse(final_path_, "cannot be inspected (" + ec.message() + "); check its permissions or choose another path");
+  }
+  if (fs::exists(status)) {
+    if (fs::is_symlink(status)) {
+      Refuse(final_path_, "is a symbolic link; vmap replaces only a real directory: give the path it points to, "
+                          "or choose another output path");
+    }
+    if (!fs::is_directory(status)) Refuse(final_path_, "exists and is not a directory; choose another path");
+    fs::directory_iterator entries(final_path_, ec);
+    if (ec) Refuse(final_path_, "cannot be read (" + ec.message() + "); check its permissions");
+    if (entries != fs::directory_iterator()) {
+      const std::string why_not = policy_.why_not_ours
+                                      ? RethrowAsInputError(
+                                            [&] {
+                                              return ErrorContext{"cannot inspect output '" + final_path_.string() + "'",
+                                                                  "check its permissions"};
+                                            },
+                                            [&] { return policy_.why_not_ours(final_path_); })
+                                      : std::string("it is not empty");
+      if (!why_not.empty()) {
+        Refuse(final_path_, "exists and is not " + policy_.kind + " (" + why_not +
+                                "), so vmap will not replace it: vmap replaces only an empty folder or " +
+                                policy_.kind + " it wrote. Choose another output directory, or move the folder away "
+                                "yourself");
+      }
+    }
+  }
+
 }
 
 void AtomicOutputDirectory::Commit() {
   if (committed_) return;
-  // rename() cannot replace a non-empty directory: move the old one aside first, then drop it.
-  fs::path old_aside;
-  if (fs::exists(final_path_)) {
-    old_aside = TemporarySibling(final_path_, "old");
-    fs::rename(final_path_, old_aside);
+  CheckReplaceable();  // the folder may have changed while vmap worked
+  fs::path old;        // where the replaced directory ends up, to be removed
+  std::unique_lock<std::mutex> lock(Temporaries().mutex);
+  std::error_code ec;
+  const bool replacing = fs::exists(fs::symlink_status(final_path_, ec));
+  auto fail = [&](const std::string& reason) {
+    throw InputError("cannot move the finished output into place at '" + final_path_.string() + "' (" + reason +
+                     "); check that its directory is writable");
+  };
+  if (!replacing) {
+    if (rename(temp_path_.c_str(), final_path_.c_str()) != 0) fail(ErrnoText());
+    Temporaries().paths.erase(temp_path_);
+  } else if (renameat2(AT_FDCWD, temp_path_.c_str(), AT_FDCWD, final_path_.c_str(), RENAME_EXCHANGE) == 0) {
+    old = temp_path_;  // still registered: it now holds the replaced directory
+  } else if (errno == EINVAL || errno == ENOSYS || errno == ENOTSUP) {
+    // No atomic exchange on this file system: move the old directory aside first. An interruption between
+    // the two renames is excluded by the registry's lock; only SIGKILL could leave the old copy aside.
+    old = TemporarySibling(final_path_, "old");
+    if (rename(final_path_.c_str(), old.c_str()) != 0) fail(ErrnoText());
+    Temporaries().paths.insert(old);
+    if (rename(temp_path_.c_str(), final_path_.c_str()) != 0) {
+      const std::string reason = ErrnoText();
+      rename(old.c_str(), final_path_.c_str());  // put the old directory back
+      Temporaries().paths.erase(old);
+      fail(reason);
+    }
+    Temporaries().paths.erase(temp_path_);
+  } else {
+    fail(ErrnoText());
   }
-  fs::rename(temp_path_, final_path_);
   committed_ = true;
-  if (!old_aside.empty()) {
-    std::error_code ignored;
-    fs::remove_all(old_aside, ignored);
-  }
+  lock.unlock();
+  if (!old.empty()) RemoveAndUnregister(old);
 }
 
 }  // namespace vmap

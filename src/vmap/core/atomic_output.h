@@ -1,40 +1,78 @@
 #pragma once
-// Outputs are written so that an interrupted run never leaves a half-written file or map behind:
-// everything goes to a temporary sibling first and is renamed into place at the end.
+// Outputs are written so that an interrupted run never leaves a half-written file or map behind, and so that
+// vmap never replaces anything it cannot prove it wrote:
+// - everything goes to a temporary sibling first (".NAME.partial-PID-N", ".NAME.tmp-PID-N") and is renamed
+//   into place at the end;
+// - every temporary is registered while it exists, so that an interrupted run can remove them
+//   (RemoveTemporaryOutputsForExit, called by the interrupt handling of interrupt.h);
+// - a temporary left by a run that was killed outright (SIGKILL, power loss) is removed by the next run that
+//   writes to the same place, once its PID no longer runs; a live process's temporaries are never touched;
+// - an existing directory is replaced only when it is empty or its owner's proof says it is vmap's (a map
+//   folder whose map.json is a vmap map, ...), and never when it is, holds or lies inside an input.
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace vmap {
 
 // Writes `content` to `path` through a temporary file in the same directory and a rename.
 void WriteFileAtomically(const std::filesystem::path& path, std::string_view content);
 
-// A directory that only appears under its final name once Commit() is called. Until then the
-// work happens in a hidden temporary sibling, removed if the object is destroyed uncommitted.
+// What an output directory may replace, and what it must never touch.
+struct OutputPolicy {
+  // Proves that an existing, non-empty directory is one vmap wrote: returns "" when it is, or why it is not
+  // ("its map.json is not a vmap map"), which the refusal shows. Null: only an absent or empty directory is
+  // ever replaced. Core stays generic: the stage that writes the files knows how to recognise them.
+  std::function<std::string(const std::filesystem::path& directory)> why_not_ours;
+  // What such a directory is, for messages: "a vmap map".
+  std::string kind = "a vmap output";
+  // What the command reads. The output may not be one of them, hold one or lie inside one (compared as the
+  // directories they resolve to, through symbolic links and bind mounts).
+  std::vector<std::filesystem::path> inputs;
+
+  // For a directory inside one already proven to be vmap's (a map's report/ assets): anything goes.
+  static OutputPolicy InsideVmapOutput();
+};
+
+// A directory that only appears under its final name once Commit() is called. Until then the work happens
+// in a hidden temporary sibling, removed if the object is destroyed uncommitted (or the process interrupted).
 class AtomicOutputDirectory {
  public:
-  // An existing directory at `final_path` is replaced on Commit() only when it is empty or holds the file
-  // `ownership_marker` (e.g. "map.json": an older map), so that a mistyped -o never deletes a user's
-  // folder. kReplaceAnything is for directories vmap owns outright (a map's report assets).
-  AtomicOutputDirectory(std::filesystem::path final_path, const std::string& ownership_marker);
-  static constexpr const char* kReplaceAnything = "";
+  // Checks the policy now (throws InputError saying why and what to do), so that a refusal comes before any
+  // work, and again in Commit().
+  AtomicOutputDirectory(std::filesystem::path final_path, OutputPolicy policy);
   ~AtomicOutputDirectory();
   AtomicOutputDirectory(const AtomicOutputDirectory&) = delete;
   AtomicOutputDirectory& operator=(const AtomicOutputDirectory&) = delete;
 
-  // The directory to write into now.
+  // The directory to write into now. Create what goes inside it with create_directory, never
+  // create_directories: an interruption removes this directory from another thread, and a recursive creation
+  // racing with that removal would bring it back, to stay behind.
   const std::filesystem::path& path() const { return temp_path_; }
   const std::filesystem::path& final_path() const { return final_path_; }
 
-  // Moves the finished directory into place (replacing an older one).
+  // Moves the finished directory into place, replacing an older one in one atomic step where the file system
+  // can (renameat2 RENAME_EXCHANGE), so that the final path always holds a complete directory.
   void Commit();
 
  private:
+  void CheckReplaceable() const;
+
   std::filesystem::path final_path_;
+  OutputPolicy policy_;
   std::filesystem::path temp_path_;
   bool committed_ = false;
 };
+
+// Removes the temporaries of dead processes next to `path` (".NAME.partial-PID-N" and the like, NAME being
+// `path`'s file name). Called by every output before it writes; exposed for tests.
+void RemoveStaleTemporaries(const std::filesystem::path& path);
+
+// Removes every temporary output this process still has, and keeps them from being created or committed from
+// then on: for the last moments of an interrupted process only. Returns how many were removed.
+int RemoveTemporaryOutputsForExit();
 
 }  // namespace vmap

@@ -1,5 +1,8 @@
 #include "vmap/core/atomic_output.h"
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <fstream>
 
 #include <gtest/gtest.h>
@@ -10,78 +13,230 @@
 namespace vmap {
 namespace fs = std::filesystem;
 
+namespace {
+
 std::string ReadAll(const fs::path& p) {
   std::ifstream in(p);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
+long CountEntries(const fs::path& directory) {
+  return std::distance(fs::directory_iterator(directory), fs::directory_iterator());
+}
+
+// A test owner: a directory is ours when its "owner.txt" says "vmap".
+OutputPolicy MarkerPolicy(std::vector<fs::path> inputs = {}) {
+  OutputPolicy policy;
+  policy.kind = "a test output";
+  policy.why_not_ours = [](const fs::path& directory) {
+    return ReadAll(directory / "owner.txt") == "vmap" ? std::string() : std::string("owner.txt does not say vmap");
+  };
+  policy.inputs = std::move(inputs);
+  return policy;
+}
+
+void MakeOwned(const fs::path& directory) {
+  fs::create_directories(directory);
+  std::ofstream(directory / "owner.txt") << "vmap";
+  std::ofstream(directory / "old.txt") << "old";
+}
+
+std::string RefusalOf(const fs::path& target, const OutputPolicy& policy) {
+  try {
+    AtomicOutputDirectory directory(target, policy);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+// The pid of a process that has ended.
+pid_t DeadPid() {
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  waitpid(child, nullptr, 0);
+  return child;
+}
+
+}  // namespace
+
 TEST(AtomicOutput, DirectoryAppearsOnlyOnCommit) {
   testing::TempDir tmp;
   const fs::path target = tmp.path() / "map";
   {
-    AtomicOutputDirectory dir(target, "marker");
+    AtomicOutputDirectory dir(target, MarkerPolicy());
     std::ofstream(dir.path() / "a.txt") << "hello";
     EXPECT_FALSE(fs::exists(target));
     dir.Commit();
   }
   EXPECT_EQ(ReadAll(target / "a.txt"), "hello");
-  EXPECT_EQ(std::distance(fs::directory_iterator(tmp.path()), fs::directory_iterator()), 1);
+  EXPECT_EQ(CountEntries(tmp.path()), 1);
 }
 
 TEST(AtomicOutput, UncommittedDirectoryLeavesNothingAndKeepsTheOldOne) {
   testing::TempDir tmp;
   const fs::path target = tmp.path() / "map";
-  fs::create_directories(target);
-  std::ofstream(target / "old.txt") << "old";
-  std::ofstream(target / "marker") << "";
+  MakeOwned(target);
   {
-    AtomicOutputDirectory dir(target, "marker");
+    AtomicOutputDirectory dir(target, MarkerPolicy());
     std::ofstream(dir.path() / "new.txt") << "new";
     // destroyed without Commit: as if the build failed half-way
   }
   EXPECT_TRUE(fs::exists(target / "old.txt"));
   EXPECT_FALSE(fs::exists(target / "new.txt"));
-  EXPECT_EQ(std::distance(fs::directory_iterator(tmp.path()), fs::directory_iterator()), 1);
+  EXPECT_EQ(CountEntries(tmp.path()), 1);
 }
 
-TEST(AtomicOutput, CommitReplacesAnOlderDirectory) {
+TEST(AtomicOutput, CommitReplacesAnOlderDirectoryAndLeavesNothingElse) {
   testing::TempDir tmp;
   const fs::path target = tmp.path() / "map";
-  fs::create_directories(target);
-  std::ofstream(target / "old.txt") << "old";
-  std::ofstream(target / "marker") << "";
-  AtomicOutputDirectory dir(target, "marker");
+  MakeOwned(target);
+  AtomicOutputDirectory dir(target, MarkerPolicy());
   std::ofstream(dir.path() / "new.txt") << "new";
   dir.Commit();
   EXPECT_FALSE(fs::exists(target / "old.txt"));
   EXPECT_EQ(ReadAll(target / "new.txt"), "new");
+  EXPECT_EQ(CountEntries(tmp.path()), 1) << "the old directory is removed";
 }
 
-TEST(AtomicOutput, RefusesToReplaceAFile) {
+TEST(AtomicOutput, RefusesToReplaceAFileOrASymbolicLink) {
   testing::TempDir tmp;
   std::ofstream(tmp.path() / "file") << "x";
-  EXPECT_THROW(AtomicOutputDirectory(tmp.path() / "file", "marker"), InputError);
+  EXPECT_NE(RefusalOf(tmp.path() / "file", MarkerPolicy()).find("not a directory"), std::string::npos);
+  MakeOwned(tmp.path() / "owned");
+  fs::create_directory_symlink(tmp.path() / "owned", tmp.path() / "link");
+  EXPECT_NE(RefusalOf(tmp.path() / "link", MarkerPolicy()).find("symbolic link"), std::string::npos);
+  EXPECT_EQ(ReadAll(tmp.path() / "file"), "x");
+  EXPECT_EQ(ReadAll(tmp.path() / "owned/old.txt"), "old");
 }
 
-TEST(AtomicOutput, NeverReplacesADirectoryItDoesNotOwn) {
+TEST(AtomicOutput, NeverReplacesADirectoryItCannotProveItsOwn) {
   testing::TempDir tmp;
-  const fs::path target = tmp.path() / "documents";
-  fs::create_directories(target);
-  std::ofstream(target / "thesis.tex") << "precious";
-  EXPECT_THROW(AtomicOutputDirectory(target, "map.json"), InputError);
-  EXPECT_EQ(ReadAll(target / "thesis.tex"), "precious");
-  // An empty directory may be used.
+  const fs::path documents = tmp.path() / "documents";
+  fs::create_directories(documents / ".git");
+  std::ofstream(documents / "thesis.tex") << "precious";
+  // No proof file, a proof that says otherwise, and no proof function at all (only empty folders then).
+  const std::string refusal = RefusalOf(documents, MarkerPolicy());
+  EXPECT_NE(refusal.find("will not replace it"), std::string::npos) << refusal;
+  EXPECT_NE(refusal.find("owner.txt does not say vmap"), std::string::npos) << refusal;
+  std::ofstream(documents / "owner.txt") << "someone else";
+  EXPECT_NE(RefusalOf(documents, MarkerPolicy()), "");
+  std::ofstream(documents / "owner.txt") << "vmap";
+  EXPECT_NE(RefusalOf(documents, OutputPolicy{}).find("not empty"), std::string::npos);
+  EXPECT_EQ(ReadAll(documents / "thesis.tex"), "precious");
+  EXPECT_TRUE(fs::is_directory(documents / ".git"));
+  // An empty directory may be used, by any policy.
   fs::create_directories(tmp.path() / "empty");
-  AtomicOutputDirectory empty(tmp.path() / "empty", "map.json");
+  AtomicOutputDirectory empty(tmp.path() / "empty", OutputPolicy{});
   empty.Commit();
+}
+
+TEST(AtomicOutput, TheProofIsCheckedAgainWhenCommitting) {
+  testing::TempDir tmp;
+  const fs::path target = tmp.path() / "map";
+  MakeOwned(target);
+  AtomicOutputDirectory dir(target, MarkerPolicy());
+  // While vmap worked, the folder became someone else's.
+  std::ofstream(target / "owner.txt") << "user";
+  std::ofstream(target / "notes.txt") << "mine";
+  EXPECT_THROW(dir.Commit(), InputError);
+  EXPECT_EQ(ReadAll(target / "notes.txt"), "mine");
+  // The same for a folder that appears while vmap works.
+  AtomicOutputDirectory fresh(tmp.path() / "fresh", MarkerPolicy());
+  fs::create_directories(tmp.path() / "fresh");
+  std::ofstream(tmp.path() / "fresh/notes.txt") << "mine";
+  EXPECT_THROW(fresh.Commit(), InputError);
+  EXPECT_EQ(ReadAll(tmp.path() / "fresh/notes.txt"), "mine");
+}
+
+TEST(AtomicOutput, NeverReplacesItsInputNorWritesIntoIt) {
+  testing::TempDir tmp;
+  const fs::path map = tmp.path() / "map";
+  MakeOwned(map);
+  fs::create_directories(map / "keys");
+  std::ofstream(map / "keys/000000.png") << "image";
+  fs::create_directories(tmp.path() / "sequence");
+  fs::create_directory_symlink(map / "keys", tmp.path() / "keys_link");
+  struct Case {
+    fs::path output, input;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {map, map, "is or holds the input"},                                    // the same folder
+      {map, map / "keys", "is or holds the input"},                           // the input inside
+      {map, map / "keys/000000.png", "is or holds the input"},                // a file inside
+      {map, tmp.path() / "keys_link", "is or holds the input"},               // through a symbolic link
+      {map, tmp.path() / "sequence/../map/keys", "is or holds the input"},    // through ".."
+      {tmp.path() / "sequence/out", tmp.path() / "sequence", "lies inside the input"},
+      {map / "keys/new", map, "lies inside the input"},
+  };
+  for (const Case& c : cases) {
+    const std::string refusal = RefusalOf(c.output, MarkerPolicy({c.input}));
+    EXPECT_NE(refusal.find(c.expected), std::string::npos) << c.output << " <- " << c.input << ": " << refusal;
+  }
+  EXPECT_EQ(ReadAll(map / "keys/000000.png"), "image");
+  // An unrelated input is fine.
+  AtomicOutputDirectory elsewhere(map, MarkerPolicy({tmp.path() / "sequence"}));
+  elsewhere.Commit();
+}
+
+TEST(AtomicOutput, StaleTemporariesOfDeadProcessesAreRemovedAndLiveOnesKept) {
+  testing::TempDir tmp;
+  const std::string dead = std::to_string(DeadPid()), alive = std::to_string(getpid());
+  const std::vector<std::string> stale = {".map.partial-" + dead + "-12", ".map.old-" + dead + "-3",
+                                          ".map.tmp-" + dead + "-4"};
+  const std::vector<std::string> kept = {".map.partial-" + alive + "-5",  // this process: alive
+                                         ".map.partial-1-6",              // init: alive
+                                         ".other.partial-" + dead + "-7", // another output's
+                                         ".map.partial-" + dead + "-x",   // not vmap's pattern
+                                         ".map.backup-" + dead + "-8", "map.partial-" + dead + "-9"};
+  for (const std::string& name : stale) {
+    fs::create_directories(tmp.path() / name / "keys");
+    std::ofstream(tmp.path() / name / "keys/a.png") << "x";
+  }
+  for (const std::string& name : kept) fs::create_directories(tmp.path() / name);
+  AtomicOutputDirectory dir(tmp.path() / "map", MarkerPolicy());
+  for (const std::string& name : stale) EXPECT_FALSE(fs::exists(tmp.path() / name)) << name;
+  for (const std::string& name : kept) EXPECT_TRUE(fs::exists(tmp.path() / name)) << name;
+
+  // WriteFileAtomically does the same for its ".NAME.tmp-PID-N" files.
+  std::ofstream(tmp.path() / (".f.json.tmp-" + dead + "-1")) << "half";
+  std::ofstream(tmp.path() / (".f.json.tmp-" + alive + "-2")) << "being written";
+  WriteFileAtomically(tmp.path() / "f.json", "{}");
+  EXPECT_FALSE(fs::exists(tmp.path() / (".f.json.tmp-" + dead + "-1")));
+  EXPECT_TRUE(fs::exists(tmp.path() / (".f.json.tmp-" + alive + "-2")));
 }
 
 TEST(AtomicOutput, WriteFileAtomicallyWritesContentAndNoTemporaries) {
   testing::TempDir tmp;
   WriteFileAtomically(tmp.path() / "f.json", "{\"a\": 1}");
   EXPECT_EQ(ReadAll(tmp.path() / "f.json"), "{\"a\": 1}");
-  EXPECT_EQ(std::distance(fs::directory_iterator(tmp.path()), fs::directory_iterator()), 1);
+  WriteFileAtomically(tmp.path() / "f.json", "{\"a\": 2}");
+  EXPECT_EQ(ReadAll(tmp.path() / "f.json"), "{\"a\": 2}");
+  EXPECT_EQ(CountEntries(tmp.path()), 1);
   EXPECT_THROW(WriteFileAtomically(tmp.path() / "missing_dir" / "f.json", "x"), InputError);
+  fs::create_directories(tmp.path() / "folder/inside");
+  EXPECT_THROW(WriteFileAtomically(tmp.path() / "folder", "x"), InputError);
+  EXPECT_TRUE(fs::is_directory(tmp.path() / "folder/inside"));
+  EXPECT_EQ(CountEntries(tmp.path()), 2);
+}
+
+TEST(AtomicOutputDeathTest, RemovingTemporariesForExitTakesEveryUnfinishedOutput) {
+  testing::TempDir tmp;
+  const fs::path target = tmp.path() / "map";
+  MakeOwned(target);
+  // In a child process: the registry stays locked afterwards, as for a process about to end.
+  EXPECT_EXIT(
+      {
+        AtomicOutputDirectory dir(target, MarkerPolicy());
+        std::ofstream(dir.path() / "half.txt") << "half";
+        AtomicOutputDirectory other(tmp.path() / "other", MarkerPolicy());
+        const int removed = RemoveTemporaryOutputsForExit();
+        _exit(removed == 2 && !fs::exists(dir.path()) && !fs::exists(other.path()) ? 0 : 1);
+      },
+      ::testing::ExitedWithCode(0), "");
+  EXPECT_EQ(CountEntries(tmp.path()), 1);
+  EXPECT_EQ(ReadAll(target / "old.txt"), "old");
 }
 
 }  // namespace vmap

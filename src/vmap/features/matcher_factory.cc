@@ -6,9 +6,10 @@
 namespace vmap {
 
 void MatcherOptions::Check() const {
-  if (type == "orb") orb.Check();
-  else if (type == "loftr") loftr.Check();
-  else throw InputError("unknown matcher '" + type + "'; use orb or loftr");
+  if (type != "orb" && type != "loftr") throw InputError("unknown matcher '" + type + "'; use orb or loftr");
+  // The options of every matcher, used or not: an absurd value (NaN, out of range) is a mistake either way.
+  orb.Check();
+  loftr.Check();
 }
 
 std::unique_ptr<Matcher> CreateMatcher(const MatcherOptions& options) {

@@ -1,6 +1,7 @@
 #include "vmap/features/orb_matcher.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -17,12 +18,20 @@
 namespace vmap {
 
 void OrbMatcherOptions::Check() const {
-  if (num_features < 1) throw InputError("--orb-features must be >= 1 (default 500)");
-  if (!(scale_factor > 1.0)) throw InputError("--orb-scale-factor must be > 1 (default 1.2)");
-  if (num_levels < 1) throw InputError("--orb-levels must be >= 1 (default 8)");
-  if (edge_threshold < 0) throw InputError("--orb-edge-threshold must be >= 0 (default 31)");
-  if (fast_threshold < 1) throw InputError("--orb-fast-threshold must be >= 1 (default 20)");
-  if (ratio < 0.0 || ratio > 1.0) throw InputError("--ratio must be in [0, 1] (0 disables the ratio test)");
+  if (num_features < 1 || num_features > 100000) {
+    throw InputError("--orb-features must be 1 to 100000 (default 500)");
+  }
+  if (!(scale_factor > 1.0 && scale_factor <= 4.0)) {
+    throw InputError("--orb-scale-factor must be in (1, 4] (default 1.2)");
+  }
+  if (num_levels < 1 || num_levels > 32) throw InputError("--orb-levels must be 1 to 32 (default 8)");
+  if (edge_threshold < 0 || edge_threshold > 1000) {
+    throw InputError("--orb-edge-threshold must be 0 to 1000 pixels (default 31)");
+  }
+  if (fast_threshold < 1 || fast_threshold > 255) {
+    throw InputError("--orb-fast-threshold must be 1 to 255 (default 20)");
+  }
+  if (!(ratio >= 0.0 && ratio <= 1.0)) throw InputError("--ratio must be in [0, 1] (0 disables the ratio test)");
 }
 
 namespace {
@@ -62,6 +71,9 @@ class OrbMatcher : public Matcher {
                                            cv::ORB::HARRIS_SCORE, 31, options_.fast_threshold);
     auto features = std::make_shared<OrbFeatures>();
     features->size = gray.size();
+    // OpenCV's pyramid fails on a level that rounds to no pixel: such an image has no ORB features.
+    const double smallest_level = std::min(gray.cols, gray.rows) / std::pow(options_.scale_factor, options_.num_levels - 1);
+    if (gray.empty() || smallest_level < 1.0) return features;
     orb->detectAndCompute(gray, cv::noArray(), features->keypoints, features->binary_descriptors);
     if (features->binary_descriptors.empty()) features->keypoints.clear();
     return features;

@@ -36,8 +36,8 @@ void RankingOptions::Check() const {
   if (!(min_cosine > -1.0 && min_cosine < 1.0)) {
     throw InputError(fmt::format("ranking min_cosine = {} is outside (-1, 1) (default 0.8)", min_cosine));
   }
-  if (max_descriptors_per_key < 0) {
-    throw InputError("ranking max_descriptors_per_key must be >= 0 (0 = all; default 250)");
+  if (max_descriptors_per_key < 0 || max_descriptors_per_key > 100000) {
+    throw InputError("ranking max_descriptors_per_key must be 0 (all) to 100000 (default 250)");
   }
   if (thumbnail_width < 8 || thumbnail_width > 512) {
     throw InputError(fmt::format("thumbnail width {} is outside [8, 512] (default 48)", thumbnail_width));

@@ -145,7 +145,12 @@ void ComputeKeyImages(const fs::path& map_directory, const VisualMap& map, const
       for (size_t k = next++; k < n; k = next++) {
         const fs::path file = map_directory / map.key_images[k].image_file;
         // Grey straight from the decoder, as the image sources read frames.
-        const cv::Mat gray = cv::imread(file.string(), cv::IMREAD_GRAYSCALE);
+        cv::Mat gray;
+        try {
+          gray = cv::imread(file.string(), cv::IMREAD_GRAYSCALE);
+        } catch (const cv::Exception&) {
+          gray.release();
+        }
         if (gray.empty()) {
           throw InputError("key image '" + file.string() + "' cannot be decoded; rebuild the map with `vmap build`");
         }
@@ -185,7 +190,9 @@ void KeyImageStoreOptions::Check() const {
   if (thumbnail_width < 8 || thumbnail_width > 512) {
     throw InputError(fmt::format("thumbnail width {} is outside [8, 512] (default 48)", thumbnail_width));
   }
-  if (extraction_threads < 0) throw InputError("key-image extraction threads must be >= 0 (0 = one per core)");
+  if (extraction_threads < 0 || extraction_threads > 256) {
+    throw InputError("key-image extraction threads must be 0 to 256 (0 = one per core)");
+  }
 }
 
 KeyImageStore LoadKeyImageStore(const fs::path& map_directory, const VisualMap& map, const Matcher& matcher,

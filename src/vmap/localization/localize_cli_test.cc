@@ -203,6 +203,37 @@ TEST(LocalizeCli, EvalCorridorRuns) {
   EXPECT_EQ(Lines(csv).size(), 51u);
 }
 
+TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
+  ::vmap::testing::TempDir tmp;
+  ::vmap::testing::SyntheticOptions synthetic;
+  synthetic.num_frames = 6;
+  ::vmap::testing::WriteImageFolder(::vmap::testing::RenderSyntheticSequence(synthetic), tmp.path() / "in");
+  std::string out;
+  ASSERT_EQ(RunVmap("build " + Quote(tmp.path() / "in") + " -q -o " + Quote(tmp.path() / "m"), &out), 0) << out;
+  const std::string localize = "localize " + Quote(tmp.path() / "m") + " " + Quote(tmp.path() / "in") + " ";
+  struct Case {
+    std::string arguments, expected;
+  };
+  const std::vector<Case> cases = {
+      {localize + "--threads 40000", "--threads must be 0 to 256"},
+      {localize + "--min-verified 3", "--min-verified 3 must be 8"},
+      {localize + "--min-similarity nan", "--min-similarity nan is outside [0, 1]"},
+      {localize + "--candidates 0", "--candidates 0 must be 1 to 10000"},
+      {localize + "--max-lost -1", "--max-lost -1 must be 0 to 1000000"},
+      {localize + "--lookahead 3", "lookahead 3 is not 1 or 2"},
+      {localize + "--ranking bow", "unknown ranking 'bow'"},
+      {localize + "--to 99", "key image 99 does not exist"},
+      {"localize " + Quote(tmp.path() / "m") + " " + Quote(tmp.path() / "missing.mp4"), "does not exist"},
+      {"route " + Quote(tmp.path() / "m") + " --min-backward-verified 2", "--min-backward-verified 2 must be 8"},
+  };
+  for (const Case& c : cases) {
+    EXPECT_EQ(RunVmap(c.arguments, &out), 2) << c.arguments << "\n" << out;
+    EXPECT_EQ(out.find("vmap: error: "), 0u) << c.arguments << "\n" << out;
+    EXPECT_NE(out.find(c.expected), std::string::npos) << c.arguments << "\n" << out;
+    EXPECT_FALSE(fs::exists(tmp.path() / "m" / kLocalizationCacheFileName)) << "work was done: " << c.arguments;
+  }
+}
+
 // The bracket test on a subset: a map of the even frames, and each odd frame localized at one of the two key
 // images around it (the README has the full sequences).
 double BracketShare(const std::string& sequence, int last) {

@@ -20,8 +20,10 @@ int LocalizeSequenceOptions::ExtractionThreads() const {
 }
 
 void LocalizeSequenceOptions::Check() const {
-  if (extraction_threads < 0) throw InputError("--threads must be >= 0 (0 = one per core)");
-  if (prefetch_frames < 1) throw InputError("prefetch_frames must be >= 1 (default 4)");
+  if (extraction_threads < 0 || extraction_threads > 256) {
+    throw InputError("--threads must be 0 to 256 (0 = one per core)");
+  }
+  if (prefetch_frames < 1 || prefetch_frames > 1024) throw InputError("prefetch_frames must be 1 to 1024 (default 4)");
 }
 
 namespace {

@@ -48,17 +48,19 @@ std::string LocalizationStatusName(LocalizationStatus status) {
 }
 
 void LocalizerOptions::Check() const {
-  if (min_verified < 8) {
-    throw InputError(fmt::format("--min-verified {} is below 8, the fewest matches F can be verified with "
-                                 "(default 20)", min_verified));
+  if (min_verified < 8 || min_verified > 100000) {
+    throw InputError(fmt::format("--min-verified {} must be 8 (the fewest matches F can be verified with) to "
+                                 "100000 (default 20)", min_verified));
   }
   if (!(min_similarity >= 0.0 && min_similarity <= 1.0)) {
     throw InputError(fmt::format("--min-similarity {} is outside [0, 1] (default 0.3)", min_similarity));
   }
   if (lookahead < 1 || lookahead > 2) throw InputError(fmt::format("lookahead {} is not 1 or 2 (default 2)", lookahead));
-  if (max_lost_frames < 0) throw InputError(fmt::format("--max-lost {} must be >= 0 (default 5)", max_lost_frames));
-  if (relocalization_candidates < 1) {
-    throw InputError(fmt::format("--candidates {} must be >= 1 (default 5)", relocalization_candidates));
+  if (max_lost_frames < 0 || max_lost_frames > 1000000) {
+    throw InputError(fmt::format("--max-lost {} must be 0 to 1000000 (default 5)", max_lost_frames));
+  }
+  if (relocalization_candidates < 1 || relocalization_candidates > 10000) {
+    throw InputError(fmt::format("--candidates {} must be 1 to 10000 (default 5)", relocalization_candidates));
   }
   ranking.Check();
   verifier.Check();

@@ -10,9 +10,9 @@
 namespace vmap {
 
 void RouteOptions::Check() const {
-  if (min_backward_verified < 8) {
-    throw InputError(fmt::format("min_backward_verified = {} is below 8, the fewest matches F can be verified with "
-                                 "(default 20)", min_backward_verified));
+  if (min_backward_verified < 8 || min_backward_verified > 100000) {
+    throw InputError(fmt::format("--min-backward-verified {} must be 8 (the fewest matches F can be verified "
+                                 "with) to 100000 (default 20)", min_backward_verified));
   }
 }
 

@@ -26,8 +26,10 @@ namespace fs = std::filesystem;
 void MapBuilderOptions::Check() const {
   key_images.Check();
   verifier.Check();
-  if (prefetch_frames < 1) throw InputError("prefetch_frames must be >= 1");
-  if (extraction_threads < 0) throw InputError("--threads must be >= 0 (0 = one per core)");
+  if (prefetch_frames < 1 || prefetch_frames > 1024) throw InputError("prefetch_frames must be 1 to 1024");
+  if (extraction_threads < 0 || extraction_threads > kMaxExtractionThreads) {
+    throw InputError("--threads must be 0 to " + std::to_string(kMaxExtractionThreads) + " (0 = one per core)");
+  }
 }
 
 int MapBuilderOptions::ExtractionThreads() const {
@@ -70,19 +72,18 @@ class FeaturePipeline {
  public:
   FeaturePipeline(FrameSource& source, const Matcher& matcher, int depth, int workers, CompareFn compare)
       : source_(source), matcher_(matcher), compare_(std::move(compare)), depth_(std::max(depth, workers + 1)) {
-    reader_ = std::thread([this] { Guard([this] { ReadFrames(); }); });
-    for (int i = 0; i < workers; ++i) workers_.emplace_back([this] { Guard([this] { ExtractFeatures(); }); });
+    try {
+      reader_ = std::thread([this] { Guard([this] { ReadFrames(); }); });
+      for (int i = 0; i < workers; ++i) workers_.emplace_back([this] { Guard([this] { ExtractFeatures(); }); });
+    } catch (const std::system_error& error) {
+      // The system refused a thread (a process limit): stop those already started, or their destructors abort.
+      Stop();
+      throw InputError("cannot start " + std::to_string(workers + 1) + " threads (" + error.what() +
+                       "); use fewer with --threads");
+    }
   }
 
-  ~FeaturePipeline() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
-    }
-    changed_.notify_all();
-    reader_.join();
-    for (std::thread& worker : workers_) worker.join();
-  }
+  ~FeaturePipeline() { Stop(); }
 
   // The key images (distinct) that frames extracted from now on are compared with, each with the lowest
   // tau of the selectors holding it: a frame below that similarity makes all of them leave the key.
@@ -124,6 +125,16 @@ class FeaturePipeline {
     }
   }
 
+  void Stop() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    changed_.notify_all();
+    if (reader_.joinable()) reader_.join();
+    for (std::thread& worker : workers_) worker.join();
+  }
+
   int InFlight() const { return static_cast<int>(decoded_.size() + ready_.size()) + extracting_; }
   bool AllDone() const { return reader_done_ && decoded_.empty() && extracting_ == 0; }
 
@@ -157,7 +168,14 @@ class FeaturePipeline {
         ++extracting_;
       }
       PipelineItem item;
-      item.record.features = matcher_.Extract(decoded.second.gray);
+      const Frame& frame = decoded.second;
+      item.record.features = RethrowAsInputError(
+          [&] {
+            return ErrorContext{"the " + matcher_.name() + " matcher failed on frame " +
+                                    std::to_string(frame.source_index) + " (" + frame.source_name + ")",
+                                "check the frame, or try other matcher options"};
+          },
+          [&] { return matcher_.Extract(frame.gray); });
       item.record.frame = std::make_shared<const Frame>(std::move(decoded.second));
       ++extracted_;
       const int frame_index = item.record.frame->index;
@@ -253,7 +271,9 @@ class KeyImageFileWriter {
   // A callback for KeyImageSelector that writes each key image into directory/keys/; null without a directory.
   KeyImageSelector::KeyImageFn CallbackFor(const fs::path& directory) {
     if (directory.empty()) return nullptr;
-    fs::create_directories(directory / "keys");
+    // Not create_directories: `directory` is or lies in a temporary output, and once an interruption has
+    // removed that, nothing may bring it back (AtomicOutputDirectory::path()). It must exist.
+    fs::create_directory(directory / "keys");
     return [this, directory](const FrameRecord& record, KeyImage& key) {
       key.image_file = KeyImageFileName(key.frame_index);
       std::lock_guard<std::mutex> lock(mutex_);
@@ -330,12 +350,17 @@ std::vector<double> ParseThresholds(const std::string& text) {
   double start, stop, step;
   char extra;
   if (std::sscanf(text.c_str(), "%lf:%lf:%lf%c", &start, &stop, &step, &extra) == 3) {
-    if (!(step > 0) || stop < start) {
+    if (!std::isfinite(start) || !std::isfinite(stop) || !(step > 0) || !std::isfinite(step) || stop < start) {
       throw InputError("--thresholds '" + text + "' must be start:stop:step with step > 0 and stop >= start");
     }
-    // Count steps with a tolerance so that 0.1:0.9:0.1 includes 0.9.
-    const int count = static_cast<int>(std::floor((stop - start) / step + 1e-9)) + 1;
-    for (int i = 0; i < count; ++i) taus.push_back(std::round((start + i * step) * 1e9) / 1e9);
+    // Count steps with a tolerance so that 0.1:0.9:0.1 includes 0.9; counted in double before anything is
+    // allocated, so that a tiny step is refused rather than filling the memory.
+    const double count = std::floor((stop - start) / step + 1e-9) + 1;
+    if (count > kMaxThresholds) {
+      throw InputError(fmt::format("--thresholds '{}' gives {:.0f} thresholds, more than {}; use a larger step",
+                                   text, count, kMaxThresholds));
+    }
+    for (int i = 0; i < static_cast<int>(count); ++i) taus.push_back(std::round((start + i * step) * 1e9) / 1e9);
   } else {
     std::stringstream list(text);
     std::string item;
@@ -347,13 +372,19 @@ std::vector<double> ParseThresholds(const std::string& text) {
       } catch (const std::exception&) {
         throw InputError("--thresholds '" + text + "' is not start:stop:step (0.1:0.9:0.1) or a list (0.2,0.5)");
       }
+      if (taus.size() > kMaxThresholds) {
+        throw InputError("--thresholds '" + text + "' lists more than " + std::to_string(kMaxThresholds) + " thresholds");
+      }
     }
   }
   if (taus.empty()) throw InputError("--thresholds '" + text + "' gives no threshold");
-  for (double tau : taus) {
+  for (size_t i = 0; i < taus.size(); ++i) {
     KeyImageOptions check;
-    check.tau = tau;
+    check.tau = taus[i];
     check.Check();
+    for (size_t j = 0; j < i; ++j) {
+      if (taus[j] == taus[i]) throw InputError(fmt::format("--thresholds '{}' gives tau = {} twice", text, taus[i]));
+    }
   }
   return taus;
 }
@@ -372,7 +403,16 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
   std::atomic<long> pairs_matched{0};
   const CompareFn compare_pair = [&](const FrameRecord& key, const FrameRecord& frame) {
     ++pairs_matched;
-    return ComparePair(matcher, *key.features, *frame.features, options.verifier, options.key_images.similarity);
+    return RethrowAsInputError(
+        [&] {
+          return ErrorContext{"matching frame " + std::to_string(frame.frame->source_index) + " (" +
+                                  frame.frame->source_name + ") with key image " +
+                                  std::to_string(key.frame->source_index) + " (" + key.frame->source_name + ") failed",
+                              "check the frames, or try other matcher or verifier options"};
+        },
+        [&] {
+          return ComparePair(matcher, *key.features, *frame.features, options.verifier, options.key_images.similarity);
+        });
   };
   // The comparisons of the current frame, by key frame: made ahead by the pipeline, or here when a key
   // image changed meanwhile. A pair compared under several taus is matched once.
@@ -467,6 +507,14 @@ SweepResult SweepThresholds(FrameSource& source, const Matcher& matcher, const M
   std::vector<fs::path> directories;
   for (double tau : taus) {
     directories.push_back(maps_directory.empty() ? fs::path() : maps_directory / fmt::format("tau_{:.2f}", tau));
+    if (std::count(directories.begin(), directories.end(), directories.back()) > 1 && !maps_directory.empty()) {
+      throw InputError(fmt::format("two thresholds round to the same map folder '{}'; the maps are named with two "
+                                   "decimals, so give thresholds at least 0.01 apart",
+                                   directories.back().filename().string()));
+    }
+  }
+  for (const fs::path& directory : directories) {
+    if (!directory.empty()) fs::create_directory(directory);  // inside maps_directory, which must exist
   }
   return RunSelectors(source, matcher, options, taus, directories, maps, options_json);
 }

@@ -14,21 +14,24 @@
 
 namespace vmap {
 
+// --threads accepts 0 (one per core) to this.
+inline constexpr int kMaxExtractionThreads = 256;
+
 struct MapBuilderOptions {
   KeyImageOptions key_images;
   VerifierOptions verifier;
   QualityMean quality_mean = QualityMean::kArithmetic;
   bool show_progress = true;   // a progress line on a terminal
   int prefetch_frames = 6;     // frames read and extracted ahead of matching
-  int extraction_threads = 0;  // threads extracting features; 0 = one per core
+  int extraction_threads = 0;  // threads extracting features; 0 = one per core, at most kMaxExtractionThreads
 
   int ExtractionThreads() const;
 
   void Check() const;  // throws InputError naming the bad option
 };
 
-// Builds one map. When `directory` is not empty, each key image is written there as keys/NNNNNN.png as
-// soon as it is chosen (the caller writes map.json with WriteMapFiles).
+// Builds one map. When `directory` (which must exist) is not empty, each key image is written there as
+// keys/NNNNNN.png as soon as it is chosen (the caller writes map.json with WriteMapFiles).
 // `options_json` is recorded verbatim in the map.
 VisualMap BuildMap(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
                    const std::filesystem::path& directory = {}, const std::string& options_json = "{}");
@@ -58,7 +61,11 @@ struct SweepResult {
   long pairs_matched = 0;      // pairs matched and verified, including a few made ahead and not needed
 };
 
-// Parses "0.1:0.9:0.1" (start:stop:step, inclusive) or "0.2,0.5,0.8".
+// A sweep runs one key-image selector per threshold, all at once: at most this many.
+inline constexpr int kMaxThresholds = 100;
+
+// Parses "0.1:0.9:0.1" (start:stop:step, inclusive) or "0.2,0.5,0.8": 1 to kMaxThresholds distinct thresholds
+// in (0, 1].
 std::vector<double> ParseThresholds(const std::string& text);
 
 // Runs every tau over one pass of the sequence: each frame's features are extracted once, and a pair

@@ -1,13 +1,18 @@
 #include "vmap/mapping/map_io.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
-#include <fstream>
+#include <limits>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/atomic_output.h"
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/file_name_encoding.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -24,7 +29,7 @@ json MapDocument(const VisualMap& map, const std::vector<long>& offsets) {
   doc["format"] = "vmap-map";
   doc["schema_version"] = kMapSchemaVersion;
   doc["vmap_version"] = VMAP_VERSION;
-  doc["input"] = {{"path", map.input.path},
+  doc["input"] = {{"path", EncodeFileName(map.input.path)},
                   {"format", SourceFormatName(map.input.format)},
                   {"native_size", SizeJson(map.input.native_size)},
                   {"frame_size", SizeJson(map.input.frame_size)},
@@ -40,8 +45,8 @@ json MapDocument(const VisualMap& map, const std::vector<long>& offsets) {
     keys.push_back({{"frame_index", k.frame_index},
                     {"source_index", k.source_index},
                     {"timestamp", TimestampJson(k.timestamp)},
-                    {"source_name", k.source_name},
-                    {"image", k.image_file},
+                    {"source_name", EncodeFileName(k.source_name)},
+                    {"image", EncodeFileName(k.image_file)},
                     {"num_features", k.num_features},
                     {"reason", k.reason}});
   }
@@ -93,37 +98,143 @@ std::vector<long> CorrespondenceOffsets(const VisualMap& map) {
 }
 
 [[noreturn]] void Malformed(const fs::path& file, const std::string& what) {
-  throw InputError("malformed map '" + file.string() + "': " + what +
-                   "; rebuild the map with `vmap build`");
+  throw InputError("malformed map '" + file.string() + "': " + what + "; rebuild the map with `vmap build`");
 }
 
-// Reads a required field with a message that names it.
-template <typename T>
-T Field(const json& object, const char* name, const fs::path& file, const std::string& where) {
-  auto it = object.find(name);
-  if (it == object.end()) Malformed(file, where + " has no field '" + name + "'");
-  try {
-    return it->get<T>();
-  } catch (const json::exception&) {
-    Malformed(file, where + " field '" + name + "' has the wrong type");
+std::string ShortText(const json& value) {
+  std::string text = value.dump();
+  return text.size() > 40 ? text.substr(0, 37) + "..." : text;
+}
+
+// Typed, range-checked access to map.json's fields: every failure names the field ("links[3].F").
+class Fields {
+ public:
+  explicit Fields(const fs::path& file) : file_(file) {}
+
+  [[noreturn]] void Fail(const std::string& field, const std::string& what) const {
+    Malformed(file_, "'" + field + "' " + what);
   }
-}
 
-cv::Size SizeField(const json& object, const char* name) {
-  auto it = object.find(name);
-  if (it == object.end() || !it->is_array() || it->size() != 2) return {};
-  return {(*it)[0].get<int>(), (*it)[1].get<int>()};
-}
-
-// A key-image path must stay inside the map directory: no absolute paths, no "..".
-bool IsSafeRelativePath(const std::string& path) {
-  if (path.empty()) return false;
-  const fs::path p(path);
-  if (p.is_absolute() || p.has_root_name() || p.has_root_directory()) return false;
-  for (const auto& part : p) {
-    if (part == "..") return false;
+  // The member, or null when absent.
+  static const json* Find(const json& object, const char* name) {
+    auto it = object.find(name);
+    return it == object.end() ? nullptr : &*it;
   }
-  return true;
+
+  const json& Required(const json& object, const std::string& where, const char* name) const {
+    const json* value = Find(object, name);
+    if (!value) Fail(Join(where, name), "is missing");
+    return *value;
+  }
+
+  const json& Object(const json& value, const std::string& field) const {
+    if (!value.is_object()) Fail(field, "must be an object");
+    return value;
+  }
+
+  const json& Array(const json& value, const std::string& field) const {
+    if (!value.is_array()) Fail(field, "must be a list");
+    return value;
+  }
+
+  static bool IntegerIn(const json& value, long low, long high) {
+    if (value.is_number_unsigned()) {
+      const std::uint64_t number = value.get<std::uint64_t>();
+      return high >= 0 && number <= static_cast<std::uint64_t>(high) &&
+             (low <= 0 || number >= static_cast<std::uint64_t>(low));
+    }
+    if (!value.is_number_integer()) return false;
+    const std::int64_t number = value.get<std::int64_t>();
+    return number >= low && number <= high;
+  }
+
+  static bool NumberIn(const json& value, double low, double high) {
+    if (!value.is_number()) return false;
+    const double number = value.get<double>();
+    return std::isfinite(number) && number >= low && number <= high;
+  }
+
+  long Integer(const json& value, const std::string& field, long low, long high) const {
+    if (!IntegerIn(value, low, high)) {
+      Fail(field, "must be an integer from " + std::to_string(low) + " to " + std::to_string(high) + " (got " +
+                      ShortText(value) + ")");
+    }
+    return static_cast<long>(value.get<std::int64_t>());
+  }
+
+  double Number(const json& value, const std::string& field, double low, double high) const {
+    if (!NumberIn(value, low, high)) {
+      Fail(field, "must be a finite number from " + FormatNumber(low) + " to " + FormatNumber(high) + " (got " +
+                      ShortText(value) + ")");
+    }
+    return value.get<double>();
+  }
+
+  std::string String(const json& value, const std::string& field) const {
+    if (!value.is_string()) Fail(field, "must be a string");
+    return value.get<std::string>();
+  }
+
+  bool Bool(const json& value, const std::string& field) const {
+    if (!value.is_boolean()) Fail(field, "must be true or false");
+    return value.get<bool>();
+  }
+
+  // Optional members: the default when absent.
+  long Integer(const json& object, const std::string& where, const char* name, long low, long high,
+               long absent) const {
+    const json* value = Find(object, name);
+    return value ? Integer(*value, Join(where, name), low, high) : absent;
+  }
+  double Number(const json& object, const std::string& where, const char* name, double low, double high,
+                double absent) const {
+    const json* value = Find(object, name);
+    return value ? Number(*value, Join(where, name), low, high) : absent;
+  }
+  std::string String(const json& object, const std::string& where, const char* name) const {
+    const json* value = Find(object, name);
+    return value ? String(*value, Join(where, name)) : std::string();
+  }
+
+  static std::string Join(const std::string& where, const char* name) {
+    return where.empty() ? std::string(name) : where + "." + name;
+  }
+
+ private:
+  static std::string FormatNumber(double value) {
+    std::ostringstream text;
+    text << value;
+    return text.str();
+  }
+
+  const fs::path& file_;
+};
+
+cv::Size SizeField(const Fields& fields, const json& object, const std::string& where, const char* name) {
+  const json* value = Fields::Find(object, name);
+  if (!value) return {};
+  const std::string field = Fields::Join(where, name);
+  if (!value->is_array() || value->size() != 2) fields.Fail(field, "must be [width, height]");
+  constexpr long kMaxSide = 1L << 20;
+  return {static_cast<int>(fields.Integer((*value)[0], field + "[0]", 0, kMaxSide)),
+          static_cast<int>(fields.Integer((*value)[1], field + "[1]", 0, kMaxSide))};
+}
+
+// The width and height a PNG file's header announces, or nullopt when the file is not a PNG.
+std::optional<cv::Size> PngSize(const ContainedFile& file) {
+  unsigned char header[24];
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  if (!file.Read(0, header, sizeof(header)) || std::memcmp(header, kSignature, 8) != 0 ||
+      std::memcmp(header + 12, "IHDR", 4) != 0) {
+    return std::nullopt;
+  }
+  auto big_endian = [&](int at) {
+    return (std::uint32_t(header[at]) << 24) | (std::uint32_t(header[at + 1]) << 16) |
+           (std::uint32_t(header[at + 2]) << 8) | std::uint32_t(header[at + 3]);
+  };
+  const std::uint32_t width = big_endian(16), height = big_endian(20);
+  if (width > (1u << 20) || height > (1u << 20)) return cv::Size(1 << 20, 1 << 20);
+  return cv::Size(static_cast<int>(width), static_cast<int>(height));
 }
 
 }  // namespace
@@ -143,129 +254,278 @@ void WriteMapFiles(const VisualMap& map, const fs::path& directory) {
   WriteFileAtomically(directory / kMapFileName, MapDocument(map, offsets).dump(1) + "\n");
 }
 
-VisualMap ReadMap(const fs::path& directory) {
-  if (!fs::is_directory(directory)) {
+namespace {
+
+constexpr long kMaxInt = std::numeric_limits<int>::max();
+// A key image of a map that does not record its frame size may have at most the pixels of a frame.
+constexpr long kMaxKeyImagePixels = 8192L * 8192L;
+constexpr int kRecordBytes = 4 * sizeof(float);
+
+// Opens a file of the map, or throws the message that fits why it cannot be.
+ContainedFile OpenMapFile(const fs::path& directory, const std::string& relative, const std::string& what,
+                          const fs::path& map_json, const std::string& field) {
+  std::string why_not;
+  std::optional<ContainedFile> file = ContainedFile::Open(directory, relative, &why_not);
+  if (file) return std::move(*file);
+  const fs::path path = directory / relative;
+  if (why_not == "is missing") {
+    throw InputError("map '" + directory.string() + "' is incomplete: " +
+                     (what.empty() ? path.string() : what + " '" + path.string() + "'") +
+                     " is missing; rebuild the map with `vmap build`");
+  }
+  // A field of map.json names the file, or the file is one of the map's own (correspondences.bin).
+  const std::string named = field.empty() ? relative : field + " '" + relative + "'";
+  const fs::path reported = field.empty() ? path : map_json;
+  if (why_not.rfind("resolves outside", 0) == 0) {
+    Malformed(reported, named + " resolves outside the map directory (a symbolic link leads out)");
+  }
+  Malformed(reported, named + " " + why_not);
+}
+
+void ReadKeyImages(const json& doc, const Fields& fields, const fs::path& directory, const fs::path& file,
+                   VisualMap* map) {
+  const json& keys = fields.Array(fields.Required(doc, "", "key_images"), "key_images");
+  if (static_cast<long>(keys.size()) > map->num_frames) {
+    fields.Fail("key_images", "lists more key images than there are frames (num_frames)");
+  }
+  for (size_t i = 0; i < keys.size(); ++i) {
+    const std::string where = "key_images[" + std::to_string(i) + "]";
+    const json& entry = fields.Object(keys[i], where);
+    KeyImage k;
+    k.frame_index = static_cast<int>(
+        fields.Integer(fields.Required(entry, where, "frame_index"), where + ".frame_index", 0, map->num_frames - 1));
+    if (i > 0 && k.frame_index <= map->key_images.back().frame_index) {
+      fields.Fail(where + ".frame_index", "must be larger than the previous key image's");
+    }
+    k.source_index = static_cast<int>(fields.Integer(entry, where, "source_index", 0, kMaxInt, k.frame_index));
+    const json* timestamp = Fields::Find(entry, "timestamp");
+    k.timestamp = timestamp && !timestamp->is_null() ? fields.Number(*timestamp, where + ".timestamp", 0.0, 1e12) : -1.0;
+    k.source_name = DecodeFileName(fields.String(entry, where, "source_name"));
+    k.image_file = DecodeFileName(fields.String(fields.Required(entry, where, "image"), where + ".image"));
+    k.num_features = static_cast<int>(fields.Integer(entry, where, "num_features", 0, kMaxInt, 0));
+    k.reason = fields.String(entry, where, "reason");
+    if (!IsPlainRelativePath(k.image_file)) {
+      Malformed(file, where + " image '" + k.image_file + "' points outside the map directory");
+    }
+    // Only the header is read here: the image must be the PNG vmap writes, of the map's frame size, so that
+    // whoever decodes it later does not meet a decompression bomb.
+    const ContainedFile image = OpenMapFile(directory, k.image_file, "key image", file, where + ".image");
+    const std::optional<cv::Size> size = PngSize(image);
+    if (!size) Malformed(file, where + ".image '" + k.image_file + "' is not a PNG image");
+    const cv::Size expected = map->input.frame_size;
+    const bool fits = expected.width > 0 && expected.height > 0
+                          ? *size == expected
+                          : static_cast<long>(size->width) * size->height <= kMaxKeyImagePixels;
+    if (!fits) {
+      Malformed(file, where + ".image '" + k.image_file + "' is " + std::to_string(size->width) + "x" +
+                          std::to_string(size->height) + ", not the map's frame size " + std::to_string(expected.width) +
+                          "x" + std::to_string(expected.height));
+    }
+    map->key_images.push_back(std::move(k));
+  }
+  if (map->key_images.empty() && map->num_frames > 0) Malformed(file, "no key images");
+  if (const json* count = Fields::Find(doc, "num_key_images")) {
+    if (fields.Integer(*count, "num_key_images", 0, kMaxInt) != static_cast<long>(map->key_images.size())) {
+      fields.Fail("num_key_images", "does not match the " + std::to_string(map->key_images.size()) +
+                                        " entries of 'key_images'");
+    }
+  }
+}
+
+// The links and, from correspondences.bin, exactly the records they reference.
+void ReadLinks(const json& doc, const Fields& fields, const fs::path& directory, const fs::path& file,
+               VisualMap* map) {
+  const json& links = fields.Array(fields.Required(doc, "", "links"), "links");
+  const long num_keys = static_cast<long>(map->key_images.size());
+  if (static_cast<long>(links.size()) > std::max(num_keys - 1, 0L)) {
+    fields.Fail("links", "has more entries than there are pairs of consecutive key images");
+  }
+  std::vector<std::pair<long, long>> ranges;  // first record and count, per link
+  long records_referenced = 0;
+  for (size_t i = 0; i < links.size(); ++i) {
+    const std::string where = "links[" + std::to_string(i) + "]";
+    const json& entry = fields.Object(links[i], where);
+    Link l;
+    l.from_key = static_cast<int>(fields.Integer(fields.Required(entry, where, "from"), where + ".from", 0, num_keys - 1));
+    l.to_key = static_cast<int>(fields.Integer(fields.Required(entry, where, "to"), where + ".to", 0, num_keys - 1));
+    if (l.to_key <= l.from_key) fields.Fail(where + ".to", "must name a key image after 'from'");
+    for (const auto& [name, key] : {std::pair<const char*, int>{"from_frame", l.from_key}, {"to_frame", l.to_key}}) {
+      const json* frame = Fields::Find(entry, name);
+      if (frame && fields.Integer(*frame, Fields::Join(where, name), 0, kMaxInt) != map->key_images[key].frame_index) {
+        fields.Fail(Fields::Join(where, name), "is not the frame of key image " + std::to_string(key));
+      }
+    }
+    if (const json* broken = Fields::Find(entry, "broken")) l.broken = fields.Bool(*broken, where + ".broken");
+    l.similarity = fields.Number(fields.Required(entry, where, "similarity"), where + ".similarity", 0.0, 1.0);
+    l.num_tentative = static_cast<int>(
+        fields.Integer(fields.Required(entry, where, "tentative"), where + ".tentative", 0, kMaxMatchesPerLink));
+    l.num_verified = static_cast<int>(
+        fields.Integer(fields.Required(entry, where, "verified"), where + ".verified", 0, l.num_tentative));
+    if (const json* F = Fields::Find(entry, "F"); F && !F->is_null()) {
+      const bool nine_numbers = F->is_array() && F->size() == 9 &&
+                                std::all_of(F->begin(), F->end(), [](const json& v) {
+                                  return Fields::NumberIn(v, -std::numeric_limits<double>::max(),
+                                                          std::numeric_limits<double>::max());
+                                });
+      if (!nine_numbers) fields.Fail(where + ".F", "must be null or a list of 9 finite numbers");
+      l.has_fundamental = true;
+      for (int k = 0; k < 9; ++k) l.F(k / 3, k % 3) = (*F)[k].get<double>();
+    }
+    long offset = 0, count = 0;
+    if (const json* correspondences = Fields::Find(entry, "correspondences")) {
+      const std::string field = where + ".correspondences";
+      fields.Object(*correspondences, field);
+      offset = fields.Integer(*correspondences, field, "offset", 0, std::numeric_limits<long>::max() / kRecordBytes, 0);
+      count = fields.Integer(*correspondences, field, "count", 0, kMaxMatchesPerLink, 0);
+    }
+    if (l.num_verified > count) fields.Fail(where + ".verified", "is more than its correspondences' count");
+    ranges.emplace_back(offset, count);
+    if (count > 0) records_referenced = std::max(records_referenced, offset + count);
+    map->links.push_back(std::move(l));
+  }
+  if (links.empty()) return;
+
+  const fs::path binary_file = directory / kCorrespondencesFileName;
+  const ContainedFile binary = OpenMapFile(directory, kCorrespondencesFileName, "", file, "");
+  // The size first, against what the links say: a file that does not belong to this map.json (or a sparse
+  // file of gigabytes) is refused before anything is read.
+  const std::uint64_t expected_bytes = static_cast<std::uint64_t>(records_referenced) * kRecordBytes;
+  if (binary.size() != expected_bytes) {
+    throw InputError("malformed map '" + binary_file.string() + "': it holds " + std::to_string(binary.size()) +
+                     " bytes, but the links of map.json reference " + std::to_string(records_referenced) +
+                     " records of 16 bytes (" + std::to_string(expected_bytes) +
+                     " bytes); the two files do not belong together: rebuild the map with `vmap build`");
+  }
+  std::vector<float> record_values;
+  for (size_t i = 0; i < map->links.size(); ++i) {
+    const auto [offset, count] = ranges[i];
+    record_values.resize(static_cast<size_t>(count) * 4);
+    if (count > 0 && !binary.Read(static_cast<std::uint64_t>(offset) * kRecordBytes, record_values.data(),
+                                  record_values.size() * sizeof(float))) {
+      throw InputError("cannot read '" + binary_file.string() + "' (it changed while being read?)");
+    }
+    std::vector<Correspondence>& correspondences = map->links[i].correspondences;
+    correspondences.resize(count);
+    for (long r = 0; r < count; ++r) {
+      const float* record = record_values.data() + 4 * r;  // little-endian on x86 and ARM, as written
+      if (!std::isfinite(record[0]) || !std::isfinite(record[1]) || !std::isfinite(record[2]) ||
+          !std::isfinite(record[3])) {
+        Malformed(binary_file, "record " + std::to_string(offset + r) + " (links[" + std::to_string(i) +
+                                   "]) holds a coordinate that is not a finite number");
+      }
+      correspondences[r] = {{record[0], record[1]}, {record[2], record[3]}};
+    }
+  }
+}
+
+void ReadEvaluations(const json& doc, const Fields& fields, VisualMap* map) {
+  const json* evaluations = Fields::Find(doc, "evaluations");
+  if (!evaluations) return;
+  fields.Object(*evaluations, "evaluations");
+  const char* names[] = {"key_frame", "frame", "similarity", "tentative", "verified", "matched"};
+  const json* columns[6];
+  for (int c = 0; c < 6; ++c) {
+    columns[c] = &fields.Array(fields.Required(*evaluations, "evaluations", names[c]),
+                               Fields::Join("evaluations", names[c]));
+    if (columns[c]->size() != columns[0]->size()) fields.Fail("evaluations", "has columns of different lengths");
+  }
+  const long last_frame = map->num_frames - 1;
+  // Checked with the cheap predicates first; the message is only built for a value that fails.
+  const auto field = [&](int c, size_t i) {
+    return "evaluations." + std::string(names[c]) + "[" + std::to_string(i) + "]";
+  };
+  const size_t n = columns[0]->size();
+  map->evaluations.reserve(n);
+  for (size_t i = 0; i < n; ++i) {
+    const json& key_frame = (*columns[0])[i];
+    const json& frame = (*columns[1])[i];
+    const json& similarity = (*columns[2])[i];
+    const json& tentative = (*columns[3])[i];
+    const json& verified = (*columns[4])[i];
+    const json& matched = (*columns[5])[i];
+    if (!Fields::IntegerIn(key_frame, 0, last_frame)) fields.Integer(key_frame, field(0, i), 0, last_frame);
+    if (!Fields::IntegerIn(frame, 0, last_frame)) fields.Integer(frame, field(1, i), 0, last_frame);
+    if (!Fields::NumberIn(similarity, 0.0, 1.0)) fields.Number(similarity, field(2, i), 0.0, 1.0);
+    if (!Fields::IntegerIn(tentative, 0, kMaxMatchesPerLink)) {
+      fields.Integer(tentative, field(3, i), 0, kMaxMatchesPerLink);
+    }
+    const long tentative_count = tentative.get<long>();
+    if (!Fields::IntegerIn(verified, 0, tentative_count)) fields.Integer(verified, field(4, i), 0, tentative_count);
+    if (!matched.is_boolean()) fields.Bool(matched, field(5, i));
+    map->evaluations.push_back({key_frame.get<int>(), frame.get<int>(), similarity.get<double>(), tentative.get<int>(),
+                                verified.get<int>(), matched.get<bool>()});
+  }
+}
+
+VisualMap ReadCheckedMap(const fs::path& directory) {
+  std::error_code ec;
+  if (!fs::is_directory(directory, ec)) {
     throw InputError("map directory '" + directory.string() + "' does not exist; build one with `vmap build`");
   }
   const fs::path file = directory / kMapFileName;
-  std::ifstream in(file);
-  if (!in) throw InputError("'" + directory.string() + "' is not a map: " + file.string() + " is missing");
-  json doc;
-  try {
-    doc = json::parse(in);
-  } catch (const json::parse_error& e) {
-    Malformed(file, std::string("not valid JSON (") + e.what() + ")");
+  const ContainedJson parsed = ReadContainedJson(directory, kMapFileName, kMaxMapJsonBytes);
+  if (parsed.missing) throw InputError("'" + directory.string() + "' is not a map: " + file.string() + " is missing");
+  if (!parsed.document) Malformed(file, parsed.why_not);
+  const json& doc = *parsed.document;
+  if (!doc.is_object() || doc.value("format", json()) != "vmap-map") {
+    Malformed(file, "not a vmap map.json (it has no \"format\": \"vmap-map\")");
   }
-  if (!doc.is_object() || doc.value("format", "") != "vmap-map") Malformed(file, "not a vmap map.json");
-  const int version = Field<int>(doc, "schema_version", file, "map.json");
+  Fields fields(file);
+  const long version =
+      fields.Integer(fields.Required(doc, "", "schema_version"), "schema_version", 1, std::numeric_limits<long>::max());
   if (version > kMapSchemaVersion) {
     throw InputError("map '" + file.string() + "' has schema version " + std::to_string(version) +
                      ", newer than this vmap understands (" + std::to_string(kMapSchemaVersion) + "); update vmap");
   }
   VisualMap map;
-  const json& input = doc.contains("input") ? doc["input"] : json::object();
-  map.input.path = input.value("path", "");
-  map.input.format = ParseSourceFormat(input.value("format", "auto"));
-  map.input.native_size = SizeField(input, "native_size");
-  map.input.frame_size = SizeField(input, "frame_size");
-  map.input.fps = input.value("fps", 0.0);
-  map.options_json = doc.contains("options") ? doc["options"].dump() : "{}";
-  map.num_frames = Field<int>(doc, "num_frames", file, "map.json");
-  map.skipped_frames = doc.value("skipped_frames", 0);
-  map.quality = Field<double>(doc, "quality", file, "map.json");
-  map.seconds = doc.value("seconds", 0.0);
-
-  const json& keys = doc.contains("key_images") ? doc["key_images"] : json();
-  if (!keys.is_array()) Malformed(file, "'key_images' is missing or not a list");
-  for (size_t i = 0; i < keys.size(); ++i) {
-    const std::string where = "key_images[" + std::to_string(i) + "]";
-    KeyImage k;
-    k.frame_index = Field<int>(keys[i], "frame_index", file, where);
-    k.source_index = keys[i].value("source_index", k.frame_index);
-    k.timestamp = keys[i].contains("timestamp") && keys[i]["timestamp"].is_number() ? keys[i]["timestamp"].get<double>()
-                                                                                    : -1.0;
-    k.source_name = keys[i].value("source_name", "");
-    k.image_file = Field<std::string>(keys[i], "image", file, where);
-    k.num_features = keys[i].value("num_features", 0);
-    k.reason = keys[i].value("reason", "");
-    if (!IsSafeRelativePath(k.image_file)) {
-      Malformed(file, where + " image '" + k.image_file + "' points outside the map directory");
-    }
-    if (!fs::exists(directory / k.image_file)) {
-      throw InputError("map '" + directory.string() + "' is incomplete: key image '" +
-                       (directory / k.image_file).string() + "' is missing");
-    }
-    map.key_images.push_back(std::move(k));
-  }
-  if (map.key_images.empty() && map.num_frames > 0) Malformed(file, "no key images");
-
-  const json& links = doc.contains("links") ? doc["links"] : json();
-  if (!links.is_array()) Malformed(file, "'links' is missing or not a list");
-  const fs::path binary_file = directory / kCorrespondencesFileName;
-  std::string binary;
-  if (!links.empty()) {
-    std::ifstream bin(binary_file, std::ios::binary);
-    if (!bin) throw InputError("map '" + directory.string() + "' is incomplete: " + binary_file.string() + " is missing");
-    binary.assign(std::istreambuf_iterator<char>(bin), std::istreambuf_iterator<char>());
-  }
-  const long records = static_cast<long>(binary.size() / (4 * sizeof(float)));
-  for (size_t i = 0; i < links.size(); ++i) {
-    const std::string where = "links[" + std::to_string(i) + "]";
-    Link l;
-    l.from_key = Field<int>(links[i], "from", file, where);
-    l.to_key = Field<int>(links[i], "to", file, where);
-    const int num_keys = static_cast<int>(map.key_images.size());
-    if (l.from_key < 0 || l.from_key >= num_keys || l.to_key < 0 || l.to_key >= num_keys) {
-      Malformed(file, where + " names a key image that does not exist");
-    }
-    l.broken = links[i].value("broken", false);
-    l.similarity = Field<double>(links[i], "similarity", file, where);
-    l.num_tentative = Field<int>(links[i], "tentative", file, where);
-    l.num_verified = Field<int>(links[i], "verified", file, where);
-    const json& F = links[i].contains("F") ? links[i]["F"] : json();
-    if (F.is_array() && F.size() == 9) {
-      l.has_fundamental = true;
-      for (int k = 0; k < 9; ++k) l.F(k / 3, k % 3) = F[k].get<double>();
-    }
-    const json& corr = links[i].contains("correspondences") ? links[i]["correspondences"] : json::object();
-    const long offset = corr.value("offset", 0L);
-    const long count = corr.value("count", 0L);
-    if (offset < 0 || count < 0 || offset + count > records) {
-      Malformed(binary_file, where + " correspondences [" + std::to_string(offset) + ", +" + std::to_string(count) +
-                                 ") exceed the file's " + std::to_string(records) + " records");
-    }
-    if (l.num_verified > count) Malformed(file, where + " has more verified matches than correspondences");
-    l.correspondences.resize(count);
-    for (long r = 0; r < count; ++r) {
-      float rec[4];
-      std::memcpy(rec, binary.data() + (offset + r) * sizeof(rec), sizeof(rec));
-      l.correspondences[r] = {{rec[0], rec[1]}, {rec[2], rec[3]}};
-    }
-    map.links.push_back(std::move(l));
-  }
-
-  if (doc.contains("evaluations")) {
-    const json& ev = doc["evaluations"];
+  if (const json* input = Fields::Find(doc, "input")) {
+    fields.Object(*input, "input");
+    map.input.path = DecodeFileName(fields.String(*input, "input", "path"));
+    const std::string format = fields.String(*input, "input", "format");
     try {
-      const auto key_frame = ev.at("key_frame").get<std::vector<int>>();
-      const auto frame = ev.at("frame").get<std::vector<int>>();
-      const auto similarity = ev.at("similarity").get<std::vector<double>>();
-      const auto tentative = ev.at("tentative").get<std::vector<int>>();
-      const auto verified = ev.at("verified").get<std::vector<int>>();
-      const auto matched = ev.at("matched").get<std::vector<bool>>();
-      const size_t n = key_frame.size();
-      if (frame.size() != n || similarity.size() != n || tentative.size() != n || verified.size() != n ||
-          matched.size() != n) {
-        Malformed(file, "'evaluations' columns have different lengths");
-      }
-      for (size_t i = 0; i < n; ++i) {
-        map.evaluations.push_back({key_frame[i], frame[i], similarity[i], tentative[i], verified[i], matched[i]});
-      }
-    } catch (const json::exception&) {
-      Malformed(file, "'evaluations' is not of the documented form");
+      map.input.format = ParseSourceFormat(format.empty() ? "auto" : format);
+    } catch (const InputError&) {
+      fields.Fail("input.format", "is not a known format ('" + format + "')");
     }
+    map.input.native_size = SizeField(fields, *input, "input", "native_size");
+    map.input.frame_size = SizeField(fields, *input, "input", "frame_size");
+    map.input.fps = fields.Number(*input, "input", "fps", 0.0, 1e6, 0.0);
   }
+  const json* options = Fields::Find(doc, "options");
+  map.options_json = options ? fields.Object(*options, "options").dump() : "{}";
+  map.num_frames = static_cast<int>(fields.Integer(fields.Required(doc, "", "num_frames"), "num_frames", 0, kMaxInt));
+  map.skipped_frames = static_cast<int>(fields.Integer(doc, "", "skipped_frames", 0, kMaxInt, 0));
+  map.quality = fields.Number(fields.Required(doc, "", "quality"), "quality", 0.0, 1.0);
+  map.seconds = fields.Number(doc, "", "seconds", 0.0, 1e9, 0.0);
+  ReadKeyImages(doc, fields, directory, file, &map);
+  ReadLinks(doc, fields, directory, file, &map);
+  ReadEvaluations(doc, fields, &map);
   return map;
+}
+
+}  // namespace
+
+VisualMap ReadMap(const fs::path& directory) {
+  return RethrowAsInputError(
+      [&] {
+        return ErrorContext{"cannot read the map '" + directory.string() + "'",
+                            "check that it exists and that you may read it"};
+      },
+      [&] { return ReadCheckedMap(directory); });
+}
+
+std::string WhyNotAVmapMap(const fs::path& directory) {
+  const ContainedJson parsed = ReadContainedJson(directory, kMapFileName, kMaxMapJsonBytes);
+  if (parsed.missing) return "it has no map.json";
+  if (!parsed.document) return "its " + parsed.why_not;
+  const json& doc = *parsed.document;
+  if (!doc.is_object() || doc.value("format", json()) != "vmap-map") {
+    return "its map.json is not a vmap map's: it has no \"format\": \"vmap-map\"";
+  }
+  if (!doc.value("schema_version", json()).is_number_integer()) {
+    return "its map.json has no integer \"schema_version\"";
+  }
+  return "";
 }
 
 }  // namespace vmap

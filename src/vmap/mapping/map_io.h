@@ -2,12 +2,14 @@
 // Reading and writing map directories.
 //
 // A map directory holds:
-//   map.json             versioned description: input, options, n, m, Q, key images, links, evaluations
+//   map.json             versioned description: input, options, n, m, Q, key images, links, evaluations;
+//                        file names and paths percent-encoded where they are not UTF-8 (file_name_encoding.h)
 //   keys/NNNNNN.png      the key images (NNNNNN = frame index in the processed sequence)
 //   correspondences.bin  every link's tentative matches, little-endian float32 records (x0, y0, x1, y1),
 //                        pixel coordinates with pixel centres at integers (OpenCV); each link names its
 //                        `offset` (first record) and `count`; its first `verified` records are the inliers.
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 
@@ -18,14 +20,27 @@ namespace vmap {
 inline constexpr int kMapSchemaVersion = 1;
 inline constexpr const char* kMapFileName = "map.json";
 inline constexpr const char* kCorrespondencesFileName = "correspondences.bin";
+// Limits a map must respect to be read, far above what vmap writes: they bound the memory a crafted map
+// can make a reader take.
+inline constexpr std::uint64_t kMaxMapJsonBytes = 1ull << 30;  // 1 GiB
+inline constexpr long kMaxMatchesPerLink = 1L << 22;           // 4,194,304 correspondences
 
 // Writes map.json and correspondences.bin into `directory` (which must exist; key images are written by
 // the builder). Each file is written atomically.
 void WriteMapFiles(const VisualMap& map, const std::filesystem::path& directory);
 
-// Reads a map directory. Throws InputError naming the file and what is wrong when it is missing or
-// malformed, including key-image paths that would point outside the directory.
+// Reads a map directory that vmap may not have written (a map someone sent). Throws InputError naming the file,
+// the field and what is wrong when it is missing or malformed. It never reads outside the directory (no
+// absolute or ".." paths, no symbolic link leading out, only regular files), checks every file's size against
+// map.json before reading it (correspondences.bin must be exactly as long as its links say; each key image a
+// PNG of the map's frame size), reads only the byte ranges the links reference, and checks every field's type
+// and range (F: null or 9 finite numbers; counts and offsets that fit; key-image and frame indices in range).
+// File names and paths are decoded (DecodeFileName).
 VisualMap ReadMap(const std::filesystem::path& directory);
+
+// The proof that `directory` is a map vmap wrote, so that `vmap build -o` may replace it: "" when its map.json
+// is a vmap map ("format": "vmap-map" and an integer "schema_version"), otherwise why it is not.
+std::string WhyNotAVmapMap(const std::filesystem::path& directory);
 
 // The map.json document alone (for tools that want the raw JSON).
 std::string MapToJson(const VisualMap& map);

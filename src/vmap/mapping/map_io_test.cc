@@ -1,6 +1,11 @@
 #include "vmap/mapping/map_io.h"
 
+#include <sys/stat.h>
+
+#include <chrono>
 #include <fstream>
+#include <functional>
+#include <limits>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -118,8 +123,248 @@ TEST(MapIo, CorrespondenceRangesAreChecked) {
   std::ifstream in(tmp.path() / kMapFileName);
   auto doc = nlohmann::json::parse(in);
   doc["links"][1]["correspondences"]["count"] = 1000;
+  doc["links"][1]["tentative"] = 1000;
   WriteText(tmp.path() / kMapFileName, doc.dump());
-  EXPECT_NE(ErrorOf(tmp.path()).find("exceed"), std::string::npos);
+  const std::string error = ErrorOf(tmp.path());
+  EXPECT_NE(error.find("reference 1003 records"), std::string::npos) << error;
+  EXPECT_NE(error.find("do not belong together"), std::string::npos) << error;
+}
+
+namespace {
+
+nlohmann::json ReadJson(const fs::path& file) {
+  std::ifstream in(file);
+  return nlohmann::json::parse(in);
+}
+
+}  // namespace
+
+// Every field of map.json is checked for its type and range, and the message names the field.
+TEST(MapIo, EveryFieldIsCheckedAndTheMessageNamesIt) {
+  testing::TempDir tmp;
+  WriteMapFiles(SmallMap(tmp.path()), tmp.path());
+  const nlohmann::json good = ReadJson(tmp.path() / kMapFileName);
+  using json = nlohmann::json;
+  struct Case {
+    std::function<void(json&)> change;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {[](json& d) { d["schema_version"] = "1"; }, "'schema_version' must be an integer"},
+      {[](json& d) { d["format"] = "geojson"; }, "not a vmap map.json"},
+      {[](json& d) { d["num_frames"] = 1e300; }, "'num_frames' must be an integer from 0 to 2147483647"},
+      {[](json& d) { d["num_frames"] = 1ull << 40; }, "'num_frames' must be an integer"},
+      {[](json& d) { d["num_frames"] = -20; }, "'num_frames' must be an integer"},
+      {[](json& d) { d["quality"] = nullptr; }, "'quality' must be a finite number"},
+      {[](json& d) { d["quality"] = 7.5; }, "'quality' must be a finite number from 0 to 1"},
+      {[](json& d) { d["skipped_frames"] = -1; }, "'skipped_frames'"},
+      {[](json& d) { d["options"] = json::array(); }, "'options' must be an object"},
+      {[](json& d) { d["input"]["frame_size"] = {64}; }, "'input.frame_size' must be [width, height]"},
+      {[](json& d) { d["input"]["frame_size"] = {64, -48}; }, "'input.frame_size[1]'"},
+      {[](json& d) { d["input"]["format"] = "tape"; }, "'input.format' is not a known format"},
+      {[](json& d) { d["input"]["fps"] = "fast"; }, "'input.fps'"},
+      {[](json& d) { d["num_key_images"] = 7; }, "'num_key_images' does not match"},
+      {[](json& d) { d["key_images"] = json::object(); }, "'key_images' must be a list"},
+      {[](json& d) { d["key_images"][1] = 5; }, "'key_images[1]' must be an object"},
+      {[](json& d) { d["key_images"][1]["frame_index"] = 20; }, "'key_images[1].frame_index' must be an integer from 0 to 19"},
+      {[](json& d) { d["key_images"][2]["frame_index"] = 9; }, "'key_images[2].frame_index' must be larger"},
+      {[](json& d) { d["key_images"][0]["timestamp"] = "noon"; }, "'key_images[0].timestamp'"},
+      {[](json& d) { d["key_images"][0]["image"] = 12; }, "'key_images[0].image' must be a string"},
+      {[](json& d) { d["key_images"][0].erase("image"); }, "'key_images[0].image' is missing"},
+      {[](json& d) { d["key_images"][2]["num_features"] = 1.5; }, "'key_images[2].num_features'"},
+      {[](json& d) { d["links"] = "none"; }, "'links' must be a list"},
+      {[](json& d) { d["links"].push_back(d["links"][0]); d["links"].push_back(d["links"][0]); }, "'links' has more entries"},
+      {[](json& d) { d["links"][0]["from"] = 5; }, "'links[0].from' must be an integer from 0 to 2"},
+      {[](json& d) { d["links"][1]["to"] = 1; }, "'links[1].to' must name a key image after"},
+      {[](json& d) { d["links"][0]["from_frame"] = 3; }, "'links[0].from_frame' is not the frame of key image 0"},
+      {[](json& d) { d["links"][0]["broken"] = "no"; }, "'links[0].broken' must be true or false"},
+      {[](json& d) { d["links"][0]["similarity"] = "high"; }, "'links[0].similarity'"},
+      {[](json& d) { d["links"][0]["similarity"] = -0.5; }, "'links[0].similarity'"},
+      {[](json& d) { d["links"][0]["verified"] = 4; }, "'links[0].verified' must be an integer from 0 to 3"},
+      {[](json& d) { d["links"][0]["tentative"] = 1e10; }, "'links[0].tentative'"},
+      {[](json& d) { d["links"][1]["F"] = {1, 2, 3, 4, 5, 6, 7, 8}; }, "'links[1].F' must be null or a list of 9 finite numbers"},
+      {[](json& d) { d["links"][1]["F"][4] = "x"; }, "'links[1].F' must be null or a list of 9 finite"},
+      {[](json& d) { d["links"][1]["F"][4] = nullptr; }, "'links[1].F'"},
+      {[](json& d) { d["links"][1]["F"] = "identity"; }, "'links[1].F'"},
+      {[](json& d) { d["links"][0]["correspondences"]["offset"] = -1; }, "'links[0].correspondences.offset'"},
+      {[](json& d) { d["links"][0]["correspondences"]["count"] = 1e12; }, "'links[0].correspondences.count'"},
+      {[](json& d) { d["links"][0]["correspondences"]["count"] = 1; }, "'links[0].verified' is more than"},
+      {[](json& d) { d["links"][0]["correspondences"]["offset"] = 1ull << 62; }, "'links[0].correspondences.offset'"},
+      {[](json& d) { d["evaluations"]["frame"][1] = -3; }, "'evaluations.frame[1]' must be an integer from 0 to 19"},
+      {[](json& d) { d["evaluations"]["similarity"][0] = 1e308; }, "'evaluations.similarity[0]'"},
+      {[](json& d) { d["evaluations"]["verified"][0] = 11; }, "'evaluations.verified[0]' must be an integer from 0 to 10"},
+      {[](json& d) { d["evaluations"]["matched"][1] = 0; }, "'evaluations.matched[1]' must be true or false"},
+      {[](json& d) { d["evaluations"]["matched"].push_back(true); }, "'evaluations' has columns of different lengths"},
+      {[](json& d) { d["evaluations"].erase("key_frame"); }, "'evaluations.key_frame' is missing"},
+  };
+  for (const Case& c : cases) {
+    json doc = good;
+    c.change(doc);
+    WriteText(tmp.path() / kMapFileName, doc.dump());
+    const std::string error = ErrorOf(tmp.path());
+    EXPECT_NE(error.find(c.expected), std::string::npos) << c.expected << "\n  got: " << error;
+    EXPECT_NE(error.find(kMapFileName), std::string::npos) << error;
+  }
+  // Numbers beyond what JSON can hold, and nesting no map has.
+  WriteText(tmp.path() / kMapFileName, R"({"format": "vmap-map", "schema_version": 1, "num_frames": 1e999})");
+  EXPECT_NE(ErrorOf(tmp.path()).find("not valid JSON"), std::string::npos) << ErrorOf(tmp.path());
+  WriteText(tmp.path() / kMapFileName, R"({"format": "vmap-map", "options": )" + std::string(10000, '[') +
+                                           std::string(10000, ']') + "}");
+  EXPECT_NE(ErrorOf(tmp.path()).find("nested"), std::string::npos) << ErrorOf(tmp.path());
+  // The untouched document still reads.
+  WriteText(tmp.path() / kMapFileName, good.dump());
+  EXPECT_EQ(ErrorOf(tmp.path()), "");
+}
+
+TEST(MapIo, FileSizesAreCheckedBeforeAnythingIsRead) {
+  testing::TempDir tmp;
+  WriteMapFiles(SmallMap(tmp.path()), tmp.path());
+  const fs::path binary = tmp.path() / kCorrespondencesFileName;
+  ASSERT_EQ(fs::file_size(binary), 6u * 16u);
+  // A sparse file of 10 GB whose links cover 96 bytes: refused at once, without reading it.
+  fs::resize_file(binary, 10ull << 30);
+  const auto start = std::chrono::steady_clock::now();
+  const std::string error = ErrorOf(tmp.path());
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
+  EXPECT_NE(error.find("10737418240 bytes"), std::string::npos) << error;
+  EXPECT_NE(error.find("96 bytes"), std::string::npos) << error;
+  // One record too many or too few.
+  for (const std::uintmax_t size : {7u * 16u, 5u * 16u, 6u * 16u + 3u}) {
+    fs::resize_file(binary, size);
+    EXPECT_NE(ErrorOf(tmp.path()).find("do not belong together"), std::string::npos) << size;
+  }
+  fs::resize_file(binary, 6u * 16u);
+  EXPECT_EQ(ErrorOf(tmp.path()), "");
+  // A map.json too large to be a map's is refused by its size too.
+  EXPECT_GT(kMaxMapJsonBytes, 1000u);
+}
+
+TEST(MapIo, OnlyTheReferencedRecordsAreRead) {
+  testing::TempDir tmp;
+  VisualMap map = SmallMap(tmp.path());
+  WriteMapFiles(map, tmp.path());
+  // Records nobody references may hold anything: they are not read, so NaNs there do not matter; a NaN in a
+  // referenced record is refused.
+  auto doc = ReadJson(tmp.path() / kMapFileName);
+  doc["links"][0]["correspondences"]["count"] = 2;
+  doc["links"][0]["tentative"] = 2;
+  WriteText(tmp.path() / kMapFileName, doc.dump());
+  {
+    std::fstream file(tmp.path() / kCorrespondencesFileName, std::ios::in | std::ios::out | std::ios::binary);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    file.seekp(2 * 16);  // link 0's third record, no longer referenced
+    file.write(reinterpret_cast<const char*>(&nan), sizeof(nan));
+  }
+  const VisualMap back = ReadMap(tmp.path());
+  EXPECT_EQ(back.links[0].correspondences.size(), 2u);
+  EXPECT_EQ(back.links[1].correspondences[2].p1.x, 6.5f);
+  doc["links"][0]["correspondences"]["count"] = 3;
+  doc["links"][0]["tentative"] = 3;
+  WriteText(tmp.path() / kMapFileName, doc.dump());
+  EXPECT_NE(ErrorOf(tmp.path()).find("record 2 (links[0]) holds a coordinate that is not a finite number"),
+            std::string::npos)
+      << ErrorOf(tmp.path());
+}
+
+TEST(MapIo, NoFileIsReadThroughASymbolicLinkLeadingOut) {
+  testing::TempDir tmp;
+  const fs::path map_dir = tmp.path() / "map";
+  WriteMapFiles(SmallMap(map_dir), map_dir);
+  const fs::path outside = tmp.path() / "outside";
+  fs::create_directories(outside);
+  fs::copy(map_dir, outside, fs::copy_options::recursive);
+  auto relink = [&](const std::string& name, const fs::path& target) {
+    fs::remove_all(map_dir / name);
+    fs::create_symlink(target, map_dir / name);
+  };
+  auto restore = [&](const std::string& name) {
+    fs::remove_all(map_dir / name);
+    fs::copy(outside / name, map_dir / name, fs::copy_options::recursive);
+    ASSERT_EQ(ErrorOf(map_dir), "");
+  };
+  relink(kMapFileName, outside / kMapFileName);
+  EXPECT_NE(ErrorOf(map_dir).find("resolves outside"), std::string::npos) << ErrorOf(map_dir);
+  restore(kMapFileName);
+  relink(kCorrespondencesFileName, "/dev/zero");
+  EXPECT_NE(ErrorOf(map_dir).find("resolves outside the map directory"), std::string::npos) << ErrorOf(map_dir);
+  restore(kCorrespondencesFileName);
+  relink(kCorrespondencesFileName, outside / kCorrespondencesFileName);
+  EXPECT_NE(ErrorOf(map_dir).find("resolves outside the map directory"), std::string::npos) << ErrorOf(map_dir);
+  restore(kCorrespondencesFileName);
+  relink("keys/9.png", outside / "keys/9.png");
+  EXPECT_NE(ErrorOf(map_dir).find("key_images[1].image 'keys/9.png' resolves outside"), std::string::npos)
+      << ErrorOf(map_dir);
+  restore("keys/9.png");
+  relink("keys", outside / "keys");
+  EXPECT_NE(ErrorOf(map_dir).find("resolves outside"), std::string::npos) << ErrorOf(map_dir);
+  restore("keys");
+  // Not regular files: a FIFO would block a reader for ever, a folder is not a file.
+  fs::remove(map_dir / kCorrespondencesFileName);
+  ASSERT_EQ(mkfifo((map_dir / kCorrespondencesFileName).c_str(), 0600), 0);
+  EXPECT_NE(ErrorOf(map_dir).find("is not a regular file"), std::string::npos) << ErrorOf(map_dir);
+  restore(kCorrespondencesFileName);
+  fs::remove(map_dir / kMapFileName);
+  fs::create_directories(map_dir / kMapFileName);
+  EXPECT_NE(ErrorOf(map_dir).find("is not a regular file"), std::string::npos) << ErrorOf(map_dir);
+  restore(kMapFileName);
+}
+
+TEST(MapIo, KeyImagesMustBeThePngsOfTheMapsFrameSize) {
+  testing::TempDir tmp;
+  WriteMapFiles(SmallMap(tmp.path()), tmp.path());
+  const fs::path key = tmp.path() / "keys/9.png";
+  std::ofstream(key, std::ios::trunc) << "GIF89a";
+  EXPECT_NE(ErrorOf(tmp.path()).find("'keys/9.png' is not a PNG image"), std::string::npos) << ErrorOf(tmp.path());
+  cv::imwrite(key.string(), cv::Mat(10, 12, CV_8U, cv::Scalar(3)));
+  EXPECT_NE(ErrorOf(tmp.path()).find("is 12x10, not the map's frame size 64x48"), std::string::npos) << ErrorOf(tmp.path());
+  // A PNG header announcing 40000 x 40000 pixels: refused from its 24 bytes, never decoded.
+  const unsigned char header[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R',
+                                  0, 0, 0x9C, 0x40, 0, 0, 0x9C, 0x40, 8, 0, 0, 0, 0};
+  std::ofstream(key, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(header), sizeof(header));
+  EXPECT_NE(ErrorOf(tmp.path()).find("is 40000x40000"), std::string::npos) << ErrorOf(tmp.path());
+}
+
+TEST(MapIo, FileNamesThatAreNotUtf8RoundTrip) {
+  testing::TempDir tmp;
+  VisualMap map = SmallMap(tmp.path());
+  map.input.path = "/data/\xFFrun%1";
+  map.key_images[1].source_name = "caf\xE9 9.png";
+  WriteMapFiles(map, tmp.path());
+  std::ifstream in(tmp.path() / kMapFileName);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("/data/%FFrun%251"), std::string::npos);
+  EXPECT_NE(text.find("caf%E9 9.png"), std::string::npos);
+  const VisualMap back = ReadMap(tmp.path());
+  EXPECT_EQ(back.input.path, map.input.path);
+  EXPECT_EQ(back.key_images[1].source_name, map.key_images[1].source_name);
+  EXPECT_EQ(back.key_images[0].source_name, "frame_0");
+}
+
+TEST(MapIo, OwnershipNeedsAVmapMapJson) {
+  testing::TempDir tmp;
+  WriteMapFiles(SmallMap(tmp.path() / "map"), tmp.path() / "map");
+  EXPECT_EQ(WhyNotAVmapMap(tmp.path() / "map"), "");
+  struct Case {
+    std::string map_json, expected;
+  };
+  const std::vector<Case> cases = {
+      {"", "it has no map.json"},
+      {R"({"type": "FeatureCollection"})", "no \"format\": \"vmap-map\""},
+      {R"({"format": "vmap-map"})", "no integer \"schema_version\""},
+      {R"({"format": "vmap-map", "schema_version": "1"})", "no integer \"schema_version\""},
+      {R"([1, 2])", "no \"format\""},
+      {"{oops", "not valid JSON"},
+  };
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const fs::path dir = tmp.path() / std::to_string(i);
+    fs::create_directories(dir / "src");
+    if (!cases[i].map_json.empty()) WriteText(dir / kMapFileName, cases[i].map_json);
+    EXPECT_NE(WhyNotAVmapMap(dir).find(cases[i].expected), std::string::npos) << WhyNotAVmapMap(dir);
+  }
+  // A map.json that is a link to a real map's elsewhere proves nothing.
+  fs::create_directories(tmp.path() / "linked");
+  fs::create_symlink(tmp.path() / "map" / kMapFileName, tmp.path() / "linked" / kMapFileName);
+  EXPECT_NE(WhyNotAVmapMap(tmp.path() / "linked"), "");
 }
 
 }  // namespace vmap

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/core/file_name_encoding.h"
 #include "vmap/neural/loftr_model.h"
 #include "vmap/neural/loftr_weights.h"
 #include "vmap/neural/weights_store.h"
@@ -109,7 +110,7 @@ class LoftrMatcher : public Matcher {
     const auto& c = model_.config();
     nlohmann::json j{{"type", "loftr"},
                      {"model", c.preset},
-                     {"weights", weights_path_},
+                     {"weights", EncodeFileName(weights_path_)},  // JSON needs UTF-8: see file_name_encoding.h
                      {"device", options_.device},
                      {"longest_side", options_.longest_side},
                      {"threshold", model_.threshold()},

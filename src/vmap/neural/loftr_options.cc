@@ -1,5 +1,7 @@
 #include "vmap/neural/loftr_options.h"
 
+#include <cmath>
+
 #include "vmap/core/error.h"
 
 namespace vmap {
@@ -11,11 +13,11 @@ void LoftrMatcherOptions::Check() const {
   if (device != "cpu" && device != "cuda") {
     throw InputError("unknown device '" + device + "'; use cpu or cuda");
   }
-  if (longest_side < 32) {
-    throw InputError("--loftr-size " + std::to_string(longest_side) + " is too small; use at least 32 (default 640)");
+  if (longest_side < 32 || longest_side > 4096) {
+    throw InputError("--loftr-size " + std::to_string(longest_side) + " is outside 32 to 4096 (default 640)");
   }
-  if (num_threads < 0) throw InputError("--loftr-threads must be >= 0 (0 = LibTorch's default)");
-  if (threshold > 1.0) {
+  if (num_threads < 0 || num_threads > 256) throw InputError("--loftr-threads must be 0 to 256 (0 = LibTorch's default)");
+  if (!std::isfinite(threshold) || threshold > 1.0) {
     // 0 is allowed: it keeps every mutual nearest neighbour (used to reproduce the random-weight golden).
     throw InputError("--loftr-threshold must be in [0, 1] (negative: the preset's)");
   }

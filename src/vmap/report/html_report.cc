@@ -15,7 +15,9 @@
 #include <opencv2/videoio.hpp>
 
 #include "vmap/core/atomic_output.h"
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/file_name_encoding.h"
 #include "vmap/mapping/map_io.h"
 #include "vmap/report/html_page.h"
 #include "vmap/report/html_util.h"
@@ -251,6 +253,10 @@ std::string Row(const std::string& name, const std::string& value_html) {
   return "<tr><th>" + HtmlEscape(name) + "</th><td>" + value_html + "</td></tr>\n";
 }
 
+// A file name or path as the page shows it: the page is UTF-8, so a name that is not is shown percent-encoded,
+// as map.json stores it.
+std::string Displayable(const std::string& name) { return IsValidUtf8(name) ? name : EncodeFileName(name); }
+
 std::string Numbered(int index) {
   char name[32];
   std::snprintf(name, sizeof(name), "%06d.jpg", index);
@@ -274,6 +280,7 @@ cv::Mat ScaledToWidth(const cv::Mat& image, int width) {
 }  // namespace report
 
 using report::Card;
+using report::Displayable;
 using report::DurationText;
 using report::FindOption;
 using report::Numbered;
@@ -475,33 +482,34 @@ class RouteVideo {
 }  // namespace
 
 fs::path KeyImagePath(const fs::path& map_directory, const KeyImage& key) {
-  const fs::path relative(key.image_file);
-  bool safe = !key.image_file.empty() && !relative.is_absolute() && !relative.has_root_name() &&
-              !relative.has_root_directory();
-  for (const auto& part : relative) safe = safe && part != "..";
-  if (!safe) {
+  if (!IsPlainRelativePath(key.image_file)) {
     throw InputError("map '" + map_directory.string() + "': key image path '" + key.image_file +
                      "' points outside the map directory; rebuild the map with `vmap build`");
   }
-  const fs::path file = map_directory / relative;
-  if (!fs::exists(file)) {
-    throw InputError("map '" + map_directory.string() + "' is incomplete: key image '" + file.string() +
-                     "' is missing; rebuild the map with `vmap build`");
+  std::string why_not;
+  if (!ContainedFile::Open(map_directory, key.image_file, &why_not)) {
+    const fs::path file = map_directory / key.image_file;
+    if (why_not == "is missing") {
+      throw InputError("map '" + map_directory.string() + "' is incomplete: key image '" + file.string() +
+                       "' is missing; rebuild the map with `vmap build`");
+    }
+    throw InputError("map '" + map_directory.string() + "': key image '" + key.image_file + "' " +
+                     (why_not.rfind("resolves outside", 0) == 0 ? std::string("resolves outside the map directory")
+                                                                 : why_not) +
+                     "; rebuild the map with `vmap build`");
   }
-  // A symbolic link inside the map could still lead elsewhere.
-  std::error_code ec;
-  const fs::path real_file = fs::canonical(file, ec);
-  const fs::path real_directory = fs::canonical(map_directory, ec);
-  if (ec || !IsInside(real_file, real_directory)) {
-    throw InputError("map '" + map_directory.string() + "': key image '" + key.image_file +
-                     "' resolves outside the map directory; rebuild the map with `vmap build`");
-  }
-  return file;
+  return map_directory / key.image_file;
 }
 
 cv::Mat ReadKeyImage(const fs::path& map_directory, const KeyImage& key) {
   const fs::path file = KeyImagePath(map_directory, key);
-  cv::Mat image = cv::imread(file.string(), cv::IMREAD_COLOR);
+  cv::Mat image;
+  try {
+    image = cv::imread(file.string(), cv::IMREAD_COLOR);
+  } catch (const cv::Exception& error) {
+    throw InputError("key image '" + file.string() + "' cannot be decoded (" + LibraryMessage(error) +
+                     "); rebuild the map with `vmap build`");
+  }
   if (image.empty()) {
     throw InputError("key image '" + file.string() + "' cannot be decoded; rebuild the map with `vmap build`");
   }
@@ -539,9 +547,10 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
   const MapStatistics stats = ComputeStatistics(
       map, OptionText(options, "quality_mean") == "harmonic" ? QualityMean::kHarmonic : QualityMean::kArithmetic);
 
-  AtomicOutputDirectory assets(map_directory / kReportAssetsDirectory, AtomicOutputDirectory::kReplaceAnything);
-  fs::create_directories(assets.path() / "keys");
-  fs::create_directories(assets.path() / "links");
+  // Inside a map that ReadMap has just recognised as vmap's: the old report/ is vmap's too.
+  AtomicOutputDirectory assets(map_directory / kReportAssetsDirectory, OutputPolicy::InsideVmapOutput());
+  fs::create_directory(assets.path() / "keys");  // not create_directories: see AtomicOutputDirectory::path()
+  fs::create_directory(assets.path() / "links");
   const std::string assets_url = std::string(kReportAssetsDirectory) + "/";
 
   // Consecutive links share a key image: keep the last two decoded. (cv::Mat copies share the pixels, so a
@@ -587,7 +596,8 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
   }
 
   const int n = map.num_frames, m = static_cast<int>(map.key_images.size());
-  const std::string input_name = map.input.path.empty() ? map_directory.filename().string() : map.input.path;
+  const std::string input_name =
+      map.input.path.empty() ? map_directory.filename().string() : Displayable(map.input.path);
   std::ostringstream html;
   html << PageStart("vmap report: " + input_name, "Visual map of " + input_name,
                     std::to_string(m) + " key images from " + std::to_string(n) + " frames, Q = " +
@@ -605,7 +615,7 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
        << Card(n > 0 ? FormatFixed(100.0 * m / n, 1) + " %" : "n/a", "of the frames")
        << Card(FormatFixed(map.quality, 3), "quality Q") << Card(FormatFixed(stats.mean_similarity, 3), "mean S")
        << Card(std::to_string(stats.broken_links), "broken links") << "</div>\n<table class=\"summary\">\n";
-  html << Row("Input", HtmlEscape(map.input.path))
+  html << Row("Input", HtmlEscape(Displayable(map.input.path)))
        << Row("Format", HtmlEscape(SourceFormatName(map.input.format)))
        << Row("Frame size", HtmlEscape(SizeText(map.input.frame_size)) +
                                 (map.input.native_size != map.input.frame_size && map.input.native_size.area() > 0
@@ -653,7 +663,7 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
     const std::string timestamp = TimestampText(k.timestamp);
     const std::string label = "key " + std::to_string(i) + " | frame " + std::to_string(k.frame_index) +
                               (timestamp.empty() ? "" : " | t = " + timestamp);
-    html << "<figure id=\"key-" << i << "\" title=\"" << HtmlEscape(k.source_name + (k.reason.empty() ? "" : ": " + k.reason))
+    html << "<figure id=\"key-" << i << "\" title=\"" << HtmlEscape(Displayable(k.source_name) + (k.reason.empty() ? "" : ": " + k.reason))
          << "\"><img loading=\"lazy\" decoding=\"async\" src=\"" << UrlPath(assets_url + "keys/" + Numbered(i))
          << "\" width=\"" << thumb_sizes[i].width << "\" height=\"" << thumb_sizes[i].height << "\" alt=\"key image "
          << i << "\" data-label=\"" << HtmlEscape(label) << "\"><figcaption><b>#" << i << "</b> frame "
@@ -731,12 +741,13 @@ std::string MapLink(const std::string& map_directory, const fs::path& report_dir
 
 void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
   const json options = ParseOptions(sweep.options_json);
+  // Not created here: the CLI writes into a temporary output (AtomicOutputDirectory), which an interruption
+  // removes and nothing may bring back.
   std::error_code ec;
-  fs::create_directories(directory, ec);
-  if (!fs::is_directory(directory)) {
-    throw InputError("cannot create the report directory '" + directory.string() + "'; choose another --report path");
+  if (!fs::is_directory(directory, ec)) {
+    throw InputError("the report directory '" + directory.string() + "' does not exist; choose another --report path");
   }
-  const std::string input_name = sweep.input.path.empty() ? std::string("the input") : sweep.input.path;
+  const std::string input_name = sweep.input.path.empty() ? std::string("the input") : Displayable(sweep.input.path);
   const bool has_best = sweep.best_row >= 0 && sweep.best_row < static_cast<int>(sweep.rows.size());
   std::ostringstream html;
   html << PageStart("vmap sweep: " + input_name, "Threshold sweep of " + input_name,
@@ -750,7 +761,7 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
                           Card(FormatFixed(sweep.rows[sweep.best_row].quality, 3), "best Q")
                     : "")
        << "</div>\n<table class=\"summary\">\n"
-       << Row("Input", HtmlEscape(sweep.input.path)) << Row("Format", HtmlEscape(SourceFormatName(sweep.input.format)))
+       << Row("Input", HtmlEscape(Displayable(sweep.input.path))) << Row("Format", HtmlEscape(SourceFormatName(sweep.input.format)))
        << Row("Frame size", HtmlEscape(SizeText(sweep.input.frame_size)))
        << Row("Matcher", HtmlEscape(OptionText(options, "matcher")))
        << Row("Verifier", HtmlEscape(OptionText(options, "verifier")))

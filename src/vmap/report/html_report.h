@@ -36,7 +36,7 @@ struct MapReportOptions {
 void WriteMapReport(const std::filesystem::path& map_directory);
 void WriteMapReport(const std::filesystem::path& map_directory, const MapReportOptions& options);
 
-// Writes report.html for a sweep into `directory` (created if needed): the paper-style table with the
+// Writes report.html for a sweep into `directory` (which must exist): the paper-style table with the
 // best tau marked, key images and Q against tau, and links to the per-tau maps that were written.
 void WriteSweepReport(const SweepResult& sweep, const std::filesystem::path& directory);
 

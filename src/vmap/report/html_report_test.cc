@@ -257,6 +257,7 @@ TEST(SweepReportTest, TableMarksTheBestTauAndLinksTheMapsRelatively) {
   TempDir temp;
   const fs::path dir = temp.path() / "sweep";
   const SweepResult sweep = SyntheticSweep(dir);
+  fs::create_directories(dir);
   WriteSweepReport(sweep, dir);
   const std::string html = ReadText(dir / kReportFileName);
   EXPECT_EQ(report_test::CountOccurrences(html, "<tr class=\""), 4);

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/core/atomic_output.h"
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/mapping/map_io.h"
 #include "vmap/report/html_page.h"
@@ -202,9 +203,15 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
                              const fs::path& directory, const LocalizationReportOptions& options) {
   options.Check();
   for (const KeyImage& k : map.key_images) KeyImagePath(map_directory, k);
-  fs::create_directories(directory);
-  AtomicOutputDirectory assets(directory / kReportAssetsDirectory, AtomicOutputDirectory::kReplaceAnything);
-  fs::create_directories(assets.path() / "frames");
+  // The whole folder is replaced at once, and only when it is empty or an older report of a run.
+  OutputPolicy policy;
+  policy.why_not_ours = WhyNotALocalizationReport;
+  policy.kind = "a vmap localization report";
+  policy.inputs = {map_directory, run.info.query};
+  AtomicOutputDirectory output(directory, policy);
+  const fs::path assets = output.path() / kReportAssetsDirectory;
+  fs::create_directory(assets);  // not create_directories: see AtomicOutputDirectory::path()
+  fs::create_directory(assets / "frames");
 
   // The chosen frames, read again from the query (streamed: only the chosen ones are kept).
   const std::vector<int> chosen = ChooseFrames(run.frames, options.pairs);
@@ -226,7 +233,7 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
       const cv::Mat key = known_key ? ReadKeyImage(map_directory, map.key_images[r.key]) : cv::Mat();
       const cv::Mat next_key = known_next ? ReadKeyImage(map_directory, map.key_images[r.next_key]) : cv::Mat();
       const cv::Mat pair = DrawPair(ColorImage(*frame), key, next_key, r, options.pair_width);
-      report::WriteJpeg(assets.path() / "frames" / report::Numbered(r.frame_index), pair, options.jpeg_quality);
+      report::WriteJpeg(assets / "frames" / report::Numbered(r.frame_index), pair, options.jpeg_quality);
       written.emplace_back(chosen[next], pair.size());
       ++next;
     }
@@ -285,8 +292,20 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
   }
   if (written.empty()) html << "<p class=\"note\">No frames to show.</p>\n";
   html << "</div>\n</section>\n" << report::PageEnd();
-  assets.Commit();
-  WriteFileAtomically(directory / kReportFileName, html.str());
+  WriteFileAtomically(output.path() / kReportFileName, html.str());
+  WriteFileAtomically(output.path() / kLocalizationReportRunFileName, LocalizationRunJson(map, run));
+  output.Commit();
+}
+
+std::string WhyNotALocalizationReport(const fs::path& directory) {
+  // A run's JSON holds a few hundred bytes per frame: 1 GB is far more than any.
+  const ContainedJson parsed = ReadContainedJson(directory, kLocalizationReportRunFileName, 1ull << 30);
+  if (parsed.missing) return std::string("it has no ") + kLocalizationReportRunFileName;
+  if (!parsed.document) return "its " + parsed.why_not;
+  if (!parsed.document->is_object() || parsed.document->value("format", nlohmann::json()) != "vmap-localization") {
+    return std::string("its ") + kLocalizationReportRunFileName + " is not a vmap localization run";
+  }
+  return "";
 }
 
 void WriteLocalizationReport(const fs::path& run_file, const fs::path& directory,

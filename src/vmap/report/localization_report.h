@@ -6,14 +6,19 @@
 //                                 S against the key image and the next one, and a few frames beside the key
 //                                 image they were localized at
 //   DIR/report/frames/NNNNNN.jpg  those pairs (NNNNNN = frame index)
-// The images folder and then the page are replaced atomically.
+//   DIR/run.json                  the run (as `vmap localize --json` writes it)
+// DIR is written as a whole and replaced atomically, and only when it is empty or an older report of a run
+// (its run.json says so), never a folder that is, holds or lies inside the map or the query.
 
 #include <filesystem>
+#include <string>
 
 #include "vmap/localization/localization_output.h"
 #include "vmap/mapping/visual_map.h"
 
 namespace vmap {
+
+inline constexpr const char* kLocalizationReportRunFileName = "run.json";
 
 struct LocalizationReportOptions {
   int pairs = 8;               // frames shown beside their key image (spread over the run, lost ones first)
@@ -28,6 +33,9 @@ struct LocalizationReportOptions {
 void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map,
                              const std::filesystem::path& map_directory, const std::filesystem::path& directory,
                              const LocalizationReportOptions& options = {});
+
+// "" when `directory` is a localization report vmap wrote (its run.json is a run), or why it is not.
+std::string WhyNotALocalizationReport(const std::filesystem::path& directory);
 
 // Reads the run (ReadLocalizationRun) and its map, and writes the report into `directory`. The map directory
 // and the query recorded in the run are taken as they are, or relative to the run file's folder when they

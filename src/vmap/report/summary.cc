@@ -3,6 +3,9 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "vmap/core/contained_file.h"
+#include "vmap/core/file_name_encoding.h"
+
 namespace vmap {
 
 std::string FormatMapSummary(const VisualMap& map, QualityMean mean) {
@@ -10,7 +13,7 @@ std::string FormatMapSummary(const VisualMap& map, QualityMean mean) {
   std::string text;
   text += fmt::format("input           {} ({})\n", map.input.path, SourceFormatName(map.input.format));
   text += fmt::format("frames (n)      {}", s.num_frames);
-  if (map.skipped_frames > 0) text += fmt::format("  ({} undecodable frames skipped)", map.skipped_frames);
+  if (map.skipped_frames > 0) text += fmt::format("  ({} unusable frames skipped)", map.skipped_frames);
   text += "\n";
   text += fmt::format("key images (m)  {} ({:.1f}% of frames)\n", s.num_key_images,
                       s.num_frames > 0 ? 100.0 * s.num_key_images / s.num_frames : 0.0);
@@ -61,7 +64,7 @@ std::string SweepToJson(const SweepResult& sweep) {
   nlohmann::json doc;
   doc["format"] = "vmap-sweep";
   doc["schema_version"] = 1;
-  doc["input"] = {{"path", sweep.input.path}, {"format", SourceFormatName(sweep.input.format)}};
+  doc["input"] = {{"path", EncodeFileName(sweep.input.path)}, {"format", SourceFormatName(sweep.input.format)}};
   doc["options"] = sweep.options_json.empty() ? nlohmann::json::object() : nlohmann::json::parse(sweep.options_json);
   doc["num_frames"] = sweep.num_frames;
   doc["seconds"] = sweep.seconds;
@@ -79,10 +82,26 @@ std::string SweepToJson(const SweepResult& sweep) {
                     {"mean_similarity", r.mean_similarity},
                     {"quality", r.quality},
                     {"broken_links", r.broken_links},
-                    {"map", r.map_directory.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.map_directory)}});
+                    {"map", r.map_directory.empty() ? nlohmann::json(nullptr)
+                                                    : nlohmann::json(EncodeFileName(r.map_directory))}});
   }
   doc["rows"] = rows;
   return doc.dump(1) + "\n";
+}
+
+std::string WhyNotAVmapSweep(const std::filesystem::path& directory) {
+  // sweep.json is a table of some hundred lines: 64 MB is far more than any.
+  const ContainedJson parsed = ReadContainedJson(directory, kSweepJsonFileName, 64ull << 20);
+  if (parsed.missing) return "it has no sweep.json";
+  if (!parsed.document) return "its " + parsed.why_not;
+  const nlohmann::json& doc = *parsed.document;
+  if (!doc.is_object() || doc.value("format", nlohmann::json()) != "vmap-sweep") {
+    return "its sweep.json is not a vmap sweep's: it has no \"format\": \"vmap-sweep\"";
+  }
+  if (!doc.value("schema_version", nlohmann::json()).is_number_integer()) {
+    return "its sweep.json has no integer \"schema_version\"";
+  }
+  return "";
 }
 
 }  // namespace vmap

@@ -38,11 +38,18 @@ std::string SourceFormatName(SourceFormat format) {
 
 void FrameSourceOptions::Check() const {
   if (first < 0) throw InputError("--first must be >= 0 (got " + std::to_string(first) + ")");
+  if (last < -1) {
+    throw InputError("--last " + std::to_string(last) + " is not a frame; give a 0-based frame index, or -1 for the "
+                     "end of the sequence");
+  }
   if (last >= 0 && last < first) {
     throw InputError("--last " + std::to_string(last) + " is before --first " + std::to_string(first));
   }
   if (stride < 1) throw InputError("--stride must be >= 1 (got " + std::to_string(stride) + ")");
-  if (!resize.empty()) internal::TargetSize(cv::Size(640, 480), resize);  // validates the text
+  if (max_frame_pixels < static_cast<long>(kMinFrameSide) * kMinFrameSide) {
+    throw InputError("max_frame_pixels must be at least " + std::to_string(kMinFrameSide * kMinFrameSide));
+  }
+  if (!resize.empty()) internal::TargetSize(cv::Size(640, 480), *this);  // validates the text
 }
 
 bool NaturalLess(const std::string& a, const std::string& b) {
@@ -71,10 +78,25 @@ bool NaturalLess(const std::string& a, const std::string& b) {
   return a.size() - i < b.size() - j;
 }
 
+std::string FrameSizeProblem(const cv::Size& size, const FrameSourceOptions& options) {
+  if (size.width < kMinFrameSide || size.height < kMinFrameSide) {
+    return "smaller than " + std::to_string(kMinFrameSide) + " pixels on a side, too small to match";
+  }
+  if (static_cast<long>(size.width) * size.height > options.max_frame_pixels) {
+    return "more than vmap's limit of " + std::to_string(options.max_frame_pixels) + " pixels per frame";
+  }
+  return "";
+}
+
 cv::Mat ColorImage(const Frame& frame) {
   if (!frame.color.empty()) return frame.color;
   if (!frame.source_path.empty()) {
-    cv::Mat color = cv::imread(frame.source_path, cv::IMREAD_COLOR);
+    cv::Mat color;
+    try {
+      color = cv::imread(frame.source_path, cv::IMREAD_COLOR);
+    } catch (const cv::Exception&) {
+      // The file decoded as grey a moment ago; if it no longer does, the grey frame is what there is.
+    }
     if (!color.empty()) {
       if (color.size() != frame.gray.size()) cv::resize(color, color, frame.gray.size(), 0, 0, cv::INTER_AREA);
       return color;
@@ -95,20 +117,37 @@ bool IsImageFile(const std::string& path) {
   return std::any_of(std::begin(kExtensions), std::end(kExtensions), [&](const char* e) { return ext == e; });
 }
 
-cv::Size TargetSize(const cv::Size& native, const std::string& resize) {
+cv::Size TargetSize(const cv::Size& native, const FrameSourceOptions& options) {
+  const std::string& resize = options.resize;
   if (resize.empty()) return native;
+  const std::string range = std::to_string(kMinFrameSide) + " to " + std::to_string(kMaxResizeSide);
   int width = 0, height = 0;
   char extra = 0;
   if (std::sscanf(resize.c_str(), "%dx%d%c", &width, &height, &extra) == 2) {
-    if (width < 16 || height < 16) throw InputError("--resize " + resize + " is too small; use at least 16x16");
+    if (width < kMinFrameSide || height < kMinFrameSide || width > kMaxResizeSide || height > kMaxResizeSide) {
+      throw InputError("--resize " + resize + ": each side must be " + range + " pixels");
+    }
+    if (static_cast<long>(width) * height > options.max_frame_pixels) {
+      throw InputError("--resize " + resize + " has more than " + std::to_string(options.max_frame_pixels) +
+                       " pixels; choose a smaller size");
+    }
     return {width, height};
   }
   int longest = 0;
   if (std::sscanf(resize.c_str(), "%d%c", &longest, &extra) == 1) {
-    if (longest < 16) throw InputError("--resize " + resize + " is too small; use a longest side of at least 16");
+    if (longest < kMinFrameSide || longest > kMaxResizeSide) {
+      throw InputError("--resize " + resize + ": the longest side must be " + range + " pixels");
+    }
     const double scale = static_cast<double>(longest) / std::max(native.width, native.height);
-    return {std::max(1, static_cast<int>(std::lround(native.width * scale))),
-            std::max(1, static_cast<int>(std::lround(native.height * scale)))};
+    const cv::Size target(std::max(1, static_cast<int>(std::lround(native.width * scale))),
+                          std::max(1, static_cast<int>(std::lround(native.height * scale))));
+    if (std::min(target.width, target.height) < kMinFrameSide ||
+        static_cast<long>(target.width) * target.height > options.max_frame_pixels) {
+      throw InputError("--resize " + resize + " turns frames of " + std::to_string(native.width) + "x" +
+                       std::to_string(native.height) + " into " + std::to_string(target.width) + "x" +
+                       std::to_string(target.height) + "; give WxH with sides of " + range + " pixels instead");
+    }
+    return target;
   }
   throw InputError("--resize '" + resize + "' is not WxH (e.g. 640x480) or a longest side (e.g. 640)");
 }
@@ -132,8 +171,9 @@ void FitFrame(Frame& frame, const cv::Size& target, const cv::Size& first_native
 
 }  // namespace internal
 
-std::unique_ptr<FrameSource> OpenFrameSource(const std::string& path, const FrameSourceOptions& options) {
-  options.Check();
+namespace {
+
+std::unique_ptr<FrameSource> OpenDetectedFrameSource(const std::string& path, const FrameSourceOptions& options) {
   std::error_code ec;
   if (!fs::exists(path, ec)) {
     throw InputError("input '" + path + "' does not exist; give a video file, an image folder, or a TUM/EuRoC/KITTI sequence");
@@ -179,6 +219,19 @@ std::unique_ptr<FrameSource> OpenFrameSource(const std::string& path, const Fram
     case SourceFormat::kAuto: break;
   }
   throw InputError("cannot tell the layout of '" + path + "'; pass --format");
+}
+
+}  // namespace
+
+std::unique_ptr<FrameSource> OpenFrameSource(const std::string& path, const FrameSourceOptions& options) {
+  options.Check();
+  // The layouts read folders and list files: a file system error (a folder that cannot be listed, a file that
+  // cannot be inspected) is reported with the input's name.
+  return RethrowAsInputError(
+      [&] {
+        return ErrorContext{"cannot read the input '" + path + "'", "check that it exists and that you may read it"};
+      },
+      [&] { return OpenDetectedFrameSource(path, options); });
 }
 
 }  // namespace vmap

@@ -16,9 +16,15 @@ enum class SourceFormat { kAuto, kVideo, kImageFolder, kTum, kEuroc, kKitti };
 SourceFormat ParseSourceFormat(const std::string& name);
 std::string SourceFormatName(SourceFormat format);
 
+// Frames narrower or lower than this are skipped: no matcher finds anything in them (ORB's border alone is
+// 31 px, LoFTR's coarse cells are 8 or 16 px), and OpenCV's image pyramids fail on them.
+inline constexpr int kMinFrameSide = 32;
+// --resize accepts sides in [kMinFrameSide, kMaxResizeSide].
+inline constexpr int kMaxResizeSide = 16384;
+
 struct FrameSourceOptions {
   SourceFormat format = SourceFormat::kAuto;
-  // Frames [first, last] of the sequence (0-based, inclusive; last < 0 means to the end), every stride-th.
+  // Frames [first, last] of the sequence (0-based, inclusive; last = -1 means to the end), every stride-th.
   int first = 0;
   int last = -1;
   int stride = 1;
@@ -26,6 +32,10 @@ struct FrameSourceOptions {
   std::string resize;
   // Frames whose size differs from the first frame's are resized to it with a warning; with strict, an error.
   bool strict = false;
+  // A decoded frame with more pixels than this is skipped with a warning and counted (skipped_frames), as is
+  // one with a side under kMinFrameSide: 8192 x 8192 (64 megapixels) is more than any camera's video frame,
+  // and bounds the memory a hostile image can take once decoded.
+  long max_frame_pixels = 8192L * 8192L;
   // A single image file is a sequence of one frame (vmap localize takes one query image); otherwise it is an
   // error, since one frame makes no map.
   bool allow_single_image = false;
@@ -58,13 +68,18 @@ class FrameSource {
   // The next frame, or nullopt at the end. Throws InputError on input that cannot be read at all.
   virtual std::optional<Frame> Next() = 0;
   virtual const SequenceInfo& info() const = 0;
-  // Frames that could not be decoded and were skipped so far (a corrupt frame inside a video).
+  // Frames that could not be used and were skipped so far: a frame that does not decode (a corrupt frame
+  // inside a video, a damaged image file), or one of a degenerate size or too many pixels.
   virtual int skipped_frames() const { return 0; }
 };
 
 // Detects the layout of `path` (or uses options.format) and opens it. Throws InputError with a message
 // that names the path and says what to do when it cannot.
 std::unique_ptr<FrameSource> OpenFrameSource(const std::string& path, const FrameSourceOptions& options = {});
+
+// Why a decoded image of this size cannot be a frame (a side under kMinFrameSide, or more than
+// options.max_frame_pixels), or "" when it can.
+std::string FrameSizeProblem(const cv::Size& size, const FrameSourceOptions& options = {});
 
 // The frame as a BGR image (re-reads a colour image file when the frame only kept the grey one).
 cv::Mat ColorImage(const Frame& frame);

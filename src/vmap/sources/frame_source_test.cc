@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 
 #include <gtest/gtest.h>
@@ -136,6 +137,99 @@ TEST(ImageFolder, UndecodableImageIsSkippedAndCounted) {
   auto source = OpenFrameSource(tmp.path().string());
   EXPECT_EQ(ReadAll(*source).size(), 11u);
   EXPECT_EQ(source->skipped_frames(), 1);
+}
+
+TEST(ImageFolder, BadFramesAreSkippedWithAWarningAndCounted) {
+  testing::TempDir tmp;
+  testing::WriteImageFolder(Sequence(), tmp.path());  // 12 frames of 320x240
+  // Decode failures, degenerate sizes and too many pixels, among good frames and at the very start.
+  cv::imwrite((tmp.path() / "frame_1.png").string(), cv::Mat(1, 1, CV_8U, cv::Scalar(7)));
+  cv::imwrite((tmp.path() / "frame_3.png").string(), cv::Mat(500, 20, CV_8U, cv::Scalar(7)));
+  cv::imwrite((tmp.path() / "frame_5.png").string(), cv::Mat(31, 400, CV_8U, cv::Scalar(7)));
+  testing::WritePngHeader(tmp.path() / "frame_7.png", 40000, 40000);  // OpenCV refuses it outright
+  testing::WritePngHeader(tmp.path() / "frame_8.png", 2, 3);         // a header and no data
+  std::ofstream(tmp.path() / "frame_10.png", std::ios::trunc) << "";
+  auto source = OpenFrameSource(tmp.path().string());
+  const auto frames = ReadAll(*source);
+  ASSERT_EQ(frames.size(), 6u);
+  EXPECT_EQ(source->skipped_frames(), 6);
+  EXPECT_EQ(frames[0].source_name, "frame_2.png") << "the first good frame sets the sequence's size";
+  EXPECT_EQ(source->info().frame_size, cv::Size(320, 240));
+  for (size_t i = 0; i < frames.size(); ++i) {
+    EXPECT_EQ(frames[i].index, static_cast<int>(i));
+    EXPECT_EQ(frames[i].gray.size(), cv::Size(320, 240));
+  }
+  // The pixel limit is an option: frames above it are skipped too.
+  FrameSourceOptions small_limit;
+  small_limit.max_frame_pixels = 100 * 100;
+  cv::imwrite((tmp.path() / "frame_13.png").string(), cv::Mat(60, 80, CV_8UC3, cv::Scalar(1, 2, 3)));
+  cv::imwrite((tmp.path() / "frame_14.png").string(), cv::Mat(90, 100, CV_8UC3, cv::Scalar(1, 2, 3)));
+  auto limited = OpenFrameSource(tmp.path().string(), small_limit);
+  const auto small_frames = ReadAll(*limited);
+  ASSERT_EQ(small_frames.size(), 2u);
+  EXPECT_EQ(small_frames[0].source_name, "frame_13.png");
+  EXPECT_EQ(limited->skipped_frames(), 12);
+}
+
+TEST(ImageFolder, AFolderOfOnlyBadFramesIsAClearError) {
+  testing::TempDir tmp;
+  cv::imwrite((tmp.path() / "a.png").string(), cv::Mat(1, 1, CV_8U));
+  testing::WritePngHeader(tmp.path() / "b.png", 40000, 40000);
+  const std::string error = OpenError(tmp.path().string());
+  EXPECT_NE(error.find("none of the 2 images"), std::string::npos) << error;
+}
+
+TEST(Video, FramesOfADegenerateSizeAreAClearError) {
+  testing::TempDir tmp;
+  const fs::path video = WriteMjpegVideo(tmp.path() / "tiny.avi", std::vector<cv::Mat>(3, cv::Mat(16, 16, CV_8UC3)));
+  const std::string error = OpenError(video.string());
+  EXPECT_NE(error.find("tiny.avi' has frames of 16x16, smaller than 32 pixels"), std::string::npos) << error;
+}
+
+TEST(FrameSourceOptions, EveryOptionHasARange) {
+  struct Case {
+    std::function<void(FrameSourceOptions&)> change;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {[](FrameSourceOptions& o) { o.first = -1; }, "--first"},
+      {[](FrameSourceOptions& o) { o.last = -5; }, "--last -5 is not a frame"},
+      {[](FrameSourceOptions& o) { o.last = -2; }, "-1 for the end"},
+      {[](FrameSourceOptions& o) { o.first = 10, o.last = 3; }, "before --first"},
+      {[](FrameSourceOptions& o) { o.stride = 0; }, "--stride"},
+      {[](FrameSourceOptions& o) { o.resize = "100000x100000"; }, "each side must be 32 to 16384"},
+      {[](FrameSourceOptions& o) { o.resize = "16x16"; }, "each side must be 32 to 16384"},
+      {[](FrameSourceOptions& o) { o.resize = "16000x16000"; }, "more than 67108864 pixels"},
+      {[](FrameSourceOptions& o) { o.resize = "100000"; }, "the longest side must be 32 to 16384"},
+      {[](FrameSourceOptions& o) { o.resize = "-640"; }, "the longest side"},
+      {[](FrameSourceOptions& o) { o.resize = "640x"; }, "is not WxH"},
+      {[](FrameSourceOptions& o) { o.max_frame_pixels = 10; }, "max_frame_pixels"},
+  };
+  for (const Case& c : cases) {
+    FrameSourceOptions options;
+    c.change(options);
+    try {
+      options.Check();
+      ADD_FAILURE() << "accepted: " << c.expected;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(c.expected), std::string::npos) << e.what();
+    }
+  }
+  FrameSourceOptions to_the_end;
+  to_the_end.last = -1;
+  EXPECT_NO_THROW(to_the_end.Check());
+}
+
+TEST(FrameSourceOptions, ALongestSideThatMakesFramesDegenerateIsAnError) {
+  testing::TempDir tmp;
+  // Panoramic frames of 1000x40: a longest side of 100 would make them 100x4.
+  for (int i = 0; i < 3; ++i) {
+    cv::imwrite((tmp.path() / ("p" + std::to_string(i) + ".png")).string(), cv::Mat(40, 1000, CV_8U, cv::Scalar(i)));
+  }
+  FrameSourceOptions options;
+  options.resize = "100";
+  const std::string error = OpenError(tmp.path().string(), options);
+  EXPECT_NE(error.find("turns frames of 1000x40 into 100x4"), std::string::npos) << error;
 }
 
 TEST(Tum, ReadsRgbTxtWithTimestamps) {

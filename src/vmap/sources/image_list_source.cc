@@ -34,10 +34,21 @@ class ImageListSource : public FrameSource {
       const ImageEntry& entry = entries_[index];
       Frame frame;
       // Grey straight from the decoder, as the matchers' reference implementations read images.
-      frame.gray = cv::imread(entry.path, cv::IMREAD_GRAYSCALE);
+      try {
+        frame.gray = cv::imread(entry.path, cv::IMREAD_GRAYSCALE);
+      } catch (const cv::Exception& error) {
+        // OpenCV refuses some files outright, e.g. a header announcing more than 2^30 pixels.
+        Skip(entry, "cannot decode it (" + LibraryMessage(error) + ")");
+        continue;
+      }
       if (frame.gray.empty()) {
-        ++skipped_;
-        spdlog::warn("cannot decode '{}' (corrupt or not an image); skipping it", entry.path);
+        Skip(entry, "cannot decode it (corrupt or not an image)");
+        continue;
+      }
+      const std::string size_problem = FrameSizeProblem(frame.gray.size(), options_);
+      if (!size_problem.empty()) {
+        Skip(entry, "it is " + std::to_string(frame.gray.cols) + "x" + std::to_string(frame.gray.rows) + ", " +
+                        size_problem);
         continue;
       }
       frame.index = delivered_++;
@@ -47,14 +58,14 @@ class ImageListSource : public FrameSource {
       frame.source_name = std::filesystem::path(entry.path).filename().string();
       if (frame.index == 0) {
         info_.native_size = frame.gray.size();
-        info_.frame_size = TargetSize(info_.native_size, options_.resize);
+        info_.frame_size = TargetSize(info_.native_size, options_);
       }
       FitFrame(frame, info_.frame_size, info_.native_size, options_, &size_warnings_);
       return frame;
     }
     if (delivered_ == 0) {
       throw InputError("none of the " + std::to_string(entries_.size()) + " images of '" + info_.path +
-                       "' could be decoded; check the files");
+                       "' could be used (see the warnings above); check the files");
     }
     return std::nullopt;
   }
@@ -63,6 +74,11 @@ class ImageListSource : public FrameSource {
   int skipped_frames() const override { return skipped_; }
 
  private:
+  void Skip(const ImageEntry& entry, const std::string& why) {
+    ++skipped_;
+    spdlog::warn("'{}': {}; skipping it", entry.path, why);
+  }
+
   std::vector<ImageEntry> entries_;
   FrameSourceOptions options_;
   SequenceInfo info_;

@@ -26,8 +26,9 @@ std::unique_ptr<FrameSource> OpenImageList(std::vector<ImageEntry> entries, cons
                                            SourceFormat format, const FrameSourceOptions& options);
 std::unique_ptr<FrameSource> OpenVideo(const std::string& path, const FrameSourceOptions& options);
 
-// Size frames are delivered at, given the first frame's native size and the --resize option.
-cv::Size TargetSize(const cv::Size& native, const std::string& resize);
+// Size frames are delivered at, given the first frame's native size and the --resize option. Throws
+// InputError when --resize is malformed or out of its range, or would make these frames degenerate.
+cv::Size TargetSize(const cv::Size& native, const FrameSourceOptions& options);
 
 // Brings a decoded frame to the sequence's frame size: the --resize target, or the first frame's size for
 // a frame that differs (a warning, or an error with strict).

@@ -77,6 +77,13 @@ class VideoSource : public FrameSource {
       if (!DecodeNext()) return Finish();
       const long index = position_++;
       if (index < options_.first || (index - options_.first) % options_.stride != 0) continue;
+      const std::string size_problem = FrameSizeProblem(cv::Size(decoded_->width, decoded_->height), options_);
+      if (!size_problem.empty()) {
+        ++skipped_;
+        spdlog::warn("{}: frame {} is {}x{}, {}; skipping it", info_.path, index, decoded_->width, decoded_->height,
+                     size_problem);
+        continue;
+      }
       Frame frame;
       frame.color = ToBgr(*decoded_);
       // Upright as the video is meant to be shown (phones store portrait video sideways), as OpenCV does.
@@ -90,7 +97,7 @@ class VideoSource : public FrameSource {
       frame.timestamp = Timestamp(index);
       if (frame.index == 0) {
         info_.native_size = frame.gray.size();
-        info_.frame_size = TargetSize(info_.native_size, options_.resize);
+        info_.frame_size = TargetSize(info_.native_size, options_);
       }
       FitFrame(frame, info_.frame_size, info_.native_size, options_, &size_warnings_);
       return frame;
@@ -117,6 +124,12 @@ class VideoSource : public FrameSource {
     if (stream_index_ < 0 || !codec) CannotOpen(path);
     const AVCodecParameters* parameters = format_->streams[stream_index_]->codecpar;
     if (parameters->width <= 0 || parameters->height <= 0) CannotOpen(path);
+    const std::string size_problem = FrameSizeProblem(cv::Size(parameters->width, parameters->height), options_);
+    if (!size_problem.empty()) {
+      throw InputError(fmt::format("video '{}' has frames of {}x{}, {}; scale it first (e.g. ffmpeg -i IN -vf "
+                                   "scale=1280:-2 OUT.mp4)",
+                                   path, parameters->width, parameters->height, size_problem));
+    }
     codec_.reset(avcodec_alloc_context3(codec));
     if (!codec_ || avcodec_parameters_to_context(codec_.get(), parameters) < 0) CannotOpen(path);
     codec_->thread_count = 1;  // see the note at the top of the file

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <fstream>
 #include <random>
 
 #include <opencv2/calib3d.hpp>
@@ -122,6 +123,33 @@ TempDir::~TempDir() {
   std::error_code ignored;
   fs::remove_all(path_, ignored);
 }
+
+void WritePngHeader(const fs::path& path, uint32_t width, uint32_t height) {
+  std::string bytes("\x89PNG\r\n\x1A\n", 8);
+  auto put = [&](uint32_t value) {
+    for (int i = 0; i < 4; ++i) bytes += static_cast<char>(value >> (24 - 8 * i));
+  };
+  auto chunk = [&](const std::string& type, const std::string& data) {
+    put(static_cast<uint32_t>(data.size()));
+    const std::string body = type + data;
+    bytes += body;
+    uint32_t crc = 0xFFFFFFFFu;  // CRC-32 of the chunk's type and data, as PNG defines it
+    for (unsigned char c : body) {
+      crc ^= c;
+      for (int bit = 0; bit < 8; ++bit) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+    }
+    put(~crc);
+  };
+  std::string header;
+  for (uint32_t value : {width, height}) {
+    for (int i = 0; i < 4; ++i) header += static_cast<char>(value >> (24 - 8 * i));
+  }
+  header += std::string("\x08\x00\x00\x00\x00", 5);  // 8 bits, grey, default compression, filter, interlace
+  chunk("IHDR", header);
+  chunk("IDAT", "");
+  std::ofstream(path, std::ios::binary) << bytes;
+}
+
 
 fs::path SharedDir() {
 #ifdef VMAP_SHARED_DIR

@@ -2,6 +2,7 @@
 // Synthetic sequences for tests: textured planes at several depths seen by a pinhole camera moving along
 // a known path, so that the true fundamental matrix between any two frames is known.
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -47,6 +48,10 @@ class TempDir {
  private:
   std::filesystem::path path_;
 };
+
+// The start of a PNG (signature, IHDR chunk, an empty IDAT chunk; CRCs included) announcing `width` x
+// `height` grey pixels, with no image data: a decoder reads the size, then finds nothing to decode.
+void WritePngHeader(const std::filesystem::path& path, uint32_t width, uint32_t height);
 
 // The shared data folder (../shared), or empty when absent.
 std::filesystem::path SharedDir();

@@ -1,0 +1,21 @@
+#pragma once
+// SIGINT, SIGTERM and SIGHUP end vmap without leaving its temporary outputs behind.
+//
+// Nothing runs inside a signal handler. InstallInterruptHandling() blocks these signals in the calling thread,
+// and so in every thread started after it, and starts one thread that waits for them with sigwait(). When one
+// arrives, that thread, as ordinary code, removes every temporary output still registered (atomic_output.h;
+// a commit in progress finishes first) and ends the process with status 128 + the signal's number, as shells
+// report it (130 for SIGINT, 143 for SIGTERM). Whatever the other threads were doing, the final outputs are
+// either the old ones or the new ones: they only ever appear by a rename.
+//
+// A signal that the process was started with ignored (nohup, `cmd &` in a script) stays ignored.
+//
+// The CLI calls this once, first thing in main(), before any other thread exists; the library never installs
+// it, so a program that embeds vmap keeps its own signal handling. (A mode in which SIGINT ends the input
+// gracefully would hook in where interrupt.cc handles a signal.)
+
+namespace vmap {
+
+void InstallInterruptHandling();
+
+}  // namespace vmap

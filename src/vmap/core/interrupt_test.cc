@@ -1,0 +1,93 @@
+#include "vmap/core/interrupt.h"
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "vmap/core/atomic_output.h"
+#include "vmap/testing/synthetic_scene.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+
+namespace {
+
+long CountEntries(const fs::path& directory) {
+  return std::distance(fs::directory_iterator(directory), fs::directory_iterator());
+}
+
+// Signal dispositions as a command started from a terminal has them, whatever this test runner inherited (a
+// shell starts background jobs with SIGINT ignored); and a deadline, so that a failure cannot hang the test.
+void StartAsFromATerminal() {
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) signal(signal_number, SIG_DFL);
+  alarm(20);
+}
+
+// In the child process of a death test: start writing an output, then receive `signal_number` from outside
+// (kill(), as a shell or a service manager sends it) and wait to be ended.
+[[noreturn]] void WriteAndReceive(const fs::path& target, int signal_number) {
+  StartAsFromATerminal();
+  InstallInterruptHandling();
+  AtomicOutputDirectory directory(target, OutputPolicy{});
+  std::ofstream(directory.path() / "half.txt") << "half";
+  WriteFileAtomically(target.parent_path() / "done.txt", "finished before the signal");
+  kill(getpid(), signal_number);
+  for (;;) pause();
+}
+
+}  // namespace
+
+// Death tests fork this process: each runs its statement in a child, so the signal handling installed there
+// never touches the test runner.
+TEST(InterruptDeathTest, SigintRemovesTheUnfinishedOutputAndExitsWith130) {
+  testing::TempDir tmp;
+  EXPECT_EXIT(WriteAndReceive(tmp.path() / "map", SIGINT), ::testing::ExitedWithCode(128 + SIGINT), "interrupted");
+  EXPECT_EQ(CountEntries(tmp.path()), 1) << "only the finished file remains";
+  EXPECT_TRUE(fs::exists(tmp.path() / "done.txt"));
+}
+
+TEST(InterruptDeathTest, SigtermAndSighupDoTheSame) {
+  for (int signal_number : {SIGTERM, SIGHUP}) {
+    testing::TempDir tmp;
+    EXPECT_EXIT(WriteAndReceive(tmp.path() / "map", signal_number), ::testing::ExitedWithCode(128 + signal_number),
+                "interrupted");
+    EXPECT_EQ(CountEntries(tmp.path()), 1) << strsignal(signal_number);
+  }
+}
+
+TEST(InterruptDeathTest, ASignalIgnoredAtStartStaysIgnored) {
+  testing::TempDir tmp;
+  // As under nohup: SIGHUP ignored before vmap starts.
+  EXPECT_EXIT(
+      {
+        StartAsFromATerminal();
+        signal(SIGHUP, SIG_IGN);
+        InstallInterruptHandling();
+        kill(getpid(), SIGHUP);
+        usleep(200000);
+        _exit(7);
+      },
+      ::testing::ExitedWithCode(7), "");
+}
+
+TEST(InterruptDeathTest, NothingIsRemovedAfterACommit) {
+  testing::TempDir tmp;
+  EXPECT_EXIT(
+      {
+        StartAsFromATerminal();
+        InstallInterruptHandling();
+        AtomicOutputDirectory directory(tmp.path() / "map", OutputPolicy{});
+        std::ofstream(directory.path() / "complete.txt") << "complete";
+        directory.Commit();
+        kill(getpid(), SIGTERM);
+        for (;;) pause();
+      },
+      ::testing::ExitedWithCode(128 + SIGTERM), "");
+  EXPECT_TRUE(fs::exists(tmp.path() / "map/complete.txt"));
+  EXPECT_EQ(CountEntries(tmp.path()), 1);
+}
+
+}  // namespace vmap
