@@ -6,7 +6,7 @@
 // of the teach run). The estimate is a position on that route: the frame is on the segment from `key`
 // (the key image last reached) to `next_key` (the one ahead).
 //
-// - Relocalization (at the start, and after the estimate was dropped): every key image of the route is
+// - Relocalization (at the start, and whenever tracking fails): every key image of the route is
 //   ranked cheaply (KeyImageRanking), the best few are verified like the map's own links (the map's matcher
 //   and fundamental-matrix verifier), and the best verified one, with the better of its two neighbours on
 //   the route, gives the segment.
@@ -20,7 +20,6 @@
 // "Better match" and "verified" are measured by the verified matches (inliers of F) and S, as in the map.
 
 #include <memory>
-#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -58,7 +57,7 @@ struct LocalizerOptions {
   // iterations (see MapVerifierOptions): a frame that shares little with a key image must fail fast.
   VerifierOptions verifier;
   SimilarityMode similarity = SimilarityMode::kInlierRatio;
-  // Key-image indices to follow, in order (RouteKeys gives one); empty = every key image in map order.
+  // Key-image indices to follow, in order (PlanRoute gives one); empty = every key image in map order.
   std::vector<int> route;
   // HOOK(camera): the camera model of the geometry stage (intrinsics from the dataset or --camera, stored
   // in map.json) goes here as an optional member. With it, Localizer::Compare (where the verified matches
