@@ -26,6 +26,7 @@ namespace fs = std::filesystem;
 void MapBuilderOptions::Check() const {
   key_images.Check();
   verifier.Check();
+  link_analysis.Check();
   if (prefetch_frames < 1) throw InputError("prefetch_frames must be >= 1");
   if (extraction_threads < 0) throw InputError("--threads must be >= 0 (0 = one per core)");
 }
@@ -59,7 +60,7 @@ struct PipelineItem {
 //
 // Key changes are followed by the workers too. A key image is retired as soon as a worker sees a frame j
 // fail against it: every selector holding it leaves it at frame j at the latest, for frame j-1 (or for j
-// itself when j-1 is that key: a broken link). Frame j and the later ones are compared with that successor
+// itself when j-1 is that key: a link below tau). Frame j and the later ones are compared with that successor
 // at once, as the consumer will ask, instead of with the old key at low S, where MAGSAC needs the most
 // iterations (up to 60 ms a pair on lab_floor) only for the result to be thrown away, and the consumer then
 // redoing the comparisons one by one while the workers wait.
@@ -304,8 +305,9 @@ class KeyImageFileWriter {
   std::thread thread_;        // last: starts after every other member exists
 };
 
+// `analyze_links`: also each link's pose, parallax and homography test (only maps that are kept need them).
 VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source, const MapBuilderOptions& options,
-                     const std::string& options_json, double seconds) {
+                     const std::string& options_json, double seconds, bool analyze_links) {
   VisualMap map;
   map.input = source.info();
   map.options_json = options_json;
@@ -316,6 +318,12 @@ VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source
   map.evaluations = selector.evaluations();
   map.seconds = seconds;
   map.quality = ComputeStatistics(map, options.quality_mean).quality;
+  if (!analyze_links) return map;
+  const auto analysis_start = std::chrono::steady_clock::now();
+  AnalyzeLinks(map, options.link_analysis, options.ExtractionThreads());
+  spdlog::debug("pose, parallax and homography test of {} links in {:.3f} s",
+                map.links.size(),
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - analysis_start).count());
   return map;
 }
 
@@ -429,7 +437,7 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
   result.input = source.info();
   result.seconds = seconds;
   for (size_t i = 0; i < selectors.size(); ++i) {
-    VisualMap map = CollectMap(*selectors[i], source, options, options_json, seconds);
+    VisualMap map = CollectMap(*selectors[i], source, options, options_json, seconds, maps != nullptr);
     const MapStatistics stats = ComputeStatistics(map, options.quality_mean);
     result.num_frames = map.num_frames;
     SweepRow row;
@@ -441,7 +449,7 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
     row.mean_verified = stats.mean_verified;
     row.mean_similarity = stats.mean_similarity;
     row.quality = stats.quality;
-    row.broken_links = stats.broken_links;
+    row.below_tau_links = stats.below_tau_links;
     row.map_directory = directories[i].string();
     result.rows.push_back(row);
     if (result.best_row < 0 || row.quality > result.rows[result.best_row].quality) {

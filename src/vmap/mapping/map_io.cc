@@ -8,6 +8,7 @@
 
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
+#include "vmap/mapping/map_geometry_json.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -29,6 +30,8 @@ json MapDocument(const VisualMap& map, const std::vector<long>& offsets) {
                   {"native_size", SizeJson(map.input.native_size)},
                   {"frame_size", SizeJson(map.input.frame_size)},
                   {"fps", map.input.fps}};
+  doc["input"]["camera"] = map.input.camera ? CameraToJson(*map.input.camera) : json(nullptr);
+  doc["conventions"] = MapConventionsJson();
   doc["options"] = map.options_json.empty() ? json::object() : json::parse(map.options_json);
   doc["num_frames"] = map.num_frames;
   doc["skipped_frames"] = map.skipped_frames;
@@ -55,16 +58,18 @@ json MapDocument(const VisualMap& map, const std::vector<long>& offsets) {
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c) F.push_back(l.F(r, c));
     }
-    links.push_back({{"from", l.from_key},
-                     {"to", l.to_key},
-                     {"from_frame", map.key_images.at(l.from_key).frame_index},
-                     {"to_frame", map.key_images.at(l.to_key).frame_index},
-                     {"broken", l.broken},
-                     {"similarity", l.similarity},
-                     {"tentative", l.num_tentative},
-                     {"verified", l.num_verified},
-                     {"F", F},
-                     {"correspondences", {{"offset", offsets[i]}, {"count", l.correspondences.size()}}}});
+    json link = {{"from", l.from_key},
+                 {"to", l.to_key},
+                 {"from_frame", map.key_images.at(l.from_key).frame_index},
+                 {"to_frame", map.key_images.at(l.to_key).frame_index},
+                 {"below_tau", l.below_tau},
+                 {"similarity", l.similarity},
+                 {"tentative", l.num_tentative},
+                 {"verified", l.num_verified},
+                 {"F", F},
+                 {"correspondences", {{"offset", offsets[i]}, {"count", l.correspondences.size()}}}};
+    AddLinkGeometryJson(l, link);
+    links.push_back(std::move(link));
   }
   doc["links"] = std::move(links);
   // Column-wise: a long sequence has one evaluation per frame or more.
@@ -169,6 +174,9 @@ VisualMap ReadMap(const fs::path& directory) {
   map.input.native_size = SizeField(input, "native_size");
   map.input.frame_size = SizeField(input, "frame_size");
   map.input.fps = input.value("fps", 0.0);
+  if (input.contains("camera") && !input["camera"].is_null()) {
+    map.input.camera = CameraFromJson(input["camera"], file.string(), "input.camera");
+  }
   map.options_json = doc.contains("options") ? doc["options"].dump() : "{}";
   map.num_frames = Field<int>(doc, "num_frames", file, "map.json");
   map.skipped_frames = doc.value("skipped_frames", 0);
@@ -218,7 +226,8 @@ VisualMap ReadMap(const fs::path& directory) {
     if (l.from_key < 0 || l.from_key >= num_keys || l.to_key < 0 || l.to_key >= num_keys) {
       Malformed(file, where + " names a key image that does not exist");
     }
-    l.broken = links[i].value("broken", false);
+    // Schema version 1 called the flag `broken`.
+    l.below_tau = links[i].contains("below_tau") ? links[i].value("below_tau", false) : links[i].value("broken", false);
     l.similarity = Field<double>(links[i], "similarity", file, where);
     l.num_tentative = Field<int>(links[i], "tentative", file, where);
     l.num_verified = Field<int>(links[i], "verified", file, where);
@@ -241,6 +250,7 @@ VisualMap ReadMap(const fs::path& directory) {
       std::memcpy(rec, binary.data() + (offset + r) * sizeof(rec), sizeof(rec));
       l.correspondences[r] = {{rec[0], rec[1]}, {rec[2], rec[3]}};
     }
+    ReadLinkGeometryJson(links[i], l, file.string(), where);
     map.links.push_back(std::move(l));
   }
 
