@@ -89,7 +89,12 @@ GroundTruthFormat DetectGroundTruthFormat(const std::string& path) {
     ++number;
     if (!IsDataLine(line)) continue;
     const bool commas = line.find(',') != std::string::npos;
-    const size_t count = LineNumbers(line, path, number).size();
+    size_t count = 0;
+    try {
+      count = LineNumbers(line, path, number).size();
+    } catch (const InputError&) {
+      break;  // not numbers: none of the formats
+    }
     if (commas && count >= 8) return GroundTruthFormat::kEuroc;
     if (!commas && count == 12) return GroundTruthFormat::kKitti;
     if (!commas && count == 8) return GroundTruthFormat::kTum;

@@ -37,6 +37,8 @@ struct PoseOptions {
   // several hypotheses: USAC run with `starts` seeds (seed, seed + 1, ...) and any given start (the pose of
   // F); each is refined, and the one with the lowest robust cost over all the matches wins.
   int starts = 3;
+  // Callers that have the link's F add its pose as one more start (mapping/link_analysis.cc).
+  bool start_from_fundamental = true;
   // Refine each start by Levenberg-Marquardt on the Sampson errors of the matches within
   // refine_inlier_factor * threshold, with a Cauchy loss of scale `threshold` (RANSAC's model fits a minimal
   // sample and a linear local optimisation, not the matches' geometric error).

@@ -42,8 +42,10 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
       pose = PoseFromFundamental(link.F, *camera, verified_from, verified_to);
     } else {
       // The pose of F is one more start: where it is right and USAC's are not, it wins on cost.
-      const std::vector<RelativePose> from_fundamental = {
-          PoseFromFundamental(link.F, *camera, verified_from, verified_to)};
+      std::vector<RelativePose> from_fundamental;
+      if (options.pose.start_from_fundamental) {
+        from_fundamental.push_back(PoseFromFundamental(link.F, *camera, verified_from, verified_to));
+      }
       pose = options.pose.use_all_matches
                  ? EstimateRelativePose(*camera, all_from, all_to, options.pose, from_fundamental)
                  : EstimateRelativePose(*camera, verified_from, verified_to, options.pose, from_fundamental);

@@ -23,6 +23,14 @@ std::string FormatMapSummary(const VisualMap& map, QualityMean mean) {
     if (s.below_tau_links > 0) text += fmt::format("  ({} links below tau)", s.below_tau_links);
     text += "\n";
   }
+  if (map.input.camera) {
+    const Camera& c = *map.input.camera;
+    text += fmt::format("camera          {} {}x{} fx {:.2f} fy {:.2f} cx {:.2f} cy {:.2f}{}; links with a pose {} of {}\n",
+                        CameraModelName(c.model), c.size.width, c.size.height, c.fx, c.fy, c.cx, c.cy,
+                        c.has_distortion() ? " (with distortion)" : "",
+                        std::count_if(map.links.begin(), map.links.end(), [](const Link& l) { return l.has_pose; }),
+                        map.links.size());
+  }
   text += fmt::format("quality Q       {:.4f} ({} mean)\n", s.quality, QualityMeanName(mean));
   if (map.seconds > 0) {
     text += fmt::format("time            {:.2f} s ({:.1f} frames/s)\n", map.seconds, s.num_frames / map.seconds);
