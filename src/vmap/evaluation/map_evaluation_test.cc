@@ -97,6 +97,19 @@ TEST(MapEvaluation, SyntheticKittiSequenceHasOnlyUsableLinks) {
   EXPECT_LT(e.summary.translation_error_deg_median, 5.0);
 }
 
+TEST(MapEvaluation, PosesDoNotDependOnTheNumberOfThreads) {
+  VisualMap again = Kitti().map;
+  AnalyzeLinks(again, LinkAnalysisOptions(), 1);
+  const VisualMap& built = Kitti().map;  // analysed on every core
+  ASSERT_EQ(again.links.size(), built.links.size());
+  for (size_t i = 0; i < again.links.size(); ++i) {
+    EXPECT_EQ(again.links[i].R, built.links[i].R);
+    EXPECT_EQ(again.links[i].t, built.links[i].t);
+    EXPECT_EQ(again.links[i].parallax, built.links[i].parallax);
+    EXPECT_EQ(again.links[i].homography_share, built.links[i].homography_share);
+  }
+}
+
 TEST(MapEvaluation, PoseFromFundamentalWhenTheMapHasNone) {
   VisualMap map = Kitti().map;
   for (Link& link : map.links) link.has_pose = false;

@@ -65,7 +65,8 @@ struct PipelineItem {
 // iterations (up to 60 ms a pair on lab_floor) only for the result to be thrown away, and the consumer then
 // redoing the comparisons one by one while the workers wait.
 //
-// The consumer compares whatever the workers did not guess. ComparePair is deterministic, so the map is the
+// The consumer compares whatever the workers did not guess (also when the selector picks another successor,
+// as it does for a frame that repeats the key image's view). ComparePair is deterministic, so the map is the
 // same whatever the threads do.
 class FeaturePipeline {
  public:

@@ -215,6 +215,14 @@ TEST(MapIo, MalformedGeometryIsRefused) {
   doc["links"][0]["parallax_px"] = "far";
   WriteText(tmp.path() / kMapFileName, doc.dump());
   EXPECT_NE(ErrorOf(tmp.path()).find("parallax_px"), std::string::npos) << ErrorOf(tmp.path());
+  doc = original;
+  doc["links"][1]["planar"] = "yes";
+  WriteText(tmp.path() / kMapFileName, doc.dump());
+  EXPECT_NE(ErrorOf(tmp.path()).find("links[1]"), std::string::npos) << ErrorOf(tmp.path());
+  doc = original;
+  doc["input"]["camera"] = {{"model", "PINHOLE"}, {"params", {500, 500, 32, 24}}, {"width", "wide"}};
+  WriteText(tmp.path() / kMapFileName, doc.dump());
+  EXPECT_NE(ErrorOf(tmp.path()).find("input.camera"), std::string::npos) << ErrorOf(tmp.path());
 }
 
 }  // namespace vmap
