@@ -12,5 +12,6 @@ void AddMatchCommand(CLI::App& app);
 void AddWeightsCommand(CLI::App& app);
 void AddReportCommand(CLI::App& app);
 void AddDrawCommand(CLI::App& app);
+void AddEvalCommand(CLI::App& app);
 
 }  // namespace vmap::cli

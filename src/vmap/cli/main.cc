@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   vmap::cli::AddWeightsCommand(app);
   vmap::cli::AddReportCommand(app);
   vmap::cli::AddDrawCommand(app);
+  vmap::cli::AddEvalCommand(app);
 
   // vmap runs frames in parallel itself; OpenCV's own threads inside ORB then only add contention
   // (measured: 5.1 ms per 640x480 frame on one thread, 7.2 ms with two).
