@@ -130,7 +130,7 @@ TEST(Cli, LoftrBuildsAMapEndToEnd) {
   int verified_links = 0;
   for (const Link& link : map.links) {
     EXPECT_EQ(static_cast<int>(link.correspondences.size()), link.num_tentative);
-    if (link.broken) continue;
+    if (link.below_tau) continue;
     ++verified_links;
     EXPECT_TRUE(link.has_fundamental);
     EXPECT_GE(link.num_verified, 8);

@@ -12,6 +12,7 @@ void AddMatchCommand(CLI::App& app);
 void AddWeightsCommand(CLI::App& app);
 void AddReportCommand(CLI::App& app);
 void AddDrawCommand(CLI::App& app);
+void AddEvalCommand(CLI::App& app);
 void AddLocalizeCommand(CLI::App& app);
 void AddRouteCommand(CLI::App& app);
 

@@ -59,6 +59,10 @@ void AddSourceOptions(CLI::App* command, SourceFlags& flags) {
   command->add_option("--stride", flags.options.stride, "Use every N-th frame")->capture_default_str();
   command->add_option("--resize", flags.options.resize, "Resize frames: WxH, or the longest side (e.g. 640)");
   command->add_flag("--strict", flags.options.strict, "Frames of a different size are an error, not a warning");
+  command->add_option("--camera", flags.options.camera,
+                      "Intrinsics: fx,fy,cx,cy[,k1,k2,p1,p2[,k3]] (pixels, native frame size) or a calibration file "
+                      "(OpenCV YAML/JSON, EuRoC sensor.yaml, KITTI calib.txt, intrinsics.txt); 'none' ignores the "
+                      "input's own. Default: the input's own, if any");
 }
 
 }  // namespace vmap::cli

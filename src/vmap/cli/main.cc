@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   vmap::cli::AddWeightsCommand(app);
   vmap::cli::AddReportCommand(app);
   vmap::cli::AddDrawCommand(app);
+  vmap::cli::AddEvalCommand(app);
   vmap::cli::AddLocalizeCommand(app);
   vmap::cli::AddRouteCommand(app);
 

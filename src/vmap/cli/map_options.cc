@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "vmap/core/error.h"
 #include "vmap/mapping/map_io.h"
 #include "vmap/report/html_report.h"
 #include "vmap/report/summary.h"
@@ -15,7 +16,15 @@ MapBuilderOptions KeyImageFlags::Resolve() const {
   options.key_images.final_key = final_key;
   options.quality_mean = ParseQualityMean(quality);
   options.extraction_threads = threads;
+  options.key_images.min_key_displacement = min_key_displacement;
+  options.link_analysis.pose.method = ParsePoseMethod(pose_method);
+  options.link_analysis.pose.threshold = pose_threshold;
+  if (pose_matches != "all" && pose_matches != "verified") {
+    throw InputError("--pose-matches '" + pose_matches + "': use all (every tentative match) or verified (F's inliers)");
+  }
+  options.link_analysis.pose.use_all_matches = pose_matches == "all";
   options.key_images.Check();
+  options.link_analysis.Check();
   return options;
 }
 
@@ -31,6 +40,19 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau) 
       ->capture_default_str();
   command->add_flag("!--no-final-key", flags.final_key, "Do not make the last frame a key image");
   command->add_option("--threads", flags.threads, "Feature-extraction threads, 0 to 256 (0 = one per core)")
+      ->capture_default_str();
+  command->add_option("--min-key-displacement", flags.min_key_displacement,
+                      "Pixels: a frame whose matches with the key image moved less (median) repeats its view and is "
+                      "never made a key image; 0 = off (Algorithm 1 as published)")
+      ->capture_default_str();
+  command->add_option("--pose", flags.pose_method,
+                      "Relative pose of each link, with a camera: essential (E on normalised points) or fundamental "
+                      "(E = K^T F K)")
+      ->capture_default_str();
+  command->add_option("--pose-threshold", flags.pose_threshold, "Inlier threshold of the essential matrix, pixels")
+      ->capture_default_str();
+  command->add_option("--pose-matches", flags.pose_matches,
+                      "Matches the essential matrix is estimated on: all (tentative) or verified (F's inliers)")
       ->capture_default_str();
 }
 
@@ -50,6 +72,17 @@ std::string DescribeOptions(const Matcher& matcher, const MapBuilderOptions& opt
   doc["quality_mean"] = QualityMeanName(options.quality_mean);
   doc["source"] = {{"format", SourceFormatName(source.format)}, {"first", source.first}, {"last", source.last},
                    {"stride", source.stride},  {"resize", source.resize},     {"strict", source.strict}};
+  doc["source"]["camera"] = source.camera.empty() ? "input" : source.camera;
+  doc["min_key_displacement"] = options.key_images.min_key_displacement;
+  const PoseOptions& pose = options.link_analysis.pose;
+  doc["pose"] = {{"method", PoseMethodName(pose.method)},
+                 {"threshold", pose.threshold},
+                 {"matches", pose.use_all_matches ? "all" : "verified"},
+                 {"confidence", pose.confidence},
+                 {"max_iterations", pose.max_iterations},
+                 {"seed", pose.seed}};
+  const HomographyOptions& homography = options.link_analysis.homography;
+  doc["homography"] = {{"threshold", homography.threshold}, {"min_share", homography.min_share}};
   return doc.dump();
 }
 

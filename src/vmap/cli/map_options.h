@@ -19,8 +19,14 @@ struct KeyImageFlags {
   std::string quality = "arithmetic";
   bool final_key = true;
   int threads = 0;
+  double min_key_displacement = KeyImageOptions().min_key_displacement;
+  // The pose of each link (with a camera) and the homography test.
+  std::string pose_method = PoseMethodName(PoseOptions().method);
+  double pose_threshold = PoseOptions().threshold;
+  std::string pose_matches = PoseOptions().use_all_matches ? "all" : "verified";
   MapBuilderOptions Resolve() const;
 };
+// Also --min-key-displacement, --pose, --pose-threshold, --pose-matches.
 void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau = true);
 
 // Every option that shaped a map, as JSON text for map.json.

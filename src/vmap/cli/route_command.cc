@@ -44,10 +44,10 @@ void RunRoute(const RouteFlags& flags) {
     const Link& l = map.links[s.link];
     std::cout << fmt::format("| {} | {} ({}) | {} ({}) | {} | {} | {:.3f} | {} |\n", i, s.from_key,
                              map.key_images[s.from_key].frame_index, s.to_key, map.key_images[s.to_key].frame_index,
-                             s.link, s.backwards ? "backwards" : (s.broken ? "forwards, broken" : "forwards"),
+                             s.link, s.backwards ? "backwards" : (s.unverified ? "forwards, no F" : "forwards"),
                              l.similarity, l.num_verified);
     steps.push_back({{"from", s.from_key}, {"to", s.to_key}, {"link", s.link}, {"backwards", s.backwards},
-                     {"broken", s.broken}, {"similarity", l.similarity}, {"verified", l.num_verified}});
+                     {"unverified", s.unverified}, {"similarity", l.similarity}, {"verified", l.num_verified}});
   }
   if (!flags.json.empty()) {
     const nlohmann::json doc = {{"format", "vmap-route"}, {"map", flags.map},      {"from", flags.from},

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 
@@ -11,6 +12,7 @@
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/evaluation/map_evaluation.h"
 #include "vmap/mapping/map_builder.h"
 #include "vmap/mapping/map_io.h"
 #include "vmap/report/html_report.h"
@@ -31,6 +33,9 @@ struct SweepFlags {
   MatcherOptions matcher;
   VerifierFlags verifier;
   KeyImageFlags key_images;
+  bool evaluate = false;  // --gt given, with or without a file
+  std::string gt;
+  std::string gt_format = "auto";
 };
 
 // Whether two output paths name the same folder (neither need exist yet).
@@ -66,12 +71,36 @@ void RunSweep(const SweepFlags& flags) {
   const std::unique_ptr<Matcher> matcher = CreateMatcher(flags.matcher);
   const std::unique_ptr<FrameSource> source = OpenFrameSource(flags.input, source_options);
   const std::string options_json = DescribeOptions(*matcher, options, source_options);
+
+  // The ground truth is read before the sweep: a missing file fails at once, not after the whole input.
+  std::optional<GroundTruth> truth;
+  if (flags.evaluate) {
+    VisualMap input_only;
+    input_only.input.path = flags.input;
+    input_only.input.format = source_options.format;
+    truth = MapGroundTruth(input_only, flags.gt, ParseGroundTruthFormat(flags.gt_format));
+  }
   std::vector<VisualMap> maps;
-  SweepResult sweep = SweepThresholds(*source, *matcher, options, taus, flags.write_maps ? &maps : nullptr,
+  const bool keep_maps = flags.write_maps || flags.evaluate;
+  SweepResult sweep = SweepThresholds(*source, *matcher, options, taus, keep_maps ? &maps : nullptr,
                                       flags.write_maps ? directory->path() : fs::path(), options_json);
-  if (directory) {
+  std::vector<MapEvaluation> evaluations;
+  if (truth && !maps.empty()) {
+    // Every tau's map against the same ground truth, with the default usability criterion of `vmap eval`.
+    const Camera camera = EvaluationCamera(maps.front(), "");
     for (size_t i = 0; i < maps.size(); ++i) {
+      evaluations.push_back(EvaluateMap(maps[i], *truth, camera, EvaluationOptions()));
+      sweep.rows[i].usable_links = evaluations.back().summary.usable_links;
+    }
+  }
+  if (directory) {
+    for (size_t i = 0; flags.write_maps && i < maps.size(); ++i) {
       WriteMapFiles(maps[i], sweep.rows[i].map_directory);
+      if (i < evaluations.size()) {
+        evaluations[i].map_path = sweep.rows[i].map_directory;
+        WriteFileAtomically(fs::path(sweep.rows[i].map_directory) / kEvaluationFileName,
+                            EvaluationToJson(evaluations[i]));
+      }
       if (!flags.report.empty()) {
         // Each tau's map gets its own page, so the sweep page links to pages rather than to map.json.
         MapReportOptions report_options;
@@ -116,7 +145,16 @@ void AddSweepCommand(CLI::App& app) {
   AddMatcherOptions(command, flags->matcher);
   AddVerifierOptions(command, flags->verifier);
   AddKeyImageOptions(command, flags->key_images, /*with_tau=*/false);
-  command->callback([flags] { RunSweep(*flags); });
+  CLI::Option* gt = command->add_option("--gt", flags->gt,
+                                        "Add a usable-links column (see `vmap eval`): with no FILE, the input's own "
+                                        "ground truth; or a kitti, tum or euroc poses file")
+                        ->expected(0, 1);
+  command->add_option("--gt-format", flags->gt_format, "Format of --gt FILE: auto, kitti, tum, euroc")
+      ->capture_default_str();
+  command->callback([flags, gt] {
+    flags->evaluate = gt->count() > 0;
+    RunSweep(*flags);
+  });
 }
 
 }  // namespace vmap::cli

@@ -59,11 +59,12 @@ struct LocalizerOptions {
   SimilarityMode similarity = SimilarityMode::kInlierRatio;
   // Key-image indices to follow, in order (PlanRoute gives one); empty = every key image in map order.
   std::vector<int> route;
-  // HOOK(camera): the camera model of the geometry stage (intrinsics from the dataset or --camera, stored
-  // in map.json) goes here as an optional member. With it, Localizer::Compare (where the verified matches
+  // HOOK(camera): the map's camera (map.input.camera, geometry/camera.h: intrinsics from the dataset or
+  // --camera, stored in map.json) goes here as an optional member. With it, Localizer::Compare (where the verified matches
   // are at hand) adds to KeyComparison the heading in degrees (median over the verified matches of the
   // difference of atan((x - cx) / fx) in the frame and in the key image) and the relative pose (R, unit t)
-  // from E = K^T F K, and Localizer::Describe copies the target's into the result. Until then: pixels only.
+  // by PoseFromFundamental (geometry/relative_pose.h), and Localizer::Describe copies the target's into the
+  // result. Until then: pixels only.
 
   void Check() const;  // throws InputError naming the bad option
 };

@@ -33,14 +33,15 @@ Route PlanRoute(const VisualMap& map, int from, int to, const RouteOptions& opti
   std::vector<Refusal> refusals;
   for (size_t i = 0; i < map.links.size(); ++i) {
     const Link& l = map.links[i];
-    steps[l.from_key].push_back({l.from_key, l.to_key, static_cast<int>(i), false, l.broken});
-    const bool verified = !l.broken && l.has_fundamental && l.num_verified >= options.min_backward_verified;
+    steps[l.from_key].push_back({l.from_key, l.to_key, static_cast<int>(i), false, !l.has_fundamental});
+    const bool verified = l.has_fundamental && l.num_verified >= options.min_backward_verified;
     if (verified) {
       steps[l.to_key].push_back({l.to_key, l.from_key, static_cast<int>(i), true, false});
     } else {
       refusals.push_back({std::min(l.from_key, l.to_key), std::max(l.from_key, l.to_key),
                           fmt::format("link {} (key {} -> {}) is {}", i, l.from_key, l.to_key,
-                                      l.broken ? "broken" : fmt::format("verified by {} matches only", l.num_verified))});
+                                      !l.has_fundamental ? std::string("not verified (matching failed)")
+                                                         : fmt::format("verified by {} matches only", l.num_verified))});
     }
   }
   // Breadth-first: fewest steps; ties go to the lower link index, so the result is deterministic.
@@ -78,8 +79,8 @@ Route PlanRoute(const VisualMap& map, int from, int to, const RouteOptions& opti
   route.keys.push_back(from);
   for (const RouteStep& s : route.steps) {
     route.keys.push_back(s.to_key);
-    if (s.broken) {
-      route.warnings.push_back(fmt::format("link {} (key {} -> {}) is broken: no verified guidance between them; "
+    if (s.unverified) {
+      route.warnings.push_back(fmt::format("link {} (key {} -> {}) has no F: no verified guidance between them; "
                                            "the robot relocalizes after it", s.link, s.from_key, s.to_key));
     }
   }

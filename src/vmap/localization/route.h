@@ -2,14 +2,15 @@
 // Route planning on a map (stage 3): the key images to follow from one key image to another.
 //
 // A link joins two consecutive key images of the teach run. It is followed forwards (in the teach run's
-// direction) always: the teach run drove it. A broken link (its second key image did not pass the test
-// against the first) is still followed forwards, with a warning: there is no verified visual guidance
-// between its two key images, and the robot has to relocalize after it.
+// direction) always: the teach run drove it. A link without F (matching failed between its key images) is
+// still followed forwards, with a warning: there is no verified guidance between its two key images, and the
+// robot has to relocalize after it.
 // A link is followed backwards (the robot retracing the teach run in reverse, e.g. reversing with the camera
 // facing as in the teach run) only when the map shows that its two key images see the same scene: the link
-// is not broken and has at least `min_backward_verified` verified matches. Verification is symmetric (the
-// same matches and F, transposed), so such a link guides the robot either way; a broken or weak link blocks
-// a backward route.
+// has F and at least `min_backward_verified` verified matches. Verification is symmetric (the same matches
+// and F, transposed), so such a link guides the robot either way; a link without F, or with fewer verified
+// matches, blocks a backward route. (A link below tau, whose S fell under the threshold within one frame,
+// has an F as good as any and is followed both ways when it has the matches.)
 
 #include <string>
 #include <vector>
@@ -29,7 +30,7 @@ struct RouteStep {
   int to_key = 0;
   int link = 0;           // index into VisualMap::links
   bool backwards = false; // against the teach run's direction
-  bool broken = false;    // the link is broken (forwards only)
+  bool unverified = false;  // the link has no F (forwards only)
 };
 
 struct Route {

@@ -7,7 +7,8 @@
 namespace vmap {
 namespace {
 
-// Key images 0..5 of one teach run; link 2 (key 2 -> 3) is broken, link 4 (key 4 -> 5) is weak.
+// Key images 0..5 of one teach run; link 2 (key 2 -> 3) has no F (matching failed), link 4 (key 4 -> 5) is
+// weak, link 1 is below tau (with an F as good as any).
 VisualMap ChainMap() {
   VisualMap map;
   for (int k = 0; k < 6; ++k) {
@@ -22,7 +23,7 @@ VisualMap ChainMap() {
     link.num_verified = k == 4 ? 12 : 150;
     link.similarity = 0.6;
     link.has_fundamental = k != 2;
-    link.broken = k == 2;
+    link.below_tau = k == 1;
     map.links.push_back(link);
   }
   return map;
@@ -37,7 +38,7 @@ std::string ErrorOf(const VisualMap& map, int from, int to) {
   return "";
 }
 
-TEST(Route, ForwardsIsTheTeachRunsOrderAndWarnsAboutBrokenLinks) {
+TEST(Route, ForwardsIsTheTeachRunsOrderAndWarnsAboutLinksWithoutF) {
   const Route route = PlanRoute(ChainMap(), 1, 5);
   EXPECT_EQ(route.keys, (std::vector<int>{1, 2, 3, 4, 5}));
   ASSERT_EQ(route.steps.size(), 4u);
@@ -45,7 +46,8 @@ TEST(Route, ForwardsIsTheTeachRunsOrderAndWarnsAboutBrokenLinks) {
     EXPECT_FALSE(route.steps[i].backwards);
     EXPECT_EQ(route.steps[i].link, static_cast<int>(i) + 1);
   }
-  EXPECT_TRUE(route.steps[1].broken);
+  EXPECT_TRUE(route.steps[1].unverified);
+  EXPECT_FALSE(route.steps[0].unverified);
   ASSERT_EQ(route.warnings.size(), 1u);
   EXPECT_NE(route.warnings[0].find("link 2"), std::string::npos) << route.warnings[0];
 }
@@ -55,10 +57,10 @@ TEST(Route, BackwardsOnlyOverVerifiedLinks) {
   EXPECT_EQ(route.keys, (std::vector<int>{2, 1, 0}));
   for (const RouteStep& s : route.steps) EXPECT_TRUE(s.backwards);
   EXPECT_TRUE(route.warnings.empty());
-  // Across the broken link, and over the weak one, there is no way back.
-  const std::string broken = ErrorOf(ChainMap(), 4, 1);
-  EXPECT_NE(broken.find("no route from key image 4 to key image 1"), std::string::npos) << broken;
-  EXPECT_NE(broken.find("link 2 (key 2 -> 3) is broken"), std::string::npos) << broken;
+  // Across the link without F, and over the weak one, there is no way back; the one below tau is fine.
+  const std::string unverified = ErrorOf(ChainMap(), 4, 1);
+  EXPECT_NE(unverified.find("no route from key image 4 to key image 1"), std::string::npos) << unverified;
+  EXPECT_NE(unverified.find("link 2 (key 2 -> 3) is not verified"), std::string::npos) << unverified;
   const std::string weak = ErrorOf(ChainMap(), 5, 4);
   EXPECT_NE(weak.find("verified by 12 matches only"), std::string::npos) << weak;
   RouteOptions lenient;

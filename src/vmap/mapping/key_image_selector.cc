@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/error.h"
+#include "vmap/geometry/relative_pose.h"
 
 namespace vmap {
 
@@ -22,6 +23,11 @@ std::string SimilarityModeName(SimilarityMode mode) {
 void KeyImageOptions::Check() const {
   if (!(tau > 0.0 && tau <= 1.0)) {
     throw InputError(fmt::format("threshold tau = {} is outside (0, 1]; the paper uses 0.1 to 0.9", tau));
+  }
+  if (!(min_key_displacement >= 0.0 && min_key_displacement <= 100.0)) {
+    throw InputError(fmt::format("--min-key-displacement {} px is outside [0, 100]; the default is 1, 0 turns the "
+                                 "check off",
+                                 min_key_displacement));
   }
 }
 
@@ -47,6 +53,12 @@ PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features
     }
   }
   if (result.matched) {
+    std::vector<double> displacements;
+    displacements.reserve(result.num_verified);
+    for (int i = 0; i < result.num_verified; ++i) {
+      displacements.push_back(cv::norm(result.correspondences[i].p1 - result.correspondences[i].p0));
+    }
+    result.median_displacement = Median(std::move(displacements));
     const int denominator = similarity == SimilarityMode::kInlierRatio
                                 ? result.num_tentative
                                 : std::max(features0.num_features(), features1.num_features());
@@ -64,6 +76,12 @@ bool KeyImageSelector::Passes(const PairComparison& comparison) const {
   return comparison.matched && comparison.similarity >= options_.tau;
 }
 
+bool KeyImageSelector::ShowsKeyView(const PairComparison& comparison) const {
+  // A displacement < 0 was not measured (a comparison made elsewhere): the frame counts as a new view.
+  return comparison.matched && comparison.median_displacement >= 0.0 &&
+         comparison.median_displacement < options_.min_key_displacement;
+}
+
 void KeyImageSelector::AddKeyImage(const FrameRecord& record, const std::string& reason) {
   KeyImage key;
   key.frame_index = record.frame->index;
@@ -78,13 +96,15 @@ void KeyImageSelector::AddKeyImage(const FrameRecord& record, const std::string&
   key_images_.push_back(std::move(key));
   key_ = record;
   previous_.reset();
+  still_frames_ = 0;
+  last_frame_still_ = false;
 }
 
-void KeyImageSelector::AddLink(const PairComparison& comparison, bool broken) {
+void KeyImageSelector::AddLink(const PairComparison& comparison, bool below_tau) {
   Link link;
   link.from_key = static_cast<int>(key_images_.size()) - 2;
   link.to_key = static_cast<int>(key_images_.size()) - 1;
-  link.broken = broken;
+  link.below_tau = below_tau;
   link.similarity = comparison.similarity;
   link.num_tentative = comparison.num_tentative;
   link.num_verified = comparison.num_verified;
@@ -108,6 +128,11 @@ void KeyImageSelector::Add(const FrameRecord& record) {
     evaluations_.push_back({key_->frame->index, record.frame->index, comparison.similarity,
                             comparison.num_tentative, comparison.num_verified, comparison.matched});
     if (Passes(comparison)) {
+      last_frame_still_ = ShowsKeyView(comparison);
+      if (last_frame_still_) {
+        ++still_frames_;  // the key image's view again: not a candidate for the next key image
+        return;
+      }
       previous_ = record;
       previous_comparison_ = std::move(comparison);
       return;
@@ -118,26 +143,33 @@ void KeyImageSelector::Add(const FrameRecord& record) {
                                 : fmt::format("matching frame {} with key frame {} failed ({} tentative matches)",
                                               record.frame->index, key_->frame->index, comparison.num_tentative);
     if (!previous_) {
-      // The very next frame after the key image fails: it becomes a key image and the link is broken.
-      AddKeyImage(record, why + "; link broken");
-      AddLink(comparison, /*broken=*/true);
+      // No frame since the key image passed with a view of its own: the very next frame fails, or those
+      // before it repeat the key image's view. The failing frame becomes a key image, linked below tau.
+      const std::string what = still_frames_ == 0
+                                   ? "; the next frame already fails: linked below tau"
+                                   : fmt::format("; the {} frame(s) before it repeat the key image's view: linked "
+                                                 "below tau",
+                                                 still_frames_);
+      AddKeyImage(record, why + what);
+      AddLink(comparison, /*below_tau=*/true);
       return;
     }
     const FrameRecord promoted = *previous_;
     PairComparison promoted_comparison = std::move(previous_comparison_);
     AddKeyImage(promoted, why);
-    AddLink(promoted_comparison, /*broken=*/false);
+    AddLink(promoted_comparison, /*below_tau=*/false);
   }
 }
 
 void KeyImageSelector::Finish() {
   if (finished_) return;
   finished_ = true;
-  if (options_.final_key && previous_) {
+  // When the last frame shows the key image's view again, the key image already is the route's goal.
+  if (options_.final_key && previous_ && !last_frame_still_) {
     const FrameRecord last = *previous_;
     PairComparison comparison = std::move(previous_comparison_);
     AddKeyImage(last, "final frame");
-    AddLink(comparison, /*broken=*/false);
+    AddLink(comparison, /*below_tau=*/false);
   }
   key_.reset();
   previous_.reset();

@@ -25,6 +25,11 @@ struct KeyImageOptions {
   double tau = 0.5;                       // similarity threshold in (0, 1]
   SimilarityMode similarity = SimilarityMode::kInlierRatio;
   bool final_key = true;                  // the last frame becomes the final key image (the route's goal)
+  // Pixels. A frame whose verified matches with the key image moved less than this (median) shows the key
+  // image's view again: a repeated frame (7-Scenes repeats a frame when one was dropped) or a camera at
+  // rest. Such a frame passes the test (S is near 1) but is never promoted to key image: a link between two
+  // views of one viewpoint has no parallax and a meaningless F. 0 turns this off (Algorithm 1 as published).
+  double min_key_displacement = 1.0;
 
   void Check() const;  // throws InputError naming the bad option
 };
@@ -43,6 +48,7 @@ struct PairComparison {
   int num_verified = 0;
   cv::Matx33d F = cv::Matx33d::zeros();
   std::vector<Correspondence> correspondences;  // verified first, then rejected
+  double median_displacement = -1.0;  // pixels, over the verified matches; -1 when not matched
 };
 
 // Matches two images and verifies the matches: the S(I_i, I_j) of the paper.
@@ -72,8 +78,9 @@ class KeyImageSelector {
 
  private:
   bool Passes(const PairComparison& comparison) const;
+  bool ShowsKeyView(const PairComparison& comparison) const;
   void AddKeyImage(const FrameRecord& record, const std::string& reason);
-  void AddLink(const PairComparison& comparison, bool broken);
+  void AddLink(const PairComparison& comparison, bool below_tau);
 
   KeyImageOptions options_;
   CompareFn compare_;
@@ -81,6 +88,8 @@ class KeyImageSelector {
   std::optional<FrameRecord> key_;
   std::optional<FrameRecord> previous_;         // the last frame that passed against the key image
   PairComparison previous_comparison_;          // key vs previous_
+  int still_frames_ = 0;                        // frames since the key image that showed its view again
+  bool last_frame_still_ = false;               // the last frame added showed the key image's view again
   std::vector<KeyImage> key_images_;
   std::vector<Link> links_;
   std::vector<Evaluation> evaluations_;

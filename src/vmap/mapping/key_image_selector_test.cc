@@ -26,7 +26,7 @@ FrameRecord Record(int index) {
 struct SelectionRun {
   std::vector<int> keys;
   std::vector<double> link_similarities;
-  std::vector<bool> broken;
+  std::vector<bool> below_tau;
   std::vector<std::pair<int, int>> evaluated;
 };
 
@@ -50,7 +50,7 @@ SelectionRun Select(int n, double tau, const std::function<double(int, int)>& si
   for (const KeyImage& k : selector.key_images()) run.keys.push_back(k.frame_index);
   for (const Link& l : selector.links()) {
     run.link_similarities.push_back(l.similarity);
-    run.broken.push_back(l.broken);
+    run.below_tau.push_back(l.below_tau);
     EXPECT_EQ(l.to_key, l.from_key + 1);
   }
   EXPECT_EQ(selector.evaluations().size(), run.evaluated.size());
@@ -71,7 +71,7 @@ TEST(KeyImageSelector, PreviousFrameBecomesKeyWhenSimilarityDrops) {
   const std::vector<std::pair<int, int>> expected = {{0, 1}, {0, 2}, {0, 3}, {2, 3}, {2, 4}, {2, 5}, {4, 5},
                                                      {4, 6}, {4, 7}, {6, 7}, {6, 8}, {6, 9}, {8, 9}};
   EXPECT_EQ(run.evaluated, expected);
-  EXPECT_EQ(run.broken, std::vector<bool>(5, false));
+  EXPECT_EQ(run.below_tau, std::vector<bool>(5, false));
 }
 
 TEST(KeyImageSelector, ThresholdIsInclusive) {
@@ -80,12 +80,12 @@ TEST(KeyImageSelector, ThresholdIsInclusive) {
   EXPECT_EQ(run.keys, (std::vector<int>{0, 3}));
 }
 
-TEST(KeyImageSelector, FrameThatMatchesNothingGivesBrokenLinks) {
+TEST(KeyImageSelector, FrameThatMatchesNothingGivesLinksBelowTau) {
   // Frame 4 is black: nothing matches it.
   auto similarity = [](int key, int frame) { return (key == 4 || frame == 4) ? -1.0 : 0.9; };
   const SelectionRun run = Select(8, 0.5, similarity);
   EXPECT_EQ(run.keys, (std::vector<int>{0, 3, 4, 5, 7}));
-  EXPECT_EQ(run.broken, (std::vector<bool>{false, true, true, false}));
+  EXPECT_EQ(run.below_tau, (std::vector<bool>{false, true, true, false}));
   EXPECT_EQ(run.link_similarities[1], 0.0);
   const SelectionRun no_final = Select(8, 0.5, similarity, /*final_key=*/false);
   EXPECT_EQ(no_final.keys, (std::vector<int>{0, 3, 4, 5}));
@@ -98,11 +98,65 @@ TEST(KeyImageSelector, OneFrameIsAMapWithOneKeyImage) {
 }
 
 TEST(KeyImageSelector, LastFrameIsAlreadyKeyImage) {
-  // Frame 2 fails against key 0 and frame 1 is promoted; then (1, 2) fails too: 2 becomes a key with a broken
-  // link, and is also the last frame: no duplicate final key image.
+  // Frame 2 fails against key 0 and frame 1 is promoted; then (1, 2) fails too: 2 becomes a key with a link
+  // below tau, and is also the last frame: no duplicate final key image.
   const SelectionRun run = Select(3, 0.5, [](int key, int frame) { return frame == 2 ? 0.1 : 0.9; });
   EXPECT_EQ(run.keys, (std::vector<int>{0, 1, 2}));
-  EXPECT_EQ(run.broken, (std::vector<bool>{false, true}));
+  EXPECT_EQ(run.below_tau, (std::vector<bool>{false, true}));
+}
+
+// Frame i shows view views[i] (a repeated frame shows the same view as the one before it); S drops by 0.2
+// per view of distance and the matches move 5 px per view.
+std::vector<int> SelectViews(const std::vector<int>& views, double tau, double min_displacement,
+                             std::vector<bool>* below_tau = nullptr, std::vector<std::string>* reasons = nullptr) {
+  KeyImageOptions options;
+  options.tau = tau;
+  options.min_key_displacement = min_displacement;
+  KeyImageSelector selector(options, [&](const FrameRecord& key, const FrameRecord& frame) {
+    const int distance = std::abs(views[frame.frame->index] - views[key.frame->index]);
+    PairComparison c;
+    c.matched = true;
+    c.similarity = 1.0 - 0.2 * distance;
+    c.median_displacement = 5.0 * distance;
+    c.num_tentative = 100;
+    c.num_verified = static_cast<int>(100 * c.similarity);
+    return c;
+  });
+  for (int i = 0; i < static_cast<int>(views.size()); ++i) selector.Add(Record(i));
+  selector.Finish();
+  std::vector<int> keys;
+  for (const KeyImage& k : selector.key_images()) {
+    keys.push_back(k.frame_index);
+    if (reasons) reasons->push_back(k.reason);
+  }
+  if (below_tau) {
+    for (const Link& l : selector.links()) below_tau->push_back(l.below_tau);
+  }
+  return keys;
+}
+
+TEST(KeyImageSelector, RepeatedFramesAreNotPromotedWhenANeighbourWillDo) {
+  // tau 0.7: a key image covers the next view only. Frame 1 repeats frame 0, frame 4 repeats frame 3.
+  const std::vector<int> views = {0, 0, 2, 3, 3, 5, 6};
+  // Algorithm 1 as published promotes frame 1 (the key image's own view again: a link without parallax),
+  // then frame 2 fails against it as it did against frame 0 and is linked below tau.
+  EXPECT_EQ(SelectViews(views, 0.7, 0.0), (std::vector<int>{0, 1, 2, 4, 5, 6}));
+  // With the check, frame 1 is no candidate: frame 2 is linked to key 0 directly, below tau. Frame 4 repeats
+  // frame 3, not the key image, and is promoted like any other frame.
+  std::vector<bool> below_tau;
+  std::vector<std::string> reasons;
+  EXPECT_EQ(SelectViews(views, 0.7, 1.0, &below_tau, &reasons), (std::vector<int>{0, 2, 4, 5, 6}));
+  EXPECT_EQ(below_tau, (std::vector<bool>{true, false, true, false}));
+  EXPECT_NE(reasons[1].find("repeat the key image's view"), std::string::npos) << reasons[1];
+  // A last frame back at the key image's view: the key image already is the route's goal (published: the
+  // last frame becomes a final key image identical to key 0).
+  EXPECT_EQ(SelectViews({0, 1, 0}, 0.7, 1.0), (std::vector<int>{0}));
+  EXPECT_EQ(SelectViews({0, 1, 0}, 0.7, 0.0), (std::vector<int>{0, 2}));
+  // Without repeats the check changes nothing.
+  EXPECT_EQ(SelectViews({0, 1, 2, 3, 4, 5}, 0.7, 1.0), SelectViews({0, 1, 2, 3, 4, 5}, 0.7, 0.0));
+  KeyImageOptions bad;
+  bad.min_key_displacement = -1;
+  EXPECT_THROW(bad.Check(), InputError);
 }
 
 TEST(KeyImageSelector, TauOutsideTheUnitIntervalIsRejected) {

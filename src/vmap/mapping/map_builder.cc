@@ -26,6 +26,7 @@ namespace fs = std::filesystem;
 void MapBuilderOptions::Check() const {
   key_images.Check();
   verifier.Check();
+  link_analysis.Check();
   if (prefetch_frames < 1 || prefetch_frames > 1024) throw InputError("prefetch_frames must be 1 to 1024");
   if (extraction_threads < 0 || extraction_threads > kMaxExtractionThreads) {
     throw InputError("--threads must be 0 to " + std::to_string(kMaxExtractionThreads) + " (0 = one per core)");
@@ -61,12 +62,13 @@ struct PipelineItem {
 //
 // Key changes are followed by the workers too. A key image is retired as soon as a worker sees a frame j
 // fail against it: every selector holding it leaves it at frame j at the latest, for frame j-1 (or for j
-// itself when j-1 is that key: a broken link). Frame j and the later ones are compared with that successor
+// itself when j-1 is that key: a link below tau). Frame j and the later ones are compared with that successor
 // at once, as the consumer will ask, instead of with the old key at low S, where MAGSAC needs the most
 // iterations (up to 60 ms a pair on lab_floor) only for the result to be thrown away, and the consumer then
 // redoing the comparisons one by one while the workers wait.
 //
-// The consumer compares whatever the workers did not guess. ComparePair is deterministic, so the map is the
+// The consumer compares whatever the workers did not guess (also when the selector picks another successor,
+// as it does for a frame that repeats the key image's view). ComparePair is deterministic, so the map is the
 // same whatever the threads do.
 class FeaturePipeline {
  public:
@@ -324,8 +326,9 @@ class KeyImageFileWriter {
   std::thread thread_;        // last: starts after every other member exists
 };
 
+// `analyze_links`: also each link's pose, parallax and homography test (only maps that are kept need them).
 VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source, const MapBuilderOptions& options,
-                     const std::string& options_json, double seconds) {
+                     const std::string& options_json, double seconds, bool analyze_links) {
   VisualMap map;
   map.input = source.info();
   map.options_json = options_json;
@@ -336,6 +339,13 @@ VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source
   map.evaluations = selector.evaluations();
   map.seconds = seconds;
   map.quality = ComputeStatistics(map, options.quality_mean).quality;
+  if (!analyze_links) return map;
+  const auto analysis_start = std::chrono::steady_clock::now();
+  AnalyzeLinks(map, options.link_analysis, options.ExtractionThreads());
+  const double analysis_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - analysis_start).count();
+  spdlog::debug("pose, parallax and homography test of {} links in {:.3f} s", map.links.size(), analysis_seconds);
+  map.seconds += analysis_seconds;  // part of building the map
   return map;
 }
 
@@ -469,7 +479,7 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
   result.input = source.info();
   result.seconds = seconds;
   for (size_t i = 0; i < selectors.size(); ++i) {
-    VisualMap map = CollectMap(*selectors[i], source, options, options_json, seconds);
+    VisualMap map = CollectMap(*selectors[i], source, options, options_json, seconds, maps != nullptr);
     const MapStatistics stats = ComputeStatistics(map, options.quality_mean);
     result.num_frames = map.num_frames;
     SweepRow row;
@@ -481,7 +491,7 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
     row.mean_verified = stats.mean_verified;
     row.mean_similarity = stats.mean_similarity;
     row.quality = stats.quality;
-    row.broken_links = stats.broken_links;
+    row.below_tau_links = stats.below_tau_links;
     row.map_directory = directories[i].string();
     result.rows.push_back(row);
     if (result.best_row < 0 || row.quality > result.rows[result.best_row].quality) {

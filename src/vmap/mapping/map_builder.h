@@ -9,6 +9,7 @@
 #include "vmap/features/matcher.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/mapping/key_image_selector.h"
+#include "vmap/mapping/link_analysis.h"
 #include "vmap/mapping/visual_map.h"
 #include "vmap/sources/frame_source.h"
 
@@ -21,6 +22,7 @@ struct MapBuilderOptions {
   KeyImageOptions key_images;
   VerifierOptions verifier;
   QualityMean quality_mean = QualityMean::kArithmetic;
+  LinkAnalysisOptions link_analysis;  // each link's pose, parallax and homography test, after selection
   bool show_progress = true;   // a progress line on a terminal
   int prefetch_frames = 6;     // frames read and extracted ahead of matching
   int extraction_threads = 0;  // threads extracting features; 0 = one per core, at most kMaxExtractionThreads
@@ -46,7 +48,8 @@ struct SweepRow {
   double mean_verified = 0.0;
   double mean_similarity = 0.0;
   double quality = 0.0;
-  int broken_links = 0;
+  int below_tau_links = 0;
+  int usable_links = -1;      // links usable against ground truth (vmap sweep --gt); -1 = not evaluated
   std::string map_directory;  // where the map for this tau was written, if it was
 };
 

@@ -95,7 +95,7 @@ TEST(MapBuilder, KeyImagesRespondToTau) {
     EXPECT_EQ(map.key_images.back().frame_index, 49);  // the final key image
     EXPECT_EQ(map.links.size(), map.key_images.size() - 1);
     for (const Link& link : map.links) {
-      EXPECT_FALSE(link.broken);
+      EXPECT_FALSE(link.below_tau);
       EXPECT_GE(link.similarity, tau);  // every link passed the test
     }
     counts.push_back(static_cast<int>(map.key_images.size()));
@@ -199,15 +199,15 @@ TEST(MapBuilder, LookAheadGivesTheSerialMapAndWastesFewComparisons) {
   }
 }
 
-TEST(MapBuilder, BlackFramesGiveBrokenLinksNotCrashes) {
+TEST(MapBuilder, BlackFramesGiveLinksBelowTauNotCrashes) {
   std::vector<cv::Mat> frames(Sequence().frames.begin(), Sequence().frames.begin() + 6);
   frames[3] = cv::Mat::zeros(frames[0].size(), CV_8UC3);
   const auto matcher = CreateOrbMatcher({});
   MemorySource source(frames);
   const VisualMap map = BuildMap(source, *matcher, Options(0.5));
-  int broken = 0;
-  for (const Link& link : map.links) broken += link.broken ? 1 : 0;
-  EXPECT_EQ(broken, 2);  // into the black frame and out of it
+  int below_tau = 0;
+  for (const Link& link : map.links) below_tau += link.below_tau ? 1 : 0;
+  EXPECT_EQ(below_tau, 2);  // into the black frame and out of it
   std::vector<int> keys;
   for (const KeyImage& k : map.key_images) keys.push_back(k.frame_index);
   EXPECT_EQ(keys, (std::vector<int>{0, 2, 3, 4, 5}));

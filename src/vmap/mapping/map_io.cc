@@ -13,6 +13,7 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/core/file_name_encoding.h"
+#include "vmap/mapping/map_geometry_json.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -34,6 +35,8 @@ json MapDocument(const VisualMap& map, const std::vector<long>& offsets) {
                   {"native_size", SizeJson(map.input.native_size)},
                   {"frame_size", SizeJson(map.input.frame_size)},
                   {"fps", map.input.fps}};
+  doc["input"]["camera"] = map.input.camera ? CameraToJson(*map.input.camera) : json(nullptr);
+  doc["conventions"] = MapConventionsJson();
   doc["options"] = map.options_json.empty() ? json::object() : json::parse(map.options_json);
   doc["num_frames"] = map.num_frames;
   doc["skipped_frames"] = map.skipped_frames;
@@ -60,16 +63,18 @@ json MapDocument(const VisualMap& map, const std::vector<long>& offsets) {
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c) F.push_back(l.F(r, c));
     }
-    links.push_back({{"from", l.from_key},
-                     {"to", l.to_key},
-                     {"from_frame", map.key_images.at(l.from_key).frame_index},
-                     {"to_frame", map.key_images.at(l.to_key).frame_index},
-                     {"broken", l.broken},
-                     {"similarity", l.similarity},
-                     {"tentative", l.num_tentative},
-                     {"verified", l.num_verified},
-                     {"F", F},
-                     {"correspondences", {{"offset", offsets[i]}, {"count", l.correspondences.size()}}}});
+    json link = {{"from", l.from_key},
+                 {"to", l.to_key},
+                 {"from_frame", map.key_images.at(l.from_key).frame_index},
+                 {"to_frame", map.key_images.at(l.to_key).frame_index},
+                 {"below_tau", l.below_tau},
+                 {"similarity", l.similarity},
+                 {"tentative", l.num_tentative},
+                 {"verified", l.num_verified},
+                 {"F", F},
+                 {"correspondences", {{"offset", offsets[i]}, {"count", l.correspondences.size()}}}};
+    AddLinkGeometryJson(l, link);
+    links.push_back(std::move(link));
   }
   doc["links"] = std::move(links);
   // Column-wise: a long sequence has one evaluation per frame or more.
@@ -355,7 +360,12 @@ void ReadLinks(const json& doc, const Fields& fields, const fs::path& directory,
         fields.Fail(Fields::Join(where, name), "is not the frame of key image " + std::to_string(key));
       }
     }
-    if (const json* broken = Fields::Find(entry, "broken")) l.broken = fields.Bool(*broken, where + ".broken");
+    // Schema version 1 called the flag `broken`.
+    if (const json* below_tau = Fields::Find(entry, "below_tau")) {
+      l.below_tau = fields.Bool(*below_tau, where + ".below_tau");
+    } else if (const json* broken = Fields::Find(entry, "broken")) {
+      l.below_tau = fields.Bool(*broken, where + ".broken");
+    }
     l.similarity = fields.Number(fields.Required(entry, where, "similarity"), where + ".similarity", 0.0, 1.0);
     l.num_tentative = static_cast<int>(
         fields.Integer(fields.Required(entry, where, "tentative"), where + ".tentative", 0, kMaxMatchesPerLink));
@@ -379,6 +389,7 @@ void ReadLinks(const json& doc, const Fields& fields, const fs::path& directory,
       count = fields.Integer(*correspondences, field, "count", 0, kMaxMatchesPerLink, 0);
     }
     if (l.num_verified > count) fields.Fail(where + ".verified", "is more than its correspondences' count");
+    ReadLinkGeometryJson(entry, l, file.string(), where);
     ranges.emplace_back(offset, count);
     if (count > 0) records_referenced = std::max(records_referenced, offset + count);
     map->links.push_back(std::move(l));
@@ -490,6 +501,9 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
     map.input.native_size = SizeField(fields, *input, "input", "native_size");
     map.input.frame_size = SizeField(fields, *input, "input", "frame_size");
     map.input.fps = fields.Number(*input, "input", "fps", 0.0, 1e6, 0.0);
+    if (const json* camera = Fields::Find(*input, "camera"); camera && !camera->is_null()) {
+      map.input.camera = CameraFromJson(*camera, file.string(), "input.camera");
+    }
   }
   const json* options = Fields::Find(doc, "options");
   map.options_json = options ? fields.Object(*options, "options").dump() : "{}";

@@ -17,7 +17,9 @@
 
 namespace vmap {
 
-inline constexpr int kMapSchemaVersion = 1;
+// 2: links say `below_tau` (version 1: `broken`) and carry their pose, parallax and homography test; the
+// input may have a camera. Version 1 maps are still read.
+inline constexpr int kMapSchemaVersion = 2;
 inline constexpr const char* kMapFileName = "map.json";
 inline constexpr const char* kCorrespondencesFileName = "correspondences.bin";
 // Limits a map must respect to be read, far above what vmap writes: they bound the memory a crafted map

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "vmap/core/error.h"
@@ -177,7 +178,7 @@ TEST(MapIo, EveryFieldIsCheckedAndTheMessageNamesIt) {
       {[](json& d) { d["links"][0]["from"] = 5; }, "'links[0].from' must be an integer from 0 to 2"},
       {[](json& d) { d["links"][1]["to"] = 1; }, "'links[1].to' must name a key image after"},
       {[](json& d) { d["links"][0]["from_frame"] = 3; }, "'links[0].from_frame' is not the frame of key image 0"},
-      {[](json& d) { d["links"][0]["broken"] = "no"; }, "'links[0].broken' must be true or false"},
+      {[](json& d) { d["links"][0]["below_tau"] = "no"; }, "'links[0].below_tau' must be true or false"},
       {[](json& d) { d["links"][0]["similarity"] = "high"; }, "'links[0].similarity'"},
       {[](json& d) { d["links"][0]["similarity"] = -0.5; }, "'links[0].similarity'"},
       {[](json& d) { d["links"][0]["verified"] = 4; }, "'links[0].verified' must be an integer from 0 to 3"},
@@ -365,6 +366,108 @@ TEST(MapIo, OwnershipNeedsAVmapMapJson) {
   fs::create_directories(tmp.path() / "linked");
   fs::create_symlink(tmp.path() / "map" / kMapFileName, tmp.path() / "linked" / kMapFileName);
   EXPECT_NE(WhyNotAVmapMap(tmp.path() / "linked"), "");
+}
+
+TEST(MapIo, CameraAndLinkGeometryRoundTrip) {
+  testing::TempDir tmp;
+  VisualMap map = SmallMap(tmp.path());
+  Camera camera = Camera::Make(50.5, 51.0, 31.5, 23.5, {-0.1, 0.01, 0.001, -0.002}, {64, 48});
+  camera.origin = "intrinsics.txt";
+  map.input.camera = camera;
+  Link& link = map.links[1];
+  link.below_tau = true;
+  link.has_pose = true;
+  cv::Rodrigues(cv::Vec3d(0.01, -0.2, 0.03), link.R);
+  link.t = cv::normalize(cv::Vec3d(0.3, -0.1, -0.9));
+  link.pose_inliers = 2;
+  link.parallax = 12.25;
+  link.parallax_without_rotation = true;
+  link.homography_share = 0.5;
+  link.planar = false;
+  WriteMapFiles(map, tmp.path());
+  const VisualMap back = ReadMap(tmp.path());
+  ASSERT_TRUE(back.input.camera);
+  EXPECT_EQ(back.input.camera->model, CameraModel::kOpenCV);
+  EXPECT_EQ(back.input.camera->K(), camera.K());
+  EXPECT_EQ(back.input.camera->distortion(), camera.distortion());
+  EXPECT_EQ(back.input.camera->size, cv::Size(64, 48));
+  EXPECT_EQ(back.input.camera->origin, "intrinsics.txt");
+  EXPECT_FALSE(back.links[0].below_tau);
+  EXPECT_FALSE(back.links[0].has_pose);
+  EXPECT_LT(back.links[0].parallax, 0);  // not computed
+  const Link& l = back.links[1];
+  EXPECT_TRUE(l.below_tau);
+  ASSERT_TRUE(l.has_pose);
+  EXPECT_LT(cv::norm(l.R - link.R), 1e-12);
+  EXPECT_LT(cv::norm(l.t - link.t), 1e-12);
+  EXPECT_EQ(l.pose_inliers, 2);
+  EXPECT_DOUBLE_EQ(l.parallax, 12.25);
+  EXPECT_TRUE(l.parallax_without_rotation);
+  EXPECT_DOUBLE_EQ(l.homography_share, 0.5);
+  // The document says what the numbers mean, and the COLMAP model name.
+  std::ifstream in(tmp.path() / kMapFileName);
+  const auto doc = nlohmann::json::parse(in);
+  EXPECT_EQ(doc["schema_version"], 2);
+  EXPECT_EQ(doc["input"]["camera"]["model"], "OPENCV");
+  EXPECT_EQ(doc["input"]["camera"]["params"].size(), 8u);
+  EXPECT_NE(doc["conventions"]["pose"].get<std::string>().find("X_to = R X_from + t"), std::string::npos);
+  EXPECT_FALSE(doc["links"][0].contains("broken"));
+}
+
+TEST(MapIo, ReadsSchemaVersionOneMapsWithBrokenLinks) {
+  testing::TempDir tmp;
+  WriteMapFiles(SmallMap(tmp.path()), tmp.path());
+  std::ifstream in(tmp.path() / kMapFileName);
+  auto doc = nlohmann::json::parse(in);
+  // A map as vmap wrote it before links had a geometry: `broken`, no camera, no pose.
+  doc["schema_version"] = 1;
+  doc["input"].erase("camera");
+  doc.erase("conventions");
+  for (auto& link : doc["links"]) {
+    for (const char* key : {"below_tau", "pose", "parallax_px", "parallax_rotation_removed", "homography_share",
+                            "planar"}) {
+      link.erase(key);
+    }
+  }
+  doc["links"][0]["broken"] = true;
+  doc["links"][1]["broken"] = false;
+  WriteText(tmp.path() / kMapFileName, doc.dump());
+  const VisualMap map = ReadMap(tmp.path());
+  EXPECT_TRUE(map.links[0].below_tau);
+  EXPECT_FALSE(map.links[1].below_tau);
+  EXPECT_FALSE(map.links[0].has_pose);
+  EXPECT_FALSE(map.input.camera);
+}
+
+TEST(MapIo, MalformedGeometryIsRefused) {
+  testing::TempDir tmp;
+  WriteMapFiles(SmallMap(tmp.path()), tmp.path());
+  std::ifstream in(tmp.path() / kMapFileName);
+  const auto original = nlohmann::json::parse(in);
+  auto doc = original;
+  doc["links"][0]["pose"] = {{"R", {2, 0, 0, 0, 1, 0, 0, 0, 1}}, {"t", {0, 0, 1}}, {"inliers", 3}};
+  WriteText(tmp.path() / kMapFileName, doc.dump());
+  EXPECT_NE(ErrorOf(tmp.path()).find("not a rotation matrix"), std::string::npos) << ErrorOf(tmp.path());
+  doc = original;
+  doc["links"][0]["pose"] = {{"R", {1, 0, 0, 0, 1, 0, 0, 0, 1}}, {"t", {0, 0, 3}}, {"inliers", 3}};
+  WriteText(tmp.path() / kMapFileName, doc.dump());
+  EXPECT_NE(ErrorOf(tmp.path()).find("not a unit vector"), std::string::npos) << ErrorOf(tmp.path());
+  doc = original;
+  doc["input"]["camera"] = {{"model", "PINHOLE"}, {"params", {500, 500, 320}}, {"width", 64}, {"height", 48}};
+  WriteText(tmp.path() / kMapFileName, doc.dump());
+  EXPECT_NE(ErrorOf(tmp.path()).find("input.camera"), std::string::npos) << ErrorOf(tmp.path());
+  doc = original;
+  doc["links"][0]["parallax_px"] = "far";
+  WriteText(tmp.path() / kMapFileName, doc.dump());
+  EXPECT_NE(ErrorOf(tmp.path()).find("parallax_px"), std::string::npos) << ErrorOf(tmp.path());
+  doc = original;
+  doc["links"][1]["planar"] = "yes";
+  WriteText(tmp.path() / kMapFileName, doc.dump());
+  EXPECT_NE(ErrorOf(tmp.path()).find("links[1]"), std::string::npos) << ErrorOf(tmp.path());
+  doc = original;
+  doc["input"]["camera"] = {{"model", "PINHOLE"}, {"params", {500, 500, 32, 24}}, {"width", "wide"}};
+  WriteText(tmp.path() / kMapFileName, doc.dump());
+  EXPECT_NE(ErrorOf(tmp.path()).find("input.camera"), std::string::npos) << ErrorOf(tmp.path());
 }
 
 }  // namespace vmap

@@ -38,7 +38,7 @@ MapStatistics ComputeStatistics(const VisualMap& map, QualityMean mean) {
   for (const Link& l : map.links) {
     similarities.push_back(l.similarity);
     total_verified += l.num_verified;
-    s.broken_links += l.broken ? 1 : 0;
+    s.below_tau_links += l.below_tau ? 1 : 0;
   }
   if (!map.links.empty()) {
     auto [lo, hi] = std::minmax_element(map.links.begin(), map.links.end(),

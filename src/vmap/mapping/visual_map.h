@@ -29,7 +29,10 @@ struct Correspondence {
 struct Link {
   int from_key = 0;    // index into VisualMap::key_images
   int to_key = 0;
-  bool broken = false;           // the second key image did not pass the test against the first
+  // The frame right after the first key image already fell below tau (or could not be matched), so that
+  // frame became the second key image: the link joins two consecutive frames and its S is below tau. Its F
+  // is as good as any (null only when matching failed). Called `broken` in maps of schema version 1.
+  bool below_tau = false;
   double similarity = 0.0;       // S of the paper
   int num_tentative = 0;         // matches that entered verification
   int num_verified = 0;          // inliers of F
@@ -37,6 +40,22 @@ struct Link {
   cv::Matx33d F = cv::Matx33d::zeros();  // x_to^T F x_from = 0, in pixels
   // The tentative matches, verified ones first: [0, num_verified) are inliers, the rest were rejected.
   std::vector<Correspondence> correspondences;
+
+  // What a robot needs to trust the link (see mapping/link_analysis.h; filled when the map is built).
+  // The relative pose, when the camera is known: X_to = R X_from + t, |t| = 1 (geometry/relative_pose.h).
+  bool has_pose = false;
+  cv::Matx33d R = cv::Matx33d::eye();
+  cv::Vec3d t;
+  int pose_inliers = 0;           // matches consistent with the pose
+  // Median displacement of the verified matches in pixels: after undoing the rotation R when there is a pose
+  // (what the translation's direction rests on), the plain displacement otherwise. < 0: not computed.
+  double parallax = -1.0;
+  bool parallax_without_rotation = false;  // parallax is the rotation-compensated one
+  // Share of the verified matches that one homography explains as well as F does; `planar` when it is at
+  // least HomographyOptions::min_share (a plane or a pure rotation: F and the pose are ill-posed). < 0: not
+  // computed.
+  double homography_share = -1.0;
+  bool planar = false;
 };
 
 // One comparison S(key, frame) made while building: what a user looks at to choose tau.
@@ -57,7 +76,7 @@ struct MapStatistics {
   double mean_verified = 0.0;
   double mean_similarity = 0.0;
   double quality = 0.0;         // Q
-  int broken_links = 0;
+  int below_tau_links = 0;      // links whose S is below tau (Link::below_tau)
 };
 
 struct VisualMap {

@@ -31,7 +31,7 @@ TEST(MapStatistics, SummarisesLinks) {
   a.similarity = 0.8;
   b.num_verified = 20;
   b.similarity = 0.6;
-  b.broken = true;
+  b.below_tau = true;
   map.links = {a, b};
   const MapStatistics s = ComputeStatistics(map, QualityMean::kArithmetic);
   EXPECT_EQ(s.num_key_images, 3);
@@ -39,7 +39,7 @@ TEST(MapStatistics, SummarisesLinks) {
   EXPECT_EQ(s.max_verified, 40);
   EXPECT_DOUBLE_EQ(s.mean_verified, 30.0);
   EXPECT_DOUBLE_EQ(s.mean_similarity, 0.7);
-  EXPECT_EQ(s.broken_links, 1);
+  EXPECT_EQ(s.below_tau_links, 1);
   EXPECT_DOUBLE_EQ(s.quality, 0.5 * (0.7 + 0.7));
 }
 

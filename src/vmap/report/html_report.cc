@@ -6,6 +6,7 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -21,6 +22,7 @@
 #include "vmap/mapping/map_io.h"
 #include "vmap/report/html_page.h"
 #include "vmap/report/html_util.h"
+#include "vmap/report/link_table.h"
 #include "vmap/report/svg_plot.h"
 
 namespace vmap {
@@ -68,7 +70,7 @@ th, td { border: 1px solid var(--line); padding: 4px 10px; text-align: left; ver
 td.num, th.num { text-align: right; font-variant-numeric: tabular-nums; }
 table.summary th { width: 220px; background: #f3f3f3; font-weight: 600; }
 tr.best td { background: #e8f5e9; font-weight: 600; }
-tr.broken td { background: #fdecea; }
+tr.below-tau td { background: #fdecea; }
 .plots { display: flex; flex-wrap: wrap; gap: 12px; }
 .plot { max-width: 100%; height: auto; background: #fff; border: 1px solid var(--line); border-radius: 6px; }
 .note { color: var(--muted); margin: 6px 0; }
@@ -81,8 +83,10 @@ tr.broken td { background: #fdecea; }
 .match-figure { margin: 0; background: #fff; border: 1px solid var(--line); border-radius: 4px; overflow: hidden; }
 .match-figure img { display: block; width: 100%; height: auto; background: #eee; }
 .match-figure figcaption { padding: 4px 8px; font-size: 13px; }
-.match-figure.broken { border: 3px solid var(--bad); }
-.match-figure.broken figcaption { background: var(--bad); color: #fff; font-weight: 600; }
+.match-figure.below-tau { border: 3px solid var(--bad); }
+.match-figure.below-tau figcaption { background: var(--bad); color: #fff; font-weight: 600; }
+.match-figure.lost { border: 3px solid var(--bad); }
+.match-figure.lost figcaption { background: var(--bad); color: #fff; font-weight: 600; }
 .legend-verified { color: var(--good); font-weight: 600; }
 .legend-rejected { color: #0040ff; font-weight: 600; }
 .route { display: flex; gap: 18px; align-items: flex-start; flex-wrap: wrap; }
@@ -354,18 +358,18 @@ std::string SimilarityPlot(const VisualMap& map, const json& options) {
   keys.segments.emplace_back();
   for (const KeyImage& k : map.key_images) keys.segments[0].emplace_back(k.frame_index, 0.0);
 
-  PlotSeries links, broken;
-  links.kind = broken.kind = PlotSeries::Kind::kMarkers;
+  PlotSeries links, below_tau;
+  links.kind = below_tau.kind = PlotSeries::Kind::kMarkers;
   links.name = "link S (next key image)";
   links.color = kGreen;
   links.css_class = "links";
-  broken.name = "broken link";
-  broken.color = kRed;
-  broken.css_class = "broken-links";
-  broken.marker_radius = 5.0;
+  below_tau.name = "link below \u03c4";
+  below_tau.color = kRed;
+  below_tau.css_class = "below-tau-links";
+  below_tau.marker_radius = 5.0;
   for (size_t i = 0; i < map.links.size(); ++i) {
     const Link& l = map.links[i];
-    PlotSeries& target = l.broken ? broken : links;
+    PlotSeries& target = l.below_tau ? below_tau : links;
     target.segments.push_back({cv::Point2d(map.key_images[l.to_key].frame_index, l.similarity)});
     target.segment_attributes.push_back("data-link=\"" + std::to_string(i) + "\"");
     target.point_titles.push_back(LinkTitle(map, static_cast<int>(i)) + ": S = " + FormatFixed(l.similarity, 3));
@@ -385,7 +389,7 @@ std::string SimilarityPlot(const VisualMap& map, const json& options) {
     plot.Add(rule);
   }
   if (!links.segments.empty()) plot.Add(links);
-  if (!broken.segments.empty()) plot.Add(broken);
+  if (!below_tau.segments.empty()) plot.Add(below_tau);
   return plot.Render();
 }
 
@@ -546,6 +550,7 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
   const json options = ParseOptions(map.options_json);
   const MapStatistics stats = ComputeStatistics(
       map, OptionText(options, "quality_mean") == "harmonic" ? QualityMean::kHarmonic : QualityMean::kArithmetic);
+  const std::optional<MapEvaluation> evaluation = ReadMatchingEvaluation(map_directory, map);
 
   // Inside a map that ReadMap has just recognised as vmap's: the old report/ is vmap's too.
   AtomicOutputDirectory assets(map_directory / kReportAssetsDirectory, OutputPolicy::InsideVmapOutput());
@@ -606,6 +611,7 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
                      {"similarity", "Similarity"},
                      {"key-images", "Key images"},
                      {"route-preview", "Route preview"},
+                     {"link-table", "Links"},
                      {"links", "Match figures"},
                      {"options", "Options"}});
 
@@ -614,7 +620,7 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
        << Card(std::to_string(n), "frames (n)") << Card(std::to_string(m), "key images (m)")
        << Card(n > 0 ? FormatFixed(100.0 * m / n, 1) + " %" : "n/a", "of the frames")
        << Card(FormatFixed(map.quality, 3), "quality Q") << Card(FormatFixed(stats.mean_similarity, 3), "mean S")
-       << Card(std::to_string(stats.broken_links), "broken links") << "</div>\n<table class=\"summary\">\n";
+       << Card(std::to_string(stats.below_tau_links), "links below \u03c4") << "</div>\n<table class=\"summary\">\n";
   html << Row("Input", HtmlEscape(Displayable(map.input.path)))
        << Row("Format", HtmlEscape(SourceFormatName(map.input.format)))
        << Row("Frame size", HtmlEscape(SizeText(map.input.frame_size)) +
@@ -630,7 +636,7 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
                                                             " unreadable frames skipped)"
                                                       : ""))
        << Row("Key images m", std::to_string(m) + (n > 0 ? " (" + FormatFixed(100.0 * m / n, 1) + " % of the frames)" : ""))
-       << Row("Links", std::to_string(map.links.size()) + ", " + std::to_string(stats.broken_links) + " broken")
+       << Row("Links", std::to_string(map.links.size()) + ", " + std::to_string(stats.below_tau_links) + " below \u03c4")
        << Row("Verified matches per link",
               map.links.empty() ? std::string("no links")
                                 : "min " + std::to_string(stats.min_verified) + ", max " +
@@ -689,21 +695,26 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
   }
   html << "</div>\n</section>\n";
 
+  html << LinkTableHtml(map, evaluation ? &*evaluation : nullptr);
+
   // Match figures.
   html << "<section id=\"links\"><h2>Match figures (" << map.links.size() << " links)</h2>\n"
        << "<p class=\"note\">Consecutive key images side by side: <span class=\"legend-verified\">verified matches "
           "as green lines</span>, <span class=\"legend-rejected\">rejected tentative matches as blue points</span>. "
-          "Broken links (the second key image failed the test against the first) have a red frame.</p>\n"
+          "Links below &tau; (the frame right after the first key image already fell below &tau;, so it became the "
+          "second key image) have a red frame.</p>\n"
        << "<div class=\"links\">\n";
   for (size_t i = 0; i < map.links.size(); ++i) {
     const Link& l = map.links[i];
-    html << "<figure class=\"match-figure" << (l.broken ? " broken" : "") << "\" id=\"link-" << i
+    html << "<figure class=\"match-figure" << (l.below_tau ? " below-tau" : "") << "\" id=\"link-" << i
          << "\" data-from=\"" << l.from_key << "\" data-to=\"" << l.to_key << "\"><img loading=\"lazy\" "
          << "decoding=\"async\" src=\"" << UrlPath(assets_url + "links/" + Numbered(static_cast<int>(i)))
          << "\" width=\"" << figure_sizes[i].width << "\" height=\"" << figure_sizes[i].height << "\" alt=\"link " << i
-         << "\"><figcaption>" << (l.broken ? "BROKEN &middot; " : "") << "Link " << i << ": "
+         << "\"><figcaption>" << (l.below_tau ? "BELOW &tau; &middot; " : "") << "Link " << i << ": "
          << HtmlEscape(LinkTitle(map, static_cast<int>(i))) << " &middot; S = " << FormatFixed(l.similarity, 3)
-         << " &middot; " << l.num_verified << " verified of " << l.num_tentative << " tentative</figcaption></figure>\n";
+         << " &middot; " << l.num_verified << " verified of " << l.num_tentative << " tentative"
+         << (evaluation ? " &middot; " + HtmlEscape(EvaluationCaption(evaluation->links[i])) : "")
+         << "</figcaption></figure>\n";
   }
   if (map.links.empty()) html << "<p class=\"note\">This map has a single key image: there are no links.</p>\n";
   html << "</div>\n</section>\n";
@@ -769,21 +780,31 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
        << Row("Pairs matched", std::to_string(sweep.pairs_matched)) << Row("Time", DurationText(sweep.seconds))
        << "</table>\n</section>\n";
 
+  const bool has_usable =
+      std::any_of(sweep.rows.begin(), sweep.rows.end(), [](const SweepRow& r) { return r.usable_links >= 0; });
   html << "<section id=\"table\"><h2>Key images and quality per threshold</h2>\n<table class=\"sweep\">\n<thead><tr>"
           "<th class=\"num\">&tau;</th><th class=\"num\">key images m</th><th class=\"num\">% of frames</th>"
           "<th class=\"num\">min</th><th class=\"num\">max</th><th class=\"num\">mean verified</th>"
-          "<th class=\"num\">mean S</th><th class=\"num\">Q</th><th class=\"num\">broken links</th><th>map</th>"
+          "<th class=\"num\">mean S</th><th class=\"num\">Q</th><th class=\"num\">links below &tau;</th>"
+       << (has_usable ? "<th class=\"num\">usable links (ground truth)</th>" : "") << "<th>map</th>"
           "</tr></thead>\n<tbody>\n";
   for (size_t i = 0; i < sweep.rows.size(); ++i) {
     const SweepRow& r = sweep.rows[i];
     const bool best = has_best && static_cast<int>(i) == sweep.best_row;
-    html << "<tr class=\"" << (best ? "best" : (r.broken_links > 0 ? "broken" : "")) << "\" data-tau=\""
+    html << "<tr class=\"" << (best ? "best" : (r.below_tau_links > 0 ? "below-tau" : "")) << "\" data-tau=\""
          << FormatExact(r.tau) << "\"><td class=\"num\">" << (best ? "&#9733; " : "") << TauText(r.tau)
          << "</td><td class=\"num\">" << r.num_key_images << "</td><td class=\"num\">"
          << FormatFixed(r.key_image_percent, 1) << "</td><td class=\"num\">" << r.min_verified
          << "</td><td class=\"num\">" << r.max_verified << "</td><td class=\"num\">" << FormatFixed(r.mean_verified, 1)
          << "</td><td class=\"num\">" << FormatFixed(r.mean_similarity, 3) << "</td><td class=\"num\">"
-         << FormatFixed(r.quality, 4) << "</td><td class=\"num\">" << r.broken_links << "</td><td>";
+         << FormatFixed(r.quality, 4) << "</td><td class=\"num\">" << r.below_tau_links << "</td>";
+    if (has_usable) {
+      html << "<td class=\"num\">"
+           << (r.usable_links >= 0 ? std::to_string(r.usable_links) + " of " + std::to_string(r.num_key_images - 1)
+                                   : std::string("-"))
+           << "</td>";
+    }
+    html << "<td>";
     if (!r.map_directory.empty()) {
       html << "<a class=\"map-link\" href=\"" << HtmlEscape(MapLink(r.map_directory, directory)) << "\">"
            << HtmlEscape(fs::path(r.map_directory).filename().string()) << "</a>";
@@ -791,7 +812,7 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
     html << "</td></tr>\n";
   }
   html << "</tbody></table>\n"
-       << (has_best ? "<p class=\"note\">&#9733; marks the threshold with the highest Q. Broken links are shaded red. "
+       << (has_best ? "<p class=\"note\">&#9733; marks the threshold with the highest Q. Rows with links below &tau; are shaded red. "
                       "A map without a page links to its map.json: <code>vmap report DIR</code> makes its page.</p>\n"
                     : "")
        << "</section>\n";

@@ -47,7 +47,7 @@ TEST(MapReportTest, WritesOnePageWithAFigurePerLinkAndAThumbnailPerKeyImage) {
 
   const std::string html = ReadText(dir / kReportFileName);
   EXPECT_EQ(report_test::CountOccurrences(html, "<figure class=\"match-figure"), static_cast<int>(map.links.size()));
-  EXPECT_EQ(report_test::CountOccurrences(html, "<figure class=\"match-figure broken\""), 1);
+  EXPECT_EQ(report_test::CountOccurrences(html, "<figure class=\"match-figure below-tau\""), 1);
   EXPECT_EQ(report_test::CountOccurrences(html, "<figure id=\"key-"), static_cast<int>(map.key_images.size()));
   EXPECT_EQ(report_test::CountOccurrences(html, "<svg class=\"plot\""), 2);
   // Offline: no address on the network anywhere, and a policy that refuses any request.
@@ -130,7 +130,7 @@ TEST(MapReportTest, MapWithOneKeyImageAndNoLinksStillGetsAPage) {
   TempDir temp;
   report_test::SyntheticMapOptions options;
   options.num_frames = 1;
-  options.broken_links.clear();
+  options.below_tau_links.clear();
   const VisualMap map = report_test::WriteSyntheticMap(temp.path(), options);
   ASSERT_EQ(map.key_images.size(), 1u);
   ASSERT_TRUE(map.links.empty());

@@ -280,7 +280,7 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
        << "<div class=\"links\">\n";
   for (const auto& [index, size] : written) {
     const LocalizationResult& r = run.frames[index];
-    html << "<figure class=\"match-figure" << (r.status == LocalizationStatus::kLost ? " broken" : "")
+    html << "<figure class=\"match-figure" << (r.status == LocalizationStatus::kLost ? " lost" : "")
          << "\" id=\"frame-" << r.frame_index << "\"><img loading=\"lazy\" decoding=\"async\" src=\""
          << UrlPath(assets_url + "frames/" + report::Numbered(r.frame_index)) << "\" width=\"" << size.width
          << "\" height=\"" << size.height << "\" alt=\"frame " << r.frame_index << "\"><figcaption>Frame "

@@ -51,7 +51,7 @@ cv::Mat DrawMatchFigure(const cv::Mat& image0, const cv::Mat& image1, const Link
   // Both images at the taller one's height, then everything scaled down to fit max_width.
   const int height = std::max(bgr0.rows, bgr1.rows);
   double s0 = static_cast<double>(height) / bgr0.rows, s1 = static_cast<double>(height) / bgr1.rows;
-  const int border = link.broken ? std::max(4, height / 60) : 0;
+  const int border = link.below_tau ? std::max(4, height / 60) : 0;
   const double gap_at_scale = std::max(4.0, height / 100.0);
   const double natural_width = bgr0.cols * s0 + bgr1.cols * s1 + gap_at_scale + 2 * border;
   const double fit = options.max_width > 0 ? std::min(1.0, options.max_width / natural_width) : 1.0;
@@ -61,7 +61,7 @@ cv::Mat DrawMatchFigure(const cv::Mat& image0, const cv::Mat& image1, const Link
   const int w0 = std::max(1, static_cast<int>(std::lround(bgr0.cols * s0)));
   const int w1 = std::max(1, static_cast<int>(std::lround(bgr1.cols * s1)));
   const int h = std::max(1, static_cast<int>(std::lround(height * fit)));
-  const int b = link.broken ? std::max(3, static_cast<int>(std::lround(border * fit))) : 0;
+  const int b = link.below_tau ? std::max(3, static_cast<int>(std::lround(border * fit))) : 0;
   const int width = w0 + gap + w1 + 2 * b;
 
   // The caption's text scales with the figure so it stays readable in a thumbnail and on a slide; long
@@ -70,7 +70,7 @@ cv::Mat DrawMatchFigure(const cv::Mat& image0, const cv::Mat& image1, const Link
   if (options.caption) {
     if (!options.title.empty()) caption_lines.push_back(options.title);
     caption_lines.push_back(MatchCaption(link));
-    if (link.broken) caption_lines.front().insert(0, "BROKEN LINK | ");
+    if (link.below_tau) caption_lines.front().insert(0, "BELOW TAU | ");
   }
   double font_scale = std::clamp(width / 1500.0, 0.38, 1.2);
   int thickness = font_scale > 0.8 ? 2 : 1;
@@ -85,11 +85,11 @@ cv::Mat DrawMatchFigure(const cv::Mat& image0, const cv::Mat& image1, const Link
   const int caption_height = caption_lines.empty() ? 0 : line_height * static_cast<int>(caption_lines.size()) + 4;
 
   cv::Mat figure(h + 2 * b + caption_height, width, CV_8UC3, cv::Scalar(255, 255, 255));
-  if (b > 0) figure.setTo(kBrokenColor);
+  if (b > 0) figure.setTo(kBelowTauColor);
   const cv::Point2d offset0(b, b), offset1(b + w0 + gap, b);
   cv::resize(bgr0, figure(cv::Rect(b, b, w0, h)), cv::Size(w0, h), 0, 0, cv::INTER_AREA);
   cv::resize(bgr1, figure(cv::Rect(b + w0 + gap, b, w1, h)), cv::Size(w1, h), 0, 0, cv::INTER_AREA);
-  if (b > 0) figure(cv::Rect(b + w0, b, gap, h)).setTo(kBrokenColor);
+  if (b > 0) figure(cv::Rect(b + w0, b, gap, h)).setTo(kBelowTauColor);
 
   const int verified = std::clamp(link.num_verified, 0, static_cast<int>(link.correspondences.size()));
   const double radius = std::max(1.5, std::min(width, h * 2) / 400.0);
@@ -114,7 +114,7 @@ cv::Mat DrawMatchFigure(const cv::Mat& image0, const cv::Mat& image1, const Link
 
   if (!caption_lines.empty()) {
     const cv::Rect band(0, h + 2 * b, width, caption_height);
-    figure(band).setTo(link.broken ? kBrokenColor : cv::Scalar(48, 48, 48));
+    figure(band).setTo(link.below_tau ? kBelowTauColor : cv::Scalar(48, 48, 48));
     int y = band.y + line_height - baseline - 4;
     for (const std::string& line : caption_lines) {
       cv::putText(figure, line, cv::Point(8, y), cv::FONT_HERSHEY_SIMPLEX, font_scale, cv::Scalar(255, 255, 255),

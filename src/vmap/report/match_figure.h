@@ -1,7 +1,8 @@
 #pragma once
 // The paper's match figure (Figure 4, Figures 7-18): two consecutive key images side by side, the verified
 // matches as green lines between them and the rejected tentative matches as blue points, with a caption
-// giving S and the counts. A broken link gets a red border and a red caption.
+// giving S and the counts. A link below tau (its second key image is the
+// frame right after the first, which already fell below tau) gets a red border and a red caption.
 
 #include <string>
 
@@ -23,7 +24,7 @@ struct MatchFigureOptions {
 // Colours (BGR) used by the figure, shared with the report's legend and the tests.
 inline const cv::Scalar kVerifiedColor(0, 200, 0);
 inline const cv::Scalar kRejectedColor(255, 64, 0);
-inline const cv::Scalar kBrokenColor(0, 0, 220);
+inline const cv::Scalar kBelowTauColor(0, 0, 220);
 
 // `image0` is the link's first key image and `image1` its second (8-bit grey or BGR; their sizes may
 // differ: both are scaled to the taller one's height). The correspondences are in each image's own

@@ -42,17 +42,17 @@ TEST(MatchFigureTest, PutsImagesSideBySideWithGreenLinesAndBluePoints) {
   EXPECT_FALSE(IsBlue(figure.at<cv::Vec3b>(50, 160)));
 }
 
-TEST(MatchFigureTest, BrokenLinkGetsARedBorderAndCaption) {
+TEST(MatchFigureTest, LinkBelowTauGetsARedBorderAndCaption) {
   const cv::Mat grey(100, 200, CV_8UC3, cv::Scalar::all(128));
   Link link = SimpleLink();
   const cv::Mat normal = DrawMatchFigure(grey, grey, link, {});
-  link.broken = true;
-  const cv::Mat broken = DrawMatchFigure(grey, grey, link, {});
+  link.below_tau = true;
+  const cv::Mat below_tau = DrawMatchFigure(grey, grey, link, {});
   EXPECT_FALSE(IsRed(normal.at<cv::Vec3b>(0, 0)));
-  EXPECT_TRUE(IsRed(broken.at<cv::Vec3b>(0, 0)));
-  EXPECT_TRUE(IsRed(broken.at<cv::Vec3b>(broken.rows / 3, broken.cols - 1)));
-  // The caption band (bottom left corner, left of the text) is red only for the broken link.
-  EXPECT_TRUE(IsRed(broken.at<cv::Vec3b>(broken.rows - 2, 2)));
+  EXPECT_TRUE(IsRed(below_tau.at<cv::Vec3b>(0, 0)));
+  EXPECT_TRUE(IsRed(below_tau.at<cv::Vec3b>(below_tau.rows / 3, below_tau.cols - 1)));
+  // The caption band (bottom left corner, left of the text) is red only for the link below tau.
+  EXPECT_TRUE(IsRed(below_tau.at<cv::Vec3b>(below_tau.rows - 2, 2)));
   EXPECT_FALSE(IsRed(normal.at<cv::Vec3b>(normal.rows - 2, 2)));
 }
 

@@ -88,7 +88,7 @@ VisualMap WriteSyntheticMap(const fs::path& directory, const SyntheticMapOptions
     l.similarity = static_cast<double>(verified) / l.num_tentative;
     l.has_fundamental = true;
     l.F = cv::Matx33d(0, 0, 0, 0, 0, -1, 0, 1, 0);
-    for (int b : options.broken_links) l.broken = l.broken || b == static_cast<int>(i);
+    for (int b : options.below_tau_links) l.below_tau = l.below_tau || b == static_cast<int>(i);
     map.links.push_back(l);
     for (int f = key_frames[i] + 1; f <= key_frames[i + 1]; ++f) {
       Evaluation e;

@@ -22,7 +22,7 @@ struct SyntheticMapOptions {
   int num_frames = 40;
   int frames_per_key = 9;
   cv::Size frame_size{320, 240};
-  std::vector<int> broken_links = {2};
+  std::vector<int> below_tau_links = {2};
   double tau = 0.35;
 };
 

@@ -1,5 +1,7 @@
 #include "vmap/report/summary.h"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -21,8 +23,16 @@ std::string FormatMapSummary(const VisualMap& map, QualityMean mean) {
     text += fmt::format("verified matches between consecutive key images  min {}  max {}  mean {:.1f}\n",
                         s.min_verified, s.max_verified, s.mean_verified);
     text += fmt::format("mean similarity {:.3f}", s.mean_similarity);
-    if (s.broken_links > 0) text += fmt::format("  ({} broken links)", s.broken_links);
+    if (s.below_tau_links > 0) text += fmt::format("  ({} links below tau)", s.below_tau_links);
     text += "\n";
+  }
+  if (map.input.camera) {
+    const Camera& c = *map.input.camera;
+    text += fmt::format("camera          {} {}x{} fx {:.2f} fy {:.2f} cx {:.2f} cy {:.2f}{}; links with a pose {} of {}\n",
+                        CameraModelName(c.model), c.size.width, c.size.height, c.fx, c.fy, c.cx, c.cy,
+                        c.has_distortion() ? " (with distortion)" : "",
+                        std::count_if(map.links.begin(), map.links.end(), [](const Link& l) { return l.has_pose; }),
+                        map.links.size());
   }
   text += fmt::format("quality Q       {:.4f} ({} mean)\n", s.quality, QualityMeanName(mean));
   if (map.seconds > 0) {
@@ -34,15 +44,24 @@ std::string FormatMapSummary(const VisualMap& map, QualityMean mean) {
 std::string SweepToMarkdown(const SweepResult& sweep) {
   std::string text = fmt::format("Threshold sweep of {} ({} frames, {:.1f} s)\n\n", sweep.input.path, sweep.num_frames,
                                  sweep.seconds);
-  text += "| tau | key images | % frames | min matches | max matches | mean matches | mean S | Q |\n";
-  text += "|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  const bool has_usable =
+      std::any_of(sweep.rows.begin(), sweep.rows.end(), [](const SweepRow& r) { return r.usable_links >= 0; });
+  text += "| tau | key images | % frames | min matches | max matches | mean matches | mean S | Q |";
+  text += has_usable ? " usable links |\n" : "\n";
+  text += has_usable ? "|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n" : "|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (size_t i = 0; i < sweep.rows.size(); ++i) {
     const SweepRow& r = sweep.rows[i];
     const bool best = static_cast<int>(i) == sweep.best_row;
-    text += fmt::format("| {}{:.2f}{} | {} | {:.1f} | {} | {} | {:.1f} | {:.3f} | {}{:.4f}{} |\n", best ? "**" : "",
+    text += fmt::format("| {}{:.2f}{} | {} | {:.1f} | {} | {} | {:.1f} | {:.3f} | {}{:.4f}{} |", best ? "**" : "",
                         r.tau, best ? "**" : "", r.num_key_images, r.key_image_percent, r.min_verified,
                         r.max_verified, r.mean_verified, r.mean_similarity, best ? "**" : "", r.quality,
                         best ? "**" : "");
+    if (has_usable) {
+      const int links = std::max(0, r.num_key_images - 1);
+      text += r.usable_links < 0 ? " - |" : fmt::format(" {} of {} ({:.0f}%) |", r.usable_links, links,
+                                                         links > 0 ? 100.0 * r.usable_links / links : 0.0);
+    }
+    text += "\n";
   }
   if (sweep.best_row >= 0) text += fmt::format("\nBest tau by Q: {:.2f}\n", sweep.rows[sweep.best_row].tau);
   return text;
@@ -50,12 +69,13 @@ std::string SweepToMarkdown(const SweepResult& sweep) {
 
 std::string SweepToCsv(const SweepResult& sweep) {
   std::string text = "tau,key_images,key_image_percent,min_matches,max_matches,mean_matches,mean_similarity,quality,"
-                     "broken_links,best\n";
+                     "below_tau_links,usable_links,best\n";
   for (size_t i = 0; i < sweep.rows.size(); ++i) {
     const SweepRow& r = sweep.rows[i];
-    text += fmt::format("{:.4f},{},{:.4f},{},{},{:.4f},{:.6f},{:.6f},{},{}\n", r.tau, r.num_key_images,
+    text += fmt::format("{:.4f},{},{:.4f},{},{},{:.4f},{:.6f},{:.6f},{},{},{}\n", r.tau, r.num_key_images,
                         r.key_image_percent, r.min_verified, r.max_verified, r.mean_verified, r.mean_similarity,
-                        r.quality, r.broken_links, static_cast<int>(i) == sweep.best_row ? 1 : 0);
+                        r.quality, r.below_tau_links, r.usable_links >= 0 ? std::to_string(r.usable_links) : "",
+                        static_cast<int>(i) == sweep.best_row ? 1 : 0);
   }
   return text;
 }
@@ -81,7 +101,8 @@ std::string SweepToJson(const SweepResult& sweep) {
                     {"mean_matches", r.mean_verified},
                     {"mean_similarity", r.mean_similarity},
                     {"quality", r.quality},
-                    {"broken_links", r.broken_links},
+                    {"below_tau_links", r.below_tau_links},
+                    {"usable_links", r.usable_links >= 0 ? nlohmann::json(r.usable_links) : nlohmann::json(nullptr)},
                     {"map", r.map_directory.empty() ? nlohmann::json(nullptr)
                                                     : nlohmann::json(EncodeFileName(r.map_directory))}});
   }

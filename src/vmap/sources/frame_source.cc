@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/error.h"
+#include "vmap/sources/dataset_camera.h"
 #include "vmap/sources/internal.h"
 
 namespace vmap {
@@ -173,32 +174,60 @@ void FitFrame(Frame& frame, const cv::Size& target, const cv::Size& first_native
 
 namespace {
 
+std::unique_ptr<FrameSource> OpenDetected(const std::string& path, const fs::path& p, SourceFormat format,
+                                          const FrameSourceOptions& options);
+
+// Attaches the camera to a source's SequenceInfo once the first frame tells the frames' size: the
+// intrinsics are checked against the native size and scaled to the delivered (--resize) size.
+class CameraSource : public FrameSource {
+ public:
+  CameraSource(std::unique_ptr<FrameSource> inner, Camera camera)
+      : inner_(std::move(inner)), camera_(std::move(camera)), info_(inner_->info()) {}
+
+  std::optional<Frame> Next() override {
+    std::optional<Frame> frame = inner_->Next();
+    info_ = inner_->info();
+    if (frame && !scaled_) scaled_ = CameraForFrames(camera_, info_.native_size, info_.frame_size);
+    info_.camera = scaled_;
+    return frame;
+  }
+  const SequenceInfo& info() const override { return info_; }
+  int skipped_frames() const override { return inner_->skipped_frames(); }
+
+ private:
+  std::unique_ptr<FrameSource> inner_;
+  Camera camera_;
+  std::optional<Camera> scaled_;
+  SequenceInfo info_;
+};
+
 std::unique_ptr<FrameSource> OpenDetectedFrameSource(const std::string& path, const FrameSourceOptions& options) {
   std::error_code ec;
   if (!fs::exists(path, ec)) {
     throw InputError("input '" + path + "' does not exist; give a video file, an image folder, or a TUM/EuRoC/KITTI sequence");
   }
   const fs::path p(path);
-  SourceFormat format = options.format;
-  if (format == SourceFormat::kAuto) {
-    if (fs::is_directory(p)) {
-      if (fs::exists(p / "rgb.txt")) format = SourceFormat::kTum;
-      else if (fs::exists(p / "mav0/cam0/data.csv") || fs::exists(p / "cam0/data.csv")) format = SourceFormat::kEuroc;
-      else if (fs::is_directory(p / "image_0") || fs::is_directory(p / "image_2")) format = SourceFormat::kKitti;
-      else format = SourceFormat::kImageFolder;
-    } else if (internal::IsImageFile(path)) {
-      if (!options.allow_single_image) {
-        throw InputError("input '" + path + "' is a single image; pass the folder that holds the sequence's images");
-      }
-      return internal::OpenImageList({{path, -1.0}}, path, SourceFormat::kImageFolder, options);
-    } else if (p.filename() == "rgb.txt") {
-      format = SourceFormat::kTum;
-    } else if (p.filename() == "data.csv") {
-      format = SourceFormat::kEuroc;
-    } else {
-      format = SourceFormat::kVideo;  // anything else that is a file: let FFmpeg try
+  if (!fs::is_directory(p) && internal::IsImageFile(path) && options.format == SourceFormat::kAuto) {
+    if (!options.allow_single_image) {
+      throw InputError("input '" + path + "' is a single image; pass the folder that holds the sequence's images");
     }
+    // One image: no dataset around it to take intrinsics from; --camera still applies.
+    std::unique_ptr<FrameSource> single =
+        internal::OpenImageList({{path, -1.0}}, path, SourceFormat::kImageFolder, options);
+    if (options.camera.empty() || options.camera == "none") return single;
+    return std::make_unique<CameraSource>(std::move(single), ParseCameraOption(options.camera));
   }
+  const SourceFormat format = DetectSourceFormat(path, options.format);
+  std::unique_ptr<FrameSource> source = OpenDetected(path, p, format, options);
+  std::optional<Camera> camera;
+  if (options.camera.empty()) camera = FindDatasetCamera(path, format);
+  else if (options.camera != "none") camera = ParseCameraOption(options.camera);
+  if (!camera) return source;
+  return std::make_unique<CameraSource>(std::move(source), *camera);
+}
+
+std::unique_ptr<FrameSource> OpenDetected(const std::string& path, const fs::path& p, SourceFormat format,
+                                          const FrameSourceOptions& options) {
   switch (format) {
     case SourceFormat::kVideo:
       if (fs::is_directory(p)) throw InputError("input '" + path + "' is a folder, not a video; drop --format video");

@@ -8,6 +8,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/geometry/camera.h"
+
 namespace vmap {
 
 enum class SourceFormat { kAuto, kVideo, kImageFolder, kTum, kEuroc, kKitti };
@@ -36,6 +38,9 @@ struct FrameSourceOptions {
   // one with a side under kMinFrameSide: 8192 x 8192 (64 megapixels) is more than any camera's video frame,
   // and bounds the memory a hostile image can take once decoded.
   long max_frame_pixels = 8192L * 8192L;
+  // The camera: "" = the intrinsics that come with the input, if any (see dataset_camera.h); "none" = no
+  // camera; otherwise "fx,fy,cx,cy[,k1,k2,p1,p2[,k3]]" or a calibration file (--camera).
+  std::string camera;
   // A single image file is a sequence of one frame (vmap localize takes one query image); otherwise it is an
   // error, since one frame makes no map.
   bool allow_single_image = false;
@@ -60,6 +65,9 @@ struct SequenceInfo {
   cv::Size native_size;        // the first frame's size as stored
   cv::Size frame_size;         // the size of delivered frames
   double fps = 0.0;            // video only
+  // The camera of the delivered frames (scaled with --resize), known once the first frame is read; empty
+  // when the input has no intrinsics and none were given.
+  std::optional<Camera> camera;
 };
 
 class FrameSource {

@@ -1,0 +1,184 @@
+// End-to-end tests of `vmap eval`, of the camera options of `vmap build`, of `vmap sweep --gt` and of the
+// report's link table, on the real sequences with ground truth and on synthetic ones.
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "vmap/evaluation/map_evaluation.h"
+#include "vmap/mapping/map_io.h"
+#include "vmap/testing/synthetic_scene.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+using testing::RunVmap;
+
+namespace {
+
+fs::path Shared() { return testing::SharedDir(); }
+
+#define REQUIRE_SHARED() \
+  if (Shared().empty()) GTEST_SKIP() << "../shared is not present"
+
+std::string Quote(const fs::path& p) { return "'" + p.string() + "'"; }
+
+nlohmann::json ReadJson(const fs::path& file) {
+  std::ifstream in(file);
+  return nlohmann::json::parse(in);
+}
+
+testing::SyntheticSequence Synthetic() {
+  testing::SyntheticOptions options;
+  options.num_frames = 30;
+  options.step = 0.06;
+  options.yaw_per_frame = 0.01;
+  return testing::RenderSyntheticSequence(options);
+}
+
+}  // namespace
+
+TEST(EvalCli, Kitti07LinksAreUsableAndTheReportShowsThem) {
+  REQUIRE_SHARED();
+  testing::TempDir tmp;
+  const fs::path map = tmp.path() / "map";
+  std::string out;
+  ASSERT_EQ(RunVmap("build " + Quote(Shared() / "data/kitti07") + " --last 59 -q -o " + Quote(map), &out), 0) << out;
+  const VisualMap built = ReadMap(map);
+  ASSERT_TRUE(built.input.camera);  // from calib.txt
+  EXPECT_EQ(built.input.camera->model, CameraModel::kSimplePinhole);
+  for (const Link& link : built.links) EXPECT_TRUE(link.has_pose);
+
+  ASSERT_EQ(RunVmap("eval " + Quote(map) + " --json " + Quote(tmp.path() / "eval.json"), &out), 0) << out;
+  EXPECT_NE(out.find("usable links"), std::string::npos) << out;
+  EXPECT_NE(out.find("| link |"), std::string::npos) << out;
+  const nlohmann::json doc = ReadJson(tmp.path() / "eval.json");
+  const nlohmann::json& summary = doc["summary"];
+  for (const char* field : {"links", "usable_links", "rotation_error_deg_median", "translation_error_deg_median"}) {
+    EXPECT_TRUE(summary.contains(field)) << field;
+  }
+  EXPECT_EQ(summary["links"].get<int>(), static_cast<int>(built.links.size()));
+  EXPECT_EQ(summary["evaluated_links"], summary["links"]);
+  // The development sequence's default map: every link usable (README, "Links a robot can trust").
+  EXPECT_GE(summary["usable_links"].get<double>(), 0.95 * summary["links"].get<double>()) << out;
+  EXPECT_LT(summary["rotation_error_deg_median"].get<double>(), 0.5);
+  EXPECT_EQ(doc["ground_truth"]["format"], "kitti");
+  // Also written into the map, where the report finds it.
+  ASSERT_TRUE(fs::exists(map / kEvaluationFileName));
+  EXPECT_EQ(ReadEvaluation((map / kEvaluationFileName).string()).summary.usable_links, summary["usable_links"]);
+
+  ASSERT_EQ(RunVmap("report " + Quote(map) + " --no-video", &out), 0) << out;
+  std::ifstream in(map / "report.html");
+  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(html.find("id=\"link-table\""), std::string::npos);
+  EXPECT_NE(html.find("usable links"), std::string::npos);
+  EXPECT_NE(html.find("rotation error"), std::string::npos);
+  // `vmap info` names the camera.
+  ASSERT_EQ(RunVmap("info " + Quote(map), &out), 0) << out;
+  EXPECT_NE(out.find("SIMPLE_PINHOLE"), std::string::npos) << out;
+}
+
+TEST(EvalCli, RedkitchenIsEvaluatedByTimestamp) {
+  REQUIRE_SHARED();
+  testing::TempDir tmp;
+  const fs::path map = tmp.path() / "map";
+  std::string out;
+  ASSERT_EQ(RunVmap("build " + Quote(Shared() / "data/redkitchen") + " --last 119 -q -o " + Quote(map), &out), 0)
+      << out;
+  ASSERT_EQ(RunVmap("eval " + Quote(map) + " --no-table --no-save --json " + Quote(tmp.path() / "e.json"), &out), 0)
+      << out;
+  EXPECT_FALSE(fs::exists(map / kEvaluationFileName));
+  const nlohmann::json doc = ReadJson(tmp.path() / "e.json");
+  EXPECT_EQ(doc["ground_truth"]["format"], "tum");
+  EXPECT_GT(doc["summary"]["links"].get<int>(), 3);
+  EXPECT_EQ(doc["summary"]["evaluated_links"], doc["summary"]["links"]);
+  // Thresholds are options, recorded with the result.
+  ASSERT_EQ(RunVmap("eval " + Quote(map) + " --no-table --no-save --max-rotation-error 0.01 --json " +
+                        Quote(tmp.path() / "strict.json"),
+                    &out),
+            0)
+      << out;
+  const nlohmann::json strict = ReadJson(tmp.path() / "strict.json");
+  EXPECT_EQ(strict["options"]["max_rotation_error_deg"], 0.01);
+  EXPECT_LT(strict["summary"]["usable_links"].get<int>(), doc["summary"]["usable_links"].get<int>());
+}
+
+TEST(EvalCli, SweepWithGroundTruthAddsAUsableLinksColumn) {
+  REQUIRE_SHARED();
+  testing::TempDir tmp;
+  std::string out;
+  ASSERT_EQ(RunVmap("sweep " + Quote(Shared() / "data/kitti07") + " --last 39 --thresholds 0.4,0.6 --gt -q -o " +
+                        Quote(tmp.path() / "sweep") + " --maps",
+                    &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("usable links |"), std::string::npos) << out;
+  const nlohmann::json doc = ReadJson(tmp.path() / "sweep/sweep.json");
+  for (const auto& row : doc["rows"]) {
+    EXPECT_TRUE(row["usable_links"].is_number()) << row.dump();
+    EXPECT_LE(row["usable_links"].get<int>(), row["key_images"].get<int>() - 1);
+  }
+  EXPECT_TRUE(fs::exists(tmp.path() / "sweep/tau_0.40" / kEvaluationFileName));
+  // Without --gt, no such column.
+  ASSERT_EQ(RunVmap("sweep " + Quote(Shared() / "data/kitti07") + " --last 19 --thresholds 0.5 -q", &out), 0) << out;
+  EXPECT_EQ(out.find("usable links"), std::string::npos) << out;
+}
+
+TEST(EvalCli, CameraOptionAndMissingGroundTruthOrIntrinsics) {
+  testing::TempDir tmp;
+  const testing::SyntheticSequence sequence = Synthetic();
+  testing::WriteImageFolder(sequence, tmp.path() / "frames");
+  std::string out;
+  // No intrinsics beside the folder: a map without camera and without poses.
+  ASSERT_EQ(RunVmap("build " + Quote(tmp.path() / "frames") + " -q -o " + Quote(tmp.path() / "plain"), &out), 0) << out;
+  EXPECT_FALSE(ReadMap(tmp.path() / "plain").input.camera);
+  EXPECT_EQ(RunVmap("eval " + Quote(tmp.path() / "plain"), &out), 2);
+  EXPECT_NE(out.find("--gt"), std::string::npos) << out;
+  // Ground truth given, intrinsics not: the error says how to give them.
+  testing::WriteKittiSequence(sequence, tmp.path() / "kitti");
+  const std::string poses = Quote(tmp.path() / "kitti/poses.txt");
+  EXPECT_EQ(RunVmap("eval " + Quote(tmp.path() / "plain") + " --gt " + poses, &out), 2);
+  EXPECT_NE(out.find("--camera"), std::string::npos) << out;
+  // With --camera at eval time, the pose comes from F.
+  const cv::Matx33d& K = sequence.K;
+  const std::string camera = cv::format("%.6f,%.6f,%.6f,%.6f", K(0, 0), K(1, 1), K(0, 2), K(1, 2));
+  ASSERT_EQ(RunVmap("eval " + Quote(tmp.path() / "plain") + " --gt " + poses + " --camera " + camera +
+                        " --no-table --json " + Quote(tmp.path() / "e.json"),
+                    &out),
+            0)
+      << out;
+  EXPECT_EQ(ReadJson(tmp.path() / "e.json")["links"][0]["pose_source"], "fundamental");
+  EXPECT_EQ(ReadJson(tmp.path() / "e.json")["ground_truth"]["format"], "kitti");
+
+  // An OpenCV calibration file as --camera at build time: the map carries the camera and poses.
+  {
+    cv::FileStorage fs((tmp.path() / "camera.yaml").string(), cv::FileStorage::WRITE);
+    fs << "image_width" << 320 << "image_height" << 240 << "camera_matrix" << cv::Mat(K)
+       << "distortion_coefficients" << cv::Mat::zeros(5, 1, CV_64F);
+  }
+  ASSERT_EQ(RunVmap("build " + Quote(tmp.path() / "frames") + " -q --camera " + Quote(tmp.path() / "camera.yaml") +
+                        " -o " + Quote(tmp.path() / "posed"),
+                    &out),
+            0)
+      << out;
+  const VisualMap posed = ReadMap(tmp.path() / "posed");
+  ASSERT_TRUE(posed.input.camera);
+  EXPECT_EQ(posed.input.camera->K(), K);
+  EXPECT_TRUE(posed.links.front().has_pose);
+  const auto options = nlohmann::json::parse(posed.options_json);
+  EXPECT_EQ(options["pose"]["method"], "essential");
+  EXPECT_EQ(options["source"]["camera"], (tmp.path() / "camera.yaml").string());
+
+  // Bad values are refused with the option's name.
+  EXPECT_EQ(RunVmap("build " + Quote(tmp.path() / "frames") + " -q --camera 1,2,3 -o " + Quote(tmp.path() / "x"), &out), 2);
+  EXPECT_NE(out.find("--camera"), std::string::npos) << out;
+  EXPECT_EQ(RunVmap("build " + Quote(tmp.path() / "frames") + " -q --pose magic -o " + Quote(tmp.path() / "x"), &out), 2);
+  EXPECT_NE(out.find("pose method"), std::string::npos) << out;
+  EXPECT_EQ(RunVmap("eval " + Quote(tmp.path() / "posed") + " --gt " + poses + " --min-parallax -3", &out), 2);
+  EXPECT_NE(out.find("--min-parallax"), std::string::npos) << out;
+  std::ofstream(tmp.path() / "junk.txt") << "hello world\n";
+  EXPECT_EQ(RunVmap("eval " + Quote(tmp.path() / "posed") + " --gt " + Quote(tmp.path() / "junk.txt"), &out), 2);
+  EXPECT_NE(out.find("--gt-format"), std::string::npos) << out;
+}
+
+}  // namespace vmap

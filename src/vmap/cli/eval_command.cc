@@ -1,0 +1,86 @@
+// vmap eval MAP_DIR [--gt FILE]: every link of a map against ground-truth camera poses.
+
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include <spdlog/spdlog.h>
+
+#include "vmap/cli/commands.h"
+#include "vmap/core/atomic_output.h"
+#include "vmap/core/error.h"
+#include "vmap/evaluation/map_evaluation.h"
+#include "vmap/mapping/map_io.h"
+#include "vmap/report/evaluation_summary.h"
+
+namespace vmap::cli {
+namespace fs = std::filesystem;
+
+namespace {
+
+struct EvalFlags {
+  std::string map;
+  std::string gt;
+  std::string gt_format = "auto";
+  std::string camera;
+  std::string json;
+  bool save = true;
+  bool table = true;
+  EvaluationOptions options;
+};
+
+void RunEval(const EvalFlags& flags) {
+  flags.options.Check();
+  const VisualMap map = ReadMap(flags.map);
+  const GroundTruth truth = MapGroundTruth(map, flags.gt, ParseGroundTruthFormat(flags.gt_format));
+  const Camera camera = EvaluationCamera(map, flags.camera);
+  MapEvaluation evaluation = EvaluateMap(map, truth, camera, flags.options);
+  evaluation.map_path = flags.map;
+  if (evaluation.summary.links > 0 && evaluation.summary.evaluated_links == 0) {
+    spdlog::warn("no link has ground truth for both key images: check that --gt belongs to this sequence{}",
+                 truth.format == GroundTruthFormat::kKitti ? "" : " and that the timestamps match");
+  }
+  const std::string json = EvaluationToJson(evaluation);
+  if (flags.save) WriteFileAtomically(fs::path(flags.map) / kEvaluationFileName, json);
+  if (!flags.json.empty()) WriteFileAtomically(flags.json, json);
+  if (flags.table) std::cout << FormatEvaluationTable(evaluation) << "\n";
+  std::cout << FormatEvaluationSummary(evaluation);
+  if (flags.save) std::cout << "written to      " << (fs::path(flags.map) / kEvaluationFileName).string() << "\n";
+}
+
+}  // namespace
+
+void AddEvalCommand(CLI::App& app) {
+  auto flags = std::make_shared<EvalFlags>();
+  CLI::App* command = app.add_subcommand(
+      "eval", "Check every link of a map against ground-truth camera poses (rotation, translation, epipolar errors)");
+  command->add_option("map", flags->map, "Map directory written by `vmap build`")->required();
+  command->add_option("--gt", flags->gt,
+                      "Ground-truth poses (default: the input's own: KITTI poses.txt, TUM groundtruth.txt, EuRoC "
+                      "state_groundtruth_estimate0/data.csv). Formats: kitti, tum, euroc");
+  command->add_option("--gt-format", flags->gt_format, "Format of --gt: auto (from its first line), kitti, tum, euroc")
+      ->capture_default_str();
+  command->add_option("--camera", flags->camera,
+                      "Intrinsics when the map has none: fx,fy,cx,cy[,k1,k2,p1,p2[,k3]] or a calibration file");
+  command->add_option("--json", flags->json, "Also write the evaluation (JSON) to this file");
+  command->add_flag("!--no-save", flags->save, "Do not write eval.json into the map directory");
+  command->add_flag("!--no-table", flags->table, "Print only the summary, not one row per link");
+  auto& o = flags->options;
+  command->add_option("--max-rotation-error", o.max_rotation_error_deg, "Usable: rotation error below this (deg)")
+      ->capture_default_str();
+  command->add_option("--max-translation-error", o.max_translation_error_deg,
+                      "Usable: translation direction error below this (deg) where the parallax is enough")
+      ->capture_default_str();
+  command->add_option("--min-parallax", o.min_parallax_px,
+                      "True parallax (px) from which the translation direction is judged")
+      ->capture_default_str();
+  command->add_option("--sampson-threshold", o.sampson_threshold_px,
+                      "A match is on its true epipolar line within this Sampson error (px)")
+      ->capture_default_str();
+  command->add_option("--max-time-difference", o.max_time_difference,
+                      "Seconds between a key image and its ground-truth pose (tum, euroc)")
+      ->capture_default_str();
+  command->callback([flags] { RunEval(*flags); });
+}
+
+}  // namespace vmap::cli

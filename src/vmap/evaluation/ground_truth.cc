@@ -1,0 +1,223 @@
+#include "vmap/evaluation/ground_truth.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "vmap/core/error.h"
+#include "vmap/sources/dataset_camera.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+
+GroundTruthFormat ParseGroundTruthFormat(const std::string& name) {
+  if (name == "auto") return GroundTruthFormat::kAuto;
+  if (name == "kitti") return GroundTruthFormat::kKitti;
+  if (name == "tum") return GroundTruthFormat::kTum;
+  if (name == "euroc") return GroundTruthFormat::kEuroc;
+  throw InputError("unknown ground-truth format '" + name + "'; use auto, kitti, tum or euroc");
+}
+
+std::string GroundTruthFormatName(GroundTruthFormat format) {
+  switch (format) {
+    case GroundTruthFormat::kAuto: return "auto";
+    case GroundTruthFormat::kKitti: return "kitti";
+    case GroundTruthFormat::kTum: return "tum";
+    case GroundTruthFormat::kEuroc: return "euroc";
+  }
+  return "auto";
+}
+
+namespace {
+
+bool IsDataLine(const std::string& line) {
+  const auto first = line.find_first_not_of(" \t\r");
+  return first != std::string::npos && line[first] != '#' && line[first] != '%';
+}
+
+// The numbers of a line, separated by spaces, tabs or commas. Throws on a token that is not a number.
+std::vector<double> LineNumbers(std::string line, const std::string& path, int number) {
+  std::replace(line.begin(), line.end(), ',', ' ');
+  std::istringstream in(line);
+  std::vector<double> values;
+  std::string token;
+  while (in >> token) {
+    try {
+      size_t used = 0;
+      values.push_back(std::stod(token, &used));
+      if (used != token.size()) throw std::invalid_argument(token);
+    } catch (const std::exception&) {
+      throw InputError(fmt::format("ground truth '{}' line {}: '{}' is not a number", path, number, token));
+    }
+  }
+  return values;
+}
+
+cv::Matx44d FromRotationTranslation(const cv::Matx33d& R, const cv::Vec3d& t) {
+  cv::Matx44d T = cv::Matx44d::eye();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) T(r, c) = R(r, c);
+    T(r, 3) = t[r];
+  }
+  return T;
+}
+
+}  // namespace
+
+cv::Matx33d QuaternionToRotation(double w, double x, double y, double z) {
+  const double n = std::sqrt(w * w + x * x + y * y + z * z);
+  if (!(n > 0)) return cv::Matx33d::eye();
+  w /= n;
+  x /= n;
+  y /= n;
+  z /= n;
+  return cv::Matx33d(1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w),  //
+                     2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),  //
+                     2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y));
+}
+
+GroundTruthFormat DetectGroundTruthFormat(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError("cannot read ground truth '" + path + "'");
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (!IsDataLine(line)) continue;
+    const bool commas = line.find(',') != std::string::npos;
+    size_t count = 0;
+    try {
+      count = LineNumbers(line, path, number).size();
+    } catch (const InputError&) {
+      break;  // not numbers: none of the formats
+    }
+    if (commas && count >= 8) return GroundTruthFormat::kEuroc;
+    if (!commas && count == 12) return GroundTruthFormat::kKitti;
+    if (!commas && count == 8) return GroundTruthFormat::kTum;
+    break;
+  }
+  throw InputError("cannot tell the format of ground truth '" + path +
+                   "': its first line is not 12 numbers (KITTI poses.txt), 'timestamp tx ty tz qx qy qz qw' (TUM) "
+                   "or 'timestamp_ns,px,py,pz,qw,qx,qy,qz,...' (EuRoC); pass --gt-format");
+}
+
+GroundTruth ReadGroundTruth(const std::string& path, GroundTruthFormat format, const cv::Matx44d& body_to_camera) {
+  if (format == GroundTruthFormat::kAuto) format = DetectGroundTruthFormat(path);
+  std::ifstream in(path);
+  if (!in) throw InputError("cannot read ground truth '" + path + "'");
+  GroundTruth truth;
+  truth.path = path;
+  truth.format = format;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (!IsDataLine(line)) continue;
+    const std::vector<double> v = LineNumbers(line, path, number);
+    const auto bad = [&](const char* expected) {
+      throw InputError(fmt::format("ground truth '{}' line {} has {} numbers; a {} line is {}", path, number,
+                                   v.size(), GroundTruthFormatName(format), expected));
+    };
+    for (double value : v) {
+      if (!std::isfinite(value)) throw InputError(fmt::format("ground truth '{}' line {}: not finite", path, number));
+    }
+    switch (format) {
+      case GroundTruthFormat::kKitti: {
+        if (v.size() != 12) bad("12 numbers (3x4 camera-to-world matrix, row-major)");
+        cv::Matx44d T = cv::Matx44d::eye();
+        for (int i = 0; i < 12; ++i) T(i / 4, i % 4) = v[i];
+        truth.camera_to_world.push_back(T);
+        break;
+      }
+      case GroundTruthFormat::kTum: {
+        if (v.size() != 8) bad("'timestamp tx ty tz qx qy qz qw'");
+        truth.timestamps.push_back(v[0]);
+        truth.camera_to_world.push_back(
+            FromRotationTranslation(QuaternionToRotation(v[7], v[4], v[5], v[6]), cv::Vec3d(v[1], v[2], v[3])));
+        break;
+      }
+      case GroundTruthFormat::kEuroc: {
+        if (v.size() < 8) bad("'timestamp_ns, px, py, pz, qw, qx, qy, qz, ...'");
+        truth.timestamps.push_back(v[0] * 1e-9);
+        const cv::Matx44d T_wb =
+            FromRotationTranslation(QuaternionToRotation(v[4], v[5], v[6], v[7]), cv::Vec3d(v[1], v[2], v[3]));
+        truth.camera_to_world.push_back(T_wb * body_to_camera);
+        break;
+      }
+      case GroundTruthFormat::kAuto: break;
+    }
+  }
+  if (truth.camera_to_world.empty()) throw InputError("ground truth '" + path + "' holds no poses");
+  for (size_t i = 1; i < truth.timestamps.size(); ++i) {
+    if (truth.timestamps[i] < truth.timestamps[i - 1]) {
+      throw InputError("ground truth '" + path + "' is not sorted by time (line " + std::to_string(i + 1) +
+                       " of its poses goes back); sort it");
+    }
+  }
+  return truth;
+}
+
+std::optional<GroundTruth> FindGroundTruth(const std::string& input_path, SourceFormat format) {
+  format = DetectSourceFormat(input_path, format);
+  const fs::path p(input_path);
+  switch (format) {
+    case SourceFormat::kKitti: {
+      if (fs::is_regular_file(p / "poses.txt")) return ReadGroundTruth((p / "poses.txt").string(), GroundTruthFormat::kKitti);
+      // The official layout: dataset/sequences/07/ and dataset/poses/07.txt.
+      const fs::path sequence = fs::absolute(p).lexically_normal();
+      const fs::path name = sequence.has_filename() ? sequence.filename() : sequence.parent_path().filename();
+      const fs::path official = sequence.parent_path().parent_path() / "poses" / (name.string() + ".txt");
+      if (fs::is_regular_file(official)) return ReadGroundTruth(official.string(), GroundTruthFormat::kKitti);
+      return std::nullopt;
+    }
+    case SourceFormat::kTum: {
+      const fs::path file = (fs::is_directory(p) ? p : p.parent_path()) / "groundtruth.txt";
+      if (fs::is_regular_file(file)) return ReadGroundTruth(file.string(), GroundTruthFormat::kTum);
+      return std::nullopt;
+    }
+    case SourceFormat::kEuroc: {
+      fs::path cam0 = fs::is_directory(p) ? (fs::exists(p / "mav0/cam0") ? p / "mav0/cam0" : p / "cam0") : p.parent_path();
+      const fs::path file = cam0.parent_path() / "state_groundtruth_estimate0" / "data.csv";
+      if (!fs::is_regular_file(file)) return std::nullopt;
+      cv::Matx44d body_to_camera = cv::Matx44d::eye();
+      if (fs::is_regular_file(cam0 / "sensor.yaml")) body_to_camera = ReadEurocSensor((cam0 / "sensor.yaml").string()).T_BS;
+      return ReadGroundTruth(file.string(), GroundTruthFormat::kEuroc, body_to_camera);
+    }
+    default: return std::nullopt;
+  }
+}
+
+std::optional<cv::Matx44d> KeyImagePose(const GroundTruth& truth, const KeyImage& key, double max_time_difference) {
+  if (truth.format == GroundTruthFormat::kKitti) {
+    if (key.source_index < 0 || key.source_index >= static_cast<int>(truth.camera_to_world.size())) return std::nullopt;
+    return truth.camera_to_world[key.source_index];
+  }
+  if (key.timestamp < 0 || truth.timestamps.empty()) return std::nullopt;
+  const auto after = std::lower_bound(truth.timestamps.begin(), truth.timestamps.end(), key.timestamp);
+  long best = -1;
+  double best_difference = max_time_difference;
+  for (auto it : {after, after == truth.timestamps.begin() ? after : after - 1}) {
+    if (it == truth.timestamps.end()) continue;
+    const double difference = std::abs(*it - key.timestamp);
+    if (difference <= best_difference) {
+      best_difference = difference;
+      best = it - truth.timestamps.begin();
+    }
+  }
+  if (best < 0) return std::nullopt;
+  return truth.camera_to_world[best];
+}
+
+void RelativeFromCameraToWorld(const cv::Matx44d& T_wa, const cv::Matx44d& T_wb, cv::Matx33d* R, cv::Vec3d* t) {
+  // X_w = R_a X_a + c_a = R_b X_b + c_b  =>  X_b = R_b^T R_a X_a + R_b^T (c_a - c_b).
+  const cv::Matx33d R_a = T_wa.get_minor<3, 3>(0, 0), R_b = T_wb.get_minor<3, 3>(0, 0);
+  const cv::Vec3d c_a(T_wa(0, 3), T_wa(1, 3), T_wa(2, 3)), c_b(T_wb(0, 3), T_wb(1, 3), T_wb(2, 3));
+  *R = R_b.t() * R_a;
+  *t = R_b.t() * (c_a - c_b);
+}
+
+}  // namespace vmap

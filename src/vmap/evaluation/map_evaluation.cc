@@ -1,0 +1,351 @@
+#include "vmap/evaluation/map_evaluation.h"
+
+#include <cmath>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "vmap/core/error.h"
+#include "vmap/geometry/relative_pose.h"
+#include "vmap/mapping/map_geometry_json.h"
+#include "vmap/sources/dataset_camera.h"
+
+namespace vmap {
+using nlohmann::json;
+
+void EvaluationOptions::Check() const {
+  if (!(max_rotation_error_deg > 0 && max_rotation_error_deg <= 180)) {
+    throw InputError(fmt::format("--max-rotation-error {} deg is outside (0, 180]; the default is 5",
+                                 max_rotation_error_deg));
+  }
+  if (!(max_translation_error_deg > 0 && max_translation_error_deg <= 180)) {
+    throw InputError(fmt::format("--max-translation-error {} deg is outside (0, 180]; the default is 20",
+                                 max_translation_error_deg));
+  }
+  if (!(min_parallax_px >= 0 && std::isfinite(min_parallax_px))) {
+    throw InputError(fmt::format("--min-parallax {} px must be >= 0; the default is 10", min_parallax_px));
+  }
+  if (!(sampson_threshold_px > 0 && std::isfinite(sampson_threshold_px))) {
+    throw InputError(fmt::format("--sampson-threshold {} px must be > 0; the default is 2", sampson_threshold_px));
+  }
+  if (!(max_time_difference >= 0 && std::isfinite(max_time_difference))) {
+    throw InputError(fmt::format("--max-time-difference {} s must be >= 0; the default is 0.02", max_time_difference));
+  }
+}
+
+namespace {
+
+// Sampson errors of matches under F, on pinhole pixels (distortion removed).
+std::vector<double> SampsonErrors(const cv::Matx33d& F, const std::vector<cv::Point2d>& from,
+                                  const std::vector<cv::Point2d>& to) {
+  std::vector<double> errors;
+  for (size_t i = 0; i < from.size(); ++i) {
+    const cv::Vec3d x0(from[i].x, from[i].y, 1.0), x1(to[i].x, to[i].y, 1.0);
+    const cv::Vec3d Fx0 = F * x0, Ftx1 = F.t() * x1;
+    const double denominator = Fx0[0] * Fx0[0] + Fx0[1] * Fx0[1] + Ftx1[0] * Ftx1[0] + Ftx1[1] * Ftx1[1];
+    errors.push_back(denominator > 0 ? std::abs(x1.dot(Fx0)) / std::sqrt(denominator) : 0.0);
+  }
+  return errors;
+}
+
+double ShareBelow(const std::vector<double>& values, double threshold) {
+  if (values.empty()) return NAN;
+  size_t count = 0;
+  for (double v : values) count += v < threshold ? 1 : 0;
+  return static_cast<double>(count) / values.size();
+}
+
+double MedianOrNan(const std::vector<double>& values) { return values.empty() ? NAN : Median(values); }
+
+double MeanOfFinite(const std::vector<double>& values) {
+  double sum = 0;
+  int count = 0;
+  for (double v : values) {
+    if (std::isfinite(v)) {
+      sum += v;
+      ++count;
+    }
+  }
+  return count > 0 ? sum / count : NAN;
+}
+
+double MedianOfFinite(const std::vector<double>& values) {
+  std::vector<double> finite;
+  for (double v : values) {
+    if (std::isfinite(v)) finite.push_back(v);
+  }
+  return MedianOrNan(finite);
+}
+
+LinkEvaluation EvaluateLink(const VisualMap& map, int index, const GroundTruth& truth, const Camera& camera,
+                            const EvaluationOptions& options) {
+  const Link& link = map.links[index];
+  const KeyImage& from = map.key_images[link.from_key];
+  const KeyImage& to = map.key_images[link.to_key];
+  LinkEvaluation e;
+  e.link = index;
+  e.from_frame = from.frame_index;
+  e.to_frame = to.frame_index;
+  e.from_source = from.source_index;
+  e.to_source = to.source_index;
+  e.below_tau = link.below_tau;
+  e.planar = link.planar;
+  e.similarity = link.similarity;
+  e.num_verified = link.has_fundamental ? link.num_verified : 0;
+  e.num_rejected = static_cast<int>(link.correspondences.size()) - e.num_verified;
+
+  std::vector<cv::Point2f> verified_from, verified_to, rejected_from, rejected_to;
+  for (size_t i = 0; i < link.correspondences.size(); ++i) {
+    const bool verified = static_cast<int>(i) < e.num_verified;
+    (verified ? verified_from : rejected_from).push_back(link.correspondences[i].p0);
+    (verified ? verified_to : rejected_to).push_back(link.correspondences[i].p1);
+  }
+
+  // The pose to judge: the map's own, or the one its F gives.
+  bool has_estimate = false;
+  cv::Matx33d R_estimate;
+  cv::Vec3d t_estimate;
+  if (link.has_pose) {
+    has_estimate = true;
+    R_estimate = link.R;
+    t_estimate = link.t;
+    e.pose_source = "stored";
+  } else if (link.has_fundamental && e.num_verified >= 5) {
+    const RelativePose pose = PoseFromFundamental(link.F, camera, verified_from, verified_to);
+    if (pose.valid) {
+      has_estimate = true;
+      R_estimate = pose.R;
+      t_estimate = pose.t;
+      e.pose_source = "fundamental";
+    }
+  }
+  if (!has_estimate) e.pose_source = "none";
+
+  const std::optional<cv::Matx44d> T_from = KeyImagePose(truth, from, options.max_time_difference);
+  const std::optional<cv::Matx44d> T_to = KeyImagePose(truth, to, options.max_time_difference);
+  if (!T_from || !T_to) return e;
+  e.has_ground_truth = true;
+  cv::Matx33d R_true;
+  cv::Vec3d t_true;
+  RelativeFromCameraToWorld(*T_from, *T_to, &R_true, &t_true);
+  e.true_rotation_deg = RotationAngleDeg(R_true);
+  e.true_baseline = cv::norm(t_true);
+  if (!verified_from.empty()) e.true_parallax_px = Median(Displacements(verified_from, verified_to, &camera, &R_true));
+
+  if (e.true_baseline > 1e-9) {
+    const cv::Matx33d F_true = FundamentalFromPose(R_true, t_true, camera.K());
+    const std::vector<double> verified_errors =
+        SampsonErrors(F_true, UndistortPixels(camera, verified_from), UndistortPixels(camera, verified_to));
+    const std::vector<double> rejected_errors =
+        SampsonErrors(F_true, UndistortPixels(camera, rejected_from), UndistortPixels(camera, rejected_to));
+    e.verified_sampson_median = MedianOrNan(verified_errors);
+    e.verified_within = ShareBelow(verified_errors, options.sampson_threshold_px);
+    e.rejected_sampson_median = MedianOrNan(rejected_errors);
+    e.rejected_within = ShareBelow(rejected_errors, options.sampson_threshold_px);
+  }
+  if (has_estimate) {
+    e.rotation_error_deg = RotationAngleDeg(R_estimate.t() * R_true);
+    if (e.true_baseline > 1e-9) e.translation_error_deg = AngleBetweenDeg(t_estimate, t_true);
+    const bool translation_judged = std::isfinite(e.true_parallax_px) && e.true_parallax_px >= options.min_parallax_px;
+    e.usable = e.rotation_error_deg < options.max_rotation_error_deg &&
+               (!translation_judged ||
+                (std::isfinite(e.translation_error_deg) && e.translation_error_deg < options.max_translation_error_deg));
+  }
+  return e;
+}
+
+json Number(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
+
+double NumberField(const json& object, const char* name) {
+  const auto it = object.find(name);
+  if (it == object.end() || !it->is_number()) return NAN;
+  return it->get<double>();
+}
+
+}  // namespace
+
+MapEvaluation EvaluateMap(const VisualMap& map, const GroundTruth& truth, const Camera& camera,
+                          const EvaluationOptions& options) {
+  options.Check();
+  MapEvaluation evaluation;
+  evaluation.ground_truth_path = truth.path;
+  evaluation.ground_truth_format = truth.format;
+  evaluation.camera = camera;
+  evaluation.options = options;
+  std::vector<double> rotation_errors, translation_errors, verified_within, rejected_within;
+  EvaluationSummary& s = evaluation.summary;
+  for (int i = 0; i < static_cast<int>(map.links.size()); ++i) {
+    LinkEvaluation e = EvaluateLink(map, i, truth, camera, options);
+    ++s.links;
+    if (e.pose_source != "none") ++s.links_with_pose;
+    if (e.has_ground_truth) {
+      ++s.evaluated_links;
+      s.usable_links += e.usable ? 1 : 0;
+      rotation_errors.push_back(e.rotation_error_deg);
+      if (std::isfinite(e.true_parallax_px) && e.true_parallax_px >= options.min_parallax_px) {
+        translation_errors.push_back(e.translation_error_deg);
+      }
+      verified_within.push_back(e.verified_within);
+      rejected_within.push_back(e.rejected_within);
+    }
+    evaluation.links.push_back(std::move(e));
+  }
+  if (s.evaluated_links > 0) s.usable_share = static_cast<double>(s.usable_links) / s.evaluated_links;
+  s.rotation_error_deg_median = MedianOfFinite(rotation_errors);
+  s.translation_error_deg_median = MedianOfFinite(translation_errors);
+  s.verified_within_mean = MeanOfFinite(verified_within);
+  s.rejected_within_mean = MeanOfFinite(rejected_within);
+  return evaluation;
+}
+
+Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option) {
+  if (map.input.camera) return *map.input.camera;
+  std::optional<Camera> camera;
+  if (!camera_option.empty()) camera = ParseCameraOption(camera_option);
+  else camera = FindDatasetCamera(map.input.path, map.input.format);
+  if (!camera) {
+    throw InputError("the map has no camera and its input '" + map.input.path +
+                     "' brings none; give the intrinsics with --camera fx,fy,cx,cy (or a calibration file)");
+  }
+  const cv::Size native = map.input.native_size.area() > 0 ? map.input.native_size : map.input.frame_size;
+  const cv::Size frames = map.input.frame_size.area() > 0 ? map.input.frame_size : native;
+  if (native.area() <= 0) throw InputError("the map does not record its frame size; rebuild it with `vmap build`");
+  return CameraForFrames(*camera, native, frames);
+}
+
+GroundTruth MapGroundTruth(const VisualMap& map, const std::string& gt_path, GroundTruthFormat format) {
+  if (!gt_path.empty()) return ReadGroundTruth(gt_path, format);
+  std::optional<GroundTruth> truth = FindGroundTruth(map.input.path, map.input.format);
+  if (!truth) {
+    throw InputError("the map's input '" + map.input.path +
+                     "' has no ground truth beside it (KITTI poses.txt, TUM groundtruth.txt, EuRoC "
+                     "state_groundtruth_estimate0/data.csv); give one with --gt FILE");
+  }
+  return *truth;
+}
+
+std::string EvaluationToJson(const MapEvaluation& evaluation) {
+  json doc;
+  doc["format"] = "vmap-eval";
+  doc["schema_version"] = 1;
+  doc["map"] = evaluation.map_path;
+  doc["ground_truth"] = {{"path", evaluation.ground_truth_path},
+                         {"format", GroundTruthFormatName(evaluation.ground_truth_format)}};
+  doc["camera"] = CameraToJson(evaluation.camera);
+  const EvaluationOptions& o = evaluation.options;
+  doc["options"] = {{"max_rotation_error_deg", o.max_rotation_error_deg},
+                    {"max_translation_error_deg", o.max_translation_error_deg},
+                    {"min_parallax_px", o.min_parallax_px},
+                    {"sampson_threshold_px", o.sampson_threshold_px},
+                    {"max_time_difference", o.max_time_difference}};
+  json links = json::array();
+  for (const LinkEvaluation& e : evaluation.links) {
+    links.push_back({{"link", e.link},
+                     {"from_frame", e.from_frame},
+                     {"to_frame", e.to_frame},
+                     {"from_source", e.from_source},
+                     {"to_source", e.to_source},
+                     {"below_tau", e.below_tau},
+                     {"planar", e.planar},
+                     {"similarity", e.similarity},
+                     {"verified", e.num_verified},
+                     {"rejected", e.num_rejected},
+                     {"has_ground_truth", e.has_ground_truth},
+                     {"pose_source", e.pose_source},
+                     {"true_rotation_deg", Number(e.true_rotation_deg)},
+                     {"true_baseline", Number(e.true_baseline)},
+                     {"true_parallax_px", Number(e.true_parallax_px)},
+                     {"rotation_error_deg", Number(e.rotation_error_deg)},
+                     {"translation_error_deg", Number(e.translation_error_deg)},
+                     {"verified_sampson_median_px", Number(e.verified_sampson_median)},
+                     {"verified_within_threshold", Number(e.verified_within)},
+                     {"rejected_sampson_median_px", Number(e.rejected_sampson_median)},
+                     {"rejected_within_threshold", Number(e.rejected_within)},
+                     {"usable", e.usable}});
+  }
+  doc["links"] = std::move(links);
+  const EvaluationSummary& s = evaluation.summary;
+  doc["summary"] = {{"links", s.links},
+                    {"evaluated_links", s.evaluated_links},
+                    {"usable_links", s.usable_links},
+                    {"usable_share", Number(s.usable_share)},
+                    {"links_with_pose", s.links_with_pose},
+                    {"rotation_error_deg_median", Number(s.rotation_error_deg_median)},
+                    {"translation_error_deg_median", Number(s.translation_error_deg_median)},
+                    {"verified_within_threshold_mean", Number(s.verified_within_mean)},
+                    {"rejected_within_threshold_mean", Number(s.rejected_within_mean)}};
+  return doc.dump(1) + "\n";
+}
+
+MapEvaluation ReadEvaluation(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError("cannot read evaluation '" + path + "'");
+  json doc;
+  try {
+    doc = json::parse(in);
+  } catch (const json::exception& e) {
+    throw InputError("evaluation '" + path + "' is not valid JSON (" + e.what() + "); run `vmap eval` again");
+  }
+  if (!doc.is_object() || doc.value("format", "") != "vmap-eval" || !doc.contains("links") ||
+      !doc["links"].is_array() || !doc.contains("summary") || !doc["summary"].is_object()) {
+    throw InputError("'" + path + "' is not an evaluation written by `vmap eval`; run `vmap eval` again");
+  }
+  MapEvaluation evaluation;
+  try {
+    evaluation.map_path = doc.value("map", "");
+    const json& gt = doc.contains("ground_truth") ? doc["ground_truth"] : json::object();
+    evaluation.ground_truth_path = gt.value("path", "");
+    evaluation.ground_truth_format = ParseGroundTruthFormat(gt.value("format", "auto"));
+    if (doc.contains("camera") && doc["camera"].is_object()) {
+      evaluation.camera = CameraFromJson(doc["camera"], path, "camera");
+    }
+    const json& o = doc.contains("options") ? doc["options"] : json::object();
+    evaluation.options.max_rotation_error_deg = o.value("max_rotation_error_deg", 5.0);
+    evaluation.options.max_translation_error_deg = o.value("max_translation_error_deg", 20.0);
+    evaluation.options.min_parallax_px = o.value("min_parallax_px", 10.0);
+    evaluation.options.sampson_threshold_px = o.value("sampson_threshold_px", 2.0);
+    evaluation.options.max_time_difference = o.value("max_time_difference", 0.02);
+    for (const json& l : doc["links"]) {
+      LinkEvaluation e;
+      e.link = l.at("link").get<int>();
+      e.from_frame = l.at("from_frame").get<int>();
+      e.to_frame = l.at("to_frame").get<int>();
+      e.from_source = l.value("from_source", e.from_frame);
+      e.to_source = l.value("to_source", e.to_frame);
+      e.below_tau = l.value("below_tau", false);
+      e.planar = l.value("planar", false);
+      e.similarity = l.value("similarity", 0.0);
+      e.num_verified = l.value("verified", 0);
+      e.num_rejected = l.value("rejected", 0);
+      e.has_ground_truth = l.value("has_ground_truth", false);
+      e.pose_source = l.value("pose_source", "none");
+      e.true_rotation_deg = NumberField(l, "true_rotation_deg");
+      e.true_baseline = NumberField(l, "true_baseline");
+      e.true_parallax_px = NumberField(l, "true_parallax_px");
+      e.rotation_error_deg = NumberField(l, "rotation_error_deg");
+      e.translation_error_deg = NumberField(l, "translation_error_deg");
+      e.verified_sampson_median = NumberField(l, "verified_sampson_median_px");
+      e.verified_within = NumberField(l, "verified_within_threshold");
+      e.rejected_sampson_median = NumberField(l, "rejected_sampson_median_px");
+      e.rejected_within = NumberField(l, "rejected_within_threshold");
+      e.usable = l.value("usable", false);
+      evaluation.links.push_back(e);
+    }
+    const json& s = doc["summary"];
+    evaluation.summary.links = s.value("links", 0);
+    evaluation.summary.evaluated_links = s.value("evaluated_links", 0);
+    evaluation.summary.usable_links = s.value("usable_links", 0);
+    evaluation.summary.usable_share = NumberField(s, "usable_share");
+    evaluation.summary.links_with_pose = s.value("links_with_pose", 0);
+    evaluation.summary.rotation_error_deg_median = NumberField(s, "rotation_error_deg_median");
+    evaluation.summary.translation_error_deg_median = NumberField(s, "translation_error_deg_median");
+    evaluation.summary.verified_within_mean = NumberField(s, "verified_within_threshold_mean");
+    evaluation.summary.rejected_within_mean = NumberField(s, "rejected_within_threshold_mean");
+  } catch (const json::exception& e) {
+    throw InputError("evaluation '" + path + "' is malformed (" + e.what() + "); run `vmap eval` again");
+  }
+  return evaluation;
+}
+
+}  // namespace vmap

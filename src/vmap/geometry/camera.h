@@ -1,0 +1,75 @@
+#pragma once
+// The camera of a sequence: a pinhole with optional Brown-Conrady distortion, named as COLMAP names its
+// camera models, so that a map's camera can be handed to COLMAP or read back from it.
+//
+// Conventions (OpenCV's, as everywhere in vmap):
+//   pixel coordinates have pixel centres at integers: the top-left pixel's centre is (0, 0);
+//   a point X in camera coordinates (x right, y down, z forward) projects to
+//   (fx * x' + cx, fy * y' + cy) with (x', y') = distort(X.x / X.z, X.y / X.z);
+//   distortion coefficients are in OpenCV's order k1, k2, p1, p2, k3.
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace vmap {
+
+// COLMAP's model names: SIMPLE_PINHOLE (f, cx, cy), PINHOLE (fx, fy, cx, cy),
+// OPENCV (fx, fy, cx, cy, k1, k2, p1, p2), FULL_OPENCV (fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6).
+enum class CameraModel { kSimplePinhole, kPinhole, kOpenCV, kFullOpenCV };
+
+std::string CameraModelName(CameraModel model);
+CameraModel ParseCameraModel(const std::string& name);  // COLMAP's names, as above
+
+struct Camera {
+  CameraModel model = CameraModel::kPinhole;
+  cv::Size size;   // the image size the intrinsics belong to; empty when the calibration did not say
+  double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+  double k1 = 0.0, k2 = 0.0, p1 = 0.0, p2 = 0.0, k3 = 0.0;
+  std::string origin;  // where the intrinsics came from (a file, or "--camera"), for messages and map.json
+
+  cv::Matx33d K() const;
+  bool has_distortion() const { return k1 != 0.0 || k2 != 0.0 || p1 != 0.0 || p2 != 0.0 || k3 != 0.0; }
+  // OpenCV's distortion vector (k1, k2, p1, p2[, k3]); empty without distortion.
+  std::vector<double> distortion() const;
+
+  // COLMAP's parameter list for `model`.
+  std::vector<double> params() const;
+  // The inverse of params(). Throws InputError when the count does not fit the model.
+  static Camera FromParams(CameraModel model, const std::vector<double>& params, cv::Size size = {});
+  // A camera from the numbers alone, with the simplest model that holds them (SIMPLE_PINHOLE when fx == fy and
+  // there is no distortion, PINHOLE, OPENCV, FULL_OPENCV when k3 != 0).
+  static Camera Make(double fx, double fy, double cx, double cy, const std::vector<double>& distortion = {},
+                     cv::Size size = {});
+
+  // The same camera for images resized to `new_size` (cv::resize maps pixel centres onto pixel centres:
+  // x' = (x + 0.5) s - 0.5). Distortion is a function of normalised coordinates and does not change.
+  // Needs `size` to be set.
+  Camera ScaledTo(cv::Size new_size) const;
+
+  // Throws InputError when a parameter cannot be right (focal lengths <= 0, non-finite values).
+  void Check() const;
+};
+
+// "fx,fy,cx,cy" with optional distortion "fx,fy,cx,cy,k1,k2,p1,p2[,k3]" (commas or spaces). Throws InputError.
+Camera ParseCameraText(const std::string& text);
+
+// An OpenCV FileStorage file (YAML, JSON or XML) as OpenCV's calibration tools write it: camera_matrix
+// (3x3), distortion_coefficients (4, 5, 8... values; those past k3 must be zero), image_width and
+// image_height (optional). Throws InputError naming the file and what is missing.
+Camera ReadOpenCvCameraFile(const std::string& path);
+
+// The camera for frames of `frame_size` that were read at `native_size` (the input's own size) from a
+// camera calibrated at `camera.size` (or at an unknown size, then assumed native): checks that the
+// intrinsics fit the native size and scales them to the frame size. Throws InputError when they cannot fit
+// (a calibration for another aspect ratio, or a principal point outside the image).
+Camera CameraForFrames(const Camera& camera, cv::Size native_size, cv::Size frame_size);
+
+// Pixel coordinates to normalised image coordinates (distortion removed, K^-1 applied): the rays
+// (x, y, 1) in the camera frame.
+std::vector<cv::Point2d> NormalizePoints(const Camera& camera, const std::vector<cv::Point2f>& pixels);
+// Pixel coordinates with the distortion removed (K applied again): the pinhole image of the same rays.
+std::vector<cv::Point2d> UndistortPixels(const Camera& camera, const std::vector<cv::Point2f>& pixels);
+
+}  // namespace vmap

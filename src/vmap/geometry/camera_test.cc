@@ -1,0 +1,142 @@
+#include "vmap/geometry/camera.h"
+
+#include <filesystem>
+
+#include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "vmap/core/error.h"
+#include "vmap/testing/synthetic_scene.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+
+TEST(Camera, PicksTheSimplestColmapModelAndRoundTripsItsParameters) {
+  EXPECT_EQ(Camera::Make(500, 500, 320, 240).model, CameraModel::kSimplePinhole);
+  EXPECT_EQ(Camera::Make(500, 510, 320, 240).model, CameraModel::kPinhole);
+  EXPECT_EQ(Camera::Make(500, 500, 320, 240, {0.1, 0, 0, 0}).model, CameraModel::kOpenCV);
+  EXPECT_EQ(Camera::Make(500, 500, 320, 240, {0.1, 0, 0, 0, 0.01}).model, CameraModel::kFullOpenCV);
+  for (const Camera& camera : {Camera::Make(500, 500, 320, 240), Camera::Make(500, 510, 321, 239),
+                               Camera::Make(500, 510, 320, 240, {-0.2, 0.05, 1e-3, -2e-3}),
+                               Camera::Make(500, 510, 320, 240, {-0.2, 0.05, 1e-3, -2e-3, 0.01})}) {
+    const Camera back = Camera::FromParams(camera.model, camera.params(), {640, 480});
+    EXPECT_EQ(ParseCameraModel(CameraModelName(camera.model)), camera.model);
+    EXPECT_EQ(back.K(), camera.K());
+    EXPECT_EQ(back.distortion(), camera.distortion());
+  }
+  EXPECT_EQ(CameraModelName(CameraModel::kPinhole), "PINHOLE");
+  EXPECT_EQ(CameraModelName(CameraModel::kOpenCV), "OPENCV");
+  EXPECT_THROW(ParseCameraModel("FISHEYE"), InputError);
+  EXPECT_THROW(Camera::FromParams(CameraModel::kPinhole, {1, 2, 3}), InputError);
+}
+
+TEST(Camera, ParsesTheCameraOptionText) {
+  const Camera plain = ParseCameraText("525.5,524,319.5,239.5");
+  EXPECT_EQ(plain.model, CameraModel::kPinhole);
+  EXPECT_DOUBLE_EQ(plain.fy, 524);
+  EXPECT_DOUBLE_EQ(plain.cx, 319.5);
+  const Camera distorted = ParseCameraText("500 500 320 240 -0.1 0.02 0.001 0.002");
+  EXPECT_EQ(distorted.model, CameraModel::kOpenCV);
+  EXPECT_DOUBLE_EQ(distorted.p2, 0.002);
+  EXPECT_DOUBLE_EQ(ParseCameraText("500,500,320,240,-0.1,0.02,0,0,0.003").k3, 0.003);
+  for (const char* bad : {"500,500,320", "500,500,320,240,0.1", "a,b,c,d", "-500,500,320,240", "0,500,320,240"}) {
+    EXPECT_THROW(ParseCameraText(bad), InputError) << bad;
+  }
+}
+
+TEST(Camera, ReadsOpenCvCalibrationFilesInYamlAndJson) {
+  testing::TempDir tmp;
+  const cv::Matx33d K(612.5, 0, 331.25, 0, 611.0, 242.75, 0, 0, 1);
+  const cv::Mat distortion = (cv::Mat_<double>(5, 1) << -0.21, 0.07, 0.0012, -0.0008, -0.011);
+  for (const char* name : {"calibration.yaml", "calibration.json"}) {
+    // What OpenCV's calibration sample writes.
+    cv::FileStorage fs((tmp.path() / name).string(), cv::FileStorage::WRITE);
+    fs << "image_width" << 640 << "image_height" << 480 << "camera_matrix" << cv::Mat(K)
+       << "distortion_coefficients" << distortion << "avg_reprojection_error" << 0.31;
+    fs.release();
+    const Camera camera = ReadOpenCvCameraFile((tmp.path() / name).string());
+    EXPECT_EQ(camera.K(), K) << name;
+    EXPECT_EQ(camera.size, cv::Size(640, 480));
+    EXPECT_EQ(camera.model, CameraModel::kFullOpenCV);
+    EXPECT_DOUBLE_EQ(camera.k3, -0.011);
+    EXPECT_DOUBLE_EQ(camera.p1, 0.0012);
+  }
+  {
+    cv::FileStorage fs((tmp.path() / "no_matrix.yaml").string(), cv::FileStorage::WRITE);
+    fs << "image_width" << 640;
+  }
+  try {
+    ReadOpenCvCameraFile((tmp.path() / "no_matrix.yaml").string());
+    FAIL() << "a file without camera_matrix was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("camera_matrix"), std::string::npos) << e.what();
+  }
+}
+
+// The scaled camera must describe the image cv::resize produces: a bright dot rendered at a sub-pixel position
+// with the full camera is found, after resizing, where the scaled camera projects the same point.
+TEST(Camera, ScaledCameraMatchesTheResizedImage) {
+  const Camera full = Camera::Make(800, 800, 639.5, 359.5, {}, {1280, 720});
+  const cv::Vec3d X(0.31, -0.17, 2.0);
+  const auto project = [&](const Camera& c) {
+    return cv::Point2d(c.fx * X[0] / X[2] + c.cx, c.fy * X[1] / X[2] + c.cy);
+  };
+  const cv::Point2d at = project(full);
+  cv::Mat image(720, 1280, CV_32F);
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) {
+      const double d2 = (x - at.x) * (x - at.x) + (y - at.y) * (y - at.y);
+      image.at<float>(y, x) = static_cast<float>(std::exp(-d2 / (2 * 6.0 * 6.0)));
+    }
+  }
+  for (const cv::Size size : {cv::Size(640, 360), cv::Size(320, 180), cv::Size(1000, 500)}) {
+    cv::Mat resized;
+    cv::resize(image, resized, size, 0, 0, cv::INTER_AREA);
+    const cv::Moments m = cv::moments(resized);
+    const cv::Point2d found(m.m10 / m.m00, m.m01 / m.m00);
+    const cv::Point2d expected = project(full.ScaledTo(size));
+    EXPECT_NEAR(found.x, expected.x, 0.05) << size;
+    EXPECT_NEAR(found.y, expected.y, 0.05) << size;
+  }
+}
+
+TEST(Camera, CameraForFramesScalesChecksAndRefuses) {
+  Camera calibrated = Camera::Make(1000, 1000, 639.5, 479.5, {}, {1280, 960});
+  calibrated.origin = "calib.yaml";
+  // Calibrated at 1280x960, frames stored at 640x480 and resized to 320x240.
+  const Camera scaled = CameraForFrames(calibrated, {640, 480}, {320, 240});
+  EXPECT_DOUBLE_EQ(scaled.fx, 250);
+  EXPECT_DOUBLE_EQ(scaled.cx, 159.5);
+  EXPECT_EQ(scaled.size, cv::Size(320, 240));
+  // Another aspect ratio cannot be the same sensor's: refused with a message naming the file.
+  try {
+    CameraForFrames(calibrated, {640, 360}, {640, 360});
+    FAIL() << "accepted a calibration of another aspect ratio";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("calib.yaml"), std::string::npos) << e.what();
+  }
+  // Without a size: the principal point must lie in the frames.
+  const Camera unsized = Camera::Make(1000, 1000, 959.5, 539.5);  // a 1920x1080 calibration
+  EXPECT_THROW(CameraForFrames(unsized, {640, 480}, {640, 480}), InputError);
+  EXPECT_DOUBLE_EQ(CameraForFrames(unsized, {1920, 1080}, {960, 540}).fx, 500);
+}
+
+TEST(Camera, NormalizePointsUndoesOpenCvsProjection) {
+  const Camera camera = Camera::Make(520, 515, 318, 241, {-0.28, 0.09, 0.0012, -0.0007, -0.01});
+  std::vector<cv::Point3d> points;
+  for (double x : {-0.5, -0.1, 0.3, 0.6})
+    for (double y : {-0.4, 0.0, 0.35}) points.emplace_back(x, y, 1.0);
+  std::vector<cv::Point2d> projected;
+  cv::projectPoints(points, cv::Vec3d(), cv::Vec3d(), cv::Mat(camera.K()), camera.distortion(), projected);
+  const std::vector<cv::Point2f> pixels(projected.begin(), projected.end());
+  const std::vector<cv::Point2d> normalized = NormalizePoints(camera, pixels);
+  const std::vector<cv::Point2d> pinhole = UndistortPixels(camera, pixels);
+  for (size_t i = 0; i < points.size(); ++i) {
+    EXPECT_NEAR(normalized[i].x, points[i].x, 2e-5);
+    EXPECT_NEAR(normalized[i].y, points[i].y, 2e-5);
+    EXPECT_NEAR(pinhole[i].x, camera.fx * points[i].x + camera.cx, 0.01);
+  }
+}
+
+}  // namespace vmap

@@ -1,0 +1,108 @@
+#pragma once
+// The relative pose of two calibrated views, and the quantities that tell whether it is well posed.
+//
+// Conventions (one set, used by every function here, by map.json and by `vmap eval`):
+//   the pair is (from, to): a link's first key image is "from", its second is "to";
+//   F satisfies x_to^T F x_from = 0 in pixels, E satisfies y_to^T E y_from = 0 in normalised coordinates;
+//   the pose (R, t) maps a point's coordinates in the "from" camera to the "to" camera: X_to = R X_from + t,
+//   so E = [t]x R. t has unit length (two views fix only the translation's direction); it is where the
+//   "from" camera's centre lies in "to" coordinates. A camera moving forward along its optical axis from
+//   "from" to "to" therefore gives t = (0, 0, -1).
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "vmap/geometry/camera.h"
+
+namespace vmap {
+
+enum class PoseMethod {
+  kEssential,        // E estimated directly on normalised points (five-point solver in OpenCV's USAC)
+  kFromFundamental,  // the link's F turned into E = K^T F K and decomposed
+};
+PoseMethod ParsePoseMethod(const std::string& name);  // "essential", "fundamental"
+std::string PoseMethodName(PoseMethod method);
+
+struct PoseOptions {
+  PoseMethod method = PoseMethod::kEssential;
+  // Inlier threshold of the essential-matrix estimation, in pixels (divided by the mean focal length to
+  // work on normalised points). Also the scale of the refinement's Cauchy loss.
+  double threshold = 1.0;
+  // Estimate on every tentative match of the link (true) or only on the verifier's inliers of F (false).
+  bool use_all_matches = true;
+  // Forward motion and short baselines leave the matches' geometric error with several local minima (a
+  // rotation error traded for a translation turned by up to 90 degrees). So the estimate starts from
+  // several hypotheses: USAC run with `starts` seeds (seed, seed + 1, ...) and any given start (the pose of
+  // F); each is refined, and the one with the lowest robust cost over all the matches wins.
+  int starts = 3;
+  // Callers that have the link's F add its pose as one more start (mapping/link_analysis.cc).
+  bool start_from_fundamental = true;
+  // Refine each start by Levenberg-Marquardt on the Sampson errors of the matches within
+  // refine_inlier_factor * threshold, with a Cauchy loss of scale `threshold` (RANSAC's model fits a minimal
+  // sample and a linear local optimisation, not the matches' geometric error).
+  bool refine = true;
+  double refine_inlier_factor = 3.0;
+  double confidence = 0.999;       // per start
+  int max_iterations = 10000;
+  int seed = 0;           // the random generator's state: the same link gives the same pose
+  int min_matches = 8;    // fewer inliers than this: no pose
+
+  void Check() const;  // throws InputError naming the bad option
+};
+
+struct RelativePose {
+  bool valid = false;
+  cv::Matx33d R = cv::Matx33d::eye();  // X_to = R X_from + t
+  cv::Vec3d t;                          // unit length
+  int num_inliers = 0;  // matches within the threshold of the pose (and, before refinement, in front of both cameras)
+};
+
+// E estimated on the normalised points with OpenCV's USAC (MSAC scoring, local optimisation) from
+// options.starts seeds, each decomposed with the cheirality check; these and `extra_starts` are refined
+// (options.refine) and the pose with the lowest PoseCost wins.
+RelativePose EstimateRelativePose(const Camera& camera, const std::vector<cv::Point2f>& from,
+                                  const std::vector<cv::Point2f>& to, const PoseOptions& options,
+                                  const std::vector<RelativePose>& extra_starts = {});
+
+// The robust cost a pose is chosen by: sum over the matches of log(1 + (e / threshold)^2), e the Sampson
+// error in pixels capped at refine_inlier_factor * threshold.
+double PoseCost(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
+                const std::vector<cv::Point2f>& to, const PoseOptions& options);
+
+// The pose of a fundamental matrix (x_to^T F x_from = 0): E = K^T F K, projected onto the essential
+// manifold and decomposed; of the four decompositions the one that puts most of the given matches (F's
+// inliers) in front of both cameras wins.
+RelativePose PoseFromFundamental(const cv::Matx33d& F, const Camera& camera, const std::vector<cv::Point2f>& from,
+                                 const std::vector<cv::Point2f>& to);
+
+// Refines a pose by Levenberg-Marquardt (OpenCV's LMSolver) on the Sampson errors, in pixels, of the matches
+// within inlier_threshold of it, each through a Cauchy loss of scale `loss_scale` pixels. The translation
+// stays a unit vector (two parameters on the sphere); the rotation takes three.
+RelativePose RefineRelativePose(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
+                                const std::vector<cv::Point2f>& to, double inlier_threshold, double loss_scale);
+
+// Sampson errors in pixels of matches under a pose (on normalised points, times the mean focal length).
+std::vector<double> PoseSampsonErrors(const cv::Matx33d& R, const cv::Vec3d& t, const Camera& camera,
+                                      const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to);
+
+// x_to^T F x_from = 0 for the pose (R, t) and a camera K (pixels, distortion removed).
+cv::Matx33d FundamentalFromPose(const cv::Matx33d& R, const cv::Vec3d& t, const cv::Matx33d& K);
+cv::Matx33d CrossMatrix(const cv::Vec3d& v);
+
+// The angle of a rotation, in degrees.
+double RotationAngleDeg(const cv::Matx33d& R);
+// The angle between two directions, in degrees (0 to 180).
+double AngleBetweenDeg(const cv::Vec3d& a, const cv::Vec3d& b);
+
+// Per match, how far the point moved between the two images, in pixels. With a camera and a rotation R
+// (from -> to), the displacement left after undoing the rotation: |x_to - K R K^-1 x_from| on pinhole pixels
+// (distortion removed), which is what triangulation and the translation's direction rest on; a pure rotation
+// leaves none. Without a camera, the plain displacement |x_to - x_from|.
+std::vector<double> Displacements(const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to,
+                                  const Camera* camera = nullptr, const cv::Matx33d* R = nullptr);
+
+double Median(std::vector<double> values);  // 0 for no values
+
+}  // namespace vmap

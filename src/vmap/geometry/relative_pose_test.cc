@@ -1,0 +1,207 @@
+#include "vmap/geometry/relative_pose.h"
+
+#include <random>
+
+#include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
+
+#include "vmap/core/error.h"
+#include "vmap/geometry/fundamental.h"
+#include "vmap/geometry/homography.h"
+
+namespace vmap {
+
+namespace {
+
+cv::Matx33d Rotation(const cv::Vec3d& axis_angle) {
+  cv::Matx33d R;
+  cv::Rodrigues(axis_angle, R);
+  return R;
+}
+
+// Matches of random points seen by two cameras: X_to = R X_from + t (X_from in the first camera's frame).
+struct Pair {
+  std::vector<cv::Point2f> from, to;
+};
+
+Pair Observe(const Camera& camera, const cv::Matx33d& R, const cv::Vec3d& t, int count, double depth_min,
+             double depth_max, double noise_px, double outlier_share, unsigned seed, bool planar = false) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), depth(depth_min, depth_max), u01(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, noise_px);
+  Pair pair;
+  while (static_cast<int>(pair.from.size()) < count) {
+    const double z = planar ? depth_min : depth(rng);
+    const cv::Vec3d X(unit(rng) * 0.6 * z, unit(rng) * 0.45 * z, z);
+    const cv::Vec3d Y = R * X + t;
+    if (Y[2] <= 0.1) continue;
+    cv::Point2f a(static_cast<float>(camera.fx * X[0] / X[2] + camera.cx + noise(rng)),
+                  static_cast<float>(camera.fy * X[1] / X[2] + camera.cy + noise(rng)));
+    cv::Point2f b(static_cast<float>(camera.fx * Y[0] / Y[2] + camera.cx + noise(rng)),
+                  static_cast<float>(camera.fy * Y[1] / Y[2] + camera.cy + noise(rng)));
+    if (u01(rng) < outlier_share) {
+      b = cv::Point2f(static_cast<float>(camera.cx + unit(rng) * camera.cx),
+                      static_cast<float>(camera.cy + unit(rng) * camera.cy));
+    }
+    pair.from.push_back(a);
+    pair.to.push_back(b);
+  }
+  return pair;
+}
+
+const Camera& TestCamera() {
+  static const Camera camera = Camera::Make(600, 600, 320, 240, {}, {640, 480});
+  return camera;
+}
+
+}  // namespace
+
+TEST(RelativePose, RecoversAKnownMotionWithNoiseAndOutliers) {
+  const cv::Matx33d R = Rotation({0.02, -0.09, 0.01});
+  const cv::Vec3d t = cv::normalize(cv::Vec3d(0.8, 0.05, -0.3));
+  const Pair pair = Observe(TestCamera(), R, t * 0.4, 300, 2.0, 8.0, 0.5, 0.3, 1);
+  for (bool all : {true, false}) {
+    PoseOptions options;
+    options.use_all_matches = all;
+    const RelativePose pose = EstimateRelativePose(TestCamera(), pair.from, pair.to, options);
+    ASSERT_TRUE(pose.valid);
+    EXPECT_LT(RotationAngleDeg(pose.R.t() * R), 0.1);
+    EXPECT_LT(AngleBetweenDeg(pose.t, t), 1.0);
+    EXPECT_NEAR(cv::norm(pose.t), 1.0, 1e-9);
+    EXPECT_GT(pose.num_inliers, 150);
+  }
+}
+
+// The conventions, each checked so that the opposite one fails: X_to = R X_from + t, the first image is
+// "from", and forward motion gives t = (0, 0, -1).
+TEST(RelativePose, ConventionsForwardMotionAndImageOrder) {
+  const cv::Matx33d R = Rotation({0.0, 0.05, 0.0});  // turning while driving forward
+  // The "to" camera is 1 m ahead of "from" along from's optical axis: C_to = (0, 0, 1) in from's frame, so
+  // X_to = R (X_from - C_to) and t = -R C_to.
+  const cv::Vec3d C_to(0.0, 0.0, 1.0);
+  const cv::Vec3d t = -(R * C_to);
+  const Pair pair = Observe(TestCamera(), R, t, 200, 4.0, 30.0, 0.3, 0.0, 2);
+  const RelativePose pose = EstimateRelativePose(TestCamera(), pair.from, pair.to, PoseOptions());
+  ASSERT_TRUE(pose.valid);
+  EXPECT_LT(AngleBetweenDeg(pose.t, cv::normalize(t)), 1.0);
+  EXPECT_LT(pose.t[2], -0.99);  // forward motion: t points back, to where the first camera was
+  EXPECT_LT(RotationAngleDeg(pose.R.t() * R), 0.1);
+  // A point straight ahead of "from" is seen to the right in "to" (x grows): R, not its inverse.
+  EXPECT_GT(pose.R(0, 2), 0.02);
+  // Swapping the images gives the inverse motion: R^T and -R^T t.
+  const RelativePose swapped = EstimateRelativePose(TestCamera(), pair.to, pair.from, PoseOptions());
+  ASSERT_TRUE(swapped.valid);
+  EXPECT_LT(RotationAngleDeg(swapped.R * pose.R), 0.1);
+  EXPECT_LT(AngleBetweenDeg(swapped.t, -(pose.R.t() * pose.t)), 1.0);
+  EXPECT_GT(AngleBetweenDeg(swapped.t, pose.t), 150.0);
+}
+
+TEST(RelativePose, FundamentalFromPoseAgreesWithProjectionsAndWithItsDecomposition) {
+  const cv::Matx33d R = Rotation({0.03, 0.1, -0.02});
+  const cv::Vec3d t = cv::normalize(cv::Vec3d(-0.5, 0.1, 0.4));
+  const Pair pair = Observe(TestCamera(), R, t, 100, 2.0, 10.0, 0.0, 0.0, 3);
+  const cv::Matx33d F = FundamentalFromPose(R, t, TestCamera().K());
+  for (size_t i = 0; i < pair.from.size(); ++i) EXPECT_LT(SampsonDistance(F, pair.from[i], pair.to[i]), 1e-3);
+  // The transposed F (the images' order swapped) does not fit.
+  double swapped = 0;
+  for (size_t i = 0; i < pair.from.size(); ++i) swapped += SampsonDistance(F.t(), pair.from[i], pair.to[i]);
+  EXPECT_GT(swapped / pair.from.size(), 1.0);
+  const RelativePose pose = PoseFromFundamental(F * 3.7, TestCamera(), pair.from, pair.to);
+  ASSERT_TRUE(pose.valid);
+  EXPECT_LT(RotationAngleDeg(pose.R.t() * R), 1e-3);
+  EXPECT_LT(AngleBetweenDeg(pose.t, t), 1e-3);
+}
+
+// A hand-held camera moving 1 cm in front of a table 1.5 m away: every point is more than 50 baselines
+// away, where cv::recoverPose's default gives up. The pose must still come out.
+TEST(RelativePose, ShortBaselineStillGivesAPose) {
+  const cv::Matx33d R = Rotation({0.004, -0.006, 0.002});
+  const cv::Vec3d t = cv::normalize(cv::Vec3d(0.9, -0.2, 0.1));
+  const Pair pair = Observe(TestCamera(), R, t * 0.01, 250, 1.2, 2.0, 0.2, 0.1, 4);
+  const RelativePose pose = EstimateRelativePose(TestCamera(), pair.from, pair.to, PoseOptions());
+  ASSERT_TRUE(pose.valid);
+  EXPECT_LT(RotationAngleDeg(pose.R.t() * R), 0.2);
+  EXPECT_LT(AngleBetweenDeg(pose.t, t), 15.0);
+}
+
+TEST(RelativePose, RefinementLowersTheCostOfAPerturbedPose) {
+  const cv::Matx33d R = Rotation({0.01, 0.04, 0.0});
+  const cv::Vec3d t = cv::normalize(cv::Vec3d(1.0, 0.0, -0.2));
+  const Pair pair = Observe(TestCamera(), R, t * 0.5, 200, 2.0, 8.0, 0.5, 0.2, 5);
+  RelativePose start;
+  start.valid = true;
+  start.R = R * Rotation({0.004, -0.003, 0.002});
+  start.t = cv::normalize(t + cv::Vec3d(0.0, 0.05, 0.03));
+  PoseOptions options;
+  const RelativePose refined = RefineRelativePose(start, TestCamera(), pair.from, pair.to, 3.0, 1.0);
+  EXPECT_LT(PoseCost(refined, TestCamera(), pair.from, pair.to, options),
+            PoseCost(start, TestCamera(), pair.from, pair.to, options));
+  EXPECT_LT(RotationAngleDeg(refined.R.t() * R), RotationAngleDeg(start.R.t() * R));
+  EXPECT_LT(AngleBetweenDeg(refined.t, t), AngleBetweenDeg(start.t, t));
+  EXPECT_NEAR(cv::norm(refined.t), 1.0, 1e-9);
+}
+
+TEST(RelativePose, SameInputSamePose) {
+  const Pair pair = Observe(TestCamera(), Rotation({0.0, 0.05, 0.0}), {0.3, 0.0, -0.2}, 200, 2, 9, 0.5, 0.3, 6);
+  const RelativePose a = EstimateRelativePose(TestCamera(), pair.from, pair.to, PoseOptions());
+  const RelativePose b = EstimateRelativePose(TestCamera(), pair.from, pair.to, PoseOptions());
+  ASSERT_TRUE(a.valid);
+  EXPECT_EQ(a.R, b.R);
+  EXPECT_EQ(a.t, b.t);
+}
+
+TEST(RelativePose, TooFewMatchesGiveNoPoseAndBadOptionsAreRefused) {
+  const Pair pair = Observe(TestCamera(), Rotation({0, 0.05, 0}), {0.3, 0, 0}, 6, 2, 9, 0.0, 0.0, 7);
+  EXPECT_FALSE(EstimateRelativePose(TestCamera(), pair.from, pair.to, PoseOptions()).valid);
+  PoseOptions bad;
+  bad.threshold = 0;
+  EXPECT_THROW(bad.Check(), InputError);
+  bad = PoseOptions();
+  bad.starts = 0;
+  EXPECT_THROW(bad.Check(), InputError);
+  EXPECT_EQ(ParsePoseMethod("fundamental"), PoseMethod::kFromFundamental);
+  EXPECT_THROW(ParsePoseMethod("homography"), InputError);
+}
+
+TEST(RelativePose, DisplacementsRemoveTheRotationOnly) {
+  // A pure rotation: large plain displacements, none once the rotation is undone.
+  const cv::Matx33d R = Rotation({0.01, 0.06, 0.0});
+  const Pair rotation = Observe(TestCamera(), R, {0, 0, 0}, 100, 2, 9, 0.0, 0.0, 8);
+  const std::vector<double> plain = Displacements(rotation.from, rotation.to);
+  const std::vector<double> without = Displacements(rotation.from, rotation.to, &TestCamera(), &R);
+  EXPECT_GT(Median(plain), 30.0);
+  EXPECT_LT(Median(without), 1e-3);
+  // Undoing the inverse rotation doubles the displacement instead: the direction matters.
+  const cv::Matx33d inverse = R.t();
+  EXPECT_GT(Median(Displacements(rotation.from, rotation.to, &TestCamera(), &inverse)), 1.5 * Median(plain));
+  // With a translation, parallax remains after the rotation is undone.
+  const Pair moved = Observe(TestCamera(), R, {0.5, 0, 0}, 100, 2, 9, 0.0, 0.0, 9);
+  EXPECT_GT(Median(Displacements(moved.from, moved.to, &TestCamera(), &R)), 20.0);
+  EXPECT_DOUBLE_EQ(Median({3.0, 1.0, 2.0, 10.0}), 2.5);
+  EXPECT_DOUBLE_EQ(Median({}), 0.0);
+}
+
+TEST(RelativePose, AnglesOfRotationsAndDirections) {
+  EXPECT_NEAR(RotationAngleDeg(Rotation({0, 0, CV_PI / 2})), 90.0, 1e-9);
+  EXPECT_NEAR(RotationAngleDeg(cv::Matx33d::eye()), 0.0, 1e-9);
+  EXPECT_NEAR(AngleBetweenDeg({1, 0, 0}, {0, 2, 0}), 90.0, 1e-9);
+  EXPECT_NEAR(AngleBetweenDeg({1, 0, 0}, {-3, 0, 0}), 180.0, 1e-9);
+  EXPECT_NEAR(AngleBetweenDeg({1, 0, 0}, {1, 1e-7, 0}), 1e-7 * 180 / CV_PI, 1e-12);
+}
+
+TEST(Homography, ExplainsAPlaneAndAPureRotationButNotADeepSceneSeenFromAfar) {
+  HomographyOptions options;
+  const Pair plane = Observe(TestCamera(), Rotation({0, 0.03, 0}), {0.4, 0, 0}, 200, 3.0, 3.0, 0.3, 0.0, 10,
+                             /*planar=*/true);
+  EXPECT_TRUE(CheckHomography(plane.from, plane.to, options).explains);
+  const Pair rotation = Observe(TestCamera(), Rotation({0.02, 0.05, 0}), {0, 0, 0}, 200, 1.0, 20.0, 0.3, 0.0, 11);
+  EXPECT_TRUE(CheckHomography(rotation.from, rotation.to, options).explains);
+  const Pair deep = Observe(TestCamera(), Rotation({0, 0.03, 0}), {0.4, 0, 0}, 200, 1.0, 20.0, 0.3, 0.0, 12);
+  const HomographyCheck check = CheckHomography(deep.from, deep.to, options);
+  EXPECT_TRUE(check.estimated);
+  EXPECT_FALSE(check.explains);
+  EXPECT_LT(check.share, 0.5);
+  EXPECT_FALSE(CheckHomography({{0, 0}, {1, 1}}, {{0, 0}, {1, 1}}, options).estimated);
+}
+
+}  // namespace vmap

@@ -1,0 +1,29 @@
+#pragma once
+// What a robot needs to know about a link besides S and F: the relative pose of its two key images (when
+// the camera is known), how much parallax its matches have, and whether a homography explains them as well
+// as F (then F and the pose are ill-posed). Computed from the link's stored matches after Algorithm 1 has
+// chosen the key images, so it never changes which key images are chosen.
+
+#include "vmap/geometry/camera.h"
+#include "vmap/geometry/homography.h"
+#include "vmap/geometry/relative_pose.h"
+#include "vmap/mapping/visual_map.h"
+
+namespace vmap {
+
+struct LinkAnalysisOptions {
+  PoseOptions pose;              // how the pose is estimated (README: "Relative pose per link")
+  HomographyOptions homography;  // when a homography counts as explaining the matches
+
+  void Check() const;  // throws InputError naming the bad option
+};
+
+// Fills link.has_pose/R/t/pose_inliers (with a camera), link.parallax and the homography test, from the
+// link's correspondences (verified first) and F. A link without F gets none of them.
+void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& options);
+
+// AnalyzeLink for every link, with the map's camera (map.input.camera) when it has one, on `threads` threads
+// (links are independent: the result does not depend on the number of threads).
+void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int threads = 1);
+
+}  // namespace vmap

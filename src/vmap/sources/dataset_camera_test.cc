@@ -1,0 +1,167 @@
+#include "vmap/sources/dataset_camera.h"
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "vmap/core/error.h"
+#include "vmap/testing/synthetic_scene.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path Shared() { return testing::SharedDir(); }
+
+#define REQUIRE_SHARED() \
+  if (Shared().empty()) GTEST_SKIP() << "../shared is not present"
+
+void WriteText(const fs::path& path, const std::string& text) {
+  fs::create_directories(path.parent_path());
+  std::ofstream(path) << text;
+}
+
+// An EuRoC cam0/sensor.yaml as the dataset ships it (MH_01_easy's values).
+constexpr const char* kEurocSensorYaml = R"(%YAML:1.0
+# General sensor definitions.
+sensor_type: camera
+comment: VI-Sensor cam0 (MT9M034)
+
+# Sensor extrinsics wrt. the body-frame.
+T_BS:
+  cols: 4
+  rows: 4
+  data: [0.0148655429818, -0.999880929698, 0.00414029679422, -0.0216401454975,
+         0.999557249008, 0.0149672133247, 0.025715529948, -0.064676986768,
+        -0.0257744366974, 0.00375618835797, 0.999660727178, 0.00981073058949,
+         0.0, 0.0, 0.0, 1.0]
+
+# Camera specific definitions.
+rate_hz: 20
+resolution: [752, 480]
+camera_model: pinhole
+intrinsics: [458.654, 457.296, 367.215, 248.375] #fu, fv, cu, cv
+distortion_model: radial-tangential
+distortion_coefficients: [-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05]
+)";
+
+void WriteImages(const fs::path& directory, int count, cv::Size size) {
+  fs::create_directories(directory);
+  for (int i = 0; i < count; ++i) {
+    cv::imwrite((directory / cv::format("%06d.png", i)).string(), cv::Mat(size, CV_8U, cv::Scalar(40 * i)));
+  }
+}
+
+}  // namespace
+
+TEST(DatasetCamera, ReadsTheSharedSequencesIntrinsics) {
+  REQUIRE_SHARED();
+  const std::optional<Camera> kitti = FindDatasetCamera((Shared() / "data/kitti07").string(), SourceFormat::kAuto);
+  ASSERT_TRUE(kitti);
+  EXPECT_DOUBLE_EQ(kitti->fx, 707.0912);
+  EXPECT_DOUBLE_EQ(kitti->cx, 601.8873);
+  EXPECT_DOUBLE_EQ(kitti->cy, 183.1104);
+  EXPECT_EQ(kitti->model, CameraModel::kSimplePinhole);
+  const std::optional<Camera> tum = FindDatasetCamera((Shared() / "data/redkitchen").string(), SourceFormat::kAuto);
+  ASSERT_TRUE(tum);
+  EXPECT_DOUBLE_EQ(tum->fx, 585);
+  EXPECT_DOUBLE_EQ(tum->cy, 240);
+  // A video's intrinsics.txt lies beside it; this one has radial distortion.
+  const std::optional<Camera> video =
+      FindDatasetCamera((Shared() / "data/lab_floor/lab_floor.mp4").string(), SourceFormat::kAuto);
+  ASSERT_TRUE(video);
+  EXPECT_EQ(video->model, CameraModel::kOpenCV);
+  EXPECT_DOUBLE_EQ(video->k1, -7.613e-3);
+  EXPECT_DOUBLE_EQ(video->fy, 524.245488213640215);
+  // No intrinsics beside rccar_room.
+  EXPECT_FALSE(FindDatasetCamera((Shared() / "data/rccar_room").string(), SourceFormat::kAuto));
+}
+
+TEST(DatasetCamera, KittiColourFramesUseP2AndTheOfficialLayoutWorks) {
+  testing::TempDir tmp;
+  WriteImages(tmp.path() / "seq/image_2", 2, {64, 48});
+  WriteText(tmp.path() / "seq/times.txt", "0\n0.1\n");
+  WriteText(tmp.path() / "seq/calib.txt",
+            "P0: 700 0 30 0 0 700 20 0 0 0 1 0\nP1: 700 0 30 -380 0 700 20 0 0 0 1 0\n"
+            "P2: 710 0 31 46 0 711 21 0.1 0 0 1 0.006\nP3: 710 0 31 -330 0 711 21 1.9 0 0 1 0.003\n");
+  const std::optional<Camera> camera = FindDatasetCamera((tmp.path() / "seq").string(), SourceFormat::kAuto);
+  ASSERT_TRUE(camera);
+  EXPECT_DOUBLE_EQ(camera->fx, 710);
+  EXPECT_DOUBLE_EQ(camera->fy, 711);
+  EXPECT_DOUBLE_EQ(camera->cx, 31);
+  WriteText(tmp.path() / "bad/calib.txt", "P0: 1 2 3\n");
+  EXPECT_THROW(ReadCameraFile((tmp.path() / "bad/calib.txt").string()), InputError);
+}
+
+TEST(DatasetCamera, ReadsEurocSensorYamlWithItsExtrinsics) {
+  testing::TempDir tmp;
+  WriteText(tmp.path() / "mav0/cam0/sensor.yaml", kEurocSensorYaml);
+  WriteText(tmp.path() / "mav0/cam0/data.csv", "#timestamp [ns],filename\n");
+  const EurocSensor sensor = ReadEurocSensor((tmp.path() / "mav0/cam0/sensor.yaml").string());
+  EXPECT_DOUBLE_EQ(sensor.camera.fx, 458.654);
+  EXPECT_DOUBLE_EQ(sensor.camera.cy, 248.375);
+  EXPECT_DOUBLE_EQ(sensor.camera.k2, 0.07395907);
+  EXPECT_DOUBLE_EQ(sensor.camera.p2, 1.76187114e-05);
+  EXPECT_EQ(sensor.camera.size, cv::Size(752, 480));
+  EXPECT_EQ(sensor.camera.model, CameraModel::kOpenCV);
+  EXPECT_DOUBLE_EQ(sensor.T_BS(0, 1), -0.999880929698);
+  EXPECT_DOUBLE_EQ(sensor.T_BS(1, 3), -0.064676986768);
+  EXPECT_DOUBLE_EQ(sensor.T_BS(3, 3), 1.0);
+  EXPECT_EQ(FindCalibrationFile(tmp.path().string(), SourceFormat::kEuroc),
+            (tmp.path() / "mav0/cam0/sensor.yaml").string());
+  // --camera accepts the same file.
+  EXPECT_DOUBLE_EQ(ParseCameraOption((tmp.path() / "mav0/cam0/sensor.yaml").string()).fx, 458.654);
+}
+
+TEST(DatasetCamera, IntrinsicsTextBesideAnImageFolderOrItsParent) {
+  testing::TempDir tmp;
+  WriteImages(tmp.path() / "run/images", 2, {64, 48});
+  WriteText(tmp.path() / "run/intrinsics.txt", "# a comment\nfx 50.5\nfy 51\ncx 31.5\ncy 23.5  # trailing\n");
+  for (const fs::path& input : {tmp.path() / "run", tmp.path() / "run/images"}) {
+    const std::optional<Camera> camera = FindDatasetCamera(input.string(), SourceFormat::kAuto);
+    ASSERT_TRUE(camera) << input;
+    EXPECT_DOUBLE_EQ(camera->fx, 50.5);
+    EXPECT_DOUBLE_EQ(camera->cy, 23.5);
+  }
+  WriteText(tmp.path() / "broken/intrinsics.txt", "fx 50\nfy 50\ncx 32\n");
+  try {
+    ReadCameraFile((tmp.path() / "broken/intrinsics.txt").string());
+    FAIL() << "accepted intrinsics without cy";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'cy'"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(ParseCameraOption("no/such/file.yaml"), InputError);
+  EXPECT_DOUBLE_EQ(ParseCameraOption("500,501,320,240").fy, 501);
+}
+
+TEST(DatasetCamera, FrameSourceCarriesTheCameraScaledWithResize) {
+  testing::TempDir tmp;
+  WriteImages(tmp.path() / "run", 3, {640, 480});
+  WriteText(tmp.path() / "run/intrinsics.txt", "fx 500\nfy 500\ncx 319.5\ncy 239.5\n");
+  FrameSourceOptions options;
+  options.resize = "320";
+  auto source = OpenFrameSource((tmp.path() / "run").string(), options);
+  EXPECT_FALSE(source->info().camera);  // known once the first frame tells the size
+  ASSERT_TRUE(source->Next());
+  ASSERT_TRUE(source->info().camera);
+  EXPECT_DOUBLE_EQ(source->info().camera->fx, 250);
+  EXPECT_DOUBLE_EQ(source->info().camera->cx, 159.5);
+  EXPECT_EQ(source->info().camera->size, cv::Size(320, 240));
+  // --camera none ignores the input's own; --camera replaces it.
+  options.camera = "none";
+  source = OpenFrameSource((tmp.path() / "run").string(), options);
+  ASSERT_TRUE(source->Next());
+  EXPECT_FALSE(source->info().camera);
+  options.camera = "400,400,320,240";
+  source = OpenFrameSource((tmp.path() / "run").string(), options);
+  ASSERT_TRUE(source->Next());
+  EXPECT_DOUBLE_EQ(source->info().camera->fx, 200);
+  // Intrinsics that cannot belong to these frames are an error at the first frame.
+  options.camera = "400,400,900,700";
+  source = OpenFrameSource((tmp.path() / "run").string(), options);
+  EXPECT_THROW(source->Next(), InputError);
+}
+
+}  // namespace vmap
