@@ -1,6 +1,8 @@
 // Timing of XFeat: per image (detectAndCompute through the Matcher interface) and per pair (matching two
 // images' descriptors) at 640x480 and at KITTI size (1226x370), on one and two LibTorch threads; the
-// network and the post-processing apart; and `vmap build` frames/s end to end on a video, next to ORB.
+// network and the post-processing apart; the same detectAndCompute with upstream's LibTorch ops instead of
+// vmap's CPU paths (measured interleaved, for the ratio); and `vmap build` frames/s end to end on a video,
+// next to ORB.
 //
 //   xfeat_bench [--reps N] [--top-k K ...] [--threads N ...] [--build [VIDEO]] [--build-repeat N]
 //
@@ -50,8 +52,8 @@ struct Pair {
 
 void TimeImages(const std::string& weights, const std::vector<Pair>& pairs, const std::vector<int>& top_ks,
                 const std::vector<int>& thread_counts, int reps) {
-  std::printf("%-9s %7s %7s %6s %10s %10s %10s %10s %8s %8s\n", "image", "threads", "top_k", "reps", "extract_s",
-              "network_s", "post_s", "match_s", "kpts", "matches");
+  std::printf("%-9s %7s %7s %6s %10s %10s %10s %10s %10s %8s %8s\n", "image", "threads", "top_k", "reps",
+              "extract_s", "network_s", "post_s", "upstream_s", "match_s", "kpts", "matches");
   const auto folded = vmap::neural::LoadXfeatWeights(weights).folded;
   const vmap::neural::XfeatModel model(folded, torch::kCPU);
   for (const Pair& pair : pairs) {
@@ -72,18 +74,23 @@ void TimeImages(const std::string& weights, const std::vector<Pair>& pairs, cons
         auto f0 = matcher->Extract(pair.image0);  // warm-up
         auto f1 = matcher->Extract(pair.image1);
         size_t matches = matcher->Match(*f0, *f1).size();
-        std::vector<double> extract_s, network_s, match_s;
+        vmap::neural::XfeatDetectOptions upstream_ops;
+        upstream_ops.top_k = top_k;
+        upstream_ops.upstream_network_ops = upstream_ops.upstream_postprocessing_ops = true;
+        std::vector<double> extract_s, network_s, upstream_s, match_s;
         for (int r = 0; r < reps; ++r) {
           extract_s.push_back(TimeSeconds([&] { f0 = matcher->Extract(pair.image0); }));
           network_s.push_back(TimeSeconds([&] {
             torch::InferenceMode guard;
             model.Forward(net_input);
           }));
+          upstream_s.push_back(TimeSeconds([&] { model.DetectAndCompute(input, upstream_ops); }));
           match_s.push_back(TimeSeconds([&] { matches = matcher->Match(*f0, *f1).size(); }));
         }
         const double extract = Median(extract_s), network = Median(network_s);
-        std::printf("%-9s %7d %7d %6d %10.4f %10.4f %10.4f %10.4f %8d %8zu\n", pair.name.c_str(), threads, top_k, reps,
-                    extract, network, extract - network, Median(match_s), f0->num_features(), matches);
+        std::printf("%-9s %7d %7d %6d %10.4f %10.4f %10.4f %10.4f %10.4f %8d %8zu\n", pair.name.c_str(), threads, top_k,
+                    reps, extract, network, extract - network, Median(upstream_s), Median(match_s), f0->num_features(),
+                    matches);
         std::fflush(stdout);
       }
     }

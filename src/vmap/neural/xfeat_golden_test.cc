@@ -197,10 +197,27 @@ TEST_P(XfeatGolden, EveryStageMatchesTheReference) {
   }
 }
 
-// The CPU's NMS (OpenCV dilation) and descriptor sampling (point by point) against upstream's LibTorch ops,
-// which the other devices use: the same points, and descriptors equal up to float rounding. KITTI's size
+// The CPU's network (oneDNN's blocked layout, OpenCV's filter2D) against upstream's LibTorch ops, which the
+// other devices use: within the golden's float32 tolerances.
+TEST(XfeatModel, CpuNetworkEqualsUpstreamsOps) {
+  SKIP_WITHOUT_SHARED();
+  for (const std::string pair : {"rccar_000000_000006", "kitti07_000010_000014"}) {
+    SCOPED_TRACE(pair);
+    const auto image = ReadBgrInput(SharedDir() + "/golden/xfeat/" + pair + "/input0.png");
+    const auto size = std::vector<int64_t>{image.size(2) / 32 * 32, image.size(3) / 32 * 32};
+    const auto input = torch::upsample_bilinear2d(image, size, false);
+    const auto fast = SharedModel().Forward(input);
+    const auto reference = SharedModel().Forward(input, /*reference_ops=*/true);
+    EXPECT_TENSOR_NEAR(fast.descriptor_map, reference.descriptor_map, kM1Atol, 0.0);
+    EXPECT_TENSOR_NEAR(fast.keypoint_logits, reference.keypoint_logits, kK1Atol, 0.0);
+    EXPECT_TENSOR_NEAR(fast.reliability, reference.reliability, kH1Atol, 0.0);
+  }
+}
+
+// The CPU's NMS (OpenCV dilation) and descriptor sampling (point by point) against upstream's LibTorch ops:
+// on the same network output, the same points, and descriptors equal up to float rounding. KITTI's size
 // exercises the resize and the padding of the bicubic taps at the map's border.
-TEST(XfeatModel, CpuPathsEqualUpstreamsOps) {
+TEST(XfeatModel, CpuPostprocessingEqualsUpstreamsOps) {
   SKIP_WITHOUT_SHARED();
   for (const std::string pair : {"rccar_000000_000006", "kitti07_000010_000014"}) {
     SCOPED_TRACE(pair);
@@ -209,7 +226,7 @@ TEST(XfeatModel, CpuPathsEqualUpstreamsOps) {
     options.keep_intermediates = true;
     options.top_k = 100000;  // every NMS point, those at the borders included
     const auto fast = SharedModel().DetectAndCompute(image, options);
-    options.reference_ops = true;
+    options.upstream_postprocessing_ops = true;
     const auto reference = SharedModel().DetectAndCompute(image, options);
     ASSERT_TRUE(torch::equal(fast.nms_keypoints, reference.nms_keypoints));
     ASSERT_TRUE(torch::equal(fast.topk_idx, reference.topk_idx));

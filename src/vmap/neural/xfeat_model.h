@@ -39,9 +39,10 @@ struct XfeatDetectOptions {
   int64_t top_k = 4096;
   double detection_threshold = 0.05;
   bool keep_intermediates = false;  // fills the fields marked "intermediate" (for the golden tests)
-  // On the CPU the NMS and the descriptor sampling have faster equivalents of upstream's LibTorch ops; true
-  // uses upstream's ops (as on a GPU), for tests that compare the two.
-  bool reference_ops = false;
+  // On the CPU the network, the NMS and the descriptor sampling have faster equivalents of upstream's
+  // LibTorch ops; these use upstream's ops (as on a GPU) instead, for tests that compare the two.
+  bool upstream_network_ops = false;
+  bool upstream_postprocessing_ops = false;
 };
 
 // detectAndCompute of one image. Keypoints are in descending score order.
@@ -68,8 +69,9 @@ class XfeatModel {
   torch::Device device() const { return device_; }
 
   // `image` (B, C, H, W) float32, C = 1 or 3 (averaged inside the network, as upstream), values in [0, 1],
-  // H and W multiples of 8. Thread-safe.
-  XfeatNetOutput Forward(const torch::Tensor& image) const;
+  // H and W multiples of 8. Thread-safe. On the CPU some layers have faster equivalents of upstream's
+  // LibTorch ops; `reference_ops` uses upstream's everywhere (as on a GPU), for tests that compare the two.
+  XfeatNetOutput Forward(const torch::Tensor& image, bool reference_ops = false) const;
 
   // Upstream's XFeat.detectAndCompute on one image (1, C, H, W) float32 in [0, 1] of any size >= 32 x 32:
   // bilinear resize to multiples of 32, network, heatmap, 5x5 NMS, scores, top-k, bicubic descriptors,
@@ -77,10 +79,13 @@ class XfeatModel {
   XfeatDetections DetectAndCompute(const torch::Tensor& image, const XfeatDetectOptions& options) const;
 
  private:
+  // conv2d (+ ReLU for BasicLayers) in the layout of `x`: dense, or oneDNN's blocked layout.
   torch::Tensor Conv(const torch::Tensor& x, const std::string& name) const;
+  torch::Tensor FirstConvOnCpu(const torch::Tensor& x) const;  // block1.0 with OpenCV
 
   std::map<std::string, XfeatConv> convs_;
   std::map<std::string, std::pair<torch::Tensor, torch::Tensor>> weights_;  // name -> (weight, bias)
+  std::map<std::string, std::pair<torch::Tensor, torch::Tensor>> blocked_weights_;  // reordered for oneDNN (CPU)
   torch::Device device_;
 };
 
