@@ -4,7 +4,7 @@
 // vmap's CPU paths (measured interleaved, for the ratio); and `vmap build` frames/s end to end on a video,
 // next to ORB.
 //
-//   xfeat_bench [--reps N] [--top-k K ...] [--threads N ...] [--build [VIDEO]] [--build-repeat N]
+//   xfeat_bench [--reps N] [--top-k K ...] [--threads N ...] [--build [VIDEO]] [--build-repeat N] [--frames N]
 //
 // Without --build it times images; with --build it only times the builds. Median of N runs after a warm-up.
 
@@ -97,10 +97,12 @@ void TimeImages(const std::string& weights, const std::vector<Pair>& pairs, cons
   }
 }
 
-void TimeBuilds(const std::string& weights, const std::string& video, const std::vector<int>& top_ks, int repeat) {
+void TimeBuilds(const std::string& weights, const std::string& video, const std::vector<int>& top_ks, int repeat,
+                int frames) {
+  vmap::FrameSourceOptions source_options;
+  source_options.last = frames - 1;  // -1: the whole video
   vmap::MapBuilderOptions options;
   options.show_progress = false;
-  const auto orb = vmap::CreateOrbMatcher({});
   std::vector<std::pair<std::string, std::unique_ptr<vmap::Matcher>>> matchers;
   matchers.emplace_back("orb", vmap::CreateOrbMatcher({}));
   for (int top_k : top_ks) {
@@ -114,7 +116,7 @@ void TimeBuilds(const std::string& weights, const std::string& video, const std:
   // Matchers alternate within each repeat, so that the machine's changing load touches them alike.
   for (int r = 0; r < repeat; ++r) {
     for (size_t m = 0; m < matchers.size(); ++m) {
-      auto source = vmap::OpenFrameSource(video);
+      auto source = vmap::OpenFrameSource(video, source_options);
       const auto directory = std::filesystem::temp_directory_path() / ("xfeat_bench_" + std::to_string(getpid()));
       const auto start = Clock::now();
       const vmap::VisualMap map = vmap::BuildMap(*source, *matchers[m].second, options, directory);
@@ -136,7 +138,7 @@ void TimeBuilds(const std::string& weights, const std::string& video, const std:
 
 int main(int argc, char** argv) {
   const std::string shared = VMAP_SHARED_DIR;
-  int reps = 20, build_repeat = 3;
+  int reps = 20, build_repeat = 3, frames = 0;
   std::vector<int> top_ks, thread_counts;
   std::string video;
   for (int i = 1; i < argc; ++i) {
@@ -144,11 +146,13 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--top-k") && i + 1 < argc) top_ks.push_back(std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) thread_counts.push_back(std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--build-repeat") && i + 1 < argc) build_repeat = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) frames = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--build")) {
       video = (i + 1 < argc && argv[i + 1][0] != '-') ? argv[++i] : shared + "/data/lab_floor/lab_floor.mp4";
     } else {
       std::fprintf(stderr,
-                   "usage: %s [--reps N] [--top-k K ...] [--threads N ...] [--build [VIDEO]] [--build-repeat N]\n",
+                   "usage: %s [--reps N] [--top-k K ...] [--threads N ...] [--build [VIDEO]] [--build-repeat N] "
+                   "[--frames N]\n",
                    argv[0]);
       return 2;
     }
@@ -158,7 +162,7 @@ int main(int argc, char** argv) {
   const std::string weights = shared + "/weights/xfeat/xfeat_folded.pt";
   cv::setNumThreads(1);  // as the vmap binary does
   if (!video.empty()) {
-    TimeBuilds(weights, video, top_ks, build_repeat);
+    TimeBuilds(weights, video, top_ks, build_repeat, frames);
     return 0;
   }
   auto read = [&](const std::string& path) {
