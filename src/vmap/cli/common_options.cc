@@ -3,7 +3,7 @@
 namespace vmap::cli {
 
 void AddMatcherOptions(CLI::App* command, MatcherOptions& options) {
-  command->add_option("--matcher", options.type, "Feature matcher: orb or loftr")->capture_default_str();
+  command->add_option("--matcher", options.type, "Feature matcher: orb, loftr or xfeat")->capture_default_str();
   auto& orb = options.orb;
   command->add_option("--orb-features", orb.num_features, "ORB: features per image")->capture_default_str();
   command->add_option("--orb-scale-factor", orb.scale_factor, "ORB: pyramid scale factor")->capture_default_str();
@@ -16,12 +16,27 @@ void AddMatcherOptions(CLI::App* command, MatcherOptions& options) {
   auto& loftr = options.loftr;
   command->add_option("--loftr-model", loftr.model, "LoFTR preset: outdoor, indoor or coarse")
       ->capture_default_str();
-  command->add_option("--weights", loftr.weights, "LoFTR weights file (see `vmap weights`)");
-  command->add_option("--device", loftr.device, "LoFTR device: cpu or cuda")->capture_default_str();
+  // --weights and --device belong to whichever deep matcher --matcher picks.
+  command->add_option_function<std::string>(
+      "--weights", [&options](const std::string& file) { options.loftr.weights = options.xfeat.weights = file; },
+      "LoFTR/XFeat weights file (see `vmap weights`)");
+  command->add_option_function<std::string>(
+      "--device", [&options](const std::string& device) { options.loftr.device = options.xfeat.device = device; },
+      "LoFTR/XFeat device: cpu or cuda")->default_str(options.loftr.device);
   command->add_option("--loftr-size", loftr.longest_side, "LoFTR: longest image side fed to the network")
       ->capture_default_str();
   command->add_option("--loftr-threshold", loftr.threshold, "LoFTR: coarse confidence threshold (default: preset's)");
   command->add_option("--loftr-threads", loftr.num_threads, "LoFTR: LibTorch threads per call (0 = LibTorch default)")
+      ->capture_default_str();
+  auto& xfeat = options.xfeat;
+  command->add_option("--xfeat-top-k", xfeat.top_k, "XFeat: keypoints kept per image, best first")
+      ->capture_default_str();
+  command->add_option("--xfeat-threshold", xfeat.detection_threshold, "XFeat: keypoint heatmap threshold")
+      ->capture_default_str();
+  command->add_option("--xfeat-min-similarity", xfeat.min_similarity,
+                      "XFeat: mutual nearest neighbours need a cosine similarity above this (<= 0: no minimum)")
+      ->capture_default_str();
+  command->add_option("--xfeat-threads", xfeat.num_threads, "XFeat: LibTorch threads per call (0 = LibTorch default)")
       ->capture_default_str();
 }
 

@@ -1,4 +1,4 @@
-// vmap weights: where LoFTR weights are searched, and getting the official ones into the cache.
+// vmap weights: where LoFTR and XFeat weights are searched, and getting the official ones into the cache.
 
 #include <algorithm>
 #include <cstdio>
@@ -27,6 +27,26 @@ std::string Join(const std::vector<std::string>& items) {
   for (const auto& item : items) text += (text.empty() ? "" : ", ") + item;
   return text;
 }
+
+#ifdef VMAP_WITH_TORCH
+// The models a file fits: LoFTR presets, and "xfeat (<layout> layout)". Throws the first reading error when
+// the file cannot be read at all.
+std::vector<std::string> ModelsFittingFile(const std::string& path) {
+  std::vector<std::string> fits;
+  std::string read_error;
+  try {
+    fits = TorchPlugin().loftr_presets_fitting_file(path);
+  } catch (const InputError& error) {
+    read_error = error.what();
+  }
+  try {
+    fits.push_back("xfeat (" + TorchPlugin().xfeat_weights_layout(path) + " layout)");
+  } catch (const InputError& error) {
+    if (fits.empty() && !read_error.empty()) throw InputError(read_error);
+  }
+  return fits;
+}
+#endif
 
 void PrintStatus() {
   std::printf("cache directory  %s\n", neural::WeightsCacheDir().c_str());
@@ -58,9 +78,9 @@ void Verify(const std::string& path) {
   std::printf("  known copy   %s\n", known_as.empty() ? "no (not byte-identical to a known published copy)"
                                                       : ("yes: " + known_as).c_str());
 #ifdef VMAP_WITH_TORCH
-  const auto presets = TorchPlugin().loftr_presets_fitting_file(path);
-  std::printf("  fits         %s\n", presets.empty() ? "no LoFTR preset" : Join(presets).c_str());
-  if (presets.empty()) throw InputError("'" + path + "' is not usable as LoFTR weights");
+  const auto presets = ModelsFittingFile(path);
+  std::printf("  fits         %s\n", presets.empty() ? "no LoFTR preset and not XFeat" : Join(presets).c_str());
+  if (presets.empty()) throw InputError("'" + path + "' is not usable as LoFTR or XFeat weights");
 #endif
 }
 
@@ -69,7 +89,7 @@ void Run(const WeightsFlags& flags) {
   bool acted = false;
   if (!flags.download.empty()) {
     std::vector<std::string> presets{flags.download};
-    if (flags.download == "all") presets = {"outdoor", "indoor"};
+    if (flags.download == "all") presets = {"outdoor", "indoor", "xfeat"};
     for (const auto& preset : presets) {
       const auto& known = neural::KnownWeightsFor(preset);
       std::printf("downloading %s from %s ...\n", preset.c_str(), known.url.c_str());
@@ -80,21 +100,23 @@ void Run(const WeightsFlags& flags) {
 #ifdef VMAP_WITH_TORCH
       if (flags.no_verify) {
         // The mirror may hold other bytes than the published copy; the layout is then the check left.
-        const auto presets = TorchPlugin().loftr_presets_fitting_file(path);
-        std::printf("  fits %s\n", presets.empty() ? "no LoFTR preset: do not use it" : Join(presets).c_str());
+        const auto presets = ModelsFittingFile(path);
+        std::printf("  fits %s\n", presets.empty() ? "no known model: do not use it" : Join(presets).c_str());
       }
 #endif
     }
     acted = true;
   }
   if (!flags.import_file.empty()) {
-    if (flags.model.empty()) throw InputError("--import needs --model outdoor|indoor|coarse");
+    if (flags.model.empty()) throw InputError("--import needs --model outdoor|indoor|coarse|xfeat");
     const auto& known = neural::KnownWeightsFor(flags.model);
     const std::string expected = flags.no_verify ? "" : known.git_blob_id;
 #ifdef VMAP_WITH_TORCH
     // Without a known id the structure is the only check available before the file enters the cache.
-    const auto presets = TorchPlugin().loftr_presets_fitting_file(flags.import_file);
-    if (std::find(presets.begin(), presets.end(), flags.model) == presets.end()) {
+    if (flags.model == "xfeat") {
+      TorchPlugin().xfeat_weights_layout(flags.import_file);  // throws, listing what does not fit
+    } else if (const auto presets = TorchPlugin().loftr_presets_fitting_file(flags.import_file);
+               std::find(presets.begin(), presets.end(), flags.model) == presets.end()) {
       throw InputError("'" + flags.import_file + "' does not fit --model " + flags.model +
                        (presets.empty() ? std::string(" (nor any LoFTR preset)") : " (it fits " + Join(presets) + ")"));
     }
@@ -118,13 +140,13 @@ void Run(const WeightsFlags& flags) {
 void AddWeightsCommand(CLI::App& app) {
   auto flags = std::make_shared<WeightsFlags>();
   CLI::App* command = app.add_subcommand(
-      "weights", "Show where LoFTR weights are searched; download, import or verify weight files");
-  command->add_option("--download", flags->download, "Download the official checkpoint: outdoor, indoor or all")
-      ->check(CLI::IsMember({"outdoor", "indoor", "all"}));
+      "weights", "Show where LoFTR and XFeat weights are searched; download, import or verify weight files");
+  command->add_option("--download", flags->download, "Download the official weights: outdoor, indoor, xfeat or all")
+      ->check(CLI::IsMember({"outdoor", "indoor", "xfeat", "all"}));
   command->add_option("--import", flags->import_file, "Copy a local weights file into the cache (needs --model)");
-  command->add_option("--model", flags->model, "Preset of the --import file: outdoor, indoor or coarse")
-      ->check(CLI::IsMember({"outdoor", "indoor", "coarse"}));
-  command->add_option("--verify", flags->verify_file, "Print a file's git blob id and which preset it fits");
+  command->add_option("--model", flags->model, "Model of the --import file: outdoor, indoor, coarse or xfeat")
+      ->check(CLI::IsMember({"outdoor", "indoor", "coarse", "xfeat"}));
+  command->add_option("--verify", flags->verify_file, "Print a file's git blob id and which model it fits");
   command->add_flag("--no-verify", flags->no_verify, "Skip the git blob id check of --download / --import");
   command->callback([flags] { Run(*flags); });
 }

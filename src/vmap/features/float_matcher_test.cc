@@ -57,13 +57,17 @@ TEST(MatchFloatDescriptors, FindsPermutedNoisyCopies) {
 
 TEST(MatchFloatDescriptors, AgreesWithThePlainDefinitionAcrossBlocksAndThresholds) {
   std::mt19937 random(7);
-  for (int rows : {1, 255, 256, 257, 600}) {
+  // Row counts around the product sizes (at least 128 rows, 256 at a time) and train sets of one and of
+  // several 1024-column tiles.
+  for (const auto& [rows, train_rows] : std::vector<std::pair<int, int>>{
+           {1, 300}, {127, 2100}, {128, 300}, {255, 300}, {256, 2100}, {257, 300}, {383, 300}, {384, 1100},
+           {600, 300}}) {
     const cv::Mat q = RandomUnitRows(rows, 32, random);
-    const cv::Mat t = RandomUnitRows(300, 32, random);
+    const cv::Mat t = RandomUnitRows(train_rows, 32, random);
     for (float threshold : {-1.f, 0.3f, 0.5f}) {
       const auto expected = PlainMutualNearest(q, t, threshold);
       const auto got = MatchFloatDescriptors(q, t, threshold);
-      ASSERT_EQ(got.size(), expected.size()) << rows << " rows, threshold " << threshold;
+      ASSERT_EQ(got.size(), expected.size()) << rows << " x " << train_rows << " rows, threshold " << threshold;
       for (size_t k = 0; k < got.size(); ++k) {
         EXPECT_EQ(got[k].query, expected[k].query);
         EXPECT_EQ(got[k].train, expected[k].train);

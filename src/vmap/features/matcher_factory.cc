@@ -6,19 +6,23 @@
 namespace vmap {
 
 void MatcherOptions::Check() const {
-  if (type != "orb" && type != "loftr") throw InputError("unknown matcher '" + type + "'; use orb or loftr");
+  if (type != "orb" && type != "loftr" && type != "xfeat")
+    throw InputError("unknown matcher '" + type + "'; use orb, loftr or xfeat");
   // The options of every matcher, used or not: an absurd value (NaN, out of range) is a mistake either way.
   orb.Check();
   loftr.Check();
+  xfeat.Check();
 }
 
 std::unique_ptr<Matcher> CreateMatcher(const MatcherOptions& options) {
   options.Check();
   if (options.type == "orb") return CreateOrbMatcher(options.orb);
 #ifdef VMAP_WITH_TORCH
+  if (options.type == "xfeat") return TorchPlugin().create_xfeat_matcher(options.xfeat);
   return TorchPlugin().create_loftr_matcher(options.loftr);
 #else
-  throw InputError("this vmap was built without LibTorch (VMAP_WITH_TORCH=OFF); rebuild with it for --matcher loftr");
+  throw InputError("this vmap was built without LibTorch (VMAP_WITH_TORCH=OFF); rebuild with it for --matcher " +
+                   options.type);
 #endif
 }
 

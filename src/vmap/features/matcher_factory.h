@@ -7,13 +7,15 @@
 #include "vmap/features/matcher.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/neural/loftr_options.h"
+#include "vmap/neural/xfeat_options.h"
 
 namespace vmap {
 
 struct MatcherOptions {
-  std::string type = "orb";  // "orb" or "loftr"
+  std::string type = "orb";  // "orb", "loftr" or "xfeat"
   OrbMatcherOptions orb;
   LoftrMatcherOptions loftr;
+  XfeatMatcherOptions xfeat;
 
   void Check() const;  // throws InputError naming the bad option
 };

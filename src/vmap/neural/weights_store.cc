@@ -17,6 +17,19 @@ namespace vmap::neural {
 namespace {
 
 const char kCoarseSharedFile[] = "weights/loftr_coarse/loftr_coarse_teacher.pt";
+const char kXfeatSharedFile[] = "weights/xfeat/xfeat_folded.pt";
+
+// The shared data folder's copy of a model's weights, where it has one.
+std::string SharedFile(const std::string& preset) {
+  if (preset == "coarse") return kCoarseSharedFile;
+  if (preset == "xfeat") return kXfeatSharedFile;
+  return "";
+}
+
+// The command-line choice a preset stands for, for messages.
+std::string ModelFlag(const std::string& preset) {
+  return preset == "xfeat" ? "--matcher xfeat" : "--loftr-model " + preset;
+}
 
 std::string Env(const char* name) {
   const char* value = std::getenv(name);
@@ -64,6 +77,10 @@ const std::vector<KnownWeights>& KnownWeightFiles() {
       {"coarse", "loftr_coarse_teacher.pt", "", "",
        "Coarse-LoFTR student (Kolkir/Coarse_LoFTR_TRT, Apache-2.0) as a plain state dict; ships in "
        "shared/weights/loftr_coarse"},
+      {"xfeat", "xfeat.pt", "https://github.com/verlab/accelerated_features/raw/main/weights/xfeat.pt",
+       "9da942e9c7406b8add3746bf98d4b1840233cd92",
+       "XFeat (verlab/accelerated_features, Apache-2.0): the official weights/xfeat.pt, 6 MB, or the BatchNorm-folded "
+       "xfeat_folded.pt of shared/weights/xfeat; both layouts load"},
   };
   return files;
 }
@@ -72,7 +89,7 @@ const KnownWeights& KnownWeightsFor(const std::string& preset) {
   for (const auto& known : KnownWeightFiles()) {
     if (known.preset == preset) return known;
   }
-  throw InputError("unknown LoFTR model '" + preset + "'; use outdoor, indoor or coarse");
+  throw InputError("unknown model '" + preset + "'; use outdoor, indoor, coarse (LoFTR) or xfeat");
 }
 
 std::string WeightsCacheDir() {
@@ -85,10 +102,10 @@ std::string WeightsCacheDir() {
 std::vector<std::string> WeightsSearchPaths(const std::string& preset) {
   const auto& known = KnownWeightsFor(preset);
   std::vector<std::string> paths{WeightsCacheDir() + "/" + known.file_name};
-  if (preset == "coarse") {
-    paths.push_back(std::string("../shared/") + kCoarseSharedFile);
+  if (const std::string shared = SharedFile(preset); !shared.empty()) {
+    paths.push_back("../shared/" + shared);
 #ifdef VMAP_DEFAULT_SHARED_DIR
-    paths.push_back(std::string(VMAP_DEFAULT_SHARED_DIR) + "/" + kCoarseSharedFile);
+    paths.push_back(std::string(VMAP_DEFAULT_SHARED_DIR) + "/" + shared);
 #endif
   }
   return paths;
@@ -97,13 +114,13 @@ std::vector<std::string> WeightsSearchPaths(const std::string& preset) {
 std::string LocateWeights(const std::string& preset, const std::string& explicit_path) {
   if (!explicit_path.empty()) {
     if (IsFile(explicit_path)) return explicit_path;
-    throw InputError("LoFTR weights file '" + explicit_path + "' (--weights) does not exist");
+    throw InputError("weights file '" + explicit_path + "' (--weights) does not exist");
   }
   const auto paths = WeightsSearchPaths(preset);
   for (const auto& path : paths) {
     if (IsFile(path)) return path;
   }
-  std::string message = "no weights for --loftr-model " + preset + "; searched:";
+  std::string message = "no weights for " + ModelFlag(preset) + "; searched:";
   for (const auto& path : paths) message += "\n  " + path;
   const auto& known = KnownWeightsFor(preset);
   if (!known.url.empty()) {
@@ -144,7 +161,7 @@ std::string ImportWeights(const std::string& source, const std::string& preset, 
 std::string DownloadWeights(const std::string& preset, const std::string& cache_dir, bool verify) {
   const auto& known = KnownWeightsFor(preset);
   if (known.url.empty()) {
-    throw InputError("there is no download for --loftr-model " + preset + ": " + known.description);
+    throw InputError("there is no download for " + ModelFlag(preset) + ": " + known.description);
   }
   std::error_code error;
   fs::create_directories(cache_dir, error);

@@ -1,10 +1,11 @@
 #pragma once
-// Where LoFTR weights are found, and how they get there (`vmap weights`). No LibTorch here.
+// Where LoFTR and XFeat weights are found, and how they get there (`vmap weights`). No LibTorch here.
 //
 // Search order for a preset, unless --weights names a file:
 //   1. the cache directory: $VMAP_WEIGHTS_DIR if set, else $XDG_CACHE_HOME/vmap/weights, else ~/.cache/vmap/weights;
-//   2. coarse only: the Coarse-LoFTR student of the shared data folder (../shared/weights/loftr_coarse relative to
-//      the working directory, then the data folder vmap was built with).
+//   2. coarse and xfeat only: the copy in the shared data folder (../shared/weights/loftr_coarse or
+//      ../shared/weights/xfeat/xfeat_folded.pt relative to the working directory, then the data folder vmap was
+//      built with).
 
 #include <string>
 #include <vector>
@@ -14,7 +15,7 @@ namespace vmap::neural {
 inline constexpr char kWeightsDirEnv[] = "VMAP_WEIGHTS_DIR";
 
 struct KnownWeights {
-  std::string preset;       // "outdoor", "indoor", "coarse"
+  std::string preset;       // "outdoor", "indoor", "coarse" (LoFTR) or "xfeat"
   std::string file_name;    // name in the cache directory
   std::string url;          // empty when there is nothing to download
   std::string git_blob_id;  // of a published copy; empty when unknown
