@@ -3,7 +3,7 @@
 namespace vmap::cli {
 
 void AddMatcherOptions(CLI::App* command, MatcherOptions& options) {
-  command->add_option("--matcher", options.type, "Feature matcher: orb or loftr")->capture_default_str();
+  command->add_option("--matcher", options.type, "Feature matcher: orb, loftr or aliked")->capture_default_str();
   auto& orb = options.orb;
   command->add_option("--orb-features", orb.num_features, "ORB: features per image")->capture_default_str();
   command->add_option("--orb-scale-factor", orb.scale_factor, "ORB: pyramid scale factor")->capture_default_str();
@@ -16,12 +16,33 @@ void AddMatcherOptions(CLI::App* command, MatcherOptions& options) {
   auto& loftr = options.loftr;
   command->add_option("--loftr-model", loftr.model, "LoFTR preset: outdoor, indoor or coarse")
       ->capture_default_str();
-  command->add_option("--weights", loftr.weights, "LoFTR weights file (see `vmap weights`)");
-  command->add_option("--device", loftr.device, "LoFTR device: cpu or cuda")->capture_default_str();
+  command->add_option("--weights", loftr.weights, "Weights file of a deep matcher (see `vmap weights`)")
+      ->each([&options](const std::string& path) { options.aliked.weights = path; });
+  command->add_option("--device", loftr.device, "Deep matchers' device: cpu or cuda")
+      ->capture_default_str()
+      ->each([&options](const std::string& device) { options.aliked.device = device; });
   command->add_option("--loftr-size", loftr.longest_side, "LoFTR: longest image side fed to the network")
       ->capture_default_str();
   command->add_option("--loftr-threshold", loftr.threshold, "LoFTR: coarse confidence threshold (default: preset's)");
   command->add_option("--loftr-threads", loftr.num_threads, "LoFTR: LibTorch threads per call (0 = LibTorch default)")
+      ->capture_default_str();
+  auto& aliked = options.aliked;
+  command->add_option("--aliked-model", aliked.model, "ALIKED model: t16 or n16")->capture_default_str();
+  command->add_option("--aliked-top-k", aliked.top_k, "ALIKED: keypoints per image (0 = score threshold mode)")
+      ->capture_default_str();
+  command->add_option("--aliked-score-threshold", aliked.score_threshold,
+                      "ALIKED: keypoint score threshold when --aliked-top-k is 0")
+      ->capture_default_str();
+  command->add_option("--aliked-max-keypoints", aliked.max_keypoints,
+                      "ALIKED: most keypoints when --aliked-top-k is 0")
+      ->capture_default_str();
+  command->add_option("--aliked-min-similarity", aliked.min_similarity,
+                      "ALIKED: least cosine similarity of a match")
+      ->capture_default_str();
+  command->add_option("--aliked-size", aliked.longest_side,
+                      "ALIKED: shrink images to this longest side first (0 = native size)")
+      ->capture_default_str();
+  command->add_option("--aliked-threads", aliked.num_threads, "ALIKED: LibTorch threads per call (0 = LibTorch default)")
       ->capture_default_str();
 }
 

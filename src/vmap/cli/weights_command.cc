@@ -1,4 +1,4 @@
-// vmap weights: where LoFTR weights are searched, and getting the official ones into the cache.
+// vmap weights: where LoFTR and ALIKED weights are searched, and getting the official ones into the cache.
 
 #include <algorithm>
 #include <cstdio>
@@ -35,6 +35,9 @@ void PrintStatus() {
   std::printf("--weights FILE overrides the search. Files are checked key by key when loaded.\n\n");
   for (const auto& known : neural::KnownWeightFiles()) {
     std::printf("%-8s %s\n", known.preset.c_str(), known.description.c_str());
+    if (known.preset.rfind("aliked-", 0) == 0) {
+      std::printf("         layouts: upstream's .pth (OrderedDict state dict) or a plain {name: tensor} dict\n");
+    }
     std::string found;
     for (const auto& path : neural::WeightsSearchPaths(known.preset)) {
       std::error_code error;
@@ -44,9 +47,34 @@ void PrintStatus() {
     }
     if (found.empty() && !known.url.empty()) {
       std::printf("         get it: vmap weights --download %s   (%s)\n", known.preset.c_str(), known.url.c_str());
+    } else if (found.empty()) {
+      std::printf("         get it: download the official file, then vmap weights --import FILE --model %s\n",
+                  known.preset.c_str());
     }
   }
 }
+
+#ifdef VMAP_WITH_TORCH
+// The presets (as `--model` names them) a file fits. A file is tried as ALIKED weights only when it is not
+// LoFTR's, and the reason it is not LoFTR's is kept when it is neither.
+std::vector<std::string> FittingPresets(const std::string& path) {
+  std::vector<std::string> presets;
+  std::string loftr_error;
+  try {
+    presets = TorchPlugin().loftr_presets_fitting_file(path);
+  } catch (const InputError& error) {
+    loftr_error = error.what();
+  }
+  if (!presets.empty()) return presets;
+  try {
+    for (const auto& model : TorchPlugin().aliked_models_fitting_file(path)) presets.push_back("aliked-" + model);
+  } catch (const InputError&) {
+    if (!loftr_error.empty()) throw InputError(loftr_error);
+    throw;
+  }
+  return presets;
+}
+#endif
 
 void Verify(const std::string& path) {
   const std::string id = neural::GitBlobId(path);
@@ -58,9 +86,9 @@ void Verify(const std::string& path) {
   std::printf("  known copy   %s\n", known_as.empty() ? "no (not byte-identical to a known published copy)"
                                                       : ("yes: " + known_as).c_str());
 #ifdef VMAP_WITH_TORCH
-  const auto presets = TorchPlugin().loftr_presets_fitting_file(path);
-  std::printf("  fits         %s\n", presets.empty() ? "no LoFTR preset" : Join(presets).c_str());
-  if (presets.empty()) throw InputError("'" + path + "' is not usable as LoFTR weights");
+  const auto presets = FittingPresets(path);
+  std::printf("  fits         %s\n", presets.empty() ? "no LoFTR or ALIKED model" : Join(presets).c_str());
+  if (presets.empty()) throw InputError("'" + path + "' is not usable as LoFTR or ALIKED weights");
 #endif
 }
 
@@ -80,7 +108,7 @@ void Run(const WeightsFlags& flags) {
 #ifdef VMAP_WITH_TORCH
       if (flags.no_verify) {
         // The mirror may hold other bytes than the published copy; the layout is then the check left.
-        const auto presets = TorchPlugin().loftr_presets_fitting_file(path);
+        const auto presets = FittingPresets(path);
         std::printf("  fits %s\n", presets.empty() ? "no LoFTR preset: do not use it" : Join(presets).c_str());
       }
 #endif
@@ -88,15 +116,16 @@ void Run(const WeightsFlags& flags) {
     acted = true;
   }
   if (!flags.import_file.empty()) {
-    if (flags.model.empty()) throw InputError("--import needs --model outdoor|indoor|coarse");
+    if (flags.model.empty()) throw InputError("--import needs --model outdoor|indoor|coarse|aliked-t16|aliked-n16");
     const auto& known = neural::KnownWeightsFor(flags.model);
     const std::string expected = flags.no_verify ? "" : known.git_blob_id;
 #ifdef VMAP_WITH_TORCH
     // Without a known id the structure is the only check available before the file enters the cache.
-    const auto presets = TorchPlugin().loftr_presets_fitting_file(flags.import_file);
+    const auto presets = FittingPresets(flags.import_file);
     if (std::find(presets.begin(), presets.end(), flags.model) == presets.end()) {
       throw InputError("'" + flags.import_file + "' does not fit --model " + flags.model +
-                       (presets.empty() ? std::string(" (nor any LoFTR preset)") : " (it fits " + Join(presets) + ")"));
+                       (presets.empty() ? std::string(" (nor any LoFTR or ALIKED model)")
+                                        : " (it fits " + Join(presets) + ")"));
     }
 #endif
     const std::string path = neural::ImportWeights(flags.import_file, flags.model, expected, cache);
@@ -118,12 +147,13 @@ void Run(const WeightsFlags& flags) {
 void AddWeightsCommand(CLI::App& app) {
   auto flags = std::make_shared<WeightsFlags>();
   CLI::App* command = app.add_subcommand(
-      "weights", "Show where LoFTR weights are searched; download, import or verify weight files");
+      "weights", "Show where LoFTR and ALIKED weights are searched; download, import or verify weight files");
   command->add_option("--download", flags->download, "Download the official checkpoint: outdoor, indoor or all")
       ->check(CLI::IsMember({"outdoor", "indoor", "all"}));
   command->add_option("--import", flags->import_file, "Copy a local weights file into the cache (needs --model)");
-  command->add_option("--model", flags->model, "Preset of the --import file: outdoor, indoor or coarse")
-      ->check(CLI::IsMember({"outdoor", "indoor", "coarse"}));
+  command->add_option("--model", flags->model,
+                      "Preset of the --import file: outdoor, indoor, coarse, aliked-t16 or aliked-n16")
+      ->check(CLI::IsMember({"outdoor", "indoor", "coarse", "aliked-t16", "aliked-n16"}));
   command->add_option("--verify", flags->verify_file, "Print a file's git blob id and which preset it fits");
   command->add_flag("--no-verify", flags->no_verify, "Skip the git blob id check of --download / --import");
   command->callback([flags] { Run(*flags); });

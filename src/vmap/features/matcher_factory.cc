@@ -8,16 +8,19 @@ namespace vmap {
 void MatcherOptions::Check() const {
   if (type == "orb") orb.Check();
   else if (type == "loftr") loftr.Check();
-  else throw InputError("unknown matcher '" + type + "'; use orb or loftr");
+  else if (type == "aliked") aliked.Check();
+  else throw InputError("unknown matcher '" + type + "'; use orb, loftr or aliked");
 }
 
 std::unique_ptr<Matcher> CreateMatcher(const MatcherOptions& options) {
   options.Check();
   if (options.type == "orb") return CreateOrbMatcher(options.orb);
 #ifdef VMAP_WITH_TORCH
+  if (options.type == "aliked") return TorchPlugin().create_aliked_matcher(options.aliked);
   return TorchPlugin().create_loftr_matcher(options.loftr);
 #else
-  throw InputError("this vmap was built without LibTorch (VMAP_WITH_TORCH=OFF); rebuild with it for --matcher loftr");
+  throw InputError("this vmap was built without LibTorch (VMAP_WITH_TORCH=OFF); rebuild with it for --matcher " +
+                   options.type);
 #endif
 }
 

@@ -8,14 +8,17 @@
 #include <vector>
 
 #include "vmap/features/matcher.h"
+#include "vmap/neural/aliked_options.h"
 #include "vmap/neural/loftr_options.h"
 
 namespace vmap {
 
-// The entry points of the plugin (see loftr_matcher.h for what they do).
+// The entry points of the plugin (see loftr_matcher.h and aliked_matcher.h for what they do).
 struct TorchPluginApi {
   std::unique_ptr<Matcher> (*create_loftr_matcher)(const LoftrMatcherOptions& options);
   std::vector<std::string> (*loftr_presets_fitting_file)(const std::string& path);
+  std::unique_ptr<Matcher> (*create_aliked_matcher)(const AlikedMatcherOptions& options);
+  std::vector<std::string> (*aliked_models_fitting_file)(const std::string& path);
 };
 
 // The plugin's entry points: linked into this program (the neural tests), or loaded from libvmap_torch.so

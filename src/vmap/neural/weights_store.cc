@@ -16,8 +16,6 @@ namespace vmap::neural {
 
 namespace {
 
-const char kCoarseSharedFile[] = "weights/loftr_coarse/loftr_coarse_teacher.pt";
-
 std::string Env(const char* name) {
   const char* value = std::getenv(name);
   return value ? std::string(value) : std::string();
@@ -57,13 +55,24 @@ const std::vector<KnownWeights>& KnownWeightFiles() {
   static const std::vector<KnownWeights> files{
       {"outdoor", "outdoor_ds.ckpt", "https://cmp.felk.cvut.cz/~mishkdmy/models/loftr_outdoor.ckpt",
        "a8c45b0ab725f933c45f001effae25f22a4574dd",
-       "official LoFTR outdoor_ds.ckpt (zju3dv/LoFTR, Apache-2.0), 46 MB, mirrored by Kornia"},
+       "official LoFTR outdoor_ds.ckpt (zju3dv/LoFTR, Apache-2.0), 46 MB, mirrored by Kornia", "", "--loftr-model"},
       {"indoor", "indoor_ds_new.ckpt", "https://cmp.felk.cvut.cz/~mishkdmy/models/loftr_indoor_ds_new.ckpt",
        "e7cb02c2c629d50e24ec9ecacf4981904979907b",
-       "official LoFTR indoor_ds_new.ckpt (zju3dv/LoFTR, Apache-2.0), 46 MB, mirrored by Kornia"},
+       "official LoFTR indoor_ds_new.ckpt (zju3dv/LoFTR, Apache-2.0), 46 MB, mirrored by Kornia", "", "--loftr-model"},
       {"coarse", "loftr_coarse_teacher.pt", "", "",
        "Coarse-LoFTR student (Kolkir/Coarse_LoFTR_TRT, Apache-2.0) as a plain state dict; ships in "
-       "shared/weights/loftr_coarse"},
+       "shared/weights/loftr_coarse",
+       "weights/loftr_coarse/loftr_coarse_teacher.pt", "--loftr-model"},
+      // Upstream releases these as models/aliked-*.pth (a collections.OrderedDict state dict); the shared folder
+      // holds the same tensors as plain dicts (*.pt). Both layouts load.
+      {"aliked-t16", "aliked-t16.pth", "", "",
+       "ALIKED-T16 (Shiaoming/ALIKED, BSD-3-Clause), 0.8 MB; official file "
+       "https://github.com/Shiaoming/ALIKED/raw/main/models/aliked-t16.pth",
+       "weights/aliked/aliked-t16.pt", "--aliked-model"},
+      {"aliked-n16", "aliked-n16.pth", "", "",
+       "ALIKED-N16 (Shiaoming/ALIKED, BSD-3-Clause), 2.7 MB; official file "
+       "https://github.com/Shiaoming/ALIKED/raw/main/models/aliked-n16.pth",
+       "weights/aliked/aliked-n16.pt", "--aliked-model"},
   };
   return files;
 }
@@ -72,7 +81,7 @@ const KnownWeights& KnownWeightsFor(const std::string& preset) {
   for (const auto& known : KnownWeightFiles()) {
     if (known.preset == preset) return known;
   }
-  throw InputError("unknown LoFTR model '" + preset + "'; use outdoor, indoor or coarse");
+  throw InputError("unknown weights preset '" + preset + "'; use outdoor, indoor, coarse, aliked-t16 or aliked-n16");
 }
 
 std::string WeightsCacheDir() {
@@ -85,10 +94,10 @@ std::string WeightsCacheDir() {
 std::vector<std::string> WeightsSearchPaths(const std::string& preset) {
   const auto& known = KnownWeightsFor(preset);
   std::vector<std::string> paths{WeightsCacheDir() + "/" + known.file_name};
-  if (preset == "coarse") {
-    paths.push_back(std::string("../shared/") + kCoarseSharedFile);
+  if (!known.shared_file.empty()) {
+    paths.push_back("../shared/" + known.shared_file);
 #ifdef VMAP_DEFAULT_SHARED_DIR
-    paths.push_back(std::string(VMAP_DEFAULT_SHARED_DIR) + "/" + kCoarseSharedFile);
+    paths.push_back(std::string(VMAP_DEFAULT_SHARED_DIR) + "/" + known.shared_file);
 #endif
   }
   return paths;
@@ -97,21 +106,22 @@ std::vector<std::string> WeightsSearchPaths(const std::string& preset) {
 std::string LocateWeights(const std::string& preset, const std::string& explicit_path) {
   if (!explicit_path.empty()) {
     if (IsFile(explicit_path)) return explicit_path;
-    throw InputError("LoFTR weights file '" + explicit_path + "' (--weights) does not exist");
+    throw InputError("weights file '" + explicit_path + "' (--weights) does not exist");
   }
   const auto paths = WeightsSearchPaths(preset);
   for (const auto& path : paths) {
     if (IsFile(path)) return path;
   }
-  std::string message = "no weights for --loftr-model " + preset + "; searched:";
-  for (const auto& path : paths) message += "\n  " + path;
   const auto& known = KnownWeightsFor(preset);
+  const std::string name = preset.rfind("aliked-", 0) == 0 ? preset.substr(7) : preset;
+  std::string message = "no weights for " + known.option + " " + name + "; searched:";
+  for (const auto& path : paths) message += "\n  " + path;
   if (!known.url.empty()) {
     message += "\nGet them with `vmap weights --download " + preset + "` (" + known.url +
                "), or pass a file with --weights. The cache directory can be moved with $" + kWeightsDirEnv + ".";
   } else {
     message += "\nPass the file with --weights, or copy it into the cache with `vmap weights --import FILE --model " +
-               preset + "`.";
+               preset + "` (" + known.description + ").";
   }
   throw InputError(message);
 }
