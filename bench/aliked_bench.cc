@@ -2,11 +2,13 @@
 // KITTI size (1226x370), with one and two LibTorch threads, ALIKED-T16 and -N16; optionally the deformable
 // convolution against a grid_sample-per-tap variant, and `vmap build` end to end next to ORB.
 //
-//   aliked_bench [--model t16|n16|all] [--reps N] [--dcn] [--build [--frames N]]
+//   aliked_bench [--model t16|n16|all] [--reps N] [--stages] [--dcn] [--build [--frames N]] [--no-tune-malloc]
 //
+// --stages splits one-thread extraction into the network, DKD and SDDH (CPU seconds).
 // Every figure is the median of N runs after one warm-up. The build rows run BuildMap as `vmap build` does
 // (one extraction worker per core, one LibTorch thread per call) on ../shared/data/lab_floor/lab_floor.mp4.
 
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -24,6 +26,8 @@
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/map_builder.h"
 #include "vmap/neural/aliked_matcher.h"
+#include "vmap/neural/aliked_model.h"
+#include "vmap/neural/aliked_weights.h"
 #include "vmap/neural/deform_conv.h"
 #include "vmap/sources/frame_source.h"
 
@@ -41,6 +45,20 @@ double TimeSeconds(F&& f) {
   const auto start = Clock::now();
   f();
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// CPU seconds of the whole process (all threads): on a loaded machine this moves much less than wall time.
+double ProcessCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+template <typename F>
+double CpuSeconds(F&& f) {
+  const double start = ProcessCpuSeconds();
+  f();
+  return ProcessCpuSeconds() - start;
 }
 
 // The alternative the README compares with: one grid_sample per kernel tap gathers the columns.
@@ -65,8 +83,9 @@ torch::Tensor DeformConvByGridSample(const torch::Tensor& input, const torch::Te
 
 void BenchDeformConv(int reps) {
   torch::InferenceMode guard;
+  at::set_num_threads(1);
   torch::manual_seed(0);
-  std::printf("\ndeformable 3x3 convolution, one thread: gather im2col + one matmul vs grid_sample per tap\n");
+  std::printf("\ndeformable 3x3 convolution, one thread, CPU ms: gather im2col + one matmul vs grid_sample per tap\n");
   std::printf("%-28s %12s %12s %8s\n", "input -> output", "im2col_ms", "gridsamp_ms", "ratio");
   struct Case { int64_t c, o, h, w; const char* what; };
   // ALIKED-N16 block 3 (1/8) and block 4 (1/32) convolutions at 640x480 and 1248x384 (KITTI padded).
@@ -78,8 +97,8 @@ void BenchDeformConv(int reps) {
     auto offset = torch::randn({1, 18, c.h, c.w}) * 3.0;
     std::vector<double> ours, grid;
     for (int r = 0; r < reps + 1; ++r) {
-      const double a = TimeSeconds([&] { vmap::neural::DeformConv2d(input, offset, weight, {}, {}, 1); });
-      const double b = TimeSeconds([&] { DeformConvByGridSample(input, offset, weight, 1); });
+      const double a = CpuSeconds([&] { vmap::neural::DeformConv2d(input, offset, weight, {}, {}, 1); });
+      const double b = CpuSeconds([&] { DeformConvByGridSample(input, offset, weight, 1); });
       if (r > 0) ours.push_back(a), grid.push_back(b);
     }
     const double max_diff = (vmap::neural::DeformConv2d(input, offset, weight, {}, {}, 1) -
@@ -92,7 +111,35 @@ void BenchDeformConv(int reps) {
   }
 }
 
-void BenchBuild(const std::string& shared, int frames, int reps) {
+void BenchStages(const std::string& shared, const std::string& which, int reps) {
+  torch::InferenceMode guard;
+  at::set_num_threads(1);
+  std::printf("\none-thread extraction by stage, CPU seconds (median of %d)\n", reps);
+  std::printf("%-6s %-9s %10s %10s %10s\n", "model", "size", "network_s", "dkd_s", "sddh_s");
+  for (const std::string model : {"t16", "n16"}) {
+    if (which != "all" && which != model) continue;
+    const std::string path = shared + "/weights/aliked/aliked-" + model + ".pt";
+    const auto config = vmap::neural::AlikedPreset(model);
+    const vmap::neural::AlikedModel net(config, vmap::neural::ReadAlikedStateDict(path), torch::kCPU);
+    for (const auto& [size, dir] : {std::pair{"640x480", "rccar_000000_000006"},
+                                    std::pair{"1226x370", "kitti07_000010_000014"}}) {
+      const cv::Mat gray = cv::imread(shared + "/golden/aliked-n16/" + dir + "/input0.png", cv::IMREAD_GRAYSCALE);
+      auto image = torch::from_blob(gray.data, {1, 1, gray.rows, gray.cols}, torch::kUInt8).to(torch::kFloat32) / 255.0;
+      std::vector<double> network, dkd, sddh;
+      for (int r = 0; r < reps + 1; ++r) {
+        vmap::neural::AlikedDenseMaps maps;
+        vmap::neural::DkdResult detected;
+        const double a = CpuSeconds([&] { maps = net.ExtractDenseMaps(image); });
+        const double b = CpuSeconds([&] { detected = vmap::neural::DetectKeypoints(maps.score_map, {}); });
+        const double c = CpuSeconds([&] { net.Describe(maps, detected.keypoints); });
+        if (r > 0) network.push_back(a), dkd.push_back(b), sddh.push_back(c);
+      }
+      std::printf("%-6s %-9s %10.4f %10.4f %10.4f\n", model.c_str(), size, Median(network), Median(dkd), Median(sddh));
+    }
+  }
+}
+
+void BenchBuild(const std::string& shared, int frames, int reps, bool tune_malloc) {
   const std::string video = shared + "/data/lab_floor/lab_floor.mp4";
   cv::setNumThreads(1);  // as the vmap binary does
   vmap::FrameSourceOptions source_options;
@@ -108,6 +155,7 @@ void BenchBuild(const std::string& shared, int frames, int reps) {
     vmap::AlikedMatcherOptions aliked;
     aliked.model = model;
     aliked.weights = shared + "/weights/aliked/aliked-" + model + ".pt";
+    aliked.tune_malloc = tune_malloc;
     entries.push_back({"aliked-" + model, vmap::CreateAlikedMatcher(aliked), {}, 0});
   }
   // Interleaved, so that the machine's changing load touches every matcher alike.
@@ -137,15 +185,19 @@ void BenchBuild(const std::string& shared, int frames, int reps) {
 int main(int argc, char** argv) {
   std::string which = "all";
   int reps = 5, frames = 0;
-  bool dcn = false, build = false;
+  bool dcn = false, build = false, stages = false, tune_malloc = true;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--model") && i + 1 < argc) which = argv[++i];
     else if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) frames = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--dcn")) dcn = true;
     else if (!std::strcmp(argv[i], "--build")) build = true;
+    else if (!std::strcmp(argv[i], "--stages")) stages = true;
+    else if (!std::strcmp(argv[i], "--no-tune-malloc")) tune_malloc = false;
     else {
-      std::fprintf(stderr, "usage: %s [--model t16|n16|all] [--reps N] [--dcn] [--build [--frames N]]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--model t16|n16|all] [--reps N] [--stages] [--dcn] [--build [--frames N]]"
+                   " [--no-tune-malloc]\n",
+                   argv[0]);
       return 2;
     }
   }
@@ -153,8 +205,8 @@ int main(int argc, char** argv) {
   struct Pair { const char* size; std::string dir; };
   const std::vector<Pair> pairs{{"640x480", shared + "/golden/aliked-n16/rccar_000000_000006"},
                                 {"1226x370", shared + "/golden/aliked-n16/kitti07_000010_000014"}};
-  std::printf("%-6s %-9s %7s %6s %11s %11s %11s %8s %8s\n", "model", "size", "threads", "reps", "extract_s",
-              "match_s", "frame_s", "kpts", "matches");
+  std::printf("%-6s %-9s %7s %6s %10s %10s %10s %10s %6s %8s\n", "model", "size", "threads", "reps", "extract_s",
+              "cpu_s", "match_s", "frame_s", "kpts", "matches");
   for (const std::string model : {"t16", "n16"}) {
     if (which != "all" && which != model) continue;
     for (const auto& pair : pairs) {
@@ -169,23 +221,26 @@ int main(int argc, char** argv) {
         options.model = model;
         options.weights = shared + "/weights/aliked/aliked-" + model + ".pt";
         options.num_threads = threads;
+        options.tune_malloc = tune_malloc;
         const auto matcher = vmap::CreateAlikedMatcher(options);
         auto key = matcher->Extract(image0);  // warm-up
         auto frame = matcher->Extract(image1);
         size_t matches = matcher->Match(*key, *frame).size();
-        std::vector<double> extract_s, match_s, frame_s;
+        std::vector<double> extract_s, cpu_s, match_s, frame_s;
         for (int r = 0; r < reps; ++r) {
-          extract_s.push_back(TimeSeconds([&] { frame = matcher->Extract(image1); }));
+          cpu_s.push_back(CpuSeconds([&] { extract_s.push_back(TimeSeconds([&] { frame = matcher->Extract(image1); })); }));
           match_s.push_back(TimeSeconds([&] { matches = matcher->Match(*key, *frame).size(); }));
           frame_s.push_back(extract_s.back() + match_s.back());
         }
-        std::printf("%-6s %-9s %7d %6d %11.4f %11.4f %11.4f %8d %8zu\n", model.c_str(), pair.size, threads, reps,
-                    Median(extract_s), Median(match_s), Median(frame_s), frame->num_features(), matches);
+        std::printf("%-6s %-9s %7d %6d %10.4f %10.4f %10.4f %10.4f %6d %8zu\n", model.c_str(), pair.size, threads,
+                    reps, Median(extract_s), Median(cpu_s), Median(match_s), Median(frame_s), frame->num_features(),
+                    matches);
         std::fflush(stdout);
       }
     }
   }
+  if (stages) BenchStages(shared, which, reps);
   if (dcn) BenchDeformConv(std::max(reps, 10));
-  if (build) BenchBuild(shared, frames, std::max(1, std::min(reps, 3)));
+  if (build) BenchBuild(shared, frames, std::max(1, std::min(reps, 3)), tune_malloc);
   return 0;
 }

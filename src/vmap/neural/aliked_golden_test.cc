@@ -251,6 +251,20 @@ TEST_P(AlikedGolden, SparseFeatureReadsEqualTheDenseFeatureMap) {
   EXPECT_TENSOR_NEAR(sparse, expected, 1e-5, 0.0);
 }
 
+// The CPU NMS loop against the tensor formulation (max_pool2d), on maps with plateaus of equal scores, where
+// upstream's recovery rounds matter.
+TEST(AlikedDkd, CpuNmsEqualsTheTensorFormulation) {
+  torch::manual_seed(11);
+  for (const auto& size : {std::pair{37, 53}, std::pair{4, 3}, std::pair{1, 9}, std::pair{120, 160}}) {
+    for (double levels : {4.0, 16.0, 1e6}) {
+      const auto map = (torch::rand({1, 1, size.first, size.second}) * levels).floor() / levels;
+      const auto cpu = SimpleNms(map, 2);                                   // float: the loop
+      const auto reference = SimpleNms(map.to(torch::kFloat64), 2).to(torch::kFloat32);  // max_pool2d
+      EXPECT_TRUE(torch::equal(cpu, reference)) << size.first << "x" << size.second << " levels " << levels;
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Pairs, AlikedGolden,
                          ::testing::Values(GoldenPair{"t16", "rccar_000000_000006"},
                                            GoldenPair{"n16", "rccar_000000_000006"},

@@ -6,7 +6,8 @@ namespace vmap::neural {
 
 namespace {
 
-// Deformable im2col of one image: (C*K*K, Ho*Wo), row c*K*K + t, as weight.view(O, C*K*K) expects.
+// Deformable im2col of one image (C, H, W), channels last: (Ho*Wo, K*K*C), column t*C + c for tap t and
+// channel c. Each bilinear corner is one row gather from the zero-bordered image seen as (pixels, C).
 torch::Tensor DeformableColumns(const torch::Tensor& image, const torch::Tensor& offset, const torch::Tensor& mask,
                                 int64_t kernel, int64_t padding) {
   const int64_t channels = image.size(0), height = image.size(1), width = image.size(2);
@@ -14,15 +15,15 @@ torch::Tensor DeformableColumns(const torch::Tensor& image, const torch::Tensor&
   const int64_t taps = kernel * kernel;
   const auto float_options = offset.options();
 
-  // Sample positions of every (tap, output pixel): (taps, Ho, Wo).
+  // Sample positions of every (output pixel, tap): (Ho, Wo, taps).
   auto tap = torch::arange(taps, float_options);
   auto tap_row = torch::floor(tap / double(kernel));
   auto tap_col = tap - tap_row * double(kernel);
   auto out_row = torch::arange(out_h, float_options).sub_(double(padding));
   auto out_col = torch::arange(out_w, float_options).sub_(double(padding));
-  auto offsets = offset.view({taps, 2, out_h, out_w});
-  auto y = (out_row.view({1, out_h, 1}) + tap_row.view({taps, 1, 1})) + offsets.select(1, 0);
-  auto x = (out_col.view({1, 1, out_w}) + tap_col.view({taps, 1, 1})) + offsets.select(1, 1);
+  auto offsets = offset.view({taps, 2, out_h, out_w}).permute({2, 3, 0, 1});  // (Ho, Wo, taps, 2)
+  auto y = (out_row.view({out_h, 1, 1}) + tap_row.view({1, 1, taps})) + offsets.select(3, 0);
+  auto x = (out_col.view({1, out_w, 1}) + tap_col.view({1, 1, taps})) + offsets.select(3, 1);
 
   // A sample contributes only strictly inside (-1, H) x (-1, W); its corners outside the image read the zero
   // border of `bordered`, so every index below stays in range.
@@ -32,24 +33,24 @@ torch::Tensor DeformableColumns(const torch::Tensor& image, const torch::Tensor&
   auto ly = y - y0, lx = x - x0;
   auto hy = 1.0 - ly, hx = 1.0 - lx;
   auto gate = inside.to(float_options.dtype());
-  if (mask.defined()) gate = gate * mask.view({taps, out_h, out_w});
+  if (mask.defined()) gate = gate * mask.view({taps, out_h, out_w}).permute({1, 2, 0});
   // Bordered coordinates: image pixel (r, c) is at (r + 1, c + 1); outside samples are moved to (0, 0).
   auto row0 = (y0 + 1.0).clamp_(0.0, double(height)).to(torch::kLong);
   auto col0 = (x0 + 1.0).clamp_(0.0, double(width)).to(torch::kLong);
   const int64_t stride = width + 2;
-  auto index00 = (row0 * stride + col0).view({-1});
+  auto index00 = (row0 * stride + col0).reshape({-1});
   auto index01 = index00 + 1;
   auto index10 = index00 + stride;
   auto index11 = index10 + 1;
 
-  auto bordered = torch::constant_pad_nd(image, {1, 1, 1, 1}, 0.0).view({channels, -1});
-  auto w00 = (hy * hx * gate).view({1, -1}), w01 = (hy * lx * gate).view({1, -1});
-  auto w10 = (ly * hx * gate).view({1, -1}), w11 = (ly * lx * gate).view({1, -1});
-  auto columns = bordered.index_select(1, index00).mul_(w00);
-  columns.addcmul_(bordered.index_select(1, index01), w01);
-  columns.addcmul_(bordered.index_select(1, index10), w10);
-  columns.addcmul_(bordered.index_select(1, index11), w11);
-  return columns.view({channels * taps, out_h * out_w});
+  auto bordered = torch::constant_pad_nd(image.permute({1, 2, 0}), {0, 0, 1, 1, 1, 1}, 0.0).reshape({-1, channels});
+  auto w00 = (hy * hx * gate).reshape({-1, 1}), w01 = (hy * lx * gate).reshape({-1, 1});
+  auto w10 = (ly * hx * gate).reshape({-1, 1}), w11 = (ly * lx * gate).reshape({-1, 1});
+  auto columns = bordered.index_select(0, index00).mul_(w00);
+  columns.addcmul_(bordered.index_select(0, index01), w01);
+  columns.addcmul_(bordered.index_select(0, index10), w10);
+  columns.addcmul_(bordered.index_select(0, index11), w11);
+  return columns.view({out_h * out_w, taps * channels});
 }
 
 }  // namespace
@@ -71,14 +72,16 @@ torch::Tensor DeformConv2d(const torch::Tensor& input, const torch::Tensor& offs
                          mask.size(2) != out_h || mask.size(3) != out_w)) {
     throw std::invalid_argument("DeformConv2d: mask must be (B, K*K, Ho, Wo)");
   }
-  const auto flat_weight = weight.reshape({out_channels, -1});
+  // (K*K*C, O), rows in the columns' tap-major order.
+  const auto flat_weight = weight.permute({2, 3, 1, 0}).reshape({-1, out_channels});
   std::vector<torch::Tensor> outputs;
   for (int64_t b = 0; b < batch; ++b) {
     auto columns = DeformableColumns(input[b], offset[b].contiguous(), mask.defined() ? mask[b] : torch::Tensor(),
                                      kernel, padding);
-    auto out = bias.defined() ? torch::addmm(bias.view({-1, 1}), flat_weight, columns) : flat_weight.mm(columns);
-    outputs.push_back(out.view({1, out_channels, out_h, out_w}));
+    auto out = bias.defined() ? torch::addmm(bias, columns, flat_weight) : columns.mm(flat_weight);  // (Ho*Wo, O)
+    outputs.push_back(out.view({1, out_h, out_w, out_channels}).permute({0, 3, 1, 2}));
   }
+  // Channels-last, as the matrix product leaves it.
   return batch == 1 ? outputs[0] : torch::cat(outputs, 0);
 }
 
