@@ -75,11 +75,11 @@ TEST(AlikedCli, BuildAndSweepRecordTheMatcher) {
   SKIP_WITHOUT_SHARED();
   const TempDir dir("build");
   const std::string input = SharedDir() + "/data/rccar_room/images";
-  auto r = RunVmap("build " + input + " --last 24 --matcher aliked --aliked-model t16 -q -o " +
+  auto r = RunVmap("build " + input + " --last 14 --matcher aliked --aliked-model t16 -q -o " +
                    (dir.path() / "map").string());
   ASSERT_EQ(r.status, 0) << r.output;
   const auto map = ReadJson(dir.path() / "map/map.json");
-  EXPECT_EQ(map["num_frames"].get<int>(), 25);
+  EXPECT_EQ(map["num_frames"].get<int>(), 15);
   const auto& matcher = map["options"]["matcher"];
   EXPECT_EQ(matcher["type"], "aliked") << matcher.dump();
   EXPECT_EQ(matcher["model"], "aliked-t16");
@@ -92,7 +92,7 @@ TEST(AlikedCli, BuildAndSweepRecordTheMatcher) {
   r = RunVmap("info " + (dir.path() / "map").string());
   EXPECT_NE(r.output.find("aliked"), std::string::npos) << r.output;
 
-  r = RunVmap("sweep " + input + " --last 14 --matcher aliked --thresholds 0.5:0.7:0.1 -q -o " +
+  r = RunVmap("sweep " + input + " --last 9 --matcher aliked --thresholds 0.5:0.7:0.1 -q -o " +
               (dir.path() / "sweep").string());
   ASSERT_EQ(r.status, 0) << r.output;
   const auto sweep = ReadJson(dir.path() / "sweep/sweep.json");
