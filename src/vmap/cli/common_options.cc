@@ -3,7 +3,7 @@
 namespace vmap::cli {
 
 void AddMatcherOptions(CLI::App* command, MatcherOptions& options) {
-  command->add_option("--matcher", options.type, "Feature matcher: orb, loftr or xfeat")->capture_default_str();
+  command->add_option("--matcher", options.type, "Feature matcher: orb, loftr, xfeat or aliked")->capture_default_str();
   auto& orb = options.orb;
   command->add_option("--orb-features", orb.num_features, "ORB: features per image")->capture_default_str();
   command->add_option("--orb-scale-factor", orb.scale_factor, "ORB: pyramid scale factor")->capture_default_str();
@@ -18,11 +18,15 @@ void AddMatcherOptions(CLI::App* command, MatcherOptions& options) {
       ->capture_default_str();
   // --weights and --device belong to whichever deep matcher --matcher picks.
   command->add_option_function<std::string>(
-      "--weights", [&options](const std::string& file) { options.loftr.weights = options.xfeat.weights = file; },
-      "LoFTR/XFeat weights file (see `vmap weights`)");
+      "--weights",
+      [&options](const std::string& file) { options.loftr.weights = options.xfeat.weights = options.aliked.weights = file; },
+      "Weights file of the deep matcher (see `vmap weights`)");
   command->add_option_function<std::string>(
-      "--device", [&options](const std::string& device) { options.loftr.device = options.xfeat.device = device; },
-      "LoFTR/XFeat device: cpu or cuda")->default_str(options.loftr.device);
+      "--device",
+      [&options](const std::string& device) {
+        options.loftr.device = options.xfeat.device = options.aliked.device = device;
+      },
+      "Deep matchers' device: cpu or cuda")->default_str(options.loftr.device);
   command->add_option("--loftr-size", loftr.longest_side, "LoFTR: longest image side fed to the network")
       ->capture_default_str();
   command->add_option("--loftr-threshold", loftr.threshold, "LoFTR: coarse confidence threshold (default: preset's)");
@@ -37,6 +41,23 @@ void AddMatcherOptions(CLI::App* command, MatcherOptions& options) {
                       "XFeat: mutual nearest neighbours need a cosine similarity above this (<= 0: no minimum)")
       ->capture_default_str();
   command->add_option("--xfeat-threads", xfeat.num_threads, "XFeat: LibTorch threads per call (0 = LibTorch default)")
+  auto& aliked = options.aliked;
+  command->add_option("--aliked-model", aliked.model, "ALIKED model: t16 or n16")->capture_default_str();
+  command->add_option("--aliked-top-k", aliked.top_k, "ALIKED: keypoints per image (0 = score threshold mode)")
+      ->capture_default_str();
+  command->add_option("--aliked-score-threshold", aliked.score_threshold,
+                      "ALIKED: keypoint score threshold when --aliked-top-k is 0")
+      ->capture_default_str();
+  command->add_option("--aliked-max-keypoints", aliked.max_keypoints,
+                      "ALIKED: most keypoints when --aliked-top-k is 0")
+      ->capture_default_str();
+  command->add_option("--aliked-min-similarity", aliked.min_similarity,
+                      "ALIKED: least cosine similarity of a match")
+      ->capture_default_str();
+  command->add_option("--aliked-size", aliked.longest_side,
+                      "ALIKED: shrink images to this longest side first (0 = native size)")
+      ->capture_default_str();
+  command->add_option("--aliked-threads", aliked.num_threads, "ALIKED: LibTorch threads per call (0 = LibTorch default)")
       ->capture_default_str();
 }
 

@@ -11,7 +11,7 @@
 
 namespace vmap::cli {
 
-// --matcher, ORB's, LoFTR's and XFeat's options.
+// --matcher, ORB's, LoFTR's, XFeat's and ALIKED's options.
 void AddMatcherOptions(CLI::App* command, MatcherOptions& options);
 
 // --verifier, --threshold, --confidence, --max-iters, --seed.

@@ -1,4 +1,4 @@
-// vmap weights: where LoFTR and XFeat weights are searched, and getting the official ones into the cache.
+// vmap weights: where LoFTR, XFeat and ALIKED weights are searched, and getting the official ones into the cache.
 
 #include <algorithm>
 #include <cstdio>
@@ -29,8 +29,8 @@ std::string Join(const std::vector<std::string>& items) {
 }
 
 #ifdef VMAP_WITH_TORCH
-// The models a file fits: LoFTR presets, and "xfeat (<layout> layout)". Throws the first reading error when
-// the file cannot be read at all.
+// The models a file fits: LoFTR presets, "xfeat (<layout> layout)" and ALIKED models as `--model` names them
+// (aliked-t16, aliked-n16). Throws the first reading error when the file cannot be read at all.
 std::vector<std::string> ModelsFittingFile(const std::string& path) {
   std::vector<std::string> fits;
   std::string read_error;
@@ -41,9 +41,13 @@ std::vector<std::string> ModelsFittingFile(const std::string& path) {
   }
   try {
     fits.push_back("xfeat (" + TorchPlugin().xfeat_weights_layout(path) + " layout)");
-  } catch (const InputError& error) {
-    if (fits.empty() && !read_error.empty()) throw InputError(read_error);
+  } catch (const InputError&) {
   }
+  try {
+    for (const auto& model : TorchPlugin().aliked_models_fitting_file(path)) fits.push_back("aliked-" + model);
+  } catch (const InputError&) {
+  }
+  if (fits.empty() && !read_error.empty()) throw InputError(read_error);
   return fits;
 }
 #endif
@@ -55,6 +59,9 @@ void PrintStatus() {
   std::printf("--weights FILE overrides the search. Files are checked key by key when loaded.\n\n");
   for (const auto& known : neural::KnownWeightFiles()) {
     std::printf("%-8s %s\n", known.preset.c_str(), known.description.c_str());
+    if (known.preset.rfind("aliked-", 0) == 0) {
+      std::printf("         layouts: upstream's .pth (OrderedDict state dict) or a plain {name: tensor} dict\n");
+    }
     std::string found;
     for (const auto& path : neural::WeightsSearchPaths(known.preset)) {
       std::error_code error;
@@ -64,9 +71,14 @@ void PrintStatus() {
     }
     if (found.empty() && !known.url.empty()) {
       std::printf("         get it: vmap weights --download %s   (%s)\n", known.preset.c_str(), known.url.c_str());
+    } else if (found.empty()) {
+      std::printf("         get it: download the official file, then vmap weights --import FILE --model %s\n",
+                  known.preset.c_str());
     }
   }
 }
+
+#ifdef VMAP_WITH_TORCH
 
 void Verify(const std::string& path) {
   const std::string id = neural::GitBlobId(path);
@@ -79,8 +91,8 @@ void Verify(const std::string& path) {
                                                       : ("yes: " + known_as).c_str());
 #ifdef VMAP_WITH_TORCH
   const auto presets = ModelsFittingFile(path);
-  std::printf("  fits         %s\n", presets.empty() ? "no LoFTR preset and not XFeat" : Join(presets).c_str());
-  if (presets.empty()) throw InputError("'" + path + "' is not usable as LoFTR or XFeat weights");
+  std::printf("  fits         %s\n", presets.empty() ? "no known model" : Join(presets).c_str());
+  if (presets.empty()) throw InputError("'" + path + "' is not usable as LoFTR, XFeat or ALIKED weights");
 #endif
 }
 
@@ -108,17 +120,18 @@ void Run(const WeightsFlags& flags) {
     acted = true;
   }
   if (!flags.import_file.empty()) {
-    if (flags.model.empty()) throw InputError("--import needs --model outdoor|indoor|coarse|xfeat");
+    if (flags.model.empty()) throw InputError("--import needs --model outdoor|indoor|coarse|xfeat|aliked-t16|aliked-n16");
     const auto& known = neural::KnownWeightsFor(flags.model);
     const std::string expected = flags.no_verify ? "" : known.git_blob_id;
 #ifdef VMAP_WITH_TORCH
     // Without a known id the structure is the only check available before the file enters the cache.
     if (flags.model == "xfeat") {
       TorchPlugin().xfeat_weights_layout(flags.import_file);  // throws, listing what does not fit
-    } else if (const auto presets = TorchPlugin().loftr_presets_fitting_file(flags.import_file);
+    } else if (const auto presets = ModelsFittingFile(flags.import_file);
                std::find(presets.begin(), presets.end(), flags.model) == presets.end()) {
       throw InputError("'" + flags.import_file + "' does not fit --model " + flags.model +
-                       (presets.empty() ? std::string(" (nor any LoFTR preset)") : " (it fits " + Join(presets) + ")"));
+                       (presets.empty() ? std::string(" (nor any other model)")
+                                        : " (it fits " + Join(presets) + ")"));
     }
 #endif
     const std::string path = neural::ImportWeights(flags.import_file, flags.model, expected, cache);
@@ -140,12 +153,13 @@ void Run(const WeightsFlags& flags) {
 void AddWeightsCommand(CLI::App& app) {
   auto flags = std::make_shared<WeightsFlags>();
   CLI::App* command = app.add_subcommand(
-      "weights", "Show where LoFTR and XFeat weights are searched; download, import or verify weight files");
+      "weights", "Show where LoFTR, XFeat and ALIKED weights are searched; download, import or verify weight files");
   command->add_option("--download", flags->download, "Download the official weights: outdoor, indoor, xfeat or all")
       ->check(CLI::IsMember({"outdoor", "indoor", "xfeat", "all"}));
   command->add_option("--import", flags->import_file, "Copy a local weights file into the cache (needs --model)");
-  command->add_option("--model", flags->model, "Model of the --import file: outdoor, indoor, coarse or xfeat")
-      ->check(CLI::IsMember({"outdoor", "indoor", "coarse", "xfeat"}));
+  command->add_option("--model", flags->model,
+                      "Model of the --import file: outdoor, indoor, coarse, xfeat, aliked-t16 or aliked-n16")
+      ->check(CLI::IsMember({"outdoor", "indoor", "coarse", "xfeat", "aliked-t16", "aliked-n16"}));
   command->add_option("--verify", flags->verify_file, "Print a file's git blob id and which model it fits");
   command->add_flag("--no-verify", flags->no_verify, "Skip the git blob id check of --download / --import");
   command->callback([flags] { Run(*flags); });

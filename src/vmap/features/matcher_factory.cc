@@ -6,12 +6,13 @@
 namespace vmap {
 
 void MatcherOptions::Check() const {
-  if (type != "orb" && type != "loftr" && type != "xfeat")
-    throw InputError("unknown matcher '" + type + "'; use orb, loftr or xfeat");
+  if (type != "orb" && type != "loftr" && type != "xfeat" && type != "aliked")
+    throw InputError("unknown matcher '" + type + "'; use orb, loftr, xfeat or aliked");
   // The options of every matcher, used or not: an absurd value (NaN, out of range) is a mistake either way.
   orb.Check();
   loftr.Check();
   xfeat.Check();
+  aliked.Check();
 }
 
 std::unique_ptr<Matcher> CreateMatcher(const MatcherOptions& options) {
@@ -19,6 +20,7 @@ std::unique_ptr<Matcher> CreateMatcher(const MatcherOptions& options) {
   if (options.type == "orb") return CreateOrbMatcher(options.orb);
 #ifdef VMAP_WITH_TORCH
   if (options.type == "xfeat") return TorchPlugin().create_xfeat_matcher(options.xfeat);
+  if (options.type == "aliked") return TorchPlugin().create_aliked_matcher(options.aliked);
   return TorchPlugin().create_loftr_matcher(options.loftr);
 #else
   throw InputError("this vmap was built without LibTorch (VMAP_WITH_TORCH=OFF); rebuild with it for --matcher " +

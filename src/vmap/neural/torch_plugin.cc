@@ -27,7 +27,7 @@ const TorchPluginApi* LoadPlugin() {
   // Never closed: matchers and features made by the plugin may live until the process ends.
   void* library = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!library) {
-    throw InputError("the deep matchers (LoFTR, XFeat) need LibTorch, through '" + path + "', which cannot be loaded (" + dlerror() +
+    throw InputError("the deep matchers need LibTorch, through '" + path + "', which cannot be loaded (" + dlerror() +
                      "); build vmap with -DVMAP_WITH_TORCH=ON (scripts/build.sh does) and keep libvmap_torch.so "
                      "beside the vmap binary");
   }

@@ -16,21 +16,6 @@ namespace vmap::neural {
 
 namespace {
 
-const char kCoarseSharedFile[] = "weights/loftr_coarse/loftr_coarse_teacher.pt";
-const char kXfeatSharedFile[] = "weights/xfeat/xfeat_folded.pt";
-
-// The shared data folder's copy of a model's weights, where it has one.
-std::string SharedFile(const std::string& preset) {
-  if (preset == "coarse") return kCoarseSharedFile;
-  if (preset == "xfeat") return kXfeatSharedFile;
-  return "";
-}
-
-// The command-line choice a preset stands for, for messages.
-std::string ModelFlag(const std::string& preset) {
-  return preset == "xfeat" ? "--matcher xfeat" : "--loftr-model " + preset;
-}
-
 std::string Env(const char* name) {
   const char* value = std::getenv(name);
   return value ? std::string(value) : std::string();
@@ -70,17 +55,29 @@ const std::vector<KnownWeights>& KnownWeightFiles() {
   static const std::vector<KnownWeights> files{
       {"outdoor", "outdoor_ds.ckpt", "https://cmp.felk.cvut.cz/~mishkdmy/models/loftr_outdoor.ckpt",
        "a8c45b0ab725f933c45f001effae25f22a4574dd",
-       "official LoFTR outdoor_ds.ckpt (zju3dv/LoFTR, Apache-2.0), 46 MB, mirrored by Kornia"},
+       "official LoFTR outdoor_ds.ckpt (zju3dv/LoFTR, Apache-2.0), 46 MB, mirrored by Kornia", "", "--loftr-model"},
       {"indoor", "indoor_ds_new.ckpt", "https://cmp.felk.cvut.cz/~mishkdmy/models/loftr_indoor_ds_new.ckpt",
        "e7cb02c2c629d50e24ec9ecacf4981904979907b",
-       "official LoFTR indoor_ds_new.ckpt (zju3dv/LoFTR, Apache-2.0), 46 MB, mirrored by Kornia"},
+       "official LoFTR indoor_ds_new.ckpt (zju3dv/LoFTR, Apache-2.0), 46 MB, mirrored by Kornia", "", "--loftr-model"},
       {"coarse", "loftr_coarse_teacher.pt", "", "",
        "Coarse-LoFTR student (Kolkir/Coarse_LoFTR_TRT, Apache-2.0) as a plain state dict; ships in "
-       "shared/weights/loftr_coarse"},
+       "shared/weights/loftr_coarse",
+       "weights/loftr_coarse/loftr_coarse_teacher.pt", "--loftr-model"},
       {"xfeat", "xfeat.pt", "https://github.com/verlab/accelerated_features/raw/main/weights/xfeat.pt",
        "9da942e9c7406b8add3746bf98d4b1840233cd92",
        "XFeat (verlab/accelerated_features, Apache-2.0): the official weights/xfeat.pt, 6 MB, or the BatchNorm-folded "
-       "xfeat_folded.pt of shared/weights/xfeat; both layouts load"},
+       "xfeat_folded.pt of shared/weights/xfeat; both layouts load",
+       "weights/xfeat/xfeat_folded.pt", "--matcher"},
+      // Upstream releases these as models/aliked-*.pth (a collections.OrderedDict state dict); the shared folder
+      // holds the same tensors as plain dicts (*.pt). Both layouts load.
+      {"aliked-t16", "aliked-t16.pth", "", "",
+       "ALIKED-T16 (Shiaoming/ALIKED, BSD-3-Clause), 0.8 MB; official file "
+       "https://github.com/Shiaoming/ALIKED/raw/main/models/aliked-t16.pth",
+       "weights/aliked/aliked-t16.pt", "--aliked-model"},
+      {"aliked-n16", "aliked-n16.pth", "", "",
+       "ALIKED-N16 (Shiaoming/ALIKED, BSD-3-Clause), 2.7 MB; official file "
+       "https://github.com/Shiaoming/ALIKED/raw/main/models/aliked-n16.pth",
+       "weights/aliked/aliked-n16.pt", "--aliked-model"},
   };
   return files;
 }
@@ -89,7 +86,7 @@ const KnownWeights& KnownWeightsFor(const std::string& preset) {
   for (const auto& known : KnownWeightFiles()) {
     if (known.preset == preset) return known;
   }
-  throw InputError("unknown model '" + preset + "'; use outdoor, indoor, coarse (LoFTR) or xfeat");
+  throw InputError("unknown model '" + preset + "'; use outdoor, indoor, coarse (LoFTR), xfeat, aliked-t16 or aliked-n16");
 }
 
 std::string WeightsCacheDir() {
@@ -102,10 +99,10 @@ std::string WeightsCacheDir() {
 std::vector<std::string> WeightsSearchPaths(const std::string& preset) {
   const auto& known = KnownWeightsFor(preset);
   std::vector<std::string> paths{WeightsCacheDir() + "/" + known.file_name};
-  if (const std::string shared = SharedFile(preset); !shared.empty()) {
-    paths.push_back("../shared/" + shared);
+  if (!known.shared_file.empty()) {
+    paths.push_back("../shared/" + known.shared_file);
 #ifdef VMAP_DEFAULT_SHARED_DIR
-    paths.push_back(std::string(VMAP_DEFAULT_SHARED_DIR) + "/" + shared);
+    paths.push_back(std::string(VMAP_DEFAULT_SHARED_DIR) + "/" + known.shared_file);
 #endif
   }
   return paths;
@@ -120,15 +117,16 @@ std::string LocateWeights(const std::string& preset, const std::string& explicit
   for (const auto& path : paths) {
     if (IsFile(path)) return path;
   }
-  std::string message = "no weights for " + ModelFlag(preset) + "; searched:";
-  for (const auto& path : paths) message += "\n  " + path;
   const auto& known = KnownWeightsFor(preset);
+  const std::string name = preset.rfind("aliked-", 0) == 0 ? preset.substr(7) : preset;
+  std::string message = "no weights for " + known.option + " " + name + "; searched:";
+  for (const auto& path : paths) message += "\n  " + path;
   if (!known.url.empty()) {
     message += "\nGet them with `vmap weights --download " + preset + "` (" + known.url +
                "), or pass a file with --weights. The cache directory can be moved with $" + kWeightsDirEnv + ".";
   } else {
     message += "\nPass the file with --weights, or copy it into the cache with `vmap weights --import FILE --model " +
-               preset + "`.";
+               preset + "` (" + known.description + ").";
   }
   throw InputError(message);
 }

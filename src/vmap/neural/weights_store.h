@@ -1,11 +1,10 @@
 #pragma once
-// Where LoFTR and XFeat weights are found, and how they get there (`vmap weights`). No LibTorch here.
+// Where LoFTR, XFeat and ALIKED weights are found, and how they get there (`vmap weights`). No LibTorch here.
 //
 // Search order for a preset, unless --weights names a file:
 //   1. the cache directory: $VMAP_WEIGHTS_DIR if set, else $XDG_CACHE_HOME/vmap/weights, else ~/.cache/vmap/weights;
-//   2. coarse and xfeat only: the copy in the shared data folder (../shared/weights/loftr_coarse or
-//      ../shared/weights/xfeat/xfeat_folded.pt relative to the working directory, then the data folder vmap was
-//      built with).
+//   2. models shipped in the shared data folder (the Coarse-LoFTR student, XFeat folded, ALIKED T16/N16): that file
+//      relative to the working directory (../shared/...), then under the data folder vmap was built with.
 
 #include <string>
 #include <vector>
@@ -15,11 +14,13 @@ namespace vmap::neural {
 inline constexpr char kWeightsDirEnv[] = "VMAP_WEIGHTS_DIR";
 
 struct KnownWeights {
-  std::string preset;       // "outdoor", "indoor", "coarse" (LoFTR) or "xfeat"
+  std::string preset;       // "outdoor", "indoor", "coarse" (LoFTR), "xfeat", "aliked-t16", "aliked-n16"
   std::string file_name;    // name in the cache directory
-  std::string url;          // empty when there is nothing to download
+  std::string url;          // empty when `vmap weights --download` cannot fetch it
   std::string git_blob_id;  // of a published copy; empty when unknown
   std::string description;
+  std::string shared_file;  // path under the shared data folder; empty when it is not shipped there
+  std::string option = "--loftr-model";  // the command-line option that selects this preset
 };
 
 const std::vector<KnownWeights>& KnownWeightFiles();
