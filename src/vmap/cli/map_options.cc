@@ -13,6 +13,7 @@ MapBuilderOptions KeyImageFlags::Resolve() const {
   options.key_images.final_key = final_key;
   options.quality_mean = ParseQualityMean(quality);
   options.extraction_threads = threads;
+  options.exhaustive = exhaustive;
   options.key_images.Check();
   return options;
 }
@@ -30,6 +31,9 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau) 
   command->add_flag("!--no-final-key", flags.final_key, "Do not make the last frame a key image");
   command->add_option("--threads", flags.threads, "Feature-extraction threads (0 = one per core)")
       ->capture_default_str();
+  command->add_flag("--exhaustive", flags.exhaustive,
+                    "The paper's exact behaviour: verify every comparison with OpenCV's USAC_MAGSAC to its "
+                    "confidence criterion (default: stop once S >= tau is settled; same maps within seed noise)");
 }
 
 std::string DescribeOptions(const Matcher& matcher, const MapBuilderOptions& options,
@@ -42,6 +46,7 @@ std::string DescribeOptions(const Matcher& matcher, const MapBuilderOptions& opt
                      {"max_iterations", options.verifier.max_iterations},
                      {"seed", options.verifier.seed},
                      {"min_matches", options.verifier.min_matches}};
+  doc["exhaustive"] = options.exhaustive;
   doc["tau"] = options.key_images.tau;
   doc["similarity"] = SimilarityModeName(options.key_images.similarity);
   doc["final_key"] = options.key_images.final_key;

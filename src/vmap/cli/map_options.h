@@ -11,13 +11,14 @@
 
 namespace vmap::cli {
 
-// --tau, --similarity, --quality, --no-final-key, --threads.
+// --tau, --similarity, --quality, --no-final-key, --threads, --exhaustive.
 struct KeyImageFlags {
   double tau = 0.5;
   std::string similarity = "inlier-ratio";
   std::string quality = "arithmetic";
   bool final_key = true;
   int threads = 0;
+  bool exhaustive = false;
   MapBuilderOptions Resolve() const;
 };
 void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau = true);

@@ -1,6 +1,7 @@
 #include "vmap/mapping/key_image_selector.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -27,11 +28,25 @@ void KeyImageOptions::Check() const {
 
 PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features0,
                            const ImageFeatures& features1, const VerifierOptions& verifier,
-                           SimilarityMode similarity) {
+                           SimilarityMode similarity, const std::vector<double>& decide_taus) {
   PairComparison result;
   const TentativeMatches matches = matcher.Match(features0, features1);
   result.num_tentative = static_cast<int>(matches.size());
-  const FundamentalResult fundamental = EstimateFundamental(matches.points0, matches.points1, verifier);
+  const int denominator = similarity == SimilarityMode::kInlierRatio
+                              ? result.num_tentative
+                              : std::max(features0.num_features(), features1.num_features());
+  // S >= tau  <=>  verified >= the least count v with v / denominator >= tau (in the arithmetic Passes uses).
+  EarlyStop early_stop;
+  const bool stops_early = verifier.own_magsac && verifier.method == VerifierMethod::kMagsac && !decide_taus.empty();
+  if (stops_early) {
+    for (double tau : decide_taus) {
+      int count = static_cast<int>(std::ceil(tau * denominator));
+      while (count > 0 && static_cast<double>(count - 1) / denominator >= tau) --count;
+      while (static_cast<double>(count) / denominator < tau) ++count;
+      early_stop.min_inliers.push_back(std::max(count, verifier.min_matches));
+    }
+  }
+  const FundamentalResult fundamental = EstimateFundamental(matches.points0, matches.points1, verifier, early_stop);
   result.correspondences.reserve(matches.size());
   if (fundamental.success) {
     result.matched = true;
@@ -47,17 +62,29 @@ PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features
     }
   }
   if (result.matched) {
-    const int denominator = similarity == SimilarityMode::kInlierRatio
-                                ? result.num_tentative
-                                : std::max(features0.num_features(), features1.num_features());
     result.similarity = denominator > 0 ? static_cast<double>(result.num_verified) / denominator : 0.0;
+  }
+  if (stops_early) {
+    result.exhaustive = false;
+    for (double tau : decide_taus) {
+      if (!(result.matched && result.similarity >= tau)) result.lowest_failed_tau = std::min(result.lowest_failed_tau, tau);
+    }
   }
   return result;
 }
 
-KeyImageSelector::KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image)
-    : options_(options), compare_(std::move(compare)), on_key_image_(std::move(on_key_image)) {
+KeyImageSelector::KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image,
+                                   LinkFn link_comparison)
+    : options_(options),
+      compare_(std::move(compare)),
+      on_key_image_(std::move(on_key_image)),
+      link_comparison_(std::move(link_comparison)) {
   options_.Check();
+}
+
+PairComparison KeyImageSelector::LinkComparison(const FrameRecord& from, const FrameRecord& to,
+                                                PairComparison decided) const {
+  return link_comparison_ ? link_comparison_(from, to, std::move(decided)) : decided;
 }
 
 bool KeyImageSelector::Passes(const PairComparison& comparison) const {
@@ -119,14 +146,15 @@ void KeyImageSelector::Add(const FrameRecord& record) {
                                               record.frame->index, key_->frame->index, comparison.num_tentative);
     if (!previous_) {
       // The very next frame after the key image fails: it becomes a key image and the link is broken.
+      const PairComparison link = LinkComparison(*key_, record, std::move(comparison));
       AddKeyImage(record, why + "; link broken");
-      AddLink(comparison, /*broken=*/true);
+      AddLink(link, /*broken=*/true);
       return;
     }
     const FrameRecord promoted = *previous_;
-    PairComparison promoted_comparison = std::move(previous_comparison_);
+    const PairComparison link = LinkComparison(*key_, promoted, std::move(previous_comparison_));
     AddKeyImage(promoted, why);
-    AddLink(promoted_comparison, /*broken=*/false);
+    AddLink(link, /*broken=*/false);
   }
 }
 
@@ -135,9 +163,9 @@ void KeyImageSelector::Finish() {
   finished_ = true;
   if (options_.final_key && previous_) {
     const FrameRecord last = *previous_;
-    PairComparison comparison = std::move(previous_comparison_);
+    const PairComparison link = LinkComparison(*key_, last, std::move(previous_comparison_));
     AddKeyImage(last, "final frame");
-    AddLink(comparison, /*broken=*/false);
+    AddLink(link, /*broken=*/false);
   }
   key_.reset();
   previous_.reset();

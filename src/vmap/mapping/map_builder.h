@@ -21,14 +21,20 @@ struct MapBuilderOptions {
   bool show_progress = true;   // a progress line on a terminal
   int prefetch_frames = 6;     // frames read and extracted ahead of matching
   int extraction_threads = 0;  // threads extracting features; 0 = one per core
+  // The paper's exact behaviour: every comparison verified by OpenCV's USAC_MAGSAC to its confidence criterion.
+  // Off (the default), with the magsac verifier, a comparison stops as soon as S >= tau is settled for the taus
+  // it is judged under (vmap's MAGSAC++, geometry/magsac.h) and each link is verified in full: the same maps
+  // within the noise of a seed change, at a fraction of the cost (README, "Threshold sweeps" and "Speed").
+  bool exhaustive = false;
 
   int ExtractionThreads() const;
 
   void Check() const;  // throws InputError naming the bad option
 };
 
-// Builds one map. When `directory` is not empty, each key image is written there as keys/NNNNNN.png as
-// soon as it is chosen (the caller writes map.json with WriteMapFiles).
+// Builds one map. When `directory` is not empty, each key image is written there as soon as it is chosen,
+// as keys/NNNNNN.png, or as a copy of its image file (keys/NNNNNN.jpg, ...) when the frame is that file as
+// decoded (the caller writes map.json with WriteMapFiles).
 // `options_json` is recorded verbatim in the map.
 VisualMap BuildMap(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
                    const std::filesystem::path& directory = {}, const std::string& options_json = "{}");
@@ -56,6 +62,7 @@ struct SweepResult {
   double seconds = 0.0;
   long features_extracted = 0; // one per frame: no frame is extracted twice
   long pairs_matched = 0;      // pairs matched and verified, including a few made ahead and not needed
+  long links_verified = 0;     // of which links verified in full after an early-stopped decision
 };
 
 // Parses "0.1:0.9:0.1" (start:stop:step, inclusive) or "0.2,0.5,0.8".
