@@ -1,6 +1,7 @@
 #pragma once
 // Geometric verification of tentative matches with a fundamental matrix (OpenCV RANSAC / USAC).
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -34,12 +35,16 @@ struct FundamentalResult {
   cv::Matx33d F = cv::Matx33d::zeros();
   std::vector<unsigned char> inlier_mask;  // one per tentative match; empty when !success
   int num_inliers = 0;
+  bool abandoned = false;       // EarlyStop::abandon ended it: not a result, discard it
 };
 
 // What a caller will decide from the result: for each entry t, "at least t inliers?". Empty: estimate
 // exhaustively. Only vmap's own MAGSAC++ stops early (see magsac.h); OpenCV's estimators ignore it.
 struct EarlyStop {
   std::vector<int> min_inliers;
+  // Polled now and then; when it returns true the estimation stops with `abandoned` set (the answer is no
+  // longer needed, e.g. the key image was replaced meanwhile).
+  std::function<bool()> abandon;
 };
 
 FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0,

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <tuple>
 
 #include <Eigen/Dense>
 
@@ -32,6 +33,7 @@ constexpr int kPlaneAndParallaxIterations = 100;
 // SPRT: model estimation costs about this many point evaluations, and a sample gives this many models.
 constexpr double kSprtModelCost = 200.0;
 constexpr double kSprtModelsPerSample = 2.0;
+constexpr int kAbandonPollEvery = 32;
 
 // MAGSAC++ marginalises the residual over noise scales sigma in [0, sigma_max]; with 4 degrees of freedom its
 // loss and its IRLS weight are closed forms in the incomplete gamma functions Gamma(1.5, x) and gamma(2.5, x),
@@ -178,15 +180,23 @@ class Estimator {
     inv_max_squared_ = 1.0 / max_squared_;
     threshold_squared_ = options.threshold * options.threshold;
 
-    // The points are visited in a random order, so that SPRT sees a fair sample of them first.
+    // The points are visited in a random order, so that SPRT sees a fair sample of them first. The order is
+    // drawn from the points sorted by coordinates, so that the result does not depend on the order they come
+    // in: a link verified again from its stored correspondences (verified ones first) continues exactly the
+    // run that decided it.
     order_.resize(n_);
     for (int i = 0; i < n_; ++i) order_[i] = i;
+    std::sort(order_.begin(), order_.end(), [&](int a, int b) {
+      const cv::Point2f &a0 = points0[a], &b0 = points0[b], &a1 = points1[a], &b1 = points1[b];
+      return std::tie(a0.x, a0.y, a1.x, a1.y) < std::tie(b0.x, b0.y, b1.x, b1.y);
+    });
     for (int i = n_ - 1; i > 0; --i) std::swap(order_[i], order_[Uniform(i + 1)]);
     points_.resize(n_);
     for (int i = 0; i < n_; ++i) {
       const int k = order_[i];
       points_[i] = {points0[k].x, points0[k].y, points1[k].x, points1[k].y};
     }
+    abandon_ = early_stop.abandon;
     for (int target : early_stop.min_inliers) {
       targets_.push_back({target, SamplesToSettle(static_cast<double>(target) / n_, options.confidence,
                                                   options.max_iterations)});
@@ -228,6 +238,7 @@ class Estimator {
   std::vector<Point> normalized_;  // Hartley-normalised copies for the solvers
   Mat3 T0_, T1_;                   // normalised = T * pixel, per image
   std::vector<Target> targets_;
+  std::function<bool()> abandon_;
 
   Model best_{};
   Score best_score_;
@@ -679,6 +690,12 @@ FundamentalResult Estimator::Run(MagsacStatistics* statistics) {
     if (Settled(iterations)) {
       stopped_early = true;
       break;
+    }
+    if (abandon_ && iterations % kAbandonPollEvery == 0 && abandon_()) {
+      stats_.iterations = iterations;
+      if (statistics) *statistics = stats_;
+      result.abandoned = true;
+      return result;
     }
     for (int k = 0; k < kSampleSize; ++k) {
       int index;

@@ -173,6 +173,25 @@ TEST(Magsac, SameSeedSameResultOtherSeedSameGeometry) {
   EXPECT_LT(MeanTrueError(scene, c.F, 0, 120), 0.3);
 }
 
+// The result does not depend on the order of the correspondences: a link verified again from its stored
+// matches (verified first) continues the very run that decided it.
+TEST(Magsac, OrderOfTheCorrespondencesDoesNotMatter) {
+  const Scene scene = MakeScene(100, 100, 0.3, 13);
+  std::vector<int> order(scene.p0.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(order.size() - 1 - i);
+  std::swap(order[3], order[150]);
+  std::vector<cv::Point2f> p0, p1;
+  for (int i : order) {
+    p0.push_back(scene.p0[i]);
+    p1.push_back(scene.p1[i]);
+  }
+  const FundamentalResult a = EstimateFundamentalMagsac(scene.p0, scene.p1, {});
+  const FundamentalResult b = EstimateFundamentalMagsac(p0, p1, {});
+  ASSERT_TRUE(a.success && b.success);
+  EXPECT_EQ(cv::norm(cv::Mat(a.F), cv::Mat(b.F), cv::NORM_INF), 0.0);
+  for (size_t i = 0; i < order.size(); ++i) EXPECT_EQ(b.inlier_mask[i], a.inlier_mask[order[i]]);
+}
+
 TEST(Magsac, SamplesToSettle) {
   EXPECT_EQ(SamplesToSettle(0.5, 0.999, 100000), 881);     // ln(0.001) / ln(1 - 0.5^7) = 880.7
   EXPECT_EQ(SamplesToSettle(0.3, 0.999, 100000), 31583);   // 31582.1
@@ -184,6 +203,12 @@ TEST(Magsac, SamplesToSettle) {
 
 int AtLeast(double tau, int n) { return static_cast<int>(std::ceil(tau * n)); }
 
+EarlyStop Targets(std::vector<int> min_inliers) {
+  EarlyStop early_stop;
+  early_stop.min_inliers = std::move(min_inliers);
+  return early_stop;
+}
+
 // A pair far above tau: the first good model settles it, long before the confidence criterion would.
 TEST(MagsacEarlyStop, StopsOnceEveryTargetIsReached) {
   const Scene scene = MakeScene(240, 60, 0.2, 10);  // 80 % inliers, ~75 % within 0.5 px
@@ -191,7 +216,7 @@ TEST(MagsacEarlyStop, StopsOnceEveryTargetIsReached) {
   MagsacStatistics exhaustive, early;
   EstimateFundamentalMagsac(scene.p0, scene.p1, {}, {}, &exhaustive);
   const FundamentalResult result =
-      EstimateFundamentalMagsac(scene.p0, scene.p1, {}, EarlyStop{{AtLeast(0.5, n)}}, &early);
+      EstimateFundamentalMagsac(scene.p0, scene.p1, {}, Targets({AtLeast(0.5, n)}), &early);
   ASSERT_TRUE(result.success);
   EXPECT_GE(result.num_inliers, AtLeast(0.5, n));
   EXPECT_TRUE(early.stopped_early);
@@ -204,7 +229,7 @@ TEST(MagsacEarlyStop, FailsAfterTheSamplesTheTargetNeeds) {
   const int n = static_cast<int>(scene.p0.size());
   MagsacStatistics stats;
   const int target = AtLeast(0.75, n);
-  const FundamentalResult result = EstimateFundamentalMagsac(scene.p0, scene.p1, {}, EarlyStop{{target}}, &stats);
+  const FundamentalResult result = EstimateFundamentalMagsac(scene.p0, scene.p1, {}, Targets({target}), &stats);
   EXPECT_LT(result.num_inliers, target);
   EXPECT_TRUE(stats.stopped_early);
   EXPECT_EQ(stats.iterations, SamplesToSettle(static_cast<double>(target) / n, 0.999, 100000));
@@ -213,7 +238,7 @@ TEST(MagsacEarlyStop, FailsAfterTheSamplesTheTargetNeeds) {
   // when to stop; the answer for the lower one is "yes".
   MagsacStatistics two_stats;
   const FundamentalResult two = EstimateFundamentalMagsac(
-      scene.p0, scene.p1, {}, EarlyStop{{AtLeast(0.3, n), target}}, &two_stats);
+      scene.p0, scene.p1, {}, Targets({AtLeast(0.3, n), target}), &two_stats);
   ASSERT_TRUE(two.success);
   EXPECT_GE(two.num_inliers, AtLeast(0.3, n));
   EXPECT_EQ(two_stats.iterations, stats.iterations);
@@ -223,7 +248,7 @@ TEST(MagsacEarlyStop, FailsAfterTheSamplesTheTargetNeeds) {
 TEST(MagsacEarlyStop, ImpossibleTargetsNeedNoSample) {
   const Scene scene = MakeScene(100, 0, 0.0, 12);
   MagsacStatistics stats;
-  const FundamentalResult result = EstimateFundamentalMagsac(scene.p0, scene.p1, {}, EarlyStop{{101}}, &stats);
+  const FundamentalResult result = EstimateFundamentalMagsac(scene.p0, scene.p1, {}, Targets({101}), &stats);
   EXPECT_FALSE(result.success);
   EXPECT_EQ(stats.iterations, 0);
 }

@@ -28,13 +28,19 @@ void KeyImageOptions::Check() const {
 
 PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features0,
                            const ImageFeatures& features1, const VerifierOptions& verifier,
-                           SimilarityMode similarity, const std::vector<double>& decide_taus) {
-  PairComparison result;
+                           SimilarityMode similarity, const std::vector<double>& decide_taus,
+                           const std::function<bool()>& abandon) {
   const TentativeMatches matches = matcher.Match(features0, features1);
-  result.num_tentative = static_cast<int>(matches.size());
   const int denominator = similarity == SimilarityMode::kInlierRatio
-                              ? result.num_tentative
+                              ? static_cast<int>(matches.size())
                               : std::max(features0.num_features(), features1.num_features());
+  return VerifyMatches(matches, denominator, verifier, decide_taus, abandon);
+}
+
+PairComparison VerifyMatches(const TentativeMatches& matches, int denominator, const VerifierOptions& verifier,
+                             const std::vector<double>& decide_taus, const std::function<bool()>& abandon) {
+  PairComparison result;
+  result.num_tentative = static_cast<int>(matches.size());
   // S >= tau  <=>  verified >= the least count v with v / denominator >= tau (in the arithmetic Passes uses).
   EarlyStop early_stop;
   const bool stops_early = verifier.own_magsac && verifier.method == VerifierMethod::kMagsac && !decide_taus.empty();
@@ -46,7 +52,12 @@ PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features
       early_stop.min_inliers.push_back(std::max(count, verifier.min_matches));
     }
   }
+  early_stop.abandon = abandon;
   const FundamentalResult fundamental = EstimateFundamental(matches.points0, matches.points1, verifier, early_stop);
+  if (fundamental.abandoned) {
+    result.abandoned = true;
+    return result;
+  }
   result.correspondences.reserve(matches.size());
   if (fundamental.success) {
     result.matched = true;
@@ -73,18 +84,23 @@ PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features
   return result;
 }
 
-KeyImageSelector::KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image,
-                                   LinkFn link_comparison)
-    : options_(options),
-      compare_(std::move(compare)),
-      on_key_image_(std::move(on_key_image)),
-      link_comparison_(std::move(link_comparison)) {
-  options_.Check();
+Link MakeLink(const PairComparison& comparison, int from_key, int to_key, bool broken) {
+  Link link;
+  link.from_key = from_key;
+  link.to_key = to_key;
+  link.broken = broken;
+  link.similarity = comparison.similarity;
+  link.num_tentative = comparison.num_tentative;
+  link.num_verified = comparison.num_verified;
+  link.has_fundamental = comparison.matched;
+  link.F = comparison.F;
+  link.correspondences = comparison.correspondences;
+  return link;
 }
 
-PairComparison KeyImageSelector::LinkComparison(const FrameRecord& from, const FrameRecord& to,
-                                                PairComparison decided) const {
-  return link_comparison_ ? link_comparison_(from, to, std::move(decided)) : decided;
+KeyImageSelector::KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image)
+    : options_(options), compare_(std::move(compare)), on_key_image_(std::move(on_key_image)) {
+  options_.Check();
 }
 
 bool KeyImageSelector::Passes(const PairComparison& comparison) const {
@@ -108,17 +124,8 @@ void KeyImageSelector::AddKeyImage(const FrameRecord& record, const std::string&
 }
 
 void KeyImageSelector::AddLink(const PairComparison& comparison, bool broken) {
-  Link link;
-  link.from_key = static_cast<int>(key_images_.size()) - 2;
-  link.to_key = static_cast<int>(key_images_.size()) - 1;
-  link.broken = broken;
-  link.similarity = comparison.similarity;
-  link.num_tentative = comparison.num_tentative;
-  link.num_verified = comparison.num_verified;
-  link.has_fundamental = comparison.matched;
-  link.F = comparison.F;
-  link.correspondences = comparison.correspondences;
-  links_.push_back(std::move(link));
+  const int to_key = static_cast<int>(key_images_.size()) - 1;
+  links_.push_back(MakeLink(comparison, to_key - 1, to_key, broken));
 }
 
 void KeyImageSelector::Add(const FrameRecord& record) {
@@ -146,15 +153,14 @@ void KeyImageSelector::Add(const FrameRecord& record) {
                                               record.frame->index, key_->frame->index, comparison.num_tentative);
     if (!previous_) {
       // The very next frame after the key image fails: it becomes a key image and the link is broken.
-      const PairComparison link = LinkComparison(*key_, record, std::move(comparison));
       AddKeyImage(record, why + "; link broken");
-      AddLink(link, /*broken=*/true);
+      AddLink(comparison, /*broken=*/true);
       return;
     }
     const FrameRecord promoted = *previous_;
-    const PairComparison link = LinkComparison(*key_, promoted, std::move(previous_comparison_));
+    PairComparison promoted_comparison = std::move(previous_comparison_);
     AddKeyImage(promoted, why);
-    AddLink(link, /*broken=*/false);
+    AddLink(promoted_comparison, /*broken=*/false);
   }
 }
 
@@ -163,9 +169,9 @@ void KeyImageSelector::Finish() {
   finished_ = true;
   if (options_.final_key && previous_) {
     const FrameRecord last = *previous_;
-    const PairComparison link = LinkComparison(*key_, last, std::move(previous_comparison_));
+    PairComparison comparison = std::move(previous_comparison_);
     AddKeyImage(last, "final frame");
-    AddLink(link, /*broken=*/false);
+    AddLink(comparison, /*broken=*/false);
   }
   key_.reset();
   previous_.reset();

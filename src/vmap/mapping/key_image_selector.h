@@ -47,6 +47,7 @@ struct PairComparison {
   // `decide_taus`): S is then the best found by that point, and only Decides(tau) says whether it answers tau.
   bool exhaustive = true;
   double lowest_failed_tau = 2.0;  // when not exhaustive: the lowest tau asked that S did not reach
+  bool abandoned = false;          // `abandon` stopped the verification: this answers nothing
   bool Decides(double tau) const {
     return exhaustive || (matched && similarity >= tau) || tau >= lowest_failed_tau;
   }
@@ -54,23 +55,28 @@ struct PairComparison {
 
 // Matches two images and verifies the matches: the S(I_i, I_j) of the paper. With `decide_taus` and a verifier
 // that can stop early (VerifierOptions::own_magsac), verification stops once "S >= tau?" is settled for each of
-// them; without, it runs to the verifier's confidence criterion.
+// them; without, it runs to the verifier's confidence criterion. `abandon` (same verifier only) is polled during
+// verification and stops it when the answer is no longer needed.
 PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features0,
                            const ImageFeatures& features1, const VerifierOptions& verifier,
-                           SimilarityMode similarity, const std::vector<double>& decide_taus = {});
+                           SimilarityMode similarity, const std::vector<double>& decide_taus = {},
+                           const std::function<bool()>& abandon = nullptr);
+
+// The verification half of ComparePair, on matches already made: S = verified / `denominator` (|D|).
+PairComparison VerifyMatches(const TentativeMatches& matches, int denominator, const VerifierOptions& verifier,
+                             const std::vector<double>& decide_taus = {},
+                             const std::function<bool()>& abandon = nullptr);
+
+// The link between key images from_key and to_key that `comparison` verified.
+Link MakeLink(const PairComparison& comparison, int from_key, int to_key, bool broken);
 
 class KeyImageSelector {
  public:
   using CompareFn = std::function<PairComparison(const FrameRecord& key, const FrameRecord& frame)>;
   // Called once for every new key image, e.g. to write its image file (may set image_file).
   using KeyImageFn = std::function<void(const FrameRecord& record, KeyImage& key)>;
-  // Returns the comparison a new link keeps, given the one that decided it: lets a caller whose comparisons
-  // stop at the decision verify the few links exhaustively. Null keeps the deciding comparison.
-  using LinkFn =
-      std::function<PairComparison(const FrameRecord& from, const FrameRecord& to, PairComparison decided)>;
 
-  KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image = nullptr,
-                   LinkFn link_comparison = nullptr);
+  KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image = nullptr);
 
   // Frames must arrive in order. The first frame becomes the first key image.
   void Add(const FrameRecord& record);
@@ -88,12 +94,10 @@ class KeyImageSelector {
   bool Passes(const PairComparison& comparison) const;
   void AddKeyImage(const FrameRecord& record, const std::string& reason);
   void AddLink(const PairComparison& comparison, bool broken);
-  PairComparison LinkComparison(const FrameRecord& from, const FrameRecord& to, PairComparison decided) const;
 
   KeyImageOptions options_;
   CompareFn compare_;
   KeyImageFn on_key_image_;
-  LinkFn link_comparison_;
   std::optional<FrameRecord> key_;
   std::optional<FrameRecord> previous_;         // the last frame that passed against the key image
   PairComparison previous_comparison_;          // key vs previous_

@@ -37,9 +37,9 @@ int MapBuilderOptions::ExtractionThreads() const {
 
 namespace {
 
-// Compares a key image with a frame for the selectors whose thresholds are `taus`.
-using CompareFn =
-    std::function<PairComparison(const FrameRecord& key, const FrameRecord& frame, const std::vector<double>& taus)>;
+// Compares a key image with a frame for the selectors whose thresholds are `taus`; `abandon` may stop it.
+using CompareFn = std::function<PairComparison(const FrameRecord& key, const FrameRecord& frame,
+                                               const std::vector<double>& taus, const std::function<bool()>& abandon)>;
 
 // A key image the workers compare frames with, and the thresholds (ascending) of the selectors that hold it.
 struct CurrentKey {
@@ -180,9 +180,14 @@ class FeaturePipeline {
             if (!key) break;
             const int key_index = key->frame->index;
             if (key_index == frame_index || item.comparisons.count(key_index)) break;
-            const PairComparison& comparison =
-                item.comparisons.emplace(key_index, compare_(*key, item.record, current.taus)).first->second;
+            // Abandoned when another worker retires the key at an earlier frame meanwhile: this frame then
+            // goes on to the key's successor.
+            PairComparison comparison = compare_(*key, item.record, current.taus, [this, key_index, frame_index] {
+              return RetiredBefore(key_index, frame_index);
+            });
+            if (comparison.abandoned) continue;
             if (!comparison.matched || comparison.similarity < current.taus.front()) Retire(key_index, frame_index);
+            item.comparisons.emplace(key_index, std::move(comparison));
           }
         }
       }
@@ -207,6 +212,14 @@ class FeaturePipeline {
     auto record = recent_.find(index);
     if (record == recent_.end()) return std::nullopt;
     return record->second;
+  }
+
+  // Whether a frame before `frame_index` failed against the key image `key_index`: no selector will compare
+  // `frame_index` with it.
+  bool RetiredBefore(int key_index, int frame_index) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = retired_.find(key_index);
+    return it != retired_.end() && it->second.at_frame < frame_index;
   }
 
   // Frame `frame_index` failed against the key image `key_index`.
@@ -326,6 +339,105 @@ class KeyImageFileWriter {
   std::thread thread_;        // last: starts after every other member exists
 };
 
+// Verifies links in full, on a thread of its own while the build goes on, when the decisions stopped early:
+// the tables are then computed from exact link values. The estimator runs again on the link's own tentative
+// matches (no matching, no features kept). A link shared by several taus (same two frames) is verified once.
+class LinkVerifier {
+ public:
+  explicit LinkVerifier(const VerifierOptions& verifier) : verifier_(verifier), thread_([this] { Run(); }) {}
+  ~LinkVerifier() { Join(); }
+
+  // Queues `link`, between key images `from` and `to`, unless that pair of frames is queued already.
+  void Add(const KeyImage& from, const KeyImage& to, const Link& link, SimilarityMode similarity) {
+    const auto pair = std::make_pair(from.frame_index, to.frame_index);
+    Job job;
+    for (const Correspondence& c : link.correspondences) {
+      job.matches.points0.push_back(c.p0);
+      job.matches.points1.push_back(c.p1);
+    }
+    job.denominator = similarity == SimilarityMode::kInlierRatio ? link.num_tentative
+                                                                 : std::max(from.num_features, to.num_features);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!results_.emplace(pair, PairComparison{}).second) return;
+    job.pair = pair;
+    queue_.push_back(std::move(job));
+    changed_.notify_all();
+  }
+
+  // Waits for every verification; rethrows a failure. Returns how many links were verified.
+  long Finish() {
+    Join();
+    if (error_) std::rethrow_exception(error_);
+    return static_cast<long>(results_.size());
+  }
+
+  // Replaces the links of `map`, built with threshold `tau`, by their verifications (after Finish). A verification
+  // that contradicts the decision (a link at S >= tau found below tau, or the reverse for a broken link: the
+  // two estimates differ by the noise of a seed change) leaves the deciding comparison in place, so that every
+  // link keeps the meaning Algorithm 1 gives it.
+  // Returns how many links kept their deciding comparison.
+  int Apply(VisualMap* map, double tau) const {
+    int kept = 0;
+    for (Link& link : map->links) {
+      const auto pair = std::make_pair(map->key_images[link.from_key].frame_index,
+                                       map->key_images[link.to_key].frame_index);
+      const PairComparison& verified = results_.at(pair);
+      if ((verified.matched && verified.similarity >= tau) == !link.broken) {
+        link = MakeLink(verified, link.from_key, link.to_key, link.broken);
+      } else {
+        ++kept;
+      }
+    }
+    return kept;
+  }
+
+ private:
+  struct Job {
+    std::pair<int, int> pair;
+    TentativeMatches matches;
+    int denominator = 0;
+  };
+
+  void Join() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      finished_ = true;
+    }
+    changed_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+
+  void Run() {
+    for (;;) {
+      Job job;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        changed_.wait(lock, [this] { return finished_ || !queue_.empty(); });
+        if (queue_.empty()) return;
+        job = std::move(queue_.front());
+        queue_.pop_front();
+      }
+      if (error_) continue;
+      try {
+        PairComparison verified = VerifyMatches(job.matches, job.denominator, verifier_);
+        std::lock_guard<std::mutex> lock(mutex_);
+        results_[job.pair] = std::move(verified);
+      } catch (...) {
+        error_ = std::current_exception();
+      }
+    }
+  }
+
+  const VerifierOptions verifier_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<Job> queue_;
+  std::map<std::pair<int, int>, PairComparison> results_;  // by (from, to) frame index
+  bool finished_ = false;
+  std::exception_ptr error_;  // written by the thread, read after join
+  std::thread thread_;        // last: starts after every other member exists
+};
+
 VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source, const MapBuilderOptions& options,
                      const std::string& options_json, double seconds) {
   VisualMap map;
@@ -401,12 +513,15 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
 
   const VerifierOptions verifier = DecisionVerifier(options);
   const bool stops_early = verifier.own_magsac;
-  std::atomic<long> pairs_matched{0}, links_verified{0};
+  std::atomic<long> pairs_matched{0}, pairs_abandoned{0};
   const CompareFn compare_pair = [&](const FrameRecord& key, const FrameRecord& frame,
-                                     const std::vector<double>& decide_taus) {
+                                     const std::vector<double>& decide_taus, const std::function<bool()>& abandon) {
     ++pairs_matched;
-    return ComparePair(matcher, *key.features, *frame.features, verifier, options.key_images.similarity,
-                       stops_early ? decide_taus : std::vector<double>{});
+    PairComparison comparison = ComparePair(matcher, *key.features, *frame.features, verifier,
+                                            options.key_images.similarity,
+                                            stops_early ? decide_taus : std::vector<double>{}, abandon);
+    if (comparison.abandoned) ++pairs_abandoned;
+    return comparison;
   };
   // The comparisons of the current frame, by key frame: made ahead by the pipeline, or here when a key image
   // changed meanwhile or a comparison that stopped early does not answer a selector's tau. A pair compared
@@ -423,34 +538,32 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
       const auto held = holders.find(key_index);
       std::vector<double> asked = it == comparisons_of_frame->end() && held != holders.end() ? held->second : taus;
       if (std::find(asked.begin(), asked.end(), tau) == asked.end()) asked.push_back(tau);
-      return (*comparisons_of_frame)[key_index] = compare_pair(key, frame, asked);
+      return (*comparisons_of_frame)[key_index] = compare_pair(key, frame, asked, nullptr);
     };
   };
-  // Links keep a full estimation when the decisions stopped early: the tables are computed from exact link
-  // values. A link shared by several taus (same key, same frame) is verified once.
-  std::map<std::pair<int, int>, PairComparison> links_of_frame;
-  KeyImageSelector::LinkFn verify_link;
-  if (stops_early) {
-    verify_link = [&](const FrameRecord& from, const FrameRecord& to, PairComparison decided) -> PairComparison {
-      if (decided.exhaustive) return decided;
-      const auto pair = std::make_pair(from.frame->index, to.frame->index);
-      auto it = links_of_frame.find(pair);
-      if (it == links_of_frame.end()) {
-        ++links_verified;
-        it = links_of_frame.emplace(pair, compare_pair(from, to, {})).first;
-      }
-      return it->second;
-    };
-  }
-
   KeyImageFileWriter image_writer;
   std::vector<std::unique_ptr<KeyImageSelector>> selectors;
   for (size_t i = 0; i < taus.size(); ++i) {
     KeyImageOptions key_options = options.key_images;
     key_options.tau = taus[i];
-    selectors.push_back(std::make_unique<KeyImageSelector>(
-        key_options, compare_for(taus[i]), image_writer.CallbackFor(directories[i]), verify_link));
+    selectors.push_back(
+        std::make_unique<KeyImageSelector>(key_options, compare_for(taus[i]), image_writer.CallbackFor(directories[i])));
   }
+  // Links keep a full estimation when the decisions stopped early; queued as soon as each link is made.
+  std::unique_ptr<LinkVerifier> link_verifier;
+  if (stops_early) link_verifier = std::make_unique<LinkVerifier>(VerifierOptions(verifier));
+  std::vector<size_t> links_queued(selectors.size(), 0);
+  auto queue_new_links = [&] {
+    if (!link_verifier) return;
+    for (size_t i = 0; i < selectors.size(); ++i) {
+      const KeyImageSelector& selector = *selectors[i];
+      for (; links_queued[i] < selector.links().size(); ++links_queued[i]) {
+        const Link& link = selector.links()[links_queued[i]];
+        link_verifier->Add(selector.key_images()[link.from_key], selector.key_images()[link.to_key], link,
+                           options.key_images.similarity);
+      }
+    }
+  };
 
   {
     FeaturePipeline pipeline(source, matcher, options.prefetch_frames, options.ExtractionThreads(), compare_pair);
@@ -461,8 +574,8 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
     long done = 0;
     while (std::optional<PipelineItem> item = pipeline.Next()) {
       comparisons_of_frame = &item->comparisons;
-      links_of_frame.clear();
       for (auto& selector : selectors) selector->Add(item->record);
+      queue_new_links();
       // Tell the workers which key images the coming frames will be compared with (a handful of
       // shared pointers: cheaper to publish every frame than to track changes).
       std::map<int, CurrentKey> keys;  // by key frame index
@@ -484,17 +597,29 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
     progress.Finish();
     result.features_extracted = pipeline.extracted();
   }
-  links_of_frame.clear();
   for (auto& selector : selectors) selector->Finish();  // the final key images
+  queue_new_links();
   image_writer.Finish();
   result.pairs_matched = pairs_matched;
-  result.links_verified = links_verified;
+  long evaluations = 0;
+  for (const auto& selector : selectors) evaluations += static_cast<long>(selector->evaluations().size());
+  if (link_verifier) result.links_verified = link_verifier->Finish();
+  spdlog::debug("{} pairs matched and verified for {} evaluations, {} abandoned; {} links verified in full",
+                result.pairs_matched, evaluations, pairs_abandoned.load(), result.links_verified);
 
   const double seconds = SecondsSince(start);
   result.input = source.info();
   result.seconds = seconds;
   for (size_t i = 0; i < selectors.size(); ++i) {
     VisualMap map = CollectMap(*selectors[i], source, options, options_json, seconds);
+    if (link_verifier) {
+      const int kept = link_verifier->Apply(&map, taus[i]);
+      if (kept > 0) {
+        spdlog::debug("tau {:.2f}: {} of {} links kept the deciding estimate (the full one crossed tau)", taus[i],
+                      kept, map.links.size());
+      }
+      map.quality = ComputeStatistics(map, options.quality_mean).quality;
+    }
     const MapStatistics stats = ComputeStatistics(map, options.quality_mean);
     result.num_frames = map.num_frames;
     SweepRow row;

@@ -62,7 +62,7 @@ struct SweepResult {
   double seconds = 0.0;
   long features_extracted = 0; // one per frame: no frame is extracted twice
   long pairs_matched = 0;      // pairs matched and verified, including a few made ahead and not needed
-  long links_verified = 0;     // of which links verified in full after an early-stopped decision
+  long links_verified = 0;     // links verified in full after an early-stopped decision (not matched again)
 };
 
 // Parses "0.1:0.9:0.1" (start:stop:step, inclusive) or "0.2,0.5,0.8".
