@@ -14,6 +14,8 @@ MapBuilderOptions KeyImageFlags::Resolve() const {
   options.quality_mean = ParseQualityMean(quality);
   options.extraction_threads = threads;
   options.exhaustive = exhaustive;
+  options.key_search = ParseKeySearch(search);
+  options.search_window = search_window;
   options.key_images.Check();
   return options;
 }
@@ -34,6 +36,13 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau) 
   command->add_flag("--exhaustive", flags.exhaustive,
                     "The paper's exact behaviour: verify every comparison with OpenCV's USAC_MAGSAC to its "
                     "confidence criterion (default: stop once S >= tau is settled; same maps within seed noise)");
+  command->add_option("--search", flags.search,
+                      "Key-image search: sequential (compare every frame), bisect (compare frames further ahead, "
+                      "then bisect; for deep matchers) or auto (bisect for deep matchers, sequential for ORB "
+                      "and with --exhaustive)")
+      ->capture_default_str();
+  command->add_option("--search-window", flags.search_window, "bisect: frames compared ahead at most (held in memory)")
+      ->capture_default_str();
 }
 
 std::string DescribeOptions(const Matcher& matcher, const MapBuilderOptions& options,
@@ -47,6 +56,8 @@ std::string DescribeOptions(const Matcher& matcher, const MapBuilderOptions& opt
                      {"seed", options.verifier.seed},
                      {"min_matches", options.verifier.min_matches}};
   doc["exhaustive"] = options.exhaustive;
+  doc["search"] = KeySearchName(ResolveKeySearch(options, matcher));
+  doc["search_window"] = options.search_window;
   doc["tau"] = options.key_images.tau;
   doc["similarity"] = SimilarityModeName(options.key_images.similarity);
   doc["final_key"] = options.key_images.final_key;

@@ -11,7 +11,7 @@
 
 namespace vmap::cli {
 
-// --tau, --similarity, --quality, --no-final-key, --threads, --exhaustive.
+// --tau, --similarity, --quality, --no-final-key, --threads, --exhaustive, --search, --search-window.
 struct KeyImageFlags {
   double tau = 0.5;
   std::string similarity = "inlier-ratio";
@@ -19,6 +19,8 @@ struct KeyImageFlags {
   bool final_key = true;
   int threads = 0;
   bool exhaustive = false;
+  std::string search = "auto";
+  int search_window = 32;
   MapBuilderOptions Resolve() const;
 };
 void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau = true);

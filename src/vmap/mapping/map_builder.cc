@@ -8,6 +8,7 @@
 #include <deque>
 #include <exception>
 #include <functional>
+#include <future>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -23,11 +24,33 @@
 namespace vmap {
 namespace fs = std::filesystem;
 
+KeySearch ParseKeySearch(const std::string& name) {
+  if (name == "auto") return KeySearch::kAuto;
+  if (name == "sequential") return KeySearch::kSequential;
+  if (name == "bisect") return KeySearch::kBisect;
+  throw InputError("unknown key-image search '" + name + "'; use auto, sequential or bisect");
+}
+
+std::string KeySearchName(KeySearch search) {
+  switch (search) {
+    case KeySearch::kAuto: return "auto";
+    case KeySearch::kSequential: return "sequential";
+    case KeySearch::kBisect: return "bisect";
+  }
+  return "auto";
+}
+
+KeySearch ResolveKeySearch(const MapBuilderOptions& options, const Matcher& matcher) {
+  if (options.key_search != KeySearch::kAuto) return options.key_search;
+  return options.exhaustive || matcher.name() == "orb" ? KeySearch::kSequential : KeySearch::kBisect;
+}
+
 void MapBuilderOptions::Check() const {
   key_images.Check();
   verifier.Check();
   if (prefetch_frames < 1) throw InputError("prefetch_frames must be >= 1");
   if (extraction_threads < 0) throw InputError("--threads must be >= 0 (0 = one per core)");
+  if (search_window < 2) throw InputError("--search-window must be >= 2 frames (default 32)");
 }
 
 int MapBuilderOptions::ExtractionThreads() const {
@@ -642,10 +665,169 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
   return result;
 }
 
+// Algorithm 1 with a search for the first frame below tau instead of a frame-by-frame scan. From the key image
+// and the last frame known to pass against it, frames ever further ahead are compared (offsets doubling, at
+// most search_window ahead), then the first failing frame is found by bisection. The last passing frame and the
+// first failing one are then given to a KeyImageSelector, which, from the cached comparisons, makes the key
+// images, links and broken links Algorithm 1 makes on the whole sequence wherever S decreases with the
+// distance to the key image. Each round compares one frame per thread at once; a frame's features are extracted
+// only when it is compared, and only the frames the search may still compare are held.
+VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
+                          const fs::path& directory, const std::string& options_json) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  const VerifierOptions verifier = DecisionVerifier(options);
+  const std::vector<double> taus = verifier.own_magsac ? std::vector<double>{options.key_images.tau}
+                                                       : std::vector<double>{};
+  const int workers = options.ExtractionThreads();
+  const int window = options.search_window;
+
+  std::map<int, FrameRecord> frames;  // frames read that the search may still need, by index
+  int frames_read = 0;
+  bool source_done = false;
+  ProgressOptions progress_options;
+  progress_options.enabled = options.show_progress;
+  ProgressLine progress("build", source.info().expected_frames, "frames", progress_options);
+  // Reads frames up to `index`; returns the index of the last frame read (-1 when there is none).
+  auto read_until = [&](int index) {
+    while (frames_read <= index && !source_done) {
+      std::optional<Frame> frame = source.Next();
+      if (!frame) {
+        source_done = true;
+        break;
+      }
+      FrameRecord record;
+      record.frame = std::make_shared<const Frame>(std::move(*frame));
+      frames.emplace(frames_read++, std::move(record));
+      progress.Update(frames_read);
+    }
+    return std::min(index, frames_read - 1);
+  };
+
+  std::map<std::pair<int, int>, PairComparison> comparisons;  // by (key, frame) index
+  std::vector<Evaluation> evaluations;                        // every comparison, in the order made
+  auto remember = [&](int key_index, int frame_index, PairComparison comparison) -> const PairComparison& {
+    evaluations.push_back({key_index, frame_index, comparison.similarity, comparison.num_tentative,
+                           comparison.num_verified, comparison.matched});
+    return comparisons[{key_index, frame_index}] = std::move(comparison);
+  };
+  auto compare = [&](const FrameRecord& key, const FrameRecord& frame) {
+    return ComparePair(matcher, *key.features, *frame.features, verifier, options.key_images.similarity, taus);
+  };
+  auto with_features = [&](int index) -> const FrameRecord& {
+    FrameRecord& record = frames.at(index);
+    if (!record.features) record.features = matcher.Extract(record.frame->gray);
+    return record;
+  };
+  // Compares the frames at `positions` with the key, one thread each; returns the first that fails (or -1)
+  // and moves *last_pass to the last one passing before it.
+  auto probe = [&](const FrameRecord& key, const std::vector<int>& positions, int* last_pass) {
+    std::vector<std::future<std::pair<std::shared_ptr<const ImageFeatures>, PairComparison>>> results;
+    for (int position : positions) {
+      if (comparisons.count({key.frame->index, position})) {
+        results.emplace_back();
+        continue;
+      }
+      FrameRecord frame = frames.at(position);
+      results.push_back(std::async(std::launch::async, [&matcher, &compare, key, frame]() mutable {
+        if (!frame.features) frame.features = matcher.Extract(frame.frame->gray);
+        return std::make_pair(frame.features, compare(key, frame));
+      }));
+    }
+    for (size_t i = 0; i < positions.size(); ++i) {
+      if (!results[i].valid()) continue;
+      auto [features, comparison] = results[i].get();
+      frames.at(positions[i]).features = std::move(features);
+      remember(key.frame->index, positions[i], std::move(comparison));
+    }
+    for (int position : positions) {
+      const PairComparison& c = comparisons.at({key.frame->index, position});
+      if (!(c.matched && c.similarity >= options.key_images.tau)) return position;
+      *last_pass = position;
+    }
+    return -1;
+  };
+
+  KeyImageFileWriter image_writer;
+  KeyImageSelector selector(
+      options.key_images,
+      [&](const FrameRecord& key, const FrameRecord& frame) {
+        const auto it = comparisons.find({key.frame->index, frame.frame->index});
+        if (it != comparisons.end()) return it->second;
+        return remember(key.frame->index, frame.frame->index, compare(key, frame));
+      },
+      image_writer.CallbackFor(directory));
+  std::unique_ptr<LinkVerifier> link_verifier;
+  if (verifier.own_magsac) link_verifier = std::make_unique<LinkVerifier>(VerifierOptions(verifier));
+
+  if (read_until(0) == 0) {
+    selector.Add(with_features(0));
+    int last_pass = 0, fed = 0, step = 1;
+    for (;;) {
+      const FrameRecord key = *selector.current_key();
+      frames.erase(frames.begin(), frames.lower_bound(last_pass));  // the selector holds the key itself
+      // Gallop: offsets step .. 2^(workers - 1) step, at most `window` ahead.
+      int first_fail = -1;
+      while (first_fail < 0 && read_until(last_pass + 1) > last_pass) {
+        const int reach = std::min(window, step << std::min(workers - 1, 20));
+        std::vector<int> positions;
+        for (int i = 1; i <= workers; ++i) {
+          const int position = read_until(last_pass + std::max(1, reach * i / workers));
+          if (positions.empty() || position > positions.back()) positions.push_back(position);
+        }
+        first_fail = probe(key, positions, &last_pass);
+        step = std::min(window, 2 * reach);
+      }
+      if (first_fail < 0) {  // the last frame passes: it is the final key image (Finish)
+        if (last_pass > fed) selector.Add(frames.at(last_pass));
+        break;
+      }
+      // Bisect: the frames between the last passing and the first failing frame, split into workers + 1 parts.
+      while (first_fail - last_pass > 1) {
+        std::vector<int> positions;
+        for (int i = 1; i <= workers; ++i) {
+          const int position = last_pass + (first_fail - last_pass) * i / (workers + 1);
+          if (position > last_pass && position < first_fail && (positions.empty() || position > positions.back())) {
+            positions.push_back(position);
+          }
+        }
+        if (positions.empty()) positions.push_back(last_pass + 1);
+        const int failing = probe(key, positions, &last_pass);
+        if (failing >= 0) first_fail = failing;
+      }
+      // Algorithm 1 on the frames found: the last passing frame, then the first failing one.
+      if (last_pass > fed) selector.Add(frames.at(last_pass));
+      selector.Add(with_features(first_fail));
+      fed = last_pass = first_fail;
+      step = 1;
+    }
+  }
+  progress.Finish();
+  selector.Finish();
+  image_writer.Finish();
+  if (link_verifier) {
+    for (const Link& link : selector.links()) {
+      link_verifier->Add(selector.key_images()[link.from_key], selector.key_images()[link.to_key], link,
+                         options.key_images.similarity);
+    }
+    link_verifier->Finish();
+  }
+  VisualMap map = CollectMap(selector, source, options, options_json, SecondsSince(start));
+  map.num_frames = frames_read;
+  map.evaluations = std::move(evaluations);
+  if (link_verifier) link_verifier->Apply(&map, options.key_images.tau);
+  map.quality = ComputeStatistics(map, options.quality_mean).quality;
+  spdlog::debug("bisect search: {} comparisons for {} frames", map.evaluations.size(), map.num_frames);
+  return map;
+}
+
 }  // namespace
 
 VisualMap BuildMap(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
                    const fs::path& directory, const std::string& options_json) {
+  if (ResolveKeySearch(options, matcher) == KeySearch::kBisect) {
+    return SearchKeyImages(source, matcher, options, directory, options_json);
+  }
   std::vector<VisualMap> maps;
   RunSelectors(source, matcher, options, {options.key_images.tau}, {directory}, &maps, options_json);
   return std::move(maps.front());
@@ -654,6 +836,10 @@ VisualMap BuildMap(FrameSource& source, const Matcher& matcher, const MapBuilder
 SweepResult SweepThresholds(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
                             const std::vector<double>& taus, std::vector<VisualMap>* maps,
                             const fs::path& maps_directory, const std::string& options_json) {
+  if (options.key_search == KeySearch::kBisect) {
+    throw InputError("--search bisect looks for each tau's key images on its own; a sweep compares every frame "
+                     "once for all taus. Run `vmap build --tau T --search bisect` per tau instead");
+  }
   std::vector<fs::path> directories;
   for (double tau : taus) {
     directories.push_back(maps_directory.empty() ? fs::path() : maps_directory / fmt::format("tau_{:.2f}", tau));

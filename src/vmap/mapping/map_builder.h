@@ -14,6 +14,17 @@
 
 namespace vmap {
 
+// How Algorithm 1 looks for the next key image.
+enum class KeySearch {
+  kAuto,        // see ResolveKeySearch
+  kSequential,  // every frame is compared with the key image, in order (Algorithm 1 as written)
+  kBisect,      // frames ever further ahead are compared with the key image, then the first frame below tau is
+                // found by bisection: the same key images wherever S decreases with the distance to the key
+                // image, for far fewer comparisons (and feature extractions)
+};
+KeySearch ParseKeySearch(const std::string& name);  // "auto", "sequential", "bisect"
+std::string KeySearchName(KeySearch search);
+
 struct MapBuilderOptions {
   KeyImageOptions key_images;
   VerifierOptions verifier;
@@ -26,11 +37,20 @@ struct MapBuilderOptions {
   // it is judged under (vmap's MAGSAC++, geometry/magsac.h) and each link is verified in full: the same maps
   // within the noise of a seed change, at a fraction of the cost (README, "Threshold sweeps" and "Speed").
   bool exhaustive = false;
+  KeySearch key_search = KeySearch::kAuto;
+  // kBisect: frames held at most (the furthest a comparison looks ahead); memory grows with it, comparisons
+  // fall slowly as it grows.
+  int search_window = 32;
 
   int ExtractionThreads() const;
 
   void Check() const;  // throws InputError naming the bad option
 };
+
+// kAuto resolves to kBisect for matchers that run a network on every image (comparisons cost tens of
+// milliseconds; measured in README "Deep matchers: comparing fewer frames"), and to kSequential for ORB, whose
+// comparisons cost less than decoding, and whenever `exhaustive` asks for the paper's exact behaviour.
+KeySearch ResolveKeySearch(const MapBuilderOptions& options, const Matcher& matcher);
 
 // Builds one map. When `directory` is not empty, each key image is written there as soon as it is chosen,
 // as keys/NNNNNN.png, or as a copy of its image file (keys/NNNNNN.jpg, ...) when the frame is that file as
@@ -69,7 +89,7 @@ struct SweepResult {
 std::vector<double> ParseThresholds(const std::string& text);
 
 // Runs every tau over one pass of the sequence: each frame's features are extracted once, and a pair
-// compared for several taus is matched once. When `maps_directory` is given, each tau's map is also
+// compared for several taus is matched once. Always compares every frame (kBisect is per tau: use BuildMap). When `maps_directory` is given, each tau's map is also
 // written there as tau_0.50/ (the caller commits the parent atomically).
 SweepResult SweepThresholds(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
                             const std::vector<double>& taus, std::vector<VisualMap>* maps = nullptr,
