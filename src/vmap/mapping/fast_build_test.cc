@@ -330,7 +330,6 @@ TEST(FastBuild, DefaultSweepDecidesWithinTheNoiseOfASeedChange) {
       flipped_by_early_stop += (fast.matched && fast.similarity >= taus[t]) != decision;
     }
   }
-  std::printf("decisions %d, flipped by seed %d, by early stop %d\n", decisions, flipped_by_seed, flipped_by_early_stop);
   EXPECT_GT(decisions, 300);
   EXPECT_GT(flipped_by_seed, 0) << "the comparison needs pairs near tau";
   EXPECT_LE(flipped_by_early_stop, 2 * flipped_by_seed + 2)
