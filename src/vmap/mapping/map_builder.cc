@@ -82,12 +82,13 @@ struct PipelineItem {
 // Why compare ahead: a frame is compared with the same key image as the frames before it until S drops,
 // so those comparisons do not depend on each other and can run in parallel.
 //
-// Key changes are followed by the workers too. A key image is retired as soon as a worker sees a frame j
-// fail against it: every selector holding it leaves it at frame j at the latest, for frame j-1 (or for j
-// itself when j-1 is that key: a broken link). Frame j and the later ones are compared with that successor
-// at once, as the consumer will ask, instead of with the old key at low S, where MAGSAC needs the most
-// iterations (up to 60 ms a pair on lab_floor) only for the result to be thrown away, and the consumer then
-// redoing the comparisons one by one while the workers wait.
+// Key changes are followed by the workers too. When a worker sees frame j fall below tau against a key
+// image, every selector holding that key with tau or a higher threshold leaves it at frame j at the latest,
+// for frame j-1 (or for j itself when j-1 is that key: a broken link); the others keep it. Frame j and the
+// later ones are compared with that successor at once for those thresholds, as the consumer will ask, instead
+// of with the old key at low S, where the estimator works longest only for the result to be thrown away, and
+// the consumer then redoing the comparisons one by one while the workers wait. A comparison whose every
+// threshold left its key at an earlier frame meanwhile is abandoned.
 //
 // The consumer compares whatever the workers did not guess. ComparePair is deterministic, so the map is the
 // same whatever the threads do.
@@ -192,27 +193,51 @@ class FeaturePipeline {
         recent_.emplace(frame_index, item.record);
         keys = current_keys_;  // taken after extraction: the freshest the consumer has published
       }
-      if (keys) {
-        for (const CurrentKey& current : *keys) {
-          // Compare as the consumer will: with the key, with its successor when the frame fails against
-          // it (or when an earlier frame turns out to have failed meanwhile), and so on, until the key in
-          // force is one already compared, the frame itself, or a successor not extracted yet (the consumer
-          // then compares).
-          for (;;) {
-            const std::optional<FrameRecord> key = ResolveKey(current.record, frame_index);
-            if (!key) break;
-            const int key_index = key->frame->index;
-            if (key_index == frame_index || item.comparisons.count(key_index)) break;
-            // Abandoned when another worker retires the key at an earlier frame meanwhile: this frame then
-            // goes on to the key's successor.
-            PairComparison comparison = compare_(*key, item.record, current.taus, [this, key_index, frame_index] {
-              return RetiredBefore(key_index, frame_index);
-            });
-            if (comparison.abandoned) continue;
-            if (!comparison.matched || comparison.similarity < current.taus.front()) Retire(key_index, frame_index);
-            item.comparisons.emplace(key_index, std::move(comparison));
+      // Compare as the consumer will: each selector's tau with the key it will hold at this frame, i.e. its
+      // published key, or the successor of a key that this frame or an earlier one fell below that tau against
+      // (and so on), grouping the taus that meet on one key; until every group is compared, is the frame itself,
+      // or waits for a successor not extracted yet (the consumer then compares).
+      while (keys) {
+        std::map<int, CurrentKey> groups;  // by the key the taus resolve to
+        {
+          std::lock_guard<std::mutex> lock(mutex_);
+          for (const CurrentKey& current : *keys) {
+            for (double tau : current.taus) {
+              const int index = ResolveKey(current.record.frame->index, tau, frame_index);
+              if (index == frame_index || item.comparisons.count(index)) continue;
+              const FrameRecord* record = &current.record;
+              if (index != current.record.frame->index) {
+                const auto found = recent_.find(index);
+                if (found == recent_.end()) continue;
+                record = &found->second;
+              }
+              CurrentKey& group = groups.emplace(index, CurrentKey{*record, {}}).first->second;
+              group.taus.push_back(tau);
+            }
           }
         }
+        if (groups.empty()) break;
+        CurrentKey& group = groups.begin()->second;
+        std::sort(group.taus.begin(), group.taus.end());
+        const int key_index = group.record.frame->index;
+        // Abandoned when other workers find, meanwhile, an earlier frame below every one of these taus: this
+        // frame then goes on to the successors.
+        PairComparison comparison =
+            compare_(group.record, item.record, group.taus, [this, key_index, frame_index, &group] {
+              std::lock_guard<std::mutex> lock(mutex_);
+              for (double tau : group.taus) {
+                if (ResolveKey(key_index, tau, frame_index - 1) == key_index) return false;
+              }
+              return true;
+            });
+        if (comparison.abandoned) continue;
+        for (double tau : group.taus) {
+          if (!(comparison.matched && comparison.similarity >= tau)) {
+            Retire(key_index, frame_index, tau);  // this tau and every higher one leave the key here
+            break;
+          }
+        }
+        item.comparisons.emplace(key_index, std::move(comparison));
       }
       std::lock_guard<std::mutex> lock(mutex_);
       --extracting_;
@@ -221,36 +246,31 @@ class FeaturePipeline {
     }
   }
 
-  // The key image `frame_index` is to be compared with next, as far as the workers know: `key`, or the
-  // successor of a key that this frame or an earlier one failed against. Nullopt when that successor is not
-  // extracted yet.
-  std::optional<FrameRecord> ResolveKey(const FrameRecord& key, int frame_index) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    int index = key.frame->index;
-    for (auto it = retired_.find(index); it != retired_.end() && it->second.at_frame <= frame_index;
-         it = retired_.find(index)) {
-      index = it->second.successor;
+  // The key image a selector with threshold `tau` that held `key_index` compares `frame_index` with, as far as
+  // the workers know: that key, or the successor of a key that this frame or an earlier one fell below tau
+  // against, and so on. Call with mutex_ held.
+  int ResolveKey(int key_index, double tau, int frame_index) const {
+    for (;;) {
+      const Retirement* first = nullptr;
+      const auto events = retired_.find(key_index);
+      if (events == retired_.end()) return key_index;
+      for (const Retirement& event : events->second) {
+        if (event.at_frame <= frame_index && tau >= event.from_tau && (!first || event.at_frame < first->at_frame)) {
+          first = &event;
+        }
+      }
+      if (!first) return key_index;
+      key_index = first->successor;  // always a later frame: the chain ends
     }
-    if (index == key.frame->index) return key;
-    auto record = recent_.find(index);
-    if (record == recent_.end()) return std::nullopt;
-    return record->second;
   }
 
-  // Whether a frame before `frame_index` failed against the key image `key_index`: no selector will compare
-  // `frame_index` with it.
-  bool RetiredBefore(int key_index, int frame_index) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    const auto it = retired_.find(key_index);
-    return it != retired_.end() && it->second.at_frame < frame_index;
-  }
-
-  // Frame `frame_index` failed against the key image `key_index`.
-  void Retire(int key_index, int frame_index) {
+  // Frame `frame_index` fell below `tau` against the key image `key_index`: the selectors holding it with tau
+  // or a higher threshold leave it here at the latest, for the previous frame (or this one when the previous
+  // is the key: a broken link).
+  void Retire(int key_index, int frame_index, double tau) {
     const int successor = frame_index - 1 == key_index ? frame_index : frame_index - 1;
     std::lock_guard<std::mutex> lock(mutex_);
-    auto [it, inserted] = retired_.emplace(key_index, Retirement{frame_index, successor});
-    if (!inserted && frame_index < it->second.at_frame) it->second = Retirement{frame_index, successor};
+    retired_[key_index].push_back(Retirement{frame_index, tau, successor});
   }
 
   FrameSource& source_;
@@ -261,10 +281,11 @@ class FeaturePipeline {
   std::condition_variable changed_;
   std::shared_ptr<const std::vector<CurrentKey>> current_keys_;
   struct Retirement {
-    int at_frame;   // the first frame seen to fail against the key
-    int successor;  // the frame that replaces the key
+    int at_frame;    // a frame seen to fall below from_tau against the key
+    double from_tau;  // the lowest threshold it fell below: selectors with this tau or a higher one leave
+    int successor;   // the frame that replaces the key for them
   };
-  std::map<int, Retirement> retired_;    // by key frame index
+  std::map<int, std::vector<Retirement>> retired_;  // by key frame index
   std::map<int, FrameRecord> recent_;    // extracted frames a successor may be taken from, by frame index
   std::deque<std::pair<long, Frame>> decoded_;  // read, waiting for a worker
   std::map<long, PipelineItem> ready_;          // extracted, waiting for the consumer
