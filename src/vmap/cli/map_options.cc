@@ -23,6 +23,9 @@ MapBuilderOptions KeyImageFlags::Resolve() const {
     throw InputError("--pose-matches '" + pose_matches + "': use all (every tentative match) or verified (F's inliers)");
   }
   options.link_analysis.pose.use_all_matches = pose_matches == "all";
+  options.exhaustive = exhaustive;
+  options.key_search = ParseKeySearch(search);
+  options.search_window = search_window;
   options.key_images.Check();
   options.link_analysis.Check();
   return options;
@@ -54,6 +57,16 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau) 
   command->add_option("--pose-matches", flags.pose_matches,
                       "Matches the essential matrix is estimated on: all (tentative) or verified (F's inliers)")
       ->capture_default_str();
+  command->add_flag("--exhaustive", flags.exhaustive,
+                    "The paper's exact behaviour: verify every comparison with OpenCV's USAC_MAGSAC to its "
+                    "confidence criterion (default: stop once S >= tau is settled; same maps within seed noise)");
+  command->add_option("--search", flags.search,
+                      "Key-image search: sequential (compare every frame), bisect (compare frames further ahead, "
+                      "then bisect; for deep matchers) or auto (bisect for deep matchers, sequential for ORB "
+                      "and with --exhaustive)")
+      ->capture_default_str();
+  command->add_option("--search-window", flags.search_window, "bisect: frames compared ahead at most (held in memory)")
+      ->capture_default_str();
 }
 
 std::string DescribeOptions(const Matcher& matcher, const MapBuilderOptions& options,
@@ -66,6 +79,9 @@ std::string DescribeOptions(const Matcher& matcher, const MapBuilderOptions& opt
                      {"max_iterations", options.verifier.max_iterations},
                      {"seed", options.verifier.seed},
                      {"min_matches", options.verifier.min_matches}};
+  doc["exhaustive"] = options.exhaustive;
+  doc["search"] = KeySearchName(ResolveKeySearch(options, matcher));
+  doc["search_window"] = options.search_window;
   doc["tau"] = options.key_images.tau;
   doc["similarity"] = SimilarityModeName(options.key_images.similarity);
   doc["final_key"] = options.key_images.final_key;

@@ -12,7 +12,7 @@
 
 namespace vmap::cli {
 
-// --tau, --similarity, --quality, --no-final-key, --threads.
+// --tau, --similarity, --quality, --no-final-key, --threads, --exhaustive, --search, --search-window.
 struct KeyImageFlags {
   double tau = 0.5;
   std::string similarity = "inlier-ratio";
@@ -24,9 +24,12 @@ struct KeyImageFlags {
   std::string pose_method = PoseMethodName(PoseOptions().method);
   double pose_threshold = PoseOptions().threshold;
   std::string pose_matches = PoseOptions().use_all_matches ? "all" : "verified";
+  bool exhaustive = false;
+  std::string search = "auto";
+  int search_window = 32;
   MapBuilderOptions Resolve() const;
 };
-// Also --min-key-displacement, --pose, --pose-threshold, --pose-matches.
+// Also --min-key-displacement, --pose, --pose-threshold, --pose-matches, --exhaustive, --search, --search-window.
 void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau = true);
 
 // Every option that shaped a map, as JSON text for map.json.

@@ -5,6 +5,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/geometry/magsac.h"
 
 namespace vmap {
 
@@ -39,10 +40,14 @@ void VerifierOptions::Check() const {
 }
 
 FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0,
-                                      const std::vector<cv::Point2f>& points1, const VerifierOptions& options) {
+                                      const std::vector<cv::Point2f>& points1, const VerifierOptions& options,
+                                      const EarlyStop& early_stop) {
   FundamentalResult result;
   CV_Assert(points0.size() == points1.size());
   if (static_cast<int>(points0.size()) < options.min_matches) return result;
+  if (options.method == VerifierMethod::kMagsac && options.own_magsac) {
+    return EstimateFundamentalMagsac(points0, points1, options, early_stop);
+  }
   cv::Mat F;
   std::vector<unsigned char> mask;
   if (options.method == VerifierMethod::kRansac) {

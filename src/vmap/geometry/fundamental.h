@@ -1,6 +1,7 @@
 #pragma once
 // Geometric verification of tentative matches with a fundamental matrix (OpenCV RANSAC / USAC).
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,9 @@ struct VerifierOptions {
   int max_iterations = 100000;
   int seed = 0;                // the random generator's state: the same input gives the same inliers
   int min_matches = 8;         // fewer tentative matches than this means matching failed
+  // kMagsac only: false runs OpenCV's USAC_MAGSAC (the paper's exact behaviour); true runs vmap's own MAGSAC++
+  // (magsac.h), which agrees with it within the noise of a seed change and can stop early (EarlyStop).
+  bool own_magsac = false;
 
   void Check() const;  // throws InputError naming the bad option
 };
@@ -31,10 +35,21 @@ struct FundamentalResult {
   cv::Matx33d F = cv::Matx33d::zeros();
   std::vector<unsigned char> inlier_mask;  // one per tentative match; empty when !success
   int num_inliers = 0;
+  bool abandoned = false;       // EarlyStop::abandon ended it: not a result, discard it
+};
+
+// What a caller will decide from the result: for each entry t, "at least t inliers?". Empty: estimate
+// exhaustively. Only vmap's own MAGSAC++ stops early (see magsac.h); OpenCV's estimators ignore it.
+struct EarlyStop {
+  std::vector<int> min_inliers;
+  // Polled now and then; when it returns true the estimation stops with `abandoned` set (the answer is no
+  // longer needed, e.g. the key image was replaced meanwhile).
+  std::function<bool()> abandon;
 };
 
 FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0,
-                                      const std::vector<cv::Point2f>& points1, const VerifierOptions& options);
+                                      const std::vector<cv::Point2f>& points1, const VerifierOptions& options,
+                                      const EarlyStop& early_stop = {});
 
 // Symmetric epipolar (Sampson) distance of x1 <-> x0 under F (x1^T F x0 = 0), in pixels.
 double SampsonDistance(const cv::Matx33d& F, const cv::Point2f& p0, const cv::Point2f& p1);

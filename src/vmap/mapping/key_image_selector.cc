@@ -1,6 +1,7 @@
 #include "vmap/mapping/key_image_selector.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -33,11 +34,36 @@ void KeyImageOptions::Check() const {
 
 PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features0,
                            const ImageFeatures& features1, const VerifierOptions& verifier,
-                           SimilarityMode similarity) {
-  PairComparison result;
+                           SimilarityMode similarity, const std::vector<double>& decide_taus,
+                           const std::function<bool()>& abandon) {
   const TentativeMatches matches = matcher.Match(features0, features1);
+  const int denominator = similarity == SimilarityMode::kInlierRatio
+                              ? static_cast<int>(matches.size())
+                              : std::max(features0.num_features(), features1.num_features());
+  return VerifyMatches(matches, denominator, verifier, decide_taus, abandon);
+}
+
+PairComparison VerifyMatches(const TentativeMatches& matches, int denominator, const VerifierOptions& verifier,
+                             const std::vector<double>& decide_taus, const std::function<bool()>& abandon) {
+  PairComparison result;
   result.num_tentative = static_cast<int>(matches.size());
-  const FundamentalResult fundamental = EstimateFundamental(matches.points0, matches.points1, verifier);
+  // S >= tau  <=>  verified >= the least count v with v / denominator >= tau (in the arithmetic Passes uses).
+  EarlyStop early_stop;
+  const bool stops_early = verifier.own_magsac && verifier.method == VerifierMethod::kMagsac && !decide_taus.empty();
+  if (stops_early) {
+    for (double tau : decide_taus) {
+      int count = static_cast<int>(std::ceil(tau * denominator));
+      while (count > 0 && static_cast<double>(count - 1) / denominator >= tau) --count;
+      while (static_cast<double>(count) / denominator < tau) ++count;
+      early_stop.min_inliers.push_back(std::max(count, verifier.min_matches));
+    }
+  }
+  early_stop.abandon = abandon;
+  const FundamentalResult fundamental = EstimateFundamental(matches.points0, matches.points1, verifier, early_stop);
+  if (fundamental.abandoned) {
+    result.abandoned = true;
+    return result;
+  }
   result.correspondences.reserve(matches.size());
   if (fundamental.success) {
     result.matched = true;
@@ -59,12 +85,29 @@ PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features
       displacements.push_back(cv::norm(result.correspondences[i].p1 - result.correspondences[i].p0));
     }
     result.median_displacement = Median(std::move(displacements));
-    const int denominator = similarity == SimilarityMode::kInlierRatio
-                                ? result.num_tentative
-                                : std::max(features0.num_features(), features1.num_features());
     result.similarity = denominator > 0 ? static_cast<double>(result.num_verified) / denominator : 0.0;
   }
+  if (stops_early) {
+    result.exhaustive = false;
+    for (double tau : decide_taus) {
+      if (!(result.matched && result.similarity >= tau)) result.lowest_failed_tau = std::min(result.lowest_failed_tau, tau);
+    }
+  }
   return result;
+}
+
+Link MakeLink(const PairComparison& comparison, int from_key, int to_key, bool below_tau) {
+  Link link;
+  link.from_key = from_key;
+  link.to_key = to_key;
+  link.below_tau = below_tau;
+  link.similarity = comparison.similarity;
+  link.num_tentative = comparison.num_tentative;
+  link.num_verified = comparison.num_verified;
+  link.has_fundamental = comparison.matched;
+  link.F = comparison.F;
+  link.correspondences = comparison.correspondences;
+  return link;
 }
 
 KeyImageSelector::KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image)
@@ -101,17 +144,8 @@ void KeyImageSelector::AddKeyImage(const FrameRecord& record, const std::string&
 }
 
 void KeyImageSelector::AddLink(const PairComparison& comparison, bool below_tau) {
-  Link link;
-  link.from_key = static_cast<int>(key_images_.size()) - 2;
-  link.to_key = static_cast<int>(key_images_.size()) - 1;
-  link.below_tau = below_tau;
-  link.similarity = comparison.similarity;
-  link.num_tentative = comparison.num_tentative;
-  link.num_verified = comparison.num_verified;
-  link.has_fundamental = comparison.matched;
-  link.F = comparison.F;
-  link.correspondences = comparison.correspondences;
-  links_.push_back(std::move(link));
+  const int to_key = static_cast<int>(key_images_.size()) - 1;
+  links_.push_back(MakeLink(comparison, to_key - 1, to_key, below_tau));
 }
 
 void KeyImageSelector::Add(const FrameRecord& record) {

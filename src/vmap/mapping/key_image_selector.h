@@ -49,12 +49,32 @@ struct PairComparison {
   cv::Matx33d F = cv::Matx33d::zeros();
   std::vector<Correspondence> correspondences;  // verified first, then rejected
   double median_displacement = -1.0;  // pixels, over the verified matches; -1 when not matched
+  // False when verification stopped as soon as S >= tau was settled for the thresholds asked (ComparePair's
+  // `decide_taus`): S is then the best found by that point, and only Decides(tau) says whether it answers tau.
+  bool exhaustive = true;
+  double lowest_failed_tau = 2.0;  // when not exhaustive: the lowest tau asked that S did not reach
+  bool abandoned = false;          // `abandon` stopped the verification: this answers nothing
+  bool Decides(double tau) const {
+    return exhaustive || (matched && similarity >= tau) || tau >= lowest_failed_tau;
+  }
 };
 
-// Matches two images and verifies the matches: the S(I_i, I_j) of the paper.
+// Matches two images and verifies the matches: the S(I_i, I_j) of the paper. With `decide_taus` and a verifier
+// that can stop early (VerifierOptions::own_magsac), verification stops once "S >= tau?" is settled for each of
+// them; without, it runs to the verifier's confidence criterion. `abandon` (same verifier only) is polled during
+// verification and stops it when the answer is no longer needed.
 PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features0,
                            const ImageFeatures& features1, const VerifierOptions& verifier,
-                           SimilarityMode similarity);
+                           SimilarityMode similarity, const std::vector<double>& decide_taus = {},
+                           const std::function<bool()>& abandon = nullptr);
+
+// The verification half of ComparePair, on matches already made: S = verified / `denominator` (|D|).
+PairComparison VerifyMatches(const TentativeMatches& matches, int denominator, const VerifierOptions& verifier,
+                             const std::vector<double>& decide_taus = {},
+                             const std::function<bool()>& abandon = nullptr);
+
+// The link between key images from_key and to_key that `comparison` verified.
+Link MakeLink(const PairComparison& comparison, int from_key, int to_key, bool below_tau);
 
 class KeyImageSelector {
  public:

@@ -8,6 +8,7 @@
 #include <deque>
 #include <exception>
 #include <functional>
+#include <future>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -23,6 +24,27 @@
 namespace vmap {
 namespace fs = std::filesystem;
 
+KeySearch ParseKeySearch(const std::string& name) {
+  if (name == "auto") return KeySearch::kAuto;
+  if (name == "sequential") return KeySearch::kSequential;
+  if (name == "bisect") return KeySearch::kBisect;
+  throw InputError("unknown key-image search '" + name + "'; use auto, sequential or bisect");
+}
+
+std::string KeySearchName(KeySearch search) {
+  switch (search) {
+    case KeySearch::kAuto: return "auto";
+    case KeySearch::kSequential: return "sequential";
+    case KeySearch::kBisect: return "bisect";
+  }
+  return "auto";
+}
+
+KeySearch ResolveKeySearch(const MapBuilderOptions& options, const Matcher& matcher) {
+  if (options.key_search != KeySearch::kAuto) return options.key_search;
+  return options.exhaustive || matcher.name() == "orb" ? KeySearch::kSequential : KeySearch::kBisect;
+}
+
 void MapBuilderOptions::Check() const {
   key_images.Check();
   verifier.Check();
@@ -30,6 +52,9 @@ void MapBuilderOptions::Check() const {
   if (prefetch_frames < 1 || prefetch_frames > 1024) throw InputError("prefetch_frames must be 1 to 1024");
   if (extraction_threads < 0 || extraction_threads > kMaxExtractionThreads) {
     throw InputError("--threads must be 0 to " + std::to_string(kMaxExtractionThreads) + " (0 = one per core)");
+  }
+  if (search_window < 2 || search_window > 4096) {
+    throw InputError("--search-window must be 2 to 4096 frames (default 32)");
   }
 }
 
@@ -40,12 +65,14 @@ int MapBuilderOptions::ExtractionThreads() const {
 
 namespace {
 
-using CompareFn = std::function<PairComparison(const FrameRecord& key, const FrameRecord& frame)>;
+// Compares a key image with a frame for the selectors whose thresholds are `taus`; `abandon` may stop it.
+using CompareFn = std::function<PairComparison(const FrameRecord& key, const FrameRecord& frame,
+                                               const std::vector<double>& taus, const std::function<bool()>& abandon)>;
 
-// A key image the workers compare frames with, and the lowest tau of the selectors that hold it.
+// A key image the workers compare frames with, and the thresholds (ascending) of the selectors that hold it.
 struct CurrentKey {
   FrameRecord record;
-  double min_tau = 1.0;
+  std::vector<double> taus;
 };
 
 // A frame with its features and the comparisons the workers already made for it (by key frame index).
@@ -60,12 +87,13 @@ struct PipelineItem {
 // Why compare ahead: a frame is compared with the same key image as the frames before it until S drops,
 // so those comparisons do not depend on each other and can run in parallel.
 //
-// Key changes are followed by the workers too. A key image is retired as soon as a worker sees a frame j
-// fail against it: every selector holding it leaves it at frame j at the latest, for frame j-1 (or for j
-// itself when j-1 is that key: a link below tau). Frame j and the later ones are compared with that successor
-// at once, as the consumer will ask, instead of with the old key at low S, where MAGSAC needs the most
-// iterations (up to 60 ms a pair on lab_floor) only for the result to be thrown away, and the consumer then
-// redoing the comparisons one by one while the workers wait.
+// Key changes are followed by the workers too. When a worker sees frame j fall below tau against a key
+// image, every selector holding that key with tau or a higher threshold leaves it at frame j at the latest,
+// for frame j-1 (or for j itself when j-1 is that key: a link below tau); the others keep it. Frame j and the
+// later ones are compared with that successor at once for those thresholds, as the consumer will ask, instead
+// of with the old key at low S, where the estimator works longest only for the result to be thrown away, and
+// the consumer then redoing the comparisons one by one while the workers wait. A comparison whose every
+// threshold left its key at an earlier frame meanwhile is abandoned.
 //
 // The consumer compares whatever the workers did not guess (also when the selector picks another successor,
 // as it does for a frame that repeats the key image's view). ComparePair is deterministic, so the map is the
@@ -87,8 +115,8 @@ class FeaturePipeline {
 
   ~FeaturePipeline() { Stop(); }
 
-  // The key images (distinct) that frames extracted from now on are compared with, each with the lowest
-  // tau of the selectors holding it: a frame below that similarity makes all of them leave the key.
+  // The key images (distinct) that frames extracted from now on are compared with, each with the thresholds
+  // of the selectors holding it: a frame below the lowest makes all of them leave the key.
   void SetCurrentKeys(std::vector<CurrentKey> keys) {
     auto shared = std::make_shared<const std::vector<CurrentKey>>(std::move(keys));
     std::lock_guard<std::mutex> lock(mutex_);
@@ -187,22 +215,51 @@ class FeaturePipeline {
         recent_.emplace(frame_index, item.record);
         keys = current_keys_;  // taken after extraction: the freshest the consumer has published
       }
-      if (keys) {
-        for (const CurrentKey& current : *keys) {
-          // Compare as the consumer will: with the key, with its successor when the frame fails against
-          // it (or when an earlier frame turns out to have failed meanwhile), and so on, until the key in
-          // force is one already compared, the frame itself, or a successor not extracted yet (the consumer
-          // then compares).
-          for (;;) {
-            const std::optional<FrameRecord> key = ResolveKey(current.record, frame_index);
-            if (!key) break;
-            const int key_index = key->frame->index;
-            if (key_index == frame_index || item.comparisons.count(key_index)) break;
-            const PairComparison& comparison =
-                item.comparisons.emplace(key_index, compare_(*key, item.record)).first->second;
-            if (!comparison.matched || comparison.similarity < current.min_tau) Retire(key_index, frame_index);
+      // Compare as the consumer will: each selector's tau with the key it will hold at this frame, i.e. its
+      // published key, or the successor of a key that this frame or an earlier one fell below that tau against
+      // (and so on), grouping the taus that meet on one key; until every group is compared, is the frame itself,
+      // or waits for a successor not extracted yet (the consumer then compares).
+      while (keys) {
+        std::map<int, CurrentKey> groups;  // by the key the taus resolve to
+        {
+          std::lock_guard<std::mutex> lock(mutex_);
+          for (const CurrentKey& current : *keys) {
+            for (double tau : current.taus) {
+              const int index = ResolveKey(current.record.frame->index, tau, frame_index);
+              if (index == frame_index || item.comparisons.count(index)) continue;
+              const FrameRecord* record = &current.record;
+              if (index != current.record.frame->index) {
+                const auto found = recent_.find(index);
+                if (found == recent_.end()) continue;
+                record = &found->second;
+              }
+              CurrentKey& group = groups.emplace(index, CurrentKey{*record, {}}).first->second;
+              group.taus.push_back(tau);
+            }
           }
         }
+        if (groups.empty()) break;
+        CurrentKey& group = groups.begin()->second;
+        std::sort(group.taus.begin(), group.taus.end());
+        const int key_index = group.record.frame->index;
+        // Abandoned when other workers find, meanwhile, an earlier frame below every one of these taus: this
+        // frame then goes on to the successors.
+        PairComparison comparison =
+            compare_(group.record, item.record, group.taus, [this, key_index, frame_index, &group] {
+              std::lock_guard<std::mutex> lock(mutex_);
+              for (double tau : group.taus) {
+                if (ResolveKey(key_index, tau, frame_index - 1) == key_index) return false;
+              }
+              return true;
+            });
+        if (comparison.abandoned) continue;
+        for (double tau : group.taus) {
+          if (!(comparison.matched && comparison.similarity >= tau)) {
+            Retire(key_index, frame_index, tau);  // this tau and every higher one leave the key here
+            break;
+          }
+        }
+        item.comparisons.emplace(key_index, std::move(comparison));
       }
       std::lock_guard<std::mutex> lock(mutex_);
       --extracting_;
@@ -211,28 +268,31 @@ class FeaturePipeline {
     }
   }
 
-  // The key image `frame_index` is to be compared with next, as far as the workers know: `key`, or the
-  // successor of a key that this frame or an earlier one failed against. Nullopt when that successor is not
-  // extracted yet.
-  std::optional<FrameRecord> ResolveKey(const FrameRecord& key, int frame_index) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    int index = key.frame->index;
-    for (auto it = retired_.find(index); it != retired_.end() && it->second.at_frame <= frame_index;
-         it = retired_.find(index)) {
-      index = it->second.successor;
+  // The key image a selector with threshold `tau` that held `key_index` compares `frame_index` with, as far as
+  // the workers know: that key, or the successor of a key that this frame or an earlier one fell below tau
+  // against, and so on. Call with mutex_ held.
+  int ResolveKey(int key_index, double tau, int frame_index) const {
+    for (;;) {
+      const Retirement* first = nullptr;
+      const auto events = retired_.find(key_index);
+      if (events == retired_.end()) return key_index;
+      for (const Retirement& event : events->second) {
+        if (event.at_frame <= frame_index && tau >= event.from_tau && (!first || event.at_frame < first->at_frame)) {
+          first = &event;
+        }
+      }
+      if (!first) return key_index;
+      key_index = first->successor;  // always a later frame: the chain ends
     }
-    if (index == key.frame->index) return key;
-    auto record = recent_.find(index);
-    if (record == recent_.end()) return std::nullopt;
-    return record->second;
   }
 
-  // Frame `frame_index` failed against the key image `key_index`.
-  void Retire(int key_index, int frame_index) {
+  // Frame `frame_index` fell below `tau` against the key image `key_index`: the selectors holding it with tau
+  // or a higher threshold leave it here at the latest, for the previous frame (or this one when the previous
+  // is the key: a link below tau).
+  void Retire(int key_index, int frame_index, double tau) {
     const int successor = frame_index - 1 == key_index ? frame_index : frame_index - 1;
     std::lock_guard<std::mutex> lock(mutex_);
-    auto [it, inserted] = retired_.emplace(key_index, Retirement{frame_index, successor});
-    if (!inserted && frame_index < it->second.at_frame) it->second = Retirement{frame_index, successor};
+    retired_[key_index].push_back(Retirement{frame_index, tau, successor});
   }
 
   FrameSource& source_;
@@ -243,10 +303,11 @@ class FeaturePipeline {
   std::condition_variable changed_;
   std::shared_ptr<const std::vector<CurrentKey>> current_keys_;
   struct Retirement {
-    int at_frame;   // the first frame seen to fail against the key
-    int successor;  // the frame that replaces the key
+    int at_frame;    // a frame seen to fall below from_tau against the key
+    double from_tau;  // the lowest threshold it fell below: selectors with this tau or a higher one leave
+    int successor;   // the frame that replaces the key for them
   };
-  std::map<int, Retirement> retired_;    // by key frame index
+  std::map<int, std::vector<Retirement>> retired_;  // by key frame index
   std::map<int, FrameRecord> recent_;    // extracted frames a successor may be taken from, by frame index
   std::deque<std::pair<long, Frame>> decoded_;  // read, waiting for a worker
   std::map<long, PipelineItem> ready_;          // extracted, waiting for the consumer
@@ -260,10 +321,31 @@ class FeaturePipeline {
   std::vector<std::thread> workers_;
 };
 
-std::string KeyImageFileName(int frame_index) { return fmt::format("keys/{:06d}.png", frame_index); }
+// A key image is the input's own file when the frame was decoded from an image file at its size: a copy costs
+// ~0.1 ms and is exactly the input. Other frames (video, resized) are written as PNG with OpenCV's default
+// settings (zlib level 1, run-length strategy): measured 2x faster than level 1 with the default strategy, for
+// files 15 % larger; still ~10 ms for 640x480, hence the thread of its own.
+// Only PNG and JPEG files are kept as they are: ReadMap checks a key image's size from those headers.
+bool KeepsSourceFile(const Frame& frame) {
+  if (frame.source_path.empty() || frame.resized) return false;
+  std::string extension = fs::path(frame.source_path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension == ".png" || extension == ".jpg" || extension == ".jpeg";
+}
 
-// Writes key images on a thread of its own: PNG encoding (~20 ms per 640x480 image) would otherwise stall
-// the consumer, and with it the whole pipeline.
+std::string KeyImageFileName(const Frame& frame) {
+  std::string extension = ".png";
+  if (KeepsSourceFile(frame)) {
+    extension = fs::path(frame.source_path).extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  }
+  return fmt::format("keys/{:06d}{}", frame.index, extension);
+}
+
+// Writes key images on a thread of its own, so that encoding never stalls the consumer, and with it the
+// whole pipeline.
 class KeyImageFileWriter {
  public:
   KeyImageFileWriter() : thread_([this] { Run(); }) {}
@@ -277,7 +359,7 @@ class KeyImageFileWriter {
     // removed that, nothing may bring it back (AtomicOutputDirectory::path()). It must exist.
     fs::create_directory(directory / "keys");
     return [this, directory](const FrameRecord& record, KeyImage& key) {
-      key.image_file = KeyImageFileName(key.frame_index);
+      key.image_file = KeyImageFileName(*record.frame);
       std::lock_guard<std::mutex> lock(mutex_);
       queue_.emplace_back(directory / key.image_file, record.frame);
       changed_.notify_all();
@@ -311,9 +393,15 @@ class KeyImageFileWriter {
         queue_.pop_front();
       }
       if (error_) continue;
-      // Fast PNG compression: lossless key images at little cost.
-      if (!cv::imwrite(job.first.string(), ColorImage(*job.second), {cv::IMWRITE_PNG_COMPRESSION, 1})) {
-        error_ = std::make_exception_ptr(InputError("cannot write key image '" + job.first.string() + "'"));
+      const Frame& frame = *job.second;
+      std::error_code copy_error;
+      const bool written =
+          KeepsSourceFile(frame)
+              ? fs::copy_file(frame.source_path, job.first, fs::copy_options::overwrite_existing, copy_error)
+              : cv::imwrite(job.first.string(), ColorImage(frame));
+      if (!written) {
+        error_ = std::make_exception_ptr(InputError("cannot write key image '" + job.first.string() + "'" +
+                                                    (copy_error ? ": " + copy_error.message() : std::string())));
       }
     }
   }
@@ -326,9 +414,110 @@ class KeyImageFileWriter {
   std::thread thread_;        // last: starts after every other member exists
 };
 
+// Verifies links in full, on a thread of its own while the build goes on, when the decisions stopped early:
+// the tables are then computed from exact link values. The estimator runs again on the link's own tentative
+// matches (no matching, no features kept). A link shared by several taus (same two frames) is verified once.
+class LinkVerifier {
+ public:
+  explicit LinkVerifier(const VerifierOptions& verifier) : verifier_(verifier), thread_([this] { Run(); }) {}
+  ~LinkVerifier() { Join(); }
+
+  // Queues `link`, between key images `from` and `to`, unless that pair of frames is queued already.
+  void Add(const KeyImage& from, const KeyImage& to, const Link& link, SimilarityMode similarity) {
+    const auto pair = std::make_pair(from.frame_index, to.frame_index);
+    Job job;
+    for (const Correspondence& c : link.correspondences) {
+      job.matches.points0.push_back(c.p0);
+      job.matches.points1.push_back(c.p1);
+    }
+    job.denominator = similarity == SimilarityMode::kInlierRatio ? link.num_tentative
+                                                                 : std::max(from.num_features, to.num_features);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!results_.emplace(pair, PairComparison{}).second) return;
+    job.pair = pair;
+    queue_.push_back(std::move(job));
+    changed_.notify_all();
+  }
+
+  // Waits for every verification; rethrows a failure. Returns how many links were verified.
+  long Finish() {
+    Join();
+    if (error_) std::rethrow_exception(error_);
+    return static_cast<long>(results_.size());
+  }
+
+  // Replaces the links of `map`, built with threshold `tau`, by their verifications (after Finish). A verification
+  // that contradicts the decision (a link at S >= tau found below tau, or the reverse for a link below tau: the
+  // two estimates differ by the noise of a seed change) leaves the deciding comparison in place, so that every
+  // link keeps the meaning Algorithm 1 gives it.
+  // Returns how many links kept their deciding comparison.
+  int Apply(VisualMap* map, double tau) const {
+    int kept = 0;
+    for (Link& link : map->links) {
+      const auto pair = std::make_pair(map->key_images[link.from_key].frame_index,
+                                       map->key_images[link.to_key].frame_index);
+      const PairComparison& verified = results_.at(pair);
+      if ((verified.matched && verified.similarity >= tau) == !link.below_tau) {
+        link = MakeLink(verified, link.from_key, link.to_key, link.below_tau);
+      } else {
+        ++kept;
+      }
+    }
+    return kept;
+  }
+
+ private:
+  struct Job {
+    std::pair<int, int> pair;
+    TentativeMatches matches;
+    int denominator = 0;
+  };
+
+  void Join() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      finished_ = true;
+    }
+    changed_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+
+  void Run() {
+    for (;;) {
+      Job job;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        changed_.wait(lock, [this] { return finished_ || !queue_.empty(); });
+        if (queue_.empty()) return;
+        job = std::move(queue_.front());
+        queue_.pop_front();
+      }
+      if (error_) continue;
+      try {
+        PairComparison verified = VerifyMatches(job.matches, job.denominator, verifier_);
+        std::lock_guard<std::mutex> lock(mutex_);
+        results_[job.pair] = std::move(verified);
+      } catch (...) {
+        error_ = std::current_exception();
+      }
+    }
+  }
+
+  const VerifierOptions verifier_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<Job> queue_;
+  std::map<std::pair<int, int>, PairComparison> results_;  // by (from, to) frame index
+  bool finished_ = false;
+  std::exception_ptr error_;  // written by the thread, read after join
+  std::thread thread_;        // last: starts after every other member exists
+};
+
+// `link_verifier` (when the decisions stopped early): the links verified in full replace the deciding ones.
 // `analyze_links`: also each link's pose, parallax and homography test (only maps that are kept need them).
 VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source, const MapBuilderOptions& options,
-                     const std::string& options_json, double seconds, bool analyze_links) {
+                     const std::string& options_json, double seconds, bool analyze_links,
+                     const LinkVerifier* link_verifier = nullptr, double tau = 0.0) {
   VisualMap map;
   map.input = source.info();
   map.options_json = options_json;
@@ -338,6 +527,13 @@ VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source
   map.links = selector.links();
   map.evaluations = selector.evaluations();
   map.seconds = seconds;
+  if (link_verifier) {
+    const int kept = link_verifier->Apply(&map, tau);
+    if (kept > 0) {
+      spdlog::debug("tau {:.2f}: {} of {} links kept the deciding estimate (the full one crossed tau)", tau, kept,
+                    map.links.size());
+    }
+  }
   map.quality = ComputeStatistics(map, options.quality_mean).quality;
   if (!analyze_links) return map;
   const auto analysis_start = std::chrono::steady_clock::now();
@@ -401,6 +597,14 @@ std::vector<double> ParseThresholds(const std::string& text) {
 
 namespace {
 
+// The verifier of the decisions: vmap's MAGSAC++, stopping once S >= tau is settled, unless the paper's
+// exact behaviour is asked for (or another verifier, which OpenCV runs to its confidence criterion).
+VerifierOptions DecisionVerifier(const MapBuilderOptions& options) {
+  VerifierOptions verifier = options.verifier;
+  verifier.own_magsac = !options.exhaustive && verifier.method == VerifierMethod::kMagsac;
+  return verifier;
+}
+
 // Runs one selector per tau over one pass of the source; directories[i] receives tau i's key images.
 SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
                          const std::vector<double>& taus, const std::vector<fs::path>& directories,
@@ -410,10 +614,13 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
   SweepResult result;
   result.options_json = options_json;
 
-  std::atomic<long> pairs_matched{0};
-  const CompareFn compare_pair = [&](const FrameRecord& key, const FrameRecord& frame) {
+  const VerifierOptions verifier = DecisionVerifier(options);
+  const bool stops_early = verifier.own_magsac;
+  std::atomic<long> pairs_matched{0}, pairs_abandoned{0};
+  const CompareFn compare_pair = [&](const FrameRecord& key, const FrameRecord& frame,
+                                     const std::vector<double>& decide_taus, const std::function<bool()>& abandon) {
     ++pairs_matched;
-    return RethrowAsInputError(
+    PairComparison comparison = RethrowAsInputError(
         [&] {
           return ErrorContext{"matching frame " + std::to_string(frame.frame->source_index) + " (" +
                                   frame.frame->source_name + ") with key image " +
@@ -421,28 +628,53 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
                               "check the frames, or try other matcher or verifier options"};
         },
         [&] {
-          return ComparePair(matcher, *key.features, *frame.features, options.verifier, options.key_images.similarity);
+          return ComparePair(matcher, *key.features, *frame.features, verifier, options.key_images.similarity,
+                             stops_early ? decide_taus : std::vector<double>{}, abandon);
         });
+    if (comparison.abandoned) ++pairs_abandoned;
+    return comparison;
   };
-  // The comparisons of the current frame, by key frame: made ahead by the pipeline, or here when a key
-  // image changed meanwhile. A pair compared under several taus is matched once.
+  // The comparisons of the current frame, by key frame: made ahead by the pipeline, or here when a key image
+  // changed meanwhile or a comparison that stopped early does not answer a selector's tau. A pair compared
+  // under several taus is matched once.
   std::map<int, PairComparison>* comparisons_of_frame = nullptr;
-  auto compare = [&](const FrameRecord& key, const FrameRecord& frame) -> PairComparison {
-    auto it = comparisons_of_frame->find(key.frame->index);
-    if (it == comparisons_of_frame->end()) {
-      it = comparisons_of_frame->emplace(key.frame->index, compare_pair(key, frame)).first;
-    }
-    return it->second;
+  std::map<int, std::vector<double>> holders;  // key frame index -> taus of the selectors holding it
+  auto compare_for = [&](double tau) -> KeyImageSelector::CompareFn {
+    return [&, tau](const FrameRecord& key, const FrameRecord& frame) -> PairComparison {
+      const int key_index = key.frame->index;
+      auto it = comparisons_of_frame->find(key_index);
+      if (it != comparisons_of_frame->end() && it->second.Decides(tau)) return it->second;
+      // Settle at once what the other selectors that may ask will need: the holders of the key, or every tau
+      // for a key just chosen (they follow from the same failing frame) or asked again.
+      const auto held = holders.find(key_index);
+      std::vector<double> asked = it == comparisons_of_frame->end() && held != holders.end() ? held->second : taus;
+      if (std::find(asked.begin(), asked.end(), tau) == asked.end()) asked.push_back(tau);
+      return (*comparisons_of_frame)[key_index] = compare_pair(key, frame, asked, nullptr);
+    };
   };
-
   KeyImageFileWriter image_writer;
   std::vector<std::unique_ptr<KeyImageSelector>> selectors;
   for (size_t i = 0; i < taus.size(); ++i) {
     KeyImageOptions key_options = options.key_images;
     key_options.tau = taus[i];
     selectors.push_back(
-        std::make_unique<KeyImageSelector>(key_options, compare, image_writer.CallbackFor(directories[i])));
+        std::make_unique<KeyImageSelector>(key_options, compare_for(taus[i]), image_writer.CallbackFor(directories[i])));
   }
+  // Links keep a full estimation when the decisions stopped early; queued as soon as each link is made.
+  std::unique_ptr<LinkVerifier> link_verifier;
+  if (stops_early) link_verifier = std::make_unique<LinkVerifier>(VerifierOptions(verifier));
+  std::vector<size_t> links_queued(selectors.size(), 0);
+  auto queue_new_links = [&] {
+    if (!link_verifier) return;
+    for (size_t i = 0; i < selectors.size(); ++i) {
+      const KeyImageSelector& selector = *selectors[i];
+      for (; links_queued[i] < selector.links().size(); ++links_queued[i]) {
+        const Link& link = selector.links()[links_queued[i]];
+        link_verifier->Add(selector.key_images()[link.from_key], selector.key_images()[link.to_key], link,
+                           options.key_images.similarity);
+      }
+    }
+  };
 
   {
     FeaturePipeline pipeline(source, matcher, options.prefetch_frames, options.ExtractionThreads(), compare_pair);
@@ -454,32 +686,44 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
     while (std::optional<PipelineItem> item = pipeline.Next()) {
       comparisons_of_frame = &item->comparisons;
       for (auto& selector : selectors) selector->Add(item->record);
+      queue_new_links();
       // Tell the workers which key images the coming frames will be compared with (a handful of
       // shared pointers: cheaper to publish every frame than to track changes).
       std::map<int, CurrentKey> keys;  // by key frame index
       for (size_t i = 0; i < selectors.size(); ++i) {
         const FrameRecord* key = selectors[i]->current_key();
         if (!key) continue;
-        auto [it, inserted] = keys.emplace(key->frame->index, CurrentKey{*key, taus[i]});
-        if (!inserted) it->second.min_tau = std::min(it->second.min_tau, taus[i]);
+        keys.emplace(key->frame->index, CurrentKey{*key, {}}).first->second.taus.push_back(taus[i]);
       }
+      holders.clear();
       std::vector<CurrentKey> current;
-      for (auto& [index, key] : keys) current.push_back(std::move(key));
+      for (auto& [index, key] : keys) {
+        std::sort(key.taus.begin(), key.taus.end());
+        holders[index] = key.taus;
+        current.push_back(std::move(key));
+      }
       pipeline.SetCurrentKeys(std::move(current));
       progress.Update(++done);
     }
     progress.Finish();
     result.features_extracted = pipeline.extracted();
   }
-  result.pairs_matched = pairs_matched;
   for (auto& selector : selectors) selector->Finish();  // the final key images
+  queue_new_links();
   image_writer.Finish();
+  result.pairs_matched = pairs_matched;
+  long evaluations = 0;
+  for (const auto& selector : selectors) evaluations += static_cast<long>(selector->evaluations().size());
+  if (link_verifier) result.links_verified = link_verifier->Finish();
+  spdlog::debug("{} pairs matched and verified for {} evaluations, {} abandoned; {} links verified in full",
+                result.pairs_matched, evaluations, pairs_abandoned.load(), result.links_verified);
 
   const double seconds = SecondsSince(start);
   result.input = source.info();
   result.seconds = seconds;
   for (size_t i = 0; i < selectors.size(); ++i) {
-    VisualMap map = CollectMap(*selectors[i], source, options, options_json, seconds, maps != nullptr);
+    VisualMap map = CollectMap(*selectors[i], source, options, options_json, seconds, maps != nullptr,
+                               link_verifier.get(), taus[i]);
     const MapStatistics stats = ComputeStatistics(map, options.quality_mean);
     result.num_frames = map.num_frames;
     SweepRow row;
@@ -502,10 +746,169 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
   return result;
 }
 
+// Algorithm 1 with a search for the first frame below tau instead of a frame-by-frame scan. From the key image
+// and the last frame known to pass against it, frames ever further ahead are compared (offsets doubling, at
+// most search_window ahead), then the first failing frame is found by bisection. The last passing frame and the
+// first failing one are then given to a KeyImageSelector, which, from the cached comparisons, makes the key
+// images, links and links below tau Algorithm 1 makes on the whole sequence wherever S decreases with the
+// distance to the key image. Each round compares one frame per thread at once; a frame's features are extracted
+// only when it is compared, and only the frames the search may still compare are held.
+VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
+                          const fs::path& directory, const std::string& options_json) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  const VerifierOptions verifier = DecisionVerifier(options);
+  const std::vector<double> taus = verifier.own_magsac ? std::vector<double>{options.key_images.tau}
+                                                       : std::vector<double>{};
+  const int workers = options.ExtractionThreads();
+  const int window = options.search_window;
+
+  std::map<int, FrameRecord> frames;  // frames read that the search may still need, by index
+  int frames_read = 0;
+  bool source_done = false;
+  ProgressOptions progress_options;
+  progress_options.enabled = options.show_progress;
+  ProgressLine progress("build", source.info().expected_frames, "frames", progress_options);
+  // Reads frames up to `index`; returns the index of the last frame read (-1 when there is none).
+  auto read_until = [&](int index) {
+    while (frames_read <= index && !source_done) {
+      std::optional<Frame> frame = source.Next();
+      if (!frame) {
+        source_done = true;
+        break;
+      }
+      FrameRecord record;
+      record.frame = std::make_shared<const Frame>(std::move(*frame));
+      frames.emplace(frames_read++, std::move(record));
+      progress.Update(frames_read);
+    }
+    return std::min(index, frames_read - 1);
+  };
+
+  std::map<std::pair<int, int>, PairComparison> comparisons;  // by (key, frame) index
+  std::vector<Evaluation> evaluations;                        // every comparison, in the order made
+  auto remember = [&](int key_index, int frame_index, PairComparison comparison) -> const PairComparison& {
+    evaluations.push_back({key_index, frame_index, comparison.similarity, comparison.num_tentative,
+                           comparison.num_verified, comparison.matched});
+    return comparisons[{key_index, frame_index}] = std::move(comparison);
+  };
+  auto compare = [&](const FrameRecord& key, const FrameRecord& frame) {
+    return ComparePair(matcher, *key.features, *frame.features, verifier, options.key_images.similarity, taus);
+  };
+  auto with_features = [&](int index) -> const FrameRecord& {
+    FrameRecord& record = frames.at(index);
+    if (!record.features) record.features = matcher.Extract(record.frame->gray);
+    return record;
+  };
+  // Compares the frames at `positions` with the key, one thread each; returns the first that fails (or -1)
+  // and moves *last_pass to the last one passing before it.
+  auto probe = [&](const FrameRecord& key, const std::vector<int>& positions, int* last_pass) {
+    std::vector<std::future<std::pair<std::shared_ptr<const ImageFeatures>, PairComparison>>> results;
+    for (int position : positions) {
+      if (comparisons.count({key.frame->index, position})) {
+        results.emplace_back();
+        continue;
+      }
+      FrameRecord frame = frames.at(position);
+      results.push_back(std::async(std::launch::async, [&matcher, &compare, key, frame]() mutable {
+        if (!frame.features) frame.features = matcher.Extract(frame.frame->gray);
+        return std::make_pair(frame.features, compare(key, frame));
+      }));
+    }
+    for (size_t i = 0; i < positions.size(); ++i) {
+      if (!results[i].valid()) continue;
+      auto [features, comparison] = results[i].get();
+      frames.at(positions[i]).features = std::move(features);
+      remember(key.frame->index, positions[i], std::move(comparison));
+    }
+    for (int position : positions) {
+      const PairComparison& c = comparisons.at({key.frame->index, position});
+      if (!(c.matched && c.similarity >= options.key_images.tau)) return position;
+      *last_pass = position;
+    }
+    return -1;
+  };
+
+  KeyImageFileWriter image_writer;
+  KeyImageSelector selector(
+      options.key_images,
+      [&](const FrameRecord& key, const FrameRecord& frame) {
+        const auto it = comparisons.find({key.frame->index, frame.frame->index});
+        if (it != comparisons.end()) return it->second;
+        return remember(key.frame->index, frame.frame->index, compare(key, frame));
+      },
+      image_writer.CallbackFor(directory));
+  std::unique_ptr<LinkVerifier> link_verifier;
+  if (verifier.own_magsac) link_verifier = std::make_unique<LinkVerifier>(VerifierOptions(verifier));
+
+  if (read_until(0) == 0) {
+    selector.Add(with_features(0));
+    int last_pass = 0, fed = 0, step = 1;
+    for (;;) {
+      const FrameRecord key = *selector.current_key();
+      frames.erase(frames.begin(), frames.lower_bound(last_pass));  // the selector holds the key itself
+      // Gallop: offsets step .. 2^(workers - 1) step, at most `window` ahead.
+      int first_fail = -1;
+      while (first_fail < 0 && read_until(last_pass + 1) > last_pass) {
+        const int reach = std::min(window, step << std::min(workers - 1, 20));
+        std::vector<int> positions;
+        for (int i = 1; i <= workers; ++i) {
+          const int position = read_until(last_pass + std::max(1, reach * i / workers));
+          if (positions.empty() || position > positions.back()) positions.push_back(position);
+        }
+        first_fail = probe(key, positions, &last_pass);
+        step = std::min(window, 2 * reach);
+      }
+      if (first_fail < 0) {  // the last frame passes: it is the final key image (Finish)
+        if (last_pass > fed) selector.Add(frames.at(last_pass));
+        break;
+      }
+      // Bisect: the frames between the last passing and the first failing frame, split into workers + 1 parts.
+      while (first_fail - last_pass > 1) {
+        std::vector<int> positions;
+        for (int i = 1; i <= workers; ++i) {
+          const int position = last_pass + (first_fail - last_pass) * i / (workers + 1);
+          if (position > last_pass && position < first_fail && (positions.empty() || position > positions.back())) {
+            positions.push_back(position);
+          }
+        }
+        if (positions.empty()) positions.push_back(last_pass + 1);
+        const int failing = probe(key, positions, &last_pass);
+        if (failing >= 0) first_fail = failing;
+      }
+      // Algorithm 1 on the frames found: the last passing frame, then the first failing one.
+      if (last_pass > fed) selector.Add(frames.at(last_pass));
+      selector.Add(with_features(first_fail));
+      fed = last_pass = first_fail;
+      step = 1;
+    }
+  }
+  progress.Finish();
+  selector.Finish();
+  image_writer.Finish();
+  if (link_verifier) {
+    for (const Link& link : selector.links()) {
+      link_verifier->Add(selector.key_images()[link.from_key], selector.key_images()[link.to_key], link,
+                         options.key_images.similarity);
+    }
+    link_verifier->Finish();
+  }
+  VisualMap map = CollectMap(selector, source, options, options_json, SecondsSince(start), /*analyze_links=*/true,
+                             link_verifier.get(), options.key_images.tau);
+  map.num_frames = frames_read;
+  map.evaluations = std::move(evaluations);
+  map.quality = ComputeStatistics(map, options.quality_mean).quality;
+  spdlog::debug("bisect search: {} comparisons for {} frames", map.evaluations.size(), map.num_frames);
+  return map;
+}
+
 }  // namespace
 
 VisualMap BuildMap(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
                    const fs::path& directory, const std::string& options_json) {
+  if (ResolveKeySearch(options, matcher) == KeySearch::kBisect) {
+    return SearchKeyImages(source, matcher, options, directory, options_json);
+  }
   std::vector<VisualMap> maps;
   RunSelectors(source, matcher, options, {options.key_images.tau}, {directory}, &maps, options_json);
   return std::move(maps.front());
@@ -514,6 +917,10 @@ VisualMap BuildMap(FrameSource& source, const Matcher& matcher, const MapBuilder
 SweepResult SweepThresholds(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
                             const std::vector<double>& taus, std::vector<VisualMap>* maps,
                             const fs::path& maps_directory, const std::string& options_json) {
+  if (options.key_search == KeySearch::kBisect) {
+    throw InputError("--search bisect looks for each tau's key images on its own; a sweep compares every frame "
+                     "once for all taus. Run `vmap build --tau T --search bisect` per tau instead");
+  }
   std::vector<fs::path> directories;
   for (double tau : taus) {
     directories.push_back(maps_directory.empty() ? fs::path() : maps_directory / fmt::format("tau_{:.2f}", tau));

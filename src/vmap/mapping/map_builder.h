@@ -17,6 +17,16 @@ namespace vmap {
 
 // --threads accepts 0 (one per core) to this.
 inline constexpr int kMaxExtractionThreads = 256;
+// How Algorithm 1 looks for the next key image.
+enum class KeySearch {
+  kAuto,        // see ResolveKeySearch
+  kSequential,  // every frame is compared with the key image, in order (Algorithm 1 as written)
+  kBisect,      // frames ever further ahead are compared with the key image, then the first frame below tau is
+                // found by bisection: the same key images wherever S decreases with the distance to the key
+                // image, for far fewer comparisons (and feature extractions)
+};
+KeySearch ParseKeySearch(const std::string& name);  // "auto", "sequential", "bisect"
+std::string KeySearchName(KeySearch search);
 
 struct MapBuilderOptions {
   KeyImageOptions key_images;
@@ -26,14 +36,29 @@ struct MapBuilderOptions {
   bool show_progress = true;   // a progress line on a terminal
   int prefetch_frames = 6;     // frames read and extracted ahead of matching
   int extraction_threads = 0;  // threads extracting features; 0 = one per core, at most kMaxExtractionThreads
+  // The paper's exact behaviour: every comparison verified by OpenCV's USAC_MAGSAC to its confidence criterion.
+  // Off (the default), with the magsac verifier, a comparison stops as soon as S >= tau is settled for the taus
+  // it is judged under (vmap's MAGSAC++, geometry/magsac.h) and each link is verified in full: the same maps
+  // within the noise of a seed change, at a fraction of the cost (README, "Threshold sweeps" and "Speed").
+  bool exhaustive = false;
+  KeySearch key_search = KeySearch::kAuto;
+  // kBisect: frames held at most (the furthest a comparison looks ahead); memory grows with it, comparisons
+  // fall slowly as it grows.
+  int search_window = 32;
 
   int ExtractionThreads() const;
 
   void Check() const;  // throws InputError naming the bad option
 };
 
-// Builds one map. When `directory` (which must exist) is not empty, each key image is written there as
-// keys/NNNNNN.png as soon as it is chosen (the caller writes map.json with WriteMapFiles).
+// kAuto resolves to kBisect for matchers that run a network on every image (comparisons cost tens of
+// milliseconds; measured in README "Deep matchers: comparing fewer frames"), and to kSequential for ORB, whose
+// comparisons cost less than decoding, and whenever `exhaustive` asks for the paper's exact behaviour.
+KeySearch ResolveKeySearch(const MapBuilderOptions& options, const Matcher& matcher);
+
+// Builds one map. When `directory` (which must exist) is not empty, each key image is written there as soon as it is chosen,
+// as keys/NNNNNN.png, or as a copy of its image file (keys/NNNNNN.jpg, ...) when the frame is that file as
+// decoded (the caller writes map.json with WriteMapFiles).
 // `options_json` is recorded verbatim in the map.
 VisualMap BuildMap(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
                    const std::filesystem::path& directory = {}, const std::string& options_json = "{}");
@@ -62,6 +87,7 @@ struct SweepResult {
   double seconds = 0.0;
   long features_extracted = 0; // one per frame: no frame is extracted twice
   long pairs_matched = 0;      // pairs matched and verified, including a few made ahead and not needed
+  long links_verified = 0;     // links verified in full after an early-stopped decision (not matched again)
 };
 
 // A sweep runs one key-image selector per threshold, all at once: at most this many.
@@ -72,7 +98,7 @@ inline constexpr int kMaxThresholds = 100;
 std::vector<double> ParseThresholds(const std::string& text);
 
 // Runs every tau over one pass of the sequence: each frame's features are extracted once, and a pair
-// compared for several taus is matched once. When `maps_directory` is given, each tau's map is also
+// compared for several taus is matched once. Always compares every frame (kBisect is per tau: use BuildMap). When `maps_directory` is given, each tau's map is also
 // written there as tau_0.50/ (the caller commits the parent atomically).
 SweepResult SweepThresholds(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
                             const std::vector<double>& taus, std::vector<VisualMap>* maps = nullptr,

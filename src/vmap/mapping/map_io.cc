@@ -242,6 +242,38 @@ std::optional<cv::Size> PngSize(const ContainedFile& file) {
   return cv::Size(static_cast<int>(width), static_cast<int>(height));
 }
 
+
+// The width and height of a baseline or progressive JPEG file's frame header (SOFn), or nullopt when the file
+// is not a JPEG. Walks the marker segments from the start; at most 64 segments and 1 MiB are looked at, since
+// the frame header comes before any image data.
+std::optional<cv::Size> JpegSize(const ContainedFile& file) {
+  unsigned char bytes[9];
+  if (!file.Read(0, bytes, 2) || bytes[0] != 0xFF || bytes[1] != 0xD8) return std::nullopt;
+  std::uint64_t at = 2;
+  for (int segment = 0; segment < 64 && at < (1u << 20); ++segment) {
+    if (!file.Read(at, bytes, 4) || bytes[0] != 0xFF) return std::nullopt;
+    const int marker = bytes[1];
+    const int length = (bytes[2] << 8) | bytes[3];
+    if (marker == 0xFF) {  // fill byte
+      ++at;
+      continue;
+    }
+    // SOF0..SOF15 except DHT (C4), JPG (C8) and DAC (CC): precision, height, width.
+    if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC) {
+      if (!file.Read(at + 4, bytes, 5)) return std::nullopt;
+      return cv::Size((bytes[3] << 8) | bytes[4], (bytes[1] << 8) | bytes[2]);
+    }
+    if (marker == 0xD9 || marker == 0xDA || length < 2) return std::nullopt;  // end or scan before a frame
+    at += 2 + static_cast<std::uint64_t>(length);
+  }
+  return std::nullopt;
+}
+
+// A key image's size from its header: PNG, or JPEG (a key image copied from the input's own file).
+std::optional<cv::Size> KeyImageSize(const ContainedFile& file) {
+  if (auto size = PngSize(file)) return size;
+  return JpegSize(file);
+}
 }  // namespace
 
 std::string MapToJson(const VisualMap& map) { return MapDocument(map, CorrespondenceOffsets(map)).dump(1); }
@@ -312,11 +344,11 @@ void ReadKeyImages(const json& doc, const Fields& fields, const fs::path& direct
     if (!IsPlainRelativePath(k.image_file)) {
       Malformed(file, where + " image '" + k.image_file + "' points outside the map directory");
     }
-    // Only the header is read here: the image must be the PNG vmap writes, of the map's frame size, so that
-    // whoever decodes it later does not meet a decompression bomb.
+    // Only the header is read here: the image must be a PNG (as vmap writes) or a JPEG (the input's own file,
+    // copied) of the map's frame size, so that whoever decodes it later does not meet a decompression bomb.
     const ContainedFile image = OpenMapFile(directory, k.image_file, "key image", file, where + ".image");
-    const std::optional<cv::Size> size = PngSize(image);
-    if (!size) Malformed(file, where + ".image '" + k.image_file + "' is not a PNG image");
+    const std::optional<cv::Size> size = KeyImageSize(image);
+    if (!size) Malformed(file, where + ".image '" + k.image_file + "' is not a PNG or JPEG image");
     const cv::Size expected = map->input.frame_size;
     const bool fits = expected.width > 0 && expected.height > 0
                           ? *size == expected

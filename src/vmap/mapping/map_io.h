@@ -4,7 +4,8 @@
 // A map directory holds:
 //   map.json             versioned description: input, options, n, m, Q, key images, links, evaluations;
 //                        file names and paths percent-encoded where they are not UTF-8 (file_name_encoding.h)
-//   keys/NNNNNN.png      the key images (NNNNNN = frame index in the processed sequence)
+//   keys/NNNNNN.png      the key images (NNNNNN = frame index in the processed sequence; .jpg etc. when the
+//                        key image is a copy of the input image file)
 //   correspondences.bin  every link's tentative matches, little-endian float32 records (x0, y0, x1, y1),
 //                        pixel coordinates with pixel centres at integers (OpenCV); each link names its
 //                        `offset` (first record) and `count`; its first `verified` records are the inliers.

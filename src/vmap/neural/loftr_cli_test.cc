@@ -101,5 +101,33 @@ TEST(VmapWeights, ImportsIntoCacheAndReportsIt) {
   fs::remove_all(cache);
 }
 
+// With the coarse student, `vmap build` looks for key images by bisection unless told otherwise: fewer frames
+// compared than Algorithm 1's scan, and a valid map (every link that is not broken at S >= tau).
+TEST(VmapBuildLoftr, BisectSearchIsTheDefaultAndComparesFewerFrames) {
+  SKIP_WITHOUT_SHARED();
+  const auto dir = TempDir("build_search");
+  const std::string common = "build " + SharedDir() + "/data/rccar_room/images --last 59 --matcher loftr -q -o ";
+  auto load = [](const fs::path& map_dir) {
+    std::ifstream file(map_dir / "map.json");
+    return nlohmann::json::parse(file);
+  };
+  auto r = RunVmap(common + (dir / "auto").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  r = RunVmap(common + (dir / "sequential").string() + " --search sequential");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto bisect = load(dir / "auto"), sequential = load(dir / "sequential");
+  EXPECT_EQ(bisect["options"]["search"], "bisect");
+  EXPECT_EQ(sequential["options"]["search"], "sequential");
+  EXPECT_EQ(bisect["num_frames"], 60);
+  EXPECT_LT(bisect["evaluations"]["frame"].size(), sequential["evaluations"]["frame"].size());
+  EXPECT_EQ(bisect["key_images"].back()["frame_index"], 59);
+  for (const auto& link : bisect["links"]) {
+    if (!link["below_tau"].get<bool>()) {
+      EXPECT_GE(link["similarity"].get<double>(), 0.5);
+    }
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace vmap::neural

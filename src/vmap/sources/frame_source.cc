@@ -165,6 +165,7 @@ void FitFrame(Frame& frame, const cv::Size& target, const cv::Size& first_native
     if ((*warnings)++ < 5) spdlog::warn("{}; resizing it to the first frame's size", message);
   }
   if (native == target) return;
+  frame.resized = true;
   const int interpolation = target.area() < native.area() ? cv::INTER_AREA : cv::INTER_LINEAR;
   cv::resize(frame.gray, frame.gray, target, 0, 0, interpolation);
   if (!frame.color.empty()) cv::resize(frame.color, frame.color, target, 0, 0, interpolation);

@@ -56,6 +56,7 @@ struct Frame {
   std::string source_path;   // the image file, empty for video
   cv::Mat gray;              // 8-bit, one channel: what the matchers see
   cv::Mat color;             // 8-bit BGR when the input is colour; may be empty (then use gray)
+  bool resized = false;      // the decoded image was resized (--resize, or a size that differs from the first)
 };
 
 struct SequenceInfo {
