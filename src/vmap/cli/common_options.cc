@@ -41,6 +41,7 @@ void AddMatcherOptions(CLI::App* command, MatcherOptions& options) {
                       "XFeat: mutual nearest neighbours need a cosine similarity above this (<= 0: no minimum)")
       ->capture_default_str();
   command->add_option("--xfeat-threads", xfeat.num_threads, "XFeat: LibTorch threads per call (0 = LibTorch default)")
+      ->capture_default_str();
   auto& aliked = options.aliked;
   command->add_option("--aliked-model", aliked.model, "ALIKED model: t16 or n16")->capture_default_str();
   command->add_option("--aliked-top-k", aliked.top_k, "ALIKED: keypoints per image (0 = score threshold mode)")

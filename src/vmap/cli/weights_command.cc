@@ -78,8 +78,6 @@ void PrintStatus() {
   }
 }
 
-#ifdef VMAP_WITH_TORCH
-
 void Verify(const std::string& path) {
   const std::string id = neural::GitBlobId(path);
   std::printf("%s\n  git blob id  %s\n", path.c_str(), id.c_str());

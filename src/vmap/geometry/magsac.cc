@@ -216,6 +216,8 @@ class Estimator {
   bool Normalize();
   int SolveMinimal(const std::array<int, kSampleSize>& sample, std::array<Model, 3>* models);
   bool Denormalize(const double* normalized, Model* model) const;
+  int SolveStationary(const std::array<int, kSampleSize>& sample, std::array<Model, 3>* models);
+  bool stationary_sample_ = false;  // the last SolveMinimal's sample had not moved (SolveStationary)
   bool OrientedConstraintHolds(const double* normalized_model, const std::array<int, kSampleSize>& sample) const;
   bool FitFundamental(const std::vector<int>& indices, int count, const std::vector<double>* weights, Model* model);
   bool FitHomography(const std::vector<int>& indices, int count, Mat3* H);
@@ -308,7 +310,7 @@ int Estimator::SolveMinimal(const std::array<int, kSampleSize>& sample, std::arr
       for (int r = k; r < 7; ++r)
         for (int c = k + 1; c < 9; ++c)
           if (std::abs(A[r][c]) > pivot) pivot = std::abs(A[r][c]), pivot_row = r, pivot_col = c;
-      if (pivot < 1e-10) return 0;  // fewer than 7 independent equations: a degenerate sample
+      if (pivot < 1e-10) return SolveStationary(sample, models);  // fewer than 7 independent equations
     }
     if (pivot_row != k) std::swap(A[k], A[pivot_row]);
     if (pivot_col != k) {
@@ -359,6 +361,31 @@ int Estimator::SolveMinimal(const std::array<int, kSampleSize>& sample, std::arr
     if (Denormalize(normalized, &(*models)[count])) ++count;
   }
   return count;
+}
+
+// A sample whose points did not move (a frame repeated, a robot standing still) leaves the epipolar system
+// rank-deficient: every F = [e]x fits it. OpenCV's USAC returns such an F with every unmoved point an inlier,
+// and Algorithm 1 depends on it (a repeated frame must pass, not become a key image); so does this: the
+// epipole is put at the sample's centroid. Any other degenerate sample
+// yields no model.
+int Estimator::SolveStationary(const std::array<int, kSampleSize>& sample, std::array<Model, 3>* models) {
+  constexpr double kUnmoved = 1e-6;  // pixels
+  double cx = 0, cy = 0;
+  for (int i : sample) {
+    const Point& p = points_[i];
+    if (std::abs(p.x1 - p.x0) > kUnmoved || std::abs(p.y1 - p.y0) > kUnmoved) return 0;
+    cx += p.x0 / kSampleSize;
+    cy += p.y0 / kSampleSize;
+  }
+  stationary_sample_ = true;
+  // [e]x for e = (cx, cy, 1), in pixels, scaled to unit norm as Denormalize does.
+  Model& m = (*models)[0];
+  m = {0, -1, cy, 1, 0, -cx, -cy, cx, 0};
+  double norm = 0;
+  for (double v : m) norm += v * v;
+  norm = std::sqrt(norm);
+  for (double& v : m) v /= norm;
+  return 1;
 }
 
 // F in pixels from F in normalised coordinates: T1^T Fn T0 with T = [s 0 tx; 0 s ty; 0 0 1], scaled to unit norm.
@@ -719,6 +746,7 @@ FundamentalResult Estimator::Run(MagsacStatistics* statistics) {
       while (std::find(sample.begin(), sample.begin() + k, index) != sample.begin() + k);
       sample[k] = index;
     }
+    stationary_sample_ = false;
     const int num_models = SolveMinimal(sample, &models);
     const bool refine_samples = iterations >= kItersScoredWithoutSprt && iterations % kSigmaConsensusEvery == 0;
     for (int m = 0; m < num_models; ++m) {
@@ -735,7 +763,9 @@ FundamentalResult Estimator::Run(MagsacStatistics* statistics) {
       if (!(score.value > best_score_.value)) continue;
       Model recovered;
       Score recovered_score;
-      if (RecoverIfDegenerate(sample, model, &recovered, &recovered_score)) {
+      // A stationary sample's model is the degenerate case itself (H = I explains every point): no plane and
+      // parallax to recover it from.
+      if (!stationary_sample_ && RecoverIfDegenerate(sample, model, &recovered, &recovered_score)) {
         if (!(recovered_score.value > best_score_.value)) continue;
         update_best(recovered, recovered_score);
       } else {

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
 
 #include "vmap/features/orb_matcher.h"
 #include "vmap/sources/frame_source.h"
@@ -147,6 +148,23 @@ TEST(Magsac, DegenerateInputFailsCleanly) {
   if (collinear.success) {
     EXPECT_EQ(collinear.inlier_mask.size(), line0.size());
   }
+}
+
+// A frame repeated (or a robot standing still): every point where it was. Like OpenCV's USAC, the estimate
+// succeeds with every unmoved point an inlier, so that Algorithm 1 sees S = 1 and makes no key image of it;
+// most points that moved are outliers.
+TEST(Magsac, UnmovedPointsAreInliers) {
+  const Scene scene = MakeScene(150, 0, 0.0, 5);
+  std::vector<cv::Point2f> p1 = scene.p0;
+  for (int i = 0; i < 15; ++i) p1[i] += cv::Point2f(40.f + i, -25.f);  // a few that moved
+  const FundamentalResult result = EstimateFundamentalMagsac(scene.p0, p1, {});
+  ASSERT_TRUE(result.success);
+  // Every unmoved point fits; of the moved ones only those that happened to move along a line through the
+  // epipole can.
+  for (size_t i = 15; i < p1.size(); ++i) EXPECT_TRUE(result.inlier_mask[i]) << i;
+  EXPECT_LT(result.num_inliers, 150);
+  const cv::Mat F = cv::findFundamentalMat(scene.p0, p1, cv::USAC_MAGSAC, 1.0, 0.999, 100000);
+  EXPECT_FALSE(F.empty()) << "OpenCV accepts the same input";
 }
 
 // A scene that is one plane only: F is not unique, but every correspondence fits the model returned.

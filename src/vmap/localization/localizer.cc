@@ -272,6 +272,15 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   return result;
 }
 
+double Localizer::SharedWithLink(const KeyComparison& comparison, int key_a, int key_b) const {
+  for (const Link& link : map_.links) {
+    if ((link.from_key == key_a && link.to_key == key_b) || (link.from_key == key_b && link.to_key == key_a)) {
+      return link.num_verified > 0 ? static_cast<double>(comparison.num_verified) / link.num_verified : 0.0;
+    }
+  }
+  return 0.0;  // no link between them: not comparable
+}
+
 LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures& features) {
   LocalizationResult result;
   const cv::Mat thumbnail = ranking_->method() == RankingMethod::kThumbnails
@@ -294,14 +303,22 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
     result.status = LocalizationStatus::kLost;
     return result;  // no estimate: key and next_key stay -1
   }
-  // The frame is near the best key image: on the segment before it or after it, whichever neighbour on the
-  // route is the better match.
+  // The frame is near the best key image: on the segment before it or after it. Each neighbour's verified
+  // matches with the frame are weighed against those of its link with the best key image: a frame between the
+  // neighbour and the key shares more with the neighbour than the key does, one beyond the key shares less. The
+  // ratio makes segments of different lengths comparable (a raw count favours the shorter one).
   int position = best_position;
   if (position > 0) {
     const KeyComparison before = CompareOnce(features, route_[position - 1]);
     const bool has_next = position + 1 < static_cast<int>(route_.size());
     const KeyComparison after = has_next ? CompareOnce(features, route_[position + 1]) : KeyComparison();
-    if (before.accepted && (!has_next || Better(before, after))) position -= 1;
+    if (before.accepted && (!has_next || !after.accepted)) {
+      position -= 1;
+    } else if (before.accepted) {
+      const double before_share = SharedWithLink(before, route_[position - 1], route_[position]);
+      const double after_share = SharedWithLink(after, route_[position], route_[position + 1]);
+      if (before_share > 0 && after_share > 0 ? before_share > after_share : Better(before, after)) position -= 1;
+    }
   }
   position_ = position;
   lost_in_a_row_ = 0;

@@ -159,6 +159,10 @@ class Localizer {
   LocalizationResult Relocalize(const Frame& frame, const ImageFeatures& features);
   void Describe(LocalizationResult& result, int position, const ImageFeatures& features);
 
+  // The frame's verified matches with key_a over those of the map's link between key_a and key_b (0 when
+  // they have no link).
+  double SharedWithLink(const KeyComparison& comparison, int key_a, int key_b) const;
+
   const VisualMap& map_;
   const KeyImageStore& keys_;
   const Matcher& matcher_;

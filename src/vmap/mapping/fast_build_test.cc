@@ -228,6 +228,7 @@ TEST(FastBuild, KeyImagesAreTheInputFilesWhenTheyCanBe) {
   };
   {
     auto source = OpenFrameSource((temp.path() / "images").string());
+    fs::create_directory(temp.path() / "map");  // BuildMap writes into an existing folder
     const VisualMap map = BuildMap(*source, *matcher, options, temp.path() / "map");
     ASSERT_GE(map.key_images.size(), 2u);
     for (const KeyImage& key : map.key_images) {
@@ -240,6 +241,7 @@ TEST(FastBuild, KeyImagesAreTheInputFilesWhenTheyCanBe) {
     FrameSourceOptions half;
     half.resize = "160x120";
     auto source = OpenFrameSource((temp.path() / "images").string(), half);
+    fs::create_directory(temp.path() / "resized");
     const VisualMap map = BuildMap(*source, *matcher, options, temp.path() / "resized");
     ASSERT_GE(map.key_images.size(), 2u);
     for (const KeyImage& key : map.key_images) {

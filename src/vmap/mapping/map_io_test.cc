@@ -315,7 +315,7 @@ TEST(MapIo, KeyImagesMustBeThePngsOfTheMapsFrameSize) {
   WriteMapFiles(SmallMap(tmp.path()), tmp.path());
   const fs::path key = tmp.path() / "keys/9.png";
   std::ofstream(key, std::ios::trunc) << "GIF89a";
-  EXPECT_NE(ErrorOf(tmp.path()).find("'keys/9.png' is not a PNG image"), std::string::npos) << ErrorOf(tmp.path());
+  EXPECT_NE(ErrorOf(tmp.path()).find("'keys/9.png' is not a PNG or JPEG image"), std::string::npos) << ErrorOf(tmp.path());
   cv::imwrite(key.string(), cv::Mat(10, 12, CV_8U, cv::Scalar(3)));
   EXPECT_NE(ErrorOf(tmp.path()).find("is 12x10, not the map's frame size 64x48"), std::string::npos) << ErrorOf(tmp.path());
   // A PNG header announcing 40000 x 40000 pixels: refused from its 24 bytes, never decoded.

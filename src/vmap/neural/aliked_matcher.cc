@@ -26,7 +26,7 @@ class AlikedFeatures : public ImageFeatures {
   int num_features() const override { return static_cast<int>(keypoints_.size()); }
   cv::Size image_size() const override { return size_; }
   const std::vector<cv::Point2f>& keypoints() const { return keypoints_; }
-  const cv::Mat& descriptors() const { return descriptors_; }  // CV_32F, one L2-normalised row per keypoint
+  cv::Mat descriptors() const override { return descriptors_; }  // CV_32F, one L2-normalised row per keypoint
 
  private:
   std::vector<cv::Point2f> keypoints_;

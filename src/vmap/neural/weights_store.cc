@@ -16,6 +16,13 @@ namespace vmap::neural {
 
 namespace {
 
+// The command-line choice a preset stands for, for messages: "--loftr-model coarse", "--matcher xfeat",
+// "--aliked-model t16".
+std::string ModelFlag(const KnownWeights& known) {
+  const std::string& preset = known.preset;
+  return known.option + " " + (preset.rfind("aliked-", 0) == 0 ? preset.substr(7) : preset);
+}
+
 std::string Env(const char* name) {
   const char* value = std::getenv(name);
   return value ? std::string(value) : std::string();
@@ -118,8 +125,7 @@ std::string LocateWeights(const std::string& preset, const std::string& explicit
     if (IsFile(path)) return path;
   }
   const auto& known = KnownWeightsFor(preset);
-  const std::string name = preset.rfind("aliked-", 0) == 0 ? preset.substr(7) : preset;
-  std::string message = "no weights for " + known.option + " " + name + "; searched:";
+  std::string message = "no weights for " + ModelFlag(known) + "; searched:";
   for (const auto& path : paths) message += "\n  " + path;
   if (!known.url.empty()) {
     message += "\nGet them with `vmap weights --download " + preset + "` (" + known.url +
@@ -159,7 +165,7 @@ std::string ImportWeights(const std::string& source, const std::string& preset, 
 std::string DownloadWeights(const std::string& preset, const std::string& cache_dir, bool verify) {
   const auto& known = KnownWeightsFor(preset);
   if (known.url.empty()) {
-    throw InputError("there is no download for " + ModelFlag(preset) + ": " + known.description);
+    throw InputError("there is no download for " + ModelFlag(known) + ": " + known.description);
   }
   std::error_code error;
   fs::create_directories(cache_dir, error);

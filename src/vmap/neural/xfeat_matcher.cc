@@ -30,7 +30,13 @@ class XfeatFeatures : public ImageFeatures {
   int num_features() const override { return static_cast<int>(keypoints_.size()); }
   cv::Size image_size() const override { return image_size_; }
   const std::vector<cv::Point2f>& keypoints() const { return keypoints_; }
-  const torch::Tensor& descriptors() const { return descriptors_; }  // (n, 64) on the model's device
+  const torch::Tensor& descriptor_tensor() const { return descriptors_; }  // (n, 64) on the model's device
+  // L2-normalised CV_32F rows, for localization's ranking of key images.
+  cv::Mat descriptors() const override {
+    if (!descriptor_rows_.empty()) return descriptor_rows_;
+    const torch::Tensor cpu = descriptors_.to(torch::kCPU).contiguous();
+    return cv::Mat(static_cast<int>(cpu.size(0)), static_cast<int>(cpu.size(1)), CV_32F, cpu.data_ptr<float>()).clone();
+  }
   const cv::Mat& descriptor_rows() const { return descriptor_rows_; }  // the same rows; CPU only
 
  private:
@@ -103,7 +109,7 @@ class XfeatMatcher : public Matcher {
       return matches;
     }
     torch::InferenceMode guard;
-    const auto [pairs, similarity] = neural::XfeatMatch(f0->descriptors(), f1->descriptors(), options_.min_similarity);
+    const auto [pairs, similarity] = neural::XfeatMatch(f0->descriptor_tensor(), f1->descriptor_tensor(), options_.min_similarity);
     const auto pairs_cpu = pairs.to(torch::kCPU).contiguous();
     const auto similarity_cpu = similarity.to(torch::kCPU).contiguous();
     const int64_t* index = pairs_cpu.data_ptr<int64_t>();
