@@ -62,9 +62,8 @@ void RunLocalize(const LocalizeFlags& flags) {
     options.route = PlanRoute(header, flags.from >= 0 ? flags.from : 0, flags.to >= 0 ? flags.to : last).keys;
   }
   // Frames are compared with key images at the map's size unless told otherwise.
-  if (source_options.resize.empty() && !header.input.frame_size.empty()) {
-    source_options.resize = fmt::format("{}x{}", header.input.frame_size.width, header.input.frame_size.height);
-  }
+  const std::string map_size = fmt::format("{}x{}", header.input.frame_size.width, header.input.frame_size.height);
+  if (source_options.resize.empty() && !header.input.frame_size.empty()) source_options.resize = map_size;
   const std::unique_ptr<FrameSource> source = OpenFrameSource(flags.query, source_options);
 
   KeyImageStoreOptions store_options;
@@ -76,6 +75,13 @@ void RunLocalize(const LocalizeFlags& flags) {
   const LocalizerOptions from_map = MapLocalizerOptions(map);
   options.verifier = from_map.verifier;
   options.similarity = from_map.similarity;
+  // The map's camera describes frames of the map's size: headings in degrees and poses need the query at it.
+  if (from_map.camera && source_options.resize == map_size) {
+    options.camera = from_map.camera;
+  } else if (from_map.camera) {
+    spdlog::warn("--resize {} differs from the map's frame size {}: headings in pixels only, no relative poses",
+                 source_options.resize, map_size);
+  }
   options.Check();
   Localizer localizer(map, opened.keys, *opened.matcher, options);
 

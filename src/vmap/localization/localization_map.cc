@@ -25,6 +25,7 @@ LocalizerOptions MapLocalizerOptions(const VisualMap& map) {
   LocalizerOptions options;
   options.verifier = MapVerifierOptions(map);
   options.similarity = MapSimilarityMode(map);
+  options.camera = map.input.camera;
   return options;
 }
 

@@ -45,6 +45,16 @@ double NumberOr(const json& object, const char* name, double fallback) {
   return it != object.end() && it->is_number() ? it->get<double>() : fallback;
 }
 
+// The pose to the key image the heading is measured against: next_key's, or key's at the route's end.
+const RelativePose& TargetPose(const LocalizationResult& r) { return r.next_key >= 0 ? r.to_next.pose : r.to_key.pose; }
+
+json PoseJson(const RelativePose& pose) {
+  if (!pose.valid) return nullptr;
+  json R = json::array();
+  for (int i = 0; i < 9; ++i) R.push_back(pose.R(i / 3, i % 3));
+  return {{"R", R}, {"t", {pose.t[0], pose.t[1], pose.t[2]}}};
+}
+
 }  // namespace
 
 std::string DescribeLocalizerOptions(const LocalizerOptions& options) {
@@ -75,7 +85,7 @@ std::string DescribeLocalizerOptions(const LocalizerOptions& options) {
 std::string LocalizationCsvHeader() {
   return "frame,source_index,timestamp,source_name,status,key,next_key,key_frame,next_key_frame,similarity,verified,"
          "tentative,next_similarity,next_verified,next_tentative,heading_px,progress,comparisons,seconds,"
-         "F00,F01,F02,F10,F11,F12,F20,F21,F22\n";
+         "F00,F01,F02,F10,F11,F12,F20,F21,F22,heading_deg,R00,R01,R02,R10,R11,R12,R20,R21,R22,tx,ty,tz\n";
 }
 
 std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r) {
@@ -90,6 +100,10 @@ std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r
     row += ',';
     if (r.to_next.matched) row += fmt::format("{:.9g}", r.to_next.F(i / 3, i % 3));
   }
+  row += ',' + CsvNumber(r.heading_deg);
+  const RelativePose& pose = TargetPose(r);
+  for (int i = 0; i < 9; ++i) row += ',' + (pose.valid ? fmt::format("{:.9g}", pose.R(i / 3, i % 3)) : std::string());
+  for (int i = 0; i < 3; ++i) row += ',' + (pose.valid ? fmt::format("{:.9g}", pose.t[i]) : std::string());
   return row + "\n";
 }
 
@@ -158,6 +172,8 @@ std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run
                       {"next_verified", r.to_next.num_verified},
                       {"next_tentative", r.to_next.num_tentative},
                       {"heading_px", Number(r.heading_px)},
+                      {"heading_deg", Number(r.heading_deg)},
+                      {"pose", PoseJson(TargetPose(r))},
                       {"progress", Number(r.progress)},
                       {"F", F},
                       {"candidates", candidates},
@@ -236,6 +252,7 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
         for (int i = 0; i < 9; ++i) r.to_next.F(i / 3, i % 3) = f["F"][i].get<double>();
       }
       r.heading_px = NumberOr(f, "heading_px", std::nan(""));
+      r.heading_deg = NumberOr(f, "heading_deg", std::nan(""));
       r.progress = NumberOr(f, "progress", std::nan(""));
       if (f.contains("candidates") && f["candidates"].is_array()) {
         for (const json& c : f["candidates"]) {

@@ -43,6 +43,10 @@ LocalizationRun SampleRun() {
   tracked.to_key = {0, true, true, 0.75, 200, 150, cv::Matx33d::zeros(), 1.5};
   tracked.to_next = {1, true, true, 0.5, 100, 50, cv::Matx33d(1, 2, 3, 4, 5, 6, 7, 8, 9), -2.0};
   tracked.heading_px = -2.0;
+  tracked.heading_deg = -0.25;
+  tracked.to_next.pose.valid = true;
+  tracked.to_next.pose.R = cv::Matx33d(0, -1, 0, 1, 0, 0, 0, 0, 1);
+  tracked.to_next.pose.t = cv::Vec3d(0.6, 0, 0.8);
   tracked.progress = 0.25;
   tracked.candidates = {{0, 120.0, true, 0.75, 150}, {1, 80.0, true, 0.5, 50}};
   LocalizationResult lost;
@@ -72,7 +76,8 @@ TEST(LocalizationOutput, CsvHasTheNamedColumnsAndOneRowPerFrame) {
   std::getline(lines, row1);
   EXPECT_FALSE(std::getline(lines, extra));
   for (const char* column : {"frame", "source_index", "status", "key", "next_key", "similarity", "verified",
-                             "next_similarity", "next_verified", "heading_px", "progress", "F00", "F22"}) {
+                             "next_similarity", "next_verified", "heading_px", "progress", "F00", "F22",
+                             "heading_deg", "R00", "R22", "tx", "tz"}) {
     EXPECT_NE(("," + header + ",").find(std::string(",") + column + ","), std::string::npos) << column;
   }
   auto count = [](const std::string& s) { return std::count(s.begin(), s.end(), ','); };
@@ -80,7 +85,7 @@ TEST(LocalizationOutput, CsvHasTheNamedColumnsAndOneRowPerFrame) {
   EXPECT_EQ(count(row1), count(header));
   EXPECT_EQ(row0.rfind("0,3,0.100000,frame_000003,relocalized,0,1,0,40,0.75,150,200,0.5,50,100,-2,0.25,", 0), 0u)
       << row0;
-  EXPECT_NE(row0.find(",1,2,3,4,5,6,7,8,9"), std::string::npos) << row0;
+  EXPECT_NE(row0.find(",1,2,3,4,5,6,7,8,9,-0.25,0,-1,0,1,0,0,0,0,1,0.6,0,0.8"), std::string::npos) << row0;
   // Unknown values are empty, not "nan".
   EXPECT_EQ(row1.find("nan"), std::string::npos) << row1;
   EXPECT_EQ(row1.rfind("1,4,,frame,lost,-1,-1,-1,-1,,0,0,,0,0,,,", 0), std::string::npos) << row1;
@@ -97,6 +102,10 @@ TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
   EXPECT_EQ(doc["format"], "vmap-localization");
   EXPECT_DOUBLE_EQ(doc["summary"]["share_lost"].get<double>(), 0.5);
   EXPECT_TRUE(doc["frames"][1]["heading_px"].is_null());
+  EXPECT_TRUE(doc["frames"][1]["pose"].is_null());
+  EXPECT_EQ(doc["frames"][0]["pose"]["t"], nlohmann::json::array({0.6, 0.0, 0.8}));
+  EXPECT_EQ(doc["frames"][0]["pose"]["R"][1], -1.0);
+  EXPECT_DOUBLE_EQ(doc["frames"][0]["heading_deg"].get<double>(), -0.25);
   EXPECT_EQ(doc["frames"][0]["key_frame"], 0);
   EXPECT_EQ(doc["frames"][0]["next_key_frame"], 40);
   const LocalizationRun back = ReadLocalizationRun(file);

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "vmap/evaluation/ground_truth.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localization_output.h"
@@ -236,7 +237,11 @@ TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
 
 // The bracket test on a subset: a map of the even frames, and each odd frame localized at one of the two key
 // images around it (the README has the full sequences).
-double BracketShare(const std::string& sequence, int last) {
+struct PoseErrors {
+  std::vector<double> rotation_deg, translation_deg;  // of each frame's pose to its target key image
+};
+
+double BracketShare(const std::string& sequence, int last, PoseErrors* pose_errors = nullptr) {
   ::vmap::testing::TempDir tmp;
   const auto matcher = CreateOrbMatcher({});
   MapBuilderOptions build;
@@ -256,10 +261,24 @@ double BracketShare(const std::string& sequence, int last) {
   LocalizeSequenceOptions run;
   run.show_progress = false;
   long bracketed = 0;
+  const std::optional<GroundTruth> truth =
+      pose_errors ? FindGroundTruth((Shared() / sequence).string(), SourceFormat::kAuto) : std::nullopt;
+  if (pose_errors) EXPECT_TRUE(truth.has_value()) << sequence << " comes with ground truth";
   const LocalizationSummary summary =
       LocalizeSequence(*source, *opened.matcher, localizer, run, [&](const Frame& frame, const LocalizationResult& r) {
         const auto [before, after] = KeysAround(opened.map, frame.source_index);
         bracketed += r.key >= 0 && (r.key == before || r.key == after);
+        const RelativePose& pose = r.next_key >= 0 ? r.to_next.pose : r.to_key.pose;
+        if (!truth || !pose.valid) return;
+        const int target_source = opened.map.key_images[r.next_key >= 0 ? r.next_key : r.key].source_index;
+        cv::Matx33d R;
+        cv::Vec3d t;
+        RelativeFromCameraToWorld(truth->camera_to_world.at(frame.source_index),
+                                  truth->camera_to_world.at(target_source), &R, &t);
+        const cv::Matx33d dR = pose.R * R.t();
+        pose_errors->rotation_deg.push_back(std::acos(std::clamp((cv::trace(dR) - 1.0) / 2.0, -1.0, 1.0)) * 180 / M_PI);
+        pose_errors->translation_deg.push_back(
+            std::acos(std::clamp(pose.t.dot(t) / cv::norm(t), -1.0, 1.0)) * 180 / M_PI);
       });
   EXPECT_EQ(summary.frames, (last + 1) / 2);
   return static_cast<double>(bracketed) / summary.frames;
@@ -267,7 +286,16 @@ double BracketShare(const std::string& sequence, int last) {
 
 TEST(LocalizationTruth, OddFramesOfKitti07AreBetweenTheirKeyImages) {
   REQUIRE_SHARED();
-  EXPECT_GE(BracketShare("data/kitti07", 99), 0.95);
+  PoseErrors errors;
+  EXPECT_GE(BracketShare("data/kitti07", 99, &errors), 0.95);
+  // With KITTI's camera each frame also gets the pose of the key image ahead: against the ground truth.
+  ASSERT_GE(errors.rotation_deg.size(), 40u);
+  auto median = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  EXPECT_LT(median(errors.rotation_deg), 0.5);
+  EXPECT_LT(median(errors.translation_deg), 5.0);
 }
 
 TEST(LocalizationTruth, OddFramesOfRedkitchenAreBetweenTheirKeyImages) {

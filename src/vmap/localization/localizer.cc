@@ -16,15 +16,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-double Median(std::vector<double> values) {
-  if (values.empty()) return kNaN;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  if (values.size() % 2 == 1) return values[mid];
-  const double upper = values[mid];
-  return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + mid));
-}
-
 // Which of two accepted comparisons is the better match: more verified matches, then higher S.
 // Measured on the bracket test (README): S first, S times verified, a 10 % or 25 % margin before moving on,
 // and moving on only when S is higher too localized no more odd frames of redkitchen between their key
@@ -157,8 +148,24 @@ KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
   std::vector<double> dx;
   dx.reserve(pair.num_verified);
   for (int i = 0; i < pair.num_verified; ++i) dx.push_back(pair.correspondences[i].p0.x - pair.correspondences[i].p1.x);
-  c.median_dx = pair.matched ? Median(std::move(dx)) : kNaN;
-  // HOOK(camera): heading in degrees and relative pose from the verified matches and c.F (see localizer.h).
+  c.median_dx = pair.matched && !dx.empty() ? Median(std::move(dx)) : kNaN;  // geometry/relative_pose.h
+  if (options_.camera && pair.matched && pair.num_verified > 0) {
+    std::vector<cv::Point2f> frame_points, key_points;
+    frame_points.reserve(pair.num_verified);
+    key_points.reserve(pair.num_verified);
+    for (int i = 0; i < pair.num_verified; ++i) {
+      frame_points.push_back(pair.correspondences[i].p0);
+      key_points.push_back(pair.correspondences[i].p1);
+    }
+    const Camera& camera = *options_.camera;
+    const std::vector<cv::Point2d> frame_rays = NormalizePoints(camera, frame_points);
+    const std::vector<cv::Point2d> key_rays = NormalizePoints(camera, key_points);
+    std::vector<double> bearings;
+    bearings.reserve(frame_points.size());
+    for (size_t i = 0; i < frame_points.size(); ++i) bearings.push_back(std::atan(frame_rays[i].x) - std::atan(key_rays[i].x));
+    c.median_dx_deg = Median(std::move(bearings)) * 180.0 / M_PI;
+    c.pose = PoseFromFundamental(pair.F, camera, frame_points, key_points);
+  }
   return c;
 }
 
@@ -208,7 +215,7 @@ void Localizer::Describe(LocalizationResult& result, int position, const ImageFe
   result.to_next = at_end ? KeyComparison() : CompareOnce(features, result.next_key);
   const KeyComparison& target = at_end ? result.to_key : result.to_next;
   result.heading_px = target.matched ? target.median_dx : kNaN;
-  // HOOK(camera): with intrinsics, the heading in degrees and the pose to `target` from target.F here.
+  result.heading_deg = target.matched ? target.median_dx_deg : kNaN;
   if (at_end) {
     result.progress = result.to_key.accepted ? 0.0 : kNaN;
   } else {

@@ -19,7 +19,9 @@
 //
 // "Better match" and "verified" are measured by the verified matches (inliers of F) and S, as in the map.
 
+#include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -27,7 +29,9 @@
 #include <opencv2/core.hpp>
 
 #include "vmap/features/matcher.h"
+#include "vmap/geometry/camera.h"
 #include "vmap/geometry/fundamental.h"
+#include "vmap/geometry/relative_pose.h"
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/localization/key_image_store.h"
 #include "vmap/mapping/key_image_selector.h"
@@ -59,12 +63,9 @@ struct LocalizerOptions {
   SimilarityMode similarity = SimilarityMode::kInlierRatio;
   // Key-image indices to follow, in order (PlanRoute gives one); empty = every key image in map order.
   std::vector<int> route;
-  // HOOK(camera): the map's camera (map.input.camera, geometry/camera.h: intrinsics from the dataset or
-  // --camera, stored in map.json) goes here as an optional member. With it, Localizer::Compare (where the verified matches
-  // are at hand) adds to KeyComparison the heading in degrees (median over the verified matches of the
-  // difference of atan((x - cx) / fx) in the frame and in the key image) and the relative pose (R, unit t)
-  // by PoseFromFundamental (geometry/relative_pose.h), and Localizer::Describe copies the target's into the
-  // result. Until then: pixels only.
+  // The map's camera (map.input.camera: intrinsics from the dataset or --camera). With it each comparison
+  // also gives the heading in degrees and the relative pose to the key image; without, pixels only.
+  std::optional<Camera> camera;
 
   void Check() const;  // throws InputError naming the bad option
 };
@@ -87,6 +88,12 @@ struct KeyComparison {
   cv::Matx33d F = cv::Matx33d::zeros();  // x_key^T F x_frame = 0 (pixels); zero when !matched
   // Verified matches: median horizontal displacement, x in the frame minus x in the key image (pixels).
   double median_dx = 0.0;
+  // With a camera: the same as a bearing, the median over the verified matches of atan(x_n) in the frame
+  // minus atan(x_n) in the key image, x_n the undistorted normalised image x (degrees; NaN without).
+  double median_dx_deg = std::numeric_limits<double>::quiet_NaN();
+  // With a camera: the key image's camera relative to the frame's, X_key = R X_frame + t, t of unit length
+  // (PoseFromFundamental on F and the verified matches: no extra estimation). Invalid without.
+  RelativePose pose;
 };
 
 // A key image the ranking proposed when relocalizing, and how its verification went.
@@ -114,7 +121,9 @@ struct LocalizationResult {
   // pixels. Positive: the scene appears to the right of where the key image has it, i.e. the robot points
   // left of the key image's heading and should turn right (clockwise seen from above). NaN when unknown.
   double heading_px = 0.0;
-  // HOOK(camera): heading_deg and the relative pose (R, unit t) to the target key image come here.
+  // The same heading as a bearing in degrees (with the map's camera; NaN without). The relative pose to the
+  // target key image is target's `pose` (to_next, or to_key at the route's end).
+  double heading_deg = std::numeric_limits<double>::quiet_NaN();
   // Progress along the segment key -> next_key in [0, 1]: v_next / (v_key + v_next) with v the verified
   // matches to each (0 at `key`, 1 at `next_key`, 0.5 where both share as much). NaN when unknown.
   double progress = 0.0;
