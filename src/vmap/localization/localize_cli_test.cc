@@ -263,7 +263,9 @@ double BracketShare(const std::string& sequence, int last, PoseErrors* pose_erro
   long bracketed = 0;
   const std::optional<GroundTruth> truth =
       pose_errors ? FindGroundTruth((Shared() / sequence).string(), SourceFormat::kAuto) : std::nullopt;
-  if (pose_errors) EXPECT_TRUE(truth.has_value()) << sequence << " comes with ground truth";
+  if (pose_errors) {
+    EXPECT_TRUE(truth.has_value()) << sequence << " comes with ground truth";
+  }
   const LocalizationSummary summary =
       LocalizeSequence(*source, *opened.matcher, localizer, run, [&](const Frame& frame, const LocalizationResult& r) {
         const auto [before, after] = KeysAround(opened.map, frame.source_index);
