@@ -22,6 +22,13 @@ void Read(const nlohmann::json& object, const char* name, T& value, const std::s
   }
 }
 
+// The weights file recorded where the map was built may not exist here: search the weights directories.
+void SearchWeightsWhenMissing(const char* model, std::string& weights) {
+  if (weights.empty() || std::filesystem::exists(weights)) return;
+  spdlog::info("the map's {} weights '{}' are not here; searching the weights directories", model, weights);
+  weights.clear();
+}
+
 }  // namespace
 
 MatcherOptions MatcherOptionsFromJson(const std::string& matcher_json, const std::string& map_file) {
@@ -54,11 +61,29 @@ MatcherOptions MatcherOptionsFromJson(const std::string& matcher_json, const std
     Read(doc, "longest_side", loftr.longest_side, map_file);
     Read(doc, "threshold", loftr.threshold, map_file);
     Read(doc, "threads", loftr.num_threads, map_file);
-    // The weights file recorded where the map was built may not exist here: search the weights directories.
-    if (!loftr.weights.empty() && !std::filesystem::exists(loftr.weights)) {
-      spdlog::info("the map's LoFTR weights '{}' are not here; searching the weights directories", loftr.weights);
-      loftr.weights.clear();
-    }
+    SearchWeightsWhenMissing("LoFTR", loftr.weights);
+  } else if (options.type == "xfeat") {
+    XfeatMatcherOptions& xfeat = options.xfeat;
+    Read(doc, "weights", xfeat.weights, map_file);
+    Read(doc, "device", xfeat.device, map_file);
+    Read(doc, "top_k", xfeat.top_k, map_file);
+    Read(doc, "detection_threshold", xfeat.detection_threshold, map_file);
+    Read(doc, "min_similarity", xfeat.min_similarity, map_file);
+    Read(doc, "threads", xfeat.num_threads, map_file);
+    SearchWeightsWhenMissing("XFeat", xfeat.weights);
+  } else if (options.type == "aliked") {
+    AlikedMatcherOptions& aliked = options.aliked;
+    Read(doc, "model", aliked.model, map_file);
+    if (aliked.model.rfind("aliked-", 0) == 0) aliked.model = aliked.model.substr(7);  // recorded as aliked-t16
+    Read(doc, "weights", aliked.weights, map_file);
+    Read(doc, "device", aliked.device, map_file);
+    Read(doc, "top_k", aliked.top_k, map_file);
+    Read(doc, "score_threshold", aliked.score_threshold, map_file);
+    Read(doc, "max_keypoints", aliked.max_keypoints, map_file);
+    Read(doc, "min_similarity", aliked.min_similarity, map_file);
+    Read(doc, "longest_side", aliked.longest_side, map_file);
+    Read(doc, "threads", aliked.num_threads, map_file);
+    SearchWeightsWhenMissing("ALIKED", aliked.weights);
   } else {
     throw InputError("map '" + map_file + "' was built with the matcher '" + options.type +
                      "', which this vmap cannot create; use a vmap that has it");

@@ -44,6 +44,32 @@ TEST(MatcherOptionsFromJson, ReadsLoftrOptionsAndDropsAWeightsFileThatIsNotHere)
   EXPECT_EQ(options.loftr.num_threads, 2);
 }
 
+// What XFeat and ALIKED matchers record in map.json (neural/xfeat_matcher.cc, aliked_matcher.cc) rebuilds
+// their options, so that `vmap localize` runs on their maps.
+TEST(MatcherOptionsFromJson, ReadsXfeatAndAlikedOptions) {
+  const MatcherOptions xfeat = MatcherOptionsFromJson(
+      R"({"type": "xfeat", "weights": "/nowhere/xfeat.pt", "weights_layout": "folded", "device": "cpu",
+          "top_k": 2048, "detection_threshold": 0.04, "min_similarity": 0.8, "threads": 1})",
+      "map.json");
+  EXPECT_EQ(xfeat.type, "xfeat");
+  EXPECT_EQ(xfeat.xfeat.weights, "");
+  EXPECT_EQ(xfeat.xfeat.top_k, 2048);
+  EXPECT_DOUBLE_EQ(xfeat.xfeat.detection_threshold, 0.04);
+  EXPECT_DOUBLE_EQ(xfeat.xfeat.min_similarity, 0.8);
+  const MatcherOptions aliked = MatcherOptionsFromJson(
+      R"({"type": "aliked", "model": "aliked-n16", "weights": "", "device": "cpu", "top_k": 0,
+          "score_threshold": 0.3, "max_keypoints": 3000, "min_similarity": 0.9, "longest_side": 640,
+          "threads": 1, "nms_radius": 2, "sub_pixel": true})",
+      "map.json");
+  EXPECT_EQ(aliked.type, "aliked");
+  EXPECT_EQ(aliked.aliked.model, "n16");
+  EXPECT_EQ(aliked.aliked.top_k, 0);
+  EXPECT_DOUBLE_EQ(aliked.aliked.score_threshold, 0.3);
+  EXPECT_EQ(aliked.aliked.max_keypoints, 3000);
+  EXPECT_DOUBLE_EQ(aliked.aliked.min_similarity, 0.9);
+  EXPECT_EQ(aliked.aliked.longest_side, 640);
+}
+
 TEST(MatcherOptionsFromJson, UnknownOrMissingMatchersAreClearErrors) {
   auto message = [](const std::string& json) {
     try {
