@@ -20,6 +20,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/core/progress.h"
+#include "vmap/mapping/map_io.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -325,13 +326,18 @@ class FeaturePipeline {
 // ~0.1 ms and is exactly the input. Other frames (video, resized) are written as PNG with OpenCV's default
 // settings (zlib level 1, run-length strategy): measured 2x faster than level 1 with the default strategy, for
 // files 15 % larger; still ~10 ms for 640x480, hence the thread of its own.
-// Only PNG and JPEG files are kept as they are: ReadMap checks a key image's size from those headers.
+// Only PNG and JPEG files are kept as they are, and only when their header gives the frame's size: ReadMap
+// checks a key image's size from those headers.
 bool KeepsSourceFile(const Frame& frame) {
   if (frame.source_path.empty() || frame.resized) return false;
   std::string extension = fs::path(frame.source_path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return extension == ".png" || extension == ".jpg" || extension == ".jpeg";
+  if (extension != ".png" && extension != ".jpg" && extension != ".jpeg") return false;
+  // A JPEG whose EXIF orientation turned it when decoded has another size in its header than the frame: a copy
+  // would not be the frame ReadMap expects.
+  const std::optional<cv::Size> size = KeyImageFileSize(frame.source_path);
+  return size && *size == frame.gray.size();
 }
 
 std::string KeyImageFileName(const Frame& frame) {

@@ -276,6 +276,15 @@ std::optional<cv::Size> KeyImageSize(const ContainedFile& file) {
 }
 }  // namespace
 
+std::optional<cv::Size> KeyImageFileSize(const fs::path& file) {
+  std::string why_not;
+  const std::optional<ContainedFile> opened =
+      ContainedFile::Open(file.parent_path().empty() ? fs::path(".") : file.parent_path(), file.filename().string(),
+                          &why_not);
+  if (!opened) return std::nullopt;
+  return KeyImageSize(*opened);
+}
+
 std::string MapToJson(const VisualMap& map) { return MapDocument(map, CorrespondenceOffsets(map)).dump(1); }
 
 void WriteMapFiles(const VisualMap& map, const fs::path& directory) {

@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "vmap/mapping/visual_map.h"
@@ -32,11 +33,15 @@ inline constexpr long kMaxMatchesPerLink = 1L << 22;           // 4,194,304 corr
 // the builder). Each file is written atomically.
 void WriteMapFiles(const VisualMap& map, const std::filesystem::path& directory);
 
+// The width and height a key-image file's header announces (PNG, or JPEG: a key image copied from the input's
+// own file), as ReadMap checks them; nullopt when the file is neither or cannot be read.
+std::optional<cv::Size> KeyImageFileSize(const std::filesystem::path& file);
+
 // Reads a map directory that vmap may not have written (a map someone sent). Throws InputError naming the file,
 // the field and what is wrong when it is missing or malformed. It never reads outside the directory (no
 // absolute or ".." paths, no symbolic link leading out, only regular files), checks every file's size against
 // map.json before reading it (correspondences.bin must be exactly as long as its links say; each key image a
-// PNG of the map's frame size), reads only the byte ranges the links reference, and checks every field's type
+// PNG or JPEG of the map's frame size), reads only the byte ranges the links reference, and checks every field's type
 // and range (F: null or 9 finite numbers; counts and offsets that fit; key-image and frame indices in range).
 // File names and paths are decoded (DecodeFileName).
 VisualMap ReadMap(const std::filesystem::path& directory);

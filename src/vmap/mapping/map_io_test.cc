@@ -470,4 +470,19 @@ TEST(MapIo, MalformedGeometryIsRefused) {
   EXPECT_NE(ErrorOf(tmp.path()).find("input.camera"), std::string::npos) << ErrorOf(tmp.path());
 }
 
+// The sizes ReadMap checks come from the headers alone, for both kinds of key image.
+TEST(MapIo, KeyImageFileSizeReadsPngAndJpegHeaders) {
+  testing::TempDir tmp;
+  const cv::Mat image(37, 53, CV_8UC3, cv::Scalar(10, 200, 30));
+  ASSERT_TRUE(cv::imwrite((tmp.path() / "a.png").string(), image));
+  ASSERT_TRUE(cv::imwrite((tmp.path() / "a.jpg").string(), image));
+  ASSERT_TRUE(cv::imwrite((tmp.path() / "p.jpg").string(), image, {cv::IMWRITE_JPEG_PROGRESSIVE, 1}));
+  EXPECT_EQ(KeyImageFileSize(tmp.path() / "a.png"), cv::Size(53, 37));
+  EXPECT_EQ(KeyImageFileSize(tmp.path() / "a.jpg"), cv::Size(53, 37));
+  EXPECT_EQ(KeyImageFileSize(tmp.path() / "p.jpg"), cv::Size(53, 37));
+  WriteText(tmp.path() / "text.jpg", "not an image");
+  EXPECT_FALSE(KeyImageFileSize(tmp.path() / "text.jpg").has_value());
+  EXPECT_FALSE(KeyImageFileSize(tmp.path() / "missing.png").has_value());
+}
+
 }  // namespace vmap
