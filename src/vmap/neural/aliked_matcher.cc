@@ -11,6 +11,7 @@
 #include "vmap/features/float_matcher.h"
 #include "vmap/neural/aliked_model.h"
 #include "vmap/neural/aliked_weights.h"
+#include "vmap/neural/torch_device.h"
 #include "vmap/neural/weights_store.h"
 
 namespace vmap {
@@ -34,24 +35,13 @@ class AlikedFeatures : public ImageFeatures {
   cv::Size size_;
 };
 
-torch::Device ParseDevice(const std::string& name) {
-  if (name == "cuda") {
-    if (!torch::cuda::is_available()) {
-      throw InputError("--device cuda: this vmap's LibTorch has no CUDA support or sees no GPU; use --device cpu "
-                       "(or build vmap against a CUDA LibTorch)");
-    }
-    return torch::Device(torch::kCUDA, 0);
-  }
-  return torch::Device(torch::kCPU);
-}
-
 class AlikedMatcher : public Matcher {
  public:
   AlikedMatcher(const AlikedMatcherOptions& options, neural::AlikedConfig config, const neural::StateDict& weights,
                 std::string weights_path)
       : options_(options),
         weights_path_(std::move(weights_path)),
-        model_(std::move(config), weights, ParseDevice(options.device)) {
+        model_(std::move(config), weights, neural::ParseTorchDevice(options.device)) {
     dkd_.top_k = options.top_k;
     dkd_.score_threshold = options.score_threshold;
     dkd_.max_keypoints = options.max_keypoints;

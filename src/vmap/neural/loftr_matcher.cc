@@ -11,6 +11,7 @@
 #include "vmap/core/file_name_encoding.h"
 #include "vmap/neural/loftr_model.h"
 #include "vmap/neural/loftr_weights.h"
+#include "vmap/neural/torch_device.h"
 #include "vmap/neural/weights_store.h"
 
 namespace vmap {
@@ -33,24 +34,13 @@ class LoftrFeatures : public ImageFeatures {
   cv::Size original_;
 };
 
-torch::Device ParseDevice(const std::string& name) {
-  if (name == "cuda") {
-    if (!torch::cuda::is_available()) {
-      throw InputError("--device cuda: this vmap's LibTorch has no CUDA support or sees no GPU; use --device cpu "
-                       "(or build vmap against a CUDA LibTorch)");
-    }
-    return torch::Device(torch::kCUDA, 0);
-  }
-  return torch::Device(torch::kCPU);
-}
-
 class LoftrMatcher : public Matcher {
  public:
   LoftrMatcher(const LoftrMatcherOptions& options, LoftrConfig config, const neural::StateDict& weights,
                std::string weights_path)
       : options_(options),
         weights_path_(std::move(weights_path)),
-        model_(std::move(config), weights, ParseDevice(options.device)) {}
+        model_(std::move(config), weights, neural::ParseTorchDevice(options.device)) {}
 
   std::string name() const override { return "loftr"; }
 

@@ -7,6 +7,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/features/float_matcher.h"
+#include "vmap/neural/torch_device.h"
 #include "vmap/neural/weights_store.h"
 #include "vmap/neural/xfeat_model.h"
 #include "vmap/neural/xfeat_weights.h"
@@ -46,24 +47,13 @@ class XfeatFeatures : public ImageFeatures {
   cv::Size image_size_;
 };
 
-torch::Device ParseDevice(const std::string& name) {
-  if (name == "cuda") {
-    if (!torch::cuda::is_available()) {
-      throw InputError("--device cuda: this vmap's LibTorch has no CUDA support or sees no GPU; use --device cpu "
-                       "(or build vmap against a CUDA LibTorch)");
-    }
-    return torch::Device(torch::kCUDA, 0);
-  }
-  return torch::Device(torch::kCPU);
-}
-
 class XfeatMatcher : public Matcher {
  public:
   XfeatMatcher(const XfeatMatcherOptions& options, const neural::XfeatWeights& weights, std::string weights_path)
       : options_(options),
         weights_path_(std::move(weights_path)),
         layout_(weights.layout),
-        model_(weights.folded, ParseDevice(options.device)) {}
+        model_(weights.folded, neural::ParseTorchDevice(options.device)) {}
 
   std::string name() const override { return "xfeat"; }
 
