@@ -15,10 +15,17 @@ extern "C" const vmap::TorchPluginApi* vmap_torch_plugin_api() __attribute__((we
 namespace vmap {
 namespace {
 
+// Beside the file that holds this code: the vmap binary, or the shared library vmap is linked into when
+// another program (a future Python module, a robot's node) loads it. dladdr names that file; /proc/self/exe
+// would name the host program instead.
 std::filesystem::path PluginPath() {
-  std::error_code error;
-  const std::filesystem::path executable = std::filesystem::read_symlink("/proc/self/exe", error);
-  return (error ? std::filesystem::path(".") : executable.parent_path()) / "libvmap_torch.so";
+  Dl_info info{};
+  if (dladdr(reinterpret_cast<void*>(&PluginPath), &info) && info.dli_fname && *info.dli_fname) {
+    std::error_code error;
+    const std::filesystem::path self = std::filesystem::canonical(info.dli_fname, error);
+    if (!error) return self.parent_path() / "libvmap_torch.so";
+  }
+  return std::filesystem::path(".") / "libvmap_torch.so";
 }
 
 const TorchPluginApi* LoadPlugin() {
