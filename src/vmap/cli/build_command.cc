@@ -31,7 +31,7 @@ struct BuildFlags {
 
 void RunBuild(const BuildFlags& flags) {
   const FrameSourceOptions source_options = flags.source.Resolve();
-  MapBuilderOptions options = flags.key_images.Resolve();
+  MapBuilderOptions options = flags.key_images.Resolve(flags.matcher.type);
   options.verifier = flags.verifier.Resolve();
   options.show_progress = spdlog::should_log(spdlog::level::info);
   options.Check();

@@ -3,15 +3,16 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/features/matcher_factory.h"
 #include "vmap/mapping/map_io.h"
 #include "vmap/report/html_report.h"
 #include "vmap/report/summary.h"
 
 namespace vmap::cli {
 
-MapBuilderOptions KeyImageFlags::Resolve() const {
+MapBuilderOptions KeyImageFlags::Resolve(const std::string& matcher_type) const {
   MapBuilderOptions options;
-  options.key_images.tau = tau;
+  options.key_images.tau = tau ? *tau : DefaultTau(matcher_type);
   options.key_images.similarity = ParseSimilarityMode(similarity);
   options.key_images.final_key = final_key;
   options.quality_mean = ParseQualityMean(quality);
@@ -33,8 +34,10 @@ MapBuilderOptions KeyImageFlags::Resolve() const {
 
 void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau) {
   if (with_tau) {
-    command->add_option("-t,--tau", flags.tau, "Similarity threshold tau in (0, 1]: lower keeps fewer key images")
-        ->capture_default_str();
+    command->add_option_function<double>(
+        "-t,--tau", [&flags](double tau) { flags.tau = tau; },
+        "Similarity threshold tau in (0, 1]: lower keeps fewer key images (default: the matcher's, orb 0.5, "
+        "xfeat 0.4, aliked 0.7, loftr 0.5)");
   }
   command->add_option("--similarity", flags.similarity,
                       "S = verified / tentative matches (inlier-ratio) or / features detected (feature-ratio)")

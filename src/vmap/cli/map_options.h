@@ -2,6 +2,7 @@
 // Options of key-image selection and the record of every option in map.json.
 
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -14,7 +15,7 @@ namespace vmap::cli {
 
 // --tau, --similarity, --quality, --no-final-key, --threads, --exhaustive, --search, --search-window.
 struct KeyImageFlags {
-  double tau = 0.5;
+  std::optional<double> tau;  // --tau; unset: the matcher's DefaultTau
   std::string similarity = "inlier-ratio";
   std::string quality = "arithmetic";
   bool final_key = true;
@@ -27,7 +28,8 @@ struct KeyImageFlags {
   bool exhaustive = false;
   std::string search = "auto";
   int search_window = 32;
-  MapBuilderOptions Resolve() const;
+  // `matcher_type` gives tau when --tau was not given.
+  MapBuilderOptions Resolve(const std::string& matcher_type) const;
 };
 // Also --min-key-displacement, --pose, --pose-threshold, --pose-matches, --exhaustive, --search, --search-window.
 void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau = true);

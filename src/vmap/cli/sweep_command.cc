@@ -47,7 +47,7 @@ bool SamePath(const std::string& a, const std::string& b) {
 void RunSweep(const SweepFlags& flags) {
   const std::vector<double> taus = ParseThresholds(flags.thresholds);
   const FrameSourceOptions source_options = flags.source.Resolve();
-  MapBuilderOptions options = flags.key_images.Resolve();
+  MapBuilderOptions options = flags.key_images.Resolve(flags.matcher.type);
   options.verifier = flags.verifier.Resolve();
   options.show_progress = spdlog::should_log(spdlog::level::info);
   options.Check();

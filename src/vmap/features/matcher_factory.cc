@@ -15,6 +15,14 @@ void MatcherOptions::Check() const {
   aliked.Check();
 }
 
+double DefaultTau(const std::string& matcher_type) {
+  if (matcher_type == "orb") return 0.5;     // the paper's tables' middle; README "The method, exactly"
+  if (matcher_type == "xfeat") return 0.4;
+  if (matcher_type == "aliked") return 0.7;
+  if (matcher_type == "loftr") return 0.5;
+  throw InputError("unknown matcher '" + matcher_type + "'; use orb, loftr, xfeat or aliked");
+}
+
 std::unique_ptr<Matcher> CreateMatcher(const MatcherOptions& options) {
   options.Check();
   if (options.type == "orb") return CreateOrbMatcher(options.orb);

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <torch/torch.h>
 
+#include "vmap/features/matcher_factory.h"
 #include "vmap/neural/golden_util.h"
 
 namespace vmap::neural {
@@ -83,6 +84,9 @@ TEST(AlikedCli, BuildAndSweepRecordTheMatcher) {
   const auto& matcher = map["options"]["matcher"];
   EXPECT_EQ(matcher["type"], "aliked") << matcher.dump();
   EXPECT_EQ(matcher["model"], "aliked-t16");
+  // Without --tau, ALIKED's own default (its S stays high as its matches thin out).
+  EXPECT_DOUBLE_EQ(map["options"]["tau"].get<double>(), DefaultTau("aliked"));
+  EXPECT_GT(DefaultTau("aliked"), DefaultTau("orb"));
   EXPECT_GE(map["key_images"].size(), 2u);
   for (const auto& link : map["links"]) {
     if (!link["below_tau"].get<bool>()) {
