@@ -70,6 +70,8 @@ void RunSweep(const SweepFlags& flags) {
 
   const std::unique_ptr<Matcher> matcher = CreateMatcher(flags.matcher);
   const std::unique_ptr<FrameSource> source = OpenFrameSource(flags.input, source_options);
+  // A sweep compares every frame once for all taus, whatever the matcher: recorded as such.
+  if (options.key_search == KeySearch::kAuto) options.key_search = KeySearch::kSequential;
   const std::string options_json = DescribeOptions(*matcher, options, source_options);
 
   // The ground truth is read before the sweep: a missing file fails at once, not after the whole input.

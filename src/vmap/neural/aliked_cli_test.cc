@@ -101,6 +101,7 @@ TEST(AlikedCli, BuildAndSweepRecordTheMatcher) {
   ASSERT_EQ(r.status, 0) << r.output;
   const auto sweep = ReadJson(dir.path() / "sweep/sweep.json");
   EXPECT_EQ(sweep["rows"].size(), 3u);
+  EXPECT_EQ(sweep["options"]["search"], "sequential") << "a sweep compares every frame, deep matcher or not";
 }
 
 TEST(AlikedCli, CudaWithoutCudaAndWrongWeightsAreRefused) {
