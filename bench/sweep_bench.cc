@@ -100,6 +100,7 @@ int main(int argc, char** argv) {
       vmap::MapBuilderOptions options = Options(exhaustive, 0);
       options.key_images.tau = tau;
       auto source = vmap::OpenFrameSource(input);
+      fs::create_directory(temp);  // BuildMap writes into an existing folder
       const vmap::VisualMap map = vmap::BuildMap(*source, *matcher, options, temp);
       vmap::WriteMapFiles(map, temp);
       fs::remove_all(temp);

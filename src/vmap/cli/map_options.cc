@@ -64,9 +64,9 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau) 
                     "The paper's exact behaviour: verify every comparison with OpenCV's USAC_MAGSAC to its "
                     "confidence criterion (default: stop once S >= tau is settled; same maps within seed noise)");
   command->add_option("--search", flags.search,
-                      "Key-image search: sequential (compare every frame), bisect (compare frames further ahead, "
-                      "then bisect; for deep matchers) or auto (bisect for deep matchers, sequential for ORB "
-                      "and with --exhaustive)")
+                      "Key-image search: sequential (compare every frame: Algorithm 1), bisect (compare frames "
+                      "further ahead, then bisect: fewer network passes, the same map only where S falls with "
+                      "distance) or auto (sequential; README \"Threshold sweeps\")")
       ->capture_default_str();
   command->add_option("--search-window", flags.search_window, "bisect: frames compared ahead at most (held in memory)")
       ->capture_default_str();

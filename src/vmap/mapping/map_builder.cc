@@ -42,8 +42,11 @@ std::string KeySearchName(KeySearch search) {
 }
 
 KeySearch ResolveKeySearch(const MapBuilderOptions& options, const Matcher& matcher) {
-  if (options.key_search != KeySearch::kAuto) return options.key_search;
-  return options.exhaustive || matcher.name() == "orb" ? KeySearch::kSequential : KeySearch::kBisect;
+  if (options.key_search != KeySearch::kAuto || options.exhaustive) {
+    return options.exhaustive ? KeySearch::kSequential : options.key_search;
+  }
+  (void)matcher;  // every matcher: see the header
+  return KeySearch::kSequential;
 }
 
 void MapBuilderOptions::Check() const {

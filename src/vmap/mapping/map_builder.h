@@ -51,9 +51,11 @@ struct MapBuilderOptions {
   void Check() const;  // throws InputError naming the bad option
 };
 
-// kAuto resolves to kBisect for matchers that run a network on every image (comparisons cost tens of
-// milliseconds; measured in README "Deep matchers: comparing fewer frames"), and to kSequential for ORB, whose
-// comparisons cost less than decoding, and whenever `exhaustive` asks for the paper's exact behaviour.
+// kAuto resolves to kSequential, for every matcher, and so does `exhaustive`. Bisect was measured as the deep
+// matchers' default and dropped (README, "Threshold sweeps": deep matchers): for XFeat it was no faster
+// (0.90-1.04x on three of four sequences, more comparisons where S does not fall with distance), and for
+// ALIKED, 1.5-10x faster, it changed the map on three of four sequences (its S stays high until its matches run
+// out). It stays available as --search bisect.
 KeySearch ResolveKeySearch(const MapBuilderOptions& options, const Matcher& matcher);
 
 // Builds one map. When `directory` (which must exist) is not empty, each key image is written there as soon as it is chosen,

@@ -103,7 +103,7 @@ TEST(VmapWeights, ImportsIntoCacheAndReportsIt) {
 
 // With the coarse student, `vmap build` looks for key images by bisection unless told otherwise: fewer frames
 // compared than Algorithm 1's scan, and a valid map (every link that is not broken at S >= tau).
-TEST(VmapBuildLoftr, BisectSearchIsTheDefaultAndComparesFewerFrames) {
+TEST(VmapBuildLoftr, BisectSearchComparesFewerFramesAndSequentialIsTheDefault) {
   SKIP_WITHOUT_SHARED();
   const auto dir = TempDir("build_search");
   const std::string common = "build " + SharedDir() + "/data/rccar_room/images --last 59 --matcher loftr -q -o ";
@@ -111,11 +111,11 @@ TEST(VmapBuildLoftr, BisectSearchIsTheDefaultAndComparesFewerFrames) {
     std::ifstream file(map_dir / "map.json");
     return nlohmann::json::parse(file);
   };
-  auto r = RunVmap(common + (dir / "auto").string());
+  auto r = RunVmap(common + (dir / "bisect").string() + " --search bisect");
   ASSERT_EQ(r.status, 0) << r.output;
-  r = RunVmap(common + (dir / "sequential").string() + " --search sequential");
+  r = RunVmap(common + (dir / "auto").string());
   ASSERT_EQ(r.status, 0) << r.output;
-  const auto bisect = load(dir / "auto"), sequential = load(dir / "sequential");
+  const auto bisect = load(dir / "bisect"), sequential = load(dir / "auto");
   EXPECT_EQ(bisect["options"]["search"], "bisect");
   EXPECT_EQ(sequential["options"]["search"], "sequential");
   EXPECT_EQ(bisect["num_frames"], 60);
