@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """vmap build against the paper-style Python peer (bench/paper_style_peer.py), side by side.
 
-For each sequence, every repeat runs, one after the other: the peer, `vmap build --exhaustive`, `vmap build`
+For each sequence, every repeat runs, one after the other: the peer, `vmap build --exhaustive --min-key-displacement 0` (the paper: no repeated-frame rule), `vmap build`
 (so a change in the machine's load touches all three alike). Each run is a child process; its wall time and its
 CPU time (user + system, all threads, from wait4) are recorded. Printed per sequence: the medians, the ratios
 peer / vmap for wall time and vmap / peer for CPU time (median of the per-repeat ratios), and whether the peer
@@ -77,7 +77,7 @@ def main():
                 times["peer"].append((wall, cpu))
                 with open(peer_json) as f:
                     peer_keys = json.load(f)["key_frames"]
-                for name, extra in (("exhaustive", ["--exhaustive"]), ("vmap", [])):
+                for name, extra in (("exhaustive", ["--exhaustive", "--min-key-displacement", "0"]), ("vmap", [])):
                     out_dir = os.path.join(tmp, "%s_%d" % (name, r))
                     wall, cpu, _ = run([args.vmap, "build", sequence, "--tau", str(args.tau), "-q",
                                         "-o", out_dir] + extra)
