@@ -198,10 +198,14 @@ TEST(KeyImageSearch, OptionsAndDefaults) {
   const auto orb = CreateOrbMatcher({});
   KnownSimilarityMatcher deep(MonotoneShare);
   EXPECT_EQ(ResolveKeySearch(MapBuilderOptions{}, *orb), KeySearch::kSequential);
-  EXPECT_EQ(ResolveKeySearch(MapBuilderOptions{}, deep), KeySearch::kBisect);
+  // auto is Algorithm 1's sequential search for every matcher (README, "Threshold sweeps"); bisect when asked.
+  EXPECT_EQ(ResolveKeySearch(MapBuilderOptions{}, deep), KeySearch::kSequential);
+  EXPECT_EQ(ResolveKeySearch(Options(0.5, KeySearch::kBisect), deep), KeySearch::kBisect);
   MapBuilderOptions exhaustive;
   exhaustive.exhaustive = true;
   EXPECT_EQ(ResolveKeySearch(exhaustive, deep), KeySearch::kSequential);
+  exhaustive.key_search = KeySearch::kBisect;  // the paper's scan cannot skip frames: a clear error
+  EXPECT_THROW(exhaustive.Check(), InputError);
   // A sweep compares every frame once for all taus: an explicit bisect is refused with the way out.
   MemorySource source(IndexFrames(10));
   try {

@@ -42,11 +42,8 @@ std::string KeySearchName(KeySearch search) {
 }
 
 KeySearch ResolveKeySearch(const MapBuilderOptions& options, const Matcher& matcher) {
-  if (options.key_search != KeySearch::kAuto || options.exhaustive) {
-    return options.exhaustive ? KeySearch::kSequential : options.key_search;
-  }
-  (void)matcher;  // every matcher: see the header
-  return KeySearch::kSequential;
+  (void)matcher;  // the same for every matcher: see the header
+  return options.key_search == KeySearch::kAuto ? KeySearch::kSequential : options.key_search;
 }
 
 void MapBuilderOptions::Check() const {
@@ -56,6 +53,9 @@ void MapBuilderOptions::Check() const {
   if (prefetch_frames < 1 || prefetch_frames > 1024) throw InputError("prefetch_frames must be 1 to 1024");
   if (extraction_threads < 0 || extraction_threads > kMaxExtractionThreads) {
     throw InputError("--threads must be 0 to " + std::to_string(kMaxExtractionThreads) + " (0 = one per core)");
+  }
+  if (exhaustive && key_search == KeySearch::kBisect) {
+    throw InputError("--exhaustive is the paper's frame-by-frame scan and --search bisect skips frames; drop one");
   }
   if (search_window < 2 || search_window > 4096) {
     throw InputError("--search-window must be 2 to 4096 frames (default 32)");
