@@ -16,40 +16,8 @@ namespace {
 
 using testing::SharedDir;
 namespace fs = std::filesystem;
-
-#define SKIP_WITHOUT_SHARED()                                                                    \
-  if (!testing::SharedDataPresent()) GTEST_SKIP() << "no shared data at " << SharedDir() << "/golden"
-
-struct Result {
-  int status;
-  std::string output;
-};
-
-Result RunVmap(const std::string& arguments, const std::string& environment = "") {
-  const std::string command = environment + std::string(VMAP_BINARY) + " " + arguments + " 2>&1";
-  Result result{-1, ""};
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return result;
-  char buffer[4096];
-  while (size_t n = fread(buffer, 1, sizeof(buffer), pipe)) result.output.append(buffer, n);
-  const int status = pclose(pipe);
-  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
-
-class TempDir {
- public:
-  explicit TempDir(const std::string& name)
-      : path_(fs::temp_directory_path() / ("vmap_aliked_cli_" + std::to_string(getpid()) + "_" + name)) {
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() { fs::remove_all(path_); }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+using testing::RunVmap;
+using TempDir = testing::ScopedTempDir;
 
 nlohmann::json ReadJson(const fs::path& path) {
   std::ifstream file(path);

@@ -31,9 +31,6 @@ constexpr double kKeypointScoreAtol = 5e-5;
 // a descriptor-level 1e-4 relative noise allows ~1e-3 px.
 constexpr double kOffsetAtol = 2e-3;
 
-#define SKIP_WITHOUT_SHARED()                                                                    \
-  if (!testing::SharedDataPresent()) GTEST_SKIP() << "no shared data at " << SharedDir() << "/golden"
-
 // The network input the golden used: gray3 pairs as one grey channel (the model treats it as three), rgb
 // pairs as imread(COLOR) -> BGR2RGB.
 torch::Tensor ReadInput(const std::string& png, bool rgb) {

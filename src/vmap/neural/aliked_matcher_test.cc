@@ -18,9 +18,6 @@ namespace {
 using neural::testing::LoadTensorDict;
 using neural::testing::SharedDir;
 
-#define SKIP_WITHOUT_SHARED()                                                                            \
-  if (!neural::testing::SharedDataPresent()) GTEST_SKIP() << "no shared data at " << SharedDir() << "/golden"
-
 std::string PairDir(const std::string& model, const std::string& pair) {
   return SharedDir() + "/golden/aliked-" + model + "/" + pair;
 }

@@ -17,9 +17,6 @@ namespace {
 using testing::SharedDir;
 namespace fs = std::filesystem;
 
-#define SKIP_WITHOUT_SHARED()                                                                    \
-  if (!testing::SharedDataPresent()) GTEST_SKIP() << "no shared data at " << SharedDir() << "/golden"
-
 std::string WeightsPath(const std::string& model) { return SharedDir() + "/weights/aliked/aliked-" + model + ".pt"; }
 
 class TempFolder {

@@ -16,39 +16,14 @@ namespace {
 using testing::LoadTensorDict;
 using testing::SharedDir;
 namespace fs = std::filesystem;
-
-#define SKIP_WITHOUT_SHARED()                                                                    \
-  if (!testing::SharedDataPresent()) GTEST_SKIP() << "no shared data at " << SharedDir() << "/golden"
-
-struct Result {
-  int status;
-  std::string output;
-};
-
-// `environment` is prepended to the command line (VAR=value ...).
-Result RunVmap(const std::string& arguments, const std::string& environment = "") {
-  const std::string command = environment + std::string(VMAP_BINARY) + " " + arguments + " 2>&1";
-  Result result{-1, ""};
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return result;
-  char buffer[4096];
-  while (size_t n = fread(buffer, 1, sizeof(buffer), pipe)) result.output.append(buffer, n);
-  const int status = pclose(pipe);
-  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
-
-fs::path TempDir(const std::string& name) {
-  auto dir = fs::temp_directory_path() / ("vmap_cli_test_" + std::to_string(getpid()) + "_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+using testing::RunVmap;
+using testing::ScopedTempDir;
 
 TEST(VmapMatch, WritesReferenceMatchesAndVerification) {
   SKIP_WITHOUT_SHARED();
   const std::string pair = SharedDir() + "/golden/loftr_coarse/rccar_000000_000006";
-  const auto dir = TempDir("match");
+  const ScopedTempDir scoped("match");
+  const fs::path& dir = scoped.path();
   const std::string json_path = (dir / "m.json").string();
   const auto r = RunVmap("match " + pair + "/input0.png " + pair + "/input1.png --matcher loftr --weights " +
                      SharedDir() + "/weights/loftr_coarse/loftr_coarse_teacher.pt --json " + json_path);
@@ -68,7 +43,6 @@ TEST(VmapMatch, WritesReferenceMatchesAndVerification) {
   for (const auto& m : j["matches"]) inliers += m["inlier"].get<bool>();
   EXPECT_EQ(inliers, j["num_verified"].get<int>());
   EXPECT_EQ(j["verified"].get<bool>(), !j["F"].is_null());
-  fs::remove_all(dir);
 }
 
 TEST(VmapMatch, BadInputExitsWithStatus2) {
@@ -85,7 +59,8 @@ TEST(VmapMatch, BadInputExitsWithStatus2) {
 
 TEST(VmapWeights, ImportsIntoCacheAndReportsIt) {
   SKIP_WITHOUT_SHARED();
-  const auto cache = TempDir("cache");
+  const ScopedTempDir scoped("cache");
+  const fs::path& cache = scoped.path();
   const std::string env = std::string("VMAP_WEIGHTS_DIR=") + cache.string() + " ";
   const std::string student = SharedDir() + "/weights/loftr_coarse/loftr_coarse_teacher.pt";
   // A file of the wrong architecture is refused and nothing enters the cache.
@@ -98,14 +73,14 @@ TEST(VmapWeights, ImportsIntoCacheAndReportsIt) {
   const std::string listing = RunVmap("weights", env).output;
   EXPECT_NE(listing.find("[used]    " + (cache / "loftr_coarse_teacher.pt").string()), std::string::npos) << listing;
   EXPECT_NE(listing.find("vmap weights --download outdoor"), std::string::npos) << listing;
-  fs::remove_all(cache);
 }
 
 // With the coarse student, `vmap build` looks for key images by bisection unless told otherwise: fewer frames
 // compared than Algorithm 1's scan, and a valid map (every link that is not broken at S >= tau).
 TEST(VmapBuildLoftr, BisectSearchComparesFewerFramesAndSequentialIsTheDefault) {
   SKIP_WITHOUT_SHARED();
-  const auto dir = TempDir("build_search");
+  const ScopedTempDir scoped("build_search");
+  const fs::path& dir = scoped.path();
   const std::string common = "build " + SharedDir() + "/data/rccar_room/images --last 59 --matcher loftr -q -o ";
   auto load = [](const fs::path& map_dir) {
     std::ifstream file(map_dir / "map.json");
@@ -126,7 +101,6 @@ TEST(VmapBuildLoftr, BisectSearchComparesFewerFramesAndSequentialIsTheDefault) {
       EXPECT_GE(link["similarity"].get<double>(), 0.5);
     }
   }
-  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -24,9 +24,6 @@ constexpr double kStudentConfAtol = 1e-5;
 // Tensors the golden stores as float16 carry up to half an fp16 ulp (2^-11 relative) of rounding.
 constexpr double kFp16Rtol = 1.0 / 2048.0;
 
-#define SKIP_WITHOUT_SHARED()                                                                    \
-  if (!testing::SharedDataPresent()) GTEST_SKIP() << "no shared data at " << SharedDir() << "/golden"
-
 // The reference's dual softmax recomputed from its own stored transformer outputs (README: bit-exact with
 // the stored conf_matrix), for the pairs whose full matrix was trimmed from the shared copy.
 torch::Tensor ReferenceConf(const torch::Tensor& feat0, const torch::Tensor& feat1, double temperature) {

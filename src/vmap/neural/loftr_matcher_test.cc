@@ -19,9 +19,6 @@ namespace {
 using neural::testing::LoadTensorDict;
 using neural::testing::SharedDir;
 
-#define SKIP_WITHOUT_SHARED()                                                                    \
-  if (!neural::testing::SharedDataPresent()) GTEST_SKIP() << "no shared data at " << SharedDir() << "/golden"
-
 LoftrMatcherOptions CoarseOptions() {
   LoftrMatcherOptions options;
   options.model = "coarse";

@@ -18,9 +18,6 @@ namespace {
 using testing::SharedDir;
 namespace fs = std::filesystem;
 
-#define SKIP_WITHOUT_SHARED()                                                                    \
-  if (!testing::SharedDataPresent()) GTEST_SKIP() << "no shared data at " << SharedDir() << "/golden"
-
 std::string TempPath(const std::string& name) {
   const auto dir = fs::temp_directory_path() / ("vmap_weights_test_" + std::to_string(getpid()));
   fs::create_directories(dir);

@@ -25,9 +25,6 @@ using TensorMap = std::map<std::string, torch::Tensor>;
 using Position = std::pair<int64_t, int64_t>;
 using MatchCoordinates = std::array<float, 4>;
 
-#define SKIP_WITHOUT_SHARED()                                                                    \
-  if (!testing::SharedDataPresent()) GTEST_SKIP() << "no shared data at " << SharedDir() << "/golden"
-
 // The golden's suggested tolerances (golden.json "suggested_tolerances").
 constexpr double kM1Atol = 1e-4, kK1Atol = 2e-4, kH1Atol = 1e-5, kHeatmapAtol = 1e-5;
 constexpr double kFp16Rtol = 1e-3, kFp16Atol = 1e-4;

@@ -22,9 +22,6 @@ namespace {
 using neural::testing::LoadTensorDict;
 using neural::testing::SharedDir;
 
-#define SKIP_WITHOUT_SHARED()                                                                    \
-  if (!neural::testing::SharedDataPresent()) GTEST_SKIP() << "no shared data at " << SharedDir() << "/golden"
-
 XfeatMatcherOptions SharedOptions() {
   XfeatMatcherOptions options;
   options.weights = SharedDir() + "/weights/xfeat/xfeat_folded.pt";

@@ -21,9 +21,6 @@ namespace {
 using testing::SharedDir;
 namespace fs = std::filesystem;
 
-#define SKIP_WITHOUT_SHARED()                                                                    \
-  if (!testing::SharedDataPresent()) GTEST_SKIP() << "no shared data at " << SharedDir() << "/golden"
-
 class TempDir {
  public:
   TempDir() : path_(fs::temp_directory_path() / ("vmap_xfeat_weights_" + std::to_string(getpid()))) {
