@@ -83,7 +83,7 @@ std::string DescribeOptions(const Matcher& matcher, const MapBuilderOptions& opt
                      {"seed", options.verifier.seed},
                      {"min_matches", options.verifier.min_matches}};
   doc["exhaustive"] = options.exhaustive;
-  doc["search"] = KeySearchName(ResolveKeySearch(options, matcher));
+  doc["search"] = KeySearchName(ResolveKeySearch(options));
   doc["search_window"] = options.search_window;
   doc["tau"] = options.key_images.tau;
   doc["similarity"] = SimilarityModeName(options.key_images.similarity);

@@ -195,15 +195,13 @@ TEST(KeyImageSearch, OptionsAndDefaults) {
   MapBuilderOptions options;
   options.search_window = 1;
   EXPECT_THROW(options.Check(), InputError);
-  const auto orb = CreateOrbMatcher({});
   KnownSimilarityMatcher deep(MonotoneShare);
-  EXPECT_EQ(ResolveKeySearch(MapBuilderOptions{}, *orb), KeySearch::kSequential);
   // auto is Algorithm 1's sequential search for every matcher (README, "Threshold sweeps"); bisect when asked.
-  EXPECT_EQ(ResolveKeySearch(MapBuilderOptions{}, deep), KeySearch::kSequential);
-  EXPECT_EQ(ResolveKeySearch(Options(0.5, KeySearch::kBisect), deep), KeySearch::kBisect);
+  EXPECT_EQ(ResolveKeySearch(MapBuilderOptions{}), KeySearch::kSequential);
+  EXPECT_EQ(ResolveKeySearch(Options(0.5, KeySearch::kBisect)), KeySearch::kBisect);
   MapBuilderOptions exhaustive;
   exhaustive.exhaustive = true;
-  EXPECT_EQ(ResolveKeySearch(exhaustive, deep), KeySearch::kSequential);
+  EXPECT_EQ(ResolveKeySearch(exhaustive), KeySearch::kSequential);
   exhaustive.key_search = KeySearch::kBisect;  // the paper's scan cannot skip frames: a clear error
   EXPECT_THROW(exhaustive.Check(), InputError);
   // A sweep compares every frame once for all taus: an explicit bisect is refused with the way out.

@@ -41,8 +41,7 @@ std::string KeySearchName(KeySearch search) {
   return "auto";
 }
 
-KeySearch ResolveKeySearch(const MapBuilderOptions& options, const Matcher& matcher) {
-  (void)matcher;  // the same for every matcher: see the header
+KeySearch ResolveKeySearch(const MapBuilderOptions& options) {
   return options.key_search == KeySearch::kAuto ? KeySearch::kSequential : options.key_search;
 }
 
@@ -915,7 +914,7 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
 
 VisualMap BuildMap(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
                    const fs::path& directory, const std::string& options_json) {
-  if (ResolveKeySearch(options, matcher) == KeySearch::kBisect) {
+  if (ResolveKeySearch(options) == KeySearch::kBisect) {
     return SearchKeyImages(source, matcher, options, directory, options_json);
   }
   std::vector<VisualMap> maps;

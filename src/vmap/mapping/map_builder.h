@@ -51,12 +51,12 @@ struct MapBuilderOptions {
   void Check() const;  // throws InputError naming the bad option
 };
 
-// kAuto resolves to kSequential, for every matcher (Check() refuses kBisect with `exhaustive`). Bisect was measured as the deep
-// matchers' default and dropped (README, "Threshold sweeps": deep matchers): for XFeat it was no faster
+// kAuto resolves to kSequential, for every matcher (Check() refuses kBisect with `exhaustive`). Bisect was
+// measured as the deep matchers' default and dropped (README, "Threshold sweeps": deep matchers): for XFeat it was no faster
 // (0.90-1.04x on three of four sequences, more comparisons where S does not fall with distance), and for
 // ALIKED, 1.5-10x faster, it changed the map on three of four sequences (its S stays high until its matches run
 // out). It stays available as --search bisect.
-KeySearch ResolveKeySearch(const MapBuilderOptions& options, const Matcher& matcher);
+KeySearch ResolveKeySearch(const MapBuilderOptions& options);
 
 // Builds one map. When `directory` (which must exist) is not empty, each key image is written there as soon as it is chosen,
 // as keys/NNNNNN.png, or as a copy of its image file (keys/NNNNNN.jpg, ...) when the frame is that file as

@@ -53,25 +53,9 @@ Mismatch Compare(const StateDict& weights, const AlikedConfig& config) {
   return result;
 }
 
-std::string ListKeys(const std::string& title, const std::vector<std::string>& keys) {
-  if (keys.empty()) return "";
-  constexpr size_t kShown = 12;
-  std::string text = "\n  " + title + " (" + std::to_string(keys.size()) + "):";
-  for (size_t i = 0; i < keys.size() && i < kShown; ++i) text += "\n    " + keys[i];
-  if (keys.size() > kShown) text += "\n    ... and " + std::to_string(keys.size() - kShown) + " more";
-  return text;
-}
-
 // The collections.OrderedDict of upstream's .pth files (and anything else LibTorch's unpickler rejects).
 StateDict ReadWithCheckpointReader(const std::string& path, const std::string& first_error, size_t file_size) {
-  StateDict weights;
-  try {
-    weights = ReadCheckpointTensors(path);
-  } catch (const std::exception& e) {
-    throw InputError("cannot read ALIKED weights file '" + path + "' (" + std::to_string(file_size) +
-                     " bytes): it is not a complete torch.save zip archive of a state dict (" + first_error + "; " +
-                     e.what() + "). Get the file again (see `vmap weights`)");
-  }
+  StateDict weights = ReadRefusedWeightsFile(path, "ALIKED", first_error, file_size);
   if (weights.empty()) throw InputError("ALIKED weights file '" + path + "' holds no tensors");
   return weights;
 }
@@ -129,9 +113,9 @@ void CheckAlikedStateDict(const StateDict& weights, const AlikedConfig& config, 
   const Mismatch mismatch = Compare(weights, config);
   if (mismatch.empty()) return;
   std::string message = "ALIKED weights file '" + path + "' does not fit the '" + config.name + "' model:" +
-                        ListKeys("missing keys", mismatch.missing) +
-                        ListKeys("unexpected keys", mismatch.unexpected) +
-                        ListKeys("keys with another shape", mismatch.wrong_shape);
+                        ListStateDictKeys("missing keys", mismatch.missing) +
+                        ListStateDictKeys("unexpected keys", mismatch.unexpected) +
+                        ListStateDictKeys("keys with another shape", mismatch.wrong_shape);
   const auto fitting = AlikedModelsFitting(weights);
   if (!fitting.empty()) {
     message += "\n  The file fits --aliked-model " + fitting.front() + "; pass that, or weights made for '" +

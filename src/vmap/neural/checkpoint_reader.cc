@@ -8,6 +8,8 @@
 
 #include <caffe2/serialize/inline_container.h>
 
+#include "vmap/core/error.h"
+
 namespace vmap::neural {
 
 namespace {
@@ -280,6 +282,26 @@ StateDict ReadCheckpointTensors(const std::string& path) {
     if (k->kind == Object::Kind::kString && v->kind == Object::Kind::kTensor) out[k->text] = v->tensor;
   }
   return out;
+}
+
+StateDict ReadRefusedWeightsFile(const std::string& path, const std::string& model, const std::string& first_error,
+                                 size_t file_size) {
+  try {
+    return ReadCheckpointTensors(path);
+  } catch (const std::exception& e) {
+    throw InputError("cannot read " + model + " weights file '" + path + "' (" + std::to_string(file_size) +
+                     " bytes): it is not a complete torch.save zip archive (" + first_error + "; " + e.what() +
+                     "). Get the file again (see `vmap weights`)");
+  }
+}
+
+std::string ListStateDictKeys(const std::string& title, const std::vector<std::string>& keys) {
+  if (keys.empty()) return "";
+  constexpr size_t kShown = 12;
+  std::string text = "\n  " + title + " (" + std::to_string(keys.size()) + "):";
+  for (size_t i = 0; i < keys.size() && i < kShown; ++i) text += "\n    " + keys[i];
+  if (keys.size() > kShown) text += "\n    ... and " + std::to_string(keys.size() - kShown) + " more";
+  return text;
 }
 
 }  // namespace vmap::neural

@@ -17,4 +17,14 @@ namespace vmap::neural {
 // missing record...).
 StateDict ReadCheckpointTensors(const std::string& path);
 
+// ReadCheckpointTensors for a weights file of `model` ("LoFTR", "XFeat", "ALIKED") that LibTorch's unpickler
+// refused with `first_error`. Throws InputError naming the file and both reasons when it is not a readable
+// torch.save archive either.
+StateDict ReadRefusedWeightsFile(const std::string& path, const std::string& model, const std::string& first_error,
+                                 size_t file_size);
+
+// One kind of state-dict mismatch (missing, unexpected, wrong shape) as lines of an error message: the count
+// and the first 12 keys; empty when there are none.
+std::string ListStateDictKeys(const std::string& title, const std::vector<std::string>& keys);
+
 }  // namespace vmap::neural

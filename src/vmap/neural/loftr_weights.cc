@@ -58,15 +58,6 @@ Mismatch Compare(const StateDict& weights, const LoftrConfig& config) {
   return result;
 }
 
-std::string ListKeys(const std::string& title, const std::vector<std::string>& keys) {
-  if (keys.empty()) return "";
-  constexpr size_t kShown = 12;
-  std::string text = "\n  " + title + " (" + std::to_string(keys.size()) + "):";
-  for (size_t i = 0; i < keys.size() && i < kShown; ++i) text += "\n    " + keys[i];
-  if (keys.size() > kShown) text += "\n    ... and " + std::to_string(keys.size() - kShown) + " more";
-  return text;
-}
-
 std::vector<char> ReadBytes(const std::string& path) {
   std::ifstream file(path, std::ios::binary);
   if (!file) throw InputError("cannot open LoFTR weights file '" + path + "'; check the path given to --weights");
@@ -92,14 +83,7 @@ void CollectTensors(const c10::Dict<c10::IValue, c10::IValue>& dict, const std::
 // Lightning checkpoints (the official files) hold an OrderedDict and Python objects LibTorch's unpickler
 // cannot build; they go through the checkpoint reader, which keeps only what a state dict needs.
 static StateDict ReadWithCheckpointReader(const std::string& path, const std::string& first_error, size_t file_size) {
-  StateDict weights;
-  try {
-    weights = ReadCheckpointTensors(path);
-  } catch (const std::exception& e) {
-    throw InputError("cannot read LoFTR weights file '" + path + "' (" + std::to_string(file_size) +
-                     " bytes): it is not a complete torch.save zip archive (" + first_error + "; " + e.what() +
-                     "). Download it again (see `vmap weights`)");
-  }
+  StateDict weights = ReadRefusedWeightsFile(path, "LoFTR", first_error, file_size);
   StateDict stripped;
   for (auto& [key, tensor] : weights) {
     const bool prefixed = key.rfind(kLightningPrefix, 0) == 0;
@@ -151,9 +135,9 @@ void CheckStateDict(const StateDict& weights, const LoftrConfig& config, const s
   const Mismatch mismatch = Compare(weights, config);
   if (mismatch.empty()) return;
   std::string message = "LoFTR weights file '" + path + "' does not fit the '" + config.preset + "' model:" +
-                        ListKeys("missing keys", mismatch.missing) +
-                        ListKeys("unexpected keys", mismatch.unexpected) +
-                        ListKeys("keys with another shape", mismatch.wrong_shape);
+                        ListStateDictKeys("missing keys", mismatch.missing) +
+                        ListStateDictKeys("unexpected keys", mismatch.unexpected) +
+                        ListStateDictKeys("keys with another shape", mismatch.wrong_shape);
   // Point at the preset the file was made for, or the closest one.
   std::string closest;
   size_t closest_size = SIZE_MAX;

@@ -70,15 +70,6 @@ Mismatch Compare(const StateDict& weights, XfeatLayout layout) {
   return result;
 }
 
-std::string ListKeys(const std::string& title, const std::vector<std::string>& keys) {
-  if (keys.empty()) return "";
-  constexpr size_t kShown = 12;
-  std::string text = "\n  " + title + " (" + std::to_string(keys.size()) + "):";
-  for (size_t i = 0; i < keys.size() && i < kShown; ++i) text += "\n    " + keys[i];
-  if (keys.size() > kShown) text += "\n    ... and " + std::to_string(keys.size() - kShown) + " more";
-  return text;
-}
-
 std::string Describe(XfeatLayout layout) {
   return layout == XfeatLayout::kOfficial ? "the official layout (xfeat.pt: BatchNorm statistics, fine_matcher)"
                                           : "the folded layout (xfeat_folded.pt: BatchNorm folded into the convolutions)";
@@ -87,14 +78,7 @@ std::string Describe(XfeatLayout layout) {
 // torch.save(model.state_dict()) pickles a collections.OrderedDict, which LibTorch's unpickler cannot
 // return; the checkpoint reader runs such files itself.
 StateDict ReadWithCheckpointReader(const std::string& path, const std::string& first_error, size_t file_size) {
-  StateDict weights;
-  try {
-    weights = ReadCheckpointTensors(path);
-  } catch (const std::exception& e) {
-    throw InputError("cannot read XFeat weights file '" + path + "' (" + std::to_string(file_size) +
-                     " bytes): it is not a complete torch.save zip archive (" + first_error + "; " + e.what() +
-                     "). Download it again (see `vmap weights`)");
-  }
+  StateDict weights = ReadRefusedWeightsFile(path, "XFeat", first_error, file_size);
   if (weights.empty()) throw InputError("XFeat weights file '" + path + "' holds no tensors");
   return weights;
 }
@@ -151,8 +135,8 @@ XfeatLayout CheckXfeatStateDict(const StateDict& weights, const std::string& pat
   const Mismatch& closest = official_closer ? official : folded;
   throw InputError("XFeat weights file '" + path + "' fits no XFeat layout; against " +
                    Describe(official_closer ? XfeatLayout::kOfficial : XfeatLayout::kFolded) + ":" +
-                   ListKeys("missing keys", closest.missing) + ListKeys("unexpected keys", closest.unexpected) +
-                   ListKeys("keys with another shape", closest.wrong_shape) +
+                   ListStateDictKeys("missing keys", closest.missing) + ListStateDictKeys("unexpected keys", closest.unexpected) +
+                   ListStateDictKeys("keys with another shape", closest.wrong_shape) +
                    "\n  Is it an XFeat file? See `vmap weights` for the supported files.");
 }
 

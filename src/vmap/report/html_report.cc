@@ -300,15 +300,6 @@ using report::WriteJpeg;
 
 namespace {
 
-bool IsInside(const fs::path& child, const fs::path& parent) {
-  auto c = child.begin();
-  for (auto p = parent.begin(); p != parent.end(); ++p, ++c) {
-    if (p->empty() && std::next(p) == parent.end()) break;  // trailing separator
-    if (c == child.end() || *c != *p) return false;
-  }
-  return true;
-}
-
 // The S(key, frame) plot: one line per key image over the frames compared with it, tau, the key images
 // and the similarity of each link at the frame that became the next key image.
 std::string SimilarityPlot(const VisualMap& map, const json& options) {
