@@ -12,7 +12,7 @@
 
 #include "vmap/evaluation/map_evaluation.h"
 #include "vmap/mapping/link_analysis.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 
 namespace {
 

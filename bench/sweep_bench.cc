@@ -28,7 +28,7 @@
 
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/map_builder.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 #include "vmap/sources/frame_source.h"
 
 namespace {

@@ -11,7 +11,7 @@
 #include "vmap/cli/map_options.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/mapping/map_builder.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 #include "vmap/report/summary.h"
 
 namespace vmap::cli {

@@ -7,7 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "vmap/geometry/fundamental.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 #include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {

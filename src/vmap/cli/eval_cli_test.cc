@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/evaluation/map_evaluation.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 #include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {

@@ -10,7 +10,7 @@
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
 #include "vmap/evaluation/map_evaluation.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 #include "vmap/report/evaluation_summary.h"
 
 namespace vmap::cli {

@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/cli/commands.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 #include "vmap/report/summary.h"
 
 namespace vmap::cli {

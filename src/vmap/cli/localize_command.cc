@@ -17,7 +17,7 @@
 #include "vmap/localization/localization_output.h"
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/localization/route.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 #include "vmap/report/localization_report.h"
 
 namespace vmap::cli {

@@ -4,7 +4,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/features/matcher_factory.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 #include "vmap/report/html_report.h"
 #include "vmap/report/summary.h"
 

@@ -27,7 +27,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "vmap/core/file_name_encoding.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 #include "vmap/testing/synthetic_scene.h"
 
 extern char** environ;

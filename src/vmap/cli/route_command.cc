@@ -10,7 +10,7 @@
 #include "vmap/cli/commands.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/localization/route.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 
 namespace vmap::cli {
 

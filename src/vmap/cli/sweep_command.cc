@@ -14,7 +14,7 @@
 #include "vmap/core/error.h"
 #include "vmap/evaluation/map_evaluation.h"
 #include "vmap/mapping/map_builder.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 #include "vmap/report/html_report.h"
 #include "vmap/report/summary.h"
 

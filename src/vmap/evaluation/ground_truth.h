@@ -17,7 +17,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "vmap/mapping/visual_map.h"
+#include "vmap/map/visual_map.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap {

@@ -8,7 +8,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/geometry/relative_pose.h"
-#include "vmap/mapping/map_geometry_json.h"
+#include "vmap/map/map_geometry_json.h"
 #include "vmap/sources/dataset_camera.h"
 
 namespace vmap {

@@ -17,7 +17,7 @@
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
 #include "vmap/localization/key_image_ranking.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 
 namespace vmap {
 namespace fs = std::filesystem;

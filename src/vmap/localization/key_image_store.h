@@ -17,7 +17,7 @@
 #include <opencv2/core.hpp>
 
 #include "vmap/features/matcher.h"
-#include "vmap/mapping/visual_map.h"
+#include "vmap/map/visual_map.h"
 
 namespace vmap {
 

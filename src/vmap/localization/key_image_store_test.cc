@@ -7,7 +7,7 @@
 
 #include "vmap/features/orb_matcher.h"
 #include "vmap/localization/localization_test_util.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 #include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {

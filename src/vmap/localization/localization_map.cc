@@ -4,7 +4,7 @@
 
 #include "vmap/features/matcher_factory.h"
 #include "vmap/features/matcher_options_json.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 
 namespace vmap {
 

@@ -8,7 +8,7 @@
 #include "vmap/features/matcher.h"
 #include "vmap/localization/key_image_store.h"
 #include "vmap/localization/localizer.h"
-#include "vmap/mapping/visual_map.h"
+#include "vmap/map/visual_map.h"
 
 namespace vmap {
 

@@ -17,7 +17,7 @@
 
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/localization/localizer.h"
-#include "vmap/mapping/visual_map.h"
+#include "vmap/map/visual_map.h"
 
 namespace vmap {
 

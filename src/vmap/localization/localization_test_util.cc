@@ -3,7 +3,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 
 namespace vmap::testing {
 

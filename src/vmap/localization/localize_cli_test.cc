@@ -14,7 +14,7 @@
 #include "vmap/localization/localization_output.h"
 #include "vmap/localization/localization_test_util.h"
 #include "vmap/localization/localize_sequence.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 #include "vmap/report/html_report.h"
 #include "vmap/testing/synthetic_scene.h"
 

@@ -35,7 +35,7 @@
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/localization/key_image_store.h"
 #include "vmap/mapping/key_image_selector.h"
-#include "vmap/mapping/visual_map.h"
+#include "vmap/map/visual_map.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap {

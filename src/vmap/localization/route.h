@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "vmap/mapping/visual_map.h"
+#include "vmap/map/visual_map.h"
 
 namespace vmap {
 

@@ -10,7 +10,7 @@
 
 #include "vmap/features/matcher.h"
 #include "vmap/geometry/fundamental.h"
-#include "vmap/mapping/visual_map.h"
+#include "vmap/map/visual_map.h"
 
 namespace vmap {
 

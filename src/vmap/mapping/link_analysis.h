@@ -7,7 +7,7 @@
 #include "vmap/geometry/camera.h"
 #include "vmap/geometry/homography.h"
 #include "vmap/geometry/relative_pose.h"
-#include "vmap/mapping/visual_map.h"
+#include "vmap/map/visual_map.h"
 
 namespace vmap {
 

@@ -20,7 +20,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/core/progress.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 
 namespace vmap {
 namespace fs = std::filesystem;

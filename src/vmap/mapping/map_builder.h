@@ -10,7 +10,7 @@
 #include "vmap/geometry/fundamental.h"
 #include "vmap/mapping/key_image_selector.h"
 #include "vmap/mapping/link_analysis.h"
-#include "vmap/mapping/visual_map.h"
+#include "vmap/map/visual_map.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap {

@@ -19,7 +19,7 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/core/file_name_encoding.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 #include "vmap/report/html_page.h"
 #include "vmap/report/html_util.h"
 #include "vmap/report/link_table.h"

@@ -11,7 +11,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "vmap/core/error.h"
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 #include "vmap/report/report_test_util.h"
 
 namespace vmap {

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "vmap/evaluation/map_evaluation.h"
-#include "vmap/mapping/visual_map.h"
+#include "vmap/map/visual_map.h"
 
 namespace vmap {
 

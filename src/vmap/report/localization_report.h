@@ -14,7 +14,7 @@
 #include <string>
 
 #include "vmap/localization/localization_output.h"
-#include "vmap/mapping/visual_map.h"
+#include "vmap/map/visual_map.h"
 
 namespace vmap {
 

@@ -8,7 +8,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "vmap/mapping/visual_map.h"
+#include "vmap/map/visual_map.h"
 
 namespace vmap {
 

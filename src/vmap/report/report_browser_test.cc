@@ -16,7 +16,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 #include "vmap/report/html_report.h"
 #include "vmap/report/localization_report.h"
 #include "vmap/report/report_test_util.h"

@@ -9,7 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 
 namespace vmap::report_test {
 namespace fs = std::filesystem;

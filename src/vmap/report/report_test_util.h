@@ -11,7 +11,7 @@
 
 #include "vmap/testing/synthetic_scene.h"
 
-#include "vmap/mapping/visual_map.h"
+#include "vmap/map/visual_map.h"
 
 namespace vmap::report_test {
 

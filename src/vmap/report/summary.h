@@ -5,7 +5,7 @@
 #include <string>
 
 #include "vmap/mapping/map_builder.h"
-#include "vmap/mapping/visual_map.h"
+#include "vmap/map/visual_map.h"
 
 namespace vmap {
 

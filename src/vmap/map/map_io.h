@@ -15,7 +15,7 @@
 #include <optional>
 #include <string>
 
-#include "vmap/mapping/visual_map.h"
+#include "vmap/map/visual_map.h"
 
 namespace vmap {
 

@@ -1,4 +1,4 @@
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 
 #include <sys/stat.h>
 

@@ -1,4 +1,4 @@
-#include "vmap/mapping/map_geometry_json.h"
+#include "vmap/map/map_geometry_json.h"
 
 #include <cmath>
 

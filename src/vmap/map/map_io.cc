@@ -1,4 +1,4 @@
-#include "vmap/mapping/map_io.h"
+#include "vmap/map/map_io.h"
 
 #include <algorithm>
 #include <cmath>
@@ -13,7 +13,7 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/core/file_name_encoding.h"
-#include "vmap/mapping/map_geometry_json.h"
+#include "vmap/map/map_geometry_json.h"
 
 namespace vmap {
 namespace fs = std::filesystem;

@@ -1,4 +1,4 @@
-#include "vmap/mapping/visual_map.h"
+#include "vmap/map/visual_map.h"
 
 #include <gtest/gtest.h>
 

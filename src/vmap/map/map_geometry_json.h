@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/geometry/camera.h"
-#include "vmap/mapping/visual_map.h"
+#include "vmap/map/visual_map.h"
 
 namespace vmap {
 
