@@ -13,12 +13,13 @@
 #include "vmap/core/error.h"
 #include "vmap/mapping/map_io.h"
 #include "vmap/report/report_test_util.h"
+#include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
 namespace {
 namespace fs = std::filesystem;
 using report_test::ReadText;
-using report_test::TempDir;
+using testing::ScopedTempDir;
 
 // Every path below `root`, relative, as a sorted set: what a directory looks like.
 std::set<std::string> Listing(const fs::path& root) {
@@ -39,7 +40,7 @@ std::string ErrorOf(const std::function<void()>& action) {
 }
 
 TEST(MapReportTest, WritesOnePageWithAFigurePerLinkAndAThumbnailPerKeyImage) {
-  TempDir temp;
+  ScopedTempDir temp;
   const fs::path dir = temp.path() / "map";
   const VisualMap map = report_test::WriteSyntheticMap(dir);
   ASSERT_EQ(map.key_images.size(), 6u);
@@ -83,7 +84,7 @@ TEST(MapReportTest, WritesOnePageWithAFigurePerLinkAndAThumbnailPerKeyImage) {
 }
 
 TEST(MapReportTest, SimilarityPlotShowsEveryEvaluationTauAndTheLinks) {
-  TempDir temp;
+  ScopedTempDir temp;
   const VisualMap map = report_test::WriteSyntheticMap(temp.path());
   WriteMapReport(temp.path());
   const std::string svg = report_test::SvgById(ReadText(temp.path() / kReportFileName), "similarity-plot");
@@ -127,7 +128,7 @@ TEST(MapReportTest, SimilarityPlotShowsEveryEvaluationTauAndTheLinks) {
 }
 
 TEST(MapReportTest, MapWithOneKeyImageAndNoLinksStillGetsAPage) {
-  TempDir temp;
+  ScopedTempDir temp;
   report_test::SyntheticMapOptions options;
   options.num_frames = 1;
   options.below_tau_links.clear();
@@ -144,7 +145,7 @@ TEST(MapReportTest, MapWithOneKeyImageAndNoLinksStillGetsAPage) {
 }
 
 TEST(MapReportTest, RewritingReplacesTheReportAndLeavesNoTemporaryFiles) {
-  TempDir temp;
+  ScopedTempDir temp;
   const fs::path dir = temp.path() / "map";
   report_test::WriteSyntheticMap(dir);
   WriteMapReport(dir);
@@ -158,7 +159,7 @@ TEST(MapReportTest, RewritingReplacesTheReportAndLeavesNoTemporaryFiles) {
 }
 
 TEST(MapReportTest, MissingOrMalformedMapsGiveClearErrorsAndWriteNothing) {
-  TempDir temp;
+  ScopedTempDir temp;
   const fs::path missing = temp.path() / "no_such_map";
   EXPECT_NE(ErrorOf([&] { WriteMapReport(missing); }).find("no_such_map"), std::string::npos);
   EXPECT_FALSE(fs::exists(missing));
@@ -190,7 +191,7 @@ void SetKeyImagePath(const fs::path& dir, int key, const std::string& image) {
 }
 
 TEST(MapReportTest, KeyImagePathsCannotLeaveTheMapDirectory) {
-  TempDir temp;
+  ScopedTempDir temp;
   const fs::path dir = temp.path() / "map";
   const VisualMap map = report_test::WriteSyntheticMap(dir);
   const fs::path outside = temp.path() / "secret.png";
@@ -215,7 +216,7 @@ TEST(MapReportTest, KeyImagePathsCannotLeaveTheMapDirectory) {
 }
 
 TEST(MapReportTest, DrawMapLinkNamesAMissingLink) {
-  TempDir temp;
+  ScopedTempDir temp;
   const VisualMap map = report_test::WriteSyntheticMap(temp.path());
   const cv::Mat figure = DrawMapLink(temp.path(), map, 0);
   EXPECT_EQ(figure.cols, 2 * 320 + 4);
@@ -254,7 +255,7 @@ SweepResult SyntheticSweep(const fs::path& maps) {
 }
 
 TEST(SweepReportTest, TableMarksTheBestTauAndLinksTheMapsRelatively) {
-  TempDir temp;
+  ScopedTempDir temp;
   const fs::path dir = temp.path() / "sweep";
   const SweepResult sweep = SyntheticSweep(dir);
   fs::create_directories(dir);
@@ -274,7 +275,7 @@ TEST(SweepReportTest, TableMarksTheBestTauAndLinksTheMapsRelatively) {
 }
 
 TEST(SweepReportTest, PlotsShowKeyImagesAndQualityAgainstTau) {
-  TempDir temp;
+  ScopedTempDir temp;
   const SweepResult sweep = SyntheticSweep(temp.path());
   WriteSweepReport(sweep, temp.path());
   const std::string html = ReadText(temp.path() / kReportFileName);
