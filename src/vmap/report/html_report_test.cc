@@ -1,6 +1,7 @@
 #include "vmap/report/html_report.h"
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <fstream>
 #include <set>
@@ -12,6 +13,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/mapping/map_io.h"
+#include "vmap/report/report_assets.h"
 #include "vmap/report/report_test_util.h"
 #include "vmap/testing/scoped_temp_dir.h"
 
@@ -181,6 +183,42 @@ TEST(MapReportTest, MissingOrMalformedMapsGiveClearErrorsAndWriteNothing) {
   std::ofstream(garbled / "map.json") << "{ not json";
   EXPECT_NE(ErrorOf([&] { WriteMapReport(garbled); }).find("not valid JSON"), std::string::npos);
   EXPECT_FALSE(fs::exists(garbled / kReportFileName));
+}
+
+TEST(MapReportTest, BadOptionsNameTheFieldAndWriteNothing) {
+  ScopedTempDir temp;
+  const fs::path dir = temp.path() / "map";
+  report_test::WriteSyntheticMap(dir);
+  const std::set<std::string> before = Listing(dir);
+  const std::vector<std::pair<std::string, std::function<void(MapReportOptions&)>>> cases = {
+      {"thumbnail_width is 31", [](MapReportOptions& o) { o.thumbnail_width = 31; }},
+      {"figure_width is 8193", [](MapReportOptions& o) { o.figure_width = 8193; }},
+      {"jpeg_quality is 0", [](MapReportOptions& o) { o.jpeg_quality = 0; }},
+      {"route_fps is 0", [](MapReportOptions& o) { o.route_fps = 0.0; }},
+      {"route_fps is nan", [](MapReportOptions& o) { o.route_fps = std::nan(""); }},
+  };
+  EXPECT_NO_THROW(MapReportOptions{}.Check());
+  for (const auto& [message, spoil] : cases) {
+    MapReportOptions options;
+    spoil(options);
+    EXPECT_NE(ErrorOf([&] { WriteMapReport(dir, options); }).find("MapReportOptions::" + message), std::string::npos)
+        << message;
+  }
+  EXPECT_EQ(Listing(dir), before);
+}
+
+// The style sheet and the script are the files in report/assets, embedded at build time, carried inline.
+TEST(MapReportTest, PageCarriesTheEmbeddedStyleAndScript) {
+  ScopedTempDir temp;
+  const fs::path dir = temp.path() / "map";
+  report_test::WriteSyntheticMap(dir);
+  WriteMapReport(dir);
+  const std::string html = ReadText(dir / kReportFileName);
+  const std::string css(report::ReportCss()), js(report::ReportJs());
+  EXPECT_NE(css.find(".match-figure.below-tau {"), std::string::npos);
+  EXPECT_NE(js.find("vmap-selfcheck"), std::string::npos);
+  EXPECT_EQ(report_test::CountOccurrences(html, "<style>\n" + css + "</style>"), 1);
+  EXPECT_EQ(report_test::CountOccurrences(html, "<script>\n" + js + "</script>"), 1);
 }
 
 // Rewrites one key image's path in map.json.
