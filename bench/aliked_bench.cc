@@ -23,6 +23,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <torch/torch.h>
 
+#include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/map_builder.h"
 #include "vmap/neural/aliked_matcher.h"
@@ -139,9 +140,8 @@ void BenchStages(const std::string& shared, const std::string& which, int reps) 
   }
 }
 
-void BenchBuild(const std::string& shared, int frames, int reps, bool tune_malloc) {
+void BenchBuild(const std::string& shared, int frames, int reps) {
   const std::string video = shared + "/data/lab_floor/lab_floor.mp4";
-  cv::setNumThreads(1);  // as the vmap binary does
   vmap::FrameSourceOptions source_options;
   source_options.last = frames > 0 ? frames - 1 : -1;
   vmap::MapBuilderOptions options;
@@ -155,7 +155,6 @@ void BenchBuild(const std::string& shared, int frames, int reps, bool tune_mallo
     vmap::AlikedMatcherOptions aliked;
     aliked.model = model;
     aliked.weights = shared + "/weights/aliked/aliked-" + model + ".pt";
-    aliked.tune_malloc = tune_malloc;
     entries.push_back({"aliked-" + model, vmap::CreateAlikedMatcher(aliked), {}, 0});
   }
   // Interleaved, so that the machine's changing load touches every matcher alike.
@@ -201,6 +200,10 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  // As the vmap binary has the process (core/runtime.h); --no-tune-malloc measures what the malloc setting saves.
+  vmap::RuntimeOptions runtime;
+  runtime.keep_freed_memory = tune_malloc;
+  vmap::InitializeRuntime(runtime);
   const std::string shared = VMAP_SHARED_DIR;
   struct Pair { const char* size; std::string dir; };
   const std::vector<Pair> pairs{{"640x480", shared + "/golden/aliked-n16/rccar_000000_000006"},
@@ -221,7 +224,6 @@ int main(int argc, char** argv) {
         options.model = model;
         options.weights = shared + "/weights/aliked/aliked-" + model + ".pt";
         options.num_threads = threads;
-        options.tune_malloc = tune_malloc;
         const auto matcher = vmap::CreateAlikedMatcher(options);
         auto key = matcher->Extract(image0);  // warm-up
         auto frame = matcher->Extract(image1);
@@ -241,6 +243,6 @@ int main(int argc, char** argv) {
   }
   if (stages) BenchStages(shared, which, reps);
   if (dcn) BenchDeformConv(std::max(reps, 10));
-  if (build) BenchBuild(shared, frames, std::max(1, std::min(reps, 3)), tune_malloc);
+  if (build) BenchBuild(shared, frames, std::max(1, std::min(reps, 3)));
   return 0;
 }

@@ -17,6 +17,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/map_builder.h"
 #include "vmap/sources/frame_source.h"
@@ -56,7 +57,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "build_bench: '%s' not found; pass a video path\n", video.c_str());
     return 2;
   }
-  cv::setNumThreads(1);  // as the vmap binary does: vmap parallelises across frames itself
+  vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   const auto matcher = vmap::CreateOrbMatcher({});
 
   vmap::MapBuilderOptions options;

@@ -23,6 +23,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/geometry/magsac.h"
@@ -61,7 +62,7 @@ int main(int argc, char** argv) {
     sequences = {shared + "/data/rccar_room/images", shared + "/data/lab_floor/lab_floor.mp4",
                  shared + "/data/kitti07", shared + "/data/redkitchen"};
   }
-  cv::setNumThreads(1);
+  vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   const auto matcher = vmap::CreateOrbMatcher({});
   const std::vector<int> gaps = {1, 2, 3, 5, 8, 13, 21, 34, 55};
 

@@ -26,6 +26,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include "vmap/core/runtime.h"
 #include "vmap/features/matcher_factory.h"
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/localization/localization_map.h"
@@ -78,7 +79,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--no-step-back")) step_back = false, --i;
     else if (!std::strcmp(argv[i], "--streaming-only")) streaming_only = true, --i;
   }
-  cv::setNumThreads(1);
+  vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   const fs::path map_directory = fs::temp_directory_path() / ("vmap_localize_accuracy_" + std::to_string(getpid()));
   fs::remove_all(map_directory);
   fs::create_directories(map_directory);

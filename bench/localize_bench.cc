@@ -25,6 +25,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include "vmap/core/runtime.h"
 #include "vmap/features/matcher_factory.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localize_sequence.h"
@@ -100,7 +101,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "localize_bench: ../shared/data is missing\n");
     return 2;
   }
-  cv::setNumThreads(1);  // as the vmap binary does
+  vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   const fs::path work = fs::temp_directory_path() / ("vmap_localize_bench_" + std::to_string(getpid()));
   fs::remove_all(work);
   BuildInto(video, {}, 0.5, work / "lab_floor");

@@ -26,6 +26,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include "vmap/core/runtime.h"
 #include "vmap/features/matcher_factory.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localize_sequence.h"
@@ -99,7 +100,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--descriptors")) descriptors = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--candidates")) candidates = std::atoi(argv[i + 1]);
   }
-  cv::setNumThreads(1);
+  vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   const auto poses = ReadGroundTruth(sequence / "groundtruth.txt");
   if (poses.empty()) {
     std::fprintf(stderr, "localize_repeat: no poses in %s\n", (sequence / "groundtruth.txt").c_str());

@@ -17,6 +17,7 @@
 #include <opencv2/imgproc.hpp>
 #include <torch/torch.h>
 
+#include "vmap/core/runtime.h"
 #include "vmap/neural/loftr_matcher.h"
 
 namespace {
@@ -51,6 +52,10 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  // As the vmap binary has the process (core/runtime.h); --no-tune-malloc measures what the malloc setting saves.
+  vmap::RuntimeOptions runtime;
+  runtime.keep_freed_memory = tune_malloc;
+  vmap::InitializeRuntime(runtime);
   const std::string shared = VMAP_SHARED_DIR;
   const std::string pair = shared + "/golden/loftr_coarse/rccar_000000_000006";
   const cv::Mat image0 = cv::imread(pair + "/input0.png", cv::IMREAD_GRAYSCALE);
@@ -70,7 +75,6 @@ int main(int argc, char** argv) {
       vmap::LoftrMatcherOptions options;
       options.model = model;
       options.longest_side = size.width;
-      options.tune_malloc = tune_malloc;
       options.num_threads = threads;
       if (model == "coarse") {
         options.weights = shared + "/weights/loftr_coarse/loftr_coarse_teacher.pt";

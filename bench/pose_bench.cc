@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "vmap/core/runtime.h"
 #include "vmap/evaluation/map_evaluation.h"
 #include "vmap/mapping/link_analysis.h"
 #include "vmap/map/map_io.h"
@@ -60,6 +61,7 @@ std::string Number(double value, int decimals) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   if (argc < 2) {
     std::fprintf(stderr, "usage: %s MAP_DIR [MAP_DIR ...]\n", argv[0]);
     return 2;

@@ -26,6 +26,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/map_builder.h"
 #include "vmap/map/map_io.h"
@@ -88,7 +89,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "sweep_bench: '%s' not found\n", input.c_str());
     return 2;
   }
-  cv::setNumThreads(1);  // as the vmap binary does
+  vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   const auto matcher = vmap::CreateOrbMatcher({});
   const std::vector<double> taus = vmap::ParseThresholds(thresholds);
   const fs::path temp = fs::temp_directory_path() / ("sweep_bench_" + std::to_string(getpid()));

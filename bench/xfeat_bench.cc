@@ -22,6 +22,7 @@
 #include <opencv2/imgproc.hpp>
 #include <torch/torch.h>
 
+#include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/map_builder.h"
 #include "vmap/neural/xfeat_matcher.h"
@@ -160,7 +161,7 @@ int main(int argc, char** argv) {
   if (top_ks.empty()) top_ks = {4096};
   if (thread_counts.empty()) thread_counts = {1, 2};
   const std::string weights = shared + "/weights/xfeat/xfeat_folded.pt";
-  cv::setNumThreads(1);  // as the vmap binary does
+  vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   if (!video.empty()) {
     TimeBuilds(weights, video, top_ks, build_repeat, frames);
     return 0;

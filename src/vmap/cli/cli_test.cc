@@ -8,20 +8,19 @@
 
 #include "vmap/geometry/fundamental.h"
 #include "vmap/map/map_io.h"
+#include "vmap/testing/run_vmap.h"
+#include "vmap/testing/scoped_temp_dir.h"
+#include "vmap/testing/shared_data.h"
 #include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
+using testing::Quote;
 using testing::RunVmap;
 
 namespace {
 
 fs::path Shared() { return testing::SharedDir(); }
-
-#define REQUIRE_SHARED()                                          \
-  if (Shared().empty()) GTEST_SKIP() << "../shared is not present"
-
-std::string Quote(const fs::path& p) { return "'" + p.string() + "'"; }
 
 // A synthetic sequence of `num_frames` written as an image folder at `directory`.
 void WriteSyntheticInput(const fs::path& directory, int num_frames, double step = testing::SyntheticOptions().step) {
@@ -34,8 +33,8 @@ void WriteSyntheticInput(const fs::path& directory, int num_frames, double step 
 }  // namespace
 
 TEST(Cli, BuildsAndReadsBackAMapFromAVideo) {
-  REQUIRE_SHARED();
-  testing::TempDir tmp;
+  SKIP_WITHOUT_SHARED();
+  testing::ScopedTempDir tmp;
   std::string out;
   const fs::path map_dir = tmp.path() / "map";
   ASSERT_EQ(RunVmap("build " + Quote(Shared() / "data/lab_floor/lab_floor.mp4") + " -o " + Quote(map_dir) +
@@ -63,14 +62,14 @@ TEST(Cli, BuildsAndReadsBackAMapFromAVideo) {
 }
 
 TEST(Cli, EveryDatasetLayoutBuilds) {
-  REQUIRE_SHARED();
+  SKIP_WITHOUT_SHARED();
   struct Case {
     std::string input, extra;
     int frames;
   };
   for (const Case& c : {Case{"data/rccar_room/images", "", 329}, Case{"data/redkitchen", "--last 299", 300},
                         Case{"data/kitti07", "", 160}}) {
-    testing::TempDir tmp;
+    testing::ScopedTempDir tmp;
     std::string out;
     ASSERT_EQ(RunVmap("build " + Quote(Shared() / c.input) + " -o " + Quote(tmp.path() / "m") + " " + c.extra, &out),
               0)
@@ -85,8 +84,8 @@ TEST(Cli, EveryDatasetLayoutBuilds) {
 }
 
 TEST(Cli, SweepWritesThePapersTable) {
-  REQUIRE_SHARED();
-  testing::TempDir tmp;
+  SKIP_WITHOUT_SHARED();
+  testing::ScopedTempDir tmp;
   std::string out;
   ASSERT_EQ(RunVmap("sweep " + Quote(Shared() / "data/rccar_room/images") + " --last 99 --thresholds 0.1:0.9:0.2 -o " +
                         Quote(tmp.path() / "sweep") + " --maps",
@@ -113,8 +112,8 @@ TEST(Cli, LoftrBuildsAMapEndToEnd) {
 #ifndef VMAP_WITH_TORCH
   GTEST_SKIP() << "built without LibTorch";
 #endif
-  REQUIRE_SHARED();
-  testing::TempDir tmp;
+  SKIP_WITHOUT_SHARED();
+  testing::ScopedTempDir tmp;
   std::string out;
   ASSERT_EQ(RunVmap("build " + Quote(Shared() / "data/rccar_room/images") + " --last 39 --matcher loftr -o " +
                         Quote(tmp.path() / "m"),
@@ -146,7 +145,7 @@ TEST(Cli, LoftrBuildsAMapEndToEnd) {
 }
 
 TEST(Cli, OneFrameSequenceIsAMapWithOneKeyImage) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 1);
   std::string out;
   ASSERT_EQ(RunVmap("build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "m"), &out), 0) << out;
@@ -156,7 +155,7 @@ TEST(Cli, OneFrameSequenceIsAMapWithOneKeyImage) {
 }
 
 TEST(Cli, VerboseLogSaysWhyEachKeyImageWasChosenAndQuietSaysNothing) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 30, 0.08);
   std::string out;
   ASSERT_EQ(RunVmap("build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "m") + " --tau 0.8 -v", &out), 0)
@@ -171,11 +170,11 @@ TEST(Cli, VerboseLogSaysWhyEachKeyImageWasChosenAndQuietSaysNothing) {
 
 TEST(Cli, ProgressLineOnATerminalOnly) {
   if (std::system("command -v script >/dev/null 2>&1") != 0) GTEST_SKIP() << "util-linux `script` is missing";
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 40);
   // `script` gives the binary a pseudo-terminal, as an interactive user would.
   auto on_terminal = [&](const std::string& flags) {
-    std::ofstream(tmp.path() / "run.sh") << "'" << VMAP_BINARY << "' " << flags << " build '"
+    std::ofstream(tmp.path() / "run.sh") << testing::Quote(testing::VmapBinary()) << " " << flags << " build '"
                                          << (tmp.path() / "in").string() << "' -o '" << (tmp.path() / "m").string()
                                          << "'\n";
     FILE* pipe = popen(("script -qec 'sh " + (tmp.path() / "run.sh").string() + "' /dev/null").c_str(), "r");
@@ -195,7 +194,7 @@ TEST(Cli, ProgressLineOnATerminalOnly) {
 }
 
 TEST(Cli, BadInputGivesAClearErrorAndWritesNothing) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 4);
   fs::create_directories(tmp.path() / "empty");
   std::ofstream(tmp.path() / "broken.mp4") << std::string(4096, '\x42');
@@ -236,7 +235,7 @@ TEST(Cli, BadInputGivesAClearErrorAndWritesNothing) {
 }
 
 TEST(Cli, ReplacesAnOlderMapButNeverAFolderOfTheUser) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 5);
   std::string out;
   const std::string build = "build " + Quote(tmp.path() / "in") + " -o ";
@@ -251,8 +250,8 @@ TEST(Cli, ReplacesAnOlderMapButNeverAFolderOfTheUser) {
 }
 
 TEST(Cli, TruncatedVideoIsAClearError) {
-  REQUIRE_SHARED();
-  testing::TempDir tmp;
+  SKIP_WITHOUT_SHARED();
+  testing::ScopedTempDir tmp;
   std::ifstream in(Shared() / "data/lab_floor/lab_floor.mp4", std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   std::ofstream(tmp.path() / "cut.mp4", std::ios::binary) << bytes.substr(0, bytes.size() / 3);
@@ -264,7 +263,7 @@ TEST(Cli, TruncatedVideoIsAClearError) {
 }
 
 TEST(Cli, DifferentFrameSizesWarnOrFailWhenStrict) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 5);
   cv::imwrite((tmp.path() / "in/frame_3.png").string(), cv::Mat(100, 150, CV_8UC3, cv::Scalar(90, 90, 90)));
   std::string out;

@@ -8,20 +8,19 @@
 
 #include "vmap/evaluation/map_evaluation.h"
 #include "vmap/map/map_io.h"
+#include "vmap/testing/run_vmap.h"
+#include "vmap/testing/scoped_temp_dir.h"
+#include "vmap/testing/shared_data.h"
 #include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
+using testing::Quote;
 using testing::RunVmap;
 
 namespace {
 
 fs::path Shared() { return testing::SharedDir(); }
-
-#define REQUIRE_SHARED() \
-  if (Shared().empty()) GTEST_SKIP() << "../shared is not present"
-
-std::string Quote(const fs::path& p) { return "'" + p.string() + "'"; }
 
 nlohmann::json ReadJson(const fs::path& file) {
   std::ifstream in(file);
@@ -39,8 +38,8 @@ testing::SyntheticSequence Synthetic() {
 }  // namespace
 
 TEST(EvalCli, Kitti07LinksAreUsableAndTheReportShowsThem) {
-  REQUIRE_SHARED();
-  testing::TempDir tmp;
+  SKIP_WITHOUT_SHARED();
+  testing::ScopedTempDir tmp;
   const fs::path map = tmp.path() / "map";
   std::string out;
   ASSERT_EQ(RunVmap("build " + Quote(Shared() / "data/kitti07") + " --last 59 -q -o " + Quote(map), &out), 0) << out;
@@ -79,8 +78,8 @@ TEST(EvalCli, Kitti07LinksAreUsableAndTheReportShowsThem) {
 }
 
 TEST(EvalCli, RedkitchenIsEvaluatedByTimestamp) {
-  REQUIRE_SHARED();
-  testing::TempDir tmp;
+  SKIP_WITHOUT_SHARED();
+  testing::ScopedTempDir tmp;
   const fs::path map = tmp.path() / "map";
   std::string out;
   ASSERT_EQ(RunVmap("build " + Quote(Shared() / "data/redkitchen") + " --last 119 -q -o " + Quote(map), &out), 0)
@@ -104,8 +103,8 @@ TEST(EvalCli, RedkitchenIsEvaluatedByTimestamp) {
 }
 
 TEST(EvalCli, SweepWithGroundTruthAddsAUsableLinksColumn) {
-  REQUIRE_SHARED();
-  testing::TempDir tmp;
+  SKIP_WITHOUT_SHARED();
+  testing::ScopedTempDir tmp;
   std::string out;
   ASSERT_EQ(RunVmap("sweep " + Quote(Shared() / "data/kitti07") + " --last 39 --thresholds 0.4,0.6 --gt -q -o " +
                         Quote(tmp.path() / "sweep") + " --maps",
@@ -125,7 +124,7 @@ TEST(EvalCli, SweepWithGroundTruthAddsAUsableLinksColumn) {
 }
 
 TEST(EvalCli, CameraOptionAndMissingGroundTruthOrIntrinsics) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const testing::SyntheticSequence sequence = Synthetic();
   testing::WriteImageFolder(sequence, tmp.path() / "frames");
   std::string out;

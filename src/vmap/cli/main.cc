@@ -4,17 +4,16 @@
 #include <exception>
 
 #include <CLI/CLI.hpp>
-#include <opencv2/core.hpp>
 
 #include "vmap/cli/commands.h"
 #include "vmap/core/error.h"
-#include "vmap/core/interrupt.h"
 #include "vmap/core/logging.h"
+#include "vmap/core/runtime.h"
 
 int main(int argc, char** argv) {
-  // First, while this is the only thread: an interrupted command removes its unfinished outputs and exits
-  // with 128 + the signal (see interrupt.h).
-  vmap::InstallInterruptHandling();
+  // First, while this is the only thread: signal handling (an interrupted command removes its unfinished
+  // outputs and exits with 128 + the signal), OpenCV's threads, malloc, FFmpeg's log (see runtime.h).
+  vmap::InitializeRuntime();
   CLI::App app{"vmap: visual maps for vision-only robot navigation (key images linked by fundamental matrices)"};
   app.set_version_flag("--version", std::string("vmap ") + VMAP_VERSION);
   app.require_subcommand(1);
@@ -35,9 +34,6 @@ int main(int argc, char** argv) {
   vmap::cli::AddLocalizeCommand(app);
   vmap::cli::AddRouteCommand(app);
 
-  // vmap runs frames in parallel itself; OpenCV's own threads inside ORB then only add contention
-  // (measured: 5.1 ms per 640x480 frame on one thread, 7.2 ms with two).
-  cv::setNumThreads(1);
   // Every failure ends as "vmap: error: ..." with status 2; 0 is success, --help and --version included.
   try {
     app.parse(argc, argv);

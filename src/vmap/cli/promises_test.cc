@@ -28,17 +28,18 @@
 
 #include "vmap/core/file_name_encoding.h"
 #include "vmap/map/map_io.h"
+#include "vmap/testing/run_vmap.h"
+#include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"
 
 extern char** environ;
 
 namespace vmap {
 namespace fs = std::filesystem;
+using testing::Quote;
 using testing::RunVmap;
 
 namespace {
-
-std::string Quote(const fs::path& p) { return "'" + p.string() + "'"; }
 
 std::string ReadText(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -73,7 +74,7 @@ std::vector<std::string> EntriesStartingWith(const fs::path& directory, const st
 class Process {
  public:
   Process(const std::vector<std::string>& arguments, const fs::path& log) {
-    std::vector<std::string> argv_storage = {VMAP_BINARY};
+    std::vector<std::string> argv_storage = {testing::VmapBinary().string()};
     argv_storage.insert(argv_storage.end(), arguments.begin(), arguments.end());
     std::vector<char*> argv;
     for (std::string& a : argv_storage) argv.push_back(a.data());
@@ -134,7 +135,7 @@ bool AppearsWithin(const fs::path& directory, const std::string& prefix, double 
 // ---- 1. Ownership -------------------------------------------------------------------------------------------
 
 TEST(Promises, OutputsVmapCannotProveItsOwnAreNeverReplaced) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 6);
   const std::string in = Quote(tmp.path() / "in");
   // The case: a project folder with a map.json that is not a vmap map.
@@ -182,7 +183,7 @@ TEST(Promises, OutputsVmapCannotProveItsOwnAreNeverReplaced) {
 }
 
 TEST(Promises, VmapReplacesWhatItWrote) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 6);
   const std::string in = Quote(tmp.path() / "in");
   std::string out;
@@ -204,7 +205,7 @@ TEST(Promises, VmapReplacesWhatItWrote) {
 }
 
 TEST(Promises, TheInputIsNeverInsideTheOutputNorTheOutputInsideTheInput) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 6);
   BuildMap(tmp.path() / "in", tmp.path() / "s");
   BuildMap(tmp.path() / "in", tmp.path() / "old_map");
@@ -237,7 +238,7 @@ TEST(Promises, TheInputIsNeverInsideTheOutputNorTheOutputInsideTheInput) {
 // ---- 2. Untrusted maps --------------------------------------------------------------------------------------
 
 TEST(Promises, UntrustedMapsAreRefusedQuicklyWithLittleMemory) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 8);
   BuildMap(tmp.path() / "in", tmp.path() / "good");
   ASSERT_GT(ReadMap(tmp.path() / "good").links.size(), 0u);
@@ -307,7 +308,7 @@ TEST(Promises, UntrustedMapsAreRefusedQuicklyWithLittleMemory) {
 // ---- 3. Interrupted runs ------------------------------------------------------------------------------------
 
 TEST(Promises, SigintOrSigtermLeaveNothingBehindAndTheOldOutputIntact) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 150);
   BuildMap(tmp.path() / "in", tmp.path() / "m", "--last 9");
   const std::string old_map = ReadText(tmp.path() / "m/map.json");
@@ -339,7 +340,7 @@ TEST(Promises, SigintOrSigtermLeaveNothingBehindAndTheOldOutputIntact) {
 }
 
 TEST(Promises, AnInterruptedReportLeavesTheMapAsItWas) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 150);
   BuildMap(tmp.path() / "in", tmp.path() / "m", "--tau 0.99");  // many key images: a report of some length
   ASSERT_GT(ReadMap(tmp.path() / "m").key_images.size(), 20u);
@@ -354,7 +355,7 @@ TEST(Promises, AnInterruptedReportLeavesTheMapAsItWas) {
 }
 
 TEST(Promises, TemporariesOfAKilledRunAreRemovedByTheNextRun) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 150);
   Process process({"build", (tmp.path() / "in").string(), "-o", (tmp.path() / "m").string(), "--threads", "1"},
                   tmp.path() / "log.txt");
@@ -374,7 +375,7 @@ TEST(Promises, TemporariesOfAKilledRunAreRemovedByTheNextRun) {
 // ---- 4. Every error is vmap's -------------------------------------------------------------------------------
 
 TEST(Promises, BadFramesAreSkippedWithAWarningAndCounted) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 10);
   cv::imwrite((tmp.path() / "in/frame_3.png").string(), cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(9)));
   cv::imwrite((tmp.path() / "in/frame_6.png").string(), cv::Mat(2, 700, CV_8UC3, cv::Scalar::all(9)));
@@ -395,7 +396,7 @@ TEST(Promises, BadFramesAreSkippedWithAWarningAndCounted) {
 }
 
 TEST(Promises, FileNamesThatAreNotUtf8Work) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 6);
   // Latin-1 names, as an old camera or a Windows share writes them, and a '%'.
   const std::vector<std::string> names = {"caf\xE9_1.png", "caf\xE9_2.png", "100%_3.png", "\xFF\xFE_4.png",
@@ -432,7 +433,7 @@ TEST(Promises, FileNamesThatAreNotUtf8Work) {
 }
 
 TEST(Promises, LibraryErrorsBecomeVmapErrorsNamingTheFile) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 6);
   BuildMap(tmp.path() / "in", tmp.path() / "m");
   // An image whose header announces 40000 x 40000 pixels: OpenCV refuses to decode it with an exception.
@@ -478,7 +479,7 @@ TEST(Promises, LibraryErrorsBecomeVmapErrorsNamingTheFile) {
 // ---- 5. Bounded options -------------------------------------------------------------------------------------
 
 TEST(Promises, AbsurdOptionsAreRefusedBeforeAnyWork) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 4);
   BuildMap(tmp.path() / "in", tmp.path() / "m");
   const std::string build = "build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "out") + " ";

@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "vmap/core/error.h"
-#include "vmap/testing/synthetic_scene.h"
+#include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -61,7 +61,7 @@ pid_t DeadPid() {
 }  // namespace
 
 TEST(AtomicOutput, DirectoryAppearsOnlyOnCommit) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const fs::path target = tmp.path() / "map";
   {
     AtomicOutputDirectory dir(target, MarkerPolicy());
@@ -74,7 +74,7 @@ TEST(AtomicOutput, DirectoryAppearsOnlyOnCommit) {
 }
 
 TEST(AtomicOutput, UncommittedDirectoryLeavesNothingAndKeepsTheOldOne) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const fs::path target = tmp.path() / "map";
   MakeOwned(target);
   {
@@ -88,7 +88,7 @@ TEST(AtomicOutput, UncommittedDirectoryLeavesNothingAndKeepsTheOldOne) {
 }
 
 TEST(AtomicOutput, CommitReplacesAnOlderDirectoryAndLeavesNothingElse) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const fs::path target = tmp.path() / "map";
   MakeOwned(target);
   AtomicOutputDirectory dir(target, MarkerPolicy());
@@ -100,7 +100,7 @@ TEST(AtomicOutput, CommitReplacesAnOlderDirectoryAndLeavesNothingElse) {
 }
 
 TEST(AtomicOutput, RefusesToReplaceAFileOrASymbolicLink) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   std::ofstream(tmp.path() / "file") << "x";
   EXPECT_NE(RefusalOf(tmp.path() / "file", MarkerPolicy()).find("not a directory"), std::string::npos);
   MakeOwned(tmp.path() / "owned");
@@ -111,7 +111,7 @@ TEST(AtomicOutput, RefusesToReplaceAFileOrASymbolicLink) {
 }
 
 TEST(AtomicOutput, NeverReplacesADirectoryItCannotProveItsOwn) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const fs::path documents = tmp.path() / "documents";
   fs::create_directories(documents / ".git");
   std::ofstream(documents / "thesis.tex") << "precious";
@@ -132,7 +132,7 @@ TEST(AtomicOutput, NeverReplacesADirectoryItCannotProveItsOwn) {
 }
 
 TEST(AtomicOutput, TheProofIsCheckedAgainWhenCommitting) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const fs::path target = tmp.path() / "map";
   MakeOwned(target);
   AtomicOutputDirectory dir(target, MarkerPolicy());
@@ -150,7 +150,7 @@ TEST(AtomicOutput, TheProofIsCheckedAgainWhenCommitting) {
 }
 
 TEST(AtomicOutput, NeverReplacesItsInputNorWritesIntoIt) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const fs::path map = tmp.path() / "map";
   MakeOwned(map);
   fs::create_directories(map / "keys");
@@ -181,7 +181,7 @@ TEST(AtomicOutput, NeverReplacesItsInputNorWritesIntoIt) {
 }
 
 TEST(AtomicOutput, StaleTemporariesOfDeadProcessesAreRemovedAndLiveOnesKept) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const std::string dead = std::to_string(DeadPid()), alive = std::to_string(getpid());
   const std::vector<std::string> stale = {".map.partial-" + dead + "-12", ".map.old-" + dead + "-3",
                                           ".map.tmp-" + dead + "-4"};
@@ -208,7 +208,7 @@ TEST(AtomicOutput, StaleTemporariesOfDeadProcessesAreRemovedAndLiveOnesKept) {
 }
 
 TEST(AtomicOutput, WriteFileAtomicallyWritesContentAndNoTemporaries) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteFileAtomically(tmp.path() / "f.json", "{\"a\": 1}");
   EXPECT_EQ(ReadAll(tmp.path() / "f.json"), "{\"a\": 1}");
   WriteFileAtomically(tmp.path() / "f.json", "{\"a\": 2}");
@@ -222,7 +222,7 @@ TEST(AtomicOutput, WriteFileAtomicallyWritesContentAndNoTemporaries) {
 }
 
 TEST(AtomicOutputDeathTest, RemovingTemporariesForExitTakesEveryUnfinishedOutput) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const fs::path target = tmp.path() / "map";
   MakeOwned(target);
   // In a child process: the registry stays locked afterwards, as for a process about to end.

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "vmap/testing/synthetic_scene.h"
+#include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -21,7 +21,7 @@ std::string WhyNot(const fs::path& directory, const std::string& relative) {
 }  // namespace
 
 TEST(ContainedFile, OpensRegularFilesInsideAndReadsRanges) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   fs::create_directories(tmp.path() / "map/keys");
   std::ofstream(tmp.path() / "map/keys/a.bin") << "0123456789";
   // A link that stays inside is fine.
@@ -39,7 +39,7 @@ TEST(ContainedFile, OpensRegularFilesInsideAndReadsRanges) {
 }
 
 TEST(ContainedFile, RefusesWhatLeadsOutOrIsNotAFile) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const fs::path map = tmp.path() / "map";
   fs::create_directories(map / "keys");
   std::ofstream(tmp.path() / "secret.txt") << "secret";
@@ -60,7 +60,7 @@ TEST(ContainedFile, RefusesWhatLeadsOutOrIsNotAFile) {
 }
 
 TEST(ContainedFile, IsSameOrInsideComparesWhatPathsResolveTo) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   fs::create_directories(tmp.path() / "a/b");
   fs::create_directory_symlink(tmp.path() / "a/b", tmp.path() / "link_to_b");
   EXPECT_TRUE(IsSameOrInside(tmp.path() / "a/b", tmp.path() / "a"));
@@ -74,7 +74,7 @@ TEST(ContainedFile, IsSameOrInsideComparesWhatPathsResolveTo) {
 }
 
 TEST(ContainedFile, ReadsJsonWithLimits) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   std::ofstream(tmp.path() / "ok.json") << R"({"format": "x", "n": [1, 2]})";
   ContainedJson ok = ReadContainedJson(tmp.path(), "ok.json", 1000);
   ASSERT_TRUE(ok.document) << ok.why_not;

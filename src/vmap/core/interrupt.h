@@ -10,8 +10,8 @@
 //
 // A signal that the process was started with ignored (nohup, `cmd &` in a script) stays ignored.
 //
-// The CLI calls this once, first thing in main(), before any other thread exists; the library never installs
-// it, so a program that embeds vmap keeps its own signal handling. (A mode in which SIGINT ends the input
+// InitializeRuntime() (runtime.h) calls this once, first thing in main(), before any other thread exists; the
+// library never installs it, so a program that embeds vmap keeps its own signal handling. (A mode in which SIGINT ends the input
 // gracefully would hook in where interrupt.cc handles a signal.)
 
 namespace vmap {

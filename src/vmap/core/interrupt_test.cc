@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "vmap/core/atomic_output.h"
-#include "vmap/testing/synthetic_scene.h"
+#include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -43,7 +43,7 @@ void StartAsFromATerminal() {
 // Death tests fork this process: each runs its statement in a child, so the signal handling installed there
 // never touches the test runner.
 TEST(InterruptDeathTest, SigintRemovesTheUnfinishedOutputAndExitsWith130) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   EXPECT_EXIT(WriteAndReceive(tmp.path() / "map", SIGINT), ::testing::ExitedWithCode(128 + SIGINT), "interrupted");
   EXPECT_EQ(CountEntries(tmp.path()), 1) << "only the finished file remains";
   EXPECT_TRUE(fs::exists(tmp.path() / "done.txt"));
@@ -51,7 +51,7 @@ TEST(InterruptDeathTest, SigintRemovesTheUnfinishedOutputAndExitsWith130) {
 
 TEST(InterruptDeathTest, SigtermAndSighupDoTheSame) {
   for (int signal_number : {SIGTERM, SIGHUP}) {
-    testing::TempDir tmp;
+    testing::ScopedTempDir tmp;
     EXPECT_EXIT(WriteAndReceive(tmp.path() / "map", signal_number), ::testing::ExitedWithCode(128 + signal_number),
                 "interrupted");
     EXPECT_EQ(CountEntries(tmp.path()), 1) << strsignal(signal_number);
@@ -59,7 +59,7 @@ TEST(InterruptDeathTest, SigtermAndSighupDoTheSame) {
 }
 
 TEST(InterruptDeathTest, ASignalIgnoredAtStartStaysIgnored) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   // As under nohup: SIGHUP ignored before vmap starts.
   EXPECT_EXIT(
       {
@@ -74,7 +74,7 @@ TEST(InterruptDeathTest, ASignalIgnoredAtStartStaysIgnored) {
 }
 
 TEST(InterruptDeathTest, NothingIsRemovedAfterACommit) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   EXPECT_EXIT(
       {
         StartAsFromATerminal();

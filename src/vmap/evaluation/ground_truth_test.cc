@@ -6,7 +6,8 @@
 #include <opencv2/calib3d.hpp>
 
 #include "vmap/core/error.h"
-#include "vmap/testing/synthetic_scene.h"
+#include "vmap/testing/scoped_temp_dir.h"
+#include "vmap/testing/shared_data.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -14,9 +15,6 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path Shared() { return testing::SharedDir(); }
-
-#define REQUIRE_SHARED() \
-  if (Shared().empty()) GTEST_SKIP() << "../shared is not present"
 
 void WriteText(const fs::path& path, const std::string& text) {
   fs::create_directories(path.parent_path());
@@ -80,7 +78,7 @@ TEST(GroundTruth, RelativePoseMapsPointsFromTheFirstCameraToTheSecond) {
 }
 
 TEST(GroundTruth, DetectsAndReadsTheThreeFormats) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteText(tmp.path() / "kitti.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0.5 0 1 0 0 0 0 1 2\n");
   WriteText(tmp.path() / "tum.txt", "# timestamp tx ty tz qx qy qz qw\n10.0 1 2 3 0 0 0 1\n10.1 1 2 4 0 0 0.7071068 0.7071068\n");
   WriteText(tmp.path() / "euroc.csv",
@@ -149,7 +147,7 @@ TEST(GroundTruth, KeyImagesTakeTheirPoseBySourceIndexOrByNearestTimestamp) {
 }
 
 TEST(GroundTruth, FindsTheGroundTruthOfEachLayout) {
-  REQUIRE_SHARED();
+  SKIP_WITHOUT_SHARED();
   const std::optional<GroundTruth> kitti = FindGroundTruth((Shared() / "data/kitti07").string(), SourceFormat::kAuto);
   ASSERT_TRUE(kitti);
   EXPECT_EQ(kitti->format, GroundTruthFormat::kKitti);
@@ -163,7 +161,7 @@ TEST(GroundTruth, FindsTheGroundTruthOfEachLayout) {
 }
 
 TEST(GroundTruth, FindsKittiPosesInTheOfficialLayout) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   // dataset/sequences/07/{image_0, times.txt} and dataset/poses/07.txt
   fs::create_directories(tmp.path() / "dataset/sequences/07/image_0");
   WriteText(tmp.path() / "dataset/poses/07.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1 0.9\n");

@@ -13,6 +13,7 @@
 #include "vmap/geometry/relative_pose.h"
 #include "vmap/mapping/map_builder.h"
 #include "vmap/report/evaluation_summary.h"
+#include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {
@@ -44,7 +45,7 @@ VisualMap Build(const std::string& input, FrameSourceOptions source_options = {}
 
 // One map of the KITTI-layout sequence, built once for the tests that only read it.
 struct KittiFixture {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   fs::path sequence;
   VisualMap map;
   GroundTruth truth;
@@ -205,7 +206,7 @@ TEST(MapEvaluation, ResizedMapsUseTheScaledCamera) {
 }
 
 TEST(MapEvaluation, TumSequenceIsAssociatedByTimestamp) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   // Ground truth sampled 5 ms after each frame, as a motion-capture system would.
   testing::WriteTumSequence(Sequence(), tmp.path() / "tum", 1.0 / 30, 0.005);
   const VisualMap map = Build((tmp.path() / "tum").string());
@@ -220,7 +221,7 @@ TEST(MapEvaluation, TumSequenceIsAssociatedByTimestamp) {
 }
 
 TEST(MapEvaluation, EurocBodyPosesAreTurnedIntoCameraPoses) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   // The camera looks along the body's x axis, 10 cm in front of it, as on a drone.
   cv::Matx44d body_to_camera(0, 0, 1, 0.10,  //
                              -1, 0, 0, 0.02,  //
@@ -249,7 +250,7 @@ TEST(MapEvaluation, OptionsAreCheckedAndTheDocumentRoundTrips) {
   const KittiFixture& k = Kitti();
   MapEvaluation e = EvaluateMap(k.map, k.truth, *k.map.input.camera, EvaluationOptions());
   e.map_path = "map";
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const fs::path file = tmp.path() / kEvaluationFileName;
   std::ofstream(file) << EvaluationToJson(e);
   const MapEvaluation back = ReadEvaluation(file.string());
@@ -266,7 +267,7 @@ TEST(MapEvaluation, OptionsAreCheckedAndTheDocumentRoundTrips) {
 // Frames shown twice in a row (7-Scenes repeats a frame when one was dropped) are never promoted to key
 // images when another frame will do; with the check off, some links join two views of one viewpoint.
 TEST(MapEvaluation, RepeatedFramesAreNotChosenAsKeyImages) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   testing::SyntheticSequence doubled = Sequence();
   doubled.frames.clear();
   doubled.poses.clear();

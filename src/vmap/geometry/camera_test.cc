@@ -7,7 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/core/error.h"
-#include "vmap/testing/synthetic_scene.h"
+#include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -46,7 +46,7 @@ TEST(Camera, ParsesTheCameraOptionText) {
 }
 
 TEST(Camera, ReadsOpenCvCalibrationFilesInYamlAndJson) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const cv::Matx33d K(612.5, 0, 331.25, 0, 611.0, 242.75, 0, 0, 1);
   const cv::Mat distortion = (cv::Mat_<double>(5, 1) << -0.21, 0.07, 0.0012, -0.0008, -0.011);
   for (const char* name : {"calibration.yaml", "calibration.json"}) {

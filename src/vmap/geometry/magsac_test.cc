@@ -7,6 +7,7 @@
 
 #include "vmap/features/orb_matcher.h"
 #include "vmap/sources/frame_source.h"
+#include "vmap/testing/shared_data.h"
 #include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {
@@ -294,7 +295,7 @@ TEST(MagsacEarlyStop, DecisionsAgreeWithTheExhaustiveRun) {
 
 // Real ORB matches from ../shared: S of vmap's estimator against OpenCV's, both averaged over three seeds.
 TEST(Magsac, AgreesWithOpenCvOnRealPairs) {
-  const auto shared = testing::SharedDir();
+  const std::filesystem::path shared = testing::SharedDir();
   if (shared.empty()) GTEST_SKIP() << "../shared not found";
   FrameSourceOptions source_options;
   source_options.first = 19;

@@ -8,6 +8,7 @@
 #include "vmap/features/orb_matcher.h"
 #include "vmap/localization/localization_test_util.h"
 #include "vmap/map/map_io.h"
+#include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {
@@ -16,7 +17,7 @@ namespace {
 
 // A small map in a fresh directory.
 struct SmallMap {
-  ::vmap::testing::TempDir directory;
+  ::vmap::testing::ScopedTempDir directory;
   fs::path path;
   VisualMap map;
   SmallMap() : path(directory.path() / "map") {

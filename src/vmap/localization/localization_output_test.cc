@@ -9,7 +9,7 @@
 
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
-#include "vmap/testing/synthetic_scene.h"
+#include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
 namespace {
@@ -95,7 +95,7 @@ TEST(LocalizationOutput, CsvHasTheNamedColumnsAndOneRowPerFrame) {
 TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
   const VisualMap map = TwoKeyMap();
   const LocalizationRun run = SampleRun();
-  ::vmap::testing::TempDir tmp;
+  ::vmap::testing::ScopedTempDir tmp;
   const auto file = tmp.path() / "run.json";
   WriteFileAtomically(file, LocalizationRunJson(map, run));
   const auto doc = nlohmann::json::parse(std::ifstream(file));
@@ -131,7 +131,7 @@ TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
 }
 
 TEST(LocalizationOutput, ReadingSomethingElseIsAClearError) {
-  ::vmap::testing::TempDir tmp;
+  ::vmap::testing::ScopedTempDir tmp;
   EXPECT_THROW(ReadLocalizationRun(tmp.path() / "missing.json"), InputError);
   WriteFileAtomically(tmp.path() / "map.json", "{\"format\": \"vmap-map\"}");
   try {

@@ -16,19 +16,18 @@
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/map/map_io.h"
 #include "vmap/report/html_report.h"
+#include "vmap/testing/run_vmap.h"
+#include "vmap/testing/scoped_temp_dir.h"
+#include "vmap/testing/shared_data.h"
 #include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
+using ::vmap::testing::Quote;
 using ::vmap::testing::RunVmap;
 namespace {
 
 fs::path Shared() { return ::vmap::testing::SharedDir(); }
-
-#define REQUIRE_SHARED() \
-  if (Shared().empty()) GTEST_SKIP() << "../shared is not present"
-
-std::string Quote(const fs::path& p) { return "'" + p.string() + "'"; }
 
 std::vector<std::string> Lines(const fs::path& file) {
   std::ifstream in(file);
@@ -39,7 +38,7 @@ std::vector<std::string> Lines(const fs::path& file) {
 
 // A map of the first 240 frames of lab_floor.mp4, built once by the binary for the tests of this file.
 const fs::path& LabMap() {
-  static ::vmap::testing::TempDir directory;
+  static ::vmap::testing::ScopedTempDir directory;
   static const fs::path map = [] {
     const fs::path path = directory.path() / "lab_map";
     std::string out;
@@ -54,8 +53,8 @@ const fs::path& LabMap() {
 }
 
 TEST(LocalizeCli, LocalizesARepeatOfTheTeachRunAndWritesCsvAndJson) {
-  REQUIRE_SHARED();
-  ::vmap::testing::TempDir tmp;
+  SKIP_WITHOUT_SHARED();
+  ::vmap::testing::ScopedTempDir tmp;
   std::string out;
   const fs::path csv = tmp.path() / "run.csv", json = tmp.path() / "run.json";
   ASSERT_EQ(RunVmap("localize " + Quote(LabMap()) + " " + Quote(Shared() / "data/lab_floor/lab_floor.mp4") +
@@ -93,8 +92,8 @@ TEST(LocalizeCli, LocalizesARepeatOfTheTeachRunAndWritesCsvAndJson) {
 }
 
 TEST(LocalizeCli, ASingleImageIsRelocalized) {
-  REQUIRE_SHARED();
-  ::vmap::testing::TempDir tmp;
+  SKIP_WITHOUT_SHARED();
+  ::vmap::testing::ScopedTempDir tmp;
   FrameSourceOptions options;
   options.first = 150;
   options.last = 150;
@@ -118,8 +117,8 @@ TEST(LocalizeCli, ASingleImageIsRelocalized) {
 
 TEST(LocalizeCli, ADifferentSceneDoesNotLocalize) {
   // desk.mp4 films a desk, not the lab floor: no frame may be localized against the lab-floor map.
-  REQUIRE_SHARED();
-  ::vmap::testing::TempDir tmp;
+  SKIP_WITHOUT_SHARED();
+  ::vmap::testing::ScopedTempDir tmp;
   std::string out;
   const fs::path json = tmp.path() / "desk.json";
   ASSERT_EQ(RunVmap("localize " + Quote(LabMap()) + " " + Quote(Shared() / "data/lab_floor/desk.mp4") +
@@ -137,7 +136,7 @@ TEST(LocalizeCli, ADifferentSceneDoesNotLocalize) {
 }
 
 TEST(LocalizeCli, RouteForwardsAndBackwards) {
-  REQUIRE_SHARED();
+  SKIP_WITHOUT_SHARED();
   const VisualMap map = ReadMap(LabMap());
   ASSERT_GE(map.key_images.size(), 4u);
   std::string out;
@@ -158,8 +157,8 @@ TEST(LocalizeCli, RouteForwardsAndBackwards) {
 }
 
 TEST(LocalizeCli, ReportOfARun) {
-  REQUIRE_SHARED();
-  ::vmap::testing::TempDir tmp;
+  SKIP_WITHOUT_SHARED();
+  ::vmap::testing::ScopedTempDir tmp;
   std::string out;
   const fs::path json = tmp.path() / "run.json";
   ASSERT_EQ(RunVmap("localize " + Quote(LabMap()) + " " + Quote(Shared() / "data/lab_floor/lab_floor.mp4") +
@@ -191,7 +190,7 @@ TEST(LocalizeCli, EvalCorridorRuns) {
   // that its 320x240 grey PNGs go through (a map of its even frames, its odd frames localized).
   const fs::path corridor = Shared() / "eval/pepper_corridor/images";
   if (Shared().empty() || !fs::exists(corridor)) GTEST_SKIP() << "../shared/eval/pepper_corridor is not present";
-  ::vmap::testing::TempDir tmp;
+  ::vmap::testing::ScopedTempDir tmp;
   std::string out;
   ASSERT_EQ(RunVmap("build " + Quote(corridor) + " --stride 2 --last 99 -q -o " + Quote(tmp.path() / "map"), &out), 0)
       << out;
@@ -205,7 +204,7 @@ TEST(LocalizeCli, EvalCorridorRuns) {
 }
 
 TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
-  ::vmap::testing::TempDir tmp;
+  ::vmap::testing::ScopedTempDir tmp;
   ::vmap::testing::SyntheticOptions synthetic;
   synthetic.num_frames = 6;
   ::vmap::testing::WriteImageFolder(::vmap::testing::RenderSyntheticSequence(synthetic), tmp.path() / "in");
@@ -242,7 +241,7 @@ struct PoseErrors {
 };
 
 double BracketShare(const std::string& sequence, int last, PoseErrors* pose_errors = nullptr) {
-  ::vmap::testing::TempDir tmp;
+  ::vmap::testing::ScopedTempDir tmp;
   const auto matcher = CreateOrbMatcher({});
   MapBuilderOptions build;
   build.show_progress = false;
@@ -287,7 +286,7 @@ double BracketShare(const std::string& sequence, int last, PoseErrors* pose_erro
 }
 
 TEST(LocalizationTruth, OddFramesOfKitti07AreBetweenTheirKeyImages) {
-  REQUIRE_SHARED();
+  SKIP_WITHOUT_SHARED();
   PoseErrors errors;
   EXPECT_GE(BracketShare("data/kitti07", 99, &errors), 0.95);
   // With KITTI's camera each frame also gets the pose of the key image ahead: against the ground truth.
@@ -301,7 +300,7 @@ TEST(LocalizationTruth, OddFramesOfKitti07AreBetweenTheirKeyImages) {
 }
 
 TEST(LocalizationTruth, OddFramesOfRedkitchenAreBetweenTheirKeyImages) {
-  REQUIRE_SHARED();
+  SKIP_WITHOUT_SHARED();
   EXPECT_GE(BracketShare("data/redkitchen", 199), 0.95);
 }
 

@@ -10,6 +10,7 @@
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localization_test_util.h"
 #include "vmap/localization/localize_sequence.h"
+#include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {
@@ -43,7 +44,7 @@ std::vector<int> Indices(int first, int stride, int last = -1) {
 
 // The map of the even frames, built once for all tests of this file.
 struct EvenMap {
-  ::vmap::testing::TempDir directory;
+  ::vmap::testing::ScopedTempDir directory;
   LocalizationMap opened;
   EvenMap() {
     const auto matcher = CreateOrbMatcher({});
@@ -212,7 +213,7 @@ TEST(Localizer, FollowsAReversedRouteWhenTheFramesComeBackwards) {
 
 TEST(Localizer, HeadingIsTheHorizontalShiftOfTheSceneInPixels) {
   // A map of one key image: the frame is at the route's end and the heading refers to that key image.
-  ::vmap::testing::TempDir directory;
+  ::vmap::testing::ScopedTempDir directory;
   const auto matcher = CreateOrbMatcher({});
   MapBuilderOptions build;
   build.show_progress = false;
@@ -238,7 +239,7 @@ TEST(Localizer, HeadingIsTheHorizontalShiftOfTheSceneInPixels) {
 // With the map's camera: the heading as a bearing in degrees, and the pose of the key image relative to the
 // frame, against the drive's true poses.
 TEST(Localizer, WithACameraTheHeadingIsInDegreesAndThePoseIsTheTrueOne) {
-  ::vmap::testing::TempDir directory;
+  ::vmap::testing::ScopedTempDir directory;
   const auto matcher = CreateOrbMatcher({});
   MapBuilderOptions build;
   build.show_progress = false;

@@ -13,7 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "vmap/core/error.h"
-#include "vmap/testing/synthetic_scene.h"
+#include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -69,7 +69,7 @@ std::string ErrorOf(const fs::path& directory) {
 }  // namespace
 
 TEST(MapIo, RoundTripKeepsEverything) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const VisualMap map = SmallMap(tmp.path());
   WriteMapFiles(map, tmp.path());
   const VisualMap back = ReadMap(tmp.path());
@@ -90,7 +90,7 @@ TEST(MapIo, RoundTripKeepsEverything) {
 }
 
 TEST(MapIo, MissingOrMalformedMapsNameTheProblem) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   EXPECT_NE(ErrorOf(tmp.path() / "nope").find("does not exist"), std::string::npos);
   EXPECT_NE(ErrorOf(tmp.path()).find("map.json is missing"), std::string::npos);
 
@@ -107,7 +107,7 @@ TEST(MapIo, MissingOrMalformedMapsNameTheProblem) {
 }
 
 TEST(MapIo, KeyImagePathsCannotLeaveTheMapDirectory) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const fs::path map_dir = tmp.path() / "map";
   VisualMap map = SmallMap(map_dir);
   cv::imwrite((tmp.path() / "outside.png").string(), cv::Mat(4, 4, CV_8U));
@@ -119,7 +119,7 @@ TEST(MapIo, KeyImagePathsCannotLeaveTheMapDirectory) {
 }
 
 TEST(MapIo, CorrespondenceRangesAreChecked) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteMapFiles(SmallMap(tmp.path()), tmp.path());
   std::ifstream in(tmp.path() / kMapFileName);
   auto doc = nlohmann::json::parse(in);
@@ -142,7 +142,7 @@ nlohmann::json ReadJson(const fs::path& file) {
 
 // Every field of map.json is checked for its type and range, and the message names the field.
 TEST(MapIo, EveryFieldIsCheckedAndTheMessageNamesIt) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteMapFiles(SmallMap(tmp.path()), tmp.path());
   const nlohmann::json good = ReadJson(tmp.path() / kMapFileName);
   using json = nlohmann::json;
@@ -218,7 +218,7 @@ TEST(MapIo, EveryFieldIsCheckedAndTheMessageNamesIt) {
 }
 
 TEST(MapIo, FileSizesAreCheckedBeforeAnythingIsRead) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteMapFiles(SmallMap(tmp.path()), tmp.path());
   const fs::path binary = tmp.path() / kCorrespondencesFileName;
   ASSERT_EQ(fs::file_size(binary), 6u * 16u);
@@ -241,7 +241,7 @@ TEST(MapIo, FileSizesAreCheckedBeforeAnythingIsRead) {
 }
 
 TEST(MapIo, OnlyTheReferencedRecordsAreRead) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   VisualMap map = SmallMap(tmp.path());
   WriteMapFiles(map, tmp.path());
   // Records nobody references may hold anything: they are not read, so NaNs there do not matter; a NaN in a
@@ -268,7 +268,7 @@ TEST(MapIo, OnlyTheReferencedRecordsAreRead) {
 }
 
 TEST(MapIo, NoFileIsReadThroughASymbolicLinkLeadingOut) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const fs::path map_dir = tmp.path() / "map";
   WriteMapFiles(SmallMap(map_dir), map_dir);
   const fs::path outside = tmp.path() / "outside";
@@ -311,7 +311,7 @@ TEST(MapIo, NoFileIsReadThroughASymbolicLinkLeadingOut) {
 }
 
 TEST(MapIo, KeyImagesMustBeThePngsOfTheMapsFrameSize) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteMapFiles(SmallMap(tmp.path()), tmp.path());
   const fs::path key = tmp.path() / "keys/9.png";
   std::ofstream(key, std::ios::trunc) << "GIF89a";
@@ -326,7 +326,7 @@ TEST(MapIo, KeyImagesMustBeThePngsOfTheMapsFrameSize) {
 }
 
 TEST(MapIo, FileNamesThatAreNotUtf8RoundTrip) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   VisualMap map = SmallMap(tmp.path());
   map.input.path = "/data/\xFFrun%1";
   map.key_images[1].source_name = "caf\xE9 9.png";
@@ -342,7 +342,7 @@ TEST(MapIo, FileNamesThatAreNotUtf8RoundTrip) {
 }
 
 TEST(MapIo, OwnershipNeedsAVmapMapJson) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteMapFiles(SmallMap(tmp.path() / "map"), tmp.path() / "map");
   EXPECT_EQ(WhyNotAVmapMap(tmp.path() / "map"), "");
   struct Case {
@@ -369,7 +369,7 @@ TEST(MapIo, OwnershipNeedsAVmapMapJson) {
 }
 
 TEST(MapIo, CameraAndLinkGeometryRoundTrip) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   VisualMap map = SmallMap(tmp.path());
   Camera camera = Camera::Make(50.5, 51.0, 31.5, 23.5, {-0.1, 0.01, 0.001, -0.002}, {64, 48});
   camera.origin = "intrinsics.txt";
@@ -415,7 +415,7 @@ TEST(MapIo, CameraAndLinkGeometryRoundTrip) {
 }
 
 TEST(MapIo, ReadsSchemaVersionOneMapsWithBrokenLinks) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteMapFiles(SmallMap(tmp.path()), tmp.path());
   std::ifstream in(tmp.path() / kMapFileName);
   auto doc = nlohmann::json::parse(in);
@@ -440,7 +440,7 @@ TEST(MapIo, ReadsSchemaVersionOneMapsWithBrokenLinks) {
 }
 
 TEST(MapIo, MalformedGeometryIsRefused) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteMapFiles(SmallMap(tmp.path()), tmp.path());
   std::ifstream in(tmp.path() / kMapFileName);
   const auto original = nlohmann::json::parse(in);
@@ -472,7 +472,7 @@ TEST(MapIo, MalformedGeometryIsRefused) {
 
 // The sizes ReadMap checks come from the headers alone, for both kinds of key image.
 TEST(MapIo, KeyImageFileSizeReadsPngAndJpegHeaders) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const cv::Mat image(37, 53, CV_8UC3, cv::Scalar(10, 200, 30));
   ASSERT_TRUE(cv::imwrite((tmp.path() / "a.png").string(), image));
   ASSERT_TRUE(cv::imwrite((tmp.path() / "a.jpg").string(), image));

@@ -16,6 +16,8 @@
 #include "vmap/core/error.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/map_builder.h"
+#include "vmap/testing/scoped_temp_dir.h"
+#include "vmap/testing/shared_data.h"
 #include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {
@@ -216,7 +218,7 @@ TEST(KeyImageSearch, OptionsAndDefaults) {
 
 // Key images of an image folder are the input's own files; of frames that were resized, PNG files.
 TEST(FastBuild, KeyImagesAreTheInputFilesWhenTheyCanBe) {
-  testing::TempDir temp;
+  testing::ScopedTempDir temp;
   testing::SyntheticOptions scene;
   scene.num_frames = 12;
   const testing::SyntheticSequence sequence = testing::RenderSyntheticSequence(scene);
@@ -258,7 +260,7 @@ namespace {
 const fs::path& RoomSequence() {
   static const fs::path path = testing::SharedDir().empty()
                                    ? fs::path()
-                                   : testing::SharedDir() / "data/rccar_room/images";
+                                   : fs::path(testing::SharedDir()) / "data/rccar_room/images";
   return path;
 }
 

@@ -1,7 +1,5 @@
 #include "vmap/neural/aliked_matcher.h"
 
-#include <malloc.h>
-
 #include <cmath>
 
 #include <nlohmann/json.hpp>
@@ -138,10 +136,6 @@ class AlikedMatcher : public Matcher {
 std::unique_ptr<Matcher> CreateAlikedMatcher(const AlikedMatcherOptions& options) {
   options.Check();
   const auto config = neural::AlikedPreset(options.model);
-  if (options.tune_malloc) {
-    mallopt(M_MMAP_MAX, 0);
-    mallopt(M_TRIM_THRESHOLD, 1 << 30);
-  }
   const std::string path = neural::LocateWeights("aliked-" + options.model, options.weights);
   const auto weights = neural::ReadAlikedStateDict(path);
   neural::CheckAlikedStateDict(weights, config, path);

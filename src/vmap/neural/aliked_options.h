@@ -23,10 +23,6 @@ struct AlikedMatcherOptions {
   // Images are processed at their own size (replicate-padded to a multiple of 32, as upstream). A value > 0
   // first shrinks images whose longest side exceeds it (INTER_AREA), for speed; keypoints are mapped back.
   int longest_side = 0;
-  // Keep freed memory in the heap instead of returning large blocks to the OS (mallopt, process-wide, as
-  // LoFTR's option): full-resolution activations above glibc's 32 MB mmap threshold (ALIKED-N16 at 640x480
-  // and larger) otherwise page-fault on every frame. Measured: N16 network 0.13 -> 0.09 CPU s at 640x480.
-  bool tune_malloc = true;
   // LibTorch threads per Extract call; 0 keeps LibTorch's default. vmap build already extracts frames on
   // one worker per core, where more threads per call only oversubscribe the cores.
   int num_threads = 1;

@@ -19,18 +19,6 @@ namespace fs = std::filesystem;
 
 std::string WeightsPath(const std::string& model) { return SharedDir() + "/weights/aliked/aliked-" + model + ".pt"; }
 
-class TempFolder {
- public:
-  TempFolder() : path_(fs::temp_directory_path() / ("vmap_aliked_weights_" + std::to_string(getpid()))) {
-    fs::create_directories(path_);
-  }
-  ~TempFolder() { fs::remove_all(path_); }
-  std::string operator/(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  fs::path path_;
-};
-
 void WriteBytes(const std::string& path, const std::vector<char>& bytes) {
   std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
@@ -137,9 +125,9 @@ TEST(AlikedWeights, SharedFilesHoldExactlyTheExpectedTensors) {
 
 TEST(AlikedWeights, ReadsUpstreamOrderedDictFiles) {
   SKIP_WITHOUT_SHARED();
-  const TempFolder temp;
+  const testing::ScopedTempDir temp("aliked_weights");
   const auto weights = ReadAlikedStateDict(WeightsPath("t16"));
-  const std::string path = temp / "aliked-t16.pth";
+  const std::string path = temp.path() / "aliked-t16.pth";
   WriteOrderedDictFile(weights, path);
   // LibTorch alone cannot read this layout (it fails on the OrderedDict); the reader falls back to its own
   // unpickler.
@@ -157,14 +145,14 @@ TEST(AlikedWeights, ReadsUpstreamOrderedDictFiles) {
 
 TEST(AlikedWeights, ReadsAStateDictNestedUnderStateDict) {
   SKIP_WITHOUT_SHARED();
-  const TempFolder temp;
+  const testing::ScopedTempDir temp("aliked_weights");
   const auto weights = ReadAlikedStateDict(WeightsPath("n16"));
   c10::Dict<std::string, torch::Tensor> state;
   for (const auto& [key, t] : weights) state.insert(key, t);
   c10::impl::GenericDict checkpoint(c10::StringType::get(), c10::AnyType::get());
   checkpoint.insert("epoch", c10::IValue(int64_t{3}));
   checkpoint.insert("state_dict", c10::IValue(state));
-  const std::string path = temp / "nested.pt";
+  const std::string path = temp.path() / "nested.pt";
   WriteBytes(path, torch::pickle_save(c10::IValue(checkpoint)));
   EXPECT_EQ(AlikedModelsFitting(ReadAlikedStateDict(path)), std::vector<std::string>{"n16"});
 }
@@ -200,24 +188,24 @@ TEST(AlikedWeights, MissingUnexpectedAndChangedKeysAreReported) {
 
 TEST(AlikedWeights, TruncatedAndForeignFilesGiveClearErrors) {
   SKIP_WITHOUT_SHARED();
-  const TempFolder temp;
+  const testing::ScopedTempDir temp("aliked_weights");
   std::ifstream source(WeightsPath("t16"), std::ios::binary);
   const std::vector<char> bytes((std::istreambuf_iterator<char>(source)), std::istreambuf_iterator<char>());
   for (size_t keep : {size_t{0}, size_t{100}, bytes.size() / 2, bytes.size() - 10}) {
-    const std::string path = temp / ("truncated_" + std::to_string(keep) + ".pt");
+    const std::string path = temp.path() / ("truncated_" + std::to_string(keep) + ".pt");
     WriteBytes(path, std::vector<char>(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(keep)));
     const std::string message = ExpectInputError([&] { ReadAlikedStateDict(path); });
     EXPECT_NE(message.find(path), std::string::npos) << message;
     EXPECT_NE(message.find("ALIKED weights file"), std::string::npos) << message;
   }
-  const std::string text_path = temp / "notes.txt";
+  const std::string text_path = temp.path() / "notes.txt";
   WriteBytes(text_path, {'h', 'e', 'l', 'l', 'o'});
   EXPECT_NE(ExpectInputError([&] { ReadAlikedStateDict(text_path); }).find("not a complete torch.save"),
             std::string::npos);
-  const std::string list_path = temp / "list.pt";
+  const std::string list_path = temp.path() / "list.pt";
   WriteBytes(list_path, torch::pickle_save(c10::IValue(c10::List<int64_t>({1, 2}))));
   EXPECT_NE(ExpectInputError([&] { ReadAlikedStateDict(list_path); }).find("not a dict"), std::string::npos);
-  EXPECT_NE(ExpectInputError([&] { ReadAlikedStateDict(temp / "absent.pt"); }).find("cannot open"),
+  EXPECT_NE(ExpectInputError([&] { ReadAlikedStateDict(temp.path() / "absent.pt"); }).find("cannot open"),
             std::string::npos);
   // A LoFTR state dict is readable but fits no ALIKED model.
   const auto loftr = ReadAlikedStateDict(SharedDir() + "/weights/loftr_coarse/loftr_coarse_teacher.pt");

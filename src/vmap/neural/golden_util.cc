@@ -1,20 +1,12 @@
 #include "vmap/neural/golden_util.h"
 
-#include <filesystem>
 #include <fstream>
 #include <iterator>
-
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <opencv2/imgcodecs.hpp>
 #include <torch/serialize.h>
 
 namespace vmap::neural::testing {
-
-std::string SharedDir() { return VMAP_SHARED_DIR; }
-
-bool SharedDataPresent() { return std::filesystem::is_directory(SharedDir() + "/golden"); }
 
 std::map<std::string, torch::Tensor> LoadTensorDict(const std::string& path) {
   std::ifstream file(path, std::ios::binary);
@@ -54,30 +46,6 @@ double ExcessOverTolerance(const torch::Tensor& actual, const torch::Tensor& exp
 double MaxAbsDiff(const torch::Tensor& actual, const torch::Tensor& expected) {
   if (actual.numel() == 0) return 0.0;
   return (actual - expected).abs().max().item<double>();
-}
-
-CliResult RunVmap(const std::string& arguments, const std::string& environment) {
-  const std::string command = environment + std::string(VMAP_BINARY) + " " + arguments + " 2>&1";
-  CliResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return result;
-  char buffer[4096];
-  while (size_t n = fread(buffer, 1, sizeof(buffer), pipe)) result.output.append(buffer, n);
-  const int status = pclose(pipe);
-  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
-
-ScopedTempDir::ScopedTempDir(const std::string& name)
-    : path_(std::filesystem::temp_directory_path() /
-            ("vmap_neural_test_" + std::to_string(getpid()) + "_" + name)) {
-  std::filesystem::remove_all(path_);
-  std::filesystem::create_directories(path_);
-}
-
-ScopedTempDir::~ScopedTempDir() {
-  std::error_code error;
-  std::filesystem::remove_all(path_, error);
 }
 
 }  // namespace vmap::neural::testing

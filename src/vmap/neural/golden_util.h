@@ -8,10 +8,12 @@
 #include <nlohmann/json.hpp>
 #include <torch/torch.h>
 
+#include "vmap/testing/run_vmap.h"
+#include "vmap/testing/scoped_temp_dir.h"
+#include "vmap/testing/shared_data.h"
+
 namespace vmap::neural::testing {
 
-std::string SharedDir();                   // VMAP_SHARED_DIR
-bool SharedDataPresent();                  // ../shared/golden exists
 std::map<std::string, torch::Tensor> LoadTensorDict(const std::string& path);
 nlohmann::json LoadJson(const std::string& path);
 // cv::imread(GRAYSCALE) as the network input tensor (1, 1, H, W) = uint8 / 255.
@@ -21,32 +23,14 @@ torch::Tensor ReadNetworkInput(const std::string& png);
 double ExcessOverTolerance(const torch::Tensor& actual, const torch::Tensor& expected, double atol, double rtol);
 double MaxAbsDiff(const torch::Tensor& actual, const torch::Tensor& expected);
 
-// The vmap binary (VMAP_BINARY) run with `arguments`; `environment` is prepended (VAR=value ...). Output is
-// stdout and stderr together.
-struct CliResult {
-  int status = -1;  // exit status; -1 when it did not exit normally
-  std::string output;
-};
-CliResult RunVmap(const std::string& arguments, const std::string& environment = "");
-
-// A fresh folder under the system's temporary folder, removed with everything in it at the end of its scope.
-class ScopedTempDir {
- public:
-  explicit ScopedTempDir(const std::string& name);
-  ~ScopedTempDir();
-  ScopedTempDir(const ScopedTempDir&) = delete;
-  ScopedTempDir& operator=(const ScopedTempDir&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
+// The torch-free helpers (shared data, temporary folders, running the binary) live in vmap_testing.
+using vmap::testing::CliResult;
+using vmap::testing::RunVmap;
+using vmap::testing::ScopedTempDir;
+using vmap::testing::SharedDataPresent;
+using vmap::testing::SharedDir;
 
 }  // namespace vmap::neural::testing
-
-#define SKIP_WITHOUT_SHARED()                                          \
-  if (!::vmap::neural::testing::SharedDataPresent())                   \
-  GTEST_SKIP() << "no shared data at " << ::vmap::neural::testing::SharedDir() << "/golden"
 
 // Asserts shapes match and every element is within atol + rtol * |expected|.
 #define EXPECT_TENSOR_NEAR(actual, expected, atol, rtol)                                                   \

@@ -1,7 +1,5 @@
 #include "vmap/neural/loftr_matcher.h"
 
-#include <malloc.h>
-
 #include <cmath>
 
 #include <nlohmann/json.hpp>
@@ -149,12 +147,6 @@ std::unique_ptr<Matcher> CreateLoftrMatcher(const LoftrMatcherOptions& options) 
   options.Check();
   LoftrConfig config = neural::LoftrPreset(options.model);
   if (options.threshold >= 0) config.threshold = options.threshold;
-  if (options.tune_malloc) {
-    // Large activations otherwise come from fresh mmap()s that page-fault on every run; keeping freed memory
-    // in the heap measured 27-37 % faster (README, LoFTR: Speed). Process-wide, so it is an option.
-    mallopt(M_MMAP_MAX, 0);
-    mallopt(M_TRIM_THRESHOLD, 1 << 30);
-  }
   const std::string path = neural::LocateWeights(options.model, options.weights);
   const auto weights = neural::ReadStateDict(path);
   neural::CheckStateDict(weights, config, path);

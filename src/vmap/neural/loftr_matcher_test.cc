@@ -23,7 +23,6 @@ LoftrMatcherOptions CoarseOptions() {
   LoftrMatcherOptions options;
   options.model = "coarse";
   options.weights = SharedDir() + "/weights/loftr_coarse/loftr_coarse_teacher.pt";
-  options.tune_malloc = false;
   return options;
 }
 

@@ -11,9 +11,6 @@ struct LoftrMatcherOptions {
   std::string device = "cpu";    // "cpu" or "cuda"
   int longest_side = 640;        // images are resized to this longest side (multiple of the coarse stride)
   double threshold = -1;         // coarse confidence threshold; < 0 uses the preset's
-  // Keep freed memory in the heap instead of returning large blocks to the OS (mallopt, process-wide):
-  // LoFTR's activations are re-allocated for every frame and page-fault when they come from fresh mmaps.
-  bool tune_malloc = true;
   // LibTorch threads per Extract/Match call; 0 keeps LibTorch's default. vmap build already extracts frames
   // on several threads at once, where more threads per call only oversubscribe the cores.
   int num_threads = 0;

@@ -19,9 +19,8 @@ using testing::SharedDir;
 namespace fs = std::filesystem;
 
 std::string TempPath(const std::string& name) {
-  const auto dir = fs::temp_directory_path() / ("vmap_weights_test_" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  return (dir / name).string();
+  static const testing::ScopedTempDir dir("loftr_weights");
+  return (dir.path() / name).string();
 }
 
 void WriteBytes(const std::string& path, const std::vector<char>& bytes) {

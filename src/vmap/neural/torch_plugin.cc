@@ -3,8 +3,8 @@
 #include <dlfcn.h>
 
 #include <filesystem>
+#include <mutex>
 #include <string>
-#include <utility>
 
 #include "vmap/core/error.h"
 
@@ -47,17 +47,13 @@ const TorchPluginApi* LoadPlugin() {
 }  // namespace
 
 const TorchPluginApi& TorchPlugin() {
-  // Loaded once per process; a failure is reported again to every caller.
-  using Loaded = std::pair<const TorchPluginApi*, std::string>;  // the entry points, or why they are missing
-  static const Loaded loaded = []() -> Loaded {
-    try {
-      return {LoadPlugin(), ""};
-    } catch (const InputError& error) {
-      return {nullptr, error.what()};
-    }
-  }();
-  if (!loaded.first) throw InputError(loaded.second);
-  return *loaded.first;
+  // Loaded once per process, on success only: after a failure the next call tries again, so a caller that
+  // fixed the cause (installed LibTorch, put the plugin in place) need not restart.
+  static std::mutex mutex;
+  static const TorchPluginApi* loaded = nullptr;
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (!loaded) loaded = LoadPlugin();
+  return *loaded;
 }
 
 }  // namespace vmap

@@ -9,6 +9,7 @@
 #include "vmap/core/error.h"
 #include "vmap/neural/sha1.h"
 #include "vmap/neural/weights_store.h"
+#include "vmap/testing/shared_data.h"
 
 namespace vmap::neural {
 namespace {
@@ -103,11 +104,9 @@ TEST_F(WeightsStoreTest, MissingWeightsErrorSaysWhereAndHow) {
 }
 
 TEST_F(WeightsStoreTest, CoarseStudentDefaultsToSharedCopy) {
-#ifdef VMAP_SHARED_DIR
-  if (!fs::exists(std::string(VMAP_SHARED_DIR) + "/weights/loftr_coarse/loftr_coarse_teacher.pt")) {
+  if (!fs::exists(testing::SharedDir() + "/weights/loftr_coarse/loftr_coarse_teacher.pt")) {
     GTEST_SKIP() << "no shared weights";
   }
-#endif
   const std::string found = LocateWeights("coarse", "");
   EXPECT_NE(found.find("loftr_coarse/loftr_coarse_teacher.pt"), std::string::npos) << found;
   // A cached copy takes precedence over the shared one.

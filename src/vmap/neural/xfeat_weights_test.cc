@@ -21,18 +21,6 @@ namespace {
 using testing::SharedDir;
 namespace fs = std::filesystem;
 
-class TempDir {
- public:
-  TempDir() : path_(fs::temp_directory_path() / ("vmap_xfeat_weights_" + std::to_string(getpid()))) {
-    fs::create_directories(path_);
-  }
-  ~TempDir() { fs::remove_all(path_); }
-  std::string operator/(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  fs::path path_;
-};
-
 std::string SharedWeights() { return SharedDir() + "/weights/xfeat/xfeat_folded.pt"; }
 
 void WriteBytes(const std::string& path, const std::vector<char>& bytes) {
@@ -142,14 +130,14 @@ TEST(XfeatWeights, FoldingIsLibTorchsBatchNorm) {
 
 TEST(XfeatWeights, OfficialLayoutLoadsAsPlainAndOrderedDictAndGivesTheSameNetwork) {
   SKIP_WITHOUT_SHARED();
-  TempDir dir;
+  const testing::ScopedTempDir dir("xfeat_weights");
   const StateDict folded = ReadXfeatStateDict(SharedWeights());
   const StateDict official = OfficialLayoutOf(folded);
-  SaveDict(official, dir / "plain.pt");
-  MakeOrderedDict(dir / "plain.pt", dir / "xfeat.pt");
+  SaveDict(official, dir.path() / "plain.pt");
+  MakeOrderedDict(dir.path() / "plain.pt", dir.path() / "xfeat.pt");
   // LibTorch alone cannot read the OrderedDict file: this exercises vmap's own reader.
   {
-    std::ifstream file(dir / "xfeat.pt", std::ios::binary);
+    std::ifstream file(dir.path() / "xfeat.pt", std::ios::binary);
     const std::vector<char> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
     bool libtorch_reads_a_dict = false;
     try {
@@ -160,10 +148,10 @@ TEST(XfeatWeights, OfficialLayoutLoadsAsPlainAndOrderedDictAndGivesTheSameNetwor
   }
   for (const std::string name : {"plain.pt", "xfeat.pt"}) {
     SCOPED_TRACE(name);
-    const StateDict read = ReadXfeatStateDict(dir / name);
+    const StateDict read = ReadXfeatStateDict(dir.path() / name);
     ASSERT_EQ(read.size(), official.size());
     for (const auto& [key, tensor] : official) ASSERT_TRUE(torch::equal(read.at(key), tensor)) << key;
-    const XfeatWeights loaded = LoadXfeatWeights(dir / name);
+    const XfeatWeights loaded = LoadXfeatWeights(dir.path() / name);
     EXPECT_EQ(loaded.layout, XfeatLayout::kOfficial);
     ASSERT_EQ(loaded.folded.size(), 54u);
     for (const auto& [key, tensor] : folded) EXPECT_TENSOR_NEAR(loaded.folded.at(key), tensor, 1e-7, 1e-6);
@@ -171,7 +159,7 @@ TEST(XfeatWeights, OfficialLayoutLoadsAsPlainAndOrderedDictAndGivesTheSameNetwor
 
   // The network with both: the same outputs within the golden's float32 tolerances, the same keypoints.
   const XfeatModel reference(folded, torch::kCPU);
-  const XfeatModel from_official(LoadXfeatWeights(dir / "xfeat.pt").folded, torch::kCPU);
+  const XfeatModel from_official(LoadXfeatWeights(dir.path() / "xfeat.pt").folded, torch::kCPU);
   const auto image = testing::ReadNetworkInput(SharedDir() + "/golden/xfeat/labfloor_00100_00130/input0.png");
   XfeatDetectOptions options;
   options.keep_intermediates = true;
@@ -220,19 +208,19 @@ TEST(XfeatWeights, MissingUnexpectedAndMisshapedKeysAreListed) {
 
 TEST(XfeatWeights, TruncatedAndForeignFilesNameTheFile) {
   SKIP_WITHOUT_SHARED();
-  TempDir dir;
+  const testing::ScopedTempDir dir("xfeat_weights");
   std::ifstream source(SharedWeights(), std::ios::binary);
   const std::vector<char> bytes((std::istreambuf_iterator<char>(source)), std::istreambuf_iterator<char>());
   for (size_t keep : {size_t{0}, size_t{100}, bytes.size() / 2, bytes.size() - 10}) {
-    const std::string path = dir / ("truncated_" + std::to_string(keep) + ".pt");
+    const std::string path = dir.path() / ("truncated_" + std::to_string(keep) + ".pt");
     WriteBytes(path, std::vector<char>(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(keep)));
     const std::string message = ExpectInputError([&] { LoadXfeatWeights(path); });
     EXPECT_NE(message.find(path), std::string::npos) << message;
     EXPECT_NE(message.find("not a complete torch.save"), std::string::npos) << message;
   }
-  WriteBytes(dir / "list.pt", torch::pickle_save(c10::IValue(c10::List<int64_t>({1, 2}))));
-  EXPECT_NE(ExpectInputError([&] { LoadXfeatWeights(dir / "list.pt"); }).find("not a dict"), std::string::npos);
-  EXPECT_NE(ExpectInputError([&] { LoadXfeatWeights(dir / "absent.pt"); }).find("cannot open"), std::string::npos);
+  WriteBytes(dir.path() / "list.pt", torch::pickle_save(c10::IValue(c10::List<int64_t>({1, 2}))));
+  EXPECT_NE(ExpectInputError([&] { LoadXfeatWeights(dir.path() / "list.pt"); }).find("not a dict"), std::string::npos);
+  EXPECT_NE(ExpectInputError([&] { LoadXfeatWeights(dir.path() / "absent.pt"); }).find("cannot open"), std::string::npos);
 }
 
 }  // namespace

@@ -33,6 +33,10 @@ std::string DurationText(double seconds);
 std::string Card(const std::string& value, const std::string& label);
 std::string Row(const std::string& name, const std::string& value_html);
 
+// A file name or path as a page shows it: the page is UTF-8, so a name that is not is shown percent-encoded,
+// as map.json stores it.
+std::string Displayable(const std::string& name);
+
 std::string Numbered(int index);  // "000012.jpg"
 // Throws InputError naming the file when it cannot be written.
 void WriteJpeg(const std::filesystem::path& file, const cv::Mat& image, int quality);

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <iterator>
 #include <map>
 #include <memory>
 #include <optional>
@@ -18,7 +16,6 @@
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
-#include "vmap/core/file_name_encoding.h"
 #include "vmap/map/map_io.h"
 #include "vmap/report/html_page.h"
 #include "vmap/report/html_util.h"
@@ -43,245 +40,7 @@ constexpr const char* kGreen = "#2a9d3a";
 constexpr const char* kRed = "#d62728";
 constexpr const char* kGrey = "#8a8a8a";
 
-// Any request to the network (or to anything but files next to the page) is refused by the browser.
-constexpr const char* kContentSecurityPolicy =
-    "default-src 'none'; img-src 'self' data:; media-src 'self'; style-src 'unsafe-inline'; "
-    "script-src 'unsafe-inline'";
-
-constexpr const char* kStyle = R"css(
-:root { --fg: #1d1d1f; --muted: #666; --line: #ddd; --accent: #1f77b4; --bad: #c62828; --good: #2a9d3a; }
-* { box-sizing: border-box; }
-body { margin: 0; font: 14px/1.45 system-ui, -apple-system, "Segoe UI", Roboto, "Helvetica Neue", Arial, sans-serif;
-       color: var(--fg); background: #fafafa; }
-header { background: #20262e; color: #fff; padding: 18px 28px; }
-header h1 { margin: 0 0 4px; font-size: 22px; }
-header p { margin: 0; color: #c9d1d9; word-break: break-all; }
-nav { position: sticky; top: 0; z-index: 2; background: #fff; border-bottom: 1px solid var(--line); padding: 8px 28px; }
-nav a { margin-right: 18px; color: var(--accent); text-decoration: none; }
-main { padding: 8px 28px 40px; max-width: 1600px; }
-section { margin-top: 22px; }
-h2 { font-size: 18px; margin: 0 0 10px; border-bottom: 2px solid var(--line); padding-bottom: 4px; }
-.cards { display: flex; flex-wrap: wrap; gap: 10px; margin-bottom: 12px; }
-.card { background: #fff; border: 1px solid var(--line); border-radius: 6px; padding: 8px 14px; min-width: 120px; }
-.card .value { font-size: 20px; font-weight: 600; }
-.card .label { color: var(--muted); font-size: 12px; }
-table { border-collapse: collapse; background: #fff; }
-th, td { border: 1px solid var(--line); padding: 4px 10px; text-align: left; vertical-align: top; }
-td.num, th.num { text-align: right; font-variant-numeric: tabular-nums; }
-table.summary th { width: 220px; background: #f3f3f3; font-weight: 600; }
-tr.best td { background: #e8f5e9; font-weight: 600; }
-tr.below-tau td { background: #fdecea; }
-.plots { display: flex; flex-wrap: wrap; gap: 12px; }
-.plot { max-width: 100%; height: auto; background: #fff; border: 1px solid var(--line); border-radius: 6px; }
-.note { color: var(--muted); margin: 6px 0; }
-.strip { display: grid; grid-template-columns: repeat(auto-fill, minmax(168px, 1fr)); gap: 8px; }
-.strip figure { margin: 0; background: #fff; border: 1px solid var(--line); border-radius: 4px; overflow: hidden; }
-.strip img { display: block; width: 100%; height: auto; background: #eee; }
-.strip figcaption { padding: 3px 6px; font-size: 12px; color: var(--muted); }
-.strip figcaption b { color: var(--fg); }
-.links { display: grid; grid-template-columns: repeat(auto-fill, minmax(520px, 1fr)); gap: 12px; }
-.match-figure { margin: 0; background: #fff; border: 1px solid var(--line); border-radius: 4px; overflow: hidden; }
-.match-figure img { display: block; width: 100%; height: auto; background: #eee; }
-.match-figure figcaption { padding: 4px 8px; font-size: 13px; }
-.match-figure.below-tau { border: 3px solid var(--bad); }
-.match-figure.below-tau figcaption { background: var(--bad); color: #fff; font-weight: 600; }
-.match-figure.lost { border: 3px solid var(--bad); }
-.match-figure.lost figcaption { background: var(--bad); color: #fff; font-weight: 600; }
-.legend-verified { color: var(--good); font-weight: 600; }
-.legend-rejected { color: #0040ff; font-weight: 600; }
-.route { display: flex; gap: 18px; align-items: flex-start; flex-wrap: wrap; }
-.route figure { margin: 0; width: 480px; max-width: 100%; }
-.route img, .route video { display: block; width: 100%; height: auto; background: #eee; border: 1px solid var(--line); }
-.route .controls { display: flex; gap: 8px; align-items: center; margin-top: 6px; }
-.route input[type=range] { flex: 1; }
-button { font: inherit; padding: 4px 14px; }
-pre { background: #fff; border: 1px solid var(--line); padding: 10px; overflow: auto; font-size: 12px; }
-footer { color: var(--muted); padding: 0 28px 20px; font-size: 12px; }
-)css";
-
-// Plays the key images in order (the route preview) and, when the page is opened as report.html#selfcheck,
-// loads every image and records what it found in a <pre id="vmap-selfcheck"> for automated checks.
-constexpr const char* kScript = R"js(
-(function () {
-  'use strict';
-  var player = document.getElementById('route-image');
-  if (player) {
-    var thumbs = Array.prototype.slice.call(document.querySelectorAll('.strip figure img'));
-    var slider = document.getElementById('route-slider');
-    var label = document.getElementById('route-label');
-    var button = document.getElementById('route-play');
-    var current = 0, timer = null;
-    var show = function (i) {
-      if (!thumbs.length) return;
-      current = (i + thumbs.length) % thumbs.length;
-      player.src = thumbs[current].getAttribute('src');
-      slider.value = String(current);
-      label.textContent = thumbs[current].getAttribute('data-label');
-    };
-    var stop = function () { if (timer) { clearInterval(timer); timer = null; button.textContent = 'Play'; } };
-    button.addEventListener('click', function () {
-      if (timer) { stop(); return; }
-      button.textContent = 'Pause';
-      timer = setInterval(function () { show(current + 1); }, 400);
-    });
-    slider.addEventListener('input', function () { stop(); show(parseInt(slider.value, 10)); });
-    show(0);
-  }
-  if (location.hash !== '#selfcheck') return;
-  var images = Array.prototype.slice.call(document.images);
-  images.forEach(function (img) { img.loading = 'eager'; });
-  var videos = Array.prototype.slice.call(document.querySelectorAll('video'));
-  var waits = images.map(function (img) {
-    if (img.complete && img.naturalWidth > 0) return Promise.resolve();
-    return new Promise(function (done) {
-      img.addEventListener('load', done);
-      img.addEventListener('error', done);
-      if (img.decode) img.decode().then(done, done);
-    });
-  }).concat(videos.map(function (video) {
-    if (video.readyState >= 2) return Promise.resolve();
-    return new Promise(function (done) {
-      video.addEventListener('loadeddata', done);
-      video.addEventListener('error', done);
-      video.preload = 'auto';
-      video.load();
-    });
-  }));
-  Promise.all(waits).then(function () {
-    var broken = images.filter(function (img) { return !(img.naturalWidth > 0); })
-                       .map(function (img) { return img.getAttribute('src'); });
-    var result = document.createElement('pre');
-    result.id = 'vmap-selfcheck';
-    result.textContent = JSON.stringify({
-      images: images.length,
-      broken: broken,
-      videos: videos.length,
-      broken_videos: videos.filter(function (v) { return !(v.readyState >= 2 && v.videoWidth > 0); })
-                           .map(function (v) { return v.getAttribute('src'); }),
-      match_figures: document.querySelectorAll('figure.match-figure').length,
-      key_images: document.querySelectorAll('.strip figure').length,
-      plots: document.querySelectorAll('svg.plot').length
-    });
-    document.body.appendChild(result);
-  });
-})();
-)js";
-
 }  // namespace
-
-// The page frame and small pieces shared with the localization report (html_page.h).
-namespace report {
-
-std::string PageStart(const std::string& title, const std::string& heading, const std::string& subtitle,
-                      const std::vector<std::pair<std::string, std::string>>& nav) {
-  std::ostringstream html;
-  html << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-       << "<meta http-equiv=\"Content-Security-Policy\" content=\"" << kContentSecurityPolicy << "\">\n"
-       << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
-       << "<meta name=\"generator\" content=\"vmap " << VMAP_VERSION << "\">\n"
-       << "<title>" << HtmlEscape(title) << "</title>\n<style>" << kStyle << "</style>\n</head>\n<body>\n"
-       << "<header><h1>" << HtmlEscape(heading) << "</h1><p>" << HtmlEscape(subtitle) << "</p></header>\n<nav>";
-  for (const auto& [anchor, text] : nav) html << "<a href=\"#" << anchor << "\">" << HtmlEscape(text) << "</a>";
-  html << "</nav>\n<main>\n";
-  return html.str();
-}
-
-std::string PageEnd() {
-  return std::string("</main>\n<footer>Written by vmap ") + VMAP_VERSION +
-         ". This page works offline: everything it shows is in this file and the folder next to it.</footer>\n"
-         "<script>" + kScript + "</script>\n</body>\n</html>\n";
-}
-
-// The first value named `name` anywhere in the options (they may be grouped per stage).
-const json* FindOption(const json& node, const std::string& name) {
-  if (node.is_object()) {
-    auto it = node.find(name);
-    if (it != node.end()) return &*it;
-    for (const auto& [key, value] : node.items()) {
-      if (const json* found = FindOption(value, name)) return found;
-    }
-  }
-  return nullptr;
-}
-
-json ParseOptions(const std::string& text) {
-  try {
-    json options = json::parse(text.empty() ? "{}" : text);
-    return options.is_object() ? options : json::object();
-  } catch (const json::exception&) {
-    return json::object();
-  }
-}
-
-// An option as one line: a grouped option (matcher, verifier) reads "orb (features 2000, ...)".
-std::string OptionText(const json& options, const std::string& name) {
-  const json* value = FindOption(options, name);
-  if (!value || value->is_null()) return "not recorded";
-  if (value->is_string()) return value->get<std::string>();
-  if (!value->is_object()) return value->dump();
-  std::string headline;
-  for (const char* key : {"name", "method", "type", "matcher"}) {
-    auto it = value->find(key);
-    if (it != value->end() && it->is_string()) {
-      headline = it->get<std::string>();
-      break;
-    }
-  }
-  std::string details;
-  for (const auto& [key, item] : value->items()) {
-    if (item.is_structured() || (item.is_string() && item.get<std::string>() == headline)) continue;
-    details += (details.empty() ? "" : ", ") + key + " " + (item.is_string() ? item.get<std::string>() : item.dump());
-  }
-  if (headline.empty()) return details.empty() ? value->dump() : details;
-  return details.empty() ? headline : headline + " (" + details + ")";
-}
-
-std::string TimestampText(double seconds) { return seconds < 0 ? "" : FormatFixed(seconds, 2) + " s"; }
-
-std::string SizeText(const cv::Size& size) {
-  return size.area() > 0 ? std::to_string(size.width) + " x " + std::to_string(size.height) : "unknown";
-}
-
-std::string DurationText(double seconds) {
-  if (seconds < 60) return FormatFixed(seconds, 1) + " s";
-  const int minutes = static_cast<int>(seconds / 60);
-  return std::to_string(minutes) + " min " + FormatFixed(seconds - 60.0 * minutes, 0) + " s";
-}
-
-std::string Card(const std::string& value, const std::string& label) {
-  return "<div class=\"card\"><div class=\"value\">" + HtmlEscape(value) + "</div><div class=\"label\">" +
-         HtmlEscape(label) + "</div></div>";
-}
-
-std::string Row(const std::string& name, const std::string& value_html) {
-  return "<tr><th>" + HtmlEscape(name) + "</th><td>" + value_html + "</td></tr>\n";
-}
-
-// A file name or path as the page shows it: the page is UTF-8, so a name that is not is shown percent-encoded,
-// as map.json stores it.
-std::string Displayable(const std::string& name) { return IsValidUtf8(name) ? name : EncodeFileName(name); }
-
-std::string Numbered(int index) {
-  char name[32];
-  std::snprintf(name, sizeof(name), "%06d.jpg", index);
-  return name;
-}
-
-void WriteJpeg(const fs::path& file, const cv::Mat& image, int quality) {
-  if (!cv::imwrite(file.string(), image, {cv::IMWRITE_JPEG_QUALITY, quality})) {
-    throw InputError("cannot write '" + file.string() + "'; check that the map directory is writable");
-  }
-}
-
-cv::Mat ScaledToWidth(const cv::Mat& image, int width) {
-  if (width <= 0 || image.cols <= width) return image;
-  cv::Mat scaled;
-  const int height = std::max(1, static_cast<int>(std::lround(static_cast<double>(image.rows) * width / image.cols)));
-  cv::resize(image, scaled, cv::Size(width, height), 0, 0, cv::INTER_AREA);
-  return scaled;
-}
-
-}  // namespace report
 
 using report::Card;
 using report::Displayable;
@@ -532,22 +291,43 @@ cv::Mat DrawMapLink(const fs::path& map_directory, const VisualMap& map, int lin
                          ReadKeyImage(map_directory, map.key_images[link.to_key]), link, with_title);
 }
 
-void WriteMapReport(const fs::path& map_directory) { WriteMapReport(map_directory, MapReportOptions{}); }
+void MapReportOptions::Check() const {
+  if (thumbnail_width < 32 || thumbnail_width > 4096) {
+    throw InputError("MapReportOptions::thumbnail_width is " + std::to_string(thumbnail_width) +
+                     "; use 32 to 4096 pixels (default 320)");
+  }
+  if (figure_width < 64 || figure_width > 8192) {
+    throw InputError("MapReportOptions::figure_width is " + std::to_string(figure_width) +
+                     "; use 64 to 8192 pixels (default 960)");
+  }
+  if (jpeg_quality < 1 || jpeg_quality > 100) {
+    throw InputError("MapReportOptions::jpeg_quality is " + std::to_string(jpeg_quality) + "; use 1 to 100 (default 85)");
+  }
+  if (!(route_fps > 0.0 && route_fps <= 120.0)) {
+    throw InputError("MapReportOptions::route_fps is " + FormatExact(route_fps) +
+                     "; use more than 0 and at most 120 key images per second (default 3)");
+  }
+}
 
-void WriteMapReport(const fs::path& map_directory, const MapReportOptions& report_options) {
-  const VisualMap map = ReadMap(map_directory);
-  // Every image path is checked before anything is written.
-  for (const KeyImage& k : map.key_images) KeyImagePath(map_directory, k);
-  const json options = ParseOptions(map.options_json);
-  const MapStatistics stats = ComputeStatistics(
-      map, OptionText(options, "quality_mean") == "harmonic" ? QualityMean::kHarmonic : QualityMean::kArithmetic);
-  const std::optional<MapEvaluation> evaluation = ReadMatchingEvaluation(map_directory, map);
+namespace {
 
-  // Inside a map that ReadMap has just recognised as vmap's: the old report/ is vmap's too.
-  AtomicOutputDirectory assets(map_directory / kReportAssetsDirectory, OutputPolicy::InsideVmapOutput());
-  fs::create_directory(assets.path() / "keys");  // not create_directories: see AtomicOutputDirectory::path()
-  fs::create_directory(assets.path() / "links");
-  const std::string assets_url = std::string(kReportAssetsDirectory) + "/";
+// What WriteReportAssets wrote into report/, for the page to show.
+struct ReportAssets {
+  std::vector<cv::Size> thumbnail_sizes;  // per key image: report/keys/NNNNNN.jpg
+  std::vector<cv::Size> figure_sizes;     // per link: report/links/NNNNNN.jpg
+  std::string video_file;                 // the route video in report/; empty when none was written
+  cv::Size video_size;
+};
+
+// A file in report/ as the page links it.
+std::string AssetUrl(const std::string& relative) { return UrlPath(std::string(kReportAssetsDirectory) + "/" + relative); }
+
+// Writes the key-image thumbnails, the route video and the match figures into `directory` (report/ while
+// it is being written).
+ReportAssets WriteReportAssets(const fs::path& map_directory, const VisualMap& map, const MapReportOptions& options,
+                               const fs::path& directory) {
+  fs::create_directory(directory / "keys");  // not create_directories: see AtomicOutputDirectory::path()
+  fs::create_directory(directory / "links");
 
   // Consecutive links share a key image: keep the last two decoded. (cv::Mat copies share the pixels, so a
   // returned image stays valid after it leaves the cache.)
@@ -559,54 +339,38 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
     return cache[index] = ReadKeyImage(map_directory, map.key_images[index]);
   };
 
-  std::vector<cv::Size> thumb_sizes;
+  ReportAssets assets;
   std::unique_ptr<RouteVideo> video;
   for (size_t i = 0; i < map.key_images.size(); ++i) {
-    const cv::Mat thumb = ScaledToWidth(key_image(static_cast<int>(i)), report_options.thumbnail_width);
-    WriteJpeg(assets.path() / "keys" / Numbered(static_cast<int>(i)), thumb, report_options.jpeg_quality);
-    thumb_sizes.push_back(thumb.size());
-    if (i == 0 && report_options.route_video && map.key_images.size() > 1) {
-      video = std::make_unique<RouteVideo>(assets.path(), thumb.size(), report_options.route_fps);
+    const cv::Mat thumb = ScaledToWidth(key_image(static_cast<int>(i)), options.thumbnail_width);
+    WriteJpeg(directory / "keys" / Numbered(static_cast<int>(i)), thumb, options.jpeg_quality);
+    assets.thumbnail_sizes.push_back(thumb.size());
+    if (i == 0 && options.route_video && map.key_images.size() > 1) {
+      video = std::make_unique<RouteVideo>(directory, thumb.size(), options.route_fps);
     }
     if (video) {
       video->Add(thumb, "key " + std::to_string(i) + "  frame " + std::to_string(map.key_images[i].frame_index));
     }
   }
-  std::string video_file;
-  cv::Size video_size;
   if (video && video->Finish()) {
-    video_file = video->file_name();
-    video_size = video->size();
+    assets.video_file = video->file_name();
+    assets.video_size = video->size();
   }
-  std::vector<cv::Size> figure_sizes;
   for (size_t i = 0; i < map.links.size(); ++i) {
     const Link& l = map.links[i];
     MatchFigureOptions figure_options;
-    figure_options.max_width = report_options.figure_width;
+    figure_options.max_width = options.figure_width;
     figure_options.title = "link " + std::to_string(i) + ": " + LinkTitle(map, static_cast<int>(i));
-    const cv::Mat from = key_image(l.from_key);
-    const cv::Mat to = key_image(l.to_key);
-    const cv::Mat figure = DrawMatchFigure(from, to, l, figure_options);
-    WriteJpeg(assets.path() / "links" / Numbered(static_cast<int>(i)), figure, report_options.jpeg_quality);
-    figure_sizes.push_back(figure.size());
+    const cv::Mat figure = DrawMatchFigure(key_image(l.from_key), key_image(l.to_key), l, figure_options);
+    WriteJpeg(directory / "links" / Numbered(static_cast<int>(i)), figure, options.jpeg_quality);
+    assets.figure_sizes.push_back(figure.size());
   }
+  return assets;
+}
 
+std::string SummarySection(const VisualMap& map, const MapStatistics& stats, const json& options) {
   const int n = map.num_frames, m = static_cast<int>(map.key_images.size());
-  const std::string input_name =
-      map.input.path.empty() ? map_directory.filename().string() : Displayable(map.input.path);
   std::ostringstream html;
-  html << PageStart("vmap report: " + input_name, "Visual map of " + input_name,
-                    std::to_string(m) + " key images from " + std::to_string(n) + " frames, Q = " +
-                        FormatFixed(map.quality, 3),
-                    {{"summary", "Summary"},
-                     {"similarity", "Similarity"},
-                     {"key-images", "Key images"},
-                     {"route-preview", "Route preview"},
-                     {"link-table", "Links"},
-                     {"links", "Match figures"},
-                     {"options", "Options"}});
-
-  // Summary.
   html << "<section id=\"summary\"><h2>Summary</h2>\n<div class=\"cards\">"
        << Card(std::to_string(n), "frames (n)") << Card(std::to_string(m), "key images (m)")
        << Card(n > 0 ? FormatFixed(100.0 * m / n, 1) + " %" : "n/a", "of the frames")
@@ -638,22 +402,27 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
        << Row("Build time", DurationText(map.seconds) +
                                 (map.seconds > 0 && n > 0 ? " (" + FormatFixed(n / map.seconds, 1) + " frames/s)" : ""))
        << "</table>\n</section>\n";
+  return html.str();
+}
 
-  // Plots.
-  html << "<section id=\"similarity\"><h2>Similarity along the sequence</h2>\n";
+std::string SimilaritySection(const VisualMap& map, const json& options) {
+  std::string html = "<section id=\"similarity\"><h2>Similarity along the sequence</h2>\n";
   if (map.evaluations.empty()) {
-    html << "<p class=\"note\">This map records no per-frame similarities; only its links are shown. Rebuild it "
+    html += "<p class=\"note\">This map records no per-frame similarities; only its links are shown. Rebuild it "
             "with a current vmap to see S for every frame.</p>\n";
   } else {
-    html << "<p class=\"note\">Each blue line follows S(key, frame) from one key image over the frames compared "
+    html += "<p class=\"note\">Each blue line follows S(key, frame) from one key image over the frames compared "
             "with it; a new key image is chosen where S drops below &tau;. A lower &tau; gives fewer key images "
             "with fewer shared matches.</p>\n";
   }
-  html << SimilarityPlot(map, options);
-  if (!map.links.empty()) html << VerifiedPlot(map);
-  html << "</section>\n";
+  html += SimilarityPlot(map, options);
+  if (!map.links.empty()) html += VerifiedPlot(map);
+  return html + "</section>\n";
+}
 
-  // Key-image strip.
+std::string KeyImagesSection(const VisualMap& map, const ReportAssets& assets) {
+  const int m = static_cast<int>(map.key_images.size());
+  std::ostringstream html;
   html << "<section id=\"key-images\"><h2>Key images (" << m << ")</h2>\n<div class=\"strip\">\n";
   for (int i = 0; i < m; ++i) {
     const KeyImage& k = map.key_images[i];
@@ -661,34 +430,42 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
     const std::string label = "key " + std::to_string(i) + " | frame " + std::to_string(k.frame_index) +
                               (timestamp.empty() ? "" : " | t = " + timestamp);
     html << "<figure id=\"key-" << i << "\" title=\"" << HtmlEscape(Displayable(k.source_name) + (k.reason.empty() ? "" : ": " + k.reason))
-         << "\"><img loading=\"lazy\" decoding=\"async\" src=\"" << UrlPath(assets_url + "keys/" + Numbered(i))
-         << "\" width=\"" << thumb_sizes[i].width << "\" height=\"" << thumb_sizes[i].height << "\" alt=\"key image "
-         << i << "\" data-label=\"" << HtmlEscape(label) << "\"><figcaption><b>#" << i << "</b> frame "
-         << k.frame_index << (timestamp.empty() ? "" : " &middot; " + HtmlEscape(timestamp)) << "</figcaption></figure>\n";
+         << "\"><img loading=\"lazy\" decoding=\"async\" src=\"" << AssetUrl("keys/" + Numbered(i))
+         << "\" width=\"" << assets.thumbnail_sizes[i].width << "\" height=\"" << assets.thumbnail_sizes[i].height
+         << "\" alt=\"key image " << i << "\" data-label=\"" << HtmlEscape(label) << "\"><figcaption><b>#" << i
+         << "</b> frame " << k.frame_index << (timestamp.empty() ? "" : " &middot; " + HtmlEscape(timestamp))
+         << "</figcaption></figure>\n";
   }
   html << "</div>\n</section>\n";
+  return html.str();
+}
 
+// The route video where one was written, and a player stepping through the thumbnails (report.js).
+std::string RoutePreviewSection(const VisualMap& map, const ReportAssets& assets, double route_fps) {
+  const int m = static_cast<int>(map.key_images.size());
+  std::ostringstream html;
   html << "<section id=\"route-preview\"><h2>Route preview</h2>\n<div class=\"route\">\n";
-  if (!video_file.empty()) {
-    html << "<figure><video id=\"route-video\" src=\"" << UrlPath(assets_url + video_file) << "\" width=\""
-         << video_size.width << "\" height=\"" << video_size.height
-         << "\" poster=\"" << UrlPath(assets_url + "keys/" + Numbered(0))
+  if (!assets.video_file.empty()) {
+    html << "<figure><video id=\"route-video\" src=\"" << AssetUrl(assets.video_file) << "\" width=\""
+         << assets.video_size.width << "\" height=\"" << assets.video_size.height
+         << "\" poster=\"" << AssetUrl("keys/" + Numbered(0))
          << "\" controls muted loop playsinline preload=\"metadata\"></video><figcaption class=\"note\">The key images "
-            "in order, " << FormatExact(report_options.route_fps) << " per second (" << HtmlEscape(video_file)
+            "in order, " << FormatExact(route_fps) << " per second (" << HtmlEscape(assets.video_file)
          << "): what a robot following this map expects to see.</figcaption></figure>\n";
   }
   if (m > 0) {
-    html << "<figure><img id=\"route-image\" alt=\"key image\" width=\"" << thumb_sizes[0].width << "\" height=\""
-         << thumb_sizes[0].height << "\" src=\"" << UrlPath(assets_url + "keys/" + Numbered(0))
+    html << "<figure><img id=\"route-image\" alt=\"key image\" width=\"" << assets.thumbnail_sizes[0].width
+         << "\" height=\"" << assets.thumbnail_sizes[0].height << "\" src=\"" << AssetUrl("keys/" + Numbered(0))
          << "\"><figcaption><div class=\"controls\"><button id=\"route-play\" type=\"button\">Play</button>"
          << "<input id=\"route-slider\" type=\"range\" min=\"0\" max=\"" << m - 1 << "\" value=\"0\" "
          << "aria-label=\"key image\"></div><span id=\"route-label\" class=\"note\"></span></figcaption></figure>\n";
   }
   html << "</div>\n</section>\n";
+  return html.str();
+}
 
-  html << LinkTableHtml(map, evaluation ? &*evaluation : nullptr);
-
-  // Match figures.
+std::string MatchFiguresSection(const VisualMap& map, const ReportAssets& assets, const MapEvaluation* evaluation) {
+  std::ostringstream html;
   html << "<section id=\"links\"><h2>Match figures (" << map.links.size() << " links)</h2>\n"
        << "<p class=\"note\">Consecutive key images side by side: <span class=\"legend-verified\">verified matches "
           "as green lines</span>, <span class=\"legend-rejected\">rejected tentative matches as blue points</span>. "
@@ -699,23 +476,67 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
     const Link& l = map.links[i];
     html << "<figure class=\"match-figure" << (l.below_tau ? " below-tau" : "") << "\" id=\"link-" << i
          << "\" data-from=\"" << l.from_key << "\" data-to=\"" << l.to_key << "\"><img loading=\"lazy\" "
-         << "decoding=\"async\" src=\"" << UrlPath(assets_url + "links/" + Numbered(static_cast<int>(i)))
-         << "\" width=\"" << figure_sizes[i].width << "\" height=\"" << figure_sizes[i].height << "\" alt=\"link " << i
-         << "\"><figcaption>" << (l.below_tau ? "BELOW &tau; &middot; " : "") << "Link " << i << ": "
-         << HtmlEscape(LinkTitle(map, static_cast<int>(i))) << " &middot; S = " << FormatFixed(l.similarity, 3)
+         << "decoding=\"async\" src=\"" << AssetUrl("links/" + Numbered(static_cast<int>(i)))
+         << "\" width=\"" << assets.figure_sizes[i].width << "\" height=\"" << assets.figure_sizes[i].height
+         << "\" alt=\"link " << i << "\"><figcaption>" << (l.below_tau ? "BELOW &tau; &middot; " : "") << "Link " << i
+         << ": " << HtmlEscape(LinkTitle(map, static_cast<int>(i))) << " &middot; S = " << FormatFixed(l.similarity, 3)
          << " &middot; " << l.num_verified << " verified of " << l.num_tentative << " tentative"
          << (evaluation ? " &middot; " + HtmlEscape(EvaluationCaption(evaluation->links[i])) : "")
          << "</figcaption></figure>\n";
   }
   if (map.links.empty()) html << "<p class=\"note\">This map has a single key image: there are no links.</p>\n";
   html << "</div>\n</section>\n";
+  return html.str();
+}
 
-  html << "<section id=\"options\"><h2>Options</h2>\n<details><summary>Every option used to build this map"
-       << "</summary><pre>" << HtmlEscape(options.dump(2)) << "</pre></details>\n</section>\n";
-  html << PageEnd();
+// Every recorded option, folded away at the end of the page.
+std::string OptionsSection(const json& options, const std::string& summary) {
+  return "<section id=\"options\"><h2>Options</h2>\n<details><summary>" + summary + "</summary><pre>" +
+         HtmlEscape(options.dump(2)) + "</pre></details>\n</section>\n";
+}
 
-  assets.Commit();
-  WriteFileAtomically(map_directory / kReportFileName, html.str());
+}  // namespace
+
+void WriteMapReport(const fs::path& map_directory) { WriteMapReport(map_directory, MapReportOptions{}); }
+
+void WriteMapReport(const fs::path& map_directory, const MapReportOptions& report_options) {
+  report_options.Check();
+  const VisualMap map = ReadMap(map_directory);
+  // Every image path is checked before anything is written.
+  for (const KeyImage& k : map.key_images) KeyImagePath(map_directory, k);
+  const json options = ParseOptions(map.options_json);
+  const MapStatistics stats = ComputeStatistics(
+      map, OptionText(options, "quality_mean") == "harmonic" ? QualityMean::kHarmonic : QualityMean::kArithmetic);
+  const std::optional<MapEvaluation> evaluation = ReadMatchingEvaluation(map_directory, map);
+
+  // Inside a map that ReadMap has just recognised as vmap's: the old report/ is vmap's too.
+  AtomicOutputDirectory assets_directory(map_directory / kReportAssetsDirectory, OutputPolicy::InsideVmapOutput());
+  const ReportAssets assets = WriteReportAssets(map_directory, map, report_options, assets_directory.path());
+
+  const std::string input_name =
+      map.input.path.empty() ? map_directory.filename().string() : Displayable(map.input.path);
+  std::string html =
+      PageStart("vmap report: " + input_name, "Visual map of " + input_name,
+                std::to_string(map.key_images.size()) + " key images from " + std::to_string(map.num_frames) +
+                    " frames, Q = " + FormatFixed(map.quality, 3),
+                {{"summary", "Summary"},
+                 {"similarity", "Similarity"},
+                 {"key-images", "Key images"},
+                 {"route-preview", "Route preview"},
+                 {"link-table", "Links"},
+                 {"links", "Match figures"},
+                 {"options", "Options"}});
+  html += SummarySection(map, stats, options);
+  html += SimilaritySection(map, options);
+  html += KeyImagesSection(map, assets);
+  html += RoutePreviewSection(map, assets, report_options.route_fps);
+  html += LinkTableHtml(map, evaluation ? &*evaluation : nullptr);
+  html += MatchFiguresSection(map, assets, evaluation ? &*evaluation : nullptr);
+  html += OptionsSection(options, "Every option used to build this map");
+  html += PageEnd();
+
+  assets_directory.Commit();
+  WriteFileAtomically(map_directory / kReportFileName, html);
 }
 
 namespace {
@@ -868,8 +689,7 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
        << "<p class=\"note\">Q is the mean of the compression 1 - m/n and the mean similarity of consecutive key "
           "images; the best threshold balances few key images against well-connected ones.</p>\n</section>\n";
 
-  html << "<section id=\"options\"><h2>Options</h2>\n<details><summary>Every option used for the sweep</summary><pre>"
-       << HtmlEscape(options.dump(2)) << "</pre></details>\n</section>\n";
+  html << OptionsSection(options, "Every option used for the sweep");
   html << PageEnd();
   WriteFileAtomically(directory / kReportFileName, html.str());
 }

@@ -1,6 +1,7 @@
 #include "vmap/report/html_report.h"
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <fstream>
 #include <set>
@@ -12,13 +13,15 @@
 
 #include "vmap/core/error.h"
 #include "vmap/map/map_io.h"
+#include "vmap/report/report_assets.h"
 #include "vmap/report/report_test_util.h"
+#include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
 namespace {
 namespace fs = std::filesystem;
 using report_test::ReadText;
-using report_test::TempDir;
+using testing::ScopedTempDir;
 
 // Every path below `root`, relative, as a sorted set: what a directory looks like.
 std::set<std::string> Listing(const fs::path& root) {
@@ -39,7 +42,7 @@ std::string ErrorOf(const std::function<void()>& action) {
 }
 
 TEST(MapReportTest, WritesOnePageWithAFigurePerLinkAndAThumbnailPerKeyImage) {
-  TempDir temp;
+  ScopedTempDir temp;
   const fs::path dir = temp.path() / "map";
   const VisualMap map = report_test::WriteSyntheticMap(dir);
   ASSERT_EQ(map.key_images.size(), 6u);
@@ -83,7 +86,7 @@ TEST(MapReportTest, WritesOnePageWithAFigurePerLinkAndAThumbnailPerKeyImage) {
 }
 
 TEST(MapReportTest, SimilarityPlotShowsEveryEvaluationTauAndTheLinks) {
-  TempDir temp;
+  ScopedTempDir temp;
   const VisualMap map = report_test::WriteSyntheticMap(temp.path());
   WriteMapReport(temp.path());
   const std::string svg = report_test::SvgById(ReadText(temp.path() / kReportFileName), "similarity-plot");
@@ -127,7 +130,7 @@ TEST(MapReportTest, SimilarityPlotShowsEveryEvaluationTauAndTheLinks) {
 }
 
 TEST(MapReportTest, MapWithOneKeyImageAndNoLinksStillGetsAPage) {
-  TempDir temp;
+  ScopedTempDir temp;
   report_test::SyntheticMapOptions options;
   options.num_frames = 1;
   options.below_tau_links.clear();
@@ -144,7 +147,7 @@ TEST(MapReportTest, MapWithOneKeyImageAndNoLinksStillGetsAPage) {
 }
 
 TEST(MapReportTest, RewritingReplacesTheReportAndLeavesNoTemporaryFiles) {
-  TempDir temp;
+  ScopedTempDir temp;
   const fs::path dir = temp.path() / "map";
   report_test::WriteSyntheticMap(dir);
   WriteMapReport(dir);
@@ -158,7 +161,7 @@ TEST(MapReportTest, RewritingReplacesTheReportAndLeavesNoTemporaryFiles) {
 }
 
 TEST(MapReportTest, MissingOrMalformedMapsGiveClearErrorsAndWriteNothing) {
-  TempDir temp;
+  ScopedTempDir temp;
   const fs::path missing = temp.path() / "no_such_map";
   EXPECT_NE(ErrorOf([&] { WriteMapReport(missing); }).find("no_such_map"), std::string::npos);
   EXPECT_FALSE(fs::exists(missing));
@@ -182,6 +185,42 @@ TEST(MapReportTest, MissingOrMalformedMapsGiveClearErrorsAndWriteNothing) {
   EXPECT_FALSE(fs::exists(garbled / kReportFileName));
 }
 
+TEST(MapReportTest, BadOptionsNameTheFieldAndWriteNothing) {
+  ScopedTempDir temp;
+  const fs::path dir = temp.path() / "map";
+  report_test::WriteSyntheticMap(dir);
+  const std::set<std::string> before = Listing(dir);
+  const std::vector<std::pair<std::string, std::function<void(MapReportOptions&)>>> cases = {
+      {"thumbnail_width is 31", [](MapReportOptions& o) { o.thumbnail_width = 31; }},
+      {"figure_width is 8193", [](MapReportOptions& o) { o.figure_width = 8193; }},
+      {"jpeg_quality is 0", [](MapReportOptions& o) { o.jpeg_quality = 0; }},
+      {"route_fps is 0", [](MapReportOptions& o) { o.route_fps = 0.0; }},
+      {"route_fps is nan", [](MapReportOptions& o) { o.route_fps = std::nan(""); }},
+  };
+  EXPECT_NO_THROW(MapReportOptions{}.Check());
+  for (const auto& [message, spoil] : cases) {
+    MapReportOptions options;
+    spoil(options);
+    EXPECT_NE(ErrorOf([&] { WriteMapReport(dir, options); }).find("MapReportOptions::" + message), std::string::npos)
+        << message;
+  }
+  EXPECT_EQ(Listing(dir), before);
+}
+
+// The style sheet and the script are the files in report/assets, embedded at build time, carried inline.
+TEST(MapReportTest, PageCarriesTheEmbeddedStyleAndScript) {
+  ScopedTempDir temp;
+  const fs::path dir = temp.path() / "map";
+  report_test::WriteSyntheticMap(dir);
+  WriteMapReport(dir);
+  const std::string html = ReadText(dir / kReportFileName);
+  const std::string css(report::ReportCss()), js(report::ReportJs());
+  EXPECT_NE(css.find(".match-figure.below-tau {"), std::string::npos);
+  EXPECT_NE(js.find("vmap-selfcheck"), std::string::npos);
+  EXPECT_EQ(report_test::CountOccurrences(html, "<style>\n" + css + "</style>"), 1);
+  EXPECT_EQ(report_test::CountOccurrences(html, "<script>\n" + js + "</script>"), 1);
+}
+
 // Rewrites one key image's path in map.json.
 void SetKeyImagePath(const fs::path& dir, int key, const std::string& image) {
   nlohmann::json doc = nlohmann::json::parse(ReadText(dir / "map.json"));
@@ -190,7 +229,7 @@ void SetKeyImagePath(const fs::path& dir, int key, const std::string& image) {
 }
 
 TEST(MapReportTest, KeyImagePathsCannotLeaveTheMapDirectory) {
-  TempDir temp;
+  ScopedTempDir temp;
   const fs::path dir = temp.path() / "map";
   const VisualMap map = report_test::WriteSyntheticMap(dir);
   const fs::path outside = temp.path() / "secret.png";
@@ -215,7 +254,7 @@ TEST(MapReportTest, KeyImagePathsCannotLeaveTheMapDirectory) {
 }
 
 TEST(MapReportTest, DrawMapLinkNamesAMissingLink) {
-  TempDir temp;
+  ScopedTempDir temp;
   const VisualMap map = report_test::WriteSyntheticMap(temp.path());
   const cv::Mat figure = DrawMapLink(temp.path(), map, 0);
   EXPECT_EQ(figure.cols, 2 * 320 + 4);
@@ -254,7 +293,7 @@ SweepResult SyntheticSweep(const fs::path& maps) {
 }
 
 TEST(SweepReportTest, TableMarksTheBestTauAndLinksTheMapsRelatively) {
-  TempDir temp;
+  ScopedTempDir temp;
   const fs::path dir = temp.path() / "sweep";
   const SweepResult sweep = SyntheticSweep(dir);
   fs::create_directories(dir);
@@ -274,7 +313,7 @@ TEST(SweepReportTest, TableMarksTheBestTauAndLinksTheMapsRelatively) {
 }
 
 TEST(SweepReportTest, PlotsShowKeyImagesAndQualityAgainstTau) {
-  TempDir temp;
+  ScopedTempDir temp;
   const SweepResult sweep = SyntheticSweep(temp.path());
   WriteSweepReport(sweep, temp.path());
   const std::string html = ReadText(temp.path() / kReportFileName);

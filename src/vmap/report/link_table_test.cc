@@ -6,6 +6,7 @@
 
 #include "vmap/report/html_report.h"
 #include "vmap/report/report_test_util.h"
+#include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
 namespace {
@@ -42,7 +43,7 @@ MapEvaluation EvaluationOf(const VisualMap& map) {
 }
 
 TEST(LinkTableTest, TheReportShowsTheEvaluationOfItsOwnLinksOnly) {
-  report_test::TempDir temp;
+  testing::ScopedTempDir temp;
   const fs::path dir = temp.path() / "map";
   const VisualMap map = report_test::WriteSyntheticMap(dir);
   MapReportOptions options;

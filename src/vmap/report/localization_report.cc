@@ -192,11 +192,17 @@ std::string SimilarityPlot(const LocalizationRun& run) {
 }  // namespace
 
 void LocalizationReportOptions::Check() const {
-  if (pairs < 0 || pairs > 200) throw InputError(fmt::format("report pairs = {} is outside [0, 200]", pairs));
-  if (pair_width < 64 || pair_width > 8192) {
-    throw InputError(fmt::format("report pair width {} is outside [64, 8192]", pair_width));
+  if (pairs < 0 || pairs > 200) {
+    throw InputError(fmt::format("LocalizationReportOptions::pairs is {}; use 0 to 200 (default 8)", pairs));
   }
-  if (jpeg_quality < 1 || jpeg_quality > 100) throw InputError("report JPEG quality must be in [1, 100]");
+  if (pair_width < 64 || pair_width > 8192) {
+    throw InputError(
+        fmt::format("LocalizationReportOptions::pair_width is {}; use 64 to 8192 pixels (default 960)", pair_width));
+  }
+  if (jpeg_quality < 1 || jpeg_quality > 100) {
+    throw InputError(
+        fmt::format("LocalizationReportOptions::jpeg_quality is {}; use 1 to 100 (default 85)", jpeg_quality));
+  }
 }
 
 void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, const fs::path& map_directory,

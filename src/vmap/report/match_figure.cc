@@ -4,9 +4,12 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
+
+#include "vmap/core/error.h"
 
 namespace vmap {
 
@@ -43,8 +46,16 @@ std::string MatchCaption(const Link& link) {
   return text;
 }
 
+void MatchFigureOptions::Check() const {
+  if (max_width != 0 && (max_width < 64 || max_width > 16384)) {
+    throw InputError("MatchFigureOptions::max_width is " + std::to_string(max_width) +
+                     "; use 0 (the key images' own scale) or 64 to 16384 pixels");
+  }
+}
+
 cv::Mat DrawMatchFigure(const cv::Mat& image0, const cv::Mat& image1, const Link& link,
                         const MatchFigureOptions& options) {
+  options.Check();
   if (image0.empty() || image1.empty()) throw std::invalid_argument("DrawMatchFigure: empty key image");
   const cv::Mat bgr0 = ToBgr(image0), bgr1 = ToBgr(image1);
 

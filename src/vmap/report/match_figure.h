@@ -19,6 +19,8 @@ struct MatchFigureOptions {
   // Hershey fonts draw ASCII only.
   std::string title;
   bool caption = true;
+
+  void Check() const;  // throws InputError naming the bad field
 };
 
 // Colours (BGR) used by the figure, shared with the report's legend and the tests.
@@ -28,7 +30,8 @@ inline const cv::Scalar kBelowTauColor(0, 0, 220);
 
 // `image0` is the link's first key image and `image1` its second (8-bit grey or BGR; their sizes may
 // differ: both are scaled to the taller one's height). The correspondences are in each image's own
-// pixel coordinates. Returns an 8-bit BGR image. Throws std::invalid_argument on an empty image.
+// pixel coordinates. Returns an 8-bit BGR image. Throws std::invalid_argument on an empty image, InputError on
+// bad options.
 cv::Mat DrawMatchFigure(const cv::Mat& image0, const cv::Mat& image1, const Link& link,
                         const MatchFigureOptions& options = {});
 

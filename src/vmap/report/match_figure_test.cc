@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "vmap/core/error.h"
+
 namespace vmap {
 namespace {
 
@@ -88,6 +90,24 @@ TEST(MatchFigureTest, AcceptsGreyImagesOfDifferentSizes) {
 
 TEST(MatchFigureTest, RejectsEmptyImages) {
   EXPECT_THROW(DrawMatchFigure(cv::Mat(), cv::Mat(10, 10, CV_8UC3), SimpleLink()), std::invalid_argument);
+}
+
+TEST(MatchFigureTest, BadOptionsNameTheField) {
+  MatchFigureOptions options;
+  EXPECT_NO_THROW(options.Check());
+  options.max_width = 64;
+  EXPECT_NO_THROW(options.Check());
+  for (int width : {-1, 63, 16385}) {
+    options.max_width = width;
+    try {
+      DrawMatchFigure(cv::Mat(10, 10, CV_8UC3), cv::Mat(10, 10, CV_8UC3), SimpleLink(), options);
+      ADD_FAILURE() << "max_width " << width << " accepted";
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find("MatchFigureOptions::max_width is " + std::to_string(width)),
+                std::string::npos)
+          << error.what();
+    }
+  }
 }
 
 TEST(MatchFigureTest, CaptionGivesSimilarityAndCounts) {

@@ -20,20 +20,17 @@
 #include "vmap/report/html_report.h"
 #include "vmap/report/localization_report.h"
 #include "vmap/report/report_test_util.h"
+#include "vmap/testing/run_vmap.h"
+#include "vmap/testing/scoped_temp_dir.h"
+#include "vmap/testing/shared_data.h"
 
 namespace vmap {
 namespace {
 namespace fs = std::filesystem;
 using report_test::ReadText;
-using report_test::TempDir;
+using testing::ScopedTempDir;
 
 constexpr const char* kChromium = "/usr/bin/chromium";
-
-std::string Quoted(const std::string& text) {
-  std::string quoted = "'";
-  for (char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return quoted + "'";
-}
 
 // Chromium takes most of a small machine: test processes running in parallel (ctest -j) take turns.
 class ChromiumTurn {
@@ -64,8 +61,8 @@ ChromiumResult RunChromium(const std::string& action, const std::string& url, co
       " --headless --no-sandbox --disable-gpu --no-first-run --disable-background-networking"
       " --disable-component-update --disable-sync --disable-extensions --hide-scrollbars"
       " --enable-logging=stderr --v=0 --virtual-time-budget=15000 --window-size=1280,2000" +
-      " --user-data-dir=" + Quoted(profile.string()) + " " + action + " " + Quoted(url) + " > " +
-      Quoted(out.string()) + " 2> " + Quoted(err.string());
+      " --user-data-dir=" + testing::Quote(profile.string()) + " " + action + " " + testing::Quote(url) + " > " +
+      testing::Quote(out.string()) + " 2> " + testing::Quote(err.string());
   ChromiumResult result;
   {
     ChromiumTurn turn;
@@ -121,7 +118,7 @@ nlohmann::json SelfCheck(const fs::path& report, const fs::path& work) {
 // The page as a 1280 x 2000 screenshot: something must be drawn (not a blank or single-colour page).
 void ExpectScreenshotNotBlank(const fs::path& report, const fs::path& work) {
   const fs::path shot = work / "screenshot.png";
-  const ChromiumResult run = RunChromium("--screenshot=" + Quoted(shot.string()), FileUrl(report), work);
+  const ChromiumResult run = RunChromium("--screenshot=" + testing::Quote(shot.string()), FileUrl(report), work);
   ASSERT_EQ(run.status, 0) << run.log;
   const cv::Mat image = cv::imread(shot.string(), cv::IMREAD_GRAYSCALE);
   ASSERT_FALSE(image.empty()) << "no screenshot written\n" << run.log;
@@ -145,7 +142,7 @@ class ReportBrowserTest : public ::testing::Test {
 };
 
 TEST_F(ReportBrowserTest, MapReportLoadsOfflineWithEveryImageAndFigure) {
-  TempDir temp;
+  ScopedTempDir temp;
   const fs::path dir = temp.path() / "map";
   report_test::SyntheticMapOptions options;
   options.num_frames = 200;  // 23 key images: most images are far below the first screen (lazy)
@@ -166,7 +163,7 @@ TEST_F(ReportBrowserTest, MapReportLoadsOfflineWithEveryImageAndFigure) {
 
 TEST_F(ReportBrowserTest, ARequestToTheNetworkWouldBeCaught) {
   // The console check must be able to fail: a page that reaches for a CDN is refused and logged.
-  TempDir temp;
+  ScopedTempDir temp;
   const fs::path dir = temp.path() / "map";
   report_test::WriteSyntheticMap(dir);
   WriteMapReport(dir);
@@ -181,7 +178,7 @@ TEST_F(ReportBrowserTest, ARequestToTheNetworkWouldBeCaught) {
 
 TEST_F(ReportBrowserTest, BrokenImageIsDetected) {
   // The self-check itself must be able to fail: remove one figure and it has to be reported.
-  TempDir temp;
+  ScopedTempDir temp;
   const fs::path dir = temp.path() / "map";
   report_test::WriteSyntheticMap(dir);
   WriteMapReport(dir);
@@ -191,7 +188,7 @@ TEST_F(ReportBrowserTest, BrokenImageIsDetected) {
 }
 
 TEST_F(ReportBrowserTest, SweepReportLoadsOffline) {
-  TempDir temp;
+  ScopedTempDir temp;
   SweepResult sweep;
   sweep.input.path = "synthetic";
   sweep.num_frames = 50;
@@ -217,15 +214,15 @@ TEST_F(ReportBrowserTest, SweepReportLoadsOffline) {
 }
 
 TEST_F(ReportBrowserTest, ReportOfARealMapBuiltFromSharedData) {
-  const fs::path images = fs::path(VMAP_SHARED_DIR) / "data/rccar_room/images";
-  if (!fs::exists(VMAP_BINARY) || !fs::exists(images)) {
+  const fs::path images = fs::path(testing::SharedDir()) / "data/rccar_room/images";
+  if (!fs::exists(testing::VmapBinary()) || testing::SharedDir().empty() || !fs::exists(images)) {
     GTEST_SKIP() << "needs the vmap binary and " << images;
   }
-  TempDir temp;
+  ScopedTempDir temp;
   const fs::path dir = temp.path() / "rccar_map";
-  const std::string command = Quoted(VMAP_BINARY) + " build " + Quoted(images.string()) + " -o " +
-                              Quoted(dir.string()) + " --stride 3 --last 119 --report -q > " +
-                              Quoted((temp.path() / "build.log").string()) + " 2>&1";
+  const std::string command = testing::Quote(testing::VmapBinary()) + " build " + testing::Quote(images.string()) + " -o " +
+                              testing::Quote(dir.string()) + " --stride 3 --last 119 --report -q > " +
+                              testing::Quote((temp.path() / "build.log").string()) + " 2>&1";
   ASSERT_EQ(std::system(command.c_str()), 0) << ReadText(temp.path() / "build.log");
   const VisualMap map = ReadMap(dir);
   ASSERT_GE(map.key_images.size(), 2u);
@@ -238,7 +235,7 @@ TEST_F(ReportBrowserTest, ReportOfARealMapBuiltFromSharedData) {
 
 TEST_F(ReportBrowserTest, LocalizationReportLoadsOffline) {
   // A run whose query frames are the map's own key images (an image folder), localized one by one.
-  TempDir temp;
+  ScopedTempDir temp;
   const fs::path dir = temp.path() / "map";
   const VisualMap map = report_test::WriteSyntheticMap(dir);
   LocalizationRun run;

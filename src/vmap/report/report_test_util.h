@@ -9,14 +9,10 @@
 
 #include <opencv2/core.hpp>
 
-#include "vmap/testing/synthetic_scene.h"
 
 #include "vmap/map/visual_map.h"
 
 namespace vmap::report_test {
-
-// The project-wide temporary directory of the tests.
-using TempDir = vmap::testing::TempDir;
 
 struct SyntheticMapOptions {
   int num_frames = 40;

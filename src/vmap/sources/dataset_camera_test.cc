@@ -6,7 +6,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "vmap/core/error.h"
-#include "vmap/testing/synthetic_scene.h"
+#include "vmap/testing/scoped_temp_dir.h"
+#include "vmap/testing/shared_data.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -14,9 +15,6 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path Shared() { return testing::SharedDir(); }
-
-#define REQUIRE_SHARED() \
-  if (Shared().empty()) GTEST_SKIP() << "../shared is not present"
 
 void WriteText(const fs::path& path, const std::string& text) {
   fs::create_directories(path.parent_path());
@@ -57,7 +55,7 @@ void WriteImages(const fs::path& directory, int count, cv::Size size) {
 }  // namespace
 
 TEST(DatasetCamera, ReadsTheSharedSequencesIntrinsics) {
-  REQUIRE_SHARED();
+  SKIP_WITHOUT_SHARED();
   const std::optional<Camera> kitti = FindDatasetCamera((Shared() / "data/kitti07").string(), SourceFormat::kAuto);
   ASSERT_TRUE(kitti);
   EXPECT_DOUBLE_EQ(kitti->fx, 707.0912);
@@ -80,7 +78,7 @@ TEST(DatasetCamera, ReadsTheSharedSequencesIntrinsics) {
 }
 
 TEST(DatasetCamera, KittiColourFramesUseP2AndTheOfficialLayoutWorks) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteImages(tmp.path() / "seq/image_2", 2, {64, 48});
   WriteText(tmp.path() / "seq/times.txt", "0\n0.1\n");
   WriteText(tmp.path() / "seq/calib.txt",
@@ -96,7 +94,7 @@ TEST(DatasetCamera, KittiColourFramesUseP2AndTheOfficialLayoutWorks) {
 }
 
 TEST(DatasetCamera, ReadsEurocSensorYamlWithItsExtrinsics) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteText(tmp.path() / "mav0/cam0/sensor.yaml", kEurocSensorYaml);
   WriteText(tmp.path() / "mav0/cam0/data.csv", "#timestamp [ns],filename\n");
   const EurocSensor sensor = ReadEurocSensor((tmp.path() / "mav0/cam0/sensor.yaml").string());
@@ -116,7 +114,7 @@ TEST(DatasetCamera, ReadsEurocSensorYamlWithItsExtrinsics) {
 }
 
 TEST(DatasetCamera, IntrinsicsTextBesideAnImageFolderOrItsParent) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteImages(tmp.path() / "run/images", 2, {64, 48});
   WriteText(tmp.path() / "run/intrinsics.txt", "# a comment\nfx 50.5\nfy 51\ncx 31.5\ncy 23.5  # trailing\n");
   for (const fs::path& input : {tmp.path() / "run", tmp.path() / "run/images"}) {
@@ -137,7 +135,7 @@ TEST(DatasetCamera, IntrinsicsTextBesideAnImageFolderOrItsParent) {
 }
 
 TEST(DatasetCamera, FrameSourceCarriesTheCameraScaledWithResize) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   WriteImages(tmp.path() / "run", 3, {640, 480});
   WriteText(tmp.path() / "run/intrinsics.txt", "fx 500\nfy 500\ncx 319.5\ncy 239.5\n");
   FrameSourceOptions options;

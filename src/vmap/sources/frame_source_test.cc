@@ -11,6 +11,8 @@
 #include <opencv2/videoio.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/testing/scoped_temp_dir.h"
+#include "vmap/testing/shared_data.h"
 #include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {
@@ -66,7 +68,7 @@ TEST(NaturalSort, DigitRunsCompareAsNumbers) {
 }
 
 TEST(ImageFolder, ReadsInNaturalOrder) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   testing::WriteImageFolder(Sequence(), tmp.path());
   auto source = OpenFrameSource(tmp.path().string());
   EXPECT_EQ(source->info().format, SourceFormat::kImageFolder);
@@ -82,7 +84,7 @@ TEST(ImageFolder, ReadsInNaturalOrder) {
 }
 
 TEST(ImageFolder, FirstLastStrideAndResize) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   testing::WriteImageFolder(Sequence(), tmp.path());
   FrameSourceOptions options;
   options.first = 2;
@@ -106,7 +108,7 @@ TEST(ImageFolder, FirstLastStrideAndResize) {
 }
 
 TEST(ImageFolder, FramesOfAnotherSizeAreResizedOrRejectedWhenStrict) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   testing::WriteImageFolder(Sequence(), tmp.path());
   cv::Mat odd;
   cv::resize(Sequence().frames[4], odd, cv::Size(200, 100));
@@ -123,7 +125,7 @@ TEST(ImageFolder, FramesOfAnotherSizeAreResizedOrRejectedWhenStrict) {
 }
 
 TEST(ImageFolder, UnknownLayoutsAndEmptyFoldersAreClearErrors) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   EXPECT_NE(OpenError(tmp.path().string()).find("holds no images"), std::string::npos);
   std::ofstream(tmp.path() / "notes.txt") << "hello";
   EXPECT_NE(OpenError(tmp.path().string()).find("--format"), std::string::npos);
@@ -131,7 +133,7 @@ TEST(ImageFolder, UnknownLayoutsAndEmptyFoldersAreClearErrors) {
 }
 
 TEST(ImageFolder, UndecodableImageIsSkippedAndCounted) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   testing::WriteImageFolder(Sequence(), tmp.path());
   std::ofstream(tmp.path() / "frame_3.png", std::ios::trunc) << "not a png";
   auto source = OpenFrameSource(tmp.path().string());
@@ -140,7 +142,7 @@ TEST(ImageFolder, UndecodableImageIsSkippedAndCounted) {
 }
 
 TEST(ImageFolder, BadFramesAreSkippedWithAWarningAndCounted) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   testing::WriteImageFolder(Sequence(), tmp.path());  // 12 frames of 320x240
   // Decode failures, degenerate sizes and too many pixels, among good frames and at the very start.
   cv::imwrite((tmp.path() / "frame_1.png").string(), cv::Mat(1, 1, CV_8U, cv::Scalar(7)));
@@ -172,7 +174,7 @@ TEST(ImageFolder, BadFramesAreSkippedWithAWarningAndCounted) {
 }
 
 TEST(ImageFolder, AFolderOfOnlyBadFramesIsAClearError) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   cv::imwrite((tmp.path() / "a.png").string(), cv::Mat(1, 1, CV_8U));
   testing::WritePngHeader(tmp.path() / "b.png", 40000, 40000);
   const std::string error = OpenError(tmp.path().string());
@@ -180,7 +182,7 @@ TEST(ImageFolder, AFolderOfOnlyBadFramesIsAClearError) {
 }
 
 TEST(Video, FramesOfADegenerateSizeAreAClearError) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const fs::path video = WriteMjpegVideo(tmp.path() / "tiny.avi", std::vector<cv::Mat>(3, cv::Mat(16, 16, CV_8UC3)));
   const std::string error = OpenError(video.string());
   EXPECT_NE(error.find("tiny.avi' has frames of 16x16, smaller than 32 pixels"), std::string::npos) << error;
@@ -221,7 +223,7 @@ TEST(FrameSourceOptions, EveryOptionHasARange) {
 }
 
 TEST(FrameSourceOptions, ALongestSideThatMakesFramesDegenerateIsAnError) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   // Panoramic frames of 1000x40: a longest side of 100 would make them 100x4.
   for (int i = 0; i < 3; ++i) {
     cv::imwrite((tmp.path() / ("p" + std::to_string(i) + ".png")).string(), cv::Mat(40, 1000, CV_8U, cv::Scalar(i)));
@@ -233,7 +235,7 @@ TEST(FrameSourceOptions, ALongestSideThatMakesFramesDegenerateIsAnError) {
 }
 
 TEST(Tum, ReadsRgbTxtWithTimestamps) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   testing::WriteImageFolder(Sequence(), tmp.path() / "rgb");
   {
     std::ofstream list(tmp.path() / "rgb.txt");
@@ -253,7 +255,7 @@ TEST(Tum, ReadsRgbTxtWithTimestamps) {
 }
 
 TEST(Euroc, ReadsDataCsv) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const fs::path cam = tmp.path() / "mav0" / "cam0";
   fs::create_directories(cam / "data");
   std::ofstream csv(cam / "data.csv");
@@ -272,7 +274,7 @@ TEST(Euroc, ReadsDataCsv) {
 }
 
 TEST(Kitti, ReadsImage0AndTimes) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   fs::create_directories(tmp.path() / "image_0");
   std::ofstream times(tmp.path() / "times.txt");
   for (int i = 0; i < 3; ++i) {
@@ -290,7 +292,7 @@ TEST(Kitti, ReadsImage0AndTimes) {
 }
 
 TEST(Video, ReadsEveryFrameWithTimestamps) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const fs::path video = WriteMjpegVideo(tmp.path() / "clip.avi", Sequence().frames);
   auto source = OpenFrameSource(video.string());
   EXPECT_EQ(source->info().format, SourceFormat::kVideo);
@@ -303,7 +305,7 @@ TEST(Video, ReadsEveryFrameWithTimestamps) {
 }
 
 TEST(Video, FirstLastAndStrideSelectTheSameFramesAsAFullRead) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const fs::path video = WriteMjpegVideo(tmp.path() / "clip.avi", Sequence().frames);
   auto full = OpenFrameSource(video.string());
   const auto all = ReadAll(*full);
@@ -326,7 +328,7 @@ TEST(Video, FirstLastAndStrideSelectTheSameFramesAsAFullRead) {
 }
 
 TEST(Video, CorruptFrameInTheMiddleIsSkippedAndCounted) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   const fs::path video = WriteMjpegVideo(tmp.path() / "clip.avi", Sequence().frames);
   // Destroy the start-of-image marker of the 7th JPEG: that frame cannot be decoded.
   std::fstream file(video, std::ios::in | std::ios::out | std::ios::binary);
@@ -346,7 +348,7 @@ TEST(Video, CorruptFrameInTheMiddleIsSkippedAndCounted) {
 }
 
 TEST(Video, GarbageOrTruncatedFilesAreClearErrors) {
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   std::ofstream(tmp.path() / "noise.mp4") << std::string(5000, 'x');
   const std::string error = OpenError((tmp.path() / "noise.mp4").string());
   EXPECT_NE(error.find("noise.mp4"), std::string::npos) << error;
@@ -395,7 +397,7 @@ TEST(SharedData, RotatedVideosAreDeliveredUpright) {
   const fs::path shared = testing::SharedDir();
   if (shared.empty()) GTEST_SKIP() << "../shared is not present";
   if (std::system("ffmpeg -version > /dev/null 2>&1") != 0) GTEST_SKIP() << "ffmpeg (scripts/install-deps.sh) is missing";
-  testing::TempDir tmp;
+  testing::ScopedTempDir tmp;
   for (int degrees : {90, 180, 270}) {
     const fs::path rotated = tmp.path() / ("rotated_" + std::to_string(degrees) + ".mp4");
     const std::string command = "ffmpeg -nostdin -loglevel error -y -i \"" +

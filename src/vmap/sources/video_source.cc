@@ -52,9 +52,7 @@ class VideoSource : public FrameSource {
   VideoSource(const std::string& path, const FrameSourceOptions& options) : options_(options) {
     info_.path = path;
     info_.format = SourceFormat::kVideo;
-    // vmap reports decoding problems itself, once per frame, with the file name; FFmpeg's own messages
-    // would repeat them without context.
-    av_log_set_level(AV_LOG_QUIET);
+    // FFmpeg's own log is the host's to set: InitializeRuntime() (core/runtime.h) silences it for vmap.
     Open(path);
     const AVStream* stream = format_->streams[stream_index_];
     clockwise_rotation_ = ClockwiseRotation(*stream);

@@ -1,12 +1,8 @@
 #include "vmap/testing/synthetic_scene.h"
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <random>
 
@@ -258,17 +254,6 @@ void WriteEurocSequence(const SyntheticSequence& sequence, const fs::path& direc
        << "] #fu, fv, cu, cv\ndistortion_model: radial-tangential\ndistortion_coefficients: [0.0, 0.0, 0.0, 0.0]\n";
 }
 
-TempDir::TempDir() {
-  std::string pattern = (fs::temp_directory_path() / "vmap_test_XXXXXX").string();
-  if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
-  path_ = pattern;
-}
-
-TempDir::~TempDir() {
-  std::error_code ignored;
-  fs::remove_all(path_, ignored);
-}
-
 void WritePngHeader(const fs::path& path, uint32_t width, uint32_t height) {
   std::string bytes("\x89PNG\r\n\x1A\n", 8);
   auto put = [&](uint32_t value) {
@@ -293,32 +278,6 @@ void WritePngHeader(const fs::path& path, uint32_t width, uint32_t height) {
   chunk("IHDR", header);
   chunk("IDAT", "");
   std::ofstream(path, std::ios::binary) << bytes;
-}
-
-
-fs::path SharedDir() {
-#ifdef VMAP_SHARED_DIR
-  const fs::path dir(VMAP_SHARED_DIR);
-  if (fs::is_directory(dir / "data")) return fs::canonical(dir);
-#endif
-  return {};
-}
-
-int RunVmap(const std::string& arguments, std::string* output) {
-#ifdef VMAP_BINARY
-  const std::string command = std::string("'") + VMAP_BINARY + "' " + arguments + " 2>&1";
-#else
-  const std::string command = "vmap " + arguments + " 2>&1";
-#endif
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return -1;
-  std::string text;
-  std::array<char, 4096> buffer;
-  size_t n;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) text.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  if (output) *output = text;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 }  // namespace vmap::testing

@@ -55,25 +55,8 @@ void WriteTumSequence(const SyntheticSequence& sequence, const std::filesystem::
 void WriteEurocSequence(const SyntheticSequence& sequence, const std::filesystem::path& directory,
                         const cv::Matx44d& body_to_camera, double seconds_per_frame = 0.05);
 
-// A unique empty temporary directory, removed by the destructor.
-class TempDir {
- public:
-  TempDir();
-  ~TempDir();
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
-
 // The start of a PNG (signature, IHDR chunk, an empty IDAT chunk; CRCs included) announcing `width` x
 // `height` grey pixels, with no image data: a decoder reads the size, then finds nothing to decode.
 void WritePngHeader(const std::filesystem::path& path, uint32_t width, uint32_t height);
-
-// The shared data folder (../shared), or empty when absent.
-std::filesystem::path SharedDir();
-
-// Runs the vmap binary with arguments (a shell command line), capturing stdout+stderr; returns the exit code.
-int RunVmap(const std::string& arguments, std::string* output);
 
 }  // namespace vmap::testing

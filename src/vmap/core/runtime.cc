@@ -1,0 +1,41 @@
+#include "vmap/core/runtime.h"
+
+#include <malloc.h>
+
+#include <mutex>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+extern "C" {
+#include <libavutil/log.h>
+}
+
+#include "vmap/core/error.h"
+#include "vmap/core/interrupt.h"
+
+namespace vmap {
+
+void RuntimeOptions::Check() const {
+  if (opencv_threads < 0) {
+    throw InputError("RuntimeOptions::opencv_threads is " + std::to_string(opencv_threads) +
+                     "; use 1 or more threads, or 0 for OpenCV's default");
+  }
+}
+
+void InitializeRuntime(const RuntimeOptions& options) {
+  options.Check();
+  if (options.handle_interrupts) {
+    // One watcher thread per process (interrupt.h); a second one would only wait beside it.
+    static std::once_flag installed;
+    std::call_once(installed, InstallInterruptHandling);
+  }
+  if (options.opencv_threads > 0) cv::setNumThreads(options.opencv_threads);
+  if (options.keep_freed_memory) {
+    mallopt(M_MMAP_MAX, 0);
+    mallopt(M_TRIM_THRESHOLD, 1 << 30);
+  }
+  if (options.quiet_ffmpeg) av_log_set_level(AV_LOG_QUIET);
+}
+
+}  // namespace vmap

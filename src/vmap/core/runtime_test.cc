@@ -1,0 +1,86 @@
+#include "vmap/core/runtime.h"
+
+#include <malloc.h>
+
+#include <cstdlib>
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+
+#include "vmap/core/error.h"
+
+extern "C" {
+#include <libavutil/log.h>
+}
+
+namespace vmap {
+namespace {
+
+RuntimeOptions Nothing() {
+  RuntimeOptions options;
+  options.opencv_threads = 0;
+  options.keep_freed_memory = false;
+  options.quiet_ffmpeg = false;
+  options.handle_interrupts = false;
+  return options;
+}
+
+// Whether a block of `bytes` comes from a mmap() of its own (glibc counts those in hblks).
+bool AllocationIsMapped(size_t bytes) {
+  const size_t before = mallinfo2().hblks;
+  void* volatile block = std::malloc(bytes);
+  const size_t during = mallinfo2().hblks;
+  std::free(block);
+  return during > before;
+}
+
+}  // namespace
+
+TEST(RuntimeOptions, CheckNamesTheBadField) {
+  RuntimeOptions options;
+  EXPECT_NO_THROW(options.Check());
+  options.opencv_threads = -2;
+  try {
+    options.Check();
+    FAIL() << "negative thread count accepted";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("opencv_threads is -2"), std::string::npos) << error.what();
+  }
+  EXPECT_THROW(InitializeRuntime(options), InputError);
+}
+
+TEST(Runtime, SetsOpenCvThreads) {
+  const int before = cv::getNumThreads();
+  RuntimeOptions options = Nothing();
+  options.opencv_threads = 3;
+  InitializeRuntime(options);
+  EXPECT_EQ(cv::getNumThreads(), 3);
+  options.opencv_threads = 0;  // leaves it
+  InitializeRuntime(options);
+  EXPECT_EQ(cv::getNumThreads(), 3);
+  cv::setNumThreads(before);
+}
+
+TEST(Runtime, KeepsLargeFreedBlocksInTheHeap) {
+  constexpr size_t kLarge = size_t(64) << 20;  // above glibc's largest dynamic mmap threshold (32 MiB)
+  mallopt(M_MMAP_MAX, 65536);                   // glibc's default
+  EXPECT_TRUE(AllocationIsMapped(kLarge)) << "the control: by default such a block is a mmap of its own";
+  InitializeRuntime(Nothing());
+  EXPECT_TRUE(AllocationIsMapped(kLarge)) << "keep_freed_memory off changes nothing";
+  RuntimeOptions options = Nothing();
+  options.keep_freed_memory = true;
+  InitializeRuntime(options);
+  EXPECT_FALSE(AllocationIsMapped(kLarge));
+}
+
+TEST(Runtime, QuietsFfmpeg) {
+  av_log_set_level(AV_LOG_INFO);
+  InitializeRuntime(Nothing());
+  EXPECT_EQ(av_log_get_level(), AV_LOG_INFO);
+  RuntimeOptions options = Nothing();
+  options.quiet_ffmpeg = true;
+  InitializeRuntime(options);
+  EXPECT_EQ(av_log_get_level(), AV_LOG_QUIET);
+}
+
+}  // namespace vmap
