@@ -82,7 +82,12 @@ class KeyImageSelector {
   // Called once for every new key image, e.g. to write its image file (may set image_file).
   using KeyImageFn = std::function<void(const FrameRecord& record, KeyImage& key)>;
 
-  KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image = nullptr);
+  // Called with every comparison made (what map.json's evaluations hold). When given, the selector does not
+  // keep them (evaluations() stays empty), so that its memory does not grow with the sequence's length.
+  using EvaluationFn = std::function<void(const Evaluation& evaluation)>;
+
+  KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image = nullptr,
+                   EvaluationFn on_evaluation = nullptr);
 
   // Frames must arrive in order. The first frame becomes the first key image.
   void Add(const FrameRecord& record);
@@ -105,6 +110,7 @@ class KeyImageSelector {
   KeyImageOptions options_;
   CompareFn compare_;
   KeyImageFn on_key_image_;
+  EvaluationFn on_evaluation_;
   std::optional<FrameRecord> key_;
   std::optional<FrameRecord> previous_;         // the last frame that passed against the key image
   PairComparison previous_comparison_;          // key vs previous_
