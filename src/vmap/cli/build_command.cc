@@ -18,6 +18,7 @@
 #include "vmap/map/map_io.h"
 #include "vmap/map/map_writer.h"
 #include "vmap/report/summary.h"
+#include "vmap/sources/read_ahead_source.h"
 
 namespace vmap::cli {
 namespace fs = std::filesystem;
@@ -37,12 +38,14 @@ struct BuildFlags {
 };
 
 // Streams the input through a MapBuilder: snapshots while it runs, the end of the input on SIGINT when asked.
-VisualMap BuildStreaming(const BuildFlags& flags, FrameSource& source, const Matcher& matcher,
+VisualMap BuildStreaming(const BuildFlags& flags, FrameSource& input, const Matcher& matcher,
                          const MapBuilderOptions& options, const AtomicOutputDirectory& directory,
                          const std::string& options_json) {
   std::optional<SnapshotTarget> snapshots;
   if (flags.snapshot_every > 0) snapshots = SnapshotTarget{directory.final_path(), MapOutputPolicy(flags.input)};
   MapWriter writer(directory.path(), snapshots);
+  // Decoded on a thread of its own, while this one runs Algorithm 1 (see BuildMap).
+  ReadAheadSource source(input, options.prefetch_frames);
   MapBuilder builder(source, matcher, options, &writer, options_json);
   using Clock = std::chrono::steady_clock;
   auto last_snapshot = Clock::now();
