@@ -88,7 +88,8 @@ struct PipelineItem {
 
 // Takes frames from the consumer (TryPush) and, on `workers` threads, extracts their features and compares
 // them with the current key images, a few frames ahead of the consumer, which receives them in order (Next).
-// The consumer decodes the frames it pushes: one thread fewer, and the frames in flight are bounded by `depth`.
+// The frames in flight are bounded by `depth`; the frames come decoded (BuildMap reads them ahead on a thread
+// of their own, ReadAheadSource).
 //
 // Why compare ahead: a frame is compared with the same key image as the frames before it until S drops,
 // so those comparisons do not depend on each other and can run in parallel.
