@@ -89,6 +89,15 @@ class KeyImageSelector {
   KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image = nullptr,
                    EvaluationFn on_evaluation = nullptr);
 
+  // Algorithm 1's successor rule, for those who compare ahead of the selector (MapBuilder's workers): when
+  // frame `failing_frame` falls below tau against the key image at `key_frame`, the next key image is the frame
+  // before it, or the failing frame itself when that is the key (a link below tau). The selector itself may
+  // pick an earlier frame when the last ones repeat the key image's view (min_key_displacement): a guess
+  // then, which the selector's own comparisons correct.
+  static int SuccessorOf(int key_frame, int failing_frame) {
+    return failing_frame - 1 == key_frame ? failing_frame : failing_frame - 1;
+  }
+
   // Frames must arrive in order. The first frame becomes the first key image.
   void Add(const FrameRecord& record);
   // Ends the sequence: adds the final key image when asked to.

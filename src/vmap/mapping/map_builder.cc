@@ -304,10 +304,9 @@ class FeaturePipeline {
   }
 
   // Frame `frame_index` fell below `tau` against the key image `key_index`: the selectors holding it with tau
-  // or a higher threshold leave it here at the latest, for the previous frame (or this one when the previous
-  // is the key: a link below tau).
+  // or a higher threshold leave it here at the latest, for the successor Algorithm 1 gives.
   void Retire(int key_index, int frame_index, double tau) {
-    const int successor = frame_index - 1 == key_index ? frame_index : frame_index - 1;
+    const int successor = KeyImageSelector::SuccessorOf(key_index, frame_index);
     std::lock_guard<std::mutex> lock(mutex_);
     retired_[key_index].push_back(Retirement{frame_index, tau, successor});
   }
