@@ -12,7 +12,7 @@ packages=(
   libopenblas0-openmp           # without it LibTorch uses the reference BLAS and runs 30-50x slower
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev libeigen3-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
-  ffmpeg                        # only used by tests, to write videos with a display rotation
+  ffmpeg                        # only used by tests: videos with a display rotation, live streams on the loopback
 )
 if [[ "${1:-}" == "--with-browser" ]]; then
   packages+=(chromium)

@@ -97,7 +97,7 @@ void RunSweep(const SweepFlags& flags) {
   }
   if (directory) {
     for (size_t i = 0; flags.write_maps && i < maps.size(); ++i) {
-      WriteMapFiles(maps[i], sweep.rows[i].map_directory);
+      // map.json, correspondences.bin and the key images are written by the sweep (MapWriter).
       if (i < evaluations.size()) {
         evaluations[i].map_path = sweep.rows[i].map_directory;
         WriteFileAtomically(fs::path(sweep.rows[i].map_directory) / kEvaluationFileName,

@@ -5,6 +5,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cstdio>
 #include <thread>
 
@@ -14,6 +15,9 @@ namespace vmap {
 namespace {
 
 constexpr int kHandledSignals[] = {SIGINT, SIGTERM, SIGHUP};
+
+std::atomic<bool> end_input_on_sigint{false};
+std::atomic<bool> input_end_requested{false};
 
 // Runs on the watcher thread, never in a signal handler.
 [[noreturn]] void EndInterruptedProcess(int signal_number) {
@@ -25,6 +29,13 @@ constexpr int kHandledSignals[] = {SIGINT, SIGTERM, SIGHUP};
 }
 
 }  // namespace
+
+void EndInputOnSigint(bool enabled) {
+  input_end_requested = false;
+  end_input_on_sigint = enabled;
+}
+
+bool InputEndRequested() { return input_end_requested; }
 
 void InstallInterruptHandling() {
   sigset_t signals;
@@ -40,10 +51,17 @@ void InstallInterruptHandling() {
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   // Detached: it waits until the process ends, and must not hold up exit().
   std::thread([signals] {
-    int signal_number = 0;
-    while (sigwait(&signals, &signal_number) != 0) {
+    for (;;) {
+      int signal_number = 0;
+      if (sigwait(&signals, &signal_number) != 0) continue;
+      // The first SIGINT of a live run ends its input; the run then finishes and exits on its own.
+      if (signal_number == SIGINT && end_input_on_sigint && !input_end_requested.exchange(true)) {
+        std::fprintf(stderr, "\nvmap: interrupted: finishing the map from the frames seen (again to abort)\n");
+        std::fflush(stderr);
+        continue;
+      }
+      EndInterruptedProcess(signal_number);
     }
-    EndInterruptedProcess(signal_number);
   }).detach();
 }
 

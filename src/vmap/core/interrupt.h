@@ -11,11 +11,19 @@
 // A signal that the process was started with ignored (nohup, `cmd &` in a script) stays ignored.
 //
 // InitializeRuntime() (runtime.h) calls this once, first thing in main(), before any other thread exists; the
-// library never installs it, so a program that embeds vmap keeps its own signal handling. (A mode in which SIGINT ends the input
-// gracefully would hook in where interrupt.cc handles a signal.)
+// library never installs it, so a program that embeds vmap keeps its own signal handling.
+//
+// A live run (`vmap build --until-interrupted`) lets SIGINT end its input instead: while EndInputOnSigint is
+// on, the first SIGINT only sets InputEndRequested(), and the run finishes its map from the frames it saw; a
+// second SIGINT, SIGTERM or SIGHUP still ends the process as above.
 
 namespace vmap {
 
 void InstallInterruptHandling();
+
+// Turns the graceful SIGINT on or off (off by default). Safe from any thread.
+void EndInputOnSigint(bool enabled);
+// Whether a SIGINT asked to end the input since EndInputOnSigint(true). Safe from any thread, cheap to poll.
+bool InputEndRequested();
 
 }  // namespace vmap

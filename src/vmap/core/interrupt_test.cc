@@ -91,3 +91,33 @@ TEST(InterruptDeathTest, NothingIsRemovedAfterACommit) {
 }
 
 }  // namespace vmap
+
+namespace vmap {
+namespace {
+
+// In the child of a death test: with the graceful SIGINT on, a first SIGINT only asks the input to end (the
+// process goes on, its outputs intact), a second one aborts as usual.
+[[noreturn]] void EndInputThenAbort(const fs::path& target) {
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) signal(signal_number, SIG_DFL);
+  alarm(20);
+  InstallInterruptHandling();
+  EndInputOnSigint(true);
+  AtomicOutputDirectory directory(target, OutputPolicy{});
+  if (InputEndRequested()) _exit(3);
+  kill(getpid(), SIGINT);
+  while (!InputEndRequested()) usleep(1000);
+  if (!fs::exists(directory.path())) _exit(4);  // the first SIGINT removed nothing
+  kill(getpid(), SIGINT);
+  for (;;) pause();
+}
+
+}  // namespace
+
+TEST(InterruptDeathTest, WithEndInputOnSigintTheFirstSigintEndsTheInputAndASecondAborts) {
+  testing::ScopedTempDir tmp;
+  EXPECT_EXIT(EndInputThenAbort(tmp.path() / "map"), ::testing::ExitedWithCode(128 + SIGINT),
+              "finishing the map from the frames seen(.|\n)*interrupted");
+  EXPECT_EQ(CountEntries(tmp.path()), 0) << "the second SIGINT removed the unfinished output";
+}
+
+}  // namespace vmap

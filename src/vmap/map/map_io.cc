@@ -25,7 +25,7 @@ json TimestampJson(double t) { return t < 0 ? json(nullptr) : json(t); }
 
 json SizeJson(const cv::Size& s) { return json::array({s.width, s.height}); }
 
-json MapDocument(const VisualMap& map, const std::vector<long>& offsets) {
+json MapDocument(const VisualMap& map, const std::vector<long>& offsets, bool with_evaluations = true) {
   json doc;
   doc["format"] = "vmap-map";
   doc["schema_version"] = kMapSchemaVersion;
@@ -43,6 +43,12 @@ json MapDocument(const VisualMap& map, const std::vector<long>& offsets) {
   doc["num_key_images"] = map.key_images.size();
   doc["quality"] = map.quality;
   doc["seconds"] = map.seconds;
+  if (map.coverage) {
+    doc["coverage"] = {{"frames", map.coverage->num_frames},
+                       {"first_source_index", map.coverage->first_source_index},
+                       {"last_source_index", map.coverage->last_source_index},
+                       {"end", CoverageEndName(map.coverage->end)}};
+  }
   json keys = json::array();
   for (const KeyImage& k : map.key_images) {
     keys.push_back({{"frame_index", k.frame_index},
@@ -77,6 +83,7 @@ json MapDocument(const VisualMap& map, const std::vector<long>& offsets) {
     links.push_back(std::move(link));
   }
   doc["links"] = std::move(links);
+  if (!with_evaluations) return doc;
   // Column-wise: a long sequence has one evaluation per frame or more.
   json ev = {{"key_frame", json::array()}, {"frame", json::array()},    {"similarity", json::array()},
              {"tentative", json::array()}, {"verified", json::array()}, {"matched", json::array()}};
@@ -287,8 +294,63 @@ std::optional<cv::Size> KeyImageFileSize(const fs::path& file) {
 
 std::string MapToJson(const VisualMap& map) { return MapDocument(map, CorrespondenceOffsets(map)).dump(1); }
 
-void WriteMapFiles(const VisualMap& map, const fs::path& directory) {
-  const std::vector<long> offsets = CorrespondenceOffsets(map);
+std::string CoverageEndName(CoverageEnd end) {
+  switch (end) {
+    case CoverageEnd::kInputEnded: return "input ended";
+    case CoverageEnd::kInterrupted: return "interrupted";
+    case CoverageEnd::kSnapshot: return "snapshot";
+  }
+  return "input ended";
+}
+
+namespace {
+
+// One column of the evaluations, as nlohmann's dump(1) writes an array two levels down.
+template <typename Value>
+void WriteEvaluationColumn(std::ostream& out, const EvaluationSource& evaluations, Value value) {
+  bool first = true;
+  out << "[";
+  evaluations([&](const Evaluation& e) {
+    out << (first ? "\n   " : ",\n   ") << value(e);
+    first = false;
+  });
+  out << (first ? "]" : "\n  ]");
+}
+
+}  // namespace
+
+void WriteMapJson(std::ostream& out, const VisualMap& map, const EvaluationSource& streamed) {
+  json doc = MapDocument(map, CorrespondenceOffsets(map), /*with_evaluations=*/false);
+  // The evaluations are written in place of a marker, column by column, exactly as dump(1) writes them (a test
+  // compares the two); "evaluations" sorts before every key whose value a user controls ("input", "options").
+  const std::string marker = "\x01vmap evaluations\x01";
+  doc["evaluations"] = marker;
+  const std::string text = doc.dump(1);
+  const size_t at = text.find(json(marker).dump());
+  const EvaluationSource evaluations = streamed ? streamed : [&map](const std::function<void(const Evaluation&)>& fn) {
+    for (const Evaluation& e : map.evaluations) fn(e);
+  };
+  out.write(text.data(), static_cast<std::streamsize>(at));
+  // Keys in nlohmann's (alphabetical) order.
+  out << "{\n  \"frame\": ";
+  WriteEvaluationColumn(out, evaluations, [](const Evaluation& e) { return e.frame; });
+  out << ",\n  \"key_frame\": ";
+  WriteEvaluationColumn(out, evaluations, [](const Evaluation& e) { return e.key_frame; });
+  out << ",\n  \"matched\": ";
+  WriteEvaluationColumn(out, evaluations, [](const Evaluation& e) { return e.matched ? "true" : "false"; });
+  out << ",\n  \"similarity\": ";
+  WriteEvaluationColumn(out, evaluations, [](const Evaluation& e) { return json(e.similarity).dump(); });
+  out << ",\n  \"tentative\": ";
+  WriteEvaluationColumn(out, evaluations, [](const Evaluation& e) { return e.num_tentative; });
+  out << ",\n  \"verified\": ";
+  WriteEvaluationColumn(out, evaluations, [](const Evaluation& e) { return e.num_verified; });
+  out << "\n }";
+  const size_t after = at + json(marker).dump().size();
+  out.write(text.data() + after, static_cast<std::streamsize>(text.size() - after));
+  out << "\n";
+}
+
+std::string CorrespondencesBinary(const VisualMap& map) {
   std::string binary;
   for (const Link& l : map.links) {
     for (const Correspondence& c : l.correspondences) {
@@ -296,8 +358,14 @@ void WriteMapFiles(const VisualMap& map, const fs::path& directory) {
       binary.append(reinterpret_cast<const char*>(record), sizeof(record));  // x86/ARM: little-endian
     }
   }
-  WriteFileAtomically(directory / kCorrespondencesFileName, binary);
-  WriteFileAtomically(directory / kMapFileName, MapDocument(map, offsets).dump(1) + "\n");
+  return binary;
+}
+
+void WriteMapFiles(const VisualMap& map, const fs::path& directory) {
+  WriteFileAtomically(directory / kCorrespondencesFileName, CorrespondencesBinary(map));
+  std::ostringstream text;
+  WriteMapJson(text, map);
+  WriteFileAtomically(directory / kMapFileName, text.str());
 }
 
 namespace {
@@ -552,6 +620,26 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
   map.skipped_frames = static_cast<int>(fields.Integer(doc, "", "skipped_frames", 0, kMaxInt, 0));
   map.quality = fields.Number(fields.Required(doc, "", "quality"), "quality", 0.0, 1.0);
   map.seconds = fields.Number(doc, "", "seconds", 0.0, 1e9, 0.0);
+  if (const json* coverage = Fields::Find(doc, "coverage")) {
+    fields.Object(*coverage, "coverage");
+    Coverage read;
+    read.num_frames = static_cast<int>(
+        fields.Integer(fields.Required(*coverage, "coverage", "frames"), "coverage.frames", 0, map.num_frames));
+    read.first_source_index = static_cast<int>(fields.Integer(
+        fields.Required(*coverage, "coverage", "first_source_index"), "coverage.first_source_index", -1, kMaxInt));
+    read.last_source_index = static_cast<int>(fields.Integer(
+        fields.Required(*coverage, "coverage", "last_source_index"), "coverage.last_source_index", -1, kMaxInt));
+    const std::string end = fields.String(fields.Required(*coverage, "coverage", "end"), "coverage.end");
+    bool known = false;
+    for (CoverageEnd candidate : {CoverageEnd::kInputEnded, CoverageEnd::kInterrupted, CoverageEnd::kSnapshot}) {
+      if (CoverageEndName(candidate) == end) {
+        read.end = candidate;
+        known = true;
+      }
+    }
+    if (!known) fields.Fail("coverage.end", "must be \"input ended\", \"interrupted\" or \"snapshot\"");
+    map.coverage = read;
+  }
   ReadKeyImages(doc, fields, directory, file, &map);
   ReadLinks(doc, fields, directory, file, &map);
   ReadEvaluations(doc, fields, &map);

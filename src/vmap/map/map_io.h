@@ -12,7 +12,9 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
+#include <ostream>
 #include <string>
 
 #include "vmap/map/visual_map.h"
@@ -32,6 +34,20 @@ inline constexpr long kMaxMatchesPerLink = 1L << 22;           // 4,194,304 corr
 // Writes map.json and correspondences.bin into `directory` (which must exist; key images are written by
 // the builder). Each file is written atomically.
 void WriteMapFiles(const VisualMap& map, const std::filesystem::path& directory);
+
+// Calls its argument with each evaluation of a map, in order; may be called several times (once per column
+// of map.json). A map being built keeps its evaluations in a file (MapWriter) and reads them back this way.
+using EvaluationSource = std::function<void(const std::function<void(const Evaluation&)>&)>;
+
+// map.json as WriteMapFiles writes it, streamed to `out`, with the evaluations from `evaluations` instead of
+// map.evaluations when given: memory does not grow with their number.
+void WriteMapJson(std::ostream& out, const VisualMap& map, const EvaluationSource& evaluations = nullptr);
+
+// correspondences.bin's content for `map`'s links.
+std::string CorrespondencesBinary(const VisualMap& map);
+
+// "input ended", "interrupted", "snapshot" (map.json's coverage.end).
+std::string CoverageEndName(CoverageEnd end);
 
 // The width and height a key-image file's header announces (PNG, or JPEG: a key image copied from the input's
 // own file), as ReadMap checks them; nullopt when the file is neither or cannot be read.

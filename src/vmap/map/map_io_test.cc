@@ -6,6 +6,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <sstream>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -483,6 +484,57 @@ TEST(MapIo, KeyImageFileSizeReadsPngAndJpegHeaders) {
   WriteText(tmp.path() / "text.jpg", "not an image");
   EXPECT_FALSE(KeyImageFileSize(tmp.path() / "text.jpg").has_value());
   EXPECT_FALSE(KeyImageFileSize(tmp.path() / "missing.png").has_value());
+}
+
+}  // namespace vmap
+
+namespace vmap {
+
+// map.json is streamed (WriteMapJson) so that a long build's evaluations never sit in memory as one JSON
+// document; its text must stay what nlohmann's dump(1) of the whole document gives (MapToJson).
+TEST(MapIo, StreamedMapJsonIsTheWholeDocumentsDump) {
+  testing::ScopedTempDir tmp;
+  VisualMap map = SmallMap(tmp.path());
+  map.evaluations.push_back({9, 10, 1.0, 7, 7, true});
+  map.evaluations.push_back({9, 11, 1e-300, 4, 1, true});
+  map.evaluations.push_back({9, 12, 0.1 + 0.2, 40, 12, true});
+  for (bool with_evaluations : {true, false}) {
+    VisualMap variant = map;
+    if (!with_evaluations) variant.evaluations.clear();
+    std::ostringstream streamed;
+    WriteMapJson(streamed, variant);
+    EXPECT_EQ(streamed.str(), MapToJson(variant) + "\n") << with_evaluations;
+  }
+  // The evaluations from elsewhere (a build's file), with the map's own list empty: the same text.
+  VisualMap without = map;
+  without.evaluations.clear();
+  std::ostringstream from_source;
+  WriteMapJson(from_source, without, [&map](const std::function<void(const Evaluation&)>& fn) {
+    for (const Evaluation& e : map.evaluations) fn(e);
+  });
+  EXPECT_EQ(from_source.str(), MapToJson(map) + "\n");
+}
+
+TEST(MapIo, CoverageIsWrittenOnlyWhenKnownAndReadBack) {
+  testing::ScopedTempDir tmp;
+  VisualMap map = SmallMap(tmp.path());
+  WriteMapFiles(map, tmp.path());
+  EXPECT_FALSE(ReadMap(tmp.path()).coverage);
+  EXPECT_FALSE(nlohmann::json::parse(std::ifstream(tmp.path() / kMapFileName)).contains("coverage"));
+  map.coverage = Coverage{20, 100, 119, CoverageEnd::kInterrupted};
+  WriteMapFiles(map, tmp.path());
+  const VisualMap back = ReadMap(tmp.path());
+  ASSERT_TRUE(back.coverage);
+  EXPECT_EQ(back.coverage->num_frames, 20);
+  EXPECT_EQ(back.coverage->first_source_index, 100);
+  EXPECT_EQ(back.coverage->last_source_index, 119);
+  EXPECT_EQ(back.coverage->end, CoverageEnd::kInterrupted);
+  // More frames covered than the map has is malformed.
+  auto doc = nlohmann::json::parse(std::ifstream(tmp.path() / kMapFileName));
+  doc["coverage"]["frames"] = 21;
+  WriteText(tmp.path() / kMapFileName, doc.dump());
+  EXPECT_NE(ErrorOf(tmp.path()).find("'coverage.frames' must be an integer from 0 to 20"), std::string::npos)
+      << ErrorOf(tmp.path());
 }
 
 }  // namespace vmap

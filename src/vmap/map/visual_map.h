@@ -1,6 +1,7 @@
 #pragma once
 // The visual map: key images and the links between consecutive key images (García-Pintos et al. 2023).
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -79,6 +80,17 @@ struct MapStatistics {
   int below_tau_links = 0;      // links whose S is below tau (Link::below_tau)
 };
 
+// Which frames of the input a map covers and why it ends there: recorded (map.json "coverage") for maps
+// of live runs, whose input has no known end: a snapshot written while the run went on, or a map finished when
+// SIGINT ended the input (`vmap build --until-interrupted`).
+enum class CoverageEnd { kInputEnded, kInterrupted, kSnapshot };
+struct Coverage {
+  int num_frames = 0;             // frames processed
+  int first_source_index = -1;    // the first and last of them, as indices in the input (-1: none)
+  int last_source_index = -1;
+  CoverageEnd end = CoverageEnd::kInputEnded;
+};
+
 struct VisualMap {
   SequenceInfo input;
   std::string options_json;  // every option used, as JSON text
@@ -89,6 +101,7 @@ struct VisualMap {
   std::vector<Evaluation> evaluations;
   double quality = 0.0;
   double seconds = 0.0;      // wall time of the build
+  std::optional<Coverage> coverage;  // absent for a map of a whole input (file, folder, dataset)
 };
 
 enum class QualityMean { kArithmetic, kHarmonic };

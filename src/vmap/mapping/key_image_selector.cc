@@ -110,8 +110,12 @@ Link MakeLink(const PairComparison& comparison, int from_key, int to_key, bool b
   return link;
 }
 
-KeyImageSelector::KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image)
-    : options_(options), compare_(std::move(compare)), on_key_image_(std::move(on_key_image)) {
+KeyImageSelector::KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image,
+                                   EvaluationFn on_evaluation)
+    : options_(options),
+      compare_(std::move(compare)),
+      on_key_image_(std::move(on_key_image)),
+      on_evaluation_(std::move(on_evaluation)) {
   options_.Check();
 }
 
@@ -159,8 +163,13 @@ void KeyImageSelector::Add(const FrameRecord& record) {
   // frame is compared again with it, so no frame is skipped.
   for (;;) {
     PairComparison comparison = compare_(*key_, record);
-    evaluations_.push_back({key_->frame->index, record.frame->index, comparison.similarity,
-                            comparison.num_tentative, comparison.num_verified, comparison.matched});
+    const Evaluation evaluation{key_->frame->index,       record.frame->index,       comparison.similarity,
+                                comparison.num_tentative, comparison.num_verified, comparison.matched};
+    if (on_evaluation_) {
+      on_evaluation_(evaluation);
+    } else {
+      evaluations_.push_back(evaluation);
+    }
     if (Passes(comparison)) {
       last_frame_still_ = ShowsKeyView(comparison);
       if (last_frame_still_) {

@@ -82,7 +82,21 @@ class KeyImageSelector {
   // Called once for every new key image, e.g. to write its image file (may set image_file).
   using KeyImageFn = std::function<void(const FrameRecord& record, KeyImage& key)>;
 
-  KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image = nullptr);
+  // Called with every comparison made (what map.json's evaluations hold). When given, the selector does not
+  // keep them (evaluations() stays empty), so that its memory does not grow with the sequence's length.
+  using EvaluationFn = std::function<void(const Evaluation& evaluation)>;
+
+  KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image = nullptr,
+                   EvaluationFn on_evaluation = nullptr);
+
+  // Algorithm 1's successor rule, for those who compare ahead of the selector (MapBuilder's workers): when
+  // frame `failing_frame` falls below tau against the key image at `key_frame`, the next key image is the frame
+  // before it, or the failing frame itself when that is the key (a link below tau). The selector itself may
+  // pick an earlier frame when the last ones repeat the key image's view (min_key_displacement): a guess
+  // then, which the selector's own comparisons correct.
+  static int SuccessorOf(int key_frame, int failing_frame) {
+    return failing_frame - 1 == key_frame ? failing_frame : failing_frame - 1;
+  }
 
   // Frames must arrive in order. The first frame becomes the first key image.
   void Add(const FrameRecord& record);
@@ -105,6 +119,7 @@ class KeyImageSelector {
   KeyImageOptions options_;
   CompareFn compare_;
   KeyImageFn on_key_image_;
+  EvaluationFn on_evaluation_;
   std::optional<FrameRecord> key_;
   std::optional<FrameRecord> previous_;         // the last frame that passed against the key image
   PairComparison previous_comparison_;          // key vs previous_

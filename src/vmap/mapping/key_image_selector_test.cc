@@ -171,3 +171,17 @@ TEST(KeyImageSelector, TauOutsideTheUnitIntervalIsRejected) {
 }
 
 }  // namespace vmap
+
+namespace vmap {
+
+// The successor rule the builder's workers predict with is the one the selector follows (frames with a view
+// of their own): frame 5 fails against key 0, so frame 4 follows; then frame 5 at once fails against key 4.
+TEST(KeyImageSelector, SuccessorOfIsTheKeyImageTheSelectorChooses) {
+  const SelectionRun run = Select(6, 0.5, [](int key, int frame) { return key == 0 && frame < 5 ? 0.9 : 0.1; });
+  ASSERT_EQ(run.keys, (std::vector<int>{0, 4, 5}));
+  EXPECT_EQ(KeyImageSelector::SuccessorOf(0, 5), 4);
+  EXPECT_EQ(KeyImageSelector::SuccessorOf(4, 5), 5);  // the next frame already fails: linked below tau
+  EXPECT_EQ(run.below_tau, (std::vector<bool>{false, true}));
+}
+
+}  // namespace vmap

@@ -21,6 +21,8 @@
 #include "vmap/core/error.h"
 #include "vmap/core/progress.h"
 #include "vmap/map/map_io.h"
+#include "vmap/map/map_writer.h"
+#include "vmap/sources/read_ahead_source.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -84,8 +86,10 @@ struct PipelineItem {
   std::map<int, PairComparison> comparisons;
 };
 
-// Decodes frames on one thread and, on `workers` threads, extracts their features and compares them with
-// the current key images, a few frames ahead of the consumer, which receives them in order.
+// Takes frames from the consumer (TryPush) and, on `workers` threads, extracts their features and compares
+// them with the current key images, a few frames ahead of the consumer, which receives them in order (Next).
+// The frames in flight are bounded by `depth`; the frames come decoded (BuildMap reads them ahead on a thread
+// of their own, ReadAheadSource).
 //
 // Why compare ahead: a frame is compared with the same key image as the frames before it until S drops,
 // so those comparisons do not depend on each other and can run in parallel.
@@ -103,20 +107,38 @@ struct PipelineItem {
 // same whatever the threads do.
 class FeaturePipeline {
  public:
-  FeaturePipeline(FrameSource& source, const Matcher& matcher, int depth, int workers, CompareFn compare)
-      : source_(source), matcher_(matcher), compare_(std::move(compare)), depth_(std::max(depth, workers + 1)) {
+  FeaturePipeline(const Matcher& matcher, int depth, int workers, CompareFn compare)
+      : matcher_(matcher), compare_(std::move(compare)), depth_(std::max(depth, workers + 1)) {
     try {
-      reader_ = std::thread([this] { Guard([this] { ReadFrames(); }); });
       for (int i = 0; i < workers; ++i) workers_.emplace_back([this] { Guard([this] { ExtractFeatures(); }); });
     } catch (const std::system_error& error) {
       // The system refused a thread (a process limit): stop those already started, or their destructors abort.
       Stop();
-      throw InputError("cannot start " + std::to_string(workers + 1) + " threads (" + error.what() +
+      throw InputError("cannot start " + std::to_string(workers) + " threads (" + error.what() +
                        "); use fewer with --threads");
     }
   }
 
   ~FeaturePipeline() { Stop(); }
+
+  // Hands `frame` to the workers, unless `depth` frames are in the pipeline already: then false, and `frame`
+  // is left as it was (take an item out with Next() first). Rethrows a worker's error.
+  bool TryPush(Frame& frame) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (error_) std::rethrow_exception(error_);
+    if (closed_) throw std::logic_error("FeaturePipeline::TryPush after Close");
+    if (InFlight() >= depth_) return false;
+    decoded_.emplace_back(pushed_++, std::move(frame));
+    changed_.notify_all();
+    return true;
+  }
+
+  // No more frames: Next() returns nullopt once every frame pushed has come out.
+  void Close() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    closed_ = true;
+    changed_.notify_all();
+  }
 
   // The key images (distinct) that frames extracted from now on are compared with, each with the thresholds
   // of the selectors holding it: a frame below the lowest makes all of them leave the key.
@@ -126,20 +148,17 @@ class FeaturePipeline {
     current_keys_ = std::move(shared);
   }
 
-  // The next frame, or nullopt at the end. Rethrows a worker's error.
+  // The next frame in order, waiting for it; nullopt at the end (after Close). Rethrows a worker's error.
   std::optional<PipelineItem> Next() {
     std::unique_lock<std::mutex> lock(mutex_);
     changed_.wait(lock, [this] { return error_ || ready_.count(next_out_) || AllDone(); });
-    if (error_) std::rethrow_exception(error_);
-    auto it = ready_.find(next_out_);
-    if (it == ready_.end()) return std::nullopt;
-    PipelineItem item = std::move(it->second);
-    ready_.erase(it);
-    ++next_out_;
-    // A successor is a frame at most a pipeline's depth behind the consumer; keep a margin.
-    recent_.erase(recent_.begin(), recent_.lower_bound(static_cast<int>(next_out_) - 2 * depth_));
-    changed_.notify_all();
-    return item;
+    return TakeNext();
+  }
+
+  // The next frame when it is ready now, otherwise nullopt.
+  std::optional<PipelineItem> TryNext() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return TakeNext();
   }
 
   long extracted() const { return extracted_; }
@@ -164,37 +183,32 @@ class FeaturePipeline {
       stop_ = true;
     }
     changed_.notify_all();
-    if (reader_.joinable()) reader_.join();
     for (std::thread& worker : workers_) worker.join();
   }
 
-  int InFlight() const { return static_cast<int>(decoded_.size() + ready_.size()) + extracting_; }
-  bool AllDone() const { return reader_done_ && decoded_.empty() && extracting_ == 0; }
-
-  void ReadFrames() {
-    for (long sequence = 0;; ++sequence) {
-      {
-        std::unique_lock<std::mutex> lock(mutex_);
-        changed_.wait(lock, [this] { return stop_ || InFlight() < depth_; });
-        if (stop_) break;
-      }
-      std::optional<Frame> frame = source_.Next();
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (!frame) break;
-      decoded_.emplace_back(sequence, std::move(*frame));
-      changed_.notify_all();
-    }
-    std::lock_guard<std::mutex> lock(mutex_);
-    reader_done_ = true;
+  // Call with mutex_ held.
+  std::optional<PipelineItem> TakeNext() {
+    if (error_) std::rethrow_exception(error_);
+    auto it = ready_.find(next_out_);
+    if (it == ready_.end()) return std::nullopt;
+    PipelineItem item = std::move(it->second);
+    ready_.erase(it);
+    ++next_out_;
+    // A successor is a frame at most a pipeline's depth behind the consumer; keep a margin.
+    recent_.erase(recent_.begin(), recent_.lower_bound(static_cast<int>(next_out_) - 2 * depth_));
     changed_.notify_all();
+    return item;
   }
+
+  int InFlight() const { return static_cast<int>(decoded_.size() + ready_.size()) + extracting_; }
+  bool AllDone() const { return closed_ && decoded_.empty() && extracting_ == 0; }
 
   void ExtractFeatures() {
     for (;;) {
       std::pair<long, Frame> decoded;
       {
         std::unique_lock<std::mutex> lock(mutex_);
-        changed_.wait(lock, [this] { return stop_ || !decoded_.empty() || reader_done_; });
+        changed_.wait(lock, [this] { return stop_ || !decoded_.empty() || closed_; });
         if (stop_ || decoded_.empty()) return;
         decoded = std::move(decoded_.front());
         decoded_.pop_front();
@@ -290,15 +304,13 @@ class FeaturePipeline {
   }
 
   // Frame `frame_index` fell below `tau` against the key image `key_index`: the selectors holding it with tau
-  // or a higher threshold leave it here at the latest, for the previous frame (or this one when the previous
-  // is the key: a link below tau).
+  // or a higher threshold leave it here at the latest, for the successor Algorithm 1 gives.
   void Retire(int key_index, int frame_index, double tau) {
-    const int successor = frame_index - 1 == key_index ? frame_index : frame_index - 1;
+    const int successor = KeyImageSelector::SuccessorOf(key_index, frame_index);
     std::lock_guard<std::mutex> lock(mutex_);
     retired_[key_index].push_back(Retirement{frame_index, tau, successor});
   }
 
-  FrameSource& source_;
   const Matcher& matcher_;
   const CompareFn compare_;
   const int depth_;
@@ -315,111 +327,13 @@ class FeaturePipeline {
   std::deque<std::pair<long, Frame>> decoded_;  // read, waiting for a worker
   std::map<long, PipelineItem> ready_;          // extracted, waiting for the consumer
   int extracting_ = 0;
+  long pushed_ = 0;
   long next_out_ = 0;
-  bool reader_done_ = false;
+  bool closed_ = false;
   bool stop_ = false;
   std::exception_ptr error_;
   std::atomic<long> extracted_{0};
-  std::thread reader_;
   std::vector<std::thread> workers_;
-};
-
-// A key image is the input's own file when the frame was decoded from an image file at its size: a copy costs
-// ~0.1 ms and is exactly the input. Other frames (video, resized) are written as PNG with OpenCV's default
-// settings (zlib level 1, run-length strategy): measured 2x faster than level 1 with the default strategy, for
-// files 15 % larger; still ~10 ms for 640x480, hence the thread of its own.
-// Only PNG and JPEG files are kept as they are, and only when their header gives the frame's size: ReadMap
-// checks a key image's size from those headers.
-bool KeepsSourceFile(const Frame& frame) {
-  if (frame.source_path.empty() || frame.resized) return false;
-  std::string extension = fs::path(frame.source_path).extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (extension != ".png" && extension != ".jpg" && extension != ".jpeg") return false;
-  // A JPEG whose EXIF orientation turned it when decoded has another size in its header than the frame: a copy
-  // would not be the frame ReadMap expects.
-  const std::optional<cv::Size> size = KeyImageFileSize(frame.source_path);
-  return size && *size == frame.gray.size();
-}
-
-std::string KeyImageFileName(const Frame& frame) {
-  std::string extension = ".png";
-  if (KeepsSourceFile(frame)) {
-    extension = fs::path(frame.source_path).extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  }
-  return fmt::format("keys/{:06d}{}", frame.index, extension);
-}
-
-// Writes key images on a thread of its own, so that encoding never stalls the consumer, and with it the
-// whole pipeline.
-class KeyImageFileWriter {
- public:
-  KeyImageFileWriter() : thread_([this] { Run(); }) {}
-  // Never throws: when the build failed, a write error no longer matters.
-  ~KeyImageFileWriter() { Join(); }
-
-  // A callback for KeyImageSelector that writes each key image into directory/keys/; null without a directory.
-  KeyImageSelector::KeyImageFn CallbackFor(const fs::path& directory) {
-    if (directory.empty()) return nullptr;
-    // Not create_directories: `directory` is or lies in a temporary output, and once an interruption has
-    // removed that, nothing may bring it back (AtomicOutputDirectory::path()). It must exist.
-    fs::create_directory(directory / "keys");
-    return [this, directory](const FrameRecord& record, KeyImage& key) {
-      key.image_file = KeyImageFileName(*record.frame);
-      std::lock_guard<std::mutex> lock(mutex_);
-      queue_.emplace_back(directory / key.image_file, record.frame);
-      changed_.notify_all();
-    };
-  }
-
-  // Waits for every image to be written; rethrows the first failure.
-  void Finish() {
-    Join();
-    if (error_) std::rethrow_exception(error_);
-  }
-
- private:
-  void Join() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      finished_ = true;
-    }
-    changed_.notify_all();
-    if (thread_.joinable()) thread_.join();
-  }
-
-  void Run() {
-    for (;;) {
-      std::pair<fs::path, std::shared_ptr<const Frame>> job;
-      {
-        std::unique_lock<std::mutex> lock(mutex_);
-        changed_.wait(lock, [this] { return finished_ || !queue_.empty(); });
-        if (queue_.empty()) return;
-        job = std::move(queue_.front());
-        queue_.pop_front();
-      }
-      if (error_) continue;
-      const Frame& frame = *job.second;
-      std::error_code copy_error;
-      const bool written =
-          KeepsSourceFile(frame)
-              ? fs::copy_file(frame.source_path, job.first, fs::copy_options::overwrite_existing, copy_error)
-              : cv::imwrite(job.first.string(), ColorImage(frame));
-      if (!written) {
-        error_ = std::make_exception_ptr(InputError("cannot write key image '" + job.first.string() + "'" +
-                                                    (copy_error ? ": " + copy_error.message() : std::string())));
-      }
-    }
-  }
-
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  std::deque<std::pair<fs::path, std::shared_ptr<const Frame>>> queue_;
-  bool finished_ = false;
-  std::exception_ptr error_;  // written by the thread, read after join
-  std::thread thread_;        // last: starts after every other member exists
 };
 
 // Verifies links in full, on a thread of its own while the build goes on, when the decisions stopped early:
@@ -452,6 +366,13 @@ class LinkVerifier {
     Join();
     if (error_) std::rethrow_exception(error_);
     return static_cast<long>(results_.size());
+  }
+
+  // Waits for every link queued so far (a snapshot applies them); rethrows a failure.
+  void Wait() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [this] { return queue_.empty() && !busy_; });
+    if (error_) std::rethrow_exception(error_);
   }
 
   // Replaces the links of `map`, built with threshold `tau`, by their verifications (after Finish). A verification
@@ -499,15 +420,21 @@ class LinkVerifier {
         if (queue_.empty()) return;
         job = std::move(queue_.front());
         queue_.pop_front();
+        busy_ = true;
       }
-      if (error_) continue;
-      try {
-        PairComparison verified = VerifyMatches(job.matches, job.denominator, verifier_);
-        std::lock_guard<std::mutex> lock(mutex_);
-        results_[job.pair] = std::move(verified);
-      } catch (...) {
-        error_ = std::current_exception();
+      if (!error_) {
+        try {
+          PairComparison verified = VerifyMatches(job.matches, job.denominator, verifier_);
+          std::lock_guard<std::mutex> lock(mutex_);
+          results_[job.pair] = std::move(verified);
+        } catch (...) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          error_ = std::current_exception();
+        }
       }
+      std::lock_guard<std::mutex> lock(mutex_);
+      busy_ = false;
+      changed_.notify_all();
     }
   }
 
@@ -516,6 +443,7 @@ class LinkVerifier {
   std::condition_variable changed_;
   std::deque<Job> queue_;
   std::map<std::pair<int, int>, PairComparison> results_;  // by (from, to) frame index
+  bool busy_ = false;
   bool finished_ = false;
   std::exception_ptr error_;  // written by the thread, read after join
   std::thread thread_;        // last: starts after every other member exists
@@ -613,125 +541,272 @@ VerifierOptions DecisionVerifier(const MapBuilderOptions& options) {
   return verifier;
 }
 
-// Runs one selector per tau over one pass of the source; directories[i] receives tau i's key images.
+}  // namespace
+
+// The streaming state of a build: the pipeline, one selector per tau, the link verifier and the sinks.
+class MapBuilder::Impl {
+ public:
+  Impl(const FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options, std::vector<double> taus,
+       std::vector<MapWriter*> writers, std::string options_json)
+      : source_(source),
+        options_(options),
+        taus_(std::move(taus)),
+        writers_(std::move(writers)),
+        options_json_(std::move(options_json)),
+        start_(std::chrono::steady_clock::now()),
+        verifier_(DecisionVerifier(options)),
+        stops_early_(verifier_.own_magsac),
+        progress_(taus_.size() == 1 ? "build" : "sweep", std::max(0L, source.info().expected_frames), "frames",
+                  ProgressOptions{options.show_progress}) {
+    options_.Check();
+    if (taus_.empty()) throw std::logic_error("MapBuilder without a threshold");
+    writers_.resize(taus_.size(), nullptr);
+    compare_pair_ = [this, &matcher](const FrameRecord& key, const FrameRecord& frame,
+                                     const std::vector<double>& decide_taus, const std::function<bool()>& abandon) {
+      ++pairs_matched_;
+      PairComparison comparison = RethrowAsInputError(
+          [&] {
+            return ErrorContext{"matching frame " + std::to_string(frame.frame->source_index) + " (" +
+                                    frame.frame->source_name + ") with key image " +
+                                    std::to_string(key.frame->source_index) + " (" + key.frame->source_name +
+                                    ") failed",
+                                "check the frames, or try other matcher or verifier options"};
+          },
+          [&] {
+            return ComparePair(matcher, *key.features, *frame.features, verifier_, options_.key_images.similarity,
+                               stops_early_ ? decide_taus : std::vector<double>{}, abandon);
+          });
+      if (comparison.abandoned) ++pairs_abandoned_;
+      return comparison;
+    };
+    for (size_t i = 0; i < taus_.size(); ++i) {
+      KeyImageOptions key_options = options_.key_images;
+      key_options.tau = taus_[i];
+      KeyImageSelector::KeyImageFn on_key_image;
+      KeyImageSelector::EvaluationFn on_evaluation;
+      if (MapWriter* writer = writers_[i]) {
+        on_key_image = [writer](const FrameRecord& record, KeyImage& key) {
+          key.image_file = writer->AddKeyImage(record.frame);
+        };
+        on_evaluation = [writer](const Evaluation& evaluation) { writer->AddEvaluation(evaluation); };
+      }
+      selectors_.push_back(std::make_unique<KeyImageSelector>(key_options, CompareFor(taus_[i]),
+                                                              std::move(on_key_image), std::move(on_evaluation)));
+    }
+    // Links keep a full estimation when the decisions stopped early; queued as soon as each link is made.
+    if (stops_early_) link_verifier_ = std::make_unique<LinkVerifier>(VerifierOptions(verifier_));
+    links_queued_.assign(selectors_.size(), 0);
+    pipeline_ = std::make_unique<FeaturePipeline>(matcher, options_.prefetch_frames, options_.ExtractionThreads(),
+                                                  compare_pair_);
+  }
+
+  void Add(Frame frame) {
+    if (finished_) throw std::logic_error("MapBuilder::Add after Finish");
+    if (first_source_index_ < 0) first_source_index_ = frame.source_index;
+    last_source_index_ = frame.source_index;
+    while (!pipeline_->TryPush(frame)) {
+      std::optional<PipelineItem> item = pipeline_->Next();  // a frame is in flight: one comes out
+      if (!item) throw std::logic_error("FeaturePipeline ended while frames were in flight");
+      Process(*item);
+    }
+    while (std::optional<PipelineItem> item = pipeline_->TryNext()) Process(*item);
+  }
+
+  void Snapshot() {
+    if (finished_) throw std::logic_error("MapBuilder::Snapshot after Finish");
+    if (link_verifier_) link_verifier_->Wait();
+    for (size_t i = 0; i < selectors_.size(); ++i) {
+      // Nothing to write before Algorithm 1 has taken its first frame.
+      if (!writers_[i] || selectors_[i]->key_images().empty()) continue;
+      VisualMap map = CollectMap(*selectors_[i], source_, options_, options_json_, SecondsSince(start_),
+                                 /*analyze_links=*/true, link_verifier_.get(), taus_[i]);
+      map.coverage = CurrentCoverage(CoverageEnd::kSnapshot);
+      writers_[i]->Snapshot(map);
+    }
+  }
+
+  std::vector<VisualMap> Finish(CoverageEnd end, bool analyze_links, bool with_evaluations) {
+    if (finished_) throw std::logic_error("MapBuilder::Finish called twice");
+    finished_ = true;
+    pipeline_->Close();
+    while (std::optional<PipelineItem> item = pipeline_->Next()) Process(*item);
+    progress_.Finish();
+    features_extracted_ = pipeline_->extracted();
+    pipeline_.reset();
+    for (auto& selector : selectors_) selector->Finish();  // the final key images
+    QueueNewLinks();
+    long evaluations = 0;
+    for (const auto& selector : selectors_) evaluations += static_cast<long>(selector->evaluations().size());
+    for (MapWriter* writer : writers_) evaluations += writer ? writer->num_evaluations() : 0;
+    if (link_verifier_) links_verified_ = link_verifier_->Finish();
+    spdlog::debug("{} pairs matched and verified for {} evaluations, {} abandoned; {} links verified in full",
+                  pairs_matched_.load(), evaluations, pairs_abandoned_.load(), links_verified_);
+    const double seconds = SecondsSince(start_);
+    std::vector<VisualMap> maps;
+    for (size_t i = 0; i < selectors_.size(); ++i) {
+      VisualMap map = CollectMap(*selectors_[i], source_, options_, options_json_, seconds, analyze_links,
+                                 link_verifier_.get(), taus_[i]);
+      // A map of a whole file says nothing more (its map.json stays as it was); a live input's says what it
+      // covers.
+      if (end != CoverageEnd::kInputEnded || source_.info().expected_frames < 0) map.coverage = CurrentCoverage(end);
+      if (writers_[i]) writers_[i]->Finish(map, with_evaluations ? &map.evaluations : nullptr);
+      maps.push_back(std::move(map));
+    }
+    return maps;
+  }
+
+  long features_extracted() const { return features_extracted_; }
+  long pairs_matched() const { return pairs_matched_; }
+  long links_verified() const { return links_verified_; }
+  double seconds() const { return SecondsSince(start_); }
+
+ private:
+  // The comparisons of the current frame, by key frame: made ahead by the pipeline, or here when a key image
+  // changed meanwhile or a comparison that stopped early does not answer a selector's tau. A pair compared
+  // under several taus is matched once.
+  KeyImageSelector::CompareFn CompareFor(double tau) {
+    return [this, tau](const FrameRecord& key, const FrameRecord& frame) -> PairComparison {
+      const int key_index = key.frame->index;
+      auto it = comparisons_of_frame_->find(key_index);
+      if (it != comparisons_of_frame_->end() && it->second.Decides(tau)) return it->second;
+      // Settle at once what the other selectors that may ask will need: the holders of the key, or every tau
+      // for a key just chosen (they follow from the same failing frame) or asked again.
+      const auto held = holders_.find(key_index);
+      std::vector<double> asked =
+          it == comparisons_of_frame_->end() && held != holders_.end() ? held->second : taus_;
+      if (std::find(asked.begin(), asked.end(), tau) == asked.end()) asked.push_back(tau);
+      return (*comparisons_of_frame_)[key_index] = compare_pair_(key, frame, asked, nullptr);
+    };
+  }
+
+  void Process(PipelineItem& item) {
+    comparisons_of_frame_ = &item.comparisons;
+    for (auto& selector : selectors_) selector->Add(item.record);
+    comparisons_of_frame_ = nullptr;
+    QueueNewLinks();
+    // Tell the workers which key images the coming frames will be compared with (a handful of shared pointers:
+    // cheaper to publish every frame than to track changes).
+    std::map<int, CurrentKey> keys;  // by key frame index
+    for (size_t i = 0; i < selectors_.size(); ++i) {
+      const FrameRecord* key = selectors_[i]->current_key();
+      if (!key) continue;
+      keys.emplace(key->frame->index, CurrentKey{*key, {}}).first->second.taus.push_back(taus_[i]);
+    }
+    holders_.clear();
+    std::vector<CurrentKey> current;
+    for (auto& [index, key] : keys) {
+      std::sort(key.taus.begin(), key.taus.end());
+      holders_[index] = key.taus;
+      current.push_back(std::move(key));
+    }
+    pipeline_->SetCurrentKeys(std::move(current));
+    progress_.Update(++frames_done_);
+  }
+
+  void QueueNewLinks() {
+    if (!link_verifier_) return;
+    for (size_t i = 0; i < selectors_.size(); ++i) {
+      const KeyImageSelector& selector = *selectors_[i];
+      for (; links_queued_[i] < selector.links().size(); ++links_queued_[i]) {
+        const Link& link = selector.links()[links_queued_[i]];
+        link_verifier_->Add(selector.key_images()[link.from_key], selector.key_images()[link.to_key], link,
+                            options_.key_images.similarity);
+      }
+    }
+  }
+
+  Coverage CurrentCoverage(CoverageEnd end) const {
+    Coverage coverage;
+    coverage.num_frames = selectors_.front()->num_frames();
+    coverage.first_source_index = first_source_index_;
+    coverage.last_source_index = last_source_index_;
+    coverage.end = end;
+    return coverage;
+  }
+
+  const FrameSource& source_;
+  const MapBuilderOptions options_;
+  const std::vector<double> taus_;
+  std::vector<MapWriter*> writers_;
+  const std::string options_json_;
+  const std::chrono::steady_clock::time_point start_;
+  const VerifierOptions verifier_;
+  const bool stops_early_;
+  ProgressLine progress_;
+  CompareFn compare_pair_;
+  std::atomic<long> pairs_matched_{0}, pairs_abandoned_{0};
+  std::map<int, PairComparison>* comparisons_of_frame_ = nullptr;
+  std::map<int, std::vector<double>> holders_;  // key frame index -> taus of the selectors holding it
+  std::vector<std::unique_ptr<KeyImageSelector>> selectors_;
+  std::unique_ptr<LinkVerifier> link_verifier_;
+  std::vector<size_t> links_queued_;
+  long frames_done_ = 0;
+  int first_source_index_ = -1;
+  int last_source_index_ = -1;
+  long features_extracted_ = 0;
+  long links_verified_ = 0;
+  bool finished_ = false;
+  std::unique_ptr<FeaturePipeline> pipeline_;  // last: its workers stop before what they use goes
+};
+
+MapBuilder::MapBuilder(const FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
+                       MapWriter* writer, std::string options_json)
+    : MapBuilder(source, matcher, options, {options.key_images.tau}, {writer}, std::move(options_json)) {}
+
+MapBuilder::MapBuilder(const FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
+                       std::vector<double> taus, std::vector<MapWriter*> writers, std::string options_json) {
+  if (ResolveKeySearch(options) == KeySearch::kBisect) {
+    throw InputError("--search bisect reads ahead of the frames it is given, so it cannot build a map one frame at a "
+                     "time (live inputs, snapshots); use --search sequential");
+  }
+  impl_ = std::make_unique<Impl>(source, matcher, options, std::move(taus), std::move(writers),
+                                 std::move(options_json));
+}
+
+MapBuilder::~MapBuilder() = default;
+
+void MapBuilder::Add(Frame frame) { impl_->Add(std::move(frame)); }
+void MapBuilder::Snapshot() { impl_->Snapshot(); }
+std::vector<VisualMap> MapBuilder::FinishAll(CoverageEnd end, bool analyze_links, bool with_evaluations) {
+  return impl_->Finish(end, analyze_links, with_evaluations);
+}
+VisualMap MapBuilder::Finish(CoverageEnd end) { return std::move(impl_->Finish(end, true, false).front()); }
+long MapBuilder::features_extracted() const { return impl_->features_extracted(); }
+long MapBuilder::pairs_matched() const { return impl_->pairs_matched(); }
+long MapBuilder::links_verified() const { return impl_->links_verified(); }
+
+namespace {
+
+// Runs one selector per tau over one pass of the source; directories[i] receives tau i's map (no directory:
+// the map stays in memory only). Maps returned whole, their evaluations read back from the writers.
 SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
                          const std::vector<double>& taus, const std::vector<fs::path>& directories,
                          std::vector<VisualMap>* maps, const std::string& options_json) {
   options.Check();
-  const auto start = std::chrono::steady_clock::now();
+  std::vector<std::unique_ptr<MapWriter>> writers;
+  std::vector<MapWriter*> sinks;
+  for (const fs::path& directory : directories) {
+    writers.push_back(directory.empty() ? nullptr : std::make_unique<MapWriter>(directory));
+    sinks.push_back(writers.back().get());
+  }
+  // Maps are only written when they are kept (vmap sweep --keep-maps, BuildMap): their links need analysing.
+  const bool analyze_links = maps != nullptr;
+  // Decoding on a thread of its own overlaps with Algorithm 1 on this one (measured: without it, lab_floor's
+  // build took longer, side by side).
+  ReadAheadSource frames(source, options.prefetch_frames);
+  MapBuilder builder(frames, matcher, options, taus, sinks, options_json);
+  while (std::optional<Frame> frame = frames.Next()) builder.Add(std::move(*frame));
+  std::vector<VisualMap> built = builder.FinishAll(CoverageEnd::kInputEnded, analyze_links, /*with_evaluations=*/true);
+
   SweepResult result;
   result.options_json = options_json;
-
-  const VerifierOptions verifier = DecisionVerifier(options);
-  const bool stops_early = verifier.own_magsac;
-  std::atomic<long> pairs_matched{0}, pairs_abandoned{0};
-  const CompareFn compare_pair = [&](const FrameRecord& key, const FrameRecord& frame,
-                                     const std::vector<double>& decide_taus, const std::function<bool()>& abandon) {
-    ++pairs_matched;
-    PairComparison comparison = RethrowAsInputError(
-        [&] {
-          return ErrorContext{"matching frame " + std::to_string(frame.frame->source_index) + " (" +
-                                  frame.frame->source_name + ") with key image " +
-                                  std::to_string(key.frame->source_index) + " (" + key.frame->source_name + ") failed",
-                              "check the frames, or try other matcher or verifier options"};
-        },
-        [&] {
-          return ComparePair(matcher, *key.features, *frame.features, verifier, options.key_images.similarity,
-                             stops_early ? decide_taus : std::vector<double>{}, abandon);
-        });
-    if (comparison.abandoned) ++pairs_abandoned;
-    return comparison;
-  };
-  // The comparisons of the current frame, by key frame: made ahead by the pipeline, or here when a key image
-  // changed meanwhile or a comparison that stopped early does not answer a selector's tau. A pair compared
-  // under several taus is matched once.
-  std::map<int, PairComparison>* comparisons_of_frame = nullptr;
-  std::map<int, std::vector<double>> holders;  // key frame index -> taus of the selectors holding it
-  auto compare_for = [&](double tau) -> KeyImageSelector::CompareFn {
-    return [&, tau](const FrameRecord& key, const FrameRecord& frame) -> PairComparison {
-      const int key_index = key.frame->index;
-      auto it = comparisons_of_frame->find(key_index);
-      if (it != comparisons_of_frame->end() && it->second.Decides(tau)) return it->second;
-      // Settle at once what the other selectors that may ask will need: the holders of the key, or every tau
-      // for a key just chosen (they follow from the same failing frame) or asked again.
-      const auto held = holders.find(key_index);
-      std::vector<double> asked = it == comparisons_of_frame->end() && held != holders.end() ? held->second : taus;
-      if (std::find(asked.begin(), asked.end(), tau) == asked.end()) asked.push_back(tau);
-      return (*comparisons_of_frame)[key_index] = compare_pair(key, frame, asked, nullptr);
-    };
-  };
-  KeyImageFileWriter image_writer;
-  std::vector<std::unique_ptr<KeyImageSelector>> selectors;
-  for (size_t i = 0; i < taus.size(); ++i) {
-    KeyImageOptions key_options = options.key_images;
-    key_options.tau = taus[i];
-    selectors.push_back(
-        std::make_unique<KeyImageSelector>(key_options, compare_for(taus[i]), image_writer.CallbackFor(directories[i])));
-  }
-  // Links keep a full estimation when the decisions stopped early; queued as soon as each link is made.
-  std::unique_ptr<LinkVerifier> link_verifier;
-  if (stops_early) link_verifier = std::make_unique<LinkVerifier>(VerifierOptions(verifier));
-  std::vector<size_t> links_queued(selectors.size(), 0);
-  auto queue_new_links = [&] {
-    if (!link_verifier) return;
-    for (size_t i = 0; i < selectors.size(); ++i) {
-      const KeyImageSelector& selector = *selectors[i];
-      for (; links_queued[i] < selector.links().size(); ++links_queued[i]) {
-        const Link& link = selector.links()[links_queued[i]];
-        link_verifier->Add(selector.key_images()[link.from_key], selector.key_images()[link.to_key], link,
-                           options.key_images.similarity);
-      }
-    }
-  };
-
-  {
-    FeaturePipeline pipeline(source, matcher, options.prefetch_frames, options.ExtractionThreads(), compare_pair);
-    ProgressOptions progress_options;
-    progress_options.enabled = options.show_progress;
-    ProgressLine progress(taus.size() == 1 ? "build" : "sweep", source.info().expected_frames, "frames",
-                          progress_options);
-    long done = 0;
-    while (std::optional<PipelineItem> item = pipeline.Next()) {
-      comparisons_of_frame = &item->comparisons;
-      for (auto& selector : selectors) selector->Add(item->record);
-      queue_new_links();
-      // Tell the workers which key images the coming frames will be compared with (a handful of
-      // shared pointers: cheaper to publish every frame than to track changes).
-      std::map<int, CurrentKey> keys;  // by key frame index
-      for (size_t i = 0; i < selectors.size(); ++i) {
-        const FrameRecord* key = selectors[i]->current_key();
-        if (!key) continue;
-        keys.emplace(key->frame->index, CurrentKey{*key, {}}).first->second.taus.push_back(taus[i]);
-      }
-      holders.clear();
-      std::vector<CurrentKey> current;
-      for (auto& [index, key] : keys) {
-        std::sort(key.taus.begin(), key.taus.end());
-        holders[index] = key.taus;
-        current.push_back(std::move(key));
-      }
-      pipeline.SetCurrentKeys(std::move(current));
-      progress.Update(++done);
-    }
-    progress.Finish();
-    result.features_extracted = pipeline.extracted();
-  }
-  for (auto& selector : selectors) selector->Finish();  // the final key images
-  queue_new_links();
-  image_writer.Finish();
-  result.pairs_matched = pairs_matched;
-  long evaluations = 0;
-  for (const auto& selector : selectors) evaluations += static_cast<long>(selector->evaluations().size());
-  if (link_verifier) result.links_verified = link_verifier->Finish();
-  spdlog::debug("{} pairs matched and verified for {} evaluations, {} abandoned; {} links verified in full",
-                result.pairs_matched, evaluations, pairs_abandoned.load(), result.links_verified);
-
-  const double seconds = SecondsSince(start);
-  result.input = source.info();
-  result.seconds = seconds;
-  for (size_t i = 0; i < selectors.size(); ++i) {
-    VisualMap map = CollectMap(*selectors[i], source, options, options_json, seconds, maps != nullptr,
-                               link_verifier.get(), taus[i]);
+  result.input = frames.info();
+  result.features_extracted = builder.features_extracted();
+  result.pairs_matched = builder.pairs_matched();
+  result.links_verified = builder.links_verified();
+  for (size_t i = 0; i < built.size(); ++i) {
+    VisualMap& map = built[i];
+    result.seconds = std::max(result.seconds, map.seconds);
     const MapStatistics stats = ComputeStatistics(map, options.quality_mean);
     result.num_frames = map.num_frames;
     SweepRow row;
@@ -837,7 +912,14 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
     return -1;
   };
 
-  KeyImageFileWriter image_writer;
+  std::unique_ptr<MapWriter> writer;
+  if (!directory.empty()) writer = std::make_unique<MapWriter>(directory);
+  KeyImageSelector::KeyImageFn on_key_image;
+  if (writer) {
+    on_key_image = [&writer](const FrameRecord& record, KeyImage& key) {
+      key.image_file = writer->AddKeyImage(record.frame);
+    };
+  }
   KeyImageSelector selector(
       options.key_images,
       [&](const FrameRecord& key, const FrameRecord& frame) {
@@ -845,7 +927,7 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
         if (it != comparisons.end()) return it->second;
         return remember(key.frame->index, frame.frame->index, compare(key, frame));
       },
-      image_writer.CallbackFor(directory));
+      on_key_image);
   std::unique_ptr<LinkVerifier> link_verifier;
   if (verifier.own_magsac) link_verifier = std::make_unique<LinkVerifier>(VerifierOptions(verifier));
 
@@ -893,7 +975,6 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
   }
   progress.Finish();
   selector.Finish();
-  image_writer.Finish();
   if (link_verifier) {
     for (const Link& link : selector.links()) {
       link_verifier->Add(selector.key_images()[link.from_key], selector.key_images()[link.to_key], link,
@@ -907,6 +988,14 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
   map.evaluations = std::move(evaluations);
   map.quality = ComputeStatistics(map, options.quality_mean).quality;
   spdlog::debug("bisect search: {} comparisons for {} frames", map.evaluations.size(), map.num_frames);
+  if (writer) {
+    // The search compares frames out of order and keeps its comparisons anyway (a window's worth): its
+    // evaluations go to the writer at the end, in the order made.
+    for (const Evaluation& evaluation : map.evaluations) writer->AddEvaluation(evaluation);
+    VisualMap written = map;
+    written.evaluations.clear();
+    writer->Finish(written);
+  }
   return map;
 }
 

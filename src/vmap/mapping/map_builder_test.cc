@@ -9,6 +9,9 @@
 
 #include "vmap/core/error.h"
 #include "vmap/features/orb_matcher.h"
+#include "vmap/map/map_io.h"
+#include "vmap/map/map_writer.h"
+#include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {
@@ -222,6 +225,68 @@ TEST(MapBuilder, ParsesThresholdRanges) {
   EXPECT_THROW(ParseThresholds("0.1:1.5:0.2"), InputError);
   EXPECT_THROW(ParseThresholds("abc"), InputError);
   EXPECT_THROW(ParseThresholds("0.5:0.1:0.1"), InputError);
+}
+
+}  // namespace vmap
+
+namespace vmap {
+
+// The incremental builder with a map sink: the map it writes is BuildMap's, its evaluations stay out of memory
+// (they are in map.json, not in the map returned), and a snapshot taken half-way is a map ReadMap accepts.
+TEST(MapBuilder, WritesThroughItsSinkWithoutKeepingEvaluationsAndSnapshotsHalfWay) {
+  const auto matcher = CreateOrbMatcher({});
+  MemorySource reference_source(Sequence().frames);
+  const VisualMap expected = BuildMap(reference_source, *matcher, Options(0.7));
+  ASSERT_GT(expected.key_images.size(), 3u);
+
+  testing::ScopedTempDir tmp;
+  const fs::path final_path = tmp.path() / "map";
+  OutputPolicy policy;
+  policy.why_not_ours = WhyNotAVmapMap;
+  AtomicOutputDirectory output(final_path, policy);
+  MemorySource source(Sequence().frames);
+  MapWriter writer(output.path(), SnapshotTarget{final_path, policy});
+  MapBuilder builder(source, *matcher, Options(0.7), &writer);
+  const int half = static_cast<int>(Sequence().frames.size()) / 2;
+  for (int i = 0; i < half; ++i) builder.Add(*source.Next());
+  builder.Snapshot();
+  const VisualMap snapshot = ReadMap(final_path);
+  EXPECT_GE(snapshot.num_frames, 1);
+  EXPECT_LE(snapshot.num_frames, half);  // the frames Algorithm 1 has taken so far
+  ASSERT_TRUE(snapshot.coverage);
+  EXPECT_EQ(snapshot.coverage->end, CoverageEnd::kSnapshot);
+  EXPECT_EQ(snapshot.coverage->first_source_index, 0);
+  // Its key images are the first ones of the finished map.
+  ASSERT_LE(snapshot.key_images.size(), expected.key_images.size());
+  for (size_t k = 0; k < snapshot.key_images.size(); ++k) {
+    EXPECT_EQ(snapshot.key_images[k].frame_index, expected.key_images[k].frame_index);
+  }
+  while (std::optional<Frame> frame = source.Next()) builder.Add(std::move(*frame));
+  const VisualMap map = builder.Finish();
+  EXPECT_TRUE(map.evaluations.empty()) << "the evaluations went to the sink";
+  EXPECT_FALSE(map.coverage) << "a whole input of known length";
+  output.Commit();
+
+  const VisualMap written = ReadMap(final_path);
+  ASSERT_EQ(written.key_images.size(), expected.key_images.size());
+  for (size_t k = 0; k < expected.key_images.size(); ++k) {
+    EXPECT_EQ(written.key_images[k].frame_index, expected.key_images[k].frame_index);
+  }
+  ASSERT_EQ(written.evaluations.size(), expected.evaluations.size());
+  for (size_t i = 0; i < expected.evaluations.size(); ++i) {
+    EXPECT_EQ(written.evaluations[i].frame, expected.evaluations[i].frame);
+    EXPECT_EQ(written.evaluations[i].num_verified, expected.evaluations[i].num_verified);
+  }
+  EXPECT_EQ(written.links.size(), expected.links.size());
+  EXPECT_FALSE(fs::exists(final_path / kEvaluationsSpillFileName));
+}
+
+TEST(MapBuilder, RefusesTheBisectSearch) {
+  const auto matcher = CreateOrbMatcher({});
+  MemorySource source(Sequence().frames);
+  MapBuilderOptions options = Options(0.5);
+  options.key_search = KeySearch::kBisect;
+  EXPECT_THROW(MapBuilder(source, *matcher, options), InputError);
 }
 
 }  // namespace vmap

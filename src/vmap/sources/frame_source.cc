@@ -51,6 +51,24 @@ void FrameSourceOptions::Check() const {
     throw InputError("max_frame_pixels must be at least " + std::to_string(kMinFrameSide * kMinFrameSide));
   }
   if (!resize.empty()) internal::TargetSize(cv::Size(640, 480), *this);  // validates the text
+  if (!(stream_timeout_seconds > 0.0 && stream_timeout_seconds <= 3600.0)) {
+    throw InputError("stream_timeout_seconds must be in (0, 3600]");
+  }
+}
+
+namespace internal {
+
+bool IsStreamUrl(const std::string& path) {
+  for (const char* scheme : {"udp://", "rtp://", "rtsp://", "rtsps://", "tcp://", "http://", "https://", "srt://"}) {
+    if (path.rfind(scheme, 0) == 0) return true;
+  }
+  return false;
+}
+
+}  // namespace internal
+
+bool IsLiveInput(const std::string& path) {
+  return internal::IsStreamUrl(path) || path.rfind("/dev/video", 0) == 0;
 }
 
 bool NaturalLess(const std::string& a, const std::string& b) {
@@ -203,6 +221,12 @@ class CameraSource : public FrameSource {
 };
 
 std::unique_ptr<FrameSource> OpenDetectedFrameSource(const std::string& path, const FrameSourceOptions& options) {
+  if (IsLiveInput(path)) {
+    std::unique_ptr<FrameSource> live = internal::IsStreamUrl(path) ? internal::OpenStream(path, options)
+                                                                    : internal::OpenV4l2Camera(path, options);
+    if (options.camera.empty() || options.camera == "none") return live;
+    return std::make_unique<CameraSource>(std::move(live), ParseCameraOption(options.camera));
+  }
   std::error_code ec;
   if (!fs::exists(path, ec)) {
     throw InputError("input '" + path + "' does not exist; give a video file, an image folder, or a TUM/EuRoC/KITTI sequence");

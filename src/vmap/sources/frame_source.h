@@ -2,6 +2,7 @@
 // Frame sources: a sequence of images streamed one at a time from a video file, an image folder, or a
 // dataset layout (TUM RGB-D, EuRoC, KITTI odometry). Memory stays flat however long the sequence is.
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -44,6 +45,12 @@ struct FrameSourceOptions {
   // A single image file is a sequence of one frame (vmap localize takes one query image); otherwise it is an
   // error, since one frame makes no map.
   bool allow_single_image = false;
+  // Live inputs (IsLiveInput): polled while the source waits for data; when it returns true the source ends
+  // as if the input had ended (`vmap build --until-interrupted` passes InputEndRequested).
+  std::function<bool()> stop_requested;
+  // Live inputs: a stream that sends nothing for this long has ended (a network sender that stopped, a
+  // camera that was unplugged); also how long opening one may take.
+  double stream_timeout_seconds = 10.0;
 
   void Check() const;  // throws InputError naming the bad option
 };
@@ -81,6 +88,11 @@ class FrameSource {
   // inside a video, a damaged image file), or one of a degenerate size or too many pixels.
   virtual int skipped_frames() const { return 0; }
 };
+
+// Whether `path` names a live input, with no known end or frame count: a network stream URL (udp://, rtp://,
+// rtsp://, rtsps://, tcp://, http://, https://, srt://), read through FFmpeg, or a V4L2 camera device
+// (/dev/video0), read through OpenCV. OpenFrameSource opens these too.
+bool IsLiveInput(const std::string& path);
 
 // Detects the layout of `path` (or uses options.format) and opens it. Throws InputError with a message
 // that names the path and says what to do when it cannot.

@@ -25,6 +25,11 @@ std::vector<ImageEntry> ListKitti(const std::string& sequence_directory);
 std::unique_ptr<FrameSource> OpenImageList(std::vector<ImageEntry> entries, const std::string& path,
                                            SourceFormat format, const FrameSourceOptions& options);
 std::unique_ptr<FrameSource> OpenVideo(const std::string& path, const FrameSourceOptions& options);
+// A network stream URL (IsLiveInput), through FFmpeg like a video file, with no frame count.
+std::unique_ptr<FrameSource> OpenStream(const std::string& url, const FrameSourceOptions& options);
+// A V4L2 camera device such as /dev/video0.
+std::unique_ptr<FrameSource> OpenV4l2Camera(const std::string& device, const FrameSourceOptions& options);
+bool IsStreamUrl(const std::string& path);
 
 // Size frames are delivered at, given the first frame's native size and the --resize option. Throws
 // InputError when --resize is malformed or out of its range, or would make these frames degenerate.

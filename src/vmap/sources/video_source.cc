@@ -14,6 +14,7 @@ extern "C" {
 #include <libswscale/swscale.h>
 }
 
+#include <chrono>
 #include <cmath>
 #include <memory>
 
@@ -49,10 +50,14 @@ struct ScalerFreer {
 
 class VideoSource : public FrameSource {
  public:
-  VideoSource(const std::string& path, const FrameSourceOptions& options) : options_(options) {
+  // `live`: a network stream (IsLiveInput): no frame count, waits bounded by options.stream_timeout_seconds
+  // and interruptible through options.stop_requested.
+  VideoSource(const std::string& path, const FrameSourceOptions& options, bool live)
+      : options_(options), live_(live) {
     info_.path = path;
     info_.format = SourceFormat::kVideo;
     // FFmpeg's own log is the host's to set: InitializeRuntime() (core/runtime.h) silences it for vmap.
+    if (live_) avformat_network_init();  // reference-counted by FFmpeg; what rtsp/https need
     Open(path);
     const AVStream* stream = format_->streams[stream_index_];
     clockwise_rotation_ = ClockwiseRotation(*stream);
@@ -63,6 +68,7 @@ class VideoSource : public FrameSource {
     } else if (stream->duration > 0 && info_.fps > 0) {
       frame_count_ = std::lround(stream->duration * av_q2d(stream->time_base) * info_.fps);
     }
+    if (live_) frame_count_ = -1;  // what a stream announces is not what it will send
     if (frame_count_ > 0) {
       long end = options.last >= 0 ? std::min<long>(options.last + 1, frame_count_) : frame_count_;
       info_.expected_frames = end > options.first ? (end - options.first + options.stride - 1) / options.stride : 0;
@@ -107,14 +113,34 @@ class VideoSource : public FrameSource {
 
  private:
   [[noreturn]] void CannotOpen(const std::string& path) const {
+    if (live_) {
+      throw InputError(fmt::format("cannot open stream '{}': no video FFmpeg can decode arrived within {:g} s; check "
+                                   "that the sender is running and the URL (scheme, address, port)",
+                                   path, options_.stream_timeout_seconds));
+    }
     throw InputError("cannot open video '" + path +
                      "': it is not a video FFmpeg can decode, or it is truncated or corrupt; check the file "
                      "(ffprobe) or convert it to MP4");
   }
 
+  // FFmpeg polls this while it waits for data: a live stream that sent nothing for the timeout, or whose run
+  // was asked to end, ends (reads fail as at the end of a file).
+  static int InterruptCallback(void* opaque) {
+    const VideoSource& self = *static_cast<const VideoSource*>(opaque);
+    if (self.options_.stop_requested && self.options_.stop_requested()) return 1;
+    const double idle = std::chrono::duration<double>(std::chrono::steady_clock::now() - self.last_data_).count();
+    return idle > self.options_.stream_timeout_seconds ? 1 : 0;
+  }
+
   void Open(const std::string& path) {
-    AVFormatContext* format = nullptr;
-    if (avformat_open_input(&format, path.c_str(), nullptr, nullptr) < 0) CannotOpen(path);
+    AVFormatContext* format = avformat_alloc_context();
+    if (!format) throw std::bad_alloc();
+    if (live_) {
+      last_data_ = std::chrono::steady_clock::now();
+      format->interrupt_callback.callback = &VideoSource::InterruptCallback;
+      format->interrupt_callback.opaque = this;
+    }
+    if (avformat_open_input(&format, path.c_str(), nullptr, nullptr) < 0) CannotOpen(path);  // frees `format`
     format_.reset(format);
     if (avformat_find_stream_info(format_.get(), nullptr) < 0) CannotOpen(path);
     const AVCodec* codec = nullptr;
@@ -151,6 +177,7 @@ class VideoSource : public FrameSource {
       if (draining_) return false;
       // The decoder needs more input.
       const int read = av_read_frame(format_.get(), packet_.get());
+      if (read >= 0 && live_) last_data_ = std::chrono::steady_clock::now();
       if (read < 0) {
         draining_ = true;
         avcodec_send_packet(codec_.get(), nullptr);  // flush the frames the decoder still holds
@@ -208,6 +235,11 @@ class VideoSource : public FrameSource {
   }
 
   std::optional<Frame> Finish() {
+    if (delivered_ == 0 && live_) {
+      throw InputError(fmt::format("stream '{}' ended before its first frame could be decoded; check that the "
+                                   "sender sends video, and that key frames come often enough (e.g. ffmpeg -g 10)",
+                                   info_.path));
+    }
     if (delivered_ == 0) {
       throw InputError("video '" + info_.path +
                        "' has no decodable frame in the requested range; it may be truncated or empty, or --first is "
@@ -224,6 +256,8 @@ class VideoSource : public FrameSource {
   }
 
   FrameSourceOptions options_;
+  const bool live_;
+  std::chrono::steady_clock::time_point last_data_;  // live: when the stream last delivered a packet
   SequenceInfo info_;
   std::unique_ptr<AVFormatContext, FormatCloser> format_;
   std::unique_ptr<AVCodecContext, CodecFreer> codec_;
@@ -244,7 +278,11 @@ class VideoSource : public FrameSource {
 }  // namespace
 
 std::unique_ptr<FrameSource> OpenVideo(const std::string& path, const FrameSourceOptions& options) {
-  return std::make_unique<VideoSource>(path, options);
+  return std::make_unique<VideoSource>(path, options, /*live=*/false);
+}
+
+std::unique_ptr<FrameSource> OpenStream(const std::string& url, const FrameSourceOptions& options) {
+  return std::make_unique<VideoSource>(url, options, /*live=*/true);
 }
 
 }  // namespace vmap::internal
