@@ -157,7 +157,7 @@ struct LiveRun {
     ASSERT_TRUE(vmap->started());
     ASSERT_TRUE(WaitFor([&] { return Listening(port) || !vmap->running(); }, 20)) << Read(tmp.path() / "vmap.log");
     ASSERT_TRUE(vmap->running()) << Read(tmp.path() / "vmap.log");
-    const std::string video = (testing::SharedDir() / "data/lab_floor/lab_floor.mp4").string();
+    const std::string video = (fs::path(testing::SharedDir()) / "data/lab_floor/lab_floor.mp4").string();
     sender = std::make_unique<Child>(
         std::vector<std::string>{"ffmpeg", "-nostdin", "-loglevel", "error", "-re", "-i", video, "-t",
                                  fmt::format("{}", seconds), "-an", "-c:v", "mpeg2video", "-q:v", "4", "-g", "10",
