@@ -2,18 +2,14 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <condition_variable>
 #include <cstring>
-#include <deque>
-#include <exception>
 #include <fstream>
-#include <mutex>
-#include <thread>
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/core/serial_worker.h"
 #include "vmap/map/map_io.h"
 
 namespace vmap {
@@ -60,72 +56,24 @@ std::string KeyImageFileName(const Frame& frame) {
 // pipeline.
 class MapWriter::KeyImageFiles {
  public:
-  KeyImageFiles() : thread_([this] { Run(); }) {}
-  ~KeyImageFiles() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      finished_ = true;
-    }
-    changed_.notify_all();
-    if (thread_.joinable()) thread_.join();
-  }
-
   void Add(fs::path file, std::shared_ptr<const Frame> frame) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    queue_.emplace_back(std::move(file), std::move(frame));
-    changed_.notify_all();
+    worker_.Post([file = std::move(file), frame = std::move(frame)] {
+      std::error_code copy_error;
+      const bool written = KeepsSourceFile(*frame)
+                               ? fs::copy_file(frame->source_path, file, fs::copy_options::overwrite_existing, copy_error)
+                               : cv::imwrite(file.string(), ColorImage(*frame));
+      if (!written) {
+        throw InputError("cannot write key image '" + file.string() + "'" +
+                         (copy_error ? ": " + copy_error.message() : std::string()));
+      }
+    });
   }
 
   // Waits until every image queued so far is written; rethrows the first failure.
-  void Flush() {
-    std::unique_lock<std::mutex> lock(mutex_);
-    changed_.wait(lock, [this] { return queue_.empty() && !busy_; });
-    if (error_) std::rethrow_exception(error_);
-  }
+  void Flush() { worker_.Wait(); }
 
  private:
-  void Run() {
-    for (;;) {
-      std::pair<fs::path, std::shared_ptr<const Frame>> job;
-      {
-        std::unique_lock<std::mutex> lock(mutex_);
-        changed_.wait(lock, [this] { return finished_ || !queue_.empty(); });
-        if (queue_.empty()) return;
-        job = std::move(queue_.front());
-        queue_.pop_front();
-        busy_ = true;
-      }
-      std::exception_ptr error;
-      {
-        std::lock_guard<std::mutex> lock(mutex_);
-        error = error_;
-      }
-      if (!error) {
-        const Frame& frame = *job.second;
-        std::error_code copy_error;
-        const bool written =
-            KeepsSourceFile(frame)
-                ? fs::copy_file(frame.source_path, job.first, fs::copy_options::overwrite_existing, copy_error)
-                : cv::imwrite(job.first.string(), ColorImage(frame));
-        if (!written) {
-          error = std::make_exception_ptr(InputError("cannot write key image '" + job.first.string() + "'" +
-                                                     (copy_error ? ": " + copy_error.message() : std::string())));
-        }
-      }
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (!error_) error_ = error;
-      busy_ = false;
-      changed_.notify_all();
-    }
-  }
-
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  std::deque<std::pair<fs::path, std::shared_ptr<const Frame>>> queue_;
-  bool busy_ = false;
-  bool finished_ = false;
-  std::exception_ptr error_;
-  std::thread thread_;  // last: starts after every other member exists
+  SerialWorker worker_;
 };
 
 MapWriter::MapWriter(fs::path directory, std::optional<SnapshotTarget> snapshots)

@@ -20,6 +20,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/core/progress.h"
+#include "vmap/core/serial_worker.h"
 #include "vmap/map/map_io.h"
 #include "vmap/map/map_writer.h"
 #include "vmap/sources/read_ahead_source.h"
@@ -341,38 +342,37 @@ class FeaturePipeline {
 // matches (no matching, no features kept). A link shared by several taus (same two frames) is verified once.
 class LinkVerifier {
  public:
-  explicit LinkVerifier(const VerifierOptions& verifier) : verifier_(verifier), thread_([this] { Run(); }) {}
-  ~LinkVerifier() { Join(); }
+  explicit LinkVerifier(const VerifierOptions& verifier) : verifier_(verifier) {}
 
   // Queues `link`, between key images `from` and `to`, unless that pair of frames is queued already.
   void Add(const KeyImage& from, const KeyImage& to, const Link& link, SimilarityMode similarity) {
     const auto pair = std::make_pair(from.frame_index, to.frame_index);
-    Job job;
-    for (const Correspondence& c : link.correspondences) {
-      job.matches.points0.push_back(c.p0);
-      job.matches.points1.push_back(c.p1);
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!results_.emplace(pair, PairComparison{}).second) return;
     }
-    job.denominator = similarity == SimilarityMode::kInlierRatio ? link.num_tentative
-                                                                 : std::max(from.num_features, to.num_features);
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!results_.emplace(pair, PairComparison{}).second) return;
-    job.pair = pair;
-    queue_.push_back(std::move(job));
-    changed_.notify_all();
-  }
-
-  // Waits for every verification; rethrows a failure. Returns how many links were verified.
-  long Finish() {
-    Join();
-    if (error_) std::rethrow_exception(error_);
-    return static_cast<long>(results_.size());
+    TentativeMatches matches;
+    for (const Correspondence& c : link.correspondences) {
+      matches.points0.push_back(c.p0);
+      matches.points1.push_back(c.p1);
+    }
+    const int denominator = similarity == SimilarityMode::kInlierRatio
+                                ? link.num_tentative
+                                : std::max(from.num_features, to.num_features);
+    worker_.Post([this, pair, matches = std::move(matches), denominator] {
+      PairComparison verified = VerifyMatches(matches, denominator, verifier_);
+      std::lock_guard<std::mutex> lock(mutex_);
+      results_[pair] = std::move(verified);
+    });
   }
 
   // Waits for every link queued so far (a snapshot applies them); rethrows a failure.
-  void Wait() {
-    std::unique_lock<std::mutex> lock(mutex_);
-    changed_.wait(lock, [this] { return queue_.empty() && !busy_; });
-    if (error_) std::rethrow_exception(error_);
+  void Wait() { worker_.Wait(); }
+
+  // Waits for every verification; rethrows a failure. Returns how many links were verified.
+  long Finish() {
+    worker_.Wait();
+    return static_cast<long>(results_.size());
   }
 
   // Replaces the links of `map`, built with threshold `tau`, by their verifications (after Finish). A verification
@@ -396,57 +396,10 @@ class LinkVerifier {
   }
 
  private:
-  struct Job {
-    std::pair<int, int> pair;
-    TentativeMatches matches;
-    int denominator = 0;
-  };
-
-  void Join() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      finished_ = true;
-    }
-    changed_.notify_all();
-    if (thread_.joinable()) thread_.join();
-  }
-
-  void Run() {
-    for (;;) {
-      Job job;
-      {
-        std::unique_lock<std::mutex> lock(mutex_);
-        changed_.wait(lock, [this] { return finished_ || !queue_.empty(); });
-        if (queue_.empty()) return;
-        job = std::move(queue_.front());
-        queue_.pop_front();
-        busy_ = true;
-      }
-      if (!error_) {
-        try {
-          PairComparison verified = VerifyMatches(job.matches, job.denominator, verifier_);
-          std::lock_guard<std::mutex> lock(mutex_);
-          results_[job.pair] = std::move(verified);
-        } catch (...) {
-          std::lock_guard<std::mutex> lock(mutex_);
-          error_ = std::current_exception();
-        }
-      }
-      std::lock_guard<std::mutex> lock(mutex_);
-      busy_ = false;
-      changed_.notify_all();
-    }
-  }
-
   const VerifierOptions verifier_;
   std::mutex mutex_;
-  std::condition_variable changed_;
-  std::deque<Job> queue_;
   std::map<std::pair<int, int>, PairComparison> results_;  // by (from, to) frame index
-  bool busy_ = false;
-  bool finished_ = false;
-  std::exception_ptr error_;  // written by the thread, read after join
-  std::thread thread_;        // last: starts after every other member exists
+  SerialWorker worker_;  // last: destroyed first, so its jobs never outlive results_
 };
 
 // `link_verifier` (when the decisions stopped early): the links verified in full replace the deciding ones.
