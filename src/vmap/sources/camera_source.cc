@@ -68,11 +68,7 @@ class V4l2CameraSource : public FrameSource {
       frame.source_index = static_cast<int>(index);
       frame.source_name = fmt::format("frame_{:06d}", index);
       frame.timestamp = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-      if (frame.index == 0) {
-        info_.native_size = frame.gray.size();
-        info_.frame_size = TargetSize(info_.native_size, options_);
-      }
-      FitFrame(frame, info_.frame_size, info_.native_size, options_, &size_warnings_);
+      FitToSequence(frame, &info_, options_, &size_warnings_);
       return frame;
     }
   }

@@ -189,6 +189,14 @@ void FitFrame(Frame& frame, const cv::Size& target, const cv::Size& first_native
   if (!frame.color.empty()) cv::resize(frame.color, frame.color, target, 0, 0, interpolation);
 }
 
+void FitToSequence(Frame& frame, SequenceInfo* info, const FrameSourceOptions& options, int* warnings) {
+  if (frame.index == 0) {
+    info->native_size = frame.gray.size();
+    info->frame_size = TargetSize(info->native_size, options);
+  }
+  FitFrame(frame, info->frame_size, info->native_size, options, warnings);
+}
+
 }  // namespace internal
 
 namespace {

@@ -56,11 +56,7 @@ class ImageListSource : public FrameSource {
       frame.timestamp = entry.timestamp;
       frame.source_path = entry.path;
       frame.source_name = std::filesystem::path(entry.path).filename().string();
-      if (frame.index == 0) {
-        info_.native_size = frame.gray.size();
-        info_.frame_size = TargetSize(info_.native_size, options_);
-      }
-      FitFrame(frame, info_.frame_size, info_.native_size, options_, &size_warnings_);
+      FitToSequence(frame, &info_, options_, &size_warnings_);
       return frame;
     }
     if (delivered_ == 0) {

@@ -40,6 +40,10 @@ cv::Size TargetSize(const cv::Size& native, const FrameSourceOptions& options);
 void FitFrame(Frame& frame, const cv::Size& target, const cv::Size& first_native, const FrameSourceOptions& options,
               int* warnings);
 
+// The first frame (index 0) sets the sequence's native and delivered sizes in `info`; every frame is then
+// brought to them with FitFrame.
+void FitToSequence(Frame& frame, SequenceInfo* info, const FrameSourceOptions& options, int* warnings);
+
 bool IsImageFile(const std::string& path);
 
 }  // namespace vmap::internal

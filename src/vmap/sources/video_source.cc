@@ -99,11 +99,7 @@ class VideoSource : public FrameSource {
       frame.source_index = static_cast<int>(index);
       frame.source_name = fmt::format("frame_{:06d}", index);
       frame.timestamp = Timestamp(index);
-      if (frame.index == 0) {
-        info_.native_size = frame.gray.size();
-        info_.frame_size = TargetSize(info_.native_size, options_);
-      }
-      FitFrame(frame, info_.frame_size, info_.native_size, options_, &size_warnings_);
+      FitToSequence(frame, &info_, options_, &size_warnings_);
       return frame;
     }
   }
