@@ -143,17 +143,7 @@ void ComputeKeyImages(const fs::path& map_directory, const VisualMap& map, const
   auto work = [&] {
     try {
       for (size_t k = next++; k < n; k = next++) {
-        const fs::path file = map_directory / map.key_images[k].image_file;
-        // Grey straight from the decoder, as the image sources read frames.
-        cv::Mat gray;
-        try {
-          gray = cv::imread(file.string(), cv::IMREAD_GRAYSCALE);
-        } catch (const cv::Exception&) {
-          gray.release();
-        }
-        if (gray.empty()) {
-          throw InputError("key image '" + file.string() + "' cannot be decoded; rebuild the map with `vmap build`");
-        }
+        const cv::Mat gray = ReadKeyImage(map_directory, map.key_images[k], /*grayscale=*/true);
         store.features[k] = matcher.Extract(gray);
         store.thumbnails[k] = ThumbnailDescriptor(gray, options.thumbnail_width);
       }

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
@@ -655,6 +656,28 @@ VisualMap ReadMap(const fs::path& directory) {
                             "check that it exists and that you may read it"};
       },
       [&] { return ReadCheckedMap(directory); });
+}
+
+fs::path KeyImageFile(const fs::path& map_directory, const KeyImage& key) {
+  if (!IsPlainRelativePath(key.image_file)) {
+    Malformed(map_directory / kMapFileName, "key image '" + key.image_file + "' points outside the map directory");
+  }
+  return OpenMapFile(map_directory, key.image_file, "key image", map_directory / kMapFileName, "key image").path();
+}
+
+cv::Mat ReadKeyImage(const fs::path& map_directory, const KeyImage& key, bool grayscale) {
+  const fs::path file = KeyImageFile(map_directory, key);
+  cv::Mat image;
+  std::string why;
+  try {
+    image = cv::imread(file.string(), grayscale ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
+  } catch (const cv::Exception& error) {
+    why = " (" + LibraryMessage(error) + ")";
+  }
+  if (image.empty()) {
+    throw InputError("key image '" + file.string() + "' cannot be decoded" + why + "; rebuild the map with `vmap build`");
+  }
+  return image;
 }
 
 std::string WhyNotAVmapMap(const fs::path& directory) {

@@ -53,6 +53,15 @@ std::string CoverageEndName(CoverageEnd end);
 // own file), as ReadMap checks them; nullopt when the file is neither or cannot be read.
 std::optional<cv::Size> KeyImageFileSize(const std::filesystem::path& file);
 
+// The file of key image `key` of the map in `map_directory`, checked again as ReadMap checks it (inside the map
+// directory, a regular file): a map read earlier may have changed on disk since. Throws InputError naming the
+// file and the fix.
+std::filesystem::path KeyImageFile(const std::filesystem::path& map_directory, const KeyImage& key);
+
+// Decodes key image `key` (in colour, or grey straight from the decoder as the image sources read frames).
+// Throws InputError naming the file when it is gone, leads outside the map or cannot be decoded.
+cv::Mat ReadKeyImage(const std::filesystem::path& map_directory, const KeyImage& key, bool grayscale = false);
+
 // Reads a map directory that vmap may not have written (a map someone sent). Throws InputError naming the file,
 // the field and what is wrong when it is missing or malformed. It never reads outside the directory (no
 // absolute or ".." paths, no symbolic link leading out, only regular files), checks every file's size against

@@ -139,6 +139,39 @@ nlohmann::json ReadJson(const fs::path& file) {
   return nlohmann::json::parse(in);
 }
 
+TEST(MapIo, ReadKeyImageDecodesTheKeyImagesReadMapChecked) {
+  testing::ScopedTempDir tmp;
+  WriteMapFiles(SmallMap(tmp.path()), tmp.path());
+  const VisualMap map = ReadMap(tmp.path());
+  const cv::Mat color = ReadKeyImage(tmp.path(), map.key_images[1]);
+  EXPECT_EQ(color.type(), CV_8UC3);
+  EXPECT_EQ(color.size(), cv::Size(64, 48));
+  const cv::Mat gray = ReadKeyImage(tmp.path(), map.key_images[1], /*grayscale=*/true);
+  ASSERT_EQ(gray.type(), CV_8UC1);
+  EXPECT_EQ(gray.at<uchar>(10, 10), 9) << "key image of frame 9 is filled with 9";
+
+  // The map changed on disk after ReadMap: each problem is named with its file and the fix.
+  auto ErrorOf = [](const auto& read) -> std::string {
+    try {
+      read();
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  KeyImage escaping = map.key_images[0];
+  escaping.image_file = "../outside.png";
+  EXPECT_NE(ErrorOf([&] { ReadKeyImage(tmp.path(), escaping); }).find("points outside the map directory"),
+            std::string::npos);
+  std::ofstream(tmp.path() / "keys/9.png", std::ios::trunc) << "not a png";
+  const std::string undecodable = ErrorOf([&] { ReadKeyImage(tmp.path(), map.key_images[1]); });
+  EXPECT_NE(undecodable.find("keys/9.png' cannot be decoded"), std::string::npos) << undecodable;
+  EXPECT_NE(undecodable.find("rebuild the map"), std::string::npos) << undecodable;
+  fs::remove(tmp.path() / "keys/9.png");
+  const std::string missing = ErrorOf([&] { KeyImageFile(tmp.path(), map.key_images[1]); });
+  EXPECT_NE(missing.find("keys/9.png' is missing"), std::string::npos) << missing;
+}
+
 }  // namespace
 
 // Every field of map.json is checked for its type and range, and the message names the field.

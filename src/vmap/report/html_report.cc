@@ -235,40 +235,6 @@ class RouteVideo {
 
 }  // namespace
 
-fs::path KeyImagePath(const fs::path& map_directory, const KeyImage& key) {
-  if (!IsPlainRelativePath(key.image_file)) {
-    throw InputError("map '" + map_directory.string() + "': key image path '" + key.image_file +
-                     "' points outside the map directory; rebuild the map with `vmap build`");
-  }
-  std::string why_not;
-  if (!ContainedFile::Open(map_directory, key.image_file, &why_not)) {
-    const fs::path file = map_directory / key.image_file;
-    if (why_not == "is missing") {
-      throw InputError("map '" + map_directory.string() + "' is incomplete: key image '" + file.string() +
-                       "' is missing; rebuild the map with `vmap build`");
-    }
-    throw InputError("map '" + map_directory.string() + "': key image '" + key.image_file + "' " +
-                     (why_not.rfind("resolves outside", 0) == 0 ? std::string("resolves outside the map directory")
-                                                                 : why_not) +
-                     "; rebuild the map with `vmap build`");
-  }
-  return map_directory / key.image_file;
-}
-
-cv::Mat ReadKeyImage(const fs::path& map_directory, const KeyImage& key) {
-  const fs::path file = KeyImagePath(map_directory, key);
-  cv::Mat image;
-  try {
-    image = cv::imread(file.string(), cv::IMREAD_COLOR);
-  } catch (const cv::Exception& error) {
-    throw InputError("key image '" + file.string() + "' cannot be decoded (" + LibraryMessage(error) +
-                     "); rebuild the map with `vmap build`");
-  }
-  if (image.empty()) {
-    throw InputError("key image '" + file.string() + "' cannot be decoded; rebuild the map with `vmap build`");
-  }
-  return image;
-}
 
 std::string LinkTitle(const VisualMap& map, int link_index) {
   const Link& l = map.links.at(link_index);
@@ -503,7 +469,7 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
   report_options.Check();
   const VisualMap map = ReadMap(map_directory);
   // Every image path is checked before anything is written.
-  for (const KeyImage& k : map.key_images) KeyImagePath(map_directory, k);
+  for (const KeyImage& k : map.key_images) KeyImageFile(map_directory, k);
   const json options = ParseOptions(map.options_json);
   const MapStatistics stats = ComputeStatistics(
       map, OptionText(options, "quality_mean") == "harmonic" ? QualityMean::kHarmonic : QualityMean::kArithmetic);

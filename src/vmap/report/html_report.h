@@ -42,13 +42,6 @@ void WriteMapReport(const std::filesystem::path& map_directory, const MapReportO
 // best tau marked, key images and Q against tau, and links to the per-tau maps that were written.
 void WriteSweepReport(const SweepResult& sweep, const std::filesystem::path& directory);
 
-// A key image's file, checked to lie inside the map directory (no absolute path, no "..", no symbolic
-// link leading out). Throws InputError otherwise.
-std::filesystem::path KeyImagePath(const std::filesystem::path& map_directory, const KeyImage& key);
-
-// The key image as 8-bit BGR. Throws InputError naming the file when it is missing or cannot be decoded.
-cv::Mat ReadKeyImage(const std::filesystem::path& map_directory, const KeyImage& key);
-
 // "key 3 (frame 120) -> key 4 (frame 161)": the title of link `link_index` in figures.
 std::string LinkTitle(const VisualMap& map, int link_index);
 

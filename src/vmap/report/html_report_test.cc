@@ -250,7 +250,7 @@ TEST(MapReportTest, KeyImagePathsCannotLeaveTheMapDirectory) {
 
   KeyImage escaping = map.key_images[0];
   escaping.image_file = "keys/../../secret.png";
-  EXPECT_THROW(KeyImagePath(dir, escaping), InputError);
+  EXPECT_THROW(KeyImageFile(dir, escaping), InputError);
 }
 
 TEST(MapReportTest, DrawMapLinkNamesAMissingLink) {

@@ -208,7 +208,7 @@ void LocalizationReportOptions::Check() const {
 void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, const fs::path& map_directory,
                              const fs::path& directory, const LocalizationReportOptions& options) {
   options.Check();
-  for (const KeyImage& k : map.key_images) KeyImagePath(map_directory, k);
+  for (const KeyImage& k : map.key_images) KeyImageFile(map_directory, k);
   // The whole folder is replaced at once, and only when it is empty or an older report of a run.
   OutputPolicy policy;
   policy.why_not_ours = WhyNotALocalizationReport;
