@@ -26,10 +26,10 @@
 #include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/map_builder.h"
-#include "vmap/neural/aliked_matcher.h"
-#include "vmap/neural/aliked_model.h"
-#include "vmap/neural/aliked_weights.h"
-#include "vmap/neural/deform_conv.h"
+#include "vmap/neural/aliked/aliked_matcher.h"
+#include "vmap/neural/aliked/aliked_model.h"
+#include "vmap/neural/aliked/aliked_weights.h"
+#include "vmap/neural/aliked/deform_conv.h"
 #include "vmap/sources/frame_source.h"
 
 namespace {

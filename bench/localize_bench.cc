@@ -26,7 +26,7 @@
 #include <opencv2/core.hpp>
 
 #include "vmap/core/runtime.h"
-#include "vmap/features/matcher_factory.h"
+#include "vmap/features/matcher_registry.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/mapping/map_builder.h"

@@ -18,7 +18,7 @@
 #include <torch/torch.h>
 
 #include "vmap/core/runtime.h"
-#include "vmap/neural/loftr_matcher.h"
+#include "vmap/neural/loftr/loftr_matcher.h"
 
 namespace {
 

@@ -25,9 +25,9 @@
 #include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/map_builder.h"
-#include "vmap/neural/xfeat_matcher.h"
-#include "vmap/neural/xfeat_model.h"
-#include "vmap/neural/xfeat_weights.h"
+#include "vmap/neural/xfeat/xfeat_matcher.h"
+#include "vmap/neural/xfeat/xfeat_model.h"
+#include "vmap/neural/xfeat/xfeat_weights.h"
 #include "vmap/sources/frame_source.h"
 
 namespace {

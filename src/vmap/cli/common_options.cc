@@ -1,65 +1,93 @@
 #include "vmap/cli/common_options.h"
 
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <type_traits>
+#include <variant>
+#include <vector>
+
 namespace vmap::cli {
 
+namespace {
+
+// Collects every registered model's fields by flag, then binds each flag once: a flag several models share
+// (--weights, --device) sets the field of each, whichever --matcher is chosen.
+class FlagBinder final : public OptionFieldVisitor {
+ public:
+  void Visit(const OptionField& field, int& value) override { Add(field, &value); }
+  void Visit(const OptionField& field, double& value) override { Add(field, &value); }
+  void Visit(const OptionField& field, bool& value) override { Add(field, &value); }
+  void Visit(const OptionField& field, std::string& value) override { Add(field, &value); }
+
+  void Bind(CLI::App* command) const {
+    for (const std::string& flag : order_) {
+      const Targets& targets = flags_.at(flag);
+      std::visit([&](auto* first) { BindTargets(command, flag, targets, first); }, targets.values.front());
+    }
+  }
+
+ private:
+  using Target = std::variant<int*, double*, bool*, std::string*>;
+  struct Targets {
+    OptionField field;
+    std::vector<Target> values;
+  };
+
+  void Add(const OptionField& field, Target value) {
+    if (*field.flag == '\0') return;
+    auto [it, added] = flags_.try_emplace(field.flag, Targets{field, {}});
+    if (added) order_.push_back(field.flag);
+    if (it->second.values.size() > 0 && it->second.values.front().index() != value.index()) {
+      throw std::logic_error(std::string("matcher flag ") + field.flag + " has fields of different types");
+    }
+    it->second.values.push_back(value);
+  }
+
+  template <typename T>
+  static void BindTargets(CLI::App* command, const std::string& flag, const Targets& targets, T* first) {
+    const OptionField& field = targets.field;
+    if (flag.front() == '!') {  // "!--no-x": a bool flag that sets false
+      if constexpr (std::is_same_v<T, bool>) {
+        if (targets.values.size() == 1) {
+          command->add_flag(flag, *first, field.help);
+          return;
+        }
+      }
+      throw std::logic_error("matcher flag " + flag + ": a negated flag needs exactly one bool field");
+    }
+    CLI::Option* option = nullptr;
+    if (targets.values.size() == 1) {
+      option = command->add_option(flag, *first, field.help);
+      if (field.show_default) option->capture_default_str();
+      return;
+    }
+    std::vector<T*> fields;
+    for (const Target& target : targets.values) fields.push_back(std::get<T*>(target));
+    option = command->add_option_function<T>(
+        flag, [fields](const T& value) { for (T* f : fields) *f = value; }, field.help);
+    if (field.show_default) {
+      std::ostringstream text;
+      text << std::boolalpha << *first;
+      option->default_str(text.str());
+    }
+  }
+
+  std::map<std::string, Targets> flags_;
+  std::vector<std::string> order_;  // as the models list them
+};
+
+}  // namespace
+
 void AddMatcherOptions(CLI::App* command, MatcherOptions& options) {
-  command->add_option("--matcher", options.type, "Feature matcher: orb, loftr, xfeat or aliked")->capture_default_str();
-  auto& orb = options.orb;
-  command->add_option("--orb-features", orb.num_features, "ORB: features per image")->capture_default_str();
-  command->add_option("--orb-scale-factor", orb.scale_factor, "ORB: pyramid scale factor")->capture_default_str();
-  command->add_option("--orb-levels", orb.num_levels, "ORB: pyramid levels")->capture_default_str();
-  command->add_option("--orb-fast-threshold", orb.fast_threshold, "ORB: FAST threshold")->capture_default_str();
-  command->add_option("--orb-edge-threshold", orb.edge_threshold, "ORB: border without features (px)")
+  std::string models;
+  for (const auto& model : MatcherModels()) models += "\n  " + model.name + ": " + model.summary;
+  command->add_option("--matcher", options.type, "Feature matcher: " + MatcherModelNames() + models)
       ->capture_default_str();
-  command->add_flag("!--no-cross-check", orb.cross_check, "ORB: keep one-way best matches too");
-  command->add_option("--ratio", orb.ratio, "ORB: Lowe's ratio test (0 = off), e.g. 0.8")->capture_default_str();
-  auto& loftr = options.loftr;
-  command->add_option("--loftr-model", loftr.model, "LoFTR preset: outdoor, indoor or coarse")
-      ->capture_default_str();
-  // --weights and --device belong to whichever deep matcher --matcher picks.
-  command->add_option_function<std::string>(
-      "--weights",
-      [&options](const std::string& file) { options.loftr.weights = options.xfeat.weights = options.aliked.weights = file; },
-      "Weights file of the deep matcher (see `vmap weights`)");
-  command->add_option_function<std::string>(
-      "--device",
-      [&options](const std::string& device) {
-        options.loftr.device = options.xfeat.device = options.aliked.device = device;
-      },
-      "Deep matchers' device: cpu or cuda")->default_str(options.loftr.device);
-  command->add_option("--loftr-size", loftr.longest_side, "LoFTR: longest image side fed to the network")
-      ->capture_default_str();
-  command->add_option("--loftr-threshold", loftr.threshold, "LoFTR: coarse confidence threshold (default: preset's)");
-  command->add_option("--loftr-threads", loftr.num_threads, "LoFTR: LibTorch threads per call (0 = LibTorch default)")
-      ->capture_default_str();
-  auto& xfeat = options.xfeat;
-  command->add_option("--xfeat-top-k", xfeat.top_k, "XFeat: keypoints kept per image, best first")
-      ->capture_default_str();
-  command->add_option("--xfeat-threshold", xfeat.detection_threshold, "XFeat: keypoint heatmap threshold")
-      ->capture_default_str();
-  command->add_option("--xfeat-min-similarity", xfeat.min_similarity,
-                      "XFeat: mutual nearest neighbours need a cosine similarity above this (<= 0: no minimum)")
-      ->capture_default_str();
-  command->add_option("--xfeat-threads", xfeat.num_threads, "XFeat: LibTorch threads per call (0 = LibTorch default)")
-      ->capture_default_str();
-  auto& aliked = options.aliked;
-  command->add_option("--aliked-model", aliked.model, "ALIKED model: t16 or n16")->capture_default_str();
-  command->add_option("--aliked-top-k", aliked.top_k, "ALIKED: keypoints per image (0 = score threshold mode)")
-      ->capture_default_str();
-  command->add_option("--aliked-score-threshold", aliked.score_threshold,
-                      "ALIKED: keypoint score threshold when --aliked-top-k is 0")
-      ->capture_default_str();
-  command->add_option("--aliked-max-keypoints", aliked.max_keypoints,
-                      "ALIKED: most keypoints when --aliked-top-k is 0")
-      ->capture_default_str();
-  command->add_option("--aliked-min-similarity", aliked.min_similarity,
-                      "ALIKED: least cosine similarity of a match")
-      ->capture_default_str();
-  command->add_option("--aliked-size", aliked.longest_side,
-                      "ALIKED: shrink images to this longest side first (0 = native size)")
-      ->capture_default_str();
-  command->add_option("--aliked-threads", aliked.num_threads, "ALIKED: LibTorch threads per call (0 = LibTorch default)")
-      ->capture_default_str();
+  // Every model's flags, as its options list them (features/option_fields.h).
+  FlagBinder binder;
+  for (const auto& model : MatcherModels()) options.model(model.name).VisitFields(binder);
+  binder.Bind(command);
 }
 
 VerifierOptions VerifierFlags::Resolve() const {

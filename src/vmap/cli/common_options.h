@@ -5,13 +5,13 @@
 
 #include <CLI/CLI.hpp>
 
-#include "vmap/features/matcher_factory.h"
+#include "vmap/features/matcher_registry.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap::cli {
 
-// --matcher, ORB's, LoFTR's, XFeat's and ALIKED's options.
+// --matcher and the flags of every registered matcher model (features/matcher_registry.h).
 void AddMatcherOptions(CLI::App* command, MatcherOptions& options);
 
 // --verifier, --threshold, --confidence, --max-iters, --seed.

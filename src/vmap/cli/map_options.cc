@@ -1,14 +1,28 @@
 #include "vmap/cli/map_options.h"
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/error.h"
-#include "vmap/features/matcher_factory.h"
+#include "vmap/features/matcher_registry.h"
 #include "vmap/map/map_io.h"
 #include "vmap/report/html_report.h"
 #include "vmap/report/summary.h"
 
 namespace vmap::cli {
+
+namespace {
+
+// "orb 0.5, aliked 0.7, ...": each registered matcher's default tau.
+std::string DefaultTaus() {
+  std::string text;
+  for (const auto& model : MatcherModels()) {
+    text += (text.empty() ? "" : ", ") + model.name + " " + fmt::format("{}", model.default_tau);
+  }
+  return text;
+}
+
+}  // namespace
 
 MapBuilderOptions KeyImageFlags::Resolve(const std::string& matcher_type) const {
   MapBuilderOptions options;
@@ -36,8 +50,8 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau) 
   if (with_tau) {
     command->add_option_function<double>(
         "-t,--tau", [&flags](double tau) { flags.tau = tau; },
-        "Similarity threshold tau in (0, 1]: lower keeps fewer key images (default: the matcher's, orb 0.5, "
-        "xfeat 0.4, aliked 0.7, loftr 0.5)");
+        "Similarity threshold tau in (0, 1]: lower keeps fewer key images (default: the matcher's, " +
+            DefaultTaus() + ")");
   }
   command->add_option("--similarity", flags.similarity,
                       "S = verified / tentative matches (inlier-ratio) or / features detected (feature-ratio)")

@@ -6,9 +6,10 @@
 
 #include "vmap/cli/commands.h"
 #include "vmap/core/error.h"
+#include "vmap/features/matcher_plugin.h"
+#include "vmap/features/matcher_registry.h"
 #include "vmap/neural/sha1.h"
 #include "vmap/neural/weights_store.h"
-#include "vmap/neural/torch_plugin.h"
 
 namespace vmap::cli {
 
@@ -29,26 +30,33 @@ std::string Join(const std::vector<std::string>& items) {
 }
 
 #ifdef VMAP_WITH_TORCH
-// The models a file fits: LoFTR presets, "xfeat (<layout> layout)" and ALIKED models as `--model` names them
-// (aliked-t16, aliked-n16). Throws the first reading error when the file cannot be read at all.
-std::vector<std::string> ModelsFittingFile(const std::string& path) {
+// What a file fits, asked of each model of the plugin (features/matcher_plugin.h): the weights as `--model`
+// names them ("coarse", "aliked-t16"), notes in parentheses ("xfeat (folded layout)").
+struct FileFits {
   std::vector<std::string> fits;
-  std::string read_error;
-  try {
-    fits = TorchPlugin().loftr_presets_fitting_file(path);
-  } catch (const InputError& error) {
-    read_error = error.what();
+  std::vector<std::string> refused_models;  // the models that could not read the file,
+  std::vector<std::string> refusals;        // and why
+  std::vector<std::string> refusals_by_model() const;  // "xfeat: ..."
+};
+
+std::vector<std::string> FileFits::refusals_by_model() const {
+  std::vector<std::string> named;
+  for (size_t i = 0; i < refusals.size(); ++i) named.push_back(refused_models[i] + ": " + refusals[i]);
+  return named;
+}
+
+FileFits ModelsFittingFile(const std::string& path) {
+  FileFits result;
+  for (const PluginMatcherModel& model : LoadMatcherPlugin().models) {
+    if (!model.weights_fitting_file) continue;
+    try {
+      for (auto& fit : model.weights_fitting_file(path)) result.fits.push_back(std::move(fit));
+    } catch (const InputError& error) {
+      result.refused_models.push_back(model.name);
+      result.refusals.push_back(error.what());
+    }
   }
-  try {
-    fits.push_back("xfeat (" + TorchPlugin().xfeat_weights_layout(path) + " layout)");
-  } catch (const InputError&) {
-  }
-  try {
-    for (const auto& model : TorchPlugin().aliked_models_fitting_file(path)) fits.push_back("aliked-" + model);
-  } catch (const InputError&) {
-  }
-  if (fits.empty() && !read_error.empty()) throw InputError(read_error);
-  return fits;
+  return result;
 }
 #endif
 
@@ -88,9 +96,16 @@ void Verify(const std::string& path) {
   std::printf("  known copy   %s\n", known_as.empty() ? "no (not byte-identical to a known published copy)"
                                                       : ("yes: " + known_as).c_str());
 #ifdef VMAP_WITH_TORCH
-  const auto presets = ModelsFittingFile(path);
-  std::printf("  fits         %s\n", presets.empty() ? "no known model" : Join(presets).c_str());
-  if (presets.empty()) throw InputError("'" + path + "' is not usable as LoFTR, XFeat or ALIKED weights");
+  const FileFits fits = ModelsFittingFile(path);
+  // A file no model can read at all is an error; say why (every model refuses an unreadable file the same way).
+  if (fits.fits.empty() && !fits.refusals.empty() && fits.refusals.size() == LoadMatcherPlugin().models.size()) {
+    throw InputError(fits.refusals.front());
+  }
+  std::printf("  fits         %s\n", fits.fits.empty() ? "no known model" : Join(fits.fits).c_str());
+  if (fits.fits.empty()) {
+    throw InputError("'" + path + "' is not usable as weights of any deep matcher (" +
+                     Join(fits.refusals_by_model()) + ")");
+  }
 #endif
 }
 
@@ -110,8 +125,8 @@ void Run(const WeightsFlags& flags) {
 #ifdef VMAP_WITH_TORCH
       if (flags.no_verify) {
         // The mirror may hold other bytes than the published copy; the layout is then the check left.
-        const auto presets = ModelsFittingFile(path);
-        std::printf("  fits %s\n", presets.empty() ? "no known model: do not use it" : Join(presets).c_str());
+        const auto fits = ModelsFittingFile(path).fits;
+        std::printf("  fits %s\n", fits.empty() ? "no known model: do not use it" : Join(fits).c_str());
       }
 #endif
     }
@@ -123,13 +138,12 @@ void Run(const WeightsFlags& flags) {
     const std::string expected = flags.no_verify ? "" : known.git_blob_id;
 #ifdef VMAP_WITH_TORCH
     // Without a known id the structure is the only check available before the file enters the cache.
-    if (flags.model == "xfeat") {
-      TorchPlugin().xfeat_weights_layout(flags.import_file);  // throws, listing what does not fit
-    } else if (const auto presets = ModelsFittingFile(flags.import_file);
-               std::find(presets.begin(), presets.end(), flags.model) == presets.end()) {
+    const FileFits fits = ModelsFittingFile(flags.import_file);
+    const auto is_model = [&](const std::string& fit) { return fit.substr(0, fit.find(" (")) == flags.model; };
+    if (std::none_of(fits.fits.begin(), fits.fits.end(), is_model)) {
       throw InputError("'" + flags.import_file + "' does not fit --model " + flags.model +
-                       (presets.empty() ? std::string(" (nor any other model)")
-                                        : " (it fits " + Join(presets) + ")"));
+                       (fits.fits.empty() ? std::string(" (nor any other model") : " (it fits " + Join(fits.fits)) +
+                       (fits.refusals.empty() ? "" : "; " + Join(fits.refusals_by_model())) + ")");
     }
 #endif
     const std::string path = neural::ImportWeights(flags.import_file, flags.model, expected, cache);

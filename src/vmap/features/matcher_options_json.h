@@ -1,15 +1,17 @@
 #pragma once
 // The matcher a map was built with, rebuilt from what map.json records (`options.matcher`, the text of
-// Matcher::DescribeOptionsJson). The one place that reads it back, until options are typed.
+// Matcher::DescribeOptionsJson). The model named by its `type` reads its own options (ModelOptions::FromJson).
 
 #include <string>
 
-#include "vmap/features/matcher_factory.h"
+#include "vmap/features/matcher_registry.h"
 
 namespace vmap {
 
 // `matcher_json` is the JSON object of map.json's `options.matcher`. Fields the record lacks keep their
-// defaults. Throws InputError naming `map_file` when the type is missing or unknown to this vmap.
+// defaults; a weights file recorded where the map was built that is not here is dropped (the weights
+// directories are searched instead). Throws InputError naming `map_file` when the type is missing or unknown
+// to this vmap, or a field is of the wrong type.
 MatcherOptions MatcherOptionsFromJson(const std::string& matcher_json, const std::string& map_file);
 
 }  // namespace vmap

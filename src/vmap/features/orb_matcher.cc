@@ -14,8 +14,19 @@
 #include <opencv2/features2d.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/features/matcher_registry.h"
 
 namespace vmap {
+
+void OrbMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit({"num_features", "--orb-features", "ORB: features per image"}, num_features);
+  visitor.Visit({"scale_factor", "--orb-scale-factor", "ORB: pyramid scale factor"}, scale_factor);
+  visitor.Visit({"num_levels", "--orb-levels", "ORB: pyramid levels"}, num_levels);
+  visitor.Visit({"fast_threshold", "--orb-fast-threshold", "ORB: FAST threshold"}, fast_threshold);
+  visitor.Visit({"edge_threshold", "--orb-edge-threshold", "ORB: border without features (px)"}, edge_threshold);
+  visitor.Visit({"cross_check", "!--no-cross-check", "ORB: keep one-way best matches too"}, cross_check);
+  visitor.Visit({"ratio", "--ratio", "ORB: Lowe's ratio test (0 = off), e.g. 0.8"}, ratio);
+}
 
 void OrbMatcherOptions::Check() const {
   if (num_features < 1 || num_features > 100000) {
@@ -95,15 +106,7 @@ class OrbMatcher : public Matcher {
   }
 
   std::string DescribeOptionsJson() const override {
-    return nlohmann::json{{"type", "orb"},
-                          {"num_features", options_.num_features},
-                          {"scale_factor", options_.scale_factor},
-                          {"num_levels", options_.num_levels},
-                          {"edge_threshold", options_.edge_threshold},
-                          {"fast_threshold", options_.fast_threshold},
-                          {"cross_check", options_.cross_check},
-                          {"ratio", options_.ratio}}
-        .dump();
+    return TypedModelOptions<OrbMatcherOptions>(options_).ToJson().dump();  // the same keys as FromJson reads
   }
 
   std::string SerializeFeatures(const ImageFeatures& features) const override {

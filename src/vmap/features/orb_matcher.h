@@ -4,10 +4,12 @@
 #include <memory>
 
 #include "vmap/features/matcher.h"
+#include "vmap/features/option_fields.h"
 
 namespace vmap {
 
 struct OrbMatcherOptions {
+  static constexpr const char* kModelName = "orb";  // --matcher orb (features/matcher_registry.h)
   // Defaults are OpenCV's ORB defaults, which the paper's prototype most likely used.
   int num_features = 500;
   double scale_factor = 1.2;
@@ -20,6 +22,7 @@ struct OrbMatcherOptions {
   double ratio = 0.0;
 
   void Check() const;  // throws InputError naming the bad option
+  void VisitFields(OptionFieldVisitor& visitor);  // JSON keys and command-line flags
 };
 
 std::unique_ptr<Matcher> CreateOrbMatcher(const OrbMatcherOptions& options);

@@ -2,7 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "vmap/features/matcher_factory.h"
+#include "vmap/features/matcher_registry.h"
 #include "vmap/features/matcher_options_json.h"
 #include "vmap/map/map_io.h"
 

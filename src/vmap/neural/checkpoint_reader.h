@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "vmap/neural/loftr_model.h"
+#include "vmap/neural/state_dict.h"
 
 namespace vmap::neural {
 

@@ -1,13 +1,8 @@
-// The entry point of libvmap_torch.so (and of the neural tests, which link the same objects).
+// The entry point of libvmap_torch.so (and of the neural tests, which link the same objects): the table each
+// model's LibTorch part registered into (PluginMatcherRegistration in neural/<model>/<model>_matcher.cc).
 
-#include "vmap/neural/aliked_matcher.h"
-#include "vmap/neural/loftr_matcher.h"
-#include "vmap/neural/torch_plugin.h"
-#include "vmap/neural/xfeat_matcher.h"
+#include "vmap/features/matcher_plugin.h"
 
-extern "C" __attribute__((visibility("default"))) const vmap::TorchPluginApi* vmap_torch_plugin_api() {
-  static const vmap::TorchPluginApi api{&vmap::CreateLoftrMatcher, &vmap::LoftrPresetsFittingFile,
-                                        &vmap::CreateXfeatMatcher, &vmap::XfeatWeightsLayoutOfFile,
-                                        &vmap::CreateAlikedMatcher, &vmap::AlikedModelsFittingFile};
-  return &api;
+extern "C" __attribute__((visibility("default"))) const vmap::MatcherPluginTable* vmap_matcher_plugin_table() {
+  return &vmap::RegisteredPluginMatchers();
 }

@@ -1,0 +1,152 @@
+#include "vmap/features/matcher_registry.h"
+
+#include <algorithm>
+
+#include "vmap/core/error.h"
+#include "vmap/features/matcher_plugin.h"
+#include "vmap/features/orb_matcher.h"
+
+namespace vmap {
+namespace {
+
+std::vector<MatcherModel>& Registry() {
+  static std::vector<MatcherModel> models;
+  return models;
+}
+
+// ORB, the paper's matcher, registers here; the deep models from their folders under neural/.
+const MatcherModelRegistration kOrb{[] {
+  MatcherModel model = MatcherModel::Of<OrbMatcherOptions>(
+      "ORB keypoints (OpenCV) with brute-force Hamming matching, the paper's matcher",
+      0.5);  // the paper's tables' middle; README "The method, exactly"
+  model.create = [](const ModelOptions& options) { return CreateOrbMatcher(options.As<OrbMatcherOptions>()); };
+  return model;
+}()};
+
+// Writes each field into a JSON object.
+class JsonWriter final : public OptionFieldVisitor {
+ public:
+  explicit JsonWriter(nlohmann::json& object) : object_(object) {}
+  void Visit(const OptionField& field, int& value) override { object_[field.key] = value; }
+  void Visit(const OptionField& field, double& value) override { object_[field.key] = value; }
+  void Visit(const OptionField& field, bool& value) override { object_[field.key] = value; }
+  void Visit(const OptionField& field, std::string& value) override { object_[field.key] = value; }
+
+ private:
+  nlohmann::json& object_;
+};
+
+// Reads the fields a JSON object holds; the others keep their values.
+class JsonReader final : public OptionFieldVisitor {
+ public:
+  JsonReader(const nlohmann::json& object, const std::string& where) : object_(object), where_(where) {}
+  void Visit(const OptionField& field, int& value) override { Read(field, value); }
+  void Visit(const OptionField& field, double& value) override { Read(field, value); }
+  void Visit(const OptionField& field, bool& value) override { Read(field, value); }
+  void Visit(const OptionField& field, std::string& value) override { Read(field, value); }
+
+ private:
+  template <typename T>
+  void Read(const OptionField& field, T& value) {
+    const auto it = object_.find(field.key);
+    if (it == object_.end() || it->is_null()) return;
+    // nlohmann converts between numbers and bools silently; a recorded value of another kind is a mistake.
+    const bool fits = std::is_same_v<T, bool>          ? it->is_boolean()
+                      : std::is_same_v<T, std::string> ? it->is_string()
+                      : std::is_same_v<T, int>         ? it->is_number_integer()
+                                                       : it->is_number();
+    if (!fits) throw InputError(where_ + "." + field.key + " has the wrong type (" + it->type_name() + ")");
+    value = it->get<T>();
+  }
+
+  const nlohmann::json& object_;
+  const std::string& where_;
+};
+
+}  // namespace
+
+nlohmann::json ModelOptions::ToJson() const {
+  nlohmann::json object{{"type", model()}};
+  JsonWriter writer(object);
+  Clone()->VisitFields(writer);  // visiting needs mutable fields; the copy keeps this const
+  return object;
+}
+
+void ModelOptions::FromJson(const nlohmann::json& object, const std::string& where) {
+  if (!object.is_object()) throw InputError(where + " is not a JSON object");
+  JsonReader reader(object, where);
+  VisitFields(reader);
+  AfterReading();
+}
+
+MatcherModelRegistration::MatcherModelRegistration(MatcherModel model) {
+  auto& models = Registry();
+  const bool known = std::any_of(models.begin(), models.end(), [&](const auto& m) { return m.name == model.name; });
+  if (known) throw std::logic_error("matcher model '" + model.name + "' registered twice");
+  if (!model.default_options) throw std::logic_error("matcher model '" + model.name + "' has no options");
+  models.push_back(std::move(model));
+  std::stable_sort(models.begin(), models.end(), [](const MatcherModel& a, const MatcherModel& b) {
+    if (a.needs_torch != b.needs_torch) return !a.needs_torch;
+    return a.name < b.name;
+  });
+}
+
+const std::vector<MatcherModel>& MatcherModels() { return Registry(); }
+
+std::string MatcherModelNames() {
+  const auto& models = MatcherModels();
+  std::string names;
+  for (size_t i = 0; i < models.size(); ++i) {
+    if (i > 0) names += i + 1 == models.size() ? " or " : ", ";
+    names += models[i].name;
+  }
+  return names;
+}
+
+const MatcherModel& FindMatcherModel(const std::string& name) {
+  for (const auto& model : MatcherModels()) {
+    if (model.name == name) return model;
+  }
+  throw InputError("unknown matcher '" + name + "'; use " + MatcherModelNames());
+}
+
+MatcherOptions::MatcherOptions() {
+  for (const auto& model : MatcherModels()) models_.emplace(model.name, model.default_options());
+}
+
+MatcherOptions::MatcherOptions(const MatcherOptions& other) : type(other.type) {
+  for (const auto& [name, options] : other.models_) models_.emplace(name, options->Clone());
+}
+
+MatcherOptions& MatcherOptions::operator=(const MatcherOptions& other) {
+  if (this != &other) *this = MatcherOptions(other);
+  return *this;
+}
+
+ModelOptions& MatcherOptions::model(const std::string& name) {
+  const auto it = models_.find(name);
+  if (it == models_.end()) FindMatcherModel(name);  // throws, listing the names
+  if (it == models_.end()) throw std::logic_error("matcher '" + name + "' registered after these options were made");
+  return *it->second;
+}
+
+const ModelOptions& MatcherOptions::model(const std::string& name) const {
+  return const_cast<MatcherOptions*>(this)->model(name);
+}
+
+void MatcherOptions::Check() const {
+  FindMatcherModel(type);
+  // The options of every matcher, used or not: an absurd value (NaN, out of range) is a mistake either way.
+  for (const auto& [name, options] : models_) options->Check();
+}
+
+double DefaultTau(const std::string& matcher_type) { return FindMatcherModel(matcher_type).default_tau; }
+
+std::unique_ptr<Matcher> CreateMatcher(const MatcherOptions& options) {
+  options.Check();
+  const MatcherModel& model = FindMatcherModel(options.type);
+  if (model.create) return model.create(options.selected());
+  return CreatePluginMatcher(options.selected());
+}
+
+}  // namespace vmap

@@ -1,0 +1,54 @@
+#include "vmap/neural/aliked/aliked_options.h"
+
+#include "vmap/core/error.h"
+
+namespace vmap {
+
+void AlikedMatcherOptions::Check() const {
+  if (model != "t16" && model != "n16") {
+    throw InputError("unknown ALIKED model '" + model + "'; use --aliked-model t16 or n16");
+  }
+  if (device != "cpu" && device != "cuda") {
+    throw InputError("unknown device '" + device + "'; use cpu or cuda");
+  }
+  if (top_k < 0) {
+    throw InputError("--aliked-top-k must be >= 0 (0 = threshold mode with --aliked-score-threshold; default 1000)");
+  }
+  if (top_k == 0 && !(score_threshold >= 0.0 && score_threshold < 1.0)) {
+    throw InputError("--aliked-score-threshold must be in [0, 1) (0 = the mean score, as upstream; default 0.2)");
+  }
+  if (max_keypoints < 1) throw InputError("--aliked-max-keypoints must be >= 1 (default 5000)");
+  if (!(min_similarity >= -1.0 && min_similarity <= 1.0)) {
+    throw InputError("--aliked-min-similarity must be a cosine similarity in [-1, 1] (default 0.75)");
+  }
+  if (longest_side != 0 && longest_side < 32) {
+    throw InputError("--aliked-size " + std::to_string(longest_side) +
+                     " is too small; use 0 (native size) or at least 32");
+  }
+  if (num_threads < 0) throw InputError("--aliked-threads must be >= 0 (0 = LibTorch's default; default 1)");
+}
+
+void AlikedMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit({"model", "--aliked-model", "ALIKED model: t16 or n16"}, model);
+  visitor.Visit({"weights", "--weights", "Weights file of the deep matcher (see `vmap weights`)", false, true},
+                weights);
+  visitor.Visit({"device", "--device", "Deep matchers' device: cpu or cuda"}, device);
+  visitor.Visit({"top_k", "--aliked-top-k", "ALIKED: keypoints per image (0 = score threshold mode)"}, top_k);
+  visitor.Visit({"score_threshold", "--aliked-score-threshold",
+                 "ALIKED: keypoint score threshold when --aliked-top-k is 0"},
+                score_threshold);
+  visitor.Visit({"max_keypoints", "--aliked-max-keypoints", "ALIKED: most keypoints when --aliked-top-k is 0"},
+                max_keypoints);
+  visitor.Visit({"min_similarity", "--aliked-min-similarity", "ALIKED: least cosine similarity of a match"},
+                min_similarity);
+  visitor.Visit({"longest_side", "--aliked-size", "ALIKED: shrink images to this longest side first (0 = native size)"},
+                longest_side);
+  visitor.Visit({"threads", "--aliked-threads", "ALIKED: LibTorch threads per call (0 = LibTorch default)"},
+                num_threads);
+}
+
+void AlikedMatcherOptions::AfterReading() {
+  if (model.rfind("aliked-", 0) == 0) model = model.substr(7);  // maps record the model as aliked-t16
+}
+
+}  // namespace vmap

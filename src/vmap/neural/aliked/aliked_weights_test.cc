@@ -1,0 +1,216 @@
+// ALIKED weights: the architecture's key set against the shared files, upstream's OrderedDict layout, and bad files.
+
+#include <filesystem>
+#include <fstream>
+
+#include <caffe2/serialize/inline_container.h>
+#include <gtest/gtest.h>
+#include <torch/serialize.h>
+
+#include "vmap/core/error.h"
+#include "vmap/neural/aliked/aliked_weights.h"
+#include "vmap/neural/golden_util.h"
+
+namespace vmap::neural {
+namespace {
+
+using testing::SharedDir;
+namespace fs = std::filesystem;
+
+std::string WeightsPath(const std::string& model) { return SharedDir() + "/weights/aliked/aliked-" + model + ".pt"; }
+
+void WriteBytes(const std::string& path, const std::vector<char>& bytes) {
+  std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+std::string ExpectInputError(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected InputError";
+  return "";
+}
+
+// Writes `weights` the way `torch.save(model.state_dict(), path)` does in Python: the root object is a
+// collections.OrderedDict (with a _metadata attribute), which LibTorch's own unpickler cannot build.
+void WriteOrderedDictFile(const StateDict& weights, const std::string& path) {
+  std::string code = "\x80\x02";
+  auto op = [&](char c) { code += c; };
+  auto int32 = [&](uint32_t v) {
+    for (int i = 0; i < 4; ++i) code += static_cast<char>((v >> (8 * i)) & 0xff);
+  };
+  auto string = [&](const std::string& s) {
+    op('X');
+    int32(static_cast<uint32_t>(s.size()));
+    code += s;
+  };
+  auto integer = [&](int64_t v) {
+    op('J');
+    int32(static_cast<uint32_t>(v));
+  };
+  auto global = [&](const std::string& module, const std::string& name) { code += "c" + module + "\n" + name + "\n"; };
+  caffe2::serialize::PyTorchStreamWriter writer(path);
+  global("collections", "OrderedDict");
+  op(')');
+  op('R');
+  op('(');
+  int record = 0;
+  std::vector<torch::Tensor> keep;
+  for (const auto& [key, tensor] : weights) {
+    auto t = tensor.contiguous();
+    keep.push_back(t);
+    string(key);
+    global("torch._utils", "_rebuild_tensor_v2");
+    op('(');
+    op('(');
+    string("storage");
+    global("torch", t.scalar_type() == torch::kInt64 ? "LongStorage" : "FloatStorage");
+    string(std::to_string(record));
+    string("cpu");
+    integer(t.numel());
+    op('t');
+    op('Q');
+    integer(0);
+    op('(');
+    for (auto d : t.sizes()) integer(d);
+    op('t');
+    op('(');
+    for (auto d : t.strides()) integer(d);
+    op('t');
+    op('\x89');  // requires_grad False
+    global("collections", "OrderedDict");
+    op(')');
+    op('R');
+    op('t');
+    op('R');
+    writer.writeRecord("data/" + std::to_string(record), t.data_ptr(), t.numel() * t.element_size());
+    ++record;
+  }
+  op('u');
+  op('}');  // the OrderedDict's attributes: {'_metadata': OrderedDict()}
+  string("_metadata");
+  global("collections", "OrderedDict");
+  op(')');
+  op('R');
+  op('s');
+  op('b');
+  op('.');
+  writer.writeRecord("data.pkl", code.data(), code.size());
+  writer.writeEndOfFile();
+}
+
+TEST(AlikedWeights, SharedFilesHoldExactlyTheExpectedTensors) {
+  SKIP_WITHOUT_SHARED();
+  for (const std::string model : {"t16", "n16"}) {
+    const auto weights = ReadAlikedStateDict(WeightsPath(model));
+    const auto expected = AlikedExpectedStateDict(AlikedPreset(model));
+    EXPECT_EQ(weights.size(), 76u) << model;
+    EXPECT_EQ(expected.size(), 76u) << model;
+    CheckAlikedStateDict(weights, AlikedPreset(model), WeightsPath(model));
+    EXPECT_EQ(AlikedModelsFitting(weights), std::vector<std::string>{model});
+  }
+  // Parameter counts of the paper's Table (ALIKED-T16 0.192 M, ALIKED-N16 0.677 M), BatchNorm statistics excluded.
+  for (const auto& [model, expected] : {std::pair{"t16", 192}, std::pair{"n16", 677}}) {
+    int64_t learnable = 0;
+    for (const auto& [key, t] : ReadAlikedStateDict(WeightsPath(model))) {
+      if (key.find("running_") == std::string::npos && key.find("num_batches") == std::string::npos) {
+        learnable += t.numel();
+      }
+    }
+    EXPECT_EQ((learnable + 500) / 1000, expected) << model << ": " << learnable;
+  }
+}
+
+TEST(AlikedWeights, ReadsUpstreamOrderedDictFiles) {
+  SKIP_WITHOUT_SHARED();
+  const testing::ScopedTempDir temp("aliked_weights");
+  const auto weights = ReadAlikedStateDict(WeightsPath("t16"));
+  const std::string path = temp.path() / "aliked-t16.pth";
+  WriteOrderedDictFile(weights, path);
+  // LibTorch alone cannot read this layout (it fails on the OrderedDict); the reader falls back to its own
+  // unpickler.
+  std::ifstream file(path, std::ios::binary);
+  const std::vector<char> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  EXPECT_ANY_THROW(torch::pickle_load(bytes));
+  const auto loaded = ReadAlikedStateDict(path);
+  ASSERT_EQ(loaded.size(), weights.size());
+  for (const auto& [key, t] : weights) {
+    ASSERT_TRUE(loaded.count(key)) << key;
+    EXPECT_TRUE(torch::equal(loaded.at(key), t)) << key;
+  }
+  CheckAlikedStateDict(loaded, AlikedPreset("t16"), path);
+}
+
+TEST(AlikedWeights, ReadsAStateDictNestedUnderStateDict) {
+  SKIP_WITHOUT_SHARED();
+  const testing::ScopedTempDir temp("aliked_weights");
+  const auto weights = ReadAlikedStateDict(WeightsPath("n16"));
+  c10::Dict<std::string, torch::Tensor> state;
+  for (const auto& [key, t] : weights) state.insert(key, t);
+  c10::impl::GenericDict checkpoint(c10::StringType::get(), c10::AnyType::get());
+  checkpoint.insert("epoch", c10::IValue(int64_t{3}));
+  checkpoint.insert("state_dict", c10::IValue(state));
+  const std::string path = temp.path() / "nested.pt";
+  WriteBytes(path, torch::pickle_save(c10::IValue(checkpoint)));
+  EXPECT_EQ(AlikedModelsFitting(ReadAlikedStateDict(path)), std::vector<std::string>{"n16"});
+}
+
+TEST(AlikedWeights, WrongModelListsKeysAndNamesTheRightOne) {
+  SKIP_WITHOUT_SHARED();
+  const std::string path = WeightsPath("n16");
+  const auto weights = ReadAlikedStateDict(path);
+  const std::string message = ExpectInputError([&] { CheckAlikedStateDict(weights, AlikedPreset("t16"), path); });
+  EXPECT_NE(message.find(path), std::string::npos) << message;
+  EXPECT_NE(message.find("keys with another shape"), std::string::npos) << message;
+  EXPECT_NE(message.find("block1.conv1.weight (file float32 16x3x3x3, expected float32 8x3x3x3)"), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("--aliked-model n16"), std::string::npos) << message;
+}
+
+TEST(AlikedWeights, MissingUnexpectedAndChangedKeysAreReported) {
+  SKIP_WITHOUT_SHARED();
+  const std::string path = WeightsPath("t16");
+  auto weights = ReadAlikedStateDict(path);
+  weights.erase("desc_head.agg_weights");
+  weights["desc_head.convM.weight"] = torch::zeros({64, 1024, 1, 1});  // the conv2D variant of SDDH
+  weights["block3.conv1.offset_conv.weight"] = torch::zeros({27, 16, 3, 3});  // a modulated (DCNv2) offset conv
+  const std::string message = ExpectInputError([&] { CheckAlikedStateDict(weights, AlikedPreset("t16"), path); });
+  EXPECT_NE(message.find("missing keys (1):\n    desc_head.agg_weights"), std::string::npos) << message;
+  EXPECT_NE(message.find("unexpected keys (1):\n    desc_head.convM.weight"), std::string::npos) << message;
+  EXPECT_NE(message.find("block3.conv1.offset_conv.weight (file float32 27x16x3x3, expected float32 18x16x3x3)"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("fits no ALIKED model"), std::string::npos) << message;
+  EXPECT_TRUE(AlikedModelsFitting(weights).empty());
+}
+
+TEST(AlikedWeights, TruncatedAndForeignFilesGiveClearErrors) {
+  SKIP_WITHOUT_SHARED();
+  const testing::ScopedTempDir temp("aliked_weights");
+  std::ifstream source(WeightsPath("t16"), std::ios::binary);
+  const std::vector<char> bytes((std::istreambuf_iterator<char>(source)), std::istreambuf_iterator<char>());
+  for (size_t keep : {size_t{0}, size_t{100}, bytes.size() / 2, bytes.size() - 10}) {
+    const std::string path = temp.path() / ("truncated_" + std::to_string(keep) + ".pt");
+    WriteBytes(path, std::vector<char>(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(keep)));
+    const std::string message = ExpectInputError([&] { ReadAlikedStateDict(path); });
+    EXPECT_NE(message.find(path), std::string::npos) << message;
+    EXPECT_NE(message.find("ALIKED weights file"), std::string::npos) << message;
+  }
+  const std::string text_path = temp.path() / "notes.txt";
+  WriteBytes(text_path, {'h', 'e', 'l', 'l', 'o'});
+  EXPECT_NE(ExpectInputError([&] { ReadAlikedStateDict(text_path); }).find("not a complete torch.save"),
+            std::string::npos);
+  const std::string list_path = temp.path() / "list.pt";
+  WriteBytes(list_path, torch::pickle_save(c10::IValue(c10::List<int64_t>({1, 2}))));
+  EXPECT_NE(ExpectInputError([&] { ReadAlikedStateDict(list_path); }).find("not a dict"), std::string::npos);
+  EXPECT_NE(ExpectInputError([&] { ReadAlikedStateDict(temp.path() / "absent.pt"); }).find("cannot open"),
+            std::string::npos);
+  // A LoFTR state dict is readable but fits no ALIKED model.
+  const auto loftr = ReadAlikedStateDict(SharedDir() + "/weights/loftr_coarse/loftr_coarse_teacher.pt");
+  EXPECT_TRUE(AlikedModelsFitting(loftr).empty());
+}
+
+}  // namespace
+}  // namespace vmap::neural

@@ -1,0 +1,38 @@
+#include "vmap/neural/loftr/loftr_options.h"
+
+#include <cmath>
+
+#include "vmap/core/error.h"
+
+namespace vmap {
+
+void LoftrMatcherOptions::Check() const {
+  if (model != "outdoor" && model != "indoor" && model != "coarse") {
+    throw InputError("unknown LoFTR model '" + model + "'; use outdoor, indoor or coarse");
+  }
+  if (device != "cpu" && device != "cuda") {
+    throw InputError("unknown device '" + device + "'; use cpu or cuda");
+  }
+  if (longest_side < 32 || longest_side > 4096) {
+    throw InputError("--loftr-size " + std::to_string(longest_side) + " is outside 32 to 4096 (default 640)");
+  }
+  if (num_threads < 0 || num_threads > 256) throw InputError("--loftr-threads must be 0 to 256 (0 = LibTorch's default)");
+  if (!std::isfinite(threshold) || threshold > 1.0) {
+    // 0 is allowed: it keeps every mutual nearest neighbour (used to reproduce the random-weight golden).
+    throw InputError("--loftr-threshold must be in [0, 1] (negative: the preset's)");
+  }
+}
+
+void LoftrMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit({"model", "--loftr-model", "LoFTR preset: outdoor, indoor or coarse"}, model);
+  visitor.Visit({"weights", "--weights", "Weights file of the deep matcher (see `vmap weights`)", false, true},
+                weights);
+  visitor.Visit({"device", "--device", "Deep matchers' device: cpu or cuda"}, device);
+  visitor.Visit({"longest_side", "--loftr-size", "LoFTR: longest image side fed to the network"}, longest_side);
+  visitor.Visit({"threshold", "--loftr-threshold", "LoFTR: coarse confidence threshold (default: preset's)", false},
+                threshold);
+  visitor.Visit({"threads", "--loftr-threads", "LoFTR: LibTorch threads per call (0 = LibTorch default)"},
+                num_threads);
+}
+
+}  // namespace vmap

@@ -1,0 +1,168 @@
+// XFeat behind the Matcher interface: the reference through Extract/Match on grey images, coordinates in
+// the image given, options recorded, concurrent use, and bad input.
+
+#include <array>
+#include <functional>
+#include <map>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "vmap/core/error.h"
+#include "vmap/features/matcher_registry.h"
+#include "vmap/neural/golden_util.h"
+#include "vmap/neural/xfeat/xfeat_matcher.h"
+
+namespace vmap {
+namespace {
+
+using neural::testing::LoadTensorDict;
+using neural::testing::SharedDir;
+
+XfeatMatcherOptions SharedOptions() {
+  XfeatMatcherOptions options;
+  options.weights = SharedDir() + "/weights/xfeat/xfeat_folded.pt";
+  options.top_k = 4096;
+  options.min_similarity = 0.82;
+  return options;
+}
+
+std::string PairDir(const std::string& pair) { return SharedDir() + "/golden/xfeat/" + pair; }
+
+std::string ExpectInputError(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected InputError";
+  return "";
+}
+
+TEST(XfeatMatcher, ReproducesTheReferenceThroughTheInterface) {
+  SKIP_WITHOUT_SHARED();
+  // KITTI is grey (B = G = R in the stored PNGs), so the grey image the interface takes is the reference's
+  // input; the image is resized from 1226x370 to 1216x352 and the keypoints come back in 1226x370 pixels.
+  MatcherOptions options;
+  options.type = "xfeat";
+  options.Of<XfeatMatcherOptions>() = SharedOptions();
+  const auto matcher = CreateMatcher(options);
+  EXPECT_EQ(matcher->name(), "xfeat");
+  const std::string dir = PairDir("kitti07_000010_000014");
+  const auto f0 = matcher->Extract(cv::imread(dir + "/input0.png", cv::IMREAD_GRAYSCALE));
+  const auto f1 = matcher->Extract(cv::imread(dir + "/input1.png", cv::IMREAD_GRAYSCALE));
+  EXPECT_EQ(f0->image_size(), cv::Size(1226, 370));
+  EXPECT_EQ(f0->num_features(), 4096);
+  const TentativeMatches matches = matcher->Match(*f0, *f1);
+  const auto g = LoadTensorDict(dir + "/golden.pt");
+  const auto mkpts0 = g.at("mkpts0_mnn0p82"), mkpts1 = g.at("mkpts1_mnn0p82"), cossim = g.at("cossim_mnn0p82");
+  std::map<std::array<float, 4>, float> reference;
+  for (int64_t k = 0; k < mkpts0.size(0); ++k) {
+    reference[{mkpts0[k][0].item<float>(), mkpts0[k][1].item<float>(), mkpts1[k][0].item<float>(),
+               mkpts1[k][1].item<float>()}] = cossim[k].item<float>();
+  }
+  ASSERT_EQ(matches.scores.size(), matches.size());
+  size_t common = 0;
+  for (size_t k = 0; k < matches.size(); ++k) {
+    const auto it = reference.find({matches.points0[k].x, matches.points0[k].y, matches.points1[k].x,
+                                    matches.points1[k].y});
+    if (it == reference.end()) continue;
+    ++common;
+    EXPECT_NEAR(matches.scores[k], it->second, 2e-5);
+    EXPECT_GT(matches.scores[k], 0.82f);
+  }
+  EXPECT_GE(common + 2, reference.size()) << matches.size() << " matches";
+  EXPECT_LE(matches.size(), common + 2);
+  // The key image's features serve any number of later frames.
+  EXPECT_EQ(matcher->Match(*f0, *f1).points1, matches.points1);
+}
+
+TEST(XfeatMatcher, OptionsShapeTheOutputAndAreRecorded) {
+  SKIP_WITHOUT_SHARED();
+  XfeatMatcherOptions options = SharedOptions();
+  options.top_k = 500;
+  options.min_similarity = 0.9;
+  const auto matcher = CreateXfeatMatcher(options);
+  const std::string dir = PairDir("rccar_000000_000006");
+  const auto f0 = matcher->Extract(cv::imread(dir + "/input0.png", cv::IMREAD_GRAYSCALE));
+  const auto f1 = matcher->Extract(cv::imread(dir + "/input1.png", cv::IMREAD_GRAYSCALE));
+  EXPECT_EQ(f0->num_features(), 500);
+  const auto matches = matcher->Match(*f0, *f1);
+  ASSERT_GT(matches.size(), 100u);
+  for (float s : matches.scores) EXPECT_GT(s, 0.9f);
+  const auto json = nlohmann::json::parse(matcher->DescribeOptionsJson());
+  EXPECT_EQ(json["type"], "xfeat");
+  EXPECT_EQ(json["top_k"], 500);
+  EXPECT_EQ(json["min_similarity"], 0.9);
+  EXPECT_EQ(json["detection_threshold"], 0.05);
+  EXPECT_EQ(json["weights_layout"], "folded");
+  EXPECT_EQ(json["device"], "cpu");
+  EXPECT_EQ(json["weights"], options.weights);
+}
+
+TEST(XfeatMatcher, ConcurrentExtractAndMatchGiveTheSameResults) {
+  SKIP_WITHOUT_SHARED();
+  XfeatMatcherOptions options = SharedOptions();
+  options.top_k = 1000;
+  const auto matcher = CreateXfeatMatcher(options);
+  const std::string dir = PairDir("labfloor_00100_00130");
+  const cv::Mat gray0 = cv::imread(dir + "/input0.png", cv::IMREAD_GRAYSCALE);
+  const cv::Mat gray1 = cv::imread(dir + "/input1.png", cv::IMREAD_GRAYSCALE);
+  const auto f0 = matcher->Extract(gray0);
+  const auto f1 = matcher->Extract(gray1);
+  const auto expected = matcher->Match(*f0, *f1);
+  std::vector<TentativeMatches> results(4);
+  std::vector<std::thread> threads;
+  for (size_t t = 0; t < results.size(); ++t) {
+    threads.emplace_back([&, t] {
+      const auto a = matcher->Extract(t % 2 ? gray1 : gray0);
+      const auto b = matcher->Extract(t % 2 ? gray0 : gray1);
+      results[t] = t % 2 ? matcher->Match(*b, *a) : matcher->Match(*a, *b);
+    });
+  }
+  for (auto& thread : threads) thread.join();
+  for (const auto& r : results) {
+    EXPECT_EQ(r.points0, expected.points0);
+    EXPECT_EQ(r.points1, expected.points1);
+  }
+}
+
+TEST(XfeatMatcher, BadInputIsRefusedClearly) {
+  SKIP_WITHOUT_SHARED();
+  const auto matcher = CreateXfeatMatcher(SharedOptions());
+  EXPECT_NE(ExpectInputError([&] { matcher->Extract(cv::Mat(64, 64, CV_8UC3, cv::Scalar(0))); }).find("single-channel"),
+            std::string::npos);
+  EXPECT_NE(ExpectInputError([&] { matcher->Extract(cv::Mat(31, 64, CV_8UC1, cv::Scalar(0))); }).find("32x32"),
+            std::string::npos);
+  // A blank image has no keypoints, and matching it gives nothing.
+  const auto blank = matcher->Extract(cv::Mat(96, 128, CV_8UC1, cv::Scalar(128)));
+  EXPECT_EQ(blank->num_features(), 0);
+  EXPECT_EQ(matcher->Match(*blank, *blank).size(), 0u);
+
+  XfeatMatcherOptions cuda = SharedOptions();
+  cuda.device = "cuda";
+  if (!torch::cuda::is_available()) {
+    EXPECT_NE(ExpectInputError([&] { CreateXfeatMatcher(cuda); }).find("--device cuda"), std::string::npos);
+  }
+  XfeatMatcherOptions bad = SharedOptions();
+  bad.top_k = 0;
+  EXPECT_NE(ExpectInputError([&] { bad.Check(); }).find("--xfeat-top-k"), std::string::npos);
+  bad = SharedOptions();
+  bad.min_similarity = 1.5;
+  EXPECT_NE(ExpectInputError([&] { bad.Check(); }).find("--xfeat-min-similarity"), std::string::npos);
+  bad = SharedOptions();
+  bad.detection_threshold = -0.1;
+  EXPECT_NE(ExpectInputError([&] { bad.Check(); }).find("--xfeat-threshold"), std::string::npos);
+  bad = SharedOptions();
+  bad.device = "tpu";
+  EXPECT_NE(ExpectInputError([&] { bad.Check(); }).find("unknown device"), std::string::npos);
+  bad = SharedOptions();
+  bad.weights = SharedDir() + "/no/such/file.pt";
+  EXPECT_NE(ExpectInputError([&] { CreateXfeatMatcher(bad); }).find("does not exist"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace vmap
