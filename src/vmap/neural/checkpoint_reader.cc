@@ -295,13 +295,4 @@ StateDict ReadRefusedWeightsFile(const std::string& path, const std::string& mod
   }
 }
 
-std::string ListStateDictKeys(const std::string& title, const std::vector<std::string>& keys) {
-  if (keys.empty()) return "";
-  constexpr size_t kShown = 12;
-  std::string text = "\n  " + title + " (" + std::to_string(keys.size()) + "):";
-  for (size_t i = 0; i < keys.size() && i < kShown; ++i) text += "\n    " + keys[i];
-  if (keys.size() > kShown) text += "\n    ... and " + std::to_string(keys.size() - kShown) + " more";
-  return text;
-}
-
 }  // namespace vmap::neural

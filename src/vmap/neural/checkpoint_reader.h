@@ -23,8 +23,4 @@ StateDict ReadCheckpointTensors(const std::string& path);
 StateDict ReadRefusedWeightsFile(const std::string& path, const std::string& model, const std::string& first_error,
                                  size_t file_size);
 
-// One kind of state-dict mismatch (missing, unexpected, wrong shape) as lines of an error message: the count
-// and the first 12 keys; empty when there are none.
-std::string ListStateDictKeys(const std::string& title, const std::vector<std::string>& keys);
-
 }  // namespace vmap::neural

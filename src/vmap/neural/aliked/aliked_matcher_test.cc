@@ -15,6 +15,8 @@
 namespace vmap {
 namespace {
 
+using neural::testing::ExpectInputError;
+
 using neural::testing::LoadTensorDict;
 using neural::testing::SharedDir;
 
@@ -27,16 +29,6 @@ AlikedMatcherOptions Options(const std::string& model) {
   options.model = model;
   options.weights = SharedDir() + "/weights/aliked/aliked-" + model + ".pt";
   return options;
-}
-
-std::string ExpectInputError(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected InputError";
-  return "";
 }
 
 // Matches as (x0, y0, x1, y1) rounded to 1e-2 px, for set comparisons independent of keypoint order.

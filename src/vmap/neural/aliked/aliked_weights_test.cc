@@ -1,6 +1,5 @@
 // ALIKED weights: the architecture's key set against the shared files, upstream's OrderedDict layout, and bad files.
 
-#include <filesystem>
 #include <fstream>
 
 #include <caffe2/serialize/inline_container.h>
@@ -14,92 +13,13 @@
 namespace vmap::neural {
 namespace {
 
+using testing::ExpectInputError;
+using testing::WriteBytes;
+using testing::WriteOrderedDictFile;
+
 using testing::SharedDir;
-namespace fs = std::filesystem;
 
 std::string WeightsPath(const std::string& model) { return SharedDir() + "/weights/aliked/aliked-" + model + ".pt"; }
-
-void WriteBytes(const std::string& path, const std::vector<char>& bytes) {
-  std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
-
-std::string ExpectInputError(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected InputError";
-  return "";
-}
-
-// Writes `weights` the way `torch.save(model.state_dict(), path)` does in Python: the root object is a
-// collections.OrderedDict (with a _metadata attribute), which LibTorch's own unpickler cannot build.
-void WriteOrderedDictFile(const StateDict& weights, const std::string& path) {
-  std::string code = "\x80\x02";
-  auto op = [&](char c) { code += c; };
-  auto int32 = [&](uint32_t v) {
-    for (int i = 0; i < 4; ++i) code += static_cast<char>((v >> (8 * i)) & 0xff);
-  };
-  auto string = [&](const std::string& s) {
-    op('X');
-    int32(static_cast<uint32_t>(s.size()));
-    code += s;
-  };
-  auto integer = [&](int64_t v) {
-    op('J');
-    int32(static_cast<uint32_t>(v));
-  };
-  auto global = [&](const std::string& module, const std::string& name) { code += "c" + module + "\n" + name + "\n"; };
-  caffe2::serialize::PyTorchStreamWriter writer(path);
-  global("collections", "OrderedDict");
-  op(')');
-  op('R');
-  op('(');
-  int record = 0;
-  std::vector<torch::Tensor> keep;
-  for (const auto& [key, tensor] : weights) {
-    auto t = tensor.contiguous();
-    keep.push_back(t);
-    string(key);
-    global("torch._utils", "_rebuild_tensor_v2");
-    op('(');
-    op('(');
-    string("storage");
-    global("torch", t.scalar_type() == torch::kInt64 ? "LongStorage" : "FloatStorage");
-    string(std::to_string(record));
-    string("cpu");
-    integer(t.numel());
-    op('t');
-    op('Q');
-    integer(0);
-    op('(');
-    for (auto d : t.sizes()) integer(d);
-    op('t');
-    op('(');
-    for (auto d : t.strides()) integer(d);
-    op('t');
-    op('\x89');  // requires_grad False
-    global("collections", "OrderedDict");
-    op(')');
-    op('R');
-    op('t');
-    op('R');
-    writer.writeRecord("data/" + std::to_string(record), t.data_ptr(), t.numel() * t.element_size());
-    ++record;
-  }
-  op('u');
-  op('}');  // the OrderedDict's attributes: {'_metadata': OrderedDict()}
-  string("_metadata");
-  global("collections", "OrderedDict");
-  op(')');
-  op('R');
-  op('s');
-  op('b');
-  op('.');
-  writer.writeRecord("data.pkl", code.data(), code.size());
-  writer.writeEndOfFile();
-}
 
 TEST(AlikedWeights, SharedFilesHoldExactlyTheExpectedTensors) {
   SKIP_WITHOUT_SHARED();

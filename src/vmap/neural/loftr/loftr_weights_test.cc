@@ -1,6 +1,5 @@
 // Weights: the architecture's key set against the official one, the file layouts users have, and bad files.
 
-#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -15,26 +14,14 @@
 namespace vmap::neural {
 namespace {
 
+using testing::ExpectInputError;
+using testing::WriteBytes;
+
 using testing::SharedDir;
-namespace fs = std::filesystem;
 
 std::string TempPath(const std::string& name) {
   static const testing::ScopedTempDir dir("loftr_weights");
   return (dir.path() / name).string();
-}
-
-void WriteBytes(const std::string& path, const std::vector<char>& bytes) {
-  std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
-
-std::string ExpectInputError(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected InputError";
-  return "";
 }
 
 // key<TAB>dtype<TAB>shape, as the golden's state_dict_keys*.txt list the official checkpoints.
@@ -103,58 +90,7 @@ TEST(LoftrWeights, ReadsLightningCheckpointLayout) {
   }
   CheckStateDict(loaded, LoftrPreset("outdoor"), path);
   CheckStateDict(loaded, LoftrPreset("indoor"), path);
-  fs::remove_all(fs::path(path).parent_path());
 }
-
-// A pickle program shaped like a PyTorch-Lightning checkpoint, written opcode by opcode: the state dict is a
-// collections.OrderedDict with a _metadata attribute, beside objects of classes LibTorch does not know.
-class LightningPickle {
- public:
-  void Raw(const std::string& bytes) { code_ += bytes; }
-  void Op(char op) { code_ += op; }
-  void String(const std::string& s) {
-    Op('X');
-    Int32(static_cast<uint32_t>(s.size()));
-    code_ += s;
-  }
-  void Int(int64_t v) {
-    Op('J');
-    Int32(static_cast<uint32_t>(v));
-  }
-  void Global(const std::string& module, const std::string& name) { code_ += "c" + module + "\n" + name + "\n"; }
-  void Tensor(const torch::Tensor& t, const std::string& record) {
-    Global("torch._utils", "_rebuild_tensor_v2");
-    Op('(');
-    Op('(');
-    String("storage");
-    Global("torch", t.scalar_type() == torch::kInt64 ? "LongStorage" : "FloatStorage");
-    String(record);
-    String("cpu");
-    Int(t.numel());
-    Op('t');
-    Op('Q');
-    Int(0);
-    Op('(');
-    for (auto d : t.sizes()) Int(d);
-    Op('t');
-    Op('(');
-    for (auto d : t.strides()) Int(d);
-    Op('t');
-    Op('\x89');  // requires_grad False
-    Global("collections", "OrderedDict");
-    Op(')');
-    Op('R');
-    Op('t');
-    Op('R');
-  }
-  const std::string& code() const { return code_; }
-
- private:
-  void Int32(uint32_t v) {
-    for (int i = 0; i < 4; ++i) code_ += static_cast<char>((v >> (8 * i)) & 0xff);
-  }
-  std::string code_;
-};
 
 TEST(LoftrWeights, ReadsLightningCheckpointWithOrderedDict) {
   SKIP_WITHOUT_SHARED();
@@ -162,7 +98,9 @@ TEST(LoftrWeights, ReadsLightningCheckpointWithOrderedDict) {
   const std::string path = TempPath("ordered.ckpt");
   {
     caffe2::serialize::PyTorchStreamWriter writer(path);
-    LightningPickle p;
+    // A PyTorch-Lightning checkpoint: the state dict as a collections.OrderedDict beside objects of classes
+    // LibTorch does not know.
+    testing::PickleProgram p;
     p.Raw("\x80\x02");
     p.Op('}');
     p.Op('(');
@@ -178,28 +116,7 @@ TEST(LoftrWeights, ReadsLightningCheckpointWithOrderedDict) {
     p.Op('s');
     p.Op('b');
     p.String("state_dict");
-    p.Global("collections", "OrderedDict");
-    p.Op(')');
-    p.Op('R');
-    p.Op('(');
-    int record = 0;
-    std::vector<torch::Tensor> keep;
-    for (const auto& [key, t] : weights) {
-      auto c = t.contiguous();
-      keep.push_back(c);
-      p.String("matcher." + key);
-      p.Tensor(c, std::to_string(record));
-      writer.writeRecord("data/" + std::to_string(record), c.data_ptr(), c.numel() * c.element_size());
-      ++record;
-    }
-    p.Op('u');
-    p.Op('}');  // the OrderedDict's attributes: {'_metadata': OrderedDict()}
-    p.String("_metadata");
-    p.Global("collections", "OrderedDict");
-    p.Op(')');
-    p.Op('R');
-    p.Op('s');
-    p.Op('b');
+    p.OrderedStateDict(weights, "matcher.", 0, writer);
     p.Op('u');
     p.Op('.');
     writer.writeRecord("data.pkl", p.code().data(), p.code().size());
@@ -212,7 +129,6 @@ TEST(LoftrWeights, ReadsLightningCheckpointWithOrderedDict) {
     EXPECT_TRUE(torch::equal(loaded.at(key), t)) << key;
   }
   CheckStateDict(loaded, LoftrPreset("coarse"), path);
-  fs::remove_all(fs::path(path).parent_path());
 }
 
 TEST(LoftrWeights, WrongPresetListsKeysAndNamesTheRightOne) {
@@ -256,7 +172,6 @@ TEST(LoftrWeights, TruncatedAndForeignFilesGiveClearErrors) {
   WriteBytes(list_path, torch::pickle_save(c10::IValue(c10::List<int64_t>({1, 2}))));
   EXPECT_NE(ExpectInputError([&] { ReadStateDict(list_path); }).find("not a dict"), std::string::npos);
   EXPECT_NE(ExpectInputError([&] { ReadStateDict(TempPath("absent.pt")); }).find("cannot open"), std::string::npos);
-  fs::remove_all(fs::path(text_path).parent_path());
 }
 
 }  // namespace

@@ -2,7 +2,6 @@
 // the image given, options recorded, concurrent use, and bad input.
 
 #include <array>
-#include <functional>
 #include <map>
 #include <thread>
 
@@ -19,6 +18,8 @@
 namespace vmap {
 namespace {
 
+using neural::testing::ExpectInputError;
+
 using neural::testing::LoadTensorDict;
 using neural::testing::SharedDir;
 
@@ -31,16 +32,6 @@ XfeatMatcherOptions SharedOptions() {
 }
 
 std::string PairDir(const std::string& pair) { return SharedDir() + "/golden/xfeat/" + pair; }
-
-std::string ExpectInputError(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected InputError";
-  return "";
-}
 
 TEST(XfeatMatcher, ReproducesTheReferenceThroughTheInterface) {
   SKIP_WITHOUT_SHARED();

@@ -1,14 +1,9 @@
 #include "vmap/neural/xfeat/xfeat_weights.h"
 
-#include <fstream>
-#include <iterator>
-#include <set>
+#include <algorithm>
 #include <tuple>
 
-#include <torch/serialize.h>
-
 #include "vmap/core/error.h"
-#include "vmap/neural/checkpoint_reader.h"
 
 namespace vmap::neural {
 
@@ -17,55 +12,30 @@ namespace {
 constexpr double kBatchNormEps = 1e-5;  // BatchNorm2d's default, used by every upstream BasicLayer
 const char kFineMatcherPrefix[] = "fine_matcher.";
 
-struct KeySpec {
-  std::vector<int64_t> shape;
-  bool floating = true;
-};
-
-std::map<std::string, KeySpec> ExpectedKeys(XfeatLayout layout) {
-  std::map<std::string, KeySpec> keys;
+std::vector<TensorSpec> ExpectedTensors(XfeatLayout layout) {
+  std::vector<TensorSpec> tensors;
   for (const XfeatConv& conv : XfeatConvolutions()) {
-    keys[conv.weight_key()] = {{conv.out_channels, conv.in_channels, conv.kernel, conv.kernel}};
+    tensors.push_back({conv.weight_key(), "float32", {conv.out_channels, conv.in_channels, conv.kernel, conv.kernel}});
     if (conv.batch_norm && layout == XfeatLayout::kOfficial) {
       const std::string bn = conv.name + ".layer.1.";
-      keys[bn + "running_mean"] = {{conv.out_channels}};
-      keys[bn + "running_var"] = {{conv.out_channels}};
-      keys[bn + "num_batches_tracked"] = {{}, false};
+      tensors.push_back({bn + "running_mean", "float32", {conv.out_channels}});
+      tensors.push_back({bn + "running_var", "float32", {conv.out_channels}});
+      tensors.push_back({bn + "num_batches_tracked", "int64", {}});
     } else {
-      keys[conv.bias_key()] = {{conv.out_channels}};
+      tensors.push_back({conv.bias_key(), "float32", {conv.out_channels}});
     }
   }
-  return keys;
+  return tensors;
 }
 
-std::string ShapeText(c10::IntArrayRef shape) {
-  if (shape.empty()) return "scalar";
-  std::string text;
-  for (size_t i = 0; i < shape.size(); ++i) text += (i ? "x" : "") + std::to_string(shape[i]);
-  return text;
-}
-
-struct Mismatch {
-  std::vector<std::string> missing, unexpected, wrong_shape;
-  size_t size() const { return missing.size() + unexpected.size() + wrong_shape.size(); }
-};
-
-Mismatch Compare(const StateDict& weights, XfeatLayout layout) {
-  Mismatch result;
-  const auto expected = ExpectedKeys(layout);
-  for (const auto& [key, spec] : expected) {
-    const auto it = weights.find(key);
-    if (it == weights.end()) {
-      result.missing.push_back(key);
-    } else if (it->second.sizes().vec() != spec.shape || it->second.is_floating_point() != spec.floating) {
-      result.wrong_shape.push_back(key + " (file " + std::string(c10::toString(it->second.scalar_type())) + " " +
-                                   ShapeText(it->second.sizes()) + ", expected " +
-                                   (spec.floating ? "float " : "integer ") + ShapeText(spec.shape) + ")");
-    }
-  }
-  for (const auto& [key, tensor] : weights) {
-    const bool fine_matcher = key.rfind(kFineMatcherPrefix, 0) == 0;
-    if (!expected.count(key) && !(fine_matcher && layout == XfeatLayout::kOfficial)) result.unexpected.push_back(key);
+StateDictMismatch Compare(const StateDict& weights, XfeatLayout layout) {
+  StateDictMismatch result = CompareStateDict(weights, ExpectedTensors(layout));
+  // The official file also holds the fine matcher, which vmap does not use.
+  if (layout == XfeatLayout::kOfficial) {
+    auto& unexpected = result.unexpected;
+    unexpected.erase(std::remove_if(unexpected.begin(), unexpected.end(),
+                                    [](const std::string& key) { return key.rfind(kFineMatcherPrefix, 0) == 0; }),
+                     unexpected.end());
   }
   return result;
 }
@@ -75,52 +45,17 @@ std::string Describe(XfeatLayout layout) {
                                           : "the folded layout (xfeat_folded.pt: BatchNorm folded into the convolutions)";
 }
 
-// torch.save(model.state_dict()) pickles a collections.OrderedDict, which LibTorch's unpickler cannot
-// return; the checkpoint reader runs such files itself.
-StateDict ReadWithCheckpointReader(const std::string& path, const std::string& first_error, size_t file_size) {
-  StateDict weights = ReadRefusedWeightsFile(path, "XFeat", first_error, file_size);
-  if (weights.empty()) throw InputError("XFeat weights file '" + path + "' holds no tensors");
-  return weights;
-}
-
 }  // namespace
 
 std::string XfeatLayoutName(XfeatLayout layout) { return layout == XfeatLayout::kOfficial ? "official" : "folded"; }
 
-StateDict ReadXfeatStateDict(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw InputError("cannot open XFeat weights file '" + path + "'; check the path given to --weights");
-  const std::vector<char> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  c10::IValue root;
-  try {
-    root = torch::pickle_load(bytes);
-  } catch (const std::exception& e) {
-    const std::string reason = e.what();
-    return ReadWithCheckpointReader(path, reason.substr(0, reason.find('\n')), bytes.size());
-  }
-  if (root.isNone()) return ReadWithCheckpointReader(path, "OrderedDict", bytes.size());
-  if (!root.isGenericDict()) {
-    throw InputError("XFeat weights file '" + path + "' holds a " + root.tagKind() +
-                     ", not a dict of tensors; see `vmap weights` for the supported files");
-  }
-  StateDict weights;
-  for (const auto& entry : root.toGenericDict()) {
-    if (!entry.key().isString() || !entry.value().isTensor()) {
-      throw InputError("XFeat weights file '" + path + "': entry '" +
-                       (entry.key().isString() ? entry.key().toStringRef() : entry.key().tagKind()) +
-                       "' is not a named tensor; expected a state dict of tensors");
-    }
-    weights[entry.key().toStringRef()] = entry.value().toTensor();
-  }
-  if (weights.empty()) throw InputError("XFeat weights file '" + path + "' holds no tensors");
-  return weights;
-}
+StateDict ReadXfeatStateDict(const std::string& path) { return ReadWeightsFile(path, "XFeat"); }
 
 XfeatLayout CheckXfeatStateDict(const StateDict& weights, const std::string& path) {
-  const Mismatch folded = Compare(weights, XfeatLayout::kFolded);
-  if (folded.size() == 0) return XfeatLayout::kFolded;
-  const Mismatch official = Compare(weights, XfeatLayout::kOfficial);
-  if (official.size() == 0) {
+  const StateDictMismatch folded = Compare(weights, XfeatLayout::kFolded);
+  if (folded.empty()) return XfeatLayout::kFolded;
+  const StateDictMismatch official = Compare(weights, XfeatLayout::kOfficial);
+  if (official.empty()) {
     for (const XfeatConv& conv : XfeatConvolutions()) {
       if (!conv.batch_norm) continue;
       const std::string key = conv.name + ".layer.1.running_var";
@@ -132,11 +67,10 @@ XfeatLayout CheckXfeatStateDict(const StateDict& weights, const std::string& pat
     return XfeatLayout::kOfficial;
   }
   const bool official_closer = official.size() < folded.size();
-  const Mismatch& closest = official_closer ? official : folded;
+  const StateDictMismatch& closest = official_closer ? official : folded;
   throw InputError("XFeat weights file '" + path + "' fits no XFeat layout; against " +
                    Describe(official_closer ? XfeatLayout::kOfficial : XfeatLayout::kFolded) + ":" +
-                   ListStateDictKeys("missing keys", closest.missing) + ListStateDictKeys("unexpected keys", closest.unexpected) +
-                   ListStateDictKeys("keys with another shape", closest.wrong_shape) +
+                   closest.Describe() +
                    "\n  Is it an XFeat file? See `vmap weights` for the supported files.");
 }
 

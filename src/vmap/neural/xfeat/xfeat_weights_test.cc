@@ -1,9 +1,7 @@
 // XFeat weights: the shared folded file, the official layout users download (BatchNorm statistics and the
 // unused fine_matcher, as a plain dict and as the collections.OrderedDict torch.save writes), and bad files.
 
-#include <filesystem>
 #include <fstream>
-#include <functional>
 
 #include <caffe2/serialize/inline_container.h>
 #include <gtest/gtest.h>
@@ -18,14 +16,12 @@
 namespace vmap::neural {
 namespace {
 
+using testing::ExpectInputError;
+using testing::WriteBytes;
+
 using testing::SharedDir;
-namespace fs = std::filesystem;
 
 std::string SharedWeights() { return SharedDir() + "/weights/xfeat/xfeat_folded.pt"; }
-
-void WriteBytes(const std::string& path, const std::vector<char>& bytes) {
-  std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
 
 void SaveDict(const StateDict& weights, const std::string& path) {
   c10::Dict<std::string, torch::Tensor> dict;
@@ -56,16 +52,6 @@ void MakeOrderedDict(const std::string& plain, const std::string& ordered) {
     writer.writeRecord(name, data.get(), size);
   }
   writer.writeEndOfFile();
-}
-
-std::string ExpectInputError(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected InputError";
-  return "";
 }
 
 constexpr double kEps = 1e-5;
@@ -182,7 +168,7 @@ TEST(XfeatWeights, MissingUnexpectedAndMisshapedKeysAreListed) {
   std::string message = ExpectInputError([&] { CheckXfeatStateDict(broken, "broken.pt"); });
   for (const std::string expected :
        {"'broken.pt'", "folded layout", "missing keys (1)", "block3.1.layer.0.bias", "unexpected keys (1)",
-        "extra.weight", "block1.0.layer.0.weight (file Float 4x1x5x5, expected float 4x1x3x3)"}) {
+        "extra.weight", "block1.0.layer.0.weight (file float32 4x1x5x5, expected float32 4x1x3x3)"}) {
     EXPECT_NE(message.find(expected), std::string::npos) << expected << " not in: " << message;
   }
 
@@ -191,7 +177,7 @@ TEST(XfeatWeights, MissingUnexpectedAndMisshapedKeysAreListed) {
   official["block5.2.layer.1.num_batches_tracked"] = torch::zeros({1});
   message = ExpectInputError([&] { CheckXfeatStateDict(official, "xfeat.pt"); });
   for (const std::string expected : {"official layout", "block5.2.layer.1.running_var",
-                                     "block5.2.layer.1.num_batches_tracked (file Float 1, expected integer scalar)"}) {
+                                     "block5.2.layer.1.num_batches_tracked (file float32 1, expected int64 scalar)"}) {
     EXPECT_NE(message.find(expected), std::string::npos) << expected << " not in: " << message;
   }
 
