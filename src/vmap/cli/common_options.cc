@@ -98,7 +98,8 @@ VerifierOptions VerifierFlags::Resolve() const {
 }
 
 void AddVerifierOptions(CLI::App* command, VerifierFlags& flags) {
-  command->add_option("--verifier", flags.method, "Fundamental matrix estimator: magsac, ransac, usac, accurate")
+  command
+      ->add_option("--verifier", flags.method, "Fundamental matrix estimator: " + ListEnumNames(kVerifierMethodNames))
       ->capture_default_str();
   command->add_option("--threshold", flags.options.threshold, "Verifier inlier threshold in pixels")
       ->capture_default_str();
@@ -117,7 +118,7 @@ FrameSourceOptions SourceFlags::Resolve() const {
 }
 
 void AddSourceOptions(CLI::App* command, SourceFlags& flags) {
-  command->add_option("--format", flags.format, "Input layout: auto, video, images, tum, euroc, kitti")
+  command->add_option("--format", flags.format, "Input layout: " + ListEnumNames(kSourceFormatNames))
       ->capture_default_str();
   command->add_option("--first", flags.options.first, "First frame (0-based)")->capture_default_str();
   command->add_option("--last", flags.options.last, "Last frame, inclusive (-1 = end)")->capture_default_str();

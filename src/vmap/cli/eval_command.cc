@@ -58,7 +58,9 @@ void AddEvalCommand(CLI::App& app) {
   command->add_option("--gt", flags->gt,
                       "Ground-truth poses (default: the input's own: KITTI poses.txt, TUM groundtruth.txt, EuRoC "
                       "state_groundtruth_estimate0/data.csv). Formats: kitti, tum, euroc");
-  command->add_option("--gt-format", flags->gt_format, "Format of --gt: auto (from its first line), kitti, tum, euroc")
+  command
+      ->add_option("--gt-format", flags->gt_format,
+                   "Format of --gt: " + ListEnumNames(kGroundTruthFormatNames) + " (auto: from its first line)")
       ->capture_default_str();
   command->add_option("--camera", flags->camera,
                       "Intrinsics when the map has none: fx,fy,cx,cy[,k1,k2,p1,p2[,k3]] or a calibration file");

@@ -22,8 +22,9 @@ void AddInfoCommand(CLI::App& app) {
       auto it = object.find(name);
       return it != object.end() && it->is_string() ? it->get<std::string>() : std::string("?");
     };
+    // A map from a newer vmap may name a mean this one does not know: its summary then uses the arithmetic one.
     const QualityMean mean =
-        text(options, "quality_mean") == "harmonic" ? QualityMean::kHarmonic : QualityMean::kArithmetic;
+        FindEnum(kQualityMeanNames, text(options, "quality_mean")).value_or(QualityMean::kArithmetic);
     std::cout << FormatMapSummary(map, mean);
     const auto matcher = options.find("matcher"), verifier = options.find("verifier"), tau = options.find("tau");
     if (matcher != options.end() && matcher->is_object() && verifier != options.end() && verifier->is_object()) {

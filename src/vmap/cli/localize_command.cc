@@ -153,7 +153,7 @@ void AddLocalizeCommand(CLI::App& app) {
   command->add_option("--lookahead", o.lookahead, "Key images beyond the next compared while tracking (1 or 2)")
       ->capture_default_str();
   command->add_flag("!--no-step-back", o.step_back, "Never move the estimate back to the previous key image");
-  command->add_option("--ranking", flags->ranking, "Relocalization ranking: auto, votes or thumbnails")
+  command->add_option("--ranking", flags->ranking, "Relocalization ranking: " + ListEnumNames(kRankingMethodNames))
       ->capture_default_str();
   command->add_option("--from", flags->from, "Follow the route from this key image (default: the first)");
   command->add_option("--to", flags->to, "Follow the route to this key image (default: the last)");

@@ -56,7 +56,7 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau) 
   command->add_option("--similarity", flags.similarity,
                       "S = verified / tentative matches (inlier-ratio) or / features detected (feature-ratio)")
       ->capture_default_str();
-  command->add_option("--quality", flags.quality, "Mean used by the quality Q: arithmetic or harmonic")
+  command->add_option("--quality", flags.quality, "Mean used by the quality Q: " + ListEnumNames(kQualityMeanNames))
       ->capture_default_str();
   command->add_flag("!--no-final-key", flags.final_key, "Do not make the last frame a key image");
   command->add_option("--threads", flags.threads, "Feature-extraction threads, 0 to 256 (0 = one per core)")

@@ -151,7 +151,7 @@ void AddSweepCommand(CLI::App& app) {
                                         "Add a usable-links column (see `vmap eval`): with no FILE, the input's own "
                                         "ground truth; or a kitti, tum or euroc poses file")
                         ->expected(0, 1);
-  command->add_option("--gt-format", flags->gt_format, "Format of --gt FILE: auto, kitti, tum, euroc")
+  command->add_option("--gt-format", flags->gt_format, "Format of --gt FILE: " + ListEnumNames(kGroundTruthFormatNames))
       ->capture_default_str();
   command->callback([flags, gt] {
     flags->evaluate = gt->count() > 0;

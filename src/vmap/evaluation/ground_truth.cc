@@ -15,22 +15,10 @@ namespace vmap {
 namespace fs = std::filesystem;
 
 GroundTruthFormat ParseGroundTruthFormat(const std::string& name) {
-  if (name == "auto") return GroundTruthFormat::kAuto;
-  if (name == "kitti") return GroundTruthFormat::kKitti;
-  if (name == "tum") return GroundTruthFormat::kTum;
-  if (name == "euroc") return GroundTruthFormat::kEuroc;
-  throw InputError("unknown ground-truth format '" + name + "'; use auto, kitti, tum or euroc");
+  return ParseEnum(kGroundTruthFormatNames, name, "ground-truth format");
 }
 
-std::string GroundTruthFormatName(GroundTruthFormat format) {
-  switch (format) {
-    case GroundTruthFormat::kAuto: return "auto";
-    case GroundTruthFormat::kKitti: return "kitti";
-    case GroundTruthFormat::kTum: return "tum";
-    case GroundTruthFormat::kEuroc: return "euroc";
-  }
-  return "auto";
-}
+std::string GroundTruthFormatName(GroundTruthFormat format) { return EnumToName(kGroundTruthFormatNames, format); }
 
 namespace {
 

@@ -17,13 +17,16 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/enum_names.h"
 #include "vmap/map/visual_map.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap {
 
 enum class GroundTruthFormat { kAuto, kKitti, kTum, kEuroc };
-GroundTruthFormat ParseGroundTruthFormat(const std::string& name);  // "auto", "kitti", "tum", "euroc"
+inline constexpr EnumName<GroundTruthFormat> kGroundTruthFormatNames[] = {{GroundTruthFormat::kAuto, "auto"},
+    {GroundTruthFormat::kKitti, "kitti"}, {GroundTruthFormat::kTum, "tum"}, {GroundTruthFormat::kEuroc, "euroc"}};
+GroundTruthFormat ParseGroundTruthFormat(const std::string& name);
 std::string GroundTruthFormatName(GroundTruthFormat format);
 
 struct GroundTruth {

@@ -146,8 +146,8 @@ TEST(MatcherRegistry, TheOrbPathDoesNotLoadThePlugin) {
 
 // A failed load is not remembered: once the plugin is where it is looked for, the next call loads it.
 TEST(MatcherRegistry, APluginThatWasMissingLoadsOnALaterCall) {
-#if defined(VMAP_WITH_TORCH) && defined(VMAP_BINARY)
-  const std::filesystem::path built = std::filesystem::path(VMAP_BINARY).parent_path() / "libvmap_torch.so";
+#if defined(VMAP_WITH_TORCH)
+  const std::filesystem::path built = testing::VmapBinary().parent_path() / "libvmap_torch.so";
   const std::filesystem::path beside_tests =
       std::filesystem::read_symlink("/proc/self/exe").parent_path() / "libvmap_torch.so";
   if (!std::filesystem::exists(built)) GTEST_SKIP() << "the plugin is not built";

@@ -11,23 +11,9 @@
 
 namespace vmap {
 
-std::string CameraModelName(CameraModel model) {
-  switch (model) {
-    case CameraModel::kSimplePinhole: return "SIMPLE_PINHOLE";
-    case CameraModel::kPinhole: return "PINHOLE";
-    case CameraModel::kOpenCV: return "OPENCV";
-    case CameraModel::kFullOpenCV: return "FULL_OPENCV";
-  }
-  return "PINHOLE";
-}
+std::string CameraModelName(CameraModel model) { return EnumToName(kCameraModelNames, model); }
 
-CameraModel ParseCameraModel(const std::string& name) {
-  if (name == "SIMPLE_PINHOLE") return CameraModel::kSimplePinhole;
-  if (name == "PINHOLE") return CameraModel::kPinhole;
-  if (name == "OPENCV") return CameraModel::kOpenCV;
-  if (name == "FULL_OPENCV") return CameraModel::kFullOpenCV;
-  throw InputError("unknown camera model '" + name + "'; vmap reads SIMPLE_PINHOLE, PINHOLE, OPENCV and FULL_OPENCV");
-}
+CameraModel ParseCameraModel(const std::string& name) { return ParseEnum(kCameraModelNames, name, "camera model"); }
 
 cv::Matx33d Camera::K() const { return cv::Matx33d(fx, 0, cx, 0, fy, cy, 0, 0, 1); }
 

@@ -13,11 +13,15 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/enum_names.h"
+
 namespace vmap {
 
 // COLMAP's model names: SIMPLE_PINHOLE (f, cx, cy), PINHOLE (fx, fy, cx, cy),
 // OPENCV (fx, fy, cx, cy, k1, k2, p1, p2), FULL_OPENCV (fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6).
 enum class CameraModel { kSimplePinhole, kPinhole, kOpenCV, kFullOpenCV };
+inline constexpr EnumName<CameraModel> kCameraModelNames[] = {{CameraModel::kSimplePinhole, "SIMPLE_PINHOLE"},
+    {CameraModel::kPinhole, "PINHOLE"}, {CameraModel::kOpenCV, "OPENCV"}, {CameraModel::kFullOpenCV, "FULL_OPENCV"}};
 
 std::string CameraModelName(CameraModel model);
 CameraModel ParseCameraModel(const std::string& name);  // COLMAP's names, as above

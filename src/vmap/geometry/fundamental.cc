@@ -10,22 +10,10 @@
 namespace vmap {
 
 VerifierMethod ParseVerifierMethod(const std::string& name) {
-  if (name == "magsac") return VerifierMethod::kMagsac;
-  if (name == "ransac") return VerifierMethod::kRansac;
-  if (name == "usac") return VerifierMethod::kUsac;
-  if (name == "accurate") return VerifierMethod::kAccurate;
-  throw InputError("unknown verifier '" + name + "'; use magsac, ransac, usac or accurate");
+  return ParseEnum(kVerifierMethodNames, name, "verifier");
 }
 
-std::string VerifierMethodName(VerifierMethod method) {
-  switch (method) {
-    case VerifierMethod::kMagsac: return "magsac";
-    case VerifierMethod::kRansac: return "ransac";
-    case VerifierMethod::kUsac: return "usac";
-    case VerifierMethod::kAccurate: return "accurate";
-  }
-  return "magsac";
-}
+std::string VerifierMethodName(VerifierMethod method) { return EnumToName(kVerifierMethodNames, method); }
 
 void VerifierOptions::Check() const {
   if (!(threshold > 0.0 && threshold <= 100.0)) {

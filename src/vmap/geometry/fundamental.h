@@ -7,11 +7,14 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/enum_names.h"
+
 namespace vmap {
 
 enum class VerifierMethod { kMagsac, kRansac, kUsac, kAccurate };
-
-// "magsac" (USAC_MAGSAC), "ransac" (FM_RANSAC), "usac" (USAC_DEFAULT), "accurate" (USAC_ACCURATE).
+// USAC_MAGSAC, FM_RANSAC, USAC_DEFAULT, USAC_ACCURATE.
+inline constexpr EnumName<VerifierMethod> kVerifierMethodNames[] = {{VerifierMethod::kMagsac, "magsac"},
+    {VerifierMethod::kRansac, "ransac"}, {VerifierMethod::kUsac, "usac"}, {VerifierMethod::kAccurate, "accurate"}};
 VerifierMethod ParseVerifierMethod(const std::string& name);
 std::string VerifierMethodName(VerifierMethod method);
 

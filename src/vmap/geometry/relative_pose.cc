@@ -11,15 +11,9 @@
 
 namespace vmap {
 
-PoseMethod ParsePoseMethod(const std::string& name) {
-  if (name == "essential") return PoseMethod::kEssential;
-  if (name == "fundamental") return PoseMethod::kFromFundamental;
-  throw InputError("unknown pose method '" + name + "'; use essential or fundamental");
-}
+PoseMethod ParsePoseMethod(const std::string& name) { return ParseEnum(kPoseMethodNames, name, "pose method"); }
 
-std::string PoseMethodName(PoseMethod method) {
-  return method == PoseMethod::kEssential ? "essential" : "fundamental";
-}
+std::string PoseMethodName(PoseMethod method) { return EnumToName(kPoseMethodNames, method); }
 
 void PoseOptions::Check() const {
   if (!(threshold > 0.0 && threshold <= 100.0)) {

@@ -14,6 +14,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/enum_names.h"
 #include "vmap/geometry/camera.h"
 
 namespace vmap {
@@ -22,7 +23,9 @@ enum class PoseMethod {
   kEssential,        // E estimated directly on normalised points (five-point solver in OpenCV's USAC)
   kFromFundamental,  // the link's F turned into E = K^T F K and decomposed
 };
-PoseMethod ParsePoseMethod(const std::string& name);  // "essential", "fundamental"
+inline constexpr EnumName<PoseMethod> kPoseMethodNames[] = {{PoseMethod::kEssential, "essential"},
+                                                            {PoseMethod::kFromFundamental, "fundamental"}};
+PoseMethod ParsePoseMethod(const std::string& name);
 std::string PoseMethodName(PoseMethod method);
 
 struct PoseOptions {

@@ -12,21 +12,9 @@
 
 namespace vmap {
 
-RankingMethod ParseRankingMethod(const std::string& name) {
-  if (name == "auto") return RankingMethod::kAuto;
-  if (name == "votes") return RankingMethod::kVotes;
-  if (name == "thumbnails") return RankingMethod::kThumbnails;
-  throw InputError("unknown ranking '" + name + "'; use auto, votes or thumbnails");
-}
+RankingMethod ParseRankingMethod(const std::string& name) { return ParseEnum(kRankingMethodNames, name, "ranking"); }
 
-std::string RankingMethodName(RankingMethod method) {
-  switch (method) {
-    case RankingMethod::kAuto: return "auto";
-    case RankingMethod::kVotes: return "votes";
-    case RankingMethod::kThumbnails: return "thumbnails";
-  }
-  return "auto";
-}
+std::string RankingMethodName(RankingMethod method) { return EnumToName(kRankingMethodNames, method); }
 
 void RankingOptions::Check() const {
   if (!(max_hamming_fraction > 0.0 && max_hamming_fraction <= 0.5)) {

@@ -17,6 +17,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/enum_names.h"
 #include "vmap/features/matcher.h"
 
 namespace vmap {
@@ -26,7 +27,9 @@ enum class RankingMethod {
   kVotes,       // descriptor votes (fails for a matcher without descriptors)
   kThumbnails,  // downsampled-image correlation
 };
-RankingMethod ParseRankingMethod(const std::string& name);  // "auto", "votes", "thumbnails"
+inline constexpr EnumName<RankingMethod> kRankingMethodNames[] = {
+    {RankingMethod::kAuto, "auto"}, {RankingMethod::kVotes, "votes"}, {RankingMethod::kThumbnails, "thumbnails"}};
+RankingMethod ParseRankingMethod(const std::string& name);
 std::string RankingMethodName(RankingMethod method);
 
 struct RankingOptions {

@@ -295,14 +295,7 @@ std::optional<cv::Size> KeyImageFileSize(const fs::path& file) {
 
 std::string MapToJson(const VisualMap& map) { return MapDocument(map, CorrespondenceOffsets(map)).dump(1); }
 
-std::string CoverageEndName(CoverageEnd end) {
-  switch (end) {
-    case CoverageEnd::kInputEnded: return "input ended";
-    case CoverageEnd::kInterrupted: return "interrupted";
-    case CoverageEnd::kSnapshot: return "snapshot";
-  }
-  return "input ended";
-}
+std::string CoverageEndName(CoverageEnd end) { return EnumToName(kCoverageEndNames, end); }
 
 namespace {
 
@@ -631,14 +624,9 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
     read.last_source_index = static_cast<int>(fields.Integer(
         fields.Required(*coverage, "coverage", "last_source_index"), "coverage.last_source_index", -1, kMaxInt));
     const std::string end = fields.String(fields.Required(*coverage, "coverage", "end"), "coverage.end");
-    bool known = false;
-    for (CoverageEnd candidate : {CoverageEnd::kInputEnded, CoverageEnd::kInterrupted, CoverageEnd::kSnapshot}) {
-      if (CoverageEndName(candidate) == end) {
-        read.end = candidate;
-        known = true;
-      }
-    }
-    if (!known) fields.Fail("coverage.end", "must be \"input ended\", \"interrupted\" or \"snapshot\"");
+    const std::optional<CoverageEnd> known = FindEnum(kCoverageEndNames, end);
+    if (!known) fields.Fail("coverage.end", "must be " + ListEnumNames(kCoverageEndNames));
+    read.end = *known;
     map.coverage = read;
   }
   ReadKeyImages(doc, fields, directory, file, &map);

@@ -7,15 +7,9 @@
 
 namespace vmap {
 
-QualityMean ParseQualityMean(const std::string& name) {
-  if (name == "arithmetic") return QualityMean::kArithmetic;
-  if (name == "harmonic") return QualityMean::kHarmonic;
-  throw InputError("unknown quality mean '" + name + "'; use arithmetic or harmonic");
-}
+QualityMean ParseQualityMean(const std::string& name) { return ParseEnum(kQualityMeanNames, name, "quality mean"); }
 
-std::string QualityMeanName(QualityMean mean) {
-  return mean == QualityMean::kArithmetic ? "arithmetic" : "harmonic";
-}
+std::string QualityMeanName(QualityMean mean) { return EnumToName(kQualityMeanNames, mean); }
 
 double MapQuality(int num_frames, int num_key_images, const std::vector<double>& link_similarities,
                   QualityMean mean) {

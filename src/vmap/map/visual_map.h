@@ -7,6 +7,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/enum_names.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap {
@@ -84,6 +85,9 @@ struct MapStatistics {
 // of live runs, whose input has no known end: a snapshot written while the run went on, or a map finished when
 // SIGINT ended the input (`vmap build --until-interrupted`).
 enum class CoverageEnd { kInputEnded, kInterrupted, kSnapshot };
+inline constexpr EnumName<CoverageEnd> kCoverageEndNames[] = {{CoverageEnd::kInputEnded, "input ended"},
+                                                              {CoverageEnd::kInterrupted, "interrupted"},
+                                                              {CoverageEnd::kSnapshot, "snapshot"}};
 struct Coverage {
   int num_frames = 0;             // frames processed
   int first_source_index = -1;    // the first and last of them, as indices in the input (-1: none)
@@ -105,7 +109,9 @@ struct VisualMap {
 };
 
 enum class QualityMean { kArithmetic, kHarmonic };
-QualityMean ParseQualityMean(const std::string& name);   // "arithmetic", "harmonic"
+inline constexpr EnumName<QualityMean> kQualityMeanNames[] = {{QualityMean::kArithmetic, "arithmetic"},
+                                                              {QualityMean::kHarmonic, "harmonic"}};
+QualityMean ParseQualityMean(const std::string& name);
 std::string QualityMeanName(QualityMean mean);
 
 // Q(M) = mean of (1 - m/n) and the mean similarity of consecutive key images (arithmetic by default:

@@ -12,14 +12,10 @@
 namespace vmap {
 
 SimilarityMode ParseSimilarityMode(const std::string& name) {
-  if (name == "inlier-ratio") return SimilarityMode::kInlierRatio;
-  if (name == "feature-ratio") return SimilarityMode::kFeatureRatio;
-  throw InputError("unknown similarity '" + name + "'; use inlier-ratio or feature-ratio");
+  return ParseEnum(kSimilarityModeNames, name, "similarity");
 }
 
-std::string SimilarityModeName(SimilarityMode mode) {
-  return mode == SimilarityMode::kInlierRatio ? "inlier-ratio" : "feature-ratio";
-}
+std::string SimilarityModeName(SimilarityMode mode) { return EnumToName(kSimilarityModeNames, mode); }
 
 void KeyImageOptions::Check() const {
   if (!(tau > 0.0 && tau <= 1.0)) {

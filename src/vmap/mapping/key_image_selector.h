@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "vmap/core/enum_names.h"
 #include "vmap/features/matcher.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/map/visual_map.h"
@@ -18,7 +19,9 @@ enum class SimilarityMode {
   kInlierRatio,   // |D| = tentative matches: S = verified / tentative (reproduces the paper's tables)
   kFeatureRatio,  // |D| = features detected: S = verified / max(|D_i|, |D_j|) (the paper's literal text)
 };
-SimilarityMode ParseSimilarityMode(const std::string& name);  // "inlier-ratio", "feature-ratio"
+inline constexpr EnumName<SimilarityMode> kSimilarityModeNames[] = {{SimilarityMode::kInlierRatio, "inlier-ratio"},
+                                                                    {SimilarityMode::kFeatureRatio, "feature-ratio"}};
+SimilarityMode ParseSimilarityMode(const std::string& name);
 std::string SimilarityModeName(SimilarityMode mode);
 
 struct KeyImageOptions {

@@ -28,21 +28,9 @@
 namespace vmap {
 namespace fs = std::filesystem;
 
-KeySearch ParseKeySearch(const std::string& name) {
-  if (name == "auto") return KeySearch::kAuto;
-  if (name == "sequential") return KeySearch::kSequential;
-  if (name == "bisect") return KeySearch::kBisect;
-  throw InputError("unknown key-image search '" + name + "'; use auto, sequential or bisect");
-}
+KeySearch ParseKeySearch(const std::string& name) { return ParseEnum(kKeySearchNames, name, "key-image search"); }
 
-std::string KeySearchName(KeySearch search) {
-  switch (search) {
-    case KeySearch::kAuto: return "auto";
-    case KeySearch::kSequential: return "sequential";
-    case KeySearch::kBisect: return "bisect";
-  }
-  return "auto";
-}
+std::string KeySearchName(KeySearch search) { return EnumToName(kKeySearchNames, search); }
 
 KeySearch ResolveKeySearch(const MapBuilderOptions& options) {
   return options.key_search == KeySearch::kAuto ? KeySearch::kSequential : options.key_search;

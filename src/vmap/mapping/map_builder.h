@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "vmap/core/enum_names.h"
 #include "vmap/features/matcher.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/mapping/key_image_selector.h"
@@ -27,7 +28,9 @@ enum class KeySearch {
                 // found by bisection: the same key images wherever S decreases with the distance to the key
                 // image, for far fewer comparisons (and feature extractions)
 };
-KeySearch ParseKeySearch(const std::string& name);  // "auto", "sequential", "bisect"
+inline constexpr EnumName<KeySearch> kKeySearchNames[] = {
+    {KeySearch::kAuto, "auto"}, {KeySearch::kSequential, "sequential"}, {KeySearch::kBisect, "bisect"}};
+KeySearch ParseKeySearch(const std::string& name);
 std::string KeySearchName(KeySearch search);
 
 struct MapBuilderOptions {

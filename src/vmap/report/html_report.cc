@@ -526,24 +526,14 @@ std::string MapLink(const std::string& map_directory, const fs::path& report_dir
   return UrlPath(page.generic_string());
 }
 
-}  // namespace
+bool HasBestRow(const SweepResult& sweep) {
+  return sweep.best_row >= 0 && sweep.best_row < static_cast<int>(sweep.rows.size());
+}
 
-void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
-  const json options = ParseOptions(sweep.options_json);
-  // Not created here: the CLI writes into a temporary output (AtomicOutputDirectory), which an interruption
-  // removes and nothing may bring back.
-  std::error_code ec;
-  if (!fs::is_directory(directory, ec)) {
-    throw InputError("the report directory '" + directory.string() + "' does not exist; choose another --report path");
-  }
-  const std::string input_name = sweep.input.path.empty() ? std::string("the input") : Displayable(sweep.input.path);
-  const bool has_best = sweep.best_row >= 0 && sweep.best_row < static_cast<int>(sweep.rows.size());
+// Cards, then the input, matcher, verifier and work done.
+std::string SweepSummarySection(const SweepResult& sweep, const json& options) {
+  const bool has_best = HasBestRow(sweep);
   std::ostringstream html;
-  html << PageStart("vmap sweep: " + input_name, "Threshold sweep of " + input_name,
-                    std::to_string(sweep.rows.size()) + " thresholds over " + std::to_string(sweep.num_frames) +
-                        " frames" + (has_best ? ", best \u03c4 = " + TauText(sweep.rows[sweep.best_row].tau) : ""),
-                    {{"summary", "Summary"}, {"table", "Table"}, {"plots", "Plots"}, {"options", "Options"}});
-
   html << "<section id=\"summary\"><h2>Summary</h2>\n<div class=\"cards\">"
        << Card(std::to_string(sweep.num_frames), "frames (n)") << Card(std::to_string(sweep.rows.size()), "thresholds")
        << (has_best ? Card(TauText(sweep.rows[sweep.best_row].tau), "best \u03c4 (highest Q)") +
@@ -557,7 +547,13 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
        << Row("Features extracted", std::to_string(sweep.features_extracted))
        << Row("Pairs matched", std::to_string(sweep.pairs_matched)) << Row("Time", DurationText(sweep.seconds))
        << "</table>\n</section>\n";
+  return html.str();
+}
 
+// One row per threshold; the best one starred, rows with links below tau shaded.
+std::string SweepTableSection(const SweepResult& sweep, const fs::path& report_directory) {
+  const bool has_best = HasBestRow(sweep);
+  std::ostringstream html;
   const bool has_usable =
       std::any_of(sweep.rows.begin(), sweep.rows.end(), [](const SweepRow& r) { return r.usable_links >= 0; });
   html << "<section id=\"table\"><h2>Key images and quality per threshold</h2>\n<table class=\"sweep\">\n<thead><tr>"
@@ -584,7 +580,7 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
     }
     html << "<td>";
     if (!r.map_directory.empty()) {
-      html << "<a class=\"map-link\" href=\"" << HtmlEscape(MapLink(r.map_directory, directory)) << "\">"
+      html << "<a class=\"map-link\" href=\"" << HtmlEscape(MapLink(r.map_directory, report_directory)) << "\">"
            << HtmlEscape(fs::path(r.map_directory).filename().string()) << "</a>";
     }
     html << "</td></tr>\n";
@@ -594,8 +590,12 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
                       "A map without a page links to its map.json: <code>vmap report DIR</code> makes its page.</p>\n"
                     : "")
        << "</section>\n";
+  return html.str();
+}
 
-  // Plots against tau.
+// Key images, Q, mean S and the compression against tau.
+std::string SweepPlotsSection(const SweepResult& sweep) {
+  const bool has_best = HasBestRow(sweep);
   SvgPlot keys_plot("keys-plot", "threshold \u03c4", "key images m");
   keys_plot.SetSize(720, 320);
   keys_plot.SetIntegerY(true);
@@ -650,11 +650,33 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
     best_keys.segments = {{cv::Point2d(best.tau, best.quality)}};
     quality_plot.Add(best_keys);
   }
+  std::ostringstream html;
   html << "<section id=\"plots\"><h2>Key images and quality against &tau;</h2>\n<div class=\"plots\">"
        << keys_plot.Render() << quality_plot.Render() << "</div>\n"
        << "<p class=\"note\">Q is the mean of the compression 1 - m/n and the mean similarity of consecutive key "
           "images; the best threshold balances few key images against well-connected ones.</p>\n</section>\n";
+  return html.str();
+}
 
+}  // namespace
+
+void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
+  const json options = ParseOptions(sweep.options_json);
+  // Not created here: the CLI writes into a temporary output (AtomicOutputDirectory), which an interruption
+  // removes and nothing may bring back.
+  std::error_code ec;
+  if (!fs::is_directory(directory, ec)) {
+    throw InputError("the report directory '" + directory.string() + "' does not exist; choose another --report path");
+  }
+  const std::string input_name = sweep.input.path.empty() ? std::string("the input") : Displayable(sweep.input.path);
+  const bool has_best = HasBestRow(sweep);
+  std::ostringstream html;
+  html << PageStart("vmap sweep: " + input_name, "Threshold sweep of " + input_name,
+                    std::to_string(sweep.rows.size()) + " thresholds over " + std::to_string(sweep.num_frames) +
+                        " frames" + (has_best ? ", best \u03c4 = " + TauText(sweep.rows[sweep.best_row].tau) : ""),
+                    {{"summary", "Summary"}, {"table", "Table"}, {"plots", "Plots"}, {"options", "Options"}});
+
+  html << SweepSummarySection(sweep, options) << SweepTableSection(sweep, directory) << SweepPlotsSection(sweep);
   html << OptionsSection(options, "Every option used for the sweep");
   html << PageEnd();
   WriteFileAtomically(directory / kReportFileName, html.str());

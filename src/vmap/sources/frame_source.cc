@@ -15,27 +15,9 @@
 namespace vmap {
 namespace fs = std::filesystem;
 
-SourceFormat ParseSourceFormat(const std::string& name) {
-  if (name == "auto") return SourceFormat::kAuto;
-  if (name == "video") return SourceFormat::kVideo;
-  if (name == "images") return SourceFormat::kImageFolder;
-  if (name == "tum") return SourceFormat::kTum;
-  if (name == "euroc") return SourceFormat::kEuroc;
-  if (name == "kitti") return SourceFormat::kKitti;
-  throw InputError("unknown format '" + name + "'; use auto, video, images, tum, euroc or kitti");
-}
+SourceFormat ParseSourceFormat(const std::string& name) { return ParseEnum(kSourceFormatNames, name, "format"); }
 
-std::string SourceFormatName(SourceFormat format) {
-  switch (format) {
-    case SourceFormat::kAuto: return "auto";
-    case SourceFormat::kVideo: return "video";
-    case SourceFormat::kImageFolder: return "images";
-    case SourceFormat::kTum: return "tum";
-    case SourceFormat::kEuroc: return "euroc";
-    case SourceFormat::kKitti: return "kitti";
-  }
-  return "auto";
-}
+std::string SourceFormatName(SourceFormat format) { return EnumToName(kSourceFormatNames, format); }
 
 void FrameSourceOptions::Check() const {
   if (first < 0) throw InputError("--first must be >= 0 (got " + std::to_string(first) + ")");

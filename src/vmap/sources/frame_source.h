@@ -9,13 +9,16 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/enum_names.h"
 #include "vmap/geometry/camera.h"
 
 namespace vmap {
 
 enum class SourceFormat { kAuto, kVideo, kImageFolder, kTum, kEuroc, kKitti };
+inline constexpr EnumName<SourceFormat> kSourceFormatNames[] = {
+    {SourceFormat::kAuto, "auto"}, {SourceFormat::kVideo, "video"}, {SourceFormat::kImageFolder, "images"},
+    {SourceFormat::kTum, "tum"},   {SourceFormat::kEuroc, "euroc"}, {SourceFormat::kKitti, "kitti"}};
 
-// "auto", "video", "images", "tum", "euroc", "kitti".
 SourceFormat ParseSourceFormat(const std::string& name);
 std::string SourceFormatName(SourceFormat format);
 
