@@ -68,15 +68,78 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
   }
 }
 
-void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int threads) {
+namespace {
+
+// FNV-1a over the bytes of what AnalyzeLink reads.
+class Fingerprint {
+ public:
+  template <typename T>
+  void Add(const T& value) {
+    const auto* bytes = reinterpret_cast<const unsigned char*>(&value);
+    for (size_t i = 0; i < sizeof(T); ++i) hash_ = (hash_ ^ bytes[i]) * 1099511628211ull;
+  }
+  uint64_t value() const { return hash_; }
+
+ private:
+  uint64_t hash_ = 14695981039346656037ull;
+};
+
+uint64_t FingerprintOf(const Link& link) {
+  Fingerprint fingerprint;
+  fingerprint.Add(link.has_fundamental);
+  fingerprint.Add(link.num_verified);
+  fingerprint.Add(link.num_tentative);
+  for (int i = 0; i < 9; ++i) fingerprint.Add(link.F.val[i]);
+  fingerprint.Add(link.correspondences.size());
+  for (const Correspondence& c : link.correspondences) {
+    fingerprint.Add(c.p0.x);
+    fingerprint.Add(c.p0.y);
+    fingerprint.Add(c.p1.x);
+    fingerprint.Add(c.p1.y);
+  }
+  return fingerprint.value();
+}
+
+void CopyAnalysis(const Link& from, Link& to) {
+  to.has_pose = from.has_pose;
+  to.R = from.R;
+  to.t = from.t;
+  to.pose_inliers = from.pose_inliers;
+  to.parallax = from.parallax;
+  to.parallax_without_rotation = from.parallax_without_rotation;
+  to.homography_share = from.homography_share;
+  to.planar = from.planar;
+}
+
+}  // namespace
+
+void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int threads, LinkAnalysisCache* cache) {
   const Camera* camera = map.input.camera ? &*map.input.camera : nullptr;
+  const auto frames_of = [&map](const Link& link) {
+    return std::make_pair(map.key_images.at(link.from_key).frame_index, map.key_images.at(link.to_key).frame_index);
+  };
+  std::vector<size_t> todo;
+  std::vector<uint64_t> fingerprints(map.links.size(), 0);
+  for (size_t i = 0; i < map.links.size(); ++i) {
+    if (cache) {
+      fingerprints[i] = FingerprintOf(map.links[i]);
+      const auto it = cache->entries_.find(frames_of(map.links[i]));
+      if (it != cache->entries_.end() && it->second.fingerprint == fingerprints[i]) {
+        CopyAnalysis(it->second.analysed, map.links[i]);
+        ++cache->hits_;
+        continue;
+      }
+    }
+    todo.push_back(i);
+  }
+
   std::atomic<size_t> next{0};
   std::exception_ptr error;
   std::mutex error_mutex;
   const auto work = [&] {
-    for (size_t i = next++; i < map.links.size(); i = next++) {
+    for (size_t k = next++; k < todo.size(); k = next++) {
       try {
-        AnalyzeLink(map.links[i], camera, options);
+        AnalyzeLink(map.links[todo[k]], camera, options);
       } catch (...) {
         std::lock_guard<std::mutex> lock(error_mutex);
         if (!error) error = std::current_exception();
@@ -84,11 +147,21 @@ void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int thread
     }
   };
   std::vector<std::thread> workers;
-  const int extra = std::min<int>(std::max(threads, 1), static_cast<int>(map.links.size())) - 1;
+  const int extra = std::min<int>(std::max(threads, 1), static_cast<int>(todo.size())) - 1;
   for (int k = 0; k < extra; ++k) workers.emplace_back(work);
   work();
   for (std::thread& worker : workers) worker.join();
   if (error) std::rethrow_exception(error);
+
+  if (!cache) return;
+  // Only this map's links stay: a live run's last link changes at every snapshot.
+  std::map<std::pair<int, int>, LinkAnalysisCache::Entry> kept;
+  for (size_t i = 0; i < map.links.size(); ++i) {
+    LinkAnalysisCache::Entry& entry = kept[frames_of(map.links[i])];
+    entry.fingerprint = fingerprints[i];
+    CopyAnalysis(map.links[i], entry.analysed);
+  }
+  cache->entries_ = std::move(kept);
 }
 
 }  // namespace vmap

@@ -391,10 +391,12 @@ class LinkVerifier {
 };
 
 // `link_verifier` (when the decisions stopped early): the links verified in full replace the deciding ones.
-// `analyze_links`: also each link's pose, parallax and homography test (only maps that are kept need them).
+// `analyze_links`: also each link's pose, parallax and homography test (only maps that are kept need them),
+// reusing those of `analysis_cache` where the links did not change.
 VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source, const MapBuilderOptions& options,
                      const std::string& options_json, double seconds, bool analyze_links,
-                     const LinkVerifier* link_verifier = nullptr, double tau = 0.0) {
+                     const LinkVerifier* link_verifier = nullptr, double tau = 0.0,
+                     LinkAnalysisCache* analysis_cache = nullptr) {
   VisualMap map;
   map.input = source.info();
   map.options_json = options_json;
@@ -414,10 +416,12 @@ VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source
   map.quality = ComputeStatistics(map, options.quality_mean).quality;
   if (!analyze_links) return map;
   const auto analysis_start = std::chrono::steady_clock::now();
-  AnalyzeLinks(map, options.link_analysis, options.ExtractionThreads());
+  const long reused_before = analysis_cache ? analysis_cache->hits() : 0;
+  AnalyzeLinks(map, options.link_analysis, options.ExtractionThreads(), analysis_cache);
   const double analysis_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - analysis_start).count();
-  spdlog::debug("pose, parallax and homography test of {} links in {:.3f} s", map.links.size(), analysis_seconds);
+  spdlog::debug("pose, parallax and homography test of {} links in {:.3f} s ({} analysed before)", map.links.size(),
+                analysis_seconds, analysis_cache ? analysis_cache->hits() - reused_before : 0);
   map.seconds += analysis_seconds;  // part of building the map
   return map;
 }
@@ -537,6 +541,7 @@ class MapBuilder::Impl {
     // Links keep a full estimation when the decisions stopped early; queued as soon as each link is made.
     if (stops_early_) link_verifier_ = std::make_unique<LinkVerifier>(VerifierOptions(verifier_));
     links_queued_.assign(selectors_.size(), 0);
+    link_analyses_.resize(selectors_.size());
     pipeline_ = std::make_unique<FeaturePipeline>(matcher, options_.prefetch_frames, options_.ExtractionThreads(),
                                                   compare_pair_);
   }
@@ -560,7 +565,7 @@ class MapBuilder::Impl {
       // Nothing to write before Algorithm 1 has taken its first frame.
       if (!writers_[i] || selectors_[i]->key_images().empty()) continue;
       VisualMap map = CollectMap(*selectors_[i], source_, options_, options_json_, SecondsSince(start_),
-                                 /*analyze_links=*/true, link_verifier_.get(), taus_[i]);
+                                 /*analyze_links=*/true, link_verifier_.get(), taus_[i], &link_analyses_[i]);
       map.coverage = CurrentCoverage(CoverageEnd::kSnapshot);
       writers_[i]->Snapshot(map);
     }
@@ -586,7 +591,7 @@ class MapBuilder::Impl {
     std::vector<VisualMap> maps;
     for (size_t i = 0; i < selectors_.size(); ++i) {
       VisualMap map = CollectMap(*selectors_[i], source_, options_, options_json_, seconds, analyze_links,
-                                 link_verifier_.get(), taus_[i]);
+                                 link_verifier_.get(), taus_[i], &link_analyses_[i]);
       // A map of a whole file says nothing more (its map.json stays as it was); a live input's says what it
       // covers.
       if (end != CoverageEnd::kInputEnded || source_.info().expected_frames < 0) map.coverage = CurrentCoverage(end);
@@ -679,6 +684,7 @@ class MapBuilder::Impl {
   std::map<int, PairComparison>* comparisons_of_frame_ = nullptr;
   std::map<int, std::vector<double>> holders_;  // key frame index -> taus of the selectors holding it
   std::vector<std::unique_ptr<KeyImageSelector>> selectors_;
+  std::vector<LinkAnalysisCache> link_analyses_;  // per selector: what snapshots analysed stays analysed
   std::unique_ptr<LinkVerifier> link_verifier_;
   std::vector<size_t> links_queued_;
   long frames_done_ = 0;
