@@ -10,6 +10,8 @@
 
 #include <Eigen/Dense>
 
+#include "vmap/geometry/sampson_errors.h"
+
 namespace vmap {
 namespace {
 
@@ -78,23 +80,11 @@ class MagsacTables {
   std::array<double, kSize + 1> weight_{};
 };
 
-struct Point {
-  double x0, y0, x1, y1;
-};
-
-// F row-major in pixels; x1^T F x0 = 0.
-using Model = std::array<double, 9>;
-
-inline double SquaredSampson(const Model& f, const Point& p) {
-  const double l0 = f[0] * p.x0 + f[1] * p.y0 + f[2];
-  const double l1 = f[3] * p.x0 + f[4] * p.y0 + f[5];
-  const double l2 = f[6] * p.x0 + f[7] * p.y0 + f[8];
-  const double m0 = f[0] * p.x1 + f[3] * p.y1 + f[6];
-  const double m1 = f[1] * p.x1 + f[4] * p.y1 + f[7];
-  const double e = p.x1 * l0 + p.y1 * l1 + l2;
-  const double d = l0 * l0 + l1 * l1 + m0 * m0 + m1 * m1;
-  return d > 0 ? e * e / d : std::numeric_limits<double>::infinity();
-}
+using internal::Model;
+using internal::Point;
+using internal::PointColumns;
+using internal::SquaredSampson;
+using internal::SquaredSampsonErrors;
 
 Model ToModel(const Mat3& F) {
   const double norm = F.norm();
@@ -196,6 +186,8 @@ class Estimator {
       const int k = order_[i];
       points_[i] = {points0[k].x, points0[k].y, points1[k].x, points1[k].y};
     }
+    columns_.Assign(points_);
+    squared_errors_.resize(n_);
     abandon_ = early_stop.abandon;
     for (int target : early_stop.min_inliers) {
       targets_.push_back({target, SamplesToSettle(static_cast<double>(target) / n_, options.confidence,
@@ -229,6 +221,11 @@ class Estimator {
   void UpdateSprt();
   bool Settled(int iterations) const;
   bool PassesAllSettledTargets(int inliers) const;
+  // With decisions to settle: the lowest target (inliers) still open, 0 when none is (or without targets).
+  // Sigma-consensus++ refits a model on the points within the maximum threshold of it, so a model with fewer
+  // such points than this is not refined: refining it costs tens of scorings and almost never settles a
+  // decision. Without targets (a full estimation) every refinement OpenCV's USAC_MAGSAC makes is made.
+  int OpenTargetSupport(int iterations) const;
 
   const VerifierOptions& options_;
   const MagsacTables& tables_;
@@ -237,6 +234,8 @@ class Estimator {
   double max_squared_ = 0, inv_max_squared_ = 0, threshold_squared_ = 0;
   std::vector<int> order_;
   std::vector<Point> points_;      // pixels, in visiting order
+  PointColumns columns_;           // the same, column by column
+  std::vector<double> squared_errors_;  // scratch for SquaredSampsonErrors
   std::vector<Point> normalized_;  // Hartley-normalised copies for the solvers
   Mat3 T0_, T1_;                   // normalised = T * pixel, per image
   std::vector<Target> targets_;
@@ -461,13 +460,33 @@ bool SmallestEigenvector(const Mat9& M, Vec9* v) {
   return true;
 }
 
-// Adds w^2 a a^T to the upper triangle of M.
-inline void AccumulateRow(const double (&a)[9], double w, Mat9* M) {
-  const double w2 = w * w;
-  for (int r = 0; r < 9; ++r) {
-    const double ar = w2 * a[r];
-    for (int c = r; c < 9; ++c) (*M)(r, c) += ar * a[c];
+// The normal equations sum_i w_i^2 a_i a_i^T of the 8-point system, a_i = (x1 x0, x1 y0, x1, y1 x0, y1 y0, y1,
+// x0, y0, 1) of points[indices[i]] (w_i = 1 without weights). Each product w^2 a[r] a[c] (r <= c) is summed
+// into the lower triangle, whose columns are contiguous in Eigen's column-major storage, so that the inner loop
+// vectorises; the upper triangle is then mirrored from it.
+__attribute__((target_clones("avx2", "default"))) void NormalEquations(const std::vector<Point>& points,
+                                                                       const std::vector<int>& indices, int count,
+                                                                       const std::vector<double>* weights, Mat9* M) {
+  M->setZero();
+  double* m = M->data();
+  for (int i = 0; i < count; ++i) {
+    const Point& p = points[indices[i]];
+    const double a[9] = {p.x1 * p.x0, p.x1 * p.y0, p.x1, p.y1 * p.x0, p.y1 * p.y0, p.y1, p.x0, p.y0, 1.0};
+    const double w = weights ? (*weights)[i] : 1.0;
+    const double w2 = w * w;
+    for (int r = 0; r < 9; ++r) {
+      const double ar = w2 * a[r];
+      for (int c = r; c < 9; ++c) m[9 * r + c] += ar * a[c];
+    }
   }
+  for (int c = 1; c < 9; ++c)
+    for (int r = 0; r < c; ++r) (*M)(r, c) = (*M)(c, r);
+}
+
+// Adds a a^T to the upper triangle of M (the homography's rows; rare: DEGENSAC only).
+inline void AccumulateRow(const double (&a)[9], Mat9* M) {
+  for (int r = 0; r < 9; ++r)
+    for (int c = r; c < 9; ++c) (*M)(r, c) += a[r] * a[c];
 }
 
 void SymmetrizeUpper(Mat9* M) {
@@ -479,13 +498,8 @@ void SymmetrizeUpper(Mat9* M) {
 bool Estimator::FitFundamental(const std::vector<int>& indices, int count, const std::vector<double>* weights,
                                Model* model) {
   if (count < 8) return false;
-  Mat9 M = Mat9::Zero();
-  for (int i = 0; i < count; ++i) {
-    const Point& p = normalized_[indices[i]];
-    const double a[9] = {p.x1 * p.x0, p.x1 * p.y0, p.x1, p.y1 * p.x0, p.y1 * p.y0, p.y1, p.x0, p.y0, 1.0};
-    AccumulateRow(a, weights ? (*weights)[i] : 1.0, &M);
-  }
-  SymmetrizeUpper(&M);
+  Mat9 M;
+  NormalEquations(normalized_, indices, count, weights, &M);
   Vec9 f;
   if (!SmallestEigenvector(M, &f)) return false;
   Mat3 F;
@@ -510,8 +524,8 @@ bool Estimator::FitHomography(const std::vector<int>& indices, int count, Mat3* 
     const Point& p = normalized_[indices[i]];
     const double a[9] = {0, 0, 0, -p.x0, -p.y0, -1, p.y1 * p.x0, p.y1 * p.y0, p.y1};
     const double b[9] = {p.x0, p.y0, 1, 0, 0, 0, -p.x1 * p.x0, -p.x1 * p.y0, -p.x1};
-    AccumulateRow(a, 1.0, &M);
-    AccumulateRow(b, 1.0, &M);
+    AccumulateRow(a, &M);
+    AccumulateRow(b, &M);
   }
   SymmetrizeUpper(&M);
   Vec9 h;
@@ -529,8 +543,12 @@ Score Estimator::Evaluate(const Model& model, double bound, bool use_sprt) {
   use_sprt = use_sprt && sprt_active_;
   Score score;
   double value = 0, log_lambda = 0;
+  // Errors a block at a time: SPRT rejects most models within the first few dozen points.
+  constexpr int kBlock = 16;
+  double* errors = squared_errors_.data();
   for (int i = 0; i < n_; ++i) {
-    const double r2 = SquaredSampson(model, points_[i]);
+    if (i % kBlock == 0) SquaredSampsonErrors(model, columns_, i, std::min(n_, i + kBlock), errors);
+    const double r2 = errors[i % kBlock];
     if (r2 < max_squared_) {
       value += tables_.Quality(r2 * inv_max_squared_);
       ++score.consistent;
@@ -586,8 +604,9 @@ bool Estimator::SigmaConsensus(const Model& model, int min_consistent, Model* re
     Score current_score;
     double value = 0;
     int count = 0;
+    SquaredSampsonErrors(current, columns_, 0, n_, squared_errors_.data());
     for (int i = 0; i < n_; ++i) {
-      const double r2 = SquaredSampson(current, points_[i]);
+      const double r2 = squared_errors_[i];
       if (r2 < max_squared_) {
         const double u = r2 * inv_max_squared_;
         value += tables_.Quality(u);
@@ -703,6 +722,17 @@ bool Estimator::Settled(int iterations) const {
   return true;
 }
 
+int Estimator::OpenTargetSupport(int iterations) const {
+  int lowest_open = std::numeric_limits<int>::max();
+  for (const Target& target : targets_) {
+    const bool passed = have_best_ && best_score_.inliers >= target.min_inliers;
+    if (!passed && target.min_inliers <= n_ && iterations < target.samples_to_fail) {
+      lowest_open = std::min(lowest_open, target.min_inliers);
+    }
+  }
+  return lowest_open == std::numeric_limits<int>::max() ? 0 : lowest_open;
+}
+
 bool Estimator::PassesAllSettledTargets(int inliers) const {
   for (const Target& target : targets_) {
     if (best_score_.inliers >= target.min_inliers && inliers < target.min_inliers) return false;
@@ -755,8 +785,13 @@ FundamentalResult Estimator::Run(MagsacStatistics* statistics) {
       if (iterations < kItersScoredWithoutSprt) {
         score = Evaluate(model, best_score_.value, false);
       } else if (refine_samples) {
-        if (Evaluate(model, -1.0, true).value < 0) continue;  // SPRT-rejected
-        if (!SigmaConsensus(model, best_score_.inliers, &model, &score)) continue;
+        const Score unrefined = Evaluate(model, -1.0, true);
+        if (unrefined.value < 0) continue;  // SPRT-rejected
+        if (unrefined.consistent < OpenTargetSupport(iterations)) {
+          score = unrefined;  // too little support to settle an open decision: scored, not refined
+        } else if (!SigmaConsensus(model, best_score_.inliers, &model, &score)) {
+          continue;
+        }
       } else {
         score = Evaluate(model, best_score_.value, true);
       }
@@ -771,7 +806,8 @@ FundamentalResult Estimator::Run(MagsacStatistics* statistics) {
       } else {
         update_best(model, score);
       }
-      if (iterations >= kItersBeforeLocalOptimization && !refine_samples) {
+      if (iterations >= kItersBeforeLocalOptimization && !refine_samples &&
+          best_score_.consistent >= OpenTargetSupport(iterations)) {
         local_optimization_ran = true;
         Model refined;
         Score refined_score;
@@ -781,7 +817,8 @@ FundamentalResult Estimator::Run(MagsacStatistics* statistics) {
         }
       }
     }
-    if (have_best_ && !local_optimization_ran && iterations >= kItersBeforeLocalOptimization) {
+    if (have_best_ && !local_optimization_ran && iterations >= kItersBeforeLocalOptimization &&
+        best_score_.consistent >= OpenTargetSupport(iterations)) {
       local_optimization_ran = true;
       Model refined;
       Score refined_score;
