@@ -221,11 +221,6 @@ class Estimator {
   void UpdateSprt();
   bool Settled(int iterations) const;
   bool PassesAllSettledTargets(int inliers) const;
-  // With decisions to settle: the lowest target (inliers) still open, 0 when none is (or without targets).
-  // Sigma-consensus++ refits a model on the points within the maximum threshold of it, so a model with fewer
-  // such points than this is not refined: refining it costs tens of scorings and almost never settles a
-  // decision. Without targets (a full estimation) every refinement OpenCV's USAC_MAGSAC makes is made.
-  int OpenTargetSupport(int iterations) const;
 
   const VerifierOptions& options_;
   const MagsacTables& tables_;
@@ -722,17 +717,6 @@ bool Estimator::Settled(int iterations) const {
   return true;
 }
 
-int Estimator::OpenTargetSupport(int iterations) const {
-  int lowest_open = std::numeric_limits<int>::max();
-  for (const Target& target : targets_) {
-    const bool passed = have_best_ && best_score_.inliers >= target.min_inliers;
-    if (!passed && target.min_inliers <= n_ && iterations < target.samples_to_fail) {
-      lowest_open = std::min(lowest_open, target.min_inliers);
-    }
-  }
-  return lowest_open == std::numeric_limits<int>::max() ? 0 : lowest_open;
-}
-
 bool Estimator::PassesAllSettledTargets(int inliers) const {
   for (const Target& target : targets_) {
     if (best_score_.inliers >= target.min_inliers && inliers < target.min_inliers) return false;
@@ -785,13 +769,8 @@ FundamentalResult Estimator::Run(MagsacStatistics* statistics) {
       if (iterations < kItersScoredWithoutSprt) {
         score = Evaluate(model, best_score_.value, false);
       } else if (refine_samples) {
-        const Score unrefined = Evaluate(model, -1.0, true);
-        if (unrefined.value < 0) continue;  // SPRT-rejected
-        if (unrefined.consistent < OpenTargetSupport(iterations)) {
-          score = unrefined;  // too little support to settle an open decision: scored, not refined
-        } else if (!SigmaConsensus(model, best_score_.inliers, &model, &score)) {
-          continue;
-        }
+        if (Evaluate(model, -1.0, true).value < 0) continue;  // SPRT-rejected
+        if (!SigmaConsensus(model, best_score_.inliers, &model, &score)) continue;
       } else {
         score = Evaluate(model, best_score_.value, true);
       }
@@ -806,8 +785,7 @@ FundamentalResult Estimator::Run(MagsacStatistics* statistics) {
       } else {
         update_best(model, score);
       }
-      if (iterations >= kItersBeforeLocalOptimization && !refine_samples &&
-          best_score_.consistent >= OpenTargetSupport(iterations)) {
+      if (iterations >= kItersBeforeLocalOptimization && !refine_samples) {
         local_optimization_ran = true;
         Model refined;
         Score refined_score;
@@ -817,8 +795,7 @@ FundamentalResult Estimator::Run(MagsacStatistics* statistics) {
         }
       }
     }
-    if (have_best_ && !local_optimization_ran && iterations >= kItersBeforeLocalOptimization &&
-        best_score_.consistent >= OpenTargetSupport(iterations)) {
+    if (have_best_ && !local_optimization_ran && iterations >= kItersBeforeLocalOptimization) {
       local_optimization_ran = true;
       Model refined;
       Score refined_score;

@@ -263,23 +263,6 @@ TEST(MagsacEarlyStop, FailsAfterTheSamplesTheTargetNeeds) {
   EXPECT_EQ(two_stats.iterations, stats.iterations);
 }
 
-// A decision no model of this pair has the support for ("no" at 80 % on a scene with 65 % inliers): no model
-// is refined, since sigma-consensus++ refits on the points within the maximum threshold and none has enough of
-// them; the answer and the samples drawn are those the target needs. The full estimation refines as OpenCV does.
-TEST(MagsacEarlyStop, ModelsWithoutSupportForAnOpenTargetAreNotRefined) {
-  const Scene scene = MakeScene(195, 105, 0.2, 13);
-  const int n = static_cast<int>(scene.p0.size());
-  const int target = AtLeast(0.8, n);  // 30 samples: the 20th's models would be refined
-  MagsacStatistics decision, full;
-  const FundamentalResult result = EstimateFundamentalMagsac(scene.p0, scene.p1, {}, Targets({target}), &decision);
-  EstimateFundamentalMagsac(scene.p0, scene.p1, {}, {}, &full);
-  EXPECT_LT(result.num_inliers, target);
-  EXPECT_TRUE(decision.stopped_early);
-  EXPECT_EQ(decision.iterations, SamplesToSettle(static_cast<double>(target) / n, 0.999, 100000));
-  EXPECT_EQ(decision.local_optimizations, 0);
-  EXPECT_GT(full.local_optimizations, 0);
-}
-
 // Targets no model can reach (more inliers than points) are settled before any sample is drawn.
 TEST(MagsacEarlyStop, ImpossibleTargetsNeedNoSample) {
   const Scene scene = MakeScene(100, 0, 0.0, 12);

@@ -85,6 +85,8 @@ PairComparison VerifyMatches(const TentativeMatches& matches, int denominator, c
   }
   if (stops_early) {
     result.exhaustive = false;
+    result.decided_taus = decide_taus;
+    std::sort(result.decided_taus.begin(), result.decided_taus.end());
     for (double tau : decide_taus) {
       if (!(result.matched && result.similarity >= tau)) result.lowest_failed_tau = std::min(result.lowest_failed_tau, tau);
     }

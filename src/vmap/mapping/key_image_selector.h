@@ -56,6 +56,9 @@ struct PairComparison {
   // `decide_taus`): S is then the best found by that point, and only Decides(tau) says whether it answers tau.
   bool exhaustive = true;
   double lowest_failed_tau = 2.0;  // when not exhaustive: the lowest tau asked that S did not reach
+  // When not exhaustive: the thresholds verification was asked to settle, ascending. Where it stopped, and so
+  // S, depends on all of them, not only on the one a caller wants answered.
+  std::vector<double> decided_taus;
   bool abandoned = false;          // `abandon` stopped the verification: this answers nothing
   bool Decides(double tau) const {
     return exhaustive || (matched && similarity >= tau) || tau >= lowest_failed_tau;

@@ -18,8 +18,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
+#include "vmap/core/bounded_queue.h"
 #include "vmap/core/error.h"
 #include "vmap/core/progress.h"
+#include "vmap/core/reorder_buffer.h"
 #include "vmap/core/serial_worker.h"
 #include "vmap/map/map_io.h"
 #include "vmap/map/map_writer.h"
@@ -63,6 +65,21 @@ namespace {
 using CompareFn = std::function<PairComparison(const FrameRecord& key, const FrameRecord& frame,
                                                const std::vector<double>& taus, const std::function<bool()>& abandon)>;
 
+// The thresholds the comparison of frame `frame_index` with key image `key_index` settles, fixed by the maps
+// alone (never by the threads' timing: where an estimation that stops early stops, and so its S, depends on
+// every threshold it settles). The previous frame may become any selector's key image during this frame, so its
+// comparison settles every threshold; an older key image is compared for the selectors holding it when the
+// frame comes (`holders`, ascending), and for `tau` (a selector that moves to it during the frame, after frames
+// that repeated the key image's view). Without holders: every threshold.
+std::vector<double> ThresholdsToSettle(int key_index, int frame_index, const std::vector<double>* holders,
+                                       const std::vector<double>& all_taus, double tau) {
+  std::vector<double> taus = key_index == frame_index - 1 || !holders ? all_taus : *holders;
+  if (!std::binary_search(taus.begin(), taus.end(), tau)) {
+    taus.insert(std::upper_bound(taus.begin(), taus.end(), tau), tau);
+  }
+  return taus;
+}
+
 // A key image the workers compare frames with, and the thresholds (ascending) of the selectors that hold it.
 struct CurrentKey {
   FrameRecord record;
@@ -96,10 +113,15 @@ struct PipelineItem {
 // same whatever the threads do.
 class FeaturePipeline {
  public:
-  FeaturePipeline(const Matcher& matcher, int depth, int workers, CompareFn compare)
-      : matcher_(matcher), compare_(std::move(compare)), depth_(std::max(depth, workers + 1)) {
+  // `all_taus`: every selector's threshold, ascending.
+  FeaturePipeline(const Matcher& matcher, int depth, int workers, CompareFn compare, std::vector<double> all_taus)
+      : matcher_(matcher),
+        compare_(std::move(compare)),
+        all_taus_(std::move(all_taus)),
+        depth_(std::max(depth, workers + 1)),
+        to_extract_(static_cast<size_t>(depth_)) {
     try {
-      for (int i = 0; i < workers; ++i) workers_.emplace_back([this] { Guard([this] { ExtractFeatures(); }); });
+      for (int i = 0; i < workers; ++i) workers_.emplace_back([this] { Work(); });
     } catch (const std::system_error& error) {
       // The system refused a thread (a process limit): stop those already started, or their destructors abort.
       Stop();
@@ -113,20 +135,18 @@ class FeaturePipeline {
   // Hands `frame` to the workers, unless `depth` frames are in the pipeline already: then false, and `frame`
   // is left as it was (take an item out with Next() first). Rethrows a worker's error.
   bool TryPush(Frame& frame) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (error_) std::rethrow_exception(error_);
+    results_.RethrowIfFailed();
     if (closed_) throw std::logic_error("FeaturePipeline::TryPush after Close");
-    if (InFlight() >= depth_) return false;
-    decoded_.emplace_back(pushed_++, std::move(frame));
-    changed_.notify_all();
+    if (pushed_ - next_out_ >= depth_) return false;
+    // Never waits: the queue holds at most the frames in flight, fewer than its capacity.
+    to_extract_.Push({pushed_++, std::move(frame)});
     return true;
   }
 
   // No more frames: Next() returns nullopt once every frame pushed has come out.
   void Close() {
-    std::lock_guard<std::mutex> lock(mutex_);
     closed_ = true;
-    changed_.notify_all();
+    to_extract_.Close();
   }
 
   // The key images (distinct) that frames extracted from now on are compared with, each with the thresholds
@@ -139,139 +159,137 @@ class FeaturePipeline {
 
   // The next frame in order, waiting for it; nullopt at the end (after Close). Rethrows a worker's error.
   std::optional<PipelineItem> Next() {
-    std::unique_lock<std::mutex> lock(mutex_);
-    changed_.wait(lock, [this] { return error_ || ready_.count(next_out_) || AllDone(); });
-    return TakeNext();
+    if (next_out_ == pushed_) {
+      if (closed_) return std::nullopt;
+      throw std::logic_error("FeaturePipeline::Next with no frame in flight");
+    }
+    return Took(results_.Take(next_out_));
   }
 
   // The next frame when it is ready now, otherwise nullopt.
   std::optional<PipelineItem> TryNext() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return TakeNext();
+    if (next_out_ == pushed_) return std::nullopt;
+    std::optional<PipelineItem> item = results_.TryTake(next_out_);
+    if (!item) return std::nullopt;
+    return Took(std::move(*item));
   }
 
   long extracted() const { return extracted_; }
 
  private:
-  // Runs a thread's work; an exception stops the pipeline and reaches the consumer.
-  template <typename Fn>
-  void Guard(Fn&& work) {
-    try {
-      work();
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (!error_) error_ = std::current_exception();
-      stop_ = true;
-      changed_.notify_all();
-    }
-  }
-
   void Stop() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
-    }
-    changed_.notify_all();
+    stop_ = true;
+    to_extract_.Close();
     for (std::thread& worker : workers_) worker.join();
   }
 
-  // Call with mutex_ held.
-  std::optional<PipelineItem> TakeNext() {
-    if (error_) std::rethrow_exception(error_);
-    auto it = ready_.find(next_out_);
-    if (it == ready_.end()) return std::nullopt;
-    PipelineItem item = std::move(it->second);
-    ready_.erase(it);
+  PipelineItem Took(PipelineItem item) {
     ++next_out_;
     // A successor is a frame at most a pipeline's depth behind the consumer; keep a margin.
+    std::lock_guard<std::mutex> lock(mutex_);
     recent_.erase(recent_.begin(), recent_.lower_bound(static_cast<int>(next_out_) - 2 * depth_));
-    changed_.notify_all();
     return item;
   }
 
-  int InFlight() const { return static_cast<int>(decoded_.size() + ready_.size()) + extracting_; }
-  bool AllDone() const { return closed_ && decoded_.empty() && extracting_ == 0; }
-
-  void ExtractFeatures() {
-    for (;;) {
-      std::pair<long, Frame> decoded;
-      {
-        std::unique_lock<std::mutex> lock(mutex_);
-        changed_.wait(lock, [this] { return stop_ || !decoded_.empty() || closed_; });
-        if (stop_ || decoded_.empty()) return;
-        decoded = std::move(decoded_.front());
-        decoded_.pop_front();
-        ++extracting_;
+  // A worker: frames from the queue until it closes; an error stops the pipeline and reaches the consumer.
+  void Work() {
+    while (std::optional<std::pair<long, Frame>> decoded = to_extract_.Pop()) {
+      if (stop_) continue;  // stopping: drain without work
+      try {
+        results_.Put(decoded->first, ExtractAndCompare(std::move(decoded->second)));
+      } catch (...) {
+        stop_ = true;
+        results_.Fail(std::current_exception());
+        to_extract_.Close();
       }
-      PipelineItem item;
-      const Frame& frame = decoded.second;
-      item.record.features = RethrowAsInputError(
-          [&] {
-            return ErrorContext{"the " + matcher_.name() + " matcher failed on frame " +
-                                    std::to_string(frame.source_index) + " (" + frame.source_name + ")",
-                                "check the frame, or try other matcher options"};
-          },
-          [&] { return matcher_.Extract(frame.gray); });
-      item.record.frame = std::make_shared<const Frame>(std::move(decoded.second));
-      ++extracted_;
-      const int frame_index = item.record.frame->index;
-      std::shared_ptr<const std::vector<CurrentKey>> keys;
+    }
+  }
+
+  PipelineItem ExtractAndCompare(Frame decoded) {
+    PipelineItem item;
+    item.record.features = RethrowAsInputError(
+        [&] {
+          return ErrorContext{"the " + matcher_.name() + " matcher failed on frame " +
+                                  std::to_string(decoded.source_index) + " (" + decoded.source_name + ")",
+                              "check the frame, or try other matcher options"};
+        },
+        [&] { return matcher_.Extract(decoded.gray); });
+    item.record.frame = std::make_shared<const Frame>(std::move(decoded));
+    ++extracted_;
+    const int frame_index = item.record.frame->index;
+    std::shared_ptr<const std::vector<CurrentKey>> keys;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      recent_.emplace(frame_index, item.record);
+      keys = current_keys_;  // taken after extraction: the freshest the consumer has published
+    }
+    // Compare as the consumer will: each selector's tau with the key it will hold at this frame, i.e. its
+    // published key, or the successor of a key that this frame or an earlier one fell below that tau against
+    // (and so on), grouping the taus that meet on one key; until every group is compared, is the frame itself,
+    // or waits for a successor not extracted yet (the consumer then compares).
+    while (keys) {
+      std::map<int, CurrentKey> groups;  // by the key the taus resolve to
       {
         std::lock_guard<std::mutex> lock(mutex_);
-        recent_.emplace(frame_index, item.record);
-        keys = current_keys_;  // taken after extraction: the freshest the consumer has published
-      }
-      // Compare as the consumer will: each selector's tau with the key it will hold at this frame, i.e. its
-      // published key, or the successor of a key that this frame or an earlier one fell below that tau against
-      // (and so on), grouping the taus that meet on one key; until every group is compared, is the frame itself,
-      // or waits for a successor not extracted yet (the consumer then compares).
-      while (keys) {
-        std::map<int, CurrentKey> groups;  // by the key the taus resolve to
-        {
-          std::lock_guard<std::mutex> lock(mutex_);
-          for (const CurrentKey& current : *keys) {
-            for (double tau : current.taus) {
-              const int index = ResolveKey(current.record.frame->index, tau, frame_index);
-              if (index == frame_index || item.comparisons.count(index)) continue;
-              const FrameRecord* record = &current.record;
-              if (index != current.record.frame->index) {
-                const auto found = recent_.find(index);
-                if (found == recent_.end()) continue;
-                record = &found->second;
-              }
-              CurrentKey& group = groups.emplace(index, CurrentKey{*record, {}}).first->second;
-              group.taus.push_back(tau);
+        for (const CurrentKey& current : *keys) {
+          for (double tau : current.taus) {
+            const int index = ResolveKey(current.record.frame->index, tau, frame_index);
+            if (index == frame_index || item.comparisons.count(index)) continue;
+            const FrameRecord* record = &current.record;
+            if (index != current.record.frame->index) {
+              const auto found = recent_.find(index);
+              if (found == recent_.end()) continue;
+              record = &found->second;
             }
+            CurrentKey& group = groups.emplace(index, CurrentKey{*record, {}}).first->second;
+            group.taus.push_back(tau);
           }
         }
-        if (groups.empty()) break;
-        CurrentKey& group = groups.begin()->second;
-        std::sort(group.taus.begin(), group.taus.end());
-        const int key_index = group.record.frame->index;
-        // Abandoned when other workers find, meanwhile, an earlier frame below every one of these taus: this
-        // frame then goes on to the successors.
-        PairComparison comparison =
-            compare_(group.record, item.record, group.taus, [this, key_index, frame_index, &group] {
-              std::lock_guard<std::mutex> lock(mutex_);
-              for (double tau : group.taus) {
-                if (ResolveKey(key_index, tau, frame_index - 1) == key_index) return false;
-              }
-              return true;
-            });
-        if (comparison.abandoned) continue;
-        for (double tau : group.taus) {
-          if (!(comparison.matched && comparison.similarity >= tau)) {
-            Retire(key_index, frame_index, tau);  // this tau and every higher one leave the key here
-            break;
-          }
-        }
-        item.comparisons.emplace(key_index, std::move(comparison));
       }
-      std::lock_guard<std::mutex> lock(mutex_);
-      --extracting_;
-      ready_.emplace(decoded.first, std::move(item));
-      changed_.notify_all();
+      if (groups.empty()) break;
+      CurrentKey& group = groups.begin()->second;
+      std::sort(group.taus.begin(), group.taus.end());
+      const int key_index = group.record.frame->index;
+      // Abandoned when other workers find, meanwhile, an earlier frame below every one of these taus: this
+      // frame then goes on to the successors.
+      std::vector<double> asked;
+      {
+        // The holders when this frame comes, as far as the workers know: the selectors whose key resolves to
+        // this one at the previous frame.
+        std::vector<double> holders;
+        std::lock_guard<std::mutex> lock(mutex_);
+        for (const CurrentKey& current : *keys) {
+          for (double tau : current.taus) {
+            if (ResolveKey(current.record.frame->index, tau, frame_index - 1) == key_index) holders.push_back(tau);
+          }
+        }
+        std::sort(holders.begin(), holders.end());
+        asked = ThresholdsToSettle(key_index, frame_index, holders.empty() ? nullptr : &holders, all_taus_,
+                                   group.taus.front());
+        for (double tau : group.taus) {
+          if (!std::binary_search(asked.begin(), asked.end(), tau)) {
+            asked.insert(std::upper_bound(asked.begin(), asked.end(), tau), tau);
+          }
+        }
+      }
+      PairComparison comparison =
+          compare_(group.record, item.record, asked, [this, key_index, frame_index, &group] {
+            std::lock_guard<std::mutex> lock(mutex_);
+            for (double tau : group.taus) {
+              if (ResolveKey(key_index, tau, frame_index - 1) == key_index) return false;
+            }
+            return true;
+          });
+      if (comparison.abandoned) continue;
+      for (double tau : group.taus) {
+        if (!(comparison.matched && comparison.similarity >= tau)) {
+          Retire(key_index, frame_index, tau);  // this tau and every higher one leave the key here
+          break;
+        }
+      }
+      item.comparisons.emplace(key_index, std::move(comparison));
     }
+    return item;
   }
 
   // The key image a selector with threshold `tau` that held `key_index` compares `frame_index` with, as far as
@@ -302,9 +320,18 @@ class FeaturePipeline {
 
   const Matcher& matcher_;
   const CompareFn compare_;
+  const std::vector<double> all_taus_;
   const int depth_;
+  // The consumer's side: frames handed over and taken out (in flight: the difference).
+  long pushed_ = 0;
+  long next_out_ = 0;
+  bool closed_ = false;
+  BoundedQueue<std::pair<long, Frame>> to_extract_;  // decoded frames waiting for a worker, numbered
+  ReorderBuffer<PipelineItem> results_;              // extracted and compared, by number
+  std::atomic<bool> stop_{false};
+  std::atomic<long> extracted_{0};
+  // What the workers share to follow key changes.
   std::mutex mutex_;
-  std::condition_variable changed_;
   std::shared_ptr<const std::vector<CurrentKey>> current_keys_;
   struct Retirement {
     int at_frame;    // a frame seen to fall below from_tau against the key
@@ -313,16 +340,7 @@ class FeaturePipeline {
   };
   std::map<int, std::vector<Retirement>> retired_;  // by key frame index
   std::map<int, FrameRecord> recent_;    // extracted frames a successor may be taken from, by frame index
-  std::deque<std::pair<long, Frame>> decoded_;  // read, waiting for a worker
-  std::map<long, PipelineItem> ready_;          // extracted, waiting for the consumer
-  int extracting_ = 0;
-  long pushed_ = 0;
-  long next_out_ = 0;
-  bool closed_ = false;
-  bool stop_ = false;
-  std::exception_ptr error_;
-  std::atomic<long> extracted_{0};
-  std::vector<std::thread> workers_;
+  std::vector<std::thread> workers_;     // last: started once everything they use exists
 };
 
 // Verifies links in full, on a thread of its own while the build goes on, when the decisions stopped early:
@@ -426,6 +444,11 @@ VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source
   return map;
 }
 
+std::vector<double> Sorted(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values;
+}
+
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -496,6 +519,7 @@ class MapBuilder::Impl {
       : source_(source),
         options_(options),
         taus_(std::move(taus)),
+        sorted_taus_(Sorted(taus_)),
         writers_(std::move(writers)),
         options_json_(std::move(options_json)),
         start_(std::chrono::steady_clock::now()),
@@ -543,7 +567,7 @@ class MapBuilder::Impl {
     links_queued_.assign(selectors_.size(), 0);
     link_analyses_.resize(selectors_.size());
     pipeline_ = std::make_unique<FeaturePipeline>(matcher, options_.prefetch_frames, options_.ExtractionThreads(),
-                                                  compare_pair_);
+                                                  compare_pair_, sorted_taus_);
   }
 
   void Add(Frame frame) {
@@ -608,19 +632,20 @@ class MapBuilder::Impl {
 
  private:
   // The comparisons of the current frame, by key frame: made ahead by the pipeline, or here when a key image
-  // changed meanwhile or a comparison that stopped early does not answer a selector's tau. A pair compared
-  // under several taus is matched once.
+  // changed meanwhile. A pair compared under several taus is matched once. A comparison that stopped early is
+  // used only when it settled exactly ThresholdsToSettle: the workers guess which selectors will hold a key
+  // image, and a comparison made for another set could give another S, and another decision (before this, a
+  // sweep could give other tables from one run to the next).
   KeyImageSelector::CompareFn CompareFor(double tau) {
     return [this, tau](const FrameRecord& key, const FrameRecord& frame) -> PairComparison {
       const int key_index = key.frame->index;
-      auto it = comparisons_of_frame_->find(key_index);
-      if (it != comparisons_of_frame_->end() && it->second.Decides(tau)) return it->second;
-      // Settle at once what the other selectors that may ask will need: the holders of the key, or every tau
-      // for a key just chosen (they follow from the same failing frame) or asked again.
       const auto held = holders_.find(key_index);
-      std::vector<double> asked =
-          it == comparisons_of_frame_->end() && held != holders_.end() ? held->second : taus_;
-      if (std::find(asked.begin(), asked.end(), tau) == asked.end()) asked.push_back(tau);
+      const std::vector<double> asked = ThresholdsToSettle(
+          key_index, frame.frame->index, held != holders_.end() ? &held->second : nullptr, sorted_taus_, tau);
+      auto it = comparisons_of_frame_->find(key_index);
+      if (it != comparisons_of_frame_->end() && (it->second.exhaustive || it->second.decided_taus == asked)) {
+        return it->second;
+      }
       return (*comparisons_of_frame_)[key_index] = compare_pair_(key, frame, asked, nullptr);
     };
   }
@@ -672,7 +697,8 @@ class MapBuilder::Impl {
 
   const FrameSource& source_;
   const MapBuilderOptions options_;
-  const std::vector<double> taus_;
+  const std::vector<double> taus_;  // selector i's is taus_[i]
+  const std::vector<double> sorted_taus_;
   std::vector<MapWriter*> writers_;
   const std::string options_json_;
   const std::chrono::steady_clock::time_point start_;
