@@ -2,10 +2,9 @@
 
 #include <iostream>
 
-#include <nlohmann/json.hpp>
-
 #include "vmap/cli/commands.h"
 #include "vmap/map/map_io.h"
+#include "vmap/mapping/map_builder.h"
 #include "vmap/report/summary.h"
 
 namespace vmap::cli {
@@ -16,21 +15,13 @@ void AddInfoCommand(CLI::App& app) {
   command->add_option("map", *directory, "Map directory written by `vmap build`")->required();
   command->callback([directory] {
     const VisualMap map = ReadMap(*directory);
-    // ReadMap checked that the options are a JSON object; their members are read whatever their types.
-    const auto options = nlohmann::json::parse(map.options_json);
-    auto text = [](const nlohmann::json& object, const char* name) {
-      auto it = object.find(name);
-      return it != object.end() && it->is_string() ? it->get<std::string>() : std::string("?");
-    };
-    // A map from a newer vmap may name a mean this one does not know: its summary then uses the arithmetic one.
-    const QualityMean mean =
-        FindEnum(kQualityMeanNames, text(options, "quality_mean")).value_or(QualityMean::kArithmetic);
-    std::cout << FormatMapSummary(map, mean);
-    const auto matcher = options.find("matcher"), verifier = options.find("verifier"), tau = options.find("tau");
-    if (matcher != options.end() && matcher->is_object() && verifier != options.end() && verifier->is_object()) {
-      std::cout << "matcher         " << text(*matcher, "type") << ", verifier " << text(*verifier, "method")
-                << ", tau " << (tau != options.end() && tau->is_number() ? tau->get<double>() : 0.0) << ", similarity "
-                << text(options, "similarity") << "\n";
+    const RecordedOptions options =
+        RecordedOptionsFromJson(map.options_json, "map '" + *directory + "': options");
+    std::cout << FormatMapSummary(map, options.builder.quality_mean);
+    if (!options.matcher_type.empty()) {
+      std::cout << "matcher         " << options.matcher_type << ", verifier "
+                << VerifierMethodName(options.builder.verifier.method) << ", tau " << options.builder.key_images.tau
+                << ", similarity " << SimilarityModeName(options.builder.key_images.similarity) << "\n";
     }
   });
 }

@@ -88,35 +88,11 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau) 
 
 std::string DescribeOptions(const Matcher& matcher, const MapBuilderOptions& options,
                             const FrameSourceOptions& source) {
-  nlohmann::json doc;
-  doc["matcher"] = nlohmann::json::parse(matcher.DescribeOptionsJson());
-  doc["verifier"] = {{"method", VerifierMethodName(options.verifier.method)},
-                     {"threshold", options.verifier.threshold},
-                     {"confidence", options.verifier.confidence},
-                     {"max_iterations", options.verifier.max_iterations},
-                     {"seed", options.verifier.seed},
-                     {"min_matches", options.verifier.min_matches}};
-  doc["exhaustive"] = options.exhaustive;
-  doc["search"] = KeySearchName(ResolveKeySearch(options));
-  doc["search_window"] = options.search_window;
-  doc["tau"] = options.key_images.tau;
-  doc["similarity"] = SimilarityModeName(options.key_images.similarity);
-  doc["final_key"] = options.key_images.final_key;
-  doc["quality_mean"] = QualityMeanName(options.quality_mean);
-  doc["source"] = {{"format", SourceFormatName(source.format)}, {"first", source.first}, {"last", source.last},
-                   {"stride", source.stride},  {"resize", source.resize},     {"strict", source.strict}};
-  doc["source"]["camera"] = source.camera.empty() ? "input" : source.camera;
-  doc["min_key_displacement"] = options.key_images.min_key_displacement;
-  const PoseOptions& pose = options.link_analysis.pose;
-  doc["pose"] = {{"method", PoseMethodName(pose.method)},
-                 {"threshold", pose.threshold},
-                 {"matches", pose.use_all_matches ? "all" : "verified"},
-                 {"confidence", pose.confidence},
-                 {"max_iterations", pose.max_iterations},
-                 {"seed", pose.seed}};
-  const HomographyOptions& homography = options.link_analysis.homography;
-  doc["homography"] = {{"threshold", homography.threshold}, {"min_share", homography.min_share}};
-  return doc.dump();
+  RecordedOptions record;
+  record.matcher_json = matcher.DescribeOptionsJson();
+  record.builder = options;
+  record.source = source;
+  return ToJson(record).dump();
 }
 
 void WriteReportIfAsked(bool asked, const std::filesystem::path& map_directory) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "vmap/core/error.h"
+#include "vmap/core/json_fields.h"
 #include "vmap/features/matcher_plugin.h"
 #include "vmap/features/orb_matcher.h"
 
@@ -36,31 +37,17 @@ class JsonWriter final : public OptionFieldVisitor {
   nlohmann::json& object_;
 };
 
-// Reads the fields a JSON object holds; the others keep their values.
+// Reads the fields a JSON object holds; the others keep their values (core/json_fields.h).
 class JsonReader final : public OptionFieldVisitor {
  public:
-  JsonReader(const nlohmann::json& object, const std::string& where) : object_(object), where_(where) {}
-  void Visit(const OptionField& field, int& value) override { Read(field, value); }
-  void Visit(const OptionField& field, double& value) override { Read(field, value); }
-  void Visit(const OptionField& field, bool& value) override { Read(field, value); }
-  void Visit(const OptionField& field, std::string& value) override { Read(field, value); }
+  explicit JsonReader(const JsonFieldReader& fields) : fields_(fields) {}
+  void Visit(const OptionField& field, int& value) override { fields_.Read(field.key, &value); }
+  void Visit(const OptionField& field, double& value) override { fields_.Read(field.key, &value); }
+  void Visit(const OptionField& field, bool& value) override { fields_.Read(field.key, &value); }
+  void Visit(const OptionField& field, std::string& value) override { fields_.Read(field.key, &value); }
 
  private:
-  template <typename T>
-  void Read(const OptionField& field, T& value) {
-    const auto it = object_.find(field.key);
-    if (it == object_.end() || it->is_null()) return;
-    // nlohmann converts between numbers and bools silently; a recorded value of another kind is a mistake.
-    const bool fits = std::is_same_v<T, bool>          ? it->is_boolean()
-                      : std::is_same_v<T, std::string> ? it->is_string()
-                      : std::is_same_v<T, int>         ? it->is_number_integer()
-                                                       : it->is_number();
-    if (!fits) throw InputError(where_ + "." + field.key + " has the wrong type (" + it->type_name() + ")");
-    value = it->get<T>();
-  }
-
-  const nlohmann::json& object_;
-  const std::string& where_;
+  const JsonFieldReader& fields_;
 };
 
 }  // namespace
@@ -73,8 +60,8 @@ nlohmann::json ModelOptions::ToJson() const {
 }
 
 void ModelOptions::FromJson(const nlohmann::json& object, const std::string& where) {
-  if (!object.is_object()) throw InputError(where + " is not a JSON object");
-  JsonReader reader(object, where);
+  const JsonFieldReader fields(object, where);
+  JsonReader reader(fields);
   VisitFields(reader);
   AfterReading();
 }

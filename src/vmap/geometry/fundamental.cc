@@ -2,9 +2,11 @@
 
 #include <cmath>
 
+#include <nlohmann/json.hpp>
 #include <opencv2/calib3d.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/core/json_fields.h"
 #include "vmap/geometry/magsac.h"
 
 namespace vmap {
@@ -95,6 +97,21 @@ double SampsonDistance(const cv::Matx33d& F, const cv::Point2f& p0, const cv::Po
   const double e = x1.dot(Fx0);
   const double denominator = Fx0[0] * Fx0[0] + Fx0[1] * Fx0[1] + Ftx1[0] * Ftx1[0] + Ftx1[1] * Ftx1[1];
   return denominator > 0 ? std::abs(e) / std::sqrt(denominator) : 0.0;
+}
+
+nlohmann::json ToJson(const VerifierOptions& options) {
+  return {{"method", VerifierMethodName(options.method)}, {"threshold", options.threshold},
+          {"confidence", options.confidence},             {"max_iterations", options.max_iterations},
+          {"seed", options.seed},                         {"min_matches", options.min_matches}};
+}
+
+void FromJson(const JsonFieldReader& fields, VerifierOptions* options) {
+  fields.Read("method", &options->method, kVerifierMethodNames);
+  fields.Read("threshold", &options->threshold);
+  fields.Read("confidence", &options->confidence);
+  fields.Read("max_iterations", &options->max_iterations);
+  fields.Read("seed", &options->seed);
+  fields.Read("min_matches", &options->min_matches);
 }
 
 }  // namespace vmap

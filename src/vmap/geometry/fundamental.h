@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
 #include <opencv2/core.hpp>
 
 #include "vmap/core/enum_names.h"
@@ -32,6 +33,13 @@ struct VerifierOptions {
 
   void Check() const;  // throws InputError naming the bad option
 };
+
+class JsonFieldReader;
+// The verifier as map.json records it: method, threshold, confidence, max_iterations, seed, min_matches
+// (not own_magsac: MapBuilderOptions::exhaustive records which estimator decided).
+nlohmann::json ToJson(const VerifierOptions& options);
+// Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
+void FromJson(const JsonFieldReader& fields, VerifierOptions* options);
 
 struct FundamentalResult {
   bool success = false;         // a model was found from at least min_matches tentative matches

@@ -3,9 +3,11 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <opencv2/calib3d.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/core/json_fields.h"
 
 namespace vmap {
 
@@ -56,6 +58,15 @@ HomographyCheck CheckHomography(const std::vector<cv::Point2f>& from, const std:
   check.share = static_cast<double>(check.num_explained) / from.size();
   check.explains = check.share >= options.min_share;
   return check;
+}
+
+nlohmann::json ToJson(const HomographyOptions& options) {
+  return {{"threshold", options.threshold}, {"min_share", options.min_share}};
+}
+
+void FromJson(const JsonFieldReader& fields, HomographyOptions* options) {
+  fields.Read("threshold", &options->threshold);
+  fields.Read("min_share", &options->min_share);
 }
 
 }  // namespace vmap

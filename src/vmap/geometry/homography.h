@@ -5,6 +5,7 @@
 
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
 #include <opencv2/core.hpp>
 
 namespace vmap {
@@ -20,6 +21,12 @@ struct HomographyOptions {
 
   void Check() const;  // throws InputError naming the bad option
 };
+
+class JsonFieldReader;
+// The homography test as map.json records it: threshold and min_share.
+nlohmann::json ToJson(const HomographyOptions& options);
+// Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
+void FromJson(const JsonFieldReader& fields, HomographyOptions* options);
 
 struct HomographyCheck {
   bool estimated = false;               // a homography could be fitted (at least 4 matches)

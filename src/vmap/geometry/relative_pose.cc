@@ -5,9 +5,11 @@
 #include <limits>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <opencv2/calib3d.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/core/json_fields.h"
 
 namespace vmap {
 
@@ -330,6 +332,24 @@ double Median(std::vector<double> values) {
   const double upper = values[middle];
   if (values.size() % 2 == 1) return upper;
   return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + middle));
+}
+
+nlohmann::json ToJson(const PoseOptions& options) {
+  return {{"method", PoseMethodName(options.method)},
+          {"threshold", options.threshold},
+          {"matches", EnumToName(kPoseMatchesNames, options.use_all_matches)},
+          {"confidence", options.confidence},
+          {"max_iterations", options.max_iterations},
+          {"seed", options.seed}};
+}
+
+void FromJson(const JsonFieldReader& fields, PoseOptions* options) {
+  fields.Read("method", &options->method, kPoseMethodNames);
+  fields.Read("threshold", &options->threshold);
+  fields.Read("matches", &options->use_all_matches, kPoseMatchesNames);
+  fields.Read("confidence", &options->confidence);
+  fields.Read("max_iterations", &options->max_iterations);
+  fields.Read("seed", &options->seed);
 }
 
 }  // namespace vmap

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
 #include <opencv2/core.hpp>
 
 #include "vmap/core/enum_names.h"
@@ -54,6 +55,16 @@ struct PoseOptions {
 
   void Check() const;  // throws InputError naming the bad option
 };
+
+// The names of PoseOptions::use_all_matches (--pose-matches, map.json's pose.matches).
+inline constexpr EnumName<bool> kPoseMatchesNames[] = {{true, "all"}, {false, "verified"}};
+
+class JsonFieldReader;
+// The pose options as map.json records them: method, threshold, matches ("all" or "verified"), confidence,
+// max_iterations, seed; the others (starts, refinement) are the algorithm's, not a user's choice.
+nlohmann::json ToJson(const PoseOptions& options);
+// Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
+void FromJson(const JsonFieldReader& fields, PoseOptions* options);
 
 struct RelativePose {
   bool valid = false;

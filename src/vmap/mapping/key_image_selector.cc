@@ -4,9 +4,11 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/error.h"
+#include "vmap/core/json_fields.h"
 #include "vmap/geometry/relative_pose.h"
 
 namespace vmap {
@@ -214,6 +216,20 @@ void KeyImageSelector::Finish() {
   }
   key_.reset();
   previous_.reset();
+}
+
+nlohmann::json ToJson(const KeyImageOptions& options) {
+  return {{"tau", options.tau},
+          {"similarity", SimilarityModeName(options.similarity)},
+          {"final_key", options.final_key},
+          {"min_key_displacement", options.min_key_displacement}};
+}
+
+void FromJson(const JsonFieldReader& fields, KeyImageOptions* options) {
+  fields.Read("tau", &options->tau);
+  fields.Read("similarity", &options->similarity, kSimilarityModeNames);
+  fields.Read("final_key", &options->final_key);
+  fields.Read("min_key_displacement", &options->min_key_displacement);
 }
 
 }  // namespace vmap

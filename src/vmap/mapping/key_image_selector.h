@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "vmap/core/enum_names.h"
 #include "vmap/features/matcher.h"
 #include "vmap/geometry/fundamental.h"
@@ -36,6 +38,12 @@ struct KeyImageOptions {
 
   void Check() const;  // throws InputError naming the bad option
 };
+
+class JsonFieldReader;
+// Algorithm 1's options as map.json records them: tau, similarity, final_key, min_key_displacement.
+nlohmann::json ToJson(const KeyImageOptions& options);
+// Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
+void FromJson(const JsonFieldReader& fields, KeyImageOptions* options);
 
 // One processed frame with its features, as the selector sees it.
 struct FrameRecord {

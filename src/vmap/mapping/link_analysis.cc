@@ -7,6 +7,10 @@
 #include <thread>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "vmap/core/json_fields.h"
+
 namespace vmap {
 
 void LinkAnalysisOptions::Check() const {
@@ -162,6 +166,15 @@ void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int thread
     CopyAnalysis(map.links[i], entry.analysed);
   }
   cache->entries_ = std::move(kept);
+}
+
+nlohmann::json ToJson(const LinkAnalysisOptions& options) {
+  return {{"pose", ToJson(options.pose)}, {"homography", ToJson(options.homography)}};
+}
+
+void FromJson(const JsonFieldReader& fields, LinkAnalysisOptions* options) {
+  FromJson(fields.Object("pose"), &options->pose);
+  FromJson(fields.Object("homography"), &options->homography);
 }
 
 }  // namespace vmap

@@ -8,6 +8,8 @@
 #include <map>
 #include <utility>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "vmap/geometry/camera.h"
 #include "vmap/geometry/homography.h"
 #include "vmap/geometry/relative_pose.h"
@@ -21,6 +23,12 @@ struct LinkAnalysisOptions {
 
   void Check() const;  // throws InputError naming the bad option
 };
+
+class JsonFieldReader;
+// As map.json records it: {"pose": ..., "homography": ...} (geometry/relative_pose.h, geometry/homography.h).
+nlohmann::json ToJson(const LinkAnalysisOptions& options);
+// Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
+void FromJson(const JsonFieldReader& fields, LinkAnalysisOptions* options);
 
 // Fills link.has_pose/R/t/pose_inliers (with a camera), link.parallax and the homography test, from the
 // link's correspondences (verified first) and F. A link without F gets none of them.

@@ -15,11 +15,13 @@
 #include <thread>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/bounded_queue.h"
 #include "vmap/core/error.h"
+#include "vmap/core/json_fields.h"
 #include "vmap/core/progress.h"
 #include "vmap/core/reorder_buffer.h"
 #include "vmap/core/serial_worker.h"
@@ -1004,6 +1006,51 @@ SweepResult SweepThresholds(FrameSource& source, const Matcher& matcher, const M
     if (!directory.empty()) fs::create_directory(directory);  // inside maps_directory, which must exist
   }
   return RunSelectors(source, matcher, options, taus, directories, maps, options_json);
+}
+
+nlohmann::json ToJson(const MapBuilderOptions& options) {
+  nlohmann::json record = ToJson(options.key_images);
+  record.update(ToJson(options.link_analysis));
+  record["verifier"] = ToJson(options.verifier);
+  record["exhaustive"] = options.exhaustive;
+  record["search"] = KeySearchName(ResolveKeySearch(options));
+  record["search_window"] = options.search_window;
+  record["quality_mean"] = QualityMeanName(options.quality_mean);
+  return record;
+}
+
+void FromJson(const JsonFieldReader& fields, MapBuilderOptions* options) {
+  FromJson(fields, &options->key_images);
+  FromJson(fields, &options->link_analysis);
+  FromJson(fields.Object("verifier"), &options->verifier);
+  fields.Read("exhaustive", &options->exhaustive);
+  fields.Read("search", &options->key_search, kKeySearchNames);
+  fields.Read("search_window", &options->search_window);
+  fields.Read("quality_mean", &options->quality_mean, kQualityMeanNames);
+}
+
+nlohmann::json ToJson(const RecordedOptions& options) {
+  nlohmann::json record = ToJson(options.builder);
+  record["matcher"] = nlohmann::json::parse(options.matcher_json);
+  record["source"] = ToJson(options.source);
+  return record;
+}
+
+RecordedOptions RecordedOptionsFromJson(const std::string& options_json, const std::string& where) {
+  nlohmann::json record;
+  try {
+    record = nlohmann::json::parse(options_json);
+  } catch (const nlohmann::json::exception&) {
+    throw InputError(where + " is not valid JSON");
+  }
+  const JsonFieldReader fields(record, where);
+  RecordedOptions options;
+  FromJson(fields, &options.builder);
+  FromJson(fields.Object("source"), &options.source);
+  const JsonFieldReader matcher = fields.Object("matcher");
+  matcher.Read("type", &options.matcher_type);
+  options.matcher_json = matcher.object().dump();
+  return options;
 }
 
 }  // namespace vmap

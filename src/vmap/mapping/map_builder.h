@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "vmap/core/enum_names.h"
 #include "vmap/features/matcher.h"
 #include "vmap/geometry/fundamental.h"
@@ -62,6 +64,30 @@ struct MapBuilderOptions {
 // ALIKED, 1.5-10x faster, it changed the map on three of four sequences (its S stays high until its matches run
 // out). It stays available as --search bisect.
 KeySearch ResolveKeySearch(const MapBuilderOptions& options);
+
+class JsonFieldReader;
+// The builder's options as map.json records them, at the top level of "options" (a layout older than these
+// structs): KeyImageOptions' fields, "verifier", "exhaustive", "search" (resolved: the search that ran),
+// "search_window", "quality_mean", and LinkAnalysisOptions' "pose" and "homography". How a run is carried out
+// (show_progress, prefetch_frames, extraction_threads) never changes its map and is not recorded.
+nlohmann::json ToJson(const MapBuilderOptions& options);
+// Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
+void FromJson(const JsonFieldReader& fields, MapBuilderOptions* options);
+
+// Every option that shaped a map: map.json's "options" (sweep.json's for a sweep), the builder's and the
+// input's typed, the matcher's as the matcher describes itself (a model's record may hold derived values;
+// features/matcher_options_json.h rebuilds its options).
+struct RecordedOptions {
+  std::string matcher_json = "{}";  // Matcher::DescribeOptionsJson()
+  std::string matcher_type;         // its "type"; "" when not recorded
+  MapBuilderOptions builder;
+  FrameSourceOptions source;
+};
+// The builder's fields at the top level, "matcher" and "source" as objects.
+nlohmann::json ToJson(const RecordedOptions& options);
+// Reads a record (fields it lacks keep their defaults). Throws InputError naming `where` and the key of a
+// value of the wrong kind or an enum name this vmap does not know.
+RecordedOptions RecordedOptionsFromJson(const std::string& options_json, const std::string& where);
 
 class MapWriter;
 

@@ -46,6 +46,8 @@ std::string PageEnd() {
          "<script>\n" + std::string(ReportJs()) + "</script>\n</body>\n</html>\n";
 }
 
+namespace {
+
 // The first value named `name` anywhere in the options (they may be grouped per stage).
 const json* FindOption(const json& node, const std::string& name) {
   if (node.is_object()) {
@@ -57,6 +59,8 @@ const json* FindOption(const json& node, const std::string& name) {
   }
   return nullptr;
 }
+
+}  // namespace
 
 json ParseOptions(const std::string& text) {
   try {

@@ -18,11 +18,10 @@ std::string PageStart(const std::string& title, const std::string& heading, cons
 // Closes <main> and the page (footer and script).
 std::string PageEnd();
 
-// The first value named `name` anywhere in recorded options (they may be grouped per stage).
-const nlohmann::json* FindOption(const nlohmann::json& node, const std::string& name);
 // Options text as a JSON object ({} when it is not one).
 nlohmann::json ParseOptions(const std::string& text);
-// An option as one line: a grouped option (matcher, verifier) reads "orb (features 2000, ...)".
+// An option as one line, for display whatever this vmap knows of it (decisions read options typed:
+// mapping/map_builder.h, RecordedOptions): a grouped option (matcher, verifier) reads "orb (features 2000, ...)".
 std::string OptionText(const nlohmann::json& options, const std::string& name);
 
 std::string TimestampText(double seconds);  // "" for a negative (unknown) time

@@ -17,6 +17,7 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/map/map_io.h"
+#include "vmap/mapping/map_builder.h"
 #include "vmap/report/html_page.h"
 #include "vmap/report/html_util.h"
 #include "vmap/report/link_table.h"
@@ -45,7 +46,6 @@ constexpr const char* kGrey = "#8a8a8a";
 using report::Card;
 using report::Displayable;
 using report::DurationText;
-using report::FindOption;
 using report::Numbered;
 using report::OptionText;
 using report::PageEnd;
@@ -61,7 +61,7 @@ namespace {
 
 // The S(key, frame) plot: one line per key image over the frames compared with it, tau, the key images
 // and the similarity of each link at the frame that became the next key image.
-std::string SimilarityPlot(const VisualMap& map, const json& options) {
+std::string SimilarityPlot(const VisualMap& map, double tau) {
   SvgPlot plot("similarity-plot", "frame index", "similarity S(key, frame)");
   plot.SetIntegerX(true);
   double y_high = 1.0;
@@ -128,16 +128,14 @@ std::string SimilarityPlot(const VisualMap& map, const json& options) {
   plot.Add(keys);
   if (!lines.segments.empty()) plot.Add(lines);
   if (!failed.segments[0].empty()) plot.Add(failed);
-  if (const json* tau = FindOption(options, "tau"); tau && tau->is_number()) {
-    PlotSeries rule;
-    rule.kind = PlotSeries::Kind::kHorizontalRule;
-    rule.name = "\u03c4 = " + FormatExact(tau->get<double>());
-    rule.color = kOrange;
-    rule.css_class = "tau";
-    rule.segments.push_back({cv::Point2d(0.0, tau->get<double>())});
-    rule.segment_attributes.push_back("data-tau=\"" + FormatExact(tau->get<double>()) + "\"");
-    plot.Add(rule);
-  }
+  PlotSeries rule;
+  rule.kind = PlotSeries::Kind::kHorizontalRule;
+  rule.name = "\u03c4 = " + FormatExact(tau);
+  rule.color = kOrange;
+  rule.css_class = "tau";
+  rule.segments.push_back({cv::Point2d(0.0, tau)});
+  rule.segment_attributes.push_back("data-tau=\"" + FormatExact(tau) + "\"");
+  plot.Add(rule);
   if (!links.segments.empty()) plot.Add(links);
   if (!below_tau.segments.empty()) plot.Add(below_tau);
   return plot.Render();
@@ -371,7 +369,7 @@ std::string SummarySection(const VisualMap& map, const MapStatistics& stats, con
   return html.str();
 }
 
-std::string SimilaritySection(const VisualMap& map, const json& options) {
+std::string SimilaritySection(const VisualMap& map, double tau) {
   std::string html = "<section id=\"similarity\"><h2>Similarity along the sequence</h2>\n";
   if (map.evaluations.empty()) {
     html += "<p class=\"note\">This map records no per-frame similarities; only its links are shown. Rebuild it "
@@ -381,7 +379,7 @@ std::string SimilaritySection(const VisualMap& map, const json& options) {
             "with it; a new key image is chosen where S drops below &tau;. A lower &tau; gives fewer key images "
             "with fewer shared matches.</p>\n";
   }
-  html += SimilarityPlot(map, options);
+  html += SimilarityPlot(map, tau);
   if (!map.links.empty()) html += VerifiedPlot(map);
   return html + "</section>\n";
 }
@@ -470,9 +468,10 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
   const VisualMap map = ReadMap(map_directory);
   // Every image path is checked before anything is written.
   for (const KeyImage& k : map.key_images) KeyImageFile(map_directory, k);
-  const json options = ParseOptions(map.options_json);
-  const MapStatistics stats = ComputeStatistics(
-      map, OptionText(options, "quality_mean") == "harmonic" ? QualityMean::kHarmonic : QualityMean::kArithmetic);
+  const json options = ParseOptions(map.options_json);  // shown as recorded, whatever this vmap knows of them
+  const RecordedOptions recorded =
+      RecordedOptionsFromJson(map.options_json, "map '" + (map_directory / kMapFileName).string() + "': options");
+  const MapStatistics stats = ComputeStatistics(map, recorded.builder.quality_mean);
   const std::optional<MapEvaluation> evaluation = ReadMatchingEvaluation(map_directory, map);
 
   // Inside a map that ReadMap has just recognised as vmap's: the old report/ is vmap's too.
@@ -493,7 +492,7 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
                  {"links", "Match figures"},
                  {"options", "Options"}});
   html += SummarySection(map, stats, options);
-  html += SimilaritySection(map, options);
+  html += SimilaritySection(map, recorded.builder.key_images.tau);
   html += KeyImagesSection(map, assets);
   html += RoutePreviewSection(map, assets, report_options.route_fps);
   html += LinkTableHtml(map, evaluation ? &*evaluation : nullptr);

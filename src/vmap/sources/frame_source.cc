@@ -4,11 +4,13 @@
 #include <cctype>
 #include <filesystem>
 
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/error.h"
+#include "vmap/core/json_fields.h"
 #include "vmap/sources/dataset_camera.h"
 #include "vmap/sources/internal.h"
 
@@ -276,6 +278,32 @@ std::unique_ptr<FrameSource> OpenFrameSource(const std::string& path, const Fram
         return ErrorContext{"cannot read the input '" + path + "'", "check that it exists and that you may read it"};
       },
       [&] { return OpenDetectedFrameSource(path, options); });
+}
+
+namespace {
+// map.json's name for FrameSourceOptions::camera's default, the intrinsics that come with the input.
+constexpr const char* kInputCamera = "input";
+}  // namespace
+
+nlohmann::json ToJson(const FrameSourceOptions& options) {
+  return {{"format", SourceFormatName(options.format)},
+          {"first", options.first},
+          {"last", options.last},
+          {"stride", options.stride},
+          {"resize", options.resize},
+          {"strict", options.strict},
+          {"camera", options.camera.empty() ? kInputCamera : options.camera}};
+}
+
+void FromJson(const JsonFieldReader& fields, FrameSourceOptions* options) {
+  fields.Read("format", &options->format, kSourceFormatNames);
+  fields.Read("first", &options->first);
+  fields.Read("last", &options->last);
+  fields.Read("stride", &options->stride);
+  fields.Read("resize", &options->resize);
+  fields.Read("strict", &options->strict);
+  fields.Read("camera", &options->camera);
+  if (options->camera == kInputCamera) options->camera.clear();
 }
 
 }  // namespace vmap

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include <nlohmann/json_fwd.hpp>
 #include <opencv2/core.hpp>
 
 #include "vmap/core/enum_names.h"
@@ -57,6 +58,13 @@ struct FrameSourceOptions {
 
   void Check() const;  // throws InputError naming the bad option
 };
+
+class JsonFieldReader;
+// Which frames of which input, as map.json records them: format, first, last, stride, resize, strict and
+// camera ("input" for the input's own intrinsics, the default ""). The rest are limits and callbacks of a run.
+nlohmann::json ToJson(const FrameSourceOptions& options);
+// Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
+void FromJson(const JsonFieldReader& fields, FrameSourceOptions* options);
 
 struct Frame {
   int index = 0;             // position in the processed sequence: 0, 1, 2, ...
