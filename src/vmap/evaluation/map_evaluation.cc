@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/core/json_fields.h"
 #include "vmap/geometry/relative_pose.h"
 #include "vmap/map/map_geometry_json.h"
 #include "vmap/sources/dataset_camera.h"
@@ -233,12 +234,7 @@ std::string EvaluationToJson(const MapEvaluation& evaluation) {
   doc["ground_truth"] = {{"path", evaluation.ground_truth_path},
                          {"format", GroundTruthFormatName(evaluation.ground_truth_format)}};
   doc["camera"] = CameraToJson(evaluation.camera);
-  const EvaluationOptions& o = evaluation.options;
-  doc["options"] = {{"max_rotation_error_deg", o.max_rotation_error_deg},
-                    {"max_translation_error_deg", o.max_translation_error_deg},
-                    {"min_parallax_px", o.min_parallax_px},
-                    {"sampson_threshold_px", o.sampson_threshold_px},
-                    {"max_time_difference", o.max_time_difference}};
+  doc["options"] = ToJson(evaluation.options);
   json links = json::array();
   for (const LinkEvaluation& e : evaluation.links) {
     links.push_back({{"link", e.link},
@@ -300,12 +296,8 @@ MapEvaluation ReadEvaluation(const std::string& path) {
     if (doc.contains("camera") && doc["camera"].is_object()) {
       evaluation.camera = CameraFromJson(doc["camera"], path, "camera");
     }
-    const json& o = doc.contains("options") ? doc["options"] : json::object();
-    evaluation.options.max_rotation_error_deg = o.value("max_rotation_error_deg", 5.0);
-    evaluation.options.max_translation_error_deg = o.value("max_translation_error_deg", 20.0);
-    evaluation.options.min_parallax_px = o.value("min_parallax_px", 10.0);
-    evaluation.options.sampson_threshold_px = o.value("sampson_threshold_px", 2.0);
-    evaluation.options.max_time_difference = o.value("max_time_difference", 0.02);
+    const json& options = doc.contains("options") ? doc["options"] : json::object();
+    FromJson(JsonFieldReader(options, "evaluation '" + path + "': options"), &evaluation.options);
     for (const json& l : doc["links"]) {
       LinkEvaluation e;
       e.link = l.at("link").get<int>();
@@ -346,6 +338,22 @@ MapEvaluation ReadEvaluation(const std::string& path) {
     throw InputError("evaluation '" + path + "' is malformed (" + e.what() + "); run `vmap eval` again");
   }
   return evaluation;
+}
+
+nlohmann::json ToJson(const EvaluationOptions& options) {
+  return {{"max_rotation_error_deg", options.max_rotation_error_deg},
+          {"max_translation_error_deg", options.max_translation_error_deg},
+          {"min_parallax_px", options.min_parallax_px},
+          {"sampson_threshold_px", options.sampson_threshold_px},
+          {"max_time_difference", options.max_time_difference}};
+}
+
+void FromJson(const JsonFieldReader& fields, EvaluationOptions* options) {
+  fields.Read("max_rotation_error_deg", &options->max_rotation_error_deg);
+  fields.Read("max_translation_error_deg", &options->max_translation_error_deg);
+  fields.Read("min_parallax_px", &options->min_parallax_px);
+  fields.Read("sampson_threshold_px", &options->sampson_threshold_px);
+  fields.Read("max_time_difference", &options->max_time_difference);
 }
 
 }  // namespace vmap

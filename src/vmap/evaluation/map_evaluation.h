@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "vmap/evaluation/ground_truth.h"
 #include "vmap/geometry/camera.h"
 #include "vmap/map/visual_map.h"
@@ -26,6 +28,12 @@ struct EvaluationOptions {
 
   void Check() const;  // throws InputError naming the bad option
 };
+
+class JsonFieldReader;
+// As eval.json records them (its "options"): every field, by its name.
+nlohmann::json ToJson(const EvaluationOptions& options);
+// Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
+void FromJson(const JsonFieldReader& fields, EvaluationOptions* options);
 
 // Values that cannot be computed for a link are NaN (written as null in JSON).
 struct LinkEvaluation {

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "vmap/core/error.h"
+#include "vmap/core/json_fields.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/geometry/relative_pose.h"
 #include "vmap/mapping/map_builder.h"
@@ -262,6 +263,24 @@ TEST(MapEvaluation, OptionsAreCheckedAndTheDocumentRoundTrips) {
   EXPECT_EQ(back.camera.K(), e.camera.K());
   std::ofstream(file) << "{\"format\": \"something else\"}";
   EXPECT_THROW(ReadEvaluation(file.string()), InputError);
+}
+
+TEST(MapEvaluation, OptionsReadBackAsWrittenAndKeepTheDefaultsOfWhatIsNotRecorded) {
+  EvaluationOptions written;
+  written.max_rotation_error_deg = 2.5;
+  written.max_translation_error_deg = 15.0;
+  written.min_parallax_px = 4.0;
+  written.sampson_threshold_px = 1.5;
+  written.max_time_difference = 0.05;
+  EvaluationOptions read;
+  FromJson(JsonFieldReader(ToJson(written), "options"), &read);
+  EXPECT_EQ(ToJson(read), ToJson(written));
+  EXPECT_EQ(read.max_time_difference, 0.05);
+  EvaluationOptions partly;
+  FromJson(JsonFieldReader(nlohmann::json{{"min_parallax_px", 3.0}}, "options"), &partly);
+  EXPECT_EQ(partly.min_parallax_px, 3.0);
+  EXPECT_EQ(partly.max_rotation_error_deg, EvaluationOptions().max_rotation_error_deg);
+  EXPECT_THROW(FromJson(JsonFieldReader(nlohmann::json{{"min_parallax_px", "3"}}, "options"), &partly), InputError);
 }
 
 // Frames shown twice in a row (7-Scenes repeats a frame when one was dropped) are never promoted to key

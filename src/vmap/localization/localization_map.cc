@@ -1,10 +1,9 @@
 #include "vmap/localization/localization_map.h"
 
-#include <nlohmann/json.hpp>
-
 #include "vmap/features/matcher_registry.h"
 #include "vmap/features/matcher_options_json.h"
 #include "vmap/map/map_io.h"
+#include "vmap/mapping/map_builder.h"
 
 namespace vmap {
 
@@ -13,10 +12,8 @@ LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, cons
   opened.directory = directory;
   opened.map = ReadMap(directory);
   const std::string map_file = (directory / kMapFileName).string();
-  const auto doc = nlohmann::json::parse(opened.map.options_json, nullptr, false);
-  const std::string matcher_json =
-      doc.is_object() && doc.contains("matcher") ? doc["matcher"].dump() : std::string("{}");
-  opened.matcher = CreateMatcher(MatcherOptionsFromJson(matcher_json, map_file));
+  const RecordedOptions recorded = RecordedOptionsFromJson(opened.map.options_json, "map '" + map_file + "': options");
+  opened.matcher = CreateMatcher(MatcherOptionsFromJson(recorded.matcher_json, map_file));
   opened.keys = LoadKeyImageStore(directory, opened.map, *opened.matcher, options);
   return opened;
 }

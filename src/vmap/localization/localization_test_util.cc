@@ -33,17 +33,10 @@ std::optional<Frame> MemorySource::Next() {
 }
 
 std::string MapOptionsJson(const Matcher& matcher, const MapBuilderOptions& options) {
-  nlohmann::json doc;
-  doc["matcher"] = nlohmann::json::parse(matcher.DescribeOptionsJson());
-  doc["verifier"] = {{"method", VerifierMethodName(options.verifier.method)},
-                     {"threshold", options.verifier.threshold},
-                     {"confidence", options.verifier.confidence},
-                     {"max_iterations", options.verifier.max_iterations},
-                     {"seed", options.verifier.seed},
-                     {"min_matches", options.verifier.min_matches}};
-  doc["similarity"] = SimilarityModeName(options.key_images.similarity);
-  doc["tau"] = options.key_images.tau;
-  return doc.dump();
+  RecordedOptions record;
+  record.matcher_json = matcher.DescribeOptionsJson();
+  record.builder = options;
+  return ToJson(record).dump();
 }
 
 VisualMap BuildMapDirectory(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,

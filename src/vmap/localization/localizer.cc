@@ -6,9 +6,9 @@
 #include <limits>
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/mapping/map_builder.h"
 
 namespace vmap {
 
@@ -67,34 +67,20 @@ std::pair<int, int> KeysAround(const VisualMap& map, int source_index) {
   return {before, after};
 }
 
+namespace {
+MapBuilderOptions RecordedBuilderOptions(const VisualMap& map) {
+  return RecordedOptionsFromJson(map.options_json.empty() ? "{}" : map.options_json, "the map's options").builder;
+}
+}  // namespace
+
 VerifierOptions MapVerifierOptions(const VisualMap& map, int max_iterations) {
-  VerifierOptions options;
-  const auto doc = nlohmann::json::parse(map.options_json.empty() ? "{}" : map.options_json, nullptr, false);
-  if (doc.is_object() && doc.contains("verifier") && doc["verifier"].is_object()) {
-    const auto& v = doc["verifier"];
-    try {
-      if (v.contains("method")) options.method = ParseVerifierMethod(v["method"].get<std::string>());
-      options.threshold = v.value("threshold", options.threshold);
-      options.confidence = v.value("confidence", options.confidence);
-      options.max_iterations = v.value("max_iterations", options.max_iterations);
-      options.seed = v.value("seed", options.seed);
-      options.min_matches = v.value("min_matches", options.min_matches);
-    } catch (const nlohmann::json::exception&) {
-      throw InputError("the map's options.verifier is not of the documented form; rebuild the map");
-    }
-  }
+  VerifierOptions options = RecordedBuilderOptions(map).verifier;
   options.max_iterations = std::min(options.max_iterations, max_iterations);
   options.Check();
   return options;
 }
 
-SimilarityMode MapSimilarityMode(const VisualMap& map) {
-  const auto doc = nlohmann::json::parse(map.options_json.empty() ? "{}" : map.options_json, nullptr, false);
-  if (doc.is_object() && doc.contains("similarity") && doc["similarity"].is_string()) {
-    return ParseSimilarityMode(doc["similarity"].get<std::string>());
-  }
-  return SimilarityMode::kInlierRatio;
-}
+SimilarityMode MapSimilarityMode(const VisualMap& map) { return RecordedBuilderOptions(map).key_images.similarity; }
 
 Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matcher& matcher, LocalizerOptions options)
     : map_(map), keys_(keys), matcher_(matcher), options_(std::move(options)) {
