@@ -41,48 +41,63 @@ MapBuilderOptions KeyImageFlags::Resolve(const std::string& matcher_type) const 
   options.exhaustive = exhaustive;
   options.key_search = ParseKeySearch(search);
   options.search_window = search_window;
-  options.key_images.Check();
-  options.link_analysis.Check();
+  CheckField("key_images", options.key_images);
+  CheckField("link_analysis", options.link_analysis);
   return options;
 }
 
-void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau) {
+void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, OptionFlags& option_flags, bool with_tau) {
   if (with_tau) {
-    command->add_option_function<double>(
-        "-t,--tau", [&flags](double tau) { flags.tau = tau; },
-        "Similarity threshold tau in (0, 1]: lower keeps fewer key images (default: the matcher's, " +
-            DefaultTaus() + ")");
+    option_flags.Record("key_images.tau",
+                        command->add_option_function<double>(
+                            "-t,--tau", [&flags](double tau) { flags.tau = tau; },
+                            "Similarity threshold tau in (0, 1]: lower keeps fewer key images (default: the "
+                            "matcher's, " + DefaultTaus() + ")"));
   }
-  command->add_option("--similarity", flags.similarity,
-                      "S = verified / tentative matches (inlier-ratio) or / features detected (feature-ratio)")
+  option_flags
+      .AddOption(command, "--similarity", flags.similarity, "key_images.similarity",
+                 "S = verified / tentative matches (inlier-ratio) or / features detected (feature-ratio)")
       ->capture_default_str();
-  command->add_option("--quality", flags.quality, "Mean used by the quality Q: " + ListEnumNames(kQualityMeanNames))
+  option_flags
+      .AddOption(command, "--quality", flags.quality, "quality_mean",
+                 "Mean used by the quality Q: " + ListEnumNames(kQualityMeanNames))
       ->capture_default_str();
-  command->add_flag("!--no-final-key", flags.final_key, "Do not make the last frame a key image");
-  command->add_option("--threads", flags.threads, "Feature-extraction threads, 0 to 256 (0 = one per core)")
+  option_flags.AddFlag(command, "!--no-final-key", flags.final_key, "key_images.final_key",
+                       "Do not make the last frame a key image");
+  option_flags
+      .AddOption(command, "--threads", flags.threads, "extraction_threads",
+                 "Feature-extraction threads, 0 to 256 (0 = one per core)")
       ->capture_default_str();
-  command->add_option("--min-key-displacement", flags.min_key_displacement,
-                      "Pixels: a frame whose matches with the key image moved less (median) repeats its view and is "
-                      "never made a key image; 0 = off (Algorithm 1 as published)")
+  option_flags
+      .AddOption(command, "--min-key-displacement", flags.min_key_displacement, "key_images.min_key_displacement",
+                 "Pixels: a frame whose matches with the key image moved less (median) repeats its view and is "
+                 "never made a key image; 0 = off (Algorithm 1 as published)")
       ->capture_default_str();
-  command->add_option("--pose", flags.pose_method,
-                      "Relative pose of each link, with a camera: essential (E on normalised points) or fundamental "
-                      "(E = K^T F K)")
+  option_flags
+      .AddOption(command, "--pose", flags.pose_method, "link_analysis.pose.method",
+                 "Relative pose of each link, with a camera: essential (E on normalised points) or fundamental "
+                 "(E = K^T F K)")
       ->capture_default_str();
-  command->add_option("--pose-threshold", flags.pose_threshold, "Inlier threshold of the essential matrix, pixels")
+  option_flags
+      .AddOption(command, "--pose-threshold", flags.pose_threshold, "link_analysis.pose.threshold",
+                 "Inlier threshold of the essential matrix, pixels")
       ->capture_default_str();
-  command->add_option("--pose-matches", flags.pose_matches,
-                      "Matches the essential matrix is estimated on: all (tentative) or verified (F's inliers)")
+  option_flags
+      .AddOption(command, "--pose-matches", flags.pose_matches, "link_analysis.pose.use_all_matches",
+                 "Matches the essential matrix is estimated on: all (tentative) or verified (F's inliers)")
       ->capture_default_str();
-  command->add_flag("--exhaustive", flags.exhaustive,
-                    "The paper's exact behaviour: verify every comparison with OpenCV's USAC_MAGSAC to its "
-                    "confidence criterion (default: stop once S >= tau is settled; same maps within seed noise)");
-  command->add_option("--search", flags.search,
-                      "Key-image search: sequential (compare every frame: Algorithm 1), bisect (compare frames "
-                      "further ahead, then bisect: fewer network passes, the same map only where S falls with "
-                      "distance) or auto (sequential; README \"Threshold sweeps\")")
+  option_flags.AddFlag(command, "--exhaustive", flags.exhaustive, "exhaustive",
+                       "The paper's exact behaviour: verify every comparison with OpenCV's USAC_MAGSAC to its "
+                       "confidence criterion (default: stop once S >= tau is settled; same maps within seed noise)");
+  option_flags
+      .AddOption(command, "--search", flags.search, "key_search",
+                 "Key-image search: sequential (compare every frame: Algorithm 1), bisect (compare frames "
+                 "further ahead, then bisect: fewer network passes, the same map only where S falls with "
+                 "distance) or auto (sequential; README \"Threshold sweeps\")")
       ->capture_default_str();
-  command->add_option("--search-window", flags.search_window, "bisect: frames compared ahead at most (held in memory)")
+  option_flags
+      .AddOption(command, "--search-window", flags.search_window, "search_window",
+                 "bisect: frames compared ahead at most (held in memory)")
       ->capture_default_str();
 }
 

@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "vmap/cli/option_flags.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/features/matcher.h"
 #include "vmap/mapping/map_builder.h"
@@ -31,8 +32,9 @@ struct KeyImageFlags {
   // `matcher_type` gives tau when --tau was not given.
   MapBuilderOptions Resolve(const std::string& matcher_type) const;
 };
-// Also --min-key-displacement, --pose, --pose-threshold, --pose-matches, --exhaustive, --search, --search-window.
-void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau = true);
+// Also --min-key-displacement, --pose, --pose-threshold, --pose-matches, --exhaustive, --search, --search-window;
+// fields as MapBuilderOptions names them.
+void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, OptionFlags& option_flags, bool with_tau = true);
 
 // Every option that shaped a map, as JSON text for map.json.
 std::string DescribeOptions(const Matcher& matcher, const MapBuilderOptions& options,

@@ -52,7 +52,7 @@ struct PoseOptions {
   int seed = 0;           // the random generator's state: the same link gives the same pose
   int min_matches = 8;    // fewer inliers than this: no pose
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 struct RelativePose {

@@ -19,7 +19,7 @@ struct LinkAnalysisOptions {
   PoseOptions pose;              // how the pose is estimated (README: "Relative pose per link")
   HomographyOptions homography;  // when a homography counts as explaining the matches
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 // Fills link.has_pose/R/t/pose_inliers (with a camera), link.parallax and the homography test, from the
