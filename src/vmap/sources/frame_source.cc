@@ -267,8 +267,8 @@ std::unique_ptr<FrameSource> OpenDetected(const std::string& path, const fs::pat
       return internal::OpenImageList(internal::ListKitti(path), path, format, options);
     case SourceFormat::kAuto: break;
   }
-  throw OptionError("format", "auto cannot tell the layout of '" + path + "'; give its layout (" +
-                                ListEnumNames(kSourceFormatNames) + ")");
+  throw OptionError("format", "auto cannot tell the layout of '" + path +
+                                "'; give its layout: video, images, tum, euroc or kitti");
 }
 
 }  // namespace
