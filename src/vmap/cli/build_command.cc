@@ -35,6 +35,7 @@ struct BuildFlags {
   bool report = false;
   double snapshot_every = 0.0;  // seconds; 0 = no snapshots
   bool until_interrupted = false;
+  OptionFlags option_flags;
 };
 
 // Streams the input through a MapBuilder: snapshots while it runs, the end of the input on SIGINT when asked.
@@ -114,10 +115,10 @@ void AddBuildCommand(CLI::App& app) {
   command->add_option("input", flags->input, "Video file, image folder, TUM RGB-D, EuRoC or KITTI sequence")
       ->required();
   command->add_option("-o,--output", flags->output, "Map directory to write (default: <input name>_map)");
-  AddSourceOptions(command, flags->source);
-  AddMatcherOptions(command, flags->matcher);
-  AddVerifierOptions(command, flags->verifier);
-  AddKeyImageOptions(command, flags->key_images);
+  AddSourceOptions(command, flags->source, flags->option_flags);
+  AddMatcherOptions(command, flags->matcher, flags->option_flags);
+  AddVerifierOptions(command, flags->verifier, flags->option_flags);
+  AddKeyImageOptions(command, flags->key_images, flags->option_flags);
   command->add_flag("--report", flags->report, "Also write report.html into the map directory");
   command->add_option("--snapshot-every", flags->snapshot_every,
                       "Seconds between snapshots: the map so far, written to the output directory while the run "
@@ -125,7 +126,7 @@ void AddBuildCommand(CLI::App& app) {
   command->add_flag("--until-interrupted", flags->until_interrupted,
                     "SIGINT (Ctrl-C) ends the input and the map is finished from the frames seen (a second SIGINT "
                     "aborts); for cameras and streams");
-  command->callback([flags] { RunBuild(*flags); });
+  command->callback([flags] { flags->option_flags.Run([&] { RunBuild(*flags); }); });
 }
 
 }  // namespace vmap::cli

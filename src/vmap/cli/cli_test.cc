@@ -234,6 +234,40 @@ TEST(Cli, BadInputGivesAClearErrorAndWritesNothing) {
   }
 }
 
+// The library names a bad option by its field ("link_analysis.pose.threshold"); the command names the flag that
+// set it, for nested fields, for the other fields a message names, and for each matcher model's options.
+TEST(Cli, OptionErrorsNameTheFlagsThatSetTheFields) {
+  testing::ScopedTempDir tmp;
+  WriteSyntheticInput(tmp.path() / "in", 4);
+  const std::string build = "build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "out") + " ";
+  struct Case {
+    std::string arguments;
+    std::string message;  // the whole error line
+  };
+  const std::vector<Case> cases = {
+      {build + "--pose-threshold -1", "vmap: error: --pose-threshold -1 px is outside (0, 100]; the default is 1\n"},
+      {build + "--threads 999", "vmap: error: --threads must be 0 to 256 (0 = one per core)\n"},
+      {build + "--min-key-displacement 200",
+       "vmap: error: --min-key-displacement 200 px is outside [0, 100]; the default is 1, 0 turns the check off\n"},
+      {build + "--exhaustive --search bisect",
+       "vmap: error: --exhaustive is the paper's frame-by-frame scan and --search bisect skips frames; drop one\n"},
+      {build + "--first 3 --last 1", "vmap: error: --last 1 is before --first 3\n"},
+      {build + "--seed -3", "vmap: error: --seed must be >= 0 (default 0)\n"},
+      {build + "--xfeat-top-k 0", "vmap: error: --xfeat-top-k 0 must be at least 1 (upstream default 4096)\n"},
+      {build + "--aliked-top-k -1",
+       "vmap: error: --aliked-top-k must be >= 0 (0 = threshold mode with --aliked-score-threshold; default 1000)\n"},
+      {"match " + Quote(tmp.path() / "in/frame_0.png") + " " + Quote(tmp.path() / "in/frame_1.png") +
+           " --confidence 2",
+       "vmap: error: --confidence must be in (0, 1) (default 0.999)\n"},
+  };
+  for (const Case& c : cases) {
+    std::string output;
+    EXPECT_EQ(RunVmap(c.arguments, &output), 2) << c.arguments << "\n" << output;
+    EXPECT_EQ(output, c.message) << c.arguments;
+  }
+  EXPECT_FALSE(fs::exists(tmp.path() / "out"));
+}
+
 TEST(Cli, ReplacesAnOlderMapButNeverAFolderOfTheUser) {
   testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 5);

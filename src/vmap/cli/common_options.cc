@@ -12,18 +12,25 @@ namespace vmap::cli {
 namespace {
 
 // Collects every registered model's fields by flag, then binds each flag once: a flag several models share
-// (--weights, --device) sets the field of each, whichever --matcher is chosen.
+// (--weights, --device) sets the field of each, whichever --matcher is chosen. Each field is recorded as
+// "<model>.<key>", the path MatcherOptions::Check() names.
 class FlagBinder final : public OptionFieldVisitor {
  public:
+  void VisitModel(const std::string& name, ModelOptions& options) {
+    model_ = name;
+    options.VisitFields(*this);
+  }
   void Visit(const OptionField& field, int& value) override { Add(field, &value); }
   void Visit(const OptionField& field, double& value) override { Add(field, &value); }
   void Visit(const OptionField& field, bool& value) override { Add(field, &value); }
   void Visit(const OptionField& field, std::string& value) override { Add(field, &value); }
 
-  void Bind(CLI::App* command) const {
+  void Bind(CLI::App* command, OptionFlags& option_flags) const {
     for (const std::string& flag : order_) {
       const Targets& targets = flags_.at(flag);
-      std::visit([&](auto* first) { BindTargets(command, flag, targets, first); }, targets.values.front());
+      CLI::Option* option = std::visit([&](auto* first) { return BindTargets(command, flag, targets, first); },
+                                       targets.values.front());
+      for (const std::string& path : targets.paths) option_flags.Record(path, option);
     }
   }
 
@@ -32,27 +39,26 @@ class FlagBinder final : public OptionFieldVisitor {
   struct Targets {
     OptionField field;
     std::vector<Target> values;
+    std::vector<std::string> paths;  // of each value
   };
 
   void Add(const OptionField& field, Target value) {
     if (*field.flag == '\0') return;
-    auto [it, added] = flags_.try_emplace(field.flag, Targets{field, {}});
+    auto [it, added] = flags_.try_emplace(field.flag, Targets{field, {}, {}});
     if (added) order_.push_back(field.flag);
     if (it->second.values.size() > 0 && it->second.values.front().index() != value.index()) {
       throw std::logic_error(std::string("matcher flag ") + field.flag + " has fields of different types");
     }
     it->second.values.push_back(value);
+    it->second.paths.push_back(model_ + "." + field.key);
   }
 
   template <typename T>
-  static void BindTargets(CLI::App* command, const std::string& flag, const Targets& targets, T* first) {
+  static CLI::Option* BindTargets(CLI::App* command, const std::string& flag, const Targets& targets, T* first) {
     const OptionField& field = targets.field;
     if (flag.front() == '!') {  // "!--no-x": a bool flag that sets false
       if constexpr (std::is_same_v<T, bool>) {
-        if (targets.values.size() == 1) {
-          command->add_flag(flag, *first, field.help);
-          return;
-        }
+        if (targets.values.size() == 1) return command->add_flag(flag, *first, field.help);
       }
       throw std::logic_error("matcher flag " + flag + ": a negated flag needs exactly one bool field");
     }
@@ -60,7 +66,7 @@ class FlagBinder final : public OptionFieldVisitor {
     if (targets.values.size() == 1) {
       option = command->add_option(flag, *first, field.help);
       if (field.show_default) option->capture_default_str();
-      return;
+      return option;
     }
     std::vector<T*> fields;
     for (const Target& target : targets.values) fields.push_back(std::get<T*>(target));
@@ -71,42 +77,52 @@ class FlagBinder final : public OptionFieldVisitor {
       text << std::boolalpha << *first;
       option->default_str(text.str());
     }
+    return option;
   }
 
+  std::string model_;  // whose fields are visited
   std::map<std::string, Targets> flags_;
   std::vector<std::string> order_;  // as the models list them
 };
 
 }  // namespace
 
-void AddMatcherOptions(CLI::App* command, MatcherOptions& options) {
+void AddMatcherOptions(CLI::App* command, MatcherOptions& options, OptionFlags& option_flags) {
   std::string models;
   for (const auto& model : MatcherModels()) models += "\n  " + model.name + ": " + model.summary;
   command->add_option("--matcher", options.type, "Feature matcher: " + MatcherModelNames() + models)
       ->capture_default_str();
   // Every model's flags, as its options list them (features/option_fields.h).
   FlagBinder binder;
-  for (const auto& model : MatcherModels()) options.model(model.name).VisitFields(binder);
-  binder.Bind(command);
+  for (const auto& model : MatcherModels()) binder.VisitModel(model.name, options.model(model.name));
+  binder.Bind(command, option_flags);
 }
 
 VerifierOptions VerifierFlags::Resolve() const {
   VerifierOptions resolved = options;
   resolved.method = ParseVerifierMethod(method);
-  resolved.Check();
+  CheckField("verifier", resolved);
   return resolved;
 }
 
-void AddVerifierOptions(CLI::App* command, VerifierFlags& flags) {
-  command
-      ->add_option("--verifier", flags.method, "Fundamental matrix estimator: " + ListEnumNames(kVerifierMethodNames))
+void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& option_flags) {
+  option_flags
+      .AddOption(command, "--verifier", flags.method, "verifier.method",
+                 "Fundamental matrix estimator: " + ListEnumNames(kVerifierMethodNames))
       ->capture_default_str();
-  command->add_option("--threshold", flags.options.threshold, "Verifier inlier threshold in pixels")
+  option_flags
+      .AddOption(command, "--threshold", flags.options.threshold, "verifier.threshold",
+                 "Verifier inlier threshold in pixels")
       ->capture_default_str();
-  command->add_option("--confidence", flags.options.confidence, "Verifier confidence")->capture_default_str();
-  command->add_option("--max-iters", flags.options.max_iterations, "Verifier maximum iterations")
+  option_flags
+      .AddOption(command, "--confidence", flags.options.confidence, "verifier.confidence", "Verifier confidence")
       ->capture_default_str();
-  command->add_option("--seed", flags.options.seed, "Verifier random seed (same seed, same map)")
+  option_flags
+      .AddOption(command, "--max-iters", flags.options.max_iterations, "verifier.max_iterations",
+                 "Verifier maximum iterations")
+      ->capture_default_str();
+  option_flags
+      .AddOption(command, "--seed", flags.options.seed, "verifier.seed", "Verifier random seed (same seed, same map)")
       ->capture_default_str();
 }
 
@@ -117,18 +133,24 @@ FrameSourceOptions SourceFlags::Resolve() const {
   return resolved;
 }
 
-void AddSourceOptions(CLI::App* command, SourceFlags& flags) {
-  command->add_option("--format", flags.format, "Input layout: " + ListEnumNames(kSourceFormatNames))
+void AddSourceOptions(CLI::App* command, SourceFlags& flags, OptionFlags& option_flags) {
+  option_flags
+      .AddOption(command, "--format", flags.format, "format", "Input layout: " + ListEnumNames(kSourceFormatNames))
       ->capture_default_str();
-  command->add_option("--first", flags.options.first, "First frame (0-based)")->capture_default_str();
-  command->add_option("--last", flags.options.last, "Last frame, inclusive (-1 = end)")->capture_default_str();
-  command->add_option("--stride", flags.options.stride, "Use every N-th frame")->capture_default_str();
-  command->add_option("--resize", flags.options.resize, "Resize frames: WxH, or the longest side (e.g. 640)");
-  command->add_flag("--strict", flags.options.strict, "Frames of a different size are an error, not a warning");
-  command->add_option("--camera", flags.options.camera,
-                      "Intrinsics: fx,fy,cx,cy[,k1,k2,p1,p2[,k3]] (pixels, native frame size) or a calibration file "
-                      "(OpenCV YAML/JSON, EuRoC sensor.yaml, KITTI calib.txt, intrinsics.txt); 'none' ignores the "
-                      "input's own. Default: the input's own, if any");
+  option_flags.AddOption(command, "--first", flags.options.first, "first", "First frame (0-based)")
+      ->capture_default_str();
+  option_flags.AddOption(command, "--last", flags.options.last, "last", "Last frame, inclusive (-1 = end)")
+      ->capture_default_str();
+  option_flags.AddOption(command, "--stride", flags.options.stride, "stride", "Use every N-th frame")
+      ->capture_default_str();
+  option_flags.AddOption(command, "--resize", flags.options.resize, "resize",
+                         "Resize frames: WxH, or the longest side (e.g. 640)");
+  option_flags.AddFlag(command, "--strict", flags.options.strict, "strict",
+                       "Frames of a different size are an error, not a warning");
+  option_flags.AddOption(command, "--camera", flags.options.camera, "camera",
+                         "Intrinsics: fx,fy,cx,cy[,k1,k2,p1,p2[,k3]] (pixels, native frame size) or a calibration "
+                         "file (OpenCV YAML/JSON, EuRoC sensor.yaml, KITTI calib.txt, intrinsics.txt); 'none' ignores "
+                         "the input's own. Default: the input's own, if any");
 }
 
 }  // namespace vmap::cli

@@ -5,29 +5,34 @@
 
 #include <CLI/CLI.hpp>
 
+#include "vmap/cli/option_flags.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap::cli {
 
-// --matcher and the flags of every registered matcher model (features/matcher_registry.h).
-void AddMatcherOptions(CLI::App* command, MatcherOptions& options);
+// Each Add*Options records its flags in `option_flags` by the paths the checks of the options name.
 
-// --verifier, --threshold, --confidence, --max-iters, --seed.
+// --matcher and the flags of every registered matcher model (features/matcher_registry.h); fields as
+// MatcherOptions::Check() names them ("orb.num_features").
+void AddMatcherOptions(CLI::App* command, MatcherOptions& options, OptionFlags& option_flags);
+
+// --verifier, --threshold, --confidence, --max-iters, --seed; fields as "verifier.<field>" (MapBuilderOptions,
+// LocalizerOptions).
 struct VerifierFlags {
   std::string method = "magsac";
   VerifierOptions options;
-  VerifierOptions Resolve() const;  // parses method names
+  VerifierOptions Resolve() const;  // parses method names; checks the options as the field "verifier"
 };
-void AddVerifierOptions(CLI::App* command, VerifierFlags& flags);
+void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& option_flags);
 
-// --format, --first, --last, --stride, --resize, --strict.
+// --format, --first, --last, --stride, --resize, --strict, --camera; fields as FrameSourceOptions names them.
 struct SourceFlags {
   std::string format = "auto";
   FrameSourceOptions options;
   FrameSourceOptions Resolve() const;
 };
-void AddSourceOptions(CLI::App* command, SourceFlags& flags);
+void AddSourceOptions(CLI::App* command, SourceFlags& flags, OptionFlags& option_flags);
 
 }  // namespace vmap::cli

@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "vmap/cli/commands.h"
+#include "vmap/cli/option_flags.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
@@ -26,6 +27,7 @@ struct DrawFlags {
   std::string output;
   int width = 0;
   bool no_caption = false;
+  OptionFlags option_flags;
 };
 
 void RunDraw(const DrawFlags& flags) {
@@ -75,11 +77,14 @@ void AddDrawCommand(CLI::App& app) {
       ->required()
       ->check(CLI::NonNegativeNumber);
   command->add_option("-o,--output", flags->output, "Image file to write (.png, .jpg)")->required();
-  command->add_option("--width", flags->width, "Scale the figure down to at most this width (0: full size)")
+  // MatchFigureOptions::max_width.
+  flags->option_flags
+      .AddOption(command, "--width", flags->width, "max_width",
+                 "Scale the figure down to at most this width (0: full size)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   command->add_flag("--no-caption", flags->no_caption, "Leave out the caption band under the images");
-  command->callback([flags] { RunDraw(*flags); });
+  command->callback([flags] { flags->option_flags.Run([&] { RunDraw(*flags); }); });
 }
 
 }  // namespace vmap::cli

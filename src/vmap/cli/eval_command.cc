@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/cli/commands.h"
+#include "vmap/cli/option_flags.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
 #include "vmap/evaluation/map_evaluation.h"
@@ -27,6 +28,7 @@ struct EvalFlags {
   bool save = true;
   bool table = true;
   EvaluationOptions options;
+  OptionFlags option_flags;
 };
 
 void RunEval(const EvalFlags& flags) {
@@ -55,34 +57,42 @@ void AddEvalCommand(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "eval", "Check every link of a map against ground-truth camera poses (rotation, translation, epipolar errors)");
   command->add_option("map", flags->map, "Map directory written by `vmap build`")->required();
-  command->add_option("--gt", flags->gt,
-                      "Ground-truth poses (default: the input's own: KITTI poses.txt, TUM groundtruth.txt, EuRoC "
-                      "state_groundtruth_estimate0/data.csv). Formats: kitti, tum, euroc");
-  command
-      ->add_option("--gt-format", flags->gt_format,
-                   "Format of --gt: " + ListEnumNames(kGroundTruthFormatNames) + " (auto: from its first line)")
+  OptionFlags& option_flags = flags->option_flags;
+  // The ground truth and camera as MapGroundTruth and EvaluationCamera name them.
+  option_flags.AddOption(command, "--gt", flags->gt, "gt.path",
+                         "Ground-truth poses (default: the input's own: KITTI poses.txt, TUM groundtruth.txt, EuRoC "
+                         "state_groundtruth_estimate0/data.csv). Formats: kitti, tum, euroc");
+  option_flags
+      .AddOption(command, "--gt-format", flags->gt_format, "gt.format",
+                 "Format of --gt: " + ListEnumNames(kGroundTruthFormatNames) + " (auto: from its first line)")
       ->capture_default_str();
-  command->add_option("--camera", flags->camera,
-                      "Intrinsics when the map has none: fx,fy,cx,cy[,k1,k2,p1,p2[,k3]] or a calibration file");
+  option_flags.AddOption(command, "--camera", flags->camera, "camera",
+                         "Intrinsics when the map has none: fx,fy,cx,cy[,k1,k2,p1,p2[,k3]] or a calibration file");
   command->add_option("--json", flags->json, "Also write the evaluation (JSON) to this file");
   command->add_flag("!--no-save", flags->save, "Do not write eval.json into the map directory");
   command->add_flag("!--no-table", flags->table, "Print only the summary, not one row per link");
   auto& o = flags->options;
-  command->add_option("--max-rotation-error", o.max_rotation_error_deg, "Usable: rotation error below this (deg)")
+  option_flags
+      .AddOption(command, "--max-rotation-error", o.max_rotation_error_deg, "max_rotation_error_deg",
+                 "Usable: rotation error below this (deg)")
       ->capture_default_str();
-  command->add_option("--max-translation-error", o.max_translation_error_deg,
-                      "Usable: translation direction error below this (deg) where the parallax is enough")
+  option_flags
+      .AddOption(command, "--max-translation-error", o.max_translation_error_deg, "max_translation_error_deg",
+                 "Usable: translation direction error below this (deg) where the parallax is enough")
       ->capture_default_str();
-  command->add_option("--min-parallax", o.min_parallax_px,
-                      "True parallax (px) from which the translation direction is judged")
+  option_flags
+      .AddOption(command, "--min-parallax", o.min_parallax_px, "min_parallax_px",
+                 "True parallax (px) from which the translation direction is judged")
       ->capture_default_str();
-  command->add_option("--sampson-threshold", o.sampson_threshold_px,
-                      "A match is on its true epipolar line within this Sampson error (px)")
+  option_flags
+      .AddOption(command, "--sampson-threshold", o.sampson_threshold_px, "sampson_threshold_px",
+                 "A match is on its true epipolar line within this Sampson error (px)")
       ->capture_default_str();
-  command->add_option("--max-time-difference", o.max_time_difference,
-                      "Seconds between a key image and its ground-truth pose (tum, euroc)")
+  option_flags
+      .AddOption(command, "--max-time-difference", o.max_time_difference, "max_time_difference",
+                 "Seconds between a key image and its ground-truth pose (tum, euroc)")
       ->capture_default_str();
-  command->callback([flags] { RunEval(*flags); });
+  command->callback([flags] { flags->option_flags.Run([&] { RunEval(*flags); }); });
 }
 
 }  // namespace vmap::cli

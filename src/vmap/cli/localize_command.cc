@@ -38,6 +38,7 @@ struct LocalizeFlags {
   int to = -1;
   int threads = 0;
   bool cache = true;
+  OptionFlags option_flags;
 };
 
 std::string Percent(long part, long whole) {
@@ -140,26 +141,44 @@ void AddLocalizeCommand(CLI::App& app) {
   command->add_option("--csv", flags->csv, "Write one row per frame to this CSV file");
   command->add_option("--json", flags->json, "Write the run (summary and every frame) to this JSON file");
   command->add_option("--report", flags->report, "Write an HTML report of the run into this directory");
-  AddSourceOptions(command, flags->source);
+  OptionFlags& option_flags = flags->option_flags;
+  AddSourceOptions(command, flags->source, option_flags);
   LocalizerOptions& o = flags->localizer;
-  command->add_option("--min-verified", o.min_verified, "Verified matches a frame needs to be localized at a key image")
+  option_flags
+      .AddOption(command, "--min-verified", o.min_verified, "min_verified",
+                 "Verified matches a frame needs to be localized at a key image")
       ->capture_default_str();
-  command->add_option("--min-similarity", o.min_similarity, "S a frame needs to be localized at a key image")
+  option_flags
+      .AddOption(command, "--min-similarity", o.min_similarity, "min_similarity",
+                 "S a frame needs to be localized at a key image")
       ->capture_default_str();
-  command->add_option("--max-lost", o.max_lost_frames, "Lost frames in a row before the estimate is dropped")
+  option_flags
+      .AddOption(command, "--max-lost", o.max_lost_frames, "max_lost_frames",
+                 "Lost frames in a row before the estimate is dropped")
       ->capture_default_str();
-  command->add_option("--candidates", o.relocalization_candidates, "Best-ranked key images verified when relocalizing")
+  option_flags
+      .AddOption(command, "--candidates", o.relocalization_candidates, "relocalization_candidates",
+                 "Best-ranked key images verified when relocalizing")
       ->capture_default_str();
-  command->add_option("--lookahead", o.lookahead, "Key images beyond the next compared while tracking (1 or 2)")
+  option_flags
+      .AddOption(command, "--lookahead", o.lookahead, "lookahead",
+                 "Key images beyond the next compared while tracking (1 or 2)")
       ->capture_default_str();
-  command->add_flag("!--no-step-back", o.step_back, "Never move the estimate back to the previous key image");
-  command->add_option("--ranking", flags->ranking, "Relocalization ranking: " + ListEnumNames(kRankingMethodNames))
+  option_flags.AddFlag(command, "!--no-step-back", o.step_back, "step_back",
+                       "Never move the estimate back to the previous key image");
+  option_flags
+      .AddOption(command, "--ranking", flags->ranking, "ranking.method",
+                 "Relocalization ranking: " + ListEnumNames(kRankingMethodNames))
       ->capture_default_str();
   command->add_option("--from", flags->from, "Follow the route from this key image (default: the first)");
   command->add_option("--to", flags->to, "Follow the route to this key image (default: the last)");
-  command->add_option("--threads", flags->threads, "Feature-extraction threads (0 = one per core)")->capture_default_str();
+  // LocalizeSequenceOptions::extraction_threads (the key-image store's keeps its default).
+  option_flags
+      .AddOption(command, "--threads", flags->threads, "extraction_threads",
+                 "Feature-extraction threads (0 = one per core)")
+      ->capture_default_str();
   command->add_flag("!--no-cache", flags->cache, "Do not read or write the key-image cache in the map directory");
-  command->callback([flags] { RunLocalize(*flags); });
+  command->callback([flags] { flags->option_flags.Run([&] { RunLocalize(*flags); }); });
 }
 
 }  // namespace vmap::cli

@@ -1,5 +1,7 @@
 #include "vmap/cli/map_options.h"
 
+#include <optional>
+
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -22,67 +24,87 @@ std::string DefaultTaus() {
   return text;
 }
 
+// Binds `names` to the enum `field` by its names: `parse` reads a name (an unknown one is its InputError, as
+// in map.json), `name` shows the default.
+template <typename Enum>
+CLI::Option* AddEnumOption(CLI::App* command, OptionFlags& option_flags, const std::string& names, Enum& field,
+                           Enum (*parse)(const std::string&), std::string (*name)(Enum), const std::string& path,
+                           const std::string& help) {
+  return option_flags.Record(
+      path, command->add_option_function<std::string>(
+                         names, [&field, parse](const std::string& text) { field = parse(text); }, help)
+                ->default_str(name(field)));
+}
+
 }  // namespace
 
 MapBuilderOptions KeyImageFlags::Resolve(const std::string& matcher_type) const {
-  MapBuilderOptions options;
-  options.key_images.tau = tau ? *tau : DefaultTau(matcher_type);
-  options.key_images.similarity = ParseSimilarityMode(similarity);
-  options.key_images.final_key = final_key;
-  options.quality_mean = ParseQualityMean(quality);
-  options.extraction_threads = threads;
-  options.key_images.min_key_displacement = min_key_displacement;
-  options.link_analysis.pose.method = ParsePoseMethod(pose_method);
-  options.link_analysis.pose.threshold = pose_threshold;
-  if (pose_matches != "all" && pose_matches != "verified") {
-    throw InputError("--pose-matches '" + pose_matches + "': use all (every tentative match) or verified (F's inliers)");
-  }
-  options.link_analysis.pose.use_all_matches = pose_matches == "all";
-  options.exhaustive = exhaustive;
-  options.key_search = ParseKeySearch(search);
-  options.search_window = search_window;
-  options.key_images.Check();
-  options.link_analysis.Check();
-  return options;
+  MapBuilderOptions resolved = options;
+  resolved.key_images.tau = tau ? *tau : DefaultTau(matcher_type);
+  CheckField("key_images", resolved.key_images);
+  CheckField("link_analysis", resolved.link_analysis);
+  return resolved;
 }
 
-void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau) {
+void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, OptionFlags& option_flags, bool with_tau) {
   if (with_tau) {
-    command->add_option_function<double>(
-        "-t,--tau", [&flags](double tau) { flags.tau = tau; },
-        "Similarity threshold tau in (0, 1]: lower keeps fewer key images (default: the matcher's, " +
-            DefaultTaus() + ")");
+    option_flags.Record("key_images.tau",
+                        command->add_option_function<double>(
+                            "-t,--tau", [&flags](double tau) { flags.tau = tau; },
+                            "Similarity threshold tau in (0, 1]: lower keeps fewer key images (default: the "
+                            "matcher's, " + DefaultTaus() + ")"));
   }
-  command->add_option("--similarity", flags.similarity,
-                      "S = verified / tentative matches (inlier-ratio) or / features detected (feature-ratio)")
+  MapBuilderOptions& o = flags.options;
+  AddEnumOption(command, option_flags, "--similarity", o.key_images.similarity, ParseSimilarityMode,
+                SimilarityModeName, "key_images.similarity",
+                "S = verified / tentative matches (inlier-ratio) or / features detected (feature-ratio)");
+  AddEnumOption(command, option_flags, "--quality", o.quality_mean, ParseQualityMean, QualityMeanName, "quality_mean",
+                "Mean used by the quality Q: " + ListEnumNames(kQualityMeanNames));
+  option_flags.AddFlag(command, "!--no-final-key", o.key_images.final_key, "key_images.final_key",
+                       "Do not make the last frame a key image");
+  option_flags
+      .AddOption(command, "--threads", o.extraction_threads, "extraction_threads",
+                 "Feature-extraction threads, 0 to 256 (0 = one per core)")
       ->capture_default_str();
-  command->add_option("--quality", flags.quality, "Mean used by the quality Q: " + ListEnumNames(kQualityMeanNames))
+  option_flags
+      .AddOption(command, "--min-key-displacement", o.key_images.min_key_displacement,
+                 "key_images.min_key_displacement",
+                 "Pixels: a frame whose matches with the key image moved less (median) repeats its view and is "
+                 "never made a key image; 0 = off (Algorithm 1 as published)")
       ->capture_default_str();
-  command->add_flag("!--no-final-key", flags.final_key, "Do not make the last frame a key image");
-  command->add_option("--threads", flags.threads, "Feature-extraction threads, 0 to 256 (0 = one per core)")
+  PoseOptions& pose = o.link_analysis.pose;
+  AddEnumOption(command, option_flags, "--pose", pose.method, ParsePoseMethod, PoseMethodName,
+                "link_analysis.pose.method",
+                "Relative pose of each link, with a camera: essential (E on normalised points) or fundamental "
+                "(E = K^T F K)");
+  option_flags
+      .AddOption(command, "--pose-threshold", pose.threshold, "link_analysis.pose.threshold",
+                 "Inlier threshold of the essential matrix, pixels")
       ->capture_default_str();
-  command->add_option("--min-key-displacement", flags.min_key_displacement,
-                      "Pixels: a frame whose matches with the key image moved less (median) repeats its view and is "
-                      "never made a key image; 0 = off (Algorithm 1 as published)")
-      ->capture_default_str();
-  command->add_option("--pose", flags.pose_method,
-                      "Relative pose of each link, with a camera: essential (E on normalised points) or fundamental "
-                      "(E = K^T F K)")
-      ->capture_default_str();
-  command->add_option("--pose-threshold", flags.pose_threshold, "Inlier threshold of the essential matrix, pixels")
-      ->capture_default_str();
-  command->add_option("--pose-matches", flags.pose_matches,
-                      "Matches the essential matrix is estimated on: all (tentative) or verified (F's inliers)")
-      ->capture_default_str();
-  command->add_flag("--exhaustive", flags.exhaustive,
-                    "The paper's exact behaviour: verify every comparison with OpenCV's USAC_MAGSAC to its "
-                    "confidence criterion (default: stop once S >= tau is settled; same maps within seed noise)");
-  command->add_option("--search", flags.search,
-                      "Key-image search: sequential (compare every frame: Algorithm 1), bisect (compare frames "
-                      "further ahead, then bisect: fewer network passes, the same map only where S falls with "
-                      "distance) or auto (sequential; README \"Threshold sweeps\")")
-      ->capture_default_str();
-  command->add_option("--search-window", flags.search_window, "bisect: frames compared ahead at most (held in memory)")
+  option_flags
+      .Record("link_analysis.pose.use_all_matches",
+              command->add_option_function<std::string>(
+                  "--pose-matches",
+                  [&pose](const std::string& matches) {
+                    const std::optional<bool> all = FindEnum(kPoseMatchesNames, matches);
+                    if (!all) {
+                      throw InputError("--pose-matches '" + matches +
+                                       "': use all (every tentative match) or verified (F's inliers)");
+                    }
+                    pose.use_all_matches = *all;
+                  },
+                  "Matches the essential matrix is estimated on: all (tentative) or verified (F's inliers)"))
+      ->default_str(EnumToName(kPoseMatchesNames, pose.use_all_matches));
+  option_flags.AddFlag(command, "--exhaustive", o.exhaustive, "exhaustive",
+                       "The paper's exact behaviour: verify every comparison with OpenCV's USAC_MAGSAC to its "
+                       "confidence criterion (default: stop once S >= tau is settled; same maps within seed noise)");
+  AddEnumOption(command, option_flags, "--search", o.key_search, ParseKeySearch, KeySearchName, "key_search",
+                "Key-image search: sequential (compare every frame: Algorithm 1), bisect (compare frames further "
+                "ahead, then bisect: fewer network passes, the same map only where S falls with distance) or auto "
+                "(sequential; README \"Threshold sweeps\")");
+  option_flags
+      .AddOption(command, "--search-window", o.search_window, "search_window",
+                 "bisect: frames compared ahead at most (held in memory)")
       ->capture_default_str();
 }
 

@@ -7,32 +7,24 @@
 
 #include <CLI/CLI.hpp>
 
+#include "vmap/cli/option_flags.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/features/matcher.h"
 #include "vmap/mapping/map_builder.h"
 
 namespace vmap::cli {
 
-// --tau, --similarity, --quality, --no-final-key, --threads, --exhaustive, --search, --search-window.
+// --tau, --similarity, --quality, --no-final-key, --threads, --exhaustive, --search, --search-window: bound
+// straight onto `options` (the library's defaults), but for tau, whose default depends on the matcher.
 struct KeyImageFlags {
+  MapBuilderOptions options;
   std::optional<double> tau;  // --tau; unset: the matcher's DefaultTau
-  std::string similarity = "inlier-ratio";
-  std::string quality = "arithmetic";
-  bool final_key = true;
-  int threads = 0;
-  double min_key_displacement = KeyImageOptions().min_key_displacement;
-  // The pose of each link (with a camera) and the homography test.
-  std::string pose_method = PoseMethodName(PoseOptions().method);
-  double pose_threshold = PoseOptions().threshold;
-  std::string pose_matches = PoseOptions().use_all_matches ? "all" : "verified";
-  bool exhaustive = false;
-  std::string search = "auto";
-  int search_window = 32;
-  // `matcher_type` gives tau when --tau was not given.
+  // `options` with tau (`matcher_type` gives it when --tau was not given), key images and links checked.
   MapBuilderOptions Resolve(const std::string& matcher_type) const;
 };
-// Also --min-key-displacement, --pose, --pose-threshold, --pose-matches, --exhaustive, --search, --search-window.
-void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, bool with_tau = true);
+// Also --min-key-displacement, --pose, --pose-threshold, --pose-matches, --exhaustive, --search, --search-window;
+// fields as MapBuilderOptions names them.
+void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, OptionFlags& option_flags, bool with_tau = true);
 
 // Every option that shaped a map, as JSON text for map.json.
 std::string DescribeOptions(const Matcher& matcher, const MapBuilderOptions& options,

@@ -25,6 +25,7 @@ struct MatchFlags {
   bool list = false;
   MatcherOptions matcher;
   VerifierFlags verifier;
+  OptionFlags option_flags;
 };
 
 cv::Mat ReadGray(const std::string& path) {
@@ -150,9 +151,9 @@ void AddMatchCommand(CLI::App& app) {
   command->add_option("image1", flags->image1, "Second image")->required();
   command->add_option("--json", flags->json_path, "Also write every match, the inlier mask and F to this JSON file");
   command->add_flag("--list", flags->list, "Print every match: x0 y0 x1 y1 score inlier");
-  AddMatcherOptions(command, flags->matcher);
-  AddVerifierOptions(command, flags->verifier);
-  command->callback([flags] { RunMatch(*flags); });
+  AddMatcherOptions(command, flags->matcher, flags->option_flags);
+  AddVerifierOptions(command, flags->verifier, flags->option_flags);
+  command->callback([flags] { flags->option_flags.Run([&] { RunMatch(*flags); }); });
 }
 
 }  // namespace vmap::cli

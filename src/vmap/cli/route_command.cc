@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/cli/commands.h"
+#include "vmap/cli/option_flags.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/localization/route.h"
 #include "vmap/map/map_io.h"
@@ -22,6 +23,7 @@ struct RouteFlags {
   int to = -1;
   std::string json;
   RouteOptions options;
+  OptionFlags option_flags;
 };
 
 void RunRoute(const RouteFlags& flags) {
@@ -67,10 +69,11 @@ void AddRouteCommand(CLI::App& app) {
   command->add_option("--from", flags->from, "Start key image")->capture_default_str();
   command->add_option("--to", flags->to, "Goal key image (default: the last)");
   command->add_option("--json", flags->json, "Also write the route to this JSON file");
-  command->add_option("--min-backward-verified", flags->options.min_backward_verified,
-                      "Verified matches a link needs to be followed backwards")
+  flags->option_flags
+      .AddOption(command, "--min-backward-verified", flags->options.min_backward_verified, "min_backward_verified",
+                 "Verified matches a link needs to be followed backwards")
       ->capture_default_str();
-  command->callback([flags] { RunRoute(*flags); });
+  command->callback([flags] { flags->option_flags.Run([&] { RunRoute(*flags); }); });
 }
 
 }  // namespace vmap::cli

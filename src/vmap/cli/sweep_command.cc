@@ -36,6 +36,7 @@ struct SweepFlags {
   bool evaluate = false;  // --gt given, with or without a file
   std::string gt;
   std::string gt_format = "auto";
+  OptionFlags option_flags;
 };
 
 // Whether two output paths name the same folder (neither need exist yet).
@@ -139,23 +140,28 @@ void AddSweepCommand(CLI::App& app) {
       app.add_subcommand("sweep", "Build maps for a range of thresholds tau in one pass (the paper's tables)");
   command->add_option("input", flags->input, "Video file, image folder, TUM RGB-D, EuRoC or KITTI sequence")
       ->required();
-  command->add_option("--thresholds", flags->thresholds, "start:stop:step or a list a,b,c")->capture_default_str();
+  flags->option_flags
+      .AddOption(command, "--thresholds", flags->thresholds, "thresholds", "start:stop:step or a list a,b,c")
+      ->capture_default_str();
   command->add_option("-o,--output", flags->output, "Directory for sweep.md, sweep.csv and sweep.json");
   command->add_flag("--maps", flags->write_maps, "Also write each tau's map into the output directory");
   command->add_option("--report", flags->report, "Write an HTML report of the sweep into this directory");
-  AddSourceOptions(command, flags->source);
-  AddMatcherOptions(command, flags->matcher);
-  AddVerifierOptions(command, flags->verifier);
-  AddKeyImageOptions(command, flags->key_images, /*with_tau=*/false);
-  CLI::Option* gt = command->add_option("--gt", flags->gt,
-                                        "Add a usable-links column (see `vmap eval`): with no FILE, the input's own "
-                                        "ground truth; or a kitti, tum or euroc poses file")
+  AddSourceOptions(command, flags->source, flags->option_flags);
+  AddMatcherOptions(command, flags->matcher, flags->option_flags);
+  AddVerifierOptions(command, flags->verifier, flags->option_flags);
+  AddKeyImageOptions(command, flags->key_images, flags->option_flags, /*with_tau=*/false);
+  CLI::Option* gt = flags->option_flags
+                        .AddOption(command, "--gt", flags->gt, "gt.path",
+                                   "Add a usable-links column (see `vmap eval`): with no FILE, the input's own "
+                                   "ground truth; or a kitti, tum or euroc poses file")
                         ->expected(0, 1);
-  command->add_option("--gt-format", flags->gt_format, "Format of --gt FILE: " + ListEnumNames(kGroundTruthFormatNames))
+  flags->option_flags
+      .AddOption(command, "--gt-format", flags->gt_format, "gt.format",
+                 "Format of --gt FILE: " + ListEnumNames(kGroundTruthFormatNames))
       ->capture_default_str();
   command->callback([flags, gt] {
     flags->evaluate = gt->count() > 0;
-    RunSweep(*flags);
+    flags->option_flags.Run([&] { RunSweep(*flags); });
   });
 }
 

@@ -18,8 +18,8 @@ namespace vmap {
 
 void RuntimeOptions::Check() const {
   if (opencv_threads < 0) {
-    throw InputError("RuntimeOptions::opencv_threads is " + std::to_string(opencv_threads) +
-                     "; use 1 or more threads, or 0 for OpenCV's default");
+    throw OptionError("opencv_threads",
+                      "is " + std::to_string(opencv_threads) + "; use 1 or more threads, or 0 for OpenCV's default");
   }
 }
 

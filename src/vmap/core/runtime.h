@@ -27,7 +27,7 @@ struct RuntimeOptions {
   // (core/interrupt.h). Off in the test binaries, whose death tests install it in their child processes.
   bool handle_interrupts = true;
 
-  void Check() const;  // throws InputError naming the bad field
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 // Applies `options` to the process. Call once, before any other thread starts (signal handling blocks the

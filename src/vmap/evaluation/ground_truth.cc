@@ -88,9 +88,9 @@ GroundTruthFormat DetectGroundTruthFormat(const std::string& path) {
     if (!commas && count == 8) return GroundTruthFormat::kTum;
     break;
   }
-  throw InputError("cannot tell the format of ground truth '" + path +
-                   "': its first line is not 12 numbers (KITTI poses.txt), 'timestamp tx ty tz qx qy qz qw' (TUM) "
-                   "or 'timestamp_ns,px,py,pz,qw,qx,qy,qz,...' (EuRoC); pass --gt-format");
+  throw OptionError("format", "auto cannot tell the format of ground truth '" + path +
+                                "': its first line is not 12 numbers (KITTI poses.txt), 'timestamp tx ty tz qx qy qz "
+                                "qw' (TUM) or 'timestamp_ns,px,py,pz,qw,qx,qy,qz,...' (EuRoC); give the format");
 }
 
 GroundTruth ReadGroundTruth(const std::string& path, GroundTruthFormat format, const cv::Matx44d& body_to_camera) {

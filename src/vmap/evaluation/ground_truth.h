@@ -37,7 +37,7 @@ struct GroundTruth {
 };
 
 // The format of a ground-truth file, from its first data line: 12 numbers (kitti), 8 numbers separated by
-// spaces (tum), 8 or more separated by commas (euroc). Throws InputError when it is none of them.
+// spaces (tum), 8 or more separated by commas (euroc). Throws OptionError ("format") when it is none of them.
 GroundTruthFormat DetectGroundTruthFormat(const std::string& path);
 
 // Reads a ground-truth file. `body_to_camera` (T_bc) turns EuRoC's body poses into camera poses; it is

@@ -17,21 +17,23 @@ using nlohmann::json;
 
 void EvaluationOptions::Check() const {
   if (!(max_rotation_error_deg > 0 && max_rotation_error_deg <= 180)) {
-    throw InputError(fmt::format("--max-rotation-error {} deg is outside (0, 180]; the default is 5",
-                                 max_rotation_error_deg));
+    throw OptionError("max_rotation_error_deg",
+                      fmt::format("{} deg is outside (0, 180]; the default is 5", max_rotation_error_deg));
   }
   if (!(max_translation_error_deg > 0 && max_translation_error_deg <= 180)) {
-    throw InputError(fmt::format("--max-translation-error {} deg is outside (0, 180]; the default is 20",
-                                 max_translation_error_deg));
+    throw OptionError("max_translation_error_deg",
+                      fmt::format("{} deg is outside (0, 180]; the default is 20", max_translation_error_deg));
   }
   if (!(min_parallax_px >= 0 && std::isfinite(min_parallax_px))) {
-    throw InputError(fmt::format("--min-parallax {} px must be >= 0; the default is 10", min_parallax_px));
+    throw OptionError("min_parallax_px", fmt::format("{} px must be >= 0; the default is 10", min_parallax_px));
   }
   if (!(sampson_threshold_px > 0 && std::isfinite(sampson_threshold_px))) {
-    throw InputError(fmt::format("--sampson-threshold {} px must be > 0; the default is 2", sampson_threshold_px));
+    throw OptionError("sampson_threshold_px",
+                      fmt::format("{} px must be > 0; the default is 2", sampson_threshold_px));
   }
   if (!(max_time_difference >= 0 && std::isfinite(max_time_difference))) {
-    throw InputError(fmt::format("--max-time-difference {} s must be >= 0; the default is 0.02", max_time_difference));
+    throw OptionError("max_time_difference",
+                      fmt::format("{} s must be >= 0; the default is 0.02", max_time_difference));
   }
 }
 
@@ -206,8 +208,8 @@ Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option) 
   if (!camera_option.empty()) camera = ParseCameraOption(camera_option);
   else camera = FindDatasetCamera(map.input.path, map.input.format);
   if (!camera) {
-    throw InputError("the map has no camera and its input '" + map.input.path +
-                     "' brings none; give the intrinsics with --camera fx,fy,cx,cy (or a calibration file)");
+    throw OptionError("camera", "is needed: the map has no camera and its input '" + map.input.path +
+                                    "' brings none; give the intrinsics fx,fy,cx,cy (or a calibration file)");
   }
   const cv::Size native = map.input.native_size.area() > 0 ? map.input.native_size : map.input.frame_size;
   const cv::Size frames = map.input.frame_size.area() > 0 ? map.input.frame_size : native;
@@ -216,12 +218,12 @@ Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option) 
 }
 
 GroundTruth MapGroundTruth(const VisualMap& map, const std::string& gt_path, GroundTruthFormat format) {
-  if (!gt_path.empty()) return ReadGroundTruth(gt_path, format);
+  if (!gt_path.empty()) return NameOptionErrorsWithin("gt", [&] { return ReadGroundTruth(gt_path, format); });
   std::optional<GroundTruth> truth = FindGroundTruth(map.input.path, map.input.format);
   if (!truth) {
-    throw InputError("the map's input '" + map.input.path +
-                     "' has no ground truth beside it (KITTI poses.txt, TUM groundtruth.txt, EuRoC "
-                     "state_groundtruth_estimate0/data.csv); give one with --gt FILE");
+    throw OptionError("gt.path", "is needed: the map's input '" + map.input.path +
+                                     "' has no ground truth beside it (KITTI poses.txt, TUM groundtruth.txt, EuRoC "
+                                     "state_groundtruth_estimate0/data.csv); give a poses file");
   }
   return *truth;
 }

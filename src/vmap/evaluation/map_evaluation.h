@@ -26,7 +26,7 @@ struct EvaluationOptions {
   // Seconds: a key image takes the ground-truth pose nearest in time within this (tum, euroc).
   double max_time_difference = 0.02;
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 class JsonFieldReader;
@@ -85,12 +85,12 @@ struct MapEvaluation {
 MapEvaluation EvaluateMap(const VisualMap& map, const GroundTruth& truth, const Camera& camera,
                           const EvaluationOptions& options);
 
-// The camera to evaluate a map with: the map's own, else `camera_option` (--camera), else the one that
-// comes with the map's input, scaled to the map's frame size. Throws InputError when there is none.
+// The camera to evaluate a map with: the map's own, else `camera_option`, else the one that comes with the
+// map's input, scaled to the map's frame size. Throws OptionError ("camera") when there is none.
 Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option);
 
 // The ground truth of a map: the file given (format from `format`, or detected), else the one that comes
-// with the map's input. Throws InputError when there is none.
+// with the map's input. Throws OptionError ("gt.path" when there is none, "gt.format" when it cannot be told).
 GroundTruth MapGroundTruth(const VisualMap& map, const std::string& gt_path, GroundTruthFormat format);
 
 inline constexpr const char* kEvaluationFileName = "eval.json";

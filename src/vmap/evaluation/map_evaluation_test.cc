@@ -14,6 +14,7 @@
 #include "vmap/geometry/relative_pose.h"
 #include "vmap/mapping/map_builder.h"
 #include "vmap/report/evaluation_summary.h"
+#include "vmap/testing/option_error.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"
 
@@ -243,10 +244,10 @@ TEST(MapEvaluation, EurocBodyPosesAreTurnedIntoCameraPoses) {
 TEST(MapEvaluation, OptionsAreCheckedAndTheDocumentRoundTrips) {
   EvaluationOptions bad;
   bad.max_rotation_error_deg = 0;
-  EXPECT_THROW(bad.Check(), InputError);
+  EXPECT_EQ(testing::OptionErrorPath([&] { bad.Check(); }), "max_rotation_error_deg");
   bad = EvaluationOptions();
   bad.min_parallax_px = -1;
-  EXPECT_THROW(bad.Check(), InputError);
+  EXPECT_EQ(testing::OptionErrorPath([&] { bad.Check(); }), "min_parallax_px");
 
   const KittiFixture& k = Kitti();
   MapEvaluation e = EvaluateMap(k.map, k.truth, *k.map.input.camera, EvaluationOptions());

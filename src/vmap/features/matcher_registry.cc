@@ -124,7 +124,7 @@ const ModelOptions& MatcherOptions::model(const std::string& name) const {
 void MatcherOptions::Check() const {
   FindMatcherModel(type);
   // The options of every matcher, used or not: an absurd value (NaN, out of range) is a mistake either way.
-  for (const auto& [name, options] : models_) options->Check();
+  for (const auto& [name, options] : models_) CheckField(name, *options);
 }
 
 double DefaultTau(const std::string& matcher_type) { return FindMatcherModel(matcher_type).default_tau; }
@@ -132,8 +132,10 @@ double DefaultTau(const std::string& matcher_type) { return FindMatcherModel(mat
 std::unique_ptr<Matcher> CreateMatcher(const MatcherOptions& options) {
   options.Check();
   const MatcherModel& model = FindMatcherModel(options.type);
-  if (model.create) return model.create(options.selected());
-  return CreatePluginMatcher(options.selected());
+  // An option found wrong only now (a device the machine lacks) is named as Check() names it.
+  return NameOptionErrorsWithin(model.name, [&] {
+    return model.create ? model.create(options.selected()) : CreatePluginMatcher(options.selected());
+  });
 }
 
 }  // namespace vmap

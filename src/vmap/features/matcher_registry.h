@@ -29,7 +29,7 @@ class ModelOptions {
   virtual const char* model() const = 0;  // the registered name
   virtual std::unique_ptr<ModelOptions> Clone() const = 0;
   virtual void VisitFields(OptionFieldVisitor& visitor) = 0;
-  virtual void Check() const = 0;  // throws InputError naming the bad option
+  virtual void Check() const = 0;  // throws OptionError naming the bad field by its JSON key
 
   // {"type": model(), one key per field}.
   nlohmann::json ToJson() const;
@@ -152,7 +152,7 @@ class MatcherOptions {
     return model(T::kModelName).template As<T>();
   }
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field as "<model>.<key>" ("orb.num_features")
 
  private:
   std::map<std::string, std::unique_ptr<ModelOptions>> models_;

@@ -30,19 +30,19 @@ void OrbMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
 
 void OrbMatcherOptions::Check() const {
   if (num_features < 1 || num_features > 100000) {
-    throw InputError("--orb-features must be 1 to 100000 (default 500)");
+    throw OptionError("num_features", "must be 1 to 100000 (default 500)");
   }
   if (!(scale_factor > 1.0 && scale_factor <= 4.0)) {
-    throw InputError("--orb-scale-factor must be in (1, 4] (default 1.2)");
+    throw OptionError("scale_factor", "must be in (1, 4] (default 1.2)");
   }
-  if (num_levels < 1 || num_levels > 32) throw InputError("--orb-levels must be 1 to 32 (default 8)");
+  if (num_levels < 1 || num_levels > 32) throw OptionError("num_levels", "must be 1 to 32 (default 8)");
   if (edge_threshold < 0 || edge_threshold > 1000) {
-    throw InputError("--orb-edge-threshold must be 0 to 1000 pixels (default 31)");
+    throw OptionError("edge_threshold", "must be 0 to 1000 pixels (default 31)");
   }
   if (fast_threshold < 1 || fast_threshold > 255) {
-    throw InputError("--orb-fast-threshold must be 1 to 255 (default 20)");
+    throw OptionError("fast_threshold", "must be 1 to 255 (default 20)");
   }
-  if (!(ratio >= 0.0 && ratio <= 1.0)) throw InputError("--ratio must be in [0, 1] (0 disables the ratio test)");
+  if (!(ratio >= 0.0 && ratio <= 1.0)) throw OptionError("ratio", "must be in [0, 1] (0 disables the ratio test)");
 }
 
 namespace {

@@ -21,7 +21,7 @@ struct OrbMatcherOptions {
   // Lowe's ratio test on Hamming distances: keep if best < ratio * second best. 0 disables it.
   double ratio = 0.0;
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
   void VisitFields(OptionFieldVisitor& visitor);  // JSON keys and command-line flags
 };
 

@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 
 #include "vmap/core/error.h"
+#include "vmap/features/matcher_registry.h"
+#include "vmap/testing/option_error.h"
 #include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {
@@ -108,15 +110,20 @@ TEST(OrbMatcher, BlackImageHasNoFeaturesAndNoMatches) {
 }
 
 TEST(OrbMatcher, OptionsAreChecked) {
+  // Named by the JSON keys of the fields; within MatcherOptions, after the model's name.
   OrbMatcherOptions options;
   options.num_features = 0;
-  EXPECT_THROW(options.Check(), InputError);
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "num_features");
   options = {};
   options.scale_factor = 1.0;
-  EXPECT_THROW(options.Check(), InputError);
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "scale_factor");
   options = {};
   options.ratio = 1.5;
-  EXPECT_THROW(options.Check(), InputError);
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "ratio");
+  MatcherOptions all;
+  all.Of<OrbMatcherOptions>().num_levels = 0;
+  EXPECT_EQ(testing::OptionErrorPath([&] { all.Check(); }), "orb.num_levels");
+  EXPECT_EQ(testing::OptionErrorPath([&] { CreateMatcher(all); }), "orb.num_levels");
 }
 
 TEST(OrbFeatures, SerialiseAndReadBackExactly) {

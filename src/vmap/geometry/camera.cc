@@ -143,8 +143,8 @@ std::vector<double> NumbersIn(const std::string& text) {
       numbers.push_back(std::stod(token, &used));
       if (used != token.size()) throw std::invalid_argument(token);
     } catch (const std::exception&) {
-      throw InputError("--camera '" + text + "': '" + token +
-                       "' is not a number; give fx,fy,cx,cy[,k1,k2,p1,p2[,k3]] or a calibration file");
+      throw OptionError("camera", "'" + text + "': '" + token +
+                                  "' is not a number; give fx,fy,cx,cy[,k1,k2,p1,p2[,k3]] or a calibration file");
     }
   }
   return numbers;
@@ -187,8 +187,9 @@ cv::FileNode FirstOf(const cv::FileStorage& fs, std::initializer_list<const char
 Camera ParseCameraText(const std::string& text) {
   const std::vector<double> n = NumbersIn(text);
   if (n.size() != 4 && n.size() != 8 && n.size() != 9) {
-    throw InputError("--camera '" + text + "' has " + std::to_string(n.size()) +
-                     " numbers; give fx,fy,cx,cy or fx,fy,cx,cy,k1,k2,p1,p2[,k3] (pixels), or a calibration file");
+    throw OptionError("camera", "'" + text + "' has " + std::to_string(n.size()) +
+                                " numbers; give fx,fy,cx,cy or fx,fy,cx,cy,k1,k2,p1,p2[,k3] (pixels), or a "
+                                "calibration file");
   }
   Camera camera = Camera::Make(n[0], n[1], n[2], n[3], std::vector<double>(n.begin() + 4, n.end()));
   camera.origin = "--camera";
@@ -236,10 +237,10 @@ Camera CameraForFrames(const Camera& camera, cv::Size native_size, cv::Size fram
     const double ratio = static_cast<double>(camera.size.width) / camera.size.height;
     const double frame_ratio = static_cast<double>(native_size.width) / native_size.height;
     if (std::abs(ratio / frame_ratio - 1.0) > 0.01) {
-      throw InputError(fmt::format("{} is for {}x{} images but the frames are {}x{}; give a calibration of "
-                                   "these frames with --camera",
-                                   where, camera.size.width, camera.size.height, native_size.width,
-                                   native_size.height));
+      throw OptionError("camera", fmt::format("must fit the frames: {} is for {}x{} images but the frames are "
+                                              "{}x{}; give a calibration of these frames",
+                                              where, camera.size.width, camera.size.height, native_size.width,
+                                              native_size.height));
     }
     spdlog::info("{} is for {}x{} images; scaling it to the frames' {}x{}", where, camera.size.width,
                  camera.size.height, native_size.width, native_size.height);
@@ -247,9 +248,9 @@ Camera CameraForFrames(const Camera& camera, cv::Size native_size, cv::Size fram
   }
   native.size = native_size;
   if (!(native.cx > 0 && native.cx < native_size.width && native.cy > 0 && native.cy < native_size.height)) {
-    throw InputError(fmt::format("{} has its principal point ({:.1f}, {:.1f}) outside the {}x{} frames: it "
-                                 "belongs to other images; give the right one with --camera",
-                                 where, native.cx, native.cy, native_size.width, native_size.height));
+    throw OptionError("camera", fmt::format("must fit the frames: {} has its principal point ({:.1f}, {:.1f}) "
+                                            "outside the {}x{} frames: it belongs to other images; give the right one",
+                                            where, native.cx, native.cy, native_size.width, native_size.height));
   }
   if (std::abs(native.cx - 0.5 * native_size.width) > 0.2 * native_size.width ||
       std::abs(native.cy - 0.5 * native_size.height) > 0.2 * native_size.height) {

@@ -19,14 +19,14 @@ std::string VerifierMethodName(VerifierMethod method) { return EnumToName(kVerif
 
 void VerifierOptions::Check() const {
   if (!(threshold > 0.0 && threshold <= 100.0)) {
-    throw InputError("--threshold (verifier, pixels) must be in (0, 100] (default 0.5)");
+    throw OptionError("threshold", "(verifier, pixels) must be in (0, 100] (default 0.5)");
   }
-  if (!(confidence > 0.0 && confidence < 1.0)) throw InputError("--confidence must be in (0, 1) (default 0.999)");
+  if (!(confidence > 0.0 && confidence < 1.0)) throw OptionError("confidence", "must be in (0, 1) (default 0.999)");
   if (max_iterations < 1 || max_iterations > 10000000) {
-    throw InputError("--max-iters must be 1 to 10000000 (default 100000)");
+    throw OptionError("max_iterations", "must be 1 to 10000000 (default 100000)");
   }
-  if (seed < 0) throw InputError("--seed must be >= 0 (default 0)");
-  if (min_matches < 8) throw InputError("min_matches must be >= 8: the 8-point algorithm needs 8 matches");
+  if (seed < 0) throw OptionError("seed", "must be >= 0 (default 0)");
+  if (min_matches < 8) throw OptionError("min_matches", "must be >= 8: the 8-point algorithm needs 8 matches");
 }
 
 FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0,

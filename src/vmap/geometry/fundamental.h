@@ -31,7 +31,7 @@ struct VerifierOptions {
   // (magsac.h), which agrees with it within the noise of a seed change and can stop early (EarlyStop).
   bool own_magsac = false;
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 class JsonFieldReader;

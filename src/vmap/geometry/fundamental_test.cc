@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "vmap/core/error.h"
+#include "vmap/testing/option_error.h"
 #include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {
@@ -125,10 +126,13 @@ TEST(Fundamental, OptionsAndNamesAreChecked) {
   EXPECT_THROW(ParseVerifierMethod("lmeds"), InputError);
   VerifierOptions options;
   options.threshold = 0;
-  EXPECT_THROW(options.Check(), InputError);
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "threshold");
   options = {};
   options.confidence = 1.0;
-  EXPECT_THROW(options.Check(), InputError);
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "confidence");
+  options = {};
+  options.max_iterations = 0;
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "max_iterations");
   for (const char* name : {"magsac", "ransac", "usac", "accurate"}) {
     EXPECT_EQ(VerifierMethodName(ParseVerifierMethod(name)), name);
   }

@@ -12,12 +12,12 @@
 namespace vmap {
 
 void HomographyOptions::Check() const {
-  if (!(threshold > 0.0)) throw InputError(fmt::format("homography threshold {} px must be > 0", threshold));
+  if (!(threshold > 0.0)) throw OptionError("threshold", fmt::format("{} px must be > 0", threshold));
   if (!(min_share > 0.0 && min_share <= 1.0)) {
-    throw InputError(fmt::format("homography min_share {} must be in (0, 1]", min_share));
+    throw OptionError("min_share", fmt::format("{} must be in (0, 1]", min_share));
   }
-  if (!(confidence > 0.0 && confidence < 1.0)) throw InputError("homography confidence must be in (0, 1)");
-  if (max_iterations < 1) throw InputError("homography max_iterations must be >= 1");
+  if (!(confidence > 0.0 && confidence < 1.0)) throw OptionError("confidence", "must be in (0, 1)");
+  if (max_iterations < 1) throw OptionError("max_iterations", "must be >= 1");
 }
 
 HomographyCheck CheckHomography(const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to,

@@ -19,7 +19,7 @@ struct HomographyOptions {
   int max_iterations = 10000;
   int seed = 0;
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 class JsonFieldReader;

@@ -19,13 +19,13 @@ std::string PoseMethodName(PoseMethod method) { return EnumToName(kPoseMethodNam
 
 void PoseOptions::Check() const {
   if (!(threshold > 0.0 && threshold <= 100.0)) {
-    throw InputError(fmt::format("--pose-threshold {} px is outside (0, 100]; the default is 1", threshold));
+    throw OptionError("threshold", fmt::format("{} px is outside (0, 100]; the default is 1", threshold));
   }
-  if (!(confidence > 0.0 && confidence < 1.0)) throw InputError("pose confidence must be in (0, 1)");
-  if (max_iterations < 1) throw InputError("pose max_iterations must be >= 1");
-  if (!(refine_inlier_factor >= 1.0)) throw InputError("pose refine_inlier_factor must be >= 1");
-  if (starts < 1 || starts > 100) throw InputError("pose starts must be in [1, 100] (default 3)");
-  if (min_matches < 5) throw InputError("pose min_matches must be >= 5: the five-point solver needs 5 matches");
+  if (!(confidence > 0.0 && confidence < 1.0)) throw OptionError("confidence", "must be in (0, 1)");
+  if (max_iterations < 1) throw OptionError("max_iterations", "must be >= 1");
+  if (!(refine_inlier_factor >= 1.0)) throw OptionError("refine_inlier_factor", "must be >= 1");
+  if (starts < 1 || starts > 100) throw OptionError("starts", "must be in [1, 100] (default 3)");
+  if (min_matches < 5) throw OptionError("min_matches", "must be >= 5: the five-point solver needs 5 matches");
 }
 
 namespace {

@@ -53,7 +53,7 @@ struct PoseOptions {
   int seed = 0;           // the random generator's state: the same link gives the same pose
   int min_matches = 8;    // fewer inliers than this: no pose
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 // The names of PoseOptions::use_all_matches (--pose-matches, map.json's pose.matches).

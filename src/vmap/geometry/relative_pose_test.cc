@@ -8,6 +8,7 @@
 #include "vmap/core/error.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/geometry/homography.h"
+#include "vmap/testing/option_error.h"
 
 namespace vmap {
 
@@ -155,10 +156,10 @@ TEST(RelativePose, TooFewMatchesGiveNoPoseAndBadOptionsAreRefused) {
   EXPECT_FALSE(EstimateRelativePose(TestCamera(), pair.from, pair.to, PoseOptions()).valid);
   PoseOptions bad;
   bad.threshold = 0;
-  EXPECT_THROW(bad.Check(), InputError);
+  EXPECT_EQ(testing::OptionErrorPath([&] { bad.Check(); }), "threshold");
   bad = PoseOptions();
   bad.starts = 0;
-  EXPECT_THROW(bad.Check(), InputError);
+  EXPECT_EQ(testing::OptionErrorPath([&] { bad.Check(); }), "starts");
   EXPECT_EQ(ParsePoseMethod("fundamental"), PoseMethod::kFromFundamental);
   EXPECT_THROW(ParsePoseMethod("homography"), InputError);
 }

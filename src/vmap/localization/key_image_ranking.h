@@ -46,7 +46,7 @@ struct RankingOptions {
   // Thumbnails: width in pixels (height keeps the aspect ratio, at least 8).
   int thumbnail_width = 48;
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 // The thumbnail descriptor of a grey image: shrunk to `width` (INTER_AREA), zero mean, unit norm, as CV_32F

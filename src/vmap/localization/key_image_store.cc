@@ -178,10 +178,10 @@ std::string KeyImageCacheStateName(KeyImageCacheState state) {
 
 void KeyImageStoreOptions::Check() const {
   if (thumbnail_width < 8 || thumbnail_width > 512) {
-    throw InputError(fmt::format("thumbnail width {} is outside [8, 512] (default 48)", thumbnail_width));
+    throw OptionError("thumbnail_width", fmt::format("{} is outside [8, 512] (default 48)", thumbnail_width));
   }
   if (extraction_threads < 0 || extraction_threads > 256) {
-    throw InputError("key-image extraction threads must be 0 to 256 (0 = one per core)");
+    throw OptionError("extraction_threads", "must be 0 to 256 (0 = one per core)");
   }
 }
 

@@ -37,7 +37,7 @@ struct KeyImageStoreOptions {
   int thumbnail_width = 48;    // ThumbnailDescriptor width (the ranking's)
   int extraction_threads = 0;  // threads extracting key-image features on a cache miss; 0 = one per core
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 struct KeyImageStore {

@@ -21,9 +21,11 @@ int LocalizeSequenceOptions::ExtractionThreads() const {
 
 void LocalizeSequenceOptions::Check() const {
   if (extraction_threads < 0 || extraction_threads > 256) {
-    throw InputError("--threads must be 0 to 256 (0 = one per core)");
+    throw OptionError("extraction_threads", "must be 0 to 256 (0 = one per core)");
   }
-  if (prefetch_frames < 1 || prefetch_frames > 1024) throw InputError("prefetch_frames must be 1 to 1024 (default 4)");
+  if (prefetch_frames < 1 || prefetch_frames > 1024) {
+    throw OptionError("prefetch_frames", "must be 1 to 1024 (default 4)");
+  }
 }
 
 namespace {

@@ -25,7 +25,7 @@ struct LocalizeSequenceOptions {
   bool show_progress = true; // a progress line on a terminal
 
   int ExtractionThreads() const;
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 struct LocalizationSummary {

@@ -40,21 +40,25 @@ std::string LocalizationStatusName(LocalizationStatus status) {
 
 void LocalizerOptions::Check() const {
   if (min_verified < 8 || min_verified > 100000) {
-    throw InputError(fmt::format("--min-verified {} must be 8 (the fewest matches F can be verified with) to "
-                                 "100000 (default 20)", min_verified));
+    throw OptionError("min_verified", fmt::format("{} must be 8 (the fewest matches F can be verified with) to "
+                                                  "100000 (default 20)",
+                                                  min_verified));
   }
   if (!(min_similarity >= 0.0 && min_similarity <= 1.0)) {
-    throw InputError(fmt::format("--min-similarity {} is outside [0, 1] (default 0.3)", min_similarity));
+    throw OptionError("min_similarity", fmt::format("{} is outside [0, 1] (default 0.3)", min_similarity));
   }
-  if (lookahead < 1 || lookahead > 2) throw InputError(fmt::format("lookahead {} is not 1 or 2 (default 2)", lookahead));
+  if (lookahead < 1 || lookahead > 2) {
+    throw OptionError("lookahead", fmt::format("{} is not 1 or 2 (default 2)", lookahead));
+  }
   if (max_lost_frames < 0 || max_lost_frames > 1000000) {
-    throw InputError(fmt::format("--max-lost {} must be 0 to 1000000 (default 5)", max_lost_frames));
+    throw OptionError("max_lost_frames", fmt::format("{} must be 0 to 1000000 (default 5)", max_lost_frames));
   }
   if (relocalization_candidates < 1 || relocalization_candidates > 10000) {
-    throw InputError(fmt::format("--candidates {} must be 1 to 10000 (default 5)", relocalization_candidates));
+    throw OptionError("relocalization_candidates",
+                      fmt::format("{} must be 1 to 10000 (default 5)", relocalization_candidates));
   }
-  ranking.Check();
-  verifier.Check();
+  CheckField("ranking", ranking);
+  CheckField("verifier", verifier);
 }
 
 std::pair<int, int> KeysAround(const VisualMap& map, int source_index) {

@@ -67,7 +67,7 @@ struct LocalizerOptions {
   // also gives the heading in degrees and the relative pose to the key image; without, pixels only.
   std::optional<Camera> camera;
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 enum class LocalizationStatus {

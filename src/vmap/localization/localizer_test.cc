@@ -10,6 +10,7 @@
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localization_test_util.h"
 #include "vmap/localization/localize_sequence.h"
+#include "vmap/testing/option_error.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"
 
@@ -343,11 +344,14 @@ TEST(Localizer, OptionsAreChecked) {
     change(options);
     return options;
   };
-  EXPECT_THROW(with([](LocalizerOptions& o) { o.min_verified = 5; }).Check(), InputError);
-  EXPECT_THROW(with([](LocalizerOptions& o) { o.min_similarity = 1.5; }).Check(), InputError);
-  EXPECT_THROW(with([](LocalizerOptions& o) { o.lookahead = 3; }).Check(), InputError);
-  EXPECT_THROW(with([](LocalizerOptions& o) { o.max_lost_frames = -1; }).Check(), InputError);
-  EXPECT_THROW(with([](LocalizerOptions& o) { o.relocalization_candidates = 0; }).Check(), InputError);
+  auto path = [&](auto change) { return testing::OptionErrorPath([&] { with(change).Check(); }); };
+  EXPECT_EQ(path([](LocalizerOptions& o) { o.min_verified = 5; }), "min_verified");
+  EXPECT_EQ(path([](LocalizerOptions& o) { o.min_similarity = 1.5; }), "min_similarity");
+  EXPECT_EQ(path([](LocalizerOptions& o) { o.lookahead = 3; }), "lookahead");
+  EXPECT_EQ(path([](LocalizerOptions& o) { o.max_lost_frames = -1; }), "max_lost_frames");
+  EXPECT_EQ(path([](LocalizerOptions& o) { o.relocalization_candidates = 0; }), "relocalization_candidates");
+  EXPECT_EQ(path([](LocalizerOptions& o) { o.ranking.min_cosine = 1.0; }), "ranking.min_cosine");
+  EXPECT_EQ(path([](LocalizerOptions& o) { o.verifier.threshold = 0.0; }), "verifier.threshold");
   EXPECT_NO_THROW(with([](LocalizerOptions&) {}).Check());
   // A route must name existing key images, once each.
   LocalizerOptions bad_route = MapLocalizerOptions(m.map);

@@ -11,8 +11,9 @@ namespace vmap {
 
 void RouteOptions::Check() const {
   if (min_backward_verified < 8 || min_backward_verified > 100000) {
-    throw InputError(fmt::format("--min-backward-verified {} must be 8 (the fewest matches F can be verified "
-                                 "with) to 100000 (default 20)", min_backward_verified));
+    throw OptionError("min_backward_verified",
+                      fmt::format("{} must be 8 (the fewest matches F can be verified with) to 100000 (default 20)",
+                                  min_backward_verified));
   }
 }
 

@@ -22,7 +22,7 @@ namespace vmap {
 struct RouteOptions {
   int min_backward_verified = 20;  // verified matches a link needs to be followed backwards
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 struct RouteStep {

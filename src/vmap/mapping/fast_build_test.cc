@@ -16,6 +16,7 @@
 #include "vmap/core/error.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/map_builder.h"
+#include "vmap/testing/option_error.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/shared_data.h"
 #include "vmap/testing/synthetic_scene.h"
@@ -196,7 +197,7 @@ TEST(KeyImageSearch, OptionsAndDefaults) {
   EXPECT_THROW(ParseKeySearch("binary"), InputError);
   MapBuilderOptions options;
   options.search_window = 1;
-  EXPECT_THROW(options.Check(), InputError);
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "search_window");
   KnownSimilarityMatcher deep(MonotoneShare);
   // auto is Algorithm 1's sequential search for every matcher (README, "Threshold sweeps"); bisect when asked.
   EXPECT_EQ(ResolveKeySearch(MapBuilderOptions{}), KeySearch::kSequential);
@@ -205,14 +206,22 @@ TEST(KeyImageSearch, OptionsAndDefaults) {
   exhaustive.exhaustive = true;
   EXPECT_EQ(ResolveKeySearch(exhaustive), KeySearch::kSequential);
   exhaustive.key_search = KeySearch::kBisect;  // the paper's scan cannot skip frames: a clear error
-  EXPECT_THROW(exhaustive.Check(), InputError);
+  try {
+    exhaustive.Check();
+    ADD_FAILURE() << "exhaustive bisect accepted";
+  } catch (const OptionError& error) {
+    EXPECT_EQ(error.path(), "exhaustive");
+    EXPECT_EQ(error.others(), std::vector<std::string>{"key_search"});
+    EXPECT_NE(error.problem().find("key_search bisect"), std::string::npos) << error.what();
+  }
   // A sweep compares every frame once for all taus: an explicit bisect is refused with the way out.
   MemorySource source(IndexFrames(10));
   try {
     SweepThresholds(source, deep, Options(0.5, KeySearch::kBisect), {0.3, 0.6});
-    FAIL() << "a sweep with --search bisect must be refused";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("vmap build"), std::string::npos) << e.what();
+    FAIL() << "a sweep with key_search bisect must be refused";
+  } catch (const OptionError& e) {
+    EXPECT_EQ(e.path(), "key_search");
+    EXPECT_NE(e.problem().find("one map per tau"), std::string::npos) << e.what();
   }
 }
 

@@ -21,12 +21,12 @@ std::string SimilarityModeName(SimilarityMode mode) { return EnumToName(kSimilar
 
 void KeyImageOptions::Check() const {
   if (!(tau > 0.0 && tau <= 1.0)) {
-    throw InputError(fmt::format("threshold tau = {} is outside (0, 1]; the paper uses 0.1 to 0.9", tau));
+    throw OptionError("tau", fmt::format("{} is outside (0, 1]; the paper uses 0.1 to 0.9", tau));
   }
   if (!(min_key_displacement >= 0.0 && min_key_displacement <= 100.0)) {
-    throw InputError(fmt::format("--min-key-displacement {} px is outside [0, 100]; the default is 1, 0 turns the "
-                                 "check off",
-                                 min_key_displacement));
+    throw OptionError("min_key_displacement",
+                      fmt::format("{} px is outside [0, 100]; the default is 1, 0 turns the check off",
+                                  min_key_displacement));
   }
 }
 

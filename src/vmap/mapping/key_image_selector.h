@@ -36,7 +36,7 @@ struct KeyImageOptions {
   // views of one viewpoint has no parallax and a meaningless F. 0 turns this off (Algorithm 1 as published).
   double min_key_displacement = 1.0;
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 class JsonFieldReader;

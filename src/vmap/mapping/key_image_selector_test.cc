@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "vmap/core/error.h"
+#include "vmap/testing/option_error.h"
 
 namespace vmap {
 
@@ -156,14 +157,14 @@ TEST(KeyImageSelector, RepeatedFramesAreNotPromotedWhenANeighbourWillDo) {
   EXPECT_EQ(SelectViews({0, 1, 2, 3, 4, 5}, 0.7, 1.0), SelectViews({0, 1, 2, 3, 4, 5}, 0.7, 0.0));
   KeyImageOptions bad;
   bad.min_key_displacement = -1;
-  EXPECT_THROW(bad.Check(), InputError);
+  EXPECT_EQ(testing::OptionErrorPath([&] { bad.Check(); }), "min_key_displacement");
 }
 
 TEST(KeyImageSelector, TauOutsideTheUnitIntervalIsRejected) {
   KeyImageOptions options;
   for (double tau : {0.0, -0.1, 1.01}) {
     options.tau = tau;
-    EXPECT_THROW(options.Check(), InputError) << tau;
+    EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "tau") << tau;
   }
   options.tau = 1.0;
   EXPECT_NO_THROW(options.Check());

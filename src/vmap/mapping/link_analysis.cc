@@ -14,8 +14,8 @@
 namespace vmap {
 
 void LinkAnalysisOptions::Check() const {
-  pose.Check();
-  homography.Check();
+  CheckField("pose", pose);
+  CheckField("homography", homography);
 }
 
 void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& options) {

@@ -21,7 +21,7 @@ struct LinkAnalysisOptions {
   PoseOptions pose;              // how the pose is estimated (README: "Relative pose per link")
   HomographyOptions homography;  // when a homography counts as explaining the matches
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 class JsonFieldReader;

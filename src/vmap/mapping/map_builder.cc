@@ -41,18 +41,20 @@ KeySearch ResolveKeySearch(const MapBuilderOptions& options) {
 }
 
 void MapBuilderOptions::Check() const {
-  key_images.Check();
-  verifier.Check();
-  link_analysis.Check();
-  if (prefetch_frames < 1 || prefetch_frames > 1024) throw InputError("prefetch_frames must be 1 to 1024");
+  CheckField("key_images", key_images);
+  CheckField("verifier", verifier);
+  CheckField("link_analysis", link_analysis);
+  if (prefetch_frames < 1 || prefetch_frames > 1024) throw OptionError("prefetch_frames", "must be 1 to 1024");
   if (extraction_threads < 0 || extraction_threads > kMaxExtractionThreads) {
-    throw InputError("--threads must be 0 to " + std::to_string(kMaxExtractionThreads) + " (0 = one per core)");
+    throw OptionError("extraction_threads",
+                      "must be 0 to " + std::to_string(kMaxExtractionThreads) + " (0 = one per core)");
   }
   if (exhaustive && key_search == KeySearch::kBisect) {
-    throw InputError("--exhaustive is the paper's frame-by-frame scan and --search bisect skips frames; drop one");
+    throw OptionError("exhaustive", "is the paper's frame-by-frame scan and key_search bisect skips frames; drop one",
+                      {"key_search"});
   }
   if (search_window < 2 || search_window > 4096) {
-    throw InputError("--search-window must be 2 to 4096 frames (default 32)");
+    throw OptionError("search_window", "must be 2 to 4096 frames (default 32)");
   }
 }
 
@@ -128,7 +130,7 @@ class FeaturePipeline {
       // The system refused a thread (a process limit): stop those already started, or their destructors abort.
       Stop();
       throw InputError("cannot start " + std::to_string(workers) + " threads (" + error.what() +
-                       "); use fewer with --threads");
+                       "); use fewer extraction threads");
     }
   }
 
@@ -463,14 +465,14 @@ std::vector<double> ParseThresholds(const std::string& text) {
   char extra;
   if (std::sscanf(text.c_str(), "%lf:%lf:%lf%c", &start, &stop, &step, &extra) == 3) {
     if (!std::isfinite(start) || !std::isfinite(stop) || !(step > 0) || !std::isfinite(step) || stop < start) {
-      throw InputError("--thresholds '" + text + "' must be start:stop:step with step > 0 and stop >= start");
+      throw OptionError("thresholds", "'" + text + "' must be start:stop:step with step > 0 and stop >= start");
     }
     // Count steps with a tolerance so that 0.1:0.9:0.1 includes 0.9; counted in double before anything is
     // allocated, so that a tiny step is refused rather than filling the memory.
     const double count = std::floor((stop - start) / step + 1e-9) + 1;
     if (count > kMaxThresholds) {
-      throw InputError(fmt::format("--thresholds '{}' gives {:.0f} thresholds, more than {}; use a larger step",
-                                   text, count, kMaxThresholds));
+      throw OptionError("thresholds", fmt::format("'{}' gives {:.0f} thresholds, more than {}; use a larger step",
+                                                  text, count, kMaxThresholds));
     }
     for (int i = 0; i < static_cast<int>(count); ++i) taus.push_back(std::round((start + i * step) * 1e9) / 1e9);
   } else {
@@ -482,20 +484,21 @@ std::vector<double> ParseThresholds(const std::string& text) {
         taus.push_back(std::stod(item, &used));
         if (used != item.size()) throw std::invalid_argument(item);
       } catch (const std::exception&) {
-        throw InputError("--thresholds '" + text + "' is not start:stop:step (0.1:0.9:0.1) or a list (0.2,0.5)");
+        throw OptionError("thresholds", "'" + text + "' is not start:stop:step (0.1:0.9:0.1) or a list (0.2,0.5)");
       }
       if (taus.size() > kMaxThresholds) {
-        throw InputError("--thresholds '" + text + "' lists more than " + std::to_string(kMaxThresholds) + " thresholds");
+        throw OptionError("thresholds",
+                          "'" + text + "' lists more than " + std::to_string(kMaxThresholds) + " thresholds");
       }
     }
   }
-  if (taus.empty()) throw InputError("--thresholds '" + text + "' gives no threshold");
+  if (taus.empty()) throw OptionError("thresholds", "'" + text + "' gives no threshold");
   for (size_t i = 0; i < taus.size(); ++i) {
     KeyImageOptions check;
     check.tau = taus[i];
     check.Check();
     for (size_t j = 0; j < i; ++j) {
-      if (taus[j] == taus[i]) throw InputError(fmt::format("--thresholds '{}' gives tau = {} twice", text, taus[i]));
+      if (taus[j] == taus[i]) throw OptionError("thresholds", fmt::format("'{}' gives tau = {} twice", text, taus[i]));
     }
   }
   return taus;
@@ -731,8 +734,10 @@ MapBuilder::MapBuilder(const FrameSource& source, const Matcher& matcher, const 
 MapBuilder::MapBuilder(const FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
                        std::vector<double> taus, std::vector<MapWriter*> writers, std::string options_json) {
   if (ResolveKeySearch(options) == KeySearch::kBisect) {
-    throw InputError("--search bisect reads ahead of the frames it is given, so it cannot build a map one frame at a "
-                     "time (live inputs, snapshots); use --search sequential");
+    throw OptionError("key_search",
+                      "bisect reads ahead of the frames it is given, so it cannot build a map one frame at a time "
+                      "(live inputs, snapshots); use key_search sequential",
+                      {"key_search"});
   }
   impl_ = std::make_unique<Impl>(source, matcher, options, std::move(taus), std::move(writers),
                                  std::move(options_json));
@@ -990,8 +995,10 @@ SweepResult SweepThresholds(FrameSource& source, const Matcher& matcher, const M
                             const std::vector<double>& taus, std::vector<VisualMap>* maps,
                             const fs::path& maps_directory, const std::string& options_json) {
   if (options.key_search == KeySearch::kBisect) {
-    throw InputError("--search bisect looks for each tau's key images on its own; a sweep compares every frame "
-                     "once for all taus. Run `vmap build --tau T --search bisect` per tau instead");
+    throw OptionError("key_search",
+                      "bisect looks for each tau's key images on its own; a sweep compares every frame once for all "
+                      "taus. Build one map per tau with key_search bisect instead",
+                      {"key_search"});
   }
   std::vector<fs::path> directories;
   for (double tau : taus) {

@@ -55,7 +55,7 @@ struct MapBuilderOptions {
 
   int ExtractionThreads() const;
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 // kAuto resolves to kSequential, for every matcher (Check() refuses kBisect with `exhaustive`). Bisect was
@@ -104,7 +104,7 @@ class MapWriter;
 class MapBuilder {
  public:
   // One map at options.key_images.tau. `source` gives the input's description (info(), skipped_frames()) as it
-  // is known when a map is written; the frames come through Add(). Refuses --search bisect (InputError), which
+  // is known when a map is written; the frames come through Add(). Refuses key_search bisect (OptionError), which
   // reads ahead of the frames it is given.
   MapBuilder(const FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
              MapWriter* writer = nullptr, std::string options_json = "{}");
@@ -178,7 +178,7 @@ struct SweepResult {
 inline constexpr int kMaxThresholds = 100;
 
 // Parses "0.1:0.9:0.1" (start:stop:step, inclusive) or "0.2,0.5,0.8": 1 to kMaxThresholds distinct thresholds
-// in (0, 1].
+// in (0, 1]. Malformed text is an OptionError naming "thresholds".
 std::vector<double> ParseThresholds(const std::string& text);
 
 // Runs every tau over one pass of the sequence (a MapBuilder with one selector per tau). Always compares every

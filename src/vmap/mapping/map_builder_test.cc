@@ -11,6 +11,7 @@
 #include "vmap/features/orb_matcher.h"
 #include "vmap/map/map_io.h"
 #include "vmap/map/map_writer.h"
+#include "vmap/testing/option_error.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"
 
@@ -225,6 +226,32 @@ TEST(MapBuilder, ParsesThresholdRanges) {
   EXPECT_THROW(ParseThresholds("0.1:1.5:0.2"), InputError);
   EXPECT_THROW(ParseThresholds("abc"), InputError);
   EXPECT_THROW(ParseThresholds("0.5:0.1:0.1"), InputError);
+  EXPECT_EQ(testing::OptionErrorPath([] { ParseThresholds("0.5,0.5"); }), "thresholds");
+}
+
+// Every check names the field it refuses, nested fields by their path from MapBuilderOptions.
+TEST(MapBuilder, OptionChecksNameTheirFields) {
+  MapBuilderOptions options;
+  options.Check();
+  options.extraction_threads = 999;
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "extraction_threads");
+  try {
+    options.Check();
+  } catch (const OptionError& error) {
+    EXPECT_STREQ(error.what(), "extraction_threads must be 0 to 256 (0 = one per core)");
+  }
+  options = MapBuilderOptions();
+  options.key_images.tau = 0.0;
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "key_images.tau");
+  options = MapBuilderOptions();
+  options.link_analysis.pose.threshold = -1.0;
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "link_analysis.pose.threshold");
+  options = MapBuilderOptions();
+  options.link_analysis.homography.min_share = 2.0;
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "link_analysis.homography.min_share");
+  options = MapBuilderOptions();
+  options.verifier.seed = -1;
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "verifier.seed");
 }
 
 }  // namespace vmap
@@ -286,7 +313,7 @@ TEST(MapBuilder, RefusesTheBisectSearch) {
   MemorySource source(Sequence().frames);
   MapBuilderOptions options = Options(0.5);
   options.key_search = KeySearch::kBisect;
-  EXPECT_THROW(MapBuilder(source, *matcher, options), InputError);
+  EXPECT_EQ(testing::OptionErrorPath([&] { MapBuilder(source, *matcher, options); }), "key_search");
 }
 
 }  // namespace vmap

@@ -47,7 +47,7 @@ StateDict ReadWithCheckpointReader(const std::string& path, const std::string& m
 
 StateDict ReadWeightsFile(const std::string& path, const std::string& model) {
   std::ifstream file(path, std::ios::binary);
-  if (!file) throw InputError("cannot open " + model + " weights file '" + path + "'; check the path given to --weights");
+  if (!file) throw InputError("cannot open " + model + " weights file '" + path + "'; check the weights path");
   const std::vector<char> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
   c10::IValue root;
   try {

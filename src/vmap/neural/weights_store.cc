@@ -118,7 +118,7 @@ std::vector<std::string> WeightsSearchPaths(const std::string& preset) {
 std::string LocateWeights(const std::string& preset, const std::string& explicit_path) {
   if (!explicit_path.empty()) {
     if (IsFile(explicit_path)) return explicit_path;
-    throw InputError("weights file '" + explicit_path + "' (--weights) does not exist");
+    throw OptionError("weights", "file '" + explicit_path + "' does not exist");
   }
   const auto paths = WeightsSearchPaths(preset);
   for (const auto& path : paths) {

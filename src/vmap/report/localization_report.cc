@@ -193,15 +193,13 @@ std::string SimilarityPlot(const LocalizationRun& run) {
 
 void LocalizationReportOptions::Check() const {
   if (pairs < 0 || pairs > 200) {
-    throw InputError(fmt::format("LocalizationReportOptions::pairs is {}; use 0 to 200 (default 8)", pairs));
+    throw OptionError("pairs", fmt::format("is {}; use 0 to 200 (default 8)", pairs));
   }
   if (pair_width < 64 || pair_width > 8192) {
-    throw InputError(
-        fmt::format("LocalizationReportOptions::pair_width is {}; use 64 to 8192 pixels (default 960)", pair_width));
+    throw OptionError("pair_width", fmt::format("is {}; use 64 to 8192 pixels (default 960)", pair_width));
   }
   if (jpeg_quality < 1 || jpeg_quality > 100) {
-    throw InputError(
-        fmt::format("LocalizationReportOptions::jpeg_quality is {}; use 1 to 100 (default 85)", jpeg_quality));
+    throw OptionError("jpeg_quality", fmt::format("is {}; use 1 to 100 (default 85)", jpeg_quality));
   }
 }
 

@@ -25,7 +25,7 @@ struct LocalizationReportOptions {
   int pair_width = 960;        // width of each pair in pixels
   int jpeg_quality = 85;
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 // `map` is the map the run localized against, read from `map_directory`; the query frames shown are read

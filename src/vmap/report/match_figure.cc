@@ -48,8 +48,8 @@ std::string MatchCaption(const Link& link) {
 
 void MatchFigureOptions::Check() const {
   if (max_width != 0 && (max_width < 64 || max_width > 16384)) {
-    throw InputError("MatchFigureOptions::max_width is " + std::to_string(max_width) +
-                     "; use 0 (the key images' own scale) or 64 to 16384 pixels");
+    throw OptionError("max_width", "is " + std::to_string(max_width) +
+                                       "; use 0 (the key images' own scale) or 64 to 16384 pixels");
   }
 }
 

@@ -20,7 +20,7 @@ struct MatchFigureOptions {
   std::string title;
   bool caption = true;
 
-  void Check() const;  // throws InputError naming the bad field
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 // Colours (BGR) used by the figure, shared with the report's legend and the tests.

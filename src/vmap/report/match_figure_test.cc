@@ -103,7 +103,7 @@ TEST(MatchFigureTest, BadOptionsNameTheField) {
       DrawMatchFigure(cv::Mat(10, 10, CV_8UC3), cv::Mat(10, 10, CV_8UC3), SimpleLink(), options);
       ADD_FAILURE() << "max_width " << width << " accepted";
     } catch (const InputError& error) {
-      EXPECT_NE(std::string(error.what()).find("MatchFigureOptions::max_width is " + std::to_string(width)),
+      EXPECT_NE(std::string(error.what()).find("max_width is " + std::to_string(width)),
                 std::string::npos)
           << error.what();
     }

@@ -271,8 +271,8 @@ Camera ParseCameraOption(const std::string& value) {
   if (fs::exists(value)) return ReadCameraFile(value);
   const bool looks_numeric = !value.empty() && value.find_first_not_of("0123456789.,;eE+- \t") == std::string::npos;
   if (!looks_numeric) {
-    throw InputError("--camera '" + value +
-                     "' is neither an existing calibration file nor fx,fy,cx,cy[,k1,k2,p1,p2[,k3]]");
+    throw OptionError("camera", "'" + value +
+                                "' is neither an existing calibration file nor fx,fy,cx,cy[,k1,k2,p1,p2[,k3]]");
   }
   return ParseCameraText(value);
 }

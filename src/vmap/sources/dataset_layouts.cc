@@ -64,7 +64,7 @@ std::map<std::string, double> ReadTimestampsFile(const fs::path& directory) {
 std::vector<ImageEntry> ListImageFolder(const std::string& directory_text) {
   fs::path directory(directory_text);
   if (!fs::is_directory(directory)) {
-    throw InputError("'" + directory_text + "' is not a folder; --format images needs a folder of images");
+    throw OptionError("format", "images needs a folder of images, and '" + directory_text + "' is not a folder");
   }
   std::vector<std::string> names = ImagesIn(directory);
   if (names.empty()) {
@@ -82,7 +82,7 @@ std::vector<ImageEntry> ListImageFolder(const std::string& directory_text) {
     throw InputError("'" + directory_text +
                      "' holds no images (.png, .jpg, .bmp, .tif, ...) and is not a TUM (rgb.txt), EuRoC "
                      "(mav0/cam0/data.csv) or KITTI (image_0/ + times.txt) sequence; point to the folder with the "
-                     "frames, or pass --format");
+                     "frames, or give its format");
   }
   const std::map<std::string, double> stamps = ReadTimestampsFile(directory);
   const bool use_stamps = !stamps.empty() && std::all_of(names.begin(), names.end(), [&](const std::string& n) {

@@ -22,21 +22,21 @@ SourceFormat ParseSourceFormat(const std::string& name) { return ParseEnum(kSour
 std::string SourceFormatName(SourceFormat format) { return EnumToName(kSourceFormatNames, format); }
 
 void FrameSourceOptions::Check() const {
-  if (first < 0) throw InputError("--first must be >= 0 (got " + std::to_string(first) + ")");
+  if (first < 0) throw OptionError("first", "must be >= 0 (got " + std::to_string(first) + ")");
   if (last < -1) {
-    throw InputError("--last " + std::to_string(last) + " is not a frame; give a 0-based frame index, or -1 for the "
-                     "end of the sequence");
+    throw OptionError("last", std::to_string(last) + " is not a frame; give a 0-based frame index, or -1 for the "
+                      "end of the sequence");
   }
   if (last >= 0 && last < first) {
-    throw InputError("--last " + std::to_string(last) + " is before --first " + std::to_string(first));
+    throw OptionError("last", std::to_string(last) + " is before first " + std::to_string(first), {"first"});
   }
-  if (stride < 1) throw InputError("--stride must be >= 1 (got " + std::to_string(stride) + ")");
+  if (stride < 1) throw OptionError("stride", "must be >= 1 (got " + std::to_string(stride) + ")");
   if (max_frame_pixels < static_cast<long>(kMinFrameSide) * kMinFrameSide) {
-    throw InputError("max_frame_pixels must be at least " + std::to_string(kMinFrameSide * kMinFrameSide));
+    throw OptionError("max_frame_pixels", "must be at least " + std::to_string(kMinFrameSide * kMinFrameSide));
   }
   if (!resize.empty()) internal::TargetSize(cv::Size(640, 480), *this);  // validates the text
   if (!(stream_timeout_seconds > 0.0 && stream_timeout_seconds <= 3600.0)) {
-    throw InputError("stream_timeout_seconds must be in (0, 3600]");
+    throw OptionError("stream_timeout_seconds", "must be in (0, 3600]");
   }
 }
 
@@ -128,31 +128,32 @@ cv::Size TargetSize(const cv::Size& native, const FrameSourceOptions& options) {
   char extra = 0;
   if (std::sscanf(resize.c_str(), "%dx%d%c", &width, &height, &extra) == 2) {
     if (width < kMinFrameSide || height < kMinFrameSide || width > kMaxResizeSide || height > kMaxResizeSide) {
-      throw InputError("--resize " + resize + ": each side must be " + range + " pixels");
+      throw OptionError("resize", resize + ": each side must be " + range + " pixels");
     }
     if (static_cast<long>(width) * height > options.max_frame_pixels) {
-      throw InputError("--resize " + resize + " has more than " + std::to_string(options.max_frame_pixels) +
-                       " pixels; choose a smaller size");
+      throw OptionError("resize", resize + " has more than " + std::to_string(options.max_frame_pixels) +
+                                      " pixels; choose a smaller size");
     }
     return {width, height};
   }
   int longest = 0;
   if (std::sscanf(resize.c_str(), "%d%c", &longest, &extra) == 1) {
     if (longest < kMinFrameSide || longest > kMaxResizeSide) {
-      throw InputError("--resize " + resize + ": the longest side must be " + range + " pixels");
+      throw OptionError("resize", resize + ": the longest side must be " + range + " pixels");
     }
     const double scale = static_cast<double>(longest) / std::max(native.width, native.height);
     const cv::Size target(std::max(1, static_cast<int>(std::lround(native.width * scale))),
                           std::max(1, static_cast<int>(std::lround(native.height * scale))));
     if (std::min(target.width, target.height) < kMinFrameSide ||
         static_cast<long>(target.width) * target.height > options.max_frame_pixels) {
-      throw InputError("--resize " + resize + " turns frames of " + std::to_string(native.width) + "x" +
-                       std::to_string(native.height) + " into " + std::to_string(target.width) + "x" +
-                       std::to_string(target.height) + "; give WxH with sides of " + range + " pixels instead");
+      throw OptionError("resize", resize + " turns frames of " + std::to_string(native.width) + "x" +
+                                      std::to_string(native.height) + " into " + std::to_string(target.width) + "x" +
+                                      std::to_string(target.height) + "; give WxH with sides of " + range +
+                                      " pixels instead");
     }
     return target;
   }
-  throw InputError("--resize '" + resize + "' is not WxH (e.g. 640x480) or a longest side (e.g. 640)");
+  throw OptionError("resize", "'" + resize + "' is not WxH (e.g. 640x480) or a longest side (e.g. 640)");
 }
 
 void FitFrame(Frame& frame, const cv::Size& target, const cv::Size& first_native, const FrameSourceOptions& options,
@@ -163,7 +164,9 @@ void FitFrame(Frame& frame, const cv::Size& target, const cv::Size& first_native
                                 std::to_string(native.width) + "x" + std::to_string(native.height) +
                                 " but the first frame is " + std::to_string(first_native.width) + "x" +
                                 std::to_string(first_native.height);
-    if (options.strict) throw InputError(message + "; frames of one sequence must have one size (--strict)");
+    if (options.strict) {
+      throw OptionError("strict", "is set and " + message + "; frames of one sequence must have one size");
+    }
     if ((*warnings)++ < 5) spdlog::warn("{}; resizing it to the first frame's size", message);
   }
   if (native == target) return;
@@ -247,7 +250,9 @@ std::unique_ptr<FrameSource> OpenDetected(const std::string& path, const fs::pat
                                           const FrameSourceOptions& options) {
   switch (format) {
     case SourceFormat::kVideo:
-      if (fs::is_directory(p)) throw InputError("input '" + path + "' is a folder, not a video; drop --format video");
+      if (fs::is_directory(p)) {
+        throw OptionError("format", "video: input '" + path + "' is a folder, not a video; drop it");
+      }
       return internal::OpenVideo(path, options);
     case SourceFormat::kImageFolder:
       return internal::OpenImageList(internal::ListImageFolder(path), path, format, options);
@@ -264,7 +269,8 @@ std::unique_ptr<FrameSource> OpenDetected(const std::string& path, const fs::pat
       return internal::OpenImageList(internal::ListKitti(path), path, format, options);
     case SourceFormat::kAuto: break;
   }
-  throw InputError("cannot tell the layout of '" + path + "'; pass --format");
+  throw OptionError("format", "auto cannot tell the layout of '" + path +
+                                "'; give its layout: video, images, tum, euroc or kitti");
 }
 
 }  // namespace

@@ -56,7 +56,7 @@ struct FrameSourceOptions {
   // camera that was unplugged); also how long opening one may take.
   double stream_timeout_seconds = 10.0;
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 class JsonFieldReader;

@@ -11,6 +11,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/testing/option_error.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/shared_data.h"
 #include "vmap/testing/synthetic_scene.h"
@@ -128,7 +129,10 @@ TEST(ImageFolder, UnknownLayoutsAndEmptyFoldersAreClearErrors) {
   testing::ScopedTempDir tmp;
   EXPECT_NE(OpenError(tmp.path().string()).find("holds no images"), std::string::npos);
   std::ofstream(tmp.path() / "notes.txt") << "hello";
-  EXPECT_NE(OpenError(tmp.path().string()).find("--format"), std::string::npos);
+  EXPECT_NE(OpenError(tmp.path().string()).find("give its format"), std::string::npos);
+  FrameSourceOptions video;
+  video.format = SourceFormat::kVideo;
+  EXPECT_EQ(testing::OptionErrorPath([&] { OpenFrameSource(tmp.path().string(), video); }), "format");
   EXPECT_NE(OpenError((tmp.path() / "missing").string()).find("does not exist"), std::string::npos);
 }
 
@@ -194,12 +198,12 @@ TEST(FrameSourceOptions, EveryOptionHasARange) {
     std::string expected;
   };
   const std::vector<Case> cases = {
-      {[](FrameSourceOptions& o) { o.first = -1; }, "--first"},
-      {[](FrameSourceOptions& o) { o.last = -5; }, "--last -5 is not a frame"},
+      {[](FrameSourceOptions& o) { o.first = -1; }, "first must be >= 0"},
+      {[](FrameSourceOptions& o) { o.last = -5; }, "last -5 is not a frame"},
       {[](FrameSourceOptions& o) { o.last = -2; }, "-1 for the end"},
-      {[](FrameSourceOptions& o) { o.first = 10, o.last = 3; }, "before --first"},
-      {[](FrameSourceOptions& o) { o.stride = 0; }, "--stride"},
-      {[](FrameSourceOptions& o) { o.resize = "100000x100000"; }, "each side must be 32 to 16384"},
+      {[](FrameSourceOptions& o) { o.first = 10, o.last = 3; }, "last 3 is before first 10"},
+      {[](FrameSourceOptions& o) { o.stride = 0; }, "stride must be >= 1"},
+      {[](FrameSourceOptions& o) { o.resize = "100000x100000"; }, "resize 100000x100000: each side must be 32"},
       {[](FrameSourceOptions& o) { o.resize = "16x16"; }, "each side must be 32 to 16384"},
       {[](FrameSourceOptions& o) { o.resize = "16000x16000"; }, "more than 67108864 pixels"},
       {[](FrameSourceOptions& o) { o.resize = "100000"; }, "the longest side must be 32 to 16384"},

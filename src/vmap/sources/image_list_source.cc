@@ -21,8 +21,8 @@ class ImageListSource : public FrameSource {
     next_ = options.first;
     end_ = options.last >= 0 ? std::min<long>(options.last + 1, entries_.size()) : static_cast<long>(entries_.size());
     if (next_ >= end_) {
-      throw InputError("'" + path + "' has " + std::to_string(entries_.size()) + " frames; --first " +
-                       std::to_string(options.first) + " leaves none");
+      throw OptionError("first", std::to_string(options.first) + " leaves none of the " +
+                                     std::to_string(entries_.size()) + " frames of '" + path + "'");
     }
     info_.expected_frames = (end_ - next_ + options.stride - 1) / options.stride;
   }

@@ -32,7 +32,7 @@ std::unique_ptr<FrameSource> OpenV4l2Camera(const std::string& device, const Fra
 bool IsStreamUrl(const std::string& path);
 
 // Size frames are delivered at, given the first frame's native size and the --resize option. Throws
-// InputError when --resize is malformed or out of its range, or would make these frames degenerate.
+// OptionError when `resize` is malformed or out of its range, or would make these frames degenerate.
 cv::Size TargetSize(const cv::Size& native, const FrameSourceOptions& options);
 
 // Brings a decoded frame to the sequence's frame size: the --resize target, or the first frame's size for

@@ -238,8 +238,8 @@ class VideoSource : public FrameSource {
     }
     if (delivered_ == 0) {
       throw InputError("video '" + info_.path +
-                       "' has no decodable frame in the requested range; it may be truncated or empty, or --first is "
-                       "past its end");
+                       "' has no decodable frame in the requested range; it may be truncated or empty, or the first "
+                       "frame asked for is past its end");
     }
     if (!warned_short_ && frame_count_ > 0 && position_ < frame_count_ && options_.last < 0) {
       // A decoder may drop a damaged frame silently; the shortfall against the container's count says so.

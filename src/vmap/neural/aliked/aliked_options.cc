@@ -6,26 +6,27 @@ namespace vmap {
 
 void AlikedMatcherOptions::Check() const {
   if (model != "t16" && model != "n16") {
-    throw InputError("unknown ALIKED model '" + model + "'; use --aliked-model t16 or n16");
+    throw OptionError("model", "'" + model + "' is not an ALIKED model; use t16 or n16");
   }
   if (device != "cpu" && device != "cuda") {
-    throw InputError("unknown device '" + device + "'; use cpu or cuda");
+    throw OptionError("device", "'" + device + "' is not a device; use cpu or cuda");
   }
   if (top_k < 0) {
-    throw InputError("--aliked-top-k must be >= 0 (0 = threshold mode with --aliked-score-threshold; default 1000)");
+    throw OptionError("top_k", "must be >= 0 (0 = threshold mode with score_threshold; default 1000)",
+                      {"score_threshold"});
   }
   if (top_k == 0 && !(score_threshold >= 0.0 && score_threshold < 1.0)) {
-    throw InputError("--aliked-score-threshold must be in [0, 1) (0 = the mean score, as upstream; default 0.2)");
+    throw OptionError("score_threshold", "must be in [0, 1) (0 = the mean score, as upstream; default 0.2)");
   }
-  if (max_keypoints < 1) throw InputError("--aliked-max-keypoints must be >= 1 (default 5000)");
+  if (max_keypoints < 1) throw OptionError("max_keypoints", "must be >= 1 (default 5000)");
   if (!(min_similarity >= -1.0 && min_similarity <= 1.0)) {
-    throw InputError("--aliked-min-similarity must be a cosine similarity in [-1, 1] (default 0.75)");
+    throw OptionError("min_similarity", "must be a cosine similarity in [-1, 1] (default 0.75)");
   }
   if (longest_side != 0 && longest_side < 32) {
-    throw InputError("--aliked-size " + std::to_string(longest_side) +
-                     " is too small; use 0 (native size) or at least 32");
+    throw OptionError("longest_side",
+                      std::to_string(longest_side) + " is too small; use 0 (native size) or at least 32");
   }
-  if (num_threads < 0) throw InputError("--aliked-threads must be >= 0 (0 = LibTorch's default; default 1)");
+  if (num_threads < 0) throw OptionError("threads", "must be >= 0 (0 = LibTorch's default; default 1)");
 }
 
 void AlikedMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {

@@ -30,7 +30,7 @@ struct AlikedMatcherOptions {
   // one worker per core, where more threads per call only oversubscribe the cores.
   int num_threads = 1;
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
   void VisitFields(OptionFieldVisitor& visitor);  // JSON keys and command-line flags
   void AfterReading();  // after reading a map: older maps name the model aliked-t16
 };

@@ -130,9 +130,11 @@ class LoftrMatcher : public Matcher {
     const int width = static_cast<int>(std::lround(original.width * scale / stride)) * stride;
     const int height = static_cast<int>(std::lround(original.height * scale / stride)) * stride;
     if (width < stride || height < stride) {
-      throw InputError("image of " + std::to_string(original.width) + "x" + std::to_string(original.height) +
-                       " gives less than one LoFTR coarse cell at --loftr-size " +
-                       std::to_string(options_.longest_side) + "; raise --loftr-size or crop the image");
+      // Found while matching, outside any check of the options: named as MatcherOptions holds them.
+      throw OptionError(std::string(LoftrMatcherOptions::kModelName) + ".longest_side",
+                        std::to_string(options_.longest_side) + " gives less than one LoFTR coarse cell for an image "
+                        "of " + std::to_string(original.width) + "x" + std::to_string(original.height) +
+                        "; raise it or crop the image");
     }
     return {width, height};
   }

@@ -152,7 +152,8 @@ TEST(LoftrMatcher, CudaWithoutCudaIsAClearError) {
     CreateLoftrMatcher(options);
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("--device cpu"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("device cuda: "), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("use cpu"), std::string::npos) << e.what();
   }
 }
 

@@ -8,18 +8,20 @@ namespace vmap {
 
 void LoftrMatcherOptions::Check() const {
   if (model != "outdoor" && model != "indoor" && model != "coarse") {
-    throw InputError("unknown LoFTR model '" + model + "'; use outdoor, indoor or coarse");
+    throw OptionError("model", "'" + model + "' is not a LoFTR model; use outdoor, indoor or coarse");
   }
   if (device != "cpu" && device != "cuda") {
-    throw InputError("unknown device '" + device + "'; use cpu or cuda");
+    throw OptionError("device", "'" + device + "' is not a device; use cpu or cuda");
   }
   if (longest_side < 32 || longest_side > 4096) {
-    throw InputError("--loftr-size " + std::to_string(longest_side) + " is outside 32 to 4096 (default 640)");
+    throw OptionError("longest_side", std::to_string(longest_side) + " is outside 32 to 4096 (default 640)");
   }
-  if (num_threads < 0 || num_threads > 256) throw InputError("--loftr-threads must be 0 to 256 (0 = LibTorch's default)");
+  if (num_threads < 0 || num_threads > 256) {
+    throw OptionError("threads", "must be 0 to 256 (0 = LibTorch's default)");
+  }
   if (!std::isfinite(threshold) || threshold > 1.0) {
     // 0 is allowed: it keeps every mutual nearest neighbour (used to reproduce the random-weight golden).
-    throw InputError("--loftr-threshold must be in [0, 1] (negative: the preset's)");
+    throw OptionError("threshold", "must be in [0, 1] (negative: the preset's)");
   }
 }
 

@@ -18,7 +18,7 @@ struct LoftrMatcherOptions {
   // on several threads at once, where more threads per call only oversubscribe the cores.
   int num_threads = 0;
 
-  void Check() const;  // throws InputError naming the bad option
+  void Check() const;  // throws OptionError naming the bad field
   void VisitFields(OptionFieldVisitor& visitor);  // JSON keys and command-line flags
 };
 

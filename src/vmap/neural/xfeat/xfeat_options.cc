@@ -5,18 +5,20 @@
 namespace vmap {
 
 void XfeatMatcherOptions::Check() const {
-  if (device != "cpu" && device != "cuda") throw InputError("unknown device '" + device + "'; use cpu or cuda");
+  if (device != "cpu" && device != "cuda") {
+    throw OptionError("device", "'" + device + "' is not a device; use cpu or cuda");
+  }
   if (top_k < 1) {
-    throw InputError("--xfeat-top-k " + std::to_string(top_k) + " must be at least 1 (upstream default 4096)");
+    throw OptionError("top_k", std::to_string(top_k) + " must be at least 1 (upstream default 4096)");
   }
   if (!(detection_threshold >= 0.0 && detection_threshold < 1.0)) {
-    throw InputError("--xfeat-threshold must be in [0, 1) (a heatmap value; upstream 0.05)");
+    throw OptionError("detection_threshold", "must be in [0, 1) (a heatmap value; upstream 0.05)");
   }
   if (!(min_similarity >= -1.0 && min_similarity < 1.0)) {
-    throw InputError("--xfeat-min-similarity must be in [-1, 1) (a cosine similarity; upstream 0.82, -1 keeps "
-                     "every mutual nearest neighbour)");
+    throw OptionError("min_similarity", "must be in [-1, 1) (a cosine similarity; upstream 0.82, -1 keeps every "
+                                        "mutual nearest neighbour)");
   }
-  if (num_threads < 0) throw InputError("--xfeat-threads must be >= 0 (0 = LibTorch's default)");
+  if (num_threads < 0) throw OptionError("threads", "must be >= 0 (0 = LibTorch's default)");
 }
 
 void XfeatMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {

@@ -1,0 +1,49 @@
+#pragma once
+// The flags of one command by the option fields they set. The library's checks name fields (OptionError:
+// "extraction_threads must be 0 to 256"); the command says the same in its own words ("--threads must be 0 to
+// 256"). Each flag records its field where it is bound, so the table cannot drift from the bindings.
+
+#include <functional>
+#include <map>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "vmap/core/error.h"
+
+namespace vmap::cli {
+
+class OptionFlags {
+ public:
+  // `option` sets the field at `path` ("extraction_threads", "key_images.tau", "orb.num_features"), as the
+  // struct the command checks names it. Returns `option`. A path recorded with two different flags is a
+  // programming error (std::logic_error when the command is set up).
+  CLI::Option* Record(const std::string& path, CLI::Option* option);
+  void Record(const std::string& path, const std::string& flag);
+
+  // Binds the flag `names` ("-t,--tau") to `field` and records it for `path`.
+  template <typename T>
+  CLI::Option* AddOption(CLI::App* command, const std::string& names, T& field, const std::string& path,
+                         const std::string& help) {
+    return Record(path, command->add_option(names, field, help));
+  }
+  CLI::Option* AddFlag(CLI::App* command, const std::string& names, bool& field, const std::string& path,
+                       const std::string& help) {
+    return Record(path, command->add_flag(names, field, help));
+  }
+
+  // The flag recorded for `path`, or "" when it has none.
+  std::string FlagOf(const std::string& path) const;
+
+  // `error`'s message with the flags of its path and of the other fields it names; a field without a flag
+  // keeps its path.
+  std::string Message(const OptionError& error) const;
+
+  // Runs `run`; an OptionError from it comes out as an InputError in the flags' words.
+  void Run(const std::function<void()>& run) const;
+
+ private:
+  std::map<std::string, std::string> flags_;  // field path -> flag
+};
+
+}  // namespace vmap::cli
