@@ -6,10 +6,28 @@
 #include <string>
 
 #include "vmap/cli/commands.h"
+#include "vmap/cli/option_flags.h"
 #include "vmap/report/html_report.h"
 #include "vmap/report/localization_report.h"
 
 namespace vmap::cli {
+
+namespace {
+
+// `target`: a map directory, or the --json file of `vmap localize` (then `run_output` is where its report goes).
+void RunReport(const std::filesystem::path& target, const std::string& run_output, const MapReportOptions& options) {
+  if (std::filesystem::is_regular_file(target)) {
+    const std::filesystem::path output =
+        run_output.empty() ? target.parent_path() / (target.stem().string() + "_report") : std::filesystem::path(run_output);
+    WriteLocalizationReport(target, output);
+    std::cout << "report          " << (output / kReportFileName).string() << "\n";
+    return;
+  }
+  WriteMapReport(target, options);
+  std::cout << "report          " << (target / kReportFileName).string() << "\n";
+}
+
+}  // namespace
 
 void AddReportCommand(CLI::App& app) {
   auto map_directory = std::make_shared<std::string>();
@@ -22,24 +40,21 @@ void AddReportCommand(CLI::App& app) {
       ->required();
   command->add_option("-o,--output", *run_output,
                       "Localization runs: directory for report.html (default: <run file name>_report beside it)");
-  command->add_option("--thumbnail-width", options->thumbnail_width, "Width of the key-image thumbnails in pixels")
+  auto option_flags = std::make_shared<OptionFlags>();
+  option_flags
+      ->AddOption(command, "--thumbnail-width", options->thumbnail_width, "thumbnail_width",
+                  "Width of the key-image thumbnails in pixels")
       ->capture_default_str()
       ->check(CLI::Range(32, 4096));
-  command->add_option("--figure-width", options->figure_width, "Width of the match figures in pixels")
+  option_flags
+      ->AddOption(command, "--figure-width", options->figure_width, "figure_width",
+                  "Width of the match figures in pixels")
       ->capture_default_str()
       ->check(CLI::Range(64, 8192));
-  command->add_flag("!--no-video", options->route_video, "Skip report/route.mp4, the video of the key images in order");
-  command->callback([map_directory, options, run_output] {
-    const std::filesystem::path target(*map_directory);
-    if (std::filesystem::is_regular_file(target)) {
-      const std::filesystem::path output =
-          run_output->empty() ? target.parent_path() / (target.stem().string() + "_report") : std::filesystem::path(*run_output);
-      WriteLocalizationReport(target, output);
-      std::cout << "report          " << (output / kReportFileName).string() << "\n";
-      return;
-    }
-    WriteMapReport(*map_directory, *options);
-    std::cout << "report          " << (std::filesystem::path(*map_directory) / kReportFileName).string() << "\n";
+  option_flags->AddFlag(command, "!--no-video", options->route_video, "route_video",
+                        "Skip report/route.mp4, the video of the key images in order");
+  command->callback([map_directory, options, run_output, option_flags] {
+    option_flags->Run([&] { RunReport(*map_directory, *run_output, *options); });
   });
 }
 

@@ -257,19 +257,17 @@ cv::Mat DrawMapLink(const fs::path& map_directory, const VisualMap& map, int lin
 
 void MapReportOptions::Check() const {
   if (thumbnail_width < 32 || thumbnail_width > 4096) {
-    throw InputError("MapReportOptions::thumbnail_width is " + std::to_string(thumbnail_width) +
-                     "; use 32 to 4096 pixels (default 320)");
+    throw OptionError("thumbnail_width", "is " + std::to_string(thumbnail_width) + "; use 32 to 4096 pixels (default 320)");
   }
   if (figure_width < 64 || figure_width > 8192) {
-    throw InputError("MapReportOptions::figure_width is " + std::to_string(figure_width) +
-                     "; use 64 to 8192 pixels (default 960)");
+    throw OptionError("figure_width", "is " + std::to_string(figure_width) + "; use 64 to 8192 pixels (default 960)");
   }
   if (jpeg_quality < 1 || jpeg_quality > 100) {
-    throw InputError("MapReportOptions::jpeg_quality is " + std::to_string(jpeg_quality) + "; use 1 to 100 (default 85)");
+    throw OptionError("jpeg_quality", "is " + std::to_string(jpeg_quality) + "; use 1 to 100 (default 85)");
   }
   if (!(route_fps > 0.0 && route_fps <= 120.0)) {
-    throw InputError("MapReportOptions::route_fps is " + FormatExact(route_fps) +
-                     "; use more than 0 and at most 120 key images per second (default 3)");
+    throw OptionError("route_fps", "is " + FormatExact(route_fps) +
+                                       "; use more than 0 and at most 120 key images per second (default 3)");
   }
 }
 
@@ -665,7 +663,7 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
   // removes and nothing may bring back.
   std::error_code ec;
   if (!fs::is_directory(directory, ec)) {
-    throw InputError("the report directory '" + directory.string() + "' does not exist; choose another --report path");
+    throw InputError("the report directory '" + directory.string() + "' does not exist; create it or write the report elsewhere");
   }
   const std::string input_name = sweep.input.path.empty() ? std::string("the input") : Displayable(sweep.input.path);
   const bool has_best = HasBestRow(sweep);

@@ -30,7 +30,7 @@ struct MapReportOptions {
   bool route_video = true;    // report/route.mp4 (or .webm): the key images in order
   double route_fps = 3.0;     // key images per second in the route video
 
-  void Check() const;  // throws InputError naming the bad field
+  void Check() const;  // throws OptionError naming the bad field
 };
 
 // Reads the map in `map_directory` (ReadMap) and writes report.html and report/ into it. Throws InputError
