@@ -100,16 +100,13 @@ void AddMatcherOptions(CLI::App* command, MatcherOptions& options, OptionFlags& 
 
 VerifierOptions VerifierFlags::Resolve() const {
   VerifierOptions resolved = options;
-  resolved.method = ParseVerifierMethod(method);
   CheckField("verifier", resolved);
   return resolved;
 }
 
 void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& option_flags) {
-  option_flags
-      .AddOption(command, "--verifier", flags.method, "verifier.method",
-                 "Fundamental matrix estimator: " + ListEnumNames(kVerifierMethodNames))
-      ->capture_default_str();
+  option_flags.AddEnumOption(command, "--verifier", flags.options.method, ParseVerifierMethod, VerifierMethodName,
+                             "verifier.method", "Fundamental matrix estimator: " + ListEnumNames(kVerifierMethodNames));
   option_flags
       .AddOption(command, "--threshold", flags.options.threshold, "verifier.threshold",
                  "Verifier inlier threshold in pixels")
@@ -128,15 +125,13 @@ void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& op
 
 FrameSourceOptions SourceFlags::Resolve() const {
   FrameSourceOptions resolved = options;
-  resolved.format = ParseSourceFormat(format);
   resolved.Check();
   return resolved;
 }
 
 void AddSourceOptions(CLI::App* command, SourceFlags& flags, OptionFlags& option_flags) {
-  option_flags
-      .AddOption(command, "--format", flags.format, "format", "Input layout: " + ListEnumNames(kSourceFormatNames))
-      ->capture_default_str();
+  option_flags.AddEnumOption(command, "--format", flags.options.format, ParseSourceFormat, SourceFormatName, "format",
+                             "Input layout: " + ListEnumNames(kSourceFormatNames));
   option_flags.AddOption(command, "--first", flags.options.first, "first", "First frame (0-based)")
       ->capture_default_str();
   option_flags.AddOption(command, "--last", flags.options.last, "last", "Last frame, inclusive (-1 = end)")

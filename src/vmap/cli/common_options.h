@@ -21,17 +21,15 @@ void AddMatcherOptions(CLI::App* command, MatcherOptions& options, OptionFlags& 
 // --verifier, --threshold, --confidence, --max-iters, --seed; fields as "verifier.<field>" (MapBuilderOptions,
 // LocalizerOptions).
 struct VerifierFlags {
-  std::string method = "magsac";
   VerifierOptions options;
-  VerifierOptions Resolve() const;  // parses method names; checks the options as the field "verifier"
+  VerifierOptions Resolve() const;  // checks the options as the field "verifier"
 };
 void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& option_flags);
 
 // --format, --first, --last, --stride, --resize, --strict, --camera; fields as FrameSourceOptions names them.
 struct SourceFlags {
-  std::string format = "auto";
   FrameSourceOptions options;
-  FrameSourceOptions Resolve() const;
+  FrameSourceOptions Resolve() const;  // checks the options
 };
 void AddSourceOptions(CLI::App* command, SourceFlags& flags, OptionFlags& option_flags);
 

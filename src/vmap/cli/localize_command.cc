@@ -33,7 +33,6 @@ struct LocalizeFlags {
   std::string report;
   SourceFlags source;
   LocalizerOptions localizer;
-  std::string ranking = "auto";
   int from = -1;
   int to = -1;
   int threads = 0;
@@ -55,7 +54,6 @@ void RunLocalize(const LocalizeFlags& flags) {
 
   // Everything that can fail fast does, before the key images are loaded (which may take seconds).
   LocalizerOptions options = flags.localizer;
-  options.ranking.method = ParseRankingMethod(flags.ranking);
   options.Check();
   const VisualMap header = ReadMap(flags.map);
   if (flags.from >= 0 || flags.to >= 0) {
@@ -166,10 +164,8 @@ void AddLocalizeCommand(CLI::App& app) {
       ->capture_default_str();
   option_flags.AddFlag(command, "!--no-step-back", o.step_back, "step_back",
                        "Never move the estimate back to the previous key image");
-  option_flags
-      .AddOption(command, "--ranking", flags->ranking, "ranking.method",
-                 "Relocalization ranking: " + ListEnumNames(kRankingMethodNames))
-      ->capture_default_str();
+  option_flags.AddEnumOption(command, "--ranking", o.ranking.method, ParseRankingMethod, RankingMethodName,
+                             "ranking.method", "Relocalization ranking: " + ListEnumNames(kRankingMethodNames));
   command->add_option("--from", flags->from, "Follow the route from this key image (default: the first)");
   command->add_option("--to", flags->to, "Follow the route to this key image (default: the last)");
   // LocalizeSequenceOptions::extraction_threads (the key-image store's keeps its default).

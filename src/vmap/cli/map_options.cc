@@ -24,18 +24,6 @@ std::string DefaultTaus() {
   return text;
 }
 
-// Binds `names` to the enum `field` by its names: `parse` reads a name (an unknown one is its InputError, as
-// in map.json), `name` shows the default.
-template <typename Enum>
-CLI::Option* AddEnumOption(CLI::App* command, OptionFlags& option_flags, const std::string& names, Enum& field,
-                           Enum (*parse)(const std::string&), std::string (*name)(Enum), const std::string& path,
-                           const std::string& help) {
-  return option_flags.Record(
-      path, command->add_option_function<std::string>(
-                         names, [&field, parse](const std::string& text) { field = parse(text); }, help)
-                ->default_str(name(field)));
-}
-
 }  // namespace
 
 MapBuilderOptions KeyImageFlags::Resolve(const std::string& matcher_type) const {
@@ -55,10 +43,10 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, OptionFlags& op
                             "matcher's, " + DefaultTaus() + ")"));
   }
   MapBuilderOptions& o = flags.options;
-  AddEnumOption(command, option_flags, "--similarity", o.key_images.similarity, ParseSimilarityMode,
+  option_flags.AddEnumOption(command, "--similarity", o.key_images.similarity, ParseSimilarityMode,
                 SimilarityModeName, "key_images.similarity",
                 "S = verified / tentative matches (inlier-ratio) or / features detected (feature-ratio)");
-  AddEnumOption(command, option_flags, "--quality", o.quality_mean, ParseQualityMean, QualityMeanName, "quality_mean",
+  option_flags.AddEnumOption(command, "--quality", o.quality_mean, ParseQualityMean, QualityMeanName, "quality_mean",
                 "Mean used by the quality Q: " + ListEnumNames(kQualityMeanNames));
   option_flags.AddFlag(command, "!--no-final-key", o.key_images.final_key, "key_images.final_key",
                        "Do not make the last frame a key image");
@@ -73,7 +61,7 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, OptionFlags& op
                  "never made a key image; 0 = off (Algorithm 1 as published)")
       ->capture_default_str();
   PoseOptions& pose = o.link_analysis.pose;
-  AddEnumOption(command, option_flags, "--pose", pose.method, ParsePoseMethod, PoseMethodName,
+  option_flags.AddEnumOption(command, "--pose", pose.method, ParsePoseMethod, PoseMethodName,
                 "link_analysis.pose.method",
                 "Relative pose of each link, with a camera: essential (E on normalised points) or fundamental "
                 "(E = K^T F K)");
@@ -98,7 +86,7 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, OptionFlags& op
   option_flags.AddFlag(command, "--exhaustive", o.exhaustive, "exhaustive",
                        "The paper's exact behaviour: verify every comparison with OpenCV's USAC_MAGSAC to its "
                        "confidence criterion (default: stop once S >= tau is settled; same maps within seed noise)");
-  AddEnumOption(command, option_flags, "--search", o.key_search, ParseKeySearch, KeySearchName, "key_search",
+  option_flags.AddEnumOption(command, "--search", o.key_search, ParseKeySearch, KeySearchName, "key_search",
                 "Key-image search: sequential (compare every frame: Algorithm 1), bisect (compare frames further "
                 "ahead, then bisect: fewer network passes, the same map only where S falls with distance) or auto "
                 "(sequential; README \"Threshold sweeps\")");

@@ -32,6 +32,17 @@ class OptionFlags {
     return Record(path, command->add_flag(names, field, help));
   }
 
+  // Binds `names` to the enum `field` by its names: `parse` reads a name (an unknown one is its InputError, as
+  // in map.json), `name` shows the default.
+  template <typename Enum>
+  CLI::Option* AddEnumOption(CLI::App* command, const std::string& names, Enum& field,
+                             Enum (*parse)(const std::string&), std::string (*name)(Enum), const std::string& path,
+                             const std::string& help) {
+    return Record(path, command->add_option_function<std::string>(
+                                names, [&field, parse](const std::string& text) { field = parse(text); }, help)
+                            ->default_str(name(field)));
+  }
+
   // The flag recorded for `path`, or "" when it has none.
   std::string FlagOf(const std::string& path) const;
 
