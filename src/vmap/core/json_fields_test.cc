@@ -2,20 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include "vmap/testing/option_error.h"
+
 namespace vmap {
 namespace {
 
 enum class Fruit { kApple, kPear };
 constexpr EnumName<Fruit> kFruitNames[] = {{Fruit::kApple, "apple"}, {Fruit::kPear, "pear"}};
-
-std::string ErrorOf(const std::function<void()>& read) {
-  try {
-    read();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST(JsonFieldReader, ReadsRecordedFieldsAndKeepsTheOthers) {
   const nlohmann::json record = {{"tau", 0.7},      {"seed", 3},   {"strict", true}, {"resize", "640"},
@@ -53,19 +46,19 @@ TEST(JsonFieldReader, AValueOfTheWrongKindNamesItsPath) {
   int seed = 0, big = 0;
   bool strict = false;
   Fruit fruit = Fruit::kApple;
-  EXPECT_EQ(ErrorOf([&] { fields.Read("tau", &tau); }),
+  EXPECT_EQ(testing::InputErrorMessage([&] { fields.Read("tau", &tau); }),
             "map 'm/map.json': options.tau must be a number (it is string)");
-  EXPECT_EQ(ErrorOf([&] { fields.Read("seed", &seed); }), "map 'm/map.json': options.seed must be an integer (it is number)");
-  EXPECT_EQ(ErrorOf([&] { fields.Read("strict", &strict); }),
+  EXPECT_EQ(testing::InputErrorMessage([&] { fields.Read("seed", &seed); }), "map 'm/map.json': options.seed must be an integer (it is number)");
+  EXPECT_EQ(testing::InputErrorMessage([&] { fields.Read("strict", &strict); }),
             "map 'm/map.json': options.strict must be true or false (it is number)");
-  EXPECT_NE(ErrorOf([&] { fields.Read("big", &big); }).find("options.big must be an integer"), std::string::npos);
-  EXPECT_EQ(ErrorOf([&] { fields.Read("fruit", &fruit, kFruitNames); }),
+  EXPECT_NE(testing::InputErrorMessage([&] { fields.Read("big", &big); }).find("options.big must be an integer"), std::string::npos);
+  EXPECT_EQ(testing::InputErrorMessage([&] { fields.Read("fruit", &fruit, kFruitNames); }),
             "map 'm/map.json': options.fruit is 'fig', which this vmap does not know (it knows apple or pear)");
   double threshold = 0;
-  EXPECT_EQ(ErrorOf([&] { fields.Object("pose").Read("threshold", &threshold); }),
+  EXPECT_EQ(testing::InputErrorMessage([&] { fields.Object("pose").Read("threshold", &threshold); }),
             "map 'm/map.json': options.pose.threshold must be a number (it is boolean)");
-  EXPECT_EQ(ErrorOf([&] { fields.Object("list"); }), "map 'm/map.json': options.list must be a JSON object (it is array)");
-  EXPECT_EQ(ErrorOf([] { JsonFieldReader(nlohmann::json::array(), "options"); }),
+  EXPECT_EQ(testing::InputErrorMessage([&] { fields.Object("list"); }), "map 'm/map.json': options.list must be a JSON object (it is array)");
+  EXPECT_EQ(testing::InputErrorMessage([] { JsonFieldReader(nlohmann::json::array(), "options"); }),
             "options is not a JSON object (it is array)");
   EXPECT_EQ(tau, 0.0);  // nothing was read from a bad value
   EXPECT_EQ(fruit, Fruit::kApple);

@@ -8,6 +8,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/mapping/map_builder.h"
+#include "vmap/testing/option_error.h"
 
 namespace vmap {
 namespace {
@@ -118,12 +119,7 @@ TEST(RecordedOptions, AnOlderRecordKeepsTheDefaultsOfWhatItLacks) {
 
 TEST(RecordedOptions, AMalformedRecordNamesTheField) {
   auto error = [](const std::string& text) {
-    try {
-      RecordedOptionsFromJson(text, "map 'm/map.json': options");
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
+    return testing::InputErrorMessage([&] { RecordedOptionsFromJson(text, "map 'm/map.json': options"); });
   };
   EXPECT_EQ(error(R"({"quality_mean": "median"})"),
             "map 'm/map.json': options.quality_mean is 'median', which this vmap does not know (it knows arithmetic "

@@ -15,6 +15,7 @@
 #include "vmap/map/map_io.h"
 #include "vmap/report/report_assets.h"
 #include "vmap/report/report_test_util.h"
+#include "vmap/testing/option_error.h"
 #include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
@@ -30,15 +31,6 @@ std::set<std::string> Listing(const fs::path& root) {
     paths.insert(entry.path().lexically_relative(root).generic_string());
   }
   return paths;
-}
-
-std::string ErrorOf(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
 }
 
 TEST(MapReportTest, WritesOnePageWithAFigurePerLinkAndAThumbnailPerKeyImage) {
@@ -163,25 +155,25 @@ TEST(MapReportTest, RewritingReplacesTheReportAndLeavesNoTemporaryFiles) {
 TEST(MapReportTest, MissingOrMalformedMapsGiveClearErrorsAndWriteNothing) {
   ScopedTempDir temp;
   const fs::path missing = temp.path() / "no_such_map";
-  EXPECT_NE(ErrorOf([&] { WriteMapReport(missing); }).find("no_such_map"), std::string::npos);
+  EXPECT_NE(testing::InputErrorMessage([&] { WriteMapReport(missing); }).find("no_such_map"), std::string::npos);
   EXPECT_FALSE(fs::exists(missing));
 
   const fs::path empty = temp.path() / "empty";
   fs::create_directories(empty);
-  EXPECT_NE(ErrorOf([&] { WriteMapReport(empty); }).find("map.json"), std::string::npos);
+  EXPECT_NE(testing::InputErrorMessage([&] { WriteMapReport(empty); }).find("map.json"), std::string::npos);
   EXPECT_TRUE(fs::is_empty(empty));
 
   const fs::path incomplete = temp.path() / "incomplete";
   report_test::WriteSyntheticMap(incomplete);
   fs::remove(incomplete / "keys/000018.png");
   const std::set<std::string> before = Listing(incomplete);
-  EXPECT_NE(ErrorOf([&] { WriteMapReport(incomplete); }).find("000018.png"), std::string::npos);
+  EXPECT_NE(testing::InputErrorMessage([&] { WriteMapReport(incomplete); }).find("000018.png"), std::string::npos);
   EXPECT_EQ(Listing(incomplete), before);
 
   const fs::path garbled = temp.path() / "garbled";
   report_test::WriteSyntheticMap(garbled);
   std::ofstream(garbled / "map.json") << "{ not json";
-  EXPECT_NE(ErrorOf([&] { WriteMapReport(garbled); }).find("not valid JSON"), std::string::npos);
+  EXPECT_NE(testing::InputErrorMessage([&] { WriteMapReport(garbled); }).find("not valid JSON"), std::string::npos);
   EXPECT_FALSE(fs::exists(garbled / kReportFileName));
 }
 
@@ -201,7 +193,7 @@ TEST(MapReportTest, BadOptionsNameTheFieldAndWriteNothing) {
   for (const auto& [message, spoil] : cases) {
     MapReportOptions options;
     spoil(options);
-    EXPECT_EQ(ErrorOf([&] { WriteMapReport(dir, options); }).rfind(message, 0), 0u) << message;  // names the field
+    EXPECT_EQ(testing::InputErrorMessage([&] { WriteMapReport(dir, options); }).rfind(message, 0), 0u) << message;
   }
   EXPECT_EQ(Listing(dir), before);
 }
@@ -235,16 +227,16 @@ TEST(MapReportTest, KeyImagePathsCannotLeaveTheMapDirectory) {
   cv::imwrite(outside.string(), cv::Mat(8, 8, CV_8UC3, cv::Scalar::all(9)));
 
   SetKeyImagePath(dir, 1, "../secret.png");
-  EXPECT_NE(ErrorOf([&] { WriteMapReport(dir); }).find("outside the map directory"), std::string::npos);
+  EXPECT_NE(testing::InputErrorMessage([&] { WriteMapReport(dir); }).find("outside the map directory"), std::string::npos);
   SetKeyImagePath(dir, 1, outside.string());
-  EXPECT_NE(ErrorOf([&] { WriteMapReport(dir); }).find("outside the map directory"), std::string::npos);
+  EXPECT_NE(testing::InputErrorMessage([&] { WriteMapReport(dir); }).find("outside the map directory"), std::string::npos);
   EXPECT_FALSE(fs::exists(dir / kReportFileName));
   EXPECT_FALSE(fs::exists(dir / kReportAssetsDirectory));
 
   // A symbolic link inside the map that leads out is refused too.
   fs::create_symlink(outside, dir / "keys/link.png");
   SetKeyImagePath(dir, 1, "keys/link.png");
-  EXPECT_NE(ErrorOf([&] { WriteMapReport(dir); }).find("resolves outside"), std::string::npos);
+  EXPECT_NE(testing::InputErrorMessage([&] { WriteMapReport(dir); }).find("resolves outside"), std::string::npos);
   EXPECT_FALSE(fs::exists(dir / kReportFileName));
 
   KeyImage escaping = map.key_images[0];
@@ -257,7 +249,7 @@ TEST(MapReportTest, DrawMapLinkNamesAMissingLink) {
   const VisualMap map = report_test::WriteSyntheticMap(temp.path());
   const cv::Mat figure = DrawMapLink(temp.path(), map, 0);
   EXPECT_EQ(figure.cols, 2 * 320 + 4);
-  const std::string error = ErrorOf([&] { DrawMapLink(temp.path(), map, 17); });
+  const std::string error = testing::InputErrorMessage([&] { DrawMapLink(temp.path(), map, 17); });
   EXPECT_NE(error.find("link 17 does not exist"), std::string::npos) << error;
   EXPECT_NE(error.find("0 to 4"), std::string::npos) << error;
 }

@@ -1,5 +1,5 @@
 #pragma once
-// The field an options check names when it refuses a value.
+// What a check says when it refuses: the field an options check names, the message of an InputError.
 
 #include <exception>
 #include <string>
@@ -22,6 +22,17 @@ std::string OptionErrorPath(Check&& check) {
     return "";
   }
   ADD_FAILURE() << "no OptionError";
+  return "";
+}
+
+// The message of the InputError `work()` throws; "" when it throws none.
+template <typename Work>
+std::string InputErrorMessage(Work&& work) {
+  try {
+    work();
+  } catch (const InputError& error) {
+    return error.what();
+  }
   return "";
 }
 
