@@ -253,6 +253,8 @@ TEST(Cli, OptionErrorsNameTheFlagsThatSetTheFields) {
        "vmap: error: --exhaustive is the paper's frame-by-frame scan and --search bisect skips frames; drop one\n"},
       {build + "--first 3 --last 1", "vmap: error: --last 1 is before --first 3\n"},
       {build + "--seed -3", "vmap: error: --seed must be >= 0 (default 0)\n"},
+      {build + "--stream-timeout 0",
+       "vmap: error: --stream-timeout must be more than 0 and at most 3600 seconds (default 10)\n"},
       {build + "--xfeat-top-k 0", "vmap: error: --xfeat-top-k 0 must be at least 1 (upstream default 4096)\n"},
       {build + "--aliked-top-k -1",
        "vmap: error: --aliked-top-k must be >= 0 (0 = threshold mode with --aliked-score-threshold; default 1000)\n"},

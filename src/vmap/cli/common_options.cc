@@ -146,6 +146,11 @@ void AddSourceOptions(CLI::App* command, SourceFlags& flags, OptionFlags& option
                          "Intrinsics: fx,fy,cx,cy[,k1,k2,p1,p2[,k3]] (pixels, native frame size) or a calibration "
                          "file (OpenCV YAML/JSON, EuRoC sensor.yaml, KITTI calib.txt, intrinsics.txt); 'none' ignores "
                          "the input's own. Default: the input's own, if any");
+  option_flags
+      .AddOption(command, "--stream-timeout", flags.options.stream_timeout_seconds, "stream_timeout_seconds",
+                 "Live inputs: seconds without a frame after which the stream has ended (and the longest opening "
+                 "it may take)")
+      ->capture_default_str();
 }
 
 }  // namespace vmap::cli

@@ -26,7 +26,7 @@ struct VerifierFlags {
 };
 void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& option_flags);
 
-// --format, --first, --last, --stride, --resize, --strict, --camera; fields as FrameSourceOptions names them.
+// --format, --first, --last, --stride, --resize, --strict, --camera, --stream-timeout; fields as FrameSourceOptions names them.
 struct SourceFlags {
   FrameSourceOptions options;
   FrameSourceOptions Resolve() const;  // checks the options

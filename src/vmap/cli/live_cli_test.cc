@@ -262,4 +262,17 @@ TEST(LiveCli, AStreamThatNeverStartsIsAnInputError) {
   EXPECT_FALSE(fs::exists(tmp.path() / "m"));
 }
 
+// A UDP stream waits for a sender; --stream-timeout says for how long (the message names the wait it made).
+TEST(LiveCli, StreamTimeoutBoundsTheWaitForAStreamThatSendsNothing) {
+  std::string out;
+  testing::ScopedTempDir tmp;
+  EXPECT_EQ(testing::RunVmap(fmt::format("build udp://127.0.0.1:{} --stream-timeout 1 -o '{}'", FreePort(),
+                                         (tmp.path() / "m").string()),
+                             &out),
+            2)
+      << out;
+  EXPECT_NE(out.find("no video FFmpeg can decode arrived within 1 s"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(tmp.path() / "m"));
+}
+
 }  // namespace vmap

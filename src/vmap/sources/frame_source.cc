@@ -36,7 +36,7 @@ void FrameSourceOptions::Check() const {
   }
   if (!resize.empty()) internal::TargetSize(cv::Size(640, 480), *this);  // validates the text
   if (!(stream_timeout_seconds > 0.0 && stream_timeout_seconds <= 3600.0)) {
-    throw OptionError("stream_timeout_seconds", "must be in (0, 3600]");
+    throw OptionError("stream_timeout_seconds", "must be more than 0 and at most 3600 seconds (default 10)");
   }
 }
 
