@@ -1,5 +1,6 @@
 // vmap info MAP_DIR: the summary of a map, from its files.
 
+#include <filesystem>
 #include <iostream>
 
 #include "vmap/cli/commands.h"
@@ -15,8 +16,8 @@ void AddInfoCommand(CLI::App& app) {
   command->add_option("map", *directory, "Map directory written by `vmap build`")->required();
   command->callback([directory] {
     const VisualMap map = ReadMap(*directory);
-    const RecordedOptions options =
-        RecordedOptionsFromJson(map.options_json, "map '" + *directory + "': options");
+    const std::string map_file = (std::filesystem::path(*directory) / kMapFileName).string();
+    const RecordedOptions options = RecordedOptionsFromJson(map.options_json, "map '" + map_file + "': options");
     std::cout << FormatMapSummary(map, options.builder.quality_mean);
     if (!options.matcher_type.empty()) {
       std::cout << "matcher         " << options.matcher_type << ", verifier "

@@ -44,10 +44,10 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, OptionFlags& op
   }
   MapBuilderOptions& o = flags.options;
   option_flags.AddEnumOption(command, "--similarity", o.key_images.similarity, ParseSimilarityMode,
-                SimilarityModeName, "key_images.similarity",
-                "S = verified / tentative matches (inlier-ratio) or / features detected (feature-ratio)");
+                             SimilarityModeName, "key_images.similarity",
+                             "S = verified / tentative matches (inlier-ratio) or / features detected (feature-ratio)");
   option_flags.AddEnumOption(command, "--quality", o.quality_mean, ParseQualityMean, QualityMeanName, "quality_mean",
-                "Mean used by the quality Q: " + ListEnumNames(kQualityMeanNames));
+                             "Mean used by the quality Q: " + ListEnumNames(kQualityMeanNames));
   option_flags.AddFlag(command, "!--no-final-key", o.key_images.final_key, "key_images.final_key",
                        "Do not make the last frame a key image");
   option_flags
@@ -62,9 +62,9 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, OptionFlags& op
       ->capture_default_str();
   PoseOptions& pose = o.link_analysis.pose;
   option_flags.AddEnumOption(command, "--pose", pose.method, ParsePoseMethod, PoseMethodName,
-                "link_analysis.pose.method",
-                "Relative pose of each link, with a camera: essential (E on normalised points) or fundamental "
-                "(E = K^T F K)");
+                             "link_analysis.pose.method",
+                             "Relative pose of each link, with a camera: essential (E on normalised points) or "
+                             "fundamental (E = K^T F K)");
   option_flags
       .AddOption(command, "--pose-threshold", pose.threshold, "link_analysis.pose.threshold",
                  "Inlier threshold of the essential matrix, pixels")
@@ -87,9 +87,9 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, OptionFlags& op
                        "The paper's exact behaviour: verify every comparison with OpenCV's USAC_MAGSAC to its "
                        "confidence criterion (default: stop once S >= tau is settled; same maps within seed noise)");
   option_flags.AddEnumOption(command, "--search", o.key_search, ParseKeySearch, KeySearchName, "key_search",
-                "Key-image search: sequential (compare every frame: Algorithm 1), bisect (compare frames further "
-                "ahead, then bisect: fewer network passes, the same map only where S falls with distance) or auto "
-                "(sequential; README \"Threshold sweeps\")");
+                             "Key-image search: sequential (compare every frame: Algorithm 1), bisect (compare frames "
+                             "further ahead, then bisect: fewer network passes, the same map only where S falls with "
+                             "distance) or auto (sequential; README \"Threshold sweeps\")");
   option_flags
       .AddOption(command, "--search-window", o.search_window, "search_window",
                  "bisect: frames compared ahead at most (held in memory)")

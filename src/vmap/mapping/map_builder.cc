@@ -75,12 +75,17 @@ using CompareFn = std::function<PairComparison(const FrameRecord& key, const Fra
 // comparison settles every threshold; an older key image is compared for the selectors holding it when the
 // frame comes (`holders`, ascending), and for `tau` (a selector that moves to it during the frame, after frames
 // that repeated the key image's view). Without holders: every threshold.
+// Adds `tau` to the ascending `taus` unless it is there.
+void AddThreshold(double tau, std::vector<double>* taus) {
+  if (!std::binary_search(taus->begin(), taus->end(), tau)) {
+    taus->insert(std::upper_bound(taus->begin(), taus->end(), tau), tau);
+  }
+}
+
 std::vector<double> ThresholdsToSettle(int key_index, int frame_index, const std::vector<double>* holders,
                                        const std::vector<double>& all_taus, double tau) {
   std::vector<double> taus = key_index == frame_index - 1 || !holders ? all_taus : *holders;
-  if (!std::binary_search(taus.begin(), taus.end(), tau)) {
-    taus.insert(std::upper_bound(taus.begin(), taus.end(), tau), tau);
-  }
+  AddThreshold(tau, &taus);
   return taus;
 }
 
@@ -270,11 +275,7 @@ class FeaturePipeline {
         std::sort(holders.begin(), holders.end());
         asked = ThresholdsToSettle(key_index, frame_index, holders.empty() ? nullptr : &holders, all_taus_,
                                    group.taus.front());
-        for (double tau : group.taus) {
-          if (!std::binary_search(asked.begin(), asked.end(), tau)) {
-            asked.insert(std::upper_bound(asked.begin(), asked.end(), tau), tau);
-          }
-        }
+        for (double tau : group.taus) AddThreshold(tau, &asked);
       }
       PairComparison comparison =
           compare_(group.record, item.record, asked, [this, key_index, frame_index, &group] {
