@@ -2,6 +2,7 @@
 // Geometric verification of tentative matches with a fundamental matrix (OpenCV RANSAC / USAC).
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,8 @@
 #include "vmap/core/enum_names.h"
 
 namespace vmap {
+
+struct MagsacCheckpoint;  // magsac.cc
 
 enum class VerifierMethod { kMagsac, kRansac, kUsac, kAccurate };
 // USAC_MAGSAC, FM_RANSAC, USAC_DEFAULT, USAC_ACCURATE.
@@ -47,6 +50,9 @@ struct FundamentalResult {
   std::vector<unsigned char> inlier_mask;  // one per tentative match; empty when !success
   int num_inliers = 0;
   bool abandoned = false;       // EarlyStop::abandon ended it: not a result, discard it
+  // Set when vmap's MAGSAC++ stopped early (EarlyStop): where its sample loop stopped. Given back as
+  // EarlyStop::resume_from with the same correspondences and options, the estimation goes on from there.
+  std::shared_ptr<const MagsacCheckpoint> checkpoint;
 };
 
 // What a caller will decide from the result: for each entry t, "at least t inliers?". Empty: estimate
@@ -56,6 +62,10 @@ struct EarlyStop {
   // Polled now and then; when it returns true the estimation stops with `abandoned` set (the answer is no
   // longer needed, e.g. the key image was replaced meanwhile).
   std::function<bool()> abandon;
+  // Continues the run that left this checkpoint (FundamentalResult::checkpoint) instead of starting over; the
+  // same correspondences (in any order) and options are required. With no targets the result is exactly that
+  // of an exhaustive run from the start, which costs only the samples the first run had not drawn.
+  std::shared_ptr<const MagsacCheckpoint> resume_from;
 };
 
 FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0,

@@ -4,8 +4,11 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
+#include <memory>
 #include <random>
+#include <stdexcept>
 #include <tuple>
 
 #include <Eigen/Dense>
@@ -114,6 +117,15 @@ struct Score {
   int consistent = 0;  // points within the maximum threshold: SPRT's notion of support
 };
 
+// SPRT state: epsilon = support of the best model, delta = support of bad models (estimated).
+struct Sprt {
+  bool active = false;
+  double delta = 0.01;
+  double log_accept = 0, log_reject = 0, log_threshold = 0;
+  double rejected_tested = 0, rejected_consistent = 0;
+  int rejected_since_update = 0;
+};
+
 // Real roots of c3 t^3 + c2 t^2 + c1 t + c0, polished by Newton steps.
 int SolveCubic(double c3, double c2, double c1, double c0, double* roots) {
   const double scale = std::max({std::abs(c3), std::abs(c2), std::abs(c1), std::abs(c0)});
@@ -157,6 +169,28 @@ int SolveCubic(double c3, double c2, double c1, double c0, double* roots) {
 }
 
 // One robust estimation; every member is scratch space reused across the loop.
+}  // namespace
+
+// Everything the sample loop carries from one sample to the next, as it was when the loop stopped early, and
+// what the run was given, so that a run resumed from it can be checked to be the same run.
+struct MagsacCheckpoint {
+  int num_points = 0;
+  std::uint64_t points_fingerprint = 0;
+  double threshold = 0, confidence = 0;
+  int max_iterations = 0, seed = 0;
+
+  int iterations = 0;
+  std::uint64_t random_draws = 0;
+  bool local_optimization_ran = false;
+  bool have_best = false;
+  internal::Model best{};
+  Score best_score;
+  Sprt sprt;
+  MagsacStatistics statistics;
+};
+
+namespace {
+
 class Estimator {
  public:
   Estimator(const std::vector<cv::Point2f>& points0, const std::vector<cv::Point2f>& points1,
@@ -189,6 +223,7 @@ class Estimator {
     columns_.Assign(points_);
     squared_errors_.resize(n_);
     abandon_ = early_stop.abandon;
+    resume_from_ = early_stop.resume_from;
     for (int target : early_stop.min_inliers) {
       targets_.push_back({target, SamplesToSettle(static_cast<double>(target) / n_, options.confidence,
                                                   options.max_iterations)});
@@ -203,7 +238,14 @@ class Estimator {
     int samples_to_fail;
   };
 
-  int Uniform(int bound) { return static_cast<int>((static_cast<std::uint64_t>(rng_()) * bound) >> 32); }
+  int Uniform(int bound) {
+    ++random_draws_;
+    return static_cast<int>((static_cast<std::uint64_t>(rng_()) * bound) >> 32);
+  }
+  // FNV-1a over the points in visiting order: a resumed run must be given the points its checkpoint was.
+  std::uint64_t PointsFingerprint() const;
+  std::shared_ptr<const MagsacCheckpoint> Checkpoint(int iterations, bool local_optimization_ran) const;
+  void Resume(const MagsacCheckpoint& checkpoint, int* iterations, bool* local_optimization_ran);
 
   bool Normalize();
   int SolveMinimal(const std::array<int, kSampleSize>& sample, std::array<Model, 3>* models);
@@ -225,6 +267,7 @@ class Estimator {
   const VerifierOptions& options_;
   const MagsacTables& tables_;
   std::mt19937 rng_;
+  std::uint64_t random_draws_ = 0;  // rng_'s outputs used so far (a checkpoint's place in the random stream)
   const int n_;
   double max_squared_ = 0, inv_max_squared_ = 0, threshold_squared_ = 0;
   std::vector<int> order_;
@@ -235,17 +278,13 @@ class Estimator {
   Mat3 T0_, T1_;                   // normalised = T * pixel, per image
   std::vector<Target> targets_;
   std::function<bool()> abandon_;
+  std::shared_ptr<const MagsacCheckpoint> resume_from_;
 
   Model best_{};
   Score best_score_;
   bool have_best_ = false;
 
-  // SPRT state: epsilon = support of the best model, delta = support of bad models (estimated).
-  bool sprt_active_ = false;
-  double sprt_delta_ = 0.01;
-  double log_accept_ = 0, log_reject_ = 0, log_threshold_ = 0;
-  double rejected_tested_ = 0, rejected_consistent_ = 0;
-  int rejected_since_update_ = 0;
+  Sprt sprt_;
 
   std::vector<int> scratch_indices_;
   std::vector<double> scratch_weights_;
@@ -535,7 +574,7 @@ bool Estimator::FitHomography(const std::vector<int>& indices, int count, Mat3* 
 // model can no longer beat `bound`, or when SPRT rejects it.
 Score Estimator::Evaluate(const Model& model, double bound, bool use_sprt) {
   ++stats_.models_scored;
-  use_sprt = use_sprt && sprt_active_;
+  use_sprt = use_sprt && sprt_.active;
   Score score;
   double value = 0, log_lambda = 0;
   // Errors a block at a time: SPRT rejects most models within the first few dozen points.
@@ -548,14 +587,14 @@ Score Estimator::Evaluate(const Model& model, double bound, bool use_sprt) {
       value += tables_.Quality(r2 * inv_max_squared_);
       ++score.consistent;
       if (r2 < threshold_squared_) ++score.inliers;
-      log_lambda += log_accept_;
+      log_lambda += sprt_.log_accept;
     } else {
-      log_lambda += log_reject_;
+      log_lambda += sprt_.log_reject;
     }
-    if (use_sprt && log_lambda > log_threshold_) {
-      rejected_tested_ += i + 1;
-      rejected_consistent_ += score.consistent;
-      if (++rejected_since_update_ >= 50) UpdateSprt();
+    if (use_sprt && log_lambda > sprt_.log_threshold) {
+      sprt_.rejected_tested += i + 1;
+      sprt_.rejected_consistent += score.consistent;
+      if (++sprt_.rejected_since_update >= 50) UpdateSprt();
       return Score{};
     }
     if (value + (n_ - 1 - i) < bound) return Score{};
@@ -567,21 +606,21 @@ Score Estimator::Evaluate(const Model& model, double bound, bool use_sprt) {
 // Matas & Chum (2008): the decision threshold A solves A = t_M C / m_S + 1 + ln A, with C the expected
 // information per point; it is recomputed when epsilon (the best model) or delta (bad models) change.
 void Estimator::UpdateSprt() {
-  if (rejected_tested_ > 0) {
-    sprt_delta_ = std::clamp(rejected_consistent_ / rejected_tested_, 0.001, 0.5);
+  if (sprt_.rejected_tested > 0) {
+    sprt_.delta = std::clamp(sprt_.rejected_consistent / sprt_.rejected_tested, 0.001, 0.5);
   }
-  rejected_since_update_ = 0;
+  sprt_.rejected_since_update = 0;
   const double epsilon = have_best_ ? static_cast<double>(best_score_.inliers) / n_ : 0.0;
-  const double delta = sprt_delta_;
-  sprt_active_ = have_best_ && epsilon > 1.5 * delta && epsilon < 1.0;
-  if (!sprt_active_) return;
-  log_accept_ = std::log(delta / epsilon);
-  log_reject_ = std::log((1 - delta) / (1 - epsilon));
-  const double C = (1 - delta) * log_reject_ + delta * log_accept_;
+  const double delta = sprt_.delta;
+  sprt_.active = have_best_ && epsilon > 1.5 * delta && epsilon < 1.0;
+  if (!sprt_.active) return;
+  sprt_.log_accept = std::log(delta / epsilon);
+  sprt_.log_reject = std::log((1 - delta) / (1 - epsilon));
+  const double C = (1 - delta) * sprt_.log_reject + delta * sprt_.log_accept;
   const double K = kSprtModelCost * C / kSprtModelsPerSample + 1;
   double A = K;
   for (int i = 0; i < 10; ++i) A = K + std::log(A);
-  log_threshold_ = std::log(A);
+  sprt_.log_threshold = std::log(A);
 }
 
 // sigma-consensus++: iteratively re-weighted least squares with MAGSAC++ weights on the points within the
@@ -707,6 +746,56 @@ bool Estimator::RecoverIfDegenerate(const std::array<int, kSampleSize>& sample, 
   return degenerate;
 }
 
+std::uint64_t Estimator::PointsFingerprint() const {
+  std::uint64_t hash = 14695981039346656037ull;
+  for (const Point& p : points_) {
+    for (double v : {p.x0, p.y0, p.x1, p.y1}) {
+      std::uint64_t bits;
+      std::memcpy(&bits, &v, sizeof bits);
+      hash = (hash ^ bits) * 1099511628211ull;
+    }
+  }
+  return hash;
+}
+
+std::shared_ptr<const MagsacCheckpoint> Estimator::Checkpoint(int iterations, bool local_optimization_ran) const {
+  auto checkpoint = std::make_shared<MagsacCheckpoint>();
+  checkpoint->num_points = n_;
+  checkpoint->points_fingerprint = PointsFingerprint();
+  checkpoint->threshold = options_.threshold;
+  checkpoint->confidence = options_.confidence;
+  checkpoint->max_iterations = options_.max_iterations;
+  checkpoint->seed = options_.seed;
+  checkpoint->iterations = iterations;
+  checkpoint->random_draws = random_draws_;
+  checkpoint->local_optimization_ran = local_optimization_ran;
+  checkpoint->have_best = have_best_;
+  checkpoint->best = best_;
+  checkpoint->best_score = best_score_;
+  checkpoint->sprt = sprt_;
+  checkpoint->statistics = stats_;
+  return checkpoint;
+}
+
+void Estimator::Resume(const MagsacCheckpoint& checkpoint, int* iterations, bool* local_optimization_ran) {
+  if (checkpoint.num_points != n_ || checkpoint.points_fingerprint != PointsFingerprint() ||
+      checkpoint.threshold != options_.threshold || checkpoint.confidence != options_.confidence ||
+      checkpoint.max_iterations != options_.max_iterations || checkpoint.seed != options_.seed ||
+      checkpoint.random_draws < random_draws_) {
+    throw std::logic_error("EstimateFundamentalMagsac: resumed with other points or options than its checkpoint's");
+  }
+  rng_.discard(checkpoint.random_draws - random_draws_);
+  random_draws_ = checkpoint.random_draws;
+  *iterations = checkpoint.iterations;
+  *local_optimization_ran = checkpoint.local_optimization_ran;
+  have_best_ = checkpoint.have_best;
+  best_ = checkpoint.best;
+  best_score_ = checkpoint.best_score;
+  sprt_ = checkpoint.sprt;
+  stats_ = checkpoint.statistics;
+  stats_.stopped_early = false;
+}
+
 bool Estimator::Settled(int iterations) const {
   if (targets_.empty()) return false;
   for (const Target& target : targets_) {
@@ -743,6 +832,13 @@ FundamentalResult Estimator::Run(MagsacStatistics* statistics) {
   };
 
   int iterations = 0;
+  if (resume_from_) {
+    Resume(*resume_from_, &iterations, &local_optimization_ran);
+    if (have_best_) {
+      max_iterations = SamplesToSettle(static_cast<double>(best_score_.inliers) / n_, options_.confidence,
+                                       options_.max_iterations);
+    }
+  }
   for (; iterations < max_iterations; ++iterations) {
     if (Settled(iterations)) {
       stopped_early = true;
@@ -807,6 +903,7 @@ FundamentalResult Estimator::Run(MagsacStatistics* statistics) {
   }
   stats_.iterations = iterations;
   stats_.stopped_early = stopped_early;
+  if (stopped_early) result.checkpoint = Checkpoint(iterations, local_optimization_ran);
   if (!have_best_) {
     if (statistics) *statistics = stats_;
     return result;

@@ -272,6 +272,52 @@ TEST(MagsacEarlyStop, ImpossibleTargetsNeedNoSample) {
   EXPECT_EQ(stats.iterations, 0);
 }
 
+// A run resumed from an early stop's checkpoint, without targets, is the exhaustive run from the start: the same
+// model, inliers and sample count, bit for bit, whichever order the correspondences come in.
+TEST(MagsacEarlyStop, ResumedRunIsTheExhaustiveRun) {
+  for (int inliers : {120, 200, 260}) {
+    const Scene scene = MakeScene(inliers, 300 - inliers, 0.3, 30 + inliers);
+    const int n = static_cast<int>(scene.p0.size());
+    MagsacStatistics exhaustive_stats, early_stats, resumed_stats;
+    const FundamentalResult exhaustive = EstimateFundamentalMagsac(scene.p0, scene.p1, {}, {}, &exhaustive_stats);
+    const FundamentalResult early = EstimateFundamentalMagsac(
+        scene.p0, scene.p1, {}, Targets({AtLeast(0.2, n), AtLeast(0.95, n)}), &early_stats);
+    ASSERT_TRUE(early_stats.stopped_early) << inliers;
+    ASSERT_NE(early.checkpoint, nullptr);
+    EXPECT_LT(early_stats.iterations, exhaustive_stats.iterations);
+
+    std::vector<cv::Point2f> reversed0(scene.p0.rbegin(), scene.p0.rend());
+    std::vector<cv::Point2f> reversed1(scene.p1.rbegin(), scene.p1.rend());
+    EarlyStop resume;
+    resume.resume_from = early.checkpoint;
+    const FundamentalResult resumed = EstimateFundamentalMagsac(reversed0, reversed1, {}, resume, &resumed_stats);
+    ASSERT_TRUE(resumed.success);
+    EXPECT_EQ(resumed.F, exhaustive.F) << inliers;
+    EXPECT_EQ(resumed.num_inliers, exhaustive.num_inliers);
+    EXPECT_EQ(std::vector<unsigned char>(resumed.inlier_mask.rbegin(), resumed.inlier_mask.rend()),
+              exhaustive.inlier_mask);
+    EXPECT_EQ(resumed_stats.iterations, exhaustive_stats.iterations);
+    EXPECT_EQ(resumed_stats.models_scored, exhaustive_stats.models_scored);
+    EXPECT_FALSE(resumed_stats.stopped_early);
+    EXPECT_EQ(resumed.checkpoint, nullptr);  // it ran to the end
+  }
+}
+
+// A checkpoint belongs to its points and options: resuming with others is a programming error.
+TEST(MagsacEarlyStop, ResumingAnotherRunThrows) {
+  const Scene scene = MakeScene(200, 100, 0.3, 40);
+  const FundamentalResult early = EstimateFundamentalMagsac(scene.p0, scene.p1, {}, Targets({60}));
+  ASSERT_NE(early.checkpoint, nullptr);
+  EarlyStop resume;
+  resume.resume_from = early.checkpoint;
+  std::vector<cv::Point2f> moved = scene.p1;
+  moved[5].x += 1.0f;
+  EXPECT_THROW(EstimateFundamentalMagsac(scene.p0, moved, {}, resume), std::logic_error);
+  VerifierOptions other_seed;
+  other_seed.seed = 1;
+  EXPECT_THROW(EstimateFundamentalMagsac(scene.p0, scene.p1, other_seed, resume), std::logic_error);
+}
+
 // Stopping early changes the answer to "S >= tau?" no more than a change of seed does: on scenes whose
 // inlier ratio lies on both sides of each tau, compare with the exhaustive run.
 TEST(MagsacEarlyStop, DecisionsAgreeWithTheExhaustiveRun) {

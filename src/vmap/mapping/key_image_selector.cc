@@ -42,7 +42,8 @@ PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features
 }
 
 PairComparison VerifyMatches(const TentativeMatches& matches, int denominator, const VerifierOptions& verifier,
-                             const std::vector<double>& decide_taus, const std::function<bool()>& abandon) {
+                             const std::vector<double>& decide_taus, const std::function<bool()>& abandon,
+                             std::shared_ptr<const MagsacCheckpoint> resume_from) {
   PairComparison result;
   result.num_tentative = static_cast<int>(matches.size());
   // S >= tau  <=>  verified >= the least count v with v / denominator >= tau (in the arithmetic Passes uses).
@@ -57,6 +58,7 @@ PairComparison VerifyMatches(const TentativeMatches& matches, int denominator, c
     }
   }
   early_stop.abandon = abandon;
+  early_stop.resume_from = std::move(resume_from);
   const FundamentalResult fundamental = EstimateFundamental(matches.points0, matches.points1, verifier, early_stop);
   if (fundamental.abandoned) {
     result.abandoned = true;
@@ -87,6 +89,7 @@ PairComparison VerifyMatches(const TentativeMatches& matches, int denominator, c
   }
   if (stops_early) {
     result.exhaustive = false;
+    result.checkpoint = fundamental.checkpoint;
     result.decided_taus = decide_taus;
     std::sort(result.decided_taus.begin(), result.decided_taus.end());
     for (double tau : decide_taus) {
@@ -111,11 +114,12 @@ Link MakeLink(const PairComparison& comparison, int from_key, int to_key, bool b
 }
 
 KeyImageSelector::KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image,
-                                   EvaluationFn on_evaluation)
+                                   EvaluationFn on_evaluation, LinkFn on_link)
     : options_(options),
       compare_(std::move(compare)),
       on_key_image_(std::move(on_key_image)),
-      on_evaluation_(std::move(on_evaluation)) {
+      on_evaluation_(std::move(on_evaluation)),
+      on_link_(std::move(on_link)) {
   options_.Check();
 }
 
@@ -150,6 +154,7 @@ void KeyImageSelector::AddKeyImage(const FrameRecord& record, const std::string&
 void KeyImageSelector::AddLink(const PairComparison& comparison, bool below_tau) {
   const int to_key = static_cast<int>(key_images_.size()) - 1;
   links_.push_back(MakeLink(comparison, to_key - 1, to_key, below_tau));
+  if (on_link_) on_link_(links_.back(), comparison);
 }
 
 void KeyImageSelector::Add(const FrameRecord& record) {

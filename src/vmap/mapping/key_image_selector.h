@@ -68,6 +68,9 @@ struct PairComparison {
   // S, depends on all of them, not only on the one a caller wants answered.
   std::vector<double> decided_taus;
   bool abandoned = false;          // `abandon` stopped the verification: this answers nothing
+  // When not exhaustive: where verification stopped. VerifyMatches given it back (`resume_from`) goes on from
+  // there instead of starting over, e.g. to verify a link in full.
+  std::shared_ptr<const MagsacCheckpoint> checkpoint;
   bool Decides(double tau) const {
     return exhaustive || (matched && similarity >= tau) || tau >= lowest_failed_tau;
   }
@@ -83,9 +86,12 @@ PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features
                            const std::function<bool()>& abandon = nullptr);
 
 // The verification half of ComparePair, on matches already made: S = verified / `denominator` (|D|).
+// `resume_from`, a checkpoint of an earlier verification of these matches that stopped early, continues that
+// run: without `decide_taus` the result is the full verification's, for the samples not drawn yet.
 PairComparison VerifyMatches(const TentativeMatches& matches, int denominator, const VerifierOptions& verifier,
                              const std::vector<double>& decide_taus = {},
-                             const std::function<bool()>& abandon = nullptr);
+                             const std::function<bool()>& abandon = nullptr,
+                             std::shared_ptr<const MagsacCheckpoint> resume_from = nullptr);
 
 // The link between key images from_key and to_key that `comparison` verified.
 Link MakeLink(const PairComparison& comparison, int from_key, int to_key, bool below_tau);
@@ -99,9 +105,11 @@ class KeyImageSelector {
   // Called with every comparison made (what map.json's evaluations hold). When given, the selector does not
   // keep them (evaluations() stays empty), so that its memory does not grow with the sequence's length.
   using EvaluationFn = std::function<void(const Evaluation& evaluation)>;
+  // Called once for every new link (already in links()), with the comparison it was made from.
+  using LinkFn = std::function<void(const Link& link, const PairComparison& comparison)>;
 
   KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image = nullptr,
-                   EvaluationFn on_evaluation = nullptr);
+                   EvaluationFn on_evaluation = nullptr, LinkFn on_link = nullptr);
 
   // Algorithm 1's successor rule, for those who compare ahead of the selector (MapBuilder's workers): when
   // frame `failing_frame` falls below tau against the key image at `key_frame`, the next key image is the frame
@@ -134,6 +142,7 @@ class KeyImageSelector {
   CompareFn compare_;
   KeyImageFn on_key_image_;
   EvaluationFn on_evaluation_;
+  LinkFn on_link_;
   std::optional<FrameRecord> key_;
   std::optional<FrameRecord> previous_;         // the last frame that passed against the key image
   PairComparison previous_comparison_;          // key vs previous_

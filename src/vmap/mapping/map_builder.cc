@@ -356,7 +356,9 @@ class LinkVerifier {
   explicit LinkVerifier(const VerifierOptions& verifier) : verifier_(verifier) {}
 
   // Queues `link`, between key images `from` and `to`, unless that pair of frames is queued already.
-  void Add(const KeyImage& from, const KeyImage& to, const Link& link, SimilarityMode similarity) {
+  // `checkpoint`, where the comparison that made the link stopped, saves the samples it drew already.
+  void Add(const KeyImage& from, const KeyImage& to, const Link& link, SimilarityMode similarity,
+           std::shared_ptr<const MagsacCheckpoint> checkpoint) {
     const auto pair = std::make_pair(from.frame_index, to.frame_index);
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -370,8 +372,8 @@ class LinkVerifier {
     const int denominator = similarity == SimilarityMode::kInlierRatio
                                 ? link.num_tentative
                                 : std::max(from.num_features, to.num_features);
-    worker_.Post([this, pair, matches = std::move(matches), denominator] {
-      PairComparison verified = VerifyMatches(matches, denominator, verifier_);
+    worker_.Post([this, pair, matches = std::move(matches), denominator, checkpoint = std::move(checkpoint)] {
+      PairComparison verified = VerifyMatches(matches, denominator, verifier_, {}, nullptr, checkpoint);
       std::lock_guard<std::mutex> lock(mutex_);
       results_[pair] = std::move(verified);
     });
@@ -565,12 +567,18 @@ class MapBuilder::Impl {
         };
         on_evaluation = [writer](const Evaluation& evaluation) { writer->AddEvaluation(evaluation); };
       }
+      // Links keep a full estimation when the decisions stopped early; queued as soon as each link is made.
+      KeyImageSelector::LinkFn on_link = [this, i](const Link& link, const PairComparison& comparison) {
+        if (!link_verifier_) return;
+        const std::vector<KeyImage>& keys = selectors_[i]->key_images();
+        link_verifier_->Add(keys[link.from_key], keys[link.to_key], link, options_.key_images.similarity,
+                            comparison.checkpoint);
+      };
       selectors_.push_back(std::make_unique<KeyImageSelector>(key_options, CompareFor(taus_[i]),
-                                                              std::move(on_key_image), std::move(on_evaluation)));
+                                                              std::move(on_key_image), std::move(on_evaluation),
+                                                              std::move(on_link)));
     }
-    // Links keep a full estimation when the decisions stopped early; queued as soon as each link is made.
     if (stops_early_) link_verifier_ = std::make_unique<LinkVerifier>(VerifierOptions(verifier_));
-    links_queued_.assign(selectors_.size(), 0);
     link_analyses_.resize(selectors_.size());
     pipeline_ = std::make_unique<FeaturePipeline>(matcher, options_.prefetch_frames, options_.ExtractionThreads(),
                                                   compare_pair_, sorted_taus_);
@@ -610,7 +618,6 @@ class MapBuilder::Impl {
     features_extracted_ = pipeline_->extracted();
     pipeline_.reset();
     for (auto& selector : selectors_) selector->Finish();  // the final key images
-    QueueNewLinks();
     long evaluations = 0;
     for (const auto& selector : selectors_) evaluations += static_cast<long>(selector->evaluations().size());
     for (MapWriter* writer : writers_) evaluations += writer ? writer->num_evaluations() : 0;
@@ -660,7 +667,6 @@ class MapBuilder::Impl {
     comparisons_of_frame_ = &item.comparisons;
     for (auto& selector : selectors_) selector->Add(item.record);
     comparisons_of_frame_ = nullptr;
-    QueueNewLinks();
     // Tell the workers which key images the coming frames will be compared with (a handful of shared pointers:
     // cheaper to publish every frame than to track changes).
     std::map<int, CurrentKey> keys;  // by key frame index
@@ -678,18 +684,6 @@ class MapBuilder::Impl {
     }
     pipeline_->SetCurrentKeys(std::move(current));
     progress_.Update(++frames_done_);
-  }
-
-  void QueueNewLinks() {
-    if (!link_verifier_) return;
-    for (size_t i = 0; i < selectors_.size(); ++i) {
-      const KeyImageSelector& selector = *selectors_[i];
-      for (; links_queued_[i] < selector.links().size(); ++links_queued_[i]) {
-        const Link& link = selector.links()[links_queued_[i]];
-        link_verifier_->Add(selector.key_images()[link.from_key], selector.key_images()[link.to_key], link,
-                            options_.key_images.similarity);
-      }
-    }
   }
 
   Coverage CurrentCoverage(CoverageEnd end) const {
@@ -718,7 +712,6 @@ class MapBuilder::Impl {
   std::vector<std::unique_ptr<KeyImageSelector>> selectors_;
   std::vector<LinkAnalysisCache> link_analyses_;  // per selector: what snapshots analysed stays analysed
   std::unique_ptr<LinkVerifier> link_verifier_;
-  std::vector<size_t> links_queued_;
   long frames_done_ = 0;
   int first_source_index_ = -1;
   int last_source_index_ = -1;
@@ -958,8 +951,10 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
   selector.Finish();
   if (link_verifier) {
     for (const Link& link : selector.links()) {
-      link_verifier->Add(selector.key_images()[link.from_key], selector.key_images()[link.to_key], link,
-                         options.key_images.similarity);
+      const KeyImage& from = selector.key_images()[link.from_key];
+      const KeyImage& to = selector.key_images()[link.to_key];
+      link_verifier->Add(from, to, link, options.key_images.similarity,
+                         comparisons.at({from.frame_index, to.frame_index}).checkpoint);
     }
     link_verifier->Finish();
   }
