@@ -121,6 +121,12 @@ void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& op
   option_flags
       .AddOption(command, "--seed", flags.options.seed, "verifier.seed", "Verifier random seed (same seed, same map)")
       ->capture_default_str();
+  option_flags
+      .AddOption(command, "--max-samples-to-reject", flags.options.max_samples_to_reject,
+                 "verifier.max_samples_to_reject",
+                 "Samples after which S < tau is settled when decisions stop early (--max-iters or more: the "
+                 "confidence criterion alone; ignored with --exhaustive)")
+      ->capture_default_str();
 }
 
 FrameSourceOptions SourceFlags::Resolve() const {

@@ -27,6 +27,10 @@ void VerifierOptions::Check() const {
   }
   if (seed < 0) throw OptionError("seed", "must be >= 0 (default 0)");
   if (min_matches < 8) throw OptionError("min_matches", "must be >= 8: the 8-point algorithm needs 8 matches");
+  if (max_samples_to_reject < 1 || max_samples_to_reject > 10000000) {
+    throw OptionError("max_samples_to_reject",
+                      "must be 1 to 10000000 (default 10000; max_iterations or more keeps the confidence criterion)");
+  }
 }
 
 FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0,
@@ -102,7 +106,8 @@ double SampsonDistance(const cv::Matx33d& F, const cv::Point2f& p0, const cv::Po
 nlohmann::json ToJson(const VerifierOptions& options) {
   return {{"method", VerifierMethodName(options.method)}, {"threshold", options.threshold},
           {"confidence", options.confidence},             {"max_iterations", options.max_iterations},
-          {"seed", options.seed},                         {"min_matches", options.min_matches}};
+          {"seed", options.seed},                         {"min_matches", options.min_matches},
+          {"max_samples_to_reject", options.max_samples_to_reject}};
 }
 
 void FromJson(const JsonFieldReader& fields, VerifierOptions* options) {
@@ -112,6 +117,7 @@ void FromJson(const JsonFieldReader& fields, VerifierOptions* options) {
   fields.Read("max_iterations", &options->max_iterations);
   fields.Read("seed", &options->seed);
   fields.Read("min_matches", &options->min_matches);
+  fields.Read("max_samples_to_reject", &options->max_samples_to_reject);
 }
 
 }  // namespace vmap

@@ -133,6 +133,9 @@ TEST(Fundamental, OptionsAndNamesAreChecked) {
   options = {};
   options.max_iterations = 0;
   EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "max_iterations");
+  options = {};
+  options.max_samples_to_reject = 0;
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "max_samples_to_reject");
   for (const char* name : {"magsac", "ransac", "usac", "accurate"}) {
     EXPECT_EQ(VerifierMethodName(ParseVerifierMethod(name)), name);
   }

@@ -225,8 +225,8 @@ class Estimator {
     abandon_ = early_stop.abandon;
     resume_from_ = early_stop.resume_from;
     for (int target : early_stop.min_inliers) {
-      targets_.push_back({target, SamplesToSettle(static_cast<double>(target) / n_, options.confidence,
-                                                  options.max_iterations)});
+      const int needed = SamplesToSettle(static_cast<double>(target) / n_, options.confidence, options.max_iterations);
+      targets_.push_back({target, std::min(needed, options.max_samples_to_reject)});
     }
   }
 

@@ -38,8 +38,8 @@ struct MagsacStatistics {
 
 // Estimates F (x1^T F x0 = 0) with the options' threshold, confidence, max_iterations, seed and min_matches
 // (options.method is not read). With `early_stop`, the loop ends as soon as, for every target t, either a model
-// with at least t inliers was found or SamplesToSettle(t / n, ...) samples were drawn; the run without targets
-// goes on from there with the same samples. Deterministic: the same correspondences (in any order) and seed
+// with at least t inliers was found or min(SamplesToSettle(t / n, ...), options.max_samples_to_reject) samples
+// were drawn; the run without targets goes on from there with the same samples. Deterministic: the same correspondences (in any order) and seed
 // give the same result.
 FundamentalResult EstimateFundamentalMagsac(const std::vector<cv::Point2f>& points0,
                                             const std::vector<cv::Point2f>& points1, const VerifierOptions& options,

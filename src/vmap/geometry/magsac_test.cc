@@ -263,6 +263,26 @@ TEST(MagsacEarlyStop, FailsAfterTheSamplesTheTargetNeeds) {
   EXPECT_EQ(two_stats.iterations, stats.iterations);
 }
 
+// A target far above the pair's inlier ratio is rejected after max_samples_to_reject samples when the confidence
+// criterion would draw more; set to max_iterations, the criterion alone decides.
+TEST(MagsacEarlyStop, RejectsAfterAtMostMaxSamplesToReject) {
+  const Scene scene = MakeScene(60, 240, 0.2, 13);  // 20 % inliers
+  const int n = static_cast<int>(scene.p0.size());
+  const int target = AtLeast(0.3, n);
+  VerifierOptions options;
+  options.max_samples_to_reject = 2000;
+  MagsacStatistics capped, criterion;
+  const FundamentalResult result = EstimateFundamentalMagsac(scene.p0, scene.p1, options, Targets({target}), &capped);
+  EXPECT_LT(result.num_inliers, target);
+  EXPECT_TRUE(capped.stopped_early);
+  EXPECT_EQ(capped.iterations, 2000);
+
+  options.max_samples_to_reject = options.max_iterations;
+  EstimateFundamentalMagsac(scene.p0, scene.p1, options, Targets({target}), &criterion);
+  EXPECT_EQ(criterion.iterations, SamplesToSettle(static_cast<double>(target) / n, 0.999, 100000));
+  EXPECT_GT(criterion.iterations, 30000);
+}
+
 // Targets no model can reach (more inliers than points) are settled before any sample is drawn.
 TEST(MagsacEarlyStop, ImpossibleTargetsNeedNoSample) {
   const Scene scene = MakeScene(100, 0, 0.0, 12);

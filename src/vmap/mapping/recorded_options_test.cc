@@ -28,6 +28,7 @@ RecordedOptions Unusual() {
   builder.verifier.max_iterations = 5000;
   builder.verifier.seed = 7;
   builder.verifier.min_matches = 12;
+  builder.verifier.max_samples_to_reject = 2500;
   builder.quality_mean = QualityMean::kHarmonic;
   builder.exhaustive = true;
   builder.key_search = KeySearch::kSequential;
@@ -67,6 +68,7 @@ TEST(RecordedOptions, EveryRecordedFieldReadsBackAsWritten) {
   EXPECT_EQ(b.verifier.max_iterations, a.verifier.max_iterations);
   EXPECT_EQ(b.verifier.seed, a.verifier.seed);
   EXPECT_EQ(b.verifier.min_matches, a.verifier.min_matches);
+  EXPECT_EQ(b.verifier.max_samples_to_reject, a.verifier.max_samples_to_reject);
   EXPECT_EQ(b.quality_mean, a.quality_mean);
   EXPECT_EQ(b.exhaustive, a.exhaustive);
   EXPECT_EQ(b.key_search, a.key_search);
