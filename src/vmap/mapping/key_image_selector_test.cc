@@ -31,21 +31,34 @@ struct SelectionRun {
   std::vector<std::pair<int, int>> evaluated;
 };
 
+// What the selector's LinkFn was told: the link's end and the S of the comparison it came with.
+struct ReportedLink {
+  int to_key;
+  double comparison_similarity;
+};
+
 SelectionRun Select(int n, double tau, const std::function<double(int, int)>& similarity, bool final_key = true) {
   SelectionRun run;
   KeyImageOptions options;
   options.tau = tau;
   options.final_key = final_key;
-  KeyImageSelector selector(options, [&](const FrameRecord& key, const FrameRecord& frame) {
-    PairComparison c;
-    const double s = similarity(key.frame->index, frame.frame->index);
-    run.evaluated.emplace_back(key.frame->index, frame.frame->index);
-    c.matched = s >= 0;
-    c.similarity = c.matched ? s : 0.0;
-    c.num_tentative = 100;
-    c.num_verified = c.matched ? static_cast<int>(s * 100) : 0;
-    return c;
-  });
+  std::vector<ReportedLink> reported;
+  KeyImageSelector selector(
+      options,
+      [&](const FrameRecord& key, const FrameRecord& frame) {
+        PairComparison c;
+        const double s = similarity(key.frame->index, frame.frame->index);
+        run.evaluated.emplace_back(key.frame->index, frame.frame->index);
+        c.matched = s >= 0;
+        c.similarity = c.matched ? s : 0.0;
+        c.num_tentative = 100;
+        c.num_verified = c.matched ? static_cast<int>(s * 100) : 0;
+        return c;
+      },
+      nullptr, nullptr,
+      [&](const Link& link, const PairComparison& comparison) {
+        reported.push_back({link.to_key, comparison.similarity});
+      });
   for (int i = 0; i < n; ++i) selector.Add(Record(i));
   selector.Finish();
   for (const KeyImage& k : selector.key_images()) run.keys.push_back(k.frame_index);
@@ -53,6 +66,12 @@ SelectionRun Select(int n, double tau, const std::function<double(int, int)>& si
     run.link_similarities.push_back(l.similarity);
     run.below_tau.push_back(l.below_tau);
     EXPECT_EQ(l.to_key, l.from_key + 1);
+  }
+  // Every link was reported once, as it was made, with the comparison it was made from.
+  EXPECT_EQ(reported.size(), selector.links().size());
+  for (size_t i = 0; i < reported.size() && i < selector.links().size(); ++i) {
+    EXPECT_EQ(reported[i].to_key, static_cast<int>(i) + 1);
+    EXPECT_EQ(reported[i].comparison_similarity, selector.links()[i].similarity);
   }
   EXPECT_EQ(selector.evaluations().size(), run.evaluated.size());
   EXPECT_EQ(selector.num_frames(), n);
