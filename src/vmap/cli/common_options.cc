@@ -104,7 +104,8 @@ VerifierOptions VerifierFlags::Resolve() const {
   return resolved;
 }
 
-void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& option_flags) {
+void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& option_flags,
+                        bool with_early_stop) {
   option_flags.AddEnumOption(command, "--verifier", flags.options.method, ParseVerifierMethod, VerifierMethodName,
                              "verifier.method", "Fundamental matrix estimator: " + ListEnumNames(kVerifierMethodNames));
   option_flags
@@ -121,6 +122,7 @@ void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& op
   option_flags
       .AddOption(command, "--seed", flags.options.seed, "verifier.seed", "Verifier random seed (same seed, same map)")
       ->capture_default_str();
+  if (!with_early_stop) return;
   option_flags
       .AddOption(command, "--max-samples-to-reject", flags.options.max_samples_to_reject,
                  "verifier.max_samples_to_reject",

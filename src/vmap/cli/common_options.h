@@ -18,13 +18,14 @@ namespace vmap::cli {
 // MatcherOptions::Check() names them ("orb.num_features").
 void AddMatcherOptions(CLI::App* command, MatcherOptions& options, OptionFlags& option_flags);
 
-// --verifier, --threshold, --confidence, --max-iters, --seed; fields as "verifier.<field>" (MapBuilderOptions,
-// LocalizerOptions).
+// --verifier, --threshold, --confidence, --max-iters, --seed and, for the commands whose decisions stop early
+// (build, sweep), --max-samples-to-reject; fields as "verifier.<field>" (MapBuilderOptions, LocalizerOptions).
 struct VerifierFlags {
   VerifierOptions options;
   VerifierOptions Resolve() const;  // checks the options as the field "verifier"
 };
-void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& option_flags);
+void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& option_flags,
+                        bool with_early_stop = true);
 
 // --format, --first, --last, --stride, --resize, --strict, --camera, --stream-timeout; fields as FrameSourceOptions names them.
 struct SourceFlags {

@@ -152,7 +152,7 @@ void AddMatchCommand(CLI::App& app) {
   command->add_option("--json", flags->json_path, "Also write every match, the inlier mask and F to this JSON file");
   command->add_flag("--list", flags->list, "Print every match: x0 y0 x1 y1 score inlier");
   AddMatcherOptions(command, flags->matcher, flags->option_flags);
-  AddVerifierOptions(command, flags->verifier, flags->option_flags);
+  AddVerifierOptions(command, flags->verifier, flags->option_flags, /*with_early_stop=*/false);  // one exhaustive pair
   command->callback([flags] { flags->option_flags.Run([&] { RunMatch(*flags); }); });
 }
 

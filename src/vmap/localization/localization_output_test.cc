@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -40,8 +41,10 @@ LocalizationRun SampleRun() {
   tracked.status = LocalizationStatus::kRelocalized;
   tracked.key = 0;
   tracked.next_key = 1;
-  tracked.to_key = {0, true, true, 0.75, 200, 150, cv::Matx33d::zeros(), 1.5};
-  tracked.to_next = {1, true, true, 0.5, 100, 50, cv::Matx33d(1, 2, 3, 4, 5, 6, 7, 8, 9), -2.0};
+  const double no_bearing = std::numeric_limits<double>::quiet_NaN();
+  tracked.to_key = {0, true, true, 0.75, 200, 150, cv::Matx33d::zeros(), 1.5, no_bearing, RelativePose{}};
+  tracked.to_next = {1, true, true, 0.5, 100, 50, cv::Matx33d(1, 2, 3, 4, 5, 6, 7, 8, 9), -2.0, no_bearing,
+                     RelativePose{}};
   tracked.heading_px = -2.0;
   tracked.heading_deg = -0.25;
   tracked.to_next.pose.valid = true;
