@@ -35,7 +35,7 @@ struct VerifierOptions {
   bool own_magsac = false;
   // Own MAGSAC++ stopping early only: "fewer inliers than the target" is settled after at most this many
   // samples, where the confidence criterion for the target's inlier ratio would draw more (31,600 at 0.3, the
-  // 100,000 cap below 0.25). The criterion counts only all-inlier samples; local optimisation also recovers the
+  // 100,000 cap at 0.25 and below). The criterion counts only all-inlier samples; local optimisation also recovers the
   // model from samples with an outlier or two, so far fewer samples find it. Measured on rccar_room's sweep
   // (README, "Threshold sweeps"): 10,000 cut the sweep's CPU by 18 % and flipped about as many of the exhaustive
   // run's decisions as a change of seed does. max_iterations keeps the confidence criterion alone.

@@ -168,7 +168,6 @@ int SolveCubic(double c3, double c2, double c1, double c0, double* roots) {
   return count;
 }
 
-// One robust estimation; every member is scratch space reused across the loop.
 }  // namespace
 
 // Everything the sample loop carries from one sample to the next, as it was when the loop stopped early, and
@@ -191,6 +190,7 @@ struct MagsacCheckpoint {
 
 namespace {
 
+// One robust estimation; every member is scratch space reused across the loop.
 class Estimator {
  public:
   Estimator(const std::vector<cv::Point2f>& points0, const std::vector<cv::Point2f>& points1,
@@ -262,6 +262,11 @@ class Estimator {
                            Score* recovered_score);
   void UpdateSprt();
   bool Settled(int iterations) const;
+  // Samples the confidence criterion asks for, given the best model's inliers.
+  int SamplesForBestModel() const {
+    return SamplesToSettle(static_cast<double>(best_score_.inliers) / n_, options_.confidence,
+                           options_.max_iterations);
+  }
   bool PassesAllSettledTargets(int inliers) const;
 
   const VerifierOptions& options_;
@@ -827,17 +832,13 @@ FundamentalResult Estimator::Run(MagsacStatistics* statistics) {
     best_score_ = score;
     have_best_ = true;
     UpdateSprt();
-    max_iterations = SamplesToSettle(static_cast<double>(score.inliers) / n_, options_.confidence,
-                                     options_.max_iterations);
+    max_iterations = SamplesForBestModel();
   };
 
   int iterations = 0;
   if (resume_from_) {
     Resume(*resume_from_, &iterations, &local_optimization_ran);
-    if (have_best_) {
-      max_iterations = SamplesToSettle(static_cast<double>(best_score_.inliers) / n_, options_.confidence,
-                                       options_.max_iterations);
-    }
+    if (have_best_) max_iterations = SamplesForBestModel();
   }
   for (; iterations < max_iterations; ++iterations) {
     if (Settled(iterations)) {

@@ -349,8 +349,9 @@ class FeaturePipeline {
 };
 
 // Verifies links in full, on a thread of its own while the build goes on, when the decisions stopped early:
-// the tables are then computed from exact link values. The estimator runs again on the link's own tentative
-// matches (no matching, no features kept). A link shared by several taus (same two frames) is verified once.
+// the tables are then computed from exact link values. The estimation goes on from where the deciding
+// comparison stopped, on the link's own tentative matches (no matching, no features kept). A link shared by
+// several taus (same two frames) is verified once.
 class LinkVerifier {
  public:
   explicit LinkVerifier(const VerifierOptions& verifier) : verifier_(verifier) {}
