@@ -1,5 +1,8 @@
 #include "vmap/localization/localization_map.h"
 
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
 #include "vmap/features/matcher_registry.h"
 #include "vmap/features/matcher_options_json.h"
 #include "vmap/map/map_io.h"
@@ -23,6 +26,25 @@ LocalizerOptions MapLocalizerOptions(const VisualMap& map) {
   options.verifier = MapVerifierOptions(map);
   options.similarity = MapSimilarityMode(map);
   options.camera = map.input.camera;
+  return options;
+}
+
+std::string QueryResize(const VisualMap& map, const std::string& resize) {
+  if (!resize.empty() || map.input.frame_size.empty()) return resize;
+  return fmt::format("{}x{}", map.input.frame_size.width, map.input.frame_size.height);
+}
+
+LocalizerOptions FollowMap(const VisualMap& map, LocalizerOptions options, const std::string& query_resize) {
+  const LocalizerOptions from_map = MapLocalizerOptions(map);
+  options.verifier = from_map.verifier;
+  options.similarity = from_map.similarity;
+  const std::string map_size = QueryResize(map, "");
+  if (from_map.camera && query_resize == map_size) {
+    options.camera = from_map.camera;
+  } else if (from_map.camera) {
+    spdlog::warn("--resize {} differs from the map's frame size {}: headings in pixels only, no relative poses",
+                 query_resize, map_size);
+  }
   return options;
 }
 

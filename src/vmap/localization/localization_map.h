@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <string>
 
 #include "vmap/features/matcher.h"
 #include "vmap/localization/key_image_store.h"
@@ -26,5 +27,14 @@ LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, cons
 // Localizer options that follow the map: its verifier (iterations capped, see MapVerifierOptions) and its
 // definition of S; the rest are LocalizerOptions' defaults.
 LocalizerOptions MapLocalizerOptions(const VisualMap& map);
+
+// The size frames are localized at: `resize` when given, otherwise the map's frame size as "WxH" (key images
+// and frames are compared at one size; "" for a map that records none).
+std::string QueryResize(const VisualMap& map, const std::string& resize);
+
+// `options` made to follow the map (MapLocalizerOptions): its verifier and definition of S, and its camera when
+// the frames are localized at the map's frame size (`query_resize`, QueryResize's), since the camera describes
+// frames of that size; otherwise headings stay in pixels, without relative poses (a warning says so).
+LocalizerOptions FollowMap(const VisualMap& map, LocalizerOptions options, const std::string& query_resize);
 
 }  // namespace vmap

@@ -107,6 +107,42 @@ std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r
   return row + "\n";
 }
 
+nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationResult& r) {
+  json F = nullptr;
+  if (r.to_next.matched) {
+    F = json::array();
+    for (int i = 0; i < 9; ++i) F.push_back(r.to_next.F(i / 3, i % 3));
+  }
+  json candidates = json::array();
+  for (const RelocalizationCandidate& c : r.candidates) {
+    candidates.push_back({{"key", c.key}, {"score", c.score}, {"accepted", c.accepted},
+                          {"similarity", c.similarity}, {"verified", c.num_verified}});
+  }
+  return {{"frame", r.frame_index},
+          {"source_index", r.source_index},
+          {"timestamp", r.timestamp >= 0 ? json(r.timestamp) : json(nullptr)},
+          {"source_name", r.source_name},
+          {"status", LocalizationStatusName(r.status)},
+          {"key", r.key},
+          {"next_key", r.next_key},
+          {"key_frame", KeyFrame(map, r.key)},
+          {"next_key_frame", KeyFrame(map, r.next_key)},
+          {"similarity", r.to_key.key >= 0 ? Number(r.to_key.similarity) : json(nullptr)},
+          {"verified", r.to_key.num_verified},
+          {"tentative", r.to_key.num_tentative},
+          {"next_similarity", r.to_next.key >= 0 ? Number(r.to_next.similarity) : json(nullptr)},
+          {"next_verified", r.to_next.num_verified},
+          {"next_tentative", r.to_next.num_tentative},
+          {"heading_px", Number(r.heading_px)},
+          {"heading_deg", Number(r.heading_deg)},
+          {"pose", PoseJson(TargetPose(r))},
+          {"progress", Number(r.progress)},
+          {"F", F},
+          {"candidates", candidates},
+          {"comparisons", r.comparisons},
+          {"seconds", r.seconds}};
+}
+
 std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run) {
   const LocalizationRunInfo& info = run.info;
   const LocalizationSummary& s = run.summary;
@@ -145,41 +181,7 @@ std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run
                     {"mean_extract_seconds", s.mean_extract_seconds},
                     {"comparisons", s.comparisons}};
   json frames = json::array();
-  for (const LocalizationResult& r : run.frames) {
-    json F = nullptr;
-    if (r.to_next.matched) {
-      F = json::array();
-      for (int i = 0; i < 9; ++i) F.push_back(r.to_next.F(i / 3, i % 3));
-    }
-    json candidates = json::array();
-    for (const RelocalizationCandidate& c : r.candidates) {
-      candidates.push_back({{"key", c.key}, {"score", c.score}, {"accepted", c.accepted},
-                            {"similarity", c.similarity}, {"verified", c.num_verified}});
-    }
-    frames.push_back({{"frame", r.frame_index},
-                      {"source_index", r.source_index},
-                      {"timestamp", r.timestamp >= 0 ? json(r.timestamp) : json(nullptr)},
-                      {"source_name", r.source_name},
-                      {"status", LocalizationStatusName(r.status)},
-                      {"key", r.key},
-                      {"next_key", r.next_key},
-                      {"key_frame", KeyFrame(map, r.key)},
-                      {"next_key_frame", KeyFrame(map, r.next_key)},
-                      {"similarity", r.to_key.key >= 0 ? Number(r.to_key.similarity) : json(nullptr)},
-                      {"verified", r.to_key.num_verified},
-                      {"tentative", r.to_key.num_tentative},
-                      {"next_similarity", r.to_next.key >= 0 ? Number(r.to_next.similarity) : json(nullptr)},
-                      {"next_verified", r.to_next.num_verified},
-                      {"next_tentative", r.to_next.num_tentative},
-                      {"heading_px", Number(r.heading_px)},
-                      {"heading_deg", Number(r.heading_deg)},
-                      {"pose", PoseJson(TargetPose(r))},
-                      {"progress", Number(r.progress)},
-                      {"F", F},
-                      {"candidates", candidates},
-                      {"comparisons", r.comparisons},
-                      {"seconds", r.seconds}});
-  }
+  for (const LocalizationResult& r : run.frames) frames.push_back(LocalizationFrameJson(map, r));
   doc["frames"] = std::move(frames);
   return doc.dump(1) + "\n";
 }

@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/localization/localizer.h"
 #include "vmap/map/visual_map.h"
@@ -49,6 +51,10 @@ std::string DescribeLocalizerOptions(const LocalizerOptions& options);
 std::string LocalizationCsvHeader();
 // One CSV row (with the newline) for `result`, localized against `map`.
 std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& result);
+
+// One frame of a run as the JSON lists it (the CSV's columns, with F and the pose as lists); the Python module
+// gives its results these names.
+nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationResult& result);
 
 // The JSON document of a run (frames listed in order).
 std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run);

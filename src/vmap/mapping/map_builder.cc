@@ -770,7 +770,10 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
   // build took longer, side by side).
   ReadAheadSource frames(source, options.prefetch_frames);
   MapBuilder builder(frames, matcher, options, taus, sinks, options_json);
-  while (std::optional<Frame> frame = frames.Next()) builder.Add(std::move(*frame));
+  while (std::optional<Frame> frame = frames.Next()) {
+    builder.Add(std::move(*frame));
+    if (options.after_frame) options.after_frame();
+  }
   std::vector<VisualMap> built = builder.FinishAll(CoverageEnd::kInputEnded, analyze_links, /*with_evaluations=*/true);
 
   SweepResult result;
@@ -839,6 +842,7 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
       record.frame = std::make_shared<const Frame>(std::move(*frame));
       frames.emplace(frames_read++, std::move(record));
       progress.Update(frames_read);
+      if (options.after_frame) options.after_frame();
     }
     return std::min(index, frames_read - 1);
   };

@@ -4,6 +4,7 @@
 // and the batch calls over it (BuildMap, SweepThresholds).
 
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -52,6 +53,10 @@ struct MapBuilderOptions {
   // kBisect: frames held at most (the furthest a comparison looks ahead); memory grows with it, comparisons
   // fall slowly as it grows.
   int search_window = 32;
+  // BuildMap and SweepThresholds call it on the calling thread after each frame they read: a host polls for
+  // its own interruption there (the Python module checks for Ctrl-C) and throws to abandon the build, which
+  // then writes nothing more. Not recorded, like the other settings of how a run is carried out.
+  std::function<void()> after_frame;
 
   int ExtractionThreads() const;
 

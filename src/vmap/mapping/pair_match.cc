@@ -1,0 +1,35 @@
+#include "vmap/mapping/pair_match.h"
+
+#include <chrono>
+
+namespace vmap {
+
+namespace {
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+PairMatch MatchPair(const Matcher& matcher, const cv::Mat& gray0, const cv::Mat& gray1,
+                    const VerifierOptions& verifier) {
+  PairMatch pair;
+  auto start = std::chrono::steady_clock::now();
+  const auto features0 = matcher.Extract(gray0);
+  const auto features1 = matcher.Extract(gray1);
+  pair.extract_seconds = SecondsSince(start);
+  start = std::chrono::steady_clock::now();
+  pair.matches = matcher.Match(*features0, *features1);
+  pair.match_seconds = SecondsSince(start);
+  start = std::chrono::steady_clock::now();
+  if (static_cast<int>(pair.matches.size()) >= verifier.min_matches) {
+    pair.fundamental = EstimateFundamental(pair.matches.points0, pair.matches.points1, verifier);
+  }
+  pair.verify_seconds = SecondsSince(start);
+  pair.similarity =
+      pair.matches.size() == 0 ? 0.0 : double(pair.fundamental.num_inliers) / double(pair.matches.size());
+  return pair;
+}
+
+}  // namespace vmap

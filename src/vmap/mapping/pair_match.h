@@ -1,0 +1,27 @@
+#pragma once
+// One image pair through a matcher and the verifier, in full: what `vmap match` and the Python module's
+// vmap.match show to try a matcher on one's own images.
+
+#include <opencv2/core.hpp>
+
+#include "vmap/features/matcher.h"
+#include "vmap/geometry/fundamental.h"
+
+namespace vmap {
+
+struct PairMatch {
+  TentativeMatches matches;       // in the matcher's order
+  FundamentalResult fundamental;  // its inlier_mask is one per match; !success below min_matches
+  double similarity = 0.0;        // S = verified / tentative (0 without matches)
+  // Wall time of each step, seconds: both images' extraction, matching, verification.
+  double extract_seconds = 0.0;
+  double match_seconds = 0.0;
+  double verify_seconds = 0.0;
+};
+
+// Extracts both images' features (`gray0`, `gray1`: 8-bit grey), matches them, and verifies the matches
+// exhaustively with `verifier` when there are at least verifier.min_matches of them.
+PairMatch MatchPair(const Matcher& matcher, const cv::Mat& gray0, const cv::Mat& gray1,
+                    const VerifierOptions& verifier);
+
+}  // namespace vmap
