@@ -11,6 +11,7 @@
 
 #include "vmap/cli/commands.h"
 #include "vmap/cli/common_options.h"
+#include "vmap/cli/localize_options.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
 #include "vmap/localization/localization_map.h"
@@ -25,18 +26,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct LocalizeFlags {
+struct LocalizeFlags : LocalizerFlags {
   std::string map;
   std::string query;
   std::string csv;
   std::string json;
   std::string report;
   SourceFlags source;
-  LocalizerOptions localizer;
-  int from = -1;
-  int to = -1;
-  int threads = 0;
-  bool cache = true;
   OptionFlags option_flags;
 };
 
@@ -61,8 +57,7 @@ void RunLocalize(const LocalizeFlags& flags) {
     options.route = PlanRoute(header, flags.from >= 0 ? flags.from : 0, flags.to >= 0 ? flags.to : last).keys;
   }
   // Frames are compared with key images at the map's size unless told otherwise.
-  const std::string map_size = fmt::format("{}x{}", header.input.frame_size.width, header.input.frame_size.height);
-  if (source_options.resize.empty() && !header.input.frame_size.empty()) source_options.resize = map_size;
+  source_options.resize = QueryResize(header, source_options.resize);
   const std::unique_ptr<FrameSource> source = OpenFrameSource(flags.query, source_options);
 
   KeyImageStoreOptions store_options;
@@ -70,17 +65,8 @@ void RunLocalize(const LocalizeFlags& flags) {
   store_options.thumbnail_width = options.ranking.thumbnail_width;
   LocalizationMap opened = OpenLocalizationMap(flags.map, store_options);
   const VisualMap& map = opened.map;
-  // The map's verifier and definition of S.
-  const LocalizerOptions from_map = MapLocalizerOptions(map);
-  options.verifier = from_map.verifier;
-  options.similarity = from_map.similarity;
-  // The map's camera describes frames of the map's size: headings in degrees and poses need the query at it.
-  if (from_map.camera && source_options.resize == map_size) {
-    options.camera = from_map.camera;
-  } else if (from_map.camera) {
-    spdlog::warn("--resize {} differs from the map's frame size {}: headings in pixels only, no relative poses",
-                 source_options.resize, map_size);
-  }
+  // The map's verifier, definition of S and camera.
+  options = FollowMap(map, options, source_options.resize);
   options.Check();
   Localizer localizer(map, opened.keys, *opened.matcher, options);
 
@@ -141,39 +127,7 @@ void AddLocalizeCommand(CLI::App& app) {
   command->add_option("--report", flags->report, "Write an HTML report of the run into this directory");
   OptionFlags& option_flags = flags->option_flags;
   AddSourceOptions(command, flags->source, option_flags);
-  LocalizerOptions& o = flags->localizer;
-  option_flags
-      .AddOption(command, "--min-verified", o.min_verified, "min_verified",
-                 "Verified matches a frame needs to be localized at a key image")
-      ->capture_default_str();
-  option_flags
-      .AddOption(command, "--min-similarity", o.min_similarity, "min_similarity",
-                 "S a frame needs to be localized at a key image")
-      ->capture_default_str();
-  option_flags
-      .AddOption(command, "--max-lost", o.max_lost_frames, "max_lost_frames",
-                 "Lost frames in a row before the estimate is dropped")
-      ->capture_default_str();
-  option_flags
-      .AddOption(command, "--candidates", o.relocalization_candidates, "relocalization_candidates",
-                 "Best-ranked key images verified when relocalizing")
-      ->capture_default_str();
-  option_flags
-      .AddOption(command, "--lookahead", o.lookahead, "lookahead",
-                 "Key images beyond the next compared while tracking (1 or 2)")
-      ->capture_default_str();
-  option_flags.AddFlag(command, "!--no-step-back", o.step_back, "step_back",
-                       "Never move the estimate back to the previous key image");
-  option_flags.AddEnumOption(command, "--ranking", o.ranking.method, ParseRankingMethod, RankingMethodName,
-                             "ranking.method", "Relocalization ranking: " + ListEnumNames(kRankingMethodNames));
-  command->add_option("--from", flags->from, "Follow the route from this key image (default: the first)");
-  command->add_option("--to", flags->to, "Follow the route to this key image (default: the last)");
-  // LocalizeSequenceOptions::extraction_threads (the key-image store's keeps its default).
-  option_flags
-      .AddOption(command, "--threads", flags->threads, "extraction_threads",
-                 "Feature-extraction threads (0 = one per core)")
-      ->capture_default_str();
-  command->add_flag("!--no-cache", flags->cache, "Do not read or write the key-image cache in the map directory");
+  AddLocalizerOptions(command, *flags, option_flags);
   command->callback([flags] { flags->option_flags.Run([&] { RunLocalize(*flags); }); });
 }
 

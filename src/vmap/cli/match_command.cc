@@ -15,6 +15,7 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/core/file_name_encoding.h"
+#include "vmap/mapping/pair_match.h"
 
 namespace vmap::cli {
 
@@ -66,22 +67,12 @@ void RunMatch(const MatchFlags& flags) {
   const std::unique_ptr<Matcher> matcher = CreateMatcher(flags.matcher);
   const double load_s = Seconds(start);
 
-  start = std::chrono::steady_clock::now();
-  const auto features0 = matcher->Extract(gray0);
-  const auto features1 = matcher->Extract(gray1);
-  const double extract_s = Seconds(start);
-  start = std::chrono::steady_clock::now();
-  const TentativeMatches matches = matcher->Match(*features0, *features1);
-  const double match_s = Seconds(start);
-
-  start = std::chrono::steady_clock::now();
-  FundamentalResult fundamental;
-  if (static_cast<int>(matches.size()) >= verifier.min_matches) {
-    fundamental = EstimateFundamental(matches.points0, matches.points1, verifier);
-  }
-  const double verify_s = Seconds(start);
-  const double similarity =
-      matches.size() == 0 ? 0.0 : double(fundamental.num_inliers) / double(matches.size());
+  // Extraction, matching and verification: the library's, as the Python module's vmap.match runs them.
+  const PairMatch pair = MatchPair(*matcher, gray0, gray1, verifier);
+  const TentativeMatches& matches = pair.matches;
+  const FundamentalResult& fundamental = pair.fundamental;
+  const double similarity = pair.similarity;
+  const double extract_s = pair.extract_seconds, match_s = pair.match_seconds, verify_s = pair.verify_seconds;
 
   std::printf("matcher     %s %s\n", matcher->name().c_str(), matcher->DescribeOptionsJson().c_str());
   std::printf("images      %s (%dx%d), %s (%dx%d)\n", flags.image0.c_str(), gray0.cols, gray0.rows,

@@ -1,0 +1,41 @@
+#include "vmap/cli/localize_options.h"
+
+namespace vmap::cli {
+
+void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& option_flags) {
+  LocalizerOptions& o = flags.localizer;
+  option_flags
+      .AddOption(command, "--min-verified", o.min_verified, "min_verified",
+                 "Verified matches a frame needs to be localized at a key image")
+      ->capture_default_str();
+  option_flags
+      .AddOption(command, "--min-similarity", o.min_similarity, "min_similarity",
+                 "S a frame needs to be localized at a key image")
+      ->capture_default_str();
+  option_flags
+      .AddOption(command, "--max-lost", o.max_lost_frames, "max_lost_frames",
+                 "Lost frames in a row before the estimate is dropped")
+      ->capture_default_str();
+  option_flags
+      .AddOption(command, "--candidates", o.relocalization_candidates, "relocalization_candidates",
+                 "Best-ranked key images verified when relocalizing")
+      ->capture_default_str();
+  option_flags
+      .AddOption(command, "--lookahead", o.lookahead, "lookahead",
+                 "Key images beyond the next compared while tracking (1 or 2)")
+      ->capture_default_str();
+  option_flags.AddFlag(command, "!--no-step-back", o.step_back, "step_back",
+                       "Never move the estimate back to the previous key image");
+  option_flags.AddEnumOption(command, "--ranking", o.ranking.method, ParseRankingMethod, RankingMethodName,
+                             "ranking.method", "Relocalization ranking: " + ListEnumNames(kRankingMethodNames));
+  command->add_option("--from", flags.from, "Follow the route from this key image (default: the first)");
+  command->add_option("--to", flags.to, "Follow the route to this key image (default: the last)");
+  // LocalizeSequenceOptions::extraction_threads (the key-image store's keeps its default).
+  option_flags
+      .AddOption(command, "--threads", flags.threads, "extraction_threads",
+                 "Feature-extraction threads (0 = one per core)")
+      ->capture_default_str();
+  command->add_flag("!--no-cache", flags.cache, "Do not read or write the key-image cache in the map directory");
+}
+
+}  // namespace vmap::cli

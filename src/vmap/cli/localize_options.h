@@ -1,0 +1,24 @@
+#pragma once
+// The localizer's options of `vmap localize` (and of the Python module's vmap.Localizer / vmap.localize, which
+// take them by the same names).
+
+#include <CLI/CLI.hpp>
+
+#include "vmap/cli/option_flags.h"
+#include "vmap/localization/localizer.h"
+
+namespace vmap::cli {
+
+struct LocalizerFlags {
+  LocalizerOptions localizer;
+  int from = -1;     // --from: the route's first key image; -1 = the first
+  int to = -1;       // --to: its last; -1 = the last
+  int threads = 0;   // LocalizeSequenceOptions::extraction_threads
+  bool cache = true; // the key-image cache in the map directory
+};
+
+// --min-verified, --min-similarity, --max-lost, --candidates, --lookahead, --no-step-back, --ranking, --from, --to,
+// --threads, --no-cache; fields as LocalizerOptions names them.
+void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& option_flags);
+
+}  // namespace vmap::cli
