@@ -13,6 +13,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev libeigen3-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   ffmpeg                        # only used by tests: videos with a display rotation, live streams on the loopback
+  pybind11-dev python3-numpy python3-pytest  # the Python module (python/, docs/python.md) and its tests
 )
 if [[ "${1:-}" == "--with-browser" ]]; then
   packages+=(chromium)

@@ -1,0 +1,12 @@
+#pragma once
+// The parts of the vmap module, each adding its functions and classes.
+
+#include <pybind11/pybind11.h>
+
+namespace vmap::python {
+
+void BindMapObjects(pybind11::module_& module);     // map_objects.cc: Map, KeyImage, Link, read_map
+void BindBuildAndMatch(pybind11::module_& module);  // build_and_match.cc: build_map, Matcher, match
+void BindLocalization(pybind11::module_& module);   // localization.cc: Localizer, localize
+
+}  // namespace vmap::python

@@ -1,0 +1,58 @@
+#include "numpy_convert.h"
+
+#include <cstring>
+
+#include "vmap/core/error.h"
+
+namespace py = pybind11;
+
+namespace vmap::python {
+
+ImageInput ImageView(const py::object& object, const std::string& what) {
+  if (!py::isinstance<py::array>(object)) {
+    throw InputError(what + " is a " + py::str(py::type::of(object).attr("__name__")).cast<std::string>() +
+                     ", not a numpy array; give a uint8 image (HxW grey or HxWx3 BGR)");
+  }
+  const py::array array = py::reinterpret_borrow<py::array>(object);
+  if (!array.dtype().is(py::dtype::of<std::uint8_t>())) {
+    throw InputError(what + " has dtype " + py::str(array.dtype()).cast<std::string>() +
+                     "; give a uint8 image (HxW grey or HxWx3 BGR), e.g. image.astype(numpy.uint8)");
+  }
+  const int channels = array.ndim() == 3 ? static_cast<int>(array.shape(2)) : 1;
+  if ((array.ndim() != 2 && array.ndim() != 3) || (channels != 1 && channels != 3 && channels != 4)) {
+    throw InputError(what + " has shape " + py::str(object.attr("shape")).cast<std::string>() +
+                     "; give HxW (grey) or HxWx3 (BGR)");
+  }
+  ImageInput input;
+  input.pixels = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(array);
+  input.image = cv::Mat(static_cast<int>(array.shape(0)), static_cast<int>(array.shape(1)), CV_8UC(channels),
+                        const_cast<void*>(input.pixels.data()));
+  return input;
+}
+
+py::array_t<std::uint8_t> ImageArray(const cv::Mat& image) {
+  std::vector<py::ssize_t> shape = {image.rows, image.cols};
+  if (image.channels() > 1) shape.push_back(image.channels());
+  py::array_t<std::uint8_t> array(shape);
+  const size_t row_bytes = static_cast<size_t>(image.cols) * image.elemSize();
+  for (int r = 0; r < image.rows; ++r) std::memcpy(array.mutable_data(r), image.ptr(r), row_bytes);
+  return array;
+}
+
+py::object MatrixArray(const cv::Matx33d& m, bool valid) {
+  if (!valid) return py::none();
+  py::array_t<double> array({3, 3});
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) array.mutable_at(r, c) = m(r, c);
+  }
+  return std::move(array);
+}
+
+py::object VectorArray(const cv::Vec3d& v, bool valid) {
+  if (!valid) return py::none();
+  py::array_t<double> array(3);
+  for (int i = 0; i < 3; ++i) array.mutable_at(i) = v[i];
+  return std::move(array);
+}
+
+}  // namespace vmap::python

@@ -1,0 +1,196 @@
+"""The module against the CLI on the same input: maps, matches and localization results must be equal."""
+import json
+import os
+import pathlib
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+import vmap
+from conftest import CLI, STRETCH, VIDEO, map_json, needs_shared, run_cli
+
+# Fields that differ between two runs of the same build: the wall time and what records it.
+RUN_FIELDS = {"seconds"}
+
+
+def without_run_fields(value):
+    if isinstance(value, dict):
+        return {k: without_run_fields(v) for k, v in value.items() if k not in RUN_FIELDS}
+    if isinstance(value, list):
+        return [without_run_fields(v) for v in value]
+    return value
+
+
+def test_build_map_writes_the_cli_map(maps):
+    cli_dir, module_dir, built = maps
+    cli, module = map_json(cli_dir), map_json(module_dir)
+    assert without_run_fields(module) == without_run_fields(cli)
+    assert (module_dir / "correspondences.bin").read_bytes() == (cli_dir / "correspondences.bin").read_bytes()
+    for key in cli["key_images"]:
+        assert (module_dir / key["image"]).read_bytes() == (cli_dir / key["image"]).read_bytes()
+    assert built.num_frames == cli["num_frames"] == len(range(0, 60, 2))
+    assert len(built.key_images) == cli["num_key_images"] and built.quality == cli["quality"]
+
+
+def test_read_map_gives_the_map_json_as_numpy(maps):
+    cli_dir, _, _ = maps
+    record = map_json(cli_dir)
+    m = vmap.read_map(cli_dir)
+    assert [k.frame_index for k in m.key_images] == [k["frame_index"] for k in record["key_images"]]
+    assert [k.timestamp for k in m.key_images] == pytest.approx([k["timestamp"] for k in record["key_images"]])
+    width, height = record["input"]["frame_size"]
+    image = m.key_images[0].image
+    assert image.shape == (height, width, 3) and image.dtype == np.uint8
+    assert m.key_images[0].gray.shape == (height, width)
+    assert len(m.links) == len(record["links"]) > 0
+    for link, entry in zip(m.links, record["links"]):
+        assert (link.verified, link.tentative, link.below_tau) == (entry["verified"], entry["tentative"],
+                                                                   entry["below_tau"])
+        assert link.similarity == pytest.approx(entry["similarity"])
+        assert link.F.shape == (3, 3)
+        np.testing.assert_allclose(link.F.ravel(), np.array(entry["F"], dtype=float).ravel(), rtol=1e-12)
+        assert link.correspondences.shape == (entry["tentative"], 4)
+        assert int(link.inliers.sum()) == entry["verified"]
+        # lab_floor has intrinsics: every link has its relative pose.
+        assert link.R.shape == (3, 3) and link.t.shape == (3,)
+        np.testing.assert_allclose(link.R @ link.R.T, np.eye(3), atol=1e-9)
+    assert m.quality == record["quality"]
+    assert m.camera is not None and m.camera == record["input"]["camera"]
+    assert m.options == record["options"]
+    assert m.options["first"] == 0 and m.options["stride"] == 2
+
+
+def key_image_file(directory, index):
+    return pathlib.Path(directory) / map_json(directory)["key_images"][index]["image"]
+
+
+def test_match_equals_vmap_match(maps, tmp_path):
+    cli_dir, _, _ = maps
+    m = vmap.read_map(cli_dir)
+    out = tmp_path / "match.json"
+    run_cli("match", key_image_file(cli_dir, 0), key_image_file(cli_dir, 1), "--json", out)
+    cli = json.loads(out.read_text())
+    # Grey images straight from the decoder, as `vmap match` reads its files.
+    result = vmap.match(m.key_images[0].gray, m.key_images[1].gray, matcher="orb")
+    assert (result.num_tentative, result.num_verified, result.verified) == (cli["num_tentative"],
+                                                                            cli["num_verified"], cli["verified"])
+    assert result.similarity == cli["similarity"]
+    np.testing.assert_array_equal(result.F, np.array(cli["F"]))
+    expected = np.array([[k["x0"], k["y0"], k["x1"], k["y1"]] for k in cli["matches"]], dtype=np.float32)
+    np.testing.assert_array_equal(result.matches, expected)
+    np.testing.assert_array_equal(result.inliers, np.array([k["inlier"] for k in cli["matches"]]))
+
+
+def test_match_takes_the_cli_options(maps, tmp_path):
+    cli_dir, _, _ = maps
+    m = vmap.read_map(cli_dir)
+    out = tmp_path / "match.json"
+    run_cli("match", key_image_file(cli_dir, 0), key_image_file(cli_dir, 2), "--json", out, "--threshold", "1.5",
+            "--seed", "7")
+    cli = json.loads(out.read_text())
+    result = vmap.Matcher(threshold=1.5, seed=7).match(m.key_images[0].gray, m.key_images[2].gray)
+    assert (result.num_tentative, result.num_verified) == (cli["num_tentative"], cli["num_verified"])
+    # A BGR image is matched in grey.
+    bgr = vmap.match(m.key_images[0].image, m.key_images[2].image)
+    assert bgr.num_tentative > 0 and bgr.F.shape == (3, 3)
+
+
+def csv_rows(path):
+    import csv
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def assert_same_localization(results, rows):
+    assert len(results) == len(rows) > 0
+    for result, row in zip(results, rows):
+        assert result.status == row["status"]
+        assert (result.key, result.next_key) == (int(row["key"]), int(row["next_key"]))
+        assert (result.verified, result.next_verified) == (int(row["verified"]), int(row["next_verified"]))
+        for name in ("similarity", "next_similarity", "heading_px", "heading_deg", "progress"):
+            value = getattr(result, name)
+            assert (value is None) == (row[name] == ""), name
+            if value is not None:
+                assert value == pytest.approx(float(row[name]), rel=1e-5, abs=1e-6), name
+
+
+def test_localize_equals_vmap_localize(maps, tmp_path):
+    cli_dir, _, _ = maps
+    csv_file = tmp_path / "run.csv"
+    run_cli("localize", cli_dir, VIDEO, "--first=1", "--last=58", "--stride=3", "--csv", csv_file, "--no-cache")
+    results = vmap.localize(vmap.read_map(cli_dir), str(VIDEO), first=1, last=58, stride=3, no_cache=True)
+    assert_same_localization(results, csv_rows(csv_file))
+    tracked = [r for r in results if r.status != "lost"]
+    assert tracked and all(r.F.shape == (3, 3) for r in tracked if r.next_key >= 0)
+
+
+def test_localizer_frame_by_frame_equals_vmap_localize(maps, tmp_path):
+    cli_dir, _, _ = maps
+    m = vmap.read_map(cli_dir)
+    csv_file = tmp_path / "run.csv"
+    # The map's own key images as the query, an image folder for the CLI and numpy frames for the module.
+    run_cli("localize", cli_dir, cli_dir / "keys", "--csv", csv_file, "--no-cache", "--candidates", "3")
+    localizer = vmap.Localizer(m, no_cache=True, candidates=3)
+    results = [localizer.localize(key.gray) for key in m.key_images]
+    assert_same_localization(results, csv_rows(csv_file))
+    assert results[0].status == "relocalized" and results[0].key == 0
+
+
+def test_results_have_the_csv_columns(maps, tmp_path):
+    cli_dir, _, _ = maps
+    m = vmap.read_map(cli_dir)
+    result = vmap.Localizer(m, no_cache=True).localize(m.key_images[1].image)
+    csv_file = tmp_path / "one.csv"
+    run_cli("localize", cli_dir, key_image_file(cli_dir, 1), "--csv", csv_file, "--no-cache")
+    columns = csv_file.read_text().splitlines()[0].split(",")
+    # The CSV spreads F, R and t over columns F00..F22, R00..R22, tx, ty, tz.
+    folded = {c[0] if c[0] in "FR" and c[1:].isdigit() else ("t" if c in ("tx", "ty", "tz") else c)
+              for c in columns}
+    assert folded <= set(vars(result)), folded - set(vars(result))
+
+
+def test_unknown_keywords_list_the_valid_ones():
+    with pytest.raises(TypeError, match="tau") as error:
+        vmap.build_map("nowhere.mp4", "nowhere_map", taux=0.5)
+    assert "max_iters" in str(error.value) and "stride" in str(error.value)
+    assert {"first", "last", "stride", "tau", "matcher", "threshold", "no_final_key"} <= set(vmap.build_map_options())
+    with pytest.raises(TypeError, match="min_verified"):
+        vmap.Localizer("nowhere_map", min_verifed=3)
+
+
+def test_bad_input_raises_vmap_errors(tmp_path):
+    with pytest.raises(vmap.Error, match="tau"):
+        vmap.build_map("nowhere.mp4", tmp_path / "out", tau=1.5)
+    with pytest.raises(ValueError, match="stride"):
+        vmap.build_map("nowhere.mp4", tmp_path / "out", stride="often")
+    with pytest.raises(vmap.Error, match="nowhere"):
+        vmap.read_map(tmp_path / "nowhere")
+    image = np.zeros((480, 640), np.uint8)
+    with pytest.raises(vmap.Error, match="uint8"):
+        vmap.match(image.astype(np.float32), image)
+    with pytest.raises(vmap.Error, match="shape"):
+        vmap.match(np.zeros((480, 640, 2), np.uint8), image)
+    with pytest.raises(vmap.Error, match="image0"):
+        vmap.match(np.zeros((4, 4), np.uint8), image)
+    with pytest.raises(vmap.Error, match="matcher"):
+        vmap.match(image, image, matcher="sift")
+    # No features: a result, not an error.
+    assert vmap.match(image, image).num_tentative == 0
+
+
+def test_ctrl_c_interrupts_a_build(tmp_path):
+    needs_shared()
+    output = tmp_path / "interrupted_map"
+    script = (f"import vmap\ntry:\n    vmap.build_map({str(VIDEO)!r}, {str(output)!r}, threads=1)\n"
+              "except KeyboardInterrupt:\n    print('interrupted')\n")
+    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=os.environ)
+    time.sleep(3)
+    child.send_signal(signal.SIGINT)
+    out, _ = child.communicate(timeout=60)
+    assert child.returncode == 0 and out.strip() == "interrupted"
+    assert not output.exists()
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary left behind

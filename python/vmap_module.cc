@@ -1,0 +1,65 @@
+// The `vmap` Python module: vmap's maps as numpy arrays, its matchers and localizer as functions (docs/python.md).
+// A thin layer: every option is the CLI's (the same Add*Options bindings), every step the library's.
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "bindings.h"
+#include "vmap/core/error.h"
+#include "vmap/core/logging.h"
+#include "vmap/core/runtime.h"
+#include "vmap/features/matcher_registry.h"
+
+namespace py = pybind11;
+
+PYBIND11_MODULE(vmap, m) {
+  m.doc() = "vmap: visual maps for teach-and-repeat navigation (key images linked by fundamental matrices)";
+  m.attr("__version__") = VMAP_VERSION;
+
+  // vmap's errors (bad input, bad options) carry the CLI's message; a ValueError, so generic handlers catch them.
+  static py::exception<vmap::InputError> error(m, "Error", PyExc_ValueError);
+  py::register_exception_translator([](std::exception_ptr pending) {
+    try {
+      if (pending) std::rethrow_exception(pending);
+    } catch (const vmap::InputError& e) {
+      PyErr_SetString(error.ptr(), e.what());
+    } catch (const CLI::ParseError& e) {
+      PyErr_SetString(error.ptr(), e.what());
+    }
+  });
+
+  // vmap's log (spdlog's "vmap" logger) to stderr at info, as the CLI; vmap.set_log_level changes it.
+  vmap::ConfigureLogging("info");
+  m.def("set_log_level", &vmap::ConfigureLogging, py::arg("level"),
+        "vmap's log: 'quiet' (warnings and errors; no progress line), 'info' (the default) or 'debug'.");
+  m.def(
+      "initialize_runtime",
+      [](int opencv_threads, bool keep_freed_memory, bool quiet_ffmpeg) {
+        vmap::RuntimeOptions options;
+        options.opencv_threads = opencv_threads;
+        options.keep_freed_memory = keep_freed_memory;
+        options.quiet_ffmpeg = quiet_ffmpeg;
+        options.handle_interrupts = false;  // Python handles signals
+        options.Check();
+        vmap::InitializeRuntime(options);
+      },
+      py::kw_only(), py::arg("opencv_threads") = 1, py::arg("keep_freed_memory") = true,
+      py::arg("quiet_ffmpeg") = true,
+      "Opt-in: the process-wide settings the vmap CLI makes at start (core/runtime.h: OpenCV's threads, malloc "
+      "keeping freed memory, FFmpeg's log), for timings equal to the CLI's. Python keeps its own signal handling.");
+  m.def(
+      "matchers",
+      [] {
+        std::vector<std::string> names;
+        for (const auto& model : vmap::MatcherModels()) names.push_back(model.name);
+        return names;
+      },
+      "The registered matcher models (matcher=...).");
+
+  vmap::python::BindMapObjects(m);
+  vmap::python::BindBuildAndMatch(m);
+  vmap::python::BindLocalization(m);
+}
