@@ -317,3 +317,31 @@ TEST(MapBuilder, RefusesTheBisectSearch) {
 }
 
 }  // namespace vmap
+
+namespace vmap {
+
+TEST(MapBuilder, AfterFrameIsCalledForEveryFrameAndAbandonsTheBuildWhenItThrows) {
+  const auto matcher = CreateOrbMatcher({});
+  for (KeySearch search : {KeySearch::kSequential, KeySearch::kBisect}) {
+    MapBuilderOptions options = Options(0.6);
+    options.key_search = search;
+    int calls = 0;
+    options.after_frame = [&] { ++calls; };
+    MemorySource source(Sequence().frames);
+    BuildMap(source, *matcher, options);
+    EXPECT_EQ(calls, 50) << KeySearchName(search);
+
+    // A host's interruption: the build stops there and writes no map.
+    testing::ScopedTempDir directory;
+    calls = 0;
+    options.after_frame = [&] {
+      if (++calls == 10) throw std::runtime_error("interrupted");
+    };
+    MemorySource again(Sequence().frames);
+    EXPECT_THROW(BuildMap(again, *matcher, options, directory.path()), std::runtime_error);
+    EXPECT_EQ(calls, 10);
+    EXPECT_FALSE(fs::exists(directory.path() / kMapFileName));
+  }
+}
+
+}  // namespace vmap
