@@ -20,7 +20,7 @@
 #include "vmap/features/matcher_registry.h"
 #include "vmap/mapping/map_builder.h"
 #include "vmap/mapping/pair_match.h"
-#include "vmap/sources/frame_source.h"
+#include "vmap/sources/image_frame.h"
 
 namespace py = pybind11;
 

@@ -61,7 +61,7 @@ void KeywordOptions::Parse(const py::kwargs& kwargs) {
       throw py::type_error(function_ + "() got an unexpected keyword argument '" + keyword + "'; valid: " + names);
     }
     if (value.is_none()) continue;
-    if (found->get_type_size() == 0) {  // a flag: on or off
+    if (found->get_expected_max() == 0) {  // a flag: on or off
       if (!py::isinstance<py::bool_>(value)) throw py::type_error(keyword + " takes True or False");
       if (value.cast<bool>()) args.push_back(flag);
       continue;

@@ -23,6 +23,7 @@
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/localization/route.h"
 #include "vmap/map/map_io.h"
+#include "vmap/sources/image_frame.h"
 
 namespace py = pybind11;
 

@@ -113,11 +113,6 @@ std::unique_ptr<FrameSource> OpenFrameSource(const std::string& path, const Fram
 // options.max_frame_pixels), or "" when it can.
 std::string FrameSizeProblem(const cv::Size& size, const FrameSourceOptions& options = {});
 
-// A frame from an image held in memory (a robot's camera callback, the Python module): 8-bit grey, BGR or BGRA
-// (grey by cv::cvtColor), brought to `size` when it is not empty as the sources bring frames to --resize. Throws
-// InputError naming `what` when the image is of another type or of a size FrameSizeProblem refuses.
-Frame FrameFromImage(const cv::Mat& image, int index, const cv::Size& size = {}, const std::string& what = "image");
-
 // The frame as a BGR image (re-reads a colour image file when the frame only kept the grey one).
 cv::Mat ColorImage(const Frame& frame);
 
