@@ -2,6 +2,7 @@
 // The parts of the vmap module, each adding its functions and classes.
 
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 namespace vmap::python {
 

@@ -10,6 +10,7 @@
 
 #include <CLI/CLI.hpp>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include "vmap/cli/option_flags.h"
 

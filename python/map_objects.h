@@ -6,6 +6,7 @@
 #include <memory>
 
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include "vmap/map/visual_map.h"
 

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 namespace vmap::python {
 

@@ -185,12 +185,14 @@ def test_bad_input_raises_vmap_errors(tmp_path):
 def test_ctrl_c_interrupts_a_build(tmp_path):
     needs_shared()
     output = tmp_path / "interrupted_map"
-    script = (f"import vmap\ntry:\n    vmap.build_map({str(VIDEO)!r}, {str(output)!r}, threads=1)\n"
-              "except KeyboardInterrupt:\n    print('interrupted')\n")
+    script = (f"import vmap\nprint('started', flush=True)\n"
+              f"try:\n    vmap.build_map({str(VIDEO)!r}, {str(output)!r}, threads=1)\n"
+              "except KeyboardInterrupt:\n    print('interrupted', flush=True)\n")
     child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=os.environ)
-    time.sleep(3)
+    assert child.stdout.readline().strip() == "started"
+    time.sleep(2)  # well inside the build of 720 frames
     child.send_signal(signal.SIGINT)
-    out, _ = child.communicate(timeout=60)
+    out, _ = child.communicate(timeout=120)
     assert child.returncode == 0 and out.strip() == "interrupted"
     assert not output.exists()
-    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary left behind
+    assert not [p.name for p in tmp_path.iterdir()]  # no temporary left behind either
