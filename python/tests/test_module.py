@@ -61,7 +61,7 @@ def test_read_map_gives_the_map_json_as_numpy(maps):
     assert m.quality == record["quality"]
     assert m.camera is not None and m.camera == record["input"]["camera"]
     assert m.options == record["options"]
-    assert m.options["first"] == 0 and m.options["stride"] == 2
+    assert m.options["source"]["first"] == 0 and m.options["source"]["stride"] == 2
 
 
 def key_image_file(directory, index):
