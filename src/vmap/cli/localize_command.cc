@@ -166,6 +166,7 @@ void AddLocalizeCommand(CLI::App& app) {
                        "Never move the estimate back to the previous key image");
   option_flags.AddEnumOption(command, "--ranking", o.ranking.method, ParseRankingMethod, RankingMethodName,
                              "ranking.method", "Relocalization ranking: " + ListEnumNames(kRankingMethodNames));
+  AddHeadingOptions(command, o.heading, option_flags);
   command->add_option("--from", flags->from, "Follow the route from this key image (default: the first)");
   command->add_option("--to", flags->to, "Follow the route to this key image (default: the last)");
   // LocalizeSequenceOptions::extraction_threads (the key-image store's keeps its default).
