@@ -1,5 +1,6 @@
 // vmap match IMAGE0 IMAGE1: one pair through a matcher and the verifier, to try a matcher on one's own
-// images and to compare matches across implementations.
+// images and to compare matches across implementations, and the heading of IMAGE1 against IMAGE0
+// (geometry/heading.h; docs/seasons.md).
 
 #include <chrono>
 #include <cmath>
@@ -176,7 +177,7 @@ void RunMatch(const MatchFlags& flags) {
     j["heading_method"] = HeadingMethodName(heading.method);
     j["heading_confidence"] = heading.confidence;
     j["heading_votes"] = heading.votes;
-    j["heading"] = {{"window_px", flags.heading.window_px},
+    j["heading_options"] = {{"window_px", flags.heading.window_px},
                     {"window_dy_px", flags.heading.window_dy_px},
                     {"min_votes", flags.heading.min_votes}};
     j["time_s"] = {{"load", load_s}, {"extract", extract_s}, {"match", match_s}, {"verify", verify_s},
@@ -191,7 +192,7 @@ void AddMatchCommand(CLI::App& app) {
   auto flags = std::make_shared<MatchFlags>();
   CLI::App* command = app.add_subcommand(
       "match", "Match one image pair: tentative matches (in original image pixels, with confidence), the verified "
-               "subset and F");
+               "subset and F, and the heading (x in image1 minus x in image0; degrees with --camera)");
   command->add_option("image0", flags->image0, "First image")->required();
   command->add_option("image1", flags->image1, "Second image")->required();
   command->add_option("--json", flags->json_path, "Also write every match, the inlier mask and F to this JSON file");
