@@ -14,7 +14,7 @@
 // image, window widths and heights; 0 = displacements vote by x alone); --verified adds the median displacement of the
 // F-verified matches (what vmap localize reported before) and its combination with the mode.
 // ms/pair: CPU time (this process, all threads) of extracting both images, matching and estimating, from
-// the per-image and per-pair means.
+// the per-image and per-pair means. Run from anywhere: XFeat's plugin is linked beside the binary.
 
 #include <time.h>
 
@@ -37,6 +37,7 @@
 #include "vmap/features/orb_matcher.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/geometry/heading.h"
+#include "vmap/neural/xfeat/xfeat_options.h"
 
 using namespace vmap;
 
@@ -330,6 +331,10 @@ int main(int argc, char** argv) {
       options.type = "xfeat";
       const std::unique_ptr<Matcher> matcher = CreateMatcher(options);
       run(MatchWithMatcher("xfeat", data, *matcher), true);
+      if (sweep) {
+        options.Of<XfeatMatcherOptions>().top_k = 2048;
+        run(MatchWithMatcher("xfeat top_k 2048", data, *CreateMatcher(options)), false);
+      }
     } catch (const std::exception& e) {
       std::printf("xfeat: not measured (%s)\n", e.what());
     }
