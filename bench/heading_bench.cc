@@ -9,10 +9,11 @@
 // the pair, the repeat image the second, as `vmap match TEACH REPEAT`: the heading is x_repeat - x_teach,
 // which gt.csv holds.
 //
-// Without --sweep: the chosen defaults (ORB as vmap's default matcher, and XFeat). --sweep adds the options
+// Without --sweep: the chosen defaults (ORB as vmap's default matcher, and XFeat), the mode alone and with the
+// F-verified median where F keeps many matches (what vmap match and localize report). --sweep adds the options
 // tried (more ORB features, the ratio test instead of cross-checking, upright ORB, ORB on a CLAHE-equalised
-// image, window widths and heights; 0 = displacements vote by x alone); --verified adds the median displacement of the
-// F-verified matches (what vmap localize reported before) and its combination with the mode.
+// image, window widths and heights; 0 = displacements vote by x alone); --verified adds the median displacement of
+// the F-verified matches (what vmap localize reported before) and other thresholds of the combination.
 // ms/pair: CPU time (this process, all threads) of extracting both images, matching and estimating, from
 // the per-image and per-pair means. Run from anywhere: XFeat's plugin is linked beside the binary.
 
@@ -37,6 +38,7 @@
 #include "vmap/features/orb_matcher.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/geometry/heading.h"
+#include "vmap/geometry/relative_pose.h"
 #include "vmap/neural/xfeat/xfeat_options.h"
 
 using namespace vmap;
@@ -195,32 +197,24 @@ Estimator ModeEstimator(const HeadingOptions& options) {
 }
 
 // The median displacement of the matches F verifies (0.5 px MAGSAC++, vmap's defaults, iterations capped as
-// vmap localize caps them); with `min_inliers_for_verified`, the mode unless F keeps at least that many.
-Estimator VerifiedEstimator(int min_inliers_for_verified) {
+// vmap localize caps them); with `min_verified` > 0, vmap's heading where F is estimated: that median when F
+// keeps at least `min_verified` matches, else the mode (EstimateHeading with the inlier mask).
+Estimator VerifiedEstimator(int min_verified) {
   VerifierOptions verifier;
   verifier.max_iterations = 5000;
-  const HeadingOptions mode;
-  std::string name = min_inliers_for_verified > 0
-                         ? "verified>=" + std::to_string(min_inliers_for_verified) + " else mode"
-                         : std::string("verified median");
+  HeadingOptions options;
+  options.min_verified = min_verified;
+  std::string name = min_verified > 0 ? "F>=" + std::to_string(min_verified) + " ? verified : mode"
+                                      : std::string("verified median");
   return {name, [=](const TentativeMatches& m) {
-            double verified = std::nan("");
-            int inliers = 0;
-            if (static_cast<int>(m.size()) >= verifier.min_matches) {
-              const FundamentalResult f = EstimateFundamental(m.points0, m.points1, verifier);
-              if (f.success) {
-                std::vector<double> dx;
-                for (size_t i = 0; i < m.size(); ++i) {
-                  if (f.inlier_mask[i]) dx.push_back(m.points1[i].x - m.points0[i].x);
-                }
-                inliers = f.num_inliers;
-                std::sort(dx.begin(), dx.end());
-                if (!dx.empty()) verified = dx[dx.size() / 2];
-              }
+            FundamentalResult f;
+            if (static_cast<int>(m.size()) >= verifier.min_matches) f = EstimateFundamental(m.points0, m.points1, verifier);
+            if (min_verified > 0) return EstimateHeading(m.points0, m.points1, f.inlier_mask, options).px;
+            std::vector<double> dx;
+            for (size_t i = 0; i < f.inlier_mask.size(); ++i) {
+              if (f.inlier_mask[i]) dx.push_back(m.points1[i].x - m.points0[i].x);
             }
-            if (min_inliers_for_verified <= 0) return verified;
-            if (inliers >= min_inliers_for_verified) return verified;
-            return EstimateHeading(m.points0, m.points1, mode).px;
+            return dx.empty() ? std::nan("") : Median(dx);
           }};
 }
 
@@ -272,7 +266,8 @@ int main(int argc, char** argv) {
   std::printf("%-22s %-24s %6s %6s %6s %6s %6s %7s %8s %8s %8s %6s\n", "matcher", "estimator", "pl1", "pl2", "pl3", "pl4",
               "pl5", "err%", "med_px", "ms/pair", "est_ms", "tent");
   const HeadingOptions chosen;
-  std::vector<Estimator> estimators = {ModeEstimator(chosen)};
+  // The mode alone (what a pair without F gets), and vmap's heading where F is estimated (match, localize).
+  std::vector<Estimator> estimators = {ModeEstimator(chosen), VerifiedEstimator(chosen.min_verified)};
   if (sweep) {
     for (double wdy : {0.0, 10.0, 20.0, 40.0, 80.0}) {
       for (double w : {10.0, 20.0, 35.0}) {
@@ -286,7 +281,8 @@ int main(int argc, char** argv) {
   }
   if (verified) {
     estimators.push_back(VerifiedEstimator(0));
-    estimators.push_back(VerifiedEstimator(50));
+    estimators.push_back(VerifiedEstimator(20));
+    estimators.push_back(VerifiedEstimator(100));
   }
   auto run = [&](const MatchedSet& set, bool all) {
     if (all) {

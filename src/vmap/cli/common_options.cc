@@ -150,6 +150,11 @@ void AddHeadingOptions(CLI::App* command, HeadingOptions& options, OptionFlags& 
       .AddOption(command, "--heading-min-votes", options.min_votes, "heading.min_votes",
                  "Heading: the fewest agreeing matches for an estimate")
       ->capture_default_str();
+  option_flags
+      .AddOption(command, "--heading-min-verified", options.min_verified, "heading.min_verified",
+                 "Heading: with at least this many F-verified matches, their median displacement (0 = always the "
+                 "mode of all matches)")
+      ->capture_default_str();
 }
 
 void AddSourceOptions(CLI::App* command, SourceFlags& flags, OptionFlags& option_flags) {

@@ -46,9 +46,15 @@ TEST(MatchCli, ReportsTheHeadingInPixelsAndWithACameraInDegrees) {
   ASSERT_TRUE(json["heading_px"].is_number()) << json.dump();
   EXPECT_NEAR(json["heading_px"].get<double>(), shift, 1.5);
   EXPECT_TRUE(json["heading_deg"].is_null()) << "no camera, no degrees";
-  EXPECT_EQ(json["heading_method"], "displacement_mode");
+  // A pure shift: F holds with many inliers, whose median is the heading.
+  EXPECT_EQ(json["heading_method"], "verified_median");
   EXPECT_GT(json["heading_confidence"].get<double>(), 0.5) << "a pure shift: most matches agree";
   EXPECT_LE(json["heading_confidence"].get<double>(), 1.0);
+
+  ASSERT_EQ(RunVmap(pair + " --heading-min-verified 0 --json " + Quote(tmp.path() / "mode.json"), &out), 0) << out;
+  const auto mode = nlohmann::json::parse(std::ifstream(tmp.path() / "mode.json"));
+  EXPECT_EQ(mode["heading_method"], "displacement_mode");
+  EXPECT_NEAR(mode["heading_px"].get<double>(), shift, 1.5);
 
   // The other way round the scene moves the other way.
   const std::string reversed = "match " + Quote(tmp.path() / "b.png") + " " + Quote(tmp.path() / "a.png");
@@ -67,7 +73,8 @@ TEST(MatchCli, HeadingOptionErrorsNameTheirFlags) {
   testing::ScopedTempDir tmp;
   WriteShiftedPair(tmp.path(), 10.0);
   const std::string pair = "match " + Quote(tmp.path() / "a.png") + " " + Quote(tmp.path() / "b.png");
-  for (const std::string flag : {"--heading-window 0", "--heading-window-dy -1", "--heading-min-votes 0"}) {
+  for (const std::string flag : {"--heading-window 0", "--heading-window-dy -1", "--heading-min-votes 0",
+                                "--heading-min-verified -1"}) {
     std::string out;
     EXPECT_EQ(RunVmap(pair + " " + flag, &out), 2) << flag << "\n" << out;
     EXPECT_EQ(out.rfind("vmap: error: " + flag.substr(0, flag.find(' ')) + " ", 0), 0u) << out;

@@ -104,10 +104,10 @@ void RunMatch(const MatchFlags& flags) {
     fundamental = EstimateFundamental(matches.points0, matches.points1, verifier);
   }
   const double verify_s = Seconds(start);
-  // From the tentative matches, not the verified ones: across seasons F rarely holds (geometry/heading.h).
+  // The mode of all tentative matches unless F keeps many: across seasons F rarely holds (geometry/heading.h).
   start = std::chrono::steady_clock::now();
-  const HeadingEstimate heading =
-      EstimateHeading(matches.points0, matches.points1, flags.heading, camera ? &*camera : nullptr);
+  const HeadingEstimate heading = EstimateHeading(matches.points0, matches.points1, fundamental.inlier_mask,
+                                                  flags.heading, camera ? &*camera : nullptr);
   const double heading_s = Seconds(start);
   const double similarity =
       matches.size() == 0 ? 0.0 : double(fundamental.num_inliers) / double(matches.size());
@@ -125,7 +125,7 @@ void RunMatch(const MatchFlags& flags) {
     }
   }
   if (heading.valid()) {
-    std::printf("heading     %.1f px%s (%s: %d of %d matches agree, confidence %.3f)\n", heading.px,
+    std::printf("heading     %.1f px%s (%s: %d of %d matches, confidence %.3f)\n", heading.px,
                 camera ? fmt::format(", {:.3f} deg", heading.deg).c_str() : "", HeadingMethodName(heading.method).c_str(),
                 heading.votes, heading.num_voters, heading.confidence);
   } else {
@@ -179,7 +179,8 @@ void RunMatch(const MatchFlags& flags) {
     j["heading_votes"] = heading.votes;
     j["heading_options"] = {{"window_px", flags.heading.window_px},
                     {"window_dy_px", flags.heading.window_dy_px},
-                    {"min_votes", flags.heading.min_votes}};
+                    {"min_votes", flags.heading.min_votes},
+                    {"min_verified", flags.heading.min_verified}};
     j["time_s"] = {{"load", load_s}, {"extract", extract_s}, {"match", match_s}, {"verify", verify_s},
                    {"heading", heading_s}};
     WriteFileAtomically(flags.json_path, j.dump(1) + "\n");

@@ -17,9 +17,34 @@ void HeadingOptions::Check() const {
     throw OptionError("window_dy_px", "must be 0 to 10000 pixels (0 = by x alone; default 40)");
   }
   if (min_votes < 1 || min_votes > 100000) throw OptionError("min_votes", "must be 1 to 100000 (default 3)");
+  if (min_verified < 0 || min_verified > 100000) {
+    throw OptionError("min_verified", "must be 0 to 100000 (0 = always the mode; default 50)");
+  }
 }
 
 std::string HeadingMethodName(HeadingMethod method) { return EnumToName(kHeadingMethodNames, method); }
+
+namespace {
+
+// The median over `matches` of the bearing of points1 minus that of points0 (degrees).
+double MedianBearingDeg(const std::vector<cv::Point2f>& points0, const std::vector<cv::Point2f>& points1,
+                        const std::vector<int>& matches, const Camera& camera) {
+  std::vector<cv::Point2f> selected0, selected1;
+  selected0.reserve(matches.size());
+  selected1.reserve(matches.size());
+  for (int i : matches) {
+    selected0.push_back(points0[i]);
+    selected1.push_back(points1[i]);
+  }
+  const std::vector<cv::Point2d> rays0 = NormalizePoints(camera, selected0);
+  const std::vector<cv::Point2d> rays1 = NormalizePoints(camera, selected1);
+  std::vector<double> bearings;
+  bearings.reserve(matches.size());
+  for (size_t k = 0; k < matches.size(); ++k) bearings.push_back(std::atan(rays1[k].x) - std::atan(rays0[k].x));
+  return Median(std::move(bearings)) * 180.0 / M_PI;  // geometry/relative_pose.h
+}
+
+}  // namespace
 
 HeadingEstimate EstimateHeading(const std::vector<cv::Point2f>& points0, const std::vector<cv::Point2f>& points1,
                                 const HeadingOptions& options, const Camera* camera) {
@@ -79,20 +104,36 @@ HeadingEstimate EstimateHeading(const std::vector<cv::Point2f>& points0, const s
   for (int k : best) window.push_back(votes[k].dx);
   estimate.px = Median(std::move(window));  // geometry/relative_pose.h
   if (camera != nullptr) {
-    std::vector<cv::Point2f> winners0, winners1;
-    winners0.reserve(count);
-    winners1.reserve(count);
-    for (int k : best) {
-      winners0.push_back(points0[votes[k].match]);
-      winners1.push_back(points1[votes[k].match]);
-    }
-    const std::vector<cv::Point2d> rays0 = NormalizePoints(*camera, winners0);
-    const std::vector<cv::Point2d> rays1 = NormalizePoints(*camera, winners1);
-    std::vector<double> bearings;
-    bearings.reserve(count);
-    for (int k = 0; k < count; ++k) bearings.push_back(std::atan(rays1[k].x) - std::atan(rays0[k].x));
-    estimate.deg = Median(std::move(bearings)) * 180.0 / M_PI;
+    std::vector<int> winners;
+    winners.reserve(count);
+    for (int k : best) winners.push_back(votes[k].match);
+    estimate.deg = MedianBearingDeg(points0, points1, winners, *camera);
   }
+  return estimate;
+}
+
+HeadingEstimate EstimateHeading(const std::vector<cv::Point2f>& points0, const std::vector<cv::Point2f>& points1,
+                                const std::vector<unsigned char>& verified, const HeadingOptions& options,
+                                const Camera* camera) {
+  options.Check();
+  CV_Assert(verified.empty() || verified.size() == points0.size());
+  std::vector<int> inliers;
+  for (size_t i = 0; i < verified.size(); ++i) {
+    if (verified[i] && std::isfinite(points1[i].x - points0[i].x)) inliers.push_back(static_cast<int>(i));
+  }
+  if (options.min_verified == 0 || static_cast<int>(inliers.size()) < options.min_verified) {
+    return EstimateHeading(points0, points1, options, camera);
+  }
+  HeadingEstimate estimate;
+  estimate.method = HeadingMethod::kVerifiedMedian;
+  std::vector<double> dx;
+  dx.reserve(inliers.size());
+  for (int i : inliers) dx.push_back(points1[i].x - points0[i].x);
+  estimate.px = Median(std::move(dx));
+  if (camera != nullptr) estimate.deg = MedianBearingDeg(points0, points1, inliers, *camera);
+  estimate.votes = static_cast<int>(inliers.size());
+  estimate.num_voters = static_cast<int>(points0.size());
+  estimate.confidence = static_cast<double>(estimate.votes) / static_cast<double>(estimate.num_voters);
   return estimate;
 }
 

@@ -37,6 +37,11 @@ struct HeadingOptions {
   double window_dy_px = 40.0;
   // The fewest displacements in the winning window for an estimate; below it there is none.
   int min_votes = 3;
+  // Where the caller has F-verified matches and F keeps at least this many, the heading is their median
+  // displacement instead (0 = always the mode): so many inliers are right matches, and their median is not
+  // cut to a window. With XFeat it was right for 1-2 more michigan pairs than the mode (docs/seasons.md),
+  // with ORB for as many; it costs nothing where F is estimated anyway (vmap match, vmap localize).
+  int min_verified = 50;
 
   void Check() const;  // throws OptionError naming the bad field
 };
@@ -44,9 +49,12 @@ struct HeadingOptions {
 enum class HeadingMethod {
   kNone,              // no estimate: too few matches agree
   kDisplacementMode,  // the densest window of the tentative matches' displacements
+  kVerifiedMedian,    // the median displacement of the F-verified matches (at least min_verified of them)
 };
-inline constexpr EnumName<HeadingMethod> kHeadingMethodNames[] = {{HeadingMethod::kNone, "none"},
-                                                                   {HeadingMethod::kDisplacementMode, "displacement_mode"}};
+inline constexpr EnumName<HeadingMethod> kHeadingMethodNames[] = {
+    {HeadingMethod::kNone, "none"},
+    {HeadingMethod::kDisplacementMode, "displacement_mode"},
+    {HeadingMethod::kVerifiedMedian, "verified_median"}};
 std::string HeadingMethodName(HeadingMethod method);
 
 struct HeadingEstimate {
@@ -56,10 +64,11 @@ struct HeadingEstimate {
   // With a camera: the same as a bearing, the median over the winning matches of atan(x_n) in the second
   // image minus atan(x_n) in the first (x_n undistorted normalised x), in degrees; NaN without.
   double deg = std::numeric_limits<double>::quiet_NaN();
-  int votes = 0;        // matches in the winning window
+  int votes = 0;        // matches in the winning window (verified_median: the verified matches)
   int num_voters = 0;   // matches that voted (those with finite coordinates)
   // The share of voters in the winning window, votes / num_voters (0 without an estimate). Wrong matches
-  // alone put about window_px / image width of them into any window.
+  // alone put a small share of them into any window (about the window's area over the image's), so a share
+  // well above that is a heading many matches agree on.
   double confidence = 0.0;
   bool valid() const { return method != HeadingMethod::kNone; }
 };
@@ -69,5 +78,11 @@ struct HeadingEstimate {
 // one with the smallest displacements.
 HeadingEstimate EstimateHeading(const std::vector<cv::Point2f>& points0, const std::vector<cv::Point2f>& points1,
                                 const HeadingOptions& options, const Camera* camera = nullptr);
+
+// The same where F was estimated: `verified[i]` != 0 for the matches F keeps (empty when there is no F). With
+// at least options.min_verified of them, their median displacement; otherwise the mode of all matches.
+HeadingEstimate EstimateHeading(const std::vector<cv::Point2f>& points0, const std::vector<cv::Point2f>& points1,
+                                const std::vector<unsigned char>& verified, const HeadingOptions& options,
+                                const Camera* camera = nullptr);
 
 }  // namespace vmap

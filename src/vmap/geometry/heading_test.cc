@@ -104,6 +104,33 @@ TEST(Heading, RightMatchesAgreeInVerticalDisplacementToo) {
   EXPECT_LT(h.votes, 25) << "few of the wrong ones fall into the right window";
 }
 
+TEST(Heading, WhereFKeepsManyMatchesTheirMedianIsTheHeading) {
+  // 60 verified matches at -20 px (give or take 6), among 200 tentative ones of which 40 wrong ones happen to
+  // agree on +90 px: the verified ones decide.
+  SyntheticMatches m = MakeMatches(-20.0, 60, 100, 6.0, 31);
+  const SyntheticMatches chance = MakeMatches(90.0, 40, 0, 1.0, 32);
+  m.points0.insert(m.points0.end(), chance.points0.begin(), chance.points0.end());
+  m.points1.insert(m.points1.end(), chance.points1.begin(), chance.points1.end());
+  std::vector<unsigned char> verified(m.points0.size(), 0);
+  std::fill(verified.begin(), verified.begin() + 60, 1);
+  std::vector<double> verified_dx;
+  for (int i = 0; i < 60; ++i) verified_dx.push_back(m.points1[i].x - m.points0[i].x);
+  HeadingOptions options;
+  options.min_verified = 50;
+  const HeadingEstimate h = EstimateHeading(m.points0, m.points1, verified, options);
+  EXPECT_EQ(h.method, HeadingMethod::kVerifiedMedian);
+  EXPECT_EQ(h.px, Median(verified_dx));
+  EXPECT_EQ(h.votes, 60);
+  EXPECT_EQ(h.num_voters, 200);
+  EXPECT_DOUBLE_EQ(h.confidence, 0.3);
+  // Fewer verified matches than min_verified, or no F at all: the mode of all matches.
+  options.min_verified = 61;
+  const HeadingEstimate mode = EstimateHeading(m.points0, m.points1, verified, options);
+  EXPECT_EQ(mode.method, HeadingMethod::kDisplacementMode);
+  EXPECT_EQ(mode.px, EstimateHeading(m.points0, m.points1, options).px);
+  EXPECT_EQ(EstimateHeading(m.points0, m.points1, {}, options).method, HeadingMethod::kDisplacementMode);
+}
+
 TEST(Heading, WithACameraGivesTheBearingOfTheShift) {
   const Camera camera = Camera::Make(800, 800, 512, 192);
   // Points shifted by a pure rotation about the camera's y axis: x_n' = tan(atan(x_n) + yaw).
@@ -135,6 +162,9 @@ TEST(Heading, OptionsCheckNamesTheBadField) {
   options = HeadingOptions();
   options.min_votes = 0;
   EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "min_votes");
+  options = HeadingOptions();
+  options.min_verified = -1;
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "min_verified");
   EXPECT_NO_THROW(HeadingOptions().Check());
 }
 

@@ -86,7 +86,8 @@ std::string DescribeLocalizerOptions(const LocalizerOptions& options) {
               {"heading",
                {{"window_px", options.heading.window_px},
                 {"window_dy_px", options.heading.window_dy_px},
-                {"min_votes", options.heading.min_votes}}},
+                {"min_votes", options.heading.min_votes},
+                {"min_verified", options.heading.min_verified}}},
               {"similarity", SimilarityModeName(options.similarity)},
               {"route", options.route}};
   return doc.dump();

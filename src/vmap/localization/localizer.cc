@@ -144,8 +144,13 @@ KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
     key_points.push_back(m.p1);
     frame_points.push_back(m.p0);
   }
+  std::vector<unsigned char> verified;
+  if (pair.matched) {
+    verified.assign(pair.correspondences.size(), 0);
+    std::fill(verified.begin(), verified.begin() + pair.num_verified, 1);
+  }
   const Camera* camera = options_.camera ? &*options_.camera : nullptr;
-  c.heading = EstimateHeading(key_points, frame_points, options_.heading, camera);
+  c.heading = EstimateHeading(key_points, frame_points, verified, options_.heading, camera);
   if (camera && pair.matched && pair.num_verified > 0) {
     key_points.resize(pair.num_verified);
     frame_points.resize(pair.num_verified);
