@@ -74,11 +74,13 @@ class PairMatcher {
     KeywordOptions keywords("Matcher");
     cli::AddMatcherOptions(keywords.command(), matcher_options, keywords.option_flags());
     cli::AddVerifierOptions(keywords.command(), verifier_flags, keywords.option_flags(), /*with_early_stop=*/false);
+    cli::AddHeadingOptions(keywords.command(), heading_, keywords.option_flags());
     keywords.Parse(kwargs);
     keywords.Run([&] {
       py::gil_scoped_release release;
       verifier_ = verifier_flags.Resolve();
       matcher_options.Check();
+      CheckField("heading", heading_);
       matcher_ = CreateMatcher(matcher_options);
     });
   }
@@ -90,7 +92,7 @@ class PairMatcher {
       py::gil_scoped_release release;
       const Frame frame0 = FrameFromImage(input0.image, 0, {}, "image0");
       const Frame frame1 = FrameFromImage(input1.image, 1, {}, "image1");
-      pair = MatchPair(*matcher_, frame0.gray, frame1.gray, verifier_);
+      pair = MatchPair(*matcher_, frame0.gray, frame1.gray, verifier_, heading_);
     }
     const size_t n = pair.matches.size();
     const bool verified = pair.fundamental.success;
@@ -114,8 +116,14 @@ class PairMatcher {
     fields["matches"] = matches;
     fields["scores"] = scores;
     fields["inliers"] = inliers;
+    const HeadingEstimate& heading = pair.heading;
+    fields["heading_px"] = heading.valid() ? py::object(py::float_(heading.px)) : py::object(py::none());
+    fields["heading_deg"] = py::none();  // vmap match gives it with --camera; the module takes no camera yet
+    fields["heading_method"] = HeadingMethodName(heading.method);
+    fields["heading_confidence"] = heading.confidence;
+    fields["heading_votes"] = heading.votes;
     fields["time_s"] = py::dict(py::arg("extract") = pair.extract_seconds, py::arg("match") = pair.match_seconds,
-                                py::arg("verify") = pair.verify_seconds);
+                                py::arg("verify") = pair.verify_seconds, py::arg("heading") = pair.heading_seconds);
     return Namespace(fields);
   }
 
@@ -124,6 +132,7 @@ class PairMatcher {
 
  private:
   VerifierOptions verifier_;
+  HeadingOptions heading_;
   std::unique_ptr<Matcher> matcher_;
 };
 

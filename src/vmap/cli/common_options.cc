@@ -137,6 +137,26 @@ FrameSourceOptions SourceFlags::Resolve() const {
   return resolved;
 }
 
+void AddHeadingOptions(CLI::App* command, HeadingOptions& options, OptionFlags& option_flags) {
+  option_flags
+      .AddOption(command, "--heading-window", options.window_px, "heading.window_px",
+                 "Heading: width of the window of horizontal displacements that votes (px)")
+      ->capture_default_str();
+  option_flags
+      .AddOption(command, "--heading-window-dy", options.window_dy_px, "heading.window_dy_px",
+                 "Heading: height of the window in vertical displacement (px; 0 = by x alone)")
+      ->capture_default_str();
+  option_flags
+      .AddOption(command, "--heading-min-votes", options.min_votes, "heading.min_votes",
+                 "Heading: the fewest agreeing matches for an estimate")
+      ->capture_default_str();
+  option_flags
+      .AddOption(command, "--heading-min-verified", options.min_verified, "heading.min_verified",
+                 "Heading: with at least this many F-verified matches, their median displacement (0 = always the "
+                 "mode of all matches)")
+      ->capture_default_str();
+}
+
 void AddSourceOptions(CLI::App* command, SourceFlags& flags, OptionFlags& option_flags) {
   option_flags.AddEnumOption(command, "--format", flags.options.format, ParseSourceFormat, SourceFormatName, "format",
                              "Input layout: " + ListEnumNames(kSourceFormatNames));

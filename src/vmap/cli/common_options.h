@@ -8,6 +8,7 @@
 #include "vmap/cli/option_flags.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/geometry/fundamental.h"
+#include "vmap/geometry/heading.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap::cli {
@@ -26,6 +27,10 @@ struct VerifierFlags {
 };
 void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& option_flags,
                         bool with_early_stop = true);
+
+// --heading-window, --heading-window-dy, --heading-min-votes, --heading-min-verified; fields as "heading.<field>" (MatchFlags,
+// LocalizerOptions).
+void AddHeadingOptions(CLI::App* command, HeadingOptions& options, OptionFlags& option_flags);
 
 // --format, --first, --last, --stride, --resize, --strict, --camera, --stream-timeout; fields as FrameSourceOptions names them.
 struct SourceFlags {

@@ -1,5 +1,7 @@
 #include "vmap/cli/localize_options.h"
 
+#include "vmap/cli/common_options.h"
+
 namespace vmap::cli {
 
 void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& option_flags) {
@@ -28,6 +30,7 @@ void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& 
                        "Never move the estimate back to the previous key image");
   option_flags.AddEnumOption(command, "--ranking", o.ranking.method, ParseRankingMethod, RankingMethodName,
                              "ranking.method", "Relocalization ranking: " + ListEnumNames(kRankingMethodNames));
+  AddHeadingOptions(command, o.heading, option_flags);
   command->add_option("--from", flags.from, "Follow the route from this key image (default: the first)");
   command->add_option("--to", flags.to, "Follow the route to this key image (default: the last)");
   // LocalizeSequenceOptions::extraction_threads (the key-image store's keeps its default).

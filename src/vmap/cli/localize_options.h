@@ -17,7 +17,7 @@ struct LocalizerFlags {
   bool cache = true; // the key-image cache in the map directory
 };
 
-// --min-verified, --min-similarity, --max-lost, --candidates, --lookahead, --no-step-back, --ranking, --from, --to,
+// --min-verified, --min-similarity, --max-lost, --candidates, --lookahead, --no-step-back, --ranking, the heading's options, --from, --to,
 // --threads, --no-cache; fields as LocalizerOptions names them.
 void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& option_flags);
 

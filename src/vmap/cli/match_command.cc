@@ -1,10 +1,15 @@
 // vmap match IMAGE0 IMAGE1: one pair through a matcher and the verifier, to try a matcher on one's own
-// images and to compare matches across implementations.
+// images and to compare matches across implementations, and the heading of IMAGE1 against IMAGE0
+// (geometry/heading.h; docs/seasons.md).
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
+
+#include <fmt/format.h>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -15,7 +20,9 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/core/file_name_encoding.h"
+#include "vmap/geometry/heading.h"
 #include "vmap/mapping/pair_match.h"
+#include "vmap/sources/dataset_camera.h"
 
 namespace vmap::cli {
 
@@ -23,9 +30,11 @@ namespace {
 
 struct MatchFlags {
   std::string image0, image1, json_path;
+  std::string camera;  // --camera: "" = none
   bool list = false;
   MatcherOptions matcher;
   VerifierFlags verifier;
+  HeadingOptions heading;
   OptionFlags option_flags;
 };
 
@@ -53,9 +62,23 @@ double Seconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// The camera of --camera for images of `size`; both images must have that size for a bearing to mean one thing.
+std::optional<Camera> CameraOf(const MatchFlags& flags, cv::Size size0, cv::Size size1) {
+  if (flags.camera.empty()) return std::nullopt;
+  if (size0 != size1) {
+    throw InputError("--camera needs both images at one size, but they are " + std::to_string(size0.width) + "x" +
+                     std::to_string(size0.height) + " and " + std::to_string(size1.width) + "x" +
+                     std::to_string(size1.height) + "; resize one, or leave out --camera for a heading in pixels");
+  }
+  return CameraForFrames(ParseCameraOption(flags.camera), size0, size0);
+}
+
+nlohmann::json NumberOrNull(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
+
 void RunMatch(const MatchFlags& flags) {
   const VerifierOptions verifier = flags.verifier.Resolve();
   flags.matcher.Check();
+  CheckField("heading", flags.heading);
   for (const std::string& image : {flags.image0, flags.image1}) {
     if (!flags.json_path.empty() && IsSameOrInside(flags.json_path, image)) {
       throw InputError("--json " + flags.json_path + " would overwrite the input image '" + image +
@@ -63,16 +86,19 @@ void RunMatch(const MatchFlags& flags) {
     }
   }
   const cv::Mat gray0 = ReadGray(flags.image0), gray1 = ReadGray(flags.image1);
+  const std::optional<Camera> camera = CameraOf(flags, gray0.size(), gray1.size());
   auto start = std::chrono::steady_clock::now();
   const std::unique_ptr<Matcher> matcher = CreateMatcher(flags.matcher);
   const double load_s = Seconds(start);
 
   // Extraction, matching and verification: the library's, as the Python module's vmap.match runs them.
-  const PairMatch pair = MatchPair(*matcher, gray0, gray1, verifier);
+  const PairMatch pair = MatchPair(*matcher, gray0, gray1, verifier, flags.heading, camera ? &*camera : nullptr);
   const TentativeMatches& matches = pair.matches;
   const FundamentalResult& fundamental = pair.fundamental;
   const double similarity = pair.similarity;
   const double extract_s = pair.extract_seconds, match_s = pair.match_seconds, verify_s = pair.verify_seconds;
+  const HeadingEstimate& heading = pair.heading;
+  const double heading_s = pair.heading_seconds;
 
   std::printf("matcher     %s %s\n", matcher->name().c_str(), matcher->DescribeOptionsJson().c_str());
   std::printf("images      %s (%dx%d), %s (%dx%d)\n", flags.image0.c_str(), gray0.cols, gray0.rows,
@@ -86,8 +112,15 @@ void RunMatch(const MatchFlags& flags) {
                   fundamental.F(r, 1), fundamental.F(r, 2));
     }
   }
-  std::printf("time        load %.3f s, extract %.3f s (2 images), match %.3f s, verify %.3f s\n", load_s, extract_s,
-              match_s, verify_s);
+  if (heading.valid()) {
+    std::printf("heading     %.1f px%s (%s: %d of %d matches, confidence %.3f)\n", heading.px,
+                camera ? fmt::format(", {:.3f} deg", heading.deg).c_str() : "", HeadingMethodName(heading.method).c_str(),
+                heading.votes, heading.num_voters, heading.confidence);
+  } else {
+    std::printf("heading     none (fewer than %d matches agree)\n", flags.heading.min_votes);
+  }
+  std::printf("time        load %.3f s, extract %.3f s (2 images), match %.3f s, verify %.3f s, heading %.4f s\n",
+              load_s, extract_s, match_s, verify_s, heading_s);
   if (flags.list) {
     std::printf("# x0 y0 x1 y1 score inlier\n");
     for (size_t k = 0; k < matches.size(); ++k) {
@@ -126,7 +159,18 @@ void RunMatch(const MatchFlags& flags) {
                       {"score", matches.scores.empty() ? 0.0f : matches.scores[k]},
                       {"inlier", fundamental.success && fundamental.inlier_mask[k] != 0}});
     }
-    j["time_s"] = {{"load", load_s}, {"extract", extract_s}, {"match", match_s}, {"verify", verify_s}};
+    // x in image1 minus x in image0 at the scene both show; null without an estimate.
+    j["heading_px"] = NumberOrNull(heading.px);
+    j["heading_deg"] = NumberOrNull(heading.deg);  // null without --camera
+    j["heading_method"] = HeadingMethodName(heading.method);
+    j["heading_confidence"] = heading.confidence;
+    j["heading_votes"] = heading.votes;
+    j["heading_options"] = {{"window_px", flags.heading.window_px},
+                    {"window_dy_px", flags.heading.window_dy_px},
+                    {"min_votes", flags.heading.min_votes},
+                    {"min_verified", flags.heading.min_verified}};
+    j["time_s"] = {{"load", load_s}, {"extract", extract_s}, {"match", match_s}, {"verify", verify_s},
+                   {"heading", heading_s}};
     WriteFileAtomically(flags.json_path, j.dump(1) + "\n");
   }
 }
@@ -137,11 +181,15 @@ void AddMatchCommand(CLI::App& app) {
   auto flags = std::make_shared<MatchFlags>();
   CLI::App* command = app.add_subcommand(
       "match", "Match one image pair: tentative matches (in original image pixels, with confidence), the verified "
-               "subset and F");
+               "subset and F, and the heading (x in image1 minus x in image0; degrees with --camera)");
   command->add_option("image0", flags->image0, "First image")->required();
   command->add_option("image1", flags->image1, "Second image")->required();
   command->add_option("--json", flags->json_path, "Also write every match, the inlier mask and F to this JSON file");
   command->add_flag("--list", flags->list, "Print every match: x0 y0 x1 y1 score inlier");
+  flags->option_flags.AddOption(command, "--camera", flags->camera, "camera",
+                                "Intrinsics of both images (fx,fy,cx,cy[,k1,k2,p1,p2[,k3]] or a calibration file): "
+                                "the heading also in degrees");
+  AddHeadingOptions(command, flags->heading, flags->option_flags);
   AddMatcherOptions(command, flags->matcher, flags->option_flags);
   AddVerifierOptions(command, flags->verifier, flags->option_flags, /*with_early_stop=*/false);  // one exhaustive pair
   command->callback([flags] { flags->option_flags.Run([&] { RunMatch(*flags); }); });

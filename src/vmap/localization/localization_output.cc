@@ -47,6 +47,12 @@ double NumberOr(const json& object, const char* name, double fallback) {
 
 // The pose to the key image the heading is measured against: next_key's, or key's at the route's end.
 const RelativePose& TargetPose(const LocalizationResult& r) { return r.next_key >= 0 ? r.to_next.pose : r.to_key.pose; }
+// The confidence of the heading against that key image (the one heading_px reports), and against `key`; NaN
+// (unknown) without an estimate.
+double Confidence(const HeadingEstimate& h) { return h.valid() ? h.confidence : std::nan(""); }
+double TargetConfidence(const LocalizationResult& r) {
+  return Confidence(r.next_key >= 0 ? r.to_next.heading : r.to_key.heading);
+}
 
 json PoseJson(const RelativePose& pose) {
   if (!pose.valid) return nullptr;
@@ -77,6 +83,11 @@ std::string DescribeLocalizerOptions(const LocalizerOptions& options) {
                 {"max_iterations", options.verifier.max_iterations},
                 {"seed", options.verifier.seed},
                 {"min_matches", options.verifier.min_matches}}},
+              {"heading",
+               {{"window_px", options.heading.window_px},
+                {"window_dy_px", options.heading.window_dy_px},
+                {"min_votes", options.heading.min_votes},
+                {"min_verified", options.heading.min_verified}}},
               {"similarity", SimilarityModeName(options.similarity)},
               {"route", options.route}};
   return doc.dump();
@@ -85,7 +96,8 @@ std::string DescribeLocalizerOptions(const LocalizerOptions& options) {
 std::string LocalizationCsvHeader() {
   return "frame,source_index,timestamp,source_name,status,key,next_key,key_frame,next_key_frame,similarity,verified,"
          "tentative,next_similarity,next_verified,next_tentative,heading_px,progress,comparisons,seconds,"
-         "F00,F01,F02,F10,F11,F12,F20,F21,F22,heading_deg,R00,R01,R02,R10,R11,R12,R20,R21,R22,tx,ty,tz\n";
+         "F00,F01,F02,F10,F11,F12,F20,F21,F22,heading_deg,R00,R01,R02,R10,R11,R12,R20,R21,R22,tx,ty,tz,"
+         "heading_confidence,heading_key_px,heading_key_deg,heading_key_confidence\n";
 }
 
 std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r) {
@@ -104,6 +116,8 @@ std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r
   const RelativePose& pose = TargetPose(r);
   for (int i = 0; i < 9; ++i) row += ',' + (pose.valid ? fmt::format("{:.9g}", pose.R(i / 3, i % 3)) : std::string());
   for (int i = 0; i < 3; ++i) row += ',' + (pose.valid ? fmt::format("{:.9g}", pose.t[i]) : std::string());
+  row += ',' + CsvNumber(TargetConfidence(r)) + ',' + CsvNumber(r.heading_key_px) + ',' +
+         CsvNumber(r.heading_key_deg) + ',' + CsvNumber(Confidence(r.to_key.heading));
   return row + "\n";
 }
 
@@ -135,6 +149,10 @@ nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationRes
           {"next_tentative", r.to_next.num_tentative},
           {"heading_px", Number(r.heading_px)},
           {"heading_deg", Number(r.heading_deg)},
+          {"heading_confidence", Number(TargetConfidence(r))},
+          {"heading_key_px", Number(r.heading_key_px)},
+          {"heading_key_deg", Number(r.heading_key_deg)},
+          {"heading_key_confidence", Number(Confidence(r.to_key.heading))},
           {"pose", PoseJson(TargetPose(r))},
           {"progress", Number(r.progress)},
           {"F", F},
@@ -255,6 +273,8 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
       }
       r.heading_px = NumberOr(f, "heading_px", std::nan(""));
       r.heading_deg = NumberOr(f, "heading_deg", std::nan(""));
+      r.heading_key_px = NumberOr(f, "heading_key_px", std::nan(""));
+      r.heading_key_deg = NumberOr(f, "heading_key_deg", std::nan(""));
       r.progress = NumberOr(f, "progress", std::nan(""));
       if (f.contains("candidates") && f["candidates"].is_array()) {
         for (const json& c : f["candidates"]) {

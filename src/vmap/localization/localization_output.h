@@ -8,8 +8,9 @@
 // seconds, and F from the frame to the next key image (x_next^T F x_frame = 0; CSV columns F00..F22, JSON a
 // row-major list; empty / null when there is none). With the map's camera also heading_deg and the pose of the
 // target key image (next_key, or key at the route's end) relative to the frame, X_key = R X_frame + t with
-// |t| = 1 (CSV R00..R22, tx, ty, tz; JSON "pose": {"R": row-major, "t"}). Unknown numbers are empty in CSV
-// and null in JSON.
+// |t| = 1 (CSV R00..R22, tx, ty, tz; JSON "pose": {"R": row-major, "t"}). Then heading_confidence (of
+// heading_px's estimate) and the heading against `key`: heading_key_px, heading_key_deg, heading_key_confidence
+// (geometry/heading.h). Unknown numbers are empty in CSV and null in JSON.
 
 #include <filesystem>
 #include <string>

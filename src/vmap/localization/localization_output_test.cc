@@ -42,11 +42,14 @@ LocalizationRun SampleRun() {
   tracked.key = 0;
   tracked.next_key = 1;
   const double no_bearing = std::numeric_limits<double>::quiet_NaN();
-  tracked.to_key = {0, true, true, 0.75, 200, 150, cv::Matx33d::zeros(), 1.5, no_bearing, RelativePose{}};
-  tracked.to_next = {1, true, true, 0.5, 100, 50, cv::Matx33d(1, 2, 3, 4, 5, 6, 7, 8, 9), -2.0, no_bearing,
+  const HeadingEstimate to_key_heading{HeadingMethod::kDisplacementMode, 1.5, no_bearing, 30, 200, 0.15};
+  const HeadingEstimate to_next_heading{HeadingMethod::kDisplacementMode, -2.0, -0.25, 40, 100, 0.4};
+  tracked.to_key = {0, true, true, 0.75, 200, 150, cv::Matx33d::zeros(), to_key_heading, RelativePose{}};
+  tracked.to_next = {1, true, true, 0.5, 100, 50, cv::Matx33d(1, 2, 3, 4, 5, 6, 7, 8, 9), to_next_heading,
                      RelativePose{}};
   tracked.heading_px = -2.0;
   tracked.heading_deg = -0.25;
+  tracked.heading_key_px = 1.5;
   tracked.to_next.pose.valid = true;
   tracked.to_next.pose.R = cv::Matx33d(0, -1, 0, 1, 0, 0, 0, 0, 1);
   tracked.to_next.pose.t = cv::Vec3d(0.6, 0, 0.8);
@@ -80,7 +83,8 @@ TEST(LocalizationOutput, CsvHasTheNamedColumnsAndOneRowPerFrame) {
   EXPECT_FALSE(std::getline(lines, extra));
   for (const char* column : {"frame", "source_index", "status", "key", "next_key", "similarity", "verified",
                              "next_similarity", "next_verified", "heading_px", "progress", "F00", "F22",
-                             "heading_deg", "R00", "R22", "tx", "tz"}) {
+                             "heading_deg", "R00", "R22", "tx", "tz", "heading_confidence", "heading_key_px",
+                             "heading_key_deg", "heading_key_confidence"}) {
     EXPECT_NE(("," + header + ",").find(std::string(",") + column + ","), std::string::npos) << column;
   }
   auto count = [](const std::string& s) { return std::count(s.begin(), s.end(), ','); };
@@ -88,7 +92,8 @@ TEST(LocalizationOutput, CsvHasTheNamedColumnsAndOneRowPerFrame) {
   EXPECT_EQ(count(row1), count(header));
   EXPECT_EQ(row0.rfind("0,3,0.100000,frame_000003,relocalized,0,1,0,40,0.75,150,200,0.5,50,100,-2,0.25,", 0), 0u)
       << row0;
-  EXPECT_NE(row0.find(",1,2,3,4,5,6,7,8,9,-0.25,0,-1,0,1,0,0,0,0,1,0.6,0,0.8"), std::string::npos) << row0;
+  EXPECT_NE(row0.find(",1,2,3,4,5,6,7,8,9,-0.25,0,-1,0,1,0,0,0,0,1,0.6,0,0.8,0.4,1.5,,0.15"), std::string::npos)
+      << row0;
   // Unknown values are empty, not "nan".
   EXPECT_EQ(row1.find("nan"), std::string::npos) << row1;
   EXPECT_EQ(row1.rfind("1,4,,frame,lost,-1,-1,-1,-1,,0,0,,0,0,,,", 0), std::string::npos) << row1;
@@ -109,6 +114,11 @@ TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
   EXPECT_EQ(doc["frames"][0]["pose"]["t"], nlohmann::json::array({0.6, 0.0, 0.8}));
   EXPECT_EQ(doc["frames"][0]["pose"]["R"][1], -1.0);
   EXPECT_DOUBLE_EQ(doc["frames"][0]["heading_deg"].get<double>(), -0.25);
+  EXPECT_DOUBLE_EQ(doc["frames"][0]["heading_key_px"].get<double>(), 1.5);
+  EXPECT_DOUBLE_EQ(doc["frames"][0]["heading_confidence"].get<double>(), 0.4);
+  EXPECT_DOUBLE_EQ(doc["frames"][0]["heading_key_confidence"].get<double>(), 0.15);
+  EXPECT_TRUE(doc["frames"][1]["heading_key_px"].is_null());
+  EXPECT_TRUE(doc["frames"][1]["heading_confidence"].is_null());
   EXPECT_EQ(doc["frames"][0]["key_frame"], 0);
   EXPECT_EQ(doc["frames"][0]["next_key_frame"], 40);
   const LocalizationRun back = ReadLocalizationRun(file);
@@ -127,6 +137,7 @@ TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
   EXPECT_EQ(r.to_next.num_verified, 50);
   EXPECT_EQ(r.to_next.F, cv::Matx33d(1, 2, 3, 4, 5, 6, 7, 8, 9));
   EXPECT_DOUBLE_EQ(r.progress, 0.25);
+  EXPECT_DOUBLE_EQ(r.heading_key_px, 1.5);
   ASSERT_EQ(r.candidates.size(), 2u);
   EXPECT_EQ(r.candidates[1].num_verified, 50);
   EXPECT_EQ(back.frames[1].status, LocalizationStatus::kLost);

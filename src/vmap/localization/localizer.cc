@@ -59,6 +59,7 @@ void LocalizerOptions::Check() const {
   }
   CheckField("ranking", ranking);
   CheckField("verifier", verifier);
+  CheckField("heading", heading);
 }
 
 std::pair<int, int> KeysAround(const VisualMap& map, int source_index) {
@@ -135,26 +136,25 @@ KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
   c.num_verified = pair.num_verified;
   c.F = pair.F;
   c.accepted = pair.matched && pair.num_verified >= options_.min_verified && pair.similarity >= options_.min_similarity;
-  std::vector<double> dx;
-  dx.reserve(pair.num_verified);
-  for (int i = 0; i < pair.num_verified; ++i) dx.push_back(pair.correspondences[i].p0.x - pair.correspondences[i].p1.x);
-  c.median_dx = pair.matched && !dx.empty() ? Median(std::move(dx)) : kNaN;  // geometry/relative_pose.h
-  if (options_.camera && pair.matched && pair.num_verified > 0) {
-    std::vector<cv::Point2f> frame_points, key_points;
-    frame_points.reserve(pair.num_verified);
-    key_points.reserve(pair.num_verified);
-    for (int i = 0; i < pair.num_verified; ++i) {
-      frame_points.push_back(pair.correspondences[i].p0);
-      key_points.push_back(pair.correspondences[i].p1);
-    }
-    const Camera& camera = *options_.camera;
-    const std::vector<cv::Point2d> frame_rays = NormalizePoints(camera, frame_points);
-    const std::vector<cv::Point2d> key_rays = NormalizePoints(camera, key_points);
-    std::vector<double> bearings;
-    bearings.reserve(frame_points.size());
-    for (size_t i = 0; i < frame_points.size(); ++i) bearings.push_back(std::atan(frame_rays[i].x) - std::atan(key_rays[i].x));
-    c.median_dx_deg = Median(std::move(bearings)) * 180.0 / M_PI;
-    c.pose = PoseFromFundamental(pair.F, camera, frame_points, key_points);
+  // The heading from every tentative match (verified first, then rejected), key image -> frame.
+  std::vector<cv::Point2f> key_points, frame_points;
+  key_points.reserve(pair.correspondences.size());
+  frame_points.reserve(pair.correspondences.size());
+  for (const Correspondence& m : pair.correspondences) {
+    key_points.push_back(m.p1);
+    frame_points.push_back(m.p0);
+  }
+  std::vector<unsigned char> verified;
+  if (pair.matched) {
+    verified.assign(pair.correspondences.size(), 0);
+    std::fill(verified.begin(), verified.begin() + pair.num_verified, 1);
+  }
+  const Camera* camera = options_.camera ? &*options_.camera : nullptr;
+  c.heading = EstimateHeading(key_points, frame_points, verified, options_.heading, camera);
+  if (camera && pair.matched && pair.num_verified > 0) {
+    key_points.resize(pair.num_verified);
+    frame_points.resize(pair.num_verified);
+    c.pose = PoseFromFundamental(pair.F, *camera, frame_points, key_points);
   }
   return c;
 }
@@ -204,8 +204,10 @@ void Localizer::Describe(LocalizationResult& result, int position, const ImageFe
   result.next_key = at_end ? -1 : route_[position + 1];
   result.to_next = at_end ? KeyComparison() : CompareOnce(features, result.next_key);
   const KeyComparison& target = at_end ? result.to_key : result.to_next;
-  result.heading_px = target.matched ? target.median_dx : kNaN;
-  result.heading_deg = target.matched ? target.median_dx_deg : kNaN;
+  result.heading_px = target.heading.px;
+  result.heading_deg = target.heading.deg;
+  result.heading_key_px = result.to_key.heading.px;
+  result.heading_key_deg = result.to_key.heading.deg;
   if (at_end) {
     result.progress = result.to_key.accepted ? 0.0 : kNaN;
   } else {

@@ -31,6 +31,7 @@
 #include "vmap/features/matcher.h"
 #include "vmap/geometry/camera.h"
 #include "vmap/geometry/fundamental.h"
+#include "vmap/geometry/heading.h"
 #include "vmap/geometry/relative_pose.h"
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/localization/key_image_store.h"
@@ -63,6 +64,8 @@ struct LocalizerOptions {
   SimilarityMode similarity = SimilarityMode::kInlierRatio;
   // Key-image indices to follow, in order (PlanRoute gives one); empty = every key image in map order.
   std::vector<int> route;
+  // How the heading to each key image compared is estimated (geometry/heading.h).
+  HeadingOptions heading;
   // The map's camera (map.input.camera: intrinsics from the dataset or --camera). With it each comparison
   // also gives the heading in degrees and the relative pose to the key image; without, pixels only.
   std::optional<Camera> camera;
@@ -86,11 +89,9 @@ struct KeyComparison {
   int num_tentative = 0;
   int num_verified = 0;
   cv::Matx33d F = cv::Matx33d::zeros();  // x_key^T F x_frame = 0 (pixels); zero when !matched
-  // Verified matches: median horizontal displacement, x in the frame minus x in the key image (pixels).
-  double median_dx = 0.0;
-  // With a camera: the same as a bearing, the median over the verified matches of atan(x_n) in the frame
-  // minus atan(x_n) in the key image, x_n the undistorted normalised image x (degrees; NaN without).
-  double median_dx_deg = std::numeric_limits<double>::quiet_NaN();
+  // The heading of the frame against the key image, x in the frame minus x in the key image (px; with a camera
+  // also degrees), from all tentative matches (geometry/heading.h): it holds across seasons, where F rarely does.
+  HeadingEstimate heading;
   // With a camera: the key image's camera relative to the frame's, X_key = R X_frame + t, t of unit length
   // (PoseFromFundamental on F and the verified matches: no extra estimation). Invalid without.
   RelativePose pose;
@@ -116,14 +117,19 @@ struct LocalizationResult {
   int route_position = -1;  // index of `key` in the route
   KeyComparison to_key;     // the frame against `key`
   KeyComparison to_next;    // against `next_key`: its F maps the frame to the next key image
-  // Heading correction for a controller: the median horizontal displacement of the verified matches to the
-  // target key image (`next_key`, or `key` at the route's end), x in the frame minus x in the key image, in
-  // pixels. Positive: the scene appears to the right of where the key image has it, i.e. the robot points
-  // left of the key image's heading and should turn right (clockwise seen from above). NaN when unknown.
+  // Heading correction for a controller: the heading of the frame against the target key image (`next_key`,
+  // or `key` at the route's end), x in the frame minus x in the key image at the scene both show, in pixels
+  // (the mode of the tentative matches' horizontal displacements, geometry/heading.h). Positive: the scene
+  // appears to the right of where the key image has it, i.e. the robot points left of the key image's
+  // heading and should turn right (clockwise seen from above). NaN when there is no estimate.
   double heading_px = 0.0;
   // The same heading as a bearing in degrees (with the map's camera; NaN without). The relative pose to the
   // target key image is target's `pose` (to_next, or to_key at the route's end).
   double heading_deg = std::numeric_limits<double>::quiet_NaN();
+  // The same against `key` (the key image the frame is at); at the route's end the same as heading_px/deg.
+  // Each comparison's `heading` holds the estimate's votes and confidence.
+  double heading_key_px = std::numeric_limits<double>::quiet_NaN();
+  double heading_key_deg = std::numeric_limits<double>::quiet_NaN();
   // Progress along the segment key -> next_key in [0, 1]: v_next / (v_key + v_next) with v the verified
   // matches to each (0 at `key`, 1 at `next_key`, 0.5 where both share as much). NaN when unknown.
   double progress = 0.0;

@@ -234,6 +234,10 @@ TEST(Localizer, HeadingIsTheHorizontalShiftOfTheSceneInPixels) {
     EXPECT_EQ(r.key, 0);
     EXPECT_EQ(r.next_key, -1);
     EXPECT_NEAR(r.heading_px, shift, 1.0) << "the scene moved " << shift << " px to the right";
+    // At the route's end the target is `key` itself: both headings are the one estimate.
+    EXPECT_EQ(r.heading_key_px, r.heading_px);
+    EXPECT_TRUE(r.to_key.heading.valid());
+    EXPECT_GT(r.to_key.heading.confidence, 0.5) << "a pure shift: most matches agree";
   }
 }
 

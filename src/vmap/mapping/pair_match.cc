@@ -13,7 +13,7 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 }  // namespace
 
 PairMatch MatchPair(const Matcher& matcher, const cv::Mat& gray0, const cv::Mat& gray1,
-                    const VerifierOptions& verifier) {
+                    const VerifierOptions& verifier, const HeadingOptions& heading, const Camera* camera) {
   PairMatch pair;
   auto start = std::chrono::steady_clock::now();
   const auto features0 = matcher.Extract(gray0);
@@ -27,6 +27,11 @@ PairMatch MatchPair(const Matcher& matcher, const cv::Mat& gray0, const cv::Mat&
     pair.fundamental = EstimateFundamental(pair.matches.points0, pair.matches.points1, verifier);
   }
   pair.verify_seconds = SecondsSince(start);
+  // The mode of all tentative matches unless F keeps many: across seasons F rarely holds (geometry/heading.h).
+  start = std::chrono::steady_clock::now();
+  pair.heading = EstimateHeading(pair.matches.points0, pair.matches.points1, pair.fundamental.inlier_mask, heading,
+                                 camera);
+  pair.heading_seconds = SecondsSince(start);
   pair.similarity =
       pair.matches.size() == 0 ? 0.0 : double(pair.fundamental.num_inliers) / double(pair.matches.size());
   return pair;

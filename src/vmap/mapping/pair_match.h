@@ -6,6 +6,7 @@
 
 #include "vmap/features/matcher.h"
 #include "vmap/geometry/fundamental.h"
+#include "vmap/geometry/heading.h"
 
 namespace vmap {
 
@@ -13,15 +14,19 @@ struct PairMatch {
   TentativeMatches matches;       // in the matcher's order
   FundamentalResult fundamental;  // its inlier_mask is one per match; !success below min_matches
   double similarity = 0.0;        // S = verified / tentative (0 without matches)
+  HeadingEstimate heading;        // x in image 1 minus x in image 0 at the scene both show (geometry/heading.h)
   // Wall time of each step, seconds: both images' extraction, matching, verification.
   double extract_seconds = 0.0;
   double match_seconds = 0.0;
   double verify_seconds = 0.0;
+  double heading_seconds = 0.0;
 };
 
 // Extracts both images' features (`gray0`, `gray1`: 8-bit grey), matches them, and verifies the matches
-// exhaustively with `verifier` when there are at least verifier.min_matches of them.
+// exhaustively with `verifier` when there are at least verifier.min_matches of them, and estimates the heading
+// (with `camera`, of images of its size, also in degrees).
 PairMatch MatchPair(const Matcher& matcher, const cv::Mat& gray0, const cv::Mat& gray1,
-                    const VerifierOptions& verifier);
+                    const VerifierOptions& verifier, const HeadingOptions& heading = {},
+                    const Camera* camera = nullptr);
 
 }  // namespace vmap
