@@ -20,9 +20,9 @@ while (($#)); do
   fi
 done
 # The vmap target builds the plugin too (a plugin older than the binary must never be loaded), except when
-# only some targets are asked for: then the binary alone is built and no plugin exists yet.
+# targets without vmap_torch are asked for: then the binary alone is built and no plugin exists yet.
 binary_builds_plugin=ON
-if ((${#targets[@]})); then binary_builds_plugin=OFF; fi
+if ((${#targets[@]})) && [[ " ${targets[*]} " != *" vmap_torch "* ]]; then binary_builds_plugin=OFF; fi
 cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release -DVMAP_BINARY_BUILDS_PLUGIN=$binary_builds_plugin \
   "${cmake_args[@]}" >/dev/null
 # Two jobs: LibTorch translation units take ~2 GB of RAM each to compile.
