@@ -1,4 +1,4 @@
-// Localization measured against truth (README "Localization"): the bracket test and the ranking recall.
+// Localization measured against truth (docs/measurements/localization.md): the bracket test and the ranking recall.
 //
 //   localize_accuracy SEQUENCE [--last N] [--tau T] [--ranking auto|votes|thumbnails] [--candidates K]
 //

@@ -1,4 +1,4 @@
-// Speed of `vmap localize` (README "Localization"): tracking frames per second with ORB at 640x480 beside
+// Speed of `vmap localize` (docs/measurements/localization.md): tracking frames per second with ORB at 640x480 beside
 // decode-only and decode + ORB on one thread, and the time of one relocalization against a map of about
 // 300 key images. Each repeat measures the stages one after the other, so that the machine's changing load
 // touches them alike; the medians and ranges are printed.

@@ -1,4 +1,4 @@
-// A teach run and a repeat run of one place, judged with ground truth (README "Localization").
+// A teach run and a repeat run of one place, judged with ground truth (docs/measurements/localization.md).
 //
 //   localize_repeat TUM_SEQUENCE --teach FIRST:LAST --repeat FIRST:LAST [--stride N]
 //                   [--max-distance M] [--max-angle DEG]

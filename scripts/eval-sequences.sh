@@ -1,6 +1,6 @@
 #!/bin/bash
 # Builds the default map of every sequence with ground truth in ../shared and evaluates it with `vmap eval`:
-# the table of README "Links a robot can trust". Extra arguments go to `vmap build` (e.g. --pose fundamental).
+# the table of docs/measurements/links.md. Extra arguments go to `vmap build` (e.g. --pose fundamental).
 #   scripts/eval-sequences.sh [build options...]
 # Maps are written under $VMAP_EVAL_DIR (default: a temporary folder, removed at the end).
 set -euo pipefail
