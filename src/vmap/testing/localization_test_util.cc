@@ -1,4 +1,4 @@
-#include "vmap/localization/localization_test_util.h"
+#include "vmap/testing/localization_test_util.h"
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
