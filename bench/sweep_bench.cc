@@ -28,7 +28,8 @@
 
 #include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/batch_build.h"
+#include "vmap/mapping/sweep_thresholds.h"
 #include "vmap/map/map_io.h"
 #include "vmap/sources/frame_source.h"
 

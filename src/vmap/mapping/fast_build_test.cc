@@ -15,7 +15,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/features/orb_matcher.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/batch_build.h"
 #include "vmap/testing/option_error.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/shared_data.h"
