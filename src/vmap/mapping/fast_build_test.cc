@@ -341,8 +341,8 @@ TEST(FastBuild, DefaultSweepDecidesWithinTheNoiseOfASeedChange) {
                                               asked[{e.key_frame, e.frame}]);
       ASSERT_TRUE(fast.Decides(taus[t]));
       ++decisions;
-      flipped_by_seed += (other.matched && other.similarity >= taus[t]) != decision;
-      flipped_by_early_stop += (fast.matched && fast.similarity >= taus[t]) != decision;
+      flipped_by_seed += other.Reaches(taus[t]) != decision;
+      flipped_by_early_stop += fast.Reaches(taus[t]) != decision;
     }
   }
   EXPECT_GT(decisions, 300);

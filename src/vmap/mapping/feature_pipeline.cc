@@ -177,7 +177,7 @@ PipelineItem FeaturePipeline::ExtractAndCompare(Frame decoded) {
         });
     if (comparison.abandoned) continue;
     for (double tau : group.taus) {
-      if (!(comparison.matched && comparison.similarity >= tau)) {
+      if (!comparison.Reaches(tau)) {
         Retire(key_index, frame_index, tau);  // this tau and every higher one leave the key here
         break;
       }

@@ -89,7 +89,7 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
     }
     for (int position : positions) {
       const PairComparison& c = comparisons.at({key.frame->index, position});
-      if (!(c.matched && c.similarity >= options.key_images.tau)) return position;
+      if (!c.Reaches(options.key_images.tau)) return position;
       *last_pass = position;
     }
     return -1;
@@ -103,19 +103,18 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
       key.image_file = writer->AddKeyImage(record.frame);
     };
   }
-  KeyImageSelector selector(
-      options.key_images,
-      [&](const FrameRecord& key, const FrameRecord& frame) {
-        const auto it = comparisons.find({key.frame->index, frame.frame->index});
-        if (it != comparisons.end()) return it->second;
-        return remember(key.frame->index, frame.frame->index, compare(key, frame));
-      },
-      on_key_image);
+  KeyImageSelector selector(options.key_images, on_key_image);
+  // The selector's comparisons: those the search made, or made now.
+  const KeyImageSelector::CompareFn compare_cached = [&](const FrameRecord& key, const FrameRecord& frame) {
+    const auto it = comparisons.find({key.frame->index, frame.frame->index});
+    if (it != comparisons.end()) return it->second;
+    return remember(key.frame->index, frame.frame->index, compare(key, frame));
+  };
   std::unique_ptr<LinkVerifier> link_verifier;
   if (verifier.own_magsac) link_verifier = std::make_unique<LinkVerifier>(VerifierOptions(verifier));
 
   if (read_until(0) == 0) {
-    selector.Add(with_features(0));
+    selector.Add(with_features(0), compare_cached);
     int last_pass = 0, fed = 0, step = 1;
     for (;;) {
       const FrameRecord key = *selector.current_key();
@@ -133,7 +132,7 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
         step = std::min(window, 2 * reach);
       }
       if (first_fail < 0) {  // the last frame passes: it is the final key image (Finish)
-        if (last_pass > fed) selector.Add(frames.at(last_pass));
+        if (last_pass > fed) selector.Add(frames.at(last_pass), compare_cached);
         break;
       }
       // Bisect: the frames between the last passing and the first failing frame, split into workers + 1 parts.
@@ -150,8 +149,8 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
         if (failing >= 0) first_fail = failing;
       }
       // Algorithm 1 on the frames found: the last passing frame, then the first failing one.
-      if (last_pass > fed) selector.Add(frames.at(last_pass));
-      selector.Add(with_features(first_fail));
+      if (last_pass > fed) selector.Add(frames.at(last_pass), compare_cached);
+      selector.Add(with_features(first_fail), compare_cached);
       fed = last_pass = first_fail;
       step = 1;
     }

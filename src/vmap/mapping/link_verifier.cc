@@ -37,7 +37,7 @@ int LinkVerifier::Apply(VisualMap* map, double tau) const {
     const auto pair = std::make_pair(map->key_images[link.from_key].frame_index,
                                      map->key_images[link.to_key].frame_index);
     const PairComparison& verified = results_.at(pair);
-    if ((verified.matched && verified.similarity >= tau) == !link.below_tau) {
+    if (verified.Reaches(tau) == !link.below_tau) {
       link = MakeLink(verified, link.from_key, link.to_key, link.below_tau);
     } else {
       ++kept;

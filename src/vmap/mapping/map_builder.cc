@@ -87,9 +87,8 @@ class MapBuilder::Impl {
         link_verifier_->Add(keys[link.from_key], keys[link.to_key], link, options_.key_images.similarity,
                             comparison.checkpoint);
       };
-      selectors_.push_back(std::make_unique<KeyImageSelector>(key_options, CompareFor(taus_[i]),
-                                                              std::move(on_key_image), std::move(on_evaluation),
-                                                              std::move(on_link)));
+      selectors_.push_back(std::make_unique<KeyImageSelector>(key_options, std::move(on_key_image),
+                                                              std::move(on_evaluation), std::move(on_link)));
     }
     if (stops_early_) link_verifier_ = std::make_unique<LinkVerifier>(VerifierOptions(verifier_));
     link_analyses_.resize(selectors_.size());
@@ -157,29 +156,29 @@ class MapBuilder::Impl {
   double seconds() const { return SecondsSince(start_); }
 
  private:
-  // The comparisons of the current frame, by key frame: made ahead by the pipeline, or here when a key image
-  // changed meanwhile. A pair compared under several taus is matched once. A comparison that stopped early is
+  // The comparisons of a frame for the selector with threshold `tau`, from `comparisons` (the frame's, by key
+  // frame): made ahead by the pipeline, or here when a key image changed meanwhile. A pair compared under several taus is matched once. A comparison that stopped early is
   // used only when it settled exactly ThresholdsToSettle: the workers guess which selectors will hold a key
   // image, and a comparison made for another set could give another S, and another decision (before this, a
   // sweep could give other tables from one run to the next).
-  KeyImageSelector::CompareFn CompareFor(double tau) {
-    return [this, tau](const FrameRecord& key, const FrameRecord& frame) -> PairComparison {
+  KeyImageSelector::CompareFn CompareFor(double tau, std::map<int, PairComparison>& comparisons) {
+    return [this, tau, &comparisons](const FrameRecord& key, const FrameRecord& frame) -> PairComparison {
       const int key_index = key.frame->index;
       const auto held = holders_.find(key_index);
       const std::vector<double> asked = ThresholdsToSettle(
           key_index, frame.frame->index, held != holders_.end() ? &held->second : nullptr, sorted_taus_, tau);
-      auto it = comparisons_of_frame_->find(key_index);
-      if (it != comparisons_of_frame_->end() && (it->second.exhaustive || it->second.decided_taus == asked)) {
+      auto it = comparisons.find(key_index);
+      if (it != comparisons.end() && (it->second.exhaustive || it->second.decided_taus == asked)) {
         return it->second;
       }
-      return (*comparisons_of_frame_)[key_index] = compare_pair_(key, frame, asked, nullptr);
+      return comparisons[key_index] = compare_pair_(key, frame, asked, nullptr);
     };
   }
 
   void Process(PipelineItem& item) {
-    comparisons_of_frame_ = &item.comparisons;
-    for (auto& selector : selectors_) selector->Add(item.record);
-    comparisons_of_frame_ = nullptr;
+    for (size_t i = 0; i < selectors_.size(); ++i) {
+      selectors_[i]->Add(item.record, CompareFor(taus_[i], item.comparisons));
+    }
     // Tell the workers which key images the coming frames will be compared with (a handful of shared pointers:
     // cheaper to publish every frame than to track changes).
     std::map<int, CurrentKey> keys;  // by key frame index
@@ -220,7 +219,6 @@ class MapBuilder::Impl {
   ProgressLine progress_;
   CompareForTausFn compare_pair_;
   std::atomic<long> pairs_matched_{0}, pairs_abandoned_{0};
-  std::map<int, PairComparison>* comparisons_of_frame_ = nullptr;
   std::map<int, std::vector<double>> holders_;  // key frame index -> taus of the selectors holding it
   std::vector<std::unique_ptr<KeyImageSelector>> selectors_;
   std::vector<LinkAnalysisCache> link_analyses_;  // per selector: what snapshots analysed stays analysed
