@@ -1,10 +1,7 @@
 #include "vmap/mapping/feature_pipeline.h"
 
 #include <algorithm>
-#include <exception>
-#include <stdexcept>
 #include <string>
-#include <system_error>
 
 #include "vmap/core/error.h"
 
@@ -29,32 +26,13 @@ FeaturePipeline::FeaturePipeline(const Matcher& matcher, int depth, int workers,
       compare_(std::move(compare)),
       all_taus_(std::move(all_taus)),
       depth_(std::max(depth, workers + 1)),
-      to_extract_(static_cast<size_t>(depth_)) {
-  try {
-    for (int i = 0; i < workers; ++i) workers_.emplace_back([this] { Work(); });
-  } catch (const std::system_error& error) {
-    // The system refused a thread (a process limit): stop those already started, or their destructors abort.
-    Stop();
-    throw InputError("cannot start " + std::to_string(workers) + " threads (" + error.what() +
-                     "); use fewer extraction threads");
-  }
-}
+      frames_(depth_, workers, [this](Frame decoded) { return ExtractAndCompare(std::move(decoded)); }) {}
 
-FeaturePipeline::~FeaturePipeline() { Stop(); }
+FeaturePipeline::~FeaturePipeline() = default;
 
-bool FeaturePipeline::TryPush(Frame& frame) {
-  results_.RethrowIfFailed();
-  if (closed_) throw std::logic_error("FeaturePipeline::TryPush after Close");
-  if (pushed_ - next_out_ >= depth_) return false;
-  // Never waits: the queue holds at most the frames in flight, fewer than its capacity.
-  to_extract_.Push({pushed_++, std::move(frame)});
-  return true;
-}
+bool FeaturePipeline::TryPush(Frame& frame) { return frames_.TryPush(frame); }
 
-void FeaturePipeline::Close() {
-  closed_ = true;
-  to_extract_.Close();
-}
+void FeaturePipeline::Close() { frames_.Close(); }
 
 void FeaturePipeline::SetCurrentKeys(std::vector<CurrentKey> keys) {
   auto shared = std::make_shared<const std::vector<CurrentKey>>(std::move(keys));
@@ -62,46 +40,16 @@ void FeaturePipeline::SetCurrentKeys(std::vector<CurrentKey> keys) {
   current_keys_ = std::move(shared);
 }
 
-std::optional<PipelineItem> FeaturePipeline::Next() {
-  if (next_out_ == pushed_) {
-    if (closed_) return std::nullopt;
-    throw std::logic_error("FeaturePipeline::Next with no frame in flight");
-  }
-  return Took(results_.Take(next_out_));
-}
+std::optional<PipelineItem> FeaturePipeline::Next() { return Took(frames_.Next()); }
 
-std::optional<PipelineItem> FeaturePipeline::TryNext() {
-  if (next_out_ == pushed_) return std::nullopt;
-  std::optional<PipelineItem> item = results_.TryTake(next_out_);
-  if (!item) return std::nullopt;
-  return Took(std::move(*item));
-}
+std::optional<PipelineItem> FeaturePipeline::TryNext() { return Took(frames_.TryNext()); }
 
-void FeaturePipeline::Stop() {
-  stop_ = true;
-  to_extract_.Close();
-  for (std::thread& worker : workers_) worker.join();
-}
-
-PipelineItem FeaturePipeline::Took(PipelineItem item) {
-  ++next_out_;
+std::optional<PipelineItem> FeaturePipeline::Took(std::optional<PipelineItem> item) {
+  if (!item) return item;
   // A successor is a frame at most a pipeline's depth behind the consumer; keep a margin.
   std::lock_guard<std::mutex> lock(mutex_);
-  recent_.erase(recent_.begin(), recent_.lower_bound(static_cast<int>(next_out_) - 2 * depth_));
+  recent_.erase(recent_.begin(), recent_.lower_bound(static_cast<int>(frames_.taken()) - 2 * depth_));
   return item;
-}
-
-void FeaturePipeline::Work() {
-  while (std::optional<std::pair<long, Frame>> decoded = to_extract_.Pop()) {
-    if (stop_) continue;  // stopping: drain without work
-    try {
-      results_.Put(decoded->first, ExtractAndCompare(std::move(decoded->second)));
-    } catch (...) {
-      stop_ = true;
-      results_.Fail(std::current_exception());
-      to_extract_.Close();
-    }
-  }
 }
 
 PipelineItem FeaturePipeline::ExtractAndCompare(Frame decoded) {

@@ -12,8 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "vmap/core/bounded_queue.h"
-#include "vmap/core/reorder_buffer.h"
+#include "vmap/core/ordered_pipeline.h"
 #include "vmap/features/matcher.h"
 #include "vmap/mapping/key_image_selector.h"
 
@@ -48,9 +47,9 @@ struct PipelineItem {
 };
 
 // Takes frames from the consumer (TryPush) and, on `workers` threads, extracts their features and compares
-// them with the current key images, a few frames ahead of the consumer, which receives them in order (Next).
-// The frames in flight are bounded by `depth`; the frames come decoded (BuildMap reads them ahead on a thread
-// of their own, ReadAheadSource).
+// them with the current key images, a few frames ahead of the consumer, which receives them in order (Next):
+// an OrderedPipeline whose work follows the key images. The frames in flight are bounded by `depth`; the
+// frames come decoded (BuildMap reads them ahead on a thread of their own, ReadAheadSource).
 //
 // Why compare ahead: a frame is compared with the same key image as the frames before it until S drops,
 // so those comparisons do not depend on each other and can run in parallel.
@@ -93,10 +92,7 @@ class FeaturePipeline {
   long extracted() const { return extracted_; }
 
  private:
-  void Stop();
-  PipelineItem Took(PipelineItem item);
-  // A worker: frames from the queue until it closes; an error stops the pipeline and reaches the consumer.
-  void Work();
+  std::optional<PipelineItem> Took(std::optional<PipelineItem> item);
   PipelineItem ExtractAndCompare(Frame decoded);
   // The key image a selector with threshold `tau` that held `key_index` compares `frame_index` with, as far as
   // the workers know: that key, or the successor of a key that this frame or an earlier one fell below tau
@@ -110,13 +106,6 @@ class FeaturePipeline {
   const CompareForTausFn compare_;
   const std::vector<double> all_taus_;
   const int depth_;
-  // The consumer's side: frames handed over and taken out (in flight: the difference).
-  long pushed_ = 0;
-  long next_out_ = 0;
-  bool closed_ = false;
-  BoundedQueue<std::pair<long, Frame>> to_extract_;  // decoded frames waiting for a worker, numbered
-  ReorderBuffer<PipelineItem> results_;              // extracted and compared, by number
-  std::atomic<bool> stop_{false};
   std::atomic<long> extracted_{0};
   // What the workers share to follow key changes.
   std::mutex mutex_;
@@ -128,7 +117,7 @@ class FeaturePipeline {
   };
   std::map<int, std::vector<Retirement>> retired_;  // by key frame index
   std::map<int, FrameRecord> recent_;    // extracted frames a successor may be taken from, by frame index
-  std::vector<std::thread> workers_;     // last: started once everything they use exists
+  OrderedPipeline<Frame, PipelineItem> frames_;  // last: its workers start once everything they use exists
 };
 
 }  // namespace vmap
