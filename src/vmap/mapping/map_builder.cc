@@ -156,11 +156,11 @@ class MapBuilder::Impl {
   double seconds() const { return SecondsSince(start_); }
 
  private:
-  // The comparisons of a frame for the selector with threshold `tau`, from `comparisons` (the frame's, by key
-  // frame): made ahead by the pipeline, or here when a key image changed meanwhile. A pair compared under several taus is matched once. A comparison that stopped early is
-  // used only when it settled exactly ThresholdsToSettle: the workers guess which selectors will hold a key
-  // image, and a comparison made for another set could give another S, and another decision (before this, a
-  // sweep could give other tables from one run to the next).
+  // The comparisons of a frame for the selector with threshold `tau`, from `comparisons` (the frame's, by key frame):
+  // made ahead by the pipeline, or here when a key image changed meanwhile. A pair compared under several taus is
+  // matched once. A comparison that stopped early is used only when it settled exactly ThresholdsToSettle: the workers
+  // guess which selectors will hold a key image, and a comparison made for another set could give another S, and
+  // another decision (before this, a sweep could give other tables from one run to the next).
   KeyImageSelector::CompareFn CompareFor(double tau, std::map<int, PairComparison>& comparisons) {
     return [this, tau, &comparisons](const FrameRecord& key, const FrameRecord& frame) -> PairComparison {
       const int key_index = key.frame->index;

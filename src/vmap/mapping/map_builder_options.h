@@ -53,11 +53,11 @@ struct MapBuilderOptions {
   void Check() const;  // throws OptionError naming the bad field
 };
 
-// kAuto resolves to kSequential, for every matcher (Check() refuses kBisect with `exhaustive`). Bisect was
-// measured as the deep matchers' default and dropped (README, "Threshold sweeps": deep matchers): for XFeat it was no faster
-// (0.90-1.04x on three of four sequences, more comparisons where S does not fall with distance), and for
-// ALIKED, 1.5-10x faster, it changed the map on three of four sequences (its S stays high until its matches run
-// out). It stays available as --search bisect.
+// kAuto resolves to kSequential, for every matcher (Check() refuses kBisect with `exhaustive`). Bisect was measured as
+// the deep matchers' default and dropped (README, "Threshold sweeps": deep matchers): for XFeat it was no faster
+// (0.90-1.04x on three of four sequences, more comparisons where S does not fall with distance), and for ALIKED,
+// 1.5-10x faster, it changed the map on three of four sequences (its S stays high until its matches run out). It stays
+// available as --search bisect.
 KeySearch ResolveKeySearch(const MapBuilderOptions& options);
 
 class JsonFieldReader;
