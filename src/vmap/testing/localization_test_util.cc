@@ -4,6 +4,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/map/map_io.h"
+#include "vmap/mapping/recorded_options.h"
 
 namespace vmap::testing {
 
