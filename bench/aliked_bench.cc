@@ -25,7 +25,7 @@
 
 #include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/batch_build.h"
 #include "vmap/neural/aliked/aliked_matcher.h"
 #include "vmap/neural/aliked/aliked_model.h"
 #include "vmap/neural/aliked/aliked_weights.h"

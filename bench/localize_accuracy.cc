@@ -31,7 +31,7 @@
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localize_sequence.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/batch_build.h"
 #include "vmap/map/map_io.h"
 
 namespace fs = std::filesystem;

@@ -29,7 +29,7 @@
 #include "vmap/features/matcher_registry.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localize_sequence.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/batch_build.h"
 #include "vmap/map/map_io.h"
 
 namespace fs = std::filesystem;

@@ -28,7 +28,8 @@
 
 #include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/batch_build.h"
+#include "vmap/mapping/sweep_thresholds.h"
 #include "vmap/map/map_io.h"
 #include "vmap/sources/frame_source.h"
 
@@ -197,8 +198,8 @@ int main(int argc, char** argv) {
       const bool reference = e.matched && e.similarity >= taus[t];
       const auto pair = std::make_pair(e.key_frame, e.frame);
       ++decisions;
-      flipped_seed += (seed_one[pair].matched && seed_one[pair].similarity >= taus[t]) != reference;
-      flipped_fast += (fast[pair].matched && fast[pair].similarity >= taus[t]) != reference;
+      flipped_seed += seed_one[pair].Reaches(taus[t]) != reference;
+      flipped_fast += fast[pair].Reaches(taus[t]) != reference;
     }
     std::printf("| %.1f | %d | %d | %d |\n", taus[t], decisions, flipped_seed, flipped_fast);
     total += decisions;

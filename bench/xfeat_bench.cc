@@ -24,7 +24,7 @@
 
 #include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/batch_build.h"
 #include "vmap/neural/xfeat/xfeat_matcher.h"
 #include "vmap/neural/xfeat/xfeat_model.h"
 #include "vmap/neural/xfeat/xfeat_weights.h"

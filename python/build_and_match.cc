@@ -19,6 +19,7 @@
 #include "vmap/cli/map_options.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/features/matcher_registry.h"
+#include "vmap/mapping/batch_build.h"
 #include "vmap/mapping/map_builder.h"
 #include "vmap/mapping/pair_match.h"
 #include "vmap/sources/image_frame.h"

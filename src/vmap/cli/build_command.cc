@@ -14,6 +14,7 @@
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
 #include "vmap/core/interrupt.h"
+#include "vmap/mapping/batch_build.h"
 #include "vmap/mapping/map_builder.h"
 #include "vmap/map/map_io.h"
 #include "vmap/map/map_writer.h"

@@ -5,7 +5,7 @@
 
 #include "vmap/cli/commands.h"
 #include "vmap/map/map_io.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/recorded_options.h"
 #include "vmap/report/summary.h"
 
 namespace vmap::cli {

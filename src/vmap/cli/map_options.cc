@@ -8,6 +8,7 @@
 #include "vmap/core/error.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/map/map_io.h"
+#include "vmap/mapping/recorded_options.h"
 #include "vmap/report/html_report.h"
 #include "vmap/report/summary.h"
 

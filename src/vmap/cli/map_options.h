@@ -10,7 +10,7 @@
 #include "vmap/cli/option_flags.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/features/matcher.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/batch_build.h"
 
 namespace vmap::cli {
 

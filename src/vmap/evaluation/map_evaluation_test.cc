@@ -12,7 +12,7 @@
 #include "vmap/core/json_fields.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/geometry/relative_pose.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/batch_build.h"
 #include "vmap/report/evaluation_summary.h"
 #include "vmap/testing/option_error.h"
 #include "vmap/testing/scoped_temp_dir.h"

@@ -20,6 +20,11 @@
 // up to three least-squares fits on the inliers polish the best model; the inliers are the points whose Sampson
 // distance is below the threshold. It matches OpenCV's results within the noise of OpenCV's own seed (see
 // magsac_test.cc and bench/estimator_compare.cc), not bit for bit: the random streams differ.
+//
+// The code, for a reader: robust_loop.h is the loop (sampling, SPRT, the stop, the state a stopped loop resumes
+// from), apart from any model; fundamental_solvers.h the 7-point and 8-point solvers; magsac_scoring.h the
+// MAGSAC++ score and sigma-consensus++; degensac.h the plane-and-parallax recovery; magsac.cc puts them
+// together (the loop's Problem), resumes, polishes and reports.
 
 #include <vector>
 
@@ -39,8 +44,8 @@ struct MagsacStatistics {
 // Estimates F (x1^T F x0 = 0) with the options' threshold, confidence, max_iterations, seed and min_matches
 // (options.method is not read). With `early_stop`, the loop ends as soon as, for every target t, either a model
 // with at least t inliers was found or min(SamplesToSettle(t / n, ...), options.max_samples_to_reject) samples
-// were drawn; the run without targets goes on from there with the same samples. Deterministic: the same correspondences (in any order) and seed
-// give the same result.
+// were drawn; the run without targets goes on from there with the same samples. Deterministic: the same
+// correspondences (in any order) and seed give the same result.
 FundamentalResult EstimateFundamentalMagsac(const std::vector<cv::Point2f>& points0,
                                             const std::vector<cv::Point2f>& points1, const VerifierOptions& options,
                                             const EarlyStop& early_stop = {}, MagsacStatistics* statistics = nullptr);

@@ -6,7 +6,7 @@
 #include "vmap/features/matcher_registry.h"
 #include "vmap/features/matcher_options_json.h"
 #include "vmap/map/map_io.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/recorded_options.h"
 
 namespace vmap {
 

@@ -12,7 +12,7 @@
 #include "vmap/features/orb_matcher.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localization_output.h"
-#include "vmap/localization/localization_test_util.h"
+#include "vmap/testing/localization_test_util.h"
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/map/map_io.h"
 #include "vmap/report/html_report.h"

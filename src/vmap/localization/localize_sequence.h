@@ -1,11 +1,11 @@
 #pragma once
-// Localizes a stream of frames against a map: frames are decoded and their features extracted on worker
-// threads, a few frames ahead, while the calling thread runs the Localizer on them in order. The workers
-// also compare each frame with the key images of the latest estimate (Localizer::LikelyKeys), since most
-// frames are compared with the same two key images as the frame before: the calling thread then only
-// decides, and compares what the workers did not guess. The results are the same as without (comparisons
-// are deterministic). Memory stays flat: only the frames in flight are held, and each result goes to the
-// caller as soon as it is known.
+// Localizes a stream of frames against a map: frames are decoded on a thread of their own and their features extracted
+// on worker threads (core/ordered_pipeline.h), a few frames ahead, while the calling thread runs the Localizer on them
+// in order. The workers also compare each frame with the key images of the latest estimate (Localizer::LikelyKeys),
+// since most frames are compared with the same two key images as the frame before: the calling thread then only
+// decides, and compares what the workers did not guess. The results are the same as without (comparisons are
+// deterministic). Memory stays flat: only the frames in flight are held, and each result goes to the caller as soon as
+// it is known.
 
 #include <functional>
 

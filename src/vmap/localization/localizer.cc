@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "vmap/core/error.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/recorded_options.h"
 
 namespace vmap {
 

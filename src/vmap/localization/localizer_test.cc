@@ -8,7 +8,7 @@
 #include "vmap/core/error.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/localization/localization_map.h"
-#include "vmap/localization/localization_test_util.h"
+#include "vmap/testing/localization_test_util.h"
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/testing/option_error.h"
 #include "vmap/testing/scoped_temp_dir.h"

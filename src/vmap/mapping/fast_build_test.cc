@@ -15,7 +15,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/features/orb_matcher.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/batch_build.h"
 #include "vmap/testing/option_error.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/shared_data.h"
@@ -341,8 +341,8 @@ TEST(FastBuild, DefaultSweepDecidesWithinTheNoiseOfASeedChange) {
                                               asked[{e.key_frame, e.frame}]);
       ASSERT_TRUE(fast.Decides(taus[t]));
       ++decisions;
-      flipped_by_seed += (other.matched && other.similarity >= taus[t]) != decision;
-      flipped_by_early_stop += (fast.matched && fast.similarity >= taus[t]) != decision;
+      flipped_by_seed += other.Reaches(taus[t]) != decision;
+      flipped_by_early_stop += fast.Reaches(taus[t]) != decision;
     }
   }
   EXPECT_GT(decisions, 300);

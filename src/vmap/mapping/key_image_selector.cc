@@ -93,7 +93,7 @@ PairComparison VerifyMatches(const TentativeMatches& matches, int denominator, c
     result.decided_taus = decide_taus;
     std::sort(result.decided_taus.begin(), result.decided_taus.end());
     for (double tau : decide_taus) {
-      if (!(result.matched && result.similarity >= tau)) result.lowest_failed_tau = std::min(result.lowest_failed_tau, tau);
+      if (!result.Reaches(tau)) result.lowest_failed_tau = std::min(result.lowest_failed_tau, tau);
     }
   }
   return result;
@@ -113,18 +113,13 @@ Link MakeLink(const PairComparison& comparison, int from_key, int to_key, bool b
   return link;
 }
 
-KeyImageSelector::KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image,
-                                   EvaluationFn on_evaluation, LinkFn on_link)
+KeyImageSelector::KeyImageSelector(KeyImageOptions options, KeyImageFn on_key_image, EvaluationFn on_evaluation,
+                                   LinkFn on_link)
     : options_(options),
-      compare_(std::move(compare)),
       on_key_image_(std::move(on_key_image)),
       on_evaluation_(std::move(on_evaluation)),
       on_link_(std::move(on_link)) {
   options_.Check();
-}
-
-bool KeyImageSelector::Passes(const PairComparison& comparison) const {
-  return comparison.matched && comparison.similarity >= options_.tau;
 }
 
 bool KeyImageSelector::ShowsKeyView(const PairComparison& comparison) const {
@@ -157,7 +152,7 @@ void KeyImageSelector::AddLink(const PairComparison& comparison, bool below_tau)
   if (on_link_) on_link_(links_.back(), comparison);
 }
 
-void KeyImageSelector::Add(const FrameRecord& record) {
+void KeyImageSelector::Add(const FrameRecord& record, const CompareFn& compare) {
   if (finished_) throw std::logic_error("KeyImageSelector::Add after Finish");
   ++num_frames_;
   if (!key_) {
@@ -167,7 +162,7 @@ void KeyImageSelector::Add(const FrameRecord& record) {
   // Compare the frame with the key image; on failure the previous frame becomes the key image and the
   // frame is compared again with it, so no frame is skipped.
   for (;;) {
-    PairComparison comparison = compare_(*key_, record);
+    PairComparison comparison = compare(*key_, record);
     const Evaluation evaluation{key_->frame->index,       record.frame->index,       comparison.similarity,
                                 comparison.num_tentative, comparison.num_verified, comparison.matched};
     if (on_evaluation_) {
@@ -175,7 +170,7 @@ void KeyImageSelector::Add(const FrameRecord& record) {
     } else {
       evaluations_.push_back(evaluation);
     }
-    if (Passes(comparison)) {
+    if (comparison.Reaches(options_.tau)) {
       last_frame_still_ = ShowsKeyView(comparison);
       if (last_frame_still_) {
         ++still_frames_;  // the key image's view again: not a candidate for the next key image

@@ -71,9 +71,9 @@ struct PairComparison {
   // When not exhaustive: where verification stopped. VerifyMatches given it back (`resume_from`) goes on from
   // there instead of starting over, e.g. to verify a link in full.
   std::shared_ptr<const MagsacCheckpoint> checkpoint;
-  bool Decides(double tau) const {
-    return exhaustive || (matched && similarity >= tau) || tau >= lowest_failed_tau;
-  }
+  // Algorithm 1's test, the one place it is written: the frame passes against the key image at threshold tau.
+  bool Reaches(double tau) const { return matched && similarity >= tau; }
+  bool Decides(double tau) const { return exhaustive || Reaches(tau) || tau >= lowest_failed_tau; }
 };
 
 // Matches two images and verifies the matches: the S(I_i, I_j) of the paper. With `decide_taus` and a verifier
@@ -108,8 +108,8 @@ class KeyImageSelector {
   // Called once for every new link (already in links()), with the comparison it was made from.
   using LinkFn = std::function<void(const Link& link, const PairComparison& comparison)>;
 
-  KeyImageSelector(KeyImageOptions options, CompareFn compare, KeyImageFn on_key_image = nullptr,
-                   EvaluationFn on_evaluation = nullptr, LinkFn on_link = nullptr);
+  explicit KeyImageSelector(KeyImageOptions options, KeyImageFn on_key_image = nullptr,
+                            EvaluationFn on_evaluation = nullptr, LinkFn on_link = nullptr);
 
   // Algorithm 1's successor rule, for those who compare ahead of the selector (MapBuilder's workers): when
   // frame `failing_frame` falls below tau against the key image at `key_frame`, the next key image is the frame
@@ -120,8 +120,10 @@ class KeyImageSelector {
     return failing_frame - 1 == key_frame ? failing_frame : failing_frame - 1;
   }
 
-  // Frames must arrive in order. The first frame becomes the first key image.
-  void Add(const FrameRecord& record);
+  // Frames must arrive in order. The first frame becomes the first key image. `compare` gives the comparisons
+  // this frame needs (with the key image, and with a new key image when it falls below tau): the caller's, per
+  // frame, e.g. from comparisons made ahead for it.
+  void Add(const FrameRecord& record, const CompareFn& compare);
   // Ends the sequence: adds the final key image when asked to.
   void Finish();
 
@@ -133,13 +135,11 @@ class KeyImageSelector {
   const FrameRecord* current_key() const { return key_ ? &*key_ : nullptr; }
 
  private:
-  bool Passes(const PairComparison& comparison) const;
   bool ShowsKeyView(const PairComparison& comparison) const;
   void AddKeyImage(const FrameRecord& record, const std::string& reason);
   void AddLink(const PairComparison& comparison, bool below_tau);
 
   KeyImageOptions options_;
-  CompareFn compare_;
   KeyImageFn on_key_image_;
   EvaluationFn on_evaluation_;
   LinkFn on_link_;

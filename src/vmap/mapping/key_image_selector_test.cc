@@ -43,23 +43,20 @@ SelectionRun Select(int n, double tau, const std::function<double(int, int)>& si
   options.tau = tau;
   options.final_key = final_key;
   std::vector<ReportedLink> reported;
-  KeyImageSelector selector(
-      options,
-      [&](const FrameRecord& key, const FrameRecord& frame) {
-        PairComparison c;
-        const double s = similarity(key.frame->index, frame.frame->index);
-        run.evaluated.emplace_back(key.frame->index, frame.frame->index);
-        c.matched = s >= 0;
-        c.similarity = c.matched ? s : 0.0;
-        c.num_tentative = 100;
-        c.num_verified = c.matched ? static_cast<int>(s * 100) : 0;
-        return c;
-      },
-      nullptr, nullptr,
-      [&](const Link& link, const PairComparison& comparison) {
-        reported.push_back({link.to_key, comparison.similarity});
-      });
-  for (int i = 0; i < n; ++i) selector.Add(Record(i));
+  KeyImageSelector selector(options, nullptr, nullptr, [&](const Link& link, const PairComparison& comparison) {
+    reported.push_back({link.to_key, comparison.similarity});
+  });
+  const KeyImageSelector::CompareFn compare = [&](const FrameRecord& key, const FrameRecord& frame) {
+    PairComparison c;
+    const double s = similarity(key.frame->index, frame.frame->index);
+    run.evaluated.emplace_back(key.frame->index, frame.frame->index);
+    c.matched = s >= 0;
+    c.similarity = c.matched ? s : 0.0;
+    c.num_tentative = 100;
+    c.num_verified = c.matched ? static_cast<int>(s * 100) : 0;
+    return c;
+  };
+  for (int i = 0; i < n; ++i) selector.Add(Record(i), compare);
   selector.Finish();
   for (const KeyImage& k : selector.key_images()) run.keys.push_back(k.frame_index);
   for (const Link& l : selector.links()) {
@@ -132,7 +129,8 @@ std::vector<int> SelectViews(const std::vector<int>& views, double tau, double m
   KeyImageOptions options;
   options.tau = tau;
   options.min_key_displacement = min_displacement;
-  KeyImageSelector selector(options, [&](const FrameRecord& key, const FrameRecord& frame) {
+  KeyImageSelector selector(options);
+  const KeyImageSelector::CompareFn compare = [&](const FrameRecord& key, const FrameRecord& frame) {
     const int distance = std::abs(views[frame.frame->index] - views[key.frame->index]);
     PairComparison c;
     c.matched = true;
@@ -141,8 +139,8 @@ std::vector<int> SelectViews(const std::vector<int>& views, double tau, double m
     c.num_tentative = 100;
     c.num_verified = static_cast<int>(100 * c.similarity);
     return c;
-  });
-  for (int i = 0; i < static_cast<int>(views.size()); ++i) selector.Add(Record(i));
+  };
+  for (int i = 0; i < static_cast<int>(views.size()); ++i) selector.Add(Record(i), compare);
   selector.Finish();
   std::vector<int> keys;
   for (const KeyImage& k : selector.key_images()) {
@@ -177,6 +175,18 @@ TEST(KeyImageSelector, RepeatedFramesAreNotPromotedWhenANeighbourWillDo) {
   KeyImageOptions bad;
   bad.min_key_displacement = -1;
   EXPECT_EQ(testing::OptionErrorPath([&] { bad.Check(); }), "min_key_displacement");
+}
+
+// Algorithm 1's test: matched and S >= tau (inclusive); an unmatched pair never passes, whatever its S.
+TEST(PairComparison, ReachesTauOnlyWhenMatchedAndSimilarEnough) {
+  PairComparison c;
+  c.matched = true;
+  c.similarity = 0.4;
+  EXPECT_TRUE(c.Reaches(0.4));
+  EXPECT_TRUE(c.Reaches(0.3));
+  EXPECT_FALSE(c.Reaches(0.41));
+  c.matched = false;
+  EXPECT_FALSE(c.Reaches(0.3));
 }
 
 TEST(KeyImageSelector, TauOutsideTheUnitIntervalIsRejected) {

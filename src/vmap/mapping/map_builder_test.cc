@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include "vmap/core/error.h"
+#include "vmap/mapping/batch_build.h"
+#include "vmap/mapping/sweep_thresholds.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/map/map_io.h"
 #include "vmap/map/map_writer.h"

@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/error.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/recorded_options.h"
 #include "vmap/testing/option_error.h"
 
 namespace vmap {

@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 #include <torch/serialize.h>
 
-#include "vmap/neural/golden_util.h"
+#include "vmap/testing/golden_util.h"
 #include "vmap/neural/state_dict.h"
 
 namespace vmap::neural {

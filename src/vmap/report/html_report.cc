@@ -17,7 +17,7 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/map/map_io.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/recorded_options.h"
 #include "vmap/report/html_page.h"
 #include "vmap/report/html_util.h"
 #include "vmap/report/link_table.h"

@@ -14,7 +14,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/batch_build.h"
 #include "vmap/map/visual_map.h"
 #include "vmap/report/match_figure.h"
 

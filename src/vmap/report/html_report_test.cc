@@ -14,7 +14,7 @@
 #include "vmap/core/error.h"
 #include "vmap/map/map_io.h"
 #include "vmap/report/report_assets.h"
-#include "vmap/report/report_test_util.h"
+#include "vmap/testing/report_test_util.h"
 #include "vmap/testing/option_error.h"
 #include "vmap/testing/scoped_temp_dir.h"
 

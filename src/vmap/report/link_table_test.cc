@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "vmap/report/html_report.h"
-#include "vmap/report/report_test_util.h"
+#include "vmap/testing/report_test_util.h"
 #include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {

@@ -19,7 +19,7 @@
 #include "vmap/map/map_io.h"
 #include "vmap/report/html_report.h"
 #include "vmap/report/localization_report.h"
-#include "vmap/report/report_test_util.h"
+#include "vmap/testing/report_test_util.h"
 #include "vmap/testing/run_vmap.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/shared_data.h"

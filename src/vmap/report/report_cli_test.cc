@@ -10,7 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "vmap/report/html_report.h"
-#include "vmap/report/report_test_util.h"
+#include "vmap/testing/report_test_util.h"
 #include "vmap/testing/run_vmap.h"
 #include "vmap/testing/scoped_temp_dir.h"
 

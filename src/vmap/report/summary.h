@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <string>
 
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/batch_build.h"
 #include "vmap/map/visual_map.h"
 
 namespace vmap {

@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "vmap/report/report_test_util.h"
+#include "vmap/testing/report_test_util.h"
 
 namespace vmap::report {
 namespace {

@@ -9,7 +9,7 @@
 #include <torch/torch.h>
 
 #include "vmap/features/matcher_registry.h"
-#include "vmap/neural/golden_util.h"
+#include "vmap/testing/golden_util.h"
 
 namespace vmap::neural {
 namespace {

@@ -13,7 +13,7 @@
 #include "vmap/features/float_matcher.h"
 #include "vmap/neural/aliked/aliked_model.h"
 #include "vmap/neural/aliked/aliked_weights.h"
-#include "vmap/neural/golden_util.h"
+#include "vmap/testing/golden_util.h"
 
 namespace vmap::neural {
 namespace {

@@ -10,7 +10,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/neural/aliked/aliked_matcher.h"
-#include "vmap/neural/golden_util.h"
+#include "vmap/testing/golden_util.h"
 
 namespace vmap {
 namespace {

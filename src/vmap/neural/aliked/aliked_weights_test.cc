@@ -8,7 +8,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/neural/aliked/aliked_weights.h"
-#include "vmap/neural/golden_util.h"
+#include "vmap/testing/golden_util.h"
 
 namespace vmap::neural {
 namespace {

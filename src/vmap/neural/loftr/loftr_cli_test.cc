@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "vmap/neural/golden_util.h"
+#include "vmap/testing/golden_util.h"
 
 namespace vmap::neural {
 namespace {

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "vmap/neural/golden_util.h"
+#include "vmap/testing/golden_util.h"
 #include "vmap/neural/loftr/loftr_model.h"
 #include "vmap/neural/loftr/loftr_weights.h"
 

@@ -10,7 +10,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/features/matcher_registry.h"
-#include "vmap/neural/golden_util.h"
+#include "vmap/testing/golden_util.h"
 #include "vmap/neural/loftr/loftr_matcher.h"
 
 namespace vmap {

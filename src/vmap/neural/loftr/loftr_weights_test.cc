@@ -8,7 +8,7 @@
 #include <torch/serialize.h>
 
 #include "vmap/core/error.h"
-#include "vmap/neural/golden_util.h"
+#include "vmap/testing/golden_util.h"
 #include "vmap/neural/loftr/loftr_weights.h"
 
 namespace vmap::neural {

@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <torch/torch.h>
 
-#include "vmap/neural/golden_util.h"
+#include "vmap/testing/golden_util.h"
 
 namespace vmap::neural {
 namespace {

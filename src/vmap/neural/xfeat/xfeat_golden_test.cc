@@ -11,7 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "vmap/features/float_matcher.h"
-#include "vmap/neural/golden_util.h"
+#include "vmap/testing/golden_util.h"
 #include "vmap/neural/xfeat/xfeat_model.h"
 #include "vmap/neural/xfeat/xfeat_weights.h"
 

@@ -12,7 +12,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/features/matcher_registry.h"
-#include "vmap/neural/golden_util.h"
+#include "vmap/testing/golden_util.h"
 #include "vmap/neural/xfeat/xfeat_matcher.h"
 
 namespace vmap {

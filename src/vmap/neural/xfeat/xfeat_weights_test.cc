@@ -9,7 +9,7 @@
 #include <torch/serialize.h>
 
 #include "vmap/core/error.h"
-#include "vmap/neural/golden_util.h"
+#include "vmap/testing/golden_util.h"
 #include "vmap/neural/xfeat/xfeat_model.h"
 #include "vmap/neural/xfeat/xfeat_weights.h"
 

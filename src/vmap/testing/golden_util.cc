@@ -1,4 +1,4 @@
-#include "vmap/neural/golden_util.h"
+#include "vmap/testing/golden_util.h"
 
 #include <fstream>
 #include <iterator>

@@ -1,4 +1,4 @@
-#include "vmap/report/report_test_util.h"
+#include "vmap/testing/report_test_util.h"
 
 #include <stdlib.h>
 

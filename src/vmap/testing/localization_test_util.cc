@@ -1,9 +1,10 @@
-#include "vmap/localization/localization_test_util.h"
+#include "vmap/testing/localization_test_util.h"
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/map/map_io.h"
+#include "vmap/mapping/recorded_options.h"
 
 namespace vmap::testing {
 

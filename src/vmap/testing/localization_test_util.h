@@ -9,7 +9,7 @@
 #include <opencv2/core.hpp>
 
 #include "vmap/features/matcher.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/batch_build.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap::testing {

@@ -1,0 +1,41 @@
+#include "vmap/mapping/collect_map.h"
+
+#include <chrono>
+
+#include <spdlog/spdlog.h>
+
+namespace vmap {
+
+VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source, const MapBuilderOptions& options,
+                     const std::string& options_json, double seconds, bool analyze_links,
+                     const LinkVerifier* link_verifier, double tau, LinkAnalysisCache* analysis_cache) {
+  VisualMap map;
+  map.input = source.info();
+  map.options_json = options_json;
+  map.num_frames = selector.num_frames();
+  map.skipped_frames = source.skipped_frames();
+  map.key_images = selector.key_images();
+  map.links = selector.links();
+  map.evaluations = selector.evaluations();
+  map.seconds = seconds;
+  if (link_verifier) {
+    const int kept = link_verifier->Apply(&map, tau);
+    if (kept > 0) {
+      spdlog::debug("tau {:.2f}: {} of {} links kept the deciding estimate (the full one crossed tau)", tau, kept,
+                    map.links.size());
+    }
+  }
+  map.quality = ComputeStatistics(map, options.quality_mean).quality;
+  if (!analyze_links) return map;
+  const auto analysis_start = std::chrono::steady_clock::now();
+  const long reused_before = analysis_cache ? analysis_cache->hits() : 0;
+  AnalyzeLinks(map, options.link_analysis, options.ExtractionThreads(), analysis_cache);
+  const double analysis_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - analysis_start).count();
+  spdlog::debug("pose, parallax and homography test of {} links in {:.3f} s ({} analysed before)", map.links.size(),
+                analysis_seconds, analysis_cache ? analysis_cache->hits() - reused_before : 0);
+  map.seconds += analysis_seconds;  // part of building the map
+  return map;
+}
+
+}  // namespace vmap

@@ -1,0 +1,24 @@
+#pragma once
+// A selector's map as it stands: key images, links (verified in full where the decisions stopped early),
+// evaluations, quality and, when asked, each link's analysis (internal to mapping/).
+
+#include <string>
+
+#include "vmap/mapping/key_image_selector.h"
+#include "vmap/mapping/link_analysis.h"
+#include "vmap/mapping/link_verifier.h"
+#include "vmap/mapping/map_builder_options.h"
+#include "vmap/map/visual_map.h"
+#include "vmap/sources/frame_source.h"
+
+namespace vmap {
+
+// `link_verifier` (when the decisions stopped early): the links verified in full replace the deciding ones.
+// `analyze_links`: also each link's pose, parallax and homography test (only maps that are kept need them),
+// reusing those of `analysis_cache` where the links did not change.
+VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source, const MapBuilderOptions& options,
+                     const std::string& options_json, double seconds, bool analyze_links,
+                     const LinkVerifier* link_verifier = nullptr, double tau = 0.0,
+                     LinkAnalysisCache* analysis_cache = nullptr);
+
+}  // namespace vmap

@@ -1,0 +1,28 @@
+#pragma once
+// What a map records of the options that shaped it (map.json's "options"), typed.
+
+#include <string>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "vmap/mapping/map_builder_options.h"
+#include "vmap/sources/frame_source.h"
+
+namespace vmap {
+
+// Every option that shaped a map: map.json's "options" (sweep.json's for a sweep), the builder's and the
+// input's typed, the matcher's as the matcher describes itself (a model's record may hold derived values;
+// features/matcher_options_json.h rebuilds its options).
+struct RecordedOptions {
+  std::string matcher_json = "{}";  // Matcher::DescribeOptionsJson()
+  std::string matcher_type;         // its "type"; "" when not recorded
+  MapBuilderOptions builder;
+  FrameSourceOptions source;
+};
+// The builder's fields at the top level, "matcher" and "source" as objects.
+nlohmann::json ToJson(const RecordedOptions& options);
+// Reads a record (fields it lacks keep their defaults). Throws InputError naming `where` and the key of a
+// value of the wrong kind or an enum name this vmap does not know.
+RecordedOptions RecordedOptionsFromJson(const std::string& options_json, const std::string& where);
+
+}  // namespace vmap

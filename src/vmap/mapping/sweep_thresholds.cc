@@ -1,0 +1,60 @@
+#include "vmap/mapping/sweep_thresholds.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "vmap/core/error.h"
+#include "vmap/mapping/key_image_selector.h"
+
+namespace vmap {
+
+std::vector<double> ParseThresholds(const std::string& text) {
+  std::vector<double> taus;
+  double start, stop, step;
+  char extra;
+  if (std::sscanf(text.c_str(), "%lf:%lf:%lf%c", &start, &stop, &step, &extra) == 3) {
+    if (!std::isfinite(start) || !std::isfinite(stop) || !(step > 0) || !std::isfinite(step) || stop < start) {
+      throw OptionError("thresholds", "'" + text + "' must be start:stop:step with step > 0 and stop >= start");
+    }
+    // Count steps with a tolerance so that 0.1:0.9:0.1 includes 0.9; counted in double before anything is
+    // allocated, so that a tiny step is refused rather than filling the memory.
+    const double count = std::floor((stop - start) / step + 1e-9) + 1;
+    if (count > kMaxThresholds) {
+      throw OptionError("thresholds", fmt::format("'{}' gives {:.0f} thresholds, more than {}; use a larger step",
+                                                  text, count, kMaxThresholds));
+    }
+    for (int i = 0; i < static_cast<int>(count); ++i) taus.push_back(std::round((start + i * step) * 1e9) / 1e9);
+  } else {
+    std::stringstream list(text);
+    std::string item;
+    while (std::getline(list, item, ',')) {
+      try {
+        size_t used = 0;
+        taus.push_back(std::stod(item, &used));
+        if (used != item.size()) throw std::invalid_argument(item);
+      } catch (const std::exception&) {
+        throw OptionError("thresholds", "'" + text + "' is not start:stop:step (0.1:0.9:0.1) or a list (0.2,0.5)");
+      }
+      if (taus.size() > kMaxThresholds) {
+        throw OptionError("thresholds",
+                          "'" + text + "' lists more than " + std::to_string(kMaxThresholds) + " thresholds");
+      }
+    }
+  }
+  if (taus.empty()) throw OptionError("thresholds", "'" + text + "' gives no threshold");
+  for (size_t i = 0; i < taus.size(); ++i) {
+    KeyImageOptions check;
+    check.tau = taus[i];
+    check.Check();
+    for (size_t j = 0; j < i; ++j) {
+      if (taus[j] == taus[i]) throw OptionError("thresholds", fmt::format("'{}' gives tau = {} twice", text, taus[i]));
+    }
+  }
+  return taus;
+}
+
+}  // namespace vmap
