@@ -15,7 +15,7 @@
 #include "vmap/core/error.h"
 #include "vmap/map/map_geometry_json.h"
 #include "vmap/map/map_io.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/recorded_options.h"
 
 namespace py = pybind11;
 
