@@ -1,5 +1,6 @@
 // vmap localize MAP QUERY: localizes every frame of a repeat run (or one image) against a map.
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -74,6 +75,7 @@ void RunLocalize(const LocalizeFlags& flags) {
   const LocalizerOptions from_map = MapLocalizerOptions(map);
   options.verifier = from_map.verifier;
   options.similarity = from_map.similarity;
+  options.translation = from_map.translation;
   // The map's camera describes frames of the map's size: headings in degrees and poses need the query at it.
   if (from_map.camera && source_options.resize == map_size) {
     options.camera = from_map.camera;
@@ -117,10 +119,18 @@ void RunLocalize(const LocalizeFlags& flags) {
             << fmt::format("relocalized     {} ({})\n", s.relocalized, Percent(s.relocalized, s.frames))
             << fmt::format("lost            {} ({})\n", s.lost, Percent(s.lost, s.frames))
             << fmt::format("time            {:.2f} s ({:.1f} frames/s)\n", s.seconds, s.frames_per_second);
+  if (options.camera) {
+    const auto heading_only = std::count_if(run.frames.begin(), run.frames.end(), [](const LocalizationResult& r) {
+      return LocalizationGuidance(r) == "heading only: translation unknown";
+    });
+    std::cout << fmt::format("heading only    {} frames: translation to the target unknown ({})\n", heading_only,
+                             Percent(heading_only, s.frames));
+  }
   if (run.frames.size() == 1) {
     const LocalizationResult& r = run.frames.front();
     std::cout << fmt::format("status          {}\n", LocalizationStatusName(r.status))
-              << fmt::format("key             {} -> next {}\n", r.key, r.next_key);
+              << fmt::format("key             {} -> next {}\n", r.key, r.next_key)
+              << fmt::format("guidance        {}\n", LocalizationGuidance(r));
   }
   if (!flags.csv.empty()) std::cout << "csv             " << flags.csv << "\n";
   if (!flags.json.empty()) std::cout << "json            " << flags.json << "\n";

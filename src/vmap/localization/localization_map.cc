@@ -23,6 +23,7 @@ LocalizerOptions MapLocalizerOptions(const VisualMap& map) {
   options.verifier = MapVerifierOptions(map);
   options.similarity = MapSimilarityMode(map);
   options.camera = map.input.camera;
+  options.translation = MapTranslationOptions(map);
   return options;
 }
 

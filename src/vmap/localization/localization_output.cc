@@ -85,7 +85,8 @@ std::string DescribeLocalizerOptions(const LocalizerOptions& options) {
 std::string LocalizationCsvHeader() {
   return "frame,source_index,timestamp,source_name,status,key,next_key,key_frame,next_key_frame,similarity,verified,"
          "tentative,next_similarity,next_verified,next_tentative,heading_px,progress,comparisons,seconds,"
-         "F00,F01,F02,F10,F11,F12,F20,F21,F22,heading_deg,R00,R01,R02,R10,R11,R12,R20,R21,R22,tx,ty,tz\n";
+         "F00,F01,F02,F10,F11,F12,F20,F21,F22,heading_deg,R00,R01,R02,R10,R11,R12,R20,R21,R22,tx,ty,tz,"
+         "translation_sigma_deg,translation_known,guidance\n";
 }
 
 std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r) {
@@ -104,6 +105,9 @@ std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r
   const RelativePose& pose = TargetPose(r);
   for (int i = 0; i < 9; ++i) row += ',' + (pose.valid ? fmt::format("{:.9g}", pose.R(i / 3, i % 3)) : std::string());
   for (int i = 0; i < 3; ++i) row += ',' + (pose.valid ? fmt::format("{:.9g}", pose.t[i]) : std::string());
+  const KeyComparison& target = r.next_key >= 0 ? r.to_next : r.to_key;
+  row += ',' + (pose.valid ? CsvNumber(target.translation_sigma_deg) : std::string());
+  row += fmt::format(",{},{}", r.translation_known ? 1 : 0, LocalizationGuidance(r));
   return row + "\n";
 }
 
@@ -174,6 +178,11 @@ std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run
                       {"heading_px", Number(r.heading_px)},
                       {"heading_deg", Number(r.heading_deg)},
                       {"pose", PoseJson(TargetPose(r))},
+                      {"translation_sigma_deg",
+                       TargetPose(r).valid ? Number((r.next_key >= 0 ? r.to_next : r.to_key).translation_sigma_deg)
+                                           : json(nullptr)},
+                      {"translation_known", r.translation_known},
+                      {"guidance", LocalizationGuidance(r)},
                       {"progress", Number(r.progress)},
                       {"F", F},
                       {"candidates", candidates},
@@ -253,6 +262,7 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
       }
       r.heading_px = NumberOr(f, "heading_px", std::nan(""));
       r.heading_deg = NumberOr(f, "heading_deg", std::nan(""));
+      r.translation_known = f.value("translation_known", false);
       r.progress = NumberOr(f, "progress", std::nan(""));
       if (f.contains("candidates") && f["candidates"].is_array()) {
         for (const json& c : f["candidates"]) {

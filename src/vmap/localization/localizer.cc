@@ -59,6 +59,7 @@ void LocalizerOptions::Check() const {
   }
   CheckField("ranking", ranking);
   CheckField("verifier", verifier);
+  CheckField("translation", translation);
 }
 
 std::pair<int, int> KeysAround(const VisualMap& map, int source_index) {
@@ -85,6 +86,17 @@ VerifierOptions MapVerifierOptions(const VisualMap& map, int max_iterations) {
 }
 
 SimilarityMode MapSimilarityMode(const VisualMap& map) { return RecordedBuilderOptions(map).key_images.similarity; }
+
+TranslationOptions MapTranslationOptions(const VisualMap& map) {
+  return RecordedBuilderOptions(map).link_analysis.translation;
+}
+
+std::string LocalizationGuidance(const LocalizationResult& result) {
+  if (!std::isfinite(result.heading_px)) return "none";
+  const KeyComparison& target = result.next_key >= 0 ? result.to_next : result.to_key;
+  if (!target.pose.valid) return "heading only: no pose";
+  return result.translation_known ? "heading and translation" : "heading only: translation unknown";
+}
 
 Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matcher& matcher, LocalizerOptions options)
     : map_(map), keys_(keys), matcher_(matcher), options_(std::move(options)) {
@@ -155,6 +167,15 @@ KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
     for (size_t i = 0; i < frame_points.size(); ++i) bearings.push_back(std::atan(frame_rays[i].x) - std::atan(key_rays[i].x));
     c.median_dx_deg = Median(std::move(bearings)) * 180.0 / M_PI;
     c.pose = PoseFromFundamental(pair.F, camera, frame_points, key_points);
+    if (c.pose.valid) {
+      // The thresholds of the map's own pose estimates (PoseOptions): 3 px inliers, Cauchy scale 1 px.
+      const PoseOptions pose_options;
+      c.translation_sigma_deg =
+          TranslationSigmaDeg(c.pose, camera, frame_points, key_points,
+                              pose_options.refine_inlier_factor * pose_options.threshold, pose_options.threshold);
+      const double parallax = Median(Displacements(frame_points, key_points, &camera, &c.pose.R));
+      c.translation_known = TranslationKnown(c.translation_sigma_deg, parallax, options_.translation);
+    }
   }
   return c;
 }
@@ -206,6 +227,7 @@ void Localizer::Describe(LocalizationResult& result, int position, const ImageFe
   const KeyComparison& target = at_end ? result.to_key : result.to_next;
   result.heading_px = target.matched ? target.median_dx : kNaN;
   result.heading_deg = target.matched ? target.median_dx_deg : kNaN;
+  result.translation_known = target.matched && target.pose.valid && target.translation_known;
   if (at_end) {
     result.progress = result.to_key.accepted ? 0.0 : kNaN;
   } else {
