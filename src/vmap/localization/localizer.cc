@@ -166,13 +166,19 @@ KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
     bearings.reserve(frame_points.size());
     for (size_t i = 0; i < frame_points.size(); ++i) bearings.push_back(std::atan(frame_rays[i].x) - std::atan(key_rays[i].x));
     c.median_dx_deg = Median(std::move(bearings)) * 180.0 / M_PI;
+    // The thresholds of the map's own pose estimates (PoseOptions): 3 px inliers, Cauchy scale 1 px.
+    const PoseOptions pose_options;
+    const double inlier_threshold = pose_options.refine_inlier_factor * pose_options.threshold;
     c.pose = PoseFromFundamental(pair.F, camera, frame_points, key_points);
     if (c.pose.valid) {
-      // The thresholds of the map's own pose estimates (PoseOptions): 3 px inliers, Cauchy scale 1 px.
-      const PoseOptions pose_options;
+      // F's pose is not an optimum of the matches' errors (E = K^T F K is not essential): refined, and the
+      // four poses of the refined E decided again by cheirality, as a link's. Only then does the sigma below
+      // measure the matches rather than how far F's pose is from their optimum.
+      c.pose = EnforceCheirality(
+          RefineRelativePose(c.pose, camera, frame_points, key_points, inlier_threshold, pose_options.threshold),
+          camera, frame_points, key_points, pose_options.threshold);
       c.translation_sigma_deg =
-          TranslationSigmaDeg(c.pose, camera, frame_points, key_points,
-                              pose_options.refine_inlier_factor * pose_options.threshold, pose_options.threshold);
+          TranslationSigmaDeg(c.pose, camera, frame_points, key_points, inlier_threshold, pose_options.threshold);
       const double parallax = Median(Displacements(frame_points, key_points, &camera, &c.pose.R));
       c.translation_known = TranslationKnown(c.translation_sigma_deg, parallax, options_.translation);
     }
