@@ -94,8 +94,8 @@ struct KeyComparison {
   // minus atan(x_n) in the key image, x_n the undistorted normalised image x (degrees; NaN without).
   double median_dx_deg = std::numeric_limits<double>::quiet_NaN();
   // With a camera: the key image's camera relative to the frame's, X_key = R X_frame + t, t of unit length
-  // (PoseFromFundamental on F and the verified matches: no extra estimation; of the four poses F allows, the
-  // one with the matches in front of both cameras, so t never points backwards). Invalid without.
+  // (PoseFromFundamental on F and the verified matches, refined by RefineRelativePose and decided again by
+  // EnforceCheirality, so t never points backwards). Invalid without.
   RelativePose pose;
   // How well the verified matches determine the pose's translation direction (TranslationSigmaDeg, degrees;
   // NaN without a pose) and whether it is trusted (TranslationKnown with LocalizerOptions::translation).
@@ -209,7 +209,7 @@ std::pair<int, int> KeysAround(const VisualMap& map, int source_index);
 VerifierOptions MapVerifierOptions(const VisualMap& map, int max_iterations = 5000);
 // S as the map defines it (options.similarity in map.json).
 SimilarityMode MapSimilarityMode(const VisualMap& map);
-// When the map trusts a translation direction (options.link_analysis.translation in map.json).
+// When the map trusts a translation direction (options.translation in map.json).
 TranslationOptions MapTranslationOptions(const VisualMap& map);
 
 // What a controller may use of a result: "heading and translation", "heading only: translation unknown"

@@ -105,7 +105,7 @@ TEST(RecordedOptions, KeepsMapJsonsLayout) {
   for (const auto& item : record.items()) keys.insert(item.key());
   EXPECT_EQ(keys, (std::set<std::string>{"exhaustive", "final_key", "homography", "matcher", "min_key_displacement",
                                          "pose", "quality_mean", "search", "search_window", "similarity", "source",
-                                         "tau", "verifier"}));
+                                         "tau", "translation", "verifier"}));
   EXPECT_EQ(record["source"]["camera"], "input");
   EXPECT_EQ(record["search"], "sequential");
   EXPECT_EQ(record["pose"]["matches"], "all");
