@@ -246,6 +246,10 @@ TEST(Cli, OptionErrorsNameTheFlagsThatSetTheFields) {
   };
   const std::vector<Case> cases = {
       {build + "--pose-threshold -1", "vmap: error: --pose-threshold -1 px is outside (0, 100]; the default is 1\n"},
+      {build + "--max-translation-sigma 0",
+       "vmap: error: --max-translation-sigma 0 deg is outside (0, 180]; the default is 3\n"},
+      {build + "--min-translation-parallax -1",
+       "vmap: error: --min-translation-parallax -1 px must be >= 0; the default is 3\n"},
       {build + "--threads 999", "vmap: error: --threads must be 0 to 256 (0 = one per core)\n"},
       {build + "--min-key-displacement 200",
        "vmap: error: --min-key-displacement 200 px is outside [0, 100]; the default is 1, 0 turns the check off\n"},

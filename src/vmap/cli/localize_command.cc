@@ -1,5 +1,6 @@
 // vmap localize MAP QUERY: localizes every frame of a repeat run (or one image) against a map.
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -65,7 +66,7 @@ void RunLocalize(const LocalizeFlags& flags) {
   store_options.thumbnail_width = options.ranking.thumbnail_width;
   LocalizationMap opened = OpenLocalizationMap(flags.map, store_options);
   const VisualMap& map = opened.map;
-  // The map's verifier, definition of S and camera.
+  // The map's verifier, definition of S, translation thresholds and camera.
   options = FollowMap(map, options, source_options.resize);
   options.Check();
   Localizer localizer(map, opened.keys, *opened.matcher, options);
@@ -103,10 +104,18 @@ void RunLocalize(const LocalizeFlags& flags) {
             << fmt::format("relocalized     {} ({})\n", s.relocalized, Percent(s.relocalized, s.frames))
             << fmt::format("lost            {} ({})\n", s.lost, Percent(s.lost, s.frames))
             << fmt::format("time            {:.2f} s ({:.1f} frames/s)\n", s.seconds, s.frames_per_second);
+  if (options.camera) {
+    const auto heading_only = std::count_if(run.frames.begin(), run.frames.end(), [](const LocalizationResult& r) {
+      return LocalizationGuidance(r) == "heading only: translation unknown";
+    });
+    std::cout << fmt::format("heading only    {} frames: translation to the target unknown ({})\n", heading_only,
+                             Percent(heading_only, s.frames));
+  }
   if (run.frames.size() == 1) {
     const LocalizationResult& r = run.frames.front();
     std::cout << fmt::format("status          {}\n", LocalizationStatusName(r.status))
-              << fmt::format("key             {} -> next {}\n", r.key, r.next_key);
+              << fmt::format("key             {} -> next {}\n", r.key, r.next_key)
+              << fmt::format("guidance        {}\n", LocalizationGuidance(r));
   }
   if (!flags.csv.empty()) std::cout << "csv             " << flags.csv << "\n";
   if (!flags.json.empty()) std::cout << "json            " << flags.json << "\n";

@@ -84,6 +84,18 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, OptionFlags& op
                   },
                   "Matches the essential matrix is estimated on: all (tentative) or verified (F's inliers)"))
       ->default_str(EnumToName(kPoseMatchesNames, pose.use_all_matches));
+  option_flags
+      .AddOption(command, "--max-translation-sigma", o.link_analysis.translation.max_sigma_deg,
+                 "link_analysis.translation.max_sigma_deg",
+                 "Degrees: a link whose translation direction is less certain than this is marked translation "
+                 "unknown (a robot gets its rotation only)")
+      ->capture_default_str();
+  option_flags
+      .AddOption(command, "--min-translation-parallax", o.link_analysis.translation.min_parallax_px,
+                 "link_analysis.translation.min_parallax_px",
+                 "Pixels: a link whose verified matches moved less than this once its rotation is undone (median) "
+                 "is marked translation unknown")
+      ->capture_default_str();
   option_flags.AddFlag(command, "--exhaustive", o.exhaustive, "exhaustive",
                        "The paper's exact behaviour: verify every comparison with OpenCV's USAC_MAGSAC to its "
                        "confidence criterion (default: stop once S >= tau is settled; same maps within seed noise)");

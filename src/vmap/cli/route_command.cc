@@ -37,19 +37,27 @@ void RunRoute(const RouteFlags& flags) {
   std::cout << fmt::format("route           key {} -> key {}, {} steps\n", flags.from, to, route.steps.size())
             << "keys            " << keys << "\n";
   if (!route.steps.empty()) {
-    std::cout << "\n| step | from key (frame) | to key (frame) | link | direction | S | verified |\n"
-              << "|---|---|---|---|---|---|---|\n";
+    std::cout << "\n| step | from key (frame) | to key (frame) | link | direction | S | verified | translation |\n"
+              << "|---|---|---|---|---|---|---|---|\n";
   }
   nlohmann::json steps = nlohmann::json::array();
   for (size_t i = 0; i < route.steps.size(); ++i) {
     const RouteStep& s = route.steps[i];
     const Link& l = map.links[s.link];
-    std::cout << fmt::format("| {} | {} ({}) | {} ({}) | {} | {} | {:.3f} | {} |\n", i, s.from_key,
+    // A link followed backwards has the inverse pose; how well its translation is known is the same.
+    const std::string translation =
+        !l.has_pose ? "no pose"
+                    : (l.translation_known ? "known" : "unknown: rotation only") +
+                          (l.translation_sigma_deg >= 0 ? fmt::format(" ({:.1f} deg)", l.translation_sigma_deg) : "");
+    std::cout << fmt::format("| {} | {} ({}) | {} ({}) | {} | {} | {:.3f} | {} | {} |\n", i, s.from_key,
                              map.key_images[s.from_key].frame_index, s.to_key, map.key_images[s.to_key].frame_index,
                              s.link, s.backwards ? "backwards" : (s.unverified ? "forwards, no F" : "forwards"),
-                             l.similarity, l.num_verified);
+                             l.similarity, l.num_verified, translation);
     steps.push_back({{"from", s.from_key}, {"to", s.to_key}, {"link", s.link}, {"backwards", s.backwards},
-                     {"unverified", s.unverified}, {"similarity", l.similarity}, {"verified", l.num_verified}});
+                     {"unverified", s.unverified}, {"similarity", l.similarity}, {"verified", l.num_verified},
+                     {"translation_known", l.has_pose && l.translation_known},
+                     {"translation_sigma_deg", l.translation_sigma_deg >= 0 ? nlohmann::json(l.translation_sigma_deg)
+                                                                            : nlohmann::json(nullptr)}});
   }
   if (!flags.json.empty()) {
     const nlohmann::json doc = {{"format", "vmap-route"}, {"map", flags.map},      {"from", flags.from},

@@ -124,6 +124,8 @@ LinkEvaluation EvaluateLink(const VisualMap& map, int index, const GroundTruth& 
     }
   }
   if (!has_estimate) e.pose_source = "none";
+  e.translation_known = link.has_pose && link.translation_known;
+  if (link.has_pose && link.translation_sigma_deg >= 0) e.translation_sigma_deg = link.translation_sigma_deg;
 
   const std::optional<cv::Matx44d> T_from = KeyImagePose(truth, from, options.max_time_difference);
   const std::optional<cv::Matx44d> T_to = KeyImagePose(truth, to, options.max_time_difference);
@@ -134,7 +136,6 @@ LinkEvaluation EvaluateLink(const VisualMap& map, int index, const GroundTruth& 
   RelativeFromCameraToWorld(*T_from, *T_to, &R_true, &t_true);
   e.true_rotation_deg = RotationAngleDeg(R_true);
   e.true_baseline = cv::norm(t_true);
-  if (!verified_from.empty()) e.true_parallax_px = Median(Displacements(verified_from, verified_to, &camera, &R_true));
 
   if (e.true_baseline > 1e-9) {
     const cv::Matx33d F_true = FundamentalFromPose(R_true, t_true, camera.K());
@@ -146,14 +147,37 @@ LinkEvaluation EvaluateLink(const VisualMap& map, int index, const GroundTruth& 
     e.verified_within = ShareBelow(verified_errors, options.sampson_threshold_px);
     e.rejected_sampson_median = MedianOrNan(rejected_errors);
     e.rejected_within = ShareBelow(rejected_errors, options.sampson_threshold_px);
+    std::vector<cv::Point2f> consistent_from, consistent_to;
+    for (size_t i = 0; i < verified_errors.size(); ++i) {
+      if (verified_errors[i] >= options.sampson_threshold_px) continue;
+      consistent_from.push_back(verified_from[i]);
+      consistent_to.push_back(verified_to[i]);
+    }
+    for (size_t i = 0; i < rejected_errors.size(); ++i) {
+      if (rejected_errors[i] >= options.sampson_threshold_px) continue;
+      consistent_from.push_back(rejected_from[i]);
+      consistent_to.push_back(rejected_to[i]);
+    }
+    e.consistent_matches = static_cast<int>(consistent_from.size());
+    if (!consistent_from.empty()) {
+      e.true_parallax_px = Median(Displacements(consistent_from, consistent_to, &camera, &R_true));
+    }
+  } else if (!link.correspondences.empty()) {
+    // No baseline: every match agrees with a pure rotation and none has parallax to speak of.
+    std::vector<cv::Point2f> all_from = verified_from, all_to = verified_to;
+    all_from.insert(all_from.end(), rejected_from.begin(), rejected_from.end());
+    all_to.insert(all_to.end(), rejected_to.begin(), rejected_to.end());
+    e.true_parallax_px = Median(Displacements(all_from, all_to, &camera, &R_true));
   }
   if (has_estimate) {
     e.rotation_error_deg = RotationAngleDeg(R_estimate.t() * R_true);
     if (e.true_baseline > 1e-9) e.translation_error_deg = AngleBetweenDeg(t_estimate, t_true);
     const bool translation_judged = std::isfinite(e.true_parallax_px) && e.true_parallax_px >= options.min_parallax_px;
-    e.usable = e.rotation_error_deg < options.max_rotation_error_deg &&
-               (!translation_judged ||
-                (std::isfinite(e.translation_error_deg) && e.translation_error_deg < options.max_translation_error_deg));
+    const bool rotation_right = e.rotation_error_deg < options.max_rotation_error_deg;
+    const bool translation_right =
+        std::isfinite(e.translation_error_deg) && e.translation_error_deg < options.max_translation_error_deg;
+    e.usable = rotation_right && (!translation_judged || translation_right);
+    e.strict_usable = rotation_right && translation_right;
   }
   return e;
 }
@@ -191,10 +215,25 @@ MapEvaluation EvaluateMap(const VisualMap& map, const GroundTruth& truth, const 
       }
       verified_within.push_back(e.verified_within);
       rejected_within.push_back(e.rejected_within);
+      s.strict_usable_links += e.strict_usable ? 1 : 0;
+      if (e.translation_known) {
+        ++s.unflagged_links;
+        s.unflagged_right_links += e.strict_usable ? 1 : 0;
+        s.unflagged_usable_links += e.usable ? 1 : 0;
+        s.unflagged_reversed_links += std::isfinite(e.translation_error_deg) && e.translation_error_deg > 90 ? 1 : 0;
+      } else {
+        ++s.flagged_links;
+        s.flagged_wrong_links += e.strict_usable ? 0 : 1;
+      }
     }
     evaluation.links.push_back(std::move(e));
   }
-  if (s.evaluated_links > 0) s.usable_share = static_cast<double>(s.usable_links) / s.evaluated_links;
+  const auto share = [](int part, int whole) { return whole > 0 ? static_cast<double>(part) / whole : NAN; };
+  s.usable_share = share(s.usable_links, s.evaluated_links);
+  s.strict_usable_share = share(s.strict_usable_links, s.evaluated_links);
+  s.flagged_wrong_share = share(s.flagged_wrong_links, s.flagged_links);
+  s.unflagged_right_share = share(s.unflagged_right_links, s.unflagged_links);
+  s.unflagged_usable_share = share(s.unflagged_usable_links, s.unflagged_links);
   s.rotation_error_deg_median = MedianOfFinite(rotation_errors);
   s.translation_error_deg_median = MedianOfFinite(translation_errors);
   s.verified_within_mean = MeanOfFinite(verified_within);
@@ -254,6 +293,10 @@ std::string EvaluationToJson(const MapEvaluation& evaluation) {
                      {"true_rotation_deg", Number(e.true_rotation_deg)},
                      {"true_baseline", Number(e.true_baseline)},
                      {"true_parallax_px", Number(e.true_parallax_px)},
+                     {"consistent_matches", e.consistent_matches},
+                     {"translation_known", e.translation_known},
+                     {"translation_sigma_deg", Number(e.translation_sigma_deg)},
+                     {"strict_usable", e.strict_usable},
                      {"rotation_error_deg", Number(e.rotation_error_deg)},
                      {"translation_error_deg", Number(e.translation_error_deg)},
                      {"verified_sampson_median_px", Number(e.verified_sampson_median)},
@@ -272,7 +315,18 @@ std::string EvaluationToJson(const MapEvaluation& evaluation) {
                     {"rotation_error_deg_median", Number(s.rotation_error_deg_median)},
                     {"translation_error_deg_median", Number(s.translation_error_deg_median)},
                     {"verified_within_threshold_mean", Number(s.verified_within_mean)},
-                    {"rejected_within_threshold_mean", Number(s.rejected_within_mean)}};
+                    {"rejected_within_threshold_mean", Number(s.rejected_within_mean)},
+                    {"strict_usable_links", s.strict_usable_links},
+                    {"strict_usable_share", Number(s.strict_usable_share)},
+                    {"flagged_links", s.flagged_links},
+                    {"flagged_wrong_links", s.flagged_wrong_links},
+                    {"flagged_wrong_share", Number(s.flagged_wrong_share)},
+                    {"unflagged_links", s.unflagged_links},
+                    {"unflagged_right_links", s.unflagged_right_links},
+                    {"unflagged_right_share", Number(s.unflagged_right_share)},
+                    {"unflagged_usable_links", s.unflagged_usable_links},
+                    {"unflagged_usable_share", Number(s.unflagged_usable_share)},
+                    {"unflagged_reversed_links", s.unflagged_reversed_links}};
   return doc.dump(1) + "\n";
 }
 
@@ -324,6 +378,10 @@ MapEvaluation ReadEvaluation(const std::string& path) {
       e.rejected_sampson_median = NumberField(l, "rejected_sampson_median_px");
       e.rejected_within = NumberField(l, "rejected_within_threshold");
       e.usable = l.value("usable", false);
+      e.consistent_matches = l.value("consistent_matches", 0);
+      e.strict_usable = l.value("strict_usable", false);
+      e.translation_known = l.value("translation_known", e.pose_source == "stored");
+      e.translation_sigma_deg = NumberField(l, "translation_sigma_deg");
       evaluation.links.push_back(e);
     }
     const json& s = doc["summary"];
@@ -336,6 +394,18 @@ MapEvaluation ReadEvaluation(const std::string& path) {
     evaluation.summary.translation_error_deg_median = NumberField(s, "translation_error_deg_median");
     evaluation.summary.verified_within_mean = NumberField(s, "verified_within_threshold_mean");
     evaluation.summary.rejected_within_mean = NumberField(s, "rejected_within_threshold_mean");
+    EvaluationSummary& summary = evaluation.summary;
+    summary.strict_usable_links = s.value("strict_usable_links", 0);
+    summary.strict_usable_share = NumberField(s, "strict_usable_share");
+    summary.flagged_links = s.value("flagged_links", 0);
+    summary.flagged_wrong_links = s.value("flagged_wrong_links", 0);
+    summary.flagged_wrong_share = NumberField(s, "flagged_wrong_share");
+    summary.unflagged_links = s.value("unflagged_links", 0);
+    summary.unflagged_right_links = s.value("unflagged_right_links", 0);
+    summary.unflagged_right_share = NumberField(s, "unflagged_right_share");
+    summary.unflagged_usable_links = s.value("unflagged_usable_links", 0);
+    summary.unflagged_usable_share = NumberField(s, "unflagged_usable_share");
+    summary.unflagged_reversed_links = s.value("unflagged_reversed_links", 0);
   } catch (const json::exception& e) {
     throw InputError("evaluation '" + path + "' is malformed (" + e.what() + "); run `vmap eval` again");
   }

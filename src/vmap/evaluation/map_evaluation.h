@@ -17,7 +17,9 @@ namespace vmap {
 struct EvaluationOptions {
   // A link is usable when its rotation error is below max_rotation_error_deg and, where the true parallax
   // is at least min_parallax_px (below it the translation's direction is not observable), its translation
-  // direction error is below max_translation_error_deg.
+  // direction error is below max_translation_error_deg. The true parallax is measured on the link's tentative
+  // matches that agree with the ground truth (Sampson error under the true F below sampson_threshold_px), so
+  // that a wrong pose cannot exempt itself through its own inliers.
   double max_rotation_error_deg = 5.0;
   double max_translation_error_deg = 20.0;
   double min_parallax_px = 10.0;
@@ -49,7 +51,10 @@ struct LinkEvaluation {
   std::string pose_source;               // "stored" (the map's pose), "fundamental" (from F), "none"
   double true_rotation_deg = NAN;        // how much the camera turned between the key images
   double true_baseline = NAN;            // how far it moved (the ground truth's unit: metres)
-  double true_parallax_px = NAN;         // median displacement of the verified matches after the true rotation
+  // Median displacement, after the true rotation, of the tentative matches within sampson_threshold_px of
+  // their true epipolar line (`consistent_matches` of them): whether the translation can be judged.
+  double true_parallax_px = NAN;
+  int consistent_matches = 0;
   double rotation_error_deg = NAN;
   double translation_error_deg = NAN;    // angle between the estimated and the true direction
   double verified_sampson_median = NAN;  // pixels, under the true F
@@ -57,6 +62,13 @@ struct LinkEvaluation {
   double rejected_sampson_median = NAN;
   double rejected_within = NAN;
   bool usable = false;
+  // Every link's translation judged, whatever its parallax: rotation and translation errors both below the
+  // limits.
+  bool strict_usable = false;
+  // What the map itself says of the stored translation (Link::translation_known, translation_sigma_deg);
+  // a pose from F, or none, is not known.
+  bool translation_known = false;
+  double translation_sigma_deg = NAN;
 };
 
 struct EvaluationSummary {
@@ -69,6 +81,21 @@ struct EvaluationSummary {
   double translation_error_deg_median = NAN;  // over links with true parallax >= min_parallax_px
   double verified_within_mean = NAN;          // mean over links of the share of verified matches within 2 px
   double rejected_within_mean = NAN;          // the same for the rejected tentative matches
+  // Every evaluated link's translation judged (LinkEvaluation::strict_usable).
+  int strict_usable_links = 0;
+  double strict_usable_share = NAN;
+  // Evaluated links the map marks translation unknown ("flagged"), and how many of them were in fact wrong
+  // (not strict_usable); the others, how many were right (strict_usable) and usable, and how many were
+  // more than 90 degrees off (pointing backwards) without a flag.
+  int flagged_links = 0;
+  int flagged_wrong_links = 0;
+  double flagged_wrong_share = NAN;
+  int unflagged_links = 0;
+  int unflagged_right_links = 0;
+  double unflagged_right_share = NAN;
+  int unflagged_usable_links = 0;
+  double unflagged_usable_share = NAN;
+  int unflagged_reversed_links = 0;
 };
 
 struct MapEvaluation {

@@ -258,6 +258,10 @@ TEST(MapEvaluation, OptionsAreCheckedAndTheDocumentRoundTrips) {
   const MapEvaluation back = ReadEvaluation(file.string());
   ASSERT_EQ(back.links.size(), e.links.size());
   EXPECT_EQ(back.summary.usable_links, e.summary.usable_links);
+  EXPECT_EQ(back.summary.strict_usable_links, e.summary.strict_usable_links);
+  EXPECT_EQ(back.summary.unflagged_links, e.summary.unflagged_links);
+  EXPECT_EQ(back.links[1].translation_known, e.links[1].translation_known);
+  EXPECT_EQ(back.links[1].consistent_matches, e.links[1].consistent_matches);
   EXPECT_DOUBLE_EQ(back.summary.rotation_error_deg_median, e.summary.rotation_error_deg_median);
   EXPECT_DOUBLE_EQ(back.links[1].translation_error_deg, e.links[1].translation_error_deg);
   EXPECT_EQ(back.links[1].to_frame, e.links[1].to_frame);
@@ -320,6 +324,62 @@ TEST(MapEvaluation, RepeatedFramesAreNotChosenAsKeyImages) {
       EXPECT_TRUE(link.planar);  // H = I explains it all
     }
   }
+}
+
+}  // namespace vmap
+
+namespace vmap {
+
+// The parallax that decides whether a translation is judged comes from the matches that agree with the ground
+// truth, so a link cannot exempt itself with wrong inliers; the summary counts the map's own flags.
+TEST(MapEvaluation, ParallaxFromMatchesThatAgreeWithTheTruthAndTheMapsFlagsCounted) {
+  const KittiFixture& k = Kitti();
+  const Camera& camera = *k.map.input.camera;
+  const MapEvaluation honest = EvaluateMap(k.map, k.truth, camera, EvaluationOptions());
+  ASSERT_EQ(honest.summary.strict_usable_links, honest.summary.links);
+  ASSERT_EQ(honest.summary.unflagged_links + honest.summary.flagged_links, honest.summary.links);
+
+  // Link 0's verified matches replaced by wrong ones with little parallax: each 6 px off its true epipolar
+  // line, beside where the rotation alone would take it. By its own inliers the link would have 6 px of
+  // parallax and its translation would not be judged; the true matches (kept, as rejected ones) have more.
+  VisualMap corrupted = k.map;
+  Link& link = corrupted.links[0];
+  ASSERT_GT(honest.links[0].true_parallax_px, 10.0);
+  cv::Matx33d R_true;
+  cv::Vec3d t_true;
+  RelativeFromCameraToWorld(*KeyImagePose(k.truth, k.map.key_images[link.from_key], 0.02),
+                            *KeyImagePose(k.truth, k.map.key_images[link.to_key], 0.02), &R_true, &t_true);
+  const cv::Matx33d K = camera.K();
+  const cv::Matx33d F_true = FundamentalFromPose(R_true, t_true, K);
+  const std::vector<Correspondence> original = link.correspondences;
+  for (int i = 0; i < link.num_verified; ++i) {
+    const cv::Point2f p0 = link.correspondences[i].p0;
+    const cv::Vec3d rotated = K * R_true * K.inv() * cv::Vec3d(p0.x, p0.y, 1.0);
+    const cv::Vec3d line = F_true * cv::Vec3d(p0.x, p0.y, 1.0);
+    const double norm = std::hypot(line[0], line[1]);
+    link.correspondences[i].p1 = cv::Point2f(static_cast<float>(rotated[0] / rotated[2] + 6.0 * line[0] / norm),
+                                             static_cast<float>(rotated[1] / rotated[2] + 6.0 * line[1] / norm));
+  }
+  link.correspondences.insert(link.correspondences.end(), original.begin(), original.begin() + link.num_verified);
+  const MapEvaluation e = EvaluateMap(corrupted, k.truth, camera, EvaluationOptions());
+  EXPECT_NEAR(e.links[0].true_parallax_px, honest.links[0].true_parallax_px, 0.05 * honest.links[0].true_parallax_px);
+  EXPECT_GE(e.links[0].consistent_matches, link.num_verified / 2);
+  EXPECT_LE(e.links[0].consistent_matches, honest.links[0].consistent_matches + 2) << "the wrong ones left out";
+
+  // Two translations reversed, one of them flagged by the map: the flagged one counts as flagged and wrong,
+  // the other as an unflagged link pointing backwards.
+  VisualMap reversed = k.map;
+  reversed.links[0].t = -reversed.links[0].t;
+  reversed.links[0].translation_known = false;
+  reversed.links[1].t = -reversed.links[1].t;
+  reversed.links[1].translation_known = true;
+  const MapEvaluation r = EvaluateMap(reversed, k.truth, camera, EvaluationOptions());
+  EXPECT_EQ(r.summary.flagged_links, honest.summary.flagged_links + (k.map.links[0].translation_known ? 1 : 0) -
+                                         (k.map.links[1].translation_known ? 0 : 1));
+  EXPECT_GE(r.summary.flagged_wrong_links, 1);
+  EXPECT_EQ(r.summary.unflagged_reversed_links, 1);
+  EXPECT_EQ(r.summary.strict_usable_links, honest.summary.strict_usable_links - 2);
+  EXPECT_LT(r.summary.unflagged_right_share, 1.0);
 }
 
 }  // namespace vmap

@@ -24,7 +24,7 @@ void PoseOptions::Check() const {
   if (!(confidence > 0.0 && confidence < 1.0)) throw OptionError("confidence", "must be in (0, 1)");
   if (max_iterations < 1) throw OptionError("max_iterations", "must be >= 1");
   if (!(refine_inlier_factor >= 1.0)) throw OptionError("refine_inlier_factor", "must be >= 1");
-  if (starts < 1 || starts > 100) throw OptionError("starts", "must be in [1, 100] (default 3)");
+  if (starts < 0 || starts > 100) throw OptionError("starts", "must be in [0, 100] (default 3)");
   if (min_matches < 5) throw OptionError("min_matches", "must be >= 5: the five-point solver needs 5 matches");
 }
 
@@ -197,6 +197,85 @@ RelativePose RefineRelativePose(const RelativePose& pose, const Camera& camera, 
   return refined;
 }
 
+namespace {
+
+std::vector<unsigned char> WithinThreshold(const RelativePose& pose, const Camera& camera,
+                                           const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to,
+                                           double threshold) {
+  std::vector<unsigned char> mask;
+  for (double e : PoseSampsonErrors(pose.R, pose.t, camera, from, to)) mask.push_back(e < threshold ? 1 : 0);
+  return mask;
+}
+
+}  // namespace
+
+RelativePose EnforceCheirality(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
+                               const std::vector<cv::Point2f>& to, double inlier_threshold) {
+  if (!pose.valid) return pose;
+  const std::vector<cv::Point2d> y_from = NormalizePoints(camera, from), y_to = NormalizePoints(camera, to);
+  const std::vector<unsigned char> mask = WithinThreshold(pose, camera, from, to, inlier_threshold);
+  const int given = CountInFront(pose.R, pose.t, y_from, y_to, mask);
+  const RelativePose decided = Decompose(cv::Mat(CrossMatrix(pose.t) * pose.R), y_from, y_to, mask);
+  if (!decided.valid || decided.num_inliers <= given) return pose;
+  RelativePose result = pose;
+  result.R = decided.R;
+  result.t = decided.t;
+  return result;
+}
+
+double TranslationSigmaDeg(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
+                           const std::vector<cv::Point2f>& to, double inlier_threshold, double loss_scale) {
+  constexpr double kUnknown = 180.0;
+  if (!pose.valid) return kUnknown;
+  const std::vector<unsigned char> mask = WithinThreshold(pose, camera, from, to, inlier_threshold);
+  std::vector<cv::Point2f> inlier_from, inlier_to;
+  for (size_t i = 0; i < mask.size(); ++i) {
+    if (!mask[i]) continue;
+    inlier_from.push_back(from[i]);
+    inlier_to.push_back(to[i]);
+  }
+  const int n = static_cast<int>(inlier_from.size());
+  if (n < 8) return kUnknown;
+  const SampsonCost cost(PoseOnManifold(pose.R, pose.t), NormalizePoints(camera, inlier_from),
+                         NormalizePoints(camera, inlier_to), 0.5 * (camera.fx + camera.fy), loss_scale);
+  cv::Mat residuals, jacobian;
+  cost.compute(cv::Mat::zeros(5, 1, CV_64F), residuals, jacobian);
+  // Residual variance with the five parameters' degrees of freedom taken out; at least (0.1 px)^2 so that
+  // noise-free matches do not claim a certainty the pixels cannot give.
+  const double variance = std::max(residuals.dot(residuals) / (n - 5), 0.01);
+  cv::Mat covariance;
+  if (cv::invert(jacobian.t() * jacobian, covariance, cv::DECOMP_SVD) <= 0) return kUnknown;
+  // The two translation parameters are tangent displacements of the unit t: radians of its direction.
+  const cv::Mat block = covariance(cv::Rect(3, 3, 2, 2)) * variance;
+  cv::Mat eigenvalues;
+  cv::eigen(block, eigenvalues);
+  const double largest = eigenvalues.at<double>(0);
+  if (!std::isfinite(largest) || largest < 0) return kUnknown;
+  return std::min(kUnknown, std::sqrt(largest) * 180.0 / CV_PI);
+}
+
+void TranslationOptions::Check() const {
+  if (!(max_sigma_deg > 0.0 && max_sigma_deg <= 180.0)) {
+    throw OptionError("max_sigma_deg", fmt::format("{} deg is outside (0, 180]; the default is 3", max_sigma_deg));
+  }
+  if (!(min_parallax_px >= 0.0 && std::isfinite(min_parallax_px))) {
+    throw OptionError("min_parallax_px", fmt::format("{} px must be >= 0; the default is 3", min_parallax_px));
+  }
+}
+
+bool TranslationKnown(double sigma_deg, double parallax_px, const TranslationOptions& options) {
+  return sigma_deg >= 0 && sigma_deg <= options.max_sigma_deg && parallax_px >= options.min_parallax_px;
+}
+
+nlohmann::json ToJson(const TranslationOptions& options) {
+  return {{"max_sigma_deg", options.max_sigma_deg}, {"min_parallax_px", options.min_parallax_px}};
+}
+
+void FromJson(const JsonFieldReader& fields, TranslationOptions* options) {
+  fields.Read("max_sigma_deg", &options->max_sigma_deg);
+  fields.Read("min_parallax_px", &options->min_parallax_px);
+}
+
 double PoseCost(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
                 const std::vector<cv::Point2f>& to, const PoseOptions& options) {
   const double cap = options.refine_inlier_factor * options.threshold;
@@ -261,10 +340,12 @@ RelativePose EstimateRelativePose(const Camera& camera, const std::vector<cv::Po
   double best_cost = std::numeric_limits<double>::infinity();
   for (const RelativePose& start : starts) {
     if (!start.valid) continue;
-    const RelativePose candidate =
+    const RelativePose refined =
         options.refine ? RefineRelativePose(start, camera, from, to, options.refine_inlier_factor * options.threshold,
                                             options.threshold)
                        : start;
+    // The refinement minimises errors that are the same for t and -t: it may end pointing backwards.
+    const RelativePose candidate = EnforceCheirality(refined, camera, from, to, options.threshold);
     const double cost = PoseCost(candidate, camera, from, to, options);
     if (cost < best_cost) {  // ties keep the earlier start: deterministic
       best_cost = cost;

@@ -39,7 +39,8 @@ struct PoseOptions {
   // Forward motion and short baselines leave the matches' geometric error with several local minima (a
   // rotation error traded for a translation turned by up to 90 degrees). So the estimate starts from
   // several hypotheses: USAC run with `starts` seeds (seed, seed + 1, ...) and any given start (the pose of
-  // F); each is refined, and the one with the lowest robust cost over all the matches wins.
+  // F); each is refined, and the one with the lowest robust cost over all the matches wins. 0: only the
+  // starts the caller gives.
   int starts = 3;
   // Callers that have the link's F add its pose as one more start (mapping/link_analysis.cc).
   bool start_from_fundamental = true;
@@ -75,7 +76,8 @@ struct RelativePose {
 
 // E estimated on the normalised points with OpenCV's USAC (MSAC scoring, local optimisation) from
 // options.starts seeds, each decomposed with the cheirality check; these and `extra_starts` are refined
-// (options.refine) and the pose with the lowest PoseCost wins.
+// (options.refine), each refined pose is decided again among the four its E allows (EnforceCheirality), and
+// the pose with the lowest PoseCost wins.
 RelativePose EstimateRelativePose(const Camera& camera, const std::vector<cv::Point2f>& from,
                                   const std::vector<cv::Point2f>& to, const PoseOptions& options,
                                   const std::vector<RelativePose>& extra_starts = {});
@@ -96,6 +98,37 @@ RelativePose PoseFromFundamental(const cv::Matx33d& F, const Camera& camera, con
 // stays a unit vector (two parameters on the sphere); the rotation takes three.
 RelativePose RefineRelativePose(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
                                 const std::vector<cv::Point2f>& to, double inlier_threshold, double loss_scale);
+
+// The Sampson errors cannot tell the four poses one E = [t]x R allows apart ((R, t), (R, -t) and the twisted
+// pair), so a refinement may end at a pose whose t points backwards. This decides among the four again: the
+// one that puts most of the matches within `inlier_threshold` px of the pose in front of both cameras (ties
+// keep the given pose). num_inliers stays: the four have the same errors.
+RelativePose EnforceCheirality(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
+                               const std::vector<cv::Point2f>& to, double inlier_threshold);
+
+// How well a pose's translation direction is determined by the matches within `inlier_threshold` px of it:
+// the standard deviation, in degrees, of t's direction from the Gauss-Newton covariance of the refinement's
+// cost (Cauchy-weighted Sampson errors, loss scale `loss_scale` px) at the pose, with the rotation
+// marginalised (the larger axis of the 2x2 block) and the noise estimated from the residuals. Short
+// baselines and pure rotations leave the cost flat along t: a large value. 180 when it cannot be computed
+// (too few matches, a singular system).
+double TranslationSigmaDeg(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
+                           const std::vector<cv::Point2f>& to, double inlier_threshold, double loss_scale);
+
+// When a translation direction is trusted (map.json's links[].translation_known, localization results): both
+// its sigma is small and the matches moved enough once the rotation is undone. The sigma alone trusts some
+// pairs a few centimetres apart whose errors are not the pixel noise it assumes (calibration, rolling
+// shutter); the parallax alone distrusts forward motion, whose median parallax is small where t is well
+// known. Both chosen on kitti07 and redkitchen 0-499 (docs/link-poses.md).
+struct TranslationOptions {
+  double max_sigma_deg = 3.0;    // largest TranslationSigmaDeg of a trusted direction
+  double min_parallax_px = 3.0;  // smallest median rotation-compensated displacement (Displacements) of one
+
+  void Check() const;  // throws OptionError naming the bad field
+};
+bool TranslationKnown(double sigma_deg, double parallax_px, const TranslationOptions& options);
+nlohmann::json ToJson(const TranslationOptions& options);
+void FromJson(const JsonFieldReader& fields, TranslationOptions* options);
 
 // Sampson errors in pixels of matches under a pose (on normalised points, times the mean focal length).
 std::vector<double> PoseSampsonErrors(const cv::Matx33d& R, const cv::Vec3d& t, const Camera& camera,

@@ -158,7 +158,7 @@ TEST(RelativePose, TooFewMatchesGiveNoPoseAndBadOptionsAreRefused) {
   bad.threshold = 0;
   EXPECT_EQ(testing::OptionErrorPath([&] { bad.Check(); }), "threshold");
   bad = PoseOptions();
-  bad.starts = 0;
+  bad.starts = -1;
   EXPECT_EQ(testing::OptionErrorPath([&] { bad.Check(); }), "starts");
   EXPECT_EQ(ParsePoseMethod("fundamental"), PoseMethod::kFromFundamental);
   EXPECT_THROW(ParsePoseMethod("homography"), InputError);
@@ -203,6 +203,86 @@ TEST(Homography, ExplainsAPlaneAndAPureRotationButNotADeepSceneSeenFromAfar) {
   EXPECT_FALSE(check.explains);
   EXPECT_LT(check.share, 0.5);
   EXPECT_FALSE(CheckHomography({{0, 0}, {1, 1}}, {{0, 0}, {1, 1}}, options).estimated);
+}
+
+}  // namespace vmap
+
+namespace vmap {
+
+// Sampson errors are the same for t and -t, so a refinement started from the reversed pose ends at the same
+// cost with t pointing backwards; the estimate must put the matches in front of both cameras again.
+TEST(RelativePose, FinalPoseNeverPointsBackwardsWhenTheOptimumIsReachedFromTheReversedStart) {
+  const cv::Matx33d R = Rotation({0.0, 0.03, 0.0});
+  const cv::Vec3d t_true(0.0, 0.0, -1.0);  // driving forward
+  const Pair pair = Observe(TestCamera(), R, t_true * 0.5, 200, 3.0, 20.0, 0.3, 0.0, 7);
+  RelativePose reversed;
+  reversed.valid = true;
+  reversed.R = R;
+  reversed.t = -t_true;
+  reversed.num_inliers = 200;
+  // The refinement alone reaches the Sampson optimum with the reversed t.
+  const RelativePose refined = RefineRelativePose(reversed, TestCamera(), pair.from, pair.to, 3.0, 1.0);
+  ASSERT_TRUE(refined.valid);
+  ASSERT_GT(AngleBetweenDeg(refined.t, t_true), 170.0);
+  PoseOptions options;
+  options.starts = 0;  // only the reversed start
+  const RelativePose pose = EstimateRelativePose(TestCamera(), pair.from, pair.to, options, {reversed});
+  ASSERT_TRUE(pose.valid);
+  EXPECT_LT(AngleBetweenDeg(pose.t, t_true), 2.0);
+  EXPECT_LT(RotationAngleDeg(pose.R.t() * R), 0.2);
+  EXPECT_NEAR(PoseCost(pose, TestCamera(), pair.from, pair.to, options),
+              PoseCost(refined, TestCamera(), pair.from, pair.to, options), 1e-6);
+  // And so does the decision on its own, for each of the four poses the optimum's E allows.
+  for (const double sign : {1.0, -1.0}) {
+    RelativePose start = refined;
+    start.t = sign * refined.t;
+    const RelativePose decided = EnforceCheirality(start, TestCamera(), pair.from, pair.to, 1.0);
+    EXPECT_LT(AngleBetweenDeg(decided.t, t_true), 2.0);
+  }
+}
+
+// The translation's direction is well determined by matches spread over the image and not by the same motion
+// seen through a small patch, where a sideways translation and a rotation look alike. (At a vanishing baseline
+// the linearised covariance is not to be trusted: the noise itself gives the cost a slope along t. That case
+// is TranslationKnown's parallax test.)
+TEST(RelativePose, TranslationSigmaIsLargeWhereRotationAndTranslationLookAlike) {
+  const cv::Matx33d R = Rotation({0.01, 0.04, 0.0});
+  const cv::Vec3d t = cv::normalize(cv::Vec3d(1.0, 0.0, -0.3));
+  const Pair all = Observe(TestCamera(), R, t * 0.3, 3000, 3.0, 20.0, 0.5, 0.0, 3);
+  Pair spread, patch;
+  for (size_t i = 0; i < all.from.size(); ++i) {
+    const bool central = cv::norm(all.from[i] - cv::Point2f(320, 240)) < 40.0;
+    if (central) {
+      patch.from.push_back(all.from[i]);
+      patch.to.push_back(all.to[i]);
+    } else if (spread.from.size() < 300) {
+      spread.from.push_back(all.from[i]);
+      spread.to.push_back(all.to[i]);
+    }
+  }
+  ASSERT_GE(patch.from.size(), 12u);
+  RelativePose pose;
+  pose.valid = true;
+  pose.R = R;
+  pose.t = t;
+  const double spread_sigma = TranslationSigmaDeg(pose, TestCamera(), spread.from, spread.to, 3.0, 1.0);
+  const double patch_sigma = TranslationSigmaDeg(pose, TestCamera(), patch.from, patch.to, 3.0, 1.0);
+  EXPECT_LT(spread_sigma, 2.0);
+  EXPECT_GT(patch_sigma, 5.0 * spread_sigma);
+  EXPECT_EQ(TranslationSigmaDeg(pose, TestCamera(), {patch.from.begin(), patch.from.begin() + 6},
+                                {patch.to.begin(), patch.to.begin() + 6}, 3.0, 1.0),
+            180.0)
+      << "too few matches";
+  TranslationOptions options;
+  options.max_sigma_deg = 0.0;
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "max_sigma_deg");
+  options = TranslationOptions();
+  options.min_parallax_px = -1.0;
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "min_parallax_px");
+  EXPECT_TRUE(TranslationKnown(1.0, 10.0, TranslationOptions()));
+  EXPECT_FALSE(TranslationKnown(1.0, 1.0, TranslationOptions())) << "too little parallax";
+  EXPECT_FALSE(TranslationKnown(30.0, 10.0, TranslationOptions())) << "too uncertain";
+  EXPECT_FALSE(TranslationKnown(-1.0, 10.0, TranslationOptions())) << "not computed";
 }
 
 }  // namespace vmap

@@ -26,6 +26,7 @@ LocalizerOptions MapLocalizerOptions(const VisualMap& map) {
   options.verifier = MapVerifierOptions(map);
   options.similarity = MapSimilarityMode(map);
   options.camera = map.input.camera;
+  options.translation = MapTranslationOptions(map);
   return options;
 }
 
@@ -38,6 +39,7 @@ LocalizerOptions FollowMap(const VisualMap& map, LocalizerOptions options, const
   const LocalizerOptions from_map = MapLocalizerOptions(map);
   options.verifier = from_map.verifier;
   options.similarity = from_map.similarity;
+  options.translation = from_map.translation;
   const std::string map_size = QueryResize(map, "");
   if (from_map.camera && query_resize == map_size) {
     options.camera = from_map.camera;

@@ -97,7 +97,8 @@ std::string LocalizationCsvHeader() {
   return "frame,source_index,timestamp,source_name,status,key,next_key,key_frame,next_key_frame,similarity,verified,"
          "tentative,next_similarity,next_verified,next_tentative,heading_px,progress,comparisons,seconds,"
          "F00,F01,F02,F10,F11,F12,F20,F21,F22,heading_deg,R00,R01,R02,R10,R11,R12,R20,R21,R22,tx,ty,tz,"
-         "heading_confidence,heading_key_px,heading_key_deg,heading_key_confidence\n";
+         "heading_confidence,heading_key_px,heading_key_deg,heading_key_confidence,"
+         "translation_sigma_deg,translation_known,guidance\n";
 }
 
 std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r) {
@@ -118,6 +119,9 @@ std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r
   for (int i = 0; i < 3; ++i) row += ',' + (pose.valid ? fmt::format("{:.9g}", pose.t[i]) : std::string());
   row += ',' + CsvNumber(TargetConfidence(r)) + ',' + CsvNumber(r.heading_key_px) + ',' +
          CsvNumber(r.heading_key_deg) + ',' + CsvNumber(Confidence(r.to_key.heading));
+  const KeyComparison& target = r.next_key >= 0 ? r.to_next : r.to_key;
+  row += ',' + (pose.valid ? CsvNumber(target.translation_sigma_deg) : std::string());
+  row += fmt::format(",{},{}", r.translation_known ? 1 : 0, LocalizationGuidance(r));
   return row + "\n";
 }
 
@@ -154,6 +158,11 @@ nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationRes
           {"heading_key_deg", Number(r.heading_key_deg)},
           {"heading_key_confidence", Number(Confidence(r.to_key.heading))},
           {"pose", PoseJson(TargetPose(r))},
+          {"translation_sigma_deg",
+           TargetPose(r).valid ? Number((r.next_key >= 0 ? r.to_next : r.to_key).translation_sigma_deg)
+                               : json(nullptr)},
+          {"translation_known", r.translation_known},
+          {"guidance", LocalizationGuidance(r)},
           {"progress", Number(r.progress)},
           {"F", F},
           {"candidates", candidates},

@@ -44,9 +44,11 @@ LocalizationRun SampleRun() {
   const double no_bearing = std::numeric_limits<double>::quiet_NaN();
   const HeadingEstimate to_key_heading{HeadingMethod::kDisplacementMode, 1.5, no_bearing, 30, 200, 0.15};
   const HeadingEstimate to_next_heading{HeadingMethod::kDisplacementMode, -2.0, -0.25, 40, 100, 0.4};
-  tracked.to_key = {0, true, true, 0.75, 200, 150, cv::Matx33d::zeros(), to_key_heading, RelativePose{}};
+  tracked.to_key = {0, true, true, 0.75, 200, 150, cv::Matx33d::zeros(), to_key_heading, RelativePose{},
+                    no_bearing, false};
   tracked.to_next = {1, true, true, 0.5, 100, 50, cv::Matx33d(1, 2, 3, 4, 5, 6, 7, 8, 9), to_next_heading,
-                     RelativePose{}};
+                     RelativePose{}, 2.5, true};
+  tracked.translation_known = true;
   tracked.heading_px = -2.0;
   tracked.heading_deg = -0.25;
   tracked.heading_key_px = 1.5;
@@ -84,7 +86,8 @@ TEST(LocalizationOutput, CsvHasTheNamedColumnsAndOneRowPerFrame) {
   for (const char* column : {"frame", "source_index", "status", "key", "next_key", "similarity", "verified",
                              "next_similarity", "next_verified", "heading_px", "progress", "F00", "F22",
                              "heading_deg", "R00", "R22", "tx", "tz", "heading_confidence", "heading_key_px",
-                             "heading_key_deg", "heading_key_confidence"}) {
+                             "heading_key_deg", "heading_key_confidence", "translation_sigma_deg",
+                             "translation_known", "guidance"}) {
     EXPECT_NE(("," + header + ",").find(std::string(",") + column + ","), std::string::npos) << column;
   }
   auto count = [](const std::string& s) { return std::count(s.begin(), s.end(), ','); };
@@ -92,7 +95,9 @@ TEST(LocalizationOutput, CsvHasTheNamedColumnsAndOneRowPerFrame) {
   EXPECT_EQ(count(row1), count(header));
   EXPECT_EQ(row0.rfind("0,3,0.100000,frame_000003,relocalized,0,1,0,40,0.75,150,200,0.5,50,100,-2,0.25,", 0), 0u)
       << row0;
-  EXPECT_NE(row0.find(",1,2,3,4,5,6,7,8,9,-0.25,0,-1,0,1,0,0,0,0,1,0.6,0,0.8,0.4,1.5,,0.15"), std::string::npos)
+  EXPECT_NE(row0.find(",1,2,3,4,5,6,7,8,9,-0.25,0,-1,0,1,0,0,0,0,1,0.6,0,0.8,0.4,1.5,,0.15,2.5,1,heading and "
+                      "translation"),
+            std::string::npos)
       << row0;
   // Unknown values are empty, not "nan".
   EXPECT_EQ(row1.find("nan"), std::string::npos) << row1;
@@ -119,6 +124,9 @@ TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
   EXPECT_DOUBLE_EQ(doc["frames"][0]["heading_key_confidence"].get<double>(), 0.15);
   EXPECT_TRUE(doc["frames"][1]["heading_key_px"].is_null());
   EXPECT_TRUE(doc["frames"][1]["heading_confidence"].is_null());
+  EXPECT_DOUBLE_EQ(doc["frames"][0]["translation_sigma_deg"].get<double>(), 2.5);
+  EXPECT_EQ(doc["frames"][0]["guidance"], "heading and translation");
+  EXPECT_EQ(doc["frames"][1]["guidance"], "none");
   EXPECT_EQ(doc["frames"][0]["key_frame"], 0);
   EXPECT_EQ(doc["frames"][0]["next_key_frame"], 40);
   const LocalizationRun back = ReadLocalizationRun(file);

@@ -146,6 +146,12 @@ TEST(LocalizeCli, RouteForwardsAndBackwards) {
   ASSERT_EQ(RunVmap("route " + Quote(LabMap()) + " --from 3 --to 1", &out), 0) << out;
   EXPECT_NE(out.find("keys            3 2 1\n"), std::string::npos) << out;
   EXPECT_NE(out.find("| backwards |"), std::string::npos) << out;
+  // Each step says whether the link's translation can be trusted, backwards as forwards.
+  EXPECT_NE(out.find("| translation |"), std::string::npos) << out;
+  const bool with_pose = map.links[1].has_pose;
+  EXPECT_NE(out.find(!with_pose ? "| no pose |" : map.links[1].translation_known ? "| known (" : "| unknown: rotation only ("),
+            std::string::npos)
+      << out;
   ASSERT_EQ(RunVmap("route " + Quote(LabMap()) + " --from 0 --to 99", &out), 2) << out;
   EXPECT_NE(out.find("key image 99 does not exist"), std::string::npos) << out;
   // A localization that follows the route backwards.

@@ -60,6 +60,7 @@ void LocalizerOptions::Check() const {
   CheckField("ranking", ranking);
   CheckField("verifier", verifier);
   CheckField("heading", heading);
+  CheckField("translation", translation);
 }
 
 std::pair<int, int> KeysAround(const VisualMap& map, int source_index) {
@@ -86,6 +87,17 @@ VerifierOptions MapVerifierOptions(const VisualMap& map, int max_iterations) {
 }
 
 SimilarityMode MapSimilarityMode(const VisualMap& map) { return RecordedBuilderOptions(map).key_images.similarity; }
+
+TranslationOptions MapTranslationOptions(const VisualMap& map) {
+  return RecordedBuilderOptions(map).link_analysis.translation;
+}
+
+std::string LocalizationGuidance(const LocalizationResult& result) {
+  if (!std::isfinite(result.heading_px)) return "none";
+  const KeyComparison& target = result.next_key >= 0 ? result.to_next : result.to_key;
+  if (!target.pose.valid) return "heading only: no pose";
+  return result.translation_known ? "heading and translation" : "heading only: translation unknown";
+}
 
 Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matcher& matcher, LocalizerOptions options)
     : map_(map), keys_(keys), matcher_(matcher), options_(std::move(options)) {
@@ -154,7 +166,22 @@ KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
   if (camera && pair.matched && pair.num_verified > 0) {
     key_points.resize(pair.num_verified);
     frame_points.resize(pair.num_verified);
+    // The thresholds of the map's own pose estimates (PoseOptions): 3 px inliers, Cauchy scale 1 px.
+    const PoseOptions pose_options;
+    const double inlier_threshold = pose_options.refine_inlier_factor * pose_options.threshold;
     c.pose = PoseFromFundamental(pair.F, *camera, frame_points, key_points);
+    if (c.pose.valid) {
+      // F's pose is not an optimum of the matches' errors (E = K^T F K is not essential): refined, and the
+      // four poses of the refined E decided again by cheirality, as a link's. Only then does the sigma below
+      // measure the matches rather than how far F's pose is from their optimum.
+      c.pose = EnforceCheirality(
+          RefineRelativePose(c.pose, *camera, frame_points, key_points, inlier_threshold, pose_options.threshold),
+          *camera, frame_points, key_points, pose_options.threshold);
+      c.translation_sigma_deg =
+          TranslationSigmaDeg(c.pose, *camera, frame_points, key_points, inlier_threshold, pose_options.threshold);
+      const double parallax = Median(Displacements(frame_points, key_points, camera, &c.pose.R));
+      c.translation_known = TranslationKnown(c.translation_sigma_deg, parallax, options_.translation);
+    }
   }
   return c;
 }
@@ -208,6 +235,7 @@ void Localizer::Describe(LocalizationResult& result, int position, const ImageFe
   result.heading_deg = target.heading.deg;
   result.heading_key_px = result.to_key.heading.px;
   result.heading_key_deg = result.to_key.heading.deg;
+  result.translation_known = target.matched && target.pose.valid && target.translation_known;
   if (at_end) {
     result.progress = result.to_key.accepted ? 0.0 : kNaN;
   } else {

@@ -69,6 +69,8 @@ struct LocalizerOptions {
   // The map's camera (map.input.camera: intrinsics from the dataset or --camera). With it each comparison
   // also gives the heading in degrees and the relative pose to the key image; without, pixels only.
   std::optional<Camera> camera;
+  // When a pose's translation direction is trusted (the map's link_analysis.translation: MapTranslationOptions).
+  TranslationOptions translation;
 
   void Check() const;  // throws OptionError naming the bad field
 };
@@ -93,8 +95,13 @@ struct KeyComparison {
   // also degrees), from all tentative matches (geometry/heading.h): it holds across seasons, where F rarely does.
   HeadingEstimate heading;
   // With a camera: the key image's camera relative to the frame's, X_key = R X_frame + t, t of unit length
-  // (PoseFromFundamental on F and the verified matches: no extra estimation). Invalid without.
+  // (PoseFromFundamental on F and the verified matches, refined by RefineRelativePose and decided again by
+  // EnforceCheirality, so t never points backwards). Invalid without.
   RelativePose pose;
+  // How well the verified matches determine the pose's translation direction (TranslationSigmaDeg, degrees;
+  // NaN without a pose) and whether it is trusted (TranslationKnown with LocalizerOptions::translation).
+  double translation_sigma_deg = std::numeric_limits<double>::quiet_NaN();
+  bool translation_known = false;
 };
 
 // A key image the ranking proposed when relocalizing, and how its verification went.
@@ -133,6 +140,9 @@ struct LocalizationResult {
   // Progress along the segment key -> next_key in [0, 1]: v_next / (v_key + v_next) with v the verified
   // matches to each (0 at `key`, 1 at `next_key`, 0.5 where both share as much). NaN when unknown.
   double progress = 0.0;
+  // The target's pose has a translation direction to trust. When not (a short baseline to the target, a
+  // pure rotation, no camera), the guidance is the heading only: LocalizationGuidance says which.
+  bool translation_known = false;
   std::vector<RelocalizationCandidate> candidates;  // relocalization only: those verified, best-ranked first
   int comparisons = 0;                // key images the frame was compared with (some maybe ahead, on workers)
   double seconds = 0.0;               // time spent localizing this frame (features excluded)
@@ -205,5 +215,12 @@ std::pair<int, int> KeysAround(const VisualMap& map, int source_index);
 VerifierOptions MapVerifierOptions(const VisualMap& map, int max_iterations = 5000);
 // S as the map defines it (options.similarity in map.json).
 SimilarityMode MapSimilarityMode(const VisualMap& map);
+// When the map trusts a translation direction (options.translation in map.json).
+TranslationOptions MapTranslationOptions(const VisualMap& map);
+
+// What a controller may use of a result: "heading and translation", "heading only: translation unknown"
+// (a pose whose translation direction is not to be trusted), "heading only: no pose" (no camera, or no pose
+// to the target) or "none" (no heading).
+std::string LocalizationGuidance(const LocalizationResult& result);
 
 }  // namespace vmap

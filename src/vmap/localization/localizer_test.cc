@@ -290,12 +290,19 @@ TEST(Localizer, WithACameraTheHeadingIsInDegreesAndThePoseIsTheTrueOne) {
   // degrees off with t reversed.
   EXPECT_LT(rotation_error_deg, 1.0);
   EXPECT_GT(cosine, std::cos(15.0 * M_PI / 180.0)) << "translation direction within 15 degrees";
+  ASSERT_TRUE(std::isfinite(r.to_key.translation_sigma_deg));
+  if (r.to_key.translation_sigma_deg > options.translation.max_sigma_deg) {
+    EXPECT_FALSE(r.translation_known);
+  }
+  EXPECT_EQ(LocalizationGuidance(r), r.translation_known ? "heading and translation" : "heading only: translation unknown");
 
   // Without the camera: no degrees, no pose.
   Localizer pixels_only(m.map, m.keys, *m.matcher, MapLocalizerOptions(m.map));
   const LocalizationResult p = pixels_only.Localize(frame, *m.matcher->Extract(frame.gray));
   EXPECT_TRUE(std::isnan(p.heading_deg));
   EXPECT_FALSE(p.to_key.pose.valid);
+  EXPECT_FALSE(p.translation_known);
+  EXPECT_EQ(LocalizationGuidance(p), "heading only: no pose");
 }
 
 TEST(Localizer, SameInputSameResults) {

@@ -54,6 +54,9 @@ void ReadLinkGeometryFields(const json& object, Link& link, const std::string& f
     }
     return it->get<double>();
   };
+  link.translation_sigma_deg = number("translation_sigma_deg");
+  const auto known = object.find("translation_known");
+  link.translation_known = known == object.end() ? link.has_pose : known->get<bool>();
   link.parallax = number("parallax_px");
   link.parallax_without_rotation = object.value("parallax_rotation_removed", false);
   link.homography_share = number("homography_share");
@@ -113,6 +116,8 @@ void AddLinkGeometryJson(const Link& link, json& object) {
   } else {
     object["pose"] = nullptr;
   }
+  object["translation_sigma_deg"] = OptionalNumber(link.translation_sigma_deg);
+  object["translation_known"] = link.translation_known;
   object["parallax_px"] = OptionalNumber(link.parallax);
   object["parallax_rotation_removed"] = link.parallax_without_rotation;
   object["homography_share"] = OptionalNumber(link.homography_share);

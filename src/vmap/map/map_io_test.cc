@@ -414,6 +414,8 @@ TEST(MapIo, CameraAndLinkGeometryRoundTrip) {
   cv::Rodrigues(cv::Vec3d(0.01, -0.2, 0.03), link.R);
   link.t = cv::normalize(cv::Vec3d(0.3, -0.1, -0.9));
   link.pose_inliers = 2;
+  link.translation_sigma_deg = 7.5;
+  link.translation_known = false;
   link.parallax = 12.25;
   link.parallax_without_rotation = true;
   link.homography_share = 0.5;
@@ -435,6 +437,9 @@ TEST(MapIo, CameraAndLinkGeometryRoundTrip) {
   EXPECT_LT(cv::norm(l.R - link.R), 1e-12);
   EXPECT_LT(cv::norm(l.t - link.t), 1e-12);
   EXPECT_EQ(l.pose_inliers, 2);
+  EXPECT_DOUBLE_EQ(l.translation_sigma_deg, 7.5);
+  EXPECT_FALSE(l.translation_known);
+  EXPECT_LT(back.links[0].translation_sigma_deg, 0);  // no pose: not computed
   EXPECT_DOUBLE_EQ(l.parallax, 12.25);
   EXPECT_TRUE(l.parallax_without_rotation);
   EXPECT_DOUBLE_EQ(l.homography_share, 0.5);
@@ -471,6 +476,27 @@ TEST(MapIo, ReadsSchemaVersionOneMapsWithBrokenLinks) {
   EXPECT_FALSE(map.links[1].below_tau);
   EXPECT_FALSE(map.links[0].has_pose);
   EXPECT_FALSE(map.input.camera);
+}
+
+// Maps written before links said how well their translation is known: a pose reads as known (what such a map
+// claimed), its sigma as not computed.
+TEST(MapIo, ReadsMapsWithoutTheTranslationFields) {
+  testing::ScopedTempDir tmp;
+  VisualMap map = SmallMap(tmp.path());
+  map.links[1].has_pose = true;
+  map.links[1].t = cv::Vec3d(0, 0, -1);
+  WriteMapFiles(map, tmp.path());
+  std::ifstream in(tmp.path() / kMapFileName);
+  auto doc = nlohmann::json::parse(in);
+  for (auto& link : doc["links"]) {
+    link.erase("translation_sigma_deg");
+    link.erase("translation_known");
+  }
+  WriteText(tmp.path() / kMapFileName, doc.dump());
+  const VisualMap back = ReadMap(tmp.path());
+  EXPECT_FALSE(back.links[0].translation_known);
+  EXPECT_TRUE(back.links[1].translation_known);
+  EXPECT_LT(back.links[1].translation_sigma_deg, 0);
 }
 
 TEST(MapIo, MalformedGeometryIsRefused) {

@@ -49,6 +49,14 @@ struct Link {
   cv::Matx33d R = cv::Matx33d::eye();
   cv::Vec3d t;
   int pose_inliers = 0;           // matches consistent with the pose
+  // How well the matches determine t's direction: its standard deviation in degrees with the rotation
+  // marginalised (geometry/relative_pose.h, TranslationSigmaDeg). < 0: not computed (maps written before it).
+  double translation_sigma_deg = -1.0;
+  // t's direction is to be trusted (translation_sigma_deg and parallax within the map's
+  // link_analysis.translation, geometry/relative_pose.h TranslationKnown); otherwise a robot gets the rotation
+  // only. False without a pose; maps written before the
+  // field say nothing and read as has_pose.
+  bool translation_known = false;
   // Median displacement of the verified matches in pixels: after undoing the rotation R when there is a pose
   // (what the translation's direction rests on), the plain displacement otherwise. < 0: not computed.
   double parallax = -1.0;

@@ -16,6 +16,7 @@ namespace vmap {
 void LinkAnalysisOptions::Check() const {
   CheckField("pose", pose);
   CheckField("homography", homography);
+  CheckField("translation", translation);
 }
 
 void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& options) {
@@ -23,6 +24,8 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
   link.R = cv::Matx33d::eye();
   link.t = cv::Vec3d();
   link.pose_inliers = 0;
+  link.translation_sigma_deg = -1.0;
+  link.translation_known = false;
   link.parallax = -1.0;
   link.parallax_without_rotation = false;
   link.homography_share = -1.0;
@@ -42,6 +45,8 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
 
   if (camera) {
     RelativePose pose;
+    const std::vector<cv::Point2f>& pose_from = options.pose.use_all_matches ? all_from : verified_from;
+    const std::vector<cv::Point2f>& pose_to = options.pose.use_all_matches ? all_to : verified_to;
     if (options.pose.method == PoseMethod::kFromFundamental) {
       pose = PoseFromFundamental(link.F, *camera, verified_from, verified_to);
     } else {
@@ -50,20 +55,23 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
       if (options.pose.start_from_fundamental) {
         from_fundamental.push_back(PoseFromFundamental(link.F, *camera, verified_from, verified_to));
       }
-      pose = options.pose.use_all_matches
-                 ? EstimateRelativePose(*camera, all_from, all_to, options.pose, from_fundamental)
-                 : EstimateRelativePose(*camera, verified_from, verified_to, options.pose, from_fundamental);
+      pose = EstimateRelativePose(*camera, pose_from, pose_to, options.pose, from_fundamental);
     }
     if (pose.valid) {
       link.has_pose = true;
       link.R = pose.R;
       link.t = pose.t;
       link.pose_inliers = pose.num_inliers;
+      link.translation_sigma_deg =
+          TranslationSigmaDeg(pose, *camera, pose_from, pose_to,
+                              options.pose.refine_inlier_factor * options.pose.threshold, options.pose.threshold);
     }
   }
   link.parallax_without_rotation = link.has_pose;
   link.parallax = Median(Displacements(verified_from, verified_to, link.has_pose ? camera : nullptr,
                                        link.has_pose ? &link.R : nullptr));
+  link.translation_known =
+      link.has_pose && TranslationKnown(link.translation_sigma_deg, link.parallax, options.translation);
 
   const HomographyCheck homography = CheckHomography(verified_from, verified_to, options.homography);
   if (homography.estimated) {
@@ -109,6 +117,8 @@ void CopyAnalysis(const Link& from, Link& to) {
   to.R = from.R;
   to.t = from.t;
   to.pose_inliers = from.pose_inliers;
+  to.translation_sigma_deg = from.translation_sigma_deg;
+  to.translation_known = from.translation_known;
   to.parallax = from.parallax;
   to.parallax_without_rotation = from.parallax_without_rotation;
   to.homography_share = from.homography_share;
@@ -169,12 +179,15 @@ void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int thread
 }
 
 nlohmann::json ToJson(const LinkAnalysisOptions& options) {
-  return {{"pose", ToJson(options.pose)}, {"homography", ToJson(options.homography)}};
+  return {{"pose", ToJson(options.pose)},
+          {"homography", ToJson(options.homography)},
+          {"translation", ToJson(options.translation)}};
 }
 
 void FromJson(const JsonFieldReader& fields, LinkAnalysisOptions* options) {
   FromJson(fields.Object("pose"), &options->pose);
   FromJson(fields.Object("homography"), &options->homography);
+  FromJson(fields.Object("translation"), &options->translation);
 }
 
 }  // namespace vmap

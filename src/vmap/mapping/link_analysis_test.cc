@@ -39,6 +39,8 @@ VisualMap Unanalysed() {
     link.has_pose = false;
     link.R = cv::Matx33d::zeros();
     link.pose_inliers = -7;
+    link.translation_sigma_deg = -7.0;
+    link.translation_known = false;
     link.parallax = -7.0;
     link.homography_share = -7.0;
   }
@@ -54,6 +56,8 @@ void ExpectSameAnalysis(const VisualMap& actual, const VisualMap& expected) {
     EXPECT_EQ(a.R, e.R) << i;
     EXPECT_EQ(a.t, e.t) << i;
     EXPECT_EQ(a.pose_inliers, e.pose_inliers) << i;
+    EXPECT_EQ(a.translation_sigma_deg, e.translation_sigma_deg) << i;
+    EXPECT_EQ(a.translation_known, e.translation_known) << i;
     EXPECT_EQ(a.parallax, e.parallax) << i;
     EXPECT_EQ(a.parallax_without_rotation, e.parallax_without_rotation) << i;
     EXPECT_EQ(a.homography_share, e.homography_share) << i;

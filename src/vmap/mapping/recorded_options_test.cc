@@ -41,6 +41,8 @@ RecordedOptions Unusual() {
   builder.link_analysis.pose.seed = 4;
   builder.link_analysis.homography.threshold = 3.0;
   builder.link_analysis.homography.min_share = 0.8;
+  builder.link_analysis.translation.max_sigma_deg = 7.5;
+  builder.link_analysis.translation.min_parallax_px = 1.5;
   options.source.format = SourceFormat::kTum;
   options.source.first = 10;
   options.source.last = 99;
@@ -83,6 +85,8 @@ TEST(RecordedOptions, EveryRecordedFieldReadsBackAsWritten) {
   EXPECT_EQ(pb.seed, pa.seed);
   EXPECT_EQ(b.link_analysis.homography.threshold, a.link_analysis.homography.threshold);
   EXPECT_EQ(b.link_analysis.homography.min_share, a.link_analysis.homography.min_share);
+  EXPECT_EQ(b.link_analysis.translation.max_sigma_deg, a.link_analysis.translation.max_sigma_deg);
+  EXPECT_EQ(b.link_analysis.translation.min_parallax_px, a.link_analysis.translation.min_parallax_px);
   EXPECT_EQ(read.source.format, written.source.format);
   EXPECT_EQ(read.source.first, written.source.first);
   EXPECT_EQ(read.source.last, written.source.last);
@@ -101,7 +105,7 @@ TEST(RecordedOptions, KeepsMapJsonsLayout) {
   for (const auto& item : record.items()) keys.insert(item.key());
   EXPECT_EQ(keys, (std::set<std::string>{"exhaustive", "final_key", "homography", "matcher", "min_key_displacement",
                                          "pose", "quality_mean", "search", "search_window", "similarity", "source",
-                                         "tau", "verifier"}));
+                                         "tau", "translation", "verifier"}));
   EXPECT_EQ(record["source"]["camera"], "input");
   EXPECT_EQ(record["search"], "sequential");
   EXPECT_EQ(record["pose"]["matches"], "all");

@@ -82,7 +82,11 @@ std::string LinkTableHtml(const VisualMap& map, const MapEvaluation* evaluation)
              {std::to_string(s.usable_links) + " / " + std::to_string(s.evaluated_links), "usable links"},
              {std::isfinite(s.usable_share) ? FormatFixed(100.0 * s.usable_share, 1) + " %" : "n/a", "usable share"},
              {Value(s.rotation_error_deg_median, 2, "\u00b0"), "median rotation error"},
-             {Value(s.translation_error_deg_median, 1, "\u00b0"), "median translation error"}}) {
+             {Value(s.translation_error_deg_median, 1, "\u00b0"), "median translation error"},
+             {std::to_string(s.strict_usable_links) + " / " + std::to_string(s.evaluated_links),
+              "usable with every translation judged"},
+             {std::to_string(s.flagged_links) + " (" + std::to_string(s.flagged_wrong_links) + " wrong)",
+              "translation unknown (the map's flag)"}}) {
       html += "<div class=\"card\"><div class=\"value\">" + value + "</div><div class=\"label\">" + HtmlEscape(label) +
               "</div></div>";
     }
@@ -95,7 +99,7 @@ std::string LinkTableHtml(const VisualMap& map, const MapEvaluation* evaluation)
   }
   html += "<table class=\"links-table\"><thead><tr><th class=\"num\">link</th><th>frames</th><th class=\"num\">S</th>"
           "<th class=\"num\">verified / tentative</th><th class=\"num\">parallax</th><th>homography</th>"
-          "<th>t (unit)</th>";
+          "<th>t (unit)</th><th>translation known (&sigma; of its direction)</th>";
   if (evaluation) {
     html += "<th class=\"num\">rotation error</th><th class=\"num\">translation error</th>"
             "<th class=\"num\">true parallax</th><th class=\"num\">verified on true epipolar line</th>"
@@ -121,6 +125,9 @@ std::string LinkTableHtml(const VisualMap& map, const MapEvaluation* evaluation)
                                          : "&ndash;",
                  false);
     html += Cell(l.has_pose ? fmt::format("({:.2f}, {:.2f}, {:.2f})", l.t[0], l.t[1], l.t[2]) : "&ndash;", false);
+    const std::string sigma = l.translation_sigma_deg >= 0 ? " (" + FormatFixed(l.translation_sigma_deg, 1) + "&deg;)" : "";
+    html += Cell(!l.has_pose ? "&ndash;" : (l.translation_known ? "yes" + sigma : "<b>no</b>" + sigma + ": rotation only"),
+                 false);
     if (e) {
       html += Cell(Value(e->rotation_error_deg, 2, "&deg;")) + Cell(Value(e->translation_error_deg, 1, "&deg;")) +
               Cell(Value(e->true_parallax_px, 1, " px")) + Cell(Share(e->verified_within)) +
@@ -132,7 +139,9 @@ std::string LinkTableHtml(const VisualMap& map, const MapEvaluation* evaluation)
   html += "</tbody></table>\n<p class=\"note\">Parallax: median displacement of the verified matches after undoing "
           "the link's rotation (* without a pose: the plain displacement). Homography: the share of the verified "
           "matches one homography explains; when it explains nearly all, the scene is a plane or the camera only "
-          "rotated, and F and the pose are ill-posed.</p>\n</section>\n";
+          "rotated, and F and the pose are ill-posed. Translation known: the standard deviation of t's direction "
+          "that the matches allow is small enough to trust it; otherwise a robot gets the link's rotation only "
+          "(docs/link-poses.md).</p>\n</section>\n";
   return html;
 }
 

@@ -33,6 +33,10 @@ std::string FormatMapSummary(const VisualMap& map, QualityMean mean) {
                         c.has_distortion() ? " (with distortion)" : "",
                         std::count_if(map.links.begin(), map.links.end(), [](const Link& l) { return l.has_pose; }),
                         map.links.size());
+    const auto known = std::count_if(map.links.begin(), map.links.end(),
+                                     [](const Link& l) { return l.has_pose && l.translation_known; });
+    text += fmt::format("translation     known on {} of {} links; the others give a robot their rotation only\n",
+                        known, map.links.size());
   }
   text += fmt::format("quality Q       {:.4f} ({} mean)\n", s.quality, QualityMeanName(mean));
   if (map.seconds > 0) {
