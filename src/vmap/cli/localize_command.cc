@@ -11,6 +11,7 @@
 
 #include "vmap/cli/commands.h"
 #include "vmap/cli/common_options.h"
+#include "vmap/cli/output_files.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
 #include "vmap/localization/localization_map.h"
@@ -55,6 +56,9 @@ void RunLocalize(const LocalizeFlags& flags) {
   // Everything that can fail fast does, before the key images are loaded (which may take seconds).
   LocalizerOptions options = flags.localizer;
   options.Check();
+  CheckOutputs({{flags.csv, "--csv"}, {flags.json, "--json"}},
+               {MapInputs(flags.map), NamedInput(flags.query, "the query"),
+                NamedInput(flags.report, "the --report folder")});
   const VisualMap header = ReadMap(flags.map);
   if (flags.from >= 0 || flags.to >= 0) {
     const int last = static_cast<int>(header.key_images.size()) - 1;
@@ -95,16 +99,27 @@ void RunLocalize(const LocalizeFlags& flags) {
   run.info.key_image_seconds = opened.keys.seconds;
   run.info.options_json = DescribeLocalizerOptions(options);
   std::string csv = LocalizationCsvHeader();
+  // A query that cannot be read again (a live input, a single image) leaves its report the frames kept here:
+  // the last ones, as many as the report shows.
+  const LocalizationReportOptions report_options;
+  const bool record = !flags.report.empty() && !QueryCanBeReadAgain(run.info);
+  RecordedFrames recorded;
   run.summary = LocalizeSequence(*source, *opened.matcher, localizer, run_options,
-                                 [&](const Frame&, const LocalizationResult& result) {
+                                 [&](const Frame& frame, const LocalizationResult& result) {
                                    if (!flags.csv.empty()) csv += LocalizationCsvRow(map, result);
                                    run.frames.push_back(result);
+                                   if (record && report_options.pairs > 0) {
+                                     recorded[result.frame_index] = ColorImage(frame);
+                                     if (recorded.size() > static_cast<size_t>(report_options.pairs)) {
+                                       recorded.erase(recorded.begin());
+                                     }
+                                   }
                                  });
   run.info.frame_size = source->info().frame_size;
 
   if (!flags.csv.empty()) WriteFileAtomically(flags.csv, csv);
   if (!flags.json.empty()) WriteFileAtomically(flags.json, LocalizationRunJson(map, run));
-  if (!flags.report.empty()) WriteLocalizationReport(run, map, flags.map, flags.report);
+  if (!flags.report.empty()) WriteLocalizationReport(run, map, flags.map, flags.report, report_options, recorded);
 
   const LocalizationSummary& s = run.summary;
   std::cout << fmt::format("map             {} ({} key images, {})\n", flags.map, map.key_images.size(),
@@ -166,8 +181,11 @@ void AddLocalizeCommand(CLI::App& app) {
                        "Never move the estimate back to the previous key image");
   option_flags.AddEnumOption(command, "--ranking", o.ranking.method, ParseRankingMethod, RankingMethodName,
                              "ranking.method", "Relocalization ranking: " + ListEnumNames(kRankingMethodNames));
-  command->add_option("--from", flags->from, "Follow the route from this key image (default: the first)");
-  command->add_option("--to", flags->to, "Follow the route to this key image (default: the last)");
+  // -1 stands for "not given" here only: a negative key image is refused as route refuses it.
+  command->add_option("--from", flags->from, "Follow the route from this key image (default: the first)")
+      ->check(CLI::NonNegativeNumber);
+  command->add_option("--to", flags->to, "Follow the route to this key image (default: the last)")
+      ->check(CLI::NonNegativeNumber);
   // LocalizeSequenceOptions::extraction_threads (the key-image store's keeps its default).
   option_flags
       .AddOption(command, "--threads", flags->threads, "extraction_threads",

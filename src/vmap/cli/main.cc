@@ -1,16 +1,24 @@
 // vmap: builds visual maps (key images linked by fundamental matrices) from teach-run videos.
 
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
+#include <new>
+#include <stdexcept>
 
 #include <CLI/CLI.hpp>
 
 #include "vmap/cli/commands.h"
+#include "vmap/cli/option_flags.h"
 #include "vmap/core/error.h"
 #include "vmap/core/logging.h"
 #include "vmap/core/runtime.h"
 
 int main(int argc, char** argv) {
+  // OpenCV checks an image's size from its header before decoding it, against this limit (read once, at the
+  // first decoding): vmap's own limit of 8192 x 8192 pixels a frame (FrameSourceOptions::max_frame_pixels), so
+  // that a small file announcing 32000 x 32000 pixels is refused before a gigabyte is allocated for it.
+  setenv("OPENCV_IO_MAX_IMAGE_PIXELS", "67108864", /*overwrite=*/0);
   // First, while this is the only thread: signal handling (an interrupted command removes its unfinished
   // outputs and exits with 128 + the signal), OpenCV's threads, malloc, FFmpeg's log (see runtime.h).
   vmap::InitializeRuntime();
@@ -36,6 +44,7 @@ int main(int argc, char** argv) {
 
   // Every failure ends as "vmap: error: ..." with status 2; 0 is success, --help and --version included.
   try {
+    vmap::cli::RefuseEmptyArguments(argc, argv);
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);  // --help, --version
@@ -45,6 +54,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "vmap: error: %s\n", e.what());
     return 2;
   } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "vmap: error: out of memory; try a smaller input or smaller options (--resize)\n");
+    return 2;
+  } catch (const std::length_error&) {  // a size no allocation could take: out of memory all the same
     std::fprintf(stderr, "vmap: error: out of memory; try a smaller input or smaller options (--resize)\n");
     return 2;
   } catch (const std::exception& e) {

@@ -11,6 +11,7 @@
 
 #include "vmap/cli/commands.h"
 #include "vmap/cli/common_options.h"
+#include "vmap/cli/output_files.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
@@ -30,8 +31,9 @@ struct MatchFlags {
 
 cv::Mat ReadGray(const std::string& path) {
   // IMREAD_GRAYSCALE, not cvtColor: the decoder's conversion is what the reference implementations see.
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) throw InputError("image '" + path + "' does not exist");
+  // A FIFO or a device is refused before OpenCV opens it (and would wait or read forever).
+  std::string why_not;
+  if (!ContainedFile::OpenRegular(path, &why_not)) throw InputError("image '" + path + "' " + why_not + "; give an image file");
   cv::Mat gray;
   try {
     gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
@@ -55,12 +57,8 @@ double Seconds(std::chrono::steady_clock::time_point start) {
 void RunMatch(const MatchFlags& flags) {
   const VerifierOptions verifier = flags.verifier.Resolve();
   flags.matcher.Check();
-  for (const std::string& image : {flags.image0, flags.image1}) {
-    if (!flags.json_path.empty() && IsSameOrInside(flags.json_path, image)) {
-      throw InputError("--json " + flags.json_path + " would overwrite the input image '" + image +
-                       "'; write it somewhere else");
-    }
-  }
+  CheckOutputs({{flags.json_path, "--json"}},
+               {NamedInput(flags.image0, "the input image"), NamedInput(flags.image1, "the input image")});
   const cv::Mat gray0 = ReadGray(flags.image0), gray1 = ReadGray(flags.image1);
   auto start = std::chrono::steady_clock::now();
   const std::unique_ptr<Matcher> matcher = CreateMatcher(flags.matcher);

@@ -18,6 +18,7 @@
 
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/output_file.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -140,6 +141,8 @@ int RemoveTemporaryOutputsForExit() {
 }
 
 void WriteFileAtomically(const fs::path& path, std::string_view content) {
+  // Refused before anything is written, and again before the rename (the path may have changed meanwhile).
+  if (const std::string why_not = WhyNotReplaceable(path); !why_not.empty()) Refuse(path, why_not);
   RemoveStaleTemporaries(path);
   fs::path temp;
   int fd = -1;
@@ -173,6 +176,10 @@ void WriteFileAtomically(const fs::path& path, std::string_view content) {
     const std::string reason = ErrnoText();
     RemoveAndUnregister(temp);
     throw InputError("writing '" + path.string() + "' failed (" + reason + "); check the free space");
+  }
+  if (const std::string why_not = WhyNotReplaceable(path); !why_not.empty()) {
+    RemoveAndUnregister(temp);
+    Refuse(path, why_not);
   }
   std::unique_lock<std::mutex> lock(Temporaries().mutex);
   if (rename(temp.c_str(), path.c_str()) != 0) {

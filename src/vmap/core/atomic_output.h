@@ -18,7 +18,8 @@
 
 namespace vmap {
 
-// Writes `content` to `path` through a temporary file in the same directory and a rename.
+// Writes `content` to `path` through a temporary file in the same directory and a rename. Never replaces a
+// symbolic link, a device, a FIFO, a socket or a read-only file (InputError; see output_file.h).
 void WriteFileAtomically(const std::filesystem::path& path, std::string_view content);
 
 // What an output directory may replace, and what it must never touch.

@@ -365,6 +365,10 @@ void WriteMapFiles(const VisualMap& map, const fs::path& directory) {
 namespace {
 
 constexpr long kMaxInt = std::numeric_limits<int>::max();
+// Values (numbers, strings, arrays, objects) in map.json: 8.4 million, far above a map of 100,000 key images
+// whose 400,000 frames were each compared three times (some 6 values a comparison); parsed, this many take
+// at most some hundred MB, where 150 million numbers would take gigabytes.
+constexpr std::uint64_t kMaxMapJsonValues = 1ull << 23;
 // A key image of a map that does not record its frame size may have at most the pixels of a frame.
 constexpr long kMaxKeyImagePixels = 8192L * 8192L;
 constexpr int kRecordBytes = 4 * sizeof(float);
@@ -412,6 +416,9 @@ void ReadKeyImages(const json& doc, const Fields& fields, const fs::path& direct
     k.image_file = DecodeFileName(fields.String(fields.Required(entry, where, "image"), where + ".image"));
     k.num_features = static_cast<int>(fields.Integer(entry, where, "num_features", 0, kMaxInt, 0));
     k.reason = fields.String(entry, where, "reason");
+    if (k.image_file.find('\0') != std::string::npos || k.source_name.find('\0') != std::string::npos) {
+      fields.Fail(where, "has a name holding a NUL character, which no file name can");
+    }
     if (!IsPlainRelativePath(k.image_file)) {
       Malformed(file, where + " image '" + k.image_file + "' points outside the map directory");
     }
@@ -577,7 +584,7 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
     throw InputError("map directory '" + directory.string() + "' does not exist; build one with `vmap build`");
   }
   const fs::path file = directory / kMapFileName;
-  const ContainedJson parsed = ReadContainedJson(directory, kMapFileName, kMaxMapJsonBytes);
+  const ContainedJson parsed = ReadContainedJson(directory, kMapFileName, kMaxMapJsonBytes, kMaxMapJsonValues);
   if (parsed.missing) throw InputError("'" + directory.string() + "' is not a map: " + file.string() + " is missing");
   if (!parsed.document) Malformed(file, parsed.why_not);
   const json& doc = *parsed.document;
@@ -592,9 +599,13 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
                      ", newer than this vmap understands (" + std::to_string(kMapSchemaVersion) + "); update vmap");
   }
   VisualMap map;
-  if (const json* input = Fields::Find(doc, "input")) {
+  const json* input = Fields::Find(doc, "input");
+  // Every map since schema 2 records its input: how it was made, and the frame size and camera it is read at.
+  if (!input && version >= 2) fields.Fail("input", "is missing; rebuild the map with `vmap build`");
+  if (input) {
     fields.Object(*input, "input");
     map.input.path = DecodeFileName(fields.String(*input, "input", "path"));
+    if (map.input.path.find('\0') != std::string::npos) fields.Fail("input.path", "holds a NUL character");
     const std::string format = fields.String(*input, "input", "format");
     try {
       map.input.format = ParseSourceFormat(format.empty() ? "auto" : format);
@@ -612,6 +623,13 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
   map.options_json = options ? fields.Object(*options, "options").dump() : "{}";
   map.num_frames = static_cast<int>(fields.Integer(fields.Required(doc, "", "num_frames"), "num_frames", 0, kMaxInt));
   map.skipped_frames = static_cast<int>(fields.Integer(doc, "", "skipped_frames", 0, kMaxInt, 0));
+  // A size with a zero side describes no frame, whereas the key images of a map with frames have one.
+  const cv::Size frame_size = map.input.frame_size;
+  if (input && Fields::Find(*input, "frame_size") && map.num_frames > 0 &&
+      (frame_size.width < 1 || frame_size.height < 1)) {
+    fields.Fail("input.frame_size", "is " + std::to_string(frame_size.width) + "x" +
+                                        std::to_string(frame_size.height) + " although the map has frames");
+  }
   map.quality = fields.Number(fields.Required(doc, "", "quality"), "quality", 0.0, 1.0);
   map.seconds = fields.Number(doc, "", "seconds", 0.0, 1e9, 0.0);
   if (const json* coverage = Fields::Find(doc, "coverage")) {
@@ -631,6 +649,11 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
   }
   ReadKeyImages(doc, fields, directory, file, &map);
   ReadLinks(doc, fields, directory, file, &map);
+  // The builder links each key image to the next one it was chosen after: several key images and no link at
+  // all cannot come from it, and would leave localization nothing to follow.
+  if (map.key_images.size() > 1 && map.links.empty()) {
+    fields.Fail("links", "is empty although the map has " + std::to_string(map.key_images.size()) + " key images");
+  }
   ReadEvaluations(doc, fields, &map);
   return map;
 }
@@ -669,7 +692,7 @@ cv::Mat ReadKeyImage(const fs::path& map_directory, const KeyImage& key, bool gr
 }
 
 std::string WhyNotAVmapMap(const fs::path& directory) {
-  const ContainedJson parsed = ReadContainedJson(directory, kMapFileName, kMaxMapJsonBytes);
+  const ContainedJson parsed = ReadContainedJson(directory, kMapFileName, kMaxMapJsonBytes, kMaxMapJsonValues);
   if (parsed.missing) return "it has no map.json";
   if (!parsed.document) return "its " + parsed.why_not;
   const json& doc = *parsed.document;
