@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <set>
+#include <string>
 
 #include "vmap/evaluation/map_evaluation.h"
 #include "vmap/localization/key_image_store.h"
@@ -17,10 +18,6 @@ std::vector<OutputInput> MapInputs(const std::string& map_directory) {
   std::set<std::string> names = {kMapFileName,    kCorrespondencesFileName, "keys",
                                  kReportFileName, kReportAssetsDirectory,   kEvaluationFileName,
                                  kLocalizationCacheFileName};
-  std::error_code ec;
-  for (fs::directory_iterator it(directory, ec), end; !ec && it != end; it.increment(ec)) {
-    names.insert(it->path().filename().string());
-  }
   std::vector<OutputInput> inputs;
   for (const std::string& name : names) inputs.push_back({directory / name, "the map's " + name});
   return inputs;

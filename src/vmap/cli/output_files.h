@@ -9,12 +9,13 @@
 
 namespace vmap::cli {
 
-// Every file of the map at `map_directory`: what it holds now (map.json, correspondences.bin, keys/, the
-// key-image cache, eval.json, report.html, report/ and anything else there) and the files vmap writes into it,
-// even where they do not exist yet. A new file of another name inside the map folder is allowed.
+// Every file of the map at `map_directory`, whether it exists yet or not: map.json, correspondences.bin,
+// keys/, the key-image cache, eval.json, report.html and report/. Another name inside the map folder (an
+// output written there by an earlier run) is not the map's, and may be written.
 std::vector<OutputInput> MapInputs(const std::string& map_directory);
 
-// A file or folder the command reads, named by `flag` for messages ("the query"); none when `path` is empty.
+// A file or folder the command reads, described by `what` for messages ("the query"); none when `path` is
+// empty.
 std::vector<OutputInput> NamedInput(const std::string& path, const std::string& what);
 
 // CheckOutputFiles over the inputs put together.
