@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -59,6 +60,14 @@ void RunLocalize(const LocalizeFlags& flags) {
   CheckOutputs({{flags.csv, "--csv"}, {flags.json, "--json"}},
                {MapInputs(flags.map), NamedInput(flags.query, "the query"),
                 NamedInput(flags.report, "the --report folder")});
+  // A FIFO or a device other than a camera would be opened blocking, waiting for a writer that may never come.
+  std::error_code ec;
+  const fs::file_status query_status = fs::status(flags.query, ec);
+  if (!IsLiveInput(flags.query) && fs::exists(query_status) && !fs::is_regular_file(query_status) &&
+      !fs::is_directory(query_status)) {
+    throw InputError("query '" + flags.query + "' is neither a file nor a folder (a FIFO or a device); give a video, "
+                     "an image folder, a TUM/EuRoC/KITTI sequence, an image, or a live input (udp://..., /dev/videoN)");
+  }
   const VisualMap header = ReadMap(flags.map);
   if (flags.from >= 0 || flags.to >= 0) {
     const int last = static_cast<int>(header.key_images.size()) - 1;
@@ -183,9 +192,9 @@ void AddLocalizeCommand(CLI::App& app) {
                              "ranking.method", "Relocalization ranking: " + ListEnumNames(kRankingMethodNames));
   // -1 stands for "not given" here only: a negative key image is refused as route refuses it.
   command->add_option("--from", flags->from, "Follow the route from this key image (default: the first)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, std::numeric_limits<int>::max()));
   command->add_option("--to", flags->to, "Follow the route to this key image (default: the last)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, std::numeric_limits<int>::max()));
   // LocalizeSequenceOptions::extraction_threads (the key-image store's keeps its default).
   option_flags
       .AddOption(command, "--threads", flags->threads, "extraction_threads",

@@ -1,7 +1,6 @@
 // vmap: builds visual maps (key images linked by fundamental matrices) from teach-run videos.
 
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <new>
 #include <stdexcept>
@@ -15,10 +14,6 @@
 #include "vmap/core/runtime.h"
 
 int main(int argc, char** argv) {
-  // OpenCV checks an image's size from its header before decoding it, against this limit (read once, at the
-  // first decoding): vmap's own limit of 8192 x 8192 pixels a frame (FrameSourceOptions::max_frame_pixels), so
-  // that a small file announcing 32000 x 32000 pixels is refused before a gigabyte is allocated for it.
-  setenv("OPENCV_IO_MAX_IMAGE_PIXELS", "67108864", /*overwrite=*/0);
   // First, while this is the only thread: signal handling (an interrupted command removes its unfinished
   // outputs and exits with 128 + the signal), OpenCV's threads, malloc, FFmpeg's log (see runtime.h).
   vmap::InitializeRuntime();

@@ -16,6 +16,7 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/core/file_name_encoding.h"
+#include "vmap/core/image_header.h"
 
 namespace vmap::cli {
 
@@ -33,7 +34,17 @@ cv::Mat ReadGray(const std::string& path) {
   // IMREAD_GRAYSCALE, not cvtColor: the decoder's conversion is what the reference implementations see.
   // A FIFO or a device is refused before OpenCV opens it (and would wait or read forever).
   std::string why_not;
-  if (!ContainedFile::OpenRegular(path, &why_not)) throw InputError("image '" + path + "' " + why_not + "; give an image file");
+  const std::optional<ContainedFile> file = ContainedFile::OpenRegular(path, &why_not);
+  if (!file) throw InputError("image '" + path + "' " + why_not + "; give an image file");
+  // The size its header announces, before a decoder allocates for it.
+  if (const std::optional<cv::Size> announced = ImageHeaderSize(*file)) {
+    const std::string problem = FrameSizeProblem(*announced);
+    if (!problem.empty()) {
+      throw InputError("image '" + path + "' is " + std::to_string(announced->width) + "x" +
+                       std::to_string(announced->height) + " (from its header), " + problem +
+                       "; give images of a usable size");
+    }
+  }
   cv::Mat gray;
   try {
     gray = cv::imread(path, cv::IMREAD_GRAYSCALE);

@@ -125,6 +125,7 @@ TEST(OutputPromises, UserNamedFilesAreReadOnlyWhenRegularAndBounded) {
   ExpectRefused(
       {
           {"eval " + map + " --gt " + Quote(tmp.path() / "fifo"), "is not a regular file"},
+          {"localize " + map + " " + Quote(tmp.path() / "fifo"), "is neither a file nor a folder"},
           {"eval " + map + " --gt /dev/zero", "is not a regular file"},
           {"eval " + map + " --gt " + Quote(tmp.path() / "sparse.txt"), "is larger than 256 MB"},
           {"report " + Quote(tmp.path() / "fifo.json"), "not a regular file"},

@@ -14,7 +14,9 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/core/file_name_encoding.h"
+#include "vmap/core/image_header.h"
 #include "vmap/map/map_geometry_json.h"
+#include "vmap/sources/frame_source.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -233,55 +235,8 @@ cv::Size SizeField(const Fields& fields, const json& object, const std::string& 
           static_cast<int>(fields.Integer((*value)[1], field + "[1]", 0, kMaxSide))};
 }
 
-// The width and height a PNG file's header announces, or nullopt when the file is not a PNG.
-std::optional<cv::Size> PngSize(const ContainedFile& file) {
-  unsigned char header[24];
-  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-  if (!file.Read(0, header, sizeof(header)) || std::memcmp(header, kSignature, 8) != 0 ||
-      std::memcmp(header + 12, "IHDR", 4) != 0) {
-    return std::nullopt;
-  }
-  auto big_endian = [&](int at) {
-    return (std::uint32_t(header[at]) << 24) | (std::uint32_t(header[at + 1]) << 16) |
-           (std::uint32_t(header[at + 2]) << 8) | std::uint32_t(header[at + 3]);
-  };
-  const std::uint32_t width = big_endian(16), height = big_endian(20);
-  if (width > (1u << 20) || height > (1u << 20)) return cv::Size(1 << 20, 1 << 20);
-  return cv::Size(static_cast<int>(width), static_cast<int>(height));
-}
-
-
-// The width and height of a baseline or progressive JPEG file's frame header (SOFn), or nullopt when the file
-// is not a JPEG. Walks the marker segments from the start; at most 64 segments and 1 MiB are looked at, since
-// the frame header comes before any image data.
-std::optional<cv::Size> JpegSize(const ContainedFile& file) {
-  unsigned char bytes[9];
-  if (!file.Read(0, bytes, 2) || bytes[0] != 0xFF || bytes[1] != 0xD8) return std::nullopt;
-  std::uint64_t at = 2;
-  for (int segment = 0; segment < 64 && at < (1u << 20); ++segment) {
-    if (!file.Read(at, bytes, 4) || bytes[0] != 0xFF) return std::nullopt;
-    const int marker = bytes[1];
-    const int length = (bytes[2] << 8) | bytes[3];
-    if (marker == 0xFF) {  // fill byte
-      ++at;
-      continue;
-    }
-    // SOF0..SOF15 except DHT (C4), JPG (C8) and DAC (CC): precision, height, width.
-    if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC) {
-      if (!file.Read(at + 4, bytes, 5)) return std::nullopt;
-      return cv::Size((bytes[3] << 8) | bytes[4], (bytes[1] << 8) | bytes[2]);
-    }
-    if (marker == 0xD9 || marker == 0xDA || length < 2) return std::nullopt;  // end or scan before a frame
-    at += 2 + static_cast<std::uint64_t>(length);
-  }
-  return std::nullopt;
-}
-
 // A key image's size from its header: PNG, or JPEG (a key image copied from the input's own file).
-std::optional<cv::Size> KeyImageSize(const ContainedFile& file) {
-  if (auto size = PngSize(file)) return size;
-  return JpegSize(file);
-}
+std::optional<cv::Size> KeyImageSize(const ContainedFile& file) { return ImageHeaderSize(file); }
 }  // namespace
 
 std::optional<cv::Size> KeyImageFileSize(const fs::path& file) {
@@ -581,6 +536,10 @@ void ReadEvaluations(const json& doc, const Fields& fields, VisualMap* map) {
 VisualMap ReadCheckedMap(const fs::path& directory) {
   std::error_code ec;
   if (!fs::is_directory(directory, ec)) {
+    if (fs::exists(directory, ec)) {
+      throw InputError("'" + directory.string() + "' is not a map: a map is the folder `vmap build -o` wrote; "
+                       "give that folder");
+    }
     throw InputError("map directory '" + directory.string() + "' does not exist; build one with `vmap build`");
   }
   const fs::path file = directory / kMapFileName;
@@ -623,12 +582,15 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
   map.options_json = options ? fields.Object(*options, "options").dump() : "{}";
   map.num_frames = static_cast<int>(fields.Integer(fields.Required(doc, "", "num_frames"), "num_frames", 0, kMaxInt));
   map.skipped_frames = static_cast<int>(fields.Integer(doc, "", "skipped_frames", 0, kMaxInt, 0));
-  // A size with a zero side describes no frame, whereas the key images of a map with frames have one.
+  // The frames of a map that has any were read at this size, and vmap reads none with a side under
+  // kMinFrameSide or more pixels than a frame may have (it skips them): such a size, 0x0 above all,
+  // contradicts the frames.
   const cv::Size frame_size = map.input.frame_size;
   if (input && Fields::Find(*input, "frame_size") && map.num_frames > 0 &&
-      (frame_size.width < 1 || frame_size.height < 1)) {
+      !FrameSizeProblem(frame_size).empty()) {
     fields.Fail("input.frame_size", "is " + std::to_string(frame_size.width) + "x" +
-                                        std::to_string(frame_size.height) + " although the map has frames");
+                                        std::to_string(frame_size.height) + " although the map has frames, " +
+                                        "which are never " + FrameSizeProblem(frame_size));
   }
   map.quality = fields.Number(fields.Required(doc, "", "quality"), "quality", 0.0, 1.0);
   map.seconds = fields.Number(doc, "", "seconds", 0.0, 1e9, 0.0);
