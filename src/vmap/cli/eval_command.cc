@@ -38,9 +38,10 @@ void RunEval(const EvalFlags& flags) {
                {MapInputs(flags.map), NamedInput(flags.gt, "the ground truth"),
                 fs::is_regular_file(flags.camera) ? NamedInput(flags.camera, "the --camera file")
                                                   : std::vector<OutputInput>{}});
+  ParseEvaluationCamera(flags.camera);  // a wrong --camera is refused first, even where the map's camera is used
   const VisualMap map = ReadMap(flags.map);
-  const Camera camera = EvaluationCamera(map, flags.camera);
   const GroundTruth truth = MapGroundTruth(map, flags.gt, ParseGroundTruthFormat(flags.gt_format));
+  const Camera camera = EvaluationCamera(map, flags.camera);
   MapEvaluation evaluation = EvaluateMap(map, truth, camera, flags.options);
   evaluation.map_path = flags.map;
   if (evaluation.summary.links > 0 && evaluation.summary.evaluated_links == 0) {

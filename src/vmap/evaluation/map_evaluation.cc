@@ -207,7 +207,7 @@ MapEvaluation EvaluateMap(const VisualMap& map, const GroundTruth& truth, const 
   return evaluation;
 }
 
-Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option) {
+std::optional<Camera> ParseEvaluationCamera(const std::string& camera_option) {
   std::optional<Camera> camera;
   if (!camera_option.empty()) {
     // Checked even where the map's own camera is used, so that a wrong value is never silently passed over.
@@ -225,6 +225,11 @@ Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option) 
       throw OptionError("camera", "'" + camera_option + "': " + error.what());
     }
   }
+  return camera;
+}
+
+Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option) {
+  std::optional<Camera> camera = ParseEvaluationCamera(camera_option);
   if (map.input.camera) {
     if (camera) spdlog::warn("the map records its camera, which is used; --camera is for maps that have none");
     return *map.input.camera;
