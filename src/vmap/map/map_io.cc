@@ -583,10 +583,11 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
   map.num_frames = static_cast<int>(fields.Integer(fields.Required(doc, "", "num_frames"), "num_frames", 0, kMaxInt));
   map.skipped_frames = static_cast<int>(fields.Integer(doc, "", "skipped_frames", 0, kMaxInt, 0));
   // The frames of a map that has any were read at this size, and vmap reads none with a side under
-  // kMinFrameSide or more pixels than a frame may have (it skips them): such a size, 0x0 above all,
-  // contradicts the frames.
+  // kMinFrameSide or more pixels than a frame may have (it skips them): such a size contradicts the frames.
+  // 0x0 says the size is not recorded (a snapshot taken before the source knew it): key images then stand
+  // for themselves.
   const cv::Size frame_size = map.input.frame_size;
-  if (input && Fields::Find(*input, "frame_size") && map.num_frames > 0 &&
+  if (input && Fields::Find(*input, "frame_size") && map.num_frames > 0 && frame_size != cv::Size() &&
       !FrameSizeProblem(frame_size).empty()) {
     fields.Fail("input.frame_size", "is " + std::to_string(frame_size.width) + "x" +
                                         std::to_string(frame_size.height) + " although the map has frames, " +

@@ -233,7 +233,7 @@ TEST(MapIo, EveryFieldIsCheckedAndTheMessageNamesIt) {
       {[](json& d) { d["evaluations"].erase("key_frame"); }, "'evaluations.key_frame' is missing"},
       // Fields that contradict each other or describe nothing a camera makes.
       {[](json& d) { d["links"] = json::array(); }, "'links' is empty although the map has 3 key images"},
-      {[](json& d) { d["input"]["frame_size"] = {0, 0}; }, "'input.frame_size' is 0x0 although the map has frames, which are never smaller than 32"},
+      {[](json& d) { d["input"]["frame_size"] = {0, 48}; }, "'input.frame_size' is 0x48 although the map has frames, which are never smaller than 32"},
       {[](json& d) { d["input"]["frame_size"] = {64, 0}; }, "'input.frame_size' is 64x0"},
       {[](json& d) { d["input"]["frame_size"] = {64, 8}; }, "'input.frame_size' is 64x8"},
       {[](json& d) { d["input"]["frame_size"] = {100000, 100000}; }, "which are never more than vmap's limit"},
