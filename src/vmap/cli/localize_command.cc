@@ -60,6 +60,7 @@ void RunLocalize(const LocalizeFlags& flags) {
   CheckOutputs({{flags.csv, "--csv"}, {flags.json, "--json"}},
                {MapInputs(flags.map), NamedInput(flags.query, "the query"),
                 NamedInput(flags.report, "the --report folder")});
+  if (!flags.report.empty()) CheckLocalizationReportDirectory(flags.report, flags.map, flags.query);
   // A FIFO or a device other than a camera would be opened blocking, waiting for a writer that may never come.
   std::error_code ec;
   const fs::file_status query_status = fs::status(flags.query, ec);

@@ -101,6 +101,8 @@ TEST(OutputPromises, SingleFileOutputsNeverReplaceAnInputOrASpecialFile) {
            "is also the output of --csv"},
           {localize + " --csv " + Quote(tmp.path() / "nowhere/a.csv"), "does not exist; create it first"},
           {"localize " + map + " " + Quote(in) + " --csv " + Quote(in / "new.csv"), "lies inside the query"},
+          {localize + " --report " + Quote(tmp.path()), "is or holds the input"},
+          {localize + " --report " + Quote(in), "is or holds the input"},
           {"route " + map + " --json " + Quote(m / kMapFileName), "would overwrite the map's map.json"},
           {"route " + map + " --json /dev/null", "is not a regular file"},
           {"eval " + map + " --gt " + Quote(tmp.path() / "gt.txt") + " --json " + Quote(tmp.path() / "gt.txt"),

@@ -203,6 +203,24 @@ void LocalizationReportOptions::Check() const {
   }
 }
 
+namespace {
+
+// The whole folder is replaced at once, and only when it is empty or an older report of a run.
+OutputPolicy ReportPolicy(const fs::path& map_directory, const std::string& query) {
+  OutputPolicy policy;
+  policy.why_not_ours = WhyNotALocalizationReport;
+  policy.kind = "a vmap localization report";
+  policy.inputs = {map_directory, query};
+  return policy;
+}
+
+}  // namespace
+
+void CheckLocalizationReportDirectory(const fs::path& directory, const fs::path& map_directory,
+                                      const std::string& query) {
+  CheckOutputDirectory(directory, ReportPolicy(map_directory, query));
+}
+
 bool QueryCanBeReadAgain(const LocalizationRunInfo& info) {
   if (IsLiveInput(info.query)) return false;
   std::error_code ec;
@@ -218,12 +236,7 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
                              const RecordedFrames& recorded) {
   options.Check();
   for (const KeyImage& k : map.key_images) KeyImageFile(map_directory, k);
-  // The whole folder is replaced at once, and only when it is empty or an older report of a run.
-  OutputPolicy policy;
-  policy.why_not_ours = WhyNotALocalizationReport;
-  policy.kind = "a vmap localization report";
-  policy.inputs = {map_directory, run.info.query};
-  AtomicOutputDirectory output(directory, policy);
+  AtomicOutputDirectory output(directory, ReportPolicy(map_directory, run.info.query));
   const fs::path assets = output.path() / kReportAssetsDirectory;
   fs::create_directory(assets);  // not create_directories: see AtomicOutputDirectory::path()
   fs::create_directory(assets / "frames");

@@ -47,6 +47,11 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map,
                              const std::filesystem::path& map_directory, const std::filesystem::path& directory,
                              const LocalizationReportOptions& options = {}, const RecordedFrames& recorded = {});
 
+// Throws InputError when `directory` may not receive the report of a run against `map_directory` of `query`
+// (the check WriteLocalizationReport makes): for `vmap localize --report`, to refuse before the run.
+void CheckLocalizationReportDirectory(const std::filesystem::path& directory,
+                                      const std::filesystem::path& map_directory, const std::string& query);
+
 // "" when `directory` is a localization report vmap wrote (its run.json is a run), or why it is not.
 std::string WhyNotALocalizationReport(const std::filesystem::path& directory);
 
