@@ -12,6 +12,7 @@
 
 #include "vmap/cli/commands.h"
 #include "vmap/cli/option_flags.h"
+#include "vmap/cli/output_files.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
@@ -41,17 +42,9 @@ void RunDraw(const DrawFlags& flags) {
   if (flags.width != 0 && (flags.width < 64 || flags.width > 16384)) {
     throw InputError("--width must be 0 (the key images' own scale) or 64 to 16384 pixels");
   }
-  const VisualMap map = ReadMap(flags.map_directory);
   // The figure must not overwrite what it is drawn from (the map's files).
-  const std::filesystem::path map_directory(flags.map_directory);
-  const std::vector<std::string> map_files = {kMapFileName, kCorrespondencesFileName, "keys", kReportFileName,
-                                              kReportAssetsDirectory};
-  for (const std::string& file : map_files) {
-    if (IsSameOrInside(output, map_directory / file)) {
-      throw InputError("output '" + flags.output + "' would overwrite the map's own '" + file +
-                       "'; write the figure somewhere else");
-    }
-  }
+  CheckOutputs({{flags.output, "-o"}}, {MapInputs(flags.map_directory)});
+  const VisualMap map = ReadMap(flags.map_directory);
   MatchFigureOptions options;
   options.max_width = flags.width;
   options.caption = !flags.no_caption;

@@ -8,6 +8,7 @@
 
 #include "vmap/cli/commands.h"
 #include "vmap/cli/option_flags.h"
+#include "vmap/cli/output_files.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
 #include "vmap/evaluation/map_evaluation.h"
@@ -33,14 +34,26 @@ struct EvalFlags {
 
 void RunEval(const EvalFlags& flags) {
   flags.options.Check();
+  CheckOutputs({{flags.json, "--json"}},
+               {MapInputs(flags.map), NamedInput(flags.gt, "the ground truth"),
+                fs::is_regular_file(flags.camera) ? NamedInput(flags.camera, "the --camera file")
+                                                  : std::vector<OutputInput>{}});
+  ParseEvaluationCamera(flags.camera);  // a wrong --camera is refused first, even where the map's camera is used
   const VisualMap map = ReadMap(flags.map);
   const GroundTruth truth = MapGroundTruth(map, flags.gt, ParseGroundTruthFormat(flags.gt_format));
   const Camera camera = EvaluationCamera(map, flags.camera);
   MapEvaluation evaluation = EvaluateMap(map, truth, camera, flags.options);
   evaluation.map_path = flags.map;
   if (evaluation.summary.links > 0 && evaluation.summary.evaluated_links == 0) {
-    spdlog::warn("no link has ground truth for both key images: check that --gt belongs to this sequence{}",
-                 truth.format == GroundTruthFormat::kKitti ? "" : " and that the timestamps match");
+    // Ground truth of another sequence: an evaluation of nothing would replace eval.json all the same.
+    throw InputError("the ground truth '" + truth.path + "' covers none of the map's " +
+                     std::to_string(evaluation.summary.links) + " links (no pose for both key images of any)" +
+                     "; give the ground truth of the map's input '" + map.input.path + "'" +
+                     (truth.format == GroundTruthFormat::kKitti ? "" : " and check that the timestamps match"));
+  }
+  if (evaluation.summary.evaluated_links < evaluation.summary.links) {
+    spdlog::warn("the ground truth covers {} of the map's {} links; the others are left out", 
+                 evaluation.summary.evaluated_links, evaluation.summary.links);
   }
   const std::string json = EvaluationToJson(evaluation);
   if (flags.save) WriteFileAtomically(fs::path(flags.map) / kEvaluationFileName, json);

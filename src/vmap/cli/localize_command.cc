@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -13,6 +14,7 @@
 #include "vmap/cli/commands.h"
 #include "vmap/cli/common_options.h"
 #include "vmap/cli/localize_options.h"
+#include "vmap/cli/output_files.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
 #include "vmap/localization/localization_map.h"
@@ -52,6 +54,18 @@ void RunLocalize(const LocalizeFlags& flags) {
   // Everything that can fail fast does, before the key images are loaded (which may take seconds).
   LocalizerOptions options = flags.localizer;
   options.Check();
+  CheckOutputs({{flags.csv, "--csv"}, {flags.json, "--json"}},
+               {MapInputs(flags.map), NamedInput(flags.query, "the query"),
+                NamedInput(flags.report, "the --report folder")});
+  if (!flags.report.empty()) CheckLocalizationReportDirectory(flags.report, flags.map, flags.query);
+  // A FIFO or a device other than a camera would be opened blocking, waiting for a writer that may never come.
+  std::error_code ec;
+  const fs::file_status query_status = fs::status(flags.query, ec);
+  if (!IsLiveInput(flags.query) && fs::exists(query_status) && !fs::is_regular_file(query_status) &&
+      !fs::is_directory(query_status)) {
+    throw InputError("query '" + flags.query + "' is neither a file nor a folder (a FIFO or a device); give a video, "
+                     "an image folder, a TUM/EuRoC/KITTI sequence, an image, or a live input (udp://..., /dev/videoN)");
+  }
   const VisualMap header = ReadMap(flags.map);
   if (flags.from >= 0 || flags.to >= 0) {
     const int last = static_cast<int>(header.key_images.size()) - 1;
@@ -82,16 +96,27 @@ void RunLocalize(const LocalizeFlags& flags) {
   run.info.key_image_seconds = opened.keys.seconds;
   run.info.options_json = DescribeLocalizerOptions(options);
   std::string csv = LocalizationCsvHeader();
+  // A query that cannot be read again (a live input, a single image) leaves its report the frames kept here:
+  // the last ones, as many as the report shows.
+  const LocalizationReportOptions report_options;
+  const bool record = !flags.report.empty() && !QueryCanBeReadAgain(run.info);
+  RecordedFrames recorded;
   run.summary = LocalizeSequence(*source, *opened.matcher, localizer, run_options,
-                                 [&](const Frame&, const LocalizationResult& result) {
+                                 [&](const Frame& frame, const LocalizationResult& result) {
                                    if (!flags.csv.empty()) csv += LocalizationCsvRow(map, result);
                                    run.frames.push_back(result);
+                                   if (record && report_options.pairs > 0) {
+                                     recorded[result.frame_index] = ColorImage(frame);
+                                     if (recorded.size() > static_cast<size_t>(report_options.pairs)) {
+                                       recorded.erase(recorded.begin());
+                                     }
+                                   }
                                  });
   run.info.frame_size = source->info().frame_size;
 
   if (!flags.csv.empty()) WriteFileAtomically(flags.csv, csv);
   if (!flags.json.empty()) WriteFileAtomically(flags.json, LocalizationRunJson(map, run));
-  if (!flags.report.empty()) WriteLocalizationReport(run, map, flags.map, flags.report);
+  if (!flags.report.empty()) WriteLocalizationReport(run, map, flags.map, flags.report, report_options, recorded);
 
   const LocalizationSummary& s = run.summary;
   std::cout << fmt::format("map             {} ({} key images, {})\n", flags.map, map.key_images.size(),

@@ -1,5 +1,7 @@
 #include "vmap/cli/localize_options.h"
 
+#include <limits>
+
 #include "vmap/cli/common_options.h"
 
 namespace vmap::cli {
@@ -31,8 +33,11 @@ void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& 
   option_flags.AddEnumOption(command, "--ranking", o.ranking.method, ParseRankingMethod, RankingMethodName,
                              "ranking.method", "Relocalization ranking: " + ListEnumNames(kRankingMethodNames));
   AddHeadingOptions(command, o.heading, option_flags);
-  command->add_option("--from", flags.from, "Follow the route from this key image (default: the first)");
-  command->add_option("--to", flags.to, "Follow the route to this key image (default: the last)");
+  // -1 stands for "not given" here only: a negative key image is refused as route refuses it.
+  command->add_option("--from", flags.from, "Follow the route from this key image (default: the first)")
+      ->check(CLI::Range(0, std::numeric_limits<int>::max()));
+  command->add_option("--to", flags.to, "Follow the route to this key image (default: the last)")
+      ->check(CLI::Range(0, std::numeric_limits<int>::max()));
   // LocalizeSequenceOptions::extraction_threads (the key-image store's keeps its default).
   option_flags
       .AddOption(command, "--threads", flags.threads, "extraction_threads",

@@ -2,10 +2,13 @@
 
 #include <cstdio>
 #include <exception>
+#include <new>
+#include <stdexcept>
 
 #include <CLI/CLI.hpp>
 
 #include "vmap/cli/commands.h"
+#include "vmap/cli/option_flags.h"
 #include "vmap/core/error.h"
 #include "vmap/core/logging.h"
 #include "vmap/core/runtime.h"
@@ -36,6 +39,7 @@ int main(int argc, char** argv) {
 
   // Every failure ends as "vmap: error: ..." with status 2; 0 is success, --help and --version included.
   try {
+    vmap::cli::RefuseEmptyArguments(argc, argv);
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);  // --help, --version
@@ -45,6 +49,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "vmap: error: %s\n", e.what());
     return 2;
   } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "vmap: error: out of memory; try a smaller input or smaller options (--resize)\n");
+    return 2;
+  } catch (const std::length_error&) {  // a size no allocation could take: out of memory all the same
     std::fprintf(stderr, "vmap: error: out of memory; try a smaller input or smaller options (--resize)\n");
     return 2;
   } catch (const std::exception& e) {

@@ -16,6 +16,7 @@
 
 #include "vmap/cli/commands.h"
 #include "vmap/cli/common_options.h"
+#include "vmap/cli/output_files.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
@@ -23,6 +24,7 @@
 #include "vmap/geometry/heading.h"
 #include "vmap/mapping/pair_match.h"
 #include "vmap/sources/dataset_camera.h"
+#include "vmap/core/image_header.h"
 
 namespace vmap::cli {
 
@@ -40,8 +42,19 @@ struct MatchFlags {
 
 cv::Mat ReadGray(const std::string& path) {
   // IMREAD_GRAYSCALE, not cvtColor: the decoder's conversion is what the reference implementations see.
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) throw InputError("image '" + path + "' does not exist");
+  // A FIFO or a device is refused before OpenCV opens it (and would wait or read forever).
+  std::string why_not;
+  const std::optional<ContainedFile> file = ContainedFile::OpenRegular(path, &why_not);
+  if (!file) throw InputError("image '" + path + "' " + why_not + "; give an image file");
+  // The size its header announces, before a decoder allocates for it.
+  if (const std::optional<cv::Size> announced = ImageHeaderSize(*file)) {
+    const std::string problem = FrameSizeProblem(*announced);
+    if (!problem.empty()) {
+      throw InputError("image '" + path + "' is " + std::to_string(announced->width) + "x" +
+                       std::to_string(announced->height) + " (from its header), " + problem +
+                       "; give images of a usable size");
+    }
+  }
   cv::Mat gray;
   try {
     gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
@@ -79,12 +92,8 @@ void RunMatch(const MatchFlags& flags) {
   const VerifierOptions verifier = flags.verifier.Resolve();
   flags.matcher.Check();
   CheckField("heading", flags.heading);
-  for (const std::string& image : {flags.image0, flags.image1}) {
-    if (!flags.json_path.empty() && IsSameOrInside(flags.json_path, image)) {
-      throw InputError("--json " + flags.json_path + " would overwrite the input image '" + image +
-                       "'; write it somewhere else");
-    }
-  }
+  CheckOutputs({{flags.json_path, "--json"}},
+               {NamedInput(flags.image0, "the input image"), NamedInput(flags.image1, "the input image")});
   const cv::Mat gray0 = ReadGray(flags.image0), gray1 = ReadGray(flags.image1);
   const std::optional<Camera> camera = CameraOf(flags, gray0.size(), gray1.size());
   auto start = std::chrono::steady_clock::now();

@@ -62,4 +62,21 @@ void OptionFlags::Run(const std::function<void()>& run) const {
   }
 }
 
+void RefuseEmptyArguments(int argc, const char* const* argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string argument = argv[i];
+    if (argument == "--") break;
+    const size_t equals = argument.find('=');
+    if (argument.rfind("--", 0) == 0 && equals != std::string::npos && equals + 1 == argument.size()) {
+      throw InputError(argument.substr(0, equals) + " is empty; give it a value or leave it out");
+    }
+    if (!argument.empty()) continue;
+    const std::string previous = i > 1 ? argv[i - 1] : "";
+    if (previous.size() > 1 && previous[0] == '-' && previous.find('=') == std::string::npos) {
+      throw InputError(previous + " is empty; give it a value or leave it out");
+    }
+    throw InputError("argument " + std::to_string(i) + " is empty; give a path or leave it out");
+  }
+}
+
 }  // namespace vmap::cli

@@ -13,6 +13,10 @@
 
 namespace vmap::cli {
 
+// Throws InputError for an empty argument ("--csv ''", "--first=", a positional ''): CLI11 would read it as 0
+// or as the default, and no option or path of vmap has an empty value. Checked once, for every command alike.
+void RefuseEmptyArguments(int argc, const char* const* argv);
+
 class OptionFlags {
  public:
   // `option` sets the field at `path` ("extraction_threads", "key_images.tau", "orb.num_features"), as the

@@ -16,7 +16,9 @@ namespace {
 
 // `target`: a map directory, or the --json file of `vmap localize` (then `run_output` is where its report goes).
 void RunReport(const std::filesystem::path& target, const std::string& run_output, const MapReportOptions& options) {
-  if (std::filesystem::is_regular_file(target)) {
+  // Anything but a folder is taken for a run's file, whose reader refuses what is not a regular file.
+  std::error_code ec;
+  if (std::filesystem::exists(target, ec) && !std::filesystem::is_directory(target, ec)) {
     const std::filesystem::path output =
         run_output.empty() ? target.parent_path() / (target.stem().string() + "_report") : std::filesystem::path(run_output);
     WriteLocalizationReport(target, output);

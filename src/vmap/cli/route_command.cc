@@ -9,7 +9,9 @@
 
 #include "vmap/cli/commands.h"
 #include "vmap/cli/option_flags.h"
+#include "vmap/cli/output_files.h"
 #include "vmap/core/atomic_output.h"
+#include "vmap/core/file_name_encoding.h"
 #include "vmap/localization/route.h"
 #include "vmap/map/map_io.h"
 
@@ -27,6 +29,7 @@ struct RouteFlags {
 };
 
 void RunRoute(const RouteFlags& flags) {
+  CheckOutputs({{flags.json, "--json"}}, {MapInputs(flags.map)});
   const VisualMap map = ReadMap(flags.map);
   const int to = flags.to >= 0 ? flags.to : static_cast<int>(map.key_images.size()) - 1;
   const Route route = PlanRoute(map, flags.from, to, flags.options);
@@ -60,7 +63,8 @@ void RunRoute(const RouteFlags& flags) {
                                                                             : nlohmann::json(nullptr)}});
   }
   if (!flags.json.empty()) {
-    const nlohmann::json doc = {{"format", "vmap-route"}, {"map", flags.map},      {"from", flags.from},
+    // The map's path percent-encoded where it is not UTF-8, as in map.json (file_name_encoding.h).
+    const nlohmann::json doc = {{"format", "vmap-route"}, {"map", EncodeFileName(flags.map)},      {"from", flags.from},
                                 {"to", to},                {"keys", route.keys},     {"steps", steps},
                                 {"warnings", route.warnings}};
     WriteFileAtomically(flags.json, doc.dump(1) + "\n");

@@ -18,6 +18,7 @@
 
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/output_file.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -140,6 +141,8 @@ int RemoveTemporaryOutputsForExit() {
 }
 
 void WriteFileAtomically(const fs::path& path, std::string_view content) {
+  // Refused before anything is written, and again before the rename (the path may have changed meanwhile).
+  if (const std::string why_not = WhyNotReplaceable(path); !why_not.empty()) Refuse(path, why_not);
   RemoveStaleTemporaries(path);
   fs::path temp;
   int fd = -1;
@@ -174,6 +177,10 @@ void WriteFileAtomically(const fs::path& path, std::string_view content) {
     RemoveAndUnregister(temp);
     throw InputError("writing '" + path.string() + "' failed (" + reason + "); check the free space");
   }
+  if (const std::string why_not = WhyNotReplaceable(path); !why_not.empty()) {
+    RemoveAndUnregister(temp);
+    Refuse(path, why_not);
+  }
   std::unique_lock<std::mutex> lock(Temporaries().mutex);
   if (rename(temp.c_str(), path.c_str()) != 0) {
     const std::string reason = ErrnoText();
@@ -191,18 +198,31 @@ OutputPolicy OutputPolicy::InsideVmapOutput() {
   return policy;
 }
 
-AtomicOutputDirectory::AtomicOutputDirectory(fs::path final_path, OutputPolicy policy)
-    : final_path_(std::move(final_path)), policy_(std::move(policy)) {
-  // "out/", "." and ".." name the directory itself.
-  const fs::path name = final_path_.filename();
+namespace {
+
+// "out/", "." and ".." name the directory itself.
+fs::path DirectoryName(fs::path path) {
+  const fs::path name = path.filename();
   if (name.empty() || name == "." || name == "..") {
     std::error_code ec;
-    final_path_ = fs::absolute(final_path_, ec).lexically_normal();
-    if (final_path_.filename().empty()) final_path_ = final_path_.parent_path();
+    path = fs::absolute(path, ec).lexically_normal();
+    if (path.filename().empty()) path = path.parent_path();
   }
-  if (final_path_.filename().empty() || !final_path_.has_relative_path()) {
-    Refuse(final_path_, "is the root of the file system; choose a directory to write into");
+  if (path.filename().empty() || !path.has_relative_path()) {
+    Refuse(path, "is the root of the file system; choose a directory to write into");
   }
+  return path;
+}
+
+}  // namespace
+
+void CheckOutputDirectory(const fs::path& final_path, const OutputPolicy& policy) {
+  // The check of a directory about to be written, and nothing else: the object is never constructed.
+  AtomicOutputDirectory::CheckReplaceable(DirectoryName(final_path), policy);
+}
+
+AtomicOutputDirectory::AtomicOutputDirectory(fs::path final_path, OutputPolicy policy)
+    : final_path_(DirectoryName(std::move(final_path))), policy_(std::move(policy)) {
   CheckReplaceable();
   const fs::path parent = final_path_.has_parent_path() ? final_path_.parent_path() : fs::path(".");
   RemoveStaleTemporaries(final_path_);
@@ -229,44 +249,46 @@ AtomicOutputDirectory::~AtomicOutputDirectory() {
   if (!committed_ && !temp_path_.empty()) RemoveAndUnregister(temp_path_);
 }
 
-void AtomicOutputDirectory::CheckReplaceable() const {
+void AtomicOutputDirectory::CheckReplaceable() const { CheckReplaceable(final_path_, policy_); }
+
+void AtomicOutputDirectory::CheckReplaceable(const fs::path& final_path, const OutputPolicy& policy) {
   // The input first: replacing it would be the worst loss, whatever else the folder is.
-  for (const fs::path& input : policy_.inputs) {
-    if (IsSameOrInside(input, final_path_)) {
-      Refuse(final_path_, "is or holds the input '" + input.string() +
+  for (const fs::path& input : policy.inputs) {
+    if (IsSameOrInside(input, final_path)) {
+      Refuse(final_path, "is or holds the input '" + input.string() +
                               "', which replacing it would delete; write the output somewhere else");
     }
-    if (IsSameOrInside(final_path_, input)) {
-      Refuse(final_path_, "lies inside the input '" + input.string() +
+    if (IsSameOrInside(final_path, input)) {
+      Refuse(final_path, "lies inside the input '" + input.string() +
                               "'; write the output somewhere else than into the input");
     }
   }
   std::error_code ec;
-  const fs::file_status status = fs::symlink_status(final_path_, ec);
+  const fs::file_status status = fs::symlink_status(final_path, ec);
   if (ec && status.type() != fs::file_type::not_found) {
-    Refuse(final_path_, "cannot be inspected (" + ec.message() + "); check its permissions or choose another path");
+    Refuse(final_path, "cannot be inspected (" + ec.message() + "); check its permissions or choose another path");
   }
   if (fs::exists(status)) {
     if (fs::is_symlink(status)) {
-      Refuse(final_path_, "is a symbolic link; vmap replaces only a real directory: give the path it points to, "
+      Refuse(final_path, "is a symbolic link; vmap replaces only a real directory: give the path it points to, "
                           "or choose another output path");
     }
-    if (!fs::is_directory(status)) Refuse(final_path_, "exists and is not a directory; choose another path");
-    fs::directory_iterator entries(final_path_, ec);
-    if (ec) Refuse(final_path_, "cannot be read (" + ec.message() + "); check its permissions");
+    if (!fs::is_directory(status)) Refuse(final_path, "exists and is not a directory; choose another path");
+    fs::directory_iterator entries(final_path, ec);
+    if (ec) Refuse(final_path, "cannot be read (" + ec.message() + "); check its permissions");
     if (entries != fs::directory_iterator()) {
-      const std::string why_not = policy_.why_not_ours
+      const std::string why_not = policy.why_not_ours
                                       ? RethrowAsInputError(
                                             [&] {
-                                              return ErrorContext{"cannot inspect output '" + final_path_.string() + "'",
+                                              return ErrorContext{"cannot inspect output '" + final_path.string() + "'",
                                                                   "check its permissions"};
                                             },
-                                            [&] { return policy_.why_not_ours(final_path_); })
+                                            [&] { return policy.why_not_ours(final_path); })
                                       : std::string("it is not empty");
       if (!why_not.empty()) {
-        Refuse(final_path_, "exists and is not " + policy_.kind + " (" + why_not +
+        Refuse(final_path, "exists and is not " + policy.kind + " (" + why_not +
                                 "), so vmap will not replace it: vmap replaces only an empty folder or " +
-                                policy_.kind + " it wrote. Choose another output directory, or move the folder away "
+                                policy.kind + " it wrote. Choose another output directory, or move the folder away "
                                 "yourself");
       }
     }

@@ -18,7 +18,8 @@
 
 namespace vmap {
 
-// Writes `content` to `path` through a temporary file in the same directory and a rename.
+// Writes `content` to `path` through a temporary file in the same directory and a rename. Never replaces a
+// symbolic link, a device, a FIFO, a socket or a read-only file (InputError; see output_file.h).
 void WriteFileAtomically(const std::filesystem::path& path, std::string_view content);
 
 // What an output directory may replace, and what it must never touch.
@@ -60,12 +61,18 @@ class AtomicOutputDirectory {
 
  private:
   void CheckReplaceable() const;
+  static void CheckReplaceable(const std::filesystem::path& final_path, const OutputPolicy& policy);
+  friend void CheckOutputDirectory(const std::filesystem::path& final_path, const OutputPolicy& policy);
 
   std::filesystem::path final_path_;
   OutputPolicy policy_;
   std::filesystem::path temp_path_;
   bool committed_ = false;
 };
+
+// The check AtomicOutputDirectory makes before any work, without creating anything: for a command that
+// writes the directory only at its end, to refuse a wrong one at its start. Throws InputError.
+void CheckOutputDirectory(const std::filesystem::path& final_path, const OutputPolicy& policy);
 
 // Removes the temporaries of dead processes next to `path` (".NAME.partial-PID-N" and the like, NAME being
 // `path`'s file name). Called by every output before it writes; exposed for tests.

@@ -5,6 +5,11 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+
+#include "vmap/core/error.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -68,6 +73,20 @@ std::optional<ContainedFile> ContainedFile::Open(const fs::path& directory, cons
   return ContainedFile(path, fd, static_cast<std::uint64_t>(file_stat.st_size));
 }
 
+std::optional<ContainedFile> ContainedFile::OpenRegular(const fs::path& path, std::string* why_not) {
+  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  struct stat file_stat;
+  if (fd < 0 || fstat(fd, &file_stat) != 0 || !S_ISREG(file_stat.st_mode)) {
+    const int error = errno;
+    if (fd >= 0) close(fd);
+    *why_not = fd < 0 && error == ENOENT ? "is missing"
+               : fd < 0                  ? "cannot be opened (" + std::string(std::strerror(error)) + ")"
+                                         : "is not a regular file (a device, a FIFO or a folder)";
+    return std::nullopt;
+  }
+  return ContainedFile(path, fd, static_cast<std::uint64_t>(file_stat.st_size));
+}
+
 ContainedFile::ContainedFile(ContainedFile&& other) noexcept
     : path_(std::move(other.path_)), fd_(other.fd_), size_(other.size_) {
   other.fd_ = -1;
@@ -90,11 +109,67 @@ bool ContainedFile::Read(std::uint64_t offset, void* data, std::size_t bytes) co
   return true;
 }
 
+bool ContainedFile::ReadAll(std::string* bytes) const {
+  bytes->assign(size_, '\0');
+  return Read(0, bytes->data(), bytes->size());
+}
+
 namespace {
 struct TooDeep {};
+struct TooMany {};
 }  // namespace
 
-ContainedJson ReadContainedJson(const fs::path& directory, const std::string& name, std::uint64_t max_bytes) {
+std::string ContainedFile::ParseJson(std::uint64_t max_values, nlohmann::json* document) const {
+  // A stream of its own over the file: the text is never held whole, only the parsed values.
+  const int copy = dup(fd_);
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> stream(copy >= 0 ? fdopen(copy, "rb") : nullptr, &std::fclose);
+  if (!stream) {
+    if (copy >= 0) close(copy);
+    return "cannot be read";
+  }
+  // Parsing is iterative in nlohmann-json, but printing a value (options are printed again) recurses: bound
+  // the nesting, far above anything vmap writes.
+  constexpr int kMaxDepth = 64;
+  std::uint64_t values = 0;
+  const nlohmann::json::parser_callback_t limit = [&](int depth, nlohmann::json::parse_event_t event,
+                                                      nlohmann::json&) {
+    if (depth > kMaxDepth) throw TooDeep{};
+    if (event != nlohmann::json::parse_event_t::key && ++values > max_values) throw TooMany{};
+    return true;
+  };
+  try {
+    *document = nlohmann::json::parse(stream.get(), limit);
+  } catch (const TooDeep&) {
+    return "is nested more than " + std::to_string(kMaxDepth) + " levels deep";
+  } catch (const TooMany&) {
+    return "holds more than " + std::to_string(max_values) + " values, more than vmap ever writes there";
+  } catch (const nlohmann::json::parse_error& error) {
+    return "is not valid JSON (at byte " + std::to_string(error.byte) + "; damaged or not a file vmap wrote)";
+  } catch (const nlohmann::json::out_of_range&) {
+    return "holds a number too large for a double (1e999: damaged or not a file vmap wrote)";
+  } catch (const nlohmann::json::exception&) {
+    return "is not valid JSON (damaged or not a file vmap wrote)";
+  }
+  return "";
+}
+
+std::string ReadNamedFile(const fs::path& path, std::uint64_t max_bytes, const std::string& what,
+                          const std::string& fix) {
+  std::string why_not;
+  const std::optional<ContainedFile> file = ContainedFile::OpenRegular(path, &why_not);
+  const std::string named = what + " '" + path.string() + "' ";
+  if (!file) throw InputError(named + why_not + "; " + fix);
+  if (file->size() > max_bytes) {
+    throw InputError(named + "is larger than " + std::to_string(max_bytes >> 20) + " MB, more than any " + what +
+                     " vmap reads; " + fix);
+  }
+  std::string bytes;
+  if (!file->ReadAll(&bytes)) throw InputError(named + "cannot be read; " + fix);
+  return bytes;
+}
+
+ContainedJson ReadContainedJson(const fs::path& directory, const std::string& name, std::uint64_t max_bytes,
+                                std::uint64_t max_values) {
   ContainedJson result;
   std::string why_not;
   const std::optional<ContainedFile> file = ContainedFile::Open(directory, name, &why_not);
@@ -107,26 +182,12 @@ ContainedJson ReadContainedJson(const fs::path& directory, const std::string& na
     result.why_not = name + " is larger than " + std::to_string(max_bytes >> 20) + " MB";
     return result;
   }
-  std::string text(file->size(), '\0');
-  if (!file->Read(0, text.data(), text.size())) {
-    result.why_not = name + " cannot be read";
-    return result;
-  }
-  // Parsing is iterative in nlohmann-json, but printing a value (options are printed again) recurses: bound
-  // the nesting, far above anything vmap writes.
-  constexpr int kMaxDepth = 64;
-  const nlohmann::json::parser_callback_t limit_depth = [](int depth, nlohmann::json::parse_event_t,
-                                                           nlohmann::json&) {
-    if (depth > kMaxDepth) throw TooDeep{};
-    return true;
-  };
-  try {
-    result.document = nlohmann::json::parse(text, limit_depth);
-  } catch (const TooDeep&) {
-    result.why_not = name + " is nested more than " + std::to_string(kMaxDepth) + " levels deep";
-  } catch (const nlohmann::json::exception& error) {
-    // parse_error, and out_of_range for a number beyond double's range (1e999)
-    result.why_not = name + " is not valid JSON (" + error.what() + ")";
+  nlohmann::json document;
+  why_not = file->ParseJson(max_values, &document);
+  if (why_not.empty()) {
+    result.document = std::move(document);
+  } else {
+    result.why_not = name + " " + why_not;
   }
   return result;
 }

@@ -29,6 +29,10 @@ class ContainedFile {
   // be a plain relative path (IsPlainRelativePath).
   static std::optional<ContainedFile> Open(const std::filesystem::path& directory, const std::string& relative,
                                            std::string* why_not);
+  // A file the user named (a ground truth, a run's JSON, weights, a query image), wherever it is: opened
+  // without blocking (a FIFO with no writer) and refused unless it is a regular file, so that neither a device
+  // nor a FIFO is ever read. nullopt with `*why_not` as for Open.
+  static std::optional<ContainedFile> OpenRegular(const std::filesystem::path& path, std::string* why_not);
   ContainedFile(ContainedFile&& other) noexcept;
   ContainedFile& operator=(ContainedFile&&) = delete;
   ContainedFile(const ContainedFile&) = delete;
@@ -40,6 +44,11 @@ class ContainedFile {
   // Reads `bytes` bytes at `offset` into `data`; false when the file is shorter (it changed since Open) or
   // cannot be read.
   bool Read(std::uint64_t offset, void* data, std::size_t bytes) const;
+  // The whole file; false when it cannot be read.
+  bool ReadAll(std::string* bytes) const;
+  // Parses the file as JSON without holding its text: at most `max_values` values (every number, string,
+  // array and object counts one), nested at most 64 deep. Returns "" or why not ("has more than ... values").
+  std::string ParseJson(std::uint64_t max_values, nlohmann::json* document) const;
 
  private:
   ContainedFile(std::filesystem::path path, int fd, std::uint64_t size) : path_(std::move(path)), fd_(fd), size_(size) {}
@@ -49,7 +58,13 @@ class ContainedFile {
   std::uint64_t size_ = 0;
 };
 
-// A JSON file inside `directory` (a ContainedFile) of at most `max_bytes`, nested at most 64 deep, parsed.
+// The whole of a file the user named (ContainedFile::OpenRegular) of at most `max_bytes`; throws InputError
+// "<what> '<path>' <why>; <fix>" otherwise: ReadNamedFile(gt, 256 << 20, "ground truth", "give a poses file").
+std::string ReadNamedFile(const std::filesystem::path& path, std::uint64_t max_bytes, const std::string& what,
+                          const std::string& fix);
+
+// A JSON file inside `directory` (a ContainedFile) of at most `max_bytes` and `max_values` values (so that its
+// parsed form stays within about 32 bytes a value), nested at most 64 deep, parsed.
 // On failure `document` is empty and `why_not` says why, naming the file: "map.json is missing", "map.json is
 // not valid JSON (...)".
 struct ContainedJson {
@@ -58,6 +73,6 @@ struct ContainedJson {
   bool missing = false;  // the file does not exist
 };
 ContainedJson ReadContainedJson(const std::filesystem::path& directory, const std::string& name,
-                                std::uint64_t max_bytes);
+                                std::uint64_t max_bytes, std::uint64_t max_values);
 
 }  // namespace vmap

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "vmap/core/error.h"
 #include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
@@ -76,17 +77,45 @@ TEST(ContainedFile, IsSameOrInsideComparesWhatPathsResolveTo) {
 TEST(ContainedFile, ReadsJsonWithLimits) {
   testing::ScopedTempDir tmp;
   std::ofstream(tmp.path() / "ok.json") << R"({"format": "x", "n": [1, 2]})";
-  ContainedJson ok = ReadContainedJson(tmp.path(), "ok.json", 1000);
+  ContainedJson ok = ReadContainedJson(tmp.path(), "ok.json", 1000, 1000);
   ASSERT_TRUE(ok.document) << ok.why_not;
   EXPECT_EQ((*ok.document)["n"][1], 2);
-  EXPECT_TRUE(ReadContainedJson(tmp.path(), "missing.json", 1000).missing);
-  EXPECT_NE(ReadContainedJson(tmp.path(), "ok.json", 10).why_not.find("larger than"), std::string::npos);
+  EXPECT_TRUE(ReadContainedJson(tmp.path(), "missing.json", 1000, 1000).missing);
+  EXPECT_NE(ReadContainedJson(tmp.path(), "ok.json", 10, 1000).why_not.find("larger than"), std::string::npos);
   std::ofstream(tmp.path() / "deep.json") << std::string(100000, '[') << std::string(100000, ']');
-  EXPECT_NE(ReadContainedJson(tmp.path(), "deep.json", 1 << 20).why_not.find("nested"), std::string::npos);
+  EXPECT_NE(ReadContainedJson(tmp.path(), "deep.json", 1 << 20, 1000).why_not.find("nested"), std::string::npos);
   std::ofstream(tmp.path() / "huge_number.json") << R"({"n": 1e999})";
-  EXPECT_NE(ReadContainedJson(tmp.path(), "huge_number.json", 1000).why_not.find("not valid JSON"), std::string::npos);
+  EXPECT_NE(ReadContainedJson(tmp.path(), "huge_number.json", 1000, 1000).why_not.find("number too large"), std::string::npos);
   std::ofstream(tmp.path() / "bad.json") << R"({"n": )";
-  EXPECT_NE(ReadContainedJson(tmp.path(), "bad.json", 1000).why_not.find("not valid JSON"), std::string::npos);
+  EXPECT_NE(ReadContainedJson(tmp.path(), "bad.json", 1000, 1000).why_not.find("not valid JSON"), std::string::npos);
+  // Many values in few bytes: refused by their count, before they are all held.
+  std::string many = "[0";
+  for (int i = 0; i < 2000; ++i) many += ",0";
+  std::ofstream(tmp.path() / "many.json") << many << "]";
+  EXPECT_NE(ReadContainedJson(tmp.path(), "many.json", 1 << 20, 1000).why_not.find("more than 1000 values"),
+            std::string::npos);
+  EXPECT_TRUE(ReadContainedJson(tmp.path(), "many.json", 1 << 20, 3000).document);
+}
+
+TEST(ContainedFile, NamedFilesMustBeRegular) {
+  testing::ScopedTempDir tmp;
+  std::ofstream(tmp.path() / "gt.txt") << "1 2 3";
+  EXPECT_EQ(ReadNamedFile(tmp.path() / "gt.txt", 100, "ground truth", "fix"), "1 2 3");
+  ASSERT_EQ(mkfifo((tmp.path() / "fifo").c_str(), 0600), 0);
+  const auto message = [&](const fs::path& path, std::uint64_t max_bytes) {
+    try {
+      ReadNamedFile(path, max_bytes, "ground truth", "give a poses file");
+    } catch (const InputError& error) {
+      return std::string(error.what());
+    }
+    return std::string("read");
+  };
+  // A FIFO without a writer would block a plain open; a device would be read forever.
+  EXPECT_NE(message(tmp.path() / "fifo", 100).find("not a regular file"), std::string::npos);
+  EXPECT_NE(message("/dev/zero", 100).find("not a regular file"), std::string::npos);
+  EXPECT_NE(message(tmp.path(), 100).find("not a regular file"), std::string::npos);
+  EXPECT_NE(message(tmp.path() / "missing", 100).find("is missing; give a poses file"), std::string::npos);
+  EXPECT_NE(message(tmp.path() / "gt.txt", 2).find("larger than"), std::string::npos);
 }
 
 }  // namespace vmap

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/sources/dataset_camera.h"
 
@@ -68,9 +69,17 @@ cv::Matx33d QuaternionToRotation(double w, double x, double y, double z) {
                      2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y));
 }
 
-GroundTruthFormat DetectGroundTruthFormat(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("cannot read ground truth '" + path + "'");
+namespace {
+
+// A poses file of some hundred bytes a frame: 256 MB is far more than any sequence's. Read whole and at once,
+// never line by line from the file itself, which a device such as /dev/zero would feed forever.
+std::string ReadGroundTruthText(const std::string& path) {
+  return ReadNamedFile(path, 256ull << 20, "ground truth",
+                       "give a poses file (KITTI poses.txt, TUM groundtruth.txt or EuRoC data.csv)");
+}
+
+GroundTruthFormat DetectFormat(const std::string& text, const std::string& path) {
+  std::istringstream in(text);
   std::string line;
   int number = 0;
   while (std::getline(in, line)) {
@@ -93,10 +102,16 @@ GroundTruthFormat DetectGroundTruthFormat(const std::string& path) {
                                 "qw' (TUM) or 'timestamp_ns,px,py,pz,qw,qx,qy,qz,...' (EuRoC); give the format");
 }
 
+}  // namespace
+
+GroundTruthFormat DetectGroundTruthFormat(const std::string& path) {
+  return DetectFormat(ReadGroundTruthText(path), path);
+}
+
 GroundTruth ReadGroundTruth(const std::string& path, GroundTruthFormat format, const cv::Matx44d& body_to_camera) {
-  if (format == GroundTruthFormat::kAuto) format = DetectGroundTruthFormat(path);
-  std::ifstream in(path);
-  if (!in) throw InputError("cannot read ground truth '" + path + "'");
+  const std::string text = ReadGroundTruthText(path);
+  if (format == GroundTruthFormat::kAuto) format = DetectFormat(text, path);
+  std::istringstream in(text);
   GroundTruth truth;
   truth.path = path;
   truth.format = format;

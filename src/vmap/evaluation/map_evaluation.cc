@@ -1,18 +1,23 @@
 #include "vmap/evaluation/map_evaluation.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
 
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/file_name_encoding.h"
 #include "vmap/core/json_fields.h"
 #include "vmap/geometry/relative_pose.h"
 #include "vmap/map/map_geometry_json.h"
 #include "vmap/sources/dataset_camera.h"
 
 namespace vmap {
+namespace fs = std::filesystem;
 using nlohmann::json;
 
 void EvaluationOptions::Check() const {
@@ -241,11 +246,34 @@ MapEvaluation EvaluateMap(const VisualMap& map, const GroundTruth& truth, const 
   return evaluation;
 }
 
-Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option) {
-  if (map.input.camera) return *map.input.camera;
+std::optional<Camera> ParseEvaluationCamera(const std::string& camera_option) {
   std::optional<Camera> camera;
-  if (!camera_option.empty()) camera = ParseCameraOption(camera_option);
-  else camera = FindDatasetCamera(map.input.path, map.input.format);
+  if (!camera_option.empty()) {
+    // Checked even where the map's own camera is used, so that a wrong value is never silently passed over.
+    std::error_code ec;
+    if (fs::exists(camera_option, ec) && !fs::is_regular_file(camera_option, ec)) {
+      throw OptionError("camera", "'" + camera_option + "' is not a regular file; give a calibration file or "
+                                  "fx,fy,cx,cy[,k1,k2,p1,p2[,k3]]");
+    }
+    camera = ParseCameraOption(camera_option);
+    try {
+      camera->Check();
+    } catch (const OptionError&) {
+      throw;
+    } catch (const InputError& error) {
+      throw OptionError("camera", "'" + camera_option + "': " + error.what());
+    }
+  }
+  return camera;
+}
+
+Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option) {
+  std::optional<Camera> camera = ParseEvaluationCamera(camera_option);
+  if (map.input.camera) {
+    if (camera) spdlog::warn("the map records its camera, which is used; --camera is for maps that have none");
+    return *map.input.camera;
+  }
+  if (!camera) camera = FindDatasetCamera(map.input.path, map.input.format);
   if (!camera) {
     throw OptionError("camera", "is needed: the map has no camera and its input '" + map.input.path +
                                     "' brings none; give the intrinsics fx,fy,cx,cy (or a calibration file)");
@@ -271,8 +299,9 @@ std::string EvaluationToJson(const MapEvaluation& evaluation) {
   json doc;
   doc["format"] = "vmap-eval";
   doc["schema_version"] = 1;
-  doc["map"] = evaluation.map_path;
-  doc["ground_truth"] = {{"path", evaluation.ground_truth_path},
+  // Paths percent-encoded where they are not UTF-8, as in map.json (file_name_encoding.h).
+  doc["map"] = EncodeFileName(evaluation.map_path);
+  doc["ground_truth"] = {{"path", EncodeFileName(evaluation.ground_truth_path)},
                          {"format", GroundTruthFormatName(evaluation.ground_truth_format)}};
   doc["camera"] = CameraToJson(evaluation.camera);
   doc["options"] = ToJson(evaluation.options);
@@ -331,23 +360,23 @@ std::string EvaluationToJson(const MapEvaluation& evaluation) {
 }
 
 MapEvaluation ReadEvaluation(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("cannot read evaluation '" + path + "'");
+  std::string why_not;
+  const std::optional<ContainedFile> file = ContainedFile::OpenRegular(path, &why_not);
+  if (!file) throw InputError("evaluation '" + path + "' " + why_not + "; run `vmap eval` again");
+  // Some 25 values a link.
+  constexpr std::uint64_t kMaxValues = 1ull << 24;
   json doc;
-  try {
-    doc = json::parse(in);
-  } catch (const json::exception& e) {
-    throw InputError("evaluation '" + path + "' is not valid JSON (" + e.what() + "); run `vmap eval` again");
-  }
+  why_not = file->ParseJson(kMaxValues, &doc);
+  if (!why_not.empty()) throw InputError("evaluation '" + path + "' " + why_not + "; run `vmap eval` again");
   if (!doc.is_object() || doc.value("format", "") != "vmap-eval" || !doc.contains("links") ||
       !doc["links"].is_array() || !doc.contains("summary") || !doc["summary"].is_object()) {
     throw InputError("'" + path + "' is not an evaluation written by `vmap eval`; run `vmap eval` again");
   }
   MapEvaluation evaluation;
   try {
-    evaluation.map_path = doc.value("map", "");
+    evaluation.map_path = DecodeFileName(doc.value("map", ""));
     const json& gt = doc.contains("ground_truth") ? doc["ground_truth"] : json::object();
-    evaluation.ground_truth_path = gt.value("path", "");
+    evaluation.ground_truth_path = DecodeFileName(gt.value("path", ""));
     evaluation.ground_truth_format = ParseGroundTruthFormat(gt.value("format", "auto"));
     if (doc.contains("camera") && doc["camera"].is_object()) {
       evaluation.camera = CameraFromJson(doc["camera"], path, "camera");

@@ -115,6 +115,10 @@ MapEvaluation EvaluateMap(const VisualMap& map, const GroundTruth& truth, const 
 // The camera to evaluate a map with: the map's own, else `camera_option`, else the one that comes with the
 // map's input, scaled to the map's frame size. Throws OptionError ("camera") when there is none.
 Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option);
+// The camera `camera_option` gives (nullopt when it is empty), checked: an OptionError for "camera" when it is
+// neither a calibration file nor fx,fy,cx,cy[,...] of finite, positive focal lengths. EvaluationCamera calls it;
+// a command calls it first, so that a wrong value is refused before anything else is read.
+std::optional<Camera> ParseEvaluationCamera(const std::string& camera_option);
 
 // The ground truth of a map: the file given (format from `format`, or detected), else the one that comes
 // with the map's input. Throws OptionError ("gt.path" when there is none, "gt.format" when it cannot be told).

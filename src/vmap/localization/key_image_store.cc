@@ -15,6 +15,7 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/atomic_output.h"
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/map/map_io.h"
@@ -56,33 +57,45 @@ void Append(std::string& out, const T& value) {
   out.append(reinterpret_cast<const char*>(&value), sizeof(value));
 }
 
-// Reads the cache file; false when it is absent, stale or malformed (then it is recomputed).
+// Reads the cache file piece by piece, each piece checked against what is left of the file before it is
+// allocated: a damaged, sparse or crafted cache costs no more memory than its real contents.
 class Reader {
  public:
-  explicit Reader(std::string bytes) : bytes_(std::move(bytes)) {}
+  explicit Reader(const ContainedFile& file) : file_(file) {}
   template <typename T>
   bool Read(T& value) {
-    if (bytes_.size() - position_ < sizeof(T)) return false;
-    std::memcpy(&value, bytes_.data() + position_, sizeof(T));
+    if (file_.size() - position_ < sizeof(T) || !file_.Read(position_, &value, sizeof(T))) return false;
     position_ += sizeof(T);
     return true;
   }
   bool View(uint64_t size, std::string_view& view) {
-    if (bytes_.size() - position_ < size) return false;
-    view = std::string_view(bytes_.data() + position_, size);
+    if (file_.size() - position_ < size || size > kMaxPiece) return false;
+    buffer_.resize(size);
+    if (!file_.Read(position_, buffer_.data(), size)) return false;
+    view = buffer_;
     position_ += size;
     return true;
   }
-  bool AtEnd() const { return position_ == bytes_.size(); }
+  bool AtEnd() const { return position_ == file_.size(); }
 
  private:
-  std::string bytes_;
-  size_t position_ = 0;
+  // One key image's features: far above the largest matcher's (some MB).
+  static constexpr uint64_t kMaxPiece = 256ull << 20;
+  const ContainedFile& file_;
+  uint64_t position_ = 0;
+  std::string buffer_;
 };
 
-bool ReadCache(const fs::path& file, uint64_t fingerprint, const Matcher& matcher, size_t num_keys,
+bool ReadCache(const fs::path& map_directory, uint64_t fingerprint, const Matcher& matcher, size_t num_keys,
                KeyImageStore& store) {
-  Reader reader(ReadWholeFile(file));
+  // Inside the map folder only, and never a device or a FIFO: a cache is recomputed rather than followed.
+  std::string why_not;
+  const std::optional<ContainedFile> file = ContainedFile::Open(map_directory, kLocalizationCacheFileName, &why_not);
+  if (!file) {
+    if (why_not != "is missing") spdlog::info("key-image cache not read: {} {}", kLocalizationCacheFileName, why_not);
+    return false;
+  }
+  Reader reader(*file);
   std::string_view magic;
   uint64_t stored_fingerprint = 0;
   uint32_t stored_keys = 0;
@@ -100,10 +113,16 @@ bool ReadCache(const fs::path& file, uint64_t fingerprint, const Matcher& matche
     if (!reader.Read(thumbnail_size) || !reader.View(uint64_t{thumbnail_size} * sizeof(float), thumbnail_bytes)) {
       return false;
     }
-    if (!reader.Read(features_size) || !reader.View(features_size, feature_bytes)) return false;
+    if (!reader.Read(features_size)) return false;
     cv::Mat thumbnail(1, static_cast<int>(thumbnail_size), CV_32F);
     if (thumbnail_size > 0) std::memcpy(thumbnail.data, thumbnail_bytes.data(), thumbnail_bytes.size());
-    std::shared_ptr<const ImageFeatures> f = matcher.DeserializeFeatures(feature_bytes);
+    if (!reader.View(features_size, feature_bytes)) return false;
+    std::shared_ptr<const ImageFeatures> f;
+    try {
+      f = matcher.DeserializeFeatures(feature_bytes);
+    } catch (const std::exception&) {
+      return false;  // crafted bytes that pass the size checks: recomputed like any other bad cache
+    }
     if (!f) return false;
     features.push_back(std::move(f));
     thumbnails.push_back(thumbnail);
@@ -192,7 +211,7 @@ KeyImageStore LoadKeyImageStore(const fs::path& map_directory, const VisualMap& 
   KeyImageStore store;
   const fs::path cache_file = map_directory / kLocalizationCacheFileName;
   const uint64_t fingerprint = options.use_cache ? Fingerprint(map_directory, matcher, options) : 0;
-  if (options.use_cache && ReadCache(cache_file, fingerprint, matcher, map.key_images.size(), store)) {
+  if (options.use_cache && ReadCache(map_directory, fingerprint, matcher, map.key_images.size(), store)) {
     store.cache = KeyImageCacheState::kHit;
   } else {
     ComputeKeyImages(map_directory, map, matcher, options, store);

@@ -6,7 +6,9 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/file_name_encoding.h"
 
 namespace vmap {
 
@@ -139,7 +141,7 @@ nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationRes
   return {{"frame", r.frame_index},
           {"source_index", r.source_index},
           {"timestamp", r.timestamp >= 0 ? json(r.timestamp) : json(nullptr)},
-          {"source_name", r.source_name},
+          {"source_name", EncodeFileName(r.source_name)},
           {"status", LocalizationStatusName(r.status)},
           {"key", r.key},
           {"next_key", r.next_key},
@@ -177,11 +179,12 @@ std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run
   doc["format"] = "vmap-localization";
   doc["schema_version"] = kLocalizationSchemaVersion;
   doc["vmap_version"] = VMAP_VERSION;
-  doc["map"] = {{"directory", info.map_directory},
+  // Paths percent-encoded where they are not UTF-8, as in map.json (file_name_encoding.h).
+  doc["map"] = {{"directory", EncodeFileName(info.map_directory)},
                 {"key_images", map.key_images.size()},
                 {"matcher", info.matcher},
-                {"input", map.input.path}};
-  doc["query"] = {{"path", info.query},
+                {"input", EncodeFileName(map.input.path)}};
+  doc["query"] = {{"path", EncodeFileName(info.query)},
                   {"format", SourceFormatName(info.query_format)},
                   {"first", info.source.first},
                   {"last", info.source.last},
@@ -214,13 +217,17 @@ std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run
 }
 
 LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError("cannot read '" + file.string() + "'; give the --json file of `vmap localize`");
+  std::string why_not;
+  const std::optional<ContainedFile> opened = ContainedFile::OpenRegular(file, &why_not);
+  if (!opened) throw InputError("'" + file.string() + "' " + why_not + "; give the --json file of `vmap localize`");
+  if (opened->size() > kMaxRunJsonBytes) {
+    throw InputError("'" + file.string() + "' is larger than any localization run; give the --json file of "
+                     "`vmap localize`");
+  }
   json doc;
-  try {
-    doc = json::parse(in);
-  } catch (const json::parse_error&) {
-    throw InputError("'" + file.string() + "' is not valid JSON; give the --json file of `vmap localize`");
+  why_not = opened->ParseJson(kMaxRunJsonValues, &doc);
+  if (!why_not.empty()) {
+    throw InputError("'" + file.string() + "' " + why_not + "; give the --json file of `vmap localize`");
   }
   if (!doc.is_object() || doc.value("format", "") != "vmap-localization") {
     throw InputError("'" + file.string() + "' is not a localization run (no format \"vmap-localization\")");
@@ -231,10 +238,10 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
   LocalizationRun run;
   try {
     const json& map = doc.at("map");
-    run.info.map_directory = map.value("directory", "");
+    run.info.map_directory = DecodeFileName(map.value("directory", ""));
     run.info.matcher = map.value("matcher", "");
     const json& query = doc.at("query");
-    run.info.query = query.value("path", "");
+    run.info.query = DecodeFileName(query.value("path", ""));
     run.info.query_format = ParseSourceFormat(query.value("format", "auto"));
     run.info.source.first = query.value("first", 0);
     run.info.source.last = query.value("last", -1);
@@ -264,7 +271,7 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
       r.frame_index = f.at("frame").get<int>();
       r.source_index = f.value("source_index", r.frame_index);
       r.timestamp = NumberOr(f, "timestamp", -1.0);
-      r.source_name = f.value("source_name", "");
+      r.source_name = DecodeFileName(f.value("source_name", ""));
       r.status = ParseStatus(f.at("status").get<std::string>(), file);
       r.key = f.value("key", -1);
       r.next_key = f.value("next_key", -1);

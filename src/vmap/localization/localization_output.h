@@ -12,6 +12,7 @@
 // heading_px's estimate) and the heading against `key`: heading_key_px, heading_key_deg, heading_key_confidence
 // (geometry/heading.h). Unknown numbers are empty in CSV and null in JSON.
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -25,6 +26,10 @@
 namespace vmap {
 
 inline constexpr int kLocalizationSchemaVersion = 1;
+// Limits a run's JSON must respect to be read (a few hundred bytes and some 40 values a frame): they bound the
+// memory a crafted file can make `vmap report` take.
+inline constexpr std::uint64_t kMaxRunJsonBytes = 1ull << 30;
+inline constexpr std::uint64_t kMaxRunJsonValues = 1ull << 24;
 
 // What a run was: the inputs and settings, recorded in the JSON.
 struct LocalizationRunInfo {

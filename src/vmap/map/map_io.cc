@@ -14,7 +14,9 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/core/file_name_encoding.h"
+#include "vmap/core/image_header.h"
 #include "vmap/map/map_geometry_json.h"
+#include "vmap/sources/frame_source.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -233,55 +235,8 @@ cv::Size SizeField(const Fields& fields, const json& object, const std::string& 
           static_cast<int>(fields.Integer((*value)[1], field + "[1]", 0, kMaxSide))};
 }
 
-// The width and height a PNG file's header announces, or nullopt when the file is not a PNG.
-std::optional<cv::Size> PngSize(const ContainedFile& file) {
-  unsigned char header[24];
-  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-  if (!file.Read(0, header, sizeof(header)) || std::memcmp(header, kSignature, 8) != 0 ||
-      std::memcmp(header + 12, "IHDR", 4) != 0) {
-    return std::nullopt;
-  }
-  auto big_endian = [&](int at) {
-    return (std::uint32_t(header[at]) << 24) | (std::uint32_t(header[at + 1]) << 16) |
-           (std::uint32_t(header[at + 2]) << 8) | std::uint32_t(header[at + 3]);
-  };
-  const std::uint32_t width = big_endian(16), height = big_endian(20);
-  if (width > (1u << 20) || height > (1u << 20)) return cv::Size(1 << 20, 1 << 20);
-  return cv::Size(static_cast<int>(width), static_cast<int>(height));
-}
-
-
-// The width and height of a baseline or progressive JPEG file's frame header (SOFn), or nullopt when the file
-// is not a JPEG. Walks the marker segments from the start; at most 64 segments and 1 MiB are looked at, since
-// the frame header comes before any image data.
-std::optional<cv::Size> JpegSize(const ContainedFile& file) {
-  unsigned char bytes[9];
-  if (!file.Read(0, bytes, 2) || bytes[0] != 0xFF || bytes[1] != 0xD8) return std::nullopt;
-  std::uint64_t at = 2;
-  for (int segment = 0; segment < 64 && at < (1u << 20); ++segment) {
-    if (!file.Read(at, bytes, 4) || bytes[0] != 0xFF) return std::nullopt;
-    const int marker = bytes[1];
-    const int length = (bytes[2] << 8) | bytes[3];
-    if (marker == 0xFF) {  // fill byte
-      ++at;
-      continue;
-    }
-    // SOF0..SOF15 except DHT (C4), JPG (C8) and DAC (CC): precision, height, width.
-    if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC) {
-      if (!file.Read(at + 4, bytes, 5)) return std::nullopt;
-      return cv::Size((bytes[3] << 8) | bytes[4], (bytes[1] << 8) | bytes[2]);
-    }
-    if (marker == 0xD9 || marker == 0xDA || length < 2) return std::nullopt;  // end or scan before a frame
-    at += 2 + static_cast<std::uint64_t>(length);
-  }
-  return std::nullopt;
-}
-
 // A key image's size from its header: PNG, or JPEG (a key image copied from the input's own file).
-std::optional<cv::Size> KeyImageSize(const ContainedFile& file) {
-  if (auto size = PngSize(file)) return size;
-  return JpegSize(file);
-}
+std::optional<cv::Size> KeyImageSize(const ContainedFile& file) { return ImageHeaderSize(file); }
 }  // namespace
 
 std::optional<cv::Size> KeyImageFileSize(const fs::path& file) {
@@ -365,6 +320,10 @@ void WriteMapFiles(const VisualMap& map, const fs::path& directory) {
 namespace {
 
 constexpr long kMaxInt = std::numeric_limits<int>::max();
+// Values (numbers, strings, arrays, objects) in map.json: 8.4 million, far above a map of 100,000 key images
+// whose 400,000 frames were each compared three times (some 6 values a comparison); parsed, this many take
+// at most some hundred MB, where 150 million numbers would take gigabytes.
+constexpr std::uint64_t kMaxMapJsonValues = 1ull << 23;
 // A key image of a map that does not record its frame size may have at most the pixels of a frame.
 constexpr long kMaxKeyImagePixels = 8192L * 8192L;
 constexpr int kRecordBytes = 4 * sizeof(float);
@@ -412,6 +371,9 @@ void ReadKeyImages(const json& doc, const Fields& fields, const fs::path& direct
     k.image_file = DecodeFileName(fields.String(fields.Required(entry, where, "image"), where + ".image"));
     k.num_features = static_cast<int>(fields.Integer(entry, where, "num_features", 0, kMaxInt, 0));
     k.reason = fields.String(entry, where, "reason");
+    if (k.image_file.find('\0') != std::string::npos || k.source_name.find('\0') != std::string::npos) {
+      fields.Fail(where, "has a name holding a NUL character, which no file name can");
+    }
     if (!IsPlainRelativePath(k.image_file)) {
       Malformed(file, where + " image '" + k.image_file + "' points outside the map directory");
     }
@@ -574,10 +536,14 @@ void ReadEvaluations(const json& doc, const Fields& fields, VisualMap* map) {
 VisualMap ReadCheckedMap(const fs::path& directory) {
   std::error_code ec;
   if (!fs::is_directory(directory, ec)) {
+    if (fs::exists(directory, ec)) {
+      throw InputError("'" + directory.string() + "' is not a map: a map is the folder `vmap build -o` wrote; "
+                       "give that folder");
+    }
     throw InputError("map directory '" + directory.string() + "' does not exist; build one with `vmap build`");
   }
   const fs::path file = directory / kMapFileName;
-  const ContainedJson parsed = ReadContainedJson(directory, kMapFileName, kMaxMapJsonBytes);
+  const ContainedJson parsed = ReadContainedJson(directory, kMapFileName, kMaxMapJsonBytes, kMaxMapJsonValues);
   if (parsed.missing) throw InputError("'" + directory.string() + "' is not a map: " + file.string() + " is missing");
   if (!parsed.document) Malformed(file, parsed.why_not);
   const json& doc = *parsed.document;
@@ -592,9 +558,13 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
                      ", newer than this vmap understands (" + std::to_string(kMapSchemaVersion) + "); update vmap");
   }
   VisualMap map;
-  if (const json* input = Fields::Find(doc, "input")) {
+  const json* input = Fields::Find(doc, "input");
+  // Every map since schema 2 records its input: how it was made, and the frame size and camera it is read at.
+  if (!input && version >= 2) fields.Fail("input", "is missing; rebuild the map with `vmap build`");
+  if (input) {
     fields.Object(*input, "input");
     map.input.path = DecodeFileName(fields.String(*input, "input", "path"));
+    if (map.input.path.find('\0') != std::string::npos) fields.Fail("input.path", "holds a NUL character");
     const std::string format = fields.String(*input, "input", "format");
     try {
       map.input.format = ParseSourceFormat(format.empty() ? "auto" : format);
@@ -612,6 +582,17 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
   map.options_json = options ? fields.Object(*options, "options").dump() : "{}";
   map.num_frames = static_cast<int>(fields.Integer(fields.Required(doc, "", "num_frames"), "num_frames", 0, kMaxInt));
   map.skipped_frames = static_cast<int>(fields.Integer(doc, "", "skipped_frames", 0, kMaxInt, 0));
+  // The frames of a map that has any were read at this size, and vmap reads none with a side under
+  // kMinFrameSide or more pixels than a frame may have (it skips them): such a size contradicts the frames.
+  // 0x0 says the size is not recorded (a snapshot taken before the source knew it): key images then stand
+  // for themselves.
+  const cv::Size frame_size = map.input.frame_size;
+  if (input && Fields::Find(*input, "frame_size") && map.num_frames > 0 && frame_size != cv::Size() &&
+      !FrameSizeProblem(frame_size).empty()) {
+    fields.Fail("input.frame_size", "is " + std::to_string(frame_size.width) + "x" +
+                                        std::to_string(frame_size.height) + " although the map has frames, " +
+                                        "which are never " + FrameSizeProblem(frame_size));
+  }
   map.quality = fields.Number(fields.Required(doc, "", "quality"), "quality", 0.0, 1.0);
   map.seconds = fields.Number(doc, "", "seconds", 0.0, 1e9, 0.0);
   if (const json* coverage = Fields::Find(doc, "coverage")) {
@@ -631,6 +612,11 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
   }
   ReadKeyImages(doc, fields, directory, file, &map);
   ReadLinks(doc, fields, directory, file, &map);
+  // The builder links each key image to the next one it was chosen after: several key images and no link at
+  // all cannot come from it, and would leave localization nothing to follow.
+  if (map.key_images.size() > 1 && map.links.empty()) {
+    fields.Fail("links", "is empty although the map has " + std::to_string(map.key_images.size()) + " key images");
+  }
   ReadEvaluations(doc, fields, &map);
   return map;
 }
@@ -669,7 +655,7 @@ cv::Mat ReadKeyImage(const fs::path& map_directory, const KeyImage& key, bool gr
 }
 
 std::string WhyNotAVmapMap(const fs::path& directory) {
-  const ContainedJson parsed = ReadContainedJson(directory, kMapFileName, kMaxMapJsonBytes);
+  const ContainedJson parsed = ReadContainedJson(directory, kMapFileName, kMaxMapJsonBytes, kMaxMapJsonValues);
   if (parsed.missing) return "it has no map.json";
   if (!parsed.document) return "its " + parsed.why_not;
   const json& doc = *parsed.document;

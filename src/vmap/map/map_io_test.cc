@@ -231,6 +231,23 @@ TEST(MapIo, EveryFieldIsCheckedAndTheMessageNamesIt) {
       {[](json& d) { d["evaluations"]["matched"][1] = 0; }, "'evaluations.matched[1]' must be true or false"},
       {[](json& d) { d["evaluations"]["matched"].push_back(true); }, "'evaluations' has columns of different lengths"},
       {[](json& d) { d["evaluations"].erase("key_frame"); }, "'evaluations.key_frame' is missing"},
+      // Fields that contradict each other or describe nothing a camera makes.
+      {[](json& d) { d["links"] = json::array(); }, "'links' is empty although the map has 3 key images"},
+      {[](json& d) { d["input"]["frame_size"] = {0, 48}; }, "'input.frame_size' is 0x48 although the map has frames, which are never smaller than 32"},
+      {[](json& d) { d["input"]["frame_size"] = {64, 0}; }, "'input.frame_size' is 64x0"},
+      {[](json& d) { d["input"]["frame_size"] = {64, 8}; }, "'input.frame_size' is 64x8"},
+      {[](json& d) { d["input"]["frame_size"] = {100000, 100000}; }, "which are never more than vmap's limit"},
+      {[](json& d) { d.erase("input"); }, "'input' is missing"},
+      {[](json& d) { d["input"]["path"] = std::string("in\0put", 6); }, "'input.path' holds a NUL character"},
+      {[](json& d) { d["key_images"][1]["image"] = std::string("keys/1.png\0.jpg", 15); }, "NUL character"},
+      {[](json& d) {
+         d["input"]["camera"] = {{"model", "PINHOLE"}, {"width", 64}, {"height", 48}, {"params", {1e308, 50, 32, 24}}};
+       },
+       "beyond 10,000,000 pixels"},
+      {[](json& d) {
+         d["input"]["camera"] = {{"model", "PINHOLE"}, {"width", 1ull << 40}, {"height", 48}, {"params", {50, 50, 32, 24}}};
+       },
+       "has the size 1099511627776x48"},
   };
   for (const Case& c : cases) {
     json doc = good;
@@ -242,7 +259,7 @@ TEST(MapIo, EveryFieldIsCheckedAndTheMessageNamesIt) {
   }
   // Numbers beyond what JSON can hold, and nesting no map has.
   WriteText(tmp.path() / kMapFileName, R"({"format": "vmap-map", "schema_version": 1, "num_frames": 1e999})");
-  EXPECT_NE(ErrorOf(tmp.path()).find("not valid JSON"), std::string::npos) << ErrorOf(tmp.path());
+  EXPECT_NE(ErrorOf(tmp.path()).find("number too large"), std::string::npos) << ErrorOf(tmp.path());
   WriteText(tmp.path() / kMapFileName, R"({"format": "vmap-map", "options": )" + std::string(10000, '[') +
                                            std::string(10000, ']') + "}");
   EXPECT_NE(ErrorOf(tmp.path()).find("nested"), std::string::npos) << ErrorOf(tmp.path());

@@ -1,11 +1,13 @@
 #include "vmap/neural/sha1.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <vector>
 
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 
 namespace vmap::neural {
@@ -67,17 +69,22 @@ std::string Sha1Hex(const std::string& bytes) {
 }
 
 std::string GitBlobId(const std::string& path) {
-  std::error_code error;
-  const auto size = std::filesystem::file_size(path, error);
-  std::ifstream file(path, std::ios::binary);
-  if (error || !file) throw InputError("cannot read '" + path + "' to verify it");
+  // Opened without blocking and refused unless a regular file: a FIFO or a device is never read.
+  std::string why_not;
+  const std::optional<ContainedFile> file = ContainedFile::OpenRegular(path, &why_not);
+  if (!file) throw InputError("cannot verify '" + path + "': it " + why_not + "; give a weights file");
+  constexpr std::uint64_t kMaxBytes = 1ull << 30;  // the largest published weights are some 50 MB
+  if (file->size() > kMaxBytes) {
+    throw InputError("cannot verify '" + path + "': it is larger than 1 GB, more than any weights file");
+  }
   Sha1 sha;
-  const std::string header = "blob " + std::to_string(size);
+  const std::string header = "blob " + std::to_string(file->size());
   sha.Update(header.data(), header.size() + 1);  // the terminating NUL is part of git's header
   std::vector<char> chunk(1 << 20);
-  while (file) {
-    file.read(chunk.data(), chunk.size());
-    sha.Update(chunk.data(), static_cast<size_t>(file.gcount()));
+  for (std::uint64_t at = 0; at < file->size(); at += chunk.size()) {
+    const size_t bytes = static_cast<size_t>(std::min<std::uint64_t>(chunk.size(), file->size() - at));
+    if (!file->Read(at, chunk.data(), bytes)) throw InputError("cannot read '" + path + "' to verify it");
+    sha.Update(chunk.data(), bytes);
   }
   return sha.HexDigest();
 }

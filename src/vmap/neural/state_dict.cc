@@ -6,6 +6,7 @@
 
 #include <torch/serialize.h>
 
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/neural/checkpoint_reader.h"
 
@@ -46,9 +47,10 @@ StateDict ReadWithCheckpointReader(const std::string& path, const std::string& m
 }  // namespace
 
 StateDict ReadWeightsFile(const std::string& path, const std::string& model) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw InputError("cannot open " + model + " weights file '" + path + "'; check the weights path");
-  const std::vector<char> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  // The largest published weights are some 50 MB: 1 GiB bounds what a wrong or sparse file costs. A FIFO or a
+  // device is refused before it is read.
+  const std::string text = ReadNamedFile(path, 1ull << 30, model + " weights file", "check the weights path");
+  const std::vector<char> bytes(text.begin(), text.end());
   c10::IValue root;
   try {
     root = torch::pickle_load(bytes);

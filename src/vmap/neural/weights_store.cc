@@ -7,6 +7,8 @@
 #include <unistd.h>
 #include <sys/wait.h>
 
+#include "vmap/core/atomic_output.h"
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/neural/sha1.h"
 
@@ -152,13 +154,9 @@ std::string ImportWeights(const std::string& source, const std::string& preset, 
   fs::create_directories(cache_dir, error);
   if (error) throw InputError("cannot create the weights cache directory '" + cache_dir + "': " + error.message());
   const std::string target = cache_dir + "/" + known.file_name;
-  const std::string temporary = target + ".part" + std::to_string(getpid());
-  fs::copy_file(source, temporary, fs::copy_options::overwrite_existing, error);
-  if (!error) fs::rename(temporary, target, error);
-  if (error) {
-    fs::remove(temporary);
-    throw InputError("cannot write '" + target + "': " + error.message());
-  }
+  // Read as every weights file is (a regular file, at most 1 GiB), then written as every output is: never over
+  // a symbolic link, a device or a read-only file.
+  WriteFileAtomically(target, ReadNamedFile(source, 1ull << 30, "weights file", "give the weights file to import"));
   return target;
 }
 

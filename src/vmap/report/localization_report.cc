@@ -203,23 +203,66 @@ void LocalizationReportOptions::Check() const {
   }
 }
 
-void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, const fs::path& map_directory,
-                             const fs::path& directory, const LocalizationReportOptions& options) {
-  options.Check();
-  for (const KeyImage& k : map.key_images) KeyImageFile(map_directory, k);
-  // The whole folder is replaced at once, and only when it is empty or an older report of a run.
+namespace {
+
+// The whole folder is replaced at once, and only when it is empty or an older report of a run.
+OutputPolicy ReportPolicy(const fs::path& map_directory, const std::string& query) {
   OutputPolicy policy;
   policy.why_not_ours = WhyNotALocalizationReport;
   policy.kind = "a vmap localization report";
-  policy.inputs = {map_directory, run.info.query};
-  AtomicOutputDirectory output(directory, policy);
+  policy.inputs = {map_directory, query};
+  return policy;
+}
+
+}  // namespace
+
+void CheckLocalizationReportDirectory(const fs::path& directory, const fs::path& map_directory,
+                                      const std::string& query) {
+  CheckOutputDirectory(directory, ReportPolicy(map_directory, query));
+}
+
+bool QueryCanBeReadAgain(const LocalizationRunInfo& info) {
+  if (IsLiveInput(info.query)) return false;
+  std::error_code ec;
+  const fs::file_status status = fs::status(info.query, ec);
+  if (fs::is_directory(status)) return true;
+  // A regular file read as a folder of images is one image, which OpenFrameSource opens as such only when
+  // asked to detect the format; a FIFO or a device gives its frames once.
+  return fs::is_regular_file(status) && info.query_format != SourceFormat::kImageFolder;
+}
+
+void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, const fs::path& map_directory,
+                             const fs::path& directory, const LocalizationReportOptions& options,
+                             const RecordedFrames& recorded) {
+  options.Check();
+  for (const KeyImage& k : map.key_images) KeyImageFile(map_directory, k);
+  AtomicOutputDirectory output(directory, ReportPolicy(map_directory, run.info.query));
   const fs::path assets = output.path() / kReportAssetsDirectory;
   fs::create_directory(assets);  // not create_directories: see AtomicOutputDirectory::path()
   fs::create_directory(assets / "frames");
 
-  // The chosen frames, read again from the query (streamed: only the chosen ones are kept).
-  const std::vector<int> chosen = ChooseFrames(run.frames, options.pairs);
   std::vector<std::pair<int, cv::Size>> written;  // run.frames index, image size
+  const auto write_pair = [&](size_t index, const cv::Mat& frame_image) {
+    const LocalizationResult& r = run.frames[index];
+    const bool known_key = r.key >= 0 && r.key < static_cast<int>(map.key_images.size());
+    const bool known_next = r.next_key >= 0 && r.next_key < static_cast<int>(map.key_images.size());
+    const cv::Mat key = known_key ? ReadKeyImage(map_directory, map.key_images[r.key]) : cv::Mat();
+    const cv::Mat next_key = known_next ? ReadKeyImage(map_directory, map.key_images[r.next_key]) : cv::Mat();
+    const cv::Mat pair = DrawPair(frame_image, key, next_key, r, options.pair_width);
+    report::WriteJpeg(assets / "frames" / report::Numbered(r.frame_index), pair, options.jpeg_quality);
+    written.emplace_back(static_cast<int>(index), pair.size());
+  };
+  const bool read_again = recorded.empty() && QueryCanBeReadAgain(run.info);
+  // The frames the run kept, in frame order: the last options.pairs of them.
+  std::vector<size_t> kept;
+  for (size_t i = 0; i < run.frames.size(); ++i) {
+    const auto found = recorded.find(run.frames[i].frame_index);
+    if (found != recorded.end() && !found->second.empty()) kept.push_back(i);
+  }
+  const size_t skip = kept.size() > static_cast<size_t>(options.pairs) ? kept.size() - options.pairs : 0;
+  for (size_t k = skip; k < kept.size(); ++k) write_pair(kept[k], recorded.at(run.frames[kept[k]].frame_index));
+  // Else the chosen frames, read again from the query (streamed: only the chosen ones are kept).
+  const std::vector<int> chosen = read_again ? ChooseFrames(run.frames, options.pairs) : std::vector<int>();
   if (!chosen.empty()) {
     FrameSourceOptions source_options = run.info.source;
     source_options.format = run.info.query_format;
@@ -231,14 +274,7 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
       if (!frame) break;
       while (next < chosen.size() && run.frames[chosen[next]].frame_index < frame->index) ++next;
       if (next == chosen.size() || run.frames[chosen[next]].frame_index != frame->index) continue;
-      const LocalizationResult& r = run.frames[chosen[next]];
-      const bool known_key = r.key >= 0 && r.key < static_cast<int>(map.key_images.size());
-      const bool known_next = r.next_key >= 0 && r.next_key < static_cast<int>(map.key_images.size());
-      const cv::Mat key = known_key ? ReadKeyImage(map_directory, map.key_images[r.key]) : cv::Mat();
-      const cv::Mat next_key = known_next ? ReadKeyImage(map_directory, map.key_images[r.next_key]) : cv::Mat();
-      const cv::Mat pair = DrawPair(ColorImage(*frame), key, next_key, r, options.pair_width);
-      report::WriteJpeg(assets / "frames" / report::Numbered(r.frame_index), pair, options.jpeg_quality);
-      written.emplace_back(chosen[next], pair.size());
+      write_pair(static_cast<size_t>(chosen[next]), ColorImage(*frame));
       ++next;
     }
   }
@@ -294,7 +330,14 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
                              : "")
          << "</figcaption></figure>\n";
   }
-  if (written.empty()) html << "<p class=\"note\">No frames to show.</p>\n";
+  if (written.empty() && recorded.empty() && !QueryCanBeReadAgain(run.info) && !run.frames.empty()) {
+    html << "<p class=\"note\">No frames to show: the query " << HtmlEscape(run.info.query)
+         << " is a live input, a single image or a stream that cannot be read a second time, and this report was "
+            "made from the run's file alone (<code>vmap localize --report</code> keeps the last frames of such a "
+            "query).</p>\n";
+  } else if (written.empty()) {
+    html << "<p class=\"note\">No frames to show.</p>\n";
+  }
   html << "</div>\n</section>\n" << report::PageEnd();
   WriteFileAtomically(output.path() / kReportFileName, html.str());
   WriteFileAtomically(output.path() / kLocalizationReportRunFileName, LocalizationRunJson(map, run));
@@ -302,8 +345,8 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
 }
 
 std::string WhyNotALocalizationReport(const fs::path& directory) {
-  // A run's JSON holds a few hundred bytes per frame: 1 GB is far more than any.
-  const ContainedJson parsed = ReadContainedJson(directory, kLocalizationReportRunFileName, 1ull << 30);
+  const ContainedJson parsed = ReadContainedJson(directory, kLocalizationReportRunFileName, kMaxRunJsonBytes,
+                                                 kMaxRunJsonValues);
   if (parsed.missing) return std::string("it has no ") + kLocalizationReportRunFileName;
   if (!parsed.document) return "its " + parsed.why_not;
   if (!parsed.document->is_object() || parsed.document->value("format", nlohmann::json()) != "vmap-localization") {

@@ -11,7 +11,10 @@
 // (its run.json says so), never a folder that is, holds or lies inside the map or the query.
 
 #include <filesystem>
+#include <map>
 #include <string>
+
+#include <opencv2/core.hpp>
 
 #include "vmap/localization/localization_output.h"
 #include "vmap/map/visual_map.h"
@@ -28,11 +31,26 @@ struct LocalizationReportOptions {
   void Check() const;  // throws OptionError naming the bad field
 };
 
-// `map` is the map the run localized against, read from `map_directory`; the query frames shown are read
-// again from the run's query. Throws InputError when a file cannot be read or written.
+// Query frames (colour) kept by the run itself, by frame index: the pictures of a report whose query cannot
+// be read again.
+using RecordedFrames = std::map<int, cv::Mat>;
+
+// Whether the run's query can be read again for the report's pictures: not a live input (a stream, a camera),
+// not a single image (its frame is kept by the run instead), nor a FIFO or device.
+bool QueryCanBeReadAgain(const LocalizationRunInfo& info);
+
+// `map` is the map the run localized against, read from `map_directory`. The query frames shown are
+// `recorded` when it is not empty, else read again from the run's query where it can be
+// (QueryCanBeReadAgain); otherwise the page says why it shows none. Throws InputError when a file cannot be
+// read or written.
 void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map,
                              const std::filesystem::path& map_directory, const std::filesystem::path& directory,
-                             const LocalizationReportOptions& options = {});
+                             const LocalizationReportOptions& options = {}, const RecordedFrames& recorded = {});
+
+// Throws InputError when `directory` may not receive the report of a run against `map_directory` of `query`
+// (the check WriteLocalizationReport makes): for `vmap localize --report`, to refuse before the run.
+void CheckLocalizationReportDirectory(const std::filesystem::path& directory,
+                                      const std::filesystem::path& map_directory, const std::string& query);
 
 // "" when `directory` is a localization report vmap wrote (its run.json is a run), or why it is not.
 std::string WhyNotALocalizationReport(const std::filesystem::path& directory);

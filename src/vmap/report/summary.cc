@@ -116,7 +116,7 @@ std::string SweepToJson(const SweepResult& sweep) {
 
 std::string WhyNotAVmapSweep(const std::filesystem::path& directory) {
   // sweep.json is a table of some hundred lines: 64 MB is far more than any.
-  const ContainedJson parsed = ReadContainedJson(directory, kSweepJsonFileName, 64ull << 20);
+  const ContainedJson parsed = ReadContainedJson(directory, kSweepJsonFileName, 64ull << 20, 1ull << 22);
   if (parsed.missing) return "it has no sweep.json";
   if (!parsed.document) return "its " + parsed.why_not;
   const nlohmann::json& doc = *parsed.document;

@@ -152,7 +152,7 @@ TEST(ImageFolder, BadFramesAreSkippedWithAWarningAndCounted) {
   cv::imwrite((tmp.path() / "frame_1.png").string(), cv::Mat(1, 1, CV_8U, cv::Scalar(7)));
   cv::imwrite((tmp.path() / "frame_3.png").string(), cv::Mat(500, 20, CV_8U, cv::Scalar(7)));
   cv::imwrite((tmp.path() / "frame_5.png").string(), cv::Mat(31, 400, CV_8U, cv::Scalar(7)));
-  testing::WritePngHeader(tmp.path() / "frame_7.png", 40000, 40000);  // OpenCV refuses it outright
+  testing::WritePngHeader(tmp.path() / "frame_7.png", 40000, 40000);  // refused from its header
   testing::WritePngHeader(tmp.path() / "frame_8.png", 2, 3);         // a header and no data
   std::ofstream(tmp.path() / "frame_10.png", std::ios::trunc) << "";
   auto source = OpenFrameSource(tmp.path().string());

@@ -5,7 +5,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/image_header.h"
 #include "vmap/sources/internal.h"
 
 namespace vmap::internal {
@@ -33,6 +35,22 @@ class ImageListSource : public FrameSource {
       next_ += options_.stride;
       const ImageEntry& entry = entries_[index];
       Frame frame;
+      // Only a regular file (a FIFO would block the decoder), and only of a size a frame may have, read from
+      // its header before anything is decoded.
+      std::string why_not;
+      const std::optional<ContainedFile> file = ContainedFile::OpenRegular(entry.path, &why_not);
+      if (!file) {
+        Skip(entry, "it " + why_not);
+        continue;
+      }
+      if (const std::optional<cv::Size> announced = ImageHeaderSize(*file)) {
+        const std::string problem = FrameSizeProblem(*announced, options_);
+        if (!problem.empty()) {
+          Skip(entry, "its header announces " + std::to_string(announced->width) + "x" +
+                          std::to_string(announced->height) + ", " + problem);
+          continue;
+        }
+      }
       // Grey straight from the decoder, as the matchers' reference implementations read images.
       try {
         frame.gray = cv::imread(entry.path, cv::IMREAD_GRAYSCALE);

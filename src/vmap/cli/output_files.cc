@@ -1,0 +1,37 @@
+#include "vmap/cli/output_files.h"
+
+#include <filesystem>
+#include <set>
+#include <string>
+
+#include "vmap/evaluation/map_evaluation.h"
+#include "vmap/localization/key_image_store.h"
+#include "vmap/map/map_io.h"
+#include "vmap/report/html_report.h"
+
+namespace vmap::cli {
+namespace fs = std::filesystem;
+
+std::vector<OutputInput> MapInputs(const std::string& map_directory) {
+  if (map_directory.empty()) return {};
+  const fs::path directory(map_directory);
+  std::set<std::string> names = {kMapFileName,    kCorrespondencesFileName, "keys",
+                                 kReportFileName, kReportAssetsDirectory,   kEvaluationFileName,
+                                 kLocalizationCacheFileName};
+  std::vector<OutputInput> inputs;
+  for (const std::string& name : names) inputs.push_back({directory / name, "the map's " + name});
+  return inputs;
+}
+
+std::vector<OutputInput> NamedInput(const std::string& path, const std::string& what) {
+  if (path.empty()) return {};
+  return {{fs::path(path), what}};
+}
+
+void CheckOutputs(const std::vector<OutputFile>& outputs, const std::vector<std::vector<OutputInput>>& inputs) {
+  std::vector<OutputInput> all;
+  for (const auto& group : inputs) all.insert(all.end(), group.begin(), group.end());
+  CheckOutputFiles(outputs, all);
+}
+
+}  // namespace vmap::cli

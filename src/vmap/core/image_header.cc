@@ -1,0 +1,60 @@
+#include "vmap/core/image_header.h"
+
+#include <cstdint>
+#include <cstring>
+
+namespace vmap {
+
+namespace {
+
+// The width and height a PNG file's header announces, or nullopt when the file is not a PNG.
+std::optional<cv::Size> PngSize(const ContainedFile& file) {
+  unsigned char header[24];
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  if (!file.Read(0, header, sizeof(header)) || std::memcmp(header, kSignature, 8) != 0 ||
+      std::memcmp(header + 12, "IHDR", 4) != 0) {
+    return std::nullopt;
+  }
+  auto big_endian = [&](int at) {
+    return (std::uint32_t(header[at]) << 24) | (std::uint32_t(header[at + 1]) << 16) |
+           (std::uint32_t(header[at + 2]) << 8) | std::uint32_t(header[at + 3]);
+  };
+  const std::uint32_t width = big_endian(16), height = big_endian(20);
+  if (width > (1u << 20) || height > (1u << 20)) return cv::Size(1 << 20, 1 << 20);
+  return cv::Size(static_cast<int>(width), static_cast<int>(height));
+}
+
+// The width and height of a baseline or progressive JPEG file's frame header (SOFn), or nullopt when the file
+// is not a JPEG. Walks the marker segments from the start; at most 64 segments and 1 MiB are looked at, since
+// the frame header comes before any image data.
+std::optional<cv::Size> JpegSize(const ContainedFile& file) {
+  unsigned char bytes[9];
+  if (!file.Read(0, bytes, 2) || bytes[0] != 0xFF || bytes[1] != 0xD8) return std::nullopt;
+  std::uint64_t at = 2;
+  for (int segment = 0; segment < 64 && at < (1u << 20); ++segment) {
+    if (!file.Read(at, bytes, 4) || bytes[0] != 0xFF) return std::nullopt;
+    const int marker = bytes[1];
+    const int length = (bytes[2] << 8) | bytes[3];
+    if (marker == 0xFF) {  // fill byte
+      ++at;
+      continue;
+    }
+    // SOF0..SOF15 except DHT (C4), JPG (C8) and DAC (CC): precision, height, width.
+    if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC) {
+      if (!file.Read(at + 4, bytes, 5)) return std::nullopt;
+      return cv::Size((bytes[3] << 8) | bytes[4], (bytes[1] << 8) | bytes[2]);
+    }
+    if (marker == 0xD9 || marker == 0xDA || length < 2) return std::nullopt;  // end or scan before a frame
+    at += 2 + static_cast<std::uint64_t>(length);
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<cv::Size> ImageHeaderSize(const ContainedFile& file) {
+  if (auto size = PngSize(file)) return size;
+  return JpegSize(file);
+}
+
+}  // namespace vmap

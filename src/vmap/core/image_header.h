@@ -1,0 +1,18 @@
+#pragma once
+// An image's size as its file's header announces it, read without decoding anything: so that a small file
+// announcing 32000 x 32000 pixels is refused before a decoder allocates a gigabyte for it. OpenCV has such a
+// limit too (OPENCV_IO_MAX_IMAGE_PIXELS), but reads it once when the library loads, and at 2^30 pixels.
+
+#include <optional>
+
+#include <opencv2/core.hpp>
+
+#include "vmap/core/contained_file.h"
+
+namespace vmap {
+
+// The width and height of a PNG (IHDR) or a baseline or progressive JPEG (SOFn), or nullopt when the file is
+// neither (or is cut short): then only the decoder's own checks apply. Sides beyond 2^20 are returned as 2^20.
+std::optional<cv::Size> ImageHeaderSize(const ContainedFile& file);
+
+}  // namespace vmap

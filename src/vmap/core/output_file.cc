@@ -1,0 +1,80 @@
+#include "vmap/core/output_file.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "vmap/core/contained_file.h"
+#include "vmap/core/error.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+
+namespace {
+
+// Whether `a` and `b` name the same existing file (one inode), whatever the path.
+bool SameFile(const fs::path& a, const fs::path& b) {
+  struct stat sa, sb;
+  return stat(a.c_str(), &sa) == 0 && stat(b.c_str(), &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+// Whether two outputs that may not exist yet name the same file: the same inode, or the same normalised path.
+bool SameOutput(const fs::path& a, const fs::path& b) {
+  if (SameFile(a, b)) return true;
+  std::error_code ec;
+  const fs::path ca = fs::weakly_canonical(fs::absolute(a, ec), ec);
+  const fs::path cb = fs::weakly_canonical(fs::absolute(b, ec), ec);
+  return !ca.empty() && ca == cb;
+}
+
+}  // namespace
+
+std::string WhyNotReplaceable(const fs::path& path) {
+  struct stat status;
+  if (lstat(path.c_str(), &status) != 0) return "";  // absent: created
+  if (S_ISLNK(status.st_mode)) {
+    return "is a symbolic link; vmap replaces only a regular file: give the path it points to, or another path";
+  }
+  if (S_ISDIR(status.st_mode)) return "is a folder; give a file name";
+  if (!S_ISREG(status.st_mode)) {
+    return "is not a regular file (a device, a FIFO or a socket), which vmap never replaces; give a file name";
+  }
+  // Root may write anything: the permission bits still say the file is meant to stay as it is.
+  if ((status.st_mode & (S_IWUSR | S_IWGRP | S_IWOTH)) == 0 || access(path.c_str(), W_OK) != 0) {
+    return "is read-only; make it writable or give another path";
+  }
+  return "";
+}
+
+void CheckOutputFiles(const std::vector<OutputFile>& outputs, const std::vector<OutputInput>& inputs) {
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    const OutputFile& output = outputs[i];
+    if (output.path.empty()) continue;
+    const std::string named = output.flag + " '" + output.path.string() + "'";
+    for (const OutputInput& input : inputs) {
+      if (input.path.empty()) continue;
+      // The same file (also where neither exists yet: a cache this run may write), or a path into a folder.
+      if (SameOutput(output.path, input.path)) {
+        throw InputError(named + " would overwrite " + input.what + " '" + input.path.string() +
+                         "', an input of this command; write it somewhere else");
+      }
+      if (IsSameOrInside(output.path, input.path)) {
+        throw InputError(named + " lies inside " + input.what + " '" + input.path.string() +
+                         "', an input of this command; write it somewhere else");
+      }
+    }
+    for (size_t j = 0; j < i; ++j) {
+      if (!outputs[j].path.empty() && SameOutput(output.path, outputs[j].path)) {
+        throw InputError(named + " is also the output of " + outputs[j].flag + "; give each output its own file");
+      }
+    }
+    const std::string why_not = WhyNotReplaceable(output.path);
+    if (!why_not.empty()) throw InputError(named + " " + why_not);
+    const fs::path parent = output.path.has_parent_path() ? output.path.parent_path() : fs::path(".");
+    std::error_code ec;
+    if (!fs::is_directory(parent, ec)) {
+      throw InputError(named + ": its folder '" + parent.string() + "' does not exist; create it first");
+    }
+  }
+}
+
+}  // namespace vmap

@@ -1,0 +1,37 @@
+#pragma once
+// The rule every single-file output of vmap follows (--csv, --json, -o FILE): it may replace only a regular
+// file that is none of the command's inputs and none of the other outputs, and it is checked before any work,
+// so that a refusal writes nothing. WriteFileAtomically checks the file again just before it renames over it.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace vmap {
+
+// One output file and how the user named it, for messages: {"out.csv", "--csv"}.
+struct OutputFile {
+  std::filesystem::path path;
+  std::string flag;
+};
+
+// An input, for messages: {"MAP/map.json", "the map's map.json"}. A folder input covers everything inside it.
+struct OutputInput {
+  std::filesystem::path path;
+  std::string what;
+};
+
+// Throws InputError, naming the output's flag and path and what is in the way, when an output (those with an
+// empty path are skipped):
+// - resolves to an input or into a folder input (symbolic links, "..", hard links and bind mounts compared by
+//   the files they reach), or to another of `outputs`;
+// - exists and is a symbolic link, a device, a FIFO, a socket or a folder (vmap never renames over those);
+// - exists and is not writable (read-only, or no write permission bit even for root);
+// - has a parent that is not an existing folder.
+void CheckOutputFiles(const std::vector<OutputFile>& outputs, const std::vector<OutputInput>& inputs);
+
+// Why the existing `path` may not be replaced by a regular file ("is a symbolic link; ..."), or "" when it may
+// (it is a writable regular file, or absent). The part of CheckOutputFiles that WriteFileAtomically repeats.
+std::string WhyNotReplaceable(const std::filesystem::path& path);
+
+}  // namespace vmap
