@@ -5,6 +5,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -38,6 +39,8 @@ struct LocalizeFlags {
   int threads = 0;
   bool cache = true;
   OptionFlags option_flags;
+  // The earlier acceptance rule's flags: given, they need --acceptance counts.
+  std::vector<const CLI::Option*> counts_flags;
 };
 
 std::string Percent(long part, long whole) {
@@ -55,6 +58,13 @@ void RunLocalize(const LocalizeFlags& flags) {
   // Everything that can fail fast does, before the key images are loaded (which may take seconds).
   LocalizerOptions options = flags.localizer;
   options.Check();
+  for (const CLI::Option* flag : flags.counts_flags) {
+    if (flag->count() > 0 && options.acceptance != AcceptanceRule::kCounts) {
+      throw InputError(fmt::format("{} belongs to the earlier acceptance rule; add --acceptance counts to use it, "
+                                   "or leave it out (--acceptance chance decides by --max-log10-nfa)",
+                                   flag->get_name()));
+    }
+  }
   const VisualMap header = ReadMap(flags.map);
   if (flags.from >= 0 || flags.to >= 0) {
     const int last = static_cast<int>(header.key_images.size()) - 1;
@@ -142,14 +152,23 @@ void AddLocalizeCommand(CLI::App& app) {
   OptionFlags& option_flags = flags->option_flags;
   AddSourceOptions(command, flags->source, option_flags);
   LocalizerOptions& o = flags->localizer;
+  option_flags.AddEnumOption(command, "--acceptance", o.acceptance, ParseAcceptanceRule, AcceptanceRuleName,
+                             "acceptance",
+                             "When a frame is seen at a key image: chance (its verified matches are unlikely by "
+                             "chance, --max-log10-nfa) or counts (--min-verified and --min-similarity)");
   option_flags
-      .AddOption(command, "--min-verified", o.min_verified, "min_verified",
-                 "Verified matches a frame needs to be localized at a key image")
+      .AddOption(command, "--max-log10-nfa", o.max_log10_nfa, "max_log10_nfa",
+                 "--acceptance chance: accept when log10 of the number of false alarms is at most this")
       ->capture_default_str();
-  option_flags
-      .AddOption(command, "--min-similarity", o.min_similarity, "min_similarity",
-                 "S a frame needs to be localized at a key image")
-      ->capture_default_str();
+  flags->counts_flags.push_back(
+      option_flags
+          .AddOption(command, "--min-verified", o.min_verified, "min_verified",
+                     "--acceptance counts: verified matches a frame needs to be localized at a key image")
+          ->capture_default_str());
+  flags->counts_flags.push_back(option_flags
+                                    .AddOption(command, "--min-similarity", o.min_similarity, "min_similarity",
+                                               "--acceptance counts: S a frame needs to be localized at a key image")
+                                    ->capture_default_str());
   option_flags
       .AddOption(command, "--max-lost", o.max_lost_frames, "max_lost_frames",
                  "Lost frames in a row before the estimate is dropped")

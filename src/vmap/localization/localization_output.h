@@ -8,8 +8,9 @@
 // seconds, and F from the frame to the next key image (x_next^T F x_frame = 0; CSV columns F00..F22, JSON a
 // row-major list; empty / null when there is none). With the map's camera also heading_deg and the pose of the
 // target key image (next_key, or key at the route's end) relative to the frame, X_key = R X_frame + t with
-// |t| = 1 (CSV R00..R22, tx, ty, tz; JSON "pose": {"R": row-major, "t"}). Unknown numbers are empty in CSV
-// and null in JSON.
+// |t| = 1 (CSV R00..R22, tx, ty, tz; JSON "pose": {"R": row-major, "t"}). Then log10_nfa and next_log10_nfa,
+// how unlikely the verified matches with `key` and `next_key` are by chance (KeyComparison::log10_nfa).
+// Unknown numbers are empty in CSV and null in JSON.
 
 #include <filesystem>
 #include <string>

@@ -42,16 +42,16 @@ LocalizationRun SampleRun() {
   tracked.key = 0;
   tracked.next_key = 1;
   const double no_bearing = std::numeric_limits<double>::quiet_NaN();
-  tracked.to_key = {0, true, true, 0.75, 200, 150, cv::Matx33d::zeros(), 1.5, no_bearing, RelativePose{}};
+  tracked.to_key = {0, true, true, 0.75, 200, 150, cv::Matx33d::zeros(), 1.5, no_bearing, RelativePose{}, -42.5};
   tracked.to_next = {1, true, true, 0.5, 100, 50, cv::Matx33d(1, 2, 3, 4, 5, 6, 7, 8, 9), -2.0, no_bearing,
-                     RelativePose{}};
+                     RelativePose{}, -3.25};
   tracked.heading_px = -2.0;
   tracked.heading_deg = -0.25;
   tracked.to_next.pose.valid = true;
   tracked.to_next.pose.R = cv::Matx33d(0, -1, 0, 1, 0, 0, 0, 0, 1);
   tracked.to_next.pose.t = cv::Vec3d(0.6, 0, 0.8);
   tracked.progress = 0.25;
-  tracked.candidates = {{0, 120.0, true, 0.75, 150}, {1, 80.0, true, 0.5, 50}};
+  tracked.candidates = {{0, 120.0, true, 0.75, 150, -42.5}, {1, 80.0, true, 0.5, 50, -3.25}};
   LocalizationResult lost;
   lost.frame_index = 1;
   lost.source_index = 4;
@@ -80,7 +80,7 @@ TEST(LocalizationOutput, CsvHasTheNamedColumnsAndOneRowPerFrame) {
   EXPECT_FALSE(std::getline(lines, extra));
   for (const char* column : {"frame", "source_index", "status", "key", "next_key", "similarity", "verified",
                              "next_similarity", "next_verified", "heading_px", "progress", "F00", "F22",
-                             "heading_deg", "R00", "R22", "tx", "tz"}) {
+                             "heading_deg", "R00", "R22", "tx", "tz", "log10_nfa", "next_log10_nfa"}) {
     EXPECT_NE(("," + header + ",").find(std::string(",") + column + ","), std::string::npos) << column;
   }
   auto count = [](const std::string& s) { return std::count(s.begin(), s.end(), ','); };
@@ -89,6 +89,7 @@ TEST(LocalizationOutput, CsvHasTheNamedColumnsAndOneRowPerFrame) {
   EXPECT_EQ(row0.rfind("0,3,0.100000,frame_000003,relocalized,0,1,0,40,0.75,150,200,0.5,50,100,-2,0.25,", 0), 0u)
       << row0;
   EXPECT_NE(row0.find(",1,2,3,4,5,6,7,8,9,-0.25,0,-1,0,1,0,0,0,0,1,0.6,0,0.8"), std::string::npos) << row0;
+  EXPECT_NE(row0.find(",-42.5,-3.25"), std::string::npos) << row0;
   // Unknown values are empty, not "nan".
   EXPECT_EQ(row1.find("nan"), std::string::npos) << row1;
   EXPECT_EQ(row1.rfind("1,4,,frame,lost,-1,-1,-1,-1,,0,0,,0,0,,,", 0), std::string::npos) << row1;
@@ -129,6 +130,10 @@ TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
   EXPECT_DOUBLE_EQ(r.progress, 0.25);
   ASSERT_EQ(r.candidates.size(), 2u);
   EXPECT_EQ(r.candidates[1].num_verified, 50);
+  EXPECT_DOUBLE_EQ(r.candidates[1].log10_nfa, -3.25);
+  EXPECT_DOUBLE_EQ(r.to_key.log10_nfa, -42.5);
+  EXPECT_DOUBLE_EQ(r.to_next.log10_nfa, -3.25);
+  EXPECT_TRUE(doc["frames"][1]["log10_nfa"].is_null()) << "a lost frame compared with nothing";
   EXPECT_EQ(back.frames[1].status, LocalizationStatus::kLost);
   EXPECT_TRUE(std::isnan(back.frames[1].heading_px));
 }

@@ -17,7 +17,8 @@
 //   none of them is relocalized at once (the robot may have turned back or skipped ahead); when that fails
 //   too it is lost and the estimate is kept, and after `max_lost_frames` lost frames in a row it is dropped.
 //
-// "Better match" and "verified" are measured by the verified matches (inliers of F) and S, as in the map.
+// "Better match" is measured by the verified matches (inliers of F) and S, as in the map; "verified" by how
+// unlikely those matches are by chance (acceptance.h).
 
 #include <limits>
 #include <memory>
@@ -32,6 +33,7 @@
 #include "vmap/geometry/camera.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/geometry/relative_pose.h"
+#include "vmap/localization/acceptance.h"
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/localization/key_image_store.h"
 #include "vmap/mapping/key_image_selector.h"
@@ -41,8 +43,14 @@
 namespace vmap {
 
 struct LocalizerOptions {
-  // A frame is localized at a key image when matching and verification succeed with at least
-  // `min_verified` verified matches and S >= `min_similarity` (S as the map defines it).
+  // When a comparison accepts the frame at a key image (acceptance.h, docs/localization-acceptance.md).
+  // kChance: matching and verification succeed and the verified set is unlikely by chance, log10 of its number
+  // of false alarms (every comparison a frame can make counted as a test) at most `max_log10_nfa`: 0 (default)
+  // accepts what chance would explain less than once over all the comparisons of a frame.
+  AcceptanceRule acceptance = AcceptanceRule::kChance;
+  double max_log10_nfa = 0.0;
+  // kCounts only (the earlier rule): at least `min_verified` verified matches and S >= `min_similarity`
+  // (S as the map defines it), whatever the matcher and image size.
   int min_verified = 20;
   double min_similarity = 0.3;
   // Key images compared beyond `next_key` when the frame has passed it (1 or 2: the issue's "next one or two").
@@ -81,7 +89,7 @@ std::string LocalizationStatusName(LocalizationStatus status);  // "tracking", "
 struct KeyComparison {
   int key = -1;             // key-image index in the map; -1: not compared
   bool matched = false;     // matching and verification succeeded
-  bool accepted = false;    // matched, with at least min_verified verified matches and S >= min_similarity
+  bool accepted = false;    // matched, and the acceptance rule holds (LocalizerOptions::acceptance)
   double similarity = 0.0;  // S
   int num_tentative = 0;
   int num_verified = 0;
@@ -94,6 +102,9 @@ struct KeyComparison {
   // With a camera: the key image's camera relative to the frame's, X_key = R X_frame + t, t of unit length
   // (PoseFromFundamental on F and the verified matches: no extra estimation). Invalid without.
   RelativePose pose;
+  // log10 of the number of false alarms of the verified set (ChanceOfComparison): how often chance alone
+  // would explain it over all the comparisons one frame can make. +infinity when !matched.
+  double log10_nfa = std::numeric_limits<double>::infinity();
 };
 
 // A key image the ranking proposed when relocalizing, and how its verification went.
@@ -103,6 +114,7 @@ struct RelocalizationCandidate {
   bool accepted = false;
   double similarity = 0.0;
   int num_verified = 0;
+  double log10_nfa = std::numeric_limits<double>::infinity();  // KeyComparison::log10_nfa
 };
 
 struct LocalizationResult {

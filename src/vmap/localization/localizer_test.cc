@@ -193,6 +193,88 @@ TEST(Localizer, AnUnrelatedImageIsLostAndTheEstimateIsDroppedAfterMaxLostFrames)
   EXPECT_TRUE(Brackets(m.map, 33, r.key));
 }
 
+// The drive's odd frames with all but a vertical strip `visible` of the width wide hidden behind noise: little
+// of the scene is left, and the noise adds tentative matches that chance explains, so S is low.
+std::vector<cv::Mat> MostlyHidden(double visible) {
+  std::vector<cv::Mat> frames = Frames(1, 2);
+  cv::RNG rng(17);
+  for (cv::Mat& frame : frames) {
+    cv::Mat noise(frame.size(), frame.type());
+    rng.fill(noise, cv::RNG::UNIFORM, 0, 255);
+    const int first_hidden = static_cast<int>(visible * frame.cols);
+    const cv::Rect covered(first_hidden, 0, frame.cols - first_hidden, frame.rows);
+    frame = frame.clone();
+    noise(covered).copyTo(frame(covered));
+  }
+  return frames;
+}
+
+std::vector<LocalizationResult> LocalizeAll(const LocalizerOptions& options, std::vector<cv::Mat> frames,
+                                            std::vector<int> indices) {
+  const LocalizationMap& m = Map().opened;
+  Localizer localizer(m.map, m.keys, *m.matcher, options);
+  ::vmap::testing::MemorySource source(std::move(frames), std::move(indices));
+  LocalizeSequenceOptions run;
+  run.show_progress = false;
+  std::vector<LocalizationResult> results;
+  LocalizeSequence(source, *m.matcher, localizer, run,
+                   [&](const Frame&, const LocalizationResult& r) { results.push_back(r); });
+  return results;
+}
+
+TEST(Localizer, AFrameThatShowsLittleOfTheSceneIsStillLocalizedByItsChance) {
+  // The earlier rule (S >= 0.3) loses frames that keep a few dozen verified matches among many chance ones;
+  // the chance of those verified matches says they see the scene.
+  const LocalizationMap& m = Map().opened;
+  LocalizerOptions chance = MapLocalizerOptions(m.map);
+  ASSERT_EQ(chance.acceptance, AcceptanceRule::kChance) << "the default";
+  LocalizerOptions counts = chance;
+  counts.acceptance = AcceptanceRule::kCounts;
+  const std::vector<LocalizationResult> by_chance = LocalizeAll(chance, MostlyHidden(0.35), Indices(1, 2));
+  const std::vector<LocalizationResult> by_counts = LocalizeAll(counts, MostlyHidden(0.35), Indices(1, 2));
+  ASSERT_EQ(by_chance.size(), 30u);
+  int chance_bracketed = 0, counts_localized = 0, low_similarity = 0;
+  for (size_t i = 0; i < by_chance.size(); ++i) {
+    const LocalizationResult& r = by_chance[i];
+    chance_bracketed += r.status != LocalizationStatus::kLost && Brackets(m.map, r.source_index, r.key);
+    counts_localized += by_counts[i].status != LocalizationStatus::kLost;
+    if (r.status != LocalizationStatus::kLost) {
+      EXPECT_LT(r.to_key.log10_nfa, chance.max_log10_nfa);
+      low_similarity += r.to_key.similarity < counts.min_similarity;
+    }
+  }
+  EXPECT_GE(chance_bracketed, 27) << "at least 90 % of the frames at a key image around them";
+  EXPECT_GE(low_similarity, 10) << "the test hides enough of the scene to matter";
+  EXPECT_LT(counts_localized, chance_bracketed) << "the earlier rule gives up on more of them";
+}
+
+TEST(Localizer, ASceneOfOtherTexturesIsNeverAccepted) {
+  // The same kind of scene (planes with blobs and boxes, the same drive), other textures: nothing is shared,
+  // though the images look alike and give ORB plenty of tentative matches.
+  ::vmap::testing::SyntheticOptions other;
+  other.num_frames = 60;
+  other.step = 0.05;
+  other.yaw_per_frame = 0.003;
+  other.seed = 8;
+  const auto elsewhere = ::vmap::testing::RenderSyntheticSequence(other);
+  std::vector<cv::Mat> frames;
+  std::vector<int> indices;
+  for (int i = 1; i < other.num_frames; i += 2) {
+    frames.push_back(elsewhere.frames[i]);
+    indices.push_back(i);
+  }
+  int candidates = 0;
+  for (const LocalizationResult& r : LocalizeAll(MapLocalizerOptions(Map().opened.map), frames, indices)) {
+    EXPECT_EQ(r.status, LocalizationStatus::kLost) << "frame " << r.source_index << " at key " << r.key;
+    for (const RelocalizationCandidate& c : r.candidates) {
+      EXPECT_FALSE(c.accepted);
+      EXPECT_GT(c.log10_nfa, 0.0);
+      ++candidates;
+    }
+  }
+  EXPECT_GE(candidates, 30) << "every frame was relocalized against the best-ranked key images";
+}
+
 TEST(Localizer, FollowsAReversedRouteWhenTheFramesComeBackwards) {
   const LocalizationMap& m = Map().opened;
   LocalizerOptions options = MapLocalizerOptions(m.map);
@@ -347,6 +429,7 @@ TEST(Localizer, OptionsAreChecked) {
   auto path = [&](auto change) { return testing::OptionErrorPath([&] { with(change).Check(); }); };
   EXPECT_EQ(path([](LocalizerOptions& o) { o.min_verified = 5; }), "min_verified");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.min_similarity = 1.5; }), "min_similarity");
+  EXPECT_EQ(path([](LocalizerOptions& o) { o.max_log10_nfa = std::nan(""); }), "max_log10_nfa");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.lookahead = 3; }), "lookahead");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.max_lost_frames = -1; }), "max_lost_frames");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.relocalization_candidates = 0; }), "relocalization_candidates");
