@@ -8,6 +8,7 @@ accepted (must be none) and the least log10 NFA any comparison reached there (th
 Each localization runs once per acceptance rule, one after the other, so the rules compare side by side.
 
 usage: bench/localize_scenes.py VMAP [--matcher orb|xfeat] [--rules chance,counts] [--same] [--different]
+                                [--work DIR]
        (from the repository root; ../shared must be there)"""
 import argparse, json, os, subprocess, sys, tempfile
 
@@ -73,19 +74,21 @@ def main():
     parser.add_argument("--rules", default="chance,counts")
     parser.add_argument("--same", action="store_true")
     parser.add_argument("--different", action="store_true")
+    parser.add_argument("--work", help="keep the maps in this folder (reused when there) instead of a temporary one")
     args = parser.parse_args()
     rules = args.rules.split(",")
     both = not args.same and not args.different
-    with tempfile.TemporaryDirectory(prefix="vmap_localize_scenes_") as tmp:
+    with tempfile.TemporaryDirectory(prefix="vmap_localize_scenes_") as scratch:
+        tmp = args.work or scratch
         if args.same or both:
             print("| repeat run (%s) | rule | frames | localized | key image moved back | lost stretches | "
                   "frames/s |" % args.matcher)
             print("|---|---|---|---|---|---|---|")
             for name, (scene, build_flags, query_flags) in SAME.items():
-                map_directory = build(vmap, args.matcher, scene, build_flags,
-                                      os.path.join(tmp, "same_%d" % len(os.listdir(tmp))))
+                map_directory = build(args.vmap, args.matcher, scene, build_flags,
+                                      os.path.join(tmp, "same_" + "".join(c for c in name if c.isalnum())))
                 for rule in rules:
-                    doc = localize(vmap, map_directory, SCENES[scene][0], query_flags, rule,
+                    doc = localize(args.vmap, map_directory, SCENES[scene][0], query_flags, rule,
                                    os.path.join(tmp, "run.json"))
                     frames = doc["frames"]
                     localized, back = forward_steps(frames)
@@ -107,13 +110,13 @@ def main():
             maps = {}
             for scene, (path, build_flags, _) in SCENES.items():
                 if build_flags is not None:
-                    maps[scene] = build(vmap, args.matcher, scene, build_flags, os.path.join(tmp, "map_" + scene))
+                    maps[scene] = build(args.vmap, args.matcher, scene, build_flags, os.path.join(tmp, "map_" + scene))
             for query, (path, _, query_flags) in SCENES.items():
                 for scene, map_directory in maps.items():
                     if scene == query:
                         continue
                     for rule in rules:
-                        doc = localize(vmap, map_directory, path, query_flags, rule, os.path.join(tmp, "run.json"))
+                        doc = localize(args.vmap, map_directory, path, query_flags, rule, os.path.join(tmp, "run.json"))
                         localized, _ = forward_steps(doc["frames"])
                         print("| %s | %s | %s | %d | %d | %.1f |" % (query, scene, rule, len(doc["frames"]),
                                                                     localized, least_nfa(doc["frames"])),

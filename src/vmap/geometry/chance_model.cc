@@ -13,6 +13,9 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 // Distances below this are float rounding of the coordinates (pixel coordinates near 1000 are exact to about
 // 1e-4 px), not a tighter fit: counted as this, so that a perfect fit gives a finite, very low NFA.
 constexpr double kLeastDistance = 1e-4;
+// Random pairings of a pair's points that measure alpha on them (all of them when there are fewer): enough
+// for a share of 1e-3 to be known within about 20 %.
+constexpr long kRandomPairs = 20000;
 
 double Log10Binomial(int n, int k) {
   return (std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0)) / std::log(10.0);
@@ -55,6 +58,35 @@ ChanceOfMatches ChanceOfFundamental(const cv::Matx33d& F, const std::vector<cv::
   std::vector<double> distances(n);
   for (int i = 0; i < n; ++i) distances[i] = EpipolarDistance(F, points0[i], points1[i]);
   std::sort(distances.begin(), distances.end());
+  // Real unrelated images do not spread their matched points uniformly: they cluster where the texture is, and
+  // an F whose epipoles sit in such clusters puts every clustered point near its line. So alpha(e) is also
+  // measured on the pair's own points, paired at random (the frame point of one match with the key point of
+  // another: what the null hypothesis says a match is), and the larger of the two probabilities is used.
+  std::vector<double> shuffled;
+  {
+    const long all_pairs = static_cast<long>(n) * (n - 1);
+    const int count = static_cast<int>(std::min<long>(all_pairs, kRandomPairs));
+    shuffled.reserve(count);
+    cv::RNG rng(0x5eed);  // deterministic: the same pair always gives the same score
+    for (int s = 0; s < count; ++s) {
+      int i, j;
+      if (all_pairs <= kRandomPairs) {
+        i = s / (n - 1);
+        j = s % (n - 1);
+        j += j >= i;
+      } else {
+        i = rng.uniform(0, n);
+        j = rng.uniform(0, n - 1);
+        j += j >= i;
+      }
+      shuffled.push_back(EpipolarDistance(F, points0[i], points1[j]));
+    }
+    std::sort(shuffled.begin(), shuffled.end());
+  }
+  auto shuffled_share = [&](double e) {
+    return static_cast<double>(std::upper_bound(shuffled.begin(), shuffled.end(), e) - shuffled.begin()) /
+           static_cast<double>(shuffled.size());
+  };
   // The k nearest for every k: C(n, k) and C(k, 7) updated from k to k + 1 rather than recomputed.
   const double tests = std::log10(std::max(num_hypotheses, 1.0) * kModelsPerSample * (n - kSampleSize));
   double log_n_choose_k = Log10Binomial(n, kSampleSize + 1);
@@ -66,7 +98,8 @@ ChanceOfMatches ChanceOfFundamental(const cv::Matx33d& F, const std::vector<cv::
     }
     const double e = std::max(distances[k - 1], kLeastDistance);
     if (!std::isfinite(e)) break;
-    const double alpha = std::min(RandomInlierProbability(e, size0), RandomInlierProbability(e, size1));
+    const double alpha = std::max(std::min(RandomInlierProbability(e, size0), RandomInlierProbability(e, size1)),
+                                  shuffled_share(e));
     if (alpha >= 1.0) break;  // every match explained: nothing is unlikely any more
     const double log10_nfa = tests + log_n_choose_k + log_k_choose_7 + (k - kSampleSize) * std::log10(alpha);
     if (log10_nfa < best.log10_nfa) best = {log10_nfa, k, e};
