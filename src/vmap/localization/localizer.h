@@ -17,8 +17,8 @@
 //   none of them is relocalized at once (the robot may have turned back or skipped ahead); when that fails
 //   too it is lost and the estimate is kept, and after `max_lost_frames` lost frames in a row it is dropped.
 //
-// "Better match" is measured by the verified matches (inliers of F) and S, as in the map; "verified" by how
-// unlikely those matches are by chance (acceptance.h).
+// "Better match" is measured by the verified matches (inliers of F) and S, as in the map; "verified" by the
+// acceptance rule (acceptance.h: counts of verified matches and S, or how unlikely they are by chance).
 
 #include <limits>
 #include <memory>
@@ -44,13 +44,15 @@ namespace vmap {
 
 struct LocalizerOptions {
   // When a comparison accepts the frame at a key image (acceptance.h, docs/localization-acceptance.md).
+  // kCounts (default): at least `min_verified` verified matches and S >= `min_similarity` (S as the map defines
+  // it), whatever the matcher and image size.
   // kChance: matching and verification succeed and the verified set is unlikely by chance, log10 of its number
-  // of false alarms (every comparison a frame can make counted as a test) at most `max_log10_nfa`: 0 (default)
-  // accepts what chance would explain less than once over all the comparisons of a frame.
-  AcceptanceRule acceptance = AcceptanceRule::kChance;
+  // of false alarms (every comparison a frame can make counted as a test) at most `max_log10_nfa` (0: what
+  // chance would explain less than once over all the comparisons of a frame). Not the default: it says "the
+  // same scene", and on redkitchen's teach/repeat test tracking then held on to key images of the same room
+  // taken too far away (147 frames wrong against 8; docs/localization-acceptance.md).
+  AcceptanceRule acceptance = AcceptanceRule::kCounts;
   double max_log10_nfa = 0.0;
-  // kCounts only (the earlier rule): at least `min_verified` verified matches and S >= `min_similarity`
-  // (S as the map defines it), whatever the matcher and image size.
   int min_verified = 20;
   double min_similarity = 0.3;
   // Key images compared beyond `next_key` when the frame has passed it (1 or 2: the issue's "next one or two").

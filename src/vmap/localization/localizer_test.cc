@@ -227,10 +227,10 @@ TEST(Localizer, AFrameThatShowsLittleOfTheSceneIsStillLocalizedByItsChance) {
   // The earlier rule (S >= 0.3) loses frames that keep a few dozen verified matches among many chance ones;
   // the chance of those verified matches says they see the scene.
   const LocalizationMap& m = Map().opened;
-  LocalizerOptions chance = MapLocalizerOptions(m.map);
-  ASSERT_EQ(chance.acceptance, AcceptanceRule::kChance) << "the default";
-  LocalizerOptions counts = chance;
-  counts.acceptance = AcceptanceRule::kCounts;
+  LocalizerOptions counts = MapLocalizerOptions(m.map);
+  ASSERT_EQ(counts.acceptance, AcceptanceRule::kCounts) << "the default";
+  LocalizerOptions chance = counts;
+  chance.acceptance = AcceptanceRule::kChance;
   const std::vector<LocalizationResult> by_chance = LocalizeAll(chance, MostlyHidden(0.35), Indices(1, 2));
   const std::vector<LocalizationResult> by_counts = LocalizeAll(counts, MostlyHidden(0.35), Indices(1, 2));
   ASSERT_EQ(by_chance.size(), 30u);
@@ -269,8 +269,10 @@ TEST(Localizer, ASceneOfOtherTexturesIsNeverAccepted) {
     frames.push_back(elsewhere.frames[i]);
     indices.push_back(i);
   }
+  LocalizerOptions chance = MapLocalizerOptions(Map().opened.map);
+  chance.acceptance = AcceptanceRule::kChance;
   int candidates = 0;
-  for (const LocalizationResult& r : LocalizeAll(MapLocalizerOptions(Map().opened.map), frames, indices)) {
+  for (const LocalizationResult& r : LocalizeAll(chance, frames, indices)) {
     EXPECT_EQ(r.status, LocalizationStatus::kLost) << "frame " << r.source_index << " at key " << r.key;
     for (const RelocalizationCandidate& c : r.candidates) {
       EXPECT_FALSE(c.accepted);
