@@ -1,6 +1,7 @@
 // Localization measured against truth (docs/measurements/localization.md): the bracket test and the ranking recall.
 //
 //   localize_accuracy SEQUENCE [--last N] [--tau T] [--ranking auto|votes|thumbnails] [--candidates K]
+//                     [--acceptance chance,counts]
 //
 // Builds a map of the even frames of SEQUENCE (`vmap build --stride 2`, default options) in a temporary
 // folder and localizes the odd frames against it:
@@ -10,6 +11,8 @@
 //    relocalization, and the recall of both rankings (a bracketing key image among the first 1 / K ranked);
 //  - progress: where the estimate is the bracketing segment, the mean absolute difference between the
 //    estimated progress and the frame's position between the two key images in input frames.
+// With several acceptance rules (--acceptance, comma-separated; default chance), the map is built once and each
+// measurement runs once per rule, one after the other, so the rules compare side by side.
 // Every figure comes from one run, so they compare; the machine's load changes the times.
 
 #include <unistd.h>
@@ -58,59 +61,21 @@ bool Brackets(const VisualMap& map, int source_index, int key) {
   return key >= 0 && (key == before || key == after);
 }
 
-}  // namespace
+// "chance,counts" -> the rules, in order.
+std::vector<AcceptanceRule> ParseAcceptanceRules(const std::string& list) {
+  std::vector<AcceptanceRule> rules;
+  for (size_t start = 0; start <= list.size();) {
+    const size_t comma = std::min(list.find(',', start), list.size());
+    rules.push_back(ParseAcceptanceRule(list.substr(start, comma - start)));
+    start = comma + 1;
+  }
+  return rules;
+}
 
-int main(int argc, char** argv) {
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: localize_accuracy SEQUENCE [--last N] [--tau T] [--ranking R] [--candidates K]\n");
-    return 2;
-  }
-  const std::string input = argv[1];
-  int last = -1, candidates = 5, lookahead = 2;
-  bool step_back = true, streaming_only = false;
-  double tau = 0.5;
-  std::string ranking = "auto";
-  for (int i = 2; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--last")) last = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--tau")) tau = std::atof(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--ranking")) ranking = argv[i + 1];
-    else if (!std::strcmp(argv[i], "--candidates")) candidates = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--lookahead")) lookahead = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--no-step-back")) step_back = false, --i;
-    else if (!std::strcmp(argv[i], "--streaming-only")) streaming_only = true, --i;
-  }
-  vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
-  const fs::path map_directory = fs::temp_directory_path() / ("vmap_localize_accuracy_" + std::to_string(getpid()));
-  fs::remove_all(map_directory);
-  fs::create_directories(map_directory);
-
-  // The map: even frames.
-  const auto matcher = CreateMatcher({});
-  MapBuilderOptions build_options;
-  build_options.key_images.tau = tau;
-  build_options.show_progress = false;
-  FrameSourceOptions even;
-  even.stride = 2;
-  even.last = last;
-  {
-    auto source = OpenFrameSource(input, even);
-    const VisualMap built = BuildMap(*source, *matcher, build_options, map_directory,
-                                     MapOptionsJson(*matcher, build_options));
-    WriteMapFiles(built, map_directory);
-  }
-  LocalizationMap opened = OpenLocalizationMap(map_directory, {});
+// The streaming and relocalization measurements with one set of localizer options.
+void Measure(const std::string& input, const LocalizationMap& opened, const LocalizerOptions& options,
+             const FrameSourceOptions& odd, int candidates, bool streaming_only) {
   const VisualMap& map = opened.map;
-  std::printf("%s: map of %d even frames, %zu key images (tau %.2f)\n", input.c_str(), map.num_frames,
-              map.key_images.size(), tau);
-
-  LocalizerOptions options = MapLocalizerOptions(map);
-  options.ranking.method = ParseRankingMethod(ranking);
-  options.relocalization_candidates = candidates;
-  options.lookahead = lookahead;
-  options.step_back = step_back;
-  FrameSourceOptions odd = even;
-  odd.first = 1;
-
   // 1. Streaming.
   {
     Localizer localizer(map, opened.keys, *opened.matcher, options);
@@ -195,6 +160,69 @@ int main(int argc, char** argv) {
                   names[m], 100.0 * top1[m] / frames, candidates, 100.0 * topk[m] / frames,
                   1000 * rank_seconds[m] / frames);
     }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: localize_accuracy SEQUENCE [--last N] [--tau T] [--ranking R] [--candidates K] "
+                 "[--acceptance chance,counts]\n");
+    return 2;
+  }
+  const std::string input = argv[1];
+  int last = -1, candidates = 5, lookahead = 2;
+  bool step_back = true, streaming_only = false;
+  double tau = 0.5;
+  std::string ranking = "auto";
+  std::vector<AcceptanceRule> rules;
+  for (int i = 2; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--last")) last = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--tau")) tau = std::atof(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--ranking")) ranking = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--candidates")) candidates = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--acceptance")) rules = ParseAcceptanceRules(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--lookahead")) lookahead = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--no-step-back")) step_back = false, --i;
+    else if (!std::strcmp(argv[i], "--streaming-only")) streaming_only = true, --i;
+  }
+  vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
+  const fs::path map_directory = fs::temp_directory_path() / ("vmap_localize_accuracy_" + std::to_string(getpid()));
+  fs::remove_all(map_directory);
+  fs::create_directories(map_directory);
+
+  // The map: even frames.
+  const auto matcher = CreateMatcher({});
+  MapBuilderOptions build_options;
+  build_options.key_images.tau = tau;
+  build_options.show_progress = false;
+  FrameSourceOptions even;
+  even.stride = 2;
+  even.last = last;
+  {
+    auto source = OpenFrameSource(input, even);
+    const VisualMap built = BuildMap(*source, *matcher, build_options, map_directory,
+                                     MapOptionsJson(*matcher, build_options));
+    WriteMapFiles(built, map_directory);
+  }
+  LocalizationMap opened = OpenLocalizationMap(map_directory, {});
+  const VisualMap& map = opened.map;
+  std::printf("%s: map of %d even frames, %zu key images (tau %.2f)\n", input.c_str(), map.num_frames,
+              map.key_images.size(), tau);
+
+  if (rules.empty()) rules.push_back(AcceptanceRule::kChance);
+  FrameSourceOptions odd = even;
+  odd.first = 1;
+  for (const AcceptanceRule rule : rules) {
+    std::printf("--- acceptance %s\n", AcceptanceRuleName(rule).c_str());
+    LocalizerOptions options = MapLocalizerOptions(map);
+    options.acceptance = rule;
+    options.ranking.method = ParseRankingMethod(ranking);
+    options.relocalization_candidates = candidates;
+    options.lookahead = lookahead;
+    options.step_back = step_back;
+    Measure(input, opened, options, odd, candidates, streaming_only);
   }
   fs::remove_all(map_directory);
   return 0;

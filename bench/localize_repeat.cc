@@ -1,14 +1,16 @@
 // A teach run and a repeat run of one place, judged with ground truth (docs/measurements/localization.md).
 //
 //   localize_repeat TUM_SEQUENCE --teach FIRST:LAST --repeat FIRST:LAST [--stride N]
-//                   [--max-distance M] [--max-angle DEG]
+//                   [--max-distance M] [--max-angle DEG] [--acceptance chance,counts]
 //
 // Builds a map of the teach frames (default options) and localizes the repeat frames against it. The
 // sequence's groundtruth.txt (TUM: timestamp tx ty tz qx qy qz qw, camera to world) judges each repeat frame:
 //  - it is coverable when some key image was taken within --max-distance metres (default 0.5) with a viewing
 //    direction within --max-angle degrees (default 30) of it;
 //  - a localized frame is right when its key image or the next one is within those bounds, wrong otherwise.
-// Prints the counts, and the stretches of repeat frames that were lost although coverable.
+// Prints the counts, and the stretches of repeat frames that were lost although coverable. With several
+// acceptance rules (comma-separated; default chance) the map is built once and the repeat run localized once
+// per rule, one after the other.
 
 #include <unistd.h>
 
@@ -77,61 +79,11 @@ std::pair<int, int> Range(const char* text) {
   return {first, last};
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: localize_repeat TUM_SEQUENCE --teach A:B --repeat C:D [--stride N]\n");
-    return 2;
-  }
-  const fs::path sequence = argv[1];
-  std::pair<int, int> teach{0, 499}, repeat{500, 999};
-  int stride = 1;
-  double max_distance = 0.5, max_angle = 30.0;
-  std::string ranking = "auto";
-  int descriptors = RankingOptions().max_descriptors_per_key, candidates = LocalizerOptions().relocalization_candidates;
-  for (int i = 2; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--teach")) teach = Range(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--repeat")) repeat = Range(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--stride")) stride = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--max-distance")) max_distance = std::atof(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--max-angle")) max_angle = std::atof(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--ranking")) ranking = argv[i + 1];
-    else if (!std::strcmp(argv[i], "--descriptors")) descriptors = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--candidates")) candidates = std::atoi(argv[i + 1]);
-  }
-  vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
-  const auto poses = ReadGroundTruth(sequence / "groundtruth.txt");
-  if (poses.empty()) {
-    std::fprintf(stderr, "localize_repeat: no poses in %s\n", (sequence / "groundtruth.txt").c_str());
-    return 2;
-  }
-  const fs::path map_directory = fs::temp_directory_path() / ("vmap_localize_repeat_" + std::to_string(getpid()));
-  fs::remove_all(map_directory);
-  fs::create_directories(map_directory);
-  {
-    const auto matcher = CreateMatcher({});
-    MapBuilderOptions options;
-    options.show_progress = false;
-    FrameSourceOptions source_options;
-    source_options.first = teach.first;
-    source_options.last = teach.second;
-    auto source = OpenFrameSource(sequence.string(), source_options);
-    nlohmann::json doc;
-    doc["matcher"] = nlohmann::json::parse(matcher->DescribeOptionsJson());
-    const VisualMap built = BuildMap(*source, *matcher, options, map_directory, doc.dump());
-    WriteMapFiles(built, map_directory);
-  }
-  LocalizationMap opened = OpenLocalizationMap(map_directory, {});
+// Localizes the repeat frames with `localizer_options` and prints what the ground truth says of them.
+void Judge(const fs::path& sequence, const LocalizationMap& opened, const LocalizerOptions& localizer_options,
+           std::pair<int, int> repeat, int stride, const std::map<double, Pose>& poses, double max_distance,
+           double max_angle) {
   const VisualMap& map = opened.map;
-  std::printf("teach frames %d-%d: %zu key images; repeat frames %d-%d (stride %d); near = within %.2f m and %.0f deg\n",
-              teach.first, teach.second, map.key_images.size(), repeat.first, repeat.second, stride, max_distance,
-              max_angle);
-
-  LocalizerOptions localizer_options = MapLocalizerOptions(map);
-  localizer_options.ranking.method = ParseRankingMethod(ranking);
-  localizer_options.ranking.max_descriptors_per_key = descriptors;
-  localizer_options.relocalization_candidates = candidates;
   Localizer localizer(map, opened.keys, *opened.matcher, localizer_options);
   FrameSourceOptions repeat_options;
   repeat_options.first = repeat.first;
@@ -190,6 +142,83 @@ int main(int argc, char** argv) {
               lost_tracking, lost_coverable - lost_tracking, ranked_near, lost_coverable - lost_tracking - ranked_near);
   for (const auto& [a, b] : lost_stretches) std::printf("  lost though coverable: frames %d-%d\n", a, b);
   for (const std::string& w : wrongs) std::printf("  wrong: %s\n", w.c_str());
+}
+
+// "chance,counts" -> the rules, in order.
+std::vector<AcceptanceRule> ParseAcceptanceRules(const std::string& list) {
+  std::vector<AcceptanceRule> rules;
+  for (size_t start = 0; start <= list.size();) {
+    const size_t comma = std::min(list.find(',', start), list.size());
+    rules.push_back(ParseAcceptanceRule(list.substr(start, comma - start)));
+    start = comma + 1;
+  }
+  return rules;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: localize_repeat TUM_SEQUENCE --teach A:B --repeat C:D [--stride N] "
+                 "[--acceptance chance,counts]\n");
+    return 2;
+  }
+  const fs::path sequence = argv[1];
+  std::pair<int, int> teach{0, 499}, repeat{500, 999};
+  int stride = 1;
+  double max_distance = 0.5, max_angle = 30.0;
+  std::string ranking = "auto";
+  std::vector<AcceptanceRule> rules;
+  int descriptors = RankingOptions().max_descriptors_per_key, candidates = LocalizerOptions().relocalization_candidates;
+  for (int i = 2; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--teach")) teach = Range(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--repeat")) repeat = Range(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--stride")) stride = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--max-distance")) max_distance = std::atof(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--max-angle")) max_angle = std::atof(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--ranking")) ranking = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--descriptors")) descriptors = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--candidates")) candidates = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--acceptance")) rules = ParseAcceptanceRules(argv[i + 1]);
+  }
+  vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
+  const auto poses = ReadGroundTruth(sequence / "groundtruth.txt");
+  if (poses.empty()) {
+    std::fprintf(stderr, "localize_repeat: no poses in %s\n", (sequence / "groundtruth.txt").c_str());
+    return 2;
+  }
+  const fs::path map_directory = fs::temp_directory_path() / ("vmap_localize_repeat_" + std::to_string(getpid()));
+  fs::remove_all(map_directory);
+  fs::create_directories(map_directory);
+  {
+    const auto matcher = CreateMatcher({});
+    MapBuilderOptions options;
+    options.show_progress = false;
+    FrameSourceOptions source_options;
+    source_options.first = teach.first;
+    source_options.last = teach.second;
+    auto source = OpenFrameSource(sequence.string(), source_options);
+    nlohmann::json doc;
+    doc["matcher"] = nlohmann::json::parse(matcher->DescribeOptionsJson());
+    const VisualMap built = BuildMap(*source, *matcher, options, map_directory, doc.dump());
+    WriteMapFiles(built, map_directory);
+  }
+  LocalizationMap opened = OpenLocalizationMap(map_directory, {});
+  const VisualMap& map = opened.map;
+  std::printf("teach frames %d-%d: %zu key images; repeat frames %d-%d (stride %d); near = within %.2f m and %.0f deg\n",
+              teach.first, teach.second, map.key_images.size(), repeat.first, repeat.second, stride, max_distance,
+              max_angle);
+
+  if (rules.empty()) rules.push_back(AcceptanceRule::kChance);
+  for (const AcceptanceRule rule : rules) {
+    std::printf("--- acceptance %s\n", AcceptanceRuleName(rule).c_str());
+    LocalizerOptions localizer_options = MapLocalizerOptions(map);
+    localizer_options.acceptance = rule;
+    localizer_options.ranking.method = ParseRankingMethod(ranking);
+    localizer_options.ranking.max_descriptors_per_key = descriptors;
+    localizer_options.relocalization_candidates = candidates;
+    Judge(sequence, opened, localizer_options, repeat, stride, poses, max_distance, max_angle);
+  }
   fs::remove_all(map_directory);
   return 0;
 }

@@ -8,14 +8,23 @@ namespace vmap::cli {
 
 void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& option_flags) {
   LocalizerOptions& o = flags.localizer;
+  option_flags.AddEnumOption(command, "--acceptance", o.acceptance, ParseAcceptanceRule, AcceptanceRuleName,
+                             "acceptance",
+                             "When a frame is seen at a key image: chance (its verified matches are unlikely by "
+                             "chance, --max-log10-nfa) or counts (--min-verified and --min-similarity)");
   option_flags
-      .AddOption(command, "--min-verified", o.min_verified, "min_verified",
-                 "Verified matches a frame needs to be localized at a key image")
+      .AddOption(command, "--max-log10-nfa", o.max_log10_nfa, "max_log10_nfa",
+                 "--acceptance chance: accept when log10 of the number of false alarms is at most this")
       ->capture_default_str();
-  option_flags
-      .AddOption(command, "--min-similarity", o.min_similarity, "min_similarity",
-                 "S a frame needs to be localized at a key image")
-      ->capture_default_str();
+  flags.counts_flags.push_back(
+      option_flags
+          .AddOption(command, "--min-verified", o.min_verified, "min_verified",
+                     "--acceptance counts: verified matches a frame needs to be localized at a key image")
+          ->capture_default_str());
+  flags.counts_flags.push_back(option_flags
+                                   .AddOption(command, "--min-similarity", o.min_similarity, "min_similarity",
+                                              "--acceptance counts: S a frame needs to be localized at a key image")
+                                   ->capture_default_str());
   option_flags
       .AddOption(command, "--max-lost", o.max_lost_frames, "max_lost_frames",
                  "Lost frames in a row before the estimate is dropped")

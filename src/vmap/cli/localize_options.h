@@ -2,6 +2,8 @@
 // The localizer's options of `vmap localize` (and of the Python module's vmap.Localizer / vmap.localize, which
 // take them by the same names).
 
+#include <vector>
+
 #include <CLI/CLI.hpp>
 
 #include "vmap/cli/option_flags.h"
@@ -15,9 +17,11 @@ struct LocalizerFlags {
   int to = -1;       // --to: its last; -1 = the last
   int threads = 0;   // LocalizeSequenceOptions::extraction_threads
   bool cache = true; // the key-image cache in the map directory
+  // --min-verified and --min-similarity: they belong to --acceptance counts alone, and are refused with chance.
+  std::vector<const CLI::Option*> counts_flags;
 };
 
-// --min-verified, --min-similarity, --max-lost, --candidates, --lookahead, --no-step-back, --ranking, the heading's options, --from, --to,
+// --acceptance, --max-log10-nfa, --min-verified, --min-similarity, --max-lost, --candidates, --lookahead, --no-step-back, --ranking, the heading's options, --from, --to,
 // --threads, --no-cache; fields as LocalizerOptions names them.
 void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& option_flags);
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -66,7 +67,9 @@ json PoseJson(const RelativePose& pose) {
 }  // namespace
 
 std::string DescribeLocalizerOptions(const LocalizerOptions& options) {
-  json doc = {{"min_verified", options.min_verified},
+  json doc = {{"acceptance", AcceptanceRuleName(options.acceptance)},
+              {"max_log10_nfa", options.max_log10_nfa},
+              {"min_verified", options.min_verified},
               {"min_similarity", options.min_similarity},
               {"lookahead", options.lookahead},
               {"step_back", options.step_back},
@@ -100,7 +103,8 @@ std::string LocalizationCsvHeader() {
          "tentative,next_similarity,next_verified,next_tentative,heading_px,progress,comparisons,seconds,"
          "F00,F01,F02,F10,F11,F12,F20,F21,F22,heading_deg,R00,R01,R02,R10,R11,R12,R20,R21,R22,tx,ty,tz,"
          "heading_confidence,heading_key_px,heading_key_deg,heading_key_confidence,"
-         "translation_sigma_deg,translation_known,guidance\n";
+         "translation_sigma_deg,translation_known,guidance,"
+         "log10_nfa,next_log10_nfa\n";
 }
 
 std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r) {
@@ -124,6 +128,7 @@ std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r
   const KeyComparison& target = r.next_key >= 0 ? r.to_next : r.to_key;
   row += ',' + (pose.valid ? CsvNumber(target.translation_sigma_deg) : std::string());
   row += fmt::format(",{},{}", r.translation_known ? 1 : 0, LocalizationGuidance(r));
+  row += ',' + CsvNumber(r.to_key.log10_nfa) + ',' + CsvNumber(r.to_next.log10_nfa);
   return row + "\n";
 }
 
@@ -136,7 +141,8 @@ nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationRes
   json candidates = json::array();
   for (const RelocalizationCandidate& c : r.candidates) {
     candidates.push_back({{"key", c.key}, {"score", c.score}, {"accepted", c.accepted},
-                          {"similarity", c.similarity}, {"verified", c.num_verified}});
+                          {"similarity", c.similarity}, {"verified", c.num_verified},
+                          {"log10_nfa", Number(c.log10_nfa)}});
   }
   return {{"frame", r.frame_index},
           {"source_index", r.source_index},
@@ -153,6 +159,8 @@ nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationRes
           {"next_similarity", r.to_next.key >= 0 ? Number(r.to_next.similarity) : json(nullptr)},
           {"next_verified", r.to_next.num_verified},
           {"next_tentative", r.to_next.num_tentative},
+          {"log10_nfa", Number(r.to_key.log10_nfa)},
+          {"next_log10_nfa", Number(r.to_next.log10_nfa)},
           {"heading_px", Number(r.heading_px)},
           {"heading_deg", Number(r.heading_deg)},
           {"heading_confidence", Number(TargetConfidence(r))},
@@ -283,6 +291,8 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
       r.to_next.similarity = NumberOr(f, "next_similarity", 0.0);
       r.to_next.num_verified = f.value("next_verified", 0);
       r.to_next.num_tentative = f.value("next_tentative", 0);
+      r.to_key.log10_nfa = NumberOr(f, "log10_nfa", std::numeric_limits<double>::infinity());
+      r.to_next.log10_nfa = NumberOr(f, "next_log10_nfa", std::numeric_limits<double>::infinity());
       if (f.contains("F") && f["F"].is_array() && f["F"].size() == 9) {
         r.to_next.matched = true;
         for (int i = 0; i < 9; ++i) r.to_next.F(i / 3, i % 3) = f["F"][i].get<double>();
@@ -295,7 +305,8 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
       if (f.contains("candidates") && f["candidates"].is_array()) {
         for (const json& c : f["candidates"]) {
           r.candidates.push_back({c.value("key", -1), c.value("score", 0.0), c.value("accepted", false),
-                                  c.value("similarity", 0.0), c.value("verified", 0)});
+                                  c.value("similarity", 0.0), c.value("verified", 0),
+                                  NumberOr(c, "log10_nfa", std::numeric_limits<double>::infinity())});
         }
       }
       r.comparisons = f.value("comparisons", 0);

@@ -10,7 +10,9 @@
 // target key image (next_key, or key at the route's end) relative to the frame, X_key = R X_frame + t with
 // |t| = 1 (CSV R00..R22, tx, ty, tz; JSON "pose": {"R": row-major, "t"}). Then heading_confidence (of
 // heading_px's estimate) and the heading against `key`: heading_key_px, heading_key_deg, heading_key_confidence
-// (geometry/heading.h). Unknown numbers are empty in CSV and null in JSON.
+// (geometry/heading.h); translation_sigma_deg, translation_known and guidance; log10_nfa and next_log10_nfa,
+// how unlikely the verified matches with `key` and `next_key` are by chance (KeyComparison::log10_nfa).
+// Unknown numbers are empty in CSV and null in JSON.
 
 #include <cstdint>
 #include <filesystem>

@@ -45,9 +45,9 @@ LocalizationRun SampleRun() {
   const HeadingEstimate to_key_heading{HeadingMethod::kDisplacementMode, 1.5, no_bearing, 30, 200, 0.15};
   const HeadingEstimate to_next_heading{HeadingMethod::kDisplacementMode, -2.0, -0.25, 40, 100, 0.4};
   tracked.to_key = {0, true, true, 0.75, 200, 150, cv::Matx33d::zeros(), to_key_heading, RelativePose{},
-                    no_bearing, false};
+                    no_bearing, false, -42.5};
   tracked.to_next = {1, true, true, 0.5, 100, 50, cv::Matx33d(1, 2, 3, 4, 5, 6, 7, 8, 9), to_next_heading,
-                     RelativePose{}, 2.5, true};
+                     RelativePose{}, 2.5, true, -3.25};
   tracked.translation_known = true;
   tracked.heading_px = -2.0;
   tracked.heading_deg = -0.25;
@@ -56,7 +56,7 @@ LocalizationRun SampleRun() {
   tracked.to_next.pose.R = cv::Matx33d(0, -1, 0, 1, 0, 0, 0, 0, 1);
   tracked.to_next.pose.t = cv::Vec3d(0.6, 0, 0.8);
   tracked.progress = 0.25;
-  tracked.candidates = {{0, 120.0, true, 0.75, 150}, {1, 80.0, true, 0.5, 50}};
+  tracked.candidates = {{0, 120.0, true, 0.75, 150, -42.5}, {1, 80.0, true, 0.5, 50, -3.25}};
   LocalizationResult lost;
   lost.frame_index = 1;
   lost.source_index = 4;
@@ -87,7 +87,8 @@ TEST(LocalizationOutput, CsvHasTheNamedColumnsAndOneRowPerFrame) {
                              "next_similarity", "next_verified", "heading_px", "progress", "F00", "F22",
                              "heading_deg", "R00", "R22", "tx", "tz", "heading_confidence", "heading_key_px",
                              "heading_key_deg", "heading_key_confidence", "translation_sigma_deg",
-                             "translation_known", "guidance"}) {
+                             "translation_known", "guidance", "log10_nfa",
+                             "next_log10_nfa"}) {
     EXPECT_NE(("," + header + ",").find(std::string(",") + column + ","), std::string::npos) << column;
   }
   auto count = [](const std::string& s) { return std::count(s.begin(), s.end(), ','); };
@@ -96,7 +97,7 @@ TEST(LocalizationOutput, CsvHasTheNamedColumnsAndOneRowPerFrame) {
   EXPECT_EQ(row0.rfind("0,3,0.100000,frame_000003,relocalized,0,1,0,40,0.75,150,200,0.5,50,100,-2,0.25,", 0), 0u)
       << row0;
   EXPECT_NE(row0.find(",1,2,3,4,5,6,7,8,9,-0.25,0,-1,0,1,0,0,0,0,1,0.6,0,0.8,0.4,1.5,,0.15,2.5,1,heading and "
-                      "translation"),
+                      "translation,-42.5,-3.25"),
             std::string::npos)
       << row0;
   // Unknown values are empty, not "nan".
@@ -148,6 +149,10 @@ TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
   EXPECT_DOUBLE_EQ(r.heading_key_px, 1.5);
   ASSERT_EQ(r.candidates.size(), 2u);
   EXPECT_EQ(r.candidates[1].num_verified, 50);
+  EXPECT_DOUBLE_EQ(r.candidates[1].log10_nfa, -3.25);
+  EXPECT_DOUBLE_EQ(r.to_key.log10_nfa, -42.5);
+  EXPECT_DOUBLE_EQ(r.to_next.log10_nfa, -3.25);
+  EXPECT_TRUE(doc["frames"][1]["log10_nfa"].is_null()) << "a lost frame compared with nothing";
   EXPECT_EQ(back.frames[1].status, LocalizationStatus::kLost);
   EXPECT_TRUE(std::isnan(back.frames[1].heading_px));
 }

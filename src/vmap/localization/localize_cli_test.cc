@@ -121,17 +121,25 @@ TEST(LocalizeCli, ADifferentSceneDoesNotLocalize) {
   ::vmap::testing::ScopedTempDir tmp;
   std::string out;
   const fs::path json = tmp.path() / "desk.json";
-  ASSERT_EQ(RunVmap("localize " + Quote(LabMap()) + " " + Quote(Shared() / "data/lab_floor/desk.mp4") +
-                        " --last 59 --stride 3 -q --json " + Quote(json),
-                    &out),
-            0)
-      << out;
-  const auto doc = nlohmann::json::parse(std::ifstream(json));
-  EXPECT_EQ(doc["summary"]["frames"], 20);
-  EXPECT_EQ(doc["summary"]["lost"], 20);
-  for (const auto& frame : doc["frames"]) {
-    EXPECT_EQ(frame["key"], -1);
-    EXPECT_EQ(frame["candidates"].size(), 5u) << "every lost frame verified the best-ranked key images";
+  // By either acceptance rule: the default (counts) and chance.
+  for (const std::string rule : {"counts", "chance"}) {
+    ASSERT_EQ(RunVmap("localize " + Quote(LabMap()) + " " + Quote(Shared() / "data/lab_floor/desk.mp4") +
+                          " --last 59 --stride 3 -q --acceptance " + rule + " --json " + Quote(json),
+                      &out),
+              0)
+        << out;
+    const auto doc = nlohmann::json::parse(std::ifstream(json));
+    EXPECT_EQ(doc["summary"]["frames"], 20);
+    EXPECT_EQ(doc["summary"]["lost"], 20);
+    for (const auto& frame : doc["frames"]) {
+      EXPECT_EQ(frame["key"], -1);
+      EXPECT_EQ(frame["candidates"].size(), 5u) << "every lost frame verified the best-ranked key images";
+      for (const auto& candidate : frame["candidates"]) {
+        // Unmatched (null), or matched with a verified set that chance explains.
+        if (!candidate["log10_nfa"].is_null()) EXPECT_GT(candidate["log10_nfa"].get<double>(), 0.0) << candidate;
+      }
+    }
+    EXPECT_EQ(doc["options"]["acceptance"], rule);
   }
 }
 
@@ -228,6 +236,10 @@ TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
       {localize + "--max-lost -1", "--max-lost -1 must be 0 to 1000000"},
       {localize + "--lookahead 3", "lookahead 3 is not 1 or 2"},
       {localize + "--ranking bow", "unknown ranking 'bow'"},
+      {localize + "--acceptance bow", "unknown acceptance rule 'bow'"},
+      {localize + "--max-log10-nfa nan", "--max-log10-nfa nan is outside"},
+      {localize + "--acceptance chance --min-verified 30",
+       "--min-verified belongs to the earlier acceptance rule; add --acceptance counts"},
       {localize + "--to 99", "key image 99 does not exist"},
       {"localize " + Quote(tmp.path() / "m") + " " + Quote(tmp.path() / "missing.mp4"), "does not exist"},
       {"route " + Quote(tmp.path() / "m") + " --min-backward-verified 2", "--min-backward-verified 2 must be 8"},

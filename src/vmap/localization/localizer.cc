@@ -47,6 +47,11 @@ void LocalizerOptions::Check() const {
   if (!(min_similarity >= 0.0 && min_similarity <= 1.0)) {
     throw OptionError("min_similarity", fmt::format("{} is outside [0, 1] (default 0.3)", min_similarity));
   }
+  if (!(max_log10_nfa >= -1000.0 && max_log10_nfa <= 1000.0)) {
+    throw OptionError("max_log10_nfa", fmt::format("{} is outside [-1000, 1000] (default 0: accept what chance "
+                                                   "explains less than once)",
+                                                   max_log10_nfa));
+  }
   if (lookahead < 1 || lookahead > 2) {
     throw OptionError("lookahead", fmt::format("{} is not 1 or 2 (default 2)", lookahead));
   }
@@ -147,7 +152,16 @@ KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
   c.num_tentative = pair.num_tentative;
   c.num_verified = pair.num_verified;
   c.F = pair.F;
-  c.accepted = pair.matched && pair.num_verified >= options_.min_verified && pair.similarity >= options_.min_similarity;
+  // Recorded whatever the rule, so that runs under either compare.
+  if (pair.matched) {
+    c.log10_nfa = ChanceOfComparison(pair, features.image_size(), keys_.features[key]->image_size(),
+                                     ComparisonsPerFrame(options_.lookahead, options_.relocalization_candidates))
+                      .log10_nfa;
+  }
+  c.accepted = pair.matched && (options_.acceptance == AcceptanceRule::kChance
+                                    ? c.log10_nfa <= options_.max_log10_nfa
+                                    : pair.num_verified >= options_.min_verified &&
+                                          pair.similarity >= options_.min_similarity);
   // The heading from every tentative match (verified first, then rejected), key image -> frame.
   std::vector<cv::Point2f> key_points, frame_points;
   key_points.reserve(pair.correspondences.size());
@@ -320,7 +334,8 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
   for (int i = 0; i < count; ++i) {
     const int position = ranked[i].key;  // the ranking holds the route's key images in route order
     const KeyComparison c = CompareOnce(features, route_[position]);
-    result.candidates.push_back({route_[position], ranked[i].score, c.accepted, c.similarity, c.num_verified});
+    result.candidates.push_back(
+        {route_[position], ranked[i].score, c.accepted, c.similarity, c.num_verified, c.log10_nfa});
     if (Better(c, best)) {
       best = c;
       best_position = position;

@@ -17,7 +17,8 @@
 //   none of them is relocalized at once (the robot may have turned back or skipped ahead); when that fails
 //   too it is lost and the estimate is kept, and after `max_lost_frames` lost frames in a row it is dropped.
 //
-// "Better match" and "verified" are measured by the verified matches (inliers of F) and S, as in the map.
+// "Better match" is measured by the verified matches (inliers of F) and S, as in the map; "verified" by the
+// acceptance rule (acceptance.h: counts of verified matches and S, or how unlikely they are by chance).
 
 #include <limits>
 #include <memory>
@@ -33,6 +34,7 @@
 #include "vmap/geometry/fundamental.h"
 #include "vmap/geometry/heading.h"
 #include "vmap/geometry/relative_pose.h"
+#include "vmap/localization/acceptance.h"
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/localization/key_image_store.h"
 #include "vmap/mapping/key_image_selector.h"
@@ -42,8 +44,16 @@
 namespace vmap {
 
 struct LocalizerOptions {
-  // A frame is localized at a key image when matching and verification succeed with at least
-  // `min_verified` verified matches and S >= `min_similarity` (S as the map defines it).
+  // When a comparison accepts the frame at a key image (acceptance.h, docs/localization-acceptance.md).
+  // kCounts (default): at least `min_verified` verified matches and S >= `min_similarity` (S as the map defines
+  // it), whatever the matcher and image size.
+  // kChance: matching and verification succeed and the verified set is unlikely by chance, log10 of its number
+  // of false alarms (every comparison a frame can make counted as a test) at most `max_log10_nfa` (0: what
+  // chance would explain less than once over all the comparisons of a frame). Not the default: it says "the
+  // same scene", and on redkitchen's teach/repeat test tracking then held on to key images of the same room
+  // taken too far away (147 frames wrong against 8; docs/localization-acceptance.md).
+  AcceptanceRule acceptance = AcceptanceRule::kCounts;
+  double max_log10_nfa = 0.0;
   int min_verified = 20;
   double min_similarity = 0.3;
   // Key images compared beyond `next_key` when the frame has passed it (1 or 2: the issue's "next one or two").
@@ -86,7 +96,7 @@ std::string LocalizationStatusName(LocalizationStatus status);  // "tracking", "
 struct KeyComparison {
   int key = -1;             // key-image index in the map; -1: not compared
   bool matched = false;     // matching and verification succeeded
-  bool accepted = false;    // matched, with at least min_verified verified matches and S >= min_similarity
+  bool accepted = false;    // matched, and the acceptance rule holds (LocalizerOptions::acceptance)
   double similarity = 0.0;  // S
   int num_tentative = 0;
   int num_verified = 0;
@@ -102,6 +112,9 @@ struct KeyComparison {
   // NaN without a pose) and whether it is trusted (TranslationKnown with LocalizerOptions::translation).
   double translation_sigma_deg = std::numeric_limits<double>::quiet_NaN();
   bool translation_known = false;
+  // log10 of the number of false alarms of the verified set (ChanceOfComparison): how often chance alone
+  // would explain it over all the comparisons one frame can make. +infinity when !matched.
+  double log10_nfa = std::numeric_limits<double>::infinity();
 };
 
 // A key image the ranking proposed when relocalizing, and how its verification went.
@@ -111,6 +124,7 @@ struct RelocalizationCandidate {
   bool accepted = false;
   double similarity = 0.0;
   int num_verified = 0;
+  double log10_nfa = std::numeric_limits<double>::infinity();  // KeyComparison::log10_nfa
 };
 
 struct LocalizationResult {

@@ -1,6 +1,7 @@
 #include "vmap/localization/localizer.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -193,6 +194,95 @@ TEST(Localizer, AnUnrelatedImageIsLostAndTheEstimateIsDroppedAfterMaxLostFrames)
   EXPECT_TRUE(Brackets(m.map, 33, r.key));
 }
 
+// The drive's odd frames with all but a vertical strip `visible` of the width wide hidden behind noise: little
+// of the scene is left, and the noise adds tentative matches that chance explains, so S is low.
+std::vector<cv::Mat> MostlyHidden(double visible) {
+  std::vector<cv::Mat> frames = Frames(1, 2);
+  cv::RNG rng(17);
+  for (cv::Mat& frame : frames) {
+    cv::Mat noise(frame.size(), frame.type());
+    rng.fill(noise, cv::RNG::UNIFORM, 0, 255);
+    const int first_hidden = static_cast<int>(visible * frame.cols);
+    const cv::Rect covered(first_hidden, 0, frame.cols - first_hidden, frame.rows);
+    frame = frame.clone();
+    noise(covered).copyTo(frame(covered));
+  }
+  return frames;
+}
+
+std::vector<LocalizationResult> LocalizeAll(const LocalizerOptions& options, std::vector<cv::Mat> frames,
+                                            std::vector<int> indices) {
+  const LocalizationMap& m = Map().opened;
+  Localizer localizer(m.map, m.keys, *m.matcher, options);
+  ::vmap::testing::MemorySource source(std::move(frames), std::move(indices));
+  LocalizeSequenceOptions run;
+  run.show_progress = false;
+  std::vector<LocalizationResult> results;
+  LocalizeSequence(source, *m.matcher, localizer, run,
+                   [&](const Frame&, const LocalizationResult& r) { results.push_back(r); });
+  return results;
+}
+
+TEST(Localizer, AFrameThatShowsLittleOfTheSceneIsStillLocalizedByItsChance) {
+  // The earlier rule (S >= 0.3) loses frames that keep a few dozen verified matches among many chance ones;
+  // the chance of those verified matches says they see the scene.
+  const LocalizationMap& m = Map().opened;
+  LocalizerOptions counts = MapLocalizerOptions(m.map);
+  ASSERT_EQ(counts.acceptance, AcceptanceRule::kCounts) << "the default";
+  LocalizerOptions chance = counts;
+  chance.acceptance = AcceptanceRule::kChance;
+  const std::vector<LocalizationResult> by_chance = LocalizeAll(chance, MostlyHidden(0.35), Indices(1, 2));
+  const std::vector<LocalizationResult> by_counts = LocalizeAll(counts, MostlyHidden(0.35), Indices(1, 2));
+  ASSERT_EQ(by_chance.size(), 30u);
+  int chance_localized = 0, bracketed = 0, counts_localized = 0, low_similarity = 0;
+  for (size_t i = 0; i < by_chance.size(); ++i) {
+    const LocalizationResult& r = by_chance[i];
+    counts_localized += by_counts[i].status != LocalizationStatus::kLost;
+    if (r.status == LocalizationStatus::kLost) continue;
+    ++chance_localized;
+    bracketed += Brackets(m.map, r.source_index, r.key);
+    EXPECT_LE(r.to_key.log10_nfa, chance.max_log10_nfa);
+    low_similarity += r.to_key.similarity < counts.min_similarity;
+  }
+  // The visible strip shares the far plane with key images well behind, so a frame may be placed there: it
+  // does see them, but the bracket counts it wrong. Nearly all are at a key image around them.
+  EXPECT_GE(10 * bracketed, 9 * chance_localized);
+  EXPECT_GE(low_similarity, 3) << "frames S would have refused were localized";
+  EXPECT_GT(bracketed, counts_localized) << "the earlier rule gives up on more of them";
+  std::printf("mostly hidden frames localized: %d by chance (%d at a key image around them), %d by counts; %d with "
+              "S < %.1f\n",
+              chance_localized, bracketed, counts_localized, low_similarity, counts.min_similarity);
+}
+
+TEST(Localizer, ASceneOfOtherTexturesIsNeverAccepted) {
+  // The same kind of scene (planes with blobs and boxes, the same drive), other textures: nothing is shared,
+  // though the images look alike and give ORB plenty of tentative matches.
+  ::vmap::testing::SyntheticOptions other;
+  other.num_frames = 60;
+  other.step = 0.05;
+  other.yaw_per_frame = 0.003;
+  other.seed = 8;
+  const auto elsewhere = ::vmap::testing::RenderSyntheticSequence(other);
+  std::vector<cv::Mat> frames;
+  std::vector<int> indices;
+  for (int i = 1; i < other.num_frames; i += 2) {
+    frames.push_back(elsewhere.frames[i]);
+    indices.push_back(i);
+  }
+  LocalizerOptions chance = MapLocalizerOptions(Map().opened.map);
+  chance.acceptance = AcceptanceRule::kChance;
+  int candidates = 0;
+  for (const LocalizationResult& r : LocalizeAll(chance, frames, indices)) {
+    EXPECT_EQ(r.status, LocalizationStatus::kLost) << "frame " << r.source_index << " at key " << r.key;
+    for (const RelocalizationCandidate& c : r.candidates) {
+      EXPECT_FALSE(c.accepted);
+      EXPECT_GT(c.log10_nfa, 0.0);
+      ++candidates;
+    }
+  }
+  EXPECT_GE(candidates, 30) << "every frame was relocalized against the best-ranked key images";
+}
+
 TEST(Localizer, FollowsAReversedRouteWhenTheFramesComeBackwards) {
   const LocalizationMap& m = Map().opened;
   LocalizerOptions options = MapLocalizerOptions(m.map);
@@ -358,6 +448,7 @@ TEST(Localizer, OptionsAreChecked) {
   auto path = [&](auto change) { return testing::OptionErrorPath([&] { with(change).Check(); }); };
   EXPECT_EQ(path([](LocalizerOptions& o) { o.min_verified = 5; }), "min_verified");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.min_similarity = 1.5; }), "min_similarity");
+  EXPECT_EQ(path([](LocalizerOptions& o) { o.max_log10_nfa = std::nan(""); }), "max_log10_nfa");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.lookahead = 3; }), "lookahead");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.max_lost_frames = -1; }), "max_lost_frames");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.relocalization_candidates = 0; }), "relocalization_candidates");

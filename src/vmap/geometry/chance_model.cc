@@ -1,0 +1,110 @@
+#include "vmap/geometry/chance_model.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vmap {
+
+namespace {
+
+constexpr int kSampleSize = 7;            // matches that determine F (the 7-point algorithm)
+constexpr double kModelsPerSample = 3.0;  // real roots of the 7-point algorithm's cubic, at most
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+// Distances below this are float rounding of the coordinates (pixel coordinates near 1000 are exact to about
+// 1e-4 px), not a tighter fit: counted as this, so that a perfect fit gives a finite, very low NFA.
+constexpr double kLeastDistance = 1e-4;
+// Random pairings of a pair's points that measure alpha on them (all of them when there are fewer): enough
+// for a share of 1e-3 to be known within about 20 %.
+constexpr long kRandomPairs = 20000;
+
+double Log10Binomial(int n, int k) {
+  return (std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0)) / std::log(10.0);
+}
+
+// The line's distance from the point, or infinity when the line is undefined (a point at an epipole).
+double LineDistance(const cv::Vec3d& line, const cv::Point2f& p) {
+  const double norm = std::hypot(line[0], line[1]);
+  if (!(norm > 0.0)) return kInfinity;
+  return std::abs(line[0] * p.x + line[1] * p.y + line[2]) / norm;
+}
+
+}  // namespace
+
+double RandomInlierProbability(double distance, cv::Size size) {
+  if (size.width <= 0 || size.height <= 0) return 1.0;
+  const double area = static_cast<double>(size.width) * size.height;
+  return std::min(1.0, 2.0 * distance * std::hypot(size.width, size.height) / area);
+}
+
+double Log10FalseAlarms(int num_matches, int num_inliers, double alpha, double num_hypotheses) {
+  if (num_inliers <= kSampleSize || num_inliers > num_matches) return kInfinity;
+  const double tests = std::log10(std::max(num_hypotheses, 1.0) * kModelsPerSample * (num_matches - kSampleSize));
+  const double chance = alpha > 0.0 ? (num_inliers - kSampleSize) * std::log10(std::min(alpha, 1.0)) : -kInfinity;
+  return tests + Log10Binomial(num_matches, num_inliers) + Log10Binomial(num_inliers, kSampleSize) + chance;
+}
+
+double EpipolarDistance(const cv::Matx33d& F, const cv::Point2f& p0, const cv::Point2f& p1) {
+  const cv::Vec3d x0(p0.x, p0.y, 1.0), x1(p1.x, p1.y, 1.0);
+  return std::max(LineDistance(F * x0, p1), LineDistance(F.t() * x1, p0));
+}
+
+ChanceOfMatches ChanceOfFundamental(const cv::Matx33d& F, const std::vector<cv::Point2f>& points0,
+                                    const std::vector<cv::Point2f>& points1, cv::Size size0, cv::Size size1,
+                                    double num_hypotheses) {
+  CV_Assert(points0.size() == points1.size());
+  ChanceOfMatches best;
+  const int n = static_cast<int>(points0.size());
+  if (n <= kSampleSize) return best;
+  std::vector<double> distances(n);
+  for (int i = 0; i < n; ++i) distances[i] = EpipolarDistance(F, points0[i], points1[i]);
+  std::sort(distances.begin(), distances.end());
+  // Real unrelated images do not spread their matched points uniformly: they cluster where the texture is, and
+  // an F whose epipoles sit in such clusters puts every clustered point near its line. So alpha(e) is also
+  // measured on the pair's own points, paired at random (the frame point of one match with the key point of
+  // another: what the null hypothesis says a match is), and the larger of the two probabilities is used.
+  std::vector<double> shuffled;
+  {
+    const long all_pairs = static_cast<long>(n) * (n - 1);
+    const int count = static_cast<int>(std::min<long>(all_pairs, kRandomPairs));
+    shuffled.reserve(count);
+    cv::RNG rng(0x5eed);  // deterministic: the same pair always gives the same score
+    for (int s = 0; s < count; ++s) {
+      int i, j;
+      if (all_pairs <= kRandomPairs) {
+        i = s / (n - 1);
+        j = s % (n - 1);
+        j += j >= i;
+      } else {
+        i = rng.uniform(0, n);
+        j = rng.uniform(0, n - 1);
+        j += j >= i;
+      }
+      shuffled.push_back(EpipolarDistance(F, points0[i], points1[j]));
+    }
+    std::sort(shuffled.begin(), shuffled.end());
+  }
+  auto shuffled_share = [&](double e) {
+    return static_cast<double>(std::upper_bound(shuffled.begin(), shuffled.end(), e) - shuffled.begin()) /
+           static_cast<double>(shuffled.size());
+  };
+  // The k nearest for every k: C(n, k) and C(k, 7) updated from k to k + 1 rather than recomputed.
+  const double tests = std::log10(std::max(num_hypotheses, 1.0) * kModelsPerSample * (n - kSampleSize));
+  double log_n_choose_k = Log10Binomial(n, kSampleSize + 1);
+  double log_k_choose_7 = Log10Binomial(kSampleSize + 1, kSampleSize);
+  for (int k = kSampleSize + 1; k <= n; ++k) {
+    if (k > kSampleSize + 1) {
+      log_n_choose_k += std::log10(static_cast<double>(n - k + 1) / k);
+      log_k_choose_7 += std::log10(static_cast<double>(k) / (k - kSampleSize));
+    }
+    const double e = std::max(distances[k - 1], kLeastDistance);
+    if (!std::isfinite(e)) break;
+    const double alpha = std::max(std::min(RandomInlierProbability(e, size0), RandomInlierProbability(e, size1)),
+                                  shuffled_share(e));
+    if (alpha >= 1.0) break;  // every match explained: nothing is unlikely any more
+    const double log10_nfa = tests + log_n_choose_k + log_k_choose_7 + (k - kSampleSize) * std::log10(alpha);
+    if (log10_nfa < best.log10_nfa) best = {log10_nfa, k, e};
+  }
+  return best;
+}
+
+}  // namespace vmap
