@@ -27,7 +27,8 @@ struct VerifierFlags {
 void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& option_flags,
                         bool with_early_stop = true);
 
-// --format, --first, --last, --stride, --resize, --strict, --camera, --stream-timeout; fields as FrameSourceOptions names them.
+// --format, --first, --last, --stride, --resize, --strict, --camera, --topic, --camera-topic, --stream-timeout;
+// fields as FrameSourceOptions names them.
 struct SourceFlags {
   FrameSourceOptions options;
   FrameSourceOptions Resolve() const;  // checks the options
