@@ -5,6 +5,7 @@
 // optional (a recording cut short has none), so the reader walks the data section in order, one chunk in
 // memory at a time. Strings are a uint32 length and bytes; integers little-endian.
 
+#include <algorithm>
 #include <map>
 
 #include "vmap/core/error.h"
@@ -85,6 +86,8 @@ class McapReader : public RecordingReader {
   }
 
   std::vector<RecordingTopic> Topics() override {
+    std::vector<RecordingTopic> summarized;
+    if (TopicsFromSummary(&summarized)) return summarized;
     Rewind();
     std::map<std::string, RecordingTopic> by_topic;
     RecordedMessage message;
@@ -105,6 +108,104 @@ class McapReader : public RecordingReader {
   }
 
  private:
+  // The topics as the summary section counts them (Statistics: messages per channel; Chunk Index: which
+  // channels each chunk holds, and its first and last log time), without reading the chunks; false when the
+  // file has no summary (a recording cut short) or it lacks those records.
+  bool TopicsFromSummary(std::vector<RecordingTopic>* topics) {
+    constexpr uint64_t kFooterSize = 9 + 20;
+    try {
+      if (file_.size() < 8 + kFooterSize + 8) return false;
+      const uint64_t footer_offset = file_.size() - 8 - kFooterSize;
+      file_.Read(footer_offset, kFooterSize, &record_, "the footer");
+      if (record_[0] != kOpFooter) return false;
+      uint64_t position = LoadU64(record_.data() + 9);
+      if (position == 0 || position >= footer_offset) return false;
+      std::map<uint16_t, Channel> channels;
+      std::map<uint16_t, std::string> schemas;
+      std::map<uint16_t, RecordingTopic> by_channel;
+      bool statistics = false;
+      uint64_t file_start = 0, file_end = 0;  // of all messages: the times of channels no chunk index names
+      while (position < footer_offset) {
+        uint8_t head[9];
+        file_.Read(position, 9, head, "a summary record");
+        const uint64_t length = LoadU64(head + 1);
+        if (length > footer_offset - position - 9) return false;
+        file_.Read(position + 9, length, &record_, "a summary record");
+        position += 9 + length;
+        Fields fields(record_.data(), record_.size());
+        if (head[0] == kOpSchema) {
+          uint16_t id = 0;
+          if (!fields.U16(&id) || !fields.String(&schemas[id])) return false;
+        } else if (head[0] == kOpChannel) {
+          uint16_t id = 0;
+          Channel channel;
+          if (!fields.U16(&id) || !fields.U16(&channel.schema) || !fields.String(&channel.topic)) return false;
+          channels[id] = channel;
+        } else if (head[0] == 0x0B) {  // Statistics
+          uint64_t skip64 = 0;
+          uint32_t skip32 = 0, map_size = 0;
+          uint16_t skip16 = 0;
+          if (!fields.U64(&skip64) || !fields.U16(&skip16) || !fields.U32(&skip32) || !fields.U32(&skip32) ||
+              !fields.U32(&skip32) || !fields.U32(&skip32) || !fields.U64(&file_start) || !fields.U64(&file_end) ||
+              !fields.U32(&map_size)) {
+            return false;
+          }
+          for (uint32_t read = 0; read + 10 <= map_size; read += 10) {
+            uint16_t id = 0;
+            uint64_t count = 0;
+            if (!fields.U16(&id) || !fields.U64(&count)) return false;
+            by_channel[id].message_count = static_cast<long>(count);
+          }
+          statistics = true;
+        } else if (head[0] == 0x08) {  // Chunk Index
+          uint64_t start = 0, end = 0, skip = 0;
+          uint32_t map_size = 0;
+          if (!fields.U64(&start) || !fields.U64(&end) || !fields.U64(&skip) || !fields.U64(&skip) ||
+              !fields.U32(&map_size)) {
+            return false;
+          }
+          for (uint32_t read = 0; read + 10 <= map_size; read += 10) {
+            uint16_t id = 0;
+            if (!fields.U16(&id) || !fields.U64(&skip)) return false;
+            RecordingTopic& topic = by_channel[id];
+            if (topic.last_time_ns == 0 || static_cast<int64_t>(start) < topic.first_time_ns) {
+              topic.first_time_ns = static_cast<int64_t>(start);
+            }
+            topic.last_time_ns = std::max(topic.last_time_ns, static_cast<int64_t>(end));
+          }
+        }
+      }
+      if (!statistics) return false;
+      std::map<std::string, RecordingTopic> by_topic;
+      for (auto& [id, counted] : by_channel) {
+        const auto channel = channels.find(id);
+        if (channel == channels.end()) return false;
+        if (counted.last_time_ns == 0) {
+          counted.first_time_ns = static_cast<int64_t>(file_start);
+          counted.last_time_ns = static_cast<int64_t>(file_end);
+        }
+        RecordingTopic& topic = by_topic[channel->second.topic];
+        const auto schema = schemas.find(channel->second.schema);
+        if (topic.message_count == 0) {
+          topic.first_time_ns = counted.first_time_ns;
+        } else {
+          topic.first_time_ns = std::min(topic.first_time_ns, counted.first_time_ns);
+        }
+        topic.name = channel->second.topic;
+        topic.type = schema == schemas.end() ? "" : schema->second;
+        topic.last_time_ns = std::max(topic.last_time_ns, counted.last_time_ns);
+        topic.message_count += counted.message_count;
+      }
+      topics->clear();
+      for (auto& [name, topic] : by_topic) {
+        if (topic.message_count > 0) topics->push_back(std::move(topic));
+      }
+      return true;
+    } catch (const InputError&) {
+      return false;  // a damaged summary: the records themselves are counted
+    }
+  }
+
   bool NextMessage(const std::set<std::string>* topics, RecordedMessage* message) {
     for (;;) {
       if (chunk_position_ < chunk_.size()) {

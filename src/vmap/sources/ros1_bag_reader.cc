@@ -9,6 +9,7 @@
 // index entries in memory before the first one is read. This reader is one file over libbz2 and liblz4, reads
 // the bag in one forward pass (memory: one chunk), and gives the frames before a damaged record.
 
+#include <algorithm>
 #include <map>
 #include <utility>
 
@@ -99,6 +100,8 @@ class Ros1BagReader : public RecordingReader {
   }
 
   std::vector<RecordingTopic> Topics() override {
+    std::vector<RecordingTopic> indexed;
+    if (TopicsFromIndex(&indexed)) return indexed;
     Rewind();
     std::map<std::string, RecordingTopic> by_topic;
     RecordedMessage message;
@@ -118,6 +121,78 @@ class Ros1BagReader : public RecordingReader {
   }
 
  private:
+  // The topics as the bag's index at its end counts them (connection and chunk info records), without reading
+  // the chunks; false when the bag has no index (still being recorded, or cut short) or it does not add up.
+  // First and last times are those of the chunks holding the topic's messages.
+  bool TopicsFromIndex(std::vector<RecordingTopic>* topics) {
+    try {
+      uint8_t length[4];
+      file_.Read(kMagicSize, 4, length, "the bag header");
+      const uint32_t header_size = LoadU32(length);
+      if (header_size > kMaxHeaderSize) return false;
+      file_.Read(kMagicSize + 4, header_size, &header_bytes_, "the bag header");
+      RecordHeader bag_header;
+      if (!bag_header.Parse(header_bytes_.data(), header_bytes_.size()).empty() || bag_header.op() != 0x03) return false;
+      uint64_t position = bag_header.Number<uint64_t>("index_pos", 8);
+      const uint32_t chunk_count = bag_header.Number<uint32_t>("chunk_count", 4);
+      if (position <= kMagicSize || position >= file_.size()) return false;
+      std::map<uint32_t, RecordingTopic> by_connection;
+      uint32_t chunks = 0;
+      while (position < file_.size()) {
+        file_.Read(position, 4, length, "an index record");
+        const uint32_t size = LoadU32(length);
+        if (size > kMaxHeaderSize) return false;
+        file_.Read(position + 4, size, &header_bytes_, "an index record");
+        if (!header_.Parse(header_bytes_.data(), header_bytes_.size()).empty()) return false;
+        file_.Read(position + 4 + size, 4, length, "an index record");
+        const uint32_t data_size = LoadU32(length);
+        file_.Read(position + 8 + size, data_size, &record_data_, "an index record");
+        position += 8 + size + uint64_t{data_size};
+        const uint32_t id = header_.Number<uint32_t>("conn", 4);
+        if (header_.op() == kOpConnection) {
+          RecordHeader connection_header;
+          const std::string* topic = header_.Find("topic");
+          if (!topic || !connection_header.Parse(record_data_.data(), record_data_.size()).empty() ||
+              !connection_header.Find("type")) {
+            return false;
+          }
+          by_connection[id].name = *topic;
+          by_connection[id].type = *connection_header.Find("type");
+        } else if (header_.op() == 0x06) {  // chunk info: (connection, count) pairs of one chunk
+          ++chunks;
+          const auto nanoseconds = [](uint64_t time) {
+            return static_cast<int64_t>(time & 0xffffffffu) * 1000000000 + static_cast<int64_t>(time >> 32);
+          };
+          const int64_t start = nanoseconds(header_.Number<uint64_t>("start_time", 8));
+          const int64_t end = nanoseconds(header_.Number<uint64_t>("end_time", 8));
+          for (size_t at = 0; at + 8 <= record_data_.size(); at += 8) {
+            RecordingTopic& topic = by_connection[LoadU32(record_data_.data() + at)];
+            if (topic.message_count == 0 || start < topic.first_time_ns) topic.first_time_ns = start;
+            topic.last_time_ns = std::max(topic.last_time_ns, end);
+            topic.message_count += LoadU32(record_data_.data() + at + 4);
+          }
+        }
+      }
+      if (chunks != chunk_count) return false;
+      std::map<std::string, RecordingTopic> by_topic;  // several connections may share a topic
+      for (const auto& [id, connection] : by_connection) {
+        if (connection.name.empty()) return false;  // counted messages of a connection the index does not name
+        RecordingTopic& topic = by_topic[connection.name];
+        if (topic.message_count == 0) topic = connection;
+        else {
+          topic.first_time_ns = std::min(topic.first_time_ns, connection.first_time_ns);
+          topic.last_time_ns = std::max(topic.last_time_ns, connection.last_time_ns);
+          topic.message_count += connection.message_count;
+        }
+      }
+      topics->clear();
+      for (auto& [name, topic] : by_topic) topics->push_back(std::move(topic));
+      return true;
+    } catch (const InputError&) {
+      return false;  // a damaged index: the records themselves are counted
+    }
+  }
+
   // The next message on `topics` (nullptr: every message, its data left out: a count).
   bool NextMessage(const std::set<std::string>* topics, RecordedMessage* message) {
     for (;;) {

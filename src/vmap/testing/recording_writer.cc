@@ -10,7 +10,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <algorithm>
 #include <map>
+#include <set>
 #include <memory>
 #include <stdexcept>
 
@@ -152,14 +154,18 @@ std::vector<uint8_t> SerializeCameraInfo(MessageEncoding encoding, double stamp,
 }
 
 void WriteMcap(const std::string& path, const std::vector<TestMessage>& messages, const std::string& compression,
-               int per_chunk) {
+               int per_chunk, bool summary) {
   std::string file("\x89MCAP0\r\n", 8);
   std::string header;
   PutString(header, "ros2");
   PutString(header, "vmap-test");
   PutRecord(file, 0x01, header);
   std::map<std::string, uint16_t> channels;
-  std::string pending;
+  std::string pending, chunk_indexes, definitions;
+  std::set<uint16_t> in_chunk_channels;
+  uint32_t chunk_count = 0;
+  std::map<uint16_t, uint64_t> counts;
+  int64_t first_time = messages.empty() ? 0 : messages.front().log_time_ns, last_time = first_time;
   int in_chunk = 0;
   int64_t start = 0, end = 0;
   const auto flush = [&] {
@@ -176,8 +182,25 @@ void WriteMcap(const std::string& path, const std::vector<TestMessage>& messages
       PutString(chunk, compression == "none" ? "" : compression);
       Put64(chunk, stored.size());
       chunk += stored;
+      std::string index;  // the chunk's Chunk Index record, for the summary
+      Put64(index, static_cast<uint64_t>(start));
+      Put64(index, static_cast<uint64_t>(end));
+      Put64(index, file.size());
+      Put64(index, 9 + chunk.size());
+      Put32(index, static_cast<uint32_t>(10 * in_chunk_channels.size()));
+      for (uint16_t id : in_chunk_channels) {
+        Put16(index, id);
+        Put64(index, 0);  // no Message Index records: vmap does not read them
+      }
+      Put64(index, 0);
+      PutString(index, compression == "none" ? "" : compression);
+      Put64(index, stored.size());
+      Put64(index, pending.size());
+      PutRecord(chunk_indexes, 0x08, index);
+      ++chunk_count;
       PutRecord(file, 0x06, chunk);
     }
+    in_chunk_channels.clear();
     pending.clear();
     in_chunk = 0;
   };
@@ -192,13 +215,19 @@ void WriteMcap(const std::string& path, const std::vector<TestMessage>& messages
       PutString(schema, "ros2msg");
       PutString(schema, "");  // the definition; vmap does not need it
       PutRecord(pending, 0x03, schema);
+      PutRecord(definitions, 0x03, schema);
       Put16(record, id);
       Put16(record, id);
       PutString(record, message.topic);
       PutString(record, "cdr");
       Put32(record, 0);  // metadata: an empty map
       PutRecord(pending, 0x04, record);
+      PutRecord(definitions, 0x04, record);
     }
+    in_chunk_channels.insert(channel->second);
+    ++counts[channel->second];
+    first_time = std::min(first_time, message.log_time_ns);
+    last_time = std::max(last_time, message.log_time_ns);
     if (in_chunk == 0) start = message.log_time_ns;
     end = message.log_time_ns;
     std::string record;
@@ -214,8 +243,27 @@ void WriteMcap(const std::string& path, const std::vector<TestMessage>& messages
   std::string data_end;
   Put32(data_end, 0);
   PutRecord(file, 0x0F, data_end);
+  const uint64_t summary_start = summary ? file.size() : 0;
+  if (summary) {
+    std::string statistics;
+    Put64(statistics, messages.size());
+    Put16(statistics, static_cast<uint16_t>(channels.size()));
+    Put32(statistics, static_cast<uint32_t>(channels.size()));
+    Put32(statistics, 0);  // attachments
+    Put32(statistics, 0);  // metadata
+    Put32(statistics, chunk_count);
+    Put64(statistics, static_cast<uint64_t>(first_time));
+    Put64(statistics, static_cast<uint64_t>(last_time));
+    Put32(statistics, static_cast<uint32_t>(10 * counts.size()));
+    for (const auto& [id, count] : counts) {
+      Put16(statistics, id);
+      Put64(statistics, count);
+    }
+    file += definitions + chunk_indexes;
+    PutRecord(file, 0x0B, statistics);
+  }
   std::string footer;
-  Put64(footer, 0);
+  Put64(footer, summary_start);
   Put64(footer, 0);
   Put32(footer, 0);
   PutRecord(file, 0x02, footer);

@@ -31,8 +31,10 @@ std::vector<uint8_t> SerializeCameraInfo(MessageEncoding encoding, double stamp,
                                          const cv::Matx33d& k);
 
 // compression: "" (unchunked), "none" (chunks, uncompressed), "zstd" or "lz4"; `per_chunk` messages a chunk.
+// `summary`: the summary section (schemas, channels, chunk indexes, statistics) as recorders write it; a
+// recording cut short has none.
 void WriteMcap(const std::string& path, const std::vector<TestMessage>& messages, const std::string& compression,
-               int per_chunk = 4);
+               int per_chunk = 4, bool summary = true);
 // A rosbag2 folder: metadata.yaml and FOLDER_0.db3.
 void WriteRosbag2(const std::string& folder, const std::vector<TestMessage>& messages);
 // compression: "none", "bz2" or "lz4". Returns false (and the reason in *why) when python3-rosbag is missing.
