@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <map>
 
+#include <spdlog/spdlog.h>
+
 #include "vmap/core/error.h"
 #include "vmap/sources/binary_file.h"
 #include "vmap/sources/chunk_decompression.h"
@@ -91,7 +93,17 @@ class McapReader : public RecordingReader {
     Rewind();
     std::map<std::string, RecordingTopic> by_topic;
     RecordedMessage message;
-    while (NextMessage(nullptr, &message)) {
+    long counted = 0;
+    for (;;) {
+      try {
+        if (!NextMessage(nullptr, &message)) break;
+      } catch (const InputError& error) {
+        // The frames before the damage are still read (RecordingSource warns again when it gets there).
+        if (counted == 0) throw;
+        spdlog::warn("{}; counting the {} messages before it", error.what(), counted);
+        break;
+      }
+      ++counted;
       RecordingTopic& topic = by_topic[message.topic];
       if (topic.message_count++ == 0) {
         topic.name = message.topic;
@@ -257,7 +269,9 @@ class McapReader : public RecordingReader {
     uint64_t left = 0;
     const uint8_t* records = fields.rest(&left);
     if (records_size > left) file_.Damaged(offset, "a chunk's records run past it");
-    if (size > kMaxChunkSize) file_.Damaged(offset, "a chunk of " + std::to_string(size) + " bytes");
+    if (size > kMaxChunkSize || !PlausibleChunkSize(records_size, size)) {
+      file_.Damaged(offset, "a chunk announces " + std::to_string(size) + " bytes from " + std::to_string(records_size));
+    }
     chunk_offset_ = offset;
     if (compression.empty()) {
       if (size != records_size) file_.Damaged(offset, "an uncompressed chunk whose sizes differ");

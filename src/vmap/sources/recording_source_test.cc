@@ -23,7 +23,8 @@ const cv::Size kSize(96, 64);
 
 cv::Mat FrameImage(int i) {
   cv::Mat image(kSize, CV_8UC3);
-  cv::randu(image, cv::Scalar::all(0), cv::Scalar::all(255));
+  cv::RNG rng(i + 1);  // the same image each time it is asked for
+  rng.fill(image, cv::RNG::UNIFORM, 0, 256);
   cv::putText(image, std::to_string(i), {10, 50}, cv::FONT_HERSHEY_SIMPLEX, 1.5, cv::Scalar(255, 0, 255 - 20 * i), 3);
   return image;
 }

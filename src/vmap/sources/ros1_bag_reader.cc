@@ -13,6 +13,8 @@
 #include <map>
 #include <utility>
 
+#include <spdlog/spdlog.h>
+
 #include "vmap/core/error.h"
 #include "vmap/sources/binary_file.h"
 #include "vmap/sources/chunk_decompression.h"
@@ -105,7 +107,17 @@ class Ros1BagReader : public RecordingReader {
     Rewind();
     std::map<std::string, RecordingTopic> by_topic;
     RecordedMessage message;
-    while (NextMessage(nullptr, &message)) {
+    long counted = 0;
+    for (;;) {
+      try {
+        if (!NextMessage(nullptr, &message)) break;
+      } catch (const InputError& error) {
+        // The frames before the damage are still read (RecordingSource warns again when it gets there).
+        if (counted == 0) throw;
+        spdlog::warn("{}; counting the {} messages before it", error.what(), counted);
+        break;
+      }
+      ++counted;
       RecordingTopic& topic = by_topic[message.topic];
       if (topic.message_count++ == 0) {
         topic.name = message.topic;
@@ -230,7 +242,9 @@ class Ros1BagReader : public RecordingReader {
       const std::string* compression = header_.Find("compression");
       const uint32_t size = header_.Number<uint32_t>("size", 4);
       if (!compression) file_.Damaged(offset, "a chunk without a compression field");
-      if (size > kMaxChunkSize) file_.Damaged(offset, "a chunk of " + std::to_string(size) + " bytes");
+      if (size > kMaxChunkSize || (*compression != "none" && !PlausibleChunkSize(data_size, size))) {
+        file_.Damaged(offset, "a chunk announces " + std::to_string(size) + " bytes from " + std::to_string(data_size));
+      }
       chunk_offset_ = offset;
       if (*compression == "none") {
         file_.Read(data_offset, data_size, &chunk_, "a chunk");
