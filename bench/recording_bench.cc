@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include <spdlog/spdlog.h>
+
 #include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/map_builder.h"
@@ -59,6 +61,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   vmap::InitializeRuntime();
+  spdlog::set_level(spdlog::level::warn);  // the recordings have no camera_info topic, as intended
   const fs::path dir = fs::temp_directory_path() / ("recording_bench_" + std::to_string(getpid()));
   fs::create_directories(dir);
   struct Recording {
@@ -98,6 +101,7 @@ int main(int argc, char** argv) {
       while (source->Next()) ++n;
       recording.rates.push_back(n / std::chrono::duration<double>(Clock::now() - start).count());
     }
+    fs::create_directories(dir / "map");
     const auto start = Clock::now();
     auto source = vmap::OpenFrameSource(recordings[0].path);
     const vmap::VisualMap map = vmap::BuildMap(*source, *matcher, options, dir / "map");
