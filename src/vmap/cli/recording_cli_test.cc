@@ -1,6 +1,10 @@
 // The vmap binary on robot recordings: a bag holding a video's decoded frames gives the video's map, for each
 // container; `vmap info` lists a recording's topics; several image topics and no --topic is refused.
 
+#include <algorithm>
+#include <fstream>
+#include <iterator>
+
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
@@ -109,6 +113,17 @@ TEST(RecordingCli, ARecordingOfAVideosFramesGivesTheVideosMap) {
     EXPECT_EQ(jpeg.num_frames, kVideoFrames);
     EXPECT_GE(jpeg.key_images.size(), expected.key_images.size() / 2 + 1);
     EXPECT_LE(jpeg.key_images.size(), expected.key_images.size() * 2);
+    if (recording != mcap) continue;
+    // Repeat against teach: the JPEG frames localized against the raw frames' map (every 5th, to be quick).
+    const fs::path csv = tmp.path() / "repeat.csv";
+    ASSERT_EQ(RunVmap("localize " + Quote(raw_map) + " " + Quote(recording) +
+                          " -q --topic /cam/image_raw/compressed --stride 5 --csv " + Quote(csv),
+                      &out),
+              0)
+        << out;
+    std::ifstream lines(csv);
+    EXPECT_EQ(std::count(std::istreambuf_iterator<char>(lines), std::istreambuf_iterator<char>(), '\n'),
+              1 + kVideoFrames / 5);  // a header and one line per frame
   }
 }
 

@@ -224,7 +224,8 @@ std::unique_ptr<FrameSource> OpenDetectedFrameSource(const std::string& path, co
   }
   std::error_code ec;
   if (!fs::exists(path, ec)) {
-    throw InputError("input '" + path + "' does not exist; give a video file, an image folder, a TUM/EuRoC/KITTI sequence or a ROS bag / MCAP recording");
+    throw InputError("input '" + path + "' does not exist; give a video file, an image folder, a TUM/EuRoC/KITTI "
+                     "sequence or a ROS bag / MCAP recording");
   }
   const fs::path p(path);
   if (!fs::is_directory(p) && internal::IsImageFile(path) && options.format == SourceFormat::kAuto) {

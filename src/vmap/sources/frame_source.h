@@ -67,7 +67,8 @@ struct FrameSourceOptions {
 
 class JsonFieldReader;
 // Which frames of which input, as map.json records them: format, first, last, stride, resize, strict and
-// camera ("input" for the input's own intrinsics, the default ""), and topic and camera_topic when set. The rest are limits and callbacks of a run.
+// camera ("input" for the input's own intrinsics, the default ""), and topic and camera_topic when set. The
+// rest are limits and callbacks of a run.
 nlohmann::json ToJson(const FrameSourceOptions& options);
 // Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
 void FromJson(const JsonFieldReader& fields, FrameSourceOptions* options);

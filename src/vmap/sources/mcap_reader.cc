@@ -270,7 +270,8 @@ class McapReader : public RecordingReader {
     const uint8_t* records = fields.rest(&left);
     if (records_size > left) file_.Damaged(offset, "a chunk's records run past it");
     if (size > kMaxChunkSize || !PlausibleChunkSize(records_size, size)) {
-      file_.Damaged(offset, "a chunk announces " + std::to_string(size) + " bytes from " + std::to_string(records_size));
+      file_.Damaged(offset,
+                    "a chunk announces " + std::to_string(size) + " bytes from " + std::to_string(records_size));
     }
     chunk_offset_ = offset;
     if (compression.empty()) {

@@ -225,7 +225,9 @@ class Ros1BagReader : public RecordingReader {
     uint8_t length[4];
     file_.Read(offset, 4, length, "a record's header length");
     const uint32_t header_size = LoadU32(length);
-    if (header_size > kMaxHeaderSize) file_.Damaged(offset, "a record header of " + std::to_string(header_size) + " bytes");
+    if (header_size > kMaxHeaderSize) {
+      file_.Damaged(offset, "a record header of " + std::to_string(header_size) + " bytes");
+    }
     file_.Read(offset + 4, header_size, &header_bytes_, "a record header");
     file_.Read(offset + 4 + header_size, 4, length, "a record's data length");
     const uint32_t data_size = LoadU32(length);

@@ -144,7 +144,8 @@ cv::Size ImageMessageSize(const uint8_t* data, size_t size, const std::string& t
     ReadHeaderStamp(buffer, encoding);
     const uint32_t height = buffer.U32();
     const uint32_t width = buffer.U32();
-    return {static_cast<int>(std::min<uint32_t>(width, INT32_MAX)), static_cast<int>(std::min<uint32_t>(height, INT32_MAX))};
+    return {static_cast<int>(std::min<uint32_t>(width, INT32_MAX)),
+            static_cast<int>(std::min<uint32_t>(height, INT32_MAX))};
   }
   return DecodeImageMessage(data, size, type, encoding, what).gray.size();
 }

@@ -84,7 +84,9 @@ TEST(RosImageMessages, BayerPatternsDemosaicToTheImage) {
     SCOPED_TRACE(name);
     cv::Mat mosaic(bgr.size(), CV_8UC1);
     for (int y = 0; y < bgr.rows; ++y) {
-      for (int x = 0; x < bgr.cols; ++x) mosaic.at<uint8_t>(y, x) = bgr.at<cv::Vec3b>(y, x)[channels[(y % 2) * 2 + x % 2]];
+      for (int x = 0; x < bgr.cols; ++x) {
+        mosaic.at<uint8_t>(y, x) = bgr.at<cv::Vec3b>(y, x)[channels[(y % 2) * 2 + x % 2]];
+      }
     }
     for (MessageEncoding encoding : kEncodings) {
       const DecodedImage image = Decode(testing::SerializeImage(encoding, 1.0, "c", mosaic, name), encoding);
