@@ -12,6 +12,7 @@ packages=(
   libopenblas0-openmp           # without it LibTorch uses the reference BLAS and runs 30-50x slower
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev libeigen3-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
+  libsqlite3-dev libzstd-dev liblz4-dev libbz2-dev python3-rosbag  # recordings (python3-rosbag: test fixtures)
   ffmpeg                        # only used by tests: videos with a display rotation, live streams on the loopback
   pybind11-dev python3-numpy python3-pytest  # the Python module (python/, docs/python.md) and its tests
 )

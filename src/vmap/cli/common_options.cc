@@ -174,6 +174,11 @@ void AddSourceOptions(CLI::App* command, SourceFlags& flags, OptionFlags& option
                          "Intrinsics: fx,fy,cx,cy[,k1,k2,p1,p2[,k3]] (pixels, native frame size) or a calibration "
                          "file (OpenCV YAML/JSON, EuRoC sensor.yaml, KITTI calib.txt, intrinsics.txt); 'none' ignores "
                          "the input's own. Default: the input's own, if any");
+  option_flags.AddOption(command, "--topic", flags.options.topic, "topic",
+                         "Recordings (ROS bag, rosbag2, MCAP): the image topic (Image or CompressedImage). Default: "
+                         "the only one; `vmap info RECORDING` lists them");
+  option_flags.AddOption(command, "--camera-topic", flags.options.camera_topic, "camera_topic",
+                         "Recordings: the CameraInfo topic. Default: camera_info beside the image topic");
   option_flags
       .AddOption(command, "--stream-timeout", flags.options.stream_timeout_seconds, "stream_timeout_seconds",
                  "Live inputs: seconds without a frame after which the stream has ended (and the longest opening "

@@ -32,7 +32,8 @@ void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& op
 // LocalizerOptions).
 void AddHeadingOptions(CLI::App* command, HeadingOptions& options, OptionFlags& option_flags);
 
-// --format, --first, --last, --stride, --resize, --strict, --camera, --stream-timeout; fields as FrameSourceOptions names them.
+// --format, --first, --last, --stride, --resize, --strict, --camera, --topic, --camera-topic, --stream-timeout;
+// fields as FrameSourceOptions names them.
 struct SourceFlags {
   FrameSourceOptions options;
   FrameSourceOptions Resolve() const;  // checks the options

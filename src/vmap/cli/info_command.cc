@@ -7,14 +7,23 @@
 #include "vmap/map/map_io.h"
 #include "vmap/mapping/recorded_options.h"
 #include "vmap/report/summary.h"
+#include "vmap/sources/recording_reader.h"
+#include "vmap/sources/recording_source.h"
 
 namespace vmap::cli {
 
 void AddInfoCommand(CLI::App& app) {
   auto directory = std::make_shared<std::string>();
-  CLI::App* command = app.add_subcommand("info", "Print the summary of a map (and check that it is well formed)");
-  command->add_option("map", *directory, "Map directory written by `vmap build`")->required();
+  CLI::App* command = app.add_subcommand(
+      "info", "Print the summary of a map (and check that it is well formed), or the topics of a recording");
+  command->add_option("map", *directory, "Map directory written by `vmap build`, or a recording (ROS bag, rosbag2 "
+                                          "folder, MCAP file): its topics with type, count, rate and image size")
+      ->required();
   command->callback([directory] {
+    if (IsRecording(*directory)) {
+      std::cout << FormatRecordingTopics(*directory, DescribeRecording(*directory));
+      return;
+    }
     const VisualMap map = ReadMap(*directory);
     const std::string map_file = (std::filesystem::path(*directory) / kMapFileName).string();
     const RecordedOptions options = RecordedOptionsFromJson(map.options_json, "map '" + map_file + "': options");

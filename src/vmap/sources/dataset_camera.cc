@@ -11,6 +11,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/sources/internal.h"
+#include "vmap/sources/recording_reader.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -200,6 +201,7 @@ EurocSensor ParseEurocSensor(const std::string& text, const std::string& path) {
 SourceFormat DetectSourceFormat(const std::string& path, SourceFormat requested) {
   if (requested != SourceFormat::kAuto) return requested;
   const fs::path p(path);
+  if (IsRecording(path)) return SourceFormat::kRecording;
   if (fs::is_directory(p)) {
     if (fs::exists(p / "rgb.txt")) return SourceFormat::kTum;
     if (fs::exists(p / "mav0/cam0/data.csv") || fs::exists(p / "cam0/data.csv")) return SourceFormat::kEuroc;
@@ -233,6 +235,7 @@ std::string FindCalibrationFile(const std::string& input_path, SourceFormat form
     }
     case SourceFormat::kVideo:
       return existing(p.parent_path() / "intrinsics.txt");
+    case SourceFormat::kRecording:  // its camera is a topic of its own (recording_source.h)
     case SourceFormat::kAuto: break;
   }
   return {};

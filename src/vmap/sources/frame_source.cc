@@ -224,7 +224,8 @@ std::unique_ptr<FrameSource> OpenDetectedFrameSource(const std::string& path, co
   }
   std::error_code ec;
   if (!fs::exists(path, ec)) {
-    throw InputError("input '" + path + "' does not exist; give a video file, an image folder, or a TUM/EuRoC/KITTI sequence");
+    throw InputError("input '" + path + "' does not exist; give a video file, an image folder, a TUM/EuRoC/KITTI "
+                     "sequence or a ROS bag / MCAP recording");
   }
   const fs::path p(path);
   if (!fs::is_directory(p) && internal::IsImageFile(path) && options.format == SourceFormat::kAuto) {
@@ -238,9 +239,15 @@ std::unique_ptr<FrameSource> OpenDetectedFrameSource(const std::string& path, co
     return std::make_unique<CameraSource>(std::move(single), ParseCameraOption(options.camera));
   }
   const SourceFormat format = DetectSourceFormat(path, options.format);
-  std::unique_ptr<FrameSource> source = OpenDetected(path, p, format, options);
+  std::optional<Camera> recording_camera;  // a recording's CameraInfo, read only when no --camera overrides it
+  std::unique_ptr<FrameSource> source =
+      format == SourceFormat::kRecording
+          ? internal::OpenRecordingSource(path, options, options.camera.empty() ? &recording_camera : nullptr)
+          : OpenDetected(path, p, format, options);
   std::optional<Camera> camera;
-  if (options.camera.empty()) camera = FindDatasetCamera(path, format);
+  if (options.camera.empty()) {
+    camera = format == SourceFormat::kRecording ? recording_camera : FindDatasetCamera(path, format);
+  }
   else if (options.camera != "none") camera = ParseCameraOption(options.camera);
   if (!camera) return source;
   return std::make_unique<CameraSource>(std::move(source), *camera);
@@ -267,6 +274,7 @@ std::unique_ptr<FrameSource> OpenDetected(const std::string& path, const fs::pat
     }
     case SourceFormat::kKitti:
       return internal::OpenImageList(internal::ListKitti(path), path, format, options);
+    case SourceFormat::kRecording:  // opened by OpenDetectedFrameSource, which also reads its camera
     case SourceFormat::kAuto: break;
   }
   throw OptionError("format", "auto cannot tell the layout of '" + path +
@@ -292,13 +300,16 @@ constexpr const char* kInputCamera = "input";
 }  // namespace
 
 nlohmann::json ToJson(const FrameSourceOptions& options) {
-  return {{"format", SourceFormatName(options.format)},
+  nlohmann::json json = {{"format", SourceFormatName(options.format)},
           {"first", options.first},
           {"last", options.last},
           {"stride", options.stride},
           {"resize", options.resize},
           {"strict", options.strict},
           {"camera", options.camera.empty() ? kInputCamera : options.camera}};
+  if (!options.topic.empty()) json["topic"] = options.topic;
+  if (!options.camera_topic.empty()) json["camera_topic"] = options.camera_topic;
+  return json;
 }
 
 void FromJson(const JsonFieldReader& fields, FrameSourceOptions* options) {
@@ -309,6 +320,8 @@ void FromJson(const JsonFieldReader& fields, FrameSourceOptions* options) {
   fields.Read("resize", &options->resize);
   fields.Read("strict", &options->strict);
   fields.Read("camera", &options->camera);
+  fields.Read("topic", &options->topic);
+  fields.Read("camera_topic", &options->camera_topic);
   if (options->camera == kInputCamera) options->camera.clear();
 }
 

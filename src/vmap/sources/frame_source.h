@@ -15,10 +15,12 @@
 
 namespace vmap {
 
-enum class SourceFormat { kAuto, kVideo, kImageFolder, kTum, kEuroc, kKitti };
+// kRecording: a robot's recording, a ROS 1 .bag, a rosbag2 folder or .db3, or an .mcap file (recording_source.h).
+enum class SourceFormat { kAuto, kVideo, kImageFolder, kTum, kEuroc, kKitti, kRecording };
 inline constexpr EnumName<SourceFormat> kSourceFormatNames[] = {
     {SourceFormat::kAuto, "auto"}, {SourceFormat::kVideo, "video"}, {SourceFormat::kImageFolder, "images"},
-    {SourceFormat::kTum, "tum"},   {SourceFormat::kEuroc, "euroc"}, {SourceFormat::kKitti, "kitti"}};
+    {SourceFormat::kTum, "tum"},   {SourceFormat::kEuroc, "euroc"}, {SourceFormat::kKitti, "kitti"},
+    {SourceFormat::kRecording, "recording"}};
 
 SourceFormat ParseSourceFormat(const std::string& name);
 std::string SourceFormatName(SourceFormat format);
@@ -55,13 +57,18 @@ struct FrameSourceOptions {
   // Live inputs: a stream that sends nothing for this long has ended (a network sender that stopped, a
   // camera that was unplugged); also how long opening one may take.
   double stream_timeout_seconds = 10.0;
+  // Recordings: the image topic ("" = the recording's only one) and its CameraInfo topic ("" = the image
+  // topic's sibling camera_info, as image_transport pairs them).
+  std::string topic;
+  std::string camera_topic;
 
   void Check() const;  // throws OptionError naming the bad field
 };
 
 class JsonFieldReader;
 // Which frames of which input, as map.json records them: format, first, last, stride, resize, strict and
-// camera ("input" for the input's own intrinsics, the default ""). The rest are limits and callbacks of a run.
+// camera ("input" for the input's own intrinsics, the default ""), and topic and camera_topic when set. The
+// rest are limits and callbacks of a run.
 nlohmann::json ToJson(const FrameSourceOptions& options);
 // Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
 void FromJson(const JsonFieldReader& fields, FrameSourceOptions* options);

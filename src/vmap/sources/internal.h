@@ -2,6 +2,7 @@
 // Pieces shared by the frame source implementations (not part of the public interface).
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,9 @@ std::unique_ptr<FrameSource> OpenStream(const std::string& url, const FrameSourc
 // A V4L2 camera device such as /dev/video0.
 std::unique_ptr<FrameSource> OpenV4l2Camera(const std::string& device, const FrameSourceOptions& options);
 bool IsStreamUrl(const std::string& path);
+// A recording (recording_source.h). `camera`, when given, receives the camera of its CameraInfo topic.
+std::unique_ptr<FrameSource> OpenRecordingSource(const std::string& path, const FrameSourceOptions& options,
+                                                 std::optional<Camera>* camera);
 
 // Size frames are delivered at, given the first frame's native size and the --resize option. Throws
 // OptionError when `resize` is malformed or out of its range, or would make these frames degenerate.

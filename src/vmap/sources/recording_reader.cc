@@ -1,0 +1,62 @@
+#include "vmap/sources/recording_reader.h"
+
+#include <filesystem>
+
+#include "vmap/core/error.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+
+namespace {
+bool IsRosbag2Folder(const fs::path& p) {
+  std::error_code ec;
+  if (!fs::is_directory(p, ec) || !fs::exists(p / "metadata.yaml", ec)) return false;
+  for (const auto& entry : fs::directory_iterator(p, ec)) {
+    const std::string extension = entry.path().extension().string();
+    if (extension == ".db3" || extension == ".mcap") return true;
+  }
+  return false;
+}
+
+// A rosbag2 folder written with the MCAP storage plugin holds one .mcap file per split; vmap reads the first
+// of them when there is one, as the folder's recording.
+std::string McapInFolder(const fs::path& p) {
+  std::error_code ec;
+  std::string found;
+  for (const auto& entry : fs::directory_iterator(p, ec)) {
+    if (entry.path().extension() == ".mcap" && (found.empty() || entry.path().string() < found)) {
+      found = entry.path().string();
+    }
+  }
+  return found;
+}
+}  // namespace
+
+bool IsRecording(const std::string& path) {
+  const fs::path p(path);
+  const std::string extension = p.extension().string();
+  if (extension == ".bag" || extension == ".mcap" || extension == ".db3") return true;
+  return IsRosbag2Folder(p);
+}
+
+std::unique_ptr<RecordingReader> OpenRecording(const std::string& path) {
+  const fs::path p(path);
+  const std::string extension = p.extension().string();
+  if (extension == ".bag") return OpenRos1Bag(path);
+  if (extension == ".mcap") return OpenMcap(path);
+  if (extension == ".db3") return OpenRosbag2(path);
+  if (IsRosbag2Folder(p)) {
+    const std::string mcap = McapInFolder(p);
+    return mcap.empty() ? OpenRosbag2(path) : OpenMcap(mcap);
+  }
+  throw InputError("'" + path + "' is not a recording vmap reads: give a ROS 1 .bag, a rosbag2 folder (metadata.yaml "
+                   "and .db3 files) or an .mcap file");
+}
+
+std::string NormalizedTypeName(const std::string& type) {
+  const size_t msg = type.find("/msg/");
+  if (msg == std::string::npos) return type;
+  return type.substr(0, msg) + "/" + type.substr(msg + 5);
+}
+
+}  // namespace vmap

@@ -1,0 +1,63 @@
+#pragma once
+// Robot recordings (ROS 1 bags, rosbag2 sqlite3 folders, MCAP files) seen as one thing: a list of topics and a
+// stream of serialized messages, in the order they are stored. The container formats differ; the messages
+// do not (recording_messages.h decodes them).
+
+#include <cstdint>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace vmap {
+
+// How a recording's messages are serialized: ROS 1 (packed little-endian) or ROS 2's CDR (aligned, with a
+// 4-byte encapsulation header).
+enum class MessageEncoding { kRos1, kCdr };
+
+enum class RecordingFormat { kRos1Bag, kRosbag2, kMcap };
+
+struct RecordingTopic {
+  std::string name;
+  std::string type;        // as stored: "sensor_msgs/Image" (ROS 1) or "sensor_msgs/msg/Image" (ROS 2)
+  long message_count = 0;
+  int64_t first_time_ns = 0;  // log (receive) times of its first and last message
+  int64_t last_time_ns = 0;
+};
+
+struct RecordedMessage {
+  std::string topic;
+  int64_t log_time_ns = 0;
+  uint64_t offset = 0;       // where the message (or its chunk) is in the file: for messages naming the damage
+  std::vector<uint8_t> data;
+};
+
+class RecordingReader {
+ public:
+  virtual ~RecordingReader() = default;
+  // Every topic with its message count. May read the whole recording (the formats' indexes are optional and
+  // a truncated recording has none), so callers ask once.
+  virtual std::vector<RecordingTopic> Topics() = 0;
+  // The next message on one of `topics` (all when empty), in stored order; false at the end. Throws
+  // InputError naming the file and offset when the recording is damaged there.
+  virtual bool Next(const std::set<std::string>& topics, RecordedMessage* message) = 0;
+  // Starts again from the first message.
+  virtual void Rewind() = 0;
+  virtual MessageEncoding encoding() const = 0;
+  virtual RecordingFormat format() const = 0;
+};
+
+// Whether `path` is a recording: a .bag or .mcap file, a .db3 file, or a folder holding metadata.yaml and .db3 files.
+bool IsRecording(const std::string& path);
+// Opens a recording (IsRecording). Throws InputError naming the file when it is not one vmap can read.
+std::unique_ptr<RecordingReader> OpenRecording(const std::string& path);
+
+// Readers of each container (ros1_bag_reader.cc, rosbag2_sqlite_reader.cc, mcap_reader.cc).
+std::unique_ptr<RecordingReader> OpenRos1Bag(const std::string& path);
+std::unique_ptr<RecordingReader> OpenRosbag2(const std::string& path);
+std::unique_ptr<RecordingReader> OpenMcap(const std::string& path);
+
+// "sensor_msgs/msg/Image" -> "sensor_msgs/Image": one name for a type in ROS 1 and ROS 2.
+std::string NormalizedTypeName(const std::string& type);
+
+}  // namespace vmap
