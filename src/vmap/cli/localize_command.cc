@@ -66,6 +66,7 @@ void RunLocalize(const LocalizeFlags& flags) {
       !fs::is_directory(query_status)) {
     throw InputError("query '" + flags.query + "' is neither a file nor a folder (a FIFO or a device); give a video, "
                      "an image folder, a TUM/EuRoC/KITTI sequence, an image, or a live input (udp://..., /dev/videoN)");
+  }
   for (const CLI::Option* flag : flags.counts_flags) {
     if (flag->count() > 0 && options.acceptance != AcceptanceRule::kCounts) {
       throw InputError(fmt::format("{} belongs to the earlier acceptance rule; add --acceptance counts to use it, "
