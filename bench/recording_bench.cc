@@ -20,7 +20,7 @@
 
 #include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
-#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/batch_build.h"
 #include "vmap/sources/frame_source.h"
 #include "vmap/testing/recording_writer.h"
 
