@@ -123,6 +123,10 @@ class PairMatcher {
     fields["heading_method"] = HeadingMethodName(heading.method);
     fields["heading_confidence"] = heading.confidence;
     fields["heading_votes"] = heading.votes;
+    fields["heading_options"] = py::dict(py::arg("window_px") = heading_.window_px,
+                                         py::arg("window_dy_px") = heading_.window_dy_px,
+                                         py::arg("min_votes") = heading_.min_votes,
+                                         py::arg("min_verified") = heading_.min_verified);
     fields["time_s"] = py::dict(py::arg("extract") = pair.extract_seconds, py::arg("match") = pair.match_seconds,
                                 py::arg("verify") = pair.verify_seconds, py::arg("heading") = pair.heading_seconds);
     return Namespace(fields);

@@ -74,6 +74,7 @@ class FrameLocalizer {
       py::gil_scoped_release release;
       LocalizerOptions options = flags.localizer;
       options.Check();
+      cli::CheckLocalizerFlags(flags);
       KeyImageStoreOptions store_options;
       store_options.use_cache = flags.cache;
       store_options.thumbnail_width = options.ranking.thumbnail_width;
@@ -129,6 +130,7 @@ py::list LocalizeFunction(const py::object& map, const std::string& query, const
     run_options.Check();
     LocalizerOptions options = flags.localizer;
     options.Check();
+    cli::CheckLocalizerFlags(flags);
     // As `vmap localize`: what can fail fast does, before the key images are loaded.
     const VisualMap header = ReadMap(directory);
     options.route = RouteOf(header, flags, options.route);

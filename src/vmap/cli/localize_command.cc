@@ -67,13 +67,7 @@ void RunLocalize(const LocalizeFlags& flags) {
     throw InputError("query '" + flags.query + "' is neither a file nor a folder (a FIFO or a device); give a video, "
                      "an image folder, a TUM/EuRoC/KITTI sequence, an image, or a live input (udp://..., /dev/videoN)");
   }
-  for (const CLI::Option* flag : flags.counts_flags) {
-    if (flag->count() > 0 && options.acceptance != AcceptanceRule::kCounts) {
-      throw InputError(fmt::format("{} belongs to the earlier acceptance rule; add --acceptance counts to use it, "
-                                   "or leave it out (--acceptance chance decides by --max-log10-nfa)",
-                                   flag->get_name()));
-    }
-  }
+  CheckLocalizerFlags(flags);
   const VisualMap header = ReadMap(flags.map);
   if (flags.from >= 0 || flags.to >= 0) {
     const int last = static_cast<int>(header.key_images.size()) - 1;

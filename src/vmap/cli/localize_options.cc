@@ -2,7 +2,10 @@
 
 #include <limits>
 
+#include <fmt/format.h>
+
 #include "vmap/cli/common_options.h"
+#include "vmap/core/error.h"
 
 namespace vmap::cli {
 
@@ -53,6 +56,16 @@ void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& 
                  "Feature-extraction threads (0 = one per core)")
       ->capture_default_str();
   command->add_flag("!--no-cache", flags.cache, "Do not read or write the key-image cache in the map directory");
+}
+
+void CheckLocalizerFlags(const LocalizerFlags& flags) {
+  for (const CLI::Option* flag : flags.counts_flags) {
+    if (flag->count() > 0 && flags.localizer.acceptance != AcceptanceRule::kCounts) {
+      throw InputError(fmt::format("{} belongs to the earlier acceptance rule; add --acceptance counts to use it, "
+                                   "or leave it out (--acceptance chance decides by --max-log10-nfa)",
+                                   flag->get_name()));
+    }
+  }
 }
 
 }  // namespace vmap::cli

@@ -16,7 +16,7 @@ struct LocalizerFlags {
   int from = -1;     // --from: the route's first key image; -1 = the first
   int to = -1;       // --to: its last; -1 = the last
   int threads = 0;   // LocalizeSequenceOptions::extraction_threads
-  bool cache = true; // the key-image cache in the map directory
+  bool cache = true;  // the key-image cache in the map directory
   // --min-verified and --min-similarity: they belong to --acceptance counts alone, and are refused with chance.
   std::vector<const CLI::Option*> counts_flags;
 };
@@ -24,5 +24,8 @@ struct LocalizerFlags {
 // --acceptance, --max-log10-nfa, --min-verified, --min-similarity, --max-lost, --candidates, --lookahead, --no-step-back, --ranking, the heading's options, --from, --to,
 // --threads, --no-cache; fields as LocalizerOptions names them.
 void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& option_flags);
+
+// Refuses --min-verified or --min-similarity given with any acceptance rule but counts, which alone reads them.
+void CheckLocalizerFlags(const LocalizerFlags& flags);
 
 }  // namespace vmap::cli

@@ -102,7 +102,7 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, OptionFlags& op
   option_flags.AddEnumOption(command, "--search", o.key_search, ParseKeySearch, KeySearchName, "key_search",
                              "Key-image search: sequential (compare every frame: Algorithm 1), bisect (compare frames "
                              "further ahead, then bisect: fewer network passes, the same map only where S falls with "
-                             "distance) or auto (sequential; README \"Threshold sweeps\")");
+                             "distance) or auto (sequential; docs/measurements/deep-matchers.md)");
   option_flags
       .AddOption(command, "--search-window", o.search_window, "search_window",
                  "bisect: frames compared ahead at most (held in memory)")

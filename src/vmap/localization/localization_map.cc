@@ -41,7 +41,7 @@ LocalizerOptions FollowMap(const VisualMap& map, LocalizerOptions options, const
   options.similarity = from_map.similarity;
   options.translation = from_map.translation;
   const std::string map_size = QueryResize(map, "");
-  if (from_map.camera && query_resize == map_size) {
+  if (from_map.camera && !map_size.empty() && query_resize == map_size) {
     options.camera = from_map.camera;
   } else if (from_map.camera) {
     spdlog::warn("--resize {} differs from the map's frame size {}: headings in pixels only, no relative poses",

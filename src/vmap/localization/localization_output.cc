@@ -93,6 +93,7 @@ std::string DescribeLocalizerOptions(const LocalizerOptions& options) {
                 {"window_dy_px", options.heading.window_dy_px},
                 {"min_votes", options.heading.min_votes},
                 {"min_verified", options.heading.min_verified}}},
+              {"translation", ToJson(options.translation)},
               {"similarity", SimilarityModeName(options.similarity)},
               {"route", options.route}};
   return doc.dump();
@@ -198,6 +199,8 @@ std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run
                   {"last", info.source.last},
                   {"stride", info.source.stride},
                   {"resize", info.source.resize},
+                  {"topic", info.source.topic},
+                  {"camera_topic", info.source.camera_topic},
                   {"frame_size", {info.frame_size.width, info.frame_size.height}}};
   doc["ranking"] = info.ranking;
   doc["key_image_cache"] = info.cache;
@@ -255,6 +258,8 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
     run.info.source.last = query.value("last", -1);
     run.info.source.stride = query.value("stride", 1);
     run.info.source.resize = query.value("resize", "");
+    run.info.source.topic = query.value("topic", "");
+    run.info.source.camera_topic = query.value("camera_topic", "");
     if (query.contains("frame_size") && query["frame_size"].size() == 2) {
       run.info.frame_size = {query["frame_size"][0].get<int>(), query["frame_size"][1].get<int>()};
     }
@@ -291,6 +296,7 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
       r.to_next.similarity = NumberOr(f, "next_similarity", 0.0);
       r.to_next.num_verified = f.value("next_verified", 0);
       r.to_next.num_tentative = f.value("next_tentative", 0);
+      r.translation_known = f.value("translation_known", false);
       r.to_key.log10_nfa = NumberOr(f, "log10_nfa", std::numeric_limits<double>::infinity());
       r.to_next.log10_nfa = NumberOr(f, "next_log10_nfa", std::numeric_limits<double>::infinity());
       if (f.contains("F") && f["F"].is_array() && f["F"].size() == 9) {

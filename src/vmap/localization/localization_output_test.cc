@@ -61,8 +61,6 @@ LocalizationRun SampleRun() {
   lost.frame_index = 1;
   lost.source_index = 4;
   lost.status = LocalizationStatus::kLost;
-  lost.heading_px = std::nan("");
-  lost.progress = std::nan("");
   run.frames = {tracked, lost};
   run.summary.frames = 2;
   run.summary.relocalized = 1;

@@ -140,10 +140,11 @@ struct LocalizationResult {
   KeyComparison to_next;    // against `next_key`: its F maps the frame to the next key image
   // Heading correction for a controller: the heading of the frame against the target key image (`next_key`,
   // or `key` at the route's end), x in the frame minus x in the key image at the scene both show, in pixels
-  // (the mode of the tentative matches' horizontal displacements, geometry/heading.h). Positive: the scene
+  // (geometry/heading.h: the densest window of the tentative matches' displacements, or the median of the
+  // F-verified ones where F keeps many). Positive: the scene
   // appears to the right of where the key image has it, i.e. the robot points left of the key image's
   // heading and should turn right (clockwise seen from above). NaN when there is no estimate.
-  double heading_px = 0.0;
+  double heading_px = std::numeric_limits<double>::quiet_NaN();
   // The same heading as a bearing in degrees (with the map's camera; NaN without). The relative pose to the
   // target key image is target's `pose` (to_next, or to_key at the route's end).
   double heading_deg = std::numeric_limits<double>::quiet_NaN();
@@ -153,7 +154,7 @@ struct LocalizationResult {
   double heading_key_deg = std::numeric_limits<double>::quiet_NaN();
   // Progress along the segment key -> next_key in [0, 1]: v_next / (v_key + v_next) with v the verified
   // matches to each (0 at `key`, 1 at `next_key`, 0.5 where both share as much). NaN when unknown.
-  double progress = 0.0;
+  double progress = std::numeric_limits<double>::quiet_NaN();
   // The target's pose has a translation direction to trust. When not (a short baseline to the target, a
   // pure rotation, no camera), the guidance is the heading only: LocalizationGuidance says which.
   bool translation_known = false;
