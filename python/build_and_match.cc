@@ -93,7 +93,7 @@ class PairMatcher {
       py::gil_scoped_release release;
       const Frame frame0 = FrameFromImage(input0.image, 0, {}, "image0");
       const Frame frame1 = FrameFromImage(input1.image, 1, {}, "image1");
-      pair = MatchPair(*matcher_, frame0.gray, frame1.gray, verifier_, heading_);
+      pair = MatchPair(*matcher_, {frame0.gray, frame0.color}, {frame1.gray, frame1.color}, verifier_, heading_);
     }
     const size_t n = pair.matches.size();
     const bool verified = pair.fundamental.success;

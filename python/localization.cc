@@ -94,7 +94,7 @@ class FrameLocalizer {
       py::gil_scoped_release release;
       Frame frame = FrameFromImage(input.image, frames_, opened_->map.input.frame_size, "image");
       if (!timestamp.is_none()) frame.timestamp = timestamp.cast<double>();
-      const auto features = opened_->matcher->Extract(frame.gray);
+      const auto features = opened_->matcher->ExtractFrame(frame.gray, frame.color);
       result = localizer_->Localize(frame, *features);
     }
     ++frames_;

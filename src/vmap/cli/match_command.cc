@@ -71,6 +71,19 @@ cv::Mat ReadGray(const std::string& path) {
   return gray;
 }
 
+// The image ReadGray accepted, decoded as 8-bit BGR as upstream's models read files (a grey file gives three
+// equal channels).
+cv::Mat ReadColor(const std::string& path, cv::Size size) {
+  cv::Mat bgr;
+  try {
+    bgr = cv::imread(path, cv::IMREAD_COLOR);
+  } catch (const cv::Exception& e) {
+    throw InputError("cannot read image '" + path + "' (" + LibraryMessage(e) + "); check that it is an image");
+  }
+  if (bgr.size() != size) throw InputError("image '" + path + "' changed while it was read; read it again");
+  return bgr;
+}
+
 double Seconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -101,7 +114,12 @@ void RunMatch(const MatchFlags& flags) {
   const double load_s = Seconds(start);
 
   // Extraction, matching and verification: the library's, as the Python module's vmap.match runs them.
-  const PairMatch pair = MatchPair(*matcher, gray0, gray1, verifier, flags.heading, camera ? &*camera : nullptr);
+  // Decoded again in colour only for a matcher that reads colour: the grey image stays the decoder's.
+  auto with_color = [&](const cv::Mat& gray, const std::string& path) {
+    return matcher->reads_color() ? PairImage(gray, ReadColor(path, gray.size())) : PairImage(gray);
+  };
+  const PairMatch pair = MatchPair(*matcher, with_color(gray0, flags.image0), with_color(gray1, flags.image1), verifier,
+                                   flags.heading, camera ? &*camera : nullptr);
   const TentativeMatches& matches = pair.matches;
   const FundamentalResult& fundamental = pair.fundamental;
   const double similarity = pair.similarity;

@@ -41,6 +41,14 @@ class Matcher {
   virtual std::string name() const = 0;
   // `gray` is 8-bit single-channel. Never returns null; an image without features gives num_features() == 0.
   virtual std::shared_ptr<const ImageFeatures> Extract(const cv::Mat& gray) const = 0;
+  // A model whose upstream reads colour says so (XFeat averages B, G, R, which no grey conversion of the
+  // decoder or of cvtColor equals): its callers then give ExtractFrame the frame's colour image too.
+  virtual bool reads_color() const { return false; }
+  // `bgr` is the same image as `gray`, 8-bit BGR, or empty for a grey input. The default, for matchers that
+  // read grey, ignores it, so that their features do not depend on whether the input had colour.
+  virtual std::shared_ptr<const ImageFeatures> ExtractFrame(const cv::Mat& gray, const cv::Mat& bgr) const {
+    return Extract(gray);
+  }
   // Features must come from this matcher's Extract.
   virtual TentativeMatches Match(const ImageFeatures& features0, const ImageFeatures& features1) const = 0;
   // The matcher's settings, recorded in map.json.

@@ -163,7 +163,8 @@ void ComputeKeyImages(const fs::path& map_directory, const VisualMap& map, const
     try {
       for (size_t k = next++; k < n; k = next++) {
         const cv::Mat gray = ReadKeyImage(map_directory, map.key_images[k], /*grayscale=*/true);
-        store.features[k] = matcher.Extract(gray);
+        const cv::Mat bgr = matcher.reads_color() ? ReadKeyImage(map_directory, map.key_images[k]) : cv::Mat();
+        store.features[k] = matcher.ExtractFrame(gray, bgr.channels() == 3 ? bgr : cv::Mat());
         store.thumbnails[k] = ThumbnailDescriptor(gray, options.thumbnail_width);
       }
     } catch (...) {

@@ -69,7 +69,7 @@ LocalizationSummary LocalizeSequence(FrameSource& source, const Matcher& matcher
   auto extract = [&](Frame frame) {
     ExtractedFrame item;
     const auto extract_start = std::chrono::steady_clock::now();
-    item.features = matcher.Extract(frame.gray);
+    item.features = matcher.ExtractFrame(frame.gray, frame.color);
     item.extract_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - extract_start).count();
     if (ahead) item.ahead = ahead(*item.features);

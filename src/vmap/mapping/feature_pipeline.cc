@@ -60,7 +60,7 @@ PipelineItem FeaturePipeline::ExtractAndCompare(Frame decoded) {
                                 std::to_string(decoded.source_index) + " (" + decoded.source_name + ")",
                             "check the frame, or try other matcher options"};
       },
-      [&] { return matcher_.Extract(decoded.gray); });
+      [&] { return matcher_.ExtractFrame(decoded.gray, decoded.color); });
   item.record.frame = std::make_shared<const Frame>(std::move(decoded));
   ++extracted_;
   const int frame_index = item.record.frame->index;

@@ -64,7 +64,7 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
   };
   auto with_features = [&](int index) -> const FrameRecord& {
     FrameRecord& record = frames.at(index);
-    if (!record.features) record.features = matcher.Extract(record.frame->gray);
+    if (!record.features) record.features = matcher.ExtractFrame(record.frame->gray, record.frame->color);
     return record;
   };
   // Compares the frames at `positions` with the key, one thread each; returns the first that fails (or -1)
@@ -78,7 +78,7 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
       }
       FrameRecord frame = frames.at(position);
       results.push_back(std::async(std::launch::async, [&matcher, &compare, key, frame]() mutable {
-        if (!frame.features) frame.features = matcher.Extract(frame.frame->gray);
+        if (!frame.features) frame.features = matcher.ExtractFrame(frame.frame->gray, frame.frame->color);
         return std::make_pair(frame.features, compare(key, frame));
       }));
     }

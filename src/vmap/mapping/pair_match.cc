@@ -12,12 +12,12 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-PairMatch MatchPair(const Matcher& matcher, const cv::Mat& gray0, const cv::Mat& gray1,
+PairMatch MatchPair(const Matcher& matcher, const PairImage& image0, const PairImage& image1,
                     const VerifierOptions& verifier, const HeadingOptions& heading, const Camera* camera) {
   PairMatch pair;
   auto start = std::chrono::steady_clock::now();
-  const auto features0 = matcher.Extract(gray0);
-  const auto features1 = matcher.Extract(gray1);
+  const auto features0 = matcher.ExtractFrame(image0.gray, image0.bgr);
+  const auto features1 = matcher.ExtractFrame(image1.gray, image1.bgr);
   pair.extract_seconds = SecondsSince(start);
   start = std::chrono::steady_clock::now();
   pair.matches = matcher.Match(*features0, *features1);

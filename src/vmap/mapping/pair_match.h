@@ -2,6 +2,8 @@
 // One image pair through a matcher and the verifier, in full: what `vmap match` and the Python module's
 // vmap.match show to try a matcher on one's own images.
 
+#include <utility>
+
 #include <opencv2/core.hpp>
 
 #include "vmap/features/matcher.h"
@@ -22,10 +24,18 @@ struct PairMatch {
   double heading_seconds = 0.0;
 };
 
-// Extracts both images' features (`gray0`, `gray1`: 8-bit grey), matches them, and verifies the matches
+// One image of a pair: 8-bit grey, and the same image as 8-bit BGR when it has colour (else empty), for a
+// matcher that reads colour (Matcher::reads_color). Built from a grey cv::Mat alone where there is no colour.
+struct PairImage {
+  PairImage(cv::Mat gray_image, cv::Mat bgr_image = {}) : gray(std::move(gray_image)), bgr(std::move(bgr_image)) {}
+  cv::Mat gray;
+  cv::Mat bgr;
+};
+
+// Extracts both images' features (Matcher::ExtractFrame), matches them, and verifies the matches
 // exhaustively with `verifier` when there are at least verifier.min_matches of them, and estimates the heading
 // (with `camera`, of images of its size, also in degrees).
-PairMatch MatchPair(const Matcher& matcher, const cv::Mat& gray0, const cv::Mat& gray1,
+PairMatch MatchPair(const Matcher& matcher, const PairImage& image0, const PairImage& image1,
                     const VerifierOptions& verifier, const HeadingOptions& heading = {},
                     const Camera* camera = nullptr);
 

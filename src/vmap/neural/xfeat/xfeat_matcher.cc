@@ -58,29 +58,20 @@ class XfeatMatcher : public Matcher {
 
   std::string name() const override { return "xfeat"; }
 
+  // Upstream's network input is the mean of B, G and R (taken inside the network), not a luminance.
+  bool reads_color() const override { return true; }
+
   std::shared_ptr<const ImageFeatures> Extract(const cv::Mat& gray) const override {
     if (gray.empty() || gray.type() != CV_8UC1) throw InputError("XFeat needs an 8-bit single-channel image");
-    if (gray.cols < kMinimumSide || gray.rows < kMinimumSide) {
-      throw InputError("image of " + std::to_string(gray.cols) + "x" + std::to_string(gray.rows) +
-                       " is smaller than the 32x32 XFeat needs");
+    return ExtractPixels(gray);
+  }
+
+  std::shared_ptr<const ImageFeatures> ExtractFrame(const cv::Mat& gray, const cv::Mat& bgr) const override {
+    if (bgr.empty()) return Extract(gray);
+    if (bgr.type() != CV_8UC3 || bgr.size() != gray.size()) {
+      throw InputError("XFeat needs the colour image as 8-bit BGR of the grey image's size");
     }
-    const cv::Mat pixels = gray.isContinuous() ? gray : gray.clone();
-    UseThreads();
-    torch::InferenceMode guard;
-    // uint8 -> float32, then a true division by 255, as upstream's parse_input (not * (1/255): not bit-equal).
-    const auto image = torch::from_blob(pixels.data, {1, 1, pixels.rows, pixels.cols}, torch::kUInt8)
-                           .to(torch::kFloat32)
-                           .div_(255.0);
-    neural::XfeatDetectOptions detect;
-    detect.top_k = options_.top_k;
-    detect.detection_threshold = options_.detection_threshold;
-    const neural::XfeatDetections found = model_.DetectAndCompute(image, detect);
-    const auto keypoints = found.keypoints.to(torch::kCPU).contiguous();
-    std::vector<cv::Point2f> points;
-    points.reserve(static_cast<size_t>(keypoints.size(0)));
-    const float* xy = keypoints.data_ptr<float>();
-    for (int64_t k = 0; k < keypoints.size(0); ++k) points.emplace_back(xy[2 * k], xy[2 * k + 1]);
-    return std::make_shared<XfeatFeatures>(std::move(points), found.descriptors, gray.size());
+    return ExtractPixels(bgr);
   }
 
   TentativeMatches Match(const ImageFeatures& features0, const ImageFeatures& features1) const override {
@@ -123,6 +114,32 @@ class XfeatMatcher : public Matcher {
   }
 
  private:
+  // `image`: 8-bit, 1 channel (grey) or 3 (BGR, in upstream's channel order; the network averages them).
+  std::shared_ptr<const ImageFeatures> ExtractPixels(const cv::Mat& image) const {
+    if (image.cols < kMinimumSide || image.rows < kMinimumSide) {
+      throw InputError("image of " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
+                       " is smaller than the 32x32 XFeat needs");
+    }
+    const cv::Mat pixels = image.isContinuous() ? image : image.clone();
+    UseThreads();
+    torch::InferenceMode guard;
+    // uint8 -> float32, then a true division by 255, as upstream's parse_input (not * (1/255): not bit-equal).
+    const auto tensor = torch::from_blob(pixels.data, {1, pixels.rows, pixels.cols, pixels.channels()}, torch::kUInt8)
+                            .permute({0, 3, 1, 2})
+                            .to(torch::kFloat32)
+                            .div_(255.0);
+    neural::XfeatDetectOptions detect;
+    detect.top_k = options_.top_k;
+    detect.detection_threshold = options_.detection_threshold;
+    const neural::XfeatDetections found = model_.DetectAndCompute(tensor, detect);
+    const auto keypoints = found.keypoints.to(torch::kCPU).contiguous();
+    std::vector<cv::Point2f> points;
+    points.reserve(static_cast<size_t>(keypoints.size(0)));
+    const float* xy = keypoints.data_ptr<float>();
+    for (int64_t k = 0; k < keypoints.size(0); ++k) points.emplace_back(xy[2 * k], xy[2 * k + 1]);
+    return std::make_shared<XfeatFeatures>(std::move(points), found.descriptors, image.size());
+  }
+
   // Upstream keeps a similarity strictly above min_cossim (compared in float32), and filters nothing when
   // min_cossim <= 0; the float matcher keeps similarities >= its threshold.
   float MinSimilarity() const {
