@@ -111,6 +111,11 @@ std::string Card(const std::string& value, const std::string& label) {
          HtmlEscape(label) + "</div></div>";
 }
 
+std::string OptionsSection(const nlohmann::json& options, const std::string& summary) {
+  return "<section id=\"options\"><h2>Options</h2>\n<details><summary>" + summary + "</summary><pre>" +
+         HtmlEscape(options.dump(2)) + "</pre></details>\n</section>\n";
+}
+
 std::string Row(const std::string& name, const std::string& value_html) {
   return "<tr><th>" + HtmlEscape(name) + "</th><td>" + value_html + "</td></tr>\n";
 }

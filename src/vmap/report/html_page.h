@@ -31,6 +31,8 @@ std::string DurationText(double seconds);
 // A summary card (a big value over a small label) and a row of a summary table (the value is HTML).
 std::string Card(const std::string& value, const std::string& label);
 std::string Row(const std::string& name, const std::string& value_html);
+// The folded section that lists every option of the run (`summary`: the fold's title, HTML).
+std::string OptionsSection(const nlohmann::json& options, const std::string& summary);
 
 // A file name or path as a page shows it: the page is UTF-8, so a name that is not is shown percent-encoded,
 // as map.json stores it.
