@@ -171,7 +171,7 @@ void AddSourceOptions(CLI::App* command, SourceFlags& flags, OptionFlags& option
   option_flags.AddFlag(command, "--strict", flags.options.strict, "strict",
                        "Frames of a different size are an error, not a warning");
   option_flags.AddOption(command, "--camera", flags.options.camera, "camera",
-                         "Intrinsics: fx,fy,cx,cy[,k1,k2,p1,p2[,k3]] (pixels, native frame size) or a calibration "
+                         "Intrinsics: fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]] (pixels, native frame size) or a calibration "
                          "file (OpenCV YAML/JSON, EuRoC sensor.yaml, KITTI calib.txt, intrinsics.txt); 'none' ignores "
                          "the input's own. Default: the input's own, if any");
   option_flags.AddOption(command, "--topic", flags.options.topic, "topic",

@@ -80,7 +80,7 @@ void AddEvalCommand(CLI::App& app) {
                  "Format of --gt: " + ListEnumNames(kGroundTruthFormatNames) + " (auto: from its first line)")
       ->capture_default_str();
   option_flags.AddOption(command, "--camera", flags->camera, "camera",
-                         "Intrinsics when the map has none: fx,fy,cx,cy[,k1,k2,p1,p2[,k3]] or a calibration file");
+                         "Intrinsics when the map has none: fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]] or a calibration file");
   command->add_option("--json", flags->json, "Also write the evaluation (JSON) to this file");
   command->add_flag("!--no-save", flags->save, "Do not write eval.json into the map directory");
   command->add_flag("!--no-table", flags->table, "Print only the summary, not one row per link");

@@ -214,7 +214,7 @@ void AddMatchCommand(CLI::App& app) {
   command->add_option("--json", flags->json_path, "Also write every match, the inlier mask and F to this JSON file");
   command->add_flag("--list", flags->list, "Print every match: x0 y0 x1 y1 score inlier");
   flags->option_flags.AddOption(command, "--camera", flags->camera, "camera",
-                                "Intrinsics of both images (fx,fy,cx,cy[,k1,k2,p1,p2[,k3]] or a calibration file): "
+                                "Intrinsics of both images (fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]] or a calibration file): "
                                 "the heading also in degrees");
   AddHeadingOptions(command, flags->heading, flags->option_flags);
   AddMatcherOptions(command, flags->matcher, flags->option_flags);

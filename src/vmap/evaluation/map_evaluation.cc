@@ -253,7 +253,7 @@ std::optional<Camera> ParseEvaluationCamera(const std::string& camera_option) {
     std::error_code ec;
     if (fs::exists(camera_option, ec) && !fs::is_regular_file(camera_option, ec)) {
       throw OptionError("camera", "'" + camera_option + "' is not a regular file; give a calibration file or "
-                                  "fx,fy,cx,cy[,k1,k2,p1,p2[,k3]]");
+                                  "fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]]");
     }
     camera = ParseCameraOption(camera_option);
     try {

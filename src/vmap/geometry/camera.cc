@@ -1,5 +1,6 @@
 #include "vmap/geometry/camera.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -18,7 +19,9 @@ CameraModel ParseCameraModel(const std::string& name) { return ParseEnum(kCamera
 cv::Matx33d Camera::K() const { return cv::Matx33d(fx, 0, cx, 0, fy, cy, 0, 0, 1); }
 
 std::vector<double> Camera::distortion() const {
+  if (is_fisheye()) return {k1, k2, k3, k4};
   if (!has_distortion()) return {};
+  if (k4 != 0.0 || k5 != 0.0 || k6 != 0.0) return {k1, k2, p1, p2, k3, k4, k5, k6};
   if (k3 != 0.0) return {k1, k2, p1, p2, k3};
   return {k1, k2, p1, p2};
 }
@@ -28,13 +31,14 @@ std::vector<double> Camera::params() const {
     case CameraModel::kSimplePinhole: return {fx, cx, cy};
     case CameraModel::kPinhole: return {fx, fy, cx, cy};
     case CameraModel::kOpenCV: return {fx, fy, cx, cy, k1, k2, p1, p2};
-    case CameraModel::kFullOpenCV: return {fx, fy, cx, cy, k1, k2, p1, p2, k3, 0.0, 0.0, 0.0};
+    case CameraModel::kFullOpenCV: return {fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6};
+    case CameraModel::kOpenCVFisheye: return {fx, fy, cx, cy, k1, k2, k3, k4};
   }
   return {};
 }
 
 Camera Camera::FromParams(CameraModel model, const std::vector<double>& params, cv::Size size) {
-  static const size_t kCounts[] = {3, 4, 8, 12};
+  static const size_t kCounts[] = {3, 4, 8, 12, 8};
   const size_t expected = kCounts[static_cast<int>(model)];
   if (params.size() != expected) {
     throw InputError(fmt::format("camera model {} has {} parameters, got {}", CameraModelName(model), expected,
@@ -61,9 +65,15 @@ Camera Camera::FromParams(CameraModel model, const std::vector<double>& params, 
   }
   if (model == CameraModel::kFullOpenCV) {
     camera.k3 = params[8];
-    if (params[9] != 0.0 || params[10] != 0.0 || params[11] != 0.0) {
-      throw InputError("FULL_OPENCV cameras with k4, k5 or k6 (rational distortion) are not supported; use k1..k3");
-    }
+    camera.k4 = params[9];
+    camera.k5 = params[10];
+    camera.k6 = params[11];
+  }
+  if (model == CameraModel::kOpenCVFisheye) {
+    camera.k1 = params[4];
+    camera.k2 = params[5];
+    camera.k3 = params[6];
+    camera.k4 = params[7];
   }
   return camera;
 }
@@ -76,24 +86,26 @@ Camera Camera::Make(double fx, double fy, double cx, double cy, const std::vecto
   camera.cx = cx;
   camera.cy = cy;
   camera.size = size;
-  if (!distortion.empty() && distortion.size() != 4 && distortion.size() != 5) {
-    // OpenCV writes 5, 8, 12 or 14 coefficients; the ones past k3 must then be zero.
-    for (size_t i = 5; i < distortion.size(); ++i) {
-      if (distortion[i] != 0.0) {
-        throw InputError("distortion coefficients past k1, k2, p1, p2, k3 (rational, thin-prism or tilt models) "
-                         "are not supported; recalibrate with OpenCV's default model");
-      }
+  if (!distortion.empty() && distortion.size() < 4) {
+    throw InputError("distortion needs k1, k2, p1, p2 (and optionally k3, or k3..k6)");
+  }
+  // OpenCV writes 5, 8, 12 or 14 coefficients; the thin-prism and tilt terms past k6 must be zero.
+  for (size_t i = 8; i < distortion.size(); ++i) {
+    if (distortion[i] != 0.0) {
+      throw InputError("distortion coefficients past k6 (thin-prism or tilt models) are not supported; "
+                       "recalibrate with OpenCV's default or rational model");
     }
-    if (distortion.size() < 4) throw InputError("distortion needs k1, k2, p1, p2 (and optionally k3)");
   }
-  if (distortion.size() >= 4) {
-    camera.k1 = distortion[0];
-    camera.k2 = distortion[1];
-    camera.p1 = distortion[2];
-    camera.p2 = distortion[3];
-    if (distortion.size() >= 5) camera.k3 = distortion[4];
+  if (distortion.size() == 6 || distortion.size() == 7) {
+    throw InputError("distortion has " + std::to_string(distortion.size()) +
+                     " coefficients; OpenCV's models have 4, 5, 8, 12 or 14");
   }
-  if (camera.k3 != 0.0) camera.model = CameraModel::kFullOpenCV;
+  double* const coefficients[] = {&camera.k1, &camera.k2, &camera.p1, &camera.p2,
+                                  &camera.k3, &camera.k4, &camera.k5, &camera.k6};
+  for (size_t i = 0; i < std::min<size_t>(distortion.size(), 8); ++i) *coefficients[i] = distortion[i];
+  if (camera.k3 != 0.0 || camera.k4 != 0.0 || camera.k5 != 0.0 || camera.k6 != 0.0) {
+    camera.model = CameraModel::kFullOpenCV;
+  }
   else if (camera.has_distortion()) camera.model = CameraModel::kOpenCV;
   else if (fx == fy) camera.model = CameraModel::kSimplePinhole;
   else camera.model = CameraModel::kPinhole;
@@ -118,13 +130,16 @@ Camera Camera::ScaledTo(cv::Size new_size) const {
 
 void Camera::Check() const {
   const std::string where = origin.empty() ? "the camera" : "the camera from " + origin;
-  for (double v : {fx, fy, cx, cy, k1, k2, p1, p2, k3}) {
+  for (double v : {fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6}) {
     if (!std::isfinite(v)) throw InputError(where + " has a parameter that is not a finite number");
   }
   if (!(fx > 0.0 && fy > 0.0)) {
     throw InputError(fmt::format("{} has focal lengths fx = {}, fy = {}; both must be > 0 (pixels)", where, fx, fy));
   }
   if (size.width < 0 || size.height < 0) throw InputError(where + " has a negative image size");
+  if (is_fisheye() && (p1 != 0.0 || p2 != 0.0 || k5 != 0.0 || k6 != 0.0)) {
+    throw InputError(where + " is a fisheye (OPENCV_FISHEYE) camera with p1, p2, k5 or k6 set; it has k1..k4 only");
+  }
 }
 
 namespace {
@@ -144,7 +159,8 @@ std::vector<double> NumbersIn(const std::string& text) {
       if (used != token.size()) throw std::invalid_argument(token);
     } catch (const std::exception&) {
       throw OptionError("camera", "'" + text + "': '" + token +
-                                  "' is not a number; give fx,fy,cx,cy[,k1,k2,p1,p2[,k3]] or a calibration file");
+                                  "' is not a number; give fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]] or a "
+                                  "calibration file");
     }
   }
   return numbers;
@@ -186,10 +202,10 @@ cv::FileNode FirstOf(const cv::FileStorage& fs, std::initializer_list<const char
 
 Camera ParseCameraText(const std::string& text) {
   const std::vector<double> n = NumbersIn(text);
-  if (n.size() != 4 && n.size() != 8 && n.size() != 9) {
+  if (n.size() != 4 && n.size() != 8 && n.size() != 9 && n.size() != 12) {
     throw OptionError("camera", "'" + text + "' has " + std::to_string(n.size()) +
-                                " numbers; give fx,fy,cx,cy or fx,fy,cx,cy,k1,k2,p1,p2[,k3] (pixels), or a "
-                                "calibration file");
+                                " numbers; give fx,fy,cx,cy or fx,fy,cx,cy,k1,k2,p1,p2[,k3[,k4,k5,k6]] (pixels), "
+                                "or a calibration file");
   }
   Camera camera = Camera::Make(n[0], n[1], n[2], n[3], std::vector<double>(n.begin() + 4, n.end()));
   camera.origin = "--camera";
@@ -223,7 +239,23 @@ Camera ReadOpenCvCameraFile(const std::string& path) {
   cv::Size size;
   const cv::FileNode width = fs["image_width"], height = fs["image_height"];
   if (width.isInt() && height.isInt()) size = cv::Size(static_cast<int>(width), static_cast<int>(height));
-  Camera camera = Camera::Make(K[0], K[4], K[2], K[5], distortion, size);
+  const cv::FileNode model_node = fs["distortion_model"];
+  const std::string model = model_node.isString() ? static_cast<std::string>(model_node) : "";
+  Camera camera;
+  if (model == "equidistant" || model == "fisheye") {
+    if (distortion.size() != 4) {
+      throw InputError("camera file '" + path + "': an " + model + " camera needs 4 distortion_coefficients (k1..k4 "
+                       "of cv::fisheye), got " + std::to_string(distortion.size()));
+    }
+    camera = Camera::FromParams(CameraModel::kOpenCVFisheye,
+                                {K[0], K[4], K[2], K[5], distortion[0], distortion[1], distortion[2], distortion[3]},
+                                size);
+  } else if (model.empty() || model == "plumb_bob" || model == "rational_polynomial" || model == "radtan") {
+    camera = Camera::Make(K[0], K[4], K[2], K[5], distortion, size);
+  } else {
+    throw InputError("camera file '" + path + "': distortion_model '" + model +
+                     "' is none of plumb_bob, rational_polynomial, equidistant, fisheye");
+  }
   camera.origin = path;
   camera.Check();
   return camera;
@@ -270,6 +302,12 @@ std::vector<cv::Point2d> NormalizePoints(const Camera& camera, const std::vector
     return normalized;
   }
   std::vector<cv::Point2d> input(pixels.begin(), pixels.end());
+  if (camera.is_fisheye()) {
+    cv::fisheye::undistortPoints(input, normalized, cv::Mat(camera.K()), camera.distortion(), cv::noArray(),
+                                 cv::noArray(),
+                                 cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 1e-10));
+    return normalized;
+  }
   // Iterative undistortion; OpenCV's default of 5 iterations leaves visible error at the image corners
   // of strongly distorted lenses.
   cv::undistortPoints(input, normalized, cv::Mat(camera.K()), camera.distortion(), cv::noArray(), cv::noArray(),

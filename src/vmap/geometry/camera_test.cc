@@ -19,7 +19,10 @@ TEST(Camera, PicksTheSimplestColmapModelAndRoundTripsItsParameters) {
   EXPECT_EQ(Camera::Make(500, 500, 320, 240, {0.1, 0, 0, 0, 0.01}).model, CameraModel::kFullOpenCV);
   for (const Camera& camera : {Camera::Make(500, 500, 320, 240), Camera::Make(500, 510, 321, 239),
                                Camera::Make(500, 510, 320, 240, {-0.2, 0.05, 1e-3, -2e-3}),
-                               Camera::Make(500, 510, 320, 240, {-0.2, 0.05, 1e-3, -2e-3, 0.01})}) {
+                               Camera::Make(500, 510, 320, 240, {-0.2, 0.05, 1e-3, -2e-3, 0.01}),
+                               Camera::Make(500, 510, 320, 240, {-0.2, 0.05, 1e-3, -2e-3, 0.01, 0.1, 0.02, 0.003}),
+                               Camera::FromParams(CameraModel::kOpenCVFisheye, {500, 510, 320, 240, 0.1, -0.02, 0.003,
+                                                                               -0.0004})}) {
     const Camera back = Camera::FromParams(camera.model, camera.params(), {640, 480});
     EXPECT_EQ(ParseCameraModel(CameraModelName(camera.model)), camera.model);
     EXPECT_EQ(back.K(), camera.K());
@@ -27,7 +30,13 @@ TEST(Camera, PicksTheSimplestColmapModelAndRoundTripsItsParameters) {
   }
   EXPECT_EQ(CameraModelName(CameraModel::kPinhole), "PINHOLE");
   EXPECT_EQ(CameraModelName(CameraModel::kOpenCV), "OPENCV");
+  EXPECT_EQ(Camera::Make(500, 500, 320, 240, {0.1, 0, 0, 0, 0, 0.01, 0, 0}).model, CameraModel::kFullOpenCV);
+  EXPECT_EQ(CameraModelName(CameraModel::kOpenCVFisheye), "OPENCV_FISHEYE");
+  // A fisheye lens with zero coefficients is still the equidistant projection, not a pinhole.
+  EXPECT_TRUE(Camera::FromParams(CameraModel::kOpenCVFisheye, {500, 500, 320, 240, 0, 0, 0, 0}).has_distortion());
   EXPECT_THROW(ParseCameraModel("FISHEYE"), InputError);
+  EXPECT_THROW(Camera::Make(500, 500, 320, 240, {0.1, 0, 0, 0, 0, 0.01}), InputError);  // 6 coefficients
+  EXPECT_THROW(Camera::Make(500, 500, 320, 240, {0.1, 0, 0, 0, 0, 0, 0, 0, 0.01, 0, 0, 0}), InputError);  // s1
   EXPECT_THROW(Camera::FromParams(CameraModel::kPinhole, {1, 2, 3}), InputError);
 }
 
@@ -40,6 +49,7 @@ TEST(Camera, ParsesTheCameraOptionText) {
   EXPECT_EQ(distorted.model, CameraModel::kOpenCV);
   EXPECT_DOUBLE_EQ(distorted.p2, 0.002);
   EXPECT_DOUBLE_EQ(ParseCameraText("500,500,320,240,-0.1,0.02,0,0,0.003").k3, 0.003);
+  EXPECT_DOUBLE_EQ(ParseCameraText("500,500,320,240,-0.1,0.02,0,0,0.003,0.1,0.01,0.001").k5, 0.01);
   for (const char* bad : {"500,500,320", "500,500,320,240,0.1", "a,b,c,d", "-500,500,320,240", "0,500,320,240"}) {
     EXPECT_THROW(ParseCameraText(bad), InputError) << bad;
   }
@@ -62,6 +72,22 @@ TEST(Camera, ReadsOpenCvCalibrationFilesInYamlAndJson) {
     EXPECT_DOUBLE_EQ(camera.k3, -0.011);
     EXPECT_DOUBLE_EQ(camera.p1, 0.0012);
   }
+  {
+    // A fisheye calibration, its model named as ROS's camera_calibration names it.
+    cv::FileStorage fs((tmp.path() / "fisheye.yaml").string(), cv::FileStorage::WRITE);
+    fs << "image_width" << 640 << "image_height" << 480 << "camera_matrix" << cv::Mat(K)
+       << "distortion_model" << "equidistant" << "distortion_coefficients"
+       << (cv::Mat_<double>(4, 1) << 0.05, -0.01, 0.002, -0.0003);
+  }
+  const Camera fisheye = ReadOpenCvCameraFile((tmp.path() / "fisheye.yaml").string());
+  EXPECT_EQ(fisheye.model, CameraModel::kOpenCVFisheye);
+  EXPECT_EQ(fisheye.distortion(), (std::vector<double>{0.05, -0.01, 0.002, -0.0003}));
+  {
+    cv::FileStorage fs((tmp.path() / "unknown_model.yaml").string(), cv::FileStorage::WRITE);
+    fs << "camera_matrix" << cv::Mat(K) << "distortion_model" << "kannala_brandt"
+       << "distortion_coefficients" << distortion;
+  }
+  EXPECT_THROW(ReadOpenCvCameraFile((tmp.path() / "unknown_model.yaml").string()), InputError);
   {
     cv::FileStorage fs((tmp.path() / "no_matrix.yaml").string(), cv::FileStorage::WRITE);
     fs << "image_width" << 640;
@@ -137,6 +163,42 @@ TEST(Camera, NormalizePointsUndoesOpenCvsProjection) {
     EXPECT_NEAR(normalized[i].y, points[i].y, 2e-5);
     EXPECT_NEAR(pinhole[i].x, camera.fx * points[i].x + camera.cx, 0.01);
   }
+}
+
+// Rational (k4..k6) and fisheye lenses: NormalizePoints inverts OpenCV's own projection for each model, the
+// fisheye's out to wide angles (rays 61 degrees off axis).
+TEST(Camera, NormalizePointsUndoesRationalAndFisheyeProjections) {
+  std::vector<cv::Point3d> points;
+  for (double x : {-1.6, -0.5, 0.0, 0.3, 1.2})
+    for (double y : {-0.9, 0.0, 0.7}) points.emplace_back(x, y, 1.0);
+  // A rational calibration as wide lenses get them (numerator and denominator nearly cancel), over the image.
+  std::vector<cv::Point3d> in_view;
+  for (double x : {-0.6, -0.2, 0.3, 0.6})
+    for (double y : {-0.45, 0.0, 0.4}) in_view.emplace_back(x, y, 1.0);
+  const Camera rational =
+      Camera::Make(520, 515, 318, 241, {0.9, 0.2, 0.0012, -0.0007, 0.005, 1.25, 0.4, 0.02});
+  ASSERT_EQ(rational.model, CameraModel::kFullOpenCV);
+  std::vector<cv::Point2d> projected;
+  cv::projectPoints(in_view, cv::Vec3d(), cv::Vec3d(), cv::Mat(rational.K()), rational.distortion(), projected);
+  std::vector<cv::Point2d> normalized =
+      NormalizePoints(rational, std::vector<cv::Point2f>(projected.begin(), projected.end()));
+  for (size_t i = 0; i < in_view.size(); ++i) {
+    EXPECT_NEAR(normalized[i].x, in_view[i].x, 1e-4) << i;
+    EXPECT_NEAR(normalized[i].y, in_view[i].y, 1e-4) << i;
+  }
+  const Camera fisheye =
+      Camera::FromParams(CameraModel::kOpenCVFisheye, {300, 302, 318, 241, 0.08, -0.02, 0.004, -0.0005});
+  cv::fisheye::projectPoints(points, projected, cv::Vec3d(), cv::Vec3d(), cv::Mat(fisheye.K()), fisheye.distortion());
+  normalized = NormalizePoints(fisheye, std::vector<cv::Point2f>(projected.begin(), projected.end()));
+  for (size_t i = 0; i < points.size(); ++i) {
+    EXPECT_NEAR(normalized[i].x, points[i].x, 1e-4) << i;
+    EXPECT_NEAR(normalized[i].y, points[i].y, 1e-4) << i;
+  }
+  // The equidistant projection is not the pinhole's: without the fisheye model these rays would be off.
+  const Camera pinhole = Camera::Make(300, 302, 318, 241);
+  const std::vector<cv::Point2d> as_pinhole =
+      NormalizePoints(pinhole, std::vector<cv::Point2f>(projected.begin(), projected.end()));
+  EXPECT_GT(std::abs(as_pinhole[0].x - points[0].x), 0.3);
 }
 
 }  // namespace vmap

@@ -103,7 +103,7 @@ Camera CameraFromJson(const json& object, const std::string& file, const std::st
         std::abs(camera.cy) > kMaxPixels) {
       Malformed(file, where + " has a focal length or principal point beyond 10,000,000 pixels");
     }
-    for (double k : {camera.k1, camera.k2, camera.p1, camera.p2, camera.k3}) {
+    for (double k : {camera.k1, camera.k2, camera.p1, camera.p2, camera.k3, camera.k4, camera.k5, camera.k6}) {
       if (std::abs(k) > kMaxDistortion) Malformed(file, where + " has a distortion coefficient beyond 1000");
     }
     camera.origin = object.value("origin", "");

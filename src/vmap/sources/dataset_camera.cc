@@ -275,7 +275,7 @@ Camera ParseCameraOption(const std::string& value) {
   const bool looks_numeric = !value.empty() && value.find_first_not_of("0123456789.,;eE+- \t") == std::string::npos;
   if (!looks_numeric) {
     throw OptionError("camera", "'" + value +
-                                "' is neither an existing calibration file nor fx,fy,cx,cy[,k1,k2,p1,p2[,k3]]");
+                                "' is neither an existing calibration file nor fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]]");
   }
   return ParseCameraText(value);
 }

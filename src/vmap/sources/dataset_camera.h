@@ -41,7 +41,7 @@ struct EurocSensor {
 };
 EurocSensor ReadEurocSensor(const std::string& sensor_yaml);
 
-// The camera a --camera value names: "fx,fy,cx,cy[,k1,k2,p1,p2[,k3]]" or a calibration file (as above).
+// The camera a --camera value names: "fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]]" or a calibration file (as above).
 Camera ParseCameraOption(const std::string& value);
 
 }  // namespace vmap

@@ -46,7 +46,7 @@ struct FrameSourceOptions {
   // and bounds the memory a hostile image can take once decoded.
   long max_frame_pixels = 8192L * 8192L;
   // The camera: "" = the intrinsics that come with the input, if any (see dataset_camera.h); "none" = no
-  // camera; otherwise "fx,fy,cx,cy[,k1,k2,p1,p2[,k3]]" or a calibration file (--camera).
+  // camera; otherwise "fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]]" or a calibration file (--camera).
   std::string camera;
   // A single image file is a sequence of one frame (vmap localize takes one query image); otherwise it is an
   // error, since one frame makes no map.

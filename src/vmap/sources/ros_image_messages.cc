@@ -161,29 +161,34 @@ std::optional<Camera> DecodeCameraInfo(const uint8_t* data, size_t size, Message
   double k[9];
   buffer.F64Fixed(k, 9);
   if (k[0] == 0.0 && k[4] == 0.0) return std::nullopt;  // an uncalibrated camera
-  if (model == "rational_polynomial") {
-    // k1 k2 p1 p2 k3 k4 k5 k6: vmap's cameras stop at k3 (COLMAP's OPENCV / FULL_OPENCV up to k3).
-    for (size_t i = 5; i < d.size(); ++i) {
-      if (d[i] != 0.0) {
-        throw InputError(what + ": the camera's rational_polynomial distortion has k4..k6, which vmap's camera "
-                         "models do not hold; give --camera (fx,fy,cx,cy,k1,k2,p1,p2,k3 or a file), or --camera none");
-      }
+  const cv::Size image_size(static_cast<int>(std::min<uint32_t>(width, INT32_MAX)),
+                            static_cast<int>(std::min<uint32_t>(height, INT32_MAX)));
+  if (model == "equidistant") {
+    // ROS's equidistant is OpenCV's fisheye model: D = k1..k4 (camera_calibration's fisheye calibration).
+    if (d.size() != 4) {
+      throw InputError(what + ": equidistant distortion has " + std::to_string(d.size()) + " coefficients, not 4");
     }
-    d.resize(std::min<size_t>(d.size(), 5));
+    Camera camera = Camera::FromParams(CameraModel::kOpenCVFisheye, {k[0], k[4], k[2], k[5], d[0], d[1], d[2], d[3]},
+                                       width == 0 || height == 0 ? cv::Size() : image_size);
+    return camera;
+  }
+  if (model == "rational_polynomial") {
+    if (d.size() > 8) {
+      throw InputError(what + ": rational_polynomial distortion has " + std::to_string(d.size()) +
+                       " coefficients, not 8");
+    }
   } else if (model == "plumb_bob" || model.empty()) {
     if (d.size() > 5) {
       throw InputError(what + ": plumb_bob distortion has " + std::to_string(d.size()) + " coefficients, not 5");
     }
   } else {
-    throw InputError(what + ": distortion model '" + model + "' is not one vmap's cameras hold (they are pinhole "
-                     "with plumb_bob / radial-tangential distortion; equidistant fisheye is not supported); give "
-                     "--camera with rectified intrinsics, or --camera none");
+    throw InputError(what + ": distortion model '" + model + "' is none of plumb_bob, rational_polynomial and "
+                     "equidistant; give --camera with rectified intrinsics, or --camera none");
   }
   while (!d.empty() && d.back() == 0.0) d.pop_back();
   if (d.size() > 0 && d.size() < 4) d.resize(4, 0.0);
-  Camera camera = Camera::Make(k[0], k[4], k[2], k[5], d,
-                               cv::Size(static_cast<int>(std::min<uint32_t>(width, INT32_MAX)),
-                                        static_cast<int>(std::min<uint32_t>(height, INT32_MAX))));
+  if (d.size() > 5) d.resize(8, 0.0);  // k4..k6 of the rational model
+  Camera camera = Camera::Make(k[0], k[4], k[2], k[5], d, image_size);
   if (width == 0 || height == 0) camera.size = cv::Size();
   return camera;
 }

@@ -1,7 +1,7 @@
 #pragma once
 // The three ROS message types vmap reads from a recording, decoded from either serialization:
 // sensor_msgs/Image (mono8, mono16, rgb8, bgr8, rgba8, bgra8, bayer_*8), sensor_msgs/CompressedImage (any
-// format OpenCV decodes: jpeg, png) and sensor_msgs/CameraInfo (plumb_bob, rational_polynomial).
+// format OpenCV decodes: jpeg, png) and sensor_msgs/CameraInfo (plumb_bob, rational_polynomial, equidistant).
 
 #include <cstdint>
 #include <optional>
@@ -37,8 +37,9 @@ cv::Size ImageMessageSize(const uint8_t* data, size_t size, const std::string& t
                           const std::string& what);
 
 // The camera of a CameraInfo message: K and D at its width x height. nullopt for an uncalibrated camera (K all
-// zero, as camera drivers publish before calibration). Throws InputError for a distortion model vmap's
-// cameras cannot hold (equidistant, rational_polynomial with k4..k6), naming the fix (--camera).
+// zero, as camera drivers publish before calibration). plumb_bob and rational_polynomial give OPENCV /
+// FULL_OPENCV cameras, equidistant an OPENCV_FISHEYE one. Throws InputError for another distortion model or a
+// wrong coefficient count, naming the fix (--camera).
 std::optional<Camera> DecodeCameraInfo(const uint8_t* data, size_t size, MessageEncoding encoding,
                                        const std::string& what);
 

@@ -161,10 +161,20 @@ TEST(RosImageMessages, CameraInfoModels) {
     const std::optional<Camera> rational = decode("rational_polynomial", {-0.2, 0.05, 0, 0, 0, 0, 0, 0}, k);
     ASSERT_TRUE(rational);
     EXPECT_EQ(rational->model, CameraModel::kOpenCV);
-    EXPECT_THROW(decode("rational_polynomial", {-0.2, 0.05, 0, 0, 0, 0.1, 0, 0}, k), InputError);
+    const std::optional<Camera> rational_k4 = decode("rational_polynomial", {-0.2, 0.05, 0, 0, 0, 0.1, 0, 0}, k);
+    ASSERT_TRUE(rational_k4);
+    EXPECT_EQ(rational_k4->model, CameraModel::kFullOpenCV);
+    EXPECT_EQ(rational_k4->k4, 0.1);
+    EXPECT_EQ(rational_k4->distortion().size(), 8u);
+    const std::optional<Camera> fisheye = decode("equidistant", {0.1, 0.01, -0.002, 0.0005}, k);
+    ASSERT_TRUE(fisheye);
+    EXPECT_EQ(fisheye->model, CameraModel::kOpenCVFisheye);
+    EXPECT_EQ(fisheye->distortion(), (std::vector<double>{0.1, 0.01, -0.002, 0.0005}));
+    EXPECT_EQ(fisheye->size, cv::Size(640, 480));
+    EXPECT_THROW(decode("equidistant", {0.1, 0.01, 0}, k), InputError);
     try {
-      decode("equidistant", {0.1, 0.01, 0, 0}, k);
-      ADD_FAILURE() << "equidistant accepted";
+      decode("kannala_brandt_8", {0.1, 0.01, 0, 0}, k);
+      ADD_FAILURE() << "an unknown distortion model accepted";
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find("--camera"), std::string::npos) << e.what();
     }
