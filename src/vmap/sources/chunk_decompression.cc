@@ -5,6 +5,7 @@
 #include <zstd.h>
 
 #include <climits>
+#include <cstdio>
 #include <memory>
 
 namespace vmap {
@@ -60,6 +61,75 @@ std::string DecompressChunk(const std::string& compression, const uint8_t* in, s
   if (compression == "bz2") return Bz2(in, size, out, out_size);
   if (compression == "zstd") return Zstd(in, size, out, out_size);
   return "compression '" + compression + "' is not one vmap reads (lz4, bz2, zstd)";
+}
+
+bool StartsWithZstdFrame(const uint8_t* data, size_t size) {
+  // ZSTD_MAGICNUMBER, little-endian.
+  return size >= 4 && data[0] == 0x28 && data[1] == 0xB5 && data[2] == 0x2F && data[3] == 0xFD;
+}
+
+namespace {
+using ZstdStream = std::unique_ptr<ZSTD_DStream, decltype(&ZSTD_freeDStream)>;
+ZstdStream NewZstdStream() { return ZstdStream(ZSTD_createDStream(), &ZSTD_freeDStream); }
+}  // namespace
+
+std::string DecompressZstd(const uint8_t* in, size_t size, size_t max_size, std::vector<uint8_t>* out) {
+  out->clear();
+  const ZstdStream stream = NewZstdStream();
+  if (!stream) return "cannot start zstd";
+  ZSTD_inBuffer input{in, size, 0};
+  uint8_t piece[1 << 16];
+  size_t hint = 1;
+  while (input.pos < input.size) {
+    ZSTD_outBuffer output{piece, sizeof piece, 0};
+    hint = ZSTD_decompressStream(stream.get(), &output, &input);
+    if (ZSTD_isError(hint)) return std::string("damaged zstd data (") + ZSTD_getErrorName(hint) + ")";
+    if (out->size() + output.pos > max_size) {
+      return "zstd data holds more than " + std::to_string(max_size) + " bytes";
+    }
+    out->insert(out->end(), piece, piece + output.pos);
+    if (output.pos == 0 && input.pos == input.size) break;
+  }
+  // The input is used up; what the decoder still holds comes out now.
+  while (hint != 0) {
+    ZSTD_outBuffer output{piece, sizeof piece, 0};
+    hint = ZSTD_decompressStream(stream.get(), &output, &input);
+    if (ZSTD_isError(hint)) return std::string("damaged zstd data (") + ZSTD_getErrorName(hint) + ")";
+    if (output.pos == 0) return "zstd data ends early";
+    if (out->size() + output.pos > max_size) {
+      return "zstd data holds more than " + std::to_string(max_size) + " bytes";
+    }
+    out->insert(out->end(), piece, piece + output.pos);
+  }
+  return "";
+}
+
+std::string DecompressZstdFile(const std::string& from, const std::string& to) {
+  const std::unique_ptr<FILE, decltype(&fclose)> in(fopen(from.c_str(), "rb"), &fclose);
+  if (!in) return "cannot open it";
+  const std::unique_ptr<FILE, decltype(&fclose)> out(fopen(to.c_str(), "wbx"), &fclose);
+  if (!out) return "cannot create the decompressed copy '" + to + "'";
+  const ZstdStream stream = NewZstdStream();
+  if (!stream) return "cannot start zstd";
+  std::vector<uint8_t> in_piece(ZSTD_DStreamInSize()), out_piece(ZSTD_DStreamOutSize());
+  size_t hint = 1, read = 0;
+  bool any = false;
+  while ((read = fread(in_piece.data(), 1, in_piece.size(), in.get())) > 0) {
+    any = true;
+    ZSTD_inBuffer input{in_piece.data(), read, 0};
+    while (input.pos < input.size) {
+      ZSTD_outBuffer output{out_piece.data(), out_piece.size(), 0};
+      hint = ZSTD_decompressStream(stream.get(), &output, &input);
+      if (ZSTD_isError(hint)) return std::string("damaged zstd data (") + ZSTD_getErrorName(hint) + ")";
+      if (fwrite(out_piece.data(), 1, output.pos, out.get()) != output.pos) {
+        return "cannot write the decompressed copy '" + to + "' (disk full?)";
+      }
+    }
+  }
+  if (ferror(in.get())) return "cannot read it";
+  if (!any || hint != 0) return "zstd data ends early";
+  if (fflush(out.get()) != 0) return "cannot write the decompressed copy '" + to + "' (disk full?)";
+  return "";
 }
 
 }  // namespace vmap

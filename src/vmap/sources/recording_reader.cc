@@ -14,6 +14,7 @@ bool IsRosbag2Folder(const fs::path& p) {
   for (const auto& entry : fs::directory_iterator(p, ec)) {
     const std::string extension = entry.path().extension().string();
     if (extension == ".db3" || extension == ".mcap") return true;
+    if (extension == ".zstd" && entry.path().stem().extension() == ".db3") return true;  // --compression-mode file
   }
   return false;
 }
@@ -50,7 +51,7 @@ std::unique_ptr<RecordingReader> OpenRecording(const std::string& path) {
     return mcap.empty() ? OpenRosbag2(path) : OpenMcap(mcap);
   }
   throw InputError("'" + path + "' is not a recording vmap reads: give a ROS 1 .bag, a rosbag2 folder (metadata.yaml "
-                   "and .db3 files) or an .mcap file");
+                   "and .db3 or .db3.zstd files) or an .mcap file");
 }
 
 std::string NormalizedTypeName(const std::string& type) {

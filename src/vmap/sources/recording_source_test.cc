@@ -1,9 +1,11 @@
 #include "vmap/sources/recording_source.h"
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -58,8 +60,9 @@ struct Container {
   std::string name;         // for traces
   std::string compression;  // as the writer takes it
 };
-const Container kContainers[] = {{"bag", "none"},   {"bag", "bz2"},      {"bag", "lz4"},  {"rosbag2", ""},
-                                 {"mcap", ""},      {"mcap", "none"},    {"mcap", "zstd"}, {"mcap", "lz4"}};
+const Container kContainers[] = {{"bag", "none"},        {"bag", "bz2"},      {"bag", "lz4"},
+                                 {"rosbag2", ""},        {"rosbag2", "message"}, {"rosbag2", "file"},
+                                 {"mcap", ""},           {"mcap", "none"},    {"mcap", "zstd"}, {"mcap", "lz4"}};
 
 // Writes the recording; "" with the reason in *why when it cannot (ROS 1 bags need python3-rosbag).
 std::string Write(const fs::path& dir, const Container& container, std::string* why) {
@@ -69,7 +72,7 @@ std::string Write(const fs::path& dir, const Container& container, std::string* 
     return testing::WriteRos1Bag(bag, Messages(MessageEncoding::kRos1), container.compression, why) ? bag : "";
   }
   if (container.name == "rosbag2") {
-    testing::WriteRosbag2(path.string(), Messages(MessageEncoding::kCdr));
+    testing::WriteRosbag2(path.string(), Messages(MessageEncoding::kCdr), container.compression);
     return path.string();
   }
   testing::WriteMcap(path.string() + ".mcap", Messages(MessageEncoding::kCdr), container.compression);
@@ -217,6 +220,53 @@ TEST(RecordingSource, DamagedRecordingsGiveTheFramesBeforeTheDamageOrAnError) {
       EXPECT_LE(read_damaged(corrupt), kFrames);
     }
   }
+}
+
+// rosbag2's zstd compression: a damaged compressed database or message is an InputError naming the file, and
+// the decompressed copy of a `--compression-mode file` database is gone once the source is.
+TEST(RecordingSource, CompressedRosbag2IsDecompressedOutOfTheWayAndDamageNamed) {
+  testing::ScopedTempDir dir("rosbag2_zstd");
+  const fs::path tmp = dir.path() / "tmp";
+  fs::create_directories(tmp);
+  const char* old_tmpdir = std::getenv("TMPDIR");
+  const std::string saved = old_tmpdir ? old_tmpdir : "";
+  setenv("TMPDIR", tmp.c_str(), 1);
+  FrameSourceOptions options;
+  options.topic = "/cam/image_raw";
+  {
+    testing::WriteRosbag2((dir.path() / "file").string(), Messages(MessageEncoding::kCdr), "file");
+    std::unique_ptr<FrameSource> source = OpenFrameSource((dir.path() / "file").string(), options);
+    long frames = 0;
+    while (source->Next()) ++frames;
+    EXPECT_EQ(frames, kFrames);
+    EXPECT_FALSE(fs::is_empty(tmp));  // the copy sqlite reads
+  }
+  EXPECT_TRUE(fs::is_empty(tmp));
+  const fs::path packed = dir.path() / "file" / "file_0.db3.zstd";
+  fs::resize_file(packed, fs::file_size(packed) / 2);
+  std::string error = ErrorOf([&] { ReadAll((dir.path() / "file").string(), options); });
+  EXPECT_NE(error.find("file_0.db3.zstd"), std::string::npos) << error;
+  EXPECT_TRUE(fs::is_empty(tmp));
+
+  // A message whose zstd frame is cut short: the first on /cam/image_raw (row 1 is the camera_info).
+  std::vector<testing::TestMessage> messages = Messages(MessageEncoding::kCdr);
+  testing::WriteRosbag2((dir.path() / "message").string(), messages, "message");
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((dir.path() / "message" / "message_0.db3").c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db, "UPDATE messages SET data = substr(data, 1, length(data) / 2) WHERE id = 2", nullptr,
+                         nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(db);
+  // As any damage: the frames before it, or an error naming the file.
+  long frames = -1;
+  error = ErrorOf([&] { frames = static_cast<long>(ReadAll((dir.path() / "message").string(), options).size()); });
+  if (error.empty()) {
+    EXPECT_LT(frames, kFrames);
+  } else {
+    EXPECT_NE(error.find("message_0.db3"), std::string::npos) << error;
+  }
+  if (old_tmpdir) setenv("TMPDIR", saved.c_str(), 1);
+  else unsetenv("TMPDIR");
 }
 
 }  // namespace

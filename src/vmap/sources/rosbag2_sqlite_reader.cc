@@ -2,14 +2,22 @@
 // bags: NAME_0.db3, NAME_1.db3, ... read in natural order), or one .db3 file. Each database has a `topics`
 // table (id, name, type, serialization_format) and a `messages` table (topic_id, timestamp in ns, data:
 // the CDR-serialized message). Messages are read in insertion order (rowid), one row at a time.
+//
+// Compressed bags (`ros2 bag record --compression-format zstd`): with `--compression-mode message` each data
+// blob is a zstd frame, told by its magic number (a CDR blob starts with a 0 byte); with `--compression-mode
+// file` each database is NAME_i.db3.zstd, decompressed into a temporary file (sqlite needs a file) that lives
+// as long as the reader.
 
 #include <sqlite3.h>
+
+#include <stdlib.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <map>
 
 #include "vmap/core/error.h"
+#include "vmap/sources/chunk_decompression.h"
 #include "vmap/sources/frame_source.h"
 #include "vmap/sources/recording_reader.h"
 
@@ -26,16 +34,26 @@ struct StatementFinalizer {
 using Database = std::unique_ptr<sqlite3, DatabaseCloser>;
 using Statement = std::unique_ptr<sqlite3_stmt, StatementFinalizer>;
 
+// The largest message vmap can use, decompressed: an image of FrameSourceOptions::max_frame_pixels (64 MP) at
+// 4 bytes a pixel, and its header. A message that claims more is damaged or hostile.
+constexpr size_t kMaxMessageBytes = size_t{320} << 20;
+
+bool IsCompressedDatabase(const fs::path& file) {
+  return file.extension() == ".zstd" && file.stem().extension() == ".db3";
+}
+
 std::vector<std::string> DatabaseFiles(const std::string& path) {
   if (!fs::is_directory(path)) return {path};
   std::vector<std::string> files;
   for (const auto& entry : fs::directory_iterator(path)) {
-    if (entry.path().extension() == ".db3") files.push_back(entry.path().string());
+    if (entry.path().extension() == ".db3" || IsCompressedDatabase(entry.path())) {
+      files.push_back(entry.path().string());
+    }
   }
   std::sort(files.begin(), files.end(), NaturalLess);
   if (files.empty()) {
-    throw InputError("rosbag2 folder '" + path + "' has no .db3 file; vmap reads rosbag2's sqlite3 storage and MCAP "
-                     "(give the .mcap file itself)");
+    throw InputError("rosbag2 folder '" + path + "' has no .db3 or .db3.zstd file; vmap reads rosbag2's sqlite3 "
+                     "storage and MCAP (give the .mcap file itself)");
   }
   return files;
 }
@@ -43,6 +61,14 @@ std::vector<std::string> DatabaseFiles(const std::string& path) {
 class Rosbag2SqliteReader : public RecordingReader {
  public:
   explicit Rosbag2SqliteReader(const std::string& path) : path_(path), files_(DatabaseFiles(path)) { Rewind(); }
+  ~Rosbag2SqliteReader() override {
+    statement_.reset();
+    database_.reset();
+    std::error_code ignored;
+    if (!decompressed_dir_.empty()) fs::remove_all(decompressed_dir_, ignored);
+  }
+  Rosbag2SqliteReader(const Rosbag2SqliteReader&) = delete;
+  Rosbag2SqliteReader& operator=(const Rosbag2SqliteReader&) = delete;
 
   MessageEncoding encoding() const override { return MessageEncoding::kCdr; }
   RecordingFormat format() const override { return RecordingFormat::kRosbag2; }
@@ -105,8 +131,17 @@ class Rosbag2SqliteReader : public RecordingReader {
         message->topic = Text(statement_.get(), 0);
         message->log_time_ns = sqlite3_column_int64(statement_.get(), 1);
         const auto* blob = static_cast<const uint8_t*>(sqlite3_column_blob(statement_.get(), 2));
-        const int size = sqlite3_column_bytes(statement_.get(), 2);
-        message->data.assign(blob, blob + std::max(size, 0));
+        const size_t size = static_cast<size_t>(std::max(sqlite3_column_bytes(statement_.get(), 2), 0));
+        if (StartsWithZstdFrame(blob, size)) {
+          const std::string error = DecompressZstd(blob, size, kMaxMessageBytes, &message->data);
+          if (!error.empty()) {
+            throw InputError("rosbag2 database '" + files_[file_index_] + "': message " +
+                             std::to_string(sqlite3_column_int64(statement_.get(), 3)) + " of " + message->topic +
+                             ": " + error + "; check that the recording is complete");
+          }
+        } else {
+          message->data.assign(blob, blob + size);
+        }
         message->offset = static_cast<uint64_t>(sqlite3_column_int64(statement_.get(), 3));
         return true;
       }
@@ -128,9 +163,33 @@ class Rosbag2SqliteReader : public RecordingReader {
                      "); check that it is a complete rosbag2 sqlite3 file");
   }
 
-  static Database Open(const std::string& file) {
+  // The database `file` as sqlite can open it: itself, or its decompressed copy, made on first use.
+  std::string Readable(const std::string& file) {
+    if (!IsCompressedDatabase(file)) return file;
+    auto found = decompressed_.find(file);
+    if (found != decompressed_.end()) return found->second;
+    if (decompressed_dir_.empty()) {
+      std::string pattern = (fs::temp_directory_path() / "vmap-rosbag2-XXXXXX").string();
+      if (mkdtemp(pattern.data()) == nullptr) {
+        throw InputError("rosbag2 database '" + file + "': cannot make a temporary folder to decompress it into; "
+                         "set TMPDIR to a writable folder");
+      }
+      decompressed_dir_ = pattern;
+    }
+    const std::string copy = (fs::path(decompressed_dir_) / fs::path(file).stem()).string();
+    const std::string error = DecompressZstdFile(file, copy);
+    if (!error.empty()) {
+      throw InputError("rosbag2 database '" + file + "': " + error +
+                       "; check that the recording is complete, or set TMPDIR to a folder with room for it");
+    }
+    decompressed_[file] = copy;
+    return copy;
+  }
+
+  Database Open(const std::string& file) {
+    const std::string readable = Readable(file);
     sqlite3* raw = nullptr;
-    const int status = sqlite3_open_v2(file.c_str(), &raw, SQLITE_OPEN_READONLY, nullptr);
+    const int status = sqlite3_open_v2(readable.c_str(), &raw, SQLITE_OPEN_READONLY, nullptr);
     Database db(raw);
     if (status != SQLITE_OK) Fail(db.get(), file, "cannot open it");
     return db;
@@ -150,6 +209,8 @@ class Rosbag2SqliteReader : public RecordingReader {
   size_t file_index_ = 0;
   Database database_;
   Statement statement_;
+  std::string decompressed_dir_;                      // the decompressed copies of .db3.zstd files, if any
+  std::map<std::string, std::string> decompressed_;  // file -> its copy
 };
 
 }  // namespace

@@ -271,14 +271,10 @@ void WriteMcap(const std::string& path, const std::vector<TestMessage>& messages
   std::ofstream(path, std::ios::binary) << file;
 }
 
-void WriteRosbag2(const std::string& folder, const std::vector<TestMessage>& messages) {
-  fs::create_directories(folder);
-  const std::string name = fs::path(folder).filename().string();
-  std::ofstream(fs::path(folder) / "metadata.yaml")
-      << "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: sqlite3\n  relative_file_paths:\n    - "
-      << name << "_0.db3\n";
+namespace {
+void WriteRosbag2Database(const std::string& file, const std::vector<TestMessage>& messages,
+                          bool compress_messages) {
   sqlite3* db = nullptr;
-  const std::string file = (fs::path(folder) / (name + "_0.db3")).string();
   Check(sqlite3_open(file.c_str(), &db), db, "open");
   const std::unique_ptr<sqlite3, decltype(&sqlite3_close)> closer(db, &sqlite3_close);
   Check(sqlite3_exec(db,
@@ -308,13 +304,45 @@ void WriteRosbag2(const std::string& folder, const std::vector<TestMessage>& mes
   for (const TestMessage& message : messages) {
     sqlite3_bind_int(insert, 1, topics[message.topic]);
     sqlite3_bind_int64(insert, 2, message.log_time_ns);
-    sqlite3_bind_blob(insert, 3, message.data.data(), static_cast<int>(message.data.size()), SQLITE_STATIC);
+    std::vector<uint8_t> packed;
+    if (compress_messages) {
+      packed.resize(ZSTD_compressBound(message.data.size()));
+      packed.resize(ZSTD_compress(packed.data(), packed.size(), message.data.data(), message.data.size(), 3));
+    }
+    const std::vector<uint8_t>& data = compress_messages ? packed : message.data;
+    sqlite3_bind_blob(insert, 3, data.data(), static_cast<int>(data.size()), SQLITE_TRANSIENT);
     Check(sqlite3_step(insert), db, "message");
     sqlite3_reset(insert);
   }
   sqlite3_finalize(insert);
   Check(sqlite3_exec(db, "COMMIT;", nullptr, nullptr, nullptr), db, "commit");
 }
+}  // namespace
+
+void WriteRosbag2(const std::string& folder, const std::vector<TestMessage>& messages,
+                  const std::string& compression) {
+  if (compression != "" && compression != "message" && compression != "file") {
+    throw std::invalid_argument("WriteRosbag2: compression " + compression);
+  }
+  fs::create_directories(folder);
+  const std::string name = fs::path(folder).filename().string();
+  std::ofstream(fs::path(folder) / "metadata.yaml")
+      << "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: sqlite3\n  relative_file_paths:\n    - "
+      << name << (compression == "file" ? "_0.db3.zstd" : "_0.db3") << "\n  compression_format: "
+      << (compression.empty() ? "\"\"" : "zstd") << "\n  compression_mode: "
+      << (compression.empty() ? "\"\"" : compression == "file" ? "FILE" : "MESSAGE") << "\n";
+  const std::string file = (fs::path(folder) / (name + "_0.db3")).string();
+  WriteRosbag2Database(file, messages, compression == "message");
+  if (compression == "file") {
+    std::ifstream in(file, std::ios::binary);
+    const std::string plain((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::string packed(ZSTD_compressBound(plain.size()), '\0');
+    packed.resize(ZSTD_compress(packed.data(), packed.size(), plain.data(), plain.size(), 3));
+    std::ofstream(file + ".zstd", std::ios::binary) << packed;
+    fs::remove(file);
+  }
+}
+
 
 bool WriteRos1Bag(const std::string& path, const std::vector<TestMessage>& messages, const std::string& compression,
                   std::string* why) {

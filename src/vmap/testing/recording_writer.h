@@ -35,8 +35,11 @@ std::vector<uint8_t> SerializeCameraInfo(MessageEncoding encoding, double stamp,
 // recording cut short has none.
 void WriteMcap(const std::string& path, const std::vector<TestMessage>& messages, const std::string& compression,
                int per_chunk = 4, bool summary = true);
-// A rosbag2 folder: metadata.yaml and FOLDER_0.db3.
-void WriteRosbag2(const std::string& folder, const std::vector<TestMessage>& messages);
+// A rosbag2 folder: metadata.yaml and FOLDER_0.db3. compression, as `ros2 bag record --compression-format zstd
+// --compression-mode MODE` writes it: "" (none), "message" (each message a zstd frame) or "file"
+// (FOLDER_0.db3.zstd).
+void WriteRosbag2(const std::string& folder, const std::vector<TestMessage>& messages,
+                  const std::string& compression = "");
 // compression: "none", "bz2" or "lz4". Returns false (and the reason in *why) when python3-rosbag is missing.
 bool WriteRos1Bag(const std::string& path, const std::vector<TestMessage>& messages, const std::string& compression,
                   std::string* why);
