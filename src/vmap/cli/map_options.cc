@@ -96,6 +96,18 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, OptionFlags& op
                  "Pixels: a link whose verified matches moved less than this once its rotation is undone (median) "
                  "is marked translation unknown")
       ->capture_default_str();
+  option_flags
+      .AddOption(command, "--rival-translation-angle", o.link_analysis.translation.rival_angle_deg,
+                 "link_analysis.translation.rival_angle_deg",
+                 "Degrees: another minimum of a link's pose cost whose translation points further away than this "
+                 "is a rival (see --min-rival-cost-gap)")
+      ->capture_default_str();
+  option_flags
+      .AddOption(command, "--min-rival-cost-gap", o.link_analysis.translation.min_rival_cost_gap,
+                 "link_analysis.translation.min_rival_cost_gap",
+                 "A link whose rival minimum costs less than this more than its pose (robust Sampson cost) is "
+                 "marked translation unknown: its direction is ambiguous (0: never)")
+      ->capture_default_str();
   option_flags.AddFlag(command, "--exhaustive", o.exhaustive, "exhaustive",
                        "The paper's exact behaviour: verify every comparison with OpenCV's USAC_MAGSAC to its "
                        "confidence criterion (default: stop once S >= tau is settled; same maps within seed noise)");

@@ -175,6 +175,19 @@ LinkEvaluation EvaluateLink(const VisualMap& map, int index, const GroundTruth& 
     e.true_parallax_px = Median(Displacements(all_from, all_to, &camera, &R_true));
   }
   if (has_estimate) {
+    if (e.true_baseline > 1e-9) {
+      std::vector<cv::Point2f> all_from = verified_from, all_to = verified_to;
+      all_from.insert(all_from.end(), rejected_from.begin(), rejected_from.end());
+      all_to.insert(all_to.end(), rejected_to.begin(), rejected_to.end());
+      RelativePose estimate, truth_pose;
+      estimate.valid = truth_pose.valid = true;
+      estimate.R = R_estimate;
+      estimate.t = t_estimate;
+      truth_pose.R = R_true;
+      truth_pose.t = cv::normalize(t_true);
+      e.true_pose_cost_excess = PoseCost(truth_pose, camera, all_from, all_to, PoseOptions()) -
+                                PoseCost(estimate, camera, all_from, all_to, PoseOptions());
+    }
     e.rotation_error_deg = RotationAngleDeg(R_estimate.t() * R_true);
     if (e.true_baseline > 1e-9) e.translation_error_deg = AngleBetweenDeg(t_estimate, t_true);
     const bool translation_judged = std::isfinite(e.true_parallax_px) && e.true_parallax_px >= options.min_parallax_px;
@@ -205,7 +218,7 @@ MapEvaluation EvaluateMap(const VisualMap& map, const GroundTruth& truth, const 
   evaluation.ground_truth_format = truth.format;
   evaluation.camera = camera;
   evaluation.options = options;
-  std::vector<double> rotation_errors, translation_errors, verified_within, rejected_within;
+  std::vector<double> rotation_errors, translation_errors, verified_within, rejected_within, cost_excesses;
   EvaluationSummary& s = evaluation.summary;
   for (int i = 0; i < static_cast<int>(map.links.size()); ++i) {
     LinkEvaluation e = EvaluateLink(map, i, truth, camera, options);
@@ -215,6 +228,7 @@ MapEvaluation EvaluateMap(const VisualMap& map, const GroundTruth& truth, const 
       ++s.evaluated_links;
       s.usable_links += e.usable ? 1 : 0;
       rotation_errors.push_back(e.rotation_error_deg);
+      cost_excesses.push_back(e.true_pose_cost_excess);
       if (std::isfinite(e.true_parallax_px) && e.true_parallax_px >= options.min_parallax_px) {
         translation_errors.push_back(e.translation_error_deg);
       }
@@ -241,6 +255,7 @@ MapEvaluation EvaluateMap(const VisualMap& map, const GroundTruth& truth, const 
   s.unflagged_usable_share = share(s.unflagged_usable_links, s.unflagged_links);
   s.rotation_error_deg_median = MedianOfFinite(rotation_errors);
   s.translation_error_deg_median = MedianOfFinite(translation_errors);
+  s.true_pose_cost_excess_median = MedianOfFinite(cost_excesses);
   s.verified_within_mean = MeanOfFinite(verified_within);
   s.rejected_within_mean = MeanOfFinite(rejected_within);
   return evaluation;
@@ -325,6 +340,7 @@ std::string EvaluationToJson(const MapEvaluation& evaluation) {
                      {"consistent_matches", e.consistent_matches},
                      {"translation_known", e.translation_known},
                      {"translation_sigma_deg", Number(e.translation_sigma_deg)},
+                     {"true_pose_cost_excess", Number(e.true_pose_cost_excess)},
                      {"strict_usable", e.strict_usable},
                      {"rotation_error_deg", Number(e.rotation_error_deg)},
                      {"translation_error_deg", Number(e.translation_error_deg)},
@@ -342,6 +358,7 @@ std::string EvaluationToJson(const MapEvaluation& evaluation) {
                     {"usable_share", Number(s.usable_share)},
                     {"links_with_pose", s.links_with_pose},
                     {"rotation_error_deg_median", Number(s.rotation_error_deg_median)},
+                    {"true_pose_cost_excess_median", Number(s.true_pose_cost_excess_median)},
                     {"translation_error_deg_median", Number(s.translation_error_deg_median)},
                     {"verified_within_threshold_mean", Number(s.verified_within_mean)},
                     {"rejected_within_threshold_mean", Number(s.rejected_within_mean)},
@@ -402,6 +419,7 @@ MapEvaluation ReadEvaluation(const std::string& path) {
       e.true_parallax_px = NumberField(l, "true_parallax_px");
       e.rotation_error_deg = NumberField(l, "rotation_error_deg");
       e.translation_error_deg = NumberField(l, "translation_error_deg");
+      e.true_pose_cost_excess = NumberField(l, "true_pose_cost_excess");
       e.verified_sampson_median = NumberField(l, "verified_sampson_median_px");
       e.verified_within = NumberField(l, "verified_within_threshold");
       e.rejected_sampson_median = NumberField(l, "rejected_sampson_median_px");
@@ -420,6 +438,7 @@ MapEvaluation ReadEvaluation(const std::string& path) {
     evaluation.summary.usable_share = NumberField(s, "usable_share");
     evaluation.summary.links_with_pose = s.value("links_with_pose", 0);
     evaluation.summary.rotation_error_deg_median = NumberField(s, "rotation_error_deg_median");
+    evaluation.summary.true_pose_cost_excess_median = NumberField(s, "true_pose_cost_excess_median");
     evaluation.summary.translation_error_deg_median = NumberField(s, "translation_error_deg_median");
     evaluation.summary.verified_within_mean = NumberField(s, "verified_within_threshold_mean");
     evaluation.summary.rejected_within_mean = NumberField(s, "rejected_within_threshold_mean");

@@ -69,6 +69,10 @@ struct LinkEvaluation {
   // a pose from F, or none, is not known.
   bool translation_known = false;
   double translation_sigma_deg = NAN;
+  // How much more the true pose costs on the link's own tentative matches than the judged pose (PoseCost with
+  // the default PoseOptions, geometry/relative_pose.h). Large: the matches, the camera or the ground truth
+  // disagree, and no better fit to the matches gets closer to the truth.
+  double true_pose_cost_excess = NAN;
 };
 
 struct EvaluationSummary {
@@ -78,6 +82,7 @@ struct EvaluationSummary {
   double usable_share = NAN; // usable / evaluated
   int links_with_pose = 0;   // stored or from F
   double rotation_error_deg_median = NAN;
+  double true_pose_cost_excess_median = NAN;  // over links with a pose and ground truth
   double translation_error_deg_median = NAN;  // over links with true parallax >= min_parallax_px
   double verified_within_mean = NAN;          // mean over links of the share of verified matches within 2 px
   double rejected_within_mean = NAN;          // the same for the rejected tentative matches

@@ -261,19 +261,36 @@ void TranslationOptions::Check() const {
   if (!(min_parallax_px >= 0.0 && std::isfinite(min_parallax_px))) {
     throw OptionError("min_parallax_px", fmt::format("{} px must be >= 0; the default is 3", min_parallax_px));
   }
+  if (!(rival_angle_deg >= 0.0 && rival_angle_deg < 180.0)) {
+    throw OptionError("rival_angle_deg", fmt::format("{} deg is outside [0, 180); the default is 15", rival_angle_deg));
+  }
+  if (!(min_rival_cost_gap >= 0.0 && std::isfinite(min_rival_cost_gap))) {
+    throw OptionError("min_rival_cost_gap", fmt::format("{} must be >= 0 (0: never ambiguous); the default is 8",
+                                                        min_rival_cost_gap));
+  }
 }
 
 bool TranslationKnown(double sigma_deg, double parallax_px, const TranslationOptions& options) {
-  return sigma_deg >= 0 && sigma_deg <= options.max_sigma_deg && parallax_px >= options.min_parallax_px;
+  return TranslationKnown(sigma_deg, parallax_px, std::numeric_limits<double>::infinity(), options);
+}
+
+bool TranslationKnown(double sigma_deg, double parallax_px, double rival_cost_gap, const TranslationOptions& options) {
+  return sigma_deg >= 0 && sigma_deg <= options.max_sigma_deg && parallax_px >= options.min_parallax_px &&
+         rival_cost_gap >= options.min_rival_cost_gap;
 }
 
 nlohmann::json ToJson(const TranslationOptions& options) {
-  return {{"max_sigma_deg", options.max_sigma_deg}, {"min_parallax_px", options.min_parallax_px}};
+  return {{"max_sigma_deg", options.max_sigma_deg},
+          {"min_parallax_px", options.min_parallax_px},
+          {"rival_angle_deg", options.rival_angle_deg},
+          {"min_rival_cost_gap", options.min_rival_cost_gap}};
 }
 
 void FromJson(const JsonFieldReader& fields, TranslationOptions* options) {
   fields.Read("max_sigma_deg", &options->max_sigma_deg);
   fields.Read("min_parallax_px", &options->min_parallax_px);
+  fields.Read("rival_angle_deg", &options->rival_angle_deg);
+  fields.Read("min_rival_cost_gap", &options->min_rival_cost_gap);
 }
 
 double PoseCost(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
@@ -325,8 +342,9 @@ RelativePose EssentialHypothesis(const std::vector<cv::Point2d>& y_from, const s
 
 RelativePose EstimateRelativePose(const Camera& camera, const std::vector<cv::Point2f>& from,
                                   const std::vector<cv::Point2f>& to, const PoseOptions& options,
-                                  const std::vector<RelativePose>& extra_starts) {
+                                  const std::vector<RelativePose>& extra_starts, std::vector<PoseMinimum>* minima) {
   CV_Assert(from.size() == to.size());
+  if (minima) minima->clear();
   if (static_cast<int>(from.size()) < options.min_matches) return RelativePose();
   const std::vector<cv::Point2d> y_from = NormalizePoints(camera, from), y_to = NormalizePoints(camera, to);
   // The threshold is a distance in pixels; on normalised points it is divided by the focal length.
@@ -347,12 +365,48 @@ RelativePose EstimateRelativePose(const Camera& camera, const std::vector<cv::Po
     // The refinement minimises errors that are the same for t and -t: it may end pointing backwards.
     const RelativePose candidate = EnforceCheirality(refined, camera, from, to, options.threshold);
     const double cost = PoseCost(candidate, camera, from, to, options);
+    if (minima) minima->push_back({candidate, cost});
     if (cost < best_cost) {  // ties keep the earlier start: deterministic
       best_cost = cost;
       best = candidate;
     }
   }
   return best;
+}
+
+double RivalCostGap(const std::vector<PoseMinimum>& minima, double min_angle_deg) {
+  const auto cheapest = std::min_element(minima.begin(), minima.end(),
+                                         [](const PoseMinimum& a, const PoseMinimum& b) { return a.cost < b.cost; });
+  double gap = std::numeric_limits<double>::infinity();
+  if (cheapest == minima.end()) return gap;
+  for (const PoseMinimum& minimum : minima) {
+    if (AngleBetweenDeg(minimum.pose.t, cheapest->pose.t) > min_angle_deg) {
+      gap = std::min(gap, minimum.cost - cheapest->cost);
+    }
+  }
+  return gap;
+}
+
+std::vector<PoseMinimum> ProbeTranslation(const RelativePose& pose, const Camera& camera,
+                                          const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to,
+                                          const PoseOptions& options, double angle_deg) {
+  std::vector<PoseMinimum> ends;
+  if (!pose.valid) return ends;
+  const cv::Vec3d t = cv::normalize(pose.t);
+  const cv::Vec3d axis = std::abs(t[0]) < 0.9 ? cv::Vec3d(1, 0, 0) : cv::Vec3d(0, 1, 0);
+  const cv::Vec3d b0 = cv::normalize(t.cross(axis)), b1 = t.cross(b0);
+  const double angle = angle_deg * CV_PI / 180.0;
+  for (const cv::Vec3d& direction : {b0, -b0, b1, -b1}) {
+    RelativePose start = pose;
+    start.t = std::cos(angle) * t + std::sin(angle) * direction;
+    const RelativePose refined =
+        options.refine ? RefineRelativePose(start, camera, from, to, options.refine_inlier_factor * options.threshold,
+                                            options.threshold)
+                       : start;
+    const RelativePose end = EnforceCheirality(refined, camera, from, to, options.threshold);
+    ends.push_back({end, PoseCost(end, camera, from, to, options)});
+  }
+  return ends;
 }
 
 RelativePose PoseFromFundamental(const cv::Matx33d& F, const Camera& camera, const std::vector<cv::Point2f>& from,

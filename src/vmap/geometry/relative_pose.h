@@ -74,13 +74,36 @@ struct RelativePose {
   int num_inliers = 0;  // matches within the threshold of the pose (and, before refinement, in front of both cameras)
 };
 
+// Where one start of EstimateRelativePose ended: its refined (and cheirality-decided) pose and PoseCost.
+struct PoseMinimum {
+  RelativePose pose;
+  double cost = 0.0;
+};
+
 // E estimated on the normalised points with OpenCV's USAC (MSAC scoring, local optimisation) from
 // options.starts seeds, each decomposed with the cheirality check; these and `extra_starts` are refined
 // (options.refine), each refined pose is decided again among the four its E allows (EnforceCheirality), and
-// the pose with the lowest PoseCost wins.
+// the pose with the lowest PoseCost wins. `minima`, when given, receives every valid start's end, in order.
 RelativePose EstimateRelativePose(const Camera& camera, const std::vector<cv::Point2f>& from,
                                   const std::vector<cv::Point2f>& to, const PoseOptions& options,
-                                  const std::vector<RelativePose>& extra_starts = {});
+                                  const std::vector<RelativePose>& extra_starts = {},
+                                  std::vector<PoseMinimum>* minima = nullptr);
+
+// The starts of EstimateRelativePose can end in different valleys of the matches' cost. Of the minima whose
+// translation points more than `min_angle_deg` away from that of the cheapest one (the pose
+// EstimateRelativePose returns), how much more the cheapest of them costs (PoseCost units); infinity when
+// there is none. A small gap says another pose, with another translation, explains the matches almost as
+// well: the direction is ambiguous whatever the curvature at the chosen minimum (TranslationSigmaDeg) says.
+double RivalCostGap(const std::vector<PoseMinimum>& minima, double min_angle_deg);
+
+// The starts find a rival only where one of them happens to fall into its valley. This looks for one next to
+// the pose: four refinements (as EstimateRelativePose's) started from `pose` with its translation turned by
+// `angle_deg` in four directions perpendicular to it. Where the cost is flat along t (a vanishing baseline, a
+// rotation that mimics a translation) they stay away from t at almost its cost; where t is well determined
+// they return to it or cost clearly more. Their ends, for RivalCostGap beside the starts'.
+std::vector<PoseMinimum> ProbeTranslation(const RelativePose& pose, const Camera& camera,
+                                          const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to,
+                                          const PoseOptions& options, double angle_deg);
 
 // The robust cost a pose is chosen by: sum over the matches of log(1 + (e / threshold)^2), e the Sampson
 // error in pixels capped at refine_inlier_factor * threshold.
@@ -123,10 +146,18 @@ double TranslationSigmaDeg(const RelativePose& pose, const Camera& camera, const
 struct TranslationOptions {
   double max_sigma_deg = 3.0;    // largest TranslationSigmaDeg of a trusted direction
   double min_parallax_px = 3.0;  // smallest median rotation-compensated displacement (Displacements) of one
+  // A rival minimum (RivalCostGap) whose translation is more than rival_angle_deg away and that costs less
+  // than min_rival_cost_gap more than the chosen pose makes the direction ambiguous. The gap is in PoseCost
+  // units (about half the sum of squared Sampson errors in pixels for errors under the 1 px loss scale).
+  // Chosen on kitti07 and redkitchen 0-499 (docs/link-poses.md).
+  double rival_angle_deg = 15.0;
+  double min_rival_cost_gap = 8.0;
 
   void Check() const;  // throws OptionError naming the bad field
 };
+// Without a rival (a single start, localization's refined pose of F): rival_cost_gap is infinity.
 bool TranslationKnown(double sigma_deg, double parallax_px, const TranslationOptions& options);
+bool TranslationKnown(double sigma_deg, double parallax_px, double rival_cost_gap, const TranslationOptions& options);
 nlohmann::json ToJson(const TranslationOptions& options);
 void FromJson(const JsonFieldReader& fields, TranslationOptions* options);
 

@@ -1,5 +1,8 @@
 #include "vmap/geometry/relative_pose.h"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -283,6 +286,102 @@ TEST(RelativePose, TranslationSigmaIsLargeWhereRotationAndTranslationLookAlike) 
   EXPECT_FALSE(TranslationKnown(1.0, 1.0, TranslationOptions())) << "too little parallax";
   EXPECT_FALSE(TranslationKnown(30.0, 10.0, TranslationOptions())) << "too uncertain";
   EXPECT_FALSE(TranslationKnown(-1.0, 10.0, TranslationOptions())) << "not computed";
+}
+
+}  // namespace vmap
+
+namespace vmap {
+
+TEST(RelativePose, RivalCostGapIsTheCheapestMinimumWhoseTranslationPointsElsewhere) {
+  const auto minimum = [](const cv::Vec3d& t, double cost) {
+    PoseMinimum m;
+    m.pose.valid = true;
+    m.pose.t = cv::normalize(t);
+    m.cost = cost;
+    return m;
+  };
+  const cv::Vec3d forward(0, 0, 1);
+  const cv::Vec3d near_forward = Rotation({0.0, 5.0 * CV_PI / 180, 0.0}) * forward;
+  const cv::Vec3d sideways = Rotation({0.0, 30.0 * CV_PI / 180, 0.0}) * forward;
+  EXPECT_TRUE(std::isinf(RivalCostGap({}, 15.0)));
+  EXPECT_TRUE(std::isinf(RivalCostGap({minimum(forward, 10.0), minimum(near_forward, 10.5)}, 15.0)))
+      << "5 degrees away is the same valley";
+  // The cheapest is the chosen pose, wherever it is in the list; the rival is the cheapest of the others
+  // more than 15 degrees away.
+  EXPECT_DOUBLE_EQ(RivalCostGap({minimum(sideways, 19.0), minimum(near_forward, 10.5), minimum(forward, 10.0),
+                                 minimum(-forward, 13.0)},
+                                15.0),
+                   3.0);
+  EXPECT_DOUBLE_EQ(RivalCostGap({minimum(sideways, 19.0), minimum(forward, 10.0)}, 40.0),
+                   std::numeric_limits<double>::infinity());
+
+  TranslationOptions options;
+  EXPECT_TRUE(TranslationKnown(1.0, 10.0, 20.0, options));
+  EXPECT_FALSE(TranslationKnown(1.0, 10.0, 3.0, options)) << "a rival almost as cheap";
+  EXPECT_TRUE(TranslationKnown(1.0, 10.0, options)) << "no rival";
+  options.min_rival_cost_gap = 0.0;
+  EXPECT_TRUE(TranslationKnown(1.0, 10.0, 0.0, options)) << "0: never ambiguous";
+  options.min_rival_cost_gap = -1.0;
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "min_rival_cost_gap");
+  options = TranslationOptions();
+  options.rival_angle_deg = 180.0;
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "rival_angle_deg");
+}
+
+namespace {
+
+// The rival gap of a pair's pose as a map's link gets it (mapping/link_analysis.cc): EstimateRelativePose's
+// minima and ProbeTranslation's at twice the rival angle, the cheapest of them the pose; default options.
+double EstimatedRivalGap(const Pair& pair, RelativePose* pose) {
+  const PoseOptions options;
+  const double rival_angle = TranslationOptions().rival_angle_deg;
+  std::vector<PoseMinimum> minima;
+  const RelativePose estimate = EstimateRelativePose(TestCamera(), pair.from, pair.to, options, {}, &minima);
+  if (!estimate.valid) return -1.0;
+  const std::vector<PoseMinimum> probes =
+      ProbeTranslation(estimate, TestCamera(), pair.from, pair.to, options, 2.0 * rival_angle);
+  minima.insert(minima.end(), probes.begin(), probes.end());
+  *pose = std::min_element(minima.begin(), minima.end(), [](const PoseMinimum& a, const PoseMinimum& b) {
+            return a.cost < b.cost;
+          })->pose;
+  return RivalCostGap(minima, rival_angle);
+}
+
+}  // namespace
+
+// Forward motion through a deep scene: every start ends in the valley of the true translation.
+TEST(RelativePose, ForwardMotionHasNoRivalMinimum) {
+  const cv::Matx33d R = Rotation({0.0, 0.03, 0.0});
+  const cv::Vec3d t_true(0.0, 0.0, -1.0);
+  const Pair pair = Observe(TestCamera(), R, t_true * 0.5, 300, 3.0, 30.0, 0.5, 0.2, 11);
+  RelativePose pose;
+  const double gap = EstimatedRivalGap(pair, &pose);
+  ASSERT_TRUE(pose.valid);
+  EXPECT_LT(AngleBetweenDeg(pose.t, t_true), 3.0);
+  EXPECT_GE(gap, TranslationOptions().min_rival_cost_gap);
+}
+
+// A pure rotation leaves the translation free: probes started away from the pose's t stay there at its cost.
+TEST(RelativePose, PureRotationHasARivalAsCheapAsThePose) {
+  const Pair pair = Observe(TestCamera(), Rotation({0.02, 0.08, 0.01}), cv::Vec3d(0, 0, 0), 300, 3.0, 30.0, 0.5,
+                            0.2, 13);
+  RelativePose pose;
+  const double gap = EstimatedRivalGap(pair, &pose);
+  ASSERT_TRUE(pose.valid);
+  EXPECT_LT(gap, TranslationOptions().min_rival_cost_gap);
+}
+
+// A plane seen from a short sideways baseline (1 cm at 2 m): one homography explains every match, and with
+// so little parallax a pose can trade translation for rotation almost freely; the probes find such a pose.
+// (The plane's second discrete pose, far from the first, is found only where a start falls near it.)
+TEST(RelativePose, PlanarSceneHasARivalMinimum) {
+  const cv::Vec3d t_true = cv::normalize(cv::Vec3d(1.0, 0.0, -0.2));
+  const Pair pair = Observe(TestCamera(), Rotation({0.0, 0.02, 0.0}), t_true * 0.01, 300, 2.0, 2.0, 0.5, 0.2, 17,
+                            /*planar=*/true);
+  RelativePose pose;
+  const double gap = EstimatedRivalGap(pair, &pose);
+  ASSERT_TRUE(pose.valid);
+  EXPECT_LT(gap, TranslationOptions().min_rival_cost_gap);
 }
 
 }  // namespace vmap

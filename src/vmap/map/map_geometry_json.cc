@@ -55,6 +55,7 @@ void ReadLinkGeometryFields(const json& object, Link& link, const std::string& f
     return it->get<double>();
   };
   link.translation_sigma_deg = number("translation_sigma_deg");
+  link.translation_rival_cost_gap = number("translation_rival_cost_gap");
   const auto known = object.find("translation_known");
   link.translation_known = known == object.end() ? link.has_pose : known->get<bool>();
   link.parallax = number("parallax_px");
@@ -133,6 +134,7 @@ void AddLinkGeometryJson(const Link& link, json& object) {
     object["pose"] = nullptr;
   }
   object["translation_sigma_deg"] = OptionalNumber(link.translation_sigma_deg);
+  object["translation_rival_cost_gap"] = OptionalNumber(link.translation_rival_cost_gap);
   object["translation_known"] = link.translation_known;
   object["parallax_px"] = OptionalNumber(link.parallax);
   object["parallax_rotation_removed"] = link.parallax_without_rotation;

@@ -432,6 +432,7 @@ TEST(MapIo, CameraAndLinkGeometryRoundTrip) {
   link.t = cv::normalize(cv::Vec3d(0.3, -0.1, -0.9));
   link.pose_inliers = 2;
   link.translation_sigma_deg = 7.5;
+  link.translation_rival_cost_gap = 2.25;
   link.translation_known = false;
   link.parallax = 12.25;
   link.parallax_without_rotation = true;
@@ -455,6 +456,8 @@ TEST(MapIo, CameraAndLinkGeometryRoundTrip) {
   EXPECT_LT(cv::norm(l.t - link.t), 1e-12);
   EXPECT_EQ(l.pose_inliers, 2);
   EXPECT_DOUBLE_EQ(l.translation_sigma_deg, 7.5);
+  EXPECT_DOUBLE_EQ(l.translation_rival_cost_gap, 2.25);
+  EXPECT_LT(back.links[0].translation_rival_cost_gap, 0);  // none
   EXPECT_FALSE(l.translation_known);
   EXPECT_LT(back.links[0].translation_sigma_deg, 0);  // no pose: not computed
   EXPECT_DOUBLE_EQ(l.parallax, 12.25);
@@ -508,12 +511,14 @@ TEST(MapIo, ReadsMapsWithoutTheTranslationFields) {
   for (auto& link : doc["links"]) {
     link.erase("translation_sigma_deg");
     link.erase("translation_known");
+    link.erase("translation_rival_cost_gap");
   }
   WriteText(tmp.path() / kMapFileName, doc.dump());
   const VisualMap back = ReadMap(tmp.path());
   EXPECT_FALSE(back.links[0].translation_known);
   EXPECT_TRUE(back.links[1].translation_known);
   EXPECT_LT(back.links[1].translation_sigma_deg, 0);
+  EXPECT_LT(back.links[1].translation_rival_cost_gap, 0);
 }
 
 TEST(MapIo, MalformedGeometryIsRefused) {

@@ -52,6 +52,10 @@ struct Link {
   // How well the matches determine t's direction: its standard deviation in degrees with the rotation
   // marginalised (geometry/relative_pose.h, TranslationSigmaDeg). < 0: not computed (maps written before it).
   double translation_sigma_deg = -1.0;
+  // How much more the cheapest other minimum of the pose's cost, with a translation more than the map's
+  // link_analysis.translation.rival_angle_deg away, costs (geometry/relative_pose.h, RivalCostGap).
+  // < 0: no such minimum was found (or not computed: maps written before it, poses from F).
+  double translation_rival_cost_gap = -1.0;
   // t's direction is to be trusted (translation_sigma_deg and parallax within the map's
   // link_analysis.translation, geometry/relative_pose.h TranslationKnown); otherwise a robot gets the rotation
   // only. False without a pose; maps written before the

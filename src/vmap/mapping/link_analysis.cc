@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <exception>
+#include <limits>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -25,6 +27,7 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
   link.t = cv::Vec3d();
   link.pose_inliers = 0;
   link.translation_sigma_deg = -1.0;
+  link.translation_rival_cost_gap = -1.0;
   link.translation_known = false;
   link.parallax = -1.0;
   link.parallax_without_rotation = false;
@@ -45,6 +48,7 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
 
   if (camera) {
     RelativePose pose;
+    std::vector<PoseMinimum> minima;
     const std::vector<cv::Point2f>& pose_from = options.pose.use_all_matches ? all_from : verified_from;
     const std::vector<cv::Point2f>& pose_to = options.pose.use_all_matches ? all_to : verified_to;
     if (options.pose.method == PoseMethod::kFromFundamental) {
@@ -55,7 +59,19 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
       if (options.pose.start_from_fundamental) {
         from_fundamental.push_back(PoseFromFundamental(link.F, *camera, verified_from, verified_to));
       }
-      pose = EstimateRelativePose(*camera, pose_from, pose_to, options.pose, from_fundamental);
+      pose = EstimateRelativePose(*camera, pose_from, pose_to, options.pose, from_fundamental, &minima);
+    }
+    if (pose.valid && options.pose.method == PoseMethod::kEssential) {
+      // Probes at twice the rival angle: one that stays there is a rival, one that returns is not. One that
+      // ends lower than every start found a better pose by the estimate's own cost: it becomes the pose.
+      const std::vector<PoseMinimum> probes = ProbeTranslation(pose, *camera, pose_from, pose_to, options.pose,
+                                                               2.0 * options.translation.rival_angle_deg);
+      minima.insert(minima.end(), probes.begin(), probes.end());
+      pose = std::min_element(minima.begin(), minima.end(), [](const PoseMinimum& a, const PoseMinimum& b) {
+               return a.cost < b.cost;
+             })->pose;
+      const double gap = RivalCostGap(minima, options.translation.rival_angle_deg);
+      if (std::isfinite(gap)) link.translation_rival_cost_gap = gap;
     }
     if (pose.valid) {
       link.has_pose = true;
@@ -70,8 +86,10 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
   link.parallax_without_rotation = link.has_pose;
   link.parallax = Median(Displacements(verified_from, verified_to, link.has_pose ? camera : nullptr,
                                        link.has_pose ? &link.R : nullptr));
+  const double rival_cost_gap = link.translation_rival_cost_gap >= 0 ? link.translation_rival_cost_gap
+                                                                     : std::numeric_limits<double>::infinity();
   link.translation_known =
-      link.has_pose && TranslationKnown(link.translation_sigma_deg, link.parallax, options.translation);
+      link.has_pose && TranslationKnown(link.translation_sigma_deg, link.parallax, rival_cost_gap, options.translation);
 
   const HomographyCheck homography = CheckHomography(verified_from, verified_to, options.homography);
   if (homography.estimated) {
@@ -118,6 +136,7 @@ void CopyAnalysis(const Link& from, Link& to) {
   to.t = from.t;
   to.pose_inliers = from.pose_inliers;
   to.translation_sigma_deg = from.translation_sigma_deg;
+  to.translation_rival_cost_gap = from.translation_rival_cost_gap;
   to.translation_known = from.translation_known;
   to.parallax = from.parallax;
   to.parallax_without_rotation = from.parallax_without_rotation;
