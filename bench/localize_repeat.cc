@@ -10,7 +10,10 @@
 //  - a localized frame is right when its key image or the next one is within those bounds, wrong otherwise.
 // Prints the counts, and the stretches of repeat frames that were lost although coverable. With several
 // acceptance rules (comma-separated; default chance) the map is built once and the repeat run localized once
-// per rule, one after the other.
+// per rule, one after the other. --variants RULE/RECHECK/SHARE,... does the same for acceptance rules with
+// LocalizerOptions::recheck_link_share and min_link_share (e.g. counts/0/0,chance/0.5/0).
+//
+//   localize_repeat TUM_SEQUENCE ... --variants counts/0/0,chance/0/0,chance/0.5/0
 
 #include <unistd.h>
 
@@ -21,6 +24,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <stdexcept>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -155,12 +159,35 @@ std::vector<AcceptanceRule> ParseAcceptanceRules(const std::string& list) {
   return rules;
 }
 
+struct Variant {
+  AcceptanceRule rule = AcceptanceRule::kChance;
+  double recheck_link_share = LocalizerOptions().recheck_link_share;
+  double min_link_share = LocalizerOptions().min_link_share;
+};
+
+// "counts/0/0,chance/0.5/0" -> the variants, in order.
+std::vector<Variant> ParseVariants(const std::string& list) {
+  std::vector<Variant> variants;
+  for (size_t start = 0; start <= list.size();) {
+    const size_t comma = std::min(list.find(',', start), list.size());
+    const std::string item = list.substr(start, comma - start);
+    const size_t a = item.find('/'), b = item.find('/', a + 1);
+    if (a == std::string::npos || b == std::string::npos) {
+      throw std::runtime_error("--variants: " + item + " is not RULE/RECHECK/SHARE");
+    }
+    variants.push_back({ParseAcceptanceRule(item.substr(0, a)), std::stod(item.substr(a + 1, b - a - 1)),
+                        std::stod(item.substr(b + 1))});
+    start = comma + 1;
+  }
+  return variants;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr, "usage: localize_repeat TUM_SEQUENCE --teach A:B --repeat C:D [--stride N] "
-                 "[--acceptance chance,counts]\n");
+                 "[--acceptance chance,counts] [--variants RULE/RECHECK/SHARE,...]\n");
     return 2;
   }
   const fs::path sequence = argv[1];
@@ -168,7 +195,7 @@ int main(int argc, char** argv) {
   int stride = 1;
   double max_distance = 0.5, max_angle = 30.0;
   std::string ranking = "auto";
-  std::vector<AcceptanceRule> rules;
+  std::vector<Variant> variants;
   int descriptors = RankingOptions().max_descriptors_per_key, candidates = LocalizerOptions().relocalization_candidates;
   for (int i = 2; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--teach")) teach = Range(argv[i + 1]);
@@ -179,7 +206,11 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--ranking")) ranking = argv[i + 1];
     else if (!std::strcmp(argv[i], "--descriptors")) descriptors = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--candidates")) candidates = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--acceptance")) rules = ParseAcceptanceRules(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--acceptance")) {
+      for (const AcceptanceRule rule : ParseAcceptanceRules(argv[i + 1])) variants.push_back({rule});
+    } else if (!std::strcmp(argv[i], "--variants")) {
+      variants = ParseVariants(argv[i + 1]);
+    }
   }
   vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   const auto poses = ReadGroundTruth(sequence / "groundtruth.txt");
@@ -209,11 +240,14 @@ int main(int argc, char** argv) {
               teach.first, teach.second, map.key_images.size(), repeat.first, repeat.second, stride, max_distance,
               max_angle);
 
-  if (rules.empty()) rules.push_back(AcceptanceRule::kChance);
-  for (const AcceptanceRule rule : rules) {
-    std::printf("--- acceptance %s\n", AcceptanceRuleName(rule).c_str());
+  if (variants.empty()) variants.push_back({});
+  for (const Variant& variant : variants) {
+    std::printf("--- acceptance %s, recheck_link_share %g, min_link_share %g\n",
+                AcceptanceRuleName(variant.rule).c_str(), variant.recheck_link_share, variant.min_link_share);
     LocalizerOptions localizer_options = MapLocalizerOptions(map);
-    localizer_options.acceptance = rule;
+    localizer_options.acceptance = variant.rule;
+    localizer_options.recheck_link_share = variant.recheck_link_share;
+    localizer_options.min_link_share = variant.min_link_share;
     localizer_options.ranking.method = ParseRankingMethod(ranking);
     localizer_options.ranking.max_descriptors_per_key = descriptors;
     localizer_options.relocalization_candidates = candidates;

@@ -8,7 +8,9 @@ accepted (must be none) and the least log10 NFA any comparison reached there (th
 Each localization runs once per acceptance rule, one after the other, so the rules compare side by side.
 
 usage: bench/localize_scenes.py VMAP [--matcher orb|xfeat] [--rules chance,counts] [--same] [--different]
-                                [--work DIR]
+                                [--work DIR] [--only SCENE,...]
+       a rule may carry more localize flags: --rules "counts,chance --recheck-link-share 0"
+       --only: the scenes (SAME names' first word / SCENES names) to run, default all
        (from the repository root; ../shared must be there)"""
 import argparse, json, os, subprocess, sys, tempfile
 
@@ -49,7 +51,9 @@ def build(vmap, matcher, scene, flags, directory):
 
 
 def localize(vmap, map_directory, query, flags, rule, output):
-    run([vmap, "localize", map_directory, query, "-q", "--acceptance", rule, "--json", output] + flags)
+    """`rule`: an acceptance rule, optionally followed by more localize flags ("chance --recheck-link-share 0")."""
+    rule_flags = rule.split()
+    run([vmap, "localize", map_directory, query, "-q", "--acceptance"] + rule_flags + ["--json", output] + flags)
     with open(output) as f:
         return json.load(f)
 
@@ -75,6 +79,7 @@ def main():
     parser.add_argument("--same", action="store_true")
     parser.add_argument("--different", action="store_true")
     parser.add_argument("--work", help="keep the maps in this folder (reused when there) instead of a temporary one")
+    parser.add_argument("--only", help="comma-separated scenes to run (default all)")
     args = parser.parse_args()
     rules = args.rules.split(",")
     both = not args.same and not args.different
@@ -85,6 +90,8 @@ def main():
                   "frames/s |" % args.matcher)
             print("|---|---|---|---|---|---|---|")
             for name, (scene, build_flags, query_flags) in SAME.items():
+                if args.only and scene not in args.only.split(","):
+                    continue
                 map_directory = build(args.vmap, args.matcher, scene, build_flags,
                                       os.path.join(tmp, "same_" + "".join(c for c in name if c.isalnum())))
                 for rule in rules:

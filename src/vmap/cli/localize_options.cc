@@ -29,6 +29,16 @@ void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& 
                                               "--acceptance counts: S a frame needs to be localized at a key image")
                                    ->capture_default_str());
   option_flags
+      .AddOption(command, "--min-link-share", o.min_link_share, "min_link_share",
+                 "--acceptance chance: verified matches a frame also needs, as a fraction of those of the key "
+                 "image's link with its route neighbour (0: chance alone)")
+      ->capture_default_str();
+  option_flags
+      .AddOption(command, "--recheck-link-share", o.recheck_link_share, "recheck_link_share",
+                 "Relocalize a tracked frame with fewer verified matches than this fraction of its key image's "
+                 "link, and move it where more verify (0: never)")
+      ->capture_default_str();
+  option_flags
       .AddOption(command, "--max-lost", o.max_lost_frames, "max_lost_frames",
                  "Lost frames in a row before the estimate is dropped")
       ->capture_default_str();

@@ -21,7 +21,7 @@ struct LocalizerFlags {
   std::vector<const CLI::Option*> counts_flags;
 };
 
-// --acceptance, --max-log10-nfa, --min-verified, --min-similarity, --max-lost, --candidates, --lookahead, --no-step-back, --ranking, the heading's options, --from, --to,
+// --acceptance, --max-log10-nfa, --min-verified, --min-similarity, --min-link-share, --recheck-link-share, --max-lost, --candidates, --lookahead, --no-step-back, --ranking, the heading's options, --from, --to,
 // --threads, --no-cache; fields as LocalizerOptions names them.
 void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& option_flags);
 

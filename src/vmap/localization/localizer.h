@@ -56,6 +56,16 @@ struct LocalizerOptions {
   double max_log10_nfa = 0.0;
   int min_verified = 20;
   double min_similarity = 0.3;
+  // Same scene is not same place. A frame tracked at a key image with fewer verified matches than
+  // `recheck_link_share` times those of the key image's link with its route neighbour (the smaller of its two
+  // links: what two neighbouring key images of this map share, so the bar follows the matcher and the texture)
+  // is also relocalized, and moved to the ranked key image that verifies more matches, if one does: a frame that
+  // verifies against a far key image of the same room must not stay there. 0: never (tracking keeps any accepted
+  // key image). docs/localization-acceptance.md measures it.
+  double recheck_link_share = 0.5;
+  // kChance only: a comparison is accepted only with at least `min_link_share` times the verified matches of the
+  // key image's link with its route neighbour (as above). 0: chance alone decides.
+  double min_link_share = 0.0;
   // Key images compared beyond `next_key` when the frame has passed it (1 or 2: the "next one or two").
   int lookahead = 2;
   // While tracking, also compare the key image before `key` when the frame is nearer `key` than `next_key`
@@ -202,6 +212,8 @@ class Localizer {
   // The frame's verified matches with key_a over those of the map's link between key_a and key_b (0 when
   // they have no link).
   double SharedWithLink(const KeyComparison& comparison, int key_a, int key_b) const;
+  // A tracked comparison shares less with its key image than the map's links do (recheck_link_share).
+  bool SharesLittle(const KeyComparison& comparison) const;
 
   const VisualMap& map_;
   const KeyImageStore& keys_;
@@ -209,6 +221,9 @@ class Localizer {
   LocalizerOptions options_;
   std::vector<int> route_;
   std::vector<int> route_position_of_key_;  // -1 for key images off the route
+  // Per key image: the verified matches of its link with a route neighbour, the smaller of the two; 0 when it
+  // has no verified link on the route (the comparisons against the map's links are then skipped).
+  std::vector<int> link_verified_;
   std::unique_ptr<KeyImageRanking> ranking_;
   int position_ = -1;  // route position of `key`; -1: no estimate
   int lost_in_a_row_ = 0;

@@ -254,6 +254,77 @@ TEST(Localizer, AFrameThatShowsLittleOfTheSceneIsStillLocalizedByItsChance) {
               chance_localized, bracketed, counts_localized, low_similarity, counts.min_similarity);
 }
 
+// A map of every frame of the drive at a high tau: many key images, each sharing much with its neighbours.
+struct DenseMap {
+  ::vmap::testing::ScopedTempDir directory;
+  LocalizationMap opened;
+  DenseMap() {
+    const auto matcher = CreateOrbMatcher({});
+    MapBuilderOptions options;
+    options.show_progress = false;
+    options.key_images.tau = 0.8;
+    ::vmap::testing::MemorySource source(Frames(0, 2), Indices(0, 2));
+    ::vmap::testing::BuildMapDirectory(source, *matcher, options, directory.path() / "map");
+    opened = OpenLocalizationMap(directory.path() / "map", {});
+  }
+};
+
+const LocalizationMap& Dense() {
+  static const DenseMap map;
+  return map.opened;
+}
+
+// Tracked at the start of the drive, then a frame far ahead: it still sees the start's far plane, so chance
+// accepts it at the start's key images (the same scene), but it is at another place.
+LocalizationResult AfterAJump(const LocalizerOptions& options, int jump_to) {
+  const LocalizationMap& m = Dense();
+  Localizer localizer(m.map, m.keys, *m.matcher, options);
+  LocalizationResult r;
+  int index = 0;
+  for (int source_index : {1, 3, jump_to}) r = LocalizeImage(localizer, Drive().frames[source_index], index++, source_index);
+  return r;
+}
+
+TEST(Localizer, AFrameTrackedAtAFarKeyImageOfTheSameSceneIsMovedWhereItVerifiesBetter) {
+  const LocalizationMap& m = Dense();
+  ASSERT_GE(m.map.key_images.size(), 12u);
+  LocalizerOptions recheck = MapLocalizerOptions(m.map);
+  recheck.acceptance = AcceptanceRule::kChance;
+  ASSERT_GT(recheck.recheck_link_share, 0.0) << "on by default";
+  LocalizerOptions hold = recheck;
+  hold.recheck_link_share = 0.0;
+  for (int jump_to : {25, 41, 57}) {
+    const LocalizationResult held = AfterAJump(hold, jump_to);
+    // Without the check the frame stays near the start: what went wrong on redkitchen's repeat run.
+    EXPECT_EQ(held.status, LocalizationStatus::kTracking) << jump_to;
+    EXPECT_FALSE(Brackets(m.map, jump_to, held.key)) << jump_to << " at key " << held.key;
+    const LocalizationResult moved = AfterAJump(recheck, jump_to);
+    EXPECT_EQ(moved.status, LocalizationStatus::kRelocalized) << jump_to;
+    EXPECT_TRUE(Brackets(m.map, jump_to, moved.key)) << jump_to << " at key " << moved.key;
+    EXPECT_GT(moved.to_key.num_verified, held.to_key.num_verified);
+    EXPECT_FALSE(moved.candidates.empty());
+  }
+}
+
+TEST(Localizer, AFrameThatSharesAsMuchAsTheMapsLinksIsNotRelocalized) {
+  // The check costs a relocalization only where tracking is doubtful: along the drive none is.
+  const LocalizationMap& m = Dense();
+  LocalizerOptions options = MapLocalizerOptions(m.map);
+  options.acceptance = AcceptanceRule::kChance;
+  Localizer localizer(m.map, m.keys, *m.matcher, options);
+  ::vmap::testing::MemorySource source(Frames(1, 2), Indices(1, 2));
+  LocalizeSequenceOptions run;
+  run.show_progress = false;
+  int bracketed = 0;
+  const LocalizationSummary summary =
+      LocalizeSequence(source, *m.matcher, localizer, run, [&](const Frame&, const LocalizationResult& r) {
+        bracketed += Brackets(m.map, r.source_index, r.key);
+      });
+  EXPECT_EQ(summary.relocalized, 1) << "the first frame only";
+  EXPECT_EQ(summary.tracking, 29);
+  EXPECT_EQ(bracketed, 30);
+}
+
 TEST(Localizer, ASceneOfOtherTexturesIsNeverAccepted) {
   // The same kind of scene (planes with blobs and boxes, the same drive), other textures: nothing is shared,
   // though the images look alike and give ORB plenty of tentative matches.
