@@ -2,6 +2,7 @@
 //
 //   localize_repeat TUM_SEQUENCE --teach FIRST:LAST --repeat FIRST:LAST [--stride N]
 //                   [--max-distance M] [--max-angle DEG] [--acceptance chance,counts]
+//                   [--variants counts/0/0,chance/0.5/0.25]
 //
 // Builds a map of the teach frames (default options) and localizes the repeat frames against it. The
 // sequence's groundtruth.txt (TUM: timestamp tx ty tz qx qy qz qw, camera to world) judges each repeat frame:
@@ -9,11 +10,9 @@
 //    direction within --max-angle degrees (default 30) of it;
 //  - a localized frame is right when its key image or the next one is within those bounds, wrong otherwise.
 // Prints the counts, and the stretches of repeat frames that were lost although coverable. With several
-// acceptance rules (comma-separated; default chance) the map is built once and the repeat run localized once
-// per rule, one after the other. --variants RULE/RECHECK/SHARE,... does the same for acceptance rules with
-// LocalizerOptions::recheck_link_share and min_link_share (e.g. counts/0/0,chance/0.5/0).
-//
-//   localize_repeat TUM_SEQUENCE ... --variants counts/0/0,chance/0/0,chance/0.5/0
+// acceptance rules (--acceptance, comma-separated; default: the localizer's defaults) or variants (--variants
+// RULE/RECHECK/SHARE,...: bench/localizer_variants.h) the map is built once and the repeat run localized once
+// per variant, one after the other.
 
 #include <unistd.h>
 
@@ -24,7 +23,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <stdexcept>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -32,6 +30,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include "localizer_variants.h"
 #include "vmap/core/runtime.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/localization/localization_map.h"
@@ -148,40 +147,6 @@ void Judge(const fs::path& sequence, const LocalizationMap& opened, const Locali
   for (const std::string& w : wrongs) std::printf("  wrong: %s\n", w.c_str());
 }
 
-// "chance,counts" -> the rules, in order.
-std::vector<AcceptanceRule> ParseAcceptanceRules(const std::string& list) {
-  std::vector<AcceptanceRule> rules;
-  for (size_t start = 0; start <= list.size();) {
-    const size_t comma = std::min(list.find(',', start), list.size());
-    rules.push_back(ParseAcceptanceRule(list.substr(start, comma - start)));
-    start = comma + 1;
-  }
-  return rules;
-}
-
-struct Variant {
-  AcceptanceRule rule = AcceptanceRule::kChance;
-  double recheck_link_share = LocalizerOptions().recheck_link_share;
-  double min_link_share = LocalizerOptions().min_link_share;
-};
-
-// "counts/0/0,chance/0.5/0" -> the variants, in order.
-std::vector<Variant> ParseVariants(const std::string& list) {
-  std::vector<Variant> variants;
-  for (size_t start = 0; start <= list.size();) {
-    const size_t comma = std::min(list.find(',', start), list.size());
-    const std::string item = list.substr(start, comma - start);
-    const size_t a = item.find('/'), b = item.find('/', a + 1);
-    if (a == std::string::npos || b == std::string::npos) {
-      throw std::runtime_error("--variants: " + item + " is not RULE/RECHECK/SHARE");
-    }
-    variants.push_back({ParseAcceptanceRule(item.substr(0, a)), std::stod(item.substr(a + 1, b - a - 1)),
-                        std::stod(item.substr(b + 1))});
-    start = comma + 1;
-  }
-  return variants;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -195,7 +160,7 @@ int main(int argc, char** argv) {
   int stride = 1;
   double max_distance = 0.5, max_angle = 30.0;
   std::string ranking = "auto";
-  std::vector<Variant> variants;
+  std::vector<bench::LocalizerVariant> variants;
   int descriptors = RankingOptions().max_descriptors_per_key, candidates = LocalizerOptions().relocalization_candidates;
   for (int i = 2; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--teach")) teach = Range(argv[i + 1]);
@@ -207,9 +172,9 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--descriptors")) descriptors = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--candidates")) candidates = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--acceptance")) {
-      for (const AcceptanceRule rule : ParseAcceptanceRules(argv[i + 1])) variants.push_back({rule});
+      variants = bench::ParseAcceptanceVariants(argv[i + 1]);
     } else if (!std::strcmp(argv[i], "--variants")) {
-      variants = ParseVariants(argv[i + 1]);
+      variants = bench::ParseLocalizerVariants(argv[i + 1]);
     }
   }
   vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
@@ -241,13 +206,10 @@ int main(int argc, char** argv) {
               max_angle);
 
   if (variants.empty()) variants.push_back({});
-  for (const Variant& variant : variants) {
-    std::printf("--- acceptance %s, recheck_link_share %g, min_link_share %g\n",
-                AcceptanceRuleName(variant.rule).c_str(), variant.recheck_link_share, variant.min_link_share);
+  for (const bench::LocalizerVariant& variant : variants) {
+    std::printf("--- %s\n", variant.Name().c_str());
     LocalizerOptions localizer_options = MapLocalizerOptions(map);
-    localizer_options.acceptance = variant.rule;
-    localizer_options.recheck_link_share = variant.recheck_link_share;
-    localizer_options.min_link_share = variant.min_link_share;
+    variant.ApplyTo(localizer_options);
     localizer_options.ranking.method = ParseRankingMethod(ranking);
     localizer_options.ranking.max_descriptors_per_key = descriptors;
     localizer_options.relocalization_candidates = candidates;

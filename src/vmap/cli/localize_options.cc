@@ -28,11 +28,12 @@ void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& 
                                    .AddOption(command, "--min-similarity", o.min_similarity, "min_similarity",
                                               "--acceptance counts: S a frame needs to be localized at a key image")
                                    ->capture_default_str());
-  option_flags
-      .AddOption(command, "--min-link-share", o.min_link_share, "min_link_share",
-                 "--acceptance chance: verified matches a frame also needs, as a fraction of those of the key "
-                 "image's link with its route neighbour (0: chance alone)")
-      ->capture_default_str();
+  flags.chance_flags.push_back(
+      option_flags
+          .AddOption(command, "--min-link-share", o.min_link_share, "min_link_share",
+                     "--acceptance chance: verified matches a frame also needs, as a fraction of those of the key "
+                     "image's link with its route neighbour (0: chance alone)")
+          ->capture_default_str());
   option_flags
       .AddOption(command, "--recheck-link-share", o.recheck_link_share, "recheck_link_share",
                  "Relocalize a tracked frame with fewer verified matches than this fraction of its key image's "
@@ -74,6 +75,12 @@ void CheckLocalizerFlags(const LocalizerFlags& flags) {
       throw InputError(fmt::format("{} belongs to the earlier acceptance rule; add --acceptance counts to use it, "
                                    "or leave it out (--acceptance chance decides by --max-log10-nfa)",
                                    flag->get_name()));
+    }
+  }
+  for (const CLI::Option* flag : flags.chance_flags) {
+    if (flag->count() > 0 && flags.localizer.acceptance != AcceptanceRule::kChance) {
+      throw InputError(fmt::format("{} belongs to --acceptance chance; add it to use {}, or leave {} out",
+                                   flag->get_name(), flag->get_name(), flag->get_name()));
     }
   }
 }

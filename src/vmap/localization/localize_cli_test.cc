@@ -240,6 +240,8 @@ TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
       {localize + "--max-log10-nfa nan", "--max-log10-nfa nan is outside"},
       {localize + "--acceptance chance --min-verified 30",
        "--min-verified belongs to the earlier acceptance rule; add --acceptance counts"},
+      {localize + "--acceptance counts --min-link-share 0.5", "--min-link-share belongs to --acceptance chance"},
+      {localize + "--recheck-link-share -1", "--recheck-link-share -1 is outside [0, 10]"},
       {localize + "--to 99", "key image 99 does not exist"},
       {"localize " + Quote(tmp.path() / "m") + " " + Quote(tmp.path() / "missing.mp4"), "does not exist"},
       {"route " + Quote(tmp.path() / "m") + " --min-backward-verified 2", "--min-backward-verified 2 must be 8"},

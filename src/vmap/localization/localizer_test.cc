@@ -520,6 +520,8 @@ TEST(Localizer, OptionsAreChecked) {
   EXPECT_EQ(path([](LocalizerOptions& o) { o.min_verified = 5; }), "min_verified");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.min_similarity = 1.5; }), "min_similarity");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.max_log10_nfa = std::nan(""); }), "max_log10_nfa");
+  EXPECT_EQ(path([](LocalizerOptions& o) { o.recheck_link_share = -0.1; }), "recheck_link_share");
+  EXPECT_EQ(path([](LocalizerOptions& o) { o.min_link_share = std::nan(""); }), "min_link_share");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.lookahead = 3; }), "lookahead");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.max_lost_frames = -1; }), "max_lost_frames");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.relocalization_candidates = 0; }), "relocalization_candidates");
