@@ -14,7 +14,8 @@ void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& 
   option_flags.AddEnumOption(command, "--acceptance", o.acceptance, ParseAcceptanceRule, AcceptanceRuleName,
                              "acceptance",
                              "When a frame is seen at a key image: chance (its verified matches are unlikely by "
-                             "chance, --max-log10-nfa) or counts (--min-verified and --min-similarity)");
+                             "chance, --max-log10-nfa, and many against the map's links, --min-link-share) or "
+                             "counts (the earlier rule: --min-verified and --min-similarity)");
   option_flags
       .AddOption(command, "--max-log10-nfa", o.max_log10_nfa, "max_log10_nfa",
                  "--acceptance chance: accept when log10 of the number of false alarms is at most this")

@@ -58,7 +58,7 @@ void LocalizerOptions::Check() const {
                                   recheck_link_share));
   }
   if (!(min_link_share >= 0.0 && min_link_share <= 10.0)) {
-    throw OptionError("min_link_share", fmt::format("{} is outside [0, 10] (default 0: chance alone decides)",
+    throw OptionError("min_link_share", fmt::format("{} is outside [0, 10] (default 0.4; 0: chance alone decides)",
                                                     min_link_share));
   }
   if (lookahead < 1 || lookahead > 2) {

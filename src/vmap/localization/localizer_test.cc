@@ -227,10 +227,11 @@ TEST(Localizer, AFrameThatShowsLittleOfTheSceneIsStillLocalizedByItsChance) {
   // The earlier rule (S >= 0.3) loses frames that keep a few dozen verified matches among many chance ones;
   // the chance of those verified matches says they see the scene.
   const LocalizationMap& m = Map().opened;
-  LocalizerOptions counts = MapLocalizerOptions(m.map);
-  ASSERT_EQ(counts.acceptance, AcceptanceRule::kCounts) << "the default";
-  LocalizerOptions chance = counts;
-  chance.acceptance = AcceptanceRule::kChance;
+  LocalizerOptions chance = MapLocalizerOptions(m.map);
+  ASSERT_EQ(chance.acceptance, AcceptanceRule::kChance) << "the default";
+  chance.min_link_share = 0.0;  // chance alone: the test is about its rule
+  LocalizerOptions counts = chance;
+  counts.acceptance = AcceptanceRule::kCounts;
   const std::vector<LocalizationResult> by_chance = LocalizeAll(chance, MostlyHidden(0.35), Indices(1, 2));
   const std::vector<LocalizationResult> by_counts = LocalizeAll(counts, MostlyHidden(0.35), Indices(1, 2));
   ASSERT_EQ(by_chance.size(), 30u);
@@ -289,10 +290,20 @@ TEST(Localizer, AFrameTrackedAtAFarKeyImageOfTheSameSceneIsMovedWhereItVerifiesB
   const LocalizationMap& m = Dense();
   ASSERT_GE(m.map.key_images.size(), 12u);
   LocalizerOptions recheck = MapLocalizerOptions(m.map);
-  recheck.acceptance = AcceptanceRule::kChance;
+  ASSERT_EQ(recheck.acceptance, AcceptanceRule::kChance);
   ASSERT_GT(recheck.recheck_link_share, 0.0) << "on by default";
+  recheck.min_link_share = 0.0;  // chance alone accepts the far key image: the recheck must move the frame
   LocalizerOptions hold = recheck;
   hold.recheck_link_share = 0.0;
+  // The default acceptance refuses the far key image by itself when the jump is long (too few verified matches
+  // against its links); frame 25 still shares more than 0.4 of a link with it, and only the recheck moves it.
+  LocalizerOptions refuse = MapLocalizerOptions(m.map);
+  refuse.recheck_link_share = 0.0;
+  for (int jump_to : {41, 57}) {
+    const LocalizationResult refused = AfterAJump(refuse, jump_to);
+    EXPECT_EQ(refused.status, LocalizationStatus::kRelocalized) << jump_to;
+    EXPECT_TRUE(Brackets(m.map, jump_to, refused.key)) << jump_to << " at key " << refused.key;
+  }
   for (int jump_to : {25, 41, 57}) {
     const LocalizationResult held = AfterAJump(hold, jump_to);
     // Without the check the frame stays near the start: what went wrong on redkitchen's repeat run.
