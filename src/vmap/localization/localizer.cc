@@ -330,15 +330,14 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   }
   if (SharesLittle(best)) {
     // Accepted, but with much less than neighbouring key images share: the frame may be elsewhere on the
-    // route, in view of this key image's scene. Moved when a ranked key image verifies more matches.
-    const int tracked_position = position_;
+    // route, in view of this key image's scene. Moved when a ranked key image verifies more matches (a
+    // relocalization that is not taken leaves nothing behind: the tracked estimate is set below).
     LocalizationResult found = Relocalize(frame, features);
     int found_verified = 0;
     for (const RelocalizationCandidate& c : found.candidates) {
       if (c.accepted) found_verified = std::max(found_verified, c.num_verified);
     }
     if (found.status == LocalizationStatus::kRelocalized && found_verified > best.num_verified) return found;
-    position_ = tracked_position;
   }
   lost_in_a_row_ = 0;
   position_ = best_position;
