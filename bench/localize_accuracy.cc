@@ -1,7 +1,7 @@
 // Localization measured against truth (docs/measurements/localization.md): the bracket test and the ranking recall.
 //
 //   localize_accuracy SEQUENCE [--last N] [--tau T] [--ranking auto|votes|thumbnails] [--candidates K]
-//                     [--acceptance chance,counts]
+//                     [--acceptance chance,counts] [--variants RULE/RECHECK/SHARE,...]
 //
 // Builds a map of the even frames of SEQUENCE (`vmap build --stride 2`, default options) in a temporary
 // folder and localizes the odd frames against it:
@@ -11,8 +11,9 @@
 //    relocalization, and the recall of both rankings (a bracketing key image among the first 1 / K ranked);
 //  - progress: where the estimate is the bracketing segment, the mean absolute difference between the
 //    estimated progress and the frame's position between the two key images in input frames.
-// With several acceptance rules (--acceptance, comma-separated; default chance), the map is built once and each
-// measurement runs once per rule, one after the other, so the rules compare side by side.
+// With several acceptance rules (--acceptance, comma-separated; default: the localizer's defaults) or variants
+// (--variants, bench/localizer_variants.h), the map is built once and each measurement runs once per variant, one
+// after the other, so they compare side by side.
 // Every figure comes from one run, so they compare; the machine's load changes the times.
 
 #include <unistd.h>
@@ -29,6 +30,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include "localizer_variants.h"
 #include "vmap/core/runtime.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/localization/key_image_ranking.h"
@@ -59,17 +61,6 @@ std::string MapOptionsJson(const Matcher& matcher, const MapBuilderOptions& opti
 bool Brackets(const VisualMap& map, int source_index, int key) {
   const auto [before, after] = KeysAround(map, source_index);
   return key >= 0 && (key == before || key == after);
-}
-
-// "chance,counts" -> the rules, in order.
-std::vector<AcceptanceRule> ParseAcceptanceRules(const std::string& list) {
-  std::vector<AcceptanceRule> rules;
-  for (size_t start = 0; start <= list.size();) {
-    const size_t comma = std::min(list.find(',', start), list.size());
-    rules.push_back(ParseAcceptanceRule(list.substr(start, comma - start)));
-    start = comma + 1;
-  }
-  return rules;
 }
 
 // The streaming and relocalization measurements with one set of localizer options.
@@ -168,7 +159,7 @@ void Measure(const std::string& input, const LocalizationMap& opened, const Loca
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr, "usage: localize_accuracy SEQUENCE [--last N] [--tau T] [--ranking R] [--candidates K] "
-                 "[--acceptance chance,counts]\n");
+                 "[--acceptance chance,counts] [--variants RULE/RECHECK/SHARE,...]\n");
     return 2;
   }
   const std::string input = argv[1];
@@ -176,13 +167,14 @@ int main(int argc, char** argv) {
   bool step_back = true, streaming_only = false;
   double tau = 0.5;
   std::string ranking = "auto";
-  std::vector<AcceptanceRule> rules;
+  std::vector<bench::LocalizerVariant> variants;
   for (int i = 2; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--last")) last = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--tau")) tau = std::atof(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--ranking")) ranking = argv[i + 1];
     else if (!std::strcmp(argv[i], "--candidates")) candidates = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--acceptance")) rules = ParseAcceptanceRules(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--acceptance")) variants = bench::ParseAcceptanceVariants(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--variants")) variants = bench::ParseLocalizerVariants(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--lookahead")) lookahead = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--no-step-back")) step_back = false, --i;
     else if (!std::strcmp(argv[i], "--streaming-only")) streaming_only = true, --i;
@@ -211,13 +203,13 @@ int main(int argc, char** argv) {
   std::printf("%s: map of %d even frames, %zu key images (tau %.2f)\n", input.c_str(), map.num_frames,
               map.key_images.size(), tau);
 
-  if (rules.empty()) rules.push_back(AcceptanceRule::kChance);
+  if (variants.empty()) variants.push_back({});
   FrameSourceOptions odd = even;
   odd.first = 1;
-  for (const AcceptanceRule rule : rules) {
-    std::printf("--- acceptance %s\n", AcceptanceRuleName(rule).c_str());
+  for (const bench::LocalizerVariant& variant : variants) {
+    std::printf("--- %s\n", variant.Name().c_str());
     LocalizerOptions options = MapLocalizerOptions(map);
-    options.acceptance = rule;
+    variant.ApplyTo(options);
     options.ranking.method = ParseRankingMethod(ranking);
     options.relocalization_candidates = candidates;
     options.lookahead = lookahead;

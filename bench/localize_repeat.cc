@@ -2,6 +2,7 @@
 //
 //   localize_repeat TUM_SEQUENCE --teach FIRST:LAST --repeat FIRST:LAST [--stride N]
 //                   [--max-distance M] [--max-angle DEG] [--acceptance chance,counts]
+//                   [--variants counts/0/0,chance/0.5/0.25]
 //
 // Builds a map of the teach frames (default options) and localizes the repeat frames against it. The
 // sequence's groundtruth.txt (TUM: timestamp tx ty tz qx qy qz qw, camera to world) judges each repeat frame:
@@ -9,8 +10,9 @@
 //    direction within --max-angle degrees (default 30) of it;
 //  - a localized frame is right when its key image or the next one is within those bounds, wrong otherwise.
 // Prints the counts, and the stretches of repeat frames that were lost although coverable. With several
-// acceptance rules (comma-separated; default chance) the map is built once and the repeat run localized once
-// per rule, one after the other.
+// acceptance rules (--acceptance, comma-separated; default: the localizer's defaults) or variants (--variants
+// RULE/RECHECK/SHARE,...: bench/localizer_variants.h) the map is built once and the repeat run localized once
+// per variant, one after the other.
 
 #include <unistd.h>
 
@@ -28,6 +30,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include "localizer_variants.h"
 #include "vmap/core/runtime.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/localization/localization_map.h"
@@ -144,23 +147,12 @@ void Judge(const fs::path& sequence, const LocalizationMap& opened, const Locali
   for (const std::string& w : wrongs) std::printf("  wrong: %s\n", w.c_str());
 }
 
-// "chance,counts" -> the rules, in order.
-std::vector<AcceptanceRule> ParseAcceptanceRules(const std::string& list) {
-  std::vector<AcceptanceRule> rules;
-  for (size_t start = 0; start <= list.size();) {
-    const size_t comma = std::min(list.find(',', start), list.size());
-    rules.push_back(ParseAcceptanceRule(list.substr(start, comma - start)));
-    start = comma + 1;
-  }
-  return rules;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr, "usage: localize_repeat TUM_SEQUENCE --teach A:B --repeat C:D [--stride N] "
-                 "[--acceptance chance,counts]\n");
+                 "[--acceptance chance,counts] [--variants RULE/RECHECK/SHARE,...]\n");
     return 2;
   }
   const fs::path sequence = argv[1];
@@ -168,7 +160,7 @@ int main(int argc, char** argv) {
   int stride = 1;
   double max_distance = 0.5, max_angle = 30.0;
   std::string ranking = "auto";
-  std::vector<AcceptanceRule> rules;
+  std::vector<bench::LocalizerVariant> variants;
   int descriptors = RankingOptions().max_descriptors_per_key, candidates = LocalizerOptions().relocalization_candidates;
   for (int i = 2; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--teach")) teach = Range(argv[i + 1]);
@@ -179,7 +171,11 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--ranking")) ranking = argv[i + 1];
     else if (!std::strcmp(argv[i], "--descriptors")) descriptors = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--candidates")) candidates = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--acceptance")) rules = ParseAcceptanceRules(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--acceptance")) {
+      variants = bench::ParseAcceptanceVariants(argv[i + 1]);
+    } else if (!std::strcmp(argv[i], "--variants")) {
+      variants = bench::ParseLocalizerVariants(argv[i + 1]);
+    }
   }
   vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   const auto poses = ReadGroundTruth(sequence / "groundtruth.txt");
@@ -209,11 +205,11 @@ int main(int argc, char** argv) {
               teach.first, teach.second, map.key_images.size(), repeat.first, repeat.second, stride, max_distance,
               max_angle);
 
-  if (rules.empty()) rules.push_back(AcceptanceRule::kChance);
-  for (const AcceptanceRule rule : rules) {
-    std::printf("--- acceptance %s\n", AcceptanceRuleName(rule).c_str());
+  if (variants.empty()) variants.push_back({});
+  for (const bench::LocalizerVariant& variant : variants) {
+    std::printf("--- %s\n", variant.Name().c_str());
     LocalizerOptions localizer_options = MapLocalizerOptions(map);
-    localizer_options.acceptance = rule;
+    variant.ApplyTo(localizer_options);
     localizer_options.ranking.method = ParseRankingMethod(ranking);
     localizer_options.ranking.max_descriptors_per_key = descriptors;
     localizer_options.relocalization_candidates = candidates;

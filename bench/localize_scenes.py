@@ -8,7 +8,11 @@ accepted (must be none) and the least log10 NFA any comparison reached there (th
 Each localization runs once per acceptance rule, one after the other, so the rules compare side by side.
 
 usage: bench/localize_scenes.py VMAP [--matcher orb|xfeat] [--rules chance,counts] [--same] [--different]
-                                [--work DIR]
+                                [--work DIR] [--only NAMES] [--maps SCENES]
+       a rule may carry more localize flags: --rules "counts,chance --recheck-link-share 0"
+       --only "pepper_corridor, map of every 8th frame;lab_floor": the repeat runs (their names, or their scene's
+       name for all of that scene) to run with --same, or the queries with --different; default all
+       --maps "lab_floor;kitti07": with --different, the maps the queries are localized against; default all
        (from the repository root; ../shared must be there)"""
 import argparse, json, os, subprocess, sys, tempfile
 
@@ -31,6 +35,7 @@ SAME = {
     "pepper_corridor": ("pepper_corridor", [], []),
     "pepper_corridor, map of every 4th frame": ("pepper_corridor", ["--stride", "4"], []),
     "pepper_corridor, map of every 8th frame": ("pepper_corridor", ["--stride", "8"], []),
+    "pepper_corridor, map of every 16th frame": ("pepper_corridor", ["--stride", "16"], []),
     "lab_floor, odd frames on a map of the even": ("lab_floor", ["--stride", "2"], ["--first", "1", "--stride", "2"]),
     "rccar_room, odd frames on a map of the even": ("rccar_room", ["--stride", "2"], ["--first", "1", "--stride", "2"]),
 }
@@ -49,7 +54,9 @@ def build(vmap, matcher, scene, flags, directory):
 
 
 def localize(vmap, map_directory, query, flags, rule, output):
-    run([vmap, "localize", map_directory, query, "-q", "--acceptance", rule, "--json", output] + flags)
+    """`rule`: an acceptance rule, optionally followed by more localize flags ("chance --recheck-link-share 0")."""
+    rule_flags = rule.split()
+    run([vmap, "localize", map_directory, query, "-q", "--acceptance"] + rule_flags + ["--json", output] + flags)
     with open(output) as f:
         return json.load(f)
 
@@ -75,6 +82,8 @@ def main():
     parser.add_argument("--same", action="store_true")
     parser.add_argument("--different", action="store_true")
     parser.add_argument("--work", help="keep the maps in this folder (reused when there) instead of a temporary one")
+    parser.add_argument("--only", help="';'-separated scenes or repeat-run names to run (default all)")
+    parser.add_argument("--maps", help="--different: ';'-separated scenes whose maps are used (default all)")
     args = parser.parse_args()
     rules = args.rules.split(",")
     both = not args.same and not args.different
@@ -85,6 +94,8 @@ def main():
                   "frames/s |" % args.matcher)
             print("|---|---|---|---|---|---|---|")
             for name, (scene, build_flags, query_flags) in SAME.items():
+                if args.only and name not in args.only.split(";") and scene not in args.only.split(";"):
+                    continue
                 map_directory = build(args.vmap, args.matcher, scene, build_flags,
                                       os.path.join(tmp, "same_" + "".join(c for c in name if c.isalnum())))
                 for rule in rules:
@@ -109,9 +120,13 @@ def main():
             print("|---|---|---|---|---|---|")
             maps = {}
             for scene, (path, build_flags, _) in SCENES.items():
+                if args.maps and scene not in args.maps.split(";"):
+                    continue
                 if build_flags is not None:
                     maps[scene] = build(args.vmap, args.matcher, scene, build_flags, os.path.join(tmp, "map_" + scene))
             for query, (path, _, query_flags) in SCENES.items():
+                if args.only and query not in args.only.split(";"):
+                    continue
                 for scene, map_directory in maps.items():
                     if scene == query:
                         continue

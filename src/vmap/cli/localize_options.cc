@@ -14,7 +14,8 @@ void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& 
   option_flags.AddEnumOption(command, "--acceptance", o.acceptance, ParseAcceptanceRule, AcceptanceRuleName,
                              "acceptance",
                              "When a frame is seen at a key image: chance (its verified matches are unlikely by "
-                             "chance, --max-log10-nfa) or counts (--min-verified and --min-similarity)");
+                             "chance, --max-log10-nfa, and many against the map's links, --min-link-share) or "
+                             "counts (the earlier rule: --min-verified and --min-similarity)");
   option_flags
       .AddOption(command, "--max-log10-nfa", o.max_log10_nfa, "max_log10_nfa",
                  "--acceptance chance: accept when log10 of the number of false alarms is at most this")
@@ -28,6 +29,17 @@ void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& 
                                    .AddOption(command, "--min-similarity", o.min_similarity, "min_similarity",
                                               "--acceptance counts: S a frame needs to be localized at a key image")
                                    ->capture_default_str());
+  flags.chance_flags.push_back(
+      option_flags
+          .AddOption(command, "--min-link-share", o.min_link_share, "min_link_share",
+                     "--acceptance chance: verified matches a frame also needs, as a fraction of those of the key "
+                     "image's link with its route neighbour (0: chance alone)")
+          ->capture_default_str());
+  option_flags
+      .AddOption(command, "--recheck-link-share", o.recheck_link_share, "recheck_link_share",
+                 "Relocalize a tracked frame with fewer verified matches than this fraction of its key image's "
+                 "link, and move it where more verify (0: never)")
+      ->capture_default_str();
   option_flags
       .AddOption(command, "--max-lost", o.max_lost_frames, "max_lost_frames",
                  "Lost frames in a row before the estimate is dropped")
@@ -64,6 +76,12 @@ void CheckLocalizerFlags(const LocalizerFlags& flags) {
       throw InputError(fmt::format("{} belongs to the earlier acceptance rule; add --acceptance counts to use it, "
                                    "or leave it out (--acceptance chance decides by --max-log10-nfa)",
                                    flag->get_name()));
+    }
+  }
+  for (const CLI::Option* flag : flags.chance_flags) {
+    if (flag->count() > 0 && flags.localizer.acceptance != AcceptanceRule::kChance) {
+      throw InputError(fmt::format("{} belongs to --acceptance chance; add it to use {}, or leave {} out",
+                                   flag->get_name(), flag->get_name(), flag->get_name()));
     }
   }
 }

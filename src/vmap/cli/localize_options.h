@@ -19,13 +19,16 @@ struct LocalizerFlags {
   bool cache = true;  // the key-image cache in the map directory
   // --min-verified and --min-similarity: they belong to --acceptance counts alone, and are refused with chance.
   std::vector<const CLI::Option*> counts_flags;
+  // --min-link-share: it belongs to --acceptance chance alone, and is refused with counts.
+  std::vector<const CLI::Option*> chance_flags;
 };
 
-// --acceptance, --max-log10-nfa, --min-verified, --min-similarity, --max-lost, --candidates, --lookahead, --no-step-back, --ranking, the heading's options, --from, --to,
+// --acceptance, --max-log10-nfa, --min-verified, --min-similarity, --min-link-share, --recheck-link-share, --max-lost, --candidates, --lookahead, --no-step-back, --ranking, the heading's options, --from, --to,
 // --threads, --no-cache; fields as LocalizerOptions names them.
 void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& option_flags);
 
-// Refuses --min-verified or --min-similarity given with any acceptance rule but counts, which alone reads them.
+// Refuses --min-verified or --min-similarity given with any acceptance rule but counts, which alone reads them,
+// and --min-link-share with any but chance.
 void CheckLocalizerFlags(const LocalizerFlags& flags);
 
 }  // namespace vmap::cli

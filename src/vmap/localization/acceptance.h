@@ -1,13 +1,14 @@
 #pragma once
 // When a frame counts as seen at a key image: the acceptance rule of a comparison (Localizer::Compare).
 //
-// kChance accepts a comparison whose verified matches are unlikely to have arisen by chance:
+// kChance (the default) accepts a comparison whose verified matches are unlikely to have arisen by chance:
 // the a-contrario number of false alarms of F on the pair's tentative matches (geometry/chance_model.h), with
-// every comparison one frame can make counted as a test (ComparisonsPerFrame), is at most 10^max_log10_nfa. The test weighs what the
-// matcher gave (the tentative count), the image size and how tightly the matches fit F, so one setting serves
-// ORB and the deep matchers, 320x240 and 1241x376 alike. kCounts (the default) is the earlier rule: at least
-// min_verified verified matches and S >= min_similarity, whatever the matcher. docs/localization-acceptance.md has the
-// derivation and the measurements.
+// every comparison one frame can make counted as a test (ComparisonsPerFrame), is at most 10^max_log10_nfa. The
+// test weighs what the matcher gave (the tentative count), the image size and how tightly the matches fit F, so
+// one setting serves ORB and the deep matchers, 320x240 and 1241x376 alike. That says "the same scene"; the
+// Localizer adds "the same place" against the map's own links (LocalizerOptions::min_link_share). kCounts is the
+// earlier rule: at least min_verified verified matches and S >= min_similarity, whatever the matcher.
+// docs/localization-acceptance.md has the derivation and the measurements.
 
 #include <string>
 

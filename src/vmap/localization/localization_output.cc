@@ -71,6 +71,8 @@ std::string DescribeLocalizerOptions(const LocalizerOptions& options) {
               {"max_log10_nfa", options.max_log10_nfa},
               {"min_verified", options.min_verified},
               {"min_similarity", options.min_similarity},
+              {"min_link_share", options.min_link_share},
+              {"recheck_link_share", options.recheck_link_share},
               {"lookahead", options.lookahead},
               {"step_back", options.step_back},
               {"max_lost_frames", options.max_lost_frames},

@@ -121,7 +121,7 @@ TEST(LocalizeCli, ADifferentSceneDoesNotLocalize) {
   ::vmap::testing::ScopedTempDir tmp;
   std::string out;
   const fs::path json = tmp.path() / "desk.json";
-  // By either acceptance rule: the default (counts) and chance.
+  // By either acceptance rule: the default (chance) and counts.
   for (const std::string rule : {"counts", "chance"}) {
     ASSERT_EQ(RunVmap("localize " + Quote(LabMap()) + " " + Quote(Shared() / "data/lab_floor/desk.mp4") +
                           " --last 59 --stride 3 -q --acceptance " + rule + " --json " + Quote(json),
@@ -230,16 +230,18 @@ TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
   };
   const std::vector<Case> cases = {
       {localize + "--threads 40000", "--threads must be 0 to 256"},
-      {localize + "--min-verified 3", "--min-verified 3 must be 8"},
-      {localize + "--min-similarity nan", "--min-similarity nan is outside [0, 1]"},
+      {localize + "--acceptance counts --min-verified 3", "--min-verified 3 must be 8"},
+      {localize + "--acceptance counts --min-similarity nan", "--min-similarity nan is outside [0, 1]"},
       {localize + "--candidates 0", "--candidates 0 must be 1 to 10000"},
       {localize + "--max-lost -1", "--max-lost -1 must be 0 to 1000000"},
       {localize + "--lookahead 3", "lookahead 3 is not 1 or 2"},
       {localize + "--ranking bow", "unknown ranking 'bow'"},
       {localize + "--acceptance bow", "unknown acceptance rule 'bow'"},
       {localize + "--max-log10-nfa nan", "--max-log10-nfa nan is outside"},
-      {localize + "--acceptance chance --min-verified 30",
+      {localize + "--min-verified 30",
        "--min-verified belongs to the earlier acceptance rule; add --acceptance counts"},
+      {localize + "--acceptance counts --min-link-share 0.5", "--min-link-share belongs to --acceptance chance"},
+      {localize + "--recheck-link-share -1", "--recheck-link-share -1 is outside [0, 10]"},
       {localize + "--to 99", "key image 99 does not exist"},
       {"localize " + Quote(tmp.path() / "m") + " " + Quote(tmp.path() / "missing.mp4"), "does not exist"},
       {"route " + Quote(tmp.path() / "m") + " --min-backward-verified 2", "--min-backward-verified 2 must be 8"},

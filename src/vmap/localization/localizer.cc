@@ -52,6 +52,15 @@ void LocalizerOptions::Check() const {
                                                    "explains less than once)",
                                                    max_log10_nfa));
   }
+  if (!(recheck_link_share >= 0.0 && recheck_link_share <= 10.0)) {
+    throw OptionError("recheck_link_share",
+                      fmt::format("{} is outside [0, 10] (default 0.5; 0: never relocalize a tracked frame)",
+                                  recheck_link_share));
+  }
+  if (!(min_link_share >= 0.0 && min_link_share <= 10.0)) {
+    throw OptionError("min_link_share", fmt::format("{} is outside [0, 10] (default 0.4; 0: chance alone decides)",
+                                                    min_link_share));
+  }
   if (lookahead < 1 || lookahead > 2) {
     throw OptionError("lookahead", fmt::format("{} is not 1 or 2 (default 2)", lookahead));
   }
@@ -125,6 +134,18 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
     if (route_position_of_key_[k] >= 0) throw InputError(fmt::format("route visits key image {} twice", k));
     route_position_of_key_[k] = static_cast<int>(p);
   }
+  link_verified_.assign(num_keys, 0);
+  for (const Link& link : map_.links) {
+    const int a = link.from_key, b = link.to_key;
+    if (a < 0 || b < 0 || a >= num_keys || b >= num_keys || route_position_of_key_[a] < 0 ||
+        route_position_of_key_[b] < 0 || std::abs(route_position_of_key_[a] - route_position_of_key_[b]) != 1 ||
+        !link.has_fundamental || link.num_verified <= 0) {
+      continue;
+    }
+    for (const int k : {a, b}) {
+      link_verified_[k] = link_verified_[k] > 0 ? std::min(link_verified_[k], link.num_verified) : link.num_verified;
+    }
+  }
   // Only the route's key images take part in the ranking.
   std::vector<std::shared_ptr<const ImageFeatures>> features;
   std::vector<cv::Mat> thumbnails;
@@ -159,7 +180,8 @@ KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
                       .log10_nfa;
   }
   c.accepted = pair.matched && (options_.acceptance == AcceptanceRule::kChance
-                                    ? c.log10_nfa <= options_.max_log10_nfa
+                                    ? c.log10_nfa <= options_.max_log10_nfa &&
+                                          pair.num_verified >= options_.min_link_share * link_verified_[key]
                                     : pair.num_verified >= options_.min_verified &&
                                           pair.similarity >= options_.min_similarity);
   // The heading from every tentative match (verified first, then rejected), key image -> frame.
@@ -306,6 +328,17 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     if (lost_in_a_row_ > options_.max_lost_frames) Reset();
     return result;
   }
+  if (SharesLittle(best)) {
+    // Accepted, but with much less than neighbouring key images share: the frame may be elsewhere on the
+    // route, in view of this key image's scene. Moved when a ranked key image verifies more matches (a
+    // relocalization that is not taken leaves nothing behind: the tracked estimate is set below).
+    LocalizationResult found = Relocalize(frame, features);
+    int found_verified = 0;
+    for (const RelocalizationCandidate& c : found.candidates) {
+      if (c.accepted) found_verified = std::max(found_verified, c.num_verified);
+    }
+    if (found.status == LocalizationStatus::kRelocalized && found_verified > best.num_verified) return found;
+  }
   lost_in_a_row_ = 0;
   position_ = best_position;
   result.status = LocalizationStatus::kTracking;
@@ -320,6 +353,11 @@ double Localizer::SharedWithLink(const KeyComparison& comparison, int key_a, int
     }
   }
   return 0.0;  // no link between them: not comparable
+}
+
+bool Localizer::SharesLittle(const KeyComparison& comparison) const {
+  const int reference = link_verified_[comparison.key];
+  return reference > 0 && comparison.num_verified < options_.recheck_link_share * reference;
 }
 
 LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures& features) {

@@ -18,7 +18,9 @@
 //   too it is lost and the estimate is kept, and after `max_lost_frames` lost frames in a row it is dropped.
 //
 // "Better match" is measured by the verified matches (inliers of F) and S, as in the map; "verified" by the
-// acceptance rule (acceptance.h: counts of verified matches and S, or how unlikely they are by chance).
+// acceptance rule (acceptance.h: how unlikely the verified matches are by chance and how many against the map's
+// links, or counts of verified matches and S). A frame tracked with far fewer verified matches than its key
+// image shares with its neighbours is relocalized too, and moved when another key image verifies more.
 
 #include <limits>
 #include <memory>
@@ -45,17 +47,26 @@ namespace vmap {
 
 struct LocalizerOptions {
   // When a comparison accepts the frame at a key image (acceptance.h, docs/localization-acceptance.md).
-  // kCounts (default): at least `min_verified` verified matches and S >= `min_similarity` (S as the map defines
-  // it), whatever the matcher and image size.
-  // kChance: matching and verification succeed and the verified set is unlikely by chance, log10 of its number
-  // of false alarms (every comparison a frame can make counted as a test) at most `max_log10_nfa` (0: what
-  // chance would explain less than once over all the comparisons of a frame). Not the default: it says "the
-  // same scene", and on redkitchen's teach/repeat test tracking then held on to key images of the same room
-  // taken too far away (147 frames wrong against 8; docs/localization-acceptance.md).
-  AcceptanceRule acceptance = AcceptanceRule::kCounts;
+  // kChance (default): matching and verification succeed, the verified set is unlikely by chance (log10 of its
+  // number of false alarms, every comparison a frame can make counted as a test, at most `max_log10_nfa`; 0:
+  // what chance would explain less than once over all the comparisons of a frame: the same scene), and it holds
+  // at least `min_link_share` times the verified matches of the key image's link with its route neighbour (the
+  // smaller of its two links: what two neighbouring key images of this map share, so the bar follows the
+  // matcher, the image size and the texture: the same place).
+  // kCounts (the earlier rule): at least `min_verified` verified matches and S >= `min_similarity` (S as the map
+  // defines it), whatever the matcher and image size.
+  // Measured on redkitchen's teach/repeat test (docs/localization-acceptance.md): chance alone 85 frames right
+  // and 147 wrong, counts 137 and 8, the defaults below 144 and 7.
+  AcceptanceRule acceptance = AcceptanceRule::kChance;
   double max_log10_nfa = 0.0;
+  double min_link_share = 0.4;  // 0: chance alone decides (a key image without a link on the route: likewise)
   int min_verified = 20;
   double min_similarity = 0.3;
+  // Same scene is not same place. A frame tracked at a key image with fewer verified matches than
+  // `recheck_link_share` times those of the key image's link (as above) is also relocalized, and moved to the
+  // ranked key image that verifies more matches, if one does: a frame that verifies against a far key image of
+  // the same room must not stay there. 0: never (tracking keeps any accepted key image).
+  double recheck_link_share = 0.5;
   // Key images compared beyond `next_key` when the frame has passed it (1 or 2: the issue's "next one or two").
   int lookahead = 2;
   // While tracking, also compare the key image before `key` when the frame is nearer `key` than `next_key`
@@ -202,6 +213,8 @@ class Localizer {
   // The frame's verified matches with key_a over those of the map's link between key_a and key_b (0 when
   // they have no link).
   double SharedWithLink(const KeyComparison& comparison, int key_a, int key_b) const;
+  // A tracked comparison shares less with its key image than the map's links do (recheck_link_share).
+  bool SharesLittle(const KeyComparison& comparison) const;
 
   const VisualMap& map_;
   const KeyImageStore& keys_;
@@ -209,6 +222,9 @@ class Localizer {
   LocalizerOptions options_;
   std::vector<int> route_;
   std::vector<int> route_position_of_key_;  // -1 for key images off the route
+  // Per key image: the verified matches of its link with a route neighbour, the smaller of the two; 0 when it
+  // has no verified link on the route (the comparisons against the map's links are then skipped).
+  std::vector<int> link_verified_;
   std::unique_ptr<KeyImageRanking> ranking_;
   int position_ = -1;  // route position of `key`; -1: no estimate
   int lost_in_a_row_ = 0;

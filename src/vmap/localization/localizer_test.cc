@@ -227,10 +227,11 @@ TEST(Localizer, AFrameThatShowsLittleOfTheSceneIsStillLocalizedByItsChance) {
   // The earlier rule (S >= 0.3) loses frames that keep a few dozen verified matches among many chance ones;
   // the chance of those verified matches says they see the scene.
   const LocalizationMap& m = Map().opened;
-  LocalizerOptions counts = MapLocalizerOptions(m.map);
-  ASSERT_EQ(counts.acceptance, AcceptanceRule::kCounts) << "the default";
-  LocalizerOptions chance = counts;
-  chance.acceptance = AcceptanceRule::kChance;
+  LocalizerOptions chance = MapLocalizerOptions(m.map);
+  ASSERT_EQ(chance.acceptance, AcceptanceRule::kChance) << "the default";
+  chance.min_link_share = 0.0;  // chance alone: the test is about its rule
+  LocalizerOptions counts = chance;
+  counts.acceptance = AcceptanceRule::kCounts;
   const std::vector<LocalizationResult> by_chance = LocalizeAll(chance, MostlyHidden(0.35), Indices(1, 2));
   const std::vector<LocalizationResult> by_counts = LocalizeAll(counts, MostlyHidden(0.35), Indices(1, 2));
   ASSERT_EQ(by_chance.size(), 30u);
@@ -449,6 +450,8 @@ TEST(Localizer, OptionsAreChecked) {
   EXPECT_EQ(path([](LocalizerOptions& o) { o.min_verified = 5; }), "min_verified");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.min_similarity = 1.5; }), "min_similarity");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.max_log10_nfa = std::nan(""); }), "max_log10_nfa");
+  EXPECT_EQ(path([](LocalizerOptions& o) { o.recheck_link_share = -0.1; }), "recheck_link_share");
+  EXPECT_EQ(path([](LocalizerOptions& o) { o.min_link_share = std::nan(""); }), "min_link_share");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.lookahead = 3; }), "lookahead");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.max_lost_frames = -1; }), "max_lost_frames");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.relocalization_candidates = 0; }), "relocalization_candidates");
