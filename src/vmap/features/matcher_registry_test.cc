@@ -58,7 +58,7 @@ TEST(MatcherRegistry, AnUnknownNameListsTheRegisteredOnes) {
 }
 
 TEST(MatcherRegistry, DefaultTauIsEachModelsOwn) {
-  // The values the README's sweeps chose (matcher_registry.h, DefaultTau).
+  // The values the sweeps of docs/measurements/deep-matchers.md chose (matcher_registry.h, DefaultTau).
   EXPECT_DOUBLE_EQ(DefaultTau("orb"), 0.5);
   EXPECT_DOUBLE_EQ(DefaultTau("xfeat"), 0.4);
   EXPECT_DOUBLE_EQ(DefaultTau("aliked"), 0.7);
