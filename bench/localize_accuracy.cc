@@ -216,7 +216,7 @@ int main(int argc, char** argv) {
   odd.first = 1;
   for (const AcceptanceRule rule : rules) {
     std::printf("--- acceptance %s\n", AcceptanceRuleName(rule).c_str());
-    LocalizerOptions options = MapLocalizerOptions(map);
+    LocalizerOptions options = MapLocalizerOptions(opened);
     options.acceptance = rule;
     options.ranking.method = ParseRankingMethod(ranking);
     options.relocalization_candidates = candidates;

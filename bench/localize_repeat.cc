@@ -212,7 +212,7 @@ int main(int argc, char** argv) {
   if (rules.empty()) rules.push_back(AcceptanceRule::kChance);
   for (const AcceptanceRule rule : rules) {
     std::printf("--- acceptance %s\n", AcceptanceRuleName(rule).c_str());
-    LocalizerOptions localizer_options = MapLocalizerOptions(map);
+    LocalizerOptions localizer_options = MapLocalizerOptions(opened);
     localizer_options.acceptance = rule;
     localizer_options.ranking.method = ParseRankingMethod(ranking);
     localizer_options.ranking.max_descriptors_per_key = descriptors;
