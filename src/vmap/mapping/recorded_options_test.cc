@@ -147,11 +147,11 @@ TEST(RecordedOptions, AMalformedRecordNamesTheField) {
 // included.
 TEST(RecordedOptions, AMapIsReadWithItsOptionsTyped) {
   testing::ScopedTempDir directory;
-  testing::SyntheticMapOptions options;
-  options.tau = 0.35;
-  VisualMap map = testing::WriteSyntheticMap(directory.path() / "m", options);
+  report_test::SyntheticMapOptions options;
+  options.tau = 0.6;
+  VisualMap map = report_test::WriteSyntheticMap(directory.path() / "m", options);
   const RecordedMap read = ReadRecordedMap(directory.path() / "m");
-  EXPECT_EQ(read.options.builder.key_images.tau, 0.35);
+  EXPECT_EQ(read.options.builder.key_images.tau, 0.6);
   EXPECT_EQ(read.options.builder.quality_mean, QualityMean::kArithmetic);
   EXPECT_EQ(read.map.key_images.size(), map.key_images.size());
   EXPECT_EQ(nlohmann::json::parse(read.map.options_json)["matcher"]["features"], 2000);

@@ -15,6 +15,8 @@
 
 namespace vmap::report_test {
 
+using testing::ReadText;
+
 struct SyntheticMapOptions {
   int num_frames = 40;
   int frames_per_key = 9;
