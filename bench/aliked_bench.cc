@@ -62,7 +62,7 @@ double CpuSeconds(F&& f) {
   return ProcessCpuSeconds() - start;
 }
 
-// The alternative the README compares with: one grid_sample per kernel tap gathers the columns.
+// The alternative it is compared with: one grid_sample per kernel tap gathers the columns.
 torch::Tensor DeformConvByGridSample(const torch::Tensor& input, const torch::Tensor& offset,
                                      const torch::Tensor& weight, int64_t padding) {
   namespace F = torch::nn::functional;

@@ -208,7 +208,7 @@ int main(int argc, char** argv) {
   odd.first = 1;
   for (const bench::LocalizerVariant& variant : variants) {
     std::printf("--- %s\n", variant.Name().c_str());
-    LocalizerOptions options = MapLocalizerOptions(map);
+    LocalizerOptions options = MapLocalizerOptions(opened);
     variant.ApplyTo(options);
     options.ranking.method = ParseRankingMethod(ranking);
     options.relocalization_candidates = candidates;

@@ -141,7 +141,7 @@ int main(int argc, char** argv) {
     }
     for (bool ahead : {false, true}) {  // vmap localize end to end: decode and extraction on the workers
       auto source = OpenFrameSource(video);
-      Localizer localizer(lab.map, lab.keys, *lab.matcher, MapLocalizerOptions(lab.map));
+      Localizer localizer(lab.map, lab.keys, *lab.matcher, MapLocalizerOptions(lab));
       LocalizeSequenceOptions options;
       options.show_progress = false;
       options.compare_ahead = ahead;
@@ -159,7 +159,7 @@ int main(int argc, char** argv) {
       between.stride = 15;
       auto source = OpenFrameSource(kitchen, between);
       Localizer localizer(kitchen_map.map, kitchen_map.keys, *kitchen_map.matcher,
-                          MapLocalizerOptions(kitchen_map.map));
+                          MapLocalizerOptions(kitchen_map));
       Samples seconds, cpu_seconds;
       while (auto frame = source->Next()) {
         const auto features = kitchen_map.matcher->Extract(frame->gray);

@@ -208,7 +208,7 @@ int main(int argc, char** argv) {
   if (variants.empty()) variants.push_back({});
   for (const bench::LocalizerVariant& variant : variants) {
     std::printf("--- %s\n", variant.Name().c_str());
-    LocalizerOptions localizer_options = MapLocalizerOptions(map);
+    LocalizerOptions localizer_options = MapLocalizerOptions(opened);
     variant.ApplyTo(localizer_options);
     localizer_options.ranking.method = ParseRankingMethod(ranking);
     localizer_options.ranking.max_descriptors_per_key = descriptors;

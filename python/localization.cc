@@ -54,13 +54,6 @@ py::object ResultObject(const VisualMap& map, const LocalizationResult& result) 
   return Namespace(fields);
 }
 
-// The route `vmap localize --from --to` follows (all key images when neither is given).
-std::vector<int> RouteOf(const VisualMap& map, const cli::LocalizerFlags& flags, std::vector<int> route) {
-  if (flags.from < 0 && flags.to < 0) return route;
-  const int last = static_cast<int>(map.key_images.size()) - 1;
-  return PlanRoute(map, flags.from >= 0 ? flags.from : 0, flags.to >= 0 ? flags.to : last).keys;
-}
-
 // The map opened for localization and a Localizer on it, for frames given one at a time.
 class FrameLocalizer {
  public:
@@ -79,9 +72,9 @@ class FrameLocalizer {
       store_options.use_cache = flags.cache;
       store_options.thumbnail_width = options.ranking.thumbnail_width;
       opened_ = std::make_unique<LocalizationMap>(OpenLocalizationMap(directory, store_options));
-      options.route = RouteOf(opened_->map, flags, options.route);
+      options.route = cli::RouteOf(opened_->map, flags, options.route);
       // Frames are brought to the map's size, so the map's camera applies.
-      options = FollowMap(opened_->map, options, QueryResize(opened_->map, ""));
+      options = FollowMap(*opened_, options, QueryResize(opened_->map, ""));
       options.Check();
       localizer_ = std::make_unique<Localizer>(opened_->map, opened_->keys, *opened_->matcher, options);
     });
@@ -122,28 +115,10 @@ py::list LocalizeFunction(const py::object& map, const std::string& query, const
   std::vector<LocalizationResult> results;
   keywords.Run([&] {
     py::gil_scoped_release release;
-    FrameSourceOptions source_options = source_flags.Resolve();
-    source_options.allow_single_image = true;
-    LocalizeSequenceOptions run_options;
-    run_options.extraction_threads = flags.threads;
-    run_options.show_progress = spdlog::should_log(spdlog::level::info);
-    run_options.Check();
-    LocalizerOptions options = flags.localizer;
-    options.Check();
-    cli::CheckLocalizerFlags(flags);
-    // As `vmap localize`: what can fail fast does, before the key images are loaded.
-    const VisualMap header = ReadMap(directory);
-    options.route = RouteOf(header, flags, options.route);
-    source_options.resize = QueryResize(header, source_options.resize);
-    const std::unique_ptr<FrameSource> source = OpenFrameSource(query, source_options);
-    KeyImageStoreOptions store_options;
-    store_options.use_cache = flags.cache;
-    store_options.thumbnail_width = options.ranking.thumbnail_width;
-    opened = std::make_unique<LocalizationMap>(OpenLocalizationMap(directory, store_options));
-    options = FollowMap(opened->map, options, source_options.resize);
-    options.Check();
-    Localizer localizer(opened->map, opened->keys, *opened->matcher, options);
-    LocalizeSequence(*source, *opened->matcher, localizer, run_options,
+    cli::LocalizationSetup setup = cli::SetUpLocalization(flags, source_flags.Resolve(), directory, query);
+    opened = std::move(setup.opened);
+    Localizer localizer(opened->map, opened->keys, *opened->matcher, setup.options);
+    LocalizeSequence(*setup.source, *opened->matcher, localizer, setup.run_options,
                      [&](const Frame&, const LocalizationResult& result) {
                        results.push_back(result);
                        RaisePendingSignals();

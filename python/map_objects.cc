@@ -68,7 +68,9 @@ std::shared_ptr<MapHandle> ReadMapHandle(const std::filesystem::path& directory)
   auto handle = std::make_shared<MapHandle>();
   handle->directory = directory;
   py::gil_scoped_release release;
-  handle->map = ReadMap(directory);
+  RecordedMap read = ReadRecordedMap(directory);
+  handle->map = std::move(read.map);
+  handle->options = std::move(read.options);
   return handle;
 }
 
@@ -165,8 +167,7 @@ void BindMapObjects(py::module_& m) {
                              "Every option that shaped the map, as map.json records them")
       .def_property_readonly("statistics",
                              [](const MapHandle& h) {
-                               const RecordedOptions recorded = RecordedOptionsFromJson(h.map.options_json, "options");
-                               const MapStatistics s = ComputeStatistics(h.map, recorded.builder.quality_mean);
+                               const MapStatistics s = ComputeStatistics(h.map, h.options.builder.quality_mean);
                                py::dict d;
                                d["num_frames"] = s.num_frames, d["num_key_images"] = s.num_key_images;
                                d["min_verified"] = s.min_verified, d["max_verified"] = s.max_verified;

@@ -9,12 +9,14 @@
 #include <pybind11/stl.h>
 
 #include "vmap/map/visual_map.h"
+#include "vmap/mapping/recorded_options.h"
 
 namespace vmap::python {
 
 struct MapHandle {
   std::filesystem::path directory;
   VisualMap map;
+  RecordedOptions options;  // what the map records of the options that shaped it, typed
 };
 
 // Reads the map in `directory` (the GIL released meanwhile).

@@ -58,7 +58,7 @@ TEST(EvalCli, Kitti07LinksAreUsableAndTheReportShowsThem) {
   }
   EXPECT_EQ(summary["links"].get<int>(), static_cast<int>(built.links.size()));
   EXPECT_EQ(summary["evaluated_links"], summary["links"]);
-  // The development sequence's default map: every link usable (README, "Links a robot can trust").
+  // The development sequence's default map: every link usable (docs/measurements/links.md).
   EXPECT_GE(summary["usable_links"].get<double>(), 0.95 * summary["links"].get<double>()) << out;
   EXPECT_LT(summary["rotation_error_deg_median"].get<double>(), 0.5);
   EXPECT_EQ(doc["ground_truth"]["format"], "kitti");

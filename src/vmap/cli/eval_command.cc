@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/cli/commands.h"
+#include "vmap/cli/option_binder.h"
 #include "vmap/cli/option_flags.h"
 #include "vmap/cli/output_files.h"
 #include "vmap/core/atomic_output.h"
@@ -84,27 +85,7 @@ void AddEvalCommand(CLI::App& app) {
   command->add_option("--json", flags->json, "Also write the evaluation (JSON) to this file");
   command->add_flag("!--no-save", flags->save, "Do not write eval.json into the map directory");
   command->add_flag("!--no-table", flags->table, "Print only the summary, not one row per link");
-  auto& o = flags->options;
-  option_flags
-      .AddOption(command, "--max-rotation-error", o.max_rotation_error_deg, "max_rotation_error_deg",
-                 "Usable: rotation error below this (deg)")
-      ->capture_default_str();
-  option_flags
-      .AddOption(command, "--max-translation-error", o.max_translation_error_deg, "max_translation_error_deg",
-                 "Usable: translation direction error below this (deg) where the parallax is enough")
-      ->capture_default_str();
-  option_flags
-      .AddOption(command, "--min-parallax", o.min_parallax_px, "min_parallax_px",
-                 "True parallax (px) from which the translation direction is judged")
-      ->capture_default_str();
-  option_flags
-      .AddOption(command, "--sampson-threshold", o.sampson_threshold_px, "sampson_threshold_px",
-                 "A match is on its true epipolar line within this Sampson error (px)")
-      ->capture_default_str();
-  option_flags
-      .AddOption(command, "--max-time-difference", o.max_time_difference, "max_time_difference",
-                 "Seconds between a key image and its ground-truth pose (tum, euroc)")
-      ->capture_default_str();
+  AddOptionFlags(command, flags->options, option_flags);
   command->callback([flags] { flags->option_flags.Run([&] { RunEval(*flags); }); });
 }
 

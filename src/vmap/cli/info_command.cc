@@ -24,9 +24,9 @@ void AddInfoCommand(CLI::App& app) {
       std::cout << FormatRecordingTopics(*directory, DescribeRecording(*directory));
       return;
     }
-    const VisualMap map = ReadMap(*directory);
-    const std::string map_file = (std::filesystem::path(*directory) / kMapFileName).string();
-    const RecordedOptions options = RecordedOptionsFromJson(map.options_json, "map '" + map_file + "': options");
+    const RecordedMap read = ReadRecordedMap(*directory);
+    const VisualMap& map = read.map;
+    const RecordedOptions& options = read.options;
     std::cout << FormatMapSummary(map, options.builder.quality_mean);
     if (!options.matcher_type.empty()) {
       std::cout << "matcher         " << options.matcher_type << ", verifier "

@@ -45,46 +45,27 @@ std::string Percent(long part, long whole) {
 }
 
 void RunLocalize(const LocalizeFlags& flags) {
-  FrameSourceOptions source_options = flags.source.Resolve();
-  source_options.allow_single_image = true;
-  LocalizeSequenceOptions run_options;
-  run_options.extraction_threads = flags.threads;
-  run_options.show_progress = spdlog::should_log(spdlog::level::info);
-  run_options.Check();
-
-  // Everything that can fail fast does, before the key images are loaded (which may take seconds).
-  LocalizerOptions options = flags.localizer;
-  options.Check();
-  CheckOutputs({{flags.csv, "--csv"}, {flags.json, "--json"}},
-               {MapInputs(flags.map), NamedInput(flags.query, "the query"),
-                NamedInput(flags.report, "the --report folder")});
-  if (!flags.report.empty()) CheckLocalizationReportDirectory(flags.report, flags.map, flags.query);
-  // A FIFO or a device other than a camera would be opened blocking, waiting for a writer that may never come.
-  std::error_code ec;
-  const fs::file_status query_status = fs::status(flags.query, ec);
-  if (!IsLiveInput(flags.query) && fs::exists(query_status) && !fs::is_regular_file(query_status) &&
-      !fs::is_directory(query_status)) {
-    throw InputError("query '" + flags.query + "' is neither a file nor a folder (a FIFO or a device); give a video, "
-                     "an image folder, a TUM/EuRoC/KITTI sequence, an image, or a live input (udp://..., /dev/videoN)");
-  }
-  CheckLocalizerFlags(flags);
-  const VisualMap header = ReadMap(flags.map);
-  if (flags.from >= 0 || flags.to >= 0) {
-    const int last = static_cast<int>(header.key_images.size()) - 1;
-    options.route = PlanRoute(header, flags.from >= 0 ? flags.from : 0, flags.to >= 0 ? flags.to : last).keys;
-  }
-  // Frames are compared with key images at the map's size unless told otherwise.
-  source_options.resize = QueryResize(header, source_options.resize);
-  const std::unique_ptr<FrameSource> source = OpenFrameSource(flags.query, source_options);
-
-  KeyImageStoreOptions store_options;
-  store_options.use_cache = flags.cache;
-  store_options.thumbnail_width = options.ranking.thumbnail_width;
-  LocalizationMap opened = OpenLocalizationMap(flags.map, store_options);
+  LocalizationSetup setup = SetUpLocalization(flags, flags.source.Resolve(), flags.map, flags.query, [&] {
+    CheckOutputs({{flags.csv, "--csv"}, {flags.json, "--json"}},
+                 {MapInputs(flags.map), NamedInput(flags.query, "the query"),
+                  NamedInput(flags.report, "the --report folder")});
+    if (!flags.report.empty()) CheckLocalizationReportDirectory(flags.report, flags.map, flags.query);
+    // A FIFO or a device other than a camera would be opened blocking, waiting for a writer that may never come.
+    std::error_code ec;
+    const fs::file_status query_status = fs::status(flags.query, ec);
+    if (!IsLiveInput(flags.query) && fs::exists(query_status) && !fs::is_regular_file(query_status) &&
+        !fs::is_directory(query_status)) {
+      throw InputError("query '" + flags.query + "' is neither a file nor a folder (a FIFO or a device); give a "
+                       "video, an image folder, a TUM/EuRoC/KITTI sequence, an image, or a live input (udp://..., "
+                       "/dev/videoN)");
+    }
+  });
+  const FrameSourceOptions& source_options = setup.source_options;
+  const LocalizeSequenceOptions& run_options = setup.run_options;
+  const std::unique_ptr<FrameSource>& source = setup.source;
+  const LocalizationMap& opened = *setup.opened;
+  const LocalizerOptions& options = setup.options;
   const VisualMap& map = opened.map;
-  // The map's verifier, definition of S, translation thresholds and camera.
-  options = FollowMap(map, options, source_options.resize);
-  options.Check();
   Localizer localizer(map, opened.keys, *opened.matcher, options);
 
   LocalizationRun run;

@@ -3,60 +3,20 @@
 #include <limits>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
-#include "vmap/cli/common_options.h"
+#include "vmap/cli/option_binder.h"
 #include "vmap/core/error.h"
+#include "vmap/localization/route.h"
+#include "vmap/map/map_io.h"
 
 namespace vmap::cli {
 
 void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& option_flags) {
-  LocalizerOptions& o = flags.localizer;
-  option_flags.AddEnumOption(command, "--acceptance", o.acceptance, ParseAcceptanceRule, AcceptanceRuleName,
-                             "acceptance",
-                             "When a frame is seen at a key image: chance (its verified matches are unlikely by "
-                             "chance, --max-log10-nfa, and many against the map's links, --min-link-share) or "
-                             "counts (the earlier rule: --min-verified and --min-similarity)");
-  option_flags
-      .AddOption(command, "--max-log10-nfa", o.max_log10_nfa, "max_log10_nfa",
-                 "--acceptance chance: accept when log10 of the number of false alarms is at most this")
-      ->capture_default_str();
-  flags.counts_flags.push_back(
-      option_flags
-          .AddOption(command, "--min-verified", o.min_verified, "min_verified",
-                     "--acceptance counts: verified matches a frame needs to be localized at a key image")
-          ->capture_default_str());
-  flags.counts_flags.push_back(option_flags
-                                   .AddOption(command, "--min-similarity", o.min_similarity, "min_similarity",
-                                              "--acceptance counts: S a frame needs to be localized at a key image")
-                                   ->capture_default_str());
-  flags.chance_flags.push_back(
-      option_flags
-          .AddOption(command, "--min-link-share", o.min_link_share, "min_link_share",
-                     "--acceptance chance: verified matches a frame also needs, as a fraction of those of the key "
-                     "image's link with its route neighbour (0: chance alone)")
-          ->capture_default_str());
-  option_flags
-      .AddOption(command, "--recheck-link-share", o.recheck_link_share, "recheck_link_share",
-                 "Relocalize a tracked frame with fewer verified matches than this fraction of its key image's "
-                 "link, and move it where more verify (0: never)")
-      ->capture_default_str();
-  option_flags
-      .AddOption(command, "--max-lost", o.max_lost_frames, "max_lost_frames",
-                 "Lost frames in a row before the estimate is dropped")
-      ->capture_default_str();
-  option_flags
-      .AddOption(command, "--candidates", o.relocalization_candidates, "relocalization_candidates",
-                 "Best-ranked key images verified when relocalizing")
-      ->capture_default_str();
-  option_flags
-      .AddOption(command, "--lookahead", o.lookahead, "lookahead",
-                 "Key images beyond the next compared while tracking (1 or 2)")
-      ->capture_default_str();
-  option_flags.AddFlag(command, "!--no-step-back", o.step_back, "step_back",
-                       "Never move the estimate back to the previous key image");
-  option_flags.AddEnumOption(command, "--ranking", o.ranking.method, ParseRankingMethod, RankingMethodName,
-                             "ranking.method", "Relocalization ranking: " + ListEnumNames(kRankingMethodNames));
-  AddHeadingOptions(command, o.heading, option_flags);
+  // The verifier and the translation thresholds follow the map; they have no flags here.
+  AddOptionFlags(command, flags.localizer, option_flags, "", Nesting{false, {"verifier", "translation"}});
+  flags.counts_flags = {command->get_option("--min-verified"), command->get_option("--min-similarity")};
+  flags.chance_flags = {command->get_option("--min-link-share")};
   // -1 stands for "not given" here only: a negative key image is refused as route refuses it.
   command->add_option("--from", flags.from, "Follow the route from this key image (default: the first)")
       ->check(CLI::Range(0, std::numeric_limits<int>::max()));
@@ -84,6 +44,41 @@ void CheckLocalizerFlags(const LocalizerFlags& flags) {
                                    flag->get_name(), flag->get_name(), flag->get_name()));
     }
   }
+}
+
+std::vector<int> RouteOf(const VisualMap& map, const LocalizerFlags& flags, std::vector<int> route) {
+  if (flags.from < 0 && flags.to < 0) return route;
+  const int last = static_cast<int>(map.key_images.size()) - 1;
+  return PlanRoute(map, flags.from >= 0 ? flags.from : 0, flags.to >= 0 ? flags.to : last).keys;
+}
+
+LocalizationSetup SetUpLocalization(const LocalizerFlags& flags, FrameSourceOptions source_options,
+                                    const std::filesystem::path& map, const std::string& query,
+                                    const std::function<void()>& checks) {
+  LocalizationSetup setup;
+  source_options.allow_single_image = true;
+  setup.run_options.extraction_threads = flags.threads;
+  setup.run_options.show_progress = spdlog::should_log(spdlog::level::info);
+  setup.run_options.Check();
+  LocalizerOptions options = flags.localizer;
+  options.Check();
+  if (checks) checks();
+  CheckLocalizerFlags(flags);
+  const VisualMap header = ReadMap(map);
+  options.route = RouteOf(header, flags, options.route);
+  // Frames are compared with key images at the map's size unless told otherwise.
+  source_options.resize = QueryResize(header, source_options.resize);
+  setup.source = OpenFrameSource(query, source_options);
+
+  KeyImageStoreOptions store_options;
+  store_options.use_cache = flags.cache;
+  store_options.thumbnail_width = options.ranking.thumbnail_width;
+  setup.opened = std::make_unique<LocalizationMap>(OpenLocalizationMap(map, store_options));
+  // The map's verifier, definition of S, translation thresholds and camera.
+  setup.options = FollowMap(*setup.opened, options, source_options.resize);
+  setup.options.Check();
+  setup.source_options = std::move(source_options);
+  return setup;
 }
 
 }  // namespace vmap::cli

@@ -1,7 +1,8 @@
 #pragma once
 // The flags of one command by the option fields they set. The library's checks name fields (OptionError:
 // "extraction_threads must be 0 to 256"); the command says the same in its own words ("--threads must be 0 to
-// 256"). Each flag records its field where it is bound, so the table cannot drift from the bindings.
+// 256"). Each flag records its field where it is bound (by the options' field lists: cli/option_binder.h; by hand
+// for the few flags that are no field of an options struct), so the table cannot drift from the bindings.
 
 #include <functional>
 #include <map>
@@ -34,17 +35,6 @@ class OptionFlags {
   CLI::Option* AddFlag(CLI::App* command, const std::string& names, bool& field, const std::string& path,
                        const std::string& help) {
     return Record(path, command->add_flag(names, field, help));
-  }
-
-  // Binds `names` to the enum `field` by its names: `parse` reads a name (an unknown one is its InputError, as
-  // in map.json), `name` shows the default.
-  template <typename Enum>
-  CLI::Option* AddEnumOption(CLI::App* command, const std::string& names, Enum& field,
-                             Enum (*parse)(const std::string&), std::string (*name)(Enum), const std::string& path,
-                             const std::string& help) {
-    return Record(path, command->add_option_function<std::string>(
-                                names, [&field, parse](const std::string& text) { field = parse(text); }, help)
-                            ->default_str(name(field)));
   }
 
   // The flag recorded for `path`, or "" when it has none.

@@ -20,14 +20,10 @@
 namespace vmap {
 namespace fs = std::filesystem;
 using testing::Quote;
+using testing::ReadText;
 using testing::RunVmap;
 
 namespace {
-
-std::string ReadText(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
 
 // A small map built by the binary from a synthetic image folder at `directory`/in, into `directory`/m.
 void BuildMap(const fs::path& directory) {

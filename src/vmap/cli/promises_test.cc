@@ -1,4 +1,4 @@
-// The promises of README's "What vmap promises", each tested on the binary with several inputs:
+// The promises of docs/promises.md, each tested on the binary with several inputs:
 // 1. vmap replaces only what it can prove it wrote, never its input;
 // 2. reading an untrusted map never leaves its folder, reads only what the links reference, checks every field;
 // 3. an interrupted run (SIGINT, SIGTERM, SIGKILL) leaves nothing behind;
@@ -37,14 +37,10 @@ extern char** environ;
 namespace vmap {
 namespace fs = std::filesystem;
 using testing::Quote;
+using testing::ReadText;
 using testing::RunVmap;
 
 namespace {
-
-std::string ReadText(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
 
 void WriteSyntheticInput(const fs::path& directory, int num_frames) {
   testing::SyntheticOptions options;

@@ -42,6 +42,28 @@ void JsonFieldReader::Read(const char* key, bool* value) const {
 
 void JsonFieldReader::Read(const char* key, std::string* value) const { ReadString(key, value); }
 
+void JsonFieldReader::Read(const char* key, std::vector<int>* value) const {
+  const nlohmann::json* found = Find(key, &nlohmann::json::is_array, "an array of integers");
+  if (!found) return;
+  std::vector<int> values;
+  for (const nlohmann::json& item : *found) {
+    if (!item.is_number_integer() || item < std::numeric_limits<int>::min() ||
+        item > std::numeric_limits<int>::max()) {
+      throw InputError(Path(key) + " must be an array of integers (it holds " + item.dump() + ")");
+    }
+    values.push_back(item.get<int>());
+  }
+  *value = std::move(values);
+}
+
+void JsonFieldReader::Read(const char* key, const EnumField& value) const {
+  std::string name;
+  if (!ReadString(key, &name)) return;
+  if (!value.Set(name)) {
+    throw InputError(Path(key) + " is '" + name + "', which this vmap does not know (it knows " + value.names() + ")");
+  }
+}
+
 bool JsonFieldReader::ReadString(const char* key, std::string* value) const {
   const nlohmann::json* found = Find(key, &nlohmann::json::is_string, "a string");
   if (found) *value = found->get<std::string>();

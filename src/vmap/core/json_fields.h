@@ -8,11 +8,12 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "vmap/core/enum_names.h"
 #include "vmap/core/error.h"
+#include "vmap/core/option_fields.h"
 
 namespace vmap {
 
@@ -26,19 +27,10 @@ class JsonFieldReader {
   void Read(const char* key, int* value) const;
   void Read(const char* key, bool* value) const;
   void Read(const char* key, std::string* value) const;
+  void Read(const char* key, std::vector<int>* value) const;
 
-  // An enum recorded by its name in `names`.
-  template <typename Enum, std::size_t N>
-  void Read(const char* key, Enum* value, const EnumName<Enum> (&names)[N]) const {
-    std::string name;
-    if (!ReadString(key, &name)) return;
-    const std::optional<Enum> found = FindEnum(names, name);
-    if (!found) {
-      throw InputError(Path(key) + " is '" + name + "', which this vmap does not know (it knows " +
-                       ListEnumNames(names) + ")");
-    }
-    *value = *found;
-  }
+  // An enum recorded by its name.
+  void Read(const char* key, const EnumField& value) const;
 
   // The object under `key`; an empty one when the record lacks it (every field then keeps its value).
   JsonFieldReader Object(const char* key) const;

@@ -9,6 +9,7 @@ namespace {
 
 enum class Fruit { kApple, kPear };
 constexpr EnumName<Fruit> kFruitNames[] = {{Fruit::kApple, "apple"}, {Fruit::kPear, "pear"}};
+Fruit ParseFruit(const std::string& name) { return ParseEnum(kFruitNames, name, "fruit"); }
 
 TEST(JsonFieldReader, ReadsRecordedFieldsAndKeepsTheOthers) {
   const nlohmann::json record = {{"tau", 0.7},      {"seed", 3},   {"strict", true}, {"resize", "640"},
@@ -23,7 +24,7 @@ TEST(JsonFieldReader, ReadsRecordedFieldsAndKeepsTheOthers) {
   fields.Read("seed", &seed);
   fields.Read("strict", &strict);
   fields.Read("resize", &resize);
-  fields.Read("fruit", &fruit, kFruitNames);
+  fields.Read("fruit", EnumField(fruit, kFruitNames, ParseFruit));
   fields.Read("note", &note);        // null: as if not recorded
   fields.Read("absent", &missing);   // an older record
   EXPECT_EQ(tau, 0.7);
@@ -52,7 +53,7 @@ TEST(JsonFieldReader, AValueOfTheWrongKindNamesItsPath) {
   EXPECT_EQ(testing::InputErrorMessage([&] { fields.Read("strict", &strict); }),
             "map 'm/map.json': options.strict must be true or false (it is number)");
   EXPECT_NE(testing::InputErrorMessage([&] { fields.Read("big", &big); }).find("options.big must be an integer"), std::string::npos);
-  EXPECT_EQ(testing::InputErrorMessage([&] { fields.Read("fruit", &fruit, kFruitNames); }),
+  EXPECT_EQ(testing::InputErrorMessage([&] { fields.Read("fruit", EnumField(fruit, kFruitNames, ParseFruit)); }),
             "map 'm/map.json': options.fruit is 'fig', which this vmap does not know (it knows apple or pear)");
   double threshold = 0;
   EXPECT_EQ(testing::InputErrorMessage([&] { fields.Object("pose").Read("threshold", &threshold); }),

@@ -16,7 +16,7 @@ struct RuntimeOptions {
   int opencv_threads = 1;
   // Keep freed memory in the heap instead of returning large blocks to the system (mallopt M_MMAP_MAX = 0,
   // M_TRIM_THRESHOLD = 1 GiB). The deep matchers re-allocate their large activations for every frame; from
-  // fresh mmap()s those page-fault every time. Measured (README, "LoFTR"): LoFTR 27-37 % faster per frame /
+  // fresh mmap()s those page-fault every time. Measured (docs/measurements/loftr.md): LoFTR 27-37 % faster per frame /
   // per pair, ALIKED-N16's network 0.13 -> 0.09 CPU s per 640x480 frame. The same as starting with
   // GLIBC_TUNABLES=glibc.malloc.mmap_max=0:glibc.malloc.trim_threshold=..., without needing the variable.
   bool keep_freed_memory = true;

@@ -11,7 +11,7 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/core/file_name_encoding.h"
-#include "vmap/core/json_fields.h"
+#include "vmap/core/options_json.h"
 #include "vmap/geometry/relative_pose.h"
 #include "vmap/map/map_geometry_json.h"
 #include "vmap/sources/dataset_camera.h"
@@ -319,7 +319,7 @@ std::string EvaluationToJson(const MapEvaluation& evaluation) {
   doc["ground_truth"] = {{"path", EncodeFileName(evaluation.ground_truth_path)},
                          {"format", GroundTruthFormatName(evaluation.ground_truth_format)}};
   doc["camera"] = CameraToJson(evaluation.camera);
-  doc["options"] = ToJson(evaluation.options);
+  doc["options"] = OptionsToJson(evaluation.options);
   json links = json::array();
   for (const LinkEvaluation& e : evaluation.links) {
     links.push_back({{"link", e.link},
@@ -399,7 +399,7 @@ MapEvaluation ReadEvaluation(const std::string& path) {
       evaluation.camera = CameraFromJson(doc["camera"], path, "camera");
     }
     const json& options = doc.contains("options") ? doc["options"] : json::object();
-    FromJson(JsonFieldReader(options, "evaluation '" + path + "': options"), &evaluation.options);
+    OptionsFromJson(JsonFieldReader(options, "evaluation '" + path + "': options"), &evaluation.options);
     for (const json& l : doc["links"]) {
       LinkEvaluation e;
       e.link = l.at("link").get<int>();
@@ -460,20 +460,20 @@ MapEvaluation ReadEvaluation(const std::string& path) {
   return evaluation;
 }
 
-nlohmann::json ToJson(const EvaluationOptions& options) {
-  return {{"max_rotation_error_deg", options.max_rotation_error_deg},
-          {"max_translation_error_deg", options.max_translation_error_deg},
-          {"min_parallax_px", options.min_parallax_px},
-          {"sampson_threshold_px", options.sampson_threshold_px},
-          {"max_time_difference", options.max_time_difference}};
-}
-
-void FromJson(const JsonFieldReader& fields, EvaluationOptions* options) {
-  fields.Read("max_rotation_error_deg", &options->max_rotation_error_deg);
-  fields.Read("max_translation_error_deg", &options->max_translation_error_deg);
-  fields.Read("min_parallax_px", &options->min_parallax_px);
-  fields.Read("sampson_threshold_px", &options->sampson_threshold_px);
-  fields.Read("max_time_difference", &options->max_time_difference);
+void EvaluationOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit({"max_rotation_error_deg", "--max-rotation-error", "Usable: rotation error below this (deg)"},
+                max_rotation_error_deg);
+  visitor.Visit({"max_translation_error_deg", "--max-translation-error",
+                 "Usable: translation direction error below this (deg) where the parallax is enough"},
+                max_translation_error_deg);
+  visitor.Visit({"min_parallax_px", "--min-parallax", "True parallax (px) from which the translation direction is judged"},
+                min_parallax_px);
+  visitor.Visit({"sampson_threshold_px", "--sampson-threshold",
+                 "A match is on its true epipolar line within this Sampson error (px)"},
+                sampson_threshold_px);
+  visitor.Visit({"max_time_difference", "--max-time-difference",
+                 "Seconds between a key image and its ground-truth pose (tum, euroc)"},
+                max_time_difference);
 }
 
 }  // namespace vmap

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "vmap/core/option_fields.h"
 #include "vmap/evaluation/ground_truth.h"
 #include "vmap/geometry/camera.h"
 #include "vmap/map/visual_map.h"
@@ -28,14 +29,10 @@ struct EvaluationOptions {
   // Seconds: a key image takes the ground-truth pose nearest in time within this (tum, euroc).
   double max_time_difference = 0.02;
 
+  // As eval.json records them (its "options"): every field, by its name; and `vmap eval`'s flags.
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
-
-class JsonFieldReader;
-// As eval.json records them (its "options"): every field, by its name.
-nlohmann::json ToJson(const EvaluationOptions& options);
-// Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
-void FromJson(const JsonFieldReader& fields, EvaluationOptions* options);
 
 // Values that cannot be computed for a link are NaN (written as null in JSON).
 struct LinkEvaluation {

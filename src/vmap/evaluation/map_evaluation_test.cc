@@ -11,7 +11,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "vmap/core/error.h"
-#include "vmap/core/json_fields.h"
+#include "vmap/core/options_json.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/geometry/relative_pose.h"
 #include "vmap/mapping/batch_build.h"
@@ -280,14 +280,14 @@ TEST(MapEvaluation, OptionsReadBackAsWrittenAndKeepTheDefaultsOfWhatIsNotRecorde
   written.sampson_threshold_px = 1.5;
   written.max_time_difference = 0.05;
   EvaluationOptions read;
-  FromJson(JsonFieldReader(ToJson(written), "options"), &read);
-  EXPECT_EQ(ToJson(read), ToJson(written));
+  OptionsFromJson(JsonFieldReader(OptionsToJson(written), "options"), &read);
+  EXPECT_EQ(OptionsToJson(read), OptionsToJson(written));
   EXPECT_EQ(read.max_time_difference, 0.05);
   EvaluationOptions partly;
-  FromJson(JsonFieldReader(nlohmann::json{{"min_parallax_px", 3.0}}, "options"), &partly);
+  OptionsFromJson(JsonFieldReader(nlohmann::json{{"min_parallax_px", 3.0}}, "options"), &partly);
   EXPECT_EQ(partly.min_parallax_px, 3.0);
   EXPECT_EQ(partly.max_rotation_error_deg, EvaluationOptions().max_rotation_error_deg);
-  EXPECT_THROW(FromJson(JsonFieldReader(nlohmann::json{{"min_parallax_px", "3"}}, "options"), &partly), InputError);
+  EXPECT_THROW(OptionsFromJson(JsonFieldReader(nlohmann::json{{"min_parallax_px", "3"}}, "options"), &partly), InputError);
 }
 
 // Frames shown twice in a row (7-Scenes repeats a frame when one was dropped) are never promoted to key

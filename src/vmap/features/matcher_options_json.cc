@@ -16,10 +16,14 @@ namespace {
 class ForgetMissingFiles final : public OptionFieldVisitor {
  public:
   explicit ForgetMissingFiles(const std::string& model) : model_(model) {}
-  void Visit(const OptionField&, int&) override {}
-  void Visit(const OptionField&, double&) override {}
-  void Visit(const OptionField&, bool&) override {}
-  void Visit(const OptionField& field, std::string& value) override {
+
+ protected:
+  void OnField(const OptionField&, int&) override {}
+  void OnField(const OptionField&, double&) override {}
+  void OnField(const OptionField&, bool&) override {}
+  void OnField(const OptionField&, std::vector<int>&) override {}
+  void OnField(const OptionField&, const EnumField&) override {}
+  void OnField(const OptionField& field, std::string& value) override {
     if (!field.is_local_file || value.empty() || std::filesystem::exists(value)) return;
     spdlog::info("the map's {} {} '{}' are not here; searching the weights directories", model_, field.key, value);
     value.clear();

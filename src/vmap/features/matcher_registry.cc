@@ -4,6 +4,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/core/json_fields.h"
+#include "vmap/core/options_json.h"
 #include "vmap/features/matcher_plugin.h"
 #include "vmap/features/orb_matcher.h"
 
@@ -19,49 +20,22 @@ std::vector<MatcherModel>& Registry() {
 const MatcherModelRegistration kOrb{[] {
   MatcherModel model = MatcherModel::Of<OrbMatcherOptions>(
       "ORB keypoints (OpenCV) with brute-force Hamming matching, the paper's matcher",
-      0.5);  // the paper's tables' middle; README "The method, exactly"
+      0.5);  // the paper's tables' middle; docs/method.md
   model.create = [](const ModelOptions& options) { return CreateOrbMatcher(options.As<OrbMatcherOptions>()); };
   return model;
 }()};
 
-// Writes each field into a JSON object.
-class JsonWriter final : public OptionFieldVisitor {
- public:
-  explicit JsonWriter(nlohmann::json& object) : object_(object) {}
-  void Visit(const OptionField& field, int& value) override { object_[field.key] = value; }
-  void Visit(const OptionField& field, double& value) override { object_[field.key] = value; }
-  void Visit(const OptionField& field, bool& value) override { object_[field.key] = value; }
-  void Visit(const OptionField& field, std::string& value) override { object_[field.key] = value; }
-
- private:
-  nlohmann::json& object_;
-};
-
-// Reads the fields a JSON object holds; the others keep their values (core/json_fields.h).
-class JsonReader final : public OptionFieldVisitor {
- public:
-  explicit JsonReader(const JsonFieldReader& fields) : fields_(fields) {}
-  void Visit(const OptionField& field, int& value) override { fields_.Read(field.key, &value); }
-  void Visit(const OptionField& field, double& value) override { fields_.Read(field.key, &value); }
-  void Visit(const OptionField& field, bool& value) override { fields_.Read(field.key, &value); }
-  void Visit(const OptionField& field, std::string& value) override { fields_.Read(field.key, &value); }
-
- private:
-  const JsonFieldReader& fields_;
-};
-
 }  // namespace
 
 nlohmann::json ModelOptions::ToJson() const {
-  nlohmann::json object{{"type", model()}};
-  JsonWriter writer(object);
+  OptionsJsonWriter writer;
   Clone()->VisitFields(writer);  // visiting needs mutable fields; the copy keeps this const
-  return object;
+  writer.record()["type"] = model();
+  return writer.record();
 }
 
 void ModelOptions::FromJson(const nlohmann::json& object, const std::string& where) {
-  const JsonFieldReader fields(object, where);
-  JsonReader reader(fields);
+  OptionsJsonReader reader{JsonFieldReader(object, where)};
   VisitFields(reader);
   AfterReading();
 }

@@ -2,7 +2,7 @@
 // The matcher models vmap knows, by name, and matchers created by name. features/ knows matchers only through
 // this registry: ORB registers in matcher_registry.cc; each deep model registers from its own folder
 // (neural/<model>/<model>_registration.cc) and is created by the LibTorch plugin (matcher_plugin.h).
-// Adding a model: README, "Code layout".
+// Adding a model: docs/code-layout.md.
 
 #include <cstring>
 #include <functional>
@@ -17,7 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/features/matcher.h"
-#include "vmap/features/option_fields.h"
+#include "vmap/core/option_fields.h"
 
 namespace vmap {
 
@@ -161,7 +161,7 @@ class MatcherOptions {
 // The threshold tau `vmap build` uses with this matcher when --tau is not given. S = verified / tentative
 // means something else for each matcher: ALIKED's mutual matches with a similarity floor stay ~80 % inliers
 // while their number collapses, XFeat's keypoints fit F at 0.5 px less often than ORB's. Each value is the
-// lowest tau of the sweeps in the README ("Deep features") whose maps keep >= 95 % usable links where ground
+// lowest tau of the sweeps in docs/measurements/deep-matchers.md whose maps keep >= 95 % usable links where ground
 // truth exists, and a key image every few frames elsewhere. Throws InputError for an unknown type.
 double DefaultTau(const std::string& matcher_type);
 

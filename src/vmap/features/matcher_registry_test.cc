@@ -58,7 +58,7 @@ TEST(MatcherRegistry, AnUnknownNameListsTheRegisteredOnes) {
 }
 
 TEST(MatcherRegistry, DefaultTauIsEachModelsOwn) {
-  // The values the README's sweeps chose (matcher_registry.h, DefaultTau).
+  // The values the sweeps of docs/measurements/deep-matchers.md chose (matcher_registry.h, DefaultTau).
   EXPECT_DOUBLE_EQ(DefaultTau("orb"), 0.5);
   EXPECT_DOUBLE_EQ(DefaultTau("xfeat"), 0.4);
   EXPECT_DOUBLE_EQ(DefaultTau("aliked"), 0.7);
@@ -67,11 +67,13 @@ TEST(MatcherRegistry, DefaultTauIsEachModelsOwn) {
 
 // Moves every field away from its default, so that a field the JSON drops shows.
 class ChangeEveryField final : public OptionFieldVisitor {
- public:
-  void Visit(const OptionField&, int& value) override { value += 3; }
-  void Visit(const OptionField&, double& value) override { value += 0.125; }
-  void Visit(const OptionField&, bool& value) override { value = !value; }
-  void Visit(const OptionField&, std::string& value) override { value += "_changed"; }
+ protected:
+  void OnField(const OptionField&, int& value) override { value += 3; }
+  void OnField(const OptionField&, double& value) override { value += 0.125; }
+  void OnField(const OptionField&, bool& value) override { value = !value; }
+  void OnField(const OptionField&, std::string& value) override { value += "_changed"; }
+  void OnField(const OptionField&, std::vector<int>& value) override { value.push_back(3); }
+  void OnField(const OptionField&, const EnumField&) override {}  // no matcher has one
 };
 
 TEST(MatcherRegistry, EveryModelsOptionsRoundTripThroughJson) {

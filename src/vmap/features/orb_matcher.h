@@ -4,7 +4,7 @@
 #include <memory>
 
 #include "vmap/features/matcher.h"
-#include "vmap/features/option_fields.h"
+#include "vmap/core/option_fields.h"
 
 namespace vmap {
 

@@ -103,21 +103,18 @@ double SampsonDistance(const cv::Matx33d& F, const cv::Point2f& p0, const cv::Po
   return denominator > 0 ? std::abs(e) / std::sqrt(denominator) : 0.0;
 }
 
-nlohmann::json ToJson(const VerifierOptions& options) {
-  return {{"method", VerifierMethodName(options.method)}, {"threshold", options.threshold},
-          {"confidence", options.confidence},             {"max_iterations", options.max_iterations},
-          {"seed", options.seed},                         {"min_matches", options.min_matches},
-          {"max_samples_to_reject", options.max_samples_to_reject}};
-}
-
-void FromJson(const JsonFieldReader& fields, VerifierOptions* options) {
-  fields.Read("method", &options->method, kVerifierMethodNames);
-  fields.Read("threshold", &options->threshold);
-  fields.Read("confidence", &options->confidence);
-  fields.Read("max_iterations", &options->max_iterations);
-  fields.Read("seed", &options->seed);
-  fields.Read("min_matches", &options->min_matches);
-  fields.Read("max_samples_to_reject", &options->max_samples_to_reject);
+void VerifierOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit(OptionField{"method", "--verifier", "Fundamental matrix estimator: "}.ListingNames(),
+                EnumField(method, kVerifierMethodNames, ParseVerifierMethod));
+  visitor.Visit({"threshold", "--threshold", "Verifier inlier threshold in pixels"}, threshold);
+  visitor.Visit({"confidence", "--confidence", "Verifier confidence"}, confidence);
+  visitor.Visit({"max_iterations", "--max-iters", "Verifier maximum iterations"}, max_iterations);
+  visitor.Visit({"seed", "--seed", "Verifier random seed (same seed, same map)"}, seed);
+  visitor.Visit({"min_matches"}, min_matches);
+  visitor.Visit({"max_samples_to_reject", "--max-samples-to-reject",
+                 "Samples after which S < tau is settled when decisions stop early (--max-iters or more: the "
+                 "confidence criterion alone; ignored with --exhaustive)"},
+                max_samples_to_reject);
 }
 
 }  // namespace vmap

@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include "vmap/core/enum_names.h"
+#include "vmap/core/option_fields.h"
 
 namespace vmap {
 
@@ -37,19 +38,16 @@ struct VerifierOptions {
   // samples, where the confidence criterion for the target's inlier ratio would draw more (31,600 at 0.3, the
   // 100,000 cap at 0.25 and below). The criterion counts only all-inlier samples; local optimisation also recovers the
   // model from samples with an outlier or two, so far fewer samples find it. Measured on rccar_room's sweep
-  // (README, "Threshold sweeps"): 10,000 cut the sweep's CPU by 18 % and flipped about as many of the exhaustive
+  // (docs/measurements/sweeps.md): 10,000 cut the sweep's CPU by 18 % and flipped about as many of the exhaustive
   // run's decisions as a change of seed does. max_iterations keeps the confidence criterion alone.
   int max_samples_to_reject = 10000;
 
+  // The verifier as map.json records it and its flags: method, threshold, confidence, max_iterations, seed,
+  // min_matches, max_samples_to_reject (not own_magsac: MapBuilderOptions::exhaustive records which estimator
+  // decided).
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
-
-class JsonFieldReader;
-// The verifier as map.json records it: method, threshold, confidence, max_iterations, seed, min_matches
-// (not own_magsac: MapBuilderOptions::exhaustive records which estimator decided).
-nlohmann::json ToJson(const VerifierOptions& options);
-// Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
-void FromJson(const JsonFieldReader& fields, VerifierOptions* options);
 
 struct FundamentalResult {
   bool success = false;         // a model was found from at least min_matches tentative matches

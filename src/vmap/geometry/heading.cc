@@ -9,6 +9,21 @@
 
 namespace vmap {
 
+void HeadingOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit({"window_px", "--heading-window",
+                 "Heading: width of the window of horizontal displacements that votes (px)"},
+                window_px);
+  visitor.Visit({"window_dy_px", "--heading-window-dy",
+                 "Heading: height of the window in vertical displacement (px; 0 = by x alone)"},
+                window_dy_px);
+  visitor.Visit({"min_votes", "--heading-min-votes", "Heading: the fewest agreeing matches for an estimate"},
+                min_votes);
+  visitor.Visit({"min_verified", "--heading-min-verified",
+                 "Heading: with at least this many F-verified matches, their median displacement (0 = always the "
+                 "mode of all matches)"},
+                min_verified);
+}
+
 void HeadingOptions::Check() const {
   if (!(window_px > 0.0 && window_px <= 10000.0)) {
     throw OptionError("window_px", "must be in (0, 10000] pixels (default 20)");

@@ -20,6 +20,7 @@
 #include <opencv2/core.hpp>
 
 #include "vmap/core/enum_names.h"
+#include "vmap/core/option_fields.h"
 #include "vmap/geometry/camera.h"
 
 namespace vmap {
@@ -44,6 +45,8 @@ struct HeadingOptions {
   // with ORB for as many; it costs nothing where F is estimated anyway (vmap match, vmap localize).
   int min_verified = 50;
 
+  // As a localization run records them (its "options.heading") and their flags (--heading-*).
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
 

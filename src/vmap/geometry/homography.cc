@@ -60,13 +60,9 @@ HomographyCheck CheckHomography(const std::vector<cv::Point2f>& from, const std:
   return check;
 }
 
-nlohmann::json ToJson(const HomographyOptions& options) {
-  return {{"threshold", options.threshold}, {"min_share", options.min_share}};
-}
-
-void FromJson(const JsonFieldReader& fields, HomographyOptions* options) {
-  fields.Read("threshold", &options->threshold);
-  fields.Read("min_share", &options->min_share);
+void HomographyOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit({"threshold"}, threshold);
+  visitor.Visit({"min_share"}, min_share);
 }
 
 }  // namespace vmap

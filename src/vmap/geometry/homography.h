@@ -8,6 +8,8 @@
 #include <nlohmann/json_fwd.hpp>
 #include <opencv2/core.hpp>
 
+#include "vmap/core/option_fields.h"
+
 namespace vmap {
 
 struct HomographyOptions {
@@ -19,14 +21,10 @@ struct HomographyOptions {
   int max_iterations = 10000;
   int seed = 0;
 
+  // The homography test as map.json records it: threshold and min_share.
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
-
-class JsonFieldReader;
-// The homography test as map.json records it: threshold and min_share.
-nlohmann::json ToJson(const HomographyOptions& options);
-// Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
-void FromJson(const JsonFieldReader& fields, HomographyOptions* options);
 
 struct HomographyCheck {
   bool estimated = false;               // a homography could be fitted (at least 4 matches)

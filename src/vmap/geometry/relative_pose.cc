@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -279,18 +280,23 @@ bool TranslationKnown(double sigma_deg, double parallax_px, double rival_cost_ga
          rival_cost_gap >= options.min_rival_cost_gap;
 }
 
-nlohmann::json ToJson(const TranslationOptions& options) {
-  return {{"max_sigma_deg", options.max_sigma_deg},
-          {"min_parallax_px", options.min_parallax_px},
-          {"rival_angle_deg", options.rival_angle_deg},
-          {"min_rival_cost_gap", options.min_rival_cost_gap}};
-}
-
-void FromJson(const JsonFieldReader& fields, TranslationOptions* options) {
-  fields.Read("max_sigma_deg", &options->max_sigma_deg);
-  fields.Read("min_parallax_px", &options->min_parallax_px);
-  fields.Read("rival_angle_deg", &options->rival_angle_deg);
-  fields.Read("min_rival_cost_gap", &options->min_rival_cost_gap);
+void TranslationOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit({"max_sigma_deg", "--max-translation-sigma",
+                 "Degrees: a link whose translation direction is less certain than this is marked translation "
+                 "unknown (a robot gets its rotation only)"},
+                max_sigma_deg);
+  visitor.Visit({"min_parallax_px", "--min-translation-parallax",
+                 "Pixels: a link whose verified matches moved less than this once its rotation is undone (median) "
+                 "is marked translation unknown"},
+                min_parallax_px);
+  visitor.Visit({"rival_angle_deg", "--rival-translation-angle",
+                 "Degrees: another minimum of a link's pose cost whose translation points further away than this "
+                 "is a rival (see --min-rival-cost-gap)"},
+                rival_angle_deg);
+  visitor.Visit({"min_rival_cost_gap", "--min-rival-cost-gap",
+                 "A link whose rival minimum costs less than this more than its pose (robust Sampson cost) is "
+                 "marked translation unknown: its direction is ambiguous (0: never)"},
+                min_rival_cost_gap);
 }
 
 double PoseCost(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
@@ -469,22 +475,25 @@ double Median(std::vector<double> values) {
   return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + middle));
 }
 
-nlohmann::json ToJson(const PoseOptions& options) {
-  return {{"method", PoseMethodName(options.method)},
-          {"threshold", options.threshold},
-          {"matches", EnumToName(kPoseMatchesNames, options.use_all_matches)},
-          {"confidence", options.confidence},
-          {"max_iterations", options.max_iterations},
-          {"seed", options.seed}};
+bool ParsePoseMatches(const std::string& name) {
+  const std::optional<bool> all = FindEnum(kPoseMatchesNames, name);
+  if (!all) throw InputError("--pose-matches '" + name + "': use all (every tentative match) or verified (F's inliers)");
+  return *all;
 }
 
-void FromJson(const JsonFieldReader& fields, PoseOptions* options) {
-  fields.Read("method", &options->method, kPoseMethodNames);
-  fields.Read("threshold", &options->threshold);
-  fields.Read("matches", &options->use_all_matches, kPoseMatchesNames);
-  fields.Read("confidence", &options->confidence);
-  fields.Read("max_iterations", &options->max_iterations);
-  fields.Read("seed", &options->seed);
+void PoseOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit({"method", "--pose",
+                 "Relative pose of each link, with a camera: essential (E on normalised points) or "
+                 "fundamental (E = K^T F K)"},
+                EnumField(method, kPoseMethodNames, ParsePoseMethod));
+  visitor.Visit({"threshold", "--pose-threshold", "Inlier threshold of the essential matrix, pixels"}, threshold);
+  visitor.Visit(OptionField{"matches", "--pose-matches",
+                            "Matches the essential matrix is estimated on: all (tentative) or verified (F's inliers)"}
+                    .Named("use_all_matches"),
+                EnumField(use_all_matches, kPoseMatchesNames, ParsePoseMatches));
+  visitor.Visit({"confidence"}, confidence);
+  visitor.Visit({"max_iterations"}, max_iterations);
+  visitor.Visit({"seed"}, seed);
 }
 
 }  // namespace vmap

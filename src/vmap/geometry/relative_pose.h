@@ -16,6 +16,7 @@
 #include <opencv2/core.hpp>
 
 #include "vmap/core/enum_names.h"
+#include "vmap/core/option_fields.h"
 #include "vmap/geometry/camera.h"
 
 namespace vmap {
@@ -54,18 +55,15 @@ struct PoseOptions {
   int seed = 0;           // the random generator's state: the same link gives the same pose
   int min_matches = 8;    // fewer inliers than this: no pose
 
+  // The pose options as map.json records them: method, threshold, matches ("all" or "verified"), confidence,
+  // max_iterations, seed; the others (starts, refinement) are the algorithm's, not a user's choice.
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
 
 // The names of PoseOptions::use_all_matches (--pose-matches, map.json's pose.matches).
 inline constexpr EnumName<bool> kPoseMatchesNames[] = {{true, "all"}, {false, "verified"}};
-
-class JsonFieldReader;
-// The pose options as map.json records them: method, threshold, matches ("all" or "verified"), confidence,
-// max_iterations, seed; the others (starts, refinement) are the algorithm's, not a user's choice.
-nlohmann::json ToJson(const PoseOptions& options);
-// Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
-void FromJson(const JsonFieldReader& fields, PoseOptions* options);
+bool ParsePoseMatches(const std::string& name);
 
 struct RelativePose {
   bool valid = false;
@@ -153,13 +151,12 @@ struct TranslationOptions {
   double rival_angle_deg = 15.0;
   double min_rival_cost_gap = 8.0;
 
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
 // Without a rival (a single start, localization's refined pose of F): rival_cost_gap is infinity.
 bool TranslationKnown(double sigma_deg, double parallax_px, const TranslationOptions& options);
 bool TranslationKnown(double sigma_deg, double parallax_px, double rival_cost_gap, const TranslationOptions& options);
-nlohmann::json ToJson(const TranslationOptions& options);
-void FromJson(const JsonFieldReader& fields, TranslationOptions* options);
 
 // Sampson errors in pixels of matches under a pose (on normalised points, times the mean focal length).
 std::vector<double> PoseSampsonErrors(const cv::Matx33d& R, const cv::Vec3d& t, const Camera& camera,

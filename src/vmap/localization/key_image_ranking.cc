@@ -16,6 +16,15 @@ RankingMethod ParseRankingMethod(const std::string& name) { return ParseEnum(kRa
 
 std::string RankingMethodName(RankingMethod method) { return EnumToName(kRankingMethodNames, method); }
 
+void RankingOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit(OptionField{"method", "--ranking", "Relocalization ranking: "}.ListingNames(),
+                EnumField(method, kRankingMethodNames, ParseRankingMethod));
+  visitor.Visit({"max_hamming_fraction"}, max_hamming_fraction);
+  visitor.Visit({"min_cosine"}, min_cosine);
+  visitor.Visit({"max_descriptors_per_key"}, max_descriptors_per_key);
+  visitor.Visit({"thumbnail_width"}, thumbnail_width);
+}
+
 void RankingOptions::Check() const {
   if (!(max_hamming_fraction > 0.0 && max_hamming_fraction <= 0.5)) {
     throw OptionError("max_hamming_fraction",

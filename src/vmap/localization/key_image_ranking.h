@@ -18,6 +18,7 @@
 #include <opencv2/core.hpp>
 
 #include "vmap/core/enum_names.h"
+#include "vmap/core/option_fields.h"
 #include "vmap/features/matcher.h"
 
 namespace vmap {
@@ -46,6 +47,8 @@ struct RankingOptions {
   // Thumbnails: width in pixels (height keeps the aspect ratio, at least 8).
   int thumbnail_width = 48;
 
+  // As a localization run records them ("options.ranking"); only the method has a flag (--ranking).
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
 

@@ -13,20 +13,21 @@ namespace vmap {
 LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, const KeyImageStoreOptions& options) {
   LocalizationMap opened;
   opened.directory = directory;
-  opened.map = ReadMap(directory);
-  const std::string map_file = (directory / kMapFileName).string();
-  const RecordedOptions recorded = RecordedOptionsFromJson(opened.map.options_json, "map '" + map_file + "': options");
-  opened.matcher = CreateMatcher(MatcherOptionsFromJson(recorded.matcher_json, map_file));
+  RecordedMap read = ReadRecordedMap(directory);
+  opened.map = std::move(read.map);
+  opened.options = std::move(read.options);
+  opened.matcher = CreateMatcher(MatcherOptionsFromJson(opened.options.matcher_json, (directory / kMapFileName).string()));
   opened.keys = LoadKeyImageStore(directory, opened.map, *opened.matcher, options);
   return opened;
 }
 
-LocalizerOptions MapLocalizerOptions(const VisualMap& map) {
+LocalizerOptions MapLocalizerOptions(const LocalizationMap& opened) {
+  const MapBuilderOptions& recorded = opened.options.builder;
   LocalizerOptions options;
-  options.verifier = MapVerifierOptions(map);
-  options.similarity = MapSimilarityMode(map);
-  options.camera = map.input.camera;
-  options.translation = MapTranslationOptions(map);
+  options.verifier = MapVerifierOptions(recorded.verifier);
+  options.similarity = recorded.key_images.similarity;
+  options.camera = opened.map.input.camera;
+  options.translation = recorded.link_analysis.translation;
   return options;
 }
 
@@ -35,8 +36,9 @@ std::string QueryResize(const VisualMap& map, const std::string& resize) {
   return fmt::format("{}x{}", map.input.frame_size.width, map.input.frame_size.height);
 }
 
-LocalizerOptions FollowMap(const VisualMap& map, LocalizerOptions options, const std::string& query_resize) {
-  const LocalizerOptions from_map = MapLocalizerOptions(map);
+LocalizerOptions FollowMap(const LocalizationMap& opened, LocalizerOptions options, const std::string& query_resize) {
+  const VisualMap& map = opened.map;
+  const LocalizerOptions from_map = MapLocalizerOptions(opened);
   options.verifier = from_map.verifier;
   options.similarity = from_map.similarity;
   options.translation = from_map.translation;

@@ -10,23 +10,26 @@
 #include "vmap/localization/key_image_store.h"
 #include "vmap/localization/localizer.h"
 #include "vmap/map/visual_map.h"
+#include "vmap/mapping/recorded_options.h"
 
 namespace vmap {
 
 struct LocalizationMap {
   std::filesystem::path directory;
   VisualMap map;
+  RecordedOptions options;  // what the map records of the options that shaped it
   std::unique_ptr<Matcher> matcher;  // the map's matcher, with the map's options
   KeyImageStore keys;
 };
 
-// Reads the map (ReadMap), creates its matcher (MatcherOptionsFromJson) and loads its key images.
+// Reads the map and its options (ReadRecordedMap), creates its matcher (MatcherOptionsFromJson) and loads its
+// key images.
 // Throws InputError naming the file and the fix when any of it fails.
 LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, const KeyImageStoreOptions& options);
 
 // Localizer options that follow the map: its verifier (iterations capped, see MapVerifierOptions) and its
 // definition of S; the rest are LocalizerOptions' defaults.
-LocalizerOptions MapLocalizerOptions(const VisualMap& map);
+LocalizerOptions MapLocalizerOptions(const LocalizationMap& opened);
 
 // The size frames are localized at: `resize` when given, otherwise the map's frame size as "WxH" (key images
 // and frames are compared at one size; "" for a map that records none).
@@ -35,6 +38,6 @@ std::string QueryResize(const VisualMap& map, const std::string& resize);
 // `options` made to follow the map (MapLocalizerOptions): its verifier and definition of S, and its camera when
 // the frames are localized at the map's frame size (`query_resize`, QueryResize's), since the camera describes
 // frames of that size; otherwise headings stay in pixels, without relative poses (a warning says so).
-LocalizerOptions FollowMap(const VisualMap& map, LocalizerOptions options, const std::string& query_resize);
+LocalizerOptions FollowMap(const LocalizationMap& opened, LocalizerOptions options, const std::string& query_resize);
 
 }  // namespace vmap

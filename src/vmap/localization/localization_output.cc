@@ -10,6 +10,7 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/core/file_name_encoding.h"
+#include "vmap/core/options_json.h"
 
 namespace vmap {
 
@@ -67,38 +68,7 @@ json PoseJson(const RelativePose& pose) {
 }  // namespace
 
 std::string DescribeLocalizerOptions(const LocalizerOptions& options) {
-  json doc = {{"acceptance", AcceptanceRuleName(options.acceptance)},
-              {"max_log10_nfa", options.max_log10_nfa},
-              {"min_verified", options.min_verified},
-              {"min_similarity", options.min_similarity},
-              {"min_link_share", options.min_link_share},
-              {"recheck_link_share", options.recheck_link_share},
-              {"lookahead", options.lookahead},
-              {"step_back", options.step_back},
-              {"max_lost_frames", options.max_lost_frames},
-              {"relocalization_candidates", options.relocalization_candidates},
-              {"ranking",
-               {{"method", RankingMethodName(options.ranking.method)},
-                {"max_hamming_fraction", options.ranking.max_hamming_fraction},
-                {"min_cosine", options.ranking.min_cosine},
-                {"max_descriptors_per_key", options.ranking.max_descriptors_per_key},
-                {"thumbnail_width", options.ranking.thumbnail_width}}},
-              {"verifier",
-               {{"method", VerifierMethodName(options.verifier.method)},
-                {"threshold", options.verifier.threshold},
-                {"confidence", options.verifier.confidence},
-                {"max_iterations", options.verifier.max_iterations},
-                {"seed", options.verifier.seed},
-                {"min_matches", options.verifier.min_matches}}},
-              {"heading",
-               {{"window_px", options.heading.window_px},
-                {"window_dy_px", options.heading.window_dy_px},
-                {"min_votes", options.heading.min_votes},
-                {"min_verified", options.heading.min_verified}}},
-              {"translation", ToJson(options.translation)},
-              {"similarity", SimilarityModeName(options.similarity)},
-              {"route", options.route}};
-  return doc.dump();
+  return OptionsToJson(options).dump();
 }
 
 std::string LocalizationCsvHeader() {

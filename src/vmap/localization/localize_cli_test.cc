@@ -1,5 +1,5 @@
 // End-to-end tests of `vmap localize`, `vmap route` and the report of a run, on the shared sequences; and the
-// bracket test against truth (README "Localization") on subsets of kitti07 and redkitchen.
+// bracket test against truth (docs/measurements/localization.md) on subsets of kitti07 and redkitchen.
 
 #include <fstream>
 #include <sstream>
@@ -255,7 +255,7 @@ TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
 }
 
 // The bracket test on a subset: a map of the even frames, and each odd frame localized at one of the two key
-// images around it (the README has the full sequences).
+// images around it (docs/measurements/localization.md has the full sequences).
 struct PoseErrors {
   std::vector<double> rotation_deg, translation_deg;  // of each frame's pose to its target key image
 };
@@ -273,7 +273,7 @@ double BracketShare(const std::string& sequence, int last, PoseErrors* pose_erro
     ::vmap::testing::BuildMapDirectory(*source, *matcher, build, tmp.path() / "map");
   }
   const LocalizationMap opened = OpenLocalizationMap(tmp.path() / "map", {});
-  Localizer localizer(opened.map, opened.keys, *opened.matcher, MapLocalizerOptions(opened.map));
+  Localizer localizer(opened.map, opened.keys, *opened.matcher, MapLocalizerOptions(opened));
   FrameSourceOptions odd = even;
   odd.first = 1;
   const auto source = OpenFrameSource((Shared() / sequence).string(), odd);

@@ -8,7 +8,6 @@
 #include <fmt/format.h>
 
 #include "vmap/core/error.h"
-#include "vmap/mapping/recorded_options.h"
 
 namespace vmap {
 
@@ -17,7 +16,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Which of two accepted comparisons is the better match: more verified matches, then higher S.
-// Measured on the bracket test (README): S first, S times verified, a 10 % or 25 % margin before moving on,
+// Measured on the bracket test (docs/measurements/localization.md): S first, S times verified, a 10 % or 25 % margin before moving on,
 // and moving on only when S is higher too localized no more odd frames of redkitchen between their key
 // images than verified matches alone.
 bool Better(const KeyComparison& a, const KeyComparison& b) {
@@ -36,6 +35,45 @@ std::string LocalizationStatusName(LocalizationStatus status) {
     case LocalizationStatus::kLost: return "lost";
   }
   return "lost";
+}
+
+void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit({"acceptance", "--acceptance",
+                 "When a frame is seen at a key image: chance (its verified matches are unlikely by "
+                 "chance, --max-log10-nfa, and many against the map's links, --min-link-share) or "
+                 "counts (the earlier rule: --min-verified and --min-similarity)"},
+                EnumField(acceptance, kAcceptanceRuleNames, ParseAcceptanceRule));
+  visitor.Visit({"max_log10_nfa", "--max-log10-nfa",
+                 "--acceptance chance: accept when log10 of the number of false alarms is at most this"},
+                max_log10_nfa);
+  visitor.Visit({"min_verified", "--min-verified",
+                 "--acceptance counts: verified matches a frame needs to be localized at a key image"},
+                min_verified);
+  visitor.Visit({"min_similarity", "--min-similarity",
+                 "--acceptance counts: S a frame needs to be localized at a key image"},
+                min_similarity);
+  visitor.Visit({"min_link_share", "--min-link-share",
+                 "--acceptance chance: verified matches a frame also needs, as a fraction of those of the key "
+                 "image's link with its route neighbour (0: chance alone)"},
+                min_link_share);
+  visitor.Visit({"recheck_link_share", "--recheck-link-share",
+                 "Relocalize a tracked frame with fewer verified matches than this fraction of its key image's "
+                 "link, and move it where more verify (0: never)"},
+                recheck_link_share);
+  visitor.Visit({"max_lost_frames", "--max-lost", "Lost frames in a row before the estimate is dropped"},
+                max_lost_frames);
+  visitor.Visit({"relocalization_candidates", "--candidates", "Best-ranked key images verified when relocalizing"},
+                relocalization_candidates);
+  visitor.Visit({"lookahead", "--lookahead", "Key images beyond the next compared while tracking (1 or 2)"},
+                lookahead);
+  visitor.Visit({"step_back", "!--no-step-back", "Never move the estimate back to the previous key image"},
+                step_back);
+  visitor.VisitNested("ranking", ranking);
+  visitor.VisitNested("heading", heading);
+  visitor.VisitNested("verifier", verifier, Nesting{false, {"max_samples_to_reject"}});
+  visitor.VisitNested("translation", translation);
+  visitor.Visit({"similarity"}, EnumField(similarity, kSimilarityModeNames, ParseSimilarityMode));
+  visitor.Visit({"route"}, route);
 }
 
 void LocalizerOptions::Check() const {
@@ -87,23 +125,11 @@ std::pair<int, int> KeysAround(const VisualMap& map, int source_index) {
   return {before, after};
 }
 
-namespace {
-MapBuilderOptions RecordedBuilderOptions(const VisualMap& map) {
-  return RecordedOptionsFromJson(map.options_json.empty() ? "{}" : map.options_json, "the map's options").builder;
-}
-}  // namespace
-
-VerifierOptions MapVerifierOptions(const VisualMap& map, int max_iterations) {
-  VerifierOptions options = RecordedBuilderOptions(map).verifier;
+VerifierOptions MapVerifierOptions(const VerifierOptions& recorded, int max_iterations) {
+  VerifierOptions options = recorded;
   options.max_iterations = std::min(options.max_iterations, max_iterations);
   options.Check();
   return options;
-}
-
-SimilarityMode MapSimilarityMode(const VisualMap& map) { return RecordedBuilderOptions(map).key_images.similarity; }
-
-TranslationOptions MapTranslationOptions(const VisualMap& map) {
-  return RecordedBuilderOptions(map).link_analysis.translation;
 }
 
 std::string LocalizationGuidance(const LocalizationResult& result) {

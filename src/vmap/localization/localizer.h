@@ -79,8 +79,8 @@ struct LocalizerOptions {
   // Best-ranked key images verified when relocalizing.
   int relocalization_candidates = 5;
   RankingOptions ranking;
-  // The map's verifier (MapVerifierOptions reads it from map.json), except that localization caps its
-  // iterations (see MapVerifierOptions): a frame that shares little with a key image must fail fast.
+  // The map's verifier (as map.json records it), except that localization caps its iterations (see
+  // MapVerifierOptions): a frame that shares little with a key image must fail fast.
   VerifierOptions verifier;
   SimilarityMode similarity = SimilarityMode::kInlierRatio;
   // Key-image indices to follow, in order (PlanRoute gives one); empty = every key image in map order.
@@ -90,9 +90,14 @@ struct LocalizerOptions {
   // The map's camera (map.input.camera: intrinsics from the dataset or --camera). With it each comparison
   // also gives the heading in degrees and the relative pose to the key image; without, pixels only.
   std::optional<Camera> camera;
-  // When a pose's translation direction is trusted (the map's link_analysis.translation: MapTranslationOptions).
+  // When a pose's translation direction is trusted (the map's link_analysis.translation: MapLocalizerOptions).
   TranslationOptions translation;
 
+  // As a localization run records them (its "options"; not the camera, which the map gives) and the flags of
+  // `vmap localize`. The verifier, the translation thresholds and the similarity follow the map
+  // (MapVerifierOptions, FollowMap): they are recorded, but have no flags here, and the verifier records no
+  // early stop (localization verifies each comparison in full).
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
 
@@ -237,17 +242,13 @@ class Localizer {
 
 // The key images on either side of position `source_index` of the map's input (KeyImage::source_index):
 // the last key image at or before it and the first at or after it; -1 where there is none. A frame of the
-// teach run's path between two key images is rightly localized at either (the bracket test of the README).
+// teach run's path between two key images is rightly localized at either (the bracket test of docs/measurements/localization.md).
 std::pair<int, int> KeysAround(const VisualMap& map, int source_index);
 
-// The verifier of the map (options.verifier in map.json), with at most `max_iterations` iterations.
+// The verifier the map records (options.verifier in map.json), with at most `max_iterations` iterations.
 // Why capped: a frame compared with a key image it barely overlaps has a low inlier ratio, for which MAGSAC
 // runs up to the map's 100,000 iterations (about a second); such a pair fails the acceptance test anyway.
-VerifierOptions MapVerifierOptions(const VisualMap& map, int max_iterations = 5000);
-// S as the map defines it (options.similarity in map.json).
-SimilarityMode MapSimilarityMode(const VisualMap& map);
-// When the map trusts a translation direction (options.translation in map.json).
-TranslationOptions MapTranslationOptions(const VisualMap& map);
+VerifierOptions MapVerifierOptions(const VerifierOptions& recorded, int max_iterations = 5000);
 
 // What a controller may use of a result: "heading and translation", "heading only: translation unknown"
 // (a pose whose translation direction is not to be trusted), "heading only: no pose" (no camera, or no pose

@@ -88,7 +88,7 @@ LocalizationResult AfterAJump(const LocalizerOptions& options, int jump_to) {
 TEST(Localizer, AFrameTrackedAtAFarKeyImageOfTheSameSceneIsMovedWhereItVerifiesBetter) {
   const LocalizationMap& m = Dense();
   ASSERT_GE(m.map.key_images.size(), 12u);
-  LocalizerOptions recheck = MapLocalizerOptions(m.map);
+  LocalizerOptions recheck = MapLocalizerOptions(m);
   ASSERT_EQ(recheck.acceptance, AcceptanceRule::kChance);
   ASSERT_GT(recheck.recheck_link_share, 0.0) << "on by default";
   recheck.min_link_share = 0.0;  // chance alone accepts the far key image: the recheck must move the frame
@@ -96,7 +96,7 @@ TEST(Localizer, AFrameTrackedAtAFarKeyImageOfTheSameSceneIsMovedWhereItVerifiesB
   hold.recheck_link_share = 0.0;
   // The default acceptance refuses the far key image by itself when the jump is long (too few verified matches
   // against its links); frame 25 still shares more than 0.4 of a link with it, and only the recheck moves it.
-  LocalizerOptions refuse = MapLocalizerOptions(m.map);
+  LocalizerOptions refuse = MapLocalizerOptions(m);
   refuse.recheck_link_share = 0.0;
   for (int jump_to : {41, 57}) {
     const LocalizationResult refused = AfterAJump(refuse, jump_to);
@@ -119,7 +119,7 @@ TEST(Localizer, AFrameTrackedAtAFarKeyImageOfTheSameSceneIsMovedWhereItVerifiesB
 TEST(Localizer, AFrameThatSharesAsMuchAsTheMapsLinksIsNotRelocalized) {
   // The check costs a relocalization only where tracking is doubtful: along the drive none is.
   const LocalizationMap& m = Dense();
-  LocalizerOptions options = MapLocalizerOptions(m.map);
+  LocalizerOptions options = MapLocalizerOptions(m);
   options.acceptance = AcceptanceRule::kChance;
   Localizer localizer(m.map, m.keys, *m.matcher, options);
   ::vmap::testing::MemorySource source(Frames(1, 2), Indices(1, 2));

@@ -90,7 +90,7 @@ TEST(Localizer, TheMapHasSeveralKeyImages) {
 
 TEST(Localizer, EveryOddFrameIsLocalizedBetweenTheKeyImagesAroundIt) {
   const LocalizationMap& m = Map().opened;
-  Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m.map));
+  Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
   ::vmap::testing::MemorySource source(Frames(1, 2), Indices(1, 2));
   LocalizeSequenceOptions run;
   run.show_progress = false;
@@ -125,7 +125,7 @@ TEST(Localizer, EveryOddFrameIsLocalizedBetweenTheKeyImagesAroundIt) {
 
 TEST(Localizer, ProgressGrowsAlongASegment) {
   const LocalizationMap& m = Map().opened;
-  Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m.map));
+  Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
   // Correlate the estimated progress with the true position between the two key images.
   std::vector<double> estimated, truth;
   const auto frames = Frames(1, 2);
@@ -148,7 +148,7 @@ TEST(Localizer, ProgressGrowsAlongASegment) {
 
 TEST(Localizer, RelocalizesAFrameFromTheMiddleAfterReset) {
   const LocalizationMap& m = Map().opened;
-  Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m.map));
+  Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
   for (int source_index : {37, 11, 53, 25}) {
     localizer.Reset();
     ASSERT_FALSE(localizer.has_estimate());
@@ -162,7 +162,7 @@ TEST(Localizer, RelocalizesAFrameFromTheMiddleAfterReset) {
 
 TEST(Localizer, AnUnrelatedImageIsLostAndTheEstimateIsDroppedAfterMaxLostFrames) {
   const LocalizationMap& m = Map().opened;
-  LocalizerOptions options = MapLocalizerOptions(m.map);
+  LocalizerOptions options = MapLocalizerOptions(m);
   options.max_lost_frames = 2;
   Localizer localizer(m.map, m.keys, *m.matcher, options);
   // Noise shares no scene point with the map.
@@ -227,7 +227,7 @@ TEST(Localizer, AFrameThatShowsLittleOfTheSceneIsStillLocalizedByItsChance) {
   // The earlier rule (S >= 0.3) loses frames that keep a few dozen verified matches among many chance ones;
   // the chance of those verified matches says they see the scene.
   const LocalizationMap& m = Map().opened;
-  LocalizerOptions chance = MapLocalizerOptions(m.map);
+  LocalizerOptions chance = MapLocalizerOptions(m);
   ASSERT_EQ(chance.acceptance, AcceptanceRule::kChance) << "the default";
   chance.min_link_share = 0.0;  // chance alone: the test is about its rule
   LocalizerOptions counts = chance;
@@ -270,7 +270,7 @@ TEST(Localizer, ASceneOfOtherTexturesIsNeverAccepted) {
     frames.push_back(elsewhere.frames[i]);
     indices.push_back(i);
   }
-  LocalizerOptions chance = MapLocalizerOptions(Map().opened.map);
+  LocalizerOptions chance = MapLocalizerOptions(Map().opened);
   chance.acceptance = AcceptanceRule::kChance;
   int candidates = 0;
   for (const LocalizationResult& r : LocalizeAll(chance, frames, indices)) {
@@ -286,7 +286,7 @@ TEST(Localizer, ASceneOfOtherTexturesIsNeverAccepted) {
 
 TEST(Localizer, FollowsAReversedRouteWhenTheFramesComeBackwards) {
   const LocalizationMap& m = Map().opened;
-  LocalizerOptions options = MapLocalizerOptions(m.map);
+  LocalizerOptions options = MapLocalizerOptions(m);
   for (int k = static_cast<int>(m.map.key_images.size()) - 1; k >= 0; --k) options.route.push_back(k);
   Localizer localizer(m.map, m.keys, *m.matcher, options);
   int previous_key = static_cast<int>(m.map.key_images.size());
@@ -315,7 +315,7 @@ TEST(Localizer, HeadingIsTheHorizontalShiftOfTheSceneInPixels) {
   const LocalizationMap m = OpenLocalizationMap(directory.path() / "map", {});
   ASSERT_EQ(m.map.key_images.size(), 1u);
   for (double shift : {-14.0, 9.0}) {
-    Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m.map));
+    Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
     cv::Mat shifted;
     const cv::Matx23d translation(1, 0, shift, 0, 1, 0);
     cv::warpAffine(key_image, shifted, translation, key_image.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
@@ -345,7 +345,7 @@ TEST(Localizer, WithACameraTheHeadingIsInDegreesAndThePoseIsTheTrueOne) {
   ::vmap::testing::BuildMapDirectory(source, *matcher, build, directory.path() / "map");
   const LocalizationMap m = OpenLocalizationMap(directory.path() / "map", {});
   const cv::Matx33d K = Drive().K;
-  LocalizerOptions options = MapLocalizerOptions(m.map);
+  LocalizerOptions options = MapLocalizerOptions(m);
   options.camera = Camera::Make(K(0, 0), K(1, 1), K(0, 2), K(1, 2));
 
   // A pure shift of the image by s pixels is a turn of about atan(s / f) near the centre.
@@ -388,7 +388,7 @@ TEST(Localizer, WithACameraTheHeadingIsInDegreesAndThePoseIsTheTrueOne) {
   EXPECT_EQ(LocalizationGuidance(r), r.translation_known ? "heading and translation" : "heading only: translation unknown");
 
   // Without the camera: no degrees, no pose.
-  Localizer pixels_only(m.map, m.keys, *m.matcher, MapLocalizerOptions(m.map));
+  Localizer pixels_only(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
   const LocalizationResult p = pixels_only.Localize(frame, *m.matcher->Extract(frame.gray));
   EXPECT_TRUE(std::isnan(p.heading_deg));
   EXPECT_FALSE(p.to_key.pose.valid);
@@ -400,7 +400,7 @@ TEST(Localizer, SameInputSameResults) {
   const LocalizationMap& m = Map().opened;
   std::vector<LocalizationResult> runs[2];
   for (auto& results : runs) {
-    Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m.map));
+    Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
     for (int source_index : {9, 11, 13, 41, 43}) {
       results.push_back(LocalizeImage(localizer, Drive().frames[source_index], 0, source_index));
     }
@@ -417,7 +417,7 @@ TEST(Localizer, ComparingAheadOnTheWorkersChangesNothing) {
   const LocalizationMap& m = Map().opened;
   std::vector<LocalizationResult> runs[2];
   for (int i = 0; i < 2; ++i) {
-    Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m.map));
+    Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
     ::vmap::testing::MemorySource source(Frames(1, 2), Indices(1, 2));
     LocalizeSequenceOptions run;
     run.show_progress = false;
@@ -442,7 +442,7 @@ TEST(Localizer, ComparingAheadOnTheWorkersChangesNothing) {
 TEST(Localizer, OptionsAreChecked) {
   const LocalizationMap& m = Map().opened;
   auto with = [&](auto change) {
-    LocalizerOptions options = MapLocalizerOptions(m.map);
+    LocalizerOptions options = MapLocalizerOptions(m);
     change(options);
     return options;
   };
@@ -459,7 +459,7 @@ TEST(Localizer, OptionsAreChecked) {
   EXPECT_EQ(path([](LocalizerOptions& o) { o.verifier.threshold = 0.0; }), "verifier.threshold");
   EXPECT_NO_THROW(with([](LocalizerOptions&) {}).Check());
   // A route must name existing key images, once each.
-  LocalizerOptions bad_route = MapLocalizerOptions(m.map);
+  LocalizerOptions bad_route = MapLocalizerOptions(m);
   bad_route.route = {0, 99};
   EXPECT_THROW(Localizer(m.map, m.keys, *m.matcher, bad_route), InputError);
   bad_route.route = {0, 1, 0};

@@ -199,7 +199,7 @@ TEST(KeyImageSearch, OptionsAndDefaults) {
   options.search_window = 1;
   EXPECT_EQ(testing::OptionErrorPath([&] { options.Check(); }), "search_window");
   KnownSimilarityMatcher deep(MonotoneShare);
-  // auto is Algorithm 1's sequential search for every matcher (README, "Threshold sweeps"); bisect when asked.
+  // auto is Algorithm 1's sequential search for every matcher (docs/measurements/deep-matchers.md); bisect when asked.
   EXPECT_EQ(ResolveKeySearch(MapBuilderOptions{}), KeySearch::kSequential);
   EXPECT_EQ(ResolveKeySearch(Options(0.5, KeySearch::kBisect)), KeySearch::kBisect);
   MapBuilderOptions exhaustive;

@@ -218,18 +218,16 @@ void KeyImageSelector::Finish() {
   previous_.reset();
 }
 
-nlohmann::json ToJson(const KeyImageOptions& options) {
-  return {{"tau", options.tau},
-          {"similarity", SimilarityModeName(options.similarity)},
-          {"final_key", options.final_key},
-          {"min_key_displacement", options.min_key_displacement}};
-}
-
-void FromJson(const JsonFieldReader& fields, KeyImageOptions* options) {
-  fields.Read("tau", &options->tau);
-  fields.Read("similarity", &options->similarity, kSimilarityModeNames);
-  fields.Read("final_key", &options->final_key);
-  fields.Read("min_key_displacement", &options->min_key_displacement);
+void KeyImageOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit({"tau"}, tau);
+  visitor.Visit({"similarity", "--similarity",
+                 "S = verified / tentative matches (inlier-ratio) or / features detected (feature-ratio)"},
+                EnumField(similarity, kSimilarityModeNames, ParseSimilarityMode));
+  visitor.Visit({"final_key", "!--no-final-key", "Do not make the last frame a key image"}, final_key);
+  visitor.Visit({"min_key_displacement", "--min-key-displacement",
+                 "Pixels: a frame whose matches with the key image moved less (median) repeats its view and is "
+                 "never made a key image; 0 = off (Algorithm 1 as published)"},
+                min_key_displacement);
 }
 
 }  // namespace vmap

@@ -11,6 +11,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "vmap/core/enum_names.h"
+#include "vmap/core/option_fields.h"
 #include "vmap/features/matcher.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/map/visual_map.h"
@@ -36,14 +37,11 @@ struct KeyImageOptions {
   // views of one viewpoint has no parallax and a meaningless F. 0 turns this off (Algorithm 1 as published).
   double min_key_displacement = 1.0;
 
+  // Algorithm 1's options as map.json records them: tau, similarity, final_key, min_key_displacement. tau has
+  // no flag here: its default depends on the matcher (cli/map_options.h binds --tau).
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
-
-class JsonFieldReader;
-// Algorithm 1's options as map.json records them: tau, similarity, final_key, min_key_displacement.
-nlohmann::json ToJson(const KeyImageOptions& options);
-// Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
-void FromJson(const JsonFieldReader& fields, KeyImageOptions* options);
 
 // One processed frame with its features, as the selector sees it.
 struct FrameRecord {

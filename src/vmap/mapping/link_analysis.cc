@@ -197,16 +197,10 @@ void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int thread
   cache->entries_ = std::move(kept);
 }
 
-nlohmann::json ToJson(const LinkAnalysisOptions& options) {
-  return {{"pose", ToJson(options.pose)},
-          {"homography", ToJson(options.homography)},
-          {"translation", ToJson(options.translation)}};
-}
-
-void FromJson(const JsonFieldReader& fields, LinkAnalysisOptions* options) {
-  FromJson(fields.Object("pose"), &options->pose);
-  FromJson(fields.Object("homography"), &options->homography);
-  FromJson(fields.Object("translation"), &options->translation);
+void LinkAnalysisOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.VisitNested("pose", pose);
+  visitor.VisitNested("homography", homography);
+  visitor.VisitNested("translation", translation);
 }
 
 }  // namespace vmap

@@ -18,19 +18,15 @@
 namespace vmap {
 
 struct LinkAnalysisOptions {
-  PoseOptions pose;              // how the pose is estimated (README: "Relative pose per link")
+  PoseOptions pose;              // how the pose is estimated (docs/method.md, "The relative pose of a link")
   HomographyOptions homography;  // when a homography counts as explaining the matches
   TranslationOptions translation;  // when a link's translation direction is trusted (docs/link-poses.md)
 
+  // As map.json records it: {"pose": ..., "homography": ..., "translation": ...} (geometry/relative_pose.h,
+  // geometry/homography.h).
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
-
-class JsonFieldReader;
-// As map.json records it: {"pose": ..., "homography": ..., "translation": ...} (geometry/relative_pose.h,
-// geometry/homography.h).
-nlohmann::json ToJson(const LinkAnalysisOptions& options);
-// Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
-void FromJson(const JsonFieldReader& fields, LinkAnalysisOptions* options);
 
 // Fills link.has_pose/R/t/pose_inliers and how well t is known (with a camera), link.parallax and the
 // homography test, from the

@@ -47,25 +47,28 @@ VerifierOptions DecisionVerifier(const MapBuilderOptions& options) {
   return verifier;
 }
 
-nlohmann::json ToJson(const MapBuilderOptions& options) {
-  nlohmann::json record = ToJson(options.key_images);
-  record.update(ToJson(options.link_analysis));
-  record["verifier"] = ToJson(options.verifier);
-  record["exhaustive"] = options.exhaustive;
-  record["search"] = KeySearchName(ResolveKeySearch(options));
-  record["search_window"] = options.search_window;
-  record["quality_mean"] = QualityMeanName(options.quality_mean);
-  return record;
-}
-
-void FromJson(const JsonFieldReader& fields, MapBuilderOptions* options) {
-  FromJson(fields, &options->key_images);
-  FromJson(fields, &options->link_analysis);
-  FromJson(fields.Object("verifier"), &options->verifier);
-  fields.Read("exhaustive", &options->exhaustive);
-  fields.Read("search", &options->key_search, kKeySearchNames);
-  fields.Read("search_window", &options->search_window);
-  fields.Read("quality_mean", &options->quality_mean, kQualityMeanNames);
+void MapBuilderOptions::VisitFields(OptionFieldVisitor& visitor) {
+  const Nesting at_top_level{/*json_inline=*/true, {}};
+  visitor.VisitNested("key_images", key_images, at_top_level);
+  visitor.Visit(OptionField{"quality_mean", "--quality", "Mean used by the quality Q: "}.ListingNames(),
+                EnumField(quality_mean, kQualityMeanNames, ParseQualityMean));
+  visitor.Visit(OptionField{"extraction_threads", "--threads", "Feature-extraction threads, 0 to 256 (0 = one per core)"}
+                    .NotRecorded(),
+                extraction_threads);
+  visitor.VisitNested("link_analysis", link_analysis, at_top_level);
+  visitor.VisitNested("verifier", verifier);
+  visitor.Visit({"exhaustive", "--exhaustive",
+                 "The paper's exact behaviour: verify every comparison with OpenCV's USAC_MAGSAC to its "
+                 "confidence criterion (default: stop once S >= tau is settled; same maps within seed noise)"},
+                exhaustive);
+  visitor.Visit(OptionField{"search", "--search",
+                            "Key-image search: sequential (compare every frame: Algorithm 1), bisect (compare frames "
+                            "further ahead, then bisect: fewer network passes, the same map only where S falls with "
+                            "distance) or auto (sequential; docs/measurements/deep-matchers.md)"}
+                    .Named("key_search"),
+                EnumField(key_search, kKeySearchNames, ParseKeySearch));
+  visitor.Visit({"search_window", "--search-window", "bisect: frames compared ahead at most (held in memory)"},
+                search_window);
 }
 
 }  // namespace vmap

@@ -42,7 +42,7 @@ struct MapBuilderOptions {
   // The paper's exact behaviour: every comparison verified by OpenCV's USAC_MAGSAC to its confidence criterion.
   // Off (the default), with the magsac verifier, a comparison stops as soon as S >= tau is settled for the taus
   // it is judged under (vmap's MAGSAC++, geometry/magsac.h) and each link is verified in full: the same maps
-  // within the noise of a seed change, at a fraction of the cost (README, "Threshold sweeps" and "Speed").
+  // within the noise of a seed change, at a fraction of the cost (docs/measurements/sweeps.md and speed.md).
   bool exhaustive = false;
   KeySearch key_search = KeySearch::kAuto;
   // kBisect: frames held at most (the furthest a comparison looks ahead); memory grows with it, comparisons
@@ -53,26 +53,23 @@ struct MapBuilderOptions {
   // then writes nothing more. Not recorded, like the other settings of how a run is carried out.
   std::function<void()> after_frame;
 
+  // The builder's options as map.json records them, at the top level of "options" (a layout older than these
+  // structs): KeyImageOptions' fields, "verifier", "exhaustive", "search", "search_window", "quality_mean",
+  // and LinkAnalysisOptions' "pose", "homography" and "translation". How a run is carried out (show_progress,
+  // prefetch_frames, extraction_threads) never changes its map and is not recorded; extraction_threads has
+  // its flag. The map records the search that ran (RecordedOptions resolves kAuto).
+  void VisitFields(OptionFieldVisitor& visitor);
   int ExtractionThreads() const;
 
   void Check() const;  // throws OptionError naming the bad field
 };
 
 // kAuto resolves to kSequential, for every matcher (Check() refuses kBisect with `exhaustive`). Bisect was measured as
-// the deep matchers' default and dropped (README, "Threshold sweeps": deep matchers): for XFeat it was no faster
+// the deep matchers' default and dropped (docs/measurements/deep-matchers.md, "Comparing fewer frames"): for XFeat it was no faster
 // (0.90-1.04x on three of four sequences, more comparisons where S does not fall with distance), and for ALIKED,
 // 1.5-10x faster, it changed the map on three of four sequences (its S stays high until its matches run out). It stays
 // available as --search bisect.
 KeySearch ResolveKeySearch(const MapBuilderOptions& options);
-
-class JsonFieldReader;
-// The builder's options as map.json records them, at the top level of "options" (a layout older than these
-// structs): KeyImageOptions' fields, "verifier", "exhaustive", "search" (resolved: the search that ran),
-// "search_window", "quality_mean", and LinkAnalysisOptions' "pose" and "homography". How a run is carried out
-// (show_progress, prefetch_frames, extraction_threads) never changes its map and is not recorded.
-nlohmann::json ToJson(const MapBuilderOptions& options);
-// Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
-void FromJson(const JsonFieldReader& fields, MapBuilderOptions* options);
 
 // The verifier of the decisions: vmap's MAGSAC++, stopping once S >= tau is settled, unless the paper's
 // exact behaviour is asked for (or another verifier, which OpenCV runs to its confidence criterion).

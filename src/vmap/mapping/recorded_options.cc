@@ -3,14 +3,17 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/error.h"
-#include "vmap/core/json_fields.h"
+#include "vmap/core/options_json.h"
+#include "vmap/map/map_io.h"
 
 namespace vmap {
 
 nlohmann::json ToJson(const RecordedOptions& options) {
-  nlohmann::json record = ToJson(options.builder);
+  MapBuilderOptions builder = options.builder;
+  builder.key_search = ResolveKeySearch(builder);  // the search that ran
+  nlohmann::json record = OptionsToJson(builder);
   record["matcher"] = nlohmann::json::parse(options.matcher_json);
-  record["source"] = ToJson(options.source);
+  record["source"] = OptionsToJson(options.source);
   return record;
 }
 
@@ -23,12 +26,20 @@ RecordedOptions RecordedOptionsFromJson(const std::string& options_json, const s
   }
   const JsonFieldReader fields(record, where);
   RecordedOptions options;
-  FromJson(fields, &options.builder);
-  FromJson(fields.Object("source"), &options.source);
+  OptionsFromJson(fields, &options.builder);
+  OptionsFromJson(fields.Object("source"), &options.source);
   const JsonFieldReader matcher = fields.Object("matcher");
   matcher.Read("type", &options.matcher_type);
   options.matcher_json = matcher.object().dump();
   return options;
+}
+
+RecordedMap ReadRecordedMap(const std::filesystem::path& directory) {
+  RecordedMap read;
+  read.map = ReadMap(directory);
+  read.options =
+      RecordedOptionsFromJson(read.map.options_json, "map '" + (directory / kMapFileName).string() + "': options");
+  return read;
 }
 
 }  // namespace vmap

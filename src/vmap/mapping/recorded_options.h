@@ -1,10 +1,12 @@
 #pragma once
 // What a map records of the options that shaped it (map.json's "options"), typed.
 
+#include <filesystem>
 #include <string>
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "vmap/map/visual_map.h"
 #include "vmap/mapping/map_builder_options.h"
 #include "vmap/sources/frame_source.h"
 
@@ -24,5 +26,15 @@ nlohmann::json ToJson(const RecordedOptions& options);
 // Reads a record (fields it lacks keep their defaults). Throws InputError naming `where` and the key of a
 // value of the wrong kind or an enum name this vmap does not know.
 RecordedOptions RecordedOptionsFromJson(const std::string& options_json, const std::string& where);
+
+// A map as ReadMap reads it, with the options it records typed: read once, for every reader of the map (vmap
+// info, the report, localization, the Python module). VisualMap::options_json keeps the record as written,
+// fields this vmap does not know included, to show it and to write the map again.
+struct RecordedMap {
+  VisualMap map;
+  RecordedOptions options;
+};
+// Throws InputError naming map.json and the key when the map or its options cannot be read.
+RecordedMap ReadRecordedMap(const std::filesystem::path& directory);
 
 }  // namespace vmap

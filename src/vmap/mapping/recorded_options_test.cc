@@ -8,7 +8,10 @@
 
 #include "vmap/core/error.h"
 #include "vmap/mapping/recorded_options.h"
+#include "vmap/map/map_io.h"
 #include "vmap/testing/option_error.h"
+#include "vmap/testing/report_test_util.h"
+#include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
 namespace {
@@ -97,7 +100,7 @@ TEST(RecordedOptions, EveryRecordedFieldReadsBackAsWritten) {
   EXPECT_EQ(ToJson(read), ToJson(written));  // and so the same record again
 }
 
-// The layout users' scripts read (README, "map.json"): the builder's fields at the top level, the input's
+// The layout users' scripts read (docs/map-format.md): the builder's fields at the top level, the input's
 // camera "input" when it came with the input, the search that ran (auto resolved).
 TEST(RecordedOptions, KeepsMapJsonsLayout) {
   const nlohmann::json record = ToJson(RecordedOptions{});
@@ -138,6 +141,27 @@ TEST(RecordedOptions, AMalformedRecordNamesTheField) {
   EXPECT_EQ(error(R"({"source": []})"), "map 'm/map.json': options.source must be a JSON object (it is array)");
   EXPECT_EQ(error("[1]"), "map 'm/map.json': options is not a JSON object (it is array)");
   EXPECT_EQ(error("{"), "map 'm/map.json': options is not valid JSON");
+}
+
+// A map is read with its options typed, once; the record stays as written, fields this vmap does not know
+// included.
+TEST(RecordedOptions, AMapIsReadWithItsOptionsTyped) {
+  testing::ScopedTempDir directory;
+  report_test::SyntheticMapOptions options;
+  options.tau = 0.6;
+  VisualMap map = report_test::WriteSyntheticMap(directory.path() / "m", options);
+  const RecordedMap read = ReadRecordedMap(directory.path() / "m");
+  EXPECT_EQ(read.options.builder.key_images.tau, 0.6);
+  EXPECT_EQ(read.options.builder.quality_mean, QualityMean::kArithmetic);
+  EXPECT_EQ(read.map.key_images.size(), map.key_images.size());
+  EXPECT_EQ(nlohmann::json::parse(read.map.options_json)["matcher"]["features"], 2000);
+
+  map.options_json = R"({"quality_mean": "median"})";
+  WriteMapFiles(map, directory.path() / "m");
+  EXPECT_EQ(testing::InputErrorMessage([&] { ReadRecordedMap(directory.path() / "m"); }),
+            "map '" + (directory.path() / "m" / "map.json").string() +
+                "': options.quality_mean is 'median', which this vmap does not know (it knows arithmetic or "
+                "harmonic)");
 }
 
 }  // namespace

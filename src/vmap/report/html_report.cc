@@ -331,7 +331,7 @@ ReportAssets WriteReportAssets(const fs::path& map_directory, const VisualMap& m
   return assets;
 }
 
-std::string SummarySection(const VisualMap& map, const MapStatistics& stats, const json& options) {
+std::string SummarySection(const VisualMap& map, const MapStatistics& stats, const json& options, double tau) {
   const int n = map.num_frames, m = static_cast<int>(map.key_images.size());
   std::ostringstream html;
   html << "<section id=\"summary\"><h2>Summary</h2>\n<div class=\"cards\">"
@@ -348,7 +348,7 @@ std::string SummarySection(const VisualMap& map, const MapStatistics& stats, con
        << (map.input.fps > 0 ? Row("Frame rate", FormatFixed(map.input.fps, 2) + " fps") : "")
        << Row("Matcher", HtmlEscape(OptionText(options, "matcher")))
        << Row("Verifier", HtmlEscape(OptionText(options, "verifier")))
-       << Row("Threshold \u03c4", HtmlEscape(OptionText(options, "tau")))
+       << Row("Threshold \u03c4", json(tau).dump())  // as map.json writes it
        << Row("Frames n", std::to_string(n) +
                               (map.skipped_frames > 0 ? " (" + std::to_string(map.skipped_frames) +
                                                             " unreadable frames skipped)"
@@ -459,13 +459,12 @@ void WriteMapReport(const fs::path& map_directory) { WriteMapReport(map_director
 
 void WriteMapReport(const fs::path& map_directory, const MapReportOptions& report_options) {
   report_options.Check();
-  const VisualMap map = ReadMap(map_directory);
+  const RecordedMap read = ReadRecordedMap(map_directory);
+  const VisualMap& map = read.map;
   // Every image path is checked before anything is written.
   for (const KeyImage& k : map.key_images) KeyImageFile(map_directory, k);
   const json options = ParseOptions(map.options_json);  // shown as recorded, whatever this vmap knows of them
-  const RecordedOptions recorded =
-      RecordedOptionsFromJson(map.options_json, "map '" + (map_directory / kMapFileName).string() + "': options");
-  const MapStatistics stats = ComputeStatistics(map, recorded.builder.quality_mean);
+  const MapStatistics stats = ComputeStatistics(map, read.options.builder.quality_mean);
   const std::optional<MapEvaluation> evaluation = ReadMatchingEvaluation(map_directory, map);
 
   // Inside a map that ReadMap has just recognised as vmap's: the old report/ is vmap's too.
@@ -485,8 +484,8 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
                  {"link-table", "Links"},
                  {"links", "Match figures"},
                  {"options", "Options"}});
-  html += SummarySection(map, stats, options);
-  html += SimilaritySection(map, recorded.builder.key_images.tau);
+  html += SummarySection(map, stats, options, read.options.builder.key_images.tau);
+  html += SimilaritySection(map, read.options.builder.key_images.tau);
   html += KeyImagesSection(map, assets);
   html += RoutePreviewSection(map, assets, report_options.route_fps);
   html += LinkTableHtml(map, evaluation ? &*evaluation : nullptr);

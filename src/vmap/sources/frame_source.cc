@@ -294,35 +294,39 @@ std::unique_ptr<FrameSource> OpenFrameSource(const std::string& path, const Fram
       [&] { return OpenDetectedFrameSource(path, options); });
 }
 
-namespace {
-// map.json's name for FrameSourceOptions::camera's default, the intrinsics that come with the input.
-constexpr const char* kInputCamera = "input";
-}  // namespace
-
-nlohmann::json ToJson(const FrameSourceOptions& options) {
-  nlohmann::json json = {{"format", SourceFormatName(options.format)},
-          {"first", options.first},
-          {"last", options.last},
-          {"stride", options.stride},
-          {"resize", options.resize},
-          {"strict", options.strict},
-          {"camera", options.camera.empty() ? kInputCamera : options.camera}};
-  if (!options.topic.empty()) json["topic"] = options.topic;
-  if (!options.camera_topic.empty()) json["camera_topic"] = options.camera_topic;
-  return json;
-}
-
-void FromJson(const JsonFieldReader& fields, FrameSourceOptions* options) {
-  fields.Read("format", &options->format, kSourceFormatNames);
-  fields.Read("first", &options->first);
-  fields.Read("last", &options->last);
-  fields.Read("stride", &options->stride);
-  fields.Read("resize", &options->resize);
-  fields.Read("strict", &options->strict);
-  fields.Read("camera", &options->camera);
-  fields.Read("topic", &options->topic);
-  fields.Read("camera_topic", &options->camera_topic);
-  if (options->camera == kInputCamera) options->camera.clear();
+void FrameSourceOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit(OptionField{"format", "--format", "Input layout: "}.ListingNames(),
+                EnumField(format, kSourceFormatNames, ParseSourceFormat));
+  visitor.Visit({"first", "--first", "First frame (0-based)"}, first);
+  visitor.Visit({"last", "--last", "Last frame, inclusive (-1 = end)"}, last);
+  visitor.Visit({"stride", "--stride", "Use every N-th frame"}, stride);
+  visitor.Visit(OptionField{"resize", "--resize", "Resize frames: WxH, or the longest side (e.g. 640)"}.HideDefault(),
+                resize);
+  visitor.Visit({"strict", "--strict", "Frames of a different size are an error, not a warning"}, strict);
+  // map.json names the default, the intrinsics that come with the input, "input".
+  visitor.Visit(OptionField{"camera", "--camera",
+                            "Intrinsics: fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]] (pixels, native frame size) or a calibration "
+                            "file (OpenCV YAML/JSON, EuRoC sensor.yaml, KITTI calib.txt, intrinsics.txt); 'none' ignores "
+                            "the input's own. Default: the input's own, if any"}
+                    .HideDefault()
+                    .EmptyAs("input"),
+                camera);
+  visitor.Visit(OptionField{"topic", "--topic",
+                            "Recordings (ROS bag, rosbag2, MCAP): the image topic (Image or CompressedImage). Default: "
+                            "the only one; `vmap info RECORDING` lists them"}
+                    .HideDefault()
+                    .OmitEmpty(),
+                topic);
+  visitor.Visit(OptionField{"camera_topic", "--camera-topic",
+                            "Recordings: the CameraInfo topic. Default: camera_info beside the image topic"}
+                    .HideDefault()
+                    .OmitEmpty(),
+                camera_topic);
+  visitor.Visit(OptionField{"stream_timeout_seconds", "--stream-timeout",
+                            "Live inputs: seconds without a frame after which the stream has ended (and the longest "
+                            "opening it may take)"}
+                    .NotRecorded(),
+                stream_timeout_seconds);
 }
 
 }  // namespace vmap

@@ -11,6 +11,7 @@
 #include <opencv2/core.hpp>
 
 #include "vmap/core/enum_names.h"
+#include "vmap/core/option_fields.h"
 #include "vmap/geometry/camera.h"
 
 namespace vmap {
@@ -62,16 +63,12 @@ struct FrameSourceOptions {
   std::string topic;
   std::string camera_topic;
 
+  // Which frames of which input, as map.json records them: format, first, last, stride, resize, strict and
+  // camera ("input" for the input's own intrinsics, the default ""), and topic and camera_topic when set. The
+  // rest are limits and callbacks of a run (stream_timeout_seconds has its flag).
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
-
-class JsonFieldReader;
-// Which frames of which input, as map.json records them: format, first, last, stride, resize, strict and
-// camera ("input" for the input's own intrinsics, the default ""), and topic and camera_topic when set. The
-// rest are limits and callbacks of a run.
-nlohmann::json ToJson(const FrameSourceOptions& options);
-// Reads a record written by ToJson; fields it lacks keep their values (core/json_fields.h).
-void FromJson(const JsonFieldReader& fields, FrameSourceOptions* options);
 
 struct Frame {
   int index = 0;             // position in the processed sequence: 0, 1, 2, ...

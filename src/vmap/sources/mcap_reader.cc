@@ -91,31 +91,12 @@ class McapReader : public RecordingReader {
     std::vector<RecordingTopic> summarized;
     if (TopicsFromSummary(&summarized)) return summarized;
     Rewind();
-    std::map<std::string, RecordingTopic> by_topic;
-    RecordedMessage message;
-    long counted = 0;
-    for (;;) {
-      try {
-        if (!NextMessage(nullptr, &message)) break;
-      } catch (const InputError& error) {
-        // The frames before the damage are still read (RecordingSource warns again when it gets there).
-        if (counted == 0) throw;
-        spdlog::warn("{}; counting the {} messages before it", error.what(), counted);
-        break;
-      }
-      ++counted;
-      RecordingTopic& topic = by_topic[message.topic];
-      if (topic.message_count++ == 0) {
-        topic.name = message.topic;
-        topic.type = type_of_last_;
-        topic.first_time_ns = message.log_time_ns;
-      }
-      topic.first_time_ns = std::min(topic.first_time_ns, message.log_time_ns);
-      topic.last_time_ns = std::max(topic.last_time_ns, message.log_time_ns);
-    }
+    std::vector<RecordingTopic> list = CountTopicsByReading([this](RecordedMessage* message, std::string* type) {
+      if (!NextMessage(nullptr, message)) return false;
+      *type = type_of_last_;
+      return true;
+    });
     Rewind();
-    std::vector<RecordingTopic> list;
-    for (auto& [name, topic] : by_topic) list.push_back(std::move(topic));
     return list;
   }
 

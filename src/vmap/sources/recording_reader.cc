@@ -1,6 +1,10 @@
 #include "vmap/sources/recording_reader.h"
 
+#include <algorithm>
 #include <filesystem>
+#include <map>
+
+#include <spdlog/spdlog.h>
 
 #include "vmap/core/error.h"
 
@@ -58,6 +62,38 @@ std::string NormalizedTypeName(const std::string& type) {
   const size_t msg = type.find("/msg/");
   if (msg == std::string::npos) return type;
   return type.substr(0, msg) + "/" + type.substr(msg + 5);
+}
+
+std::vector<RecordingTopic> CountTopicsByReading(
+    const std::function<bool(RecordedMessage* message, std::string* type)>& next) {
+  std::map<std::string, RecordingTopic> by_topic;
+  RecordedMessage message;
+  std::string type;
+  long counted = 0;
+  for (;;) {
+    try {
+      if (!next(&message, &type)) break;
+    } catch (const InputError& error) {
+      // The frames before the damage are still read (RecordingSource warns again when it gets there).
+      if (counted == 0) throw;
+      spdlog::warn("{}; counting the {} messages before it", error.what(), counted);
+      break;
+    }
+    ++counted;
+    RecordingTopic& topic = by_topic[message.topic];
+    if (topic.message_count++ == 0) {
+      topic.name = message.topic;
+      topic.type = type;
+      topic.first_time_ns = message.log_time_ns;
+      topic.last_time_ns = message.log_time_ns;
+    }
+    // Stored order need not be time order (MCAP chunks may overlap in time).
+    topic.first_time_ns = std::min(topic.first_time_ns, message.log_time_ns);
+    topic.last_time_ns = std::max(topic.last_time_ns, message.log_time_ns);
+  }
+  std::vector<RecordingTopic> list;
+  for (auto& [name, topic] : by_topic) list.push_back(std::move(topic));
+  return list;
 }
 
 }  // namespace vmap

@@ -4,6 +4,7 @@
 // do not (recording_messages.h decodes them).
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <set>
 #include <string>
@@ -46,6 +47,13 @@ class RecordingReader {
   virtual MessageEncoding encoding() const = 0;
   virtual RecordingFormat format() const = 0;
 };
+
+// Every topic counted by reading each message, for a recording whose index (or summary) is missing: `next`
+// reads the next message of any topic and gives the type of its topic, false at the end. Damage after the
+// first message ends the count with a warning (the frames before it are still read); damage at the first is
+// its InputError.
+std::vector<RecordingTopic> CountTopicsByReading(
+    const std::function<bool(RecordedMessage* message, std::string* type)>& next);
 
 // Whether `path` is a recording: a .bag or .mcap file, a .db3 file, or a folder holding metadata.yaml and .db3 files.
 bool IsRecording(const std::string& path);

@@ -106,13 +106,6 @@ VisualMap WriteSyntheticMap(const fs::path& directory, const SyntheticMapOptions
   return map;
 }
 
-std::string ReadText(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 std::vector<std::string> AttributeValues(const std::string& html, const std::string& name) {
   std::vector<std::string> values;
   const std::string needle = " " + name + "=\"";

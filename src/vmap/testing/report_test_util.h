@@ -11,8 +11,11 @@
 
 
 #include "vmap/map/visual_map.h"
+#include "vmap/testing/scoped_temp_dir.h"  // ReadText
 
 namespace vmap::report_test {
+
+using testing::ReadText;
 
 struct SyntheticMapOptions {
   int num_frames = 40;
@@ -26,8 +29,6 @@ struct SyntheticMapOptions {
 // (verified ones follow the true shift, rejected ones do not) and records an evaluation per frame. Writes
 // map.json, correspondences.bin and keys/*.png into `directory` (created) and returns the map.
 VisualMap WriteSyntheticMap(const std::filesystem::path& directory, const SyntheticMapOptions& options = {});
-
-std::string ReadText(const std::filesystem::path& file);
 
 // Every value of attribute `name` in `html`, in order.
 std::vector<std::string> AttributeValues(const std::string& html, const std::string& name);

@@ -21,4 +21,7 @@ class ScopedTempDir {
   std::filesystem::path path_;
 };
 
+// The bytes of a file a test wrote or wants to compare (empty when it cannot be read).
+std::string ReadText(const std::filesystem::path& file);
+
 }  // namespace vmap::testing

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "vmap/features/option_fields.h"
+#include "vmap/core/option_fields.h"
 
 namespace vmap {
 
@@ -15,13 +15,13 @@ struct AlikedMatcherOptions {
   std::string device = "cpu";  // "cpu" or "cuda"
   // Keypoints per image: the top_k highest DKD scores. 0 switches to upstream's threshold mode: every NMS
   // peak whose score exceeds score_threshold, at most max_keypoints of them (the upstream demos' mode).
-  // 1000 keypoints gave the best maps of the measured settings (README, "ALIKED"); more cost matching and
+  // 1000 keypoints gave the best maps of the measured settings (docs/matchers.md, ALIKED); more cost matching and
   // MAGSAC time without more usable links.
   int top_k = 1000;
   double score_threshold = 0.2;  // threshold mode only (upstream default)
   int max_keypoints = 5000;      // threshold mode only (upstream n_limit)
   // Mutual nearest neighbours with a cosine similarity of at least this are tentative matches. Upstream's
-  // demos use 0.75 for pairs and 0.9 for sequences; see the README for the measurement behind the default.
+  // demos use 0.75 for pairs and 0.9 for sequences; docs/matchers.md has the measurement behind the default.
   double min_similarity = 0.75;
   // Images are processed at their own size (replicate-padded to a multiple of 32, as upstream). A value > 0
   // first shrinks images whose longest side exceeds it (INTER_AREA), for speed; keypoints are mapped back.

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "vmap/features/option_fields.h"
+#include "vmap/core/option_fields.h"
 
 namespace vmap {
 

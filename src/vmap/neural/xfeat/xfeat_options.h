@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "vmap/features/option_fields.h"
+#include "vmap/core/option_fields.h"
 
 namespace vmap {
 
@@ -13,7 +13,7 @@ struct XfeatMatcherOptions {
   std::string weights;         // file; empty searches the weights directories (see `vmap weights`)
   std::string device = "cpu";  // "cpu" or "cuda"
   // Keypoints kept per image, the best by score (upstream's default is 4096). Fewer keypoints make matching
-  // (quadratic in top_k) and MAGSAC cheaper; see the README's XFeat section for the measured choice.
+  // (quadratic in top_k) and MAGSAC cheaper; docs/measurements/deep-matchers.md has the measured choice.
   int top_k = 4096;
   // A keypoint needs a heatmap value above this (upstream 0.05).
   double detection_threshold = 0.05;
