@@ -37,6 +37,11 @@ void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& 
                  "Best-ranked key images verified when relocalizing")
       ->capture_default_str();
   option_flags
+      .AddOption(command, "--experience-candidates", o.experience_candidates, "experience_candidates",
+                 "Maps with experiences: views of a key image verified besides it, those with the most tentative "
+                 "matches (0 = the teach key images only)")
+      ->capture_default_str();
+  option_flags
       .AddOption(command, "--lookahead", o.lookahead, "lookahead",
                  "Key images beyond the next compared while tracking (1 or 2)")
       ->capture_default_str();

@@ -17,7 +17,8 @@ LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, cons
   const std::string map_file = (directory / kMapFileName).string();
   const RecordedOptions recorded = RecordedOptionsFromJson(opened.map.options_json, "map '" + map_file + "': options");
   opened.matcher = CreateMatcher(MatcherOptionsFromJson(recorded.matcher_json, map_file));
-  opened.keys = LoadKeyImageStore(directory, opened.map, *opened.matcher, options);
+  opened.experiences = ReadExperiences(directory, opened.map);
+  opened.keys = LoadKeyImageStore(directory, opened.map, *opened.matcher, options, opened.experiences);
   return opened;
 }
 

@@ -81,6 +81,10 @@ struct LocalizerOptions {
   std::optional<Camera> camera;
   // When a pose's translation direction is trusted (the map's link_analysis.translation: MapTranslationOptions).
   TranslationOptions translation;
+  // Maps with experiences (map/experiences.h): views of a key image verified besides the key image itself,
+  // those with the most tentative matches with the frame (matching is cheap, verification is not). 0: the
+  // teach key images only. 2 by default: a frame rarely fits more than the one or two views of its season.
+  int experience_candidates = 2;
 
   void Check() const;  // throws OptionError naming the bad field
 };
@@ -95,6 +99,11 @@ std::string LocalizationStatusName(LocalizationStatus status);  // "tracking", "
 // The frame compared with one key image.
 struct KeyComparison {
   int key = -1;             // key-image index in the map; -1: not compared
+  // Which image of the key was compared, the best fitting: 0 the teach run's key image, n > 0 the view of
+  // experience n (map/experiences.h). With a view, the counts, S, F and log10_nfa are the frame's against the
+  // view; the heading is against the key image (the view's heading plus the view's own against the key image);
+  // there is no pose (the view's pose to the key image is not known).
+  int experience = 0;
   bool matched = false;     // matching and verification succeeded
   bool accepted = false;    // matched, and the acceptance rule holds (LocalizerOptions::acceptance)
   double similarity = 0.0;  // S
@@ -193,6 +202,9 @@ class Localizer {
   RankingMethod ranking_method() const { return ranking_->method(); }
 
  private:
+  // The frame against one image of key image `key` (the key image itself or a view), from their matches.
+  KeyComparison CompareImage(const ImageFeatures& features, const ImageFeatures& image,
+                             const TentativeMatches& matches, int key) const;
   // Each key image is compared with a frame at most once per Localize call.
   KeyComparison CompareOnce(const ImageFeatures& features, int key);
   LocalizationResult Track(const Frame& frame, const ImageFeatures& features);
