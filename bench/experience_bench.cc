@@ -3,8 +3,10 @@
 // the sessions held out of both, per place: the heading error rate (35 px criterion against gt.csv's labels,
 // as heading_bench) and how many frames `vmap localize` puts at the right place.
 //
-//   experience_bench [--matchers orb,xfeat] [--teach 1,2,...,12] [--k 0,1,2,3]
+//   experience_bench [--matchers orb,xfeat] [--teach 1,2,...,12] [--k 0,1,2,3] [--acceptance counts|chance]
 //
+// --acceptance: when a frame is seen at a key image, both while adding an experience and while localizing
+// (LocalizerOptions::acceptance; counts by default, as vmap localize).
 // For teach session t the experiences are the sessions spread over the year after it: k = 1: t+6; k = 2: t+4,
 // t+8; k = 3: t+3, t+6, t+9 (mod 12). The queries are the six sessions in none of these sets (t+1, t+2, t+5,
 // t+7, t+10, t+11), the same for every k, so that the columns compare like with like. An experience is added
@@ -156,12 +158,14 @@ struct Tally {
 };
 
 void Run(const std::string& name, const Matcher& matcher, const std::vector<int>& teach_sessions,
-         const std::vector<int>& ks, const Labels& labels) {
+         const std::vector<int>& ks, const Labels& labels, AcceptanceRule acceptance) {
   const Images images = Extract(matcher);
   LocalizerOptions options;
+  options.acceptance = acceptance;
   options.Check();
   std::map<int, Tally> tallies;
   for (int teach : teach_sessions) {
+    std::fprintf(stderr, "%s: teach session %d\n", name.c_str(), teach);
     const VisualMap map = TeachMap(images, teach, matcher, options);
     std::vector<int> queries;
     const std::vector<int> excluded = {0, 3, 4, 6, 8, 9};  // teach and every experience of k <= 3
@@ -209,7 +213,8 @@ void Run(const std::string& name, const Matcher& matcher, const std::vector<int>
       }
     }
   }
-  std::printf("\n%s (extraction %.0f ms/image)\n", name.c_str(), images.extract_ms);
+  std::printf("\n%s, --acceptance %s, teach sessions %zu (extraction %.0f ms/image)\n", name.c_str(),
+              AcceptanceRuleName(acceptance).c_str(), teach_sessions.size(), images.extract_ms);
   std::printf("| matcher | experiences k | pairs | heading error rate pl1..pl5 (%%) | heading error rate | median error "
               "| right place pl1..pl5 (%%) | right place | wrong place | heading from a view | ms/compare |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
@@ -243,6 +248,7 @@ int main(int argc, char** argv) {
   std::string matchers = "orb,xfeat";
   std::vector<int> teach = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
   std::vector<int> ks = {0, 1, 2, 3};
+  AcceptanceRule acceptance = AcceptanceRule::kCounts;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--matchers" && i + 1 < argc) {
@@ -251,8 +257,11 @@ int main(int argc, char** argv) {
       teach = ParseList(argv[++i]);
     } else if (arg == "--k" && i + 1 < argc) {
       ks = ParseList(argv[++i]);
+    } else if (arg == "--acceptance" && i + 1 < argc) {
+      acceptance = ParseAcceptanceRule(argv[++i]);
     } else {
-      std::fprintf(stderr, "usage: experience_bench [--matchers orb,xfeat] [--teach 1,...,12] [--k 0,1,2,3]\n");
+      std::fprintf(stderr, "usage: experience_bench [--matchers orb,xfeat] [--teach 1,...,12] [--k 0,1,2,3] "
+                           "[--acceptance counts|chance]\n");
       return 2;
     }
   }
@@ -269,7 +278,7 @@ int main(int argc, char** argv) {
       MatcherOptions options;
       options.type = type;
       const std::unique_ptr<Matcher> matcher = CreateMatcher(options);
-      Run(type, *matcher, teach, ks, labels);
+      Run(type, *matcher, teach, ks, labels, acceptance);
     } catch (const std::exception& e) {
       std::printf("%s: not measured (%s)\n", type.c_str(), e.what());
     }

@@ -41,7 +41,9 @@ struct BuildFlags {
   double snapshot_every = 0.0;  // seconds; 0 = no snapshots
   bool until_interrupted = false;
   std::string add_experience_to;  // a map: the input is added to it as an experience instead of building one
+  AddExperienceOptions experience;
   bool matcher_given = false;
+  bool acceptance_given = false;  // one of --acceptance, --max-log10-nfa, --min-verified, --min-similarity
   OptionFlags option_flags;
 };
 
@@ -101,7 +103,7 @@ void RunAddExperience(const BuildFlags& flags) {
   }
   FrameSourceOptions source_options = flags.source.Resolve();
   const std::unique_ptr<FrameSource> source = OpenFrameSource(flags.input, source_options);
-  AddExperienceOptions options;
+  AddExperienceOptions options = flags.experience;
   options.run.show_progress = spdlog::should_log(spdlog::level::info);
   const AddExperienceSummary added = AddExperience(flags.add_experience_to, *source, flags.input, options);
   std::cout << fmt::format("experience      {} of map {}\n", added.experience.id, flags.add_experience_to)
@@ -112,6 +114,10 @@ void RunAddExperience(const BuildFlags& flags) {
 
 void RunBuild(const BuildFlags& flags) {
   if (!flags.add_experience_to.empty()) return RunAddExperience(flags);
+  if (flags.acceptance_given) {
+    throw InputError("--acceptance, --max-log10-nfa, --min-verified and --min-similarity say when a repeat run's "
+                     "frames localize; they go with --add-experience-to MAP");
+  }
   FrameSourceOptions source_options = flags.source.Resolve();
   MapBuilderOptions options = flags.key_images.Resolve(flags.matcher.type);
   options.verifier = flags.verifier.Resolve();
@@ -167,8 +173,30 @@ void AddBuildCommand(CLI::App& app) {
   command->add_option("--add-experience-to", flags->add_experience_to,
                       "Add the input, a repeat run of the route, to this map as another experience: each key image "
                       "gains the frame that localized at it best (docs/experiences.md)");
+  // When a frame of the repeat run is seen at a key image, as `vmap localize` decides it (localize.md).
+  LocalizerOptions& localizer = flags->experience.localizer;
+  flags->option_flags.AddEnumOption(command, "--acceptance", localizer.acceptance, ParseAcceptanceRule,
+                                    AcceptanceRuleName, "acceptance",
+                                    "--add-experience-to: when a repeat frame is seen at a key image, as vmap "
+                                    "localize decides it: counts or chance");
+  flags->option_flags
+      .AddOption(command, "--max-log10-nfa", localizer.max_log10_nfa, "max_log10_nfa",
+                 "--add-experience-to, --acceptance chance: accept when log10 of the number of false alarms is at "
+                 "most this")
+      ->capture_default_str();
+  flags->option_flags
+      .AddOption(command, "--min-verified", localizer.min_verified, "min_verified",
+                 "--add-experience-to, --acceptance counts: verified matches a frame needs")
+      ->capture_default_str();
+  flags->option_flags
+      .AddOption(command, "--min-similarity", localizer.min_similarity, "min_similarity",
+                 "--add-experience-to, --acceptance counts: S a frame needs")
+      ->capture_default_str();
   command->callback([flags, command] {
     flags->matcher_given = command->count("--matcher") > 0;
+    flags->acceptance_given = command->count("--acceptance") + command->count("--max-log10-nfa") +
+                                  command->count("--min-verified") + command->count("--min-similarity") >
+                              0;
     flags->option_flags.Run([&] { RunBuild(*flags); });
   });
 }

@@ -99,11 +99,6 @@ std::string LocalizationStatusName(LocalizationStatus status);  // "tracking", "
 // The frame compared with one key image.
 struct KeyComparison {
   int key = -1;             // key-image index in the map; -1: not compared
-  // Which image of the key was compared, the best fitting: 0 the teach run's key image, n > 0 the view of
-  // experience n (map/experiences.h). With a view, the counts, S, F and log10_nfa are the frame's against the
-  // view; the heading is against the key image (the view's heading plus the view's own against the key image);
-  // there is no pose (the view's pose to the key image is not known).
-  int experience = 0;
   bool matched = false;     // matching and verification succeeded
   bool accepted = false;    // matched, and the acceptance rule holds (LocalizerOptions::acceptance)
   double similarity = 0.0;  // S
@@ -124,6 +119,11 @@ struct KeyComparison {
   // log10 of the number of false alarms of the verified set (ChanceOfComparison): how often chance alone
   // would explain it over all the comparisons one frame can make. +infinity when !matched.
   double log10_nfa = std::numeric_limits<double>::infinity();
+  // Which image of the key was compared, the best fitting: 0 the teach run's key image, n > 0 the view of
+  // experience n (map/experiences.h). With a view, the counts, S, F and log10_nfa are the frame's against the
+  // view; the heading is against the key image (the view's heading plus the view's own against the key image);
+  // there is no pose (the view's pose to the key image is not known).
+  int experience = 0;
 };
 
 // A key image the ranking proposed when relocalizing, and how its verification went.
