@@ -1,5 +1,7 @@
 #include "vmap/localization/add_experience.h"
 
+#include <cmath>
+#include <memory>
 #include <system_error>
 
 #include <fmt/format.h>
