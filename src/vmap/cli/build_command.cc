@@ -5,6 +5,7 @@
 #include <iostream>
 #include <optional>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
@@ -14,6 +15,9 @@
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
 #include "vmap/core/interrupt.h"
+#include "vmap/features/matcher_options_json.h"
+#include "vmap/localization/add_experience.h"
+#include "vmap/mapping/recorded_options.h"
 #include "vmap/mapping/batch_build.h"
 #include "vmap/mapping/map_builder.h"
 #include "vmap/map/map_io.h"
@@ -36,6 +40,10 @@ struct BuildFlags {
   bool report = false;
   double snapshot_every = 0.0;  // seconds; 0 = no snapshots
   bool until_interrupted = false;
+  std::string add_experience_to;  // a map: the input is added to it as an experience instead of building one
+  AddExperienceOptions experience;
+  bool matcher_given = false;
+  bool acceptance_given = false;  // one of --acceptance, --max-log10-nfa, --min-verified, --min-similarity
   OptionFlags option_flags;
 };
 
@@ -74,7 +82,42 @@ VisualMap BuildStreaming(const BuildFlags& flags, FrameSource& input, const Matc
   return builder.Finish(interrupted ? CoverageEnd::kInterrupted : CoverageEnd::kInputEnded);
 }
 
+// vmap build REPEAT --add-experience-to MAP: the input is localized against MAP and added as an experience.
+void RunAddExperience(const BuildFlags& flags) {
+  if (!flags.output.empty()) {
+    throw InputError("--add-experience-to adds to the map it names; drop -o " + flags.output);
+  }
+  if (flags.snapshot_every > 0 || flags.until_interrupted || flags.report) {
+    throw InputError("--add-experience-to takes a whole recorded run; drop --snapshot-every, --until-interrupted "
+                     "and --report");
+  }
+  const VisualMap header = ReadMap(flags.add_experience_to);
+  const std::string map_file = (fs::path(flags.add_experience_to) / kMapFileName).string();
+  const std::string map_matcher =
+      MatcherOptionsFromJson(RecordedOptionsFromJson(header.options_json, "map '" + map_file + "': options").matcher_json,
+                             map_file)
+          .type;
+  if (flags.matcher_given && flags.matcher.type != map_matcher) {
+    throw InputError("the map '" + flags.add_experience_to + "' was built with --matcher " + map_matcher +
+                     ", and its experiences are matched as its key images are; drop --matcher " + flags.matcher.type);
+  }
+  FrameSourceOptions source_options = flags.source.Resolve();
+  const std::unique_ptr<FrameSource> source = OpenFrameSource(flags.input, source_options);
+  AddExperienceOptions options = flags.experience;
+  options.run.show_progress = spdlog::should_log(spdlog::level::info);
+  const AddExperienceSummary added = AddExperience(flags.add_experience_to, *source, flags.input, options);
+  std::cout << fmt::format("experience      {} of map {}\n", added.experience.id, flags.add_experience_to)
+            << fmt::format("frames          {} ({} lost)\n", added.frames, added.lost)
+            << fmt::format("views           {} of {} key images\n", added.experience.views.size(),
+                           added.num_key_images);
+}
+
 void RunBuild(const BuildFlags& flags) {
+  if (!flags.add_experience_to.empty()) return RunAddExperience(flags);
+  if (flags.acceptance_given) {
+    throw InputError("--acceptance, --max-log10-nfa, --min-verified and --min-similarity say when a repeat run's "
+                     "frames localize; they go with --add-experience-to MAP");
+  }
   FrameSourceOptions source_options = flags.source.Resolve();
   MapBuilderOptions options = flags.key_images.Resolve(flags.matcher.type);
   options.verifier = flags.verifier.Resolve();
@@ -127,7 +170,38 @@ void AddBuildCommand(CLI::App& app) {
   command->add_flag("--until-interrupted", flags->until_interrupted,
                     "SIGINT (Ctrl-C) ends the input and the map is finished from the frames seen (a second SIGINT "
                     "aborts); for cameras and streams");
-  command->callback([flags] { flags->option_flags.Run([&] { RunBuild(*flags); }); });
+  command->add_option("--add-experience-to", flags->add_experience_to,
+                      "Add the input, a repeat run of the route, to this map as another experience: each key image "
+                      "gains the frame that localized at it best (docs/experiences.md)");
+  // When a frame of the repeat run is seen at a key image, as `vmap localize` decides it (localize.md).
+  LocalizerOptions& localizer = flags->experience.localizer;
+  flags->option_flags
+      .Record("acceptance", command->add_option_function<std::string>(
+                                "--acceptance",
+                                [&localizer](const std::string& rule) { localizer.acceptance = ParseAcceptanceRule(rule); },
+                                "--add-experience-to: when a repeat frame is seen at a key image, as vmap localize "
+                                "decides it: chance or counts"))
+      ->default_str(AcceptanceRuleName(localizer.acceptance));
+  flags->option_flags
+      .AddOption(command, "--max-log10-nfa", localizer.max_log10_nfa, "max_log10_nfa",
+                 "--add-experience-to, --acceptance chance: accept when log10 of the number of false alarms is at "
+                 "most this")
+      ->capture_default_str();
+  flags->option_flags
+      .AddOption(command, "--min-verified", localizer.min_verified, "min_verified",
+                 "--add-experience-to, --acceptance counts: verified matches a frame needs")
+      ->capture_default_str();
+  flags->option_flags
+      .AddOption(command, "--min-similarity", localizer.min_similarity, "min_similarity",
+                 "--add-experience-to, --acceptance counts: S a frame needs")
+      ->capture_default_str();
+  command->callback([flags, command] {
+    flags->matcher_given = command->count("--matcher") > 0;
+    flags->acceptance_given = command->count("--acceptance") + command->count("--max-log10-nfa") +
+                                  command->count("--min-verified") + command->count("--min-similarity") >
+                              0;
+    flags->option_flags.Run([&] { RunBuild(*flags); });
+  });
 }
 
 }  // namespace vmap::cli

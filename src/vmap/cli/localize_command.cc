@@ -78,7 +78,8 @@ void RunLocalize(const LocalizeFlags& flags) {
   run.info.cache = KeyImageCacheStateName(opened.keys.cache);
   run.info.key_image_seconds = opened.keys.seconds;
   run.info.options_json = DescribeLocalizerOptions(options);
-  std::string csv = LocalizationCsvHeader();
+  run.info.experiences = !opened.experiences.empty();
+  std::string csv = LocalizationCsvHeader(run.info.experiences);
   // A query that cannot be read again (a live input, a single image) leaves its report the frames kept here:
   // the last ones, as many as the report shows.
   const LocalizationReportOptions report_options;
@@ -86,7 +87,7 @@ void RunLocalize(const LocalizeFlags& flags) {
   RecordedFrames recorded;
   run.summary = LocalizeSequence(*source, *opened.matcher, localizer, run_options,
                                  [&](const Frame& frame, const LocalizationResult& result) {
-                                   if (!flags.csv.empty()) csv += LocalizationCsvRow(map, result);
+                                   if (!flags.csv.empty()) csv += LocalizationCsvRow(map, result, run.info.experiences);
                                    run.frames.push_back(result);
                                    if (record && report_options.pairs > 0) {
                                      recorded[result.frame_index] = ColorImage(frame);

@@ -151,9 +151,10 @@ std::string EncodeCache(uint64_t fingerprint, const Matcher& matcher, const KeyI
   return out;
 }
 
-void ComputeKeyImages(const fs::path& map_directory, const VisualMap& map, const Matcher& matcher,
+// `images`: the key images, then the experiences' views (as KeyImage records naming their files).
+void ComputeKeyImages(const fs::path& map_directory, const std::vector<KeyImage>& images, const Matcher& matcher,
                       const KeyImageStoreOptions& options, KeyImageStore& store) {
-  const size_t n = map.key_images.size();
+  const size_t n = images.size();
   store.features.assign(n, nullptr);
   store.thumbnails.assign(n, cv::Mat());
   std::atomic<size_t> next{0};
@@ -162,8 +163,8 @@ void ComputeKeyImages(const fs::path& map_directory, const VisualMap& map, const
   auto work = [&] {
     try {
       for (size_t k = next++; k < n; k = next++) {
-        const cv::Mat gray = ReadKeyImage(map_directory, map.key_images[k], /*grayscale=*/true);
-        const cv::Mat bgr = matcher.reads_color() ? ReadKeyImage(map_directory, map.key_images[k]) : cv::Mat();
+        const cv::Mat gray = ReadKeyImage(map_directory, images[k], /*grayscale=*/true);
+        const cv::Mat bgr = matcher.reads_color() ? ReadKeyImage(map_directory, images[k]) : cv::Mat();
         store.features[k] = matcher.ExtractFrame(gray, bgr.channels() == 3 ? bgr : cv::Mat());
         store.thumbnails[k] = ThumbnailDescriptor(gray, options.thumbnail_width);
       }
@@ -206,16 +207,25 @@ void KeyImageStoreOptions::Check() const {
 }
 
 KeyImageStore LoadKeyImageStore(const fs::path& map_directory, const VisualMap& map, const Matcher& matcher,
-                                const KeyImageStoreOptions& options) {
+                                const KeyImageStoreOptions& options, const std::vector<Experience>& experiences) {
   options.Check();
   const auto start = std::chrono::steady_clock::now();
   KeyImageStore store;
+  // The views are stored and cached as further key images, after the map's own.
+  std::vector<KeyImage> images = map.key_images;
+  for (const Experience& e : experiences) {
+    for (const ExperienceView& v : e.views) {
+      KeyImage image;
+      image.image_file = v.image_file;
+      images.push_back(std::move(image));
+    }
+  }
   const fs::path cache_file = map_directory / kLocalizationCacheFileName;
   const uint64_t fingerprint = options.use_cache ? Fingerprint(map_directory, matcher, options) : 0;
-  if (options.use_cache && ReadCache(map_directory, fingerprint, matcher, map.key_images.size(), store)) {
+  if (options.use_cache && ReadCache(map_directory, fingerprint, matcher, images.size(), store)) {
     store.cache = KeyImageCacheState::kHit;
   } else {
-    ComputeKeyImages(map_directory, map, matcher, options, store);
+    ComputeKeyImages(map_directory, images, matcher, options, store);
     if (options.use_cache) {
       const std::string bytes = EncodeCache(fingerprint, matcher, store);
       if (bytes.empty()) {
@@ -230,6 +240,15 @@ KeyImageStore LoadKeyImageStore(const fs::path& map_directory, const VisualMap& 
         }
       }
     }
+  }
+  if (!experiences.empty()) {
+    store.views.resize(map.key_images.size());
+    size_t next = map.key_images.size();
+    for (const Experience& e : experiences) {
+      for (const ExperienceView& v : e.views) store.views.at(v.key).push_back({e.id, v.heading_px, store.features[next++]});
+    }
+    store.features.resize(map.key_images.size());
+    store.thumbnails.resize(map.key_images.size());
   }
   store.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return store;

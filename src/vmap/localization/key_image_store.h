@@ -17,6 +17,7 @@
 #include <opencv2/core.hpp>
 
 #include "vmap/features/matcher.h"
+#include "vmap/map/experiences.h"
 #include "vmap/map/visual_map.h"
 
 namespace vmap {
@@ -40,16 +41,27 @@ struct KeyImageStoreOptions {
   void Check() const;  // throws OptionError naming the bad field
 };
 
+// A view an experience added to a key image (map/experiences.h), with the matcher's features.
+struct KeyImageView {
+  int experience = 1;       // Experience::id
+  double heading_px = 0.0;  // x in the view minus x in the key image (ExperienceView::heading_px)
+  std::shared_ptr<const ImageFeatures> features;
+};
+
 struct KeyImageStore {
   std::vector<std::shared_ptr<const ImageFeatures>> features;  // one per key image, in map order
   std::vector<cv::Mat> thumbnails;                            // ThumbnailDescriptor of each key image
+  // Per key image, the views of the map's experiences; empty (no list at all) for a map without experiences.
+  std::vector<std::vector<KeyImageView>> views;
   KeyImageCacheState cache = KeyImageCacheState::kOff;
   double seconds = 0.0;                                        // time to load or compute them
 };
 
-// Reads (or computes and caches) the features of every key image of `map`, read from `map_directory`.
-// Throws InputError naming the file when a key image cannot be decoded.
+// Reads (or computes and caches) the features of every key image of `map`, read from `map_directory`, and of
+// every view of `experiences` (ReadExperiences; cached after the key images).
+// Throws InputError naming the file when a key image or view cannot be decoded.
 KeyImageStore LoadKeyImageStore(const std::filesystem::path& map_directory, const VisualMap& map,
-                                const Matcher& matcher, const KeyImageStoreOptions& options);
+                                const Matcher& matcher, const KeyImageStoreOptions& options,
+                                const std::vector<Experience>& experiences = {});
 
 }  // namespace vmap

@@ -17,7 +17,8 @@ LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, cons
   opened.map = std::move(read.map);
   opened.options = std::move(read.options);
   opened.matcher = CreateMatcher(MatcherOptionsFromJson(opened.options.matcher_json, (directory / kMapFileName).string()));
-  opened.keys = LoadKeyImageStore(directory, opened.map, *opened.matcher, options);
+  opened.experiences = ReadExperiences(directory, opened.map);
+  opened.keys = LoadKeyImageStore(directory, opened.map, *opened.matcher, options, opened.experiences);
   return opened;
 }
 

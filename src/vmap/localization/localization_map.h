@@ -19,11 +19,12 @@ struct LocalizationMap {
   VisualMap map;
   RecordedOptions options;  // what the map records of the options that shaped it
   std::unique_ptr<Matcher> matcher;  // the map's matcher, with the map's options
+  std::vector<Experience> experiences;  // map/experiences.h; their views' features are in `keys`
   KeyImageStore keys;
 };
 
-// Reads the map and its options (ReadRecordedMap), creates its matcher (MatcherOptionsFromJson) and loads its
-// key images.
+// Reads the map and its options (ReadRecordedMap) and its experiences (ReadExperiences), creates its matcher
+// (MatcherOptionsFromJson) and loads its key images and views.
 // Throws InputError naming the file and the fix when any of it fails.
 LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, const KeyImageStoreOptions& options);
 

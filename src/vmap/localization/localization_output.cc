@@ -71,16 +71,17 @@ std::string DescribeLocalizerOptions(const LocalizerOptions& options) {
   return OptionsToJson(options).dump();
 }
 
-std::string LocalizationCsvHeader() {
-  return "frame,source_index,timestamp,source_name,status,key,next_key,key_frame,next_key_frame,similarity,verified,"
+std::string LocalizationCsvHeader(bool experiences) {
+  return std::string("frame,source_index,timestamp,source_name,status,key,next_key,key_frame,next_key_frame,similarity,verified,"
          "tentative,next_similarity,next_verified,next_tentative,heading_px,progress,comparisons,seconds,"
          "F00,F01,F02,F10,F11,F12,F20,F21,F22,heading_deg,R00,R01,R02,R10,R11,R12,R20,R21,R22,tx,ty,tz,"
          "heading_confidence,heading_key_px,heading_key_deg,heading_key_confidence,"
          "translation_sigma_deg,translation_known,guidance,"
-         "log10_nfa,next_log10_nfa\n";
+         "log10_nfa,next_log10_nfa") +
+         (experiences ? ",experience,next_experience\n" : "\n");
 }
 
-std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r) {
+std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r, bool experiences) {
   std::string row = fmt::format(
       "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.6f}", r.frame_index, r.source_index,
       r.timestamp >= 0 ? fmt::format("{:.6f}", r.timestamp) : std::string(), CsvText(r.source_name),
@@ -102,10 +103,14 @@ std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r
   row += ',' + (pose.valid ? CsvNumber(target.translation_sigma_deg) : std::string());
   row += fmt::format(",{},{}", r.translation_known ? 1 : 0, LocalizationGuidance(r));
   row += ',' + CsvNumber(r.to_key.log10_nfa) + ',' + CsvNumber(r.to_next.log10_nfa);
+  if (experiences) {
+    row += ',' + (r.to_key.key >= 0 ? std::to_string(r.to_key.experience) : std::string()) + ',' +
+           (r.to_next.key >= 0 ? std::to_string(r.to_next.experience) : std::string());
+  }
   return row + "\n";
 }
 
-nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationResult& r) {
+nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationResult& r, bool experiences) {
   json F = nullptr;
   if (r.to_next.matched) {
     F = json::array();
@@ -117,7 +122,7 @@ nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationRes
                           {"similarity", c.similarity}, {"verified", c.num_verified},
                           {"log10_nfa", Number(c.log10_nfa)}});
   }
-  return {{"frame", r.frame_index},
+  json frame = {{"frame", r.frame_index},
           {"source_index", r.source_index},
           {"timestamp", r.timestamp >= 0 ? json(r.timestamp) : json(nullptr)},
           {"source_name", EncodeFileName(r.source_name)},
@@ -151,6 +156,11 @@ nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationRes
           {"candidates", candidates},
           {"comparisons", r.comparisons},
           {"seconds", r.seconds}};
+  if (experiences) {
+    frame["experience"] = r.to_key.key >= 0 ? json(r.to_key.experience) : json(nullptr);
+    frame["next_experience"] = r.to_next.key >= 0 ? json(r.to_next.experience) : json(nullptr);
+  }
+  return frame;
 }
 
 std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run) {
@@ -194,7 +204,7 @@ std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run
                     {"mean_extract_seconds", s.mean_extract_seconds},
                     {"comparisons", s.comparisons}};
   json frames = json::array();
-  for (const LocalizationResult& r : run.frames) frames.push_back(LocalizationFrameJson(map, r));
+  for (const LocalizationResult& r : run.frames) frames.push_back(LocalizationFrameJson(map, r, info.experiences));
   doc["frames"] = std::move(frames);
   return doc.dump(1) + "\n";
 }

@@ -12,7 +12,9 @@
 // heading_px's estimate) and the heading against `key`: heading_key_px, heading_key_deg, heading_key_confidence
 // (geometry/heading.h); translation_sigma_deg, translation_known and guidance; log10_nfa and next_log10_nfa,
 // how unlikely the verified matches with `key` and `next_key` are by chance (KeyComparison::log10_nfa).
-// Unknown numbers are empty in CSV and null in JSON.
+// Against a map with experiences (map/experiences.h), and only then, also experience and next_experience: the
+// image of `key` and `next_key` the frame fitted best (0 the teach key image, n the view of experience n;
+// KeyComparison::experience). Unknown numbers are empty in CSV and null in JSON.
 
 #include <cstdint>
 #include <filesystem>
@@ -45,6 +47,7 @@ struct LocalizationRunInfo {
   std::string cache;                // KeyImageCacheStateName
   double key_image_seconds = 0.0;   // loading or computing the key images' features
   std::string options_json = "{}";  // the localizer's options
+  bool experiences = false;         // the map has experiences: frames say which one fitted
 };
 
 struct LocalizationRun {
@@ -56,13 +59,15 @@ struct LocalizationRun {
 // The localizer's options as JSON text (for LocalizationRunInfo::options_json).
 std::string DescribeLocalizerOptions(const LocalizerOptions& options);
 
-std::string LocalizationCsvHeader();
+// `experiences`: the map has experiences (adds their columns).
+std::string LocalizationCsvHeader(bool experiences = false);
 // One CSV row (with the newline) for `result`, localized against `map`.
-std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& result);
+std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& result, bool experiences = false);
 
 // One frame of a run as the JSON lists it (the CSV's columns, with F and the pose as lists); the Python module
 // gives its results these names.
-nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationResult& result);
+nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationResult& result,
+                                     bool experiences = false);
 
 // The JSON document of a run (frames listed in order).
 std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run);

@@ -26,6 +26,15 @@ bool Better(const KeyComparison& a, const KeyComparison& b) {
   return a.similarity > b.similarity;
 }
 
+// Which of two images of one key image (the key image, a view) fits a frame better: the better match by
+// Better, and when neither is accepted, more verified matches (the heading is still reported). Ties keep the
+// first (the teach key image).
+bool FitsBetter(const KeyComparison& a, const KeyComparison& b) {
+  if (a.accepted || b.accepted) return Better(a, b);
+  if (a.num_verified != b.num_verified) return a.num_verified > b.num_verified;
+  return a.similarity > b.similarity;
+}
+
 }  // namespace
 
 std::string LocalizationStatusName(LocalizationStatus status) {
@@ -64,6 +73,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                 max_lost_frames);
   visitor.Visit({"relocalization_candidates", "--candidates", "Best-ranked key images verified when relocalizing"},
                 relocalization_candidates);
+  visitor.Visit({"experience_candidates", "--experience-candidates",
+                 "Maps with experiences: views of a key image verified besides it, those with the most tentative "
+                 "matches (0 = the teach key images only)"},
+                experience_candidates);
   visitor.Visit({"lookahead", "--lookahead", "Key images beyond the next compared while tracking (1 or 2)"},
                 lookahead);
   visitor.Visit({"step_back", "!--no-step-back", "Never move the estimate back to the previous key image"},
@@ -113,6 +126,10 @@ void LocalizerOptions::Check() const {
   CheckField("verifier", verifier);
   CheckField("heading", heading);
   CheckField("translation", translation);
+  if (experience_candidates < 0 || experience_candidates > 1000) {
+    throw OptionError("experience_candidates",
+                      fmt::format("{} must be 0 (teach key images only) to 1000 (default 2)", experience_candidates));
+  }
 }
 
 std::pair<int, int> KeysAround(const VisualMap& map, int source_index) {
@@ -144,6 +161,9 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   options_.Check();
   const int num_keys = static_cast<int>(map_.key_images.size());
   if (num_keys == 0) throw InputError("the map has no key images; nothing to localize against");
+  if (!keys_.views.empty() && static_cast<int>(keys_.views.size()) != num_keys) {
+    throw InputError("the experiences' views do not belong to this map; load them with LoadKeyImageStore");
+  }
   if (static_cast<int>(keys_.features.size()) != num_keys || static_cast<int>(keys_.thumbnails.size()) != num_keys) {
     throw InputError("the key-image features do not belong to this map; load them with LoadKeyImageStore");
   }
@@ -190,8 +210,45 @@ void Localizer::Reset() {
 }
 
 KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
-  const PairComparison pair = ComparePair(matcher_, features, *keys_.features[key], options_.verifier,
-                                          options_.similarity);
+  const ImageFeatures& key_image = *keys_.features[key];
+  KeyComparison best = CompareImage(features, key_image, matcher_.Match(features, key_image), key);
+  if (keys_.views.empty() || keys_.views[key].empty() || options_.experience_candidates == 0) return best;
+  // Every view is matched (cheap); the few with the most tentative matches are verified.
+  const std::vector<KeyImageView>& views = keys_.views[key];
+  std::vector<TentativeMatches> matches;
+  std::vector<int> order;
+  for (size_t v = 0; v < views.size(); ++v) {
+    matches.push_back(matcher_.Match(features, *views[v].features));
+    order.push_back(static_cast<int>(v));
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return matches[a].size() > matches[b].size(); });
+  order.resize(std::min<size_t>(order.size(), options_.experience_candidates));
+  for (int v : order) {
+    KeyComparison c = CompareImage(features, *views[v].features, matches[v], key);
+    if (!FitsBetter(c, best)) continue;
+    c.experience = views[v].experience;
+    // Headings add up: x_frame - x_key = (x_frame - x_view) + (x_view - x_key).
+    c.heading.px += views[v].heading_px;
+    if (options_.camera && std::isfinite(c.heading.deg)) {
+      // The view's offset as the bearing of a point it moves by that much at the image's centre.
+      c.heading.deg += std::atan(views[v].heading_px / options_.camera->fx) * 180.0 / M_PI;
+    }
+    c.pose = RelativePose();
+    c.translation_sigma_deg = kNaN;
+    c.translation_known = false;
+    best = std::move(c);
+  }
+  return best;
+}
+
+KeyComparison Localizer::CompareImage(const ImageFeatures& features, const ImageFeatures& image,
+                                      const TentativeMatches& matches, int key) const {
+  // As ComparePair, on matches made already.
+  const int denominator = options_.similarity == SimilarityMode::kInlierRatio
+                              ? static_cast<int>(matches.size())
+                              : std::max(features.num_features(), image.num_features());
+  const PairComparison pair = VerifyMatches(matches, denominator, options_.verifier);
   KeyComparison c;
   c.key = key;
   c.matched = pair.matched;
@@ -201,7 +258,7 @@ KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
   c.F = pair.F;
   // Recorded whatever the rule, so that runs under either compare.
   if (pair.matched) {
-    c.log10_nfa = ChanceOfComparison(pair, features.image_size(), keys_.features[key]->image_size(),
+    c.log10_nfa = ChanceOfComparison(pair, features.image_size(), image.image_size(),
                                      ComparisonsPerFrame(options_.lookahead, options_.relocalization_candidates))
                       .log10_nfa;
   }

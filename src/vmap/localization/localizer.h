@@ -92,6 +92,10 @@ struct LocalizerOptions {
   std::optional<Camera> camera;
   // When a pose's translation direction is trusted (the map's link_analysis.translation: MapLocalizerOptions).
   TranslationOptions translation;
+  // Maps with experiences (map/experiences.h): views of a key image verified besides the key image itself,
+  // those with the most tentative matches with the frame (matching is cheap, verification is not). 0: the
+  // teach key images only. 2 by default: a frame rarely fits more than the one or two views of its season.
+  int experience_candidates = 2;
 
   // As a localization run records them (its "options"; not the camera, which the map gives) and the flags of
   // `vmap localize`. The verifier, the translation thresholds and the similarity follow the map
@@ -131,6 +135,11 @@ struct KeyComparison {
   // log10 of the number of false alarms of the verified set (ChanceOfComparison): how often chance alone
   // would explain it over all the comparisons one frame can make. +infinity when !matched.
   double log10_nfa = std::numeric_limits<double>::infinity();
+  // Which image of the key was compared, the best fitting: 0 the teach run's key image, n > 0 the view of
+  // experience n (map/experiences.h). With a view, the counts, S, F and log10_nfa are the frame's against the
+  // view; the heading is against the key image (the view's heading plus the view's own against the key image);
+  // there is no pose (the view's pose to the key image is not known).
+  int experience = 0;
 };
 
 // A key image the ranking proposed when relocalizing, and how its verification went.
@@ -209,6 +218,9 @@ class Localizer {
   RankingMethod ranking_method() const { return ranking_->method(); }
 
  private:
+  // The frame against one image of key image `key` (the key image itself or a view), from their matches.
+  KeyComparison CompareImage(const ImageFeatures& features, const ImageFeatures& image,
+                             const TentativeMatches& matches, int key) const;
   // Each key image is compared with a frame at most once per Localize call.
   KeyComparison CompareOnce(const ImageFeatures& features, int key);
   LocalizationResult Track(const Frame& frame, const ImageFeatures& features);
