@@ -27,6 +27,9 @@ void VerifierOptions::Check() const {
   }
   if (seed < 0) throw OptionError("seed", "must be >= 0 (default 0)");
   if (min_matches < 8) throw OptionError("min_matches", "must be >= 8: the 8-point algorithm needs 8 matches");
+  if (loop_points < 0 || (loop_points > 0 && loop_points < 16) || loop_points > 1000000) {
+    throw OptionError("loop_points", "must be 0 (every match) or 16 to 1000000 (default 0)");
+  }
   if (max_samples_to_reject < 1 || max_samples_to_reject > 10000000) {
     throw OptionError("max_samples_to_reject",
                       "must be 1 to 10000000 (default 10000; max_iterations or more keeps the confidence criterion)");
@@ -35,11 +38,14 @@ void VerifierOptions::Check() const {
 
 FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0,
                                       const std::vector<cv::Point2f>& points1, const VerifierOptions& options,
-                                      const EarlyStop& early_stop) {
+                                      const EarlyStop& early_stop, const std::vector<float>* scores) {
   FundamentalResult result;
   CV_Assert(points0.size() == points1.size());
   if (static_cast<int>(points0.size()) < options.min_matches) return result;
   if (options.method == VerifierMethod::kMagsac && options.own_magsac) {
+    if (options.loop_points > 0 && scores && early_stop.min_inliers.empty() && !early_stop.resume_from) {
+      return EstimateFundamentalMagsacOnBest(points0, points1, *scores, options);
+    }
     return EstimateFundamentalMagsac(points0, points1, options, early_stop);
   }
   cv::Mat F;

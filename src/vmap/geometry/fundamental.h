@@ -40,6 +40,11 @@ struct VerifierOptions {
   // (README, "Threshold sweeps"): 10,000 cut the sweep's CPU by 18 % and flipped about as many of the exhaustive
   // run's decisions as a change of seed does. max_iterations keeps the confidence criterion alone.
   int max_samples_to_reject = 10000;
+  // Own MAGSAC++ without EarlyStop targets only, and for matches with scores: 0 (default) samples from every
+  // match; N > 0 samples from the N best-scored ones and refines the model found on all of them
+  // (EstimateFundamentalMagsacOnBest), so that thousands of matches cost what N do. Not recorded in map.json:
+  // maps are built without it; localization uses it (MapVerifierOptions).
+  int loop_points = 0;
 
   void Check() const;  // throws OptionError naming the bad field
 };
@@ -75,9 +80,10 @@ struct EarlyStop {
   std::shared_ptr<const MagsacCheckpoint> resume_from;
 };
 
+// `scores`: one per match, higher is better (TentativeMatches::scores), read only for options.loop_points.
 FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0,
                                       const std::vector<cv::Point2f>& points1, const VerifierOptions& options,
-                                      const EarlyStop& early_stop = {});
+                                      const EarlyStop& early_stop = {}, const std::vector<float>* scores = nullptr);
 
 // Symmetric epipolar (Sampson) distance of x1 <-> x0 under F (x1^T F x0 = 0), in pixels.
 double SampsonDistance(const cv::Matx33d& F, const cv::Point2f& p0, const cv::Point2f& p1);

@@ -84,9 +84,11 @@ MapBuilderOptions RecordedBuilderOptions(const VisualMap& map) {
 }
 }  // namespace
 
-VerifierOptions MapVerifierOptions(const VisualMap& map, int max_iterations) {
+VerifierOptions MapVerifierOptions(const VisualMap& map, int max_iterations, int loop_points) {
   VerifierOptions options = RecordedBuilderOptions(map).verifier;
   options.max_iterations = std::min(options.max_iterations, max_iterations);
+  options.own_magsac = options.method == VerifierMethod::kMagsac;
+  options.loop_points = loop_points;
   options.Check();
   return options;
 }
