@@ -8,6 +8,7 @@
 // the frame 10, 30 and 60 later (thousands of matches, the tracking case). --every N keeps every N-th pair.
 // Each pair is matched once (XFeat, its defaults) and verified by:
 //   exhaustive  OpenCV's USAC_MAGSAC with the map's 100,000 iterations (what `vmap match` runs)
+//   seed 1      the same with another seed: how many decisions a change of seed alone flips
 //   localizer   the same capped at 5,000 iterations (what `vmap localize` ran before)
 //   own         vmap's MAGSAC++ capped at 5,000, every match in the sample loop
 //   S:P         vmap's MAGSAC++ with at most S samples on the P best-scored matches, refined on all (the
@@ -103,7 +104,10 @@ void Run(const std::string& set, const std::vector<PairImages>& pairs, const vma
   localizer.max_iterations = 5000;
   vmap::VerifierOptions own = localizer;
   own.own_magsac = true;
-  std::vector<Method> methods = {{"exhaustive", exhaustive}, {"localizer", localizer}, {"own", own}};
+  vmap::VerifierOptions other_seed = exhaustive;  // the noise of the exhaustive run itself
+  other_seed.seed = 1;
+  std::vector<Method> methods = {{"exhaustive", exhaustive}, {"seed 1", other_seed}, {"localizer", localizer},
+                                 {"own", own}};
   for (const auto& [samples, points] : bounded_settings) {
     vmap::VerifierOptions bounded = own;
     bounded.max_iterations = samples;
@@ -114,11 +118,15 @@ void Run(const std::string& set, const std::vector<PairImages>& pairs, const vma
   auto accepts = [&](const vmap::PairComparison& c) {
     return c.matched && c.num_verified >= acceptance.min_verified && c.similarity >= acceptance.min_similarity;
   };
-  std::vector<double> tentative;
+  std::vector<double> tentative, extract_seconds, match_seconds;
   for (const PairImages& pair : pairs) {
+    double start = ThreadSeconds();
     const auto f0 = matcher.Extract(pair.image0);
+    extract_seconds.push_back(ThreadSeconds() - start);
     const auto f1 = matcher.Extract(pair.image1);
+    start = ThreadSeconds();
     const vmap::TentativeMatches matches = matcher.Match(*f0, *f1);
+    match_seconds.push_back(ThreadSeconds() - start);
     tentative.push_back(static_cast<double>(matches.size()));
     bool reference = false;
     int reference_verified = 0;
@@ -142,6 +150,8 @@ void Run(const std::string& set, const std::vector<PairImages>& pairs, const vma
   }
   std::printf("\n%s: %zu pairs, tentative matches median %.0f (min %.0f, max %.0f)\n", set.c_str(), pairs.size(),
               Percentile(tentative, 0.5), Percentile(tentative, 0.0), Percentile(tentative, 1.0));
+  std::printf("XFeat CPU per image (extraction, one LibTorch thread) median %.1f ms; per pair (matching) %.1f ms\n",
+              1e3 * Percentile(extract_seconds, 0.5), 1e3 * Percentile(match_seconds, 0.5));
   std::printf("%-11s %9s %9s %9s %9s %9s %9s %13s\n", "verifier", "cpu_med_ms", "p90_ms", "max_ms", "cpu_s",
               "accepted", "same", "|dv| median");
   for (const Method& m : methods) {

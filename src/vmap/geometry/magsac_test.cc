@@ -382,8 +382,12 @@ TEST(MagsacOnBest, FindsTheModelAmongThousandsOfLowRatioMatchesInABoundedLoop) {
   const FundamentalResult result = EstimateFundamentalMagsacOnBest(scene.p0, scene.p1, scores, options, &statistics);
   ASSERT_TRUE(result.success);
   EXPECT_LE(statistics.iterations, options.max_iterations);
+  // Refined on all: as many inliers as the true F keeps, those outside the 512 best-scored matches too.
+  int true_inliers = 0;
+  for (int i = 0; i < scene.inliers; ++i) true_inliers += SampsonDistance(scene.F_true, scene.p0[i], scene.p1[i]) < 0.5;
   const Kept kept = Count(scene, result);
-  EXPECT_GE(kept.inliers, 380);  // refined on all: inliers outside the 512 best-scored are verified too
+  EXPECT_GE(kept.inliers, 0.9 * true_inliers);
+  EXPECT_GT(kept.inliers, 200);
   EXPECT_LE(kept.outliers, 20);
   EXPECT_LT(MeanTrueError(scene, result.F, 0, scene.inliers), 0.5);
   // The same budget on every match does not find it: 1,000 samples at a ratio of 0.1.

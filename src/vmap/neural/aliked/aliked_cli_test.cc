@@ -122,7 +122,7 @@ TEST(AlikedCli, SecondLocalizeStartReadsTheKeyImagesFromTheCache) {
   const std::string input = SharedDir() + "/data/rccar_room/images";
   const auto r = RunVmap("build " + input + " --last 8 --tau 0.6 --matcher aliked -q -o " + (dir.path() / "map").string());
   ASSERT_EQ(r.status, 0) << r.output;
-  testing::ExpectSecondLocalizeReadsTheCache(dir.path() / "map", input, "--last 8");
+  ::vmap::testing::ExpectSecondLocalizeReadsTheCache(dir.path() / "map", input, "--last 8");
 }
 
 }  // namespace

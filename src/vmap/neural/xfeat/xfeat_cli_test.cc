@@ -116,7 +116,7 @@ TEST(VmapXfeat, SecondLocalizeStartReadsTheKeyImagesFromTheCache) {
   const auto r = RunVmap("build " + input + " --last 8 --tau 0.6 --matcher xfeat --xfeat-top-k 1000 --weights " +
                          FoldedWeights() + " -q -o " + (dir.path() / "map").string());
   ASSERT_EQ(r.status, 0) << r.output;
-  testing::ExpectSecondLocalizeReadsTheCache(dir.path() / "map", input, "--last 8");
+  ::vmap::testing::ExpectSecondLocalizeReadsTheCache(dir.path() / "map", input, "--last 8");
 }
 
 }  // namespace
