@@ -109,8 +109,8 @@ void Run(const std::string& set, const std::vector<PairImages>& pairs, const vma
   std::vector<Method> methods = {{"exhaustive", exhaustive}, {"seed 1", other_seed}, {"localizer", localizer},
                                  {"own", own}};
   for (const auto& [samples, points] : bounded_settings) {
-    vmap::VerifierOptions bounded = own;
-    bounded.max_iterations = samples;
+    vmap::VerifierOptions bounded = localizer;  // as MapVerifierOptions makes it
+    bounded.max_samples_to_reject = samples;
     bounded.loop_points = points;
     methods.emplace_back(std::to_string(samples) + ":" + std::to_string(points), bounded);
   }

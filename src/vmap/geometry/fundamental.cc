@@ -1,5 +1,6 @@
 #include "vmap/geometry/fundamental.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <nlohmann/json.hpp>
@@ -42,10 +43,14 @@ FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0,
   FundamentalResult result;
   CV_Assert(points0.size() == points1.size());
   if (static_cast<int>(points0.size()) < options.min_matches) return result;
+  if (options.method == VerifierMethod::kMagsac && options.loop_points > 0 && scores &&
+      scores->size() == points0.size() && early_stop.min_inliers.empty() && !early_stop.resume_from) {
+    // Bounded: "not enough inliers" is accepted after max_samples_to_reject samples, as when stopping early.
+    VerifierOptions bounded = options;
+    bounded.max_iterations = std::min(options.max_iterations, options.max_samples_to_reject);
+    return EstimateFundamentalMagsacOnBest(points0, points1, *scores, bounded);
+  }
   if (options.method == VerifierMethod::kMagsac && options.own_magsac) {
-    if (options.loop_points > 0 && scores && early_stop.min_inliers.empty() && !early_stop.resume_from) {
-      return EstimateFundamentalMagsacOnBest(points0, points1, *scores, options);
-    }
     return EstimateFundamentalMagsac(points0, points1, options, early_stop);
   }
   cv::Mat F;

@@ -418,14 +418,20 @@ TEST(MagsacOnBest, IndependentOfTheOrderAndTheSameAsTheFullRunWithoutScores) {
   EXPECT_EQ(EstimateFundamentalMagsacOnBest(scene.p0, scene.p1, scores, options).inlier_mask, full.inlier_mask);
 }
 
-TEST(MagsacOnBest, ChosenThroughEstimateFundamentalOnlyWithoutTargets) {
+TEST(MagsacOnBest, ChosenThroughEstimateFundamentalForScoredMatchesWithoutTargets) {
   const Scene scene = MakeScene(300, 700, 0.5, 31);
   const std::vector<float> scores = ScoresFavouringInliers(scene, 32);
   VerifierOptions options;
-  options.own_magsac = true;
   options.loop_points = 256;
+  options.max_samples_to_reject = 2000;  // the bounded loop's samples
+  VerifierOptions bounded = options;
+  bounded.max_iterations = 2000;
   EXPECT_EQ(EstimateFundamental(scene.p0, scene.p1, options, {}, &scores).inlier_mask,
-            EstimateFundamentalMagsacOnBest(scene.p0, scene.p1, scores, options).inlier_mask);
+            EstimateFundamentalMagsacOnBest(scene.p0, scene.p1, scores, bounded).inlier_mask);
+  // Without scores, the verifier as configured (here OpenCV's USAC_MAGSAC).
+  EXPECT_EQ(EstimateFundamental(scene.p0, scene.p1, options).inlier_mask,
+            EstimateFundamental(scene.p0, scene.p1, VerifierOptions()).inlier_mask);
+  options.own_magsac = true;
   EarlyStop targets;
   targets.min_inliers = {100};
   EXPECT_EQ(EstimateFundamental(scene.p0, scene.p1, options, targets, &scores).inlier_mask,
