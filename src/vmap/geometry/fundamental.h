@@ -40,10 +40,11 @@ struct VerifierOptions {
   // (README, "Threshold sweeps"): 10,000 cut the sweep's CPU by 18 % and flipped about as many of the exhaustive
   // run's decisions as a change of seed does. max_iterations keeps the confidence criterion alone.
   int max_samples_to_reject = 10000;
-  // Own MAGSAC++ without EarlyStop targets only, and for matches with scores: 0 (default) samples from every
-  // match; N > 0 samples from the N best-scored ones and refines the model found on all of them
-  // (EstimateFundamentalMagsacOnBest), so that thousands of matches cost what N do. Not recorded in map.json:
-  // maps are built without it; localization uses it (MapVerifierOptions).
+  // Bounded verification of scored matches (kMagsac, no EarlyStop targets, one score per match), whatever
+  // own_magsac says: with N > 0, vmap's MAGSAC++ draws at most max_samples_to_reject samples from the N
+  // best-scored matches and refines the model found on all of them (EstimateFundamentalMagsacOnBest), so that
+  // thousands of matches cost what N do. Matches without scores (ORB) get the verifier above. 0 (default): off.
+  // Not recorded in map.json: maps are built without it; localization uses it (MapVerifierOptions).
   int loop_points = 0;
 
   void Check() const;  // throws OptionError naming the bad field

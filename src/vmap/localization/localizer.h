@@ -226,11 +226,12 @@ std::pair<int, int> KeysAround(const VisualMap& map, int source_index);
 
 // The verifier of the map (options.verifier in map.json), bounded: a comparison asks "is the frame at this key
 // image?", not for the best F, so its cost must not grow with the matches or fall to MAGSAC's iteration cap.
-// - At most `max_iterations` samples: a frame compared with a key image it barely overlaps has a low inlier
-//   ratio, for which MAGSAC runs to the map's 100,000 iterations (about a second); such a pair fails anyway.
-// - A map verified by MAGSAC is verified by vmap's own MAGSAC++ (within a seed change of OpenCV's), whose sample
-//   loop sees only the `loop_points` best-scored matches (VerifierOptions::loop_points; 0: all of them) and
-//   whose model is refined on all of them: thousands of XFeat matches cost what 512 do.
+// - Scored matches (XFeat, ALIKED) of a map verified by MAGSAC: vmap's MAGSAC++ (within a seed change of
+//   OpenCV's) with at most `max_iterations` samples drawn from the `loop_points` best-scored matches, its model
+//   refined on all of them (VerifierOptions::loop_points): thousands of XFeat matches cost what 512 do.
+// - Matches without scores (ORB): the map's verifier with at most 5000 iterations. Why capped: a frame compared
+//   with a key image it barely overlaps has a low inlier ratio, for which MAGSAC runs to the map's 100,000
+//   iterations (about a second); such a pair fails the acceptance test anyway.
 // Measured with bench/verify_bench (docs/matchers.md, "Speed of verification").
 VerifierOptions MapVerifierOptions(const VisualMap& map, int max_iterations = 1000, int loop_points = 512);
 // S as the map defines it (options.similarity in map.json).
