@@ -1,5 +1,6 @@
 #include "vmap/geometry/fundamental.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <nlohmann/json.hpp>
@@ -27,6 +28,9 @@ void VerifierOptions::Check() const {
   }
   if (seed < 0) throw OptionError("seed", "must be >= 0 (default 0)");
   if (min_matches < 8) throw OptionError("min_matches", "must be >= 8: the 8-point algorithm needs 8 matches");
+  if (loop_points < 0 || (loop_points > 0 && loop_points < 16) || loop_points > 1000000) {
+    throw OptionError("loop_points", "must be 0 (every match) or 16 to 1000000 (default 0)");
+  }
   if (max_samples_to_reject < 1 || max_samples_to_reject > 10000000) {
     throw OptionError("max_samples_to_reject",
                       "must be 1 to 10000000 (default 10000; max_iterations or more keeps the confidence criterion)");
@@ -35,10 +39,17 @@ void VerifierOptions::Check() const {
 
 FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0,
                                       const std::vector<cv::Point2f>& points1, const VerifierOptions& options,
-                                      const EarlyStop& early_stop) {
+                                      const EarlyStop& early_stop, const std::vector<float>* scores) {
   FundamentalResult result;
   CV_Assert(points0.size() == points1.size());
   if (static_cast<int>(points0.size()) < options.min_matches) return result;
+  if (options.method == VerifierMethod::kMagsac && options.loop_points > 0 && scores &&
+      scores->size() == points0.size() && early_stop.min_inliers.empty() && !early_stop.resume_from) {
+    // Bounded: "not enough inliers" is accepted after max_samples_to_reject samples, as when stopping early.
+    VerifierOptions bounded = options;
+    bounded.max_iterations = std::min(options.max_iterations, options.max_samples_to_reject);
+    return EstimateFundamentalMagsacOnBest(points0, points1, *scores, bounded);
+  }
   if (options.method == VerifierMethod::kMagsac && options.own_magsac) {
     return EstimateFundamentalMagsac(points0, points1, options, early_stop);
   }

@@ -41,6 +41,12 @@ struct VerifierOptions {
   // (docs/measurements/sweeps.md): 10,000 cut the sweep's CPU by 18 % and flipped about as many of the exhaustive
   // run's decisions as a change of seed does. max_iterations keeps the confidence criterion alone.
   int max_samples_to_reject = 10000;
+  // Bounded verification of scored matches (kMagsac, no EarlyStop targets, one score per match), whatever
+  // own_magsac says: with N > 0, vmap's MAGSAC++ draws at most max_samples_to_reject samples from the N
+  // best-scored matches and refines the model found on all of them (EstimateFundamentalMagsacOnBest), so that
+  // thousands of matches cost what N do. Matches without scores (ORB) get the verifier above. 0 (default): off.
+  // Not recorded in map.json: maps are built without it; localization uses it (MapVerifierOptions).
+  int loop_points = 0;
 
   // The verifier as map.json records it and its flags: method, threshold, confidence, max_iterations, seed,
   // min_matches, max_samples_to_reject (not own_magsac: MapBuilderOptions::exhaustive records which estimator
@@ -73,9 +79,10 @@ struct EarlyStop {
   std::shared_ptr<const MagsacCheckpoint> resume_from;
 };
 
+// `scores`: one per match, higher is better (TentativeMatches::scores), read only for options.loop_points.
 FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0,
                                       const std::vector<cv::Point2f>& points1, const VerifierOptions& options,
-                                      const EarlyStop& early_stop = {});
+                                      const EarlyStop& early_stop = {}, const std::vector<float>* scores = nullptr);
 
 // Symmetric epipolar (Sampson) distance of x1 <-> x0 under F (x1^T F x0 = 0), in pixels.
 double SampsonDistance(const cv::Matx33d& F, const cv::Point2f& p0, const cv::Point2f& p1);

@@ -8,6 +8,8 @@
 #include <memory>
 #include <stdexcept>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include "vmap/geometry/degensac.h"
 #include "vmap/geometry/fundamental_solvers.h"
@@ -118,8 +120,13 @@ class Estimator {
   }
 
   FundamentalResult Run(MagsacStatistics* statistics);
+  // No sample loop: `model` (from a loop over some of these points) refined by sigma-consensus++ and polished on
+  // all of them, and its inliers among them.
+  FundamentalResult RefineFrom(const Model& model, MagsacStatistics* statistics);
 
  private:
+  // Steps shared by Run and RefineFrom once the best model is known: polished, then its inliers, into `result`.
+  FundamentalResult PolishAndCount(FundamentalResult result, MagsacStatistics* statistics);
   // FNV-1a over the points in visiting order: a resumed run must be given the points its checkpoint was.
   std::uint64_t PointsFingerprint() const;
   std::shared_ptr<const MagsacCheckpoint> Checkpoint() const;
@@ -234,10 +241,28 @@ FundamentalResult Estimator::Run(MagsacStatistics* statistics) {
     return result;
   }
 
-  // 5. The best model polished by least squares on its inliers.
-  PolishBest();
+  // 5-6. The best model polished by least squares on its inliers, and its inliers.
+  return PolishAndCount(std::move(result), statistics);
+}
 
-  // 6. Its inliers, in the order the points were given.
+FundamentalResult Estimator::RefineFrom(const Model& model, MagsacStatistics* statistics) {
+  if (n_ < std::max(internal::kSevenPointSampleSize, options_.min_matches) || !points_.Normalize()) return {};
+  state_.best = model;
+  state_.best_score = scorer_.FullScore(model);
+  state_.have_best = true;
+  Model refined;
+  Score refined_score;
+  if (scorer_.SigmaConsensus(model, 0, random_, &refined, &refined_score) &&
+      refined_score.value > state_.best_score.value) {
+    state_.best = refined;
+    state_.best_score = refined_score;
+  }
+  return PolishAndCount({}, statistics);
+}
+
+FundamentalResult Estimator::PolishAndCount(FundamentalResult result, MagsacStatistics* statistics) {
+  PolishBest();
+  // Its inliers, in the order the points were given.
   result.inlier_mask.assign(n_, 0);
   for (int i = 0; i < n_; ++i) {
     if (scorer_.IsInlier(state_.best, i)) {
@@ -269,6 +294,45 @@ FundamentalResult EstimateFundamentalMagsac(const std::vector<cv::Point2f>& poin
   CV_Assert(points0.size() == points1.size());
   Estimator estimator(points0, points1, options, early_stop);
   return estimator.Run(statistics);
+}
+
+FundamentalResult EstimateFundamentalMagsacOnBest(const std::vector<cv::Point2f>& points0,
+                                                  const std::vector<cv::Point2f>& points1,
+                                                  const std::vector<float>& scores, const VerifierOptions& options,
+                                                  MagsacStatistics* statistics) {
+  CV_Assert(points0.size() == points1.size());
+  const int n = static_cast<int>(points0.size());
+  if (options.loop_points <= 0 || n <= options.loop_points || static_cast<int>(scores.size()) != n) {
+    return EstimateFundamentalMagsac(points0, points1, options, {}, statistics);
+  }
+  // Best score first; ties by coordinates, so that the subset does not depend on the order the matches come in.
+  std::vector<int> order(n);
+  for (int i = 0; i < n; ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    if (scores[a] != scores[b]) return scores[a] > scores[b];
+    return std::tie(points0[a].x, points0[a].y, points1[a].x, points1[a].y) <
+           std::tie(points0[b].x, points0[b].y, points1[b].x, points1[b].y);
+  });
+  std::vector<cv::Point2f> best0(options.loop_points), best1(options.loop_points);
+  for (int i = 0; i < options.loop_points; ++i) {
+    best0[i] = points0[order[i]];
+    best1[i] = points1[order[i]];
+  }
+  MagsacStatistics loop_statistics;
+  const FundamentalResult loop = EstimateFundamentalMagsac(best0, best1, options, {}, &loop_statistics);
+  if (statistics) *statistics = loop_statistics;
+  if (!loop.success) return {};
+  Model model;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) model[3 * r + c] = loop.F(r, c);
+  Estimator all(points0, points1, options, {});
+  MagsacStatistics refine_statistics;
+  FundamentalResult result = all.RefineFrom(model, &refine_statistics);
+  if (statistics) {
+    statistics->models_scored += refine_statistics.models_scored;
+    statistics->local_optimizations += refine_statistics.local_optimizations;
+  }
+  return result;
 }
 
 }  // namespace vmap

@@ -50,6 +50,17 @@ FundamentalResult EstimateFundamentalMagsac(const std::vector<cv::Point2f>& poin
                                             const std::vector<cv::Point2f>& points1, const VerifierOptions& options,
                                             const EarlyStop& early_stop = {}, MagsacStatistics* statistics = nullptr);
 
+// The same estimation (without targets) at a cost that does not grow with the matches: when there are more than
+// options.loop_points matches and a score for each (TentativeMatches::scores, higher is better), the sample loop
+// runs on the loop_points best-scored ones only (PROSAC's ordering: a matcher's most confident matches are the
+// likeliest inliers), and its model is then refined by sigma-consensus++ and least squares on every match, whose
+// inliers it reports. Otherwise (loop_points 0, fewer matches, no scores) it is EstimateFundamentalMagsac.
+// Deterministic as that is: the subset is chosen by score, ties by coordinates.
+FundamentalResult EstimateFundamentalMagsacOnBest(const std::vector<cv::Point2f>& points0,
+                                                  const std::vector<cv::Point2f>& points1,
+                                                  const std::vector<float>& scores, const VerifierOptions& options,
+                                                  MagsacStatistics* statistics = nullptr);
+
 // Samples of 7 that must be drawn to find, with the given confidence, an all-inlier sample when a share
 // `inlier_ratio` of the points are inliers: ceil(ln(1 - confidence) / ln(1 - inlier_ratio^7)), at most
 // max_iterations (also when the ratio is 0).

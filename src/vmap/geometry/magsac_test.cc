@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 
+#include "vmap/core/error.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/sources/frame_source.h"
 #include "vmap/testing/shared_data.h"
@@ -360,6 +361,85 @@ TEST(MagsacEarlyStop, DecisionsAgreeWithTheExhaustiveRun) {
 }
 
 // Real ORB matches from ../shared: S of vmap's estimator against OpenCV's, both averaged over three seeds.
+// Scores that favour the inliers, as a matcher's similarities do, with overlap: an outlier may outscore an inlier.
+std::vector<float> ScoresFavouringInliers(const Scene& scene, unsigned seed) {
+  cv::RNG rng(seed);
+  std::vector<float> scores;
+  for (size_t i = 0; i < scene.p0.size(); ++i) {
+    const bool inlier = static_cast<int>(i) < scene.inliers;
+    scores.push_back(static_cast<float>((inlier ? 0.9 : 0.85) + rng.uniform(-0.05, 0.05)));
+  }
+  return scores;
+}
+
+TEST(MagsacOnBest, FindsTheModelAmongThousandsOfLowRatioMatchesInABoundedLoop) {
+  const Scene scene = MakeScene(400, 3600, 0.5, 11);  // 10 % inliers
+  const std::vector<float> scores = ScoresFavouringInliers(scene, 12);
+  VerifierOptions options;
+  options.max_iterations = 1000;
+  options.loop_points = 512;
+  MagsacStatistics statistics;
+  const FundamentalResult result = EstimateFundamentalMagsacOnBest(scene.p0, scene.p1, scores, options, &statistics);
+  ASSERT_TRUE(result.success);
+  EXPECT_LE(statistics.iterations, options.max_iterations);
+  // Refined on all: as many inliers as the true F keeps, those outside the 512 best-scored matches too.
+  int true_inliers = 0;
+  for (int i = 0; i < scene.inliers; ++i) true_inliers += SampsonDistance(scene.F_true, scene.p0[i], scene.p1[i]) < 0.5;
+  const Kept kept = Count(scene, result);
+  EXPECT_GE(kept.inliers, 0.9 * true_inliers);
+  EXPECT_GT(kept.inliers, 200);
+  EXPECT_LE(kept.outliers, 20);
+  EXPECT_LT(MeanTrueError(scene, result.F, 0, scene.inliers), 0.5);
+  // The same budget on every match does not find it: 1,000 samples at a ratio of 0.1.
+  options.loop_points = 0;
+  const FundamentalResult everything = EstimateFundamentalMagsacOnBest(scene.p0, scene.p1, scores, options);
+  EXPECT_LT(everything.num_inliers, 300);
+}
+
+TEST(MagsacOnBest, IndependentOfTheOrderAndTheSameAsTheFullRunWithoutScores) {
+  const Scene scene = MakeScene(300, 700, 0.5, 21);
+  const std::vector<float> scores = ScoresFavouringInliers(scene, 22);
+  VerifierOptions options;
+  options.loop_points = 256;
+  const FundamentalResult result = EstimateFundamentalMagsacOnBest(scene.p0, scene.p1, scores, options);
+  ASSERT_TRUE(result.success);
+  // Reversed input: the same subset, the same run, the same inliers.
+  std::vector<cv::Point2f> p0(scene.p0.rbegin(), scene.p0.rend()), p1(scene.p1.rbegin(), scene.p1.rend());
+  const std::vector<float> reversed_scores(scores.rbegin(), scores.rend());
+  const FundamentalResult reversed = EstimateFundamentalMagsacOnBest(p0, p1, reversed_scores, options);
+  ASSERT_EQ(reversed.num_inliers, result.num_inliers);
+  for (size_t i = 0; i < result.inlier_mask.size(); ++i) {
+    EXPECT_EQ(result.inlier_mask[i], reversed.inlier_mask[result.inlier_mask.size() - 1 - i]) << i;
+  }
+  // Without a score per match, or with fewer matches than loop_points, it is the full run.
+  const FundamentalResult full = EstimateFundamentalMagsac(scene.p0, scene.p1, options);
+  EXPECT_EQ(EstimateFundamentalMagsacOnBest(scene.p0, scene.p1, {}, options).inlier_mask, full.inlier_mask);
+  options.loop_points = 2000;
+  EXPECT_EQ(EstimateFundamentalMagsacOnBest(scene.p0, scene.p1, scores, options).inlier_mask, full.inlier_mask);
+}
+
+TEST(MagsacOnBest, ChosenThroughEstimateFundamentalForScoredMatchesWithoutTargets) {
+  const Scene scene = MakeScene(300, 700, 0.5, 31);
+  const std::vector<float> scores = ScoresFavouringInliers(scene, 32);
+  VerifierOptions options;
+  options.loop_points = 256;
+  options.max_samples_to_reject = 2000;  // the bounded loop's samples
+  VerifierOptions bounded = options;
+  bounded.max_iterations = 2000;
+  EXPECT_EQ(EstimateFundamental(scene.p0, scene.p1, options, {}, &scores).inlier_mask,
+            EstimateFundamentalMagsacOnBest(scene.p0, scene.p1, scores, bounded).inlier_mask);
+  // Without scores, the verifier as configured (here OpenCV's USAC_MAGSAC).
+  EXPECT_EQ(EstimateFundamental(scene.p0, scene.p1, options).inlier_mask,
+            EstimateFundamental(scene.p0, scene.p1, VerifierOptions()).inlier_mask);
+  options.own_magsac = true;
+  EarlyStop targets;
+  targets.min_inliers = {100};
+  EXPECT_EQ(EstimateFundamental(scene.p0, scene.p1, options, targets, &scores).inlier_mask,
+            EstimateFundamentalMagsac(scene.p0, scene.p1, options, targets).inlier_mask);
+  options.loop_points = 8;
+  EXPECT_THROW(options.Check(), OptionError);
+}
+
 TEST(Magsac, AgreesWithOpenCvOnRealPairs) {
   const std::filesystem::path shared = testing::SharedDir();
   if (shared.empty()) GTEST_SKIP() << "../shared not found";

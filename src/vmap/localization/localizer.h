@@ -257,10 +257,16 @@ class Localizer {
 // teach run's path between two key images is rightly localized at either (the bracket test of docs/measurements/localization.md).
 std::pair<int, int> KeysAround(const VisualMap& map, int source_index);
 
-// The verifier the map records (options.verifier in map.json), with at most `max_iterations` iterations.
-// Why capped: a frame compared with a key image it barely overlaps has a low inlier ratio, for which MAGSAC
-// runs up to the map's 100,000 iterations (about a second); such a pair fails the acceptance test anyway.
-VerifierOptions MapVerifierOptions(const VerifierOptions& recorded, int max_iterations = 5000);
+// The verifier the map records (options.verifier in map.json), bounded: a comparison asks "is the frame at this key
+// image?", not for the best F, so its cost must not grow with the matches or fall to MAGSAC's iteration cap.
+// - Scored matches (XFeat, ALIKED) of a map verified by MAGSAC: vmap's MAGSAC++ (within a seed change of
+//   OpenCV's) with at most `max_iterations` samples drawn from the `loop_points` best-scored matches, its model
+//   refined on all of them (VerifierOptions::loop_points): thousands of XFeat matches cost what 512 do.
+// - Matches without scores (ORB): the map's verifier with at most 5000 iterations. Why capped: a frame compared
+//   with a key image it barely overlaps has a low inlier ratio, for which MAGSAC runs to the map's 100,000
+//   iterations (about a second); such a pair fails the acceptance test anyway.
+// Measured with bench/verify_bench (docs/matchers.md, "Speed of verification").
+VerifierOptions MapVerifierOptions(const VerifierOptions& recorded, int max_iterations = 1000, int loop_points = 512);
 
 // What a controller may use of a result: "heading and translation", "heading only: translation unknown"
 // (a pose whose translation direction is not to be trusted), "heading only: no pose" (no camera, or no pose

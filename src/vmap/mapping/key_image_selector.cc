@@ -59,7 +59,8 @@ PairComparison VerifyMatches(const TentativeMatches& matches, int denominator, c
   }
   early_stop.abandon = abandon;
   early_stop.resume_from = std::move(resume_from);
-  const FundamentalResult fundamental = EstimateFundamental(matches.points0, matches.points1, verifier, early_stop);
+  const FundamentalResult fundamental = EstimateFundamental(matches.points0, matches.points1, verifier, early_stop,
+                                                               &matches.scores);
   if (fundamental.abandoned) {
     result.abandoned = true;
     return result;

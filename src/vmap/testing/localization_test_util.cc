@@ -1,10 +1,14 @@
 #include "vmap/testing/localization_test_util.h"
 
+#include <fstream>
+
+#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/map/map_io.h"
 #include "vmap/mapping/recorded_options.h"
+#include "vmap/testing/run_vmap.h"
 
 namespace vmap::testing {
 
@@ -46,6 +50,30 @@ VisualMap BuildMapDirectory(FrameSource& source, const Matcher& matcher, const M
   VisualMap map = BuildMap(source, matcher, options, directory, MapOptionsJson(matcher, options));
   WriteMapFiles(map, directory);
   return map;
+}
+
+void ExpectSecondLocalizeReadsTheCache(const std::filesystem::path& map, const std::filesystem::path& query,
+                                       const std::string& arguments) {
+  ASSERT_FALSE(std::filesystem::exists(map / "localization_cache.bin"));
+  nlohmann::json runs[2];
+  for (int run = 0; run < 2; ++run) {
+    const std::filesystem::path json = map.parent_path() / ("localize" + std::to_string(run) + ".json");
+    const CliResult r =
+        RunVmap("localize " + Quote(map) + " " + Quote(query) + " " + arguments + " -q --json " + Quote(json));
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::ifstream file(json);
+    runs[run] = nlohmann::json::parse(file);
+  }
+  EXPECT_EQ(runs[0]["key_image_cache"], "written");
+  EXPECT_EQ(runs[1]["key_image_cache"], "hit");
+  ASSERT_EQ(runs[0]["frames"].size(), runs[1]["frames"].size());
+  ASSERT_GT(runs[0]["frames"].size(), 0u);
+  for (size_t i = 0; i < runs[0]["frames"].size(); ++i) {
+    nlohmann::json a = runs[0]["frames"][i], b = runs[1]["frames"][i];
+    a.erase("seconds");
+    b.erase("seconds");
+    EXPECT_EQ(a, b) << "frame " << i;
+  }
 }
 
 }  // namespace vmap::testing

@@ -35,4 +35,10 @@ std::string MapOptionsJson(const Matcher& matcher, const MapBuilderOptions& opti
 VisualMap BuildMapDirectory(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
                             const std::filesystem::path& directory);
 
+// Runs `vmap localize MAP QUERY` twice through the binary (`arguments` added, e.g. --last): the first start must
+// compute the key-image features and write the cache, the second read them from it, and both must localize
+// every frame alike (everything in the --json output but times). `map` must have no cache yet.
+void ExpectSecondLocalizeReadsTheCache(const std::filesystem::path& map, const std::filesystem::path& query,
+                                       const std::string& arguments = "");
+
 }  // namespace vmap::testing

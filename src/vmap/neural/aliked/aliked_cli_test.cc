@@ -10,6 +10,7 @@
 
 #include "vmap/features/matcher_registry.h"
 #include "vmap/testing/golden_util.h"
+#include "vmap/testing/localization_test_util.h"
 
 namespace vmap::neural {
 namespace {
@@ -112,6 +113,16 @@ TEST(AlikedCli, WeightsListsImportsAndVerifiesAlikedFiles) {
   r = RunVmap("weights --verify " + n16, env);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("fits         aliked-n16"), std::string::npos) << r.output;
+}
+
+// Key-image features of a map are computed at the first `vmap localize` start and read from the map's cache after.
+TEST(AlikedCli, SecondLocalizeStartReadsTheKeyImagesFromTheCache) {
+  SKIP_WITHOUT_SHARED();
+  const TempDir dir("cache");
+  const std::string input = SharedDir() + "/data/rccar_room/images";
+  const auto r = RunVmap("build " + input + " --last 8 --tau 0.6 --matcher aliked -q -o " + (dir.path() / "map").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  ::vmap::testing::ExpectSecondLocalizeReadsTheCache(dir.path() / "map", input, "--last 8");
 }
 
 }  // namespace

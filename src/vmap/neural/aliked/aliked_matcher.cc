@@ -8,6 +8,7 @@
 #include "vmap/core/error.h"
 #include "vmap/features/float_matcher.h"
 #include "vmap/features/matcher_plugin.h"
+#include "vmap/features/point_features_bytes.h"
 #include "vmap/neural/aliked/aliked_model.h"
 #include "vmap/neural/aliked/aliked_weights.h"
 #include "vmap/neural/torch_device.h"
@@ -18,6 +19,8 @@ namespace vmap {
 namespace {
 
 using neural::AlikedModel;
+
+constexpr std::string_view kFeaturesTag = "vmapALK1";  // the localization cache's record of ALIKED features
 
 class AlikedFeatures : public ImageFeatures {
  public:
@@ -116,6 +119,18 @@ class AlikedMatcher : public Matcher {
       j["max_keypoints"] = options_.max_keypoints;
     }
     return j.dump();
+  }
+
+  std::string SerializeFeatures(const ImageFeatures& features) const override {
+    const auto& f = dynamic_cast<const AlikedFeatures&>(features);
+    return EncodePointFeatures(kFeaturesTag, {f.image_size(), f.keypoints(), f.descriptors()});
+  }
+
+  std::shared_ptr<const ImageFeatures> DeserializeFeatures(std::string_view bytes) const override {
+    std::optional<PointFeatureRows> read = DecodePointFeatures(kFeaturesTag, bytes);
+    if (!read) return nullptr;
+    return std::make_shared<AlikedFeatures>(std::move(read->keypoints), std::move(read->descriptors),
+                                            read->image_size);
   }
 
  private:

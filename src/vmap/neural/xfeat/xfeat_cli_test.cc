@@ -9,6 +9,7 @@
 #include <torch/torch.h>
 
 #include "vmap/testing/golden_util.h"
+#include "vmap/testing/localization_test_util.h"
 
 namespace vmap::neural {
 namespace {
@@ -105,6 +106,17 @@ TEST(VmapXfeat, WeightsKnowsXfeatAndItsLayouts) {
               "--no-verify", env);
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("fits no XFeat layout"), std::string::npos) << r.output;
+}
+
+// Key-image features of a map are computed at the first `vmap localize` start and read from the map's cache after.
+TEST(VmapXfeat, SecondLocalizeStartReadsTheKeyImagesFromTheCache) {
+  SKIP_WITHOUT_SHARED();
+  const TempDir dir("cache");
+  const std::string input = SharedDir() + "/data/rccar_room/images";
+  const auto r = RunVmap("build " + input + " --last 8 --tau 0.6 --matcher xfeat --xfeat-top-k 1000 --weights " +
+                         FoldedWeights() + " -q -o " + (dir.path() / "map").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  ::vmap::testing::ExpectSecondLocalizeReadsTheCache(dir.path() / "map", input, "--last 8");
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include "vmap/core/error.h"
 #include "vmap/features/float_matcher.h"
 #include "vmap/features/matcher_plugin.h"
+#include "vmap/features/point_features_bytes.h"
 #include "vmap/neural/torch_device.h"
 #include "vmap/neural/weights_store.h"
 #include "vmap/neural/xfeat/xfeat_model.h"
@@ -18,6 +19,7 @@ namespace vmap {
 namespace {
 
 constexpr int kMinimumSide = 32;  // the network input is the image cut down to multiples of 32
+constexpr std::string_view kFeaturesTag = "vmapXFT1";  // the localization cache's record of XFeat features
 
 class XfeatFeatures : public ImageFeatures {
  public:
@@ -111,6 +113,23 @@ class XfeatMatcher : public Matcher {
                      {"min_similarity", options_.min_similarity},
                      {"threads", options_.num_threads}};
     return j.dump();
+  }
+
+  std::string SerializeFeatures(const ImageFeatures& features) const override {
+    const auto& f = dynamic_cast<const XfeatFeatures&>(features);
+    return EncodePointFeatures(kFeaturesTag, {f.image_size(), f.keypoints(), f.descriptors()});
+  }
+
+  std::shared_ptr<const ImageFeatures> DeserializeFeatures(std::string_view bytes) const override {
+    std::optional<PointFeatureRows> read = DecodePointFeatures(kFeaturesTag, bytes);
+    if (!read) return nullptr;
+    const int64_t dimensions = read->descriptors.empty() ? 64 : read->descriptors.cols;
+    torch::Tensor rows = read->descriptors.empty()
+                             ? torch::zeros({0, dimensions}, torch::kFloat32)
+                             : torch::from_blob(read->descriptors.data, {read->descriptors.rows, dimensions},
+                                                torch::kFloat32)
+                                   .clone();
+    return std::make_shared<XfeatFeatures>(std::move(read->keypoints), rows.to(model_.device()), read->image_size);
   }
 
  private:
