@@ -37,12 +37,46 @@ void VerifierOptions::Check() const {
   }
 }
 
+namespace {
+
+// Matches that did not move (within the inlier threshold) are those of a camera that stayed where it was: a
+// frame identical to its key image, a robot standing still. Every F = [e]x explains them exactly, so their
+// 7-point samples do not determine a model and the estimators fail or keep a chance one (a frame identical to
+// its key image was lost by `vmap localize`). When they are the majority they are the verified matches, with
+// the F of a forward motion from their centroid, which they satisfy exactly. Empty result otherwise.
+FundamentalResult WithoutMotion(const std::vector<cv::Point2f>& points0, const std::vector<cv::Point2f>& points1,
+                                const VerifierOptions& options) {
+  FundamentalResult result;
+  std::vector<unsigned char> still(points0.size(), 0);
+  int count = 0;
+  cv::Point2d centroid(0.0, 0.0);
+  for (size_t i = 0; i < points0.size(); ++i) {
+    const cv::Point2f d = points1[i] - points0[i];
+    if (d.x * d.x + d.y * d.y <= options.threshold * options.threshold) {
+      still[i] = 1;
+      ++count;
+      centroid += cv::Point2d(points0[i]);
+    }
+  }
+  if (count < options.min_matches || 2 * count <= static_cast<int>(points0.size())) return result;
+  centroid *= 1.0 / count;
+  result.F = cv::Matx33d(0.0, -1.0, centroid.y, 1.0, 0.0, -centroid.x, -centroid.y, centroid.x, 0.0);  // [e]x
+  result.F *= 1.0 / cv::norm(result.F);
+  result.inlier_mask = std::move(still);
+  result.num_inliers = count;
+  result.success = true;
+  return result;
+}
+
+}  // namespace
+
 FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0,
                                       const std::vector<cv::Point2f>& points1, const VerifierOptions& options,
                                       const EarlyStop& early_stop, const std::vector<float>* scores) {
   FundamentalResult result;
   CV_Assert(points0.size() == points1.size());
   if (static_cast<int>(points0.size()) < options.min_matches) return result;
+  if (FundamentalResult still = WithoutMotion(points0, points1, options); still.success) return still;
   if (options.method == VerifierMethod::kMagsac && options.loop_points > 0 && scores &&
       scores->size() == points0.size() && early_stop.min_inliers.empty() && !early_stop.resume_from) {
     // Bounded: "not enough inliers" is accepted after max_samples_to_reject samples, as when stopping early.

@@ -106,6 +106,50 @@ TEST(Fundamental, SameSeedSameResult) {
   EXPECT_EQ(cv::norm(cv::Mat(a.F), cv::Mat(b.F)), 0.0);
 }
 
+// A camera that did not move: every F = [e]x explains its matches, no 7-point sample determines one, and the
+// estimators failed (a frame identical to its key image was lost). The matches that stayed put are verified
+// when they are the majority, whichever estimator; a moving pair with a few static matches is left to it.
+TEST(Fundamental, MatchesOfACameraThatDidNotMoveAreVerified) {
+  cv::RNG rng(5);
+  std::vector<cv::Point2f> p0, p1;
+  for (int i = 0; i < 300; ++i) {
+    p0.emplace_back(rng.uniform(0.f, 1024.f), rng.uniform(0.f, 384.f));
+    p1.push_back(p0.back() + cv::Point2f(rng.uniform(-0.2f, 0.2f), rng.uniform(-0.2f, 0.2f)));
+  }
+  for (int i = 0; i < 60; ++i) {  // wrong matches
+    p0.emplace_back(rng.uniform(0.f, 1024.f), rng.uniform(0.f, 384.f));
+    p1.emplace_back(rng.uniform(0.f, 1024.f), rng.uniform(0.f, 384.f));
+  }
+  for (VerifierMethod method : {VerifierMethod::kMagsac, VerifierMethod::kRansac, VerifierMethod::kUsac}) {
+    for (bool own : {false, true}) {
+      VerifierOptions options;
+      options.method = method;
+      options.own_magsac = own;
+      const FundamentalResult result = EstimateFundamental(p0, p1, options);
+      ASSERT_TRUE(result.success) << VerifierMethodName(method) << " own " << own;
+      EXPECT_EQ(result.num_inliers, 300);
+      for (int i = 0; i < 300; ++i) {
+        EXPECT_TRUE(result.inlier_mask[i]);
+        EXPECT_LT(SampsonDistance(result.F, p0[i], p1[i]), options.threshold);
+      }
+    }
+  }
+  // Moving: 200 matches of a real motion and 30 that stayed put; F is the motion's.
+  std::vector<cv::Point2f> m0, m1;
+  cv::Matx33d F_true;
+  MakeCorrespondences(200, 0, &m0, &m1, &F_true);
+  for (int i = 0; i < 30; ++i) {
+    m0.emplace_back(rng.uniform(0.f, 640.f), rng.uniform(0.f, 480.f));
+    m1.push_back(m0.back());
+  }
+  const FundamentalResult moving = EstimateFundamental(m0, m1, VerifierOptions());
+  ASSERT_TRUE(moving.success);
+  EXPECT_GE(moving.num_inliers, 190);
+  // The epipole far outside the image, in the true direction from the centre (as the test above judges it).
+  const cv::Point2d centre(320, 240), e = Epipole(moving.F) - centre, e_true = Epipole(F_true) - centre;
+  EXPECT_LT(std::acos(e.dot(e_true) / (cv::norm(e) * cv::norm(e_true))) * 180 / CV_PI, 2.0);
+}
+
 TEST(Fundamental, TooFewMatchesFail) {
   std::vector<cv::Point2f> p0, p1;
   cv::Matx33d F_true;
