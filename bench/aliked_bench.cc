@@ -75,8 +75,7 @@ torch::Tensor DeformConvByGridSample(const torch::Tensor& input, const torch::Te
     auto y = rows + double(t / k - padding) + offset[0][2 * t];
     auto x = cols + double(t % k - padding) + offset[0][2 * t + 1];
     auto grid = torch::stack({x / double(w - 1) * 2 - 1, y / double(h - 1) * 2 - 1}, -1).unsqueeze(0);
-    taps.push_back(F::grid_sample(input, grid,
-                                  F::GridSampleFuncOptions().mode(torch::kBilinear).align_corners(true)));
+    taps.push_back(F::grid_sample(input, grid, F::GridSampleFuncOptions().mode(torch::kBilinear).align_corners(true)));
   }
   auto columns = torch::stack(taps, 2).view({input.size(1) * k * k, out_h * out_w});
   return weight.view({weight.size(0), -1}).mm(columns).view({1, weight.size(0), out_h, out_w});
@@ -88,7 +87,10 @@ void BenchDeformConv(int reps) {
   torch::manual_seed(0);
   std::printf("\ndeformable 3x3 convolution, one thread, CPU ms: gather im2col + one matmul vs grid_sample per tap\n");
   std::printf("%-28s %12s %12s %8s\n", "input -> output", "im2col_ms", "gridsamp_ms", "ratio");
-  struct Case { int64_t c, o, h, w; const char* what; };
+  struct Case {
+    int64_t c, o, h, w;
+    const char* what;
+  };
   // ALIKED-N16 block 3 (1/8) and block 4 (1/32) convolutions at 640x480 and 1248x384 (KITTI padded).
   for (const Case& c : {Case{32, 64, 60, 80, "N16 block3 conv1 640x480"}, Case{64, 64, 60, 80, "N16 block3 conv2"},
                         Case{64, 128, 15, 20, "N16 block4 conv1"}, Case{128, 128, 15, 20, "N16 block4 conv2"},
@@ -122,8 +124,8 @@ void BenchStages(const std::string& shared, const std::string& which, int reps) 
     const std::string path = shared + "/weights/aliked/aliked-" + model + ".pt";
     const auto config = vmap::neural::AlikedPreset(model);
     const vmap::neural::AlikedModel net(config, vmap::neural::ReadAlikedStateDict(path), torch::kCPU);
-    for (const auto& [size, dir] : {std::pair{"640x480", "rccar_000000_000006"},
-                                    std::pair{"1226x370", "kitti07_000010_000014"}}) {
+    for (const auto& [size, dir] :
+         {std::pair{"640x480", "rccar_000000_000006"}, std::pair{"1226x370", "kitti07_000010_000014"}}) {
       const cv::Mat gray = cv::imread(shared + "/golden/aliked-n16/" + dir + "/input0.png", cv::IMREAD_GRAYSCALE);
       auto image = torch::from_blob(gray.data, {1, 1, gray.rows, gray.cols}, torch::kUInt8).to(torch::kFloat32) / 255.0;
       std::vector<double> network, dkd, sddh;
@@ -148,7 +150,12 @@ void BenchBuild(const std::string& shared, int frames, int reps) {
   options.show_progress = false;
   std::printf("\nvmap build end to end on %s (%s frames, default options, %d extraction workers, median of %d)\n",
               video.c_str(), frames > 0 ? std::to_string(frames).c_str() : "all", options.ExtractionThreads(), reps);
-  struct Entry { std::string name; std::unique_ptr<vmap::Matcher> matcher; std::vector<double> rates; long keys = 0; };
+  struct Entry {
+    std::string name;
+    std::unique_ptr<vmap::Matcher> matcher;
+    std::vector<double> rates;
+    long keys = 0;
+  };
   std::vector<Entry> entries;
   entries.push_back({"orb", vmap::CreateOrbMatcher({}), {}, 0});
   for (const std::string model : {"t16", "n16"}) {
@@ -186,15 +193,23 @@ int main(int argc, char** argv) {
   int reps = 5, frames = 0;
   bool dcn = false, build = false, stages = false, tune_malloc = true;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--model") && i + 1 < argc) which = argv[++i];
-    else if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) frames = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--dcn")) dcn = true;
-    else if (!std::strcmp(argv[i], "--build")) build = true;
-    else if (!std::strcmp(argv[i], "--stages")) stages = true;
-    else if (!std::strcmp(argv[i], "--no-tune-malloc")) tune_malloc = false;
+    if (!std::strcmp(argv[i], "--model") && i + 1 < argc)
+      which = argv[++i];
+    else if (!std::strcmp(argv[i], "--reps") && i + 1 < argc)
+      reps = std::max(1, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc)
+      frames = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--dcn"))
+      dcn = true;
+    else if (!std::strcmp(argv[i], "--build"))
+      build = true;
+    else if (!std::strcmp(argv[i], "--stages"))
+      stages = true;
+    else if (!std::strcmp(argv[i], "--no-tune-malloc"))
+      tune_malloc = false;
     else {
-      std::fprintf(stderr, "usage: %s [--model t16|n16|all] [--reps N] [--stages] [--dcn] [--build [--frames N]]"
+      std::fprintf(stderr,
+                   "usage: %s [--model t16|n16|all] [--reps N] [--stages] [--dcn] [--build [--frames N]]"
                    " [--no-tune-malloc]\n",
                    argv[0]);
       return 2;
@@ -205,7 +220,10 @@ int main(int argc, char** argv) {
   runtime.keep_freed_memory = tune_malloc;
   vmap::InitializeRuntime(runtime);
   const std::string shared = VMAP_SHARED_DIR;
-  struct Pair { const char* size; std::string dir; };
+  struct Pair {
+    const char* size;
+    std::string dir;
+  };
   const std::vector<Pair> pairs{{"640x480", shared + "/golden/aliked-n16/rccar_000000_000006"},
                                 {"1226x370", shared + "/golden/aliked-n16/kitti07_000010_000014"}};
   std::printf("%-6s %-9s %7s %6s %10s %10s %10s %10s %6s %8s\n", "model", "size", "threads", "reps", "extract_s",
@@ -230,13 +248,13 @@ int main(int argc, char** argv) {
         size_t matches = matcher->Match(*key, *frame).size();
         std::vector<double> extract_s, cpu_s, match_s, frame_s;
         for (int r = 0; r < reps; ++r) {
-          cpu_s.push_back(CpuSeconds([&] { extract_s.push_back(TimeSeconds([&] { frame = matcher->Extract(image1); })); }));
+          cpu_s.push_back(
+              CpuSeconds([&] { extract_s.push_back(TimeSeconds([&] { frame = matcher->Extract(image1); })); }));
           match_s.push_back(TimeSeconds([&] { matches = matcher->Match(*key, *frame).size(); }));
           frame_s.push_back(extract_s.back() + match_s.back());
         }
-        std::printf("%-6s %-9s %7d %6d %10.4f %10.4f %10.4f %10.4f %6d %8zu\n", model.c_str(), pair.size, threads,
-                    reps, Median(extract_s), Median(cpu_s), Median(match_s), Median(frame_s), frame->num_features(),
-                    matches);
+        std::printf("%-6s %-9s %7d %6d %10.4f %10.4f %10.4f %10.4f %6d %8zu\n", model.c_str(), pair.size, threads, reps,
+                    Median(extract_s), Median(cpu_s), Median(match_s), Median(frame_s), frame->num_features(), matches);
         std::fflush(stdout);
       }
     }

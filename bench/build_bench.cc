@@ -50,8 +50,10 @@ int main(int argc, char** argv) {
   std::string video = std::string(VMAP_SHARED_DIR) + "/data/lab_floor/lab_floor.mp4";
   int repeat = 5;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::atoi(argv[++i]);
-    else video = argv[i];
+    if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
+      repeat = std::atoi(argv[++i]);
+    else
+      video = argv[i];
   }
   if (!std::filesystem::exists(video)) {
     std::fprintf(stderr, "build_bench: '%s' not found; pass a video path\n", video.c_str());
@@ -101,7 +103,7 @@ int main(int argc, char** argv) {
   print("decode only", decode);
   print("decode + ORB detection (one thread)", detect);
   print("vmap build (ORB + MAGSAC, end to end)", build);
-  std::printf("%ld key images at tau %.2f; build / (decode + detection) = %.2f\n", key_images,
-              options.key_images.tau, build.Median() / detect.Median());
+  std::printf("%ld key images at tau %.2f; build / (decode + detection) = %.2f\n", key_images, options.key_images.tau,
+              build.Median() / detect.Median());
   return 0;
 }

@@ -51,16 +51,21 @@ int main(int argc, char** argv) {
   bool verbose = false;
   std::vector<std::string> sequences;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--seeds") && i + 1 < argc) seeds = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) frames_per_sequence = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--pairs-per-gap") && i + 1 < argc) pairs_per_gap = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--verbose")) verbose = true;
-    else sequences.push_back(argv[i]);
+    if (!std::strcmp(argv[i], "--seeds") && i + 1 < argc)
+      seeds = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc)
+      frames_per_sequence = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--pairs-per-gap") && i + 1 < argc)
+      pairs_per_gap = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--verbose"))
+      verbose = true;
+    else
+      sequences.push_back(argv[i]);
   }
   if (sequences.empty()) {
     const std::string shared = VMAP_SHARED_DIR;
-    sequences = {shared + "/data/rccar_room/images", shared + "/data/lab_floor/lab_floor.mp4",
-                 shared + "/data/kitti07", shared + "/data/redkitchen"};
+    sequences = {shared + "/data/rccar_room/images", shared + "/data/lab_floor/lab_floor.mp4", shared + "/data/kitti07",
+                 shared + "/data/redkitchen"};
   }
   vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   const auto matcher = vmap::CreateOrbMatcher({});
@@ -89,7 +94,8 @@ int main(int argc, char** argv) {
           vmap::VerifierOptions options;
           options.seed = seed;
           auto start = Clock::now();
-          pair.opencv.push_back(Similarity(vmap::EstimateFundamental(matches.points0, matches.points1, options), pair.n));
+          pair.opencv.push_back(
+              Similarity(vmap::EstimateFundamental(matches.points0, matches.points1, options), pair.n));
           time_opencv += Seconds(start);
           start = Clock::now();
           vmap::MagsacStatistics stats;
@@ -100,17 +106,18 @@ int main(int argc, char** argv) {
         }
         vmap::VerifierOptions options;
         vmap::EarlyStop sweep, build;
-        for (double tau : kTaus) sweep.min_inliers.push_back(std::max(8, static_cast<int>(std::ceil(tau * pair.n - 1e-9))));
+        for (double tau : kTaus)
+          sweep.min_inliers.push_back(std::max(8, static_cast<int>(std::ceil(tau * pair.n - 1e-9))));
         build.min_inliers.push_back(std::max(8, static_cast<int>(std::ceil(0.5 * pair.n - 1e-9))));
         vmap::MagsacStatistics stats;
         auto start = Clock::now();
-        pair.own_early_sweep =
-            Similarity(vmap::EstimateFundamentalMagsac(matches.points0, matches.points1, options, sweep, &stats), pair.n);
+        pair.own_early_sweep = Similarity(
+            vmap::EstimateFundamentalMagsac(matches.points0, matches.points1, options, sweep, &stats), pair.n);
         time_early_sweep += Seconds(start);
         iterations_sweep += stats.iterations;
         start = Clock::now();
-        pair.own_early_build =
-            Similarity(vmap::EstimateFundamentalMagsac(matches.points0, matches.points1, options, build, &stats), pair.n);
+        pair.own_early_build = Similarity(
+            vmap::EstimateFundamentalMagsac(matches.points0, matches.points1, options, build, &stats), pair.n);
         time_early_build += Seconds(start);
         iterations_build += stats.iterations;
         if (verbose) {
@@ -154,8 +161,9 @@ int main(int argc, char** argv) {
 
   // Decisions.
   std::printf("\ndecisions S >= tau flipped against OpenCV seed 0 (of %zu pairs)\n", results.size());
-  std::printf("| tau | OpenCV, seed 1 | vmap exhaustive, seed 0 | vmap exhaustive, seed 1 | vmap early stop (9 taus) |%s\n",
-              " vmap early stop (tau alone, 0.5) |");
+  std::printf(
+      "| tau | OpenCV, seed 1 | vmap exhaustive, seed 0 | vmap exhaustive, seed 1 | vmap early stop (9 taus) |%s\n",
+      " vmap early stop (tau alone, 0.5) |");
   int totals[5] = {0, 0, 0, 0, 0};
   for (double tau : kTaus) {
     int flips[5] = {0, 0, 0, 0, 0};
@@ -180,6 +188,7 @@ int main(int argc, char** argv) {
               1e3 * time_early_sweep / results.size(), double(iterations_sweep) / results.size(),
               1e3 * time_early_build / results.size(), double(iterations_build) / results.size());
   std::printf("OpenCV / vmap exhaustive: %.2fx; OpenCV / vmap early stop (9 taus): %.2fx; (tau 0.5): %.2fx\n",
-              time_opencv / time_own, (time_opencv / seeds) / time_early_sweep, (time_opencv / seeds) / time_early_build);
+              time_opencv / time_own, (time_opencv / seeds) / time_early_sweep,
+              (time_opencv / seeds) / time_early_build);
   return 0;
 }

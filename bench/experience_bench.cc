@@ -183,7 +183,8 @@ void Run(const std::string& name, const Matcher& matcher, const std::vector<int>
         // As AddExperience: the session localized as a run against the map with the experiences so far.
         Localizer localizer(map, store, matcher, options);
         ExperienceViewPicker picker(kPlaces);
-        for (int p = 1; p <= kPlaces; ++p) picker.Offer(localizer.Localize(MakeFrame(images, session, p), *images.features[session][p]));
+        for (int p = 1; p <= kPlaces; ++p)
+          picker.Offer(localizer.Localize(MakeFrame(images, session, p), *images.features[session][p]));
         ++id;
         if (store.views.empty()) store.views.resize(kPlaces);
         for (const ExperienceView& v : picker.Views()) {
@@ -215,8 +216,9 @@ void Run(const std::string& name, const Matcher& matcher, const std::vector<int>
   }
   std::printf("\n%s, --acceptance %s, teach sessions %zu (extraction %.0f ms/image)\n", name.c_str(),
               AcceptanceRuleName(acceptance).c_str(), teach_sessions.size(), images.extract_ms);
-  std::printf("| matcher | experiences k | pairs | heading error rate pl1..pl5 (%%) | heading error rate | median error "
-              "| right place pl1..pl5 (%%) | right place | wrong place | heading from a view | ms/compare |\n");
+  std::printf(
+      "| matcher | experiences k | pairs | heading error rate pl1..pl5 (%%) | heading error rate | median error "
+      "| right place pl1..pl5 (%%) | right place | wrong place | heading from a view | ms/compare |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (int k : ks) {
     Tally& t = tallies[k];
@@ -234,8 +236,8 @@ void Run(const std::string& name, const Matcher& matcher, const std::vector<int>
       misplaced += t.localized_wrong[p];
     }
     std::nth_element(t.errors.begin(), t.errors.begin() + t.errors.size() / 2, t.errors.end());
-    std::printf("| %s | %d | %d | %s | %.1f %% | %.1f px | %s | %.1f %% | %.1f %% | %.1f %% | %.1f |\n", name.c_str(), k,
-                pairs, per_place_heading.c_str(), 100.0 * wrong / pairs, t.errors[t.errors.size() / 2],
+    std::printf("| %s | %d | %d | %s | %.1f %% | %.1f px | %s | %.1f %% | %.1f %% | %.1f %% | %.1f |\n", name.c_str(),
+                k, pairs, per_place_heading.c_str(), 100.0 * wrong / pairs, t.errors[t.errors.size() / 2],
                 per_place_right.c_str(), 100.0 * right / pairs, 100.0 * misplaced / pairs,
                 100.0 * t.used_experience / pairs, 1e3 * t.compare_seconds / t.compares);
     std::fflush(stdout);
@@ -260,8 +262,9 @@ int main(int argc, char** argv) {
     } else if (arg == "--acceptance" && i + 1 < argc) {
       acceptance = ParseAcceptanceRule(argv[++i]);
     } else {
-      std::fprintf(stderr, "usage: experience_bench [--matchers orb,xfeat] [--teach 1,...,12] [--k 0,1,2,3] "
-                           "[--acceptance counts|chance]\n");
+      std::fprintf(stderr,
+                   "usage: experience_bench [--matchers orb,xfeat] [--teach 1,...,12] [--k 0,1,2,3] "
+                   "[--acceptance counts|chance]\n");
       return 2;
     }
   }

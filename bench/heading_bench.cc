@@ -118,7 +118,8 @@ MatchedSet MatchAll(const std::string& name, const Dataset& data, const ExtractF
   for (const cv::Mat& image : data.images) features.push_back(extract(image));
   set.extract_ms = 1e3 * (CpuSeconds() - start) / data.images.size();
   start = CpuSeconds();
-  for (const LabelledPair& pair : data.pairs) set.matches.push_back(match(*features[pair.teach], *features[pair.repeat]));
+  for (const LabelledPair& pair : data.pairs)
+    set.matches.push_back(match(*features[pair.teach], *features[pair.repeat]));
   set.match_ms = 1e3 * (CpuSeconds() - start) / data.pairs.size();
   for (const TentativeMatches& m : set.matches) set.mean_tentative += double(m.size()) / set.matches.size();
   return set;
@@ -149,9 +150,9 @@ MatchedSet MatchOrb(const std::string& name, const Dataset& data, const OrbVaria
   auto extract = [&](const cv::Mat& gray) -> std::shared_ptr<const ImageFeatures> {
     cv::Mat input = gray;
     if (v.clahe) cv::createCLAHE(2.0, cv::Size(8, 8))->apply(gray, input);
-    cv::Ptr<cv::ORB> orb = cv::ORB::create(v.num_features, static_cast<float>(defaults.scale_factor),
-                                           defaults.num_levels, defaults.edge_threshold, 0, 2, cv::ORB::HARRIS_SCORE,
-                                           31, defaults.fast_threshold);
+    cv::Ptr<cv::ORB> orb =
+        cv::ORB::create(v.num_features, static_cast<float>(defaults.scale_factor), defaults.num_levels,
+                        defaults.edge_threshold, 0, 2, cv::ORB::HARRIS_SCORE, 31, defaults.fast_threshold);
     auto f = std::make_shared<BenchOrbFeatures>();
     f->size = gray.size();
     if (v.upright) {
@@ -204,11 +205,12 @@ Estimator VerifiedEstimator(int min_verified) {
   verifier.max_iterations = 5000;
   HeadingOptions options;
   options.min_verified = min_verified;
-  std::string name = min_verified > 0 ? "F>=" + std::to_string(min_verified) + " ? verified : mode"
-                                      : std::string("verified median");
+  std::string name =
+      min_verified > 0 ? "F>=" + std::to_string(min_verified) + " ? verified : mode" : std::string("verified median");
   return {name, [=](const TentativeMatches& m) {
             FundamentalResult f;
-            if (static_cast<int>(m.size()) >= verifier.min_matches) f = EstimateFundamental(m.points0, m.points1, verifier);
+            if (static_cast<int>(m.size()) >= verifier.min_matches)
+              f = EstimateFundamental(m.points0, m.points1, verifier);
             if (min_verified > 0) return EstimateHeading(m.points0, m.points1, f.inlier_mask, options).px;
             std::vector<double> dx;
             for (size_t i = 0; i < f.inlier_mask.size(); ++i) {
@@ -238,7 +240,8 @@ void Report(const Dataset& data, const MatchedSet& set, const Estimator& estimat
   std::sort(errors.begin(), errors.end());
   const double median = errors[errors.size() / 2];
   std::printf("%-22s %-24s", set.name.c_str(), estimator.name.c_str());
-  for (int place = 1; place <= 5; ++place) std::printf(" %6.1f", total[place] ? 100.0 * wrong[place] / total[place] : 0.0);
+  for (int place = 1; place <= 5; ++place)
+    std::printf(" %6.1f", total[place] ? 100.0 * wrong[place] / total[place] : 0.0);
   std::printf(" %7.1f %8.1f %8.1f %8.1f %6.0f\n", 100.0 * wrong[0] / total[0], median,
               2 * set.extract_ms + set.match_ms + estimate_ms, estimate_ms, set.mean_tentative);
   std::fflush(stdout);
@@ -251,20 +254,24 @@ int main(int argc, char** argv) {
   bool sweep = false, verified = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--matchers" && i + 1 < argc) matchers = argv[++i];
-    else if (arg == "--sweep") sweep = true;
-    else if (arg == "--verified") verified = true;
+    if (arg == "--matchers" && i + 1 < argc)
+      matchers = argv[++i];
+    else if (arg == "--sweep")
+      sweep = true;
+    else if (arg == "--verified")
+      verified = true;
     else {
       std::fprintf(stderr, "usage: heading_bench [--matchers orb,xfeat] [--sweep] [--verified]\n");
       return 2;
     }
   }
   const Dataset data = LoadMichigan();
-  std::printf("michigan_seasons: %zu images, %zu labelled pairs; error rate (%%) = share of headings more than %g px "
-              "off\nanchors (Krajnik et al. RAS 2017, michigan): 1.5%% best (STAR/GRIEF), 20.9%% ORB/ORB\n\n",
-              data.images.size(), data.pairs.size(), kCorrectPx);
-  std::printf("%-22s %-24s %6s %6s %6s %6s %6s %7s %8s %8s %8s %6s\n", "matcher", "estimator", "pl1", "pl2", "pl3", "pl4",
-              "pl5", "err%", "med_px", "ms/pair", "est_ms", "tent");
+  std::printf(
+      "michigan_seasons: %zu images, %zu labelled pairs; error rate (%%) = share of headings more than %g px "
+      "off\nanchors (Krajnik et al. RAS 2017, michigan): 1.5%% best (STAR/GRIEF), 20.9%% ORB/ORB\n\n",
+      data.images.size(), data.pairs.size(), kCorrectPx);
+  std::printf("%-22s %-24s %6s %6s %6s %6s %6s %7s %8s %8s %8s %6s\n", "matcher", "estimator", "pl1", "pl2", "pl3",
+              "pl4", "pl5", "err%", "med_px", "ms/pair", "est_ms", "tent");
   const HeadingOptions chosen;
   // The mode alone (what a pair without F gets), and vmap's heading where F is estimated (match, localize).
   std::vector<Estimator> estimators = {ModeEstimator(chosen), VerifiedEstimator(chosen.min_verified)};

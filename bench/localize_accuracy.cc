@@ -30,14 +30,15 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
-#include "localizer_variants.h"
 #include "vmap/core/runtime.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localize_sequence.h"
-#include "vmap/mapping/batch_build.h"
 #include "vmap/map/map_io.h"
+#include "vmap/mapping/batch_build.h"
+
+#include "localizer_variants.h"
 
 namespace fs = std::filesystem;
 using namespace vmap;
@@ -95,11 +96,11 @@ void Measure(const std::string& input, const LocalizationMap& opened, const Loca
             ++progress_count;
           }
         });
-    std::printf("streaming: %ld odd frames, bracketed %ld (%.1f%%), within one key image of the bracket %.1f%%; "
-                "tracking %ld, relocalized %ld, lost %ld; %.1f frames/s, %.1f ms localizing per frame\n",
-                s.frames, bracketed, 100.0 * bracketed / std::max(1L, s.frames), 100.0 * near / std::max(1L, s.frames),
-                s.tracking, s.relocalized, s.lost,
-                s.frames_per_second, 1000 * s.mean_localize_seconds);
+    std::printf(
+        "streaming: %ld odd frames, bracketed %ld (%.1f%%), within one key image of the bracket %.1f%%; "
+        "tracking %ld, relocalized %ld, lost %ld; %.1f frames/s, %.1f ms localizing per frame\n",
+        s.frames, bracketed, 100.0 * bracketed / std::max(1L, s.frames), 100.0 * near / std::max(1L, s.frames),
+        s.tracking, s.relocalized, s.lost, s.frames_per_second, 1000 * s.mean_localize_seconds);
     std::printf("progress: mean |estimate - truth| %.3f over %ld frames on their bracketing segment\n",
                 progress_count ? progress_error / progress_count : 0.0, progress_count);
     for (const std::string& m : misses) std::printf("  miss %s\n", m.c_str());
@@ -141,10 +142,10 @@ void Measure(const std::string& input, const LocalizationMap& opened, const Loca
         }
       }
     }
-    std::printf("relocalization only: %ld frames, localized %ld, bracketed %ld (%.1f%%); %.1f ms per frame, "
-                "worst %.1f ms\n",
-                frames, localized, bracketed, 100.0 * bracketed / std::max(1L, frames), 1000 * seconds / frames,
-                1000 * worst);
+    std::printf(
+        "relocalization only: %ld frames, localized %ld, bracketed %ld (%.1f%%); %.1f ms per frame, "
+        "worst %.1f ms\n",
+        frames, localized, bracketed, 100.0 * bracketed / std::max(1L, frames), 1000 * seconds / frames, 1000 * worst);
     const char* names[2] = {"votes", "thumbnails"};
     for (int m = 0; m < 2; ++m) {
       std::printf("ranking %-10s: bracketing key first %.1f%%, among the first %d %.1f%%; %.2f ms per query\n",
@@ -158,7 +159,8 @@ void Measure(const std::string& input, const LocalizationMap& opened, const Loca
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: localize_accuracy SEQUENCE [--last N] [--tau T] [--ranking R] [--candidates K] "
+    std::fprintf(stderr,
+                 "usage: localize_accuracy SEQUENCE [--last N] [--tau T] [--ranking R] [--candidates K] "
                  "[--acceptance chance,counts] [--variants RULE/RECHECK/SHARE,...]\n");
     return 2;
   }
@@ -169,15 +171,24 @@ int main(int argc, char** argv) {
   std::string ranking = "auto";
   std::vector<bench::LocalizerVariant> variants;
   for (int i = 2; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--last")) last = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--tau")) tau = std::atof(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--ranking")) ranking = argv[i + 1];
-    else if (!std::strcmp(argv[i], "--candidates")) candidates = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--acceptance")) variants = bench::ParseAcceptanceVariants(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--variants")) variants = bench::ParseLocalizerVariants(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--lookahead")) lookahead = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--no-step-back")) step_back = false, --i;
-    else if (!std::strcmp(argv[i], "--streaming-only")) streaming_only = true, --i;
+    if (!std::strcmp(argv[i], "--last"))
+      last = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--tau"))
+      tau = std::atof(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--ranking"))
+      ranking = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--candidates"))
+      candidates = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--acceptance"))
+      variants = bench::ParseAcceptanceVariants(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--variants"))
+      variants = bench::ParseLocalizerVariants(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--lookahead"))
+      lookahead = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--no-step-back"))
+      step_back = false, --i;
+    else if (!std::strcmp(argv[i], "--streaming-only"))
+      streaming_only = true, --i;
   }
   vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   const fs::path map_directory = fs::temp_directory_path() / ("vmap_localize_accuracy_" + std::to_string(getpid()));
@@ -194,8 +205,8 @@ int main(int argc, char** argv) {
   even.last = last;
   {
     auto source = OpenFrameSource(input, even);
-    const VisualMap built = BuildMap(*source, *matcher, build_options, map_directory,
-                                     MapOptionsJson(*matcher, build_options));
+    const VisualMap built =
+        BuildMap(*source, *matcher, build_options, map_directory, MapOptionsJson(*matcher, build_options));
     WriteMapFiles(built, map_directory);
   }
   LocalizationMap opened = OpenLocalizationMap(map_directory, {});

@@ -29,8 +29,8 @@
 #include "vmap/features/matcher_registry.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localize_sequence.h"
-#include "vmap/mapping/batch_build.h"
 #include "vmap/map/map_io.h"
+#include "vmap/mapping/batch_build.h"
 
 namespace fs = std::filesystem;
 using namespace vmap;
@@ -158,8 +158,7 @@ int main(int argc, char** argv) {
       between.first = 1;
       between.stride = 15;
       auto source = OpenFrameSource(kitchen, between);
-      Localizer localizer(kitchen_map.map, kitchen_map.keys, *kitchen_map.matcher,
-                          MapLocalizerOptions(kitchen_map));
+      Localizer localizer(kitchen_map.map, kitchen_map.keys, *kitchen_map.matcher, MapLocalizerOptions(kitchen_map));
       Samples seconds, cpu_seconds;
       while (auto frame = source->Next()) {
         const auto features = kitchen_map.matcher->Extract(frame->gray);
@@ -177,7 +176,8 @@ int main(int argc, char** argv) {
     }
   }
   std::printf("| stage | median [range] |\n|---|---|\n");
-  std::printf("| decode only (one thread), frames/s | %.0f [%.0f-%.0f] |\n", decode.Median(), decode.Min(), decode.Max());
+  std::printf("| decode only (one thread), frames/s | %.0f [%.0f-%.0f] |\n", decode.Median(), decode.Min(),
+              decode.Max());
   std::printf("| decode + ORB (one thread), frames/s | %.0f [%.0f-%.0f] |\n", extract.Median(), extract.Min(),
               extract.Max());
   const char* variant[2] = {"comparisons on the localizer thread", "workers compare ahead (default)"};
@@ -194,8 +194,8 @@ int main(int argc, char** argv) {
   for (int a = 0; a < 2; ++a) {
     std::printf("| vmap localize, tracking, %s, CPU ms per frame: all threads | %.1f [%.1f-%.1f] |\n", variant[a],
                 track_cpu[a].Median(), track_cpu[a].Min(), track_cpu[a].Max());
-    std::printf("| vmap localize, tracking, %s, CPU ms per frame: localizer thread | %.1f [%.1f-%.1f] |\n",
-                variant[a], track_main_cpu[a].Median(), track_main_cpu[a].Min(), track_main_cpu[a].Max());
+    std::printf("| vmap localize, tracking, %s, CPU ms per frame: localizer thread | %.1f [%.1f-%.1f] |\n", variant[a],
+                track_main_cpu[a].Median(), track_main_cpu[a].Min(), track_main_cpu[a].Max());
   }
   std::printf("| relocalization, 300-key map, median CPU ms per frame | %.1f [%.1f-%.1f] |\n", relocalize_cpu.Median(),
               relocalize_cpu.Min(), relocalize_cpu.Max());

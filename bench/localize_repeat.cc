@@ -30,13 +30,14 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
-#include "localizer_variants.h"
 #include "vmap/core/runtime.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localize_sequence.h"
-#include "vmap/mapping/batch_build.h"
 #include "vmap/map/map_io.h"
+#include "vmap/mapping/batch_build.h"
+
+#include "localizer_variants.h"
 
 namespace fs = std::filesystem;
 using namespace vmap;
@@ -95,11 +96,12 @@ void Judge(const fs::path& sequence, const LocalizationMap& opened, const Locali
   auto source = OpenFrameSource(sequence.string(), repeat_options);
   LocalizeSequenceOptions run;
   run.show_progress = false;
-  long coverable = 0, right = 0, wrong = 0, lost_coverable = 0, lost_uncoverable = 0, ranked_near = 0, lost_tracking = 0;
+  long coverable = 0, right = 0, wrong = 0, lost_coverable = 0, lost_uncoverable = 0, ranked_near = 0,
+       lost_tracking = 0;
   std::vector<std::pair<int, int>> lost_stretches;  // coverable frames lost, as [first, last] runs
   std::vector<std::string> wrongs;
-  const LocalizationSummary summary = LocalizeSequence(
-      *source, *opened.matcher, localizer, run, [&](const Frame& frame, const LocalizationResult& r) {
+  const LocalizationSummary summary =
+      LocalizeSequence(*source, *opened.matcher, localizer, run, [&](const Frame& frame, const LocalizationResult& r) {
         const Pose* pose = PoseAt(poses, frame.timestamp);
         if (!pose) return;
         auto key_near = [&](int key) {
@@ -136,13 +138,15 @@ void Judge(const fs::path& sequence, const LocalizationMap& opened, const Locali
           }
         }
       });
-  std::printf("repeat frames %ld: coverable %ld; localized right %ld, wrong %ld; lost %ld (coverable %ld, not "
-              "coverable %ld); tracking %ld, relocalized %ld; %.1f frames/s\n",
-              summary.frames, coverable, right, wrong, summary.lost, lost_coverable, lost_uncoverable,
-              summary.tracking, summary.relocalized, summary.frames_per_second);
-  std::printf("lost though coverable: %ld while tracking (before the estimate is dropped), %ld relocalizing: the "
-              "ranking proposed a key image near the frame for %ld (verification refused it), none for %ld\n",
-              lost_tracking, lost_coverable - lost_tracking, ranked_near, lost_coverable - lost_tracking - ranked_near);
+  std::printf(
+      "repeat frames %ld: coverable %ld; localized right %ld, wrong %ld; lost %ld (coverable %ld, not "
+      "coverable %ld); tracking %ld, relocalized %ld; %.1f frames/s\n",
+      summary.frames, coverable, right, wrong, summary.lost, lost_coverable, lost_uncoverable, summary.tracking,
+      summary.relocalized, summary.frames_per_second);
+  std::printf(
+      "lost though coverable: %ld while tracking (before the estimate is dropped), %ld relocalizing: the "
+      "ranking proposed a key image near the frame for %ld (verification refused it), none for %ld\n",
+      lost_tracking, lost_coverable - lost_tracking, ranked_near, lost_coverable - lost_tracking - ranked_near);
   for (const auto& [a, b] : lost_stretches) std::printf("  lost though coverable: frames %d-%d\n", a, b);
   for (const std::string& w : wrongs) std::printf("  wrong: %s\n", w.c_str());
 }
@@ -151,7 +155,8 @@ void Judge(const fs::path& sequence, const LocalizationMap& opened, const Locali
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: localize_repeat TUM_SEQUENCE --teach A:B --repeat C:D [--stride N] "
+    std::fprintf(stderr,
+                 "usage: localize_repeat TUM_SEQUENCE --teach A:B --repeat C:D [--stride N] "
                  "[--acceptance chance,counts] [--variants RULE/RECHECK/SHARE,...]\n");
     return 2;
   }
@@ -163,14 +168,22 @@ int main(int argc, char** argv) {
   std::vector<bench::LocalizerVariant> variants;
   int descriptors = RankingOptions().max_descriptors_per_key, candidates = LocalizerOptions().relocalization_candidates;
   for (int i = 2; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--teach")) teach = Range(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--repeat")) repeat = Range(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--stride")) stride = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--max-distance")) max_distance = std::atof(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--max-angle")) max_angle = std::atof(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--ranking")) ranking = argv[i + 1];
-    else if (!std::strcmp(argv[i], "--descriptors")) descriptors = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--candidates")) candidates = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--teach"))
+      teach = Range(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--repeat"))
+      repeat = Range(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--stride"))
+      stride = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--max-distance"))
+      max_distance = std::atof(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--max-angle"))
+      max_angle = std::atof(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--ranking"))
+      ranking = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--descriptors"))
+      descriptors = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--candidates"))
+      candidates = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--acceptance")) {
       variants = bench::ParseAcceptanceVariants(argv[i + 1]);
     } else if (!std::strcmp(argv[i], "--variants")) {
@@ -201,9 +214,9 @@ int main(int argc, char** argv) {
   }
   LocalizationMap opened = OpenLocalizationMap(map_directory, {});
   const VisualMap& map = opened.map;
-  std::printf("teach frames %d-%d: %zu key images; repeat frames %d-%d (stride %d); near = within %.2f m and %.0f deg\n",
-              teach.first, teach.second, map.key_images.size(), repeat.first, repeat.second, stride, max_distance,
-              max_angle);
+  std::printf(
+      "teach frames %d-%d: %zu key images; repeat frames %d-%d (stride %d); near = within %.2f m and %.0f deg\n",
+      teach.first, teach.second, map.key_images.size(), repeat.first, repeat.second, stride, max_distance, max_angle);
 
   if (variants.empty()) variants.push_back({});
   for (const bench::LocalizerVariant& variant : variants) {

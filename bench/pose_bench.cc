@@ -12,8 +12,8 @@
 
 #include "vmap/core/runtime.h"
 #include "vmap/evaluation/map_evaluation.h"
-#include "vmap/mapping/link_analysis.h"
 #include "vmap/map/map_io.h"
+#include "vmap/mapping/link_analysis.h"
 
 namespace {
 
@@ -71,8 +71,9 @@ int main(int argc, char** argv) {
     const vmap::GroundTruth truth = vmap::MapGroundTruth(map, "", vmap::GroundTruthFormat::kAuto);
     const vmap::Camera camera = vmap::EvaluationCamera(map, "");
     std::printf("\n%s (%s, %zu links)\n\n", argv[a], map.input.path.c_str(), map.links.size());
-    std::printf("| pose estimator | usable links | rotation error, median (deg) | translation error, median (deg) | "
-                "ms per link |\n|---|---:|---:|---:|---:|\n");
+    std::printf(
+        "| pose estimator | usable links | rotation error, median (deg) | translation error, median (deg) | "
+        "ms per link |\n|---|---:|---:|---:|---:|\n");
     for (const Variant& variant : Variants()) {
       vmap::VisualMap copy = map;
       copy.input.camera = camera;

@@ -52,9 +52,12 @@ int main(int argc, char** argv) {
   std::string video = std::string(VMAP_SHARED_DIR) + "/data/lab_floor/lab_floor.mp4";
   int frames = 300, repeat = 3;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) frames = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::atoi(argv[++i]);
-    else video = argv[i];
+    if (!std::strcmp(argv[i], "--frames") && i + 1 < argc)
+      frames = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
+      repeat = std::atoi(argv[++i]);
+    else
+      video = argv[i];
   }
   if (!fs::exists(video)) {
     std::fprintf(stderr, "recording_bench: '%s' not found; pass a video path\n", video.c_str());
@@ -115,7 +118,8 @@ int main(int argc, char** argv) {
     std::printf("read %-28s %8.1f frames/s  %5.1fx the build's rate  (%.0f MB)\n", recording.name.c_str(),
                 Median(recording.rates), Median(recording.rates) / build,
                 (fs::is_directory(recording.path) ? fs::file_size(fs::path(recording.path) / "rosbag2_0.db3")
-                                                  : fs::file_size(recording.path)) / 1e6);
+                                                  : fs::file_size(recording.path)) /
+                    1e6);
   }
   std::printf("vmap build (ORB + MAGSAC) of the MCAP   %8.1f frames/s  (%ld key images)\n", build, key_images);
   fs::remove_all(dir);

@@ -42,9 +42,9 @@ int main(int argc, char** argv) {
           all_to.push_back(c.p1);
         }
         const auto t0 = Clock::now();
-        const vmap::RelativePose pose = vmap::EstimateRelativePose(
-            camera, all_from, all_to, pose_options,
-            {vmap::PoseFromFundamental(link.F, camera, verified_from, verified_to)});
+        const vmap::RelativePose pose =
+            vmap::EstimateRelativePose(camera, all_from, all_to, pose_options,
+                                       {vmap::PoseFromFundamental(link.F, camera, verified_from, verified_to)});
         const auto t1 = Clock::now();
         const std::vector<vmap::PoseMinimum> probes =
             vmap::ProbeTranslation(pose, camera, all_from, all_to, pose_options, probe_angle);

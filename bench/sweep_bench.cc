@@ -28,9 +28,9 @@
 
 #include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
+#include "vmap/map/map_io.h"
 #include "vmap/mapping/batch_build.h"
 #include "vmap/mapping/sweep_thresholds.h"
-#include "vmap/map/map_io.h"
 #include "vmap/sources/frame_source.h"
 
 namespace {
@@ -78,13 +78,20 @@ int main(int argc, char** argv) {
   int repeat = 3, seeds = 3;
   bool timing = true, flips = true;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--thresholds") && i + 1 < argc) thresholds = argv[++i];
-    else if (!std::strcmp(argv[i], "--tau") && i + 1 < argc) tau = std::atof(argv[++i]);
-    else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--seeds") && i + 1 < argc) seeds = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--no-timing")) timing = false;
-    else if (!std::strcmp(argv[i], "--no-flips")) flips = false;
-    else input = argv[i];
+    if (!std::strcmp(argv[i], "--thresholds") && i + 1 < argc)
+      thresholds = argv[++i];
+    else if (!std::strcmp(argv[i], "--tau") && i + 1 < argc)
+      tau = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
+      repeat = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--seeds") && i + 1 < argc)
+      seeds = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--no-timing"))
+      timing = false;
+    else if (!std::strcmp(argv[i], "--no-flips"))
+      flips = false;
+    else
+      input = argv[i];
   }
   if (!fs::exists(input)) {
     std::fprintf(stderr, "sweep_bench: '%s' not found\n", input.c_str());
@@ -176,7 +183,8 @@ int main(int argc, char** argv) {
   }
   std::map<std::pair<int, int>, std::vector<double>> asked;  // pair -> taus whose maps compared it
   for (size_t t = 0; t < taus.size(); ++t) {
-    for (const vmap::Evaluation& e : exhaustive_maps[0][t].evaluations) asked[{e.key_frame, e.frame}].push_back(taus[t]);
+    for (const vmap::Evaluation& e : exhaustive_maps[0][t].evaluations)
+      asked[{e.key_frame, e.frame}].push_back(taus[t]);
   }
   vmap::VerifierOptions other_seed;
   other_seed.seed = 1;

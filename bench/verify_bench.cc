@@ -18,8 +18,8 @@
 // from the exhaustive run's are listed.
 
 #include <algorithm>
-#include <ctime>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <string>
 #include <utility>
@@ -106,8 +106,8 @@ void Run(const std::string& set, const std::vector<PairImages>& pairs, const vma
   own.own_magsac = true;
   vmap::VerifierOptions other_seed = exhaustive;  // the noise of the exhaustive run itself
   other_seed.seed = 1;
-  std::vector<Method> methods = {{"exhaustive", exhaustive}, {"seed 1", other_seed}, {"localizer", localizer},
-                                 {"own", own}};
+  std::vector<Method> methods = {
+      {"exhaustive", exhaustive}, {"seed 1", other_seed}, {"localizer", localizer}, {"own", own}};
   for (const auto& [samples, points] : bounded_settings) {
     vmap::VerifierOptions bounded = localizer;  // as MapVerifierOptions makes it
     bounded.max_samples_to_reject = samples;
@@ -152,8 +152,8 @@ void Run(const std::string& set, const std::vector<PairImages>& pairs, const vma
               Percentile(tentative, 0.5), Percentile(tentative, 0.0), Percentile(tentative, 1.0));
   std::printf("XFeat CPU per image (extraction, one LibTorch thread) median %.1f ms; per pair (matching) %.1f ms\n",
               1e3 * Percentile(extract_seconds, 0.5), 1e3 * Percentile(match_seconds, 0.5));
-  std::printf("%-11s %9s %9s %9s %9s %9s %9s %13s\n", "verifier", "cpu_med_ms", "p90_ms", "max_ms", "cpu_s",
-              "accepted", "same", "|dv| median");
+  std::printf("%-11s %9s %9s %9s %9s %9s %9s %13s\n", "verifier", "cpu_med_ms", "p90_ms", "max_ms", "cpu_s", "accepted",
+              "same", "|dv| median");
   for (const Method& m : methods) {
     double total = 0;
     for (double s : m.seconds) total += s;
@@ -185,8 +185,9 @@ int main(int argc, char** argv) {
       if (colon == std::string::npos) return 2;
       bounded.emplace_back(std::stoi(setting.substr(0, colon)), std::stoi(setting.substr(colon + 1)));
     } else {
-      std::fprintf(stderr, "usage: verify_bench [--set michigan|lab_floor|both] [--every N] [--top-k K] "
-                           "[--bounded SAMPLES:POINTS ...]\n");
+      std::fprintf(stderr,
+                   "usage: verify_bench [--set michigan|lab_floor|both] [--every N] [--top-k K] "
+                   "[--bounded SAMPLES:POINTS ...]\n");
       return 2;
     }
   }

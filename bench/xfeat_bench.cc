@@ -53,8 +53,8 @@ struct Pair {
 
 void TimeImages(const std::string& weights, const std::vector<Pair>& pairs, const std::vector<int>& top_ks,
                 const std::vector<int>& thread_counts, int reps) {
-  std::printf("%-9s %7s %7s %6s %10s %10s %10s %10s %10s %8s %8s\n", "image", "threads", "top_k", "reps",
-              "extract_s", "network_s", "post_s", "upstream_s", "match_s", "kpts", "matches");
+  std::printf("%-9s %7s %7s %6s %10s %10s %10s %10s %10s %8s %8s\n", "image", "threads", "top_k", "reps", "extract_s",
+              "network_s", "post_s", "upstream_s", "match_s", "kpts", "matches");
   const auto folded = vmap::neural::LoadXfeatWeights(weights).folded;
   const vmap::neural::XfeatModel model(folded, torch::kCPU);
   for (const Pair& pair : pairs) {
@@ -68,9 +68,8 @@ void TimeImages(const std::string& weights, const std::vector<Pair>& pairs, cons
         torch::set_num_threads(threads);
         // The network alone, on the same input as Extract gives it.
         const cv::Mat& gray = pair.image0;
-        const auto input = torch::from_blob(gray.data, {1, 1, gray.rows, gray.cols}, torch::kUInt8)
-                               .to(torch::kFloat32)
-                               .div_(255.0);
+        const auto input =
+            torch::from_blob(gray.data, {1, 1, gray.rows, gray.cols}, torch::kUInt8).to(torch::kFloat32).div_(255.0);
         const auto net_input = torch::upsample_bilinear2d(input, {gray.rows / 32 * 32, gray.cols / 32 * 32}, false);
         auto f0 = matcher->Extract(pair.image0);  // warm-up
         auto f1 = matcher->Extract(pair.image1);
@@ -130,8 +129,8 @@ void TimeBuilds(const std::string& weights, const std::string& video, const std:
               options.key_images.tau, repeat);
   for (size_t m = 0; m < matchers.size(); ++m) {
     std::printf("%-20s %8.1f frames/s [%.1f-%.1f]  %zu key images\n", matchers[m].first.c_str(), Median(rates[m]),
-                *std::min_element(rates[m].begin(), rates[m].end()), *std::max_element(rates[m].begin(), rates[m].end()),
-                key_images[m]);
+                *std::min_element(rates[m].begin(), rates[m].end()),
+                *std::max_element(rates[m].begin(), rates[m].end()), key_images[m]);
   }
 }
 
@@ -143,11 +142,16 @@ int main(int argc, char** argv) {
   std::vector<int> top_ks, thread_counts;
   std::string video;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--top-k") && i + 1 < argc) top_ks.push_back(std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) thread_counts.push_back(std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--build-repeat") && i + 1 < argc) build_repeat = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) frames = std::atoi(argv[++i]);
+    if (!std::strcmp(argv[i], "--reps") && i + 1 < argc)
+      reps = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--top-k") && i + 1 < argc)
+      top_ks.push_back(std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc)
+      thread_counts.push_back(std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--build-repeat") && i + 1 < argc)
+      build_repeat = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc)
+      frames = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--build")) {
       video = (i + 1 < argc && argv[i + 1][0] != '-') ? argv[++i] : shared + "/data/lab_floor/lab_floor.mp4";
     } else {
@@ -177,7 +181,8 @@ int main(int argc, char** argv) {
   const std::string golden = shared + "/golden/xfeat/";
   const std::vector<Pair> pairs{
       {"640x480", read(golden + "rccar_000000_000006/input0.png"), read(golden + "rccar_000000_000006/input1.png")},
-      {"1226x370", read(golden + "kitti07_000010_000014/input0.png"), read(golden + "kitti07_000010_000014/input1.png")}};
+      {"1226x370", read(golden + "kitti07_000010_000014/input0.png"),
+       read(golden + "kitti07_000010_000014/input1.png")}};
   TimeImages(weights, pairs, top_ks, thread_counts, reps);
   return 0;
 }

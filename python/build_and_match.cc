@@ -10,11 +10,6 @@
 #include <pybind11/stl/filesystem.h>
 #include <spdlog/spdlog.h>
 
-#include "bindings.h"
-#include "keyword_options.h"
-#include "map_objects.h"
-#include "numpy_convert.h"
-#include "python_results.h"
 #include "vmap/cli/common_options.h"
 #include "vmap/cli/map_options.h"
 #include "vmap/core/atomic_output.h"
@@ -23,6 +18,12 @@
 #include "vmap/mapping/map_builder.h"
 #include "vmap/mapping/pair_match.h"
 #include "vmap/sources/image_frame.h"
+
+#include "bindings.h"
+#include "keyword_options.h"
+#include "map_objects.h"
+#include "numpy_convert.h"
+#include "python_results.h"
 
 namespace py = pybind11;
 
@@ -123,10 +124,9 @@ class PairMatcher {
     fields["heading_method"] = HeadingMethodName(heading.method);
     fields["heading_confidence"] = heading.confidence;
     fields["heading_votes"] = heading.votes;
-    fields["heading_options"] = py::dict(py::arg("window_px") = heading_.window_px,
-                                         py::arg("window_dy_px") = heading_.window_dy_px,
-                                         py::arg("min_votes") = heading_.min_votes,
-                                         py::arg("min_verified") = heading_.min_verified);
+    fields["heading_options"] =
+        py::dict(py::arg("window_px") = heading_.window_px, py::arg("window_dy_px") = heading_.window_dy_px,
+                 py::arg("min_votes") = heading_.min_votes, py::arg("min_verified") = heading_.min_verified);
     fields["time_s"] = py::dict(py::arg("extract") = pair.extract_seconds, py::arg("match") = pair.match_seconds,
                                 py::arg("verify") = pair.verify_seconds, py::arg("heading") = pair.heading_seconds);
     return Namespace(fields);

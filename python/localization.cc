@@ -12,11 +12,6 @@
 #include <pybind11/stl/filesystem.h>
 #include <spdlog/spdlog.h>
 
-#include "bindings.h"
-#include "keyword_options.h"
-#include "map_objects.h"
-#include "numpy_convert.h"
-#include "python_results.h"
 #include "vmap/cli/common_options.h"
 #include "vmap/cli/localize_options.h"
 #include "vmap/localization/localization_map.h"
@@ -25,6 +20,12 @@
 #include "vmap/localization/route.h"
 #include "vmap/map/map_io.h"
 #include "vmap/sources/image_frame.h"
+
+#include "bindings.h"
+#include "keyword_options.h"
+#include "map_objects.h"
+#include "numpy_convert.h"
+#include "python_results.h"
 
 namespace py = pybind11;
 

@@ -1,7 +1,5 @@
 #include "map_objects.h"
 
-#include "bindings.h"
-
 #include <cmath>
 #include <string>
 
@@ -11,11 +9,13 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
-#include "numpy_convert.h"
 #include "vmap/core/error.h"
 #include "vmap/map/map_geometry_json.h"
 #include "vmap/map/map_io.h"
 #include "vmap/mapping/recorded_options.h"
+
+#include "bindings.h"
+#include "numpy_convert.h"
 
 namespace py = pybind11;
 
@@ -84,8 +84,7 @@ void BindMapObjects(py::module_& m) {
       .def_property_readonly("index", [](const KeyImageRef& k) { return k.index; })
       .def_property_readonly("frame_index", [](const KeyImageRef& k) { return k.key().frame_index; })
       .def_property_readonly("source_index", [](const KeyImageRef& k) { return k.key().source_index; })
-      .def_property_readonly("timestamp",
-                             [](const KeyImageRef& k) { return NoneIfNegative(k.key().timestamp); })
+      .def_property_readonly("timestamp", [](const KeyImageRef& k) { return NoneIfNegative(k.key().timestamp); })
       .def_property_readonly("source_name", [](const KeyImageRef& k) { return k.key().source_name; })
       .def_property_readonly("image_file", [](const KeyImageRef& k) { return k.key().image_file; })
       .def_property_readonly("num_features", [](const KeyImageRef& k) { return k.key().num_features; })
@@ -104,8 +103,8 @@ void BindMapObjects(py::module_& m) {
       .def_property_readonly("index", [](const LinkRef& l) { return l.index; })
       .def_property_readonly("from_key", [](const LinkRef& l) { return l.link().from_key; })
       .def_property_readonly("to_key", [](const LinkRef& l) { return l.link().to_key; })
-      .def_property_readonly("from_frame",
-                             [](const LinkRef& l) { return l.handle->map.key_images.at(l.link().from_key).frame_index; })
+      .def_property_readonly(
+          "from_frame", [](const LinkRef& l) { return l.handle->map.key_images.at(l.link().from_key).frame_index; })
       .def_property_readonly("to_frame",
                              [](const LinkRef& l) { return l.handle->map.key_images.at(l.link().to_key).frame_index; })
       .def_property_readonly("below_tau", [](const LinkRef& l) { return l.link().below_tau; })
@@ -114,11 +113,13 @@ void BindMapObjects(py::module_& m) {
       .def_property_readonly("verified", [](const LinkRef& l) { return l.link().num_verified; })
       .def_property_readonly("num_tentative", [](const LinkRef& l) { return l.link().num_tentative; })
       .def_property_readonly("num_verified", [](const LinkRef& l) { return l.link().num_verified; })
-      .def_property_readonly("F", [](const LinkRef& l) { return MatrixArray(l.link().F, l.link().has_fundamental); },
-                             "3x3: x_to^T F x_from = 0 in pixels; None when matching failed")
+      .def_property_readonly(
+          "F", [](const LinkRef& l) { return MatrixArray(l.link().F, l.link().has_fundamental); },
+          "3x3: x_to^T F x_from = 0 in pixels; None when matching failed")
       .def_property_readonly("has_pose", [](const LinkRef& l) { return l.link().has_pose; })
-      .def_property_readonly("R", [](const LinkRef& l) { return MatrixArray(l.link().R, l.link().has_pose); },
-                             "X_to = R X_from + t (with the map's camera); None without")
+      .def_property_readonly(
+          "R", [](const LinkRef& l) { return MatrixArray(l.link().R, l.link().has_pose); },
+          "X_to = R X_from + t (with the map's camera); None without")
       .def_property_readonly("t", [](const LinkRef& l) { return VectorArray(l.link().t, l.link().has_pose); })
       .def_property_readonly("pose_inliers", [](const LinkRef& l) { return l.link().pose_inliers; })
       .def_property_readonly("parallax", [](const LinkRef& l) { return NoneIfNegative(l.link().parallax); })
@@ -127,10 +128,12 @@ void BindMapObjects(py::module_& m) {
       .def_property_readonly("homography_share",
                              [](const LinkRef& l) { return NoneIfNegative(l.link().homography_share); })
       .def_property_readonly("planar", [](const LinkRef& l) { return l.link().planar; })
-      .def_property_readonly("correspondences", [](const LinkRef& l) { return CorrespondenceArray(l.link()); },
-                             "N x 4 float32 (x0 y0 x1 y1), the verified ones first")
-      .def_property_readonly("inliers", [](const LinkRef& l) { return InlierMask(l.link()); },
-                             "N bools: the correspondence is an inlier of F")
+      .def_property_readonly(
+          "correspondences", [](const LinkRef& l) { return CorrespondenceArray(l.link()); },
+          "N x 4 float32 (x0 y0 x1 y1), the verified ones first")
+      .def_property_readonly(
+          "inliers", [](const LinkRef& l) { return InlierMask(l.link()); },
+          "N bools: the correspondence is an inlier of F")
       .def("__repr__", [](const LinkRef& l) {
         return fmt::format("<vmap.Link {} -> {}: S {:.3f}, {} / {} verified{}>", l.link().from_key, l.link().to_key,
                            l.link().similarity, l.link().num_verified, l.link().num_tentative,
@@ -151,20 +154,24 @@ void BindMapObjects(py::module_& m) {
                                for (size_t i = 0; i < h->map.links.size(); ++i) links.push_back({h, int(i)});
                                return links;
                              })
-      .def_property_readonly("quality", [](const MapHandle& h) { return h.map.quality; }, "Q of the paper")
+      .def_property_readonly(
+          "quality", [](const MapHandle& h) { return h.map.quality; }, "Q of the paper")
       .def_property_readonly("num_frames", [](const MapHandle& h) { return h.map.num_frames; })
       .def_property_readonly("skipped_frames", [](const MapHandle& h) { return h.map.skipped_frames; })
       .def_property_readonly("seconds", [](const MapHandle& h) { return h.map.seconds; })
-      .def_property_readonly("input", [](const MapHandle& h) { return JsonToPython(MapToJson(h.map))["input"]; },
-                             "map.json's input: path, format, native_size, frame_size, fps, camera")
-      .def_property_readonly("camera",
-                             [](const MapHandle& h) -> py::object {
-                               if (!h.map.input.camera) return py::none();
-                               return JsonToPython(CameraToJson(*h.map.input.camera).dump());
-                             },
-                             "The input's intrinsics as map.json records them; None without")
-      .def_property_readonly("options", [](const MapHandle& h) { return JsonToPython(h.map.options_json); },
-                             "Every option that shaped the map, as map.json records them")
+      .def_property_readonly(
+          "input", [](const MapHandle& h) { return JsonToPython(MapToJson(h.map))["input"]; },
+          "map.json's input: path, format, native_size, frame_size, fps, camera")
+      .def_property_readonly(
+          "camera",
+          [](const MapHandle& h) -> py::object {
+            if (!h.map.input.camera) return py::none();
+            return JsonToPython(CameraToJson(*h.map.input.camera).dump());
+          },
+          "The input's intrinsics as map.json records them; None without")
+      .def_property_readonly(
+          "options", [](const MapHandle& h) { return JsonToPython(h.map.options_json); },
+          "Every option that shaped the map, as map.json records them")
       .def_property_readonly("statistics",
                              [](const MapHandle& h) {
                                const MapStatistics s = ComputeStatistics(h.map, h.options.builder.quality_mean);
@@ -175,16 +182,17 @@ void BindMapObjects(py::module_& m) {
                                d["quality"] = s.quality, d["below_tau_links"] = s.below_tau_links;
                                return d;
                              })
-      .def_property_readonly("json", [](const MapHandle& h) { return JsonToPython(MapToJson(h.map)); },
-                             "The whole map.json document as a dict")
+      .def_property_readonly(
+          "json", [](const MapHandle& h) { return JsonToPython(MapToJson(h.map)); },
+          "The whole map.json document as a dict")
       .def("__repr__", [](const MapHandle& h) {
         return fmt::format("<vmap.Map '{}': {} frames, {} key images, Q {:.4f}>", h.directory.string(),
                            h.map.num_frames, h.map.key_images.size(), h.map.quality);
       });
 
   m.def(
-      "read_map", [](const std::filesystem::path& directory) { return ReadMapHandle(directory); },
-      py::arg("directory"), "Reads a map directory written by `vmap build` (or vmap.build_map).");
+      "read_map", [](const std::filesystem::path& directory) { return ReadMapHandle(directory); }, py::arg("directory"),
+      "Reads a map directory written by `vmap build` (or vmap.build_map).");
 }
 
 }  // namespace vmap::python

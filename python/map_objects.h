@@ -25,5 +25,4 @@ std::shared_ptr<MapHandle> ReadMapHandle(const std::filesystem::path& directory)
 // The map directory a Python argument names: a vmap.Map or a path.
 std::filesystem::path MapDirectory(const pybind11::object& map_or_path);
 
-
 }  // namespace vmap::python

@@ -6,12 +6,18 @@ namespace vmap::python {
 
 py::object JsonToPython(const nlohmann::json& value) {
   switch (value.type()) {
-    case nlohmann::json::value_t::null: return py::none();
-    case nlohmann::json::value_t::boolean: return py::bool_(value.get<bool>());
-    case nlohmann::json::value_t::number_integer: return py::int_(value.get<long long>());
-    case nlohmann::json::value_t::number_unsigned: return py::int_(value.get<unsigned long long>());
-    case nlohmann::json::value_t::number_float: return py::float_(value.get<double>());
-    case nlohmann::json::value_t::string: return py::str(value.get_ref<const std::string&>());
+    case nlohmann::json::value_t::null:
+      return py::none();
+    case nlohmann::json::value_t::boolean:
+      return py::bool_(value.get<bool>());
+    case nlohmann::json::value_t::number_integer:
+      return py::int_(value.get<long long>());
+    case nlohmann::json::value_t::number_unsigned:
+      return py::int_(value.get<unsigned long long>());
+    case nlohmann::json::value_t::number_float:
+      return py::float_(value.get<double>());
+    case nlohmann::json::value_t::string:
+      return py::str(value.get_ref<const std::string&>());
     case nlohmann::json::value_t::array: {
       py::list list;
       for (const auto& item : value) list.append(JsonToPython(item));
@@ -22,13 +28,12 @@ py::object JsonToPython(const nlohmann::json& value) {
       for (const auto& [key, item] : value.items()) dict[py::str(key)] = JsonToPython(item);
       return std::move(dict);
     }
-    default: return py::none();  // binary and discarded values never occur in vmap's records
+    default:
+      return py::none();  // binary and discarded values never occur in vmap's records
   }
 }
 
-py::object Namespace(const py::dict& fields) {
-  return py::module_::import("types").attr("SimpleNamespace")(**fields);
-}
+py::object Namespace(const py::dict& fields) { return py::module_::import("types").attr("SimpleNamespace")(**fields); }
 
 void RaisePendingSignals() {
   py::gil_scoped_acquire acquire;

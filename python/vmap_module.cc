@@ -7,11 +7,12 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include "bindings.h"
 #include "vmap/core/error.h"
 #include "vmap/core/logging.h"
 #include "vmap/core/runtime.h"
 #include "vmap/features/matcher_registry.h"
+
+#include "bindings.h"
 
 namespace py = pybind11;
 
@@ -46,8 +47,7 @@ PYBIND11_MODULE(vmap, m) {
         options.Check();
         vmap::InitializeRuntime(options);
       },
-      py::kw_only(), py::arg("opencv_threads") = 1, py::arg("keep_freed_memory") = true,
-      py::arg("quiet_ffmpeg") = true,
+      py::kw_only(), py::arg("opencv_threads") = 1, py::arg("keep_freed_memory") = true, py::arg("quiet_ffmpeg") = true,
       "Opt-in: the process-wide settings the vmap CLI makes at start (core/runtime.h: OpenCV's threads, malloc "
       "keeping freed memory, FFmpeg's log), for timings equal to the CLI's. Python keeps its own signal handling.");
   m.def(

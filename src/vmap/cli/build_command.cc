@@ -17,11 +17,11 @@
 #include "vmap/core/interrupt.h"
 #include "vmap/features/matcher_options_json.h"
 #include "vmap/localization/add_experience.h"
-#include "vmap/mapping/recorded_options.h"
-#include "vmap/mapping/batch_build.h"
-#include "vmap/mapping/map_builder.h"
 #include "vmap/map/map_io.h"
 #include "vmap/map/map_writer.h"
+#include "vmap/mapping/batch_build.h"
+#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/recorded_options.h"
 #include "vmap/report/summary.h"
 #include "vmap/sources/read_ahead_source.h"
 
@@ -88,14 +88,15 @@ void RunAddExperience(const BuildFlags& flags) {
     throw InputError("--add-experience-to adds to the map it names; drop -o " + flags.output);
   }
   if (flags.snapshot_every > 0 || flags.until_interrupted || flags.report) {
-    throw InputError("--add-experience-to takes a whole recorded run; drop --snapshot-every, --until-interrupted "
-                     "and --report");
+    throw InputError(
+        "--add-experience-to takes a whole recorded run; drop --snapshot-every, --until-interrupted "
+        "and --report");
   }
   const VisualMap header = ReadMap(flags.add_experience_to);
   const std::string map_file = (fs::path(flags.add_experience_to) / kMapFileName).string();
   const std::string map_matcher =
-      MatcherOptionsFromJson(RecordedOptionsFromJson(header.options_json, "map '" + map_file + "': options").matcher_json,
-                             map_file)
+      MatcherOptionsFromJson(
+          RecordedOptionsFromJson(header.options_json, "map '" + map_file + "': options").matcher_json, map_file)
           .type;
   if (flags.matcher_given && flags.matcher.type != map_matcher) {
     throw InputError("the map '" + flags.add_experience_to + "' was built with --matcher " + map_matcher +
@@ -115,8 +116,9 @@ void RunAddExperience(const BuildFlags& flags) {
 void RunBuild(const BuildFlags& flags) {
   if (!flags.add_experience_to.empty()) return RunAddExperience(flags);
   if (flags.acceptance_given) {
-    throw InputError("--acceptance, --max-log10-nfa, --min-verified and --min-similarity say when a repeat run's "
-                     "frames localize; they go with --add-experience-to MAP");
+    throw InputError(
+        "--acceptance, --max-log10-nfa, --min-verified and --min-similarity say when a repeat run's "
+        "frames localize; they go with --add-experience-to MAP");
   }
   FrameSourceOptions source_options = flags.source.Resolve();
   MapBuilderOptions options = flags.key_images.Resolve(flags.matcher.type);
@@ -129,8 +131,9 @@ void RunBuild(const BuildFlags& flags) {
   }
   const bool streaming = flags.snapshot_every > 0 || flags.until_interrupted;
   if (streaming && ResolveKeySearch(options) == KeySearch::kBisect) {
-    throw InputError("--snapshot-every and --until-interrupted build the map frame by frame, and --search bisect "
-                     "reads ahead; drop --search bisect");
+    throw InputError(
+        "--snapshot-every and --until-interrupted build the map frame by frame, and --search bisect "
+        "reads ahead; drop --search bisect");
   }
   const fs::path output = flags.output.empty() ? fs::path(fs::path(flags.input).filename().stem().string() + "_map")
                                                : fs::path(flags.output);
@@ -176,11 +179,12 @@ void AddBuildCommand(CLI::App& app) {
   // When a frame of the repeat run is seen at a key image, as `vmap localize` decides it (localize.md).
   LocalizerOptions& localizer = flags->experience.localizer;
   flags->option_flags
-      .Record("acceptance", command->add_option_function<std::string>(
-                                "--acceptance",
-                                [&localizer](const std::string& rule) { localizer.acceptance = ParseAcceptanceRule(rule); },
-                                "--add-experience-to: when a repeat frame is seen at a key image, as vmap localize "
-                                "decides it: chance or counts"))
+      .Record("acceptance",
+              command->add_option_function<std::string>(
+                  "--acceptance",
+                  [&localizer](const std::string& rule) { localizer.acceptance = ParseAcceptanceRule(rule); },
+                  "--add-experience-to: when a repeat frame is seen at a key image, as vmap localize "
+                  "decides it: chance or counts"))
       ->default_str(AcceptanceRuleName(localizer.acceptance));
   flags->option_flags
       .AddOption(command, "--max-log10-nfa", localizer.max_log10_nfa, "max_log10_nfa",

@@ -37,10 +37,10 @@ TEST(Cli, BuildsAndReadsBackAMapFromAVideo) {
   testing::ScopedTempDir tmp;
   std::string out;
   const fs::path map_dir = tmp.path() / "map";
-  ASSERT_EQ(RunVmap("build " + Quote(Shared() / "data/lab_floor/lab_floor.mp4") + " -o " + Quote(map_dir) +
-                        " --last 239",
-                    &out),
-            0)
+  ASSERT_EQ(
+      RunVmap("build " + Quote(Shared() / "data/lab_floor/lab_floor.mp4") + " -o " + Quote(map_dir) + " --last 239",
+              &out),
+      0)
       << out;
   EXPECT_NE(out.find("frames (n)      240"), std::string::npos) << out;
   const VisualMap map = ReadMap(map_dir);
@@ -71,8 +71,7 @@ TEST(Cli, EveryDatasetLayoutBuilds) {
                         Case{"data/kitti07", "", 160}}) {
     testing::ScopedTempDir tmp;
     std::string out;
-    ASSERT_EQ(RunVmap("build " + Quote(Shared() / c.input) + " -o " + Quote(tmp.path() / "m") + " " + c.extra, &out),
-              0)
+    ASSERT_EQ(RunVmap("build " + Quote(Shared() / c.input) + " -o " + Quote(tmp.path() / "m") + " " + c.extra, &out), 0)
         << c.input << "\n"
         << out;
     const VisualMap map = ReadMap(tmp.path() / "m");
@@ -262,8 +261,7 @@ TEST(Cli, OptionErrorsNameTheFlagsThatSetTheFields) {
       {build + "--xfeat-top-k 0", "vmap: error: --xfeat-top-k 0 must be at least 1 (upstream default 4096)\n"},
       {build + "--aliked-top-k -1",
        "vmap: error: --aliked-top-k must be >= 0 (0 = threshold mode with --aliked-score-threshold; default 1000)\n"},
-      {"match " + Quote(tmp.path() / "in/frame_0.png") + " " + Quote(tmp.path() / "in/frame_1.png") +
-           " --confidence 2",
+      {"match " + Quote(tmp.path() / "in/frame_0.png") + " " + Quote(tmp.path() / "in/frame_1.png") + " --confidence 2",
        "vmap: error: --confidence must be in (0, 1) (default 0.999)\n"},
   };
   for (const Case& c : cases) {

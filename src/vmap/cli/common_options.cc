@@ -23,8 +23,7 @@ VerifierOptions VerifierFlags::Resolve() const {
   return resolved;
 }
 
-void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& option_flags,
-                        bool with_early_stop) {
+void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& option_flags, bool with_early_stop) {
   Nesting nesting;
   if (!with_early_stop) nesting.skip = {"max_samples_to_reject"};
   AddOptionFlags(command, flags.options, option_flags, "verifier", nesting);

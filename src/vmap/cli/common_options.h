@@ -28,8 +28,8 @@ struct VerifierFlags {
 void AddVerifierOptions(CLI::App* command, VerifierFlags& flags, OptionFlags& option_flags,
                         bool with_early_stop = true);
 
-// --heading-window, --heading-window-dy, --heading-min-votes, --heading-min-verified; fields as "heading.<field>" (MatchFlags,
-// LocalizerOptions).
+// --heading-window, --heading-window-dy, --heading-min-votes, --heading-min-verified; fields as "heading.<field>"
+// (MatchFlags, LocalizerOptions).
 void AddHeadingOptions(CLI::App* command, HeadingOptions& options, OptionFlags& option_flags);
 
 // --format, --first, --last, --stride, --resize, --strict, --camera, --topic, --camera-topic, --stream-timeout;

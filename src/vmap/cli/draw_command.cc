@@ -50,8 +50,8 @@ void RunDraw(const DrawFlags& flags) {
   options.caption = !flags.no_caption;
   const cv::Mat figure = DrawMapLink(flags.map_directory, map, flags.link, options);
   std::vector<uchar> encoded;
-  const std::vector<int> parameters =
-      extension == ".png" ? std::vector<int>{cv::IMWRITE_PNG_COMPRESSION, 6} : std::vector<int>{cv::IMWRITE_JPEG_QUALITY, 92};
+  const std::vector<int> parameters = extension == ".png" ? std::vector<int>{cv::IMWRITE_PNG_COMPRESSION, 6}
+                                                          : std::vector<int>{cv::IMWRITE_JPEG_QUALITY, 92};
   if (!cv::imencode(extension, figure, encoded, parameters)) {
     throw InputError("cannot encode the figure as '" + extension + "'");
   }

@@ -152,8 +152,8 @@ TEST(EvalCli, CameraOptionAndMissingGroundTruthOrIntrinsics) {
   // An OpenCV calibration file as --camera at build time: the map carries the camera and poses.
   {
     cv::FileStorage fs((tmp.path() / "camera.yaml").string(), cv::FileStorage::WRITE);
-    fs << "image_width" << 320 << "image_height" << 240 << "camera_matrix" << cv::Mat(K)
-       << "distortion_coefficients" << cv::Mat::zeros(5, 1, CV_64F);
+    fs << "image_width" << 320 << "image_height" << 240 << "camera_matrix" << cv::Mat(K) << "distortion_coefficients"
+       << cv::Mat::zeros(5, 1, CV_64F);
   }
   ASSERT_EQ(RunVmap("build " + Quote(tmp.path() / "frames") + " -q --camera " + Quote(tmp.path() / "camera.yaml") +
                         " -o " + Quote(tmp.path() / "posed"),
@@ -169,9 +169,11 @@ TEST(EvalCli, CameraOptionAndMissingGroundTruthOrIntrinsics) {
   EXPECT_EQ(options["source"]["camera"], (tmp.path() / "camera.yaml").string());
 
   // Bad values are refused with the option's name.
-  EXPECT_EQ(RunVmap("build " + Quote(tmp.path() / "frames") + " -q --camera 1,2,3 -o " + Quote(tmp.path() / "x"), &out), 2);
+  EXPECT_EQ(RunVmap("build " + Quote(tmp.path() / "frames") + " -q --camera 1,2,3 -o " + Quote(tmp.path() / "x"), &out),
+            2);
   EXPECT_NE(out.find("--camera"), std::string::npos) << out;
-  EXPECT_EQ(RunVmap("build " + Quote(tmp.path() / "frames") + " -q --pose magic -o " + Quote(tmp.path() / "x"), &out), 2);
+  EXPECT_EQ(RunVmap("build " + Quote(tmp.path() / "frames") + " -q --pose magic -o " + Quote(tmp.path() / "x"), &out),
+            2);
   EXPECT_NE(out.find("pose method"), std::string::npos) << out;
   EXPECT_EQ(RunVmap("eval " + Quote(tmp.path() / "posed") + " --gt " + poses + " --min-parallax -3", &out), 2);
   EXPECT_NE(out.find("--min-parallax"), std::string::npos) << out;

@@ -35,10 +35,10 @@ struct EvalFlags {
 
 void RunEval(const EvalFlags& flags) {
   flags.options.Check();
-  CheckOutputs({{flags.json, "--json"}},
-               {MapInputs(flags.map), NamedInput(flags.gt, "the ground truth"),
-                fs::is_regular_file(flags.camera) ? NamedInput(flags.camera, "the --camera file")
-                                                  : std::vector<OutputInput>{}});
+  CheckOutputs(
+      {{flags.json, "--json"}},
+      {MapInputs(flags.map), NamedInput(flags.gt, "the ground truth"),
+       fs::is_regular_file(flags.camera) ? NamedInput(flags.camera, "the --camera file") : std::vector<OutputInput>{}});
   ParseEvaluationCamera(flags.camera);  // a wrong --camera is refused first, even where the map's camera is used
   const VisualMap map = ReadMap(flags.map);
   const GroundTruth truth = MapGroundTruth(map, flags.gt, ParseGroundTruthFormat(flags.gt_format));
@@ -53,7 +53,7 @@ void RunEval(const EvalFlags& flags) {
                      (truth.format == GroundTruthFormat::kKitti ? "" : " and check that the timestamps match"));
   }
   if (evaluation.summary.evaluated_links < evaluation.summary.links) {
-    spdlog::warn("the ground truth covers {} of the map's {} links; the others are left out", 
+    spdlog::warn("the ground truth covers {} of the map's {} links; the others are left out",
                  evaluation.summary.evaluated_links, evaluation.summary.links);
   }
   const std::string json = EvaluationToJson(evaluation);
@@ -80,8 +80,9 @@ void AddEvalCommand(CLI::App& app) {
       .AddOption(command, "--gt-format", flags->gt_format, "gt.format",
                  "Format of --gt: " + ListEnumNames(kGroundTruthFormatNames) + " (auto: from its first line)")
       ->capture_default_str();
-  option_flags.AddOption(command, "--camera", flags->camera, "camera",
-                         "Intrinsics when the map has none: fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]] or a calibration file");
+  option_flags.AddOption(
+      command, "--camera", flags->camera, "camera",
+      "Intrinsics when the map has none: fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]] or a calibration file");
   command->add_option("--json", flags->json, "Also write the evaluation (JSON) to this file");
   command->add_flag("!--no-save", flags->save, "Do not write eval.json into the map directory");
   command->add_flag("!--no-table", flags->table, "Print only the summary, not one row per link");

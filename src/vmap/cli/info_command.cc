@@ -16,8 +16,10 @@ void AddInfoCommand(CLI::App& app) {
   auto directory = std::make_shared<std::string>();
   CLI::App* command = app.add_subcommand(
       "info", "Print the summary of a map (and check that it is well formed), or the topics of a recording");
-  command->add_option("map", *directory, "Map directory written by `vmap build`, or a recording (ROS bag, rosbag2 "
-                                          "folder, MCAP file): its topics with type, count, rate and image size")
+  command
+      ->add_option("map", *directory,
+                   "Map directory written by `vmap build`, or a recording (ROS bag, rosbag2 "
+                   "folder, MCAP file): its topics with type, count, rate and image size")
       ->required();
   command->callback([directory] {
     if (IsRecording(*directory)) {

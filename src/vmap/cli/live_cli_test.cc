@@ -37,8 +37,8 @@ namespace {
 
 bool HaveFfmpeg() { return std::system("command -v ffmpeg > /dev/null 2>&1") == 0; }
 
-#define REQUIRE_SHARED_AND_FFMPEG()                                                          \
-  if (testing::SharedDir().empty()) GTEST_SKIP() << "../shared is not present";             \
+#define REQUIRE_SHARED_AND_FFMPEG()                                             \
+  if (testing::SharedDir().empty()) GTEST_SKIP() << "../shared is not present"; \
   if (!HaveFfmpeg()) GTEST_SKIP() << "the ffmpeg CLI is not installed (scripts/install-deps.sh)"
 
 // A child process with its output in `log`, ended (SIGKILL) if a test leaves it running.
@@ -150,8 +150,8 @@ struct LiveRun {
   std::unique_ptr<Child> sender;
 
   void Start(const std::vector<std::string>& flags, double seconds) {
-    std::vector<std::string> arguments = {testing::VmapBinary().string(), "build", fmt::format("tcp://127.0.0.1:{}?listen=1", port),
-                                          "-o", output.string()};
+    std::vector<std::string> arguments = {testing::VmapBinary().string(), "build",
+                                          fmt::format("tcp://127.0.0.1:{}?listen=1", port), "-o", output.string()};
     arguments.insert(arguments.end(), flags.begin(), flags.end());
     vmap = std::make_unique<Child>(arguments, tmp.path() / "vmap.log");
     ASSERT_TRUE(vmap->started());
@@ -160,8 +160,8 @@ struct LiveRun {
     const std::string video = (fs::path(testing::SharedDir()) / "data/lab_floor/lab_floor.mp4").string();
     sender = std::make_unique<Child>(
         std::vector<std::string>{"ffmpeg", "-nostdin", "-loglevel", "error", "-re", "-i", video, "-t",
-                                 fmt::format("{}", seconds), "-an", "-c:v", "mpeg2video", "-q:v", "4", "-g", "10",
-                                 "-f", "mpegts", fmt::format("tcp://127.0.0.1:{}", port)},
+                                 fmt::format("{}", seconds), "-an", "-c:v", "mpeg2video", "-q:v", "4", "-g", "10", "-f",
+                                 "mpegts", fmt::format("tcp://127.0.0.1:{}", port)},
         tmp.path() / "ffmpeg.log");
     ASSERT_TRUE(sender->started());
   }
@@ -254,9 +254,9 @@ TEST(LiveCli, AStreamThatNeverStartsIsAnInputError) {
   // Nothing listens on this port: the connection is refused at once.
   std::string out;
   testing::ScopedTempDir tmp;
-  EXPECT_EQ(testing::RunVmap(fmt::format("build tcp://127.0.0.1:{} -o '{}'", FreePort(), (tmp.path() / "m").string()),
-                             &out),
-            2)
+  EXPECT_EQ(
+      testing::RunVmap(fmt::format("build tcp://127.0.0.1:{} -o '{}'", FreePort(), (tmp.path() / "m").string()), &out),
+      2)
       << out;
   EXPECT_NE(out.find("cannot open stream 'tcp://127.0.0.1:"), std::string::npos) << out;
   EXPECT_FALSE(fs::exists(tmp.path() / "m"));

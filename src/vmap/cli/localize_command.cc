@@ -40,22 +40,21 @@ struct LocalizeFlags : LocalizerFlags {
   OptionFlags option_flags;
 };
 
-std::string Percent(long part, long whole) {
-  return whole > 0 ? fmt::format("{:.1f}%", 100.0 * part / whole) : "-";
-}
+std::string Percent(long part, long whole) { return whole > 0 ? fmt::format("{:.1f}%", 100.0 * part / whole) : "-"; }
 
 void RunLocalize(const LocalizeFlags& flags) {
   LocalizationSetup setup = SetUpLocalization(flags, flags.source.Resolve(), flags.map, flags.query, [&] {
-    CheckOutputs({{flags.csv, "--csv"}, {flags.json, "--json"}},
-                 {MapInputs(flags.map), NamedInput(flags.query, "the query"),
-                  NamedInput(flags.report, "the --report folder")});
+    CheckOutputs(
+        {{flags.csv, "--csv"}, {flags.json, "--json"}},
+        {MapInputs(flags.map), NamedInput(flags.query, "the query"), NamedInput(flags.report, "the --report folder")});
     if (!flags.report.empty()) CheckLocalizationReportDirectory(flags.report, flags.map, flags.query);
     // A FIFO or a device other than a camera would be opened blocking, waiting for a writer that may never come.
     std::error_code ec;
     const fs::file_status query_status = fs::status(flags.query, ec);
     if (!IsLiveInput(flags.query) && fs::exists(query_status) && !fs::is_regular_file(query_status) &&
         !fs::is_directory(query_status)) {
-      throw InputError("query '" + flags.query + "' is neither a file nor a folder (a FIFO or a device); give a "
+      throw InputError("query '" + flags.query +
+                       "' is neither a file nor a folder (a FIFO or a device); give a "
                        "video, an image folder, a TUM/EuRoC/KITTI sequence, an image, or a live input (udp://..., "
                        "/dev/videoN)");
     }
@@ -106,8 +105,8 @@ void RunLocalize(const LocalizeFlags& flags) {
   std::cout << fmt::format("map             {} ({} key images, {})\n", flags.map, map.key_images.size(),
                            opened.matcher->name())
             << fmt::format("query           {} ({})\n", flags.query, SourceFormatName(run.info.query_format))
-            << fmt::format("key images      {:.2f} s (cache: {}), ranking by {}\n", opened.keys.seconds,
-                           run.info.cache, run.info.ranking)
+            << fmt::format("key images      {:.2f} s (cache: {}), ranking by {}\n", opened.keys.seconds, run.info.cache,
+                           run.info.ranking)
             << fmt::format("frames          {}\n", s.frames)
             << fmt::format("tracking        {} ({})\n", s.tracking, Percent(s.tracking, s.frames))
             << fmt::format("relocalized     {} ({})\n", s.relocalized, Percent(s.relocalized, s.frames))
@@ -128,7 +127,8 @@ void RunLocalize(const LocalizeFlags& flags) {
   }
   if (!flags.csv.empty()) std::cout << "csv             " << flags.csv << "\n";
   if (!flags.json.empty()) std::cout << "json            " << flags.json << "\n";
-  if (!flags.report.empty()) std::cout << "report          " << (fs::path(flags.report) / "report.html").string() << "\n";
+  if (!flags.report.empty())
+    std::cout << "report          " << (fs::path(flags.report) / "report.html").string() << "\n";
 }
 
 }  // namespace

@@ -33,9 +33,10 @@ void AddLocalizerOptions(CLI::App* command, LocalizerFlags& flags, OptionFlags& 
 void CheckLocalizerFlags(const LocalizerFlags& flags) {
   for (const CLI::Option* flag : flags.counts_flags) {
     if (flag->count() > 0 && flags.localizer.acceptance != AcceptanceRule::kCounts) {
-      throw InputError(fmt::format("{} belongs to the earlier acceptance rule; add --acceptance counts to use it, "
-                                   "or leave it out (--acceptance chance decides by --max-log10-nfa)",
-                                   flag->get_name()));
+      throw InputError(
+          fmt::format("{} belongs to the earlier acceptance rule; add --acceptance counts to use it, "
+                      "or leave it out (--acceptance chance decides by --max-log10-nfa)",
+                      flag->get_name()));
     }
   }
   for (const CLI::Option* flag : flags.chance_flags) {

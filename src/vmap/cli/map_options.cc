@@ -42,7 +42,8 @@ void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, OptionFlags& op
                         command->add_option_function<double>(
                             "-t,--tau", [&flags](double tau) { flags.tau = tau; },
                             "Similarity threshold tau in (0, 1]: lower keeps fewer key images (default: the "
-                            "matcher's, " + DefaultTaus() + ")"));
+                            "matcher's, " +
+                                DefaultTaus() + ")"));
   }
   // The verifier's flags are bound by AddVerifierOptions, onto the command's VerifierFlags.
   AddOptionFlags(command, flags.options, option_flags, "", Nesting{false, {"verifier"}});

@@ -27,8 +27,7 @@ struct KeyImageFlags {
 void AddKeyImageOptions(CLI::App* command, KeyImageFlags& flags, OptionFlags& option_flags, bool with_tau = true);
 
 // Every option that shaped a map, as JSON text for map.json.
-std::string DescribeOptions(const Matcher& matcher, const MapBuilderOptions& options,
-                            const FrameSourceOptions& source);
+std::string DescribeOptions(const Matcher& matcher, const MapBuilderOptions& options, const FrameSourceOptions& source);
 
 // Writes report.html into a map directory when asked (and when this vmap has the report stage).
 void WriteReportIfAsked(bool asked, const std::filesystem::path& map_directory);

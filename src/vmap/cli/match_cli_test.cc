@@ -26,8 +26,7 @@ void WriteShiftedPair(const fs::path& directory, double shift) {
       cv::imread(testing::SharedDir() + "/data/michigan_seasons/images/0103.png", cv::IMREAD_GRAYSCALE);
   ASSERT_FALSE(image.empty());
   cv::Mat shifted;
-  cv::warpAffine(image, shifted, cv::Matx23d(1, 0, shift, 0, 1, 0), image.size(), cv::INTER_LINEAR,
-                 cv::BORDER_REFLECT);
+  cv::warpAffine(image, shifted, cv::Matx23d(1, 0, shift, 0, 1, 0), image.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
   shifted.convertTo(shifted, CV_8U, 0.7, 20.0);
   cv::imwrite((directory / "a.png").string(), image);
   cv::imwrite((directory / "b.png").string(), shifted);
@@ -59,8 +58,7 @@ TEST(MatchCli, ReportsTheHeadingInPixelsAndWithACameraInDegrees) {
   // The other way round the scene moves the other way.
   const std::string reversed = "match " + Quote(tmp.path() / "b.png") + " " + Quote(tmp.path() / "a.png");
   const double fx = 800.0;
-  ASSERT_EQ(RunVmap(reversed + " --camera 800,800,511.5,191.5 --json " + Quote(tmp.path() / "r.json"), &out), 0)
-      << out;
+  ASSERT_EQ(RunVmap(reversed + " --camera 800,800,511.5,191.5 --json " + Quote(tmp.path() / "r.json"), &out), 0) << out;
   EXPECT_NE(out.find(" deg"), std::string::npos) << out;
   json = nlohmann::json::parse(std::ifstream(tmp.path() / "r.json"));
   EXPECT_NEAR(json["heading_px"].get<double>(), -shift, 1.5);
@@ -73,8 +71,8 @@ TEST(MatchCli, HeadingOptionErrorsNameTheirFlags) {
   testing::ScopedTempDir tmp;
   WriteShiftedPair(tmp.path(), 10.0);
   const std::string pair = "match " + Quote(tmp.path() / "a.png") + " " + Quote(tmp.path() / "b.png");
-  for (const std::string flag : {"--heading-window 0", "--heading-window-dy -1", "--heading-min-votes 0",
-                                "--heading-min-verified -1"}) {
+  for (const std::string flag :
+       {"--heading-window 0", "--heading-window-dy -1", "--heading-min-votes 0", "--heading-min-verified -1"}) {
     std::string out;
     EXPECT_EQ(RunVmap(pair + " " + flag, &out), 2) << flag << "\n" << out;
     EXPECT_EQ(out.rfind("vmap: error: " + flag.substr(0, flag.find(' ')) + " ", 0), 0u) << out;

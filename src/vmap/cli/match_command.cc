@@ -10,7 +10,6 @@
 #include <optional>
 
 #include <fmt/format.h>
-
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -21,10 +20,10 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/core/file_name_encoding.h"
+#include "vmap/core/image_header.h"
 #include "vmap/geometry/heading.h"
 #include "vmap/mapping/pair_match.h"
 #include "vmap/sources/dataset_camera.h"
-#include "vmap/core/image_header.h"
 
 namespace vmap::cli {
 
@@ -141,8 +140,8 @@ void RunMatch(const MatchFlags& flags) {
   }
   if (heading.valid()) {
     std::printf("heading     %.1f px%s (%s: %d of %d matches, confidence %.3f)\n", heading.px,
-                camera ? fmt::format(", {:.3f} deg", heading.deg).c_str() : "", HeadingMethodName(heading.method).c_str(),
-                heading.votes, heading.num_voters, heading.confidence);
+                camera ? fmt::format(", {:.3f} deg", heading.deg).c_str() : "",
+                HeadingMethodName(heading.method).c_str(), heading.votes, heading.num_voters, heading.confidence);
   } else {
     std::printf("heading     none (fewer than %d matches agree)\n", flags.heading.min_votes);
   }
@@ -193,11 +192,11 @@ void RunMatch(const MatchFlags& flags) {
     j["heading_confidence"] = heading.confidence;
     j["heading_votes"] = heading.votes;
     j["heading_options"] = {{"window_px", flags.heading.window_px},
-                    {"window_dy_px", flags.heading.window_dy_px},
-                    {"min_votes", flags.heading.min_votes},
-                    {"min_verified", flags.heading.min_verified}};
-    j["time_s"] = {{"load", load_s}, {"extract", extract_s}, {"match", match_s}, {"verify", verify_s},
-                   {"heading", heading_s}};
+                            {"window_dy_px", flags.heading.window_dy_px},
+                            {"min_votes", flags.heading.min_votes},
+                            {"min_verified", flags.heading.min_verified}};
+    j["time_s"] = {
+        {"load", load_s}, {"extract", extract_s}, {"match", match_s}, {"verify", verify_s}, {"heading", heading_s}};
     WriteFileAtomically(flags.json_path, j.dump(1) + "\n");
   }
 }
@@ -207,15 +206,17 @@ void RunMatch(const MatchFlags& flags) {
 void AddMatchCommand(CLI::App& app) {
   auto flags = std::make_shared<MatchFlags>();
   CLI::App* command = app.add_subcommand(
-      "match", "Match one image pair: tentative matches (in original image pixels, with confidence), the verified "
-               "subset and F, and the heading (x in image1 minus x in image0; degrees with --camera)");
+      "match",
+      "Match one image pair: tentative matches (in original image pixels, with confidence), the verified "
+      "subset and F, and the heading (x in image1 minus x in image0; degrees with --camera)");
   command->add_option("image0", flags->image0, "First image")->required();
   command->add_option("image1", flags->image1, "Second image")->required();
   command->add_option("--json", flags->json_path, "Also write every match, the inlier mask and F to this JSON file");
   command->add_flag("--list", flags->list, "Print every match: x0 y0 x1 y1 score inlier");
-  flags->option_flags.AddOption(command, "--camera", flags->camera, "camera",
-                                "Intrinsics of both images (fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]] or a calibration file): "
-                                "the heading also in degrees");
+  flags->option_flags.AddOption(
+      command, "--camera", flags->camera, "camera",
+      "Intrinsics of both images (fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]] or a calibration file): "
+      "the heading also in degrees");
   AddHeadingOptions(command, flags->heading, flags->option_flags);
   AddMatcherOptions(command, flags->matcher, flags->option_flags);
   AddVerifierOptions(command, flags->verifier, flags->option_flags, /*with_early_stop=*/false);  // one exhaustive pair

@@ -38,7 +38,11 @@ CLI::Option* BindValues(CLI::App* command, const std::string& flag, const Option
     return option;
   }
   option = command->add_option_function<T>(
-      flag, [values](const T& value) { for (T* f : values) *f = value; }, field.help);
+      flag,
+      [values](const T& value) {
+        for (T* f : values) *f = value;
+      },
+      field.help);
   if (field.show_default) {
     std::ostringstream text;
     text << std::boolalpha << *values.front();

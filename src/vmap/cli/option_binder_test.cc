@@ -32,7 +32,8 @@ struct Whole {
   int unflagged = 3;
   Part part;
   void VisitFields(OptionFieldVisitor& visitor) {
-    visitor.Visit(OptionField{"shape", "--shape", "Outline: "}.ListingNames(), EnumField(shape, kShapeNames, ParseShape));
+    visitor.Visit(OptionField{"shape", "--shape", "Outline: "}.ListingNames(),
+                  EnumField(shape, kShapeNames, ParseShape));
     visitor.Visit({"final_key", "!--no-final-key", "No final key"}, final_key);
     visitor.Visit({"strict", "--strict", "Strict"}, strict);
     visitor.Visit(OptionField{"extraction_threads", "--threads", "Threads"}.NotRecorded(), threads);

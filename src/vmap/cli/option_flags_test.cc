@@ -36,8 +36,8 @@ TEST(OptionFlags, SaysAnErrorWithTheFlagsOfItsFields) {
   flags.Record("key_search", "--search");
   EXPECT_EQ(flags.Message(OptionError("extraction_threads", "must be 0 to 256 (0 = one per core)")),
             "--threads must be 0 to 256 (0 = one per core)");
-  EXPECT_EQ(flags.Message(OptionError("exhaustive", "is a scan and key_search bisect skips frames; drop one",
-                                      {"key_search"})),
+  EXPECT_EQ(flags.Message(
+                OptionError("exhaustive", "is a scan and key_search bisect skips frames; drop one", {"key_search"})),
             "--exhaustive is a scan and --search bisect skips frames; drop one");
   // A field without a flag keeps its path; so does a named field without one.
   EXPECT_EQ(flags.Message(OptionError("prefetch_frames", "must be 1 to 1024", {"search_window"})),
@@ -58,8 +58,8 @@ TEST(OptionFlags, ReplacesOnlyWholeNames) {
 TEST(OptionFlags, TranslatesNestedPaths) {
   OptionFlags flags;
   flags.Record("link_analysis.pose.threshold", "--pose-threshold");
-  const OptionError nested = OptionError("threshold", "-1 px is outside (0, 100]").Within("pose").Within(
-      "link_analysis");
+  const OptionError nested =
+      OptionError("threshold", "-1 px is outside (0, 100]").Within("pose").Within("link_analysis");
   EXPECT_EQ(flags.Message(nested), "--pose-threshold -1 px is outside (0, 100]");
 }
 

@@ -15,9 +15,9 @@ namespace fs = std::filesystem;
 std::vector<OutputInput> MapInputs(const std::string& map_directory) {
   if (map_directory.empty()) return {};
   const fs::path directory(map_directory);
-  std::set<std::string> names = {kMapFileName,    kCorrespondencesFileName, "keys",
-                                 kReportFileName, kReportAssetsDirectory,   kEvaluationFileName,
-                                 kLocalizationCacheFileName};
+  std::set<std::string> names = {
+      kMapFileName,        kCorrespondencesFileName,  "keys", kReportFileName, kReportAssetsDirectory,
+      kEvaluationFileName, kLocalizationCacheFileName};
   std::vector<OutputInput> inputs;
   for (const std::string& name : names) inputs.push_back({directory / name, "the map's " + name});
   return inputs;

@@ -57,8 +57,8 @@ void ExpectRefused(const std::vector<Case>& cases, const fs::path& watched) {
     EXPECT_EQ(RunVmap(c.arguments, &out), 2) << c.arguments << "\n" << out;
     const size_t error = out.find("vmap: error: ");
     EXPECT_NE(error, std::string::npos) << c.arguments << "\n" << out;
-    EXPECT_NE(out.find(c.expected, error), std::string::npos) << c.arguments << "\n  expected: " << c.expected
-                                                               << "\n  got: " << out;
+    EXPECT_NE(out.find(c.expected, error), std::string::npos)
+        << c.arguments << "\n  expected: " << c.expected << "\n  got: " << out;
     EXPECT_EQ(out.find("please report it"), std::string::npos) << out;
   }
   EXPECT_EQ(Snapshot(watched), before) << "an input changed";
@@ -85,7 +85,8 @@ TEST(OutputPromises, SingleFileOutputsNeverReplaceAnInputOrASpecialFile) {
           {localize + " --csv " + query, "--csv '" + (in / "frame_1.png").string() + "' would overwrite the query"},
           {localize + " --csv " + Quote(m / kMapFileName), "would overwrite the map's map.json"},
           {localize + " --csv " + Quote(m / "keys/000000.png"), "lies inside the map's keys"},
-          {localize + " --json " + Quote(m / kCorrespondencesFileName), "would overwrite the map's correspondences.bin"},
+          {localize + " --json " + Quote(m / kCorrespondencesFileName),
+           "would overwrite the map's correspondences.bin"},
           {localize + " --json " + Quote(m / "keys/../map.json"), "would overwrite the map's map.json"},
           {localize + " --json " + Quote(m / "localization_cache.bin"), "the map's localization_cache.bin"},
           {localize + " --csv " + Quote(tmp.path() / "link.csv"), "is a symbolic link"},

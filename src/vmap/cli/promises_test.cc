@@ -6,14 +6,13 @@
 //    file names that are not UTF-8 work;
 // 5. every numeric option has a range, checked before any work.
 
+#include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-#include <fcntl.h>
 
 #include <algorithm>
 #include <chrono>
@@ -310,7 +309,8 @@ TEST(Promises, UntrustedMapsAreRefusedQuicklyWithLittleMemory) {
       EXPECT_EQ(log.find("vmap: error: "), 0u) << log;
       EXPECT_NE(log.find(c.expected), std::string::npos) << c.map << " " << command[0] << ": " << log;
       EXPECT_LT(seconds, 10.0) << c.map;
-      EXPECT_LT(max_rss_kb, c.max_rss_mb * 1024) << c.map << " " << command[0];  // far below the 10 GB of the sparse file
+      EXPECT_LT(max_rss_kb, c.max_rss_mb * 1024)
+          << c.map << " " << command[0];  // far below the 10 GB of the sparse file
     }
     EXPECT_FALSE(fs::exists(c.map / "report.html")) << c.map;
   }
@@ -334,7 +334,9 @@ TEST(Promises, SigintOrSigtermLeaveNothingBehindAndTheOldOutputIntact) {
   const std::vector<Case> cases = {
       {{"build", in, "-o", (tmp.path() / "m").string(), "--threads", "1"}, tmp.path(), ".m.partial-", SIGINT},
       {{"sweep", in, "--thresholds", "0.3,0.6,0.9", "-o", (tmp.path() / "s").string(), "--maps", "--threads", "1"},
-       tmp.path(), ".s.partial-", SIGTERM},
+       tmp.path(),
+       ".s.partial-",
+       SIGTERM},
       {{"build", in, "-o", (tmp.path() / "m2").string(), "--threads", "1"}, tmp.path(), ".m2.partial-", SIGHUP},
   };
   for (const Case& c : cases) {
@@ -411,10 +413,10 @@ TEST(Promises, FileNamesThatAreNotUtf8Work) {
   testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 6);
   // Latin-1 names, as an old camera or a Windows share writes them, and a '%'.
-  const std::vector<std::string> names = {"caf\xE9_1.png", "caf\xE9_2.png", "100%_3.png", "\xFF\xFE_4.png",
-                                          "na\xEFve_5.png", "ok_6.png"};
-  for (int i = 0; i < 6; ++i) fs::rename(tmp.path() / "in" / ("frame_" + std::to_string(i + 1) + ".png"),
-                                         tmp.path() / "in" / names[i]);
+  const std::vector<std::string> names = {"caf\xE9_1.png",  "caf\xE9_2.png",  "100%_3.png",
+                                          "\xFF\xFE_4.png", "na\xEFve_5.png", "ok_6.png"};
+  for (int i = 0; i < 6; ++i)
+    fs::rename(tmp.path() / "in" / ("frame_" + std::to_string(i + 1) + ".png"), tmp.path() / "in" / names[i]);
   const fs::path input = tmp.path() / "in\xE9";
   fs::rename(tmp.path() / "in", input);
   std::string out;

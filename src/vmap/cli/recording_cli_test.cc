@@ -64,10 +64,10 @@ TEST(RecordingCli, ARecordingOfAVideosFramesGivesTheVideosMap) {
   const std::string video = testing::SharedDir() + "/data/lab_floor/lab_floor.mp4";
   std::string out;
   const fs::path video_map = tmp.path() / "video_map";
-  ASSERT_EQ(RunVmap("build " + Quote(video) + " -q --last " + std::to_string(kVideoFrames - 1) + " -o " +
-                        Quote(video_map),
-                    &out),
-            0)
+  ASSERT_EQ(
+      RunVmap("build " + Quote(video) + " -q --last " + std::to_string(kVideoFrames - 1) + " -o " + Quote(video_map),
+              &out),
+      0)
       << out;
   const VisualMap expected = ReadMap(video_map);
   ASSERT_GE(expected.key_images.size(), 2u);
@@ -89,8 +89,7 @@ TEST(RecordingCli, ARecordingOfAVideosFramesGivesTheVideosMap) {
   for (const std::string& recording : recordings) {
     SCOPED_TRACE(recording);
     const fs::path raw_map = tmp.path() / (fs::path(recording).filename().string() + "_raw");
-    ASSERT_EQ(RunVmap("build " + Quote(recording) + " -q --topic /cam/image_raw -o " + Quote(raw_map), &out), 0)
-        << out;
+    ASSERT_EQ(RunVmap("build " + Quote(recording) + " -q --topic /cam/image_raw -o " + Quote(raw_map), &out), 0) << out;
     const VisualMap raw = ReadMap(raw_map);
     EXPECT_EQ(raw.num_frames, kVideoFrames);
     EXPECT_EQ(KeySourceIndices(raw), KeySourceIndices(expected));
@@ -105,9 +104,8 @@ TEST(RecordingCli, ARecordingOfAVideosFramesGivesTheVideosMap) {
 
     // JPEG frames differ a little from the video's: a sane map, not the same one.
     const fs::path jpeg_map = tmp.path() / (fs::path(recording).filename().string() + "_jpeg");
-    ASSERT_EQ(RunVmap("build " + Quote(recording) + " -q --topic /cam/image_raw/compressed -o " + Quote(jpeg_map),
-                      &out),
-              0)
+    ASSERT_EQ(
+        RunVmap("build " + Quote(recording) + " -q --topic /cam/image_raw/compressed -o " + Quote(jpeg_map), &out), 0)
         << out;
     const VisualMap jpeg = ReadMap(jpeg_map);
     EXPECT_EQ(jpeg.num_frames, kVideoFrames);
@@ -131,8 +129,8 @@ TEST(RecordingCli, InfoListsTopicsAndBuildRefusesToGuess) {
   SKIP_WITHOUT_SHARED();
   testing::ScopedTempDir dir("recording_cli");
   const std::string path = (dir.path() / "run.mcap").string();
-  std::vector<TestMessage> messages = VideoMessages(testing::SharedDir() + "/data/lab_floor/lab_floor.mp4",
-                                                  MessageEncoding::kCdr);
+  std::vector<TestMessage> messages =
+      VideoMessages(testing::SharedDir() + "/data/lab_floor/lab_floor.mp4", MessageEncoding::kCdr);
   messages.resize(3 * 20);  // 20 frames
   testing::WriteMcap(path, messages, "lz4");
   std::string output;

@@ -19,8 +19,9 @@ void RunReport(const std::filesystem::path& target, const std::string& run_outpu
   // Anything but a folder is taken for a run's file, whose reader refuses what is not a regular file.
   std::error_code ec;
   if (std::filesystem::exists(target, ec) && !std::filesystem::is_directory(target, ec)) {
-    const std::filesystem::path output =
-        run_output.empty() ? target.parent_path() / (target.stem().string() + "_report") : std::filesystem::path(run_output);
+    const std::filesystem::path output = run_output.empty()
+                                             ? target.parent_path() / (target.stem().string() + "_report")
+                                             : std::filesystem::path(run_output);
     WriteLocalizationReport(target, output);
     std::cout << "report          " << (output / kReportFileName).string() << "\n";
     return;
@@ -36,8 +37,9 @@ void AddReportCommand(CLI::App& app) {
   auto options = std::make_shared<MapReportOptions>();
   auto run_output = std::make_shared<std::string>();
   CLI::App* command = app.add_subcommand(
-      "report", "Write report.html into a map directory: summary, key images, match figures and plots (offline "
-                "page); or, given the --json file of `vmap localize`, the report of that localization run");
+      "report",
+      "Write report.html into a map directory: summary, key images, match figures and plots (offline "
+      "page); or, given the --json file of `vmap localize`, the report of that localization run");
   command->add_option("map", *map_directory, "Map directory written by `vmap build`, or a `vmap localize --json` file")
       ->required();
   command->add_option("-o,--output", *run_output,

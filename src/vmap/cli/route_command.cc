@@ -56,16 +56,22 @@ void RunRoute(const RouteFlags& flags) {
                              map.key_images[s.from_key].frame_index, s.to_key, map.key_images[s.to_key].frame_index,
                              s.link, s.backwards ? "backwards" : (s.unverified ? "forwards, no F" : "forwards"),
                              l.similarity, l.num_verified, translation);
-    steps.push_back({{"from", s.from_key}, {"to", s.to_key}, {"link", s.link}, {"backwards", s.backwards},
-                     {"unverified", s.unverified}, {"similarity", l.similarity}, {"verified", l.num_verified},
+    steps.push_back({{"from", s.from_key},
+                     {"to", s.to_key},
+                     {"link", s.link},
+                     {"backwards", s.backwards},
+                     {"unverified", s.unverified},
+                     {"similarity", l.similarity},
+                     {"verified", l.num_verified},
                      {"translation_known", l.has_pose && l.translation_known},
                      {"translation_sigma_deg", l.translation_sigma_deg >= 0 ? nlohmann::json(l.translation_sigma_deg)
                                                                             : nlohmann::json(nullptr)}});
   }
   if (!flags.json.empty()) {
     // The map's path percent-encoded where it is not UTF-8, as in map.json (file_name_encoding.h).
-    const nlohmann::json doc = {{"format", "vmap-route"}, {"map", EncodeFileName(flags.map)},      {"from", flags.from},
-                                {"to", to},                {"keys", route.keys},     {"steps", steps},
+    const nlohmann::json doc = {{"format", "vmap-route"},    {"map", EncodeFileName(flags.map)},
+                                {"from", flags.from},        {"to", to},
+                                {"keys", route.keys},        {"steps", steps},
                                 {"warnings", route.warnings}};
     WriteFileAtomically(flags.json, doc.dump(1) + "\n");
   }

@@ -13,9 +13,9 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/evaluation/map_evaluation.h"
+#include "vmap/map/map_io.h"
 #include "vmap/mapping/batch_build.h"
 #include "vmap/mapping/sweep_thresholds.h"
-#include "vmap/map/map_io.h"
 #include "vmap/report/html_report.h"
 #include "vmap/report/summary.h"
 

@@ -34,8 +34,8 @@ std::string Join(const std::vector<std::string>& items) {
 // names them ("coarse", "aliked-t16"), notes in parentheses ("xfeat (folded layout)").
 struct FileFits {
   std::vector<std::string> fits;
-  std::vector<std::string> refused_models;  // the models that could not read the file,
-  std::vector<std::string> refusals;        // and why
+  std::vector<std::string> refused_models;             // the models that could not read the file,
+  std::vector<std::string> refusals;                   // and why
   std::vector<std::string> refusals_by_model() const;  // "xfeat: ..."
 };
 
@@ -93,8 +93,8 @@ void Verify(const std::string& path) {
   for (const auto& known : neural::KnownWeightFiles()) {
     if (!known.git_blob_id.empty() && known.git_blob_id == id) known_as = known.file_name;
   }
-  std::printf("  known copy   %s\n", known_as.empty() ? "no (not byte-identical to a known published copy)"
-                                                      : ("yes: " + known_as).c_str());
+  std::printf("  known copy   %s\n",
+              known_as.empty() ? "no (not byte-identical to a known published copy)" : ("yes: " + known_as).c_str());
 #ifdef VMAP_WITH_TORCH
   const FileFits fits = ModelsFittingFile(path);
   // A file no model can read at all is an error; say why (every model refuses an unreadable file the same way).
@@ -103,8 +103,8 @@ void Verify(const std::string& path) {
   }
   std::printf("  fits         %s\n", fits.fits.empty() ? "no known model" : Join(fits.fits).c_str());
   if (fits.fits.empty()) {
-    throw InputError("'" + path + "' is not usable as weights of any deep matcher (" +
-                     Join(fits.refusals_by_model()) + ")");
+    throw InputError("'" + path + "' is not usable as weights of any deep matcher (" + Join(fits.refusals_by_model()) +
+                     ")");
   }
 #endif
 }
@@ -120,8 +120,9 @@ void Run(const WeightsFlags& flags) {
       std::printf("downloading %s from %s ...\n", preset.c_str(), known.url.c_str());
       std::fflush(stdout);
       const std::string path = neural::DownloadWeights(preset, cache, !flags.no_verify);
-      std::printf("  saved %s (%s)\n", path.c_str(),
-                  flags.no_verify ? "git blob id NOT checked" : ("git blob id " + known.git_blob_id + " verified").c_str());
+      std::printf(
+          "  saved %s (%s)\n", path.c_str(),
+          flags.no_verify ? "git blob id NOT checked" : ("git blob id " + known.git_blob_id + " verified").c_str());
 #ifdef VMAP_WITH_TORCH
       if (flags.no_verify) {
         // The mirror may hold other bytes than the published copy; the layout is then the check left.
@@ -133,7 +134,8 @@ void Run(const WeightsFlags& flags) {
     acted = true;
   }
   if (!flags.import_file.empty()) {
-    if (flags.model.empty()) throw InputError("--import needs --model outdoor|indoor|coarse|xfeat|aliked-t16|aliked-n16");
+    if (flags.model.empty())
+      throw InputError("--import needs --model outdoor|indoor|coarse|xfeat|aliked-t16|aliked-n16");
     const auto& known = neural::KnownWeightsFor(flags.model);
     const std::string expected = flags.no_verify ? "" : known.git_blob_id;
 #ifdef VMAP_WITH_TORCH
@@ -148,9 +150,9 @@ void Run(const WeightsFlags& flags) {
 #endif
     const std::string path = neural::ImportWeights(flags.import_file, flags.model, expected, cache);
     std::printf("imported %s -> %s (%s)\n", flags.import_file.c_str(), path.c_str(),
-                flags.no_verify        ? "git blob id NOT checked (--no-verify)"
-                : expected.empty()     ? "no published git blob id for this model; structure checked"
-                                       : ("git blob id " + expected + " verified").c_str());
+                flags.no_verify    ? "git blob id NOT checked (--no-verify)"
+                : expected.empty() ? "no published git blob id for this model; structure checked"
+                                   : ("git blob id " + expected + " verified").c_str());
     acted = true;
   }
   if (!flags.verify_file.empty()) {
@@ -169,8 +171,9 @@ void AddWeightsCommand(CLI::App& app) {
   command->add_option("--download", flags->download, "Download the official weights: outdoor, indoor, xfeat or all")
       ->check(CLI::IsMember({"outdoor", "indoor", "xfeat", "all"}));
   command->add_option("--import", flags->import_file, "Copy a local weights file into the cache (needs --model)");
-  command->add_option("--model", flags->model,
-                      "Model of the --import file: outdoor, indoor, coarse, xfeat, aliked-t16 or aliked-n16")
+  command
+      ->add_option("--model", flags->model,
+                   "Model of the --import file: outdoor, indoor, coarse, xfeat, aliked-t16 or aliked-n16")
       ->check(CLI::IsMember({"outdoor", "indoor", "coarse", "xfeat", "aliked-t16", "aliked-n16"}));
   command->add_option("--verify", flags->verify_file, "Print a file's git blob id and which model it fits");
   command->add_flag("--no-verify", flags->no_verify, "Skip the git blob id check of --download / --import");

@@ -66,13 +66,12 @@ fs::path TemporarySibling(const fs::path& path, const char* tag) {
     suffix = random() % 1000000;
   }
   const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
-  return parent / ("." + path.filename().string() + "." + tag + "-" + std::to_string(getpid()) + "-" +
-                   std::to_string(suffix));
+  return parent /
+         ("." + path.filename().string() + "." + tag + "-" + std::to_string(getpid()) + "-" + std::to_string(suffix));
 }
 
 bool AllDigits(const std::string& text) {
-  return !text.empty() && text.size() <= 18 &&
-         text.find_first_not_of("0123456789") == std::string::npos;
+  return !text.empty() && text.size() <= 18 && text.find_first_not_of("0123456789") == std::string::npos;
 }
 
 // The pid in a temporary's name ".NAME.TAG-PID-N" of `name`, or 0 when `file_name` is not one.
@@ -148,10 +147,12 @@ void WriteFileAtomically(const fs::path& path, std::string_view content) {
   int fd = -1;
   for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
     temp = TemporarySibling(path, "tmp");
-    fd = CreateRegistered(temp, [&] {
-      const int opened = open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-      return opened >= 0 ? opened + 1 : 0;  // 0: not created
-    }) - 1;
+    fd = CreateRegistered(temp,
+                          [&] {
+                            const int opened = open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+                            return opened >= 0 ? opened + 1 : 0;  // 0: not created
+                          }) -
+         1;
     if (fd < 0 && errno != EEXIST) break;
   }
   if (fd < 0) {
@@ -162,7 +163,8 @@ void WriteFileAtomically(const fs::path& path, std::string_view content) {
     const std::string reason = ErrnoText();
     close(fd);
     RemoveAndUnregister(temp);
-    throw InputError(what + " '" + path.string() + "' failed (" + reason + "); check the free space and the "
+    throw InputError(what + " '" + path.string() + "' failed (" + reason +
+                     "); check the free space and the "
                      "permissions of its directory");
   };
   for (size_t written = 0; written < content.size();) {
@@ -186,7 +188,8 @@ void WriteFileAtomically(const fs::path& path, std::string_view content) {
     const std::string reason = ErrnoText();
     lock.unlock();
     RemoveAndUnregister(temp);
-    throw InputError("cannot replace '" + path.string() + "' (" + reason + "); check that it is not a folder and "
+    throw InputError("cannot replace '" + path.string() + "' (" + reason +
+                     "); check that it is not a folder and "
                      "that its directory is writable");
   }
   Temporaries().paths.erase(temp);
@@ -242,7 +245,8 @@ AtomicOutputDirectory::AtomicOutputDirectory(fs::path final_path, OutputPolicy p
                        "); check that '" + parent.string() + "' exists and is writable");
     }
   }
-  if (temp_path_.empty()) throw InputError("cannot create a temporary directory next to '" + final_path_.string() + "'");
+  if (temp_path_.empty())
+    throw InputError("cannot create a temporary directory next to '" + final_path_.string() + "'");
 }
 
 AtomicOutputDirectory::~AtomicOutputDirectory() {
@@ -256,11 +260,11 @@ void AtomicOutputDirectory::CheckReplaceable(const fs::path& final_path, const O
   for (const fs::path& input : policy.inputs) {
     if (IsSameOrInside(input, final_path)) {
       Refuse(final_path, "is or holds the input '" + input.string() +
-                              "', which replacing it would delete; write the output somewhere else");
+                             "', which replacing it would delete; write the output somewhere else");
     }
     if (IsSameOrInside(final_path, input)) {
-      Refuse(final_path, "lies inside the input '" + input.string() +
-                              "'; write the output somewhere else than into the input");
+      Refuse(final_path,
+             "lies inside the input '" + input.string() + "'; write the output somewhere else than into the input");
     }
   }
   std::error_code ec;
@@ -270,8 +274,9 @@ void AtomicOutputDirectory::CheckReplaceable(const fs::path& final_path, const O
   }
   if (fs::exists(status)) {
     if (fs::is_symlink(status)) {
-      Refuse(final_path, "is a symbolic link; vmap replaces only a real directory: give the path it points to, "
-                          "or choose another output path");
+      Refuse(final_path,
+             "is a symbolic link; vmap replaces only a real directory: give the path it points to, "
+             "or choose another output path");
     }
     if (!fs::is_directory(status)) Refuse(final_path, "exists and is not a directory; choose another path");
     fs::directory_iterator entries(final_path, ec);
@@ -287,13 +292,12 @@ void AtomicOutputDirectory::CheckReplaceable(const fs::path& final_path, const O
                                       : std::string("it is not empty");
       if (!why_not.empty()) {
         Refuse(final_path, "exists and is not " + policy.kind + " (" + why_not +
-                                "), so vmap will not replace it: vmap replaces only an empty folder or " +
-                                policy.kind + " it wrote. Choose another output directory, or move the folder away "
-                                "yourself");
+                               "), so vmap will not replace it: vmap replaces only an empty folder or " + policy.kind +
+                               " it wrote. Choose another output directory, or move the folder away "
+                               "yourself");
       }
     }
   }
-
 }
 
 void AtomicOutputDirectory::Commit() {

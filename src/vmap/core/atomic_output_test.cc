@@ -162,11 +162,11 @@ TEST(AtomicOutput, NeverReplacesItsInputNorWritesIntoIt) {
     std::string expected;
   };
   const std::vector<Case> cases = {
-      {map, map, "is or holds the input"},                                    // the same folder
-      {map, map / "keys", "is or holds the input"},                           // the input inside
-      {map, map / "keys/000000.png", "is or holds the input"},                // a file inside
-      {map, tmp.path() / "keys_link", "is or holds the input"},               // through a symbolic link
-      {map, tmp.path() / "sequence/../map/keys", "is or holds the input"},    // through ".."
+      {map, map, "is or holds the input"},                                  // the same folder
+      {map, map / "keys", "is or holds the input"},                         // the input inside
+      {map, map / "keys/000000.png", "is or holds the input"},              // a file inside
+      {map, tmp.path() / "keys_link", "is or holds the input"},             // through a symbolic link
+      {map, tmp.path() / "sequence/../map/keys", "is or holds the input"},  // through ".."
       {tmp.path() / "sequence/out", tmp.path() / "sequence", "lies inside the input"},
       {map / "keys/new", map, "lies inside the input"},
   };
@@ -185,11 +185,12 @@ TEST(AtomicOutput, StaleTemporariesOfDeadProcessesAreRemovedAndLiveOnesKept) {
   const std::string dead = std::to_string(DeadPid()), alive = std::to_string(getpid());
   const std::vector<std::string> stale = {".map.partial-" + dead + "-12", ".map.old-" + dead + "-3",
                                           ".map.tmp-" + dead + "-4"};
-  const std::vector<std::string> kept = {".map.partial-" + alive + "-5",  // this process: alive
-                                         ".map.partial-1-6",              // init: alive
-                                         ".other.partial-" + dead + "-7", // another output's
-                                         ".map.partial-" + dead + "-x",   // not vmap's pattern
-                                         ".map.backup-" + dead + "-8", "map.partial-" + dead + "-9"};
+  const std::vector<std::string> kept = {".map.partial-" + alive + "-5",   // this process: alive
+                                         ".map.partial-1-6",               // init: alive
+                                         ".other.partial-" + dead + "-7",  // another output's
+                                         ".map.partial-" + dead + "-x",    // not vmap's pattern
+                                         ".map.backup-" + dead + "-8",
+                                         "map.partial-" + dead + "-9"};
   for (const std::string& name : stale) {
     fs::create_directories(tmp.path() / name / "keys");
     std::ofstream(tmp.path() / name / "keys/a.png") << "x";

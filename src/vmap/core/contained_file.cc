@@ -131,8 +131,7 @@ std::string ContainedFile::ParseJson(std::uint64_t max_values, nlohmann::json* d
   // the nesting, far above anything vmap writes.
   constexpr int kMaxDepth = 64;
   std::uint64_t values = 0;
-  const nlohmann::json::parser_callback_t limit = [&](int depth, nlohmann::json::parse_event_t event,
-                                                      nlohmann::json&) {
+  const nlohmann::json::parser_callback_t limit = [&](int depth, nlohmann::json::parse_event_t event, nlohmann::json&) {
     if (depth > kMaxDepth) throw TooDeep{};
     if (event != nlohmann::json::parse_event_t::key && ++values > max_values) throw TooMany{};
     return true;

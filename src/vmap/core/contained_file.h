@@ -51,7 +51,8 @@ class ContainedFile {
   std::string ParseJson(std::uint64_t max_values, nlohmann::json* document) const;
 
  private:
-  ContainedFile(std::filesystem::path path, int fd, std::uint64_t size) : path_(std::move(path)), fd_(fd), size_(size) {}
+  ContainedFile(std::filesystem::path path, int fd, std::uint64_t size)
+      : path_(std::move(path)), fd_(fd), size_(size) {}
 
   std::filesystem::path path_;
   int fd_ = -1;

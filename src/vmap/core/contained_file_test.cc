@@ -85,7 +85,8 @@ TEST(ContainedFile, ReadsJsonWithLimits) {
   std::ofstream(tmp.path() / "deep.json") << std::string(100000, '[') << std::string(100000, ']');
   EXPECT_NE(ReadContainedJson(tmp.path(), "deep.json", 1 << 20, 1000).why_not.find("nested"), std::string::npos);
   std::ofstream(tmp.path() / "huge_number.json") << R"({"n": 1e999})";
-  EXPECT_NE(ReadContainedJson(tmp.path(), "huge_number.json", 1000, 1000).why_not.find("number too large"), std::string::npos);
+  EXPECT_NE(ReadContainedJson(tmp.path(), "huge_number.json", 1000, 1000).why_not.find("number too large"),
+            std::string::npos);
   std::ofstream(tmp.path() / "bad.json") << R"({"n": )";
   EXPECT_NE(ReadContainedJson(tmp.path(), "bad.json", 1000, 1000).why_not.find("not valid JSON"), std::string::npos);
   // Many values in few bytes: refused by their count, before they are all held.

@@ -13,18 +13,18 @@ TEST(FileNameEncoding, KeepsValidUtf8AndEncodesTheRest) {
   };
   const std::vector<Case> cases = {
       {"frame_0001.png", "frame_0001.png"},
-      {"caf\xC3\xA9.png", "caf\xC3\xA9.png"},           // UTF-8 é stays
+      {"caf\xC3\xA9.png", "caf\xC3\xA9.png"},                            // UTF-8 é stays
       {"\xE6\x97\xA5\xE6\x9C\xAC.jpg", "\xE6\x97\xA5\xE6\x9C\xAC.jpg"},  // CJK stays
-      {"\xF0\x9F\x93\xB7.png", "\xF0\x9F\x93\xB7.png"},  // 4-byte emoji stays
-      {"caf\xE9.png", "caf%E9.png"},                    // Latin-1 é
-      {"100%.png", "100%25.png"},                       // '%' itself
+      {"\xF0\x9F\x93\xB7.png", "\xF0\x9F\x93\xB7.png"},                  // 4-byte emoji stays
+      {"caf\xE9.png", "caf%E9.png"},                                     // Latin-1 é
+      {"100%.png", "100%25.png"},                                        // '%' itself
       {"%41", "%2541"},
       {"\xFF\xFE", "%FF%FE"},
-      {"\xC3", "%C3"},                                  // truncated sequence
-      {"\xC0\xAF", "%C0%AF"},                           // overlong '/'
-      {"\xED\xA0\x80", "%ED%A0%80"},                    // UTF-16 surrogate
-      {"\xF4\x90\x80\x80", "%F4%90%80%80"},             // above U+10FFFF
-      {std::string("a\0b", 3), std::string("a\0b", 3)}, // NUL is valid UTF-8 (JSON escapes it)
+      {"\xC3", "%C3"},                                   // truncated sequence
+      {"\xC0\xAF", "%C0%AF"},                            // overlong '/'
+      {"\xED\xA0\x80", "%ED%A0%80"},                     // UTF-16 surrogate
+      {"\xF4\x90\x80\x80", "%F4%90%80%80"},              // above U+10FFFF
+      {std::string("a\0b", 3), std::string("a\0b", 3)},  // NUL is valid UTF-8 (JSON escapes it)
   };
   for (const Case& c : cases) {
     EXPECT_EQ(EncodeFileName(c.bytes), c.text) << c.text;

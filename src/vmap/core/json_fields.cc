@@ -37,7 +37,8 @@ void JsonFieldReader::Read(const char* key, int* value) const {
 }
 
 void JsonFieldReader::Read(const char* key, bool* value) const {
-  if (const nlohmann::json* found = Find(key, &nlohmann::json::is_boolean, "true or false")) *value = found->get<bool>();
+  if (const nlohmann::json* found = Find(key, &nlohmann::json::is_boolean, "true or false"))
+    *value = found->get<bool>();
 }
 
 void JsonFieldReader::Read(const char* key, std::string* value) const { ReadString(key, value); }
@@ -47,8 +48,7 @@ void JsonFieldReader::Read(const char* key, std::vector<int>* value) const {
   if (!found) return;
   std::vector<int> values;
   for (const nlohmann::json& item : *found) {
-    if (!item.is_number_integer() || item < std::numeric_limits<int>::min() ||
-        item > std::numeric_limits<int>::max()) {
+    if (!item.is_number_integer() || item < std::numeric_limits<int>::min() || item > std::numeric_limits<int>::max()) {
       throw InputError(Path(key) + " must be an array of integers (it holds " + item.dump() + ")");
     }
     values.push_back(item.get<int>());

@@ -12,7 +12,7 @@ constexpr EnumName<Fruit> kFruitNames[] = {{Fruit::kApple, "apple"}, {Fruit::kPe
 Fruit ParseFruit(const std::string& name) { return ParseEnum(kFruitNames, name, "fruit"); }
 
 TEST(JsonFieldReader, ReadsRecordedFieldsAndKeepsTheOthers) {
-  const nlohmann::json record = {{"tau", 0.7},      {"seed", 3},   {"strict", true}, {"resize", "640"},
+  const nlohmann::json record = {{"tau", 0.7},      {"seed", 3},       {"strict", true}, {"resize", "640"},
                                  {"fruit", "pear"}, {"note", nullptr}, {"newer", 1}};
   const JsonFieldReader fields(record, "options");
   double tau = 0.5, missing = 2.5;
@@ -25,8 +25,8 @@ TEST(JsonFieldReader, ReadsRecordedFieldsAndKeepsTheOthers) {
   fields.Read("strict", &strict);
   fields.Read("resize", &resize);
   fields.Read("fruit", EnumField(fruit, kFruitNames, ParseFruit));
-  fields.Read("note", &note);        // null: as if not recorded
-  fields.Read("absent", &missing);   // an older record
+  fields.Read("note", &note);       // null: as if not recorded
+  fields.Read("absent", &missing);  // an older record
   EXPECT_EQ(tau, 0.7);
   EXPECT_EQ(seed, 3);
   EXPECT_TRUE(strict);
@@ -40,8 +40,9 @@ TEST(JsonFieldReader, ReadsRecordedFieldsAndKeepsTheOthers) {
 }
 
 TEST(JsonFieldReader, AValueOfTheWrongKindNamesItsPath) {
-  const nlohmann::json record = {{"tau", "high"}, {"seed", 1.5}, {"strict", 1}, {"big", 1e12},
-                                 {"fruit", "fig"}, {"pose", {{"threshold", true}}}, {"list", {1, 2}}};
+  const nlohmann::json record = {{"tau", "high"}, {"seed", 1.5},    {"strict", 1},
+                                 {"big", 1e12},   {"fruit", "fig"}, {"pose", {{"threshold", true}}},
+                                 {"list", {1, 2}}};
   const JsonFieldReader fields(record, "map 'm/map.json': options");
   double tau = 0;
   int seed = 0, big = 0;
@@ -49,16 +50,19 @@ TEST(JsonFieldReader, AValueOfTheWrongKindNamesItsPath) {
   Fruit fruit = Fruit::kApple;
   EXPECT_EQ(testing::InputErrorMessage([&] { fields.Read("tau", &tau); }),
             "map 'm/map.json': options.tau must be a number (it is string)");
-  EXPECT_EQ(testing::InputErrorMessage([&] { fields.Read("seed", &seed); }), "map 'm/map.json': options.seed must be an integer (it is number)");
+  EXPECT_EQ(testing::InputErrorMessage([&] { fields.Read("seed", &seed); }),
+            "map 'm/map.json': options.seed must be an integer (it is number)");
   EXPECT_EQ(testing::InputErrorMessage([&] { fields.Read("strict", &strict); }),
             "map 'm/map.json': options.strict must be true or false (it is number)");
-  EXPECT_NE(testing::InputErrorMessage([&] { fields.Read("big", &big); }).find("options.big must be an integer"), std::string::npos);
+  EXPECT_NE(testing::InputErrorMessage([&] { fields.Read("big", &big); }).find("options.big must be an integer"),
+            std::string::npos);
   EXPECT_EQ(testing::InputErrorMessage([&] { fields.Read("fruit", EnumField(fruit, kFruitNames, ParseFruit)); }),
             "map 'm/map.json': options.fruit is 'fig', which this vmap does not know (it knows apple or pear)");
   double threshold = 0;
   EXPECT_EQ(testing::InputErrorMessage([&] { fields.Object("pose").Read("threshold", &threshold); }),
             "map 'm/map.json': options.pose.threshold must be a number (it is boolean)");
-  EXPECT_EQ(testing::InputErrorMessage([&] { fields.Object("list"); }), "map 'm/map.json': options.list must be a JSON object (it is array)");
+  EXPECT_EQ(testing::InputErrorMessage([&] { fields.Object("list"); }),
+            "map 'm/map.json': options.list must be a JSON object (it is array)");
   EXPECT_EQ(testing::InputErrorMessage([] { JsonFieldReader(nlohmann::json::array(), "options"); }),
             "options is not a JSON object (it is array)");
   EXPECT_EQ(tau, 0.0);  // nothing was read from a bad value

@@ -27,19 +27,19 @@
 namespace vmap {
 
 struct OptionField {
-  const char* key;         // the name in JSON and, unless `name` is set, in option paths
-  const char* flag = "";   // the command-line flag; "" = none. "!--no-x" is a bool flag that sets false.
-                           // Several fields may share a flag (the matchers' --weights): it then sets each.
-  const char* help = "";   // the flag's help
+  const char* key;           // the name in JSON and, unless `name` is set, in option paths
+  const char* flag = "";     // the command-line flag; "" = none. "!--no-x" is a bool flag that sets false.
+                             // Several fields may share a flag (the matchers' --weights): it then sets each.
+  const char* help = "";     // the flag's help
   bool show_default = true;  // --help shows the default (off where the default means "the preset's")
   // A file recorded where a map was built (weights): when a map read on another machine names a file that is
   // not here, it is cleared, so that the model searches its weights directories instead.
   bool is_local_file = false;
-  bool recorded = true;          // written to and read from JSON; off for how a run is carried out (threads)
-  const char* name = nullptr;    // the field's name in option paths where it differs from its JSON key
-  bool omit_empty = false;       // a string written only when it is not empty
+  bool recorded = true;            // written to and read from JSON; off for how a run is carried out (threads)
+  const char* name = nullptr;      // the field's name in option paths where it differs from its JSON key
+  bool omit_empty = false;         // a string written only when it is not empty
   const char* empty_as = nullptr;  // the JSON name of an empty string ("input": the input's own camera)
-  bool lists_names = false;      // an enum's help ends with its names ("... : auto, sequential or bisect")
+  bool lists_names = false;        // an enum's help ends with its names ("... : auto, sequential or bisect")
 
   // Attributes beyond the first three, set by name: OptionField{"camera", "--camera", "..."}.EmptyAs("input").
   OptionField HideDefault() const { return With(&OptionField::show_default, false); }
@@ -77,10 +77,10 @@ class EnumField {
         parse_([&value, parse](const std::string& name) { value = parse(name); }),
         names_(ListEnumNames(names)) {}
 
-  std::string name() const { return name_(); }         // the value's name
+  std::string name() const { return name_(); }                    // the value's name
   bool Set(const std::string& name) const { return set_(name); }  // false (value kept) for an unknown name
   void Parse(const std::string& name) const { parse_(name); }     // InputError for an unknown name
-  const std::string& names() const { return names_; }  // "a, b or c"
+  const std::string& names() const { return names_; }             // "a, b or c"
 
  private:
   std::function<std::string()> name_;
@@ -102,12 +102,24 @@ class OptionFieldVisitor {
  public:
   virtual ~OptionFieldVisitor() = default;
 
-  void Visit(const OptionField& field, int& value) { if (!Skipped(field)) OnField(field, value); }
-  void Visit(const OptionField& field, double& value) { if (!Skipped(field)) OnField(field, value); }
-  void Visit(const OptionField& field, bool& value) { if (!Skipped(field)) OnField(field, value); }
-  void Visit(const OptionField& field, std::string& value) { if (!Skipped(field)) OnField(field, value); }
-  void Visit(const OptionField& field, std::vector<int>& value) { if (!Skipped(field)) OnField(field, value); }
-  void Visit(const OptionField& field, const EnumField& value) { if (!Skipped(field)) OnField(field, value); }
+  void Visit(const OptionField& field, int& value) {
+    if (!Skipped(field)) OnField(field, value);
+  }
+  void Visit(const OptionField& field, double& value) {
+    if (!Skipped(field)) OnField(field, value);
+  }
+  void Visit(const OptionField& field, bool& value) {
+    if (!Skipped(field)) OnField(field, value);
+  }
+  void Visit(const OptionField& field, std::string& value) {
+    if (!Skipped(field)) OnField(field, value);
+  }
+  void Visit(const OptionField& field, std::vector<int>& value) {
+    if (!Skipped(field)) OnField(field, value);
+  }
+  void Visit(const OptionField& field, const EnumField& value) {
+    if (!Skipped(field)) OnField(field, value);
+  }
 
   // Visits the fields of `options`, the field `name` of the struct being visited ("" adds no level: a struct
   // visited as the top).

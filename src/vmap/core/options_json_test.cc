@@ -27,13 +27,13 @@ struct Inner {
 struct Outer {
   Shape shape = Shape::kRound;
   bool strict = false;
-  std::string camera;      // "" recorded as "input"
-  std::string topic;       // recorded only when set
-  int threads = 0;         // not recorded
+  std::string camera;  // "" recorded as "input"
+  std::string topic;   // recorded only when set
+  int threads = 0;     // not recorded
   std::vector<int> route;
-  Inner flat;              // its fields at this level
-  Inner nested;            // an object "nested"
-  Inner trimmed;           // an object "trimmed" without "budget"
+  Inner flat;     // its fields at this level
+  Inner nested;   // an object "nested"
+  Inner trimmed;  // an object "trimmed" without "budget"
   void VisitFields(OptionFieldVisitor& visitor) {
     visitor.Visit(OptionField{"shape"}.Named("outline"), EnumField(shape, kShapeNames, ParseShape));
     visitor.Visit({"strict"}, strict);
@@ -51,11 +51,15 @@ TEST(OptionsJson, WritesEachRecordedFieldByItsKey) {
   Outer options;
   options.threads = 4;
   options.flat.seed = 3;
-  const nlohmann::json expected = {
-      {"shape", "round"}, {"strict", false}, {"camera", "input"}, {"route", nlohmann::json::array()},
-      {"threshold", 1.0}, {"seed", 3},       {"budget", 10},
-      {"nested", {{"threshold", 1.0}, {"seed", 0}, {"budget", 10}}},
-      {"trimmed", {{"threshold", 1.0}, {"seed", 0}}}};
+  const nlohmann::json expected = {{"shape", "round"},
+                                   {"strict", false},
+                                   {"camera", "input"},
+                                   {"route", nlohmann::json::array()},
+                                   {"threshold", 1.0},
+                                   {"seed", 3},
+                                   {"budget", 10},
+                                   {"nested", {{"threshold", 1.0}, {"seed", 0}, {"budget", 10}}},
+                                   {"trimmed", {{"threshold", 1.0}, {"seed", 0}}}};
   EXPECT_EQ(OptionsToJson(options), expected);
   options.topic = "/camera/image";
   options.camera = "525,525,320,240";

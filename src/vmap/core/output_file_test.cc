@@ -43,8 +43,8 @@ TEST(OutputFile, InputsAreNeverOutputs) {
                                            {tmp.path() / "map/cache.bin", "the map's cache"},
                                            {tmp.path() / "query.png", "the query"}};
   const auto refusal = [&](const fs::path& output) { return Refusal({{output, "--csv"}}, inputs); };
-  EXPECT_NE(refusal(tmp.path() / "query.png").find("--csv '" + (tmp.path() / "query.png").string() +
-                                                  "' would overwrite the query '"),
+  EXPECT_NE(refusal(tmp.path() / "query.png")
+                .find("--csv '" + (tmp.path() / "query.png").string() + "' would overwrite the query '"),
             std::string::npos);
   EXPECT_NE(refusal(tmp.path() / "map/keys/../map.json").find("would overwrite the map's map.json"), std::string::npos);
   EXPECT_NE(refusal(tmp.path() / "query_hard.png").find("would overwrite the query"), std::string::npos);

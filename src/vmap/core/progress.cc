@@ -19,8 +19,7 @@ std::string FormatDuration(double seconds) {
 
 }  // namespace
 
-ProgressLine::ProgressLine(std::string label, long total, std::string unit, ProgressOptions options,
-                           std::FILE* stream)
+ProgressLine::ProgressLine(std::string label, long total, std::string unit, ProgressOptions options, std::FILE* stream)
     : label_(std::move(label)),
       total_(total),
       unit_(std::move(unit)),
@@ -36,8 +35,10 @@ std::string ProgressLine::Format(const std::string& label, long done, long total
                                  double elapsed_s) {
   const double rate = elapsed_s > 0 ? done / elapsed_s : 0.0;
   std::string text = fmt::format("{}: {}", label, done);
-  if (total > 0) text += fmt::format("/{} {} ({:.0f}%)", total, unit, 100.0 * done / total);
-  else text += " " + unit;
+  if (total > 0)
+    text += fmt::format("/{} {} ({:.0f}%)", total, unit, 100.0 * done / total);
+  else
+    text += " " + unit;
   text += fmt::format(", {:.1f} {}/s", rate, unit);
   if (total > 0 && rate > 0 && done < total) text += ", ETA " + FormatDuration((total - done) / rate);
   return text;

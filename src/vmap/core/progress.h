@@ -9,8 +9,8 @@
 namespace vmap {
 
 struct ProgressOptions {
-  bool enabled = true;        // false for --quiet
-  bool force = false;         // draw even when stderr is not a terminal (tests)
+  bool enabled = true;  // false for --quiet
+  bool force = false;   // draw even when stderr is not a terminal (tests)
   double min_interval_s = 0.2;
 };
 
@@ -26,8 +26,7 @@ class ProgressLine {
   void Finish();
 
   // "12.5 frames/s, ETA 1m05s" style text for the given state; exposed for tests.
-  static std::string Format(const std::string& label, long done, long total, const std::string& unit,
-                            double elapsed_s);
+  static std::string Format(const std::string& label, long done, long total, const std::string& unit, double elapsed_s);
 
  private:
   std::string label_;

@@ -63,7 +63,7 @@ TEST(Runtime, SetsOpenCvThreads) {
 
 TEST(Runtime, KeepsLargeFreedBlocksInTheHeap) {
   constexpr size_t kLarge = size_t(64) << 20;  // above glibc's largest dynamic mmap threshold (32 MiB)
-  mallopt(M_MMAP_MAX, 65536);                   // glibc's default
+  mallopt(M_MMAP_MAX, 65536);                  // glibc's default
   EXPECT_TRUE(AllocationIsMapped(kLarge)) << "the control: by default such a block is a mmap of its own";
   InitializeRuntime(Nothing());
   EXPECT_TRUE(AllocationIsMapped(kLarge)) << "keep_freed_memory off changes nothing";

@@ -98,8 +98,8 @@ GroundTruthFormat DetectFormat(const std::string& text, const std::string& path)
     break;
   }
   throw OptionError("format", "auto cannot tell the format of ground truth '" + path +
-                                "': its first line is not 12 numbers (KITTI poses.txt), 'timestamp tx ty tz qx qy qz "
-                                "qw' (TUM) or 'timestamp_ns,px,py,pz,qw,qx,qy,qz,...' (EuRoC); give the format");
+                                  "': its first line is not 12 numbers (KITTI poses.txt), 'timestamp tx ty tz qx qy qz "
+                                  "qw' (TUM) or 'timestamp_ns,px,py,pz,qw,qx,qy,qz,...' (EuRoC); give the format");
 }
 
 }  // namespace
@@ -122,8 +122,8 @@ GroundTruth ReadGroundTruth(const std::string& path, GroundTruthFormat format, c
     if (!IsDataLine(line)) continue;
     const std::vector<double> v = LineNumbers(line, path, number);
     const auto bad = [&](const char* expected) {
-      throw InputError(fmt::format("ground truth '{}' line {} has {} numbers; a {} line is {}", path, number,
-                                   v.size(), GroundTruthFormatName(format), expected));
+      throw InputError(fmt::format("ground truth '{}' line {} has {} numbers; a {} line is {}", path, number, v.size(),
+                                   GroundTruthFormatName(format), expected));
     };
     for (double value : v) {
       if (!std::isfinite(value)) throw InputError(fmt::format("ground truth '{}' line {}: not finite", path, number));
@@ -151,7 +151,8 @@ GroundTruth ReadGroundTruth(const std::string& path, GroundTruthFormat format, c
         truth.camera_to_world.push_back(T_wb * body_to_camera);
         break;
       }
-      case GroundTruthFormat::kAuto: break;
+      case GroundTruthFormat::kAuto:
+        break;
     }
   }
   if (truth.camera_to_world.empty()) throw InputError("ground truth '" + path + "' holds no poses");
@@ -169,7 +170,8 @@ std::optional<GroundTruth> FindGroundTruth(const std::string& input_path, Source
   const fs::path p(input_path);
   switch (format) {
     case SourceFormat::kKitti: {
-      if (fs::is_regular_file(p / "poses.txt")) return ReadGroundTruth((p / "poses.txt").string(), GroundTruthFormat::kKitti);
+      if (fs::is_regular_file(p / "poses.txt"))
+        return ReadGroundTruth((p / "poses.txt").string(), GroundTruthFormat::kKitti);
       // The official layout: dataset/sequences/07/ and dataset/poses/07.txt.
       const fs::path sequence = fs::absolute(p).lexically_normal();
       const fs::path name = sequence.has_filename() ? sequence.filename() : sequence.parent_path().filename();
@@ -183,14 +185,17 @@ std::optional<GroundTruth> FindGroundTruth(const std::string& input_path, Source
       return std::nullopt;
     }
     case SourceFormat::kEuroc: {
-      fs::path cam0 = fs::is_directory(p) ? (fs::exists(p / "mav0/cam0") ? p / "mav0/cam0" : p / "cam0") : p.parent_path();
+      fs::path cam0 =
+          fs::is_directory(p) ? (fs::exists(p / "mav0/cam0") ? p / "mav0/cam0" : p / "cam0") : p.parent_path();
       const fs::path file = cam0.parent_path() / "state_groundtruth_estimate0" / "data.csv";
       if (!fs::is_regular_file(file)) return std::nullopt;
       cv::Matx44d body_to_camera = cv::Matx44d::eye();
-      if (fs::is_regular_file(cam0 / "sensor.yaml")) body_to_camera = ReadEurocSensor((cam0 / "sensor.yaml").string()).T_BS;
+      if (fs::is_regular_file(cam0 / "sensor.yaml"))
+        body_to_camera = ReadEurocSensor((cam0 / "sensor.yaml").string()).T_BS;
       return ReadGroundTruth(file.string(), GroundTruthFormat::kEuroc, body_to_camera);
     }
-    default: return std::nullopt;
+    default:
+      return std::nullopt;
   }
 }
 

@@ -25,14 +25,16 @@ namespace vmap {
 
 enum class GroundTruthFormat { kAuto, kKitti, kTum, kEuroc };
 inline constexpr EnumName<GroundTruthFormat> kGroundTruthFormatNames[] = {{GroundTruthFormat::kAuto, "auto"},
-    {GroundTruthFormat::kKitti, "kitti"}, {GroundTruthFormat::kTum, "tum"}, {GroundTruthFormat::kEuroc, "euroc"}};
+                                                                          {GroundTruthFormat::kKitti, "kitti"},
+                                                                          {GroundTruthFormat::kTum, "tum"},
+                                                                          {GroundTruthFormat::kEuroc, "euroc"}};
 GroundTruthFormat ParseGroundTruthFormat(const std::string& name);
 std::string GroundTruthFormatName(GroundTruthFormat format);
 
 struct GroundTruth {
   std::string path;
   GroundTruthFormat format = GroundTruthFormat::kAuto;
-  std::vector<double> timestamps;         // seconds, ascending; empty for kitti (indexed by image)
+  std::vector<double> timestamps;            // seconds, ascending; empty for kitti (indexed by image)
   std::vector<cv::Matx44d> camera_to_world;  // T_wc of the camera, one per line
 };
 

@@ -80,7 +80,8 @@ TEST(GroundTruth, RelativePoseMapsPointsFromTheFirstCameraToTheSecond) {
 TEST(GroundTruth, DetectsAndReadsTheThreeFormats) {
   testing::ScopedTempDir tmp;
   WriteText(tmp.path() / "kitti.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0.5 0 1 0 0 0 0 1 2\n");
-  WriteText(tmp.path() / "tum.txt", "# timestamp tx ty tz qx qy qz qw\n10.0 1 2 3 0 0 0 1\n10.1 1 2 4 0 0 0.7071068 0.7071068\n");
+  WriteText(tmp.path() / "tum.txt",
+            "# timestamp tx ty tz qx qy qz qw\n10.0 1 2 3 0 0 0 1\n10.1 1 2 4 0 0 0.7071068 0.7071068\n");
   WriteText(tmp.path() / "euroc.csv",
             "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], q_RS_z []\n"
             "1403636579758555392,4.6,-1.8,0.8,0.7071068,0,0,0.7071068,0,0,0,0,0,0,0,0,0\n");
@@ -102,7 +103,8 @@ TEST(GroundTruth, DetectsAndReadsTheThreeFormats) {
   // EuRoC orders it w x y z, gives the body's pose and nanoseconds; the camera's pose is T_wb T_bc.
   cv::Matx44d body_to_camera = cv::Matx44d::eye();
   body_to_camera(0, 3) = 0.1;  // the camera sits 10 cm along the body's x axis
-  const GroundTruth euroc = ReadGroundTruth((tmp.path() / "euroc.csv").string(), GroundTruthFormat::kAuto, body_to_camera);
+  const GroundTruth euroc =
+      ReadGroundTruth((tmp.path() / "euroc.csv").string(), GroundTruthFormat::kAuto, body_to_camera);
   ASSERT_EQ(euroc.timestamps.size(), 1u);
   EXPECT_NEAR(euroc.timestamps[0], 1403636579.758555392, 1e-6);
   EXPECT_NEAR(euroc.camera_to_world[0](1, 0), 1.0, 1e-6);
@@ -143,7 +145,7 @@ TEST(GroundTruth, KeyImagesTakeTheirPoseBySourceIndexOrByNearestTimestamp) {
   EXPECT_EQ(Translation(*KeyImagePose(tum, Key(0, 100.0), 0.02))[2], 0.0);
   EXPECT_FALSE(KeyImagePose(tum, Key(0, 100.15), 0.02));  // 50 ms from any pose
   EXPECT_FALSE(KeyImagePose(tum, Key(0, 99.0), 0.02));
-  EXPECT_FALSE(KeyImagePose(tum, Key(2, -1), 0.02));       // no timestamp: never by index
+  EXPECT_FALSE(KeyImagePose(tum, Key(2, -1), 0.02));  // no timestamp: never by index
 }
 
 TEST(GroundTruth, FindsTheGroundTruthOfEachLayout) {

@@ -33,8 +33,7 @@ void EvaluationOptions::Check() const {
     throw OptionError("min_parallax_px", fmt::format("{} px must be >= 0; the default is 10", min_parallax_px));
   }
   if (!(sampson_threshold_px > 0 && std::isfinite(sampson_threshold_px))) {
-    throw OptionError("sampson_threshold_px",
-                      fmt::format("{} px must be > 0; the default is 2", sampson_threshold_px));
+    throw OptionError("sampson_threshold_px", fmt::format("{} px must be > 0; the default is 2", sampson_threshold_px));
   }
   if (!(max_time_difference >= 0 && std::isfinite(max_time_difference))) {
     throw OptionError("max_time_difference",
@@ -267,8 +266,9 @@ std::optional<Camera> ParseEvaluationCamera(const std::string& camera_option) {
     // Checked even where the map's own camera is used, so that a wrong value is never silently passed over.
     std::error_code ec;
     if (fs::exists(camera_option, ec) && !fs::is_regular_file(camera_option, ec)) {
-      throw OptionError("camera", "'" + camera_option + "' is not a regular file; give a calibration file or "
-                                  "fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]]");
+      throw OptionError("camera", "'" + camera_option +
+                                      "' is not a regular file; give a calibration file or "
+                                      "fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]]");
     }
     camera = ParseCameraOption(camera_option);
     try {
@@ -466,8 +466,9 @@ void EvaluationOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"max_translation_error_deg", "--max-translation-error",
                  "Usable: translation direction error below this (deg) where the parallax is enough"},
                 max_translation_error_deg);
-  visitor.Visit({"min_parallax_px", "--min-parallax", "True parallax (px) from which the translation direction is judged"},
-                min_parallax_px);
+  visitor.Visit(
+      {"min_parallax_px", "--min-parallax", "True parallax (px) from which the translation direction is judged"},
+      min_parallax_px);
   visitor.Visit({"sampson_threshold_px", "--sampson-threshold",
                  "A match is on its true epipolar line within this Sampson error (px)"},
                 sampson_threshold_px);

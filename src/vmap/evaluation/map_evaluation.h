@@ -37,17 +37,17 @@ struct EvaluationOptions {
 // Values that cannot be computed for a link are NaN (written as null in JSON).
 struct LinkEvaluation {
   int link = 0;
-  int from_frame = 0, to_frame = 0;      // frame indices of the two key images
-  int from_source = 0, to_source = 0;    // their indices in the input
+  int from_frame = 0, to_frame = 0;    // frame indices of the two key images
+  int from_source = 0, to_source = 0;  // their indices in the input
   bool below_tau = false;
-  bool planar = false;                   // the link's homography test (mapping/link_analysis.h)
+  bool planar = false;  // the link's homography test (mapping/link_analysis.h)
   double similarity = 0.0;
   int num_verified = 0;
   int num_rejected = 0;
-  bool has_ground_truth = false;         // both key images have a ground-truth pose
-  std::string pose_source;               // "stored" (the map's pose), "fundamental" (from F), "none"
-  double true_rotation_deg = NAN;        // how much the camera turned between the key images
-  double true_baseline = NAN;            // how far it moved (the ground truth's unit: metres)
+  bool has_ground_truth = false;   // both key images have a ground-truth pose
+  std::string pose_source;         // "stored" (the map's pose), "fundamental" (from F), "none"
+  double true_rotation_deg = NAN;  // how much the camera turned between the key images
+  double true_baseline = NAN;      // how far it moved (the ground truth's unit: metres)
   // Median displacement, after the true rotation, of the tentative matches within sampson_threshold_px of
   // their true epipolar line (`consistent_matches` of them): whether the translation can be judged.
   double true_parallax_px = NAN;
@@ -74,10 +74,10 @@ struct LinkEvaluation {
 
 struct EvaluationSummary {
   int links = 0;
-  int evaluated_links = 0;   // with ground truth for both key images
+  int evaluated_links = 0;  // with ground truth for both key images
   int usable_links = 0;
-  double usable_share = NAN; // usable / evaluated
-  int links_with_pose = 0;   // stored or from F
+  double usable_share = NAN;  // usable / evaluated
+  int links_with_pose = 0;    // stored or from F
   double rotation_error_deg_median = NAN;
   double true_pose_cost_excess_median = NAN;  // over links with a pose and ground truth
   double translation_error_deg_median = NAN;  // over links with true parallax >= min_parallax_px

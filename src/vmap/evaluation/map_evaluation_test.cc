@@ -227,8 +227,8 @@ TEST(MapEvaluation, TumSequenceIsAssociatedByTimestamp) {
 TEST(MapEvaluation, EurocBodyPosesAreTurnedIntoCameraPoses) {
   testing::ScopedTempDir tmp;
   // The camera looks along the body's x axis, 10 cm in front of it, as on a drone.
-  cv::Matx44d body_to_camera(0, 0, 1, 0.10,  //
-                             -1, 0, 0, 0.02,  //
+  cv::Matx44d body_to_camera(0, 0, 1, 0.10,    //
+                             -1, 0, 0, 0.02,   //
                              0, -1, 0, -0.03,  //
                              0, 0, 0, 1);
   testing::WriteEurocSequence(Sequence(), tmp.path() / "euroc", body_to_camera);
@@ -287,7 +287,8 @@ TEST(MapEvaluation, OptionsReadBackAsWrittenAndKeepTheDefaultsOfWhatIsNotRecorde
   OptionsFromJson(JsonFieldReader(nlohmann::json{{"min_parallax_px", 3.0}}, "options"), &partly);
   EXPECT_EQ(partly.min_parallax_px, 3.0);
   EXPECT_EQ(partly.max_rotation_error_deg, EvaluationOptions().max_rotation_error_deg);
-  EXPECT_THROW(OptionsFromJson(JsonFieldReader(nlohmann::json{{"min_parallax_px", "3"}}, "options"), &partly), InputError);
+  EXPECT_THROW(OptionsFromJson(JsonFieldReader(nlohmann::json{{"min_parallax_px", "3"}}, "options"), &partly),
+               InputError);
 }
 
 // Frames shown twice in a row (7-Scenes repeats a frame when one was dropped) are never promoted to key

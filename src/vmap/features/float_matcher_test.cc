@@ -23,9 +23,11 @@ std::vector<FloatMatch> PlainMutualNearest(const cv::Mat& q, const cv::Mat& t, f
   std::vector<FloatMatch> out;
   for (int i = 0; i < q.rows; ++i) {
     int best_j = 0;
-    for (int j = 1; j < t.rows; ++j) if (s.at<float>(i, j) > s.at<float>(i, best_j)) best_j = j;
+    for (int j = 1; j < t.rows; ++j)
+      if (s.at<float>(i, j) > s.at<float>(i, best_j)) best_j = j;
     int best_i = 0;
-    for (int k = 1; k < q.rows; ++k) if (s.at<float>(k, best_j) > s.at<float>(best_i, best_j)) best_i = k;
+    for (int k = 1; k < q.rows; ++k)
+      if (s.at<float>(k, best_j) > s.at<float>(best_i, best_j)) best_i = k;
     if (best_i == i && s.at<float>(i, best_j) >= min_similarity) out.push_back({i, best_j, s.at<float>(i, best_j)});
   }
   return out;
@@ -59,9 +61,15 @@ TEST(MatchFloatDescriptors, AgreesWithThePlainDefinitionAcrossBlocksAndThreshold
   std::mt19937 random(7);
   // Row counts around the product sizes (at least 128 rows, 256 at a time) and train sets of one and of
   // several 1024-column tiles.
-  for (const auto& [rows, train_rows] : std::vector<std::pair<int, int>>{
-           {1, 300}, {127, 2100}, {128, 300}, {255, 300}, {256, 2100}, {257, 300}, {383, 300}, {384, 1100},
-           {600, 300}}) {
+  for (const auto& [rows, train_rows] : std::vector<std::pair<int, int>>{{1, 300},
+                                                                         {127, 2100},
+                                                                         {128, 300},
+                                                                         {255, 300},
+                                                                         {256, 2100},
+                                                                         {257, 300},
+                                                                         {383, 300},
+                                                                         {384, 1100},
+                                                                         {600, 300}}) {
     const cv::Mat q = RandomUnitRows(rows, 32, random);
     const cv::Mat t = RandomUnitRows(train_rows, 32, random);
     for (float threshold : {-1.f, 0.3f, 0.5f}) {

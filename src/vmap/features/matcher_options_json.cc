@@ -43,7 +43,8 @@ MatcherOptions MatcherOptionsFromJson(const std::string& matcher_json, const std
     throw InputError("map '" + map_file + "': options.matcher is not valid JSON; rebuild the map");
   }
   if (!doc.is_object() || !doc.contains("type") || !doc["type"].is_string()) {
-    throw InputError("map '" + map_file + "' does not record its matcher (options.matcher.type); rebuild it with "
+    throw InputError("map '" + map_file +
+                     "' does not record its matcher (options.matcher.type); rebuild it with "
                      "this vmap");
   }
   MatcherOptions options;

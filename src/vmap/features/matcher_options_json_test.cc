@@ -42,8 +42,9 @@ TEST(MatcherOptionsFromJson, UnknownOrMissingMatchersAreClearErrors) {
   };
   EXPECT_NE(message(R"({"type": "sift"})").find("built with the matcher 'sift'"), std::string::npos);
   EXPECT_NE(message("{}").find("does not record its matcher"), std::string::npos);
-  EXPECT_NE(message(R"({"type": "orb", "num_features": "many"})").find("num_features must be an integer (it is string)"),
-            std::string::npos);
+  EXPECT_NE(
+      message(R"({"type": "orb", "num_features": "many"})").find("num_features must be an integer (it is string)"),
+      std::string::npos);
   // Named by its JSON key, as the model's options are.
   EXPECT_NE(message(R"({"type": "orb", "num_features": 0})").find("orb.num_features must be 1 to 100000"),
             std::string::npos);

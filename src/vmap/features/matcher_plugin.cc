@@ -51,8 +51,9 @@ const MatcherPluginTable* OpenPlugin() {
   }
   return entry();
 #else
-  throw InputError("this vmap was built without LibTorch (VMAP_WITH_TORCH=OFF); rebuild with it for the deep "
-                   "matchers");
+  throw InputError(
+      "this vmap was built without LibTorch (VMAP_WITH_TORCH=OFF); rebuild with it for the deep "
+      "matchers");
 #endif
 }
 

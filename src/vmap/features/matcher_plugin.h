@@ -26,7 +26,7 @@ struct PluginMatcherModel {
 };
 
 struct MatcherPluginTable {
-  std::vector<PluginMatcherModel> models;  // by name
+  std::vector<PluginMatcherModel> models;                         // by name
   const PluginMatcherModel* Find(const std::string& name) const;  // null when absent
 };
 

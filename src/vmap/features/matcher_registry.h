@@ -16,8 +16,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "vmap/features/matcher.h"
 #include "vmap/core/option_fields.h"
+#include "vmap/features/matcher.h"
 
 namespace vmap {
 

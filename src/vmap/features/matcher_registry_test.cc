@@ -39,13 +39,13 @@ TEST(MatcherRegistry, HoldsOrbAndTheDeepModels) {
 }
 
 TEST(MatcherRegistry, AnUnknownNameListsTheRegisteredOnes) {
-  for (const auto& call : std::vector<std::function<void()>>{
-           [] { FindMatcherModel("sift"); }, [] { DefaultTau("sift"); },
-           [] {
-             MatcherOptions options;
-             options.type = "sift";
-             CreateMatcher(options);
-           }}) {
+  for (const auto& call :
+       std::vector<std::function<void()>>{[] { FindMatcherModel("sift"); }, [] { DefaultTau("sift"); },
+                                          [] {
+                                            MatcherOptions options;
+                                            options.type = "sift";
+                                            CreateMatcher(options);
+                                          }}) {
     try {
       call();
       ADD_FAILURE() << "no error for an unknown matcher";

@@ -77,13 +77,14 @@ class OrbMatcher : public Matcher {
 
   std::shared_ptr<const ImageFeatures> Extract(const cv::Mat& gray) const override {
     // A detector per call: cv::ORB is not documented as thread-safe, and creating one is cheap.
-    cv::Ptr<cv::ORB> orb = cv::ORB::create(options_.num_features, static_cast<float>(options_.scale_factor),
-                                           options_.num_levels, options_.edge_threshold, 0, 2,
-                                           cv::ORB::HARRIS_SCORE, 31, options_.fast_threshold);
+    cv::Ptr<cv::ORB> orb =
+        cv::ORB::create(options_.num_features, static_cast<float>(options_.scale_factor), options_.num_levels,
+                        options_.edge_threshold, 0, 2, cv::ORB::HARRIS_SCORE, 31, options_.fast_threshold);
     auto features = std::make_shared<OrbFeatures>();
     features->size = gray.size();
     // OpenCV's pyramid fails on a level that rounds to no pixel: such an image has no ORB features.
-    const double smallest_level = std::min(gray.cols, gray.rows) / std::pow(options_.scale_factor, options_.num_levels - 1);
+    const double smallest_level =
+        std::min(gray.cols, gray.rows) / std::pow(options_.scale_factor, options_.num_levels - 1);
     if (gray.empty() || smallest_level < 1.0) return features;
     orb->detectAndCompute(gray, cv::noArray(), features->keypoints, features->binary_descriptors);
     if (features->binary_descriptors.empty()) features->keypoints.clear();
@@ -95,7 +96,8 @@ class OrbMatcher : public Matcher {
     const auto& b = static_cast<const OrbFeatures&>(features1);
     TentativeMatches matches;
     if (a.binary_descriptors.empty() || b.binary_descriptors.empty()) return matches;
-    const auto pairs = MatchBinaryDescriptors(a.binary_descriptors, b.binary_descriptors, options_.cross_check, options_.ratio);
+    const auto pairs =
+        MatchBinaryDescriptors(a.binary_descriptors, b.binary_descriptors, options_.cross_check, options_.ratio);
     matches.points0.reserve(pairs.size());
     matches.points1.reserve(pairs.size());
     for (const auto& [i, j] : pairs) {
@@ -152,7 +154,8 @@ class OrbMatcher : public Matcher {
     }
     if (header.count > 0) {
       features->binary_descriptors.create(header.count, header.descriptor_bytes, CV_8U);
-      std::memcpy(features->binary_descriptors.data, cursor, static_cast<size_t>(header.count) * header.descriptor_bytes);
+      std::memcpy(features->binary_descriptors.data, cursor,
+                  static_cast<size_t>(header.count) * header.descriptor_bytes);
     }
     return features;
   }
@@ -179,9 +182,9 @@ std::vector<uint64_t> PackWords(const cv::Mat& descriptors, int words, int rows)
 
 // Any width: one popcount per 64-bit word. Compiled with the POPCNT instruction and without, picked at
 // load time, so a generic x86-64 build still gets the fast path.
-__attribute__((target_clones("popcnt", "default"))) void HammingRowWords(const uint64_t* query,
-                                                                         const uint64_t* train, int num_train,
-                                                                         int words, Distance* distances) {
+__attribute__((target_clones("popcnt", "default"))) void HammingRowWords(const uint64_t* query, const uint64_t* train,
+                                                                         int num_train, int words,
+                                                                         Distance* distances) {
   for (int j = 0; j < num_train; ++j) {
     int d = 0;
     for (int w = 0; w < words; ++w) d += __builtin_popcountll(query[w] ^ train[words * j + w]);
@@ -207,22 +210,23 @@ __attribute__((target("avx2"))) inline __m256i QuarterCounts(__m256i query, cons
 
 // Lane L holds quarter L of four consecutive trains, one per 16-bit field.
 __attribute__((target("avx2"))) inline __m256i FourTrains(__m256i query, const uint64_t* train) {
-  return _mm256_or_si256(_mm256_or_si256(QuarterCounts(query, train), _mm256_slli_epi64(QuarterCounts(query, train + 4), 16)),
-                         _mm256_or_si256(_mm256_slli_epi64(QuarterCounts(query, train + 8), 32),
-                                         _mm256_slli_epi64(QuarterCounts(query, train + 12), 48)));
+  return _mm256_or_si256(
+      _mm256_or_si256(QuarterCounts(query, train), _mm256_slli_epi64(QuarterCounts(query, train + 4), 16)),
+      _mm256_or_si256(_mm256_slli_epi64(QuarterCounts(query, train + 8), 32),
+                      _mm256_slli_epi64(QuarterCounts(query, train + 12), 48)));
 }
 
-__attribute__((target("avx2"))) void HammingRow256Avx2(const uint64_t* query, const uint64_t* train,
-                                                      int padded_trains, Distance* distances) {
+__attribute__((target("avx2"))) void HammingRow256Avx2(const uint64_t* query, const uint64_t* train, int padded_trains,
+                                                       Distance* distances) {
   const __m256i q = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(query));
   for (int j = 0; j < padded_trains; j += kLanes) {
     const uint64_t* t = train + 4 * static_cast<size_t>(j);
-    const __m256i a = FourTrains(q, t), b = FourTrains(q, t + 16), c = FourTrains(q, t + 32),
-                  d = FourTrains(q, t + 48);
+    const __m256i a = FourTrains(q, t), b = FourTrains(q, t + 16), c = FourTrains(q, t + 32), d = FourTrains(q, t + 48);
     // Sum the four quarters: [a0+a1, b0+b1 | a2+a3, b2+b3] and the same for c, d, then across halves.
     const __m256i ab = _mm256_add_epi16(_mm256_unpacklo_epi64(a, b), _mm256_unpackhi_epi64(a, b));
     const __m256i cd = _mm256_add_epi16(_mm256_unpacklo_epi64(c, d), _mm256_unpackhi_epi64(c, d));
-    const __m256i sums = _mm256_add_epi16(_mm256_permute2x128_si256(ab, cd, 0x20), _mm256_permute2x128_si256(ab, cd, 0x31));
+    const __m256i sums =
+        _mm256_add_epi16(_mm256_permute2x128_si256(ab, cd, 0x20), _mm256_permute2x128_si256(ab, cd, 0x31));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(distances + j), sums);
   }
 }
@@ -301,7 +305,8 @@ std::vector<std::pair<int, int>> MatchBinaryDescriptors(const cv::Mat& query, co
   for (int i = 0; i < nq; ++i) {
     const uint64_t* row = q.data() + static_cast<size_t>(i) * words;
 #if defined(__x86_64__)
-    if (avx2) HammingRow256Avx2(row, t.data(), padded, distances.data());
+    if (avx2)
+      HammingRow256Avx2(row, t.data(), padded, distances.data());
     else
 #endif
       HammingRowWords(row, t.data(), nt, words, distances.data());

@@ -3,10 +3,9 @@
 #include <climits>
 #include <tuple>
 
+#include <gtest/gtest.h>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
-
-#include <gtest/gtest.h>
 
 #include "vmap/core/error.h"
 #include "vmap/features/matcher_registry.h"
@@ -41,16 +40,19 @@ std::vector<std::pair<int, int>> ReferenceMatches(const cv::Mat& query, const cv
                                                   double ratio) {
   cv::Mat distance(query.rows, train.rows, CV_32S);
   for (int i = 0; i < query.rows; ++i) {
-    for (int j = 0; j < train.rows; ++j) distance.at<int>(i, j) = static_cast<int>(cv::norm(query.row(i), train.row(j), cv::NORM_HAMMING));
+    for (int j = 0; j < train.rows; ++j)
+      distance.at<int>(i, j) = static_cast<int>(cv::norm(query.row(i), train.row(j), cv::NORM_HAMMING));
   }
   std::vector<std::pair<int, int>> pairs;
   for (int i = 0; i < query.rows; ++i) {
     int best = 0;
     for (int j = 1; j < train.rows; ++j) best = distance.at<int>(i, j) < distance.at<int>(i, best) ? j : best;
     int second = INT_MAX;
-    for (int j = 0; j < train.rows; ++j) if (j != best) second = std::min(second, distance.at<int>(i, j));
+    for (int j = 0; j < train.rows; ++j)
+      if (j != best) second = std::min(second, distance.at<int>(i, j));
     int best_query = 0;
-    for (int k = 1; k < query.rows; ++k) best_query = distance.at<int>(k, best) < distance.at<int>(best_query, best) ? k : best_query;
+    for (int k = 1; k < query.rows; ++k)
+      best_query = distance.at<int>(k, best) < distance.at<int>(best_query, best) ? k : best_query;
     if (cross_check && best_query != i) continue;
     if (ratio > 0 && train.rows > 1 && !(distance.at<int>(i, best) < ratio * second)) continue;
     pairs.emplace_back(i, best);
@@ -60,8 +62,8 @@ std::vector<std::pair<int, int>> ReferenceMatches(const cv::Mat& query, const cv
 
 TEST(BinaryMatching, EqualsThePlainDefinitionForAnySizeWidthAndTies) {
   cv::RNG rng(11);
-  for (const auto& [rows_a, rows_b, width] : {std::tuple{1, 1, 32}, {7, 5, 32}, {33, 17, 32}, {100, 130, 32},
-                                              {40, 31, 64}, {20, 45, 8}}) {
+  for (const auto& [rows_a, rows_b, width] :
+       {std::tuple{1, 1, 32}, {7, 5, 32}, {33, 17, 32}, {100, 130, 32}, {40, 31, 64}, {20, 45, 8}}) {
     cv::Mat a(rows_a, width, CV_8U), b(rows_b, width, CV_8U);
     // Few distinct bytes: many equal distances, so the tie rules are exercised.
     rng.fill(a, cv::RNG::UNIFORM, 0, 4);

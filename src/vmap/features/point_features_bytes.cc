@@ -49,8 +49,8 @@ std::optional<PointFeatureRows> DecodePointFeatures(std::string_view tag, std::s
   Header header;
   if (tag.size() != kTagSize || bytes.size() < sizeof(header)) return std::nullopt;
   std::memcpy(&header, bytes.data(), sizeof(header));
-  if (std::memcmp(header.tag, tag.data(), kTagSize) != 0 || header.width < 0 || header.height < 0 ||
-      header.count < 0 || header.count > kMaxCount || header.dimensions < 0 || header.dimensions > kMaxDimensions ||
+  if (std::memcmp(header.tag, tag.data(), kTagSize) != 0 || header.width < 0 || header.height < 0 || header.count < 0 ||
+      header.count > kMaxCount || header.dimensions < 0 || header.dimensions > kMaxDimensions ||
       (header.count > 0 && header.dimensions == 0)) {
     return std::nullopt;
   }

@@ -35,10 +35,10 @@ TEST(PointFeaturesBytes, RoundTripIsExact) {
 
 TEST(PointFeaturesBytes, DamagedOrForeignBytesAreRefused) {
   const std::string bytes = EncodePointFeatures(kTag, SomeFeatures(5, 128));
-  EXPECT_FALSE(DecodePointFeatures("vmapELSE", bytes));                               // another matcher's
-  EXPECT_FALSE(DecodePointFeatures(kTag, bytes.substr(0, bytes.size() - 1)));        // truncated
-  EXPECT_FALSE(DecodePointFeatures(kTag, bytes + "x"));                              // trailing bytes
-  EXPECT_FALSE(DecodePointFeatures(kTag, bytes.substr(0, 10)));                      // no whole header
+  EXPECT_FALSE(DecodePointFeatures("vmapELSE", bytes));                        // another matcher's
+  EXPECT_FALSE(DecodePointFeatures(kTag, bytes.substr(0, bytes.size() - 1)));  // truncated
+  EXPECT_FALSE(DecodePointFeatures(kTag, bytes + "x"));                        // trailing bytes
+  EXPECT_FALSE(DecodePointFeatures(kTag, bytes.substr(0, 10)));                // no whole header
   std::string huge = bytes;
   const int32_t count = 1 << 30;
   std::memcpy(huge.data() + 16, &count, sizeof(count));  // the count field after tag, width, height

@@ -28,11 +28,16 @@ std::vector<double> Camera::distortion() const {
 
 std::vector<double> Camera::params() const {
   switch (model) {
-    case CameraModel::kSimplePinhole: return {fx, cx, cy};
-    case CameraModel::kPinhole: return {fx, fy, cx, cy};
-    case CameraModel::kOpenCV: return {fx, fy, cx, cy, k1, k2, p1, p2};
-    case CameraModel::kFullOpenCV: return {fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6};
-    case CameraModel::kOpenCVFisheye: return {fx, fy, cx, cy, k1, k2, k3, k4};
+    case CameraModel::kSimplePinhole:
+      return {fx, cx, cy};
+    case CameraModel::kPinhole:
+      return {fx, fy, cx, cy};
+    case CameraModel::kOpenCV:
+      return {fx, fy, cx, cy, k1, k2, p1, p2};
+    case CameraModel::kFullOpenCV:
+      return {fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6};
+    case CameraModel::kOpenCVFisheye:
+      return {fx, fy, cx, cy, k1, k2, k3, k4};
   }
   return {};
 }
@@ -41,8 +46,8 @@ Camera Camera::FromParams(CameraModel model, const std::vector<double>& params, 
   static const size_t kCounts[] = {3, 4, 8, 12, 8};
   const size_t expected = kCounts[static_cast<int>(model)];
   if (params.size() != expected) {
-    throw InputError(fmt::format("camera model {} has {} parameters, got {}", CameraModelName(model), expected,
-                                 params.size()));
+    throw InputError(
+        fmt::format("camera model {} has {} parameters, got {}", CameraModelName(model), expected, params.size()));
   }
   Camera camera;
   camera.model = model;
@@ -78,8 +83,7 @@ Camera Camera::FromParams(CameraModel model, const std::vector<double>& params, 
   return camera;
 }
 
-Camera Camera::Make(double fx, double fy, double cx, double cy, const std::vector<double>& distortion,
-                    cv::Size size) {
+Camera Camera::Make(double fx, double fy, double cx, double cy, const std::vector<double>& distortion, cv::Size size) {
   Camera camera;
   camera.fx = fx;
   camera.fy = fy;
@@ -92,8 +96,9 @@ Camera Camera::Make(double fx, double fy, double cx, double cy, const std::vecto
   // OpenCV writes 5, 8, 12 or 14 coefficients; the thin-prism and tilt terms past k6 must be zero.
   for (size_t i = 8; i < distortion.size(); ++i) {
     if (distortion[i] != 0.0) {
-      throw InputError("distortion coefficients past k6 (thin-prism or tilt models) are not supported; "
-                       "recalibrate with OpenCV's default or rational model");
+      throw InputError(
+          "distortion coefficients past k6 (thin-prism or tilt models) are not supported; "
+          "recalibrate with OpenCV's default or rational model");
     }
   }
   if (distortion.size() == 6 || distortion.size() == 7) {
@@ -105,10 +110,12 @@ Camera Camera::Make(double fx, double fy, double cx, double cy, const std::vecto
   for (size_t i = 0; i < std::min<size_t>(distortion.size(), 8); ++i) *coefficients[i] = distortion[i];
   if (camera.k3 != 0.0 || camera.k4 != 0.0 || camera.k5 != 0.0 || camera.k6 != 0.0) {
     camera.model = CameraModel::kFullOpenCV;
-  }
-  else if (camera.has_distortion()) camera.model = CameraModel::kOpenCV;
-  else if (fx == fy) camera.model = CameraModel::kSimplePinhole;
-  else camera.model = CameraModel::kPinhole;
+  } else if (camera.has_distortion())
+    camera.model = CameraModel::kOpenCV;
+  else if (fx == fy)
+    camera.model = CameraModel::kSimplePinhole;
+  else
+    camera.model = CameraModel::kPinhole;
   return camera;
 }
 
@@ -159,8 +166,8 @@ std::vector<double> NumbersIn(const std::string& text) {
       if (used != token.size()) throw std::invalid_argument(token);
     } catch (const std::exception&) {
       throw OptionError("camera", "'" + text + "': '" + token +
-                                  "' is not a number; give fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]] or a "
-                                  "calibration file");
+                                      "' is not a number; give fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]] or a "
+                                      "calibration file");
     }
   }
   return numbers;
@@ -204,8 +211,8 @@ Camera ParseCameraText(const std::string& text) {
   const std::vector<double> n = NumbersIn(text);
   if (n.size() != 4 && n.size() != 8 && n.size() != 9 && n.size() != 12) {
     throw OptionError("camera", "'" + text + "' has " + std::to_string(n.size()) +
-                                " numbers; give fx,fy,cx,cy or fx,fy,cx,cy,k1,k2,p1,p2[,k3[,k4,k5,k6]] (pixels), "
-                                "or a calibration file");
+                                    " numbers; give fx,fy,cx,cy or fx,fy,cx,cy,k1,k2,p1,p2[,k3[,k4,k5,k6]] (pixels), "
+                                    "or a calibration file");
   }
   Camera camera = Camera::Make(n[0], n[1], n[2], n[3], std::vector<double>(n.begin() + 4, n.end()));
   camera.origin = "--camera";
@@ -244,12 +251,14 @@ Camera ReadOpenCvCameraFile(const std::string& path) {
   Camera camera;
   if (model == "equidistant" || model == "fisheye") {
     if (distortion.size() != 4) {
-      throw InputError("camera file '" + path + "': an " + model + " camera needs 4 distortion_coefficients (k1..k4 "
-                       "of cv::fisheye), got " + std::to_string(distortion.size()));
+      throw InputError("camera file '" + path + "': an " + model +
+                       " camera needs 4 distortion_coefficients (k1..k4 "
+                       "of cv::fisheye), got " +
+                       std::to_string(distortion.size()));
     }
-    camera = Camera::FromParams(CameraModel::kOpenCVFisheye,
-                                {K[0], K[4], K[2], K[5], distortion[0], distortion[1], distortion[2], distortion[3]},
-                                size);
+    camera =
+        Camera::FromParams(CameraModel::kOpenCVFisheye,
+                           {K[0], K[4], K[2], K[5], distortion[0], distortion[1], distortion[2], distortion[3]}, size);
   } else if (model.empty() || model == "plumb_bob" || model == "rational_polynomial" || model == "radtan") {
     camera = Camera::Make(K[0], K[4], K[2], K[5], distortion, size);
   } else {
@@ -269,10 +278,10 @@ Camera CameraForFrames(const Camera& camera, cv::Size native_size, cv::Size fram
     const double ratio = static_cast<double>(camera.size.width) / camera.size.height;
     const double frame_ratio = static_cast<double>(native_size.width) / native_size.height;
     if (std::abs(ratio / frame_ratio - 1.0) > 0.01) {
-      throw OptionError("camera", fmt::format("must fit the frames: {} is for {}x{} images but the frames are "
-                                              "{}x{}; give a calibration of these frames",
-                                              where, camera.size.width, camera.size.height, native_size.width,
-                                              native_size.height));
+      throw OptionError(
+          "camera", fmt::format("must fit the frames: {} is for {}x{} images but the frames are "
+                                "{}x{}; give a calibration of these frames",
+                                where, camera.size.width, camera.size.height, native_size.width, native_size.height));
     }
     spdlog::info("{} is for {}x{} images; scaling it to the frames' {}x{}", where, camera.size.width,
                  camera.size.height, native_size.width, native_size.height);
@@ -286,9 +295,10 @@ Camera CameraForFrames(const Camera& camera, cv::Size native_size, cv::Size fram
   }
   if (std::abs(native.cx - 0.5 * native_size.width) > 0.2 * native_size.width ||
       std::abs(native.cy - 0.5 * native_size.height) > 0.2 * native_size.height) {
-    spdlog::warn("{} has its principal point ({:.1f}, {:.1f}) far from the centre of the {}x{} frames; check that "
-                 "it belongs to these images",
-                 where, native.cx, native.cy, native_size.width, native_size.height);
+    spdlog::warn(
+        "{} has its principal point ({:.1f}, {:.1f}) far from the centre of the {}x{} frames; check that "
+        "it belongs to these images",
+        where, native.cx, native.cy, native_size.width, native_size.height);
   }
   return native.ScaledTo(frame_size);
 }
@@ -298,7 +308,8 @@ std::vector<cv::Point2d> NormalizePoints(const Camera& camera, const std::vector
   if (pixels.empty()) return normalized;
   if (!camera.has_distortion()) {
     normalized.reserve(pixels.size());
-    for (const cv::Point2f& p : pixels) normalized.emplace_back((p.x - camera.cx) / camera.fx, (p.y - camera.cy) / camera.fy);
+    for (const cv::Point2f& p : pixels)
+      normalized.emplace_back((p.x - camera.cx) / camera.fx, (p.y - camera.cy) / camera.fy);
     return normalized;
   }
   std::vector<cv::Point2d> input(pixels.begin(), pixels.end());

@@ -25,15 +25,17 @@ namespace vmap {
 // OPENCV_FISHEYE (fx, fy, cx, cy, k1, k2, k3, k4).
 enum class CameraModel { kSimplePinhole, kPinhole, kOpenCV, kFullOpenCV, kOpenCVFisheye };
 inline constexpr EnumName<CameraModel> kCameraModelNames[] = {{CameraModel::kSimplePinhole, "SIMPLE_PINHOLE"},
-    {CameraModel::kPinhole, "PINHOLE"}, {CameraModel::kOpenCV, "OPENCV"}, {CameraModel::kFullOpenCV, "FULL_OPENCV"},
-    {CameraModel::kOpenCVFisheye, "OPENCV_FISHEYE"}};
+                                                              {CameraModel::kPinhole, "PINHOLE"},
+                                                              {CameraModel::kOpenCV, "OPENCV"},
+                                                              {CameraModel::kFullOpenCV, "FULL_OPENCV"},
+                                                              {CameraModel::kOpenCVFisheye, "OPENCV_FISHEYE"}};
 
 std::string CameraModelName(CameraModel model);
 CameraModel ParseCameraModel(const std::string& name);  // COLMAP's names, as above
 
 struct Camera {
   CameraModel model = CameraModel::kPinhole;
-  cv::Size size;   // the image size the intrinsics belong to; empty when the calibration did not say
+  cv::Size size;  // the image size the intrinsics belong to; empty when the calibration did not say
   double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
   double k1 = 0.0, k2 = 0.0, p1 = 0.0, p2 = 0.0, k3 = 0.0;
   double k4 = 0.0, k5 = 0.0, k6 = 0.0;  // rational radial terms (FULL_OPENCV), or the fisheye's k4
@@ -43,8 +45,8 @@ struct Camera {
   bool is_fisheye() const { return model == CameraModel::kOpenCVFisheye; }
   // A fisheye lens always distorts: its zero coefficients are the equidistant projection, not a pinhole.
   bool has_distortion() const {
-    return is_fisheye() || k1 != 0.0 || k2 != 0.0 || p1 != 0.0 || p2 != 0.0 || k3 != 0.0 || k4 != 0.0 ||
-           k5 != 0.0 || k6 != 0.0;
+    return is_fisheye() || k1 != 0.0 || k2 != 0.0 || p1 != 0.0 || p2 != 0.0 || k3 != 0.0 || k4 != 0.0 || k5 != 0.0 ||
+           k6 != 0.0;
   }
   // OpenCV's distortion vector (k1, k2, p1, p2[, k3[, k4, k5, k6]]), or cv::fisheye's (k1, k2, k3, k4); empty
   // without distortion.

@@ -17,12 +17,12 @@ TEST(Camera, PicksTheSimplestColmapModelAndRoundTripsItsParameters) {
   EXPECT_EQ(Camera::Make(500, 510, 320, 240).model, CameraModel::kPinhole);
   EXPECT_EQ(Camera::Make(500, 500, 320, 240, {0.1, 0, 0, 0}).model, CameraModel::kOpenCV);
   EXPECT_EQ(Camera::Make(500, 500, 320, 240, {0.1, 0, 0, 0, 0.01}).model, CameraModel::kFullOpenCV);
-  for (const Camera& camera : {Camera::Make(500, 500, 320, 240), Camera::Make(500, 510, 321, 239),
-                               Camera::Make(500, 510, 320, 240, {-0.2, 0.05, 1e-3, -2e-3}),
-                               Camera::Make(500, 510, 320, 240, {-0.2, 0.05, 1e-3, -2e-3, 0.01}),
-                               Camera::Make(500, 510, 320, 240, {-0.2, 0.05, 1e-3, -2e-3, 0.01, 0.1, 0.02, 0.003}),
-                               Camera::FromParams(CameraModel::kOpenCVFisheye, {500, 510, 320, 240, 0.1, -0.02, 0.003,
-                                                                               -0.0004})}) {
+  for (const Camera& camera :
+       {Camera::Make(500, 500, 320, 240), Camera::Make(500, 510, 321, 239),
+        Camera::Make(500, 510, 320, 240, {-0.2, 0.05, 1e-3, -2e-3}),
+        Camera::Make(500, 510, 320, 240, {-0.2, 0.05, 1e-3, -2e-3, 0.01}),
+        Camera::Make(500, 510, 320, 240, {-0.2, 0.05, 1e-3, -2e-3, 0.01, 0.1, 0.02, 0.003}),
+        Camera::FromParams(CameraModel::kOpenCVFisheye, {500, 510, 320, 240, 0.1, -0.02, 0.003, -0.0004})}) {
     const Camera back = Camera::FromParams(camera.model, camera.params(), {640, 480});
     EXPECT_EQ(ParseCameraModel(CameraModelName(camera.model)), camera.model);
     EXPECT_EQ(back.K(), camera.K());
@@ -62,8 +62,8 @@ TEST(Camera, ReadsOpenCvCalibrationFilesInYamlAndJson) {
   for (const char* name : {"calibration.yaml", "calibration.json"}) {
     // What OpenCV's calibration sample writes.
     cv::FileStorage fs((tmp.path() / name).string(), cv::FileStorage::WRITE);
-    fs << "image_width" << 640 << "image_height" << 480 << "camera_matrix" << cv::Mat(K)
-       << "distortion_coefficients" << distortion << "avg_reprojection_error" << 0.31;
+    fs << "image_width" << 640 << "image_height" << 480 << "camera_matrix" << cv::Mat(K) << "distortion_coefficients"
+       << distortion << "avg_reprojection_error" << 0.31;
     fs.release();
     const Camera camera = ReadOpenCvCameraFile((tmp.path() / name).string());
     EXPECT_EQ(camera.K(), K) << name;
@@ -75,16 +75,17 @@ TEST(Camera, ReadsOpenCvCalibrationFilesInYamlAndJson) {
   {
     // A fisheye calibration, its model named as ROS's camera_calibration names it.
     cv::FileStorage fs((tmp.path() / "fisheye.yaml").string(), cv::FileStorage::WRITE);
-    fs << "image_width" << 640 << "image_height" << 480 << "camera_matrix" << cv::Mat(K)
-       << "distortion_model" << "equidistant" << "distortion_coefficients"
-       << (cv::Mat_<double>(4, 1) << 0.05, -0.01, 0.002, -0.0003);
+    fs << "image_width" << 640 << "image_height" << 480 << "camera_matrix" << cv::Mat(K) << "distortion_model"
+       << "equidistant"
+       << "distortion_coefficients" << (cv::Mat_<double>(4, 1) << 0.05, -0.01, 0.002, -0.0003);
   }
   const Camera fisheye = ReadOpenCvCameraFile((tmp.path() / "fisheye.yaml").string());
   EXPECT_EQ(fisheye.model, CameraModel::kOpenCVFisheye);
   EXPECT_EQ(fisheye.distortion(), (std::vector<double>{0.05, -0.01, 0.002, -0.0003}));
   {
     cv::FileStorage fs((tmp.path() / "unknown_model.yaml").string(), cv::FileStorage::WRITE);
-    fs << "camera_matrix" << cv::Mat(K) << "distortion_model" << "kannala_brandt"
+    fs << "camera_matrix" << cv::Mat(K) << "distortion_model"
+       << "kannala_brandt"
        << "distortion_coefficients" << distortion;
   }
   EXPECT_THROW(ReadOpenCvCameraFile((tmp.path() / "unknown_model.yaml").string()), InputError);
@@ -175,8 +176,7 @@ TEST(Camera, NormalizePointsUndoesRationalAndFisheyeProjections) {
   std::vector<cv::Point3d> in_view;
   for (double x : {-0.6, -0.2, 0.3, 0.6})
     for (double y : {-0.45, 0.0, 0.4}) in_view.emplace_back(x, y, 1.0);
-  const Camera rational =
-      Camera::Make(520, 515, 318, 241, {0.9, 0.2, 0.0012, -0.0007, 0.005, 1.25, 0.4, 0.02});
+  const Camera rational = Camera::Make(520, 515, 318, 241, {0.9, 0.2, 0.0012, -0.0007, 0.005, 1.25, 0.4, 0.02});
   ASSERT_EQ(rational.model, CameraModel::kFullOpenCV);
   std::vector<cv::Point2d> projected;
   cv::projectPoints(in_view, cv::Vec3d(), cv::Vec3d(), cv::Mat(rational.K()), rational.distortion(), projected);

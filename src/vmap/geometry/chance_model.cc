@@ -98,8 +98,8 @@ ChanceOfMatches ChanceOfFundamental(const cv::Matx33d& F, const std::vector<cv::
     }
     const double e = std::max(distances[k - 1], kLeastDistance);
     if (!std::isfinite(e)) break;
-    const double alpha = std::max(std::min(RandomInlierProbability(e, size0), RandomInlierProbability(e, size1)),
-                                  shuffled_share(e));
+    const double alpha =
+        std::max(std::min(RandomInlierProbability(e, size0), RandomInlierProbability(e, size1)), shuffled_share(e));
     if (alpha >= 1.0) break;  // every match explained: nothing is unlikely any more
     const double log10_nfa = tests + log_n_choose_k + log_k_choose_7 + (k - kSampleSize) * std::log10(alpha);
     if (log10_nfa < best.log10_nfa) best = {log10_nfa, k, e};

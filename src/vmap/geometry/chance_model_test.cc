@@ -124,8 +124,8 @@ TEST(ChanceModel, RandomMatchesAreRefused) {
       ++verified;
       const ChanceOfMatches chance = ChanceOfFundamental(fit.F, p0, p1, kQvga, kQvga);
       EXPECT_GT(chance.log10_nfa, 0.0) << n << " random matches (seed " << seed << "), " << fit.num_inliers
-                                       << " kept by MAGSAC: " << chance.num_inliers << " within "
-                                       << chance.threshold << " px";
+                                       << " kept by MAGSAC: " << chance.num_inliers << " within " << chance.threshold
+                                       << " px";
     }
   }
   EXPECT_GT(verified, 6) << "MAGSAC found some F in random matches: the test tests something";

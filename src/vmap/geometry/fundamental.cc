@@ -70,9 +70,9 @@ FundamentalResult WithoutMotion(const std::vector<cv::Point2f>& points0, const s
 
 }  // namespace
 
-FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0,
-                                      const std::vector<cv::Point2f>& points1, const VerifierOptions& options,
-                                      const EarlyStop& early_stop, const std::vector<float>* scores) {
+FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0, const std::vector<cv::Point2f>& points1,
+                                      const VerifierOptions& options, const EarlyStop& early_stop,
+                                      const std::vector<float>* scores) {
   FundamentalResult result;
   CV_Assert(points0.size() == points1.size());
   if (static_cast<int>(points0.size()) < options.min_matches) return result;

@@ -19,18 +19,20 @@ struct MagsacCheckpoint;  // magsac.cc
 enum class VerifierMethod { kMagsac, kRansac, kUsac, kAccurate };
 // USAC_MAGSAC, FM_RANSAC, USAC_DEFAULT, USAC_ACCURATE.
 inline constexpr EnumName<VerifierMethod> kVerifierMethodNames[] = {{VerifierMethod::kMagsac, "magsac"},
-    {VerifierMethod::kRansac, "ransac"}, {VerifierMethod::kUsac, "usac"}, {VerifierMethod::kAccurate, "accurate"}};
+                                                                    {VerifierMethod::kRansac, "ransac"},
+                                                                    {VerifierMethod::kUsac, "usac"},
+                                                                    {VerifierMethod::kAccurate, "accurate"}};
 VerifierMethod ParseVerifierMethod(const std::string& name);
 std::string VerifierMethodName(VerifierMethod method);
 
 struct VerifierOptions {
   // Defaults follow Kornia's LoFTR + MAGSAC tutorial, which the paper's code most likely followed.
   VerifierMethod method = VerifierMethod::kMagsac;
-  double threshold = 0.5;      // pixels (epipolar distance for RANSAC, MAGSAC's sigma bound)
+  double threshold = 0.5;  // pixels (epipolar distance for RANSAC, MAGSAC's sigma bound)
   double confidence = 0.999;
   int max_iterations = 100000;
-  int seed = 0;                // the random generator's state: the same input gives the same inliers
-  int min_matches = 8;         // fewer tentative matches than this means matching failed
+  int seed = 0;         // the random generator's state: the same input gives the same inliers
+  int min_matches = 8;  // fewer tentative matches than this means matching failed
   // kMagsac only: false runs OpenCV's USAC_MAGSAC (the paper's exact behaviour); true runs vmap's own MAGSAC++
   // (magsac.h), which agrees with it within the noise of a seed change and can stop early (EarlyStop).
   bool own_magsac = false;
@@ -56,11 +58,11 @@ struct VerifierOptions {
 };
 
 struct FundamentalResult {
-  bool success = false;         // a model was found from at least min_matches tentative matches
+  bool success = false;  // a model was found from at least min_matches tentative matches
   cv::Matx33d F = cv::Matx33d::zeros();
   std::vector<unsigned char> inlier_mask;  // one per tentative match; empty when !success
   int num_inliers = 0;
-  bool abandoned = false;       // EarlyStop::abandon ended it: not a result, discard it
+  bool abandoned = false;  // EarlyStop::abandon ended it: not a result, discard it
   // Set when vmap's MAGSAC++ stopped early (EarlyStop): where its sample loop stopped. Given back as
   // EarlyStop::resume_from with the same correspondences and options, the estimation goes on from there.
   std::shared_ptr<const MagsacCheckpoint> checkpoint;
@@ -80,9 +82,9 @@ struct EarlyStop {
 };
 
 // `scores`: one per match, higher is better (TentativeMatches::scores), read only for options.loop_points.
-FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0,
-                                      const std::vector<cv::Point2f>& points1, const VerifierOptions& options,
-                                      const EarlyStop& early_stop = {}, const std::vector<float>* scores = nullptr);
+FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0, const std::vector<cv::Point2f>& points1,
+                                      const VerifierOptions& options, const EarlyStop& early_stop = {},
+                                      const std::vector<float>* scores = nullptr);
 
 // Symmetric epipolar (Sampson) distance of x1 <-> x0 under F (x1^T F x0 = 0), in pixels.
 double SampsonDistance(const cv::Matx33d& F, const cv::Point2f& p0, const cv::Point2f& p1);

@@ -93,8 +93,10 @@ bool OrientedConstraintHolds(const NormalizedPoints& points, const double* m, co
     // (e x x0) . l with x0 = (x, y, 1)
     const double c0 = e[1] - e[2] * p.y0, c1 = e[2] * p.x0 - e[0], c2 = e[0] * p.y0 - e[1] * p.x0;
     const double sign = c0 * l0 + c1 * l1 + c2 * l2;
-    if (i == 0) first_sign = sign;
-    else if (sign * first_sign < 0) return false;
+    if (i == 0)
+      first_sign = sign;
+    else if (sign * first_sign < 0)
+      return false;
   }
   return true;
 }
@@ -294,8 +296,7 @@ int SolveSevenPoint(const NormalizedPoints& points, const SevenPointSample& samp
   auto det_at = [&](double a) {
     double m[9];
     for (int i = 0; i < 9; ++i) m[i] = F2[i] + a * D[i];
-    return m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
-           m[2] * (m[3] * m[7] - m[4] * m[6]);
+    return m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) + m[2] * (m[3] * m[7] - m[4] * m[6]);
   };
   const double p0 = det_at(0), p1 = det_at(1), pm = det_at(-1), p2 = det_at(2);
   const double c0 = p0, c2 = 0.5 * (p1 + pm) - p0, s = 0.5 * (p1 - pm);

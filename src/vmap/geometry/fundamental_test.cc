@@ -2,9 +2,8 @@
 
 #include <cmath>
 
-#include <opencv2/imgproc.hpp>
-
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "vmap/core/error.h"
 #include "vmap/testing/option_error.h"
@@ -88,7 +87,8 @@ TEST_P(FundamentalByMethod, RecoversTheTrueGeometryAndRejectsOutliers) {
   // Far from the image, the epipole's distance is poorly determined by matches inside it (plain RANSAC, without
   // refinement, places it 20 % off); its direction from the image centre, which sets the epipolar lines, is not.
   const cv::Point2d centre(320, 240);
-  const double angle = std::acos((e - centre).dot(e_true - centre) / (cv::norm(e - centre) * cv::norm(e_true - centre)));
+  const double angle =
+      std::acos((e - centre).dot(e_true - centre) / (cv::norm(e - centre) * cv::norm(e_true - centre)));
   EXPECT_LT(angle * 180 / CV_PI, 2.0) << e << " vs " << e_true;
 }
 

@@ -10,9 +10,9 @@
 namespace vmap {
 
 void HeadingOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Visit({"window_px", "--heading-window",
-                 "Heading: width of the window of horizontal displacements that votes (px)"},
-                window_px);
+  visitor.Visit(
+      {"window_px", "--heading-window", "Heading: width of the window of horizontal displacements that votes (px)"},
+      window_px);
   visitor.Visit({"window_dy_px", "--heading-window-dy",
                  "Heading: height of the window in vertical displacement (px; 0 = by x alone)"},
                 window_dy_px);
@@ -92,9 +92,8 @@ HeadingEstimate EstimateHeading(const std::vector<cv::Point2f>& points0, const s
     column.clear();
     for (size_t k = begin; k < end; ++k) column.push_back(static_cast<int>(k));
     if (options.window_dy_px > 0.0) {
-      std::sort(column.begin(), column.end(), [&](int a, int b) {
-        return votes[a].dy < votes[b].dy || (votes[a].dy == votes[b].dy && a < b);
-      });
+      std::sort(column.begin(), column.end(),
+                [&](int a, int b) { return votes[a].dy < votes[b].dy || (votes[a].dy == votes[b].dy && a < b); });
       size_t best_low = 0, best_high = 0;
       for (size_t low = 0, high = 0; low < column.size(); ++low) {
         high = std::max(high, low);

@@ -68,8 +68,8 @@ struct HeadingEstimate {
   // With a camera: the same as a bearing, the median over the winning matches of atan(x_n) in the second
   // image minus atan(x_n) in the first (x_n undistorted normalised x), in degrees; NaN without.
   double deg = std::numeric_limits<double>::quiet_NaN();
-  int votes = 0;        // matches in the winning window (verified_median: the verified matches)
-  int num_voters = 0;   // matches that voted (those with finite coordinates)
+  int votes = 0;       // matches in the winning window (verified_median: the verified matches)
+  int num_voters = 0;  // matches that voted (those with finite coordinates)
   // The share of voters in the winning window, votes / num_voters (0 without an estimate). Wrong matches
   // alone put a small share of them into any window (about the window's area over the image's), so a share
   // well above that is a heading many matches agree on.

@@ -27,11 +27,11 @@ struct HomographyOptions {
 };
 
 struct HomographyCheck {
-  bool estimated = false;               // a homography could be fitted (at least 4 matches)
-  cv::Matx33d H = cv::Matx33d::eye();   // x_to ~ H x_from
-  int num_explained = 0;                // matches within the threshold
-  double share = 0.0;                   // num_explained / matches given
-  bool explains = false;                // share >= min_share
+  bool estimated = false;              // a homography could be fitted (at least 4 matches)
+  cv::Matx33d H = cv::Matx33d::eye();  // x_to ~ H x_from
+  int num_explained = 0;               // matches within the threshold
+  double share = 0.0;                  // num_explained / matches given
+  bool explains = false;               // share >= min_share
 };
 
 // Fits H robustly (OpenCV USAC, seeded) to the matches (a link's verified matches) and counts how many it

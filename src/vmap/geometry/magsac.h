@@ -35,8 +35,8 @@
 namespace vmap {
 
 struct MagsacStatistics {
-  int iterations = 0;       // samples drawn
-  int models_scored = 0;    // models evaluated (SPRT-rejected ones included)
+  int iterations = 0;     // samples drawn
+  int models_scored = 0;  // models evaluated (SPRT-rejected ones included)
   int local_optimizations = 0;
   bool stopped_early = false;  // every decision was settled before the confidence criterion
 };

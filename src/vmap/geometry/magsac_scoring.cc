@@ -8,9 +8,9 @@ namespace vmap::internal {
 namespace {
 
 // The settings of OpenCV 4.6's USAC_MAGSAC preset for F.
-constexpr double kSigmaQuantile = 3.64;     // sqrt of the 0.99 quantile of chi^2 with 4 degrees of freedom
-constexpr double kMaximumThreshold = 2.5;   // px: residuals beyond it carry no score (sigma_max = 2.5 / 3.64)
-constexpr int kIrlsSampleSize = 50;         // points per weighted fit of sigma-consensus++
+constexpr double kSigmaQuantile = 3.64;    // sqrt of the 0.99 quantile of chi^2 with 4 degrees of freedom
+constexpr double kMaximumThreshold = 2.5;  // px: residuals beyond it carry no score (sigma_max = 2.5 / 3.64)
+constexpr int kIrlsSampleSize = 50;        // points per weighted fit of sigma-consensus++
 constexpr int kIrlsRounds = 10;
 
 }  // namespace

@@ -20,16 +20,16 @@ class MagsacScorer {
  public:
   MagsacScorer(const NormalizedPoints& points, double threshold, MagsacStatistics* statistics);
 
-// The MAGSAC++ score of a model over the points in visiting order. Stops (and returns value -1) as soon as the
-// model can no longer beat `bound`, or when SPRT rejects it.
+  // The MAGSAC++ score of a model over the points in visiting order. Stops (and returns value -1) as soon as the
+  // model can no longer beat `bound`, or when SPRT rejects it.
   // With `sprt` (and SPRT active) the model is tested point by point and rejected early.
   Score Evaluate(const Model& model, double bound, Sprt* sprt);
   // The score over every point.
   Score FullScore(const Model& model) { return Evaluate(model, -1.0, nullptr); }
 
-// sigma-consensus++: iteratively re-weighted least squares with MAGSAC++ weights on the points within the
-// maximum threshold (a random 50 of them per round, as OpenCV does), keeping the best-scoring model of the
-// rounds. Each pass over the points both scores the current model and weighs the points for the next fit.
+  // sigma-consensus++: iteratively re-weighted least squares with MAGSAC++ weights on the points within the
+  // maximum threshold (a random 50 of them per round, as OpenCV does), keeping the best-scoring model of the
+  // rounds. Each pass over the points both scores the current model and weighs the points for the next fit.
   // False (no refit) when fewer than `min_consistent` points are within the maximum threshold: the model cannot
   // beat the best one's inliers.
   bool SigmaConsensus(const Model& model, int min_consistent, RandomStream& random, Model* refined, Score* score);

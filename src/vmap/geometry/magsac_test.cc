@@ -257,8 +257,8 @@ TEST(MagsacEarlyStop, FailsAfterTheSamplesTheTargetNeeds) {
   // With a second target below the inlier ratio, the pair passes it early and the stricter one still decides
   // when to stop; the answer for the lower one is "yes".
   MagsacStatistics two_stats;
-  const FundamentalResult two = EstimateFundamentalMagsac(
-      scene.p0, scene.p1, {}, Targets({AtLeast(0.3, n), target}), &two_stats);
+  const FundamentalResult two =
+      EstimateFundamentalMagsac(scene.p0, scene.p1, {}, Targets({AtLeast(0.3, n), target}), &two_stats);
   ASSERT_TRUE(two.success);
   EXPECT_GE(two.num_inliers, AtLeast(0.3, n));
   EXPECT_EQ(two_stats.iterations, stats.iterations);
@@ -301,8 +301,8 @@ TEST(MagsacEarlyStop, ResumedRunIsTheExhaustiveRun) {
     const int n = static_cast<int>(scene.p0.size());
     MagsacStatistics exhaustive_stats, early_stats, resumed_stats;
     const FundamentalResult exhaustive = EstimateFundamentalMagsac(scene.p0, scene.p1, {}, {}, &exhaustive_stats);
-    const FundamentalResult early = EstimateFundamentalMagsac(
-        scene.p0, scene.p1, {}, Targets({AtLeast(0.2, n), AtLeast(0.95, n)}), &early_stats);
+    const FundamentalResult early =
+        EstimateFundamentalMagsac(scene.p0, scene.p1, {}, Targets({AtLeast(0.2, n), AtLeast(0.95, n)}), &early_stats);
     ASSERT_TRUE(early_stats.stopped_early) << inliers;
     ASSERT_NE(early.checkpoint, nullptr);
     EXPECT_LT(early_stats.iterations, exhaustive_stats.iterations);

@@ -112,8 +112,8 @@ class PoseOnManifold {
 // Robust Sampson residuals (pixels, Cauchy-weighted) of matches under the pose at parameters x.
 class SampsonCost : public cv::LMSolver::Callback {
  public:
-  SampsonCost(const PoseOnManifold& manifold, std::vector<cv::Point2d> from, std::vector<cv::Point2d> to,
-              double focal, double scale)
+  SampsonCost(const PoseOnManifold& manifold, std::vector<cv::Point2d> from, std::vector<cv::Point2d> to, double focal,
+              double scale)
       : manifold_(manifold), from_(std::move(from)), to_(std::move(to)), focal_(focal), scale_(scale) {}
 
   bool compute(cv::InputArray param, cv::OutputArray err, cv::OutputArray J) const override {
@@ -134,7 +134,8 @@ class SampsonCost : public cv::LMSolver::Callback {
         Residuals(shifted, plus.data());
         shifted[k] -= 2 * h;
         Residuals(shifted, minus.data());
-        for (size_t i = 0; i < from_.size(); ++i) jacobian.at<double>(static_cast<int>(i), k) = (plus[i] - minus[i]) / (2 * h);
+        for (size_t i = 0; i < from_.size(); ++i)
+          jacobian.at<double>(static_cast<int>(i), k) = (plus[i] - minus[i]) / (2 * h);
       }
     }
     return true;
@@ -184,9 +185,9 @@ RelativePose RefineRelativePose(const RelativePose& pose, const Camera& camera, 
   }
   if (inlier_from.size() < 5) return pose;
   const PoseOnManifold manifold(pose.R, pose.t);
-  cv::Ptr<SampsonCost> cost = cv::makePtr<SampsonCost>(manifold, NormalizePoints(camera, inlier_from),
-                                                       NormalizePoints(camera, inlier_to),
-                                                       0.5 * (camera.fx + camera.fy), loss_scale);
+  cv::Ptr<SampsonCost> cost =
+      cv::makePtr<SampsonCost>(manifold, NormalizePoints(camera, inlier_from), NormalizePoints(camera, inlier_to),
+                               0.5 * (camera.fx + camera.fy), loss_scale);
   cv::Mat x = cv::Mat::zeros(5, 1, CV_64F);
   cv::LMSolver::create(cost, 50)->run(x);
   RelativePose refined = pose;
@@ -266,8 +267,8 @@ void TranslationOptions::Check() const {
     throw OptionError("rival_angle_deg", fmt::format("{} deg is outside [0, 180); the default is 15", rival_angle_deg));
   }
   if (!(min_rival_cost_gap >= 0.0 && std::isfinite(min_rival_cost_gap))) {
-    throw OptionError("min_rival_cost_gap", fmt::format("{} must be >= 0 (0: never ambiguous); the default is 8",
-                                                        min_rival_cost_gap));
+    throw OptionError("min_rival_cost_gap",
+                      fmt::format("{} must be >= 0 (0: never ambiguous); the default is 8", min_rival_cost_gap));
   }
 }
 
@@ -477,7 +478,8 @@ double Median(std::vector<double> values) {
 
 bool ParsePoseMatches(const std::string& name) {
   const std::optional<bool> all = FindEnum(kPoseMatchesNames, name);
-  if (!all) throw InputError("--pose-matches '" + name + "': use all (every tentative match) or verified (F's inliers)");
+  if (!all)
+    throw InputError("--pose-matches '" + name + "': use all (every tentative match) or verified (F's inliers)");
   return *all;
 }
 

@@ -50,10 +50,10 @@ struct PoseOptions {
   // sample and a linear local optimisation, not the matches' geometric error).
   bool refine = true;
   double refine_inlier_factor = 3.0;
-  double confidence = 0.999;       // per start
+  double confidence = 0.999;  // per start
   int max_iterations = 10000;
-  int seed = 0;           // the random generator's state: the same link gives the same pose
-  int min_matches = 8;    // fewer inliers than this: no pose
+  int seed = 0;         // the random generator's state: the same link gives the same pose
+  int min_matches = 8;  // fewer inliers than this: no pose
 
   // The pose options as map.json records them: method, threshold, matches ("all" or "verified"), confidence,
   // max_iterations, seed; the others (starts, refinement) are the algorithm's, not a user's choice.
@@ -68,7 +68,7 @@ bool ParsePoseMatches(const std::string& name);
 struct RelativePose {
   bool valid = false;
   cv::Matx33d R = cv::Matx33d::eye();  // X_to = R X_from + t
-  cv::Vec3d t;                          // unit length
+  cv::Vec3d t;                         // unit length
   int num_inliers = 0;  // matches within the threshold of the pose (and, before refinement, in front of both cameras)
 };
 

@@ -363,8 +363,8 @@ TEST(RelativePose, ForwardMotionHasNoRivalMinimum) {
 
 // A pure rotation leaves the translation free: probes started away from the pose's t stay there at its cost.
 TEST(RelativePose, PureRotationHasARivalAsCheapAsThePose) {
-  const Pair pair = Observe(TestCamera(), Rotation({0.02, 0.08, 0.01}), cv::Vec3d(0, 0, 0), 300, 3.0, 30.0, 0.5,
-                            0.2, 13);
+  const Pair pair =
+      Observe(TestCamera(), Rotation({0.02, 0.08, 0.01}), cv::Vec3d(0, 0, 0), 300, 3.0, 30.0, 0.5, 0.2, 13);
   RelativePose pose;
   const double gap = EstimatedRivalGap(pair, &pose);
   ASSERT_TRUE(pose.valid);

@@ -205,8 +205,7 @@ LoopEnd RunRobustLoop(Problem& problem, const LoopSettings& settings, const std:
       sample[k] = index;
     }
     const int num_models = problem.SolveMinimal(sample, &models);
-    const bool refine_samples =
-        iterations >= settings.scored_without_sprt && iterations % settings.refine_every == 0;
+    const bool refine_samples = iterations >= settings.scored_without_sprt && iterations % settings.refine_every == 0;
     for (int m = 0; m < num_models; ++m) {
       Model model = models[m];
       Score score;

@@ -10,9 +10,8 @@ void PointColumns::Assign(const std::vector<Point>& points) {
   }
 }
 
-__attribute__((target_clones("avx2", "default"))) void SquaredSampsonErrors(const Model& f,
-                                                                            const PointColumns& points, int begin,
-                                                                            int end, double* r2) {
+__attribute__((target_clones("avx2", "default"))) void SquaredSampsonErrors(const Model& f, const PointColumns& points,
+                                                                            int begin, int end, double* r2) {
   const double* x0 = points.x0.data() + begin;
   const double* y0 = points.y0.data() + begin;
   const double* x1 = points.x1.data() + begin;

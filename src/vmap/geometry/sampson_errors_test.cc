@@ -37,8 +37,7 @@ TEST(SampsonErrors, BlockEqualsScalarBitForBit) {
         for (int i = begin; i < end; ++i) {
           const double expected = SquaredSampson(f, points[i]);
           EXPECT_TRUE(SameBits(r2[i - begin], expected))
-              << "point " << i << " of block [" << begin << ", " << end << "): " << r2[i - begin] << " vs "
-              << expected;
+              << "point " << i << " of block [" << begin << ", " << end << "): " << r2[i - begin] << " vs " << expected;
         }
         EXPECT_EQ(r2[end - begin], -1.0) << "wrote past the block";
       }

@@ -25,7 +25,7 @@ enum class AcceptanceRule {
   kCounts,  // verified >= min_verified and S >= min_similarity
 };
 inline constexpr EnumName<AcceptanceRule> kAcceptanceRuleNames[] = {{AcceptanceRule::kChance, "chance"},
-                                                                     {AcceptanceRule::kCounts, "counts"}};
+                                                                    {AcceptanceRule::kCounts, "counts"}};
 AcceptanceRule ParseAcceptanceRule(const std::string& name);
 std::string AcceptanceRuleName(AcceptanceRule rule);
 

@@ -114,15 +114,17 @@ AddExperienceSummary AddExperience(const fs::path& map_directory, FrameSource& s
   const LocalizationSummary run = LocalizeSequence(
       source, *opened.matcher, localizer, options.run, [&](const Frame& frame, const LocalizationResult& result) {
         if (map_size.area() > 0 && frame.gray.size() != map_size) {
-          throw InputError(fmt::format("'{}' has frames of {}, the map '{}' key images of {}: an experience's views "
-                                       "must be of the map's size; give --resize {}",
-                                       source_path, SizeText(frame.gray.size()), map_directory.string(),
-                                       SizeText(map_size), SizeText(map_size)));
+          throw InputError(
+              fmt::format("'{}' has frames of {}, the map '{}' key images of {}: an experience's views "
+                          "must be of the map's size; give --resize {}",
+                          source_path, SizeText(frame.gray.size()), map_directory.string(), SizeText(map_size),
+                          SizeText(map_size)));
         }
         for (int key : picker.Offer(result)) {
           const fs::path file = views_directory->path() / view_file(key);
           if (!cv::imwrite(file.string(), ColorImage(frame))) {
-            throw InputError("cannot write '" + file.string() + "'; check the free space and the permissions of the "
+            throw InputError("cannot write '" + file.string() +
+                             "'; check the free space and the permissions of the "
                              "map directory");
           }
         }
@@ -131,9 +133,10 @@ AddExperienceSummary AddExperience(const fs::path& map_directory, FrameSource& s
   summary.lost = run.lost;
   summary.experience.views = picker.Views();
   if (summary.experience.views.empty()) {
-    throw InputError(fmt::format("no frame of '{}' localized at a key image of the map '{}' ({} frames): nothing "
-                                 "added; is it a run of the same route?",
-                                 source_path, map_directory.string(), run.frames));
+    throw InputError(
+        fmt::format("no frame of '{}' localized at a key image of the map '{}' ({} frames): nothing "
+                    "added; is it a run of the same route?",
+                    source_path, map_directory.string(), run.frames));
   }
   for (ExperienceView& v : summary.experience.views) v.image_file = folder + "/" + view_file(v.key);
 

@@ -53,22 +53,20 @@ TEST(AddExperienceCli, AddsASessionAndLocalizeReportsTheExperienceUsed) {
   const fs::path repeat = SessionFolder(tmp.path(), 2);
   EXPECT_EQ(RunVmap("build " + Quote(repeat) + " --add-experience-to " + Quote(map) + " --matcher aliked", &out), 2);
   EXPECT_NE(out.find("--matcher orb"), std::string::npos) << out;
-  EXPECT_EQ(RunVmap("build " + Quote(repeat) + " --add-experience-to " + Quote(map) + " -o " +
-                        Quote(tmp.path() / "other"),
-                    &out),
-            2);
+  EXPECT_EQ(
+      RunVmap("build " + Quote(repeat) + " --add-experience-to " + Quote(map) + " -o " + Quote(tmp.path() / "other"),
+              &out),
+      2);
   EXPECT_NE(out.find("drop -o"), std::string::npos) << out;
   EXPECT_EQ(RunVmap("build " + Quote(repeat) + " --add-experience-to " + Quote(repeat), &out), 2);
   EXPECT_NE(out.find("vmap: error:"), std::string::npos) << out;
   EXPECT_EQ(ReadText(map / "map.json"), json_before);
   EXPECT_FALSE(fs::exists(map / "experiences"));
 
-  EXPECT_EQ(RunVmap("build " + Quote(repeat) + " -o " + Quote(tmp.path() / "other") + " --acceptance chance", &out),
-            2);
+  EXPECT_EQ(RunVmap("build " + Quote(repeat) + " -o " + Quote(tmp.path() / "other") + " --acceptance chance", &out), 2);
   EXPECT_NE(out.find("go with --add-experience-to"), std::string::npos) << out;
   // Across seasons ORB's verified sets are small: they are accepted by how unlikely they are by chance.
-  ASSERT_EQ(RunVmap("build " + Quote(repeat) + " --add-experience-to " + Quote(map) + " --acceptance chance", &out),
-            0)
+  ASSERT_EQ(RunVmap("build " + Quote(repeat) + " --add-experience-to " + Quote(map) + " --acceptance chance", &out), 0)
       << out;
   EXPECT_NE(out.find("experience      1"), std::string::npos) << out;
   const nlohmann::json doc = nlohmann::json::parse(ReadText(map / "map.json"));

@@ -197,8 +197,9 @@ TEST(AddExperience, AMapWithoutExperiencesComparesAsBefore) {
   cv::cvtColor(Drive().frames[5], gray, cv::COLOR_BGR2GRAY);
   const auto features = opened.matcher->Extract(gray);
   const KeyComparison c = localizer.Compare(*features, 1);
-  const PairComparison pair = ComparePair(*opened.matcher, *features, *opened.keys.features[1],
-                                          MapLocalizerOptions(opened).verifier, opened.options.builder.key_images.similarity);
+  const PairComparison pair =
+      ComparePair(*opened.matcher, *features, *opened.keys.features[1], MapLocalizerOptions(opened).verifier,
+                  opened.options.builder.key_images.similarity);
   EXPECT_EQ(c.experience, 0);
   EXPECT_EQ(c.num_verified, pair.num_verified);
   EXPECT_EQ(c.num_tentative, pair.num_tentative);

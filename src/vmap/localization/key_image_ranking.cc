@@ -115,8 +115,8 @@ class KeyImageRanking::VoteIndex {
       if (query.type() != CV_32F) query.convertTo(query, CV_32F);
       for (size_t k = 0; k < keys_.size(); ++k) {
         if (keys_[k].empty()) continue;
-        votes[k] += static_cast<double>(
-            MatchFloatDescriptors(query, keys_[k], static_cast<float>(options_.min_cosine)).size());
+        votes[k] +=
+            static_cast<double>(MatchFloatDescriptors(query, keys_[k], static_cast<float>(options_.min_cosine)).size());
       }
     }
   }
@@ -139,8 +139,9 @@ KeyImageRanking::KeyImageRanking(const std::vector<std::shared_ptr<const ImageFe
   if (method_ == RankingMethod::kAuto) method_ = has_descriptors ? RankingMethod::kVotes : RankingMethod::kThumbnails;
   if (method_ == RankingMethod::kVotes) {
     if (!has_descriptors) {
-      throw InputError("ranking by descriptor votes needs a matcher with per-feature descriptors; this map's "
-                       "matcher has none: use the thumbnail ranking");
+      throw InputError(
+          "ranking by descriptor votes needs a matcher with per-feature descriptors; this map's "
+          "matcher has none: use the thumbnail ranking");
     }
     votes_ = std::make_unique<VoteIndex>(key_features, options_);
   } else if (!key_thumbnails.empty()) {

@@ -174,9 +174,10 @@ void ComputeKeyImages(const fs::path& map_directory, const std::vector<KeyImage>
       next = n;
     }
   };
-  const int threads = std::max(1, std::min<int>(static_cast<int>(n), options.extraction_threads > 0
-                                                                         ? options.extraction_threads
-                                                                         : static_cast<int>(std::thread::hardware_concurrency())));
+  const int threads =
+      std::max(1, std::min<int>(static_cast<int>(n), options.extraction_threads > 0
+                                                         ? options.extraction_threads
+                                                         : static_cast<int>(std::thread::hardware_concurrency())));
   std::vector<std::thread> workers;
   for (int i = 1; i < threads; ++i) workers.emplace_back(work);
   work();
@@ -188,11 +189,16 @@ void ComputeKeyImages(const fs::path& map_directory, const std::vector<KeyImage>
 
 std::string KeyImageCacheStateName(KeyImageCacheState state) {
   switch (state) {
-    case KeyImageCacheState::kOff: return "off";
-    case KeyImageCacheState::kHit: return "hit";
-    case KeyImageCacheState::kWritten: return "written";
-    case KeyImageCacheState::kNotWritten: return "not written";
-    case KeyImageCacheState::kUnsupported: return "unsupported";
+    case KeyImageCacheState::kOff:
+      return "off";
+    case KeyImageCacheState::kHit:
+      return "hit";
+    case KeyImageCacheState::kWritten:
+      return "written";
+    case KeyImageCacheState::kNotWritten:
+      return "not written";
+    case KeyImageCacheState::kUnsupported:
+      return "unsupported";
   }
   return "off";
 }
@@ -245,7 +251,8 @@ KeyImageStore LoadKeyImageStore(const fs::path& map_directory, const VisualMap& 
     store.views.resize(map.key_images.size());
     size_t next = map.key_images.size();
     for (const Experience& e : experiences) {
-      for (const ExperienceView& v : e.views) store.views.at(v.key).push_back({e.id, v.heading_px, store.features[next++]});
+      for (const ExperienceView& v : e.views)
+        store.views.at(v.key).push_back({e.id, v.heading_px, store.features[next++]});
     }
     store.features.resize(map.key_images.size());
     store.thumbnails.resize(map.key_images.size());

@@ -5,9 +5,9 @@
 // The cache, MAP/localization_cache.bin, is written atomically. It starts with a fingerprint of map.json's
 // bytes, the matcher's recorded options (Matcher::DescribeOptionsJson), the thumbnail width and the vmap and
 // OpenCV versions, and is used only when all are unchanged: a rebuilt map, another matcher setting, another
-// vmap or a newer cache format makes it stale, and it is then recomputed and replaced. A map directory that cannot be written is not an
-// error (the features are then computed at every start). Matchers that cannot serialise their features
-// (Matcher::SerializeFeatures returns "") get no cache.
+// vmap or a newer cache format makes it stale, and it is then recomputed and replaced. A map directory that cannot be
+// written is not an error (the features are then computed at every start). Matchers that cannot serialise their
+// features (Matcher::SerializeFeatures returns "") get no cache.
 
 #include <filesystem>
 #include <memory>
@@ -50,11 +50,11 @@ struct KeyImageView {
 
 struct KeyImageStore {
   std::vector<std::shared_ptr<const ImageFeatures>> features;  // one per key image, in map order
-  std::vector<cv::Mat> thumbnails;                            // ThumbnailDescriptor of each key image
+  std::vector<cv::Mat> thumbnails;                             // ThumbnailDescriptor of each key image
   // Per key image, the views of the map's experiences; empty (no list at all) for a map without experiences.
   std::vector<std::vector<KeyImageView>> views;
   KeyImageCacheState cache = KeyImageCacheState::kOff;
-  double seconds = 0.0;                                        // time to load or compute them
+  double seconds = 0.0;  // time to load or compute them
 };
 
 // Reads (or computes and caches) the features of every key image of `map`, read from `map_directory`, and of

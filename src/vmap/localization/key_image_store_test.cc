@@ -6,8 +6,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/features/orb_matcher.h"
-#include "vmap/testing/localization_test_util.h"
 #include "vmap/map/map_io.h"
+#include "vmap/testing/localization_test_util.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"
 

@@ -3,8 +3,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include "vmap/features/matcher_registry.h"
 #include "vmap/features/matcher_options_json.h"
+#include "vmap/features/matcher_registry.h"
 #include "vmap/map/map_io.h"
 #include "vmap/mapping/recorded_options.h"
 
@@ -16,7 +16,8 @@ LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, cons
   RecordedMap read = ReadRecordedMap(directory);
   opened.map = std::move(read.map);
   opened.options = std::move(read.options);
-  opened.matcher = CreateMatcher(MatcherOptionsFromJson(opened.options.matcher_json, (directory / kMapFileName).string()));
+  opened.matcher =
+      CreateMatcher(MatcherOptionsFromJson(opened.options.matcher_json, (directory / kMapFileName).string()));
   opened.experiences = ReadExperiences(directory, opened.map);
   opened.keys = LoadKeyImageStore(directory, opened.map, *opened.matcher, options, opened.experiences);
   return opened;

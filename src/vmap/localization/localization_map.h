@@ -17,8 +17,8 @@ namespace vmap {
 struct LocalizationMap {
   std::filesystem::path directory;
   VisualMap map;
-  RecordedOptions options;  // what the map records of the options that shaped it
-  std::unique_ptr<Matcher> matcher;  // the map's matcher, with the map's options
+  RecordedOptions options;              // what the map records of the options that shaped it
+  std::unique_ptr<Matcher> matcher;     // the map's matcher, with the map's options
   std::vector<Experience> experiences;  // map/experiences.h; their views' features are in `keys`
   KeyImageStore keys;
 };

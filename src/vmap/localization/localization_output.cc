@@ -67,17 +67,17 @@ json PoseJson(const RelativePose& pose) {
 
 }  // namespace
 
-std::string DescribeLocalizerOptions(const LocalizerOptions& options) {
-  return OptionsToJson(options).dump();
-}
+std::string DescribeLocalizerOptions(const LocalizerOptions& options) { return OptionsToJson(options).dump(); }
 
 std::string LocalizationCsvHeader(bool experiences) {
-  return std::string("frame,source_index,timestamp,source_name,status,key,next_key,key_frame,next_key_frame,similarity,verified,"
-         "tentative,next_similarity,next_verified,next_tentative,heading_px,progress,comparisons,seconds,"
-         "F00,F01,F02,F10,F11,F12,F20,F21,F22,heading_deg,R00,R01,R02,R10,R11,R12,R20,R21,R22,tx,ty,tz,"
-         "heading_confidence,heading_key_px,heading_key_deg,heading_key_confidence,"
-         "translation_sigma_deg,translation_known,guidance,"
-         "log10_nfa,next_log10_nfa") +
+  return std::string(
+             "frame,source_index,timestamp,source_name,status,key,next_key,key_frame,next_key_frame,similarity,"
+             "verified,"
+             "tentative,next_similarity,next_verified,next_tentative,heading_px,progress,comparisons,seconds,"
+             "F00,F01,F02,F10,F11,F12,F20,F21,F22,heading_deg,R00,R01,R02,R10,R11,R12,R20,R21,R22,tx,ty,tz,"
+             "heading_confidence,heading_key_px,heading_key_deg,heading_key_confidence,"
+             "translation_sigma_deg,translation_known,guidance,"
+             "log10_nfa,next_log10_nfa") +
          (experiences ? ",experience,next_experience\n" : "\n");
 }
 
@@ -97,8 +97,8 @@ std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r
   const RelativePose& pose = TargetPose(r);
   for (int i = 0; i < 9; ++i) row += ',' + (pose.valid ? fmt::format("{:.9g}", pose.R(i / 3, i % 3)) : std::string());
   for (int i = 0; i < 3; ++i) row += ',' + (pose.valid ? fmt::format("{:.9g}", pose.t[i]) : std::string());
-  row += ',' + CsvNumber(TargetConfidence(r)) + ',' + CsvNumber(r.heading_key_px) + ',' +
-         CsvNumber(r.heading_key_deg) + ',' + CsvNumber(Confidence(r.to_key.heading));
+  row += ',' + CsvNumber(TargetConfidence(r)) + ',' + CsvNumber(r.heading_key_px) + ',' + CsvNumber(r.heading_key_deg) +
+         ',' + CsvNumber(Confidence(r.to_key.heading));
   const KeyComparison& target = r.next_key >= 0 ? r.to_next : r.to_key;
   row += ',' + (pose.valid ? CsvNumber(target.translation_sigma_deg) : std::string());
   row += fmt::format(",{},{}", r.translation_known ? 1 : 0, LocalizationGuidance(r));
@@ -118,44 +118,47 @@ nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationRes
   }
   json candidates = json::array();
   for (const RelocalizationCandidate& c : r.candidates) {
-    candidates.push_back({{"key", c.key}, {"score", c.score}, {"accepted", c.accepted},
-                          {"similarity", c.similarity}, {"verified", c.num_verified},
+    candidates.push_back({{"key", c.key},
+                          {"score", c.score},
+                          {"accepted", c.accepted},
+                          {"similarity", c.similarity},
+                          {"verified", c.num_verified},
                           {"log10_nfa", Number(c.log10_nfa)}});
   }
-  json frame = {{"frame", r.frame_index},
-          {"source_index", r.source_index},
-          {"timestamp", r.timestamp >= 0 ? json(r.timestamp) : json(nullptr)},
-          {"source_name", EncodeFileName(r.source_name)},
-          {"status", LocalizationStatusName(r.status)},
-          {"key", r.key},
-          {"next_key", r.next_key},
-          {"key_frame", KeyFrame(map, r.key)},
-          {"next_key_frame", KeyFrame(map, r.next_key)},
-          {"similarity", r.to_key.key >= 0 ? Number(r.to_key.similarity) : json(nullptr)},
-          {"verified", r.to_key.num_verified},
-          {"tentative", r.to_key.num_tentative},
-          {"next_similarity", r.to_next.key >= 0 ? Number(r.to_next.similarity) : json(nullptr)},
-          {"next_verified", r.to_next.num_verified},
-          {"next_tentative", r.to_next.num_tentative},
-          {"log10_nfa", Number(r.to_key.log10_nfa)},
-          {"next_log10_nfa", Number(r.to_next.log10_nfa)},
-          {"heading_px", Number(r.heading_px)},
-          {"heading_deg", Number(r.heading_deg)},
-          {"heading_confidence", Number(TargetConfidence(r))},
-          {"heading_key_px", Number(r.heading_key_px)},
-          {"heading_key_deg", Number(r.heading_key_deg)},
-          {"heading_key_confidence", Number(Confidence(r.to_key.heading))},
-          {"pose", PoseJson(TargetPose(r))},
-          {"translation_sigma_deg",
-           TargetPose(r).valid ? Number((r.next_key >= 0 ? r.to_next : r.to_key).translation_sigma_deg)
-                               : json(nullptr)},
-          {"translation_known", r.translation_known},
-          {"guidance", LocalizationGuidance(r)},
-          {"progress", Number(r.progress)},
-          {"F", F},
-          {"candidates", candidates},
-          {"comparisons", r.comparisons},
-          {"seconds", r.seconds}};
+  json frame = {
+      {"frame", r.frame_index},
+      {"source_index", r.source_index},
+      {"timestamp", r.timestamp >= 0 ? json(r.timestamp) : json(nullptr)},
+      {"source_name", EncodeFileName(r.source_name)},
+      {"status", LocalizationStatusName(r.status)},
+      {"key", r.key},
+      {"next_key", r.next_key},
+      {"key_frame", KeyFrame(map, r.key)},
+      {"next_key_frame", KeyFrame(map, r.next_key)},
+      {"similarity", r.to_key.key >= 0 ? Number(r.to_key.similarity) : json(nullptr)},
+      {"verified", r.to_key.num_verified},
+      {"tentative", r.to_key.num_tentative},
+      {"next_similarity", r.to_next.key >= 0 ? Number(r.to_next.similarity) : json(nullptr)},
+      {"next_verified", r.to_next.num_verified},
+      {"next_tentative", r.to_next.num_tentative},
+      {"log10_nfa", Number(r.to_key.log10_nfa)},
+      {"next_log10_nfa", Number(r.to_next.log10_nfa)},
+      {"heading_px", Number(r.heading_px)},
+      {"heading_deg", Number(r.heading_deg)},
+      {"heading_confidence", Number(TargetConfidence(r))},
+      {"heading_key_px", Number(r.heading_key_px)},
+      {"heading_key_deg", Number(r.heading_key_deg)},
+      {"heading_key_confidence", Number(Confidence(r.to_key.heading))},
+      {"pose", PoseJson(TargetPose(r))},
+      {"translation_sigma_deg",
+       TargetPose(r).valid ? Number((r.next_key >= 0 ? r.to_next : r.to_key).translation_sigma_deg) : json(nullptr)},
+      {"translation_known", r.translation_known},
+      {"guidance", LocalizationGuidance(r)},
+      {"progress", Number(r.progress)},
+      {"F", F},
+      {"candidates", candidates},
+      {"comparisons", r.comparisons},
+      {"seconds", r.seconds}};
   if (experiences) {
     frame["experience"] = r.to_key.key >= 0 ? json(r.to_key.experience) : json(nullptr);
     frame["next_experience"] = r.to_next.key >= 0 ? json(r.to_next.experience) : json(nullptr);
@@ -214,7 +217,8 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
   const std::optional<ContainedFile> opened = ContainedFile::OpenRegular(file, &why_not);
   if (!opened) throw InputError("'" + file.string() + "' " + why_not + "; give the --json file of `vmap localize`");
   if (opened->size() > kMaxRunJsonBytes) {
-    throw InputError("'" + file.string() + "' is larger than any localization run; give the --json file of "
+    throw InputError("'" + file.string() +
+                     "' is larger than any localization run; give the --json file of "
                      "`vmap localize`");
   }
   json doc;
@@ -302,7 +306,8 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
       run.frames.push_back(std::move(r));
     }
   } catch (const json::exception&) {
-    throw InputError("'" + file.string() + "' is not of the documented form of a localization run; write it again "
+    throw InputError("'" + file.string() +
+                     "' is not of the documented form of a localization run; write it again "
                      "with `vmap localize --json`");
   }
   return run;

@@ -38,7 +38,7 @@ inline constexpr std::uint64_t kMaxRunJsonValues = 1ull << 24;
 // What a run was: the inputs and settings, recorded in the JSON.
 struct LocalizationRunInfo {
   std::string map_directory;
-  std::string query;                // the query's path as given
+  std::string query;  // the query's path as given
   SourceFormat query_format = SourceFormat::kAuto;
   FrameSourceOptions source;        // first, last, stride, resize
   cv::Size frame_size;              // of the query frames as localized
@@ -66,8 +66,7 @@ std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r
 
 // One frame of a run as the JSON lists it (the CSV's columns, with F and the pose as lists); the Python module
 // gives its results these names.
-nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationResult& result,
-                                     bool experiences = false);
+nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationResult& result, bool experiences = false);
 
 // The JSON document of a run (frames listed in order).
 std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run);

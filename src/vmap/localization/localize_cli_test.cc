@@ -12,10 +12,10 @@
 #include "vmap/features/orb_matcher.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localization_output.h"
-#include "vmap/testing/localization_test_util.h"
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/map/map_io.h"
 #include "vmap/report/html_report.h"
+#include "vmap/testing/localization_test_util.h"
 #include "vmap/testing/run_vmap.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/shared_data.h"
@@ -42,10 +42,10 @@ const fs::path& LabMap() {
   static const fs::path map = [] {
     const fs::path path = directory.path() / "lab_map";
     std::string out;
-    EXPECT_EQ(RunVmap("build " + Quote(Shared() / "data/lab_floor/lab_floor.mp4") + " -o " + Quote(path) +
-                          " --last 239 -q",
-                      &out),
-              0)
+    EXPECT_EQ(
+        RunVmap("build " + Quote(Shared() / "data/lab_floor/lab_floor.mp4") + " -o " + Quote(path) + " --last 239 -q",
+                &out),
+        0)
         << out;
     return path;
   }();
@@ -83,10 +83,10 @@ TEST(LocalizeCli, LocalizesARepeatOfTheTeachRunAndWritesCsvAndJson) {
   EXPECT_GE(bracketed, 57) << "at least 95 % of 60";
   // The key-image cache was written into the map; the next run reads it.
   EXPECT_TRUE(fs::exists(LabMap() / kLocalizationCacheFileName));
-  ASSERT_EQ(RunVmap("localize " + Quote(LabMap()) + " " + Quote(Shared() / "data/lab_floor/lab_floor.mp4") +
-                        " --last 3",
-                    &out),
-            0)
+  ASSERT_EQ(
+      RunVmap("localize " + Quote(LabMap()) + " " + Quote(Shared() / "data/lab_floor/lab_floor.mp4") + " --last 3",
+              &out),
+      0)
       << out;
   EXPECT_NE(out.find("cache: hit"), std::string::npos) << out;
 }
@@ -157,7 +157,9 @@ TEST(LocalizeCli, RouteForwardsAndBackwards) {
   // Each step says whether the link's translation can be trusted, backwards as forwards.
   EXPECT_NE(out.find("| translation |"), std::string::npos) << out;
   const bool with_pose = map.links[1].has_pose;
-  EXPECT_NE(out.find(!with_pose ? "| no pose |" : map.links[1].translation_known ? "| known (" : "| unknown: rotation only ("),
+  EXPECT_NE(out.find(!with_pose                       ? "| no pose |"
+                     : map.links[1].translation_known ? "| known ("
+                                                      : "| unknown: rotation only ("),
             std::string::npos)
       << out;
   ASSERT_EQ(RunVmap("route " + Quote(LabMap()) + " --from 0 --to 99", &out), 2) << out;
@@ -298,8 +300,8 @@ double BracketShare(const std::string& sequence, int last, PoseErrors* pose_erro
                                   truth->camera_to_world.at(target_source), &R, &t);
         const cv::Matx33d dR = pose.R * R.t();
         pose_errors->rotation_deg.push_back(std::acos(std::clamp((cv::trace(dR) - 1.0) / 2.0, -1.0, 1.0)) * 180 / M_PI);
-        pose_errors->translation_deg.push_back(
-            std::acos(std::clamp(pose.t.dot(t) / cv::norm(t), -1.0, 1.0)) * 180 / M_PI);
+        pose_errors->translation_deg.push_back(std::acos(std::clamp(pose.t.dot(t) / cv::norm(t), -1.0, 1.0)) * 180 /
+                                               M_PI);
       });
   EXPECT_EQ(summary.frames, (last + 1) / 2);
   return static_cast<double>(bracketed) / summary.frames;

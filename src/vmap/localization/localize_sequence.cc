@@ -70,8 +70,7 @@ LocalizationSummary LocalizeSequence(FrameSource& source, const Matcher& matcher
     ExtractedFrame item;
     const auto extract_start = std::chrono::steady_clock::now();
     item.features = matcher.ExtractFrame(frame.gray, frame.color);
-    item.extract_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - extract_start).count();
+    item.extract_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - extract_start).count();
     if (ahead) item.ahead = ahead(*item.features);
     item.frame = std::move(frame);
     return item;
@@ -84,9 +83,15 @@ LocalizationSummary LocalizeSequence(FrameSource& source, const Matcher& matcher
     }
     ++summary.frames;
     switch (result.status) {
-      case LocalizationStatus::kTracking: ++summary.tracking; break;
-      case LocalizationStatus::kRelocalized: ++summary.relocalized; break;
-      case LocalizationStatus::kLost: ++summary.lost; break;
+      case LocalizationStatus::kTracking:
+        ++summary.tracking;
+        break;
+      case LocalizationStatus::kRelocalized:
+        ++summary.relocalized;
+        break;
+      case LocalizationStatus::kLost:
+        ++summary.lost;
+        break;
     }
     summary.comparisons += result.comparisons;
     extract_seconds += item.extract_seconds;

@@ -20,9 +20,9 @@ struct LocalizeSequenceOptions {
   // overlaps with the matching of the current one, so a deep matcher's extraction (XFeat, ALIKED) runs on
   // both cores while ORB's matching and verification keep the calling thread busy.
   int extraction_threads = 0;
-  int prefetch_frames = 4;   // frames extracted ahead of the localizer
-  bool compare_ahead = true; // workers compare frames with the likely key images (see above)
-  bool show_progress = true; // a progress line on a terminal
+  int prefetch_frames = 4;    // frames extracted ahead of the localizer
+  bool compare_ahead = true;  // workers compare frames with the likely key images (see above)
+  bool show_progress = true;  // a progress line on a terminal
 
   int ExtractionThreads() const;
   void Check() const;  // throws OptionError naming the bad field
@@ -33,13 +33,13 @@ struct LocalizationSummary {
   long tracking = 0;
   long relocalized = 0;
   long lost = 0;
-  int skipped_frames = 0;         // frames the source could not decode
-  double seconds = 0.0;           // wall time of the run (key images not included)
+  int skipped_frames = 0;  // frames the source could not decode
+  double seconds = 0.0;    // wall time of the run (key images not included)
   double frames_per_second = 0.0;
   double mean_localize_seconds = 0.0;  // Localizer::Localize per frame (matching, verification, ranking)
   double max_localize_seconds = 0.0;
-  double mean_extract_seconds = 0.0;   // feature extraction per frame, on the workers
-  long comparisons = 0;                // pairs matched and verified
+  double mean_extract_seconds = 0.0;  // feature extraction per frame, on the workers
+  long comparisons = 0;               // pairs matched and verified
 };
 
 using LocalizationCallback = std::function<void(const Frame& frame, const LocalizationResult& result)>;

@@ -16,9 +16,9 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Which of two accepted comparisons is the better match: more verified matches, then higher S.
-// Measured on the bracket test (docs/measurements/localization.md): S first, S times verified, a 10 % or 25 % margin before moving on,
-// and moving on only when S is higher too localized no more odd frames of redkitchen between their key
-// images than verified matches alone.
+// Measured on the bracket test (docs/measurements/localization.md): S first, S times verified, a 10 % or 25 % margin
+// before moving on, and moving on only when S is higher too localized no more odd frames of redkitchen between their
+// key images than verified matches alone.
 bool Better(const KeyComparison& a, const KeyComparison& b) {
   if (!a.accepted) return false;
   if (!b.accepted) return true;
@@ -39,9 +39,12 @@ bool FitsBetter(const KeyComparison& a, const KeyComparison& b) {
 
 std::string LocalizationStatusName(LocalizationStatus status) {
   switch (status) {
-    case LocalizationStatus::kTracking: return "tracking";
-    case LocalizationStatus::kRelocalized: return "relocalized";
-    case LocalizationStatus::kLost: return "lost";
+    case LocalizationStatus::kTracking:
+      return "tracking";
+    case LocalizationStatus::kRelocalized:
+      return "relocalized";
+    case LocalizationStatus::kLost:
+      return "lost";
   }
   return "lost";
 }
@@ -58,9 +61,9 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"min_verified", "--min-verified",
                  "--acceptance counts: verified matches a frame needs to be localized at a key image"},
                 min_verified);
-  visitor.Visit({"min_similarity", "--min-similarity",
-                 "--acceptance counts: S a frame needs to be localized at a key image"},
-                min_similarity);
+  visitor.Visit(
+      {"min_similarity", "--min-similarity", "--acceptance counts: S a frame needs to be localized at a key image"},
+      min_similarity);
   visitor.Visit({"min_link_share", "--min-link-share",
                  "--acceptance chance: verified matches a frame also needs, as a fraction of those of the key "
                  "image's link with its route neighbour (0: chance alone)"},
@@ -77,10 +80,8 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Maps with experiences: views of a key image verified besides it, those with the most tentative "
                  "matches (0 = the teach key images only)"},
                 experience_candidates);
-  visitor.Visit({"lookahead", "--lookahead", "Key images beyond the next compared while tracking (1 or 2)"},
-                lookahead);
-  visitor.Visit({"step_back", "!--no-step-back", "Never move the estimate back to the previous key image"},
-                step_back);
+  visitor.Visit({"lookahead", "--lookahead", "Key images beyond the next compared while tracking (1 or 2)"}, lookahead);
+  visitor.Visit({"step_back", "!--no-step-back", "Never move the estimate back to the previous key image"}, step_back);
   visitor.VisitNested("ranking", ranking);
   visitor.VisitNested("heading", heading);
   visitor.VisitNested("verifier", verifier, Nesting{false, {"max_samples_to_reject"}});
@@ -104,13 +105,13 @@ void LocalizerOptions::Check() const {
                                                    max_log10_nfa));
   }
   if (!(recheck_link_share >= 0.0 && recheck_link_share <= 10.0)) {
-    throw OptionError("recheck_link_share",
-                      fmt::format("{} is outside [0, 10] (default 0.5; 0: never relocalize a tracked frame)",
-                                  recheck_link_share));
+    throw OptionError(
+        "recheck_link_share",
+        fmt::format("{} is outside [0, 10] (default 0.5; 0: never relocalize a tracked frame)", recheck_link_share));
   }
   if (!(min_link_share >= 0.0 && min_link_share <= 10.0)) {
-    throw OptionError("min_link_share", fmt::format("{} is outside [0, 10] (default 0.4; 0: chance alone decides)",
-                                                    min_link_share));
+    throw OptionError("min_link_share",
+                      fmt::format("{} is outside [0, 10] (default 0.4; 0: chance alone decides)", min_link_share));
   }
   if (lookahead < 1 || lookahead > 2) {
     throw OptionError("lookahead", fmt::format("{} is not 1 or 2 (default 2)", lookahead));
@@ -226,8 +227,7 @@ KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
     matches.push_back(matcher_.Match(features, *views[v].features));
     order.push_back(static_cast<int>(v));
   }
-  std::stable_sort(order.begin(), order.end(),
-                   [&](int a, int b) { return matches[a].size() > matches[b].size(); });
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return matches[a].size() > matches[b].size(); });
   order.resize(std::min<size_t>(order.size(), options_.experience_candidates));
   for (int v : order) {
     KeyComparison c = CompareImage(features, *views[v].features, matches[v], key);
@@ -267,11 +267,11 @@ KeyComparison Localizer::CompareImage(const ImageFeatures& features, const Image
                                      ComparisonsPerFrame(options_.lookahead, options_.relocalization_candidates))
                       .log10_nfa;
   }
-  c.accepted = pair.matched && (options_.acceptance == AcceptanceRule::kChance
-                                    ? c.log10_nfa <= options_.max_log10_nfa &&
-                                          pair.num_verified >= options_.min_link_share * link_verified_[key]
-                                    : pair.num_verified >= options_.min_verified &&
-                                          pair.similarity >= options_.min_similarity);
+  c.accepted =
+      pair.matched &&
+      (options_.acceptance == AcceptanceRule::kChance
+           ? c.log10_nfa <= options_.max_log10_nfa && pair.num_verified >= options_.min_link_share * link_verified_[key]
+           : pair.num_verified >= options_.min_verified && pair.similarity >= options_.min_similarity);
   // The heading from every tentative match (verified first, then rejected), key image -> frame.
   std::vector<cv::Point2f> key_points, frame_points;
   key_points.reserve(pair.correspondences.size());
@@ -311,15 +311,15 @@ KeyComparison Localizer::CompareImage(const ImageFeatures& features, const Image
 }
 
 LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& features,
-                                      std::vector<KeyComparison> ahead) {
+                                       std::vector<KeyComparison> ahead) {
   const auto start = std::chrono::steady_clock::now();
   comparisons_.clear();
   for (KeyComparison& c : ahead) {
     if (c.key >= 0 && c.key < static_cast<int>(keys_.features.size())) comparisons_.push_back({std::move(c), false});
   }
   LocalizationResult result = has_estimate() ? Track(frame, features) : Relocalize(frame, features);
-  result.comparisons = static_cast<int>(
-      std::count_if(comparisons_.begin(), comparisons_.end(), [](const Memo& m) { return m.used; }));
+  result.comparisons =
+      static_cast<int>(std::count_if(comparisons_.begin(), comparisons_.end(), [](const Memo& m) { return m.used; }));
   result.frame_index = frame.index;
   result.source_index = frame.source_index;
   result.timestamp = frame.timestamp;

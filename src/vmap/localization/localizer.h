@@ -39,8 +39,8 @@
 #include "vmap/localization/acceptance.h"
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/localization/key_image_store.h"
-#include "vmap/mapping/key_image_selector.h"
 #include "vmap/map/visual_map.h"
+#include "vmap/mapping/key_image_selector.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap {
@@ -184,8 +184,8 @@ struct LocalizationResult {
   // pure rotation, no camera), the guidance is the heading only: LocalizationGuidance says which.
   bool translation_known = false;
   std::vector<RelocalizationCandidate> candidates;  // relocalization only: those verified, best-ranked first
-  int comparisons = 0;                // key images the frame was compared with (some maybe ahead, on workers)
-  double seconds = 0.0;               // time spent localizing this frame (features excluded)
+  int comparisons = 0;   // key images the frame was compared with (some maybe ahead, on workers)
+  double seconds = 0.0;  // time spent localizing this frame (features excluded)
 };
 
 class Localizer {
@@ -201,8 +201,7 @@ class Localizer {
   // be extracted on another thread: see LocalizeSequence). `ahead` may hold comparisons of this frame that
   // were already made (Compare, on another thread, with the LikelyKeys of an earlier state): they are used
   // instead of comparing again, which gives the same result.
-  LocalizationResult Localize(const Frame& frame, const ImageFeatures& features,
-                              std::vector<KeyComparison> ahead = {});
+  LocalizationResult Localize(const Frame& frame, const ImageFeatures& features, std::vector<KeyComparison> ahead = {});
 
   // The key images the next frame will most likely be compared with: `key` and `next_key` of the current
   // estimate (none without an estimate).
@@ -219,8 +218,8 @@ class Localizer {
 
  private:
   // The frame against one image of key image `key` (the key image itself or a view), from their matches.
-  KeyComparison CompareImage(const ImageFeatures& features, const ImageFeatures& image,
-                             const TentativeMatches& matches, int key) const;
+  KeyComparison CompareImage(const ImageFeatures& features, const ImageFeatures& image, const TentativeMatches& matches,
+                             int key) const;
   // Each key image is compared with a frame at most once per Localize call.
   KeyComparison CompareOnce(const ImageFeatures& features, int key);
   LocalizationResult Track(const Frame& frame, const ImageFeatures& features);
@@ -254,7 +253,8 @@ class Localizer {
 
 // The key images on either side of position `source_index` of the map's input (KeyImage::source_index):
 // the last key image at or before it and the first at or after it; -1 where there is none. A frame of the
-// teach run's path between two key images is rightly localized at either (the bracket test of docs/measurements/localization.md).
+// teach run's path between two key images is rightly localized at either (the bracket test of
+// docs/measurements/localization.md).
 std::pair<int, int> KeysAround(const VisualMap& map, int source_index);
 
 // The verifier the map records (options.verifier in map.json), bounded: a comparison asks "is the frame at this key

@@ -126,10 +126,9 @@ TEST(Localizer, AFrameThatSharesAsMuchAsTheMapsLinksIsNotRelocalized) {
   LocalizeSequenceOptions run;
   run.show_progress = false;
   int bracketed = 0;
-  const LocalizationSummary summary =
-      LocalizeSequence(source, *m.matcher, localizer, run, [&](const Frame&, const LocalizationResult& r) {
-        bracketed += Brackets(m.map, r.source_index, r.key);
-      });
+  const LocalizationSummary summary = LocalizeSequence(
+      source, *m.matcher, localizer, run,
+      [&](const Frame&, const LocalizationResult& r) { bracketed += Brackets(m.map, r.source_index, r.key); });
   EXPECT_EQ(summary.relocalized, 1) << "the first frame only";
   EXPECT_EQ(summary.tracking, 29);
   EXPECT_EQ(bracketed, 30);

@@ -9,8 +9,8 @@
 #include "vmap/core/error.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/localization/localization_map.h"
-#include "vmap/testing/localization_test_util.h"
 #include "vmap/localization/localize_sequence.h"
+#include "vmap/testing/localization_test_util.h"
 #include "vmap/testing/option_error.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"
@@ -95,10 +95,8 @@ TEST(Localizer, EveryOddFrameIsLocalizedBetweenTheKeyImagesAroundIt) {
   LocalizeSequenceOptions run;
   run.show_progress = false;
   std::vector<LocalizationResult> results;
-  const LocalizationSummary summary =
-      LocalizeSequence(source, *m.matcher, localizer, run, [&](const Frame&, const LocalizationResult& r) {
-        results.push_back(r);
-      });
+  const LocalizationSummary summary = LocalizeSequence(
+      source, *m.matcher, localizer, run, [&](const Frame&, const LocalizationResult& r) { results.push_back(r); });
   ASSERT_EQ(summary.frames, 30);
   EXPECT_EQ(results.front().status, LocalizationStatus::kRelocalized);
   EXPECT_EQ(summary.relocalized, 1);
@@ -250,9 +248,10 @@ TEST(Localizer, AFrameThatShowsLittleOfTheSceneIsStillLocalizedByItsChance) {
   EXPECT_GE(10 * bracketed, 9 * chance_localized);
   EXPECT_GE(low_similarity, 3) << "frames S would have refused were localized";
   EXPECT_GT(bracketed, counts_localized) << "the earlier rule gives up on more of them";
-  std::printf("mostly hidden frames localized: %d by chance (%d at a key image around them), %d by counts; %d with "
-              "S < %.1f\n",
-              chance_localized, bracketed, counts_localized, low_similarity, counts.min_similarity);
+  std::printf(
+      "mostly hidden frames localized: %d by chance (%d at a key image around them), %d by counts; %d with "
+      "S < %.1f\n",
+      chance_localized, bracketed, counts_localized, low_similarity, counts.min_similarity);
 }
 
 TEST(Localizer, ASceneOfOtherTexturesIsNeverAccepted) {
@@ -385,7 +384,8 @@ TEST(Localizer, WithACameraTheHeadingIsInDegreesAndThePoseIsTheTrueOne) {
   if (r.to_key.translation_sigma_deg > options.translation.max_sigma_deg) {
     EXPECT_FALSE(r.translation_known);
   }
-  EXPECT_EQ(LocalizationGuidance(r), r.translation_known ? "heading and translation" : "heading only: translation unknown");
+  EXPECT_EQ(LocalizationGuidance(r),
+            r.translation_known ? "heading and translation" : "heading only: translation unknown");
 
   // Without the camera: no degrees, no pose.
   Localizer pixels_only(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));

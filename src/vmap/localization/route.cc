@@ -39,10 +39,11 @@ Route PlanRoute(const VisualMap& map, int from, int to, const RouteOptions& opti
     if (verified) {
       steps[l.to_key].push_back({l.to_key, l.from_key, static_cast<int>(i), true, false});
     } else {
-      refusals.push_back({std::min(l.from_key, l.to_key), std::max(l.from_key, l.to_key),
-                          fmt::format("link {} (key {} -> {}) is {}", i, l.from_key, l.to_key,
-                                      !l.has_fundamental ? std::string("not verified (matching failed)")
-                                                         : fmt::format("verified by {} matches only", l.num_verified))});
+      refusals.push_back(
+          {std::min(l.from_key, l.to_key), std::max(l.from_key, l.to_key),
+           fmt::format("link {} (key {} -> {}) is {}", i, l.from_key, l.to_key,
+                       !l.has_fundamental ? std::string("not verified (matching failed)")
+                                          : fmt::format("verified by {} matches only", l.num_verified))});
     }
   }
   // Breadth-first: fewest steps; ties go to the lower link index, so the result is deterministic.
@@ -81,8 +82,10 @@ Route PlanRoute(const VisualMap& map, int from, int to, const RouteOptions& opti
   for (const RouteStep& s : route.steps) {
     route.keys.push_back(s.to_key);
     if (s.unverified) {
-      route.warnings.push_back(fmt::format("link {} (key {} -> {}) has no F: no verified guidance between them; "
-                                           "the robot relocalizes after it", s.link, s.from_key, s.to_key));
+      route.warnings.push_back(
+          fmt::format("link {} (key {} -> {}) has no F: no verified guidance between them; "
+                      "the robot relocalizes after it",
+                      s.link, s.from_key, s.to_key));
     }
   }
   return route;

@@ -28,14 +28,14 @@ struct RouteOptions {
 struct RouteStep {
   int from_key = 0;
   int to_key = 0;
-  int link = 0;           // index into VisualMap::links
-  bool backwards = false; // against the teach run's direction
+  int link = 0;             // index into VisualMap::links
+  bool backwards = false;   // against the teach run's direction
   bool unverified = false;  // the link has no F (forwards only)
 };
 
 struct Route {
-  std::vector<int> keys;          // key images in the order to follow, `from` first and `to` last
-  std::vector<RouteStep> steps;   // keys.size() - 1 steps
+  std::vector<int> keys;         // key images in the order to follow, `from` first and `to` last
+  std::vector<RouteStep> steps;  // keys.size() - 1 steps
   std::vector<std::string> warnings;
 };
 

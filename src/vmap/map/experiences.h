@@ -24,19 +24,19 @@ struct VisualMap;
 
 // One repeat frame stored as a view of a teach key image.
 struct ExperienceView {
-  int key = 0;                 // index into VisualMap::key_images
-  std::string image_file;      // relative to the map directory: experiences/<id>/<frame>.png
-  int frame_index = 0;         // the frame's index in the repeat run
-  int source_index = 0;        // its index in the repeat run's input
-  double timestamp = -1.0;     // seconds; -1 when the input has none
-  std::string source_name;     // the frame's file name, or "frame_000123"
-  double heading_px = 0.0;     // x in the view minus x in the key image (finite)
-  int num_verified = 0;        // verified matches of the view with the key image when it was chosen
+  int key = 0;              // index into VisualMap::key_images
+  std::string image_file;   // relative to the map directory: experiences/<id>/<frame>.png
+  int frame_index = 0;      // the frame's index in the repeat run
+  int source_index = 0;     // its index in the repeat run's input
+  double timestamp = -1.0;  // seconds; -1 when the input has none
+  std::string source_name;  // the frame's file name, or "frame_000123"
+  double heading_px = 0.0;  // x in the view minus x in the key image (finite)
+  int num_verified = 0;     // verified matches of the view with the key image when it was chosen
 };
 
 struct Experience {
-  int id = 1;                  // 1, 2, ... in the order added; 0 names the teach run
-  std::string source;          // the repeat run's input, as given
+  int id = 1;                         // 1, 2, ... in the order added; 0 names the teach run
+  std::string source;                 // the repeat run's input, as given
   std::vector<ExperienceView> views;  // at most one per key image, in key order
 };
 

@@ -108,8 +108,7 @@ class Fields {
   }
 
   // Optional members: the default when absent.
-  long Integer(const json& object, const std::string& where, const char* name, long low, long high,
-               long absent) const {
+  long Integer(const json& object, const std::string& where, const char* name, long low, long high, long absent) const {
     const json* value = Find(object, name);
     return value ? Integer(*value, Join(where, name), low, high) : absent;
   }
@@ -153,9 +152,8 @@ std::optional<cv::Size> KeyImageSize(const ContainedFile& file) { return ImageHe
 
 std::optional<cv::Size> KeyImageFileSize(const fs::path& file) {
   std::string why_not;
-  const std::optional<ContainedFile> opened =
-      ContainedFile::Open(file.parent_path().empty() ? fs::path(".") : file.parent_path(), file.filename().string(),
-                          &why_not);
+  const std::optional<ContainedFile> opened = ContainedFile::Open(
+      file.parent_path().empty() ? fs::path(".") : file.parent_path(), file.filename().string(), &why_not);
   if (!opened) return std::nullopt;
   return KeyImageSize(*opened);
 }
@@ -179,8 +177,8 @@ ContainedFile OpenMapFile(const fs::path& directory, const std::string& relative
   if (file) return std::move(*file);
   const fs::path path = directory / relative;
   if (why_not == "is missing") {
-    throw InputError("map '" + directory.string() + "' is incomplete: " +
-                     (what.empty() ? path.string() : what + " '" + path.string() + "'") +
+    throw InputError("map '" + directory.string() +
+                     "' is incomplete: " + (what.empty() ? path.string() : what + " '" + path.string() + "'") +
                      " is missing; rebuild the map with `vmap build`");
   }
   // A field of map.json names the file, or the file is one of the map's own (correspondences.bin).
@@ -209,7 +207,8 @@ void ReadKeyImages(const json& doc, const Fields& fields, const fs::path& direct
     }
     k.source_index = static_cast<int>(fields.Integer(entry, where, "source_index", 0, kMaxInt, k.frame_index));
     const json* timestamp = Fields::Find(entry, "timestamp");
-    k.timestamp = timestamp && !timestamp->is_null() ? fields.Number(*timestamp, where + ".timestamp", 0.0, 1e12) : -1.0;
+    k.timestamp =
+        timestamp && !timestamp->is_null() ? fields.Number(*timestamp, where + ".timestamp", 0.0, 1e12) : -1.0;
     k.source_name = DecodeFileName(fields.String(entry, where, "source_name"));
     k.image_file = DecodeFileName(fields.String(fields.Required(entry, where, "image"), where + ".image"));
     k.num_features = static_cast<int>(fields.Integer(entry, where, "num_features", 0, kMaxInt, 0));
@@ -231,23 +230,22 @@ void ReadKeyImages(const json& doc, const Fields& fields, const fs::path& direct
                           : static_cast<long>(size->width) * size->height <= kMaxKeyImagePixels;
     if (!fits) {
       Malformed(file, where + ".image '" + k.image_file + "' is " + std::to_string(size->width) + "x" +
-                          std::to_string(size->height) + ", not the map's frame size " + std::to_string(expected.width) +
-                          "x" + std::to_string(expected.height));
+                          std::to_string(size->height) + ", not the map's frame size " +
+                          std::to_string(expected.width) + "x" + std::to_string(expected.height));
     }
     map->key_images.push_back(std::move(k));
   }
   if (map->key_images.empty() && map->num_frames > 0) Malformed(file, "no key images");
   if (const json* count = Fields::Find(doc, "num_key_images")) {
     if (fields.Integer(*count, "num_key_images", 0, kMaxInt) != static_cast<long>(map->key_images.size())) {
-      fields.Fail("num_key_images", "does not match the " + std::to_string(map->key_images.size()) +
-                                        " entries of 'key_images'");
+      fields.Fail("num_key_images",
+                  "does not match the " + std::to_string(map->key_images.size()) + " entries of 'key_images'");
     }
   }
 }
 
 // The links and, from correspondences.bin, exactly the records they reference.
-void ReadLinks(const json& doc, const Fields& fields, const fs::path& directory, const fs::path& file,
-               VisualMap* map) {
+void ReadLinks(const json& doc, const Fields& fields, const fs::path& directory, const fs::path& file, VisualMap* map) {
   const json& links = fields.Array(fields.Required(doc, "", "links"), "links");
   const long num_keys = static_cast<long>(map->key_images.size());
   if (static_cast<long>(links.size()) > std::max(num_keys - 1, 0L)) {
@@ -259,7 +257,8 @@ void ReadLinks(const json& doc, const Fields& fields, const fs::path& directory,
     const std::string where = "links[" + std::to_string(i) + "]";
     const json& entry = fields.Object(links[i], where);
     Link l;
-    l.from_key = static_cast<int>(fields.Integer(fields.Required(entry, where, "from"), where + ".from", 0, num_keys - 1));
+    l.from_key =
+        static_cast<int>(fields.Integer(fields.Required(entry, where, "from"), where + ".from", 0, num_keys - 1));
     l.to_key = static_cast<int>(fields.Integer(fields.Required(entry, where, "to"), where + ".to", 0, num_keys - 1));
     if (l.to_key <= l.from_key) fields.Fail(where + ".to", "must name a key image after 'from'");
     for (const auto& [name, key] : {std::pair<const char*, int>{"from_frame", l.from_key}, {"to_frame", l.to_key}}) {
@@ -280,11 +279,10 @@ void ReadLinks(const json& doc, const Fields& fields, const fs::path& directory,
     l.num_verified = static_cast<int>(
         fields.Integer(fields.Required(entry, where, "verified"), where + ".verified", 0, l.num_tentative));
     if (const json* F = Fields::Find(entry, "F"); F && !F->is_null()) {
-      const bool nine_numbers = F->is_array() && F->size() == 9 &&
-                                std::all_of(F->begin(), F->end(), [](const json& v) {
-                                  return Fields::NumberIn(v, -std::numeric_limits<double>::max(),
-                                                          std::numeric_limits<double>::max());
-                                });
+      const bool nine_numbers =
+          F->is_array() && F->size() == 9 && std::all_of(F->begin(), F->end(), [](const json& v) {
+            return Fields::NumberIn(v, -std::numeric_limits<double>::max(), std::numeric_limits<double>::max());
+          });
       if (!nine_numbers) fields.Fail(where + ".F", "must be null or a list of 9 finite numbers");
       l.has_fundamental = true;
       for (int k = 0; k < 9; ++k) l.F(k / 3, k % 3) = (*F)[k].get<double>();
@@ -344,8 +342,8 @@ void ReadEvaluations(const json& doc, const Fields& fields, VisualMap* map) {
   const char* names[] = {"key_frame", "frame", "similarity", "tentative", "verified", "matched"};
   const json* columns[6];
   for (int c = 0; c < 6; ++c) {
-    columns[c] = &fields.Array(fields.Required(*evaluations, "evaluations", names[c]),
-                               Fields::Join("evaluations", names[c]));
+    columns[c] =
+        &fields.Array(fields.Required(*evaluations, "evaluations", names[c]), Fields::Join("evaluations", names[c]));
     if (columns[c]->size() != columns[0]->size()) fields.Fail("evaluations", "has columns of different lengths");
   }
   const long last_frame = map->num_frames - 1;
@@ -380,7 +378,8 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
   std::error_code ec;
   if (!fs::is_directory(directory, ec)) {
     if (fs::exists(directory, ec)) {
-      throw InputError("'" + directory.string() + "' is not a map: a map is the folder `vmap build -o` wrote; "
+      throw InputError("'" + directory.string() +
+                       "' is not a map: a map is the folder `vmap build -o` wrote; "
                        "give that folder");
     }
     throw InputError("map directory '" + directory.string() + "' does not exist; build one with `vmap build`");
@@ -432,9 +431,9 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
   const cv::Size frame_size = map.input.frame_size;
   if (input && Fields::Find(*input, "frame_size") && map.num_frames > 0 && frame_size != cv::Size() &&
       !FrameSizeProblem(frame_size).empty()) {
-    fields.Fail("input.frame_size", "is " + std::to_string(frame_size.width) + "x" +
-                                        std::to_string(frame_size.height) + " although the map has frames, " +
-                                        "which are never " + FrameSizeProblem(frame_size));
+    fields.Fail("input.frame_size", "is " + std::to_string(frame_size.width) + "x" + std::to_string(frame_size.height) +
+                                        " although the map has frames, " + "which are never " +
+                                        FrameSizeProblem(frame_size));
   }
   map.quality = fields.Number(fields.Required(doc, "", "quality"), "quality", 0.0, 1.0);
   map.seconds = fields.Number(doc, "", "seconds", 0.0, 1e9, 0.0);
@@ -492,7 +491,8 @@ cv::Mat ReadKeyImage(const fs::path& map_directory, const KeyImage& key, bool gr
     why = " (" + LibraryMessage(error) + ")";
   }
   if (image.empty()) {
-    throw InputError("key image '" + file.string() + "' cannot be decoded" + why + "; rebuild the map with `vmap build`");
+    throw InputError("key image '" + file.string() + "' cannot be decoded" + why +
+                     "; rebuild the map with `vmap build`");
   }
   return image;
 }

@@ -195,20 +195,28 @@ TEST(MapIo, EveryFieldIsCheckedAndTheMessageNamesIt) {
       {[](json& d) { d["skipped_frames"] = -1; }, "'skipped_frames'"},
       {[](json& d) { d["options"] = json::array(); }, "'options' must be an object"},
       {[](json& d) { d["input"]["frame_size"] = {64}; }, "'input.frame_size' must be [width, height]"},
-      {[](json& d) { d["input"]["frame_size"] = {64, -48}; }, "'input.frame_size[1]'"},
+      {[](json& d) {
+         d["input"]["frame_size"] = {64, -48};
+       },
+       "'input.frame_size[1]'"},
       {[](json& d) { d["input"]["format"] = "tape"; }, "'input.format' is not a known format"},
       {[](json& d) { d["input"]["fps"] = "fast"; }, "'input.fps'"},
       {[](json& d) { d["num_key_images"] = 7; }, "'num_key_images' does not match"},
       {[](json& d) { d["key_images"] = json::object(); }, "'key_images' must be a list"},
       {[](json& d) { d["key_images"][1] = 5; }, "'key_images[1]' must be an object"},
-      {[](json& d) { d["key_images"][1]["frame_index"] = 20; }, "'key_images[1].frame_index' must be an integer from 0 to 19"},
+      {[](json& d) { d["key_images"][1]["frame_index"] = 20; },
+       "'key_images[1].frame_index' must be an integer from 0 to 19"},
       {[](json& d) { d["key_images"][2]["frame_index"] = 9; }, "'key_images[2].frame_index' must be larger"},
       {[](json& d) { d["key_images"][0]["timestamp"] = "noon"; }, "'key_images[0].timestamp'"},
       {[](json& d) { d["key_images"][0]["image"] = 12; }, "'key_images[0].image' must be a string"},
       {[](json& d) { d["key_images"][0].erase("image"); }, "'key_images[0].image' is missing"},
       {[](json& d) { d["key_images"][2]["num_features"] = 1.5; }, "'key_images[2].num_features'"},
       {[](json& d) { d["links"] = "none"; }, "'links' must be a list"},
-      {[](json& d) { d["links"].push_back(d["links"][0]); d["links"].push_back(d["links"][0]); }, "'links' has more entries"},
+      {[](json& d) {
+         d["links"].push_back(d["links"][0]);
+         d["links"].push_back(d["links"][0]);
+       },
+       "'links' has more entries"},
       {[](json& d) { d["links"][0]["from"] = 5; }, "'links[0].from' must be an integer from 0 to 2"},
       {[](json& d) { d["links"][1]["to"] = 1; }, "'links[1].to' must name a key image after"},
       {[](json& d) { d["links"][0]["from_frame"] = 3; }, "'links[0].from_frame' is not the frame of key image 0"},
@@ -217,7 +225,8 @@ TEST(MapIo, EveryFieldIsCheckedAndTheMessageNamesIt) {
       {[](json& d) { d["links"][0]["similarity"] = -0.5; }, "'links[0].similarity'"},
       {[](json& d) { d["links"][0]["verified"] = 4; }, "'links[0].verified' must be an integer from 0 to 3"},
       {[](json& d) { d["links"][0]["tentative"] = 1e10; }, "'links[0].tentative'"},
-      {[](json& d) { d["links"][1]["F"] = {1, 2, 3, 4, 5, 6, 7, 8}; }, "'links[1].F' must be null or a list of 9 finite numbers"},
+      {[](json& d) { d["links"][1]["F"] = {1, 2, 3, 4, 5, 6, 7, 8}; },
+       "'links[1].F' must be null or a list of 9 finite numbers"},
       {[](json& d) { d["links"][1]["F"][4] = "x"; }, "'links[1].F' must be null or a list of 9 finite"},
       {[](json& d) { d["links"][1]["F"][4] = nullptr; }, "'links[1].F'"},
       {[](json& d) { d["links"][1]["F"] = "identity"; }, "'links[1].F'"},
@@ -227,16 +236,29 @@ TEST(MapIo, EveryFieldIsCheckedAndTheMessageNamesIt) {
       {[](json& d) { d["links"][0]["correspondences"]["offset"] = 1ull << 62; }, "'links[0].correspondences.offset'"},
       {[](json& d) { d["evaluations"]["frame"][1] = -3; }, "'evaluations.frame[1]' must be an integer from 0 to 19"},
       {[](json& d) { d["evaluations"]["similarity"][0] = 1e308; }, "'evaluations.similarity[0]'"},
-      {[](json& d) { d["evaluations"]["verified"][0] = 11; }, "'evaluations.verified[0]' must be an integer from 0 to 10"},
+      {[](json& d) { d["evaluations"]["verified"][0] = 11; },
+       "'evaluations.verified[0]' must be an integer from 0 to 10"},
       {[](json& d) { d["evaluations"]["matched"][1] = 0; }, "'evaluations.matched[1]' must be true or false"},
       {[](json& d) { d["evaluations"]["matched"].push_back(true); }, "'evaluations' has columns of different lengths"},
       {[](json& d) { d["evaluations"].erase("key_frame"); }, "'evaluations.key_frame' is missing"},
       // Fields that contradict each other or describe nothing a camera makes.
       {[](json& d) { d["links"] = json::array(); }, "'links' is empty although the map has 3 key images"},
-      {[](json& d) { d["input"]["frame_size"] = {0, 48}; }, "'input.frame_size' is 0x48 although the map has frames, which are never smaller than 32"},
-      {[](json& d) { d["input"]["frame_size"] = {64, 0}; }, "'input.frame_size' is 64x0"},
-      {[](json& d) { d["input"]["frame_size"] = {64, 8}; }, "'input.frame_size' is 64x8"},
-      {[](json& d) { d["input"]["frame_size"] = {100000, 100000}; }, "which are never more than vmap's limit"},
+      {[](json& d) {
+         d["input"]["frame_size"] = {0, 48};
+       },
+       "'input.frame_size' is 0x48 although the map has frames, which are never smaller than 32"},
+      {[](json& d) {
+         d["input"]["frame_size"] = {64, 0};
+       },
+       "'input.frame_size' is 64x0"},
+      {[](json& d) {
+         d["input"]["frame_size"] = {64, 8};
+       },
+       "'input.frame_size' is 64x8"},
+      {[](json& d) {
+         d["input"]["frame_size"] = {100000, 100000};
+       },
+       "which are never more than vmap's limit"},
       {[](json& d) { d.erase("input"); }, "'input' is missing"},
       {[](json& d) { d["input"]["path"] = std::string("in\0put", 6); }, "'input.path' holds a NUL character"},
       {[](json& d) { d["key_images"][1]["image"] = std::string("keys/1.png\0.jpg", 15); }, "NUL character"},
@@ -245,7 +267,8 @@ TEST(MapIo, EveryFieldIsCheckedAndTheMessageNamesIt) {
        },
        "beyond 10,000,000 pixels"},
       {[](json& d) {
-         d["input"]["camera"] = {{"model", "PINHOLE"}, {"width", 1ull << 40}, {"height", 48}, {"params", {50, 50, 32, 24}}};
+         d["input"]["camera"] = {
+             {"model", "PINHOLE"}, {"width", 1ull << 40}, {"height", 48}, {"params", {50, 50, 32, 24}}};
        },
        "has the size 1099511627776x48"},
   };
@@ -260,8 +283,8 @@ TEST(MapIo, EveryFieldIsCheckedAndTheMessageNamesIt) {
   // Numbers beyond what JSON can hold, and nesting no map has.
   WriteText(tmp.path() / kMapFileName, R"({"format": "vmap-map", "schema_version": 1, "num_frames": 1e999})");
   EXPECT_NE(ErrorOf(tmp.path()).find("number too large"), std::string::npos) << ErrorOf(tmp.path());
-  WriteText(tmp.path() / kMapFileName, R"({"format": "vmap-map", "options": )" + std::string(10000, '[') +
-                                           std::string(10000, ']') + "}");
+  WriteText(tmp.path() / kMapFileName,
+            R"({"format": "vmap-map", "options": )" + std::string(10000, '[') + std::string(10000, ']') + "}");
   EXPECT_NE(ErrorOf(tmp.path()).find("nested"), std::string::npos) << ErrorOf(tmp.path());
   // The untouched document still reads.
   WriteText(tmp.path() / kMapFileName, good.dump());
@@ -366,12 +389,14 @@ TEST(MapIo, KeyImagesMustBeThePngsOfTheMapsFrameSize) {
   WriteMapFiles(SmallMap(tmp.path()), tmp.path());
   const fs::path key = tmp.path() / "keys/9.png";
   std::ofstream(key, std::ios::trunc) << "GIF89a";
-  EXPECT_NE(ErrorOf(tmp.path()).find("'keys/9.png' is not a PNG or JPEG image"), std::string::npos) << ErrorOf(tmp.path());
+  EXPECT_NE(ErrorOf(tmp.path()).find("'keys/9.png' is not a PNG or JPEG image"), std::string::npos)
+      << ErrorOf(tmp.path());
   cv::imwrite(key.string(), cv::Mat(10, 12, CV_8U, cv::Scalar(3)));
-  EXPECT_NE(ErrorOf(tmp.path()).find("is 12x10, not the map's frame size 64x48"), std::string::npos) << ErrorOf(tmp.path());
+  EXPECT_NE(ErrorOf(tmp.path()).find("is 12x10, not the map's frame size 64x48"), std::string::npos)
+      << ErrorOf(tmp.path());
   // A PNG header announcing 40000 x 40000 pixels: refused from its 24 bytes, never decoded.
-  const unsigned char header[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R',
-                                  0, 0, 0x9C, 0x40, 0, 0, 0x9C, 0x40, 8, 0, 0, 0, 0};
+  const unsigned char header[] = {0x89, 'P', 'N', 'G',  '\r', '\n', 0x1A, '\n', 0,    0, 0, 13, 'I', 'H', 'D',
+                                  'R',  0,   0,   0x9C, 0x40, 0,    0,    0x9C, 0x40, 8, 0, 0,  0,   0};
   std::ofstream(key, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(header), sizeof(header));
   EXPECT_NE(ErrorOf(tmp.path()).find("is 40000x40000"), std::string::npos) << ErrorOf(tmp.path());
 }
@@ -483,8 +508,8 @@ TEST(MapIo, ReadsSchemaVersionOneMapsWithBrokenLinks) {
   doc["input"].erase("camera");
   doc.erase("conventions");
   for (auto& link : doc["links"]) {
-    for (const char* key : {"below_tau", "pose", "parallax_px", "parallax_rotation_removed", "homography_share",
-                            "planar"}) {
+    for (const char* key :
+         {"below_tau", "pose", "parallax_px", "parallax_rotation_removed", "homography_share", "planar"}) {
       link.erase(key);
     }
   }

@@ -59,9 +59,9 @@ class MapWriter::KeyImageFiles {
   void Add(fs::path file, std::shared_ptr<const Frame> frame) {
     worker_.Post([file = std::move(file), frame = std::move(frame)] {
       std::error_code copy_error;
-      const bool written = KeepsSourceFile(*frame)
-                               ? fs::copy_file(frame->source_path, file, fs::copy_options::overwrite_existing, copy_error)
-                               : cv::imwrite(file.string(), ColorImage(*frame));
+      const bool written = KeepsSourceFile(*frame) ? fs::copy_file(frame->source_path, file,
+                                                                   fs::copy_options::overwrite_existing, copy_error)
+                                                   : cv::imwrite(file.string(), ColorImage(*frame));
       if (!written) {
         throw InputError("cannot write key image '" + file.string() + "'" +
                          (copy_error ? ": " + copy_error.message() : std::string()));

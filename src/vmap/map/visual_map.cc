@@ -11,8 +11,7 @@ QualityMean ParseQualityMean(const std::string& name) { return ParseEnum(kQualit
 
 std::string QualityMeanName(QualityMean mean) { return EnumToName(kQualityMeanNames, mean); }
 
-double MapQuality(int num_frames, int num_key_images, const std::vector<double>& link_similarities,
-                  QualityMean mean) {
+double MapQuality(int num_frames, int num_key_images, const std::vector<double>& link_similarities, QualityMean mean) {
   if (num_frames <= 0) return 0.0;
   const double compression = 1.0 - static_cast<double>(num_key_images) / num_frames;
   const double similarity =

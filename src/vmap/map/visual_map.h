@@ -13,13 +13,13 @@
 namespace vmap {
 
 struct KeyImage {
-  int frame_index = 0;        // index in the processed sequence
-  int source_index = 0;       // index in the input
-  double timestamp = -1.0;    // seconds; -1 when the input has none
-  std::string source_name;    // image file name or "frame_000123"
-  std::string image_file;     // relative to the map directory, e.g. "keys/000012.png"
+  int frame_index = 0;      // index in the processed sequence
+  int source_index = 0;     // index in the input
+  double timestamp = -1.0;  // seconds; -1 when the input has none
+  std::string source_name;  // image file name or "frame_000123"
+  std::string image_file;   // relative to the map directory, e.g. "keys/000012.png"
   int num_features = 0;
-  std::string reason;         // why it was chosen (first frame, similarity drop, matching failed, final frame)
+  std::string reason;  // why it was chosen (first frame, similarity drop, matching failed, final frame)
 };
 
 struct Correspondence {
@@ -29,15 +29,15 @@ struct Correspondence {
 
 // Two consecutive key images and what ties them together.
 struct Link {
-  int from_key = 0;    // index into VisualMap::key_images
+  int from_key = 0;  // index into VisualMap::key_images
   int to_key = 0;
   // The frame right after the first key image already fell below tau (or could not be matched), so that
   // frame became the second key image: the link joins two consecutive frames and its S is below tau. Its F
   // is as good as any (null only when matching failed). Called `broken` in maps of schema version 1.
   bool below_tau = false;
-  double similarity = 0.0;       // S of the paper
-  int num_tentative = 0;         // matches that entered verification
-  int num_verified = 0;          // inliers of F
+  double similarity = 0.0;  // S of the paper
+  int num_tentative = 0;    // matches that entered verification
+  int num_verified = 0;     // inliers of F
   bool has_fundamental = false;
   cv::Matx33d F = cv::Matx33d::zeros();  // x_to^T F x_from = 0, in pixels
   // The tentative matches, verified ones first: [0, num_verified) are inliers, the rest were rejected.
@@ -48,7 +48,7 @@ struct Link {
   bool has_pose = false;
   cv::Matx33d R = cv::Matx33d::eye();
   cv::Vec3d t;
-  int pose_inliers = 0;           // matches consistent with the pose
+  int pose_inliers = 0;  // matches consistent with the pose
   // How well the matches determine t's direction: its standard deviation in degrees with the rotation
   // marginalised (geometry/relative_pose.h, TranslationSigmaDeg). < 0: not computed (maps written before it).
   double translation_sigma_deg = -1.0;
@@ -83,14 +83,14 @@ struct Evaluation {
 };
 
 struct MapStatistics {
-  int num_frames = 0;           // n
-  int num_key_images = 0;       // m
-  int min_verified = 0;         // over links
+  int num_frames = 0;      // n
+  int num_key_images = 0;  // m
+  int min_verified = 0;    // over links
   int max_verified = 0;
   double mean_verified = 0.0;
   double mean_similarity = 0.0;
-  double quality = 0.0;         // Q
-  int below_tau_links = 0;      // links whose S is below tau (Link::below_tau)
+  double quality = 0.0;     // Q
+  int below_tau_links = 0;  // links whose S is below tau (Link::below_tau)
 };
 
 // Which frames of the input a map covers and why it ends there: recorded (map.json "coverage") for maps
@@ -101,8 +101,8 @@ inline constexpr EnumName<CoverageEnd> kCoverageEndNames[] = {{CoverageEnd::kInp
                                                               {CoverageEnd::kInterrupted, "interrupted"},
                                                               {CoverageEnd::kSnapshot, "snapshot"}};
 struct Coverage {
-  int num_frames = 0;             // frames processed
-  int first_source_index = -1;    // the first and last of them, as indices in the input (-1: none)
+  int num_frames = 0;           // frames processed
+  int first_source_index = -1;  // the first and last of them, as indices in the input (-1: none)
   int last_source_index = -1;
   CoverageEnd end = CoverageEnd::kInputEnded;
 };
@@ -111,12 +111,12 @@ struct VisualMap {
   SequenceInfo input;
   std::string options_json;  // every option used, as JSON text
   int num_frames = 0;
-  int skipped_frames = 0;    // corrupt frames skipped while reading
+  int skipped_frames = 0;  // corrupt frames skipped while reading
   std::vector<KeyImage> key_images;
   std::vector<Link> links;
   std::vector<Evaluation> evaluations;
   double quality = 0.0;
-  double seconds = 0.0;      // wall time of the build
+  double seconds = 0.0;              // wall time of the build
   std::optional<Coverage> coverage;  // absent for a map of a whole input (file, folder, dataset)
 };
 
@@ -128,8 +128,7 @@ std::string QualityMeanName(QualityMean mean);
 
 // Q(M) = mean of (1 - m/n) and the mean similarity of consecutive key images (arithmetic by default:
 // the paper's formula and tables; its text says harmonic). With no link the mean similarity is 0.
-double MapQuality(int num_frames, int num_key_images, const std::vector<double>& link_similarities,
-                  QualityMean mean);
+double MapQuality(int num_frames, int num_key_images, const std::vector<double>& link_similarities, QualityMean mean);
 
 MapStatistics ComputeStatistics(const VisualMap& map, QualityMean mean);
 

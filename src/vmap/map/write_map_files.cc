@@ -1,7 +1,5 @@
 // WriteMapFiles and its parts: map.json (its evaluations streamed column by column) and correspondences.bin.
 // Reading them back, with every check an untrusted map needs, is map_io.cc.
-#include "vmap/map/map_io.h"
-
 #include <functional>
 #include <sstream>
 #include <string>
@@ -12,6 +10,7 @@
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/file_name_encoding.h"
 #include "vmap/map/map_geometry_json.h"
+#include "vmap/map/map_io.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap {

@@ -7,9 +7,9 @@
 #include <fmt/format.h>
 
 #include "vmap/core/error.h"
+#include "vmap/map/map_writer.h"
 #include "vmap/mapping/key_image_search.h"
 #include "vmap/mapping/map_builder.h"
-#include "vmap/map/map_writer.h"
 #include "vmap/sources/read_ahead_source.h"
 
 namespace vmap {
@@ -97,9 +97,10 @@ SweepResult SweepThresholds(FrameSource& source, const Matcher& matcher, const M
   for (double tau : taus) {
     directories.push_back(maps_directory.empty() ? fs::path() : maps_directory / fmt::format("tau_{:.2f}", tau));
     if (std::count(directories.begin(), directories.end(), directories.back()) > 1 && !maps_directory.empty()) {
-      throw InputError(fmt::format("two thresholds round to the same map folder '{}'; the maps are named with two "
-                                   "decimals, so give thresholds at least 0.01 apart",
-                                   directories.back().filename().string()));
+      throw InputError(
+          fmt::format("two thresholds round to the same map folder '{}'; the maps are named with two "
+                      "decimals, so give thresholds at least 0.01 apart",
+                      directories.back().filename().string()));
     }
   }
   for (const fs::path& directory : directories) {

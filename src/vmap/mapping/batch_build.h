@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "vmap/features/matcher.h"
-#include "vmap/mapping/map_builder_options.h"
 #include "vmap/map/visual_map.h"
+#include "vmap/mapping/map_builder_options.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap {
@@ -41,11 +41,11 @@ struct SweepResult {
   std::string options_json;
   int num_frames = 0;
   std::vector<SweepRow> rows;
-  int best_row = -1;           // highest Q
+  int best_row = -1;  // highest Q
   double seconds = 0.0;
-  long features_extracted = 0; // one per frame: no frame is extracted twice
-  long pairs_matched = 0;      // pairs matched and verified, including a few made ahead and not needed
-  long links_verified = 0;     // links verified in full after an early-stopped decision (not matched again)
+  long features_extracted = 0;  // one per frame: no frame is extracted twice
+  long pairs_matched = 0;       // pairs matched and verified, including a few made ahead and not needed
+  long links_verified = 0;      // links verified in full after an early-stopped decision (not matched again)
 };
 
 // Runs every tau over one pass of the sequence (a MapBuilder with one selector per tau). Always compares every

@@ -4,11 +4,11 @@
 
 #include <string>
 
+#include "vmap/map/visual_map.h"
 #include "vmap/mapping/key_image_selector.h"
 #include "vmap/mapping/link_analysis.h"
 #include "vmap/mapping/link_verifier.h"
 #include "vmap/mapping/map_builder_options.h"
-#include "vmap/map/visual_map.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap {

@@ -8,10 +8,9 @@
 #include <map>
 #include <set>
 
+#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-
-#include <gtest/gtest.h>
 
 #include "vmap/core/error.h"
 #include "vmap/features/orb_matcher.h"
@@ -267,9 +266,8 @@ TEST(FastBuild, KeyImagesAreTheInputFilesWhenTheyCanBe) {
 namespace {
 
 const fs::path& RoomSequence() {
-  static const fs::path path = testing::SharedDir().empty()
-                                   ? fs::path()
-                                   : fs::path(testing::SharedDir()) / "data/rccar_room/images";
+  static const fs::path path =
+      testing::SharedDir().empty() ? fs::path() : fs::path(testing::SharedDir()) / "data/rccar_room/images";
   return path;
 }
 
@@ -337,8 +335,8 @@ TEST(FastBuild, DefaultSweepDecidesWithinTheNoiseOfASeedChange) {
       const ImageFeatures& frame = *features[e.frame];
       const bool decision = e.matched && e.similarity >= taus[t];
       const PairComparison other = ComparePair(*matcher, key, frame, seed_one, SimilarityMode::kInlierRatio);
-      const PairComparison fast = ComparePair(*matcher, key, frame, early, SimilarityMode::kInlierRatio,
-                                              asked[{e.key_frame, e.frame}]);
+      const PairComparison fast =
+          ComparePair(*matcher, key, frame, early, SimilarityMode::kInlierRatio, asked[{e.key_frame, e.frame}]);
       ASSERT_TRUE(fast.Decides(taus[t]));
       ++decisions;
       flipped_by_seed += other.Reaches(taus[t]) != decision;
@@ -347,9 +345,8 @@ TEST(FastBuild, DefaultSweepDecidesWithinTheNoiseOfASeedChange) {
   }
   EXPECT_GT(decisions, 300);
   EXPECT_GT(flipped_by_seed, 0) << "the comparison needs pairs near tau";
-  EXPECT_LE(flipped_by_early_stop, 2 * flipped_by_seed + 2)
-      << flipped_by_early_stop << " flips by early stopping, " << flipped_by_seed << " by a seed change, of "
-      << decisions;
+  EXPECT_LE(flipped_by_early_stop, 2 * flipped_by_seed + 2) << flipped_by_early_stop << " flips by early stopping, "
+                                                            << flipped_by_seed << " by a seed change, of " << decisions;
 
   auto fast_source = Room(99);
   const SweepResult fast = SweepThresholds(*fast_source, *matcher, Options(0.5, KeySearch::kAuto), taus);

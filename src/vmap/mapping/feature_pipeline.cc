@@ -115,14 +115,13 @@ PipelineItem FeaturePipeline::ExtractAndCompare(Frame decoded) {
                                  group.taus.front());
       for (double tau : group.taus) AddThreshold(tau, &asked);
     }
-    PairComparison comparison =
-        compare_(group.record, item.record, asked, [this, key_index, frame_index, &group] {
-          std::lock_guard<std::mutex> lock(mutex_);
-          for (double tau : group.taus) {
-            if (ResolveKey(key_index, tau, frame_index - 1) == key_index) return false;
-          }
-          return true;
-        });
+    PairComparison comparison = compare_(group.record, item.record, asked, [this, key_index, frame_index, &group] {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (double tau : group.taus) {
+        if (ResolveKey(key_index, tau, frame_index - 1) == key_index) return false;
+      }
+      return true;
+    });
     if (comparison.abandoned) continue;
     for (double tau : group.taus) {
       if (!comparison.Reaches(tau)) {

@@ -17,8 +17,9 @@
 namespace vmap {
 
 // Compares a key image with a frame for the selectors whose thresholds are `taus`; `abandon` may stop it.
-using CompareForTausFn = std::function<PairComparison(const FrameRecord& key, const FrameRecord& frame,
-                                               const std::vector<double>& taus, const std::function<bool()>& abandon)>;
+using CompareForTausFn =
+    std::function<PairComparison(const FrameRecord& key, const FrameRecord& frame, const std::vector<double>& taus,
+                                 const std::function<bool()>& abandon)>;
 
 // Adds `tau` to the ascending `taus` unless it is there.
 void AddThreshold(double tau, std::vector<double>* taus);
@@ -109,13 +110,13 @@ class FeaturePipeline {
   std::mutex mutex_;
   std::shared_ptr<const std::vector<CurrentKey>> current_keys_;
   struct Retirement {
-    int at_frame;    // a frame seen to fall below from_tau against the key
+    int at_frame;     // a frame seen to fall below from_tau against the key
     double from_tau;  // the lowest threshold it fell below: selectors with this tau or a higher one leave
-    int successor;   // the frame that replaces the key for them
+    int successor;    // the frame that replaces the key for them
   };
   std::map<int, std::vector<Retirement>> retired_;  // by key frame index
-  std::map<int, FrameRecord> recent_;    // extracted frames a successor may be taken from, by frame index
-  OrderedPipeline<Frame, PipelineItem> frames_;  // last: its workers start once everything they use exists
+  std::map<int, FrameRecord> recent_;               // extracted frames a successor may be taken from, by frame index
+  OrderedPipeline<Frame, PipelineItem> frames_;     // last: its workers start once everything they use exists
 };
 
 }  // namespace vmap

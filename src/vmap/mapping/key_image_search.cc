@@ -12,10 +12,10 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/progress.h"
+#include "vmap/map/map_writer.h"
 #include "vmap/mapping/collect_map.h"
 #include "vmap/mapping/key_image_selector.h"
 #include "vmap/mapping/link_verifier.h"
-#include "vmap/map/map_writer.h"
 
 namespace vmap {
 
@@ -24,8 +24,8 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
   options.Check();
   const auto start = std::chrono::steady_clock::now();
   const VerifierOptions verifier = DecisionVerifier(options);
-  const std::vector<double> taus = verifier.own_magsac ? std::vector<double>{options.key_images.tau}
-                                                       : std::vector<double>{};
+  const std::vector<double> taus =
+      verifier.own_magsac ? std::vector<double>{options.key_images.tau} : std::vector<double>{};
   const int workers = options.ExtractionThreads();
   const int window = options.search_window;
 

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "vmap/features/matcher.h"
-#include "vmap/mapping/map_builder_options.h"
 #include "vmap/map/visual_map.h"
+#include "vmap/mapping/map_builder_options.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap {

@@ -24,16 +24,15 @@ void KeyImageOptions::Check() const {
     throw OptionError("tau", fmt::format("{} is outside (0, 1]; the paper uses 0.1 to 0.9", tau));
   }
   if (!(min_key_displacement >= 0.0 && min_key_displacement <= 100.0)) {
-    throw OptionError("min_key_displacement",
-                      fmt::format("{} px is outside [0, 100]; the default is 1, 0 turns the check off",
-                                  min_key_displacement));
+    throw OptionError(
+        "min_key_displacement",
+        fmt::format("{} px is outside [0, 100]; the default is 1, 0 turns the check off", min_key_displacement));
   }
 }
 
-PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features0,
-                           const ImageFeatures& features1, const VerifierOptions& verifier,
-                           SimilarityMode similarity, const std::vector<double>& decide_taus,
-                           const std::function<bool()>& abandon) {
+PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features0, const ImageFeatures& features1,
+                           const VerifierOptions& verifier, SimilarityMode similarity,
+                           const std::vector<double>& decide_taus, const std::function<bool()>& abandon) {
   const TentativeMatches matches = matcher.Match(features0, features1);
   const int denominator = similarity == SimilarityMode::kInlierRatio
                               ? static_cast<int>(matches.size())
@@ -59,8 +58,8 @@ PairComparison VerifyMatches(const TentativeMatches& matches, int denominator, c
   }
   early_stop.abandon = abandon;
   early_stop.resume_from = std::move(resume_from);
-  const FundamentalResult fundamental = EstimateFundamental(matches.points0, matches.points1, verifier, early_stop,
-                                                               &matches.scores);
+  const FundamentalResult fundamental =
+      EstimateFundamental(matches.points0, matches.points1, verifier, early_stop, &matches.scores);
   if (fundamental.abandoned) {
     result.abandoned = true;
     return result;
@@ -138,8 +137,7 @@ void KeyImageSelector::AddKeyImage(const FrameRecord& record, const std::string&
   key.num_features = record.features->num_features();
   key.reason = reason;
   if (on_key_image_) on_key_image_(record, key);
-  spdlog::debug("tau {:.2f}: key image {} = frame {} ({})", options_.tau, key_images_.size(), key.frame_index,
-                reason);
+  spdlog::debug("tau {:.2f}: key image {} = frame {} ({})", options_.tau, key_images_.size(), key.frame_index, reason);
   key_images_.push_back(std::move(key));
   key_ = record;
   previous_.reset();
@@ -164,7 +162,7 @@ void KeyImageSelector::Add(const FrameRecord& record, const CompareFn& compare) 
   // frame is compared again with it, so no frame is skipped.
   for (;;) {
     PairComparison comparison = compare(*key_, record);
-    const Evaluation evaluation{key_->frame->index,       record.frame->index,       comparison.similarity,
+    const Evaluation evaluation{key_->frame->index,       record.frame->index,     comparison.similarity,
                                 comparison.num_tentative, comparison.num_verified, comparison.matched};
     if (on_evaluation_) {
       on_evaluation_(evaluation);
@@ -191,9 +189,10 @@ void KeyImageSelector::Add(const FrameRecord& record, const CompareFn& compare) 
       // before it repeat the key image's view. The failing frame becomes a key image, linked below tau.
       const std::string what = still_frames_ == 0
                                    ? "; the next frame already fails: linked below tau"
-                                   : fmt::format("; the {} frame(s) before it repeat the key image's view: linked "
-                                                 "below tau",
-                                                 still_frames_);
+                                   : fmt::format(
+                                         "; the {} frame(s) before it repeat the key image's view: linked "
+                                         "below tau",
+                                         still_frames_);
       AddKeyImage(record, why + what);
       AddLink(comparison, /*below_tau=*/true);
       return;

@@ -28,9 +28,9 @@ SimilarityMode ParseSimilarityMode(const std::string& name);
 std::string SimilarityModeName(SimilarityMode mode);
 
 struct KeyImageOptions {
-  double tau = 0.5;                       // similarity threshold in (0, 1]
+  double tau = 0.5;  // similarity threshold in (0, 1]
   SimilarityMode similarity = SimilarityMode::kInlierRatio;
-  bool final_key = true;                  // the last frame becomes the final key image (the route's goal)
+  bool final_key = true;  // the last frame becomes the final key image (the route's goal)
   // Pixels. A frame whose verified matches with the key image moved less than this (median) shows the key
   // image's view again: a repeated frame (7-Scenes repeats a frame when one was dropped) or a camera at
   // rest. Such a frame passes the test (S is near 1) but is never promoted to key image: a link between two
@@ -51,13 +51,13 @@ struct FrameRecord {
 
 // The outcome of comparing a key image with a frame: S and everything a link keeps.
 struct PairComparison {
-  bool matched = false;     // enough tentative matches and a fundamental matrix
+  bool matched = false;  // enough tentative matches and a fundamental matrix
   double similarity = 0.0;
   int num_tentative = 0;
   int num_verified = 0;
   cv::Matx33d F = cv::Matx33d::zeros();
   std::vector<Correspondence> correspondences;  // verified first, then rejected
-  double median_displacement = -1.0;  // pixels, over the verified matches; -1 when not matched
+  double median_displacement = -1.0;            // pixels, over the verified matches; -1 when not matched
   // False when verification stopped as soon as S >= tau was settled for the thresholds asked (ComparePair's
   // `decide_taus`): S is then the best found by that point, and only Decides(tau) says whether it answers tau.
   bool exhaustive = true;
@@ -65,7 +65,7 @@ struct PairComparison {
   // When not exhaustive: the thresholds verification was asked to settle, ascending. Where it stopped, and so
   // S, depends on all of them, not only on the one a caller wants answered.
   std::vector<double> decided_taus;
-  bool abandoned = false;          // `abandon` stopped the verification: this answers nothing
+  bool abandoned = false;  // `abandon` stopped the verification: this answers nothing
   // When not exhaustive: where verification stopped. VerifyMatches given it back (`resume_from`) goes on from
   // there instead of starting over, e.g. to verify a link in full.
   std::shared_ptr<const MagsacCheckpoint> checkpoint;
@@ -78,10 +78,9 @@ struct PairComparison {
 // that can stop early (VerifierOptions::own_magsac), verification stops once "S >= tau?" is settled for each of
 // them; without, it runs to the verifier's confidence criterion. `abandon` (same verifier only) is polled during
 // verification and stops it when the answer is no longer needed.
-PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features0,
-                           const ImageFeatures& features1, const VerifierOptions& verifier,
-                           SimilarityMode similarity, const std::vector<double>& decide_taus = {},
-                           const std::function<bool()>& abandon = nullptr);
+PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features0, const ImageFeatures& features1,
+                           const VerifierOptions& verifier, SimilarityMode similarity,
+                           const std::vector<double>& decide_taus = {}, const std::function<bool()>& abandon = nullptr);
 
 // The verification half of ComparePair, on matches already made: S = verified / `denominator` (|D|).
 // `resume_from`, a checkpoint of an earlier verification of these matches that stopped early, continues that
@@ -142,10 +141,10 @@ class KeyImageSelector {
   EvaluationFn on_evaluation_;
   LinkFn on_link_;
   std::optional<FrameRecord> key_;
-  std::optional<FrameRecord> previous_;         // the last frame that passed against the key image
-  PairComparison previous_comparison_;          // key vs previous_
-  int still_frames_ = 0;                        // frames since the key image that showed its view again
-  bool last_frame_still_ = false;               // the last frame added showed the key image's view again
+  std::optional<FrameRecord> previous_;  // the last frame that passed against the key image
+  PairComparison previous_comparison_;   // key vs previous_
+  int still_frames_ = 0;                 // frames since the key image that showed its view again
+  bool last_frame_still_ = false;        // the last frame added showed the key image's view again
   std::vector<KeyImage> key_images_;
   std::vector<Link> links_;
   std::vector<Evaluation> evaluations_;

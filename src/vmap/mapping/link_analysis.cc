@@ -64,8 +64,8 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
     if (pose.valid && options.pose.method == PoseMethod::kEssential) {
       // Probes at twice the rival angle: one that stays there is a rival, one that returns is not. One that
       // ends lower than every start found a better pose by the estimate's own cost: it becomes the pose.
-      const std::vector<PoseMinimum> probes = ProbeTranslation(pose, *camera, pose_from, pose_to, options.pose,
-                                                               2.0 * options.translation.rival_angle_deg);
+      const std::vector<PoseMinimum> probes =
+          ProbeTranslation(pose, *camera, pose_from, pose_to, options.pose, 2.0 * options.translation.rival_angle_deg);
       minima.insert(minima.end(), probes.begin(), probes.end());
       pose = std::min_element(minima.begin(), minima.end(), [](const PoseMinimum& a, const PoseMinimum& b) {
                return a.cost < b.cost;
@@ -84,10 +84,10 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
     }
   }
   link.parallax_without_rotation = link.has_pose;
-  link.parallax = Median(Displacements(verified_from, verified_to, link.has_pose ? camera : nullptr,
-                                       link.has_pose ? &link.R : nullptr));
-  const double rival_cost_gap = link.translation_rival_cost_gap >= 0 ? link.translation_rival_cost_gap
-                                                                     : std::numeric_limits<double>::infinity();
+  link.parallax = Median(
+      Displacements(verified_from, verified_to, link.has_pose ? camera : nullptr, link.has_pose ? &link.R : nullptr));
+  const double rival_cost_gap =
+      link.translation_rival_cost_gap >= 0 ? link.translation_rival_cost_gap : std::numeric_limits<double>::infinity();
   link.translation_known =
       link.has_pose && TranslationKnown(link.translation_sigma_deg, link.parallax, rival_cost_gap, options.translation);
 

@@ -18,8 +18,8 @@
 namespace vmap {
 
 struct LinkAnalysisOptions {
-  PoseOptions pose;              // how the pose is estimated (docs/method.md, "The relative pose of a link")
-  HomographyOptions homography;  // when a homography counts as explaining the matches
+  PoseOptions pose;                // how the pose is estimated (docs/method.md, "The relative pose of a link")
+  HomographyOptions homography;    // when a homography counts as explaining the matches
   TranslationOptions translation;  // when a link's translation direction is trusted (docs/link-poses.md)
 
   // As map.json records it: {"pose": ..., "homography": ..., "translation": ...} (geometry/relative_pose.h,

@@ -16,9 +16,8 @@ void LinkVerifier::Add(const KeyImage& from, const KeyImage& to, const Link& lin
     matches.points0.push_back(c.p0);
     matches.points1.push_back(c.p1);
   }
-  const int denominator = similarity == SimilarityMode::kInlierRatio
-                              ? link.num_tentative
-                              : std::max(from.num_features, to.num_features);
+  const int denominator =
+      similarity == SimilarityMode::kInlierRatio ? link.num_tentative : std::max(from.num_features, to.num_features);
   worker_.Post([this, pair, matches = std::move(matches), denominator, checkpoint = std::move(checkpoint)] {
     PairComparison verified = VerifyMatches(matches, denominator, verifier_, {}, nullptr, checkpoint);
     std::lock_guard<std::mutex> lock(mutex_);
@@ -34,8 +33,8 @@ long LinkVerifier::Finish() {
 int LinkVerifier::Apply(VisualMap* map, double tau) const {
   int kept = 0;
   for (Link& link : map->links) {
-    const auto pair = std::make_pair(map->key_images[link.from_key].frame_index,
-                                     map->key_images[link.to_key].frame_index);
+    const auto pair =
+        std::make_pair(map->key_images[link.from_key].frame_index, map->key_images[link.to_key].frame_index);
     const PairComparison& verified = results_.at(pair);
     if (verified.Reaches(tau) == !link.below_tau) {
       link = MakeLink(verified, link.from_key, link.to_key, link.below_tau);

@@ -8,8 +8,8 @@
 
 #include "vmap/core/serial_worker.h"
 #include "vmap/geometry/fundamental.h"
-#include "vmap/mapping/key_image_selector.h"
 #include "vmap/map/visual_map.h"
+#include "vmap/mapping/key_image_selector.h"
 
 namespace vmap {
 
@@ -43,7 +43,7 @@ class LinkVerifier {
   const VerifierOptions verifier_;
   std::mutex mutex_;
   std::map<std::pair<int, int>, PairComparison> results_;  // by (from, to) frame index
-  SerialWorker worker_;  // last: destroyed first, so its jobs never outlive results_
+  SerialWorker worker_;                                    // last: destroyed first, so its jobs never outlive results_
 };
 
 }  // namespace vmap

@@ -11,12 +11,12 @@
 
 #include "vmap/core/error.h"
 #include "vmap/core/progress.h"
+#include "vmap/map/map_writer.h"
 #include "vmap/mapping/collect_map.h"
 #include "vmap/mapping/feature_pipeline.h"
 #include "vmap/mapping/key_image_selector.h"
 #include "vmap/mapping/link_analysis.h"
 #include "vmap/mapping/link_verifier.h"
-#include "vmap/map/map_writer.h"
 
 namespace vmap {
 namespace {
@@ -244,8 +244,8 @@ MapBuilder::MapBuilder(const FrameSource& source, const Matcher& matcher, const 
                       "(live inputs, snapshots); use key_search sequential",
                       {"key_search"});
   }
-  impl_ = std::make_unique<Impl>(source, matcher, options, std::move(taus), std::move(writers),
-                                 std::move(options_json));
+  impl_ =
+      std::make_unique<Impl>(source, matcher, options, std::move(taus), std::move(writers), std::move(options_json));
 }
 
 MapBuilder::~MapBuilder() = default;

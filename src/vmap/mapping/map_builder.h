@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "vmap/features/matcher.h"
-#include "vmap/mapping/map_builder_options.h"
 #include "vmap/map/visual_map.h"
+#include "vmap/mapping/map_builder_options.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap {

@@ -52,9 +52,10 @@ void MapBuilderOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.VisitNested("key_images", key_images, at_top_level);
   visitor.Visit(OptionField{"quality_mean", "--quality", "Mean used by the quality Q: "}.ListingNames(),
                 EnumField(quality_mean, kQualityMeanNames, ParseQualityMean));
-  visitor.Visit(OptionField{"extraction_threads", "--threads", "Feature-extraction threads, 0 to 256 (0 = one per core)"}
-                    .NotRecorded(),
-                extraction_threads);
+  visitor.Visit(
+      OptionField{"extraction_threads", "--threads", "Feature-extraction threads, 0 to 256 (0 = one per core)"}
+          .NotRecorded(),
+      extraction_threads);
   visitor.VisitNested("link_analysis", link_analysis, at_top_level);
   visitor.VisitNested("verifier", verifier);
   visitor.Visit({"exhaustive", "--exhaustive",

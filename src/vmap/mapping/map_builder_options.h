@@ -10,9 +10,9 @@
 #include "vmap/core/enum_names.h"
 #include "vmap/features/matcher.h"
 #include "vmap/geometry/fundamental.h"
+#include "vmap/map/visual_map.h"
 #include "vmap/mapping/key_image_selector.h"
 #include "vmap/mapping/link_analysis.h"
-#include "vmap/map/visual_map.h"
 
 namespace vmap {
 
@@ -36,9 +36,9 @@ struct MapBuilderOptions {
   VerifierOptions verifier;
   QualityMean quality_mean = QualityMean::kArithmetic;
   LinkAnalysisOptions link_analysis;  // each link's pose, parallax and homography test, after selection
-  bool show_progress = true;   // a progress line on a terminal
-  int prefetch_frames = 6;     // frames read and extracted ahead of matching
-  int extraction_threads = 0;  // threads extracting features; 0 = one per core, at most kMaxExtractionThreads
+  bool show_progress = true;          // a progress line on a terminal
+  int prefetch_frames = 6;            // frames read and extracted ahead of matching
+  int extraction_threads = 0;         // threads extracting features; 0 = one per core, at most kMaxExtractionThreads
   // The paper's exact behaviour: every comparison verified by OpenCV's USAC_MAGSAC to its confidence criterion.
   // Off (the default), with the magsac verifier, a comparison stops as soon as S >= tau is settled for the taus
   // it is judged under (vmap's MAGSAC++, geometry/magsac.h) and each link is verified in full: the same maps
@@ -65,10 +65,10 @@ struct MapBuilderOptions {
 };
 
 // kAuto resolves to kSequential, for every matcher (Check() refuses kBisect with `exhaustive`). Bisect was measured as
-// the deep matchers' default and dropped (docs/measurements/deep-matchers.md, "Comparing fewer frames"): for XFeat it was no faster
-// (0.90-1.04x on three of four sequences, more comparisons where S does not fall with distance), and for ALIKED,
-// 1.5-10x faster, it changed the map on three of four sequences (its S stays high until its matches run out). It stays
-// available as --search bisect.
+// the deep matchers' default and dropped (docs/measurements/deep-matchers.md, "Comparing fewer frames"): for XFeat it
+// was no faster (0.90-1.04x on three of four sequences, more comparisons where S does not fall with distance), and for
+// ALIKED, 1.5-10x faster, it changed the map on three of four sequences (its S stays high until its matches run out).
+// It stays available as --search bisect.
 KeySearch ResolveKeySearch(const MapBuilderOptions& options);
 
 // The verifier of the decisions: vmap's MAGSAC++, stopping once S >= tau is settled, unless the paper's

@@ -3,16 +3,15 @@
 #include <chrono>
 #include <thread>
 
+#include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include <gtest/gtest.h>
-
 #include "vmap/core/error.h"
-#include "vmap/mapping/batch_build.h"
-#include "vmap/mapping/sweep_thresholds.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/map/map_io.h"
 #include "vmap/map/map_writer.h"
+#include "vmap/mapping/batch_build.h"
+#include "vmap/mapping/sweep_thresholds.h"
 #include "vmap/testing/option_error.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"

@@ -29,11 +29,10 @@ PairMatch MatchPair(const Matcher& matcher, const PairImage& image0, const PairI
   pair.verify_seconds = SecondsSince(start);
   // The mode of all tentative matches unless F keeps many: across seasons F rarely holds (geometry/heading.h).
   start = std::chrono::steady_clock::now();
-  pair.heading = EstimateHeading(pair.matches.points0, pair.matches.points1, pair.fundamental.inlier_mask, heading,
-                                 camera);
+  pair.heading =
+      EstimateHeading(pair.matches.points0, pair.matches.points1, pair.fundamental.inlier_mask, heading, camera);
   pair.heading_seconds = SecondsSince(start);
-  pair.similarity =
-      pair.matches.size() == 0 ? 0.0 : double(pair.fundamental.num_inliers) / double(pair.matches.size());
+  pair.similarity = pair.matches.size() == 0 ? 0.0 : double(pair.fundamental.num_inliers) / double(pair.matches.size());
   return pair;
 }
 

@@ -1,8 +1,7 @@
 #include "vmap/mapping/pair_match.h"
 
-#include <opencv2/imgproc.hpp>
-
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "vmap/features/orb_matcher.h"
 #include "vmap/testing/synthetic_scene.h"
@@ -26,8 +25,8 @@ TEST(MatchPair, VerifiesTheMatchesInTheMatchersOrder) {
   const PairMatch pair = MatchPair(*matcher, Gray(sequence.frames[0]), Gray(sequence.frames[3]), verifier);
 
   // The same matches as the matcher's own, in its order, one inlier flag each.
-  const TentativeMatches direct = matcher->Match(*matcher->Extract(Gray(sequence.frames[0])),
-                                                 *matcher->Extract(Gray(sequence.frames[3])));
+  const TentativeMatches direct =
+      matcher->Match(*matcher->Extract(Gray(sequence.frames[0])), *matcher->Extract(Gray(sequence.frames[3])));
   ASSERT_EQ(pair.matches.size(), direct.size());
   for (size_t i = 0; i < direct.size(); ++i) EXPECT_EQ(pair.matches.points0[i], direct.points0[i]);
   ASSERT_TRUE(pair.fundamental.success);
@@ -38,8 +37,8 @@ TEST(MatchPair, VerifiesTheMatchesInTheMatchersOrder) {
   const cv::Matx33d F_true = testing::TrueFundamental(sequence.K, sequence.poses[0], sequence.poses[3]);
   int near = 0;
   for (size_t i = 0; i < pair.matches.size(); ++i) {
-    if (pair.fundamental.inlier_mask[i]) near += SampsonDistance(F_true, pair.matches.points0[i],
-                                                                 pair.matches.points1[i]) < 2.0;
+    if (pair.fundamental.inlier_mask[i])
+      near += SampsonDistance(F_true, pair.matches.points0[i], pair.matches.points1[i]) < 2.0;
   }
   EXPECT_GT(near, 0.9 * pair.fundamental.num_inliers);
   EXPECT_GE(pair.extract_seconds, 0.0);

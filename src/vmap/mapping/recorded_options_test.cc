@@ -1,5 +1,7 @@
 // map.json's "options" written from the options structs and read back into them.
 
+#include "vmap/mapping/recorded_options.h"
+
 #include <set>
 #include <string>
 
@@ -7,7 +9,6 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/error.h"
-#include "vmap/mapping/recorded_options.h"
 #include "vmap/map/map_io.h"
 #include "vmap/testing/option_error.h"
 #include "vmap/testing/report_test_util.h"

@@ -24,8 +24,8 @@ std::vector<double> ParseThresholds(const std::string& text) {
     // allocated, so that a tiny step is refused rather than filling the memory.
     const double count = std::floor((stop - start) / step + 1e-9) + 1;
     if (count > kMaxThresholds) {
-      throw OptionError("thresholds", fmt::format("'{}' gives {:.0f} thresholds, more than {}; use a larger step",
-                                                  text, count, kMaxThresholds));
+      throw OptionError("thresholds", fmt::format("'{}' gives {:.0f} thresholds, more than {}; use a larger step", text,
+                                                  count, kMaxThresholds));
     }
     for (int i = 0; i < static_cast<int>(count); ++i) taus.push_back(std::round((start + i * step) * 1e9) / 1e9);
   } else {

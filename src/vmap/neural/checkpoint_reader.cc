@@ -37,11 +37,11 @@ Ref Make(Object::Kind kind) {
 
 torch::ScalarType StorageDtype(const std::string& global) {
   static const std::unordered_map<std::string, torch::ScalarType> types{
-      {"torch.FloatStorage", torch::kFloat32}, {"torch.HalfStorage", torch::kFloat16},
+      {"torch.FloatStorage", torch::kFloat32},  {"torch.HalfStorage", torch::kFloat16},
       {"torch.DoubleStorage", torch::kFloat64}, {"torch.BFloat16Storage", torch::kBFloat16},
-      {"torch.LongStorage", torch::kInt64},    {"torch.IntStorage", torch::kInt32},
-      {"torch.ShortStorage", torch::kInt16},   {"torch.CharStorage", torch::kInt8},
-      {"torch.ByteStorage", torch::kUInt8},    {"torch.BoolStorage", torch::kBool}};
+      {"torch.LongStorage", torch::kInt64},     {"torch.IntStorage", torch::kInt32},
+      {"torch.ShortStorage", torch::kInt16},    {"torch.CharStorage", torch::kInt8},
+      {"torch.ByteStorage", torch::kUInt8},     {"torch.BoolStorage", torch::kBool}};
   auto it = types.find(global);
   if (it == types.end()) throw std::runtime_error("unsupported storage type " + global);
   return it->second;
@@ -56,15 +56,35 @@ class PickleMachine {
     while (true) {
       const uint8_t op = Byte();
       switch (op) {
-        case 0x80: Byte(); break;                      // PROTO
-        case 0x95: Skip(8); break;                     // FRAME
-        case '.': return Pop();                        // STOP
-        case '(': stack_.push_back(Make(Object::Kind::kMark)); break;
-        case '}': stack_.push_back(Make(Object::Kind::kDict)); break;
-        case ']': stack_.push_back(Make(Object::Kind::kList)); break;
-        case ')': stack_.push_back(Make(Object::Kind::kTuple)); break;
-        case 't': { auto t = Make(Object::Kind::kTuple); t->items = PopToMark(); stack_.push_back(t); break; }
-        case 0x85: case 0x86: case 0x87: {             // TUPLE1..3
+        case 0x80:
+          Byte();
+          break;  // PROTO
+        case 0x95:
+          Skip(8);
+          break;  // FRAME
+        case '.':
+          return Pop();  // STOP
+        case '(':
+          stack_.push_back(Make(Object::Kind::kMark));
+          break;
+        case '}':
+          stack_.push_back(Make(Object::Kind::kDict));
+          break;
+        case ']':
+          stack_.push_back(Make(Object::Kind::kList));
+          break;
+        case ')':
+          stack_.push_back(Make(Object::Kind::kTuple));
+          break;
+        case 't': {
+          auto t = Make(Object::Kind::kTuple);
+          t->items = PopToMark();
+          stack_.push_back(t);
+          break;
+        }
+        case 0x85:
+        case 0x86:
+        case 0x87: {  // TUPLE1..3
           auto t = Make(Object::Kind::kTuple);
           const size_t n = op - 0x84;
           if (stack_.size() < n) throw std::runtime_error("stack underflow");
@@ -73,12 +93,26 @@ class PickleMachine {
           stack_.push_back(t);
           break;
         }
-        case 'N': stack_.push_back(Make(Object::Kind::kNone)); break;
-        case 0x88: case 0x89: { auto b = Make(Object::Kind::kBool); b->integer = op == 0x88; stack_.push_back(b); break; }
-        case 'J': PushInt(static_cast<int32_t>(Le(4))); break;
-        case 'K': PushInt(static_cast<int64_t>(Le(1))); break;
-        case 'M': PushInt(static_cast<int64_t>(Le(2))); break;
-        case 0x8a: {                                    // LONG1: little-endian two's complement
+        case 'N':
+          stack_.push_back(Make(Object::Kind::kNone));
+          break;
+        case 0x88:
+        case 0x89: {
+          auto b = Make(Object::Kind::kBool);
+          b->integer = op == 0x88;
+          stack_.push_back(b);
+          break;
+        }
+        case 'J':
+          PushInt(static_cast<int32_t>(Le(4)));
+          break;
+        case 'K':
+          PushInt(static_cast<int64_t>(Le(1)));
+          break;
+        case 'M':
+          PushInt(static_cast<int64_t>(Le(2)));
+          break;
+        case 0x8a: {  // LONG1: little-endian two's complement
           const size_t n = Byte();
           uint64_t v = 0;
           for (size_t i = 0; i < n; ++i) v |= uint64_t(Byte()) << (8 * i);
@@ -86,7 +120,7 @@ class PickleMachine {
           PushInt(static_cast<int64_t>(v));
           break;
         }
-        case 'G': {                                     // BINFLOAT, big-endian
+        case 'G': {  // BINFLOAT, big-endian
           uint64_t bits = 0;
           for (int i = 0; i < 8; ++i) bits = (bits << 8) | Byte();
           auto f = Make(Object::Kind::kFloat);
@@ -94,46 +128,100 @@ class PickleMachine {
           stack_.push_back(f);
           break;
         }
-        case 'X': PushString(Le(4)); break;             // BINUNICODE
-        case 0x8c: PushString(Byte()); break;           // SHORT_BINUNICODE
-        case 'T': PushString(Le(4)); break;             // BINSTRING
-        case 'U': PushString(Byte()); break;            // SHORT_BINSTRING
-        case 'B': PushString(Le(4)); break;             // BINBYTES
-        case 'C': PushString(Byte()); break;            // SHORT_BINBYTES
-        case 'q': memo_[Byte()] = Top(); break;         // BINPUT
-        case 'r': memo_[Le(4)] = Top(); break;          // LONG_BINPUT
-        case 0x94: memo_[memo_.size()] = Top(); break;  // MEMOIZE
-        case 'h': stack_.push_back(Memo(Byte())); break;
-        case 'j': stack_.push_back(Memo(Le(4))); break;
-        case 'c': {                                     // GLOBAL module\nname\n
+        case 'X':
+          PushString(Le(4));
+          break;  // BINUNICODE
+        case 0x8c:
+          PushString(Byte());
+          break;  // SHORT_BINUNICODE
+        case 'T':
+          PushString(Le(4));
+          break;  // BINSTRING
+        case 'U':
+          PushString(Byte());
+          break;  // SHORT_BINSTRING
+        case 'B':
+          PushString(Le(4));
+          break;  // BINBYTES
+        case 'C':
+          PushString(Byte());
+          break;  // SHORT_BINBYTES
+        case 'q':
+          memo_[Byte()] = Top();
+          break;  // BINPUT
+        case 'r':
+          memo_[Le(4)] = Top();
+          break;  // LONG_BINPUT
+        case 0x94:
+          memo_[memo_.size()] = Top();
+          break;  // MEMOIZE
+        case 'h':
+          stack_.push_back(Memo(Byte()));
+          break;
+        case 'j':
+          stack_.push_back(Memo(Le(4)));
+          break;
+        case 'c': {  // GLOBAL module\nname\n
           const std::string module = Line(), name = Line();
           auto g = Make(Object::Kind::kGlobal);
           g->text = module + "." + name;
           stack_.push_back(g);
           break;
         }
-        case 0x93: {                                    // STACK_GLOBAL
+        case 0x93: {  // STACK_GLOBAL
           auto name = Pop(), module = Pop();
           auto g = Make(Object::Kind::kGlobal);
           g->text = module->text + "." + name->text;
           stack_.push_back(g);
           break;
         }
-        case 'R': { auto args = Pop(); auto callable = Pop(); stack_.push_back(Call(callable, args)); break; }
-        case 0x81: { Pop(); Pop(); stack_.push_back(Make(Object::Kind::kOpaque)); break; }  // NEWOBJ
-        case 'b': Pop(); break;  // BUILD: object state (attributes) is not needed
-        case 'Q': stack_.push_back(Persistent(Pop())); break;
-        case 's': { auto v = Pop(); auto k = Pop(); SetItem(Top(), k, v); break; }
+        case 'R': {
+          auto args = Pop();
+          auto callable = Pop();
+          stack_.push_back(Call(callable, args));
+          break;
+        }
+        case 0x81: {
+          Pop();
+          Pop();
+          stack_.push_back(Make(Object::Kind::kOpaque));
+          break;
+        }  // NEWOBJ
+        case 'b':
+          Pop();
+          break;  // BUILD: object state (attributes) is not needed
+        case 'Q':
+          stack_.push_back(Persistent(Pop()));
+          break;
+        case 's': {
+          auto v = Pop();
+          auto k = Pop();
+          SetItem(Top(), k, v);
+          break;
+        }
         case 'u': {
           auto items = PopToMark();
           for (size_t i = 0; i + 1 < items.size(); i += 2) SetItem(Top(), items[i], items[i + 1]);
           break;
         }
-        case 'a': { auto v = Pop(); Append(Top(), v); break; }
-        case 'e': { for (auto& v : PopToMark()) Append(Top(), v); break; }
-        case '0': Pop(); break;
-        case '1': PopToMark(); break;
-        case '2': stack_.push_back(Top()); break;
+        case 'a': {
+          auto v = Pop();
+          Append(Top(), v);
+          break;
+        }
+        case 'e': {
+          for (auto& v : PopToMark()) Append(Top(), v);
+          break;
+        }
+        case '0':
+          Pop();
+          break;
+        case '1':
+          PopToMark();
+          break;
+        case '2':
+          stack_.push_back(Top());
+          break;
         default: {
           char hex[8];
           std::snprintf(hex, sizeof(hex), "0x%02x", op);
@@ -148,7 +236,9 @@ class PickleMachine {
     if (pos_ >= code_.size()) throw std::runtime_error("pickle program ends early");
     return code_[pos_++];
   }
-  void Skip(size_t n) { for (size_t i = 0; i < n; ++i) Byte(); }
+  void Skip(size_t n) {
+    for (size_t i = 0; i < n; ++i) Byte();
+  }
   uint64_t Le(int n) {
     uint64_t v = 0;
     for (int i = 0; i < n; ++i) v |= uint64_t(Byte()) << (8 * i);
@@ -159,7 +249,11 @@ class PickleMachine {
     for (char c; (c = static_cast<char>(Byte())) != '\n';) s += c;
     return s;
   }
-  void PushInt(int64_t v) { auto i = Make(Object::Kind::kInt); i->integer = v; stack_.push_back(i); }
+  void PushInt(int64_t v) {
+    auto i = Make(Object::Kind::kInt);
+    i->integer = v;
+    stack_.push_back(i);
+  }
   void PushString(uint64_t n) {
     if (n > code_.size() - pos_) throw std::runtime_error("string past the end of the pickle");
     auto s = Make(Object::Kind::kString);
@@ -233,8 +327,9 @@ class PickleMachine {
         throw std::runtime_error("malformed tensor record");
       }
       auto t = Make(Object::Kind::kTensor);
-      t->tensor = args->items[0]->tensor.as_strided(Ints(args->items[2]), Ints(args->items[3]),
-                                                    args->items[1]->integer).clone();
+      t->tensor = args->items[0]
+                      ->tensor.as_strided(Ints(args->items[2]), Ints(args->items[3]), args->items[1]->integer)
+                      .clone();
       return t;
     }
     if (name == "torch._utils._rebuild_parameter" && !args->items.empty()) return args->items[0];

@@ -21,8 +21,8 @@ std::string LibraryDefining(const void* address) {
 TEST(LibstdcxxFirst, FilesystemCallsReachLibstdcxx) {
   using RemoveAll = std::uintmax_t (*)(const std::filesystem::path&);
   using Status = std::filesystem::file_status (*)(const std::filesystem::path&);
-  const std::string remove_all = LibraryDefining(reinterpret_cast<const void*>(
-      static_cast<RemoveAll>(&std::filesystem::remove_all)));
+  const std::string remove_all =
+      LibraryDefining(reinterpret_cast<const void*>(static_cast<RemoveAll>(&std::filesystem::remove_all)));
   const std::string status =
       LibraryDefining(reinterpret_cast<const void*>(static_cast<Status>(&std::filesystem::status)));
   EXPECT_NE(remove_all.find("libstdc++"), std::string::npos) << "remove_all comes from " << remove_all;

@@ -16,11 +16,16 @@ namespace {
 
 std::string DtypeName(const torch::Tensor& t) {
   switch (t.scalar_type()) {
-    case torch::kFloat32: return "float32";
-    case torch::kFloat16: return "float16";
-    case torch::kFloat64: return "float64";
-    case torch::kInt64: return "int64";
-    default: return std::string(c10::toString(t.scalar_type()));
+    case torch::kFloat32:
+      return "float32";
+    case torch::kFloat16:
+      return "float16";
+    case torch::kFloat64:
+      return "float64";
+    case torch::kInt64:
+      return "int64";
+    default:
+      return std::string(c10::toString(t.scalar_type()));
   }
 }
 

@@ -1,12 +1,13 @@
 // Reading weights files in every layout torch.save gives them, and comparing a state dict with a network's.
 
+#include "vmap/neural/state_dict.h"
+
 #include <filesystem>
 
 #include <gtest/gtest.h>
 #include <torch/serialize.h>
 
 #include "vmap/testing/golden_util.h"
-#include "vmap/neural/state_dict.h"
 
 namespace vmap::neural {
 namespace {

@@ -9,8 +9,9 @@ namespace vmap::neural {
 torch::Device ParseTorchDevice(const std::string& name) {
   if (name == "cuda") {
     if (!torch::cuda::is_available()) {
-      throw OptionError("device", "cuda: this vmap's LibTorch has no CUDA support or sees no GPU; use cpu (or build "
-                                  "vmap against a CUDA LibTorch)");
+      throw OptionError("device",
+                        "cuda: this vmap's LibTorch has no CUDA support or sees no GPU; use cpu (or build "
+                        "vmap against a CUDA LibTorch)");
     }
     return torch::Device(torch::kCUDA, 0);
   }

@@ -1,11 +1,11 @@
 #include "vmap/neural/weights_store.h"
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cstdlib>
 #include <filesystem>
 #include <system_error>
-
-#include <unistd.h>
-#include <sys/wait.h>
 
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
@@ -95,7 +95,8 @@ const KnownWeights& KnownWeightsFor(const std::string& preset) {
   for (const auto& known : KnownWeightFiles()) {
     if (known.preset == preset) return known;
   }
-  throw InputError("unknown model '" + preset + "'; use outdoor, indoor, coarse (LoFTR), xfeat, aliked-t16 or aliked-n16");
+  throw InputError("unknown model '" + preset +
+                   "'; use outdoor, indoor, coarse (LoFTR), xfeat, aliked-t16 or aliked-n16");
 }
 
 std::string WeightsCacheDir() {
@@ -175,8 +176,10 @@ std::string DownloadWeights(const std::string& preset, const std::string& cache_
   } else if (ProgramInstalled("wget")) {
     status = RunProgram({"wget", "--quiet", "--output-document", download, known.url});
   } else {
-    throw InputError("neither curl nor wget is installed; download " + known.url + " yourself and run `vmap weights "
-                     "--import FILE --model " + preset + "`");
+    throw InputError("neither curl nor wget is installed; download " + known.url +
+                     " yourself and run `vmap weights "
+                     "--import FILE --model " +
+                     preset + "`");
   }
   if (status != 0) {
     fs::remove(download, error);

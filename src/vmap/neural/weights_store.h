@@ -19,7 +19,7 @@ struct KnownWeights {
   std::string url;          // empty when `vmap weights --download` cannot fetch it
   std::string git_blob_id;  // of a published copy; empty when unknown
   std::string description;
-  std::string shared_file;  // path under the shared data folder; empty when it is not shipped there
+  std::string shared_file;               // path under the shared data folder; empty when it is not shipped there
   std::string option = "--loftr-model";  // the command-line option that selects this preset
 };
 

@@ -1,5 +1,7 @@
 // `vmap weights` without a network: SHA-1 / git blob ids, the cache, and the search order.
 
+#include "vmap/neural/weights_store.h"
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -8,7 +10,6 @@
 
 #include "vmap/core/error.h"
 #include "vmap/neural/sha1.h"
-#include "vmap/neural/weights_store.h"
 #include "vmap/testing/shared_data.h"
 
 namespace vmap::neural {
@@ -27,7 +28,10 @@ class WeightsStoreTest : public ::testing::Test {
     setenv(kWeightsDirEnv, cache_.c_str(), 1);
   }
   void TearDown() override {
-    if (had_value_) setenv(kWeightsDirEnv, saved_.c_str(), 1); else unsetenv(kWeightsDirEnv);
+    if (had_value_)
+      setenv(kWeightsDirEnv, saved_.c_str(), 1);
+    else
+      unsetenv(kWeightsDirEnv);
     fs::remove_all(cache_);
   }
   std::string WriteFile(const std::string& name, const std::string& contents) {

@@ -38,7 +38,8 @@ std::string FormatEvaluationTable(const MapEvaluation& evaluation) {
         e.link, e.from_frame, e.to_frame, e.similarity, e.num_verified, Fixed(e.verified_sampson_median, 2, 9),
         Percent(e.verified_within, 10), Fixed(e.rejected_sampson_median, 2, 9), Percent(e.rejected_within, 10),
         Fixed(e.rotation_error_deg, 2, 4), Fixed(e.translation_error_deg, 1, 7), Fixed(e.true_parallax_px, 1, 10),
-        Fixed(e.translation_sigma_deg, 1, 4), e.translation_known ? "yes" : "no", e.pose_source, !e.has_ground_truth ? "no GT" : (e.usable ? "yes" : "NO"), notes);
+        Fixed(e.translation_sigma_deg, 1, 4), e.translation_known ? "yes" : "no", e.pose_source,
+        !e.has_ground_truth ? "no GT" : (e.usable ? "yes" : "NO"), notes);
   }
   return text;
 }
@@ -55,11 +56,12 @@ std::string FormatEvaluationSummary(const MapEvaluation& evaluation) {
                       evaluation.camera.cy, evaluation.camera.has_distortion() ? " (with distortion)" : "");
   text += fmt::format("links           {} ({} with ground truth for both key images, {} with a pose)\n", s.links,
                       s.evaluated_links, s.links_with_pose);
-  text += fmt::format("usable links    {} of {}{}  (rotation error < {:g} deg; translation error < {:g} deg where "
-                      "the true parallax >= {:g} px)\n",
-                      s.usable_links, s.evaluated_links,
-                      std::isfinite(s.usable_share) ? fmt::format(" = {:.1f}%", 100.0 * s.usable_share) : "",
-                      o.max_rotation_error_deg, o.max_translation_error_deg, o.min_parallax_px);
+  text += fmt::format(
+      "usable links    {} of {}{}  (rotation error < {:g} deg; translation error < {:g} deg where "
+      "the true parallax >= {:g} px)\n",
+      s.usable_links, s.evaluated_links,
+      std::isfinite(s.usable_share) ? fmt::format(" = {:.1f}%", 100.0 * s.usable_share) : "", o.max_rotation_error_deg,
+      o.max_translation_error_deg, o.min_parallax_px);
   const auto of = [](int part, int whole, double share) {
     return fmt::format("{} of {}{}", part, whole, std::isfinite(share) ? fmt::format(" = {:.1f}%", 100.0 * share) : "");
   };
@@ -67,8 +69,8 @@ std::string FormatEvaluationSummary(const MapEvaluation& evaluation) {
                       of(s.strict_usable_links, s.evaluated_links, s.strict_usable_share));
   text += fmt::format("translation unknown (the map's flag)  {} links, wrong {}\n", s.flagged_links,
                       of(s.flagged_wrong_links, s.flagged_links, s.flagged_wrong_share));
-  text += fmt::format("translation known  {} links, right {}, usable {}, more than 90 deg off {}\n",
-                      s.unflagged_links, of(s.unflagged_right_links, s.unflagged_links, s.unflagged_right_share),
+  text += fmt::format("translation known  {} links, right {}, usable {}, more than 90 deg off {}\n", s.unflagged_links,
+                      of(s.unflagged_right_links, s.unflagged_links, s.unflagged_right_share),
                       of(s.unflagged_usable_links, s.unflagged_links, s.unflagged_usable_share),
                       s.unflagged_reversed_links);
   text += fmt::format("rotation error  median {} deg\n", Fixed(s.rotation_error_deg_median, 3, 0));

@@ -33,7 +33,8 @@ std::string PageStart(const std::string& title, const std::string& heading, cons
        << "<meta http-equiv=\"Content-Security-Policy\" content=\"" << kContentSecurityPolicy << "\">\n"
        << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
        << "<meta name=\"generator\" content=\"vmap " << VMAP_VERSION << "\">\n"
-       << "<title>" << HtmlEscape(title) << "</title>\n<style>\n" << ReportCss() << "</style>\n</head>\n<body>\n"
+       << "<title>" << HtmlEscape(title) << "</title>\n<style>\n"
+       << ReportCss() << "</style>\n</head>\n<body>\n"
        << "<header><h1>" << HtmlEscape(heading) << "</h1><p>" << HtmlEscape(subtitle) << "</p></header>\n<nav>";
   for (const auto& [anchor, text] : nav) html << "<a href=\"#" << anchor << "\">" << HtmlEscape(text) << "</a>";
   html << "</nav>\n<main>\n";
@@ -43,7 +44,8 @@ std::string PageStart(const std::string& title, const std::string& heading, cons
 std::string PageEnd() {
   return std::string("</main>\n<footer>Written by vmap ") + VMAP_VERSION +
          ". This page works offline: everything it shows is in this file and the folder next to it.</footer>\n"
-         "<script>\n" + std::string(ReportJs()) + "</script>\n</body>\n</html>\n";
+         "<script>\n" +
+         std::string(ReportJs()) + "</script>\n</body>\n</html>\n";
 }
 
 namespace {

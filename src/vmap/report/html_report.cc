@@ -47,8 +47,8 @@ using report::Card;
 using report::Displayable;
 using report::DurationText;
 using report::Numbered;
-using report::OptionText;
 using report::OptionsSection;
+using report::OptionText;
 using report::PageEnd;
 using report::PageStart;
 using report::ParseOptions;
@@ -205,8 +205,8 @@ class RouteVideo {
     const double scale = std::clamp(size_.width / 700.0, 0.35, 1.0);
     cv::putText(frame, label, cv::Point(7, size_.height - 9), cv::FONT_HERSHEY_SIMPLEX, scale, cv::Scalar::all(0), 3,
                 cv::LINE_AA);
-    cv::putText(frame, label, cv::Point(7, size_.height - 9), cv::FONT_HERSHEY_SIMPLEX, scale,
-                cv::Scalar::all(255), 1, cv::LINE_AA);
+    cv::putText(frame, label, cv::Point(7, size_.height - 9), cv::FONT_HERSHEY_SIMPLEX, scale, cv::Scalar::all(255), 1,
+                cv::LINE_AA);
     writer_.write(frame);
     ++frames_;
   }
@@ -234,7 +234,6 @@ class RouteVideo {
 
 }  // namespace
 
-
 std::string LinkTitle(const VisualMap& map, int link_index) {
   const Link& l = map.links.at(link_index);
   return "key " + std::to_string(l.from_key) + " (frame " + std::to_string(map.key_images.at(l.from_key).frame_index) +
@@ -251,14 +250,16 @@ cv::Mat DrawMapLink(const fs::path& map_directory, const VisualMap& map, int lin
   }
   const Link& link = map.links[link_index];
   MatchFigureOptions with_title = options;
-  if (with_title.title.empty()) with_title.title = "link " + std::to_string(link_index) + ": " + LinkTitle(map, link_index);
+  if (with_title.title.empty())
+    with_title.title = "link " + std::to_string(link_index) + ": " + LinkTitle(map, link_index);
   return DrawMatchFigure(ReadKeyImage(map_directory, map.key_images[link.from_key]),
                          ReadKeyImage(map_directory, map.key_images[link.to_key]), link, with_title);
 }
 
 void MapReportOptions::Check() const {
   if (thumbnail_width < 32 || thumbnail_width > 4096) {
-    throw OptionError("thumbnail_width", "is " + std::to_string(thumbnail_width) + "; use 32 to 4096 pixels (default 320)");
+    throw OptionError("thumbnail_width",
+                      "is " + std::to_string(thumbnail_width) + "; use 32 to 4096 pixels (default 320)");
   }
   if (figure_width < 64 || figure_width > 8192) {
     throw OptionError("figure_width", "is " + std::to_string(figure_width) + "; use 64 to 8192 pixels (default 960)");
@@ -283,7 +284,9 @@ struct ReportAssets {
 };
 
 // A file in report/ as the page links it.
-std::string AssetUrl(const std::string& relative) { return UrlPath(std::string(kReportAssetsDirectory) + "/" + relative); }
+std::string AssetUrl(const std::string& relative) {
+  return UrlPath(std::string(kReportAssetsDirectory) + "/" + relative);
+}
 
 // Writes the key-image thumbnails, the route video and the match figures into `directory` (report/ while
 // it is being written).
@@ -334,8 +337,8 @@ ReportAssets WriteReportAssets(const fs::path& map_directory, const VisualMap& m
 std::string SummarySection(const VisualMap& map, const MapStatistics& stats, const json& options, double tau) {
   const int n = map.num_frames, m = static_cast<int>(map.key_images.size());
   std::ostringstream html;
-  html << "<section id=\"summary\"><h2>Summary</h2>\n<div class=\"cards\">"
-       << Card(std::to_string(n), "frames (n)") << Card(std::to_string(m), "key images (m)")
+  html << "<section id=\"summary\"><h2>Summary</h2>\n<div class=\"cards\">" << Card(std::to_string(n), "frames (n)")
+       << Card(std::to_string(m), "key images (m)")
        << Card(n > 0 ? FormatFixed(100.0 * m / n, 1) + " %" : "n/a", "of the frames")
        << Card(FormatFixed(map.quality, 3), "quality Q") << Card(FormatFixed(stats.mean_similarity, 3), "mean S")
        << Card(std::to_string(stats.below_tau_links), "links below \u03c4") << "</div>\n<table class=\"summary\">\n";
@@ -349,17 +352,17 @@ std::string SummarySection(const VisualMap& map, const MapStatistics& stats, con
        << Row("Matcher", HtmlEscape(OptionText(options, "matcher")))
        << Row("Verifier", HtmlEscape(OptionText(options, "verifier")))
        << Row("Threshold \u03c4", json(tau).dump())  // as map.json writes it
-       << Row("Frames n", std::to_string(n) +
-                              (map.skipped_frames > 0 ? " (" + std::to_string(map.skipped_frames) +
-                                                            " unreadable frames skipped)"
-                                                      : ""))
-       << Row("Key images m", std::to_string(m) + (n > 0 ? " (" + FormatFixed(100.0 * m / n, 1) + " % of the frames)" : ""))
-       << Row("Links", std::to_string(map.links.size()) + ", " + std::to_string(stats.below_tau_links) + " below \u03c4")
-       << Row("Verified matches per link",
-              map.links.empty() ? std::string("no links")
-                                : "min " + std::to_string(stats.min_verified) + ", max " +
-                                      std::to_string(stats.max_verified) + ", mean " +
-                                      FormatFixed(stats.mean_verified, 1))
+       << Row("Frames n", std::to_string(n) + (map.skipped_frames > 0 ? " (" + std::to_string(map.skipped_frames) +
+                                                                            " unreadable frames skipped)"
+                                                                      : ""))
+       << Row("Key images m",
+              std::to_string(m) + (n > 0 ? " (" + FormatFixed(100.0 * m / n, 1) + " % of the frames)" : ""))
+       << Row("Links",
+              std::to_string(map.links.size()) + ", " + std::to_string(stats.below_tau_links) + " below \u03c4")
+       << Row("Verified matches per link", map.links.empty() ? std::string("no links")
+                                                             : "min " + std::to_string(stats.min_verified) + ", max " +
+                                                                   std::to_string(stats.max_verified) + ", mean " +
+                                                                   FormatFixed(stats.mean_verified, 1))
        << Row("Mean similarity of links", FormatFixed(stats.mean_similarity, 3))
        << Row("Quality Q", FormatFixed(map.quality, 4))
        << Row("Build time", DurationText(map.seconds) +
@@ -371,12 +374,14 @@ std::string SummarySection(const VisualMap& map, const MapStatistics& stats, con
 std::string SimilaritySection(const VisualMap& map, double tau) {
   std::string html = "<section id=\"similarity\"><h2>Similarity along the sequence</h2>\n";
   if (map.evaluations.empty()) {
-    html += "<p class=\"note\">This map records no per-frame similarities; only its links are shown. Rebuild it "
-            "with a current vmap to see S for every frame.</p>\n";
+    html +=
+        "<p class=\"note\">This map records no per-frame similarities; only its links are shown. Rebuild it "
+        "with a current vmap to see S for every frame.</p>\n";
   } else {
-    html += "<p class=\"note\">Each blue line follows S(key, frame) from one key image over the frames compared "
-            "with it; a new key image is chosen where S drops below &tau;. A lower &tau; gives fewer key images "
-            "with fewer shared matches.</p>\n";
+    html +=
+        "<p class=\"note\">Each blue line follows S(key, frame) from one key image over the frames compared "
+        "with it; a new key image is chosen where S drops below &tau;. A lower &tau; gives fewer key images "
+        "with fewer shared matches.</p>\n";
   }
   html += SimilarityPlot(map, tau);
   if (!map.links.empty()) html += VerifiedPlot(map);
@@ -392,9 +397,10 @@ std::string KeyImagesSection(const VisualMap& map, const ReportAssets& assets) {
     const std::string timestamp = TimestampText(k.timestamp);
     const std::string label = "key " + std::to_string(i) + " | frame " + std::to_string(k.frame_index) +
                               (timestamp.empty() ? "" : " | t = " + timestamp);
-    html << "<figure id=\"key-" << i << "\" title=\"" << HtmlEscape(Displayable(k.source_name) + (k.reason.empty() ? "" : ": " + k.reason))
-         << "\"><img loading=\"lazy\" decoding=\"async\" src=\"" << AssetUrl("keys/" + Numbered(i))
-         << "\" width=\"" << assets.thumbnail_sizes[i].width << "\" height=\"" << assets.thumbnail_sizes[i].height
+    html << "<figure id=\"key-" << i << "\" title=\""
+         << HtmlEscape(Displayable(k.source_name) + (k.reason.empty() ? "" : ": " + k.reason))
+         << "\"><img loading=\"lazy\" decoding=\"async\" src=\"" << AssetUrl("keys/" + Numbered(i)) << "\" width=\""
+         << assets.thumbnail_sizes[i].width << "\" height=\"" << assets.thumbnail_sizes[i].height
          << "\" alt=\"key image " << i << "\" data-label=\"" << HtmlEscape(label) << "\"><figcaption><b>#" << i
          << "</b> frame " << k.frame_index << (timestamp.empty() ? "" : " &middot; " + HtmlEscape(timestamp))
          << "</figcaption></figure>\n";
@@ -410,10 +416,11 @@ std::string RoutePreviewSection(const VisualMap& map, const ReportAssets& assets
   html << "<section id=\"route-preview\"><h2>Route preview</h2>\n<div class=\"route\">\n";
   if (!assets.video_file.empty()) {
     html << "<figure><video id=\"route-video\" src=\"" << AssetUrl(assets.video_file) << "\" width=\""
-         << assets.video_size.width << "\" height=\"" << assets.video_size.height
-         << "\" poster=\"" << AssetUrl("keys/" + Numbered(0))
+         << assets.video_size.width << "\" height=\"" << assets.video_size.height << "\" poster=\""
+         << AssetUrl("keys/" + Numbered(0))
          << "\" controls muted loop playsinline preload=\"metadata\"></video><figcaption class=\"note\">The key images "
-            "in order, " << FormatExact(route_fps) << " per second (" << HtmlEscape(assets.video_file)
+            "in order, "
+         << FormatExact(route_fps) << " per second (" << HtmlEscape(assets.video_file)
          << "): what a robot following this map expects to see.</figcaption></figure>\n";
   }
   if (m > 0) {
@@ -439,10 +446,10 @@ std::string MatchFiguresSection(const VisualMap& map, const ReportAssets& assets
     const Link& l = map.links[i];
     html << "<figure class=\"match-figure" << (l.below_tau ? " below-tau" : "") << "\" id=\"link-" << i
          << "\" data-from=\"" << l.from_key << "\" data-to=\"" << l.to_key << "\"><img loading=\"lazy\" "
-         << "decoding=\"async\" src=\"" << AssetUrl("links/" + Numbered(static_cast<int>(i)))
-         << "\" width=\"" << assets.figure_sizes[i].width << "\" height=\"" << assets.figure_sizes[i].height
-         << "\" alt=\"link " << i << "\"><figcaption>" << (l.below_tau ? "BELOW &tau; &middot; " : "") << "Link " << i
-         << ": " << HtmlEscape(LinkTitle(map, static_cast<int>(i))) << " &middot; S = " << FormatFixed(l.similarity, 3)
+         << "decoding=\"async\" src=\"" << AssetUrl("links/" + Numbered(static_cast<int>(i))) << "\" width=\""
+         << assets.figure_sizes[i].width << "\" height=\"" << assets.figure_sizes[i].height << "\" alt=\"link " << i
+         << "\"><figcaption>" << (l.below_tau ? "BELOW &tau; &middot; " : "") << "Link " << i << ": "
+         << HtmlEscape(LinkTitle(map, static_cast<int>(i))) << " &middot; S = " << FormatFixed(l.similarity, 3)
          << " &middot; " << l.num_verified << " verified of " << l.num_tentative << " tentative"
          << (evaluation ? " &middot; " + HtmlEscape(EvaluationCaption(evaluation->links[i])) : "")
          << "</figcaption></figure>\n";
@@ -473,17 +480,16 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
 
   const std::string input_name =
       map.input.path.empty() ? map_directory.filename().string() : Displayable(map.input.path);
-  std::string html =
-      PageStart("vmap report: " + input_name, "Visual map of " + input_name,
-                std::to_string(map.key_images.size()) + " key images from " + std::to_string(map.num_frames) +
-                    " frames, Q = " + FormatFixed(map.quality, 3),
-                {{"summary", "Summary"},
-                 {"similarity", "Similarity"},
-                 {"key-images", "Key images"},
-                 {"route-preview", "Route preview"},
-                 {"link-table", "Links"},
-                 {"links", "Match figures"},
-                 {"options", "Options"}});
+  std::string html = PageStart("vmap report: " + input_name, "Visual map of " + input_name,
+                               std::to_string(map.key_images.size()) + " key images from " +
+                                   std::to_string(map.num_frames) + " frames, Q = " + FormatFixed(map.quality, 3),
+                               {{"summary", "Summary"},
+                                {"similarity", "Similarity"},
+                                {"key-images", "Key images"},
+                                {"route-preview", "Route preview"},
+                                {"link-table", "Links"},
+                                {"links", "Match figures"},
+                                {"options", "Options"}});
   html += SummarySection(map, stats, options, read.options.builder.key_images.tau);
   html += SimilaritySection(map, read.options.builder.key_images.tau);
   html += KeyImagesSection(map, assets);

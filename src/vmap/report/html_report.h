@@ -14,8 +14,8 @@
 
 #include <opencv2/core.hpp>
 
-#include "vmap/mapping/batch_build.h"
 #include "vmap/map/visual_map.h"
+#include "vmap/mapping/batch_build.h"
 #include "vmap/report/match_figure.h"
 
 namespace vmap {
@@ -27,8 +27,8 @@ struct MapReportOptions {
   int thumbnail_width = 320;  // key-image strip
   int figure_width = 960;     // match figures (two images of about 480 px)
   int jpeg_quality = 85;
-  bool route_video = true;    // report/route.mp4 (or .webm): the key images in order
-  double route_fps = 3.0;     // key images per second in the route video
+  bool route_video = true;  // report/route.mp4 (or .webm): the key images in order
+  double route_fps = 3.0;   // key images per second in the route video
 
   void Check() const;  // throws OptionError naming the bad field
 };

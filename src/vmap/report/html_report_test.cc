@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -14,8 +14,8 @@
 #include "vmap/core/error.h"
 #include "vmap/map/map_io.h"
 #include "vmap/report/report_assets.h"
-#include "vmap/testing/report_test_util.h"
 #include "vmap/testing/option_error.h"
+#include "vmap/testing/report_test_util.h"
 #include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
@@ -227,9 +227,11 @@ TEST(MapReportTest, KeyImagePathsCannotLeaveTheMapDirectory) {
   cv::imwrite(outside.string(), cv::Mat(8, 8, CV_8UC3, cv::Scalar::all(9)));
 
   SetKeyImagePath(dir, 1, "../secret.png");
-  EXPECT_NE(testing::InputErrorMessage([&] { WriteMapReport(dir); }).find("outside the map directory"), std::string::npos);
+  EXPECT_NE(testing::InputErrorMessage([&] { WriteMapReport(dir); }).find("outside the map directory"),
+            std::string::npos);
   SetKeyImagePath(dir, 1, outside.string());
-  EXPECT_NE(testing::InputErrorMessage([&] { WriteMapReport(dir); }).find("outside the map directory"), std::string::npos);
+  EXPECT_NE(testing::InputErrorMessage([&] { WriteMapReport(dir); }).find("outside the map directory"),
+            std::string::npos);
   EXPECT_FALSE(fs::exists(dir / kReportFileName));
   EXPECT_FALSE(fs::exists(dir / kReportAssetsDirectory));
 
@@ -279,7 +281,7 @@ SweepResult SyntheticSweep(const fs::path& maps) {
   fs::create_directories(maps / "tau_0.60");
   std::ofstream(maps / "tau_0.60" / kReportFileName) << "x";
   sweep.rows[1].map_directory = (maps / "tau_0.40").string();  // absolute
-  sweep.rows[2].map_directory = "tau_0.60";                      // relative to the report
+  sweep.rows[2].map_directory = "tau_0.60";                    // relative to the report
   return sweep;
 }
 

@@ -68,12 +68,14 @@ std::string LinkTableHtml(const VisualMap& map, const MapEvaluation* evaluation)
     html += "<p class=\"note\">Camera " + HtmlEscape(CameraModelName(c.model)) + " " + std::to_string(c.size.width) +
             "x" + std::to_string(c.size.height) + ", fx " + FormatFixed(c.fx, 2) + ", fy " + FormatFixed(c.fy, 2) +
             ", cx " + FormatFixed(c.cx, 2) + ", cy " + FormatFixed(c.cy, 2) +
-            (c.has_distortion() ? ", with distortion" : "") + (c.origin.empty() ? "" : " (" + HtmlEscape(c.origin) + ")") +
+            (c.has_distortion() ? ", with distortion" : "") +
+            (c.origin.empty() ? "" : " (" + HtmlEscape(c.origin) + ")") +
             ". Each link's pose maps the first key image's camera frame to the second's: X<sub>to</sub> = R "
             "X<sub>from</sub> + t, |t| = 1.</p>\n";
   } else {
-    html += "<p class=\"note\">The map has no camera: its links have no pose (build with <code>--camera</code> to "
-            "get one). The parallax is the plain median displacement of the verified matches.</p>\n";
+    html +=
+        "<p class=\"note\">The map has no camera: its links have no pose (build with <code>--camera</code> to "
+        "get one). The parallax is the plain median displacement of the verified matches.</p>\n";
   }
   if (evaluation) {
     const EvaluationSummary& s = evaluation->summary;
@@ -97,13 +99,15 @@ std::string LinkTableHtml(const VisualMap& map, const MapEvaluation* evaluation)
             " px, translation direction error below " + FormatFixed(evaluation->options.max_translation_error_deg, 0) +
             "&deg;. Sampson errors are under the true F.</p>\n";
   }
-  html += "<table class=\"links-table\"><thead><tr><th class=\"num\">link</th><th>frames</th><th class=\"num\">S</th>"
-          "<th class=\"num\">verified / tentative</th><th class=\"num\">parallax</th><th>homography</th>"
-          "<th>t (unit)</th><th>translation known (&sigma; of its direction)</th>";
+  html +=
+      "<table class=\"links-table\"><thead><tr><th class=\"num\">link</th><th>frames</th><th class=\"num\">S</th>"
+      "<th class=\"num\">verified / tentative</th><th class=\"num\">parallax</th><th>homography</th>"
+      "<th>t (unit)</th><th>translation known (&sigma; of its direction)</th>";
   if (evaluation) {
-    html += "<th class=\"num\">rotation error</th><th class=\"num\">translation error</th>"
-            "<th class=\"num\">true parallax</th><th class=\"num\">verified on true epipolar line</th>"
-            "<th class=\"num\">rejected on true epipolar line</th><th>usable</th>";
+    html +=
+        "<th class=\"num\">rotation error</th><th class=\"num\">translation error</th>"
+        "<th class=\"num\">true parallax</th><th class=\"num\">verified on true epipolar line</th>"
+        "<th class=\"num\">rejected on true epipolar line</th><th>usable</th>";
   }
   html += "</tr></thead>\n<tbody>\n";
   for (size_t i = 0; i < map.links.size(); ++i) {
@@ -119,15 +123,17 @@ std::string LinkTableHtml(const VisualMap& map, const MapEvaluation* evaluation)
     html += Cell(std::to_string(l.num_verified) + " / " + std::to_string(l.num_tentative));
     html += Cell(l.parallax >= 0 ? FormatFixed(l.parallax, 1) + " px" + (l.parallax_without_rotation ? "" : "*")
                                  : "&ndash;");
-    html += Cell(l.homography_share >= 0 ? (l.planar ? "<b>explains " : "explains ") +
-                                               FormatFixed(100.0 * l.homography_share, 0) + " %" +
-                                               (l.planar ? " (plane or rotation)</b>" : "")
-                                         : "&ndash;",
+    html += Cell(l.homography_share >= 0
+                     ? (l.planar ? "<b>explains " : "explains ") + FormatFixed(100.0 * l.homography_share, 0) + " %" +
+                           (l.planar ? " (plane or rotation)</b>" : "")
+                     : "&ndash;",
                  false);
     html += Cell(l.has_pose ? fmt::format("({:.2f}, {:.2f}, {:.2f})", l.t[0], l.t[1], l.t[2]) : "&ndash;", false);
-    const std::string sigma = l.translation_sigma_deg >= 0 ? " (" + FormatFixed(l.translation_sigma_deg, 1) + "&deg;)" : "";
-    html += Cell(!l.has_pose ? "&ndash;" : (l.translation_known ? "yes" + sigma : "<b>no</b>" + sigma + ": rotation only"),
-                 false);
+    const std::string sigma =
+        l.translation_sigma_deg >= 0 ? " (" + FormatFixed(l.translation_sigma_deg, 1) + "&deg;)" : "";
+    html +=
+        Cell(!l.has_pose ? "&ndash;" : (l.translation_known ? "yes" + sigma : "<b>no</b>" + sigma + ": rotation only"),
+             false);
     if (e) {
       html += Cell(Value(e->rotation_error_deg, 2, "&deg;")) + Cell(Value(e->translation_error_deg, 1, "&deg;")) +
               Cell(Value(e->true_parallax_px, 1, " px")) + Cell(Share(e->verified_within)) +
@@ -136,12 +142,13 @@ std::string LinkTableHtml(const VisualMap& map, const MapEvaluation* evaluation)
     }
     html += "</tr>\n";
   }
-  html += "</tbody></table>\n<p class=\"note\">Parallax: median displacement of the verified matches after undoing "
-          "the link's rotation (* without a pose: the plain displacement). Homography: the share of the verified "
-          "matches one homography explains; when it explains nearly all, the scene is a plane or the camera only "
-          "rotated, and F and the pose are ill-posed. Translation known: the standard deviation of t's direction "
-          "that the matches allow is small enough to trust it; otherwise a robot gets the link's rotation only "
-          "(docs/link-poses.md).</p>\n</section>\n";
+  html +=
+      "</tbody></table>\n<p class=\"note\">Parallax: median displacement of the verified matches after undoing "
+      "the link's rotation (* without a pose: the plain displacement). Homography: the share of the verified "
+      "matches one homography explains; when it explains nearly all, the scene is a plane or the camera only "
+      "rotated, and F and the pose are ill-posed. Translation known: the standard deviation of t's direction "
+      "that the matches allow is small enough to trust it; otherwise a robot gets the link's rotation only "
+      "(docs/link-poses.md).</p>\n</section>\n";
   return html;
 }
 

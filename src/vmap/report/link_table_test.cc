@@ -68,7 +68,8 @@ TEST(LinkTableTest, TheReportShowsTheEvaluationOfItsOwnLinksOnly) {
   // Unusable links are shaded.
   EXPECT_EQ(report_test::CountOccurrences(html, "<tr class=\"below-tau\" data-link="),
             evaluation.summary.links - evaluation.summary.usable_links);
-  EXPECT_EQ(report_test::CountOccurrences(html, "NOT usable"), evaluation.summary.links - evaluation.summary.usable_links);
+  EXPECT_EQ(report_test::CountOccurrences(html, "NOT usable"),
+            evaluation.summary.links - evaluation.summary.usable_links);
 
   // An evaluation of other links (the map was rebuilt since) is ignored.
   MapEvaluation stale = evaluation;

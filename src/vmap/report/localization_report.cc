@@ -39,8 +39,8 @@ std::vector<int> ChooseFrames(const std::vector<LocalizationResult>& frames, int
   const int n = static_cast<int>(frames.size());
   if (n == 0 || count <= 0) return {};
   for (int i = 0; i < n && static_cast<int>(chosen.size()) < std::max(1, count / 4); ++i) {
-    const bool starts_streak = frames[i].status == LocalizationStatus::kLost &&
-                               (i == 0 || frames[i - 1].status != LocalizationStatus::kLost);
+    const bool starts_streak =
+        frames[i].status == LocalizationStatus::kLost && (i == 0 || frames[i - 1].status != LocalizationStatus::kLost);
     if (starts_streak) chosen.insert(i);
   }
   for (int i = 0; i < n; ++i) {
@@ -90,8 +90,10 @@ cv::Mat DrawPair(const cv::Mat& frame, const cv::Mat& key, const cv::Mat& next, 
   int x = 0;
   for (size_t i = 0; i < panels.size(); ++i) {
     cv::Mat roi = canvas(cv::Rect(x, 0, panels[i].cols, height));
-    if (panels[i].channels() == 1) cv::cvtColor(panels[i], roi, cv::COLOR_GRAY2BGR);
-    else panels[i].copyTo(roi);
+    if (panels[i].channels() == 1)
+      cv::cvtColor(panels[i], roi, cv::COLOR_GRAY2BGR);
+    else
+      panels[i].copyTo(roi);
     const double scale = std::max(0.4, height / 600.0);
     const int baseline_y = static_cast<int>(22 * scale) + 4;
     cv::rectangle(canvas, cv::Rect(x, 0, panels[i].cols, baseline_y + 6), cv::Scalar(0, 0, 0), cv::FILLED);
@@ -133,9 +135,15 @@ std::string KeyPlot(const LocalizationRun& run, int num_keys) {
   for (const LocalizationResult& r : run.frames) {
     const cv::Point2d p(r.frame_index, r.key);
     switch (r.status) {
-      case LocalizationStatus::kTracking: tracking.segments[0].push_back(p); break;
-      case LocalizationStatus::kRelocalized: relocalized.segments[0].push_back(p); break;
-      case LocalizationStatus::kLost: lost.segments[0].push_back(p); break;
+      case LocalizationStatus::kTracking:
+        tracking.segments[0].push_back(p);
+        break;
+      case LocalizationStatus::kRelocalized:
+        relocalized.segments[0].push_back(p);
+        break;
+      case LocalizationStatus::kLost:
+        lost.segments[0].push_back(p);
+        break;
     }
     if (r.status == LocalizationStatus::kLost) {
       if (!segment.empty()) line.segments.push_back(std::move(segment));
@@ -283,11 +291,13 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
   const double n = s.frames > 0 ? static_cast<double>(s.frames) : 1.0;
   const std::string assets_url = std::string(kReportAssetsDirectory) + "/";
   std::ostringstream html;
-  html << report::PageStart("vmap localization: " + run.info.query, "Localization of " + run.info.query,
-                            "against the map " + run.info.map_directory + " (" +
-                                std::to_string(map.key_images.size()) + " key images)",
-                            {{"summary", "Summary"}, {"keys", "Key image over time"},
-                             {"similarity", "Similarity"}, {"frames", "Frames and key images"}});
+  html << report::PageStart(
+      "vmap localization: " + run.info.query, "Localization of " + run.info.query,
+      "against the map " + run.info.map_directory + " (" + std::to_string(map.key_images.size()) + " key images)",
+      {{"summary", "Summary"},
+       {"keys", "Key image over time"},
+       {"similarity", "Similarity"},
+       {"frames", "Frames and key images"}});
   html << "<section id=\"summary\"><h2>Summary</h2>\n<div class=\"cards\">"
        << report::Card(std::to_string(s.frames), "frames")
        << report::Card(FormatFixed(100.0 * s.tracking / n, 1) + " %", "tracking")
@@ -305,8 +315,8 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
                                   " frames/s; " + FormatFixed(1000.0 * s.mean_localize_seconds, 1) +
                                   " ms localizing and " + FormatFixed(1000.0 * s.mean_extract_seconds, 1) +
                                   " ms extracting per frame)")
-       << report::Row("Key images", FormatFixed(run.info.key_image_seconds, 2) + " s to load (cache: " +
-                                        HtmlEscape(run.info.cache) + ")")
+       << report::Row("Key images", FormatFixed(run.info.key_image_seconds, 2) +
+                                        " s to load (cache: " + HtmlEscape(run.info.cache) + ")")
        << "</table>\n</section>\n";
   html << "<section id=\"keys\"><h2>Key image over time</h2>\n<p class=\"note\">The key image each frame was "
           "localized at (the last one reached on the route): tracking in blue, relocalization in orange, lost "
@@ -320,14 +330,15 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
        << "<div class=\"links\">\n";
   for (const auto& [index, size] : written) {
     const LocalizationResult& r = run.frames[index];
-    html << "<figure class=\"match-figure" << (r.status == LocalizationStatus::kLost ? " lost" : "")
-         << "\" id=\"frame-" << r.frame_index << "\"><img loading=\"lazy\" decoding=\"async\" src=\""
+    html << "<figure class=\"match-figure" << (r.status == LocalizationStatus::kLost ? " lost" : "") << "\" id=\"frame-"
+         << r.frame_index << "\"><img loading=\"lazy\" decoding=\"async\" src=\""
          << UrlPath(assets_url + "frames/" + report::Numbered(r.frame_index)) << "\" width=\"" << size.width
          << "\" height=\"" << size.height << "\" alt=\"frame " << r.frame_index << "\"><figcaption>Frame "
          << r.frame_index << " (" << HtmlEscape(r.source_name) << "): " << LocalizationStatusName(r.status)
          << (r.key >= 0 ? fmt::format(" &middot; key {} (S = {})", r.key, FormatFixed(r.to_key.similarity, 3)) : "")
-         << (r.next_key >= 0 ? fmt::format(" &middot; next {} (S = {})", r.next_key, FormatFixed(r.to_next.similarity, 3))
-                             : "")
+         << (r.next_key >= 0
+                 ? fmt::format(" &middot; next {} (S = {})", r.next_key, FormatFixed(r.to_next.similarity, 3))
+                 : "")
          << "</figcaption></figure>\n";
   }
   if (written.empty() && recorded.empty() && !QueryCanBeReadAgain(run.info) && !run.frames.empty()) {
@@ -345,8 +356,8 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
 }
 
 std::string WhyNotALocalizationReport(const fs::path& directory) {
-  const ContainedJson parsed = ReadContainedJson(directory, kLocalizationReportRunFileName, kMaxRunJsonBytes,
-                                                 kMaxRunJsonValues);
+  const ContainedJson parsed =
+      ReadContainedJson(directory, kLocalizationReportRunFileName, kMaxRunJsonBytes, kMaxRunJsonValues);
   if (parsed.missing) return std::string("it has no ") + kLocalizationReportRunFileName;
   if (!parsed.document) return "its " + parsed.why_not;
   if (!parsed.document->is_object() || parsed.document->value("format", nlohmann::json()) != "vmap-localization") {

@@ -24,8 +24,8 @@ namespace vmap {
 inline constexpr const char* kLocalizationReportRunFileName = "run.json";
 
 struct LocalizationReportOptions {
-  int pairs = 8;               // frames shown beside their key image (spread over the run, lost ones first)
-  int pair_width = 960;        // width of each pair in pixels
+  int pairs = 8;         // frames shown beside their key image (spread over the run, lost ones first)
+  int pair_width = 960;  // width of each pair in pixels
   int jpeg_quality = 85;
 
   void Check() const;  // throws OptionError naming the bad field

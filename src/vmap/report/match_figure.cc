@@ -17,9 +17,12 @@ namespace {
 
 cv::Mat ToBgr(const cv::Mat& image) {
   cv::Mat bgr;
-  if (image.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
-  else if (image.channels() == 4) cv::cvtColor(image, bgr, cv::COLOR_BGRA2BGR);
-  else bgr = image;
+  if (image.channels() == 1)
+    cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
+  else if (image.channels() == 4)
+    cv::cvtColor(image, bgr, cv::COLOR_BGRA2BGR);
+  else
+    bgr = image;
   if (bgr.depth() != CV_8U) bgr.convertTo(bgr, CV_8U);
   return bgr;
 }
@@ -48,8 +51,8 @@ std::string MatchCaption(const Link& link) {
 
 void MatchFigureOptions::Check() const {
   if (max_width != 0 && (max_width < 64 || max_width > 16384)) {
-    throw OptionError("max_width", "is " + std::to_string(max_width) +
-                                       "; use 0 (the key images' own scale) or 64 to 16384 pixels");
+    throw OptionError("max_width",
+                      "is " + std::to_string(max_width) + "; use 0 (the key images' own scale) or 64 to 16384 pixels");
   }
 }
 

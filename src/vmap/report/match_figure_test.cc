@@ -32,7 +32,7 @@ TEST(MatchFigureTest, PutsImagesSideBySideWithGreenLinesAndBluePoints) {
   ASSERT_EQ(figure.type(), CV_8UC3);
   EXPECT_GE(figure.cols, 404);
   EXPECT_LE(figure.cols, 420);
-  EXPECT_GT(figure.rows, 100);  // the caption band
+  EXPECT_GT(figure.rows, 100);           // the caption band
   const int offset = figure.cols - 200;  // where the second image starts
   // The green line runs at y = 50 from the first image into the second.
   EXPECT_TRUE(IsGreen(figure.at<cv::Vec3b>(50, 120)));
@@ -103,8 +103,7 @@ TEST(MatchFigureTest, BadOptionsNameTheField) {
       DrawMatchFigure(cv::Mat(10, 10, CV_8UC3), cv::Mat(10, 10, CV_8UC3), SimpleLink(), options);
       ADD_FAILURE() << "max_width " << width << " accepted";
     } catch (const InputError& error) {
-      EXPECT_NE(std::string(error.what()).find("max_width is " + std::to_string(width)),
-                std::string::npos)
+      EXPECT_NE(std::string(error.what()).find("max_width is " + std::to_string(width)), std::string::npos)
           << error.what();
     }
   }

@@ -6,8 +6,8 @@
 #include <unistd.h>
 
 #include <cstdlib>
-#include <fstream>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -56,13 +56,13 @@ struct ChromiumResult {
 ChromiumResult RunChromium(const std::string& action, const std::string& url, const fs::path& work) {
   const fs::path profile = work / ("profile-" + std::to_string(rand()));
   const fs::path out = work / "chromium.out", err = work / "chromium.err";
-  const std::string command =
-      std::string("timeout 120 ") + kChromium +
-      " --headless --no-sandbox --disable-gpu --no-first-run --disable-background-networking"
-      " --disable-component-update --disable-sync --disable-extensions --hide-scrollbars"
-      " --enable-logging=stderr --v=0 --virtual-time-budget=15000 --window-size=1280,2000" +
-      " --user-data-dir=" + testing::Quote(profile.string()) + " " + action + " " + testing::Quote(url) + " > " +
-      testing::Quote(out.string()) + " 2> " + testing::Quote(err.string());
+  const std::string command = std::string("timeout 120 ") + kChromium +
+                              " --headless --no-sandbox --disable-gpu --no-first-run --disable-background-networking"
+                              " --disable-component-update --disable-sync --disable-extensions --hide-scrollbars"
+                              " --enable-logging=stderr --v=0 --virtual-time-budget=15000 --window-size=1280,2000" +
+                              " --user-data-dir=" + testing::Quote(profile.string()) + " " + action + " " +
+                              testing::Quote(url) + " > " + testing::Quote(out.string()) + " 2> " +
+                              testing::Quote(err.string());
   ChromiumResult result;
   {
     ChromiumTurn turn;
@@ -220,8 +220,8 @@ TEST_F(ReportBrowserTest, ReportOfARealMapBuiltFromSharedData) {
   }
   ScopedTempDir temp;
   const fs::path dir = temp.path() / "rccar_map";
-  const std::string command = testing::Quote(testing::VmapBinary()) + " build " + testing::Quote(images.string()) + " -o " +
-                              testing::Quote(dir.string()) + " --stride 3 --last 119 --report -q > " +
+  const std::string command = testing::Quote(testing::VmapBinary()) + " build " + testing::Quote(images.string()) +
+                              " -o " + testing::Quote(dir.string()) + " --stride 3 --last 119 --report -q > " +
                               testing::Quote((temp.path() / "build.log").string()) + " 2>&1";
   ASSERT_EQ(std::system(command.c_str()), 0) << ReadText(temp.path() / "build.log");
   const VisualMap map = ReadMap(dir);
@@ -245,8 +245,9 @@ TEST_F(ReportBrowserTest, LocalizationReportLoadsOffline) {
   for (int i = 0; i < static_cast<int>(map.key_images.size()); ++i) {
     LocalizationResult r;
     r.frame_index = r.source_index = i;
-    r.status = i == 0 ? LocalizationStatus::kRelocalized : i == 2 ? LocalizationStatus::kLost
-                                                                  : LocalizationStatus::kTracking;
+    r.status = i == 0   ? LocalizationStatus::kRelocalized
+               : i == 2 ? LocalizationStatus::kLost
+                        : LocalizationStatus::kTracking;
     r.key = i == 2 ? 1 : i;
     r.next_key = r.key + 1 < static_cast<int>(map.key_images.size()) ? r.key + 1 : -1;
     r.to_key.similarity = 0.8;

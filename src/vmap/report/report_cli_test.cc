@@ -39,8 +39,8 @@ TEST_F(ReportCliTest, DrawWritesOneMatchFigure) {
   EXPECT_EQ(figure.cols, 2 * 320 + 4);
   EXPECT_GT(figure.rows, 240);
 
-  const testing::CliResult scaled = testing::RunVmap("draw '" + map.string() + "' --link 0 --width 300 -o '" + (temp.path() / "s.jpg").string() +
-                              "'");
+  const testing::CliResult scaled = testing::RunVmap("draw '" + map.string() + "' --link 0 --width 300 -o '" +
+                                                     (temp.path() / "s.jpg").string() + "'");
   ASSERT_EQ(scaled.status, 0) << scaled.output;
   EXPECT_LE(cv::imread((temp.path() / "s.jpg").string()).cols, 300);
 }
@@ -49,10 +49,12 @@ TEST_F(ReportCliTest, DrawRejectsAMissingLinkOrFormat) {
   ScopedTempDir temp;
   const fs::path map = temp.path() / "map";
   report_test::WriteSyntheticMap(map);
-  const testing::CliResult missing = testing::RunVmap("draw '" + map.string() + "' --link 9 -o '" + (temp.path() / "x.png").string() + "'");
+  const testing::CliResult missing =
+      testing::RunVmap("draw '" + map.string() + "' --link 9 -o '" + (temp.path() / "x.png").string() + "'");
   EXPECT_EQ(missing.status, 2);
   EXPECT_NE(missing.output.find("link 9 does not exist"), std::string::npos) << missing.output;
-  const testing::CliResult format = testing::RunVmap("draw '" + map.string() + "' --link 0 -o '" + (temp.path() / "x.gif").string() + "'");
+  const testing::CliResult format =
+      testing::RunVmap("draw '" + map.string() + "' --link 0 -o '" + (temp.path() / "x.gif").string() + "'");
   EXPECT_EQ(format.status, 2);
   EXPECT_NE(format.output.find(".png"), std::string::npos) << format.output;
   EXPECT_FALSE(fs::exists(temp.path() / "x.png"));

@@ -28,15 +28,15 @@ std::string FormatMapSummary(const VisualMap& map, QualityMean mean) {
   }
   if (map.input.camera) {
     const Camera& c = *map.input.camera;
-    text += fmt::format("camera          {} {}x{} fx {:.2f} fy {:.2f} cx {:.2f} cy {:.2f}{}; links with a pose {} of {}\n",
-                        CameraModelName(c.model), c.size.width, c.size.height, c.fx, c.fy, c.cx, c.cy,
-                        c.has_distortion() ? " (with distortion)" : "",
-                        std::count_if(map.links.begin(), map.links.end(), [](const Link& l) { return l.has_pose; }),
-                        map.links.size());
+    text += fmt::format(
+        "camera          {} {}x{} fx {:.2f} fy {:.2f} cx {:.2f} cy {:.2f}{}; links with a pose {} of {}\n",
+        CameraModelName(c.model), c.size.width, c.size.height, c.fx, c.fy, c.cx, c.cy,
+        c.has_distortion() ? " (with distortion)" : "",
+        std::count_if(map.links.begin(), map.links.end(), [](const Link& l) { return l.has_pose; }), map.links.size());
     const auto known = std::count_if(map.links.begin(), map.links.end(),
                                      [](const Link& l) { return l.has_pose && l.translation_known; });
-    text += fmt::format("translation     known on {} of {} links; the others give a robot their rotation only\n",
-                        known, map.links.size());
+    text += fmt::format("translation     known on {} of {} links; the others give a robot their rotation only\n", known,
+                        map.links.size());
   }
   text += fmt::format("quality Q       {:.4f} ({} mean)\n", s.quality, QualityMeanName(mean));
   if (map.seconds > 0) {
@@ -46,24 +46,25 @@ std::string FormatMapSummary(const VisualMap& map, QualityMean mean) {
 }
 
 std::string SweepToMarkdown(const SweepResult& sweep) {
-  std::string text = fmt::format("Threshold sweep of {} ({} frames, {:.1f} s)\n\n", sweep.input.path, sweep.num_frames,
-                                 sweep.seconds);
+  std::string text =
+      fmt::format("Threshold sweep of {} ({} frames, {:.1f} s)\n\n", sweep.input.path, sweep.num_frames, sweep.seconds);
   const bool has_usable =
       std::any_of(sweep.rows.begin(), sweep.rows.end(), [](const SweepRow& r) { return r.usable_links >= 0; });
   text += "| tau | key images | % frames | min matches | max matches | mean matches | mean S | Q |";
   text += has_usable ? " usable links |\n" : "\n";
-  text += has_usable ? "|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n" : "|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  text +=
+      has_usable ? "|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n" : "|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (size_t i = 0; i < sweep.rows.size(); ++i) {
     const SweepRow& r = sweep.rows[i];
     const bool best = static_cast<int>(i) == sweep.best_row;
     text += fmt::format("| {}{:.2f}{} | {} | {:.1f} | {} | {} | {:.1f} | {:.3f} | {}{:.4f}{} |", best ? "**" : "",
-                        r.tau, best ? "**" : "", r.num_key_images, r.key_image_percent, r.min_verified,
-                        r.max_verified, r.mean_verified, r.mean_similarity, best ? "**" : "", r.quality,
-                        best ? "**" : "");
+                        r.tau, best ? "**" : "", r.num_key_images, r.key_image_percent, r.min_verified, r.max_verified,
+                        r.mean_verified, r.mean_similarity, best ? "**" : "", r.quality, best ? "**" : "");
     if (has_usable) {
       const int links = std::max(0, r.num_key_images - 1);
-      text += r.usable_links < 0 ? " - |" : fmt::format(" {} of {} ({:.0f}%) |", r.usable_links, links,
-                                                         links > 0 ? 100.0 * r.usable_links / links : 0.0);
+      text += r.usable_links < 0 ? " - |"
+                                 : fmt::format(" {} of {} ({:.0f}%) |", r.usable_links, links,
+                                               links > 0 ? 100.0 * r.usable_links / links : 0.0);
     }
     text += "\n";
   }
@@ -72,8 +73,9 @@ std::string SweepToMarkdown(const SweepResult& sweep) {
 }
 
 std::string SweepToCsv(const SweepResult& sweep) {
-  std::string text = "tau,key_images,key_image_percent,min_matches,max_matches,mean_matches,mean_similarity,quality,"
-                     "below_tau_links,usable_links,best\n";
+  std::string text =
+      "tau,key_images,key_image_percent,min_matches,max_matches,mean_matches,mean_similarity,quality,"
+      "below_tau_links,usable_links,best\n";
   for (size_t i = 0; i < sweep.rows.size(); ++i) {
     const SweepRow& r = sweep.rows[i];
     text += fmt::format("{:.4f},{},{:.4f},{},{},{:.4f},{:.6f},{:.6f},{},{},{}\n", r.tau, r.num_key_images,
@@ -97,18 +99,18 @@ std::string SweepToJson(const SweepResult& sweep) {
   doc["best_tau"] = sweep.best_row >= 0 ? nlohmann::json(sweep.rows[sweep.best_row].tau) : nlohmann::json(nullptr);
   nlohmann::json rows = nlohmann::json::array();
   for (const SweepRow& r : sweep.rows) {
-    rows.push_back({{"tau", r.tau},
-                    {"key_images", r.num_key_images},
-                    {"key_image_percent", r.key_image_percent},
-                    {"min_matches", r.min_verified},
-                    {"max_matches", r.max_verified},
-                    {"mean_matches", r.mean_verified},
-                    {"mean_similarity", r.mean_similarity},
-                    {"quality", r.quality},
-                    {"below_tau_links", r.below_tau_links},
-                    {"usable_links", r.usable_links >= 0 ? nlohmann::json(r.usable_links) : nlohmann::json(nullptr)},
-                    {"map", r.map_directory.empty() ? nlohmann::json(nullptr)
-                                                    : nlohmann::json(EncodeFileName(r.map_directory))}});
+    rows.push_back(
+        {{"tau", r.tau},
+         {"key_images", r.num_key_images},
+         {"key_image_percent", r.key_image_percent},
+         {"min_matches", r.min_verified},
+         {"max_matches", r.max_verified},
+         {"mean_matches", r.mean_verified},
+         {"mean_similarity", r.mean_similarity},
+         {"quality", r.quality},
+         {"below_tau_links", r.below_tau_links},
+         {"usable_links", r.usable_links >= 0 ? nlohmann::json(r.usable_links) : nlohmann::json(nullptr)},
+         {"map", r.map_directory.empty() ? nlohmann::json(nullptr) : nlohmann::json(EncodeFileName(r.map_directory))}});
   }
   doc["rows"] = rows;
   return doc.dump(1) + "\n";

@@ -4,8 +4,8 @@
 #include <filesystem>
 #include <string>
 
-#include "vmap/mapping/batch_build.h"
 #include "vmap/map/visual_map.h"
+#include "vmap/mapping/batch_build.h"
 
 namespace vmap {
 

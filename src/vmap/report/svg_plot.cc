@@ -23,9 +23,12 @@ AxisTicks NiceTicks(double low, double high, int target) {
   const double magnitude = std::pow(10.0, std::floor(std::log10(raw_step)));
   const double fraction = raw_step / magnitude;
   double nice = 10.0;
-  if (fraction <= 1.0) nice = 1.0;
-  else if (fraction <= 2.0) nice = 2.0;
-  else if (fraction <= 5.0) nice = 5.0;
+  if (fraction <= 1.0)
+    nice = 1.0;
+  else if (fraction <= 2.0)
+    nice = 2.0;
+  else if (fraction <= 5.0)
+    nice = 5.0;
   AxisTicks ticks;
   ticks.step = nice * magnitude;
   // The epsilon keeps a limit that is already a multiple of the step from gaining an extra tick.
@@ -128,9 +131,9 @@ std::string SvgPlot::Render() const {
 
   // Series, clipped to the plot area so a value outside a fixed range cannot draw over the labels.
   const std::string clip_id = id_ + "-clip";
-  svg << "<clipPath id=\"" << HtmlEscape(clip_id) << "\"><rect x=\"" << Px(box.left - 4) << "\" y=\""
-      << Px(box.top - 4) << "\" width=\"" << Px(box.right - box.left + 8) << "\" height=\""
-      << Px(box.bottom - box.top + 8) << "\"/></clipPath>\n";
+  svg << "<clipPath id=\"" << HtmlEscape(clip_id) << "\"><rect x=\"" << Px(box.left - 4) << "\" y=\"" << Px(box.top - 4)
+      << "\" width=\"" << Px(box.right - box.left + 8) << "\" height=\"" << Px(box.bottom - box.top + 8)
+      << "\"/></clipPath>\n";
   for (const PlotSeries& s : series_) {
     const std::string color = HtmlEscape(s.color);
     svg << "<g class=\"series" << (s.css_class.empty() ? "" : " " + HtmlEscape(s.css_class)) << "\" data-name=\""
@@ -157,14 +160,13 @@ std::string SvgPlot::Render() const {
                 point_number < s.point_titles.size() ? HtmlEscape(s.point_titles[point_number]) : std::string();
             ++point_number;
             if (s.kind == PlotSeries::Kind::kMarkers) {
-              svg << "<circle" << extra << " cx=\"" << Px(x) << "\" cy=\"" << Px(y) << "\" r=\""
-                  << Px(s.marker_radius) << "\" fill=\"" << color << "\" stroke=\"#fff\" stroke-width=\"0.8\">";
+              svg << "<circle" << extra << " cx=\"" << Px(x) << "\" cy=\"" << Px(y) << "\" r=\"" << Px(s.marker_radius)
+                  << "\" fill=\"" << color << "\" stroke=\"#fff\" stroke-width=\"0.8\">";
             } else {
               const double r = s.marker_radius;
               svg << "<path" << extra << " data-x=\"" << Px(x) << "\" data-y=\"" << Px(y) << "\" d=\"M" << Px(x - r)
-                  << ' ' << Px(y - r) << "L" << Px(x + r) << ' ' << Px(y + r) << "M" << Px(x - r) << ' '
-                  << Px(y + r) << "L" << Px(x + r) << ' ' << Px(y - r) << "\" stroke=\"" << color
-                  << "\" stroke-width=\"1.6\">";
+                  << ' ' << Px(y - r) << "L" << Px(x + r) << ' ' << Px(y + r) << "M" << Px(x - r) << ' ' << Px(y + r)
+                  << "L" << Px(x + r) << ' ' << Px(y - r) << "\" stroke=\"" << color << "\" stroke-width=\"1.6\">";
             }
             if (!title.empty()) svg << "<title>" << title << "</title>";
             svg << (s.kind == PlotSeries::Kind::kMarkers ? "</circle>\n" : "</path>\n");
@@ -175,14 +177,16 @@ std::string SvgPlot::Render() const {
           if (segment.empty()) break;
           const double y = to_y(segment[0].y);
           svg << "<line" << extra << " x1=\"" << Px(box.left) << "\" x2=\"" << Px(box.right) << "\" y1=\"" << Px(y)
-              << "\" y2=\"" << Px(y) << "\" stroke=\"" << color << "\" stroke-width=\"1.5\" stroke-dasharray=\"6 4\"/>\n";
+              << "\" y2=\"" << Px(y) << "\" stroke=\"" << color
+              << "\" stroke-width=\"1.5\" stroke-dasharray=\"6 4\"/>\n";
           break;
         }
         case PlotSeries::Kind::kVerticalRules: {
           for (const cv::Point2d& p : segment) {
             const double x = to_x(p.x);
             svg << "<line" << extra << " x1=\"" << Px(x) << "\" x2=\"" << Px(x) << "\" y1=\"" << Px(box.top)
-                << "\" y2=\"" << Px(box.bottom) << "\" stroke=\"" << color << "\" stroke-width=\"1\" opacity=\"0.6\"/>\n";
+                << "\" y2=\"" << Px(box.bottom) << "\" stroke=\"" << color
+                << "\" stroke-width=\"1\" opacity=\"0.6\"/>\n";
           }
           break;
         }

@@ -15,26 +15,26 @@ namespace vmap::report {
 
 // Tick positions at 1, 2 or 5 times a power of ten covering [low, high] with about `target` ticks.
 struct AxisTicks {
-  double low = 0.0;   // the axis range: the first and last tick
+  double low = 0.0;  // the axis range: the first and last tick
   double high = 1.0;
   double step = 0.1;
   std::vector<double> values;
-  int decimals = 1;   // digits after the point that tell the ticks apart
+  int decimals = 1;  // digits after the point that tell the ticks apart
 };
 AxisTicks NiceTicks(double low, double high, int target = 6);
 
 struct PlotSeries {
   enum class Kind {
-    kLines,          // each segment is a polyline
-    kMarkers,        // every point is a circle
-    kCrosses,        // every point is an x
-    kHorizontalRule, // one dashed line across the plot at points[0].y of the first segment
-    kVerticalRules,  // a thin line across the plot at each point's x
+    kLines,           // each segment is a polyline
+    kMarkers,         // every point is a circle
+    kCrosses,         // every point is an x
+    kHorizontalRule,  // one dashed line across the plot at points[0].y of the first segment
+    kVerticalRules,   // a thin line across the plot at each point's x
   };
   Kind kind = Kind::kLines;
-  std::string name;        // legend text; empty: not in the legend
+  std::string name;  // legend text; empty: not in the legend
   std::string color = "#1f77b4";
-  std::string css_class;   // class of the series' <g>, for tests and styling
+  std::string css_class;  // class of the series' <g>, for tests and styling
   std::vector<std::vector<cv::Point2d>> segments;
   std::vector<std::string> segment_attributes;  // optional raw attributes per segment (already escaped)
   std::vector<std::string> point_titles;        // optional tooltip per point (markers only), plain text
@@ -45,7 +45,10 @@ class SvgPlot {
  public:
   SvgPlot(std::string id, std::string x_label, std::string y_label);
 
-  void SetSize(int width, int height) { width_ = width; height_ = height; }
+  void SetSize(int width, int height) {
+    width_ = width;
+    height_ = height;
+  }
   // Fixes an axis range instead of fitting it to the data (it still widens to round ticks).
   void SetXRange(double low, double high) { x_range_ = cv::Point2d(low, high); }
   void SetYRange(double low, double high) { y_range_ = cv::Point2d(low, high); }

@@ -1,7 +1,5 @@
 // The HTML report of a threshold sweep (`vmap sweep --report`): its summary, the table of every tau and the
 // plots of m, Q and S against tau. A map's own report is html_report.cc.
-#include "vmap/report/html_report.h"
-
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -21,6 +19,7 @@
 #include "vmap/map/map_io.h"
 #include "vmap/mapping/recorded_options.h"
 #include "vmap/report/html_page.h"
+#include "vmap/report/html_report.h"
 #include "vmap/report/html_util.h"
 #include "vmap/report/link_table.h"
 #include "vmap/report/svg_plot.h"
@@ -49,8 +48,8 @@ using report::Card;
 using report::Displayable;
 using report::DurationText;
 using report::Numbered;
-using report::OptionText;
 using report::OptionsSection;
+using report::OptionText;
 using report::PageEnd;
 using report::PageStart;
 using report::ParseOptions;
@@ -59,7 +58,6 @@ using report::ScaledToWidth;
 using report::SizeText;
 using report::TimestampText;
 using report::WriteJpeg;
-
 
 namespace {
 
@@ -77,8 +75,8 @@ std::string MapLink(const std::string& map_directory, const fs::path& report_dir
   const fs::path absolute_base = fs::weakly_canonical(fs::absolute(report_directory), ec);
   fs::path relative = absolute_target.lexically_relative(absolute_base);
   if (relative.empty()) relative = absolute_target;
-  const fs::path page = fs::exists(absolute_target / kReportFileName) ? relative / kReportFileName
-                                                                       : relative / kMapFileName;
+  const fs::path page =
+      fs::exists(absolute_target / kReportFileName) ? relative / kReportFileName : relative / kMapFileName;
   return UrlPath(page.generic_string());
 }
 
@@ -96,7 +94,8 @@ std::string SweepSummarySection(const SweepResult& sweep, const json& options) {
                           Card(FormatFixed(sweep.rows[sweep.best_row].quality, 3), "best Q")
                     : "")
        << "</div>\n<table class=\"summary\">\n"
-       << Row("Input", HtmlEscape(Displayable(sweep.input.path))) << Row("Format", HtmlEscape(SourceFormatName(sweep.input.format)))
+       << Row("Input", HtmlEscape(Displayable(sweep.input.path)))
+       << Row("Format", HtmlEscape(SourceFormatName(sweep.input.format)))
        << Row("Frame size", HtmlEscape(SizeText(sweep.input.frame_size)))
        << Row("Matcher", HtmlEscape(OptionText(options, "matcher")))
        << Row("Verifier", HtmlEscape(OptionText(options, "verifier")))
@@ -116,7 +115,8 @@ std::string SweepTableSection(const SweepResult& sweep, const fs::path& report_d
           "<th class=\"num\">&tau;</th><th class=\"num\">key images m</th><th class=\"num\">% of frames</th>"
           "<th class=\"num\">min</th><th class=\"num\">max</th><th class=\"num\">mean verified</th>"
           "<th class=\"num\">mean S</th><th class=\"num\">Q</th><th class=\"num\">links below &tau;</th>"
-       << (has_usable ? "<th class=\"num\">usable links (ground truth)</th>" : "") << "<th>map</th>"
+       << (has_usable ? "<th class=\"num\">usable links (ground truth)</th>" : "")
+       << "<th>map</th>"
           "</tr></thead>\n<tbody>\n";
   for (size_t i = 0; i < sweep.rows.size(); ++i) {
     const SweepRow& r = sweep.rows[i];
@@ -142,7 +142,8 @@ std::string SweepTableSection(const SweepResult& sweep, const fs::path& report_d
     html << "</td></tr>\n";
   }
   html << "</tbody></table>\n"
-       << (has_best ? "<p class=\"note\">&#9733; marks the threshold with the highest Q. Rows with links below &tau; are shaded red. "
+       << (has_best ? "<p class=\"note\">&#9733; marks the threshold with the highest Q. Rows with links below &tau; "
+                      "are shaded red. "
                       "A map without a page links to its map.json: <code>vmap report DIR</code> makes its page.</p>\n"
                     : "")
        << "</section>\n";
@@ -222,7 +223,8 @@ void WriteSweepReport(const SweepResult& sweep, const fs::path& directory) {
   // removes and nothing may bring back.
   std::error_code ec;
   if (!fs::is_directory(directory, ec)) {
-    throw InputError("the report directory '" + directory.string() + "' does not exist; create it or write the report elsewhere");
+    throw InputError("the report directory '" + directory.string() +
+                     "' does not exist; create it or write the report elsewhere");
   }
   const std::string input_name = sweep.input.path.empty() ? std::string("the input") : Displayable(sweep.input.path);
   const bool has_best = HasBestRow(sweep);

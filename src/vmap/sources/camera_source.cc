@@ -23,11 +23,13 @@ class V4l2CameraSource : public FrameSource {
     info_.format = SourceFormat::kVideo;
     std::error_code ec;
     if (!std::filesystem::exists(device, ec)) {
-      throw InputError("camera '" + device + "' does not exist: there is no V4L2 device at that path. Connect the "
+      throw InputError("camera '" + device +
+                       "' does not exist: there is no V4L2 device at that path. Connect the "
                        "camera and give the device it appears as (ls /dev/video*, or v4l2-ctl --list-devices)");
     }
     if (!capture_.open(device, cv::CAP_V4L2) || !capture_.isOpened()) {
-      throw InputError("cannot open camera '" + device + "' through V4L2: it is not a video capture device, another "
+      throw InputError("cannot open camera '" + device +
+                       "' through V4L2: it is not a video capture device, another "
                        "program holds it, or this user may not read it (add the user to the 'video' group)");
     }
     info_.fps = capture_.get(cv::CAP_PROP_FPS);

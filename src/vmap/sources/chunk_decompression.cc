@@ -15,7 +15,7 @@ std::string Lz4Frame(const uint8_t* in, size_t size, uint8_t* out, size_t out_si
   LZ4F_dctx* raw = nullptr;
   if (LZ4F_isError(LZ4F_createDecompressionContext(&raw, LZ4F_VERSION))) return "cannot start lz4";
   const std::unique_ptr<LZ4F_dctx, decltype(&LZ4F_freeDecompressionContext)> context(raw,
-                                                                                      &LZ4F_freeDecompressionContext);
+                                                                                     &LZ4F_freeDecompressionContext);
   size_t in_done = 0, out_done = 0;
   for (;;) {
     size_t in_step = size - in_done, out_step = out_size - out_done;
@@ -28,8 +28,8 @@ std::string Lz4Frame(const uint8_t* in, size_t size, uint8_t* out, size_t out_si
       return in_done == size ? "lz4 data ends early" : "lz4 data is larger than the chunk's announced size";
     }
   }
-  if (out_done != out_size) return "lz4 data holds " + std::to_string(out_done) + " bytes, not the announced " +
-                                   std::to_string(out_size);
+  if (out_done != out_size)
+    return "lz4 data holds " + std::to_string(out_done) + " bytes, not the announced " + std::to_string(out_size);
   return "";
 }
 
@@ -40,16 +40,16 @@ std::string Bz2(const uint8_t* in, size_t size, uint8_t* out, size_t out_size) {
                                                 const_cast<char*>(reinterpret_cast<const char*>(in)),
                                                 static_cast<unsigned int>(size), 0, 0);
   if (status != BZ_OK) return "damaged bz2 data (bzip2 status " + std::to_string(status) + ")";
-  if (produced != out_size) return "bz2 data holds " + std::to_string(produced) + " bytes, not the announced " +
-                                   std::to_string(out_size);
+  if (produced != out_size)
+    return "bz2 data holds " + std::to_string(produced) + " bytes, not the announced " + std::to_string(out_size);
   return "";
 }
 
 std::string Zstd(const uint8_t* in, size_t size, uint8_t* out, size_t out_size) {
   const size_t produced = ZSTD_decompress(out, out_size, in, size);
   if (ZSTD_isError(produced)) return std::string("damaged zstd data (") + ZSTD_getErrorName(produced) + ")";
-  if (produced != out_size) return "zstd data holds " + std::to_string(produced) + " bytes, not the announced " +
-                                   std::to_string(out_size);
+  if (produced != out_size)
+    return "zstd data holds " + std::to_string(produced) + " bytes, not the announced " + std::to_string(out_size);
   return "";
 }
 

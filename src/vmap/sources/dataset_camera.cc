@@ -120,8 +120,8 @@ Camera ReadIntrinsicsText(const std::string& path) {
     std::string value_text;
     double value = 0;
     if (!(fields >> value_text)) {
-      throw InputError(fmt::format("'{}' line {}: '{}' has no value; write 'name value' (e.g. fx 525.0)", path,
-                                   number, name));
+      throw InputError(
+          fmt::format("'{}' line {}: '{}' has no value; write 'name value' (e.g. fx 525.0)", path, number, name));
     }
     try {
       value = std::stod(value_text);
@@ -223,7 +223,8 @@ std::string FindCalibrationFile(const std::string& input_path, SourceFormat form
       return existing(p / "calib.txt");
     case SourceFormat::kEuroc: {
       fs::path csv = p;
-      if (fs::is_directory(p)) csv = fs::exists(p / "mav0/cam0/data.csv") ? p / "mav0/cam0/data.csv" : p / "cam0/data.csv";
+      if (fs::is_directory(p))
+        csv = fs::exists(p / "mav0/cam0/data.csv") ? p / "mav0/cam0/data.csv" : p / "cam0/data.csv";
       return existing(csv.parent_path() / "sensor.yaml");
     }
     case SourceFormat::kTum:
@@ -236,7 +237,8 @@ std::string FindCalibrationFile(const std::string& input_path, SourceFormat form
     case SourceFormat::kVideo:
       return existing(p.parent_path() / "intrinsics.txt");
     case SourceFormat::kRecording:  // its camera is a topic of its own (recording_source.h)
-    case SourceFormat::kAuto: break;
+    case SourceFormat::kAuto:
+      break;
   }
   return {};
 }
@@ -274,8 +276,9 @@ Camera ParseCameraOption(const std::string& value) {
   if (fs::exists(value)) return ReadCameraFile(value);
   const bool looks_numeric = !value.empty() && value.find_first_not_of("0123456789.,;eE+- \t") == std::string::npos;
   if (!looks_numeric) {
-    throw OptionError("camera", "'" + value +
-                                "' is neither an existing calibration file nor fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]]");
+    throw OptionError(
+        "camera",
+        "'" + value + "' is neither an existing calibration file nor fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]]");
   }
   return ParseCameraText(value);
 }

@@ -20,7 +20,8 @@ namespace {
 std::vector<std::string> ImagesIn(const fs::path& directory) {
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(directory)) {
-    if (entry.is_regular_file() && IsImageFile(entry.path().string())) names.push_back(entry.path().filename().string());
+    if (entry.is_regular_file() && IsImageFile(entry.path().string()))
+      names.push_back(entry.path().filename().string());
   }
   std::sort(names.begin(), names.end(), NaturalLess);
   return names;
@@ -85,9 +86,8 @@ std::vector<ImageEntry> ListImageFolder(const std::string& directory_text) {
                      "frames, or give its format");
   }
   const std::map<std::string, double> stamps = ReadTimestampsFile(directory);
-  const bool use_stamps = !stamps.empty() && std::all_of(names.begin(), names.end(), [&](const std::string& n) {
-    return stamps.count(n) > 0;
-  });
+  const bool use_stamps = !stamps.empty() && std::all_of(names.begin(), names.end(),
+                                                         [&](const std::string& n) { return stamps.count(n) > 0; });
   std::vector<ImageEntry> entries;
   entries.reserve(names.size());
   for (const std::string& name : names) {

@@ -24,8 +24,9 @@ std::string SourceFormatName(SourceFormat format) { return EnumToName(kSourceFor
 void FrameSourceOptions::Check() const {
   if (first < 0) throw OptionError("first", "must be >= 0 (got " + std::to_string(first) + ")");
   if (last < -1) {
-    throw OptionError("last", std::to_string(last) + " is not a frame; give a 0-based frame index, or -1 for the "
-                      "end of the sequence");
+    throw OptionError("last", std::to_string(last) +
+                                  " is not a frame; give a 0-based frame index, or -1 for the "
+                                  "end of the sequence");
   }
   if (last >= 0 && last < first) {
     throw OptionError("last", std::to_string(last) + " is before first " + std::to_string(first), {"first"});
@@ -51,9 +52,7 @@ bool IsStreamUrl(const std::string& path) {
 
 }  // namespace internal
 
-bool IsLiveInput(const std::string& path) {
-  return internal::IsStreamUrl(path) || path.rfind("/dev/video", 0) == 0;
-}
+bool IsLiveInput(const std::string& path) { return internal::IsStreamUrl(path) || path.rfind("/dev/video", 0) == 0; }
 
 bool NaturalLess(const std::string& a, const std::string& b) {
   size_t i = 0, j = 0;
@@ -115,8 +114,8 @@ namespace internal {
 bool IsImageFile(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  static const char* kExtensions[] = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm",
-                                      ".pbm", ".webp", ".jp2", ".exr", ".hdr", ".pnm", ".ras", ".sr"};
+  static const char* kExtensions[] = {".png", ".jpg",  ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm",
+                                      ".pbm", ".webp", ".jp2",  ".exr", ".hdr", ".pnm",  ".ras", ".sr"};
   return std::any_of(std::begin(kExtensions), std::end(kExtensions), [&](const char* e) { return ext == e; });
 }
 
@@ -217,14 +216,15 @@ class CameraSource : public FrameSource {
 
 std::unique_ptr<FrameSource> OpenDetectedFrameSource(const std::string& path, const FrameSourceOptions& options) {
   if (IsLiveInput(path)) {
-    std::unique_ptr<FrameSource> live = internal::IsStreamUrl(path) ? internal::OpenStream(path, options)
-                                                                    : internal::OpenV4l2Camera(path, options);
+    std::unique_ptr<FrameSource> live =
+        internal::IsStreamUrl(path) ? internal::OpenStream(path, options) : internal::OpenV4l2Camera(path, options);
     if (options.camera.empty() || options.camera == "none") return live;
     return std::make_unique<CameraSource>(std::move(live), ParseCameraOption(options.camera));
   }
   std::error_code ec;
   if (!fs::exists(path, ec)) {
-    throw InputError("input '" + path + "' does not exist; give a video file, an image folder, a TUM/EuRoC/KITTI "
+    throw InputError("input '" + path +
+                     "' does not exist; give a video file, an image folder, a TUM/EuRoC/KITTI "
                      "sequence or a ROS bag / MCAP recording");
   }
   const fs::path p(path);
@@ -247,8 +247,8 @@ std::unique_ptr<FrameSource> OpenDetectedFrameSource(const std::string& path, co
   std::optional<Camera> camera;
   if (options.camera.empty()) {
     camera = format == SourceFormat::kRecording ? recording_camera : FindDatasetCamera(path, format);
-  }
-  else if (options.camera != "none") camera = ParseCameraOption(options.camera);
+  } else if (options.camera != "none")
+    camera = ParseCameraOption(options.camera);
   if (!camera) return source;
   return std::make_unique<CameraSource>(std::move(source), *camera);
 }
@@ -264,21 +264,23 @@ std::unique_ptr<FrameSource> OpenDetected(const std::string& path, const fs::pat
     case SourceFormat::kImageFolder:
       return internal::OpenImageList(internal::ListImageFolder(path), path, format, options);
     case SourceFormat::kTum:
-      return internal::OpenImageList(
-          internal::ListTum(fs::is_directory(p) ? (p / "rgb.txt").string() : path), path, format, options);
+      return internal::OpenImageList(internal::ListTum(fs::is_directory(p) ? (p / "rgb.txt").string() : path), path,
+                                     format, options);
     case SourceFormat::kEuroc: {
       std::string csv = path;
-      if (fs::is_directory(p)) csv = fs::exists(p / "mav0/cam0/data.csv") ? (p / "mav0/cam0/data.csv").string()
-                                                                            : (p / "cam0/data.csv").string();
+      if (fs::is_directory(p))
+        csv =
+            fs::exists(p / "mav0/cam0/data.csv") ? (p / "mav0/cam0/data.csv").string() : (p / "cam0/data.csv").string();
       return internal::OpenImageList(internal::ListEuroc(csv), path, format, options);
     }
     case SourceFormat::kKitti:
       return internal::OpenImageList(internal::ListKitti(path), path, format, options);
     case SourceFormat::kRecording:  // opened by OpenDetectedFrameSource, which also reads its camera
-    case SourceFormat::kAuto: break;
+    case SourceFormat::kAuto:
+      break;
   }
-  throw OptionError("format", "auto cannot tell the layout of '" + path +
-                                "'; give its layout: video, images, tum, euroc or kitti");
+  throw OptionError(
+      "format", "auto cannot tell the layout of '" + path + "'; give its layout: video, images, tum, euroc or kitti");
 }
 
 }  // namespace
@@ -304,13 +306,14 @@ void FrameSourceOptions::VisitFields(OptionFieldVisitor& visitor) {
                 resize);
   visitor.Visit({"strict", "--strict", "Frames of a different size are an error, not a warning"}, strict);
   // map.json names the default, the intrinsics that come with the input, "input".
-  visitor.Visit(OptionField{"camera", "--camera",
-                            "Intrinsics: fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]] (pixels, native frame size) or a calibration "
-                            "file (OpenCV YAML/JSON, EuRoC sensor.yaml, KITTI calib.txt, intrinsics.txt); 'none' ignores "
-                            "the input's own. Default: the input's own, if any"}
-                    .HideDefault()
-                    .EmptyAs("input"),
-                camera);
+  visitor.Visit(
+      OptionField{"camera", "--camera",
+                  "Intrinsics: fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]] (pixels, native frame size) or a calibration "
+                  "file (OpenCV YAML/JSON, EuRoC sensor.yaml, KITTI calib.txt, intrinsics.txt); 'none' ignores "
+                  "the input's own. Default: the input's own, if any"}
+          .HideDefault()
+          .EmptyAs("input"),
+      camera);
   visitor.Visit(OptionField{"topic", "--topic",
                             "Recordings (ROS bag, rosbag2, MCAP): the image topic (Image or CompressedImage). Default: "
                             "the only one; `vmap info RECORDING` lists them"}

@@ -19,8 +19,9 @@ namespace vmap {
 // kRecording: a robot's recording, a ROS 1 .bag, a rosbag2 folder or .db3, or an .mcap file (recording_source.h).
 enum class SourceFormat { kAuto, kVideo, kImageFolder, kTum, kEuroc, kKitti, kRecording };
 inline constexpr EnumName<SourceFormat> kSourceFormatNames[] = {
-    {SourceFormat::kAuto, "auto"}, {SourceFormat::kVideo, "video"}, {SourceFormat::kImageFolder, "images"},
-    {SourceFormat::kTum, "tum"},   {SourceFormat::kEuroc, "euroc"}, {SourceFormat::kKitti, "kitti"},
+    {SourceFormat::kAuto, "auto"},          {SourceFormat::kVideo, "video"},
+    {SourceFormat::kImageFolder, "images"}, {SourceFormat::kTum, "tum"},
+    {SourceFormat::kEuroc, "euroc"},        {SourceFormat::kKitti, "kitti"},
     {SourceFormat::kRecording, "recording"}};
 
 SourceFormat ParseSourceFormat(const std::string& name);
@@ -71,23 +72,23 @@ struct FrameSourceOptions {
 };
 
 struct Frame {
-  int index = 0;             // position in the processed sequence: 0, 1, 2, ...
-  int source_index = 0;      // position in the input (differs with first/stride)
-  double timestamp = -1.0;   // seconds, from the dataset or the video; -1 when the format has none
-  std::string source_name;   // the image file name, or "frame_000123" for video
-  std::string source_path;   // the image file, empty for video
-  cv::Mat gray;              // 8-bit, one channel: what the matchers see
-  cv::Mat color;             // 8-bit BGR when the input is colour; may be empty (then use gray)
-  bool resized = false;      // the decoded image was resized (--resize, or a size that differs from the first)
+  int index = 0;            // position in the processed sequence: 0, 1, 2, ...
+  int source_index = 0;     // position in the input (differs with first/stride)
+  double timestamp = -1.0;  // seconds, from the dataset or the video; -1 when the format has none
+  std::string source_name;  // the image file name, or "frame_000123" for video
+  std::string source_path;  // the image file, empty for video
+  cv::Mat gray;             // 8-bit, one channel: what the matchers see
+  cv::Mat color;            // 8-bit BGR when the input is colour; may be empty (then use gray)
+  bool resized = false;     // the decoded image was resized (--resize, or a size that differs from the first)
 };
 
 struct SequenceInfo {
-  std::string path;            // as given by the user
+  std::string path;  // as given by the user
   SourceFormat format = SourceFormat::kAuto;
-  long expected_frames = -1;   // frames that will be delivered (after first/last/stride); -1 if unknown
-  cv::Size native_size;        // the first frame's size as stored
-  cv::Size frame_size;         // the size of delivered frames
-  double fps = 0.0;            // video only
+  long expected_frames = -1;  // frames that will be delivered (after first/last/stride); -1 if unknown
+  cv::Size native_size;       // the first frame's size as stored
+  cv::Size frame_size;        // the size of delivered frames
+  double fps = 0.0;           // video only
   // The camera of the delivered frames (scaled with --resize), known once the first frame is read; empty
   // when the input has no intrinsics and none were given.
   std::optional<Camera> camera;

@@ -153,7 +153,7 @@ TEST(ImageFolder, BadFramesAreSkippedWithAWarningAndCounted) {
   cv::imwrite((tmp.path() / "frame_3.png").string(), cv::Mat(500, 20, CV_8U, cv::Scalar(7)));
   cv::imwrite((tmp.path() / "frame_5.png").string(), cv::Mat(31, 400, CV_8U, cv::Scalar(7)));
   testing::WritePngHeader(tmp.path() / "frame_7.png", 40000, 40000);  // refused from its header
-  testing::WritePngHeader(tmp.path() / "frame_8.png", 2, 3);         // a header and no data
+  testing::WritePngHeader(tmp.path() / "frame_8.png", 2, 3);          // a header and no data
   std::ofstream(tmp.path() / "frame_10.png", std::ios::trunc) << "";
   auto source = OpenFrameSource(tmp.path().string());
   const auto frames = ReadAll(*source);
@@ -400,14 +400,14 @@ TEST(SharedData, VideoFramesEqualOpenCvCapture) {
 TEST(SharedData, RotatedVideosAreDeliveredUpright) {
   const fs::path shared = testing::SharedDir();
   if (shared.empty()) GTEST_SKIP() << "../shared is not present";
-  if (std::system("ffmpeg -version > /dev/null 2>&1") != 0) GTEST_SKIP() << "ffmpeg (scripts/install-deps.sh) is missing";
+  if (std::system("ffmpeg -version > /dev/null 2>&1") != 0)
+    GTEST_SKIP() << "ffmpeg (scripts/install-deps.sh) is missing";
   testing::ScopedTempDir tmp;
   for (int degrees : {90, 180, 270}) {
     const fs::path rotated = tmp.path() / ("rotated_" + std::to_string(degrees) + ".mp4");
-    const std::string command = "ffmpeg -nostdin -loglevel error -y -i \"" +
-                                (shared / "data/lab_floor/lab_floor.mp4").string() +
-                                "\" -frames:v 5 -c copy -metadata:s:v:0 rotate=" + std::to_string(degrees) + " \"" +
-                                rotated.string() + "\"";
+    const std::string command =
+        "ffmpeg -nostdin -loglevel error -y -i \"" + (shared / "data/lab_floor/lab_floor.mp4").string() +
+        "\" -frames:v 5 -c copy -metadata:s:v:0 rotate=" + std::to_string(degrees) + " \"" + rotated.string() + "\"";
     ASSERT_EQ(std::system(command.c_str()), 0) << command;
     auto source = OpenFrameSource(rotated.string());
     cv::VideoCapture capture(rotated.string(), cv::CAP_FFMPEG);
@@ -429,10 +429,10 @@ TEST(SharedData, EveryLayoutOpens) {
     SourceFormat format;
     long frames;
   };
-  for (const Case& c : {Case{"data/rccar_room/images", SourceFormat::kImageFolder, 329},
-                        Case{"data/rccar_room", SourceFormat::kImageFolder, 329},
-                        Case{"data/redkitchen", SourceFormat::kTum, 1000},
-                        Case{"data/kitti07", SourceFormat::kKitti, 160}}) {
+  for (const Case& c :
+       {Case{"data/rccar_room/images", SourceFormat::kImageFolder, 329},
+        Case{"data/rccar_room", SourceFormat::kImageFolder, 329}, Case{"data/redkitchen", SourceFormat::kTum, 1000},
+        Case{"data/kitti07", SourceFormat::kKitti, 160}}) {
     auto source = OpenFrameSource((shared / c.path).string());
     EXPECT_EQ(source->info().format, c.format) << c.path;
     EXPECT_EQ(source->info().expected_frames, c.frames) << c.path;

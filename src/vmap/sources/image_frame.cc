@@ -11,8 +11,9 @@ namespace vmap {
 Frame FrameFromImage(const cv::Mat& image, int index, const cv::Size& size, const std::string& what) {
   const int channels = image.channels();
   if (image.depth() != CV_8U || (channels != 1 && channels != 3 && channels != 4) || image.dims != 2) {
-    throw InputError(what + " must be an 8-bit image, grey (HxW) or BGR (HxWx3, as OpenCV reads it); convert it "
-                            "to uint8 first");
+    throw InputError(what +
+                     " must be an 8-bit image, grey (HxW) or BGR (HxWx3, as OpenCV reads it); convert it "
+                     "to uint8 first");
   }
   const std::string problem = FrameSizeProblem(image.size());
   if (!problem.empty()) {

@@ -1,8 +1,7 @@
 #include "vmap/sources/image_frame.h"
 
-#include <opencv2/imgproc.hpp>
-
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "vmap/core/error.h"
 

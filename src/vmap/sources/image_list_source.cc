@@ -65,8 +65,8 @@ class ImageListSource : public FrameSource {
       }
       const std::string size_problem = FrameSizeProblem(frame.gray.size(), options_);
       if (!size_problem.empty()) {
-        Skip(entry, "it is " + std::to_string(frame.gray.cols) + "x" + std::to_string(frame.gray.rows) + ", " +
-                        size_problem);
+        Skip(entry,
+             "it is " + std::to_string(frame.gray.cols) + "x" + std::to_string(frame.gray.rows) + ", " + size_problem);
         continue;
       }
       frame.index = delivered_++;

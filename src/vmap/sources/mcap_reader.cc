@@ -33,9 +33,15 @@ struct Channel {
 class Fields {
  public:
   Fields(const uint8_t* data, uint64_t size) : data_(data), size_(size) {}
-  bool U16(uint16_t* v) { return Fixed(2, [&](const uint8_t* b) { *v = LoadU16(b); }); }
-  bool U32(uint32_t* v) { return Fixed(4, [&](const uint8_t* b) { *v = LoadU32(b); }); }
-  bool U64(uint64_t* v) { return Fixed(8, [&](const uint8_t* b) { *v = LoadU64(b); }); }
+  bool U16(uint16_t* v) {
+    return Fixed(2, [&](const uint8_t* b) { *v = LoadU16(b); });
+  }
+  bool U32(uint32_t* v) {
+    return Fixed(4, [&](const uint8_t* b) { *v = LoadU32(b); });
+  }
+  bool U64(uint64_t* v) {
+    return Fixed(8, [&](const uint8_t* b) { *v = LoadU64(b); });
+  }
   bool String(std::string* v) {
     uint32_t length = 0;
     if (!U32(&length) || length > size_ - at_) return false;

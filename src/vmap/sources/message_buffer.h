@@ -26,8 +26,8 @@ class MessageBuffer {
   std::string String();
   // A uint8[] field: the bytes stay in the message (no copy); `*size` is their count.
   const uint8_t* Bytes(size_t* size);
-  std::vector<double> F64Array();                 // float64[]
-  void F64Fixed(double* values, size_t count);    // float64[N]
+  std::vector<double> F64Array();               // float64[]
+  void F64Fixed(double* values, size_t count);  // float64[N]
 
   size_t remaining() const { return size_ - position_; }
 

@@ -5,8 +5,11 @@
 namespace vmap {
 
 ReadAheadSource::ReadAheadSource(FrameSource& source, int frames)
-    : source_(source), info_(source.info()), skipped_(source.skipped_frames()),
-      queue_(static_cast<size_t>(std::max(1, frames))), reader_([this] { Read(); }) {}
+    : source_(source),
+      info_(source.info()),
+      skipped_(source.skipped_frames()),
+      queue_(static_cast<size_t>(std::max(1, frames))),
+      reader_([this] { Read(); }) {}
 
 ReadAheadSource::~ReadAheadSource() {
   queue_.Close();

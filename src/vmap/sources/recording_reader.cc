@@ -54,7 +54,8 @@ std::unique_ptr<RecordingReader> OpenRecording(const std::string& path) {
     const std::string mcap = McapInFolder(p);
     return mcap.empty() ? OpenRosbag2(path) : OpenMcap(mcap);
   }
-  throw InputError("'" + path + "' is not a recording vmap reads: give a ROS 1 .bag, a rosbag2 folder (metadata.yaml "
+  throw InputError("'" + path +
+                   "' is not a recording vmap reads: give a ROS 1 .bag, a rosbag2 folder (metadata.yaml "
                    "and .db3 or .db3.zstd files) or an .mcap file");
 }
 

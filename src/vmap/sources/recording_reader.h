@@ -20,7 +20,7 @@ enum class RecordingFormat { kRos1Bag, kRosbag2, kMcap };
 
 struct RecordingTopic {
   std::string name;
-  std::string type;        // as stored: "sensor_msgs/Image" (ROS 1) or "sensor_msgs/msg/Image" (ROS 2)
+  std::string type;  // as stored: "sensor_msgs/Image" (ROS 1) or "sensor_msgs/msg/Image" (ROS 2)
   long message_count = 0;
   int64_t first_time_ns = 0;  // log (receive) times of its first and last message
   int64_t last_time_ns = 0;
@@ -29,7 +29,7 @@ struct RecordingTopic {
 struct RecordedMessage {
   std::string topic;
   int64_t log_time_ns = 0;
-  uint64_t offset = 0;       // where the message (or its chunk) is in the file: for messages naming the damage
+  uint64_t offset = 0;  // where the message (or its chunk) is in the file: for messages naming the damage
   std::vector<uint8_t> data;
 };
 

@@ -156,8 +156,10 @@ std::optional<Camera> ReadCameraTopic(const std::string& path, const std::string
   if (!reader->Next({camera_topic}, &message)) return std::nullopt;
   const std::string what = MessageName(0, camera_topic, path);
   std::optional<Camera> camera = DecodeCameraInfo(message.data.data(), message.data.size(), reader->encoding(), what);
-  if (camera) camera->origin = path + " " + camera_topic;
-  else spdlog::warn("{} holds no calibration (K is zero); the frames have no camera", what);
+  if (camera)
+    camera->origin = path + " " + camera_topic;
+  else
+    spdlog::warn("{} holds no calibration (K is zero); the frames have no camera", what);
   return camera;
 }
 
@@ -177,14 +179,16 @@ std::string ChooseImageTopic(const std::vector<RecordingTopic>& topics, const st
   for (const RecordingTopic& topic : topics) {
     if (!IsImageType(topic.type)) continue;
     if (only) {
-      throw InputError(fmt::format("recording '{}' has several image topics; choose one with --topic:{}", path, images));
+      throw InputError(
+          fmt::format("recording '{}' has several image topics; choose one with --topic:{}", path, images));
     }
     only = &topic.name;
   }
   if (!only) {
-    throw InputError(fmt::format("recording '{}' has no image topic (sensor_msgs/Image or sensor_msgs/"
-                                 "CompressedImage); `vmap info {}` lists its topics",
-                                 path, path));
+    throw InputError(
+        fmt::format("recording '{}' has no image topic (sensor_msgs/Image or sensor_msgs/"
+                    "CompressedImage); `vmap info {}` lists its topics",
+                    path, path));
   }
   return *only;
 }
@@ -232,9 +236,8 @@ std::string FormatRecordingTopics(const std::string& path, const std::vector<Rec
   std::string text = fmt::format("recording {}\n{:<40} {:<32} {:>9} {:>9}  {}\n", path, "topic", "type", "messages",
                                  "rate Hz", "image");
   for (const RecordingTopicSummary& summary : topics) {
-    const std::string size = summary.image_size.area() > 0
-                                 ? fmt::format("{}x{}", summary.image_size.width, summary.image_size.height)
-                                 : "";
+    const std::string size =
+        summary.image_size.area() > 0 ? fmt::format("{}x{}", summary.image_size.width, summary.image_size.height) : "";
     text += fmt::format("{:<40} {:<32} {:>9} {:>9.2f}  {}\n", summary.topic.name, summary.topic.type,
                         summary.topic.message_count, summary.rate_hz, size);
   }
@@ -252,9 +255,10 @@ std::unique_ptr<FrameSource> OpenRecordingSource(const std::string& path, const 
     const std::string camera_topic = options.camera_topic.empty() ? CameraInfoTopicFor(name) : options.camera_topic;
     const RecordingTopic* info = FindTopic(topics, camera_topic);
     if (info && NormalizedTypeName(info->type) != kCameraInfoType) {
-      throw InputError(fmt::format("camera topic {} of recording '{}' is a {} topic, not sensor_msgs/CameraInfo; "
-                                   "name the right one with --camera-topic",
-                                   camera_topic, path, info->type));
+      throw InputError(
+          fmt::format("camera topic {} of recording '{}' is a {} topic, not sensor_msgs/CameraInfo; "
+                      "name the right one with --camera-topic",
+                      camera_topic, path, info->type));
     }
     if (!info && !options.camera_topic.empty()) {
       throw InputError(fmt::format("--camera-topic {} is not in recording '{}'; `vmap info {}` lists its topics",

@@ -1,11 +1,12 @@
 #include "vmap/sources/recording_source.h"
 
+#include <sqlite3.h>
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
 #include <gtest/gtest.h>
-#include <sqlite3.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -40,8 +41,8 @@ std::vector<TestMessage> Messages(MessageEncoding encoding) {
   std::vector<TestMessage> messages;
   int64_t time = 1'000'000'000;
   messages.push_back({"/cam/camera_info", "sensor_msgs/CameraInfo", time,
-                      testing::SerializeCameraInfo(encoding, Stamp(0), "cam", kSize, "plumb_bob",
-                                                   {-0.1, 0.01, 0, 0, 0}, {80, 0, 47.5, 0, 80, 31.5, 0, 0, 1})});
+                      testing::SerializeCameraInfo(encoding, Stamp(0), "cam", kSize, "plumb_bob", {-0.1, 0.01, 0, 0, 0},
+                                                   {80, 0, 47.5, 0, 80, 31.5, 0, 0, 1})});
   for (int stored = 0; stored < kFrames; ++stored) {
     const int i = stored ^ 1;
     time += 100'000'000;
@@ -60,13 +61,14 @@ struct Container {
   std::string name;         // for traces
   std::string compression;  // as the writer takes it
 };
-const Container kContainers[] = {{"bag", "none"},        {"bag", "bz2"},      {"bag", "lz4"},
-                                 {"rosbag2", ""},        {"rosbag2", "message"}, {"rosbag2", "file"},
-                                 {"mcap", ""},           {"mcap", "none"},    {"mcap", "zstd"}, {"mcap", "lz4"}};
+const Container kContainers[] = {{"bag", "none"},        {"bag", "bz2"},      {"bag", "lz4"}, {"rosbag2", ""},
+                                 {"rosbag2", "message"}, {"rosbag2", "file"}, {"mcap", ""},   {"mcap", "none"},
+                                 {"mcap", "zstd"},       {"mcap", "lz4"}};
 
 // Writes the recording; "" with the reason in *why when it cannot (ROS 1 bags need python3-rosbag).
 std::string Write(const fs::path& dir, const Container& container, std::string* why) {
-  const fs::path path = dir / (container.name + "_" + (container.compression.empty() ? "plain" : container.compression));
+  const fs::path path =
+      dir / (container.name + "_" + (container.compression.empty() ? "plain" : container.compression));
   if (container.name == "bag") {
     const std::string bag = path.string() + ".bag";
     return testing::WriteRos1Bag(bag, Messages(MessageEncoding::kRos1), container.compression, why) ? bag : "";
@@ -171,8 +173,8 @@ TEST(RecordingSource, TopicsAreListedAndChosen) {
   const std::string several = ErrorOf([&] { ReadAll(path, {}); });
   EXPECT_NE(several.find("--topic"), std::string::npos) << several;
   EXPECT_NE(several.find("/cam/image_raw (sensor_msgs/msg/Image, 12 messages)"), std::string::npos) << several;
-  EXPECT_NE(several.find("/cam/image_raw/compressed (sensor_msgs/msg/CompressedImage, 12 messages)"),
-            std::string::npos) << several;
+  EXPECT_NE(several.find("/cam/image_raw/compressed (sensor_msgs/msg/CompressedImage, 12 messages)"), std::string::npos)
+      << several;
   FrameSourceOptions imu;
   imu.topic = "/imu";
   EXPECT_NE(ErrorOf([&] { ReadAll(path, imu); }).find("not an image topic"), std::string::npos);
@@ -265,8 +267,10 @@ TEST(RecordingSource, CompressedRosbag2IsDecompressedOutOfTheWayAndDamageNamed) 
   } else {
     EXPECT_NE(error.find("message_0.db3"), std::string::npos) << error;
   }
-  if (old_tmpdir) setenv("TMPDIR", saved.c_str(), 1);
-  else unsetenv("TMPDIR");
+  if (old_tmpdir)
+    setenv("TMPDIR", saved.c_str(), 1);
+  else
+    unsetenv("TMPDIR");
 }
 
 }  // namespace

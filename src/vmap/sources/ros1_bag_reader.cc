@@ -82,7 +82,8 @@ class Ros1BagReader : public RecordingReader {
     if (file_.size() < kMagicSize) file_.Damaged(0, "it is not a ROS bag (too short)");
     file_.Read(0, kMagicSize, magic, "the bag's version line");
     if (std::string(reinterpret_cast<char*>(magic), kMagicSize) != kMagic) {
-      throw InputError("'" + path + "' is not a ROS 1 bag of format 2.0 (it does not start with '#ROSBAG V2.0'); "
+      throw InputError("'" + path +
+                       "' is not a ROS 1 bag of format 2.0 (it does not start with '#ROSBAG V2.0'); "
                        "migrate older bags with `rosbag fix`, or give a ROS 2 recording as its folder or .mcap file");
     }
     Rewind();
@@ -126,7 +127,8 @@ class Ros1BagReader : public RecordingReader {
       if (header_size > kMaxHeaderSize) return false;
       file_.Read(kMagicSize + 4, header_size, &header_bytes_, "the bag header");
       RecordHeader bag_header;
-      if (!bag_header.Parse(header_bytes_.data(), header_bytes_.size()).empty() || bag_header.op() != 0x03) return false;
+      if (!bag_header.Parse(header_bytes_.data(), header_bytes_.size()).empty() || bag_header.op() != 0x03)
+        return false;
       uint64_t position = bag_header.Number<uint64_t>("index_pos", 8);
       const uint32_t chunk_count = bag_header.Number<uint32_t>("chunk_count", 4);
       if (position <= kMagicSize || position >= file_.size()) return false;
@@ -172,7 +174,8 @@ class Ros1BagReader : public RecordingReader {
       for (const auto& [id, connection] : by_connection) {
         if (connection.name.empty()) return false;  // counted messages of a connection the index does not name
         RecordingTopic& topic = by_topic[connection.name];
-        if (topic.message_count == 0) topic = connection;
+        if (topic.message_count == 0)
+          topic = connection;
         else {
           topic.first_time_ns = std::min(topic.first_time_ns, connection.first_time_ns);
           topic.last_time_ns = std::max(topic.last_time_ns, connection.last_time_ns);
@@ -235,8 +238,8 @@ class Ros1BagReader : public RecordingReader {
       } else {
         file_.Read(data_offset, data_size, &compressed_, "a chunk");
         chunk_.resize(size);
-        const std::string failed = DecompressChunk(*compression, compressed_.data(), compressed_.size(),
-                                                   chunk_.data(), chunk_.size());
+        const std::string failed =
+            DecompressChunk(*compression, compressed_.data(), compressed_.size(), chunk_.data(), chunk_.size());
         if (!failed.empty()) {
           chunk_.clear();
           file_.Damaged(offset, "a chunk: " + failed);

@@ -14,7 +14,7 @@ namespace {
 
 double ReadHeaderStamp(MessageBuffer& buffer, MessageEncoding encoding) {
   if (encoding == MessageEncoding::kRos1) buffer.U32();  // seq: ROS 1 only
-  const uint32_t seconds = buffer.U32();                  // ROS 1 uint32, ROS 2 int32: both non-negative in practice
+  const uint32_t seconds = buffer.U32();                 // ROS 1 uint32, ROS 2 int32: both non-negative in practice
   const uint32_t nanoseconds = buffer.U32();
   buffer.String();  // frame_id
   const double sec = encoding == MessageEncoding::kCdr ? static_cast<double>(static_cast<int32_t>(seconds)) : seconds;
@@ -53,13 +53,20 @@ int BayerCode(const std::string& encoding) {
 DecodedImage ConvertRawImage(const RawImage& raw, const std::string& what) {
   int type = -1, code = -1;
   const std::string& e = raw.encoding;
-  if (e == "mono8" || e == "8UC1") type = CV_8UC1;
-  else if (e == "mono16" || e == "16UC1") type = CV_16UC1;
-  else if (e == "bgr8" || e == "8UC3") type = CV_8UC3;
-  else if (e == "rgb8") type = CV_8UC3, code = cv::COLOR_RGB2BGR;
-  else if (e == "bgra8" || e == "8UC4") type = CV_8UC4, code = cv::COLOR_BGRA2BGR;
-  else if (e == "rgba8") type = CV_8UC4, code = cv::COLOR_RGBA2BGR;
-  else if (BayerCode(e) >= 0) type = CV_8UC1, code = BayerCode(e);
+  if (e == "mono8" || e == "8UC1")
+    type = CV_8UC1;
+  else if (e == "mono16" || e == "16UC1")
+    type = CV_16UC1;
+  else if (e == "bgr8" || e == "8UC3")
+    type = CV_8UC3;
+  else if (e == "rgb8")
+    type = CV_8UC3, code = cv::COLOR_RGB2BGR;
+  else if (e == "bgra8" || e == "8UC4")
+    type = CV_8UC4, code = cv::COLOR_BGRA2BGR;
+  else if (e == "rgba8")
+    type = CV_8UC4, code = cv::COLOR_RGBA2BGR;
+  else if (BayerCode(e) >= 0)
+    type = CV_8UC1, code = BayerCode(e);
   if (type < 0) {
     throw InputError(what + " has image encoding '" + e +
                      "'; vmap reads mono8, mono16, rgb8, bgr8, rgba8, bgra8 and bayer_*8 (or a compressed topic)");
@@ -67,13 +74,13 @@ DecodedImage ConvertRawImage(const RawImage& raw, const std::string& what) {
   const size_t row_bytes = size_t{raw.width} * CV_ELEM_SIZE(type);
   if (raw.width == 0 || raw.height == 0 || raw.step < row_bytes ||
       raw.size / std::max<size_t>(raw.step, 1) < raw.height) {
-    throw InputError(what + " is malformed: " + std::to_string(raw.width) + "x" + std::to_string(raw.height) + " " +
-                     e + " with step " + std::to_string(raw.step) + " needs more than its " +
-                     std::to_string(raw.size) + " bytes of data");
+    throw InputError(what + " is malformed: " + std::to_string(raw.width) + "x" + std::to_string(raw.height) + " " + e +
+                     " with step " + std::to_string(raw.step) + " needs more than its " + std::to_string(raw.size) +
+                     " bytes of data");
   }
   // A view of the message's bytes: converted below into images of their own.
-  const cv::Mat view(static_cast<int>(raw.height), static_cast<int>(raw.width), type,
-                     const_cast<uint8_t*>(raw.data), raw.step);
+  const cv::Mat view(static_cast<int>(raw.height), static_cast<int>(raw.width), type, const_cast<uint8_t*>(raw.data),
+                     raw.step);
   DecodedImage image;
   if (type == CV_16UC1) {
     cv::Mat wide = view;
@@ -87,8 +94,10 @@ DecodedImage ConvertRawImage(const RawImage& raw, const std::string& what) {
   } else if (type == CV_8UC1 && code < 0) {
     image.gray = view.clone();
   } else {
-    if (code < 0) image.color = view.clone();
-    else cv::cvtColor(view, image.color, code);
+    if (code < 0)
+      image.color = view.clone();
+    else
+      cv::cvtColor(view, image.color, code);
     cv::cvtColor(image.color, image.gray, cv::COLOR_BGR2GRAY);
   }
   return image;
@@ -102,7 +111,7 @@ bool IsImageType(const std::string& type) {
 }
 
 DecodedImage DecodeImageMessage(const uint8_t* data, size_t size, const std::string& type, MessageEncoding encoding,
-                                 const std::string& what) {
+                                const std::string& what) {
   MessageBuffer buffer(data, size, encoding, what);
   const double stamp = ReadHeaderStamp(buffer, encoding);
   DecodedImage image;
@@ -182,7 +191,8 @@ std::optional<Camera> DecodeCameraInfo(const uint8_t* data, size_t size, Message
       throw InputError(what + ": plumb_bob distortion has " + std::to_string(d.size()) + " coefficients, not 5");
     }
   } else {
-    throw InputError(what + ": distortion model '" + model + "' is none of plumb_bob, rational_polynomial and "
+    throw InputError(what + ": distortion model '" + model +
+                     "' is none of plumb_bob, rational_polynomial and "
                      "equidistant; give --camera with rectified intrinsics, or --camera none");
   }
   while (!d.empty() && d.back() == 0.0) d.pop_back();

@@ -30,7 +30,7 @@ struct DecodedImage {
 // `what` (e.g. "message 12 of /cam/image_raw in 'run.bag'") when the message is malformed or its encoding
 // is not one vmap reads.
 DecodedImage DecodeImageMessage(const uint8_t* data, size_t size, const std::string& type, MessageEncoding encoding,
-                                 const std::string& what);
+                                const std::string& what);
 
 // The size of the image a message holds, from its fields (raw) or its image header (compressed).
 cv::Size ImageMessageSize(const uint8_t* data, size_t size, const std::string& type, MessageEncoding encoding,

@@ -43,8 +43,8 @@ TEST(RosImageMessages, ColourEncodingsGiveTheSameBgrImageAndStamp) {
   cv::cvtColor(bgr, rgba, cv::COLOR_BGR2RGBA);
   cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
   for (MessageEncoding encoding : kEncodings) {
-    for (const auto& [name, pixels] : {std::pair<const char*, cv::Mat>{"bgr8", bgr}, {"rgb8", rgb}, {"bgra8", bgra},
-                                       {"rgba8", rgba}}) {
+    for (const auto& [name, pixels] :
+         {std::pair<const char*, cv::Mat>{"bgr8", bgr}, {"rgb8", rgb}, {"bgra8", bgra}, {"rgba8", rgba}}) {
       SCOPED_TRACE(name);
       // frame_id lengths that leave CDR's uint32 fields unaligned unless padded, and rows with padding.
       const DecodedImage image =
@@ -75,11 +75,11 @@ TEST(RosImageMessages, MonoEncodings) {
 // red and blue, which differ by over 100 here).
 TEST(RosImageMessages, BayerPatternsDemosaicToTheImage) {
   const cv::Mat bgr = TestImage();
-  const std::map<std::string, std::array<int, 4>> patterns = {  // channel (B 0, G 1, R 2) at (0,0) (0,1) (1,0) (1,1)
-      {"bayer_rggb8", {2, 1, 1, 0}},
-      {"bayer_bggr8", {0, 1, 1, 2}},
-      {"bayer_gbrg8", {1, 0, 2, 1}},
-      {"bayer_grbg8", {1, 2, 0, 1}}};
+  const std::map<std::string, std::array<int, 4>> patterns = {// channel (B 0, G 1, R 2) at (0,0) (0,1) (1,0) (1,1)
+                                                              {"bayer_rggb8", {2, 1, 1, 0}},
+                                                              {"bayer_bggr8", {0, 1, 1, 2}},
+                                                              {"bayer_gbrg8", {1, 0, 2, 1}},
+                                                              {"bayer_grbg8", {1, 2, 0, 1}}};
   for (const auto& [name, channels] : patterns) {
     SCOPED_TRACE(name);
     cv::Mat mosaic(bgr.size(), CV_8UC1);
@@ -143,9 +143,8 @@ TEST(RosImageMessages, CameraInfoModels) {
   for (MessageEncoding encoding : kEncodings) {
     const auto decode = [&](const std::string& model, const std::vector<double>& d, const cv::Matx33d& matrix) {
       // "cam" leaves the float64 fields needing CDR padding; "camera_frame" another amount.
-      const std::vector<uint8_t> data =
-          testing::SerializeCameraInfo(encoding, 2.0, model.size() % 2 ? "cam" : "camera_frame", {640, 480}, model,
-                                       d, matrix);
+      const std::vector<uint8_t> data = testing::SerializeCameraInfo(
+          encoding, 2.0, model.size() % 2 ? "cam" : "camera_frame", {640, 480}, model, d, matrix);
       return DecodeCameraInfo(data.data(), data.size(), encoding, "camera info");
     };
     const std::optional<Camera> plumb_bob = decode("plumb_bob", {-0.2, 0.05, 0.001, -0.002, 0.01}, k);

@@ -9,7 +9,6 @@
 // as long as the reader.
 
 #include <sqlite3.h>
-
 #include <stdlib.h>
 
 #include <algorithm>
@@ -52,7 +51,8 @@ std::vector<std::string> DatabaseFiles(const std::string& path) {
   }
   std::sort(files.begin(), files.end(), NaturalLess);
   if (files.empty()) {
-    throw InputError("rosbag2 folder '" + path + "' has no .db3 or .db3.zstd file; vmap reads rosbag2's sqlite3 "
+    throw InputError("rosbag2 folder '" + path +
+                     "' has no .db3 or .db3.zstd file; vmap reads rosbag2's sqlite3 "
                      "storage and MCAP (give the .mcap file itself)");
   }
   return files;
@@ -97,7 +97,8 @@ class Rosbag2SqliteReader : public RecordingReader {
         }
         topic.name = name;
         topic.type = Text(counts.get(), 1);
-        if (count > 0) topic.last_time_ns = std::max<int64_t>(topic.last_time_ns, sqlite3_column_int64(counts.get(), 5));
+        if (count > 0)
+          topic.last_time_ns = std::max<int64_t>(topic.last_time_ns, sqlite3_column_int64(counts.get(), 5));
         topic.message_count += count;
       }
       if (status != SQLITE_DONE) Fail(db.get(), file, "cannot count its messages");
@@ -112,8 +113,9 @@ class Rosbag2SqliteReader : public RecordingReader {
       if (!statement_) {
         if (file_index_ >= files_.size()) return false;
         database_ = Open(files_[file_index_]);
-        std::string query = "SELECT t.name, m.timestamp, m.data, m.id FROM messages m JOIN topics t ON "
-                            "m.topic_id = t.id";
+        std::string query =
+            "SELECT t.name, m.timestamp, m.data, m.id FROM messages m JOIN topics t ON "
+            "m.topic_id = t.id";
         if (!topics.empty()) {
           query += " WHERE t.name IN (";
           for (size_t i = 0; i < topics.size(); ++i) query += i ? ",?" : "?";
@@ -159,8 +161,8 @@ class Rosbag2SqliteReader : public RecordingReader {
   }
 
   [[noreturn]] static void Fail(sqlite3* db, const std::string& file, const std::string& what) {
-    throw InputError("rosbag2 database '" + file + "': " + what + " (sqlite: " + (db ? sqlite3_errmsg(db) : "no memory") +
-                     "); check that it is a complete rosbag2 sqlite3 file");
+    throw InputError("rosbag2 database '" + file + "': " + what + " (sqlite: " +
+                     (db ? sqlite3_errmsg(db) : "no memory") + "); check that it is a complete rosbag2 sqlite3 file");
   }
 
   // The database `file` as sqlite can open it: itself, or its decompressed copy, made on first use.
@@ -171,7 +173,8 @@ class Rosbag2SqliteReader : public RecordingReader {
     if (decompressed_dir_.empty()) {
       std::string pattern = (fs::temp_directory_path() / "vmap-rosbag2-XXXXXX").string();
       if (mkdtemp(pattern.data()) == nullptr) {
-        throw InputError("rosbag2 database '" + file + "': cannot make a temporary folder to decompress it into; "
+        throw InputError("rosbag2 database '" + file +
+                         "': cannot make a temporary folder to decompress it into; "
                          "set TMPDIR to a writable folder");
       }
       decompressed_dir_ = pattern;
@@ -209,7 +212,7 @@ class Rosbag2SqliteReader : public RecordingReader {
   size_t file_index_ = 0;
   Database database_;
   Statement statement_;
-  std::string decompressed_dir_;                      // the decompressed copies of .db3.zstd files, if any
+  std::string decompressed_dir_;                     // the decompressed copies of .db3.zstd files, if any
   std::map<std::string, std::string> decompressed_;  // file -> its copy
 };
 

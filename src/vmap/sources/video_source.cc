@@ -3,8 +3,8 @@
 // Why not cv::VideoCapture: OpenCV 4.6 always decodes with one thread per core, and vmap already keeps
 // every core busy with feature extraction and verification. Decoding on one thread costs about 10 % less
 // CPU per frame (lab_floor.mp4: 2.6 against 2.9 ms, BGR and grey included), and frames skipped by
-// --first/--stride are never converted to BGR. The BGR conversion is the one OpenCV makes (swscale, bicubic), so the frames are
-// pixel-identical to cv::VideoCapture's.
+// --first/--stride are never converted to BGR. The BGR conversion is the one OpenCV makes (swscale, bicubic), so the
+// frames are pixel-identical to cv::VideoCapture's.
 
 extern "C" {
 #include <libavcodec/avcodec.h>
@@ -52,8 +52,7 @@ class VideoSource : public FrameSource {
  public:
   // `live`: a network stream (IsLiveInput): no frame count, waits bounded by options.stream_timeout_seconds
   // and interruptible through options.stop_requested.
-  VideoSource(const std::string& path, const FrameSourceOptions& options, bool live)
-      : options_(options), live_(live) {
+  VideoSource(const std::string& path, const FrameSourceOptions& options, bool live) : options_(options), live_(live) {
     info_.path = path;
     info_.format = SourceFormat::kVideo;
     // FFmpeg's own log is the host's to set: InitializeRuntime() (core/runtime.h) silences it for vmap.
@@ -110,9 +109,10 @@ class VideoSource : public FrameSource {
  private:
   [[noreturn]] void CannotOpen(const std::string& path) const {
     if (live_) {
-      throw InputError(fmt::format("cannot open stream '{}': no video FFmpeg can decode arrived within {:g} s; check "
-                                   "that the sender is running and the URL (scheme, address, port)",
-                                   path, options_.stream_timeout_seconds));
+      throw InputError(
+          fmt::format("cannot open stream '{}': no video FFmpeg can decode arrived within {:g} s; check "
+                      "that the sender is running and the URL (scheme, address, port)",
+                      path, options_.stream_timeout_seconds));
     }
     throw InputError("cannot open video '" + path +
                      "': it is not a video FFmpeg can decode, or it is truncated or corrupt; check the file "
@@ -146,9 +146,10 @@ class VideoSource : public FrameSource {
     if (parameters->width <= 0 || parameters->height <= 0) CannotOpen(path);
     const std::string size_problem = FrameSizeProblem(cv::Size(parameters->width, parameters->height), options_);
     if (!size_problem.empty()) {
-      throw InputError(fmt::format("video '{}' has frames of {}x{}, {}; scale it first (e.g. ffmpeg -i IN -vf "
-                                   "scale=1280:-2 OUT.mp4)",
-                                   path, parameters->width, parameters->height, size_problem));
+      throw InputError(
+          fmt::format("video '{}' has frames of {}x{}, {}; scale it first (e.g. ffmpeg -i IN -vf "
+                      "scale=1280:-2 OUT.mp4)",
+                      path, parameters->width, parameters->height, size_problem));
     }
     codec_.reset(avcodec_alloc_context3(codec));
     if (!codec_ || avcodec_parameters_to_context(codec_.get(), parameters) < 0) CannotOpen(path);
@@ -205,7 +206,8 @@ class VideoSource : public FrameSource {
     if (!matrix) return 0;
     // The display matrix's sign conventions are easy to get backwards: this reading turns pictures as
     // cv::VideoCapture does, which a test checks for 90, 180 and 270 degrees.
-    const int degrees = static_cast<int>(std::lround(av_display_rotation_get(reinterpret_cast<const int32_t*>(matrix))));
+    const int degrees =
+        static_cast<int>(std::lround(av_display_rotation_get(reinterpret_cast<const int32_t*>(matrix))));
     return ((degrees % 360) + 360) % 360;
   }
 
@@ -232,9 +234,10 @@ class VideoSource : public FrameSource {
 
   std::optional<Frame> Finish() {
     if (delivered_ == 0 && live_) {
-      throw InputError(fmt::format("stream '{}' ended before its first frame could be decoded; check that the "
-                                   "sender sends video, and that key frames come often enough (e.g. ffmpeg -g 10)",
-                                   info_.path));
+      throw InputError(
+          fmt::format("stream '{}' ended before its first frame could be decoded; check that the "
+                      "sender sends video, and that key frames come often enough (e.g. ffmpeg -g 10)",
+                      info_.path));
     }
     if (delivered_ == 0) {
       throw InputError("video '" + info_.path +

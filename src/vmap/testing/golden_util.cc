@@ -98,7 +98,7 @@ void PickleProgram::Tensor(const torch::Tensor& t, const std::string& record) {
   Op('(');
   for (auto d : t.strides()) Int(d);
   Op('t');
-  Op('\x89');  // requires_grad False
+  Op('\x89');                            // requires_grad False
   Global("collections", "OrderedDict");  // backward hooks
   Op(')');
   Op('R');

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
 #include <caffe2/serialize/inline_container.h>
+#include <nlohmann/json.hpp>
 #include <torch/torch.h>
 
 #include "vmap/neural/state_dict.h"
@@ -69,11 +69,11 @@ using vmap::testing::SharedDir;
 }  // namespace vmap::neural::testing
 
 // Asserts shapes match and every element is within atol + rtol * |expected|.
-#define EXPECT_TENSOR_NEAR(actual, expected, atol, rtol)                                                   \
-  do {                                                                                                     \
-    auto _a = (actual).detach().to(torch::kCPU).to(torch::kFloat64);                                      \
-    auto _e = (expected).detach().to(torch::kCPU).to(torch::kFloat64);                                    \
-    ASSERT_EQ(_a.sizes(), _e.sizes()) << #actual;                                                         \
-    EXPECT_LE(::vmap::neural::testing::ExcessOverTolerance(_a, _e, atol, rtol), 0.0)                      \
+#define EXPECT_TENSOR_NEAR(actual, expected, atol, rtol)                                                     \
+  do {                                                                                                       \
+    auto _a = (actual).detach().to(torch::kCPU).to(torch::kFloat64);                                         \
+    auto _e = (expected).detach().to(torch::kCPU).to(torch::kFloat64);                                       \
+    ASSERT_EQ(_a.sizes(), _e.sizes()) << #actual;                                                            \
+    EXPECT_LE(::vmap::neural::testing::ExcessOverTolerance(_a, _e, atol, rtol), 0.0)                         \
         << #actual << " vs " << #expected << ": max |diff| " << ::vmap::neural::testing::MaxAbsDiff(_a, _e); \
   } while (0)

@@ -4,16 +4,16 @@
 #include <sqlite3.h>
 #include <zstd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <algorithm>
 #include <map>
-#include <set>
 #include <memory>
+#include <set>
 #include <stdexcept>
 
 #include "vmap/testing/run_vmap.h"
@@ -272,8 +272,7 @@ void WriteMcap(const std::string& path, const std::vector<TestMessage>& messages
 }
 
 namespace {
-void WriteRosbag2Database(const std::string& file, const std::vector<TestMessage>& messages,
-                          bool compress_messages) {
+void WriteRosbag2Database(const std::string& file, const std::vector<TestMessage>& messages, bool compress_messages) {
   sqlite3* db = nullptr;
   Check(sqlite3_open(file.c_str(), &db), db, "open");
   const std::unique_ptr<sqlite3, decltype(&sqlite3_close)> closer(db, &sqlite3_close);
@@ -298,9 +297,9 @@ void WriteRosbag2Database(const std::string& file, const std::vector<TestMessage
     sqlite3_finalize(insert);
   }
   sqlite3_stmt* insert = nullptr;
-  Check(sqlite3_prepare_v2(db, "INSERT INTO messages (topic_id, timestamp, data) VALUES (?, ?, ?)", -1, &insert,
-                           nullptr),
-        db, "message");
+  Check(
+      sqlite3_prepare_v2(db, "INSERT INTO messages (topic_id, timestamp, data) VALUES (?, ?, ?)", -1, &insert, nullptr),
+      db, "message");
   for (const TestMessage& message : messages) {
     sqlite3_bind_int(insert, 1, topics[message.topic]);
     sqlite3_bind_int64(insert, 2, message.log_time_ns);
@@ -319,8 +318,7 @@ void WriteRosbag2Database(const std::string& file, const std::vector<TestMessage
 }
 }  // namespace
 
-void WriteRosbag2(const std::string& folder, const std::vector<TestMessage>& messages,
-                  const std::string& compression) {
+void WriteRosbag2(const std::string& folder, const std::vector<TestMessage>& messages, const std::string& compression) {
   if (compression != "" && compression != "message" && compression != "file") {
     throw std::invalid_argument("WriteRosbag2: compression " + compression);
   }
@@ -328,9 +326,12 @@ void WriteRosbag2(const std::string& folder, const std::vector<TestMessage>& mes
   const std::string name = fs::path(folder).filename().string();
   std::ofstream(fs::path(folder) / "metadata.yaml")
       << "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: sqlite3\n  relative_file_paths:\n    - "
-      << name << (compression == "file" ? "_0.db3.zstd" : "_0.db3") << "\n  compression_format: "
-      << (compression.empty() ? "\"\"" : "zstd") << "\n  compression_mode: "
-      << (compression.empty() ? "\"\"" : compression == "file" ? "FILE" : "MESSAGE") << "\n";
+      << name << (compression == "file" ? "_0.db3.zstd" : "_0.db3")
+      << "\n  compression_format: " << (compression.empty() ? "\"\"" : "zstd") << "\n  compression_mode: "
+      << (compression.empty()     ? "\"\""
+          : compression == "file" ? "FILE"
+                                  : "MESSAGE")
+      << "\n";
   const std::string file = (fs::path(folder) / (name + "_0.db3")).string();
   WriteRosbag2Database(file, messages, compression == "message");
   if (compression == "file") {
@@ -342,7 +343,6 @@ void WriteRosbag2(const std::string& folder, const std::vector<TestMessage>& mes
     fs::remove(file);
   }
 }
-
 
 bool WriteRos1Bag(const std::string& path, const std::vector<TestMessage>& messages, const std::string& compression,
                   std::string* why) {

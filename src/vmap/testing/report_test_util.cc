@@ -47,7 +47,8 @@ VisualMap WriteSyntheticMap(const fs::path& directory, const SyntheticMapOptions
   map.input.format = SourceFormat::kImageFolder;
   map.input.native_size = map.input.frame_size = options.frame_size;
   map.options_json = R"({"matcher":{"name":"orb","features":2000},"verifier":{"method":"magsac","threshold":0.5},)"
-                     R"("tau":)" + std::to_string(options.tau) + R"(,"quality_mean":"arithmetic"})";
+                     R"("tau":)" +
+                     std::to_string(options.tau) + R"(,"quality_mean":"arithmetic"})";
   map.num_frames = options.num_frames;
   map.seconds = 1.5;
 
@@ -76,7 +77,8 @@ VisualMap WriteSyntheticMap(const fs::path& directory, const SyntheticMapOptions
     const float shift = static_cast<float>(kShiftPerFrame * (key_frames[i + 1] - key_frames[i]));
     const int verified = 30 + 5 * static_cast<int>(i), rejected = 12;
     for (int v = 0; v < verified; ++v) {
-      const cv::Point2f p0(rng.uniform(shift, options.frame_size.width - 1.0f), rng.uniform(0.0f, options.frame_size.height - 1.0f));
+      const cv::Point2f p0(rng.uniform(shift, options.frame_size.width - 1.0f),
+                           rng.uniform(0.0f, options.frame_size.height - 1.0f));
       l.correspondences.push_back({p0, p0 - cv::Point2f(shift, 0.0f)});
     }
     for (int r = 0; r < rejected; ++r) {

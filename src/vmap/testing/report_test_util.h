@@ -9,7 +9,6 @@
 
 #include <opencv2/core.hpp>
 
-
 #include "vmap/map/visual_map.h"
 #include "vmap/testing/scoped_temp_dir.h"  // ReadText
 

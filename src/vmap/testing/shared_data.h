@@ -18,6 +18,5 @@ std::string NoSharedDataMessage();
 }  // namespace vmap::testing
 
 // First in a test that needs the shared data.
-#define SKIP_WITHOUT_SHARED()                  \
-  if (!::vmap::testing::SharedDataPresent()) \
-  GTEST_SKIP() << ::vmap::testing::NoSharedDataMessage()
+#define SKIP_WITHOUT_SHARED() \
+  if (!::vmap::testing::SharedDataPresent()) GTEST_SKIP() << ::vmap::testing::NoSharedDataMessage()

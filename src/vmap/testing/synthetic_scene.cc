@@ -50,9 +50,9 @@ SyntheticSequence RenderSyntheticSequence(const SyntheticOptions& options) {
   std::vector<Plane> planes;
   // A far wall, a floor-like slanted plane and boxes at several depths: a scene F can be estimated from.
   planes.push_back(FrontoParallel(-12, 16, -6, 6, 12.0, cv::Size(1400, 600), rng));
-  planes.push_back({{cv::Vec3d(-8, 1.2, 2.0), cv::Vec3d(12, 1.2, 2.0), cv::Vec3d(12, 3.0, 12.0),
-                     cv::Vec3d(-8, 3.0, 12.0)},
-                    RandomTexture(cv::Size(1000, 500), rng)});
+  planes.push_back(
+      {{cv::Vec3d(-8, 1.2, 2.0), cv::Vec3d(12, 1.2, 2.0), cv::Vec3d(12, 3.0, 12.0), cv::Vec3d(-8, 3.0, 12.0)},
+       RandomTexture(cv::Size(1000, 500), rng)});
   for (int i = 0; i < 7; ++i) {
     const double x = -3.0 + 2.2 * i, z = 4.0 + 1.3 * (i % 3);
     planes.push_back(FrontoParallel(x, x + 1.2, -1.5 + 0.3 * (i % 2), 0.6, z, cv::Size(240, 240), rng));

@@ -32,8 +32,10 @@ TEST(AlikedCli, MatchFindsTheReferenceMatchCount) {
   const TempDir dir("match");
   const auto json_path = dir.path() / "m.json";
   // Default weights: found in the shared data folder; upstream's pair settings.
-  const auto r = RunVmap("match " + pair + "/input0.png " + pair + "/input1.png --matcher aliked --aliked-top-k 1000 "
-                         "--aliked-min-similarity 0.75 --json " + json_path.string());
+  const auto r = RunVmap("match " + pair + "/input0.png " + pair +
+                         "/input1.png --matcher aliked --aliked-top-k 1000 "
+                         "--aliked-min-similarity 0.75 --json " +
+                         json_path.string());
   ASSERT_EQ(r.status, 0) << r.output;
   const auto j = ReadJson(json_path);
   EXPECT_NEAR(j["num_tentative"].get<int>(), meta["counts"]["mnn0p75"].get<int>(), 3);
@@ -120,7 +122,8 @@ TEST(AlikedCli, SecondLocalizeStartReadsTheKeyImagesFromTheCache) {
   SKIP_WITHOUT_SHARED();
   const TempDir dir("cache");
   const std::string input = SharedDir() + "/data/rccar_room/images";
-  const auto r = RunVmap("build " + input + " --last 8 --tau 0.6 --matcher aliked -q -o " + (dir.path() / "map").string());
+  const auto r =
+      RunVmap("build " + input + " --last 8 --tau 0.6 --matcher aliked -q -o " + (dir.path() / "map").string());
   ASSERT_EQ(r.status, 0) << r.output;
   ::vmap::testing::ExpectSecondLocalizeReadsTheCache(dir.path() / "map", input, "--last 8");
 }

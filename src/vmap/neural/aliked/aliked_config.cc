@@ -21,8 +21,7 @@ void AddConv(std::vector<TensorSpec>& specs, const std::string& prefix, int64_t 
 
 // A 3x3 convolution without bias, plain or deformable (offsets predicted by a 3x3 convolution with bias:
 // 2 x 9 channels, one (dy, dx) per kernel tap).
-void AddBlockConv(std::vector<TensorSpec>& specs, const std::string& prefix, int64_t out, int64_t in,
-                  bool deformable) {
+void AddBlockConv(std::vector<TensorSpec>& specs, const std::string& prefix, int64_t out, int64_t in, bool deformable) {
   if (deformable) {
     AddConv(specs, prefix + ".offset_conv", 2 * 3 * 3, in, 3, true);
     AddConv(specs, prefix + ".regular_conv", out, in, 3, false);

@@ -10,7 +10,7 @@
 namespace vmap::neural {
 
 struct AlikedConfig {
-  std::string name;  // "t16" or "n16"
+  std::string name;                    // "t16" or "n16"
   int c1 = 0, c2 = 0, c3 = 0, c4 = 0;  // widths of blocks 1-4 (full, 1/2, 1/8 and 1/32 resolution)
   int dim = 0;                         // descriptor width; the aggregated feature map has dim channels
   int kernel = 3;                      // SDDH: patch size at the keypoint that predicts the sampling offsets

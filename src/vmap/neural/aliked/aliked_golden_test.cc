@@ -174,8 +174,7 @@ TEST_P(AlikedGolden, DkdOnTheReferenceScoreMapIsExact) {
     DkdOptions threshold_mode = GoldenDkd();
     threshold_mode.top_k = -1;
     const auto thresholded = DetectKeypoints(score_map, threshold_mode);
-    EXPECT_EQ(thresholded.keypoints.size(0),
-              meta_["robustness"]["image" + s]["n_threshold_mode"].get<int64_t>());
+    EXPECT_EQ(thresholded.keypoints.size(0), meta_["robustness"]["image" + s]["n_threshold_mode"].get<int64_t>());
     EXPECT_GT(thresholded.scores.min().item<float>(), 0.0f);
   }
 }
@@ -262,7 +261,7 @@ TEST(AlikedDkd, CpuNmsEqualsTheTensorFormulation) {
   for (const auto& size : {std::pair{37, 53}, std::pair{4, 3}, std::pair{1, 9}, std::pair{120, 160}}) {
     for (double levels : {4.0, 16.0, 1e6}) {
       const auto map = (torch::rand({1, 1, size.first, size.second}) * levels).floor() / levels;
-      const auto cpu = SimpleNms(map, 2);                                   // float: the loop
+      const auto cpu = SimpleNms(map, 2);                                                // float: the loop
       const auto reference = SimpleNms(map.to(torch::kFloat64), 2).to(torch::kFloat32);  // max_pool2d
       EXPECT_TRUE(torch::equal(cpu, reference)) << size.first << "x" << size.second << " levels " << levels;
     }

@@ -57,7 +57,8 @@ class AlikedMatcher : public Matcher {
     const int longest = std::max(gray.cols, gray.rows);
     if (options_.longest_side > 0 && longest > options_.longest_side) {
       const double scale = double(options_.longest_side) / double(longest);
-      const cv::Size size(std::max(1, int(std::lround(gray.cols * scale))), std::max(1, int(std::lround(gray.rows * scale))));
+      const cv::Size size(std::max(1, int(std::lround(gray.cols * scale))),
+                          std::max(1, int(std::lround(gray.rows * scale))));
       cv::resize(gray, net_image, size, 0, 0, cv::INTER_AREA);
     }
     if (!net_image.isContinuous()) net_image = net_image.clone();
@@ -94,8 +95,8 @@ class AlikedMatcher : public Matcher {
     const auto* f1 = dynamic_cast<const AlikedFeatures*>(&features1);
     if (!f0 || !f1) throw std::invalid_argument("AlikedMatcher::Match: features from another matcher");
     TentativeMatches matches;
-    for (const auto& m : MatchFloatDescriptors(f0->descriptors(), f1->descriptors(),
-                                               static_cast<float>(options_.min_similarity))) {
+    for (const auto& m :
+         MatchFloatDescriptors(f0->descriptors(), f1->descriptors(), static_cast<float>(options_.min_similarity))) {
       matches.points0.push_back(f0->keypoints()[m.query]);
       matches.points1.push_back(f1->keypoints()[m.train]);
       matches.scores.push_back(m.similarity);
@@ -129,8 +130,7 @@ class AlikedMatcher : public Matcher {
   std::shared_ptr<const ImageFeatures> DeserializeFeatures(std::string_view bytes) const override {
     std::optional<PointFeatureRows> read = DecodePointFeatures(kFeaturesTag, bytes);
     if (!read) return nullptr;
-    return std::make_shared<AlikedFeatures>(std::move(read->keypoints), std::move(read->descriptors),
-                                            read->image_size);
+    return std::make_shared<AlikedFeatures>(std::move(read->keypoints), std::move(read->descriptors), read->image_size);
   }
 
  private:

@@ -1,6 +1,8 @@
 // The ALIKED matcher through the Matcher interface: reference keypoints and matches, coordinates, options and
 // bad input.
 
+#include "vmap/neural/aliked/aliked_matcher.h"
+
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -9,7 +11,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/core/error.h"
-#include "vmap/neural/aliked/aliked_matcher.h"
 #include "vmap/testing/golden_util.h"
 
 namespace vmap {
@@ -51,7 +52,8 @@ size_t CommonCount(const std::set<std::array<long, 4>>& a, const std::set<std::a
 // the reference's matches, as coordinates.
 TEST(AlikedMatcher, ReproducesTheReferenceMatchesThroughTheInterface) {
   SKIP_WITHOUT_SHARED();
-  for (const auto& [model, pair] : {std::pair{"t16", "rccar_000000_000006"}, std::pair{"n16", "kitti07_000010_000014"}}) {
+  for (const auto& [model, pair] :
+       {std::pair{"t16", "rccar_000000_000006"}, std::pair{"n16", "kitti07_000010_000014"}}) {
     const std::string dir = PairDir(model, pair);
     const auto g = LoadTensorDict(dir + "/golden.pt");
     auto options = Options(model);

@@ -108,7 +108,9 @@ torch::Tensor SimpleNmsCpu(const torch::Tensor& scores, int radius) {
 torch::Tensor SimpleNms(const torch::Tensor& scores, int radius) {
   if (scores.device().is_cpu() && scores.scalar_type() == torch::kFloat32) return SimpleNmsCpu(scores, radius);
   const int64_t window = 2 * radius + 1;
-  auto max_pool = [&](const torch::Tensor& x) { return torch::max_pool2d(x, {window, window}, {1, 1}, {radius, radius}); };
+  auto max_pool = [&](const torch::Tensor& x) {
+    return torch::max_pool2d(x, {window, window}, {1, 1}, {radius, radius});
+  };
   auto zeros = torch::zeros_like(scores);
   auto max_mask = scores == max_pool(scores);
   for (int round = 0; round < 2; ++round) {
@@ -249,12 +251,12 @@ AlikedModel::AlikedModel(AlikedConfig config, const StateDict& weights, torch::D
   weights_["score_head.0.weight"] = head0.to(device_).contiguous();
   // SDDH as matrix products: the offset convolution on a K x K patch is one (2M, dim*K*K) matrix.
   const int64_t offsets = 2 * config_.num_samples;
-  weights_["desc_head.offset_conv.0.matrix"] = get("desc_head.offset_conv.0.weight").reshape({offsets, -1})
-                                                   .t().to(device_).contiguous();
-  weights_["desc_head.offset_conv.2.matrix"] = get("desc_head.offset_conv.2.weight").reshape({offsets, offsets})
-                                                   .t().to(device_).contiguous();
-  weights_["desc_head.sf_conv.matrix"] = get("desc_head.sf_conv.weight").reshape({config_.dim, config_.dim})
-                                             .t().to(device_).contiguous();
+  weights_["desc_head.offset_conv.0.matrix"] =
+      get("desc_head.offset_conv.0.weight").reshape({offsets, -1}).t().to(device_).contiguous();
+  weights_["desc_head.offset_conv.2.matrix"] =
+      get("desc_head.offset_conv.2.weight").reshape({offsets, offsets}).t().to(device_).contiguous();
+  weights_["desc_head.sf_conv.matrix"] =
+      get("desc_head.sf_conv.weight").reshape({config_.dim, config_.dim}).t().to(device_).contiguous();
   weights_["desc_head.agg_matrix"] = get("desc_head.agg_weights").reshape({-1, config_.dim}).to(device_).contiguous();
 }
 
@@ -274,8 +276,7 @@ torch::Tensor AlikedModel::BlockConv(const torch::Tensor& x, const std::string& 
   // Offsets are clamped to a quarter of the map's larger side, as upstream.
   const double max_offset = double(std::max(x.size(2), x.size(3))) / 4.0;
   auto offset = Conv(x, name + ".offset_conv", 1).clamp_(-max_offset, max_offset);
-  return DeformConv2d(x, offset, W(name + ".regular_conv.weight"), W(name + ".regular_conv.bias"), torch::Tensor(),
-                      1);
+  return DeformConv2d(x, offset, W(name + ".regular_conv.weight"), W(name + ".regular_conv.bias"), torch::Tensor(), 1);
 }
 
 torch::Tensor AlikedModel::Block(const torch::Tensor& x, const std::string& name, bool deformable,
@@ -316,8 +317,9 @@ AlikedDenseMaps AlikedModel::ExtractDenseMaps(const torch::Tensor& image_in) con
   x[3] = Block(torch::avg_pool2d(x[2], 4, 4), "block4", true, true);
   for (int k = 0; k < 4; ++k) {
     // Channels-last: each pixel's dim/4 features are one contiguous row, which FeaturesAt gathers.
-    maps.level[k] = torch::selu(Conv(x[k].contiguous(torch::MemoryFormat::ChannelsLast), "conv" + std::to_string(k + 1), 0))
-                        .contiguous(torch::MemoryFormat::ChannelsLast);
+    maps.level[k] =
+        torch::selu(Conv(x[k].contiguous(torch::MemoryFormat::ChannelsLast), "conv" + std::to_string(k + 1), 0))
+            .contiguous(torch::MemoryFormat::ChannelsLast);
   }
 
   // The score head starts with a 1x1 convolution of the upsampled concatenation. Upsampling is linear per
@@ -405,14 +407,19 @@ AlikedDescriptors AlikedModel::Describe(const AlikedDenseMaps& maps, const torch
   auto tap = torch::arange(kernel, long_options);
   auto patch_rows = (corner.select(1, 1).view({-1, 1, 1}) + tap.view({1, -1, 1})).expand({n, kernel, kernel});
   auto patch_cols = (corner.select(1, 0).view({-1, 1, 1}) + tap.view({1, 1, -1})).expand({n, kernel, kernel});
-  auto patch_inside = (patch_rows >= 0).logical_and(patch_rows < height).logical_and(patch_cols >= 0)
-                          .logical_and(patch_cols < width).reshape({-1, 1});
-  auto patch = FeaturesAt(maps, patch_rows.clamp(0, height - 1).reshape({-1}), patch_cols.clamp(0, width - 1).reshape({-1}));
-  patch = patch.mul_(patch_inside.to(torch::kFloat32));                 // (n*K*K, dim)
+  auto patch_inside = (patch_rows >= 0)
+                          .logical_and(patch_rows < height)
+                          .logical_and(patch_cols >= 0)
+                          .logical_and(patch_cols < width)
+                          .reshape({-1, 1});
+  auto patch =
+      FeaturesAt(maps, patch_rows.clamp(0, height - 1).reshape({-1}), patch_cols.clamp(0, width - 1).reshape({-1}));
+  patch = patch.mul_(patch_inside.to(torch::kFloat32));  // (n*K*K, dim)
   patch = patch.view({n, kernel * kernel, dim}).transpose(1, 2).reshape({n, dim * kernel * kernel});
 
   // Offsets: conv KxK (no padding) -> selu -> conv 1x1, on the patch, clamped as upstream.
-  auto offsets = torch::selu(torch::addmm(W("desc_head.offset_conv.0.bias"), patch, W("desc_head.offset_conv.0.matrix")));
+  auto offsets =
+      torch::selu(torch::addmm(W("desc_head.offset_conv.0.bias"), patch, W("desc_head.offset_conv.0.matrix")));
   offsets = torch::addmm(W("desc_head.offset_conv.2.bias"), offsets, W("desc_head.offset_conv.2.matrix"));
   const double max_offset = double(std::max(height, width)) / 4.0;
   offsets = offsets.clamp_(-max_offset, max_offset).view({n, 2, samples}).transpose(1, 2);  // (n, M, 2) as (x, y)

@@ -14,8 +14,8 @@ namespace vmap::neural {
 
 // Upstream's DKD ("differentiable keypoint detection"), inference part.
 struct DkdOptions {
-  int radius = 2;              // NMS window 2r+1, border of r pixels without keypoints, soft-argmax window
-  int top_k = 1000;            // > 0: the top_k highest NMS peaks, in descending score order
+  int radius = 2;                // NMS window 2r+1, border of r pixels without keypoints, soft-argmax window
+  int top_k = 1000;              // > 0: the top_k highest NMS peaks, in descending score order
   double score_threshold = 0.2;  // top_k <= 0: NMS peaks above this (0: above the mean score), row-major order
   int max_keypoints = 5000;      // top_k <= 0: at most this many, the highest scores (upstream's n_limit)
   double temperature = 0.1;      // soft-argmax temperature
@@ -46,8 +46,8 @@ struct AlikedDenseMaps {
   // padded size. The feature map is the L2-normalised concatenation of their bilinear (align_corners)
   // upsamplings to the padded size.
   torch::Tensor level[4];
-  int64_t height = 0, width = 0;        // image size (without padding)
-  int64_t pad_top = 0, pad_left = 0;    // replicate padding added before the network
+  int64_t height = 0, width = 0;      // image size (without padding)
+  int64_t pad_top = 0, pad_left = 0;  // replicate padding added before the network
   int64_t padded_height = 0, padded_width = 0;
 };
 

@@ -35,9 +35,9 @@ void AlikedMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
                 weights);
   visitor.Visit({"device", "--device", "Deep matchers' device: cpu or cuda"}, device);
   visitor.Visit({"top_k", "--aliked-top-k", "ALIKED: keypoints per image (0 = score threshold mode)"}, top_k);
-  visitor.Visit({"score_threshold", "--aliked-score-threshold",
-                 "ALIKED: keypoint score threshold when --aliked-top-k is 0"},
-                score_threshold);
+  visitor.Visit(
+      {"score_threshold", "--aliked-score-threshold", "ALIKED: keypoint score threshold when --aliked-top-k is 0"},
+      score_threshold);
   visitor.Visit({"max_keypoints", "--aliked-max-keypoints", "ALIKED: most keypoints when --aliked-top-k is 0"},
                 max_keypoints);
   visitor.Visit({"min_similarity", "--aliked-min-similarity", "ALIKED: least cosine similarity of a match"},

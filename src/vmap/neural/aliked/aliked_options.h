@@ -10,7 +10,7 @@ namespace vmap {
 
 struct AlikedMatcherOptions {
   static constexpr const char* kModelName = "aliked";  // --matcher aliked (features/matcher_registry.h)
-  std::string model = "t16";   // "t16" (ALIKED-T16) or "n16" (ALIKED-N16)
+  std::string model = "t16";                           // "t16" (ALIKED-T16) or "n16" (ALIKED-N16)
   std::string weights;         // file; empty searches the weights directories (see `vmap weights`)
   std::string device = "cpu";  // "cpu" or "cuda"
   // Keypoints per image: the top_k highest DKD scores. 0 switches to upstream's threshold mode: every NMS
@@ -30,9 +30,9 @@ struct AlikedMatcherOptions {
   // one worker per core, where more threads per call only oversubscribe the cores.
   int num_threads = 1;
 
-  void Check() const;  // throws OptionError naming the bad field
+  void Check() const;                             // throws OptionError naming the bad field
   void VisitFields(OptionFieldVisitor& visitor);  // JSON keys and command-line flags
-  void AfterReading();  // after reading a map: older maps name the model aliked-t16
+  void AfterReading();                            // after reading a map: older maps name the model aliked-t16
 };
 
 }  // namespace vmap

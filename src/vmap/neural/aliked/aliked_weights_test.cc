@@ -1,5 +1,7 @@
 // ALIKED weights: the architecture's key set against the shared files, upstream's OrderedDict layout, and bad files.
 
+#include "vmap/neural/aliked/aliked_weights.h"
+
 #include <fstream>
 
 #include <caffe2/serialize/inline_container.h>
@@ -7,7 +9,6 @@
 #include <torch/serialize.h>
 
 #include "vmap/core/error.h"
-#include "vmap/neural/aliked/aliked_weights.h"
 #include "vmap/testing/golden_util.h"
 
 namespace vmap::neural {
@@ -94,7 +95,7 @@ TEST(AlikedWeights, MissingUnexpectedAndChangedKeysAreReported) {
   const std::string path = WeightsPath("t16");
   auto weights = ReadAlikedStateDict(path);
   weights.erase("desc_head.agg_weights");
-  weights["desc_head.convM.weight"] = torch::zeros({64, 1024, 1, 1});  // the conv2D variant of SDDH
+  weights["desc_head.convM.weight"] = torch::zeros({64, 1024, 1, 1});         // the conv2D variant of SDDH
   weights["block3.conv1.offset_conv.weight"] = torch::zeros({27, 16, 3, 3});  // a modulated (DCNv2) offset conv
   const std::string message = ExpectInputError([&] { CheckAlikedStateDict(weights, AlikedPreset("t16"), path); });
   EXPECT_NE(message.find("missing keys (1):\n    desc_head.agg_weights"), std::string::npos) << message;

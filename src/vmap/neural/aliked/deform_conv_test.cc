@@ -1,10 +1,10 @@
 // DeformConv2d against a direct, one-sample-at-a-time evaluation of torchvision's definition.
 
+#include "vmap/neural/aliked/deform_conv.h"
+
 #include <cmath>
 
 #include <gtest/gtest.h>
-
-#include "vmap/neural/aliked/deform_conv.h"
 
 namespace vmap::neural {
 namespace {
@@ -77,7 +77,7 @@ TEST_F(DeformConvTest, IntegerOffsetsShiftTheInput) {
   auto input = torch::randn({1, 3, 8, 8});
   auto weight = torch::randn({2, 3, 3, 3});
   auto offset = torch::zeros({1, 18, 8, 8});
-  offset.select(1, 0).fill_(2.0);   // tap 0 reads two rows lower
+  offset.select(1, 0).fill_(2.0);    // tap 0 reads two rows lower
   offset.select(1, 17).fill_(-1.0);  // tap 8 reads one column to the left
   auto ours = DeformConv2d(input, offset, weight, torch::Tensor(), torch::Tensor(), 1);
   EXPECT_TRUE(torch::allclose(ours, Reference(input, offset, weight, torch::Tensor(), torch::Tensor(), 1), 1e-5, 1e-5));

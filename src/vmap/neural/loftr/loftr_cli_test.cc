@@ -26,7 +26,7 @@ TEST(VmapMatch, WritesReferenceMatchesAndVerification) {
   const fs::path& dir = scoped.path();
   const std::string json_path = (dir / "m.json").string();
   const auto r = RunVmap("match " + pair + "/input0.png " + pair + "/input1.png --matcher loftr --weights " +
-                     SharedDir() + "/weights/loftr_coarse/loftr_coarse_teacher.pt --json " + json_path);
+                         SharedDir() + "/weights/loftr_coarse/loftr_coarse_teacher.pt --json " + json_path);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("tentative   86"), std::string::npos) << r.output;
   std::ifstream file(json_path);
@@ -52,7 +52,7 @@ TEST(VmapMatch, BadInputExitsWithStatus2) {
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("/nonexistent.png"), std::string::npos) << r.output;
   r = RunVmap("match " + pair + "/input0.png " + pair + "/input1.png --matcher loftr --loftr-model outdoor --weights " +
-          SharedDir() + "/weights/loftr_coarse/loftr_coarse_teacher.pt");
+              SharedDir() + "/weights/loftr_coarse/loftr_coarse_teacher.pt");
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("--loftr-model coarse"), std::string::npos) << r.output;
 }

@@ -104,8 +104,8 @@ std::vector<TensorSpec> ExpectedStateDict(const LoftrConfig& config) {
   // Top-down path, deepest level first, as the modules are registered upstream.
   const int deepest = static_cast<int>(dims.size());
   const int finest = config.backbone == BackboneKind::kResNetFpn8_2 ? 1 : 2;
-  AddConv(specs, "backbone.layer" + std::to_string(deepest) + "_outconv.weight", dims[deepest - 1],
-          dims[deepest - 1], 1);
+  AddConv(specs, "backbone.layer" + std::to_string(deepest) + "_outconv.weight", dims[deepest - 1], dims[deepest - 1],
+          1);
   for (int level = deepest - 1; level >= finest; --level) {
     AddFpnMerge(specs, "layer" + std::to_string(level), dims[level - 1], dims[level], dims[level - 1]);
   }

@@ -54,5 +54,4 @@ const std::vector<std::string>& LoftrPresetNames();
 // Every tensor the configured network needs, in the order PyTorch's module registration lists them.
 std::vector<TensorSpec> ExpectedStateDict(const LoftrConfig& config);
 
-
 }  // namespace vmap::neural

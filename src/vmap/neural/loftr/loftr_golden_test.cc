@@ -6,9 +6,9 @@
 
 #include <gtest/gtest.h>
 
-#include "vmap/testing/golden_util.h"
 #include "vmap/neural/loftr/loftr_model.h"
 #include "vmap/neural/loftr/loftr_weights.h"
+#include "vmap/testing/golden_util.h"
 
 namespace vmap::neural {
 namespace {
@@ -34,8 +34,8 @@ torch::Tensor ReferenceConf(const torch::Tensor& feat0, const torch::Tensor& fea
 
 void ExpectSameMatches(const LoftrPairOutput& out, const TensorMap& g, const std::string& suffix, double conf_atol) {
   ASSERT_TRUE(g.count("i_ids" + suffix)) << suffix;
-  EXPECT_TRUE(torch::equal(out.i_ids.cpu(), g.at("i_ids" + suffix))) << "i_ids" << suffix << ": " << out.i_ids.size(0)
-                                                                      << " vs " << g.at("i_ids" + suffix).size(0);
+  EXPECT_TRUE(torch::equal(out.i_ids.cpu(), g.at("i_ids" + suffix)))
+      << "i_ids" << suffix << ": " << out.i_ids.size(0) << " vs " << g.at("i_ids" + suffix).size(0);
   EXPECT_TRUE(torch::equal(out.j_ids.cpu(), g.at("j_ids" + suffix))) << "j_ids" << suffix;
   if (out.i_ids.size(0) != g.at("i_ids" + suffix).size(0)) return;
   EXPECT_TENSOR_NEAR(out.mconf, g.at("mconf" + suffix), conf_atol, 0.0);
@@ -99,8 +99,8 @@ INSTANTIATE_TEST_SUITE_P(AllPairs, CoarseStudentGolden,
 // ---------------------------------------------------------------- full outdoor architecture, random weights
 
 // Rows where the argmax differs are accepted only when the two candidates tie within `atol` in our matrix.
-void ExpectArgmaxConsistent(const torch::Tensor& conf, const torch::Tensor& ours, const torch::Tensor& theirs,
-                            int dim, double atol) {
+void ExpectArgmaxConsistent(const torch::Tensor& conf, const torch::Tensor& ours, const torch::Tensor& theirs, int dim,
+                            double atol) {
   auto differ = ours.cpu().ne(theirs.cpu().flatten()).nonzero().flatten();
   for (int64_t k = 0; k < differ.size(0); ++k) {
     const int64_t idx = differ[k].item<int64_t>();
@@ -130,10 +130,10 @@ void RunFullGolden(const std::string& dir, const std::string& bn_override, bool 
     EXPECT_TENSOR_NEAR(f1.coarse_backbone, g.at("feat_c1_backbone"), kFeatureAtol, kFp16Rtol + kFeatureRtol);
     using torch::indexing::None;
     using torch::indexing::Slice;
-    EXPECT_TENSOR_NEAR(f0.fine.index({Slice(), Slice(0, None, 32)}), g.at("feat_f0_backbone_ch_step32"),
-                       kFeatureAtol, kFeatureRtol);
-    EXPECT_TENSOR_NEAR(f1.fine.index({Slice(), Slice(0, None, 32)}), g.at("feat_f1_backbone_ch_step32"),
-                       kFeatureAtol, kFeatureRtol);
+    EXPECT_TENSOR_NEAR(f0.fine.index({Slice(), Slice(0, None, 32)}), g.at("feat_f0_backbone_ch_step32"), kFeatureAtol,
+                       kFeatureRtol);
+    EXPECT_TENSOR_NEAR(f1.fine.index({Slice(), Slice(0, None, 32)}), g.at("feat_f1_backbone_ch_step32"), kFeatureAtol,
+                       kFeatureRtol);
     const int64_t first_rows = g.at("feat_c0_pe_first2rows").size(1);
     EXPECT_TENSOR_NEAR(f0.coarse.index({Slice(), Slice(0, first_rows)}), g.at("feat_c0_pe_first2rows"), kFeatureAtol,
                        kFeatureRtol);
@@ -203,7 +203,8 @@ TEST(LoftrBorderRemoval, DropsExactlyTheBorderBand) {
     return y < b || y >= h - b || x < b || x >= w - b;
   };
   std::set<std::pair<int64_t, int64_t>> kept;
-  for (int64_t k = 0; k < inner.i_ids.size(0); ++k) kept.insert({inner.i_ids[k].item<int64_t>(), inner.j_ids[k].item<int64_t>()});
+  for (int64_t k = 0; k < inner.i_ids.size(0); ++k)
+    kept.insert({inner.i_ids[k].item<int64_t>(), inner.j_ids[k].item<int64_t>()});
   size_t outside_band = 0;
   for (int64_t k = 0; k < all.i_ids.size(0); ++k) {
     const int64_t i = all.i_ids[k].item<int64_t>(), j = all.j_ids[k].item<int64_t>();

@@ -132,9 +132,11 @@ class LoftrMatcher : public Matcher {
     if (width < stride || height < stride) {
       // Found while matching, outside any check of the options: named as MatcherOptions holds them.
       throw OptionError(std::string(LoftrMatcherOptions::kModelName) + ".longest_side",
-                        std::to_string(options_.longest_side) + " gives less than one LoFTR coarse cell for an image "
-                        "of " + std::to_string(original.width) + "x" + std::to_string(original.height) +
-                        "; raise it or crop the image");
+                        std::to_string(options_.longest_side) +
+                            " gives less than one LoFTR coarse cell for an image "
+                            "of " +
+                            std::to_string(original.width) + "x" + std::to_string(original.height) +
+                            "; raise it or crop the image");
     }
     return {width, height};
   }

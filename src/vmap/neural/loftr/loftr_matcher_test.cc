@@ -1,6 +1,8 @@
 // LoFTR behind the Matcher interface: coordinates in the original image, the key-image reuse path, and
 // bad input (too small, no CUDA, no matches).
 
+#include "vmap/neural/loftr/loftr_matcher.h"
+
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -11,7 +13,6 @@
 #include "vmap/core/error.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/testing/golden_util.h"
-#include "vmap/neural/loftr/loftr_matcher.h"
 
 namespace vmap {
 namespace {
@@ -127,7 +128,7 @@ TEST(LoftrMatcher, NoMatchesIsAnEmptyResultNotACrash) {
 TEST(LoftrMatcher, BadInputGivesInputErrors) {
   SKIP_WITHOUT_SHARED();
   auto matcher = CreateLoftrMatcher(CoarseOptions());
-  EXPECT_THROW(matcher->Extract(cv::Mat(12, 200, CV_8UC1, cv::Scalar(0))), InputError);  // < one 16 px cell
+  EXPECT_THROW(matcher->Extract(cv::Mat(12, 200, CV_8UC1, cv::Scalar(0))), InputError);   // < one 16 px cell
   EXPECT_THROW(matcher->Extract(cv::Mat(20, 5000, CV_8UC1, cv::Scalar(0))), InputError);  // rounds to 0 rows
   EXPECT_THROW(matcher->Extract(cv::Mat(64, 64, CV_8UC3, cv::Scalar(0))), InputError);
   LoftrMatcherOptions wrong = CoarseOptions();

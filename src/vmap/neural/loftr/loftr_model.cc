@@ -29,9 +29,9 @@ torch::Tensor LinearAttention(const torch::Tensor& q, const torch::Tensor& k, co
   auto K = PositiveFeatureMap(k).permute({0, 2, 1, 3});  // (N, H, S, D)
   // Dividing V by the length before the product (and multiplying back after) keeps K^T V in float range
   // for long sequences, as the reference does; the result is unchanged up to rounding.
-  auto V = (v / length).permute({0, 2, 1, 3});            // (N, H, S, D)
-  auto kv = torch::matmul(K.transpose(2, 3), V);          // (N, H, D, D)
-  auto k_sum = K.sum(2).unsqueeze(-1);                    // (N, H, D, 1)
+  auto V = (v / length).permute({0, 2, 1, 3});                        // (N, H, S, D)
+  auto kv = torch::matmul(K.transpose(2, 3), V);                      // (N, H, D, D)
+  auto k_sum = K.sum(2).unsqueeze(-1);                                // (N, H, D, 1)
   auto normaliser = torch::matmul(Q, k_sum).add_(eps).reciprocal_();  // (N, H, L, 1)
   auto out = torch::matmul(Q, kv).mul_(normaliser).mul_(length);      // (N, H, L, D)
   return out.permute({0, 2, 1, 3});
@@ -62,8 +62,8 @@ torch::Tensor LoftrModel::BatchNorm(const torch::Tensor& x, const std::string& b
                            /*training=*/false, /*momentum=*/0.0, kBatchNormEps, /*cudnn_enabled=*/true);
 }
 
-torch::Tensor LoftrModel::ConvBn(const torch::Tensor& x, const std::string& conv, const std::string& bn,
-                                 int64_t stride, int64_t padding) const {
+torch::Tensor LoftrModel::ConvBn(const torch::Tensor& x, const std::string& conv, const std::string& bn, int64_t stride,
+                                 int64_t padding) const {
   return BatchNorm(torch::conv2d(x, W(conv), {}, stride, padding), bn);
 }
 
@@ -118,7 +118,10 @@ LoftrImageFeatures LoftrModel::Extract(const torch::Tensor& image_in) const {
     const int64_t s = stage == 0 ? 1 : 2;
     auto x = ResidualBlock(levels.back(), p + ".0", s != 1 || in_dim != dims[stage], s);
     x = ResidualBlock(x, p + ".1", false, 1);
-    if (stage == 0) levels.back() = x; else levels.push_back(x);
+    if (stage == 0)
+      levels.back() = x;
+    else
+      levels.push_back(x);
     in_dim = dims[stage];
   }
   // levels: [layer1 (1/2), layer2 (1/4), layer3 (1/8), (layer4 (1/16))]
@@ -274,14 +277,14 @@ void LoftrModel::FineStage(const LoftrImageFeatures& image0, const LoftrImageFea
   out.fine1 = fine1;
 
   // Where image 0's window centre lands in image 1's window: the expectation of a softmax heatmap.
-  auto centre = fine0.select(1, ww / 2);                                             // (M, C)
-  auto sim = torch::matmul(fine1, centre.unsqueeze(2)).squeeze(2);                   // (M, ww)
+  auto centre = fine0.select(1, ww / 2);                            // (M, C)
+  auto sim = torch::matmul(fine1, centre.unsqueeze(2)).squeeze(2);  // (M, ww)
   auto heatmap = torch::softmax(sim * (1.0 / std::sqrt(static_cast<double>(channels))), 1);
   auto axis = torch::linspace(-1.0, 1.0, window, float_opts);
-  auto grid_x = axis.repeat({window});                                  // column-fastest, x = column
+  auto grid_x = axis.repeat({window});  // column-fastest, x = column
   auto grid_y = axis.repeat_interleave(window);
-  auto grid = torch::stack({grid_x, grid_y}, 1);                        // (ww, 2)
-  auto coords = torch::matmul(heatmap, grid);                           // (M, 2)
+  auto grid = torch::stack({grid_x, grid_y}, 1);  // (ww, 2)
+  auto coords = torch::matmul(heatmap, grid);     // (M, 2)
   auto variance = torch::matmul(heatmap, grid * grid) - coords * coords;
   auto spread = variance.clamp_min(1e-10).sqrt().sum(1, true);
   out.expec_f = torch::cat({coords, spread}, 1);

@@ -25,9 +25,9 @@ struct LoftrPairOutput {
   torch::Tensor feat_c0, feat_c1;  // (1, L, C) after the coarse transformer
   torch::Tensor conf;              // (1, L0, L1) dual-softmax confidence (only when keep_conf is set)
   torch::Tensor row_max, row_argmax, col_max, col_argmax;  // (L0) and (L1) over the whole matrix
-  torch::Tensor i_ids, j_ids;      // (M) int64 flat coarse indices, i ascending
-  torch::Tensor mconf;             // (M)
-  torch::Tensor mkpts0_c, mkpts1_c;  // (M, 2) network-input pixels, top-left corner of the coarse cell
+  torch::Tensor i_ids, j_ids;                              // (M) int64 flat coarse indices, i ascending
+  torch::Tensor mconf;                                     // (M)
+  torch::Tensor mkpts0_c, mkpts1_c;    // (M, 2) network-input pixels, top-left corner of the coarse cell
   torch::Tensor fine_pre0, fine_pre1;  // (M, ww, Cf) fine windows before the fine transformer
   torch::Tensor fine0, fine1;          // (M, ww, Cf) after it
   torch::Tensor expec_f;               // (M, 3) x, y in [-1, 1] over the window and the spread
@@ -63,8 +63,8 @@ class LoftrModel {
                               int64_t stride) const;
   torch::Tensor EncoderLayer(const torch::Tensor& x, const torch::Tensor& source, const std::string& prefix,
                              int64_t nhead, double norm_eps) const;
-  void Transformer(torch::Tensor& feat0, torch::Tensor& feat1, const std::string& prefix, int num_pairs,
-                   int64_t nhead, double norm_eps) const;
+  void Transformer(torch::Tensor& feat0, torch::Tensor& feat1, const std::string& prefix, int num_pairs, int64_t nhead,
+                   double norm_eps) const;
   void FineStage(const LoftrImageFeatures& image0, const LoftrImageFeatures& image1, LoftrPairOutput& out) const;
 
   LoftrConfig config_;

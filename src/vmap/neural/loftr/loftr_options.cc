@@ -33,8 +33,7 @@ void LoftrMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"longest_side", "--loftr-size", "LoFTR: longest image side fed to the network"}, longest_side);
   visitor.Visit({"threshold", "--loftr-threshold", "LoFTR: coarse confidence threshold (default: preset's)", false},
                 threshold);
-  visitor.Visit({"threads", "--loftr-threads", "LoFTR: LibTorch threads per call (0 = LibTorch default)"},
-                num_threads);
+  visitor.Visit({"threads", "--loftr-threads", "LoFTR: LibTorch threads per call (0 = LibTorch default)"}, num_threads);
 }
 
 }  // namespace vmap

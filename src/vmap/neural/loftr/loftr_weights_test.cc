@@ -1,15 +1,16 @@
 // Weights: the architecture's key set against the official one, the file layouts users have, and bad files.
 
+#include "vmap/neural/loftr/loftr_weights.h"
+
 #include <fstream>
 #include <sstream>
 
-#include <gtest/gtest.h>
 #include <caffe2/serialize/inline_container.h>
+#include <gtest/gtest.h>
 #include <torch/serialize.h>
 
 #include "vmap/core/error.h"
 #include "vmap/testing/golden_util.h"
-#include "vmap/neural/loftr/loftr_weights.h"
 
 namespace vmap::neural {
 namespace {
@@ -139,8 +140,8 @@ TEST(LoftrWeights, WrongPresetListsKeysAndNamesTheRightOne) {
   EXPECT_NE(message.find("missing keys"), std::string::npos) << message;
   EXPECT_NE(message.find("loftr_coarse.layers.4.q_proj.weight"), std::string::npos) << message;  // missing
   EXPECT_NE(message.find("backbone.layer3_outconv2.0.weight"), std::string::npos) << message;    // unexpected
-  EXPECT_NE(message.find("backbone.conv1.weight (file float32 8x1x7x7, expected float32 128x1x7x7)"),
-            std::string::npos) << message;
+  EXPECT_NE(message.find("backbone.conv1.weight (file float32 8x1x7x7, expected float32 128x1x7x7)"), std::string::npos)
+      << message;
   EXPECT_NE(message.find("--loftr-model coarse"), std::string::npos) << message;
 }
 

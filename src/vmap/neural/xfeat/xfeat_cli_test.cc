@@ -103,7 +103,8 @@ TEST(VmapXfeat, WeightsKnowsXfeatAndItsLayouts) {
   EXPECT_NE(r.output.find((cache.path() / "xfeat.pt").string()), std::string::npos) << r.output;
   // A LoFTR file is no XFeat file.
   r = RunVmap("weights --import " + SharedDir() + "/weights/loftr_coarse/loftr_coarse_teacher.pt --model xfeat " +
-              "--no-verify", env);
+                  "--no-verify",
+              env);
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("fits no XFeat layout"), std::string::npos) << r.output;
 }

@@ -11,9 +11,9 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "vmap/features/float_matcher.h"
-#include "vmap/testing/golden_util.h"
 #include "vmap/neural/xfeat/xfeat_model.h"
 #include "vmap/neural/xfeat/xfeat_weights.h"
+#include "vmap/testing/golden_util.h"
 
 namespace vmap::neural {
 namespace {
@@ -118,8 +118,8 @@ TEST_P(XfeatGolden, EveryStageMatchesTheReference) {
     ASSERT_EQ(d.net_width, size[1].get<int64_t>());
     if (g.count("x_net_crop_tl" + s)) {  // resized input (KITTI): corners of the bilinear resize
       EXPECT_TENSOR_NEAR(d.net_input.slice(2, 0, 32).slice(3, 0, 128), g.at("x_net_crop_tl" + s), 1e-6, 0.0);
-      EXPECT_TENSOR_NEAR(d.net_input.slice(2, d.net_height - 32).slice(3, d.net_width - 128),
-                         g.at("x_net_crop_br" + s), 1e-6, 0.0);
+      EXPECT_TENSOR_NEAR(d.net_input.slice(2, d.net_height - 32).slice(3, d.net_width - 128), g.at("x_net_crop_br" + s),
+                         1e-6, 0.0);
     }
 
     // Network outputs: full maps, and the exact float32 crops where the full map is stored as float16.

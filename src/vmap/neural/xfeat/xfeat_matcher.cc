@@ -18,7 +18,7 @@ namespace vmap {
 
 namespace {
 
-constexpr int kMinimumSide = 32;  // the network input is the image cut down to multiples of 32
+constexpr int kMinimumSide = 32;                       // the network input is the image cut down to multiples of 32
 constexpr std::string_view kFeaturesTag = "vmapXFT1";  // the localization cache's record of XFeat features
 
 class XfeatFeatures : public ImageFeatures {
@@ -27,8 +27,8 @@ class XfeatFeatures : public ImageFeatures {
       : keypoints_(std::move(keypoints)), descriptors_(std::move(descriptors)), image_size_(image_size) {
     if (descriptors_.is_cpu()) {
       // A header over the tensor's memory: the float matcher reads it without a copy.
-      descriptor_rows_ = cv::Mat(static_cast<int>(descriptors_.size(0)), static_cast<int>(descriptors_.size(1)),
-                                 CV_32F, descriptors_.data_ptr<float>());
+      descriptor_rows_ = cv::Mat(static_cast<int>(descriptors_.size(0)), static_cast<int>(descriptors_.size(1)), CV_32F,
+                                 descriptors_.data_ptr<float>());
     }
   }
   int num_features() const override { return static_cast<int>(keypoints_.size()); }
@@ -93,7 +93,8 @@ class XfeatMatcher : public Matcher {
       return matches;
     }
     torch::InferenceMode guard;
-    const auto [pairs, similarity] = neural::XfeatMatch(f0->descriptor_tensor(), f1->descriptor_tensor(), options_.min_similarity);
+    const auto [pairs, similarity] =
+        neural::XfeatMatch(f0->descriptor_tensor(), f1->descriptor_tensor(), options_.min_similarity);
     const auto pairs_cpu = pairs.to(torch::kCPU).contiguous();
     const auto similarity_cpu = similarity.to(torch::kCPU).contiguous();
     const int64_t* index = pairs_cpu.data_ptr<int64_t>();
@@ -124,11 +125,10 @@ class XfeatMatcher : public Matcher {
     std::optional<PointFeatureRows> read = DecodePointFeatures(kFeaturesTag, bytes);
     if (!read) return nullptr;
     const int64_t dimensions = read->descriptors.empty() ? 64 : read->descriptors.cols;
-    torch::Tensor rows = read->descriptors.empty()
-                             ? torch::zeros({0, dimensions}, torch::kFloat32)
-                             : torch::from_blob(read->descriptors.data, {read->descriptors.rows, dimensions},
-                                                torch::kFloat32)
-                                   .clone();
+    torch::Tensor rows =
+        read->descriptors.empty()
+            ? torch::zeros({0, dimensions}, torch::kFloat32)
+            : torch::from_blob(read->descriptors.data, {read->descriptors.rows, dimensions}, torch::kFloat32).clone();
     return std::make_shared<XfeatFeatures>(std::move(read->keypoints), rows.to(model_.device()), read->image_size);
   }
 

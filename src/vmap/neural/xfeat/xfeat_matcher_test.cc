@@ -1,6 +1,8 @@
 // XFeat behind the Matcher interface: the reference through Extract/Match on grey images, coordinates in
 // the image given, options recorded, concurrent use, and bad input.
 
+#include "vmap/neural/xfeat/xfeat_matcher.h"
+
 #include <array>
 #include <map>
 #include <set>
@@ -15,7 +17,6 @@
 #include "vmap/features/matcher_registry.h"
 #include "vmap/mapping/pair_match.h"
 #include "vmap/testing/golden_util.h"
-#include "vmap/neural/xfeat/xfeat_matcher.h"
 
 namespace vmap {
 namespace {
@@ -60,8 +61,8 @@ TEST(XfeatMatcher, ReproducesTheReferenceThroughTheInterface) {
   ASSERT_EQ(matches.scores.size(), matches.size());
   size_t common = 0;
   for (size_t k = 0; k < matches.size(); ++k) {
-    const auto it = reference.find({matches.points0[k].x, matches.points0[k].y, matches.points1[k].x,
-                                    matches.points1[k].y});
+    const auto it =
+        reference.find({matches.points0[k].x, matches.points0[k].y, matches.points1[k].x, matches.points1[k].y});
     if (it == reference.end()) continue;
     ++common;
     EXPECT_NEAR(matches.scores[k], it->second, 2e-5);
@@ -103,8 +104,8 @@ TEST(XfeatMatcher, ColourImagesGiveTheReferencesMatches) {
     const TentativeMatches& matches = result.matches;
     size_t common = 0;
     for (size_t k = 0; k < matches.size(); ++k) {
-      common += reference.count({matches.points0[k].x, matches.points0[k].y, matches.points1[k].x,
-                                 matches.points1[k].y});
+      common +=
+          reference.count({matches.points0[k].x, matches.points0[k].y, matches.points1[k].x, matches.points1[k].y});
     }
     EXPECT_GE(common + 2, reference.size()) << common << " of the reference's " << reference.size() << " matches";
     EXPECT_LE(matches.size(), common + 2) << matches.size() << " matches";

@@ -60,7 +60,7 @@ torch::Tensor LocalMaximaOnCpu(const torch::Tensor& heatmap, double threshold) {
 // LibTorch's bicubic convolution coefficients (A = -0.75) for a fractional position t.
 std::array<float, 4> CubicCoefficients(float t) {
   constexpr float A = -0.75f;
-  auto near = [&](float x) { return ((A + 2) * x - (A + 3)) * x * x + 1; };   // |x| <= 1
+  auto near = [&](float x) { return ((A + 2) * x - (A + 3)) * x * x + 1; };       // |x| <= 1
   auto far = [&](float x) { return ((A * x - 5 * A) * x + 8 * A) * x - 4 * A; };  // 1 < |x| < 2
   return {far(t + 1.0f), near(t), near(1.0f - t), far(1.0f - t + 1.0f)};
 }
@@ -120,22 +120,20 @@ torch::Tensor SampleDescriptorsOnCpu(const torch::Tensor& map, const torch::Tens
 
 const std::vector<XfeatConv>& XfeatConvolutions() {
   static const std::vector<XfeatConv> convs{
-      {"skip1.1", 24, 1, 1, 1, false},
-      {"block1.0", 4, 1, 3, 1, true},         {"block1.1", 8, 4, 3, 2, true},
-      {"block1.2", 8, 8, 3, 1, true},         {"block1.3", 24, 8, 3, 2, true},
-      {"block2.0", 24, 24, 3, 1, true},       {"block2.1", 24, 24, 3, 1, true},
-      {"block3.0", 64, 24, 3, 2, true},       {"block3.1", 64, 64, 3, 1, true},
-      {"block3.2", 64, 64, 1, 1, true},
-      {"block4.0", 64, 64, 3, 2, true},       {"block4.1", 64, 64, 3, 1, true},
-      {"block4.2", 64, 64, 3, 1, true},
-      {"block5.0", 128, 64, 3, 2, true},      {"block5.1", 128, 128, 3, 1, true},
-      {"block5.2", 128, 128, 3, 1, true},     {"block5.3", 64, 128, 1, 1, true},
-      {"block_fusion.0", 64, 64, 3, 1, true}, {"block_fusion.1", 64, 64, 3, 1, true},
-      {"block_fusion.2", 64, 64, 1, 1, false},
-      {"heatmap_head.0", 64, 64, 1, 1, true}, {"heatmap_head.1", 64, 64, 1, 1, true},
-      {"heatmap_head.2", 1, 64, 1, 1, false},
-      {"keypoint_head.0", 64, 64, 1, 1, true}, {"keypoint_head.1", 64, 64, 1, 1, true},
-      {"keypoint_head.2", 64, 64, 1, 1, true}, {"keypoint_head.3", 65, 64, 1, 1, false},
+      {"skip1.1", 24, 1, 1, 1, false},          {"block1.0", 4, 1, 3, 1, true},
+      {"block1.1", 8, 4, 3, 2, true},           {"block1.2", 8, 8, 3, 1, true},
+      {"block1.3", 24, 8, 3, 2, true},          {"block2.0", 24, 24, 3, 1, true},
+      {"block2.1", 24, 24, 3, 1, true},         {"block3.0", 64, 24, 3, 2, true},
+      {"block3.1", 64, 64, 3, 1, true},         {"block3.2", 64, 64, 1, 1, true},
+      {"block4.0", 64, 64, 3, 2, true},         {"block4.1", 64, 64, 3, 1, true},
+      {"block4.2", 64, 64, 3, 1, true},         {"block5.0", 128, 64, 3, 2, true},
+      {"block5.1", 128, 128, 3, 1, true},       {"block5.2", 128, 128, 3, 1, true},
+      {"block5.3", 64, 128, 1, 1, true},        {"block_fusion.0", 64, 64, 3, 1, true},
+      {"block_fusion.1", 64, 64, 3, 1, true},   {"block_fusion.2", 64, 64, 1, 1, false},
+      {"heatmap_head.0", 64, 64, 1, 1, true},   {"heatmap_head.1", 64, 64, 1, 1, true},
+      {"heatmap_head.2", 1, 64, 1, 1, false},   {"keypoint_head.0", 64, 64, 1, 1, true},
+      {"keypoint_head.1", 64, 64, 1, 1, true},  {"keypoint_head.2", 64, 64, 1, 1, true},
+      {"keypoint_head.3", 65, 64, 1, 1, false},
   };
   return convs;
 }
@@ -211,7 +209,8 @@ XfeatNetOutput XfeatModel::Forward(const torch::Tensor& image, bool reference_op
   // The network sees grey: the mean of the channels (the mean of one channel is that channel, bit for bit).
   if (x.size(1) != 1) x = x.mean(1, /*keepdim=*/true);
   x = torch::instance_norm(x, {}, {}, {}, {}, /*use_input_stats=*/true, /*momentum=*/0.1, kInstanceNormEps,
-                           /*cudnn_enabled=*/true).contiguous();
+                           /*cudnn_enabled=*/true)
+          .contiguous();
 
   auto first = on_cpu ? to_blocked(FirstConvOnCpu(x)) : Conv(x, "block1.0");
   auto x1 = Conv(Conv(Conv(first, "block1.1"), "block1.2"), "block1.3");
@@ -314,9 +313,9 @@ XfeatDetections XfeatModel::DetectAndCompute(const torch::Tensor& image, const X
     descriptors = F::normalize(descriptors, F::NormalizeFuncOptions().p(2).dim(-1).eps(1e-12));
   }
   // Back to the given image: float32 (x, y) times float32 (W / W', H / H'), as upstream scales them.
-  const auto scale = torch::tensor({static_cast<float>(double(width) / double(net_width)),
-                                    static_cast<float>(double(height) / double(net_height))},
-                                   torch::TensorOptions().dtype(torch::kFloat32).device(device_));
+  const auto scale = torch::tensor(
+      {static_cast<float>(double(width) / double(net_width)), static_cast<float>(double(height) / double(net_height))},
+      torch::TensorOptions().dtype(torch::kFloat32).device(device_));
   out.keypoints = keypoints.mul(scale);
   out.scores = kept_scores;
   out.descriptors = descriptors.contiguous();
@@ -332,8 +331,8 @@ XfeatDetections XfeatModel::DetectAndCompute(const torch::Tensor& image, const X
 
 namespace vmap::neural {
 
-std::pair<torch::Tensor, torch::Tensor> XfeatMatch(const torch::Tensor& descriptors0,
-                                                   const torch::Tensor& descriptors1, double min_cossim) {
+std::pair<torch::Tensor, torch::Tensor> XfeatMatch(const torch::Tensor& descriptors0, const torch::Tensor& descriptors1,
+                                                   double min_cossim) {
   torch::InferenceMode guard;
   const auto long_options = torch::TensorOptions().dtype(torch::kInt64).device(descriptors0.device());
   if (descriptors0.size(0) == 0 || descriptors1.size(0) == 0) {

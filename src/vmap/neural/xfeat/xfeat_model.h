@@ -30,7 +30,7 @@ const std::vector<XfeatConv>& XfeatConvolutions();  // all 27, in upstream state
 
 // The raw network outputs for an (B, C, H, W) input.
 struct XfeatNetOutput {
-  torch::Tensor descriptor_map;  // M1 (B, 64, H/8, W/8), not normalised
+  torch::Tensor descriptor_map;   // M1 (B, 64, H/8, W/8), not normalised
   torch::Tensor keypoint_logits;  // K1 (B, 65, H/8, W/8), channel 64 is the "no keypoint" bin
   torch::Tensor reliability;      // H1 (B, 1, H/8, W/8), after the sigmoid
 };
@@ -52,7 +52,7 @@ struct XfeatDetections {
   torch::Tensor descriptors;  // (n, 64) float32, unit rows
   int64_t net_height = 0, net_width = 0;  // the network input: the image resized to multiples of 32
   // intermediate
-  torch::Tensor net_input;      // (1, C, H', W') the resized image the network saw
+  torch::Tensor net_input;  // (1, C, H', W') the resized image the network saw
   XfeatNetOutput net;
   torch::Tensor heatmap;        // (1, 1, H, W) keypoint probability per network-input pixel
   torch::Tensor nms_keypoints;  // (N, 2) int64 (x, y) local maxima above the threshold, row-major order
@@ -84,7 +84,7 @@ class XfeatModel {
   torch::Tensor FirstConvOnCpu(const torch::Tensor& x) const;  // block1.0 with OpenCV
 
   std::map<std::string, XfeatConv> convs_;
-  std::map<std::string, std::pair<torch::Tensor, torch::Tensor>> weights_;  // name -> (weight, bias)
+  std::map<std::string, std::pair<torch::Tensor, torch::Tensor>> weights_;          // name -> (weight, bias)
   std::map<std::string, std::pair<torch::Tensor, torch::Tensor>> blocked_weights_;  // reordered for oneDNN (CPU)
   torch::Device device_;
 };
@@ -96,7 +96,7 @@ namespace vmap::neural {
 // Upstream's XFeat.match on (N0, D) and (N1, D) unit descriptors on any device: mutual nearest neighbours by
 // cosine similarity, kept when the similarity exceeds `min_cossim` (strictly; min_cossim <= 0 keeps every
 // mutual pair, as upstream). Returns (K, 2) int64 [idx0, idx1] in increasing idx0 and their similarities.
-std::pair<torch::Tensor, torch::Tensor> XfeatMatch(const torch::Tensor& descriptors0,
-                                                   const torch::Tensor& descriptors1, double min_cossim);
+std::pair<torch::Tensor, torch::Tensor> XfeatMatch(const torch::Tensor& descriptors0, const torch::Tensor& descriptors1,
+                                                   double min_cossim);
 
 }  // namespace vmap::neural

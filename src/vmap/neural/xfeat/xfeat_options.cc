@@ -15,8 +15,9 @@ void XfeatMatcherOptions::Check() const {
     throw OptionError("detection_threshold", "must be in [0, 1) (a heatmap value; upstream 0.05)");
   }
   if (!(min_similarity >= -1.0 && min_similarity < 1.0)) {
-    throw OptionError("min_similarity", "must be in [-1, 1) (a cosine similarity; upstream 0.82, -1 keeps every "
-                                        "mutual nearest neighbour)");
+    throw OptionError("min_similarity",
+                      "must be in [-1, 1) (a cosine similarity; upstream 0.82, -1 keeps every "
+                      "mutual nearest neighbour)");
   }
   if (num_threads < 0) throw OptionError("threads", "must be >= 0 (0 = LibTorch's default)");
 }
@@ -26,13 +27,11 @@ void XfeatMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
                 weights);
   visitor.Visit({"device", "--device", "Deep matchers' device: cpu or cuda"}, device);
   visitor.Visit({"top_k", "--xfeat-top-k", "XFeat: keypoints kept per image, best first"}, top_k);
-  visitor.Visit({"detection_threshold", "--xfeat-threshold", "XFeat: keypoint heatmap threshold"},
-                detection_threshold);
+  visitor.Visit({"detection_threshold", "--xfeat-threshold", "XFeat: keypoint heatmap threshold"}, detection_threshold);
   visitor.Visit({"min_similarity", "--xfeat-min-similarity",
                  "XFeat: mutual nearest neighbours need a cosine similarity above this (<= 0: no minimum)"},
                 min_similarity);
-  visitor.Visit({"threads", "--xfeat-threads", "XFeat: LibTorch threads per call (0 = LibTorch default)"},
-                num_threads);
+  visitor.Visit({"threads", "--xfeat-threads", "XFeat: LibTorch threads per call (0 = LibTorch default)"}, num_threads);
 }
 
 }  // namespace vmap

@@ -24,7 +24,7 @@ struct XfeatMatcherOptions {
   // worker per core, where more threads per call only oversubscribe the cores.
   int num_threads = 1;
 
-  void Check() const;  // throws OptionError naming the bad field
+  void Check() const;                             // throws OptionError naming the bad field
   void VisitFields(OptionFieldVisitor& visitor);  // JSON keys and command-line flags
 };
 

@@ -41,8 +41,9 @@ StateDictMismatch Compare(const StateDict& weights, XfeatLayout layout) {
 }
 
 std::string Describe(XfeatLayout layout) {
-  return layout == XfeatLayout::kOfficial ? "the official layout (xfeat.pt: BatchNorm statistics, fine_matcher)"
-                                          : "the folded layout (xfeat_folded.pt: BatchNorm folded into the convolutions)";
+  return layout == XfeatLayout::kOfficial
+             ? "the official layout (xfeat.pt: BatchNorm statistics, fine_matcher)"
+             : "the folded layout (xfeat_folded.pt: BatchNorm folded into the convolutions)";
 }
 
 }  // namespace
@@ -70,8 +71,7 @@ XfeatLayout CheckXfeatStateDict(const StateDict& weights, const std::string& pat
   const StateDictMismatch& closest = official_closer ? official : folded;
   throw InputError("XFeat weights file '" + path + "' fits no XFeat layout; against " +
                    Describe(official_closer ? XfeatLayout::kOfficial : XfeatLayout::kFolded) + ":" +
-                   closest.Describe() +
-                   "\n  Is it an XFeat file? See `vmap weights` for the supported files.");
+                   closest.Describe() + "\n  Is it an XFeat file? See `vmap weights` for the supported files.");
 }
 
 std::pair<torch::Tensor, torch::Tensor> FoldBatchNorm(const torch::Tensor& weight, const torch::Tensor& running_mean,

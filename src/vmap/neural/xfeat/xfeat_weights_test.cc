@@ -1,6 +1,8 @@
 // XFeat weights: the shared folded file, the official layout users download (BatchNorm statistics and the
 // unused fine_matcher, as a plain dict and as the collections.OrderedDict torch.save writes), and bad files.
 
+#include "vmap/neural/xfeat/xfeat_weights.h"
+
 #include <fstream>
 
 #include <caffe2/serialize/inline_container.h>
@@ -9,9 +11,8 @@
 #include <torch/serialize.h>
 
 #include "vmap/core/error.h"
-#include "vmap/testing/golden_util.h"
 #include "vmap/neural/xfeat/xfeat_model.h"
-#include "vmap/neural/xfeat/xfeat_weights.h"
+#include "vmap/testing/golden_util.h"
 
 namespace vmap::neural {
 namespace {
@@ -37,13 +38,19 @@ void MakeOrderedDict(const std::string& plain, const std::string& ordered) {
   std::string program(static_cast<const char*>(pickle_data.get()), pickle_size);
   // LibTorch writes restore_type_tag(<dict>, "Dict[str, Tensor]"); Python writes the bare dict. Unwrap it,
   // then build the dict as collections.OrderedDict() (GLOBAL, EMPTY_TUPLE, REDUCE) instead of EMPTY_DICT.
-  const std::string tag("\x80\x02" "ctorch.jit._pickle\nrestore_type_tag\nq\x00", 40);
+  const std::string tag(
+      "\x80\x02"
+      "ctorch.jit._pickle\nrestore_type_tag\nq\x00",
+      40);
   const std::string type_name = "Dict[str, Tensor]";
   const size_t type_at = program.rfind(type_name);
   ASSERT_EQ(program.substr(0, tag.size()), tag) << "unexpected pickle from torch::pickle_save";
   ASSERT_NE(type_at, std::string::npos);
   ASSERT_EQ(program[tag.size()], '}');
-  program = "\x80\x02" "ccollections\nOrderedDict\n)R" + program.substr(tag.size() + 1, type_at - 5 - tag.size() - 1) + ".";
+  program =
+      "\x80\x02"
+      "ccollections\nOrderedDict\n)R" +
+      program.substr(tag.size() + 1, type_at - 5 - tag.size() - 1) + ".";
   caffe2::serialize::PyTorchStreamWriter writer(ordered);
   writer.writeRecord("data.pkl", program.data(), program.size());
   for (const std::string& name : reader.getAllRecords()) {
@@ -108,8 +115,8 @@ TEST(XfeatWeights, FoldingIsLibTorchsBatchNorm) {
   const auto var = torch::rand({64}) * 2;
   const auto [folded_weight, folded_bias] = FoldBatchNorm(weight, mean, var);
   const auto x = torch::randn({1, 64, 24, 32});
-  const auto expected = torch::batch_norm(torch::conv2d(x, weight, {}, 1, 1), {}, {}, mean, var, false, 0.0, kEps,
-                                          false);
+  const auto expected =
+      torch::batch_norm(torch::conv2d(x, weight, {}, 1, 1), {}, {}, mean, var, false, 0.0, kEps, false);
   const auto actual = torch::conv2d(x, folded_weight, folded_bias, 1, 1);
   EXPECT_TENSOR_NEAR(actual, expected, 2e-5, 1e-5);
 }
@@ -183,8 +190,7 @@ TEST(XfeatWeights, MissingUnexpectedAndMisshapedKeysAreListed) {
 
   official = OfficialLayoutOf(folded);
   official["block2.0.layer.1.running_var"][3] = -1.0f;
-  EXPECT_NE(ExpectInputError([&] { CheckXfeatStateDict(official, "xfeat.pt"); }).find("negative"),
-            std::string::npos);
+  EXPECT_NE(ExpectInputError([&] { CheckXfeatStateDict(official, "xfeat.pt"); }).find("negative"), std::string::npos);
 
   const std::string loftr = SharedDir() + "/weights/loftr_coarse/loftr_coarse_teacher.pt";
   message = ExpectInputError([&] { LoadXfeatWeights(loftr); });
@@ -206,7 +212,8 @@ TEST(XfeatWeights, TruncatedAndForeignFilesNameTheFile) {
   }
   WriteBytes(dir.path() / "list.pt", torch::pickle_save(c10::IValue(c10::List<int64_t>({1, 2}))));
   EXPECT_NE(ExpectInputError([&] { LoadXfeatWeights(dir.path() / "list.pt"); }).find("not a dict"), std::string::npos);
-  EXPECT_NE(ExpectInputError([&] { LoadXfeatWeights(dir.path() / "absent.pt"); }).find("is missing"), std::string::npos);
+  EXPECT_NE(ExpectInputError([&] { LoadXfeatWeights(dir.path() / "absent.pt"); }).find("is missing"),
+            std::string::npos);
 }
 
 }  // namespace
