@@ -21,16 +21,15 @@ namespace vmap {
 namespace fs = std::filesystem;
 using report::FormatFixed;
 using report::HtmlEscape;
+using report::kBlue;
+using report::kGreen;
+using report::kOrange;
+using report::kRed;
 using report::PlotSeries;
 using report::SvgPlot;
 using report::UrlPath;
 
 namespace {
-
-constexpr const char* kBlue = "#1f77b4";
-constexpr const char* kOrange = "#e07b00";
-constexpr const char* kGreen = "#2a9d3a";
-constexpr const char* kRed = "#d62728";
 
 // The frames to show: the first frame of every lost streak (at most a quarter of the pairs), the first
 // relocalized frame, and the rest spread evenly over the run.

@@ -13,6 +13,13 @@
 
 namespace vmap::report {
 
+// The reports' palette: one colour per meaning across the map, sweep and localization reports.
+inline constexpr const char* kBlue = "#1f77b4";
+inline constexpr const char* kOrange = "#e07b00";
+inline constexpr const char* kGreen = "#2a9d3a";
+inline constexpr const char* kRed = "#d62728";
+inline constexpr const char* kGrey = "#8a8a8a";
+
 // Tick positions at 1, 2 or 5 times a power of ten covering [low, high] with about `target` ticks.
 struct AxisTicks {
   double low = 0.0;  // the axis range: the first and last tick

@@ -30,19 +30,14 @@ using nlohmann::json;
 using report::FormatExact;
 using report::FormatFixed;
 using report::HtmlEscape;
+using report::kBlue;
+using report::kGreen;
+using report::kGrey;
+using report::kOrange;
+using report::kRed;
 using report::PlotSeries;
 using report::SvgPlot;
 using report::UrlPath;
-
-namespace {
-
-constexpr const char* kBlue = "#1f77b4";
-constexpr const char* kOrange = "#e07b00";
-constexpr const char* kGreen = "#2a9d3a";
-constexpr const char* kRed = "#d62728";
-constexpr const char* kGrey = "#8a8a8a";
-
-}  // namespace
 
 using report::Card;
 using report::Displayable;
