@@ -68,15 +68,12 @@ FundamentalResult WithoutMotion(const std::vector<cv::Point2f>& points0, const s
   return result;
 }
 
-}  // namespace
-
-FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0, const std::vector<cv::Point2f>& points1,
+FundamentalResult EstimateFromSamples(const std::vector<cv::Point2f>& points0, const std::vector<cv::Point2f>& points1,
                                       const VerifierOptions& options, const EarlyStop& early_stop,
                                       const std::vector<float>* scores) {
   FundamentalResult result;
   CV_Assert(points0.size() == points1.size());
   if (static_cast<int>(points0.size()) < options.min_matches) return result;
-  if (FundamentalResult still = WithoutMotion(points0, points1, options); still.success) return still;
   if (options.method == VerifierMethod::kMagsac && options.loop_points > 0 && scores &&
       scores->size() == points0.size() && early_stop.min_inliers.empty() && !early_stop.resume_from) {
     // Bounded: "not enough inliers" is accepted after max_samples_to_reject samples, as when stopping early.
@@ -137,6 +134,20 @@ FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0, c
   F.rowRange(0, 3).convertTo(cv::Mat(3, 3, CV_64F, result.F.val), CV_64F);
   result.success = true;
   return result;
+}
+
+}  // namespace
+
+FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0, const std::vector<cv::Point2f>& points1,
+                                      const VerifierOptions& options, const EarlyStop& early_stop,
+                                      const std::vector<float>* scores) {
+  FundamentalResult estimated = EstimateFromSamples(points0, points1, options, early_stop, scores);
+  if (estimated.abandoned) return estimated;
+  // A camera that moved gives a model that also explains its still matches (those near the epipole, or far
+  // away): the estimator's answer stands unless it explains fewer matches than stayed put.
+  FundamentalResult still = WithoutMotion(points0, points1, options);
+  if (still.success && (!estimated.success || estimated.num_inliers < still.num_inliers)) return still;
+  return estimated;
 }
 
 double SampsonDistance(const cv::Matx33d& F, const cv::Point2f& p0, const cv::Point2f& p1) {
