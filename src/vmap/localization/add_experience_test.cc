@@ -51,19 +51,12 @@ std::vector<cv::Mat> Frames(int first, int stride, bool other_season = false) {
   return frames;
 }
 
-std::string ReadBytes(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 // Every file of a folder with its bytes: what "left as it was" compares.
 std::map<std::string, std::string> Snapshot(const fs::path& directory) {
   std::map<std::string, std::string> files;
   for (const auto& entry : fs::recursive_directory_iterator(directory)) {
     const std::string name = fs::relative(entry.path(), directory).string();
-    files[name] = entry.is_regular_file() ? ReadBytes(entry.path()) : "<dir>";
+    files[name] = entry.is_regular_file() ? ::vmap::testing::ReadText(entry.path()) : "<dir>";
   }
   return files;
 }
@@ -89,8 +82,8 @@ AddExperienceOptions Quiet() {
 
 TEST(AddExperience, AddsViewsAndKeepsTheTeachRunByteIdentical) {
   TeachMap map;
-  const std::string json_before = ReadBytes(map.path / kMapFileName);
-  const std::string correspondences_before = ReadBytes(map.path / kCorrespondencesFileName);
+  const std::string json_before = ::vmap::testing::ReadText(map.path / kMapFileName);
+  const std::string correspondences_before = ::vmap::testing::ReadText(map.path / kCorrespondencesFileName);
   const VisualMap before = ReadMap(map.path);
   std::map<std::string, std::string> keys_before = Snapshot(map.path / "keys");
 
@@ -101,9 +94,9 @@ TEST(AddExperience, AddsViewsAndKeepsTheTeachRunByteIdentical) {
   ASSERT_GE(added.experience.views.size(), before.key_images.size() / 2);
 
   // Key images, links and every other field as before; only `experiences` is new.
-  EXPECT_EQ(ReadBytes(map.path / kCorrespondencesFileName), correspondences_before);
+  EXPECT_EQ(::vmap::testing::ReadText(map.path / kCorrespondencesFileName), correspondences_before);
   EXPECT_EQ(Snapshot(map.path / "keys"), keys_before);
-  nlohmann::json now = nlohmann::json::parse(ReadBytes(map.path / kMapFileName));
+  nlohmann::json now = nlohmann::json::parse(::vmap::testing::ReadText(map.path / kMapFileName));
   ASSERT_TRUE(now.contains("experiences"));
   now.erase("experiences");
   EXPECT_EQ(now.dump(1) + "\n", json_before);
@@ -138,7 +131,7 @@ TEST(AddExperience, AddsViewsAndKeepsTheTeachRunByteIdentical) {
   const std::vector<Experience> two = ReadExperiences(map.path, ReadMap(map.path));
   ASSERT_EQ(two.size(), 2u);
   EXPECT_EQ(two[0].views.size(), experiences[0].views.size());
-  EXPECT_EQ(ReadBytes(map.path / kCorrespondencesFileName), correspondences_before);
+  EXPECT_EQ(::vmap::testing::ReadText(map.path / kCorrespondencesFileName), correspondences_before);
 }
 
 TEST(AddExperience, LocalizationPicksTheViewThatFitsAndHeadsAgainstTheKeyImage) {

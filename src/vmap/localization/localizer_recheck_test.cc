@@ -16,29 +16,9 @@
 namespace vmap {
 namespace {
 
-// The synthetic drive of localizer_test.cc: textured planes seen by a camera moving sideways with a little yaw.
-const ::vmap::testing::SyntheticSequence& Drive() {
-  static const auto sequence = [] {
-    ::vmap::testing::SyntheticOptions options;
-    options.num_frames = 60;
-    options.step = 0.05;
-    options.yaw_per_frame = 0.003;
-    return ::vmap::testing::RenderSyntheticSequence(options);
-  }();
-  return sequence;
-}
-
-// Frames first, first + stride, ... of the drive, and their indices.
-std::vector<cv::Mat> Frames(int first, int stride) {
-  std::vector<cv::Mat> frames;
-  for (int i = first; i < static_cast<int>(Drive().frames.size()); i += stride) frames.push_back(Drive().frames[i]);
-  return frames;
-}
-std::vector<int> Indices(int first, int stride) {
-  std::vector<int> indices;
-  for (int i = first; i < static_cast<int>(Drive().frames.size()); i += stride) indices.push_back(i);
-  return indices;
-}
+using ::vmap::testing::DriveFrames;
+using ::vmap::testing::DriveIndices;
+using ::vmap::testing::SidewaysDrive;
 
 bool Brackets(const VisualMap& map, int source_index, int key) {
   const auto [before, after] = KeysAround(map, source_index);
@@ -54,7 +34,7 @@ struct DenseMap {
     MapBuilderOptions options;
     options.show_progress = false;
     options.key_images.tau = 0.8;
-    ::vmap::testing::MemorySource source(Frames(0, 2), Indices(0, 2));
+    ::vmap::testing::MemorySource source(DriveFrames(0, 2), DriveIndices(0, 2));
     ::vmap::testing::BuildMapDirectory(source, *matcher, options, directory.path() / "map");
     opened = OpenLocalizationMap(directory.path() / "map", {});
   }
@@ -67,7 +47,7 @@ const LocalizationMap& Dense() {
 
 // Drive frame `source_index` localized as the `index`-th frame of a stream.
 LocalizationResult LocalizeImage(Localizer& localizer, int source_index, int index) {
-  ::vmap::testing::MemorySource source({Drive().frames[source_index]}, {source_index});
+  ::vmap::testing::MemorySource source({SidewaysDrive().frames[source_index]}, {source_index});
   Frame frame = *source.Next();
   frame.index = index;
   const auto features = Dense().matcher->Extract(frame.gray);
@@ -122,7 +102,7 @@ TEST(Localizer, AFrameThatSharesAsMuchAsTheMapsLinksIsNotRelocalized) {
   LocalizerOptions options = MapLocalizerOptions(m);
   options.acceptance = AcceptanceRule::kChance;
   Localizer localizer(m.map, m.keys, *m.matcher, options);
-  ::vmap::testing::MemorySource source(Frames(1, 2), Indices(1, 2));
+  ::vmap::testing::MemorySource source(DriveFrames(1, 2), DriveIndices(1, 2));
   LocalizeSequenceOptions run;
   run.show_progress = false;
   int bracketed = 0;

@@ -18,31 +18,9 @@
 namespace vmap {
 namespace {
 
-// A synthetic drive: textured planes seen by a camera moving sideways with a little yaw.
-const ::vmap::testing::SyntheticSequence& Drive() {
-  static const auto sequence = [] {
-    ::vmap::testing::SyntheticOptions options;
-    options.num_frames = 60;
-    options.step = 0.05;
-    options.yaw_per_frame = 0.003;
-    return ::vmap::testing::RenderSyntheticSequence(options);
-  }();
-  return sequence;
-}
-
-std::vector<cv::Mat> Frames(int first, int stride, int last = -1) {
-  std::vector<cv::Mat> frames;
-  const int end = last >= 0 ? last + 1 : static_cast<int>(Drive().frames.size());
-  for (int i = first; i < end; i += stride) frames.push_back(Drive().frames[i]);
-  return frames;
-}
-
-std::vector<int> Indices(int first, int stride, int last = -1) {
-  std::vector<int> indices;
-  const int end = last >= 0 ? last + 1 : static_cast<int>(Drive().frames.size());
-  for (int i = first; i < end; i += stride) indices.push_back(i);
-  return indices;
-}
+using ::vmap::testing::DriveFrames;
+using ::vmap::testing::DriveIndices;
+using ::vmap::testing::SidewaysDrive;
 
 // The map of the even frames, built once for all tests of this file.
 struct EvenMap {
@@ -52,7 +30,7 @@ struct EvenMap {
     const auto matcher = CreateOrbMatcher({});
     MapBuilderOptions options;
     options.show_progress = false;
-    ::vmap::testing::MemorySource source(Frames(0, 2), Indices(0, 2));
+    ::vmap::testing::MemorySource source(DriveFrames(0, 2), DriveIndices(0, 2));
     ::vmap::testing::BuildMapDirectory(source, *matcher, options, directory.path() / "map");
     opened = OpenLocalizationMap(directory.path() / "map", {});
   }
@@ -91,7 +69,7 @@ TEST(Localizer, TheMapHasSeveralKeyImages) {
 TEST(Localizer, EveryOddFrameIsLocalizedBetweenTheKeyImagesAroundIt) {
   const LocalizationMap& m = Map().opened;
   Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
-  ::vmap::testing::MemorySource source(Frames(1, 2), Indices(1, 2));
+  ::vmap::testing::MemorySource source(DriveFrames(1, 2), DriveIndices(1, 2));
   LocalizeSequenceOptions run;
   run.show_progress = false;
   std::vector<LocalizationResult> results;
@@ -126,8 +104,8 @@ TEST(Localizer, ProgressGrowsAlongASegment) {
   Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
   // Correlate the estimated progress with the true position between the two key images.
   std::vector<double> estimated, truth;
-  const auto frames = Frames(1, 2);
-  const auto indices = Indices(1, 2);
+  const auto frames = DriveFrames(1, 2);
+  const auto indices = DriveIndices(1, 2);
   for (size_t i = 0; i < frames.size(); ++i) {
     const LocalizationResult r = LocalizeImage(localizer, frames[i], static_cast<int>(i), indices[i]);
     const auto [before, after] = KeysAround(m.map, indices[i]);
@@ -150,7 +128,7 @@ TEST(Localizer, RelocalizesAFrameFromTheMiddleAfterReset) {
   for (int source_index : {37, 11, 53, 25}) {
     localizer.Reset();
     ASSERT_FALSE(localizer.has_estimate());
-    const LocalizationResult r = LocalizeImage(localizer, Drive().frames[source_index], 0, source_index);
+    const LocalizationResult r = LocalizeImage(localizer, SidewaysDrive().frames[source_index], 0, source_index);
     EXPECT_EQ(r.status, LocalizationStatus::kRelocalized);
     EXPECT_TRUE(Brackets(m.map, source_index, r.key)) << "frame " << source_index << " at key " << r.key;
     EXPECT_FALSE(r.candidates.empty());
@@ -164,7 +142,7 @@ TEST(Localizer, AnUnrelatedImageIsLostAndTheEstimateIsDroppedAfterMaxLostFrames)
   options.max_lost_frames = 2;
   Localizer localizer(m.map, m.keys, *m.matcher, options);
   // Noise shares no scene point with the map.
-  cv::Mat noise(Drive().frames[0].size(), CV_8UC3);
+  cv::Mat noise(SidewaysDrive().frames[0].size(), CV_8UC3);
   cv::RNG rng(3);
   rng.fill(noise, cv::RNG::UNIFORM, 0, 255);
   LocalizationResult r = LocalizeImage(localizer, noise, 0, 0);
@@ -173,7 +151,7 @@ TEST(Localizer, AnUnrelatedImageIsLostAndTheEstimateIsDroppedAfterMaxLostFrames)
   EXPECT_EQ(r.next_key, -1);
   EXPECT_FALSE(localizer.has_estimate());
 
-  r = LocalizeImage(localizer, Drive().frames[21], 1, 21);
+  r = LocalizeImage(localizer, SidewaysDrive().frames[21], 1, 21);
   EXPECT_EQ(r.status, LocalizationStatus::kRelocalized);
   const int key = r.key;
   for (int i = 0; i < 2; ++i) {
@@ -187,7 +165,7 @@ TEST(Localizer, AnUnrelatedImageIsLostAndTheEstimateIsDroppedAfterMaxLostFrames)
   EXPECT_FALSE(localizer.has_estimate()) << "dropped after max_lost_frames + 1 lost frames in a row";
   // A frame inside a segment: one right after a key image is as much "at the end of the segment before" it
   // (RelocalizesAFrameFromTheMiddleAfterReset covers the choice between the two segments).
-  r = LocalizeImage(localizer, Drive().frames[33], 5, 33);
+  r = LocalizeImage(localizer, SidewaysDrive().frames[33], 5, 33);
   EXPECT_EQ(r.status, LocalizationStatus::kRelocalized);
   EXPECT_TRUE(Brackets(m.map, 33, r.key));
 }
@@ -195,7 +173,7 @@ TEST(Localizer, AnUnrelatedImageIsLostAndTheEstimateIsDroppedAfterMaxLostFrames)
 // The drive's odd frames with all but a vertical strip `visible` of the width wide hidden behind noise: little
 // of the scene is left, and the noise adds tentative matches that chance explains, so S is low.
 std::vector<cv::Mat> MostlyHidden(double visible) {
-  std::vector<cv::Mat> frames = Frames(1, 2);
+  std::vector<cv::Mat> frames = DriveFrames(1, 2);
   cv::RNG rng(17);
   for (cv::Mat& frame : frames) {
     cv::Mat noise(frame.size(), frame.type());
@@ -230,8 +208,8 @@ TEST(Localizer, AFrameThatShowsLittleOfTheSceneIsStillLocalizedByItsChance) {
   chance.min_link_share = 0.0;  // chance alone: the test is about its rule
   LocalizerOptions counts = chance;
   counts.acceptance = AcceptanceRule::kCounts;
-  const std::vector<LocalizationResult> by_chance = LocalizeAll(chance, MostlyHidden(0.35), Indices(1, 2));
-  const std::vector<LocalizationResult> by_counts = LocalizeAll(counts, MostlyHidden(0.35), Indices(1, 2));
+  const std::vector<LocalizationResult> by_chance = LocalizeAll(chance, MostlyHidden(0.35), DriveIndices(1, 2));
+  const std::vector<LocalizationResult> by_counts = LocalizeAll(counts, MostlyHidden(0.35), DriveIndices(1, 2));
   ASSERT_EQ(by_chance.size(), 30u);
   int chance_localized = 0, bracketed = 0, counts_localized = 0, low_similarity = 0;
   for (size_t i = 0; i < by_chance.size(); ++i) {
@@ -291,7 +269,8 @@ TEST(Localizer, FollowsAReversedRouteWhenTheFramesComeBackwards) {
   int previous_key = static_cast<int>(m.map.key_images.size());
   int frame_index = 22;
   for (int source_index = 59; source_index > 0; source_index -= 2) {
-    const LocalizationResult r = LocalizeImage(localizer, Drive().frames[source_index], frame_index++, source_index);
+    const LocalizationResult r =
+        LocalizeImage(localizer, SidewaysDrive().frames[source_index], frame_index++, source_index);
     EXPECT_NE(r.status, LocalizationStatus::kLost) << "frame " << source_index;
     EXPECT_TRUE(Brackets(m.map, source_index, r.key)) << "frame " << source_index << " at key " << r.key;
     EXPECT_LE(r.key, previous_key);
@@ -308,7 +287,7 @@ TEST(Localizer, HeadingIsTheHorizontalShiftOfTheSceneInPixels) {
   const auto matcher = CreateOrbMatcher({});
   MapBuilderOptions build;
   build.show_progress = false;
-  const cv::Mat key_image = Drive().frames[30];
+  const cv::Mat key_image = SidewaysDrive().frames[30];
   ::vmap::testing::MemorySource source(std::vector<cv::Mat>{key_image});
   ::vmap::testing::BuildMapDirectory(source, *matcher, build, directory.path() / "map");
   const LocalizationMap m = OpenLocalizationMap(directory.path() / "map", {});
@@ -339,11 +318,11 @@ TEST(Localizer, WithACameraTheHeadingIsInDegreesAndThePoseIsTheTrueOne) {
   MapBuilderOptions build;
   build.show_progress = false;
   const int key_index = 30, frame_index = 22;
-  const cv::Mat key_image = Drive().frames[key_index];
+  const cv::Mat key_image = SidewaysDrive().frames[key_index];
   ::vmap::testing::MemorySource source(std::vector<cv::Mat>{key_image});
   ::vmap::testing::BuildMapDirectory(source, *matcher, build, directory.path() / "map");
   const LocalizationMap m = OpenLocalizationMap(directory.path() / "map", {});
-  const cv::Matx33d K = Drive().K;
+  const cv::Matx33d K = SidewaysDrive().K;
   LocalizerOptions options = MapLocalizerOptions(m);
   options.camera = Camera::Make(K(0, 0), K(1, 1), K(0, 2), K(1, 2));
 
@@ -363,13 +342,13 @@ TEST(Localizer, WithACameraTheHeadingIsInDegreesAndThePoseIsTheTrueOne) {
   // A frame of the drive 8 frames before the key image (1.4 degrees of yaw): R and t against the true motion
   // from it to the key image.
   Localizer localizer(m.map, m.keys, *m.matcher, options);
-  const Frame frame = MakeFrame(Drive().frames[frame_index], 0, frame_index);
+  const Frame frame = MakeFrame(SidewaysDrive().frames[frame_index], 0, frame_index);
   const LocalizationResult r = localizer.Localize(frame, *m.matcher->Extract(frame.gray));
   ASSERT_EQ(r.status, LocalizationStatus::kRelocalized);
   const RelativePose& pose = r.to_key.pose;
   ASSERT_TRUE(pose.valid);
-  const auto& from = Drive().poses[frame_index];
-  const auto& to = Drive().poses[key_index];
+  const auto& from = SidewaysDrive().poses[frame_index];
+  const auto& to = SidewaysDrive().poses[key_index];
   const cv::Matx33d true_R = to.R * from.R.t();
   const cv::Vec3d true_t = to.t - true_R * from.t;
   const cv::Matx33d dR = pose.R * true_R.t();
@@ -402,7 +381,7 @@ TEST(Localizer, SameInputSameResults) {
   for (auto& results : runs) {
     Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
     for (int source_index : {9, 11, 13, 41, 43}) {
-      results.push_back(LocalizeImage(localizer, Drive().frames[source_index], 0, source_index));
+      results.push_back(LocalizeImage(localizer, SidewaysDrive().frames[source_index], 0, source_index));
     }
   }
   for (size_t i = 0; i < runs[0].size(); ++i) {
@@ -418,7 +397,7 @@ TEST(Localizer, ComparingAheadOnTheWorkersChangesNothing) {
   std::vector<LocalizationResult> runs[2];
   for (int i = 0; i < 2; ++i) {
     Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
-    ::vmap::testing::MemorySource source(Frames(1, 2), Indices(1, 2));
+    ::vmap::testing::MemorySource source(DriveFrames(1, 2), DriveIndices(1, 2));
     LocalizeSequenceOptions run;
     run.show_progress = false;
     run.compare_ahead = i == 1;

@@ -76,4 +76,28 @@ void ExpectSecondLocalizeReadsTheCache(const std::filesystem::path& map, const s
   }
 }
 
+const SyntheticSequence& SidewaysDrive() {
+  static const SyntheticSequence sequence = [] {
+    SyntheticOptions options;
+    options.num_frames = 60;
+    options.step = 0.05;
+    options.yaw_per_frame = 0.003;
+    return RenderSyntheticSequence(options);
+  }();
+  return sequence;
+}
+
+std::vector<int> DriveIndices(int first, int stride, int last) {
+  std::vector<int> indices;
+  const int end = last >= 0 ? last + 1 : static_cast<int>(SidewaysDrive().frames.size());
+  for (int i = first; i < end; i += stride) indices.push_back(i);
+  return indices;
+}
+
+std::vector<cv::Mat> DriveFrames(int first, int stride, int last) {
+  std::vector<cv::Mat> frames;
+  for (int i : DriveIndices(first, stride, last)) frames.push_back(SidewaysDrive().frames[i]);
+  return frames;
+}
+
 }  // namespace vmap::testing

@@ -11,6 +11,7 @@
 #include "vmap/features/matcher.h"
 #include "vmap/mapping/batch_build.h"
 #include "vmap/sources/frame_source.h"
+#include "vmap/testing/synthetic_scene.h"
 
 namespace vmap::testing {
 
@@ -27,6 +28,12 @@ class MemorySource : public FrameSource {
   size_t next_ = 0;
   SequenceInfo info_;
 };
+
+// The localizer tests' drive: textured planes seen by a camera moving sideways with a little yaw (60 frames).
+const SyntheticSequence& SidewaysDrive();
+// Frames first, first + stride, ... up to `last` (-1: the end) of the drive, and their indices.
+std::vector<cv::Mat> DriveFrames(int first, int stride, int last = -1);
+std::vector<int> DriveIndices(int first, int stride, int last = -1);
 
 // The options text `vmap build` records (matcher, verifier, similarity, tau), enough for localization.
 std::string MapOptionsJson(const Matcher& matcher, const MapBuilderOptions& options);
