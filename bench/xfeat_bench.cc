@@ -2,9 +2,11 @@
 // images' descriptors) at 640x480 and at KITTI size (1226x370), on one and two LibTorch threads; the
 // network and the post-processing apart; the same detectAndCompute with upstream's LibTorch ops instead of
 // vmap's CPU paths (measured interleaved, for the ratio); and `vmap build` frames/s end to end on a video,
-// next to ORB.
+// next to ORB; with --float-matching, MatchFloatDescriptors against every pair's similarity
+// (MatchFloatDescriptorsExhaustively) on XFeat's descriptors of real pairs, interleaved.
 //
 //   xfeat_bench [--reps N] [--top-k K ...] [--threads N ...] [--build [VIDEO]] [--build-repeat N] [--frames N]
+//               [--float-matching]
 //
 // Without --build it times images; with --build it only times the builds. Median of N runs after a warm-up.
 
@@ -23,6 +25,7 @@
 #include <torch/torch.h>
 
 #include "vmap/core/runtime.h"
+#include "vmap/features/float_matcher.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/batch_build.h"
 #include "vmap/neural/xfeat/xfeat_matcher.h"
@@ -134,6 +137,60 @@ void TimeBuilds(const std::string& weights, const std::string& video, const std:
   }
 }
 
+// The pairs a tracking frame and a key image make (lab_floor, frames 10, 30 and 60 apart) and those of
+// another season (michigan_seasons, the same place a season apart), XFeat's 4096 keypoints, its 0.82 floor.
+void TimeFloatMatching(const std::string& weights, const std::string& shared, int reps) {
+  torch::set_num_threads(1);
+  const auto folded = vmap::neural::LoadXfeatWeights(weights).folded;
+  const vmap::neural::XfeatModel model(folded, torch::kCPU);
+  vmap::neural::XfeatDetectOptions detect;
+  auto descriptors = [&](const cv::Mat& gray) {
+    torch::InferenceMode guard;
+    const auto input =
+        torch::from_blob(gray.data, {1, 1, gray.rows, gray.cols}, torch::kUInt8).to(torch::kFloat32).div_(255.0);
+    const torch::Tensor rows = model.DetectAndCompute(input, detect).descriptors.contiguous();
+    return cv::Mat(static_cast<int>(rows.size(0)), 64, CV_32F, rows.data_ptr<float>()).clone();
+  };
+  std::vector<std::pair<std::string, std::pair<cv::Mat, cv::Mat>>> pairs;
+  vmap::FrameSourceOptions source_options;
+  source_options.last = 120;
+  auto source = vmap::OpenFrameSource(shared + "/data/lab_floor/lab_floor.mp4", source_options);
+  std::vector<cv::Mat> frames;
+  while (auto frame = source->Next()) frames.push_back(frame->gray.clone());
+  for (int first : {0, 60}) {
+    for (int apart : {10, 30, 60}) {
+      pairs.push_back({"lab_floor " + std::to_string(first) + "-" + std::to_string(first + apart),
+                       {descriptors(frames[first]), descriptors(frames[first + apart])}});
+    }
+  }
+  const std::string seasons = shared + "/data/michigan_seasons/images/";
+  for (const auto& [a, b] : std::vector<std::pair<std::string, std::string>>{{"0101", "0601"}, {"0302", "1102"}}) {
+    pairs.push_back({"michigan " + a + "-" + b,
+                     {descriptors(cv::imread(seasons + a + ".png", cv::IMREAD_GRAYSCALE)),
+                      descriptors(cv::imread(seasons + b + ".png", cv::IMREAD_GRAYSCALE))}});
+  }
+  std::printf("%-22s %6s %6s %8s %8s %14s %10s %7s\n", "pair", "rows", "cols", "matches", "same", "exhaustive_ms",
+              "bound_ms", "ratio");
+  for (const auto& [name, pair] : pairs) {
+    const auto& [query, train] = pair;
+    const auto exhaustive = vmap::MatchFloatDescriptorsExhaustively(query, train, 0.82f);
+    const auto bounded = vmap::MatchFloatDescriptors(query, train, 0.82f);
+    size_t same = 0;
+    for (size_t k = 0; k < std::min(exhaustive.size(), bounded.size()); ++k) {
+      same += exhaustive[k].query == bounded[k].query && exhaustive[k].train == bounded[k].train;
+    }
+    std::vector<double> exhaustive_s, bounded_s;
+    for (int r = 0; r < reps; ++r) {
+      exhaustive_s.push_back(TimeSeconds([&] { vmap::MatchFloatDescriptorsExhaustively(query, train, 0.82f); }));
+      bounded_s.push_back(TimeSeconds([&] { vmap::MatchFloatDescriptors(query, train, 0.82f); }));
+    }
+    std::printf("%-22s %6d %6d %8zu %8zu %14.2f %10.2f %7.2f\n", name.c_str(), query.rows, train.rows,
+                exhaustive.size(), same, 1e3 * Median(exhaustive_s), 1e3 * Median(bounded_s),
+                Median(exhaustive_s) / Median(bounded_s));
+    std::fflush(stdout);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -141,6 +198,7 @@ int main(int argc, char** argv) {
   int reps = 20, build_repeat = 3, frames = 0;
   std::vector<int> top_ks, thread_counts;
   std::string video;
+  bool float_matching = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--reps") && i + 1 < argc)
       reps = std::atoi(argv[++i]);
@@ -152,12 +210,14 @@ int main(int argc, char** argv) {
       build_repeat = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc)
       frames = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--float-matching"))
+      float_matching = true;
     else if (!std::strcmp(argv[i], "--build")) {
       video = (i + 1 < argc && argv[i + 1][0] != '-') ? argv[++i] : shared + "/data/lab_floor/lab_floor.mp4";
     } else {
       std::fprintf(stderr,
                    "usage: %s [--reps N] [--top-k K ...] [--threads N ...] [--build [VIDEO]] [--build-repeat N] "
-                   "[--frames N]\n",
+                   "[--frames N] [--float-matching]\n",
                    argv[0]);
       return 2;
     }
@@ -166,6 +226,10 @@ int main(int argc, char** argv) {
   if (thread_counts.empty()) thread_counts = {1, 2};
   const std::string weights = shared + "/weights/xfeat/xfeat_folded.pt";
   vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
+  if (float_matching) {
+    TimeFloatMatching(weights, shared, reps);
+    return 0;
+  }
   if (!video.empty()) {
     TimeBuilds(weights, video, top_ks, build_repeat, frames);
     return 0;

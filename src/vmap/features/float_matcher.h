@@ -17,7 +17,13 @@ struct FloatMatch {
 // Keeps the pairs (i, j) where j is i's most similar train row, i is j's most similar query row, and their
 // similarity is at least `min_similarity`. Rows are CV_32F descriptors of the same width, expected to be
 // L2-normalised (then the dot product is the cosine similarity). Ties go to the lowest index. The similarity
-// matrix is computed block by block (one matrix product per block), so memory stays small for any size.
+// matrix is computed block by block (one matrix product per block), so memory stays small for any size. With
+// a high `min_similarity` (>= 0.5) and wide descriptors, most pairs are ruled out by a cheaper bound first
+// (float_matcher.cc); the matches are those of MatchFloatDescriptorsExhaustively.
 std::vector<FloatMatch> MatchFloatDescriptors(const cv::Mat& query, const cv::Mat& train, float min_similarity);
+
+// The same matches from every pair's similarity: the reference for tests and benchmarks.
+std::vector<FloatMatch> MatchFloatDescriptorsExhaustively(const cv::Mat& query, const cv::Mat& train,
+                                                          float min_similarity);
 
 }  // namespace vmap

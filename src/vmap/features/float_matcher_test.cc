@@ -85,6 +85,46 @@ TEST(MatchFloatDescriptors, AgreesWithThePlainDefinitionAcrossBlocksAndThreshold
   }
 }
 
+// Descriptors like a network's: most of their spread on a few axes, the rest small but not negligible.
+cv::Mat AnisotropicRows(int rows, int cols, std::mt19937& random) {
+  cv::Mat m = RandomUnitRows(rows, cols, random);
+  for (int c = 0; c < cols; ++c) m.col(c) *= 1.0 / (1.0 + 0.15 * c);
+  for (int r = 0; r < rows; ++r) cv::normalize(m.row(r), m.row(r));
+  return m;
+}
+
+// The fast path (a high floor, wide descriptors, at least 128 x 1024 rows) rules most pairs out by a bound
+// on a projection; it must never rule out a pair at or above the floor. Noisy copies put similarities on
+// both sides of every floor; rows of other lengths than 1 and repeated train rows (ties) are included.
+TEST(MatchFloatDescriptors, TheBoundOnAProjectionNeverLosesAMatch) {
+  std::mt19937 random(11);
+  const cv::Mat train = AnisotropicRows(2100, 64, random);
+  train.row(7).copyTo(train.row(1500));  // a tie: query rows near row 7 must pick 7
+  train.row(40) *= 1.3;
+  cv::Mat query(1300, 64, CV_32F);
+  const cv::Mat noise = AnisotropicRows(query.rows, 64, random);
+  std::uniform_int_distribution<int> any_train(0, train.rows - 1);
+  std::uniform_real_distribution<float> amount(0.f, 0.9f);
+  for (int i = 0; i < query.rows; ++i) {
+    cv::Mat row = train.row(i < 10 ? 7 : any_train(random)) + amount(random) * noise.row(i);
+    cv::normalize(row, query.row(i));
+  }
+  query.row(3) *= 0.8;
+  for (float floor : {0.5f, 0.7f, 0.82f, 0.9f}) {
+    const auto expected = PlainMutualNearest(query, train, floor);
+    const auto got = MatchFloatDescriptors(query, train, floor);
+    ASSERT_GT(expected.size(), 100u) << floor;
+    ASSERT_EQ(got.size(), expected.size()) << "floor " << floor;
+    for (size_t k = 0; k < got.size(); ++k) {
+      EXPECT_EQ(got[k].query, expected[k].query) << floor;
+      EXPECT_EQ(got[k].train, expected[k].train) << floor;
+      EXPECT_NEAR(got[k].similarity, expected[k].similarity, 1e-5f);
+    }
+    const auto exhaustive = MatchFloatDescriptorsExhaustively(query, train, floor);
+    EXPECT_EQ(exhaustive.size(), expected.size()) << floor;
+  }
+}
+
 TEST(MatchFloatDescriptors, TiesGoToTheLowestIndexAndEmptyInputsGiveNothing) {
   cv::Mat q = (cv::Mat_<float>(2, 2) << 1, 0, 1, 0);  // two identical query rows
   cv::Mat t = (cv::Mat_<float>(3, 2) << 0, 1, 1, 0, 1, 0);

@@ -20,7 +20,9 @@ namespace {
 
 using neural::AlikedModel;
 
-constexpr std::string_view kFeaturesTag = "vmapALK1";  // the localization cache's record of ALIKED features
+// The localization cache's record of ALIKED features; 2: features of colour images from their colour (older
+// caches, from grey, are recomputed).
+constexpr std::string_view kFeaturesTag = "vmapALK2";
 
 class AlikedFeatures : public ImageFeatures {
  public:
@@ -51,43 +53,22 @@ class AlikedMatcher : public Matcher {
 
   std::string name() const override { return "aliked"; }
 
+  // Upstream's demo reads the image in colour and gives the network its R, G, B channels.
+  bool reads_color() const override { return true; }
+
   std::shared_ptr<const ImageFeatures> Extract(const cv::Mat& gray) const override {
     if (gray.empty() || gray.type() != CV_8UC1) throw InputError("ALIKED needs an 8-bit single-channel image");
-    cv::Mat net_image = gray;
-    const int longest = std::max(gray.cols, gray.rows);
-    if (options_.longest_side > 0 && longest > options_.longest_side) {
-      const double scale = double(options_.longest_side) / double(longest);
-      const cv::Size size(std::max(1, int(std::lround(gray.cols * scale))),
-                          std::max(1, int(std::lround(gray.rows * scale))));
-      cv::resize(gray, net_image, size, 0, 0, cv::INTER_AREA);
-    }
-    if (!net_image.isContinuous()) net_image = net_image.clone();
-    UseThreads();
-    torch::InferenceMode guard;
-    // uint8 -> float then / 255, as upstream's ToTensor; a grey image stands for its three equal channels.
-    auto image = torch::from_blob(net_image.data, {1, 1, net_image.rows, net_image.cols}, torch::kUInt8)
-                     .to(torch::kFloat32)
-                     .div_(255.0);
-    const auto maps = model_.ExtractDenseMaps(image);
-    const auto detected = neural::DetectKeypoints(maps.score_map, dkd_);
-    const auto described = model_.Describe(maps, detected.keypoints);
+    return ExtractPixels(gray);
+  }
 
-    const auto keypoints = detected.keypoints.to(torch::kCPU).contiguous();
-    const auto descriptors = described.descriptors.to(torch::kCPU).contiguous();
-    const int64_t n = keypoints.size(0);
-    // Normalised -> pixels of the network image (pixel centres at integers) -> pixels of `gray`.
-    const float half_w = float(net_image.cols - 1) / 2.f, half_h = float(net_image.rows - 1) / 2.f;
-    const float sx = float(gray.cols) / float(net_image.cols), sy = float(gray.rows) / float(net_image.rows);
-    std::vector<cv::Point2f> points;
-    points.reserve(n);
-    const float* k = keypoints.data_ptr<float>();
-    for (int64_t i = 0; i < n; ++i) {
-      const float x = (k[2 * i] + 1.f) * half_w, y = (k[2 * i + 1] + 1.f) * half_h;
-      points.emplace_back((x + 0.5f) * sx - 0.5f, (y + 0.5f) * sy - 0.5f);
+  std::shared_ptr<const ImageFeatures> ExtractFrame(const cv::Mat& gray, const cv::Mat& bgr) const override {
+    if (bgr.empty()) return Extract(gray);
+    if (bgr.type() != CV_8UC3 || bgr.size() != gray.size()) {
+      throw InputError("ALIKED needs the colour image as 8-bit BGR of the grey image's size");
     }
-    cv::Mat rows(static_cast<int>(n), static_cast<int>(descriptors.size(1)), CV_32F,
-                 const_cast<float*>(descriptors.data_ptr<float>()));
-    return std::make_shared<AlikedFeatures>(std::move(points), rows.clone(), gray.size());
+    cv::Mat rgb;
+    cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+    return ExtractPixels(rgb);
   }
 
   TentativeMatches Match(const ImageFeatures& features0, const ImageFeatures& features1) const override {
@@ -134,6 +115,47 @@ class AlikedMatcher : public Matcher {
   }
 
  private:
+  // `image`: 8-bit grey or RGB.
+  std::shared_ptr<const ImageFeatures> ExtractPixels(const cv::Mat& image) const {
+    cv::Mat net_image = image;
+    const int longest = std::max(image.cols, image.rows);
+    if (options_.longest_side > 0 && longest > options_.longest_side) {
+      const double scale = double(options_.longest_side) / double(longest);
+      const cv::Size size(std::max(1, int(std::lround(image.cols * scale))),
+                          std::max(1, int(std::lround(image.rows * scale))));
+      cv::resize(image, net_image, size, 0, 0, cv::INTER_AREA);
+    }
+    if (!net_image.isContinuous()) net_image = net_image.clone();
+    UseThreads();
+    torch::InferenceMode guard;
+    // uint8 -> float then / 255, as upstream's ToTensor; a grey image stands for its three equal channels.
+    const auto tensor =
+        torch::from_blob(net_image.data, {1, net_image.rows, net_image.cols, net_image.channels()}, torch::kUInt8)
+            .permute({0, 3, 1, 2})
+            .to(torch::kFloat32)
+            .div_(255.0);
+    const auto maps = model_.ExtractDenseMaps(tensor);
+    const auto detected = neural::DetectKeypoints(maps.score_map, dkd_);
+    const auto described = model_.Describe(maps, detected.keypoints);
+
+    const auto keypoints = detected.keypoints.to(torch::kCPU).contiguous();
+    const auto descriptors = described.descriptors.to(torch::kCPU).contiguous();
+    const int64_t n = keypoints.size(0);
+    // Normalised -> pixels of the network image (pixel centres at integers) -> pixels of `image`.
+    const float half_w = float(net_image.cols - 1) / 2.f, half_h = float(net_image.rows - 1) / 2.f;
+    const float sx = float(image.cols) / float(net_image.cols), sy = float(image.rows) / float(net_image.rows);
+    std::vector<cv::Point2f> points;
+    points.reserve(n);
+    const float* k = keypoints.data_ptr<float>();
+    for (int64_t i = 0; i < n; ++i) {
+      const float x = (k[2 * i] + 1.f) * half_w, y = (k[2 * i + 1] + 1.f) * half_h;
+      points.emplace_back((x + 0.5f) * sx - 0.5f, (y + 0.5f) * sy - 0.5f);
+    }
+    cv::Mat rows(static_cast<int>(n), static_cast<int>(descriptors.size(1)), CV_32F,
+                 const_cast<float*>(descriptors.data_ptr<float>()));
+    return std::make_shared<AlikedFeatures>(std::move(points), rows.clone(), image.size());
+  }
+
   // OpenMP thread counts belong to the calling thread, so they are set on every call, not once.
   void UseThreads() const {
     if (options_.num_threads > 0 && at::get_num_threads() != options_.num_threads) {

@@ -12,8 +12,9 @@ namespace vmap {
 
 // Loads the model's weights (see weights_store.h for where they are searched) and checks every key and shape.
 // Throws InputError for missing or mismatched weights and for --device cuda without CUDA.
-// Extract runs the network on the grey image (as its three identical channels, at its own size unless
-// options.longest_side shrinks it), detects keypoints with DKD and describes them with SDDH; keypoints are in
+// Extract runs the network on the grey image (as its three identical channels), ExtractFrame on the colour
+// image when there is one (its R, G, B channels, as upstream's demo), at its own size unless
+// options.longest_side shrinks it; detects keypoints with DKD and describes them with SDDH; keypoints are in
 // pixels of the image given to Extract (OpenCV convention: pixel centres at integers). Match keeps mutual
 // nearest neighbours of the descriptors with cosine similarity >= options.min_similarity (scores = the
 // similarity). Extract and Match may run concurrently on different threads.

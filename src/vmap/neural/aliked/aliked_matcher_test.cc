@@ -3,6 +3,7 @@
 
 #include "vmap/neural/aliked/aliked_matcher.h"
 
+#include <array>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -11,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/mapping/pair_match.h"
 #include "vmap/testing/golden_util.h"
 
 namespace vmap {
@@ -82,6 +84,42 @@ TEST(AlikedMatcher, ReproducesTheReferenceMatchesThroughTheInterface) {
     EXPECT_LE(ours.size(), reference.size() + 3);
     for (float s : matches.scores) EXPECT_GE(s, 0.75f);
   }
+}
+
+// A colour frame through the product's path (MatchPair gives ExtractFrame the BGR image): upstream's demo
+// reads the colour image and gives the network R, G, B; so must vmap, to reproduce its matches.
+TEST(AlikedMatcher, ColourImagesGiveTheReferencesMatches) {
+  SKIP_WITHOUT_SHARED();
+  const std::string dir = PairDir("n16", "labfloor_00100_00130_rgb");
+  const auto g = LoadTensorDict(dir + "/golden.pt");
+  auto options = Options("n16");
+  options.top_k = 1000;
+  options.min_similarity = 0.75;
+  const auto matcher = CreateAlikedMatcher(options);
+  ASSERT_TRUE(matcher->reads_color());
+  std::array<PairImage, 2> images{PairImage(cv::Mat()), PairImage(cv::Mat())};
+  for (int k = 0; k < 2; ++k) {
+    const std::string png = dir + "/input" + std::to_string(k) + ".png";
+    images[k] = PairImage(cv::imread(png, cv::IMREAD_GRAYSCALE), cv::imread(png, cv::IMREAD_COLOR));
+    ASSERT_EQ(images[k].bgr.type(), CV_8UC3);
+  }
+  const TentativeMatches matches = MatchPair(*matcher, images[0], images[1], VerifierOptions{}).matches;
+  std::vector<cv::Point2f> expected0, expected1;
+  const auto& index = g.at("matches_mnn0p75");
+  for (int64_t i = 0; i < index.size(0); ++i) {
+    const int64_t a = index[i][0].item<int64_t>(), b = index[i][1].item<int64_t>();
+    expected0.emplace_back(g.at("keypoints_px0")[a][0].item<float>(), g.at("keypoints_px0")[a][1].item<float>());
+    expected1.emplace_back(g.at("keypoints_px1")[b][0].item<float>(), g.at("keypoints_px1")[b][1].item<float>());
+  }
+  const auto ours = AsSet(matches.points0, matches.points1);
+  const auto reference = AsSet(expected0, expected1);
+  EXPECT_GE(CommonCount(ours, reference), reference.size() - 3) << ours.size() << " matches";
+  EXPECT_LE(ours.size(), reference.size() + 3);
+
+  // The grey image is another input, with other matches: the test above tells the two paths apart.
+  const TentativeMatches from_grey =
+      matcher->Match(*matcher->Extract(images[0].gray), *matcher->Extract(images[1].gray));
+  EXPECT_LT(CommonCount(AsSet(from_grey.points0, from_grey.points1), reference) + 10, CommonCount(ours, reference));
 }
 
 TEST(AlikedMatcher, ShrinkingMapsKeypointsBackToTheOriginalImage) {
