@@ -50,6 +50,18 @@ size_t CommonCount(const std::set<std::array<long, 4>>& a, const std::set<std::a
   return n;
 }
 
+// Upstream's matches at its demo's similarity (0.75), as coordinates.
+std::set<std::array<long, 4>> ReferenceMatches(const std::map<std::string, torch::Tensor>& g) {
+  std::vector<cv::Point2f> expected0, expected1;
+  const auto& index = g.at("matches_mnn0p75");
+  for (int64_t i = 0; i < index.size(0); ++i) {
+    const int64_t a = index[i][0].item<int64_t>(), b = index[i][1].item<int64_t>();
+    expected0.emplace_back(g.at("keypoints_px0")[a][0].item<float>(), g.at("keypoints_px0")[a][1].item<float>());
+    expected1.emplace_back(g.at("keypoints_px1")[b][0].item<float>(), g.at("keypoints_px1")[b][1].item<float>());
+  }
+  return AsSet(expected0, expected1);
+}
+
 // Through Extract/Match on the stored grey inputs, with upstream's settings (top-k 1000, similarity 0.75):
 // the reference's matches, as coordinates.
 TEST(AlikedMatcher, ReproducesTheReferenceMatchesThroughTheInterface) {
@@ -70,15 +82,8 @@ TEST(AlikedMatcher, ReproducesTheReferenceMatchesThroughTheInterface) {
     EXPECT_EQ(f0->image_size(), image0.size());
     const auto matches = matcher->Match(*f0, *f1);
 
-    std::vector<cv::Point2f> expected0, expected1;
-    const auto& index = g.at("matches_mnn0p75");
-    for (int64_t i = 0; i < index.size(0); ++i) {
-      const int64_t a = index[i][0].item<int64_t>(), b = index[i][1].item<int64_t>();
-      expected0.emplace_back(g.at("keypoints_px0")[a][0].item<float>(), g.at("keypoints_px0")[a][1].item<float>());
-      expected1.emplace_back(g.at("keypoints_px1")[b][0].item<float>(), g.at("keypoints_px1")[b][1].item<float>());
-    }
     const auto ours = AsSet(matches.points0, matches.points1);
-    const auto reference = AsSet(expected0, expected1);
+    const auto reference = ReferenceMatches(g);
     // Keypoints may differ only where the top-k boundary is a near-tie (golden README); allow a handful.
     EXPECT_GE(CommonCount(ours, reference), reference.size() - 3) << model << " " << pair;
     EXPECT_LE(ours.size(), reference.size() + 3);
@@ -104,15 +109,8 @@ TEST(AlikedMatcher, ColourImagesGiveTheReferencesMatches) {
     ASSERT_EQ(images[k].bgr.type(), CV_8UC3);
   }
   const TentativeMatches matches = MatchPair(*matcher, images[0], images[1], VerifierOptions{}).matches;
-  std::vector<cv::Point2f> expected0, expected1;
-  const auto& index = g.at("matches_mnn0p75");
-  for (int64_t i = 0; i < index.size(0); ++i) {
-    const int64_t a = index[i][0].item<int64_t>(), b = index[i][1].item<int64_t>();
-    expected0.emplace_back(g.at("keypoints_px0")[a][0].item<float>(), g.at("keypoints_px0")[a][1].item<float>());
-    expected1.emplace_back(g.at("keypoints_px1")[b][0].item<float>(), g.at("keypoints_px1")[b][1].item<float>());
-  }
   const auto ours = AsSet(matches.points0, matches.points1);
-  const auto reference = AsSet(expected0, expected1);
+  const auto reference = ReferenceMatches(g);
   EXPECT_GE(CommonCount(ours, reference), reference.size() - 3) << ours.size() << " matches";
   EXPECT_LE(ours.size(), reference.size() + 3);
 
