@@ -161,63 +161,85 @@ class SampsonCost : public cv::LMSolver::Callback {
 
 }  // namespace
 
-std::vector<double> PoseSampsonErrors(const cv::Matx33d& R, const cv::Vec3d& t, const Camera& camera,
-                                      const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to) {
-  const std::vector<cv::Point2d> y_from = NormalizePoints(camera, from), y_to = NormalizePoints(camera, to);
+NormalizedMatches::NormalizedMatches(const Camera& camera, const std::vector<cv::Point2f>& from_pixels,
+                                     const std::vector<cv::Point2f>& to_pixels)
+    : from(NormalizePoints(camera, from_pixels)),
+      to(NormalizePoints(camera, to_pixels)),
+      fx(camera.fx),
+      fy(camera.fy),
+      K(camera.K()) {
+  CV_Assert(from_pixels.size() == to_pixels.size());
+}
+
+NormalizedMatches NormalizedMatches::Select(const std::vector<unsigned char>& mask) const {
+  NormalizedMatches selected = *this;
+  selected.from.clear();
+  selected.to.clear();
+  for (size_t i = 0; i < mask.size(); ++i) {
+    if (!mask[i]) continue;
+    selected.from.push_back(from[i]);
+    selected.to.push_back(to[i]);
+  }
+  return selected;
+}
+
+std::vector<double> PoseSampsonErrors(const cv::Matx33d& R, const cv::Vec3d& t, const NormalizedMatches& matches) {
   const cv::Matx33d E = CrossMatrix(t) * R;
-  const double focal = 0.5 * (camera.fx + camera.fy);
   std::vector<double> errors;
-  errors.reserve(from.size());
-  for (size_t i = 0; i < from.size(); ++i) errors.push_back(std::abs(focal * SampsonNormalized(E, y_from[i], y_to[i])));
+  errors.reserve(matches.size());
+  for (size_t i = 0; i < matches.size(); ++i) {
+    errors.push_back(std::abs(matches.focal() * SampsonNormalized(E, matches.from[i], matches.to[i])));
+  }
   return errors;
 }
 
-RelativePose RefineRelativePose(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
-                                const std::vector<cv::Point2f>& to, double inlier_threshold, double loss_scale) {
-  if (!pose.valid) return pose;
-  const std::vector<double> errors = PoseSampsonErrors(pose.R, pose.t, camera, from, to);
-  std::vector<cv::Point2f> inlier_from, inlier_to;
-  for (size_t i = 0; i < errors.size(); ++i) {
-    if (errors[i] < inlier_threshold) {
-      inlier_from.push_back(from[i]);
-      inlier_to.push_back(to[i]);
-    }
-  }
-  if (inlier_from.size() < 5) return pose;
-  const PoseOnManifold manifold(pose.R, pose.t);
-  cv::Ptr<SampsonCost> cost =
-      cv::makePtr<SampsonCost>(manifold, NormalizePoints(camera, inlier_from), NormalizePoints(camera, inlier_to),
-                               0.5 * (camera.fx + camera.fy), loss_scale);
-  cv::Mat x = cv::Mat::zeros(5, 1, CV_64F);
-  cv::LMSolver::create(cost, 50)->run(x);
-  RelativePose refined = pose;
-  manifold.At(x.ptr<double>(), &refined.R, &refined.t);
-  if (!cv::checkRange(cv::Mat(refined.R)) || !cv::checkRange(cv::Mat(refined.t))) return pose;
-  const std::vector<double> refined_errors = PoseSampsonErrors(refined.R, refined.t, camera, from, to);
-  refined.num_inliers = static_cast<int>(
-      std::count_if(refined_errors.begin(), refined_errors.end(), [&](double e) { return e < loss_scale; }));
-  return refined;
+std::vector<double> PoseSampsonErrors(const cv::Matx33d& R, const cv::Vec3d& t, const Camera& camera,
+                                      const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to) {
+  return PoseSampsonErrors(R, t, NormalizedMatches(camera, from, to));
 }
 
 namespace {
 
-std::vector<unsigned char> WithinThreshold(const RelativePose& pose, const Camera& camera,
-                                           const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to,
+// The matches within `threshold` px of a pose.
+std::vector<unsigned char> WithinThreshold(const RelativePose& pose, const NormalizedMatches& matches,
                                            double threshold) {
   std::vector<unsigned char> mask;
-  for (double e : PoseSampsonErrors(pose.R, pose.t, camera, from, to)) mask.push_back(e < threshold ? 1 : 0);
+  for (double e : PoseSampsonErrors(pose.R, pose.t, matches)) mask.push_back(e < threshold ? 1 : 0);
   return mask;
 }
 
 }  // namespace
 
-RelativePose EnforceCheirality(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
-                               const std::vector<cv::Point2f>& to, double inlier_threshold) {
+RelativePose RefineRelativePose(const RelativePose& pose, const NormalizedMatches& matches, double inlier_threshold,
+                                double loss_scale) {
   if (!pose.valid) return pose;
-  const std::vector<cv::Point2d> y_from = NormalizePoints(camera, from), y_to = NormalizePoints(camera, to);
-  const std::vector<unsigned char> mask = WithinThreshold(pose, camera, from, to, inlier_threshold);
-  const int given = CountInFront(pose.R, pose.t, y_from, y_to, mask);
-  const RelativePose decided = Decompose(cv::Mat(CrossMatrix(pose.t) * pose.R), y_from, y_to, mask);
+  NormalizedMatches inliers = matches.Select(WithinThreshold(pose, matches, inlier_threshold));
+  if (inliers.size() < 5) return pose;
+  const PoseOnManifold manifold(pose.R, pose.t);
+  cv::Ptr<SampsonCost> cost =
+      cv::makePtr<SampsonCost>(manifold, std::move(inliers.from), std::move(inliers.to), matches.focal(), loss_scale);
+  cv::Mat x = cv::Mat::zeros(5, 1, CV_64F);
+  cv::LMSolver::create(cost, 50)->run(x);
+  RelativePose refined = pose;
+  manifold.At(x.ptr<double>(), &refined.R, &refined.t);
+  if (!cv::checkRange(cv::Mat(refined.R)) || !cv::checkRange(cv::Mat(refined.t))) return pose;
+  const std::vector<double> refined_errors = PoseSampsonErrors(refined.R, refined.t, matches);
+  refined.num_inliers = static_cast<int>(
+      std::count_if(refined_errors.begin(), refined_errors.end(), [&](double e) { return e < loss_scale; }));
+  return refined;
+}
+
+RelativePose RefineRelativePose(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
+                                const std::vector<cv::Point2f>& to, double inlier_threshold, double loss_scale) {
+  if (!pose.valid) return pose;
+  return RefineRelativePose(pose, NormalizedMatches(camera, from, to), inlier_threshold, loss_scale);
+}
+
+RelativePose EnforceCheirality(const RelativePose& pose, const NormalizedMatches& matches, double inlier_threshold) {
+  if (!pose.valid) return pose;
+  const std::vector<unsigned char> mask = WithinThreshold(pose, matches, inlier_threshold);
+  const int given = CountInFront(pose.R, pose.t, matches.from, matches.to, mask);
+  const RelativePose decided = Decompose(cv::Mat(CrossMatrix(pose.t) * pose.R), matches.from, matches.to, mask);
   if (!decided.valid || decided.num_inliers <= given) return pose;
   RelativePose result = pose;
   result.R = decided.R;
@@ -225,21 +247,21 @@ RelativePose EnforceCheirality(const RelativePose& pose, const Camera& camera, c
   return result;
 }
 
-double TranslationSigmaDeg(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
-                           const std::vector<cv::Point2f>& to, double inlier_threshold, double loss_scale) {
+RelativePose EnforceCheirality(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
+                               const std::vector<cv::Point2f>& to, double inlier_threshold) {
+  if (!pose.valid) return pose;
+  return EnforceCheirality(pose, NormalizedMatches(camera, from, to), inlier_threshold);
+}
+
+double TranslationSigmaDeg(const RelativePose& pose, const NormalizedMatches& matches, double inlier_threshold,
+                           double loss_scale) {
   constexpr double kUnknown = 180.0;
   if (!pose.valid) return kUnknown;
-  const std::vector<unsigned char> mask = WithinThreshold(pose, camera, from, to, inlier_threshold);
-  std::vector<cv::Point2f> inlier_from, inlier_to;
-  for (size_t i = 0; i < mask.size(); ++i) {
-    if (!mask[i]) continue;
-    inlier_from.push_back(from[i]);
-    inlier_to.push_back(to[i]);
-  }
-  const int n = static_cast<int>(inlier_from.size());
+  NormalizedMatches inliers = matches.Select(WithinThreshold(pose, matches, inlier_threshold));
+  const int n = static_cast<int>(inliers.size());
   if (n < 8) return kUnknown;
-  const SampsonCost cost(PoseOnManifold(pose.R, pose.t), NormalizePoints(camera, inlier_from),
-                         NormalizePoints(camera, inlier_to), 0.5 * (camera.fx + camera.fy), loss_scale);
+  const SampsonCost cost(PoseOnManifold(pose.R, pose.t), std::move(inliers.from), std::move(inliers.to),
+                         matches.focal(), loss_scale);
   cv::Mat residuals, jacobian;
   cost.compute(cv::Mat::zeros(5, 1, CV_64F), residuals, jacobian);
   // Residual variance with the five parameters' degrees of freedom taken out; at least (0.1 px)^2 so that
@@ -254,6 +276,12 @@ double TranslationSigmaDeg(const RelativePose& pose, const Camera& camera, const
   const double largest = eigenvalues.at<double>(0);
   if (!std::isfinite(largest) || largest < 0) return kUnknown;
   return std::min(kUnknown, std::sqrt(largest) * 180.0 / CV_PI);
+}
+
+double TranslationSigmaDeg(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
+                           const std::vector<cv::Point2f>& to, double inlier_threshold, double loss_scale) {
+  if (!pose.valid) return 180.0;
+  return TranslationSigmaDeg(pose, NormalizedMatches(camera, from, to), inlier_threshold, loss_scale);
 }
 
 void TranslationOptions::Check() const {
@@ -300,15 +328,19 @@ void TranslationOptions::VisitFields(OptionFieldVisitor& visitor) {
                 min_rival_cost_gap);
 }
 
-double PoseCost(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
-                const std::vector<cv::Point2f>& to, const PoseOptions& options) {
+double PoseCost(const RelativePose& pose, const NormalizedMatches& matches, const PoseOptions& options) {
   const double cap = options.refine_inlier_factor * options.threshold;
   double cost = 0.0;
-  for (double e : PoseSampsonErrors(pose.R, pose.t, camera, from, to)) {
+  for (double e : PoseSampsonErrors(pose.R, pose.t, matches)) {
     const double r = std::min(e, cap) / options.threshold;
     cost += std::log1p(r * r);
   }
   return cost;
+}
+
+double PoseCost(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
+                const std::vector<cv::Point2f>& to, const PoseOptions& options) {
+  return PoseCost(pose, NormalizedMatches(camera, from, to), options);
 }
 
 namespace {
@@ -353,12 +385,12 @@ RelativePose EstimateRelativePose(const Camera& camera, const std::vector<cv::Po
   CV_Assert(from.size() == to.size());
   if (minima) minima->clear();
   if (static_cast<int>(from.size()) < options.min_matches) return RelativePose();
-  const std::vector<cv::Point2d> y_from = NormalizePoints(camera, from), y_to = NormalizePoints(camera, to);
+  const NormalizedMatches matches(camera, from, to);
   // The threshold is a distance in pixels; on normalised points it is divided by the focal length.
-  const double normalised_threshold = options.threshold / (0.5 * (camera.fx + camera.fy));
+  const double normalised_threshold = options.threshold / matches.focal();
   std::vector<RelativePose> starts;
   for (int k = 0; k < options.starts; ++k) {
-    starts.push_back(EssentialHypothesis(y_from, y_to, normalised_threshold, options, options.seed + k));
+    starts.push_back(EssentialHypothesis(matches.from, matches.to, normalised_threshold, options, options.seed + k));
   }
   starts.insert(starts.end(), extra_starts.begin(), extra_starts.end());
   RelativePose best;
@@ -366,12 +398,12 @@ RelativePose EstimateRelativePose(const Camera& camera, const std::vector<cv::Po
   for (const RelativePose& start : starts) {
     if (!start.valid) continue;
     const RelativePose refined =
-        options.refine ? RefineRelativePose(start, camera, from, to, options.refine_inlier_factor * options.threshold,
-                                            options.threshold)
-                       : start;
+        options.refine
+            ? RefineRelativePose(start, matches, options.refine_inlier_factor * options.threshold, options.threshold)
+            : start;
     // The refinement minimises errors that are the same for t and -t: it may end pointing backwards.
-    const RelativePose candidate = EnforceCheirality(refined, camera, from, to, options.threshold);
-    const double cost = PoseCost(candidate, camera, from, to, options);
+    const RelativePose candidate = EnforceCheirality(refined, matches, options.threshold);
+    const double cost = PoseCost(candidate, matches, options);
     if (minima) minima->push_back({candidate, cost});
     if (cost < best_cost) {  // ties keep the earlier start: deterministic
       best_cost = cost;
@@ -399,6 +431,7 @@ std::vector<PoseMinimum> ProbeTranslation(const RelativePose& pose, const Camera
                                           const PoseOptions& options, double angle_deg) {
   std::vector<PoseMinimum> ends;
   if (!pose.valid) return ends;
+  const NormalizedMatches matches(camera, from, to);
   const cv::Vec3d t = cv::normalize(pose.t);
   const cv::Vec3d axis = std::abs(t[0]) < 0.9 ? cv::Vec3d(1, 0, 0) : cv::Vec3d(0, 1, 0);
   const cv::Vec3d b0 = cv::normalize(t.cross(axis)), b1 = t.cross(b0);
@@ -407,21 +440,23 @@ std::vector<PoseMinimum> ProbeTranslation(const RelativePose& pose, const Camera
     RelativePose start = pose;
     start.t = std::cos(angle) * t + std::sin(angle) * direction;
     const RelativePose refined =
-        options.refine ? RefineRelativePose(start, camera, from, to, options.refine_inlier_factor * options.threshold,
-                                            options.threshold)
-                       : start;
-    const RelativePose end = EnforceCheirality(refined, camera, from, to, options.threshold);
-    ends.push_back({end, PoseCost(end, camera, from, to, options)});
+        options.refine
+            ? RefineRelativePose(start, matches, options.refine_inlier_factor * options.threshold, options.threshold)
+            : start;
+    const RelativePose end = EnforceCheirality(refined, matches, options.threshold);
+    ends.push_back({end, PoseCost(end, matches, options)});
   }
   return ends;
 }
 
+RelativePose PoseFromFundamental(const cv::Matx33d& F, const NormalizedMatches& matches) {
+  const cv::Matx33d E = matches.K.t() * F * matches.K;
+  return Decompose(cv::Mat(E), matches.from, matches.to, {});
+}
+
 RelativePose PoseFromFundamental(const cv::Matx33d& F, const Camera& camera, const std::vector<cv::Point2f>& from,
                                  const std::vector<cv::Point2f>& to) {
-  CV_Assert(from.size() == to.size());
-  const cv::Matx33d K = camera.K();
-  const cv::Matx33d E = K.t() * F * K;
-  return Decompose(cv::Mat(E), NormalizePoints(camera, from), NormalizePoints(camera, to), {});
+  return PoseFromFundamental(F, NormalizedMatches(camera, from, to));
 }
 
 cv::Matx33d CrossMatrix(const cv::Vec3d& v) { return cv::Matx33d(0, -v[2], v[1], v[2], 0, -v[0], -v[1], v[0], 0); }
@@ -452,16 +487,21 @@ std::vector<double> Displacements(const std::vector<cv::Point2f>& from, const st
     for (size_t i = 0; i < from.size(); ++i) displacements.push_back(cv::norm(to[i] - from[i]));
     return displacements;
   }
-  const std::vector<cv::Point2d> y_from = NormalizePoints(*camera, from), y_to = NormalizePoints(*camera, to);
-  for (size_t i = 0; i < from.size(); ++i) {
+  return Displacements(NormalizedMatches(*camera, from, to), *R);
+}
+
+std::vector<double> Displacements(const NormalizedMatches& matches, const cv::Matx33d& R) {
+  std::vector<double> displacements;
+  displacements.reserve(matches.size());
+  for (size_t i = 0; i < matches.size(); ++i) {
     // Where the point would be seen after the rotation alone (the infinite homography K R K^-1).
-    const cv::Vec3d rotated = (*R) * cv::Vec3d(y_from[i].x, y_from[i].y, 1.0);
+    const cv::Vec3d rotated = R * cv::Vec3d(matches.from[i].x, matches.from[i].y, 1.0);
     if (!(rotated[2] > 1e-9)) {
       displacements.push_back(std::numeric_limits<double>::infinity());
       continue;
     }
-    const double dx = camera->fx * (y_to[i].x - rotated[0] / rotated[2]);
-    const double dy = camera->fy * (y_to[i].y - rotated[1] / rotated[2]);
+    const double dx = matches.fx * (matches.to[i].x - rotated[0] / rotated[2]);
+    const double dy = matches.fy * (matches.to[i].y - rotated[1] / rotated[2]);
     displacements.push_back(std::hypot(dx, dy));
   }
   return displacements;

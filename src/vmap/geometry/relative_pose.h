@@ -103,22 +103,42 @@ std::vector<PoseMinimum> ProbeTranslation(const RelativePose& pose, const Camera
                                           const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to,
                                           const PoseOptions& options, double angle_deg);
 
+// The matches of one pose problem in normalised image coordinates (distortion removed), undistorted once.
+// Each function below takes them or, for convenience, pixels and the camera; the pose code undistorts no
+// point twice through this (cv::undistortPoints is iterative: a comparison of `vmap localize` spent more on
+// undistorting the same points again in each step than on refining the pose).
+struct NormalizedMatches {
+  NormalizedMatches(const Camera& camera, const std::vector<cv::Point2f>& from_pixels,
+                    const std::vector<cv::Point2f>& to_pixels);
+  NormalizedMatches Select(const std::vector<unsigned char>& mask) const;  // those where mask != 0
+  size_t size() const { return from.size(); }
+  double focal() const { return 0.5 * (fx + fy); }  // pixels per normalised unit, for thresholds in pixels
+
+  std::vector<cv::Point2d> from, to;
+  double fx = 0.0, fy = 0.0;
+  cv::Matx33d K;
+};
+
 // The robust cost a pose is chosen by: sum over the matches of log(1 + (e / threshold)^2), e the Sampson
 // error in pixels capped at refine_inlier_factor * threshold.
 double PoseCost(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
                 const std::vector<cv::Point2f>& to, const PoseOptions& options);
+double PoseCost(const RelativePose& pose, const NormalizedMatches& matches, const PoseOptions& options);
 
 // The pose of a fundamental matrix (x_to^T F x_from = 0): E = K^T F K, projected onto the essential
 // manifold and decomposed; of the four decompositions the one that puts most of the given matches (F's
 // inliers) in front of both cameras wins.
 RelativePose PoseFromFundamental(const cv::Matx33d& F, const Camera& camera, const std::vector<cv::Point2f>& from,
                                  const std::vector<cv::Point2f>& to);
+RelativePose PoseFromFundamental(const cv::Matx33d& F, const NormalizedMatches& matches);
 
 // Refines a pose by Levenberg-Marquardt (OpenCV's LMSolver) on the Sampson errors, in pixels, of the matches
 // within inlier_threshold of it, each through a Cauchy loss of scale `loss_scale` pixels. The translation
 // stays a unit vector (two parameters on the sphere); the rotation takes three.
 RelativePose RefineRelativePose(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
                                 const std::vector<cv::Point2f>& to, double inlier_threshold, double loss_scale);
+RelativePose RefineRelativePose(const RelativePose& pose, const NormalizedMatches& matches, double inlier_threshold,
+                                double loss_scale);
 
 // The Sampson errors cannot tell the four poses one E = [t]x R allows apart ((R, t), (R, -t) and the twisted
 // pair), so a refinement may end at a pose whose t points backwards. This decides among the four again: the
@@ -126,6 +146,7 @@ RelativePose RefineRelativePose(const RelativePose& pose, const Camera& camera, 
 // keep the given pose). num_inliers stays: the four have the same errors.
 RelativePose EnforceCheirality(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
                                const std::vector<cv::Point2f>& to, double inlier_threshold);
+RelativePose EnforceCheirality(const RelativePose& pose, const NormalizedMatches& matches, double inlier_threshold);
 
 // How well a pose's translation direction is determined by the matches within `inlier_threshold` px of it:
 // the standard deviation, in degrees, of t's direction from the Gauss-Newton covariance of the refinement's
@@ -135,6 +156,8 @@ RelativePose EnforceCheirality(const RelativePose& pose, const Camera& camera, c
 // (too few matches, a singular system).
 double TranslationSigmaDeg(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
                            const std::vector<cv::Point2f>& to, double inlier_threshold, double loss_scale);
+double TranslationSigmaDeg(const RelativePose& pose, const NormalizedMatches& matches, double inlier_threshold,
+                           double loss_scale);
 
 // When a translation direction is trusted (map.json's links[].translation_known, localization results): both
 // its sigma is small and the matches moved enough once the rotation is undone. The sigma alone trusts some
@@ -161,6 +184,7 @@ bool TranslationKnown(double sigma_deg, double parallax_px, double rival_cost_ga
 // Sampson errors in pixels of matches under a pose (on normalised points, times the mean focal length).
 std::vector<double> PoseSampsonErrors(const cv::Matx33d& R, const cv::Vec3d& t, const Camera& camera,
                                       const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to);
+std::vector<double> PoseSampsonErrors(const cv::Matx33d& R, const cv::Vec3d& t, const NormalizedMatches& matches);
 
 // x_to^T F x_from = 0 for the pose (R, t) and a camera K (pixels, distortion removed).
 cv::Matx33d FundamentalFromPose(const cv::Matx33d& R, const cv::Vec3d& t, const cv::Matx33d& K);
@@ -177,6 +201,7 @@ double AngleBetweenDeg(const cv::Vec3d& a, const cv::Vec3d& b);
 // leaves none. Without a camera, the plain displacement |x_to - x_from|.
 std::vector<double> Displacements(const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to,
                                   const Camera* camera = nullptr, const cv::Matx33d* R = nullptr);
+std::vector<double> Displacements(const NormalizedMatches& matches, const cv::Matx33d& R);
 
 double Median(std::vector<double> values);  // 0 for no values
 

@@ -293,17 +293,16 @@ KeyComparison Localizer::CompareImage(const ImageFeatures& features, const Image
     // The thresholds of the map's own pose estimates (PoseOptions): 3 px inliers, Cauchy scale 1 px.
     const PoseOptions pose_options;
     const double inlier_threshold = pose_options.refine_inlier_factor * pose_options.threshold;
-    c.pose = PoseFromFundamental(pair.F, *camera, frame_points, key_points);
+    const NormalizedMatches verified_matches(*camera, frame_points, key_points);
+    c.pose = PoseFromFundamental(pair.F, verified_matches);
     if (c.pose.valid) {
       // F's pose is not an optimum of the matches' errors (E = K^T F K is not essential): refined, and the
       // four poses of the refined E decided again by cheirality, as a link's. Only then does the sigma below
       // measure the matches rather than how far F's pose is from their optimum.
-      c.pose = EnforceCheirality(
-          RefineRelativePose(c.pose, *camera, frame_points, key_points, inlier_threshold, pose_options.threshold),
-          *camera, frame_points, key_points, pose_options.threshold);
-      c.translation_sigma_deg =
-          TranslationSigmaDeg(c.pose, *camera, frame_points, key_points, inlier_threshold, pose_options.threshold);
-      const double parallax = Median(Displacements(frame_points, key_points, camera, &c.pose.R));
+      c.pose = EnforceCheirality(RefineRelativePose(c.pose, verified_matches, inlier_threshold, pose_options.threshold),
+                                 verified_matches, pose_options.threshold);
+      c.translation_sigma_deg = TranslationSigmaDeg(c.pose, verified_matches, inlier_threshold, pose_options.threshold);
+      const double parallax = Median(Displacements(verified_matches, c.pose.R));
       c.translation_known = TranslationKnown(c.translation_sigma_deg, parallax, options_.translation);
     }
   }
