@@ -8,7 +8,6 @@
 // Every figure is the median of N runs after one warm-up. The build rows run BuildMap as `vmap build` does
 // (one extraction worker per core, one LibTorch thread per call) on ../shared/data/lab_floor/lab_floor.mp4.
 
-#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -32,6 +31,8 @@
 #include "vmap/neural/aliked/deform_conv.h"
 #include "vmap/sources/frame_source.h"
 
+#include "cpu_time.h"
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -49,17 +50,11 @@ double TimeSeconds(F&& f) {
 }
 
 // CPU seconds of the whole process (all threads): on a loaded machine this moves much less than wall time.
-double ProcessCpuSeconds() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
 template <typename F>
 double CpuSeconds(F&& f) {
-  const double start = ProcessCpuSeconds();
+  const double start = vmap::bench::ProcessCpuSeconds();
   f();
-  return ProcessCpuSeconds() - start;
+  return vmap::bench::ProcessCpuSeconds() - start;
 }
 
 // The alternative it is compared with: one grid_sample per kernel tap gathers the columns.

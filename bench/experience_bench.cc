@@ -16,13 +16,10 @@
 // Localization: the query session's 5 images localized in order as one run from scratch; right when the frame
 // is localized (not lost) with `key` the key image of its place.
 
-#include <time.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -31,11 +28,14 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "vmap/evaluation/heading_labels.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/localization/add_experience.h"
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/localization/localizer.h"
 #include "vmap/mapping/key_image_selector.h"
+
+#include "cpu_time.h"
 
 using namespace vmap;
 
@@ -45,12 +45,6 @@ constexpr double kCorrectPx = 35.0;
 constexpr int kSessions = 12;
 constexpr int kPlaces = 5;
 const std::string kData = std::string(VMAP_SHARED_DIR) + "/data/michigan_seasons";
-
-double CpuSeconds() {
-  timespec t;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return t.tv_sec + 1e-9 * t.tv_nsec;
-}
 
 std::string ImageName(int session, int place) {
   char name[32];
@@ -63,18 +57,9 @@ using Labels = std::map<std::pair<std::string, std::string>, double>;
 
 Labels LoadLabels() {
   Labels labels;
-  std::ifstream csv(kData + "/gt.csv");
-  if (!csv) throw std::runtime_error("no " + kData + "/gt.csv (the shared data)");
-  std::string line;
-  std::getline(csv, line);  // repeat_image,teach_image,dx_px
-  while (std::getline(csv, line)) {
-    std::stringstream row(line);
-    std::string repeat, teach, dx;
-    std::getline(row, repeat, ',');
-    std::getline(row, teach, ',');
-    std::getline(row, dx, ',');
-    labels[{teach, repeat}] = std::stod(dx);
-    labels[{repeat, teach}] = -std::stod(dx);
+  for (const HeadingLabel& l : ReadHeadingLabels(kData + "/gt.csv")) {
+    labels[{l.teach_image, l.repeat_image}] = l.dx_px;
+    labels[{l.repeat_image, l.teach_image}] = -l.dx_px;
   }
   return labels;
 }
@@ -105,7 +90,7 @@ Images Extract(const Matcher& matcher) {
   Images images;
   images.gray.assign(kSessions + 1, std::vector<cv::Mat>(kPlaces + 1));
   images.features.assign(kSessions + 1, std::vector<std::shared_ptr<const ImageFeatures>>(kPlaces + 1));
-  const double start = CpuSeconds();
+  const double start = vmap::bench::ProcessCpuSeconds();
   for (int s = 1; s <= kSessions; ++s) {
     for (int p = 1; p <= kPlaces; ++p) {
       cv::Mat gray = cv::imread(kData + "/" + ImageName(s, p), cv::IMREAD_GRAYSCALE);
@@ -114,7 +99,7 @@ Images Extract(const Matcher& matcher) {
       images.gray[s][p] = gray;
     }
   }
-  images.extract_ms = 1e3 * (CpuSeconds() - start) / (kSessions * kPlaces);
+  images.extract_ms = 1e3 * (vmap::bench::ProcessCpuSeconds() - start) / (kSessions * kPlaces);
   return images;
 }
 
@@ -200,9 +185,9 @@ void Run(const std::string& name, const Matcher& matcher, const std::vector<int>
           const bool localized = r.status != LocalizationStatus::kLost && r.key >= 0;
           tally.localized_right[p] += localized && r.key == p - 1;
           tally.localized_wrong[p] += localized && r.key != p - 1;
-          const double start = CpuSeconds();
+          const double start = vmap::bench::ProcessCpuSeconds();
           const KeyComparison c = localizer.Compare(*images.features[query][p], p - 1);
-          tally.compare_seconds += CpuSeconds() - start;
+          tally.compare_seconds += vmap::bench::ProcessCpuSeconds() - start;
           ++tally.compares;
           const double label = labels.at({ImageName(teach, p), ImageName(query, p)});
           const double error = std::isfinite(c.heading.px) ? std::abs(c.heading.px - label) : 1e9;

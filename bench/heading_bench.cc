@@ -17,16 +17,12 @@
 // ms/pair: CPU time (this process, all threads) of extracting both images, matching and estimating, from
 // the per-image and per-pair means. Run from anywhere: XFeat's plugin is linked beside the binary.
 
-#include <time.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <functional>
 #include <map>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -34,6 +30,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "vmap/evaluation/heading_labels.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/geometry/fundamental.h"
@@ -41,18 +38,14 @@
 #include "vmap/geometry/relative_pose.h"
 #include "vmap/neural/xfeat/xfeat_options.h"
 
+#include "cpu_time.h"
+
 using namespace vmap;
 
 namespace {
 
 constexpr double kCorrectPx = 35.0;
 const std::string kData = std::string(VMAP_SHARED_DIR) + "/data/michigan_seasons";
-
-double CpuSeconds() {
-  timespec t;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return t.tv_sec + 1e-9 * t.tv_nsec;
-}
 
 struct LabelledPair {
   int teach, repeat;  // image indices
@@ -78,21 +71,12 @@ Dataset LoadMichigan() {
     data.images.push_back(gray);
     return index[name] = static_cast<int>(data.images.size()) - 1;
   };
-  std::ifstream csv(kData + "/gt.csv");
-  if (!csv) throw std::runtime_error("no " + kData + "/gt.csv (the shared data)");
-  std::string line;
-  std::getline(csv, line);  // header: repeat_image,teach_image,dx_px
-  while (std::getline(csv, line)) {
-    std::stringstream row(line);
-    std::string repeat, teach, dx;
-    std::getline(row, repeat, ',');
-    std::getline(row, teach, ',');
-    std::getline(row, dx, ',');
+  for (const HeadingLabel& label : ReadHeadingLabels(kData + "/gt.csv")) {
     LabelledPair pair;
-    pair.teach = image(teach);
-    pair.repeat = image(repeat);
-    pair.place = std::stoi(teach.substr(teach.size() - 6, 2));  // images/SSLL.png
-    pair.dx = std::stod(dx);
+    pair.teach = image(label.teach_image);
+    pair.repeat = image(label.repeat_image);
+    pair.place = std::stoi(label.teach_image.substr(label.teach_image.size() - 6, 2));  // images/SSLL.png
+    pair.dx = label.dx_px;
     data.pairs.push_back(pair);
   }
   return data;
@@ -114,13 +98,13 @@ MatchedSet MatchAll(const std::string& name, const Dataset& data, const ExtractF
   MatchedSet set;
   set.name = name;
   std::vector<std::shared_ptr<const ImageFeatures>> features;
-  double start = CpuSeconds();
+  double start = vmap::bench::ProcessCpuSeconds();
   for (const cv::Mat& image : data.images) features.push_back(extract(image));
-  set.extract_ms = 1e3 * (CpuSeconds() - start) / data.images.size();
-  start = CpuSeconds();
+  set.extract_ms = 1e3 * (vmap::bench::ProcessCpuSeconds() - start) / data.images.size();
+  start = vmap::bench::ProcessCpuSeconds();
   for (const LabelledPair& pair : data.pairs)
     set.matches.push_back(match(*features[pair.teach], *features[pair.repeat]));
-  set.match_ms = 1e3 * (CpuSeconds() - start) / data.pairs.size();
+  set.match_ms = 1e3 * (vmap::bench::ProcessCpuSeconds() - start) / data.pairs.size();
   for (const TentativeMatches& m : set.matches) set.mean_tentative += double(m.size()) / set.matches.size();
   return set;
 }
@@ -223,7 +207,7 @@ Estimator VerifiedEstimator(int min_verified) {
 void Report(const Dataset& data, const MatchedSet& set, const Estimator& estimator) {
   int wrong[6] = {0}, total[6] = {0};
   std::vector<double> errors;
-  const double start = CpuSeconds();
+  const double start = vmap::bench::ProcessCpuSeconds();
   for (size_t p = 0; p < data.pairs.size(); ++p) {
     const LabelledPair& pair = data.pairs[p];
     const double heading = estimator.heading(set.matches[p]);
@@ -236,7 +220,7 @@ void Report(const Dataset& data, const MatchedSet& set, const Estimator& estimat
       ++wrong[0];
     }
   }
-  const double estimate_ms = 1e3 * (CpuSeconds() - start) / data.pairs.size();
+  const double estimate_ms = 1e3 * (vmap::bench::ProcessCpuSeconds() - start) / data.pairs.size();
   std::sort(errors.begin(), errors.end());
   const double median = errors[errors.size() / 2];
   std::printf("%-22s %-24s", set.name.c_str(), estimator.name.c_str());

@@ -10,8 +10,6 @@
 // Relocalization: a map whose key images are every third frame of ../shared/data/redkitchen (frames 0-899,
 // tau 1.0 makes every frame a key image), queried with frames between them, the estimate reset before each.
 
-#include <sys/resource.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -31,6 +29,8 @@
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/map/map_io.h"
 #include "vmap/mapping/batch_build.h"
+
+#include "cpu_time.h"
 
 namespace fs = std::filesystem;
 using namespace vmap;
@@ -75,18 +75,6 @@ void BuildInto(const std::string& input, FrameSourceOptions source_options, doub
 
 // CPU seconds of the whole process, and of the calling thread: unlike wall time, they hardly change with
 // the load other programs put on the machine.
-double ProcessCpuSeconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_utime.tv_sec + usage.ru_stime.tv_sec + 1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-}
-
-double ThreadCpuSeconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec + 1e-9 * t.tv_nsec;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -130,14 +118,14 @@ int main(int argc, char** argv) {
     {  // decode + ORB, one thread
       auto source = OpenFrameSource(video);
       const auto start = Clock::now();
-      const double cpu = ProcessCpuSeconds();
+      const double cpu = vmap::bench::ProcessCpuSeconds();
       long n = 0;
       while (auto frame = source->Next()) {
         lab.matcher->Extract(frame->gray);
         ++n;
       }
       extract.values.push_back(n / std::chrono::duration<double>(Clock::now() - start).count());
-      extract_cpu.values.push_back(1000 * (ProcessCpuSeconds() - cpu) / n);
+      extract_cpu.values.push_back(1000 * (vmap::bench::ProcessCpuSeconds() - cpu) / n);
     }
     for (bool ahead : {false, true}) {  // vmap localize end to end: decode and extraction on the workers
       auto source = OpenFrameSource(video);
@@ -145,11 +133,11 @@ int main(int argc, char** argv) {
       LocalizeSequenceOptions options;
       options.show_progress = false;
       options.compare_ahead = ahead;
-      const double cpu = ProcessCpuSeconds(), main_cpu = ThreadCpuSeconds();
+      const double cpu = vmap::bench::ProcessCpuSeconds(), main_cpu = vmap::bench::ThreadCpuSeconds();
       const LocalizationSummary s = LocalizeSequence(*source, *lab.matcher, localizer, options, nullptr);
       track[ahead].values.push_back(s.frames_per_second);
-      track_cpu[ahead].values.push_back(1000 * (ProcessCpuSeconds() - cpu) / s.frames);
-      track_main_cpu[ahead].values.push_back(1000 * (ThreadCpuSeconds() - main_cpu) / s.frames);
+      track_cpu[ahead].values.push_back(1000 * (vmap::bench::ProcessCpuSeconds() - cpu) / s.frames);
+      track_main_cpu[ahead].values.push_back(1000 * (vmap::bench::ThreadCpuSeconds() - main_cpu) / s.frames);
       tracked += s.tracking;
       frames += s.frames;
     }
@@ -163,9 +151,9 @@ int main(int argc, char** argv) {
       while (auto frame = source->Next()) {
         const auto features = kitchen_map.matcher->Extract(frame->gray);
         localizer.Reset();
-        const double cpu = ThreadCpuSeconds();
+        const double cpu = vmap::bench::ThreadCpuSeconds();
         const LocalizationResult result = localizer.Localize(*frame, *features);
-        cpu_seconds.values.push_back(ThreadCpuSeconds() - cpu);
+        cpu_seconds.values.push_back(vmap::bench::ThreadCpuSeconds() - cpu);
         seconds.values.push_back(result.seconds);
         relocalized += result.status == LocalizationStatus::kRelocalized;
         ++queries;

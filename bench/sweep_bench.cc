@@ -12,7 +12,6 @@
 //     same pair: by OpenCV with seed 1, and by vmap's early-stopping estimator asked for the taus whose maps
 //     compared that pair (as the default sweep asks). Printed per tau: decisions flipped by each.
 
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -33,15 +32,11 @@
 #include "vmap/mapping/sweep_thresholds.h"
 #include "vmap/sources/frame_source.h"
 
+#include "cpu_time.h"
+
 namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-double CpuSeconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_utime.tv_sec + usage.ru_stime.tv_sec + 1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-}
 
 struct Timing {
   std::vector<double> wall, cpu;
@@ -54,11 +49,11 @@ double Median(std::vector<double> values) {
 
 template <typename Fn>
 void Measure(Timing* timing, Fn&& run) {
-  const double cpu = CpuSeconds();
+  const double cpu = vmap::bench::ProcessCpuSeconds();
   const auto start = Clock::now();
   run();
   timing->wall.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-  timing->cpu.push_back(CpuSeconds() - cpu);
+  timing->cpu.push_back(vmap::bench::ProcessCpuSeconds() - cpu);
 }
 
 vmap::MapBuilderOptions Options(bool exhaustive, int seed) {

@@ -2,15 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <random>
-#include <sstream>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "vmap/evaluation/heading_labels.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/geometry/relative_pose.h"
@@ -211,8 +210,6 @@ TEST(Heading, FindsTheShiftBetweenTwoCropsOfAScene_DarkerAndNoisy) {
 TEST(Heading, FindsTheLabelledHeadingAcrossSeasonsOnMichigan) {
   SKIP_WITHOUT_SHARED();
   const std::string root = testing::SharedDir() + "/data/michigan_seasons/";
-  std::ifstream csv(root + "gt.csv");
-  ASSERT_TRUE(csv.good());
   const auto matcher = CreateOrbMatcher(OrbMatcherOptions());
   std::map<std::string, std::shared_ptr<const ImageFeatures>> features;
   auto features_of = [&](const std::string& name) {
@@ -222,18 +219,11 @@ TEST(Heading, FindsTheLabelledHeadingAcrossSeasonsOnMichigan) {
   };
   VerifierOptions verifier;
   verifier.max_iterations = 5000;
-  std::string line;
-  std::getline(csv, line);
   int pairs = 0, mode_correct = 0, verified_correct = 0;
-  while (std::getline(csv, line)) {
-    std::stringstream row(line);
-    std::string repeat, teach, dx;
-    std::getline(row, repeat, ',');
-    std::getline(row, teach, ',');
-    std::getline(row, dx, ',');
-    if (teach.find("02.png") == std::string::npos) continue;  // place 02 only: 66 pairs
-    const double label = std::stod(dx);
-    const TentativeMatches m = matcher->Match(*features_of(teach), *features_of(repeat));
+  for (const HeadingLabel& labelled : ReadHeadingLabels(root + "gt.csv")) {
+    if (labelled.teach_image.find("02.png") == std::string::npos) continue;  // place 02 only: 66 pairs
+    const double label = labelled.dx_px;
+    const TentativeMatches m = matcher->Match(*features_of(labelled.teach_image), *features_of(labelled.repeat_image));
     const HeadingEstimate h = EstimateHeading(m.points0, m.points1, HeadingOptions());
     ++pairs;
     if (h.valid() && std::abs(h.px - label) <= 35.0) ++mode_correct;

@@ -382,10 +382,13 @@ RelativePose EssentialHypothesis(const std::vector<cv::Point2d>& y_from, const s
 RelativePose EstimateRelativePose(const Camera& camera, const std::vector<cv::Point2f>& from,
                                   const std::vector<cv::Point2f>& to, const PoseOptions& options,
                                   const std::vector<RelativePose>& extra_starts, std::vector<PoseMinimum>* minima) {
-  CV_Assert(from.size() == to.size());
+  return EstimateRelativePose(NormalizedMatches(camera, from, to), options, extra_starts, minima);
+}
+
+RelativePose EstimateRelativePose(const NormalizedMatches& matches, const PoseOptions& options,
+                                  const std::vector<RelativePose>& extra_starts, std::vector<PoseMinimum>* minima) {
   if (minima) minima->clear();
-  if (static_cast<int>(from.size()) < options.min_matches) return RelativePose();
-  const NormalizedMatches matches(camera, from, to);
+  if (static_cast<int>(matches.size()) < options.min_matches) return RelativePose();
   // The threshold is a distance in pixels; on normalised points it is divided by the focal length.
   const double normalised_threshold = options.threshold / matches.focal();
   std::vector<RelativePose> starts;
@@ -429,9 +432,14 @@ double RivalCostGap(const std::vector<PoseMinimum>& minima, double min_angle_deg
 std::vector<PoseMinimum> ProbeTranslation(const RelativePose& pose, const Camera& camera,
                                           const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to,
                                           const PoseOptions& options, double angle_deg) {
+  if (!pose.valid) return {};
+  return ProbeTranslation(pose, NormalizedMatches(camera, from, to), options, angle_deg);
+}
+
+std::vector<PoseMinimum> ProbeTranslation(const RelativePose& pose, const NormalizedMatches& matches,
+                                          const PoseOptions& options, double angle_deg) {
   std::vector<PoseMinimum> ends;
   if (!pose.valid) return ends;
-  const NormalizedMatches matches(camera, from, to);
   const cv::Vec3d t = cv::normalize(pose.t);
   const cv::Vec3d axis = std::abs(t[0]) < 0.9 ? cv::Vec3d(1, 0, 0) : cv::Vec3d(0, 1, 0);
   const cv::Vec3d b0 = cv::normalize(t.cross(axis)), b1 = t.cross(b0);

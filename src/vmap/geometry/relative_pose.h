@@ -78,12 +78,31 @@ struct PoseMinimum {
   double cost = 0.0;
 };
 
+// The matches of one pose problem in normalised image coordinates (distortion removed), undistorted once.
+// Each function below takes them or, for convenience, pixels and the camera; the pose code undistorts no
+// point twice through this (cv::undistortPoints is iterative: a comparison of `vmap localize` spent more on
+// undistorting the same points again in each step than on refining the pose).
+struct NormalizedMatches {
+  NormalizedMatches(const Camera& camera, const std::vector<cv::Point2f>& from_pixels,
+                    const std::vector<cv::Point2f>& to_pixels);
+  NormalizedMatches Select(const std::vector<unsigned char>& mask) const;  // those where mask != 0
+  size_t size() const { return from.size(); }
+  double focal() const { return 0.5 * (fx + fy); }  // pixels per normalised unit, for thresholds in pixels
+
+  std::vector<cv::Point2d> from, to;
+  double fx = 0.0, fy = 0.0;
+  cv::Matx33d K;
+};
+
 // E estimated on the normalised points with OpenCV's USAC (MSAC scoring, local optimisation) from
 // options.starts seeds, each decomposed with the cheirality check; these and `extra_starts` are refined
 // (options.refine), each refined pose is decided again among the four its E allows (EnforceCheirality), and
 // the pose with the lowest PoseCost wins. `minima`, when given, receives every valid start's end, in order.
 RelativePose EstimateRelativePose(const Camera& camera, const std::vector<cv::Point2f>& from,
                                   const std::vector<cv::Point2f>& to, const PoseOptions& options,
+                                  const std::vector<RelativePose>& extra_starts = {},
+                                  std::vector<PoseMinimum>* minima = nullptr);
+RelativePose EstimateRelativePose(const NormalizedMatches& matches, const PoseOptions& options,
                                   const std::vector<RelativePose>& extra_starts = {},
                                   std::vector<PoseMinimum>* minima = nullptr);
 
@@ -102,22 +121,8 @@ double RivalCostGap(const std::vector<PoseMinimum>& minima, double min_angle_deg
 std::vector<PoseMinimum> ProbeTranslation(const RelativePose& pose, const Camera& camera,
                                           const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to,
                                           const PoseOptions& options, double angle_deg);
-
-// The matches of one pose problem in normalised image coordinates (distortion removed), undistorted once.
-// Each function below takes them or, for convenience, pixels and the camera; the pose code undistorts no
-// point twice through this (cv::undistortPoints is iterative: a comparison of `vmap localize` spent more on
-// undistorting the same points again in each step than on refining the pose).
-struct NormalizedMatches {
-  NormalizedMatches(const Camera& camera, const std::vector<cv::Point2f>& from_pixels,
-                    const std::vector<cv::Point2f>& to_pixels);
-  NormalizedMatches Select(const std::vector<unsigned char>& mask) const;  // those where mask != 0
-  size_t size() const { return from.size(); }
-  double focal() const { return 0.5 * (fx + fy); }  // pixels per normalised unit, for thresholds in pixels
-
-  std::vector<cv::Point2d> from, to;
-  double fx = 0.0, fy = 0.0;
-  cv::Matx33d K;
-};
+std::vector<PoseMinimum> ProbeTranslation(const RelativePose& pose, const NormalizedMatches& matches,
+                                          const PoseOptions& options, double angle_deg);
 
 // The robust cost a pose is chosen by: sum over the matches of log(1 + (e / threshold)^2), e the Sampson
 // error in pixels capped at refine_inlier_factor * threshold.

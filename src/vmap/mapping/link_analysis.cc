@@ -51,6 +51,7 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
     std::vector<PoseMinimum> minima;
     const std::vector<cv::Point2f>& pose_from = options.pose.use_all_matches ? all_from : verified_from;
     const std::vector<cv::Point2f>& pose_to = options.pose.use_all_matches ? all_to : verified_to;
+    const NormalizedMatches pose_matches(*camera, pose_from, pose_to);  // undistorted once for every step below
     if (options.pose.method == PoseMethod::kFromFundamental) {
       pose = PoseFromFundamental(link.F, *camera, verified_from, verified_to);
     } else {
@@ -59,13 +60,13 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
       if (options.pose.start_from_fundamental) {
         from_fundamental.push_back(PoseFromFundamental(link.F, *camera, verified_from, verified_to));
       }
-      pose = EstimateRelativePose(*camera, pose_from, pose_to, options.pose, from_fundamental, &minima);
+      pose = EstimateRelativePose(pose_matches, options.pose, from_fundamental, &minima);
     }
     if (pose.valid && options.pose.method == PoseMethod::kEssential) {
       // Probes at twice the rival angle: one that stays there is a rival, one that returns is not. One that
       // ends lower than every start found a better pose by the estimate's own cost: it becomes the pose.
       const std::vector<PoseMinimum> probes =
-          ProbeTranslation(pose, *camera, pose_from, pose_to, options.pose, 2.0 * options.translation.rival_angle_deg);
+          ProbeTranslation(pose, pose_matches, options.pose, 2.0 * options.translation.rival_angle_deg);
       minima.insert(minima.end(), probes.begin(), probes.end());
       pose = std::min_element(minima.begin(), minima.end(), [](const PoseMinimum& a, const PoseMinimum& b) {
                return a.cost < b.cost;
@@ -78,9 +79,8 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
       link.R = pose.R;
       link.t = pose.t;
       link.pose_inliers = pose.num_inliers;
-      link.translation_sigma_deg =
-          TranslationSigmaDeg(pose, *camera, pose_from, pose_to,
-                              options.pose.refine_inlier_factor * options.pose.threshold, options.pose.threshold);
+      link.translation_sigma_deg = TranslationSigmaDeg(
+          pose, pose_matches, options.pose.refine_inlier_factor * options.pose.threshold, options.pose.threshold);
     }
   }
   link.parallax_without_rotation = link.has_pose;
