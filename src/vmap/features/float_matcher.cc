@@ -9,17 +9,20 @@ namespace vmap {
 
 namespace {
 
-// Similarities are computed tile by tile: kTileRows query rows x kTileCols train rows (1 MB), scanned while
-// the tile is still in cache. cv::gemm hands products of at least 100 rows to the BLAS OpenCV is built with
-// (OpenBLAS, dispatched at run time to the CPU's best kernels) and computes smaller ones itself, 25x slower;
-// so every product has at least kMinRows rows.
+// Similarities are computed tile by tile: kTileRows query rows x kTileCols train rows (512 KB), scanned while
+// the tile is still in cache (half a core's L2 here: 7 % faster than 1 MB tiles on XFeat's pairs, either path;
+// 256 x 384 and 512 x 512 were no faster). cv::gemm hands products of at least 100 rows to the BLAS OpenCV is built
+// with (OpenBLAS, dispatched at run time to the CPU's best kernels) and computes smaller ones itself, 25x slower; so
+// every product has at least kMinRows rows.
 //
 // Measured on 512 x 4096 unit 64-d descriptors, one thread of a loaded Zen 3 core (min of 40 runs, gemm +
 // scan): cv::gemm 2.8-3.0 ms (74 ms with 32- or 64-row products); cblas_sgemm (OpenBLAS) 2.8-3.0 ms;
 // LibTorch mm 2.9-3.1 ms; Eigen 3.4 6.5-14.5 ms, compiled for SSE2 or with -mavx2 -mfma alike.
 constexpr int kTileRows = 256;
-constexpr int kTileCols = 1024;
+constexpr int kTileCols = 512;
 constexpr int kMinRows = 128;
+// The bound's set-up (the train rows' principal axes) pays off from about this many train rows.
+constexpr int kMinTrainRowsToPrune = 1024;
 constexpr float kLowest = -std::numeric_limits<float>::infinity();
 
 // The best partner of every query row and of every train row among the pairs offered so far. Offers come in
@@ -236,7 +239,8 @@ std::vector<FloatMatch> MatchFloatDescriptors(const cv::Mat& query, const cv::Ma
   // 10-60 apart, michigan a season apart; `xfeat_bench --float-matching`); 1/4 of the axes: 1/1.1-1/1.3,
   // 1/2: 1/1.4-1/1.5. Below a floor of ~0.5 nearly every pair passes, and small sets are fast either way.
   const int axes = query.cols * 3 / 8;
-  const bool prune = min_similarity >= 0.5f && axes >= 8 && query.rows >= kMinRows && train.rows >= kTileCols;
+  const bool prune =
+      min_similarity >= 0.5f && axes >= 8 && query.rows >= kMinRows && train.rows >= kMinTrainRowsToPrune;
   if (prune) {
     OfferPairsAboveFloor(query, train, min_similarity, axes, best);
   } else {

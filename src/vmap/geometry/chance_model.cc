@@ -58,17 +58,22 @@ ChanceOfMatches ChanceOfFundamental(const cv::Matx33d& F, const std::vector<cv::
   std::vector<double> distances(n);
   for (int i = 0; i < n; ++i) distances[i] = EpipolarDistance(F, points0[i], points1[i]);
   std::sort(distances.begin(), distances.end());
+  // The k-th smallest distance is the threshold e of the k nearest matches (clamping keeps the order).
+  for (double& d : distances) d = std::max(d, kLeastDistance);
   // Real unrelated images do not spread their matched points uniformly: they cluster where the texture is, and
   // an F whose epipoles sit in such clusters puts every clustered point near its line. So alpha(e) is also
   // measured on the pair's own points, paired at random (the frame point of one match with the key point of
   // another: what the null hypothesis says a match is), and the larger of the two probabilities is used.
-  std::vector<double> shuffled;
+  // It is needed only at the n thresholds above: each random pairing is counted under the first threshold it
+  // does not exceed, and the running sum gives how many are within each. The same counts as sorting the
+  // pairings, 3-4x faster (this took 5 % of XFeat localization's CPU sorted).
+  std::vector<int> within_threshold(n + 1, 0);  // [k]: random pairings with a distance <= distances[k]
+  int num_shuffled = 0;
   {
     const long all_pairs = static_cast<long>(n) * (n - 1);
-    const int count = static_cast<int>(std::min<long>(all_pairs, kRandomPairs));
-    shuffled.reserve(count);
+    num_shuffled = static_cast<int>(std::min<long>(all_pairs, kRandomPairs));
     cv::RNG rng(0x5eed);  // deterministic: the same pair always gives the same score
-    for (int s = 0; s < count; ++s) {
+    for (int s = 0; s < num_shuffled; ++s) {
       int i, j;
       if (all_pairs <= kRandomPairs) {
         i = s / (n - 1);
@@ -79,14 +84,11 @@ ChanceOfMatches ChanceOfFundamental(const cv::Matx33d& F, const std::vector<cv::
         j = rng.uniform(0, n - 1);
         j += j >= i;
       }
-      shuffled.push_back(EpipolarDistance(F, points0[i], points1[j]));
+      const double distance = EpipolarDistance(F, points0[i], points1[j]);
+      ++within_threshold[std::lower_bound(distances.begin(), distances.end(), distance) - distances.begin()];
     }
-    std::sort(shuffled.begin(), shuffled.end());
+    for (int k = 1; k <= n; ++k) within_threshold[k] += within_threshold[k - 1];
   }
-  auto shuffled_share = [&](double e) {
-    return static_cast<double>(std::upper_bound(shuffled.begin(), shuffled.end(), e) - shuffled.begin()) /
-           static_cast<double>(shuffled.size());
-  };
   // The k nearest for every k: C(n, k) and C(k, 7) updated from k to k + 1 rather than recomputed.
   const double tests = std::log10(std::max(num_hypotheses, 1.0) * kModelsPerSample * (n - kSampleSize));
   double log_n_choose_k = Log10Binomial(n, kSampleSize + 1);
@@ -96,10 +98,11 @@ ChanceOfMatches ChanceOfFundamental(const cv::Matx33d& F, const std::vector<cv::
       log_n_choose_k += std::log10(static_cast<double>(n - k + 1) / k);
       log_k_choose_7 += std::log10(static_cast<double>(k) / (k - kSampleSize));
     }
-    const double e = std::max(distances[k - 1], kLeastDistance);
+    const double e = distances[k - 1];
     if (!std::isfinite(e)) break;
+    const double shuffled_share = static_cast<double>(within_threshold[k - 1]) / num_shuffled;
     const double alpha =
-        std::max(std::min(RandomInlierProbability(e, size0), RandomInlierProbability(e, size1)), shuffled_share(e));
+        std::max(std::min(RandomInlierProbability(e, size0), RandomInlierProbability(e, size1)), shuffled_share);
     if (alpha >= 1.0) break;  // every match explained: nothing is unlikely any more
     const double log10_nfa = tests + log_n_choose_k + log_k_choose_7 + (k - kSampleSize) * std::log10(alpha);
     if (log10_nfa < best.log10_nfa) best = {log10_nfa, k, e};

@@ -1,5 +1,6 @@
 #include "vmap/geometry/chance_model.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -109,6 +110,45 @@ TEST(ChanceModel, TheScoreIsTheLeastFalseAlarmsOverTheNearestMatches) {
   // The 40 scene matches and hardly any of the 120 random ones.
   EXPECT_GE(chance.num_inliers, 36);
   EXPECT_LE(chance.num_inliers, 46);
+}
+
+// Points that crowd into a corner lie near many epipolar lines there: the pair's own points paired at random
+// (all 9,900 ordered pairings of 100 matches) then explain more than points spread over the image would, and
+// the score takes the larger share.
+TEST(ChanceModel, ThePairsOwnPointsPairedAtRandomRaiseAlphaWhereTheyCrowd) {
+  std::vector<cv::Point2f> p0, p1;
+  SceneMatches(60, 40, 0.3, 5, &p0, &p1);
+  for (size_t i = 0; i < p0.size(); ++i) {  // into the top-left quarter: the same geometry, crowded
+    p0[i] *= 0.25f;
+    p1[i] *= 0.25f;
+  }
+  const FundamentalResult fit = EstimateFundamental(p0, p1, LocalizationVerifier());
+  ASSERT_TRUE(fit.success);
+  const ChanceOfMatches chance = ChanceOfFundamental(fit.F, p0, p1, kQvga, kQvga, 12.0);
+  const int n = static_cast<int>(p0.size());
+  std::vector<double> distances, paired;
+  for (int i = 0; i < n; ++i) {
+    distances.push_back(std::max(EpipolarDistance(fit.F, p0[i], p1[i]), 1e-4));
+    for (int j = 0; j < n; ++j) {
+      if (j != i) paired.push_back(EpipolarDistance(fit.F, p0[i], p1[j]));
+    }
+  }
+  std::sort(distances.begin(), distances.end());
+  double least = std::numeric_limits<double>::infinity();
+  int crowded = 0;  // thresholds where the random pairings explain more than uniform points would
+  for (int k = 8; k <= n; ++k) {
+    const double e = distances[k - 1];
+    const double share =
+        static_cast<double>(std::count_if(paired.begin(), paired.end(), [&](double d) { return d <= e; })) /
+        paired.size();
+    const double uniform = RandomInlierProbability(e, kQvga);
+    crowded += share > uniform;
+    const double alpha = std::max(uniform, share);
+    if (alpha >= 1.0) break;
+    least = std::min(least, Log10FalseAlarms(n, k, alpha, 12.0));
+  }
+  EXPECT_GT(crowded, n / 2) << "the crowding is what this test tests";
+  EXPECT_NEAR(chance.log10_nfa, least, 1e-6);
 }
 
 TEST(ChanceModel, RandomMatchesAreRefused) {

@@ -44,11 +44,10 @@ LocalizationRun SampleRun() {
   const double no_bearing = std::numeric_limits<double>::quiet_NaN();
   const HeadingEstimate to_key_heading{HeadingMethod::kDisplacementMode, 1.5, no_bearing, 30, 200, 0.15};
   const HeadingEstimate to_next_heading{HeadingMethod::kDisplacementMode, -2.0, -0.25, 40, 100, 0.4};
-  tracked.to_key = {0,          true,  true, 0.75, 200, 150, cv::Matx33d::zeros(), to_key_heading, RelativePose{},
-                    no_bearing, false, -42.5};
-  tracked.to_next = {
-      1,   true, true, 0.5, 100, 50, cv::Matx33d(1, 2, 3, 4, 5, 6, 7, 8, 9), to_next_heading, RelativePose{},
-      2.5, true, -3.25};
+  tracked.to_key = {0,  true,           true,       0.75,  200,  150, cv::Matx33d::zeros(), to_key_heading,
+                    {}, RelativePose{}, no_bearing, false, -42.5};
+  tracked.to_next = {1,  true,           true, 0.5,  100,  50, cv::Matx33d(1, 2, 3, 4, 5, 6, 7, 8, 9), to_next_heading,
+                     {}, RelativePose{}, 2.5,  true, -3.25};
   tracked.translation_known = true;
   tracked.heading_px = -2.0;
   tracked.heading_deg = -0.25;

@@ -239,9 +239,6 @@ KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
       // The view's offset as the bearing of a point it moves by that much at the image's centre.
       c.heading.deg += std::atan(views[v].heading_px / options_.camera->fx) * 180.0 / M_PI;
     }
-    c.pose = RelativePose();
-    c.translation_sigma_deg = kNaN;
-    c.translation_known = false;
     best = std::move(c);
   }
   return best;
@@ -287,26 +284,33 @@ KeyComparison Localizer::CompareImage(const ImageFeatures& features, const Image
   }
   const Camera* camera = options_.camera ? &*options_.camera : nullptr;
   c.heading = EstimateHeading(key_points, frame_points, verified, options_.heading, camera);
-  if (camera && pair.matched && pair.num_verified > 0) {
-    key_points.resize(pair.num_verified);
-    frame_points.resize(pair.num_verified);
-    // The thresholds of the map's own pose estimates (PoseOptions): 3 px inliers, Cauchy scale 1 px.
-    const PoseOptions pose_options;
-    const double inlier_threshold = pose_options.refine_inlier_factor * pose_options.threshold;
-    const NormalizedMatches verified_matches(*camera, frame_points, key_points);
-    c.pose = PoseFromFundamental(pair.F, verified_matches);
-    if (c.pose.valid) {
-      // F's pose is not an optimum of the matches' errors (E = K^T F K is not essential): refined, and the
-      // four poses of the refined E decided again by cheirality, as a link's. Only then does the sigma below
-      // measure the matches rather than how far F's pose is from their optimum.
-      c.pose = EnforceCheirality(RefineRelativePose(c.pose, verified_matches, inlier_threshold, pose_options.threshold),
-                                 verified_matches, pose_options.threshold);
-      c.translation_sigma_deg = TranslationSigmaDeg(c.pose, verified_matches, inlier_threshold, pose_options.threshold);
-      const double parallax = Median(Displacements(verified_matches, c.pose.R));
-      c.translation_known = TranslationKnown(c.translation_sigma_deg, parallax, options_.translation);
-    }
-  }
+  if (pair.matched) c.verified.assign(pair.correspondences.begin(), pair.correspondences.begin() + pair.num_verified);
   return c;
+}
+
+void Localizer::AddPose(KeyComparison& c) const {
+  if (!options_.camera || !c.matched || c.experience != 0 || c.verified.empty() || c.pose.valid) return;
+  std::vector<cv::Point2f> key_points, frame_points;
+  key_points.reserve(c.verified.size());
+  frame_points.reserve(c.verified.size());
+  for (const Correspondence& m : c.verified) {
+    key_points.push_back(m.p1);
+    frame_points.push_back(m.p0);
+  }
+  // The thresholds of the map's own pose estimates (PoseOptions): 3 px inliers, Cauchy scale 1 px.
+  const PoseOptions pose_options;
+  const double inlier_threshold = pose_options.refine_inlier_factor * pose_options.threshold;
+  const NormalizedMatches verified_matches(*options_.camera, frame_points, key_points);
+  RelativePose pose = PoseFromFundamental(c.F, verified_matches);
+  if (!pose.valid) return;
+  // F's pose is not an optimum of the matches' errors (E = K^T F K is not essential): refined, and the four
+  // poses of the refined E decided again by cheirality, as a link's. Only then does the sigma below measure
+  // the matches rather than how far F's pose is from their optimum.
+  c.pose = EnforceCheirality(RefineRelativePose(pose, verified_matches, inlier_threshold, pose_options.threshold),
+                             verified_matches, pose_options.threshold);
+  c.translation_sigma_deg = TranslationSigmaDeg(c.pose, verified_matches, inlier_threshold, pose_options.threshold);
+  const double parallax = Median(Displacements(verified_matches, c.pose.R));
+  c.translation_known = TranslationKnown(c.translation_sigma_deg, parallax, options_.translation);
 }
 
 LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& features,
@@ -353,7 +357,8 @@ void Localizer::Describe(LocalizationResult& result, int position, const ImageFe
   const bool at_end = position + 1 >= static_cast<int>(route_.size());
   result.next_key = at_end ? -1 : route_[position + 1];
   result.to_next = at_end ? KeyComparison() : CompareOnce(features, result.next_key);
-  const KeyComparison& target = at_end ? result.to_key : result.to_next;
+  KeyComparison& target = at_end ? result.to_key : result.to_next;
+  AddPose(target);
   result.heading_px = target.heading.px;
   result.heading_deg = target.heading.deg;
   result.heading_key_px = result.to_key.heading.px;

@@ -124,9 +124,13 @@ struct KeyComparison {
   // The heading of the frame against the key image, x in the frame minus x in the key image (px; with a camera
   // also degrees), from all tentative matches (geometry/heading.h): it holds across seasons, where F rarely does.
   HeadingEstimate heading;
-  // With a camera: the key image's camera relative to the frame's, X_key = R X_frame + t, t of unit length
+  // The verified matches, p0 in the frame and p1 in the compared image (pixels); empty when !matched.
+  std::vector<Correspondence> verified;
+  // With a camera, on the target comparison of a result (LocalizationResult::to_next, or to_key at the route's
+  // end): the key image's camera relative to the frame's, X_key = R X_frame + t, t of unit length
   // (PoseFromFundamental on F and the verified matches, refined by RefineRelativePose and decided again by
-  // EnforceCheirality, so t never points backwards). Invalid without.
+  // EnforceCheirality, so t never points backwards). Invalid without a camera, and on the other comparisons:
+  // a pose costs as much as a verification, and only the target's guides the robot (Localizer::AddPose).
   RelativePose pose;
   // How well the verified matches determine the pose's translation direction (TranslationSigmaDeg, degrees;
   // NaN without a pose) and whether it is trusted (TranslationKnown with LocalizerOptions::translation).
@@ -209,6 +213,11 @@ class Localizer {
   // The frame's features against key image `key`, as Localize compares them. Thread-safe (const, and the
   // matcher's Match and the verifier are), so frames can be compared ahead on other threads.
   KeyComparison Compare(const ImageFeatures& features, int key) const;
+
+  // Adds the relative pose, its translation sigma and whether the translation is known to a comparison of
+  // the teach key image (experience 0) that matched, when the options have a camera. Localize does it for the
+  // target comparison of each result.
+  void AddPose(KeyComparison& comparison) const;
 
   // Forgets the estimate: the next frame is relocalized.
   void Reset();

@@ -8,6 +8,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/features/orb_matcher.h"
+#include "vmap/geometry/chance_model.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/testing/localization_test_util.h"
@@ -373,6 +374,38 @@ TEST(Localizer, WithACameraTheHeadingIsInDegreesAndThePoseIsTheTrueOne) {
   EXPECT_FALSE(p.to_key.pose.valid);
   EXPECT_FALSE(p.translation_known);
   EXPECT_EQ(LocalizationGuidance(p), "heading only: no pose");
+}
+
+// A pose costs as much as a verification, and only the target's guides the robot: the other comparisons carry
+// their verified matches, from which AddPose gives the same pose on demand.
+TEST(Localizer, OnlyTheTargetComparisonIsPosed) {
+  const LocalizationMap& m = Map().opened;
+  LocalizerOptions options = MapLocalizerOptions(m);
+  const cv::Matx33d K = SidewaysDrive().K;
+  options.camera = Camera::Make(K(0, 0), K(1, 1), K(0, 2), K(1, 2));
+  Localizer localizer(m.map, m.keys, *m.matcher, options);
+  const auto frames = DriveFrames(1, 2);
+  const auto indices = DriveIndices(1, 2);
+  int checked = 0;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const LocalizationResult r = LocalizeImage(localizer, frames[i], static_cast<int>(i), indices[i]);
+    if (r.next_key < 0 || !r.to_key.matched || !r.to_next.matched) continue;
+    ++checked;
+    EXPECT_TRUE(r.to_next.pose.valid) << "frame " << indices[i];
+    EXPECT_FALSE(r.to_key.pose.valid) << "frame " << indices[i];
+    EXPECT_TRUE(std::isnan(r.to_key.translation_sigma_deg));
+    ASSERT_EQ(static_cast<int>(r.to_key.verified.size()), r.to_key.num_verified);
+    // The verified matches are the frame's (p0) against the key image's (p1), on F's epipolar lines.
+    std::vector<double> distances;
+    for (const Correspondence& c : r.to_key.verified) distances.push_back(EpipolarDistance(r.to_key.F, c.p0, c.p1));
+    std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
+    EXPECT_LT(distances[distances.size() / 2], 1.0);
+    KeyComparison posed = r.to_key;
+    localizer.AddPose(posed);
+    EXPECT_TRUE(posed.pose.valid);
+    EXPECT_TRUE(std::isfinite(posed.translation_sigma_deg));
+  }
+  EXPECT_GE(checked, 20);
 }
 
 TEST(Localizer, SameInputSameResults) {
