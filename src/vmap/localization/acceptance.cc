@@ -14,12 +14,7 @@ ChanceOfMatches ChanceOfComparison(const PairComparison& pair, cv::Size frame_si
                                    int comparisons_per_frame) {
   if (!pair.matched) return {};
   std::vector<cv::Point2f> frame_points, key_points;
-  frame_points.reserve(pair.correspondences.size());
-  key_points.reserve(pair.correspondences.size());
-  for (const Correspondence& c : pair.correspondences) {
-    frame_points.push_back(c.p0);
-    key_points.push_back(c.p1);
-  }
+  SplitCorrespondences(pair.correspondences, &frame_points, &key_points);
   // pair.F maps frame points to lines in the key image: x_key^T F x_frame = 0.
   return ChanceOfFundamental(pair.F, frame_points, key_points, frame_size, key_size, comparisons_per_frame);
 }

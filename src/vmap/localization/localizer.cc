@@ -271,12 +271,7 @@ KeyComparison Localizer::CompareImage(const ImageFeatures& features, const Image
            : pair.num_verified >= options_.min_verified && pair.similarity >= options_.min_similarity);
   // The heading from every tentative match (verified first, then rejected), key image -> frame.
   std::vector<cv::Point2f> key_points, frame_points;
-  key_points.reserve(pair.correspondences.size());
-  frame_points.reserve(pair.correspondences.size());
-  for (const Correspondence& m : pair.correspondences) {
-    key_points.push_back(m.p1);
-    frame_points.push_back(m.p0);
-  }
+  SplitCorrespondences(pair.correspondences, &frame_points, &key_points);
   std::vector<unsigned char> verified;
   if (pair.matched) {
     verified.assign(pair.correspondences.size(), 0);
@@ -291,12 +286,7 @@ KeyComparison Localizer::CompareImage(const ImageFeatures& features, const Image
 void Localizer::AddPose(KeyComparison& c) const {
   if (!options_.camera || !c.matched || c.experience != 0 || c.verified.empty() || c.pose.valid) return;
   std::vector<cv::Point2f> key_points, frame_points;
-  key_points.reserve(c.verified.size());
-  frame_points.reserve(c.verified.size());
-  for (const Correspondence& m : c.verified) {
-    key_points.push_back(m.p1);
-    frame_points.push_back(m.p0);
-  }
+  SplitCorrespondences(c.verified, &frame_points, &key_points);
   // The thresholds of the map's own pose estimates (PoseOptions): 3 px inliers, Cauchy scale 1 px.
   const PoseOptions pose_options;
   const double inlier_threshold = pose_options.refine_inlier_factor * pose_options.threshold;

@@ -104,6 +104,8 @@ std::string MapWriter::AddKeyImage(std::shared_ptr<const Frame> frame) {
   return name;
 }
 
+void MapWriter::FlushKeyImages() { key_images_->Flush(); }
+
 void MapWriter::AddEvaluation(const Evaluation& evaluation) {
   // The record is the struct as laid out in memory: the file never leaves this process.
   if (std::fwrite(&evaluation, sizeof evaluation, 1, evaluations_) != 1) {

@@ -45,6 +45,8 @@ class MapWriter {
   // Queues `frame`, a new key image, to be written into keys/; returns its file name relative to the map
   // (keys/NNNNNN.png, or keys/NNNNNN.jpg etc. when it is a copy of its input image file).
   std::string AddKeyImage(std::shared_ptr<const Frame> frame);
+  // Waits until every key image queued so far is in directory() (to be read back: the links' cross-check).
+  void FlushKeyImages();
   void AddEvaluation(const Evaluation& evaluation);
   long num_evaluations() const { return num_evaluations_; }
 

@@ -7,6 +7,19 @@
 
 namespace vmap {
 
+void SplitCorrespondences(const std::vector<Correspondence>& correspondences, std::vector<cv::Point2f>* points0,
+                          std::vector<cv::Point2f>* points1, int count) {
+  const size_t n = count < 0 ? correspondences.size() : std::min(correspondences.size(), static_cast<size_t>(count));
+  points0->clear();
+  points1->clear();
+  points0->reserve(n);
+  points1->reserve(n);
+  for (size_t i = 0; i < n; ++i) {
+    points0->push_back(correspondences[i].p0);
+    points1->push_back(correspondences[i].p1);
+  }
+}
+
 QualityMean ParseQualityMean(const std::string& name) { return ParseEnum(kQualityMeanNames, name, "quality mean"); }
 
 std::string QualityMeanName(QualityMean mean) { return EnumToName(kQualityMeanNames, mean); }

@@ -27,6 +27,11 @@ struct Correspondence {
   cv::Point2f p1;  // in the link's second key image
 };
 
+// The p0 and the p1 of the first `count` correspondences (all when count < 0): the two point lists the geometry
+// functions take.
+void SplitCorrespondences(const std::vector<Correspondence>& correspondences, std::vector<cv::Point2f>* points0,
+                          std::vector<cv::Point2f>* points1, int count = -1);
+
 // Two consecutive key images and what ties them together.
 struct Link {
   int from_key = 0;  // index into VisualMap::key_images

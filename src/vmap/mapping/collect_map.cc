@@ -1,6 +1,7 @@
 #include "vmap/mapping/collect_map.h"
 
 #include <chrono>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 
@@ -8,7 +9,8 @@ namespace vmap {
 
 VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source, const MapBuilderOptions& options,
                      const std::string& options_json, double seconds, bool analyze_links,
-                     const LinkVerifier* link_verifier, double tau, LinkAnalysisCache* analysis_cache) {
+                     const LinkVerifier* link_verifier, double tau, LinkAnalysisCache* analysis_cache,
+                     MapWriter* key_image_files) {
   VisualMap map;
   map.input = source.info();
   map.options_json = options_json;
@@ -29,7 +31,16 @@ VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source
   if (!analyze_links) return map;
   const auto analysis_start = std::chrono::steady_clock::now();
   const long reused_before = analysis_cache ? analysis_cache->hits() : 0;
-  AnalyzeLinks(map, options.link_analysis, options.ExtractionThreads(), analysis_cache);
+  std::optional<KeyImagePixels> key_images;
+  if (key_image_files) {
+    key_image_files->FlushKeyImages();
+    key_images = KeyImagePixels{[directory = key_image_files->directory()](const KeyImage& key) {
+                                  return ReadKeyImage(directory, key, /*grayscale=*/true);
+                                },
+                                options.verifier};
+  }
+  AnalyzeLinks(map, options.link_analysis, options.ExtractionThreads(), analysis_cache,
+               key_images ? &*key_images : nullptr);
   const double analysis_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - analysis_start).count();
   spdlog::debug("pose, parallax and homography test of {} links in {:.3f} s ({} analysed before)", map.links.size(),

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "vmap/map/map_writer.h"
 #include "vmap/map/visual_map.h"
 #include "vmap/mapping/key_image_selector.h"
 #include "vmap/mapping/link_analysis.h"
@@ -15,10 +16,11 @@ namespace vmap {
 
 // `link_verifier` (when the decisions stopped early): the links verified in full replace the deciding ones.
 // `analyze_links`: also each link's pose, parallax and homography test (only maps that are kept need them),
-// reusing those of `analysis_cache` where the links did not change.
+// reusing those of `analysis_cache` where the links did not change. `key_image_files`: the writer the key images
+// went to, from which the links' cross-check (LinkAnalysisOptions::cross_check_features) reads them back.
 VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source, const MapBuilderOptions& options,
                      const std::string& options_json, double seconds, bool analyze_links,
                      const LinkVerifier* link_verifier = nullptr, double tau = 0.0,
-                     LinkAnalysisCache* analysis_cache = nullptr);
+                     LinkAnalysisCache* analysis_cache = nullptr, MapWriter* key_image_files = nullptr);
 
 }  // namespace vmap

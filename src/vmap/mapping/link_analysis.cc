@@ -4,7 +4,9 @@
 #include <atomic>
 #include <cmath>
 #include <exception>
+#include <functional>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -12,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/json_fields.h"
+#include "vmap/features/orb_matcher.h"
 
 namespace vmap {
 
@@ -19,6 +22,9 @@ void LinkAnalysisOptions::Check() const {
   CheckField("pose", pose);
   CheckField("homography", homography);
   CheckField("translation", translation);
+  if (cross_check_features < 0 || cross_check_features > 100000) {
+    throw OptionError("cross_check_features", "must be 0 (no cross-check) to 100000 ORB features per key image");
+  }
 }
 
 void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& options) {
@@ -98,7 +104,69 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
   }
 }
 
+void CrossCheckLinkPose(Link& link, const Link& denser, const Camera& camera, const TranslationOptions& translation) {
+  if (!link.has_pose || !denser.has_pose) return;
+  const bool agree = AngleBetweenDeg(link.t, denser.t) <= translation.rival_angle_deg;
+  const bool known = link.translation_known && denser.translation_known && agree;
+  if (denser.num_tentative > link.num_tentative) {
+    link.R = denser.R;
+    link.t = denser.t;
+    link.pose_inliers = denser.pose_inliers;
+    link.translation_sigma_deg = denser.translation_sigma_deg;
+    link.translation_rival_cost_gap = denser.translation_rival_cost_gap;
+    std::vector<cv::Point2f> from, to;
+    SplitCorrespondences(link.correspondences, &from, &to, link.num_verified);
+    link.parallax = Median(Displacements(from, to, &camera, &link.R));
+  }
+  link.translation_known = known;
+}
+
 namespace {
+
+// The two key images of a link matched and verified anew with `matcher` (denser features than the map's), as a
+// link: F, the counts and the correspondences (verified first); no analysis yet.
+Link MatchAgain(const Link& link, const ImageFeatures& from, const ImageFeatures& to, const Matcher& matcher,
+                const VerifierOptions& verifier) {
+  Link again;
+  again.from_key = link.from_key;
+  again.to_key = link.to_key;
+  const TentativeMatches matches = matcher.Match(from, to);
+  const FundamentalResult fit = EstimateFundamental(matches.points0, matches.points1, verifier);
+  again.num_tentative = static_cast<int>(matches.size());
+  if (!fit.success) return again;
+  again.has_fundamental = true;
+  again.F = fit.F;
+  again.num_verified = fit.num_inliers;
+  std::vector<Correspondence> rejected;
+  for (size_t i = 0; i < matches.size(); ++i) {
+    (fit.inlier_mask[i] ? again.correspondences : rejected).push_back({matches.points0[i], matches.points1[i]});
+  }
+  again.correspondences.insert(again.correspondences.end(), rejected.begin(), rejected.end());
+  return again;
+}
+
+// Calls work(i) for i in [0, count) on `threads` threads (the calling one included); rethrows the first failure.
+void ForEachOnThreads(size_t count, int threads, const std::function<void(size_t)>& work) {
+  std::atomic<size_t> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  const auto run = [&] {
+    for (size_t k = next++; k < count; k = next++) {
+      try {
+        work(k);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+      }
+    }
+  };
+  std::vector<std::thread> workers;
+  const int extra = std::min<int>(std::max(threads, 1), static_cast<int>(count)) - 1;
+  for (int k = 0; k < extra; ++k) workers.emplace_back(run);
+  run();
+  for (std::thread& worker : workers) worker.join();
+  if (error) std::rethrow_exception(error);
+}
 
 // FNV-1a over the bytes of what AnalyzeLink reads.
 class Fingerprint {
@@ -146,7 +214,8 @@ void CopyAnalysis(const Link& from, Link& to) {
 
 }  // namespace
 
-void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int threads, LinkAnalysisCache* cache) {
+void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int threads, LinkAnalysisCache* cache,
+                  const KeyImagePixels* key_images) {
   const Camera* camera = map.input.camera ? &*map.input.camera : nullptr;
   const auto frames_of = [&map](const Link& link) {
     return std::make_pair(map.key_images.at(link.from_key).frame_index, map.key_images.at(link.to_key).frame_index);
@@ -166,25 +235,40 @@ void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int thread
     todo.push_back(i);
   }
 
-  std::atomic<size_t> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  const auto work = [&] {
-    for (size_t k = next++; k < todo.size(); k = next++) {
-      try {
-        AnalyzeLink(map.links[todo[k]], camera, options);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (!error) error = std::current_exception();
+  const bool cross_check = camera && key_images && key_images->read && options.cross_check_features > 0;
+  std::unique_ptr<Matcher> denser_matcher;
+  if (cross_check) {
+    OrbMatcherOptions orb;
+    orb.num_features = options.cross_check_features;
+    denser_matcher = CreateOrbMatcher(orb);
+  }
+  // In chunks of links, so that only a chunk's key images' denser features are held at once; each key image's
+  // features are extracted once per chunk (a key image is in two links).
+  constexpr size_t kChunkLinks = 256;
+  for (size_t begin = 0; begin < todo.size(); begin += kChunkLinks) {
+    const size_t end = std::min(todo.size(), begin + kChunkLinks);
+    std::map<int, std::shared_ptr<const ImageFeatures>> features;  // by key-image index
+    if (cross_check) {
+      for (size_t k = begin; k < end; ++k) {
+        features[map.links[todo[k]].from_key];
+        features[map.links[todo[k]].to_key];
       }
+      std::vector<std::pair<const int, std::shared_ptr<const ImageFeatures>>*> slots;
+      for (auto& slot : features) slots.push_back(&slot);
+      ForEachOnThreads(slots.size(), threads, [&](size_t i) {
+        slots[i]->second = denser_matcher->Extract(key_images->read(map.key_images.at(slots[i]->first)));
+      });
     }
-  };
-  std::vector<std::thread> workers;
-  const int extra = std::min<int>(std::max(threads, 1), static_cast<int>(todo.size())) - 1;
-  for (int k = 0; k < extra; ++k) workers.emplace_back(work);
-  work();
-  for (std::thread& worker : workers) worker.join();
-  if (error) std::rethrow_exception(error);
+    ForEachOnThreads(end - begin, threads, [&](size_t k) {
+      Link& link = map.links[todo[begin + k]];
+      AnalyzeLink(link, camera, options);
+      if (!cross_check || !link.has_pose) return;
+      Link denser = MatchAgain(link, *features.at(link.from_key), *features.at(link.to_key), *denser_matcher,
+                               key_images->verifier);
+      AnalyzeLink(denser, camera, options);
+      CrossCheckLinkPose(link, denser, *camera, options.translation);
+    });
+  }
 
   if (!cache) return;
   // Only this map's links stay: a live run's last link changes at every snapshot.
@@ -201,6 +285,10 @@ void LinkAnalysisOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.VisitNested("pose", pose);
   visitor.VisitNested("homography", homography);
   visitor.VisitNested("translation", translation);
+  visitor.Visit({"cross_check_features", "--cross-check-features",
+                 "ORB features per key image for a second estimate of each link's pose: its translation is known "
+                 "only where both estimates agree (0: the link's own matches only)"},
+                cross_check_features);
 }
 
 }  // namespace vmap

@@ -2,8 +2,13 @@
 
 #include "vmap/mapping/link_analysis.h"
 
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
 #include <gtest/gtest.h>
 
+#include "vmap/core/error.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/batch_build.h"
 #include "vmap/testing/scoped_temp_dir.h"
@@ -12,22 +17,30 @@
 namespace vmap {
 namespace {
 
-// A map with a camera (KITTI layout), so that links get poses: the costly part of the analysis.
+// A drive with a camera (KITTI layout in `directory`), so that links get poses: the costly part of the analysis.
+void WriteDrive(const std::filesystem::path& directory) {
+  testing::SyntheticOptions scene;
+  scene.num_frames = 40;
+  scene.step = 0.06;
+  scene.yaw_per_frame = 0.01;
+  testing::WriteKittiSequence(testing::RenderSyntheticSequence(scene), directory);
+}
+
+MapBuilderOptions DriveBuildOptions() {
+  MapBuilderOptions options;
+  options.key_images.tau = 0.7;
+  options.show_progress = false;
+  options.verifier.threshold = 1.0;
+  return options;
+}
+
+// The drive's map, built in memory: the links' own estimates only (no key-image files to cross-check with).
 const VisualMap& AnalysedMap() {
   static const VisualMap map = [] {
-    testing::SyntheticOptions scene;
-    scene.num_frames = 40;
-    scene.step = 0.06;
-    scene.yaw_per_frame = 0.01;
     const testing::ScopedTempDir tmp("link_analysis");
-    testing::WriteKittiSequence(testing::RenderSyntheticSequence(scene), tmp.path() / "kitti");
-    MapBuilderOptions options;
-    options.key_images.tau = 0.7;
-    options.show_progress = false;
-    options.verifier.threshold = 1.0;
-    const auto matcher = CreateOrbMatcher({});
+    WriteDrive(tmp.path() / "kitti");
     auto source = OpenFrameSource((tmp.path() / "kitti").string(), {});
-    return BuildMap(*source, *matcher, options);
+    return BuildMap(*source, *CreateOrbMatcher({}), DriveBuildOptions());
   }();
   return map;
 }
@@ -115,6 +128,113 @@ TEST(LinkAnalysisCache, KeepsOnlyTheLinksOfTheLastMap) {
   AnalyzeLinks(again, options, 1, &cache);
   EXPECT_EQ(cache.hits(), 2 * static_cast<long>(shorter.links.size()));
   ExpectSameAnalysis(again, AnalysedMap());
+}
+
+// A rotation of `degrees` about the camera's y axis (a turn of the robot).
+cv::Matx33d Yaw(double degrees) {
+  const double a = degrees * M_PI / 180.0;
+  return cv::Matx33d(std::cos(a), 0, std::sin(a), 0, 1, 0, -std::sin(a), 0, std::cos(a));
+}
+
+TEST(CrossCheckLinkPose, TheTranslationIsKnownOnlyWhereBothEstimatesKnowItAndAgree) {
+  const VisualMap& map = AnalysedMap();
+  const Camera& camera = *map.input.camera;
+  const TranslationOptions translation;  // rival angle 15 degrees
+  const auto known =
+      std::find_if(map.links.begin(), map.links.end(), [](const Link& l) { return l.translation_known; });
+  ASSERT_NE(known, map.links.end()) << "a link whose translation is known";
+  const Link own = *known;
+  Link denser = own;
+  denser.num_tentative = 4 * own.num_tentative;
+  denser.R = own.R * Yaw(0.5);
+  denser.pose_inliers = 3 * own.num_tentative;
+  denser.translation_sigma_deg = 0.25;
+
+  // 10 degrees apart: the same direction. The link takes the denser pose, and the parallax of its own verified
+  // matches under that rotation.
+  denser.t = Yaw(10.0) * own.t;
+  Link link = own;
+  CrossCheckLinkPose(link, denser, camera, translation);
+  EXPECT_TRUE(link.translation_known);
+  EXPECT_EQ(link.R, denser.R);
+  EXPECT_EQ(link.t, denser.t);
+  EXPECT_EQ(link.pose_inliers, denser.pose_inliers);
+  EXPECT_EQ(link.translation_sigma_deg, 0.25);
+  std::vector<cv::Point2f> from, to;
+  SplitCorrespondences(own.correspondences, &from, &to, own.num_verified);
+  EXPECT_EQ(link.parallax, Median(Displacements(from, to, &camera, &denser.R)));
+  EXPECT_NE(link.parallax, own.parallax) << "the rotation changed: so does what it leaves of the displacements";
+
+  // 20 degrees apart: two estimates that disagree; the pose is still the denser one.
+  denser.t = Yaw(20.0) * own.t;
+  link = own;
+  CrossCheckLinkPose(link, denser, camera, translation);
+  EXPECT_FALSE(link.translation_known);
+  EXPECT_EQ(link.t, denser.t);
+
+  // Agreeing, but the denser estimate does not know its translation.
+  denser.t = own.t;
+  denser.translation_known = false;
+  link = own;
+  CrossCheckLinkPose(link, denser, camera, translation);
+  EXPECT_FALSE(link.translation_known);
+
+  // The link's own estimate has more matches: it keeps its pose; the flag still needs both.
+  denser.translation_known = true;
+  denser.num_tentative = own.num_tentative / 2;
+  denser.t = Yaw(30.0) * own.t;
+  link = own;
+  CrossCheckLinkPose(link, denser, camera, translation);
+  EXPECT_EQ(link.t, own.t);
+  EXPECT_EQ(link.R, own.R);
+  EXPECT_FALSE(link.translation_known);
+
+  // No denser pose: nothing to check against, the link stays as it was.
+  denser.has_pose = false;
+  link = own;
+  CrossCheckLinkPose(link, denser, camera, translation);
+  EXPECT_TRUE(link.translation_known);
+  EXPECT_EQ(link.t, own.t);
+  EXPECT_EQ(link.parallax, own.parallax);
+}
+
+// Built into a directory, the links are cross-checked with the key images read back from it: their poses come
+// from the denser matches (more inliers than the link's own matches hold); with cross_check_features 0 they
+// come from the link's own matches. The same input gives the same poses.
+TEST(CrossCheckLinkPose, AMapBuiltIntoADirectoryIsCrossChecked) {
+  const testing::ScopedTempDir tmp("cross_check");
+  WriteDrive(tmp.path() / "kitti");
+  const auto matcher = CreateOrbMatcher({});
+  auto build = [&](int cross_check_features, const std::string& name) {
+    MapBuilderOptions options = DriveBuildOptions();
+    options.link_analysis.cross_check_features = cross_check_features;
+    auto source = OpenFrameSource((tmp.path() / "kitti").string(), {});
+    std::filesystem::create_directories(tmp.path() / name);
+    return BuildMap(*source, *matcher, options, tmp.path() / name);
+  };
+  const VisualMap checked = build(2000, "checked");
+  const VisualMap again = build(2000, "again");
+  const VisualMap own = build(0, "own");
+  ASSERT_EQ(checked.links.size(), own.links.size());
+  ASSERT_GE(checked.links.size(), 3u);
+  int denser_poses = 0;
+  for (size_t i = 0; i < checked.links.size(); ++i) {
+    ASSERT_TRUE(checked.links[i].has_pose);
+    EXPECT_LE(own.links[i].pose_inliers, own.links[i].num_tentative) << i;
+    denser_poses += checked.links[i].pose_inliers > checked.links[i].num_tentative;
+    EXPECT_EQ(checked.links[i].R, again.links[i].R) << i;
+    EXPECT_EQ(checked.links[i].t, again.links[i].t) << i;
+    EXPECT_EQ(checked.links[i].translation_known, again.links[i].translation_known) << i;
+  }
+  EXPECT_EQ(denser_poses, static_cast<int>(checked.links.size()));
+}
+
+TEST(CrossCheckLinkPose, OptionsAreChecked) {
+  LinkAnalysisOptions options;
+  options.cross_check_features = -1;
+  EXPECT_THROW(options.Check(), OptionError);
+  options.cross_check_features = 0;
+  EXPECT_NO_THROW(options.Check());
 }
 
 }  // namespace

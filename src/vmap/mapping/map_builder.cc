@@ -114,8 +114,9 @@ class MapBuilder::Impl {
     for (size_t i = 0; i < selectors_.size(); ++i) {
       // Nothing to write before Algorithm 1 has taken its first frame.
       if (!writers_[i] || selectors_[i]->key_images().empty()) continue;
-      VisualMap map = CollectMap(*selectors_[i], source_, options_, options_json_, SecondsSince(start_),
-                                 /*analyze_links=*/true, link_verifier_.get(), taus_[i], &link_analyses_[i]);
+      VisualMap map =
+          CollectMap(*selectors_[i], source_, options_, options_json_, SecondsSince(start_),
+                     /*analyze_links=*/true, link_verifier_.get(), taus_[i], &link_analyses_[i], writers_[i]);
       map.coverage = CurrentCoverage(CoverageEnd::kSnapshot);
       writers_[i]->Snapshot(map);
     }
@@ -140,7 +141,7 @@ class MapBuilder::Impl {
     std::vector<VisualMap> maps;
     for (size_t i = 0; i < selectors_.size(); ++i) {
       VisualMap map = CollectMap(*selectors_[i], source_, options_, options_json_, seconds, analyze_links,
-                                 link_verifier_.get(), taus_[i], &link_analyses_[i]);
+                                 link_verifier_.get(), taus_[i], &link_analyses_[i], writers_[i]);
       // A map of a whole file says nothing more (its map.json stays as it was); a live input's says what it
       // covers.
       if (end != CoverageEnd::kInputEnded || source_.info().expected_frames < 0) map.coverage = CurrentCoverage(end);
