@@ -136,7 +136,9 @@ TEST(LocalizeCli, ADifferentSceneDoesNotLocalize) {
       EXPECT_EQ(frame["candidates"].size(), 5u) << "every lost frame verified the best-ranked key images";
       for (const auto& candidate : frame["candidates"]) {
         // Unmatched (null), or matched with a verified set that chance explains.
-        if (!candidate["log10_nfa"].is_null()) EXPECT_GT(candidate["log10_nfa"].get<double>(), 0.0) << candidate;
+        if (!candidate["log10_nfa"].is_null()) {
+          EXPECT_GT(candidate["log10_nfa"].get<double>(), 0.0) << candidate;
+        }
       }
     }
     EXPECT_EQ(doc["options"]["acceptance"], rule);
