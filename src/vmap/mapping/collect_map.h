@@ -17,7 +17,7 @@ namespace vmap {
 // `link_verifier` (when the decisions stopped early): the links verified in full replace the deciding ones.
 // `analyze_links`: also each link's pose, parallax and homography test (only maps that are kept need them),
 // reusing those of `analysis_cache` where the links did not change. `key_image_files`: the writer the key images
-// went to, from which the links' cross-check (LinkAnalysisOptions::cross_check_features) reads them back.
+// went to, from which the links' cross-check (LinkAnalysisOptions::pose_check_features) reads them back.
 VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source, const MapBuilderOptions& options,
                      const std::string& options_json, double seconds, bool analyze_links,
                      const LinkVerifier* link_verifier = nullptr, double tau = 0.0,

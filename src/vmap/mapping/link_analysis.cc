@@ -22,8 +22,8 @@ void LinkAnalysisOptions::Check() const {
   CheckField("pose", pose);
   CheckField("homography", homography);
   CheckField("translation", translation);
-  if (cross_check_features < 0 || cross_check_features > 100000) {
-    throw OptionError("cross_check_features", "must be 0 (no cross-check) to 100000 ORB features per key image");
+  if (pose_check_features < 0 || pose_check_features > 100000) {
+    throw OptionError("pose_check_features", "must be 0 (no cross-check) to 100000 ORB features per key image");
   }
 }
 
@@ -235,11 +235,11 @@ void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int thread
     todo.push_back(i);
   }
 
-  const bool cross_check = camera && key_images && key_images->read && options.cross_check_features > 0;
+  const bool cross_check = camera && key_images && key_images->read && options.pose_check_features > 0;
   std::unique_ptr<Matcher> denser_matcher;
   if (cross_check) {
     OrbMatcherOptions orb;
-    orb.num_features = options.cross_check_features;
+    orb.num_features = options.pose_check_features;
     denser_matcher = CreateOrbMatcher(orb);
   }
   // In chunks of links, so that only a chunk's key images' denser features are held at once; each key image's
@@ -285,10 +285,10 @@ void LinkAnalysisOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.VisitNested("pose", pose);
   visitor.VisitNested("homography", homography);
   visitor.VisitNested("translation", translation);
-  visitor.Visit({"cross_check_features", "--cross-check-features",
+  visitor.Visit({"pose_check_features", "--pose-check-features",
                  "ORB features per key image for a second estimate of each link's pose: its translation is known "
                  "only where both estimates agree (0: the link's own matches only)"},
-                cross_check_features);
+                pose_check_features);
 }
 
 }  // namespace vmap

@@ -2,7 +2,8 @@
 // What a robot needs to know about a link besides S and F: the relative pose of its two key images (when
 // the camera is known), how much parallax its matches have, and whether a homography explains them as well
 // as F (then F and the pose are ill-posed). Computed from the link's stored matches after Algorithm 1 has
-// chosen the key images, so it never changes which key images are chosen.
+// chosen the key images, so it never changes which key images are chosen; the pose is then cross-checked
+// against a second estimate from denser features of the two key images (CrossCheckLinkPose).
 
 #include <cstdint>
 #include <functional>
@@ -29,10 +30,10 @@ struct LinkAnalysisOptions {
   // the pose of the estimate with more tentative matches, and its translation is known only where both
   // estimates know it and agree within translation.rival_angle_deg. 0: the link's own matches only. 2000:
   // the only count of 1000, 2000 and 3000 with >= 95 % usable links on redkitchen 0-499 (docs/link-poses.md).
-  int cross_check_features = 2000;
+  int pose_check_features = 2000;
 
-  // As map.json records it: {"pose": ..., "homography": ..., "translation": ...} (geometry/relative_pose.h,
-  // geometry/homography.h).
+  // As map.json records it: {"pose": ..., "homography": ..., "translation": ..., "pose_check_features": ...}
+  // (geometry/relative_pose.h, geometry/homography.h).
   void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
@@ -49,7 +50,7 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
 // the matches do not determine, whatever each one's sigma says. Without both poses the link stays as it is.
 void CrossCheckLinkPose(Link& link, const Link& denser, const Camera& camera, const TranslationOptions& translation);
 
-// What the cross-check (LinkAnalysisOptions::cross_check_features) reads besides the map: a key image's pixels
+// What the cross-check (LinkAnalysisOptions::pose_check_features) reads besides the map: a key image's pixels
 // (8-bit grey; e.g. ReadKeyImage from the map directory being written), and the verifier of the map.
 struct KeyImagePixels {
   std::function<cv::Mat(const KeyImage&)> read;
@@ -77,7 +78,7 @@ class LinkAnalysisCache {
 // AnalyzeLink for every link, with the map's camera (map.input.camera) when it has one, on `threads` threads
 // (links are independent: the result does not depend on the number of threads). With `cache`, links analysed
 // by an earlier call are not analysed again, and the cache keeps only this map's links (memory stays flat).
-// With `key_images`, a camera and options.cross_check_features > 0, each posed link is also cross-checked
+// With `key_images`, a camera and options.pose_check_features > 0, each posed link is also cross-checked
 // against the pose of denser features of its key images (CrossCheckLinkPose).
 void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int threads = 1,
                   LinkAnalysisCache* cache = nullptr, const KeyImagePixels* key_images = nullptr);

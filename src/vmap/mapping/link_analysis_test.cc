@@ -199,15 +199,15 @@ TEST(CrossCheckLinkPose, TheTranslationIsKnownOnlyWhereBothEstimatesKnowItAndAgr
 }
 
 // Built into a directory, the links are cross-checked with the key images read back from it: their poses come
-// from the denser matches (more inliers than the link's own matches hold); with cross_check_features 0 they
+// from the denser matches (more inliers than the link's own matches hold); with pose_check_features 0 they
 // come from the link's own matches. The same input gives the same poses.
 TEST(CrossCheckLinkPose, AMapBuiltIntoADirectoryIsCrossChecked) {
   const testing::ScopedTempDir tmp("cross_check");
   WriteDrive(tmp.path() / "kitti");
   const auto matcher = CreateOrbMatcher({});
-  auto build = [&](int cross_check_features, const std::string& name) {
+  auto build = [&](int pose_check_features, const std::string& name) {
     MapBuilderOptions options = DriveBuildOptions();
-    options.link_analysis.cross_check_features = cross_check_features;
+    options.link_analysis.pose_check_features = pose_check_features;
     auto source = OpenFrameSource((tmp.path() / "kitti").string(), {});
     std::filesystem::create_directories(tmp.path() / name);
     return BuildMap(*source, *matcher, options, tmp.path() / name);
@@ -231,9 +231,9 @@ TEST(CrossCheckLinkPose, AMapBuiltIntoADirectoryIsCrossChecked) {
 
 TEST(CrossCheckLinkPose, OptionsAreChecked) {
   LinkAnalysisOptions options;
-  options.cross_check_features = -1;
+  options.pose_check_features = -1;
   EXPECT_THROW(options.Check(), OptionError);
-  options.cross_check_features = 0;
+  options.pose_check_features = 0;
   EXPECT_NO_THROW(options.Check());
 }
 

@@ -107,10 +107,10 @@ TEST(RecordedOptions, KeepsMapJsonsLayout) {
   const nlohmann::json record = ToJson(RecordedOptions{});
   std::set<std::string> keys;
   for (const auto& item : record.items()) keys.insert(item.key());
-  EXPECT_EQ(keys, (std::set<std::string>{"cross_check_features", "exhaustive", "final_key", "homography", "matcher",
+  EXPECT_EQ(keys, (std::set<std::string>{"pose_check_features", "exhaustive", "final_key", "homography", "matcher",
                                          "min_key_displacement", "pose", "quality_mean", "search", "search_window",
                                          "similarity", "source", "tau", "translation", "verifier"}));
-  EXPECT_EQ(record["cross_check_features"], 2000);
+  EXPECT_EQ(record["pose_check_features"], 2000);
   EXPECT_EQ(record["source"]["camera"], "input");
   EXPECT_EQ(record["search"], "sequential");
   EXPECT_EQ(record["pose"]["matches"], "all");
