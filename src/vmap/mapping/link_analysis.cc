@@ -27,7 +27,11 @@ void LinkAnalysisOptions::Check() const {
   }
 }
 
-void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& options) {
+namespace {
+
+// AnalyzeLink; without `test_homography` the homography fields are left unset (a pose cross-check's denser
+// estimate, whose homography nobody reads).
+void Analyze(Link& link, const Camera* camera, const LinkAnalysisOptions& options, bool test_homography) {
   link.has_pose = false;
   link.R = cv::Matx33d::eye();
   link.t = cv::Vec3d();
@@ -97,11 +101,18 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
   link.translation_known =
       link.has_pose && TranslationKnown(link.translation_sigma_deg, link.parallax, rival_cost_gap, options.translation);
 
+  if (!test_homography) return;
   const HomographyCheck homography = CheckHomography(verified_from, verified_to, options.homography);
   if (homography.estimated) {
     link.homography_share = homography.share;
     link.planar = homography.explains;
   }
+}
+
+}  // namespace
+
+void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& options) {
+  Analyze(link, camera, options, /*test_homography=*/true);
 }
 
 void CrossCheckLinkPose(Link& link, const Link& denser, const Camera& camera, const TranslationOptions& translation) {
@@ -265,7 +276,7 @@ void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int thread
       if (!cross_check || !link.has_pose) return;
       Link denser = MatchAgain(link, *features.at(link.from_key), *features.at(link.to_key), *denser_matcher,
                                key_images->verifier);
-      AnalyzeLink(denser, camera, options);
+      Analyze(denser, camera, options, /*test_homography=*/false);
       CrossCheckLinkPose(link, denser, *camera, options.translation);
     });
   }
