@@ -8,8 +8,8 @@
 
 #include "vmap/features/orb_matcher.h"
 #include "vmap/map/map_io.h"
+#include "vmap/mapping/key_image_selector.h"
 #include "vmap/mapping/link_analysis.h"
-#include "vmap/mapping/pair_match.h"
 
 int main(int argc, char** argv) {
   if (argc != 4) {
@@ -29,17 +29,11 @@ int main(int argc, char** argv) {
     if (!link.has_fundamental) continue;
     const cv::Mat a = vmap::ReadKeyImage(in, map.key_images[link.from_key], true);
     const cv::Mat b = vmap::ReadKeyImage(in, map.key_images[link.to_key], true);
-    const vmap::PairMatch pm = vmap::MatchPair(*matcher, vmap::PairImage(a), vmap::PairImage(b), verifier);
-    if (!pm.fundamental.success) continue;
-    std::vector<vmap::Correspondence> verified, rejected;
-    for (size_t i = 0; i < pm.matches.size(); ++i) {
-      (pm.fundamental.inlier_mask[i] ? verified : rejected).push_back({pm.matches.points0[i], pm.matches.points1[i]});
-    }
-    link.num_tentative = static_cast<int>(pm.matches.size());
-    link.num_verified = static_cast<int>(verified.size());
-    link.F = pm.fundamental.F;
-    link.correspondences = verified;
-    link.correspondences.insert(link.correspondences.end(), rejected.begin(), rejected.end());
+    const vmap::Link again = vmap::MakeLink(vmap::ComparePair(*matcher, *matcher->Extract(a), *matcher->Extract(b),
+                                                              verifier, vmap::SimilarityMode::kInlierRatio),
+                                            link.from_key, link.to_key, link.below_tau);
+    if (!again.has_fundamental) continue;
+    link = again;
     vmap::AnalyzeLink(link, camera, analysis);
   }
   fs::create_directories(out);

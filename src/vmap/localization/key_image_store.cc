@@ -1,13 +1,11 @@
 #include "vmap/localization/key_image_store.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <cstring>
 #include <exception>
 #include <fstream>
-#include <mutex>
 #include <thread>
 
 #include <fmt/format.h>
@@ -17,6 +15,7 @@
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/parallel_for.h"
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/map/map_io.h"
 
@@ -157,32 +156,14 @@ void ComputeKeyImages(const fs::path& map_directory, const std::vector<KeyImage>
   const size_t n = images.size();
   store.features.assign(n, nullptr);
   store.thumbnails.assign(n, cv::Mat());
-  std::atomic<size_t> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto work = [&] {
-    try {
-      for (size_t k = next++; k < n; k = next++) {
-        const cv::Mat gray = ReadKeyImage(map_directory, images[k], /*grayscale=*/true);
-        const cv::Mat bgr = matcher.reads_color() ? ReadKeyImage(map_directory, images[k]) : cv::Mat();
-        store.features[k] = matcher.ExtractFrame(gray, bgr.channels() == 3 ? bgr : cv::Mat());
-        store.thumbnails[k] = ThumbnailDescriptor(gray, options.thumbnail_width);
-      }
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(error_mutex);
-      if (!error) error = std::current_exception();
-      next = n;
-    }
-  };
-  const int threads =
-      std::max(1, std::min<int>(static_cast<int>(n), options.extraction_threads > 0
-                                                         ? options.extraction_threads
-                                                         : static_cast<int>(std::thread::hardware_concurrency())));
-  std::vector<std::thread> workers;
-  for (int i = 1; i < threads; ++i) workers.emplace_back(work);
-  work();
-  for (std::thread& t : workers) t.join();
-  if (error) std::rethrow_exception(error);
+  const int threads = options.extraction_threads > 0 ? options.extraction_threads
+                                                     : static_cast<int>(std::thread::hardware_concurrency());
+  ParallelFor(n, threads, [&](size_t k) {
+    const cv::Mat gray = ReadKeyImage(map_directory, images[k], /*grayscale=*/true);
+    const cv::Mat bgr = matcher.reads_color() ? ReadKeyImage(map_directory, images[k]) : cv::Mat();
+    store.features[k] = matcher.ExtractFrame(gray, bgr.channels() == 3 ? bgr : cv::Mat());
+    store.thumbnails[k] = ThumbnailDescriptor(gray, options.thumbnail_width);
+  });
 }
 
 }  // namespace

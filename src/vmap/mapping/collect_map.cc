@@ -31,16 +31,16 @@ VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source
   if (!analyze_links) return map;
   const auto analysis_start = std::chrono::steady_clock::now();
   const long reused_before = analysis_cache ? analysis_cache->hits() : 0;
-  std::optional<KeyImagePixels> key_images;
+  std::optional<PoseCheckInputs> pose_check;
   if (key_image_files) {
     key_image_files->FlushKeyImages();
-    key_images = KeyImagePixels{[directory = key_image_files->directory()](const KeyImage& key) {
-                                  return ReadKeyImage(directory, key, /*grayscale=*/true);
-                                },
-                                options.verifier};
+    pose_check = PoseCheckInputs{[directory = key_image_files->directory()](const KeyImage& key) {
+                                   return ReadKeyImage(directory, key, /*grayscale=*/true);
+                                 },
+                                 options.verifier};
   }
   AnalyzeLinks(map, options.link_analysis, options.ExtractionThreads(), analysis_cache,
-               key_images ? &*key_images : nullptr);
+               pose_check ? &*pose_check : nullptr);
   const double analysis_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - analysis_start).count();
   spdlog::debug("pose, parallax and homography test of {} links in {:.3f} s ({} analysed before)", map.links.size(),

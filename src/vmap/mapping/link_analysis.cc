@@ -1,20 +1,17 @@
 #include "vmap/mapping/link_analysis.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <exception>
-#include <functional>
 #include <limits>
 #include <memory>
-#include <mutex>
-#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/json_fields.h"
+#include "vmap/core/parallel_for.h"
 #include "vmap/features/orb_matcher.h"
+#include "vmap/mapping/key_image_selector.h"
 
 namespace vmap {
 
@@ -134,51 +131,6 @@ void CrossCheckLinkPose(Link& link, const Link& denser, const Camera& camera, co
 
 namespace {
 
-// The two key images of a link matched and verified anew with `matcher` (denser features than the map's), as a
-// link: F, the counts and the correspondences (verified first); no analysis yet.
-Link MatchAgain(const Link& link, const ImageFeatures& from, const ImageFeatures& to, const Matcher& matcher,
-                const VerifierOptions& verifier) {
-  Link again;
-  again.from_key = link.from_key;
-  again.to_key = link.to_key;
-  const TentativeMatches matches = matcher.Match(from, to);
-  const FundamentalResult fit = EstimateFundamental(matches.points0, matches.points1, verifier);
-  again.num_tentative = static_cast<int>(matches.size());
-  if (!fit.success) return again;
-  again.has_fundamental = true;
-  again.F = fit.F;
-  again.num_verified = fit.num_inliers;
-  std::vector<Correspondence> rejected;
-  for (size_t i = 0; i < matches.size(); ++i) {
-    (fit.inlier_mask[i] ? again.correspondences : rejected).push_back({matches.points0[i], matches.points1[i]});
-  }
-  again.correspondences.insert(again.correspondences.end(), rejected.begin(), rejected.end());
-  return again;
-}
-
-// Calls work(i) for i in [0, count) on `threads` threads (the calling one included); rethrows the first failure.
-void ForEachOnThreads(size_t count, int threads, const std::function<void(size_t)>& work) {
-  std::atomic<size_t> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  const auto run = [&] {
-    for (size_t k = next++; k < count; k = next++) {
-      try {
-        work(k);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (!error) error = std::current_exception();
-      }
-    }
-  };
-  std::vector<std::thread> workers;
-  const int extra = std::min<int>(std::max(threads, 1), static_cast<int>(count)) - 1;
-  for (int k = 0; k < extra; ++k) workers.emplace_back(run);
-  run();
-  for (std::thread& worker : workers) worker.join();
-  if (error) std::rethrow_exception(error);
-}
-
 // FNV-1a over the bytes of what AnalyzeLink reads.
 class Fingerprint {
  public:
@@ -226,7 +178,7 @@ void CopyAnalysis(const Link& from, Link& to) {
 }  // namespace
 
 void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int threads, LinkAnalysisCache* cache,
-                  const KeyImagePixels* key_images) {
+                  const PoseCheckInputs* inputs) {
   const Camera* camera = map.input.camera ? &*map.input.camera : nullptr;
   const auto frames_of = [&map](const Link& link) {
     return std::make_pair(map.key_images.at(link.from_key).frame_index, map.key_images.at(link.to_key).frame_index);
@@ -246,7 +198,7 @@ void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int thread
     todo.push_back(i);
   }
 
-  const bool cross_check = camera && key_images && key_images->read && options.pose_check_features > 0;
+  const bool cross_check = camera && inputs && inputs->read_key_image && options.pose_check_features > 0;
   std::unique_ptr<Matcher> denser_matcher;
   if (cross_check) {
     OrbMatcherOptions orb;
@@ -266,16 +218,17 @@ void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int thread
       }
       std::vector<std::pair<const int, std::shared_ptr<const ImageFeatures>>*> slots;
       for (auto& slot : features) slots.push_back(&slot);
-      ForEachOnThreads(slots.size(), threads, [&](size_t i) {
-        slots[i]->second = denser_matcher->Extract(key_images->read(map.key_images.at(slots[i]->first)));
+      ParallelFor(slots.size(), threads, [&](size_t i) {
+        slots[i]->second = denser_matcher->Extract(inputs->read_key_image(map.key_images.at(slots[i]->first)));
       });
     }
-    ForEachOnThreads(end - begin, threads, [&](size_t k) {
+    ParallelFor(end - begin, threads, [&](size_t k) {
       Link& link = map.links[todo[begin + k]];
       AnalyzeLink(link, camera, options);
       if (!cross_check || !link.has_pose) return;
-      Link denser = MatchAgain(link, *features.at(link.from_key), *features.at(link.to_key), *denser_matcher,
-                               key_images->verifier);
+      Link denser = MakeLink(ComparePair(*denser_matcher, *features.at(link.from_key), *features.at(link.to_key),
+                                         inputs->verifier, SimilarityMode::kInlierRatio),
+                             link.from_key, link.to_key, link.below_tau);
       Analyze(denser, camera, options, /*test_homography=*/false);
       CrossCheckLinkPose(link, denser, *camera, options.translation);
     });

@@ -50,11 +50,11 @@ void AnalyzeLink(Link& link, const Camera* camera, const LinkAnalysisOptions& op
 // the matches do not determine, whatever each one's sigma says. Without both poses the link stays as it is.
 void CrossCheckLinkPose(Link& link, const Link& denser, const Camera& camera, const TranslationOptions& translation);
 
-// What the cross-check (LinkAnalysisOptions::pose_check_features) reads besides the map: a key image's pixels
-// (8-bit grey; e.g. ReadKeyImage from the map directory being written), and the verifier of the map.
-struct KeyImagePixels {
-  std::function<cv::Mat(const KeyImage&)> read;
-  VerifierOptions verifier;
+// What the pose cross-check (LinkAnalysisOptions::pose_check_features) reads besides the map.
+struct PoseCheckInputs {
+  // A key image's pixels, 8-bit grey: e.g. ReadKeyImage from the map directory being written.
+  std::function<cv::Mat(const KeyImage&)> read_key_image;
+  VerifierOptions verifier;  // the map's
 };
 
 // The analyses of one map's links, kept for when the same map is collected again as a run goes on (a snapshot
@@ -66,7 +66,7 @@ class LinkAnalysisCache {
   long hits() const { return hits_; }  // links that were not analysed again
 
  private:
-  friend void AnalyzeLinks(VisualMap&, const LinkAnalysisOptions&, int, LinkAnalysisCache*, const KeyImagePixels*);
+  friend void AnalyzeLinks(VisualMap&, const LinkAnalysisOptions&, int, LinkAnalysisCache*, const PoseCheckInputs*);
   struct Entry {
     uint64_t fingerprint = 0;  // of what the analysis reads: the counts, F and the correspondences
     Link analysed;             // only the fields AnalyzeLink fills are used (no correspondences kept)
@@ -78,9 +78,9 @@ class LinkAnalysisCache {
 // AnalyzeLink for every link, with the map's camera (map.input.camera) when it has one, on `threads` threads
 // (links are independent: the result does not depend on the number of threads). With `cache`, links analysed
 // by an earlier call are not analysed again, and the cache keeps only this map's links (memory stays flat).
-// With `key_images`, a camera and options.pose_check_features > 0, each posed link is also cross-checked
+// With `inputs`, a camera and options.pose_check_features > 0, each posed link is also cross-checked
 // against the pose of denser features of its key images (CrossCheckLinkPose).
 void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int threads = 1,
-                  LinkAnalysisCache* cache = nullptr, const KeyImagePixels* key_images = nullptr);
+                  LinkAnalysisCache* cache = nullptr, const PoseCheckInputs* inputs = nullptr);
 
 }  // namespace vmap
