@@ -154,6 +154,20 @@ float Dot(const float* a, const float* b, int size) {
   return total;
 }
 
+// The bound's share of the width: with 3/8 of the axes (24 of XFeat's 64) XFeat's 4096 x 4096 pairs took
+// 1/1.5-1/1.8 of the time of every pair's similarity (lab_floor frames 10-60 apart, michigan a season apart;
+// `xfeat_bench --float-matching`); 1/4 of the axes: 1/1.1-1/1.3, 1/2: 1/1.4-1/1.5.
+int BoundAxes(int dims) { return dims * 3 / 8; }
+
+// The bound pays off where the floor is high and the descriptors wide. Below a floor of ~0.5 nearly every pair
+// passes, and small sets are fast either way.
+bool UseBound(const cv::Mat& query, const cv::Mat& train, float min_similarity) {
+  return min_similarity >= 0.5f && BoundAxes(query.cols) >= 8 && query.rows >= kMinRows &&
+         train.rows >= kMinTrainRowsToPrune;
+}
+
+}  // namespace
+
 // Only pairs with a similarity of at least `min_similarity` can be matches, and they are a small share of all
 // pairs (0.2-0.3 % of XFeat's 4096 x 4096 at 0.82 on lab_floor). A projection P onto k orthonormal axes
 // never lengthens a vector, so a pair can reach the floor only if
@@ -163,35 +177,53 @@ float Dot(const float* a, const float* b, int size) {
 // The axes are the train rows' principal ones, where descriptors differ most, so the bound prunes hard;
 // the pairs it keeps get their exact similarity. The result is the exhaustive one (up to float rounding in
 // a similarity: the dot products are summed in another order).
-void OfferPairsAboveFloor(const cv::Mat& query, const cv::Mat& train, float min_similarity, int axes,
-                          MutualBest& best) {
-  const int dims = query.cols;
+//
+// The train side (its axes and augmented projections) depends on the train rows alone.
+struct FloatTrainBound {
+  cv::Mat basis;              // k x width, the principal axes by decreasing variance
+  cv::Mat rows;               // train rows x (k + 2): [Pt, (|t|^2 - |Pt|^2)/2, 1]
+  double largest_norm = 0.0;  // the largest |t|^2
+};
+
+namespace {
+
+FloatTrainBound PrepareTrainBound(const cv::Mat& train) {
+  const int axes = BoundAxes(train.cols);
+  FloatTrainBound out;
   cv::Mat mean, covariance, eigenvalues, eigenvectors;
   cv::reduce(train, mean, 0, cv::REDUCE_AVG);
   cv::gemm(train, train, 1.0 / train.rows, cv::noArray(), 0.0, covariance, cv::GEMM_1_T);
   covariance -= mean.t() * mean;
   cv::eigen(covariance, eigenvalues, eigenvectors);  // rows, by decreasing eigenvalue
-  const cv::Mat basis = eigenvectors.rowRange(0, axes);
+  out.basis = eigenvectors.rowRange(0, axes).clone();
+  out.rows.create(train.rows, axes + 2, CV_32F);
+  cv::Mat projection = out.rows.colRange(0, axes);
+  cv::gemm(train, out.basis, 1.0, cv::noArray(), 0.0, projection, cv::GEMM_2_T);
+  for (int j = 0; j < train.rows; ++j) {
+    float* row = out.rows.ptr<float>(j);
+    const float norm = SquaredNorm(train.ptr<float>(j), train.cols);
+    out.largest_norm = std::max(out.largest_norm, static_cast<double>(norm));
+    row[axes] = 0.5f * (norm - SquaredNorm(row, axes));
+    row[axes + 1] = 1.f;
+  }
+  return out;
+}
 
+void OfferPairsAboveFloor(const cv::Mat& query, const cv::Mat& train, const FloatTrainBound& train_bound,
+                          float min_similarity, MutualBest& best) {
+  const int dims = query.cols;
+  const int axes = train_bound.basis.rows;
   // Float rounding in the k+2 terms (each at most about |q|^2 + |t|^2) is far below this margin; a pair let
   // through by it only costs an exact similarity.
-  double largest_norm = 0.0;
-  cv::Mat query_bound(query.rows, axes + 2, CV_32F), train_bound(train.rows, axes + 2, CV_32F);
-  cv::Mat query_projection = query_bound.colRange(0, axes), train_projection = train_bound.colRange(0, axes);
-  cv::gemm(query, basis, 1.0, cv::noArray(), 0.0, query_projection, cv::GEMM_2_T);
-  cv::gemm(train, basis, 1.0, cv::noArray(), 0.0, train_projection, cv::GEMM_2_T);
+  double largest_norm = train_bound.largest_norm;
+  cv::Mat query_bound(query.rows, axes + 2, CV_32F);
+  cv::Mat query_projection = query_bound.colRange(0, axes);
+  cv::gemm(query, train_bound.basis, 1.0, cv::noArray(), 0.0, query_projection, cv::GEMM_2_T);
   std::vector<float> query_residual(query.rows);
   for (int i = 0; i < query.rows; ++i) {
     const float norm = SquaredNorm(query.ptr<float>(i), dims);
     largest_norm = std::max(largest_norm, static_cast<double>(norm));
     query_residual[i] = 0.5f * (norm - SquaredNorm(query_bound.ptr<float>(i), axes));
-  }
-  for (int j = 0; j < train.rows; ++j) {
-    float* row = train_bound.ptr<float>(j);
-    const float norm = SquaredNorm(train.ptr<float>(j), dims);
-    largest_norm = std::max(largest_norm, static_cast<double>(norm));
-    row[axes] = 0.5f * (norm - SquaredNorm(row, axes));
-    row[axes + 1] = 1.f;
   }
   const float margin = static_cast<float>(1e-4 * (1.0 + 2.0 * largest_norm));
   for (int i = 0; i < query.rows; ++i) {
@@ -200,32 +232,33 @@ void OfferPairsAboveFloor(const cv::Mat& query, const cv::Mat& train, float min_
     row[axes + 1] = query_residual[i] - min_similarity + margin;
   }
 
-  ForEachProductTile(query_bound, train_bound, [&](int row_begin, int row_end, int col_begin, const cv::Mat& tile) {
-    const int width = tile.cols;
-    for (int i = row_begin; i < row_end; ++i) {
-      const float* bound = tile.ptr<float>(i - row_begin);
-      const float* q = query.ptr<float>(i);
-      int j = 0;
-      for (; j + 16 <= width; j += 16) {
-        // 16 bounds at a time; nearly all are negative (the pair cannot reach the floor).
-        const cv::v_uint32x4 b0 = cv::v_reinterpret_as_u32(cv::v_load(bound + j));
-        const cv::v_uint32x4 b1 = cv::v_reinterpret_as_u32(cv::v_load(bound + j + 4));
-        const cv::v_uint32x4 b2 = cv::v_reinterpret_as_u32(cv::v_load(bound + j + 8));
-        const cv::v_uint32x4 b3 = cv::v_reinterpret_as_u32(cv::v_load(bound + j + 12));
-        if (cv::v_signmask(cv::v_reinterpret_as_f32(b0 & b1 & b2 & b3)) == 0xF) continue;
-        for (int x = j; x < j + 16; ++x) {
-          if (bound[x] < 0.f) continue;
-          const float similarity = Dot(q, train.ptr<float>(col_begin + x), dims);
-          if (similarity >= min_similarity) best.Offer(i, col_begin + x, similarity);
-        }
-      }
-      for (; j < width; ++j) {
-        if (bound[j] < 0.f) continue;
-        const float similarity = Dot(q, train.ptr<float>(col_begin + j), dims);
-        if (similarity >= min_similarity) best.Offer(i, col_begin + j, similarity);
-      }
-    }
-  });
+  ForEachProductTile(query_bound, train_bound.rows,
+                     [&](int row_begin, int row_end, int col_begin, const cv::Mat& tile) {
+                       const int width = tile.cols;
+                       for (int i = row_begin; i < row_end; ++i) {
+                         const float* bound = tile.ptr<float>(i - row_begin);
+                         const float* q = query.ptr<float>(i);
+                         int j = 0;
+                         for (; j + 16 <= width; j += 16) {
+                           // 16 bounds at a time; nearly all are negative (the pair cannot reach the floor).
+                           const cv::v_uint32x4 b0 = cv::v_reinterpret_as_u32(cv::v_load(bound + j));
+                           const cv::v_uint32x4 b1 = cv::v_reinterpret_as_u32(cv::v_load(bound + j + 4));
+                           const cv::v_uint32x4 b2 = cv::v_reinterpret_as_u32(cv::v_load(bound + j + 8));
+                           const cv::v_uint32x4 b3 = cv::v_reinterpret_as_u32(cv::v_load(bound + j + 12));
+                           if (cv::v_signmask(cv::v_reinterpret_as_f32(b0 & b1 & b2 & b3)) == 0xF) continue;
+                           for (int x = j; x < j + 16; ++x) {
+                             if (bound[x] < 0.f) continue;
+                             const float similarity = Dot(q, train.ptr<float>(col_begin + x), dims);
+                             if (similarity >= min_similarity) best.Offer(i, col_begin + x, similarity);
+                           }
+                         }
+                         for (; j < width; ++j) {
+                           if (bound[j] < 0.f) continue;
+                           const float similarity = Dot(q, train.ptr<float>(col_begin + j), dims);
+                           if (similarity >= min_similarity) best.Offer(i, col_begin + j, similarity);
+                         }
+                       }
+                     });
 }
 
 }  // namespace
@@ -234,17 +267,31 @@ std::vector<FloatMatch> MatchFloatDescriptors(const cv::Mat& query, const cv::Ma
   if (query.empty() || train.empty()) return {};
   CV_Assert(query.type() == CV_32F && train.type() == CV_32F && query.cols == train.cols);
   MutualBest best(query.rows, train.rows);
-  // The bound pays off where the floor is high and the descriptors wide. With 3/8 of the axes (24 of XFeat's
-  // 64) XFeat's 4096 x 4096 pairs took 1/1.5-1/1.8 of the time of every pair's similarity (lab_floor frames
-  // 10-60 apart, michigan a season apart; `xfeat_bench --float-matching`); 1/4 of the axes: 1/1.1-1/1.3,
-  // 1/2: 1/1.4-1/1.5. Below a floor of ~0.5 nearly every pair passes, and small sets are fast either way.
-  const int axes = query.cols * 3 / 8;
-  const bool prune =
-      min_similarity >= 0.5f && axes >= 8 && query.rows >= kMinRows && train.rows >= kMinTrainRowsToPrune;
-  if (prune) {
-    OfferPairsAboveFloor(query, train, min_similarity, axes, best);
+  if (UseBound(query, train, min_similarity)) {
+    OfferPairsAboveFloor(query, train, PrepareTrainBound(train), min_similarity, best);
   } else {
     OfferAllPairs(query, train, best);
+  }
+  return best.Mutual(min_similarity);
+}
+
+FloatTrainRows::FloatTrainRows(cv::Mat rows) : rows_(std::move(rows)) {}
+FloatTrainRows::~FloatTrainRows() = default;
+
+const FloatTrainBound& FloatTrainRows::bound() const {
+  std::call_once(once_, [&] { bound_ = std::make_unique<const FloatTrainBound>(PrepareTrainBound(rows_)); });
+  return *bound_;
+}
+
+std::vector<FloatMatch> MatchFloatDescriptors(const cv::Mat& query, const FloatTrainRows& train, float min_similarity) {
+  const cv::Mat& rows = train.rows();
+  if (query.empty() || rows.empty()) return {};
+  CV_Assert(query.type() == CV_32F && rows.type() == CV_32F && query.cols == rows.cols);
+  MutualBest best(query.rows, rows.rows);
+  if (UseBound(query, rows, min_similarity)) {
+    OfferPairsAboveFloor(query, rows, train.bound(), min_similarity, best);
+  } else {
+    OfferAllPairs(query, rows, best);
   }
   return best.Mutual(min_similarity);
 }

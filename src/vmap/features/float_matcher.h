@@ -1,6 +1,8 @@
 #pragma once
 // Mutual nearest-neighbour matching of float descriptors (the deep detectors' descriptors: XFeat, ALIKED).
 
+#include <memory>
+#include <mutex>
 #include <utility>
 #include <vector>
 
@@ -21,6 +23,30 @@ struct FloatMatch {
 // a high `min_similarity` (>= 0.5) and wide descriptors, most pairs are ruled out by a cheaper bound first
 // (float_matcher.cc); the matches are those of MatchFloatDescriptorsExhaustively.
 std::vector<FloatMatch> MatchFloatDescriptors(const cv::Mat& query, const cv::Mat& train, float min_similarity);
+
+struct FloatTrainBound;  // float_matcher.cc
+
+// Descriptor rows matched as the train side many times (a key image against every frame of a localization):
+// what the bound of MatchFloatDescriptors needs of them alone (their principal axes, their projections) is
+// computed on first use and kept, about 0.4 of the rows' own memory. Thread-safe; not copyable.
+class FloatTrainRows {
+ public:
+  explicit FloatTrainRows(cv::Mat rows);
+  ~FloatTrainRows();
+  FloatTrainRows(const FloatTrainRows&) = delete;
+  FloatTrainRows& operator=(const FloatTrainRows&) = delete;
+
+  const cv::Mat& rows() const { return rows_; }
+  const FloatTrainBound& bound() const;
+
+ private:
+  cv::Mat rows_;
+  mutable std::once_flag once_;
+  mutable std::unique_ptr<const FloatTrainBound> bound_;
+};
+
+// As above, with the train side's bound kept between calls: the same matches.
+std::vector<FloatMatch> MatchFloatDescriptors(const cv::Mat& query, const FloatTrainRows& train, float min_similarity);
 
 // The same matches from every pair's similarity: the reference for tests and benchmarks.
 std::vector<FloatMatch> MatchFloatDescriptorsExhaustively(const cv::Mat& query, const cv::Mat& train,

@@ -1,6 +1,7 @@
 #include "vmap/features/float_matcher.h"
 
 #include <random>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -123,6 +124,53 @@ TEST(MatchFloatDescriptors, TheBoundOnAProjectionNeverLosesAMatch) {
     const auto exhaustive = MatchFloatDescriptorsExhaustively(query, train, floor);
     EXPECT_EQ(exhaustive.size(), expected.size()) << floor;
   }
+}
+
+// A key image's rows keep the bound's train side between frames: every frame, floor and thread gets the
+// matches of a bound computed afresh, including threads that race to compute it first.
+TEST(MatchFloatDescriptors, TrainRowsKeepTheirBoundAndGiveTheSameMatches) {
+  std::mt19937 random(5);
+  const cv::Mat train_rows = AnisotropicRows(1500, 64, random);
+  std::vector<cv::Mat> queries;
+  for (int q = 0; q < 4; ++q) {
+    cv::Mat query(400, 64, CV_32F);
+    const cv::Mat noise = AnisotropicRows(query.rows, 64, random);
+    std::uniform_int_distribution<int> any_train(0, train_rows.rows - 1);
+    for (int i = 0; i < query.rows; ++i) {
+      cv::Mat row = train_rows.row(any_train(random)) + (0.1f * q + 0.1f) * noise.row(i);
+      cv::normalize(row, query.row(i));
+    }
+    queries.push_back(query);
+  }
+  auto same = [](const std::vector<FloatMatch>& a, const std::vector<FloatMatch>& b) {
+    if (a.size() != b.size()) return false;
+    for (size_t k = 0; k < a.size(); ++k) {
+      if (a[k].query != b[k].query || a[k].train != b[k].train || a[k].similarity != b[k].similarity) return false;
+    }
+    return true;
+  };
+  const FloatTrainRows train(train_rows);
+  std::vector<int> agreed(8, 0);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 8; ++t) {
+    threads.emplace_back([&, t] {
+      for (float floor : {0.82f, 0.6f, 0.3f}) {
+        const cv::Mat& query = queries[t % queries.size()];
+        agreed[t] += same(MatchFloatDescriptors(query, train, floor), MatchFloatDescriptors(query, train_rows, floor));
+      }
+    });
+  }
+  for (std::thread& thread : threads) thread.join();
+  for (int t = 0; t < 8; ++t) EXPECT_EQ(agreed[t], 3) << "thread " << t;
+  const auto matches = MatchFloatDescriptors(queries[0], train, 0.82f);
+  const auto expected = PlainMutualNearest(queries[0], train_rows, 0.82f);
+  EXPECT_GT(expected.size(), 200u);
+  ASSERT_EQ(matches.size(), expected.size());
+  for (size_t k = 0; k < matches.size(); ++k) {
+    EXPECT_EQ(matches[k].query, expected[k].query);
+    EXPECT_EQ(matches[k].train, expected[k].train);
+  }
+  EXPECT_EQ(train.rows().data, train_rows.data);  // a header, not a copy
 }
 
 TEST(MatchFloatDescriptors, TiesGoToTheLowestIndexAndEmptyInputsGiveNothing) {

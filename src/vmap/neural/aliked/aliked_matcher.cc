@@ -31,11 +31,12 @@ class AlikedFeatures : public ImageFeatures {
   int num_features() const override { return static_cast<int>(keypoints_.size()); }
   cv::Size image_size() const override { return size_; }
   const std::vector<cv::Point2f>& keypoints() const { return keypoints_; }
-  cv::Mat descriptors() const override { return descriptors_; }  // CV_32F, one L2-normalised row per keypoint
+  cv::Mat descriptors() const override { return descriptors_.rows(); }    // CV_32F, one L2-normalised row per keypoint
+  const FloatTrainRows& descriptor_rows() const { return descriptors_; }  // the same, for the float matcher
 
  private:
   std::vector<cv::Point2f> keypoints_;
-  cv::Mat descriptors_;
+  FloatTrainRows descriptors_;
   cv::Size size_;
 };
 
@@ -77,7 +78,7 @@ class AlikedMatcher : public Matcher {
     if (!f0 || !f1) throw std::invalid_argument("AlikedMatcher::Match: features from another matcher");
     TentativeMatches matches;
     for (const auto& m :
-         MatchFloatDescriptors(f0->descriptors(), f1->descriptors(), static_cast<float>(options_.min_similarity))) {
+         MatchFloatDescriptors(f0->descriptors(), f1->descriptor_rows(), static_cast<float>(options_.min_similarity))) {
       matches.points0.push_back(f0->keypoints()[m.query]);
       matches.points1.push_back(f1->keypoints()[m.train]);
       matches.scores.push_back(m.similarity);

@@ -27,8 +27,9 @@ class XfeatFeatures : public ImageFeatures {
       : keypoints_(std::move(keypoints)), descriptors_(std::move(descriptors)), image_size_(image_size) {
     if (descriptors_.is_cpu()) {
       // A header over the tensor's memory: the float matcher reads it without a copy.
-      descriptor_rows_ = cv::Mat(static_cast<int>(descriptors_.size(0)), static_cast<int>(descriptors_.size(1)), CV_32F,
-                                 descriptors_.data_ptr<float>());
+      descriptor_rows_ = std::make_unique<FloatTrainRows>(cv::Mat(static_cast<int>(descriptors_.size(0)),
+                                                                  static_cast<int>(descriptors_.size(1)), CV_32F,
+                                                                  descriptors_.data_ptr<float>()));
     }
   }
   int num_features() const override { return static_cast<int>(keypoints_.size()); }
@@ -37,16 +38,17 @@ class XfeatFeatures : public ImageFeatures {
   const torch::Tensor& descriptor_tensor() const { return descriptors_; }  // (n, 64) on the model's device
   // L2-normalised CV_32F rows, for localization's ranking of key images.
   cv::Mat descriptors() const override {
-    if (!descriptor_rows_.empty()) return descriptor_rows_;
+    if (descriptor_rows_) return descriptor_rows_->rows();
     const torch::Tensor cpu = descriptors_.to(torch::kCPU).contiguous();
     return cv::Mat(static_cast<int>(cpu.size(0)), static_cast<int>(cpu.size(1)), CV_32F, cpu.data_ptr<float>()).clone();
   }
-  const cv::Mat& descriptor_rows() const { return descriptor_rows_; }  // the same rows; CPU only
+  // The same rows, for the float matcher; CPU only.
+  const FloatTrainRows& descriptor_rows() const { return *descriptor_rows_; }
 
  private:
   std::vector<cv::Point2f> keypoints_;
   torch::Tensor descriptors_;
-  cv::Mat descriptor_rows_;
+  std::unique_ptr<const FloatTrainRows> descriptor_rows_;  // a header over the tensor's memory
   cv::Size image_size_;
 };
 
@@ -87,7 +89,8 @@ class XfeatMatcher : public Matcher {
       matches.scores.push_back(similarity);
     };
     if (model_.device().is_cpu()) {
-      for (const FloatMatch& m : MatchFloatDescriptors(f0->descriptor_rows(), f1->descriptor_rows(), MinSimilarity())) {
+      for (const FloatMatch& m :
+           MatchFloatDescriptors(f0->descriptor_rows().rows(), f1->descriptor_rows(), MinSimilarity())) {
         add(m.query, m.train, m.similarity);
       }
       return matches;
