@@ -115,6 +115,36 @@ TEST(ChanceModel, TheScoreIsTheLeastFalseAlarmsOverTheNearestMatches) {
 // Points that crowd into a corner lie near many epipolar lines there: the pair's own points paired at random
 // (all 9,900 ordered pairings of 100 matches) then explain more than points spread over the image would, and
 // the score takes the larger share.
+// The score written out plainly: every pairing of a frame point with another match's key point (the pairs
+// are few enough for ChanceOfFundamental to take them all), counted at each threshold. `crowded`: thresholds
+// where the pairings explain more than uniform points would.
+double LeastFalseAlarmsOverAllPairings(const cv::Matx33d& F, const std::vector<cv::Point2f>& p0,
+                                       const std::vector<cv::Point2f>& p1, double hypotheses, int* crowded) {
+  const int n = static_cast<int>(p0.size());
+  std::vector<double> distances, paired;
+  for (int i = 0; i < n; ++i) {
+    distances.push_back(std::max(EpipolarDistance(F, p0[i], p1[i]), 1e-4));
+    for (int j = 0; j < n; ++j) {
+      if (j != i) paired.push_back(EpipolarDistance(F, p0[i], p1[j]));
+    }
+  }
+  std::sort(distances.begin(), distances.end());
+  double least = std::numeric_limits<double>::infinity();
+  *crowded = 0;
+  for (int k = 8; k <= n; ++k) {
+    const double e = distances[k - 1];
+    const double share =
+        static_cast<double>(std::count_if(paired.begin(), paired.end(), [&](double d) { return d <= e; })) /
+        paired.size();
+    const double uniform = RandomInlierProbability(e, kQvga);
+    *crowded += share > uniform;
+    const double alpha = std::max(uniform, share);
+    if (alpha >= 1.0) break;
+    least = std::min(least, Log10FalseAlarms(n, k, alpha, hypotheses));
+  }
+  return least;
+}
+
 TEST(ChanceModel, ThePairsOwnPointsPairedAtRandomRaiseAlphaWhereTheyCrowd) {
   std::vector<cv::Point2f> p0, p1;
   SceneMatches(60, 40, 0.3, 5, &p0, &p1);
@@ -125,30 +155,30 @@ TEST(ChanceModel, ThePairsOwnPointsPairedAtRandomRaiseAlphaWhereTheyCrowd) {
   const FundamentalResult fit = EstimateFundamental(p0, p1, LocalizationVerifier());
   ASSERT_TRUE(fit.success);
   const ChanceOfMatches chance = ChanceOfFundamental(fit.F, p0, p1, kQvga, kQvga, 12.0);
-  const int n = static_cast<int>(p0.size());
-  std::vector<double> distances, paired;
-  for (int i = 0; i < n; ++i) {
-    distances.push_back(std::max(EpipolarDistance(fit.F, p0[i], p1[i]), 1e-4));
-    for (int j = 0; j < n; ++j) {
-      if (j != i) paired.push_back(EpipolarDistance(fit.F, p0[i], p1[j]));
-    }
-  }
-  std::sort(distances.begin(), distances.end());
-  double least = std::numeric_limits<double>::infinity();
-  int crowded = 0;  // thresholds where the random pairings explain more than uniform points would
-  for (int k = 8; k <= n; ++k) {
-    const double e = distances[k - 1];
-    const double share =
-        static_cast<double>(std::count_if(paired.begin(), paired.end(), [&](double d) { return d <= e; })) /
-        paired.size();
-    const double uniform = RandomInlierProbability(e, kQvga);
-    crowded += share > uniform;
-    const double alpha = std::max(uniform, share);
-    if (alpha >= 1.0) break;
-    least = std::min(least, Log10FalseAlarms(n, k, alpha, 12.0));
-  }
-  EXPECT_GT(crowded, n / 2) << "the crowding is what this test tests";
+  int crowded = 0;
+  const double least = LeastFalseAlarmsOverAllPairings(fit.F, p0, p1, 12.0, &crowded);
+  EXPECT_GT(crowded, static_cast<int>(p0.size()) / 2) << "the crowding is what this test tests";
   EXPECT_NEAR(chance.log10_nfa, least, 1e-6);
+}
+
+// A pairing exactly at a match's threshold is within it. A sideways camera (F = [(1, 0, 0)]x: every epipolar
+// line is a row) on whole-pixel rows makes every distance a whole number of pixels, so pairings tie with the
+// thresholds all the time.
+TEST(ChanceModel, PairingsAtAThresholdAreWithinIt) {
+  const cv::Matx33d F(0, 0, 0, 0, 0, -1, 0, 1, 0);
+  cv::RNG rng(3);
+  std::vector<cv::Point2f> p0, p1;
+  for (int i = 0; i < 100; ++i) {
+    const int row = rng.uniform(0, 60);
+    const int offset = i < 70 ? rng.uniform(0, 3) : rng.uniform(-40, 41);
+    p0.emplace_back(static_cast<float>(rng.uniform(0, 320)), static_cast<float>(row));
+    p1.emplace_back(static_cast<float>(rng.uniform(0, 320)), static_cast<float>(row + offset));
+  }
+  ASSERT_EQ(EpipolarDistance(F, {10, 5}, {200, 7}), 2.0);
+  int crowded = 0;
+  const double least = LeastFalseAlarmsOverAllPairings(F, p0, p1, 1.0, &crowded);
+  ASSERT_GT(crowded, 0);
+  EXPECT_NEAR(ChanceOfFundamental(F, p0, p1, kQvga, kQvga).log10_nfa, least, 1e-6);
 }
 
 TEST(ChanceModel, RandomMatchesAreRefused) {
