@@ -71,7 +71,9 @@ struct LocalizerOptions {
   int lookahead = 2;
   // While tracking, also compare the key image before `key` when the frame is nearer `key` than `next_key`
   // (fewer than a third of their verified matches are with `next_key`), and move back when it is the better
-  // match: the frame may be behind `key`. Off: the estimate only moves forwards (a robot that never reverses).
+  // match: the frame may be behind `key`. A check that finds it clearly worse is repeated on the frames that
+  // follow only once their verified matches with `next_key` fall below that frame's (they moved back). Off: the
+  // estimate only moves forwards (a robot that never reverses).
   bool step_back = true;
   // Lost frames in a row (each one also failed to relocalize) after which the estimate is dropped: key and
   // next_key then read -1 until a frame is relocalized.
@@ -253,6 +255,12 @@ class Localizer {
   std::unique_ptr<KeyImageRanking> ranking_;
   int position_ = -1;  // route position of `key`; -1: no estimate
   int lost_in_a_row_ = 0;
+  // The step back last ruled out (Track): at route position `position`, on the frame before this one, with the
+  // frame's verified matches with the next key image at that last check. position -1: none.
+  struct StepBackRuledOut {
+    int position = -1;
+    int next_verified = 0;
+  } step_back_ruled_out_;
   struct Memo {
     KeyComparison comparison;
     bool used = false;  // counted in LocalizationResult::comparisons

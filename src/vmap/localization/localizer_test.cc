@@ -282,6 +282,38 @@ TEST(Localizer, FollowsAReversedRouteWhenTheFramesComeBackwards) {
   }
 }
 
+// Near `key` the key image before it is compared too, in case the frame is behind `key`. Once that comparison
+// finds it clearly worse, it is spared while the frame does not move back (here: the same frame again), and
+// made again once the frame does (here: back at the previous key image, where the estimate must go).
+TEST(Localizer, AStepBackRuledOutIsCheckedAgainOnceTheFrameMovesBack) {
+  const LocalizationMap& m = Map().opened;
+  const std::vector<KeyImage>& keys = m.map.key_images;
+  ASSERT_GE(keys.size(), 4u);
+  Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
+  const auto& frames = SidewaysDrive().frames;
+  int frame_index = 0;
+  auto localize = [&](int source_index) {
+    return LocalizeImage(localizer, frames[source_index], frame_index++, source_index);
+  };
+  const int k = 2;
+  const int at = keys[k].source_index;
+  localize(at - 1);  // relocalized just before key image k
+  localize(at);      // at it: moved on to it (no step back is checked on a frame that moves on)
+  const LocalizationResult checked = localize(at);
+  const LocalizationResult spared = localize(at);
+  const LocalizationResult behind = localize(at - 2);
+  ASSERT_EQ(checked.key, k);
+  ASSERT_EQ(checked.status, LocalizationStatus::kTracking);
+  EXPECT_EQ(checked.comparisons, 3) << "key, next_key and the key image before key";
+  EXPECT_EQ(spared.key, k);
+  EXPECT_EQ(spared.to_key.num_verified, checked.to_key.num_verified);
+  EXPECT_EQ(spared.to_next.num_verified, checked.to_next.num_verified);
+  EXPECT_EQ(spared.comparisons, 2) << "the same frame again: not behind key";
+  ASSERT_LT(behind.to_next.num_verified, checked.to_next.num_verified) << "the test's frame must have moved back";
+  EXPECT_EQ(behind.comparisons, 3) << "moved back: checked again";
+  EXPECT_EQ(behind.key, k);
+}
+
 TEST(Localizer, HeadingIsTheHorizontalShiftOfTheSceneInPixels) {
   // A map of one key image: the frame is at the route's end and the heading refers to that key image.
   ::vmap::testing::ScopedTempDir directory;
