@@ -44,9 +44,8 @@ void EpipolarLines(const cv::Matx33d& F, const std::vector<cv::Point2f>& points0
   for (const cv::Point2f& p : points1) lines0->emplace_back(Ft * cv::Vec3d(p.x, p.y, 1.0));
 }
 
-// std::lower_bound's index, with a conditional move where it has a branch: the random pairings below fall
-// anywhere among the thresholds, so its branches were mispredicted half the time (3.5x faster on 20,000
-// lookups among 2,000 thresholds).
+// std::lower_bound's index, with a conditional move where it has a branch (the values fall anywhere among the
+// thresholds: the branch would be mispredicted half the time).
 size_t FirstNotBelow(const std::vector<double>& sorted, double value) {
   if (sorted.empty()) return 0;
   const double* base = sorted.data();
@@ -58,13 +57,49 @@ size_t FirstNotBelow(const std::vector<double>& sorted, double value) {
   return static_cast<size_t>(base - sorted.data()) + (*base < value);
 }
 
+// How many `values` have each index as FirstNotBelow in `sorted` (counts[sorted.size()]: above them all).
+// Eight searches go side by side, step by step: a search's steps wait on each other's loads, eight searches'
+// do not. With it ChanceOfFundamental took 0.22 / 0.52 / 0.89 ms instead of 1.07 / 1.55 / 2.0 ms for 500 / 2000
+// / 4000 matches (one search at a time, std::lower_bound or branchless alike).
+std::vector<int> CountByFirstNotBelow(const std::vector<double>& sorted, const std::vector<double>& values) {
+  std::vector<int> counts(sorted.size() + 1, 0);
+  constexpr size_t kSideBySide = 8;
+  size_t v = 0;
+  if (!sorted.empty()) {
+    for (; v + kSideBySide <= values.size(); v += kSideBySide) {
+      const double* base[kSideBySide];
+      for (size_t b = 0; b < kSideBySide; ++b) base[b] = sorted.data();
+      for (size_t length = sorted.size(); length > 1;) {
+        const size_t half = length / 2;
+        for (size_t b = 0; b < kSideBySide; ++b) base[b] += base[b][half] < values[v + b] ? half : 0;
+        length -= half;
+      }
+      for (size_t b = 0; b < kSideBySide; ++b) {
+        ++counts[static_cast<size_t>(base[b] - sorted.data()) + (*base[b] < values[v + b])];
+      }
+    }
+  }
+  for (; v < values.size(); ++v) ++counts[FirstNotBelow(sorted, values[v])];
+  return counts;
+}
+
+// RandomInlierProbability for one image size, with the diagonal computed once (it is asked at every k).
+class StripProbability {
+ public:
+  explicit StripProbability(cv::Size size)
+      : valid_(size.width > 0 && size.height > 0),
+        diagonal_(std::hypot(size.width, size.height)),
+        area_(static_cast<double>(size.width) * size.height) {}
+  double operator()(double distance) const { return valid_ ? std::min(1.0, 2.0 * distance * diagonal_ / area_) : 1.0; }
+
+ private:
+  bool valid_;
+  double diagonal_, area_;
+};
+
 }  // namespace
 
-double RandomInlierProbability(double distance, cv::Size size) {
-  if (size.width <= 0 || size.height <= 0) return 1.0;
-  const double area = static_cast<double>(size.width) * size.height;
-  return std::min(1.0, 2.0 * distance * std::hypot(size.width, size.height) / area);
-}
+double RandomInlierProbability(double distance, cv::Size size) { return StripProbability(size)(distance); }
 
 double Log10FalseAlarms(int num_matches, int num_inliers, double alpha, double num_hypotheses) {
   if (num_inliers <= kSampleSize || num_inliers > num_matches) return kInfinity;
@@ -104,27 +139,25 @@ ChanceOfMatches ChanceOfFundamental(const cv::Matx33d& F, const std::vector<cv::
   // It is needed only at the n thresholds above: each random pairing is counted under the first threshold it
   // does not exceed, and the running sum gives how many are within each. The same counts as sorting the
   // pairings, 3-4x faster (this took 5 % of XFeat localization's CPU sorted).
-  std::vector<int> within_threshold(n + 1, 0);  // [k]: random pairings with a distance <= distances[k]
-  int num_shuffled = 0;
-  {
-    const long all_pairs = static_cast<long>(n) * (n - 1);
-    num_shuffled = static_cast<int>(std::min<long>(all_pairs, kRandomPairs));
-    cv::RNG rng(0x5eed);  // deterministic: the same pair always gives the same score
-    for (int s = 0; s < num_shuffled; ++s) {
-      int i, j;
-      if (all_pairs <= kRandomPairs) {
-        i = s / (n - 1);
-        j = s % (n - 1);
-        j += j >= i;
-      } else {
-        i = rng.uniform(0, n);
-        j = rng.uniform(0, n - 1);
-        j += j >= i;
-      }
-      ++within_threshold[FirstNotBelow(distances, distance(i, j))];
+  const long all_pairs = static_cast<long>(n) * (n - 1);
+  std::vector<double> paired(static_cast<size_t>(std::min<long>(all_pairs, kRandomPairs)));
+  cv::RNG rng(0x5eed);  // deterministic: the same pair always gives the same score
+  for (size_t s = 0; s < paired.size(); ++s) {
+    int i, j;
+    if (all_pairs <= kRandomPairs) {
+      i = static_cast<int>(s) / (n - 1);
+      j = static_cast<int>(s) % (n - 1);
+    } else {
+      i = rng.uniform(0, n);
+      j = rng.uniform(0, n - 1);
     }
-    for (int k = 1; k <= n; ++k) within_threshold[k] += within_threshold[k - 1];
+    j += j >= i;
+    paired[s] = distance(i, j);
   }
+  const int num_shuffled = static_cast<int>(paired.size());
+  std::vector<int> within_threshold = CountByFirstNotBelow(distances, paired);  // then [k]: <= distances[k]
+  for (int k = 1; k <= n; ++k) within_threshold[k] += within_threshold[k - 1];
+  const StripProbability strip0(size0), strip1(size1);
   // The k nearest for every k: C(n, k) and C(k, 7) updated from k to k + 1 rather than recomputed.
   const double tests = std::log10(std::max(num_hypotheses, 1.0) * kModelsPerSample * (n - kSampleSize));
   double log_n_choose_k = Log10Binomial(n, kSampleSize + 1);
@@ -137,8 +170,7 @@ ChanceOfMatches ChanceOfFundamental(const cv::Matx33d& F, const std::vector<cv::
     const double e = distances[k - 1];
     if (!std::isfinite(e)) break;
     const double shuffled_share = static_cast<double>(within_threshold[k - 1]) / num_shuffled;
-    const double alpha =
-        std::max(std::min(RandomInlierProbability(e, size0), RandomInlierProbability(e, size1)), shuffled_share);
+    const double alpha = std::max(std::min(strip0(e), strip1(e)), shuffled_share);
     if (alpha >= 1.0) break;  // every match explained: nothing is unlikely any more
     const double log10_nfa = tests + log_n_choose_k + log_k_choose_7 + (k - kSampleSize) * std::log10(alpha);
     if (log10_nfa < best.log10_nfa) best = {log10_nfa, k, e};
