@@ -267,15 +267,7 @@ void OfferPairsAboveFloor(const cv::Mat& query, const cv::Mat& train, const Floa
 }  // namespace
 
 std::vector<FloatMatch> MatchFloatDescriptors(const cv::Mat& query, const cv::Mat& train, float min_similarity) {
-  if (query.empty() || train.empty()) return {};
-  CV_Assert(query.type() == CV_32F && train.type() == CV_32F && query.cols == train.cols);
-  MutualBest best(query.rows, train.rows);
-  if (UseBound(query, train, min_similarity)) {
-    OfferPairsAboveFloor(query, train, PrepareTrainBound(train), min_similarity, best);
-  } else {
-    OfferAllPairs(query, train, best);
-  }
-  return best.Mutual(min_similarity);
+  return MatchFloatDescriptors(query, FloatTrainRows(train), min_similarity);  // its bound is made if used
 }
 
 FloatTrainRows::FloatTrainRows(cv::Mat rows) : rows_(std::move(rows)) {}
