@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <vector>
 
-#include "vmap/geometry/relative_pose.h"
+#include "vmap/geometry/translation_evidence.h"
 #include "vmap/map/map_io.h"
 
 int main(int argc, char** argv) {

@@ -164,28 +164,6 @@ double TranslationSigmaDeg(const RelativePose& pose, const Camera& camera, const
 double TranslationSigmaDeg(const RelativePose& pose, const NormalizedMatches& matches, double inlier_threshold,
                            double loss_scale);
 
-// When a translation direction is trusted (map.json's links[].translation_known, localization results): both
-// its sigma is small and the matches moved enough once the rotation is undone. The sigma alone trusts some
-// pairs a few centimetres apart whose errors are not the pixel noise it assumes (calibration, rolling
-// shutter); the parallax alone distrusts forward motion, whose median parallax is small where t is well
-// known. Both chosen on kitti07 and redkitchen 0-499 (docs/link-poses.md).
-struct TranslationOptions {
-  double max_sigma_deg = 3.0;    // largest TranslationSigmaDeg of a trusted direction
-  double min_parallax_px = 3.0;  // smallest median rotation-compensated displacement (Displacements) of one
-  // A rival minimum (RivalCostGap) whose translation is more than rival_angle_deg away and that costs less
-  // than min_rival_cost_gap more than the chosen pose makes the direction ambiguous. The gap is in PoseCost
-  // units (about half the sum of squared Sampson errors in pixels for errors under the 1 px loss scale).
-  // Chosen on kitti07 and redkitchen 0-499 (docs/link-poses.md).
-  double rival_angle_deg = 15.0;
-  double min_rival_cost_gap = 8.0;
-
-  void VisitFields(OptionFieldVisitor& visitor);
-  void Check() const;  // throws OptionError naming the bad field
-};
-// Without a rival (a single start, localization's refined pose of F): rival_cost_gap is infinity.
-bool TranslationKnown(double sigma_deg, double parallax_px, const TranslationOptions& options);
-bool TranslationKnown(double sigma_deg, double parallax_px, double rival_cost_gap, const TranslationOptions& options);
-
 // Sampson errors in pixels of matches under a pose (on normalised points, times the mean focal length).
 std::vector<double> PoseSampsonErrors(const cv::Matx33d& R, const cv::Vec3d& t, const Camera& camera,
                                       const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to);

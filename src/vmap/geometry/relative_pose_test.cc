@@ -11,6 +11,7 @@
 #include "vmap/core/error.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/geometry/homography.h"
+#include "vmap/geometry/translation_evidence.h"
 #include "vmap/testing/option_error.h"
 
 namespace vmap {
@@ -286,6 +287,35 @@ TEST(RelativePose, TranslationSigmaIsLargeWhereRotationAndTranslationLookAlike) 
   EXPECT_FALSE(TranslationKnown(1.0, 1.0, TranslationOptions())) << "too little parallax";
   EXPECT_FALSE(TranslationKnown(30.0, 10.0, TranslationOptions())) << "too uncertain";
   EXPECT_FALSE(TranslationKnown(-1.0, 10.0, TranslationOptions())) << "not computed";
+}
+
+// A pose's flags: a sideways step seen over the whole image is known; the same step seen from ten times as far
+// (little parallax left once the rotation is undone) is not, nor is a pose with a rival almost as cheap.
+TEST(RelativePose, AssessTranslationTrustsADirectionOnlyWithParallaxSigmaAndNoRival) {
+  const cv::Matx33d R = Rotation({0.01, 0.05, 0.0});
+  const cv::Vec3d t = cv::normalize(cv::Vec3d(1.0, 0.0, -0.2));
+  RelativePose pose;
+  pose.valid = true;
+  pose.R = R;
+  pose.t = t;
+  const Pair near = Observe(TestCamera(), R, t * 0.5, 300, 2.0, 8.0, 0.3, 0.0, 5);
+  const NormalizedMatches near_matches(TestCamera(), near.from, near.to);
+  const TranslationEvidence known =
+      AssessTranslation(pose, near_matches, near_matches, PoseOptions(), TranslationOptions());
+  EXPECT_TRUE(known.known);
+  EXPECT_LT(known.sigma_deg, TranslationOptions().max_sigma_deg);
+  EXPECT_GT(known.parallax_px, 20.0);
+  EXPECT_DOUBLE_EQ(known.parallax_px, Median(Displacements(near.from, near.to, &TestCamera(), &R)));
+
+  const Pair far = Observe(TestCamera(), R, t * 0.5, 300, 200.0, 800.0, 0.3, 0.0, 5);
+  const NormalizedMatches far_matches(TestCamera(), far.from, far.to);
+  const TranslationEvidence distant =
+      AssessTranslation(pose, far_matches, far_matches, PoseOptions(), TranslationOptions());
+  EXPECT_LT(distant.parallax_px, TranslationOptions().min_parallax_px);
+  EXPECT_FALSE(distant.known);
+
+  EXPECT_FALSE(AssessTranslation(pose, near_matches, near_matches, PoseOptions(), TranslationOptions(), 1.0).known)
+      << "a rival 1 cost unit away";
 }
 
 }  // namespace vmap

@@ -253,9 +253,8 @@ KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
 KeyComparison Localizer::CompareImage(const ImageFeatures& features, const ImageFeatures& image,
                                       const TentativeMatches& matches, int key) const {
   // As ComparePair, on matches made already.
-  const int denominator = options_.similarity == SimilarityMode::kInlierRatio
-                              ? static_cast<int>(matches.size())
-                              : std::max(features.num_features(), image.num_features());
+  const int denominator = SimilarityDenominator(options_.similarity, static_cast<int>(matches.size()),
+                                                features.num_features(), image.num_features());
   const PairComparison pair = VerifyMatches(matches, denominator, options_.verifier);
   KeyComparison c;
   c.key = key;
@@ -304,9 +303,10 @@ void Localizer::AddPose(KeyComparison& c) const {
   // the matches rather than how far F's pose is from their optimum.
   c.pose = EnforceCheirality(RefineRelativePose(pose, verified_matches, inlier_threshold, pose_options.threshold),
                              verified_matches, pose_options.threshold);
-  c.translation_sigma_deg = TranslationSigmaDeg(c.pose, verified_matches, inlier_threshold, pose_options.threshold);
-  const double parallax = Median(Displacements(verified_matches, c.pose.R));
-  c.translation_known = TranslationKnown(c.translation_sigma_deg, parallax, options_.translation);
+  const TranslationEvidence evidence =
+      AssessTranslation(c.pose, verified_matches, verified_matches, pose_options, options_.translation);
+  c.translation_sigma_deg = evidence.sigma_deg;
+  c.translation_known = evidence.known;
 }
 
 LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& features,

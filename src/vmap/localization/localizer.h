@@ -35,7 +35,7 @@
 #include "vmap/geometry/camera.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/geometry/heading.h"
-#include "vmap/geometry/relative_pose.h"
+#include "vmap/geometry/translation_evidence.h"
 #include "vmap/localization/acceptance.h"
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/localization/key_image_store.h"

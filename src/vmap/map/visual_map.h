@@ -62,9 +62,8 @@ struct Link {
   // < 0: no such minimum was found (or not computed: maps written before it, poses from F).
   double translation_rival_cost_gap = -1.0;
   // t's direction is to be trusted (translation_sigma_deg and parallax within the map's
-  // link_analysis.translation, geometry/relative_pose.h TranslationKnown); otherwise a robot gets the rotation
-  // only. False without a pose; maps written before the
-  // field say nothing and read as has_pose.
+  // link_analysis.translation, geometry/translation_evidence.h TranslationKnown); otherwise a robot gets the
+  // rotation only. False without a pose; maps written before the field say nothing and read as has_pose.
   bool translation_known = false;
   // Median displacement of the verified matches in pixels: after undoing the rotation R when there is a pose
   // (what the translation's direction rests on), the plain displacement otherwise. < 0: not computed.

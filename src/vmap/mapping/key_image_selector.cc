@@ -34,9 +34,8 @@ PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features
                            const VerifierOptions& verifier, SimilarityMode similarity,
                            const std::vector<double>& decide_taus, const std::function<bool()>& abandon) {
   const TentativeMatches matches = matcher.Match(features0, features1);
-  const int denominator = similarity == SimilarityMode::kInlierRatio
-                              ? static_cast<int>(matches.size())
-                              : std::max(features0.num_features(), features1.num_features());
+  const int denominator = SimilarityDenominator(similarity, static_cast<int>(matches.size()), features0.num_features(),
+                                                features1.num_features());
   return VerifyMatches(matches, denominator, verifier, decide_taus, abandon);
 }
 

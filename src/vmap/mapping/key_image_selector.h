@@ -2,6 +2,7 @@
 // The key-image selection of García-Pintos et al. (2023), Algorithm 1, one frame at a time, so that a
 // sequence of any length streams through it and a threshold sweep runs every tau in one pass.
 
+#include <algorithm>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -26,6 +27,12 @@ inline constexpr EnumName<SimilarityMode> kSimilarityModeNames[] = {{SimilarityM
                                                                     {SimilarityMode::kFeatureRatio, "feature-ratio"}};
 SimilarityMode ParseSimilarityMode(const std::string& name);
 std::string SimilarityModeName(SimilarityMode mode);
+
+// |D| of S = verified / |D| under `mode`, the one place it is written (selector, link verifier, localizer): the
+// tentative matches of the pair, or the larger of the two images' feature counts.
+inline int SimilarityDenominator(SimilarityMode mode, int num_tentative, int num_features0, int num_features1) {
+  return mode == SimilarityMode::kInlierRatio ? num_tentative : std::max(num_features0, num_features1);
+}
 
 struct KeyImageOptions {
   double tau = 0.5;  // similarity threshold in (0, 1]

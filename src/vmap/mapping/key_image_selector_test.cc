@@ -178,6 +178,13 @@ TEST(KeyImageSelector, RepeatedFramesAreNotPromotedWhenANeighbourWillDo) {
 }
 
 // Algorithm 1's test: matched and S >= tau (inclusive); an unmatched pair never passes, whatever its S.
+// S = verified / |D|: the paper's tables divide by the tentative matches, its text by the larger feature count.
+TEST(PairComparison, SimilarityDenominatorFollowsTheMode) {
+  EXPECT_EQ(SimilarityDenominator(SimilarityMode::kInlierRatio, 120, 500, 800), 120);
+  EXPECT_EQ(SimilarityDenominator(SimilarityMode::kFeatureRatio, 120, 500, 800), 800);
+  EXPECT_EQ(SimilarityDenominator(SimilarityMode::kFeatureRatio, 120, 900, 800), 900);
+}
+
 TEST(PairComparison, ReachesTauOnlyWhenMatchedAndSimilarEnough) {
   PairComparison c;
   c.matched = true;

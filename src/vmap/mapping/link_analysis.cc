@@ -86,17 +86,19 @@ void Analyze(Link& link, const Camera* camera, const LinkAnalysisOptions& option
       link.R = pose.R;
       link.t = pose.t;
       link.pose_inliers = pose.num_inliers;
-      link.translation_sigma_deg = TranslationSigmaDeg(
-          pose, pose_matches, options.pose.refine_inlier_factor * options.pose.threshold, options.pose.threshold);
+      const double rival_cost_gap = link.translation_rival_cost_gap >= 0 ? link.translation_rival_cost_gap
+                                                                         : std::numeric_limits<double>::infinity();
+      const TranslationEvidence evidence =
+          AssessTranslation(pose, pose_matches, NormalizedMatches(*camera, verified_from, verified_to), options.pose,
+                            options.translation, rival_cost_gap);
+      link.translation_sigma_deg = evidence.sigma_deg;
+      link.parallax = evidence.parallax_px;
+      link.translation_known = evidence.known;
     }
   }
+  // Without a pose, the plain displacement.
   link.parallax_without_rotation = link.has_pose;
-  link.parallax = Median(
-      Displacements(verified_from, verified_to, link.has_pose ? camera : nullptr, link.has_pose ? &link.R : nullptr));
-  const double rival_cost_gap =
-      link.translation_rival_cost_gap >= 0 ? link.translation_rival_cost_gap : std::numeric_limits<double>::infinity();
-  link.translation_known =
-      link.has_pose && TranslationKnown(link.translation_sigma_deg, link.parallax, rival_cost_gap, options.translation);
+  if (!link.has_pose) link.parallax = Median(Displacements(verified_from, verified_to));
 
   if (!test_homography) return;
   const HomographyCheck homography = CheckHomography(verified_from, verified_to, options.homography);
@@ -124,7 +126,7 @@ void CrossCheckLinkPose(Link& link, const Link& denser, const Camera& camera, co
     link.translation_rival_cost_gap = denser.translation_rival_cost_gap;
     std::vector<cv::Point2f> from, to;
     SplitCorrespondences(link.correspondences, &from, &to, link.num_verified);
-    link.parallax = Median(Displacements(from, to, &camera, &link.R));
+    link.parallax = RotationCompensatedParallax(NormalizedMatches(camera, from, to), link.R);
   }
   link.translation_known = known;
 }

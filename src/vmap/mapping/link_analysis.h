@@ -17,6 +17,7 @@
 #include "vmap/geometry/fundamental.h"
 #include "vmap/geometry/homography.h"
 #include "vmap/geometry/relative_pose.h"
+#include "vmap/geometry/translation_evidence.h"
 #include "vmap/map/visual_map.h"
 
 namespace vmap {
@@ -33,7 +34,7 @@ struct LinkAnalysisOptions {
   int pose_check_features = 2000;
 
   // As map.json records it: {"pose": ..., "homography": ..., "translation": ..., "pose_check_features": ...}
-  // (geometry/relative_pose.h, geometry/homography.h).
+  // (geometry/relative_pose.h, geometry/homography.h, geometry/translation_evidence.h).
   void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };

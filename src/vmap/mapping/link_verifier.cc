@@ -16,8 +16,7 @@ void LinkVerifier::Add(const KeyImage& from, const KeyImage& to, const Link& lin
     matches.points0.push_back(c.p0);
     matches.points1.push_back(c.p1);
   }
-  const int denominator =
-      similarity == SimilarityMode::kInlierRatio ? link.num_tentative : std::max(from.num_features, to.num_features);
+  const int denominator = SimilarityDenominator(similarity, link.num_tentative, from.num_features, to.num_features);
   worker_.Post([this, pair, matches = std::move(matches), denominator, checkpoint = std::move(checkpoint)] {
     PairComparison verified = VerifyMatches(matches, denominator, verifier_, {}, nullptr, checkpoint);
     std::lock_guard<std::mutex> lock(mutex_);
