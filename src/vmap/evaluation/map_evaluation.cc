@@ -13,6 +13,7 @@
 #include "vmap/core/file_name_encoding.h"
 #include "vmap/core/options_json.h"
 #include "vmap/geometry/relative_pose.h"
+#include "vmap/geometry/sampson_error.h"
 #include "vmap/map/map_geometry_json.h"
 #include "vmap/sources/dataset_camera.h"
 
@@ -47,12 +48,7 @@ namespace {
 std::vector<double> SampsonErrors(const cv::Matx33d& F, const std::vector<cv::Point2d>& from,
                                   const std::vector<cv::Point2d>& to) {
   std::vector<double> errors;
-  for (size_t i = 0; i < from.size(); ++i) {
-    const cv::Vec3d x0(from[i].x, from[i].y, 1.0), x1(to[i].x, to[i].y, 1.0);
-    const cv::Vec3d Fx0 = F * x0, Ftx1 = F.t() * x1;
-    const double denominator = Fx0[0] * Fx0[0] + Fx0[1] * Fx0[1] + Ftx1[0] * Ftx1[0] + Ftx1[1] * Ftx1[1];
-    errors.push_back(denominator > 0 ? std::abs(x1.dot(Fx0)) / std::sqrt(denominator) : 0.0);
-  }
+  for (size_t i = 0; i < from.size(); ++i) errors.push_back(SampsonDistance(F, from[i], to[i]));
   return errors;
 }
 

@@ -150,15 +150,6 @@ FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0, c
   return estimated;
 }
 
-double SampsonDistance(const cv::Matx33d& F, const cv::Point2f& p0, const cv::Point2f& p1) {
-  const cv::Vec3d x0(p0.x, p0.y, 1.0), x1(p1.x, p1.y, 1.0);
-  const cv::Vec3d Fx0 = F * x0;
-  const cv::Vec3d Ftx1 = F.t() * x1;
-  const double e = x1.dot(Fx0);
-  const double denominator = Fx0[0] * Fx0[0] + Fx0[1] * Fx0[1] + Ftx1[0] * Ftx1[0] + Ftx1[1] * Ftx1[1];
-  return denominator > 0 ? std::abs(e) / std::sqrt(denominator) : 0.0;
-}
-
 void VerifierOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(OptionField{"method", "--verifier", "Fundamental matrix estimator: "}.ListingNames(),
                 EnumField(method, kVerifierMethodNames, ParseVerifierMethod));

@@ -11,6 +11,7 @@
 
 #include "vmap/core/enum_names.h"
 #include "vmap/core/option_fields.h"
+#include "vmap/geometry/sampson_error.h"  // SampsonDistance: how far a match is from F
 
 namespace vmap {
 
@@ -85,8 +86,5 @@ struct EarlyStop {
 FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0, const std::vector<cv::Point2f>& points1,
                                       const VerifierOptions& options, const EarlyStop& early_stop = {},
                                       const std::vector<float>* scores = nullptr);
-
-// Symmetric epipolar (Sampson) distance of x1 <-> x0 under F (x1^T F x0 = 0), in pixels.
-double SampsonDistance(const cv::Matx33d& F, const cv::Point2f& p0, const cv::Point2f& p1);
 
 }  // namespace vmap

@@ -8,7 +8,7 @@
 
 #include <Eigen/Dense>
 
-#include "vmap/geometry/sampson_errors.h"
+#include "vmap/geometry/sampson_error.h"
 
 namespace vmap::internal {
 

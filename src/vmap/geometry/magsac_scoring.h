@@ -8,7 +8,7 @@
 #include "vmap/geometry/fundamental_solvers.h"
 #include "vmap/geometry/magsac.h"
 #include "vmap/geometry/robust_loop.h"
-#include "vmap/geometry/sampson_errors.h"
+#include "vmap/geometry/sampson_error.h"
 
 namespace vmap::internal {
 

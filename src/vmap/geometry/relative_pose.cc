@@ -11,6 +11,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/core/json_fields.h"
+#include "vmap/geometry/sampson_error.h"
 
 namespace vmap {
 
@@ -82,13 +83,6 @@ RelativePose Decompose(const cv::Mat& E, const std::vector<cv::Point2d>& from, c
   return pose;
 }
 
-double SampsonNormalized(const cv::Matx33d& E, const cv::Point2d& a, const cv::Point2d& b) {
-  const cv::Vec3d x0(a.x, a.y, 1.0), x1(b.x, b.y, 1.0);
-  const cv::Vec3d Ex0 = E * x0, Etx1 = E.t() * x1;
-  const double denominator = Ex0[0] * Ex0[0] + Ex0[1] * Ex0[1] + Etx1[0] * Etx1[0] + Etx1[1] * Etx1[1];
-  return denominator > 0 ? x1.dot(Ex0) / std::sqrt(denominator) : 0.0;
-}
-
 // The pose R0 exp([w]x), t = normalise(t0 + d0 b0 + d1 b1) around a start pose; parameters (w, d).
 class PoseOnManifold {
  public:
@@ -148,7 +142,7 @@ class SampsonCost : public cv::LMSolver::Callback {
     manifold_.At(x, &R, &t);
     const cv::Matx33d E = CrossMatrix(t) * R;
     for (size_t i = 0; i < from_.size(); ++i) {
-      const double r = focal_ * SampsonNormalized(E, from_[i], to_[i]);
+      const double r = focal_ * SignedSampsonError(E, from_[i], to_[i]);
       // sqrt of the Cauchy loss's weight: least squares on these minimises sum log(1 + (r / scale)^2).
       out[i] = r / std::sqrt(1.0 + (r / scale_) * (r / scale_));
     }
@@ -188,7 +182,7 @@ std::vector<double> PoseSampsonErrors(const cv::Matx33d& R, const cv::Vec3d& t, 
   std::vector<double> errors;
   errors.reserve(matches.size());
   for (size_t i = 0; i < matches.size(); ++i) {
-    errors.push_back(std::abs(matches.focal() * SampsonNormalized(E, matches.from[i], matches.to[i])));
+    errors.push_back(std::abs(matches.focal() * SignedSampsonError(E, matches.from[i], matches.to[i])));
   }
   return errors;
 }

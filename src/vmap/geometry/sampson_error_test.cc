@@ -1,5 +1,6 @@
-#include "vmap/geometry/sampson_errors.h"
+#include "vmap/geometry/sampson_error.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -45,6 +46,23 @@ TEST(SampsonErrors, BlockEqualsScalarBitForBit) {
   }
   const Model epipolar = {0, -1, 7, 1, 0, -5, -7, 5, 0};
   EXPECT_TRUE(std::isinf(SquaredSampson(epipolar, {5, 7, 5, 7})));
+}
+
+// Rectified stereo (the second camera beside the first): epipolar lines are rows, and the Sampson error of a match
+// whose rows differ by dy is the least total move that puts both points on one row, dy / sqrt(2), whichever form.
+TEST(SampsonError, IsTheDistanceToTheEpipolarLinesInEveryForm) {
+  const cv::Matx33d F(0, 0, 0, 0, 0, -1, 0, 1, 0);
+  const cv::Point2d x0(10, 20), x1(50, 23);
+  EXPECT_DOUBLE_EQ(SignedSampsonError(F, x0, x1), -3.0 / std::sqrt(2.0));
+  EXPECT_DOUBLE_EQ(SignedSampsonError(F, x1, x0), 3.0 / std::sqrt(2.0));
+  EXPECT_DOUBLE_EQ(SampsonDistance(F, x0, x1), 3.0 / std::sqrt(2.0));
+  Model f;
+  std::copy(F.val, F.val + 9, f.begin());
+  EXPECT_DOUBLE_EQ(SquaredSampson(f, {x0.x, x0.y, x1.x, x1.y}), 4.5);
+  EXPECT_EQ(SampsonDistance(F, x0, cv::Point2d(-400, 20)), 0.0) << "anywhere on the row";
+  // At the epipoles the gradient vanishes: no distance (signed forms), never an inlier (squared form).
+  const cv::Matx33d cross(0, -1, 7, 1, 0, -5, -7, 5, 0);
+  EXPECT_EQ(SignedSampsonError(cross, {5, 7}, {5, 7}), 0.0);
 }
 
 }  // namespace
