@@ -30,6 +30,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "vmap/core/numeric.h"
 #include "vmap/evaluation/heading_labels.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/features/orb_matcher.h"

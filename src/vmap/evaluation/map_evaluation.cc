@@ -11,6 +11,7 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/core/file_name_encoding.h"
+#include "vmap/core/numeric.h"
 #include "vmap/core/options_json.h"
 #include "vmap/geometry/relative_pose.h"
 #include "vmap/geometry/sampson_error.h"
@@ -50,35 +51,6 @@ std::vector<double> SampsonErrors(const cv::Matx33d& F, const std::vector<cv::Po
   std::vector<double> errors;
   for (size_t i = 0; i < from.size(); ++i) errors.push_back(SampsonDistance(F, from[i], to[i]));
   return errors;
-}
-
-double ShareBelow(const std::vector<double>& values, double threshold) {
-  if (values.empty()) return NAN;
-  size_t count = 0;
-  for (double v : values) count += v < threshold ? 1 : 0;
-  return static_cast<double>(count) / values.size();
-}
-
-double MedianOrNan(const std::vector<double>& values) { return values.empty() ? NAN : Median(values); }
-
-double MeanOfFinite(const std::vector<double>& values) {
-  double sum = 0;
-  int count = 0;
-  for (double v : values) {
-    if (std::isfinite(v)) {
-      sum += v;
-      ++count;
-    }
-  }
-  return count > 0 ? sum / count : NAN;
-}
-
-double MedianOfFinite(const std::vector<double>& values) {
-  std::vector<double> finite;
-  for (double v : values) {
-    if (std::isfinite(v)) finite.push_back(v);
-  }
-  return MedianOrNan(finite);
 }
 
 LinkEvaluation EvaluateLink(const VisualMap& map, int index, const GroundTruth& truth, const Camera& camera,

@@ -5,7 +5,7 @@
 #include <numeric>
 
 #include "vmap/core/error.h"
-#include "vmap/geometry/relative_pose.h"
+#include "vmap/core/numeric.h"
 
 namespace vmap {
 
@@ -56,7 +56,7 @@ double MedianBearingDeg(const std::vector<cv::Point2f>& points0, const std::vect
   std::vector<double> bearings;
   bearings.reserve(matches.size());
   for (size_t k = 0; k < matches.size(); ++k) bearings.push_back(std::atan(rays1[k].x) - std::atan(rays0[k].x));
-  return Median(std::move(bearings)) * 180.0 / M_PI;  // geometry/relative_pose.h
+  return Median(std::move(bearings)) * 180.0 / M_PI;
 }
 
 }  // namespace
@@ -116,7 +116,7 @@ HeadingEstimate EstimateHeading(const std::vector<cv::Point2f>& points0, const s
   std::vector<double> window;
   window.reserve(count);
   for (int k : best) window.push_back(votes[k].dx);
-  estimate.px = Median(std::move(window));  // geometry/relative_pose.h
+  estimate.px = Median(std::move(window));
   if (camera != nullptr) {
     std::vector<int> winners;
     winners.reserve(count);

@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "vmap/core/numeric.h"
 #include "vmap/evaluation/heading_labels.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/geometry/fundamental.h"

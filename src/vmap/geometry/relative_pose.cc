@@ -465,15 +465,6 @@ std::vector<double> Displacements(const NormalizedMatches& matches, const cv::Ma
   return displacements;
 }
 
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const size_t middle = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + middle, values.end());
-  const double upper = values[middle];
-  if (values.size() % 2 == 1) return upper;
-  return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + middle));
-}
-
 bool ParsePoseMatches(const std::string& name) {
   const std::optional<bool> all = FindEnum(kPoseMatchesNames, name);
   if (!all)

@@ -186,6 +186,4 @@ std::vector<double> Displacements(const std::vector<cv::Point2f>& from, const st
                                   const Camera* camera = nullptr, const cv::Matx33d* R = nullptr);
 std::vector<double> Displacements(const NormalizedMatches& matches, const cv::Matx33d& R);
 
-double Median(std::vector<double> values);  // 0 for no values
-
 }  // namespace vmap

@@ -9,6 +9,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/core/numeric.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/geometry/homography.h"
 #include "vmap/geometry/translation_evidence.h"
@@ -182,8 +183,6 @@ TEST(RelativePose, DisplacementsRemoveTheRotationOnly) {
   // With a translation, parallax remains after the rotation is undone.
   const Pair moved = Observe(TestCamera(), R, {0.5, 0, 0}, 100, 2, 9, 0.0, 0.0, 9);
   EXPECT_GT(Median(Displacements(moved.from, moved.to, &TestCamera(), &R)), 20.0);
-  EXPECT_DOUBLE_EQ(Median({3.0, 1.0, 2.0, 10.0}), 2.5);
-  EXPECT_DOUBLE_EQ(Median({}), 0.0);
 }
 
 TEST(RelativePose, AnglesOfRotationsAndDirections) {

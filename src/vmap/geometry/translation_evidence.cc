@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "vmap/core/error.h"
+#include "vmap/core/numeric.h"
 
 namespace vmap {
 

@@ -9,7 +9,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/core/json_fields.h"
-#include "vmap/geometry/relative_pose.h"
+#include "vmap/core/numeric.h"
 
 namespace vmap {
 

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/json_fields.h"
+#include "vmap/core/numeric.h"
 #include "vmap/core/parallel_for.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/key_image_selector.h"

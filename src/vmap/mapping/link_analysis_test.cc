@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "vmap/core/error.h"
+#include "vmap/core/numeric.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/batch_build.h"
 #include "vmap/testing/scoped_temp_dir.h"
