@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "vmap/core/runtime.h"
+#include "vmap/evaluation/evaluation_inputs.h"
 #include "vmap/evaluation/map_evaluation.h"
 #include "vmap/map/map_io.h"
 #include "vmap/mapping/link_analysis.h"

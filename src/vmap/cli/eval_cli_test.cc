@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "vmap/evaluation/evaluation_json.h"
 #include "vmap/evaluation/map_evaluation.h"
 #include "vmap/map/map_io.h"
 #include "vmap/testing/run_vmap.h"

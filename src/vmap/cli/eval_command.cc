@@ -12,6 +12,8 @@
 #include "vmap/cli/output_files.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
+#include "vmap/evaluation/evaluation_inputs.h"
+#include "vmap/evaluation/evaluation_json.h"
 #include "vmap/evaluation/map_evaluation.h"
 #include "vmap/map/map_io.h"
 #include "vmap/report/evaluation_summary.h"

@@ -4,7 +4,7 @@
 #include <set>
 #include <string>
 
-#include "vmap/evaluation/map_evaluation.h"
+#include "vmap/evaluation/evaluation_json.h"
 #include "vmap/localization/key_image_store.h"
 #include "vmap/map/map_io.h"
 #include "vmap/report/html_report.h"

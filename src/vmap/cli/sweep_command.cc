@@ -12,6 +12,8 @@
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/evaluation/evaluation_inputs.h"
+#include "vmap/evaluation/evaluation_json.h"
 #include "vmap/evaluation/map_evaluation.h"
 #include "vmap/map/map_io.h"
 #include "vmap/mapping/batch_build.h"

@@ -12,6 +12,8 @@
 
 #include "vmap/core/error.h"
 #include "vmap/core/options_json.h"
+#include "vmap/evaluation/evaluation_inputs.h"
+#include "vmap/evaluation/evaluation_json.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/geometry/relative_pose.h"
 #include "vmap/mapping/batch_build.h"

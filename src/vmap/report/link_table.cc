@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/error.h"
+#include "vmap/evaluation/evaluation_json.h"
 #include "vmap/report/html_util.h"
 
 namespace vmap {

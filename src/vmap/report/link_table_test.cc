@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "vmap/evaluation/evaluation_json.h"
 #include "vmap/report/html_report.h"
 #include "vmap/testing/report_test_util.h"
 #include "vmap/testing/scoped_temp_dir.h"

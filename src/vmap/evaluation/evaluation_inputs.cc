@@ -1,0 +1,63 @@
+#include "vmap/evaluation/evaluation_inputs.h"
+
+#include <filesystem>
+
+#include <spdlog/spdlog.h>
+
+#include "vmap/core/error.h"
+#include "vmap/sources/dataset_camera.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+
+std::optional<Camera> ParseEvaluationCamera(const std::string& camera_option) {
+  std::optional<Camera> camera;
+  if (!camera_option.empty()) {
+    // Checked even where the map's own camera is used, so that a wrong value is never silently passed over.
+    std::error_code ec;
+    if (fs::exists(camera_option, ec) && !fs::is_regular_file(camera_option, ec)) {
+      throw OptionError("camera", "'" + camera_option +
+                                      "' is not a regular file; give a calibration file or "
+                                      "fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]]");
+    }
+    camera = ParseCameraOption(camera_option);
+    try {
+      camera->Check();
+    } catch (const OptionError&) {
+      throw;
+    } catch (const InputError& error) {
+      throw OptionError("camera", "'" + camera_option + "': " + error.what());
+    }
+  }
+  return camera;
+}
+
+Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option) {
+  std::optional<Camera> camera = ParseEvaluationCamera(camera_option);
+  if (map.input.camera) {
+    if (camera) spdlog::warn("the map records its camera, which is used; --camera is for maps that have none");
+    return *map.input.camera;
+  }
+  if (!camera) camera = FindDatasetCamera(map.input.path, map.input.format);
+  if (!camera) {
+    throw OptionError("camera", "is needed: the map has no camera and its input '" + map.input.path +
+                                    "' brings none; give the intrinsics fx,fy,cx,cy (or a calibration file)");
+  }
+  const cv::Size native = map.input.native_size.area() > 0 ? map.input.native_size : map.input.frame_size;
+  const cv::Size frames = map.input.frame_size.area() > 0 ? map.input.frame_size : native;
+  if (native.area() <= 0) throw InputError("the map does not record its frame size; rebuild it with `vmap build`");
+  return CameraForFrames(*camera, native, frames);
+}
+
+GroundTruth MapGroundTruth(const VisualMap& map, const std::string& gt_path, GroundTruthFormat format) {
+  if (!gt_path.empty()) return NameOptionErrorsWithin("gt", [&] { return ReadGroundTruth(gt_path, format); });
+  std::optional<GroundTruth> truth = FindGroundTruth(map.input.path, map.input.format);
+  if (!truth) {
+    throw OptionError("gt.path", "is needed: the map's input '" + map.input.path +
+                                     "' has no ground truth beside it (KITTI poses.txt, TUM groundtruth.txt, EuRoC "
+                                     "state_groundtruth_estimate0/data.csv); give a poses file");
+  }
+  return *truth;
+}
+
+}  // namespace vmap
