@@ -137,14 +137,6 @@ RelativePose PoseFromFundamental(const cv::Matx33d& F, const Camera& camera, con
                                  const std::vector<cv::Point2f>& to);
 RelativePose PoseFromFundamental(const cv::Matx33d& F, const NormalizedMatches& matches);
 
-// Refines a pose by Levenberg-Marquardt (OpenCV's LMSolver) on the Sampson errors, in pixels, of the matches
-// within inlier_threshold of it, each through a Cauchy loss of scale `loss_scale` pixels. The translation
-// stays a unit vector (two parameters on the sphere); the rotation takes three.
-RelativePose RefineRelativePose(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
-                                const std::vector<cv::Point2f>& to, double inlier_threshold, double loss_scale);
-RelativePose RefineRelativePose(const RelativePose& pose, const NormalizedMatches& matches, double inlier_threshold,
-                                double loss_scale);
-
 // The Sampson errors cannot tell the four poses one E = [t]x R allows apart ((R, t), (R, -t) and the twisted
 // pair), so a refinement may end at a pose whose t points backwards. This decides among the four again: the
 // one that puts most of the matches within `inlier_threshold` px of the pose in front of both cameras (ties
@@ -152,22 +144,6 @@ RelativePose RefineRelativePose(const RelativePose& pose, const NormalizedMatche
 RelativePose EnforceCheirality(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
                                const std::vector<cv::Point2f>& to, double inlier_threshold);
 RelativePose EnforceCheirality(const RelativePose& pose, const NormalizedMatches& matches, double inlier_threshold);
-
-// How well a pose's translation direction is determined by the matches within `inlier_threshold` px of it:
-// the standard deviation, in degrees, of t's direction from the Gauss-Newton covariance of the refinement's
-// cost (Cauchy-weighted Sampson errors, loss scale `loss_scale` px) at the pose, with the rotation
-// marginalised (the larger axis of the 2x2 block) and the noise estimated from the residuals. Short
-// baselines and pure rotations leave the cost flat along t: a large value. 180 when it cannot be computed
-// (too few matches, a singular system).
-double TranslationSigmaDeg(const RelativePose& pose, const Camera& camera, const std::vector<cv::Point2f>& from,
-                           const std::vector<cv::Point2f>& to, double inlier_threshold, double loss_scale);
-double TranslationSigmaDeg(const RelativePose& pose, const NormalizedMatches& matches, double inlier_threshold,
-                           double loss_scale);
-
-// Sampson errors in pixels of matches under a pose (on normalised points, times the mean focal length).
-std::vector<double> PoseSampsonErrors(const cv::Matx33d& R, const cv::Vec3d& t, const Camera& camera,
-                                      const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to);
-std::vector<double> PoseSampsonErrors(const cv::Matx33d& R, const cv::Vec3d& t, const NormalizedMatches& matches);
 
 // x_to^T F x_from = 0 for the pose (R, t) and a camera K (pixels, distortion removed).
 cv::Matx33d FundamentalFromPose(const cv::Matx33d& R, const cv::Vec3d& t, const cv::Matx33d& K);

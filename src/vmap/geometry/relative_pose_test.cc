@@ -12,6 +12,7 @@
 #include "vmap/core/numeric.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/geometry/homography.h"
+#include "vmap/geometry/pose_refinement.h"
 #include "vmap/geometry/translation_evidence.h"
 #include "vmap/testing/option_error.h"
 

@@ -8,6 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include "vmap/core/option_fields.h"
+#include "vmap/geometry/pose_refinement.h"
 #include "vmap/geometry/relative_pose.h"
 
 namespace vmap {
