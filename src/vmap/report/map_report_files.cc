@@ -1,0 +1,122 @@
+#include "vmap/report/map_report_files.h"
+
+#include <algorithm>
+#include <map>
+#include <memory>
+
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "vmap/map/map_io.h"
+#include "vmap/report/html_page.h"
+#include "vmap/report/match_figure.h"
+
+namespace vmap::report {
+namespace fs = std::filesystem;
+
+namespace {
+
+// The key images in order as a short video: H.264 in MP4 where OpenCV's FFmpeg has an encoder for it, else
+// VP9 in WebM; both play in current browsers. Without either, the page keeps only the step-through player.
+class RouteVideo {
+ public:
+  RouteVideo(const fs::path& directory, const cv::Size& frame_size, double fps)
+      // H.264 with 4:2:0 sampling needs even sides.
+      : size_(std::max(2, frame_size.width & ~1), std::max(2, frame_size.height & ~1)) {
+    const std::pair<const char*, int> candidates[] = {{"route.mp4", cv::VideoWriter::fourcc('a', 'v', 'c', '1')},
+                                                      {"route.webm", cv::VideoWriter::fourcc('V', 'P', '9', '0')}};
+    for (const auto& [name, fourcc] : candidates) {
+      try {
+        if (writer_.open((directory / name).string(), cv::CAP_FFMPEG, fourcc, fps, size_)) {
+          file_name_ = name;
+          path_ = directory / name;
+          return;
+        }
+      } catch (const cv::Exception&) {
+      }
+      std::error_code ignored;
+      fs::remove(directory / name, ignored);
+    }
+  }
+
+  void Add(const cv::Mat& image, const std::string& label) {
+    if (!writer_.isOpened()) return;
+    cv::Mat frame;
+    cv::resize(image, frame, size_, 0, 0, cv::INTER_AREA);
+    const double scale = std::clamp(size_.width / 700.0, 0.35, 1.0);
+    cv::putText(frame, label, cv::Point(7, size_.height - 9), cv::FONT_HERSHEY_SIMPLEX, scale, cv::Scalar::all(0), 3,
+                cv::LINE_AA);
+    cv::putText(frame, label, cv::Point(7, size_.height - 9), cv::FONT_HERSHEY_SIMPLEX, scale, cv::Scalar::all(255), 1,
+                cv::LINE_AA);
+    writer_.write(frame);
+    ++frames_;
+  }
+
+  // Closes the file; false (and no file) when nothing usable was written.
+  bool Finish() {
+    if (!writer_.isOpened()) return false;
+    writer_.release();
+    std::error_code ec;
+    if (frames_ > 0 && fs::file_size(path_, ec) > 0 && !ec) return true;
+    fs::remove(path_, ec);
+    return false;
+  }
+
+  const std::string& file_name() const { return file_name_; }
+  const cv::Size& size() const { return size_; }
+
+ private:
+  cv::Size size_;
+  cv::VideoWriter writer_;
+  std::string file_name_;
+  fs::path path_;
+  int frames_ = 0;
+};
+
+}  // namespace
+
+MapReportFiles WriteMapReportFiles(const fs::path& map_directory, const VisualMap& map, const MapReportOptions& options,
+                                   const fs::path& directory) {
+  fs::create_directory(directory / "keys");  // not create_directories: see AtomicOutputDirectory::path()
+  fs::create_directory(directory / "links");
+
+  // Consecutive links share a key image: keep the last two decoded. (cv::Mat copies share the pixels, so a
+  // returned image stays valid after it leaves the cache.)
+  std::map<int, cv::Mat> cache;
+  auto key_image = [&](int index) -> cv::Mat {
+    auto it = cache.find(index);
+    if (it != cache.end()) return it->second;
+    while (cache.size() >= 2) cache.erase(cache.begin());
+    return cache[index] = ReadKeyImage(map_directory, map.key_images[index]);
+  };
+
+  MapReportFiles assets;
+  std::unique_ptr<RouteVideo> video;
+  for (size_t i = 0; i < map.key_images.size(); ++i) {
+    const cv::Mat thumb = ScaledToWidth(key_image(static_cast<int>(i)), options.thumbnail_width);
+    WriteJpeg(directory / "keys" / Numbered(static_cast<int>(i)), thumb, options.jpeg_quality);
+    assets.thumbnail_sizes.push_back(thumb.size());
+    if (i == 0 && options.route_video && map.key_images.size() > 1) {
+      video = std::make_unique<RouteVideo>(directory, thumb.size(), options.route_fps);
+    }
+    if (video) {
+      video->Add(thumb, "key " + std::to_string(i) + "  frame " + std::to_string(map.key_images[i].frame_index));
+    }
+  }
+  if (video && video->Finish()) {
+    assets.video_file = video->file_name();
+    assets.video_size = video->size();
+  }
+  for (size_t i = 0; i < map.links.size(); ++i) {
+    const Link& l = map.links[i];
+    MatchFigureOptions figure_options;
+    figure_options.max_width = options.figure_width;
+    figure_options.title = "link " + std::to_string(i) + ": " + LinkTitle(map, static_cast<int>(i));
+    const cv::Mat figure = DrawMatchFigure(key_image(l.from_key), key_image(l.to_key), l, figure_options);
+    WriteJpeg(directory / "links" / Numbered(static_cast<int>(i)), figure, options.jpeg_quality);
+    assets.figure_sizes.push_back(figure.size());
+  }
+  return assets;
+}
+
+}  // namespace vmap::report
