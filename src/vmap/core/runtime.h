@@ -11,13 +11,13 @@ namespace vmap {
 
 struct RuntimeOptions {
   // OpenCV's own threads per call (cv::setNumThreads); 0 keeps OpenCV's default. vmap runs frames in parallel
-  // itself, and OpenCV's threads inside ORB then only add contention (measured: 5.1 ms per 640x480 frame on
-  // one thread, 7.2 ms with two).
+  // itself, and OpenCV's threads inside ORB then only add contention (docs/measurements/code-choices.md,
+  // "Process-wide settings").
   int opencv_threads = 1;
   // Keep freed memory in the heap instead of returning large blocks to the system (mallopt M_MMAP_MAX = 0,
   // M_TRIM_THRESHOLD = 1 GiB). The deep matchers re-allocate their large activations for every frame; from
-  // fresh mmap()s those page-fault every time. Measured (docs/measurements/loftr.md): LoFTR 27-37 % faster per frame /
-  // per pair, ALIKED-N16's network 0.13 -> 0.09 CPU s per 640x480 frame. The same as starting with
+  // fresh mmap()s those page-fault every time; kept, LoFTR and ALIKED run clearly faster
+  // (docs/measurements/code-choices.md, "Process-wide settings"). The same as starting with
   // GLIBC_TUNABLES=glibc.malloc.mmap_max=0:glibc.malloc.trim_threshold=..., without needing the variable.
   bool keep_freed_memory = true;
   // Silence FFmpeg's own log: vmap reports decoding problems itself, once per frame, with the file name;

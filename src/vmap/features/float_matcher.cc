@@ -10,14 +10,11 @@ namespace vmap {
 namespace {
 
 // Similarities are computed tile by tile: kTileRows query rows x kTileCols train rows (512 KB), scanned while
-// the tile is still in cache (half a core's L2 here: 7 % faster than 1 MB tiles on XFeat's pairs, either path;
-// 256 x 384 and 512 x 512 were no faster). cv::gemm hands products of at least 100 rows to the BLAS OpenCV is built
-// with (OpenBLAS, dispatched at run time to the CPU's best kernels) and computes smaller ones itself, 25x slower; so
-// every product has at least kMinRows rows.
-//
-// Measured on 512 x 4096 unit 64-d descriptors, one thread of a loaded Zen 3 core (min of 40 runs, gemm +
-// scan): cv::gemm 2.8-3.0 ms (74 ms with 32- or 64-row products); cblas_sgemm (OpenBLAS) 2.8-3.0 ms;
-// LibTorch mm 2.9-3.1 ms; Eigen 3.4 6.5-14.5 ms, compiled for SSE2 or with -mavx2 -mfma alike.
+// the tile is still in cache (half a core's L2 here; larger and other tiles were no faster). cv::gemm hands
+// products of at least 100 rows to the BLAS OpenCV is built with (OpenBLAS, dispatched at run time to the CPU's
+// best kernels) and computes smaller ones itself, far slower; so every product has at least kMinRows rows.
+// cv::gemm was as fast as OpenBLAS called directly and LibTorch, and faster than Eigen
+// (docs/measurements/code-choices.md, "Float matching: tiles and the matrix product").
 constexpr int kTileRows = 256;
 constexpr int kTileCols = 512;
 constexpr int kMinRows = 128;
@@ -125,7 +122,7 @@ void ForEachProductTile(const cv::Mat& a, const cv::Mat& b, Visit visit) {
   }
 }
 
-// Every pair's similarity: one 64-d product per pair (a 4096 x 4096 XFeat pair: 20 ms on one core above).
+// Every pair's similarity: one 64-d product per pair.
 void OfferAllPairs(const cv::Mat& query, const cv::Mat& train, MutualBest& best) {
   ForEachProductTile(query, train, [&](int row_begin, int row_end, int col_begin, const cv::Mat& tile) {
     for (int i = row_begin; i < row_end; ++i) best.OfferRow(i, col_begin, tile.ptr<float>(i - row_begin), tile.cols);
@@ -138,7 +135,8 @@ float SquaredNorm(const float* row, int size) {
   return sum;
 }
 
-// Four sums side by side: one running sum would wait on its own additions (a 64-d product takes ~3x longer).
+// Four sums side by side: one running sum would wait on its own additions (measured in
+// docs/measurements/code-choices.md, "Float matching: the bound on a projection").
 float Dot(const float* a, const float* b, int size) {
   cv::v_float32x4 sum0 = cv::v_setzero_f32(), sum1 = sum0, sum2 = sum0, sum3 = sum0;
   int x = 0;
@@ -154,9 +152,9 @@ float Dot(const float* a, const float* b, int size) {
   return total;
 }
 
-// The bound's share of the width: with 3/8 of the axes (24 of XFeat's 64) XFeat's 4096 x 4096 pairs took
-// 1/1.5-1/1.8 of the time of every pair's similarity (lab_floor frames 10-60 apart, michigan a season apart;
-// `xfeat_bench --float-matching`); 1/4 of the axes: 1/1.1-1/1.3, 1/2: 1/1.4-1/1.5.
+// The bound's share of the width: 3/8 of the axes (24 of XFeat's 64) was the fastest of 1/4, 3/8 and 1/2 on
+// XFeat's pairs (`xfeat_bench --float-matching`; docs/measurements/code-choices.md, "Float matching: the bound
+// on a projection").
 int BoundAxes(int dims) { return dims * 3 / 8; }
 
 // The bound pays off where the floor is high and the descriptors wide. Below a floor of ~0.5 nearly every pair
@@ -169,7 +167,7 @@ bool UseBound(const cv::Mat& query, const cv::Mat& train, float min_similarity) 
 }  // namespace
 
 // Only pairs with a similarity of at least `min_similarity` can be matches, and they are a small share of all
-// pairs (0.2-0.3 % of XFeat's 4096 x 4096 at 0.82 on lab_floor). A projection P onto k orthonormal axes
+// pairs (a fraction of a percent of XFeat's on lab_floor). A projection P onto k orthonormal axes
 // never lengthens a vector, so a pair can reach the floor only if
 //   |P q - P t|^2 <= |q - t|^2 = |q|^2 + |t|^2 - 2 q.t <= |q|^2 + |t|^2 - 2 min_similarity,
 // which, with the projections augmented by two columns, is the sign of one k+2-wide product:
@@ -246,8 +244,8 @@ void OfferPairsAboveFloor(const cv::Mat& query, const cv::Mat& train, const Floa
         if (cv::v_signmask(b0 & b1 & b2 & b3) == 0xF) continue;
         const int negative =
             cv::v_signmask(b0) | cv::v_signmask(b1) << 4 | cv::v_signmask(b2) << 8 | cv::v_signmask(b3) << 12;
-        // The others by their bits, lowest first: one branch per pair let through rather than one per bound
-        // (6-11 % less matching time on XFeat's lab_floor pairs).
+        // The others by their bits, lowest first: one branch per pair let through rather than one per bound,
+        // the faster (docs/measurements/code-choices.md, "Float matching: the bound on a projection").
         for (unsigned let_through = ~negative & 0xFFFFu; let_through != 0; let_through &= let_through - 1) {
           const int x = j + __builtin_ctz(let_through);
           const float similarity = Dot(q, train.ptr<float>(col_begin + x), dims);

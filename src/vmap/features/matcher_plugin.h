@@ -1,7 +1,8 @@
 #pragma once
 // The LibTorch half of vmap (the deep matchers) is a plugin, libvmap_torch.so beside the vmap binary, loaded
 // the first time a deep model is created or inspected. Linked into the binary, LibTorch's static initialisers
-// cost every command about 0.45 s of start-up (vmap info included), deep matcher or not. No LibTorch here.
+// would slow the start-up of every command (vmap info included), deep matcher or not
+// (docs/measurements/code-choices.md, "LibTorch as a plugin"). No LibTorch here.
 //
 // The plugin exports one C symbol, vmap_matcher_plugin_table, returning a table of what it offers per model
 // name; each model's LibTorch part adds its row with a PluginMatcherRegistration.

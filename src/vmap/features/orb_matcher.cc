@@ -195,8 +195,8 @@ __attribute__((target_clones("popcnt", "default"))) void HammingRowWords(const u
 #if defined(__x86_64__)
 // 256-bit descriptors (ORB) with AVX2, 16 trains per step: per byte a nibble-table popcount, summed per
 // 8 bytes with vpsadbw, then four trains' partial sums packed per 64-bit lane and transposed so that the
-// step ends with 16 distances in one register. With it a 500x500 ORB pair is matched in 0.33 ms, against
-// 0.55 ms with one POPCNT per word (lab_floor frames, one Zen 3 core).
+// step ends with 16 distances in one register: faster than one POPCNT per word (docs/measurements/code-choices.md,
+// "ORB matching with AVX2").
 // Four u64 lanes: the set bits of each 8-byte quarter of query ^ train.
 __attribute__((target("avx2"))) inline __m256i QuarterCounts(__m256i query, const uint64_t* train) {
   const __m256i nibble_counts = _mm256_setr_epi8(0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4,  //

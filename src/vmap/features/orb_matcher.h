@@ -28,8 +28,8 @@ struct OrbMatcherOptions {
 std::unique_ptr<Matcher> CreateOrbMatcher(const OrbMatcherOptions& options);
 
 // Brute-force Hamming matching of binary descriptors (CV_8U rows, any width that is a multiple of 8 bytes).
-// AVX2 for 256-bit descriptors, POPCNT otherwise: measured 0.33 ms per 500x500 ORB pair against 5.9 ms for
-// cv::BFMatcher(NORM_HAMMING, crossCheck) on one Zen 3 core, with the same matches.
+// AVX2 for 256-bit descriptors, POPCNT otherwise: the same matches as cv::BFMatcher(NORM_HAMMING, crossCheck), many
+// times faster (docs/measurements/code-choices.md, "ORB matching with AVX2").
 // Returns pairs (query row, train row).
 std::vector<std::pair<int, int>> MatchBinaryDescriptors(const cv::Mat& query, const cv::Mat& train, bool cross_check,
                                                         double ratio);

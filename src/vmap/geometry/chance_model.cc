@@ -59,8 +59,7 @@ size_t FirstNotBelow(const std::vector<double>& sorted, double value) {
 
 // How many `values` have each index as FirstNotBelow in `sorted` (counts[sorted.size()]: above them all).
 // Eight searches go side by side, step by step: a search's steps wait on each other's loads, eight searches'
-// do not. With it ChanceOfFundamental took 0.22 / 0.52 / 0.89 ms instead of 1.07 / 1.55 / 2.0 ms for 500 / 2000
-// / 4000 matches (one search at a time, std::lower_bound or branchless alike).
+// do not (docs/measurements/code-choices.md, "The chance model's counts").
 std::vector<int> CountByFirstNotBelow(const std::vector<double>& sorted, const std::vector<double>& values) {
   std::vector<int> counts(sorted.size() + 1, 0);
   constexpr size_t kSideBySide = 8;
@@ -138,7 +137,7 @@ ChanceOfMatches ChanceOfFundamental(const cv::Matx33d& F, const std::vector<cv::
   // another: what the null hypothesis says a match is), and the larger of the two probabilities is used.
   // It is needed only at the n thresholds above: each random pairing is counted under the first threshold it
   // does not exceed, and the running sum gives how many are within each. The same counts as sorting the
-  // pairings, 3-4x faster (this took 5 % of XFeat localization's CPU sorted).
+  // pairings, faster (docs/measurements/code-choices.md, "The chance model's counts").
   const long all_pairs = static_cast<long>(n) * (n - 1);
   std::vector<double> paired(static_cast<size_t>(std::min<long>(all_pairs, kRandomPairs)));
   cv::RNG rng(0x5eed);  // deterministic: the same pair always gives the same score

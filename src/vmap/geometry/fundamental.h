@@ -40,9 +40,10 @@ struct VerifierOptions {
   // Own MAGSAC++ stopping early only: "fewer inliers than the target" is settled after at most this many
   // samples, where the confidence criterion for the target's inlier ratio would draw more (31,600 at 0.3, the
   // 100,000 cap at 0.25 and below). The criterion counts only all-inlier samples; local optimisation also recovers the
-  // model from samples with an outlier or two, so far fewer samples find it. Measured on rccar_room's sweep
-  // (docs/measurements/sweeps.md): 10,000 cut the sweep's CPU by 18 % and flipped about as many of the exhaustive
-  // run's decisions as a change of seed does. max_iterations keeps the confidence criterion alone.
+  // model from samples with an outlier or two, so far fewer samples find it. On rccar_room's sweep 10,000 cut
+  // the CPU and flipped about as many of the exhaustive run's decisions as a change of seed does
+  // (docs/measurements/code-choices.md, "Stopping verification once the decisions are settled").
+  // max_iterations keeps the confidence criterion alone.
   int max_samples_to_reject = 10000;
   // Bounded verification of scored matches (kMagsac, no EarlyStop targets, one score per match), whatever
   // own_magsac says: with N > 0, vmap's MAGSAC++ draws at most max_samples_to_reject samples from the N

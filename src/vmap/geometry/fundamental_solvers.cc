@@ -129,7 +129,8 @@ int SolveStationary(const NormalizedPoints& points, const SevenPointSample& samp
 
 // The unit vector minimising v^T M v for a symmetric positive semi-definite 9x9 M: inverse iteration, which
 // converges in a few steps because the smallest eigenvalue of these normal equations is far below the next;
-// measured 3x faster than Eigen's SelfAdjointEigenSolver, which remains the fallback.
+// faster than Eigen's SelfAdjointEigenSolver, which remains the fallback (docs/measurements/code-choices.md,
+// "MAGSAC++'s solvers").
 bool SmallestEigenvector(const Mat9& M, Vec9* v) {
   const double shift = 1e-12 * M.trace();
   const Eigen::LDLT<Mat9> ldlt(M + shift * Mat9::Identity());
@@ -323,7 +324,7 @@ bool FitFundamental(const NormalizedPoints& points, const std::vector<int>& indi
   Mat3 F;
   F << f(0), f(1), f(2), f(3), f(4), f(5), f(6), f(7), f(8);
   // Rank 2: remove the smallest singular component, F - (F v) v^T with v the right singular vector of the
-  // smallest singular value (closed-form 3x3 eigen-decomposition of F^T F, ~10x cheaper than a 3x3 SVD).
+  // smallest singular value (closed-form 3x3 eigen-decomposition of F^T F, cheaper than a 3x3 SVD).
   Eigen::SelfAdjointEigenSolver<Mat3> eigen;
   eigen.computeDirect(F.transpose() * F);
   const Vec3 v = eigen.eigenvectors().col(0);

@@ -7,8 +7,8 @@
 // to find a model reaching tau if there were one (ln(1 - confidence) / ln(1 - w^7) for the inlier ratio w that
 // tau needs), the answer "no" is known with the requested confidence. OpenCV's loop cannot be stopped there: it
 // runs until the confidence criterion of the best model it found, which for pairs below tau = 0.3 is the
-// 100,000-iteration cap. Stopping at the settled decisions made a sweep's estimation about 7x cheaper
-// (docs/measurements/sweeps.md).
+// 100,000-iteration cap. Stopping at the settled decisions makes a sweep's estimation several times cheaper
+// (docs/measurements/code-choices.md, "Stopping verification once the decisions are settled").
 //
 // Run without targets it estimates exhaustively, as USAC_MAGSAC does (OpenCV 4.6, calib3d/src/usac): uniform
 // 7-point samples; models breaking the oriented epipolar constraint are dropped; SPRT (Matas & Chum 2008)

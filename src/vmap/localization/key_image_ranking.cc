@@ -78,9 +78,10 @@ int HammingDistance(const uchar* a, const uchar* b, int bytes) {
 // Each key image's descriptors (at most max_descriptors_per_key); a query is matched with every key image by
 // brute force, cross-checked, and a key image's score is the number of matches that are close enough.
 // Why brute force and not an approximate index: OpenCV's FLANN multi-probe LSH, the packaged index for binary
-// descriptors, took 27x longer per query than this on an 18-key ORB map (624 ms against 22 ms, lab_floor,
-// same run; ORB's bits are far from uniform, so its hash buckets are very unequal), and brute force over a few
-// hundred descriptors per key image stays within the relocalization budget for a few hundred key images.
+// descriptors, took far longer per query than this on an ORB map (docs/measurements/code-choices.md, "Ranking
+// key images by brute force"; ORB's bits are far from uniform, so its hash buckets are very unequal), and brute
+// force over a few hundred descriptors per key image stays within the relocalization budget for a few hundred
+// key images.
 class KeyImageRanking::VoteIndex {
  public:
   VoteIndex(const std::vector<std::shared_ptr<const ImageFeatures>>& key_features, const RankingOptions& options)

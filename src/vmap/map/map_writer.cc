@@ -24,10 +24,10 @@ std::string LowerExtension(const std::string& path) {
   return extension;
 }
 
-// A key image is the input's own file when the frame was decoded from an image file at its size: a copy costs
-// ~0.1 ms and is exactly the input. Other frames (video, resized) are written as PNG with OpenCV's default
-// settings (zlib level 1, run-length strategy): measured 2x faster than level 1 with the default strategy, for
-// files 15 % larger; still ~10 ms for 640x480, hence the thread of its own.
+// A key image is the input's own file when the frame was decoded from an image file at its size: a copy is
+// cheap and exactly the input. Other frames (video, resized) are written as PNG with OpenCV's default settings
+// (zlib level 1, run-length strategy): faster than level 1 with the default strategy, for somewhat larger files,
+// and still slow enough to need a thread of its own (docs/measurements/code-choices.md, "Writing key images").
 // Only PNG and JPEG files are kept as they are, and only when their header gives the frame's size: ReadMap
 // checks a key image's size from those headers.
 bool KeepsSourceFile(const Frame& frame) {

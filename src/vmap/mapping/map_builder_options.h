@@ -65,10 +65,10 @@ struct MapBuilderOptions {
 };
 
 // kAuto resolves to kSequential, for every matcher (Check() refuses kBisect with `exhaustive`). Bisect was measured as
-// the deep matchers' default and dropped (docs/measurements/deep-matchers.md, "Comparing fewer frames"): for XFeat it
-// was no faster (0.90-1.04x on three of four sequences, more comparisons where S does not fall with distance), and for
-// ALIKED, 1.5-10x faster, it changed the map on three of four sequences (its S stays high until its matches run out).
-// It stays available as --search bisect.
+// the deep matchers' default and dropped (docs/measurements/deep-matchers.md, "Comparing fewer frames";
+// docs/measurements/code-choices.md): for XFeat it was no faster (more comparisons where S does not fall with
+// distance), and for ALIKED, though faster, it changed the map on three of four sequences (its S stays high until
+// its matches run out). It stays available as --search bisect.
 KeySearch ResolveKeySearch(const MapBuilderOptions& options);
 
 // The verifier of the decisions: vmap's MAGSAC++, stopping once S >= tau is settled, unless the paper's

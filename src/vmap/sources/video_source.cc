@@ -1,8 +1,8 @@
 // A frame source over a video file, decoded with FFmpeg's libavformat/libavcodec.
 //
 // Why not cv::VideoCapture: OpenCV 4.6 always decodes with one thread per core, and vmap already keeps
-// every core busy with feature extraction and verification. Decoding on one thread costs about 10 % less
-// CPU per frame (lab_floor.mp4: 2.6 against 2.9 ms, BGR and grey included), and frames skipped by
+// every core busy with feature extraction and verification. Decoding on one thread costs less CPU per frame
+// (docs/measurements/code-choices.md, "Decoding video on one thread"), and frames skipped by
 // --first/--stride are never converted to BGR. The BGR conversion is the one OpenCV makes (swscale, bicubic), so the
 // frames are pixel-identical to cv::VideoCapture's.
 

@@ -80,7 +80,8 @@ void WindowMax(const float* in, float* out, std::vector<float>& rows, int64_t h,
 }
 
 // SimpleNms on a contiguous float CPU map, with the same arithmetic as the tensor version (comparisons and
-// maxima only, so the result is identical). Measured 40 ms -> 7 ms per 640x480 map on one core.
+// maxima only, so the result is identical), several times faster (docs/measurements/code-choices.md, "ALIKED on
+// the CPU").
 torch::Tensor SimpleNmsCpu(const torch::Tensor& scores, int radius) {
   const auto map = scores.contiguous();
   const int64_t h = map.size(-2), w = map.size(-1), n = h * w;
@@ -229,7 +230,8 @@ AlikedModel::AlikedModel(AlikedConfig config, const StateDict& weights, torch::D
     }
   }
   // The full- and half-resolution layers run in channels-last memory: oneDNN's 3x3 convolutions with 4-16
-  // channels were 1.7-5x faster so on this project's CPU than on NCHW tensors (bench/aliked_bench --stages).
+  // channels were faster so on this project's CPU than on NCHW tensors (bench/aliked_bench --stages;
+  // docs/measurements/code-choices.md, "ALIKED on the CPU").
   for (const char* key : {"block1.conv1.weight", "block1.conv2.weight", "block2.conv1.weight", "block2.conv2.weight",
                           "block2.downsample.weight"}) {
     weights_[key] = weights_[key].contiguous(torch::MemoryFormat::ChannelsLast);

@@ -17,10 +17,9 @@ namespace vmap::neural {
 // Implementation: the bilinear samples of all taps are gathered into one channels-last column matrix
 // (Ho*Wo, K*K*C): four row gathers from a zero-bordered copy of the input and their weighted sum; one matrix
 // product with the weights gives the output, returned channels-last (B, O, Ho, Wo). On this project's CPU the
-// gather + product took 1.2-1.5x less CPU time than one grid_sample per tap followed by the same product
-// (bench/aliked_bench --dcn, ALIKED-N16's four deformable layers at 640x480 and KITTI size); the product
-// itself is most of the cost (5 of 11 ms for 64->64 channels at 80x60), so a hand-written kernel for the
-// gather would gain little.
+// gather + product took less CPU time than one grid_sample per tap followed by the same product
+// (bench/aliked_bench --dcn); the product itself is most of the cost, so a hand-written kernel for the gather
+// would gain little (docs/measurements/code-choices.md, "ALIKED on the CPU").
 torch::Tensor DeformConv2d(const torch::Tensor& input, const torch::Tensor& offset, const torch::Tensor& weight,
                            const torch::Tensor& bias, const torch::Tensor& mask, int64_t padding);
 

@@ -35,7 +35,7 @@ torch::Tensor SampleAt(const torch::Tensor& map, const torch::Tensor& positions,
 
 // The 5x5 non-maximum suppression on the CPU: OpenCV's dilation is a separable, vectorised max filter whose
 // border never wins (as max_pool2d's -inf padding). A maximum is exact, so the points are the same as
-// upstream's; this took 0.6 ms instead of 30 ms for max_pool2d at 640x480 (one core, loaded machine).
+// upstream's, far faster than max_pool2d (docs/measurements/code-choices.md, "XFeat on the CPU").
 // Returns (N, 2) int64 (x, y) in row-major order, as nonzero() gives them.
 torch::Tensor LocalMaximaOnCpu(const torch::Tensor& heatmap, double threshold) {
   const auto heat = heatmap.contiguous();
@@ -68,7 +68,7 @@ std::array<float, 4> CubicCoefficients(float t) {
 // Upstream's descriptor sampling on the CPU: grid_sample(bicubic, align_corners = false, zeros padding) of
 // the (1, C, h, w) map at the integer points (x, y) of the H x W network input, normalised with upstream's
 // normgrid, then each row L2-normalised. The arithmetic is LibTorch's, point by point over channel-last
-// memory: 0.9 ms instead of 13 ms for grid_sampler + normalize at 4096 points (one core, loaded machine).
+// memory, far faster than grid_sampler + normalize (docs/measurements/code-choices.md, "XFeat on the CPU").
 torch::Tensor SampleDescriptorsOnCpu(const torch::Tensor& map, const torch::Tensor& points, int64_t height,
                                      int64_t width) {
   const auto channels_last = map[0].permute({1, 2, 0}).contiguous();  // (h, w, C)
@@ -177,7 +177,7 @@ torch::Tensor XfeatModel::Conv(const torch::Tensor& x, const std::string& name) 
 
 torch::Tensor XfeatModel::FirstConvOnCpu(const torch::Tensor& x) const {
   // block1.0 reads one channel at full resolution, where oneDNN is slow: cv::filter2D (a correlation, as
-  // conv2d) took 0.48 ms instead of 2.1 ms for LibTorch's conv2d at 640x480 (one core, loaded machine).
+  // conv2d) is several times faster (docs/measurements/code-choices.md, "XFeat on the CPU").
   const auto& [weight, bias] = weights_.at("block1.0");
   const int height = static_cast<int>(x.size(2)), width = static_cast<int>(x.size(3));
   auto out = torch::empty({x.size(0), weight.size(0), x.size(2), x.size(3)}, x.options());
@@ -199,7 +199,8 @@ XfeatNetOutput XfeatModel::Forward(const torch::Tensor& image, bool reference_op
     throw std::invalid_argument("XfeatModel::Forward: expected (B, 1 or 3, H, W) with H, W positive multiples of 8");
   }
   // On the CPU the activations stay in oneDNN's blocked layout from layer to layer, with the weights
-  // reordered once: 6-10 % faster than LibTorch's conv2d, which reorders both at every call.
+  // reordered once: faster than LibTorch's conv2d, which reorders both at every call
+  // (docs/measurements/code-choices.md, "XFeat on the CPU").
   const bool on_cpu = device_.is_cpu() && !reference_ops;
   const bool blocked = on_cpu && !blocked_weights_.empty();
   auto to_blocked = [&](const torch::Tensor& t) { return blocked ? t.to_mkldnn() : t; };
