@@ -5,7 +5,6 @@
 #include <cstring>
 #include <limits>
 #include <optional>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -16,135 +15,17 @@
 #include "vmap/core/file_name_encoding.h"
 #include "vmap/core/image_header.h"
 #include "vmap/map/map_geometry_json.h"
+#include "vmap/map/map_json_fields.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
+using internal::Fields;
+using internal::Malformed;
+using internal::SizeField;
 using nlohmann::json;
 
 namespace {
-
-[[noreturn]] void Malformed(const fs::path& file, const std::string& what) {
-  throw InputError("malformed map '" + file.string() + "': " + what + "; rebuild the map with `vmap build`");
-}
-
-std::string ShortText(const json& value) {
-  std::string text = value.dump();
-  return text.size() > 40 ? text.substr(0, 37) + "..." : text;
-}
-
-// Typed, range-checked access to map.json's fields: every failure names the field ("links[3].F").
-class Fields {
- public:
-  explicit Fields(const fs::path& file) : file_(file) {}
-
-  [[noreturn]] void Fail(const std::string& field, const std::string& what) const {
-    Malformed(file_, "'" + field + "' " + what);
-  }
-
-  // The member, or null when absent.
-  static const json* Find(const json& object, const char* name) {
-    auto it = object.find(name);
-    return it == object.end() ? nullptr : &*it;
-  }
-
-  const json& Required(const json& object, const std::string& where, const char* name) const {
-    const json* value = Find(object, name);
-    if (!value) Fail(Join(where, name), "is missing");
-    return *value;
-  }
-
-  const json& Object(const json& value, const std::string& field) const {
-    if (!value.is_object()) Fail(field, "must be an object");
-    return value;
-  }
-
-  const json& Array(const json& value, const std::string& field) const {
-    if (!value.is_array()) Fail(field, "must be a list");
-    return value;
-  }
-
-  static bool IntegerIn(const json& value, long low, long high) {
-    if (value.is_number_unsigned()) {
-      const std::uint64_t number = value.get<std::uint64_t>();
-      return high >= 0 && number <= static_cast<std::uint64_t>(high) &&
-             (low <= 0 || number >= static_cast<std::uint64_t>(low));
-    }
-    if (!value.is_number_integer()) return false;
-    const std::int64_t number = value.get<std::int64_t>();
-    return number >= low && number <= high;
-  }
-
-  static bool NumberIn(const json& value, double low, double high) {
-    if (!value.is_number()) return false;
-    const double number = value.get<double>();
-    return std::isfinite(number) && number >= low && number <= high;
-  }
-
-  long Integer(const json& value, const std::string& field, long low, long high) const {
-    if (!IntegerIn(value, low, high)) {
-      Fail(field, "must be an integer from " + std::to_string(low) + " to " + std::to_string(high) + " (got " +
-                      ShortText(value) + ")");
-    }
-    return static_cast<long>(value.get<std::int64_t>());
-  }
-
-  double Number(const json& value, const std::string& field, double low, double high) const {
-    if (!NumberIn(value, low, high)) {
-      Fail(field, "must be a finite number from " + FormatNumber(low) + " to " + FormatNumber(high) + " (got " +
-                      ShortText(value) + ")");
-    }
-    return value.get<double>();
-  }
-
-  std::string String(const json& value, const std::string& field) const {
-    if (!value.is_string()) Fail(field, "must be a string");
-    return value.get<std::string>();
-  }
-
-  bool Bool(const json& value, const std::string& field) const {
-    if (!value.is_boolean()) Fail(field, "must be true or false");
-    return value.get<bool>();
-  }
-
-  // Optional members: the default when absent.
-  long Integer(const json& object, const std::string& where, const char* name, long low, long high, long absent) const {
-    const json* value = Find(object, name);
-    return value ? Integer(*value, Join(where, name), low, high) : absent;
-  }
-  double Number(const json& object, const std::string& where, const char* name, double low, double high,
-                double absent) const {
-    const json* value = Find(object, name);
-    return value ? Number(*value, Join(where, name), low, high) : absent;
-  }
-  std::string String(const json& object, const std::string& where, const char* name) const {
-    const json* value = Find(object, name);
-    return value ? String(*value, Join(where, name)) : std::string();
-  }
-
-  static std::string Join(const std::string& where, const char* name) {
-    return where.empty() ? std::string(name) : where + "." + name;
-  }
-
- private:
-  static std::string FormatNumber(double value) {
-    std::ostringstream text;
-    text << value;
-    return text.str();
-  }
-
-  const fs::path& file_;
-};
-
-cv::Size SizeField(const Fields& fields, const json& object, const std::string& where, const char* name) {
-  const json* value = Fields::Find(object, name);
-  if (!value) return {};
-  const std::string field = Fields::Join(where, name);
-  if (!value->is_array() || value->size() != 2) fields.Fail(field, "must be [width, height]");
-  constexpr long kMaxSide = 1L << 20;
-  return {static_cast<int>(fields.Integer((*value)[0], field + "[0]", 0, kMaxSide)),
-          static_cast<int>(fields.Integer((*value)[1], field + "[1]", 0, kMaxSide))};
-}
 
 // A key image's size from its header: PNG, or JPEG (a key image copied from the input's own file).
 std::optional<cv::Size> KeyImageSize(const ContainedFile& file) { return ImageHeaderSize(file); }
