@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Installs everything vmap needs on Debian 12 (bookworm) from Debian's own packages.
-# Usage: scripts/install-deps.sh [--with-browser]
+# Usage: scripts/install-deps.sh [--with-browser] [--with-ros]
 #   --with-browser  also installs Chromium, used by the report tests.
+#   --with-ros      also installs ROS 1 (Debian's ROS Noetic packages): the node in ros/ and its tests against a
+#                   real rosmaster (docs/ros.md). The vmap binary never needs it.
 set -euo pipefail
 
 packages=(
@@ -16,9 +18,21 @@ packages=(
   ffmpeg                        # only used by tests: videos with a display rotation, live streams on the loopback
   pybind11-dev python3-numpy python3-pytest  # the Python module (python/, docs/python.md) and its tests
 )
-if [[ "${1:-}" == "--with-browser" ]]; then
-  packages+=(chromium)
-fi
+ros_packages=(
+  ros-core                      # rosmaster, rosout, rostopic, roslaunch, rosbag play and record
+  libroscpp-dev libtopic-tools-dev libcv-bridge-dev  # the node: roscpp, any image type (ShapeShifter), the debug image
+  libsensor-msgs-dev libgeometry-msgs-dev libnav-msgs-dev libstd-msgs-dev libstd-srvs-dev  # message headers
+  ros-sensor-msgs ros-geometry-msgs ros-nav-msgs ros-std-msgs ros-std-srvs  # their .msg files (genmsg, rostopic)
+  python3-gencpp python3-genpy  # the generators of the vmap_ros messages (C++ and Python)
+  python3-sensor-msgs python3-geometry-msgs python3-nav-msgs python3-std-srvs  # rostopic echo of the node's topics
+)
+for flag in "$@"; do
+  case "$flag" in
+    --with-browser) packages+=(chromium) ;;
+    --with-ros) packages+=("${ros_packages[@]}") ;;
+    *) echo "install-deps: unknown option $flag (use --with-browser, --with-ros)" >&2; exit 2 ;;
+  esac
+done
 
 sudo_cmd=()
 if [[ $(id -u) -ne 0 ]]; then sudo_cmd=(sudo); fi

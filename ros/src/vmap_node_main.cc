@@ -1,0 +1,27 @@
+// vmap_node: teach and repeat on a robot (docs/ros.md). `rosrun vmap_ros vmap_node image:=/camera/image_raw`, or
+// the launch files in ros/launch.
+
+#include <ros/ros.h>
+
+#include "vmap/core/runtime.h"
+
+#include "vmap_ros/rosconsole_sink.h"
+#include "vmap_ros/vmap_node.h"
+
+int main(int argc, char** argv) {
+  // First, while this is the only thread (core/runtime.h). ROS handles SIGINT itself: a run in progress is ended
+  // by the node, not by vmap's handler.
+  vmap::RuntimeOptions runtime;
+  runtime.handle_interrupts = false;
+  vmap::InitializeRuntime(runtime);
+  ros::init(argc, argv, "vmap");
+  vmap::ros_node::LogThroughRosconsole();
+  ros::NodeHandle node;
+  ros::NodeHandle private_node("~");
+  vmap::ros_node::VmapNode vmap_node(node, private_node);
+  // Services that take seconds (a map loading, a teach run finishing) keep one thread; the camera has another.
+  ros::AsyncSpinner spinner(3);
+  spinner.start();
+  ros::waitForShutdown();
+  return 0;
+}

@@ -1,0 +1,171 @@
+// The node against bad input on a real ROS master: malformed camera messages, a NaN CameraInfo, a missing map,
+// services called in the wrong state. Each gets a clear answer or log line; the node keeps running, and nothing
+// on disk is lost.
+
+#include <fstream>
+#include <mutex>
+
+#include <gtest/gtest.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <std_srvs/Trigger.h>
+
+#include "vmap/testing/run_vmap.h"
+#include "vmap/testing/scoped_temp_dir.h"
+#include "vmap/testing/shared_data.h"
+
+#include "ros_harness.h"
+#include "vmap_ros/Localization.h"
+#include "vmap_ros/StartRepeat.h"
+
+namespace vmap::ros_testing {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::Quote;
+using testing::RunVmap;
+using testing::ScopedTempDir;
+using testing::SharedDir;
+
+constexpr auto kTimeout = std::chrono::seconds(60);
+
+std::string Trigger(const std::string& service, bool* success) {
+  std_srvs::Trigger call;
+  EXPECT_TRUE(ros::service::call(service, call)) << service;
+  *success = call.response.success;
+  return call.response.message;
+}
+
+sensor_msgs::Image GreyImage(int width, int height, double stamp) {
+  sensor_msgs::Image image;
+  image.header.stamp = ros::Time(stamp);
+  image.header.frame_id = "camera";
+  image.width = width;
+  image.height = height;
+  image.encoding = "mono8";
+  image.step = width;
+  image.data.assign(static_cast<size_t>(width) * height, 128);
+  return image;
+}
+
+TEST(NodeErrors, BadMessagesMapsAndCallsAreAnsweredAndTheNodeRunsOn) {
+  SKIP_WITHOUT_SHARED();
+  ScopedTempDir dir("ros_errors");
+  const std::string ns = "/errors_test";
+  const auto node = StartVmapNode(ns, {"image:=/errors/image_raw"}, dir.path() / "node.log");
+  ASSERT_TRUE(WaitForService(ns + "/vmap/repeat/start")) << node->Log();
+
+  // Services in the wrong state.
+  bool success = true;
+  EXPECT_NE(Trigger(ns + "/vmap/repeat/pause", &success).find("no repeat run is in progress"), std::string::npos);
+  EXPECT_FALSE(success);
+  EXPECT_NE(Trigger(ns + "/vmap/repeat/resume", &success).find("no repeat run is in progress"), std::string::npos);
+  EXPECT_FALSE(success);
+  EXPECT_NE(Trigger(ns + "/vmap/repeat/stop", &success).find("no repeat run is in progress"), std::string::npos);
+  EXPECT_FALSE(success);
+
+  // A missing map, a folder that is not a map (its file stays as it was), no map at all.
+  vmap_ros::StartRepeat start;
+  start.request.map = (dir.path() / "no_such_map").string();
+  start.request.goal = -1;
+  start.request.start = -1;
+  ASSERT_TRUE(ros::service::call(ns + "/vmap/repeat/start", start));
+  EXPECT_FALSE(start.response.success);
+  EXPECT_NE(start.response.message.find("no_such_map"), std::string::npos) << start.response.message;
+  fs::create_directories(dir.path() / "notes");
+  std::ofstream(dir.path() / "notes" / "todo.txt") << "my notes\n";
+  start.request.map = (dir.path() / "notes").string();
+  ASSERT_TRUE(ros::service::call(ns + "/vmap/repeat/start", start));
+  EXPECT_FALSE(start.response.success);
+  EXPECT_NE(start.response.message.find("notes"), std::string::npos) << start.response.message;
+  EXPECT_EQ(testing::ReadText(dir.path() / "notes" / "todo.txt"), "my notes\n");
+  start.request.map = "";
+  ASSERT_TRUE(ros::service::call(ns + "/vmap/repeat/start", start));
+  EXPECT_FALSE(start.response.success);
+  EXPECT_NE(start.response.message.find("~map"), std::string::npos) << start.response.message;
+
+  // A real map; a goal it does not have; then a repeat run, and a second start while it runs.
+  const fs::path bag = dir.path() / "teach.bag", map = dir.path() / "map";
+  WriteVideoBag(fs::path(SharedDir()) / "data/lab_floor/lab_floor.mp4", 0, 59, bag);
+  std::string output;
+  ASSERT_EQ(RunVmap("build -q " + Quote(bag) + " -o " + Quote(map), &output), 0) << output;
+  start.request.map = map.string();
+  start.request.goal = 1000;
+  ASSERT_TRUE(ros::service::call(ns + "/vmap/repeat/start", start));
+  EXPECT_FALSE(start.response.success);
+  EXPECT_NE(start.response.message.find("no key image 1000"), std::string::npos) << start.response.message;
+  start.request.goal = -1;
+  ASSERT_TRUE(ros::service::call(ns + "/vmap/repeat/start", start));
+  ASSERT_TRUE(start.response.success) << start.response.message;
+  ASSERT_TRUE(ros::service::call(ns + "/vmap/repeat/start", start));
+  EXPECT_FALSE(start.response.success);
+  EXPECT_NE(start.response.message.find("in progress"), std::string::npos) << start.response.message;
+  EXPECT_NE(Trigger(ns + "/vmap/repeat/resume", &success).find("not paused"), std::string::npos);
+  EXPECT_FALSE(success);
+
+  // Malformed camera messages, one at a time: each is logged (the node takes the newest frame, so the next is
+  // sent once the last was seen), then a good frame is still localized.
+  ros::NodeHandle handle;
+  ros::Publisher images = handle.advertise<sensor_msgs::Image>("/errors/image_raw", 10);
+  ros::Publisher infos = handle.advertise<sensor_msgs::CameraInfo>("/errors/camera_info", 10);
+  ASSERT_TRUE(WaitFor([&] { return images.getNumSubscribers() > 0 && infos.getNumSubscribers() > 0; }, kTimeout));
+  std::mutex mutex;
+  std::vector<vmap_ros::Localization> localizations;
+  const ros::Subscriber subscriber = handle.subscribe<vmap_ros::Localization>(
+      ns + "/vmap/localization", 100, [&](const vmap_ros::Localization::ConstPtr& message) {
+        std::lock_guard<std::mutex> lock(mutex);
+        localizations.push_back(*message);
+      });
+  ASSERT_TRUE(WaitFor([&] { return subscriber.getNumPublishers() > 0; }, kTimeout));
+  const auto logged = [&](const std::string& text) {
+    return WaitFor([&] { return node->Log().find(text) != std::string::npos; }, kTimeout);
+  };
+
+  sensor_msgs::Image short_data = GreyImage(640, 480, 1.0);
+  short_data.data.resize(1000);
+  images.publish(short_data);
+  EXPECT_TRUE(logged("640x480 mono8 with step 640 needs more than its 1000 bytes")) << node->Log();
+  sensor_msgs::Image short_step = GreyImage(640, 480, 2.0);
+  short_step.encoding = "bgr8";  // 640 bytes a row cannot hold 640 BGR pixels
+  images.publish(short_step);
+  EXPECT_TRUE(logged("640x480 bgr8 with step 640")) << node->Log();
+  sensor_msgs::Image unknown = GreyImage(640, 480, 3.0);
+  unknown.encoding = "yuv422_weird";
+  images.publish(unknown);
+  EXPECT_TRUE(logged("has image encoding 'yuv422_weird'")) << node->Log();
+  sensor_msgs::CameraInfo nan_info;
+  nan_info.width = 640;
+  nan_info.height = 480;
+  nan_info.distortion_model = "plumb_bob";
+  nan_info.K = {std::nan(""), 0, 320, 0, 500, 240, 0, 0, 1};
+  infos.publish(nan_info);
+  EXPECT_TRUE(logged("has a parameter that is not a finite number; the message is ignored")) << node->Log();
+
+  images.publish(GreyImage(640, 480, 4.0));
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(mutex);
+        return !localizations.empty();
+      },
+      kTimeout))
+      << node->Log();
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    ASSERT_EQ(localizations.size(), 1u);  // only the good frame
+    EXPECT_EQ(localizations.front().header.stamp, ros::Time(4.0));
+    EXPECT_EQ(localizations.front().status_name, "lost");  // a grey frame shows nothing of the map
+  }
+
+  // Pause twice, resume, stop twice: the second of each is refused.
+  EXPECT_TRUE((Trigger(ns + "/vmap/repeat/pause", &success), success));
+  EXPECT_NE(Trigger(ns + "/vmap/repeat/pause", &success).find("paused already"), std::string::npos);
+  EXPECT_FALSE(success);
+  EXPECT_TRUE((Trigger(ns + "/vmap/repeat/resume", &success), success));
+  EXPECT_TRUE((Trigger(ns + "/vmap/repeat/stop", &success), success));
+  EXPECT_FALSE((Trigger(ns + "/vmap/repeat/stop", &success), success));
+  EXPECT_TRUE(node->Running()) << node->Log();
+  EXPECT_EQ(node->Stop(), 0) << node->Log();  // SIGINT: a clean exit
+}
+
+}  // namespace
+}  // namespace vmap::ros_testing

@@ -1,0 +1,177 @@
+// The node's repeat run on a real ROS master: a bag made from a shared video is played to it, and what it publishes
+// is checked against `vmap localize` on the same frames.
+
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <std_msgs/Bool.h>
+#include <std_srvs/Trigger.h>
+
+#include "vmap/testing/run_vmap.h"
+#include "vmap/testing/scoped_temp_dir.h"
+#include "vmap/testing/shared_data.h"
+
+#include "ros_harness.h"
+#include "vmap_ros/Localization.h"
+#include "vmap_ros/StartRepeat.h"
+
+namespace vmap::ros_testing {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::Quote;
+using testing::RunVmap;
+using testing::ScopedTempDir;
+using testing::SharedDir;
+
+std::vector<std::string> SplitCsvLine(const std::string& line) {
+  std::vector<std::string> fields;
+  std::stringstream stream(line);
+  std::string field;
+  while (std::getline(stream, field, ',')) fields.push_back(field);
+  if (!line.empty() && line.back() == ',') fields.emplace_back();
+  return fields;
+}
+
+// The rows of a CSV written by `vmap localize`, each by its column names.
+std::vector<std::map<std::string, std::string>> ReadCsv(const fs::path& file) {
+  std::stringstream text(testing::ReadText(file));
+  std::string line;
+  std::getline(text, line);
+  const std::vector<std::string> header = SplitCsvLine(line);
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(text, line)) {
+    const std::vector<std::string> fields = SplitCsvLine(line);
+    std::map<std::string, std::string> row;
+    for (size_t i = 0; i < header.size() && i < fields.size(); ++i) row[header[i]] = fields[i];
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+std::string Number(double value) { return std::isfinite(value) ? fmt::format("{:.6g}", value) : std::string(); }
+
+// Collects what the node publishes.
+struct Published {
+  std::mutex mutex;
+  std::vector<vmap_ros::Localization> localizations;
+  std::vector<bool> localized;
+
+  void OnLocalization(const vmap_ros::Localization::ConstPtr& message) {
+    std::lock_guard<std::mutex> lock(mutex);
+    localizations.push_back(*message);
+  }
+  void OnLocalized(const std_msgs::Bool::ConstPtr& message) {
+    std::lock_guard<std::mutex> lock(mutex);
+    localized.push_back(message->data);
+  }
+  bool HasStamp(const ros::Time& stamp) {
+    std::lock_guard<std::mutex> lock(mutex);
+    return !localizations.empty() && localizations.back().header.stamp == stamp;
+  }
+};
+
+TEST(RepeatNode, LocalizesThePlayedFramesAsVmapLocalizeDoes) {
+  SKIP_WITHOUT_SHARED();
+  ScopedTempDir dir("ros_repeat");
+  const fs::path video = fs::path(SharedDir()) / "data/lab_floor/lab_floor.mp4";
+  const fs::path teach = dir.path() / "teach.bag", repeat = dir.path() / "repeat.bag", map = dir.path() / "map";
+  WriteVideoBag(video, 0, 199, teach);
+  const std::vector<ros::Time> stamps = WriteVideoBag(video, 20, 139, repeat);
+  std::string output;
+  ASSERT_EQ(RunVmap("build -q " + Quote(teach) + " -o " + Quote(map), &output), 0) << output;
+
+  const auto node = StartVmapNode("/repeat_test", {"image:=/camera/image_raw"}, dir.path() / "node.log");
+  ASSERT_TRUE(WaitForService("/repeat_test/vmap/repeat/start")) << node->Log();
+  ros::NodeHandle handle;
+  Published published;
+  const ros::Subscriber localizations =
+      handle.subscribe("/repeat_test/vmap/localization", 1000, &Published::OnLocalization, &published);
+  const ros::Subscriber localized =
+      handle.subscribe("/repeat_test/vmap/localized", 10, &Published::OnLocalized, &published);
+
+  vmap_ros::StartRepeat start;
+  start.request.map = map.string();
+  start.request.goal = -1;
+  start.request.start = -1;
+  ASSERT_TRUE(ros::service::call("/repeat_test/vmap/repeat/start", start)) << node->Log();
+  ASSERT_TRUE(start.response.success) << start.response.message;
+  ASSERT_FALSE(start.response.route.empty());
+  EXPECT_EQ(start.response.route.front(), 0);
+  // Our subscription is connected before the first frame is played.
+  ASSERT_TRUE(WaitFor([&] { return localizations.getNumPublishers() > 0; }, std::chrono::seconds(60)));
+
+  const auto player = PlayBag(repeat, 1.0, dir.path() / "play.log");
+  ASSERT_EQ(player->Wait(std::chrono::seconds(180)), 0) << player->Log();
+  // Drop, do not lag: the newest frame is always processed, however many were dropped before it.
+  ASSERT_TRUE(WaitFor([&] { return published.HasStamp(stamps.back()); }, std::chrono::seconds(60))) << node->Log();
+
+  std::vector<vmap_ros::Localization> messages;
+  {
+    std::lock_guard<std::mutex> lock(published.mutex);
+    messages = published.localizations;
+    ASSERT_FALSE(published.localized.empty());
+    EXPECT_FALSE(published.localized.front());  // latched false at the start, then true once localized
+    EXPECT_TRUE(published.localized.back());
+  }
+  // Every played frame is either processed or counted as dropped, in order.
+  size_t dropped = 0;
+  std::vector<ros::Time> processed;
+  for (const vmap_ros::Localization& message : messages) {
+    dropped += message.frames_dropped;
+    if (!processed.empty()) {
+      EXPECT_LT(processed.back(), message.header.stamp);
+    }
+    processed.push_back(message.header.stamp);
+    EXPECT_EQ(message.header.frame_id, "camera");
+    EXPECT_GE(message.latency, 0.0);
+  }
+  EXPECT_EQ(processed.size() + dropped, stamps.size());
+  RecordProperty("frames", static_cast<int>(stamps.size()));
+  RecordProperty("processed", static_cast<int>(processed.size()));
+
+  // `vmap localize` on the frames the node processed.
+  WriteBagSubset(repeat, processed, dir.path() / "processed.bag");
+  ASSERT_EQ(RunVmap("localize -q " + Quote(map) + " " + Quote(dir.path() / "processed.bag") + " --csv " +
+                        Quote(dir.path() / "cli.csv"),
+                    &output),
+            0)
+      << output;
+  const auto rows = ReadCsv(dir.path() / "cli.csv");
+  ASSERT_EQ(rows.size(), messages.size());
+  int localized_frames = 0;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const auto& row = rows[i];
+    const vmap_ros::Localization& message = messages[i];
+    SCOPED_TRACE("frame " + std::to_string(i) + " stamp " + row.at("timestamp"));
+    EXPECT_EQ(fmt::format("{:.6f}", message.header.stamp.toSec()), row.at("timestamp"));
+    EXPECT_EQ(message.status_name, row.at("status"));
+    EXPECT_EQ(std::to_string(message.key), row.at("key"));
+    EXPECT_EQ(std::to_string(message.next_key), row.at("next_key"));
+    EXPECT_EQ(std::to_string(message.verified_key), row.at("verified"));
+    EXPECT_EQ(std::to_string(message.verified_next), row.at("next_verified"));
+    EXPECT_EQ(Number(message.heading_px), row.at("heading_px"));
+    EXPECT_EQ(Number(message.heading_deg), row.at("heading_deg"));
+    EXPECT_EQ(Number(message.progress), row.at("progress"));
+    EXPECT_EQ(message.translation_known ? "1" : "0", row.at("translation_known"));
+    EXPECT_EQ(message.guidance, row.at("guidance"));
+    if (message.pose_valid) {
+      EXPECT_EQ(fmt::format("{:.9g}", message.pose.position.x), row.at("tx"));
+    }
+    localized_frames += message.status != vmap_ros::Localization::LOST;
+  }
+  // The frames are the map's own place: most localize.
+  EXPECT_GT(localized_frames, static_cast<int>(rows.size()) * 9 / 10);
+
+  std_srvs::Trigger stop;
+  ASSERT_TRUE(ros::service::call("/repeat_test/vmap/repeat/stop", stop));
+  EXPECT_TRUE(stop.response.success) << stop.response.message;
+  EXPECT_TRUE(node->Running());
+}
+
+}  // namespace
+}  // namespace vmap::ros_testing
