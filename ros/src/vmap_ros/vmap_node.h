@@ -1,16 +1,15 @@
 #pragma once
-// The vmap node (docs/ros.md): teach and repeat on a robot.
+// The vmap node (docs/ros.md): repeat runs on a robot.
 //
 // Topics (remappable):      image (sensor_msgs/Image or CompressedImage), camera_info (beside image, as
-//                           image_transport pairs them), odom (nav_msgs/Odometry, when the robot has it);
-//                           publishes cmd_vel (geometry_msgs/Twist).
+//                           image_transport pairs them); publishes cmd_vel (geometry_msgs/Twist).
 // Private topics:           ~localization (vmap_ros/Localization, one per frame processed), ~debug_image
 //                           (sensor_msgs/Image, drawn only while someone subscribes; a plain publisher, since
 //                           Debian's image_transport cannot be linked: it needs a ROS 1 pluginlib), ~localized
 //                           (std_msgs/Bool, latched: true once a repeat run's first frame is localized).
-// Services:                 ~teach/start, ~teach/stop, ~repeat/start, ~repeat/pause, ~repeat/resume, ~repeat/stop.
-// Parameters:               the flags of `vmap build` (teach) and `vmap localize` (repeat) by their names
-//                           (parameter_reader.h), read when a run starts; ~map, the map directory.
+// Services:                 ~repeat/start, ~repeat/pause, ~repeat/resume, ~repeat/stop.
+// Parameters:               the flags of `vmap localize` by their names (parameter_reader.h), read when a run
+//                           starts; ~map, the map directory.
 //
 // Threads: ROS's spinner threads run the callbacks and services; the camera callback only drops the message in a
 // mailbox (mailbox.h), and one worker thread decodes, localizes and publishes. In a repeat run the mailbox holds
