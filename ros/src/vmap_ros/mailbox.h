@@ -34,12 +34,12 @@ class Mailbox {
     return true;
   }
 
-  // The oldest item held, waiting up to `timeout` for one; nullopt after the timeout or once closed (what is held
-  // is then dropped).
+  // The oldest item held, waiting up to `timeout` for one; nullopt after the timeout, or once the mailbox is closed
+  // and empty.
   std::optional<T> Take(std::chrono::milliseconds timeout) {
     std::unique_lock<std::mutex> lock(mutex_);
     changed_.wait_for(lock, timeout, [this] { return closed_ || !items_.empty(); });
-    if (closed_ || items_.empty()) return std::nullopt;
+    if (items_.empty()) return std::nullopt;
     T item = std::move(items_.front());
     items_.pop_front();
     return item;
@@ -61,13 +61,18 @@ class Mailbox {
     capacity_ = capacity > 0 ? capacity : 1;
   }
 
+  // No more items: Put refuses them, Take hands out those held, then nullopt at once.
   void Close() {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       closed_ = true;
-      items_.clear();
     }
     changed_.notify_all();
+  }
+
+  bool closed_and_empty() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return closed_ && items_.empty();
   }
 
  private:

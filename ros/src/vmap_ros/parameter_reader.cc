@@ -39,6 +39,7 @@ InputError WrongKind(const std::string& parameter, XmlRpc::XmlRpcValue& value, c
 std::string ParameterName(const char* flag) {
   std::string name = flag;
   if (!name.empty() && name[0] == '!') name.erase(0, 1);
+  if (name.empty() || name[0] != '-') return "";  // a positional argument (the input), not an option
   // "-t,--tau": the long name.
   const size_t comma = name.rfind(',');
   if (comma != std::string::npos) name.erase(0, comma + 1);

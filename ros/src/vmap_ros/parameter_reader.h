@@ -16,8 +16,8 @@
 
 namespace vmap::ros_node {
 
-// The parameter of a flag: "--min-link-share" -> "min_link_share", "!--no-step-back" -> "no_step_back"; "" for
-// a field without a flag.
+// The parameter of a flag: "--min-link-share" -> "min_link_share", "!--no-step-back" -> "no_step_back",
+// "-t,--tau" -> "tau"; "" for a field without a flag or a positional argument.
 std::string ParameterName(const char* flag);
 
 class ParameterReader final : public OptionFieldVisitor {
