@@ -159,10 +159,11 @@ class MatcherOptions {
 };
 
 // The threshold tau `vmap build` uses with this matcher when --tau is not given. S = verified / tentative
-// means something else for each matcher: ALIKED's mutual matches with a similarity floor stay ~80 % inliers
-// while their number collapses, XFeat's keypoints fit F at 0.5 px less often than ORB's. Each value is the
-// lowest tau of the sweeps in docs/measurements/deep-matchers.md whose maps keep >= 95 % usable links where ground
-// truth exists, and a key image every few frames elsewhere. Throws InputError for an unknown type.
+// means something else for each matcher: ALIKED's mutual matches with a similarity floor stay mostly inliers
+// while their number collapses (docs/measurements/code-choices.md, "Default tau per matcher"), XFeat's keypoints
+// fit F at 0.5 px less often than ORB's. Each value is the lowest tau of the sweeps in
+// docs/measurements/deep-matchers.md whose maps keep >= 95 % usable links where ground truth exists, and a key
+// image every few frames elsewhere. Throws InputError for an unknown type.
 double DefaultTau(const std::string& matcher_type);
 
 // Throws InputError when the matcher cannot be created (unknown type, a deep matcher without LibTorch, weights
