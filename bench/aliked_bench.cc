@@ -22,6 +22,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <torch/torch.h>
 
+#include "vmap/core/numeric.h"
 #include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/batch_build.h"
@@ -37,10 +38,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
+using vmap::Median;
 
 template <typename F>
 double TimeSeconds(F&& f) {

@@ -17,6 +17,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/numeric.h"
 #include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/batch_build.h"
@@ -28,11 +29,7 @@ using Clock = std::chrono::steady_clock;
 
 struct Rates {
   std::vector<double> values;
-  double Median() const {
-    std::vector<double> sorted = values;
-    std::sort(sorted.begin(), sorted.end());
-    return sorted[sorted.size() / 2];
-  }
+  double Median() const { return vmap::Median(values); }
   double Min() const { return *std::min_element(values.begin(), values.end()); }
   double Max() const { return *std::max_element(values.begin(), values.end()); }
 };

@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include "vmap/core/numeric.h"
 #include "vmap/core/runtime.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/localization/localization_map.h"
@@ -40,11 +41,7 @@ namespace {
 
 struct Samples {
   std::vector<double> values;
-  double Median() const {
-    std::vector<double> sorted = values;
-    std::sort(sorted.begin(), sorted.end());
-    return sorted.empty() ? 0.0 : sorted[sorted.size() / 2];
-  }
+  double Median() const { return vmap::Median(values); }
   double Min() const { return values.empty() ? 0.0 : *std::min_element(values.begin(), values.end()); }
   double Max() const { return values.empty() ? 0.0 : *std::max_element(values.begin(), values.end()); }
 };

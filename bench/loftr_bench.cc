@@ -17,15 +17,13 @@
 #include <opencv2/imgproc.hpp>
 #include <torch/torch.h>
 
+#include "vmap/core/numeric.h"
 #include "vmap/core/runtime.h"
 #include "vmap/neural/loftr/loftr_matcher.h"
 
 namespace {
 
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
+using vmap::Median;
 
 template <typename F>
 double TimeSeconds(F&& f) {

@@ -18,6 +18,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "vmap/core/numeric.h"
 #include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/batch_build.h"
@@ -41,10 +42,7 @@ std::vector<vmap::testing::TestMessage> Messages(const std::string& video, int f
   return messages;
 }
 
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
+using vmap::Median;
 
 }  // namespace
 

@@ -25,6 +25,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/numeric.h"
 #include "vmap/core/runtime.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/map/map_io.h"
@@ -42,10 +43,7 @@ struct Timing {
   std::vector<double> wall, cpu;
 };
 
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
+using vmap::Median;
 
 template <typename Fn>
 void Measure(Timing* timing, Fn&& run) {
