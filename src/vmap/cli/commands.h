@@ -15,5 +15,6 @@ void AddDrawCommand(CLI::App& app);
 void AddEvalCommand(CLI::App& app);
 void AddLocalizeCommand(CLI::App& app);
 void AddRouteCommand(CLI::App& app);
+void AddSimulateCommand(CLI::App& app);
 
 }  // namespace vmap::cli

@@ -10,10 +10,12 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
 #include "vmap/cli/commands.h"
 #include "vmap/cli/common_options.h"
+#include "vmap/cli/localize_odometry.h"
 #include "vmap/cli/localize_options.h"
 #include "vmap/cli/output_files.h"
 #include "vmap/core/atomic_output.h"
@@ -37,6 +39,7 @@ struct LocalizeFlags : LocalizerFlags {
   std::string json;
   std::string report;
   SourceFlags source;
+  OdometryFlags odometry;
   OptionFlags option_flags;
 };
 
@@ -79,6 +82,10 @@ void RunLocalize(const LocalizeFlags& flags) {
   run.info.options_json = DescribeLocalizerOptions(options);
   run.info.experiences = !opened.experiences.empty();
   std::string csv = LocalizationCsvHeader(run.info.experiences);
+  // With odometry, its columns come last on every row (csv and json).
+  std::optional<OdometryProgress> odometry = OpenQueryOdometry(flags.odometry, flags.query);
+  nlohmann::json odometry_json = nlohmann::json::array();
+  if (odometry) csv.insert(csv.size() - 1, OdometryCsvColumns());
   // A query that cannot be read again (a live input, a single image) leaves its report the frames kept here:
   // the last ones, as many as the report shows.
   const LocalizationReportOptions report_options;
@@ -86,7 +93,13 @@ void RunLocalize(const LocalizeFlags& flags) {
   RecordedFrames recorded;
   run.summary = LocalizeSequence(*source, *opened.matcher, localizer, run_options,
                                  [&](const Frame& frame, const LocalizationResult& result) {
-                                   if (!flags.csv.empty()) csv += LocalizationCsvRow(map, result, run.info.experiences);
+                                   std::string row = LocalizationCsvRow(map, result, run.info.experiences);
+                                   if (odometry) {
+                                     const FrameOdometry at = odometry->Update(result);
+                                     row.insert(row.size() - 1, OdometryCsvCells(at));
+                                     odometry_json.push_back(OdometryJson(result.frame_index, at));
+                                   }
+                                   if (!flags.csv.empty()) csv += row;
                                    run.frames.push_back(result);
                                    if (record && report_options.pairs > 0) {
                                      recorded[result.frame_index] = ColorImage(frame);
@@ -98,7 +111,15 @@ void RunLocalize(const LocalizeFlags& flags) {
   run.info.frame_size = source->info().frame_size;
 
   if (!flags.csv.empty()) WriteFileAtomically(flags.csv, csv);
-  if (!flags.json.empty()) WriteFileAtomically(flags.json, LocalizationRunJson(map, run));
+  if (!flags.json.empty()) {
+    std::string json = LocalizationRunJson(map, run);
+    if (odometry) {
+      nlohmann::json document = nlohmann::json::parse(json);
+      document["odometry"] = std::move(odometry_json);
+      json = document.dump(1) + "\n";
+    }
+    WriteFileAtomically(flags.json, json);
+  }
   if (!flags.report.empty()) WriteLocalizationReport(run, map, flags.map, flags.report, report_options, recorded);
 
   const LocalizationSummary& s = run.summary;
@@ -146,6 +167,7 @@ void AddLocalizeCommand(CLI::App& app) {
   OptionFlags& option_flags = flags->option_flags;
   AddSourceOptions(command, flags->source, option_flags);
   AddLocalizerOptions(command, *flags, option_flags);
+  AddOdometryOptions(command, flags->odometry, option_flags);
   command->callback([flags] { flags->option_flags.Run([&] { RunLocalize(*flags); }); });
 }
 

@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   vmap::cli::AddEvalCommand(app);
   vmap::cli::AddLocalizeCommand(app);
   vmap::cli::AddRouteCommand(app);
+  vmap::cli::AddSimulateCommand(app);
 
   // Every failure ends as "vmap: error: ..." with status 2; 0 is success, --help and --version included.
   try {

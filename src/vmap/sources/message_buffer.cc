@@ -80,4 +80,13 @@ void MessageBuffer::F64Fixed(double* values, size_t count) {
   for (size_t i = 0; i < count; ++i) values[i] = F64();
 }
 
+double ReadHeaderStamp(MessageBuffer& buffer, MessageEncoding encoding) {
+  if (encoding == MessageEncoding::kRos1) buffer.U32();  // seq: ROS 1 only
+  const uint32_t seconds = buffer.U32();                 // ROS 1 uint32, ROS 2 int32: both non-negative in practice
+  const uint32_t nanoseconds = buffer.U32();
+  buffer.String();  // frame_id
+  const double sec = encoding == MessageEncoding::kCdr ? static_cast<double>(static_cast<int32_t>(seconds)) : seconds;
+  return sec + nanoseconds * 1e-9;
+}
+
 }  // namespace vmap

@@ -44,4 +44,7 @@ class MessageBuffer {
   std::string what_;
 };
 
+// A std_msgs/Header (ROS 1: seq, stamp, frame_id; ROS 2: stamp, frame_id), read whole: its stamp in seconds.
+double ReadHeaderStamp(MessageBuffer& buffer, MessageEncoding encoding);
+
 }  // namespace vmap

@@ -153,6 +153,15 @@ std::vector<uint8_t> SerializeCameraInfo(MessageEncoding encoding, double stamp,
   return writer.Take();
 }
 
+std::vector<uint8_t> SerializeOdometry(MessageEncoding encoding, double stamp, double x, double y, double yaw) {
+  MessageWriter writer(encoding);
+  writer.Header(stamp, "odom");
+  writer.String("base_link");
+  for (double v : {x, y, 0.0, 0.0, 0.0, std::sin(0.5 * yaw), std::cos(0.5 * yaw)}) writer.F64(v);
+  for (int i = 0; i < 36 + 6 + 36; ++i) writer.F64(0.0);  // pose covariance, twist, twist covariance
+  return writer.Take();
+}
+
 void WriteMcap(const std::string& path, const std::vector<TestMessage>& messages, const std::string& compression,
                int per_chunk, bool summary) {
   std::string file("\x89MCAP0\r\n", 8);

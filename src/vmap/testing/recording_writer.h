@@ -30,6 +30,9 @@ std::vector<uint8_t> SerializeCameraInfo(MessageEncoding encoding, double stamp,
                                          cv::Size size, const std::string& model, const std::vector<double>& d,
                                          const cv::Matx33d& k);
 
+// nav_msgs/Odometry at (x, y) turned `yaw` about z (covariances and twist zero).
+std::vector<uint8_t> SerializeOdometry(MessageEncoding encoding, double stamp, double x, double y, double yaw);
+
 // compression: "" (unchunked), "none" (chunks, uncompressed), "zstd" or "lz4"; `per_chunk` messages a chunk.
 // `summary`: the summary section (schemas, channels, chunk indexes, statistics) as recorders write it; a
 // recording cut short has none.

@@ -1,0 +1,67 @@
+#include "vmap/cli/localize_odometry.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "vmap/core/error.h"
+#include "vmap/sources/recording_reader.h"
+
+namespace vmap::cli {
+
+void AddOdometryOptions(CLI::App* command, OdometryFlags& flags, OptionFlags& option_flags) {
+  option_flags.AddOption(command, "--odometry", flags.path, "odometry",
+                         "Odometry of the query: a CSV of timestamp,x,y,yaw (s, m, rad) or a recording with a "
+                         "nav_msgs/Odometry topic (default: the query recording's own, if any)");
+  option_flags.AddOption(command, "--odometry-topic", flags.topic, "odometry_topic",
+                         "The nav_msgs/Odometry topic to read (default: the recording's only one)");
+}
+
+std::optional<OdometryProgress> OpenQueryOdometry(const OdometryFlags& flags, const std::string& query) {
+  if (!flags.path.empty()) return OdometryProgress(OdometryTrack(ReadOdometry(flags.path, flags.topic)));
+  if (!IsRecording(query)) {
+    if (!flags.topic.empty()) {
+      throw InputError("--odometry-topic names a topic of the query recording, and '" + query +
+                       "' is not a recording; give the odometry with --odometry FILE");
+    }
+    return std::nullopt;
+  }
+  const std::vector<std::string> topics = OdometryTopics(OpenRecording(query)->Topics());
+  if (topics.empty() && flags.topic.empty()) return std::nullopt;
+  if (topics.size() > 1 && flags.topic.empty()) {
+    spdlog::warn(
+        "'{}' has {} nav_msgs/Odometry topics; localizing without odometry (name one with "
+        "--odometry-topic)",
+        query, topics.size());
+    return std::nullopt;
+  }
+  std::vector<OdometrySample> samples = ReadOdometryTopic(query, flags.topic);
+  spdlog::info("odometry        {} samples from {}", samples.size(),
+               flags.topic.empty() ? topics.front() : flags.topic);
+  return OdometryProgress(OdometryTrack(std::move(samples)));
+}
+
+std::string OdometryCsvColumns() { return ",odometry_x,odometry_y,odometry_yaw,odometry_distance,key_distance"; }
+
+std::string OdometryCsvCells(const FrameOdometry& odometry) {
+  if (!odometry.valid) return ",,,,,";
+  return fmt::format(",{:.6f},{:.6f},{:.6f},{:.6f},{}", odometry.pose.x, odometry.pose.y, odometry.pose.yaw,
+                     odometry.distance,
+                     std::isfinite(odometry.key_distance) ? fmt::format("{:.6f}", odometry.key_distance) : "");
+}
+
+nlohmann::json OdometryJson(int frame, const FrameOdometry& odometry) {
+  auto number = [](double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr); };
+  if (!odometry.valid)
+    return {{"frame", frame}, {"x", nullptr},        {"y", nullptr},
+            {"yaw", nullptr}, {"distance", nullptr}, {"key_distance", nullptr}};
+  return {{"frame", frame},
+          {"x", odometry.pose.x},
+          {"y", odometry.pose.y},
+          {"yaw", odometry.pose.yaw},
+          {"distance", number(odometry.distance)},
+          {"key_distance", number(odometry.key_distance)}};
+}
+
+}  // namespace vmap::cli

@@ -1,0 +1,57 @@
+#include "vmap/control/guidance_signals.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vmap {
+
+const KeyComparison& TargetComparison(const LocalizationResult& result) {
+  return result.next_key >= 0 ? result.to_next : result.to_key;
+}
+
+double HeadingOffset(const LocalizationResult& result, double focal_px) {
+  // heading > 0: the scene appears right of where the key image has it, i.e. the robot points left of it.
+  if (std::isfinite(result.heading_deg)) return result.heading_deg * M_PI / 180.0;
+  if (std::isfinite(result.heading_px) && focal_px > 0.0) return std::atan(result.heading_px / focal_px);
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+TargetBearing BearingToKey(const RelativePose& pose) {
+  TargetBearing bearing;
+  if (!pose.valid) return bearing;
+  // The key image's camera centre in the frame's camera coordinates (x right, y down, z forward): -R^T t.
+  const cv::Vec3d centre = -(pose.R.t() * pose.t);
+  if (!(centre[2] > 0.0)) return bearing;  // not ahead: a bearing to it would turn the robot around
+  bearing.valid = true;
+  bearing.bearing = -std::atan2(centre[0], centre[2]);
+  // The key image's optical axis in the frame's coordinates, R^T (0, 0, 1).
+  bearing.key_heading = -std::atan2(pose.R(2, 0), pose.R(2, 2));
+  return bearing;
+}
+
+double ApparentLogScale(const std::vector<Correspondence>& verified, int min_pairs, double min_distance_px) {
+  const int n = static_cast<int>(verified.size());
+  std::vector<double> ratios;
+  // Each match paired with a few others at fixed offsets: deterministic, and linear in the matches.
+  constexpr int kOffsets[] = {1, 2, 3, 5, 8, 13, 21, 34};
+  const double min_squared = min_distance_px * min_distance_px;
+  for (int offset : kOffsets) {
+    if (offset >= n) break;
+    for (int i = 0; i < n; ++i) {
+      const int j = (i + offset) % n;
+      const cv::Point2f key_delta = verified[i].p1 - verified[j].p1;
+      const double key_squared = key_delta.dot(key_delta);
+      if (key_squared < min_squared) continue;
+      const cv::Point2f frame_delta = verified[i].p0 - verified[j].p0;
+      const double frame_squared = frame_delta.dot(frame_delta);
+      if (!(frame_squared > 0.0)) continue;
+      ratios.push_back(0.5 * std::log(frame_squared / key_squared));
+    }
+  }
+  if (static_cast<int>(ratios.size()) < min_pairs) return std::numeric_limits<double>::quiet_NaN();
+  auto middle = ratios.begin() + ratios.size() / 2;
+  std::nth_element(ratios.begin(), middle, ratios.end());
+  return *middle;
+}
+
+}  // namespace vmap

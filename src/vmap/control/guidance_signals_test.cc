@@ -1,0 +1,68 @@
+#include "vmap/control/guidance_signals.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
+
+namespace vmap {
+namespace {
+
+// The pose of a key image seen from a frame (X_key = R X_frame + t) for a key camera at `centre` (frame
+// coordinates: x right, z forward) turned left by `yaw`.
+RelativePose PoseOfKeyAt(cv::Vec3d centre, double yaw) {
+  cv::Matx33d R_fk;  // the key camera's axes in the frame's coordinates
+  cv::Rodrigues(cv::Vec3d(0, -yaw, 0), R_fk);
+  RelativePose pose;
+  pose.valid = true;
+  pose.R = R_fk.t();
+  const cv::Vec3d t = -(pose.R * centre);
+  pose.t = t / cv::norm(t);
+  return pose;
+}
+
+TEST(GuidanceSignals, BearingToAKeyImageAheadOnTheLeft) {
+  // The key image 2 m ahead and 0.5 m to the left, looking straight ahead: it is on the left (alpha > 0), and
+  // the robot is right of the key image's line (beta < 0).
+  const TargetBearing b = BearingToKey(PoseOfKeyAt({-0.5, 0, 2.0}, 0.0));
+  ASSERT_TRUE(b.valid);
+  EXPECT_NEAR(b.bearing, std::atan2(0.5, 2.0), 1e-9);
+  EXPECT_NEAR(b.key_heading, 0.0, 1e-9);
+  EXPECT_LT(b.line_angle(), 0.0);
+  // Looking 0.2 rad left of the robot, straight ahead of it: only the heading differs.
+  const TargetBearing turned = BearingToKey(PoseOfKeyAt({0, 0, 2.0}, 0.2));
+  ASSERT_TRUE(turned.valid);
+  EXPECT_NEAR(turned.bearing, 0.0, 1e-9);
+  EXPECT_NEAR(turned.key_heading, 0.2, 1e-9);
+  // Behind the camera: no bearing to steer by.
+  EXPECT_FALSE(BearingToKey(PoseOfKeyAt({0.3, 0, -1.0}, 0.0)).valid);
+  EXPECT_FALSE(BearingToKey(RelativePose{}).valid);
+}
+
+TEST(GuidanceSignals, HeadingOffsetIsPositiveWhenTheRobotPointsLeft) {
+  LocalizationResult result;
+  result.heading_px = 40.0;  // the scene appears right of where the key image has it
+  EXPECT_NEAR(HeadingOffset(result, 400.0), std::atan(0.1), 1e-12);
+  EXPECT_TRUE(std::isnan(HeadingOffset(result, std::nan(""))));
+  result.heading_deg = -3.0;  // degrees win where the camera gives them
+  EXPECT_NEAR(HeadingOffset(result, 400.0), -3.0 * M_PI / 180.0, 1e-12);
+}
+
+TEST(GuidanceSignals, ApparentScaleOfAZoom) {
+  // Points of the key image seen 10 % larger (about the image centre) in the frame: log(1.1).
+  std::vector<Correspondence> matches;
+  cv::RNG rng(3);
+  for (int i = 0; i < 80; ++i) {
+    const cv::Point2f key(rng.uniform(0.f, 640.f), rng.uniform(0.f, 480.f));
+    const cv::Point2f frame = cv::Point2f(320, 240) + 1.1f * (key - cv::Point2f(320, 240)) + cv::Point2f(15, -4);
+    matches.push_back({frame, key});
+  }
+  EXPECT_NEAR(ApparentLogScale(matches), std::log(1.1), 1e-5);
+  for (Correspondence& m : matches) std::swap(m.p0, m.p1);
+  EXPECT_NEAR(ApparentLogScale(matches), -std::log(1.1), 1e-5);
+  matches.resize(3);
+  EXPECT_TRUE(std::isnan(ApparentLogScale(matches)));  // too few pairs
+}
+
+}  // namespace
+}  // namespace vmap

@@ -1,0 +1,228 @@
+#include "vmap/control/route_controller.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "vmap/control/guidance_signals.h"
+#include "vmap/core/error.h"
+
+namespace vmap {
+
+std::string ControllerStateName(ControllerState state) { return EnumToName(kControllerStateNames, state); }
+
+RouteController::RouteController(TaughtRoute route, ControllerOptions options)
+    : route_(std::move(route)), options_(options) {
+  options_.Check();
+  if (route_.keys.size() < 2 || route_.segments.size() + 1 != route_.keys.size()) {
+    throw InputError("a route to follow needs at least two key images (MakeTaughtRoute gives one)");
+  }
+  focal_px_ = options_.focal_px > 0.0 ? options_.focal_px : route_.focal_px;
+  if (!(focal_px_ > 0.0)) {
+    throw OptionError("focal_px",
+                      "must be given (the focal length in pixels) for a map without a camera: headings in pixels "
+                      "need it to become angles");
+  }
+}
+
+void RouteController::Reset() {
+  last_time_.reset();
+  last_usable_time_.reset();
+  last_odometry_.reset();
+  last_command_ = {};
+  localized_ = false;
+  reached_goal_ = false;
+  position_ = -1;
+  fraction_ = 0.0;
+  lost_speed_ = 0.0;
+  unusable_since_.reset();
+  line_angle_.reset();
+  swept_ = 0.0;
+  search_direction_ = 1.0;
+}
+
+double RouteController::NominalSpeed(int position) const {
+  const int last = static_cast<int>(route_.segments.size()) - 1;
+  const TaughtSegment& segment = route_.segments[std::clamp(position, 0, last)];
+  double speed = segment.speed();
+  speed = std::isfinite(speed) && speed > 0.0 ? speed * options_.speed_scale : options_.speed;
+  // The last stretch is driven slower: the goal is seen late, and stopping takes time.
+  if (position >= last) speed *= options_.goal_speed_share;
+  speed = std::min(speed, options_.max_speed);
+  return segment.backwards ? -speed : speed;
+}
+
+double RouteController::TaughtTurnRate(int position, double speed) const {
+  const int last = static_cast<int>(route_.segments.size()) - 1;
+  const TaughtSegment& segment = route_.segments[std::clamp(position, 0, last)];
+  if (!std::isfinite(segment.yaw_change)) return 0.0;
+  // Curvature times speed where the length is known; otherwise the taught rate, at the pace of `speed`
+  // against options.speed (the teach run is taken to have been driven at it).
+  if (std::isfinite(segment.length) && segment.length > 1e-3)
+    return segment.yaw_change / segment.length * std::abs(speed);
+  if (std::isfinite(segment.duration) && segment.duration > 1e-3) {
+    return segment.yaw_change / segment.duration * std::abs(speed) / options_.speed;
+  }
+  return 0.0;
+}
+
+double RouteController::RemainingTurn(int position, double progress) const {
+  const int last = static_cast<int>(route_.segments.size()) - 1;
+  if (position > last) return 0.0;  // at the goal: the target is where the robot is headed
+  const double turn = route_.segments[position].yaw_change;
+  if (!std::isfinite(turn)) return 0.0;
+  return turn * (1.0 - (std::isfinite(progress) ? std::clamp(progress, 0.0, 1.0) : 0.0));
+}
+
+VelocityCommand RouteController::Limit(VelocityCommand wanted, double dt) const {
+  wanted.linear = std::clamp(wanted.linear, -options_.max_speed, options_.max_speed);
+  wanted.angular = std::clamp(wanted.angular, -options_.max_angular_speed, options_.max_angular_speed);
+  if (dt > 0.0) {
+    const double dv = options_.max_acceleration * dt, dw = options_.max_angular_acceleration * dt;
+    wanted.linear = std::clamp(wanted.linear, last_command_.linear - dv, last_command_.linear + dv);
+    wanted.angular = std::clamp(wanted.angular, last_command_.angular - dw, last_command_.angular + dw);
+  }
+  return wanted;
+}
+
+ControlStep RouteController::Update(double time, const LocalizationResult& localization,
+                                    const OdometrySample* odometry) {
+  const auto start = std::chrono::steady_clock::now();
+  ControlStep step;
+  const double dt = last_time_ ? std::max(0.0, time - *last_time_) : 0.0;
+  last_time_ = time;
+  // Metres driven since the last step, by odometry (0 without).
+  // Metres driven and radians turned since the last step: by odometry, or the last command (0 at the first step).
+  double driven = 0.0;
+  double turned = last_command_.angular * dt;
+  if (odometry != nullptr) {
+    if (last_odometry_) {
+      driven = std::hypot(odometry->x - last_odometry_->x, odometry->y - last_odometry_->y);
+      turned = WrapAngle(odometry->yaw - last_odometry_->yaw);
+    }
+    last_odometry_ = *odometry;
+  }
+  auto finish = [&](VelocityCommand wanted, ControllerState state) {
+    step.command = Limit(wanted, dt);
+    if (state == ControllerState::kReachedGoal) step.command = {};
+    step.state = state;
+    step.localized = localized_;
+    step.route_position = position_;
+    last_command_ = step.command;
+    step.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return step;
+  };
+  if (reached_goal_) return finish({}, ControllerState::kReachedGoal);
+
+  // Only frames verified at a key image of this route are steered by: a lost or uncertain frame's key images are
+  // a guess (LocalizationGuidance), and so is a heading without them.
+  const bool located =
+      localization.status == LocalizationStatus::kTracking || localization.status == LocalizationStatus::kRelocalized;
+  const int position = located ? route_.PositionOf(localization.key) : -1;
+  const double heading_offset = HeadingOffset(localization, focal_px_);
+  const bool usable = position >= 0 && std::isfinite(heading_offset);
+  const int last = static_cast<int>(route_.keys.size()) - 1;
+
+  // The search for the route: after standing search_after_seconds without a usable frame, sweep the heading.
+  auto search = [&](VelocityCommand wanted) {
+    if (usable) {
+      unusable_since_.reset();
+      return wanted;
+    }
+    if (!unusable_since_) unusable_since_ = time;
+    if (wanted.linear != 0.0 || options_.search_after_seconds <= 0.0 ||
+        time - *unusable_since_ < options_.search_after_seconds) {
+      swept_ = 0.0;
+      search_direction_ = 1.0;
+      return wanted;
+    }
+    swept_ += turned;
+    if (search_direction_ * swept_ >= options_.search_angle_deg * M_PI / 180.0) search_direction_ = -search_direction_;
+    step.steering = "search";
+    return VelocityCommand{0.0, search_direction_ * options_.search_turn_rate};
+  };
+  if (usable) {
+    localized_ = true;
+    position_ = position;
+    fraction_ = std::isfinite(localization.progress) ? localization.progress : 0.0;
+    last_usable_time_ = time;
+    step.target_key = localization.next_key >= 0 ? localization.next_key : localization.key;
+    if (position == last) {
+      step.goal_log_scale = ApparentLogScale(localization.to_key.verified);
+      if (localization.to_key.accepted && std::isfinite(step.goal_log_scale) &&
+          step.goal_log_scale >= std::log1p(-options_.goal_scale_tolerance)) {
+        reached_goal_ = true;
+        step.steering = "none";
+        return finish({}, ControllerState::kReachedGoal);
+      }
+    }
+  }
+  if (!localized_) return finish(search({}), ControllerState::kStarting);
+
+  if (!usable) {
+    // Slow to a stop along the taught turn rate; then wait for a frame to steer by. Odometry tells when the
+    // robot has driven into the next stretch, whose taught turn rate then applies.
+    const double length = route_.segments[std::min(position_, last - 1)].length;
+    if (driven > 0.0 && std::isfinite(length) && length > 0.0) {
+      fraction_ += driven / length;
+      while (fraction_ >= 1.0 && position_ < last) {
+        fraction_ -= 1.0;
+        ++position_;
+      }
+    }
+    const double elapsed = last_usable_time_ ? time - *last_usable_time_ : options_.lost_stop_seconds;
+    const double share =
+        options_.lost_stop_seconds > 0.0 ? std::max(0.0, 1.0 - elapsed / options_.lost_stop_seconds) : 0.0;
+    const double speed = lost_speed_ * share;
+    step.steering = speed != 0.0 ? "taught" : "none";
+    return finish(search({speed, speed != 0.0 ? TaughtTurnRate(position_, speed) : 0.0}), ControllerState::kLost);
+  }
+
+  const double speed = NominalSpeed(position_);
+  lost_speed_ = speed;
+  step.heading_offset = heading_offset;
+  // The target key image lies ahead by what remains of this stretch, and the path turns by what the teach run
+  // turned over it: on the taught path the heading offset is minus that turn and the line angle half of it (the
+  // chord of an arc). Steering to zero them unaltered would cut every corner.
+  const double remaining_turn = RemainingTurn(position_, localization.progress);
+  const double heading_error = heading_offset + remaining_turn;
+  double turn = TaughtTurnRate(position_, speed) - options_.heading_gain * heading_error;
+  step.steering = "bearnav";
+  const bool backwards = route_.segments[std::min(position_, last - 1)].backwards;
+  if (options_.law == ControlLaw::kServo && !backwards) {
+    // The line angle (beta) from the target's pose where its translation is known and its rotation agrees with the
+    // heading (a pose whose rotation is off has no better a translation), each frame's capped, then smoothed.
+    const TargetBearing target =
+        localization.translation_known ? BearingToKey(TargetComparison(localization).pose) : TargetBearing{};
+    if (target.valid &&
+        std::abs(WrapAngle(target.key_heading + heading_offset)) <= options_.pose_agreement_deg * M_PI / 180.0) {
+      step.bearing = target.bearing;
+      step.line_angle = target.line_angle();
+      constexpr double kMaxLineAngle = 0.5;  // radians: beyond, a measurement is more likely wrong than right
+      const double measured = std::clamp(target.line_angle(), -kMaxLineAngle, kMaxLineAngle);
+      const double weight = line_angle_ && options_.line_filter_seconds > 0.0
+                                ? 1.0 - std::exp(-(time - line_angle_time_) / options_.line_filter_seconds)
+                                : 1.0;
+      line_angle_ = line_angle_ ? *line_angle_ + weight * (measured - *line_angle_) : measured;
+      line_angle_time_ = time;
+    }
+    // A line angle older than a few filter time constants is forgotten: the heading law steers until a new one.
+    if (line_angle_ && time - line_angle_time_ > 3.0 * options_.line_filter_seconds + 0.5) line_angle_.reset();
+    if (line_angle_) {
+      // The polar-coordinate law of a unicycle parking on the key image's line, w = k_a alpha + k_b beta, with
+      // alpha = psi - beta and psi (the key image's heading) = -heading offset: the heading term from the
+      // features' heading, the line term from the filtered pose.
+      turn = TaughtTurnRate(position_, speed) - options_.bearing_gain * heading_error +
+             (options_.line_gain - options_.bearing_gain) * (*line_angle_ - 0.5 * remaining_turn);
+      step.steering = "servo";
+    }
+  }
+  search({});  // usable: the search, if any, is over
+  if (std::abs(heading_offset) > options_.turn_in_place_deg * M_PI / 180.0) {
+    step.steering = "turn in place";
+    return finish({0.0, -options_.heading_gain * heading_offset}, ControllerState::kTurning);
+  }
+  return finish({speed, turn}, ControllerState::kFollowing);
+}
+
+}  // namespace vmap

@@ -1,0 +1,243 @@
+#include "vmap/control/route_controller.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "vmap/core/error.h"
+
+namespace vmap {
+namespace {
+
+// A straight route of four key images, 2 s apart, with a 500 px camera.
+TaughtRoute StraightRoute() {
+  TaughtRoute route;
+  route.keys = {0, 1, 2, 3};
+  for (int k = 0; k < 3; ++k) {
+    TaughtSegment segment;
+    segment.from_key = k;
+    segment.to_key = k + 1;
+    segment.duration = 2.0;
+    segment.yaw_change = 0.0;
+    route.segments.push_back(segment);
+  }
+  route.focal_px = 500.0;
+  return route;
+}
+
+LocalizationResult Tracked(int key, double heading_deg) {
+  LocalizationResult result;
+  result.status = LocalizationStatus::kTracking;
+  result.key = key;
+  result.route_position = key;
+  result.next_key = key < 3 ? key + 1 : -1;
+  result.heading_deg = heading_deg;
+  result.heading_px = std::tan(heading_deg * M_PI / 180.0) * 500.0;
+  result.progress = 0.5;
+  result.to_key.accepted = true;
+  return result;
+}
+
+LocalizationResult Lost() {
+  LocalizationResult result;
+  result.status = LocalizationStatus::kLost;
+  result.key = 1;  // the last estimate, not to steer by
+  result.next_key = 2;
+  result.heading_deg = 5.0;
+  return result;
+}
+
+ControllerOptions NoRateLimits() {
+  ControllerOptions options;
+  options.max_acceleration = 100.0;
+  options.max_angular_acceleration = 100.0;
+  return options;
+}
+
+TEST(RouteController, StartsOnlyOnceLocalized) {
+  RouteController controller(StraightRoute(), NoRateLimits());
+  ControlStep step = controller.Update(0.0, Lost());
+  EXPECT_EQ(step.state, ControllerState::kStarting);
+  EXPECT_FALSE(step.localized);
+  EXPECT_EQ(step.command.linear, 0.0);
+  EXPECT_EQ(step.command.angular, 0.0);
+  step = controller.Update(0.1, Tracked(1, 0.0));
+  EXPECT_EQ(step.state, ControllerState::kFollowing);
+  EXPECT_TRUE(step.localized);
+  EXPECT_EQ(step.route_position, 1);  // started mid-route
+  EXPECT_EQ(step.target_key, 2);
+  EXPECT_DOUBLE_EQ(step.command.linear, 0.3);
+  EXPECT_DOUBLE_EQ(step.command.angular, 0.0);
+}
+
+TEST(RouteController, BearnavTurnsAgainstTheHeading) {
+  ControllerOptions options = NoRateLimits();
+  options.law = ControlLaw::kBearnav;
+  options.heading_gain = 2.0;
+  RouteController controller(StraightRoute(), options);
+  // The scene appears 5 degrees right: the robot points left and turns right (clockwise, w < 0).
+  const ControlStep step = controller.Update(0.0, Tracked(0, 5.0));
+  EXPECT_EQ(step.steering, "bearnav");
+  EXPECT_NEAR(step.heading_offset, 5.0 * M_PI / 180.0, 1e-12);
+  EXPECT_NEAR(step.command.angular, -2.0 * 5.0 * M_PI / 180.0, 1e-12);
+}
+
+TEST(RouteController, TaughtTurnRateIsFedForward) {
+  TaughtRoute route = StraightRoute();
+  route.segments[1].yaw_change = 0.4;  // 0.4 rad left in 2 s at the taught pace (options.speed)
+  ControllerOptions options = NoRateLimits();
+  options.law = ControlLaw::kBearnav;
+  // Half-way along the stretch (progress 0.5), on the taught path: the next key image looks 0.2 rad further left
+  // than the robot (heading offset -0.2 rad), as it should; only the taught rate turns the robot.
+  const double on_path_deg = -0.2 * 180.0 / M_PI;
+  RouteController controller(route, options);
+  ControlStep step = controller.Update(0.0, Tracked(1, on_path_deg));
+  EXPECT_NEAR(step.command.angular, 0.2, 1e-12);
+  // Pointing 0.1 rad further left than that: the heading term turns it back.
+  RouteController off(route, options);
+  EXPECT_NEAR(off.Update(0.0, Tracked(1, on_path_deg + 0.1 * 180.0 / M_PI)).command.angular, 0.2 - 0.1, 1e-12);
+  // With the length from odometry: curvature times speed.
+  route.segments[1].length = 1.0;
+  RouteController with_length(route, options);
+  step = with_length.Update(0.0, Tracked(1, on_path_deg));
+  EXPECT_DOUBLE_EQ(step.command.linear, 0.5);  // the taught speed, 1 m in 2 s
+  EXPECT_NEAR(step.command.angular, 0.4 / 1.0 * 0.5, 1e-12);
+}
+
+TEST(RouteController, ServoSteersToTheKeyImagesLineWhenTheTranslationIsKnown) {
+  RouteController controller(StraightRoute(), NoRateLimits());
+  LocalizationResult result = Tracked(0, 0.0);
+  // The next key image 1.5 m ahead and 0.4 m to the left, looking as the robot does.
+  result.translation_known = true;
+  result.to_next.pose.valid = true;
+  result.to_next.pose.R = cv::Matx33d::eye();
+  const cv::Vec3d centre(-0.4, 0.0, 1.5);
+  result.to_next.pose.t = -centre / cv::norm(centre);
+  const ControlStep step = controller.Update(0.0, result);
+  EXPECT_EQ(step.steering, "servo");
+  EXPECT_GT(step.bearing, 0.0);
+  EXPECT_LT(step.line_angle, 0.0);
+  EXPECT_GT(step.command.angular, 0.0);  // turns left, towards the line
+  // Unknown translation: the heading law.
+  result.translation_known = false;
+  RouteController again(StraightRoute(), NoRateLimits());
+  EXPECT_EQ(again.Update(0.0, result).steering, "bearnav");
+}
+
+TEST(RouteController, TurnsOnTheSpotWhenFacingFarOff) {
+  RouteController controller(StraightRoute(), NoRateLimits());
+  const ControlStep step = controller.Update(0.0, Tracked(0, -60.0));
+  EXPECT_EQ(step.state, ControllerState::kTurning);
+  EXPECT_EQ(step.command.linear, 0.0);
+  EXPECT_GT(step.command.angular, 0.0);  // points right of the key image: turns left
+}
+
+TEST(RouteController, LostSlowsToAStopAndResumes) {
+  ControllerOptions options = NoRateLimits();
+  options.lost_stop_seconds = 1.0;
+  RouteController controller(StraightRoute(), options);
+  controller.Update(0.0, Tracked(1, 0.0));
+  ControlStep step = controller.Update(0.5, Lost());
+  EXPECT_EQ(step.state, ControllerState::kLost);
+  EXPECT_NEAR(step.command.linear, 0.15, 1e-12);  // half-way to a stop
+  EXPECT_DOUBLE_EQ(step.command.angular, 0.0);    // the taught turn rate, not the lost frame's heading
+  step = controller.Update(1.5, Lost());
+  EXPECT_EQ(step.command.linear, 0.0);
+  step = controller.Update(1.6, Tracked(1, 0.0));
+  EXPECT_EQ(step.state, ControllerState::kFollowing);
+  EXPECT_DOUBLE_EQ(step.command.linear, 0.3);
+}
+
+TEST(RouteController, SearchesForTheRouteWhenStandingUnlocalized) {
+  RouteController controller(StraightRoute(), NoRateLimits());
+  ControlStep step;
+  double t = 0.0;
+  for (; t < 1.95; t += 0.1) EXPECT_EQ(controller.Update(t, Lost()).command.angular, 0.0) << t;  // waits 2 s
+  step = controller.Update(t, Lost());
+  EXPECT_EQ(step.state, ControllerState::kStarting);
+  EXPECT_EQ(step.steering, "search");
+  EXPECT_EQ(step.command.linear, 0.0);
+  EXPECT_DOUBLE_EQ(step.command.angular, 0.3);  // left first
+  // 30 degrees at 0.3 rad/s take 1.75 s; then it sweeps back to the right.
+  double last_angular = step.command.angular;
+  int flips = 0;
+  double flip_time = 0.0;
+  for (t += 0.1; t < 6.0; t += 0.1) {
+    step = controller.Update(t, Lost());
+    if (step.command.angular != last_angular && flips++ == 0) flip_time = t;
+    last_angular = step.command.angular;
+  }
+  EXPECT_GE(flips, 1);
+  EXPECT_NEAR(flip_time, 2.0 + 1.8, 0.15);
+  // Localized: the search ends.
+  step = controller.Update(t, Tracked(0, 0.0));
+  EXPECT_EQ(step.state, ControllerState::kFollowing);
+  EXPECT_NE(step.steering, "search");
+}
+
+TEST(RouteController, AccelerationIsLimited) {
+  ControllerOptions options;
+  options.max_acceleration = 0.5;
+  RouteController controller(StraightRoute(), options);
+  controller.Update(0.0, Lost());
+  ControlStep step = controller.Update(0.1, Tracked(1, 0.0));
+  EXPECT_NEAR(step.command.linear, 0.05, 1e-12);
+  step = controller.Update(0.2, Tracked(1, 0.0));
+  EXPECT_NEAR(step.command.linear, 0.10, 1e-12);
+}
+
+// The goal key image's points, seen `scale` times as large in the frame.
+std::vector<Correspondence> Zoomed(double scale) {
+  std::vector<Correspondence> matches;
+  for (int i = 0; i < 60; ++i) {
+    const cv::Point2f key(40.f + 9.f * i, 60.f + static_cast<float>((i * 37) % 360));
+    const cv::Point2f frame = cv::Point2f(320, 240) + static_cast<float>(scale) * (key - cv::Point2f(320, 240));
+    matches.push_back({frame, key});
+  }
+  return matches;
+}
+
+TEST(RouteController, StopsWhereTheGoalLooksAsLargeAsInItsKeyImage) {
+  RouteController controller(StraightRoute(), NoRateLimits());
+  LocalizationResult at_goal = Tracked(3, 0.0);
+  at_goal.to_key.verified = Zoomed(0.9);  // still 10 % smaller: drive on, at the goal speed
+  ControlStep step = controller.Update(0.0, at_goal);
+  EXPECT_EQ(step.state, ControllerState::kFollowing);
+  EXPECT_NEAR(step.goal_log_scale, std::log(0.9), 1e-4);
+  EXPECT_DOUBLE_EQ(step.command.linear, 0.3 * 0.5);
+  at_goal.to_key.verified = Zoomed(0.99);
+  step = controller.Update(0.1, at_goal);
+  EXPECT_EQ(step.state, ControllerState::kReachedGoal);
+  EXPECT_EQ(step.command.linear, 0.0);
+  // Stays stopped whatever comes next, until Reset.
+  EXPECT_EQ(controller.Update(0.2, Tracked(1, 0.0)).state, ControllerState::kReachedGoal);
+  controller.Reset();
+  EXPECT_EQ(controller.Update(0.3, Lost()).state, ControllerState::kStarting);
+}
+
+TEST(RouteController, KeyImagesOffTheRouteAreNotSteeredBy) {
+  TaughtRoute route = StraightRoute();
+  RouteController controller(route, NoRateLimits());
+  LocalizationResult elsewhere = Tracked(1, 0.0);
+  elsewhere.key = 7;
+  EXPECT_EQ(controller.Update(0.0, elsewhere).state, ControllerState::kStarting);
+}
+
+TEST(RouteController, BadOptionsAndRoutesAreRefused) {
+  ControllerOptions options;
+  options.speed = std::nan("");
+  EXPECT_THROW(RouteController(StraightRoute(), options), OptionError);
+  options = {};
+  options.line_gain = 0.5;
+  EXPECT_THROW(RouteController(StraightRoute(), options), OptionError);
+  TaughtRoute no_camera = StraightRoute();
+  no_camera.focal_px = std::nan("");
+  EXPECT_THROW(RouteController(no_camera, ControllerOptions{}), OptionError);
+  TaughtRoute one_key;
+  one_key.keys = {0};
+  one_key.focal_px = 500.0;
+  EXPECT_THROW(RouteController(one_key, ControllerOptions{}), InputError);
+}
+
+}  // namespace
+}  // namespace vmap

@@ -1,0 +1,61 @@
+#pragma once
+// The teach run of a simulation: the route driven along its centre line at the teach speed, each frame rendered
+// as the robot's camera sees it, and the map built from them by vmap's normal build (BuildMap), written to a
+// map directory like `vmap build` writes one.
+
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include "vmap/features/matcher.h"
+#include "vmap/map/visual_map.h"
+#include "vmap/simulation/corridor_world.h"
+#include "vmap/simulation/route_path.h"
+#include "vmap/simulation/simulation_options.h"
+#include "vmap/sources/frame_source.h"
+#include "vmap/sources/odometry.h"
+
+namespace vmap {
+
+// Frames rendered on demand, one per pose (nothing is held but the world): a FrameSource like any input, with
+// the rig's pinhole camera as its intrinsics and timestamps `seconds_per_frame` apart.
+class RenderedFrameSource : public FrameSource {
+ public:
+  RenderedFrameSource(const CorridorWorld& world, const CameraRigOptions& camera, std::vector<Pose2d> poses,
+                      double seconds_per_frame, std::string name);
+  std::optional<Frame> Next() override;
+  const SequenceInfo& info() const override { return info_; }
+  double render_seconds() const { return render_seconds_; }
+
+ private:
+  const CorridorWorld& world_;
+  CameraRigOptions camera_;
+  std::vector<Pose2d> poses_;
+  double seconds_per_frame_;
+  SequenceInfo info_;
+  int next_ = 0;
+  double render_seconds_ = 0.0;
+};
+
+// One rendered frame as a source delivers it (BGR and grey).
+Frame RenderFrame(const CorridorWorld& world, const CameraRigOptions& camera, const Pose2d& pose, int index,
+                  double timestamp);
+
+// The rig's camera as vmap describes cameras (pinhole, no distortion).
+Camera RigCamera(const CameraRigOptions& camera);
+
+struct TeachRun {
+  std::vector<Pose2d> poses;             // of each frame, on the route's centre line
+  std::vector<OdometrySample> odometry;  // the teach run's odometry (exact: the poses, timestamped)
+  VisualMap map;
+  double seconds = 0.0;         // wall time of rendering and building
+  double render_seconds = 0.0;  // of it, rendering
+};
+
+// Drives `route` at options.teach_speed and options.rate through `world`, builds the map with `matcher` at
+// threshold `tau` (DefaultTau of its model, as `vmap build` does), and writes it to `map_directory` (which must
+// exist and be empty).
+TeachRun RunTeach(const SimulatedRoute& route, const CorridorWorld& world, const SimulationOptions& options,
+                  const Matcher& matcher, double tau, const std::filesystem::path& map_directory);
+
+}  // namespace vmap
