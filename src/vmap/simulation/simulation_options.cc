@@ -32,10 +32,10 @@ void SimulationOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"use_odometry", "!--no-odometry", "Do not give the repeat run's odometry to the controller"},
                 use_odometry);
   visitor.Visit(OptionField{"threads", "--threads", "Trials run at once (0 = one per core)"}.NotRecorded(), threads);
-  visitor.VisitNested("corridor", corridor, Nesting{true});
+  visitor.VisitNested("corridor", corridor, Nesting{true, {}});
   visitor.VisitNested("camera", camera);
-  visitor.VisitNested("noise", noise, Nesting{true});
-  visitor.VisitNested("controller", controller, Nesting{true});
+  visitor.VisitNested("noise", noise, Nesting{true, {}});
+  visitor.VisitNested("controller", controller, Nesting{true, {}});
   visitor.VisitNested("localizer", localizer, Nesting{false, {"verifier", "translation", "similarity", "route"}});
 }
 
