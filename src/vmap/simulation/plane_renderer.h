@@ -53,6 +53,11 @@ struct RenderOptions {
   double near = 0.05;  // metres: what is nearer the camera plane is clipped away
   cv::Scalar background = cv::Scalar(40, 40, 40);
   bool mipmaps = true;  // read minified textures from their mip level (off: level 0 always)
+  // How the tests' synthetic scenes (testing/synthetic_scene.h) were first drawn, which their expectations were
+  // measured on: polygons with a corner nearer than `near` skipped rather than clipped, drawn in the order
+  // given rather than far to near, their edges blended with black (texture border constant) and masked by
+  // where the texture lands rather than by the polygon.
+  bool legacy_synthetic = false;
 };
 
 // The image (8-bit BGR) of `polygons` seen by `view`.

@@ -43,8 +43,14 @@ SyntheticSequence RenderSyntheticSequence(const SyntheticOptions& options) {
   SyntheticSequence sequence;
   const double f = 0.9 * options.size.width;
   sequence.K = cv::Matx33d(f, 0, (options.size.width - 1) / 2.0, 0, f, (options.size.height - 1) / 2.0, 0, 0, 1);
+  // Far to near, as the planes were first drawn (the tests' expectations were measured on those images).
+  std::stable_sort(planes.begin(), planes.end(), [](const TexturedPolygon& a, const TexturedPolygon& b) {
+    return a.corners[0][2] + a.corners[2][2] > b.corners[0][2] + b.corners[2][2];
+  });
   RenderOptions render;
   render.mipmaps = false;  // the textures are seen at about their size
+  render.near = 0.1;
+  render.legacy_synthetic = true;
   for (int k = 0; k < options.num_frames; ++k) {
     const cv::Vec3d center(options.step * k, 0.0, 0.25 * options.step * k);
     cv::Matx33d R;
