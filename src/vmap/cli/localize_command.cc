@@ -132,6 +132,7 @@ void RunLocalize(const LocalizeFlags& flags) {
             << fmt::format("tracking        {} ({})\n", s.tracking, Percent(s.tracking, s.frames))
             << fmt::format("relocalized     {} ({})\n", s.relocalized, Percent(s.relocalized, s.frames))
             << fmt::format("lost            {} ({})\n", s.lost, Percent(s.lost, s.frames))
+            << fmt::format("uncertain       {} ({})\n", s.uncertain, Percent(s.uncertain, s.frames))
             << fmt::format("time            {:.2f} s ({:.1f} frames/s)\n", s.seconds, s.frames_per_second);
   if (options.camera) {
     const auto heading_only = std::count_if(run.frames.begin(), run.frames.end(), [](const LocalizationResult& r) {

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <optional>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -38,9 +39,7 @@ std::string CsvText(const std::string& text) {
 }
 
 LocalizationStatus ParseStatus(const std::string& name, const std::filesystem::path& file) {
-  if (name == "tracking") return LocalizationStatus::kTracking;
-  if (name == "relocalized") return LocalizationStatus::kRelocalized;
-  if (name == "lost") return LocalizationStatus::kLost;
+  if (const std::optional<LocalizationStatus> status = FindEnum(kLocalizationStatusNames, name)) return *status;
   throw InputError("'" + file.string() + "' has a frame with the unknown status '" + name + "'");
 }
 
@@ -78,7 +77,7 @@ std::string LocalizationCsvHeader(bool experiences) {
              "heading_confidence,heading_key_px,heading_key_deg,heading_key_confidence,"
              "translation_sigma_deg,translation_known,guidance,"
              "log10_nfa,next_log10_nfa") +
-         (experiences ? ",experience,next_experience\n" : "\n");
+         (experiences ? ",experience,next_experience" : "") + ",confidence,key_rank\n";
 }
 
 std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r, bool experiences) {
@@ -107,6 +106,7 @@ std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r
     row += ',' + (r.to_key.key >= 0 ? std::to_string(r.to_key.experience) : std::string()) + ',' +
            (r.to_next.key >= 0 ? std::to_string(r.to_next.experience) : std::string());
   }
+  row += ',' + CsvNumber(r.confidence) + ',' + std::to_string(r.key_rank);
   return row + "\n";
 }
 
@@ -163,6 +163,8 @@ nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationRes
     frame["experience"] = r.to_key.key >= 0 ? json(r.to_key.experience) : json(nullptr);
     frame["next_experience"] = r.to_next.key >= 0 ? json(r.to_next.experience) : json(nullptr);
   }
+  frame["confidence"] = Number(r.confidence);
+  frame["key_rank"] = r.key_rank;
   return frame;
 }
 
@@ -196,9 +198,11 @@ std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run
                     {"tracking", s.tracking},
                     {"relocalized", s.relocalized},
                     {"lost", s.lost},
+                    {"uncertain", s.uncertain},
                     {"share_tracking", s.tracking / n},
                     {"share_relocalized", s.relocalized / n},
                     {"share_lost", s.lost / n},
+                    {"share_uncertain", s.uncertain / n},
                     {"skipped_frames", s.skipped_frames},
                     {"seconds", s.seconds},
                     {"frames_per_second", s.frames_per_second},
@@ -258,6 +262,7 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
     run.summary.tracking = s.value("tracking", 0L);
     run.summary.relocalized = s.value("relocalized", 0L);
     run.summary.lost = s.value("lost", 0L);
+    run.summary.uncertain = s.value("uncertain", 0L);
     run.summary.skipped_frames = s.value("skipped_frames", 0);
     run.summary.seconds = s.value("seconds", 0.0);
     run.summary.frames_per_second = s.value("frames_per_second", 0.0);
@@ -303,6 +308,8 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
       }
       r.comparisons = f.value("comparisons", 0);
       r.seconds = f.value("seconds", 0.0);
+      r.confidence = NumberOr(f, "confidence", std::nan(""));
+      r.key_rank = f.value("key_rank", -1);
       run.frames.push_back(std::move(r));
     }
   } catch (const json::exception&) {

@@ -14,7 +14,8 @@
 // how unlikely the verified matches with `key` and `next_key` are by chance (KeyComparison::log10_nfa).
 // Against a map with experiences (map/experiences.h), and only then, also experience and next_experience: the
 // image of `key` and `next_key` the frame fitted best (0 the teach key image, n the view of experience n;
-// KeyComparison::experience). Unknown numbers are empty in CSV and null in JSON.
+// KeyComparison::experience). Last, in both: confidence and key_rank (LocalizationResult). Unknown numbers are
+// empty in CSV and null in JSON. New columns are only ever appended at the end.
 
 #include <cstdint>
 #include <filesystem>

@@ -57,12 +57,21 @@ LocalizationRun SampleRun() {
   tracked.to_next.pose.t = cv::Vec3d(0.6, 0, 0.8);
   tracked.progress = 0.25;
   tracked.candidates = {{0, 120.0, true, 0.75, 150, -42.5}, {1, 80.0, true, 0.5, 50, -3.25}};
+  tracked.confidence = 0.875;
+  tracked.key_rank = 2;
   LocalizationResult lost;
   lost.frame_index = 1;
   lost.source_index = 4;
   lost.status = LocalizationStatus::kLost;
-  run.frames = {tracked, lost};
-  run.summary.frames = 2;
+  LocalizationResult uncertain = tracked;
+  uncertain.frame_index = 2;
+  uncertain.source_index = 5;
+  uncertain.status = LocalizationStatus::kUncertain;
+  uncertain.confidence = 0.125;
+  uncertain.key_rank = 1;
+  run.frames = {tracked, lost, uncertain};
+  run.summary.frames = 3;
+  run.summary.uncertain = 1;
   run.summary.relocalized = 1;
   run.summary.lost = 1;
   run.summary.seconds = 0.5;
@@ -76,10 +85,11 @@ TEST(LocalizationOutput, CsvHasTheNamedColumnsAndOneRowPerFrame) {
   std::string csv = LocalizationCsvHeader();
   for (const LocalizationResult& r : run.frames) csv += LocalizationCsvRow(map, r);
   std::istringstream lines(csv);
-  std::string header, row0, row1, extra;
+  std::string header, row0, row1, row2, extra;
   std::getline(lines, header);
   std::getline(lines, row0);
   std::getline(lines, row1);
+  std::getline(lines, row2);
   EXPECT_FALSE(std::getline(lines, extra));
   for (const char* column : {"frame",
                              "source_index",
@@ -123,6 +133,19 @@ TEST(LocalizationOutput, CsvHasTheNamedColumnsAndOneRowPerFrame) {
   EXPECT_EQ(row1.find("nan"), std::string::npos) << row1;
   EXPECT_EQ(row1.rfind("1,4,,frame,lost,-1,-1,-1,-1,,0,0,,0,0,,,", 0), std::string::npos) << row1;
   EXPECT_NE(row1.find(",lost,-1,-1,-1,-1,,0,0,,0,0,,,"), std::string::npos) << row1;
+  // The columns added later come last, in the order they were added: readers of older runs keep their indices.
+  const std::string old_columns = "log10_nfa,next_log10_nfa";
+  EXPECT_EQ(header.substr(header.size() - (old_columns + ",confidence,key_rank").size()),
+            old_columns + ",confidence,key_rank");
+  auto ends_with = [](const std::string& text, const std::string& end) {
+    return text.size() >= end.size() && text.compare(text.size() - end.size(), end.size(), end) == 0;
+  };
+  EXPECT_TRUE(ends_with(row0, ",-42.5,-3.25,0.875,2")) << row0;
+  EXPECT_TRUE(ends_with(row1, ",,-1")) << row1;
+  EXPECT_NE(row2.find(",uncertain,"), std::string::npos) << row2;
+  EXPECT_NE(row2.find(",none: position uncertain,"), std::string::npos) << row2;
+  const std::string with_experiences = LocalizationCsvHeader(true);
+  EXPECT_NE(with_experiences.find(",experience,next_experience,confidence,key_rank\n"), std::string::npos);
 }
 
 TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
@@ -133,7 +156,7 @@ TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
   WriteFileAtomically(file, LocalizationRunJson(map, run));
   const auto doc = nlohmann::json::parse(std::ifstream(file));
   EXPECT_EQ(doc["format"], "vmap-localization");
-  EXPECT_DOUBLE_EQ(doc["summary"]["share_lost"].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(doc["summary"]["share_lost"].get<double>(), 1.0 / 3.0);
   EXPECT_TRUE(doc["frames"][1]["heading_px"].is_null());
   EXPECT_TRUE(doc["frames"][1]["pose"].is_null());
   EXPECT_EQ(doc["frames"][0]["pose"]["t"], nlohmann::json::array({0.6, 0.0, 0.8}));
@@ -146,16 +169,24 @@ TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
   EXPECT_TRUE(doc["frames"][1]["heading_confidence"].is_null());
   EXPECT_DOUBLE_EQ(doc["frames"][0]["translation_sigma_deg"].get<double>(), 2.5);
   EXPECT_EQ(doc["frames"][0]["guidance"], "heading and translation");
-  EXPECT_EQ(doc["frames"][1]["guidance"], "none");
+  EXPECT_EQ(doc["frames"][1]["guidance"], "none: lost");
+  EXPECT_EQ(doc["frames"][2]["guidance"], "none: position uncertain");
+  EXPECT_EQ(doc["frames"][2]["status"], "uncertain");
+  EXPECT_DOUBLE_EQ(doc["frames"][0]["confidence"].get<double>(), 0.875);
+  EXPECT_EQ(doc["frames"][0]["key_rank"], 2);
+  EXPECT_TRUE(doc["frames"][1]["confidence"].is_null());
+  EXPECT_EQ(doc["frames"][1]["key_rank"], -1);
+  EXPECT_EQ(doc["summary"]["uncertain"], 1);
   EXPECT_EQ(doc["frames"][0]["key_frame"], 0);
   EXPECT_EQ(doc["frames"][0]["next_key_frame"], 40);
   const LocalizationRun back = ReadLocalizationRun(file);
   EXPECT_EQ(back.info.query, run.info.query);
   EXPECT_EQ(back.info.query_format, SourceFormat::kVideo);
   EXPECT_EQ(back.info.frame_size, cv::Size(640, 480));
-  EXPECT_EQ(back.summary.frames, 2);
+  EXPECT_EQ(back.summary.frames, 3);
   EXPECT_EQ(back.summary.lost, 1);
-  ASSERT_EQ(back.frames.size(), 2u);
+  EXPECT_EQ(back.summary.uncertain, 1);
+  ASSERT_EQ(back.frames.size(), 3u);
   const LocalizationResult& r = back.frames[0];
   EXPECT_EQ(r.status, LocalizationStatus::kRelocalized);
   EXPECT_EQ(r.source_index, 3);
@@ -174,6 +205,12 @@ TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
   EXPECT_TRUE(doc["frames"][1]["log10_nfa"].is_null()) << "a lost frame compared with nothing";
   EXPECT_EQ(back.frames[1].status, LocalizationStatus::kLost);
   EXPECT_TRUE(std::isnan(back.frames[1].heading_px));
+  EXPECT_DOUBLE_EQ(r.confidence, 0.875);
+  EXPECT_EQ(r.key_rank, 2);
+  EXPECT_TRUE(std::isnan(back.frames[1].confidence));
+  EXPECT_EQ(back.frames[1].key_rank, -1);
+  EXPECT_EQ(back.frames[2].status, LocalizationStatus::kUncertain);
+  EXPECT_DOUBLE_EQ(back.frames[2].confidence, 0.125);
 }
 
 TEST(LocalizationOutput, ReadingSomethingElseIsAClearError) {

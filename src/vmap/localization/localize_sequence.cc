@@ -92,6 +92,9 @@ LocalizationSummary LocalizeSequence(FrameSource& source, const Matcher& matcher
       case LocalizationStatus::kLost:
         ++summary.lost;
         break;
+      case LocalizationStatus::kUncertain:
+        ++summary.uncertain;
+        break;
     }
     summary.comparisons += result.comparisons;
     extract_seconds += item.extract_seconds;

@@ -33,6 +33,7 @@ struct LocalizationSummary {
   long tracking = 0;
   long relocalized = 0;
   long lost = 0;
+  long uncertain = 0;
   int skipped_frames = 0;  // frames the source could not decode
   double seconds = 0.0;    // wall time of the run (key images not included)
   double frames_per_second = 0.0;

@@ -42,17 +42,7 @@ bool FitsBetter(const KeyComparison& a, const KeyComparison& b) {
 
 }  // namespace
 
-std::string LocalizationStatusName(LocalizationStatus status) {
-  switch (status) {
-    case LocalizationStatus::kTracking:
-      return "tracking";
-    case LocalizationStatus::kRelocalized:
-      return "relocalized";
-    case LocalizationStatus::kLost:
-      return "lost";
-  }
-  return "lost";
-}
+std::string LocalizationStatusName(LocalizationStatus status) { return EnumToName(kLocalizationStatusNames, status); }
 
 void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"acceptance", "--acceptance",
@@ -161,10 +151,17 @@ VerifierOptions MapVerifierOptions(const VerifierOptions& recorded, int max_iter
 }
 
 std::string LocalizationGuidance(const LocalizationResult& result) {
+  if (result.status == LocalizationStatus::kLost) return "none: lost";
+  if (result.status == LocalizationStatus::kUncertain) return "none: position uncertain";
   if (!std::isfinite(result.heading_px)) return "none";
   const KeyComparison& target = result.next_key >= 0 ? result.to_next : result.to_key;
   if (!target.pose.valid) return "heading only: no pose";
   return result.translation_known ? "heading and translation" : "heading only: translation unknown";
+}
+
+bool MaySteerBy(const LocalizationResult& result) {
+  return (result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized) &&
+         std::isfinite(result.heading_px);
 }
 
 Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matcher& matcher, LocalizerOptions options)
@@ -319,6 +316,11 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   LocalizationResult result = has_estimate() ? Track(frame, features) : Relocalize(frame, features);
   result.comparisons =
       static_cast<int>(std::count_if(comparisons_.begin(), comparisons_.end(), [](const Memo& m) { return m.used; }));
+  if (result.key >= 0 && result.to_key.key == result.key) {
+    result.key_rank = 1 + static_cast<int>(std::count_if(comparisons_.begin(), comparisons_.end(), [&](const Memo& m) {
+                        return m.used && m.comparison.key != result.key && FitsBetter(m.comparison, result.to_key);
+                      }));
+  }
   result.frame_index = frame.index;
   result.source_index = frame.source_index;
   result.timestamp = frame.timestamp;

@@ -31,6 +31,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/enum_names.h"
 #include "vmap/features/matcher.h"
 #include "vmap/geometry/camera.h"
 #include "vmap/geometry/fundamental.h"
@@ -111,8 +112,16 @@ enum class LocalizationStatus {
   kTracking,     // verified against the key image(s) of the current estimate
   kRelocalized,  // found by ranking and verifying the whole route (first frame, or the estimate failed)
   kLost,         // verified against no key image; key/next_key keep the last estimate (-1 when there is none)
+  // The position is doubted: key/next_key are the belief's best guess along the route, but the evidence does not
+  // single it out. A robot must not steer by this frame (LocalizationGuidance, MaySteerBy).
+  kUncertain,
 };
-std::string LocalizationStatusName(LocalizationStatus status);  // "tracking", "relocalized", "lost"
+inline constexpr EnumName<LocalizationStatus> kLocalizationStatusNames[] = {
+    {LocalizationStatus::kTracking, "tracking"},
+    {LocalizationStatus::kRelocalized, "relocalized"},
+    {LocalizationStatus::kLost, "lost"},
+    {LocalizationStatus::kUncertain, "uncertain"}};
+std::string LocalizationStatusName(LocalizationStatus status);
 
 // The frame compared with one key image.
 struct KeyComparison {
@@ -192,6 +201,12 @@ struct LocalizationResult {
   std::vector<RelocalizationCandidate> candidates;  // relocalization only: those verified, best-ranked first
   int comparisons = 0;   // key images the frame was compared with (some maybe ahead, on workers)
   double seconds = 0.0;  // time spent localizing this frame (features excluded)
+  // How sure the localizer is that the frame is at `key` (on the segment key -> next_key): the belief's mass
+  // near the chosen key image, 0..1. NaN when not computed.
+  double confidence = std::numeric_limits<double>::quiet_NaN();
+  // The rank of `key` among the key images the frame was compared with, by the evidence of this frame alone
+  // (1: the best match; 2: one other key image matched better...). -1 when unknown (nothing compared).
+  int key_rank = -1;
 };
 
 class Localizer {
@@ -287,7 +302,12 @@ VerifierOptions MapVerifierOptions(const VerifierOptions& recorded, int max_iter
 
 // What a controller may use of a result: "heading and translation", "heading only: translation unknown"
 // (a pose whose translation direction is not to be trusted), "heading only: no pose" (no camera, or no pose
-// to the target) or "none" (no heading).
+// to the target), or nothing to steer by: "none: lost" (kLost), "none: position uncertain" (kUncertain: the
+// key images are a guess), "none" (no heading). Every value that starts with "none" means: do not steer by
+// this frame.
 std::string LocalizationGuidance(const LocalizationResult& result);
+// Whether a controller may steer by the result: tracking or relocalized, with a heading to the target
+// (LocalizationGuidance does not start with "none").
+bool MaySteerBy(const LocalizationResult& result);
 
 }  // namespace vmap

@@ -81,9 +81,12 @@ TEST(Localizer, EveryOddFrameIsLocalizedBetweenTheKeyImagesAroundIt) {
   EXPECT_EQ(summary.relocalized, 1);
   EXPECT_EQ(summary.lost, 0);
   EXPECT_EQ(summary.tracking, 29);
-  int previous_key = 0;
+  int previous_key = 0, best_of_those_compared = 0;
   for (const LocalizationResult& r : results) {
     EXPECT_TRUE(Brackets(m.map, r.source_index, r.key)) << "frame " << r.source_index << " at key " << r.key;
+    EXPECT_GE(r.key_rank, 1);
+    EXPECT_LE(r.key_rank, r.comparisons);
+    best_of_those_compared += r.key_rank == 1;
     EXPECT_GE(r.key, previous_key) << "the estimate only moves forwards along a forward drive";
     previous_key = r.key;
     EXPECT_EQ(r.next_key, r.key + 1 < static_cast<int>(m.map.key_images.size()) ? r.key + 1 : -1);
@@ -98,6 +101,7 @@ TEST(Localizer, EveryOddFrameIsLocalizedBetweenTheKeyImagesAroundIt) {
       EXPECT_LE(r.progress, 1.0);
     }
   }
+  EXPECT_GE(best_of_those_compared, 25) << "the key image a frame is at is mostly the best match it was compared with";
 }
 
 TEST(Localizer, ProgressGrowsAlongASegment) {
@@ -149,6 +153,8 @@ TEST(Localizer, AnUnrelatedImageIsLostAndTheEstimateIsDroppedAfterMaxLostFrames)
   LocalizationResult r = LocalizeImage(localizer, noise, 0, 0);
   EXPECT_EQ(r.status, LocalizationStatus::kLost);
   EXPECT_EQ(r.key, -1);
+  EXPECT_EQ(r.key_rank, -1) << "no key image: no rank";
+  EXPECT_FALSE(MaySteerBy(r));
   EXPECT_EQ(r.next_key, -1);
   EXPECT_FALSE(localizer.has_estimate());
 
@@ -508,6 +514,30 @@ TEST(Localizer, OptionsAreChecked) {
   EXPECT_THROW(Localizer(m.map, m.keys, *m.matcher, bad_route), InputError);
   bad_route.route = {0, 1, 0};
   EXPECT_THROW(Localizer(m.map, m.keys, *m.matcher, bad_route), InputError);
+}
+
+// A controller must not steer by a frame the localizer is lost at or doubts, whatever its heading says.
+TEST(LocalizationGuidance, SaysNotToSteerByALostOrUncertainFrame) {
+  LocalizationResult r;
+  r.key = 3;
+  r.next_key = 4;
+  r.heading_px = 12.0;
+  r.status = LocalizationStatus::kTracking;
+  EXPECT_EQ(LocalizationGuidance(r), "heading only: no pose");
+  EXPECT_TRUE(MaySteerBy(r));
+  r.status = LocalizationStatus::kRelocalized;
+  EXPECT_TRUE(MaySteerBy(r));
+  r.status = LocalizationStatus::kUncertain;
+  EXPECT_EQ(LocalizationGuidance(r), "none: position uncertain");
+  EXPECT_FALSE(MaySteerBy(r));
+  r.status = LocalizationStatus::kLost;
+  EXPECT_EQ(LocalizationGuidance(r), "none: lost");
+  EXPECT_FALSE(MaySteerBy(r));
+  r.status = LocalizationStatus::kTracking;
+  r.heading_px = std::nan("");
+  EXPECT_EQ(LocalizationGuidance(r), "none");
+  EXPECT_FALSE(MaySteerBy(r));
+  EXPECT_EQ(LocalizationStatusName(LocalizationStatus::kUncertain), "uncertain");
 }
 
 TEST(Localizer, KeysAroundFollowsTheInputIndices) {

@@ -111,11 +111,11 @@ std::string KeyPlot(const LocalizationRun& run, int num_keys) {
   plot.SetIntegerX(true);
   plot.SetIntegerY(true);
   plot.SetYRange(-1.0, std::max(1, num_keys - 1));
-  PlotSeries line, tracking, relocalized, lost;
+  PlotSeries line, tracking, relocalized, uncertain, lost;
   line.name = "";
   line.color = "#9ab7d3";
   line.css_class = "key-line";
-  tracking.kind = relocalized.kind = PlotSeries::Kind::kMarkers;
+  tracking.kind = relocalized.kind = uncertain.kind = PlotSeries::Kind::kMarkers;
   lost.kind = PlotSeries::Kind::kCrosses;
   tracking.name = "tracking";
   tracking.color = kBlue;
@@ -124,11 +124,16 @@ std::string KeyPlot(const LocalizationRun& run, int num_keys) {
   relocalized.name = "relocalized";
   relocalized.color = kOrange;
   relocalized.css_class = "relocalized";
+  uncertain.name = "uncertain (the best guess; not to steer by)";
+  uncertain.color = "#b0b0b0";
+  uncertain.css_class = "uncertain";
+  uncertain.marker_radius = 2.0;
   lost.name = "lost (at the last estimate; -1: none)";
   lost.color = kRed;
   lost.css_class = "lost";
   tracking.segments.emplace_back();
   relocalized.segments.emplace_back();
+  uncertain.segments.emplace_back();
   lost.segments.emplace_back();
   std::vector<cv::Point2d> segment;
   for (const LocalizationResult& r : run.frames) {
@@ -143,6 +148,9 @@ std::string KeyPlot(const LocalizationRun& run, int num_keys) {
       case LocalizationStatus::kLost:
         lost.segments[0].push_back(p);
         break;
+      case LocalizationStatus::kUncertain:
+        uncertain.segments[0].push_back(p);
+        break;
     }
     if (r.status == LocalizationStatus::kLost) {
       if (!segment.empty()) line.segments.push_back(std::move(segment));
@@ -155,6 +163,7 @@ std::string KeyPlot(const LocalizationRun& run, int num_keys) {
   plot.Add(std::move(line));
   plot.Add(std::move(tracking));
   plot.Add(std::move(relocalized));
+  plot.Add(std::move(uncertain));
   plot.Add(std::move(lost));
   return plot.Render();
 }
@@ -301,6 +310,7 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
        << report::Card(std::to_string(s.frames), "frames")
        << report::Card(FormatFixed(100.0 * s.tracking / n, 1) + " %", "tracking")
        << report::Card(FormatFixed(100.0 * s.relocalized / n, 1) + " %", "relocalized")
+       << report::Card(FormatFixed(100.0 * s.uncertain / n, 1) + " %", "uncertain")
        << report::Card(FormatFixed(100.0 * s.lost / n, 1) + " %", "lost")
        << report::Card(FormatFixed(s.frames_per_second, 1), "frames/s") << "</div>\n<table class=\"summary\">\n"
        << report::Row("Map", HtmlEscape(run.info.map_directory))
@@ -308,8 +318,8 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
                                    ", " + HtmlEscape(report::SizeText(run.info.frame_size)) + ")")
        << report::Row("Matcher", HtmlEscape(run.info.matcher))
        << report::Row("Relocalization ranking", HtmlEscape(run.info.ranking))
-       << report::Row("Frames", fmt::format("{}: {} tracking, {} relocalized, {} lost", s.frames, s.tracking,
-                                            s.relocalized, s.lost))
+       << report::Row("Frames", fmt::format("{}: {} tracking, {} relocalized, {} uncertain, {} lost", s.frames,
+                                            s.tracking, s.relocalized, s.uncertain, s.lost))
        << report::Row("Time", report::DurationText(s.seconds) + " (" + FormatFixed(s.frames_per_second, 1) +
                                   " frames/s; " + FormatFixed(1000.0 * s.mean_localize_seconds, 1) +
                                   " ms localizing and " + FormatFixed(1000.0 * s.mean_extract_seconds, 1) +
@@ -318,8 +328,8 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
                                         " s to load (cache: " + HtmlEscape(run.info.cache) + ")")
        << "</table>\n</section>\n";
   html << "<section id=\"keys\"><h2>Key image over time</h2>\n<p class=\"note\">The key image each frame was "
-          "localized at (the last one reached on the route): tracking in blue, relocalization in orange, lost "
-          "frames as red crosses.</p>\n"
+          "localized at (the last one reached on the route): tracking in blue, relocalization in orange, "
+          "uncertain frames (the best guess) in grey, lost frames as red crosses.</p>\n"
        << KeyPlot(run, static_cast<int>(map.key_images.size())) << "</section>\n";
   html << "<section id=\"similarity\"><h2>Similarity</h2>\n<p class=\"note\">S of each frame against its key image "
           "and against the next one; the estimate moves on when the next key image becomes the better match.</p>\n"
