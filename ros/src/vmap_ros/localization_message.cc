@@ -10,6 +10,8 @@ uint8_t StatusConstant(LocalizationStatus status) {
       return vmap_ros::Localization::TRACKING;
     case LocalizationStatus::kRelocalized:
       return vmap_ros::Localization::RELOCALIZED;
+    case LocalizationStatus::kUncertain:
+      return vmap_ros::Localization::UNCERTAIN;
     case LocalizationStatus::kLost:
       break;
   }
@@ -28,8 +30,8 @@ vmap_ros::Localization LocalizationMessage(const std_msgs::Header& header, const
   message.route_position = result.route_position;
   message.route_length = static_cast<int>(route.size());
   message.progress = result.progress;
-  message.confidence = std::numeric_limits<double>::quiet_NaN();
-  message.key_rank = -1;
+  message.confidence = result.confidence;
+  message.key_rank = result.key_rank;
   message.heading_px = result.heading_px;
   message.heading_deg = result.heading_deg;
   message.heading_key_px = result.heading_key_px;
