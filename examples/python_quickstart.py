@@ -22,8 +22,9 @@ with tempfile.TemporaryDirectory() as tmp:
     result = vmap.match(a.image, b.image, matcher="orb")
     print(f"match: {result.num_verified} of {result.num_tentative} verified, S = {result.similarity:.3f}")
 
-    # The robot's loop: one frame at a time (here the map's own key images stand in for camera frames).
-    localizer = vmap.Localizer(m, min_verified=20)
+    # The robot's loop: one frame at a time (here the map's own key images stand in for camera frames). Options are
+    # keywords named as their fields (or as the CLI's flags): here 3 ranked key images verified when relocalizing.
+    localizer = vmap.Localizer(m, relocalization_candidates=3)
     for key in m.key_images[:5]:
-        r = localizer.localize(key.image)
+        r = localizer.localize(key.image, timestamp=key.timestamp)
         print(f"frame {key.frame_index}: {r.status} at key {r.key} -> {r.next_key}, heading {r.heading_px} px")

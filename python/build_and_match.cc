@@ -1,4 +1,5 @@
-// vmap.build_map, vmap.Matcher and vmap.match: `vmap build` and `vmap match` with the same options, as calls.
+// vmap.build_map, vmap.Matcher and vmap.match: the build pipeline and one pair's matching, their options as
+// keywords (keyword_options.h).
 
 #include <filesystem>
 #include <memory>
@@ -7,18 +8,15 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
-#include <pybind11/stl/filesystem.h>
 #include <spdlog/spdlog.h>
 
-#include "vmap/cli/common_options.h"
-#include "vmap/cli/map_options.h"
-#include "vmap/core/atomic_output.h"
 #include "vmap/features/matcher_registry.h"
-#include "vmap/mapping/batch_build.h"
-#include "vmap/mapping/map_builder.h"
 #include "vmap/mapping/pair_match.h"
+#include "vmap/pipelines/build_pipeline.h"
+#include "vmap/pipelines/match_pipeline.h"
 #include "vmap/sources/image_frame.h"
 
+#include "argument_errors.h"
 #include "bindings.h"
 #include "keyword_options.h"
 #include "map_objects.h"
@@ -31,59 +29,37 @@ namespace vmap::python {
 
 namespace {
 
-std::shared_ptr<MapHandle> BuildMapFunction(const std::string& input, const std::filesystem::path& output,
+// The build pipeline's fields a call takes by keyword: not its positional arguments, nor the live runs' own.
+const std::vector<const char*> kBuildMapSkipped = {"input", "output", "snapshot_every", "until_interrupted"};
+
+std::shared_ptr<MapHandle> BuildMapFunction(const py::object& input, const py::object& output,
                                             const py::kwargs& kwargs) {
-  // The options of `vmap build` (cli/build_command.cc), bound by the same calls.
-  cli::SourceFlags source_flags;
-  MatcherOptions matcher_options;
-  cli::VerifierFlags verifier_flags;
-  cli::KeyImageFlags key_image_flags;
-  bool report = false;
+  BuildPipelineOptions options;
   KeywordOptions keywords("build_map");
-  cli::AddSourceOptions(keywords.command(), source_flags, keywords.option_flags());
-  cli::AddMatcherOptions(keywords.command(), matcher_options, keywords.option_flags());
-  cli::AddVerifierOptions(keywords.command(), verifier_flags, keywords.option_flags());
-  cli::AddKeyImageOptions(keywords.command(), key_image_flags, keywords.option_flags());
-  keywords.command()->add_flag("--report", report, "Also write report.html into the map directory");
+  keywords.Add(options, kBuildMapSkipped);
   keywords.Parse(kwargs);
+  options.input = TextArgument(input, "build_map(): input");
+  options.output = TextArgument(output, "build_map(): output_dir");
+  // Ctrl-C between frames: KeyboardInterrupt, and the output left as it was.
+  options.map.after_frame = RaisePendingSignals;
   keywords.Run([&] {
     py::gil_scoped_release release;
-    const FrameSourceOptions source_options = source_flags.Resolve();
-    MapBuilderOptions options = key_image_flags.Resolve(matcher_options.type);
-    options.verifier = verifier_flags.Resolve();
-    options.show_progress = spdlog::should_log(spdlog::level::info);
-    options.Check();
-    matcher_options.Check();
-    options.after_frame = RaisePendingSignals;
-    AtomicOutputDirectory directory(output, cli::MapOutputPolicy(input));
-    const std::unique_ptr<Matcher> matcher = CreateMatcher(matcher_options);
-    const std::unique_ptr<FrameSource> source = OpenFrameSource(input, source_options);
-    const std::string options_json = cli::DescribeOptions(*matcher, options, source_options);
-    BuildMap(*source, *matcher, options, directory.path(), options_json);
-    cli::WriteReportIfAsked(report, directory.path());
-    directory.Commit();
+    RunBuildPipeline(options);
   });
-  return ReadMapHandle(output);
+  return ReadMapHandle(options.output);
 }
 
 // A matcher and a verifier, created once and used for any number of pairs (a deep model's weights load once).
 class PairMatcher {
  public:
   explicit PairMatcher(const py::kwargs& kwargs) {
-    // The options of `vmap match` (cli/match_command.cc): the matchers' and the verifier's without early stops.
-    MatcherOptions matcher_options;
-    cli::VerifierFlags verifier_flags;
     KeywordOptions keywords("Matcher");
-    cli::AddMatcherOptions(keywords.command(), matcher_options, keywords.option_flags());
-    cli::AddVerifierOptions(keywords.command(), verifier_flags, keywords.option_flags(), /*with_early_stop=*/false);
-    cli::AddHeadingOptions(keywords.command(), heading_, keywords.option_flags());
+    keywords.Add(options_);
     keywords.Parse(kwargs);
     keywords.Run([&] {
       py::gil_scoped_release release;
-      verifier_ = verifier_flags.Resolve();
-      matcher_options.Check();
-      CheckField("heading", heading_);
-      matcher_ = CreateMatcher(matcher_options);
+      options_.Check();
+      matcher_ = CreateMatcher(options_.matcher);
     });
   }
 
@@ -94,7 +70,8 @@ class PairMatcher {
       py::gil_scoped_release release;
       const Frame frame0 = FrameFromImage(input0.image, 0, {}, "image0");
       const Frame frame1 = FrameFromImage(input1.image, 1, {}, "image1");
-      pair = MatchPair(*matcher_, {frame0.gray, frame0.color}, {frame1.gray, frame1.color}, verifier_, heading_);
+      pair = MatchPair(*matcher_, {frame0.gray, frame0.color}, {frame1.gray, frame1.color}, options_.verifier,
+                       options_.heading);
     }
     const size_t n = pair.matches.size();
     const bool verified = pair.fundamental.success;
@@ -109,6 +86,7 @@ class PairMatcher {
       inliers.mutable_at(k) = verified && pair.fundamental.inlier_mask[k] != 0;
     }
     // Named as `vmap match --json` names them; a field added there is one more line here.
+    const HeadingOptions& heading_options = options_.heading;
     py::dict fields;
     fields["num_tentative"] = n;
     fields["num_verified"] = pair.fundamental.num_inliers;
@@ -124,9 +102,9 @@ class PairMatcher {
     fields["heading_method"] = HeadingMethodName(heading.method);
     fields["heading_confidence"] = heading.confidence;
     fields["heading_votes"] = heading.votes;
-    fields["heading_options"] =
-        py::dict(py::arg("window_px") = heading_.window_px, py::arg("window_dy_px") = heading_.window_dy_px,
-                 py::arg("min_votes") = heading_.min_votes, py::arg("min_verified") = heading_.min_verified);
+    fields["heading_options"] = py::dict(
+        py::arg("window_px") = heading_options.window_px, py::arg("window_dy_px") = heading_options.window_dy_px,
+        py::arg("min_votes") = heading_options.min_votes, py::arg("min_verified") = heading_options.min_verified);
     fields["time_s"] = py::dict(py::arg("extract") = pair.extract_seconds, py::arg("match") = pair.match_seconds,
                                 py::arg("verify") = pair.verify_seconds, py::arg("heading") = pair.heading_seconds);
     return Namespace(fields);
@@ -136,8 +114,7 @@ class PairMatcher {
   py::object options() const { return py::module_::import("json").attr("loads")(matcher_->DescribeOptionsJson()); }
 
  private:
-  VerifierOptions verifier_;
-  HeadingOptions heading_;
+  PairMatchOptions options_;
   std::unique_ptr<Matcher> matcher_;
 };
 
@@ -145,23 +122,16 @@ class PairMatcher {
 
 void BindBuildAndMatch(py::module_& m) {
   m.def("build_map", &BuildMapFunction, py::arg("input"), py::arg("output_dir"),
-        "Builds a map as `vmap build INPUT -o OUTPUT_DIR` does, with its options as keywords (--max-iters: "
-        "max_iters=...; vmap.build_map_options() lists them), and returns it (vmap.read_map). Ctrl-C abandons "
-        "the build and leaves OUTPUT_DIR as it was.");
+        "Builds a map as `vmap build INPUT -o OUTPUT_DIR` does (the build pipeline), its options as keywords "
+        "named as their fields (verifier_max_iterations=...) or as the CLI's flags (max_iters=...; "
+        "vmap.build_map_options() lists them), and returns it (vmap.read_map). Ctrl-C abandons the build and leaves "
+        "OUTPUT_DIR as it was.");
   m.def(
       "build_map_options",
       [] {
-        cli::SourceFlags source;
-        MatcherOptions matcher;
-        cli::VerifierFlags verifier;
-        cli::KeyImageFlags key_images;
-        bool report = false;
+        BuildPipelineOptions options;
         KeywordOptions keywords("build_map");
-        cli::AddSourceOptions(keywords.command(), source, keywords.option_flags());
-        cli::AddMatcherOptions(keywords.command(), matcher, keywords.option_flags());
-        cli::AddVerifierOptions(keywords.command(), verifier, keywords.option_flags());
-        cli::AddKeyImageOptions(keywords.command(), key_images, keywords.option_flags());
-        keywords.command()->add_flag("--report", report, "");
+        keywords.Add(options, kBuildMapSkipped);
         return keywords.Keywords();
       },
       "The keywords vmap.build_map accepts.");
@@ -180,7 +150,7 @@ void BindBuildAndMatch(py::module_& m) {
         return PairMatcher(kwargs).Match(image0, image1);
       },
       py::arg("image0"), py::arg("image1"),
-      "Matches one pair as `vmap match` does (keywords: its options, e.g. matcher='orb', threshold=0.5). "
+      "Matches one pair as `vmap match` does (keywords: its options, e.g. matcher='orb', verifier_threshold=0.5). "
       "Returns num_tentative, num_verified, verified, similarity, F (3x3 or None), matches (N x 4 float32: x0 y0 "
       "x1 y1), scores, inliers (N bools) and time_s.");
 }

@@ -1,9 +1,11 @@
 #include "keyword_options.h"
 
 #include <algorithm>
-#include <cctype>
+#include <stdexcept>
 
-#include "vmap/core/error.h"
+#include "vmap/core/option_names.h"
+
+#include "argument_errors.h"
 
 namespace py = pybind11;
 
@@ -11,101 +13,146 @@ namespace vmap::python {
 
 namespace {
 
-std::string KeywordOf(const std::string& long_name) {
-  std::string keyword = long_name;
-  std::replace(keyword.begin(), keyword.end(), '-', '_');
-  return keyword;
+// The keywords of a flag: "--max-iters" is max_iters, "!--no-cache" no_cache (negated); short names and
+// positional arguments have none.
+std::vector<std::string> FlagKeywords(std::string flag, bool* negated) {
+  *negated = !flag.empty() && flag.front() == '!';
+  if (*negated) flag.erase(0, 1);
+  std::vector<std::string> keywords;
+  size_t start = 0;
+  while (start <= flag.size()) {
+    const size_t comma = std::min(flag.find(',', start), flag.size());
+    const std::string name = flag.substr(start, comma - start);
+    if (name.rfind("--", 0) == 0) {
+      std::string keyword = name.substr(2);
+      std::replace(keyword.begin(), keyword.end(), '-', '_');
+      keywords.push_back(keyword);
+    }
+    start = comma + 1;
+  }
+  return keywords;
 }
 
-// The value as the command line would spell it; a float by repr, which reads back as the same double.
-std::string FlagText(const py::handle& value) {
-  if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
-  if (py::isinstance<py::int_>(value)) return py::str(value).cast<std::string>();
-  if (py::isinstance<py::float_>(value)) return py::repr(value).cast<std::string>();
-  if (py::isinstance<py::str>(value)) return value.cast<std::string>();
-  if (py::hasattr(value, "__fspath__")) return py::str(value.attr("__fspath__")()).cast<std::string>();
-  throw py::type_error("a " + py::str(py::type::of(value).attr("__name__")).cast<std::string>() +
-                       " where a number, a string or a bool is expected");
-}
+bool IsOption(const OptionField& field) { return field.flag[0] == '-' || field.flag[0] == '!'; }
 
 }  // namespace
 
-KeywordOptions::KeywordOptions(std::string function) : function_(std::move(function)) {
-  command_.set_help_flag();  // no --help keyword
-  command_.allow_extras(false);
+void KeywordOptions::OnEnter(const char* name, bool json_inline) { prefixes_.push_back(json_inline ? "" : name); }
+
+void KeywordOptions::OnLeave(bool /*json_inline*/) { prefixes_.pop_back(); }
+
+void KeywordOptions::OnField(const OptionField& field, int& value) {
+  AddField(field, [&value](const py::handle& v, const std::string& what) { value = IntArgument(v, what); });
+}
+
+void KeywordOptions::OnField(const OptionField& field, double& value) {
+  AddField(field, [&value](const py::handle& v, const std::string& what) { value = FloatArgument(v, what); });
+}
+
+void KeywordOptions::OnField(const OptionField& field, bool& value) {
+  AddField(
+      field, [&value](const py::handle& v, const std::string& what) { value = BoolArgument(v, what); },
+      [&value](bool on) { value = on; });
+}
+
+void KeywordOptions::OnField(const OptionField& field, std::optional<double>& value) {
+  AddField(field, [&value](const py::handle& v, const std::string& what) { value = FloatArgument(v, what); });
+}
+
+void KeywordOptions::OnField(const OptionField& field, std::string& value) {
+  AddField(field, [&value](const py::handle& v, const std::string& what) { value = TextArgument(v, what); });
+}
+
+void KeywordOptions::OnField(const OptionField& field, std::vector<int>& /*value*/) {
+  if (IsOption(field)) throw std::logic_error(std::string("option ") + field.key + ": a list field has no keyword");
+}
+
+void KeywordOptions::OnField(const OptionField& field, const EnumField& value) {
+  AddField(field, [value](const py::handle& v, const std::string& what) {
+    if (!PyUnicode_Check(v.ptr()))
+      throw ArgumentTypeError(what + " takes a str (" + value.names() + "), not " + TypeName(v));
+    value.Parse(v.cast<std::string>());
+  });
+}
+
+void KeywordOptions::AddField(const OptionField& field, Setter set, std::function<void(bool)> set_bool) {
+  if (!IsOption(field)) return;  // no flag, or a positional argument: not an option a call takes by keyword
+  std::string keyword;
+  for (const std::string& prefix : prefixes_) {
+    if (!prefix.empty()) keyword += prefix + "_";
+  }
+  keyword += field.path_name();
+  fields_.push_back({keyword, Path(field), std::move(set), std::move(set_bool)});
+  const size_t index = fields_.size() - 1;
+  AddKeyword(keyword, index, false);
+  bool negated = false;
+  for (const std::string& alias : FlagKeywords(field.flag, &negated)) {
+    if (negated && !fields_[index].set_bool) throw std::logic_error("flag " + std::string(field.flag) + " is no bool");
+    AddKeyword(alias, index, negated);
+  }
+}
+
+void KeywordOptions::AddKeyword(const std::string& keyword, size_t field, bool negated) {
+  Keyword& entry = keywords_[keyword];
+  if (std::find(entry.fields.begin(), entry.fields.end(), field) != entry.fields.end()) return;
+  // A keyword names several fields only as a flag they share does (--weights): same negation, a field each.
+  if (!entry.fields.empty() && (entry.negated != negated || fields_[entry.fields.front()].keyword == keyword ||
+                                fields_[field].keyword == keyword)) {
+    throw std::logic_error("keyword " + keyword + " names two options: " + fields_[entry.fields.front()].path +
+                           " and " + fields_[field].path);
+  }
+  entry.negated = negated;
+  entry.fields.push_back(field);
 }
 
 std::vector<std::string> KeywordOptions::Keywords() const {
   std::vector<std::string> keywords;
-  for (const CLI::Option* option : command_.get_options()) {
-    for (const std::string& name : option->get_lnames()) keywords.push_back(KeywordOf(name));
-  }
-  std::sort(keywords.begin(), keywords.end());
-  return keywords;
+  for (const auto& [keyword, entry] : keywords_) keywords.push_back(keyword);
+  return keywords;  // a std::map's keys: sorted
 }
 
 void KeywordOptions::Parse(const py::kwargs& kwargs) {
-  std::vector<std::string> args;
+  std::map<size_t, std::string> set_by;  // field -> the keyword that set it
   for (const auto& [key, value] : kwargs) {
     const std::string keyword = key.cast<std::string>();
-    const CLI::Option* found = nullptr;
-    std::string flag;
-    for (const CLI::Option* option : command_.get_options()) {
-      for (const std::string& name : option->get_lnames()) {
-        if (KeywordOf(name) == keyword) found = option, flag = "--" + name;
-      }
-    }
-    if (!found) {
+    const auto found = keywords_.find(keyword);
+    if (found == keywords_.end()) {
       std::string names;
       for (const std::string& name : Keywords()) names += (names.empty() ? "" : ", ") + name;
       throw py::type_error(function_ + "() got an unexpected keyword argument '" + keyword + "'; valid: " + names);
     }
     if (value.is_none()) continue;
-    if (found->get_expected_max() == 0) {  // a flag: on or off
-      if (!py::isinstance<py::bool_>(value)) throw py::type_error(keyword + " takes True or False");
-      if (value.cast<bool>()) args.push_back(flag);
-      continue;
-    }
-    try {
-      args.push_back(flag + "=" + FlagText(value));
-    } catch (const py::type_error& e) {
-      throw py::type_error(function_ + "(): " + keyword + " got " + e.what());
+    const Keyword& entry = found->second;
+    const std::string what = function_ + "(): " + keyword;
+    for (const size_t index : entry.fields) {
+      const auto [earlier, added] = set_by.emplace(index, keyword);
+      if (!added) {
+        throw py::type_error(function_ + "() got " + earlier->second + " and " + keyword + ", one option twice");
+      }
+      const Field& field = fields_[index];
+      if (entry.negated) {
+        field.set_bool(!BoolArgument(value, what));
+      } else {
+        field.set(value, what);
+      }
+      given_.push_back(field.path);
     }
   }
-  std::reverse(args.begin(), args.end());  // CLI11 takes them last first
-  try {
-    Run([&] { command_.parse(args); });
-  } catch (const CLI::ParseError& e) {
-    throw InputError(InKeywords(e.what()));
+}
+
+std::string KeywordOptions::KeywordOf(const std::string& path) const {
+  for (const Field& field : fields_) {
+    if (field.path == path) return field.keyword;
   }
+  return "";
 }
 
 void KeywordOptions::Run(const std::function<void()>& work) const {
   try {
     work();
   } catch (const OptionError& error) {
-    throw InputError(InKeywords(option_flags_.Message(error)));
-  } catch (const InputError& error) {
-    throw InputError(InKeywords(error.what()));
+    throw InputError(OptionErrorMessage(error, [this](const std::string& path) { return KeywordOf(path); }));
   }
-}
-
-std::string KeywordOptions::InKeywords(std::string text) const {
-  std::vector<std::string> names;
-  for (const CLI::Option* option : command_.get_options()) {
-    for (const std::string& name : option->get_lnames()) names.push_back(name);
-  }
-  // Longest first: --pose-threshold before --pose.
-  std::sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) { return a.size() > b.size(); });
-  for (const std::string& name : names) {
-    const std::string flag = "--" + name;
-    for (size_t at = text.find(flag); at != std::string::npos; at = text.find(flag, at + 1)) {
-      const size_t end = at + flag.size();
-      if (end < text.size() && (std::isalnum(static_cast<unsigned char>(text[end])) || text[end] == '-')) continue;
-      text.replace(at, flag.size(), KeywordOf(name));
-    }
-  }
-  return text;
 }
 
 }  // namespace vmap::python

@@ -1,47 +1,85 @@
 #pragma once
-// Python keyword arguments read as the flags of a vmap command: the keyword `max_iters` is the flag
-// --max-iters, bound by the same Add*Options calls the command uses (cli/common_options.h), so the module
-// accepts exactly the command's options, with its defaults, parsing and checks, and no list of its own.
+// Python keyword arguments bound to an options struct through its field list (core/option_fields.h), by field,
+// with typed values: the keyword `verifier_threshold` sets the field VerifierOptions::threshold of the struct
+// the call takes, as a float, its type checked. Keywords are the fields' names: a field's JSON key, after the
+// names of the structs that hold it where its record nests them (`tau`, `verifier_max_iterations`,
+// `orb_num_features`, `heading_window_px`). Where the CLI's flag says it otherwise, the flag's name is a keyword
+// too (`max_iters`, `orb_features`, `heading_window`, `threshold`, `no_cache=True` for `cache=False`), so that
+// scripts written with the flags' names keep working. The options a call takes are the fields with a flag: the
+// ones a user sets.
 
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
 #include <pybind11/pybind11.h>
-#include <pybind11/stl.h>
 
-#include "vmap/cli/option_flags.h"
+#include "vmap/core/error.h"
+#include "vmap/core/option_fields.h"
 
 namespace vmap::python {
 
-class KeywordOptions {
+class KeywordOptions final : public OptionFieldVisitor {
  public:
-  // `function`: the Python function's name, for messages ("vmap.build_map").
-  explicit KeywordOptions(std::string function);
+  // `function`: the Python function's name, for messages ("build_map").
+  explicit KeywordOptions(std::string function) : function_(std::move(function)) {}
 
-  // Where the caller binds the command's flags (AddSourceOptions(command(), ..., option_flags()), ...).
-  CLI::App* command() { return &command_; }
-  cli::OptionFlags& option_flags() { return option_flags_; }
+  // The fields of `options` (a struct with VisitFields), but those whose key is in `skip` (the call's positional
+  // arguments, a front end's own options). `options` must outlive Parse.
+  template <typename Options>
+  void Add(Options& options, std::vector<const char*> skip = {}) {
+    VisitNested("", options, Nesting{false, std::move(skip)});
+  }
 
-  // Sets the bound fields from `kwargs` (None keeps a default; True/False switch a flag on/off). An unknown
-  // keyword is a TypeError listing the valid ones; a value the flag refuses is a vmap.Error naming the keyword.
+  // Sets the fields from `kwargs` (None keeps a default), each value converted with its type checked: a value of
+  // the wrong type is a vmap.ArgumentTypeError (a TypeError and a vmap.Error), an unknown keyword a TypeError
+  // listing the valid ones. Call with the GIL held.
   void Parse(const pybind11::kwargs& kwargs);
 
-  // The keywords accepted, sorted.
+  // The keywords accepted (fields' names and flags' names), sorted.
   std::vector<std::string> Keywords() const;
+  // The paths of the fields Parse set ("min_verified"), for the checks of what was given.
+  const std::vector<std::string>& Given() const { return given_; }
 
-  // Runs `work`; an OptionError or InputError from it comes out in the keywords' words ("first must be ...").
+  // Runs `work`; an OptionError from it comes out as an InputError naming the fields by their keywords.
   void Run(const std::function<void()>& work) const;
 
-  // `text` with every flag of the command ("--max-iters") written as its keyword ("max_iters").
-  std::string InKeywords(std::string text) const;
+ protected:
+  void OnField(const OptionField& field, int& value) override;
+  void OnField(const OptionField& field, double& value) override;
+  void OnField(const OptionField& field, bool& value) override;
+  void OnField(const OptionField& field, std::string& value) override;
+  void OnField(const OptionField& field, std::vector<int>& value) override;
+  void OnField(const OptionField& field, const EnumField& value) override;
+  void OnField(const OptionField& field, std::optional<double>& value) override;
+  void OnEnter(const char* name, bool json_inline) override;
+  void OnLeave(bool json_inline) override;
 
  private:
+  // Converts a Python value and sets the field; `what` names the keyword for messages.
+  using Setter = std::function<void(const pybind11::handle& value, const std::string& what)>;
+  struct Field {
+    std::string keyword;  // its name
+    std::string path;     // as its checks name it
+    Setter set;
+    std::function<void(bool)> set_bool;  // bool fields: for the negated flag's keyword (no_cache=True)
+  };
+  struct Keyword {
+    std::vector<size_t> fields;  // indices into fields_ (a flag several fields share sets each)
+    bool negated = false;        // the keyword of a "!--no-x" flag: True sets the field false
+  };
+
+  void AddField(const OptionField& field, Setter set, std::function<void(bool)> set_bool = {});
+  void AddKeyword(const std::string& keyword, size_t field, bool negated);
+  std::string KeywordOf(const std::string& path) const;  // "" when no field has it
+
   std::string function_;
-  CLI::App command_;
-  cli::OptionFlags option_flags_;
+  std::vector<Field> fields_;
+  std::map<std::string, Keyword> keywords_;
+  std::vector<std::string> prefixes_;  // of the structs entered: their names where their record nests them
+  std::vector<std::string> given_;
 };
 
 }  // namespace vmap::python

@@ -1,26 +1,20 @@
-// vmap.Localizer and vmap.localize: `vmap localize` with the same options, one frame at a time or a sequence.
+// vmap.Localizer and vmap.localize: the localization pipeline, one frame at a time (its session) or over a whole
+// query, its options as keywords (keyword_options.h).
 
 #include <cmath>
-#include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
-#include <pybind11/stl/filesystem.h>
-#include <spdlog/spdlog.h>
 
-#include "vmap/cli/common_options.h"
-#include "vmap/cli/localize_options.h"
-#include "vmap/localization/localization_map.h"
 #include "vmap/localization/localization_output.h"
-#include "vmap/localization/localize_sequence.h"
-#include "vmap/localization/route.h"
-#include "vmap/map/map_io.h"
-#include "vmap/sources/image_frame.h"
+#include "vmap/pipelines/localize_pipeline.h"
 
+#include "argument_errors.h"
 #include "bindings.h"
 #include "keyword_options.h"
 #include "map_objects.h"
@@ -55,78 +49,59 @@ py::object ResultObject(const VisualMap& map, const LocalizationResult& result) 
   return Namespace(fields);
 }
 
-// The map opened for localization and a Localizer on it, for frames given one at a time.
+// The localization session of a map, for frames given one at a time.
 class FrameLocalizer {
  public:
   FrameLocalizer(const py::object& map, const py::kwargs& kwargs) {
-    cli::LocalizerFlags flags;
+    LocalizePipelineOptions options;
     KeywordOptions keywords("Localizer");
-    cli::AddLocalizerOptions(keywords.command(), flags, keywords.option_flags());
+    keywords.Add(options.session);
     keywords.Parse(kwargs);
-    const std::filesystem::path directory = MapDirectory(map);
+    options.map = MapDirectory(map).string();
     keywords.Run([&] {
       py::gil_scoped_release release;
-      LocalizerOptions options = flags.localizer;
-      options.Check();
-      cli::CheckLocalizerFlags(flags);
-      KeyImageStoreOptions store_options;
-      store_options.use_cache = flags.cache;
-      store_options.thumbnail_width = options.ranking.thumbnail_width;
-      opened_ = std::make_unique<LocalizationMap>(OpenLocalizationMap(directory, store_options));
-      options.route = cli::RouteOf(opened_->map, flags, options.route);
-      // Frames are brought to the map's size, so the map's camera applies.
-      options = FollowMap(*opened_, options, QueryResize(opened_->map, ""));
-      options.Check();
-      localizer_ = std::make_unique<Localizer>(opened_->map, opened_->keys, *opened_->matcher, options);
+      options.session.CheckGiven(keywords.Given());
+      session_ = std::make_unique<LocalizationSession>(options);
     });
   }
 
   py::object Localize(const py::object& image, const py::object& timestamp) {
     const ImageInput input = ImageView(image, "image");
+    std::optional<double> seconds;
+    if (!timestamp.is_none()) {
+      seconds = FloatArgument(timestamp, "timestamp");
+      if (!std::isfinite(*seconds)) throw InputError("timestamp is not finite; give the frame's time in seconds");
+    }
     LocalizationResult result;
     {
       py::gil_scoped_release release;
-      Frame frame = FrameFromImage(input.image, frames_, opened_->map.input.frame_size, "image");
-      if (!timestamp.is_none()) frame.timestamp = timestamp.cast<double>();
-      const auto features = opened_->matcher->ExtractFrame(frame.gray, frame.color);
-      result = localizer_->Localize(frame, *features);
+      result = session_->Localize(input.image, seconds);
     }
-    ++frames_;
-    return ResultObject(opened_->map, result);
+    return ResultObject(session_->map(), result);
   }
 
-  void Reset() { localizer_->Reset(); }
+  void Reset() { session_->Reset(); }
 
  private:
-  std::unique_ptr<LocalizationMap> opened_;
-  std::unique_ptr<Localizer> localizer_;
-  int frames_ = 0;  // frames localized: the next one's index
+  std::unique_ptr<LocalizationSession> session_;
 };
 
-py::list LocalizeFunction(const py::object& map, const std::string& query, const py::kwargs& kwargs) {
-  // The options of `vmap localize` (cli/localize_command.cc), bound by the same calls.
-  cli::SourceFlags source_flags;
-  cli::LocalizerFlags flags;
+py::list LocalizeFunction(const py::object& map, const py::object& query, const py::kwargs& kwargs) {
+  LocalizePipelineOptions options;
   KeywordOptions keywords("localize");
-  cli::AddSourceOptions(keywords.command(), source_flags, keywords.option_flags());
-  cli::AddLocalizerOptions(keywords.command(), flags, keywords.option_flags());
+  // The outputs are the CLI's; so is the odometry, whose columns a result does not have.
+  keywords.Add(options, {"map", "query", "csv", "json", "report", "odometry", "odometry_topic"});
   keywords.Parse(kwargs);
-  const std::filesystem::path directory = MapDirectory(map);
-  std::unique_ptr<LocalizationMap> opened;
-  std::vector<LocalizationResult> results;
+  options.map = MapDirectory(map).string();
+  options.query = TextArgument(query, "localize(): input");
+  LocalizePipelineResult run;
   keywords.Run([&] {
     py::gil_scoped_release release;
-    cli::LocalizationSetup setup = cli::SetUpLocalization(flags, source_flags.Resolve(), directory, query);
-    opened = std::move(setup.opened);
-    Localizer localizer(opened->map, opened->keys, *opened->matcher, setup.options);
-    LocalizeSequence(*setup.source, *opened->matcher, localizer, setup.run_options,
-                     [&](const Frame&, const LocalizationResult& result) {
-                       results.push_back(result);
-                       RaisePendingSignals();
-                     });
+    options.session.CheckGiven(keywords.Given());
+    run = RunLocalizePipeline(options, [](const Frame&, const LocalizationResult&) { RaisePendingSignals(); });
   });
   py::list list;
-  for (const LocalizationResult& result : results) list.append(ResultObject(opened->map, result));
+  for (const LocalizationResult& result : run.run.frames) list.append(ResultObject(run.map, result));
   return list;
 }
 
@@ -135,12 +110,12 @@ py::list LocalizeFunction(const py::object& map, const std::string& query, const
 void BindLocalization(py::module_& m) {
   py::class_<FrameLocalizer>(m, "Localizer",
                              "Localizes frames one at a time against a map (a vmap.Map or its directory), with the "
-                             "options of `vmap localize` as keywords (min_verified=..., ranking=..., ...).")
+                             "options of `vmap localize` as keywords (candidates=..., ranking=..., ...).")
       .def(py::init<const py::object&, const py::kwargs&>(), py::arg("map"))
       .def("localize", &FrameLocalizer::Localize, py::arg("image"), py::arg("timestamp") = py::none(),
-           "Localizes the next frame (uint8 HxW grey or HxWx3 BGR; brought to the map's frame size). Returns an "
-           "object whose attributes are the columns of `vmap localize --csv` (status, key, next_key, similarity, "
-           "heading_px, ...), with F, R and t as numpy arrays (None when unknown).")
+           "Localizes the next frame (uint8 HxW grey or HxWx3 BGR; brought to the map's frame size; timestamp in "
+           "seconds or None). Returns an object whose attributes are the columns of `vmap localize --csv` (status, "
+           "key, next_key, similarity, heading_px, ...), with F, R and t as numpy arrays (None when unknown).")
       .def("reset", &FrameLocalizer::Reset, "Forgets the estimate: the next frame is relocalized.");
   m.def("localize", &LocalizeFunction, py::arg("map"), py::arg("input"),
         "Localizes every frame of INPUT (video, image folder, dataset or one image) as `vmap localize MAP INPUT` "

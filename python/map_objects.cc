@@ -14,6 +14,7 @@
 #include "vmap/map/map_io.h"
 #include "vmap/mapping/recorded_options.h"
 
+#include "argument_errors.h"
 #include "bindings.h"
 #include "numpy_convert.h"
 
@@ -76,7 +77,7 @@ std::shared_ptr<MapHandle> ReadMapHandle(const std::filesystem::path& directory)
 
 std::filesystem::path MapDirectory(const py::object& map_or_path) {
   if (py::isinstance<MapHandle>(map_or_path)) return map_or_path.cast<const MapHandle&>().directory;
-  return map_or_path.cast<std::filesystem::path>();
+  return std::filesystem::path(TextArgument(map_or_path, "map"));
 }
 
 void BindMapObjects(py::module_& m) {

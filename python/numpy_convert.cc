@@ -1,8 +1,12 @@
 #include "numpy_convert.h"
 
 #include <cstring>
+#include <limits>
 
 #include "vmap/core/error.h"
+#include "vmap/sources/frame_source.h"
+
+#include "argument_errors.h"
 
 namespace py = pybind11;
 
@@ -10,8 +14,8 @@ namespace vmap::python {
 
 ImageInput ImageView(const py::object& object, const std::string& what) {
   if (!py::isinstance<py::array>(object)) {
-    throw InputError(what + " is a " + py::str(py::type::of(object).attr("__name__")).cast<std::string>() +
-                     ", not a numpy array; give a uint8 image (HxW grey or HxWx3 BGR)");
+    throw ArgumentTypeError(what + " is a " + TypeName(object) +
+                            ", not a numpy array; give a uint8 image (HxW grey or HxWx3 BGR)");
   }
   const py::array array = py::reinterpret_borrow<py::array>(object);
   if (!array.dtype().is(py::dtype::of<std::uint8_t>())) {
@@ -23,9 +27,20 @@ ImageInput ImageView(const py::object& object, const std::string& what) {
     throw InputError(what + " has shape " + py::str(object.attr("shape")).cast<std::string>() +
                      "; give HxW (grey) or HxWx3 (BGR)");
   }
+  // The size is checked before any copy: a broadcast array of a few bytes may stand for gigabytes.
+  const py::ssize_t height = array.shape(0), width = array.shape(1);
+  const py::ssize_t largest = std::numeric_limits<int>::max();
+  const std::string problem = width > largest || height > largest
+                                  ? "larger than any image"
+                                  : FrameSizeProblem(cv::Size(static_cast<int>(width), static_cast<int>(height)));
+  if (!problem.empty()) {
+    throw InputError(what + " is " + std::to_string(width) + "x" + std::to_string(height) + ", " + problem +
+                     "; give an image of a usable size");
+  }
   ImageInput input;
   input.pixels = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(array);
-  input.image = cv::Mat(static_cast<int>(array.shape(0)), static_cast<int>(array.shape(1)), CV_8UC(channels),
+  if (!input.pixels) throw py::error_already_set();
+  input.image = cv::Mat(static_cast<int>(height), static_cast<int>(width), CV_8UC(channels),
                         const_cast<void*>(input.pixels.data()));
   return input;
 }

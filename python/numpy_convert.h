@@ -16,7 +16,8 @@ struct ImageInput {
   pybind11::array pixels;
   cv::Mat image;
 };
-// Anything but such an array is a vmap.Error naming `what`.
+// Anything but such an array is a vmap.Error naming `what` (vmap.ArgumentTypeError for what is no array), and so
+// is an image of a size vmap refuses (FrameSizeProblem): checked before any copy.
 ImageInput ImageView(const pybind11::object& object, const std::string& what);
 
 // A copy of an 8-bit image: HxW, or HxWxC for C > 1 channels.

@@ -1,9 +1,9 @@
 // The `vmap` Python module: vmap's maps as numpy arrays, its matchers and localizer as functions (docs/python.md).
-// A thin layer: every option is the CLI's (the same Add*Options bindings), every step the library's.
+// A thin layer: every call runs a pipeline (src/vmap/pipelines/) or a stage of the library, its options structs
+// bound by field (keyword_options.h).
 
 #include <string>
 
-#include <CLI/CLI.hpp>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
@@ -12,6 +12,7 @@
 #include "vmap/core/runtime.h"
 #include "vmap/features/matcher_registry.h"
 
+#include "argument_errors.h"
 #include "bindings.h"
 
 namespace py = pybind11;
@@ -20,14 +21,19 @@ PYBIND11_MODULE(vmap, m) {
   m.doc() = "vmap: visual maps for teach-and-repeat navigation (key images linked by fundamental matrices)";
   m.attr("__version__") = VMAP_VERSION;
 
-  // vmap's errors (bad input, bad options) carry the CLI's message; a ValueError, so generic handlers catch them.
+  // vmap's errors (bad input, bad options) carry the library's message, options named by keyword; a ValueError,
+  // so generic handlers catch them. An argument of the wrong type is also a TypeError.
   static py::exception<vmap::InputError> error(m, "Error", PyExc_ValueError);
+  static py::object argument_type_error = py::reinterpret_steal<py::object>(PyErr_NewExceptionWithDoc(
+      "vmap.ArgumentTypeError", "An argument of the wrong type: a TypeError, and a vmap.Error.",
+      py::make_tuple(error, py::handle(PyExc_TypeError)).ptr(), nullptr));
+  m.attr("ArgumentTypeError") = argument_type_error;
   py::register_exception_translator([](std::exception_ptr pending) {
     try {
       if (pending) std::rethrow_exception(pending);
+    } catch (const vmap::python::ArgumentTypeError& e) {
+      PyErr_SetString(argument_type_error.ptr(), e.what());
     } catch (const vmap::InputError& e) {
-      PyErr_SetString(error.ptr(), e.what());
-    } catch (const CLI::ParseError& e) {
       PyErr_SetString(error.ptr(), e.what());
     }
   });

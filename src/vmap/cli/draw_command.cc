@@ -11,12 +11,12 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "vmap/cli/commands.h"
-#include "vmap/cli/option_flags.h"
-#include "vmap/cli/output_files.h"
+#include "vmap/cli/option_binder.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/map/map_io.h"
+#include "vmap/pipelines/output_policies.h"
 #include "vmap/report/html_report.h"
 
 namespace vmap::cli {
@@ -26,8 +26,7 @@ struct DrawFlags {
   std::string map_directory;
   int link = 0;
   std::string output;
-  int width = 0;
-  bool no_caption = false;
+  MatchFigureOptions figure;  // --width, --no-caption
   OptionFlags option_flags;
 };
 
@@ -39,16 +38,11 @@ void RunDraw(const DrawFlags& flags) {
   if (extension != ".png" && extension != ".jpg" && extension != ".jpeg") {
     throw InputError("output '" + flags.output + "' must end in .png, .jpg or .jpeg");
   }
-  if (flags.width != 0 && (flags.width < 64 || flags.width > 16384)) {
-    throw InputError("--width must be 0 (the key images' own scale) or 64 to 16384 pixels");
-  }
+  flags.figure.Check();
   // The figure must not overwrite what it is drawn from (the map's files).
   CheckOutputs({{flags.output, "-o"}}, {MapInputs(flags.map_directory)});
   const VisualMap map = ReadMap(flags.map_directory);
-  MatchFigureOptions options;
-  options.max_width = flags.width;
-  options.caption = !flags.no_caption;
-  const cv::Mat figure = DrawMapLink(flags.map_directory, map, flags.link, options);
+  const cv::Mat figure = DrawMapLink(flags.map_directory, map, flags.link, flags.figure);
   std::vector<uchar> encoded;
   const std::vector<int> parameters = extension == ".png" ? std::vector<int>{cv::IMWRITE_PNG_COMPRESSION, 6}
                                                           : std::vector<int>{cv::IMWRITE_JPEG_QUALITY, 92};
@@ -70,13 +64,7 @@ void AddDrawCommand(CLI::App& app) {
       ->required()
       ->check(CLI::NonNegativeNumber);
   command->add_option("-o,--output", flags->output, "Image file to write (.png, .jpg)")->required();
-  // MatchFigureOptions::max_width.
-  flags->option_flags
-      .AddOption(command, "--width", flags->width, "max_width",
-                 "Scale the figure down to at most this width (0: full size)")
-      ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
-  command->add_flag("--no-caption", flags->no_caption, "Leave out the caption band under the images");
+  AddOptionFlags(command, flags->figure, flags->option_flags);
   command->callback([flags] { flags->option_flags.Run([&] { RunDraw(*flags); }); });
 }
 

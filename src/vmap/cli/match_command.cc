@@ -14,8 +14,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "vmap/cli/commands.h"
-#include "vmap/cli/common_options.h"
-#include "vmap/cli/output_files.h"
+#include "vmap/cli/option_binder.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
@@ -23,6 +22,8 @@
 #include "vmap/core/image_header.h"
 #include "vmap/geometry/heading.h"
 #include "vmap/mapping/pair_match.h"
+#include "vmap/pipelines/match_pipeline.h"
+#include "vmap/pipelines/output_policies.h"
 #include "vmap/sources/dataset_camera.h"
 
 namespace vmap::cli {
@@ -33,9 +34,7 @@ struct MatchFlags {
   std::string image0, image1, json_path;
   std::string camera;  // --camera: "" = none
   bool list = false;
-  MatcherOptions matcher;
-  VerifierFlags verifier;
-  HeadingOptions heading;
+  PairMatchOptions pair;
   OptionFlags option_flags;
 };
 
@@ -101,15 +100,14 @@ std::optional<Camera> CameraOf(const MatchFlags& flags, cv::Size size0, cv::Size
 nlohmann::json NumberOrNull(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
 
 void RunMatch(const MatchFlags& flags) {
-  const VerifierOptions verifier = flags.verifier.Resolve();
-  flags.matcher.Check();
-  CheckField("heading", flags.heading);
+  flags.pair.Check();
+  const VerifierOptions& verifier = flags.pair.verifier;
   CheckOutputs({{flags.json_path, "--json"}},
                {NamedInput(flags.image0, "the input image"), NamedInput(flags.image1, "the input image")});
   const cv::Mat gray0 = ReadGray(flags.image0), gray1 = ReadGray(flags.image1);
   const std::optional<Camera> camera = CameraOf(flags, gray0.size(), gray1.size());
   auto start = std::chrono::steady_clock::now();
-  const std::unique_ptr<Matcher> matcher = CreateMatcher(flags.matcher);
+  const std::unique_ptr<Matcher> matcher = CreateMatcher(flags.pair.matcher);
   const double load_s = Seconds(start);
 
   // Extraction, matching and verification: the library's, as the Python module's vmap.match runs them.
@@ -118,7 +116,7 @@ void RunMatch(const MatchFlags& flags) {
     return matcher->reads_color() ? PairImage(gray, ReadColor(path, gray.size())) : PairImage(gray);
   };
   const PairMatch pair = MatchPair(*matcher, with_color(gray0, flags.image0), with_color(gray1, flags.image1), verifier,
-                                   flags.heading, camera ? &*camera : nullptr);
+                                   flags.pair.heading, camera ? &*camera : nullptr);
   const TentativeMatches& matches = pair.matches;
   const FundamentalResult& fundamental = pair.fundamental;
   const double similarity = pair.similarity;
@@ -143,7 +141,7 @@ void RunMatch(const MatchFlags& flags) {
                 camera ? fmt::format(", {:.3f} deg", heading.deg).c_str() : "",
                 HeadingMethodName(heading.method).c_str(), heading.votes, heading.num_voters, heading.confidence);
   } else {
-    std::printf("heading     none (fewer than %d matches agree)\n", flags.heading.min_votes);
+    std::printf("heading     none (fewer than %d matches agree)\n", flags.pair.heading.min_votes);
   }
   std::printf("time        load %.3f s, extract %.3f s (2 images), match %.3f s, verify %.3f s, heading %.4f s\n",
               load_s, extract_s, match_s, verify_s, heading_s);
@@ -191,10 +189,10 @@ void RunMatch(const MatchFlags& flags) {
     j["heading_method"] = HeadingMethodName(heading.method);
     j["heading_confidence"] = heading.confidence;
     j["heading_votes"] = heading.votes;
-    j["heading_options"] = {{"window_px", flags.heading.window_px},
-                            {"window_dy_px", flags.heading.window_dy_px},
-                            {"min_votes", flags.heading.min_votes},
-                            {"min_verified", flags.heading.min_verified}};
+    j["heading_options"] = {{"window_px", flags.pair.heading.window_px},
+                            {"window_dy_px", flags.pair.heading.window_dy_px},
+                            {"min_votes", flags.pair.heading.min_votes},
+                            {"min_verified", flags.pair.heading.min_verified}};
     j["time_s"] = {
         {"load", load_s}, {"extract", extract_s}, {"match", match_s}, {"verify", verify_s}, {"heading", heading_s}};
     WriteFileAtomically(flags.json_path, j.dump(1) + "\n");
@@ -217,9 +215,7 @@ void AddMatchCommand(CLI::App& app) {
       command, "--camera", flags->camera, "camera",
       "Intrinsics of both images (fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]] or a calibration file): "
       "the heading also in degrees");
-  AddHeadingOptions(command, flags->heading, flags->option_flags);
-  AddMatcherOptions(command, flags->matcher, flags->option_flags);
-  AddVerifierOptions(command, flags->verifier, flags->option_flags, /*with_early_stop=*/false);  // one exhaustive pair
+  AddOptionFlags(command, flags->pair, flags->option_flags);
   command->callback([flags] { flags->option_flags.Run([&] { RunMatch(*flags); }); });
 }
 

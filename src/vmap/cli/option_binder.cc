@@ -1,5 +1,6 @@
 #include "vmap/cli/option_binder.h"
 
+#include <cstdint>
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
@@ -12,43 +13,52 @@ std::string Help(const OptionField& field, const std::string& names) {
   return field.lists_names ? field.help + names : field.help;
 }
 
-CLI::Option* BindEnum(CLI::App* command, const std::string& flag, const OptionField& field, const EnumField& value) {
+CLI::Option* BindEnum(CLI::App* command, const std::string& flag, const OptionField& field,
+                      const std::vector<EnumField>& values) {
   return command
       ->add_option_function<std::string>(
-          flag, [value](const std::string& text) { value.Parse(text); }, Help(field, value.names()))
-      ->default_str(value.name());
+          flag,
+          [values](const std::string& text) {
+            for (const EnumField& value : values) value.Parse(text);
+          },
+          Help(field, values.front().names()))
+      ->default_str(values.front().name());
 }
 
 template <typename T>
 CLI::Option* BindValues(CLI::App* command, const std::string& flag, const OptionField& field,
                         const std::vector<T*>& values) {
-  if (flag.front() == '!') {  // "!--no-x": a bool flag that sets false
-    if constexpr (std::is_same_v<T, bool>) {
-      if (values.size() == 1) return command->add_flag(flag, *values.front(), field.help);
-    }
-    throw std::logic_error("flag " + flag + ": a negated flag needs exactly one bool field");
-  }
   if constexpr (std::is_same_v<T, bool>) {
+    // A switch; "!--no-x" sets false. Several fields that share it are each set.
+    const bool negated = flag.front() == '!';
     if (values.size() == 1) return command->add_flag(flag, *values.front(), field.help);
+    return command->add_flag_function(
+        negated ? flag.substr(1) : flag,
+        [values, negated](std::int64_t count) {
+          for (bool* value : values) *value = (count > 0) != negated;
+        },
+        field.help);
   }
+  if (flag.front() == '!') throw std::logic_error("flag " + flag + ": a negated flag needs bool fields");
   CLI::Option* option = nullptr;
   if (values.size() == 1) {
     option = command->add_option(flag, *values.front(), field.help);
-    if (field.show_default) option->capture_default_str();
-    return option;
+    if (field.show_default && !field.positional) option->capture_default_str();
+  } else {
+    option = command->add_option_function<T>(
+        flag,
+        [values](const T& value) {
+          for (T* f : values) *f = value;
+        },
+        field.help);
+    if (field.show_default && !field.positional) {
+      std::ostringstream text;
+      text << std::boolalpha << *values.front();
+      option->default_str(text.str());
+    }
   }
-  option = command->add_option_function<T>(
-      flag,
-      [values](const T& value) {
-        for (T* f : values) *f = value;
-      },
-      field.help);
-  if (field.show_default) {
-    std::ostringstream text;
-    text << std::boolalpha << *values.front();
-    option->default_str(text.str());
-  }
-  return option;
+  // A positional argument (its flag is its name) is required.
+  return field.positional ? option->required() : option;
 }
 
 }  // namespace
@@ -65,8 +75,9 @@ void OptionBinder::AddTarget(const OptionField& field, Target value) {
   if (!targets.values.empty() && targets.values.front().index() != value.index()) {
     throw std::logic_error(std::string("flag ") + field.flag + " has fields of different types");
   }
-  if (!targets.values.empty() && std::holds_alternative<EnumField>(value)) {
-    throw std::logic_error(std::string("flag ") + field.flag + ": an enum field cannot share its flag");
+  if (!targets.values.empty() && std::holds_alternative<EnumField>(value) &&
+      std::get<EnumField>(targets.values.front()).names() != std::get<EnumField>(value).names()) {
+    throw std::logic_error(std::string("flag ") + field.flag + " has fields of different enums");
   }
   targets.values.push_back(std::move(value));
   targets.paths.push_back(Path(field));
@@ -78,8 +89,16 @@ void OptionBinder::Bind(CLI::App* command, OptionFlags& option_flags) const {
     CLI::Option* option = std::visit(
         [&](const auto& first) -> CLI::Option* {
           using T = std::decay_t<decltype(first)>;
-          if constexpr (std::is_same_v<T, EnumField>) {
-            return BindEnum(command, flag, targets.field, first);
+          if constexpr (std::is_same_v<T, std::optional<double>*>) {
+            // Unset until given: no default to show (the help says what it follows).
+            if (targets.values.size() != 1) throw std::logic_error("flag " + flag + ": an optional field shares it");
+            std::optional<double>* value = first;
+            return command->add_option_function<double>(
+                flag, [value](double given) { *value = given; }, targets.field.help);
+          } else if constexpr (std::is_same_v<T, EnumField>) {
+            std::vector<EnumField> values;
+            for (const Target& target : targets.values) values.push_back(std::get<EnumField>(target));
+            return BindEnum(command, flag, targets.field, values);
           } else {
             using Value = std::remove_pointer_t<T>;
             std::vector<Value*> values;

@@ -4,6 +4,7 @@
 // OptionError from Check() reaches the user in the flag's words.
 
 #include <map>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -33,9 +34,10 @@ class OptionBinder final : public OptionFieldVisitor {
   void OnField(const OptionField& field, std::string& value) override { AddTarget(field, &value); }
   void OnField(const OptionField& field, std::vector<int>& value) override;
   void OnField(const OptionField& field, const EnumField& value) override { AddTarget(field, value); }
+  void OnField(const OptionField& field, std::optional<double>& value) override { AddTarget(field, &value); }
 
  private:
-  using Target = std::variant<int*, double*, bool*, std::string*, EnumField>;
+  using Target = std::variant<int*, double*, bool*, std::string*, EnumField, std::optional<double>*>;
   struct Targets {
     OptionField field;
     std::vector<Target> values;

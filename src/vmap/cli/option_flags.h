@@ -7,6 +7,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -39,6 +40,8 @@ class OptionFlags {
 
   // The flag recorded for `path`, or "" when it has none.
   std::string FlagOf(const std::string& path) const;
+  // The paths of the fields whose flags were given on the command line (after parsing).
+  std::vector<std::string> Given() const;
 
   // `error`'s message with the flags of its path and of the other fields it names; a field without a flag
   // keeps its path.
@@ -48,7 +51,8 @@ class OptionFlags {
   void Run(const std::function<void()>& run) const;
 
  private:
-  std::map<std::string, std::string> flags_;  // field path -> flag
+  std::map<std::string, std::string> flags_;           // field path -> flag
+  std::map<std::string, const CLI::Option*> options_;  // field path -> its flag's option, where bound here
 };
 
 }  // namespace vmap::cli

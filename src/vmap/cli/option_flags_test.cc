@@ -5,7 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include "vmap/cli/common_options.h"
+#include "vmap/cli/option_binder.h"
+#include "vmap/features/matcher_registry.h"
 #include "vmap/features/orb_matcher.h"
 
 namespace vmap::cli {
@@ -93,7 +94,7 @@ TEST(OptionFlags, MatcherFlagsAreRecordedByModelAndKey) {
   CLI::App app;
   MatcherOptions options;
   OptionFlags flags;
-  AddMatcherOptions(&app, options, flags);
+  AddOptionFlags(&app, options, flags);
   EXPECT_EQ(flags.FlagOf("orb.num_features"), "--orb-features");
   EXPECT_EQ(flags.FlagOf("orb.ratio"), "--ratio");
   options.Of<OrbMatcherOptions>().num_features = 0;

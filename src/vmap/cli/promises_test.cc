@@ -539,7 +539,7 @@ TEST(Promises, AbsurdOptionsAreRefusedBeforeAnyWork) {
       {build + "--frobnicate", "--frobnicate"},
       {"report " + Quote(tmp.path() / "m") + " --thumbnail-width 1", "--thumbnail-width"},
       {"draw " + Quote(tmp.path() / "m") + " --link 0 -o " + Quote(tmp.path() / "out.png") + " --width 5",
-       "--width must be 0"},
+       "--width is 5; use 0"},
       {"build", "input is required"},
   };
   for (const Case& c : cases) {

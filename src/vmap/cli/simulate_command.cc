@@ -12,12 +12,11 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/cli/commands.h"
-#include "vmap/cli/common_options.h"
 #include "vmap/cli/option_binder.h"
-#include "vmap/cli/output_files.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/progress.h"
 #include "vmap/map/map_io.h"
+#include "vmap/pipelines/output_policies.h"
 #include "vmap/simulation/closed_loop.h"
 #include "vmap/simulation/simulation_output.h"
 
@@ -119,7 +118,7 @@ void AddSimulateCommand(CLI::App& app) {
       "Teach a route in a simulated corridor and repeat it from random offsets, vmap's localizer and controller in "
       "the loop");
   AddOptionFlags(command, flags->options, flags->option_flags);
-  AddMatcherOptions(command, flags->matcher, flags->option_flags);
+  AddOptionFlags(command, flags->matcher, flags->option_flags);
   command->add_option("--json", flags->json, "Write the run (options, summary, every trial) to this JSON file");
   command->add_option("--report", flags->report, "Write an HTML report of the run into this directory");
   command->add_option("--map", flags->map, "Keep the teach run's map in this directory");

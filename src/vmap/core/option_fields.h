@@ -1,7 +1,8 @@
 #pragma once
 // One field list per options struct, from which its JSON (map.json's, sweep.json's, eval.json's and the
 // localization run's "options"; core/options_json.h) and its command-line flags (cli/option_binder.h) are
-// derived, so that a field's key, flag, help and default are written once. An options struct lists its fields:
+// derived, so that a field's key, flag, help and default are written once; so are the Python module's keywords
+// (python/keyword_options.h). An options struct lists its fields:
 //
 //   void VerifierOptions::VisitFields(OptionFieldVisitor& visitor) {
 //     visitor.Visit(OptionField{"method", "--verifier", "Fundamental matrix estimator: "}.ListingNames(),
@@ -18,6 +19,7 @@
 #include <cstring>
 #include <functional>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -40,6 +42,9 @@ struct OptionField {
   bool omit_empty = false;         // a string written only when it is not empty
   const char* empty_as = nullptr;  // the JSON name of an empty string ("input": the input's own camera)
   bool lists_names = false;        // an enum's help ends with its names ("... : auto, sequential or bisect")
+  // A positional argument of the command line (required; its flag is its name, "input"): what a command works
+  // on, not one of its options (the Python module takes it as an argument, not a keyword).
+  bool positional = false;
 
   // Attributes beyond the first three, set by name: OptionField{"camera", "--camera", "..."}.EmptyAs("input").
   OptionField HideDefault() const { return With(&OptionField::show_default, false); }
@@ -49,6 +54,7 @@ struct OptionField {
   OptionField OmitEmpty() const { return With(&OptionField::omit_empty, true); }
   OptionField EmptyAs(const char* json_name) const { return With(&OptionField::empty_as, json_name); }
   OptionField ListingNames() const { return With(&OptionField::lists_names, true); }
+  OptionField Positional() const { return With(&OptionField::positional, true).HideDefault().NotRecorded(); }
 
   const char* path_name() const { return name != nullptr ? name : key; }
 
@@ -117,6 +123,10 @@ class OptionFieldVisitor {
   void Visit(const OptionField& field, std::vector<int>& value) {
     if (!Skipped(field)) OnField(field, value);
   }
+  // A number that may be unset: "the default follows another option" (the build's tau: the matcher's).
+  void Visit(const OptionField& field, std::optional<double>& value) {
+    if (!Skipped(field)) OnField(field, value);
+  }
   void Visit(const OptionField& field, const EnumField& value) {
     if (!Skipped(field)) OnField(field, value);
   }
@@ -153,6 +163,10 @@ class OptionFieldVisitor {
   virtual void OnField(const OptionField& field, std::string& value) = 0;
   virtual void OnField(const OptionField& field, std::vector<int>& value) = 0;
   virtual void OnField(const OptionField& field, const EnumField& value) = 0;
+  // Visitors of structs without such a field need not take one.
+  virtual void OnField(const OptionField& field, std::optional<double>& /*value*/) {
+    throw std::logic_error(std::string("option ") + field.key + ": this visitor takes no optional number");
+  }
   // Around a nested struct's fields; `json_inline`: its fields belong to the holder's JSON object.
   virtual void OnEnter(const char* /*name*/, bool /*json_inline*/) {}
   virtual void OnLeave(bool /*json_inline*/) {}

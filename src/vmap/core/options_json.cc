@@ -24,6 +24,18 @@ void OptionsJsonReader::OnField(const OptionField& field, std::string& value) {
   if (field.empty_as != nullptr && value == field.empty_as) value.clear();
 }
 
+void OptionsJsonReader::OnField(const OptionField& field, std::optional<double>& value) {
+  if (!field.recorded) return;
+  const nlohmann::json& object = readers_.back().object();
+  if (object.contains(field.key) && object[field.key].is_null()) {
+    value.reset();
+    return;
+  }
+  double number = value.value_or(0.0);
+  readers_.back().Read(field.key, &number);
+  if (object.contains(field.key)) value = number;
+}
+
 void OptionsJsonReader::OnEnter(const char* name, bool json_inline) {
   readers_.push_back(json_inline ? readers_.back() : readers_.back().Object(name));
 }

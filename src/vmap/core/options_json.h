@@ -25,6 +25,9 @@ class OptionsJsonWriter final : public OptionFieldVisitor {
   void OnField(const OptionField& field, std::string& value) override;
   void OnField(const OptionField& field, std::vector<int>& value) override { Write(field, value); }
   void OnField(const OptionField& field, const EnumField& value) override { Write(field, value.name()); }
+  void OnField(const OptionField& field, std::optional<double>& value) override {  // null when unset
+    Write(field, value ? nlohmann::json(*value) : nlohmann::json(nullptr));
+  }
   void OnEnter(const char* name, bool json_inline) override;
   void OnLeave(bool json_inline) override;
 
@@ -51,6 +54,7 @@ class OptionsJsonReader final : public OptionFieldVisitor {
   void OnField(const OptionField& field, const EnumField& value) override {
     if (field.recorded) readers_.back().Read(field.key, value);
   }
+  void OnField(const OptionField& field, std::optional<double>& value) override;
   void OnEnter(const char* name, bool json_inline) override;
   void OnLeave(bool json_inline) override;
 

@@ -136,5 +136,29 @@ TEST(OptionFields, PathsNameTheFieldWithinTheStructVisited) {
                                       "outer.trimmed.threshold", "outer.trimmed.seed"}));
 }
 
+// An optional number is written as null while unset, and read back either way.
+struct WithOptional {
+  std::optional<double> tau;
+  void VisitFields(OptionFieldVisitor& visitor) { visitor.Visit({"tau"}, tau); }
+};
+
+TEST(OptionsJson, AnUnsetOptionalNumberIsNull) {
+  WithOptional options;
+  EXPECT_EQ(OptionsToJson(options).dump(), R"({"tau":null})");
+  options.tau = 0.25;
+  EXPECT_EQ(OptionsToJson(options).dump(), R"({"tau":0.25})");
+  WithOptional back;
+  OptionsFromJson(JsonFieldReader(OptionsToJson(options), "x"), &back);
+  EXPECT_EQ(back.tau, 0.25);
+  OptionsFromJson(JsonFieldReader(nlohmann::json::parse(R"({"tau":null})"), "x"), &back);
+  EXPECT_FALSE(back.tau.has_value());
+  back.tau = 0.5;
+  OptionsFromJson(JsonFieldReader(nlohmann::json::object(), "x"), &back);  // missing: kept
+  EXPECT_EQ(back.tau, 0.5);
+  const std::string wrong = testing::InputErrorMessage(
+      [&] { OptionsFromJson(JsonFieldReader(nlohmann::json::parse(R"({"tau":"x"})"), "r"), &back); });
+  EXPECT_EQ(wrong.rfind("r.tau ", 0), 0u) << wrong;
+}
+
 }  // namespace
 }  // namespace vmap

@@ -49,30 +49,33 @@ void CheckOutputFiles(const std::vector<OutputFile>& outputs, const std::vector<
   for (size_t i = 0; i < outputs.size(); ++i) {
     const OutputFile& output = outputs[i];
     if (output.path.empty()) continue;
-    const std::string named = output.flag + " '" + output.path.string() + "'";
+    // An OptionError of the output's field (a front end names it, e.g. by its flag), the path quoted.
+    const std::string path = "'" + output.path.string() + "'";
     for (const OutputInput& input : inputs) {
       if (input.path.empty()) continue;
       // The same file (also where neither exists yet: a cache this run may write), or a path into a folder.
       if (SameOutput(output.path, input.path)) {
-        throw InputError(named + " would overwrite " + input.what + " '" + input.path.string() +
-                         "', an input of this command; write it somewhere else");
+        throw OptionError(output.flag, path + " would overwrite " + input.what + " '" + input.path.string() +
+                                           "', an input of this command; write it somewhere else");
       }
       if (IsSameOrInside(output.path, input.path)) {
-        throw InputError(named + " lies inside " + input.what + " '" + input.path.string() +
-                         "', an input of this command; write it somewhere else");
+        throw OptionError(output.flag, path + " lies inside " + input.what + " '" + input.path.string() +
+                                           "', an input of this command; write it somewhere else");
       }
     }
     for (size_t j = 0; j < i; ++j) {
       if (!outputs[j].path.empty() && SameOutput(output.path, outputs[j].path)) {
-        throw InputError(named + " is also the output of " + outputs[j].flag + "; give each output its own file");
+        throw OptionError(output.flag,
+                          path + " is also the output of " + outputs[j].flag + "; give each output its own file",
+                          {outputs[j].flag});
       }
     }
     const std::string why_not = WhyNotReplaceable(output.path);
-    if (!why_not.empty()) throw InputError(named + " " + why_not);
+    if (!why_not.empty()) throw OptionError(output.flag, path + " " + why_not);
     const fs::path parent = output.path.has_parent_path() ? output.path.parent_path() : fs::path(".");
     std::error_code ec;
     if (!fs::is_directory(parent, ec)) {
-      throw InputError(named + ": its folder '" + parent.string() + "' does not exist; create it first");
+      throw OptionError(output.flag, path + ": its folder '" + parent.string() + "' does not exist; create it first");
     }
   }
 }

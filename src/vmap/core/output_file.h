@@ -9,7 +9,8 @@
 
 namespace vmap {
 
-// One output file and how the user named it, for messages: {"out.csv", "--csv"}.
+// One output file and the option that names it: {"out.csv", "csv"} (a field's path, which a front end names
+// its own way), or how the user named it ({"out.csv", "--csv"}).
 struct OutputFile {
   std::filesystem::path path;
   std::string flag;
@@ -21,8 +22,8 @@ struct OutputInput {
   std::string what;
 };
 
-// Throws InputError, naming the output's flag and path and what is in the way, when an output (those with an
-// empty path are skipped):
+// Throws OptionError (an InputError) of the output's option, naming its path and what is in the way, when an
+// output (those with an empty path are skipped):
 // - resolves to an input or into a folder input (symbolic links, "..", hard links and bind mounts compared by
 //   the files they reach), or to another of `outputs`;
 // - exists and is a symbolic link, a device, a FIFO, a socket or a folder (vmap never renames over those);

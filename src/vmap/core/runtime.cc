@@ -16,6 +16,13 @@ extern "C" {
 
 namespace vmap {
 
+void RuntimeOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit(OptionField{"opencv_threads"}.NotRecorded(), opencv_threads);
+  visitor.Visit(OptionField{"keep_freed_memory"}.NotRecorded(), keep_freed_memory);
+  visitor.Visit(OptionField{"quiet_ffmpeg"}.NotRecorded(), quiet_ffmpeg);
+  visitor.Visit(OptionField{"handle_interrupts"}.NotRecorded(), handle_interrupts);
+}
+
 void RuntimeOptions::Check() const {
   if (opencv_threads < 0) {
     throw OptionError("opencv_threads",

@@ -7,6 +7,8 @@
 // InitializeRuntime() once, first thing in main(), while it is the only thread: the vmap CLI, the benchmarks
 // and the test binaries do.
 
+#include "vmap/core/option_fields.h"
+
 namespace vmap {
 
 struct RuntimeOptions {
@@ -27,6 +29,8 @@ struct RuntimeOptions {
   // (core/interrupt.h). Off in the test binaries, whose death tests install it in their child processes.
   bool handle_interrupts = true;
 
+  // No flags: each host makes its settings (the Python module's initialize_runtime takes them as keywords).
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
 

@@ -95,6 +95,19 @@ const ModelOptions& MatcherOptions::model(const std::string& name) const {
   return const_cast<MatcherOptions*>(this)->model(name);
 }
 
+void MatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
+  // "Feature matcher: orb, aliked, loftr or xfeat" and each model's summary on a line of its own.
+  static const std::string help = [] {
+    std::string text = "Feature matcher: " + MatcherModelNames();
+    for (const auto& model : MatcherModels()) text += "\n  " + model.name + ": " + model.summary;
+    return text;
+  }();
+  visitor.Visit(OptionField{"type", "--matcher", help.c_str()}.Named("matcher").NotRecorded(), type);
+  // Every model's fields, as "<model>.<key>" (the paths Check() names); a flag several models share (--weights,
+  // --device) sets the field of each, whichever matcher is chosen.
+  for (const auto& model : MatcherModels()) visitor.VisitNested(model.name.c_str(), *models_.at(model.name));
+}
+
 void MatcherOptions::Check() const {
   FindMatcherModel(type);
   // The options of every matcher, used or not: an absurd value (NaN, out of range) is a mistake either way.

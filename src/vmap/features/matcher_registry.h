@@ -152,6 +152,10 @@ class MatcherOptions {
     return model(T::kModelName).template As<T>();
   }
 
+  // `type` as "matcher" (--matcher) and every registered model's options under its name, for the command line
+  // and the Python module. Not a record: a map records its matcher as the matcher describes itself
+  // (Matcher::DescribeOptionsJson).
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field as "<model>.<key>" ("orb.num_features")
 
  private:

@@ -17,6 +17,11 @@ namespace vmap {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+void AddExperienceOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.VisitNested("localizer", localizer, Nesting{false, {"verifier", "translation"}});
+  visitor.VisitNested("run", run);
+}
+
 void AddExperienceOptions::Check() const {
   CheckField("localizer", localizer);
   CheckField("run", run);

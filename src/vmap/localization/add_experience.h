@@ -25,6 +25,8 @@ struct AddExperienceOptions {
   LocalizerOptions localizer;
   LocalizeSequenceOptions run;
 
+  // "localizer" (but its verifier and translation thresholds, which follow the map) and "run".
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
 

@@ -184,6 +184,12 @@ std::string KeyImageCacheStateName(KeyImageCacheState state) {
   return "off";
 }
 
+void KeyImageStoreOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit(OptionField{"use_cache"}.NotRecorded(), use_cache);
+  visitor.Visit(OptionField{"thumbnail_width"}.NotRecorded(), thumbnail_width);
+  visitor.Visit(OptionField{"extraction_threads"}.NotRecorded(), extraction_threads);
+}
+
 void KeyImageStoreOptions::Check() const {
   if (thumbnail_width < 8 || thumbnail_width > 512) {
     throw OptionError("thumbnail_width", fmt::format("{} is outside [8, 512] (default 48)", thumbnail_width));

@@ -16,6 +16,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/option_fields.h"
 #include "vmap/features/matcher.h"
 #include "vmap/map/experiences.h"
 #include "vmap/map/visual_map.h"
@@ -38,6 +39,8 @@ struct KeyImageStoreOptions {
   int thumbnail_width = 48;    // ThumbnailDescriptor width (the ranking's)
   int extraction_threads = 0;  // threads extracting key-image features on a cache miss; 0 = one per core
 
+  // No flags: a localization session sets them (its cache option, the ranking's thumbnail width).
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
 

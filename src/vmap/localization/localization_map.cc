@@ -11,9 +11,13 @@
 namespace vmap {
 
 LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, const KeyImageStoreOptions& options) {
+  return OpenLocalizationMap(ReadRecordedMap(directory), directory, options);
+}
+
+LocalizationMap OpenLocalizationMap(RecordedMap read, const std::filesystem::path& directory,
+                                    const KeyImageStoreOptions& options) {
   LocalizationMap opened;
   opened.directory = directory;
-  RecordedMap read = ReadRecordedMap(directory);
   opened.map = std::move(read.map);
   opened.options = std::move(read.options);
   opened.matcher =

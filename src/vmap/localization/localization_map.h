@@ -27,6 +27,9 @@ struct LocalizationMap {
 // (MatcherOptionsFromJson) and loads its key images and views.
 // Throws InputError naming the file and the fix when any of it fails.
 LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, const KeyImageStoreOptions& options);
+// The same for a map already read from `directory` (ReadRecordedMap): a map is read once.
+LocalizationMap OpenLocalizationMap(RecordedMap read, const std::filesystem::path& directory,
+                                    const KeyImageStoreOptions& options);
 
 // Localizer options that follow the map: its verifier (iterations capped, see MapVerifierOptions) and its
 // definition of S; the rest are LocalizerOptions' defaults.

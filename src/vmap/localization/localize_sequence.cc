@@ -19,6 +19,15 @@ int LocalizeSequenceOptions::ExtractionThreads() const {
   return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 }
 
+void LocalizeSequenceOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit(
+      OptionField{"extraction_threads", "--threads", "Feature-extraction threads (0 = one per core)"}.NotRecorded(),
+      extraction_threads);
+  visitor.Visit(OptionField{"prefetch_frames"}.NotRecorded(), prefetch_frames);
+  visitor.Visit(OptionField{"compare_ahead"}.NotRecorded(), compare_ahead);
+  visitor.Visit(OptionField{"show_progress"}.NotRecorded(), show_progress);
+}
+
 void LocalizeSequenceOptions::Check() const {
   if (extraction_threads < 0 || extraction_threads > 256) {
     throw OptionError("extraction_threads", "must be 0 to 256 (0 = one per core)");

@@ -9,6 +9,7 @@
 
 #include <functional>
 
+#include "vmap/core/option_fields.h"
 #include "vmap/features/matcher.h"
 #include "vmap/localization/localizer.h"
 #include "vmap/sources/frame_source.h"
@@ -25,6 +26,8 @@ struct LocalizeSequenceOptions {
   bool show_progress = true;  // a progress line on a terminal
 
   int ExtractionThreads() const;
+  // How a run is carried out: none is recorded; extraction_threads has its flag (--threads).
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
 

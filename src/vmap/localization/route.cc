@@ -9,6 +9,12 @@
 
 namespace vmap {
 
+void RouteOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit(
+      {"min_backward_verified", "--min-backward-verified", "Verified matches a link needs to be followed backwards"},
+      min_backward_verified);
+}
+
 void RouteOptions::Check() const {
   if (min_backward_verified < 8 || min_backward_verified > 100000) {
     throw OptionError("min_backward_verified",

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "vmap/core/option_fields.h"
 #include "vmap/map/visual_map.h"
 
 namespace vmap {
@@ -22,6 +23,8 @@ namespace vmap {
 struct RouteOptions {
   int min_backward_verified = 20;  // verified matches a link needs to be followed backwards
 
+  // The flag of `vmap route` (--min-backward-verified).
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
 

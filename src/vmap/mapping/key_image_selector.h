@@ -45,7 +45,7 @@ struct KeyImageOptions {
   double min_key_displacement = 1.0;
 
   // Algorithm 1's options as map.json records them: tau, similarity, final_key, min_key_displacement. tau has
-  // no flag here: its default depends on the matcher (cli/map_options.h binds --tau).
+  // no flag here: its default depends on the matcher (pipelines/build_pipeline.h has the option, --tau).
   void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };

@@ -17,6 +17,15 @@ nlohmann::json ToJson(const RecordedOptions& options) {
   return record;
 }
 
+std::string DescribeMapOptions(const Matcher& matcher, const MapBuilderOptions& options,
+                               const FrameSourceOptions& source) {
+  RecordedOptions record;
+  record.matcher_json = matcher.DescribeOptionsJson();
+  record.builder = options;
+  record.source = source;
+  return ToJson(record).dump();
+}
+
 RecordedOptions RecordedOptionsFromJson(const std::string& options_json, const std::string& where) {
   nlohmann::json record;
   try {

@@ -23,6 +23,10 @@ struct RecordedOptions {
 };
 // The builder's fields at the top level, "matcher" and "source" as objects.
 nlohmann::json ToJson(const RecordedOptions& options);
+// The record of a map built by `matcher` with `options` from `source`'s frames, as JSON text (map.json's and
+// sweep.json's "options").
+std::string DescribeMapOptions(const Matcher& matcher, const MapBuilderOptions& options,
+                               const FrameSourceOptions& source);
 // Reads a record (fields it lacks keep their defaults). Throws InputError naming `where` and the key of a
 // value of the wrong kind or an enum name this vmap does not know.
 RecordedOptions RecordedOptionsFromJson(const std::string& options_json, const std::string& where);

@@ -61,6 +61,16 @@ cv::Mat DrawMapLink(const fs::path& map_directory, const VisualMap& map, int lin
                          ReadKeyImage(map_directory, map.key_images[link.to_key]), link, with_title);
 }
 
+void MapReportOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit({"thumbnail_width", "--thumbnail-width", "Width of the key-image thumbnails in pixels"},
+                thumbnail_width);
+  visitor.Visit({"figure_width", "--figure-width", "Width of the match figures in pixels"}, figure_width);
+  visitor.Visit({"jpeg_quality"}, jpeg_quality);
+  visitor.Visit({"route_video", "!--no-video", "Skip report/route.mp4, the video of the key images in order"},
+                route_video);
+  visitor.Visit({"route_fps"}, route_fps);
+}
+
 void MapReportOptions::Check() const {
   if (thumbnail_width < 32 || thumbnail_width > 4096) {
     throw OptionError("thumbnail_width",

@@ -14,6 +14,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/option_fields.h"
 #include "vmap/map/visual_map.h"
 #include "vmap/mapping/batch_build.h"
 #include "vmap/report/match_figure.h"
@@ -30,6 +31,8 @@ struct MapReportOptions {
   bool route_video = true;  // report/route.mp4 (or .webm): the key images in order
   double route_fps = 3.0;   // key images per second in the route video
 
+  // The flags of `vmap report` (--thumbnail-width, --figure-width, --no-video); the rest have none.
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
 

@@ -207,6 +207,12 @@ std::string SimilarityPlot(const LocalizationRun& run) {
 
 }  // namespace
 
+void LocalizationReportOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit({"pairs"}, pairs);
+  visitor.Visit({"pair_width"}, pair_width);
+  visitor.Visit({"jpeg_quality"}, jpeg_quality);
+}
+
 void LocalizationReportOptions::Check() const {
   if (pairs < 0 || pairs > 200) {
     throw OptionError("pairs", fmt::format("is {}; use 0 to 200 (default 8)", pairs));

@@ -16,6 +16,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/option_fields.h"
 #include "vmap/localization/localization_output.h"
 #include "vmap/map/visual_map.h"
 
@@ -28,6 +29,8 @@ struct LocalizationReportOptions {
   int pair_width = 960;  // width of each pair in pixels
   int jpeg_quality = 85;
 
+  // No flags: the run's report is made as it is.
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
 

@@ -49,6 +49,12 @@ std::string MatchCaption(const Link& link) {
   return text;
 }
 
+void MatchFigureOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit({"max_width", "--width", "Scale the figure down to at most this width (0: full size)"}, max_width);
+  visitor.Visit(OptionField{"title"}.NotRecorded(), title);
+  visitor.Visit({"caption", "!--no-caption", "Leave out the caption band under the images"}, caption);
+}
+
 void MatchFigureOptions::Check() const {
   if (max_width != 0 && (max_width < 64 || max_width > 16384)) {
     throw OptionError("max_width",

@@ -8,6 +8,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/option_fields.h"
 #include "vmap/map/visual_map.h"
 
 namespace vmap {
@@ -20,6 +21,8 @@ struct MatchFigureOptions {
   std::string title;
   bool caption = true;
 
+  // The flags of `vmap draw` (--width, --no-caption); the title is the caller's.
+  void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
 

@@ -1,4 +1,4 @@
-#include "vmap/cli/output_files.h"
+#include "vmap/pipelines/output_policies.h"
 
 #include <filesystem>
 #include <set>
@@ -8,9 +8,26 @@
 #include "vmap/localization/key_image_store.h"
 #include "vmap/map/map_io.h"
 #include "vmap/report/html_report.h"
+#include "vmap/report/summary.h"
 
-namespace vmap::cli {
+namespace vmap {
 namespace fs = std::filesystem;
+
+OutputPolicy MapOutputPolicy(const std::string& input) {
+  OutputPolicy policy;
+  policy.why_not_ours = WhyNotAVmapMap;
+  policy.kind = "a vmap map";
+  policy.inputs = {input};
+  return policy;
+}
+
+OutputPolicy SweepOutputPolicy(const std::string& input) {
+  OutputPolicy policy;
+  policy.why_not_ours = WhyNotAVmapSweep;
+  policy.kind = "a vmap sweep";
+  policy.inputs = {input};
+  return policy;
+}
 
 std::vector<OutputInput> MapInputs(const std::string& map_directory) {
   if (map_directory.empty()) return {};
@@ -34,4 +51,4 @@ void CheckOutputs(const std::vector<OutputFile>& outputs, const std::vector<std:
   CheckOutputFiles(outputs, all);
 }
 
-}  // namespace vmap::cli
+}  // namespace vmap

@@ -1,4 +1,4 @@
-#include "vmap/cli/localize_odometry.h"
+#include "vmap/pipelines/localize_odometry.h"
 
 #include <cmath>
 
@@ -8,37 +8,30 @@
 #include "vmap/core/error.h"
 #include "vmap/sources/recording_reader.h"
 
-namespace vmap::cli {
+namespace vmap {
 
-void AddOdometryOptions(CLI::App* command, OdometryFlags& flags, OptionFlags& option_flags) {
-  option_flags.AddOption(command, "--odometry", flags.path, "odometry",
-                         "Odometry of the query: a CSV of timestamp,x,y,yaw (s, m, rad) or a recording with a "
-                         "nav_msgs/Odometry topic (default: the query recording's own, if any)");
-  option_flags.AddOption(command, "--odometry-topic", flags.topic, "odometry_topic",
-                         "The nav_msgs/Odometry topic to read (default: the recording's only one)");
-}
-
-std::optional<OdometryProgress> OpenQueryOdometry(const OdometryFlags& flags, const std::string& query) {
-  if (!flags.path.empty()) return OdometryProgress(OdometryTrack(ReadOdometry(flags.path, flags.topic)));
+std::optional<OdometryProgress> OpenQueryOdometry(const std::string& path, const std::string& topic,
+                                                  const std::string& query) {
+  if (!path.empty()) return OdometryProgress(OdometryTrack(ReadOdometry(path, topic)));
   if (!IsRecording(query)) {
-    if (!flags.topic.empty()) {
-      throw InputError("--odometry-topic names a topic of the query recording, and '" + query +
-                       "' is not a recording; give the odometry with --odometry FILE");
+    if (!topic.empty()) {
+      throw OptionError("odometry_topic", "names a topic of the query recording, and '" + query +
+                                              "' is not a recording; give the odometry as a file (odometry)",
+                        {"odometry"});
     }
     return std::nullopt;
   }
   const std::vector<std::string> topics = OdometryTopics(OpenRecording(query)->Topics());
-  if (topics.empty() && flags.topic.empty()) return std::nullopt;
-  if (topics.size() > 1 && flags.topic.empty()) {
+  if (topics.empty() && topic.empty()) return std::nullopt;
+  if (topics.size() > 1 && topic.empty()) {
     spdlog::warn(
         "'{}' has {} nav_msgs/Odometry topics; localizing without odometry (name one with "
         "--odometry-topic)",
         query, topics.size());
     return std::nullopt;
   }
-  std::vector<OdometrySample> samples = ReadOdometryTopic(query, flags.topic);
-  spdlog::info("odometry        {} samples from {}", samples.size(),
-               flags.topic.empty() ? topics.front() : flags.topic);
+  std::vector<OdometrySample> samples = ReadOdometryTopic(query, topic);
+  spdlog::info("odometry        {} samples from {}", samples.size(), topic.empty() ? topics.front() : topic);
   return OdometryProgress(OdometryTrack(std::move(samples)));
 }
 
@@ -64,4 +57,4 @@ nlohmann::json OdometryJson(int frame, const FrameOdometry& odometry) {
           {"key_distance", number(odometry.key_distance)}};
 }
 
-}  // namespace vmap::cli
+}  // namespace vmap

@@ -1,0 +1,131 @@
+"""Every argument is converted with its type checked: a wrong type is a TypeError (vmap.ArgumentTypeError, also a
+vmap.Error), a bad value a vmap.Error, never a crash; an image's size is checked before any copy. Options are
+keywords named as their fields, with the CLI's flag names as aliases."""
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import vmap
+from conftest import VIDEO, needs_shared
+
+
+def run_isolated(code):
+    """Runs `code` in a fresh interpreter (a crash there fails the test instead of ending pytest)."""
+    done = subprocess.run([sys.executable, "-c", "import vmap\nvmap.set_log_level('quiet')\n" + code],
+                          capture_output=True, text=True, timeout=300, env=os.environ)
+    assert done.returncode >= 0, f"killed by signal {-done.returncode}: {done.stderr}"
+    return done
+
+
+@pytest.mark.parametrize("timestamp", ["'now'", "[1.0]", "object()", "10**400", "b'1'", "float('nan')", "True"])
+def test_a_bad_timestamp_is_an_exception(maps, timestamp):
+    cli_dir, _, _ = maps
+    done = run_isolated(f"""
+m = vmap.read_map({str(cli_dir)!r})
+localizer = vmap.Localizer(m, no_cache=True)
+try:
+    localizer.localize(m.key_images[0].gray, timestamp={timestamp})
+except (TypeError, vmap.Error) as e:
+    print(type(e).__name__, e)
+else:
+    print('accepted')
+""")
+    assert done.returncode == 0, done.stderr
+    assert "accepted" not in done.stdout and "timestamp" in done.stdout, done.stdout
+
+
+def test_a_good_timestamp_is_recorded(maps):
+    cli_dir, _, _ = maps
+    m = vmap.read_map(cli_dir)
+    localizer = vmap.Localizer(m, no_cache=True)
+    assert localizer.localize(m.key_images[0].gray, timestamp=12.5).timestamp == 12.5
+    assert localizer.localize(m.key_images[1].gray, timestamp=np.float32(13)).timestamp == 13.0
+
+
+def test_huge_broadcast_images_are_refused_before_any_copy():
+    image = np.zeros((480, 640), np.uint8)
+    for shape in [(100000, 100000), (80000, 80000), (2**31, 8)]:
+        done = run_isolated(f"""
+import numpy as np, resource
+resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))  # a copy of the image would not fit
+try:
+    vmap.match(np.broadcast_to(np.uint8(7), {shape}), np.zeros((480, 640), np.uint8))
+except vmap.Error as e:
+    print('refused:', e)
+""")
+        assert done.returncode == 0, done.stderr
+        assert "refused:" in done.stdout and "image0" in done.stdout, done.stdout
+    with pytest.raises(vmap.ArgumentTypeError, match="image1"):
+        vmap.match(image, [[0, 1], [2, 3]])
+    with pytest.raises(TypeError, match="image0"):
+        vmap.match(object(), image)
+
+
+@pytest.mark.parametrize("value", ["'often'", "1.5", "True", "[2]", "b'2'", "object()", "10**400"])
+def test_option_values_are_type_checked(value, tmp_path):
+    done = run_isolated(f"""
+try:
+    vmap.build_map('nowhere.mp4', {str(tmp_path / 'out')!r}, stride={value})
+except vmap.Error as e:
+    print(type(e).__name__, isinstance(e, TypeError), e)
+""")
+    assert done.returncode == 0, done.stderr
+    assert "stride" in done.stdout, done.stdout
+    if value != "10**400":  # a value out of range is a vmap.Error; a value of the wrong type also a TypeError
+        assert "ArgumentTypeError True" in done.stdout, done.stdout
+
+
+def test_wrong_types_are_type_errors_and_vmap_errors(tmp_path):
+    with pytest.raises(TypeError, match="threshold takes a number, not str"):
+        vmap.match(np.zeros((8, 8), np.uint8), np.zeros((8, 8), np.uint8), threshold="1")
+    with pytest.raises(vmap.Error, match="no_cache takes True or False"):
+        vmap.Localizer(tmp_path, no_cache=1)
+    with pytest.raises(TypeError, match="verifier takes a str"):
+        vmap.Matcher(verifier=3)
+    with pytest.raises(vmap.ArgumentTypeError, match="map"):
+        vmap.Localizer(42)
+    with pytest.raises(vmap.Error, match="NUL"):
+        vmap.Localizer("a\0b")
+    assert issubclass(vmap.ArgumentTypeError, TypeError) and issubclass(vmap.ArgumentTypeError, vmap.Error)
+
+
+def test_keywords_are_field_names_with_the_flags_as_aliases():
+    keywords = set(vmap.build_map_options())
+    # Fields' names (as their record nests them) and the CLI's flag names for the same fields.
+    assert {"verifier_max_iterations", "max_iters", "orb_num_features", "orb_features", "pose_threshold",
+            "tau", "first", "extraction_threads", "threads", "final_key", "no_final_key", "search"} <= keywords
+    # A field is given once, whichever name it is given by.
+    with pytest.raises(TypeError, match="one option twice"):
+        vmap.Matcher(threshold=1.0, verifier_threshold=2.0)
+    a = vmap.Matcher(verifier_threshold=1.5, verifier_seed=7)
+    b = vmap.Matcher(threshold=1.5, seed=7)
+    image = np.zeros((64, 64), np.uint8)
+    assert a.name == b.name == "orb" and a.match(image, image).num_tentative == b.match(image, image).num_tentative
+
+
+def test_errors_name_options_by_keyword(tmp_path):
+    with pytest.raises(vmap.Error, match=r"^verifier_threshold \(verifier, pixels\) must be in"):
+        vmap.Matcher(threshold=-1)
+    with pytest.raises(vmap.Error, match="^tau 1.5 is outside"):
+        vmap.build_map("nowhere.mp4", tmp_path / "out", tau=1.5)
+
+
+def test_min_verified_belongs_to_the_counts_rule(maps):
+    cli_dir, _, _ = maps
+    with pytest.raises(vmap.Error, match="min_verified belongs to acceptance counts"):
+        vmap.Localizer(cli_dir, min_verified=20)
+    localizer = vmap.Localizer(cli_dir, acceptance="counts", min_verified=20, no_cache=True)
+    assert localizer.localize(vmap.read_map(cli_dir).key_images[0].gray).status != "lost"
+
+
+def test_the_quickstart_example_runs(tmp_path):
+    needs_shared()
+    example = os.path.join(os.path.dirname(__file__), "..", "..", "examples", "python_quickstart.py")
+    env = dict(os.environ, PYTHONPATH=os.path.dirname(vmap.__file__))  # the module under test, from any folder
+    done = subprocess.run([sys.executable, example, str(VIDEO)], capture_output=True, text=True, timeout=600,
+                          env=env, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert "links:" in done.stdout and "match:" in done.stdout and "frame " in done.stdout, done.stdout

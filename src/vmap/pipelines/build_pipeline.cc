@@ -1,0 +1,193 @@
+#include "vmap/pipelines/build_pipeline.h"
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "vmap/core/atomic_output.h"
+#include "vmap/core/error.h"
+#include "vmap/core/interrupt.h"
+#include "vmap/map/map_writer.h"
+#include "vmap/mapping/batch_build.h"
+#include "vmap/mapping/map_builder.h"
+#include "vmap/mapping/recorded_options.h"
+#include "vmap/pipelines/output_policies.h"
+#include "vmap/report/html_report.h"
+#include "vmap/sources/read_ahead_source.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kMaxSnapshotEvery = 86400.0;  // seconds: a day
+
+// "orb 0.5, aliked 0.7, ...": each registered matcher's default τ, for --help.
+std::string DefaultTaus() {
+  std::string text;
+  for (const auto& model : MatcherModels()) {
+    text += (text.empty() ? "" : ", ") + model.name + " " + fmt::format("{}", model.default_tau);
+  }
+  return text;
+}
+
+// SIGINT ends the input (InputEndRequested) while a live build runs, and no longer once it is over.
+class EndInputOnSigintWhile {
+ public:
+  explicit EndInputOnSigintWhile(bool enabled) : enabled_(enabled) {
+    if (enabled_) EndInputOnSigint(true);
+  }
+  ~EndInputOnSigintWhile() {
+    if (enabled_) EndInputOnSigint(false);
+  }
+  EndInputOnSigintWhile(const EndInputOnSigintWhile&) = delete;
+  EndInputOnSigintWhile& operator=(const EndInputOnSigintWhile&) = delete;
+
+ private:
+  bool enabled_;
+};
+
+// Streams the input through a MapBuilder: snapshots while it runs, the end of the input when the host asks.
+VisualMap BuildStreaming(const BuildPipelineOptions& pipeline, FrameSource& input, const Matcher& matcher,
+                         const MapBuilderOptions& options, const AtomicOutputDirectory& directory,
+                         const std::string& options_json, bool* interrupted) {
+  std::optional<SnapshotTarget> snapshots;
+  if (pipeline.snapshot_every > 0) snapshots = SnapshotTarget{directory.final_path(), MapOutputPolicy(pipeline.input)};
+  MapWriter writer(directory.path(), snapshots);
+  // Decoded on a thread of its own, while this one runs Algorithm 1 (see BuildMap).
+  ReadAheadSource source(input, options.prefetch_frames);
+  MapBuilder builder(source, matcher, options, &writer, options_json);
+  using Clock = std::chrono::steady_clock;
+  auto last_snapshot = Clock::now();
+  *interrupted = false;
+  for (;;) {
+    if (pipeline.until_interrupted && InputEndRequested()) {
+      *interrupted = true;
+      break;
+    }
+    std::optional<Frame> frame = source.Next();
+    if (!frame) {
+      *interrupted = pipeline.until_interrupted && InputEndRequested();
+      break;
+    }
+    builder.Add(std::move(*frame));
+    if (options.after_frame) options.after_frame();
+    // Between frames: a source that waits long for its next frame delays the snapshot as long.
+    if (snapshots && std::chrono::duration<double>(Clock::now() - last_snapshot).count() >= pipeline.snapshot_every) {
+      builder.Snapshot();
+      last_snapshot = Clock::now();
+      spdlog::debug("snapshot written to {}", directory.final_path().string());
+    }
+  }
+  if (*interrupted) spdlog::info("input ended by SIGINT: finishing the map from the frames seen");
+  return builder.Finish(*interrupted ? CoverageEnd::kInterrupted : CoverageEnd::kInputEnded);
+}
+
+}  // namespace
+
+void BuildPipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
+  static const std::string tau_help =
+      "Similarity threshold tau in (0, 1]: lower keeps fewer key images (default: the matcher's, " + DefaultTaus() +
+      ")";
+  visitor.Visit(
+      OptionField{"input", "input", "Video file, image folder, TUM RGB-D, EuRoC or KITTI sequence"}.Positional(),
+      input);
+  visitor.Visit(OptionField{"output", "-o,--output", "Map directory to write (default: <input name>_map)"}
+                    .HideDefault()
+                    .NotRecorded(),
+                output);
+  visitor.VisitNested("", source);
+  visitor.VisitNested("", matcher);
+  // The verifier's options first, as `vmap build --help` has always listed them.
+  visitor.VisitNested("verifier", map.verifier);
+  visitor.Visit(OptionField{"tau", "-t,--tau", tau_help.c_str()}.HideDefault().NotRecorded(), tau);
+  visitor.VisitNested("", map, Nesting{false, {"verifier"}});
+  visitor.Visit(OptionField{"report", "--report", "Also write report.html into the map directory"}.NotRecorded(),
+                report);
+  visitor.Visit(OptionField{"snapshot_every", "--snapshot-every",
+                            "Seconds between snapshots: the map so far, written to the output directory while the "
+                            "run goes on (0 = none)"}
+                    .NotRecorded(),
+                snapshot_every);
+  visitor.Visit(OptionField{"until_interrupted", "--until-interrupted",
+                            "SIGINT (Ctrl-C) ends the input and the map is finished from the frames seen (a second "
+                            "SIGINT aborts); for cameras and streams"}
+                    .NotRecorded(),
+                until_interrupted);
+}
+
+MapBuilderOptions BuildPipelineOptions::ResolvedMapOptions() const {
+  MapBuilderOptions resolved = map;
+  resolved.key_images.tau = tau ? *tau : DefaultTau(matcher.type);
+  return resolved;
+}
+
+fs::path BuildPipelineOptions::OutputDirectory() const {
+  return output.empty() ? fs::path(fs::path(input).filename().stem().string() + "_map") : fs::path(output);
+}
+
+void BuildPipelineOptions::Check() const {
+  source.Check();
+  try {
+    ResolvedMapOptions().Check();
+  } catch (const OptionError& error) {
+    // τ is given as `tau`, whatever field of the builder's it becomes.
+    if (error.path() == "key_images.tau") throw OptionError("tau", error.problem());
+    throw;
+  }
+  matcher.Check();
+  if (!(snapshot_every >= 0.0 && snapshot_every <= kMaxSnapshotEvery)) {
+    throw OptionError("snapshot_every",
+                      fmt::format("must be 0 (no snapshots) to {} seconds", static_cast<int>(kMaxSnapshotEvery)));
+  }
+  const bool streaming = snapshot_every > 0 || until_interrupted;
+  if (streaming && ResolveKeySearch(ResolvedMapOptions()) == KeySearch::kBisect) {
+    throw OptionError("key_search",
+                      "bisect reads ahead, while snapshot_every and until_interrupted build the map frame by frame; "
+                      "leave it out",
+                      {"snapshot_every", "until_interrupted"});
+  }
+}
+
+BuildPipelineResult RunBuildPipeline(const BuildPipelineOptions& pipeline, FrameSource* given_source) {
+  // 1. The options, τ resolved; the progress line where the log shows information.
+  pipeline.Check();
+  MapBuilderOptions options = pipeline.ResolvedMapOptions();
+  options.show_progress = options.show_progress && spdlog::should_log(spdlog::level::info);
+  BuildPipelineResult result;
+  result.directory = pipeline.OutputDirectory();
+
+  // 2. The output, claimed before any work: one that is not vmap's, or that holds the input, is refused here.
+  AtomicOutputDirectory directory(result.directory, MapOutputPolicy(pipeline.input));
+
+  // 3. The matcher (a deep model loads its weights here).
+  const std::unique_ptr<Matcher> matcher = CreateMatcher(pipeline.matcher);
+
+  // 4. The input.
+  FrameSourceOptions source_options = pipeline.source;
+  const EndInputOnSigintWhile live_end(pipeline.until_interrupted);
+  if (pipeline.until_interrupted) source_options.stop_requested = [] { return InputEndRequested(); };
+  std::unique_ptr<FrameSource> opened;
+  if (given_source == nullptr) opened = OpenFrameSource(pipeline.input, source_options);
+  FrameSource& source = given_source != nullptr ? *given_source : *opened;
+
+  // 5. The map.
+  const std::string options_json = DescribeMapOptions(*matcher, options, source_options);
+  result.map = ResolveKeySearch(options) == KeySearch::kBisect
+                   ? BuildMap(source, *matcher, options, directory.path(), options_json)
+                   : BuildStreaming(pipeline, source, *matcher, options, directory, options_json, &result.interrupted);
+
+  // 6. The report.
+  if (pipeline.report) WriteMapReport(directory.path());
+
+  // 7. The map in place.
+  directory.Commit();
+  return result;
+}
+
+}  // namespace vmap

@@ -1,0 +1,97 @@
+#include "vmap/pipelines/build_pipeline.h"
+
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "vmap/features/matcher_registry.h"
+#include "vmap/features/orb_matcher.h"
+#include "vmap/map/map_io.h"
+#include "vmap/mapping/recorded_options.h"
+#include "vmap/testing/localization_test_util.h"
+#include "vmap/testing/option_error.h"
+#include "vmap/testing/scoped_temp_dir.h"
+#include "vmap/testing/synthetic_scene.h"
+
+namespace vmap {
+namespace {
+namespace fs = std::filesystem;
+
+BuildPipelineOptions Quiet(BuildPipelineOptions options) {
+  options.map.show_progress = false;
+  return options;
+}
+
+// The same teach run as a folder and as the host's own frames: the same map, committed where asked.
+TEST(BuildPipeline, BuildsFromAPathOrFromTheHostsFramesAlike) {
+  testing::ScopedTempDir tmp;
+  testing::WriteImageFolder(testing::SidewaysDrive(), tmp.path() / "teach");
+  BuildPipelineOptions options;
+  options.input = (tmp.path() / "teach").string();
+  options.output = (tmp.path() / "from_path").string();
+  const BuildPipelineResult from_path = RunBuildPipeline(Quiet(options));
+  EXPECT_EQ(from_path.directory, tmp.path() / "from_path");
+  EXPECT_FALSE(from_path.interrupted);
+  ASSERT_GE(from_path.map.key_images.size(), 2u);
+  const RecordedMap read = ReadRecordedMap(tmp.path() / "from_path");
+  EXPECT_EQ(read.map.key_images.size(), from_path.map.key_images.size());
+  // τ unset: the matcher's own.
+  EXPECT_EQ(read.options.builder.key_images.tau, DefaultTau("orb"));
+
+  testing::MemorySource frames(testing::DriveFrames(0, 1));
+  options.output = (tmp.path() / "from_frames").string();
+  const BuildPipelineResult from_frames = RunBuildPipeline(Quiet(options), &frames);
+  ASSERT_EQ(from_frames.map.key_images.size(), from_path.map.key_images.size());
+  for (size_t i = 0; i < from_path.map.key_images.size(); ++i) {
+    EXPECT_EQ(from_frames.map.key_images[i].frame_index, from_path.map.key_images[i].frame_index);
+  }
+}
+
+TEST(BuildPipeline, TauGivenIsRecordedAndAfterFrameSeesEveryFrame) {
+  testing::ScopedTempDir tmp;
+  testing::WriteImageFolder(testing::SidewaysDrive(), tmp.path() / "teach");
+  BuildPipelineOptions options;
+  options.input = (tmp.path() / "teach").string();
+  options.output = (tmp.path() / "map").string();
+  options.tau = 0.3;
+  int frames = 0;
+  options.map.after_frame = [&] { ++frames; };
+  const BuildPipelineResult built = RunBuildPipeline(Quiet(options));
+  EXPECT_EQ(frames, built.map.num_frames);
+  EXPECT_EQ(ReadRecordedMap(tmp.path() / "map").options.builder.key_images.tau, 0.3);
+}
+
+// The output defaults to "<input name>_map" beside the working directory.
+TEST(BuildPipeline, OutputDefaultsToTheInputsName) {
+  BuildPipelineOptions options;
+  options.input = "/data/teach.mp4";
+  EXPECT_EQ(options.OutputDirectory(), fs::path("teach_map"));
+  options.output = "elsewhere";
+  EXPECT_EQ(options.OutputDirectory(), fs::path("elsewhere"));
+}
+
+// Bad options are named by their field and refused before any work: nothing is written.
+TEST(BuildPipeline, BadOptionsNameTheirFieldAndWriteNothing) {
+  testing::ScopedTempDir tmp;
+  testing::WriteImageFolder(testing::SidewaysDrive(), tmp.path() / "teach");
+  BuildPipelineOptions options;
+  options.input = (tmp.path() / "teach").string();
+  options.output = (tmp.path() / "map").string();
+  auto path_of = [&](const std::function<void(BuildPipelineOptions&)>& change) {
+    BuildPipelineOptions changed = options;
+    change(changed);
+    return testing::OptionErrorPath([&] { RunBuildPipeline(Quiet(changed)); });
+  };
+  EXPECT_EQ(path_of([](BuildPipelineOptions& o) { o.tau = 1.5; }), "tau");
+  EXPECT_EQ(path_of([](BuildPipelineOptions& o) { o.snapshot_every = -1; }), "snapshot_every");
+  EXPECT_EQ(path_of([](BuildPipelineOptions& o) { o.snapshot_every = 1, o.map.key_search = KeySearch::kBisect; }),
+            "key_search");
+  EXPECT_EQ(path_of([](BuildPipelineOptions& o) { o.source.stride = 0; }), "stride");
+  EXPECT_EQ(path_of([](BuildPipelineOptions& o) { o.map.verifier.threshold = -1; }), "verifier.threshold");
+  EXPECT_EQ(path_of([](BuildPipelineOptions& o) { o.matcher.Of<OrbMatcherOptions>().num_features = 0; }),
+            "orb.num_features");
+  EXPECT_FALSE(fs::exists(tmp.path() / "map"));
+}
+
+}  // namespace
+}  // namespace vmap

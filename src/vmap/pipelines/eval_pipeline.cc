@@ -1,0 +1,85 @@
+#include "vmap/pipelines/eval_pipeline.h"
+
+#include <filesystem>
+#include <vector>
+
+#include <spdlog/spdlog.h>
+
+#include "vmap/core/atomic_output.h"
+#include "vmap/core/error.h"
+#include "vmap/map/map_io.h"
+#include "vmap/pipelines/output_policies.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+
+void GroundTruthOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit(OptionField{"path", "--gt",
+                            "Ground-truth poses (default: the input's own: KITTI poses.txt, TUM groundtruth.txt, EuRoC "
+                            "state_groundtruth_estimate0/data.csv). Formats: kitti, tum, euroc"}
+                    .HideDefault(),
+                path);
+  visitor.Visit(OptionField{"format", "--gt-format", "Format of --gt (auto: from its first line): "}.ListingNames(),
+                EnumField(format, kGroundTruthFormatNames, ParseGroundTruthFormat));
+}
+
+void EvalPipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit(OptionField{"map", "map", "Map directory written by `vmap build`"}.Positional(), map);
+  visitor.VisitNested("gt", gt);
+  visitor.Visit(OptionField{"camera", "--camera",
+                            "Intrinsics when the map has none: fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]] or a "
+                            "calibration file"}
+                    .HideDefault(),
+                camera);
+  visitor.Visit(
+      OptionField{"json", "--json", "Also write the evaluation (JSON) to this file"}.HideDefault().NotRecorded(), json);
+  visitor.Visit(OptionField{"save", "!--no-save", "Do not write eval.json into the map directory"}.NotRecorded(), save);
+  visitor.VisitNested("", evaluation);
+}
+
+void EvalPipelineOptions::Check() const { evaluation.Check(); }
+
+EvalPipelineResult RunEvalPipeline(const EvalPipelineOptions& options) {
+  // 1. The options, the outputs, the camera option.
+  options.Check();
+  CheckOutputs({{options.json, "json"}},
+               {MapInputs(options.map), NamedInput(options.gt.path, "the ground truth"),
+                fs::is_regular_file(options.camera) ? NamedInput(options.camera, "the camera file")
+                                                    : std::vector<OutputInput>{}});
+  ParseEvaluationCamera(options.camera);  // a wrong camera is refused first, even where the map's camera is used
+
+  // 2. The map.
+  const VisualMap map = ReadMap(options.map);
+
+  // 3. The ground truth and the camera.
+  const GroundTruth truth = MapGroundTruth(map, options.gt.path, options.gt.format);
+  const Camera camera = EvaluationCamera(map, options.camera);
+
+  // 4. Every link.
+  EvalPipelineResult result;
+  MapEvaluation& evaluation = result.evaluation;
+  evaluation = EvaluateMap(map, truth, camera, options.evaluation);
+  evaluation.map_path = options.map;
+  if (evaluation.summary.links > 0 && evaluation.summary.evaluated_links == 0) {
+    // Ground truth of another sequence: an evaluation of nothing would replace eval.json all the same.
+    throw InputError("the ground truth '" + truth.path + "' covers none of the map's " +
+                     std::to_string(evaluation.summary.links) + " links (no pose for both key images of any)" +
+                     "; give the ground truth of the map's input '" + map.input.path + "'" +
+                     (truth.format == GroundTruthFormat::kKitti ? "" : " and check that the timestamps match"));
+  }
+  if (evaluation.summary.evaluated_links < evaluation.summary.links) {
+    spdlog::warn("the ground truth covers {} of the map's {} links; the others are left out",
+                 evaluation.summary.evaluated_links, evaluation.summary.links);
+  }
+
+  // 5. The records.
+  const std::string json = EvaluationToJson(evaluation);
+  if (options.save) {
+    result.saved_to = (fs::path(options.map) / kEvaluationFileName).string();
+    WriteFileAtomically(result.saved_to, json);
+  }
+  if (!options.json.empty()) WriteFileAtomically(options.json, json);
+  return result;
+}
+
+}  // namespace vmap

@@ -1,0 +1,110 @@
+#include "vmap/pipelines/localize_pipeline.h"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "vmap/pipelines/build_pipeline.h"
+#include "vmap/testing/localization_test_util.h"
+#include "vmap/testing/option_error.h"
+#include "vmap/testing/scoped_temp_dir.h"
+#include "vmap/testing/synthetic_scene.h"
+
+namespace vmap {
+namespace {
+namespace fs = std::filesystem;
+
+// A map of the drive's even frames, and its odd frames as the repeat run.
+struct Drive {
+  testing::ScopedTempDir tmp;
+  fs::path map = tmp.path() / "map";
+  fs::path repeat = tmp.path() / "repeat";
+
+  Drive() {
+    testing::WriteImageFolder(testing::SidewaysDrive(), tmp.path() / "teach");
+    BuildPipelineOptions build;
+    build.input = (tmp.path() / "teach").string();
+    build.output = map.string();
+    build.source.stride = 2;
+    build.map.show_progress = false;
+    RunBuildPipeline(build);
+    fs::create_directory(repeat);
+    const std::vector<int> odd = testing::DriveIndices(1, 2);
+    for (size_t i = 0; i < odd.size(); ++i) {
+      fs::copy_file(tmp.path() / "teach" / ("frame_" + std::to_string(odd[i] + 1) + ".png"),
+                    repeat / ("frame_" + std::to_string(i + 1) + ".png"));
+    }
+  }
+
+  LocalizePipelineOptions Options() const {
+    LocalizePipelineOptions options;
+    options.map = map.string();
+    options.query = repeat.string();
+    options.session.cache = false;
+    options.session.run.show_progress = false;
+    return options;
+  }
+};
+
+// The robot's loop (one image at a time through the session) localizes every frame as the whole run does.
+TEST(LocalizePipeline, TheSessionFrameByFrameEqualsTheRun) {
+  Drive drive;
+  LocalizePipelineOptions options = drive.Options();
+  options.csv = (drive.tmp.path() / "run.csv").string();
+  int seen = 0;
+  const LocalizePipelineResult run =
+      RunLocalizePipeline(options, [&](const Frame&, const LocalizationResult&) { ++seen; });
+  ASSERT_GT(run.run.frames.size(), 10u);
+  EXPECT_EQ(seen, static_cast<int>(run.run.frames.size()));
+  EXPECT_TRUE(fs::is_regular_file(options.csv));
+  EXPECT_GE(run.map.key_images.size(), 2u);
+
+  LocalizePipelineOptions session_options = drive.Options();
+  session_options.query.clear();
+  LocalizationSession session(session_options);
+  EXPECT_EQ(session.query(), nullptr);
+  for (size_t i = 0; i < run.run.frames.size(); ++i) {
+    const cv::Mat gray =
+        cv::imread((drive.repeat / ("frame_" + std::to_string(i + 1) + ".png")).string(), cv::IMREAD_GRAYSCALE);
+    const LocalizationResult result = session.Localize(gray);
+    const LocalizationResult& expected = run.run.frames[i];
+    EXPECT_EQ(result.status, expected.status) << i;
+    EXPECT_EQ(result.key, expected.key) << i;
+    EXPECT_EQ(result.next_key, expected.next_key) << i;
+    EXPECT_EQ(result.to_key.num_verified, expected.to_key.num_verified) << i;
+  }
+}
+
+// Options a user gives that the acceptance rule does not read are refused, by field.
+TEST(LocalizePipeline, GivenOptionsTheAcceptanceRuleIgnoresAreRefused) {
+  LocalizationSessionOptions options;
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.CheckGiven({"min_verified"}); }), "min_verified");
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.CheckGiven({"first", "min_similarity"}); }), "min_similarity");
+  options.CheckGiven({"min_link_share", "max_log10_nfa"});
+  options.localizer.acceptance = AcceptanceRule::kCounts;
+  options.CheckGiven({"min_verified", "min_similarity"});
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.CheckGiven({"min_link_share"}); }), "min_link_share");
+}
+
+// An output that would overwrite the map is refused by its field before the map is read.
+TEST(LocalizePipeline, OutputsAreCheckedFirstAndNamedByField) {
+  Drive drive;
+  LocalizePipelineOptions options = drive.Options();
+  options.csv = (drive.map / "map.json").string();
+  EXPECT_EQ(testing::OptionErrorPath([&] { RunLocalizePipeline(options); }), "csv");
+  options.csv = (drive.tmp.path() / "same.txt").string();
+  options.json = options.csv;
+  EXPECT_EQ(testing::OptionErrorPath([&] { RunLocalizePipeline(options); }), "json");
+  options = drive.Options();
+  options.session.from = -3;
+  EXPECT_EQ(testing::OptionErrorPath([&] { RunLocalizePipeline(options); }), "from");
+  options = drive.Options();
+  options.query.clear();
+  EXPECT_EQ(testing::OptionErrorPath([&] { RunLocalizePipeline(options); }), "query");
+}
+
+}  // namespace
+}  // namespace vmap

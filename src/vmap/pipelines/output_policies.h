@@ -1,0 +1,31 @@
+#pragma once
+// What the pipelines may write, and over what: the folders they replace (a map, a sweep) and the inputs their
+// single-file outputs (--csv, --json) must never overwrite (core/output_file.h's rule).
+
+#include <string>
+#include <vector>
+
+#include "vmap/core/atomic_output.h"
+#include "vmap/core/output_file.h"
+
+namespace vmap {
+
+// What a map's folder may replace: an empty folder or a map (a sweep) that vmap wrote, never one that is,
+// holds or lies inside the input.
+OutputPolicy MapOutputPolicy(const std::string& input);
+OutputPolicy SweepOutputPolicy(const std::string& input);
+
+// Every file of the map at `map_directory`, whether it exists yet or not: map.json, correspondences.bin,
+// keys/, the key-image cache, eval.json, report.html and report/. Another name inside the map folder (an
+// output written there by an earlier run) is not the map's, and may be written.
+std::vector<OutputInput> MapInputs(const std::string& map_directory);
+
+// A file or folder a pipeline reads, described by `what` for messages ("the query"); none when `path` is
+// empty.
+std::vector<OutputInput> NamedInput(const std::string& path, const std::string& what);
+
+// CheckOutputFiles over the inputs put together. A pipeline names each output by its options field ({path,
+// "csv"}): the refusal is an OptionError of that field, named by each front end as it names the field.
+void CheckOutputs(const std::vector<OutputFile>& outputs, const std::vector<std::vector<OutputInput>>& inputs);
+
+}  // namespace vmap

@@ -1,0 +1,42 @@
+#include "vmap/pipelines/report_pipeline.h"
+
+#include "vmap/report/localization_report.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+
+void ReportPipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit(OptionField{"target", "map", "Map directory written by `vmap build`, or a `vmap localize --json` file"}
+                    .Positional(),
+                target);
+  visitor.Visit(OptionField{"output", "-o,--output",
+                            "Localization runs: directory for report.html (default: <run file name>_report beside it)"}
+                    .HideDefault()
+                    .NotRecorded(),
+                output);
+  visitor.VisitNested("", map_report);
+}
+
+void ReportPipelineOptions::Check() const { map_report.Check(); }
+
+fs::path RunReportPipeline(const ReportPipelineOptions& options) {
+  // 1. The options.
+  options.Check();
+
+  // 2. A map or a run.
+  const fs::path target(options.target);
+  std::error_code ec;
+  const bool is_run = fs::exists(target, ec) && !fs::is_directory(target, ec);
+
+  // 3. The report.
+  if (is_run) {
+    const fs::path output =
+        options.output.empty() ? target.parent_path() / (target.stem().string() + "_report") : fs::path(options.output);
+    WriteLocalizationReport(target, output);
+    return output / kReportFileName;
+  }
+  WriteMapReport(target, options.map_report);
+  return target / kReportFileName;
+}
+
+}  // namespace vmap
