@@ -14,23 +14,27 @@
 namespace vmap {
 
 void EvaluationOptions::Check() const {
+  const EvaluationOptions defaults;  // the defaults the messages give, as declared
   if (!(max_rotation_error_deg > 0 && max_rotation_error_deg <= 180)) {
-    throw OptionError("max_rotation_error_deg",
-                      fmt::format("{} deg is outside (0, 180]; the default is 5", max_rotation_error_deg));
+    throw OptionError("max_rotation_error_deg", fmt::format("{} deg is outside (0, 180]; the default is {}",
+                                                            max_rotation_error_deg, defaults.max_rotation_error_deg));
   }
   if (!(max_translation_error_deg > 0 && max_translation_error_deg <= 180)) {
     throw OptionError("max_translation_error_deg",
-                      fmt::format("{} deg is outside (0, 180]; the default is 20", max_translation_error_deg));
+                      fmt::format("{} deg is outside (0, 180]; the default is {}", max_translation_error_deg,
+                                  defaults.max_translation_error_deg));
   }
   if (!(min_parallax_px >= 0 && std::isfinite(min_parallax_px))) {
-    throw OptionError("min_parallax_px", fmt::format("{} px must be >= 0; the default is 10", min_parallax_px));
+    throw OptionError("min_parallax_px",
+                      fmt::format("{} px must be >= 0; the default is {}", min_parallax_px, defaults.min_parallax_px));
   }
   if (!(sampson_threshold_px > 0 && std::isfinite(sampson_threshold_px))) {
-    throw OptionError("sampson_threshold_px", fmt::format("{} px must be > 0; the default is 2", sampson_threshold_px));
+    throw OptionError("sampson_threshold_px", fmt::format("{} px must be > 0; the default is {}", sampson_threshold_px,
+                                                          defaults.sampson_threshold_px));
   }
   if (!(max_time_difference >= 0 && std::isfinite(max_time_difference))) {
-    throw OptionError("max_time_difference",
-                      fmt::format("{} s must be >= 0; the default is 0.02", max_time_difference));
+    throw OptionError("max_time_difference", fmt::format("{} s must be >= 0; the default is {}", max_time_difference,
+                                                         defaults.max_time_difference));
   }
 }
 

@@ -6,6 +6,8 @@
 #include <cstring>
 #include <limits>
 
+#include <fmt/format.h>
+
 #if defined(__x86_64__)
 #include <immintrin.h>
 #endif
@@ -29,18 +31,20 @@ void OrbMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
 }
 
 void OrbMatcherOptions::Check() const {
+  const OrbMatcherOptions defaults;  // the defaults the messages give, as declared
   if (num_features < 1 || num_features > 100000) {
-    throw OptionError("num_features", "must be 1 to 100000 (default 500)");
+    throw OptionError("num_features", fmt::format("must be 1 to 100000 (default {})", defaults.num_features));
   }
   if (!(scale_factor > 1.0 && scale_factor <= 4.0)) {
-    throw OptionError("scale_factor", "must be in (1, 4] (default 1.2)");
+    throw OptionError("scale_factor", fmt::format("must be in (1, 4] (default {})", defaults.scale_factor));
   }
-  if (num_levels < 1 || num_levels > 32) throw OptionError("num_levels", "must be 1 to 32 (default 8)");
+  if (num_levels < 1 || num_levels > 32)
+    throw OptionError("num_levels", fmt::format("must be 1 to 32 (default {})", defaults.num_levels));
   if (edge_threshold < 0 || edge_threshold > 1000) {
-    throw OptionError("edge_threshold", "must be 0 to 1000 pixels (default 31)");
+    throw OptionError("edge_threshold", fmt::format("must be 0 to 1000 pixels (default {})", defaults.edge_threshold));
   }
   if (fast_threshold < 1 || fast_threshold > 255) {
-    throw OptionError("fast_threshold", "must be 1 to 255 (default 20)");
+    throw OptionError("fast_threshold", fmt::format("must be 1 to 255 (default {})", defaults.fast_threshold));
   }
   if (!(ratio >= 0.0 && ratio <= 1.0)) throw OptionError("ratio", "must be in [0, 1] (0 disables the ratio test)");
 }

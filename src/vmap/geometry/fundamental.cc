@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/calib3d.hpp>
 
@@ -19,21 +20,27 @@ VerifierMethod ParseVerifierMethod(const std::string& name) {
 std::string VerifierMethodName(VerifierMethod method) { return EnumToName(kVerifierMethodNames, method); }
 
 void VerifierOptions::Check() const {
+  const VerifierOptions defaults;  // the defaults the messages give, as declared
   if (!(threshold > 0.0 && threshold <= 100.0)) {
-    throw OptionError("threshold", "(verifier, pixels) must be in (0, 100] (default 0.5)");
+    throw OptionError("threshold",
+                      fmt::format("(verifier, pixels) must be in (0, 100] (default {})", defaults.threshold));
   }
-  if (!(confidence > 0.0 && confidence < 1.0)) throw OptionError("confidence", "must be in (0, 1) (default 0.999)");
+  if (!(confidence > 0.0 && confidence < 1.0))
+    throw OptionError("confidence", fmt::format("must be in (0, 1) (default {})", defaults.confidence));
   if (max_iterations < 1 || max_iterations > 10000000) {
-    throw OptionError("max_iterations", "must be 1 to 10000000 (default 100000)");
+    throw OptionError("max_iterations", fmt::format("must be 1 to 10000000 (default {})", defaults.max_iterations));
   }
-  if (seed < 0) throw OptionError("seed", "must be >= 0 (default 0)");
+  if (seed < 0) throw OptionError("seed", fmt::format("must be >= 0 (default {})", defaults.seed));
   if (min_matches < 8) throw OptionError("min_matches", "must be >= 8: the 8-point algorithm needs 8 matches");
   if (loop_points < 0 || (loop_points > 0 && loop_points < 16) || loop_points > 1000000) {
-    throw OptionError("loop_points", "must be 0 (every match) or 16 to 1000000 (default 0)");
+    throw OptionError("loop_points",
+                      fmt::format("must be 0 (every match) or 16 to 1000000 (default {})", defaults.loop_points));
   }
   if (max_samples_to_reject < 1 || max_samples_to_reject > 10000000) {
     throw OptionError("max_samples_to_reject",
-                      "must be 1 to 10000000 (default 10000; max_iterations or more keeps the confidence criterion)");
+                      fmt::format("must be 1 to 10000000 (default {}; max_iterations or more keeps the confidence "
+                                  "criterion)",
+                                  defaults.max_samples_to_reject));
   }
 }
 

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numeric>
 
+#include <fmt/format.h>
+
 #include "vmap/core/error.h"
 #include "vmap/core/numeric.h"
 
@@ -25,15 +27,19 @@ void HeadingOptions::VisitFields(OptionFieldVisitor& visitor) {
 }
 
 void HeadingOptions::Check() const {
+  const HeadingOptions defaults;  // the defaults the messages give, as declared
   if (!(window_px > 0.0 && window_px <= 10000.0)) {
-    throw OptionError("window_px", "must be in (0, 10000] pixels (default 20)");
+    throw OptionError("window_px", fmt::format("must be in (0, 10000] pixels (default {})", defaults.window_px));
   }
   if (!(window_dy_px >= 0.0 && window_dy_px <= 10000.0)) {
-    throw OptionError("window_dy_px", "must be 0 to 10000 pixels (0 = by x alone; default 40)");
+    throw OptionError("window_dy_px",
+                      fmt::format("must be 0 to 10000 pixels (0 = by x alone; default {})", defaults.window_dy_px));
   }
-  if (min_votes < 1 || min_votes > 100000) throw OptionError("min_votes", "must be 1 to 100000 (default 3)");
+  if (min_votes < 1 || min_votes > 100000)
+    throw OptionError("min_votes", fmt::format("must be 1 to 100000 (default {})", defaults.min_votes));
   if (min_verified < 0 || min_verified > 100000) {
-    throw OptionError("min_verified", "must be 0 to 100000 (0 = always the mode; default 50)");
+    throw OptionError("min_verified",
+                      fmt::format("must be 0 to 100000 (0 = always the mode; default {})", defaults.min_verified));
   }
 }
 

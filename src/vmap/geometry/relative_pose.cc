@@ -20,13 +20,16 @@ PoseMethod ParsePoseMethod(const std::string& name) { return ParseEnum(kPoseMeth
 std::string PoseMethodName(PoseMethod method) { return EnumToName(kPoseMethodNames, method); }
 
 void PoseOptions::Check() const {
+  const PoseOptions defaults;  // the defaults the messages give, as declared
   if (!(threshold > 0.0 && threshold <= 100.0)) {
-    throw OptionError("threshold", fmt::format("{} px is outside (0, 100]; the default is 1", threshold));
+    throw OptionError("threshold",
+                      fmt::format("{} px is outside (0, 100]; the default is {}", threshold, defaults.threshold));
   }
   if (!(confidence > 0.0 && confidence < 1.0)) throw OptionError("confidence", "must be in (0, 1)");
   if (max_iterations < 1) throw OptionError("max_iterations", "must be >= 1");
   if (!(refine_inlier_factor >= 1.0)) throw OptionError("refine_inlier_factor", "must be >= 1");
-  if (starts < 0 || starts > 100) throw OptionError("starts", "must be in [0, 100] (default 3)");
+  if (starts < 0 || starts > 100)
+    throw OptionError("starts", fmt::format("must be in [0, 100] (default {})", defaults.starts));
   if (min_matches < 5) throw OptionError("min_matches", "must be >= 5: the five-point solver needs 5 matches");
 }
 

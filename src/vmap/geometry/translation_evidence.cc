@@ -10,18 +10,22 @@
 namespace vmap {
 
 void TranslationOptions::Check() const {
+  const TranslationOptions defaults;  // the defaults the messages give, as declared
   if (!(max_sigma_deg > 0.0 && max_sigma_deg <= 180.0)) {
-    throw OptionError("max_sigma_deg", fmt::format("{} deg is outside (0, 180]; the default is 3", max_sigma_deg));
+    throw OptionError("max_sigma_deg", fmt::format("{} deg is outside (0, 180]; the default is {}", max_sigma_deg,
+                                                   defaults.max_sigma_deg));
   }
   if (!(min_parallax_px >= 0.0 && std::isfinite(min_parallax_px))) {
-    throw OptionError("min_parallax_px", fmt::format("{} px must be >= 0; the default is 3", min_parallax_px));
+    throw OptionError("min_parallax_px",
+                      fmt::format("{} px must be >= 0; the default is {}", min_parallax_px, defaults.min_parallax_px));
   }
   if (!(rival_angle_deg >= 0.0 && rival_angle_deg < 180.0)) {
-    throw OptionError("rival_angle_deg", fmt::format("{} deg is outside [0, 180); the default is 15", rival_angle_deg));
+    throw OptionError("rival_angle_deg", fmt::format("{} deg is outside [0, 180); the default is {}", rival_angle_deg,
+                                                     defaults.rival_angle_deg));
   }
   if (!(min_rival_cost_gap >= 0.0 && std::isfinite(min_rival_cost_gap))) {
-    throw OptionError("min_rival_cost_gap",
-                      fmt::format("{} must be >= 0 (0: never ambiguous); the default is 8", min_rival_cost_gap));
+    throw OptionError("min_rival_cost_gap", fmt::format("{} must be >= 0 (0: never ambiguous); the default is {}",
+                                                        min_rival_cost_gap, defaults.min_rival_cost_gap));
   }
 }
 

@@ -26,18 +26,21 @@ void RankingOptions::VisitFields(OptionFieldVisitor& visitor) {
 }
 
 void RankingOptions::Check() const {
+  const RankingOptions defaults;  // the defaults the messages give, as declared
   if (!(max_hamming_fraction > 0.0 && max_hamming_fraction <= 0.5)) {
-    throw OptionError("max_hamming_fraction",
-                      fmt::format("{} is outside (0, 0.5] (default 0.25)", max_hamming_fraction));
+    throw OptionError("max_hamming_fraction", fmt::format("{} is outside (0, 0.5] (default {})", max_hamming_fraction,
+                                                          defaults.max_hamming_fraction));
   }
   if (!(min_cosine > -1.0 && min_cosine < 1.0)) {
-    throw OptionError("min_cosine", fmt::format("{} is outside (-1, 1) (default 0.8)", min_cosine));
+    throw OptionError("min_cosine", fmt::format("{} is outside (-1, 1) (default {})", min_cosine, defaults.min_cosine));
   }
   if (max_descriptors_per_key < 0 || max_descriptors_per_key > 100000) {
-    throw OptionError("max_descriptors_per_key", "must be 0 (all) to 100000 (default 250)");
+    throw OptionError("max_descriptors_per_key",
+                      fmt::format("must be 0 (all) to 100000 (default {})", defaults.max_descriptors_per_key));
   }
   if (thumbnail_width < 8 || thumbnail_width > 512) {
-    throw OptionError("thumbnail_width", fmt::format("{} is outside [8, 512] (default 48)", thumbnail_width));
+    throw OptionError("thumbnail_width",
+                      fmt::format("{} is outside [8, 512] (default {})", thumbnail_width, defaults.thumbnail_width));
   }
 }
 

@@ -191,8 +191,10 @@ void KeyImageStoreOptions::VisitFields(OptionFieldVisitor& visitor) {
 }
 
 void KeyImageStoreOptions::Check() const {
+  const KeyImageStoreOptions defaults;  // the defaults the messages give, as declared
   if (thumbnail_width < 8 || thumbnail_width > 512) {
-    throw OptionError("thumbnail_width", fmt::format("{} is outside [8, 512] (default 48)", thumbnail_width));
+    throw OptionError("thumbnail_width",
+                      fmt::format("{} is outside [8, 512] (default {})", thumbnail_width, defaults.thumbnail_width));
   }
   if (extraction_threads < 0 || extraction_threads > 256) {
     throw OptionError("extraction_threads", "must be 0 to 256 (0 = one per core)");

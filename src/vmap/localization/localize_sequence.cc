@@ -7,6 +7,8 @@
 #include <optional>
 #include <thread>
 
+#include <fmt/format.h>
+
 #include "vmap/core/error.h"
 #include "vmap/core/ordered_pipeline.h"
 #include "vmap/core/progress.h"
@@ -29,11 +31,12 @@ void LocalizeSequenceOptions::VisitFields(OptionFieldVisitor& visitor) {
 }
 
 void LocalizeSequenceOptions::Check() const {
+  const LocalizeSequenceOptions defaults;  // the defaults the messages give, as declared
   if (extraction_threads < 0 || extraction_threads > 256) {
     throw OptionError("extraction_threads", "must be 0 to 256 (0 = one per core)");
   }
   if (prefetch_frames < 1 || prefetch_frames > 1024) {
-    throw OptionError("prefetch_frames", "must be 1 to 1024 (default 4)");
+    throw OptionError("prefetch_frames", fmt::format("must be 1 to 1024 (default {})", defaults.prefetch_frames));
   }
 }
 

@@ -86,45 +86,49 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
 }
 
 void LocalizerOptions::Check() const {
+  const LocalizerOptions defaults;  // the defaults the messages give, as declared
   if (min_verified < 8 || min_verified > 100000) {
     throw OptionError("min_verified", fmt::format("{} must be 8 (the fewest matches F can be verified with) to "
-                                                  "100000 (default 20)",
-                                                  min_verified));
+                                                  "100000 (default {})",
+                                                  min_verified, defaults.min_verified));
   }
   if (!(min_similarity >= 0.0 && min_similarity <= 1.0)) {
-    throw OptionError("min_similarity", fmt::format("{} is outside [0, 1] (default 0.3)", min_similarity));
+    throw OptionError("min_similarity",
+                      fmt::format("{} is outside [0, 1] (default {})", min_similarity, defaults.min_similarity));
   }
   if (!(max_log10_nfa >= -1000.0 && max_log10_nfa <= 1000.0)) {
-    throw OptionError("max_log10_nfa", fmt::format("{} is outside [-1000, 1000] (default 0: accept what chance "
-                                                   "explains less than once)",
-                                                   max_log10_nfa));
+    throw OptionError("max_log10_nfa", fmt::format("{} is outside [-1000, 1000] (default {}; 0: accept what "
+                                                   "chance explains less than once)",
+                                                   max_log10_nfa, defaults.max_log10_nfa));
   }
   if (!(recheck_link_share >= 0.0 && recheck_link_share <= 10.0)) {
-    throw OptionError(
-        "recheck_link_share",
-        fmt::format("{} is outside [0, 10] (default 0.5; 0: never relocalize a tracked frame)", recheck_link_share));
+    throw OptionError("recheck_link_share",
+                      fmt::format("{} is outside [0, 10] (default {}; 0: never relocalize a tracked frame)",
+                                  recheck_link_share, defaults.recheck_link_share));
   }
   if (!(min_link_share >= 0.0 && min_link_share <= 10.0)) {
-    throw OptionError("min_link_share",
-                      fmt::format("{} is outside [0, 10] (default 0.4; 0: chance alone decides)", min_link_share));
+    throw OptionError("min_link_share", fmt::format("{} is outside [0, 10] (default {}; 0: chance alone decides)",
+                                                    min_link_share, defaults.min_link_share));
   }
   if (lookahead < 1 || lookahead > 2) {
-    throw OptionError("lookahead", fmt::format("{} is not 1 or 2 (default 2)", lookahead));
+    throw OptionError("lookahead", fmt::format("{} is not 1 or 2 (default {})", lookahead, defaults.lookahead));
   }
   if (max_lost_frames < 0 || max_lost_frames > 1000000) {
-    throw OptionError("max_lost_frames", fmt::format("{} must be 0 to 1000000 (default 5)", max_lost_frames));
+    throw OptionError("max_lost_frames",
+                      fmt::format("{} must be 0 to 1000000 (default {})", max_lost_frames, defaults.max_lost_frames));
   }
   if (relocalization_candidates < 1 || relocalization_candidates > 10000) {
     throw OptionError("relocalization_candidates",
-                      fmt::format("{} must be 1 to 10000 (default 5)", relocalization_candidates));
+                      fmt::format("{} must be 1 to 10000 (default {})", relocalization_candidates,
+                                  defaults.relocalization_candidates));
   }
   CheckField("ranking", ranking);
   CheckField("verifier", verifier);
   CheckField("heading", heading);
   CheckField("translation", translation);
   if (experience_candidates < 0 || experience_candidates > 1000) {
-    throw OptionError("experience_candidates",
-                      fmt::format("{} must be 0 (teach key images only) to 1000 (default 2)", experience_candidates));
+    throw OptionError("experience_candidates", fmt::format("{} must be 0 (teach key images only) to 1000 (default {})",
+                                                           experience_candidates, defaults.experience_candidates));
   }
 }
 

@@ -16,10 +16,11 @@ void RouteOptions::VisitFields(OptionFieldVisitor& visitor) {
 }
 
 void RouteOptions::Check() const {
+  const RouteOptions defaults;  // the defaults the messages give, as declared
   if (min_backward_verified < 8 || min_backward_verified > 100000) {
     throw OptionError("min_backward_verified",
-                      fmt::format("{} must be 8 (the fewest matches F can be verified with) to 100000 (default 20)",
-                                  min_backward_verified));
+                      fmt::format("{} must be 8 (the fewest matches F can be verified with) to 100000 (default {})",
+                                  min_backward_verified, defaults.min_backward_verified));
   }
 }
 

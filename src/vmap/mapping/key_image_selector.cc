@@ -20,13 +20,14 @@ SimilarityMode ParseSimilarityMode(const std::string& name) {
 std::string SimilarityModeName(SimilarityMode mode) { return EnumToName(kSimilarityModeNames, mode); }
 
 void KeyImageOptions::Check() const {
+  const KeyImageOptions defaults;  // the defaults the messages give, as declared
   if (!(tau > 0.0 && tau <= 1.0)) {
     throw OptionError("tau", fmt::format("{} is outside (0, 1]; the paper uses 0.1 to 0.9", tau));
   }
   if (!(min_key_displacement >= 0.0 && min_key_displacement <= 100.0)) {
-    throw OptionError(
-        "min_key_displacement",
-        fmt::format("{} px is outside [0, 100]; the default is 1, 0 turns the check off", min_key_displacement));
+    throw OptionError("min_key_displacement",
+                      fmt::format("{} px is outside [0, 100]; the default is {}, 0 turns the check off",
+                                  min_key_displacement, defaults.min_key_displacement));
   }
 }
 

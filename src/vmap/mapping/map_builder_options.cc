@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <thread>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/error.h"
@@ -19,6 +20,7 @@ KeySearch ResolveKeySearch(const MapBuilderOptions& options) {
 }
 
 void MapBuilderOptions::Check() const {
+  const MapBuilderOptions defaults;  // the defaults the messages give, as declared
   CheckField("key_images", key_images);
   CheckField("verifier", verifier);
   CheckField("link_analysis", link_analysis);
@@ -32,7 +34,7 @@ void MapBuilderOptions::Check() const {
                       {"key_search"});
   }
   if (search_window < 2 || search_window > 4096) {
-    throw OptionError("search_window", "must be 2 to 4096 frames (default 32)");
+    throw OptionError("search_window", fmt::format("must be 2 to 4096 frames (default {})", defaults.search_window));
   }
 }
 

@@ -3,6 +3,7 @@
 #include <optional>
 #include <sstream>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/atomic_output.h"
@@ -72,19 +73,24 @@ void MapReportOptions::VisitFields(OptionFieldVisitor& visitor) {
 }
 
 void MapReportOptions::Check() const {
+  const MapReportOptions defaults;  // the defaults the messages give, as declared
   if (thumbnail_width < 32 || thumbnail_width > 4096) {
-    throw OptionError("thumbnail_width",
-                      "is " + std::to_string(thumbnail_width) + "; use 32 to 4096 pixels (default 320)");
+    throw OptionError("thumbnail_width", fmt::format("is {}; use 32 to 4096 pixels (default {})", thumbnail_width,
+                                                     defaults.thumbnail_width));
   }
   if (figure_width < 64 || figure_width > 8192) {
-    throw OptionError("figure_width", "is " + std::to_string(figure_width) + "; use 64 to 8192 pixels (default 960)");
+    throw OptionError("figure_width",
+                      fmt::format("is {}; use 64 to 8192 pixels (default {})", figure_width, defaults.figure_width));
   }
   if (jpeg_quality < 1 || jpeg_quality > 100) {
-    throw OptionError("jpeg_quality", "is " + std::to_string(jpeg_quality) + "; use 1 to 100 (default 85)");
+    throw OptionError("jpeg_quality",
+                      fmt::format("is {}; use 1 to 100 (default {})", jpeg_quality, defaults.jpeg_quality));
   }
   if (!(route_fps > 0.0 && route_fps <= 120.0)) {
-    throw OptionError("route_fps", "is " + FormatExact(route_fps) +
-                                       "; use more than 0 and at most 120 key images per second (default 3)");
+    throw OptionError(
+        "route_fps",
+        "is " + FormatExact(route_fps) +
+            fmt::format("; use more than 0 and at most 120 key images per second (default {})", defaults.route_fps));
   }
 }
 

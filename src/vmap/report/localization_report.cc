@@ -214,14 +214,17 @@ void LocalizationReportOptions::VisitFields(OptionFieldVisitor& visitor) {
 }
 
 void LocalizationReportOptions::Check() const {
+  const LocalizationReportOptions defaults;  // the defaults the messages give, as declared
   if (pairs < 0 || pairs > 200) {
-    throw OptionError("pairs", fmt::format("is {}; use 0 to 200 (default 8)", pairs));
+    throw OptionError("pairs", fmt::format("is {}; use 0 to 200 (default {})", pairs, defaults.pairs));
   }
   if (pair_width < 64 || pair_width > 8192) {
-    throw OptionError("pair_width", fmt::format("is {}; use 64 to 8192 pixels (default 960)", pair_width));
+    throw OptionError("pair_width",
+                      fmt::format("is {}; use 64 to 8192 pixels (default {})", pair_width, defaults.pair_width));
   }
   if (jpeg_quality < 1 || jpeg_quality > 100) {
-    throw OptionError("jpeg_quality", fmt::format("is {}; use 1 to 100 (default 85)", jpeg_quality));
+    throw OptionError("jpeg_quality",
+                      fmt::format("is {}; use 1 to 100 (default {})", jpeg_quality, defaults.jpeg_quality));
   }
 }
 

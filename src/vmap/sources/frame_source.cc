@@ -4,6 +4,7 @@
 #include <cctype>
 #include <filesystem>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -22,6 +23,7 @@ SourceFormat ParseSourceFormat(const std::string& name) { return ParseEnum(kSour
 std::string SourceFormatName(SourceFormat format) { return EnumToName(kSourceFormatNames, format); }
 
 void FrameSourceOptions::Check() const {
+  const FrameSourceOptions defaults;  // the defaults the messages give, as declared
   if (first < 0) throw OptionError("first", "must be >= 0 (got " + std::to_string(first) + ")");
   if (last < -1) {
     throw OptionError("last", std::to_string(last) +
@@ -37,7 +39,8 @@ void FrameSourceOptions::Check() const {
   }
   if (!resize.empty()) internal::TargetSize(cv::Size(640, 480), *this);  // validates the text
   if (!(stream_timeout_seconds > 0.0 && stream_timeout_seconds <= 3600.0)) {
-    throw OptionError("stream_timeout_seconds", "must be more than 0 and at most 3600 seconds (default 10)");
+    throw OptionError("stream_timeout_seconds", fmt::format("must be more than 0 and at most 3600 seconds (default {})",
+                                                            defaults.stream_timeout_seconds));
   }
 }
 

@@ -1,10 +1,13 @@
 #include "vmap/neural/aliked/aliked_options.h"
 
+#include <fmt/format.h>
+
 #include "vmap/core/error.h"
 
 namespace vmap {
 
 void AlikedMatcherOptions::Check() const {
+  const AlikedMatcherOptions defaults;  // the defaults the messages give, as declared
   if (model != "t16" && model != "n16") {
     throw OptionError("model", "'" + model + "' is not an ALIKED model; use t16 or n16");
   }
@@ -12,21 +15,27 @@ void AlikedMatcherOptions::Check() const {
     throw OptionError("device", "'" + device + "' is not a device; use cpu or cuda");
   }
   if (top_k < 0) {
-    throw OptionError("top_k", "must be >= 0 (0 = threshold mode with score_threshold; default 1000)",
+    throw OptionError("top_k",
+                      fmt::format("must be >= 0 (0 = threshold mode with score_threshold; default {})", defaults.top_k),
                       {"score_threshold"});
   }
   if (top_k == 0 && !(score_threshold >= 0.0 && score_threshold < 1.0)) {
-    throw OptionError("score_threshold", "must be in [0, 1) (0 = the mean score, as upstream; default 0.2)");
+    throw OptionError("score_threshold", fmt::format("must be in [0, 1) (0 = the mean score, as upstream; default {})",
+                                                     defaults.score_threshold));
   }
-  if (max_keypoints < 1) throw OptionError("max_keypoints", "must be >= 1 (default 5000)");
+  if (max_keypoints < 1)
+    throw OptionError("max_keypoints", fmt::format("must be >= 1 (default {})", defaults.max_keypoints));
   if (!(min_similarity >= -1.0 && min_similarity <= 1.0)) {
-    throw OptionError("min_similarity", "must be a cosine similarity in [-1, 1] (default 0.75)");
+    throw OptionError("min_similarity",
+                      fmt::format("must be a cosine similarity in [-1, 1] (default {})", defaults.min_similarity));
   }
   if (longest_side != 0 && longest_side < 32) {
     throw OptionError("longest_side",
                       std::to_string(longest_side) + " is too small; use 0 (native size) or at least 32");
   }
-  if (num_threads < 0) throw OptionError("threads", "must be >= 0 (0 = LibTorch's default; default 1)");
+  if (num_threads < 0)
+    throw OptionError("threads",
+                      fmt::format("must be >= 0 (0 = LibTorch's default; default {})", defaults.num_threads));
 }
 
 void AlikedMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {

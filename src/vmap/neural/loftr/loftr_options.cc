@@ -2,11 +2,14 @@
 
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include "vmap/core/error.h"
 
 namespace vmap {
 
 void LoftrMatcherOptions::Check() const {
+  const LoftrMatcherOptions defaults;  // the defaults the messages give, as declared
   if (model != "outdoor" && model != "indoor" && model != "coarse") {
     throw OptionError("model", "'" + model + "' is not a LoFTR model; use outdoor, indoor or coarse");
   }
@@ -14,7 +17,8 @@ void LoftrMatcherOptions::Check() const {
     throw OptionError("device", "'" + device + "' is not a device; use cpu or cuda");
   }
   if (longest_side < 32 || longest_side > 4096) {
-    throw OptionError("longest_side", std::to_string(longest_side) + " is outside 32 to 4096 (default 640)");
+    throw OptionError("longest_side",
+                      fmt::format("{} is outside 32 to 4096 (default {})", longest_side, defaults.longest_side));
   }
   if (num_threads < 0 || num_threads > 256) {
     throw OptionError("threads", "must be 0 to 256 (0 = LibTorch's default)");
