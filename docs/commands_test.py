@@ -11,8 +11,9 @@ laid out as the repository is (`../shared` beside the working folder), with:
   ../shared short (30 frames; 6 with a deep matcher), and live inputs (cameras, streams) become a short video;
 - `/tmp/...` inside the sandbox;
 - the commands that install, build or measure (scripts/install-deps.sh, scripts/build.sh, scripts/identity_run.sh,
-  ctest, cmake, ninja, bench/, build/bench/, the test binaries) checked, not run: the script or program must exist
-  (a build target by name), so a renamed one still fails the block;
+  ctest, cmake, ninja, bench/, build/bench/, the test binaries) and ROS 1's tools (roscore, roslaunch: its launch
+  file must exist, rosservice, rostopic) checked, not run: the script or program must exist (a build target by
+  name), so a renamed one still fails the block;
 - what needs the network (`vmap weights --download`, `--import` of an official file, LoFTR's official
   checkpoints) checked as far as it goes: the flags exist, the command asks for the missing weights;
 - the weights cache ($VMAP_WEIGHTS_DIR) inside the sandbox.
@@ -158,7 +159,7 @@ def make_fixtures(folder, vmap, shared):
     os.symlink("teach.bag", os.path.join(folder, "repeat.bag"))
 
 
-def make_sandbox(root, vmap, shared, build, fixtures):
+def make_sandbox(root, vmap, shared, build, fixtures, block):
     """root/work (the working folder, as the repository's root), root/shared, root/tmp, root/bin/vmap."""
     work = os.path.join(root, "work")
     os.makedirs(os.path.join(work, "build"))
@@ -191,6 +192,14 @@ def make_sandbox(root, vmap, shared, build, fixtures):
         with open(stub, "w") as f:
             f.write(STUB)
         os.chmod(stub, 0o755)
+    # Other files of the build the block names (build/ros/devel/setup.sh): there, empty (sourced or run, they do
+    # nothing).
+    for path in set(re.findall(r"(?<![\w/])build/([\w./-]+)", block)):
+        stub = os.path.join(work, "build", path)
+        if os.path.isfile(os.path.join(build, path)) and not os.path.exists(stub):
+            os.makedirs(os.path.dirname(stub), exist_ok=True)
+            open(stub, "w").close()
+            os.chmod(stub, 0o755)
     shutil.copytree(os.path.join(ROOT, "examples"), os.path.join(work, "examples"))
     return work
 
@@ -200,6 +209,16 @@ PREAMBLE = r'''
 set -e -o pipefail
 ctest() { :; }
 cmake() { :; }
+# ROS 1 (docs/ros.md): the node's launch files must exist; the master and its tools are not run.
+roscore() { :; }
+rosservice() { :; }
+rostopic() { :; }
+rosparam() { :; }
+rosnode() { :; }
+rosrun() { :; }
+roslaunch() {
+  [[ "$1" == vmap_ros && -f "$DOC_ROOT/ros/launch/$2" ]] || { echo "no launch file $2 in package $1" >&2; return 1; }
+}
 ninja() {
   for target in "$@"; do
     case "$target" in -*|build) continue;; esac
@@ -238,9 +257,9 @@ def main():
         make_fixtures(fixtures, vmap, shared)
         for number, (file, line, block) in enumerate(blocks(files)):
             sandbox = os.path.join(temp, f"block{number}")
-            work = make_sandbox(sandbox, vmap, shared, build, fixtures)
+            work = make_sandbox(sandbox, vmap, shared, build, fixtures, block)
             script = PREAMBLE + prepare(block, file, sandbox)
-            env = dict(os.environ, DOC_VMAP=vmap, DOC_FIXTURES=fixtures, DOC_BUILD=build,
+            env = dict(os.environ, DOC_VMAP=vmap, DOC_FIXTURES=fixtures, DOC_BUILD=build, DOC_ROOT=ROOT,
                        VMAP_WEIGHTS_DIR=os.path.join(sandbox, "weights"),
                        PATH=os.path.join(sandbox, "bin") + os.pathsep + os.environ["PATH"])
             start = time.monotonic()

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "vmap/features/matcher_registry.h"
 #include "vmap/features/orb_matcher.h"
@@ -38,7 +39,13 @@ TEST(BuildPipeline, BuildsFromAPathOrFromTheHostsFramesAlike) {
   // τ unset: the matcher's own.
   EXPECT_EQ(read.options.builder.key_images.tau, DefaultTau("orb"));
 
-  testing::MemorySource frames(testing::DriveFrames(0, 1));
+  // The folder's images decoded as its source decodes them (grey, straight from the decoder).
+  std::vector<cv::Mat> images;
+  for (int i = 1; i <= from_path.map.num_frames; ++i) {
+    images.push_back(
+        cv::imread((tmp.path() / "teach" / ("frame_" + std::to_string(i) + ".png")).string(), cv::IMREAD_GRAYSCALE));
+  }
+  testing::MemorySource frames(images);
   options.output = (tmp.path() / "from_frames").string();
   const BuildPipelineResult from_frames = RunBuildPipeline(Quiet(options), &frames);
   ASSERT_EQ(from_frames.map.key_images.size(), from_path.map.key_images.size());
