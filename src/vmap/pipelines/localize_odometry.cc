@@ -15,8 +15,9 @@ std::optional<OdometryProgress> OpenQueryOdometry(const std::string& path, const
   if (!path.empty()) return OdometryProgress(OdometryTrack(ReadOdometry(path, topic)));
   if (!IsRecording(query)) {
     if (!topic.empty()) {
-      throw OptionError("odometry_topic", "names a topic of the query recording, and '" + query +
-                                              "' is not a recording; give the odometry as a file (odometry)",
+      throw OptionError("odometry_topic",
+                        "names a topic of the query recording, and '" + query +
+                            "' is not a recording; give the odometry as a file (odometry)",
                         {"odometry"});
     }
     return std::nullopt;

@@ -178,8 +178,7 @@ LocalizePipelineResult RunLocalizePipeline(const LocalizePipelineOptions& option
   const VisualMap& map = opened.map;
 
   // 8. The odometry: with it, its columns come last on every row (CSV and JSON).
-  std::optional<OdometryProgress> odometry =
-      OpenQueryOdometry(options.odometry, options.odometry_topic, options.query);
+  std::optional<OdometryProgress> odometry = OpenQueryOdometry(options.odometry, options.odometry_topic, options.query);
   nlohmann::json odometry_json = nlohmann::json::array();
 
   // 9. Every frame.
@@ -231,8 +230,7 @@ LocalizePipelineResult RunLocalizePipeline(const LocalizePipelineOptions& option
     if (odometry) {
       nlohmann::json document = nlohmann::json::parse(json);
       document["odometry"] = std::move(odometry_json);
-      json = document.dump(1) + "
-";
+      json = document.dump(1) + "\n";
     }
     WriteFileAtomically(options.json, json);
   }
