@@ -2,9 +2,9 @@
 """Issue 34's goals, measured with `vmap simulate`: teach and repeat in the simulator, many trials per route.
 
 Runs (each a `vmap simulate` per route, straight, turn, s-curve and loop, --trials N, default 50):
-  same       photographs on walls and floor, ORB, the default law (tracker)
+  same       photographs on walls and floor, ORB, the default law (servo)
   odometry5  the same with the repeat run's odometry 5 % too long (--odometry-scale-error 0.05)
-  servo      the same appearance with the servo law
+  tracker    the same appearance with the tracker law (a pose estimate on the taught odometry path)
   bearnav    the same appearance with the Bearnav-style law (the baseline)
   seasons    teach textures of michigan session 01 (snow), repeat textures of session 09 (spring), --matcher xfeat
              (at 5 Hz: XFeat's localization takes about 100 ms a frame on this CPU)
@@ -39,12 +39,12 @@ ROUTES = ["straight", "turn", "s-curve", "loop"]
 RUNS = {
     "same": {"textures": "photos", "args": []},
     "odometry5": {"textures": "photos", "args": ["--odometry-scale-error", "0.05"]},
-    "servo": {"textures": "photos", "args": ["--law", "servo"]},
+    "tracker": {"textures": "photos", "args": ["--law", "tracker"]},
     "bearnav": {"textures": "photos", "args": ["--law", "bearnav"]},
     "seasons": {"textures": "seasons", "args": ["--matcher", "xfeat", "--rate", "5"]},
     "seasons_orb": {"textures": "seasons", "args": []},
 }
-LAWS = {"same": "tracker", "servo": "servo", "bearnav": "bearnav"}
+LAWS = {"same": "servo", "tracker": "tracker", "bearnav": "bearnav"}
 
 
 def link_photos(out):

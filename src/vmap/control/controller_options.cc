@@ -37,6 +37,9 @@ void ControllerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"line_filter_seconds", "--line-filter",
                  "Servo: seconds over which the line angle is smoothed (0 = not smoothed)"},
                 line_filter_seconds);
+  visitor.Visit({"convergence_distance", "--convergence-distance",
+                 "Tracker: distance along the path over which an offset decays (m)"},
+                convergence_distance);
   visitor.Visit({"turn_in_place_deg", "--turn-in-place", "Heading error above which the robot turns on the spot (deg)"},
                 turn_in_place_deg);
   visitor.Visit({"lost_stop_seconds", "--lost-stop", "Seconds to slow to a stop once localization is lost"},
@@ -84,6 +87,7 @@ void ControllerOptions::Check() const {
   CheckRange("line_gain", line_gain, -100.0, 0.0, "1/s", d.line_gain);
   CheckRange("pose_agreement_deg", pose_agreement_deg, 0.0, 180.0, "deg", d.pose_agreement_deg, true);
   CheckRange("line_filter_seconds", line_filter_seconds, 0.0, 60.0, "s", d.line_filter_seconds);
+  CheckRange("convergence_distance", convergence_distance, 0.05, 100.0, "m", d.convergence_distance);
   CheckRange("turn_in_place_deg", turn_in_place_deg, 0.0, 180.0, "deg", d.turn_in_place_deg, true);
   CheckRange("lost_stop_seconds", lost_stop_seconds, 0.0, 3600.0, "s", d.lost_stop_seconds);
   CheckRange("search_after_seconds", search_after_seconds, 0.0, 3600.0, "s", d.search_after_seconds);

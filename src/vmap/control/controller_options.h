@@ -16,9 +16,14 @@ namespace vmap {
 //   bearing to the key image's position and the angle of that bearing to the key image's own heading, steered
 //   to zero like a unicycle parking on a line (polar coordinates, scale-free); the Bearnav law where the
 //   translation is unknown.
-enum class ControlLaw { kBearnav, kServo };
-inline constexpr EnumName<ControlLaw> kControlLawNames[] = {{ControlLaw::kBearnav, "bearnav"},
-                                                            {ControlLaw::kServo, "servo"}};
+// kTracker: where the teach run had odometry (TaughtRoute::metric()), the robot's pose on the taught path is
+//   estimated from every frame's headings and bearings to the key images, whose poses the teach odometry gives
+//   (route_pose_estimator.h), and a path-following law steers it onto the taught path (path_tracker.h); the
+//   servo law where the route is not metric. Not the default: on the simulator's routes it is not yet as sure as
+//   the servo law (docs/drive.md has the figures).
+enum class ControlLaw { kBearnav, kServo, kTracker };
+inline constexpr EnumName<ControlLaw> kControlLawNames[] = {
+    {ControlLaw::kBearnav, "bearnav"}, {ControlLaw::kServo, "servo"}, {ControlLaw::kTracker, "tracker"}};
 ControlLaw ParseControlLaw(const std::string& name);
 std::string ControlLawName(ControlLaw law);
 
@@ -43,6 +48,8 @@ struct ControllerOptions {
   // line angle is smoothed over this many seconds (first-order filter; 0: each frame's as it is).
   double pose_agreement_deg = 5.0;
   double line_filter_seconds = 0.5;
+  // Tracker law: the distance along the path over which a lateral offset and a heading error decay (m).
+  double convergence_distance = 0.6;
   // A heading error above this turns the robot on the spot before it drives (degrees): a repeat started
   // facing away from the route does not drive off it.
   double turn_in_place_deg = 35.0;

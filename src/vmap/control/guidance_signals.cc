@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
+
+#include "vmap/core/numeric.h"
 
 namespace vmap {
 
@@ -49,9 +52,7 @@ double ApparentLogScale(const std::vector<Correspondence>& verified, int min_pai
     }
   }
   if (static_cast<int>(ratios.size()) < min_pairs) return std::numeric_limits<double>::quiet_NaN();
-  auto middle = ratios.begin() + ratios.size() / 2;
-  std::nth_element(ratios.begin(), middle, ratios.end());
-  return *middle;
+  return Median(std::move(ratios));
 }
 
 }  // namespace vmap

@@ -18,6 +18,7 @@ RouteController::RouteController(TaughtRoute route, ControllerOptions options)
     throw InputError("a route to follow needs at least two key images (MakeTaughtRoute gives one)");
   }
   focal_px_ = options_.focal_px > 0.0 ? options_.focal_px : route_.focal_px;
+  if (options_.law == ControlLaw::kTracker && route_.metric()) tracking_.emplace(route_);
   if (!(focal_px_ > 0.0)) {
     throw OptionError("focal_px",
                       "must be given (the focal length in pixels) for a map without a camera: headings in pixels "
@@ -37,6 +38,7 @@ void RouteController::Reset() {
   lost_speed_ = 0.0;
   unusable_since_.reset();
   line_angle_.reset();
+  if (tracking_) tracking_->Reset();
   swept_ = 0.0;
   search_direction_ = 1.0;
 }
@@ -66,6 +68,15 @@ double RouteController::TaughtTurnRate(int position, double speed) const {
   return 0.0;
 }
 
+double RouteController::PastTheEnd(const cv::Vec3d& pose) const {
+  const std::vector<OdometrySample>& path = route_.path;
+  const cv::Point2d end(path.back().x, path.back().y);
+  cv::Point2d direction = end - cv::Point2d(path[path.size() - 2].x, path[path.size() - 2].y);
+  if (cv::norm(direction) <= 0.0) return 0.0;
+  direction /= cv::norm(direction);
+  return (cv::Point2d(pose[0], pose[1]) - end).dot(direction);
+}
+
 double RouteController::RemainingTurn(int position, double progress) const {
   const int last = static_cast<int>(route_.segments.size()) - 1;
   if (position > last) return 0.0;  // at the goal: the target is where the robot is headed
@@ -91,17 +102,21 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
   ControlStep step;
   const double dt = last_time_ ? std::max(0.0, time - *last_time_) : 0.0;
   last_time_ = time;
-  // Metres driven since the last step, by odometry (0 without).
-  // Metres driven and radians turned since the last step: by odometry, or the last command (0 at the first step).
-  double driven = 0.0;
+  // Metres driven (signed: negative when reversing) and radians turned since the last step: by odometry, or by the
+  // last command where there is none (0 at the first step).
+  double driven = last_command_.linear * dt;
   double turned = last_command_.angular * dt;
   if (odometry != nullptr) {
+    driven = turned = 0.0;
     if (last_odometry_) {
-      driven = std::hypot(odometry->x - last_odometry_->x, odometry->y - last_odometry_->y);
+      const double dx = odometry->x - last_odometry_->x, dy = odometry->y - last_odometry_->y;
+      const double middle = last_odometry_->yaw + 0.5 * WrapAngle(odometry->yaw - last_odometry_->yaw);
+      driven = dx * std::cos(middle) + dy * std::sin(middle);
       turned = WrapAngle(odometry->yaw - last_odometry_->yaw);
     }
     last_odometry_ = *odometry;
   }
+  if (tracking_) tracking_->Predict(driven, turned);
   auto finish = [&](VelocityCommand wanted, ControllerState state) {
     step.command = Limit(wanted, dt);
     if (state == ControllerState::kReachedGoal) step.command = {};
@@ -147,6 +162,9 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
     fraction_ = std::isfinite(localization.progress) ? localization.progress : 0.0;
     last_usable_time_ = time;
     step.target_key = localization.next_key >= 0 ? localization.next_key : localization.key;
+    if (tracking_) {
+      step.observation = tracking_->Observe(localization, focal_px_);
+    }
     if (position == last) {
       step.goal_log_scale = ApparentLogScale(localization.to_key.verified);
       if (localization.to_key.accepted && std::isfinite(step.goal_log_scale) &&
@@ -160,11 +178,11 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
   if (!localized_) return finish(search({}), ControllerState::kStarting);
 
   if (!usable) {
-    // Slow to a stop along the taught turn rate; then wait for a frame to steer by. Odometry tells when the
-    // robot has driven into the next stretch, whose taught turn rate then applies.
+    // Slow to a stop along the taught turn rate; then wait for a frame to steer by. Odometry (or the commands
+    // driven) tells when the robot has driven into the next stretch, whose taught turn rate then applies.
     const double length = route_.segments[std::min(position_, last - 1)].length;
-    if (driven > 0.0 && std::isfinite(length) && length > 0.0) {
-      fraction_ += driven / length;
+    if (driven != 0.0 && std::isfinite(length) && length > 0.0) {
+      fraction_ += std::abs(driven) / length;
       while (fraction_ >= 1.0 && position_ < last) {
         fraction_ -= 1.0;
         ++position_;
@@ -175,12 +193,39 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
         options_.lost_stop_seconds > 0.0 ? std::max(0.0, 1.0 - elapsed / options_.lost_stop_seconds) : 0.0;
     const double speed = lost_speed_ * share;
     step.steering = speed != 0.0 ? "taught" : "none";
-    return finish(search({speed, speed != 0.0 ? TaughtTurnRate(position_, speed) : 0.0}), ControllerState::kLost);
+    double turn = speed != 0.0 ? TaughtTurnRate(position_, speed) : 0.0;
+    if (speed != 0.0 && tracking_ && tracking_->started()) {
+      // The estimate goes on with the robot's motion: it steers while the robot slows down.
+      const PathLocation at = tracking_->Locate();
+      step.lateral_estimate = at.lateral;
+      step.heading_error_estimate = at.heading_error;
+      turn = PathFollowingTurnRate(at, speed, options_.convergence_distance);
+      step.steering = "tracker";
+    }
+    return finish(search({speed, turn}), ControllerState::kLost);
   }
 
   const double speed = NominalSpeed(position_);
   lost_speed_ = speed;
   step.heading_offset = heading_offset;
+  search({});  // usable: the search, if any, is over
+  if (tracking_ && tracking_->started()) {
+    const PathLocation at = tracking_->Locate();
+    step.lateral_estimate = at.lateral;
+    step.heading_error_estimate = at.heading_error;
+    // The goal is the goal key image's (above); an estimate well past the end of the path stops the robot too.
+    if (at.s >= tracking_->path_length() - 1e-6 && PastTheEnd(tracking_->pose()) > 0.5) {
+      reached_goal_ = true;
+      return finish({}, ControllerState::kReachedGoal);
+    }
+    if (std::abs(at.heading_error) > options_.turn_in_place_deg * M_PI / 180.0) {
+      step.steering = "turn in place";
+      return finish({0.0, -options_.heading_gain * at.heading_error}, ControllerState::kTurning);
+    }
+    step.steering = "tracker";
+    return finish({speed, PathFollowingTurnRate(at, speed, options_.convergence_distance)},
+                  ControllerState::kFollowing);
+  }
   // The target key image lies ahead by what remains of this stretch, and the path turns by what the teach run
   // turned over it: on the taught path the heading offset is minus that turn and the line angle half of it (the
   // chord of an arc). Steering to zero them unaltered would cut every corner.
@@ -189,7 +234,9 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
   double turn = TaughtTurnRate(position_, speed) - options_.heading_gain * heading_error;
   step.steering = "bearnav";
   const bool backwards = route_.segments[std::min(position_, last - 1)].backwards;
-  if (options_.law == ControlLaw::kServo && !backwards) {
+  // The servo law, and the tracker's on a route without teach odometry.
+  const bool servo = options_.law == ControlLaw::kServo || (options_.law == ControlLaw::kTracker && !tracking_);
+  if (servo && !backwards) {
     // The line angle (beta) from the target's pose where its translation is known and its rotation agrees with the
     // heading (a pose whose rotation is off has no better a translation), each frame's capped, then smoothed.
     const TargetBearing target =
@@ -217,7 +264,6 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
       step.steering = "servo";
     }
   }
-  search({});  // usable: the search, if any, is over
   if (std::abs(heading_offset) > options_.turn_in_place_deg * M_PI / 180.0) {
     step.steering = "turn in place";
     return finish({0.0, -options_.heading_gain * heading_offset}, ControllerState::kTurning);

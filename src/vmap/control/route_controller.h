@@ -28,6 +28,7 @@
 #include <string>
 
 #include "vmap/control/controller_options.h"
+#include "vmap/control/route_tracking.h"
 #include "vmap/control/taught_route.h"
 #include "vmap/core/enum_names.h"
 #include "vmap/localization/localizer.h"
@@ -64,6 +65,11 @@ struct ControlStep {
   double bearing = std::numeric_limits<double>::quiet_NaN();
   double line_angle = std::numeric_limits<double>::quiet_NaN();
   double goal_log_scale = std::numeric_limits<double>::quiet_NaN();
+  // Tracker law: the estimated offset from the taught path (m, left positive) and heading error (rad), and the
+  // measurements the frame gave the estimate; NaN / 0 otherwise.
+  double lateral_estimate = std::numeric_limits<double>::quiet_NaN();
+  double heading_error_estimate = std::numeric_limits<double>::quiet_NaN();
+  TrackingObservation observation;
   double seconds = 0.0;  // time spent in Update
 };
 
@@ -92,6 +98,8 @@ class RouteController {
   // share of it still ahead (1 - progress); 0 at the goal or where the turn is unknown.
   double RemainingTurn(int position, double progress) const;
   VelocityCommand Limit(VelocityCommand wanted, double dt) const;
+  // How far beyond the end of the metric path `pose` is, along its last stretch (m; negative before it).
+  double PastTheEnd(const cv::Vec3d& pose) const;
 
   TaughtRoute route_;
   ControllerOptions options_;
@@ -105,6 +113,8 @@ class RouteController {
   int position_ = -1;        // route position of the key image the robot is at
   double fraction_ = 0.0;    // progress from it to the next one (the localizer's; odometry's while lost)
   double lost_speed_ = 0.0;  // the speed commanded on the last usable frame
+  // The tracker law's estimate (options.law kTracker on a metric route).
+  std::optional<RouteTracking> tracking_;
   // The search (ControllerOptions::search_after_seconds): since when no frame was usable, how far the heading
   // has swept from where the search began (radians, left positive), and which way it turns now.
   std::optional<double> unusable_since_;

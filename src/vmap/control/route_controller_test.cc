@@ -124,6 +124,38 @@ TEST(RouteController, ServoSteersToTheKeyImagesLineWhenTheTranslationIsKnown) {
   EXPECT_EQ(again.Update(0.0, result).steering, "bearnav");
 }
 
+TEST(RouteController, TrackerFollowsTheTaughtPathWhereTheRouteIsMetric) {
+  // The straight route with its teach odometry: key images 1 m apart along x, taken 2 s apart.
+  TaughtRoute route = StraightRoute();
+  for (int k = 0; k < 4; ++k) route.key_poses.push_back({10.0 + 2.0 * k, 1.0 * k, 0.0, 0.0});
+  for (int i = 0; i <= 30; ++i) route.path.push_back({10.0 + 0.2 * i, 0.1 * i, 0.0, 0.0});
+  for (TaughtSegment& segment : route.segments) segment.length = 1.0;
+  ASSERT_TRUE(route.metric());
+  ControllerOptions options = NoRateLimits();
+  options.law = ControlLaw::kTracker;
+  RouteController controller(route, options);
+  // The first frame places the estimate on the path at the localizer's progress, turned as the heading says:
+  // the robot points 10 degrees left of the path and turns right.
+  ControlStep step = controller.Update(0.0, Tracked(1, 10.0));
+  EXPECT_EQ(step.steering, "tracker");
+  EXPECT_NEAR(step.lateral_estimate, 0.0, 1e-9);
+  EXPECT_NEAR(step.heading_error_estimate, 10.0 * M_PI / 180.0, 1e-9);
+  EXPECT_LT(step.command.angular, 0.0);
+  // Half a metre driven at that heading (odometry) while the localization is lost, the estimate is left of the
+  // path by as much as the robot.
+  const double yaw = 10.0 * M_PI / 180.0;
+  const OdometrySample start{0.0, 0.0, 0.0, yaw};
+  controller.Reset();
+  controller.Update(0.0, Tracked(1, 10.0), &start);
+  const OdometrySample later{0.5, 0.5 * std::cos(yaw), 0.5 * std::sin(yaw), yaw};
+  step = controller.Update(0.5, Lost(), &later);
+  EXPECT_EQ(step.state, ControllerState::kLost);
+  EXPECT_NEAR(step.lateral_estimate, 0.5 * std::sin(yaw), 1e-3);
+  // A route without teach odometry is not metric: the tracker steers as the servo law does.
+  RouteController without(StraightRoute(), options);
+  EXPECT_EQ(without.Update(0.0, Tracked(1, 0.0)).steering, "bearnav");
+}
+
 TEST(RouteController, TurnsOnTheSpotWhenFacingFarOff) {
   RouteController controller(StraightRoute(), NoRateLimits());
   const ControlStep step = controller.Update(0.0, Tracked(0, -60.0));

@@ -88,6 +88,28 @@ TaughtRoute MakeTaughtRoute(const VisualMap& map, std::vector<int> keys,
   }
   route.keys = std::move(keys);
   if (map.input.camera) route.focal_px = map.input.camera->fx;
+  // The metric route: every key image's pose on the teach odometry, and the odometry between the first and last.
+  if (!teach_odometry.empty()) {
+    for (int key : route.keys) {
+      const double t = map.key_images[key].timestamp;
+      const std::optional<OdometrySample> pose = t >= 0.0 ? InterpolateOdometry(teach_odometry, t) : std::nullopt;
+      if (!pose) {
+        route.key_poses.clear();
+        break;
+      }
+      route.key_poses.push_back(*pose);
+    }
+  }
+  if (route.key_poses.size() == route.keys.size() && route.keys.size() >= 2) {
+    const double t0 = route.key_poses.front().timestamp, t1 = route.key_poses.back().timestamp;
+    const double first = std::min(t0, t1), last = std::max(t0, t1);
+    route.path.push_back(*InterpolateOdometry(teach_odometry, first));
+    for (const OdometrySample& sample : teach_odometry) {
+      if (sample.timestamp > first && sample.timestamp < last) route.path.push_back(sample);
+    }
+    route.path.push_back(*InterpolateOdometry(teach_odometry, last));
+    if (t1 < t0) std::reverse(route.path.begin(), route.path.end());
+  }
   return route;
 }
 

@@ -35,7 +35,13 @@ struct TaughtRoute {
   std::vector<TaughtSegment> segments;  // keys.size() - 1
   // The map camera's focal length in pixels (fx): turns pixel headings into angles; NaN without a camera.
   double focal_px = std::numeric_limits<double>::quiet_NaN();
+  // With teach odometry covering the route: each route key image's pose in the teach odometry's frame, and the
+  // path the teach run drove from the first to the last, in the route's order (a route driven backwards lists
+  // it backwards; yaw stays the teach run's heading). Empty without: the route is then known only up to scale.
+  std::vector<OdometrySample> key_poses;
+  std::vector<OdometrySample> path;
 
+  bool metric() const { return !path.empty() && key_poses.size() == keys.size(); }
   int goal() const { return keys.empty() ? -1 : keys.back(); }
   // The route position of key image `key` (its index in `keys`), -1 when it is not on the route.
   int PositionOf(int key) const;

@@ -78,6 +78,22 @@ TEST(TaughtRoute, OdometryGivesLengthsTurnsAndSpeeds) {
     EXPECT_NEAR(segment.yaw_change, 0.5, 1e-9);
     EXPECT_NEAR(segment.speed(), 0.5, 1e-3);
   }
+  // Metric: each key image's pose on the odometry, and the path driven from the first to the last.
+  ASSERT_TRUE(route.metric());
+  ASSERT_EQ(route.key_poses.size(), 4u);
+  EXPECT_NEAR(route.key_poses[2].yaw, 1.0, 1e-9);
+  EXPECT_NEAR(route.key_poses[2].x, 2.0 * std::sin(1.0), 1e-9);
+  EXPECT_DOUBLE_EQ(route.path.front().timestamp, 10.0);
+  EXPECT_DOUBLE_EQ(route.path.back().timestamp, 16.0);
+  // Backwards, the path is listed in the order driven.
+  const TaughtRoute back = MakeTaughtRoute(TurningMap(), {3, 2, 1}, odometry);
+  ASSERT_TRUE(back.metric());
+  EXPECT_DOUBLE_EQ(back.path.front().timestamp, 16.0);
+  EXPECT_DOUBLE_EQ(back.path.back().timestamp, 12.0);
+  // Without odometry, or with odometry that does not cover the route, it is not.
+  EXPECT_FALSE(MakeTaughtRoute(TurningMap()).metric());
+  odometry.resize(30);  // up to t = 12.9
+  EXPECT_FALSE(MakeTaughtRoute(TurningMap(), {}, odometry).metric());
 }
 
 TEST(TaughtRoute, KeyImagesNoLinkJoinsAreRefused) {

@@ -3,7 +3,7 @@
 // texture to the image (cv::warpPerspective into the polygon's bounding box, masked by the polygon clipped to
 // the camera's near plane), drawn far to near so that the nearest wins (painter's order by depth). A texture
 // minified on screen is read from its mip level, so that distant walls do not shimmer with aliasing.
-// Measured at 640x480 in docs/drive.md (bench/simulate_bench).
+// Measured at 640x480 in docs/drive.md (bench/drive_bench.py, its timing run).
 
 #include <memory>
 #include <vector>

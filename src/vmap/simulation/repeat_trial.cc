@@ -110,6 +110,8 @@ TrialResult RunTrial(const TrialContext& context, int index) {
     sample.heading_offset = step.heading_offset;
     sample.bearing = step.bearing;
     sample.line_angle = step.line_angle;
+    sample.lateral_estimate = step.lateral_estimate;
+    sample.observation = step.observation;
     sample.translation_sigma_deg = TargetComparison(localization).translation_sigma_deg;
     sample.target_verified = TargetComparison(localization).num_verified;
     if (step.target_key >= 0 && step.target_key < static_cast<int>(context.key_image_poses.size())) {

@@ -29,6 +29,8 @@ struct TrialSample {
   double heading_offset = 0.0;  // what the controller read (ControlStep; NaN when not used)
   double bearing = 0.0;
   double line_angle = 0.0;
+  double lateral_estimate = 0.0;       // the tracker's (ControlStep; NaN otherwise)
+  TrackingObservation observation;     // what the frame gave the tracker's estimate
   double translation_sigma_deg = 0.0;  // of the target's pose (KeyComparison; NaN without one)
   int target_verified = 0;             // verified matches with the target key image
   // The truth of the same, from the target key image's pose in the teach run (NaN without a target).

@@ -80,9 +80,28 @@ nlohmann::json SimulationJson(const SimulationResult& result, const SimulationOp
                         {"mean_render_ms", Number(1e3 * trial.mean_render_seconds, 1e-2)},
                         {"duration_s", Rounded(trial.duration, 0.01)}};
     nlohmann::json columns;
-    for (const char* name :
-         {"t", "x", "y", "yaw", "s", "lateral", "v", "w", "key", "status", "state", "steering", "heading_offset",
-          "bearing", "line_angle", "true_bearing", "true_line_angle", "translation_sigma_deg", "target_verified"}) {
+    for (const char* name : {"t",
+                             "x",
+                             "y",
+                             "yaw",
+                             "s",
+                             "lateral",
+                             "v",
+                             "w",
+                             "key",
+                             "status",
+                             "state",
+                             "steering",
+                             "heading_offset",
+                             "bearing",
+                             "line_angle",
+                             "true_bearing",
+                             "true_line_angle",
+                             "translation_sigma_deg",
+                             "target_verified",
+                             "lateral_estimate",
+                             "bearings_taken",
+                             "measurements_refused"}) {
       columns[name] = nlohmann::json::array();
     }
     for (const TrialSample& sample : trial.samples) {
@@ -105,6 +124,9 @@ nlohmann::json SimulationJson(const SimulationResult& result, const SimulationOp
       columns["true_line_angle"].push_back(Number(sample.true_line_angle, 1e-4));
       columns["translation_sigma_deg"].push_back(Number(sample.translation_sigma_deg, 0.01));
       columns["target_verified"].push_back(sample.target_verified);
+      columns["lateral_estimate"].push_back(Number(sample.lateral_estimate));
+      columns["bearings_taken"].push_back(sample.observation.bearings);
+      columns["measurements_refused"].push_back(sample.observation.refused);
     }
     t["samples"] = columns;
     trials.push_back(t);

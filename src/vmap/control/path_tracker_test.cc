@@ -1,0 +1,125 @@
+// The tracker law's pieces: locating a pose on a taught path, the path-following turn rate, and the pose
+// estimate from bearings to key images.
+
+#include "vmap/control/path_tracker.h"
+
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "vmap/control/route_pose_estimator.h"
+
+namespace vmap {
+namespace {
+
+// Samples 0.1 m apart along the x axis, from 0 to `length` metres, one a second.
+std::vector<OdometrySample> StraightPath(double length) {
+  std::vector<OdometrySample> samples;
+  for (int i = 0; i * 0.1 <= length + 1e-9; ++i) samples.push_back({double(i), 0.1 * i, 0.0, 0.0});
+  return samples;
+}
+
+TEST(TaughtPath, LocatesAPoseBesideAStraightPath) {
+  const TaughtPath path(StraightPath(4.0));
+  EXPECT_NEAR(path.length(), 4.0, 1e-9);
+  const PathLocation at = path.Locate({1.25, 0.2, 0.1}, 0.0, path.length());
+  EXPECT_NEAR(at.s, 1.25, 1e-9);
+  EXPECT_NEAR(at.lateral, 0.2, 1e-9);  // left of the taught heading
+  EXPECT_NEAR(at.heading_error, 0.1, 1e-9);
+  EXPECT_NEAR(at.curvature, 0.0, 1e-9);
+  EXPECT_NEAR(path.Locate({2.0, -0.3, 0.0}, 0.0, path.length()).lateral, -0.3, 1e-9);
+  EXPECT_NEAR(path.ArcAtTime(12.5), 1.25, 1e-9);
+}
+
+TEST(TaughtPath, CurvatureOfALeftArcAndTheWindowOfALoop) {
+  // A full circle of radius 1 m driven counter-clockwise: the start and the end are the same place.
+  std::vector<OdometrySample> circle;
+  for (int i = 0; i <= 200; ++i) {
+    const double a = 2.0 * M_PI * i / 200.0;
+    circle.push_back({double(i), std::sin(a), 1.0 - std::cos(a), a});
+  }
+  const TaughtPath path(circle);
+  EXPECT_NEAR(path.length(), 2.0 * M_PI, 1e-3);
+  const PathLocation middle = path.Locate({0.0, 1.8, M_PI}, 0.0, path.length());  // inside, at the top
+  EXPECT_NEAR(middle.s, M_PI, 1e-2);
+  EXPECT_NEAR(middle.lateral, 0.2, 1e-3);  // the centre is left of a counter-clockwise circle
+  EXPECT_NEAR(middle.curvature, 1.0, 1e-2);
+  // Near the start, searched late in the route: the end of the loop, not its beginning.
+  EXPECT_GT(path.Locate({0.0, 0.0, 0.0}, 5.0, path.length()).s, 5.0);
+  EXPECT_LT(path.Locate({0.0, 0.0, 0.0}, 0.0, 1.0).s, 0.1);
+}
+
+// A unicycle at `speed` steered by PathFollowingTurnRate along a straight path, from an offset.
+double LateralAfter(double distance, double start_lateral, double start_heading, double speed) {
+  const TaughtPath path(StraightPath(20.0));
+  cv::Vec3d pose(speed > 0 ? 1.0 : 19.0, start_lateral, start_heading);
+  const double dt = 0.05;
+  for (double driven = 0.0; driven < distance; driven += std::abs(speed) * dt) {
+    const PathLocation at = path.Locate(pose, 0.0, path.length());
+    const double w = PathFollowingTurnRate(at, speed, 0.6);
+    pose[0] += speed * dt * std::cos(pose[2]);
+    pose[1] += speed * dt * std::sin(pose[2]);
+    pose[2] += w * dt;
+  }
+  return path.Locate(pose, 0.0, path.length()).lateral;
+}
+
+TEST(PathFollowing, AnOffsetDecaysWithinAFewConvergenceDistances) {
+  EXPECT_LT(std::abs(LateralAfter(3.0, 0.5, 0.0, 0.3)), 0.02);
+  EXPECT_LT(std::abs(LateralAfter(3.0, -0.4, 0.17, 0.3)), 0.02);
+  // Driven backwards along the path (the teach heading kept), the offset decays too.
+  EXPECT_LT(std::abs(LateralAfter(3.0, 0.3, 0.0, -0.3)), 0.02);
+  // Not yet after a fraction of one.
+  EXPECT_GT(std::abs(LateralAfter(0.2, 0.5, 0.0, 0.3)), 0.3);
+}
+
+TEST(PathFollowing, LeftOfThePathTurnsRightAndAFarOffsetIsCapped) {
+  PathLocation left;
+  left.lateral = 0.2;
+  EXPECT_LT(PathFollowingTurnRate(left, 0.3, 0.6), 0.0);
+  PathLocation far = left, farther = left;
+  far.lateral = 0.6;
+  farther.lateral = 3.0;
+  EXPECT_DOUBLE_EQ(PathFollowingTurnRate(far, 0.3, 0.6), PathFollowingTurnRate(farther, 0.3, 0.6));
+  PathLocation curve;
+  curve.curvature = 0.5;
+  EXPECT_DOUBLE_EQ(PathFollowingTurnRate(curve, 0.4, 0.6), 0.2);  // on the path: the taught turn
+}
+
+TEST(RoutePoseEstimator, BearingsToKnownLandmarksCorrectAnOffset) {
+  // The robot drives along y = 0.3 while the estimate starts on y = 0, unsure by half a metre; landmarks
+  // (where key images were taken) lie every metre along y = 0.
+  RoutePoseEstimator estimator;
+  cv::Vec3d truth(0.0, 0.3, 0.0);
+  estimator.Initialize({0.0, 0.0, 0.0}, {0.5, 0.5, 0.05});
+  for (int step = 0; step < 40; ++step) {
+    truth[0] += 0.05;
+    estimator.Predict(0.05, 0.0);
+    const cv::Point2d landmark(std::floor(truth[0]) + 2.0, 0.0);
+    const double bearing = std::atan2(landmark.y - truth[1], landmark.x - truth[0]) - truth[2];
+    EXPECT_TRUE(estimator.UpdateBearing(landmark, bearing));
+    EXPECT_TRUE(estimator.UpdateHeading(truth[2], 0.02));
+  }
+  EXPECT_NEAR(estimator.pose()[1], 0.3, 0.03);
+  EXPECT_NEAR(estimator.pose()[0], truth[0], 0.1);
+  // Once sure, a bearing far from what it predicts is an outlier: refused, and the estimate stays.
+  const cv::Vec3d before = estimator.pose();
+  EXPECT_FALSE(estimator.UpdateBearing({truth[0] + 2.0, 0.0}, 1.0));
+  EXPECT_EQ(estimator.pose(), before);
+}
+
+TEST(RoutePoseEstimator, NothingIsMeasuredBeforeItStarts) {
+  RoutePoseEstimator estimator;
+  EXPECT_FALSE(estimator.initialized());
+  EXPECT_FALSE(estimator.UpdateHeading(0.1, 0.02));
+  EXPECT_FALSE(estimator.UpdateBearing({1.0, 0.0}, 0.0));
+  estimator.Initialize({1.0, 2.0, 0.5}, {0.1, 0.1, 0.1});
+  estimator.Predict(1.0, 0.0);
+  EXPECT_NEAR(estimator.pose()[0], 1.0 + std::cos(0.5), 1e-12);
+  EXPECT_NEAR(estimator.pose()[1], 2.0 + std::sin(0.5), 1e-12);
+  EXPECT_FALSE(estimator.UpdateBearing({estimator.pose()[0], estimator.pose()[1]}, 0.0));  // under the robot
+}
+
+}  // namespace
+}  // namespace vmap

@@ -1,0 +1,71 @@
+#include "vmap/control/route_pose_estimator.h"
+
+#include <cmath>
+
+#include "vmap/sources/odometry.h"
+
+namespace vmap {
+
+void RoutePoseEstimator::Initialize(const cv::Vec3d& pose, const cv::Vec3d& sigma) {
+  pose_ = pose;
+  pose_[2] = WrapAngle(pose_[2]);
+  covariance_ = cv::Matx33d::diag(cv::Vec3d(sigma[0] * sigma[0], sigma[1] * sigma[1], sigma[2] * sigma[2]));
+  initialized_ = true;
+  refused_in_a_row_ = 0;
+}
+
+void RoutePoseEstimator::Predict(double distance, double turn) {
+  if (!initialized_) return;
+  const double middle = pose_[2] + 0.5 * turn;
+  const double c = std::cos(middle), s = std::sin(middle);
+  pose_[0] += distance * c;
+  pose_[1] += distance * s;
+  pose_[2] = WrapAngle(pose_[2] + turn);
+  const cv::Matx33d F(1, 0, -distance * s, 0, 1, distance * c, 0, 0, 1);
+  // Noise of the distance and the turn, mapped into the pose (G), and a heading slip growing with the distance.
+  const cv::Matx32d G(c, -0.5 * distance * s, s, 0.5 * distance * c, 0, 1);
+  const double sd = options_.distance_noise * std::abs(distance) + 1e-4;
+  const double st = options_.turn_noise * std::abs(turn) + options_.heading_noise_per_metre * std::abs(distance) + 1e-4;
+  const cv::Matx22d noise(sd * sd, 0, 0, st * st);
+  covariance_ = F * covariance_ * F.t() + G * noise * G.t();
+  const double slip = options_.position_noise_per_metre * std::abs(distance);
+  covariance_(0, 0) += slip * slip;
+  covariance_(1, 1) += slip * slip;
+}
+
+bool RoutePoseEstimator::Update(const cv::Matx13d& H, double residual, double r) {
+  const double innovation_variance = (H * covariance_ * H.t())(0, 0) + r;
+  if (residual * residual > options_.gate * options_.gate * innovation_variance) {
+    if (++refused_in_a_row_ >= options_.refusals_before_recovery) {
+      const double widened = options_.recovery_sigma * options_.recovery_sigma;
+      covariance_(0, 0) = std::max(covariance_(0, 0), widened);
+      covariance_(1, 1) = std::max(covariance_(1, 1), widened);
+      refused_in_a_row_ = 0;
+    }
+    return false;
+  }
+  refused_in_a_row_ = 0;
+  const cv::Matx31d K = covariance_ * H.t() * (1.0 / innovation_variance);
+  for (int i = 0; i < 3; ++i) pose_[i] += K(i, 0) * residual;
+  pose_[2] = WrapAngle(pose_[2]);
+  covariance_ = (cv::Matx33d::eye() - K * H) * covariance_;
+  covariance_ = 0.5 * (covariance_ + covariance_.t());
+  return true;
+}
+
+bool RoutePoseEstimator::UpdateHeading(double yaw, double sigma) {
+  if (!initialized_) return false;
+  return Update(cv::Matx13d(0, 0, 1), WrapAngle(yaw - pose_[2]), sigma * sigma);
+}
+
+bool RoutePoseEstimator::UpdateBearing(const cv::Point2d& landmark, double bearing) {
+  if (!initialized_) return false;
+  const double dx = landmark.x - pose_[0], dy = landmark.y - pose_[1];
+  const double range_squared = dx * dx + dy * dy;
+  if (range_squared < 0.01) return false;  // a landmark under the robot gives no bearing
+  const double predicted = WrapAngle(std::atan2(dy, dx) - pose_[2]);
+  const cv::Matx13d H(dy / range_squared, -dx / range_squared, -1.0);
+  return Update(H, WrapAngle(bearing - predicted), options_.bearing_sigma * options_.bearing_sigma);
+}
+
+}  // namespace vmap

@@ -1,0 +1,76 @@
+#include "vmap/control/route_tracking.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "vmap/control/guidance_signals.h"
+
+namespace vmap {
+
+namespace {
+// Metres along the path either way of the estimate within which a key image can be the one the robot sees.
+constexpr double kAssociationWindow = 3.0;
+}  // namespace
+
+RouteTracking::RouteTracking(const TaughtRoute& route, RoutePoseEstimatorOptions options)
+    : route_(route), options_(options), estimator_(options), path_(route.path) {
+  for (const OdometrySample& key : route_.key_poses) key_arc_.push_back(path_.ArcAtTime(key.timestamp));
+}
+
+void RouteTracking::Reset() {
+  estimator_.Reset();
+  arc_ = 0.0;
+}
+
+void RouteTracking::Predict(double distance, double turn) { estimator_.Predict(distance, turn); }
+
+TrackingObservation RouteTracking::Observe(const LocalizationResult& result, double focal_px) {
+  TrackingObservation seen;
+  const int key_position = route_.PositionOf(result.key);
+  const int next_position = result.next_key >= 0 ? route_.PositionOf(result.next_key) : -1;
+  const int target_position = next_position >= 0 ? next_position : key_position;
+  if (key_position < 0 || target_position < 0) return seen;
+  const OdometrySample& target = route_.key_poses[target_position];
+  // The robot's heading against the target: from the relative pose's rotation where there is one (it holds
+  // wherever the robot is); otherwise from the features' heading, which a sideways offset biases by its parallax,
+  // with a larger uncertainty.
+  const RelativePose& pose = TargetComparison(result).pose;
+  const bool rotation = pose.valid;
+  const double offset = rotation ? -YawOfCameraRotation(pose.R) : HeadingOffset(result, focal_px);
+  if (!std::isfinite(offset)) return seen;
+  const double heading_sigma = rotation ? options_.heading_sigma : options_.feature_heading_sigma;
+  if (!estimator_.initialized()) {
+    // Between key and next_key at the localizer's progress, uncertain by a stretch either way: a relocalization
+    // may be off by a key image or two; the bearings that follow pull it in.
+    const OdometrySample& key = route_.key_poses[key_position];
+    const double progress = std::isfinite(result.progress) ? std::clamp(result.progress, 0.0, 1.0) : 0.0;
+    const double spacing = std::max(0.5, std::hypot(target.x - key.x, target.y - key.y));
+    estimator_.Initialize(
+        {key.x + progress * (target.x - key.x), key.y + progress * (target.y - key.y), target.yaw + offset},
+        {2.0 * spacing, 2.0 * spacing, 2.0 * heading_sigma});
+    arc_ = key_arc_[key_position] + progress * (key_arc_[target_position] - key_arc_[key_position]);
+    return seen;
+  }
+  // A key image the estimate puts far from the robot is a localizer's mistake (a relocalization to a look-alike
+  // place, a jump ahead): it says nothing of where the robot is. A bearing needs the key image ahead.
+  const double ahead = key_arc_[target_position] - Locate().s;
+  if (ahead < -kAssociationWindow || ahead > kAssociationWindow) {
+    ++seen.unassociated;
+    return seen;
+  }
+  (estimator_.UpdateHeading(target.yaw + offset, heading_sigma) ? seen.headings : seen.refused) += 1;
+  if (result.translation_known && ahead > 0.0) {
+    const TargetBearing bearing = BearingToKey(pose);
+    if (bearing.valid)
+      (estimator_.UpdateBearing({target.x, target.y}, bearing.bearing) ? seen.bearings : seen.refused) += 1;
+  }
+  return seen;
+}
+
+PathLocation RouteTracking::Locate() {
+  const PathLocation at = path_.Locate(estimator_.pose(), arc_ - 1.0, arc_ + 2.0);
+  arc_ = at.s;
+  return at;
+}
+
+}  // namespace vmap
