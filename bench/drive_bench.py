@@ -2,12 +2,12 @@
 """Issue 34's goals, measured with `vmap simulate`: teach and repeat in the simulator, many trials per route.
 
 Runs (each a `vmap simulate` per route, straight, turn, s-curve and loop, --trials N, default 50):
-  same       photographs on walls and floor, ORB, the default law (servo)
-  odometry5  the same with the repeat run's odometry 5 % too long (--odometry-scale-error 0.05)
-  tracker    the same appearance with the tracker law (a pose estimate on the taught odometry path)
-  bearnav    the same appearance with the Bearnav-style law (the baseline)
-  seasons    teach textures of michigan session 01 (snow), repeat textures of session 09 (spring), --matcher xfeat
-             (at 5 Hz: XFeat's localization takes about 100 ms a frame on this CPU)
+  tracker    photographs on walls and floor, the same appearance, ORB, the tracker law (the default)
+  servo      the same with the servo law
+  bearnav    the same with the Bearnav-style law (the baseline)
+  odometry5  tracker with the repeat run's odometry 5 % too long (--odometry-scale-error 0.05)
+  seasons    tracker, teach textures of michigan session 01 (snow), repeat textures of session 09 (spring),
+             --matcher xfeat (at 5 Hz: XFeat's localization takes about 100 ms a frame on this CPU)
   seasons_orb  the same with ORB (10 Hz)
   timing     one trial of each route on one thread: the control step (features, localization, control) and the
              renderer's frames per second at 640x480
@@ -21,7 +21,7 @@ OUT/season_09/ under the same names (1.png ... 5.png), so that a place keeps its
 
 Run from the repository root after building vmap (and the plugin for xfeat):
 
-  /usr/bin/python3 bench/drive_bench.py [--vmap build/vmap] [--out drive_bench] [--trials 50] [--only same bearnav]
+  /usr/bin/python3 bench/drive_bench.py [--vmap build/vmap] [--out drive_bench] [--trials 50] [--only tracker bearnav]
 """
 
 import argparse
@@ -37,14 +37,14 @@ DATA = os.path.normpath(os.path.join(HERE, "..", "..", "shared", "data"))
 ROUTES = ["straight", "turn", "s-curve", "loop"]
 
 RUNS = {
-    "same": {"textures": "photos", "args": []},
-    "odometry5": {"textures": "photos", "args": ["--odometry-scale-error", "0.05"]},
     "tracker": {"textures": "photos", "args": ["--law", "tracker"]},
+    "servo": {"textures": "photos", "args": ["--law", "servo"]},
     "bearnav": {"textures": "photos", "args": ["--law", "bearnav"]},
-    "seasons": {"textures": "seasons", "args": ["--matcher", "xfeat", "--rate", "5"]},
-    "seasons_orb": {"textures": "seasons", "args": []},
+    "odometry5": {"textures": "photos", "args": ["--law", "tracker", "--odometry-scale-error", "0.05"]},
+    "seasons": {"textures": "seasons", "args": ["--law", "tracker", "--matcher", "xfeat", "--rate", "5"]},
+    "seasons_orb": {"textures": "seasons", "args": ["--law", "tracker"]},
 }
-LAWS = {"same": "servo", "tracker": "tracker", "bearnav": "bearnav"}
+LAWS = {"tracker": "tracker", "servo": "servo", "bearnav": "bearnav"}
 
 
 def link_photos(out):

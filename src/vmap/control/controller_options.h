@@ -19,8 +19,8 @@ namespace vmap {
 // kTracker: where the teach run had odometry (TaughtRoute::metric()), the robot's pose on the taught path is
 //   estimated from every frame's headings and bearings to the key images, whose poses the teach odometry gives
 //   (route_pose_estimator.h), and a path-following law steers it onto the taught path (path_tracker.h); the
-//   servo law where the route is not metric. Not the default: on the simulator's routes it is not yet as sure as
-//   the servo law (docs/drive.md has the figures).
+//   servo law where the route is not metric. The default: a measurement far from what the estimate predicts is
+//   refused, where the servo law steers by every pose it is given (docs/drive.md has the figures).
 enum class ControlLaw { kBearnav, kServo, kTracker };
 inline constexpr EnumName<ControlLaw> kControlLawNames[] = {
     {ControlLaw::kBearnav, "bearnav"}, {ControlLaw::kServo, "servo"}, {ControlLaw::kTracker, "tracker"}};
@@ -28,7 +28,7 @@ ControlLaw ParseControlLaw(const std::string& name);
 std::string ControlLawName(ControlLaw law);
 
 struct ControllerOptions {
-  ControlLaw law = ControlLaw::kServo;
+  ControlLaw law = ControlLaw::kTracker;
   // Forward speed (m/s) where the teach run's speed is unknown (no teach odometry); with it, the taught speed of
   // each stretch times `speed_scale`.
   double speed = 0.3;
