@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <geometry_msgs/Twist.h>
 #include <gtest/gtest.h>
 #include <std_msgs/Bool.h>
 #include <std_srvs/Trigger.h>
@@ -60,10 +61,15 @@ struct Published {
   std::mutex mutex;
   std::vector<vmap_ros::Localization> localizations;
   std::vector<bool> localized;
+  std::vector<geometry_msgs::Twist> commands;
 
   void OnLocalization(const vmap_ros::Localization::ConstPtr& message) {
     std::lock_guard<std::mutex> lock(mutex);
     localizations.push_back(*message);
+  }
+  void OnCommand(const geometry_msgs::Twist::ConstPtr& message) {
+    std::lock_guard<std::mutex> lock(mutex);
+    commands.push_back(*message);
   }
   void OnLocalized(const std_msgs::Bool::ConstPtr& message) {
     std::lock_guard<std::mutex> lock(mutex);
@@ -93,7 +99,10 @@ TEST(RepeatNode, LocalizesThePlayedFramesAsVmapLocalizeDoes) {
       handle.subscribe("/repeat_test/vmap/localization", 1000, &Published::OnLocalization, &published);
   const ros::Subscriber localized =
       handle.subscribe("/repeat_test/vmap/localized", 10, &Published::OnLocalized, &published);
+  const ros::Subscriber commands = handle.subscribe("/repeat_test/cmd_vel", 1000, &Published::OnCommand, &published);
 
+  ASSERT_TRUE(WaitFor([&] { return localized.getNumPublishers() > 0 && commands.getNumPublishers() > 0; },
+                      std::chrono::seconds(60)));
   vmap_ros::StartRepeat start;
   start.request.map = map.string();
   start.request.goal = -1;
@@ -110,10 +119,27 @@ TEST(RepeatNode, LocalizesThePlayedFramesAsVmapLocalizeDoes) {
   // Drop, do not lag: the newest frame is always processed, however many were dropped before it.
   ASSERT_TRUE(WaitFor([&] { return published.HasStamp(stamps.back()); }, std::chrono::seconds(60))) << node->Log();
 
+  // A command for every frame processed, published before its localization message (and so received before it).
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(published.mutex);
+        return published.commands.size() >= published.localizations.size();
+      },
+      std::chrono::seconds(60)));
   std::vector<vmap_ros::Localization> messages;
   {
     std::lock_guard<std::mutex> lock(published.mutex);
     messages = published.localizations;
+    EXPECT_EQ(published.commands.size(), messages.size());
+    int following = 0;
+    for (size_t k = 0; k < messages.size() && k < published.commands.size(); ++k) {
+      EXPECT_EQ(published.commands[k].linear.x, messages[k].command.linear.x) << "frame " << k;
+      EXPECT_EQ(published.commands[k].angular.z, messages[k].command.angular.z) << "frame " << k;
+      EXPECT_TRUE(std::isfinite(messages[k].command.linear.x) && std::isfinite(messages[k].command.angular.z));
+      following += messages[k].controller_state == "following" && messages[k].command.linear.x > 0.0;
+    }
+    // The frames are the map's route: once localized the robot drives along it.
+    EXPECT_GT(following, static_cast<int>(messages.size()) / 2);
     ASSERT_FALSE(published.localized.empty());
     EXPECT_FALSE(published.localized.front());  // latched false at the start, then true once localized
     EXPECT_TRUE(published.localized.back());

@@ -16,6 +16,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include <nav_msgs/Odometry.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 
@@ -214,7 +215,7 @@ bool WaitForService(const std::string& name, std::chrono::seconds timeout) {
 }
 
 std::vector<ros::Time> WriteVideoBag(const fs::path& video, int first, int last, const fs::path& bag,
-                                     const std::string& encoding) {
+                                     const std::string& encoding, bool odometry) {
   FrameSourceOptions options;
   options.first = first;
   options.last = last;
@@ -246,6 +247,15 @@ std::vector<ros::Time> WriteVideoBag(const fs::path& video, int first, int last,
       info.P = {camera->fx, 0, camera->cx, 0, 0, camera->fy, camera->cy, 0, 0, 0, 1, 0};
       messages.push_back({"/camera/camera_info", "sensor_msgs/CameraInfo", static_cast<int64_t>(stamp.toNSec()),
                           ros_node::SerializeMessage(info)});
+    }
+    if (odometry) {
+      nav_msgs::Odometry pose;
+      pose.header.stamp = stamp;
+      pose.header.frame_id = "odom";
+      pose.pose.pose.position.x = 0.05 * static_cast<double>(stamps.size());
+      pose.pose.pose.orientation.w = 1.0;
+      messages.push_back(
+          {"/odom", "nav_msgs/Odometry", static_cast<int64_t>(stamp.toNSec()), ros_node::SerializeMessage(pose)});
     }
     messages.push_back({"/camera/image_raw", "sensor_msgs/Image", static_cast<int64_t>(stamp.toNSec()),
                         ros_node::SerializeMessage(image)});

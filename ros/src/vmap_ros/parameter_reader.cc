@@ -53,7 +53,6 @@ std::string ParameterName(const char* flag) {
 std::string ParameterReader::SetParameter(const OptionField& field) {
   const std::string name = ParameterName(field.flag);
   if (name.empty()) return "";
-  known_.insert(name);
   parameter_of_path_[Path(field)] = name;
   if (!node_.hasParam(name)) return "";
   given_.insert(Path(field));
@@ -81,6 +80,13 @@ void ParameterReader::OnField(const OptionField& field, double& value) {
   } else {
     throw WrongKind(name, v, "a number");
   }
+}
+
+void ParameterReader::OnField(const OptionField& field, std::optional<double>& value) {
+  double number = value.value_or(0.0);
+  const std::string name = ParameterName(field.flag);
+  OnField(field, number);
+  if (!name.empty() && node_.hasParam(name)) value = number;
 }
 
 void ParameterReader::OnField(const OptionField& field, bool& value) {

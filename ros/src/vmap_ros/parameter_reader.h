@@ -6,6 +6,7 @@
 // knows no option of its own.
 
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -34,8 +35,6 @@ class ParameterReader final : public OptionFieldVisitor {
 
   // The paths of the fields read from a parameter that was set ("min_link_share", "ranking.method").
   const std::set<std::string>& given() const { return given_; }
-  // Every parameter a field visited so far has, set or not.
-  const std::set<std::string>& known() const { return known_; }
   // `error`, an OptionError of a struct read here, as the parameters name its field ("~min_link_share must be
   // ..."); other errors as they are.
   std::string Message(const InputError& error) const;
@@ -43,6 +42,7 @@ class ParameterReader final : public OptionFieldVisitor {
  protected:
   void OnField(const OptionField& field, int& value) override;
   void OnField(const OptionField& field, double& value) override;
+  void OnField(const OptionField& field, std::optional<double>& value) override;
   void OnField(const OptionField& field, bool& value) override;
   void OnField(const OptionField& field, std::string& value) override;
   void OnField(const OptionField& field, std::vector<int>& value) override;
@@ -54,8 +54,33 @@ class ParameterReader final : public OptionFieldVisitor {
 
   ros::NodeHandle node_;
   std::set<std::string> given_;
-  std::set<std::string> known_;
   std::map<std::string, std::string> parameter_of_path_;
+};
+
+// The parameters of `Options`' fields (those with a flag).
+class ParameterNames final : public OptionFieldVisitor {
+ public:
+  template <typename Options>
+  void Add(Options& options) {
+    options.VisitFields(*this);
+  }
+  const std::set<std::string>& names() const { return names_; }
+
+ protected:
+  void OnField(const OptionField& field, int&) override { Note(field); }
+  void OnField(const OptionField& field, double&) override { Note(field); }
+  void OnField(const OptionField& field, std::optional<double>&) override { Note(field); }
+  void OnField(const OptionField& field, bool&) override { Note(field); }
+  void OnField(const OptionField& field, std::string&) override { Note(field); }
+  void OnField(const OptionField& field, std::vector<int>&) override { Note(field); }
+  void OnField(const OptionField& field, const EnumField&) override { Note(field); }
+
+ private:
+  void Note(const OptionField& field) {
+    const std::string name = ParameterName(field.flag);
+    if (!name.empty()) names_.insert(name);
+  }
+  std::set<std::string> names_;
 };
 
 // Logs a warning for each private parameter of `node` that is not in `known` (the fields' parameters and the

@@ -1,59 +1,64 @@
 #pragma once
-// A repeat run as the node drives it, without ROS: the map opened for localization, the route to the goal, and
-// each camera frame localized against it (as `vmap localize` localizes a recording's frames: the same frames give
-// the same results).
+// A repeat run as the node drives it, without ROS: `vmap localize`'s session (pipelines/localize_pipeline.h: the map
+// opened once, the route, the localizer following the map) with each camera frame localized as `vmap localize`
+// localizes a recording's frames (the same frames give the same results), and the route controller
+// (control/route_controller.h) turning each localization into a velocity command.
 
 #include <filesystem>
 #include <memory>
-#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
-#include "vmap/localization/localization_map.h"
-#include "vmap/localization/localizer.h"
+#include "vmap/control/route_controller.h"
+#include "vmap/pipelines/localize_pipeline.h"
 
 #include "vmap_ros/camera_messages.h"
 
 namespace vmap::ros_node {
 
-struct RepeatRequest {
-  std::filesystem::path map;  // the map directory
-  int goal = -1;              // the key image to reach; -1 = the map's last
-  int start = -1;             // the route's first key image; -1 = the map's first
-  // The localizer's options (the node's parameters); its verifier, S, translation thresholds and camera follow
-  // the map, its route is planned from start to goal.
-  LocalizerOptions localizer;
-  bool cache = true;  // the key-image cache in the map directory
+// One frame of a repeat run: where it is, and what the controller commands.
+struct RepeatStep {
+  LocalizationResult localization;
+  ControlStep control;
 };
 
 class RepeatRun {
  public:
-  // Opens the map (its key images' features: seconds for a large map without a cache) and plans the route. Throws
-  // InputError naming the map and what is wrong (missing, malformed, a goal it has not, no route to it).
-  explicit RepeatRun(const RepeatRequest& request);
-  ~RepeatRun();
+  // Opens the map of `options` (its key images' features: seconds for a large map without a cache), plans the route
+  // from `from` to `to` and sets up the controller on it (the taught profile from the map: the key images'
+  // timestamps and the links' poses, or the teach run's odometry when given). Throws InputError naming the map and what
+  // is wrong (missing, malformed, a key image it has not, no route, no camera and no ~focal_px) and OptionError for a
+  // bad controller option. `teach_odometry` (may be empty): the teach run's odometry on the key images' clock, for the
+  // taught speeds and turns.
+  RepeatRun(const LocalizePipelineOptions& options, const ControllerOptions& controller,
+            const std::vector<OdometrySample>& teach_odometry = {});
 
-  // Localizes the next camera frame of the run (brought to the map's frame size: frame()).
+  // Localizes the next camera frame of the run (brought to the map's frame size: frame()) and asks the controller
+  // for its command at `time` (seconds), with the robot's odometry at that time when it has one (else null).
+  RepeatStep Step(const CameraImage& image, double time, const OdometrySample* odometry);
+  // Localizes the frame only (a paused run keeps its estimate up to date; the controller is not asked).
   LocalizationResult Localize(const CameraImage& image);
+  // The controller starts again (after a pause): it commands nothing until a frame is localized.
+  void ResetController() { controller_.Reset(); }
+
+  const VisualMap& map() const { return session_.map(); }
+  const std::filesystem::path& directory() const { return session_.opened().directory; }
+  // The key images followed, in order (the whole map in its order when no from/to was given).
+  const std::vector<int>& route() const { return route_; }
+  const LocalizerOptions& options() const { return session_.localizer_options(); }
+  int frames() const { return frames_; }
   // The frame last localized, at the map's frame size (the matches' coordinates).
   const Frame& frame() const { return frame_; }
-  // Forgets the estimate: the next frame is relocalized.
-  void Reset();
-
-  const VisualMap& map() const { return opened_->map; }
-  const std::filesystem::path& directory() const { return opened_->directory; }
-  const std::vector<int>& route() const { return options_.route; }
-  const LocalizerOptions& options() const { return options_; }
-  int frames() const { return frames_; }
 
   // Key image `key` of the map as stored (BGR or grey); empty when it cannot be read. Read once, then kept.
   cv::Mat KeyImage(int key);
 
  private:
-  std::unique_ptr<LocalizationMap> opened_;
-  LocalizerOptions options_;
-  std::unique_ptr<Localizer> localizer_;
+  LocalizationSession session_;
+  std::vector<int> route_;
+  RouteController controller_;
+  double last_time_ = -1e300;
   std::vector<cv::Mat> key_images_;
   Frame frame_;
   int frames_ = 0;

@@ -1,43 +1,30 @@
+// The vmap node (vmap_node.h): its set-up, the camera's callbacks, the worker, and what teach and repeat share.
+
 #include "vmap_ros/vmap_node.h"
 
-#include <cv_bridge/cv_bridge.h>
 #include <fmt/format.h>
 #include <geometry_msgs/Twist.h>
+#include <sensor_msgs/Image.h>
 #include <std_msgs/Bool.h>
 
 #include "vmap/core/error.h"
+#include "vmap/pipelines/build_pipeline.h"
+#include "vmap/pipelines/localize_pipeline.h"
 #include "vmap/sources/recording_source.h"
 
 #include "vmap_ros/Localization.h"
-#include "vmap_ros/debug_image.h"
-#include "vmap_ros/localization_message.h"
+#include "vmap_ros/TeachProgress.h"
 #include "vmap_ros/parameter_reader.h"
 
 namespace vmap::ros_node {
 namespace {
 
-// The mailbox decides what is kept; ROS's own queue only holds messages while no spinner thread is free, and would
-// drop them uncounted if it filled up.
+// The mailbox decides what a repeat run keeps; ROS's own queue only holds messages while no spinner thread is free,
+// and would drop them uncounted if it filled up.
 constexpr uint32_t kImageQueue = 100;
 constexpr std::chrono::milliseconds kWorkerPoll{100};
 // A camera that keeps sending one malformed message is logged once every this many seconds.
 constexpr double kRepeatedErrorSeconds = 5.0;
-
-template <typename Response>
-bool Fail(Response& response, const std::string& message) {
-  ROS_ERROR("%s", message.c_str());
-  response.success = false;
-  response.message = message;
-  return true;  // the call itself succeeded: the answer says why nothing was done
-}
-
-template <typename Response>
-bool Succeed(Response& response, const std::string& message) {
-  ROS_INFO("%s", message.c_str());
-  response.success = true;
-  response.message = message;
-  return true;
-}
 
 // Why the camera of a repeat run does not look like the one the map was taught with (another camera, another
 // calibration), or "" when it does: focal lengths within 5 % at the map's frame size.
@@ -59,50 +46,94 @@ std::string CameraMismatch(const Camera& live, const Camera& map) {
       scaled.fx, scaled.fy, map.fx, map.fy);
 }
 
-std::string RouteText(const std::vector<int>& route) {
-  if (route.empty()) return "an empty route";
-  return fmt::format("key image {} to {} ({} key images)", route.front(), route.back(), route.size());
-}
-
 }  // namespace
 
 VmapNode::VmapNode(const ros::NodeHandle& node, const ros::NodeHandle& private_node)
     : node_(node), private_node_(private_node) {
   image_topic_ = node_.resolveName("image");
-  // camera_info beside the image topic, as image_transport pairs them, unless it is remapped itself.
+  // The CameraInfo topic: ~camera_topic (vmap build's --camera-topic), camera_info when it is remapped, else the one
+  // beside the image topic, as image_transport pairs them.
+  std::string camera_topic;
   const std::string remapped = node_.resolveName("camera_info");
-  camera_info_topic_ =
-      remapped != node_.resolveName("camera_info", false) ? remapped : CameraInfoTopicFor(image_topic_);
+  if (private_node_.getParam("camera_topic", camera_topic) && !camera_topic.empty()) {
+    camera_info_topic_ = node_.resolveName(camera_topic);
+  } else if (remapped != node_.resolveName("camera_info", false)) {
+    camera_info_topic_ = remapped;
+  } else {
+    camera_info_topic_ = CameraInfoTopicFor(image_topic_);
+  }
 
   cmd_vel_ = node_.advertise<geometry_msgs::Twist>("cmd_vel", 1);
   localization_ = private_node_.advertise<vmap_ros::Localization>("localization", 10);
   localized_ = private_node_.advertise<std_msgs::Bool>("localized", 1, /*latch=*/true);
   debug_image_ = private_node_.advertise<sensor_msgs::Image>("debug_image", 1);
+  teach_progress_ = private_node_.advertise<vmap_ros::TeachProgress>("teach/progress", 10);
+  services_.push_back(private_node_.advertiseService("teach/start", &VmapNode::StartTeach, this));
+  services_.push_back(private_node_.advertiseService("teach/stop", &VmapNode::StopTeach, this));
   services_.push_back(private_node_.advertiseService("repeat/start", &VmapNode::StartRepeat, this));
   services_.push_back(private_node_.advertiseService("repeat/pause", &VmapNode::PauseRepeat, this));
   services_.push_back(private_node_.advertiseService("repeat/resume", &VmapNode::ResumeRepeat, this));
   services_.push_back(private_node_.advertiseService("repeat/stop", &VmapNode::StopRepeat, this));
-
-  // Every option the node reads, to tell a typo from a parameter.
-  ParameterReader known(private_node_);
-  LocalizerOptions localizer;
-  known.Read(localizer);
-  std::set<std::string> names = known.known();
-  names.insert({"map", "no_cache"});
-  WarnAboutUnknownParameters(private_node_, names);
+  WarnAboutUnknownParameters(private_node_, KnownParameters());
 
   worker_ = std::thread([this] { Work(); });
-  ROS_INFO("vmap node ready: camera %s (%s); call %s/repeat/start", image_topic_.c_str(), camera_info_topic_.c_str(),
-           private_node_.getNamespace().c_str());
+  ROS_INFO("vmap node ready: camera %s (CameraInfo %s); call %s/teach/start or %s/repeat/start", image_topic_.c_str(),
+           camera_info_topic_.c_str(), private_node_.getNamespace().c_str(), private_node_.getNamespace().c_str());
 }
 
 VmapNode::~VmapNode() {
   stopping_ = true;
   mailbox_.Close();
   if (worker_.joinable()) worker_.join();
+  std::unique_ptr<TeachRun> teach;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    teach = std::move(teach_);
+  }
+  if (teach) {
+    ROS_WARN("the node is shutting down during a teach run: finishing its map");
+    try {
+      const BuildPipelineResult result = teach->Stop();
+      ROS_INFO("map %s written: %zu key images", result.directory.string().c_str(), result.map.key_images.size());
+    } catch (const std::exception& error) {
+      ROS_ERROR("the teach run's map could not be written: %s", error.what());
+    }
+  }
+}
+
+std::set<std::string> VmapNode::KnownParameters() const {
+  ParameterNames names;
+  BuildPipelineOptions teach;
+  LocalizationSessionOptions repeat;
+  ControllerOptions controller;
+  names.Add(teach);
+  names.Add(repeat);
+  names.Add(controller);
+  std::set<std::string> known = names.names();
+  known.insert({"map", "teach_queue", "teach_odometry", "teach_odometry_topic"});
+  return known;
+}
+
+void VmapNode::SubscribeCamera() {
+  image_subscriber_ =
+      node_.subscribe(image_topic_, kImageQueue, &VmapNode::OnImage, this, ros::TransportHints().tcpNoDelay());
+  camera_info_subscriber_ = node_.subscribe(camera_info_topic_, 1, &VmapNode::OnCameraInfo, this);
+}
+
+void VmapNode::UnsubscribeCamera() {
+  image_subscriber_.shutdown();
+  camera_info_subscriber_.shutdown();
 }
 
 void VmapNode::OnImage(const topic_tools::ShapeShifter::ConstPtr& message) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (mode_ == Mode::kTeaching) {
+      teach_->source().Put(message);
+      return;
+    }
+    if (mode_ != Mode::kRepeating && mode_ != Mode::kPaused) return;
+  }
   mailbox_.Put(Arrival{message, ros::WallTime::now()});
 }
 
@@ -114,6 +145,10 @@ void VmapNode::OnCameraInfo(const sensor_msgs::CameraInfo::ConstPtr& info) {
     LogMessageError(std::string(error.what()) + "; the message is ignored", error.what());
     return;
   }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (mode_ == Mode::kTeaching) teach_->source().SetCamera(camera);
+  }
   std::lock_guard<std::mutex> lock(camera_mutex_);
   camera_ = camera;
   if (camera_checked_ || !camera || !map_camera_) return;
@@ -122,97 +157,27 @@ void VmapNode::OnCameraInfo(const sensor_msgs::CameraInfo::ConstPtr& info) {
   if (!problem.empty()) ROS_WARN("%s", problem.c_str());
 }
 
+std::string VmapNode::Busy() const {
+  switch (mode_) {
+    case Mode::kIdle:
+      return "";
+    case Mode::kTeaching:
+      return fmt::format("a teach run is in progress; call {}/teach/stop first", private_node_.getNamespace());
+    case Mode::kFinishing:
+      return "a teach run's map is being written; try again when ~teach/stop has answered";
+    case Mode::kRepeating:
+    case Mode::kPaused:
+      break;
+  }
+  return fmt::format("a repeat run is in progress (goal {}); call {}/repeat/stop first", repeat_->route().back(),
+                     private_node_.getNamespace());
+}
+
 std::string VmapNode::MapOf(const std::string& requested) const {
   if (!requested.empty()) return requested;
   std::string map;
   private_node_.getParam("map", map);
   return map;
-}
-
-bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::StartRepeat::Response& response) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (mode_ != Mode::kIdle) {
-      return Fail(response, fmt::format("a repeat run is in progress (goal {}); call {}/repeat/stop first",
-                                        repeat_->route().back(), private_node_.getNamespace()));
-    }
-  }
-  RepeatRequest repeat;
-  repeat.map = MapOf(request.map);
-  repeat.goal = request.goal;
-  repeat.start = request.start;
-  if (repeat.map.empty()) return Fail(response, "repeat/start: no map; give one in the request or set ~map");
-  ParameterReader parameters(private_node_);
-  std::unique_ptr<RepeatRun> run;
-  try {
-    parameters.Read(repeat.localizer);
-    bool no_cache = false;
-    private_node_.getParam("no_cache", no_cache);
-    repeat.cache = !no_cache;
-    run = std::make_unique<RepeatRun>(repeat);
-  } catch (const InputError& error) {
-    return Fail(response, "repeat/start: " + parameters.Message(error));
-  } catch (const std::exception& error) {
-    return Fail(response, std::string("repeat/start: ") + error.what());
-  }
-  response.route = run->route();
-  const std::optional<Camera> map_camera = run->options().camera;
-  const std::string started =
-      fmt::format("repeat run started on map {}: {}", repeat.map.string(), RouteText(run->route()));
-  {
-    std::lock_guard<std::mutex> run_lock(run_mutex_);
-    std::lock_guard<std::mutex> lock(mutex_);
-    repeat_ = std::move(run);
-    mode_ = Mode::kRepeating;
-    localized_once_ = false;
-    mailbox_.Reset(1);
-  }
-  {
-    std::lock_guard<std::mutex> lock(camera_mutex_);
-    map_camera_ = map_camera;
-    camera_checked_ = false;
-  }
-  std_msgs::Bool localized;
-  localized.data = false;
-  localized_.publish(localized);
-  image_subscriber_ =
-      node_.subscribe(image_topic_, kImageQueue, &VmapNode::OnImage, this, ros::TransportHints().tcpNoDelay());
-  camera_info_subscriber_ = node_.subscribe(camera_info_topic_, 1, &VmapNode::OnCameraInfo, this);
-  return Succeed(response, started);
-}
-
-bool VmapNode::PauseRepeat(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (mode_ == Mode::kIdle) return Fail(response, "repeat/pause: no repeat run is in progress");
-  if (mode_ == Mode::kPaused) return Fail(response, "repeat/pause: the repeat run is paused already");
-  mode_ = Mode::kPaused;
-  PublishStop();
-  return Succeed(response, "repeat run paused: the robot stops; frames are still localized");
-}
-
-bool VmapNode::ResumeRepeat(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (mode_ == Mode::kIdle) return Fail(response, "repeat/resume: no repeat run is in progress");
-  if (mode_ == Mode::kRepeating) return Fail(response, "repeat/resume: the repeat run is not paused");
-  mode_ = Mode::kRepeating;
-  return Succeed(response, "repeat run resumed");
-}
-
-bool VmapNode::StopRepeat(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
-  int frames = 0;
-  {
-    std::lock_guard<std::mutex> run_lock(run_mutex_);  // the frame in progress ends first
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (mode_ == Mode::kIdle) return Fail(response, "repeat/stop: no repeat run is in progress");
-    frames = repeat_->frames();
-    mode_ = Mode::kIdle;
-    repeat_.reset();
-    mailbox_.Reset(1);
-  }
-  image_subscriber_.shutdown();
-  camera_info_subscriber_.shutdown();
-  PublishStop();
-  return Succeed(response, fmt::format("repeat run stopped after {} frames", frames));
 }
 
 void VmapNode::LogMessageError(const std::string& text, const std::string& problem) {
@@ -223,8 +188,6 @@ void VmapNode::LogMessageError(const std::string& text, const std::string& probl
   last_problem_time_ = now;
   ROS_ERROR("%s", text.c_str());
 }
-
-void VmapNode::PublishStop() { cmd_vel_.publish(geometry_msgs::Twist()); }
 
 void VmapNode::Work() {
   while (!stopping_) {
@@ -237,52 +200,6 @@ void VmapNode::Work() {
       // Not one error of a frame ends the node: the next frame is another chance.
       ROS_ERROR("frame skipped: %s", error.what());
     }
-  }
-}
-
-void VmapNode::RepeatFrame(const Arrival& arrival) {
-  Mode mode;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    mode = mode_;
-  }
-  if (mode == Mode::kIdle) return;
-  CameraImage image;
-  try {
-    image = DecodeCameraImage(*arrival.message, image_topic_);
-  } catch (const InputError& error) {
-    ++malformed_;
-    LogMessageError(fmt::format("{}; frame skipped ({} so far)", error.what(), malformed_), error.what());
-    return;
-  }
-  const LocalizationResult result = repeat_->Localize(image);
-  const bool localized =
-      result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized;
-  ControlSummary control;
-  if (localized && !localized_once_) {
-    localized_once_ = true;
-    std_msgs::Bool message;
-    message.data = true;
-    localized_.publish(message);
-    ROS_INFO("first localization: key image %d (%s)", result.key, LocalizationStatusName(result.status).c_str());
-  }
-  control.localized = localized_once_;
-  if (mode == Mode::kPaused) control.state = "paused";
-
-  vmap_ros::Localization message = LocalizationMessage(image.header, result, repeat_->route(), control);
-  message.latency = (ros::WallTime::now() - arrival.time).toSec();
-  message.frames_dropped = static_cast<uint32_t>(mailbox_.TakeDropped());
-  localization_.publish(message);
-
-  if (debug_image_.getNumSubscribers() > 0) {
-    const KeyComparison* comparison = SteeringComparison(result);
-    const std::string caption =
-        fmt::format("frame {} {} | key {} next {} | {}", result.frame_index, LocalizationStatusName(result.status),
-                    result.key, result.next_key, control.state);
-    const cv::Mat figure =
-        DrawDebugImage(repeat_->frame().color.empty() ? repeat_->frame().gray : repeat_->frame().color,
-                       comparison ? repeat_->KeyImage(comparison->key) : cv::Mat(), comparison, caption);
-    debug_image_.publish(cv_bridge::CvImage(image.header, "bgr8", figure).toImageMsg());
   }
 }
 

@@ -1,21 +1,26 @@
 #pragma once
-// The vmap node (docs/ros.md): repeat runs on a robot.
+// The vmap node (docs/ros.md): teach and repeat on a robot.
 //
 // Topics (remappable):      image (sensor_msgs/Image or CompressedImage), camera_info (beside image, as
-//                           image_transport pairs them); publishes cmd_vel (geometry_msgs/Twist).
-// Private topics:           ~localization (vmap_ros/Localization, one per frame processed), ~debug_image
-//                           (sensor_msgs/Image, drawn only while someone subscribes; a plain publisher, since
-//                           Debian's image_transport cannot be linked: it needs a ROS 1 pluginlib), ~localized
-//                           (std_msgs/Bool, latched: true once a repeat run's first frame is localized).
-// Services:                 ~repeat/start, ~repeat/pause, ~repeat/resume, ~repeat/stop.
-// Parameters:               the flags of `vmap localize` by their names (parameter_reader.h), read when a run
-//                           starts; ~map, the map directory.
+//                           image_transport pairs them, or ~camera_topic), odom (nav_msgs/Odometry, when the
+//                           robot has it: the controller reads it at each frame's time); publishes cmd_vel
+//                           (geometry_msgs/Twist, one per frame a repeat run processes, and a zero one at a
+//                           pause or stop).
+// Private topics:           ~localization (vmap_ros/Localization, one per frame a repeat run processes),
+//                           ~debug_image (sensor_msgs/Image, drawn only while someone subscribes; a plain publisher,
+//                           since Debian's image_transport cannot be linked: it needs a ROS 1 pluginlib),
+//                           ~localized (std_msgs/Bool, latched: true once a repeat run's first frame is localized),
+//                           ~teach/progress (vmap_ros/TeachProgress, after every frame a teach run takes).
+// Services:                 ~teach/start, ~teach/stop, ~repeat/start, ~repeat/pause, ~repeat/resume, ~repeat/stop.
+// Parameters:               the flags of `vmap build` (teach) and `vmap localize` (repeat) by their names
+//                           (parameter_reader.h), read when a run starts; ~map, the map directory; ~teach_queue.
 //
-// Threads: ROS's spinner threads run the callbacks and services; the camera callback only drops the message in a
-// mailbox (mailbox.h), and one worker thread decodes, localizes and publishes. In a repeat run the mailbox holds
-// one frame: the worker always takes the newest, so a slow frame delays no other (frames arriving meanwhile are
-// dropped and counted in the next message's frames_dropped). No error of a message, a map or a service call ends
-// the node: each is answered or logged, and the node goes on.
+// Threads: ROS's spinner threads run the callbacks and services; a camera callback only hands the message on. In
+// a repeat run it goes to a mailbox of one frame (mailbox.h) that one worker thread empties: the worker always
+// takes the newest frame, so a slow frame delays no other (frames arriving meanwhile are dropped and counted in the
+// next message's frames_dropped). In a teach run it goes to the build pipeline's source (topic_frame_source.h),
+// which holds ~teach_queue frames: every frame counts towards the map. No error of a message, a map or a service
+// call ends the node: each is answered or logged, and the node goes on.
 
 #include <atomic>
 #include <memory>
@@ -23,48 +28,68 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
+#include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <std_srvs/Trigger.h>
 #include <topic_tools/shape_shifter.h>
 
 #include "vmap_ros/StartRepeat.h"
+#include "vmap_ros/StartTeach.h"
 #include "vmap_ros/mailbox.h"
+#include "vmap_ros/odometry_buffer.h"
 #include "vmap_ros/repeat_run.h"
+#include "vmap_ros/teach_run.h"
 
 namespace vmap::ros_node {
 
 class VmapNode {
  public:
-  // `node`: the namespace of the topics (image, camera_info, odom, cmd_vel); `private_node`: "~".
+  // `node`: the namespace of the topics (image, camera_info, cmd_vel); `private_node`: "~".
   VmapNode(const ros::NodeHandle& node, const ros::NodeHandle& private_node);
+  // A teach run still going is finished: its map is written (as when ~teach/stop is called).
   ~VmapNode();
   VmapNode(const VmapNode&) = delete;
   VmapNode& operator=(const VmapNode&) = delete;
 
  private:
-  enum class Mode { kIdle, kRepeating, kPaused };
+  // kFinishing: a teach run's map is being written; no run starts meanwhile.
+  enum class Mode { kIdle, kTeaching, kFinishing, kRepeating, kPaused };
   struct Arrival {
     topic_tools::ShapeShifter::ConstPtr message;
     ros::WallTime time;  // when the callback got it
   };
 
+  // vmap_node.cc: the camera, the worker, what both runs share.
   void OnImage(const topic_tools::ShapeShifter::ConstPtr& message);
   void OnCameraInfo(const sensor_msgs::CameraInfo::ConstPtr& info);
+  void SubscribeCamera();
+  void UnsubscribeCamera();
+  void Work();
+  // Why a run cannot start now ("a teach run is in progress; ..."); "" when the node is idle. Under mutex_.
+  std::string Busy() const;
+  std::string MapOf(const std::string& requested) const;
+  // Logs an error of a message: at once when its problem differs from the last one logged, else at most every
+  // few seconds (a camera sending one malformed message 30 times a second would flood the log).
+  void LogMessageError(const std::string& text, const std::string& problem);
+  // Every parameter the node reads, for the warning about the others.
+  std::set<std::string> KnownParameters() const;
 
+  // teach_mode.cc
+  bool StartTeach(vmap_ros::StartTeach::Request& request, vmap_ros::StartTeach::Response& response);
+  bool StopTeach(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  void PublishTeachProgress();
+
+  // repeat_mode.cc
   bool StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::StartRepeat::Response& response);
   bool PauseRepeat(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
   bool ResumeRepeat(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
   bool StopRepeat(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
-
-  void Work();
+  void OnOdometry(const nav_msgs::Odometry::ConstPtr& odometry);
   void RepeatFrame(const Arrival& arrival);
   void PublishStop();
-  // Logs an error of a message: at once when its problem differs from the last one logged, else at most every
-  // few seconds (a camera sending one malformed message 30 times a second would flood the log).
-  void LogMessageError(const std::string& text, const std::string& problem);
-  std::string MapOf(const std::string& requested) const;
 
   ros::NodeHandle node_;
   ros::NodeHandle private_node_;
@@ -73,24 +98,35 @@ class VmapNode {
 
   ros::Subscriber image_subscriber_;
   ros::Subscriber camera_info_subscriber_;
+  ros::Subscriber odometry_subscriber_;
   ros::Publisher cmd_vel_;
   ros::Publisher localization_;
   ros::Publisher localized_;
   ros::Publisher debug_image_;
+  ros::Publisher teach_progress_;
   std::vector<ros::ServiceServer> services_;
 
   Mailbox<Arrival> mailbox_{1};
   std::atomic<bool> stopping_{false};
   std::thread worker_;
 
-  // Guards mode_ and the run's pointer. run_mutex_ is held while the worker processes a frame, so that a service
-  // that ends a run waits for its frame (taken first when both are needed).
+  // mutex_ guards mode_ and the runs' pointers. run_mutex_ is held while the worker processes a frame, so that a
+  // service that ends a repeat run waits for its frame (taken first when both are needed).
   std::mutex run_mutex_;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   Mode mode_ = Mode::kIdle;
   std::unique_ptr<RepeatRun> repeat_;
+  std::unique_ptr<TeachRun> teach_;
   bool localized_once_ = false;
-  long malformed_ = 0;  // camera messages that could not be decoded, since the node started
+  bool goal_reached_ = false;
+  OdometryBuffer odometry_;
+  // A teach run's odometry, written beside its map (teach_odometry.h).
+  std::mutex teach_odometry_mutex_;
+  bool recording_teach_odometry_ = false;
+  std::vector<OdometrySample> teach_odometry_;
+  long malformed_ = 0;  // camera messages a repeat run could not decode, since the node started
+  std::atomic<long> teach_frames_{0};
+  std::atomic<long> teach_dropped_{0};
 
   // The camera's latest CameraInfo (a teach run's map gets it) and, in a repeat run, the map's camera to check it
   // against once.

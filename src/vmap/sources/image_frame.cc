@@ -38,4 +38,8 @@ Frame FrameFromImage(const cv::Mat& image, int index, const cv::Size& size, cons
   return frame;
 }
 
+void FitFrameToSequence(Frame& frame, SequenceInfo* info, const FrameSourceOptions& options, int* warnings) {
+  internal::FitToSequence(frame, info, options, warnings);
+}
+
 }  // namespace vmap

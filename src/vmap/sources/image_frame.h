@@ -15,4 +15,10 @@ namespace vmap {
 // is of another type or of a size FrameSizeProblem refuses.
 Frame FrameFromImage(const cv::Mat& image, int index, const cv::Size& size = {}, const std::string& what = "image");
 
+// Brings a frame that a host decoded itself (a ROS node's camera topic) into its sequence as the sources bring
+// theirs: the first frame (index 0) sets `info`'s native size and the size frames are delivered at
+// (options.resize); every frame is then brought to that size (one of another size than the first: a warning, or an
+// OptionError with options.strict).
+void FitFrameToSequence(Frame& frame, SequenceInfo* info, const FrameSourceOptions& options, int* warnings);
+
 }  // namespace vmap

@@ -50,6 +50,14 @@ bool ParseNumber(const std::string& text, double* value) {
 
 }  // namespace
 
+std::string OdometryCsv(const std::vector<OdometrySample>& samples) {
+  std::string csv = "timestamp,x,y,yaw\n";
+  for (const OdometrySample& sample : samples) {
+    csv += fmt::format("{:.17g},{:.17g},{:.17g},{:.17g}\n", sample.timestamp, sample.x, sample.y, sample.yaw);
+  }
+  return csv;
+}
+
 std::vector<OdometrySample> ReadOdometryCsv(const std::filesystem::path& path) {
   const std::string name = path.string();
   std::ifstream in(path);

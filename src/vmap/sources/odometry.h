@@ -35,6 +35,9 @@ inline constexpr const char* kOdometryType = "nav_msgs/Odometry";
 // and line: a value that is not a finite number, fewer than four columns, timestamps that go backwards, no
 // sample at all, more than 10 million lines.
 std::vector<OdometrySample> ReadOdometryCsv(const std::filesystem::path& path);
+// The text of such a CSV (with its header line), every value to full precision: ReadOdometryCsv reads the same
+// samples back.
+std::string OdometryCsv(const std::vector<OdometrySample>& samples);
 
 // The nav_msgs/Odometry topics of a recording (RecordingReader::Topics).
 std::vector<std::string> OdometryTopics(const std::vector<RecordingTopic>& topics);

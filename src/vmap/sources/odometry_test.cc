@@ -39,6 +39,20 @@ TEST(OdometryCsv, ReadsTimestampedPoses) {
   EXPECT_TRUE(std::isnan(track.DistanceAt(2.0)));
 }
 
+TEST(OdometryCsv, WrittenSamplesReadBackExactly) {
+  testing::ScopedTempDir temp("odometry_csv_write");
+  const std::vector<OdometrySample> samples = {{1000.1, 0.1, -2.0 / 3.0, 0.25}, {1000.2, 1.0 / 3.0, 1e-17, -3.0}};
+  std::ofstream(temp.path() / "odom.csv") << OdometryCsv(samples);
+  const std::vector<OdometrySample> read = ReadOdometryCsv(temp.path() / "odom.csv");
+  ASSERT_EQ(read.size(), samples.size());
+  for (size_t i = 0; i < samples.size(); ++i) {
+    EXPECT_EQ(read[i].timestamp, samples[i].timestamp);
+    EXPECT_EQ(read[i].x, samples[i].x);
+    EXPECT_EQ(read[i].y, samples[i].y);
+    EXPECT_EQ(read[i].yaw, samples[i].yaw);
+  }
+}
+
 TEST(OdometryCsv, MalformedFilesAreRefusedNamingTheLine) {
   EXPECT_NE(ErrorOfCsv("").find("no timestamp"), std::string::npos);
   EXPECT_NE(ErrorOfCsv("0,0,0,0\n1,0,0\n").find("line 2"), std::string::npos);

@@ -16,6 +16,7 @@ MD5 = {
     "sensor_msgs/Image": "060021388200f6f0f447d0fcd9c64743",
     "sensor_msgs/CompressedImage": "8f7a12909da2c9d3332d540a0977563f",
     "sensor_msgs/CameraInfo": "c9a58c1b0b154e0e6da7578cb991d214",
+    "nav_msgs/Odometry": "cd5e73d190d741a2f92e81eda573aca7",
 }
 
 

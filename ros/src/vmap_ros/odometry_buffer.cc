@@ -1,0 +1,35 @@
+#include "vmap_ros/odometry_buffer.h"
+
+#include <algorithm>
+
+namespace vmap::ros_node {
+
+void OdometryBuffer::Add(const OdometrySample& sample) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!samples_.empty() && sample.timestamp <= samples_.back().timestamp) return;
+  samples_.push_back(sample);
+  while (samples_.front().timestamp < sample.timestamp - keep_seconds_) samples_.pop_front();
+}
+
+std::optional<OdometrySample> OdometryBuffer::At(double timestamp) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (samples_.empty() || timestamp < samples_.front().timestamp) return std::nullopt;
+  if (timestamp >= samples_.back().timestamp) {
+    if (timestamp - samples_.back().timestamp > max_gap_seconds_) return std::nullopt;
+    OdometrySample last = samples_.back();
+    last.timestamp = timestamp;
+    return last;
+  }
+  // The two samples around it, interpolated as the odometry of a recording is (sources/odometry.h).
+  const auto after = std::lower_bound(samples_.begin(), samples_.end(), timestamp,
+                                      [](const OdometrySample& s, double t) { return s.timestamp < t; });
+  if (after == samples_.begin()) return *after;
+  return InterpolateOdometry({*(after - 1), *after}, timestamp);
+}
+
+void OdometryBuffer::Clear() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  samples_.clear();
+}
+
+}  // namespace vmap::ros_node

@@ -1,0 +1,217 @@
+// The node's repeat run (vmap_node.h): services, each camera frame localized, what is published for it.
+
+#include <cmath>
+
+#include <cv_bridge/cv_bridge.h>
+#include <fmt/format.h>
+#include <geometry_msgs/Twist.h>
+#include <std_msgs/Bool.h>
+
+#include "vmap/core/error.h"
+#include "vmap/sources/odometry.h"
+
+#include "vmap_ros/Localization.h"
+#include "vmap_ros/debug_image.h"
+#include "vmap_ros/localization_message.h"
+#include "vmap_ros/parameter_reader.h"
+#include "vmap_ros/service_answers.h"
+#include "vmap_ros/teach_odometry.h"
+#include "vmap_ros/vmap_node.h"
+
+namespace vmap::ros_node {
+namespace {
+
+std::string RouteText(const std::vector<int>& route) {
+  if (route.empty()) return "an empty route";
+  return fmt::format("key image {} to {} ({} key images)", route.front(), route.back(), route.size());
+}
+
+}  // namespace
+
+bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::StartRepeat::Response& response) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (mode_ != Mode::kIdle) return Fail(response, "repeat/start: " + Busy());
+  }
+  LocalizePipelineOptions options;
+  options.map = MapOf(request.map);
+  if (options.map.empty()) return Fail(response, "repeat/start: no map; give one in the request or set ~map");
+  ParameterReader parameters(private_node_);
+  std::unique_ptr<RepeatRun> run;
+  std::string taught_with;
+  try {
+    parameters.Read(options.session);  // vmap localize's flags, --from and --to included
+    options.session.CheckGiven({parameters.given().begin(), parameters.given().end()});
+    if (request.start >= 0) options.session.from = request.start;
+    if (request.goal >= 0) options.session.to = request.goal;
+    options.session.run.show_progress = false;
+    ControllerOptions controller;
+    parameters.Read(controller);  // the controller's flags (vmap simulate's)
+    // The teach run's odometry, when the robot had one (teach_odometry.h), for the taught speeds and turns.
+    std::string teach_odometry, teach_odometry_topic;
+    private_node_.getParam("teach_odometry", teach_odometry);
+    private_node_.getParam("teach_odometry_topic", teach_odometry_topic);
+    const std::vector<OdometrySample> taught = TeachOdometryFor(options.map, teach_odometry, teach_odometry_topic);
+    run = std::make_unique<RepeatRun>(options, controller, taught);
+    taught_with = taught.empty() ? "the map alone (no teach odometry)"
+                                 : fmt::format("the teach odometry ({} samples)", taught.size());
+  } catch (const InputError& error) {
+    return Fail(response, "repeat/start: " + parameters.Message(error));
+  } catch (const std::exception& error) {
+    return Fail(response, std::string("repeat/start: ") + error.what());
+  }
+  response.route = run->route();
+  const std::optional<Camera> map_camera = run->options().camera;
+  const std::string started = fmt::format("repeat run started on map {}: {}, the taught profile from {}", options.map,
+                                          RouteText(run->route()), taught_with);
+  {
+    std::lock_guard<std::mutex> run_lock(run_mutex_);
+    std::lock_guard<std::mutex> lock(mutex_);
+    repeat_ = std::move(run);
+    mode_ = Mode::kRepeating;
+    localized_once_ = false;
+    goal_reached_ = false;
+    mailbox_.Reset(1);
+  }
+  odometry_.Clear();
+  odometry_subscriber_ = node_.subscribe("odom", 50, &VmapNode::OnOdometry, this);
+  {
+    std::lock_guard<std::mutex> lock(camera_mutex_);
+    map_camera_ = map_camera;
+    camera_checked_ = false;
+  }
+  std_msgs::Bool localized;
+  localized.data = false;
+  localized_.publish(localized);
+  SubscribeCamera();
+  return Succeed(response, started);
+}
+
+bool VmapNode::PauseRepeat(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (mode_ == Mode::kIdle) return Fail(response, "repeat/pause: no repeat run is in progress");
+  if (mode_ == Mode::kPaused) return Fail(response, "repeat/pause: the repeat run is paused already");
+  mode_ = Mode::kPaused;
+  PublishStop();
+  return Succeed(response, "repeat run paused: the robot stops; frames are still localized");
+}
+
+bool VmapNode::ResumeRepeat(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+  std::lock_guard<std::mutex> run_lock(run_mutex_);  // the controller starts again between two frames
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (mode_ != Mode::kRepeating && mode_ != Mode::kPaused) {
+    return Fail(response, "repeat/resume: no repeat run is in progress");
+  }
+  if (mode_ == Mode::kRepeating) return Fail(response, "repeat/resume: the repeat run is not paused");
+  repeat_->ResetController();
+  mode_ = Mode::kRepeating;
+  return Succeed(response, "repeat run resumed: the robot drives again once a frame is localized");
+}
+
+bool VmapNode::StopRepeat(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+  int frames = 0;
+  {
+    std::lock_guard<std::mutex> run_lock(run_mutex_);  // the frame in progress ends first
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (mode_ == Mode::kIdle) return Fail(response, "repeat/stop: no repeat run is in progress");
+    frames = repeat_->frames();
+    mode_ = Mode::kIdle;
+    repeat_.reset();
+    mailbox_.Reset(1);
+  }
+  UnsubscribeCamera();
+  odometry_subscriber_.shutdown();
+  PublishStop();
+  return Succeed(response, fmt::format("repeat run stopped after {} frames", frames));
+}
+
+void VmapNode::OnOdometry(const nav_msgs::Odometry::ConstPtr& odometry) {
+  // Both runs: a repeat run's controller reads it at each frame's time, a teach run keeps it for its map.
+  const geometry_msgs::Quaternion& q = odometry->pose.pose.orientation;
+  OdometrySample sample;
+  sample.timestamp = odometry->header.stamp.toSec();
+  sample.x = odometry->pose.pose.position.x;
+  sample.y = odometry->pose.pose.position.y;
+  sample.yaw = std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
+  if (std::isfinite(sample.timestamp) && std::isfinite(sample.x) && std::isfinite(sample.y) &&
+      std::isfinite(sample.yaw)) {
+    odometry_.Add(sample);
+    std::lock_guard<std::mutex> lock(teach_odometry_mutex_);
+    if (recording_teach_odometry_ && (teach_odometry_.empty() || sample.timestamp > teach_odometry_.back().timestamp)) {
+      teach_odometry_.push_back(sample);
+    }
+  } else {
+    LogMessageError("an Odometry message on " + node_.resolveName("odom") +
+                        " has a value that is not a finite "
+                        "number; the message is ignored",
+                    "odometry not finite");
+  }
+}
+
+void VmapNode::PublishStop() { cmd_vel_.publish(geometry_msgs::Twist()); }
+
+void VmapNode::RepeatFrame(const Arrival& arrival) {
+  Mode mode;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    mode = mode_;
+  }
+  if (mode == Mode::kIdle) return;
+  CameraImage image;
+  try {
+    image = DecodeCameraImage(*arrival.message, image_topic_);
+  } catch (const InputError& error) {
+    ++malformed_;
+    LogMessageError(fmt::format("{}; frame skipped ({} so far)", error.what(), malformed_), error.what());
+    return;
+  }
+  // The controller's clock is the camera's (an odometry topic stamps by the same clock); the arrival time for a
+  // camera that leaves its stamps zero.
+  const double time = image.stamp > 0.0 ? image.stamp : ros::Time::now().toSec();
+  RepeatStep step;
+  ControlSummary control;
+  if (mode == Mode::kPaused) {
+    step.localization = repeat_->Localize(image);
+    control.state = "paused";
+  } else {
+    const std::optional<OdometrySample> odometry = odometry_.At(time);
+    step = repeat_->Step(image, time, odometry ? &*odometry : nullptr);
+    control.state = ControllerStateName(step.control.state);
+    control.steering = step.control.steering;
+    control.command.linear.x = step.control.command.linear;
+    control.command.angular.z = step.control.command.angular;
+    cmd_vel_.publish(control.command);
+    if (step.control.localized && !localized_once_) {
+      localized_once_ = true;
+      std_msgs::Bool message;
+      message.data = true;
+      localized_.publish(message);
+      ROS_INFO("first localization: key image %d (%s)", step.localization.key,
+               LocalizationStatusName(step.localization.status).c_str());
+    }
+    if (step.control.state == ControllerState::kReachedGoal && !goal_reached_) {
+      goal_reached_ = true;
+      ROS_INFO("goal key image %d reached: the robot stops", repeat_->route().back());
+    }
+  }
+  control.localized = localized_once_;
+  const LocalizationResult& result = step.localization;
+
+  vmap_ros::Localization message = LocalizationMessage(image.header, result, repeat_->route(), control);
+  message.latency = (ros::WallTime::now() - arrival.time).toSec();
+  message.frames_dropped = static_cast<uint32_t>(mailbox_.TakeDropped());
+  localization_.publish(message);
+
+  if (debug_image_.getNumSubscribers() > 0) {
+    const KeyComparison* comparison = SteeringComparison(result);
+    const std::string caption =
+        fmt::format("frame {} {} | key {} next {} | {}", result.frame_index, LocalizationStatusName(result.status),
+                    result.key, result.next_key, control.state);
+    const cv::Mat figure =
+        DrawDebugImage(repeat_->frame().color.empty() ? repeat_->frame().gray : repeat_->frame().color,
+                       comparison ? repeat_->KeyImage(comparison->key) : cv::Mat(), comparison, caption);
+    debug_image_.publish(cv_bridge::CvImage(image.header, "bgr8", figure).toImageMsg());
+  }
+}
+
+}  // namespace vmap::ros_node

@@ -1,0 +1,135 @@
+// The node's teach run (vmap_node.h): services, the camera's frames into the build pipeline, progress.
+
+#include <fmt/format.h>
+
+#include "vmap/core/error.h"
+
+#include "vmap_ros/TeachProgress.h"
+#include "vmap_ros/parameter_reader.h"
+#include "vmap_ros/service_answers.h"
+#include "vmap_ros/teach_odometry.h"
+#include "vmap_ros/vmap_node.h"
+
+namespace vmap::ros_node {
+namespace {
+
+// Frames held while the map builder is busy, by default: two seconds of a 30 Hz camera.
+constexpr int kTeachQueue = 60;
+
+// `vmap build`'s flags that name what a recording is read from: the node's input is its camera topic.
+constexpr const char* kRecordingOnly[] = {"format", "topic", "until_interrupted"};
+
+}  // namespace
+
+bool VmapNode::StartTeach(vmap_ros::StartTeach::Request& request, vmap_ros::StartTeach::Response& response) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (mode_ != Mode::kIdle) return Fail(response, "teach/start: " + Busy());
+  }
+  const std::string map = MapOf(request.map);
+  if (map.empty()) return Fail(response, "teach/start: no map; give one in the request or set ~map");
+  ParameterReader parameters(private_node_);
+  std::unique_ptr<TeachRun> run;
+  try {
+    BuildPipelineOptions options;
+    parameters.Read(options);
+    for (const char* name : kRecordingOnly) {
+      if (private_node_.hasParam(name)) {
+        throw InputError(
+            fmt::format("~{} is vmap build's option for recordings; the node's camera is the `image` "
+                        "topic: remap it, and drop ~{}",
+                        name, name));
+      }
+    }
+    options.input = image_topic_;
+    options.output = map;
+    options.until_interrupted = false;
+    options.map.show_progress = false;
+    options.map.after_frame = [this] { PublishTeachProgress(); };
+    int capacity = kTeachQueue;
+    private_node_.getParam("teach_queue", capacity);
+    if (capacity < 1) throw InputError("~teach_queue must be at least 1 (frames held while the builder is busy)");
+    run = std::make_unique<TeachRun>(options, static_cast<size_t>(capacity));
+  } catch (const InputError& error) {
+    return Fail(response, "teach/start: " + parameters.Message(error));
+  } catch (const std::exception& error) {
+    return Fail(response, std::string("teach/start: ") + error.what());
+  }
+  {
+    std::lock_guard<std::mutex> camera_lock(camera_mutex_);
+    if (camera_) run->source().SetCamera(camera_);  // the latest CameraInfo, if the topic went quiet before
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    teach_ = std::move(run);
+    teach_frames_ = 0;
+    teach_dropped_ = 0;
+    mode_ = Mode::kTeaching;
+  }
+  {
+    std::lock_guard<std::mutex> lock(teach_odometry_mutex_);
+    teach_odometry_.clear();
+    recording_teach_odometry_ = true;
+  }
+  SubscribeCamera();
+  odometry_subscriber_ = node_.subscribe("odom", 100, &VmapNode::OnOdometry, this);
+  return Succeed(response, fmt::format("teach run started: frames of {} go into the map {}", image_topic_, map));
+}
+
+bool VmapNode::StopTeach(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+  std::unique_ptr<TeachRun> run;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (mode_ != Mode::kTeaching) return Fail(response, "teach/stop: no teach run is in progress");
+    run = std::move(teach_);
+    mode_ = Mode::kFinishing;  // no other run starts while this map is written
+  }
+  UnsubscribeCamera();
+  odometry_subscriber_.shutdown();
+  std::vector<OdometrySample> odometry;
+  {
+    std::lock_guard<std::mutex> lock(teach_odometry_mutex_);
+    recording_teach_odometry_ = false;
+    odometry.swap(teach_odometry_);
+  }
+  const long received = run->source().received();
+  std::string answer;
+  bool success = true;
+  try {
+    const BuildPipelineResult result = run->Stop();
+    teach_dropped_ += static_cast<long>(run->source().dropped());
+    answer = fmt::format("teach run stopped: map {} written, {} key images from {} frames ({} dropped, {} skipped)",
+                         result.directory.string(), result.map.key_images.size(), teach_frames_.load(),
+                         teach_dropped_.load(), run->source().skipped_frames());
+    if (!odometry.empty()) {
+      WriteTeachOdometry(result.directory, odometry);
+      answer += fmt::format(", and {} odometry samples beside it ({})", odometry.size(), kTeachOdometryFileName);
+    }
+  } catch (const std::exception& error) {
+    success = false;
+    answer = fmt::format("teach/stop: the map could not be written ({} frames received): {}", received, error.what());
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    mode_ = Mode::kIdle;
+  }
+  return success ? Succeed(response, answer) : Fail(response, answer);
+}
+
+void VmapNode::PublishTeachProgress() {
+  ++teach_frames_;
+  vmap_ros::TeachProgress progress;
+  progress.header.stamp = ros::Time::now();
+  progress.frames = static_cast<uint32_t>(teach_frames_);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (teach_) {
+      teach_dropped_ += teach_->source().dropped();
+      progress.skipped = static_cast<uint32_t>(teach_->source().skipped_frames());
+    }
+  }
+  progress.dropped = static_cast<uint32_t>(teach_dropped_);
+  teach_progress_.publish(progress);
+}
+
+}  // namespace vmap::ros_node

@@ -1,0 +1,94 @@
+#include "vmap_ros/topic_frame_source.h"
+
+#include <fmt/format.h>
+#include <ros/time.h>
+#include <spdlog/spdlog.h>
+
+#include "vmap/core/error.h"
+#include "vmap/sources/dataset_camera.h"
+#include "vmap/sources/image_frame.h"
+
+#include "vmap_ros/camera_messages.h"
+
+namespace vmap::ros_node {
+namespace {
+constexpr std::chrono::milliseconds kPoll{100};
+}  // namespace
+
+TopicFrameSource::TopicFrameSource(std::string topic, const FrameSourceOptions& options, size_t capacity)
+    : topic_(std::move(topic)), options_(options), mailbox_(capacity) {
+  options_.Check();
+  info_.path = topic_;
+  info_.format = SourceFormat::kRecording;
+  // --camera overrides the topic's CameraInfo, --camera none ignores it (as for a recording).
+  if (!options_.camera.empty()) {
+    camera_given_ = true;
+    if (options_.camera != "none") camera_ = ParseCameraOption(options_.camera);
+  }
+}
+
+void TopicFrameSource::Put(const topic_tools::ShapeShifter::ConstPtr& message) {
+  const double now = ros::Time::now().toSec();
+  if (mailbox_.Put(Received{message, now})) ++received_;
+}
+
+void TopicFrameSource::SetCamera(const std::optional<Camera>& camera) {
+  std::lock_guard<std::mutex> lock(camera_mutex_);
+  if (camera_given_) return;
+  camera_given_ = true;
+  camera_ = camera;
+}
+
+void TopicFrameSource::End() { mailbox_.Close(); }
+
+std::optional<Frame> TopicFrameSource::Next() {
+  pulled_ = true;
+  for (;;) {
+    if (options_.last >= 0 && position_ > options_.last) return std::nullopt;
+    std::optional<Received> received = mailbox_.Take(kPoll);
+    if (!received) {
+      if (mailbox_.closed_and_empty()) return std::nullopt;
+      continue;
+    }
+    const long index = position_++;
+    if (index < options_.first || (index - options_.first) % options_.stride != 0) continue;
+    CameraImage image;
+    try {
+      image = DecodeCameraImage(*received->message, topic_);
+    } catch (const InputError& error) {
+      ++skipped_;
+      spdlog::warn("{}; skipping it", error.what());
+      continue;
+    }
+    const std::string size_problem = FrameSizeProblem(image.gray.size(), options_);
+    if (!size_problem.empty()) {
+      ++skipped_;
+      spdlog::warn("{}: frame {} is {}x{}, {}; skipping it", topic_, index, image.gray.cols, image.gray.rows,
+                   size_problem);
+      continue;
+    }
+    Frame frame;
+    frame.gray = std::move(image.gray);
+    frame.color = std::move(image.color);
+    frame.index = delivered_++;
+    frame.source_index = static_cast<int>(index);
+    frame.source_name = fmt::format("frame_{:06d}", index);
+    frame.timestamp = image.stamp > 0.0 ? image.stamp : received->arrival;
+    FitFrameToSequence(frame, &info_, options_, &size_warnings_);
+    if (!info_.camera) {
+      std::lock_guard<std::mutex> lock(camera_mutex_);
+      if (camera_) {
+        try {
+          info_.camera = CameraForFrames(*camera_, info_.native_size, info_.frame_size);
+        } catch (const InputError& error) {
+          // A live run goes on without it (`vmap build` on a recording stops): the map has pixel headings only.
+          spdlog::warn("{}; the map gets no camera (give ~camera to set one)", error.what());
+          camera_.reset();
+        }
+      }
+    }
+    return frame;
+  }
+}
+
+}  // namespace vmap::ros_node

@@ -1,0 +1,218 @@
+// The node's parts that need no ROS master: the mailbox, camera messages as frames, the odometry buffer, parameter
+// names, the localization message's pose.
+
+#include <cmath>
+#include <thread>
+
+#include <geometry_msgs/Twist.h>
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sensor_msgs/CompressedImage.h>
+#include <sensor_msgs/Image.h>
+
+#include "vmap/core/error.h"
+#include "vmap/sources/recording_reader.h"
+#include "vmap/sources/ros_image_messages.h"
+
+#include "vmap_ros/camera_messages.h"
+#include "vmap_ros/localization_message.h"
+#include "vmap_ros/mailbox.h"
+#include "vmap_ros/odometry_buffer.h"
+#include "vmap_ros/parameter_reader.h"
+
+namespace vmap::ros_node {
+namespace {
+
+// A message as a ShapeShifter subscription receives it: its bytes and its type.
+template <typename Message>
+topic_tools::ShapeShifter AsReceived(const Message& message) {
+  std::vector<uint8_t> bytes = SerializeMessage(message);
+  topic_tools::ShapeShifter shifter;
+  shifter.morph(ros::message_traits::md5sum(message), ros::message_traits::datatype(message),
+                ros::message_traits::definition(message), "0");
+  ros::serialization::IStream stream(bytes.data(), static_cast<uint32_t>(bytes.size()));
+  shifter.read(stream);
+  return shifter;
+}
+
+cv::Mat TestPattern() {
+  cv::Mat image(120, 160, CV_8UC3);
+  cv::randu(image, cv::Scalar::all(0), cv::Scalar::all(255));
+  cv::GaussianBlur(image, image, cv::Size(5, 5), 1.5);
+  return image;
+}
+
+sensor_msgs::Image ImageMessage(const cv::Mat& pixels, const std::string& encoding, int padding = 0) {
+  sensor_msgs::Image image;
+  image.header.stamp = ros::Time(12.5);
+  image.header.frame_id = "cam";
+  image.width = pixels.cols;
+  image.height = pixels.rows;
+  image.encoding = encoding;
+  image.step = static_cast<uint32_t>(pixels.cols * pixels.elemSize() + padding);
+  image.data.assign(image.step * image.height, 0);
+  for (int y = 0; y < pixels.rows; ++y) {
+    std::memcpy(&image.data[y * image.step], pixels.ptr(y), pixels.cols * pixels.elemSize());
+  }
+  return image;
+}
+
+TEST(Mailbox, KeepsTheNewestAndCountsWhatItPushedOut) {
+  Mailbox<int> mailbox(1);
+  for (int i = 0; i < 5; ++i) EXPECT_TRUE(mailbox.Put(i));
+  EXPECT_EQ(mailbox.Take(std::chrono::milliseconds(0)), 4);
+  EXPECT_EQ(mailbox.TakeDropped(), 4u);
+  EXPECT_EQ(mailbox.TakeDropped(), 0u);
+  EXPECT_FALSE(mailbox.Take(std::chrono::milliseconds(1)).has_value());
+}
+
+TEST(Mailbox, HoldsItsCapacityInOrderAndDrainsAfterClose) {
+  Mailbox<int> mailbox(3);
+  for (int i = 0; i < 4; ++i) mailbox.Put(i);
+  mailbox.Close();
+  EXPECT_FALSE(mailbox.Put(9));
+  EXPECT_FALSE(mailbox.closed_and_empty());
+  EXPECT_EQ(mailbox.Take(std::chrono::milliseconds(0)), 1);
+  EXPECT_EQ(mailbox.Take(std::chrono::milliseconds(0)), 2);
+  EXPECT_EQ(mailbox.Take(std::chrono::milliseconds(0)), 3);
+  EXPECT_TRUE(mailbox.closed_and_empty());
+  EXPECT_EQ(mailbox.TakeDropped(), 1u);
+}
+
+TEST(Mailbox, TakeWakesWhenAnItemArrives) {
+  Mailbox<int> mailbox(1);
+  std::thread producer([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    mailbox.Put(7);
+  });
+  EXPECT_EQ(mailbox.Take(std::chrono::seconds(30)), 7);
+  producer.join();
+}
+
+TEST(CameraMessages, DecodesAnImageAsVmapDecodesItsRecording) {
+  const cv::Mat pattern = TestPattern();
+  for (const std::string encoding : {"bgr8", "rgb8", "mono8"}) {
+    SCOPED_TRACE(encoding);
+    cv::Mat pixels = pattern.clone();
+    if (encoding == "rgb8") cv::cvtColor(pattern, pixels, cv::COLOR_BGR2RGB);
+    if (encoding == "mono8") cv::cvtColor(pattern, pixels, cv::COLOR_BGR2GRAY);
+    const sensor_msgs::Image message = ImageMessage(pixels, encoding, /*padding=*/3);
+    const CameraImage image = DecodeCameraImage(AsReceived(message), "/cam/image_raw");
+    const std::vector<uint8_t> bytes = SerializeMessage(message);
+    const DecodedImage recorded =
+        DecodeImageMessage(bytes.data(), bytes.size(), "sensor_msgs/Image", MessageEncoding::kRos1, "a message");
+    EXPECT_EQ(cv::norm(image.gray, recorded.gray, cv::NORM_INF), 0.0);
+    EXPECT_EQ(image.color.empty(), encoding == "mono8");
+    if (!image.color.empty()) {
+      EXPECT_EQ(cv::norm(image.color, pattern, cv::NORM_INF), 0.0);
+    }
+    EXPECT_DOUBLE_EQ(image.stamp, 12.5);
+    EXPECT_EQ(image.header.frame_id, "cam");
+  }
+}
+
+TEST(CameraMessages, DecodesACompressedImage) {
+  const cv::Mat pattern = TestPattern();
+  sensor_msgs::CompressedImage message;
+  message.header.stamp = ros::Time(3.0);
+  message.format = "png";
+  cv::imencode(".png", pattern, message.data);
+  const CameraImage image = DecodeCameraImage(AsReceived(message), "/cam/image_raw/compressed");
+  EXPECT_EQ(cv::norm(image.color, pattern, cv::NORM_INF), 0.0);
+  EXPECT_DOUBLE_EQ(image.stamp, 3.0);
+}
+
+TEST(CameraMessages, RefusesMalformedImagesAndOtherTypesNamingTheTopic) {
+  const cv::Mat pattern = TestPattern();
+  sensor_msgs::Image short_data = ImageMessage(pattern, "bgr8");
+  short_data.data.resize(100);
+  sensor_msgs::Image short_step = ImageMessage(pattern, "bgr8");
+  short_step.step = 100;
+  sensor_msgs::Image unknown = ImageMessage(pattern, "bgr8");
+  unknown.encoding = "yuv422";
+  sensor_msgs::CompressedImage garbage;
+  garbage.format = "jpeg";
+  garbage.data = {1, 2, 3};
+  const auto refusal = [](const topic_tools::ShapeShifter& message) {
+    try {
+      DecodeCameraImage(message, "/cam/image_raw");
+    } catch (const InputError& error) {
+      return std::string(error.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(refusal(AsReceived(short_data)).find("needs more than its 100 bytes"), std::string::npos);
+  EXPECT_NE(refusal(AsReceived(short_step)).find("with step 100"), std::string::npos);
+  EXPECT_NE(refusal(AsReceived(unknown)).find("encoding 'yuv422'"), std::string::npos);
+  EXPECT_NE(refusal(AsReceived(garbage)).find("cannot decode"), std::string::npos);
+  const std::string twist = refusal(AsReceived(geometry_msgs::Twist()));
+  EXPECT_NE(twist.find("/cam/image_raw carries geometry_msgs/Twist"), std::string::npos) << twist;
+}
+
+TEST(CameraMessages, ACameraInfoWithNanOrNoCalibration) {
+  sensor_msgs::CameraInfo info;
+  info.width = 640;
+  info.height = 480;
+  info.distortion_model = "plumb_bob";
+  info.K = {500, 0, 320, 0, 500, 240, 0, 0, 1};
+  const std::optional<Camera> camera = CameraFromInfo(info, "/cam/camera_info");
+  ASSERT_TRUE(camera.has_value());
+  EXPECT_EQ(camera->fx, 500.0);
+  EXPECT_EQ(camera->size, cv::Size(640, 480));
+  info.K[4] = std::nan("");
+  EXPECT_THROW(CameraFromInfo(info, "/cam/camera_info"), InputError);
+  info.K = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+  EXPECT_FALSE(CameraFromInfo(info, "/cam/camera_info").has_value());  // uncalibrated
+}
+
+TEST(OdometryBuffer, InterpolatesBetweenSamplesAndGivesNoneOutsideThem) {
+  OdometryBuffer buffer(10.0, 0.5);
+  EXPECT_FALSE(buffer.At(1.0).has_value());
+  buffer.Add({1.0, 0.0, 0.0, 0.0});
+  buffer.Add({2.0, 1.0, 0.0, 0.2});
+  buffer.Add({1.5, 9.0, 9.0, 9.0});  // older than the newest: ignored
+  const std::optional<OdometrySample> middle = buffer.At(1.5);
+  ASSERT_TRUE(middle.has_value());
+  EXPECT_NEAR(middle->x, 0.5, 1e-12);
+  EXPECT_NEAR(middle->yaw, 0.1, 1e-12);
+  EXPECT_FALSE(buffer.At(0.5).has_value());  // before the odometry
+  ASSERT_TRUE(buffer.At(2.3).has_value());   // a frame a little newer: the last sample
+  EXPECT_EQ(buffer.At(2.3)->x, 1.0);
+  EXPECT_FALSE(buffer.At(2.6).has_value());  // odometry that stopped
+}
+
+TEST(Parameters, AreTheFlagsNamesWithUnderscores) {
+  EXPECT_EQ(ParameterName("--min-link-share"), "min_link_share");
+  EXPECT_EQ(ParameterName("!--no-step-back"), "no_step_back");
+  EXPECT_EQ(ParameterName("-t,--tau"), "tau");
+  EXPECT_EQ(ParameterName("input"), "");  // a positional argument
+  EXPECT_EQ(ParameterName(""), "");
+}
+
+TEST(LocalizationMessage, CarriesTheTargetsPoseAsAQuaternion) {
+  LocalizationResult result;
+  result.status = LocalizationStatus::kTracking;
+  result.key = 2;
+  result.next_key = 3;
+  result.to_next.key = 3;
+  result.to_next.pose.valid = true;
+  const double angle = 0.3;  // about the camera's y axis (down): a turn
+  result.to_next.pose.R =
+      cv::Matx33d(std::cos(angle), 0, std::sin(angle), 0, 1, 0, -std::sin(angle), 0, std::cos(angle));
+  result.to_next.pose.t = cv::Vec3d(0.0, 0.0, 1.0);
+  std_msgs::Header header;
+  header.frame_id = "cam";
+  const vmap_ros::Localization message = LocalizationMessage(header, result, {0, 1, 2, 3, 4}, ControlSummary{});
+  EXPECT_TRUE(message.pose_valid);
+  EXPECT_NEAR(message.pose.orientation.y, std::sin(angle / 2), 1e-12);
+  EXPECT_NEAR(message.pose.orientation.w, std::cos(angle / 2), 1e-12);
+  EXPECT_EQ(message.pose.position.z, 1.0);
+  EXPECT_EQ(message.goal, 4);
+  EXPECT_EQ(message.route_length, 5);
+  EXPECT_EQ(message.status, vmap_ros::Localization::TRACKING);
+  EXPECT_EQ(message.status_name, "tracking");
+}
+
+}  // namespace
+}  // namespace vmap::ros_node

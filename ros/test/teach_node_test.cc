@@ -1,0 +1,127 @@
+// The node's teach run on a real ROS master: a bag made from a shared video is played to it, and the map it
+// writes is compared with `vmap build` on the same bag.
+
+#include <fstream>
+#include <mutex>
+
+#include <gtest/gtest.h>
+#include <std_srvs/Trigger.h>
+
+#include "vmap/map/map_io.h"
+#include "vmap/sources/odometry.h"
+#include "vmap/testing/run_vmap.h"
+#include "vmap/testing/scoped_temp_dir.h"
+#include "vmap/testing/shared_data.h"
+
+#include "ros_harness.h"
+#include "vmap_ros/StartTeach.h"
+#include "vmap_ros/TeachProgress.h"
+
+namespace vmap::ros_testing {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::Quote;
+using testing::RunVmap;
+using testing::ScopedTempDir;
+using testing::SharedDir;
+
+constexpr auto kTimeout = std::chrono::seconds(120);
+
+TEST(TeachNode, BuildsFromAPlayedBagTheMapVmapBuildBuilds) {
+  SKIP_WITHOUT_SHARED();
+  ScopedTempDir dir("ros_teach");
+  const fs::path bag = dir.path() / "teach.bag";
+  const std::vector<ros::Time> stamps =
+      WriteVideoBag(fs::path(SharedDir()) / "data/lab_floor/lab_floor.mp4", 0, 239, bag, "bgr8", /*odometry=*/true);
+  std::string output;
+  ASSERT_EQ(RunVmap("build -q " + Quote(bag) + " -o " + Quote(dir.path() / "cli_map"), &output), 0) << output;
+
+  // Frames held while the builder is busy: the whole bag, so that a slow moment of this shared machine drops none.
+  const auto node = StartVmapNode("/teach_test", {"image:=/camera/image_raw", "odom:=/odom", "_teach_queue:=300"},
+                                  dir.path() / "node.log");
+  ASSERT_TRUE(WaitForService("/teach_test/vmap/teach/start")) << node->Log();
+  ros::NodeHandle handle;
+  std::mutex mutex;
+  vmap_ros::TeachProgress progress;
+  const ros::Subscriber subscriber = handle.subscribe<vmap_ros::TeachProgress>(
+      "/teach_test/vmap/teach/progress", 1000, [&](const vmap_ros::TeachProgress::ConstPtr& message) {
+        std::lock_guard<std::mutex> lock(mutex);
+        progress = *message;
+      });
+  vmap_ros::StartTeach start;
+  start.request.map = (dir.path() / "node_map").string();
+  ASSERT_TRUE(ros::service::call("/teach_test/vmap/teach/start", start));
+  ASSERT_TRUE(start.response.success) << start.response.message;
+  ASSERT_TRUE(WaitFor([&] { return subscriber.getNumPublishers() > 0; }, kTimeout));
+
+  const auto player = PlayBag(bag, 1.0, dir.path() / "play.log");
+  ASSERT_EQ(player->Wait(std::chrono::seconds(300)), 0) << player->Log();
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(mutex);
+        return progress.frames == stamps.size();
+      },
+      kTimeout))
+      << "frames " << progress.frames << "\n"
+      << node->Log();
+  EXPECT_EQ(progress.dropped, 0u);
+  EXPECT_EQ(progress.skipped, 0u);
+  std_srvs::Trigger stop;
+  ASSERT_TRUE(ros::service::call("/teach_test/vmap/teach/stop", stop));
+  ASSERT_TRUE(stop.response.success) << stop.response.message;
+
+  // The same key images, links and camera as `vmap build` on the bag.
+  const VisualMap cli = ReadMap(dir.path() / "cli_map");
+  const VisualMap ros = ReadMap(dir.path() / "node_map");
+  ASSERT_EQ(ros.key_images.size(), cli.key_images.size());
+  for (size_t i = 0; i < cli.key_images.size(); ++i) {
+    EXPECT_EQ(ros.key_images[i].source_index, cli.key_images[i].source_index) << "key image " << i;
+    EXPECT_DOUBLE_EQ(ros.key_images[i].timestamp, cli.key_images[i].timestamp) << "key image " << i;
+  }
+  ASSERT_EQ(ros.links.size(), cli.links.size());
+  for (size_t i = 0; i < cli.links.size(); ++i) {
+    EXPECT_EQ(ros.links[i].num_verified, cli.links[i].num_verified) << "link " << i;
+    EXPECT_EQ(ros.links[i].similarity, cli.links[i].similarity) << "link " << i;
+    EXPECT_EQ(ros.links[i].has_pose, cli.links[i].has_pose) << "link " << i;
+  }
+  // The robot's odometry, beside the map for the repeat runs.
+  const std::vector<OdometrySample> odometry = ReadOdometryCsv(dir.path() / "node_map" / "teach_odometry.csv");
+  ASSERT_EQ(odometry.size(), stamps.size());
+  EXPECT_EQ(odometry.front().timestamp, stamps.front().toSec());
+  EXPECT_NEAR(odometry.back().x, 0.05 * (stamps.size() - 1), 1e-12);
+  ASSERT_TRUE(ros.input.camera.has_value());
+  EXPECT_EQ(ros.input.camera->fx, cli.input.camera->fx);
+  EXPECT_EQ(ros.input.path, "/camera/image_raw");
+  EXPECT_TRUE(node->Running());
+}
+
+TEST(TeachNode, RefusesAFolderThatIsNotAMapAndLeavesItAsItWas) {
+  ScopedTempDir dir("ros_teach_refuse");
+  fs::create_directories(dir.path() / "notes");
+  std::ofstream(dir.path() / "notes" / "todo.txt") << "my notes\n";
+  const auto node = StartVmapNode("/teach_refuse", {}, dir.path() / "node.log");
+  ASSERT_TRUE(WaitForService("/teach_refuse/vmap/teach/start")) << node->Log();
+  std_srvs::Trigger stop;
+  ASSERT_TRUE(ros::service::call("/teach_refuse/vmap/teach/stop", stop));
+  EXPECT_FALSE(stop.response.success);
+  EXPECT_NE(stop.response.message.find("no teach run is in progress"), std::string::npos) << stop.response.message;
+  vmap_ros::StartTeach start;
+  start.request.map = (dir.path() / "notes").string();
+  ASSERT_TRUE(ros::service::call("/teach_refuse/vmap/teach/start", start));
+  EXPECT_FALSE(start.response.success);
+  EXPECT_NE(start.response.message.find("notes"), std::string::npos) << start.response.message;
+  EXPECT_EQ(testing::ReadText(dir.path() / "notes" / "todo.txt"), "my notes\n");
+  EXPECT_TRUE(fs::exists(dir.path() / "notes" / "todo.txt"));
+  // A bad parameter is named.
+  ros::param::set("/teach_refuse/vmap/tau", "high");
+  start.request.map = (dir.path() / "map").string();
+  ASSERT_TRUE(ros::service::call("/teach_refuse/vmap/teach/start", start));
+  EXPECT_FALSE(start.response.success);
+  EXPECT_NE(start.response.message.find("~tau"), std::string::npos) << start.response.message;
+  EXPECT_FALSE(fs::exists(dir.path() / "map"));
+  EXPECT_TRUE(node->Running());
+}
+
+}  // namespace
+}  // namespace vmap::ros_testing
