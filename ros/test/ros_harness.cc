@@ -182,6 +182,7 @@ RosMaster::~RosMaster() {
 }
 
 fs::path VmapNodeBinary() { return VMAP_NODE_BINARY; }
+fs::path SimulatorBinary() { return VMAP_SIMULATOR_BINARY; }
 
 std::unique_ptr<ChildProcess> StartVmapNode(const std::string& ns, const std::vector<std::string>& arguments,
                                             const fs::path& log) {

@@ -84,7 +84,8 @@ std::vector<ros::Time> WriteVideoBag(const std::filesystem::path& video, int fir
 void WriteBagSubset(const std::filesystem::path& bag, const std::vector<ros::Time>& stamps,
                     const std::filesystem::path& subset);
 
-// The vmap_node binary of this build.
+// The vmap_node and vmap_simulator binaries of this build.
 std::filesystem::path VmapNodeBinary();
+std::filesystem::path SimulatorBinary();
 
 }  // namespace vmap::ros_testing

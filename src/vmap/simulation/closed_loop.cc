@@ -57,53 +57,68 @@ SimulationSummary Summarize(const std::vector<TrialResult>& trials) {
   return summary;
 }
 
-SimulationResult Simulate(const SimulationOptions& options, const MatcherOptions& matcher_options,
-                          const std::filesystem::path& map_directory,
-                          const std::function<void(const TrialResult&)>& on_trial) {
-  const auto start = std::chrono::steady_clock::now();
+std::unique_ptr<PreparedTrials> PrepareTrials(const SimulationOptions& options, const MatcherOptions& matcher_options,
+                                              const std::filesystem::path& map_directory) {
   // 1. Everything that can be refused, before any work.
   options.Check();
   matcher_options.Check();
-  SimulationResult result;
-  result.route = LoadSimulatedRoute(options);
+  auto prepared = std::make_unique<PreparedTrials>();
+  prepared->route = LoadSimulatedRoute(options);
   if (options.teach_textures.empty() && !options.repeat_textures.empty()) {
     throw InputError("--repeat-textures replaces the teach textures in another season; give --teach-textures too");
   }
   const std::vector<cv::Mat> teach_images =
       options.teach_textures.empty()
-          ? ProceduralTextures(TexturesToCover(result.route.corridor.length(), options.corridor), kTextureSeed)
+          ? ProceduralTextures(TexturesToCover(prepared->route.corridor.length(), options.corridor), kTextureSeed)
           : ReadTextureFolder(options.teach_textures, "--teach-textures");
   const std::vector<cv::Mat> repeat_images = options.repeat_textures.empty()
                                                  ? std::vector<cv::Mat>{}
                                                  : ReadTextureFolder(options.repeat_textures, "--repeat-textures");
 
   // 2. The worlds: the repeat world shows the repeat textures in the teach world's panels.
-  const CorridorWorld teach_world(result.route.corridor, options.corridor, teach_images);
-  const CorridorWorld repeat_world = repeat_images.empty() ? teach_world : teach_world.WithImages(repeat_images);
+  prepared->teach_world.emplace(prepared->route.corridor, options.corridor, teach_images);
+  prepared->repeat_world.emplace(repeat_images.empty() ? *prepared->teach_world
+                                                       : prepared->teach_world->WithImages(repeat_images));
 
   // 3. The teach run and its map, built as `vmap build` builds one.
   const std::unique_ptr<Matcher> matcher = CreateMatcher(matcher_options);
-  const TeachRun teach =
-      RunTeach(result.route, teach_world, options, *matcher, DefaultTau(matcher_options.type), map_directory);
-  result.teach_frames = static_cast<int>(teach.poses.size());
-  result.teach_seconds = teach.seconds;
+  const TeachRun teach = RunTeach(prepared->route, *prepared->teach_world, options, *matcher,
+                                  DefaultTau(matcher_options.type), map_directory);
+  prepared->teach_frames = static_cast<int>(teach.poses.size());
+  prepared->teach_seconds = teach.seconds;
+  prepared->teach_odometry = teach.odometry;
 
   // 4. The map opened for localization, and the route with its taught profile (from the teach odometry).
   KeyImageStoreOptions store_options;
-  const LocalizationMap opened = OpenLocalizationMap(map_directory, store_options);
-  result.matcher = opened.matcher->name();
-  result.key_images = static_cast<int>(opened.map.key_images.size());
-  for (const KeyImage& key : opened.map.key_images) result.key_image_poses.push_back(teach.poses.at(key.frame_index));
-  TrialContext context;
-  context.route = &result.route;
-  context.world = &repeat_world;
-  context.map = &opened;
-  context.taught = MakeTaughtRoute(opened.map, {}, teach.odometry);
-  context.localizer = FollowMap(opened, options.localizer, QueryResize(opened.map, ""));
+  prepared->map = OpenLocalizationMap(map_directory, store_options);
+  TrialContext& context = prepared->context;
+  for (const KeyImage& key : prepared->map.map.key_images)
+    context.key_image_poses.push_back(teach.poses.at(key.frame_index));
+  context.route = &prepared->route;
+  context.world = &*prepared->repeat_world;
+  context.map = &prepared->map;
+  context.taught = MakeTaughtRoute(prepared->map.map, {}, teach.odometry);
+  context.localizer = FollowMap(prepared->map, options.localizer, QueryResize(prepared->map.map, ""));
   context.localizer.route = context.taught.keys;
-  context.key_image_poses = result.key_image_poses;
   context.teach_duration = teach.odometry.back().timestamp;
   context.options = options;
+  return prepared;
+}
+
+SimulationResult Simulate(const SimulationOptions& options, const MatcherOptions& matcher_options,
+                          const std::filesystem::path& map_directory,
+                          const std::function<void(const TrialResult&)>& on_trial) {
+  const auto start = std::chrono::steady_clock::now();
+  // 1-4. The route, the worlds, the teach run and its map, the trials' context.
+  const std::unique_ptr<PreparedTrials> prepared = PrepareTrials(options, matcher_options, map_directory);
+  const TrialContext& context = prepared->context;
+  SimulationResult result;
+  result.route = prepared->route;
+  result.teach_frames = prepared->teach_frames;
+  result.teach_seconds = prepared->teach_seconds;
+  result.matcher = prepared->map.matcher->name();
+  result.key_images = static_cast<int>(prepared->map.map.key_images.size());
+  result.key_image_poses = context.key_image_poses;
 
   // 5. The trials, independent of each other (each its own localizer, controller and robot).
   result.trials.resize(options.trials);

@@ -11,10 +11,14 @@
 
 #include <filesystem>
 #include <functional>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "vmap/features/matcher_registry.h"
+#include "vmap/localization/localization_map.h"
+#include "vmap/simulation/corridor_world.h"
 #include "vmap/simulation/repeat_trial.h"
 #include "vmap/simulation/route_path.h"
 #include "vmap/simulation/simulation_options.h"
@@ -51,6 +55,25 @@ struct SimulationResult {
 // The route options.route names: a built-in shape, or a CSV of waypoints; checked against the corridor. Throws
 // InputError when it cannot be read or does not fit.
 SimulatedRoute LoadSimulatedRoute(const SimulationOptions& options);
+
+// What every trial of a simulation shares, made once (Simulate's stages 1-4): the route and its worlds, the teach
+// run and its map (built into a directory), the map opened for localization, and the trials' context, which
+// points into the rest: keep it where PrepareTrials put it.
+struct PreparedTrials {
+  SimulatedRoute route;
+  std::optional<CorridorWorld> teach_world;
+  std::optional<CorridorWorld> repeat_world;  // the teach world's panels with the repeat textures, if any
+  LocalizationMap map;
+  int teach_frames = 0;
+  double teach_seconds = 0.0;
+  std::vector<OdometrySample> teach_odometry;  // the teach run's, exact (the taught profile's source)
+  TrialContext context;                        // for RunTrial, or a TrialRun stepped from outside (trial_run.h)
+};
+
+// Checks the options, builds the worlds, teaches the route (the map built with `matcher` into `map_directory`,
+// which must exist and be empty) and opens the map. Throws as Simulate does, before any work.
+std::unique_ptr<PreparedTrials> PrepareTrials(const SimulationOptions& options, const MatcherOptions& matcher,
+                                              const std::filesystem::path& map_directory);
 
 // Teaches and repeats. The map is built with `matcher` into `map_directory` (which must exist and be empty).
 // Throws InputError (bad route or textures) and OptionError (options.Check()) before any work.

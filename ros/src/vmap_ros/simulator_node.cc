@@ -1,0 +1,270 @@
+#include "vmap_ros/simulator_node.h"
+
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <filesystem>
+#include <mutex>
+
+#include <fmt/format.h>
+#include <geometry_msgs/Twist.h>
+#include <nav_msgs/Odometry.h>
+#include <nlohmann/json.hpp>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <std_msgs/Bool.h>
+
+#include "vmap/core/atomic_output.h"
+#include "vmap/core/error.h"
+#include "vmap/simulation/closed_loop.h"
+#include "vmap/simulation/teach_run.h"
+#include "vmap/simulation/trial_run.h"
+
+#include "vmap_ros/Localization.h"
+#include "vmap_ros/parameter_reader.h"
+#include "vmap_ros/teach_odometry.h"
+
+namespace vmap::ros_node {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The simulation's clock starts at 0; ROS reads a zero stamp as "no stamp", so the topics' stamps start here.
+constexpr double kStampOffset = 1000.0;
+
+struct SimulatorParameters {
+  SimulationOptions simulation;
+  MatcherOptions matcher;
+  int trial = 0;
+  std::string map;
+  std::string result;
+  double answer_timeout = 60.0;
+};
+
+SimulatorParameters ReadParameters(const ros::NodeHandle& private_node) {
+  SimulatorParameters parameters;
+  ParameterReader reader(private_node);
+  try {
+    reader.Read(parameters.simulation);
+    reader.Read(parameters.matcher);
+    parameters.simulation.trials = 1;
+    parameters.simulation.Check();
+  } catch (const InputError& error) {
+    throw InputError(reader.Message(error));
+  }
+  private_node.getParam("trial", parameters.trial);
+  private_node.getParam("map", parameters.map);
+  private_node.getParam("result", parameters.result);
+  private_node.getParam("answer_timeout", parameters.answer_timeout);
+  if (parameters.trial < 0) throw InputError("~trial must be 0 or more (the index of `vmap simulate`'s trial)");
+  if (parameters.map.empty()) throw InputError("~map must name a folder for the teach run's map (new or empty)");
+  return parameters;
+}
+
+// The vmap node's answers to the frames, as they arrive.
+class Answers {
+ public:
+  void OnLocalization(const vmap_ros::Localization::ConstPtr& message) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      last_localization_ = *message;
+      ++localizations_;
+    }
+    changed_.notify_all();
+  }
+  void OnCommand(const geometry_msgs::Twist::ConstPtr& message) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      last_command_ = *message;
+      ++commands_;
+    }
+    changed_.notify_all();
+  }
+  // Waits for the localization message of the frame stamped `stamp` and the command sent before it (the node
+  // sends a frame's command, then its localization, on two connections: either may arrive first).
+  bool Wait(const ros::Time& stamp, double timeout, vmap_ros::Localization* localization,
+            geometry_msgs::Twist* command) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    const bool answered = changed_.wait_for(lock, std::chrono::duration<double>(timeout), [&] {
+      return localizations_ > 0 && last_localization_.header.stamp == stamp && commands_ >= localizations_;
+    });
+    *localization = last_localization_;
+    *command = last_command_;
+    return answered;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  vmap_ros::Localization last_localization_;
+  geometry_msgs::Twist last_command_;
+  long localizations_ = 0;
+  long commands_ = 0;
+};
+
+sensor_msgs::Image ImageMessage(const Frame& frame, const ros::Time& stamp) {
+  sensor_msgs::Image image;
+  image.header.stamp = stamp;
+  image.header.frame_id = "camera";
+  image.height = frame.color.rows;
+  image.width = frame.color.cols;
+  image.encoding = "bgr8";
+  image.step = static_cast<uint32_t>(frame.color.cols * 3);
+  image.data.resize(image.step * image.height);
+  for (int y = 0; y < frame.color.rows; ++y) {
+    std::memcpy(&image.data[y * image.step], frame.color.ptr(y), image.step);
+  }
+  return image;
+}
+
+sensor_msgs::CameraInfo CameraInfoMessage(const Camera& camera, const ros::Time& stamp) {
+  sensor_msgs::CameraInfo info;
+  info.header.stamp = stamp;
+  info.header.frame_id = "camera";
+  info.width = camera.size.width;
+  info.height = camera.size.height;
+  info.distortion_model = "plumb_bob";
+  info.D = {0, 0, 0, 0, 0};
+  info.K = {camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1};
+  info.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  info.P = {camera.fx, 0, camera.cx, 0, 0, camera.fy, camera.cy, 0, 0, 0, 1, 0};
+  return info;
+}
+
+nav_msgs::Odometry OdometryMessage(const OdometrySample& odometry, const ros::Time& stamp) {
+  nav_msgs::Odometry message;
+  message.header.stamp = stamp;
+  message.header.frame_id = "odom";
+  message.child_frame_id = "base_link";
+  message.pose.pose.position.x = odometry.x;
+  message.pose.pose.position.y = odometry.y;
+  message.pose.pose.orientation.z = std::sin(0.5 * odometry.yaw);
+  message.pose.pose.orientation.w = std::cos(0.5 * odometry.yaw);
+  return message;
+}
+
+// The localization and the controller's step a trial records, from the vmap node's messages.
+void FromMessages(const vmap_ros::Localization& message, const geometry_msgs::Twist& command,
+                  LocalizationResult* localization, ControlStep* step) {
+  localization->key = message.key;
+  localization->next_key = message.next_key;
+  switch (message.status) {
+    case vmap_ros::Localization::TRACKING:
+      localization->status = LocalizationStatus::kTracking;
+      break;
+    case vmap_ros::Localization::RELOCALIZED:
+      localization->status = LocalizationStatus::kRelocalized;
+      break;
+    case vmap_ros::Localization::UNCERTAIN:
+      localization->status = LocalizationStatus::kUncertain;
+      break;
+    default:
+      localization->status = LocalizationStatus::kLost;
+  }
+  step->state = FindEnum(kControllerStateNames, message.controller_state).value_or(ControllerState::kLost);
+  step->steering = message.steering;
+  step->localized = message.localized;
+  step->target_key = message.next_key >= 0 ? message.next_key : message.key;
+  step->command.linear = command.linear.x;
+  step->command.angular = command.angular.z;
+}
+
+nlohmann::json TrialJson(const TrialResult& trial) {
+  const auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  return {{"end", trial.end},
+          {"reached_goal", trial.reached_goal},
+          {"success", trial.success},
+          {"final_error", number(trial.final_error)},
+          {"lateral_rms_second_half", number(trial.lateral_rms_second_half)},
+          {"lateral_max", number(trial.lateral_max)},
+          {"start_lateral", trial.start_lateral},
+          {"start_heading_deg", trial.start_heading_deg},
+          {"frames", trial.frames},
+          {"frames_lost", trial.frames_lost},
+          {"duration", trial.duration}};
+}
+
+}  // namespace
+
+int RunSimulatorNode(ros::NodeHandle& node, ros::NodeHandle& private_node) {
+  SimulatorParameters parameters;
+  std::unique_ptr<PreparedTrials> prepared;
+  try {
+    parameters = ReadParameters(private_node);
+    fs::create_directories(parameters.map);
+    ROS_INFO("teaching route %s into %s", parameters.simulation.route.c_str(), parameters.map.c_str());
+    prepared = PrepareTrials(parameters.simulation, parameters.matcher, parameters.map);
+    // The teach run's odometry beside its map, as the vmap node's teach run writes it (teach_odometry.h).
+    WriteTeachOdometry(parameters.map, prepared->teach_odometry);
+  } catch (const std::exception& error) {
+    ROS_ERROR("vmap simulator: %s", error.what());
+    return 2;
+  }
+  const TrialContext& context = prepared->context;
+  ROS_INFO("map written: %zu key images from %d frames; running trial %d in process for reference",
+           prepared->map.map.key_images.size(), prepared->teach_frames, parameters.trial);
+  const TrialResult in_process = RunTrial(context, parameters.trial);
+
+  // The robot on ROS.
+  ros::Publisher camera = node.advertise<sensor_msgs::Image>("camera/image_raw", 1);
+  ros::Publisher camera_info = node.advertise<sensor_msgs::CameraInfo>("camera/camera_info", 1);
+  ros::Publisher odometry = node.advertise<nav_msgs::Odometry>("odom", 10);
+  ros::Publisher ready = private_node.advertise<std_msgs::Bool>("ready", 1, /*latch=*/true);
+  Answers answers;
+  const ros::Subscriber commands = node.subscribe("cmd_vel", 100, &Answers::OnCommand, &answers);
+  const ros::Subscriber localizations = node.subscribe("localization", 100, &Answers::OnLocalization, &answers);
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  std_msgs::Bool map_ready;
+  map_ready.data = true;
+  ready.publish(map_ready);
+  ROS_INFO("waiting for a vmap node on %s (start its repeat run on %s)", camera.getTopic().c_str(),
+           parameters.map.c_str());
+  while (ros::ok() && (camera.getNumSubscribers() == 0 || localizations.getNumPublishers() == 0 ||
+                       commands.getNumPublishers() == 0)) {
+    ros::WallDuration(0.01).sleep();
+  }
+
+  const Camera rig = RigCamera(parameters.simulation.camera);
+  TrialRun run(context, parameters.trial);
+  std::string failure;
+  while (ros::ok() && run.Continues()) {
+    const Frame frame = run.Render();
+    const ros::Time stamp(kStampOffset + run.time());
+    odometry.publish(OdometryMessage(run.odometry(), stamp));
+    camera_info.publish(CameraInfoMessage(rig, stamp));
+    camera.publish(ImageMessage(frame, stamp));
+    const auto sent = std::chrono::steady_clock::now();
+    vmap_ros::Localization message;
+    geometry_msgs::Twist command;
+    if (!answers.Wait(stamp, parameters.answer_timeout, &message, &command)) {
+      failure =
+          fmt::format("no answer from the vmap node to frame {} within {} s", run.step(), parameters.answer_timeout);
+      break;
+    }
+    LocalizationResult localization;
+    ControlStep step;
+    FromMessages(message, command, &localization, &step);
+    run.Record(localization, step, std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count());
+    if (step.state == ControllerState::kReachedGoal) break;
+    run.Drive(step.command);
+  }
+  const TrialResult through_ros = run.Finish();
+  nlohmann::json result = {{"route", context.route->name},
+                           {"trial", parameters.trial},
+                           {"key_images", prepared->map.map.key_images.size()},
+                           {"ros", TrialJson(through_ros)},
+                           {"in_process", TrialJson(in_process)}};
+  if (!failure.empty()) result["failure"] = failure;
+  if (!parameters.result.empty()) WriteFileAtomically(parameters.result, result.dump(2) + "\n");
+  ROS_INFO("trial %d through ROS: %s, %.3f m from the goal (in process: %s, %.3f m)", parameters.trial,
+           through_ros.end.c_str(), through_ros.final_error, in_process.end.c_str(), in_process.final_error);
+  if (!failure.empty()) {
+    ROS_ERROR("vmap simulator: %s", failure.c_str());
+    return 2;
+  }
+  return 0;
+}
+
+}  // namespace vmap::ros_node

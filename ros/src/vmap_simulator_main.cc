@@ -1,0 +1,22 @@
+// vmap_simulator: vmap's closed-loop simulator as a ROS node (vmap_ros/simulator_node.h, docs/ros.md): the camera,
+// odometry and motors of a simulated robot on ROS topics, for a vmap node to drive.
+
+#include <ros/ros.h>
+
+#include "vmap/core/runtime.h"
+
+#include "vmap_ros/rosconsole_sink.h"
+#include "vmap_ros/simulator_node.h"
+
+int main(int argc, char** argv) {
+  vmap::RuntimeOptions runtime;
+  runtime.handle_interrupts = false;  // ROS handles SIGINT
+  vmap::InitializeRuntime(runtime);
+  ros::init(argc, argv, "vmap_simulator");
+  vmap::ros_node::LogThroughRosconsole();
+  ros::NodeHandle node;
+  ros::NodeHandle private_node("~");
+  const int status = vmap::ros_node::RunSimulatorNode(node, private_node);
+  ros::shutdown();
+  return status;
+}

@@ -1,0 +1,76 @@
+// The closed loop through ROS: vmap's simulator as a node (camera, odometry and motors on topics) driven by a vmap
+// node on a real master reaches the goal as the same trial run in process does.
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <std_msgs/Bool.h>
+
+#include "vmap/testing/scoped_temp_dir.h"
+
+#include "ros_harness.h"
+#include "vmap_ros/StartRepeat.h"
+
+namespace vmap::ros_testing {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::ScopedTempDir;
+
+TEST(ClosedLoopNode, ASimulatedRobotDrivenThroughRosReachesTheGoalAsInProcess) {
+  ScopedTempDir dir("ros_closed_loop");
+  // drive's closed-loop test route: 6 m straight; trial 0 of seed 3 starts off the path.
+  std::ofstream(dir.path() / "route.csv") << "x,y\n0,0\n6,0\n";
+  const std::string simulation = "_route:=" + (dir.path() / "route.csv").string();
+  RosMaster::Get();
+  ChildProcess simulator(
+      {SimulatorBinary().string(), "__ns:=/loop_robot", "__name:=simulator", "localization:=/loop/vmap/localization",
+       simulation, "_seed:=3", "_teach_speed:=0.4", "_trial:=0", "_map:=" + (dir.path() / "map").string(),
+       "_result:=" + (dir.path() / "result.json").string()},
+      dir.path() / "simulator.log");
+  // The teach odometry the simulator writes beside the map gives the node the taught profile `vmap simulate` uses.
+  const auto node = StartVmapNode(
+      "/loop", {"image:=/loop_robot/camera/image_raw", "odom:=/loop_robot/odom", "cmd_vel:=/loop_robot/cmd_vel"},
+      dir.path() / "node.log");
+  ASSERT_TRUE(WaitForService("/loop/vmap/repeat/start")) << node->Log();
+
+  // The simulator teaches the route and writes the map (and runs the trial in process) before it says so.
+  ros::NodeHandle handle;
+  bool ready = false;
+  const ros::Subscriber subscriber = handle.subscribe<std_msgs::Bool>(
+      "/loop_robot/simulator/ready", 1, [&](const std_msgs::Bool::ConstPtr& message) { ready = message->data; });
+  ASSERT_TRUE(WaitFor([&] { return ready || !simulator.Running(); }, std::chrono::seconds(300)));
+  ASSERT_TRUE(ready) << simulator.Log();
+
+  vmap_ros::StartRepeat start;
+  start.request.map = (dir.path() / "map").string();
+  start.request.goal = -1;
+  start.request.start = -1;
+  ASSERT_TRUE(ros::service::call("/loop/vmap/repeat/start", start)) << node->Log();
+  ASSERT_TRUE(start.response.success) << start.response.message;
+  EXPECT_NE(start.response.message.find("teach odometry"), std::string::npos) << start.response.message;
+
+  ASSERT_EQ(simulator.Wait(std::chrono::seconds(600)), 0) << simulator.Log() << node->Log();
+  nlohmann::json result;
+  std::ifstream(dir.path() / "result.json") >> result;
+  const nlohmann::json& ros = result.at("ros");
+  const nlohmann::json& in_process = result.at("in_process");
+  SCOPED_TRACE(result.dump(2));
+  RecordProperty("ros", ros.dump());
+  RecordProperty("in_process", in_process.dump());
+  EXPECT_EQ(in_process.at("end"), "reached goal");
+  EXPECT_TRUE(in_process.at("success").get<bool>());
+  EXPECT_EQ(ros.at("end"), "reached goal");
+  EXPECT_TRUE(ros.at("success").get<bool>());
+  // The same trial (start, noise, frames, map, taught profile) with the same brain: the same path to the goal, up
+  // to the rounding of stamps and poses in the messages.
+  EXPECT_NEAR(ros.at("final_error").get<double>(), in_process.at("final_error").get<double>(), 0.02);
+  EXPECT_NEAR(ros.at("frames").get<int>(), in_process.at("frames").get<int>(), 2);
+  EXPECT_LE(ros.at("lateral_rms_second_half").get<double>(), 0.1);
+  EXPECT_GT(std::abs(ros.at("start_lateral").get<double>()), 0.05);  // it started off the path
+  EXPECT_TRUE(node->Running());
+}
+
+}  // namespace
+}  // namespace vmap::ros_testing
