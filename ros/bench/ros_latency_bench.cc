@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
   RosMaster::Get();
   const auto node =
       StartVmapNode("/bench", {"image:=/bench/camera/image_raw", "cmd_vel:=/bench/cmd_vel"}, dir.path() / "node.log");
-  if (!WaitForService("/bench/vmap/repeat/start")) {
+  if (!WaitForNodeServices("/bench/vmap")) {
     std::fprintf(stderr, "ros_latency_bench: the node did not start:\n%s\n", node->Log().c_str());
     return 1;
   }

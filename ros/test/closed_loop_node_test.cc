@@ -33,7 +33,7 @@ TEST(ClosedLoopNode, ASimulatedRobotDrivenThroughRosReachesTheGoalAsInProcess) {
   const auto node = StartVmapNode(
       "/loop", {"image:=/loop_robot/camera/image_raw", "odom:=/loop_robot/odom", "cmd_vel:=/loop_robot/cmd_vel"},
       dir.path() / "node.log");
-  ASSERT_TRUE(WaitForService("/loop/vmap/repeat/start")) << node->Log();
+  ASSERT_TRUE(WaitForNodeServices("/loop/vmap")) << node->Log();
 
   // The simulator teaches the route and writes the map (and runs the trial in process) before it says so.
   ros::NodeHandle handle;

@@ -53,7 +53,7 @@ TEST(NodeErrors, BadMessagesMapsAndCallsAreAnsweredAndTheNodeRunsOn) {
   ScopedTempDir dir("ros_errors");
   const std::string ns = "/errors_test";
   const auto node = StartVmapNode(ns, {"image:=/errors/image_raw"}, dir.path() / "node.log");
-  ASSERT_TRUE(WaitForService(ns + "/vmap/repeat/start")) << node->Log();
+  ASSERT_TRUE(WaitForNodeServices(ns + "/vmap")) << node->Log();
 
   // Services in the wrong state.
   bool success = true;

@@ -92,7 +92,7 @@ TEST(RepeatNode, LocalizesThePlayedFramesAsVmapLocalizeDoes) {
   ASSERT_EQ(RunVmap("build -q " + Quote(teach) + " -o " + Quote(map), &output), 0) << output;
 
   const auto node = StartVmapNode("/repeat_test", {"image:=/camera/image_raw"}, dir.path() / "node.log");
-  ASSERT_TRUE(WaitForService("/repeat_test/vmap/repeat/start")) << node->Log();
+  ASSERT_TRUE(WaitForNodeServices("/repeat_test/vmap")) << node->Log();
   ros::NodeHandle handle;
   Published published;
   const ros::Subscriber localizations =

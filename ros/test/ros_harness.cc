@@ -215,6 +215,18 @@ bool WaitForService(const std::string& name, std::chrono::seconds timeout) {
   return WaitFor([&] { return ros::service::exists(name, false); }, timeout);
 }
 
+bool WaitForNodeServices(const std::string& node, std::chrono::seconds timeout) {
+  return WaitFor(
+      [&] {
+        for (const char* service :
+             {"teach/start", "teach/stop", "repeat/start", "repeat/pause", "repeat/resume", "repeat/stop"}) {
+          if (!ros::service::exists(node + "/" + service, false)) return false;
+        }
+        return true;
+      },
+      timeout);
+}
+
 std::vector<ros::Time> WriteVideoBag(const fs::path& video, int first, int last, const fs::path& bag,
                                      const std::string& encoding, bool odometry) {
   FrameSourceOptions options;

@@ -68,8 +68,12 @@ std::unique_ptr<ChildProcess> PlayBag(const std::filesystem::path& bag, double r
 
 // Waits until `done()` holds, spinning this process's callbacks, up to `timeout`. Returns done().
 bool WaitFor(const std::function<bool()>& done, std::chrono::seconds timeout);
-// Waits for service `name` to be advertised (the node is up).
+// Waits for service `name` to be advertised.
 bool WaitForService(const std::string& name, std::chrono::seconds timeout = std::chrono::seconds(60));
+// Waits for every service of the vmap node `node` ("/ns/vmap") to be advertised: the node is up. It advertises
+// them one after the other, so that one is there says nothing of the next (on a loaded machine a call to a service
+// not yet advertised fails at once).
+bool WaitForNodeServices(const std::string& node, std::chrono::seconds timeout = std::chrono::seconds(60));
 
 // A camera recording for the tests: frames [first, last] of a video as sensor_msgs/Image (`encoding`: bgr8 or
 // mono8) on /camera/image_raw with the video's intrinsics as CameraInfo on /camera/camera_info, stamped from

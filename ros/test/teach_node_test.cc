@@ -40,7 +40,7 @@ TEST(TeachNode, BuildsFromAPlayedBagTheMapVmapBuildBuilds) {
   // Frames held while the builder is busy: the whole bag, so that a slow moment of this shared machine drops none.
   const auto node = StartVmapNode("/teach_test", {"image:=/camera/image_raw", "odom:=/odom", "_teach_queue:=300"},
                                   dir.path() / "node.log");
-  ASSERT_TRUE(WaitForService("/teach_test/vmap/teach/start")) << node->Log();
+  ASSERT_TRUE(WaitForNodeServices("/teach_test/vmap")) << node->Log();
   ros::NodeHandle handle;
   std::mutex mutex;
   vmap_ros::TeachProgress progress;
@@ -101,7 +101,7 @@ TEST(TeachNode, RefusesAFolderThatIsNotAMapAndLeavesItAsItWas) {
   fs::create_directories(dir.path() / "notes");
   std::ofstream(dir.path() / "notes" / "todo.txt") << "my notes\n";
   const auto node = StartVmapNode("/teach_refuse", {}, dir.path() / "node.log");
-  ASSERT_TRUE(WaitForService("/teach_refuse/vmap/teach/start")) << node->Log();
+  ASSERT_TRUE(WaitForNodeServices("/teach_refuse/vmap")) << node->Log();
   std_srvs::Trigger stop;
   ASSERT_TRUE(ros::service::call("/teach_refuse/vmap/teach/stop", stop));
   EXPECT_FALSE(stop.response.success);
