@@ -8,8 +8,10 @@
 
 #include <gtest/gtest.h>
 
+#include "vmap/core/error.h"
 #include "vmap/pipelines/add_experience_pipeline.h"
 #include "vmap/pipelines/build_pipeline.h"
+#include "vmap/pipelines/draw_pipeline.h"
 #include "vmap/pipelines/eval_pipeline.h"
 #include "vmap/pipelines/localize_pipeline.h"
 #include "vmap/pipelines/match_pipeline.h"
@@ -72,6 +74,20 @@ TEST(PipelineOptions, EachFieldIsDescribedOnceAndTheDefaultsPass) {
   ExpectDescribedOnce(EvalPipelineOptions(), {"map"});
   ExpectDescribedOnce(ReportPipelineOptions(), {"target"});
   ExpectDescribedOnce(PairMatchOptions(), {});
+  ExpectDescribedOnce(MatchPipelineOptions(), {"image0", "image1"});
+  ExpectDescribedOnce(DrawPipelineOptions(), {"map"});
+}
+
+// A negative link is refused by the options, naming the field (the CLI's --link, before any map is read).
+TEST(PipelineOptions, DrawRefusesANegativeLink) {
+  DrawPipelineOptions draw;
+  draw.link = -1;
+  try {
+    draw.Check();
+    FAIL() << "a negative link passed";
+  } catch (const OptionError& e) {
+    EXPECT_EQ(e.path(), "link");
+  }
 }
 
 // The paths the fields are visited under are the ones their checks name, so that a front end can name a bad
