@@ -16,157 +16,11 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // A previous key image with fewer verified matches than this share of the key image's is clearly the worse
-// match: the step back is not checked again until the frame moves back (Localizer::Track). 0.7 spared 58 % of
-// the checks of XFeat's lab_floor run and moved no frame (docs/localize.md).
+// match: the step back is not checked again until the frame moves back (Localizer::Track). Chosen on lab_floor
+// (docs/measurements/code-choices.md, "Ruling out a step back").
 constexpr double kClearlyWorse = 0.7;
 
-// Which of two accepted comparisons is the better match: more verified matches, then higher S.
-// Measured on the bracket test (docs/measurements/localization.md): S first, S times verified, a 10 % or 25 % margin
-// before moving on, and moving on only when S is higher too localized no more odd frames of redkitchen between their
-// key images than verified matches alone.
-bool Better(const KeyComparison& a, const KeyComparison& b) {
-  if (!a.accepted) return false;
-  if (!b.accepted) return true;
-  if (a.num_verified != b.num_verified) return a.num_verified > b.num_verified;
-  return a.similarity > b.similarity;
-}
-
-// Which of two images of one key image (the key image, a view) fits a frame better: the better match by
-// Better, and when neither is accepted, more verified matches (the heading is still reported). Ties keep the
-// first (the teach key image).
-bool FitsBetter(const KeyComparison& a, const KeyComparison& b) {
-  if (a.accepted || b.accepted) return Better(a, b);
-  if (a.num_verified != b.num_verified) return a.num_verified > b.num_verified;
-  return a.similarity > b.similarity;
-}
-
 }  // namespace
-
-std::string LocalizationStatusName(LocalizationStatus status) { return EnumToName(kLocalizationStatusNames, status); }
-
-void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Visit({"acceptance", "--acceptance",
-                 "When a frame is seen at a key image: chance (its verified matches are unlikely by "
-                 "chance, --max-log10-nfa, and many against the map's links, --min-link-share) or "
-                 "counts (the earlier rule: --min-verified and --min-similarity)"},
-                EnumField(acceptance, kAcceptanceRuleNames, ParseAcceptanceRule));
-  visitor.Visit({"max_log10_nfa", "--max-log10-nfa",
-                 "--acceptance chance: accept when log10 of the number of false alarms is at most this"},
-                max_log10_nfa);
-  visitor.Visit({"min_verified", "--min-verified",
-                 "--acceptance counts: verified matches a frame needs to be localized at a key image"},
-                min_verified);
-  visitor.Visit(
-      {"min_similarity", "--min-similarity", "--acceptance counts: S a frame needs to be localized at a key image"},
-      min_similarity);
-  visitor.Visit({"min_link_share", "--min-link-share",
-                 "--acceptance chance: verified matches a frame also needs, as a fraction of those of the key "
-                 "image's link with its route neighbour (0: chance alone)"},
-                min_link_share);
-  visitor.Visit({"recheck_link_share", "--recheck-link-share",
-                 "Relocalize a tracked frame with fewer verified matches than this fraction of its key image's "
-                 "link, and move it where more verify (0: never)"},
-                recheck_link_share);
-  visitor.Visit({"max_lost_frames", "--max-lost", "Lost frames in a row before the estimate is dropped"},
-                max_lost_frames);
-  visitor.Visit({"relocalization_candidates", "--candidates", "Best-ranked key images verified when relocalizing"},
-                relocalization_candidates);
-  visitor.Visit({"experience_candidates", "--experience-candidates",
-                 "Maps with experiences: views of a key image verified besides it, those with the most tentative "
-                 "matches (0 = the teach key images only)"},
-                experience_candidates);
-  visitor.Visit({"lookahead", "--lookahead", "Key images beyond the next compared while tracking (1 or 2)"}, lookahead);
-  visitor.Visit({"step_back", "!--no-step-back", "Never move the estimate back to the previous key image"}, step_back);
-  visitor.VisitNested("ranking", ranking);
-  visitor.VisitNested("heading", heading);
-  visitor.VisitNested("verifier", verifier, Nesting{false, {"max_samples_to_reject"}});
-  visitor.VisitNested("translation", translation);
-  visitor.Visit({"similarity"}, EnumField(similarity, kSimilarityModeNames, ParseSimilarityMode));
-  visitor.Visit({"route"}, route);
-}
-
-void LocalizerOptions::Check() const {
-  const LocalizerOptions defaults;  // the defaults the messages give, as declared
-  if (min_verified < 8 || min_verified > 100000) {
-    throw OptionError("min_verified", fmt::format("{} must be 8 (the fewest matches F can be verified with) to "
-                                                  "100000 (default {})",
-                                                  min_verified, defaults.min_verified));
-  }
-  if (!(min_similarity >= 0.0 && min_similarity <= 1.0)) {
-    throw OptionError("min_similarity",
-                      fmt::format("{} is outside [0, 1] (default {})", min_similarity, defaults.min_similarity));
-  }
-  if (!(max_log10_nfa >= -1000.0 && max_log10_nfa <= 1000.0)) {
-    throw OptionError("max_log10_nfa", fmt::format("{} is outside [-1000, 1000] (default {}; 0: accept what "
-                                                   "chance explains less than once)",
-                                                   max_log10_nfa, defaults.max_log10_nfa));
-  }
-  if (!(recheck_link_share >= 0.0 && recheck_link_share <= 10.0)) {
-    throw OptionError("recheck_link_share",
-                      fmt::format("{} is outside [0, 10] (default {}; 0: never relocalize a tracked frame)",
-                                  recheck_link_share, defaults.recheck_link_share));
-  }
-  if (!(min_link_share >= 0.0 && min_link_share <= 10.0)) {
-    throw OptionError("min_link_share", fmt::format("{} is outside [0, 10] (default {}; 0: chance alone decides)",
-                                                    min_link_share, defaults.min_link_share));
-  }
-  if (lookahead < 1 || lookahead > 2) {
-    throw OptionError("lookahead", fmt::format("{} is not 1 or 2 (default {})", lookahead, defaults.lookahead));
-  }
-  if (max_lost_frames < 0 || max_lost_frames > 1000000) {
-    throw OptionError("max_lost_frames",
-                      fmt::format("{} must be 0 to 1000000 (default {})", max_lost_frames, defaults.max_lost_frames));
-  }
-  if (relocalization_candidates < 1 || relocalization_candidates > 10000) {
-    throw OptionError("relocalization_candidates",
-                      fmt::format("{} must be 1 to 10000 (default {})", relocalization_candidates,
-                                  defaults.relocalization_candidates));
-  }
-  CheckField("ranking", ranking);
-  CheckField("verifier", verifier);
-  CheckField("heading", heading);
-  CheckField("translation", translation);
-  if (experience_candidates < 0 || experience_candidates > 1000) {
-    throw OptionError("experience_candidates", fmt::format("{} must be 0 (teach key images only) to 1000 (default {})",
-                                                           experience_candidates, defaults.experience_candidates));
-  }
-}
-
-std::pair<int, int> KeysAround(const VisualMap& map, int source_index) {
-  int before = -1, after = -1;
-  for (int k = 0; k < static_cast<int>(map.key_images.size()); ++k) {
-    const int s = map.key_images[k].source_index;
-    if (s <= source_index && (before < 0 || s >= map.key_images[before].source_index)) before = k;
-    if (s >= source_index && (after < 0 || s < map.key_images[after].source_index)) after = k;
-  }
-  return {before, after};
-}
-
-VerifierOptions MapVerifierOptions(const VerifierOptions& recorded, int max_iterations, int loop_points) {
-  // ORB's matches (no scores) keep the map's verifier with the cap localization always had.
-  constexpr int kUnscoredMaxIterations = 5000;
-  VerifierOptions options = recorded;
-  options.max_iterations = std::min(options.max_iterations, kUnscoredMaxIterations);
-  // Scored matches: at most `max_iterations` samples on the `loop_points` best-scored ones.
-  options.loop_points = loop_points;
-  options.max_samples_to_reject = std::min(options.max_iterations, max_iterations);
-  options.Check();
-  return options;
-}
-
-std::string LocalizationGuidance(const LocalizationResult& result) {
-  if (result.status == LocalizationStatus::kLost) return "none: lost";
-  if (result.status == LocalizationStatus::kUncertain) return "none: position uncertain";
-  if (!std::isfinite(result.heading_px)) return "none";
-  const KeyComparison& target = result.next_key >= 0 ? result.to_next : result.to_key;
-  if (!target.pose.valid) return "heading only: no pose";
-  return result.translation_known ? "heading and translation" : "heading only: translation unknown";
-}
-
-bool MaySteerBy(const LocalizationResult& result) {
-  return (result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized) &&
-         std::isfinite(result.heading_px);
-}
 
 Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matcher& matcher, LocalizerOptions options)
     : map_(map), keys_(keys), matcher_(matcher), options_(std::move(options)) {
@@ -222,94 +76,6 @@ void Localizer::Reset() {
   step_back_ruled_out_ = {};
 }
 
-KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
-  const ImageFeatures& key_image = *keys_.features[key];
-  KeyComparison best = CompareImage(features, key_image, matcher_.Match(features, key_image), key);
-  if (keys_.views.empty() || keys_.views[key].empty() || options_.experience_candidates == 0) return best;
-  // Every view is matched (cheap); the few with the most tentative matches are verified.
-  const std::vector<KeyImageView>& views = keys_.views[key];
-  std::vector<TentativeMatches> matches;
-  std::vector<int> order;
-  for (size_t v = 0; v < views.size(); ++v) {
-    matches.push_back(matcher_.Match(features, *views[v].features));
-    order.push_back(static_cast<int>(v));
-  }
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return matches[a].size() > matches[b].size(); });
-  order.resize(std::min<size_t>(order.size(), options_.experience_candidates));
-  for (int v : order) {
-    KeyComparison c = CompareImage(features, *views[v].features, matches[v], key);
-    if (!FitsBetter(c, best)) continue;
-    c.experience = views[v].experience;
-    // Headings add up: x_frame - x_key = (x_frame - x_view) + (x_view - x_key).
-    c.heading.px += views[v].heading_px;
-    if (options_.camera && std::isfinite(c.heading.deg)) {
-      // The view's offset as the bearing of a point it moves by that much at the image's centre.
-      c.heading.deg += std::atan(views[v].heading_px / options_.camera->fx) * 180.0 / M_PI;
-    }
-    best = std::move(c);
-  }
-  return best;
-}
-
-KeyComparison Localizer::CompareImage(const ImageFeatures& features, const ImageFeatures& image,
-                                      const TentativeMatches& matches, int key) const {
-  // As ComparePair, on matches made already.
-  const int denominator = SimilarityDenominator(options_.similarity, static_cast<int>(matches.size()),
-                                                features.num_features(), image.num_features());
-  const PairComparison pair = VerifyMatches(matches, denominator, options_.verifier);
-  KeyComparison c;
-  c.key = key;
-  c.matched = pair.matched;
-  c.similarity = pair.similarity;
-  c.num_tentative = pair.num_tentative;
-  c.num_verified = pair.num_verified;
-  c.F = pair.F;
-  // Recorded whatever the rule, so that runs under either compare.
-  if (pair.matched) {
-    c.log10_nfa = ChanceOfComparison(pair, features.image_size(), image.image_size(),
-                                     ComparisonsPerFrame(options_.lookahead, options_.relocalization_candidates))
-                      .log10_nfa;
-  }
-  c.accepted =
-      pair.matched &&
-      (options_.acceptance == AcceptanceRule::kChance
-           ? c.log10_nfa <= options_.max_log10_nfa && pair.num_verified >= options_.min_link_share * link_verified_[key]
-           : pair.num_verified >= options_.min_verified && pair.similarity >= options_.min_similarity);
-  // The heading from every tentative match (verified first, then rejected), key image -> frame.
-  std::vector<cv::Point2f> key_points, frame_points;
-  SplitCorrespondences(pair.correspondences, &frame_points, &key_points);
-  std::vector<unsigned char> verified;
-  if (pair.matched) {
-    verified.assign(pair.correspondences.size(), 0);
-    std::fill(verified.begin(), verified.begin() + pair.num_verified, 1);
-  }
-  const Camera* camera = options_.camera ? &*options_.camera : nullptr;
-  c.heading = EstimateHeading(key_points, frame_points, verified, options_.heading, camera);
-  if (pair.matched) c.verified.assign(pair.correspondences.begin(), pair.correspondences.begin() + pair.num_verified);
-  return c;
-}
-
-void Localizer::AddPose(KeyComparison& c) const {
-  if (!options_.camera || !c.matched || c.experience != 0 || c.verified.empty() || c.pose.valid) return;
-  std::vector<cv::Point2f> key_points, frame_points;
-  SplitCorrespondences(c.verified, &frame_points, &key_points);
-  // The thresholds of the map's own pose estimates (PoseOptions): 3 px inliers, Cauchy scale 1 px.
-  const PoseOptions pose_options;
-  const double inlier_threshold = pose_options.refine_inlier_factor * pose_options.threshold;
-  const NormalizedMatches verified_matches(*options_.camera, frame_points, key_points);
-  RelativePose pose = PoseFromFundamental(c.F, verified_matches);
-  if (!pose.valid) return;
-  // F's pose is not an optimum of the matches' errors (E = K^T F K is not essential): refined, and the four
-  // poses of the refined E decided again by cheirality, as a link's. Only then does the sigma below measure
-  // the matches rather than how far F's pose is from their optimum.
-  c.pose = EnforceCheirality(RefineRelativePose(pose, verified_matches, inlier_threshold, pose_options.threshold),
-                             verified_matches, pose_options.threshold);
-  const TranslationEvidence evidence =
-      AssessTranslation(c.pose, verified_matches, verified_matches, pose_options, options_.translation);
-  c.translation_sigma_deg = evidence.sigma_deg;
-  c.translation_known = evidence.known;
-}
-
 LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& features,
                                        std::vector<KeyComparison> ahead) {
   const auto start = std::chrono::steady_clock::now();
@@ -338,17 +104,6 @@ std::vector<int> Localizer::LikelyKeys() const {
   std::vector<int> keys = {route_[position_]};
   if (position_ + 1 < static_cast<int>(route_.size())) keys.push_back(route_[position_ + 1]);
   return keys;
-}
-
-KeyComparison Localizer::CompareOnce(const ImageFeatures& features, int key) {
-  for (Memo& m : comparisons_) {
-    if (m.comparison.key == key) {
-      m.used = true;
-      return m.comparison;
-    }
-  }
-  comparisons_.push_back({Compare(features, key), true});
-  return comparisons_.back().comparison;
 }
 
 // Fills key, next_key, their comparisons, heading and progress for the estimate at route `position`.
@@ -386,7 +141,7 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   // Move on while the key image ahead is the better match, at most `lookahead` key images.
   for (int step = 1; step <= options_.lookahead && position + step <= last; ++step) {
     const KeyComparison ahead = compare_at(position + step);
-    if (!Better(ahead, best)) {
+    if (!IsBetterMatch(ahead, best)) {
       // A frame that verifies against nothing so far may still have passed the next key image quickly.
       if (best.accepted || step > 1) break;
       continue;
@@ -410,7 +165,7 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
         step_back_ruled_out_ = ruled_out;
       } else {
         const KeyComparison behind = compare_at(position - 1);
-        if (Better(behind, best)) {
+        if (IsBetterMatch(behind, best)) {
           best = behind;
           best_position = position - 1;
         } else if (v_key > 0 && behind.num_verified < kClearlyWorse * v_key) {
@@ -478,7 +233,7 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
     const KeyComparison c = CompareOnce(features, route_[position]);
     result.candidates.push_back(
         {route_[position], ranked[i].score, c.accepted, c.similarity, c.num_verified, c.log10_nfa});
-    if (Better(c, best)) {
+    if (IsBetterMatch(c, best)) {
       best = c;
       best_position = position;
     }
@@ -501,7 +256,8 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
     } else if (before.accepted) {
       const double before_share = SharedWithLink(before, route_[position - 1], route_[position]);
       const double after_share = SharedWithLink(after, route_[position], route_[position + 1]);
-      if (before_share > 0 && after_share > 0 ? before_share > after_share : Better(before, after)) position -= 1;
+      if (before_share > 0 && after_share > 0 ? before_share > after_share : IsBetterMatch(before, after))
+        position -= 1;
     }
   }
   position_ = position;

@@ -1,0 +1,110 @@
+// The Localizer's comparisons of a frame with key images: matching, verification, acceptance, heading and pose.
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "vmap/geometry/pose_refinement.h"
+#include "vmap/localization/localizer.h"
+
+namespace vmap {
+
+KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
+  const ImageFeatures& key_image = *keys_.features[key];
+  KeyComparison best = CompareImage(features, key_image, matcher_.Match(features, key_image), key);
+  if (keys_.views.empty() || keys_.views[key].empty() || options_.experience_candidates == 0) return best;
+  // Every view is matched (cheap); the few with the most tentative matches are verified.
+  const std::vector<KeyImageView>& views = keys_.views[key];
+  std::vector<TentativeMatches> matches;
+  std::vector<int> order;
+  for (size_t v = 0; v < views.size(); ++v) {
+    matches.push_back(matcher_.Match(features, *views[v].features));
+    order.push_back(static_cast<int>(v));
+  }
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return matches[a].size() > matches[b].size(); });
+  order.resize(std::min<size_t>(order.size(), options_.experience_candidates));
+  for (int v : order) {
+    KeyComparison c = CompareImage(features, *views[v].features, matches[v], key);
+    if (!FitsBetter(c, best)) continue;
+    c.experience = views[v].experience;
+    // Headings add up: x_frame - x_key = (x_frame - x_view) + (x_view - x_key).
+    c.heading.px += views[v].heading_px;
+    if (options_.camera && std::isfinite(c.heading.deg)) {
+      // The view's offset as the bearing of a point it moves by that much at the image's centre.
+      c.heading.deg += std::atan(views[v].heading_px / options_.camera->fx) * 180.0 / M_PI;
+    }
+    best = std::move(c);
+  }
+  return best;
+}
+
+KeyComparison Localizer::CompareImage(const ImageFeatures& features, const ImageFeatures& image,
+                                      const TentativeMatches& matches, int key) const {
+  // As ComparePair, on matches made already.
+  const int denominator = SimilarityDenominator(options_.similarity, static_cast<int>(matches.size()),
+                                                features.num_features(), image.num_features());
+  const PairComparison pair = VerifyMatches(matches, denominator, options_.verifier);
+  KeyComparison c;
+  c.key = key;
+  c.matched = pair.matched;
+  c.similarity = pair.similarity;
+  c.num_tentative = pair.num_tentative;
+  c.num_verified = pair.num_verified;
+  c.F = pair.F;
+  // Recorded whatever the rule, so that runs under either compare.
+  if (pair.matched) {
+    c.log10_nfa = ChanceOfComparison(pair, features.image_size(), image.image_size(),
+                                     ComparisonsPerFrame(options_.lookahead, options_.relocalization_candidates))
+                      .log10_nfa;
+  }
+  c.accepted =
+      pair.matched &&
+      (options_.acceptance == AcceptanceRule::kChance
+           ? c.log10_nfa <= options_.max_log10_nfa && pair.num_verified >= options_.min_link_share * link_verified_[key]
+           : pair.num_verified >= options_.min_verified && pair.similarity >= options_.min_similarity);
+  // The heading from every tentative match (verified first, then rejected), key image -> frame.
+  std::vector<cv::Point2f> key_points, frame_points;
+  SplitCorrespondences(pair.correspondences, &frame_points, &key_points);
+  std::vector<unsigned char> verified;
+  if (pair.matched) {
+    verified.assign(pair.correspondences.size(), 0);
+    std::fill(verified.begin(), verified.begin() + pair.num_verified, 1);
+  }
+  const Camera* camera = options_.camera ? &*options_.camera : nullptr;
+  c.heading = EstimateHeading(key_points, frame_points, verified, options_.heading, camera);
+  if (pair.matched) c.verified.assign(pair.correspondences.begin(), pair.correspondences.begin() + pair.num_verified);
+  return c;
+}
+
+void Localizer::AddPose(KeyComparison& c) const {
+  if (!options_.camera || !c.matched || c.experience != 0 || c.verified.empty() || c.pose.valid) return;
+  std::vector<cv::Point2f> key_points, frame_points;
+  SplitCorrespondences(c.verified, &frame_points, &key_points);
+  // The thresholds of the map's own pose estimates (PoseOptions): 3 px inliers, Cauchy scale 1 px.
+  const PoseOptions pose_options;
+  const double inlier_threshold = pose_options.refine_inlier_factor * pose_options.threshold;
+  const NormalizedMatches verified_matches(*options_.camera, frame_points, key_points);
+  RelativePose pose = PoseFromFundamental(c.F, verified_matches);
+  if (!pose.valid) return;
+  // F's pose is not an optimum of the matches' errors (E = K^T F K is not essential): refined, and the four
+  // poses of the refined E decided again by cheirality, as a link's. Only then does the sigma below measure
+  // the matches rather than how far F's pose is from their optimum.
+  c.pose = EnforceCheirality(RefineRelativePose(pose, verified_matches, inlier_threshold, pose_options.threshold),
+                             verified_matches, pose_options.threshold);
+  const TranslationEvidence evidence =
+      AssessTranslation(c.pose, verified_matches, verified_matches, pose_options, options_.translation);
+  c.translation_sigma_deg = evidence.sigma_deg;
+  c.translation_known = evidence.known;
+}
+
+KeyComparison Localizer::CompareOnce(const ImageFeatures& features, int key) {
+  for (Memo& m : comparisons_) {
+    if (m.comparison.key == key) {
+      m.used = true;
+      return m.comparison;
+    }
+  }
+  comparisons_.push_back({Compare(features, key), true});
+  return comparisons_.back().comparison;
+}
+
+}  // namespace vmap

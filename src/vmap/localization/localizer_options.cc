@@ -1,0 +1,97 @@
+#include "vmap/localization/localizer_options.h"
+
+#include <fmt/format.h>
+
+#include "vmap/core/error.h"
+
+namespace vmap {
+
+void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit({"acceptance", "--acceptance",
+                 "When a frame is seen at a key image: chance (its verified matches are unlikely by "
+                 "chance, --max-log10-nfa, and many against the map's links, --min-link-share) or "
+                 "counts (the earlier rule: --min-verified and --min-similarity)"},
+                EnumField(acceptance, kAcceptanceRuleNames, ParseAcceptanceRule));
+  visitor.Visit({"max_log10_nfa", "--max-log10-nfa",
+                 "--acceptance chance: accept when log10 of the number of false alarms is at most this"},
+                max_log10_nfa);
+  visitor.Visit({"min_verified", "--min-verified",
+                 "--acceptance counts: verified matches a frame needs to be localized at a key image"},
+                min_verified);
+  visitor.Visit(
+      {"min_similarity", "--min-similarity", "--acceptance counts: S a frame needs to be localized at a key image"},
+      min_similarity);
+  visitor.Visit({"min_link_share", "--min-link-share",
+                 "--acceptance chance: verified matches a frame also needs, as a fraction of those of the key "
+                 "image's link with its route neighbour (0: chance alone)"},
+                min_link_share);
+  visitor.Visit({"recheck_link_share", "--recheck-link-share",
+                 "Relocalize a tracked frame with fewer verified matches than this fraction of its key image's "
+                 "link, and move it where more verify (0: never)"},
+                recheck_link_share);
+  visitor.Visit({"max_lost_frames", "--max-lost", "Lost frames in a row before the estimate is dropped"},
+                max_lost_frames);
+  visitor.Visit({"relocalization_candidates", "--candidates", "Best-ranked key images verified when relocalizing"},
+                relocalization_candidates);
+  visitor.Visit({"experience_candidates", "--experience-candidates",
+                 "Maps with experiences: views of a key image verified besides it, those with the most tentative "
+                 "matches (0 = the teach key images only)"},
+                experience_candidates);
+  visitor.Visit({"lookahead", "--lookahead", "Key images beyond the next compared while tracking (1 or 2)"}, lookahead);
+  visitor.Visit({"step_back", "!--no-step-back", "Never move the estimate back to the previous key image"}, step_back);
+  visitor.VisitNested("ranking", ranking);
+  visitor.VisitNested("heading", heading);
+  visitor.VisitNested("verifier", verifier, Nesting{false, {"max_samples_to_reject"}});
+  visitor.VisitNested("translation", translation);
+  visitor.Visit({"similarity"}, EnumField(similarity, kSimilarityModeNames, ParseSimilarityMode));
+  visitor.Visit({"route"}, route);
+}
+
+void LocalizerOptions::Check() const {
+  const LocalizerOptions defaults;  // the defaults the messages give, as declared
+  if (min_verified < 8 || min_verified > 100000) {
+    throw OptionError("min_verified", fmt::format("{} must be 8 (the fewest matches F can be verified with) to "
+                                                  "100000 (default {})",
+                                                  min_verified, defaults.min_verified));
+  }
+  if (!(min_similarity >= 0.0 && min_similarity <= 1.0)) {
+    throw OptionError("min_similarity",
+                      fmt::format("{} is outside [0, 1] (default {})", min_similarity, defaults.min_similarity));
+  }
+  if (!(max_log10_nfa >= -1000.0 && max_log10_nfa <= 1000.0)) {
+    throw OptionError("max_log10_nfa", fmt::format("{} is outside [-1000, 1000] (default {}; 0: accept what "
+                                                   "chance explains less than once)",
+                                                   max_log10_nfa, defaults.max_log10_nfa));
+  }
+  if (!(recheck_link_share >= 0.0 && recheck_link_share <= 10.0)) {
+    throw OptionError("recheck_link_share",
+                      fmt::format("{} is outside [0, 10] (default {}; 0: never relocalize a tracked frame)",
+                                  recheck_link_share, defaults.recheck_link_share));
+  }
+  if (!(min_link_share >= 0.0 && min_link_share <= 10.0)) {
+    throw OptionError("min_link_share", fmt::format("{} is outside [0, 10] (default {}; 0: chance alone decides)",
+                                                    min_link_share, defaults.min_link_share));
+  }
+  if (lookahead < 1 || lookahead > 2) {
+    throw OptionError("lookahead", fmt::format("{} is not 1 or 2 (default {})", lookahead, defaults.lookahead));
+  }
+  if (max_lost_frames < 0 || max_lost_frames > 1000000) {
+    throw OptionError("max_lost_frames",
+                      fmt::format("{} must be 0 to 1000000 (default {})", max_lost_frames, defaults.max_lost_frames));
+  }
+  if (relocalization_candidates < 1 || relocalization_candidates > 10000) {
+    throw OptionError("relocalization_candidates",
+                      fmt::format("{} must be 1 to 10000 (default {})", relocalization_candidates,
+                                  defaults.relocalization_candidates));
+  }
+  CheckField("ranking", ranking);
+  CheckField("verifier", verifier);
+  CheckField("heading", heading);
+  CheckField("translation", translation);
+  if (experience_candidates < 0 || experience_candidates > 1000) {
+    throw OptionError("experience_candidates", fmt::format("{} must be 0 (teach key images only) to 1000 (default {})",
+                                                           experience_candidates, defaults.experience_candidates));
+  }
+}
+
+}  // namespace vmap

@@ -1,0 +1,82 @@
+#pragma once
+// The options of the Localizer (localizer.h): how a comparison accepts a frame, how tracking and relocalization
+// search the route, and what the map lends them (verifier, similarity, camera, translation thresholds).
+
+#include <optional>
+#include <vector>
+
+#include "vmap/core/option_fields.h"
+#include "vmap/geometry/camera.h"
+#include "vmap/geometry/fundamental.h"
+#include "vmap/geometry/heading.h"
+#include "vmap/geometry/translation_evidence.h"
+#include "vmap/localization/acceptance.h"
+#include "vmap/localization/key_image_ranking.h"
+#include "vmap/mapping/key_image_selector.h"
+
+namespace vmap {
+
+struct LocalizerOptions {
+  // When a comparison accepts the frame at a key image (acceptance.h, docs/localization-acceptance.md).
+  // kChance (default): matching and verification succeed, the verified set is unlikely by chance (log10 of its
+  // number of false alarms, every comparison a frame can make counted as a test, at most `max_log10_nfa`; 0:
+  // what chance would explain less than once over all the comparisons of a frame: the same scene), and it holds
+  // at least `min_link_share` times the verified matches of the key image's link with its route neighbour (the
+  // smaller of its two links: what two neighbouring key images of this map share, so the bar follows the
+  // matcher, the image size and the texture: the same place).
+  // kCounts (the earlier rule): at least `min_verified` verified matches and S >= `min_similarity` (S as the map
+  // defines it), whatever the matcher and image size.
+  // Chance alone says "the same scene", which a far key image of the same room also is; the link share adds "the
+  // same place". The defaults were chosen on redkitchen's teach/repeat test (docs/localization-acceptance.md; the
+  // figures: docs/measurements/code-choices.md, "Accepting a frame at a key image").
+  AcceptanceRule acceptance = AcceptanceRule::kChance;
+  double max_log10_nfa = 0.0;
+  double min_link_share = 0.4;  // 0: chance alone decides (a key image without a link on the route: likewise)
+  int min_verified = 20;
+  double min_similarity = 0.3;
+  // Same scene is not same place. A frame tracked at a key image with fewer verified matches than
+  // `recheck_link_share` times those of the key image's link (as above) is also relocalized, and moved to the
+  // ranked key image that verifies more matches, if one does: a frame that verifies against a far key image of
+  // the same room must not stay there. 0: never (tracking keeps any accepted key image).
+  double recheck_link_share = 0.5;
+  // Key images compared beyond `next_key` when the frame has passed it (1 or 2: the issue's "next one or two").
+  int lookahead = 2;
+  // While tracking, also compare the key image before `key` when the frame is nearer `key` than `next_key`
+  // (fewer than a third of their verified matches are with `next_key`), and move back when it is the better
+  // match: the frame may be behind `key`. A check that finds it clearly worse is repeated on the frames that
+  // follow only once their verified matches with `next_key` fall below that frame's (they moved back). Off: the
+  // estimate only moves forwards (a robot that never reverses).
+  bool step_back = true;
+  // Lost frames in a row (each one also failed to relocalize) after which the estimate is dropped: key and
+  // next_key then read -1 until a frame is relocalized.
+  int max_lost_frames = 5;
+  // Best-ranked key images verified when relocalizing.
+  int relocalization_candidates = 5;
+  RankingOptions ranking;
+  // The map's verifier (as map.json records it), except that localization caps its iterations (see
+  // MapVerifierOptions): a frame that shares little with a key image must fail fast.
+  VerifierOptions verifier;
+  SimilarityMode similarity = SimilarityMode::kInlierRatio;
+  // Key-image indices to follow, in order (PlanRoute gives one); empty = every key image in map order.
+  std::vector<int> route;
+  // How the heading to each key image compared is estimated (geometry/heading.h).
+  HeadingOptions heading;
+  // The map's camera (map.input.camera: intrinsics from the dataset or --camera). With it each comparison
+  // also gives the heading in degrees and the relative pose to the key image; without, pixels only.
+  std::optional<Camera> camera;
+  // When a pose's translation direction is trusted (the map's link_analysis.translation: MapLocalizerOptions).
+  TranslationOptions translation;
+  // Maps with experiences (map/experiences.h): views of a key image verified besides the key image itself,
+  // those with the most tentative matches with the frame (matching is cheap, verification is not). 0: the
+  // teach key images only. 2 by default: a frame rarely fits more than the one or two views of its season.
+  int experience_candidates = 2;
+
+  // As a localization run records them (its "options"; not the camera, which the map gives) and the flags of
+  // `vmap localize`. The verifier, the translation thresholds and the similarity follow the map
+  // (MapVerifierOptions, FollowMap): they are recorded, but have no flags here, and the verifier records no
+  // early stop (localization verifies each comparison in full).
+  void VisitFields(OptionFieldVisitor& visitor);
+  void Check() const;  // throws OptionError naming the bad field
+};
+
+}  // namespace vmap
