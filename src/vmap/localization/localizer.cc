@@ -23,7 +23,12 @@ constexpr double kClearlyWorse = 0.7;
 }  // namespace
 
 Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matcher& matcher, LocalizerOptions options)
-    : map_(map), keys_(keys), matcher_(matcher), options_(std::move(options)) {
+    : map_(map),
+      keys_(keys),
+      matcher_(matcher),
+      options_(std::move(options)),
+      belief_(std::max<int>(1, options_.route.empty() ? map.key_images.size() : options_.route.size()),
+              options_.belief) {
   options_.Check();
   const int num_keys = static_cast<int>(map_.key_images.size());
   if (num_keys == 0) throw InputError("the map has no key images; nothing to localize against");
@@ -66,11 +71,15 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
     thumbnails.push_back(keys_.thumbnails[k]);
   }
   ranking_ = std::make_unique<KeyImageRanking>(features, thumbnails, options_.ranking);
+  const cv::Mat descriptors = keys_.features.front()->descriptors();
+  evidence_ =
+      !descriptors.empty() && descriptors.depth() == CV_8U ? BinaryDescriptorEvidence() : FloatDescriptorEvidence();
 }
 
 Localizer::~Localizer() = default;
 
 void Localizer::Reset() {
+  belief_.Reset();
   position_ = -1;
   lost_in_a_row_ = 0;
   step_back_ruled_out_ = {};
@@ -83,7 +92,9 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   for (KeyComparison& c : ahead) {
     if (c.key >= 0 && c.key < static_cast<int>(keys_.features.size())) comparisons_.push_back({std::move(c), false});
   }
+  belief_.Predict();
   LocalizationResult result = has_estimate() ? Track(frame, features) : Relocalize(frame, features);
+  Believe(result);
   result.comparisons =
       static_cast<int>(std::count_if(comparisons_.begin(), comparisons_.end(), [](const Memo& m) { return m.used; }));
   if (result.key >= 0 && result.to_key.key == result.key) {

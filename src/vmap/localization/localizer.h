@@ -33,6 +33,8 @@
 #include "vmap/localization/localization_result.h"
 #include "vmap/localization/localizer_options.h"
 #include "vmap/localization/map_verifier_options.h"
+#include "vmap/localization/route_belief.h"
+#include "vmap/localization/route_evidence.h"
 #include "vmap/map/visual_map.h"
 #include "vmap/sources/frame_source.h"
 
@@ -80,6 +82,10 @@ class Localizer {
   LocalizationResult Track(const Frame& frame, const ImageFeatures& features);
   LocalizationResult Relocalize(const Frame& frame, const ImageFeatures& features);
   void Describe(LocalizationResult& result, int position, const ImageFeatures& features);
+  // The belief's step (localizer_belief.cc): weighs the evidence of every comparison of the frame, then sets the
+  // result's confidence and, when the belief does not single out the tracked position, the status kUncertain.
+  void Believe(LocalizationResult& result);
+  void WeighComparisons();
 
   // The frame's verified matches with key_a over those of the map's link between key_a and key_b (0 when
   // they have no link).
@@ -105,9 +111,12 @@ class Localizer {
     int position = -1;
     int next_verified = 0;
   } step_back_ruled_out_;
+  RouteBelief belief_;
+  EvidenceModel evidence_;  // by the kind of the matcher's descriptors
   struct Memo {
     KeyComparison comparison;
-    bool used = false;  // counted in LocalizationResult::comparisons
+    bool used = false;     // counted in LocalizationResult::comparisons
+    bool weighed = false;  // its evidence is in the belief
   };
   std::vector<Memo> comparisons_;  // of the frame being localized
 };

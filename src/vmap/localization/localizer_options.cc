@@ -40,6 +40,7 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"lookahead", "--lookahead", "Key images beyond the next compared while tracking (1 or 2)"}, lookahead);
   visitor.Visit({"step_back", "!--no-step-back", "Never move the estimate back to the previous key image"}, step_back);
   visitor.VisitNested("ranking", ranking);
+  visitor.VisitNested("belief", belief);
   visitor.VisitNested("heading", heading);
   visitor.VisitNested("verifier", verifier, Nesting{false, {"max_samples_to_reject"}});
   visitor.VisitNested("translation", translation);
@@ -85,6 +86,7 @@ void LocalizerOptions::Check() const {
                                   defaults.relocalization_candidates));
   }
   CheckField("ranking", ranking);
+  CheckField("belief", belief);
   CheckField("verifier", verifier);
   CheckField("heading", heading);
   CheckField("translation", translation);

@@ -12,6 +12,7 @@
 #include "vmap/geometry/translation_evidence.h"
 #include "vmap/localization/acceptance.h"
 #include "vmap/localization/key_image_ranking.h"
+#include "vmap/localization/route_belief.h"
 #include "vmap/mapping/key_image_selector.h"
 
 namespace vmap {
@@ -53,6 +54,8 @@ struct LocalizerOptions {
   // Best-ranked key images verified when relocalizing.
   int relocalization_candidates = 5;
   RankingOptions ranking;
+  // The belief over the route (route_belief.h): its motion model and when a frame is uncertain.
+  RouteBeliefOptions belief;
   // The map's verifier (as map.json records it), except that localization caps its iterations (see
   // MapVerifierOptions): a frame that shares little with a key image must fail fast.
   VerifierOptions verifier;

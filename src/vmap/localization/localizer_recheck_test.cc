@@ -80,7 +80,9 @@ TEST(Localizer, AFrameTrackedAtAFarKeyImageOfTheSameSceneIsMovedWhereItVerifiesB
   refuse.recheck_link_share = 0.0;
   for (int jump_to : {41, 57}) {
     const LocalizationResult refused = AfterAJump(refuse, jump_to);
-    EXPECT_EQ(refused.status, LocalizationStatus::kRelocalized) << jump_to;
+    // Relocalized, and doubted by the belief over the route on this first frame after the jump (the test below).
+    EXPECT_TRUE(refused.status == LocalizationStatus::kRelocalized || refused.status == LocalizationStatus::kUncertain)
+        << jump_to;
     EXPECT_TRUE(Brackets(m.map, jump_to, refused.key)) << jump_to << " at key " << refused.key;
   }
   for (int jump_to : {25, 41, 57}) {
@@ -89,10 +91,40 @@ TEST(Localizer, AFrameTrackedAtAFarKeyImageOfTheSameSceneIsMovedWhereItVerifiesB
     EXPECT_EQ(held.status, LocalizationStatus::kTracking) << jump_to;
     EXPECT_FALSE(Brackets(m.map, jump_to, held.key)) << jump_to << " at key " << held.key;
     const LocalizationResult moved = AfterAJump(recheck, jump_to);
-    EXPECT_EQ(moved.status, LocalizationStatus::kRelocalized) << jump_to;
+    EXPECT_TRUE(moved.status == LocalizationStatus::kRelocalized || moved.status == LocalizationStatus::kUncertain)
+        << jump_to;
     EXPECT_TRUE(Brackets(m.map, jump_to, moved.key)) << jump_to << " at key " << moved.key;
     EXPECT_GT(moved.to_key.num_verified, held.to_key.num_verified);
     EXPECT_FALSE(moved.candidates.empty());
+  }
+}
+
+// The belief over the route (route_belief.h): a frame far from where the frames before it were is relocalized, but
+// one frame is not enough to be sure of it (a chance match could look alike): it is uncertain, not to steer by,
+// until the frames that follow confirm the place. Without the belief (min_confidence 0) it is steered by at once.
+TEST(Localizer, AOneFrameJumpIsUncertainUntilTheFramesThatFollowConfirmIt) {
+  const LocalizationMap& m = Dense();
+  for (const double min_confidence : {0.5, 0.0}) {
+    LocalizerOptions options = MapLocalizerOptions(m);
+    ASSERT_EQ(options.belief.min_confidence, 0.5) << "the default";
+    options.belief.min_confidence = min_confidence;
+    Localizer localizer(m.map, m.keys, *m.matcher, options);
+    int index = 0;
+    for (int source_index : {1, 3, 5}) {
+      const LocalizationResult r = LocalizeImage(localizer, source_index, index++);
+      EXPECT_NE(r.status, LocalizationStatus::kUncertain) << source_index;
+      EXPECT_GT(r.confidence, 0.5) << source_index;
+    }
+    const LocalizationResult jumped = LocalizeImage(localizer, 41, index++);
+    EXPECT_TRUE(Brackets(m.map, 41, jumped.key)) << "at key " << jumped.key;
+    EXPECT_LT(jumped.confidence, 0.5);
+    EXPECT_EQ(jumped.status, min_confidence > 0 ? LocalizationStatus::kUncertain : LocalizationStatus::kRelocalized);
+    EXPECT_FALSE(min_confidence > 0 && MaySteerBy(jumped));
+    LocalizationResult r;
+    for (int source_index : {43, 45, 47}) r = LocalizeImage(localizer, source_index, index++);
+    EXPECT_EQ(r.status, LocalizationStatus::kTracking);
+    EXPECT_TRUE(Brackets(m.map, 47, r.key)) << "at key " << r.key;
+    EXPECT_GT(r.confidence, 0.5);
   }
 }
 

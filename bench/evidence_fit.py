@@ -1,0 +1,124 @@
+#!/usr/bin/python3
+"""The evidence of one comparison, fitted: how much likelier a comparison's outcome is at a right key image than at
+a wrong one (localization/route_evidence.cc, docs/localize.md "The belief over the route").
+
+Input: the CSVs of bench/route_conditions.py --evidence-dir (every frame against every key image of its map, from
+build/bench/evidence_dump): corridor_MATCHER.csv (frame i of the repeat is right at the key images around teach
+frames i-2..i+2) and michigan_MATCHER.csv (frame i right at key image i). The corridor's maps need their key images'
+source indices: --corridor-map-MATCHER MAP_DIR (as route_conditions.py --work left them).
+
+Fits, by logistic regression (Newton's method), the log odds of "right" on a matched comparison's significance
+s = clamp(-log10 NFA, lo, hi) and its share of the key image's link (verified / link_verified, at most 1), and
+the log odds of an unmatched one; subtracting the log prior odds gives log likelihood ratios. Prints them, per set and
+pooled, and the false acceptance rate (wrong among those accepted) of the localizer's acceptance rule and of the
+fitted ratio above 0.
+
+usage: bench/evidence_fit.py DIR [--corridor-map-orb MAP] [--corridor-map-xfeat MAP] [--lo -5] [--hi 12]"""
+import argparse, csv, json, math, os, sys
+
+import numpy as np
+
+
+def keys_around(key_sources, source):
+    before = max((k for k, s in enumerate(key_sources) if s <= source), default=None, key=lambda k: key_sources[k])
+    after = min((k for k, s in enumerate(key_sources) if s >= source), default=None, key=lambda k: key_sources[k])
+    return {k for k in (before, after) if k is not None}
+
+
+def load(path, right_of):
+    rows = []
+    with open(path) as f:
+        for r in csv.DictReader(f):
+            rows.append((int(r["matched"]), int(r["accepted"]), float(r["log10_nfa"]), int(r["verified"]),
+                         int(r["link_verified"]), 1 if right_of(r) else 0))
+    return rows
+
+
+def features(rows, lo, hi):
+    x, y, unmatched = [], [], []
+    for matched, accepted, nfa, verified, link, right in rows:
+        if not matched:
+            unmatched.append(right)
+            continue
+        s = min(max(-nfa, lo), hi)
+        share = min(1.0, verified / link) if link > 0 else 0.0
+        x.append([1.0, s, share])
+        y.append(right)
+    return np.array(x), np.array(y, dtype=float), unmatched
+
+
+def logistic(x, y, iterations=50, ridge=1e-3):
+    w = np.zeros(x.shape[1])
+    for _ in range(iterations):
+        p = 1.0 / (1.0 + np.exp(-x @ w))
+        g = x.T @ (y - p) - ridge * w
+        h = (x * (p * (1 - p))[:, None]).T @ x + ridge * np.eye(len(w))
+        step = np.linalg.solve(h, g)
+        w += step
+        if np.abs(step).max() < 1e-9:
+            break
+    return w
+
+
+def report(name, rows, lo, hi):
+    x, y, unmatched = features(rows, lo, hi)
+    right = sum(r[5] for r in rows)
+    wrong = len(rows) - right
+    prior = math.log(right / wrong)
+    w = logistic(x, y) if len(y) and 0 < y.sum() < len(y) else np.zeros(3)
+    u_right = sum(unmatched)
+    u_wrong = len(unmatched) - u_right
+    unmatched_llr = math.log((u_right + 0.5) / (u_wrong + 0.5)) - prior
+    accepted = [r for r in rows if r[1]]
+    false_accepted = sum(1 for r in accepted if not r[5])
+    llr = x @ w - prior if len(y) else np.array([])
+    positive = llr > 0
+    print("%s: %d comparisons (%d right), matched %d; llr = %.3f + %.3f s + %.3f share (matched), %.3f unmatched" % (
+        name, len(rows), right, len(y), w[0] - prior, w[1], w[2], unmatched_llr))
+    print("    accepted by the localizer's rule: %d, of them wrong %d (%.1f %%); right ones accepted: %.1f %%" % (
+        len(accepted), false_accepted, 100.0 * false_accepted / max(1, len(accepted)),
+        100.0 * sum(1 for r in accepted if r[5]) / max(1, right)))
+    if len(y):
+        print("    fitted llr > 0: %d, of them wrong %d (%.1f %%); right ones with llr > 0: %.1f %%" % (
+            positive.sum(), int((positive & (y == 0)).sum()), 100.0 * (positive & (y == 0)).sum() / max(1, positive.sum()),
+            100.0 * (positive & (y == 1)).sum() / max(1, right)))
+    return w, prior
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("directory")
+    parser.add_argument("--corridor-map-orb")
+    parser.add_argument("--corridor-map-xfeat")
+    parser.add_argument("--lo", type=float, default=-5.0)
+    parser.add_argument("--hi", type=float, default=12.0)
+    args = parser.parse_args()
+    pooled = []
+    for matcher in ("orb", "xfeat"):
+        path = os.path.join(args.directory, "corridor_%s.csv" % matcher)
+        map_directory = getattr(args, "corridor_map_" + matcher)
+        if os.path.exists(path) and map_directory:
+            with open(os.path.join(map_directory, "map.json")) as f:
+                key_sources = [k["source_index"] for k in json.load(f)["key_images"]]
+
+            def right(r, key_sources=key_sources):
+                i = int(r["source_index"])
+                keys = set()
+                for j in range(max(0, i - 2), min(110, i + 2) + 1):
+                    keys |= keys_around(key_sources, j)
+                return int(r["key"]) in keys
+
+            rows = load(path, right)
+            report("corridor %s" % matcher, rows, args.lo, args.hi)
+            pooled += rows
+        path = os.path.join(args.directory, "michigan_%s.csv" % matcher)
+        if os.path.exists(path):
+            rows = load(path, lambda r: int(r["key"]) == int(r["source_index"]))
+            report("michigan %s" % matcher, rows, args.lo, args.hi)
+            pooled += rows
+    if pooled:
+        report("pooled", pooled, args.lo, args.hi)
+
+
+if __name__ == "__main__":
+    main()

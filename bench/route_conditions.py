@@ -1,0 +1,202 @@
+#!/usr/bin/python3
+"""Localization along a route whose appearance changed (docs/localize.md, "Across seasons and conditions").
+
+corridor: ../shared/data/corridor_conditions: a map of teach/ (`vmap build`), repeat/ localized against it; repeat
+  frame i was taken where teach frame i was, and a frame is right when its key image is one of those around any
+  teach frame i-2..i+2 (the key images bracketing it, with the data set's +-2 frames).
+michigan: ../shared/data/michigan_seasons as routes: for every ordered pair of sessions (a, b), a map of session a's
+  five places in order (`--tau 1`: every place a key image) and session b's five places localized against it
+  (frame i right at key image i). 132 routes of 5 frames.
+Per run: frames right (at a right key image, whatever the status), right and not uncertain, localized wrong, confidently wrong by more than 2 places (status tracking or relocalized at a
+key image more than 2 key images from every right one), uncertain and lost, and frames/s. Several vmap binaries
+(`--vmap A,B`) run one after the other on the same maps' inputs (each builds its own maps), so they compare side by
+side.
+
+With --evidence-dir DIR, also every frame of each run against every key image of its map
+(build/bench/evidence_dump) into DIR/corridor_MATCHER.csv and DIR/michigan_MATCHER.csv, the input of
+bench/evidence_fit.py.
+
+usage: bench/route_conditions.py --vmap build/vmap[,old/vmap] [--sets corridor,michigan] [--matchers orb,xfeat]
+                                 [--tau T] [--localize "FLAGS"] [--repeat-stride N] [--work DIR] [--csv-dir DIR]
+                                 [--evidence-dir DIR]
+(from the repository root; ../shared must be there)"""
+import argparse, json, os, subprocess, sys, tempfile
+
+SHARED = "../shared/data"
+
+
+def run(command):
+    done = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if done.returncode != 0:
+        sys.exit("failed: %s\n%s" % (" ".join(command), done.stdout))
+    return done.stdout
+
+
+def build(vmap, images, matcher, flags, directory):
+    if not os.path.exists(os.path.join(directory, "map.json")):
+        run([vmap, "build", images, "-q", "--matcher", matcher, "-o", directory] + flags)
+    with open(os.path.join(directory, "map.json")) as f:
+        return json.load(f)
+
+
+def localize(vmap, map_directory, query, flags, output):
+    run([vmap, "localize", map_directory, query, "-q", "--json", output] + flags)
+    with open(output) as f:
+        return json.load(f)
+
+
+def keys_around(key_sources, source):
+    """The key images bracketing teach frame `source` (the last at or before it, the first at or after it)."""
+    before = max((k for k, s in enumerate(key_sources) if s <= source), default=None, key=lambda k: key_sources[k])
+    after = min((k for k, s in enumerate(key_sources) if s >= source), default=None, key=lambda k: key_sources[k])
+    return {k for k in (before, after) if k is not None}
+
+
+class Tally:
+    def __init__(self):
+        self.frames = self.right = self.right_sure = self.wrong = self.confidently_far = self.uncertain = self.lost = 0
+        self.seconds = 0.0
+        self.far = []
+
+    def add(self, doc, right_keys_of, label):
+        """`right_keys_of(frame)`: the set of right key images of that frame."""
+        for f in doc["frames"]:
+            self.frames += 1
+            right = right_keys_of(f)
+            status = f["status"]
+            if status == "lost":
+                self.lost += 1
+                continue
+            if status == "uncertain":
+                self.uncertain += 1
+            if f["key"] in right:
+                self.right += 1
+                self.right_sure += status != "uncertain"
+                continue
+            if status == "uncertain":
+                continue
+            self.wrong += 1
+            if min(abs(f["key"] - k) for k in right) > 2:
+                self.confidently_far += 1
+                if len(self.far) < 8:
+                    self.far.append("%s frame %d at key %d (right %s)" % (label, f["source_index"], f["key"],
+                                                                          ",".join(map(str, sorted(right)))))
+        self.seconds += doc["summary"]["seconds"]
+
+    def row(self, name):
+        n = max(1, self.frames)
+        return "| %s | %d | %d (%.1f %%) | %d (%.1f %%) | %d | %d | %d | %d | %.1f |" % (
+            name, self.frames, self.right, 100.0 * self.right / n, self.right_sure, 100.0 * self.right_sure / n,
+            self.wrong, self.confidently_far, self.uncertain, self.lost,
+            self.frames / self.seconds if self.seconds > 0 else 0.0)
+
+
+HEADER = ("| run | frames | right | right, not uncertain | localized wrong | confidently > 2 places off | uncertain | "
+          "lost | frames/s |\n|---|---|---|---|---|---|---|---|---|")
+
+
+EVIDENCE_DUMP = "build/bench/evidence_dump"
+
+
+def dump_evidence(map_directory, query, output, prefix=""):
+    """Appends evidence_dump's rows of `query` against the map to `output` (its header once), each row after
+    `prefix` (for michigan: the teach and repeat sessions)."""
+    text = run([EVIDENCE_DUMP, map_directory, query])
+    lines = text.splitlines()
+    header = [l for l in lines if l.startswith("frame,")]
+    rows = [l for l in lines if l and l[0].isdigit()]
+    new = not os.path.exists(output)
+    with open(output, "a") as f:
+        if new:
+            f.write(("teach,repeat," if prefix else "") + header[0] + "\n")
+        for row in rows:
+            f.write(prefix + row + "\n")
+
+
+def corridor(vmap, matcher, tau_flags, localize_flags, stride, work, csv_dir, evidence_dir=None):
+    root = os.path.join(SHARED, "corridor_conditions")
+    map_directory = os.path.join(work, "corridor_%s_%s" % (matcher, "".join(tau_flags).replace("-", "")))
+    built = build(vmap, os.path.join(root, "teach"), matcher, tau_flags, map_directory)
+    key_sources = [k["source_index"] for k in built["key_images"]]
+    flags = localize_flags + (["--stride", str(stride)] if stride > 1 else [])
+    if csv_dir:
+        flags += ["--csv", os.path.join(csv_dir, "corridor_%s.csv" % matcher)]
+    doc = localize(vmap, map_directory, os.path.join(root, "repeat"), flags, os.path.join(work, "run.json"))
+    if evidence_dir:
+        dump_evidence(map_directory, os.path.join(root, "repeat"), os.path.join(evidence_dir, "corridor_%s.csv" % matcher))
+
+    def right(f):
+        i = f["source_index"]
+        keys = set()
+        for j in range(max(0, i - 2), min(110, i + 2) + 1):
+            keys |= keys_around(key_sources, j)
+        return keys
+
+    tally = Tally()
+    tally.add(doc, right, "corridor")
+    return tally, len(key_sources)
+
+
+def michigan(vmap, matcher, localize_flags, work, evidence_dir=None):
+    images = os.path.join(SHARED, "michigan_seasons", "images")
+    sessions = ["%02d" % s for s in range(1, 13)]
+    folders = {}
+    for s in sessions:
+        folder = os.path.join(work, "michigan_session_" + s)
+        os.makedirs(folder, exist_ok=True)
+        for place in range(1, 6):
+            link = os.path.join(folder, "%d.png" % place)
+            if not os.path.exists(link):
+                os.symlink(os.path.abspath(os.path.join(images, "%s%02d.png" % (s, place))), link)
+        folders[s] = folder
+    tally = Tally()
+    for a in sessions:
+        map_directory = os.path.join(work, "michigan_%s_map_%s" % (matcher, a))
+        build(vmap, folders[a], matcher, ["--tau", "1"], map_directory)
+        for b in sessions:
+            if a == b:
+                continue
+            doc = localize(vmap, map_directory, folders[b], localize_flags, os.path.join(work, "run.json"))
+            tally.add(doc, lambda f: {f["source_index"]}, "%s->%s" % (b, a))
+            if evidence_dir:
+                dump_evidence(map_directory, folders[b], os.path.join(evidence_dir, "michigan_%s.csv" % matcher),
+                              "%s,%s," % (a, b))
+    return tally
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--vmap", default="build/vmap", help="comma-separated binaries, compared side by side")
+    parser.add_argument("--sets", default="corridor,michigan")
+    parser.add_argument("--matchers", default="orb,xfeat")
+    parser.add_argument("--tau", help="the corridor map's tau (default: the matcher's)")
+    parser.add_argument("--localize", default="", help="more flags for vmap localize")
+    parser.add_argument("--repeat-stride", type=int, default=1, help="corridor: every Nth repeat frame (a faster robot)")
+    parser.add_argument("--work", help="keep maps here (reused) instead of a temporary folder")
+    parser.add_argument("--csv-dir", help="write each corridor run's CSV here")
+    parser.add_argument("--evidence-dir", help="write every frame's comparisons with every key image here")
+    args = parser.parse_args()
+    tau_flags = ["--tau", args.tau] if args.tau else []
+    print(HEADER)
+    with tempfile.TemporaryDirectory(prefix="vmap_route_conditions_") as scratch:
+        for index, vmap in enumerate(args.vmap.split(",")):
+            work = os.path.join(args.work or scratch, "binary%d" % index)
+            os.makedirs(work, exist_ok=True)
+            for matcher in args.matchers.split(","):
+                if "corridor" in args.sets:
+                    tally, keys = corridor(vmap, matcher, tau_flags, args.localize.split(), args.repeat_stride, work,
+                                           args.csv_dir, args.evidence_dir)
+                    print(tally.row("%s: corridor, %s, %d key images%s" % (
+                        vmap, matcher, keys, ", repeat stride %d" % args.repeat_stride if args.repeat_stride > 1
+                        else "")), flush=True)
+                    for line in tally.far:
+                        print("    " + line)
+                if "michigan" in args.sets:
+                    tally = michigan(vmap, matcher, args.localize.split(), work, args.evidence_dir)
+                    print(tally.row("%s: michigan 132 routes, %s" % (vmap, matcher)), flush=True)
+                    for line in tally.far:
+                        print("    " + line)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,118 @@
+// The belief over the route (route_belief.h) and the evidence that weighs it (route_evidence.h).
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "vmap/localization/route_belief.h"
+#include "vmap/localization/route_evidence.h"
+#include "vmap/testing/option_error.h"
+
+namespace vmap {
+namespace {
+
+// A robot that moves one key image every few frames and sees each key image it passes only weakly: the run of
+// weak but consistent evidence carries the belief along, which no single frame's evidence could.
+TEST(RouteBelief, ARunOfWeakConsistentEvidenceMovesItForward) {
+  RouteBelief belief(30, RouteBeliefOptions{});
+  const double weak = 1.0;  // e^1: under three times likelier at the right key image than elsewhere
+  int frame = 0;
+  for (int key = 0; key < 20; ++key) {
+    for (int repeat = 0; repeat < 3; ++repeat, ++frame) {
+      belief.Predict();
+      belief.Weigh(key, weak);
+      belief.Weigh(key + 1, weak);
+      belief.Normalize();
+    }
+  }
+  // Positions 18-20 see key image 19 (and 20): the belief follows the run.
+  EXPECT_NEAR(belief.Peak(), 19, 1);
+  EXPECT_GT(belief.MassWithin(belief.Peak(), 1), 0.5);
+  // One frame's weak evidence from a flat belief singles nothing out.
+  RouteBelief once(30, RouteBeliefOptions{});
+  once.Predict();
+  once.Weigh(19, weak);
+  once.Weigh(20, weak);
+  once.Normalize();
+  EXPECT_LT(once.MassWithin(19, 1), 0.5);
+}
+
+// A single chance match far from where the run of frames put the robot does not move the belief there, and the
+// belief is back on the route with the next frames.
+TEST(RouteBelief, ASingleChanceMatchDoesNotHoldItBack) {
+  RouteBelief belief(30, RouteBeliefOptions{});
+  auto frame = [&](int key, double strength) {
+    belief.Predict();
+    belief.Weigh(key, strength);
+    belief.Normalize();
+  };
+  for (int key = 0; key < 15; ++key) frame(key, 4.0);
+  ASSERT_NEAR(belief.Peak(), 14, 1);
+  // Key image 3 matches once, as a chance match does (weaker than the run's), while the run's key image fails.
+  belief.Predict();
+  belief.Weigh(3, 2.0);
+  belief.Weigh(15, -1.0);
+  belief.Normalize();
+  EXPECT_GE(belief.Peak(), 13);
+  EXPECT_LT(belief.MassWithin(3, 1), 0.5);
+  frame(16, 4.0);
+  EXPECT_NEAR(belief.Peak(), 16, 1);
+}
+
+TEST(RouteBelief, ItCanJumpAnywhereWhenTheEvidenceSaysSo) {
+  RouteBelief belief(30, RouteBeliefOptions{});
+  for (int frame = 0; frame < 10; ++frame) {
+    belief.Predict();
+    belief.Weigh(5, 4.0);
+    belief.Normalize();
+  }
+  ASSERT_NEAR(belief.Peak(), 5, 1);
+  // Carried: key image 25 is seen strongly, frame after frame, and 5 no more.
+  for (int frame = 0; frame < 4; ++frame) {
+    belief.Predict();
+    belief.Weigh(5, -1.0);
+    belief.Weigh(25, 6.0);
+    belief.Normalize();
+  }
+  EXPECT_NEAR(belief.Peak(), 25, 1);
+  belief.Reset();
+  EXPECT_NEAR(belief.MassWithin(0, 29), 1.0, 1e-9);
+  EXPECT_NEAR(belief.MassWithin(10, 1), 3.0 / 30.0, 1e-9);
+}
+
+TEST(RouteBelief, OptionsAreChecked) {
+  auto path = [](auto change) {
+    return testing::OptionErrorPath([&] {
+      RouteBeliefOptions options;
+      change(options);
+      options.Check();
+    });
+  };
+  EXPECT_EQ(path([](RouteBeliefOptions& o) { o.jump = 0.0; }), "jump");
+  EXPECT_EQ(path([](RouteBeliefOptions& o) { o.stay = -0.1; }), "stay");
+  EXPECT_EQ(path([](RouteBeliefOptions& o) { o.min_confidence = 1.5; }), "min_confidence");
+  EXPECT_NO_THROW(RouteBeliefOptions{}.Check());
+}
+
+// The evidence grows with how unlikely the verified matches are by chance and with the share of the key image's
+// link they hold; an unmatched comparison speaks against the key image.
+TEST(RouteEvidence, GrowsWithSignificanceAndTheLinkShare) {
+  for (const EvidenceModel& model : {BinaryDescriptorEvidence(), FloatDescriptorEvidence()}) {
+    KeyComparison unmatched;
+    EXPECT_LT(EvidenceLogRatio(model, unmatched, 100), 0.0);
+    KeyComparison chance;
+    chance.matched = true;
+    chance.num_verified = 20;
+    chance.log10_nfa = 10.0;  // chance explains it easily: as most comparisons with a wrong key image
+    KeyComparison strong = chance;
+    strong.log10_nfa = -30.0;
+    strong.num_verified = 150;
+    EXPECT_LT(EvidenceLogRatio(model, chance, 200), 0.0);
+    EXPECT_GT(EvidenceLogRatio(model, strong, 200), 1.0);
+    KeyComparison shared = strong;
+    shared.num_verified = 200;
+    EXPECT_GT(EvidenceLogRatio(model, shared, 200), EvidenceLogRatio(model, strong, 200));
+  }
+}
+
+}  // namespace
+}  // namespace vmap
