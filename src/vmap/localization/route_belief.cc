@@ -23,6 +23,7 @@ void RouteBeliefOptions::VisitFields(OptionFieldVisitor& visitor) {
 }
 
 void RouteBeliefOptions::Check() const {
+  const RouteBeliefOptions defaults;  // the defaults the messages give, as declared
   const std::pair<const char*, double> steps[] = {
       {"stay", stay}, {"forward", forward}, {"forward2", forward2}, {"back", back}, {"jump", jump}};
   for (const auto& [name, value] : steps) {
