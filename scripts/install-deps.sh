@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # Installs everything vmap needs on Debian 12 (bookworm) from Debian's own packages.
-# Usage: scripts/install-deps.sh [--with-browser] [--with-ros]
+# Usage: scripts/install-deps.sh [--with-browser] [--with-ros] [--with-fuzzers]
 #   --with-browser  also installs Chromium, used by the report tests.
 #   --with-ros      also installs ROS 1 (Debian's ROS Noetic packages): the node in ros/ and its tests against a
 #                   real rosmaster (docs/ros.md). The vmap binary never needs it.
+#   --with-fuzzers  also installs clang and its libFuzzer, for the fuzz targets (fuzz/, docs/fuzzing.md); without
+#                   them the build skips the fuzz targets and ctest reports their runs as skipped.
 set -euo pipefail
 
 packages=(
@@ -30,7 +32,8 @@ for flag in "$@"; do
   case "$flag" in
     --with-browser) packages+=(chromium) ;;
     --with-ros) packages+=("${ros_packages[@]}") ;;
-    *) echo "install-deps: unknown option $flag (use --with-browser, --with-ros)" >&2; exit 2 ;;
+    --with-fuzzers) packages+=(clang libclang-rt-14-dev) ;;
+    *) echo "install-deps: unknown option $flag (use --with-browser, --with-ros, --with-fuzzers)" >&2; exit 2 ;;
   esac
 done
 

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstring>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <set>
 #include <thread>
@@ -17,6 +18,7 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/contained_file.h"
+#include "vmap/core/directory_lock.h"
 #include "vmap/core/error.h"
 #include "vmap/core/output_file.h"
 
@@ -139,7 +141,8 @@ int RemoveTemporaryOutputsForExit() {
   return removed;
 }
 
-void WriteFileAtomically(const fs::path& path, std::string_view content) {
+void WriteFileAtomically(const fs::path& path, std::string_view content,
+                         const std::vector<TemporaryDirectory*>& completes) {
   // Refused before anything is written, and again before the rename (the path may have changed meanwhile).
   if (const std::string why_not = WhyNotReplaceable(path); !why_not.empty()) Refuse(path, why_not);
   RemoveStaleTemporaries(path);
@@ -193,6 +196,70 @@ void WriteFileAtomically(const fs::path& path, std::string_view content) {
                      "that its directory is writable");
   }
   Temporaries().paths.erase(temp);
+  for (TemporaryDirectory* directory : completes) {
+    Temporaries().paths.erase(directory->path_);
+    directory->completed_ = true;
+  }
+}
+
+TemporaryDirectory::TemporaryDirectory(const fs::path& near) {
+  RemoveStaleTemporaries(near);
+  for (int attempt = 0; attempt < 100 && path_.empty(); ++attempt) {
+    const fs::path candidate = TemporarySibling(near, "partial");
+    if (CreateRegistered(candidate, [&] { return mkdir(candidate.c_str(), 0777) == 0; })) {
+      path_ = candidate;
+    } else if (errno != EEXIST) {
+      break;
+    }
+  }
+  if (path_.empty()) {
+    throw InputError("cannot create a folder next to '" + near.string() + "' (" + ErrnoText() +
+                     "); check that its folder exists and is writable");
+  }
+}
+
+TemporaryDirectory::~TemporaryDirectory() {
+  if (!completed_) RemoveAndUnregister(path_);
+}
+
+void TemporaryDirectory::MoveTo(const fs::path& from, const fs::path& to) {
+  const auto fail = [&](const std::string& why) {
+    throw InputError("cannot move '" + from.string() + "' to '" + to.string() + "' (" + why +
+                     "); check the permissions of '" + to.parent_path().string() + "'");
+  };
+  // The parent opened without following a link: a symbolic link put in its place is refused, not followed.
+  const int parent = open(to.parent_path().c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+  if (parent < 0) {
+    fail(errno == ELOOP || errno == ENOTDIR ? "it is a symbolic link or not a folder; vmap writes nothing through "
+                                              "a link"
+                                            : ErrnoText());
+  }
+  const std::string name = to.filename().string();
+  std::lock_guard<std::mutex> lock(Temporaries().mutex);  // an interruption sees it before or after, never lost
+  int moved = renameat2(AT_FDCWD, from.c_str(), parent, name.c_str(), RENAME_NOREPLACE);
+  if (moved != 0 && (errno == EINVAL || errno == ENOSYS || errno == ENOTSUP)) {
+    // No RENAME_NOREPLACE on this file system: rename() would replace an empty folder, so look first.
+    struct stat existing;
+    if (fstatat(parent, name.c_str(), &existing, AT_SYMLINK_NOFOLLOW) == 0) {
+      errno = EEXIST;
+    } else {
+      moved = renameat(AT_FDCWD, from.c_str(), parent, name.c_str());
+    }
+  }
+  const int error = errno;
+  close(parent);
+  if (moved != 0) {
+    errno = error;
+    fail(error == EEXIST || error == ENOTEMPTY ? "it exists already" : ErrnoText());
+  }
+  // What a failure must remove from now on: `to` (moved out of the folder, the rest of the folder stays ours).
+  if (from != path_) {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  Temporaries().paths.erase(path_);
+  path_ = to;
+  Temporaries().paths.insert(path_);
 }
 
 OutputPolicy OutputPolicy::InsideVmapOutput() {
@@ -302,6 +369,11 @@ void AtomicOutputDirectory::CheckReplaceable(const fs::path& final_path, const O
 
 void AtomicOutputDirectory::Commit() {
   if (committed_) return;
+  // Another vmap writing into the folder being replaced (`build --add-experience-to` a map) finishes first:
+  // replacing it now would throw its work away while it still thinks it is writing it.
+  std::optional<DirectoryWriteLock> writers;
+  std::error_code exists_ec;
+  if (fs::is_directory(fs::symlink_status(final_path_, exists_ec))) writers.emplace(final_path_, "the output");
   CheckReplaceable();  // the folder may have changed while vmap worked
   fs::path old;        // where the replaced directory ends up, to be removed
   std::unique_lock<std::mutex> lock(Temporaries().mutex);

@@ -20,7 +20,37 @@ namespace vmap {
 
 // Writes `content` to `path` through a temporary file in the same directory and a rename. Never replaces a
 // symbolic link, a device, a FIFO, a socket or a read-only file (InputError; see output_file.h).
-void WriteFileAtomically(const std::filesystem::path& path, std::string_view content);
+// `completes`: TemporaryDirectory objects moved into place before this file, which this file makes part of
+// the output (a map.json naming the views just moved in): they stop being temporary in the same step as the
+// rename, so that an interruption removes them exactly when the file was not written.
+class TemporaryDirectory;
+void WriteFileAtomically(const std::filesystem::path& path, std::string_view content,
+                         const std::vector<TemporaryDirectory*>& completes = {});
+
+// A folder of this process's own work, ".NAME.partial-PID-N" beside `near` (NAME its file name), that becomes
+// part of an output by a rename: an experience's views, written before they are moved into a map. It is
+// removed when the object is destroyed or the process interrupted (wherever MoveTo put it) until a
+// WriteFileAtomically completes it; one left by a killed process is removed by the next one made beside it.
+class TemporaryDirectory {
+ public:
+  explicit TemporaryDirectory(const std::filesystem::path& near);
+  ~TemporaryDirectory();
+  TemporaryDirectory(const TemporaryDirectory&) = delete;
+  TemporaryDirectory& operator=(const TemporaryDirectory&) = delete;
+
+  // Where it is now.
+  const std::filesystem::path& path() const { return path_; }
+  // Renames `from` (this folder, or a folder inside it, which then becomes what is removed on failure) to
+  // `to`, which must not exist, and whose parent must be a real folder, not a symbolic link (its own path
+  // resolved by the caller). Throws InputError naming `to`.
+  void MoveTo(const std::filesystem::path& from, const std::filesystem::path& to);
+
+ private:
+  friend void WriteFileAtomically(const std::filesystem::path&, std::string_view,
+                                  const std::vector<TemporaryDirectory*>&);
+  std::filesystem::path path_;
+  bool completed_ = false;
+};
 
 // What an output directory may replace, and what it must never touch.
 struct OutputPolicy {

@@ -3,6 +3,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <optional>
+
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 
@@ -24,6 +26,23 @@ bool SameOutput(const fs::path& a, const fs::path& b) {
   const fs::path ca = fs::weakly_canonical(fs::absolute(a, ec), ec);
   const fs::path cb = fs::weakly_canonical(fs::absolute(b, ec), ec);
   return !ca.empty() && ca == cb;
+}
+
+// A file inside the folder `folder` (at any depth, links not followed) that is `file` under another name: a hard
+// link. Only asked for an existing output that has several links, so the walk is rare.
+std::optional<fs::path> HardLinkInside(const fs::path& file, const fs::path& folder) {
+  struct stat target;
+  if (stat(file.c_str(), &target) != 0 || target.st_nlink < 2) return std::nullopt;
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) return std::nullopt;
+  for (fs::recursive_directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    struct stat entry;
+    if (lstat(it->path().c_str(), &entry) == 0 && S_ISREG(entry.st_mode) && entry.st_dev == target.st_dev &&
+        entry.st_ino == target.st_ino) {
+      return it->path();
+    }
+  }
+  return std::nullopt;
 }
 
 }  // namespace
@@ -61,6 +80,10 @@ void CheckOutputFiles(const std::vector<OutputFile>& outputs, const std::vector<
       if (IsSameOrInside(output.path, input.path)) {
         throw OptionError(output.flag, path + " lies inside " + input.what + " '" + input.path.string() +
                                            "', an input of this command; write it somewhere else");
+      }
+      if (const std::optional<fs::path> link = HardLinkInside(output.path, input.path)) {
+        throw InputError(named + " is a hard link of '" + link->string() + "' in " + input.what + " '" +
+                         input.path.string() + "', an input of this command; write it somewhere else");
       }
     }
     for (size_t j = 0; j < i; ++j) {

@@ -61,6 +61,19 @@ TEST(OutputFile, InputsAreNeverOutputs) {
   EXPECT_EQ(Refusal({{"", "--csv"}, {"", "--json"}}, inputs), "");  // not asked for
 }
 
+// Issue 38: `--csv h.png`, h.png a hard link of an image inside the query folder, was written (renamed over).
+TEST(OutputFile, AHardLinkOfAFileInsideAnInputFolderIsThatFile) {
+  testing::ScopedTempDir tmp;
+  fs::create_directories(tmp.path() / "query/sub");
+  std::ofstream(tmp.path() / "query/sub/0001.png") << "png";
+  fs::create_hard_link(tmp.path() / "query/sub/0001.png", tmp.path() / "h.png");
+  std::ofstream(tmp.path() / "other.png") << "png";
+  fs::create_hard_link(tmp.path() / "other.png", tmp.path() / "other_link.png");
+  const std::vector<OutputInput> inputs = {{tmp.path() / "query", "the query"}};
+  EXPECT_NE(Refusal({{tmp.path() / "h.png", "--csv"}}, inputs).find("is a hard link of '"), std::string::npos);
+  EXPECT_EQ(Refusal({{tmp.path() / "other_link.png", "--csv"}}, inputs), "");  // links, but of no input
+}
+
 TEST(OutputFile, OnlyWritableRegularFilesAreReplaced) {
   testing::ScopedTempDir tmp;
   std::ofstream(tmp.path() / "old.csv") << "old";

@@ -71,6 +71,35 @@ cv::Matx33d QuaternionToRotation(double w, double x, double y, double z) {
 
 namespace {
 
+// Ground truth positions lie within some thousand kilometres of their origin; 1e300 is damage, and its
+// differences would be infinite or zero.
+constexpr double kMaxPositionMetres = 1e7;
+
+// Why a camera-to-world pose cannot be one (its rotation part not a rotation, a position beyond
+// kMaxPositionMetres), or "". Files print poses to 6 digits or more: R^T R is I to within 1e-4 then.
+std::string WhyNotAPose(const cv::Matx44d& T) {
+  const cv::Matx33d R = T.get_minor<3, 3>(0, 0);
+  const cv::Matx33d error = R.t() * R - cv::Matx33d::eye();
+  double worst = 0.0;
+  for (int i = 0; i < 9; ++i) worst = std::max(worst, std::abs(error.val[i]));
+  if (!(worst <= 1e-2) || !(cv::determinant(R) > 0.0)) {
+    return "its rotation is not a rotation matrix (R^T R - I reaches " + fmt::format("{:.3g}", worst) +
+           ", det R = " + fmt::format("{:.3g}", cv::determinant(R)) + ")";
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (!(std::abs(T(i, 3)) <= kMaxPositionMetres)) return "its position lies beyond 10,000 km";
+  }
+  return "";
+}
+
+// The rotation of a unit quaternion; why not when it is not one (TUM and EuRoC print 4 or more decimals, so
+// a norm far from 1 is a column out of place or damage).
+std::string WhyNotAUnitQuaternion(double w, double x, double y, double z) {
+  const double norm = std::sqrt(w * w + x * x + y * y + z * z);
+  if (!(std::abs(norm - 1.0) <= 1e-2)) return "its quaternion has norm " + fmt::format("{:.3g}", norm) + ", not 1";
+  return "";
+}
+
 // A poses file of some hundred bytes a frame: 256 MB is far more than any sequence's. Read whole and at once,
 // never line by line from the file itself, which a device such as /dev/zero would feed forever.
 std::string ReadGroundTruthText(const std::string& path) {
@@ -128,27 +157,40 @@ GroundTruth ReadGroundTruth(const std::string& path, GroundTruthFormat format, c
     for (double value : v) {
       if (!std::isfinite(value)) throw InputError(fmt::format("ground truth '{}' line {}: not finite", path, number));
     }
+    const auto check = [&](const std::string& why_not) {
+      if (!why_not.empty()) {
+        throw InputError(
+            fmt::format("ground truth '{}' line {} is not a pose: {}; check that the file is a {} "
+                        "poses file",
+                        path, number, why_not, GroundTruthFormatName(format)));
+      }
+    };
     switch (format) {
       case GroundTruthFormat::kKitti: {
         if (v.size() != 12) bad("12 numbers (3x4 camera-to-world matrix, row-major)");
         cv::Matx44d T = cv::Matx44d::eye();
         for (int i = 0; i < 12; ++i) T(i / 4, i % 4) = v[i];
+        check(WhyNotAPose(T));
         truth.camera_to_world.push_back(T);
         break;
       }
       case GroundTruthFormat::kTum: {
         if (v.size() != 8) bad("'timestamp tx ty tz qx qy qz qw'");
+        check(WhyNotAUnitQuaternion(v[7], v[4], v[5], v[6]));
         truth.timestamps.push_back(v[0]);
         truth.camera_to_world.push_back(
             FromRotationTranslation(QuaternionToRotation(v[7], v[4], v[5], v[6]), cv::Vec3d(v[1], v[2], v[3])));
+        check(WhyNotAPose(truth.camera_to_world.back()));
         break;
       }
       case GroundTruthFormat::kEuroc: {
         if (v.size() < 8) bad("'timestamp_ns, px, py, pz, qw, qx, qy, qz, ...'");
+        check(WhyNotAUnitQuaternion(v[4], v[5], v[6], v[7]));
         truth.timestamps.push_back(v[0] * 1e-9);
         const cv::Matx44d T_wb =
             FromRotationTranslation(QuaternionToRotation(v[4], v[5], v[6], v[7]), cv::Vec3d(v[1], v[2], v[3]));
         truth.camera_to_world.push_back(T_wb * body_to_camera);
+        check(WhyNotAPose(truth.camera_to_world.back()));
         break;
       }
       case GroundTruthFormat::kAuto:

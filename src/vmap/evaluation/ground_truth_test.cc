@@ -126,6 +126,40 @@ TEST(GroundTruth, DetectsAndReadsTheThreeFormats) {
   EXPECT_THROW(ReadGroundTruth((tmp.path() / "missing.txt").string()), InputError);
 }
 
+// Issue 38: all-zero or 1e300 matrices were read as poses and gave 120-degree errors; a zero quaternion the
+// identity.
+TEST(GroundTruth, LinesThatAreNoPoseAreRefusedNamingTheLine) {
+  testing::ScopedTempDir tmp;
+  const std::string good = "1 0 0 0 0 1 0 0 0 0 1 0\n";
+  const struct {
+    const char* name;
+    std::string text;
+    GroundTruthFormat format;
+  } cases[] = {
+      {"zeros.txt", good + "0 0 0 0 0 0 0 0 0 0 0 0\n", GroundTruthFormat::kKitti},
+      {"huge.txt", good + "1e300 0 0 0 0 1e300 0 0 0 0 1e300 0\n", GroundTruthFormat::kKitti},
+      {"far.txt", good + "1 0 0 1e300 0 1 0 0 0 0 1 0\n", GroundTruthFormat::kKitti},
+      {"mirror.txt", good + "-1 0 0 0 0 1 0 0 0 0 1 0\n", GroundTruthFormat::kKitti},
+      {"tum.txt", "1.0 0 0 0 0 0 0 1\n2.0 0 0 0 0 0 0 0\n", GroundTruthFormat::kTum},
+      {"euroc.csv", "1000,0,0,0,1,0,0,0\n2000,0,0,0,3,0,0,0\n", GroundTruthFormat::kEuroc},
+  };
+  for (const auto& c : cases) {
+    WriteText(tmp.path() / c.name, c.text);
+    try {
+      ReadGroundTruth((tmp.path() / c.name).string(), c.format);
+      ADD_FAILURE() << c.name << " was read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("line 2 is not a pose"), std::string::npos) << c.name << ": " << e.what();
+    }
+  }
+  // Poses printed to 6 digits, as KITTI's are, stay poses.
+  WriteText(tmp.path() / "printed.txt", good +
+                                            "9.999978e-01 5.272628e-04 -2.066935e-03 -4.690294e-02 "
+                                            "-5.296506e-04 9.999992e-01 -1.154865e-03 -2.839928e-02 "
+                                            "2.066324e-03 1.155958e-03 9.999971e-01 8.586941e-01\n");
+  EXPECT_EQ(ReadGroundTruth((tmp.path() / "printed.txt").string()).camera_to_world.size(), 2u);
+}
+
 TEST(GroundTruth, KeyImagesTakeTheirPoseBySourceIndexOrByNearestTimestamp) {
   GroundTruth kitti;
   kitti.format = GroundTruthFormat::kKitti;

@@ -144,6 +144,20 @@ void Camera::Check() const {
     throw InputError(fmt::format("{} has focal lengths fx = {}, fy = {}; both must be > 0 (pixels)", where, fx, fy));
   }
   if (size.width < 0 || size.height < 0) throw InputError(where + " has a negative image size");
+  if (size.width > kMaxCameraSide || size.height > kMaxCameraSide) {
+    throw InputError(fmt::format("{} has the size {}x{}; a side must be 0 to {} pixels", where, size.width, size.height,
+                                 kMaxCameraSide));
+  }
+  // No lens has a focal length or principal point of ten million pixels, nor distortion coefficients in the
+  // thousands: such values come from a damaged or crafted calibration, and would overflow what is computed from
+  // them (a map's reader refuses them too).
+  if (fx > kMaxCameraPixels || fy > kMaxCameraPixels || std::abs(cx) > kMaxCameraPixels ||
+      std::abs(cy) > kMaxCameraPixels) {
+    throw InputError(where + " has a focal length or principal point beyond 10,000,000 pixels");
+  }
+  for (double k : {k1, k2, p1, p2, k3, k4, k5, k6}) {
+    if (std::abs(k) > kMaxDistortion) throw InputError(where + " has a distortion coefficient beyond 1000");
+  }
   if (is_fisheye() && (p1 != 0.0 || p2 != 0.0 || k5 != 0.0 || k6 != 0.0)) {
     throw InputError(where + " is a fisheye (OPENCV_FISHEYE) camera with p1, p2, k5 or k6 set; it has k1..k4 only");
   }

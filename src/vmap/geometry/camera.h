@@ -33,6 +33,10 @@ inline constexpr EnumName<CameraModel> kCameraModelNames[] = {{CameraModel::kSim
 std::string CameraModelName(CameraModel model);
 CameraModel ParseCameraModel(const std::string& name);  // COLMAP's names, as above
 
+inline constexpr double kMaxCameraPixels = 1e7;  // focal lengths and principal point, pixels
+inline constexpr double kMaxDistortion = 1e3;    // each distortion coefficient, in absolute value
+inline constexpr int kMaxCameraSide = 1 << 20;   // the image size the intrinsics belong to, pixels
+
 struct Camera {
   CameraModel model = CameraModel::kPinhole;
   cv::Size size;  // the image size the intrinsics belong to; empty when the calibration did not say
@@ -67,7 +71,9 @@ struct Camera {
   // Needs `size` to be set.
   Camera ScaledTo(cv::Size new_size) const;
 
-  // Throws InputError when a parameter cannot be right (focal lengths <= 0, non-finite values).
+  // Throws InputError when a parameter cannot be right: non-finite values, focal lengths <= 0 or, like the
+  // principal point, beyond kMaxCameraPixels, distortion coefficients beyond kMaxDistortion, a side of the size
+  // beyond kMaxCameraSide. The one rule for every camera vmap takes in or writes (map.json, CameraInfo, --camera).
   void Check() const;
 };
 

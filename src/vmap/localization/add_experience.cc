@@ -9,6 +9,7 @@
 
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
+#include "vmap/core/directory_lock.h"
 #include "vmap/core/error.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/map/map_io.h"
@@ -61,35 +62,24 @@ namespace {
 
 std::string SizeText(const cv::Size& size) { return fmt::format("{}x{}", size.width, size.height); }
 
-// Removes what an interrupted add created, so that the map is left as it was.
-class Undo {
- public:
-  void Add(fs::path path) { paths_.push_back(std::move(path)); }
-  void Dismiss() { paths_.clear(); }
-  ~Undo() {
-    for (auto it = paths_.rbegin(); it != paths_.rend(); ++it) {
-      std::error_code ignored;
-      fs::remove_all(*it, ignored);
-    }
-  }
-
- private:
-  std::vector<fs::path> paths_;
-};
-
 }  // namespace
 
 AddExperienceSummary AddExperience(const fs::path& map_directory, FrameSource& source, const std::string& source_path,
                                    const AddExperienceOptions& options) {
   options.Check();
+  // Another writer of this map (another add, a `build -o` replacing it) finishes first; the map is read only
+  // once this one holds the lock, so that the experience it adds is numbered after the others and no other
+  // writer's map.json is written over with a copy that lacks their work.
+  const DirectoryWriteLock lock(map_directory, "the map");
+  const fs::path& map_path = lock.path();  // its real path: nothing below is written through a link
   KeyImageStoreOptions store_options;
   store_options.use_cache = false;
   store_options.thumbnail_width = options.localizer.ranking.thumbnail_width;
-  const LocalizationMap opened = OpenLocalizationMap(map_directory, store_options);
+  const LocalizationMap opened = OpenLocalizationMap(map_path, store_options);
   const VisualMap& map = opened.map;
-  const fs::path map_file = map_directory / kMapFileName;
+  const fs::path map_file = map_path / kMapFileName;
   // map.json as it is now: everything but `experiences` is written back as it was.
-  const ContainedJson parsed = ReadContainedJson(map_directory, kMapFileName, kMaxMapJsonBytes, 1ull << 23);
+  const ContainedJson parsed = ReadContainedJson(map_path, kMapFileName, kMaxMapJsonBytes, kMaxMapJsonValues);
   if (!parsed.document) throw InputError("cannot read '" + map_file.string() + "' again: " + parsed.why_not);
   json document = *parsed.document;
 
@@ -101,17 +91,32 @@ AddExperienceSummary AddExperience(const fs::path& map_directory, FrameSource& s
   summary.num_key_images = static_cast<int>(map.key_images.size());
   summary.experience.id = static_cast<int>(opened.experiences.size()) + 1;
   summary.experience.source = source_path;
-  const std::string folder = fmt::format("{}/{}", kExperiencesDirectory, summary.experience.id);
-
-  Undo undo;
-  const fs::path experiences_directory = map_directory / kExperiencesDirectory;
+  const std::string id = std::to_string(summary.experience.id);
+  const std::string folder = std::string(kExperiencesDirectory) + "/" + id;
+  const fs::path experiences_directory = map_path / kExperiencesDirectory;
+  // Refused before any work: an `experiences` that is not a real folder of the map, or an experience folder
+  // that map.json does not list (left by an add killed between moving it in and writing map.json).
   std::error_code ec;
-  if (fs::create_directory(experiences_directory, ec)) undo.Add(experiences_directory);
-  if (ec) {
-    throw InputError("cannot create '" + experiences_directory.string() + "' (" + ec.message() +
+  const fs::file_status experiences_status = fs::symlink_status(experiences_directory, ec);
+  if (fs::exists(experiences_status) && !fs::is_directory(experiences_status)) {
+    throw InputError("'" + experiences_directory.string() +
+                     "' is not a folder (a symbolic link, or a file): vmap writes nothing through a link in a map; "
+                     "move it away");
+  }
+  if (fs::exists(fs::symlink_status(map_path / folder, ec))) {
+    throw InputError("'" + (map_path / folder).string() + "' exists but map.json lists no experience " + id +
+                     " (left by an add that was killed?); move it away and add again");
+  }
+
+  // The views are written into a folder of this run's own (".experiences.partial-PID-N" in the map), removed
+  // if the run fails or is interrupted, and by the next add when it was killed outright. The map's own
+  // `experiences` folder appears, or gains `id`, only once every view is written.
+  TemporaryDirectory views(experiences_directory);
+  const fs::path views_directory = views.path() / id;
+  if (!fs::create_directory(views_directory, ec) || ec) {
+    throw InputError("cannot create '" + views_directory.string() + "' (" + ec.message() +
                      "); check the permissions of the map directory");
   }
-  auto views_directory = std::make_unique<AtomicOutputDirectory>(map_directory / folder, OutputPolicy());
   const auto view_file = [](int key) { return fmt::format("{:06d}.png", key); };
 
   ExperienceViewPicker picker(summary.num_key_images);
@@ -126,7 +131,7 @@ AddExperienceSummary AddExperience(const fs::path& map_directory, FrameSource& s
                           SizeText(map_size)));
         }
         for (int key : picker.Offer(result)) {
-          const fs::path file = views_directory->path() / view_file(key);
+          const fs::path file = views_directory / view_file(key);
           if (!cv::imwrite(file.string(), ColorImage(frame))) {
             throw InputError("cannot write '" + file.string() +
                              "'; check the free space and the permissions of the "
@@ -145,14 +150,17 @@ AddExperienceSummary AddExperience(const fs::path& map_directory, FrameSource& s
   }
   for (ExperienceView& v : summary.experience.views) v.image_file = folder + "/" + view_file(v.key);
 
-  // The new files first, map.json last: a map.json never names a view that is not there.
-  views_directory->Commit();
-  undo.Add(map_directory / folder);
+  // The new files first, map.json last: a map.json never names a view that is not there, and until map.json
+  // is written the views are this run's to remove (on failure, on an interruption).
+  if (fs::exists(fs::symlink_status(experiences_directory, ec))) {
+    views.MoveTo(views_directory, map_path / folder);
+  } else {
+    views.MoveTo(views.path(), experiences_directory);
+  }
   json list = document.contains("experiences") ? document["experiences"] : json::array();
   list.push_back(ExperiencesToJson({summary.experience}).at(0));
   document["experiences"] = std::move(list);
-  WriteFileAtomically(map_file, document.dump(1) + "\n");
-  undo.Dismiss();
+  WriteFileAtomically(map_file, document.dump(1) + "\n", {&views});
   return summary;
 }
 

@@ -4,10 +4,12 @@
 // each key image gains as its view the repeat frame that localized at it best (most verified matches), with
 // that frame's heading against it. The key images, links and every other file of the map stay as they were.
 //
-// Atomic: the views are written into a temporary folder renamed to MAP/experiences/<id>/ once complete, and
-// map.json is replaced last (core/atomic_output); when anything fails the new folder is removed again, so the
-// map is left as it was. The map's key-image cache (localization_cache.bin) is neither read nor written: the
-// new map.json makes it stale anyway.
+// Atomic: the views are written into a folder of the run's own inside the map, moved to MAP/experiences/<id>/
+// once complete, and map.json is replaced last (core/atomic_output); when anything fails, or the run is
+// interrupted, what was moved is removed again, so the map is left as it was. Writers of one map exclude each
+// other (core/directory_lock.h): a second add waits for the first, then adds the next experience. Nothing is
+// written through a symbolic link inside the map. The map's key-image cache (localization_cache.bin) is
+// neither read nor written: the new map.json makes it stale anyway.
 
 #include <filesystem>
 #include <string>

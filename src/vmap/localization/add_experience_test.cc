@@ -1,14 +1,19 @@
 #include "vmap/localization/add_experience.h"
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "vmap/core/directory_lock.h"
 #include "vmap/core/error.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/localization/localization_map.h"
@@ -103,7 +108,7 @@ TEST(AddExperience, AddsViewsAndKeepsTheTeachRunByteIdentical) {
 
   // It reads back, as written.
   const VisualMap after = ReadMap(map.path);
-  const std::vector<Experience> experiences = ReadExperiences(map.path, after);
+  const std::vector<Experience> experiences = after.experiences;
   ASSERT_EQ(experiences.size(), 1u);
   EXPECT_EQ(experiences[0].source, "repeat");
   ASSERT_EQ(experiences[0].views.size(), added.experience.views.size());
@@ -128,7 +133,7 @@ TEST(AddExperience, AddsViewsAndKeepsTheTeachRunByteIdentical) {
   // A second run becomes experience 2; the first stays.
   MemorySource again(Frames(1, 4, /*other_season=*/true));
   EXPECT_EQ(AddExperience(map.path, again, "again", Quiet()).experience.id, 2);
-  const std::vector<Experience> two = ReadExperiences(map.path, ReadMap(map.path));
+  const std::vector<Experience> two = ReadMap(map.path).experiences;
   ASSERT_EQ(two.size(), 2u);
   EXPECT_EQ(two[0].views.size(), experiences[0].views.size());
   EXPECT_EQ(::vmap::testing::ReadText(map.path / kCorrespondencesFileName), correspondences_before);
@@ -245,6 +250,98 @@ TEST(AddExperience, RefusesWhatIsNotAMap) {
   MemorySource repeat(Frames(2, 4));
   EXPECT_THROW(AddExperience(tmp.path() / "not_a_map", repeat, "repeat", Quiet()), InputError);
   EXPECT_TRUE(fs::is_empty(tmp.path() / "not_a_map"));
+}
+
+// ---- Issue 38: concurrent writers, links inside the map, runs that were killed ------------------------------
+
+TEST(AddExperience, TwoAddsAtOnceBothLandOneAfterTheOther) {
+  // The issue's case: two adds on one map at once. Each read map.json with no experience, both wrote
+  // experience 1, and the loser's clean-up deleted `experiences/` under the winner's map.json.
+  TeachMap map;
+  std::string errors[2];
+  int ids[2] = {0, 0};
+  std::thread runs[2];
+  for (int i = 0; i < 2; ++i) {
+    runs[i] = std::thread([&, i] {
+      try {
+        MemorySource repeat(Frames(1 + i, 4, /*other_season=*/true));
+        ids[i] = AddExperience(map.path, repeat, "repeat" + std::to_string(i), Quiet()).experience.id;
+      } catch (const std::exception& e) {
+        errors[i] = e.what();
+      }
+    });
+  }
+  for (std::thread& run : runs) run.join();
+  EXPECT_EQ(errors[0], "");
+  EXPECT_EQ(errors[1], "");
+  EXPECT_EQ(std::set<int>(ids, ids + 2), (std::set<int>{1, 2}));
+  // Both are there, every view of each; and localization opens the map.
+  const VisualMap after = ReadMap(map.path);
+  ASSERT_EQ(after.experiences.size(), 2u);
+  for (const Experience& experience : after.experiences) {
+    for (const ExperienceView& view : experience.views) EXPECT_TRUE(fs::is_regular_file(map.path / view.image_file));
+  }
+  EXPECT_NO_THROW(OpenLocalizationMap(map.path, {}));
+}
+
+TEST(AddExperience, ASecondWriterWaitsForTheLockAndTouchesNothingMeanwhile) {
+  TeachMap map;
+  const auto before = Snapshot(map.path);
+  std::optional<DirectoryWriteLock> other(std::in_place, map.path, "the map");  // another writer, in effect
+  std::atomic<bool> done{false};
+  std::thread add([&] {
+    MemorySource repeat(Frames(2, 4, /*other_season=*/true));
+    AddExperience(map.path, repeat, "repeat", Quiet());
+    done = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_FALSE(done);
+  EXPECT_EQ(Snapshot(map.path), before);  // nothing read into a temporary, nothing written
+  other.reset();
+  add.join();
+  EXPECT_TRUE(done);
+  EXPECT_EQ(ReadMap(map.path).experiences.size(), 1u);
+  EXPECT_FALSE(DirectoryWriteLock::IsHeldElsewhere(map.path));
+}
+
+TEST(AddExperience, WritesNothingThroughALinkInsideTheMap) {
+  TeachMap map;
+  const fs::path outside = map.tmp.path() / "outside";
+  fs::create_directories(outside);
+  fs::create_directory_symlink(outside, map.path / kExperiencesDirectory);
+  const auto before = Snapshot(map.path);
+  MemorySource repeat(Frames(2, 4, /*other_season=*/true));
+  try {
+    AddExperience(map.path, repeat, "repeat", Quiet());
+    FAIL() << "an experience was written through a symbolic link";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("writes nothing through a link"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(fs::is_empty(outside));
+  EXPECT_EQ(Snapshot(map.path), before);
+}
+
+TEST(AddExperience, WhatAKilledAddLeftIsCleanedOrNamed) {
+  TeachMap map;
+  // A killed add's views (its pid runs no more): removed by the next add, which then lands.
+  const fs::path stale = map.path / ".experiences.partial-999999999-7";
+  fs::create_directories(stale / "1");
+  std::ofstream(stale / "1/000000.png") << "half";
+  MemorySource repeat(Frames(2, 4, /*other_season=*/true));
+  EXPECT_EQ(AddExperience(map.path, repeat, "repeat", Quiet()).experience.id, 1);
+  EXPECT_FALSE(fs::exists(stale));
+  // An experience folder map.json does not list (killed between moving it in and writing map.json) is not
+  // vmap's to remove: refused, naming it.
+  fs::create_directories(map.path / kExperiencesDirectory / "2");
+  const auto before = Snapshot(map.path);
+  MemorySource again(Frames(1, 4, /*other_season=*/true));
+  try {
+    AddExperience(map.path, again, "again", Quiet());
+    FAIL() << "experience 2 was written over an unlisted folder";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("map.json lists no experience 2"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(Snapshot(map.path), before);
 }
 
 TEST(ExperienceViewPicker, KeepsTheFrameWithMostVerifiedMatchesPerKeyImage) {

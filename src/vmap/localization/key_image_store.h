@@ -61,7 +61,7 @@ struct KeyImageStore {
 };
 
 // Reads (or computes and caches) the features of every key image of `map`, read from `map_directory`, and of
-// every view of `experiences` (ReadExperiences; cached after the key images).
+// every view of `experiences` (VisualMap::experiences; cached after the key images).
 // Throws InputError naming the file when a key image or view cannot be decoded.
 KeyImageStore LoadKeyImageStore(const std::filesystem::path& map_directory, const VisualMap& map,
                                 const Matcher& matcher, const KeyImageStoreOptions& options,

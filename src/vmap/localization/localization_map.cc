@@ -22,7 +22,7 @@ LocalizationMap OpenLocalizationMap(RecordedMap read, const std::filesystem::pat
   opened.options = std::move(read.options);
   opened.matcher =
       CreateMatcher(MatcherOptionsFromJson(opened.options.matcher_json, (directory / kMapFileName).string()));
-  opened.experiences = ReadExperiences(directory, opened.map);
+  opened.experiences = opened.map.experiences;
   opened.keys = LoadKeyImageStore(directory, opened.map, *opened.matcher, options, opened.experiences);
   return opened;
 }

@@ -23,7 +23,7 @@ struct LocalizationMap {
   KeyImageStore keys;
 };
 
-// Reads the map and its options (ReadRecordedMap) and its experiences (ReadExperiences), creates its matcher
+// Reads the map with its experiences and its options (ReadRecordedMap), creates its matcher
 // (MatcherOptionsFromJson) and loads its key images and views.
 // Throws InputError naming the file and the fix when any of it fails.
 LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, const KeyImageStoreOptions& options);

@@ -320,4 +320,19 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
   return run;
 }
 
+void CheckRunFitsMap(const LocalizationRun& run, const VisualMap& map, const std::filesystem::path& file) {
+  const int num_keys = static_cast<int>(map.key_images.size());
+  for (const LocalizationResult& r : run.frames) {
+    std::vector<int> keys = {r.key, r.next_key};
+    for (const RelocalizationCandidate& c : r.candidates) keys.push_back(c.key);
+    for (int key : keys) {
+      if (key >= -1 && key < num_keys) continue;
+      throw InputError(
+          fmt::format("'{}': frame {} names key image {}, and its map '{}' has key images 0 to {}: the run "
+                      "is of another map, or was edited; localize again with `vmap localize --json`",
+                      file.string(), r.frame_index, key, run.info.map_directory, num_keys - 1));
+    }
+  }
+}
+
 }  // namespace vmap

@@ -75,4 +75,8 @@ std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run
 // Reads a run written by LocalizationRunJson. Throws InputError naming the file when it is not one.
 LocalizationRun ReadLocalizationRun(const std::filesystem::path& file);
 
+// Throws InputError naming `file` (the run's) and the frame when a frame of `run` names a key image `map` does
+// not have (its key, next key or a candidate's): a run of another map, or an edited file.
+void CheckRunFitsMap(const LocalizationRun& run, const VisualMap& map, const std::filesystem::path& file);
+
 }  // namespace vmap

@@ -213,6 +213,26 @@ TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
   EXPECT_DOUBLE_EQ(back.frames[2].confidence, 0.125);
 }
 
+// Issue 38: `vmap report RUN.json` of a run whose frames name key image 999 or -7 on a map of two.
+TEST(LocalizationOutput, ARunNamingKeyImagesItsMapLacksIsRefused) {
+  const VisualMap map = TwoKeyMap();
+  LocalizationRun run = SampleRun();
+  EXPECT_NO_THROW(CheckRunFitsMap(run, map, "run.json"));
+  for (int key : {999, -7, 2}) {
+    LocalizationRun bad = run;
+    bad.frames[0].key = key;
+    try {
+      CheckRunFitsMap(bad, map, "run.json");
+      ADD_FAILURE() << "key " << key << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("names key image " + std::to_string(key)), std::string::npos) << e.what();
+    }
+  }
+  LocalizationRun bad_candidate = run;
+  bad_candidate.frames[0].candidates[1].key = 40;
+  EXPECT_THROW(CheckRunFitsMap(bad_candidate, map, "run.json"), InputError);
+}
+
 TEST(LocalizationOutput, ReadingSomethingElseIsAClearError) {
   ::vmap::testing::ScopedTempDir tmp;
   EXPECT_THROW(ReadLocalizationRun(tmp.path() / "missing.json"), InputError);

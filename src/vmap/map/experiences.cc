@@ -129,14 +129,4 @@ std::vector<Experience> ExperiencesFromJson(const json& value, const VisualMap& 
   return experiences;
 }
 
-std::vector<Experience> ReadExperiences(const fs::path& directory, const VisualMap& map) {
-  const fs::path file = directory / kMapFileName;
-  // ReadMap has read this file: what could fail here is a file replaced since.
-  const ContainedJson parsed = ReadContainedJson(directory, kMapFileName, kMaxMapJsonBytes, 1ull << 23);
-  if (!parsed.document) throw InputError("cannot read '" + file.string() + "' again: " + parsed.why_not);
-  const auto it = parsed.document->find("experiences");
-  if (it == parsed.document->end()) return {};
-  return ExperiencesFromJson(*it, map, directory, file);
-}
-
 }  // namespace vmap

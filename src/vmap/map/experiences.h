@@ -45,12 +45,8 @@ inline constexpr const char* kExperiencesDirectory = "experiences";
 // The `experiences` array of map.json.
 nlohmann::json ExperiencesToJson(const std::vector<Experience>& experiences);
 
-// The experiences of the map in `directory` (`map` as ReadMap read it): map.json's `experiences`, or none.
-// Kept out of VisualMap and ReadMap, which every stage uses and which need none of it: only localization and
-// adding an experience read them. Throws InputError as ExperiencesFromJson.
-std::vector<Experience> ReadExperiences(const std::filesystem::path& directory, const VisualMap& map);
-
-// Reads and checks map.json's `experiences` (`value`) against the map read so far (key indices in range,
+// Reads and checks map.json's `experiences` (`value`) against the map read so far: ReadMap's reader of them,
+// the one every command uses (key indices in range,
 // finite headings, ids 1, 2, ... in order, each view's image a PNG or JPEG of the map's frame size inside the
 // map directory). Throws InputError naming `map_file` and the field.
 std::vector<Experience> ExperiencesFromJson(const nlohmann::json& value, const VisualMap& map,

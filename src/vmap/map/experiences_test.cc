@@ -1,12 +1,18 @@
 #include "vmap/map/experiences.h"
 
+#include <sys/stat.h>
+
+#include <fstream>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "vmap/core/error.h"
 #include "vmap/map/visual_map.h"
+#include "vmap/testing/run_vmap.h"
 #include "vmap/testing/scoped_temp_dir.h"
+#include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {
 namespace {
@@ -106,6 +112,70 @@ TEST(Experiences, RefusesMalformedEntriesNamingTheField) {
   bad[0].erase("views");
   expect_refused(bad, "experiences[0].views");
   expect_refused(json::object(), "experiences");
+}
+
+// Issue 38: `info`, `report` and `route` read a map's experiences as `localize` does (ReadMap reads them), so a
+// map whose views lead out of it, are FIFOs or are missing is refused by every command.
+TEST(Experiences, EveryCommandRefusesAMapWithBrokenExperiences) {
+  ::vmap::testing::ScopedTempDir tmp;
+  ::vmap::testing::SyntheticOptions options;
+  options.num_frames = 30;
+  ::vmap::testing::WriteImageFolder(::vmap::testing::RenderSyntheticSequence(options), tmp.path() / "in");
+  const fs::path map = tmp.path() / "map";
+  std::string out;
+  ASSERT_EQ(::vmap::testing::RunVmap(
+                "build " + ::vmap::testing::Quote(tmp.path() / "in") + " -o " + ::vmap::testing::Quote(map), &out),
+            0)
+      << out;
+  const std::string original = ::vmap::testing::ReadText(map / "map.json");
+  const json document = json::parse(original);
+  ASSERT_GE(document["key_images"].size(), 2u);
+  fs::create_directories(map / "experiences/1");
+  fs::copy_file(map / document["key_images"][0]["image"].get<std::string>(), map / "experiences/1/000000.png");
+  fs::copy_file(map / document["key_images"][0]["image"].get<std::string>(), tmp.path() / "outside.png");
+  fs::create_symlink(tmp.path() / "outside.png", map / "experiences/1/link.png");
+  ASSERT_EQ(mkfifo((map / "experiences/1/fifo.png").c_str(), 0644), 0);
+  const json view = {{"key", 0},
+                     {"image", "experiences/1/000000.png"},
+                     {"frame_index", 0},
+                     {"source_index", 0},
+                     {"timestamp", nullptr},
+                     {"source_name", "0.png"},
+                     {"heading_px", 0.0},
+                     {"verified", 30}};
+  const auto experience = [&](int id, json image, int key) {
+    json v = view;
+    v["image"] = std::move(image);
+    v["key"] = key;
+    return json{{"id", id}, {"source", "repeat"}, {"views", json::array({v})}};
+  };
+  const struct {
+    json experiences;
+    const char* expected;
+  } cases[] = {
+      {json::array({experience(1, "../outside.png", 0)}), "points outside the map directory"},
+      {json::array({experience(1, (tmp.path() / "outside.png").string(), 0)}), "points outside the map directory"},
+      {json::array({experience(1, "experiences/1/link.png", 0)}), "resolves outside"},
+      {json::array({experience(1, "experiences/1/fifo.png", 0)}), "is not a regular file"},
+      {json::array({experience(1, "experiences/1/missing.png", 0)}), "is missing"},
+      {json::array({experience(1, "experiences/1/000000.png", 0), experience(1, "experiences/1/000000.png", 0)}),
+       "experiences[1].id"},
+      {json::array({experience(1, "experiences/1/000000.png", 999)}), "experiences[0].views[0].key"},
+  };
+  for (const auto& c : cases) {
+    json broken = document;
+    broken["experiences"] = c.experiences;
+    std::ofstream(map / "map.json") << broken.dump(1);
+    const std::vector<std::vector<std::string>> commands = {
+        {"info", map.string()}, {"route", map.string(), "--from", "0", "--to", "1"}, {"report", map.string()}};
+    for (const std::vector<std::string>& command : commands) {
+      const ::vmap::testing::BoundedRun run = ::vmap::testing::RunVmapBounded(command, 30);
+      EXPECT_EQ(run.status, 2) << command[0] << ": " << c.experiences.dump() << "\n" << run.output;
+      EXPECT_NE(run.output.find(c.expected), std::string::npos) << command[0] << "\n" << run.output;
+    }
+  }
+  std::ofstream(map / "map.json") << original;
+  EXPECT_EQ(::vmap::testing::RunVmap("info " + ::vmap::testing::Quote(map), &out), 0) << out;
 }
 
 }  // namespace

@@ -90,25 +90,14 @@ Camera CameraFromJson(const json& object, const std::string& file, const std::st
   try {
     // Read wide, then bounded: 2^40 must not wrap around to a plausible int.
     const long width = object.value("width", 0L), height = object.value("height", 0L);
-    constexpr long kMaxSide = 1L << 20;
-    if (width < 0 || height < 0 || width > kMaxSide || height > kMaxSide) {
+    if (width < 0 || height < 0 || width > kMaxCameraSide || height > kMaxCameraSide) {
       Malformed(file, where + " has the size " + std::to_string(width) + "x" + std::to_string(height) +
-                          "; a side must be 0 to " + std::to_string(kMaxSide) + " pixels");
+                          "; a side must be 0 to " + std::to_string(kMaxCameraSide) + " pixels");
     }
     camera = Camera::FromParams(model, Numbers(*params_it, params_it->size(), file, where + ".params"),
                                 cv::Size(static_cast<int>(width), static_cast<int>(height)));
-    // No lens has a focal length or principal point of ten million pixels, nor distortion coefficients in the
-    // thousands: such values come from a damaged or crafted file, and would overflow what is computed from them.
-    constexpr double kMaxPixels = 1e7, kMaxDistortion = 1e3;
-    if (camera.fx > kMaxPixels || camera.fy > kMaxPixels || std::abs(camera.cx) > kMaxPixels ||
-        std::abs(camera.cy) > kMaxPixels) {
-      Malformed(file, where + " has a focal length or principal point beyond 10,000,000 pixels");
-    }
-    for (double k : {camera.k1, camera.k2, camera.p1, camera.p2, camera.k3, camera.k4, camera.k5, camera.k6}) {
-      if (std::abs(k) > kMaxDistortion) Malformed(file, where + " has a distortion coefficient beyond 1000");
-    }
+    camera.Check();  // before the origin: the message names the field, not where the camera came from
     camera.origin = object.value("origin", "");
-    camera.Check();
   } catch (const InputError& e) {
     Malformed(file, where + ": " + e.what());
   } catch (const nlohmann::json::exception&) {

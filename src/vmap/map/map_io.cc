@@ -42,12 +42,8 @@ std::optional<cv::Size> KeyImageFileSize(const fs::path& file) {
 namespace {
 
 constexpr long kMaxInt = std::numeric_limits<int>::max();
-// Values (numbers, strings, arrays, objects) in map.json: 8.4 million, far above a map of 100,000 key images
-// whose 400,000 frames were each compared three times (some 6 values a comparison); parsed, this many take
-// at most some hundred MB, where 150 million numbers would take gigabytes.
-constexpr std::uint64_t kMaxMapJsonValues = 1ull << 23;
 // A key image of a map that does not record its frame size may have at most the pixels of a frame.
-constexpr long kMaxKeyImagePixels = 8192L * 8192L;
+constexpr long kMaxKeyImagePixels = kMaxFramePixels;
 constexpr int kRecordBytes = 4 * sizeof(float);
 
 // Opens a file of the map, or throws the message that fits why it cannot be.
@@ -296,7 +292,7 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
     }
     map.input.native_size = SizeField(fields, *input, "input", "native_size");
     map.input.frame_size = SizeField(fields, *input, "input", "frame_size");
-    map.input.fps = fields.Number(*input, "input", "fps", 0.0, 1e6, 0.0);
+    map.input.fps = fields.Number(*input, "input", "fps", 0.0, kMaxFramesPerSecond, 0.0);
     if (const json* camera = Fields::Find(*input, "camera"); camera && !camera->is_null()) {
       map.input.camera = CameraFromJson(*camera, file.string(), "input.camera");
     }
@@ -341,6 +337,9 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
     fields.Fail("links", "is empty although the map has " + std::to_string(map.key_images.size()) + " key images");
   }
   ReadEvaluations(doc, fields, &map);
+  if (const json* experiences = Fields::Find(doc, "experiences")) {
+    map.experiences = ExperiencesFromJson(*experiences, map, directory, file);
+  }
   return map;
 }
 

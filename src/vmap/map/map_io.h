@@ -30,6 +30,10 @@ inline constexpr const char* kCorrespondencesFileName = "correspondences.bin";
 // can make a reader take.
 inline constexpr std::uint64_t kMaxMapJsonBytes = 1ull << 30;  // 1 GiB
 inline constexpr long kMaxMatchesPerLink = 1L << 22;           // 4,194,304 correspondences
+// Values (numbers, strings, arrays, objects) in map.json: 8.4 million, far above a map of 100,000 key images
+// whose 400,000 frames were each compared three times (some 6 values a comparison); parsed, this many take
+// at most some hundred MB, where 150 million numbers would take gigabytes.
+inline constexpr std::uint64_t kMaxMapJsonValues = 1ull << 23;
 
 // Writes map.json and correspondences.bin into `directory` (which must exist; key images are written by
 // the builder). Each file is written atomically.

@@ -8,6 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include "vmap/core/enum_names.h"
+#include "vmap/map/experiences.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap {
@@ -122,6 +123,8 @@ struct VisualMap {
   double quality = 0.0;
   double seconds = 0.0;              // wall time of the build
   std::optional<Coverage> coverage;  // absent for a map of a whole input (file, folder, dataset)
+  // Other runs of the route added to the map (map/experiences.h); checked by ReadMap like every other field.
+  std::vector<Experience> experiences;
 };
 
 enum class QualityMean { kArithmetic, kHarmonic };

@@ -81,6 +81,7 @@ json MapDocument(const VisualMap& map, const std::vector<long>& offsets, bool wi
     links.push_back(std::move(link));
   }
   doc["links"] = std::move(links);
+  if (!map.experiences.empty()) doc["experiences"] = ExperiencesToJson(map.experiences);
   if (!with_evaluations) return doc;
   // Column-wise: a long sequence has one evaluation per frame or more.
   json ev = {{"key_frame", json::array()}, {"frame", json::array()},    {"similarity", json::array()},

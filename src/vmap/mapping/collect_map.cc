@@ -3,7 +3,10 @@
 #include <chrono>
 #include <optional>
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
+
+#include "vmap/core/error.h"
 
 namespace vmap {
 
@@ -47,6 +50,13 @@ VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source
                 analysis_seconds, analysis_cache ? analysis_cache->hits() - reused_before : 0);
   map.seconds += analysis_seconds;  // part of building the map
   return map;
+}
+
+void ThrowNoFrameUsed(const FrameSource& source) {
+  const int skipped = source.skipped_frames();
+  throw InputError(fmt::format(
+      "no frame of '{}' could be used{}: there is no map to write; check the input and --first, --last, --topic",
+      source.info().path, skipped > 0 ? fmt::format(" ({} skipped, see the warnings above)", skipped) : ""));
 }
 
 }  // namespace vmap

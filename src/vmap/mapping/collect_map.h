@@ -23,4 +23,8 @@ VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source
                      const LinkVerifier* link_verifier = nullptr, double tau = 0.0,
                      LinkAnalysisCache* analysis_cache = nullptr, MapWriter* key_image_files = nullptr);
 
+// Throws the InputError of a build that took no frame of `source` (none could be used, or none was there):
+// a map without a key image is no map, and no command would read it.
+[[noreturn]] void ThrowNoFrameUsed(const FrameSource& source);
+
 }  // namespace vmap

@@ -157,6 +157,7 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
     }
   }
   progress.Finish();
+  if (selector.key_images().empty()) ThrowNoFrameUsed(source);
   selector.Finish();
   if (link_verifier) {
     for (const Link& link : selector.links()) {

@@ -128,6 +128,8 @@ class MapBuilder::Impl {
     pipeline_->Close();
     while (std::optional<PipelineItem> item = pipeline_->Next()) Process(*item);
     progress_.Finish();
+    // A map of no key image is no map: no command could read it (whatever the input, this is an error).
+    if (first_source_index_ < 0) ThrowNoFrameUsed(source_);
     features_extracted_ = pipeline_->extracted();
     pipeline_.reset();
     for (auto& selector : selectors_) selector->Finish();  // the final key images

@@ -397,6 +397,7 @@ void WriteLocalizationReport(const fs::path& run_file, const fs::path& directory
     run.info.query = (run_file.parent_path() / query).string();
   }
   const VisualMap map = ReadMap(map_directory);
+  CheckRunFitsMap(run, map, run_file);
   WriteLocalizationReport(run, map, map_directory, directory, options);
 }
 

@@ -4,6 +4,7 @@
 #include <lz4frame.h>
 #include <zstd.h>
 
+#include <algorithm>
 #include <climits>
 #include <cstdio>
 #include <memory>
@@ -73,8 +74,10 @@ using ZstdStream = std::unique_ptr<ZSTD_DStream, decltype(&ZSTD_freeDStream)>;
 ZstdStream NewZstdStream() { return ZstdStream(ZSTD_createDStream(), &ZSTD_freeDStream); }
 }  // namespace
 
-std::string DecompressZstd(const uint8_t* in, size_t size, size_t max_size, std::vector<uint8_t>* out) {
+std::string DecompressZstd(const uint8_t* in, size_t size, size_t max_size, std::vector<uint8_t>* out,
+                           bool* too_large) {
   out->clear();
+  if (too_large) *too_large = false;
   const ZstdStream stream = NewZstdStream();
   if (!stream) return "cannot start zstd";
   ZSTD_inBuffer input{in, size, 0};
@@ -85,6 +88,7 @@ std::string DecompressZstd(const uint8_t* in, size_t size, size_t max_size, std:
     hint = ZSTD_decompressStream(stream.get(), &output, &input);
     if (ZSTD_isError(hint)) return std::string("damaged zstd data (") + ZSTD_getErrorName(hint) + ")";
     if (out->size() + output.pos > max_size) {
+      if (too_large) *too_large = true;
       return "zstd data holds more than " + std::to_string(max_size) + " bytes";
     }
     out->insert(out->end(), piece, piece + output.pos);
@@ -97,6 +101,7 @@ std::string DecompressZstd(const uint8_t* in, size_t size, size_t max_size, std:
     if (ZSTD_isError(hint)) return std::string("damaged zstd data (") + ZSTD_getErrorName(hint) + ")";
     if (output.pos == 0) return "zstd data ends early";
     if (out->size() + output.pos > max_size) {
+      if (too_large) *too_large = true;
       return "zstd data holds more than " + std::to_string(max_size) + " bytes";
     }
     out->insert(out->end(), piece, piece + output.pos);
@@ -104,30 +109,36 @@ std::string DecompressZstd(const uint8_t* in, size_t size, size_t max_size, std:
   return "";
 }
 
-std::string DecompressZstdFile(const std::string& from, const std::string& to) {
-  const std::unique_ptr<FILE, decltype(&fclose)> in(fopen(from.c_str(), "rb"), &fclose);
-  if (!in) return "cannot open it";
+std::string DecompressZstdFile(const ContainedFile& in, const std::string& to, uint64_t max_size) {
   const std::unique_ptr<FILE, decltype(&fclose)> out(fopen(to.c_str(), "wbx"), &fclose);
   if (!out) return "cannot create the decompressed copy '" + to + "'";
   const ZstdStream stream = NewZstdStream();
   if (!stream) return "cannot start zstd";
   std::vector<uint8_t> in_piece(ZSTD_DStreamInSize()), out_piece(ZSTD_DStreamOutSize());
-  size_t hint = 1, read = 0;
-  bool any = false;
-  while ((read = fread(in_piece.data(), 1, in_piece.size(), in.get())) > 0) {
-    any = true;
-    ZSTD_inBuffer input{in_piece.data(), read, 0};
-    while (input.pos < input.size) {
+  size_t hint = 1;
+  uint64_t read = 0, written = 0;
+  while (read < in.size() || hint != 0) {
+    const size_t piece = static_cast<size_t>(std::min<uint64_t>(in_piece.size(), in.size() - read));
+    if (piece > 0 && !in.Read(read, in_piece.data(), piece)) return "cannot read it";
+    read += piece;
+    ZSTD_inBuffer input{in_piece.data(), piece, 0};
+    // Once the input is used up, what the decoder still holds comes out (one call at least).
+    for (bool first = true; first || input.pos < input.size; first = false) {
       ZSTD_outBuffer output{out_piece.data(), out_piece.size(), 0};
       hint = ZSTD_decompressStream(stream.get(), &output, &input);
       if (ZSTD_isError(hint)) return std::string("damaged zstd data (") + ZSTD_getErrorName(hint) + ")";
+      if (piece == 0 && output.pos == 0 && hint != 0) return "zstd data ends early";
+      written += output.pos;
+      if (written > max_size) {
+        return "it decompresses to more than " + std::to_string(max_size >> 20) +
+               " MiB, more than a recording of its size holds (a decompression bomb, or damage)";
+      }
       if (fwrite(out_piece.data(), 1, output.pos, out.get()) != output.pos) {
         return "cannot write the decompressed copy '" + to + "' (disk full?)";
       }
     }
   }
-  if (ferror(in.get())) return "cannot read it";
-  if (!any || hint != 0) return "zstd data ends early";
+  if (read == 0) return "zstd data ends early";
   if (fflush(out.get()) != 0) return "cannot write the decompressed copy '" + to + "' (disk full?)";
   return "";
 }

@@ -1,5 +1,6 @@
 #pragma once
-// Decompressing one chunk of a recording into a buffer of the size its record announces: lz4 (LZ4's frame
+// Decompressing one chunk of a recording into a buffer of the size its record announces (checked first
+// against recording_limits.h): lz4 (LZ4's frame
 // format: ROS 1's roslz4 and MCAP write it), bz2 (ROS 1) and zstd (MCAP); and rosbag2's zstd compression of
 // single messages or whole database files, whose sizes nothing announces.
 
@@ -8,14 +9,9 @@
 #include <string>
 #include <vector>
 
-namespace vmap {
+#include "vmap/core/contained_file.h"
 
-// Whether a chunk announcing `out_size` bytes once decompressed from `in_size` bytes can be believed: the
-// announced size is allocated before decompressing, so a damaged field must not ask for gigabytes.
-// Recorders write chunks of about 1 MB; none of them is this large, nor compressed by more than 1024:1 past it.
-inline bool PlausibleChunkSize(uint64_t in_size, uint64_t out_size) {
-  return out_size <= (uint64_t{256} << 20) || out_size / 1024 <= in_size;
-}
+namespace vmap {
 
 // Decompresses `size` bytes at `in` with `compression` ("lz4", "bz2" or "zstd") into exactly `out_size`
 // bytes at `out`. Returns "" on success, or what went wrong (an unknown compression, damaged data, a size
@@ -29,11 +25,14 @@ std::string DecompressChunk(const std::string& compression, const uint8_t* in, s
 bool StartsWithZstdFrame(const uint8_t* data, size_t size);
 
 // Decompresses the zstd frame(s) of `size` bytes at `in` into `out`, refusing to produce more than `max_size`
-// bytes (a damaged or hostile message must not take unbounded memory). Returns "" or what went wrong.
-std::string DecompressZstd(const uint8_t* in, size_t size, size_t max_size, std::vector<uint8_t>* out);
+// bytes (a damaged or hostile message must not take unbounded memory). Returns "" or what went wrong;
+// `*too_large` (when given) says whether it was the size.
+std::string DecompressZstd(const uint8_t* in, size_t size, size_t max_size, std::vector<uint8_t>* out,
+                           bool* too_large = nullptr);
 
-// Decompresses the zstd file `from` into the new file `to`, streaming (memory stays flat): a database of a
-// rosbag2 recorded with `--compression-mode file`. Returns "" or what went wrong.
-std::string DecompressZstdFile(const std::string& from, const std::string& to);
+// Decompresses the zstd file `in` (already open: a regular file) into the new file `to`, streaming (memory
+// stays flat), refusing to write more than `max_size` bytes: a database of a rosbag2 recorded with
+// `--compression-mode file`. Returns "" or what went wrong.
+std::string DecompressZstdFile(const ContainedFile& in, const std::string& to, uint64_t max_size);
 
 }  // namespace vmap

@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/sources/internal.h"
 #include "vmap/sources/recording_reader.h"
@@ -18,10 +19,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// A calibration file: a regular file (a FIFO would block) of at most 16 MB.
 std::string ReadText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError("cannot read calibration file '" + path + "'");
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return ReadNamedFile(path, uint64_t{16} << 20, "calibration file", "give a calibration file");
 }
 
 std::string Lower(std::string s) {

@@ -3,12 +3,13 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include <spdlog/spdlog.h>
 
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/sources/internal.h"
 
@@ -33,6 +34,19 @@ std::string Trim(const std::string& s) {
   return s.substr(begin, s.find_last_not_of(" \t\r\n") - begin + 1);
 }
 
+// A list file of a dataset (rgb.txt, data.csv, times.txt, timestamps.txt): read only when it is a regular
+// file (a FIFO would block) and at most 256 MB.
+std::istringstream ListFile(const fs::path& path, const std::string& what) {
+  return std::istringstream(ReadNamedFile(path, uint64_t{256} << 20, what, "give the sequence's own " + what));
+}
+
+// An optional list file: absent, or not a regular file, is no list.
+std::optional<std::istringstream> OptionalListFile(const fs::path& path, const std::string& what) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return std::nullopt;
+  return ListFile(path, what);
+}
+
 void RequireExists(const fs::path& image, const std::string& list, int line) {
   if (!fs::exists(image)) {
     throw InputError("'" + list + "' line " + std::to_string(line) + " names '" + image.string() +
@@ -44,8 +58,9 @@ void RequireExists(const fs::path& image, const std::string& list, int line) {
 std::map<std::string, double> ReadTimestampsFile(const fs::path& directory) {
   std::map<std::string, double> stamps;
   for (const fs::path& candidate : {directory / "timestamps.txt", directory.parent_path() / "timestamps.txt"}) {
-    std::ifstream in(candidate);
-    if (!in) continue;
+    std::optional<std::istringstream> file = OptionalListFile(candidate, "timestamps file");
+    if (!file) continue;
+    std::istream& in = *file;
     std::string line;
     while (std::getline(in, line)) {
       line = Trim(line);
@@ -97,8 +112,7 @@ std::vector<ImageEntry> ListImageFolder(const std::string& directory_text) {
 }
 
 std::vector<ImageEntry> ListTum(const std::string& rgb_txt) {
-  std::ifstream in(rgb_txt);
-  if (!in) throw InputError("cannot read '" + rgb_txt + "'; a TUM RGB-D sequence needs rgb.txt");
+  std::istringstream in = ListFile(rgb_txt, "TUM RGB-D image list (rgb.txt)");
   const fs::path base = fs::path(rgb_txt).parent_path();
   std::vector<ImageEntry> entries;
   std::string line;
@@ -122,8 +136,7 @@ std::vector<ImageEntry> ListTum(const std::string& rgb_txt) {
 }
 
 std::vector<ImageEntry> ListEuroc(const std::string& data_csv) {
-  std::ifstream in(data_csv);
-  if (!in) throw InputError("cannot read '" + data_csv + "'; an EuRoC sequence needs mav0/cam0/data.csv");
+  std::istringstream in = ListFile(data_csv, "EuRoC image list (mav0/cam0/data.csv)");
   const fs::path images = fs::path(data_csv).parent_path() / "data";
   std::vector<ImageEntry> entries;
   std::string line;
@@ -161,9 +174,10 @@ std::vector<ImageEntry> ListKitti(const std::string& sequence_directory) {
   const std::vector<std::string> names = ImagesIn(images);
   if (names.empty()) throw InputError("'" + images.string() + "' holds no images; the sequence is empty");
   std::vector<double> times;
-  std::ifstream in(sequence / "times.txt");
-  double t;
-  while (in >> t) times.push_back(t);
+  if (std::optional<std::istringstream> in = OptionalListFile(sequence / "times.txt", "KITTI times.txt")) {
+    double t;
+    while (*in >> t) times.push_back(t);
+  }
   if (!times.empty() && times.size() != names.size()) {
     spdlog::warn("{} has {} times for {} images; ignoring the timestamps", (sequence / "times.txt").string(),
                  times.size(), names.size());

@@ -11,6 +11,7 @@
 #include <opencv2/core.hpp>
 
 #include "vmap/core/enum_names.h"
+#include "vmap/core/natural_less.h"  // NaturalLess, which the layouts sort by
 #include "vmap/core/option_fields.h"
 #include "vmap/geometry/camera.h"
 
@@ -32,6 +33,10 @@ std::string SourceFormatName(SourceFormat format);
 inline constexpr int kMinFrameSide = 32;
 // --resize accepts sides in [kMinFrameSide, kMaxResizeSide].
 inline constexpr int kMaxResizeSide = 16384;
+// The default of FrameSourceOptions::max_frame_pixels: 8192 x 8192 (64 megapixels).
+inline constexpr long kMaxFramePixels = 8192L * 8192L;
+// A frame rate above this is not a camera's: the sources report 0 (unknown) instead, as map.json records it.
+inline constexpr double kMaxFramesPerSecond = 1e6;
 
 struct FrameSourceOptions {
   SourceFormat format = SourceFormat::kAuto;
@@ -46,7 +51,7 @@ struct FrameSourceOptions {
   // A decoded frame with more pixels than this is skipped with a warning and counted (skipped_frames), as is
   // one with a side under kMinFrameSide: 8192 x 8192 (64 megapixels) is more than any camera's video frame,
   // and bounds the memory a hostile image can take once decoded.
-  long max_frame_pixels = 8192L * 8192L;
+  long max_frame_pixels = kMaxFramePixels;
   // The camera: "" = the intrinsics that come with the input, if any (see dataset_camera.h); "none" = no
   // camera; otherwise "fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]]" or a calibration file (--camera).
   std::string camera;
@@ -120,8 +125,5 @@ std::string FrameSizeProblem(const cv::Size& size, const FrameSourceOptions& opt
 
 // The frame as a BGR image (re-reads a colour image file when the frame only kept the grey one).
 cv::Mat ColorImage(const Frame& frame);
-
-// "img2" < "img10": digit runs compare as numbers.
-bool NaturalLess(const std::string& a, const std::string& b);
 
 }  // namespace vmap

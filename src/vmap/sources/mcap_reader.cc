@@ -21,7 +21,6 @@ namespace {
 constexpr uint8_t kMagic[8] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
 constexpr uint8_t kOpFooter = 0x02, kOpSchema = 0x03, kOpChannel = 0x04, kOpMessage = 0x05, kOpChunk = 0x06,
                   kOpDataEnd = 0x0F;
-constexpr uint64_t kMaxChunkSize = uint64_t{1} << 31;
 
 struct Channel {
   std::string topic;
@@ -69,7 +68,9 @@ class Fields {
 
 class McapReader : public RecordingReader {
  public:
-  explicit McapReader(const std::string& path) : file_(path) {
+  McapReader(BinaryFile file, const RecordingLimits& limits)
+      : file_(std::move(file)), limits_(limits), budget_(limits, file_.size()) {
+    const std::string& path = file_.path();
     uint8_t magic[8] = {};
     if (file_.size() < 8) file_.Damaged(0, "it is not an MCAP file (too short)");
     file_.Read(0, 8, magic, "the magic bytes");
@@ -87,6 +88,7 @@ class McapReader : public RecordingReader {
     ended_ = false;
     chunk_.clear();
     chunk_position_ = 0;
+    budget_.Reset();
   }
 
   bool Next(const std::set<std::string>& topics, RecordedMessage* message) override {
@@ -210,6 +212,10 @@ class McapReader : public RecordingReader {
       if (chunk_position_ < chunk_.size()) {
         const uint64_t at = chunk_position_;
         const uint64_t left = chunk_.size() - at;
+        if (const std::string over = budget_.CountRecord(); !over.empty()) {
+          chunk_position_ = chunk_.size();
+          file_.OverLimit(chunk_offset_, "in the chunk there, at byte " + std::to_string(at) + " of it: " + over);
+        }
         if (left < 9) ChunkDamaged(at, "a record's opcode and length are cut off");
         const uint64_t length = LoadU64(chunk_.data() + at + 1);
         if (length > left - 9) ChunkDamaged(at, "a record runs past the chunk");
@@ -221,6 +227,7 @@ class McapReader : public RecordingReader {
       chunk_position_ = 0;
       if (ended_ || position_ >= file_.size()) return false;
       const uint64_t offset = position_;
+      if (const std::string over = budget_.CountRecord(); !over.empty()) file_.OverLimit(offset, over);
       uint8_t head[9];
       file_.Read(offset, 9, head, "a record's opcode and length");
       const uint64_t length = LoadU64(head + 1);
@@ -235,6 +242,11 @@ class McapReader : public RecordingReader {
         continue;
       }
       if (op != kOpSchema && op != kOpChannel && op != kOpMessage && op != kOpChunk) continue;
+      if (length > (op == kOpChunk ? limits_.max_chunk_bytes : limits_.max_message_bytes)) {
+        file_.OverLimit(offset, "a record of " + std::to_string(length) +
+                                    " bytes, more than one of the largest frames "
+                                    "needs");
+      }
       file_.Read(offset + 9, length, &record_, "a record");
       if (op == kOpChunk) {
         ReadChunk(offset);
@@ -256,15 +268,17 @@ class McapReader : public RecordingReader {
     uint64_t left = 0;
     const uint8_t* records = fields.rest(&left);
     if (records_size > left) file_.Damaged(offset, "a chunk's records run past it");
-    if (size > kMaxChunkSize || !PlausibleChunkSize(records_size, size)) {
-      file_.Damaged(offset,
-                    "a chunk announces " + std::to_string(size) + " bytes from " + std::to_string(records_size));
+    if (size > limits_.max_chunk_bytes) {
+      file_.OverLimit(offset, "a chunk announces " + std::to_string(size) + " bytes, more than the " +
+                                  std::to_string(limits_.max_chunk_bytes >> 20) +
+                                  " MiB a chunk of the largest frames needs");
     }
     chunk_offset_ = offset;
     if (compression.empty()) {
       if (size != records_size) file_.Damaged(offset, "an uncompressed chunk whose sizes differ");
       chunk_.assign(records, records + records_size);
     } else {
+      if (const std::string over = budget_.Spend(size); !over.empty()) file_.OverLimit(offset, "a chunk: " + over);
       chunk_.resize(size);
       const std::string failed = DecompressChunk(compression, records, records_size, chunk_.data(), size);
       if (!failed.empty()) {
@@ -331,6 +345,8 @@ class McapReader : public RecordingReader {
   }
 
   BinaryFile file_;
+  RecordingLimits limits_;
+  PassBudget budget_;  // of this pass through the file
   uint64_t position_ = 8;
   bool ended_ = false;
   std::vector<uint8_t> record_, chunk_;
@@ -343,6 +359,13 @@ class McapReader : public RecordingReader {
 
 }  // namespace
 
-std::unique_ptr<RecordingReader> OpenMcap(const std::string& path) { return std::make_unique<McapReader>(path); }
+std::unique_ptr<RecordingReader> OpenMcap(const std::string& path, const RecordingLimits& limits) {
+  return std::make_unique<McapReader>(BinaryFile(path), limits);
+}
+
+std::unique_ptr<RecordingReader> OpenMcapInFolder(const std::filesystem::path& folder, const std::string& name,
+                                                  const RecordingLimits& limits) {
+  return std::make_unique<McapReader>(BinaryFile(folder, name), limits);
+}
 
 }  // namespace vmap

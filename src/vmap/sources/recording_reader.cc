@@ -29,9 +29,8 @@ std::string McapInFolder(const fs::path& p) {
   std::error_code ec;
   std::string found;
   for (const auto& entry : fs::directory_iterator(p, ec)) {
-    if (entry.path().extension() == ".mcap" && (found.empty() || entry.path().string() < found)) {
-      found = entry.path().string();
-    }
+    const std::string name = entry.path().filename().string();
+    if (entry.path().extension() == ".mcap" && (found.empty() || name < found)) found = name;
   }
   return found;
 }
@@ -44,15 +43,17 @@ bool IsRecording(const std::string& path) {
   return IsRosbag2Folder(p);
 }
 
-std::unique_ptr<RecordingReader> OpenRecording(const std::string& path) {
+std::unique_ptr<RecordingReader> OpenRecording(const std::string& path, const RecordingLimits& limits) {
   const fs::path p(path);
   const std::string extension = p.extension().string();
-  if (extension == ".bag") return OpenRos1Bag(path);
-  if (extension == ".mcap") return OpenMcap(path);
-  if (extension == ".db3") return OpenRosbag2(path);
+  std::error_code ec;
+  const bool folder = fs::is_directory(p, ec);
+  if (extension == ".bag" && !folder) return OpenRos1Bag(path, limits);
+  if (extension == ".mcap" && !folder) return OpenMcap(path, limits);
+  if (extension == ".db3" && !folder) return OpenRosbag2(path, limits);
   if (IsRosbag2Folder(p)) {
     const std::string mcap = McapInFolder(p);
-    return mcap.empty() ? OpenRosbag2(path) : OpenMcap(mcap);
+    return mcap.empty() ? OpenRosbag2(path, limits) : OpenMcapInFolder(p, mcap, limits);
   }
   throw InputError("'" + path +
                    "' is not a recording vmap reads: give a ROS 1 .bag, a rosbag2 folder (metadata.yaml "
@@ -74,6 +75,8 @@ std::vector<RecordingTopic> CountTopicsByReading(
   for (;;) {
     try {
       if (!next(&message, &type)) break;
+    } catch (const RecordingLimitExceeded&) {
+      throw;  // not a recording cut short: one that asks too much, whatever came before
     } catch (const InputError& error) {
       // The frames before the damage are still read (RecordingSource warns again when it gets there).
       if (counted == 0) throw;

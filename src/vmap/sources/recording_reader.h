@@ -4,11 +4,14 @@
 // do not (recording_messages.h decodes them).
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <set>
 #include <string>
 #include <vector>
+
+#include "vmap/sources/recording_limits.h"
 
 namespace vmap {
 
@@ -57,13 +60,19 @@ std::vector<RecordingTopic> CountTopicsByReading(
 
 // Whether `path` is a recording: a .bag or .mcap file, a .db3 file, or a folder holding metadata.yaml and .db3 files.
 bool IsRecording(const std::string& path);
-// Opens a recording (IsRecording). Throws InputError naming the file when it is not one vmap can read.
-std::unique_ptr<RecordingReader> OpenRecording(const std::string& path);
+// Opens a recording (IsRecording). Throws InputError naming the file when it is not one vmap can read: also
+// when it, or a file of its folder, is not a regular file (a FIFO would block, a device never ends) or is a
+// symbolic link leading out of the folder. Every reader keeps to `limits` (recording_limits.h) whatever the
+// recording announces, and throws InputError naming the file and the offset past them.
+std::unique_ptr<RecordingReader> OpenRecording(const std::string& path, const RecordingLimits& limits = {});
 
 // Readers of each container (ros1_bag_reader.cc, rosbag2_sqlite_reader.cc, mcap_reader.cc).
-std::unique_ptr<RecordingReader> OpenRos1Bag(const std::string& path);
-std::unique_ptr<RecordingReader> OpenRosbag2(const std::string& path);
-std::unique_ptr<RecordingReader> OpenMcap(const std::string& path);
+std::unique_ptr<RecordingReader> OpenRos1Bag(const std::string& path, const RecordingLimits& limits = {});
+std::unique_ptr<RecordingReader> OpenRosbag2(const std::string& path, const RecordingLimits& limits = {});
+std::unique_ptr<RecordingReader> OpenMcap(const std::string& path, const RecordingLimits& limits = {});
+// The .mcap file `name` of the rosbag2 folder `folder` (written with the MCAP storage plugin).
+std::unique_ptr<RecordingReader> OpenMcapInFolder(const std::filesystem::path& folder, const std::string& name,
+                                                  const RecordingLimits& limits = {});
 
 // "sensor_msgs/msg/Image" -> "sensor_msgs/Image": one name for a type in ROS 1 and ROS 2.
 std::string NormalizedTypeName(const std::string& type);

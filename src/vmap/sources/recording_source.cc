@@ -1,6 +1,7 @@
 #include "vmap/sources/recording_source.h"
 
 #include <map>
+#include <set>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -14,8 +15,11 @@ namespace vmap {
 namespace {
 
 // Messages are stored by receive time; a camera's stamps can be out of that order by a few frames (several
-// publishers, a driver's queue). Frames are delivered in stamp order within a window of this many messages.
+// publishers, a driver's queue). Frames are delivered in stamp order within a window of this many messages,
+// holding at most kReorderBytes of them (at least one): a window of the largest frames would otherwise hold
+// gigabytes.
 constexpr size_t kReorderWindow = 8;
+constexpr size_t kReorderBytes = size_t{64} << 20;
 
 std::string ListImageTopics(const std::vector<RecordingTopic>& topics) {
   std::string list;
@@ -38,6 +42,12 @@ std::string MessageName(long index, const std::string& topic, const std::string&
   return fmt::format("message {} of {} in '{}'", index, topic, path);
 }
 
+// Messages per second of log time; 0 with fewer than two messages or no time between them.
+double MessageRate(const RecordingTopic& topic) {
+  if (topic.message_count < 2 || topic.last_time_ns <= topic.first_time_ns) return 0.0;
+  return (topic.message_count - 1) * 1e9 / static_cast<double>(topic.last_time_ns - topic.first_time_ns);
+}
+
 class RecordingSource : public FrameSource {
  public:
   RecordingSource(std::unique_ptr<RecordingReader> reader, const RecordingTopic& topic, const std::string& path,
@@ -45,22 +55,34 @@ class RecordingSource : public FrameSource {
       : reader_(std::move(reader)), topic_(topic), topics_{topic.name}, options_(options) {
     info_.path = path;
     info_.format = SourceFormat::kRecording;
+    if (topic.message_count == 0) {
+      throw InputError(fmt::format("image topic {} of recording '{}' has no messages; `vmap info {}` lists its topics",
+                                   topic.name, path, path));
+    }
+    if (options.first >= topic.message_count) {
+      throw OptionError("first", fmt::format("{} leaves none of the {} frames of {} in '{}'", options.first,
+                                             topic.message_count, topic.name, path));
+    }
     long end = options.last >= 0 ? std::min<long>(options.last + 1, topic.message_count) : topic.message_count;
     info_.expected_frames = end > options.first ? (end - options.first + options.stride - 1) / options.stride : 0;
-    if (topic.message_count > 1 && topic.last_time_ns > topic.first_time_ns) {
-      info_.fps = (topic.message_count - 1) * 1e9 / static_cast<double>(topic.last_time_ns - topic.first_time_ns);
+    info_.fps = MessageRate(topic);
+    if (info_.fps > kMaxFramesPerSecond) {
+      spdlog::warn("{}: {} has {} messages within {} ns, which no camera sends; its frame rate is left unknown", path,
+                   topic.name, topic.message_count, topic.last_time_ns - topic.first_time_ns);
+      info_.fps = 0.0;
     }
   }
 
   std::optional<Frame> Next() override {
     for (;;) {
-      if (options_.last >= 0 && position_ > options_.last) return std::nullopt;
+      if (options_.last >= 0 && position_ > options_.last) return End();
       Fill();
-      if (pending_.empty()) return std::nullopt;
+      if (pending_.empty()) return End();
       auto next = pending_.begin();
       const double stamp = next->first;
       RecordedMessage message = std::move(next->second);
       pending_.erase(next);
+      pending_bytes_ -= message.data.size();
       if (stamp < last_stamp_ && out_of_order_warnings_++ == 0) {
         spdlog::warn("{}: {} has stamps out of order by more than {} messages; those frames keep their stored order",
                      info_.path, topic_.name, kReorderWindow);
@@ -69,12 +91,17 @@ class RecordingSource : public FrameSource {
       const long index = position_++;
       if (index < options_.first || (index - options_.first) % options_.stride != 0) continue;
       DecodedImage image;
+      const std::string name = MessageName(index, topic_.name, info_.path);
       try {
-        image = DecodeImageMessage(message.data.data(), message.data.size(), topic_.type, reader_->encoding(),
-                                   MessageName(index, topic_.name, info_.path));
+        image = DecodeImageMessage(message.data.data(), message.data.size(), topic_.type, reader_->encoding(), name);
       } catch (const InputError& error) {
         ++skipped_;
         spdlog::warn("{}; skipping it", error.what());
+        continue;
+      } catch (const cv::Exception& error) {
+        // A malformed message OpenCV refuses (a step it cannot take): that message, not the recording.
+        ++skipped_;
+        spdlog::warn("{} cannot be decoded ({}); skipping it", name, LibraryMessage(error));
         continue;
       }
       const std::string size_problem = FrameSizeProblem(image.gray.size(), options_);
@@ -100,16 +127,27 @@ class RecordingSource : public FrameSource {
   int skipped_frames() const override { return skipped_; }
 
  private:
+  std::optional<Frame> End() const {
+    if (delivered_ == 0) {
+      throw InputError(fmt::format("none of the {} messages of {} read from '{}' could be used{}; check the recording",
+                                   position_, topic_.name, info_.path,
+                                   skipped_ > 0 ? " (see the warnings above)" : " (--first is past its last message)"));
+    }
+    return std::nullopt;
+  }
+
   // Reads messages until the window is full or the recording ends. Damage ends the recording with a warning
   // once frames came before it, and is an error otherwise.
   void Fill() {
-    while (!ended_ && pending_.size() < kReorderWindow) {
+    while (!ended_ && pending_.size() < kReorderWindow && (pending_.empty() || pending_bytes_ < kReorderBytes)) {
       RecordedMessage message;
       try {
         if (!reader_->Next(topics_, &message)) {
           ended_ = true;
           break;
         }
+      } catch (const RecordingLimitExceeded&) {
+        throw;  // crafted or damaged beyond use: not a recording cut short whose frames before the cut count
       } catch (const InputError& error) {
         ended_ = true;
         if (read_ == 0) throw;
@@ -130,6 +168,7 @@ class RecordingSource : public FrameSource {
       // A driver that never sets the stamp: the time the recorder received the message.
       if (stamp <= 0.0) stamp = message.log_time_ns * 1e-9;
       ++read_;
+      pending_bytes_ += message.data.size();
       pending_.emplace(stamp, std::move(message));
     }
   }
@@ -140,6 +179,7 @@ class RecordingSource : public FrameSource {
   FrameSourceOptions options_;
   SequenceInfo info_;
   std::multimap<double, RecordedMessage> pending_;
+  size_t pending_bytes_ = 0;
   bool ended_ = false;
   long read_ = 0;
   long position_ = 0;
@@ -150,8 +190,9 @@ class RecordingSource : public FrameSource {
   double last_stamp_ = -1e300;
 };
 
-std::optional<Camera> ReadCameraTopic(const std::string& path, const std::string& camera_topic) {
-  std::unique_ptr<RecordingReader> reader = OpenRecording(path);
+std::optional<Camera> ReadCameraTopic(const std::string& path, const std::string& camera_topic,
+                                      const RecordingLimits& limits) {
+  std::unique_ptr<RecordingReader> reader = OpenRecording(path, limits);
   RecordedMessage message;
   if (!reader->Next({camera_topic}, &message)) return std::nullopt;
   const std::string what = MessageName(0, camera_topic, path);
@@ -209,25 +250,30 @@ std::string CameraInfoTopicFor(const std::string& image_topic) {
 std::vector<RecordingTopicSummary> DescribeRecording(const std::string& path) {
   std::unique_ptr<RecordingReader> reader = OpenRecording(path);
   std::vector<RecordingTopicSummary> summaries;
+  std::map<std::string, size_t> image_topics;  // not yet sized -> its summary
   for (const RecordingTopic& topic : reader->Topics()) {
     RecordingTopicSummary summary;
     summary.topic = topic;
-    if (topic.message_count > 1 && topic.last_time_ns > topic.first_time_ns) {
-      summary.rate_hz = (topic.message_count - 1) * 1e9 / static_cast<double>(topic.last_time_ns - topic.first_time_ns);
-    }
-    if (IsImageType(topic.type) && topic.message_count > 0) {
-      reader->Rewind();
-      RecordedMessage message;
-      if (reader->Next({topic.name}, &message)) {
-        try {
-          summary.image_size = ImageMessageSize(message.data.data(), message.data.size(), topic.type,
-                                                reader->encoding(), MessageName(0, topic.name, path));
-        } catch (const InputError& error) {
-          spdlog::warn("{}", error.what());
-        }
-      }
-    }
+    summary.rate_hz = MessageRate(topic);
+    if (IsImageType(topic.type) && topic.message_count > 0) image_topics[topic.name] = summaries.size();
     summaries.push_back(summary);
+  }
+  // The first image of every image topic, in one pass however many topics the recording lists.
+  std::set<std::string> wanted;
+  for (const auto& [name, index] : image_topics) wanted.insert(name);
+  reader->Rewind();
+  RecordedMessage message;
+  while (!wanted.empty() && reader->Next(wanted, &message)) {
+    RecordingTopicSummary& summary = summaries[image_topics.at(message.topic)];
+    wanted.erase(message.topic);
+    try {
+      summary.image_size = ImageMessageSize(message.data.data(), message.data.size(), summary.topic.type,
+                                            reader->encoding(), MessageName(0, message.topic, path));
+    } catch (const InputError& error) {
+      spdlog::warn("{}", error.what());
+    } catch (const cv::Exception& error) {
+      spdlog::warn("{} cannot be decoded ({})", MessageName(0, message.topic, path), LibraryMessage(error));
+    }
   }
   return summaries;
 }
@@ -248,7 +294,8 @@ namespace internal {
 
 std::unique_ptr<FrameSource> OpenRecordingSource(const std::string& path, const FrameSourceOptions& options,
                                                  std::optional<Camera>* camera) {
-  std::unique_ptr<RecordingReader> reader = OpenRecording(path);
+  const RecordingLimits limits = RecordingLimits::ForFrames(options.max_frame_pixels);
+  std::unique_ptr<RecordingReader> reader = OpenRecording(path, limits);
   const std::vector<RecordingTopic> topics = reader->Topics();
   const std::string name = ChooseImageTopic(topics, options.topic, path);
   if (camera) {
@@ -264,7 +311,7 @@ std::unique_ptr<FrameSource> OpenRecordingSource(const std::string& path, const 
       throw InputError(fmt::format("--camera-topic {} is not in recording '{}'; `vmap info {}` lists its topics",
                                    camera_topic, path, path));
     }
-    if (info && info->message_count > 0) *camera = ReadCameraTopic(path, camera_topic);
+    if (info && info->message_count > 0) *camera = ReadCameraTopic(path, camera_topic, limits);
     if (!info) spdlog::info("{}: no {} topic; the frames have no camera unless --camera gives one", path, camera_topic);
   }
   return std::make_unique<RecordingSource>(std::move(reader), *FindTopic(topics, name), path, options);

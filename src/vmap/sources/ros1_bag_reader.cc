@@ -26,9 +26,8 @@ namespace {
 constexpr char kMagic[] = "#ROSBAG V2.0\n";
 constexpr size_t kMagicSize = sizeof(kMagic) - 1;
 constexpr uint8_t kOpMessage = 0x02, kOpChunk = 0x05, kOpConnection = 0x07;
-// A record header is a handful of short fields; a chunk is rarely over a few MB. Larger values are damage.
+// A record header is a handful of short fields. Larger values are damage.
 constexpr uint32_t kMaxHeaderSize = 1 << 20;
-constexpr uint64_t kMaxChunkSize = uint64_t{1} << 31;
 
 struct Connection {
   std::string topic;
@@ -77,7 +76,8 @@ class RecordHeader {
 
 class Ros1BagReader : public RecordingReader {
  public:
-  explicit Ros1BagReader(const std::string& path) : file_(path) {
+  Ros1BagReader(const std::string& path, const RecordingLimits& limits)
+      : file_(path), limits_(limits), budget_(limits, file_.size()) {
     uint8_t magic[kMagicSize];
     if (file_.size() < kMagicSize) file_.Damaged(0, "it is not a ROS bag (too short)");
     file_.Read(0, kMagicSize, magic, "the bag's version line");
@@ -96,6 +96,7 @@ class Ros1BagReader : public RecordingReader {
     position_ = kMagicSize;
     chunk_.clear();
     chunk_position_ = 0;
+    budget_.Reset();
   }
 
   bool Next(const std::set<std::string>& topics, RecordedMessage* message) override {
@@ -207,6 +208,7 @@ class Ros1BagReader : public RecordingReader {
   // One record of the file; true when it is a wanted message.
   bool NextInFile(const std::set<std::string>* topics, RecordedMessage* message) {
     const uint64_t offset = position_;
+    if (const std::string over = budget_.CountRecord(); !over.empty()) file_.OverLimit(offset, over);
     uint8_t length[4];
     file_.Read(offset, 4, length, "a record's header length");
     const uint32_t header_size = LoadU32(length);
@@ -229,13 +231,17 @@ class Ros1BagReader : public RecordingReader {
       const std::string* compression = header_.Find("compression");
       const uint32_t size = header_.Number<uint32_t>("size", 4);
       if (!compression) file_.Damaged(offset, "a chunk without a compression field");
-      if (size > kMaxChunkSize || (*compression != "none" && !PlausibleChunkSize(data_size, size))) {
-        file_.Damaged(offset, "a chunk announces " + std::to_string(size) + " bytes from " + std::to_string(data_size));
+      const uint64_t stored = *compression == "none" ? data_size : size;
+      if (stored > limits_.max_chunk_bytes) {
+        file_.OverLimit(offset, "a chunk announces " + std::to_string(stored) + " bytes, more than the " +
+                                    std::to_string(limits_.max_chunk_bytes >> 20) +
+                                    " MiB a chunk of the largest frames needs");
       }
       chunk_offset_ = offset;
       if (*compression == "none") {
         file_.Read(data_offset, data_size, &chunk_, "a chunk");
       } else {
+        if (const std::string over = budget_.Spend(size); !over.empty()) file_.OverLimit(offset, "a chunk: " + over);
         file_.Read(data_offset, data_size, &compressed_, "a chunk");
         chunk_.resize(size);
         const std::string failed =
@@ -249,6 +255,11 @@ class Ros1BagReader : public RecordingReader {
       return false;
     }
     if (op != kOpConnection && op != kOpMessage) return false;  // bag header, index and chunk info records
+    if (data_size > limits_.max_message_bytes) {
+      file_.OverLimit(offset, "a record of " + std::to_string(data_size) +
+                                  " bytes, more than a message of the largest "
+                                  "frames needs");
+    }
     file_.Read(data_offset, data_size, &record_data_, "a record");
     return Handle(op, record_data_.data(), record_data_.size(), offset, topics, message);
   }
@@ -258,6 +269,10 @@ class Ros1BagReader : public RecordingReader {
     const uint8_t* base = chunk_.data();
     const size_t size = chunk_.size();
     size_t at = chunk_position_;
+    if (const std::string over = budget_.CountRecord(); !over.empty()) {
+      chunk_position_ = size;
+      file_.OverLimit(chunk_offset_, "in the chunk there, at byte " + std::to_string(at) + " of it: " + over);
+    }
     const auto damaged = [&](const std::string& problem) {
       chunk_position_ = size;
       file_.Damaged(chunk_offset_, "in the chunk there, at byte " + std::to_string(at) + " of it: " + problem);
@@ -304,6 +319,8 @@ class Ros1BagReader : public RecordingReader {
   }
 
   BinaryFile file_;
+  RecordingLimits limits_;
+  PassBudget budget_;           // of this pass through the bag
   uint64_t position_ = 0;       // the next record of the file
   std::vector<uint8_t> chunk_;  // the current chunk, decompressed
   size_t chunk_position_ = 0;
@@ -316,6 +333,8 @@ class Ros1BagReader : public RecordingReader {
 
 }  // namespace
 
-std::unique_ptr<RecordingReader> OpenRos1Bag(const std::string& path) { return std::make_unique<Ros1BagReader>(path); }
+std::unique_ptr<RecordingReader> OpenRos1Bag(const std::string& path, const RecordingLimits& limits) {
+  return std::make_unique<Ros1BagReader>(path, limits);
+}
 
 }  // namespace vmap

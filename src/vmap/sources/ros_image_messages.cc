@@ -63,11 +63,16 @@ DecodedImage ConvertRawImage(const RawImage& raw, const std::string& what) {
                      "'; vmap reads mono8, mono16, rgb8, bgr8, rgba8, bgra8 and bayer_*8 (or a compressed topic)");
   }
   const size_t row_bytes = size_t{raw.width} * CV_ELEM_SIZE(type);
-  if (raw.width == 0 || raw.height == 0 || raw.step < row_bytes ||
+  if (raw.width == 0 || raw.height == 0 || raw.width > INT32_MAX || raw.height > INT32_MAX || raw.step < row_bytes ||
       raw.size / std::max<size_t>(raw.step, 1) < raw.height) {
     throw InputError(what + " is malformed: " + std::to_string(raw.width) + "x" + std::to_string(raw.height) + " " + e +
                      " with step " + std::to_string(raw.step) + " needs more than its " + std::to_string(raw.size) +
                      " bytes of data");
+  }
+  // OpenCV takes rows only at whole elements (its "Step must be a multiple of esz1").
+  if (raw.step % CV_ELEM_SIZE1(type) != 0) {
+    throw InputError(what + " is malformed: " + e + " rows of step " + std::to_string(raw.step) +
+                     " bytes, which is not a multiple of its " + std::to_string(CV_ELEM_SIZE1(type)) + "-byte values");
   }
   // A view of the message's bytes: converted below into images of their own.
   const cv::Mat view(static_cast<int>(raw.height), static_cast<int>(raw.width), type, const_cast<uint8_t*>(raw.data),
@@ -92,6 +97,18 @@ DecodedImage ConvertRawImage(const RawImage& raw, const std::string& what) {
     cv::cvtColor(image.color, image.gray, cv::COLOR_BGR2GRAY);
   }
   return image;
+}
+
+// The camera of a CameraInfo message, checked as a map's reader checks it: a calibration with fx NaN or a
+// distortion of 1e9 is refused here, naming the message, rather than written into a map no command then reads.
+Camera Checked(Camera camera, const std::string& what) {
+  try {
+    camera.Check();
+  } catch (const InputError& error) {
+    throw InputError(what + ": " + error.what() +
+                     "; give the right intrinsics with --camera, or --camera none to build without them");
+  }
+  return camera;
 }
 
 }  // namespace
@@ -170,7 +187,7 @@ std::optional<Camera> DecodeCameraInfo(const uint8_t* data, size_t size, Message
     }
     Camera camera = Camera::FromParams(CameraModel::kOpenCVFisheye, {k[0], k[4], k[2], k[5], d[0], d[1], d[2], d[3]},
                                        width == 0 || height == 0 ? cv::Size() : image_size);
-    return camera;
+    return Checked(std::move(camera), what);
   }
   if (model == "rational_polynomial") {
     if (d.size() > 8) {
@@ -191,7 +208,7 @@ std::optional<Camera> DecodeCameraInfo(const uint8_t* data, size_t size, Message
   if (d.size() > 5) d.resize(8, 0.0);  // k4..k6 of the rational model
   Camera camera = Camera::Make(k[0], k[4], k[2], k[5], d, image_size);
   if (width == 0 || height == 0) camera.size = cv::Size();
-  return camera;
+  return Checked(std::move(camera), what);
 }
 
 }  // namespace vmap

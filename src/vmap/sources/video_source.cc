@@ -62,6 +62,7 @@ class VideoSource : public FrameSource {
     clockwise_rotation_ = ClockwiseRotation(*stream);
     const AVRational rate = stream->avg_frame_rate.num > 0 ? stream->avg_frame_rate : stream->r_frame_rate;
     info_.fps = rate.num > 0 && rate.den > 0 ? av_q2d(rate) : 0.0;
+    if (!(info_.fps <= kMaxFramesPerSecond)) info_.fps = 0.0;  // a rate no camera has: unknown, as map.json says
     if (stream->nb_frames > 0) {
       frame_count_ = stream->nb_frames;
     } else if (stream->duration > 0 && info_.fps > 0) {

@@ -1,9 +1,18 @@
 #include "vmap/testing/run_vmap.h"
 
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <utility>
+
+extern char** environ;
 
 namespace vmap::testing {
 
@@ -31,6 +40,113 @@ int RunVmap(const std::string& arguments, std::string* output) {
   CliResult result = RunVmap(arguments, "");
   if (output) *output = std::move(result.output);
   return result.status;
+}
+
+BoundedRun RunVmapBounded(const std::vector<std::string>& arguments, double timeout_seconds) {
+  return RunBounded(VmapBinary(), arguments, timeout_seconds);
+}
+
+BoundedRun RunBounded(const std::filesystem::path& binary, const std::vector<std::string>& arguments,
+                      double timeout_seconds, const std::vector<std::string>& environment) {
+  BoundedRun run;
+  std::vector<std::string> variables = environment;
+  for (char** variable = environ; *variable; ++variable) variables.push_back(*variable);  // the first one wins
+  std::vector<char*> envp;
+  for (std::string& v : variables) envp.push_back(v.data());
+  envp.push_back(nullptr);
+  std::vector<std::string> storage = {binary.string()};
+  storage.insert(storage.end(), arguments.begin(), arguments.end());
+  std::vector<char*> argv;
+  for (std::string& a : storage) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  int pipe_fds[2];
+  if (pipe2(pipe_fds, O_CLOEXEC) != 0) return run;
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  posix_spawn_file_actions_adddup2(&files, pipe_fds[1], 1);
+  posix_spawn_file_actions_adddup2(&files, pipe_fds[1], 2);
+  pid_t pid = -1;
+  const int spawned = posix_spawn(&pid, argv[0], &files, nullptr, argv.data(), envp.data());
+  posix_spawn_file_actions_destroy(&files);
+  close(pipe_fds[1]);
+  if (spawned != 0) {
+    close(pipe_fds[0]);
+    return run;
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_seconds);
+  char buffer[4096];
+  for (;;) {
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) {
+      run.timed_out = true;
+      kill(pid, SIGKILL);
+      break;
+    }
+    pollfd readable{pipe_fds[0], POLLIN, 0};
+    if (poll(&readable, 1, static_cast<int>(std::min<long>(left.count(), 1000))) <= 0) continue;
+    const ssize_t n = read(pipe_fds[0], buffer, sizeof buffer);
+    if (n <= 0) break;  // the child closed its output: it ends
+    run.output.append(buffer, static_cast<size_t>(n));
+  }
+  close(pipe_fds[0]);
+  int status = 0;
+  struct rusage usage {};
+  wait4(pid, &status, 0, &usage);
+  run.max_rss_bytes = usage.ru_maxrss * 1024L;
+  run.status = !run.timed_out && WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if (run.timed_out) run.output += "\n(timed out after " + std::to_string(timeout_seconds) + " s)";
+  return run;
+}
+
+BackgroundVmap::BackgroundVmap(const std::vector<std::string>& arguments, const std::filesystem::path& log) {
+  std::vector<std::string> storage = {VmapBinary().string()};
+  storage.insert(storage.end(), arguments.begin(), arguments.end());
+  std::vector<char*> argv;
+  for (std::string& a : storage) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t defaults, empty;
+  sigemptyset(&defaults);
+  for (int s : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&defaults, s);
+  sigemptyset(&empty);
+  posix_spawnattr_setsigdefault(&attributes, &defaults);
+  posix_spawnattr_setsigmask(&attributes, &empty);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETSIGMASK);
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  posix_spawn_file_actions_addopen(&files, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&files, 1, 2);
+  pid_t pid = -1;
+  if (posix_spawn(&pid, argv[0], &files, &attributes, argv.data(), environ) == 0) pid_ = pid;
+  posix_spawn_file_actions_destroy(&files);
+  posix_spawnattr_destroy(&attributes);
+}
+
+BackgroundVmap::~BackgroundVmap() {
+  if (pid_ > 0 && !waited_) {
+    kill(pid_, SIGKILL);
+    Wait();
+  }
+}
+
+void BackgroundVmap::Signal(int signal_number) const {
+  if (pid_ > 0) kill(pid_, signal_number);
+}
+
+bool BackgroundVmap::Running() const {
+  if (pid_ <= 0 || waited_) return false;
+  siginfo_t info{};
+  return waitid(P_PID, pid_, &info, WEXITED | WNOHANG | WNOWAIT) == 0 && info.si_pid == 0;
+}
+
+int BackgroundVmap::Wait() {
+  if (pid_ <= 0) return -1;
+  int status = 0;
+  waitpid(pid_, &status, 0);
+  waited_ = true;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
 }  // namespace vmap::testing

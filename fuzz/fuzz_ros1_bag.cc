@@ -1,0 +1,6 @@
+// libFuzzer target: a ros1 bag file (.bag) as vmap reads it (recording_fuzzer.h).
+#include "recording_fuzzer.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  return vmap::fuzz::FuzzRecording(data, size, ".bag");
+}

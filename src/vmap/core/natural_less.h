@@ -1,0 +1,11 @@
+#pragma once
+// The order people give numbered file names: "img2" before "img10".
+
+#include <string>
+
+namespace vmap {
+
+// "img2" < "img10": digit runs compare as numbers.
+bool NaturalLess(const std::string& a, const std::string& b);
+
+}  // namespace vmap
