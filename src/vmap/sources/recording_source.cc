@@ -131,7 +131,7 @@ class RecordingSource : public FrameSource {
     if (delivered_ == 0) {
       throw InputError(fmt::format("none of the {} messages of {} read from '{}' could be used{}; check the recording",
                                    position_, topic_.name, info_.path,
-                                   skipped_ > 0 ? " (see the warnings above)" : " (--first is past its last message)"));
+                                   skipped_ > 0 ? " (see the warnings above)" : " (none is there from --first on)"));
     }
     return std::nullopt;
   }

@@ -328,7 +328,9 @@ class Rosbag2SqliteReader : public RecordingReader {
     const std::pair<const char*, std::vector<const char*>> tables[] = {
         {"topics", {"id", "name", "type", "serialization_format"}},
         {"messages", {"id", "topic_id", "timestamp", "data"}}};
-    for (const auto& [table, columns] : tables) {
+    for (const auto& entry : tables) {
+      const char* table = entry.first;
+      const std::vector<const char*>& columns = entry.second;
       const auto refuse = [&](const std::string& why) {
         throw InputError("rosbag2 database '" + file.path + "': its " + table + " " + why +
                          "; vmap reads the tables rosbag2's sqlite3 storage writes");
