@@ -78,6 +78,16 @@ std::string DecompressZstd(const uint8_t* in, size_t size, size_t max_size, std:
                            bool* too_large) {
   out->clear();
   if (too_large) *too_large = false;
+  // A frame that says how much it holds (ZSTD_compress writes it) is refused or sized from that, before any
+  // work: grown a piece at a time, the buffer would reach twice the size.
+  const unsigned long long announced = ZSTD_getFrameContentSize(in, size);
+  if (announced != ZSTD_CONTENTSIZE_UNKNOWN && announced != ZSTD_CONTENTSIZE_ERROR) {
+    if (announced > max_size) {
+      if (too_large) *too_large = true;
+      return "zstd data announces " + std::to_string(announced) + " bytes, more than " + std::to_string(max_size);
+    }
+    out->reserve(static_cast<size_t>(announced));
+  }
   const ZstdStream stream = NewZstdStream();
   if (!stream) return "cannot start zstd";
   ZSTD_inBuffer input{in, size, 0};

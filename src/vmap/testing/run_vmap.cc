@@ -65,8 +65,14 @@ BoundedRun RunBounded(const std::filesystem::path& binary, const std::vector<std
   posix_spawn_file_actions_init(&files);
   posix_spawn_file_actions_adddup2(&files, pipe_fds[1], 1);
   posix_spawn_file_actions_adddup2(&files, pipe_fds[1], 2);
+  // A process group of its own: a run past its time is killed with whatever it started (GNU time's child).
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  posix_spawnattr_setpgroup(&attributes, 0);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
   pid_t pid = -1;
-  const int spawned = posix_spawn(&pid, argv[0], &files, nullptr, argv.data(), envp.data());
+  const int spawned = posix_spawn(&pid, argv[0], &files, &attributes, argv.data(), envp.data());
+  posix_spawnattr_destroy(&attributes);
   posix_spawn_file_actions_destroy(&files);
   close(pipe_fds[1]);
   if (spawned != 0) {
@@ -80,7 +86,7 @@ BoundedRun RunBounded(const std::filesystem::path& binary, const std::vector<std
         std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) {
       run.timed_out = true;
-      kill(pid, SIGKILL);
+      kill(-pid, SIGKILL);
       break;
     }
     pollfd readable{pipe_fds[0], POLLIN, 0};
