@@ -115,7 +115,8 @@ Outcome Timed(const fs::path& binary, const std::vector<std::string>& arguments,
   outcome.run.max_rss_bytes = peak == std::string::npos ? 0 : std::stol(outcome.run.output.substr(peak + 8)) * 1024;
   // GNU time's own line when the program was killed by a signal.
   const size_t signal_line = outcome.run.output.find("Command terminated by signal");
-  if (signal_line != std::string::npos) outcome.run.status = 128 + std::stoi(outcome.run.output.substr(signal_line + 29));
+  if (signal_line != std::string::npos)
+    outcome.run.status = 128 + std::stoi(outcome.run.output.substr(signal_line + 29));
   return outcome;
 }
 
@@ -165,7 +166,8 @@ std::vector<Case> Cases() {
                      Outcome outcome;
                      {
                        vmap::testing::BackgroundVmap add(
-                           {"build", route.repeat.string(), "--add-experience-to", route.map.string()}, dir / "log");
+                           {"build", route.repeat.string(), "--add-experience-to", route.map.string()}, dir / "log",
+                           binary);
                        // Once it writes (the old add made experiences/ first, the new one its own folder).
                        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
                        bool writing = false;

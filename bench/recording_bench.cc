@@ -5,6 +5,8 @@
 // camera) and a map is built from the MCAP one (ORB + MAGSAC, as `vmap build`), in the same run.
 //
 //   recording_bench [VIDEO] [--frames N] [--repeat N]   (default: lab_floor.mp4, 300 frames, 3 repeats)
+//   recording_bench [VIDEO] [--frames N] --write DIR    (only writes the recordings into DIR, for timing two
+//                                                        vmap binaries on them: bench/hostile_speed.sh)
 
 #include <unistd.h>
 
@@ -49,11 +51,14 @@ using vmap::Median;
 int main(int argc, char** argv) {
   std::string video = std::string(VMAP_SHARED_DIR) + "/data/lab_floor/lab_floor.mp4";
   int frames = 300, repeat = 3;
+  std::string write_only;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--frames") && i + 1 < argc)
       frames = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
       repeat = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--write") && i + 1 < argc)
+      write_only = argv[++i];
     else
       video = argv[i];
   }
@@ -63,7 +68,8 @@ int main(int argc, char** argv) {
   }
   vmap::InitializeRuntime();
   spdlog::set_level(spdlog::level::warn);  // the recordings have no camera_info topic, as intended
-  const fs::path dir = fs::temp_directory_path() / ("recording_bench_" + std::to_string(getpid()));
+  const fs::path dir = write_only.empty() ? fs::temp_directory_path() / ("recording_bench_" + std::to_string(getpid()))
+                                          : fs::path(write_only);
   fs::create_directories(dir);
   struct Recording {
     std::string name, path;
@@ -89,6 +95,7 @@ int main(int argc, char** argv) {
       }
     }
   }
+  if (!write_only.empty()) return 0;
   const auto matcher = vmap::CreateOrbMatcher({});
   vmap::MapBuilderOptions options;
   options.show_progress = false;

@@ -105,8 +105,9 @@ BoundedRun RunBounded(const std::filesystem::path& binary, const std::vector<std
   return run;
 }
 
-BackgroundVmap::BackgroundVmap(const std::vector<std::string>& arguments, const std::filesystem::path& log) {
-  std::vector<std::string> storage = {VmapBinary().string()};
+BackgroundVmap::BackgroundVmap(const std::vector<std::string>& arguments, const std::filesystem::path& log,
+                               const std::filesystem::path& binary) {
+  std::vector<std::string> storage = {binary.empty() ? VmapBinary().string() : binary.string()};
   storage.insert(storage.end(), arguments.begin(), arguments.end());
   std::vector<char*> argv;
   for (std::string& a : storage) argv.push_back(a.data());

@@ -42,10 +42,11 @@ BoundedRun RunBounded(const std::filesystem::path& binary, const std::vector<std
 
 // The binary started in the background as from a terminal (SIGINT, SIGTERM and SIGHUP at their defaults,
 // whatever the test runner inherited), its output in the file `log`; killed (SIGKILL) if still running when
-// destroyed.
+// destroyed. `binary` is another build of vmap when given (bench/hostile_bench).
 class BackgroundVmap {
  public:
-  BackgroundVmap(const std::vector<std::string>& arguments, const std::filesystem::path& log);
+  BackgroundVmap(const std::vector<std::string>& arguments, const std::filesystem::path& log,
+                 const std::filesystem::path& binary = {});
   ~BackgroundVmap();
   BackgroundVmap(const BackgroundVmap&) = delete;
   BackgroundVmap& operator=(const BackgroundVmap&) = delete;
