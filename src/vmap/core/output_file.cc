@@ -82,8 +82,9 @@ void CheckOutputFiles(const std::vector<OutputFile>& outputs, const std::vector<
                                            "', an input of this command; write it somewhere else");
       }
       if (const std::optional<fs::path> link = HardLinkInside(output.path, input.path)) {
-        throw InputError(named + " is a hard link of '" + link->string() + "' in " + input.what + " '" +
-                         input.path.string() + "', an input of this command; write it somewhere else");
+        throw OptionError(output.flag, path + " is a hard link of '" + link->string() + "' in " + input.what + " '" +
+                                           input.path.string() +
+                                           "', an input of this command; write it somewhere else");
       }
     }
     for (size_t j = 0; j < i; ++j) {
