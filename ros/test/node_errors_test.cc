@@ -139,7 +139,9 @@ TEST(NodeErrors, BadMessagesMapsAndCallsAreAnsweredAndTheNodeRunsOn) {
   nan_info.distortion_model = "plumb_bob";
   nan_info.K = {std::nan(""), 0, 320, 0, 500, 240, 0, 0, 1};
   infos.publish(nan_info);
-  EXPECT_TRUE(logged("has a parameter that is not a finite number; the message is ignored")) << node->Log();
+  // The camera's rule is vmap's (its advice may follow the reason); the node then ignores the message.
+  EXPECT_TRUE(logged("has a parameter that is not a finite number")) << node->Log();
+  EXPECT_TRUE(logged("the message is ignored")) << node->Log();
 
   images.publish(GreyImage(640, 480, 4.0));
   ASSERT_TRUE(WaitFor(
