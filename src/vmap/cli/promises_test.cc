@@ -6,12 +6,8 @@
 //    file names that are not UTF-8 work;
 // 5. every numeric option has a range, checked before any work.
 
-#include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
-#include <sys/resource.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -31,7 +27,6 @@
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"
 
-extern char** environ;
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -63,57 +58,6 @@ std::vector<std::string> EntriesStartingWith(const fs::path& directory, const st
   }
   return names;
 }
-
-// The binary started in the background as from a terminal (SIGINT, SIGTERM and SIGHUP at their defaults,
-// whatever this test runner inherited), its output in `log`.
-class Process {
- public:
-  Process(const std::vector<std::string>& arguments, const fs::path& log) {
-    std::vector<std::string> argv_storage = {testing::VmapBinary().string()};
-    argv_storage.insert(argv_storage.end(), arguments.begin(), arguments.end());
-    std::vector<char*> argv;
-    for (std::string& a : argv_storage) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawnattr_t attributes;
-    posix_spawnattr_init(&attributes);
-    sigset_t defaults, empty;
-    sigemptyset(&defaults);
-    for (int s : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&defaults, s);
-    sigemptyset(&empty);
-    posix_spawnattr_setsigdefault(&attributes, &defaults);
-    posix_spawnattr_setsigmask(&attributes, &empty);
-    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETSIGMASK);
-    posix_spawn_file_actions_t files;
-    posix_spawn_file_actions_init(&files);
-    posix_spawn_file_actions_addopen(&files, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&files, 1, 2);
-    EXPECT_EQ(posix_spawn(&pid_, argv[0], &files, &attributes, argv.data(), environ), 0);
-    posix_spawn_file_actions_destroy(&files);
-    posix_spawnattr_destroy(&attributes);
-  }
-  ~Process() {
-    if (pid_ > 0 && !waited_) {
-      kill(pid_, SIGKILL);
-      Wait();
-    }
-  }
-
-  void Signal(int signal_number) { kill(pid_, signal_number); }
-
-  // The exit status, or 128 + the signal that ended it; the peak memory in `max_rss_kb`.
-  int Wait(long* max_rss_kb = nullptr) {
-    int status = 0;
-    struct rusage usage {};
-    wait4(pid_, &status, 0, &usage);
-    waited_ = true;
-    if (max_rss_kb) *max_rss_kb = usage.ru_maxrss;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  }
-
- private:
-  pid_t pid_ = -1;
-  bool waited_ = false;
-};
 
 // Waits until `directory` holds an entry starting with `prefix` (the run has started writing).
 bool AppearsWithin(const fs::path& directory, const std::string& prefix, double seconds) {
@@ -301,7 +245,7 @@ TEST(Promises, UntrustedMapsAreRefusedQuicklyWithLittleMemory) {
         {"draw", c.map.string(), "--link", "0", "-o", (tmp.path() / "fig.png").string()}};
     for (const std::vector<std::string>& command : commands) {
       const auto start = std::chrono::steady_clock::now();
-      Process process(command, tmp.path() / "log.txt");
+      testing::BackgroundVmap process(command, tmp.path() / "log.txt");
       long max_rss_kb = 0;
       EXPECT_EQ(process.Wait(&max_rss_kb), 2) << c.map << " " << command[0];
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -340,7 +284,7 @@ TEST(Promises, SigintOrSigtermLeaveNothingBehindAndTheOldOutputIntact) {
       {{"build", in, "-o", (tmp.path() / "m2").string(), "--threads", "1"}, tmp.path(), ".m2.partial-", SIGHUP},
   };
   for (const Case& c : cases) {
-    Process process(c.arguments, tmp.path() / "log.txt");
+    testing::BackgroundVmap process(c.arguments, tmp.path() / "log.txt");
     ASSERT_TRUE(AppearsWithin(c.watched, c.prefix, 30.0)) << c.arguments[0];
     process.Signal(c.signal_number);
     EXPECT_EQ(process.Wait(), 128 + c.signal_number) << ReadText(tmp.path() / "log.txt");
@@ -358,7 +302,7 @@ TEST(Promises, AnInterruptedReportLeavesTheMapAsItWas) {
   WriteSyntheticInput(tmp.path() / "in", 150);
   BuildMap(tmp.path() / "in", tmp.path() / "m", "--tau 0.99");  // many key images: a report of some length
   ASSERT_GT(ReadMap(tmp.path() / "m").key_images.size(), 20u);
-  Process process({"report", (tmp.path() / "m").string()}, tmp.path() / "log.txt");
+  testing::BackgroundVmap process({"report", (tmp.path() / "m").string()}, tmp.path() / "log.txt");
   ASSERT_TRUE(AppearsWithin(tmp.path() / "m", ".report.partial-", 30.0));
   process.Signal(SIGINT);
   EXPECT_EQ(process.Wait(), 128 + SIGINT) << ReadText(tmp.path() / "log.txt");
@@ -371,8 +315,9 @@ TEST(Promises, AnInterruptedReportLeavesTheMapAsItWas) {
 TEST(Promises, TemporariesOfAKilledRunAreRemovedByTheNextRun) {
   testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 150);
-  Process process({"build", (tmp.path() / "in").string(), "-o", (tmp.path() / "m").string(), "--threads", "1"},
-                  tmp.path() / "log.txt");
+  testing::BackgroundVmap process(
+      {"build", (tmp.path() / "in").string(), "-o", (tmp.path() / "m").string(), "--threads", "1"},
+      tmp.path() / "log.txt");
   ASSERT_TRUE(AppearsWithin(tmp.path(), ".m.partial-", 30.0));
   process.Signal(SIGKILL);  // no clean-up is possible
   EXPECT_EQ(process.Wait(), 128 + SIGKILL);

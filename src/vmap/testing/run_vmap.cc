@@ -148,11 +148,13 @@ bool BackgroundVmap::Running() const {
   return waitid(P_PID, pid_, &info, WEXITED | WNOHANG | WNOWAIT) == 0 && info.si_pid == 0;
 }
 
-int BackgroundVmap::Wait() {
+int BackgroundVmap::Wait(long* max_rss_kb) {
   if (pid_ <= 0) return -1;
   int status = 0;
-  waitpid(pid_, &status, 0);
+  struct rusage usage {};
+  wait4(pid_, &status, 0, &usage);
   waited_ = true;
+  if (max_rss_kb) *max_rss_kb = usage.ru_maxrss;
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 

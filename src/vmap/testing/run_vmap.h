@@ -54,8 +54,8 @@ class BackgroundVmap {
   void Signal(int signal_number) const;
   // Whether it has not exited yet (it is not reaped).
   bool Running() const;
-  // The exit status, or 128 + the signal that ended it.
-  int Wait();
+  // The exit status, or 128 + the signal that ended it; the peak memory in `max_rss_kb` when given.
+  int Wait(long* max_rss_kb = nullptr);
 
  private:
   int pid_ = -1;
