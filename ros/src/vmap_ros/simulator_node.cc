@@ -17,7 +17,7 @@
 
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
-#include "vmap/simulation/closed_loop.h"
+#include "vmap/pipelines/simulate_pipeline.h"
 #include "vmap/simulation/teach_run.h"
 #include "vmap/simulation/trial_run.h"
 
@@ -203,7 +203,7 @@ int RunSimulatorNode(ros::NodeHandle& node, ros::NodeHandle& private_node) {
   }
   const TrialContext& context = prepared->context;
   ROS_INFO("map written: %zu key images from %d frames; running trial %d in process for reference",
-           prepared->map.map.key_images.size(), prepared->teach_frames, parameters.trial);
+           prepared->map().map.key_images.size(), prepared->teach_frames, parameters.trial);
   const TrialResult in_process = RunTrial(context, parameters.trial);
 
   // The robot on ROS.
@@ -253,7 +253,7 @@ int RunSimulatorNode(ros::NodeHandle& node, ros::NodeHandle& private_node) {
   const TrialResult through_ros = run.Finish();
   nlohmann::json result = {{"route", context.route->name},
                            {"trial", parameters.trial},
-                           {"key_images", prepared->map.map.key_images.size()},
+                           {"key_images", prepared->map().map.key_images.size()},
                            {"ros", TrialJson(through_ros)},
                            {"in_process", TrialJson(in_process)}};
   if (!failure.empty()) result["failure"] = failure;

@@ -17,6 +17,7 @@
 #include "vmap/pipelines/match_pipeline.h"
 #include "vmap/pipelines/report_pipeline.h"
 #include "vmap/pipelines/route_pipeline.h"
+#include "vmap/pipelines/simulate_pipeline.h"
 #include "vmap/pipelines/sweep_pipeline.h"
 
 namespace vmap {
@@ -76,6 +77,7 @@ TEST(PipelineOptions, EachFieldIsDescribedOnceAndTheDefaultsPass) {
   ExpectDescribedOnce(PairMatchOptions(), {});
   ExpectDescribedOnce(MatchPipelineOptions(), {"image0", "image1"});
   ExpectDescribedOnce(DrawPipelineOptions(), {"map"});
+  ExpectDescribedOnce(SimulatePipelineOptions(), {});
 }
 
 // A negative link is refused by the options, naming the field (the CLI's --link, before any map is read).

@@ -1,13 +1,11 @@
 #include "vmap/simulation/teach_run.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
-#include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "vmap/mapping/batch_build.h"
-#include "vmap/mapping/recorded_options.h"
 
 namespace vmap {
 
@@ -49,30 +47,18 @@ std::optional<Frame> RenderedFrameSource::Next() {
   return frame;
 }
 
-TeachRun RunTeach(const SimulatedRoute& route, const CorridorWorld& world, const SimulationOptions& options,
-                  const Matcher& matcher, double tau, const std::filesystem::path& map_directory) {
-  const auto start = std::chrono::steady_clock::now();
+TeachRun PlanTeachRun(const SimulatedRoute& route, const SimulationOptions& options) {
   TeachRun teach;
-  const double dt = 1.0 / options.rate;
-  const double step = options.teach_speed * dt;
+  teach.seconds_per_frame = 1.0 / options.rate;
+  const double step = options.teach_speed * teach.seconds_per_frame;
   const double length = route.path.length();
   const int steps = static_cast<int>(std::ceil(length / step - 1e-9));
   for (int k = 0; k <= steps; ++k) {
     const double s = std::min(k * step, length);  // the last frame exactly at the goal
     const Pose2d pose = route.path.At(s);
     teach.poses.push_back(pose);
-    teach.odometry.push_back({k * dt, pose.x, pose.y, pose.yaw});
+    teach.odometry.push_back({k * teach.seconds_per_frame, pose.x, pose.y, pose.yaw});
   }
-  RenderedFrameSource source(world, options.camera, teach.poses, dt, "simulated teach run (" + route.name + ")");
-  MapBuilderOptions builder;
-  builder.key_images.tau = tau;
-  builder.show_progress = false;
-  RecordedOptions record;
-  record.matcher_json = matcher.DescribeOptionsJson();
-  record.builder = builder;
-  teach.map = BuildMap(source, matcher, builder, map_directory, ToJson(record).dump());
-  teach.render_seconds = source.render_seconds();
-  teach.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return teach;
 }
 

@@ -1,14 +1,10 @@
 #pragma once
 // The teach run of a simulation: the route driven along its centre line at the teach speed, each frame rendered
-// as the robot's camera sees it, and the map built from them by vmap's normal build (BuildMap), written to a
-// map directory like `vmap build` writes one.
+// as the robot's camera sees it (a FrameSource like any input: the simulate pipeline builds the map from it with
+// the build pipeline, as `vmap build` builds one).
 
-#include <filesystem>
-#include <memory>
 #include <vector>
 
-#include "vmap/features/matcher.h"
-#include "vmap/map/visual_map.h"
 #include "vmap/simulation/corridor_world.h"
 #include "vmap/simulation/route_path.h"
 #include "vmap/simulation/simulation_options.h"
@@ -44,18 +40,15 @@ Frame RenderFrame(const CorridorWorld& world, const CameraRigOptions& camera, co
 // The rig's camera as vmap describes cameras (pinhole, no distortion).
 Camera RigCamera(const CameraRigOptions& camera);
 
+// Where the teach run takes each frame and its odometry.
 struct TeachRun {
   std::vector<Pose2d> poses;             // of each frame, on the route's centre line
   std::vector<OdometrySample> odometry;  // the teach run's odometry (exact: the poses, timestamped)
-  VisualMap map;
-  double seconds = 0.0;         // wall time of rendering and building
-  double render_seconds = 0.0;  // of it, rendering
+  double seconds_per_frame = 0.0;
 };
 
-// Drives `route` at options.teach_speed and options.rate through `world`, builds the map with `matcher` at
-// threshold `tau` (DefaultTau of its model, as `vmap build` does), and writes it to `map_directory` (which must
-// exist and be empty).
-TeachRun RunTeach(const SimulatedRoute& route, const CorridorWorld& world, const SimulationOptions& options,
-                  const Matcher& matcher, double tau, const std::filesystem::path& map_directory);
+// `route` driven along its centre line at options.teach_speed, a frame every 1 / options.rate seconds, the last
+// frame exactly at the goal.
+TeachRun PlanTeachRun(const SimulatedRoute& route, const SimulationOptions& options);
 
 }  // namespace vmap

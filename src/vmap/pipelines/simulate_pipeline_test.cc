@@ -1,7 +1,9 @@
 // The closed loop on every commit: a short straight route taught in the simulator, repeated from offsets with
 // vmap's localizer and the route controller; the robot must stop at the goal and converge onto the path.
 
-#include "vmap/simulation/closed_loop.h"
+#include "vmap/pipelines/simulate_pipeline.h"
+
+#include <unistd.h>
 
 #include <cmath>
 #include <fstream>
@@ -13,23 +15,25 @@
 namespace vmap {
 namespace {
 
-SimulationOptions StraightRoute(const std::filesystem::path& directory, double length) {
+SimulatePipelineOptions StraightRoute(const std::filesystem::path& directory, double length) {
   const std::filesystem::path csv = directory / "route.csv";
   std::ofstream(csv) << "x,y\n0,0\n" << length << ",0\n";
-  SimulationOptions options;
+  SimulatePipelineOptions pipeline;
+  SimulationOptions& options = pipeline.simulation;
   options.route = csv.string();
   options.trials = 2;
   options.seed = 3;
   options.teach_speed = 0.4;
   options.threads = 2;
-  return options;
+  return pipeline;
 }
 
 TEST(ClosedLoop, AShortStraightRouteIsRepeatedFromOffsetsToTheGoal) {
   testing::ScopedTempDir temp("closed_loop");
-  const SimulationOptions options = StraightRoute(temp.path(), 6.0);
-  std::filesystem::create_directory(temp.path() / "map");
-  const SimulationResult result = Simulate(options, MatcherOptions{}, temp.path() / "map");
+  SimulatePipelineOptions pipeline = StraightRoute(temp.path(), 6.0);
+  pipeline.map = (temp.path() / "map").string();
+  const SimulationOptions& options = pipeline.simulation;
+  const SimulationResult result = RunSimulatePipeline(pipeline).simulation;
   EXPECT_GE(result.key_images, 3);
   ASSERT_EQ(result.trials.size(), 2u);
   for (const TrialResult& trial : result.trials) {
@@ -44,25 +48,28 @@ TEST(ClosedLoop, AShortStraightRouteIsRepeatedFromOffsetsToTheGoal) {
     EXPECT_LT(std::abs(trial.samples.back().lateral), std::abs(trial.start_lateral));
   }
   EXPECT_EQ(result.summary.successes, 2);
+  EXPECT_TRUE(std::filesystem::is_regular_file(temp.path() / "map" / "map.json"));  // kept, as asked
 }
 
 TEST(ClosedLoop, TheSameOptionsGiveTheSameRuns) {
   testing::ScopedTempDir temp("closed_loop_same");
-  SimulationOptions options = StraightRoute(temp.path(), 3.0);
+  SimulatePipelineOptions pipeline = StraightRoute(temp.path(), 3.0);
+  SimulationOptions& options = pipeline.simulation;
   options.camera.width = 320;  // a quarter of the pixels: only the sameness is checked
   options.camera.height = 240;
   options.trials = 1;
   options.threads = 1;
   options.max_lateral_offset = 0.3;
   SimulationResult runs[2];
-  for (int run = 0; run < 2; ++run) {
-    const auto map = temp.path() / ("map" + std::to_string(run));
-    std::filesystem::create_directory(map);
-    runs[run] = Simulate(options, MatcherOptions{}, map);
-  }
+  for (int run = 0; run < 2; ++run) runs[run] = RunSimulatePipeline(pipeline).simulation;
   ASSERT_EQ(runs[0].trials[0].samples.size(), runs[1].trials[0].samples.size());
   EXPECT_EQ(runs[0].trials[0].samples.back().pose.x, runs[1].trials[0].samples.back().pose.x);
   EXPECT_EQ(runs[0].trials[0].samples.back().pose.y, runs[1].trials[0].samples.back().pose.y);
+  // Without options.map the maps were built in temporary folders, gone with the runs.
+  const std::string own_prefix = "vmap-simulate-map-" + std::to_string(::getpid()) + "-";
+  for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::temp_directory_path())) {
+    EXPECT_NE(entry.path().filename().string().rfind(own_prefix, 0), 0u) << entry.path();
+  }
 }
 
 }  // namespace

@@ -1,0 +1,187 @@
+#include "vmap/pipelines/simulate_pipeline.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+
+#include <fmt/format.h>
+
+#include "vmap/control/taught_route.h"
+#include "vmap/core/atomic_output.h"
+#include "vmap/core/error.h"
+#include "vmap/map/map_io.h"
+#include "vmap/pipelines/build_pipeline.h"
+#include "vmap/pipelines/output_policies.h"
+#include "vmap/simulation/simulation_output.h"
+#include "vmap/simulation/teach_run.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+
+namespace {
+
+// The procedural textures do not change with the seed: the seed varies the trials, not the world.
+constexpr unsigned kTextureSeed = 20261128;
+
+// A report folder this pipeline wrote: report.html and top_view.png, nothing else.
+std::string WhyNotASimulationReport(const fs::path& directory) {
+  std::error_code ec;
+  for (const fs::directory_entry& entry : fs::directory_iterator(directory, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name != "report.html" && name != "top_view.png")
+      return "it holds '" + name + "', which vmap simulate never writes";
+  }
+  return ec ? "it cannot be listed: " + ec.message() : "";
+}
+
+std::vector<fs::path> TextureFolders(const SimulationOptions& options) {
+  std::vector<fs::path> folders;
+  for (const std::string& path : {options.teach_textures, options.repeat_textures}) {
+    if (!path.empty()) folders.emplace_back(path);
+  }
+  return folders;
+}
+
+// Where a map nobody asked to keep is built: a folder of its own per run, also when runs share a process.
+fs::path TemporaryMapFolder() {
+  static std::atomic<int> runs{0};
+  return fs::temp_directory_path() / fmt::format("vmap-simulate-map-{}-{}", ::getpid(), runs++);
+}
+
+}  // namespace
+
+void SimulatePipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.VisitNested("", simulation);
+  visitor.VisitNested("", matcher);
+  visitor.Visit(OptionField{"json", "--json", "Write the run (options, summary, every trial) to this JSON file"}
+                    .HideDefault()
+                    .NotRecorded(),
+                json);
+  visitor.Visit(OptionField{"report", "--report", "Write an HTML report of the run into this directory"}
+                    .HideDefault()
+                    .NotRecorded(),
+                report);
+  visitor.Visit(OptionField{"map", "--map", "Keep the teach run's map in this directory"}.HideDefault().NotRecorded(),
+                map);
+}
+
+void SimulatePipelineOptions::Check() const {
+  simulation.Check();
+  matcher.Check();
+}
+
+std::unique_ptr<PreparedTrials> PrepareTrials(const SimulationOptions& options, const MatcherOptions& matcher_options,
+                                              const fs::path& map_directory) {
+  // 1. Everything that can be refused, before any work.
+  options.Check();
+  matcher_options.Check();
+  auto prepared = std::make_unique<PreparedTrials>();
+  prepared->route = LoadSimulatedRoute(options);
+  if (options.teach_textures.empty() && !options.repeat_textures.empty()) {
+    throw InputError("--repeat-textures replaces the teach textures in another season; give --teach-textures too");
+  }
+  const std::vector<cv::Mat> teach_images =
+      options.teach_textures.empty()
+          ? ProceduralTextures(TexturesToCover(prepared->route.corridor.length(), options.corridor), kTextureSeed)
+          : ReadTextureFolder(options.teach_textures, "--teach-textures");
+  const std::vector<cv::Mat> repeat_images = options.repeat_textures.empty()
+                                                 ? std::vector<cv::Mat>{}
+                                                 : ReadTextureFolder(options.repeat_textures, "--repeat-textures");
+
+  // 2. The worlds: the repeat world shows the repeat textures in the teach world's panels.
+  prepared->teach_world.emplace(prepared->route.corridor, options.corridor, teach_images);
+  prepared->repeat_world.emplace(repeat_images.empty() ? *prepared->teach_world
+                                                       : prepared->teach_world->WithImages(repeat_images));
+
+  // 3. The teach run, its frames rendered as the build pipeline reads them, and its map built as `vmap build`
+  //    builds one (τ the matcher's).
+  const auto start = std::chrono::steady_clock::now();
+  const TeachRun teach = PlanTeachRun(prepared->route, options);
+  BuildPipelineOptions build;
+  build.input = "simulated teach run (" + prepared->route.name + ")";
+  build.output = map_directory.string();
+  build.matcher = matcher_options;
+  build.map.show_progress = false;
+  RenderedFrameSource frames(*prepared->teach_world, options.camera, teach.poses, teach.seconds_per_frame,
+                             build.input);
+  RunBuildPipeline(build, &frames);
+  prepared->teach_frames = static_cast<int>(teach.poses.size());
+  prepared->teach_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  prepared->teach_odometry = teach.odometry;
+
+  // 4. The map opened for localization, and the route with its taught profile (from the teach odometry). Each
+  //    trial drives its own localizer with the session's options, along the taught route.
+  LocalizePipelineOptions localize;
+  localize.map = map_directory.string();
+  localize.session.localizer = options.localizer;
+  prepared->session = std::make_unique<LocalizationSession>(localize);
+  const LocalizationMap& map = prepared->session->opened();
+  TrialContext& context = prepared->context;
+  for (const KeyImage& key : map.map.key_images) context.key_image_poses.push_back(teach.poses.at(key.frame_index));
+  context.route = &prepared->route;
+  context.world = &*prepared->repeat_world;
+  context.map = &map;
+  context.taught = MakeTaughtRoute(map.map, {}, teach.odometry);
+  context.localizer = prepared->session->localizer_options();
+  context.localizer.route = context.taught.keys;
+  context.teach_duration = teach.odometry.back().timestamp;
+  context.options = options;
+  return prepared;
+}
+
+SimulatePipelineResult RunSimulatePipeline(const SimulatePipelineOptions& options,
+                                           const std::function<void(const TrialResult&)>& on_trial) {
+  const auto start = std::chrono::steady_clock::now();
+  const SimulationOptions& simulation = options.simulation;
+
+  // 1. The options and the outputs: none may overwrite the route, the textures or each other.
+  options.Check();
+  std::vector<std::vector<OutputInput>> inputs = {NamedInput(simulation.teach_textures, "--teach-textures"),
+                                                  NamedInput(simulation.repeat_textures, "--repeat-textures")};
+  if (FindEnum(kRouteShapeNames, simulation.route) == std::nullopt)
+    inputs.push_back(NamedInput(simulation.route, "--route"));
+  CheckOutputs({{options.json, "json"}}, inputs);
+
+  // 2. The folders, claimed before any work: the report's, and the map's (kept only with options.map; until the
+  //    end it is built in a hidden folder beside it, which goes if the run fails).
+  OutputPolicy report_policy;
+  report_policy.why_not_ours = WhyNotASimulationReport;
+  report_policy.kind = "a vmap simulate report";
+  report_policy.inputs = TextureFolders(simulation);
+  std::unique_ptr<AtomicOutputDirectory> report;
+  if (!options.report.empty()) report = std::make_unique<AtomicOutputDirectory>(options.report, report_policy);
+  OutputPolicy map_policy;
+  map_policy.why_not_ours = WhyNotAVmapMap;
+  map_policy.kind = "a vmap map";
+  map_policy.inputs = report_policy.inputs;
+  AtomicOutputDirectory map_directory(options.map.empty() ? TemporaryMapFolder() : fs::path(options.map), map_policy);
+
+  // 3-4. The route, the worlds, the teach run and its map, the trials' context.
+  const std::unique_ptr<PreparedTrials> prepared = PrepareTrials(simulation, options.matcher, map_directory.path());
+  const TrialContext& context = prepared->context;
+  SimulatePipelineResult result;
+  SimulationResult& run = result.simulation;
+  run.route = prepared->route;
+  run.teach_frames = prepared->teach_frames;
+  run.teach_seconds = prepared->teach_seconds;
+  run.matcher = prepared->map().matcher->name();
+  run.key_images = static_cast<int>(prepared->map().map.key_images.size());
+  run.key_image_poses = context.key_image_poses;
+
+  // 5. The trials, independent of each other.
+  run.trials = RunTrials(context, simulation.trials, simulation.threads, on_trial);
+  run.summary = Summarize(run.trials);
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  // 6. The outputs.
+  if (!options.map.empty()) map_directory.Commit();
+  if (report) {
+    WriteSimulationReport(run, simulation, report->path());
+    report->Commit();
+  }
+  if (!options.json.empty()) WriteFileAtomically(options.json, SimulationJson(run, simulation).dump() + "\n");
+  return result;
+}
+
+}  // namespace vmap
