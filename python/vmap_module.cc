@@ -68,4 +68,5 @@ PYBIND11_MODULE(vmap, m) {
   vmap::python::BindMapObjects(m);
   vmap::python::BindBuildAndMatch(m);
   vmap::python::BindLocalization(m);
+  vmap::python::BindSimulation(m);
 }

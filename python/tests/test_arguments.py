@@ -89,6 +89,13 @@ def test_wrong_types_are_type_errors_and_vmap_errors(tmp_path):
         vmap.Localizer(42)
     with pytest.raises(vmap.Error, match="NUL"):
         vmap.Localizer("a\0b")
+    with pytest.raises(vmap.ArgumentTypeError, match="trials"):
+        vmap.simulate(trials="many")
+    with pytest.raises(vmap.Error, match="lateral_offset"):
+        vmap.simulate(lateral_offset=float("nan"))
+    with pytest.raises(vmap.Error, match="missing.csv"):
+        vmap.simulate(route=str(tmp_path / "missing.csv"), json=str(tmp_path / "run.json"))
+    assert not (tmp_path / "run.json").exists()
     assert issubclass(vmap.ArgumentTypeError, TypeError) and issubclass(vmap.ArgumentTypeError, vmap.Error)
 
 

@@ -196,3 +196,33 @@ def test_ctrl_c_interrupts_a_build(tmp_path):
     assert child.returncode == 0 and out.strip() == "interrupted"
     assert not output.exists()
     assert not [p.name for p in tmp_path.iterdir()]  # no temporary left behind either
+
+
+def without_timings(value):
+    """A simulation's JSON record without its wall times (seconds, milliseconds, frames per second)."""
+    if isinstance(value, dict):
+        timed = ("seconds", "_ms", "per_second")
+        return {k: without_timings(v) for k, v in value.items() if not any(t in k for t in timed)}
+    if isinstance(value, list):
+        return [without_timings(v) for v in value]
+    return value
+
+
+def test_simulate_equals_vmap_simulate(tmp_path):
+    """vmap.simulate runs the simulate pipeline as `vmap simulate` does: the same teach run, map and trials.
+    Procedural textures: no ../shared needed."""
+    if not os.access(CLI, os.X_OK):
+        pytest.skip(f"the vmap CLI {CLI} is not built")
+    route = tmp_path / "route.csv"
+    route.write_text("x,y\n0,0\n3,0\n")
+    small = {"route": str(route), "trials": 1, "threads": 1, "camera_width": 320, "camera_height": 240,
+             "lateral_offset": 0.3}
+    module = vmap.simulate(**small, map=str(tmp_path / "module_map"))
+    run_cli("simulate", "--route", route, "--trials", 1, "--threads", 1, "--camera-width", 320, "--camera-height",
+            240, "--lateral-offset", 0.3, "--json", tmp_path / "cli.json")
+    cli = json.loads((tmp_path / "cli.json").read_text())
+    assert without_timings(module) == without_timings(cli)
+    assert module["summary"]["trials"] == 1 and len(module["trials"][0]["samples"]["x"]) > 10
+    assert (tmp_path / "module_map" / "map.json").is_file()  # map=... keeps the teach run's map
+    with pytest.raises(vmap.Error, match="trials"):
+        vmap.simulate(trials=0)
