@@ -89,12 +89,14 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
                                        std::vector<KeyComparison> ahead) {
   const auto start = std::chrono::steady_clock::now();
   comparisons_.clear();
+  ranked_.clear();
   for (KeyComparison& c : ahead) {
     if (c.key >= 0 && c.key < static_cast<int>(keys_.features.size())) comparisons_.push_back({std::move(c), false});
   }
   belief_.Predict();
+  belief_confident_ = SinglesOut(belief_.Peak());
   LocalizationResult result = has_estimate() ? Track(frame, features) : Relocalize(frame, features);
-  Believe(result);
+  Believe(result, frame, features);
   result.comparisons =
       static_cast<int>(std::count_if(comparisons_.begin(), comparisons_.end(), [](const Memo& m) { return m.used; }));
   if (result.key >= 0 && result.to_key.key == result.key) {
@@ -195,7 +197,12 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     result.candidates = std::move(found.candidates);
     ++lost_in_a_row_;
     Describe(result, position, features);
-    if (lost_in_a_row_ > options_.max_lost_frames) Reset();
+    if (lost_in_a_row_ > options_.max_lost_frames) {
+      // The estimate is dropped; the belief is kept (its evidence still says where the frames were).
+      position_ = -1;
+      lost_in_a_row_ = 0;
+      step_back_ruled_out_ = {};
+    }
     return result;
   }
   if (SharesLittle(best)) {
@@ -230,20 +237,30 @@ bool Localizer::SharesLittle(const KeyComparison& comparison) const {
   return reference > 0 && comparison.num_verified < options_.recheck_link_share * reference;
 }
 
-LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures& features) {
-  LocalizationResult result;
-  const cv::Mat thumbnail = ranking_->method() == RankingMethod::kThumbnails
+std::vector<int> Localizer::CompareBestRanked(const Frame& frame, const ImageFeatures& features) {
+  const cv::Mat thumbnail = ranking_->method() == RankingMethod::kThumbnails && ranked_.empty()
                                 ? ThumbnailDescriptor(frame.gray, options_.ranking.thumbnail_width)
                                 : cv::Mat();
-  const std::vector<RankedKey> ranked = ranking_->Rank(features, thumbnail);
+  if (ranked_.empty()) ranked_ = ranking_->Rank(features, thumbnail);  // once per frame
+  const int count = std::min<int>(options_.relocalization_candidates, static_cast<int>(ranked_.size()));
+  std::vector<int> positions;
+  for (int i = 0; i < count; ++i) {
+    positions.push_back(ranked_[i].key);  // the ranking holds the route's key images in route order
+    CompareOnce(features, route_[ranked_[i].key]);
+  }
+  return positions;
+}
+
+LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures& features) {
+  LocalizationResult result;
+  const std::vector<int> positions = CompareBestRanked(frame, features);
   KeyComparison best;
   int best_position = -1;
-  const int count = std::min<int>(options_.relocalization_candidates, static_cast<int>(ranked.size()));
-  for (int i = 0; i < count; ++i) {
-    const int position = ranked[i].key;  // the ranking holds the route's key images in route order
+  for (size_t i = 0; i < positions.size(); ++i) {
+    const int position = positions[i];
     const KeyComparison c = CompareOnce(features, route_[position]);
     result.candidates.push_back(
-        {route_[position], ranked[i].score, c.accepted, c.similarity, c.num_verified, c.log10_nfa});
+        {route_[position], ranked_[i].score, c.accepted, c.similarity, c.num_verified, c.log10_nfa});
     if (IsBetterMatch(c, best)) {
       best = c;
       best_position = position;

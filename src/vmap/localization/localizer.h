@@ -84,8 +84,17 @@ class Localizer {
   void Describe(LocalizationResult& result, int position, const ImageFeatures& features);
   // The belief's step (localizer_belief.cc): weighs the evidence of every comparison of the frame, then sets the
   // result's confidence and, when the belief does not single out the tracked position, the status kUncertain.
-  void Believe(LocalizationResult& result);
+  void Believe(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
   void WeighComparisons();
+  // When the belief doubts the frame's position: compares around the belief's peak (over the whole route when
+  // it is flat) and moves the estimate to the peak when the belief singles it out.
+  // The belief singles out route `position` (not only holds min_confidence near it: also far more than a flat
+  // belief would).
+  bool SinglesOut(int position) const;
+  void Question(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
+  // Compares the frame with the best-ranked key images of the route (relocalization_candidates of them), in
+  // rank order; returns the ranking's route positions compared.
+  std::vector<int> CompareBestRanked(const Frame& frame, const ImageFeatures& features);
 
   // The frame's verified matches with key_a over those of the map's link between key_a and key_b (0 when
   // they have no link).
@@ -112,6 +121,9 @@ class Localizer {
     int next_verified = 0;
   } step_back_ruled_out_;
   RouteBelief belief_;
+  // After the frame's motion step, before its evidence: the belief held at least min_confidence near its peak
+  // (the frames before this one singled out a place). A flat belief does not move the estimate.
+  bool belief_confident_ = false;
   EvidenceModel evidence_;  // by the kind of the matcher's descriptors
   struct Memo {
     KeyComparison comparison;
@@ -119,6 +131,7 @@ class Localizer {
     bool weighed = false;  // its evidence is in the belief
   };
   std::vector<Memo> comparisons_;  // of the frame being localized
+  std::vector<RankedKey> ranked_;  // the last ranking of the route (CompareBestRanked)
 };
 
 }  // namespace vmap

@@ -90,6 +90,7 @@ TEST(RouteBelief, OptionsAreChecked) {
   EXPECT_EQ(path([](RouteBeliefOptions& o) { o.jump = 0.0; }), "jump");
   EXPECT_EQ(path([](RouteBeliefOptions& o) { o.stay = -0.1; }), "stay");
   EXPECT_EQ(path([](RouteBeliefOptions& o) { o.min_confidence = 1.5; }), "min_confidence");
+  EXPECT_EQ(path([](RouteBeliefOptions& o) { o.window = -1; }), "window");
   EXPECT_NO_THROW(RouteBeliefOptions{}.Check());
 }
 

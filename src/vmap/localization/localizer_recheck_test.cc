@@ -4,6 +4,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "vmap/features/orb_matcher.h"
 #include "vmap/localization/localization_map.h"
@@ -125,6 +126,50 @@ TEST(Localizer, AOneFrameJumpIsUncertainUntilTheFramesThatFollowConfirmIt) {
     EXPECT_EQ(r.status, LocalizationStatus::kTracking);
     EXPECT_TRUE(Brackets(m.map, 47, r.key)) << "at key " << r.key;
     EXPECT_GT(r.confidence, 0.5);
+  }
+}
+
+// The belief moves the estimate (LocalizerOptions::belief.window): frames that verify against no key image (here
+// the drive's frames through fog and glare) after a run of frames that singled out a place are not lost but placed
+// at the belief's peak, carried along the route by its motion model, as a best guess not to steer by
+// (uncertain); the next frame that sees the scene is tracked from there. Without it (window 0) they are lost.
+TEST(Localizer, FramesThatVerifyNothingAfterAConfidentRunAreCarriedByTheBelief) {
+  const LocalizationMap& m = Dense();
+  cv::Mat noise(SidewaysDrive().frames[0].size(), CV_8UC3);
+  cv::RNG rng(5);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 255);
+  for (const int window : {2, 0}) {
+    LocalizerOptions options = MapLocalizerOptions(m);
+    ASSERT_EQ(options.belief.window, 2) << "the default";
+    options.belief.window = window;
+    Localizer localizer(m.map, m.keys, *m.matcher, options);
+    int index = 0;
+    LocalizationResult r;
+    for (int source_index : {1, 3, 5, 7, 9}) r = LocalizeImage(localizer, source_index, index++);
+    ASSERT_EQ(r.status, LocalizationStatus::kTracking);
+    const int tracked_position = r.route_position;
+    for (int blind = 0; blind < 3; ++blind) {
+      // The drive's next frames seen through fog and glare: little of the scene is left, and nothing verifies.
+      cv::Mat foggy;
+      cv::addWeighted(SidewaysDrive().frames[11 + blind], 0.25, noise, 0.75, 0.0, foggy);
+      Frame frame;
+      frame.index = index++;
+      cv::cvtColor(foggy, frame.gray, cv::COLOR_BGR2GRAY);
+      frame.color = foggy;
+      r = localizer.Localize(frame, *Dense().matcher->Extract(frame.gray));
+      EXPECT_FALSE(MaySteerBy(r)) << window;
+      if (window > 0) {
+        EXPECT_EQ(r.status, LocalizationStatus::kUncertain) << blind;
+        EXPECT_GE(r.confidence, 0.5) << blind;
+        EXPECT_GE(r.route_position, tracked_position - 1) << "carried along the route, not lost";
+        EXPECT_LE(r.route_position, tracked_position + 4);
+      } else {
+        EXPECT_EQ(r.status, LocalizationStatus::kLost) << blind;
+      }
+    }
+    r = LocalizeImage(localizer, 13, index++);
+    EXPECT_EQ(r.status, LocalizationStatus::kTracking) << window;
+    EXPECT_TRUE(Brackets(m.map, 13, r.key)) << "at key " << r.key;
   }
 }
 

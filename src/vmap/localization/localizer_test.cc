@@ -145,6 +145,9 @@ TEST(Localizer, AnUnrelatedImageIsLostAndTheEstimateIsDroppedAfterMaxLostFrames)
   const LocalizationMap& m = Map().opened;
   LocalizerOptions options = MapLocalizerOptions(m);
   options.max_lost_frames = 2;
+  // The tracker's own rule; the belief would place blind frames after a confident run at its best guess
+  // (Localizer.FramesThatVerifyNothingAfterAConfidentRunAreCarriedByTheBelief).
+  options.belief.window = 0;
   Localizer localizer(m.map, m.keys, *m.matcher, options);
   // Noise shares no scene point with the map.
   cv::Mat noise(SidewaysDrive().frames[0].size(), CV_8UC3);
@@ -213,6 +216,7 @@ TEST(Localizer, AFrameThatShowsLittleOfTheSceneIsStillLocalizedByItsChance) {
   LocalizerOptions chance = MapLocalizerOptions(m);
   ASSERT_EQ(chance.acceptance, AcceptanceRule::kChance) << "the default";
   chance.min_link_share = 0.0;  // chance alone: the test is about its rule
+  chance.belief.window = 0;      // frames placed by the acceptance rule, not by the belief's best guess
   LocalizerOptions counts = chance;
   counts.acceptance = AcceptanceRule::kCounts;
   const std::vector<LocalizationResult> by_chance = LocalizeAll(chance, MostlyHidden(0.35), DriveIndices(1, 2));

@@ -15,6 +15,10 @@ void RouteBeliefOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "A frame is uncertain (not to steer by) when the belief over the route holds less than this near "
                  "its key image (0: never)"},
                 min_confidence);
+  visitor.Visit({"window", "--belief-window",
+                 "When the belief doubts the key image, compare key images this many places around the belief's "
+                 "peak and move there when it is singled out (0: the belief never moves the estimate)"},
+                window);
   visitor.Visit({"stay"}, stay);
   visitor.Visit({"forward"}, forward);
   visitor.Visit({"forward2"}, forward2);
@@ -32,6 +36,10 @@ void RouteBeliefOptions::Check() const {
     }
   }
   if (!(jump > 0.0)) throw OptionError("jump", "must be above 0: a belief that cannot jump can be stuck for ever");
+  if (window < 0 || window > 50) {
+    throw OptionError("window", fmt::format("{} is outside [0, 50] (default 2; 0: the belief never moves the estimate)",
+                                            window));
+  }
   if (!(min_confidence >= 0.0 && min_confidence <= 1.0)) {
     throw OptionError("min_confidence",
                       fmt::format("{} is outside [0, 1] (default 0.5; 0: never uncertain)", min_confidence));

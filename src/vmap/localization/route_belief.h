@@ -29,6 +29,11 @@ struct RouteBeliefOptions {
   // A frame whose belief holds less than this within two positions of its key image is uncertain
   // (LocalizationStatus::kUncertain: not to steer by). 0: never uncertain.
   double min_confidence = 0.5;
+  // When the belief doubts the tracked key image (it holds less than min_confidence near it), the frame is also
+  // compared with the key images within this many route positions of the belief's peak (behind and ahead), and
+  // with the best-ranked ones of the whole route when the belief is flat; the estimate then moves to the belief's
+  // peak when the belief singles it out. 0: the belief never moves the estimate (it only flags frames).
+  int window = 2;
 
   // As a localization run records them ("options.belief"); min_confidence has a flag.
   void VisitFields(OptionFieldVisitor& visitor);
