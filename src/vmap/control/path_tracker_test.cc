@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "vmap/control/route_pose_estimator.h"
+#include "vmap/control/route_tracking.h"
 
 namespace vmap {
 namespace {
@@ -107,6 +108,121 @@ TEST(RoutePoseEstimator, BearingsToKnownLandmarksCorrectAnOffset) {
   const cv::Vec3d before = estimator.pose();
   EXPECT_FALSE(estimator.UpdateBearing({truth[0] + 2.0, 0.0}, 1.0));
   EXPECT_EQ(estimator.pose(), before);
+}
+
+// An estimate sure of a wrong heading (a bad first frame): every true heading then looks like an outlier.
+// Without the recovery it refuses them all and stays wrong; with it, too many refusals widen its heading's
+// uncertainty and the true headings, then the bearings, pull it back.
+cv::Vec3d AfterWrongStart(RoutePoseEstimatorOptions options, int* recoveries) {
+  RoutePoseEstimator estimator(options);
+  cv::Vec3d truth(0.0, 0.2, 0.0);
+  estimator.Initialize({0.0, 0.0, 0.4}, {0.1, 0.1, 0.02});
+  for (int step = 0; step < 40; ++step) {
+    truth[0] += 0.03;
+    estimator.Predict(0.03, 0.0);
+    const cv::Point2d landmark(std::floor(truth[0]) + 2.0, 0.0);
+    estimator.UpdateHeading(truth[2], 0.02);
+    estimator.UpdateBearing(landmark, std::atan2(landmark.y - truth[1], landmark.x - truth[0]) - truth[2]);
+  }
+  *recoveries = estimator.recoveries();
+  return estimator.pose() - truth;
+}
+
+TEST(RoutePoseEstimator, RecoversFromAWrongHeadingItWasSureOf) {
+  int recoveries = 0;
+  RoutePoseEstimatorOptions never;
+  never.recovery_window = 0;
+  const cv::Vec3d stuck = AfterWrongStart(never, &recoveries);
+  EXPECT_GT(std::abs(stuck[2]), 0.3);
+  EXPECT_EQ(recoveries, 0);
+  const cv::Vec3d error = AfterWrongStart(RoutePoseEstimatorOptions{}, &recoveries);
+  EXPECT_GE(recoveries, 1);
+  EXPECT_LT(std::abs(error[2]), 0.03);
+  EXPECT_LT(std::abs(error[1]), 0.05);
+}
+
+TEST(RoutePoseEstimator, ABearingCloseToTheKeyImageDoesNotThrowAnUnsureEstimateAlongItsLineOfSight) {
+  // Unsure by 2 m along the route, sure across it; the key image 0.5 m ahead is seen 0.3 rad off what the
+  // estimate predicts (a small error in a bearing this close). Linearized, the bearing would move the estimate
+  // metres along its line of sight; the step limit refuses it.
+  auto after = [](double share) {
+    RoutePoseEstimatorOptions options;
+    options.max_bearing_step_share = share;
+    RoutePoseEstimator estimator(options);
+    estimator.Initialize({0.5, 0.05, 0.0}, {2.0, 0.05, 0.01});
+    estimator.UpdateBearing({1.0, 0.0}, -0.1 - 0.3);
+    return estimator.pose();
+  };
+  EXPECT_GT(std::abs(after(1e9)[0] - 0.5), 1.0);
+  EXPECT_NEAR(after(RoutePoseEstimatorOptions{}.max_bearing_step_share)[0], 0.5, 0.15);
+  // Across the line of sight, what a bearing measures, a large correction is taken: 0.4 m off with the key image
+  // 1 m ahead.
+  RoutePoseEstimator estimator;
+  estimator.Initialize({0.0, -0.2, 0.0}, {0.05, 0.5, 0.01});
+  EXPECT_TRUE(estimator.UpdateBearing({1.0, 0.0}, std::atan2(-0.2, 1.0)));
+  EXPECT_GT(estimator.pose()[1], 0.1);
+}
+
+// Key images 1 m apart along x, taken 10 s apart, on the teach path of StraightPath(4).
+TaughtRoute StraightMetricRoute() {
+  TaughtRoute route;
+  route.keys = {0, 1, 2, 3};
+  for (int k = 0; k < 4; ++k) route.key_poses.push_back({10.0 * k, 1.0 * k, 0.0, 0.0});
+  for (int k = 0; k < 3; ++k) {
+    TaughtSegment segment;
+    segment.from_key = k;
+    segment.to_key = k + 1;
+    segment.duration = 10.0;
+    segment.length = 1.0;
+    segment.yaw_change = 0.0;
+    route.segments.push_back(segment);
+  }
+  route.path = StraightPath(4.0);
+  route.focal_px = 500.0;
+  return route;
+}
+
+// A frame tracked between key images 1 and 2 whose pose to key image 2 has a rotation saying the robot points
+// `rotation_offset` rad left of it, and whose features say `features_offset`.
+LocalizationResult FrameWithHeadings(double rotation_offset, double features_offset) {
+  LocalizationResult result;
+  result.status = LocalizationStatus::kTracking;
+  result.key = 1;
+  result.next_key = 2;
+  result.route_position = 1;
+  result.progress = 0.5;
+  result.heading_deg = features_offset * 180.0 / M_PI;
+  const double a = -rotation_offset;  // YawOfCameraRotation of a turn about the camera's y axis by a
+  result.to_next.pose.valid = true;
+  result.to_next.pose.R = cv::Matx33d(std::cos(a), 0, std::sin(a), 0, 1, 0, -std::sin(a), 0, std::cos(a));
+  result.to_next.pose.t = cv::Vec3d(0, 0, -1);
+  return result;
+}
+
+TEST(RouteTracking, ARotationTheFeaturesContradictGivesNoHeading) {
+  ASSERT_TRUE(StraightMetricRoute().metric());
+  RouteTracking agreeing(StraightMetricRoute());
+  agreeing.Observe(FrameWithHeadings(0.12, 0.1), 500.0);  // they agree: the rotation's, the surer
+  EXPECT_NEAR(agreeing.pose()[2], 0.12, 1e-9);
+  RouteTracking contradicted(StraightMetricRoute());
+  contradicted.Observe(FrameWithHeadings(-0.35, 0.1), 500.0);  // a wrong rotation (or biased features): no heading
+  EXPECT_FALSE(contradicted.started());
+  RoutePoseEstimatorOptions trusting;
+  trusting.rotation_agreement = M_PI;
+  RouteTracking without(StraightMetricRoute(), trusting);
+  without.Observe(FrameWithHeadings(-0.35, 0.1), 500.0);
+  EXPECT_NEAR(without.pose()[2], -0.35, 1e-9);
+}
+
+TEST(RouteTracking, StartsBetweenTheKeyImagesUnsureAlongTheRouteMoreThanAcrossIt) {
+  RouteTracking tracking(StraightMetricRoute());
+  EXPECT_FALSE(tracking.started());
+  tracking.Observe(FrameWithHeadings(0.0, 0.0), 500.0);
+  ASSERT_TRUE(tracking.started());
+  EXPECT_NEAR(tracking.pose()[0], 1.5, 1e-9);
+  EXPECT_NEAR(tracking.pose()[1], 0.0, 1e-9);
+  EXPECT_NEAR(std::sqrt(tracking.covariance()(0, 0)), 1.0, 1e-9);   // one key image spacing along
+  EXPECT_NEAR(std::sqrt(tracking.covariance()(1, 1)), 0.35, 1e-9);  // start_lateral_sigma across
 }
 
 TEST(RoutePoseEstimator, NothingIsMeasuredBeforeItStarts) {

@@ -199,6 +199,7 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
       const PathLocation at = tracking_->Locate();
       step.lateral_estimate = at.lateral;
       step.heading_error_estimate = at.heading_error;
+      step.arc_estimate = at.s;
       turn = PathFollowingTurnRate(at, speed, options_.convergence_distance);
       step.steering = "tracker";
     }
@@ -213,6 +214,7 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
     const PathLocation at = tracking_->Locate();
     step.lateral_estimate = at.lateral;
     step.heading_error_estimate = at.heading_error;
+    step.arc_estimate = at.s;
     // The goal is the goal key image's (above); an estimate well past the end of the path stops the robot too.
     if (at.s >= tracking_->path_length() - 1e-6 && PastTheEnd(tracking_->pose()) > 0.5) {
       reached_goal_ = true;

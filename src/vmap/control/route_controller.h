@@ -69,6 +69,7 @@ struct ControlStep {
   // measurements the frame gave the estimate; NaN / 0 otherwise.
   double lateral_estimate = std::numeric_limits<double>::quiet_NaN();
   double heading_error_estimate = std::numeric_limits<double>::quiet_NaN();
+  double arc_estimate = std::numeric_limits<double>::quiet_NaN();  // where along the taught path (m)
   TrackingObservation observation;
   double seconds = 0.0;  // time spent in Update
 };

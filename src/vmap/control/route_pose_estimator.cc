@@ -1,5 +1,6 @@
 #include "vmap/control/route_pose_estimator.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "vmap/sources/odometry.h"
@@ -7,11 +8,16 @@
 namespace vmap {
 
 void RoutePoseEstimator::Initialize(const cv::Vec3d& pose, const cv::Vec3d& sigma) {
+  InitializeWithCovariance(pose, cv::Matx33d::diag(cv::Vec3d(sigma[0] * sigma[0], sigma[1] * sigma[1], sigma[2] * sigma[2])));
+}
+
+void RoutePoseEstimator::InitializeWithCovariance(const cv::Vec3d& pose, const cv::Matx33d& covariance) {
   pose_ = pose;
   pose_[2] = WrapAngle(pose_[2]);
-  covariance_ = cv::Matx33d::diag(cv::Vec3d(sigma[0] * sigma[0], sigma[1] * sigma[1], sigma[2] * sigma[2]));
+  covariance_ = covariance;
   initialized_ = true;
-  refused_in_a_row_ = 0;
+  outcomes_.clear();
+  recoveries_ = 0;
 }
 
 void RoutePoseEstimator::Predict(double distance, double turn) {
@@ -33,19 +39,26 @@ void RoutePoseEstimator::Predict(double distance, double turn) {
   covariance_(1, 1) += slip * slip;
 }
 
-bool RoutePoseEstimator::Update(const cv::Matx13d& H, double residual, double r) {
+void RoutePoseEstimator::RememberHeading(bool refused) {
+  if (options_.recovery_window <= 0) return;
+  outcomes_.push_back(refused);
+  if (static_cast<int>(outcomes_.size()) > options_.recovery_window) outcomes_.pop_front();
+  const int refusals = static_cast<int>(std::count(outcomes_.begin(), outcomes_.end(), true));
+  if (refusals < options_.recovery_refused) return;
+  covariance_(2, 2) = std::max(covariance_(2, 2), options_.recovery_heading_sigma * options_.recovery_heading_sigma);
+  outcomes_.clear();
+  ++recoveries_;
+}
+
+bool RoutePoseEstimator::Update(const cv::Matx13d& H, double residual, double r, double max_step,
+                                const cv::Vec2d& max_step_direction) {
   const double innovation_variance = (H * covariance_ * H.t())(0, 0) + r;
   if (residual * residual > options_.gate * options_.gate * innovation_variance) {
-    if (++refused_in_a_row_ >= options_.refusals_before_recovery) {
-      const double widened = options_.recovery_sigma * options_.recovery_sigma;
-      covariance_(0, 0) = std::max(covariance_(0, 0), widened);
-      covariance_(1, 1) = std::max(covariance_(1, 1), widened);
-      refused_in_a_row_ = 0;
-    }
     return false;
   }
-  refused_in_a_row_ = 0;
   const cv::Matx31d K = covariance_ * H.t() * (1.0 / innovation_variance);
+  if (std::abs(K(0, 0) * residual * max_step_direction[0] + K(1, 0) * residual * max_step_direction[1]) > max_step)
+    return false;
   for (int i = 0; i < 3; ++i) pose_[i] += K(i, 0) * residual;
   pose_[2] = WrapAngle(pose_[2]);
   covariance_ = (cv::Matx33d::eye() - K * H) * covariance_;
@@ -55,7 +68,9 @@ bool RoutePoseEstimator::Update(const cv::Matx13d& H, double residual, double r)
 
 bool RoutePoseEstimator::UpdateHeading(double yaw, double sigma) {
   if (!initialized_) return false;
-  return Update(cv::Matx13d(0, 0, 1), WrapAngle(yaw - pose_[2]), sigma * sigma);
+  const bool taken = Update(cv::Matx13d(0, 0, 1), WrapAngle(yaw - pose_[2]), sigma * sigma);
+  RememberHeading(!taken);
+  return taken;
 }
 
 bool RoutePoseEstimator::UpdateBearing(const cv::Point2d& landmark, double bearing) {
@@ -65,7 +80,9 @@ bool RoutePoseEstimator::UpdateBearing(const cv::Point2d& landmark, double beari
   if (range_squared < 0.01) return false;  // a landmark under the robot gives no bearing
   const double predicted = WrapAngle(std::atan2(dy, dx) - pose_[2]);
   const cv::Matx13d H(dy / range_squared, -dx / range_squared, -1.0);
-  return Update(H, WrapAngle(bearing - predicted), options_.bearing_sigma * options_.bearing_sigma);
+  const double range = std::sqrt(range_squared);
+  return Update(H, WrapAngle(bearing - predicted), options_.bearing_sigma * options_.bearing_sigma,
+                options_.max_bearing_step_share * range, cv::Vec2d(dx / range, dy / range));
 }
 
 }  // namespace vmap

@@ -9,6 +9,9 @@
 // robot is at: a localizer a key image behind or ahead still gives true bearings. A measurement far from what
 // the estimate predicts (beyond `gate` standard deviations) is refused, as an outlier.
 
+#include <deque>
+#include <limits>
+
 #include <opencv2/core.hpp>
 
 namespace vmap {
@@ -26,10 +29,30 @@ struct RoutePoseEstimatorOptions {
   // recorded with its own odometry's errors). It keeps the estimate from growing so sure of itself that it
   // refuses the bearings that would correct it.
   double position_noise_per_metre = 0.05;
-  // After this many measurements in a row refused by the gate, the estimate is taken to have gone wrong: its
-  // position uncertainty is widened to `recovery_sigma` metres so that the next measurements pull it back.
-  int refusals_before_recovery = 1000000;
-  double recovery_sigma = 0.5;
+  // Recovery: when at least `recovery_refused` of the last `recovery_window` heading measurements were refused by
+  // the gate, the estimate is taken to have grown sure of a wrong heading (then every true heading looks like an
+  // outlier, and the odometry carries the error into the position): its heading uncertainty is widened to
+  // `recovery_heading_sigma` so that the next headings pull it back. Only the heading: a position widened as
+  // well let wrong bearings (the corridor's end wall filling the view) throw the estimate across the corridor.
+  // recovery_window 0: never.
+  int recovery_window = 10;
+  int recovery_refused = 8;
+  double recovery_heading_sigma = 0.3;
+  // A bearing whose correction would move the estimate along the line of sight to the key image by more than this
+  // share of the distance to it is not taken: a bearing measures the position across that line, and its
+  // linearization does not hold that far along it (close to the key image with a wide uncertainty along the line
+  // of sight, a bearing's small error would throw the estimate metres along it).
+  double max_bearing_step_share = 0.3;
+  // The start (RouteTracking): the estimate begins between the localizer's key images, unsure by one key
+  // image spacing along the route (`start_along_share` of it, at least 0.5 m) and by `start_lateral_sigma`
+  // metres across it.
+  double start_along_share = 1.0;
+  double start_lateral_sigma = 0.35;
+  // The frame's heading from the relative pose's rotation is taken only where it agrees with the features'
+  // heading within this (rad); otherwise the frame gives no heading (the rotation may be wrong, and the features'
+  // heading is biased by the parallax of a sideways offset: taken instead, it pulled the estimate to the wrong
+  // side of the path).
+  double rotation_agreement = 0.15;
 };
 
 class RoutePoseEstimator {
@@ -39,6 +62,8 @@ class RoutePoseEstimator {
   bool initialized() const { return initialized_; }
   // Starts at (x, y, yaw) with these standard deviations (metres, metres, radians).
   void Initialize(const cv::Vec3d& pose, const cv::Vec3d& sigma);
+  // The same with a full covariance (x, y, yaw).
+  void InitializeWithCovariance(const cv::Vec3d& pose, const cv::Matx33d& covariance);
   void Reset() { initialized_ = false; }
 
   // The robot drove `distance` metres (negative: backwards) while turning by `turn` radians.
@@ -46,17 +71,25 @@ class RoutePoseEstimator {
   // Measurements; each returns whether it was taken (false: refused by the gate, or not initialized).
   bool UpdateHeading(double yaw, double sigma);
   bool UpdateBearing(const cv::Point2d& landmark, double bearing);
+  // How many times the estimate's uncertainty was widened since it started (RoutePoseEstimatorOptions: recovery).
+  int recoveries() const { return recoveries_; }
 
   const cv::Vec3d& pose() const { return pose_; }  // x, y, yaw
   const cv::Matx33d& covariance() const { return covariance_; }
 
  private:
   // One scalar measurement with Jacobian H and innovation `residual`, variance r.
-  bool Update(const cv::Matx13d& H, double residual, double r);
+  // `max_step`: a correction moving the position farther than this (m) along the unit `max_step_direction` is
+  // not taken (and not counted as refused).
+  bool Update(const cv::Matx13d& H, double residual, double r,
+              double max_step = std::numeric_limits<double>::infinity(), const cv::Vec2d& max_step_direction = {1, 0});
+  // Records whether a heading was refused; widens the heading's uncertainty when too many of the last ones were.
+  void RememberHeading(bool refused);
 
   RoutePoseEstimatorOptions options_;
   bool initialized_ = false;
-  int refused_in_a_row_ = 0;
+  std::deque<bool> outcomes_;  // the last recovery_window headings: true where refused
+  int recoveries_ = 0;
   cv::Vec3d pose_;
   cv::Matx33d covariance_ = cv::Matx33d::eye();
 };

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "vmap/control/guidance_signals.h"
 
@@ -32,22 +33,38 @@ TrackingObservation RouteTracking::Observe(const LocalizationResult& result, dou
   if (key_position < 0 || target_position < 0) return seen;
   const OdometrySample& target = route_.key_poses[target_position];
   // The robot's heading against the target: from the relative pose's rotation where there is one (it holds
-  // wherever the robot is); otherwise from the features' heading, which a sideways offset biases by its parallax,
-  // with a larger uncertainty.
+  // wherever the robot is) where the features' heading agrees with it; without a pose, from the features' heading,
+  // which a sideways offset biases by its parallax, with a larger uncertainty.
   const RelativePose& pose = TargetComparison(result).pose;
-  const bool rotation = pose.valid;
-  const double offset = rotation ? -YawOfCameraRotation(pose.R) : HeadingOffset(result, focal_px);
+  const double features = HeadingOffset(result, focal_px);
+  const double rotation_offset = pose.valid ? -YawOfCameraRotation(pose.R) : std::numeric_limits<double>::quiet_NaN();
+  // A rotation the features' heading contradicts is wrong or the features are biased: no heading from this frame.
+  if (std::isfinite(rotation_offset) && std::isfinite(features) &&
+      std::abs(WrapAngle(rotation_offset - features)) > options_.rotation_agreement) {
+    return seen;
+  }
+  const bool rotation = std::isfinite(rotation_offset);
+  const double offset = rotation ? rotation_offset : features;
   if (!std::isfinite(offset)) return seen;
   const double heading_sigma = rotation ? options_.heading_sigma : options_.feature_heading_sigma;
   if (!estimator_.initialized()) {
-    // Between key and next_key at the localizer's progress, uncertain by a stretch either way: a relocalization
-    // may be off by a key image or two; the bearings that follow pull it in.
+    // Between key and next_key at the localizer's progress, uncertain along the route by a stretch (a
+    // relocalization may be off by a key image), across it by where a robot may start; the bearings that follow
+    // pull it in.
     const OdometrySample& key = route_.key_poses[key_position];
     const double progress = std::isfinite(result.progress) ? std::clamp(result.progress, 0.0, 1.0) : 0.0;
-    const double spacing = std::max(0.5, std::hypot(target.x - key.x, target.y - key.y));
-    estimator_.Initialize(
+    const double spacing = std::hypot(target.x - key.x, target.y - key.y);
+    const double along = std::max(0.5, options_.start_along_share * spacing);
+    const double across = options_.start_lateral_sigma;
+    const double c = std::cos(target.yaw), s = std::sin(target.yaw);
+    const cv::Matx22d rotate(c, -s, s, c);
+    const cv::Matx22d position = rotate * cv::Matx22d(along * along, 0, 0, across * across) * rotate.t();
+    const double yaw_sigma = 2.0 * heading_sigma;
+    const cv::Matx33d covariance(position(0, 0), position(0, 1), 0, position(1, 0), position(1, 1), 0, 0, 0,
+                                 yaw_sigma * yaw_sigma);
+    estimator_.InitializeWithCovariance(
         {key.x + progress * (target.x - key.x), key.y + progress * (target.y - key.y), target.yaw + offset},
-        {2.0 * spacing, 2.0 * spacing, 2.0 * heading_sigma});
+        covariance);
     arc_ = key_arc_[key_position] + progress * (key_arc_[target_position] - key_arc_[key_position]);
     return seen;
   }

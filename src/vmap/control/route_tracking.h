@@ -37,6 +37,7 @@ class RouteTracking {
   // Where the estimate is on the taught path (near where it was last: a loop passes a place twice).
   PathLocation Locate();
   const cv::Vec3d& pose() const { return estimator_.pose(); }
+  const cv::Matx33d& covariance() const { return estimator_.covariance(); }
   double path_length() const { return path_.length(); }
   void Reset();
 

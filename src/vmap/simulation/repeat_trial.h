@@ -30,6 +30,8 @@ struct TrialSample {
   double bearing = 0.0;
   double line_angle = 0.0;
   double lateral_estimate = 0.0;       // the tracker's (ControlStep; NaN otherwise)
+  double heading_error_estimate = 0.0;  // the tracker's (rad, ControlStep; NaN otherwise)
+  double arc_estimate = 0.0;            // the tracker's (m along the taught path; NaN otherwise)
   TrackingObservation observation;     // what the frame gave the tracker's estimate
   double translation_sigma_deg = 0.0;  // of the target's pose (KeyComparison; NaN without one)
   int target_verified = 0;             // verified matches with the target key image

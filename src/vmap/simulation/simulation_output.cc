@@ -101,7 +101,11 @@ nlohmann::json SimulationJson(const SimulationResult& result, const SimulationOp
                              "target_verified",
                              "lateral_estimate",
                              "bearings_taken",
-                             "measurements_refused"}) {
+                             "measurements_refused",
+                             "heading_error_estimate",
+                             "headings_taken",
+                             "unassociated",
+                             "arc_estimate"}) {
       columns[name] = nlohmann::json::array();
     }
     for (const TrialSample& sample : trial.samples) {
@@ -127,6 +131,10 @@ nlohmann::json SimulationJson(const SimulationResult& result, const SimulationOp
       columns["lateral_estimate"].push_back(Number(sample.lateral_estimate));
       columns["bearings_taken"].push_back(sample.observation.bearings);
       columns["measurements_refused"].push_back(sample.observation.refused);
+      columns["heading_error_estimate"].push_back(Number(sample.heading_error_estimate, 1e-4));
+      columns["headings_taken"].push_back(sample.observation.headings);
+      columns["unassociated"].push_back(sample.observation.unassociated);
+      columns["arc_estimate"].push_back(Number(sample.arc_estimate));
     }
     t["samples"] = columns;
     trials.push_back(t);

@@ -126,6 +126,8 @@ void TrialRun::Record(const LocalizationResult& localization, const ControlStep&
   sample.bearing = step.bearing;
   sample.line_angle = step.line_angle;
   sample.lateral_estimate = step.lateral_estimate;
+  sample.heading_error_estimate = step.heading_error_estimate;
+  sample.arc_estimate = step.arc_estimate;
   sample.observation = step.observation;
   sample.translation_sigma_deg = TargetComparison(localization).translation_sigma_deg;
   sample.target_verified = TargetComparison(localization).num_verified;
