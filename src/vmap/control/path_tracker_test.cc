@@ -130,12 +130,13 @@ cv::Vec3d AfterWrongStart(RoutePoseEstimatorOptions options, int* recoveries) {
 
 TEST(RoutePoseEstimator, RecoversFromAWrongHeadingItWasSureOf) {
   int recoveries = 0;
-  RoutePoseEstimatorOptions never;
-  never.recovery_window = 0;
+  RoutePoseEstimatorOptions never;  // the default
   const cv::Vec3d stuck = AfterWrongStart(never, &recoveries);
   EXPECT_GT(std::abs(stuck[2]), 0.3);
   EXPECT_EQ(recoveries, 0);
-  const cv::Vec3d error = AfterWrongStart(RoutePoseEstimatorOptions{}, &recoveries);
+  RoutePoseEstimatorOptions recovering;
+  recovering.recovery_window = 10;
+  const cv::Vec3d error = AfterWrongStart(recovering, &recoveries);
   EXPECT_GE(recoveries, 1);
   EXPECT_LT(std::abs(error[2]), 0.03);
   EXPECT_LT(std::abs(error[1]), 0.05);

@@ -34,8 +34,9 @@ struct RoutePoseEstimatorOptions {
   // outlier, and the odometry carries the error into the position): its heading uncertainty is widened to
   // `recovery_heading_sigma` so that the next headings pull it back. Only the heading: a position widened as
   // well let wrong bearings (the corridor's end wall filling the view) throw the estimate across the corridor.
-  // recovery_window 0: never.
-  int recovery_window = 10;
+  // recovery_window 0: never, the default: in the simulator it let the end wall's wrong headings in over the last
+  // metres of the straight route (docs/drive.md, "Measured behaviour").
+  int recovery_window = 0;
   int recovery_refused = 8;
   double recovery_heading_sigma = 0.3;
   // A bearing whose correction would move the estimate along the line of sight to the key image by more than this
