@@ -3,6 +3,7 @@
 
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "vmap/core/enum_names.h"
@@ -75,6 +76,10 @@ struct LocalizationResult {
   // The rank of `key` among the key images the frame was compared with, by the evidence of this frame alone
   // (1: the best match; 2: one other key image matched better...). -1 when unknown (nothing compared).
   int key_rank = -1;
+  // The belief over the route after this frame: (key image, mass) for each route position holding at least 1 % of
+  // it (position p at its key image, the start of segment p), in route order; empty when not computed. The
+  // report's plot of the belief over time (report/belief_plot.h) draws it; the JSON lists it, the CSV does not.
+  std::vector<std::pair<int, double>> belief;
 };
 
 // What a controller may use of a result: "heading and translation", "heading only: translation unknown"

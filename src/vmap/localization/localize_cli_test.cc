@@ -191,6 +191,7 @@ TEST(LocalizeCli, ReportOfARun) {
   const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(html.find("id=\"key-plot\""), std::string::npos);
   EXPECT_NE(html.find("id=\"localization-similarity-plot\""), std::string::npos);
+  EXPECT_NE(html.find("id=\"belief-plot\""), std::string::npos) << "the belief over the route over time";
   int pictures = 0;
   for (const auto& entry : fs::directory_iterator(report / "report/frames")) {
     const cv::Mat image = cv::imread(entry.path().string());

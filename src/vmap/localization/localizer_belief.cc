@@ -2,6 +2,7 @@
 // tracked position the belief does not single out is questioned (compared around the belief's peak, and over the
 // whole route when the belief is flat), moved to where the belief puts it, or else uncertain.
 #include <algorithm>
+#include <cmath>
 
 #include "vmap/localization/localizer.h"
 
@@ -12,6 +13,8 @@ namespace {
 // "Near" the chosen key image: within two route positions, the tolerance of the goal "no frame confidently at a
 // key image more than 2 places away" (key images two apart often both see the frame).
 constexpr int kNear = 2;
+// The positions a result records its belief at (LocalizationResult::belief): those holding at least this.
+constexpr double kRecordedMass = 0.01;
 
 }  // namespace
 
@@ -39,11 +42,29 @@ bool Localizer::SinglesOut(int position) const {
 void Localizer::Believe(LocalizationResult& result, const Frame& frame, const ImageFeatures& features) {
   WeighComparisons();
   Question(result, frame, features);
+  const std::vector<double>& p = belief_.probabilities();
+  for (size_t i = 0; i < p.size() && i < route_.size(); ++i) {
+    if (p[i] >= kRecordedMass) result.belief.emplace_back(route_[i], std::round(1000.0 * p[i]) / 1000.0);
+  }
   if (result.route_position < 0) return;
   result.confidence = belief_.MassWithin(result.route_position, kNear);
   const bool placed =
       result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized;
   if (placed && result.confidence < options_.belief.min_confidence) result.status = LocalizationStatus::kUncertain;
+  // An uncertain frame's key images are the best guess: the belief's peak when the belief singles it out and holds
+  // more there than near the tracker's key image (the tracker goes on from its own; nothing steers by this frame).
+  // A flat belief's peak is no better a guess than the tracker's (corridor_conditions, docs/localize.md).
+  const int peak = belief_.Peak();
+  if (options_.belief.window > 0 && result.status == LocalizationStatus::kUncertain && peak != result.route_position &&
+      SinglesOut(peak) && belief_.MassWithin(peak, kNear) > result.confidence) {
+    LocalizationResult guess;
+    guess.candidates = std::move(result.candidates);
+    Describe(guess, peak, features);
+    guess.status = LocalizationStatus::kUncertain;
+    guess.belief = std::move(result.belief);
+    guess.confidence = belief_.MassWithin(peak, kNear);
+    result = std::move(guess);
+  }
 }
 
 void Localizer::Question(LocalizationResult& result, const Frame& frame, const ImageFeatures& features) {
@@ -73,10 +94,10 @@ void Localizer::Question(LocalizationResult& result, const Frame& frame, const I
   }
   const int peak = belief_.Peak();
   if (!doubted() || !SinglesOut(peak)) return;
-  // A frame relocalized elsewhere on a verified key image (the robot may have been carried) keeps that place as
-  // its best guess and is uncertain until the frames after it confirm or refute it; a tracked frame held at a key
-  // image the belief does not support, or a lost one, moves to the belief's peak.
-  if (result.status == LocalizationStatus::kRelocalized) return;
+  // A frame the tracker relocalized elsewhere on a verified key image: one frame does not undo the run before it
+  // (a chance match looks alike), but the robot may have been carried. The tracker goes on from the new place, so
+  // that the frames after it confirm or refute it; the frame is uncertain, its best guess the belief's peak.
+  const bool jumped = result.status == LocalizationStatus::kRelocalized;
   // The run of frames before this one singled out a place, and this frame's evidence leaves it there: the
   // estimate moves there. It is relocalized when a key image there verifies; on weak evidence alone (nothing
   // verifies) its key images are the best guess, not to steer by.
@@ -84,11 +105,12 @@ void Localizer::Question(LocalizationResult& result, const Frame& frame, const I
   moved.candidates = std::move(result.candidates);
   Describe(moved, peak, features);
   const bool verified = moved.to_key.accepted || moved.to_next.accepted;
-  moved.status = verified ? LocalizationStatus::kRelocalized : LocalizationStatus::kUncertain;
+  moved.status = verified && !jumped ? LocalizationStatus::kRelocalized : LocalizationStatus::kUncertain;
+  result = std::move(moved);
+  if (jumped) return;
   position_ = peak;
   step_back_ruled_out_ = {};
   if (verified) lost_in_a_row_ = 0;
-  result = std::move(moved);
 }
 
 }  // namespace vmap

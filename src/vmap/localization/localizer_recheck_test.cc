@@ -79,6 +79,8 @@ TEST(Localizer, AFrameTrackedAtAFarKeyImageOfTheSameSceneIsMovedWhereItVerifiesB
   // against its links); frame 25 still shares more than 0.4 of a link with it, and only the recheck moves it.
   LocalizerOptions refuse = MapLocalizerOptions(m);
   refuse.recheck_link_share = 0.0;
+  // The tracker's own decisions: an uncertain frame's key would be the belief's best guess (the test below).
+  for (LocalizerOptions* o : {&recheck, &hold, &refuse}) o->belief.window = 0;
   for (int jump_to : {41, 57}) {
     const LocalizationResult refused = AfterAJump(refuse, jump_to);
     // Relocalized, and doubted by the belief over the route on this first frame after the jump (the test below).
@@ -102,7 +104,8 @@ TEST(Localizer, AFrameTrackedAtAFarKeyImageOfTheSameSceneIsMovedWhereItVerifiesB
 
 // The belief over the route (route_belief.h): a frame far from where the frames before it were is relocalized, but
 // one frame is not enough to be sure of it (a chance match could look alike): it is uncertain, not to steer by,
-// until the frames that follow confirm the place. Without the belief (min_confidence 0) it is steered by at once.
+// until the frames that follow confirm the place (a single chance match does not hold the robot back). Without the
+// belief (min_confidence 0) it is steered by at once.
 TEST(Localizer, AOneFrameJumpIsUncertainUntilTheFramesThatFollowConfirmIt) {
   const LocalizationMap& m = Dense();
   for (const double min_confidence : {0.5, 0.0}) {
@@ -117,8 +120,13 @@ TEST(Localizer, AOneFrameJumpIsUncertainUntilTheFramesThatFollowConfirmIt) {
       EXPECT_GT(r.confidence, 0.5) << source_index;
     }
     const LocalizationResult jumped = LocalizeImage(localizer, 41, index++);
-    EXPECT_TRUE(Brackets(m.map, 41, jumped.key)) << "at key " << jumped.key;
-    EXPECT_LT(jumped.confidence, 0.5);
+    if (min_confidence > 0) {
+      // Uncertain: its key images are the best guess, where the belief holds the most (still at the start, where
+      // the run of frames was: frame 41 sees the start's far plane too); the tracker goes on from frame 41's place.
+      EXPECT_GT(jumped.confidence, 0.5) << "the belief's mass near its best guess";
+    } else {
+      EXPECT_TRUE(Brackets(m.map, 41, jumped.key)) << "at key " << jumped.key;
+    }
     EXPECT_EQ(jumped.status, min_confidence > 0 ? LocalizationStatus::kUncertain : LocalizationStatus::kRelocalized);
     EXPECT_FALSE(min_confidence > 0 && MaySteerBy(jumped));
     LocalizationResult r;

@@ -15,6 +15,7 @@
 #include "vmap/report/html_page.h"
 #include "vmap/report/html_report.h"
 #include "vmap/report/html_util.h"
+#include "vmap/report/belief_plot.h"
 #include "vmap/report/svg_plot.h"
 
 namespace vmap {
@@ -340,6 +341,14 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
           "localized at (the last one reached on the route): tracking in blue, relocalization in orange, "
           "uncertain frames (the best guess) in grey, lost frames as red crosses.</p>\n"
        << KeyPlot(run, static_cast<int>(map.key_images.size())) << "</section>\n";
+  if (const std::string belief = report::BeliefPlot(run, static_cast<int>(map.key_images.size())); !belief.empty()) {
+    html << "<section id=\"belief\"><h2>The belief over the route</h2>\n<p class=\"note\">Where the localizer "
+            "believed each frame was along the route (each key image holding at least 1 % of the belief, darker "
+            "where it held more), and the key image the frame was placed at (orange). A frame whose key image the "
+            "belief does not hold is uncertain; a band that moves on while frames are lost is the belief carrying "
+            "the estimate along the route.</p>\n"
+         << belief << "</section>\n";
+  }
   html << "<section id=\"similarity\"><h2>Similarity</h2>\n<p class=\"note\">S of each frame against its key image "
           "and against the next one; the estimate moves on when the next key image becomes the better match.</p>\n"
        << SimilarityPlot(run) << "</section>\n";
