@@ -23,8 +23,8 @@ last=()
 [[ -n $frames ]] && last=(--last $((frames - 1)))
 
 for matcher in orb xfeat; do
-  "$new" build "$lab" -q --matcher "$matcher" -o "$dir/lab_$matcher" "${last[@]}"
-  "$new" build "$teach" -q --matcher "$matcher" -o "$dir/corridor_$matcher"
+  "$new" build "$lab" -q --matcher "$matcher" -o "$dir/lab_$matcher" "${last[@]}" >>"$dir/log" 2>&1
+  "$new" build "$teach" -q --matcher "$matcher" -o "$dir/corridor_$matcher" >>"$dir/log" 2>&1
   for which in old new; do
     for set in lab corridor; do
       cp -r "$dir/${set}_$matcher" "$dir/${set}_${matcher}_$which"
