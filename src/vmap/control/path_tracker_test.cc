@@ -215,12 +215,12 @@ TEST(RouteTracking, ARotationTheFeaturesContradictGivesNoHeading) {
   EXPECT_NEAR(without.pose()[2], -0.35, 1e-9);
 }
 
-TEST(RouteTracking, StartsBetweenTheKeyImagesUnsureAlongTheRouteMoreThanAcrossIt) {
+TEST(RouteTracking, StartsAtTheKeyImageUnsureAlongTheRouteMoreThanAcrossIt) {
   RouteTracking tracking(StraightMetricRoute());
   EXPECT_FALSE(tracking.started());
-  tracking.Observe(FrameWithHeadings(0.0, 0.0), 500.0);
+  tracking.Observe(FrameWithHeadings(0.0, 0.0), 500.0);  // at key image 1, progress 0.5 towards 2
   ASSERT_TRUE(tracking.started());
-  EXPECT_NEAR(tracking.pose()[0], 1.5, 1e-9);
+  EXPECT_NEAR(tracking.pose()[0], 1.0, 1e-9);  // the key image's place, not the progress's
   EXPECT_NEAR(tracking.pose()[1], 0.0, 1e-9);
   EXPECT_NEAR(std::sqrt(tracking.covariance()(0, 0)), 1.0, 1e-9);   // one key image spacing along
   EXPECT_NEAR(std::sqrt(tracking.covariance()(1, 1)), 0.35, 1e-9);  // start_lateral_sigma across

@@ -134,7 +134,7 @@ TEST(RouteController, TrackerFollowsTheTaughtPathWhereTheRouteIsMetric) {
   ControllerOptions options = NoRateLimits();
   options.law = ControlLaw::kTracker;
   RouteController controller(route, options);
-  // The first frame places the estimate on the path at the localizer's progress, turned as the heading says:
+  // The first frame places the estimate on the path at the key image, turned as the heading says:
   // the robot points 10 degrees left of the path and turns right.
   ControlStep step = controller.Update(0.0, Tracked(1, 10.0));
   EXPECT_EQ(step.steering, "tracker");
