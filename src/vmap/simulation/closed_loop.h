@@ -6,7 +6,6 @@
 //
 // Docs: docs/drive.md.
 
-#include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>

@@ -1,7 +1,6 @@
 #include "vmap/simulation/teach_run.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include <opencv2/imgproc.hpp>
@@ -40,9 +39,7 @@ RenderedFrameSource::RenderedFrameSource(const CorridorWorld& world, const Camer
 
 std::optional<Frame> RenderedFrameSource::Next() {
   if (next_ >= static_cast<int>(poses_.size())) return std::nullopt;
-  const auto start = std::chrono::steady_clock::now();
   Frame frame = RenderFrame(world_, camera_, poses_[next_], next_, next_ * seconds_per_frame_);
-  render_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ++next_;
   return frame;
 }

@@ -21,7 +21,6 @@ class RenderedFrameSource : public FrameSource {
                       double seconds_per_frame, std::string name);
   std::optional<Frame> Next() override;
   const SequenceInfo& info() const override { return info_; }
-  double render_seconds() const { return render_seconds_; }
 
  private:
   const CorridorWorld& world_;
@@ -30,7 +29,6 @@ class RenderedFrameSource : public FrameSource {
   double seconds_per_frame_;
   SequenceInfo info_;
   int next_ = 0;
-  double render_seconds_ = 0.0;
 };
 
 // One rendered frame as a source delivers it (BGR and grey).
