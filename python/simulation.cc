@@ -22,6 +22,8 @@ py::object SimulateFunction(const py::kwargs& kwargs) {
   KeywordOptions keywords("simulate");
   keywords.Add(options);
   keywords.Parse(kwargs);
+  // Ctrl-C between frames: KeyboardInterrupt, and nothing written.
+  options.after_frame = RaisePendingSignals;
   nlohmann::json record;
   keywords.Run([&] {
     py::gil_scoped_release release;

@@ -5,6 +5,7 @@ import pathlib
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -196,6 +197,26 @@ def test_ctrl_c_interrupts_a_build(tmp_path):
     assert child.returncode == 0 and out.strip() == "interrupted"
     assert not output.exists()
     assert not [p.name for p in tmp_path.iterdir()]  # no temporary left behind either
+
+
+def test_ctrl_c_interrupts_a_simulation(tmp_path):
+    """Ctrl-C during vmap.simulate: KeyboardInterrupt soon (between frames, not at the end of 200 trials), no JSON,
+    and the temporary teach map removed. Procedural textures: no ../shared needed."""
+    route = tmp_path / "route.csv"
+    route.write_text("x,y\n0,0\n3,0\n")
+    output = tmp_path / "run.json"
+    script = (f"import vmap\nprint('started', flush=True)\n"
+              f"try:\n    vmap.simulate(route={str(route)!r}, trials=200, threads=1, camera_width=320, "
+              f"camera_height=240, json={str(output)!r})\n"
+              "except KeyboardInterrupt:\n    print('interrupted', flush=True)\n")
+    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=os.environ)
+    assert child.stdout.readline().strip() == "started"
+    time.sleep(3)
+    child.send_signal(signal.SIGINT)
+    out, _ = child.communicate(timeout=60)
+    assert child.returncode == 0 and out.strip() == "interrupted"
+    assert [p.name for p in tmp_path.iterdir()] == ["route.csv"]
+    assert not list(pathlib.Path(tempfile.gettempdir()).glob(f"*vmap-simulate-map-{child.pid}-*"))
 
 
 def without_timings(value):

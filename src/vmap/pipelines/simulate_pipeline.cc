@@ -72,7 +72,8 @@ void SimulatePipelineOptions::Check() const {
 }
 
 std::unique_ptr<PreparedTrials> PrepareTrials(const SimulationOptions& options, const MatcherOptions& matcher_options,
-                                              const fs::path& map_directory) {
+                                              const fs::path& map_directory,
+                                              const std::function<void()>& after_frame) {
   // 1. Everything that can be refused, before any work.
   options.Check();
   matcher_options.Check();
@@ -103,6 +104,7 @@ std::unique_ptr<PreparedTrials> PrepareTrials(const SimulationOptions& options, 
   build.output = map_directory.string();
   build.matcher = matcher_options;
   build.map.show_progress = false;
+  build.map.after_frame = after_frame;
   RenderedFrameSource frames(*prepared->teach_world, options.camera, teach.poses, teach.seconds_per_frame,
                              build.input);
   RunBuildPipeline(build, &frames);
@@ -127,6 +129,7 @@ std::unique_ptr<PreparedTrials> PrepareTrials(const SimulationOptions& options, 
   context.localizer.route = context.taught.keys;
   context.teach_duration = teach.odometry.back().timestamp;
   context.options = options;
+  context.after_frame = after_frame;
   return prepared;
 }
 
@@ -158,7 +161,7 @@ SimulatePipelineResult RunSimulatePipeline(const SimulatePipelineOptions& option
   AtomicOutputDirectory map_directory(options.map.empty() ? TemporaryMapFolder() : fs::path(options.map), map_policy);
 
   // 3-4. The route, the worlds, the teach run and its map, the trials' context.
-  const std::unique_ptr<PreparedTrials> prepared = PrepareTrials(simulation, options.matcher, map_directory.path());
+  const std::unique_ptr<PreparedTrials> prepared = PrepareTrials(simulation, options.matcher, map_directory.path(), options.after_frame);
   const TrialContext& context = prepared->context;
   SimulatePipelineResult result;
   SimulationResult& run = result.simulation;

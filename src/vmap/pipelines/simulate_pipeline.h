@@ -33,6 +33,9 @@ struct SimulatePipelineOptions {
   std::string map;         // keep the teach run's map in this folder; "" = built in a temporary one, removed
   std::string json;        // the run (options, summary, every trial); "" = none
   std::string report;      // a folder for the HTML report; "" = none
+  // Not an option (no flag, no JSON): called after each rendered frame, of the teach run and of every trial, from
+  // the thread that rendered it. It may throw to stop the run (a host's Ctrl-C); nothing is written then.
+  std::function<void()> after_frame;
 
   // The fields above, each once: the simulation's, the matchers', --map, --json, --report.
   void VisitFields(OptionFieldVisitor& visitor);
@@ -57,9 +60,11 @@ struct PreparedTrials {
 
 // Stages 1-4 of RunSimulatePipeline: checks the options, reads the route and the textures, builds the worlds,
 // teaches the route (RunBuildPipeline into `map_directory`: absent, empty or a vmap map, replaced) and opens the
-// map (a LocalizationSession). Throws InputError (OptionError for an option) before any work.
+// map (a LocalizationSession). Throws InputError (OptionError for an option) before any work. `after_frame`
+// (optional) as SimulatePipelineOptions::after_frame, also kept in the trials' context.
 std::unique_ptr<PreparedTrials> PrepareTrials(const SimulationOptions& options, const MatcherOptions& matcher,
-                                              const std::filesystem::path& map_directory);
+                                              const std::filesystem::path& map_directory,
+                                              const std::function<void()>& after_frame = {});
 
 struct SimulatePipelineResult {
   SimulationResult simulation;

@@ -12,6 +12,7 @@ TrialResult RunTrial(const TrialContext& context, int index) {
   RouteController controller(context.taught, context.options.controller);
   while (run.Continues()) {
     const Frame frame = run.Render();
+    if (context.after_frame) context.after_frame();
     const auto step_start = std::chrono::steady_clock::now();
     const auto features = context.map->matcher->ExtractFrame(frame.gray, frame.color);
     const LocalizationResult localization = localizer.Localize(frame, *features);

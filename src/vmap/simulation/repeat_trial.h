@@ -3,6 +3,7 @@
 // control step renders its camera's frame, localizes it against the map, asks the controller for a command and
 // drives it, until the controller stops at the goal, the robot leaves the corridor, or time runs out.
 
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -74,6 +75,7 @@ struct TrialContext {
   std::vector<Pose2d> key_image_poses;  // where the teach run took each key image
   double teach_duration = 0.0;          // seconds
   SimulationOptions options;
+  std::function<void()> after_frame;  // optional, after each rendered frame; may throw to stop the trial
 };
 
 // Trial `index` (its offsets and noise drawn from options.seed and the index).
