@@ -97,7 +97,7 @@ void Judge(const fs::path& sequence, const LocalizationMap& opened, const Locali
   LocalizeSequenceOptions run;
   run.show_progress = false;
   long coverable = 0, right = 0, wrong = 0, lost_coverable = 0, lost_uncoverable = 0, ranked_near = 0,
-       lost_tracking = 0;
+       lost_tracking = 0, right_steered = 0, wrong_steered = 0, uncertain = 0;
   std::vector<std::pair<int, int>> lost_stretches;  // coverable frames lost, as [first, last] runs
   std::vector<std::string> wrongs;
   const LocalizationSummary summary =
@@ -130,19 +130,25 @@ void Judge(const fs::path& sequence, const LocalizationMap& opened, const Locali
           }
         } else if (key_near(r.key) || key_near(r.next_key)) {
           ++right;
+          right_steered += MaySteerBy(r);
         } else {
           ++wrong;
+          wrong_steered += MaySteerBy(r);
           if (wrongs.size() < 10) {
             wrongs.push_back(std::to_string(frame.source_index) + "->key " + std::to_string(r.key) + " (frame " +
-                             std::to_string(map.key_images[r.key].source_index) + ")");
+                             std::to_string(map.key_images[r.key].source_index) + ", " +
+                             LocalizationStatusName(r.status) + ")");
           }
         }
+        uncertain += r.status == LocalizationStatus::kUncertain;
       });
   std::printf(
       "repeat frames %ld: coverable %ld; localized right %ld, wrong %ld; lost %ld (coverable %ld, not "
       "coverable %ld); tracking %ld, relocalized %ld; %.1f frames/s\n",
       summary.frames, coverable, right, wrong, summary.lost, lost_coverable, lost_uncoverable, summary.tracking,
       summary.relocalized, summary.frames_per_second);
+  std::printf("steered by (tracking or relocalized): right %ld, wrong %ld; uncertain %ld\n", right_steered,
+              wrong_steered, uncertain);
   std::printf(
       "lost though coverable: %ld while tracking (before the estimate is dropped), %ld relocalizing: the "
       "ranking proposed a key image near the frame for %ld (verification refused it), none for %ld\n",

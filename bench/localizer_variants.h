@@ -1,7 +1,8 @@
 #pragma once
 // The localizer settings a localization bench compares side by side (localize_accuracy, localize_repeat):
 // "--acceptance counts,chance" (each rule with the other options at their defaults) or
-// "--variants RULE/RECHECK/SHARE,..." (rule, LocalizerOptions::recheck_link_share, min_link_share).
+// "--variants RULE/RECHECK/SHARE[/RIVAL[/RIVAL_NFA]],..." (rule, LocalizerOptions::recheck_link_share,
+// min_link_share, min_rival_ratio and rival_max_log10_nfa; the defaults when not given).
 
 #include <algorithm>
 #include <stdexcept>
@@ -18,15 +19,20 @@ struct LocalizerVariant {
   AcceptanceRule rule = LocalizerOptions().acceptance;
   double recheck_link_share = LocalizerOptions().recheck_link_share;
   double min_link_share = LocalizerOptions().min_link_share;
+  double min_rival_ratio = LocalizerOptions().min_rival_ratio;
+  double rival_max_log10_nfa = LocalizerOptions().rival_max_log10_nfa;
 
   void ApplyTo(LocalizerOptions& options) const {
     options.acceptance = rule;
     options.recheck_link_share = recheck_link_share;
     options.min_link_share = min_link_share;
+    options.min_rival_ratio = min_rival_ratio;
+    options.rival_max_log10_nfa = rival_max_log10_nfa;
   }
   std::string Name() const {
-    return fmt::format("acceptance {}, recheck_link_share {:g}, min_link_share {:g}", AcceptanceRuleName(rule),
-                       recheck_link_share, min_link_share);
+    return fmt::format(
+        "acceptance {}, recheck_link_share {:g}, min_link_share {:g}, min_rival_ratio {:g}, rival_max_log10_nfa {:g}",
+        AcceptanceRuleName(rule), recheck_link_share, min_link_share, min_rival_ratio, rival_max_log10_nfa);
   }
 };
 
@@ -52,13 +58,18 @@ inline std::vector<LocalizerVariant> ParseAcceptanceVariants(const std::string& 
   return variants;
 }
 
-// "counts/0/0,chance/0.5/0.25".
+// "counts/0/0,chance/0.5/0.25,chance/0.5/0.4/0".
 inline std::vector<LocalizerVariant> ParseLocalizerVariants(const std::string& list) {
   std::vector<LocalizerVariant> variants;
   for (const std::string& item : SplitList(list, ',')) {
     const std::vector<std::string> fields = SplitList(item, '/');
-    if (fields.size() != 3) throw std::runtime_error("--variants: " + item + " is not RULE/RECHECK/SHARE");
-    variants.push_back({ParseAcceptanceRule(fields[0]), std::stod(fields[1]), std::stod(fields[2])});
+    if (fields.size() < 3 || fields.size() > 5) {
+      throw std::runtime_error("--variants: " + item + " is not RULE/RECHECK/SHARE[/RIVAL[/RIVAL_NFA]]");
+    }
+    LocalizerVariant v{ParseAcceptanceRule(fields[0]), std::stod(fields[1]), std::stod(fields[2])};
+    if (fields.size() >= 4) v.min_rival_ratio = std::stod(fields[3]);
+    if (fields.size() == 5) v.rival_max_log10_nfa = std::stod(fields[4]);
+    variants.push_back(v);
   }
   return variants;
 }

@@ -254,6 +254,8 @@ std::vector<int> Localizer::CompareBestRanked(const Frame& frame, const ImageFea
 LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures& features) {
   LocalizationResult result;
   const std::vector<int> positions = CompareBestRanked(frame, features);
+  // Across seasons the link share refuses every key image: the frame's own rivals decide then.
+  const int standout = AcceptAgainstRivals(features);
   KeyComparison best;
   int best_position = -1;
   for (size_t i = 0; i < positions.size(); ++i) {
@@ -265,6 +267,10 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
       best = c;
       best_position = position;
     }
+  }
+  if (best_position < 0 && standout >= 0) {
+    best_position = standout;
+    best = CompareOnce(features, route_[standout]);
   }
   if (best_position < 0) {
     result.status = LocalizationStatus::kLost;
@@ -286,6 +292,12 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
       const double after_share = SharedWithLink(after, route_[position], route_[position + 1]);
       if (before_share > 0 && after_share > 0 ? before_share > after_share : IsBetterMatch(before, after))
         position -= 1;
+    } else if (standout >= 0 && before.matched) {
+      // Accepted against its rivals: its neighbours are refused by the link share as it was; the one that shares the
+      // larger part of its link with the key image is on the frame's side.
+      const double after_share =
+          has_next && after.matched ? SharedWithLink(after, route_[position], route_[position + 1]) : 0.0;
+      if (SharedWithLink(before, route_[position - 1], route_[position]) > after_share) position -= 1;
     }
   }
   position_ = position;

@@ -96,11 +96,21 @@ class Localizer {
   // rank order; returns the ranking's route positions compared.
   std::vector<int> CompareBestRanked(const Frame& frame, const ImageFeatures& features);
 
+  // When no comparison of the frame is accepted: accepts the one with the most verified matches if it stands out
+  // against its rivals, those compared more than kNear route positions away (LocalizerOptions::min_rival_ratio;
+  // compares the best-ranked one when none was, so the route must have been ranked for the frame). Returns its
+  // route position, -1 when none is accepted.
+  int AcceptAgainstRivals(const ImageFeatures& features);
+
   // The frame's verified matches with key_a over those of the map's link between key_a and key_b (0 when
   // they have no link).
   double SharedWithLink(const KeyComparison& comparison, int key_a, int key_b) const;
   // A tracked comparison shares less with its key image than the map's links do (recheck_link_share).
   bool SharesLittle(const KeyComparison& comparison) const;
+
+  // "Near" a route position: within two (key images two apart often both see the frame); the tolerance of the
+  // goal "no frame confidently at a key image more than 2 places away".
+  static constexpr int kNear = 2;
 
   const VisualMap& map_;
   const KeyImageStore& keys_;

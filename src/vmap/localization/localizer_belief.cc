@@ -10,9 +10,6 @@ namespace vmap {
 
 namespace {
 
-// "Near" the chosen key image: within two route positions, the tolerance of the goal "no frame confidently at a
-// key image more than 2 places away" (key images two apart often both see the frame).
-constexpr int kNear = 2;
 // The positions a result records its belief at (LocalizationResult::belief): those holding at least this.
 constexpr double kRecordedMass = 0.01;
 

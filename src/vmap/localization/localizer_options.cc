@@ -25,6 +25,14 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "--acceptance chance: verified matches a frame also needs, as a fraction of those of the key "
                  "image's link with its route neighbour (0: chance alone)"},
                 min_link_share);
+  visitor.Visit({"min_rival_ratio", "--min-rival-ratio",
+                 "--acceptance chance: when no key image passes --min-link-share, accept the one that verifies this "
+                 "many times the matches of every key image compared more than two route positions away (0: never)"},
+                min_rival_ratio);
+  visitor.Visit({"rival_max_log10_nfa", "--rival-max-log10-nfa",
+                 "--acceptance chance: the log10 number of false alarms a key image accepted against its rivals "
+                 "(--min-rival-ratio) needs at most"},
+                rival_max_log10_nfa);
   visitor.Visit({"recheck_link_share", "--recheck-link-share",
                  "Relocalize a tracked frame with fewer verified matches than this fraction of its key image's "
                  "link, and move it where more verify (0: never)"},
@@ -72,6 +80,14 @@ void LocalizerOptions::Check() const {
   if (!(min_link_share >= 0.0 && min_link_share <= 10.0)) {
     throw OptionError("min_link_share", fmt::format("{} is outside [0, 10] (default {}; 0: chance alone decides)",
                                                     min_link_share, defaults.min_link_share));
+  }
+  if (!(min_rival_ratio == 0.0 || (min_rival_ratio >= 1.0 && min_rival_ratio <= 1000.0))) {
+    throw OptionError("min_rival_ratio", fmt::format("{} is not 0 (never) nor in [1, 1000] (default {})",
+                                                     min_rival_ratio, defaults.min_rival_ratio));
+  }
+  if (!(rival_max_log10_nfa >= -1000.0 && rival_max_log10_nfa <= 0.0)) {
+    throw OptionError("rival_max_log10_nfa", fmt::format("{} is outside [-1000, 0] (default {})", rival_max_log10_nfa,
+                                                         defaults.rival_max_log10_nfa));
   }
   if (lookahead < 1 || lookahead > 2) {
     throw OptionError("lookahead", fmt::format("{} is not 1 or 2 (default {})", lookahead, defaults.lookahead));

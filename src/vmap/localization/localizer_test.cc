@@ -216,7 +216,7 @@ TEST(Localizer, AFrameThatShowsLittleOfTheSceneIsStillLocalizedByItsChance) {
   LocalizerOptions chance = MapLocalizerOptions(m);
   ASSERT_EQ(chance.acceptance, AcceptanceRule::kChance) << "the default";
   chance.min_link_share = 0.0;  // chance alone: the test is about its rule
-  chance.belief.window = 0;      // frames placed by the acceptance rule, not by the belief's best guess
+  chance.belief.window = 0;     // frames placed by the acceptance rule, not by the belief's best guess
   LocalizerOptions counts = chance;
   counts.acceptance = AcceptanceRule::kCounts;
   const std::vector<LocalizationResult> by_chance = LocalizeAll(chance, MostlyHidden(0.35), DriveIndices(1, 2));
@@ -412,6 +412,8 @@ TEST(Localizer, OptionsAreChecked) {
   EXPECT_EQ(path([](LocalizerOptions& o) { o.max_log10_nfa = std::nan(""); }), "max_log10_nfa");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.recheck_link_share = -0.1; }), "recheck_link_share");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.min_link_share = std::nan(""); }), "min_link_share");
+  EXPECT_EQ(path([](LocalizerOptions& o) { o.min_rival_ratio = 0.5; }), "min_rival_ratio");
+  EXPECT_EQ(path([](LocalizerOptions& o) { o.rival_max_log10_nfa = 1.0; }), "rival_max_log10_nfa");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.lookahead = 3; }), "lookahead");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.max_lost_frames = -1; }), "max_lost_frames");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.relocalization_candidates = 0; }), "relocalization_candidates");
