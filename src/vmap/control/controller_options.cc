@@ -54,6 +54,10 @@ void ControllerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"goal_scale_tolerance", "--goal-scale-tolerance",
                  "Goal reached when the scene is at most this much smaller than in the goal key image (0.02 = 2 %)"},
                 goal_scale_tolerance);
+  visitor.Visit({"goal_scale_share", "--goal-scale-share",
+                 "... and when at most this share of the growth of the goal's scene over the last stretch remains "
+                 "(measured in the map; the stricter of the two; 0: the tolerance alone)"},
+                goal_scale_share);
   visitor.Visit({"goal_speed_share", "--goal-speed-share", "Speed on the last stretch, as a share of the cruise speed"},
                 goal_speed_share);
   visitor.Visit({"focal_px", "--focal-px", "Focal length in pixels for maps without a camera (0 = the map's)"},
@@ -94,6 +98,7 @@ void ControllerOptions::Check() const {
   CheckRange("search_angle_deg", search_angle_deg, 0.0, 180.0, "deg", d.search_angle_deg, true);
   CheckRange("search_turn_rate", search_turn_rate, 0.0, 20.0, "rad/s", d.search_turn_rate, true);
   CheckRange("goal_scale_tolerance", goal_scale_tolerance, 0.0, 0.5, "", d.goal_scale_tolerance, true);
+  CheckRange("goal_scale_share", goal_scale_share, 0.0, 1.0, "", d.goal_scale_share);
   CheckRange("goal_speed_share", goal_speed_share, 0.0, 1.0, "", d.goal_speed_share, true);
   CheckRange("focal_px", focal_px, 0.0, 1e6, "px", d.focal_px);
 }

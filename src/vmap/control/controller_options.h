@@ -65,6 +65,12 @@ struct ControllerOptions {
   // The goal is reached when the frame shows the goal key image's scene at least this close to the size it has
   // in the goal key image (relative: 0.02 = 2 % smaller), or larger (passed).
   double goal_scale_tolerance = 0.02;
+  // ... and, where the map tells how much the goal's scene grows over the route's last stretch (its link's
+  // apparent scale change, TaughtSegment::log_scale), when at most this share of that growth remains: the
+  // stricter of the two. 2 % is metres short of the goal where the scene is deep (a long corridor ahead grows
+  // little as the robot approaches); a share of the last stretch's growth is a share of its length whatever the
+  // depth. 0: the tolerance alone.
+  double goal_scale_share = 0.1;
   // Speed on the last stretch, as a share of the cruise speed: a smaller overshoot when the goal is seen late.
   double goal_speed_share = 0.5;
   // Converts pixel headings to angles when the map has no camera (its focal length in pixels); 0: the map's

@@ -6,6 +6,7 @@
 
 #include "vmap/control/guidance_signals.h"
 #include "vmap/core/error.h"
+#include "vmap/core/numeric.h"
 
 namespace vmap {
 
@@ -38,6 +39,7 @@ void RouteController::Reset() {
   lost_speed_ = 0.0;
   unusable_since_.reset();
   line_angle_.reset();
+  goal_log_scales_.clear();
   if (tracking_) tracking_->Reset();
   swept_ = 0.0;
   search_direction_ = 1.0;
@@ -83,6 +85,14 @@ double RouteController::RemainingTurn(int position, double progress) const {
   const double turn = route_.segments[position].yaw_change;
   if (!std::isfinite(turn)) return 0.0;
   return turn * (1.0 - (std::isfinite(progress) ? std::clamp(progress, 0.0, 1.0) : 0.0));
+}
+
+double RouteController::GoalLogScaleThreshold() const {
+  const double tolerance = std::log1p(-options_.goal_scale_tolerance);
+  // The last stretch's growth, where the map measured it: a share of it is a share of the stretch's length.
+  const double growth = route_.segments.back().log_scale;
+  if (!(growth < 0.0) || options_.goal_scale_share <= 0.0) return tolerance;
+  return std::max(tolerance, options_.goal_scale_share * growth);
 }
 
 VelocityCommand RouteController::Limit(VelocityCommand wanted, double dt) const {
@@ -167,8 +177,16 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
     }
     if (position == last) {
       step.goal_log_scale = ApparentLogScale(localization.to_key.verified);
+      // The median of the goal's last three scales: one frame's stray scale does not stop the robot (on the loop
+      // a frame 0.36 m short measured -0.001 between two of -0.02).
+      constexpr size_t kGoalFrames = 3;
+      if (localization.to_key.accepted && std::isfinite(step.goal_log_scale)) {
+        goal_log_scales_.push_back(step.goal_log_scale);
+        if (goal_log_scales_.size() > kGoalFrames) goal_log_scales_.pop_front();
+      }
       if (localization.to_key.accepted && std::isfinite(step.goal_log_scale) &&
-          step.goal_log_scale >= std::log1p(-options_.goal_scale_tolerance)) {
+          goal_log_scales_.size() == kGoalFrames &&
+          Median(std::vector<double>(goal_log_scales_.begin(), goal_log_scales_.end())) >= GoalLogScaleThreshold()) {
         reached_goal_ = true;
         step.steering = "none";
         return finish({}, ControllerState::kReachedGoal);

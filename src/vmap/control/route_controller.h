@@ -21,8 +21,10 @@
 // - search (starting or lost, steering "search"): standing search_after_seconds without a usable frame, the robot
 //   sweeps its heading search_angle_deg either way until a frame localizes.
 // - reached goal: at the route's end, once the goal key image's scene appears as large as in the key image
-//   (ApparentLogScale within goal_scale_tolerance): the robot stops and stays stopped until Reset.
+//   (ApparentLogScale within goal_scale_tolerance, and within goal_scale_share of how much it grows over the
+//   last stretch where the map tells): the robot stops and stays stopped until Reset.
 
+#include <deque>
 #include <limits>
 #include <optional>
 #include <string>
@@ -99,6 +101,8 @@ class RouteController {
   // share of it still ahead (1 - progress); 0 at the goal or where the turn is unknown.
   double RemainingTurn(int position, double progress) const;
   VelocityCommand Limit(VelocityCommand wanted, double dt) const;
+  // The goal's apparent log scale at and above which the goal is reached (goal_scale_tolerance, goal_scale_share).
+  double GoalLogScaleThreshold() const;
   // How far beyond the end of the metric path `pose` is, along its last stretch (m; negative before it).
   double PastTheEnd(const cv::Vec3d& pose) const;
 
@@ -124,6 +128,8 @@ class RouteController {
   double line_angle_time_ = 0.0;
   double swept_ = 0.0;
   double search_direction_ = 1.0;
+  // The goal key image's apparent log scale in the last (up to three) frames localized at it.
+  std::deque<double> goal_log_scales_;
 };
 
 }  // namespace vmap

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "vmap/control/guidance_signals.h"
 #include "vmap/core/error.h"
 
 namespace vmap {
@@ -84,6 +85,13 @@ TaughtRoute MakeTaughtRoute(const VisualMap& map, std::vector<int> keys,
       segment.yaw_change = sign * turn;
     }
     if (std::isnan(segment.yaw_change) && link->has_pose) segment.yaw_change = sign * YawOfCameraRotation(link->R);
+    // The link's verified matches, from_key's point first (a link stored the other way round is read swapped).
+    const int verified = std::clamp(link->num_verified, 0, static_cast<int>(link->correspondences.size()));
+    std::vector<Correspondence> matches(link->correspondences.begin(), link->correspondences.begin() + verified);
+    if (link->from_key != a) {
+      for (Correspondence& match : matches) std::swap(match.p0, match.p1);
+    }
+    segment.log_scale = ApparentLogScale(matches);
     route.segments.push_back(segment);
   }
   route.keys = std::move(keys);

@@ -26,6 +26,11 @@ struct TaughtSegment {
   // from above (radians, REP 103's yaw): from the teach odometry, else from the link's relative pose; NaN when
   // neither is known.
   double yaw_change = std::numeric_limits<double>::quiet_NaN();
+  // How much larger to_key's scene appears in to_key than from from_key: the link's ApparentLogScale
+  // (guidance_signals.h) with from_key as the frame, negative when the route drives towards the scene. How
+  // much the scene grows over the stretch: a deep scene (a long corridor ahead) grows little. NaN when the link's
+  // verified matches do not tell.
+  double log_scale = std::numeric_limits<double>::quiet_NaN();
 
   double speed() const { return length / duration; }  // m/s; NaN unless both are known
 };

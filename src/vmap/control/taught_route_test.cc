@@ -57,6 +57,25 @@ TEST(TaughtRoute, DurationsFromTimestampsAndTurnsFromLinkPoses) {
   EXPECT_EQ(route.PositionOf(7), -1);
 }
 
+TEST(TaughtRoute, TheLinksMatchesTellHowMuchTheNextScenesGrows) {
+  VisualMap map = TurningMap();
+  // Link 2 (key images 2 -> 3): key image 3 sees key image 2's points 10 % larger; 60 verified, then 5 rejected
+  // matches that say otherwise.
+  Link& link = map.links[2];
+  for (int i = 0; i < 65; ++i) {
+    const cv::Point2f at2(40.f + 9.f * i, 60.f + static_cast<float>((i * 37) % 360));
+    const cv::Point2f at3 = i < 60 ? cv::Point2f(320, 240) + 1.1f * (at2 - cv::Point2f(320, 240)) : at2 * 3.f;
+    link.correspondences.push_back({at2, at3});
+  }
+  link.num_verified = 60;
+  const TaughtRoute route = MakeTaughtRoute(map);
+  EXPECT_NEAR(route.segments[2].log_scale, std::log(1.0 / 1.1), 1e-4);
+  EXPECT_TRUE(std::isnan(route.segments[0].log_scale));  // no matches
+  // Backwards (3 -> 2) the scene shrinks: the link is read the other way round.
+  const TaughtRoute back = MakeTaughtRoute(map, {3, 2});
+  EXPECT_NEAR(back.segments[0].log_scale, std::log(1.1), 1e-4);
+}
+
 TEST(TaughtRoute, BackwardsTheTurnIsUndone) {
   const TaughtRoute route = MakeTaughtRoute(TurningMap(), {3, 2, 1});
   ASSERT_EQ(route.segments.size(), 2u);

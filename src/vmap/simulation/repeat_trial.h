@@ -36,6 +36,8 @@ struct TrialSample {
   TrackingObservation observation;     // what the frame gave the tracker's estimate
   double translation_sigma_deg = 0.0;  // of the target's pose (KeyComparison; NaN without one)
   int target_verified = 0;             // verified matches with the target key image
+  // How large key's scene appears in the frame against the key image (ApparentLogScale; NaN where unknown).
+  double key_log_scale = std::numeric_limits<double>::quiet_NaN();
   // The truth of the same, from the target key image's pose in the teach run (NaN without a target).
   double true_bearing = std::numeric_limits<double>::quiet_NaN();
   double true_line_angle = std::numeric_limits<double>::quiet_NaN();

@@ -105,7 +105,8 @@ nlohmann::json SimulationJson(const SimulationResult& result, const SimulationOp
                              "heading_error_estimate",
                              "headings_taken",
                              "unassociated",
-                             "arc_estimate"}) {
+                             "arc_estimate",
+                             "key_log_scale"}) {
       columns[name] = nlohmann::json::array();
     }
     for (const TrialSample& sample : trial.samples) {
@@ -135,6 +136,7 @@ nlohmann::json SimulationJson(const SimulationResult& result, const SimulationOp
       columns["headings_taken"].push_back(sample.observation.headings);
       columns["unassociated"].push_back(sample.observation.unassociated);
       columns["arc_estimate"].push_back(Number(sample.arc_estimate));
+      columns["key_log_scale"].push_back(Number(sample.key_log_scale, 1e-4));
     }
     t["samples"] = columns;
     trials.push_back(t);

@@ -131,6 +131,7 @@ void TrialRun::Record(const LocalizationResult& localization, const ControlStep&
   sample.observation = step.observation;
   sample.translation_sigma_deg = TargetComparison(localization).translation_sigma_deg;
   sample.target_verified = TargetComparison(localization).num_verified;
+  sample.key_log_scale = ApparentLogScale(localization.to_key.verified);
   if (step.target_key >= 0 && step.target_key < static_cast<int>(context_.key_image_poses.size())) {
     // The servo's angles as they truly are: alpha, the bearing of the key image's position from the robot's
     // heading, and beta, the key image's heading minus that bearing's direction.
