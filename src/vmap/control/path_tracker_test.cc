@@ -226,6 +226,45 @@ TEST(RouteTracking, StartsAtTheKeyImageUnsureAlongTheRouteMoreThanAcrossIt) {
   EXPECT_NEAR(std::sqrt(tracking.covariance()(1, 1)), 0.35, 1e-9);  // start_lateral_sigma across
 }
 
+// A robot drives 18 m around a circle of radius 3 m (the simulator's loop) with the odometry 5 % too long; the
+// key images, every metre of the circle, are seen ahead (a bearing every third frame) and the heading every frame.
+// Returns the estimate's position error at the end; `scale` gets the estimated odometry scale.
+double PositionErrorAroundACircle(RoutePoseEstimatorOptions options, double* scale) {
+  constexpr double kRadius = 3.0, kStep = 0.03;
+  RoutePoseEstimator estimator(options);
+  cv::Vec3d truth(0.0, -kRadius, 0.0);  // on the circle about the origin, driving counter-clockwise
+  estimator.Initialize(truth, {0.1, 0.1, 0.02});
+  for (int step = 0; step < 600; ++step) {
+    const double turn = kStep / kRadius;
+    const double middle = truth[2] + 0.5 * turn;
+    truth[0] += kStep * std::cos(middle);
+    truth[1] += kStep * std::sin(middle);
+    truth[2] += turn;
+    estimator.Predict(kStep * 1.05, turn);
+    estimator.UpdateHeading(truth[2], 0.02);
+    if (step % 3 == 0) {
+      // The next key image at least 0.5 m ahead along the circle.
+      const double angle = std::ceil((truth[2] + 0.5 / kRadius) / (1.0 / kRadius)) * (1.0 / kRadius);
+      const cv::Point2d landmark(kRadius * std::sin(angle), -kRadius * std::cos(angle));
+      estimator.UpdateBearing(landmark, std::atan2(landmark.y - truth[1], landmark.x - truth[0]) - truth[2]);
+    }
+  }
+  *scale = estimator.odometry_scale();
+  return std::hypot(estimator.pose()[0] - truth[0], estimator.pose()[1] - truth[1]);
+}
+
+TEST(RoutePoseEstimator, LearnsTheOdometrysScaleErrorAndStaysWithTheRobot) {
+  double scale = 0.0;
+  RoutePoseEstimatorOptions fixed;
+  fixed.odometry_scale_sigma = 0.0;  // the scale taken as 1: the estimate runs ahead
+  const double fixed_error = PositionErrorAroundACircle(fixed, &scale);
+  EXPECT_EQ(scale, 1.0);
+  const double error = PositionErrorAroundACircle(RoutePoseEstimatorOptions{}, &scale);
+  EXPECT_NEAR(scale, 1.0 / 1.05, 0.01);
+  EXPECT_GT(fixed_error, 0.08);  // 0.12 m measured: about what the simulator's loop showed across the path
+  EXPECT_LT(error, 0.2 * fixed_error);
+}
+
 TEST(RoutePoseEstimator, NothingIsMeasuredBeforeItStarts) {
   RoutePoseEstimator estimator;
   EXPECT_FALSE(estimator.initialized());

@@ -12,9 +12,12 @@ void RoutePoseEstimator::Initialize(const cv::Vec3d& pose, const cv::Vec3d& sigm
 }
 
 void RoutePoseEstimator::InitializeWithCovariance(const cv::Vec3d& pose, const cv::Matx33d& covariance) {
-  pose_ = pose;
-  pose_[2] = WrapAngle(pose_[2]);
-  covariance_ = covariance;
+  state_ = {pose[0], pose[1], WrapAngle(pose[2]), 1.0};
+  covariance_ = cv::Matx44d::zeros();
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) covariance_(i, j) = covariance(i, j);
+  }
+  covariance_(3, 3) = options_.odometry_scale_sigma * options_.odometry_scale_sigma;
   initialized_ = true;
   outcomes_.clear();
   recoveries_ = 0;
@@ -22,14 +25,19 @@ void RoutePoseEstimator::InitializeWithCovariance(const cv::Vec3d& pose, const c
 
 void RoutePoseEstimator::Predict(double distance, double turn) {
   if (!initialized_) return;
-  const double middle = pose_[2] + 0.5 * turn;
+  const double scale = state_[3];
+  const double middle = state_[2] + 0.5 * turn;
   const double c = std::cos(middle), s = std::sin(middle);
-  pose_[0] += distance * c;
-  pose_[1] += distance * s;
-  pose_[2] = WrapAngle(pose_[2] + turn);
-  const cv::Matx33d F(1, 0, -distance * s, 0, 1, distance * c, 0, 0, 1);
+  const double driven = scale * distance;
+  state_[0] += driven * c;
+  state_[1] += driven * s;
+  state_[2] = WrapAngle(state_[2] + turn);
+  const cv::Matx44d F(1, 0, -driven * s, distance * c,  //
+                      0, 1, driven * c, distance * s,   //
+                      0, 0, 1, 0,                       //
+                      0, 0, 0, 1);
   // Noise of the distance and the turn, mapped into the pose (G), and a heading slip growing with the distance.
-  const cv::Matx32d G(c, -0.5 * distance * s, s, 0.5 * distance * c, 0, 1);
+  const cv::Matx<double, 4, 2> G(scale * c, -0.5 * driven * s, scale * s, 0.5 * driven * c, 0, 1, 0, 0);
   const double sd = options_.distance_noise * std::abs(distance) + 1e-4;
   const double st = options_.turn_noise * std::abs(turn) + options_.heading_noise_per_metre * std::abs(distance) + 1e-4;
   const cv::Matx22d noise(sd * sd, 0, 0, st * st);
@@ -37,6 +45,10 @@ void RoutePoseEstimator::Predict(double distance, double turn) {
   const double slip = options_.position_noise_per_metre * std::abs(distance);
   covariance_(0, 0) += slip * slip;
   covariance_(1, 1) += slip * slip;
+  if (options_.odometry_scale_sigma > 0.0) {
+    const double drift = options_.odometry_scale_drift_per_metre * std::abs(distance);
+    covariance_(3, 3) += drift * drift;
+  }
 }
 
 void RoutePoseEstimator::RememberHeading(bool refused) {
@@ -50,36 +62,36 @@ void RoutePoseEstimator::RememberHeading(bool refused) {
   ++recoveries_;
 }
 
-bool RoutePoseEstimator::Update(const cv::Matx13d& H, double residual, double r, double max_step,
+bool RoutePoseEstimator::Update(const cv::Matx14d& H, double residual, double r, double max_step,
                                 const cv::Vec2d& max_step_direction) {
   const double innovation_variance = (H * covariance_ * H.t())(0, 0) + r;
   if (residual * residual > options_.gate * options_.gate * innovation_variance) {
     return false;
   }
-  const cv::Matx31d K = covariance_ * H.t() * (1.0 / innovation_variance);
+  const cv::Matx41d K = covariance_ * H.t() * (1.0 / innovation_variance);
   if (std::abs(K(0, 0) * residual * max_step_direction[0] + K(1, 0) * residual * max_step_direction[1]) > max_step)
     return false;
-  for (int i = 0; i < 3; ++i) pose_[i] += K(i, 0) * residual;
-  pose_[2] = WrapAngle(pose_[2]);
-  covariance_ = (cv::Matx33d::eye() - K * H) * covariance_;
+  for (int i = 0; i < 4; ++i) state_[i] += K(i, 0) * residual;
+  state_[2] = WrapAngle(state_[2]);
+  covariance_ = (cv::Matx44d::eye() - K * H) * covariance_;
   covariance_ = 0.5 * (covariance_ + covariance_.t());
   return true;
 }
 
 bool RoutePoseEstimator::UpdateHeading(double yaw, double sigma) {
   if (!initialized_) return false;
-  const bool taken = Update(cv::Matx13d(0, 0, 1), WrapAngle(yaw - pose_[2]), sigma * sigma);
+  const bool taken = Update(cv::Matx14d(0, 0, 1, 0), WrapAngle(yaw - state_[2]), sigma * sigma);
   RememberHeading(!taken);
   return taken;
 }
 
 bool RoutePoseEstimator::UpdateBearing(const cv::Point2d& landmark, double bearing) {
   if (!initialized_) return false;
-  const double dx = landmark.x - pose_[0], dy = landmark.y - pose_[1];
+  const double dx = landmark.x - state_[0], dy = landmark.y - state_[1];
   const double range_squared = dx * dx + dy * dy;
   if (range_squared < 0.01) return false;  // a landmark under the robot gives no bearing
-  const double predicted = WrapAngle(std::atan2(dy, dx) - pose_[2]);
-  const cv::Matx13d H(dy / range_squared, -dx / range_squared, -1.0);
+  const double predicted = WrapAngle(std::atan2(dy, dx) - state_[2]);
+  const cv::Matx14d H(dy / range_squared, -dx / range_squared, -1.0, 0.0);
   const double range = std::sqrt(range_squared);
   return Update(H, WrapAngle(bearing - predicted), options_.bearing_sigma * options_.bearing_sigma,
                 options_.max_bearing_step_share * range, cv::Vec2d(dx / range, dy / range));

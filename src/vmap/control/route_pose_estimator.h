@@ -54,6 +54,13 @@ struct RoutePoseEstimatorOptions {
   // heading is biased by the parallax of a sideways offset: taken instead, it pulled the estimate to the wrong
   // side of the path).
   double rotation_agreement = 0.15;
+  // The odometry's scale (true distance / measured distance) is estimated with the pose: it starts at 1, unsure
+  // by `odometry_scale_sigma`, and may drift by `odometry_scale_drift_per_metre` per metre driven. A wheel a little
+  // larger than its nominal size makes every distance too long; with the scale fixed at 1 the estimate runs ahead
+  // of the robot, and in a bend the path-following law then turns early (a loop driven with the odometry 5 % too
+  // long ended 0.1-0.2 m inside the path). 0: the scale stays 1.
+  double odometry_scale_sigma = 0.05;
+  double odometry_scale_drift_per_metre = 0.002;
 };
 
 class RoutePoseEstimator {
@@ -61,13 +68,13 @@ class RoutePoseEstimator {
   explicit RoutePoseEstimator(RoutePoseEstimatorOptions options = {}) : options_(options) {}
 
   bool initialized() const { return initialized_; }
-  // Starts at (x, y, yaw) with these standard deviations (metres, metres, radians).
+  // Starts at (x, y, yaw) with these standard deviations (metres, metres, radians), the odometry's scale at 1.
   void Initialize(const cv::Vec3d& pose, const cv::Vec3d& sigma);
   // The same with a full covariance (x, y, yaw).
   void InitializeWithCovariance(const cv::Vec3d& pose, const cv::Matx33d& covariance);
   void Reset() { initialized_ = false; }
 
-  // The robot drove `distance` metres (negative: backwards) while turning by `turn` radians.
+  // The odometry says the robot drove `distance` metres (negative: backwards) while turning by `turn` radians.
   void Predict(double distance, double turn);
   // Measurements; each returns whether it was taken (false: refused by the gate, or not initialized).
   bool UpdateHeading(double yaw, double sigma);
@@ -75,14 +82,15 @@ class RoutePoseEstimator {
   // How many times the estimate's uncertainty was widened since it started (RoutePoseEstimatorOptions: recovery).
   int recoveries() const { return recoveries_; }
 
-  const cv::Vec3d& pose() const { return pose_; }  // x, y, yaw
-  const cv::Matx33d& covariance() const { return covariance_; }
+  cv::Vec3d pose() const { return {state_[0], state_[1], state_[2]}; }  // x, y, yaw
+  cv::Matx33d covariance() const { return covariance_.get_minor<3, 3>(0, 0); }  // of the pose
+  double odometry_scale() const { return state_[3]; }  // true distance / odometry's distance
 
  private:
-  // One scalar measurement with Jacobian H and innovation `residual`, variance r.
+  // One scalar measurement with Jacobian H (of x, y, yaw, scale) and innovation `residual`, variance r.
   // `max_step`: a correction moving the position farther than this (m) along the unit `max_step_direction` is
   // not taken (and not counted as refused).
-  bool Update(const cv::Matx13d& H, double residual, double r,
+  bool Update(const cv::Matx14d& H, double residual, double r,
               double max_step = std::numeric_limits<double>::infinity(), const cv::Vec2d& max_step_direction = {1, 0});
   // Records whether a heading was refused; widens the heading's uncertainty when too many of the last ones were.
   void RememberHeading(bool refused);
@@ -91,8 +99,8 @@ class RoutePoseEstimator {
   bool initialized_ = false;
   std::deque<bool> outcomes_;  // the last recovery_window headings: true where refused
   int recoveries_ = 0;
-  cv::Vec3d pose_;
-  cv::Matx33d covariance_ = cv::Matx33d::eye();
+  cv::Vec4d state_;  // x, y, yaw, odometry scale
+  cv::Matx44d covariance_ = cv::Matx44d::eye();
 };
 
 }  // namespace vmap

@@ -36,8 +36,9 @@ class RouteTracking {
   bool started() const { return estimator_.initialized(); }
   // Where the estimate is on the taught path (near where it was last: a loop passes a place twice).
   PathLocation Locate();
-  const cv::Vec3d& pose() const { return estimator_.pose(); }
-  const cv::Matx33d& covariance() const { return estimator_.covariance(); }
+  cv::Vec3d pose() const { return estimator_.pose(); }
+  cv::Matx33d covariance() const { return estimator_.covariance(); }
+  double odometry_scale() const { return estimator_.odometry_scale(); }
   double path_length() const { return path_.length(); }
   void Reset();
 
