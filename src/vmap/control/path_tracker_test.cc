@@ -265,6 +265,23 @@ TEST(RoutePoseEstimator, LearnsTheOdometrysScaleErrorAndStaysWithTheRobot) {
   EXPECT_LT(error, 0.2 * fixed_error);
 }
 
+TEST(RoutePoseEstimator, TheOdometrysScaleStaysWithinThreeStandardDeviations) {
+  // Bearings that say the robot drives a third of what its odometry says (wrong ones, or a broken odometry):
+  // the scale follows them only down to 1 - 3 sigma.
+  RoutePoseEstimator estimator;
+  cv::Vec3d truth(0.0, 0.0, 0.0);
+  estimator.Initialize(truth, {0.05, 0.05, 0.01});
+  const cv::Point2d landmark(5.0, 1.0);
+  for (int step = 0; step < 100; ++step) {
+    truth[0] += 0.01;
+    estimator.Predict(0.03, 0.0);
+    estimator.UpdateHeading(0.0, 0.02);
+    estimator.UpdateBearing(landmark, std::atan2(landmark.y - truth[1], landmark.x - truth[0]));
+  }
+  const double sigma = RoutePoseEstimatorOptions{}.odometry_scale_sigma;
+  EXPECT_NEAR(estimator.odometry_scale(), 1.0 - 3.0 * sigma, 1e-9);
+}
+
 TEST(RoutePoseEstimator, NothingIsMeasuredBeforeItStarts) {
   RoutePoseEstimator estimator;
   EXPECT_FALSE(estimator.initialized());

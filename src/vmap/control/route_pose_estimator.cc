@@ -73,6 +73,10 @@ bool RoutePoseEstimator::Update(const cv::Matx14d& H, double residual, double r,
     return false;
   for (int i = 0; i < 4; ++i) state_[i] += K(i, 0) * residual;
   state_[2] = WrapAngle(state_[2]);
+  // A scale beyond three of its standard deviations is not an odometry's but wrong bearings' (taken while the
+  // estimate was unsure, they put it at 0.5 in an s-curve repeat, and the estimate fell metres behind the robot).
+  const double scale_bound = 3.0 * options_.odometry_scale_sigma;
+  state_[3] = std::clamp(state_[3], 1.0 - scale_bound, 1.0 + scale_bound);
   covariance_ = (cv::Matx44d::eye() - K * H) * covariance_;
   covariance_ = 0.5 * (covariance_ + covariance_.t());
   return true;
