@@ -70,8 +70,12 @@ void LocalizationSessionOptions::CheckGiven(const std::vector<std::string>& give
       }
     }
   }
-  if (localizer.acceptance != AcceptanceRule::kChance && was_given("min_link_share")) {
-    throw OptionError("min_link_share", "belongs to acceptance chance; give that, or leave it out", {"acceptance"});
+  if (localizer.acceptance != AcceptanceRule::kChance) {
+    for (const char* path : {"min_link_share", "min_rival_ratio", "rival_max_log10_nfa"}) {
+      if (was_given(path)) {
+        throw OptionError(path, "belongs to acceptance chance; give that, or leave it out", {"acceptance"});
+      }
+    }
   }
 }
 

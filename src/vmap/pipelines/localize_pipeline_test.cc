@@ -83,10 +83,12 @@ TEST(LocalizePipeline, GivenOptionsTheAcceptanceRuleIgnoresAreRefused) {
   LocalizationSessionOptions options;
   EXPECT_EQ(testing::OptionErrorPath([&] { options.CheckGiven({"min_verified"}); }), "min_verified");
   EXPECT_EQ(testing::OptionErrorPath([&] { options.CheckGiven({"first", "min_similarity"}); }), "min_similarity");
-  options.CheckGiven({"min_link_share", "max_log10_nfa"});
+  options.CheckGiven({"min_link_share", "max_log10_nfa", "min_rival_ratio", "rival_max_log10_nfa"});
   options.localizer.acceptance = AcceptanceRule::kCounts;
   options.CheckGiven({"min_verified", "min_similarity"});
   EXPECT_EQ(testing::OptionErrorPath([&] { options.CheckGiven({"min_link_share"}); }), "min_link_share");
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.CheckGiven({"min_rival_ratio"}); }), "min_rival_ratio");
+  EXPECT_EQ(testing::OptionErrorPath([&] { options.CheckGiven({"rival_max_log10_nfa"}); }), "rival_max_log10_nfa");
 }
 
 // An output that would overwrite the map is refused by its field before the map is read.
