@@ -18,9 +18,9 @@
 namespace vmap {
 namespace {
 
-constexpr uint8_t kMagic[8] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
-constexpr uint8_t kOpFooter = 0x02, kOpSchema = 0x03, kOpChannel = 0x04, kOpMessage = 0x05, kOpChunk = 0x06,
-                  kOpDataEnd = 0x0F;
+constexpr uint8_t kMcapMagic[8] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
+constexpr uint8_t kMcapFooter = 0x02, kMcapSchema = 0x03, kMcapChannel = 0x04, kMcapMessage = 0x05, kMcapChunk = 0x06,
+                  kMcapDataEnd = 0x0F;
 
 struct Channel {
   std::string topic;
@@ -74,7 +74,7 @@ class McapReader : public RecordingReader {
     uint8_t magic[8] = {};
     if (file_.size() < 8) file_.Damaged(0, "it is not an MCAP file (too short)");
     file_.Read(0, 8, magic, "the magic bytes");
-    if (!std::equal(magic, magic + 8, kMagic)) {
+    if (!std::equal(magic, magic + 8, kMcapMagic)) {
       throw InputError("'" + path + "' is not an MCAP file of version 0 (its magic bytes differ)");
     }
     Rewind();
@@ -118,7 +118,7 @@ class McapReader : public RecordingReader {
       if (file_.size() < 8 + kFooterSize + 8) return false;
       const uint64_t footer_offset = file_.size() - 8 - kFooterSize;
       file_.Read(footer_offset, kFooterSize, &record_, "the footer");
-      if (record_[0] != kOpFooter) return false;
+      if (record_[0] != kMcapFooter) return false;
       uint64_t position = LoadU64(record_.data() + 9);
       if (position == 0 || position >= footer_offset) return false;
       std::map<uint16_t, Channel> channels;
@@ -134,10 +134,10 @@ class McapReader : public RecordingReader {
         file_.Read(position + 9, length, &record_, "a summary record");
         position += 9 + length;
         Fields fields(record_.data(), record_.size());
-        if (head[0] == kOpSchema) {
+        if (head[0] == kMcapSchema) {
           uint16_t id = 0;
           if (!fields.U16(&id) || !fields.String(&schemas[id])) return false;
-        } else if (head[0] == kOpChannel) {
+        } else if (head[0] == kMcapChannel) {
           uint16_t id = 0;
           Channel channel;
           if (!fields.U16(&id) || !fields.U16(&channel.schema) || !fields.String(&channel.topic)) return false;
@@ -237,18 +237,18 @@ class McapReader : public RecordingReader {
       }
       position_ = offset + 9 + length;
       const uint8_t op = head[0];
-      if (op == kOpDataEnd || op == kOpFooter) {
+      if (op == kMcapDataEnd || op == kMcapFooter) {
         ended_ = true;  // the summary that follows repeats the schemas and channels
         continue;
       }
-      if (op != kOpSchema && op != kOpChannel && op != kOpMessage && op != kOpChunk) continue;
-      if (length > (op == kOpChunk ? limits_.max_chunk_bytes : limits_.max_message_bytes)) {
+      if (op != kMcapSchema && op != kMcapChannel && op != kMcapMessage && op != kMcapChunk) continue;
+      if (length > (op == kMcapChunk ? limits_.max_chunk_bytes : limits_.max_message_bytes)) {
         file_.OverLimit(offset, "a record of " + std::to_string(length) +
                                     " bytes, more than one of the largest frames "
                                     "needs");
       }
       file_.Read(offset + 9, length, &record_, "a record");
-      if (op == kOpChunk) {
+      if (op == kMcapChunk) {
         ReadChunk(offset);
         continue;
       }
@@ -297,14 +297,14 @@ class McapReader : public RecordingReader {
   bool Handle(uint8_t op, const uint8_t* data, uint64_t size, uint64_t offset, const std::set<std::string>* topics,
               RecordedMessage* message) {
     Fields fields(data, size);
-    if (op == kOpSchema) {
+    if (op == kMcapSchema) {
       uint16_t id = 0;
       std::string name;
       if (!fields.U16(&id) || !fields.String(&name)) file_.Damaged(offset, "a schema record is cut off");
       schemas_[id] = name;
       return false;
     }
-    if (op == kOpChannel) {
+    if (op == kMcapChannel) {
       uint16_t id = 0;
       Channel channel;
       if (!fields.U16(&id) || !fields.U16(&channel.schema) || !fields.String(&channel.topic) ||
@@ -314,7 +314,7 @@ class McapReader : public RecordingReader {
       channels_[id] = channel;
       return false;
     }
-    if (op != kOpMessage) return false;
+    if (op != kMcapMessage) return false;
     uint16_t id = 0;
     uint32_t sequence = 0;
     uint64_t log_time = 0, publish_time = 0;
