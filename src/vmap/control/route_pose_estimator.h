@@ -59,7 +59,7 @@ struct RoutePoseEstimatorOptions {
   // larger than its nominal size makes every distance too long; with the scale fixed at 1 the estimate runs ahead
   // of the robot, and in a bend the path-following law then turns early (a loop driven with the odometry 5 % too
   // long ended 0.1-0.2 m inside the path). 0: the scale stays 1.
-  double odometry_scale_sigma = 0.05;
+  double odometry_scale_sigma = 0.03;
   double odometry_scale_drift_per_metre = 0.002;
 };
 
