@@ -180,12 +180,12 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
       // The median of the goal's last three scales: one frame's stray scale does not stop the robot (on the loop
       // a frame 0.36 m short measured -0.001 between two of -0.02).
       constexpr size_t kGoalFrames = 3;
-      if (localization.to_key.accepted && std::isfinite(step.goal_log_scale)) {
+      const bool measured = localization.to_key.accepted && std::isfinite(step.goal_log_scale);
+      if (measured) {
         goal_log_scales_.push_back(step.goal_log_scale);
         if (goal_log_scales_.size() > kGoalFrames) goal_log_scales_.pop_front();
       }
-      if (localization.to_key.accepted && std::isfinite(step.goal_log_scale) &&
-          goal_log_scales_.size() == kGoalFrames &&
+      if (measured && goal_log_scales_.size() == kGoalFrames &&
           Median(std::vector<double>(goal_log_scales_.begin(), goal_log_scales_.end())) >= GoalLogScaleThreshold()) {
         reached_goal_ = true;
         step.steering = "none";

@@ -161,7 +161,8 @@ SimulatePipelineResult RunSimulatePipeline(const SimulatePipelineOptions& option
   AtomicOutputDirectory map_directory(options.map.empty() ? TemporaryMapFolder() : fs::path(options.map), map_policy);
 
   // 3-4. The route, the worlds, the teach run and its map, the trials' context.
-  const std::unique_ptr<PreparedTrials> prepared = PrepareTrials(simulation, options.matcher, map_directory.path(), options.after_frame);
+  const std::unique_ptr<PreparedTrials> prepared =
+      PrepareTrials(simulation, options.matcher, map_directory.path(), options.after_frame);
   const TrialContext& context = prepared->context;
   SimulatePipelineResult result;
   SimulationResult& run = result.simulation;

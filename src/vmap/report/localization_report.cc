@@ -12,10 +12,10 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/map/map_io.h"
+#include "vmap/report/belief_plot.h"
 #include "vmap/report/html_page.h"
 #include "vmap/report/html_report.h"
 #include "vmap/report/html_util.h"
-#include "vmap/report/belief_plot.h"
 #include "vmap/report/svg_plot.h"
 
 namespace vmap {
