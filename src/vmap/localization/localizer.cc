@@ -146,7 +146,9 @@ void Localizer::Describe(LocalizationResult& result, int position, const ImageFe
 LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& features) {
   LocalizationResult result;
   const int last = static_cast<int>(route_.size()) - 1;
-  auto compare_at = [&](int position) { return CompareOnce(features, route_[position]); };
+  // Across seasons the link share refuses the tracked key images too: each is judged against the frame's own rivals
+  // then (a rival or two compared, where a relocalization would compare the ranking's five and their neighbours).
+  auto compare_at = [&](int position) { return CompareTracked(frame, features, position); };
   const int position = position_;
   const KeyComparison at_key = compare_at(position);
   KeyComparison best = at_key;
@@ -205,7 +207,7 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     }
     return result;
   }
-  if (SharesLittle(best)) {
+  if (!AcceptedAgainstRivals(best) && SharesLittle(best)) {
     // Accepted, but with much less than neighbouring key images share: the frame may be elsewhere on the
     // route, in view of this key image's scene. Moved when a ranked key image verifies more matches (a
     // relocalization that is not taken leaves nothing behind: the tracked estimate is set below).
@@ -238,10 +240,7 @@ bool Localizer::SharesLittle(const KeyComparison& comparison) const {
 }
 
 std::vector<int> Localizer::CompareBestRanked(const Frame& frame, const ImageFeatures& features) {
-  const cv::Mat thumbnail = ranking_->method() == RankingMethod::kThumbnails && ranked_.empty()
-                                ? ThumbnailDescriptor(frame.gray, options_.ranking.thumbnail_width)
-                                : cv::Mat();
-  if (ranked_.empty()) ranked_ = ranking_->Rank(features, thumbnail);  // once per frame
+  RankRoute(frame, features);
   const int count = std::min<int>(options_.relocalization_candidates, static_cast<int>(ranked_.size()));
   std::vector<int> positions;
   for (int i = 0; i < count; ++i) {
@@ -255,7 +254,7 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
   LocalizationResult result;
   const std::vector<int> positions = CompareBestRanked(frame, features);
   // Across seasons the link share refuses every key image: the frame's own rivals decide then.
-  const int standout = AcceptAgainstRivals(features);
+  const int standout = AcceptAgainstRivals(frame, features);
   KeyComparison best;
   int best_position = -1;
   for (size_t i = 0; i < positions.size(); ++i) {

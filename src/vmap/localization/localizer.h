@@ -96,11 +96,29 @@ class Localizer {
   // rank order; returns the ranking's route positions compared.
   std::vector<int> CompareBestRanked(const Frame& frame, const ImageFeatures& features);
 
+  // The route's key images ranked for the frame (KeyImageRanking), best first; ranked once per frame.
+  const std::vector<RankedKey>& RankRoute(const Frame& frame, const ImageFeatures& features);
   // When no comparison of the frame is accepted: accepts the one with the most verified matches if it stands out
-  // against its rivals, those compared more than kNear route positions away (LocalizerOptions::min_rival_ratio;
-  // compares the best-ranked one when none was, so the route must have been ranked for the frame). Returns its
-  // route position, -1 when none is accepted.
-  int AcceptAgainstRivals(const ImageFeatures& features);
+  // against its rivals, those compared more than kNear route positions away, the best-ranked of them always among
+  // them (LocalizerOptions::min_rival_ratio; compared now when it was not). Returns its route position, -1 when none
+  // is accepted.
+  int AcceptAgainstRivals(const Frame& frame, const ImageFeatures& features);
+
+  // A tracked comparison: CompareOnce, and when only the link share refuses it, judged against the frame's rivals
+  // as a relocalized one is (AcceptAgainstRivals), on its own: at least min_rival_ratio times the verified matches of
+  // every key image compared more than kNear route positions from it, the best-ranked such one among them (compared
+  // now when it was not). Accepted so, it stays accepted for the rest of the frame.
+  KeyComparison CompareTracked(const Frame& frame, const ImageFeatures& features, int position);
+  // Accepted against the frame's rivals: accepted, though with fewer verified matches than the link share asks.
+  bool AcceptedAgainstRivals(const KeyComparison& comparison) const;
+
+  // The most verified matches of a key image compared with the frame more than kNear route positions from
+  // `position`, the best-ranked such key image compared first when it was not; -1: none (a route too short).
+  int RivalVerified(const Frame& frame, const ImageFeatures& features, int position);
+  // The comparison may be accepted against the frame's rivals (kChance, min_rival_ratio > 0, matched and its log10
+  // NFA at most rival_max_log10_nfa), and does stand out when it verifies min_rival_ratio times its rivals' best.
+  bool MayStandOut(const KeyComparison& comparison) const;
+  bool StandsOut(int verified, int rival_verified) const;
 
   // The frame's verified matches with key_a over those of the map's link between key_a and key_b (0 when
   // they have no link).
@@ -141,7 +159,7 @@ class Localizer {
     bool weighed = false;  // its evidence is in the belief
   };
   std::vector<Memo> comparisons_;  // of the frame being localized
-  std::vector<RankedKey> ranked_;  // the last ranking of the route (CompareBestRanked)
+  std::vector<RankedKey> ranked_;  // the route ranked for the frame being localized (RankRoute); empty: not yet
 };
 
 }  // namespace vmap

@@ -213,6 +213,29 @@ TEST(Localizer, AKeyImageThatStandsOutAgainstTheFramesRivalsIsAcceptedWhenTheLin
   }
 }
 
+// Across seasons a tracked frame is refused by the link share as a relocalized one is: it is judged against its
+// rivals before it is relocalized (the best-ranked key image more than two route positions away compared), and stays
+// tracked when its key image stands out, instead of paying for a relocalization every frame.
+TEST(Localizer, ATrackedKeyImageThatStandsOutAgainstTheFramesRivalsKeepsTrackingWhenTheLinkShareRefusesAll) {
+  const LocalizationMap& m = Dense();
+  LocalizerOptions options = MapLocalizerOptions(m);
+  options.min_link_share = 10.0;
+  options.min_rival_ratio = 1.2;  // the synthetic drive's rivals verify 60-80 % of the right key image's matches
+  options.belief.window = 0;      // the acceptance alone
+  options.belief.min_confidence = 0.0;
+  Localizer localizer(m.map, m.keys, *m.matcher, options);
+  ::vmap::testing::MemorySource source(DriveFrames(1, 2), DriveIndices(1, 2));
+  LocalizeSequenceOptions run;
+  run.show_progress = false;
+  int bracketed = 0;
+  const LocalizationSummary summary = LocalizeSequence(
+      source, *m.matcher, localizer, run,
+      [&](const Frame&, const LocalizationResult& r) { bracketed += Brackets(m.map, r.source_index, r.key); });
+  EXPECT_EQ(summary.relocalized, 1) << "the first frame only";
+  EXPECT_EQ(summary.tracking, 29);
+  EXPECT_EQ(bracketed, 30);
+}
+
 TEST(Localizer, AFrameThatSharesAsMuchAsTheMapsLinksIsNotRelocalized) {
   // The check costs a relocalization only where tracking is doubtful: along the drive none is.
   const LocalizationMap& m = Dense();

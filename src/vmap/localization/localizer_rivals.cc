@@ -9,8 +9,64 @@
 
 namespace vmap {
 
-int Localizer::AcceptAgainstRivals(const ImageFeatures& features) {
-  if (options_.acceptance != AcceptanceRule::kChance || options_.min_rival_ratio <= 0.0) return -1;
+const std::vector<RankedKey>& Localizer::RankRoute(const Frame& frame, const ImageFeatures& features) {
+  if (ranked_.empty()) {
+    const cv::Mat thumbnail = ranking_->method() == RankingMethod::kThumbnails
+                                  ? ThumbnailDescriptor(frame.gray, options_.ranking.thumbnail_width)
+                                  : cv::Mat();
+    ranked_ = ranking_->Rank(features, thumbnail);
+  }
+  return ranked_;
+}
+
+int Localizer::RivalVerified(const Frame& frame, const ImageFeatures& features, int position) {
+  // The best-ranked key image more than kNear away is always a rival: the likeliest other place, as the frame's
+  // descriptors tell (a relocalization has compared it already; a tracked frame compares it now, one comparison where
+  // a relocalization makes five).
+  for (const RankedKey& r : RankRoute(frame, features)) {
+    if (std::abs(r.key - position) > kNear) {
+      CompareOnce(features, route_[r.key]);  // the ranking holds the route's key images in route order
+      break;
+    }
+  }
+  int rival_verified = -1;
+  for (const Memo& m : comparisons_) {
+    const int q = route_position_of_key_[m.comparison.key];
+    if (m.used && q >= 0 && std::abs(q - position) > kNear) {
+      rival_verified = std::max(rival_verified, m.comparison.num_verified);
+    }
+  }
+  return rival_verified;
+}
+
+bool Localizer::MayStandOut(const KeyComparison& comparison) const {
+  return options_.acceptance == AcceptanceRule::kChance && options_.min_rival_ratio > 0.0 && comparison.matched &&
+         comparison.log10_nfa <= options_.rival_max_log10_nfa;
+}
+
+bool Localizer::StandsOut(int verified, int rival_verified) const {
+  // No rival: a route too short to hold one (5 key images, the frame in the middle): the frame cannot tell.
+  return rival_verified >= 0 && verified >= options_.min_rival_ratio * rival_verified;
+}
+
+KeyComparison Localizer::CompareTracked(const Frame& frame, const ImageFeatures& features, int position) {
+  const int key = route_[position];
+  KeyComparison c = CompareOnce(features, key);
+  if (c.accepted || !MayStandOut(c)) return c;
+  if (!StandsOut(c.num_verified, RivalVerified(frame, features, position))) return c;
+  for (Memo& m : comparisons_) {
+    if (m.comparison.key == key) m.comparison.accepted = true;
+  }
+  c.accepted = true;
+  return c;
+}
+
+bool Localizer::AcceptedAgainstRivals(const KeyComparison& comparison) const {
+  return comparison.accepted && options_.acceptance == AcceptanceRule::kChance &&
+         comparison.num_verified < options_.min_link_share * link_verified_[comparison.key];
+}
+
+int Localizer::AcceptAgainstRivals(const Frame& frame, const ImageFeatures& features) {
   auto position_of = [&](const Memo& m) { return route_position_of_key_[m.comparison.key]; };
   int best = -1;  // index in comparisons_ (CompareOnce below may grow it)
   for (size_t i = 0; i < comparisons_.size(); ++i) {
@@ -20,28 +76,9 @@ int Localizer::AcceptAgainstRivals(const ImageFeatures& features) {
     if (best < 0 || m.comparison.num_verified > comparisons_[best].comparison.num_verified) best = static_cast<int>(i);
   }
   if (best < 0) return -1;
-  const KeyComparison& standout = comparisons_[best].comparison;
-  if (!standout.matched || standout.log10_nfa > options_.rival_max_log10_nfa) return -1;
-  const int position = position_of(comparisons_[best]);
-  const int verified = standout.num_verified;
-  // The rivals: key images more than kNear route positions away (nearer ones often see the frame too).
-  int rival_verified = -1;
-  for (const Memo& m : comparisons_) {
-    const int q = position_of(m);
-    if (m.used && q >= 0 && std::abs(q - position) > kNear)
-      rival_verified = std::max(rival_verified, m.comparison.num_verified);
-  }
-  if (rival_verified < 0) {
-    // None compared yet (the ranking put every candidate near it): the best-ranked key image far enough away.
-    for (const RankedKey& r : ranked_) {
-      if (std::abs(r.key - position) > kNear) {
-        rival_verified = CompareOnce(features, route_[r.key]).num_verified;
-        break;
-      }
-    }
-    if (rival_verified < 0) return -1;  // a route too short to hold a rival: the frame cannot tell
-  }
-  if (verified < options_.min_rival_ratio * rival_verified) return -1;
+  if (!MayStandOut(comparisons_[best].comparison)) return -1;
+  const int position = route_position_of_key_[comparisons_[best].comparison.key];
+  if (!StandsOut(comparisons_[best].comparison.num_verified, RivalVerified(frame, features, position))) return -1;
   comparisons_[best].comparison.accepted = true;
   return position;
 }

@@ -37,8 +37,8 @@ void RouteBeliefOptions::Check() const {
   }
   if (!(jump > 0.0)) throw OptionError("jump", "must be above 0: a belief that cannot jump can be stuck for ever");
   if (window < 0 || window > 50) {
-    throw OptionError("window", fmt::format("{} is outside [0, 50] (default 2; 0: the belief never moves the estimate)",
-                                            window));
+    throw OptionError("window",
+                      fmt::format("{} is outside [0, 50] (default 2; 0: the belief never moves the estimate)", window));
   }
   if (!(min_confidence >= 0.0 && min_confidence <= 1.0)) {
     throw OptionError("min_confidence",

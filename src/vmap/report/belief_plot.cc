@@ -9,8 +9,8 @@
 namespace vmap::report {
 
 std::string BeliefPlot(const LocalizationRun& run, int num_keys) {
-  const bool recorded = std::any_of(run.frames.begin(), run.frames.end(),
-                                    [](const LocalizationResult& r) { return !r.belief.empty(); });
+  const bool recorded =
+      std::any_of(run.frames.begin(), run.frames.end(), [](const LocalizationResult& r) { return !r.belief.empty(); });
   if (!recorded) return {};
   SvgPlot plot("belief-plot", "frame index", "key image");
   plot.SetIntegerX(true);
@@ -31,10 +31,10 @@ std::string BeliefPlot(const LocalizationRun& run, int num_keys) {
     for (const auto& [k, m] : r.belief) {
       // One segment per marker: each carries its own opacity.
       mass.segments.push_back({cv::Point2d(r.frame_index, k)});
-      mass.segment_attributes.push_back(fmt::format("fill-opacity=\"{:.3f}\" data-mass=\"{:.3f}\"",
-                                                    std::clamp(0.1 + 0.9 * m, 0.0, 1.0), m));
-      mass.point_titles.push_back(fmt::format("frame {}: {:.0f} % of the belief at key image {}", r.frame_index,
-                                              100.0 * m, k));
+      mass.segment_attributes.push_back(
+          fmt::format("fill-opacity=\"{:.3f}\" data-mass=\"{:.3f}\"", std::clamp(0.1 + 0.9 * m, 0.0, 1.0), m));
+      mass.point_titles.push_back(
+          fmt::format("frame {}: {:.0f} % of the belief at key image {}", r.frame_index, 100.0 * m, k));
     }
     if (r.key >= 0) key.segments[0].emplace_back(r.frame_index, r.key);
   }

@@ -46,7 +46,8 @@ TEST(BeliefPlot, DrawsEachFramesBeliefAtItsKeyImagesWithItsMass) {
   EXPECT_NE(svg.find("belief-key"), std::string::npos);
   int keys_drawn = 0;
   for (const cv::Point2d& p : report_test::CircleCentres(svg, "fill=\"#e07b00\"", axes)) {
-    keys_drawn += (std::abs(p.x - 0) < 0.05 && std::abs(p.y - 2) < 0.05) || (std::abs(p.x - 1) < 0.05 && std::abs(p.y - 3) < 0.05);
+    keys_drawn += (std::abs(p.x - 0) < 0.05 && std::abs(p.y - 2) < 0.05) ||
+                  (std::abs(p.x - 1) < 0.05 && std::abs(p.y - 3) < 0.05);
   }
   EXPECT_EQ(keys_drawn, 2);
 }
