@@ -26,8 +26,9 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "image's link with its route neighbour (0: chance alone)"},
                 min_link_share);
   visitor.Visit({"min_rival_ratio", "--min-rival-ratio",
-                 "--acceptance chance: when no key image passes --min-link-share, accept the one that verifies this "
-                 "many times the matches of every key image compared more than two route positions away (0: never)"},
+                 "--acceptance chance: a key image refused by --min-link-share alone is accepted when it verifies "
+                 "this many times the matches of every key image compared more than two route positions away (the "
+                 "tracked ones each, else the best of a relocalization's; 0: never)"},
                 min_rival_ratio);
   visitor.Visit({"rival_max_log10_nfa", "--rival-max-log10-nfa",
                  "--acceptance chance: the log10 number of false alarms a key image accepted against its rivals "

@@ -37,10 +37,11 @@ struct LocalizerOptions {
   double min_similarity = 0.3;
   // Across seasons the link share refuses the right key image: the map's links are of one season, and a frame of
   // another verifies a fraction of their matches there (michigan textures in the simulator: 0.17-0.33 of them, at
-  // log10 NFA -390 to -1015). When no comparison of a frame is accepted, the one with the most verified matches is
-  // accepted against the frame's own rivals instead: when its log10 NFA is at most `rival_max_log10_nfa` and it
-  // verifies at least `min_rival_ratio` times as many matches as every key image compared with the frame more than
-  // two route positions away (the best-ranked such key image is compared when none was). A frame at a place the
+  // log10 NFA -390 to -1015). A comparison refused by the link share alone is then judged against the frame's own
+  // rivals: accepted when its log10 NFA is at most `rival_max_log10_nfa` and it verifies at least `min_rival_ratio`
+  // times as many matches as every key image compared with the frame more than two route positions from it (the
+  // best-ranked such key image always among them: compared when it was not). Tracking judges each tracked key image
+  // so; a relocalization that accepts none judges the one with the most verified matches. A frame at a place the
   // map does not hold has no key image standing out so far above the others. 0: never (kChance only; how the
   // defaults were measured: docs/localize.md, "Acceptance against the frame's rivals").
   double min_rival_ratio = 2.0;
