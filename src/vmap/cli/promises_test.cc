@@ -27,7 +27,6 @@
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"
 
-
 namespace vmap {
 namespace fs = std::filesystem;
 using testing::Quote;

@@ -265,7 +265,7 @@ TEST(RouteController, WhereTheGoalsSceneIsDeepTheGoalWaitsForMostOfItsGrowth) {
     return controller.Update(time + 0.2, at_goal).state;
   };
   EXPECT_EQ(state_after_three(controller, 0.985, 0.0), ControllerState::kFollowing);  // 1.5 %: within 2 %, but a
-                                                                                     // fifth of the growth remains
+                                                                                      // fifth of the growth remains
   EXPECT_EQ(state_after_three(controller, 0.995, 1.0), ControllerState::kReachedGoal);
   // A shallow scene (the last stretch's growth 30 %): the 2 % tolerance is the stricter, as without the link's.
   route.segments.back().log_scale = std::log(0.7);

@@ -72,8 +72,7 @@ void SimulatePipelineOptions::Check() const {
 }
 
 std::unique_ptr<PreparedTrials> PrepareTrials(const SimulationOptions& options, const MatcherOptions& matcher_options,
-                                              const fs::path& map_directory,
-                                              const std::function<void()>& after_frame) {
+                                              const fs::path& map_directory, const std::function<void()>& after_frame) {
   // 1. Everything that can be refused, before any work.
   options.Check();
   matcher_options.Check();
@@ -105,8 +104,7 @@ std::unique_ptr<PreparedTrials> PrepareTrials(const SimulationOptions& options, 
   build.matcher = matcher_options;
   build.map.show_progress = false;
   build.map.after_frame = after_frame;
-  RenderedFrameSource frames(*prepared->teach_world, options.camera, teach.poses, teach.seconds_per_frame,
-                             build.input);
+  RenderedFrameSource frames(*prepared->teach_world, options.camera, teach.poses, teach.seconds_per_frame, build.input);
   RunBuildPipeline(build, &frames);
   prepared->teach_frames = static_cast<int>(teach.poses.size());
   prepared->teach_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -5,7 +5,6 @@
 
 #include <opencv2/imgproc.hpp>
 
-
 namespace vmap {
 
 Camera RigCamera(const CameraRigOptions& camera) {
