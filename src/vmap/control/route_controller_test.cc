@@ -289,6 +289,33 @@ TEST(RouteController, OneStrayScaleAtTheGoalDoesNotStopTheRobot) {
   }
 }
 
+// Across seasons the localizer placed nearly every frame of the last stretch at the key image before the goal,
+// never at the goal, and the robot drove 0.3-0.5 m past it: the goal's scene is judged against the goal as the
+// next key image too, where the frame verifies enough matches with it.
+TEST(RouteController, AFrameStillBeforeTheGoalStopsWhereTheGoalLooksAsLarge) {
+  auto state_after_three = [](double zoom, int verified) {
+    RouteController controller(StraightRoute(), NoRateLimits());
+    LocalizationResult before_goal = Tracked(2, 0.0);  // next_key 3, the goal
+    before_goal.to_next.matched = true;
+    before_goal.to_next.verified = Zoomed(zoom);
+    before_goal.to_next.verified.resize(verified);
+    before_goal.to_next.num_verified = verified;
+    ControlStep step;
+    for (int i = 0; i < 3; ++i) step = controller.Update(0.1 * i, before_goal);
+    return step.state;
+  };
+  EXPECT_EQ(state_after_three(0.99, 60), ControllerState::kReachedGoal);
+  EXPECT_EQ(state_after_three(0.9, 60), ControllerState::kFollowing);  // still 10 % smaller
+  EXPECT_EQ(state_after_three(0.99, 10), ControllerState::kFollowing);  // too few matches to judge by
+  // Two stretches before the goal: not judged.
+  RouteController controller(StraightRoute(), NoRateLimits());
+  LocalizationResult earlier = Tracked(1, 0.0);
+  earlier.to_next.matched = true;
+  earlier.to_next.verified = Zoomed(1.0);
+  earlier.to_next.num_verified = 60;
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(controller.Update(0.1 * i, earlier).state, ControllerState::kFollowing);
+}
+
 TEST(RouteController, KeyImagesOffTheRouteAreNotSteeredBy) {
   TaughtRoute route = StraightRoute();
   RouteController controller(route, NoRateLimits());

@@ -89,7 +89,7 @@ bool RoutePoseEstimator::UpdateHeading(double yaw, double sigma) {
   return taken;
 }
 
-bool RoutePoseEstimator::UpdateBearing(const cv::Point2d& landmark, double bearing) {
+bool RoutePoseEstimator::UpdateBearing(const cv::Point2d& landmark, double bearing, double sigma) {
   if (!initialized_) return false;
   const double dx = landmark.x - state_[0], dy = landmark.y - state_[1];
   const double range_squared = dx * dx + dy * dy;
@@ -97,7 +97,8 @@ bool RoutePoseEstimator::UpdateBearing(const cv::Point2d& landmark, double beari
   const double predicted = WrapAngle(std::atan2(dy, dx) - state_[2]);
   const cv::Matx14d H(dy / range_squared, -dx / range_squared, -1.0, 0.0);
   const double range = std::sqrt(range_squared);
-  return Update(H, WrapAngle(bearing - predicted), options_.bearing_sigma * options_.bearing_sigma,
+  if (!std::isfinite(sigma)) sigma = options_.bearing_sigma;
+  return Update(H, WrapAngle(bearing - predicted), sigma * sigma,
                 options_.max_bearing_step_share * range, cv::Vec2d(dx / range, dy / range));
 }
 

@@ -46,7 +46,10 @@ TrackingObservation RouteTracking::Observe(const LocalizationResult& result, dou
   const bool rotation = std::isfinite(rotation_offset);
   const double offset = rotation ? rotation_offset : features;
   if (!std::isfinite(offset)) return seen;
-  const double heading_sigma = rotation ? options_.heading_sigma : options_.feature_heading_sigma;
+  // The comparison's own evidence of how alike the appearance is: its verified matches against the link's.
+  const bool weak = Weak(TargetComparison(result), target_position);
+  const double heading_sigma = rotation ? (weak ? options_.weak_heading_sigma : options_.heading_sigma)
+                                        : std::max(options_.feature_heading_sigma, weak ? options_.weak_heading_sigma : 0.0);
   if (!estimator_.initialized()) {
     // At the key image the localizer names, uncertain along the route by a stretch (a relocalization may be off
     // by a key image), across it by where a robot may start; the bearings that follow pull it in. Not at the
@@ -78,10 +81,20 @@ TrackingObservation RouteTracking::Observe(const LocalizationResult& result, dou
   (estimator_.UpdateHeading(target.yaw + offset, heading_sigma) ? seen.headings : seen.refused) += 1;
   if (result.translation_known && ahead > 0.0) {
     const TargetBearing bearing = BearingToKey(pose);
-    if (bearing.valid)
-      (estimator_.UpdateBearing({target.x, target.y}, bearing.bearing) ? seen.bearings : seen.refused) += 1;
+    if (bearing.valid) {
+      const double sigma = weak ? options_.weak_bearing_sigma : options_.bearing_sigma;
+      (estimator_.UpdateBearing({target.x, target.y}, bearing.bearing, sigma) ? seen.bearings : seen.refused) += 1;
+    }
   }
   return seen;
+}
+
+bool RouteTracking::Weak(const KeyComparison& comparison, int target_position) const {
+  // The link into the target (out of it at the route's start): what a frame of the teach run's appearance shares.
+  if (route_.segments.empty()) return false;
+  const TaughtSegment& link = route_.segments[std::max(target_position, 1) - 1];
+  if (link.verified <= 0) return false;
+  return comparison.num_verified < options_.weak_share * link.verified;
 }
 
 PathLocation RouteTracking::Locate() {

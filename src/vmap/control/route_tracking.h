@@ -43,6 +43,10 @@ class RouteTracking {
   void Reset();
 
  private:
+  // Whether the comparison shares too little with its key image to measure as the teach run's appearance does:
+  // fewer verified matches than RoutePoseEstimatorOptions::weak_share of the map link's.
+  bool Weak(const KeyComparison& comparison, int target_position) const;
+
   TaughtRoute route_;
   RoutePoseEstimatorOptions options_;
   RoutePoseEstimator estimator_;

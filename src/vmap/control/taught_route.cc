@@ -92,6 +92,7 @@ TaughtRoute MakeTaughtRoute(const VisualMap& map, std::vector<int> keys,
       for (Correspondence& match : matches) std::swap(match.p0, match.p1);
     }
     segment.log_scale = ApparentLogScale(matches);
+    segment.verified = verified;
     route.segments.push_back(segment);
   }
   route.keys = std::move(keys);

@@ -31,6 +31,10 @@ struct TaughtSegment {
   // much the scene grows over the stretch: a deep scene (a long corridor ahead) grows little. NaN when the link's
   // verified matches do not tell.
   double log_scale = std::numeric_limits<double>::quiet_NaN();
+  // The link's verified matches: how much a frame taken at one of its key images shares with the other when the
+  // appearance is the teach run's (0: unknown). A frame's verified matches against them tell how alike the
+  // appearance is (RouteTracking: another season's comparisons give much noisier bearings).
+  int verified = 0;
 
   double speed() const { return length / duration; }  // m/s; NaN unless both are known
 };

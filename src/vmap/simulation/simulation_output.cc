@@ -106,7 +106,9 @@ nlohmann::json SimulationJson(const SimulationResult& result, const SimulationOp
                              "headings_taken",
                              "unassociated",
                              "arc_estimate",
-                             "key_log_scale"}) {
+                             "key_log_scale",
+                             "pose_bearing",
+                             "pose_heading"}) {
       columns[name] = nlohmann::json::array();
     }
     for (const TrialSample& sample : trial.samples) {
@@ -137,6 +139,8 @@ nlohmann::json SimulationJson(const SimulationResult& result, const SimulationOp
       columns["unassociated"].push_back(sample.observation.unassociated);
       columns["arc_estimate"].push_back(Number(sample.arc_estimate));
       columns["key_log_scale"].push_back(Number(sample.key_log_scale, 1e-4));
+      columns["pose_bearing"].push_back(Number(sample.pose_bearing, 1e-4));
+      columns["pose_heading"].push_back(Number(sample.pose_heading, 1e-4));
     }
     t["samples"] = columns;
     trials.push_back(t);

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "vmap/control/guidance_signals.h"
+#include "vmap/control/taught_route.h"
 #include "vmap/simulation/teach_run.h"
 
 namespace vmap {
@@ -131,6 +132,12 @@ void TrialRun::Record(const LocalizationResult& localization, const ControlStep&
   sample.observation = step.observation;
   sample.translation_sigma_deg = TargetComparison(localization).translation_sigma_deg;
   sample.target_verified = TargetComparison(localization).num_verified;
+  if (TargetComparison(localization).pose.valid)
+    sample.pose_heading = -YawOfCameraRotation(TargetComparison(localization).pose.R);
+  if (localization.translation_known) {
+    const TargetBearing measured = BearingToKey(TargetComparison(localization).pose);
+    if (measured.valid) sample.pose_bearing = measured.bearing;
+  }
   sample.key_log_scale = ApparentLogScale(localization.to_key.verified);
   if (step.target_key >= 0 && step.target_key < static_cast<int>(context_.key_image_poses.size())) {
     // The servo's angles as they truly are: alpha, the bearing of the key image's position from the robot's
