@@ -268,6 +268,52 @@ TEST(RouteTracking, AnotherSeasonsNoisyBearingsAreWeighedAsSuch) {
   EXPECT_GT(std::abs(LateralErrorAcrossSeasons(as_the_teach_run)), 0.15);
 }
 
+// Verified matches of a scene that appears `scale` times as large in the frame as in the key image.
+std::vector<Correspondence> Zoomed(double scale) {
+  std::vector<Correspondence> matches;
+  for (int i = 0; i < 60; ++i) {
+    const cv::Point2f key(40.f + 9.f * i, 60.f + static_cast<float>((i * 37) % 360));
+    const cv::Point2f frame = cv::Point2f(320, 240) + static_cast<float>(scale) * (key - cv::Point2f(320, 240));
+    matches.push_back({frame, key});
+  }
+  return matches;
+}
+
+// Across seasons a first frame relocalized a key image ahead of the robot started the estimate there, and the
+// bearings (which measure across their line of sight) never pulled it back. How large the key image's scene
+// appears against its growth over the link into it says how far before or past the key image the robot is.
+// Returns the estimate's error along the route after the robot drove 0.6 m from 0.2 m before key image 0... 1.
+double AlongErrorAfterAWrongStart(RoutePoseEstimatorOptions options) {
+  TaughtRoute route = StraightMetricRoute();
+  for (TaughtSegment& segment : route.segments) segment.log_scale = std::log(0.8);  // 1 m: the scene grows 25 %
+  const double rate = -std::log(0.8);
+  RouteTracking tracking(route, options);
+  double truth = 0.2;
+  for (int step = 0; step < 13; ++step) {
+    if (step > 0) {
+      truth += 0.05;
+      tracking.Predict(0.05, 0.0);
+    }
+    LocalizationResult frame = FrameWithHeadings(0.0, 0.0);
+    frame.status = LocalizationStatus::kRelocalized;
+    frame.key = step == 0 ? 1 : static_cast<int>(std::lround(truth));  // the first frame a key image ahead
+    frame.next_key = frame.key + 1;
+    frame.route_position = frame.key;
+    frame.to_key.matched = true;
+    frame.to_key.verified = Zoomed(std::exp(rate * (truth - frame.key)));
+    frame.to_key.num_verified = static_cast<int>(frame.to_key.verified.size());
+    tracking.Observe(frame, 500.0);
+  }
+  return tracking.pose()[0] - truth;
+}
+
+TEST(RouteTracking, TheKeyImagesScaleTellsHowFarBeforeOrPastItTheRobotIs) {
+  EXPECT_NEAR(AlongErrorAfterAWrongStart({}), 0.0, 0.1);
+  RoutePoseEstimatorOptions bearings_only;
+  bearings_only.scale_sigma = 0.0;
+  EXPECT_GT(AlongErrorAfterAWrongStart(bearings_only), 0.6);  // still a key image ahead
+}
+
 // A robot drives 18 m around a circle of radius 3 m (the simulator's loop) with the odometry 5 % too long; the
 // key images, every metre of the circle, are seen ahead (a bearing every third frame) and the heading every frame.
 // Returns the estimate's position error at the end; `scale` gets the estimated odometry scale.

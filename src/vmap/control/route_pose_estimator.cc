@@ -89,6 +89,14 @@ bool RoutePoseEstimator::UpdateHeading(double yaw, double sigma) {
   return taken;
 }
 
+bool RoutePoseEstimator::UpdateScale(const cv::Point2d& landmark, const cv::Vec2d& direction, double rate,
+                                     double log_scale, double sigma) {
+  if (!initialized_ || !(rate > 0.0) || !(sigma > 0.0) || !std::isfinite(log_scale)) return false;
+  const double predicted = rate * ((state_[0] - landmark.x) * direction[0] + (state_[1] - landmark.y) * direction[1]);
+  return Update(cv::Matx14d(rate * direction[0], rate * direction[1], 0.0, 0.0), log_scale - predicted,
+                sigma * sigma);
+}
+
 bool RoutePoseEstimator::UpdateBearing(const cv::Point2d& landmark, double bearing, double sigma) {
   if (!initialized_) return false;
   const double dx = landmark.x - state_[0], dy = landmark.y - state_[1];

@@ -27,6 +27,17 @@ struct RoutePoseEstimatorOptions {
   // rad where the share was 0.5 or more (same appearance), 0.14-0.22 rad where it was 0.1-0.5 (another season);
   // the rotation's heading 0.002 and 0.033 rad. Taken with the same-appearance sigmas, the true ones were refused by
   // the gate and the wrong ones pulled the estimate across the path (3 of 10 trials reached the goal).
+  // Along the route: how large the key image's scene appears in the frame (ApparentLogScale of the verified
+  // matches) against how much it grows over the map's link into the key image says how far before (smaller) or
+  // past (larger) the key image the robot is, unsure by `scale_sigma` metres (`weak_scale_sigma` for a weak
+  // comparison). Measured in the simulator (straight route, 4 and 10 trials, the robot's distance to the key
+  // image against a line fitted to the log-scales): residuals of 0.02 m median (0.09 m at 90 %) in the teach run's
+  // appearance, 0.16 m (0.39 m) across seasons. Without it the bearings alone, which measure across their line of
+  // sight, left the estimate of some cross-season runs a key image (0.66 m) ahead of the robot from a
+  // relocalization one key image ahead at the start, and every bearing near a key image was then refused.
+  // 0: not measured.
+  double scale_sigma = 0.1;
+  double weak_scale_sigma = 0.3;
   double weak_share = 0.5;
   double weak_bearing_sigma = 0.25;
   double weak_heading_sigma = 0.05;
@@ -90,6 +101,10 @@ class RoutePoseEstimator {
   // Measurements; each returns whether it was taken (false: refused by the gate, or not initialized).
   bool UpdateHeading(double yaw, double sigma);
   // `sigma` (rad): the bearing's uncertainty; NaN: RoutePoseEstimatorOptions::bearing_sigma.
+  // The log-scale at which the scene of a key image taken at `landmark`, looking along `direction` (unit), appears:
+  // `rate` times the robot's distance past the landmark along `direction` (rate: per metre), unsure by `sigma`.
+  bool UpdateScale(const cv::Point2d& landmark, const cv::Vec2d& direction, double rate, double log_scale,
+                   double sigma);
   bool UpdateBearing(const cv::Point2d& landmark, double bearing,
                      double sigma = std::numeric_limits<double>::quiet_NaN());
   // How many times the estimate's uncertainty was widened since it started (RoutePoseEstimatorOptions: recovery).

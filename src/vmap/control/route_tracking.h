@@ -16,6 +16,7 @@ namespace vmap {
 struct TrackingObservation {
   int headings = 0;      // heading measurements taken
   int bearings = 0;      // bearing measurements taken
+  int scales = 0;        // key images' scales taken (how far before or past the key image)
   int refused = 0;       // measurements the gate refused
   int unassociated = 0;  // frames at a key image the estimate puts too far away to be seen
 };

@@ -108,7 +108,8 @@ nlohmann::json SimulationJson(const SimulationResult& result, const SimulationOp
                              "arc_estimate",
                              "key_log_scale",
                              "pose_bearing",
-                             "pose_heading"}) {
+                             "pose_heading",
+                             "scales_taken"}) {
       columns[name] = nlohmann::json::array();
     }
     for (const TrialSample& sample : trial.samples) {
@@ -141,6 +142,7 @@ nlohmann::json SimulationJson(const SimulationResult& result, const SimulationOp
       columns["key_log_scale"].push_back(Number(sample.key_log_scale, 1e-4));
       columns["pose_bearing"].push_back(Number(sample.pose_bearing, 1e-4));
       columns["pose_heading"].push_back(Number(sample.pose_heading, 1e-4));
+      columns["scales_taken"].push_back(sample.observation.scales);
     }
     t["samples"] = columns;
     trials.push_back(t);
