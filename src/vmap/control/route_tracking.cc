@@ -80,10 +80,11 @@ TrackingObservation RouteTracking::Observe(const LocalizationResult& result, dou
   }
   (estimator_.UpdateHeading(target.yaw + offset, heading_sigma) ? seen.headings : seen.refused) += 1;
   // How far before or past the key image, from how large its scene appears against its growth over the link into
-  // it (out of it at the route's start). Not on a link driven backwards (the camera faces away from the motion),
+  // it (none at the route's start: the next link's growth is another scene's, and it held the estimate of an
+  // s-curve repeat at the start while the robot drove 0.7 m). Not on a link driven backwards (the camera faces away from the motion),
   // nor on one that turns (RoutePoseEstimatorOptions::scale_max_turn).
-  if (options_.scale_sigma > 0.0 && result.to_key.matched && !route_.segments.empty()) {
-    const TaughtSegment& link = route_.segments[std::max(key_position, 1) - 1];
+  if (options_.scale_sigma > 0.0 && result.to_key.matched && key_position > 0) {
+    const TaughtSegment& link = route_.segments[key_position - 1];
     const double log_scale = ApparentLogScale(result.to_key.verified);
     const bool straight = std::abs(link.yaw_change) <= options_.scale_max_turn;  // false when NaN
     if (straight && !link.backwards && link.log_scale < 0.0 && link.length > 0.0 && std::isfinite(log_scale)) {
