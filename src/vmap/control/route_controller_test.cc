@@ -305,7 +305,7 @@ TEST(RouteController, AFrameStillBeforeTheGoalStopsWhereTheGoalLooksAsLarge) {
     return step.state;
   };
   EXPECT_EQ(state_after_three(0.99, 60), ControllerState::kReachedGoal);
-  EXPECT_EQ(state_after_three(0.9, 60), ControllerState::kFollowing);  // still 10 % smaller
+  EXPECT_EQ(state_after_three(0.9, 60), ControllerState::kFollowing);   // still 10 % smaller
   EXPECT_EQ(state_after_three(0.99, 10), ControllerState::kFollowing);  // too few matches to judge by
   // Two stretches before the goal: not judged.
   RouteController controller(StraightRoute(), NoRateLimits());

@@ -8,7 +8,8 @@
 namespace vmap {
 
 void RoutePoseEstimator::Initialize(const cv::Vec3d& pose, const cv::Vec3d& sigma) {
-  InitializeWithCovariance(pose, cv::Matx33d::diag(cv::Vec3d(sigma[0] * sigma[0], sigma[1] * sigma[1], sigma[2] * sigma[2])));
+  InitializeWithCovariance(pose,
+                           cv::Matx33d::diag(cv::Vec3d(sigma[0] * sigma[0], sigma[1] * sigma[1], sigma[2] * sigma[2])));
 }
 
 void RoutePoseEstimator::InitializeWithCovariance(const cv::Vec3d& pose, const cv::Matx33d& covariance) {
@@ -93,8 +94,7 @@ bool RoutePoseEstimator::UpdateScale(const cv::Point2d& landmark, const cv::Vec2
                                      double log_scale, double sigma) {
   if (!initialized_ || !(rate > 0.0) || !(sigma > 0.0) || !std::isfinite(log_scale)) return false;
   const double predicted = rate * ((state_[0] - landmark.x) * direction[0] + (state_[1] - landmark.y) * direction[1]);
-  return Update(cv::Matx14d(rate * direction[0], rate * direction[1], 0.0, 0.0), log_scale - predicted,
-                sigma * sigma);
+  return Update(cv::Matx14d(rate * direction[0], rate * direction[1], 0.0, 0.0), log_scale - predicted, sigma * sigma);
 }
 
 bool RoutePoseEstimator::UpdateBearing(const cv::Point2d& landmark, double bearing, double sigma) {
@@ -106,8 +106,8 @@ bool RoutePoseEstimator::UpdateBearing(const cv::Point2d& landmark, double beari
   const cv::Matx14d H(dy / range_squared, -dx / range_squared, -1.0, 0.0);
   const double range = std::sqrt(range_squared);
   if (!std::isfinite(sigma)) sigma = options_.bearing_sigma;
-  return Update(H, WrapAngle(bearing - predicted), sigma * sigma,
-                options_.max_bearing_step_share * range, cv::Vec2d(dx / range, dy / range));
+  return Update(H, WrapAngle(bearing - predicted), sigma * sigma, options_.max_bearing_step_share * range,
+                cv::Vec2d(dx / range, dy / range));
 }
 
 }  // namespace vmap

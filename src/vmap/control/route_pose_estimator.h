@@ -20,6 +20,7 @@ struct RoutePoseEstimatorOptions {
   double heading_sigma = 0.02;          // rad: a frame's heading against a key image, from the relative pose
   double feature_heading_sigma = 0.08;  // rad: the same from the features' heading (biased by parallax)
   double bearing_sigma = 0.06;          // rad: the bearing to a key image from a relative pose
+  double gate = 3.0;                    // standard deviations beyond which a measurement is refused
   // A comparison that verifies fewer than `weak_share` of the map link's verified matches (the appearance differs
   // from the teach run's: another season, other light) gives measurements unsure by `weak_bearing_sigma` and
   // `weak_heading_sigma` instead. Measured in the simulator (straight route, michigan textures, XFeat, 4 trials
@@ -27,6 +28,9 @@ struct RoutePoseEstimatorOptions {
   // rad where the share was 0.5 or more (same appearance), 0.14-0.22 rad where it was 0.1-0.5 (another season);
   // the rotation's heading 0.002 and 0.033 rad. Taken with the same-appearance sigmas, the true ones were refused by
   // the gate and the wrong ones pulled the estimate across the path (3 of 10 trials reached the goal).
+  double weak_share = 0.5;
+  double weak_bearing_sigma = 0.25;
+  double weak_heading_sigma = 0.05;
   // Along the route: how large the key image's scene appears in the frame (ApparentLogScale of the verified
   // matches) against how much it grows over the map's link into the key image says how far before (smaller) or
   // past (larger) the key image the robot is, unsure by `scale_sigma` metres (`weak_scale_sigma` for a weak
@@ -40,12 +44,8 @@ struct RoutePoseEstimatorOptions {
   // trials' estimates ran 0.2-0.9 m off along the route, and 8/10 reached the goal instead of 9/10).
   // 0: not measured.
   double scale_sigma = 0.1;
-  double scale_max_turn = 0.1;
   double weak_scale_sigma = 0.3;
-  double weak_share = 0.5;
-  double weak_bearing_sigma = 0.25;
-  double weak_heading_sigma = 0.05;
-  double gate = 3.0;                    // standard deviations beyond which a measurement is refused
+  double scale_max_turn = 0.1;
   // Motion noise: of the distance driven (relative), of the turn (relative) and of the heading per metre (slip).
   double distance_noise = 0.05;
   double turn_noise = 0.05;
@@ -114,9 +114,9 @@ class RoutePoseEstimator {
   // How many times the estimate's uncertainty was widened since it started (RoutePoseEstimatorOptions: recovery).
   int recoveries() const { return recoveries_; }
 
-  cv::Vec3d pose() const { return {state_[0], state_[1], state_[2]}; }  // x, y, yaw
+  cv::Vec3d pose() const { return {state_[0], state_[1], state_[2]}; }          // x, y, yaw
   cv::Matx33d covariance() const { return covariance_.get_minor<3, 3>(0, 0); }  // of the pose
-  double odometry_scale() const { return state_[3]; }  // true distance / odometry's distance
+  double odometry_scale() const { return state_[3]; }                           // true distance / odometry's distance
 
  private:
   // One scalar measurement with Jacobian H (of x, y, yaw, scale) and innovation `residual`, variance r.

@@ -48,8 +48,9 @@ TrackingObservation RouteTracking::Observe(const LocalizationResult& result, dou
   if (!std::isfinite(offset)) return seen;
   // The comparison's own evidence of how alike the appearance is: its verified matches against the link's.
   const bool weak = Weak(TargetComparison(result), target_position);
-  const double heading_sigma = rotation ? (weak ? options_.weak_heading_sigma : options_.heading_sigma)
-                                        : std::max(options_.feature_heading_sigma, weak ? options_.weak_heading_sigma : 0.0);
+  const double heading_sigma = rotation
+                                   ? (weak ? options_.weak_heading_sigma : options_.heading_sigma)
+                                   : std::max(options_.feature_heading_sigma, weak ? options_.weak_heading_sigma : 0.0);
   if (!estimator_.initialized()) {
     // At the key image the localizer names, uncertain along the route by a stretch (a relocalization may be off
     // by a key image), across it by where a robot may start; the bearings that follow pull it in. Not at the
@@ -65,9 +66,7 @@ TrackingObservation RouteTracking::Observe(const LocalizationResult& result, dou
     const double yaw_sigma = 2.0 * heading_sigma;
     const cv::Matx33d covariance(position(0, 0), position(0, 1), 0, position(1, 0), position(1, 1), 0, 0, 0,
                                  yaw_sigma * yaw_sigma);
-    estimator_.InitializeWithCovariance(
-        {key.x, key.y, target.yaw + offset},
-        covariance);
+    estimator_.InitializeWithCovariance({key.x, key.y, target.yaw + offset}, covariance);
     arc_ = key_arc_[key_position];
     return seen;
   }
@@ -81,8 +80,8 @@ TrackingObservation RouteTracking::Observe(const LocalizationResult& result, dou
   (estimator_.UpdateHeading(target.yaw + offset, heading_sigma) ? seen.headings : seen.refused) += 1;
   // How far before or past the key image, from how large its scene appears against its growth over the link into
   // it (none at the route's start: the next link's growth is another scene's, and it held the estimate of an
-  // s-curve repeat at the start while the robot drove 0.7 m). Not on a link driven backwards (the camera faces away from the motion),
-  // nor on one that turns (RoutePoseEstimatorOptions::scale_max_turn).
+  // s-curve repeat at the start while the robot drove 0.7 m). Not on a link driven backwards (the camera faces away
+  // from the motion), nor on one that turns (RoutePoseEstimatorOptions::scale_max_turn).
   if (options_.scale_sigma > 0.0 && result.to_key.matched && key_position > 0) {
     const TaughtSegment& link = route_.segments[key_position - 1];
     const double log_scale = ApparentLogScale(result.to_key.verified);

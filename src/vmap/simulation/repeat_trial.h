@@ -30,18 +30,18 @@ struct TrialSample {
   double heading_offset = 0.0;  // what the controller read (ControlStep; NaN when not used)
   double bearing = 0.0;
   double line_angle = 0.0;
-  double lateral_estimate = 0.0;       // the tracker's (ControlStep; NaN otherwise)
+  double lateral_estimate = 0.0;        // the tracker's (ControlStep; NaN otherwise)
   double heading_error_estimate = 0.0;  // the tracker's (rad, ControlStep; NaN otherwise)
   double arc_estimate = 0.0;            // the tracker's (m along the taught path; NaN otherwise)
-  TrackingObservation observation;     // what the frame gave the tracker's estimate
-  double translation_sigma_deg = 0.0;  // of the target's pose (KeyComparison; NaN without one)
+  TrackingObservation observation;      // what the frame gave the tracker's estimate
+  double translation_sigma_deg = 0.0;   // of the target's pose (KeyComparison; NaN without one)
   // The bearing to the target key image from the frame's relative pose where its translation is known (rad, the
   // tracker's measurement, whatever the law; NaN otherwise): against true_bearing, how wrong the measurement is.
   double pose_bearing = std::numeric_limits<double>::quiet_NaN();
   // The robot's heading against the target key image's from the relative pose's rotation (rad, left positive; NaN
   // without a pose): the tracker's heading measurement.
   double pose_heading = std::numeric_limits<double>::quiet_NaN();
-  int target_verified = 0;             // verified matches with the target key image
+  int target_verified = 0;  // verified matches with the target key image
   // How large key's scene appears in the frame against the key image (ApparentLogScale; NaN where unknown).
   double key_log_scale = std::numeric_limits<double>::quiet_NaN();
   // The truth of the same, from the target key image's pose in the teach run (NaN without a target).
