@@ -10,6 +10,7 @@
 
 #include "vmap/control/route_pose_estimator.h"
 #include "vmap/control/route_tracking.h"
+#include "vmap/testing/zoomed_matches.h"
 
 namespace vmap {
 namespace {
@@ -268,17 +269,6 @@ TEST(RouteTracking, AnotherSeasonsNoisyBearingsAreWeighedAsSuch) {
   EXPECT_GT(std::abs(LateralErrorAcrossSeasons(as_the_teach_run)), 0.15);
 }
 
-// Verified matches of a scene that appears `scale` times as large in the frame as in the key image.
-std::vector<Correspondence> Zoomed(double scale) {
-  std::vector<Correspondence> matches;
-  for (int i = 0; i < 60; ++i) {
-    const cv::Point2f key(40.f + 9.f * i, 60.f + static_cast<float>((i * 37) % 360));
-    const cv::Point2f frame = cv::Point2f(320, 240) + static_cast<float>(scale) * (key - cv::Point2f(320, 240));
-    matches.push_back({frame, key});
-  }
-  return matches;
-}
-
 // Across seasons a first frame relocalized a key image ahead of the robot started the estimate there, and the
 // bearings (which measure across their line of sight) never pulled it back. How large the key image's scene
 // appears against its growth over the link into it says how far before or past the key image the robot is.
@@ -300,7 +290,7 @@ double AlongErrorAfterAWrongStart(RoutePoseEstimatorOptions options) {
     frame.next_key = frame.key + 1;
     frame.route_position = frame.key;
     frame.to_key.matched = true;
-    frame.to_key.verified = Zoomed(std::exp(rate * (truth - frame.key)));
+    frame.to_key.verified = testing::ZoomedMatches(std::exp(rate * (truth - frame.key)));
     frame.to_key.num_verified = static_cast<int>(frame.to_key.verified.size());
     tracking.Observe(frame, 500.0);
   }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "vmap/core/error.h"
+#include "vmap/testing/zoomed_matches.h"
 
 namespace vmap {
 namespace {
@@ -218,26 +219,15 @@ TEST(RouteController, AccelerationIsLimited) {
   EXPECT_NEAR(step.command.linear, 0.10, 1e-12);
 }
 
-// The goal key image's points, seen `scale` times as large in the frame.
-std::vector<Correspondence> Zoomed(double scale) {
-  std::vector<Correspondence> matches;
-  for (int i = 0; i < 60; ++i) {
-    const cv::Point2f key(40.f + 9.f * i, 60.f + static_cast<float>((i * 37) % 360));
-    const cv::Point2f frame = cv::Point2f(320, 240) + static_cast<float>(scale) * (key - cv::Point2f(320, 240));
-    matches.push_back({frame, key});
-  }
-  return matches;
-}
-
 TEST(RouteController, StopsWhereTheGoalLooksAsLargeAsInItsKeyImage) {
   RouteController controller(StraightRoute(), NoRateLimits());
   LocalizationResult at_goal = Tracked(3, 0.0);
-  at_goal.to_key.verified = Zoomed(0.9);  // still 10 % smaller: drive on, at the goal speed
+  at_goal.to_key.verified = testing::ZoomedMatches(0.9);  // still 10 % smaller: drive on, at the goal speed
   ControlStep step = controller.Update(0.0, at_goal);
   EXPECT_EQ(step.state, ControllerState::kFollowing);
   EXPECT_NEAR(step.goal_log_scale, std::log(0.9), 1e-4);
   EXPECT_DOUBLE_EQ(step.command.linear, 0.3 * 0.5);
-  at_goal.to_key.verified = Zoomed(0.99);
+  at_goal.to_key.verified = testing::ZoomedMatches(0.99);
   step = controller.Update(0.1, at_goal);
   EXPECT_EQ(step.state, ControllerState::kFollowing);  // the median of the last three frames: one is not enough
   step = controller.Update(0.15, at_goal);
@@ -259,7 +249,7 @@ TEST(RouteController, WhereTheGoalsSceneIsDeepTheGoalWaitsForMostOfItsGrowth) {
   // Three frames at the goal each time: the goal is judged on the median of the last three.
   auto state_after_three = [](RouteController& controller, double zoom, double time) {
     LocalizationResult at_goal = Tracked(3, 0.0);
-    at_goal.to_key.verified = Zoomed(zoom);
+    at_goal.to_key.verified = testing::ZoomedMatches(zoom);
     controller.Update(time, at_goal);
     controller.Update(time + 0.1, at_goal);
     return controller.Update(time + 0.2, at_goal).state;
@@ -284,7 +274,7 @@ TEST(RouteController, OneStrayScaleAtTheGoalDoesNotStopTheRobot) {
   RouteController controller(StraightRoute(), NoRateLimits());
   LocalizationResult at_goal = Tracked(3, 0.0);
   for (double zoom : {0.9, 0.9, 1.0, 0.9}) {
-    at_goal.to_key.verified = Zoomed(zoom);
+    at_goal.to_key.verified = testing::ZoomedMatches(zoom);
     EXPECT_EQ(controller.Update(0.0, at_goal).state, ControllerState::kFollowing) << zoom;
   }
 }
@@ -297,7 +287,7 @@ TEST(RouteController, AFrameStillBeforeTheGoalStopsWhereTheGoalLooksAsLarge) {
     RouteController controller(StraightRoute(), NoRateLimits());
     LocalizationResult before_goal = Tracked(2, 0.0);  // next_key 3, the goal
     before_goal.to_next.matched = true;
-    before_goal.to_next.verified = Zoomed(zoom);
+    before_goal.to_next.verified = testing::ZoomedMatches(zoom);
     before_goal.to_next.verified.resize(verified);
     before_goal.to_next.num_verified = verified;
     ControlStep step;
@@ -311,7 +301,7 @@ TEST(RouteController, AFrameStillBeforeTheGoalStopsWhereTheGoalLooksAsLarge) {
   RouteController controller(StraightRoute(), NoRateLimits());
   LocalizationResult earlier = Tracked(1, 0.0);
   earlier.to_next.matched = true;
-  earlier.to_next.verified = Zoomed(1.0);
+  earlier.to_next.verified = testing::ZoomedMatches(1.0);
   earlier.to_next.num_verified = 60;
   for (int i = 0; i < 3; ++i) EXPECT_EQ(controller.Update(0.1 * i, earlier).state, ControllerState::kFollowing);
 }

@@ -66,6 +66,22 @@ LocalizationResult AfterAJump(const LocalizerOptions& options, int jump_to) {
   return r;
 }
 
+// Localizes the drive's odd frames with `options`: the first frame is relocalized, every other one tracked, and each
+// is bracketed by its key images.
+void ExpectTrackedAlongTheDrive(const LocalizationMap& m, const LocalizerOptions& options) {
+  Localizer localizer(m.map, m.keys, *m.matcher, options);
+  ::vmap::testing::MemorySource source(DriveFrames(1, 2), DriveIndices(1, 2));
+  LocalizeSequenceOptions run;
+  run.show_progress = false;
+  int bracketed = 0;
+  const LocalizationSummary summary = LocalizeSequence(
+      source, *m.matcher, localizer, run,
+      [&](const Frame&, const LocalizationResult& r) { bracketed += Brackets(m.map, r.source_index, r.key); });
+  EXPECT_EQ(summary.relocalized, 1) << "the first frame only";
+  EXPECT_EQ(summary.tracking, 29);
+  EXPECT_EQ(bracketed, 30);
+}
+
 TEST(Localizer, AFrameTrackedAtAFarKeyImageOfTheSameSceneIsMovedWhereItVerifiesBetter) {
   const LocalizationMap& m = Dense();
   ASSERT_GE(m.map.key_images.size(), 12u);
@@ -223,17 +239,7 @@ TEST(Localizer, ATrackedKeyImageThatStandsOutAgainstTheFramesRivalsKeepsTracking
   options.min_rival_ratio = 1.2;  // the synthetic drive's rivals verify 60-80 % of the right key image's matches
   options.belief.window = 0;      // the acceptance alone
   options.belief.min_confidence = 0.0;
-  Localizer localizer(m.map, m.keys, *m.matcher, options);
-  ::vmap::testing::MemorySource source(DriveFrames(1, 2), DriveIndices(1, 2));
-  LocalizeSequenceOptions run;
-  run.show_progress = false;
-  int bracketed = 0;
-  const LocalizationSummary summary = LocalizeSequence(
-      source, *m.matcher, localizer, run,
-      [&](const Frame&, const LocalizationResult& r) { bracketed += Brackets(m.map, r.source_index, r.key); });
-  EXPECT_EQ(summary.relocalized, 1) << "the first frame only";
-  EXPECT_EQ(summary.tracking, 29);
-  EXPECT_EQ(bracketed, 30);
+  ExpectTrackedAlongTheDrive(m, options);
 }
 
 TEST(Localizer, AFrameThatSharesAsMuchAsTheMapsLinksIsNotRelocalized) {
@@ -241,17 +247,7 @@ TEST(Localizer, AFrameThatSharesAsMuchAsTheMapsLinksIsNotRelocalized) {
   const LocalizationMap& m = Dense();
   LocalizerOptions options = MapLocalizerOptions(m);
   options.acceptance = AcceptanceRule::kChance;
-  Localizer localizer(m.map, m.keys, *m.matcher, options);
-  ::vmap::testing::MemorySource source(DriveFrames(1, 2), DriveIndices(1, 2));
-  LocalizeSequenceOptions run;
-  run.show_progress = false;
-  int bracketed = 0;
-  const LocalizationSummary summary = LocalizeSequence(
-      source, *m.matcher, localizer, run,
-      [&](const Frame&, const LocalizationResult& r) { bracketed += Brackets(m.map, r.source_index, r.key); });
-  EXPECT_EQ(summary.relocalized, 1) << "the first frame only";
-  EXPECT_EQ(summary.tracking, 29);
-  EXPECT_EQ(bracketed, 30);
+  ExpectTrackedAlongTheDrive(m, options);
 }
 
 }  // namespace
