@@ -104,11 +104,11 @@ class RoutePoseEstimator {
   void Predict(double distance, double turn);
   // Measurements; each returns whether it was taken (false: refused by the gate, or not initialized).
   bool UpdateHeading(double yaw, double sigma);
-  // `sigma` (rad): the bearing's uncertainty; NaN: RoutePoseEstimatorOptions::bearing_sigma.
   // The log-scale at which the scene of a key image taken at `landmark`, looking along `direction` (unit), appears:
   // `rate` times the robot's distance past the landmark along `direction` (rate: per metre), unsure by `sigma`.
   bool UpdateScale(const cv::Point2d& landmark, const cv::Vec2d& direction, double rate, double log_scale,
                    double sigma);
+  // `sigma` (rad): the bearing's uncertainty; NaN: RoutePoseEstimatorOptions::bearing_sigma.
   bool UpdateBearing(const cv::Point2d& landmark, double bearing,
                      double sigma = std::numeric_limits<double>::quiet_NaN());
   // How many times the estimate's uncertainty was widened since it started (RoutePoseEstimatorOptions: recovery).
