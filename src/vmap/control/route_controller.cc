@@ -187,9 +187,9 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
                localization.to_next.num_verified >= kGoalMinVerified) {
       goal = &localization.to_next;
     }
-    step.goal_log_scale = ApparentLogScale(position == last  ? localization.to_key.verified
-                                           : goal != nullptr ? goal->verified
-                                                             : std::vector<Correspondence>{});
+    // Reported at the goal key image even when not accepted (the --json samples show it).
+    const KeyComparison* scaled = position == last ? &localization.to_key : goal;
+    step.goal_log_scale = ApparentLogScale(scaled != nullptr ? scaled->verified : std::vector<Correspondence>{});
     // The median of the goal's last three scales: one frame's stray scale does not stop the robot (on the loop
     // a frame 0.36 m short measured -0.001 between two of -0.02).
     constexpr size_t kGoalFrames = 3;

@@ -132,10 +132,10 @@ void TrialRun::Record(const LocalizationResult& localization, const ControlStep&
   sample.observation = step.observation;
   sample.translation_sigma_deg = TargetComparison(localization).translation_sigma_deg;
   sample.target_verified = TargetComparison(localization).num_verified;
-  if (TargetComparison(localization).pose.valid)
-    sample.pose_heading = -YawOfCameraRotation(TargetComparison(localization).pose.R);
+  const RelativePose& pose = TargetComparison(localization).pose;
+  if (pose.valid) sample.pose_heading = -YawOfCameraRotation(pose.R);
   if (localization.translation_known) {
-    const TargetBearing measured = BearingToKey(TargetComparison(localization).pose);
+    const TargetBearing measured = BearingToKey(pose);
     if (measured.valid) sample.pose_bearing = measured.bearing;
   }
   sample.key_log_scale = ApparentLogScale(localization.to_key.verified);
