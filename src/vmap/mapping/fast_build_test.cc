@@ -10,11 +10,11 @@
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "vmap/core/error.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/mapping/batch_build.h"
+#include "vmap/testing/memory_source.h"
 #include "vmap/testing/option_error.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/shared_data.h"
@@ -25,29 +25,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A source over frames held in memory.
-class MemorySource : public FrameSource {
- public:
-  explicit MemorySource(std::vector<cv::Mat> frames) : frames_(std::move(frames)) {
-    info_.path = "memory";
-    info_.expected_frames = static_cast<long>(frames_.size());
-  }
-  std::optional<Frame> Next() override {
-    if (next_ >= frames_.size()) return std::nullopt;
-    Frame frame;
-    frame.index = frame.source_index = static_cast<int>(next_);
-    frame.color = frames_[next_];
-    cv::cvtColor(frame.color, frame.gray, cv::COLOR_BGR2GRAY);
-    frame.source_name = "frame" + std::to_string(next_++);
-    return frame;
-  }
-  const SequenceInfo& info() const override { return info_; }
-
- private:
-  std::vector<cv::Mat> frames_;
-  size_t next_ = 0;
-  SequenceInfo info_;
-};
+using ::vmap::testing::MemorySource;
 
 // A matcher whose similarity is a known function of the two frames: each frame is a tiny image carrying its
 // index; Match returns 200 correspondences of which a share `InlierShare(i, j)` are exact projections of one

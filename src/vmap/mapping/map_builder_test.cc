@@ -4,7 +4,6 @@
 #include <thread>
 
 #include <gtest/gtest.h>
-#include <opencv2/imgproc.hpp>
 
 #include "vmap/core/error.h"
 #include "vmap/features/orb_matcher.h"
@@ -12,6 +11,7 @@
 #include "vmap/map/map_writer.h"
 #include "vmap/mapping/batch_build.h"
 #include "vmap/mapping/sweep_thresholds.h"
+#include "vmap/testing/memory_source.h"
 #include "vmap/testing/option_error.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"
@@ -21,29 +21,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A source over frames held in memory.
-class MemorySource : public FrameSource {
- public:
-  explicit MemorySource(const std::vector<cv::Mat>& frames) : frames_(frames) {
-    info_.path = "memory";
-    info_.expected_frames = static_cast<long>(frames.size());
-  }
-  std::optional<Frame> Next() override {
-    if (next_ >= frames_.size()) return std::nullopt;
-    Frame frame;
-    frame.index = frame.source_index = static_cast<int>(next_);
-    frame.color = frames_[next_];
-    cv::cvtColor(frame.color, frame.gray, cv::COLOR_BGR2GRAY);
-    frame.source_name = "frame" + std::to_string(next_++);
-    return frame;
-  }
-  const SequenceInfo& info() const override { return info_; }
-
- private:
-  std::vector<cv::Mat> frames_;
-  size_t next_ = 0;
-  SequenceInfo info_;
-};
+using ::vmap::testing::MemorySource;
 
 // Counts Extract calls, to prove no frame is extracted twice.
 class CountingMatcher : public Matcher {

@@ -1,6 +1,6 @@
 #pragma once
-// Test helpers of the localization stage: frames held in memory as a source, and maps built in-process
-// into a directory, as `vmap build` writes them.
+// Test helpers of the localization stage: a drive through a synthetic scene, and maps built in-process into a
+// directory, as `vmap build` writes them (their frames come from a testing::MemorySource).
 
 #include <filesystem>
 #include <string>
@@ -11,23 +11,10 @@
 #include "vmap/features/matcher.h"
 #include "vmap/mapping/batch_build.h"
 #include "vmap/sources/frame_source.h"
+#include "vmap/testing/memory_source.h"
 #include "vmap/testing/synthetic_scene.h"
 
 namespace vmap::testing {
-
-// Frames (BGR or grey) as a source; frame i has source index `source_indices[i]` (default: i).
-class MemorySource : public FrameSource {
- public:
-  explicit MemorySource(std::vector<cv::Mat> frames, std::vector<int> source_indices = {});
-  std::optional<Frame> Next() override;
-  const SequenceInfo& info() const override { return info_; }
-
- private:
-  std::vector<cv::Mat> frames_;
-  std::vector<int> source_indices_;
-  size_t next_ = 0;
-  SequenceInfo info_;
-};
 
 // The localizer tests' drive: textured planes seen by a camera moving sideways with a little yaw (60 frames).
 const SyntheticSequence& SidewaysDrive();
