@@ -27,7 +27,6 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
 #include "vmap/core/runtime.h"
@@ -37,6 +36,7 @@
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/map/map_io.h"
 #include "vmap/mapping/batch_build.h"
+#include "vmap/mapping/recorded_options.h"
 
 #include "localizer_variants.h"
 
@@ -44,20 +44,6 @@ namespace fs = std::filesystem;
 using namespace vmap;
 
 namespace {
-
-std::string MapOptionsJson(const Matcher& matcher, const MapBuilderOptions& options) {
-  nlohmann::json doc;
-  doc["matcher"] = nlohmann::json::parse(matcher.DescribeOptionsJson());
-  doc["verifier"] = {{"method", VerifierMethodName(options.verifier.method)},
-                     {"threshold", options.verifier.threshold},
-                     {"confidence", options.verifier.confidence},
-                     {"max_iterations", options.verifier.max_iterations},
-                     {"seed", options.verifier.seed},
-                     {"min_matches", options.verifier.min_matches}};
-  doc["similarity"] = SimilarityModeName(options.key_images.similarity);
-  doc["tau"] = options.key_images.tau;
-  return doc.dump();
-}
 
 bool Brackets(const VisualMap& map, int source_index, int key) {
   const auto [before, after] = KeysAround(map, source_index);
@@ -206,7 +192,7 @@ int main(int argc, char** argv) {
   {
     auto source = OpenFrameSource(input, even);
     const VisualMap built =
-        BuildMap(*source, *matcher, build_options, map_directory, MapOptionsJson(*matcher, build_options));
+        BuildMap(*source, *matcher, build_options, map_directory, DescribeMapOptions(*matcher, build_options, even));
     WriteMapFiles(built, map_directory);
   }
   LocalizationMap opened = OpenLocalizationMap(map_directory, {});

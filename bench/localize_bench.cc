@@ -20,7 +20,6 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
 #include "vmap/core/numeric.h"
@@ -30,6 +29,7 @@
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/map/map_io.h"
 #include "vmap/mapping/batch_build.h"
+#include "vmap/mapping/recorded_options.h"
 
 #include "cpu_time.h"
 
@@ -46,19 +46,6 @@ struct Samples {
   double Max() const { return values.empty() ? 0.0 : *std::max_element(values.begin(), values.end()); }
 };
 
-std::string MapOptionsJson(const Matcher& matcher, const MapBuilderOptions& options) {
-  nlohmann::json doc;
-  doc["matcher"] = nlohmann::json::parse(matcher.DescribeOptionsJson());
-  doc["verifier"] = {{"method", VerifierMethodName(options.verifier.method)},
-                     {"threshold", options.verifier.threshold},
-                     {"confidence", options.verifier.confidence},
-                     {"max_iterations", options.verifier.max_iterations},
-                     {"seed", options.verifier.seed},
-                     {"min_matches", options.verifier.min_matches}};
-  doc["similarity"] = SimilarityModeName(options.key_images.similarity);
-  return doc.dump();
-}
-
 void BuildInto(const std::string& input, FrameSourceOptions source_options, double tau, const fs::path& directory) {
   const auto matcher = CreateMatcher({});
   MapBuilderOptions options;
@@ -66,7 +53,8 @@ void BuildInto(const std::string& input, FrameSourceOptions source_options, doub
   options.show_progress = false;
   fs::create_directories(directory);
   auto source = OpenFrameSource(input, source_options);
-  const VisualMap map = BuildMap(*source, *matcher, options, directory, MapOptionsJson(*matcher, options));
+  const VisualMap map =
+      BuildMap(*source, *matcher, options, directory, DescribeMapOptions(*matcher, options, source_options));
   WriteMapFiles(map, directory);
 }
 

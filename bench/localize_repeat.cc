@@ -27,7 +27,6 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
 #include "vmap/core/runtime.h"
@@ -36,6 +35,7 @@
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/map/map_io.h"
 #include "vmap/mapping/batch_build.h"
+#include "vmap/mapping/recorded_options.h"
 
 #include "localizer_variants.h"
 
@@ -213,9 +213,8 @@ int main(int argc, char** argv) {
     source_options.first = teach.first;
     source_options.last = teach.second;
     auto source = OpenFrameSource(sequence.string(), source_options);
-    nlohmann::json doc;
-    doc["matcher"] = nlohmann::json::parse(matcher->DescribeOptionsJson());
-    const VisualMap built = BuildMap(*source, *matcher, options, map_directory, doc.dump());
+    const VisualMap built =
+        BuildMap(*source, *matcher, options, map_directory, DescribeMapOptions(*matcher, options, source_options));
     WriteMapFiles(built, map_directory);
   }
   LocalizationMap opened = OpenLocalizationMap(map_directory, {});

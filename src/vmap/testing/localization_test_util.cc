@@ -11,17 +11,10 @@
 
 namespace vmap::testing {
 
-std::string MapOptionsJson(const Matcher& matcher, const MapBuilderOptions& options) {
-  RecordedOptions record;
-  record.matcher_json = matcher.DescribeOptionsJson();
-  record.builder = options;
-  return ToJson(record).dump();
-}
-
 VisualMap BuildMapDirectory(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
                             const std::filesystem::path& directory) {
   std::filesystem::create_directories(directory);
-  VisualMap map = BuildMap(source, matcher, options, directory, MapOptionsJson(matcher, options));
+  VisualMap map = BuildMap(source, matcher, options, directory, DescribeMapOptions(matcher, options, {}));
   WriteMapFiles(map, directory);
   return map;
 }

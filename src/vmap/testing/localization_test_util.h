@@ -22,9 +22,6 @@ const SyntheticSequence& SidewaysDrive();
 std::vector<cv::Mat> DriveFrames(int first, int stride, int last = -1);
 std::vector<int> DriveIndices(int first, int stride, int last = -1);
 
-// The options text `vmap build` records (matcher, verifier, similarity, tau), enough for localization.
-std::string MapOptionsJson(const Matcher& matcher, const MapBuilderOptions& options);
-
 // Builds a map of `source` with `matcher` into `directory` (created), key images and map files included.
 VisualMap BuildMapDirectory(FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options,
                             const std::filesystem::path& directory);
