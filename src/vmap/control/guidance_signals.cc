@@ -37,18 +37,15 @@ double ApparentLogScale(const std::vector<Correspondence>& verified, int min_pai
   std::vector<double> ratios;
   // Each match paired with a few others at fixed offsets: deterministic, and linear in the matches.
   constexpr int kOffsets[] = {1, 2, 3, 5, 8, 13, 21, 34};
-  const double min_squared = min_distance_px * min_distance_px;
   for (int offset : kOffsets) {
     if (offset >= n) break;
     for (int i = 0; i < n; ++i) {
       const int j = (i + offset) % n;
-      const cv::Point2f key_delta = verified[i].p1 - verified[j].p1;
-      const double key_squared = key_delta.dot(key_delta);
-      if (key_squared < min_squared) continue;
-      const cv::Point2f frame_delta = verified[i].p0 - verified[j].p0;
-      const double frame_squared = frame_delta.dot(frame_delta);
-      if (!(frame_squared > 0.0)) continue;
-      ratios.push_back(0.5 * std::log(frame_squared / key_squared));
+      const double key_height = std::abs(verified[i].p1.y - verified[j].p1.y);
+      if (key_height < min_distance_px) continue;
+      const double frame_height = std::abs(verified[i].p0.y - verified[j].p0.y);
+      if (!(frame_height > 0.0)) continue;
+      ratios.push_back(std::log(frame_height / key_height));
     }
   }
   if (static_cast<int>(ratios.size()) < min_pairs) return std::numeric_limits<double>::quiet_NaN();

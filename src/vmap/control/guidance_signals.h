@@ -38,9 +38,13 @@ struct TargetBearing {
 TargetBearing BearingToKey(const RelativePose& pose);
 
 // log of how much larger the scene appears in the frame than in the key image: the median, over pairs of
-// verified matches, of log(distance in the frame / distance in the key image) (p0 the frame, p1 the key
-// image, as in KeyComparison::verified). Below 0 behind the key image (the scene still smaller), about 0 at it,
-// above 0 past it; NaN with fewer than `min_pairs` pairs at least `min_distance_px` apart in the key image.
+// verified matches, of log(vertical distance in the frame / vertical distance in the key image) (p0 the frame,
+// p1 the key image, as in KeyComparison::verified). Below 0 behind the key image (the scene still smaller),
+// about 0 at it, above 0 past it; NaN with fewer than `min_pairs` pairs at least `min_distance_px` apart
+// vertically in the key image. Vertical distances only: for a camera that looks along the route (upright, as a
+// robot's), a point's image height is its height over its depth, and a step sideways changes no depth; a
+// horizontal distance also changes with the angle an oblique surface is seen at, so a robot beside the path
+// would look ahead of or behind where it is.
 double ApparentLogScale(const std::vector<Correspondence>& verified, int min_pairs = 20, double min_distance_px = 20.0);
 
 }  // namespace vmap

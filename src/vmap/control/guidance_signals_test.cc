@@ -64,5 +64,38 @@ TEST(GuidanceSignals, ApparentScaleOfAZoom) {
   EXPECT_TRUE(std::isnan(ApparentLogScale(matches)));  // too few pairs
 }
 
+// The matches of points on a wall ahead, turned 40 degrees from the optical axis (a corridor's outer wall in a
+// bend), seen by the key image's camera at the origin and by a frame's camera at `centre` with the same heading
+// (pinhole 457 px, 640 x 480; x right, y down, z forward).
+std::vector<Correspondence> ObliqueWallMatches(cv::Vec3d centre) {
+  const auto project = [](cv::Vec3d point) {
+    return cv::Point2f(static_cast<float>(320.0 + 457.0 * point[0] / point[2]),
+                       static_cast<float>(240.0 + 457.0 * point[1] / point[2]));
+  };
+  const double angle = 40.0 * M_PI / 180.0;
+  std::vector<Correspondence> matches;
+  cv::RNG rng(5);
+  for (int i = 0; i < 150; ++i) {
+    const double along = rng.uniform(-3.0, 3.0);
+    const cv::Vec3d point(along * std::sin(angle), rng.uniform(-1.5, 0.5), 4.0 + along * std::cos(angle));
+    const cv::Point2f key = project(point), frame = project(point - centre);
+    if (key.x < 0 || key.x > 640 || frame.x < 0 || frame.x > 640 || key.y > 480 || frame.y > 480) continue;
+    matches.push_back({frame, key});
+  }
+  return matches;
+}
+
+TEST(GuidanceSignals, ASideStepChangesNoApparentScaleABackStepDoes) {
+  // A step sideways leaves every point's depth, so how near the scene is, as it was; but the oblique wall is
+  // seen more or less head-on, so its horizontal extent changes (by 7 % here): measured on whole distances, a
+  // robot 0.3 m beside the path looked 0.3 m behind (in the simulator's s-curve, a robot starting left of the
+  // path looked a metre ahead of where it was, and turned into the bend early). Vertical distances scale with
+  // the depth alone.
+  EXPECT_NEAR(ApparentLogScale(ObliqueWallMatches({-0.3, 0, 0})), 0.0, 0.005);
+  EXPECT_NEAR(ApparentLogScale(ObliqueWallMatches({0.3, 0, 0})), 0.0, 0.005);
+  // 0.3 m back: the wall, about 4 m ahead, appears about 7 % smaller.
+  EXPECT_LT(ApparentLogScale(ObliqueWallMatches({0, 0, -0.3})), -0.05);
+}
+
 }  // namespace
 }  // namespace vmap
