@@ -52,4 +52,19 @@ double ApparentLogScale(const std::vector<Correspondence>& verified, int min_pai
   return Median(std::move(ratios));
 }
 
+std::vector<Correspondence> UndoFrameYaw(std::vector<Correspondence> verified, double yaw, double focal_px,
+                                         cv::Point2d principal) {
+  // The frame's ray (u, v, 1) in the key image's camera axes (x right, y down, z forward; the frame turned left
+  // by yaw): (u cos yaw - sin yaw, v, u sin yaw + cos yaw).
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  for (Correspondence& match : verified) {
+    const double u = (match.p0.x - principal.x) / focal_px, v = (match.p0.y - principal.y) / focal_px;
+    const double depth = u * s + c;
+    if (!(depth > 0.0)) continue;  // behind the turned camera: left as it is (a turn of over 45 degrees)
+    match.p0 = cv::Point2f(static_cast<float>(principal.x + focal_px * (u * c - s) / depth),
+                           static_cast<float>(principal.y + focal_px * v / depth));
+  }
+  return verified;
+}
+
 }  // namespace vmap

@@ -47,4 +47,12 @@ TargetBearing BearingToKey(const RelativePose& pose);
 // would look ahead of or behind where it is.
 double ApparentLogScale(const std::vector<Correspondence>& verified, int min_pairs = 20, double min_distance_px = 20.0);
 
+// The matches with each frame point (p0) moved to where a camera at the frame's place, but with the key image's
+// heading, would see it (the rotation's homography; a pinhole camera of focal length `focal_px` and principal
+// point `principal`). `yaw`: the frame's heading relative to the key image's (radians, counter-clockwise seen
+// from above: the robot points left of where the key image looked). A turned camera sees one side of the image
+// nearer than the other, which ApparentLogScale would read as a step along the route.
+std::vector<Correspondence> UndoFrameYaw(std::vector<Correspondence> verified, double yaw, double focal_px,
+                                         cv::Point2d principal);
+
 }  // namespace vmap

@@ -65,12 +65,17 @@ TEST(GuidanceSignals, ApparentScaleOfAZoom) {
 }
 
 // The matches of points on a wall ahead, turned 40 degrees from the optical axis (a corridor's outer wall in a
-// bend), seen by the key image's camera at the origin and by a frame's camera at `centre` with the same heading
+// bend), seen by the key image's camera at the origin and by a frame's camera at `centre` turned left by `yaw`
 // (pinhole 457 px, 640 x 480; x right, y down, z forward).
-std::vector<Correspondence> ObliqueWallMatches(cv::Vec3d centre) {
+std::vector<Correspondence> ObliqueWallMatches(cv::Vec3d centre, double yaw = 0.0) {
   const auto project = [](cv::Vec3d point) {
     return cv::Point2f(static_cast<float>(320.0 + 457.0 * point[0] / point[2]),
                        static_cast<float>(240.0 + 457.0 * point[1] / point[2]));
+  };
+  // The frame's axes in the key camera's: x (cos, 0, sin), z (-sin, 0, cos).
+  const auto in_frame = [&](cv::Vec3d point) {
+    const cv::Vec3d d = point - centre;
+    return cv::Vec3d(d[0] * std::cos(yaw) + d[2] * std::sin(yaw), d[1], -d[0] * std::sin(yaw) + d[2] * std::cos(yaw));
   };
   const double angle = 40.0 * M_PI / 180.0;
   std::vector<Correspondence> matches;
@@ -78,7 +83,7 @@ std::vector<Correspondence> ObliqueWallMatches(cv::Vec3d centre) {
   for (int i = 0; i < 150; ++i) {
     const double along = rng.uniform(-3.0, 3.0);
     const cv::Vec3d point(along * std::sin(angle), rng.uniform(-1.5, 0.5), 4.0 + along * std::cos(angle));
-    const cv::Point2f key = project(point), frame = project(point - centre);
+    const cv::Point2f key = project(point), frame = project(in_frame(point));
     if (key.x < 0 || key.x > 640 || frame.x < 0 || frame.x > 640 || key.y > 480 || frame.y > 480) continue;
     matches.push_back({frame, key});
   }
@@ -95,6 +100,23 @@ TEST(GuidanceSignals, ASideStepChangesNoApparentScaleABackStepDoes) {
   EXPECT_NEAR(ApparentLogScale(ObliqueWallMatches({0.3, 0, 0})), 0.0, 0.005);
   // 0.3 m back: the wall, about 4 m ahead, appears about 7 % smaller.
   EXPECT_LT(ApparentLogScale(ObliqueWallMatches({0, 0, -0.3})), -0.05);
+}
+
+TEST(GuidanceSignals, AFrameTurnedIsSeenWithTheKeyImagesHeadingBeforeItsScaleIsRead) {
+  // Turned 0.2 rad left at the key image's place, matches on the image's right side only (where the scene has
+  // its features on a turn): they move out to the image's edge, where the scene looks larger, and the scale
+  // reads a step forward (0.07 here, a quarter of a metre on the s-curve's links); with the turn undone, none.
+  std::vector<Correspondence> turned;
+  for (const Correspondence& match : ObliqueWallMatches({0, 0, 0}, 0.2)) {
+    if (match.p1.x > 400.0f) turned.push_back(match);
+  }
+  ASSERT_GE(turned.size(), 30u);
+  EXPECT_GT(ApparentLogScale(turned), 0.04);
+  EXPECT_NEAR(ApparentLogScale(UndoFrameYaw(turned, 0.2, 457.0, {320.0, 240.0})), 0.0, 0.002);
+  // Undone, every frame point is where the key image has it.
+  const std::vector<Correspondence> undone =
+      UndoFrameYaw(ObliqueWallMatches({0, 0, 0}, -0.3), -0.3, 457.0, {320.0, 240.0});
+  for (const Correspondence& match : undone) EXPECT_LT(cv::norm(match.p0 - match.p1), 1e-3);
 }
 
 }  // namespace

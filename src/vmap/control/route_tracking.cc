@@ -84,10 +84,17 @@ TrackingObservation RouteTracking::Observe(const LocalizationResult& result, dou
   // from the motion), nor on one that turns (RoutePoseEstimatorOptions::scale_max_turn).
   if (options_.scale_sigma > 0.0 && result.to_key.matched && key_position > 0) {
     const TaughtSegment& link = route_.segments[key_position - 1];
-    const double log_scale = ApparentLogScale(result.to_key.verified);
+    const OdometrySample& key = route_.key_poses[key_position];
+    // Seen with the key image's heading (the estimate's, measured well by the rotations): turned, one side of
+    // the view is nearer than the other and the scale would read as a step along the route.
+    const bool camera =
+        focal_px > 0.0 && std::isfinite(route_.principal_point.x) && std::isfinite(route_.principal_point.y);
+    const double log_scale =
+        ApparentLogScale(camera ? UndoFrameYaw(result.to_key.verified, WrapAngle(estimator_.pose()[2] - key.yaw),
+                                               focal_px, route_.principal_point)
+                                : result.to_key.verified);
     const bool straight = std::abs(link.yaw_change) <= options_.scale_max_turn;  // false when NaN
     if (straight && !link.backwards && link.log_scale < 0.0 && link.length > 0.0 && std::isfinite(log_scale)) {
-      const OdometrySample& key = route_.key_poses[key_position];
       const double rate = -link.log_scale / link.length;
       const double sigma = Weak(result.to_key, key_position) ? options_.weak_scale_sigma : options_.scale_sigma;
       (estimator_.UpdateScale({key.x, key.y}, {std::cos(key.yaw), std::sin(key.yaw)}, rate, log_scale, rate * sigma)

@@ -96,7 +96,10 @@ TaughtRoute MakeTaughtRoute(const VisualMap& map, std::vector<int> keys,
     route.segments.push_back(segment);
   }
   route.keys = std::move(keys);
-  if (map.input.camera) route.focal_px = map.input.camera->fx;
+  if (map.input.camera) {
+    route.focal_px = map.input.camera->fx;
+    route.principal_point = {map.input.camera->cx, map.input.camera->cy};
+  }
   // The metric route: every key image's pose on the teach odometry, and the odometry between the first and last.
   if (!teach_odometry.empty()) {
     for (int key : route.keys) {

@@ -44,6 +44,8 @@ struct TaughtRoute {
   std::vector<TaughtSegment> segments;  // keys.size() - 1
   // The map camera's focal length in pixels (fx): turns pixel headings into angles; NaN without a camera.
   double focal_px = std::numeric_limits<double>::quiet_NaN();
+  // The map camera's principal point (cx, cy) in pixels; NaN without a camera.
+  cv::Point2d principal_point{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
   // With teach odometry covering the route: each route key image's pose in the teach odometry's frame, and the
   // path the teach run drove from the first to the last, in the route's order (a route driven backwards lists
   // it backwards; yaw stays the teach run's heading). Empty without: the route is then known only up to scale.
