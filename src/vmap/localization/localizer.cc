@@ -80,6 +80,7 @@ Localizer::~Localizer() = default;
 
 void Localizer::Reset() {
   belief_.Reset();
+  pointed_ = pointed_before_ = -1;
   position_ = -1;
   lost_in_a_row_ = 0;
   step_back_ruled_out_ = {};
@@ -95,6 +96,8 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   }
   belief_.Predict();
   belief_confident_ = SinglesOut(belief_.Peak());
+  moved_twice_ = false;
+  pointed_before_ = std::exchange(pointed_, -1);
   LocalizationResult result = has_estimate() ? Track(frame, features) : Relocalize(frame, features);
   Believe(result, frame, features);
   result.comparisons =
@@ -193,11 +196,16 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     // Lost against the estimate: the frame may be elsewhere on the route (the robot turned back, skipped
     // ahead, or the estimate was wrong). Look for it over the whole route at once; keep the estimate when
     // that fails too.
+    const int lost_before = lost_in_a_row_;
     LocalizationResult found = Relocalize(frame, features);
-    if (found.status == LocalizationStatus::kRelocalized) return found;
-    result.status = LocalizationStatus::kLost;
+    const bool relocalized = found.status == LocalizationStatus::kRelocalized;
+    if (relocalized && TakesJump(position, found.route_position)) return found;
+    // Lost, or found far from where the frames were on this frame's evidence alone: the estimate stays (uncertain,
+    // the best guess, until the next frame confirms the far place).
+    result.status = relocalized ? LocalizationStatus::kUncertain : LocalizationStatus::kLost;
     result.candidates = std::move(found.candidates);
-    ++lost_in_a_row_;
+    position_ = position;
+    lost_in_a_row_ = lost_before + 1;
     Describe(result, position, features);
     if (lost_in_a_row_ > options_.max_lost_frames) {
       // The estimate is dropped; the belief is kept (its evidence still says where the frames were).
@@ -216,13 +224,34 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     for (const RelocalizationCandidate& c : found.candidates) {
       if (c.accepted) found_verified = std::max(found_verified, c.num_verified);
     }
-    if (found.status == LocalizationStatus::kRelocalized && found_verified > best.num_verified) return found;
+    if (found.status == LocalizationStatus::kRelocalized && found_verified > best.num_verified &&
+        TakesJump(position, found.route_position)) {
+      return found;
+    }
   }
   lost_in_a_row_ = 0;
   position_ = best_position;
+  moved_twice_ = best_position == position + 2;
   result.status = LocalizationStatus::kTracking;
   Describe(result, position_, features);
   return result;
+}
+
+bool Localizer::TakesJump(int from, int to) {
+  if (options_.belief.window <= 0 || options_.belief.min_confidence <= 0.0 || std::abs(to - from) <= kNear) return true;
+  if (pointed_before_ >= 0 && std::abs(to - pointed_before_) <= kNear) {
+    // Two frames in a row point there; the belief, weighed by both, must not hold less near it than near `from`.
+    WeighComparisons();
+    if (NearDensity(to) >= NearDensity(from)) return true;
+  }
+  pointed_ = to;
+  return false;
+}
+
+double Localizer::NearDensity(int position) const {
+  const int last = static_cast<int>(route_.size()) - 1;
+  const int width = std::min(last, position + kNear) - std::max(0, position - kNear) + 1;
+  return belief_.MassWithin(position, kNear) / width;
 }
 
 double Localizer::SharedWithLink(const KeyComparison& comparison, int key_a, int key_b) const {

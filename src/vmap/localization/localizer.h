@@ -86,6 +86,10 @@ class Localizer {
   // result's confidence and, when the belief does not single out the tracked position, the status kUncertain.
   void Believe(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
   void WeighComparisons();
+  // A frame tracked two key images on is moved back to the key image it passed when the belief holds more on the
+  // segment after that key image: the motion prior (one key image a frame is likelier than two) and the evidence of
+  // both key images say the frame has not passed the second.
+  void SettleDoubleStep(LocalizationResult& result, const ImageFeatures& features);
   // When the belief doubts the frame's position: compares around the belief's peak (over the whole route when
   // it is flat) and moves the estimate to the peak when the belief singles it out.
   // The belief singles out route `position` (not only holds min_confidence near it: also far more than a flat
@@ -152,6 +156,17 @@ class Localizer {
   // After the frame's motion step, before its evidence: the belief held at least min_confidence near its peak
   // (the frames before this one singled out a place). A flat belief does not move the estimate.
   bool belief_confident_ = false;
+  // A relocalization more than kNear route positions from the tracked estimate: one frame's evidence (a chance match
+  // across lighting looks alike) does not move the tracker; two frames in a row pointing there do. Returns whether
+  // the tracker moves from route position `from` to `to`; when not, remembers `to` for the next frame. Only with the
+  // belief on (belief.window and min_confidence above 0).
+  bool TakesJump(int from, int to);
+  // The belief's mass per route position within kNear of `position` (fewer positions at the route's ends).
+  double NearDensity(int position) const;
+  int pointed_ = -1;         // the far route position this frame's relocalization pointed at; -1: none
+  int pointed_before_ = -1;  // the previous frame's
+  // Track moved the estimate two key images on this frame (LocalizerOptions::lookahead).
+  bool moved_twice_ = false;
   EvidenceModel evidence_;  // by the kind of the matcher's descriptors
   struct Memo {
     KeyComparison comparison;

@@ -38,6 +38,7 @@ bool Localizer::SinglesOut(int position) const {
 
 void Localizer::Believe(LocalizationResult& result, const Frame& frame, const ImageFeatures& features) {
   WeighComparisons();
+  SettleDoubleStep(result, features);
   Question(result, frame, features);
   const std::vector<double>& p = belief_.probabilities();
   for (size_t i = 0; i < p.size() && i < route_.size(); ++i) {
@@ -53,7 +54,7 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
   // A flat belief's peak is no better a guess than the tracker's (corridor_conditions, docs/localize.md).
   const int peak = belief_.Peak();
   if (options_.belief.window > 0 && result.status == LocalizationStatus::kUncertain && peak != result.route_position &&
-      SinglesOut(peak) && belief_.MassWithin(peak, kNear) > result.confidence) {
+      belief_confident_ && SinglesOut(peak) && belief_.MassWithin(peak, kNear) > result.confidence) {
     LocalizationResult guess;
     guess.candidates = std::move(result.candidates);
     Describe(guess, peak, features);
@@ -62,6 +63,20 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
     guess.confidence = belief_.MassWithin(peak, kNear);
     result = std::move(guess);
   }
+}
+
+void Localizer::SettleDoubleStep(LocalizationResult& result, const ImageFeatures& features) {
+  if (!moved_twice_ || options_.belief.window <= 0 || result.status != LocalizationStatus::kTracking) return;
+  const int passed = result.route_position - 1;
+  const std::vector<double>& p = belief_.probabilities();
+  if (!(p[passed] > p[result.route_position]) || !CompareOnce(features, route_[passed]).accepted) return;
+  LocalizationResult settled;
+  settled.candidates = std::move(result.candidates);
+  Describe(settled, passed, features);
+  settled.status = LocalizationStatus::kTracking;
+  result = std::move(settled);
+  position_ = passed;
+  step_back_ruled_out_ = {};
 }
 
 void Localizer::Question(LocalizationResult& result, const Frame& frame, const ImageFeatures& features) {
