@@ -153,6 +153,7 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   // then (a rival or two compared, where a relocalization would compare the ranking's five and their neighbours).
   auto compare_at = [&](int position) { return CompareTracked(frame, features, position); };
   const int position = position_;
+  const int lost_before = lost_in_a_row_;  // frames lost since `position` was tracked
   const KeyComparison at_key = compare_at(position);
   KeyComparison best = at_key;
   int best_position = position;
@@ -196,10 +197,9 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     // Lost against the estimate: the frame may be elsewhere on the route (the robot turned back, skipped
     // ahead, or the estimate was wrong). Look for it over the whole route at once; keep the estimate when
     // that fails too.
-    const int lost_before = lost_in_a_row_;
     LocalizationResult found = Relocalize(frame, features);
     const bool relocalized = found.status == LocalizationStatus::kRelocalized;
-    if (relocalized && TakesJump(position, found.route_position)) return found;
+    if (relocalized && TakesJump(position, found.route_position, lost_before)) return found;
     // Lost, or found far from where the frames were on this frame's evidence alone: the estimate stays (uncertain,
     // the best guess, until the next frame confirms the far place).
     result.status = relocalized ? LocalizationStatus::kUncertain : LocalizationStatus::kLost;
@@ -225,7 +225,7 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
       if (c.accepted) found_verified = std::max(found_verified, c.num_verified);
     }
     if (found.status == LocalizationStatus::kRelocalized && found_verified > best.num_verified &&
-        TakesJump(position, found.route_position)) {
+        TakesJump(position, found.route_position, lost_before)) {
       return found;
     }
   }
@@ -237,8 +237,10 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   return result;
 }
 
-bool Localizer::TakesJump(int from, int to) {
-  if (options_.belief.window <= 0 || options_.belief.min_confidence <= 0.0 || std::abs(to - from) <= kNear) return true;
+bool Localizer::TakesJump(int from, int to, int lost_frames) {
+  // While lost the robot moved on unseen: up to `lookahead` key images a frame, as the tracker would have followed.
+  const int reach = kNear + options_.lookahead * lost_frames;
+  if (options_.belief.window <= 0 || options_.belief.min_confidence <= 0.0 || std::abs(to - from) <= reach) return true;
   if (pointed_before_ >= 0 && std::abs(to - pointed_before_) <= kNear) {
     // Two frames in a row point there; the belief, weighed by both, must not hold less near it than near `from`.
     WeighComparisons();

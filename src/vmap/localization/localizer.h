@@ -124,6 +124,16 @@ class Localizer {
   bool MayStandOut(const KeyComparison& comparison) const;
   bool StandsOut(int verified, int rival_verified) const;
 
+  // A relocalization far from the tracked estimate (more than kNear route positions, plus `lookahead` for each of
+  // the `lost_frames` frames lost since it was tracked): one frame's evidence (across lighting a chance match looks
+  // alike) does not move the tracker; two frames in a row pointing there do, when the belief, weighed by both, holds
+  // at least as much per position near it as near the tracked estimate. Returns whether the tracker moves from route
+  // position `from` to `to`; when not, remembers `to` for the next frame. Only with the belief on (belief.window and
+  // min_confidence above 0).
+  bool TakesJump(int from, int to, int lost_frames);
+  // The belief's mass per route position within kNear of `position` (fewer positions at the route's ends).
+  double NearDensity(int position) const;
+
   // The frame's verified matches with key_a over those of the map's link between key_a and key_b (0 when
   // they have no link).
   double SharedWithLink(const KeyComparison& comparison, int key_a, int key_b) const;
@@ -156,13 +166,6 @@ class Localizer {
   // After the frame's motion step, before its evidence: the belief held at least min_confidence near its peak
   // (the frames before this one singled out a place). A flat belief does not move the estimate.
   bool belief_confident_ = false;
-  // A relocalization more than kNear route positions from the tracked estimate: one frame's evidence (a chance match
-  // across lighting looks alike) does not move the tracker; two frames in a row pointing there do. Returns whether
-  // the tracker moves from route position `from` to `to`; when not, remembers `to` for the next frame. Only with the
-  // belief on (belief.window and min_confidence above 0).
-  bool TakesJump(int from, int to);
-  // The belief's mass per route position within kNear of `position` (fewer positions at the route's ends).
-  double NearDensity(int position) const;
   int pointed_ = -1;         // the far route position this frame's relocalization pointed at; -1: none
   int pointed_before_ = -1;  // the previous frame's
   // Track moved the estimate two key images on this frame (LocalizerOptions::lookahead).

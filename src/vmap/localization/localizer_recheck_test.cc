@@ -1,6 +1,7 @@
 // The tracking check of the Localizer (LocalizerOptions::recheck_link_share, min_link_share): a frame tracked at
 // a key image it shares far less with than the map's links is relocalized and moved where it verifies better.
 
+#include <cstdlib>
 #include <limits>
 #include <vector>
 
@@ -224,6 +225,44 @@ TEST(Localizer, AFlatBeliefMakesNoBestGuessOfOneFramesEvidence) {
   const LocalizationResult second = localize(41, 1, true);
   EXPECT_EQ(second.status, LocalizationStatus::kUncertain);
   EXPECT_LE(second.key, 4) << "the tracker's key image, not the peak of one frame's evidence";
+}
+
+// While frames are lost the robot moves on unseen: a relocalization after them may be further from the tracked
+// estimate than two route positions, by up to `lookahead` key images a lost frame, and is taken at once (a route of
+// michigan's five places, a place a frame, needs it). Here three frames see nothing, then the frame sees the key
+// images 8 route positions on (and only them). The frames' comparisons are given (Localize's `ahead`).
+TEST(Localizer, AfterLostFramesARelocalizationAsFarAsTheRobotCouldGoIsTakenAtOnce) {
+  const LocalizationMap& m = Dense();
+  const int count = static_cast<int>(m.map.key_images.size());
+  Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
+  int index = 0;
+  LocalizationResult r;
+  for (int source_index : {1, 3, 5, 7, 9}) r = LocalizeImage(localizer, source_index, index++);
+  ASSERT_EQ(r.status, LocalizationStatus::kTracking);
+  const int far = r.route_position + 8;  // the route is the key images in order
+  ASSERT_LT(far + 2, count);
+  auto localize = [&](int source_index, bool sees) {
+    std::vector<KeyComparison> given(count);
+    for (int key = 0; key < count; ++key) {
+      KeyComparison& c = given[key];
+      c.key = key;
+      if (sees && std::abs(key - far) <= 1) {
+        c.matched = c.accepted = true;
+        c.num_verified = 200;
+        c.similarity = 0.5;
+        c.log10_nfa = -40.0;
+      }
+    }
+    ::vmap::testing::MemorySource source({SidewaysDrive().frames[source_index]}, {source_index});
+    Frame frame = *source.Next();
+    frame.index = index++;
+    return localizer.Localize(frame, *m.matcher->Extract(frame.gray), std::move(given));
+  };
+  for (int blind = 0; blind < 3; ++blind) r = localize(11 + 2 * blind, false);
+  ASSERT_FALSE(MaySteerBy(r));
+  r = localize(2 * far + 1, true);
+  EXPECT_EQ(r.status, LocalizationStatus::kRelocalized);
+  EXPECT_LE(std::abs(r.route_position - far), 1) << "at route position " << r.route_position;
 }
 
 // A frame the tracker moves two key images on (LocalizerOptions::lookahead 2) because the second verifies a match or
