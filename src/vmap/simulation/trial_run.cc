@@ -130,12 +130,12 @@ void TrialRun::Record(const LocalizationResult& localization, const ControlStep&
   sample.heading_error_estimate = step.heading_error_estimate;
   sample.arc_estimate = step.arc_estimate;
   sample.observation = step.observation;
-  sample.translation_sigma_deg = TargetComparison(localization).translation_sigma_deg;
-  sample.target_verified = TargetComparison(localization).num_verified;
-  const RelativePose& pose = TargetComparison(localization).pose;
-  if (pose.valid) sample.pose_heading = -YawOfCameraRotation(pose.R);
+  const KeyComparison& target = TargetComparison(localization);
+  sample.translation_sigma_deg = target.translation_sigma_deg;
+  sample.target_verified = target.num_verified;
+  if (target.pose.valid) sample.pose_heading = -YawOfCameraRotation(target.pose.R);
   if (localization.translation_known) {
-    const TargetBearing measured = BearingToKey(pose);
+    const TargetBearing measured = BearingToKey(target.pose);
     if (measured.valid) sample.pose_bearing = measured.bearing;
   }
   sample.key_log_scale = ApparentLogScale(localization.to_key.verified);
