@@ -96,7 +96,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   }
   belief_.Predict();
   belief_confident_ = SinglesOut(belief_.Peak());
-  moved_twice_ = false;
+  steps_on_ = 0;
   pointed_before_ = std::exchange(pointed_, -1);
   LocalizationResult result = has_estimate() ? Track(frame, features) : Relocalize(frame, features);
   Believe(result, frame, features);
@@ -231,7 +231,7 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   }
   lost_in_a_row_ = 0;
   position_ = best_position;
-  moved_twice_ = best_position == position + 2;
+  steps_on_ = std::max(0, best_position - position);
   result.status = LocalizationStatus::kTracking;
   Describe(result, position_, features);
   return result;

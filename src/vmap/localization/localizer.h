@@ -86,10 +86,12 @@ class Localizer {
   // result's confidence and, when the belief does not single out the tracked position, the status kUncertain.
   void Believe(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
   void WeighComparisons();
-  // A frame tracked two key images on is moved back to the key image it passed when the belief holds more on the
-  // segment after that key image: the motion prior (one key image a frame is likelier than two) and the evidence of
-  // both key images say the frame has not passed the second.
-  void SettleDoubleStep(LocalizationResult& result, const ImageFeatures& features);
+  // A frame the tracker moved on (one or two key images: it is tracked at the key image it is nearest) goes back one
+  // when the belief says it is nearer the one before: the belief's positions are segments, and a frame at key image
+  // k is on segment k - 1 or k; it goes back from k to k - 1 when the belief holds more on segment k - 2 (before
+  // k - 1) than on segment k (after k). Two key images that look alike (one teach frame apart, or across seasons)
+  // are not told apart by one frame's verified matches; the run of frames before it and the motion prior decide.
+  void SettleStepOn(LocalizationResult& result, const ImageFeatures& features);
   // When the belief doubts the frame's position: compares around the belief's peak (over the whole route when
   // it is flat) and moves the estimate to the peak when the belief singles it out.
   // The belief singles out route `position` (not only holds min_confidence near it: also far more than a flat
@@ -168,8 +170,8 @@ class Localizer {
   bool belief_confident_ = false;
   int pointed_ = -1;         // the far route position this frame's relocalization pointed at; -1: none
   int pointed_before_ = -1;  // the previous frame's
-  // Track moved the estimate two key images on this frame (LocalizerOptions::lookahead).
-  bool moved_twice_ = false;
+  // How many key images Track moved the estimate on this frame (LocalizerOptions::lookahead); 0: none.
+  int steps_on_ = 0;
   EvidenceModel evidence_;  // by the kind of the matcher's descriptors
   struct Memo {
     KeyComparison comparison;

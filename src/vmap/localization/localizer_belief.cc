@@ -38,7 +38,7 @@ bool Localizer::SinglesOut(int position) const {
 
 void Localizer::Believe(LocalizationResult& result, const Frame& frame, const ImageFeatures& features) {
   WeighComparisons();
-  SettleDoubleStep(result, features);
+  SettleStepOn(result, features);
   Question(result, frame, features);
   const std::vector<double>& p = belief_.probabilities();
   for (size_t i = 0; i < p.size() && i < route_.size(); ++i) {
@@ -65,11 +65,21 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
   }
 }
 
-void Localizer::SettleDoubleStep(LocalizationResult& result, const ImageFeatures& features) {
-  if (!moved_twice_ || options_.belief.window <= 0 || result.status != LocalizationStatus::kTracking) return;
-  const int passed = result.route_position - 1;
+void Localizer::SettleStepOn(LocalizationResult& result, const ImageFeatures& features) {
+  const int reached = result.route_position;
+  if (steps_on_ <= 0 || options_.belief.window <= 0 || result.status != LocalizationStatus::kTracking || reached < 2) {
+    return;
+  }
   const std::vector<double>& p = belief_.probabilities();
-  if (!(p[passed] > p[result.route_position]) || !CompareOnce(features, route_[passed]).accepted) return;
+  const int passed = reached - 1;
+  // Two key images on: back when the belief holds more on the segment after the passed key image than after the
+  // reached one (one key image a frame is likelier than two). One key image on: back when the belief holds more on
+  // the segment before the key image left than after the one reached, and more there than a flat belief would (where
+  // it holds next to nothing on either side, it is sure of the segment between them and cannot tell which is nearer).
+  const bool back = steps_on_ >= 2
+                        ? p[passed] > p[reached]
+                        : p[reached - 2] > p[reached] && p[reached - 2] > 1.0 / static_cast<double>(p.size());
+  if (!back || !CompareOnce(features, route_[passed]).accepted) return;
   LocalizationResult settled;
   settled.candidates = std::move(result.candidates);
   Describe(settled, passed, features);

@@ -302,6 +302,44 @@ TEST(Localizer, TwoKeyImagesOnInOneFrameNeedsTheBeliefToAgree) {
   }
 }
 
+// A frame the tracker moves one key image on because the next verifies a match or two more than its key image goes
+// back when the belief holds more on the segment before its key image than on the segment after the next one: two key
+// images that look alike to the frame (one teach frame apart, or across seasons) are not told apart by one frame's
+// matches, and the run of frames before it says where it is. Without the belief (window 0) the frame moves on.
+TEST(Localizer, OneKeyImageOnNeedsTheBeliefNotToHoldMoreBehind) {
+  const LocalizationMap& m = Dense();
+  for (const int window : {2, 0}) {
+    LocalizerOptions options = MapLocalizerOptions(m);
+    options.belief.window = window;
+    Localizer localizer(m.map, m.keys, *m.matcher, options);
+    int index = 0;
+    LocalizationResult r;
+    for (int source_index : {1, 3, 5}) r = LocalizeImage(localizer, source_index, index++);
+    ASSERT_EQ(r.status, LocalizationStatus::kTracking);
+    const int p = r.route_position;
+    ASSERT_GE(p, 1);
+    ASSERT_LT(p + 2, static_cast<int>(m.map.key_images.size()));
+    // The frame sees key images p and p + 1 alike and weakly, as across seasons (p + 1 by two matches more, log10 NFA
+    // -1), not p + 2.
+    auto given = [&](int key, bool seen, int verified) {
+      KeyComparison c;
+      c.key = key;
+      c.matched = c.accepted = seen;
+      c.num_verified = verified;
+      c.similarity = 0.3;
+      c.log10_nfa = seen ? -1.0 : std::numeric_limits<double>::infinity();
+      return c;
+    };
+    ::vmap::testing::MemorySource source({SidewaysDrive().frames[7]}, {7});
+    Frame frame = *source.Next();
+    frame.index = index++;
+    const auto features = m.matcher->Extract(frame.gray);
+    r = localizer.Localize(frame, *features, {given(p, true, 20), given(p + 1, true, 22), given(p + 2, false, 0)});
+    EXPECT_EQ(r.status, LocalizationStatus::kTracking) << window;
+    EXPECT_EQ(r.route_position, window > 0 ? p : p + 1) << window;
+  }
+}
+
 // The belief moves the estimate (LocalizerOptions::belief.window): frames that verify against no key image (here
 // the drive's frames through fog and glare) after a run of frames that singled out a place are not lost but placed
 // at the belief's peak, carried along the route by its motion model, as a best guess not to steer by
