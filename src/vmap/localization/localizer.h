@@ -86,11 +86,11 @@ class Localizer {
   // result's confidence and, when the belief does not single out the tracked position, the status kUncertain.
   void Believe(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
   void WeighComparisons();
-  // A frame the tracker moved on (one or two key images: it is tracked at the key image it is nearest) goes back one
-  // when the belief says it is nearer the one before: the belief's positions are segments, and a frame at key image
-  // k is on segment k - 1 or k; it goes back from k to k - 1 when the belief holds more on segment k - 2 (before
-  // k - 1) than on segment k (after k). Two key images that look alike (one teach frame apart, or across seasons)
-  // are not told apart by one frame's verified matches; the run of frames before it and the motion prior decide.
+  // A frame the tracker moved on (it is tracked at the key image it is nearest) goes back one key image when the
+  // belief says so. The belief's positions are segments: a frame at key image k is on segment k - 1 or k. One key
+  // image on, to k: back when the belief holds more on segment k - 2 than on segment k (two key images that look alike,
+  // one teach frame apart or across seasons, are not told apart by one frame's matches; the frames before it and the
+  // motion prior are). Two on: back when it holds more on segment k - 1 than on k (one key image a frame is likelier).
   void SettleStepOn(LocalizationResult& result, const ImageFeatures& features);
   // When the belief doubts the frame's position: compares around the belief's peak (over the whole route when
   // it is flat) and moves the estimate to the peak when the belief singles it out.
