@@ -276,7 +276,7 @@ TEST(RouteTracking, AnotherSeasonsNoisyBearingsAreWeighedAsSuch) {
 double AlongErrorAfterAWrongStart(RoutePoseEstimatorOptions options) {
   TaughtRoute route = StraightMetricRoute();
   for (TaughtSegment& segment : route.segments) segment.log_scale = std::log(0.8);  // 1 m: the scene grows 25 %
-  const double rate = -std::log(0.8);
+  const double depth = 4.0;  // of each key image's scene: 4 / (4 + 1) = 0.8
   RouteTracking tracking(route, options);
   double truth = 0.2;
   for (int step = 0; step < 13; ++step) {
@@ -290,7 +290,7 @@ double AlongErrorAfterAWrongStart(RoutePoseEstimatorOptions options) {
     frame.next_key = frame.key + 1;
     frame.route_position = frame.key;
     frame.to_key.matched = true;
-    frame.to_key.verified = testing::ZoomedMatches(std::exp(rate * (truth - frame.key)));
+    frame.to_key.verified = testing::ZoomedMatches(depth / (depth - (truth - frame.key)));
     frame.to_key.num_verified = static_cast<int>(frame.to_key.verified.size());
     tracking.Observe(frame, 500.0);
   }
@@ -302,6 +302,56 @@ TEST(RouteTracking, TheKeyImagesScaleTellsHowFarBeforeOrPastItTheRobotIs) {
   RoutePoseEstimatorOptions bearings_only;
   bearings_only.scale_sigma = 0.0;
   EXPECT_GT(AlongErrorAfterAWrongStart(bearings_only), 0.6);  // still a key image ahead
+}
+
+// The scene of a key image 2 m ahead of it grows by 2 / (2 - d) when the robot is d metres past it (by 1.5 over the
+// map's 1 m link into it): faster the nearer the robot. A robot stands `past` metres past key image 1, the estimate
+// starts at the key image; returns where 20 frames of its scene put it, in metres past the key image. Taken as a
+// straight line over the link (a rate per metre), the growth put the s-curve's robot 0.1-0.2 m farther past its
+// first key image than it was, and the estimate entered the bend early.
+double DistancePastAKeyImageFromItsScene(double past) {
+  TaughtRoute route = StraightMetricRoute();
+  const double depth = 2.0;
+  for (TaughtSegment& segment : route.segments) segment.log_scale = std::log(depth / (depth + segment.length));
+  RouteTracking tracking(route);
+  for (int frame_index = 0; frame_index < 20; ++frame_index) {
+    LocalizationResult frame = FrameWithHeadings(0.0, 0.0);
+    frame.to_key.matched = true;
+    frame.to_key.verified = testing::ZoomedMatches(depth / (depth - past));
+    frame.to_key.num_verified = static_cast<int>(frame.to_key.verified.size());
+    tracking.Observe(frame, 500.0);
+  }
+  return tracking.pose()[0] - route.key_poses[1].x;
+}
+
+TEST(RouteTracking, TheKeyImagesSceneGrowsFasterTheNearerTheRobotIs) {
+  EXPECT_NEAR(DistancePastAKeyImageFromItsScene(-0.6), -0.6, 0.02);
+  EXPECT_NEAR(DistancePastAKeyImageFromItsScene(0.25), 0.25, 0.02);
+  // Farther past, the scene's nearest parts leave the view: not read (the estimate stays where it started).
+  EXPECT_NEAR(DistancePastAKeyImageFromItsScene(0.6), 0.0, 1e-9);
+}
+
+// In the s-curve's bends the poses to the key image ahead (a wall seen obliquely) came with wrong rotations and
+// bearings off by +0.13 to +0.30 rad together: a pose whose rotation the gate refuses gives no bearing.
+TEST(RouteTracking, APoseWhoseRotationIsRefusedGivesNoBearing) {
+  RouteTracking tracking(StraightMetricRoute());
+  tracking.Observe(FrameWithHeadings(0.0, 0.0), 500.0);  // starts at key image 1, heading 0 within 0.04 rad
+  ASSERT_TRUE(tracking.started());
+  const auto with_bearing = [](double rotation_offset, double bearing) {
+    LocalizationResult frame = FrameWithHeadings(rotation_offset, rotation_offset);
+    const cv::Vec3d centre(-std::sin(bearing), 0.0, std::cos(bearing));  // key image 2 `bearing` rad left
+    frame.to_next.pose.t = -(frame.to_next.pose.R * centre);
+    frame.translation_known = true;
+    return frame;
+  };
+  const TrackingObservation refused = tracking.Observe(with_bearing(0.3, 0.2), 500.0);
+  EXPECT_EQ(refused.headings, 0);
+  EXPECT_EQ(refused.bearings, 0);
+  EXPECT_NEAR(tracking.pose()[1], 0.0, 1e-12);
+  const TrackingObservation taken = tracking.Observe(with_bearing(0.0, 0.2), 500.0);  // the same with its heading
+  EXPECT_EQ(taken.headings, 1);
+  EXPECT_EQ(taken.bearings, 1);
+  EXPECT_LT(tracking.pose()[1], -0.05);  // key image 2 seen left: the robot is right of the path
 }
 
 // A robot drives 18 m around a circle of radius 3 m (the simulator's loop) with the odometry 5 % too long; the

@@ -90,11 +90,17 @@ bool RoutePoseEstimator::UpdateHeading(double yaw, double sigma) {
   return taken;
 }
 
-bool RoutePoseEstimator::UpdateScale(const cv::Point2d& landmark, const cv::Vec2d& direction, double rate,
+bool RoutePoseEstimator::UpdateScale(const cv::Point2d& landmark, const cv::Vec2d& direction, double depth,
                                      double log_scale, double sigma) {
-  if (!initialized_ || !(rate > 0.0) || !(sigma > 0.0) || !std::isfinite(log_scale)) return false;
-  const double predicted = rate * ((state_[0] - landmark.x) * direction[0] + (state_[1] - landmark.y) * direction[1]);
-  return Update(cv::Matx14d(rate * direction[0], rate * direction[1], 0.0, 0.0), log_scale - predicted, sigma * sigma);
+  if (!initialized_ || !(depth > 0.0) || !(sigma > 0.0) || !std::isfinite(log_scale)) return false;
+  const double past = (state_[0] - landmark.x) * direction[0] + (state_[1] - landmark.y) * direction[1];
+  const double remaining = depth - past;  // from the robot to the scene, as the estimate has it
+  // How far past the measurement says (not the estimate: an estimate a key image ahead must still be pulled back).
+  const double measured_past = -depth * std::expm1(-log_scale);
+  if (!(measured_past <= options_.scale_max_past) || !(remaining >= 0.5 * depth)) return false;
+  const double slope = 1.0 / remaining;  // of the log-scale, per metre past the landmark
+  return Update(cv::Matx14d(slope * direction[0], slope * direction[1], 0.0, 0.0),
+                log_scale - std::log(depth / remaining), (slope * sigma) * (slope * sigma));
 }
 
 bool RoutePoseEstimator::UpdateBearing(const cv::Point2d& landmark, double bearing, double sigma) {
