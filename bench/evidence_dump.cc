@@ -11,11 +11,13 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "vmap/core/runtime.h"
+#include "vmap/features/orb_matcher.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/sources/frame_source.h"
 
@@ -28,14 +30,25 @@ int main(int argc, char** argv) {
     return 2;
   }
   FrameSourceOptions query_options;
+  // ORB only, an experiment (docs/localize.md, "guided matching"): the frame's features and the matching of the
+  // comparisons made with other options than the map's (OrbMatcherOptions' defaults otherwise).
+  OrbMatcherOptions frame_orb, match_orb;
+  bool orb_override = false;
   for (int i = 3; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--stride")) query_options.stride = std::stoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--last")) query_options.last = std::stoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--cross-check"))
+      match_orb.cross_check = std::stoi(argv[i + 1]) != 0, orb_override = true;
+    if (!std::strcmp(argv[i], "--ratio")) match_orb.ratio = std::stod(argv[i + 1]), orb_override = true;
+    if (!std::strcmp(argv[i], "--frame-fast")) frame_orb.fast_threshold = std::stoi(argv[i + 1]), orb_override = true;
+    if (!std::strcmp(argv[i], "--frame-features")) frame_orb.num_features = std::stoi(argv[i + 1]), orb_override = true;
   }
   const LocalizationMap opened = OpenLocalizationMap(argv[1], {});
   query_options.resize = QueryResize(opened.map, "");
   const LocalizerOptions options = FollowMap(opened, MapLocalizerOptions(opened), query_options.resize);
-  const Localizer localizer(opened.map, opened.keys, *opened.matcher, options);
+  const std::unique_ptr<Matcher> frame_matcher = orb_override ? CreateOrbMatcher(frame_orb) : nullptr;
+  const std::unique_ptr<Matcher> match_matcher = orb_override ? CreateOrbMatcher(match_orb) : nullptr;
+  const Localizer localizer(opened.map, opened.keys, orb_override ? *match_matcher : *opened.matcher, options);
   const int num_keys = static_cast<int>(opened.map.key_images.size());
   std::vector<int> link_verified(num_keys, 0);
   for (const Link& link : opened.map.links) {
@@ -50,7 +63,7 @@ int main(int argc, char** argv) {
       "heading_confidence,heading_votes\n");
   while (const std::optional<Frame> next = source->Next()) {
     const Frame& frame = *next;
-    const auto features = opened.matcher->Extract(frame.gray);
+    const auto features = (orb_override ? *frame_matcher : *opened.matcher).Extract(frame.gray);
     for (int k = 0; k < num_keys; ++k) {
       const KeyComparison c = localizer.Compare(*features, k);
       std::printf("%d,%d,%d,%d,%d,%d,%d,%.4f,%.3f,%d,%.4f,%d\n", frame.index, frame.source_index, k, c.matched ? 1 : 0,

@@ -222,6 +222,33 @@ TEST(LocalizeCli, EvalCorridorRuns) {
   EXPECT_EQ(Lines(csv).size(), 51u);
 }
 
+TEST(LocalizeCli, GuidedMatchingTracksFramesChanceRefusedAcrossLighting) {
+  // corridor_conditions with ORB (docs/localize.md, "Guided matching by the belief"): frames whose cross-checked
+  // matches verify too few at the tracked key images for chance while the belief holds them there are matched
+  // again with those key images only, one-way best matches kept, and the a-contrario test accepts some of them.
+  const fs::path data = Shared() / "data/corridor_conditions";
+  if (Shared().empty() || !fs::exists(data)) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  ::vmap::testing::ScopedTempDir tmp;
+  std::string out;
+  ASSERT_EQ(RunVmap("build " + Quote(data / "teach") + " -q -o " + Quote(tmp.path() / "map"), &out), 0) << out;
+  auto steered = [&](const std::string& flags) {
+    const fs::path csv = tmp.path() / "run.csv";
+    EXPECT_EQ(RunVmap("localize " + Quote(tmp.path() / "map") + " " + Quote(data / "repeat") + " --last 39 -q --csv " +
+                          Quote(csv) + flags,
+                      &out),
+              0)
+        << out;
+    int count = 0;
+    for (const std::string& row : Lines(csv)) {
+      count += row.find(",tracking,") != std::string::npos || row.find(",relocalized,") != std::string::npos;
+    }
+    return count;
+  };
+  const int guided = steered("");
+  const int unguided = steered(" --no-guided-matching");
+  EXPECT_GE(guided, unguided + 4) << "guided " << guided << ", without " << unguided;
+}
+
 TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
   ::vmap::testing::ScopedTempDir tmp;
   ::vmap::testing::SyntheticOptions synthetic;

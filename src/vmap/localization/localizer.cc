@@ -7,8 +7,11 @@
 #include <utility>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/features/matcher_registry.h"
+#include "vmap/features/orb_matcher.h"
 
 namespace vmap {
 
@@ -74,6 +77,13 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   const cv::Mat descriptors = keys_.features.front()->descriptors();
   evidence_ =
       !descriptors.empty() && descriptors.depth() == CV_8U ? BinaryDescriptorEvidence() : FloatDescriptorEvidence();
+  if (options_.guided_matching && matcher_.name() == OrbMatcherOptions::kModelName) {
+    MatcherOptions guided;
+    guided.type = OrbMatcherOptions::kModelName;
+    guided.model(guided.type).FromJson(nlohmann::json::parse(matcher_.DescribeOptionsJson()), "the map's matcher");
+    guided.Of<OrbMatcherOptions>().cross_check = false;
+    guided_matcher_ = CreateMatcher(guided);
+  }
 }
 
 Localizer::~Localizer() = default;
@@ -191,6 +201,17 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
           step_back_ruled_out_ = {position, v_next};
         }
       }
+    }
+  }
+  if (!best.accepted) {
+    const int guided = TrackGuided(features, position);
+    if (guided >= 0) {
+      lost_in_a_row_ = 0;
+      position_ = guided;
+      steps_on_ = std::max(0, guided - position);
+      result.status = LocalizationStatus::kTracking;
+      Describe(result, position_, features);
+      return result;
     }
   }
   if (!best.accepted) {

@@ -79,6 +79,12 @@ class Localizer {
                              int key) const;
   // Each key image is compared with a frame at most once per Localize call.
   KeyComparison CompareOnce(const ImageFeatures& features, int key);
+  // Guided matching (LocalizerOptions::guided_matching): the frame matched again with guided_matcher_ at route
+  // `position` and the one after it, the belief singling out that place, each only where its first comparison
+  // verified at least the link share (min_link_share; chance alone refused it). Returns the route position of the
+  // better accepted comparison, which replaces the frame's memo of that key image (its first comparison weighed
+  // into the belief first); -1 when neither is accepted or guided matching does not apply.
+  int TrackGuided(const ImageFeatures& features, int position);
   LocalizationResult Track(const Frame& frame, const ImageFeatures& features);
   LocalizationResult Relocalize(const Frame& frame, const ImageFeatures& features);
   void Describe(LocalizationResult& result, int position, const ImageFeatures& features);
@@ -149,6 +155,7 @@ class Localizer {
   const VisualMap& map_;
   const KeyImageStore& keys_;
   const Matcher& matcher_;
+  std::unique_ptr<Matcher> guided_matcher_;  // ORB without the cross check; null: no guided matching
   LocalizerOptions options_;
   std::vector<int> route_;
   std::vector<int> route_position_of_key_;  // -1 for key images off the route

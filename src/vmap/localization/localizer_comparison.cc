@@ -96,6 +96,38 @@ void Localizer::AddPose(KeyComparison& c) const {
   c.translation_known = evidence.known;
 }
 
+int Localizer::TrackGuided(const ImageFeatures& features, int position) {
+  const int last = static_cast<int>(route_.size()) - 1;
+  // Looser matching is decided by chance only (the counts rule would take its extra matches as evidence).
+  if (!guided_matcher_ || options_.acceptance != AcceptanceRule::kChance || !belief_confident_ ||
+      std::abs(belief_.Peak() - position) > kNear) {
+    return -1;
+  }
+  int found = -1;
+  KeyComparison best;
+  for (int p = position; p <= std::min(last, position + 1); ++p) {
+    const int key = route_[p];
+    // Only where chance refused the first comparison and the link share did not: guided matching asks chance again,
+    // never the share (a frame that shares little with the key image's scene, seen from elsewhere, stays refused:
+    // redkitchen's teach/repeat run, docs/localize.md).
+    if (CompareOnce(features, key).num_verified < options_.min_link_share * link_verified_[key]) continue;
+    WeighComparisons();  // the first comparisons' evidence, before a guided one replaces its key image's
+    KeyComparison c =
+        CompareImage(features, *keys_.features[key], guided_matcher_->Match(features, *keys_.features[key]), key);
+    if (!c.accepted || (found >= 0 && !IsBetterMatch(c, best))) continue;
+    found = p;
+    best = std::move(c);
+  }
+  if (found < 0) return -1;
+  for (Memo& m : comparisons_) {
+    if (m.comparison.key != best.key) continue;
+    m = {std::move(best), true, true};
+    return found;
+  }
+  comparisons_.push_back({std::move(best), true, true});
+  return found;
+}
+
 KeyComparison Localizer::CompareOnce(const ImageFeatures& features, int key) {
   for (Memo& m : comparisons_) {
     if (m.comparison.key == key) {

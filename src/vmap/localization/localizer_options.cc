@@ -48,6 +48,9 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                 experience_candidates);
   visitor.Visit({"lookahead", "--lookahead", "Key images beyond the next compared while tracking (1 or 2)"}, lookahead);
   visitor.Visit({"step_back", "!--no-step-back", "Never move the estimate back to the previous key image"}, step_back);
+  visitor.Visit({"guided_matching", "!--no-guided-matching",
+                 "ORB: never match a frame again with looser matching at the key images the belief holds"},
+                guided_matching);
   visitor.VisitNested("ranking", ranking);
   visitor.VisitNested("belief", belief);
   visitor.VisitNested("heading", heading);

@@ -59,6 +59,11 @@ struct LocalizerOptions {
   // follow only once their verified matches with `next_key` fall below that frame's (they moved back). Off: the
   // estimate only moves forwards (a robot that never reverses).
   bool step_back = true;
+  // Guided matching (ORB maps): a frame that verifies nothing at the tracked key images while the belief singles
+  // out that place is matched with them again, and only with them, keeping one-way best matches too (no cross
+  // check); the a-contrario test, which counts every tentative match, decides as before (docs/localize.md,
+  // "Guided matching by the belief"). Off: never.
+  bool guided_matching = true;
   // Lost frames in a row (each one also failed to relocalize) after which the estimate is dropped: key and
   // next_key then read -1 until a frame is relocalized.
   int max_lost_frames = 5;
