@@ -205,14 +205,7 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   }
   if (!best.accepted) {
     const int guided = TrackGuided(features, position);
-    if (guided >= 0) {
-      lost_in_a_row_ = 0;
-      position_ = guided;
-      steps_on_ = std::max(0, guided - position);
-      result.status = LocalizationStatus::kTracking;
-      Describe(result, position_, features);
-      return result;
-    }
+    if (guided >= 0) return TrackedAt(std::move(result), position, guided, features);
   }
   if (!best.accepted) {
     // Lost against the estimate: the frame may be elsewhere on the route (the robot turned back, skipped
@@ -250,9 +243,14 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
       return found;
     }
   }
+  return TrackedAt(std::move(result), position, best_position, features);
+}
+
+LocalizationResult Localizer::TrackedAt(LocalizationResult result, int from, int position,
+                                        const ImageFeatures& features) {
   lost_in_a_row_ = 0;
-  position_ = best_position;
-  steps_on_ = std::max(0, best_position - position);
+  position_ = position;
+  steps_on_ = std::max(0, position - from);
   result.status = LocalizationStatus::kTracking;
   Describe(result, position_, features);
   return result;

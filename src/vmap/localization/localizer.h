@@ -86,6 +86,8 @@ class Localizer {
   // into the belief first); -1 when neither is accepted or guided matching does not apply.
   int TrackGuided(const ImageFeatures& features, int position);
   LocalizationResult Track(const Frame& frame, const ImageFeatures& features);
+  // The frame tracked at route `position`, the estimate having been at `from`.
+  LocalizationResult TrackedAt(LocalizationResult result, int from, int position, const ImageFeatures& features);
   LocalizationResult Relocalize(const Frame& frame, const ImageFeatures& features);
   void Describe(LocalizationResult& result, int position, const ImageFeatures& features);
   // The belief's step (localizer_belief.cc): weighs the evidence of every comparison of the frame, then sets the

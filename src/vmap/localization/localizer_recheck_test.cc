@@ -3,6 +3,7 @@
 
 #include <cstdlib>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -48,13 +49,26 @@ const LocalizationMap& Dense() {
   return map.opened;
 }
 
-// Drive frame `source_index` localized as the `index`-th frame of a stream.
-LocalizationResult LocalizeImage(Localizer& localizer, int source_index, int index) {
+// Drive frame `source_index` localized as the `index`-th frame of a stream; `given`: comparisons the frame is taken
+// to have made already (Localizer::Localize's `ahead`).
+LocalizationResult LocalizeImage(Localizer& localizer, int source_index, int index,
+                                 std::vector<KeyComparison> given = {}) {
   ::vmap::testing::MemorySource source({SidewaysDrive().frames[source_index]}, {source_index});
   Frame frame = *source.Next();
   frame.index = index;
   const auto features = Dense().matcher->Extract(frame.gray);
-  return localizer.Localize(frame, *features);
+  return localizer.Localize(frame, *features, std::move(given));
+}
+
+// A comparison with key image `key` that verified `verified` matches at `log10_nfa` when `seen`, nothing otherwise.
+KeyComparison GivenComparison(int key, bool seen, int verified, double log10_nfa) {
+  KeyComparison c;
+  c.key = key;
+  c.matched = c.accepted = seen;
+  c.num_verified = verified;
+  c.similarity = 0.3;
+  c.log10_nfa = seen ? log10_nfa : std::numeric_limits<double>::infinity();
+  return c;
 }
 
 // Tracked at the start of the drive, then a frame far ahead: it still sees the start's far plane, so chance
@@ -282,21 +296,9 @@ TEST(Localizer, TwoKeyImagesOnInOneFrameNeedsTheBeliefToAgree) {
     const int p = r.route_position;
     ASSERT_LT(p + 3, static_cast<int>(m.map.key_images.size()));
     // The frame no longer sees key image p, sees p + 1 and p + 2 alike (p + 2 by two matches more), not p + 3.
-    auto given = [&](int key, bool seen, int verified) {
-      KeyComparison c;
-      c.key = key;
-      c.matched = c.accepted = seen;
-      c.num_verified = verified;
-      c.similarity = 0.3;
-      c.log10_nfa = seen ? -10.0 : std::numeric_limits<double>::infinity();
-      return c;
-    };
-    ::vmap::testing::MemorySource source({SidewaysDrive().frames[7]}, {7});
-    Frame frame = *source.Next();
-    frame.index = index++;
-    const auto features = m.matcher->Extract(frame.gray);
-    r = localizer.Localize(
-        frame, *features, {given(p, false, 0), given(p + 1, true, 60), given(p + 2, true, 62), given(p + 3, false, 0)});
+    auto given = [](int key, bool seen, int verified) { return GivenComparison(key, seen, verified, -10.0); };
+    r = LocalizeImage(localizer, 7, index++,
+                      {given(p, false, 0), given(p + 1, true, 60), given(p + 2, true, 62), given(p + 3, false, 0)});
     EXPECT_EQ(r.status, LocalizationStatus::kTracking) << window;
     EXPECT_EQ(r.route_position, window > 0 ? p + 1 : p + 2) << window;
   }
@@ -321,20 +323,8 @@ TEST(Localizer, OneKeyImageOnNeedsTheBeliefNotToHoldMoreBehind) {
     ASSERT_LT(p + 2, static_cast<int>(m.map.key_images.size()));
     // The frame sees key images p and p + 1 alike and weakly, as across seasons (p + 1 by two matches more, log10 NFA
     // -1), not p + 2.
-    auto given = [&](int key, bool seen, int verified) {
-      KeyComparison c;
-      c.key = key;
-      c.matched = c.accepted = seen;
-      c.num_verified = verified;
-      c.similarity = 0.3;
-      c.log10_nfa = seen ? -1.0 : std::numeric_limits<double>::infinity();
-      return c;
-    };
-    ::vmap::testing::MemorySource source({SidewaysDrive().frames[7]}, {7});
-    Frame frame = *source.Next();
-    frame.index = index++;
-    const auto features = m.matcher->Extract(frame.gray);
-    r = localizer.Localize(frame, *features, {given(p, true, 20), given(p + 1, true, 22), given(p + 2, false, 0)});
+    auto given = [](int key, bool seen, int verified) { return GivenComparison(key, seen, verified, -1.0); };
+    r = LocalizeImage(localizer, 7, index++, {given(p, true, 20), given(p + 1, true, 22), given(p + 2, false, 0)});
     EXPECT_EQ(r.status, LocalizationStatus::kTracking) << window;
     EXPECT_EQ(r.route_position, window > 0 ? p : p + 1) << window;
   }
