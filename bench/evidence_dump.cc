@@ -2,7 +2,8 @@
 // the evidence a belief over the route weighs, one CSV row per (frame, key image). The input of the calibration of
 // the route belief's evidence (bench/route_conditions.py --evidence-dir, docs/localize.md).
 //
-//   evidence_dump MAP QUERY [--stride N] [--last N]
+//   evidence_dump MAP QUERY [--stride N] [--last N] [--cross-check 0|1] [--ratio R] [--frame-fast T]
+//                 [--frame-features N] [--frame-edge PX] [--frame-grid-cell PX] [--frame-min-fast T] [--frame-clahe C]
 //
 // Columns: frame, source_index, key, matched, accepted, tentative, verified, similarity, log10_nfa, link_verified
 // (the smaller of the verified matches of the key image's links with its neighbours in the map; 0 without),
@@ -42,6 +43,11 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--ratio")) match_orb.ratio = std::stod(argv[i + 1]), orb_override = true;
     if (!std::strcmp(argv[i], "--frame-fast")) frame_orb.fast_threshold = std::stoi(argv[i + 1]), orb_override = true;
     if (!std::strcmp(argv[i], "--frame-features")) frame_orb.num_features = std::stoi(argv[i + 1]), orb_override = true;
+    if (!std::strcmp(argv[i], "--frame-edge")) frame_orb.edge_threshold = std::stoi(argv[i + 1]), orb_override = true;
+    if (!std::strcmp(argv[i], "--frame-grid-cell")) frame_orb.grid_cell = std::stoi(argv[i + 1]), orb_override = true;
+    if (!std::strcmp(argv[i], "--frame-min-fast"))
+      frame_orb.min_fast_threshold = std::stoi(argv[i + 1]), orb_override = true;
+    if (!std::strcmp(argv[i], "--frame-clahe")) frame_orb.clahe_clip = std::stod(argv[i + 1]), orb_override = true;
   }
   const LocalizationMap opened = OpenLocalizationMap(argv[1], {});
   query_options.resize = QueryResize(opened.map, "");

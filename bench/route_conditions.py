@@ -16,8 +16,11 @@ With --evidence-dir DIR, also every frame of each run against every key image of
 (build/bench/evidence_dump) into DIR/corridor_MATCHER.csv and DIR/michigan_MATCHER.csv, the input of
 bench/evidence_fit.py.
 
+With --build "FLAGS", every map is built with these flags too (e.g. ORB's extraction: "--orb-grid-cell 30
+--orb-edge-threshold 16"); the localizer follows what the map records.
+
 usage: bench/route_conditions.py --vmap build/vmap[,old/vmap] [--sets corridor,michigan] [--matchers orb,xfeat]
-                                 [--tau T] [--localize "FLAGS"] [--repeat-stride N] [--work DIR] [--csv-dir DIR]
+                                 [--tau T] [--build "FLAGS"] [--localize "FLAGS"] [--repeat-stride N] [--work DIR] [--csv-dir DIR]
                                  [--evidence-dir DIR]
 (from the repository root; ../shared must be there)"""
 import argparse, json, os, subprocess, sys, tempfile
@@ -137,7 +140,7 @@ def corridor(vmap, matcher, tau_flags, localize_flags, stride, work, csv_dir, ev
     return tally, len(key_sources)
 
 
-def michigan(vmap, matcher, localize_flags, work, evidence_dir=None):
+def michigan(vmap, matcher, localize_flags, work, evidence_dir=None, build_flags=()):
     images = os.path.join(SHARED, "michigan_seasons", "images")
     sessions = ["%02d" % s for s in range(1, 13)]
     folders = {}
@@ -151,8 +154,8 @@ def michigan(vmap, matcher, localize_flags, work, evidence_dir=None):
         folders[s] = folder
     tally = Tally()
     for a in sessions:
-        map_directory = os.path.join(work, "michigan_%s_map_%s" % (matcher, a))
-        build(vmap, folders[a], matcher, ["--tau", "1"], map_directory)
+        map_directory = os.path.join(work, "michigan_%s_map_%s%s" % (matcher, a, "".join(build_flags).replace("-", "")))
+        build(vmap, folders[a], matcher, ["--tau", "1"] + list(build_flags), map_directory)
         for b in sessions:
             if a == b:
                 continue
@@ -170,13 +173,15 @@ def main():
     parser.add_argument("--sets", default="corridor,michigan")
     parser.add_argument("--matchers", default="orb,xfeat")
     parser.add_argument("--tau", help="the corridor map's tau (default: the matcher's)")
+    parser.add_argument("--build", default="", help="more flags for vmap build (every map)")
     parser.add_argument("--localize", default="", help="more flags for vmap localize")
     parser.add_argument("--repeat-stride", type=int, default=1, help="corridor: every Nth repeat frame (a faster robot)")
     parser.add_argument("--work", help="keep maps here (reused) instead of a temporary folder")
     parser.add_argument("--csv-dir", help="write each corridor run's CSV here")
     parser.add_argument("--evidence-dir", help="write every frame's comparisons with every key image here")
     args = parser.parse_args()
-    tau_flags = ["--tau", args.tau] if args.tau else []
+    tau_flags = (["--tau", args.tau] if args.tau else []) + args.build.split()
+    build_flags = args.build.split()
     print(HEADER)
     with tempfile.TemporaryDirectory(prefix="vmap_route_conditions_") as scratch:
         for index, vmap in enumerate(args.vmap.split(",")):
@@ -192,7 +197,7 @@ def main():
                     for line in tally.far:
                         print("    " + line)
                 if "michigan" in args.sets:
-                    tally = michigan(vmap, matcher, args.localize.split(), work, args.evidence_dir)
+                    tally = michigan(vmap, matcher, args.localize.split(), work, args.evidence_dir, build_flags)
                     print(tally.row("%s: michigan 132 routes, %s" % (vmap, matcher)), flush=True)
                     for line in tally.far:
                         print("    " + line)

@@ -14,9 +14,11 @@
 
 #include <nlohmann/json.hpp>
 #include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "vmap/core/error.h"
 #include "vmap/features/matcher_registry.h"
+#include "vmap/features/orb_extraction.h"
 
 namespace vmap {
 
@@ -26,6 +28,15 @@ void OrbMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"num_levels", "--orb-levels", "ORB: pyramid levels"}, num_levels);
   visitor.Visit({"fast_threshold", "--orb-fast-threshold", "ORB: FAST threshold"}, fast_threshold);
   visitor.Visit({"edge_threshold", "--orb-edge-threshold", "ORB: border without features (px)"}, edge_threshold);
+  visitor.Visit({"grid_cell", "--orb-grid-cell",
+                 "ORB: 0 = OpenCV's detector; N = FAST per N px cell at every pyramid level, spread over cells "
+                 "and levels (edge threshold per level)"},
+                grid_cell);
+  visitor.Visit({"min_fast_threshold", "--orb-min-fast-threshold",
+                 "ORB grid: FAST threshold in cells where --orb-fast-threshold finds none"},
+                min_fast_threshold);
+  visitor.Visit({"clahe_clip", "--orb-clahe", "ORB: CLAHE (8x8 tiles) before extraction, its clip limit; 0 = off"},
+                clahe_clip);
   visitor.Visit({"cross_check", "!--no-cross-check", "ORB: keep one-way best matches too"}, cross_check);
   visitor.Visit({"ratio", "--ratio", "ORB: Lowe's ratio test (0 = off), e.g. 0.8"}, ratio);
 }
@@ -46,6 +57,11 @@ void OrbMatcherOptions::Check() const {
   if (fast_threshold < 1 || fast_threshold > 255) {
     throw OptionError("fast_threshold", fmt::format("must be 1 to 255 (default {})", defaults.fast_threshold));
   }
+  if (grid_cell < 0 || grid_cell > 10000) throw OptionError("grid_cell", "must be 0 (OpenCV's detector) to 10000 px");
+  if (min_fast_threshold < 1 || min_fast_threshold > 255) {
+    throw OptionError("min_fast_threshold", fmt::format("must be 1 to 255 (default {})", defaults.min_fast_threshold));
+  }
+  if (!(clahe_clip >= 0.0 && clahe_clip <= 1000.0)) throw OptionError("clahe_clip", "must be 0 (off) to 1000");
   if (!(ratio >= 0.0 && ratio <= 1.0)) throw OptionError("ratio", "must be in [0, 1] (0 disables the ratio test)");
 }
 
@@ -80,17 +96,34 @@ class OrbMatcher : public Matcher {
   std::string name() const override { return "orb"; }
 
   std::shared_ptr<const ImageFeatures> Extract(const cv::Mat& gray) const override {
+    auto features = std::make_shared<OrbFeatures>();
+    features->size = gray.size();
+    if (gray.empty()) return features;
+    cv::Mat image = gray;
+    if (options_.clahe_clip > 0.0) {
+      cv::createCLAHE(options_.clahe_clip, cv::Size(8, 8))->apply(gray, image);
+    }
+    if (options_.grid_cell > 0) {
+      OrbGridExtraction grid;
+      grid.num_features = options_.num_features;
+      grid.scale_factor = options_.scale_factor;
+      grid.num_levels = options_.num_levels;
+      grid.border = options_.edge_threshold;
+      grid.cell_size = options_.grid_cell;
+      grid.fast_threshold = options_.fast_threshold;
+      grid.min_fast_threshold = options_.min_fast_threshold;
+      ExtractOrbOnGrid(image, grid, features->keypoints, features->binary_descriptors);
+      return features;
+    }
     // A detector per call: cv::ORB is not documented as thread-safe, and creating one is cheap.
     cv::Ptr<cv::ORB> orb =
         cv::ORB::create(options_.num_features, static_cast<float>(options_.scale_factor), options_.num_levels,
                         options_.edge_threshold, 0, 2, cv::ORB::HARRIS_SCORE, 31, options_.fast_threshold);
-    auto features = std::make_shared<OrbFeatures>();
-    features->size = gray.size();
     // OpenCV's pyramid fails on a level that rounds to no pixel: such an image has no ORB features.
     const double smallest_level =
         std::min(gray.cols, gray.rows) / std::pow(options_.scale_factor, options_.num_levels - 1);
-    if (gray.empty() || smallest_level < 1.0) return features;
-    orb->detectAndCompute(gray, cv::noArray(), features->keypoints, features->binary_descriptors);
+    if (smallest_level < 1.0) return features;
+    orb->detectAndCompute(image, cv::noArray(), features->keypoints, features->binary_descriptors);
     if (features->binary_descriptors.empty()) features->keypoints.clear();
     return features;
   }

@@ -16,6 +16,15 @@ struct OrbMatcherOptions {
   int num_levels = 8;
   int edge_threshold = 31;
   int fast_threshold = 20;
+  // 0: OpenCV's detector (the fields above). N > 0: FAST per N px grid cell at every pyramid level, features
+  // spread over the cells and the levels (features/orb_extraction.h); edge_threshold is then the border at every
+  // level in that level's pixels. Absent from a map's JSON: 0, the extraction the map was built with.
+  int grid_cell = 0;
+  // Grid only: FAST's threshold in the cells where fast_threshold finds no corner.
+  int min_fast_threshold = 7;
+  // Contrast-limited histogram equalisation (cv::createCLAHE, 8 x 8 tiles) before extraction: its clip limit;
+  // 0 = none. Absent from a map's JSON: 0.
+  double clahe_clip = 0.0;
   // Keep a match only if it is the best in both directions (BFMatcher's crossCheck).
   bool cross_check = true;
   // Lowe's ratio test on Hamming distances: keep if best < ratio * second best. 0 disables it.
