@@ -2,7 +2,7 @@
 //
 //   localize_repeat TUM_SEQUENCE --teach FIRST:LAST --repeat FIRST:LAST [--stride N]
 //                   [--max-distance M] [--max-angle DEG] [--acceptance chance,counts]
-//                   [--variants counts/0/0,chance/0.5/0.25]
+//                   [--variants counts/0/0,chance/0.5/0.25] [--orb-fast-threshold T]
 //
 // Builds a map of the teach frames (default options) and localizes the repeat frames against it. The
 // sequence's groundtruth.txt (TUM: timestamp tx ty tz qx qy qz qw, camera to world) judges each repeat frame:
@@ -31,6 +31,7 @@
 
 #include "vmap/core/runtime.h"
 #include "vmap/features/matcher_registry.h"
+#include "vmap/features/orb_matcher.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/map/map_io.h"
@@ -167,6 +168,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path sequence = argv[1];
+  MatcherOptions matcher_options;  // ORB with its defaults unless --orb-fast-threshold
   std::pair<int, int> teach{0, 499}, repeat{500, 999};
   int stride = 1;
   double max_distance = 0.5, max_angle = 30.0;
@@ -194,6 +196,8 @@ int main(int argc, char** argv) {
       variants = bench::ParseAcceptanceVariants(argv[i + 1]);
     } else if (!std::strcmp(argv[i], "--variants")) {
       variants = bench::ParseLocalizerVariants(argv[i + 1]);
+    } else if (!std::strcmp(argv[i], "--orb-fast-threshold")) {
+      matcher_options.Of<OrbMatcherOptions>().fast_threshold = std::atoi(argv[i + 1]);
     }
   }
   vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
@@ -206,7 +210,7 @@ int main(int argc, char** argv) {
   fs::remove_all(map_directory);
   fs::create_directories(map_directory);
   {
-    const auto matcher = CreateMatcher({});
+    const auto matcher = CreateMatcher(matcher_options);
     MapBuilderOptions options;
     options.show_progress = false;
     FrameSourceOptions source_options;
