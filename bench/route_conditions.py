@@ -8,7 +8,9 @@ michigan: ../shared/data/michigan_seasons as routes: for every ordered pair of s
   five places in order (`--tau 1`: every place a key image) and session b's five places localized against it
   (frame i right at key image i). 132 routes of 5 frames.
 Per run: frames right (at a right key image, whatever the status), right and not uncertain, localized wrong, confidently wrong by more than 2 places (status tracking or relocalized at a
-key image more than 2 key images from every right one), uncertain and lost, and frames/s. Several vmap binaries
+key image more than 2 key images from every right one), uncertain and lost, frames/s, and back-jumps (a frame steered
+by, tracking or relocalized, at a key image before the previous steered-by frame's: the route goes forwards, and the
+held-out robot corridor's goal is none). Several vmap binaries
 (`--vmap A,B`) run one after the other on the same maps' inputs (each builds its own maps), so they compare side by
 side.
 
@@ -58,13 +60,22 @@ def keys_around(key_sources, source):
 class Tally:
     def __init__(self):
         self.frames = self.right = self.right_sure = self.wrong = self.confidently_far = self.uncertain = self.lost = 0
+        self.back_jumps = 0
         self.seconds = 0.0
         self.far = []
 
     def add(self, doc, right_keys_of, label):
         """`right_keys_of(frame)`: the set of right key images of that frame."""
+        steered_key = None  # the key image of the last frame steered by
         for f in doc["frames"]:
             self.frames += 1
+            if f["status"] in ("tracking", "relocalized"):
+                if steered_key is not None and f["key"] < steered_key:
+                    self.back_jumps += 1
+                    if len(self.far) < 8:
+                        self.far.append("%s frame %d: back-jump to key %d from %d" % (label, f["source_index"], f["key"],
+                                                                                      steered_key))
+                steered_key = f["key"]
             right = right_keys_of(f)
             status = f["status"]
             if status == "lost":
@@ -88,14 +99,14 @@ class Tally:
 
     def row(self, name):
         n = max(1, self.frames)
-        return "| %s | %d | %d (%.1f %%) | %d (%.1f %%) | %d | %d | %d | %d | %.1f |" % (
+        return "| %s | %d | %d (%.1f %%) | %d (%.1f %%) | %d | %d | %d | %d | %.1f | %d |" % (
             name, self.frames, self.right, 100.0 * self.right / n, self.right_sure, 100.0 * self.right_sure / n,
             self.wrong, self.confidently_far, self.uncertain, self.lost,
-            self.frames / self.seconds if self.seconds > 0 else 0.0)
+            self.frames / self.seconds if self.seconds > 0 else 0.0, self.back_jumps)
 
 
 HEADER = ("| run | frames | right | right, not uncertain | localized wrong | confidently > 2 places off | uncertain | "
-          "lost | frames/s |\n|---|---|---|---|---|---|---|---|---|")
+          "lost | frames/s | back-jumps |\n|---|---|---|---|---|---|---|---|---|---|")
 
 
 EVIDENCE_DUMP = "build/bench/evidence_dump"

@@ -222,19 +222,19 @@ TEST(LocalizeCli, EvalCorridorRuns) {
   EXPECT_EQ(Lines(csv).size(), 51u);
 }
 
-TEST(LocalizeCli, GuidedMatchingTracksFramesChanceRefusedAcrossLighting) {
-  // corridor_conditions with ORB (docs/localize.md, "Guided matching by the belief"): frames whose cross-checked
-  // matches verify too few at the tracked key images for chance while the belief holds them there are matched
-  // again with those key images only, one-way best matches kept, and the a-contrario test accepts some of them.
+// corridor_conditions' first 40 repeat frames against an ORB map of its teach run, once per entry of `flags` (more
+// flags for vmap localize): how many frames are steered by (tracking or relocalized). Empty without the data.
+std::vector<int> SteeredOnCorridor(const std::vector<std::string>& flags) {
   const fs::path data = Shared() / "data/corridor_conditions";
-  if (Shared().empty() || !fs::exists(data)) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  if (Shared().empty() || !fs::exists(data)) return {};
   ::vmap::testing::ScopedTempDir tmp;
   std::string out;
-  ASSERT_EQ(RunVmap("build " + Quote(data / "teach") + " -q -o " + Quote(tmp.path() / "map"), &out), 0) << out;
-  auto steered = [&](const std::string& flags) {
+  EXPECT_EQ(RunVmap("build " + Quote(data / "teach") + " -q -o " + Quote(tmp.path() / "map"), &out), 0) << out;
+  std::vector<int> steered;
+  for (const std::string& f : flags) {
     const fs::path csv = tmp.path() / "run.csv";
     EXPECT_EQ(RunVmap("localize " + Quote(tmp.path() / "map") + " " + Quote(data / "repeat") + " --last 39 -q --csv " +
-                          Quote(csv) + flags,
+                          Quote(csv) + f,
                       &out),
               0)
         << out;
@@ -242,11 +242,27 @@ TEST(LocalizeCli, GuidedMatchingTracksFramesChanceRefusedAcrossLighting) {
     for (const std::string& row : Lines(csv)) {
       count += row.find(",tracking,") != std::string::npos || row.find(",relocalized,") != std::string::npos;
     }
-    return count;
-  };
-  const int guided = steered("");
-  const int unguided = steered(" --no-guided-matching");
-  EXPECT_GE(guided, unguided + 4) << "guided " << guided << ", without " << unguided;
+    steered.push_back(count);
+  }
+  return steered;
+}
+
+TEST(LocalizeCli, GuidedMatchingTracksFramesChanceRefusedAcrossLighting) {
+  // corridor_conditions with ORB (docs/localize.md, "Guided matching by the belief"): frames whose cross-checked
+  // matches verify too few at the tracked key images for chance while the belief holds them there are matched
+  // again with those key images only, one-way best matches kept, and the a-contrario test accepts some of them
+  // (the continuity of the heading off, to see guided matching's own).
+  const std::vector<int> steered = SteeredOnCorridor({" --continuity-share 0", " --no-guided-matching"});
+  if (steered.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  EXPECT_GE(steered[0], steered[1] + 4) << "guided " << steered[0] << ", without " << steered[1];
+}
+
+TEST(LocalizeCli, TheHeadingsContinuityTracksGuidedFramesChanceRefuses) {
+  // corridor_conditions with ORB (docs/localize.md, "Continuity of the heading"): a guided comparison chance refuses
+  // is accepted when its matches move as the previous frame's heading against the key image predicts.
+  const std::vector<int> steered = SteeredOnCorridor({"", " --continuity-share 0"});
+  if (steered.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  EXPECT_GE(steered[0], steered[1] + 4) << "with the continuity " << steered[0] << ", without " << steered[1];
 }
 
 TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
@@ -273,6 +289,7 @@ TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
       {localize + "--min-verified 30", "--min-verified belongs to --acceptance counts (the earlier rule)"},
       {localize + "--acceptance counts --min-link-share 0.5", "--min-link-share belongs to --acceptance chance"},
       {localize + "--recheck-link-share -1", "--recheck-link-share -1 is outside [0, 10]"},
+      {localize + "--continuity-share 2", "--continuity-share 2 is outside [0, 1]"},
       {localize + "--to 99", "key image 99 does not exist"},
       {"localize " + Quote(tmp.path() / "m") + " " + Quote(tmp.path() / "missing.mp4"), "does not exist"},
       {"route " + Quote(tmp.path() / "m") + " --min-backward-verified 2", "--min-backward-verified 2 must be 8"},

@@ -94,6 +94,7 @@ void Localizer::Reset() {
   position_ = -1;
   lost_in_a_row_ = 0;
   step_back_ruled_out_ = {};
+  previous_headings_.clear();
 }
 
 LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& features,
@@ -116,6 +117,11 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
     result.key_rank = 1 + static_cast<int>(std::count_if(comparisons_.begin(), comparisons_.end(), [&](const Memo& m) {
                         return m.used && m.comparison.key != result.key && FitsBetter(m.comparison, result.to_key);
                       }));
+  }
+  previous_headings_.clear();
+  for (const Memo& m : comparisons_) {
+    if (std::isfinite(m.comparison.heading.px))
+      previous_headings_.emplace_back(m.comparison.key, m.comparison.heading.px);
   }
   result.frame_index = frame.index;
   result.source_index = frame.source_index;

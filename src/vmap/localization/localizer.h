@@ -85,6 +85,10 @@ class Localizer {
   // better accepted comparison, which replaces the frame's memo of that key image (its first comparison weighed
   // into the belief first); -1 when neither is accepted or guided matching does not apply.
   int TrackGuided(const ImageFeatures& features, int position);
+  // The continuity of the heading (LocalizerOptions::continuity_share): `guided`, the guided matches of the frame
+  // with key image `key` whose first comparison is `first`, move as the previous frame's heading against that key
+  // image predicts. False without such a heading.
+  bool HoldsContinuity(const KeyComparison& first, const TentativeMatches& guided, int key, cv::Size size) const;
   LocalizationResult Track(const Frame& frame, const ImageFeatures& features);
   // The frame tracked at route `position`, the estimate having been at `from`.
   LocalizationResult TrackedAt(LocalizationResult result, int from, int position, const ImageFeatures& features);
@@ -188,6 +192,8 @@ class Localizer {
     bool weighed = false;  // its evidence is in the belief
   };
   std::vector<Memo> comparisons_;  // of the frame being localized
+  // The previous frame's headings (px) against the key images it was compared with: (key, heading), those with one.
+  std::vector<std::pair<int, double>> previous_headings_;
   std::vector<RankedKey> ranked_;  // the route ranked for the frame being localized (RankRoute); empty: not yet
 };
 

@@ -112,8 +112,11 @@ int Localizer::TrackGuided(const ImageFeatures& features, int position) {
     // redkitchen's teach/repeat run, docs/localize.md).
     if (CompareOnce(features, key).num_verified < options_.min_link_share * link_verified_[key]) continue;
     WeighComparisons();  // the first comparisons' evidence, before a guided one replaces its key image's
-    KeyComparison c =
-        CompareImage(features, *keys_.features[key], guided_matcher_->Match(features, *keys_.features[key]), key);
+    const TentativeMatches matches = guided_matcher_->Match(features, *keys_.features[key]);
+    KeyComparison c = CompareImage(features, *keys_.features[key], matches, key);
+    if (c.matched && !c.accepted && HoldsContinuity(CompareOnce(features, key), matches, key, features.image_size())) {
+      c.accepted = true;
+    }
     if (!c.accepted || (found >= 0 && !IsBetterMatch(c, best))) continue;
     found = p;
     best = std::move(c);
@@ -126,6 +129,26 @@ int Localizer::TrackGuided(const ImageFeatures& features, int position) {
   }
   comparisons_.push_back({std::move(best), true, true});
   return found;
+}
+
+bool Localizer::HoldsContinuity(const KeyComparison& first, const TentativeMatches& guided, int key,
+                                cv::Size size) const {
+  if (options_.continuity_share <= 0.0 || guided.size() == 0 ||
+      first.heading.confidence < options_.continuity_heading_confidence ||
+      !(first.log10_nfa <= options_.continuity_max_log10_nfa)) {
+    return false;
+  }
+  const auto previous = std::find_if(previous_headings_.begin(), previous_headings_.end(),
+                                     [&](const std::pair<int, double>& h) { return h.first == key; });
+  if (previous == previous_headings_.end()) return false;
+  // The window of displacements around the prediction: those of bench/evidence_dump's near_L, where it was measured.
+  const double half_width = size.width / 40.0, half_height = size.height / 20.0;
+  int moving = 0;
+  for (size_t i = 0; i < guided.size(); ++i) {
+    const double dx = guided.points0[i].x - guided.points1[i].x, dy = guided.points0[i].y - guided.points1[i].y;
+    moving += std::abs(dx - previous->second) <= half_width && std::abs(dy) <= half_height;
+  }
+  return moving >= options_.continuity_share * static_cast<double>(guided.size());
 }
 
 KeyComparison Localizer::CompareOnce(const ImageFeatures& features, int key) {

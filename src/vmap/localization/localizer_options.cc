@@ -51,6 +51,16 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"guided_matching", "!--no-guided-matching",
                  "ORB: never match a frame again with looser matching at the key images the belief holds"},
                 guided_matching);
+  visitor.Visit({"continuity_share", "--continuity-share",
+                 "ORB, guided matching: accept a comparison chance refuses when this share of its matches move as the "
+                 "previous frame's heading against the key image predicts (0 = never)"},
+                continuity_share);
+  visitor.Visit({"continuity_heading_confidence", "--continuity-heading-confidence",
+                 "The continuity rule: the least share of the first comparison's matches in its heading mode"},
+                continuity_heading_confidence);
+  visitor.Visit({"continuity_max_log10_nfa", "--continuity-max-log10-nfa",
+                 "The continuity rule: the first comparison's log10 NFA at most this"},
+                continuity_max_log10_nfa);
   visitor.VisitNested("ranking", ranking);
   visitor.VisitNested("belief", belief);
   visitor.VisitNested("heading", heading);
@@ -92,6 +102,20 @@ void LocalizerOptions::Check() const {
   if (!(rival_max_log10_nfa >= -1000.0 && rival_max_log10_nfa <= 0.0)) {
     throw OptionError("rival_max_log10_nfa", fmt::format("{} is outside [-1000, 0] (default {})", rival_max_log10_nfa,
                                                          defaults.rival_max_log10_nfa));
+  }
+  if (!(continuity_share >= 0.0 && continuity_share <= 1.0)) {
+    throw OptionError("continuity_share", fmt::format("{} is outside [0, 1] (default {}; 0: never)", continuity_share,
+                                                      defaults.continuity_share));
+  }
+  if (!(continuity_heading_confidence >= 0.0 && continuity_heading_confidence <= 1.0)) {
+    throw OptionError("continuity_heading_confidence",
+                      fmt::format("{} is outside [0, 1] (default {})", continuity_heading_confidence,
+                                  defaults.continuity_heading_confidence));
+  }
+  if (!(continuity_max_log10_nfa >= -1000.0 && continuity_max_log10_nfa <= 1000.0)) {
+    throw OptionError("continuity_max_log10_nfa",
+                      fmt::format("{} is outside [-1000, 1000] (default {})", continuity_max_log10_nfa,
+                                  defaults.continuity_max_log10_nfa));
   }
   if (lookahead < 1 || lookahead > 2) {
     throw OptionError("lookahead", fmt::format("{} is not 1 or 2 (default {})", lookahead, defaults.lookahead));

@@ -64,6 +64,16 @@ struct LocalizerOptions {
   // check); the a-contrario test, which counts every tentative match, decides as before (docs/localize.md,
   // "Guided matching by the belief"). Off: never.
   bool guided_matching = true;
+  // The continuity of the heading (guided matching only): a guided comparison chance refuses is accepted when the
+  // frame moves as the previous frame did against the same key image. At least `continuity_share` of its tentative
+  // matches move by the previous frame's heading against that key image (within 1/40 of the image's width across,
+  // 1/20 of its height up or down: a robot turns slowly, chance matches have no reason to), its first comparison's
+  // heading mode holds at least `continuity_heading_confidence` of its matches and that comparison's log10 NFA is at
+  // most `continuity_max_log10_nfa`. Measured against wrong key images with the prediction a run would have there
+  // (docs/localize.md, "Continuity of the heading"). 0 share: never.
+  double continuity_share = 0.18;
+  double continuity_heading_confidence = 0.43;
+  double continuity_max_log10_nfa = 7.5;
   // Lost frames in a row (each one also failed to relocalize) after which the estimate is dropped: key and
   // next_key then read -1 until a frame is relocalized.
   int max_lost_frames = 5;
