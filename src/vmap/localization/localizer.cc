@@ -235,10 +235,12 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     }
     return result;
   }
-  if (!AcceptedAgainstRivals(best) && SharesLittle(best)) {
+  if (!AcceptedAgainstRivals(best) && (SharesLittle(best) || pointed_before_ >= 0)) {
     // Accepted, but with much less than neighbouring key images share: the frame may be elsewhere on the
     // route, in view of this key image's scene. Moved when a ranked key image verifies more matches (a
-    // relocalization that is not taken leaves nothing behind: the tracked estimate is set below).
+    // relocalization that is not taken leaves nothing behind: the tracked estimate is set below). Also asked when
+    // the previous frame pointed far: a far place needs two frames (TakesJump), and the second may still keep half
+    // its key image's link (redkitchen's hand-held camera held one key image 15 frames past blurred ones ahead).
     LocalizationResult found = Relocalize(frame, features);
     int found_verified = 0;
     for (const RelocalizationCandidate& c : found.candidates) {
