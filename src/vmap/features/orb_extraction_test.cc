@@ -55,7 +55,7 @@ TEST(OrbGridExtraction, CellsWithoutStrongCornersTakeTheFallbackThreshold) {
   cv::Mat descriptors;
   ExtractOrbOnGrid(image, options, keypoints, descriptors);
   ASSERT_EQ(descriptors.rows, static_cast<int>(keypoints.size()));
-  EXPECT_GE(CountRightOf(keypoints, 84), 10);  // the faint half has features
+  EXPECT_GE(CountRightOf(keypoints, 84), 10);           // the faint half has features
   options.min_fast_threshold = options.fast_threshold;  // no fallback: the faint half has none
   ExtractOrbOnGrid(image, options, keypoints, descriptors);
   EXPECT_EQ(CountRightOf(keypoints, 84), 0);
