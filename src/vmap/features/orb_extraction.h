@@ -1,6 +1,7 @@
 #pragma once
 // ORB keypoints spread over the image and over the pyramid (the extraction ORB-SLAM describes), for images where
-// OpenCV's detector finds few corners: small, dark or re-lit ones (docs/matchers.md, "ORB extraction").
+// OpenCV's detector finds few corners: small, dark or re-lit ones (docs/localize.md, "ORB's extraction across
+// lighting").
 
 #include <vector>
 

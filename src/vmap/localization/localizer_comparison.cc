@@ -110,11 +110,12 @@ int Localizer::TrackGuided(const ImageFeatures& features, int position) {
     // Only where chance refused the first comparison and the link share did not: guided matching asks chance again,
     // never the share (a frame that shares little with the key image's scene, seen from elsewhere, stays refused:
     // redkitchen's teach/repeat run, docs/localize.md).
-    if (CompareOnce(features, key).num_verified < options_.min_link_share * link_verified_[key]) continue;
+    const KeyComparison first = CompareOnce(features, key);
+    if (first.num_verified < options_.min_link_share * link_verified_[key]) continue;
     WeighComparisons();  // the first comparisons' evidence, before a guided one replaces its key image's
     const TentativeMatches matches = guided_matcher_->Match(features, *keys_.features[key]);
     KeyComparison c = CompareImage(features, *keys_.features[key], matches, key);
-    if (c.matched && !c.accepted && HoldsContinuity(CompareOnce(features, key), matches, key, features.image_size())) {
+    if (c.matched && !c.accepted && HoldsContinuity(first, matches, key, features.image_size())) {
       c.accepted = true;
     }
     if (!c.accepted || (found >= 0 && !IsBetterMatch(c, best))) continue;
@@ -122,12 +123,10 @@ int Localizer::TrackGuided(const ImageFeatures& features, int position) {
     best = std::move(c);
   }
   if (found < 0) return -1;
+  // The guided comparison replaces the first one's memo (CompareOnce made it above).
   for (Memo& m : comparisons_) {
-    if (m.comparison.key != best.key) continue;
-    m = {std::move(best), true, true};
-    return found;
+    if (m.comparison.key == best.key) m = {std::move(best), true, true};
   }
-  comparisons_.push_back({std::move(best), true, true});
   return found;
 }
 
