@@ -179,12 +179,14 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
     // against the goal as the next key image (to_next, verified on enough matches): across seasons the localizer
     // placed nearly every frame of the last stretch at the key image before the goal, and the robot drove 0.3-0.5 m
     // past the goal until the tracker's estimate stopped it (docs/drive.md).
-    constexpr int kGoalMinVerified = 20;  // the localizer's --min-verified default
+    // As many as the localizer's counts rule asks of a key image it accepts (its default: the controller follows
+    // any localizer, not only one made with the user's flags).
+    const int goal_min_verified = LocalizerOptions().min_verified;
     const KeyComparison* goal = nullptr;
     if (position == last && localization.to_key.accepted) {
       goal = &localization.to_key;
     } else if (position == last - 1 && localization.next_key == route_.keys[last] && localization.to_next.matched &&
-               localization.to_next.num_verified >= kGoalMinVerified) {
+               localization.to_next.num_verified >= goal_min_verified) {
       goal = &localization.to_next;
     }
     // Reported at the goal key image even when not accepted (the --json samples show it).
