@@ -18,11 +18,16 @@ With --evidence-dir DIR, also every frame of each run against every key image of
 (build/bench/evidence_dump) into DIR/corridor_MATCHER.csv and DIR/michigan_MATCHER.csv, the input of
 bench/evidence_fit.py.
 
+--start-key K (default 0): every run is localized with `vmap localize --start-key K`: a repeat run starts where its
+teach run started (corridor: repeat frame 0 at teach frame 0; michigan: frame 0 at key image 0), as a teach-and-repeat
+robot does; "none" for binaries before the option (68a4a54 and older) or to start anywhere (docs/localize.md, "The
+start").
+
 With --build "FLAGS", every map is built with these flags too (e.g. ORB's extraction: "--orb-grid-cell 30
 --orb-edge-threshold 16"); the localizer follows what the map records.
 
 usage: bench/route_conditions.py --vmap build/vmap[,old/vmap] [--sets corridor,michigan] [--matchers orb,xfeat]
-                                 [--tau T] [--build "FLAGS"] [--localize "FLAGS"] [--repeat-stride N] [--work DIR] [--csv-dir DIR]
+                                 [--tau T] [--start-key K|none] [--build "FLAGS"] [--localize "FLAGS"] [--repeat-stride N] [--work DIR] [--csv-dir DIR]
                                  [--evidence-dir DIR]
 (from the repository root; ../shared must be there)"""
 import argparse, json, os, subprocess, sys, tempfile
@@ -186,11 +191,14 @@ def main():
     parser.add_argument("--tau", help="the corridor map's tau (default: the matcher's)")
     parser.add_argument("--build", default="", help="more flags for vmap build (every map)")
     parser.add_argument("--localize", default="", help="more flags for vmap localize")
+    parser.add_argument("--start-key", default="0", help="vmap localize --start-key (none: not passed)")
     parser.add_argument("--repeat-stride", type=int, default=1, help="corridor: every Nth repeat frame (a faster robot)")
     parser.add_argument("--work", help="keep maps here (reused) instead of a temporary folder")
     parser.add_argument("--csv-dir", help="write each corridor run's CSV here")
     parser.add_argument("--evidence-dir", help="write every frame's comparisons with every key image here")
     args = parser.parse_args()
+    if args.start_key != "none":
+        args.localize += " --start-key " + args.start_key
     tau_flags = (["--tau", args.tau] if args.tau else []) + args.build.split()
     build_flags = args.build.split()
     print(HEADER)

@@ -265,6 +265,14 @@ TEST(LocalizeCli, TheHeadingsContinuityTracksGuidedFramesChanceRefuses) {
   EXPECT_GE(steered[0], steered[1] + 4) << "with the continuity " << steered[0] << ", without " << steered[1];
 }
 
+TEST(LocalizeCli, AStartKeyTracksTheRepeatRunsFirstFrames) {
+  // corridor_conditions with ORB (docs/localize.md, "The start"): the repeat run starts where the teach run did;
+  // started there, the belief singles that place out and guided matching asks there on the first frames.
+  const std::vector<int> steered = SteeredOnCorridor({" --start-key 0", ""});
+  if (steered.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  EXPECT_GE(steered[0], steered[1] + 2) << "started at key image 0 " << steered[0] << ", anywhere " << steered[1];
+}
+
 TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
   ::vmap::testing::ScopedTempDir tmp;
   ::vmap::testing::SyntheticOptions synthetic;
@@ -291,6 +299,8 @@ TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
       {localize + "--recheck-link-share -1", "--recheck-link-share -1 is outside [0, 10]"},
       {localize + "--continuity-share 2", "--continuity-share 2 is outside [0, 1]"},
       {localize + "--to 99", "key image 99 does not exist"},
+      {localize + "--start-key 99", "start key image 99 (--start-key) does not exist"},
+      {localize + "--start-key -2", "--start-key -2 is not -1"},
       {"localize " + Quote(tmp.path() / "m") + " " + Quote(tmp.path() / "missing.mp4"), "does not exist"},
       {"route " + Quote(tmp.path() / "m") + " --min-backward-verified 2", "--min-backward-verified 2 must be 8"},
   };

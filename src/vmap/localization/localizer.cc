@@ -54,6 +54,8 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
     if (route_position_of_key_[k] >= 0) throw InputError(fmt::format("route visits key image {} twice", k));
     route_position_of_key_[k] = static_cast<int>(p);
   }
+  CheckStartKey(map_, options_);
+  if (options_.start_key >= 0) start_position_ = route_position_of_key_[options_.start_key];
   link_verified_.assign(num_keys, 0);
   for (const Link& link : map_.links) {
     const int a = link.from_key, b = link.to_key;
@@ -84,14 +86,29 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
     guided.Of<OrbMatcherOptions>().cross_check = false;
     guided_matcher_ = CreateMatcher(guided);
   }
+  Reset();  // at the start key image, when there is one
 }
 
 Localizer::~Localizer() = default;
 
+void CheckStartKey(const VisualMap& map, const LocalizerOptions& options) {
+  const int key = options.start_key, num_keys = static_cast<int>(map.key_images.size());
+  if (key < 0) return;
+  if (key >= num_keys) {
+    throw InputError(fmt::format("start key image {} (--start-key) does not exist; the map has key images 0 to {}", key,
+                                 num_keys - 1));
+  }
+  if (!options.route.empty() && std::find(options.route.begin(), options.route.end(), key) == options.route.end()) {
+    throw InputError(fmt::format("start key image {} (--start-key) is not on the route (key images {} to {})", key,
+                                 options.route.front(), options.route.back()));
+  }
+}
+
 void Localizer::Reset() {
   belief_.Reset();
+  if (start_position_ >= 0) belief_.Start(start_position_, options_.start_mass);
   pointed_ = pointed_before_ = -1;
-  position_ = -1;
+  position_ = start_position_;
   lost_in_a_row_ = 0;
   step_back_ruled_out_ = {};
   previous_headings_.clear();

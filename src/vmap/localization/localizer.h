@@ -40,6 +40,9 @@
 
 namespace vmap {
 
+// Throws InputError when LocalizerOptions::start_key is not a key image of `map` on the options' route.
+void CheckStartKey(const VisualMap& map, const LocalizerOptions& options);
+
 class Localizer {
  public:
   // `keys` must hold the features of `map`'s key images computed by `matcher` (LoadKeyImageStore).
@@ -67,7 +70,7 @@ class Localizer {
   // target comparison of each result.
   void AddPose(KeyComparison& comparison) const;
 
-  // Forgets the estimate: the next frame is relocalized.
+  // Forgets the estimate: the next frame is relocalized, or starts again at LocalizerOptions::start_key.
   void Reset();
   bool has_estimate() const { return position_ >= 0; }
   const std::vector<int>& route() const { return route_; }
@@ -169,7 +172,8 @@ class Localizer {
   // has no verified link on the route (the comparisons against the map's links are then skipped).
   std::vector<int> link_verified_;
   std::unique_ptr<KeyImageRanking> ranking_;
-  int position_ = -1;  // route position of `key`; -1: no estimate
+  int position_ = -1;        // route position of `key`; -1: no estimate
+  int start_position_ = -1;  // route position of LocalizerOptions::start_key; -1: none
   int lost_in_a_row_ = 0;
   // The step back last ruled out (Track): at route position `position`, on the frame before this one, with the
   // frame's verified matches with the next key image at that last check. position -1: none.

@@ -79,6 +79,24 @@ TEST(RouteBelief, ItCanJumpAnywhereWhenTheEvidenceSaysSo) {
   EXPECT_NEAR(belief.MassWithin(10, 1), 3.0 / 30.0, 1e-9);
 }
 
+// A run that starts at a known place: the belief leans there (half of it), and strong evidence elsewhere, two frames in
+// a row, moves it there all the same.
+TEST(RouteBelief, AStartLeansItThereAndTheEvidenceOverridesIt) {
+  RouteBelief belief(30, RouteBeliefOptions{});
+  belief.Start(0, 0.5);
+  EXPECT_NEAR(belief.probabilities()[0], 0.5 + 0.5 / 30, 1e-9);
+  EXPECT_NEAR(belief.MassWithin(10, 1), 0.5 * 3.0 / 30.0, 1e-9);
+  EXPECT_EQ(belief.Peak(), 0);
+  for (int frame = 0; frame < 2; ++frame) {
+    belief.Predict();
+    belief.Weigh(0, -1.0);
+    belief.Weigh(20, 6.0);
+    belief.Normalize();
+  }
+  EXPECT_NEAR(belief.Peak(), 20, 1);
+  EXPECT_GT(belief.MassWithin(belief.Peak(), 1), 0.9);
+}
+
 TEST(RouteBelief, OptionsAreChecked) {
   auto path = [](auto change) {
     return testing::OptionErrorPath([&] {

@@ -38,6 +38,13 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Relocalize a tracked frame with fewer verified matches than this fraction of its key image's "
                  "link, and move it where more verify (0: never)"},
                 recheck_link_share);
+  visitor.Visit({"start_key", "--start-key",
+                 "The key image the run starts at (teach and repeat: 0, the route's first): the tracker starts there "
+                 "and the belief leans there, which the frames' evidence overrides (-1 = anywhere)"},
+                start_key);
+  visitor.Visit({"start_mass", "--start-mass",
+                 "--start-key: the share of the belief at the start key image at the first frame (the rest flat)"},
+                start_mass);
   visitor.Visit({"max_lost_frames", "--max-lost", "Lost frames in a row before the estimate is dropped"},
                 max_lost_frames);
   visitor.Visit({"relocalization_candidates", "--candidates", "Best-ranked key images verified when relocalizing"},
@@ -119,6 +126,15 @@ void LocalizerOptions::Check() const {
   }
   if (lookahead < 1 || lookahead > 2) {
     throw OptionError("lookahead", fmt::format("{} is not 1 or 2 (default {})", lookahead, defaults.lookahead));
+  }
+  if (start_key < -1) {
+    throw OptionError("start_key", fmt::format("{} is not -1 (anywhere) nor a key image (default {})", start_key,
+                                               defaults.start_key));
+  }
+  if (!(start_mass >= 0.0 && start_mass < 1.0)) {
+    throw OptionError("start_mass", fmt::format("{} is outside [0, 1) (default {}; 1 would trap a run started "
+                                                "elsewhere)",
+                                                start_mass, defaults.start_mass));
   }
   if (max_lost_frames < 0 || max_lost_frames > 1000000) {
     throw OptionError("max_lost_frames",

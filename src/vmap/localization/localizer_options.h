@@ -74,6 +74,12 @@ struct LocalizerOptions {
   double continuity_share = 0.18;
   double continuity_heading_confidence = 0.43;
   double continuity_max_log10_nfa = 7.5;
+  // The key image the run starts at (a teach-and-repeat robot starts where the teach run started: the route's
+  // first key image), or -1: anywhere (the first frame is relocalized over the whole route). The tracker starts
+  // there and the belief holds `start_mass` there (the rest spread over the route as a flat belief): a soft prior,
+  // which the frames' evidence overrides when the run starts elsewhere (docs/localize.md, "The start").
+  int start_key = -1;
+  double start_mass = 0.5;
   // Lost frames in a row (each one also failed to relocalize) after which the estimate is dropped: key and
   // next_key then read -1 until a frame is relocalized.
   int max_lost_frames = 5;

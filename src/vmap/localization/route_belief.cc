@@ -54,6 +54,13 @@ RouteBelief::RouteBelief(int positions, const RouteBeliefOptions& options) : opt
 
 void RouteBelief::Reset() { std::fill(p_.begin(), p_.end(), 1.0 / p_.size()); }
 
+void RouteBelief::Start(int position, double mass) {
+  Reset();
+  if (position < 0 || position >= static_cast<int>(p_.size())) return;
+  for (double& v : p_) v *= 1.0 - mass;
+  p_[position] += mass;
+}
+
 void RouteBelief::Predict() {
   const int n = static_cast<int>(p_.size());
   const double total = options_.stay + options_.forward + options_.forward2 + options_.back + options_.jump;

@@ -46,6 +46,8 @@ class RouteBelief {
 
   // Flat: nothing known.
   void Reset();
+  // A run that starts at `position`: `mass` there, the rest flat.
+  void Start(int position, double mass);
   // One frame of motion (the motion model).
   void Predict();
   // The evidence of the frame against the route's key image at `position`: the belief at positions `position` - 1

@@ -9,6 +9,7 @@
 
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
+#include "vmap/localization/localizer.h"
 #include "vmap/localization/route.h"
 #include "vmap/map/map_io.h"
 #include "vmap/mapping/recorded_options.h"
@@ -137,6 +138,7 @@ LocalizationSession::LocalizationSession(const LocalizePipelineOptions& options)
   // 4. The route.
   LocalizerOptions localizer = options.session.localizer;
   localizer.route = RouteOf(read.map, options.session, localizer.route);
+  CheckStartKey(read.map, localizer);
 
   // 5. The query: frames are compared with key images at the map's size unless told otherwise.
   query_options_ = options.source;
