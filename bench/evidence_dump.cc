@@ -4,7 +4,7 @@
 //
 //   evidence_dump MAP QUERY [--stride N] [--last N] [--cross-check 0|1] [--ratio R] [--frame-fast T]
 //                 [--frame-features N] [--frame-edge PX] [--frame-grid-cell PX] [--frame-min-fast T] [--frame-clahe C]
-//                 [--guided 1]
+//                 [--guided 1] [--windowed W[:Z[:D[:R[:L]]]][,...]] [--window-frame-fast T] [--window-frame-features N]
 //
 // Columns: frame, source_index, key, matched, accepted, tentative, verified, similarity, log10_nfa, link_verified
 // (the smaller of the verified matches of the key image's links with its neighbours in the map; 0 without),
@@ -15,6 +15,14 @@
 // of the image's width of prev_heading_px, dy within 1/20 of its height of 0). With --guided 1 (ORB maps), the same key
 // image matched again as the localizer's guided matching does (no cross check): g_tentative, g_verified, g_log10_nfa,
 // g_heading_px, g_heading_votes, g_near_S, g_near_L (g_near_* against the same prediction).
+// With --windowed (ORB maps; docs/localize.md, "Matching guided by the prediction"), for each window given the frame
+// matched with the key image by the prediction as the localizer's window matching does (MatchOrbInWindow: candidates
+// within W of the image's width of prev_heading_px across and 1/20 of its height up or down, both widened by Z times
+// the feature's distance from the image's centre, pyramid levels at most L apart, Hamming distance at most D, ratio R
+// among the candidates; defaults Z 0, D 64, R 0.9, L 1) and verified as the localizer verifies: wN_tentative,
+// wN_verified, wN_log10_nfa, wN_similarity for window N (-1, -1, 1e9, 0 without a prediction). The frame's features for
+// it: the map's, or extracted again with FAST threshold T / N features (the localizer's window_fast_threshold,
+// window_features).
 
 #include <algorithm>
 #include <cmath>
@@ -30,7 +38,9 @@
 #include "vmap/core/runtime.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/features/orb_matcher.h"
+#include "vmap/localization/acceptance.h"
 #include "vmap/localization/localization_map.h"
+#include "vmap/mapping/key_image_selector.h"
 #include "vmap/sources/frame_source.h"
 
 using namespace vmap;
@@ -46,6 +56,9 @@ int main(int argc, char** argv) {
   // comparisons made with other options than the map's (OrbMatcherOptions' defaults otherwise).
   OrbMatcherOptions frame_orb, match_orb;
   bool orb_override = false, guided = false;
+  int window_frame_fast = 0, window_frame_features = 0;
+  double window_frame_clahe = 0.0;
+  std::vector<std::vector<double>> windows;  // share of the width, zoom, max distance, ratio, level difference
   for (int i = 3; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--stride")) query_options.stride = std::stoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--last")) query_options.last = std::stoi(argv[i + 1]);
@@ -60,6 +73,25 @@ int main(int argc, char** argv) {
       frame_orb.min_fast_threshold = std::stoi(argv[i + 1]), orb_override = true;
     if (!std::strcmp(argv[i], "--frame-clahe")) frame_orb.clahe_clip = std::stod(argv[i + 1]), orb_override = true;
     if (!std::strcmp(argv[i], "--guided")) guided = std::stoi(argv[i + 1]) != 0;
+    if (!std::strcmp(argv[i], "--window-frame-fast")) window_frame_fast = std::stoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--window-frame-features")) window_frame_features = std::stoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--window-frame-clahe")) window_frame_clahe = std::stod(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--windowed")) {
+      std::string list = argv[i + 1];
+      for (size_t at = 0; at < list.size();) {
+        const size_t comma = std::min(list.find(',', at), list.size());
+        const std::string spec = list.substr(at, comma - at);
+        std::vector<double> values = {0.0625, 0.0, 64, 0.9, 1};
+        size_t field = 0;
+        for (size_t from = 0; from <= spec.size() && field < values.size(); ++field) {
+          const size_t colon = std::min(spec.find(':', from), spec.size());
+          values[field] = std::stod(spec.substr(from, colon - from));
+          from = colon + 1;
+        }
+        windows.push_back(values);
+        at = comma + 1;
+      }
+    }
   }
   const LocalizationMap opened = OpenLocalizationMap(argv[1], {});
   query_options.resize = QueryResize(opened.map, "");
@@ -77,6 +109,17 @@ int main(int argc, char** argv) {
     guided_options.Of<OrbMatcherOptions>().cross_check = false;
     guided_matcher = CreateMatcher(guided_options);
   }
+  // The frame's features for the windowed matching: the map's ORB options, FAST threshold / features changed.
+  std::unique_ptr<Matcher> window_frame_matcher;
+  if (window_frame_fast > 0 || window_frame_features > 0 || window_frame_clahe > 0.0) {
+    MatcherOptions o;
+    o.type = OrbMatcherOptions::kModelName;
+    o.model(o.type).FromJson(nlohmann::json::parse(opened.matcher->DescribeOptionsJson()), "the map's matcher");
+    if (window_frame_fast > 0) o.Of<OrbMatcherOptions>().fast_threshold = window_frame_fast;
+    if (window_frame_features > 0) o.Of<OrbMatcherOptions>().num_features = window_frame_features;
+    o.Of<OrbMatcherOptions>().clahe_clip = window_frame_clahe;
+    window_frame_matcher = CreateMatcher(o);
+  }
   std::unique_ptr<Localizer> guided_localizer;
   if (guided) guided_localizer = std::make_unique<Localizer>(opened.map, opened.keys, *guided_matcher, options);
   const int num_keys = static_cast<int>(opened.map.key_images.size());
@@ -90,8 +133,12 @@ int main(int argc, char** argv) {
   auto source = OpenFrameSource(argv[2], query_options);
   std::printf(
       "frame,source_index,key,matched,accepted,tentative,verified,similarity,log10_nfa,link_verified,"
-      "heading_confidence,heading_votes,heading_px,heading_voters,prev_heading_px,near_S,near_L%s\n",
-      guided ? ",g_tentative,g_verified,g_log10_nfa,g_heading_px,g_heading_votes,g_near_S,g_near_L" : "");
+      "heading_confidence,heading_votes,heading_px,heading_voters,prev_heading_px,near_S,near_L%s%s",
+      guided ? ",g_tentative,g_verified,g_log10_nfa,g_heading_px,g_heading_votes,g_near_S,g_near_L" : "", "");
+  for (size_t w = 0; w < windows.size(); ++w) {
+    std::printf(",w%zu_tentative,w%zu_verified,w%zu_log10_nfa,w%zu_similarity", w, w, w, w);
+  }
+  std::printf("\n");
   std::vector<double> previous_heading(num_keys, std::nan("")), heading(num_keys, std::nan(""));
   // How many tentative matches frame -> key image move by (predicted_dx, 0) within the window.
   auto near = [](const TentativeMatches& m, cv::Size size, double predicted_dx, double share_x) {
@@ -108,6 +155,7 @@ int main(int argc, char** argv) {
     const Frame& frame = *next;
     const auto features = (orb_override ? *frame_matcher : *opened.matcher).Extract(frame.gray);
     const cv::Size size = features->image_size();
+    const auto window_features = window_frame_matcher ? window_frame_matcher->Extract(frame.gray) : features;
     for (int k = 0; k < num_keys; ++k) {
       const KeyComparison c = localizer.Compare(*features, k);
       const TentativeMatches m = matcher.Match(*features, *opened.keys.features[k]);
@@ -124,6 +172,34 @@ int main(int argc, char** argv) {
         std::printf(",%d,%d,%.3f,%.2f,%d,%d,%d", g.num_tentative, g.num_verified, std::min(g.log10_nfa, 1e9),
                     g.heading.px, g.heading.votes, near(gm, size, predicted, 1.0 / 80),
                     near(gm, size, predicted, 1.0 / 40));
+      }
+      for (const std::vector<double>& spec : windows) {
+        if (!std::isfinite(predicted)) {
+          std::printf(",-1,-1,1e9,0");
+          continue;
+        }
+        MatchWindow window;
+        window.predicted_dx = predicted;
+        window.half_width = spec[0] * size.width;
+        window.half_height = size.height / 20.0;
+        window.zoom = spec[1];
+        window.max_distance = static_cast<int>(spec[2]);
+        window.ratio = spec[3];
+        window.max_level_difference = static_cast<int>(spec[4]);
+        window.centre = cv::Point2f(size.width / 2.0f, size.height / 2.0f);
+        const ImageFeatures& key_features = *opened.keys.features[k];
+        const TentativeMatches wm = MatchOrbInWindow(*window_features, key_features, window);
+        const PairComparison pair =
+            VerifyMatches(wm,
+                          SimilarityDenominator(options.similarity, static_cast<int>(wm.size()),
+                                                window_features->num_features(), key_features.num_features()),
+                          options.verifier);
+        const double nfa =
+            pair.matched ? ChanceOfComparison(pair, size, key_features.image_size(),
+                                              ComparisonsPerFrame(options.lookahead, options.relocalization_candidates))
+                               .log10_nfa
+                         : 1e9;
+        std::printf(",%d,%d,%.3f,%.4f", pair.num_tentative, pair.num_verified, std::min(nfa, 1e9), pair.similarity);
       }
       std::printf("\n");
     }

@@ -2,7 +2,7 @@
 //
 //   localize_repeat TUM_SEQUENCE --teach FIRST:LAST --repeat FIRST:LAST [--stride N]
 //                   [--max-distance M] [--max-angle DEG] [--acceptance chance,counts]
-//                   [--variants counts/0/0,chance/0.5/0.25] [--orb-fast-threshold T]
+//                   [--variants counts/0/0,chance/0.5/0.25] [--orb-fast-threshold T] [--no-window-matching 1]
 //
 // Builds a map of the teach frames (default options) and localizes the repeat frames against it. The
 // sequence's groundtruth.txt (TUM: timestamp tx ty tz qx qy qz qw, camera to world) judges each repeat frame:
@@ -174,6 +174,7 @@ int main(int argc, char** argv) {
   double max_distance = 0.5, max_angle = 30.0;
   std::string ranking = "auto";
   std::vector<bench::LocalizerVariant> variants;
+  bool window_matching = LocalizerOptions().window_matching;  // --no-window-matching 1: off
   int descriptors = RankingOptions().max_descriptors_per_key, candidates = LocalizerOptions().relocalization_candidates;
   for (int i = 2; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--teach"))
@@ -196,6 +197,8 @@ int main(int argc, char** argv) {
       variants = bench::ParseAcceptanceVariants(argv[i + 1]);
     } else if (!std::strcmp(argv[i], "--variants")) {
       variants = bench::ParseLocalizerVariants(argv[i + 1]);
+    } else if (!std::strcmp(argv[i], "--no-window-matching")) {
+      window_matching = std::atoi(argv[i + 1]) == 0;
     } else if (!std::strcmp(argv[i], "--orb-fast-threshold")) {
       matcher_options.Of<OrbMatcherOptions>().fast_threshold = std::atoi(argv[i + 1]);
     }
@@ -235,6 +238,7 @@ int main(int argc, char** argv) {
     localizer_options.ranking.method = ParseRankingMethod(ranking);
     localizer_options.ranking.max_descriptors_per_key = descriptors;
     localizer_options.relocalization_candidates = candidates;
+    localizer_options.window_matching = window_matching;
     Judge(sequence, opened, localizer_options, repeat, stride, poses, max_distance, max_angle);
   }
   fs::remove_all(map_directory);

@@ -363,6 +363,57 @@ std::vector<std::pair<int, int>> MatchBinaryDescriptors(const cv::Mat& query, co
   return pairs;
 }
 
+TentativeMatches MatchOrbInWindow(const ImageFeatures& frame, const ImageFeatures& key, const MatchWindow& window) {
+  const auto& a = static_cast<const OrbFeatures&>(frame);
+  const auto& b = static_cast<const OrbFeatures&>(key);
+  TentativeMatches matches;
+  if (a.binary_descriptors.empty() || b.binary_descriptors.empty()) return matches;
+  CV_Assert(a.binary_descriptors.cols == b.binary_descriptors.cols && a.binary_descriptors.cols <= 4096);
+  const int words = (a.binary_descriptors.cols + 7) / 8;
+  const int na = a.binary_descriptors.rows, nb = b.binary_descriptors.rows;
+  const std::vector<uint64_t> qa = PackWords(a.binary_descriptors, words, na);
+  const std::vector<uint64_t> qb = PackWords(b.binary_descriptors, words, nb);
+  // Per key feature: the frame feature that matched it best, and that distance.
+  std::vector<int> best_query(nb, -1), best_distance(nb, kFar);
+  for (int i = 0; i < na; ++i) {
+    const cv::KeyPoint& p = a.keypoints[i];
+    const float x = p.pt.x - static_cast<float>(window.predicted_dx), y = p.pt.y;
+    const double half_width = window.half_width + window.zoom * std::abs(p.pt.x - window.centre.x);
+    const double half_height = window.half_height + window.zoom * std::abs(p.pt.y - window.centre.y);
+    int best = kFar, second = kFar, arg = -1;
+    for (int j = 0; j < nb; ++j) {
+      const cv::KeyPoint& q = b.keypoints[j];
+      if (std::abs(q.pt.x - x) > half_width || std::abs(q.pt.y - y) > half_height ||
+          std::abs(q.octave - p.octave) > window.max_level_difference) {
+        continue;
+      }
+      int d = 0;
+      const uint64_t* u = qa.data() + static_cast<size_t>(i) * words;
+      const uint64_t* v = qb.data() + static_cast<size_t>(j) * words;
+      for (int w = 0; w < words; ++w) d += __builtin_popcountll(u[w] ^ v[w]);
+      if (d < best) {
+        second = best;
+        best = d;
+        arg = j;
+      } else if (d < second) {
+        second = d;
+      }
+    }
+    if (arg < 0 || best > window.max_distance) continue;
+    if (window.ratio > 0.0 && second < kFar && !(best < window.ratio * second)) continue;
+    if (best < best_distance[arg]) {
+      best_distance[arg] = best;
+      best_query[arg] = i;
+    }
+  }
+  for (int j = 0; j < nb; ++j) {
+    if (best_query[j] < 0) continue;
+    matches.points0.push_back(a.keypoints[best_query[j]].pt);
+    matches.points1.push_back(b.keypoints[j].pt);
+  }
+  return matches;
+}
+
 std::unique_ptr<Matcher> CreateOrbMatcher(const OrbMatcherOptions& options) {
   return std::make_unique<OrbMatcher>(options);
 }

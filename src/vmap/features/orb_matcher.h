@@ -43,4 +43,25 @@ std::unique_ptr<Matcher> CreateOrbMatcher(const OrbMatcherOptions& options);
 std::vector<std::pair<int, int>> MatchBinaryDescriptors(const cv::Mat& query, const cv::Mat& train, bool cross_check,
                                                         double ratio);
 
+// Matching guided by a predicted displacement, as ORB-SLAM searches by its motion model: each feature of `frame`
+// is matched only among the features of `key` inside a window around where the prediction puts it (key x = frame x -
+// predicted_dx, key y = frame y, within half_width / half_height px, widened by zoom times the feature's distance from
+// centre across and up or down) and at a pyramid level at most
+// max_level_difference from its own; the best by Hamming distance is kept when it is at most max_distance and below
+// ratio times the second best among those candidates (no second: kept), and each feature of `key` keeps only its
+// best such match. Features must come from an ORB matcher's Extract (CreateOrbMatcher). points0: frame, points1: key.
+struct MatchWindow {
+  double predicted_dx = 0.0;  // x_frame - x_key, px
+  double half_width = 4.0;
+  double half_height = 6.0;
+  // The window grows with the distance from `centre` by this share of it (0: none): a robot moving along its route
+  // sees the scene grow or shrink about the direction it moves (a key image ahead or behind the frame).
+  double zoom = 0.0;
+  cv::Point2f centre;
+  int max_level_difference = 1;
+  int max_distance = 64;
+  double ratio = 0.9;
+};
+TentativeMatches MatchOrbInWindow(const ImageFeatures& frame, const ImageFeatures& key, const MatchWindow& window);
+
 }  // namespace vmap

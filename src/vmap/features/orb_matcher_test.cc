@@ -1,6 +1,8 @@
 #include "vmap/features/orb_matcher.h"
 
+#include <algorithm>
 #include <climits>
+#include <cmath>
 #include <tuple>
 
 #include <gtest/gtest.h>
@@ -102,6 +104,46 @@ TEST(OrbMatcher, MatchesNeighbouringFramesOfASyntheticScene) {
   const TentativeMatches matches = matcher->Match(*f0, *f1);
   EXPECT_GT(matches.size(), 150u);
   EXPECT_EQ(matches.points0.size(), matches.points1.size());
+}
+
+TEST(OrbMatcher, MatchingInAWindowFindsTheFeaturesWhereThePredictionPutsThem) {
+  // A frame that is its key image moved 12 px to the right: within a window around the true displacement every match
+  // moves by it, and around a wrong one (12 px to the left) far fewer features find a candidate good enough.
+  testing::SyntheticOptions options;
+  options.num_frames = 1;
+  cv::Mat key_gray, frame_gray;
+  cv::cvtColor(testing::RenderSyntheticSequence(options).frames[0], key_gray, cv::COLOR_BGR2GRAY);
+  const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 12, 0, 1, 0);
+  cv::warpAffine(key_gray, frame_gray, shift, key_gray.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  const auto matcher = CreateOrbMatcher({});
+  const auto key = matcher->Extract(key_gray);
+  const auto frame = matcher->Extract(frame_gray);
+  MatchWindow window;
+  window.predicted_dx = 12.0;
+  window.half_width = 4.0;
+  window.half_height = 4.0;
+  const TentativeMatches right = MatchOrbInWindow(*frame, *key, window);
+  EXPECT_GT(right.size(), 150u);
+  int moved = 0;
+  for (size_t i = 0; i < right.size(); ++i) {
+    EXPECT_LE(std::abs(right.points0[i].x - right.points1[i].x - 12.0), 4.0 + 1e-4);
+    EXPECT_LE(std::abs(right.points0[i].y - right.points1[i].y), 4.0 + 1e-4);
+    moved += std::abs(right.points0[i].x - right.points1[i].x - 12.0) < 1.5;
+  }
+  EXPECT_GT(moved, 0.9 * right.size());
+  window.predicted_dx = -12.0;
+  const TentativeMatches wrong = MatchOrbInWindow(*frame, *key, window);
+  EXPECT_LT(wrong.size(), right.size() / 4) << "right " << right.size() << ", wrong " << wrong.size();
+  // Each key image feature keeps one match at most.
+  std::vector<std::pair<float, float>> keys;
+  for (const cv::Point2f& p : right.points1) keys.emplace_back(p.x, p.y);
+  std::sort(keys.begin(), keys.end());
+  EXPECT_EQ(std::unique(keys.begin(), keys.end()), keys.end());
+  // The window grows with the distance from the centre by the zoom: more candidates, never fewer matches here.
+  window.predicted_dx = 12.0;
+  window.zoom = 0.2;
+  window.centre = cv::Point2f(key_gray.cols / 2.0f, key_gray.rows / 2.0f);
+  EXPECT_GE(MatchOrbInWindow(*frame, *key, window).size() + 10, right.size());
 }
 
 TEST(OrbMatcher, BlackImageHasNoFeaturesAndNoMatches) {

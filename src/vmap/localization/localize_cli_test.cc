@@ -224,7 +224,7 @@ TEST(LocalizeCli, EvalCorridorRuns) {
 
 // corridor_conditions' first 40 repeat frames against an ORB map of its teach run, once per entry of `flags` (more
 // flags for vmap localize): how many frames are steered by (tracking or relocalized). Empty without the data.
-std::vector<int> SteeredOnCorridor(const std::vector<std::string>& flags) {
+std::vector<int> SteeredOnCorridor(const std::vector<std::string>& flags, int last = 39) {
   const fs::path data = Shared() / "data/corridor_conditions";
   if (Shared().empty() || !fs::exists(data)) return {};
   ::vmap::testing::ScopedTempDir tmp;
@@ -233,8 +233,8 @@ std::vector<int> SteeredOnCorridor(const std::vector<std::string>& flags) {
   std::vector<int> steered;
   for (const std::string& f : flags) {
     const fs::path csv = tmp.path() / "run.csv";
-    EXPECT_EQ(RunVmap("localize " + Quote(tmp.path() / "map") + " " + Quote(data / "repeat") + " --last 39 -q --csv " +
-                          Quote(csv) + f,
+    EXPECT_EQ(RunVmap("localize " + Quote(tmp.path() / "map") + " " + Quote(data / "repeat") + " --last " +
+                          std::to_string(last) + " -q --csv " + Quote(csv) + f,
                       &out),
               0)
         << out;
@@ -251,8 +251,9 @@ TEST(LocalizeCli, GuidedMatchingTracksFramesChanceRefusedAcrossLighting) {
   // corridor_conditions with ORB (docs/localize.md, "Guided matching by the belief"): frames whose cross-checked
   // matches verify too few at the tracked key images for chance while the belief holds them there are matched
   // again with those key images only, one-way best matches kept, and the a-contrario test accepts some of them
-  // (the continuity of the heading off, to see guided matching's own).
-  const std::vector<int> steered = SteeredOnCorridor({" --continuity-share 0", " --no-guided-matching"});
+  // (the continuity of the heading and the window off, to see guided matching's own).
+  const std::vector<int> steered =
+      SteeredOnCorridor({" --continuity-share 0 --no-window-matching", " --no-guided-matching"});
   if (steered.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   EXPECT_GE(steered[0], steered[1] + 4) << "guided " << steered[0] << ", without " << steered[1];
 }
@@ -260,7 +261,8 @@ TEST(LocalizeCli, GuidedMatchingTracksFramesChanceRefusedAcrossLighting) {
 TEST(LocalizeCli, TheHeadingsContinuityTracksGuidedFramesChanceRefuses) {
   // corridor_conditions with ORB (docs/localize.md, "Continuity of the heading"): a guided comparison chance refuses
   // is accepted when its matches move as the previous frame's heading against the key image predicts.
-  const std::vector<int> steered = SteeredOnCorridor({"", " --continuity-share 0"});
+  const std::vector<int> steered =
+      SteeredOnCorridor({" --no-window-matching", " --continuity-share 0 --no-window-matching"});
   if (steered.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   EXPECT_GE(steered[0], steered[1] + 4) << "with the continuity " << steered[0] << ", without " << steered[1];
 }
@@ -271,6 +273,15 @@ TEST(LocalizeCli, AStartKeyTracksTheRepeatRunsFirstFrames) {
   const std::vector<int> steered = SteeredOnCorridor({" --start-key 0", ""});
   if (steered.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   EXPECT_GE(steered[0], steered[1] + 2) << "started at key image 0 " << steered[0] << ", anywhere " << steered[1];
+}
+
+TEST(LocalizeCli, MatchingInTheWindowOfThePredictionTracksFramesTheContinuityMisses) {
+  // corridor_conditions with ORB (docs/localize.md, "Matching guided by the prediction"): a guided comparison neither
+  // chance nor the continuity of the heading accepts is matched again only around the previous frame's heading
+  // against the key image, and accepted by that matching's own measured threshold (frames 80 and 81).
+  const std::vector<int> steered = SteeredOnCorridor({"", " --no-window-matching"}, 85);
+  if (steered.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  EXPECT_GE(steered[0], steered[1] + 2) << "with the window " << steered[0] << ", without " << steered[1];
 }
 
 TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
@@ -298,6 +309,8 @@ TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
       {localize + "--acceptance counts --min-link-share 0.5", "--min-link-share belongs to --acceptance chance"},
       {localize + "--recheck-link-share -1", "--recheck-link-share -1 is outside [0, 10]"},
       {localize + "--continuity-share 2", "--continuity-share 2 is outside [0, 1]"},
+      {localize + "--window-width 0", "--window-width 0 is outside (0, 1]"},
+      {localize + "--window-max-log10-nfa nan", "--window-max-log10-nfa nan is outside"},
       {localize + "--to 99", "key image 99 does not exist"},
       {localize + "--start-key 99", "start key image 99 (--start-key) does not exist"},
       {localize + "--start-key -2", "--start-key -2 is not -1"},

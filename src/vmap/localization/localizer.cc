@@ -85,6 +85,12 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
     guided.model(guided.type).FromJson(nlohmann::json::parse(matcher_.DescribeOptionsJson()), "the map's matcher");
     guided.Of<OrbMatcherOptions>().cross_check = false;
     guided_matcher_ = CreateMatcher(guided);
+    if (options_.window_matching && (options_.window_fast_threshold > 0 || options_.window_features > 0)) {
+      OrbMatcherOptions& orb = guided.Of<OrbMatcherOptions>();
+      if (options_.window_fast_threshold > 0) orb.fast_threshold = options_.window_fast_threshold;
+      if (options_.window_features > 0) orb.num_features = options_.window_features;
+      window_matcher_ = CreateMatcher(guided);
+    }
   }
   Reset();  // at the start key image, when there is one
 }
@@ -227,7 +233,7 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     }
   }
   if (!best.accepted) {
-    const int guided = TrackGuided(features, position);
+    const int guided = TrackGuided(frame, features, position);
     if (guided >= 0) return TrackedAt(std::move(result), position, guided, features);
   }
   if (!best.accepted) {

@@ -87,11 +87,19 @@ class Localizer {
   // verified at least the link share (min_link_share; chance alone refused it). Returns the route position of the
   // better accepted comparison, which replaces the frame's memo of that key image (its first comparison weighed
   // into the belief first); -1 when neither is accepted or guided matching does not apply.
-  int TrackGuided(const ImageFeatures& features, int position);
+  int TrackGuided(const Frame& frame, const ImageFeatures& features, int position);
   // The continuity of the heading (LocalizerOptions::continuity_share): `guided`, the guided matches of the frame
   // with key image `key` whose first comparison is `first`, move as the previous frame's heading against that key
   // image predicts. False without such a heading.
   bool HoldsContinuity(const KeyComparison& first, const TentativeMatches& guided, int key, cv::Size size) const;
+  // The first comparison's heading mode and log10 NFA are within the continuity rule's guards
+  // (continuity_heading_confidence, continuity_max_log10_nfa).
+  bool PassesContinuityGuards(const KeyComparison& first) const;
+  // Matching guided by the prediction (LocalizerOptions::window_matching): the frame against key image `key` matched
+  // only within the window around the previous frame's heading against it, accepted by window_max_log10_nfa.
+  // Unmatched without such a heading or with the rule off.
+  // `window_features`: the frame's features for it (window_matcher_'s, extracted once per frame by the caller).
+  KeyComparison CompareInWindow(const ImageFeatures& features, const ImageFeatures& window_features, int key) const;
   LocalizationResult Track(const Frame& frame, const ImageFeatures& features);
   // The frame tracked at route `position`, the estimate having been at `from`.
   LocalizationResult TrackedAt(LocalizationResult result, int from, int position, const ImageFeatures& features);
@@ -165,6 +173,9 @@ class Localizer {
   const KeyImageStore& keys_;
   const Matcher& matcher_;
   std::unique_ptr<Matcher> guided_matcher_;  // ORB without the cross check; null: no guided matching
+  // The frame's features for matching by the prediction (LocalizerOptions::window_fast_threshold, window_features);
+  // null: the map's.
+  std::unique_ptr<Matcher> window_matcher_;
   LocalizerOptions options_;
   std::vector<int> route_;
   std::vector<int> route_position_of_key_;  // -1 for key images off the route

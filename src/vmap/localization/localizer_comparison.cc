@@ -3,6 +3,7 @@
 #include <cmath>
 #include <utility>
 
+#include "vmap/features/orb_matcher.h"
 #include "vmap/geometry/pose_refinement.h"
 #include "vmap/localization/localizer.h"
 
@@ -96,7 +97,7 @@ void Localizer::AddPose(KeyComparison& c) const {
   c.translation_known = evidence.known;
 }
 
-int Localizer::TrackGuided(const ImageFeatures& features, int position) {
+int Localizer::TrackGuided(const Frame& frame, const ImageFeatures& features, int position) {
   const int last = static_cast<int>(route_.size()) - 1;
   // Looser matching is decided by chance only (the counts rule would take its extra matches as evidence).
   if (!guided_matcher_ || options_.acceptance != AcceptanceRule::kChance || !belief_confident_ ||
@@ -105,6 +106,7 @@ int Localizer::TrackGuided(const ImageFeatures& features, int position) {
   }
   int found = -1;
   KeyComparison best;
+  std::shared_ptr<const ImageFeatures> window_features;  // extracted when first needed
   for (int p = position; p <= std::min(last, position + 1); ++p) {
     const int key = route_[p];
     // Only where chance refused the first comparison and the link share did not: guided matching asks chance again,
@@ -117,6 +119,15 @@ int Localizer::TrackGuided(const ImageFeatures& features, int position) {
     KeyComparison c = CompareImage(features, *keys_.features[key], matches, key);
     if (c.matched && !c.accepted && HoldsContinuity(first, matches, key, features.image_size())) {
       c.accepted = true;
+    }
+    if (!c.accepted && options_.window_matching && PassesContinuityGuards(first)) {
+      if (!window_features) {
+        window_features = window_matcher_
+                              ? window_matcher_->ExtractFrame(frame.gray, frame.color)
+                              : std::shared_ptr<const ImageFeatures>(&features, [](const ImageFeatures*) {});
+      }
+      KeyComparison windowed = CompareInWindow(features, *window_features, key);
+      if (windowed.accepted) c = std::move(windowed);
     }
     if (!c.accepted || (found >= 0 && !IsBetterMatch(c, best))) continue;
     found = p;
@@ -132,11 +143,7 @@ int Localizer::TrackGuided(const ImageFeatures& features, int position) {
 
 bool Localizer::HoldsContinuity(const KeyComparison& first, const TentativeMatches& guided, int key,
                                 cv::Size size) const {
-  if (options_.continuity_share <= 0.0 || guided.size() == 0 ||
-      first.heading.confidence < options_.continuity_heading_confidence ||
-      !(first.log10_nfa <= options_.continuity_max_log10_nfa)) {
-    return false;
-  }
+  if (options_.continuity_share <= 0.0 || guided.size() == 0 || !PassesContinuityGuards(first)) return false;
   const auto previous = std::find_if(previous_headings_.begin(), previous_headings_.end(),
                                      [&](const std::pair<int, double>& h) { return h.first == key; });
   if (previous == previous_headings_.end()) return false;
@@ -148,6 +155,31 @@ bool Localizer::HoldsContinuity(const KeyComparison& first, const TentativeMatch
     moving += std::abs(dx - previous->second) <= half_width && std::abs(dy) <= half_height;
   }
   return moving >= options_.continuity_share * static_cast<double>(guided.size());
+}
+
+bool Localizer::PassesContinuityGuards(const KeyComparison& first) const {
+  return !(first.heading.confidence < options_.continuity_heading_confidence) &&
+         first.log10_nfa <= options_.continuity_max_log10_nfa;
+}
+
+KeyComparison Localizer::CompareInWindow(const ImageFeatures& features, const ImageFeatures& window_features,
+                                         int key) const {
+  KeyComparison c;
+  const auto previous = std::find_if(previous_headings_.begin(), previous_headings_.end(),
+                                     [&](const std::pair<int, double>& h) { return h.first == key; });
+  if (previous == previous_headings_.end()) return c;
+  const cv::Size size = features.image_size();
+  MatchWindow window;
+  window.predicted_dx = previous->second;
+  window.half_width = options_.window_width * size.width;
+  window.half_height = size.height / 20.0;
+  window.zoom = options_.window_zoom;
+  window.centre = cv::Point2f(size.width / 2.0f, size.height / 2.0f);
+  const ImageFeatures& key_features = *keys_.features[key];
+  c = CompareImage(window_features, key_features, MatchOrbInWindow(window_features, key_features, window), key);
+  // Chance's test counts matches that agree with the prediction by construction: its own threshold, measured.
+  c.accepted = c.matched && c.log10_nfa <= options_.window_max_log10_nfa;
+  return c;
 }
 
 KeyComparison Localizer::CompareOnce(const ImageFeatures& features, int key) {

@@ -68,6 +68,25 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"continuity_max_log10_nfa", "--continuity-max-log10-nfa",
                  "The continuity rule: the first comparison's log10 NFA at most this"},
                 continuity_max_log10_nfa);
+  visitor.Visit({"window_matching", "!--no-window-matching",
+                 "ORB, guided matching: never match a frame again within a window around the previous frame's heading"},
+                window_matching);
+  visitor.Visit({"window_width", "--window-width",
+                 "ORB, guided matching: the window of matching by the prediction, a share of the image's width"},
+                window_width);
+  visitor.Visit({"window_zoom", "--window-zoom",
+                 "ORB, matching by the prediction: the window grows by this share of a feature's distance from the "
+                 "image's centre"},
+                window_zoom);
+  visitor.Visit({"window_fast_threshold", "--window-fast-threshold",
+                 "ORB, matching by the prediction: the frame's FAST threshold for it (0 = the map's features)"},
+                window_fast_threshold);
+  visitor.Visit({"window_features", "--window-features",
+                 "ORB, matching by the prediction: the frame's features for it (0 = the map's number)"},
+                window_features);
+  visitor.Visit({"window_max_log10_nfa", "--window-max-log10-nfa",
+                 "ORB, matching by the prediction: accept when the window's matches' log10 NFA is at most this"},
+                window_max_log10_nfa);
   visitor.VisitNested("ranking", ranking);
   visitor.VisitNested("belief", belief);
   visitor.VisitNested("heading", heading);
@@ -118,6 +137,26 @@ void LocalizerOptions::Check() const {
     throw OptionError("continuity_heading_confidence",
                       fmt::format("{} is outside [0, 1] (default {})", continuity_heading_confidence,
                                   defaults.continuity_heading_confidence));
+  }
+  if (!(window_width > 0.0 && window_width <= 1.0)) {
+    throw OptionError("window_width",
+                      fmt::format("{} is outside (0, 1] (default {})", window_width, defaults.window_width));
+  }
+  if (!(window_zoom >= 0.0 && window_zoom <= 10.0)) {
+    throw OptionError("window_zoom",
+                      fmt::format("{} is outside [0, 10] (default {})", window_zoom, defaults.window_zoom));
+  }
+  if (window_fast_threshold < 0 || window_fast_threshold > 255) {
+    throw OptionError("window_fast_threshold", fmt::format("{} is outside [0, 255] (default {}; 0: the map's)",
+                                                           window_fast_threshold, defaults.window_fast_threshold));
+  }
+  if (window_features < 0 || window_features > 100000) {
+    throw OptionError("window_features", fmt::format("{} is outside [0, 100000] (default {}; 0: the map's)",
+                                                     window_features, defaults.window_features));
+  }
+  if (!(window_max_log10_nfa >= -1000.0 && window_max_log10_nfa <= 1000.0)) {
+    throw OptionError("window_max_log10_nfa", fmt::format("{} is outside [-1000, 1000] (default {})",
+                                                          window_max_log10_nfa, defaults.window_max_log10_nfa));
   }
   if (!(continuity_max_log10_nfa >= -1000.0 && continuity_max_log10_nfa <= 1000.0)) {
     throw OptionError("continuity_max_log10_nfa",

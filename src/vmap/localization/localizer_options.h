@@ -74,6 +74,22 @@ struct LocalizerOptions {
   double continuity_share = 0.18;
   double continuity_heading_confidence = 0.43;
   double continuity_max_log10_nfa = 7.5;
+  // Matching guided by the prediction (guided matching only, where the continuity rule did not accept): the frame's
+  // features extracted again (FAST threshold `window_fast_threshold`, `window_features` of them; 0: the map's) and
+  // matched with the key image only within a window around the previous frame's heading against it
+  // (features/orb_matcher.h, MatchOrbInWindow: `window_width` of the image's width across and 1/20 of its height up
+  // or down, both widened by `window_zoom` times the feature's distance from the image's centre; pyramid levels at
+  // most 1 apart, Hamming distance at most 64, ratio 0.9 among the window's candidates). Accepted when the a-contrario
+  // count of those matches is at most `window_max_log10_nfa` and the first comparison passes the continuity rule's
+  // guards (continuity_heading_confidence, continuity_max_log10_nfa). Such matches agree with the prediction by
+  // construction, so that count is no chance: the threshold was measured against wrong key images with the prediction
+  // a run would have there (docs/localize.md, "Matching guided by the prediction"). Off: never.
+  bool window_matching = true;
+  double window_width = 0.1;
+  double window_zoom = 0.15;
+  int window_fast_threshold = 7;
+  int window_features = 1000;
+  double window_max_log10_nfa = -1.5;
   // The key image the run starts at (a teach-and-repeat robot starts where the teach run started: the route's
   // first key image), or -1: anywhere (the first frame is relocalized over the whole route). The tracker starts
   // there and the belief holds `start_mass` there (the rest spread over the route as a flat belief): a soft prior,
