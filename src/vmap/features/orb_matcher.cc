@@ -387,10 +387,10 @@ TentativeMatches MatchOrbInWindow(const ImageFeatures& frame, const ImageFeature
           std::abs(q.octave - p.octave) > window.max_level_difference) {
         continue;
       }
-      int d = 0;
-      const uint64_t* u = qa.data() + static_cast<size_t>(i) * words;
-      const uint64_t* v = qb.data() + static_cast<size_t>(j) * words;
-      for (int w = 0; w < words; ++w) d += __builtin_popcountll(u[w] ^ v[w]);
+      Distance distance;  // one train row: the POPCNT-dispatched loop the full matcher uses
+      HammingRowWords(qa.data() + static_cast<size_t>(i) * words, qb.data() + static_cast<size_t>(j) * words, 1, words,
+                      &distance);
+      const int d = distance;
       if (d < best) {
         second = best;
         best = d;

@@ -23,6 +23,7 @@
 // image shares with its neighbours is relocalized too, and moved when another key image verifies more.
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "vmap/features/matcher.h"
@@ -88,18 +89,22 @@ class Localizer {
   // better accepted comparison, which replaces the frame's memo of that key image (its first comparison weighed
   // into the belief first); -1 when neither is accepted or guided matching does not apply.
   int TrackGuided(const Frame& frame, const ImageFeatures& features, int position);
+  // The previous frame's heading (px) against key image `key`; none when that frame was not compared with it.
+  std::optional<double> PreviousHeading(int key) const;
   // The continuity of the heading (LocalizerOptions::continuity_share): `guided`, the guided matches of the frame
-  // with key image `key` whose first comparison is `first`, move as the previous frame's heading against that key
-  // image predicts. False without such a heading.
-  bool HoldsContinuity(const KeyComparison& first, const TentativeMatches& guided, int key, cv::Size size) const;
+  // with a key image whose first comparison is `first`, move by `predicted_dx`, the previous frame's heading against
+  // that key image.
+  bool HoldsContinuity(const KeyComparison& first, const TentativeMatches& guided, double predicted_dx,
+                       cv::Size size) const;
   // The first comparison's heading mode and log10 NFA are within the continuity rule's guards
   // (continuity_heading_confidence, continuity_max_log10_nfa).
   bool PassesContinuityGuards(const KeyComparison& first) const;
-  // Matching guided by the prediction (LocalizerOptions::window_matching): the frame against key image `key` matched
-  // only within the window around the previous frame's heading against it, accepted by window_max_log10_nfa.
-  // Unmatched without such a heading or with the rule off.
-  // `window_features`: the frame's features for it (window_matcher_'s, extracted once per frame by the caller).
-  KeyComparison CompareInWindow(const ImageFeatures& features, const ImageFeatures& window_features, int key) const;
+  // Matching guided by the prediction (LocalizerOptions::window_matching): the frame (`window_features`:
+  // window_matcher_'s features of it, or the frame's own; `size`, its size) against key image `key`, matched only
+  // within the window around `predicted_dx`, the previous frame's heading against it; accepted by
+  // window_max_log10_nfa.
+  KeyComparison CompareInWindow(const ImageFeatures& window_features, int key, double predicted_dx,
+                                cv::Size size) const;
   LocalizationResult Track(const Frame& frame, const ImageFeatures& features);
   // The frame tracked at route `position`, the estimate having been at `from`.
   LocalizationResult TrackedAt(LocalizationResult result, int from, int position, const ImageFeatures& features);

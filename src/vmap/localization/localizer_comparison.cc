@@ -1,6 +1,7 @@
 // The Localizer's comparisons of a frame with key images: matching, verification, acceptance, heading and pose.
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "vmap/features/orb_matcher.h"
@@ -106,7 +107,7 @@ int Localizer::TrackGuided(const Frame& frame, const ImageFeatures& features, in
   }
   int found = -1;
   KeyComparison best;
-  std::shared_ptr<const ImageFeatures> window_features;  // extracted when first needed
+  std::shared_ptr<const ImageFeatures> window_features;  // window_matcher_'s, extracted when first needed
   for (int p = position; p <= std::min(last, position + 1); ++p) {
     const int key = route_[p];
     // Only where chance refused the first comparison and the link share did not: guided matching asks chance again,
@@ -117,16 +118,15 @@ int Localizer::TrackGuided(const Frame& frame, const ImageFeatures& features, in
     WeighComparisons();  // the first comparisons' evidence, before a guided one replaces its key image's
     const TentativeMatches matches = guided_matcher_->Match(features, *keys_.features[key]);
     KeyComparison c = CompareImage(features, *keys_.features[key], matches, key);
-    if (c.matched && !c.accepted && HoldsContinuity(first, matches, key, features.image_size())) {
+    const std::optional<double> predicted_dx = PreviousHeading(key);
+    if (c.matched && !c.accepted && predicted_dx &&
+        HoldsContinuity(first, matches, *predicted_dx, features.image_size())) {
       c.accepted = true;
     }
-    if (!c.accepted && options_.window_matching && PassesContinuityGuards(first)) {
-      if (!window_features) {
-        window_features = window_matcher_
-                              ? window_matcher_->ExtractFrame(frame.gray, frame.color)
-                              : std::shared_ptr<const ImageFeatures>(&features, [](const ImageFeatures*) {});
-      }
-      KeyComparison windowed = CompareInWindow(features, *window_features, key);
+    if (!c.accepted && options_.window_matching && predicted_dx && PassesContinuityGuards(first)) {
+      if (window_matcher_ && !window_features) window_features = window_matcher_->ExtractFrame(frame.gray, frame.color);
+      KeyComparison windowed =
+          CompareInWindow(window_features ? *window_features : features, key, *predicted_dx, features.image_size());
       if (windowed.accepted) c = std::move(windowed);
     }
     if (!c.accepted || (found >= 0 && !IsBetterMatch(c, best))) continue;
@@ -141,18 +141,22 @@ int Localizer::TrackGuided(const Frame& frame, const ImageFeatures& features, in
   return found;
 }
 
-bool Localizer::HoldsContinuity(const KeyComparison& first, const TentativeMatches& guided, int key,
-                                cv::Size size) const {
-  if (options_.continuity_share <= 0.0 || guided.size() == 0 || !PassesContinuityGuards(first)) return false;
+std::optional<double> Localizer::PreviousHeading(int key) const {
   const auto previous = std::find_if(previous_headings_.begin(), previous_headings_.end(),
                                      [&](const std::pair<int, double>& h) { return h.first == key; });
-  if (previous == previous_headings_.end()) return false;
+  if (previous == previous_headings_.end()) return std::nullopt;
+  return previous->second;
+}
+
+bool Localizer::HoldsContinuity(const KeyComparison& first, const TentativeMatches& guided, double predicted_dx,
+                                cv::Size size) const {
+  if (options_.continuity_share <= 0.0 || guided.size() == 0 || !PassesContinuityGuards(first)) return false;
   // The window of displacements around the prediction: those of bench/evidence_dump's near_L, where it was measured.
   const double half_width = size.width / 40.0, half_height = size.height / 20.0;
   int moving = 0;
   for (size_t i = 0; i < guided.size(); ++i) {
     const double dx = guided.points0[i].x - guided.points1[i].x, dy = guided.points0[i].y - guided.points1[i].y;
-    moving += std::abs(dx - previous->second) <= half_width && std::abs(dy) <= half_height;
+    moving += std::abs(dx - predicted_dx) <= half_width && std::abs(dy) <= half_height;
   }
   return moving >= options_.continuity_share * static_cast<double>(guided.size());
 }
@@ -162,21 +166,17 @@ bool Localizer::PassesContinuityGuards(const KeyComparison& first) const {
          first.log10_nfa <= options_.continuity_max_log10_nfa;
 }
 
-KeyComparison Localizer::CompareInWindow(const ImageFeatures& features, const ImageFeatures& window_features,
-                                         int key) const {
-  KeyComparison c;
-  const auto previous = std::find_if(previous_headings_.begin(), previous_headings_.end(),
-                                     [&](const std::pair<int, double>& h) { return h.first == key; });
-  if (previous == previous_headings_.end()) return c;
-  const cv::Size size = features.image_size();
+KeyComparison Localizer::CompareInWindow(const ImageFeatures& window_features, int key, double predicted_dx,
+                                         cv::Size size) const {
   MatchWindow window;
-  window.predicted_dx = previous->second;
+  window.predicted_dx = predicted_dx;
   window.half_width = options_.window_width * size.width;
   window.half_height = size.height / 20.0;
   window.zoom = options_.window_zoom;
   window.centre = cv::Point2f(size.width / 2.0f, size.height / 2.0f);
   const ImageFeatures& key_features = *keys_.features[key];
-  c = CompareImage(window_features, key_features, MatchOrbInWindow(window_features, key_features, window), key);
+  KeyComparison c =
+      CompareImage(window_features, key_features, MatchOrbInWindow(window_features, key_features, window), key);
   // Chance's test counts matches that agree with the prediction by construction: its own threshold, measured.
   c.accepted = c.matched && c.log10_nfa <= options_.window_max_log10_nfa;
   return c;
