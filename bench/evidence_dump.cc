@@ -9,20 +9,20 @@
 // Columns: frame, source_index, key, matched, accepted, tentative, verified, similarity, log10_nfa, link_verified
 // (the smaller of the verified matches of the key image's links with its neighbours in the map; 0 without),
 // heading_confidence, heading_votes, heading_px, heading_voters, and the continuity of the heading
-// (docs/localize.md, "Continuity of the heading"): prev_heading_px, the previous frame's heading against the same key
-// image (the prediction a tracking run has of this frame's; empty on the first frame or without a heading), and near_S
-// / near_L, how many of this comparison's tentative matches move by the predicted displacement (dx within 1/80 or 1/40
-// of the image's width of prev_heading_px, dy within 1/20 of its height of 0). With --guided 1 (ORB maps), the same key
-// image matched again as the localizer's guided matching does (no cross check): g_tentative, g_verified, g_log10_nfa,
-// g_heading_px, g_heading_votes, g_near_S, g_near_L (g_near_* against the same prediction).
-// With --windowed (ORB maps; docs/localize.md, "Matching guided by the prediction"), for each window given the frame
-// matched with the key image by the prediction as the localizer's window matching does (MatchOrbInWindow: candidates
-// within W of the image's width of prev_heading_px across and 1/20 of its height up or down, both widened by Z times
-// the feature's distance from the image's centre, pyramid levels at most L apart, Hamming distance at most D, ratio R
-// among the candidates; defaults Z 0, D 64, R 0.9, L 1) and verified as the localizer verifies: wN_tentative,
-// wN_verified, wN_log10_nfa, wN_similarity for window N (-1, -1, 1e9, 0 without a prediction). The frame's features for
-// it: the map's, or extracted again with FAST threshold T / N features (the localizer's window_fast_threshold,
-// window_features).
+// (docs/measurements/localization-conditions.md, "Continuity of the heading"): prev_heading_px, the previous frame's
+// heading against the same key image (the prediction a tracking run has of this frame's; empty on the first frame or
+// without a heading), and near_S / near_L, how many of this comparison's tentative matches move by the predicted
+// displacement (dx within 1/80 or 1/40 of the image's width of prev_heading_px, dy within 1/20 of its height of 0).
+// With --guided 1 (ORB maps), the same key image matched again as the localizer's guided matching does (no cross
+// check): g_tentative, g_verified, g_log10_nfa, g_heading_px, g_heading_votes, g_near_S, g_near_L (g_near_* against the
+// same prediction). With --windowed (ORB maps; docs/measurements/localization-conditions.md, "Matching guided by the
+// prediction"), for each window given the frame matched with the key image by the prediction as the localizer's window
+// matching does (MatchOrbInWindow: candidates within W of the image's width of prev_heading_px across and 1/20 of its
+// height up or down, both widened by Z times the feature's distance from the image's centre, pyramid levels at most L
+// apart, Hamming distance at most D, ratio R among the candidates; defaults Z 0, D 64, R 0.9, L 1) and verified as the
+// localizer verifies: wN_tentative, wN_verified, wN_log10_nfa, wN_similarity for window N (-1, -1, 1e9, 0 without a
+// prediction). The frame's features for it: the map's, or extracted again with FAST threshold T / N features (the
+// localizer's window_fast_threshold, window_features).
 
 #include <algorithm>
 #include <cmath>

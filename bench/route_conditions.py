@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Localization along a route whose appearance changed (docs/localize.md, "Across seasons and conditions").
+"""Localization along a route whose appearance changed (docs/measurements/localization-conditions.md).
 
 corridor: ../shared/data/corridor_conditions: a map of teach/ (`vmap build`), repeat/ localized against it; repeat
   frame i was taken where teach frame i was, and a frame is right when its key image is one of those around any

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Sequence evidence (SeqSLAM's point), measured against chance: does "the same key images winning, in route order,
-over N consecutive frames" tell a right place from a wrong one where each frame alone cannot? (docs/localize.md,
-"Sequence evidence across seasons".)
+over N consecutive frames" tell a right place from a wrong one where each frame alone cannot? (docs/measurements/
+localization-conditions.md, "Sequence evidence across seasons".)
 
 Input: every frame of a run against every key image of its map (build/bench/evidence_dump MAP QUERY, or
 bench/route_conditions.py --evidence-dir), the map's map.json (its key images' teach frames: frame i of the repeat run
