@@ -148,13 +148,17 @@ bool BackgroundVmap::Running() const {
   return waitid(P_PID, pid_, &info, WEXITED | WNOHANG | WNOWAIT) == 0 && info.si_pid == 0;
 }
 
-int BackgroundVmap::Wait(long* max_rss_kb) {
+int BackgroundVmap::Wait(long* max_rss_kb, double* cpu_seconds) {
   if (pid_ <= 0) return -1;
   int status = 0;
   struct rusage usage {};
   wait4(pid_, &status, 0, &usage);
   waited_ = true;
   if (max_rss_kb) *max_rss_kb = usage.ru_maxrss;
+  if (cpu_seconds) {
+    *cpu_seconds =
+        usage.ru_utime.tv_sec + usage.ru_stime.tv_sec + (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) / 1e6;
+  }
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 

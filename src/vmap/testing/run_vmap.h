@@ -54,8 +54,9 @@ class BackgroundVmap {
   void Signal(int signal_number) const;
   // Whether it has not exited yet (it is not reaped).
   bool Running() const;
-  // The exit status, or 128 + the signal that ended it; the peak memory in `max_rss_kb` when given.
-  int Wait(long* max_rss_kb = nullptr);
+  // The exit status, or 128 + the signal that ended it; the peak memory in `max_rss_kb` and the CPU time it used
+  // (user and system) in `cpu_seconds` when given.
+  int Wait(long* max_rss_kb = nullptr, double* cpu_seconds = nullptr);
 
  private:
   int pid_ = -1;
