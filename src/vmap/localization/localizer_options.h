@@ -93,9 +93,11 @@ struct LocalizerOptions {
   // The key image the run starts at (a teach-and-repeat robot starts where the teach run started: the route's
   // first key image), or -1: anywhere (the first frame is relocalized over the whole route). The tracker starts
   // there and the belief holds `start_mass` there (the rest spread over the route as a flat belief): a soft prior,
-  // which the frames' evidence overrides when the run starts elsewhere (docs/localize.md, "The start").
+  // which the frames' evidence overrides when the run starts elsewhere (docs/localize.md, "The start"). 0.8 rather
+  // than 0.5: XFeat's first frames across lighting weigh far key images too, and half the belief did not keep them
+  // near the start (corridor_conditions frames 5-6; a run started elsewhere pays a frame or two more of doubt).
   int start_key = -1;
-  double start_mass = 0.5;
+  double start_mass = 0.8;
   // Lost frames in a row (each one also failed to relocalize) after which the estimate is dropped: key and
   // next_key then read -1 until a frame is relocalized.
   int max_lost_frames = 5;
