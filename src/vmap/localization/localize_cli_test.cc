@@ -1,6 +1,7 @@
 // End-to-end tests of `vmap localize`, `vmap route` and the report of a run, on the shared sequences; and the
 // bracket test against truth (docs/measurements/localization.md) on subsets of kitti07 and redkitchen.
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -222,15 +223,15 @@ TEST(LocalizeCli, EvalCorridorRuns) {
   EXPECT_EQ(Lines(csv).size(), 51u);
 }
 
-// corridor_conditions' first 40 repeat frames against an ORB map of its teach run, once per entry of `flags` (more
-// flags for vmap localize): how many frames are steered by (tracking or relocalized). Empty without the data.
-std::vector<int> SteeredOnCorridor(const std::vector<std::string>& flags, int last = 39) {
+// corridor_conditions' first `last` + 1 repeat frames against an ORB map of its teach run, once per entry of `flags`
+// (more flags for vmap localize): each frame's status and key image. Empty without the data.
+std::vector<std::vector<std::pair<std::string, int>>> CorridorRuns(const std::vector<std::string>& flags, int last) {
   const fs::path data = Shared() / "data/corridor_conditions";
   if (Shared().empty() || !fs::exists(data)) return {};
   ::vmap::testing::ScopedTempDir tmp;
   std::string out;
   EXPECT_EQ(RunVmap("build " + Quote(data / "teach") + " -q -o " + Quote(tmp.path() / "map"), &out), 0) << out;
-  std::vector<int> steered;
+  std::vector<std::vector<std::pair<std::string, int>>> runs;
   for (const std::string& f : flags) {
     const fs::path csv = tmp.path() / "run.csv";
     EXPECT_EQ(RunVmap("localize " + Quote(tmp.path() / "map") + " " + Quote(data / "repeat") + " --last " +
@@ -238,11 +239,29 @@ std::vector<int> SteeredOnCorridor(const std::vector<std::string>& flags, int la
                       &out),
               0)
         << out;
-    int count = 0;
-    for (const std::string& row : Lines(csv)) {
-      count += row.find(",tracking,") != std::string::npos || row.find(",relocalized,") != std::string::npos;
+    std::vector<std::pair<std::string, int>> frames;
+    const std::vector<std::string> rows = Lines(csv);
+    for (size_t r = 1; r < rows.size(); ++r) {
+      // frame,source_index,timestamp,source_name,status,key,...
+      std::stringstream row(rows[r]);
+      std::vector<std::string> cells;
+      for (std::string cell; cells.size() < 6 && std::getline(row, cell, ',');) cells.push_back(cell);
+      if (cells.size() == 6) frames.emplace_back(cells[4], std::stoi(cells[5]));
     }
-    steered.push_back(count);
+    runs.push_back(std::move(frames));
+  }
+  return runs;
+}
+
+bool SteeredBy(const std::pair<std::string, int>& frame) {
+  return frame.first == "tracking" || frame.first == "relocalized";
+}
+
+// As CorridorRuns, how many frames are steered by (tracking or relocalized) in each run.
+std::vector<int> SteeredOnCorridor(const std::vector<std::string>& flags, int last = 39) {
+  std::vector<int> steered;
+  for (const auto& run : CorridorRuns(flags, last)) {
+    steered.push_back(static_cast<int>(std::count_if(run.begin(), run.end(), SteeredBy)));
   }
   return steered;
 }
@@ -284,6 +303,34 @@ TEST(LocalizeCli, MatchingInTheWindowOfThePredictionTracksFramesTheContinuityMis
   EXPECT_GE(steered[0], steered[1] + 2) << "with the window " << steered[0] << ", without " << steered[1];
 }
 
+TEST(LocalizeCli, AStepBackOnTheEdgeOfChanceIsNotTaken) {
+  // corridor_conditions with ORB (docs/localize.md, "A step back needs more than chance"): frame 96 verifies nothing
+  // at its key image and the two ahead, and the key image behind at log10 NFA -0.05; at chance's own bar (0) the
+  // tracker steps back to it, one more frame steered by behind the frame before it.
+  const auto runs = CorridorRuns({"", " --step-back-max-log10-nfa 0"}, 99);
+  if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  std::vector<int> back_jumps;
+  for (const auto& run : runs) {
+    int jumps = 0, steered_key = -1;
+    for (const auto& frame : run) {
+      if (!SteeredBy(frame)) continue;
+      jumps += frame.second < steered_key;
+      steered_key = frame.second;
+    }
+    back_jumps.push_back(jumps);
+  }
+  EXPECT_LT(back_jumps[0], back_jumps[1]) << "back-jumps: -1 " << back_jumps[0] << ", 0 " << back_jumps[1];
+}
+
+TEST(LocalizeCli, GuidedMatchingAsksWhereTheEstimateWasDroppedWhileLost) {
+  // corridor_conditions with ORB (docs/localize.md, "Guided matching while lost"): nothing verifies on frames 36-41,
+  // the estimate is dropped and the belief flattens; frame 43's guided comparison with key image 16, where the
+  // tracker held the frames, is accepted and steered by.
+  const std::vector<int> steered = SteeredOnCorridor({"", " --no-guided-while-lost"}, 45);
+  if (steered.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  EXPECT_GE(steered[0], steered[1] + 1) << "asked while lost " << steered[0] << ", not " << steered[1];
+}
+
 TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
   ::vmap::testing::ScopedTempDir tmp;
   ::vmap::testing::SyntheticOptions synthetic;
@@ -311,6 +358,7 @@ TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
       {localize + "--continuity-share 2", "--continuity-share 2 is outside [0, 1]"},
       {localize + "--window-width 0", "--window-width 0 is outside (0, 1]"},
       {localize + "--window-max-log10-nfa nan", "--window-max-log10-nfa nan is outside"},
+      {localize + "--step-back-max-log10-nfa nan", "--step-back-max-log10-nfa nan is outside"},
       {localize + "--to 99", "key image 99 does not exist"},
       {localize + "--start-key 99", "start key image 99 (--start-key) does not exist"},
       {localize + "--start-key -2", "--start-key -2 is not -1"},

@@ -116,6 +116,8 @@ void Localizer::Reset() {
   pointed_ = pointed_before_ = -1;
   position_ = start_position_;
   lost_in_a_row_ = 0;
+  dropped_position_ = -1;
+  frames_since_drop_ = 0;
   step_back_ruled_out_ = {};
   previous_headings_.clear();
 }
@@ -129,10 +131,14 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
     if (c.key >= 0 && c.key < static_cast<int>(keys_.features.size())) comparisons_.push_back({std::move(c), false});
   }
   belief_.Predict();
+  // Guided matching asks where the estimate was dropped for max_lost_frames frames (guided_while_lost).
+  if (dropped_position_ >= 0 && (!options_.guided_while_lost || ++frames_since_drop_ > options_.max_lost_frames)) {
+    dropped_position_ = -1;
+  }
   belief_confident_ = SinglesOut(belief_.Peak());
   steps_on_ = 0;
   pointed_before_ = std::exchange(pointed_, -1);
-  LocalizationResult result = has_estimate() ? Track(frame, features) : Relocalize(frame, features);
+  LocalizationResult result = has_estimate() ? Track(frame, features) : Reacquire(frame, features);
   Believe(result, frame, features);
   result.comparisons =
       static_cast<int>(std::count_if(comparisons_.begin(), comparisons_.end(), [](const Memo& m) { return m.used; }));
@@ -223,7 +229,10 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
         step_back_ruled_out_ = ruled_out;
       } else {
         const KeyComparison behind = compare_at(position - 1);
-        if (IsBetterMatch(behind, best)) {
+        // With nothing accepted at or ahead of `key`, the key image behind has nothing to beat but chance, and a step
+        // back is the likelier chance on a route that goes forwards: it must beat chance by more.
+        const bool beats_chance = best.accepted || behind.log10_nfa <= options_.step_back_max_log10_nfa;
+        if (IsBetterMatch(behind, best) && beats_chance) {
           best = behind;
           best_position = position - 1;
         } else if (v_key > 0 && behind.num_verified < kClearlyWorse * v_key) {
@@ -233,7 +242,8 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     }
   }
   if (!best.accepted) {
-    const int guided = TrackGuided(frame, features, position);
+    // After a drop, until a frame is steered by again, asked whatever the belief (Reacquire).
+    const int guided = TrackGuided(frame, features, position, /*whatever_the_belief=*/dropped_position_ >= 0);
     if (guided >= 0) return TrackedAt(std::move(result), position, guided, features);
   }
   if (!best.accepted) {
@@ -252,6 +262,8 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     Describe(result, position, features);
     if (lost_in_a_row_ > options_.max_lost_frames) {
       // The estimate is dropped; the belief is kept (its evidence still says where the frames were).
+      dropped_position_ = position;
+      frames_since_drop_ = 0;
       position_ = -1;
       lost_in_a_row_ = 0;
       step_back_ruled_out_ = {};
@@ -275,6 +287,20 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     }
   }
   return TrackedAt(std::move(result), position, best_position, features);
+}
+
+LocalizationResult Localizer::Reacquire(const Frame& frame, const ImageFeatures& features) {
+  LocalizationResult found = Relocalize(frame, features);
+  const int dropped = dropped_position_;
+  if (dropped < 0 || found.status != LocalizationStatus::kLost) return found;
+  // Nothing verified anywhere the ranking looked. The frames were lost where the tracker last held them, on evidence
+  // too weak for chance: a frame's own guided comparison there may be accepted (a dark stretch of a corridor), though
+  // the belief, weighed by those frames' weak evidence, no longer singles the place out.
+  const int guided = TrackGuided(frame, features, dropped, /*whatever_the_belief=*/true);
+  if (guided < 0) return found;
+  LocalizationResult tracked;
+  tracked.candidates = std::move(found.candidates);
+  return TrackedAt(std::move(tracked), dropped, guided, features);
 }
 
 LocalizationResult Localizer::TrackedAt(LocalizationResult result, int from, int position,

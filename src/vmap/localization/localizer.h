@@ -88,7 +88,8 @@ class Localizer {
   // verified at least the link share (min_link_share; chance alone refused it). Returns the route position of the
   // better accepted comparison, which replaces the frame's memo of that key image (its first comparison weighed
   // into the belief first); -1 when neither is accepted or guided matching does not apply.
-  int TrackGuided(const Frame& frame, const ImageFeatures& features, int position);
+  // `whatever_the_belief`: asked though the belief does not single the place out (guided_while_lost).
+  int TrackGuided(const Frame& frame, const ImageFeatures& features, int position, bool whatever_the_belief = false);
   // The previous frame's heading (px) against key image `key`; none when that frame was not compared with it.
   std::optional<double> PreviousHeading(int key) const;
   // The continuity of the heading (LocalizerOptions::continuity_share): `guided`, the guided matches of the frame
@@ -109,6 +110,9 @@ class Localizer {
   // The frame tracked at route `position`, the estimate having been at `from`.
   LocalizationResult TrackedAt(LocalizationResult result, int from, int position, const ImageFeatures& features);
   LocalizationResult Relocalize(const Frame& frame, const ImageFeatures& features);
+  // Without an estimate: relocalized, and when nothing verifies, matched guided where the estimate was dropped
+  // (LocalizerOptions::guided_while_lost).
+  LocalizationResult Reacquire(const Frame& frame, const ImageFeatures& features);
   void Describe(LocalizationResult& result, int position, const ImageFeatures& features);
   // The belief's step (localizer_belief.cc): weighs the evidence of every comparison of the frame, then sets the
   // result's confidence and, when the belief does not single out the tracked position, the status kUncertain.
@@ -191,6 +195,10 @@ class Localizer {
   int position_ = -1;        // route position of `key`; -1: no estimate
   int start_position_ = -1;  // route position of LocalizerOptions::start_key; -1: none
   int lost_in_a_row_ = 0;
+  // Where the estimate was last dropped (route position; -1: none) and the frames since, while guided_while_lost
+  // still asks there.
+  int dropped_position_ = -1;
+  int frames_since_drop_ = 0;
   // The step back last ruled out (Track): at route position `position`, on the frame before this one, with the
   // frame's verified matches with the next key image at that last check. position -1: none.
   struct StepBackRuledOut {

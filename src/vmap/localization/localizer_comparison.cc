@@ -98,13 +98,11 @@ void Localizer::AddPose(KeyComparison& c) const {
   c.translation_known = evidence.known;
 }
 
-int Localizer::TrackGuided(const Frame& frame, const ImageFeatures& features, int position) {
+int Localizer::TrackGuided(const Frame& frame, const ImageFeatures& features, int position, bool whatever_the_belief) {
   const int last = static_cast<int>(route_.size()) - 1;
   // Looser matching is decided by chance only (the counts rule would take its extra matches as evidence).
-  if (!guided_matcher_ || options_.acceptance != AcceptanceRule::kChance || !belief_confident_ ||
-      std::abs(belief_.Peak() - position) > kNear) {
-    return -1;
-  }
+  if (!guided_matcher_ || options_.acceptance != AcceptanceRule::kChance) return -1;
+  if (!whatever_the_belief && (!belief_confident_ || std::abs(belief_.Peak() - position) > kNear)) return -1;
   int found = -1;
   KeyComparison best;
   std::shared_ptr<const ImageFeatures> window_features;  // window_matcher_'s, extracted when first needed

@@ -55,9 +55,16 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                 experience_candidates);
   visitor.Visit({"lookahead", "--lookahead", "Key images beyond the next compared while tracking (1 or 2)"}, lookahead);
   visitor.Visit({"step_back", "!--no-step-back", "Never move the estimate back to the previous key image"}, step_back);
+  visitor.Visit({"step_back_max_log10_nfa", "--step-back-max-log10-nfa",
+                 "A step back to the previous key image when nothing at or ahead of the key image verifies: its log10 "
+                 "NFA at most this (stricter than --max-log10-nfa: the route goes forwards)"},
+                step_back_max_log10_nfa);
   visitor.Visit({"guided_matching", "!--no-guided-matching",
                  "ORB: never match a frame again with looser matching at the key images the belief holds"},
                 guided_matching);
+  visitor.Visit({"guided_while_lost", "!--no-guided-while-lost",
+                 "ORB: never match a frame guided at the key image the tracker held once the estimate is dropped"},
+                guided_while_lost);
   visitor.Visit({"continuity_share", "--continuity-share",
                  "ORB, guided matching: accept a comparison chance refuses when this share of its matches move as the "
                  "previous frame's heading against the key image predicts (0 = never)"},
@@ -111,6 +118,11 @@ void LocalizerOptions::Check() const {
     throw OptionError("max_log10_nfa", fmt::format("{} is outside [-1000, 1000] (default {}; 0: accept what "
                                                    "chance explains less than once)",
                                                    max_log10_nfa, defaults.max_log10_nfa));
+  }
+  if (!(step_back_max_log10_nfa >= -1000.0 && step_back_max_log10_nfa <= 1000.0)) {
+    throw OptionError("step_back_max_log10_nfa",
+                      fmt::format("{} is outside [-1000, 1000] (default {})", step_back_max_log10_nfa,
+                                  defaults.step_back_max_log10_nfa));
   }
   if (!(recheck_link_share >= 0.0 && recheck_link_share <= 10.0)) {
     throw OptionError("recheck_link_share",

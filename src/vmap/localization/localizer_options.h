@@ -59,11 +59,22 @@ struct LocalizerOptions {
   // follow only once their verified matches with `next_key` fall below that frame's (they moved back). Off: the
   // estimate only moves forwards (a robot that never reverses).
   bool step_back = true;
+  // A step back when neither `key` nor the key images ahead verify (nothing there to weigh it against) needs the key
+  // image behind to verify at a log10 NFA of at most this, stricter than chance's `max_log10_nfa`: the route goes
+  // forwards, so a key image behind that verifies at the edge of chance is likelier chance than a step back. -1: about
+  // the motion model's odds against a step back rather than staying (0.05 / 0.55; docs/localize.md).
+  double step_back_max_log10_nfa = -1.0;
   // Guided matching (ORB maps): a frame that verifies nothing at the tracked key images while the belief singles
   // out that place is matched with them again, and only with them, keeping one-way best matches too (no cross
   // check); the a-contrario test, which counts every tentative match, decides as before (docs/localize.md,
   // "Guided matching by the belief"). Off: never.
   bool guided_matching = true;
+  // Guided matching after the estimate was dropped (`max_lost_frames`): for as many frames again, until a frame is
+  // steered by, a frame that verifies nothing is still matched guided at the key image the tracker last held (or holds
+  // again) and the one after it, whatever the belief (flat by then: nothing verified for frames), and tracked there
+  // when its own guided comparison is accepted; a frame that a ranked key image verifies is relocalized first
+  // (docs/localize.md). Off: a dropped estimate is only relocalized.
+  bool guided_while_lost = true;
   // The continuity of the heading (guided matching only): a guided comparison chance refuses is accepted when the
   // frame moves as the previous frame did against the same key image. At least `continuity_share` of its tentative
   // matches move by the previous frame's heading against that key image (within 1/40 of the image's width across,
