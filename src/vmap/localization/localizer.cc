@@ -132,14 +132,15 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   }
   belief_.Predict();
   // Guided matching asks where the estimate was dropped for max_lost_frames frames (guided_while_lost).
-  if (dropped_position_ >= 0 && (!options_.guided_while_lost || ++frames_since_drop_ > options_.max_lost_frames)) {
-    dropped_position_ = -1;
-  }
+  if (dropped_position_ >= 0 && ++frames_since_drop_ > options_.max_lost_frames) dropped_position_ = -1;
   belief_confident_ = SinglesOut(belief_.Peak());
   steps_on_ = 0;
   pointed_before_ = std::exchange(pointed_, -1);
   LocalizationResult result = has_estimate() ? Track(frame, features) : Reacquire(frame, features);
   Believe(result, frame, features);
+  if (result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized) {
+    dropped_position_ = -1;  // steered by again: the drop is behind
+  }
   result.comparisons =
       static_cast<int>(std::count_if(comparisons_.begin(), comparisons_.end(), [](const Memo& m) { return m.used; }));
   if (result.key >= 0 && result.to_key.key == result.key) {
@@ -262,7 +263,7 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     Describe(result, position, features);
     if (lost_in_a_row_ > options_.max_lost_frames) {
       // The estimate is dropped; the belief is kept (its evidence still says where the frames were).
-      dropped_position_ = position;
+      if (options_.guided_while_lost) dropped_position_ = position;
       frames_since_drop_ = 0;
       position_ = -1;
       lost_in_a_row_ = 0;

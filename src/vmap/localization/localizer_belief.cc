@@ -49,9 +49,6 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
   const bool placed =
       result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized;
   if (placed && result.confidence < options_.belief.min_confidence) result.status = LocalizationStatus::kUncertain;
-  if (result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized) {
-    dropped_position_ = -1;  // steered by again: the drop is behind
-  }
   // An uncertain frame's key images are the best guess: the belief's peak when the belief singles it out and holds
   // more there than near the tracker's key image (the tracker goes on from its own; nothing steers by this frame).
   // A flat belief's peak is no better a guess than the tracker's (corridor_conditions, docs/localize.md).
