@@ -7,6 +7,10 @@ corridor: ../shared/data/corridor_conditions: a map of teach/ (`vmap build`), re
 michigan: ../shared/data/michigan_seasons as routes: for every ordered pair of sessions (a, b), a map of session a's
   five places in order (`--tau 1`: every place a key image) and session b's five places localized against it
   (frame i right at key image i). 132 routes of 5 frames.
+kidnapped: corridor_conditions' repeat frames 0-50, 80-110, 20-40 as one run (a folder of links in that order), against
+  the corridor's map: a robot carried on twice, forwards then back (docs/localize.md, "A far relocalization needs two
+  frames"). A run frame is right as its repeat frame is in the corridor set; the back-jumps count the second jump
+  (one is the carried robot's, not the localizer's).
 Per run: frames right (at a right key image, whatever the status), right and not uncertain, localized wrong, confidently wrong by more than 2 places (status tracking or relocalized at a
 key image more than 2 key images from every right one), uncertain and lost, frames/s, and back-jumps (a frame steered
 by, tracking or relocalized, at a key image before the previous steered-by frame's: the route goes forwards, and the
@@ -26,7 +30,7 @@ start").
 With --build "FLAGS", every map is built with these flags too (e.g. ORB's extraction: "--orb-grid-cell 30
 --orb-edge-threshold 16"); the localizer follows what the map records.
 
-usage: bench/route_conditions.py --vmap build/vmap[,old/vmap] [--sets corridor,michigan] [--matchers orb,xfeat]
+usage: bench/route_conditions.py --vmap build/vmap[,old/vmap] [--sets corridor,kidnapped,michigan] [--matchers orb,xfeat]
                                  [--tau T] [--start-key K|none] [--build "FLAGS"] [--localize "FLAGS"] [--repeat-stride N] [--work DIR] [--csv-dir DIR]
                                  [--evidence-dir DIR]
 (from the repository root; ../shared must be there)"""
@@ -69,8 +73,8 @@ class Tally:
         self.seconds = 0.0
         self.far = []
 
-    def add(self, doc, right_keys_of, label):
-        """`right_keys_of(frame)`: the set of right key images of that frame."""
+    def add(self, doc, right_keys_of, label, name_of=lambda f: "frame %d" % f["source_index"]):
+        """`right_keys_of(frame)`: the set of right key images of that frame; `name_of(frame)`: how `far` names it."""
         steered_key = None  # the key image of the last frame steered by
         for f in doc["frames"]:
             self.frames += 1
@@ -78,8 +82,7 @@ class Tally:
                 if steered_key is not None and f["key"] < steered_key:
                     self.back_jumps += 1
                     if len(self.far) < 8:
-                        self.far.append("%s frame %d: back-jump to key %d from %d" % (label, f["source_index"], f["key"],
-                                                                                      steered_key))
+                        self.far.append("%s %s: back-jump to key %d from %d" % (label, name_of(f), f["key"], steered_key))
                 steered_key = f["key"]
             right = right_keys_of(f)
             status = f["status"]
@@ -98,8 +101,8 @@ class Tally:
             if min(abs(f["key"] - k) for k in right) > 2:
                 self.confidently_far += 1
                 if len(self.far) < 8:
-                    self.far.append("%s frame %d at key %d (right %s)" % (label, f["source_index"], f["key"],
-                                                                          ",".join(map(str, sorted(right)))))
+                    self.far.append("%s %s at key %d (right %s)" % (label, name_of(f), f["key"],
+                                                                    ",".join(map(str, sorted(right)))))
         self.seconds += doc["summary"]["seconds"]
 
     def row(self, name):
@@ -132,11 +135,27 @@ def dump_evidence(map_directory, query, output, prefix=""):
             f.write(prefix + row + "\n")
 
 
-def corridor(vmap, matcher, tau_flags, localize_flags, stride, work, csv_dir, evidence_dir=None):
-    root = os.path.join(SHARED, "corridor_conditions")
+CORRIDOR = os.path.join(SHARED, "corridor_conditions")
+
+
+def corridor_map(vmap, matcher, tau_flags, work):
+    """The map of the corridor's teach run (built once per binary) and its key images' teach frames."""
     map_directory = os.path.join(work, "corridor_%s_%s" % (matcher, "".join(tau_flags).replace("-", "")))
-    built = build(vmap, os.path.join(root, "teach"), matcher, tau_flags, map_directory)
-    key_sources = [k["source_index"] for k in built["key_images"]]
+    built = build(vmap, os.path.join(CORRIDOR, "teach"), matcher, tau_flags, map_directory)
+    return map_directory, [k["source_index"] for k in built["key_images"]]
+
+
+def corridor_right_keys(key_sources, i):
+    """The right key images of repeat frame i: those bracketing any teach frame i-2..i+2 (the data set's +-2)."""
+    keys = set()
+    for j in range(max(0, i - 2), min(110, i + 2) + 1):
+        keys |= keys_around(key_sources, j)
+    return keys
+
+
+def corridor(vmap, matcher, tau_flags, localize_flags, stride, work, csv_dir, evidence_dir=None):
+    root = CORRIDOR
+    map_directory, key_sources = corridor_map(vmap, matcher, tau_flags, work)
     flags = localize_flags + (["--stride", str(stride)] if stride > 1 else [])
     if csv_dir:
         flags += ["--csv", os.path.join(csv_dir, "corridor_%s.csv" % matcher)]
@@ -144,16 +163,32 @@ def corridor(vmap, matcher, tau_flags, localize_flags, stride, work, csv_dir, ev
     if evidence_dir:
         dump_evidence(map_directory, os.path.join(root, "repeat"), os.path.join(evidence_dir, "corridor_%s.csv" % matcher))
 
-    def right(f):
-        i = f["source_index"]
-        keys = set()
-        for j in range(max(0, i - 2), min(110, i + 2) + 1):
-            keys |= keys_around(key_sources, j)
-        return keys
-
     tally = Tally()
-    tally.add(doc, right, "corridor")
+    tally.add(doc, lambda f: corridor_right_keys(key_sources, f["source_index"]), "corridor")
     return tally, len(key_sources)
+
+
+# The kidnapped run's stretches of repeat frames, first and last included, in the order the robot saw them.
+KIDNAPPED = ((0, 50), (80, 110), (20, 40))
+
+
+def kidnapped(vmap, matcher, tau_flags, localize_flags, work, csv_dir):
+    map_directory, key_sources = corridor_map(vmap, matcher, tau_flags, work)
+    repeat_of = [i for first, last in KIDNAPPED for i in range(first, last + 1)]  # run frame -> repeat frame
+    folder = os.path.join(work, "kidnapped_repeat")
+    os.makedirs(folder, exist_ok=True)
+    for run_frame, i in enumerate(repeat_of):
+        link = os.path.join(folder, "%07d.jpg" % run_frame)
+        if not os.path.exists(link):
+            os.symlink(os.path.abspath(os.path.join(CORRIDOR, "repeat", "%07d.jpg" % i)), link)
+    flags = list(localize_flags)
+    if csv_dir:
+        flags += ["--csv", os.path.join(csv_dir, "kidnapped_%s.csv" % matcher)]
+    doc = localize(vmap, map_directory, folder, flags, os.path.join(work, "run.json"))
+    tally = Tally()
+    tally.add(doc, lambda f: corridor_right_keys(key_sources, repeat_of[f["source_index"]]), "kidnapped",
+              lambda f: "run frame %d (repeat %d)" % (f["source_index"], repeat_of[f["source_index"]]))
+    return tally
 
 
 def michigan(vmap, matcher, localize_flags, work, evidence_dir=None, build_flags=()):
@@ -213,6 +248,12 @@ def main():
                     print(tally.row("%s: corridor, %s, %d key images%s" % (
                         vmap, matcher, keys, ", repeat stride %d" % args.repeat_stride if args.repeat_stride > 1
                         else "")), flush=True)
+                    for line in tally.far:
+                        print("    " + line)
+                if "kidnapped" in args.sets:
+                    tally = kidnapped(vmap, matcher, tau_flags, args.localize.split(), work, args.csv_dir)
+                    print(tally.row("%s: kidnapped corridor (repeat %s), %s" % (
+                        vmap, ", ".join("%d-%d" % s for s in KIDNAPPED), matcher)), flush=True)
                     for line in tally.far:
                         print("    " + line)
                 if "michigan" in args.sets:

@@ -221,6 +221,9 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   // the frame shares fewer verified matches with the next key image than it did then: until then it has not
   // moved back, and one comparison in 2.4 is spared on most frames near a key image (docs/localize.md).
   const StepBackRuledOut ruled_out = std::exchange(step_back_ruled_out_, {});
+  // Stepped back with nothing at or ahead of `key` accepted and `key` refused by chance itself, not only by the link
+  // share: the key image the frames were at no longer sees the frame's scene.
+  bool lone_step_back = false;
   if (options_.step_back && best_position == position && position > 0) {
     const KeyComparison next = position < last ? compare_at(position + 1) : KeyComparison();
     const int v_key = at_key.accepted ? at_key.num_verified : 0;
@@ -234,6 +237,7 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
         // back is the likelier chance on a route that goes forwards: it must beat chance by more.
         const bool beats_chance = best.accepted || behind.log10_nfa <= options_.step_back_max_log10_nfa;
         if (IsBetterMatch(behind, best) && beats_chance) {
+          lone_step_back = !best.accepted && !(at_key.matched && at_key.log10_nfa <= options_.max_log10_nfa);
           best = behind;
           best_position = position - 1;
         } else if (v_key > 0 && behind.num_verified < kClearlyWorse * v_key) {
@@ -271,6 +275,7 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     }
     return result;
   }
+  bool doubted = false;  // a lone step back, while a far relocalization verified more (doubt_lone_step_back)
   if (!AcceptedAgainstRivals(best) && (SharesLittle(best) || pointed_before_ >= 0)) {
     // Accepted, but with much less than neighbouring key images share: the frame may be elsewhere on the
     // route, in view of this key image's scene. Moved when a ranked key image verifies more matches (a
@@ -282,12 +287,17 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     for (const RelocalizationCandidate& c : found.candidates) {
       if (c.accepted) found_verified = std::max(found_verified, c.num_verified);
     }
-    if (found.status == LocalizationStatus::kRelocalized && found_verified > best.num_verified &&
-        TakesJump(position, found.route_position, lost_before)) {
-      return found;
+    if (found.status == LocalizationStatus::kRelocalized && found_verified > best.num_verified) {
+      if (TakesJump(position, found.route_position, lost_before)) return found;
+      // A far place verifies more, on one frame: no jump yet. The key image behind, all that still verifies where the
+      // frames were, holds the tracker as a lost frame's estimate is held: not steered by (the robot may have been
+      // carried off; the next frame is asked again and decides).
+      doubted = lone_step_back && options_.doubt_lone_step_back;
     }
   }
-  return TrackedAt(std::move(result), position, best_position, features);
+  result = TrackedAt(std::move(result), position, best_position, features);
+  if (doubted) result.status = LocalizationStatus::kUncertain;
+  return result;
 }
 
 LocalizationResult Localizer::Reacquire(const Frame& frame, const ImageFeatures& features) {

@@ -38,6 +38,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Relocalize a tracked frame with fewer verified matches than this fraction of its key image's "
                  "link, and move it where more verify (0: never)"},
                 recheck_link_share);
+  visitor.Visit({"doubt_lone_step_back", "!--no-doubt-lone-step-back",
+                 "Track a frame that stepped back because nothing at or ahead of the key image verified, though a far "
+                 "key image verifies more (otherwise it is uncertain)"},
+                doubt_lone_step_back);
   visitor.Visit({"start_key", "--start-key",
                  "The key image the run starts at (teach and repeat: 0, the route's first): the tracker starts there "
                  "and the belief leans there, which the frames' evidence overrides (-1 = anywhere)"},

@@ -51,6 +51,13 @@ struct LocalizerOptions {
   // ranked key image that verifies more matches, if one does: a frame that verifies against a far key image of
   // the same room must not stay there. 0: never (tracking keeps any accepted key image).
   double recheck_link_share = 0.5;
+  // A lone step back (taken because nothing at or ahead of `key` verified, `key` refused by chance itself and not only
+  // by the link share: the key image the frames were at no longer sees the frame's scene) is `uncertain`, not tracked,
+  // when that frame's relocalization (above) finds a key image verifying more far away (a jump one frame does not make:
+  // Localizer::TakesJump). The tracker keeps the key image behind, as a lost frame keeps the estimate, but a robot
+  // carried elsewhere must not be steered by the place it left while the frames after it decide (docs/localize.md, "A
+  // lone step back is doubted"). Off: it is tracked there.
+  bool doubt_lone_step_back = true;
   // Key images compared beyond `next_key` when the frame has passed it (1 or 2: the issue's "next one or two").
   int lookahead = 2;
   // While tracking, also compare the key image before `key` when the frame is nearer `key` than `next_key`

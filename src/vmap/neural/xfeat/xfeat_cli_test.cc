@@ -1,8 +1,13 @@
 // `vmap match`, `vmap build` and `vmap weights` with XFeat, through the built binary.
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -118,6 +123,86 @@ TEST(VmapXfeat, SecondLocalizeStartReadsTheKeyImagesFromTheCache) {
                          FoldedWeights() + " -q -o " + (dir.path() / "map").string());
   ASSERT_EQ(r.status, 0) << r.output;
   ::vmap::testing::ExpectSecondLocalizeReadsTheCache(dir.path() / "map", input, "--last 8");
+}
+
+// The key images bracketing teach frame `frame` (the last at or before it, the first at or after it), of a map whose
+// key images are teach frames `sources` (ascending).
+std::vector<int> KeysAround(const std::vector<int>& sources, int frame) {
+  std::vector<int> keys;
+  for (int k = static_cast<int>(sources.size()) - 1; k >= 0; --k) {
+    if (sources[k] <= frame) {
+      keys.push_back(k);
+      break;
+    }
+  }
+  for (int k = 0; k < static_cast<int>(sources.size()); ++k) {
+    if (sources[k] >= frame) {
+      keys.push_back(k);
+      break;
+    }
+  }
+  return keys;
+}
+
+// A robot carried off (docs/localize.md, "A lone step back is doubted"): corridor_conditions' repeat frames 90-110 and
+// then 20-25 as one run (carried 70 frames back) against an XFeat map of its teach run, started at teach frame 90's
+// key image. On the first frame after the jump nothing verifies at the key images where the run was but the one
+// behind, while a far key image verifies more: the robot must not be steered by the place it left.
+TEST(VmapXfeat, ARobotCarriedOffIsNotSteeredByThePlaceItLeft) {
+  SKIP_WITHOUT_SHARED();
+  const fs::path data = fs::path(SharedDir()) / "data/corridor_conditions";
+  if (!fs::exists(data)) GTEST_SKIP() << data << " is not present";
+  const TempDir dir("kidnapped");
+  const fs::path map = dir.path() / "map";
+  const auto built = RunVmap("build " + ::vmap::testing::Quote(data / "teach") + " --matcher xfeat --weights " +
+                             FoldedWeights() + " -q -o " + ::vmap::testing::Quote(map));
+  ASSERT_EQ(built.status, 0) << built.output;
+  std::ifstream map_file(map / "map.json");
+  const nlohmann::json map_json = nlohmann::json::parse(map_file);
+  std::vector<int> sources;
+  for (const auto& key : map_json["key_images"]) {
+    sources.push_back(key["source_index"].get<int>());
+  }
+  std::vector<int> repeat_of;  // run frame -> repeat frame (repeat frame i was taken where teach frame i was)
+  for (int i = 90; i <= 110; ++i) repeat_of.push_back(i);
+  for (int i = 20; i <= 25; ++i) repeat_of.push_back(i);
+  const fs::path run = dir.path() / "run";
+  fs::create_directories(run);
+  for (size_t f = 0; f < repeat_of.size(); ++f) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "%07d.jpg", repeat_of[f]);
+    char link[32];
+    std::snprintf(link, sizeof(link), "%07zu.jpg", f);
+    fs::create_symlink(data / "repeat" / name, run / link);
+  }
+  // Frames steered by (tracking or relocalized) at a key image more than 2 from every key image bracketing their
+  // teach frames i-2..i+2 (bench/route_conditions.py's count).
+  auto steered_far = [&](const std::string& flags) {
+    const fs::path csv = dir.path() / "run.csv";
+    const auto r =
+        RunVmap("localize " + ::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(run) + " -q --start-key " +
+                std::to_string(KeysAround(sources, 90).front()) + " --csv " + ::vmap::testing::Quote(csv) + flags);
+    EXPECT_EQ(r.status, 0) << r.output;
+    std::ifstream in(csv);
+    std::string line;
+    std::getline(in, line);  // frame,source_index,timestamp,source_name,status,key,...
+    int far = 0;
+    while (std::getline(in, line)) {
+      std::stringstream row(line);
+      std::vector<std::string> cells;
+      for (std::string cell; cells.size() < 6 && std::getline(row, cell, ',');) cells.push_back(cell);
+      if (cells.size() < 6 || (cells[4] != "tracking" && cells[4] != "relocalized")) continue;
+      const int key = std::stoi(cells[5]), repeat = repeat_of.at(std::stoi(cells[1]));
+      int nearest = 1 << 20;
+      for (int j = repeat - 2; j <= repeat + 2; ++j) {
+        for (int k : KeysAround(sources, j)) nearest = std::min(nearest, std::abs(key - k));
+      }
+      far += nearest > 2;
+    }
+    return far;
+  };
+  EXPECT_EQ(steered_far(""), 0);
+  EXPECT_GE(steered_far(" --no-doubt-lone-step-back"), 1) << "the test no longer reaches a lone step back";
 }
 
 }  // namespace
