@@ -2,6 +2,7 @@
 // bracket test against truth (docs/measurements/localization.md) on subsets of kitti07 and redkitchen.
 
 #include <algorithm>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -224,8 +225,10 @@ TEST(LocalizeCli, EvalCorridorRuns) {
 }
 
 // corridor_conditions' first `last` + 1 repeat frames against an ORB map of its teach run, once per entry of `flags`
-// (more flags for vmap localize): each frame's status and key image. Empty without the data.
-std::vector<std::vector<std::pair<std::string, int>>> CorridorRuns(const std::vector<std::string>& flags, int last) {
+// (more flags for vmap localize): each frame's status and key image (with `teach_frames`: the key image's frame in
+// the teach run, the CSV's key_frame). Empty without the data.
+std::vector<std::vector<std::pair<std::string, int>>> CorridorRuns(const std::vector<std::string>& flags, int last,
+                                                                   bool teach_frames = false) {
   const fs::path data = Shared() / "data/corridor_conditions";
   if (Shared().empty() || !fs::exists(data)) return {};
   ::vmap::testing::ScopedTempDir tmp;
@@ -242,11 +245,11 @@ std::vector<std::vector<std::pair<std::string, int>>> CorridorRuns(const std::ve
     std::vector<std::pair<std::string, int>> frames;
     const std::vector<std::string> rows = Lines(csv);
     for (size_t r = 1; r < rows.size(); ++r) {
-      // frame,source_index,timestamp,source_name,status,key,...
+      // frame,source_index,timestamp,source_name,status,key,next_key,key_frame,...
       std::stringstream row(rows[r]);
       std::vector<std::string> cells;
-      for (std::string cell; cells.size() < 6 && std::getline(row, cell, ',');) cells.push_back(cell);
-      if (cells.size() == 6) frames.emplace_back(cells[4], std::stoi(cells[5]));
+      for (std::string cell; cells.size() < 8 && std::getline(row, cell, ',');) cells.push_back(cell);
+      if (cells.size() == 8) frames.emplace_back(cells[4], std::stoi(cells[teach_frames ? 7 : 5]));
     }
     runs.push_back(std::move(frames));
   }
@@ -320,6 +323,44 @@ TEST(LocalizeCli, AStepBackOnTheEdgeOfChanceIsNotTaken) {
     back_jumps.push_back(jumps);
   }
   EXPECT_LT(back_jumps[0], back_jumps[1]) << "back-jumps: -1 " << back_jumps[0] << ", 0 " << back_jumps[1];
+}
+
+TEST(LocalizeCli, AStepBackOnATieIsNotTaken) {
+  // corridor_conditions with ORB (docs/localize.md, "A step back needs more than a tie"): at frame 17 the key image
+  // behind verifies as many matches as the tracked one and S took the tracker back, one more frame steered by behind
+  // the frame before it.
+  const auto runs = CorridorRuns({"", " --step-back-on-tie"}, 20);
+  if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  std::vector<int> back_jumps;
+  for (const auto& run : runs) {
+    int jumps = 0, steered_key = -1;
+    for (const auto& frame : run) {
+      if (!SteeredBy(frame)) continue;
+      jumps += frame.second < steered_key;
+      steered_key = frame.second;
+    }
+    back_jumps.push_back(jumps);
+  }
+  EXPECT_LT(back_jumps[0], back_jumps[1])
+      << "back-jumps: needs more " << back_jumps[0] << ", on a tie " << back_jumps[1];
+}
+
+TEST(LocalizeCli, GuidedMatchingOverTheLookaheadKeepsUpWithTheRobot) {
+  // corridor_conditions with ORB (docs/localize.md, "Guided matching over the lookahead"): repeat frame i was taken
+  // where teach frame i was. Where the repeat passes a key image a frame (frames 97-99) guided matching asked only the
+  // tracked key image and the next, and the continuity of the heading held the frames at key image 38 (teach frame 91);
+  // asked over the lookahead and ranked by the one-way matches' NFA, they are steered by at key images within 3 teach
+  // frames of them.
+  const auto runs = CorridorRuns({"", " --no-guided-lookahead"}, 99, /*teach_frames=*/true);
+  if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  std::vector<int> near;
+  for (const auto& run : runs) {
+    int count = 0;
+    for (size_t i = 0; i < run.size(); ++i)
+      count += SteeredBy(run[i]) && std::abs(run[i].second - static_cast<int>(i)) <= 3;
+    near.push_back(count);
+  }
+  EXPECT_GE(near[0], near[1] + 2) << "within 3 teach frames: over the lookahead " << near[0] << ", not " << near[1];
 }
 
 TEST(LocalizeCli, GuidedMatchingAsksWhereTheEstimateWasDroppedWhileLost) {

@@ -236,7 +236,10 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
         // With nothing accepted at or ahead of `key`, the key image behind has nothing to beat but chance, and a step
         // back is the likelier chance on a route that goes forwards: it must beat chance by more.
         const bool beats_chance = best.accepted || behind.log10_nfa <= options_.step_back_max_log10_nfa;
-        if (IsBetterMatch(behind, best) && beats_chance) {
+        // A tie is no step back: the route goes forwards.
+        const bool beats_best =
+            !best.accepted || !options_.step_back_needs_more || behind.num_verified > best.num_verified;
+        if (IsBetterMatch(behind, best) && beats_chance && beats_best) {
           lone_step_back = !best.accepted && !(at_key.matched && at_key.log10_nfa <= options_.max_log10_nfa);
           best = behind;
           best_position = position - 1;

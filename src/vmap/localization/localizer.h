@@ -84,10 +84,11 @@ class Localizer {
   // Each key image is compared with a frame at most once per Localize call.
   KeyComparison CompareOnce(const ImageFeatures& features, int key);
   // Guided matching (LocalizerOptions::guided_matching): the frame matched again with guided_matcher_ at route
-  // `position` and the one after it, the belief singling out that place, each only where its first comparison
-  // verified at least the link share (min_link_share; chance alone refused it). Returns the route position of the
-  // better accepted comparison, which replaces the frame's memo of that key image (its first comparison weighed
-  // into the belief first); -1 when neither is accepted or guided matching does not apply.
+  // `position` and the `lookahead` after it (guided_lookahead; else the one after it), the belief singling out that
+  // place, each only where its first comparison verified at least the link share (min_link_share; chance alone refused
+  // it). Returns the route position of the best accepted comparison (guided_lookahead: by one measure common to them),
+  // which replaces the frame's memo of that key image (its first comparison weighed into the belief first); -1 when
+  // none is accepted or guided matching does not apply.
   // `whatever_the_belief`: asked though the belief does not single the place out (guided_while_lost).
   int TrackGuided(const Frame& frame, const ImageFeatures& features, int position, bool whatever_the_belief = false);
   // The previous frame's heading (px) against key image `key`; none when that frame was not compared with it.

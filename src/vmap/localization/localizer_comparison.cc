@@ -103,10 +103,14 @@ int Localizer::TrackGuided(const Frame& frame, const ImageFeatures& features, in
   // Looser matching is decided by chance only (the counts rule would take its extra matches as evidence).
   if (!guided_matcher_ || options_.acceptance != AcceptanceRule::kChance) return -1;
   if (!whatever_the_belief && (!belief_confident_ || std::abs(belief_.Peak() - position) > kNear)) return -1;
+  const int reach = options_.guided_lookahead ? options_.lookahead : 1;
   int found = -1;
   KeyComparison best;
+  // The best's one-way guided comparison: its log10 NFA, and whether chance accepted it.
+  double best_guided_log10_nfa = 0.0;
+  bool best_by_chance = false;
   std::shared_ptr<const ImageFeatures> window_features;  // window_matcher_'s, extracted when first needed
-  for (int p = position; p <= std::min(last, position + 1); ++p) {
+  for (int p = position; p <= std::min(last, position + reach); ++p) {
     const int key = route_[p];
     // Only where chance refused the first comparison and the link share did not: guided matching asks chance again,
     // never the share (a frame that shares little with the key image's scene, seen from elsewhere, stays refused:
@@ -116,6 +120,8 @@ int Localizer::TrackGuided(const Frame& frame, const ImageFeatures& features, in
     WeighComparisons();  // the first comparisons' evidence, before a guided one replaces its key image's
     const TentativeMatches matches = guided_matcher_->Match(features, *keys_.features[key]);
     KeyComparison c = CompareImage(features, *keys_.features[key], matches, key);
+    const bool by_chance = c.accepted;
+    const double guided_log10_nfa = c.log10_nfa;
     const std::optional<double> predicted_dx = PreviousHeading(key);
     if (c.matched && !c.accepted && predicted_dx &&
         HoldsContinuity(first, matches, *predicted_dx, features.image_size())) {
@@ -127,9 +133,19 @@ int Localizer::TrackGuided(const Frame& frame, const ImageFeatures& features, in
           CompareInWindow(window_features ? *window_features : features, key, *predicted_dx, features.image_size());
       if (windowed.accepted) c = std::move(windowed);
     }
-    if (!c.accepted || (found >= 0 && !IsBetterMatch(c, best))) continue;
+    if (!c.accepted) continue;
+    if (found >= 0) {
+      // One measure for every candidate: chance's verified matches where chance accepts, else the one-way NFA.
+      const bool better = !options_.guided_lookahead    ? IsBetterMatch(c, best)
+                          : by_chance != best_by_chance ? by_chance
+                          : by_chance                   ? IsBetterMatch(c, best)
+                                                        : guided_log10_nfa < best_guided_log10_nfa;
+      if (!better) continue;
+    }
     found = p;
     best = std::move(c);
+    best_guided_log10_nfa = guided_log10_nfa;
+    best_by_chance = by_chance;
   }
   if (found < 0) return -1;
   // The guided comparison replaces the first one's memo (CompareOnce made it above).

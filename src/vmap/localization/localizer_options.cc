@@ -63,12 +63,19 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "A step back to the previous key image when nothing at or ahead of the key image verifies: its log10 "
                  "NFA at most this (stricter than --max-log10-nfa: the route goes forwards)"},
                 step_back_max_log10_nfa);
+  visitor.Visit({"step_back_needs_more", "!--step-back-on-tie",
+                 "Step back to the previous key image on a tie of verified matches (S decides, as before)"},
+                step_back_needs_more);
   visitor.Visit({"guided_matching", "!--no-guided-matching",
                  "ORB: never match a frame again with looser matching at the key images the belief holds"},
                 guided_matching);
   visitor.Visit({"guided_while_lost", "!--no-guided-while-lost",
                  "ORB: never match a frame guided at the key image the tracker held once the estimate is dropped"},
                 guided_while_lost);
+  visitor.Visit({"guided_lookahead", "!--no-guided-lookahead",
+                 "ORB: match a frame guided at the key image and the next one only, ranked by verified matches (not "
+                 "over the lookahead, ranked by the one-way matches' NFA where chance accepts none)"},
+                guided_lookahead);
   visitor.Visit({"continuity_share", "--continuity-share",
                  "ORB, guided matching: accept a comparison chance refuses when this share of its matches move as the "
                  "previous frame's heading against the key image predicts (0 = never)"},

@@ -71,6 +71,11 @@ struct LocalizerOptions {
   // forwards, so a key image behind that verifies at the edge of chance is likelier chance than a step back. -1: about
   // the motion model's odds against a step back rather than staying (0.05 / 0.55; docs/localize.md).
   double step_back_max_log10_nfa = -1.0;
+  // A step back needs more verified matches than the key image or the key image ahead it would replace: on a tie
+  // (which S would decide) the estimate stays, since the route goes forwards and two key images a frame apart that
+  // verify as many matches are a coin toss (corridor_conditions frame 17: back to key image 4 on 0.01 of S, and the
+  // next frame on again). Off: the better match by IsBetterMatch, a tie decided by S (docs/localize.md).
+  bool step_back_needs_more = true;
   // Guided matching (ORB maps): a frame that verifies nothing at the tracked key images while the belief singles
   // out that place is matched with them again, and only with them, keeping one-way best matches too (no cross
   // check); the a-contrario test, which counts every tentative match, decides as before (docs/localize.md,
@@ -82,6 +87,15 @@ struct LocalizerOptions {
   // when its own guided comparison is accepted; a frame that a ranked key image verifies is relocalized first
   // (docs/localize.md). Off: a dropped estimate is only relocalized.
   bool guided_while_lost = true;
+  // Guided matching over the lookahead: it asks the tracked key image and the `lookahead` key images after it (the
+  // tracker's own reach), and ranks what it accepts by a measure common to the key images asked: those chance accepts
+  // by their verified matches (as the tracker ranks), and when chance accepts none, those the continuity of the heading
+  // or the window accepted by the log10 NFA of their one-way guided matches, the one test made the same way at each
+  // key image (the verified counts of those two tests are not comparable with each other: the window's come from
+  // features extracted again). A robot that passes a key image a frame (corridor_conditions frames 97-99) is otherwise
+  // held one key image behind by a comparison the continuity accepts. Off: the key image and the next one only,
+  // ranked by verified matches.
+  bool guided_lookahead = true;
   // The continuity of the heading (guided matching only): a guided comparison chance refuses is accepted when the
   // frame moves as the previous frame did against the same key image. At least `continuity_share` of its tentative
   // matches move by the previous frame's heading against that key image (within 1/40 of the image's width across,
