@@ -22,7 +22,10 @@
 // apart, Hamming distance at most D, ratio R among the candidates; defaults Z 0, D 64, R 0.9, L 1) and verified as the
 // localizer verifies: wN_tentative, wN_verified, wN_log10_nfa, wN_similarity for window N (-1, -1, 1e9, 0 without a
 // prediction). The frame's features for it: the map's, or extracted again with FAST threshold T / N features (the
-// localizer's window_fast_threshold, window_features).
+// localizer's window_fast_threshold, window_features). Last, rank and rank_score: the key image's place (0: the best)
+// and score in the relocalization's ranking of every key image for the frame (KeyImageRanking, the map's options; a
+// run compares the best-ranked key images, so its comparisons at wrong key images are not a random draw), and
+// frame_features, the frame's number of features.
 
 #include <algorithm>
 #include <cmath>
@@ -39,6 +42,7 @@
 #include "vmap/features/matcher_registry.h"
 #include "vmap/features/orb_matcher.h"
 #include "vmap/localization/acceptance.h"
+#include "vmap/localization/key_image_ranking.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/mapping/key_image_selector.h"
 #include "vmap/sources/frame_source.h"
@@ -130,6 +134,8 @@ int main(int argc, char** argv) {
       link_verified[k] = link_verified[k] > 0 ? std::min(link_verified[k], link.num_verified) : link.num_verified;
     }
   }
+  // The relocalization's ranking of every key image, as the localizer ranks the route.
+  const KeyImageRanking ranking(opened.keys.features, opened.keys.thumbnails, options.ranking);
   auto source = OpenFrameSource(argv[2], query_options);
   std::printf(
       "frame,source_index,key,matched,accepted,tentative,verified,similarity,log10_nfa,link_verified,"
@@ -138,7 +144,7 @@ int main(int argc, char** argv) {
   for (size_t w = 0; w < windows.size(); ++w) {
     std::printf(",w%zu_tentative,w%zu_verified,w%zu_log10_nfa,w%zu_similarity", w, w, w, w);
   }
-  std::printf("\n");
+  std::printf(",rank,rank_score,frame_features\n");
   std::vector<double> previous_heading(num_keys, std::nan("")), heading(num_keys, std::nan(""));
   // How many tentative matches frame -> key image move by (predicted_dx, 0) within the window.
   auto near = [](const TentativeMatches& m, cv::Size size, double predicted_dx, double share_x) {
@@ -153,9 +159,20 @@ int main(int argc, char** argv) {
   const Matcher& matcher = orb_override ? *match_matcher : *opened.matcher;
   while (const std::optional<Frame> next = source->Next()) {
     const Frame& frame = *next;
-    const auto features = (orb_override ? *frame_matcher : *opened.matcher).Extract(frame.gray);
+    // As the localizer extracts them (LocalizeSequence): XFeat and ALIKED read the frame's colour.
+    const auto features = (orb_override ? *frame_matcher : *opened.matcher).ExtractFrame(frame.gray, frame.color);
     const cv::Size size = features->image_size();
     const auto window_features = window_frame_matcher ? window_frame_matcher->Extract(frame.gray) : features;
+    const cv::Mat thumbnail = ranking.method() == RankingMethod::kThumbnails
+                                  ? ThumbnailDescriptor(frame.gray, options.ranking.thumbnail_width)
+                                  : cv::Mat();
+    std::vector<int> rank_of(num_keys, -1);
+    std::vector<double> score_of(num_keys, 0.0);
+    const std::vector<RankedKey> ranked = ranking.Rank(*features, thumbnail);
+    for (size_t i = 0; i < ranked.size(); ++i) {
+      rank_of[ranked[i].key] = static_cast<int>(i);
+      score_of[ranked[i].key] = ranked[i].score;
+    }
     for (int k = 0; k < num_keys; ++k) {
       const KeyComparison c = localizer.Compare(*features, k);
       const TentativeMatches m = matcher.Match(*features, *opened.keys.features[k]);
@@ -201,7 +218,7 @@ int main(int argc, char** argv) {
                          : 1e9;
         std::printf(",%d,%d,%.3f,%.4f", pair.num_tentative, pair.num_verified, std::min(nfa, 1e9), pair.similarity);
       }
-      std::printf("\n");
+      std::printf(",%d,%.4f,%d\n", rank_of[k], score_of[k], features->num_features());
     }
     previous_heading.swap(heading);
   }
