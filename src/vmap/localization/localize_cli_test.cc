@@ -260,6 +260,21 @@ bool SteeredBy(const std::pair<std::string, int>& frame) {
   return frame.first == "tracking" || frame.first == "relocalized";
 }
 
+// As CorridorRuns, how many times each run's steered-by frames go back to an earlier key image.
+std::vector<int> BackJumpsOnCorridor(const std::vector<std::string>& flags, int last) {
+  std::vector<int> back_jumps;
+  for (const auto& run : CorridorRuns(flags, last)) {
+    int jumps = 0, steered_key = -1;
+    for (const auto& frame : run) {
+      if (!SteeredBy(frame)) continue;
+      jumps += frame.second < steered_key;
+      steered_key = frame.second;
+    }
+    back_jumps.push_back(jumps);
+  }
+  return back_jumps;
+}
+
 // As CorridorRuns, how many frames are steered by (tracking or relocalized) in each run.
 std::vector<int> SteeredOnCorridor(const std::vector<std::string>& flags, int last = 39) {
   std::vector<int> steered;
@@ -313,18 +328,8 @@ TEST(LocalizeCli, AStepBackOnTheEdgeOfChanceIsNotTaken) {
   // corridor_conditions with ORB (docs/localize.md, "A step back needs more than chance"): frame 96 verifies nothing
   // at its key image and the two ahead, and the key image behind at log10 NFA -0.05; at chance's own bar (0) the
   // tracker steps back to it, one more frame steered by behind the frame before it.
-  const auto runs = CorridorRuns({"", " --step-back-max-log10-nfa 0"}, 99);
-  if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
-  std::vector<int> back_jumps;
-  for (const auto& run : runs) {
-    int jumps = 0, steered_key = -1;
-    for (const auto& frame : run) {
-      if (!SteeredBy(frame)) continue;
-      jumps += frame.second < steered_key;
-      steered_key = frame.second;
-    }
-    back_jumps.push_back(jumps);
-  }
+  const std::vector<int> back_jumps = BackJumpsOnCorridor({"", " --step-back-max-log10-nfa 0"}, 99);
+  if (back_jumps.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   EXPECT_LT(back_jumps[0], back_jumps[1]) << "back-jumps: -1 " << back_jumps[0] << ", 0 " << back_jumps[1];
 }
 
@@ -332,18 +337,8 @@ TEST(LocalizeCli, AStepBackOnATieIsNotTaken) {
   // corridor_conditions with ORB (docs/localize.md, "A step back needs more than a tie"): at frame 17 the key image
   // behind verifies as many matches as the tracked one and S took the tracker back, one more frame steered by behind
   // the frame before it.
-  const auto runs = CorridorRuns({"", " --step-back-on-tie"}, 20);
-  if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
-  std::vector<int> back_jumps;
-  for (const auto& run : runs) {
-    int jumps = 0, steered_key = -1;
-    for (const auto& frame : run) {
-      if (!SteeredBy(frame)) continue;
-      jumps += frame.second < steered_key;
-      steered_key = frame.second;
-    }
-    back_jumps.push_back(jumps);
-  }
+  const std::vector<int> back_jumps = BackJumpsOnCorridor({"", " --step-back-on-tie"}, 20);
+  if (back_jumps.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   EXPECT_LT(back_jumps[0], back_jumps[1])
       << "back-jumps: needs more " << back_jumps[0] << ", on a tie " << back_jumps[1];
 }
