@@ -154,14 +154,14 @@ def corridor_right_keys(key_sources, i):
 
 
 def corridor(vmap, matcher, tau_flags, localize_flags, stride, work, csv_dir, evidence_dir=None):
-    root = CORRIDOR
+    repeat = os.path.join(CORRIDOR, "repeat")
     map_directory, key_sources = corridor_map(vmap, matcher, tau_flags, work)
     flags = localize_flags + (["--stride", str(stride)] if stride > 1 else [])
     if csv_dir:
         flags += ["--csv", os.path.join(csv_dir, "corridor_%s.csv" % matcher)]
-    doc = localize(vmap, map_directory, os.path.join(root, "repeat"), flags, os.path.join(work, "run.json"))
+    doc = localize(vmap, map_directory, repeat, flags, os.path.join(work, "run.json"))
     if evidence_dir:
-        dump_evidence(map_directory, os.path.join(root, "repeat"), os.path.join(evidence_dir, "corridor_%s.csv" % matcher))
+        dump_evidence(map_directory, repeat, os.path.join(evidence_dir, "corridor_%s.csv" % matcher))
 
     tally = Tally()
     tally.add(doc, lambda f: corridor_right_keys(key_sources, f["source_index"]), "corridor")
