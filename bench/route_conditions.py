@@ -11,6 +11,9 @@ kidnapped: corridor_conditions' repeat frames 0-50, 80-110, 20-40 as one run (a 
   the corridor's map: a robot carried on twice, forwards then back (docs/localize.md, "A far relocalization needs two
   frames"). A run frame is right as its repeat frame is in the corridor set; the back-jumps count the second jump
   (one is the carried robot's, not the localizer's).
+elsewhere: runs that start elsewhere than --start-key says (a user passes --start-key 0 by habit while the robot is
+  further on): the corridor's repeat from frames 20, 50 and 90 and the kidnapped run from its frame 51 (repeat frame 80),
+  each localized with `--first N`, their frames summed in one row (the far frames name their run).
 Per run: frames right (at a right key image, whatever the status), right and not uncertain, localized wrong, confidently wrong by more than 2 places (status tracking or relocalized at a
 key image more than 2 key images from every right one), uncertain and lost, frames/s, and back-jumps (a frame steered
 by, tracking or relocalized, at a key image before the previous steered-by frame's: the route goes forwards, and the
@@ -30,7 +33,7 @@ start").
 With --build "FLAGS", every map is built with these flags too (e.g. ORB's extraction: "--orb-grid-cell 30
 --orb-edge-threshold 16"); the localizer follows what the map records.
 
-usage: bench/route_conditions.py --vmap build/vmap[,old/vmap] [--sets corridor,kidnapped,michigan] [--matchers orb,xfeat]
+usage: bench/route_conditions.py --vmap build/vmap[,old/vmap] [--sets corridor,kidnapped,elsewhere,michigan] [--matchers orb,xfeat]
                                  [--tau T] [--start-key K|none] [--build "FLAGS"] [--localize "FLAGS"] [--repeat-stride N] [--work DIR] [--csv-dir DIR]
                                  [--evidence-dir DIR]
 (from the repository root; ../shared must be there)"""
@@ -153,18 +156,19 @@ def corridor_right_keys(key_sources, i):
     return keys
 
 
-def corridor(vmap, matcher, tau_flags, localize_flags, stride, work, csv_dir, evidence_dir=None):
+def corridor(vmap, matcher, tau_flags, localize_flags, stride, work, csv_dir, evidence_dir=None, tally=None,
+             label="corridor"):
     repeat = os.path.join(CORRIDOR, "repeat")
     map_directory, key_sources = corridor_map(vmap, matcher, tau_flags, work)
     flags = localize_flags + (["--stride", str(stride)] if stride > 1 else [])
     if csv_dir:
-        flags += ["--csv", os.path.join(csv_dir, "corridor_%s.csv" % matcher)]
+        flags += ["--csv", os.path.join(csv_dir, "%s_%s.csv" % (label.replace(" ", "_"), matcher))]
     doc = localize(vmap, map_directory, repeat, flags, os.path.join(work, "run.json"))
     if evidence_dir:
         dump_evidence(map_directory, repeat, os.path.join(evidence_dir, "corridor_%s.csv" % matcher))
 
-    tally = Tally()
-    tally.add(doc, lambda f: corridor_right_keys(key_sources, f["source_index"]), "corridor")
+    tally = tally or Tally()
+    tally.add(doc, lambda f: corridor_right_keys(key_sources, f["source_index"]), label)
     return tally, len(key_sources)
 
 
@@ -172,7 +176,7 @@ def corridor(vmap, matcher, tau_flags, localize_flags, stride, work, csv_dir, ev
 KIDNAPPED = ((0, 50), (80, 110), (20, 40))
 
 
-def kidnapped(vmap, matcher, tau_flags, localize_flags, work, csv_dir):
+def kidnapped(vmap, matcher, tau_flags, localize_flags, work, csv_dir, tally=None, label="kidnapped"):
     map_directory, key_sources = corridor_map(vmap, matcher, tau_flags, work)
     repeat_of = [i for first, last in KIDNAPPED for i in range(first, last + 1)]  # run frame -> repeat frame
     folder = os.path.join(work, "kidnapped_repeat")
@@ -183,11 +187,27 @@ def kidnapped(vmap, matcher, tau_flags, localize_flags, work, csv_dir):
             os.symlink(os.path.abspath(os.path.join(CORRIDOR, "repeat", "%07d.jpg" % i)), link)
     flags = list(localize_flags)
     if csv_dir:
-        flags += ["--csv", os.path.join(csv_dir, "kidnapped_%s.csv" % matcher)]
+        flags += ["--csv", os.path.join(csv_dir, "%s_%s.csv" % (label.replace(" ", "_"), matcher))]
     doc = localize(vmap, map_directory, folder, flags, os.path.join(work, "run.json"))
-    tally = Tally()
-    tally.add(doc, lambda f: corridor_right_keys(key_sources, repeat_of[f["source_index"]]), "kidnapped",
+    tally = tally or Tally()
+    tally.add(doc, lambda f: corridor_right_keys(key_sources, repeat_of[f["source_index"]]), label,
               lambda f: "run frame %d (repeat %d)" % (f["source_index"], repeat_of[f["source_index"]]))
+    return tally
+
+
+# The started-elsewhere runs: (set, first frame of the run), each started with the bench's --start-key.
+ELSEWHERE = (("corridor", 20), ("corridor", 50), ("corridor", 90), ("kidnapped", 51))
+
+
+def elsewhere(vmap, matcher, tau_flags, localize_flags, work, csv_dir):
+    tally = Tally()
+    for name, first in ELSEWHERE:
+        flags = list(localize_flags) + ["--first", str(first)]
+        label = "%s from %d" % (name, first)
+        if name == "corridor":
+            corridor(vmap, matcher, tau_flags, flags, 1, work, csv_dir, tally=tally, label=label)
+        else:
+            kidnapped(vmap, matcher, tau_flags, flags, work, csv_dir, tally=tally, label=label)
     return tally
 
 
@@ -254,6 +274,12 @@ def main():
                     tally = kidnapped(vmap, matcher, tau_flags, args.localize.split(), work, args.csv_dir)
                     print(tally.row("%s: kidnapped corridor (repeat %s), %s" % (
                         vmap, ", ".join("%d-%d" % s for s in KIDNAPPED), matcher)), flush=True)
+                    for line in tally.far:
+                        print("    " + line)
+                if "elsewhere" in args.sets:
+                    tally = elsewhere(vmap, matcher, tau_flags, args.localize.split(), work, args.csv_dir)
+                    print(tally.row("%s: started elsewhere than --start-key (%s), %s" % (
+                        vmap, ", ".join("%s from %d" % e for e in ELSEWHERE), matcher)), flush=True)
                     for line in tally.far:
                         print("    " + line)
                 if "michigan" in args.sets:

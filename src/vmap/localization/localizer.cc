@@ -31,7 +31,8 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
       matcher_(matcher),
       options_(std::move(options)),
       belief_(std::max<int>(1, options_.route.empty() ? map.key_images.size() : options_.route.size()),
-              options_.belief) {
+              options_.belief),
+      evidence_belief_(belief_) {
   options_.Check();
   const int num_keys = static_cast<int>(map_.key_images.size());
   if (num_keys == 0) throw InputError("the map has no key images; nothing to localize against");
@@ -77,8 +78,9 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   }
   ranking_ = std::make_unique<KeyImageRanking>(features, thumbnails, options_.ranking);
   const cv::Mat descriptors = keys_.features.front()->descriptors();
-  evidence_ =
-      !descriptors.empty() && descriptors.depth() == CV_8U ? BinaryDescriptorEvidence() : FloatDescriptorEvidence();
+  const bool binary = !descriptors.empty() && descriptors.depth() == CV_8U;
+  evidence_ = binary ? BinaryDescriptorEvidence() : FloatDescriptorEvidence();
+  start_checked_over_route_ = binary;
   if (options_.guided_matching && matcher_.name() == OrbMatcherOptions::kModelName) {
     MatcherOptions guided;
     guided.type = OrbMatcherOptions::kModelName;
@@ -112,7 +114,9 @@ void CheckStartKey(const VisualMap& map, const LocalizerOptions& options) {
 
 void Localizer::Reset() {
   belief_.Reset();
+  evidence_belief_.Reset();
   if (start_position_ >= 0) belief_.Start(start_position_, options_.start_mass);
+  start_unconfirmed_ = start_position_ >= 0 && options_.start_is_hint;
   pointed_ = pointed_before_ = -1;
   position_ = start_position_;
   lost_in_a_row_ = 0;
@@ -131,12 +135,15 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
     if (c.key >= 0 && c.key < static_cast<int>(keys_.features.size())) comparisons_.push_back({std::move(c), false});
   }
   belief_.Predict();
+  evidence_belief_.Predict();
   // Guided matching asks where the estimate was dropped for max_lost_frames frames (guided_while_lost).
   if (dropped_position_ >= 0 && ++frames_since_drop_ > options_.max_lost_frames) dropped_position_ = -1;
   belief_confident_ = SinglesOut(belief_.Peak());
   steps_on_ = 0;
   pointed_before_ = std::exchange(pointed_, -1);
   LocalizationResult result = has_estimate() ? Track(frame, features) : Reacquire(frame, features);
+  // A hint is checked: the frame's evidence over the whole route weighs where the run is.
+  if (start_unconfirmed_ && start_checked_over_route_) CompareBestRanked(frame, features);
   Believe(result, frame, features);
   if (result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized) {
     dropped_position_ = -1;  // steered by again: the drop is behind

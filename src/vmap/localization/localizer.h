@@ -129,7 +129,11 @@ class Localizer {
   // it is flat) and moves the estimate to the peak when the belief singles it out.
   // The belief singles out route `position` (not only holds min_confidence near it: also far more than a flat
   // belief would).
-  bool SinglesOut(int position) const;
+  bool SinglesOut(int position) const { return SinglesOut(belief_, position); }
+  bool SinglesOut(const RouteBelief& belief, int position) const;
+  // The start is a hint (LocalizerOptions::start_is_hint): the frames' evidence alone (evidence_belief_) singles out
+  // a place more than kNear route positions from `position` and holds less than min_confidence near it.
+  bool EvidencePointsAway(int position) const;
   void Question(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
   // Compares the frame with the best-ranked key images of the route (relocalization_candidates of them), in
   // rank order; returns the ranking's route positions compared.
@@ -207,6 +211,17 @@ class Localizer {
     int next_verified = 0;
   } step_back_ruled_out_;
   RouteBelief belief_;
+  // The belief the frames' evidence alone would hold: the same motion and comparisons as belief_, from a flat start
+  // (without the start key image's prior). The same as belief_ without a start key image.
+  RouteBelief evidence_belief_;
+  // The start key image is a hint the frames have not yet confirmed (start_is_hint): until a frame is steered by near
+  // the evidence belief's peak, the evidence belief may make a frame uncertain, and with binary descriptors every frame
+  // is also compared with the best-ranked key images of the whole route.
+  bool start_unconfirmed_ = false;
+  // Binary descriptors (ORB): a wrong key image's comparison weighs against it, so comparing the whole route checks
+  // the start. Float descriptors (XFeat) verify chance matches at most wrong key images, which the evidence credits:
+  // comparing the whole route at the start pulled the evidence belief to chance places (docs/localize.md).
+  bool start_checked_over_route_ = false;
   // After the frame's motion step, before its evidence: the belief held at least min_confidence near its peak
   // (the frames before this one singled out a place). A flat belief does not move the estimate.
   bool belief_confident_ = false;

@@ -3,6 +3,7 @@
 // whole route when the belief is flat), moved to where the belief puts it, or else uncertain.
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 #include "vmap/localization/localizer.h"
 
@@ -22,18 +23,31 @@ void Localizer::WeighComparisons() {
     m.weighed = weighed = true;
     const int key = m.comparison.key;
     const int position = route_position_of_key_[key];
-    if (position >= 0) belief_.Weigh(position, EvidenceLogRatio(evidence_, m.comparison, link_verified_[key]));
+    if (position < 0) continue;
+    const double log_ratio = EvidenceLogRatio(evidence_, m.comparison, link_verified_[key]);
+    belief_.Weigh(position, log_ratio);
+    evidence_belief_.Weigh(position, log_ratio);
   }
-  if (weighed) belief_.Normalize();
+  if (weighed) {
+    belief_.Normalize();
+    evidence_belief_.Normalize();
+  }
 }
 
-bool Localizer::SinglesOut(int position) const {
+bool Localizer::SinglesOut(const RouteBelief& belief, int position) const {
   // Near the position: at least min_confidence of the belief, and twice what a flat belief holds there (on a
   // short route a flat belief holds much of its mass within two places of anywhere).
-  const double near = belief_.MassWithin(position, kNear);
-  const int positions = static_cast<int>(belief_.probabilities().size());
+  const double near = belief.MassWithin(position, kNear);
+  const int positions = static_cast<int>(belief.probabilities().size());
   const double flat = static_cast<double>(std::min(positions, 2 * kNear + 1)) / positions;
   return near >= options_.belief.min_confidence && near >= 2.0 * flat;
+}
+
+bool Localizer::EvidencePointsAway(int position) const {
+  if (!start_unconfirmed_ || options_.belief.min_confidence <= 0.0) return false;
+  const int peak = evidence_belief_.Peak();
+  return std::abs(peak - position) > kNear && SinglesOut(evidence_belief_, peak) &&
+         evidence_belief_.MassWithin(position, kNear) < options_.belief.min_confidence;
 }
 
 void Localizer::Believe(LocalizationResult& result, const Frame& frame, const ImageFeatures& features) {
@@ -48,7 +62,14 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
   result.confidence = belief_.MassWithin(result.route_position, kNear);
   const bool placed =
       result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized;
-  if (placed && result.confidence < options_.belief.min_confidence) result.status = LocalizationStatus::kUncertain;
+  if (placed && (result.confidence < options_.belief.min_confidence || EvidencePointsAway(result.route_position))) {
+    result.status = LocalizationStatus::kUncertain;
+  }
+  // Confirmed: the frames' evidence alone leans most near the place the frame is steered by.
+  if (start_unconfirmed_ && placed && result.status != LocalizationStatus::kUncertain &&
+      std::abs(evidence_belief_.Peak() - result.route_position) <= kNear) {
+    start_unconfirmed_ = false;
+  }
   // An uncertain frame's key images are the best guess: the belief's peak when the belief singles it out and holds
   // more there than near the tracker's key image (the tracker goes on from its own; nothing steers by this frame).
   // A flat belief's peak is no better a guess than the tracker's (corridor_conditions, docs/localize.md).

@@ -49,6 +49,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"start_mass", "--start-mass",
                  "--start-key: the share of the belief at the start key image at the first frame (the rest flat)"},
                 start_mass);
+  visitor.Visit({"start_is_hint", "!--no-start-is-hint",
+                 "--start-key: steer by a frame even where the frames' evidence alone, without the start's prior, "
+                 "singles out a place more than two key images away (otherwise it is uncertain)"},
+                start_is_hint);
   visitor.Visit({"max_lost_frames", "--max-lost", "Lost frames in a row before the estimate is dropped"},
                 max_lost_frames);
   visitor.Visit({"relocalization_candidates", "--candidates", "Best-ranked key images verified when relocalizing"},

@@ -130,6 +130,13 @@ struct LocalizerOptions {
   // near the start (corridor_conditions frames 5-6; a run started elsewhere pays a frame or two more of doubt).
   int start_key = -1;
   double start_mass = 0.8;
+  // The start key image is a hint, not evidence: a frame is `uncertain`, not steered by, where the belief the frames'
+  // evidence alone would hold (the same comparisons, weighed from a flat start) singles out a place more than two key
+  // images from it and holds less than min_confidence near it. The start's prior lends confidence where the frames do
+  // not tell, never against what they tell: a robot started elsewhere than `start_key` says is not steered by the
+  // start key image's neighbours while its frames point elsewhere (docs/localize.md, "The start is a hint"). Without
+  // `start_key` both beliefs are one. Off: the start's prior alone decides.
+  bool start_is_hint = true;
   // Lost frames in a row (each one also failed to relocalize) after which the estimate is dropped: key and
   // next_key then read -1 until a frame is relocalized.
   int max_lost_frames = 5;
