@@ -312,6 +312,25 @@ TEST(LocalizeCli, AStartKeyTracksTheRepeatRunsFirstFrames) {
   EXPECT_GE(steered[0], steered[1] + 2) << "started at key image 0 " << steered[0] << ", anywhere " << steered[1];
 }
 
+TEST(LocalizeCli, AStartKeyIsAHintARunStartedElsewhereOverrides) {
+  // corridor_conditions with ORB from repeat frame 20, started with --start-key 0 as a user does by habit
+  // (docs/localize.md, "The start is a hint"): the start's prior alone steered frames 23-25 by key images 1-2 (teach
+  // frames 2-5) and lost the frames after them; checked over the route, the frames find teach frames 20 on.
+  const auto runs =
+      CorridorRuns({" --start-key 0 --first 20", " --start-key 0 --first 20 --no-start-is-hint"}, 33, true);
+  if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  std::vector<int> far(2, 0), near(2, 0);
+  for (int r = 0; r < 2; ++r) {
+    for (size_t i = 0; i < runs[r].size(); ++i) {
+      if (!SteeredBy(runs[r][i])) continue;
+      const int repeat_frame = 20 + static_cast<int>(i);  // at teach frame repeat_frame
+      (std::abs(runs[r][i].second - repeat_frame) > 8 ? far : near)[r] += 1;
+    }
+  }
+  EXPECT_LT(far[0], far[1]) << "steered by far from their place: a hint " << far[0] << ", a prior " << far[1];
+  EXPECT_GE(near[0], near[1] + 4) << "steered by near their place: a hint " << near[0] << ", a prior " << near[1];
+}
+
 TEST(LocalizeCli, MatchingInTheWindowOfThePredictionTracksFramesTheContinuityMisses) {
   // corridor_conditions with ORB (docs/localize.md, "Matching guided by the prediction"): a guided comparison neither
   // chance nor the continuity of the heading accepts is matched again only around the previous frame's heading
