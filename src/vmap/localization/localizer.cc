@@ -213,7 +213,9 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   // Move on while the key image ahead is the better match, at most `lookahead` key images.
   for (int step = 1; step <= options_.lookahead && position + step <= last; ++step) {
     const KeyComparison ahead = compare_at(position + step);
-    if (!IsBetterMatch(ahead, best)) {
+    // A tie is no step on: the frame is as near the one as the other, on the segment it is on.
+    const bool beats_best = !best.accepted || !options_.step_on_needs_more || ahead.num_verified > best.num_verified;
+    if (!IsBetterMatch(ahead, best) || !beats_best) {
       // A frame that verifies against nothing so far may still have passed the next key image quickly.
       if (best.accepted || step > 1) break;
       continue;

@@ -205,5 +205,52 @@ TEST(VmapXfeat, ARobotCarriedOffIsNotSteeredByThePlaceItLeft) {
   EXPECT_GE(steered_far(" --no-doubt-lone-step-back"), 1) << "the test no longer reaches a lone step back";
 }
 
+// A step on across lighting (docs/localize.md, "A step on needs more than a tie"): corridor_conditions' repeat frames
+// 26-40 against an XFeat map of its teach run, started at teach frame 26's key image. Key images 8 and 9 (teach frames
+// 35 and 36) verify 27 matches each with repeat frame 32; S took the tracker on to 9, a key image early for frames
+// 32-33 (their teach frames i-2..i+2 lie before key image 9).
+TEST(VmapXfeat, AStepOnOnATieIsNotTaken) {
+  SKIP_WITHOUT_SHARED();
+  const fs::path data = fs::path(SharedDir()) / "data/corridor_conditions";
+  if (!fs::exists(data)) GTEST_SKIP() << data << " is not present";
+  const TempDir dir("step_on");
+  const fs::path map = dir.path() / "map";
+  const auto built = RunVmap("build " + ::vmap::testing::Quote(data / "teach") + " --matcher xfeat --weights " +
+                             FoldedWeights() + " -q -o " + ::vmap::testing::Quote(map));
+  ASSERT_EQ(built.status, 0) << built.output;
+  std::ifstream map_file(map / "map.json");
+  const nlohmann::json map_json = nlohmann::json::parse(map_file);
+  std::vector<int> sources;
+  for (const auto& key : map_json["key_images"]) sources.push_back(key["source_index"].get<int>());
+  // Frames steered by (tracking or relocalized) at a key image bracketing one of their teach frames i-2..i+2.
+  auto steered_right = [&](const std::string& flags) {
+    const fs::path csv = dir.path() / "run.csv";
+    const auto r = RunVmap("localize " + ::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(data / "repeat") +
+                           " --first 26 --last 40 -q --start-key " + std::to_string(KeysAround(sources, 26).front()) +
+                           " --csv " + ::vmap::testing::Quote(csv) + flags);
+    EXPECT_EQ(r.status, 0) << r.output;
+    std::ifstream in(csv);
+    std::string line;
+    std::getline(in, line);  // frame,source_index,timestamp,source_name,status,key,...
+    int right = 0;
+    while (std::getline(in, line)) {
+      std::stringstream row(line);
+      std::vector<std::string> cells;
+      for (std::string cell; cells.size() < 6 && std::getline(row, cell, ',');) cells.push_back(cell);
+      if (cells.size() < 6 || (cells[4] != "tracking" && cells[4] != "relocalized")) continue;
+      const int key = std::stoi(cells[5]), repeat = std::stoi(cells[1]);
+      bool brackets = false;
+      for (int j = repeat - 2; j <= repeat + 2; ++j) {
+        for (int k : KeysAround(sources, j)) brackets = brackets || k == key;
+      }
+      right += brackets;
+    }
+    return right;
+  };
+  const int needs_more = steered_right(""), on_tie = steered_right(" --step-on-on-tie");
+  EXPECT_GE(needs_more, on_tie + 2) << "steered by at a right key image: needs more " << needs_more << ", on a tie "
+                                    << on_tie;
+}
+
 }  // namespace
 }  // namespace vmap::neural
