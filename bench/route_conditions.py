@@ -238,6 +238,13 @@ def michigan(vmap, matcher, localize_flags, work, evidence_dir=None, build_flags
     return tally
 
 
+def report(tally, name):
+    """Prints the tally's row and the frames it names (far, back-jumps)."""
+    print(tally.row(name), flush=True)
+    for line in tally.far:
+        print("    " + line)
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--vmap", default="build/vmap", help="comma-separated binaries, compared side by side")
@@ -257,36 +264,30 @@ def main():
     tau_flags = (["--tau", args.tau] if args.tau else []) + args.build.split()
     build_flags = args.build.split()
     print(HEADER)
+    sets = args.sets.split(",")
+    localize_flags = args.localize.split()
     with tempfile.TemporaryDirectory(prefix="vmap_route_conditions_") as scratch:
         for index, vmap in enumerate(args.vmap.split(",")):
             work = os.path.join(args.work or scratch, "binary%d" % index)
             os.makedirs(work, exist_ok=True)
             for matcher in args.matchers.split(","):
-                if "corridor" in args.sets:
-                    tally, keys = corridor(vmap, matcher, tau_flags, args.localize.split(), args.repeat_stride, work,
+                if "corridor" in sets:
+                    tally, keys = corridor(vmap, matcher, tau_flags, localize_flags, args.repeat_stride, work,
                                            args.csv_dir, args.evidence_dir)
-                    print(tally.row("%s: corridor, %s, %d key images%s" % (
+                    report(tally, "%s: corridor, %s, %d key images%s" % (
                         vmap, matcher, keys, ", repeat stride %d" % args.repeat_stride if args.repeat_stride > 1
-                        else "")), flush=True)
-                    for line in tally.far:
-                        print("    " + line)
-                if "kidnapped" in args.sets:
-                    tally = kidnapped(vmap, matcher, tau_flags, args.localize.split(), work, args.csv_dir)
-                    print(tally.row("%s: kidnapped corridor (repeat %s), %s" % (
-                        vmap, ", ".join("%d-%d" % s for s in KIDNAPPED), matcher)), flush=True)
-                    for line in tally.far:
-                        print("    " + line)
-                if "elsewhere" in args.sets:
-                    tally = elsewhere(vmap, matcher, tau_flags, args.localize.split(), work, args.csv_dir)
-                    print(tally.row("%s: started elsewhere than --start-key (%s), %s" % (
-                        vmap, ", ".join("%s from %d" % e for e in ELSEWHERE), matcher)), flush=True)
-                    for line in tally.far:
-                        print("    " + line)
-                if "michigan" in args.sets:
-                    tally = michigan(vmap, matcher, args.localize.split(), work, args.evidence_dir, build_flags)
-                    print(tally.row("%s: michigan 132 routes, %s" % (vmap, matcher)), flush=True)
-                    for line in tally.far:
-                        print("    " + line)
+                        else ""))
+                if "kidnapped" in sets:
+                    report(kidnapped(vmap, matcher, tau_flags, localize_flags, work, args.csv_dir),
+                           "%s: kidnapped corridor (repeat %s), %s" % (
+                               vmap, ", ".join("%d-%d" % s for s in KIDNAPPED), matcher))
+                if "elsewhere" in sets:
+                    report(elsewhere(vmap, matcher, tau_flags, localize_flags, work, args.csv_dir),
+                           "%s: started elsewhere than --start-key (%s), %s" % (
+                               vmap, ", ".join("%s from %d" % e for e in ELSEWHERE), matcher))
+                if "michigan" in sets:
+                    report(michigan(vmap, matcher, localize_flags, work, args.evidence_dir, build_flags),
+                           "%s: michigan 132 routes, %s" % (vmap, matcher))
 
 
 if __name__ == "__main__":

@@ -135,7 +135,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
     if (c.key >= 0 && c.key < static_cast<int>(keys_.features.size())) comparisons_.push_back({std::move(c), false});
   }
   belief_.Predict();
-  evidence_belief_.Predict();
+  if (start_unconfirmed_) evidence_belief_.Predict();
   // Guided matching asks where the estimate was dropped for max_lost_frames frames (guided_while_lost).
   if (dropped_position_ >= 0 && ++frames_since_drop_ > options_.max_lost_frames) dropped_position_ = -1;
   belief_confident_ = SinglesOut(belief_.Peak());

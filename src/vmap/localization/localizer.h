@@ -212,7 +212,7 @@ class Localizer {
   } step_back_ruled_out_;
   RouteBelief belief_;
   // The belief the frames' evidence alone would hold: the same motion and comparisons as belief_, from a flat start
-  // (without the start key image's prior). The same as belief_ without a start key image.
+  // (without the start key image's prior). Kept only while the start is unconfirmed, the only time it is read.
   RouteBelief evidence_belief_;
   // The start key image is a hint the frames have not yet confirmed (start_is_hint): until a frame is steered by near
   // the evidence belief's peak, the evidence belief may make a frame uncertain, and with binary descriptors every frame

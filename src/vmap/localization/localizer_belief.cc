@@ -26,11 +26,11 @@ void Localizer::WeighComparisons() {
     if (position < 0) continue;
     const double log_ratio = EvidenceLogRatio(evidence_, m.comparison, link_verified_[key]);
     belief_.Weigh(position, log_ratio);
-    evidence_belief_.Weigh(position, log_ratio);
+    if (start_unconfirmed_) evidence_belief_.Weigh(position, log_ratio);
   }
   if (weighed) {
     belief_.Normalize();
-    evidence_belief_.Normalize();
+    if (start_unconfirmed_) evidence_belief_.Normalize();
   }
 }
 

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -144,6 +145,47 @@ std::vector<int> KeysAround(const std::vector<int>& sources, int frame) {
   return keys;
 }
 
+// The right key images of corridor_conditions' repeat frame `repeat`: those bracketing its teach frames i-2..i+2
+// (bench/route_conditions.py's count).
+std::vector<int> RightKeys(const std::vector<int>& sources, int repeat) {
+  std::vector<int> keys;
+  for (int j = repeat - 2; j <= repeat + 2; ++j) {
+    for (int k : KeysAround(sources, j)) keys.push_back(k);
+  }
+  return keys;
+}
+
+// An XFeat map of corridor_conditions' teach run in `map`; returns its key images' teach frames.
+std::vector<int> BuildCorridorMap(const fs::path& data, const fs::path& map) {
+  const auto built = RunVmap("build " + ::vmap::testing::Quote(data / "teach") + " --matcher xfeat --weights " +
+                             FoldedWeights() + " -q -o " + ::vmap::testing::Quote(map));
+  EXPECT_EQ(built.status, 0) << built.output;
+  std::vector<int> sources;
+  std::ifstream map_file(map / "map.json");
+  if (!map_file) return sources;
+  const nlohmann::json map_json = nlohmann::json::parse(map_file);
+  for (const auto& key : map_json["key_images"]) sources.push_back(key["source_index"].get<int>());
+  return sources;
+}
+
+// The frames of `vmap localize ARGS --csv` steered by (tracking or relocalized): (source_index, key) each.
+std::vector<std::pair<int, int>> SteeredFrames(const std::string& args, const fs::path& csv) {
+  const auto r = RunVmap("localize " + args + " -q --csv " + ::vmap::testing::Quote(csv));
+  EXPECT_EQ(r.status, 0) << r.output;
+  std::vector<std::pair<int, int>> steered;
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);  // frame,source_index,timestamp,source_name,status,key,...
+  while (std::getline(in, line)) {
+    std::stringstream row(line);
+    std::vector<std::string> cells;
+    for (std::string cell; cells.size() < 6 && std::getline(row, cell, ',');) cells.push_back(cell);
+    if (cells.size() < 6 || (cells[4] != "tracking" && cells[4] != "relocalized")) continue;
+    steered.emplace_back(std::stoi(cells[1]), std::stoi(cells[5]));
+  }
+  return steered;
+}
+
 // A robot carried off (docs/localize.md, "A lone step back is doubted"): corridor_conditions' repeat frames 90-110 and
 // then 20-25 as one run (carried 70 frames back) against an XFeat map of its teach run, started at teach frame 90's
 // key image. On the first frame after the jump nothing verifies at the key images where the run was but the one
@@ -154,15 +196,8 @@ TEST(VmapXfeat, ARobotCarriedOffIsNotSteeredByThePlaceItLeft) {
   if (!fs::exists(data)) GTEST_SKIP() << data << " is not present";
   const TempDir dir("kidnapped");
   const fs::path map = dir.path() / "map";
-  const auto built = RunVmap("build " + ::vmap::testing::Quote(data / "teach") + " --matcher xfeat --weights " +
-                             FoldedWeights() + " -q -o " + ::vmap::testing::Quote(map));
-  ASSERT_EQ(built.status, 0) << built.output;
-  std::ifstream map_file(map / "map.json");
-  const nlohmann::json map_json = nlohmann::json::parse(map_file);
-  std::vector<int> sources;
-  for (const auto& key : map_json["key_images"]) {
-    sources.push_back(key["source_index"].get<int>());
-  }
+  const std::vector<int> sources = BuildCorridorMap(data, map);
+  ASSERT_FALSE(sources.empty());
   std::vector<int> repeat_of;  // run frame -> repeat frame (repeat frame i was taken where teach frame i was)
   for (int i = 90; i <= 110; ++i) repeat_of.push_back(i);
   for (int i = 20; i <= 25; ++i) repeat_of.push_back(i);
@@ -175,28 +210,15 @@ TEST(VmapXfeat, ARobotCarriedOffIsNotSteeredByThePlaceItLeft) {
     std::snprintf(link, sizeof(link), "%07zu.jpg", f);
     fs::create_symlink(data / "repeat" / name, run / link);
   }
-  // Frames steered by (tracking or relocalized) at a key image more than 2 from every key image bracketing their
-  // teach frames i-2..i+2 (bench/route_conditions.py's count).
+  // Frames steered by at a key image more than 2 from every right one.
   auto steered_far = [&](const std::string& flags) {
-    const fs::path csv = dir.path() / "run.csv";
-    const auto r =
-        RunVmap("localize " + ::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(run) + " -q --start-key " +
-                std::to_string(KeysAround(sources, 90).front()) + " --csv " + ::vmap::testing::Quote(csv) + flags);
-    EXPECT_EQ(r.status, 0) << r.output;
-    std::ifstream in(csv);
-    std::string line;
-    std::getline(in, line);  // frame,source_index,timestamp,source_name,status,key,...
     int far = 0;
-    while (std::getline(in, line)) {
-      std::stringstream row(line);
-      std::vector<std::string> cells;
-      for (std::string cell; cells.size() < 6 && std::getline(row, cell, ',');) cells.push_back(cell);
-      if (cells.size() < 6 || (cells[4] != "tracking" && cells[4] != "relocalized")) continue;
-      const int key = std::stoi(cells[5]), repeat = repeat_of.at(std::stoi(cells[1]));
+    for (const auto& [frame, key] :
+         SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(run) + " --start-key " +
+                           std::to_string(KeysAround(sources, 90).front()) + flags,
+                       dir.path() / "run.csv")) {
       int nearest = 1 << 20;
-      for (int j = repeat - 2; j <= repeat + 2; ++j) {
-        for (int k : KeysAround(sources, j)) nearest = std::min(nearest, std::abs(key - k));
-      }
+      for (int k : RightKeys(sources, repeat_of.at(frame))) nearest = std::min(nearest, std::abs(key - k));
       far += nearest > 2;
     }
     return far;
@@ -215,35 +237,17 @@ TEST(VmapXfeat, AStepOnOnATieIsNotTaken) {
   if (!fs::exists(data)) GTEST_SKIP() << data << " is not present";
   const TempDir dir("step_on");
   const fs::path map = dir.path() / "map";
-  const auto built = RunVmap("build " + ::vmap::testing::Quote(data / "teach") + " --matcher xfeat --weights " +
-                             FoldedWeights() + " -q -o " + ::vmap::testing::Quote(map));
-  ASSERT_EQ(built.status, 0) << built.output;
-  std::ifstream map_file(map / "map.json");
-  const nlohmann::json map_json = nlohmann::json::parse(map_file);
-  std::vector<int> sources;
-  for (const auto& key : map_json["key_images"]) sources.push_back(key["source_index"].get<int>());
-  // Frames steered by (tracking or relocalized) at a key image bracketing one of their teach frames i-2..i+2.
+  const std::vector<int> sources = BuildCorridorMap(data, map);
+  ASSERT_FALSE(sources.empty());
+  // Frames steered by at a right key image.
   auto steered_right = [&](const std::string& flags) {
-    const fs::path csv = dir.path() / "run.csv";
-    const auto r = RunVmap("localize " + ::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(data / "repeat") +
-                           " --first 26 --last 40 -q --start-key " + std::to_string(KeysAround(sources, 26).front()) +
-                           " --csv " + ::vmap::testing::Quote(csv) + flags);
-    EXPECT_EQ(r.status, 0) << r.output;
-    std::ifstream in(csv);
-    std::string line;
-    std::getline(in, line);  // frame,source_index,timestamp,source_name,status,key,...
     int right = 0;
-    while (std::getline(in, line)) {
-      std::stringstream row(line);
-      std::vector<std::string> cells;
-      for (std::string cell; cells.size() < 6 && std::getline(row, cell, ',');) cells.push_back(cell);
-      if (cells.size() < 6 || (cells[4] != "tracking" && cells[4] != "relocalized")) continue;
-      const int key = std::stoi(cells[5]), repeat = std::stoi(cells[1]);
-      bool brackets = false;
-      for (int j = repeat - 2; j <= repeat + 2; ++j) {
-        for (int k : KeysAround(sources, j)) brackets = brackets || k == key;
-      }
-      right += brackets;
+    for (const auto& [frame, key] : SteeredFrames(
+             ::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(data / "repeat") +
+                 " --first 26 --last 40 --start-key " + std::to_string(KeysAround(sources, 26).front()) + flags,
+             dir.path() / "run.csv")) {
+      const std::vector<int> keys = RightKeys(sources, frame);
+      right += std::find(keys.begin(), keys.end(), key) != keys.end();
     }
     return right;
   };
