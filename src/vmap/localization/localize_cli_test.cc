@@ -362,6 +362,26 @@ TEST(LocalizeCli, AStepBackOnATieIsNotTaken) {
       << "back-jumps: needs more " << back_jumps[0] << ", on a tie " << back_jumps[1];
 }
 
+TEST(LocalizeCli, AStepBackWhoseMatchesChanceExplainsBetterIsNotTaken) {
+  // corridor_conditions with ORB (docs/localize.md, "A step back or on needs a lower NFA too"): at frame 57 the key
+  // image behind verifies 27 matches at log10 NFA -3.6 against the tracked key image's 26 at -12.1, and the count alone
+  // took the tracker back, a frame steered by behind the frame before it.
+  const std::vector<int> back_jumps = BackJumpsOnCorridor({"", " --step-back-on-count"}, 60);
+  if (back_jumps.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  EXPECT_LT(back_jumps[0], back_jumps[1])
+      << "back-jumps: needs a lower NFA " << back_jumps[0] << ", on the count " << back_jumps[1];
+}
+
+TEST(LocalizeCli, AStepOnWhoseMatchesChanceExplainsBetterIsNotTakenWithOrb) {
+  // corridor_conditions with ORB (docs/localize.md, "A step back or on needs a lower NFA too"): at frame 103 the key
+  // image ahead verifies 23 matches at log10 NFA -8.5 against the tracked key image's 22 at -15.8; the count alone took
+  // the tracker on, a teach frame early, and a frame after it stepped back.
+  const std::vector<int> back_jumps = BackJumpsOnCorridor({"", " --step-on-on-count"}, 110);
+  if (back_jumps.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  EXPECT_LT(back_jumps[0], back_jumps[1])
+      << "back-jumps: needs a lower NFA " << back_jumps[0] << ", on the count " << back_jumps[1];
+}
+
 TEST(LocalizeCli, GuidedMatchingOverTheLookaheadKeepsUpWithTheRobot) {
   // corridor_conditions with ORB (docs/localize.md, "Guided matching over the lookahead"): repeat frame i was taken
   // where teach frame i was. Where the repeat passes a key image a frame (frames 97-99) guided matching asked only the

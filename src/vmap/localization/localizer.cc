@@ -81,6 +81,7 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   const bool binary = !descriptors.empty() && descriptors.depth() == CV_8U;
   evidence_ = binary ? BinaryDescriptorEvidence() : FloatDescriptorEvidence();
   start_checked_over_route_ = binary;
+  nfa_ranks_key_images_ = binary;
   if (options_.guided_matching && matcher_.name() == OrbMatcherOptions::kModelName) {
     MatcherOptions guided;
     guided.type = OrbMatcherOptions::kModelName;
@@ -213,8 +214,12 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   // Move on while the key image ahead is the better match, at most `lookahead` key images.
   for (int step = 1; step <= options_.lookahead && position + step <= last; ++step) {
     const KeyComparison ahead = compare_at(position + step);
-    // A tie is no step on: the frame is as near the one as the other, on the segment it is on.
-    const bool beats_best = !best.accepted || !options_.step_on_needs_more || ahead.num_verified > best.num_verified;
+    // A tie is no step on: the frame is as near the one as the other, on the segment it is on. With ORB, neither is a
+    // step on that chance explains better than the key image left behind (a frame a teach frame short of it).
+    const bool beats_best =
+        !best.accepted ||
+        ((!options_.step_on_needs_more || ahead.num_verified > best.num_verified) &&
+         (!nfa_ranks_key_images_ || !options_.step_on_needs_lower_nfa || NoLikelierChance(ahead, best)));
     if (!IsBetterMatch(ahead, best) || !beats_best) {
       // A frame that verifies against nothing so far may still have passed the next key image quickly.
       if (best.accepted || step > 1) break;
@@ -245,9 +250,11 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
         // With nothing accepted at or ahead of `key`, the key image behind has nothing to beat but chance, and a step
         // back is the likelier chance on a route that goes forwards: it must beat chance by more.
         const bool beats_chance = best.accepted || behind.log10_nfa <= options_.step_back_max_log10_nfa;
-        // A tie is no step back: the route goes forwards.
+        // A tie is no step back, nor a step back that chance explains better than the key image it would leave: the
+        // route goes forwards.
         const bool beats_best =
-            !best.accepted || !options_.step_back_needs_more || behind.num_verified > best.num_verified;
+            !best.accepted || ((!options_.step_back_needs_more || behind.num_verified > best.num_verified) &&
+                               (!options_.step_back_needs_lower_nfa || NoLikelierChance(behind, best)));
         if (IsBetterMatch(behind, best) && beats_chance && beats_best) {
           lone_step_back = !best.accepted && !(at_key.matched && at_key.log10_nfa <= options_.max_log10_nfa);
           best = behind;
@@ -362,6 +369,13 @@ double Localizer::SharedWithLink(const KeyComparison& comparison, int key_a, int
     }
   }
   return 0.0;  // no link between them: not comparable
+}
+
+bool Localizer::NoLikelierChance(const KeyComparison& to, const KeyComparison& from) const {
+  // Beyond the evidence's bound both are the same scene beyond doubt (redkitchen's frames verify at -200 to -460), and
+  // the count alone ranks them, as the bracket test chose.
+  const double beyond_doubt = -evidence_.max_significance;
+  return std::max(to.log10_nfa, beyond_doubt) <= std::max(from.log10_nfa, beyond_doubt);
 }
 
 bool Localizer::SharesLittle(const KeyComparison& comparison) const {

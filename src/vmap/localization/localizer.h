@@ -176,6 +176,10 @@ class Localizer {
   // The frame's verified matches with key_a over those of the map's link between key_a and key_b (0 when
   // they have no link).
   double SharedWithLink(const KeyComparison& comparison, int key_a, int key_b) const;
+  // A move of the tracker from comparison `from` to comparison `to` is not one chance explains better: `to`'s log10
+  // NFA is at most `from`'s, both clamped at the evidence's bound (-max_significance), beyond which both are the same
+  // scene beyond doubt (LocalizerOptions::step_back_needs_lower_nfa, step_on_needs_lower_nfa).
+  bool NoLikelierChance(const KeyComparison& to, const KeyComparison& from) const;
   // A tracked comparison shares less with its key image than the map's links do (recheck_link_share).
   bool SharesLittle(const KeyComparison& comparison) const;
 
@@ -222,6 +226,10 @@ class Localizer {
   // the start. Float descriptors (XFeat) verify chance matches at most wrong key images, which the evidence credits:
   // comparing the whole route at the start pulled the evidence belief to chance places (docs/localize.md).
   bool start_checked_over_route_ = false;
+  // Binary descriptors (ORB): across lighting their verified sets at wrong key images almost never pass chance, so
+  // the log10 NFA ranks the key images near the frame as the verified count does; XFeat's pass chance at most wrong
+  // key images, and its NFA does not (a step on needing a lower NFA too held XFeat's corridor frames a key image back).
+  bool nfa_ranks_key_images_ = false;
   // After the frame's motion step, before its evidence: the belief held at least min_confidence near its peak
   // (the frames before this one singled out a place). A flat belief does not move the estimate.
   bool belief_confident_ = false;

@@ -70,9 +70,17 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"step_back_needs_more", "!--step-back-on-tie",
                  "Step back to the previous key image on a tie of verified matches (S decides, as before)"},
                 step_back_needs_more);
+  visitor.Visit({"step_back_needs_lower_nfa", "!--step-back-on-count",
+                 "Step back to the previous key image on more verified matches alone, whatever their log10 NFA (as "
+                 "before)"},
+                step_back_needs_lower_nfa);
   visitor.Visit({"step_on_needs_more", "!--step-on-on-tie",
                  "Step on to the next key image on a tie of verified matches (S decides, as before)"},
                 step_on_needs_more);
+  visitor.Visit({"step_on_needs_lower_nfa", "!--step-on-on-count",
+                 "ORB: step on to the next key image on more verified matches alone, whatever their log10 NFA (as "
+                 "before)"},
+                step_on_needs_lower_nfa);
   visitor.Visit({"guided_matching", "!--no-guided-matching",
                  "ORB: never match a frame again with looser matching at the key images the belief holds"},
                 guided_matching);

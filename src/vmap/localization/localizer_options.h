@@ -76,12 +76,22 @@ struct LocalizerOptions {
   // verify as many matches are a coin toss (corridor_conditions frame 17: back to key image 4 on 0.01 of S, and the
   // next frame on again). Off: the better match by IsBetterMatch, a tie decided by S (docs/localize.md).
   bool step_back_needs_more = true;
+  // A step back from a key image that verifies needs its verified matches less likely by chance too (a lower log10
+  // NFA) than those of the key image it would replace: the count and the a-contrario test must agree before the route
+  // goes backwards. Off: the count alone decides.
+  bool step_back_needs_lower_nfa = true;
   // A step on needs more verified matches than the key image it would leave behind (or the key image ahead it would
   // pass): on a tie the frame is as near one as the other, midway on the segment it is on, so the estimate stays.
   // Across lighting XFeat verifies 20-30 matches at every key image around the frame, and key images a teach frame
   // apart tie often (corridor_conditions frames 32 and 95 went on a key image early on S). Off: the better match by
   // IsBetterMatch, a tie decided by S (docs/localize.md).
   bool step_on_needs_more = true;
+  // With binary descriptors (ORB), a step on needs the key image ahead's verified matches less likely by chance too (a
+  // lower log10 NFA) than those of the key image it would leave or pass: a frame a teach frame or two short of the next
+  // key image verifies about as many matches at both, and the count alone went on early and the next frame stepped back
+  // (corridor_conditions frame 103). Float descriptors (XFeat) verify chance matches at most key images, where the NFA
+  // ranks nothing: off for them whatever this says. Off: the count alone decides (docs/localize.md).
+  bool step_on_needs_lower_nfa = true;
   // Guided matching (ORB maps): a frame that verifies nothing at the tracked key images while the belief singles
   // out that place is matched with them again, and only with them, keeping one-way best matches too (no cross
   // check); the a-contrario test, which counts every tentative match, decides as before (docs/localize.md,
