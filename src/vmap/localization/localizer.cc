@@ -119,6 +119,8 @@ void Localizer::Reset() {
   if (start_position_ >= 0) belief_.Start(start_position_, options_.start_mass);
   start_unconfirmed_ = start_position_ >= 0 && options_.start_is_hint;
   pointed_ = pointed_before_ = -1;
+  rival_place_ = -1;
+  rival_frames_left_ = 0;
   position_ = start_position_;
   lost_in_a_row_ = 0;
   dropped_position_ = -1;
@@ -146,6 +148,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   // A hint is checked: the frame's evidence over the whole route weighs where the run is.
   if (start_unconfirmed_ && start_checked_over_route_) CompareBestRanked(frame, features);
   Believe(result, frame, features);
+  RememberRivalPlace(result);
   if (result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized) {
     dropped_position_ = -1;  // steered by again: the drop is behind
   }
@@ -294,8 +297,17 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     }
     return result;
   }
+  // A rival place (rival_place_frames) asked again: where it verifies more than the tracked key image, the frame may be
+  // there, and is relocalized as a frame that shares little with its key image is.
+  bool rival_beats = false;
+  if (rival_place_ >= 0 && std::abs(rival_place_ - best_position) > kNear) {
+    for (int q = rival_place_; q <= std::min(last, rival_place_ + 1); ++q) {
+      const KeyComparison c = CompareOnce(features, route_[q]);
+      if (c.accepted && c.num_verified > best.num_verified) rival_beats = true;
+    }
+  }
   bool doubted = false;  // a lone step back, while a far relocalization verified more (doubt_lone_step_back)
-  if (!AcceptedAgainstRivals(best) && (SharesLittle(best) || pointed_before_ >= 0)) {
+  if (!AcceptedAgainstRivals(best) && (SharesLittle(best) || pointed_before_ >= 0 || rival_beats)) {
     // Accepted, but with much less than neighbouring key images share: the frame may be elsewhere on the
     // route, in view of this key image's scene. Moved when a ranked key image verifies more matches (a
     // relocalization that is not taken leaves nothing behind: the tracked estimate is set below). Also asked when
@@ -354,6 +366,35 @@ bool Localizer::TakesJump(int from, int to, int lost_frames) {
   }
   pointed_ = to;
   return false;
+}
+
+void Localizer::RememberRivalPlace(const LocalizationResult& result) {
+  if (rival_place_ >= 0 && --rival_frames_left_ <= 0) rival_place_ = -1;
+  const bool placed =
+      result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized;
+  if (options_.rival_place_frames <= 0 || !placed || result.route_position < 0) return;
+  const int rival = OutVerifiedFrom(result);
+  if (rival < 0) return;
+  rival_place_ = rival;
+  rival_frames_left_ = options_.rival_place_frames;
+}
+
+int Localizer::OutVerifiedFrom(const LocalizationResult& result) const {
+  int most = 0;  // the verified matches of the key images the frame is placed at
+  for (const KeyComparison* c : {&result.to_key, &result.to_next}) {
+    if (c->accepted) most = std::max(most, c->num_verified);
+  }
+  int rival = -1;
+  for (const Memo& m : comparisons_) {
+    const KeyComparison& c = m.comparison;
+    const int p = route_position_of_key_[c.key];
+    if (!m.used || !c.accepted || p < 0 || std::abs(p - result.route_position) <= kNear) continue;
+    if (c.num_verified > most) {
+      most = c.num_verified;
+      rival = p;
+    }
+  }
+  return rival;
 }
 
 double Localizer::NearDensity(int position) const {

@@ -170,6 +170,12 @@ class Localizer {
   // position `from` to `to`; when not, remembers `to` for the next frame. Only with the belief on (belief.window and
   // min_confidence above 0).
   bool TakesJump(int from, int to, int lost_frames);
+  // Remembers the far place the frame's comparisons verified more at than the key images it is steered by
+  // (rival_place_), or counts down the one remembered.
+  void RememberRivalPlace(const LocalizationResult& result);
+  // The route position, more than kNear from the result's, of the frame's accepted comparison that verified the most
+  // matches, more than the result's key images; -1: none.
+  int OutVerifiedFrom(const LocalizationResult& result) const;
   // The belief's mass per route position within kNear of `position` (fewer positions at the route's ends).
   double NearDensity(int position) const;
 
@@ -233,6 +239,10 @@ class Localizer {
   // After the frame's motion step, before its evidence: the belief held at least min_confidence near its peak
   // (the frames before this one singled out a place). A flat belief does not move the estimate.
   bool belief_confident_ = false;
+  // A far route position that verified more than the place the last frames were steered by (rival_place_frames);
+  // -1: none. Compared again for rival_frames_left_ more frames.
+  int rival_place_ = -1;
+  int rival_frames_left_ = 0;
   int pointed_ = -1;         // the far route position this frame's relocalization pointed at; -1: none
   int pointed_before_ = -1;  // the previous frame's
   // How many key images Track moved the estimate on this frame (LocalizerOptions::lookahead); 0: none.

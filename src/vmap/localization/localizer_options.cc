@@ -42,6 +42,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Track a frame that stepped back because nothing at or ahead of the key image verified, though a far "
                  "key image verifies more (otherwise it is uncertain)"},
                 doubt_lone_step_back);
+  visitor.Visit({"rival_place_frames", "--rival-place-frames",
+                 "Frames a far key image that verified more than the one a frame was steered by is compared again; "
+                 "a tracked frame it out-verifies again is relocalized (0 = never)"},
+                rival_place_frames);
   visitor.Visit({"start_key", "--start-key",
                  "The key image the run starts at (teach and repeat: 0, the route's first): the tracker starts there "
                  "and the belief leans there, which the frames' evidence overrides (-1 = anywhere)"},

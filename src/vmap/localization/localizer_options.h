@@ -58,6 +58,12 @@ struct LocalizerOptions {
   // carried elsewhere must not be steered by the place it left while the frames after it decide (docs/localize.md, "A
   // lone step back is doubted"). Off: it is tracked there.
   bool doubt_lone_step_back = true;
+  // A place elsewhere on the route that verified more matches than the key images a frame was steered by (a key image
+  // more than two route positions away) is a rival: for this many frames it is compared again (it and the key image
+  // after it), and a tracked frame it out-verifies again is relocalized, as a frame that shares little with its key
+  // image is. Where the corridor repeats itself, a wrong place verifies as much as a right one, and is questioned
+  // only when something else is compared (docs/localize.md, "A rival place is asked again"). 0: never.
+  int rival_place_frames = 3;
   // Key images compared beyond `next_key` when the frame has passed it (1 or 2: the issue's "next one or two").
   int lookahead = 2;
   // While tracking, also compare the key image before `key` when the frame is nearer `key` than `next_key`

@@ -256,5 +256,36 @@ TEST(VmapXfeat, AStepOnOnATieIsNotTaken) {
                                     << on_tie;
 }
 
+// Where the corridor repeats itself (docs/localize.md, "A rival place is asked again"): corridor_conditions' repeat
+// frames 90-104 against an XFeat map of its teach run, started at key image 0 (a run started elsewhere than --start-key
+// says). From frame 95 the run is held at key images 12-13 (right: 28-31), which verify 21-32 matches there, as many
+// as the right ones do; on frame 95 key image 31 verified more. Asked again on the frames after it, the right place
+// out-verifies the tracked one again and the tracker goes there two frames sooner (frame 101, not 103).
+TEST(VmapXfeat, AFarPlaceThatVerifiedMoreIsAskedAgain) {
+  SKIP_WITHOUT_SHARED();
+  const fs::path data = fs::path(SharedDir()) / "data/corridor_conditions";
+  if (!fs::exists(data)) GTEST_SKIP() << data << " is not present";
+  const TempDir dir("rival_place");
+  const fs::path map = dir.path() / "map";
+  const std::vector<int> sources = BuildCorridorMap(data, map);
+  ASSERT_FALSE(sources.empty());
+  // Frames steered by at a key image more than 2 from every right one.
+  auto steered_far = [&](const std::string& flags) {
+    int far = 0;
+    for (const auto& [frame, key] :
+         SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(data / "repeat") +
+                           " --first 90 --last 104 --start-key 0" + flags,
+                       dir.path() / "run.csv")) {
+      int nearest = 1 << 20;
+      for (int k : RightKeys(sources, frame)) nearest = std::min(nearest, std::abs(key - k));
+      far += nearest > 2;
+    }
+    return far;
+  };
+  const int asked = steered_far(""), not_asked = steered_far(" --rival-place-frames 0");
+  EXPECT_LE(asked, not_asked - 2) << "steered by more than 2 key images off: asked again " << asked << ", not "
+                                  << not_asked;
+}
+
 }  // namespace
 }  // namespace vmap::neural
