@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -186,6 +187,19 @@ std::vector<std::pair<int, int>> SteeredFrames(const std::string& args, const fs
   return steered;
 }
 
+// How many of `steered` (run frame, key) are at a key image more than 2 from every right one; `repeat_of` gives a run
+// frame's repeat frame.
+int SteeredFar(const std::vector<int>& sources, const std::vector<std::pair<int, int>>& steered,
+               const std::function<int(int)>& repeat_of) {
+  int far = 0;
+  for (const auto& [frame, key] : steered) {
+    int nearest = 1 << 20;
+    for (int k : RightKeys(sources, repeat_of(frame))) nearest = std::min(nearest, std::abs(key - k));
+    far += nearest > 2;
+  }
+  return far;
+}
+
 // A robot carried off (docs/localize.md, "A lone step back is doubted"): corridor_conditions' repeat frames 90-110 and
 // then 20-25 as one run (carried 70 frames back) against an XFeat map of its teach run, started at teach frame 90's
 // key image. On the first frame after the jump nothing verifies at the key images where the run was but the one
@@ -210,18 +224,12 @@ TEST(VmapXfeat, ARobotCarriedOffIsNotSteeredByThePlaceItLeft) {
     std::snprintf(link, sizeof(link), "%07zu.jpg", f);
     fs::create_symlink(data / "repeat" / name, run / link);
   }
-  // Frames steered by at a key image more than 2 from every right one.
   auto steered_far = [&](const std::string& flags) {
-    int far = 0;
-    for (const auto& [frame, key] :
-         SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(run) + " --start-key " +
-                           std::to_string(KeysAround(sources, 90).front()) + flags,
-                       dir.path() / "run.csv")) {
-      int nearest = 1 << 20;
-      for (int k : RightKeys(sources, repeat_of.at(frame))) nearest = std::min(nearest, std::abs(key - k));
-      far += nearest > 2;
-    }
-    return far;
+    return SteeredFar(sources,
+                      SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(run) + " --start-key " +
+                                        std::to_string(KeysAround(sources, 90).front()) + flags,
+                                    dir.path() / "run.csv"),
+                      [&](int frame) { return repeat_of.at(frame); });
   };
   EXPECT_EQ(steered_far(""), 0);
   EXPECT_GE(steered_far(" --no-doubt-lone-step-back"), 1) << "the test no longer reaches a lone step back";
@@ -269,18 +277,12 @@ TEST(VmapXfeat, AFarPlaceThatVerifiedMoreIsAskedAgain) {
   const fs::path map = dir.path() / "map";
   const std::vector<int> sources = BuildCorridorMap(data, map);
   ASSERT_FALSE(sources.empty());
-  // Frames steered by at a key image more than 2 from every right one.
   auto steered_far = [&](const std::string& flags) {
-    int far = 0;
-    for (const auto& [frame, key] :
-         SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(data / "repeat") +
-                           " --first 90 --last 104 --start-key 0" + flags,
-                       dir.path() / "run.csv")) {
-      int nearest = 1 << 20;
-      for (int k : RightKeys(sources, frame)) nearest = std::min(nearest, std::abs(key - k));
-      far += nearest > 2;
-    }
-    return far;
+    return SteeredFar(sources,
+                      SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(data / "repeat") +
+                                        " --first 90 --last 104 --start-key 0" + flags,
+                                    dir.path() / "run.csv"),
+                      [](int frame) { return frame; });
   };
   const int asked = steered_far(""), not_asked = steered_far(" --rival-place-frames 0");
   EXPECT_LE(asked, not_asked - 2) << "steered by more than 2 key images off: asked again " << asked << ", not "
