@@ -2,6 +2,7 @@
 // bracket test against truth (docs/measurements/localization.md) on subsets of kitti07 and redkitchen.
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -226,21 +227,32 @@ TEST(LocalizeCli, EvalCorridorRuns) {
 
 // corridor_conditions' first `last` + 1 repeat frames against an ORB map of its teach run, once per entry of `flags`
 // (more flags for vmap localize): each frame's status and key image (with `teach_frames`: the key image's frame in
-// the teach run, the CSV's key_frame). Empty without the data.
+// the teach run, the CSV's key_frame). With `repeat_frames`, those repeat frames in that order instead, as one run (a
+// robot carried along the route; `last` unused). Empty without the data.
 std::vector<std::vector<std::pair<std::string, int>>> CorridorRuns(const std::vector<std::string>& flags, int last,
-                                                                   bool teach_frames = false) {
+                                                                   bool teach_frames = false,
+                                                                   const std::vector<int>& repeat_frames = {}) {
   const fs::path data = Shared() / "data/corridor_conditions";
   if (Shared().empty() || !fs::exists(data)) return {};
   ::vmap::testing::ScopedTempDir tmp;
   std::string out;
   EXPECT_EQ(RunVmap("build " + Quote(data / "teach") + " -q -o " + Quote(tmp.path() / "map"), &out), 0) << out;
+  std::string query = Quote(data / "repeat") + " --last " + std::to_string(last);
+  if (!repeat_frames.empty()) {
+    const fs::path folder = tmp.path() / "carried";
+    fs::create_directories(folder);
+    for (size_t i = 0; i < repeat_frames.size(); ++i) {
+      char name[32], link[32];
+      std::snprintf(name, sizeof(name), "%07d.jpg", repeat_frames[i]);
+      std::snprintf(link, sizeof(link), "%07zu.jpg", i);
+      fs::create_symlink(data / "repeat" / name, folder / link);
+    }
+    query = Quote(folder);
+  }
   std::vector<std::vector<std::pair<std::string, int>>> runs;
   for (const std::string& f : flags) {
     const fs::path csv = tmp.path() / "run.csv";
-    EXPECT_EQ(RunVmap("localize " + Quote(tmp.path() / "map") + " " + Quote(data / "repeat") + " --last " +
-                          std::to_string(last) + " -q --csv " + Quote(csv) + f,
-                      &out),
-              0)
+    EXPECT_EQ(RunVmap("localize " + Quote(tmp.path() / "map") + " " + query + " -q --csv " + Quote(csv) + f, &out), 0)
         << out;
     std::vector<std::pair<std::string, int>> frames;
     const std::vector<std::string> rows = Lines(csv);
@@ -409,6 +421,30 @@ TEST(LocalizeCli, GuidedMatchingAsksWhereTheEstimateWasDroppedWhileLost) {
   const std::vector<int> steered = SteeredOnCorridor({"", " --no-guided-while-lost"}, 45);
   if (steered.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   EXPECT_GE(steered[0], steered[1] + 1) << "asked while lost " << steered[0] << ", not " << steered[1];
+}
+
+TEST(LocalizeCli, AFarPlaceALostFrameVerifiedIsAskedAgain) {
+  // corridor_conditions with ORB (docs/localize.md, "A rival place is asked again while the frames are not steered
+  // by"): repeat frames 30-50 and then 80-95 as one run, the robot carried 30 frames on. After the jump nothing
+  // verifies where the tracker holds the frames; the run's frame 25 (repeat frame 84) verifies key image 36, a far
+  // place one frame does not move the tracker to, and the ranking did not bring it back on the frames after it. Asked
+  // again, its evidence moves the belief and the tracker there two frames later; without it the frames stay uncertain
+  // until the estimate is dropped (repeat frame 93).
+  std::vector<int> repeat_frames;
+  for (int i = 30; i <= 50; ++i) repeat_frames.push_back(i);
+  for (int i = 80; i <= 95; ++i) repeat_frames.push_back(i);
+  const auto runs = CorridorRuns({" --start-key 10", " --start-key 10 --no-rival-place-when-not-steered"}, 0,
+                                 /*teach_frames=*/true, repeat_frames);
+  if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  std::vector<int> near(2, 0), far(2, 0);
+  for (int r = 0; r < 2; ++r) {
+    for (size_t i = 21; i < runs[r].size(); ++i) {  // the frames after the jump
+      if (!SteeredBy(runs[r][i])) continue;
+      (std::abs(runs[r][i].second - repeat_frames[i]) <= 5 ? near : far)[r] += 1;
+    }
+  }
+  EXPECT_EQ(far[0], 0);
+  EXPECT_GE(near[0], near[1] + 4) << "steered by near their place: asked again " << near[0] << ", not " << near[1];
 }
 
 TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {

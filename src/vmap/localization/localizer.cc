@@ -145,6 +145,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   steps_on_ = 0;
   pointed_before_ = std::exchange(pointed_, -1);
   LocalizationResult result = has_estimate() ? Track(frame, features) : Reacquire(frame, features);
+  CompareRivalPlace(result, features);
   // A hint is checked: the frame's evidence over the whole route weighs where the run is.
   if (start_unconfirmed_ && start_checked_over_route_) CompareBestRanked(frame, features);
   Believe(result, frame, features);
@@ -372,7 +373,10 @@ void Localizer::RememberRivalPlace(const LocalizationResult& result) {
   if (rival_place_ >= 0 && --rival_frames_left_ <= 0) rival_place_ = -1;
   const bool placed =
       result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized;
-  if (options_.rival_place_frames <= 0 || !placed || result.route_position < 0) return;
+  if (options_.rival_place_frames <= 0 || (!placed && !options_.rival_place_when_not_steered) ||
+      result.route_position < 0) {
+    return;
+  }
   const int rival = OutVerifiedFrom(result);
   if (rival < 0) return;
   rival_place_ = rival;

@@ -170,9 +170,13 @@ class Localizer {
   // position `from` to `to`; when not, remembers `to` for the next frame. Only with the belief on (belief.window and
   // min_confidence above 0).
   bool TakesJump(int from, int to, int lost_frames);
-  // Remembers the far place the frame's comparisons verified more at than the key images it is steered by
-  // (rival_place_), or counts down the one remembered.
+  // Remembers the far place the frame's comparisons verified more at than the key images it is steered by (or, for a
+  // frame not steered by, than its key images: rival_place_when_not_steered) as rival_place_, or counts down the one
+  // remembered.
   void RememberRivalPlace(const LocalizationResult& result);
+  // A frame not steered by compares the rival place (it and the key image after it), whose evidence then weighs the
+  // belief; Track compares it for the frames it tracks (rival_place_when_not_steered).
+  void CompareRivalPlace(const LocalizationResult& result, const ImageFeatures& features);
   // The route position, more than kNear from the result's, of the frame's accepted comparison that verified the most
   // matches, more than the result's key images; -1: none.
   int OutVerifiedFrom(const LocalizationResult& result) const;

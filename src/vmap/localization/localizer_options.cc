@@ -46,6 +46,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Frames a far key image that verified more than the one a frame was steered by is compared again; "
                  "a tracked frame it out-verifies again is relocalized (0 = never)"},
                 rival_place_frames);
+  visitor.Visit({"rival_place_when_not_steered", "!--no-rival-place-when-not-steered",
+                 "Remember and compare a far key image a lost or uncertain frame verified as a rival place too "
+                 "(otherwise only frames steered by remember one)"},
+                rival_place_when_not_steered);
   visitor.Visit({"start_key", "--start-key",
                  "The key image the run starts at (teach and repeat: 0, the route's first): the tracker starts there "
                  "and the belief leans there, which the frames' evidence overrides (-1 = anywhere)"},

@@ -64,6 +64,13 @@ struct LocalizerOptions {
   // image is. Where the corridor repeats itself, a wrong place verifies as much as a right one, and is questioned
   // only when something else is compared (docs/localize.md, "A rival place is asked again"). 0: never.
   int rival_place_frames = 3;
+  // A frame not steered by (lost or uncertain) remembers a rival place too: any far key image its comparisons accepted
+  // (it verifies more than the frame's key images, which verify nothing a robot may steer by), and compares the one
+  // remembered, as a tracked frame does. A robot carried along the route verifies nothing where the tracker holds it,
+  // and the ranking's five seldom hold its new place twice in a row: once verified there, the place is asked again and
+  // its evidence weighs the belief until the belief moves the estimate there (docs/localize.md, "A rival place is
+  // asked again while the frames are not steered by"). Off: only frames steered by remember one.
+  bool rival_place_when_not_steered = true;
   // Key images compared beyond `next_key` when the frame has passed it (1 or 2: the issue's "next one or two").
   int lookahead = 2;
   // While tracking, also compare the key image before `key` when the frame is nearer `key` than `next_key`

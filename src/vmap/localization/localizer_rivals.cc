@@ -1,7 +1,8 @@
 // The acceptance of a frame against its own rivals (LocalizerOptions::min_rival_ratio): the map's links are of one
 // season, and across seasons they refuse every key image a frame is compared with, the right one too. The key image
 // that stands far above those compared elsewhere on the route is then accepted: it is the frame's place, not only
-// its scene, as far as the frame itself can tell.
+// its scene, as far as the frame itself can tell. And the rival place (LocalizerOptions::rival_place_frames) compared
+// by the frames not steered by.
 #include <algorithm>
 #include <cstdlib>
 
@@ -81,6 +82,14 @@ int Localizer::AcceptAgainstRivals(const Frame& frame, const ImageFeatures& feat
   if (!StandsOut(comparisons_[best].comparison.num_verified, RivalVerified(frame, features, position))) return -1;
   comparisons_[best].comparison.accepted = true;
   return position;
+}
+
+void Localizer::CompareRivalPlace(const LocalizationResult& result, const ImageFeatures& features) {
+  const bool steered =
+      result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized;
+  if (!options_.rival_place_when_not_steered || steered || rival_place_ < 0) return;
+  const int last = static_cast<int>(route_.size()) - 1;
+  for (int q = rival_place_; q <= std::min(last, rival_place_ + 1); ++q) CompareOnce(features, route_[q]);
 }
 
 }  // namespace vmap
