@@ -13,7 +13,10 @@ the log odds of an unmatched one; subtracting the log prior odds gives log likel
 pooled, and the false acceptance rate (wrong among those accepted) of the localizer's acceptance rule and of the
 fitted ratio above 0.
 
-usage: bench/evidence_fit.py DIR [--corridor-map-orb MAP] [--corridor-map-xfeat MAP] [--lo -5] [--hi 12]"""
+With --rank, also the ranking's evidence on the corridor (EvidenceModel::rank_alone and the model of a comparison given
+its rank; docs/localize.md, "The ranking is evidence").
+
+usage: bench/evidence_fit.py DIR [--corridor-map-orb MAP] [--corridor-map-xfeat MAP] [--lo -5] [--hi 12] [--rank]"""
 import argparse, csv, json, math, os, sys
 
 import numpy as np
@@ -85,6 +88,40 @@ def report(name, rows, lo, hi):
     return w, prior
 
 
+RANK_BUCKETS = ((0, 0), (1, 2), (3, 4), (5, 9), (10, 1 << 30))  # localization/route_evidence.cc, RankBucket
+
+
+def rank_bucket(rank):
+    return next(b for b, (lo, hi) in enumerate(RANK_BUCKETS) if lo <= rank <= hi)
+
+
+def report_rank(name, path, right_of, lo, hi):
+    """The ranking as evidence (EvidenceModel::rank_alone, rank_given): the log ratio of each rank bucket alone, and a
+    matched comparison's model given its rank (bucket indicators beside s and the share; the last bucket the base)."""
+    alone_right, alone_wrong = [0] * len(RANK_BUCKETS), [0] * len(RANK_BUCKETS)
+    x, y = [], []
+    with open(path) as f:
+        for r in csv.DictReader(f):
+            right = 1 if right_of(r) else 0
+            bucket = rank_bucket(int(r["rank"]))
+            (alone_right if right else alone_wrong)[bucket] += 1
+            if int(r["matched"]):
+                s = min(max(-float(r["log10_nfa"]), lo), hi)
+                link = int(r["link_verified"])
+                share = min(1.0, int(r["verified"]) / link) if link > 0 else 0.0
+                x.append([1.0, s, share] + [1.0 if bucket == b else 0.0 for b in range(len(RANK_BUCKETS) - 1)])
+                y.append(right)
+    right, wrong = sum(alone_right), sum(alone_wrong)
+    prior = math.log(right / wrong)
+    alone = [math.log(((alone_right[b] + 0.5) / right) / ((alone_wrong[b] + 0.5) / wrong)) for b in range(len(RANK_BUCKETS))]
+    w = logistic(np.array(x), np.array(y, dtype=float))
+    print("%s, the ranking: rank_alone (ranks %s) = %s" % (
+        name, ", ".join("%d-%d" % b if b[1] < 1 << 20 else "%d+" % b[0] for b in RANK_BUCKETS),
+        ", ".join("%.2f" % a for a in alone)))
+    print("    given the rank: llr = %.3f + %.3f s + %.3f share + rank_given (%s, 0)" % (
+        w[0] - prior, w[1], w[2], ", ".join("%.2f" % c for c in w[3:])))
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("directory")
@@ -92,6 +129,8 @@ def main():
     parser.add_argument("--corridor-map-xfeat")
     parser.add_argument("--lo", type=float, default=-5.0)
     parser.add_argument("--hi", type=float, default=12.0)
+    parser.add_argument("--rank", action="store_true",
+                        help="also the ranking's evidence on the corridor (the dump's `rank` column)")
     args = parser.parse_args()
     pooled = []
     for matcher in ("orb", "xfeat"):
@@ -110,6 +149,8 @@ def main():
 
             rows = load(path, right)
             report("corridor %s" % matcher, rows, args.lo, args.hi)
+            if args.rank:
+                report_rank("corridor %s" % matcher, path, right, args.lo, args.hi)
             pooled += rows
         path = os.path.join(args.directory, "michigan_%s.csv" % matcher)
         if os.path.exists(path):

@@ -80,6 +80,7 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   const cv::Mat descriptors = keys_.features.front()->descriptors();
   const bool binary = !descriptors.empty() && descriptors.depth() == CV_8U;
   evidence_ = binary ? BinaryDescriptorEvidence() : FloatDescriptorEvidence();
+  if (!options_.rank_evidence) evidence_.rank_alone.clear();
   start_checked_over_route_ = binary;
   nfa_ranks_key_images_ = binary;
   if (options_.guided_matching && matcher_.name() == OrbMatcherOptions::kModelName) {
@@ -119,6 +120,7 @@ void Localizer::Reset() {
   if (start_position_ >= 0) belief_.Start(start_position_, options_.start_mass);
   start_unconfirmed_ = start_position_ >= 0 && options_.start_is_hint;
   pointed_ = pointed_before_ = -1;
+  confident_peak_ = confident_peak_before_ = -1;
   rival_place_ = -1;
   rival_frames_left_ = 0;
   position_ = start_position_;
@@ -134,6 +136,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   const auto start = std::chrono::steady_clock::now();
   comparisons_.clear();
   ranked_.clear();
+  rank_of_position_.clear();
   for (KeyComparison& c : ahead) {
     if (c.key >= 0 && c.key < static_cast<int>(keys_.features.size())) comparisons_.push_back({std::move(c), false});
   }
@@ -142,6 +145,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   // Guided matching asks where the estimate was dropped for max_lost_frames frames (guided_while_lost).
   if (dropped_position_ >= 0 && ++frames_since_drop_ > options_.max_lost_frames) dropped_position_ = -1;
   belief_confident_ = SinglesOut(belief_.Peak());
+  confident_peak_before_ = std::exchange(confident_peak_, belief_confident_ ? belief_.Peak() : -1);
   steps_on_ = 0;
   pointed_before_ = std::exchange(pointed_, -1);
   LocalizationResult result = has_estimate() ? Track(frame, features) : Reacquire(frame, features);

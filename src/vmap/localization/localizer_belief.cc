@@ -17,14 +17,16 @@ constexpr double kRecordedMass = 0.01;
 }  // namespace
 
 void Localizer::WeighComparisons() {
-  bool weighed = false;
+  bool weighed = WeighRanking();
   for (Memo& m : comparisons_) {
     if (!m.used || m.weighed) continue;
     m.weighed = weighed = true;
     const int key = m.comparison.key;
     const int position = route_position_of_key_[key];
     if (position < 0) continue;
-    const double log_ratio = EvidenceLogRatio(evidence_, m.comparison, link_verified_[key]);
+    m.weighed_ranked = !rank_of_position_.empty();
+    const int rank = m.weighed_ranked ? rank_of_position_[position] : -1;
+    const double log_ratio = EvidenceLogRatio(evidence_, m.comparison, link_verified_[key], rank);
     belief_.Weigh(position, log_ratio);
     if (start_unconfirmed_) evidence_belief_.Weigh(position, log_ratio);
   }
@@ -32,6 +34,29 @@ void Localizer::WeighComparisons() {
     belief_.Normalize();
     if (start_unconfirmed_) evidence_belief_.Normalize();
   }
+}
+
+bool Localizer::WeighRanking() {
+  if (ranked_.empty() || !rank_of_position_.empty() || evidence_.rank_alone.empty()) return false;
+  rank_of_position_.assign(route_.size(), static_cast<int>(route_.size()));
+  for (size_t r = 0; r < ranked_.size(); ++r) rank_of_position_[ranked_[r].key] = static_cast<int>(r);
+  auto weigh = [&](int position, double log_ratio) {
+    belief_.Weigh(position, log_ratio);
+    if (start_unconfirmed_) evidence_belief_.Weigh(position, log_ratio);
+  };
+  for (size_t p = 0; p < route_.size(); ++p) weigh(static_cast<int>(p), RankLogRatio(evidence_, rank_of_position_[p]));
+  // A comparison weighed before the frame was ranked said what its rank now says in part: it weighs what it adds to
+  // the rank instead.
+  for (Memo& m : comparisons_) {
+    if (!m.weighed || m.weighed_ranked) continue;
+    m.weighed_ranked = true;
+    const int key = m.comparison.key;
+    const int position = route_position_of_key_[key];
+    if (position < 0) continue;
+    weigh(position, EvidenceLogRatio(evidence_, m.comparison, link_verified_[key], rank_of_position_[position]) -
+                        EvidenceLogRatio(evidence_, m.comparison, link_verified_[key]));
+  }
+  return true;
 }
 
 bool Localizer::SinglesOut(const RouteBelief& belief, int position) const {
@@ -137,6 +162,14 @@ void Localizer::Question(LocalizationResult& result, const Frame& frame, const I
   }
   const int peak = belief_.Peak();
   if (!doubted() || !SinglesOut(peak)) return;
+  // Where the ranking weighs the belief (XFeat), one frame's ranking can single out a place: a key image where the
+  // corridor repeats itself ranks first on a dark frame. One frame's evidence is not yet a place: the belief moves the
+  // estimate only where it had singled out the place before the evidence of the frame before this one too. (ORB's
+  // belief, weighed by its comparisons alone, moves on one frame: two cost corridor_conditions' runs frames.)
+  if (options_.belief.move_needs_two_frames && !evidence_.rank_alone.empty() &&
+      (confident_peak_before_ < 0 || std::abs(confident_peak_before_ - peak) > kNear)) {
+    return;
+  }
   // A frame the tracker relocalized elsewhere on a verified key image: one frame does not undo the run before it
   // (a chance match looks alike), but the robot may have been carried. The tracker goes on from the new place, so
   // that the frames after it confirm or refute it; the frame is uncertain, its best guess the belief's peak.

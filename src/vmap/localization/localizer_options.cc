@@ -50,6 +50,9 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Remember and compare a far key image a lost or uncertain frame verified as a rival place too "
                  "(otherwise only frames steered by remember one)"},
                 rival_place_when_not_steered);
+  visitor.Visit({"rank_evidence", "!--no-rank-evidence",
+                 "XFeat: never weigh the belief by the relocalization's ranking of a frame (the comparisons alone)"},
+                rank_evidence);
   visitor.Visit({"start_key", "--start-key",
                  "The key image the run starts at (teach and repeat: 0, the route's first): the tracker starts there "
                  "and the belief leans there, which the frames' evidence overrides (-1 = anywhere)"},

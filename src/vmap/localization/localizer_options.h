@@ -71,6 +71,11 @@ struct LocalizerOptions {
   // its evidence weighs the belief until the belief moves the estimate there (docs/localize.md, "A rival place is
   // asked again while the frames are not steered by"). Off: only frames steered by remember one.
   bool rival_place_when_not_steered = true;
+  // Where a frame was ranked (a relocalization, a question of the belief, a rival), the ranking weighs the belief too:
+  // each key image by its rank, and a comparison by what it adds to its rank (EvidenceModel::rank_alone; fitted for
+  // float descriptors, XFeat, on every pair of corridor_conditions: docs/localize.md, "The ranking is evidence"). Off:
+  // the comparisons alone weigh it.
+  bool rank_evidence = true;
   // Key images compared beyond `next_key` when the frame has passed it (1 or 2: the issue's "next one or two").
   int lookahead = 2;
   // While tracking, also compare the key image before `key` when the frame is nearer `key` than `next_key`

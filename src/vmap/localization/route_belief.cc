@@ -19,6 +19,10 @@ void RouteBeliefOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "When the belief doubts the key image, compare key images this many places around the belief's "
                  "peak and move there when it is singled out (0: the belief never moves the estimate)"},
                 window);
+  visitor.Visit(
+      {"move_needs_two_frames", "!--belief-moves-on-one-frame",
+       "Move the estimate to the belief's peak when the belief singles it out on one frame (not two running)"},
+      move_needs_two_frames);
   visitor.Visit({"stay"}, stay);
   visitor.Visit({"forward"}, forward);
   visitor.Visit({"forward2"}, forward2);

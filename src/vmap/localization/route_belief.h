@@ -34,6 +34,10 @@ struct RouteBeliefOptions {
   // with the best-ranked ones of the whole route when the belief is flat; the estimate then moves to the belief's
   // peak when the belief singles it out. 0: the belief never moves the estimate (it only flags frames).
   int window = 2;
+  // Where the ranking weighs the belief (LocalizerOptions::rank_evidence, XFeat), the estimate moves to the belief's
+  // peak only when the belief had singled that place out (within two positions) before the evidence of the frame
+  // before this one too: one frame's ranking is not yet a place. Off: one frame (always with ORB).
+  bool move_needs_two_frames = true;
 
   // As a localization run records them ("options.belief"); min_confidence has a flag.
   void VisitFields(OptionFieldVisitor& visitor);

@@ -289,5 +289,58 @@ TEST(VmapXfeat, AFarPlaceThatVerifiedMoreIsAskedAgain) {
                                   << not_asked;
 }
 
+// The ranking is evidence (docs/localize.md): corridor_conditions' repeat frames 70-82 against an XFeat map of its
+// teach run, started at teach frame 70's key image. Frames 76-77 verify key image 29 (where the corridor repeats
+// itself) at log10 NFA -18 and -19, and on frame 78 the comparisons alone leave the belief in doubt at the right key
+// image; the frame's ranking puts the right key images 23, 25 and 22 first.
+TEST(VmapXfeat, TheRankingWeighsTheBelief) {
+  SKIP_WITHOUT_SHARED();
+  const fs::path data = fs::path(SharedDir()) / "data/corridor_conditions";
+  if (!fs::exists(data)) GTEST_SKIP() << data << " is not present";
+  const TempDir dir("rank_evidence");
+  const fs::path map = dir.path() / "map";
+  const std::vector<int> sources = BuildCorridorMap(data, map);
+  ASSERT_FALSE(sources.empty());
+  auto steered_right = [&](const std::string& flags) {
+    int right = 0;
+    for (const auto& [frame, key] : SteeredFrames(
+             ::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(data / "repeat") +
+                 " --first 70 --last 82 --start-key " + std::to_string(KeysAround(sources, 70).front()) + flags,
+             dir.path() / "run.csv")) {
+      const std::vector<int> keys = RightKeys(sources, frame);
+      right += std::find(keys.begin(), keys.end(), key) != keys.end();
+    }
+    return right;
+  };
+  const int ranked = steered_right(""), comparisons_alone = steered_right(" --no-rank-evidence");
+  EXPECT_GE(ranked, comparisons_alone + 1) << "steered by at a right key image: with the ranking " << ranked
+                                           << ", the comparisons alone " << comparisons_alone;
+}
+
+// One frame's ranking is not yet a place (docs/localize.md, "The ranking is evidence"): corridor_conditions' repeat
+// frames 44-60, started at teach frame 45's key image. Frames 51-54 are dark and verify little anywhere; on frame 53
+// key image 29 ranks first and verifies 22 matches at log10 NFA -19, and the belief singles out its place on that frame
+// alone. Moved there on one frame, frame 54 was relocalized at key image 29 (right: 14-15).
+TEST(VmapXfeat, OneFramesRankingIsNotYetAPlace) {
+  SKIP_WITHOUT_SHARED();
+  const fs::path data = fs::path(SharedDir()) / "data/corridor_conditions";
+  if (!fs::exists(data)) GTEST_SKIP() << data << " is not present";
+  const TempDir dir("two_frames");
+  const fs::path map = dir.path() / "map";
+  const std::vector<int> sources = BuildCorridorMap(data, map);
+  ASSERT_FALSE(sources.empty());
+  auto steered_far = [&](const std::string& flags) {
+    return SteeredFar(sources,
+                      SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(data / "repeat") +
+                                        " --first 44 --last 60 --start-key " +
+                                        std::to_string(KeysAround(sources, 45).front()) + flags,
+                                    dir.path() / "run.csv"),
+                      [](int frame) { return frame; });
+  };
+  EXPECT_EQ(steered_far(""), 0);
+  EXPECT_GE(steered_far(" --belief-moves-on-one-frame"), 1)
+      << "the test no longer reaches a place one frame singles out";
+}
+
 }  // namespace
 }  // namespace vmap::neural
