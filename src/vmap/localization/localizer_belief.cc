@@ -39,6 +39,7 @@ void Localizer::WeighComparisons() {
 bool Localizer::WeighRanking() {
   if (ranked_.empty() || !rank_of_position_.empty() || evidence_.rank_alone.empty()) return false;
   rank_of_position_.assign(route_.size(), static_cast<int>(route_.size()));
+  // The ranking holds the route's key images in route order: ranked_[r].key is a route position.
   for (size_t r = 0; r < ranked_.size(); ++r) rank_of_position_[ranked_[r].key] = static_cast<int>(r);
   auto weigh = [&](int position, double log_ratio) {
     belief_.Weigh(position, log_ratio);
