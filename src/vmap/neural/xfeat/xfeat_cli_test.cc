@@ -200,6 +200,16 @@ int SteeredFar(const std::vector<int>& sources, const std::vector<std::pair<int,
   return far;
 }
 
+// How many of `steered` (repeat frame, key) are at a right key image.
+int SteeredRight(const std::vector<int>& sources, const std::vector<std::pair<int, int>>& steered) {
+  int right = 0;
+  for (const auto& [frame, key] : steered) {
+    const std::vector<int> keys = RightKeys(sources, frame);
+    right += std::find(keys.begin(), keys.end(), key) != keys.end();
+  }
+  return right;
+}
+
 // A robot carried off (docs/localize.md, "A lone step back is doubted"): corridor_conditions' repeat frames 90-110 and
 // then 20-25 as one run (carried 70 frames back) against an XFeat map of its teach run, started at teach frame 90's
 // key image. On the first frame after the jump nothing verifies at the key images where the run was but the one
@@ -253,15 +263,11 @@ TEST(VmapXfeat, AStepOnOnATieIsNotTaken) {
   ASSERT_FALSE(sources.empty());
   // Frames steered by at a right key image.
   auto steered_right = [&](const std::string& flags) {
-    int right = 0;
-    for (const auto& [frame, key] : SteeredFrames(
-             ::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(data / "repeat") +
-                 " --first 26 --last 40 --start-key " + std::to_string(KeysAround(sources, 26).front()) + flags,
-             dir.path() / "run.csv")) {
-      const std::vector<int> keys = RightKeys(sources, frame);
-      right += std::find(keys.begin(), keys.end(), key) != keys.end();
-    }
-    return right;
+    return SteeredRight(sources,
+                        SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(data / "repeat") +
+                                          " --first 26 --last 40 --start-key " +
+                                          std::to_string(KeysAround(sources, 26).front()) + flags,
+                                      dir.path() / "run.csv"));
   };
   const int needs_more = steered_right(""), on_tie = steered_right(" --step-on-on-tie");
   EXPECT_GE(needs_more, on_tie + 2) << "steered by at a right key image: needs more " << needs_more << ", on a tie "
@@ -309,15 +315,11 @@ TEST(VmapXfeat, TheRankingWeighsTheBelief) {
   const std::vector<int> sources = BuildCorridorMap(data, map);
   ASSERT_FALSE(sources.empty());
   auto steered_right = [&](const std::string& flags) {
-    int right = 0;
-    for (const auto& [frame, key] : SteeredFrames(
-             ::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(data / "repeat") +
-                 " --first 70 --last 82 --start-key " + std::to_string(KeysAround(sources, 70).front()) + flags,
-             dir.path() / "run.csv")) {
-      const std::vector<int> keys = RightKeys(sources, frame);
-      right += std::find(keys.begin(), keys.end(), key) != keys.end();
-    }
-    return right;
+    return SteeredRight(sources,
+                        SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(data / "repeat") +
+                                          " --first 70 --last 82 --start-key " +
+                                          std::to_string(KeysAround(sources, 70).front()) + flags,
+                                      dir.path() / "run.csv"));
   };
   const int ranked = steered_right(""), comparisons_alone = steered_right(" --no-rank-evidence");
   EXPECT_GE(ranked, comparisons_alone + 1) << "steered by at a right key image: with the ranking " << ranked
