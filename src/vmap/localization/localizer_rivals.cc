@@ -92,4 +92,36 @@ void Localizer::CompareRivalPlace(const LocalizationResult& result, const ImageF
   for (int q = rival_place_; q <= std::min(last, rival_place_ + 1); ++q) CompareOnce(features, route_[q]);
 }
 
+void Localizer::RememberRivalPlace(const LocalizationResult& result) {
+  if (rival_place_ >= 0 && --rival_frames_left_ <= 0) rival_place_ = -1;
+  const bool placed =
+      result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized;
+  if (options_.rival_place_frames <= 0 || (!placed && !options_.rival_place_when_not_steered) ||
+      result.route_position < 0) {
+    return;
+  }
+  const int rival = OutVerifiedFrom(result);
+  if (rival < 0) return;
+  rival_place_ = rival;
+  rival_frames_left_ = options_.rival_place_frames;
+}
+
+int Localizer::OutVerifiedFrom(const LocalizationResult& result) const {
+  int most = 0;  // the verified matches of the key images the frame is placed at
+  for (const KeyComparison* c : {&result.to_key, &result.to_next}) {
+    if (c->accepted) most = std::max(most, c->num_verified);
+  }
+  int rival = -1;
+  for (const Memo& m : comparisons_) {
+    const KeyComparison& c = m.comparison;
+    const int p = route_position_of_key_[c.key];
+    if (!m.used || !c.accepted || p < 0 || std::abs(p - result.route_position) <= kNear) continue;
+    if (c.num_verified > most) {
+      most = c.num_verified;
+      rival = p;
+    }
+  }
+  return rival;
+}
+
 }  // namespace vmap
