@@ -11,8 +11,7 @@ FrameOdometry OdometryProgress::Update(const LocalizationResult& result) {
   odometry.valid = true;
   odometry.pose = *pose;
   odometry.distance = track_.DistanceAt(result.timestamp);
-  const bool located =
-      result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized;
+  const bool located = IsPlaced(result.status);
   if (located && result.key >= 0 && result.key != key_) {
     key_ = result.key;
     key_reached_at_ = odometry.distance;

@@ -141,8 +141,7 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
 
   // Only frames verified at a key image of this route are steered by: a lost or uncertain frame's key images are
   // a guess (LocalizationGuidance), and so is a heading without them.
-  const bool located =
-      localization.status == LocalizationStatus::kTracking || localization.status == LocalizationStatus::kRelocalized;
+  const bool located = IsPlaced(localization.status);
   const int position = located ? route_.PositionOf(localization.key) : -1;
   const double heading_offset = HeadingOffset(localization, focal_px_);
   const bool usable = position >= 0 && std::isfinite(heading_offset);

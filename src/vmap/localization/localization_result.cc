@@ -16,8 +16,7 @@ std::string LocalizationGuidance(const LocalizationResult& result) {
 }
 
 bool MaySteerBy(const LocalizationResult& result) {
-  return (result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized) &&
-         std::isfinite(result.heading_px);
+  return IsPlaced(result.status) && std::isfinite(result.heading_px);
 }
 
 }  // namespace vmap

@@ -25,6 +25,11 @@ inline constexpr EnumName<LocalizationStatus> kLocalizationStatusNames[] = {
     {LocalizationStatus::kLost, "lost"},
     {LocalizationStatus::kUncertain, "uncertain"}};
 std::string LocalizationStatusName(LocalizationStatus status);
+// Placed: verified at a key image of the route and not doubted, the only frames a robot may steer by (with a
+// heading: MaySteerBy) and the only ones that move the estimate's own key image.
+constexpr bool IsPlaced(LocalizationStatus status) {
+  return status == LocalizationStatus::kTracking || status == LocalizationStatus::kRelocalized;
+}
 
 // A key image the ranking proposed when relocalizing, and how its verification went.
 struct RelocalizationCandidate {

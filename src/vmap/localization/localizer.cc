@@ -154,7 +154,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   if (start_unconfirmed_ && start_checked_over_route_) CompareBestRanked(frame, features);
   Believe(result, frame, features);
   RememberRivalPlace(result);
-  if (result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized) {
+  if (IsPlaced(result.status)) {
     dropped_position_ = -1;  // steered by again: the drop is behind
   }
   result.comparisons =

@@ -86,8 +86,7 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
   }
   if (result.route_position < 0) return;
   result.confidence = belief_.MassWithin(result.route_position, kNear);
-  const bool placed =
-      result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized;
+  const bool placed = IsPlaced(result.status);
   if (placed && (result.confidence < options_.belief.min_confidence || EvidencePointsAway(result.route_position))) {
     result.status = LocalizationStatus::kUncertain;
   }

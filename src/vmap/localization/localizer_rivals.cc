@@ -85,8 +85,7 @@ int Localizer::AcceptAgainstRivals(const Frame& frame, const ImageFeatures& feat
 }
 
 void Localizer::CompareRivalPlace(const LocalizationResult& result, const ImageFeatures& features) {
-  const bool steered =
-      result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized;
+  const bool steered = IsPlaced(result.status);
   if (!options_.rival_place_when_not_steered || steered || rival_place_ < 0) return;
   const int last = static_cast<int>(route_.size()) - 1;
   for (int q = rival_place_; q <= std::min(last, rival_place_ + 1); ++q) CompareOnce(features, route_[q]);
@@ -94,8 +93,7 @@ void Localizer::CompareRivalPlace(const LocalizationResult& result, const ImageF
 
 void Localizer::RememberRivalPlace(const LocalizationResult& result) {
   if (rival_place_ >= 0 && --rival_frames_left_ <= 0) rival_place_ = -1;
-  const bool placed =
-      result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized;
+  const bool placed = IsPlaced(result.status);
   if (options_.rival_place_frames <= 0 || (!placed && !options_.rival_place_when_not_steered) ||
       result.route_position < 0) {
     return;

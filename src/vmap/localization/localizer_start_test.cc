@@ -104,7 +104,7 @@ TEST(Localizer, ARunStartedElsewhereIsNotTrappedAtTheStartKey) {
     if (index == 0) continue;  // the first frame may doubt a far place (uncertain), the second confirms it
     EXPECT_TRUE(Bracketed(source_index, r.key)) << source_index << " at key " << r.key;
     EXPECT_TRUE(Bracketed(source_index, a.key)) << source_index << " at key " << a.key;
-    steered += r.status == LocalizationStatus::kTracking || r.status == LocalizationStatus::kRelocalized;
+    steered += IsPlaced(r.status);
   }
   EXPECT_EQ(steered, index - 1);
 }
