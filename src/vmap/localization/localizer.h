@@ -129,6 +129,10 @@ class Localizer {
   // one teach frame apart or across seasons, are not told apart by one frame's matches; the frames before it and the
   // motion prior are). Two on: back when it holds more on segment k - 1 than on k (one key image a frame is likelier).
   void SettleStepOn(LocalizationResult& result, const ImageFeatures& features);
+  // The mirror of SettleStepOn (LocalizerOptions::step_on_by_belief): a frame tracked at key image k moves on to k + 1
+  // when the belief holds more on the segments from k + 1 on than on segments k and k - 1 (the frame is past k + 1
+  // more likely than before it) and k + 1 verifies; again for k + 2, up to `lookahead` key images.
+  void StepOnByBelief(LocalizationResult& result, const ImageFeatures& features);
   // When the belief doubts the frame's position: compares around the belief's peak (over the whole route when
   // it is flat) and moves the estimate to the peak when the belief singles it out.
   // The belief singles out route `position` (not only holds min_confidence near it: also far more than a flat

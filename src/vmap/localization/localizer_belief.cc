@@ -79,6 +79,7 @@ bool Localizer::EvidencePointsAway(int position) const {
 void Localizer::Believe(LocalizationResult& result, const Frame& frame, const ImageFeatures& features) {
   WeighComparisons();
   SettleStepOn(result, features);
+  StepOnByBelief(result, features);
   Question(result, frame, features);
   const std::vector<double>& p = belief_.probabilities();
   for (size_t i = 0; i < p.size() && i < route_.size(); ++i) {
@@ -132,6 +133,35 @@ void Localizer::SettleStepOn(LocalizationResult& result, const ImageFeatures& fe
   settled.status = LocalizationStatus::kTracking;
   result = std::move(settled);
   position_ = passed;
+  step_back_ruled_out_ = {};
+}
+
+void Localizer::StepOnByBelief(LocalizationResult& result, const ImageFeatures& features) {
+  const bool placed =
+      result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized;
+  if (!options_.step_on_by_belief || options_.belief.window <= 0 || !placed || result.route_position < 0) return;
+  const std::vector<double>& p = belief_.probabilities();
+  const int last = static_cast<int>(route_.size()) - 1;
+  const int from = result.route_position;
+  auto mass = [&](int first, int end) {  // positions [first, end)
+    double sum = 0.0;
+    for (int i = std::max(0, first); i < std::min(end, last + 1); ++i) sum += p[i];
+    return sum;
+  };
+  int to = from;
+  for (int q = from; q < last && q + 1 - from <= options_.lookahead; ++q) {
+    // At key image q the frame is on segment q - 1 or q; past key image q + 1, on q + 1 or after.
+    if (mass(q + 1, q + 2 + kNear) <= mass(q - 1, q + 1)) break;
+    if (!CompareOnce(features, route_[q + 1]).accepted) break;
+    to = q + 1;
+  }
+  if (to == from) return;
+  LocalizationResult moved;
+  moved.candidates = std::move(result.candidates);
+  Describe(moved, to, features);
+  moved.status = result.status;
+  result = std::move(moved);
+  position_ = to;
   step_back_ruled_out_ = {};
 }
 

@@ -92,6 +92,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "ORB: step on to the next key image on more verified matches alone, whatever their log10 NFA (as "
                  "before)"},
                 step_on_needs_lower_nfa);
+  visitor.Visit({"step_on_by_belief", "!--no-step-on-by-belief",
+                 "Never move a tracked frame on to the next key image because the belief puts it past that key "
+                 "image (only the verified counts step on)"},
+                step_on_by_belief);
   visitor.Visit({"guided_matching", "!--no-guided-matching",
                  "ORB: never match a frame again with looser matching at the key images the belief holds"},
                 guided_matching);

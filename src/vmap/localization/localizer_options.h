@@ -110,6 +110,12 @@ struct LocalizerOptions {
   // (corridor_conditions frame 103). Float descriptors (XFeat) verify chance matches at most key images, where the NFA
   // ranks nothing: off for them whatever this says. Off: the count alone decides (docs/localize.md).
   bool step_on_needs_lower_nfa = true;
+  // A frame tracked at a key image the belief puts behind it moves on: where the belief, after the frame's evidence,
+  // holds more on the segments past the next key image than on the segment it is on and the one before, and that key
+  // image verifies, the tracker steps on to it (up to `lookahead` key images). Across lighting XFeat verifies as many
+  // matches at the key image left behind as at the one reached, so the count alone keeps the tracker where it was
+  // (docs/localize.md, "A key image the belief puts behind is left"). Off: only the counts step on.
+  bool step_on_by_belief = true;
   // Guided matching (ORB maps): a frame that verifies nothing at the tracked key images while the belief singles
   // out that place is matched with them again, and only with them, keeping one-way best matches too (no cross
   // check); the a-contrario test, which counts every tentative match, decides as before (docs/localize.md,

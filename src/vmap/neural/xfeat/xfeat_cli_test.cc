@@ -351,5 +351,44 @@ TEST(VmapXfeat, OneFramesRankingIsNotYetAPlace) {
       << "the test no longer reaches a place one frame singles out";
 }
 
+// A key image the belief puts behind is left (docs/localize.md): corridor_conditions' repeat frames 100-110 and then
+// 20-30 as one run (a robot carried back 90 frames) against an XFeat map of its teach run, started at teach frame 100's
+// key image. After the jump the tracker is relocalized a key image or two short of the right ones (key images 2-4 are
+// teach frames 6-13, the right ones 4-8), and the counts never step it on: across lighting XFeat verifies as many
+// matches (18-28) at the key image behind as at those ahead, while the belief, weighed by the frames' comparisons and
+// rankings, already holds most of its mass past the next key image.
+TEST(VmapXfeat, AKeyImageTheBeliefPutsBehindIsLeft) {
+  SKIP_WITHOUT_SHARED();
+  const fs::path data = fs::path(SharedDir()) / "data/corridor_conditions";
+  if (!fs::exists(data)) GTEST_SKIP() << data << " is not present";
+  const TempDir dir("carried_back");
+  const fs::path map = dir.path() / "map";
+  const std::vector<int> sources = BuildCorridorMap(data, map);
+  ASSERT_FALSE(sources.empty());
+  std::vector<int> repeat_of;  // run frame -> repeat frame
+  for (int i = 100; i <= 110; ++i) repeat_of.push_back(i);
+  for (int i = 20; i <= 30; ++i) repeat_of.push_back(i);
+  const fs::path run = dir.path() / "run";
+  fs::create_directories(run);
+  for (size_t f = 0; f < repeat_of.size(); ++f) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "%07d.jpg", repeat_of[f]);
+    char link[32];
+    std::snprintf(link, sizeof(link), "%07zu.jpg", f);
+    fs::create_symlink(data / "repeat" / name, run / link);
+  }
+  auto steered_right = [&](const std::string& flags) {
+    std::vector<std::pair<int, int>> steered =
+        SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(run) + " --start-key " +
+                          std::to_string(KeysAround(sources, 100).front()) + flags,
+                      dir.path() / "run.csv");
+    for (auto& [frame, key] : steered) frame = repeat_of.at(frame);
+    return SteeredRight(sources, steered);
+  };
+  const int left = steered_right(""), kept = steered_right(" --no-step-on-by-belief");
+  EXPECT_GE(left, kept + 4) << "steered by at a right key image: the belief stepping on " << left
+                            << ", the counts alone " << kept;
+}
+
 }  // namespace
 }  // namespace vmap::neural
