@@ -131,7 +131,8 @@ class Localizer {
   void SettleStepOn(LocalizationResult& result, const ImageFeatures& features);
   // The mirror of SettleStepOn (LocalizerOptions::step_on_by_belief): a frame tracked at key image k moves on to k + 1
   // when the belief holds more on the segments from k + 1 on than on segments k and k - 1 (the frame is past k + 1
-  // more likely than before it) and k + 1 verifies; again for k + 2, up to `lookahead` key images.
+  // more likely than before it) and k + 1 verifies; again for k + 2, up to `lookahead` key images. Only where the
+  // belief singled out a place before the frame's evidence (belief_confident_).
   void StepOnByBelief(LocalizationResult& result, const ImageFeatures& features);
   // When the belief doubts the frame's position: compares around the belief's peak (over the whole route when
   // it is flat) and moves the estimate to the peak when the belief singles it out.

@@ -137,9 +137,12 @@ void Localizer::SettleStepOn(LocalizationResult& result, const ImageFeatures& fe
 }
 
 void Localizer::StepOnByBelief(LocalizationResult& result, const ImageFeatures& features) {
-  const bool placed =
-      result.status == LocalizationStatus::kTracking || result.status == LocalizationStatus::kRelocalized;
-  if (!options_.step_on_by_belief || options_.belief.window <= 0 || !placed || result.route_position < 0) return;
+  // A flat belief (the frames before this one singled out no place) does not move the tracker: one frame's evidence
+  // leans anywhere (a run's first frame).
+  if (!options_.step_on_by_belief || options_.belief.window <= 0 || !belief_confident_ || !IsPlaced(result.status) ||
+      result.route_position < 0) {
+    return;
+  }
   const std::vector<double>& p = belief_.probabilities();
   const int last = static_cast<int>(route_.size()) - 1;
   const int from = result.route_position;
