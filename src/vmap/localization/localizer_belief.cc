@@ -138,9 +138,11 @@ void Localizer::SettleStepOn(LocalizationResult& result, const ImageFeatures& fe
 
 void Localizer::StepOnByBelief(LocalizationResult& result, const ImageFeatures& features) {
   // A flat belief (the frames before this one singled out no place) does not move the tracker: one frame's evidence
-  // leans anywhere (a run's first frame).
-  if (!options_.step_on_by_belief || options_.belief.window <= 0 || !belief_confident_ || !IsPlaced(result.status) ||
-      result.route_position < 0) {
+  // leans anywhere (a run's first frame). Only where the ranking weighs the belief (XFeat) does the belief know more
+  // than the counts the tracker stepped by; ORB's is weighed by those comparisons alone (redkitchen's teach/repeat run
+  // lost 2 frames steered by at a right key image with it).
+  if (!options_.step_on_by_belief || evidence_.rank_alone.empty() || options_.belief.window <= 0 ||
+      !belief_confident_ || !IsPlaced(result.status) || result.route_position < 0) {
     return;
   }
   const std::vector<double>& p = belief_.probabilities();

@@ -113,7 +113,8 @@ struct LocalizerOptions {
   // A frame tracked at a key image the belief puts behind it moves on: where the belief, after the frame's evidence,
   // holds more on the segments past the next key image than on the segment it is on and the one before, and that key
   // image verifies, the tracker steps on to it (up to `lookahead` key images). Across lighting XFeat verifies as many
-  // matches at the key image left behind as at the one reached, so the count alone keeps the tracker where it was
+  // matches at the key image left behind as at the one reached, so the count alone keeps the tracker where it was.
+  // Only where the ranking weighs the belief (`rank_evidence`, XFeat): ORB's belief holds nothing the counts did not
   // (docs/localize.md, "A key image the belief puts behind is left"). Off: only the counts step on.
   bool step_on_by_belief = true;
   // Guided matching (ORB maps): a frame that verifies nothing at the tracked key images while the belief singles
