@@ -268,6 +268,11 @@ std::vector<std::vector<std::pair<std::string, int>>> CorridorRuns(const std::ve
   return runs;
 }
 
+// Tests of a step back or of guided matching on the corridor measure them without the heading's acceptance, which
+// accepts some of the frames they probe (frames 96-97 tracked at key image 39 either way: docs/localize.md, "A heading
+// that stands out against the frame's rivals").
+const std::string kWithoutHeading = " --min-heading-rival-ratio 0";
+
 bool SteeredBy(const std::pair<std::string, int>& frame) {
   return frame.first == "tracking" || frame.first == "relocalized";
 }
@@ -359,7 +364,8 @@ TEST(LocalizeCli, AStepBackOnTheEdgeOfChanceIsNotTaken) {
   // corridor_conditions with ORB (docs/localize.md, "A step back needs more than chance"): frame 96 verifies nothing
   // at its key image and the two ahead, and the key image behind at log10 NFA -0.05; at chance's own bar (0) the
   // tracker steps back to it, one more frame steered by behind the frame before it.
-  const std::vector<int> back_jumps = BackJumpsOnCorridor({"", " --step-back-max-log10-nfa 0"}, 99);
+  const std::vector<int> back_jumps =
+      BackJumpsOnCorridor({kWithoutHeading, kWithoutHeading + " --step-back-max-log10-nfa 0"}, 99);
   if (back_jumps.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   EXPECT_LT(back_jumps[0], back_jumps[1]) << "back-jumps: -1 " << back_jumps[0] << ", 0 " << back_jumps[1];
 }
@@ -380,7 +386,8 @@ TEST(LocalizeCli, AStepBackWhoseMatchesChanceExplainsBetterIsNotTaken) {
   // corridor_conditions with ORB (docs/localize.md, "A step back or on needs a lower NFA too"): at frame 57 the key
   // image behind verifies 27 matches at log10 NFA -3.6 against the tracked key image's 26 at -12.1, and the count alone
   // took the tracker back, a frame steered by behind the frame before it.
-  const std::vector<int> back_jumps = BackJumpsOnCorridor({"", " --step-back-on-count"}, 60);
+  const std::vector<int> back_jumps =
+      BackJumpsOnCorridor({kWithoutHeading, kWithoutHeading + " --step-back-on-count"}, 60);
   if (back_jumps.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   EXPECT_LT(back_jumps[0], back_jumps[1])
       << "back-jumps: needs a lower NFA " << back_jumps[0] << ", on the count " << back_jumps[1];
@@ -402,7 +409,8 @@ TEST(LocalizeCli, GuidedMatchingOverTheLookaheadKeepsUpWithTheRobot) {
   // tracked key image and the next, and the continuity of the heading held the frames at key image 38 (teach frame 91);
   // asked over the lookahead and ranked by the one-way matches' NFA, they are steered by at key images within 3 teach
   // frames of them.
-  const auto runs = CorridorRuns({"", " --no-guided-lookahead"}, 99, /*teach_frames=*/true);
+  const auto runs =
+      CorridorRuns({kWithoutHeading, kWithoutHeading + " --no-guided-lookahead"}, 99, /*teach_frames=*/true);
   if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   std::vector<int> near;
   for (const auto& run : runs) {
@@ -445,6 +453,56 @@ TEST(LocalizeCli, AFarPlaceALostFrameVerifiedIsAskedAgain) {
   }
   EXPECT_EQ(far[0], 0);
   EXPECT_GE(near[0], near[1] + 4) << "steered by near their place: asked again " << near[0] << ", not " << near[1];
+}
+
+// michigan_seasons as a route (docs/localize.md, "A heading that stands out against the frame's rivals"): a --tau 1
+// map of session 01's five places, another session's five localized against it from key image 0. Across seasons chance
+// refuses ORB's verified sets at most right key images, but their matches agree on one displacement (the heading
+// mode) far more than another place's do: frames that stand out so are steered by at their place, none elsewhere.
+TEST(LocalizeCli, AHeadingThatStandsOutAgainstTheFramesRivalsLocalizesAcrossSeasons) {
+  SKIP_WITHOUT_SHARED();
+  ::vmap::testing::ScopedTempDir tmp;
+  std::string out;
+  auto session = [&](int s) {
+    const fs::path folder = tmp.path() / ("session" + std::to_string(s));
+    fs::create_directories(folder);
+    for (int place = 1; place <= 5; ++place) {
+      char name[16];
+      std::snprintf(name, sizeof(name), "%02d%02d.png", s, place);
+      fs::create_symlink(Shared() / "data/michigan_seasons/images" / name, folder / (std::to_string(place) + ".png"));
+    }
+    return folder;
+  };
+  const fs::path map = tmp.path() / "map";
+  ASSERT_EQ(RunVmap("build " + Quote(session(1)) + " -o " + Quote(map) + " --tau 1 -q", &out), 0) << out;
+  const std::vector<fs::path> queries = {session(2), session(5), session(7), session(9), session(11)};
+  auto right_and_wrong = [&](const std::string& flags) -> std::pair<int, int> {
+    std::pair<int, int> counts = {0, 0};
+    for (const fs::path& query : queries) {
+      const fs::path csv = tmp.path() / "run.csv";
+      EXPECT_EQ(RunVmap("localize " + Quote(map) + " " + Quote(query) + " --start-key 0 -q --csv " + Quote(csv) + flags,
+                        &out),
+                0)
+          << out;
+      const std::vector<std::string> rows = Lines(csv);
+      for (size_t r = 1; r < rows.size(); ++r) {
+        // frame,source_index,timestamp,source_name,status,key,...: frame i was taken at key image i's place
+        std::stringstream row(rows[r]);
+        std::vector<std::string> cells;
+        for (std::string cell; cells.size() < 6 && std::getline(row, cell, ',');) cells.push_back(cell);
+        if (cells.size() < 6) {
+          ADD_FAILURE() << rows[r];
+          continue;
+        }
+        if (!SteeredBy({cells[4], 0})) continue;
+        (std::stoi(cells[5]) == std::stoi(cells[0]) ? counts.first : counts.second) += 1;
+      }
+    }
+    return counts;
+  };
+  const std::pair<int, int> with = right_and_wrong(""), without = right_and_wrong(" --min-heading-rival-ratio 0");
+  EXPECT_GE(with.first, without.first + 4) << "with the heading " << with.first << ", without " << without.first;
+  EXPECT_EQ(with.second, 0) << "steered by at another place";
 }
 
 TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {

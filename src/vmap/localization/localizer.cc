@@ -23,6 +23,19 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // (docs/measurements/code-choices.md, "Ruling out a step back").
 constexpr double kClearlyWorse = 0.7;
 
+// The link's verified matches pass chance as a comparison's must (acceptance.h), one test: the two key images share a
+// scene. Without its matches in memory (a map loaded without them) it is taken to.
+bool OfOneScene(const Link& link, cv::Size from_size, cv::Size to_size, double max_log10_nfa) {
+  if (link.correspondences.empty()) return true;
+  PairComparison pair;
+  pair.matched = true;
+  pair.num_tentative = link.num_tentative;
+  pair.num_verified = link.num_verified;
+  pair.F = link.F;
+  pair.correspondences = link.correspondences;
+  return ChanceOfComparison(pair, from_size, to_size, 1).log10_nfa <= max_log10_nfa;
+}
+
 }  // namespace
 
 Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matcher& matcher, LocalizerOptions options)
@@ -58,6 +71,7 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   CheckStartKey(map_, options_);
   if (options_.start_key >= 0) start_position_ = route_position_of_key_[options_.start_key];
   link_verified_.assign(num_keys, 0);
+  scene_link_after_.assign(route_.size(), false);
   for (const Link& link : map_.links) {
     const int a = link.from_key, b = link.to_key;
     if (a < 0 || b < 0 || a >= num_keys || b >= num_keys || route_position_of_key_[a] < 0 ||
@@ -65,6 +79,11 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
         !link.has_fundamental || link.num_verified <= 0) {
       continue;
     }
+    // A link chance refuses joins two places, not one scene (a --tau 1 map of unrelated places). Its verified count
+    // still bounds the link share: what two unrelated places verify by chance is a floor a frame must pass (with XFeat,
+    // whose chance model passes at most wrong key images, dropping it cost michigan 653 -> 581, 5 frames far).
+    scene_link_after_[std::min(route_position_of_key_[a], route_position_of_key_[b])] =
+        OfOneScene(link, keys_.features[a]->image_size(), keys_.features[b]->image_size(), options_.max_log10_nfa);
     for (const int k : {a, b}) {
       link_verified_[k] = link_verified_[k] > 0 ? std::min(link_verified_[k], link.num_verified) : link.num_verified;
     }
@@ -83,6 +102,7 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   if (!options_.rank_evidence) evidence_.rank_alone.clear();
   start_checked_over_route_ = binary;
   nfa_ranks_key_images_ = binary;
+  heading_accepts_ = binary;
   if (options_.guided_matching && matcher_.name() == OrbMatcherOptions::kModelName) {
     MatcherOptions guided;
     guided.type = OrbMatcherOptions::kModelName;
@@ -441,7 +461,8 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
   // neighbour and the key shares more with the neighbour than the key does, one beyond the key shares less. The
   // ratio makes segments of different lengths comparable (a raw count favours the shorter one).
   int position = best_position;
-  if (position > 0) {
+  // The segment before the key image only where the two share a scene: a frame is not between two unrelated places.
+  if (position > 0 && scene_link_after_[position - 1]) {
     const KeyComparison before = CompareOnce(features, route_[position - 1]);
     const bool has_next = position + 1 < static_cast<int>(route_.size());
     const KeyComparison after = has_next ? CompareOnce(features, route_[position + 1]) : KeyComparison();

@@ -171,6 +171,18 @@ class Localizer {
   // NFA at most rival_max_log10_nfa), and does stand out when it verifies min_rival_ratio times its rivals' best.
   bool MayStandOut(const KeyComparison& comparison) const;
   bool StandsOut(int verified, int rival_verified) const;
+  // Across seasons with binary descriptors (min_heading_rival_ratio): the comparison at route `position` is accepted
+  // where chance refused it when its heading mode holds at least min_heading_votes matches and min_heading_rival_ratio
+  // times the heading votes of every heading rival compared (IsHeadingRival), the best-ranked one compared first when
+  // it was not. Without a rival (a route too short) it is not: the frame cannot tell.
+  bool HeadingStandsOut(const Frame& frame, const ImageFeatures& features, const KeyComparison& comparison,
+                        int position);
+  // Route position `q` is a heading rival of `position`: more than kNear away, or nearer but not joined to it by links
+  // of one scene (scene_link_after_): another place, whose matches agree with the frame's only by chance.
+  bool IsHeadingRival(int position, int q) const;
+  // When nothing else is accepted: the comparison whose heading mode holds the most votes, if HeadingStandsOut.
+  // Returns its route position, -1 when none.
+  int AcceptByHeading(const Frame& frame, const ImageFeatures& features);
 
   // A relocalization far from the tracked estimate (more than kNear route positions, plus `lookahead` for each of
   // the `lost_frames` frames lost since it was tracked): one frame's evidence (across lighting a chance match looks
@@ -219,6 +231,12 @@ class Localizer {
   // Per key image: the verified matches of its link with a route neighbour, the smaller of the two; 0 when it
   // has no verified link on the route (the comparisons against the map's links are then skipped).
   std::vector<int> link_verified_;
+  // Per route position p: the map's link between p and p + 1 is of one scene (its verified matches pass chance, as a
+  // comparison's must). A --tau 1 map of unrelated places has links chance refuses; a teach run's are of one scene.
+  std::vector<bool> scene_link_after_;
+  // Binary descriptors (ORB): a heading mode that stands out against the frame's rivals accepts a comparison
+  // (min_heading_rival_ratio; measured on ORB only).
+  bool heading_accepts_ = false;
   std::unique_ptr<KeyImageRanking> ranking_;
   int position_ = -1;        // route position of `key`; -1: no estimate
   int start_position_ = -1;  // route position of LocalizerOptions::start_key; -1: none
@@ -266,6 +284,10 @@ class Localizer {
     bool used = false;            // counted in LocalizationResult::comparisons
     bool weighed = false;         // its evidence is in the belief
     bool weighed_ranked = false;  // weighed given the frame's ranking (EvidenceModel::rank_alone)
+    // Accepted by its heading mode against the frame's rivals (HeadingStandsOut), and weighed as such
+    // (EvidenceModel::heading_stands_out).
+    bool by_heading = false;
+    bool weighed_by_heading = false;
   };
   std::vector<Memo> comparisons_;  // of the frame being localized
   // The previous frame's headings (px) against the key images it was compared with: (key, heading), those with one.

@@ -19,14 +19,27 @@ constexpr double kRecordedMass = 0.01;
 void Localizer::WeighComparisons() {
   bool weighed = WeighRanking();
   for (Memo& m : comparisons_) {
-    if (!m.used || m.weighed) continue;
-    m.weighed = weighed = true;
+    if (!m.used || (m.weighed && (!m.by_heading || m.weighed_by_heading))) continue;
     const int key = m.comparison.key;
     const int position = route_position_of_key_[key];
-    if (position < 0) continue;
-    m.weighed_ranked = !rank_of_position_.empty();
-    const int rank = m.weighed_ranked ? rank_of_position_[position] : -1;
-    const double log_ratio = EvidenceLogRatio(evidence_, m.comparison, link_verified_[key], rank);
+    if (position < 0) {
+      m.weighed = true;
+      continue;
+    }
+    double log_ratio = 0.0;
+    if (!m.weighed) {
+      m.weighed_ranked = !rank_of_position_.empty();
+      const int rank = m.weighed_ranked ? rank_of_position_[position] : -1;
+      log_ratio = EvidenceLogRatio(evidence_, m.comparison, link_verified_[key], rank);
+      if (m.by_heading) log_ratio = std::max(log_ratio, evidence_.heading_stands_out);
+    } else {
+      // Weighed before the heading accepted it: what the acceptance adds.
+      const int rank = m.weighed_ranked ? rank_of_position_[position] : -1;
+      log_ratio = std::max(
+          0.0, evidence_.heading_stands_out - EvidenceLogRatio(evidence_, m.comparison, link_verified_[key], rank));
+    }
+    m.weighed = weighed = true;
+    m.weighed_by_heading = m.by_heading;
     belief_.Weigh(position, log_ratio);
     if (start_unconfirmed_) evidence_belief_.Weigh(position, log_ratio);
   }

@@ -34,6 +34,14 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "--acceptance chance: the log10 number of false alarms a key image accepted against its rivals "
                  "(--min-rival-ratio) needs at most"},
                 rival_max_log10_nfa);
+  visitor.Visit({"min_heading_rival_ratio", "--min-heading-rival-ratio",
+                 "--acceptance chance, binary descriptors: a key image chance refuses is accepted when its heading "
+                 "mode holds this many times the votes of every rival compared (far, or near without a link of one "
+                 "scene; 0: never)"},
+                min_heading_rival_ratio);
+  visitor.Visit({"min_heading_votes", "--min-heading-votes",
+                 "The matches a heading mode needs to be accepted against its rivals (--min-heading-rival-ratio)"},
+                min_heading_votes);
   visitor.Visit({"recheck_link_share", "--recheck-link-share",
                  "Relocalize a tracked frame with fewer verified matches than this fraction of its key image's "
                  "link, and move it where more verify (0: never)"},
@@ -181,6 +189,15 @@ void LocalizerOptions::Check() const {
   if (!(rival_max_log10_nfa >= -1000.0 && rival_max_log10_nfa <= 0.0)) {
     throw OptionError("rival_max_log10_nfa", fmt::format("{} is outside [-1000, 0] (default {})", rival_max_log10_nfa,
                                                          defaults.rival_max_log10_nfa));
+  }
+  if (!(min_heading_rival_ratio == 0.0 || (min_heading_rival_ratio >= 1.0 && min_heading_rival_ratio <= 1000.0))) {
+    throw OptionError("min_heading_rival_ratio",
+                      fmt::format("{} is not 0 (never) nor in [1, 1000] (default {})", min_heading_rival_ratio,
+                                  defaults.min_heading_rival_ratio));
+  }
+  if (!(min_heading_votes >= 3 && min_heading_votes <= 100000)) {
+    throw OptionError("min_heading_votes", fmt::format("{} is outside [3, 100000] (default {})", min_heading_votes,
+                                                       defaults.min_heading_votes));
   }
   if (!(continuity_share >= 0.0 && continuity_share <= 1.0)) {
     throw OptionError("continuity_share", fmt::format("{} is outside [0, 1] (default {}; 0: never)", continuity_share,

@@ -46,6 +46,17 @@ struct LocalizerOptions {
   // defaults were measured: docs/localize.md, "Acceptance against the frame's rivals").
   double min_rival_ratio = 2.0;
   double rival_max_log10_nfa = -100.0;
+  // Across seasons ORB's verified sets at the right key image rarely pass chance, yet its matches still agree on one
+  // displacement there (the heading mode: 30-60 of them where a wrong place's modes hold at most 15, michigan_seasons).
+  // A comparison whose heading mode holds at least `min_heading_votes` matches and at least `min_heading_rival_ratio`
+  // times the heading votes of every rival the frame was compared with is accepted where chance refused it (never
+  // where the link share refuses it: a frame seen from elsewhere sees the scene's matches agree too). Its
+  // rivals: the key images compared more than two route positions away, and nearer ones the map's links do not join
+  // to it by a scene (a link chance refuses: a route of unrelated places), the best-ranked rival always among them.
+  // Binary descriptors only (fitted on ORB; XFeat's modes were not measured). 0: never (docs/localize.md, "A heading
+  // that stands out against the frame's rivals").
+  double min_heading_rival_ratio = 2.0;
+  int min_heading_votes = 12;
   // Same scene is not same place. A frame tracked at a key image with fewer verified matches than
   // `recheck_link_share` times those of the key image's link (as above) is also relocalized, and moved to the
   // ranked key image that verifies more matches, if one does: a frame that verifies against a far key image of

@@ -50,13 +50,75 @@ bool Localizer::StandsOut(int verified, int rival_verified) const {
   return rival_verified >= 0 && verified >= options_.min_rival_ratio * rival_verified;
 }
 
+bool Localizer::IsHeadingRival(int position, int q) const {
+  if (q == position) return false;
+  if (std::abs(q - position) > kNear) return true;
+  for (int p = std::min(q, position); p < std::max(q, position); ++p) {
+    if (!scene_link_after_[p]) return true;
+  }
+  return false;
+}
+
+bool Localizer::HeadingStandsOut(const Frame& frame, const ImageFeatures& features, const KeyComparison& comparison,
+                                 int position) {
+  if (!heading_accepts_ || options_.acceptance != AcceptanceRule::kChance || options_.min_heading_rival_ratio <= 0.0 ||
+      !comparison.matched || comparison.heading.votes < options_.min_heading_votes) {
+    return false;
+  }
+  // The heading answers chance only, never the link share: a frame that shares little with a key image's place sees
+  // its scene from elsewhere, and the scene's matches agree there too (redkitchen's teach/repeat run: 2 -> 57 frames
+  // steered by wrong when the heading overrode the share).
+  const int key = comparison.key;
+  if (comparison.log10_nfa <= options_.max_log10_nfa ||
+      comparison.num_verified < options_.min_link_share * link_verified_[key]) {
+    return false;
+  }
+  // The likeliest other place, as the frame's descriptors tell, is always among the rivals.
+  for (const RankedKey& r : RankRoute(frame, features)) {
+    if (IsHeadingRival(position, r.key)) {
+      CompareOnce(features, route_[r.key]);  // the ranking holds the route's key images in route order
+      break;
+    }
+  }
+  int rival_votes = -1;
+  for (const Memo& m : comparisons_) {
+    const int q = route_position_of_key_[m.comparison.key];
+    if (m.used && q >= 0 && IsHeadingRival(position, q))
+      rival_votes = std::max(rival_votes, m.comparison.heading.votes);
+  }
+  return rival_votes >= 0 && comparison.heading.votes >= options_.min_heading_rival_ratio * rival_votes;
+}
+
+int Localizer::AcceptByHeading(const Frame& frame, const ImageFeatures& features) {
+  int best = -1;  // index in comparisons_ (HeadingStandsOut may grow it)
+  for (size_t i = 0; i < comparisons_.size(); ++i) {
+    const Memo& m = comparisons_[i];
+    if (!m.used || route_position_of_key_[m.comparison.key] < 0) continue;
+    if (best < 0 || m.comparison.heading.votes > comparisons_[best].comparison.heading.votes)
+      best = static_cast<int>(i);
+  }
+  if (best < 0) return -1;
+  const KeyComparison candidate = comparisons_[best].comparison;
+  const int position = route_position_of_key_[candidate.key];
+  if (!HeadingStandsOut(frame, features, candidate, position)) return -1;
+  for (Memo& m : comparisons_) {
+    if (m.comparison.key == candidate.key) m.comparison.accepted = m.by_heading = true;
+  }
+  return position;
+}
+
 KeyComparison Localizer::CompareTracked(const Frame& frame, const ImageFeatures& features, int position) {
   const int key = route_[position];
   KeyComparison c = CompareOnce(features, key);
-  if (c.accepted || !MayStandOut(c)) return c;
-  if (!StandsOut(c.num_verified, RivalVerified(frame, features, position))) return c;
+  if (c.accepted) return c;
+  const bool by_verified = MayStandOut(c) && StandsOut(c.num_verified, RivalVerified(frame, features, position));
+  const bool by_heading = !by_verified && HeadingStandsOut(frame, features, c, position);
+  if (!by_verified && !by_heading) return c;
   for (Memo& m : comparisons_) {
-    if (m.comparison.key == key) m.comparison.accepted = true;
+    if (m.comparison.key == key) {
+      m.comparison.accepted = true;
+      m.by_heading = by_heading;
+    }
   }
   c.accepted = true;
   return c;
@@ -77,9 +139,11 @@ int Localizer::AcceptAgainstRivals(const Frame& frame, const ImageFeatures& feat
     if (best < 0 || m.comparison.num_verified > comparisons_[best].comparison.num_verified) best = static_cast<int>(i);
   }
   if (best < 0) return -1;
-  if (!MayStandOut(comparisons_[best].comparison)) return -1;
   const int position = route_position_of_key_[comparisons_[best].comparison.key];
-  if (!StandsOut(comparisons_[best].comparison.num_verified, RivalVerified(frame, features, position))) return -1;
+  if (!MayStandOut(comparisons_[best].comparison) ||
+      !StandsOut(comparisons_[best].comparison.num_verified, RivalVerified(frame, features, position))) {
+    return AcceptByHeading(frame, features);
+  }
   comparisons_[best].comparison.accepted = true;
   return position;
 }

@@ -216,7 +216,8 @@ TEST(Localizer, AFrameThatShowsLittleOfTheSceneIsStillLocalizedByItsChance) {
   LocalizerOptions chance = MapLocalizerOptions(m);
   ASSERT_EQ(chance.acceptance, AcceptanceRule::kChance) << "the default";
   chance.min_link_share = 0.0;  // chance alone: the test is about its rule
-  chance.belief.window = 0;     // frames placed by the acceptance rule, not by the belief's best guess
+  chance.min_heading_rival_ratio = 0.0;
+  chance.belief.window = 0;  // frames placed by the acceptance rule, not by the belief's best guess
   LocalizerOptions counts = chance;
   counts.acceptance = AcceptanceRule::kCounts;
   const std::vector<LocalizationResult> by_chance = LocalizeAll(chance, MostlyHidden(0.35), DriveIndices(1, 2));

@@ -7,7 +7,11 @@ namespace vmap {
 
 // The coefficients as bench/evidence_fit.py fitted them (docs/localize.md, "The belief over the route"; the ranking's:
 // "The ranking is evidence", bench/evidence_fit.py --rank).
-EvidenceModel BinaryDescriptorEvidence() { return {-1.0, 1.59, 0.383, 1.52, -15.0, 40.0}; }
+EvidenceModel BinaryDescriptorEvidence() {
+  EvidenceModel model{-1.0, 1.59, 0.383, 1.52, -15.0, 40.0};
+  model.heading_stands_out = 3.0;
+  return model;
+}
 EvidenceModel FloatDescriptorEvidence() {
   EvidenceModel model{-1.0, -2.66, 0.086, 3.75, -15.0, 40.0};
   model.rank_alone = {3.22, 1.53, 0.86, 0.19, -1.15};

@@ -38,9 +38,9 @@ struct LocalizationSessionOptions {
   void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
   // Throws OptionError when a field a user gave (`given`: their paths) is one the acceptance rule chosen does
-  // not read: min_verified and min_similarity belong to acceptance counts, min_link_share, min_rival_ratio and
-  // rival_max_log10_nfa to acceptance chance. Front ends know what was given; a default is read by no rule that ignores
-  // it.
+  // not read: min_verified and min_similarity belong to acceptance counts, min_link_share, min_rival_ratio,
+  // rival_max_log10_nfa, min_heading_rival_ratio and min_heading_votes to acceptance chance. Front ends know what was
+  // given; a default is read by no rule that ignores it.
   void CheckGiven(const std::vector<std::string>& given) const;
 };
 
