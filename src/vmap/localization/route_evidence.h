@@ -33,16 +33,17 @@ struct EvidenceModel {
   // then weighs ranked_intercept + ranked_per_significance * s + ranked_per_link_share * share + rank_given[bucket]
   // minus rank_alone[bucket] (its rank is weighed already); an unmatched one `unmatched`. Empty: the ranking is not
   // weighed (binary descriptors: not fitted).
-  // A comparison accepted because its heading mode stands out against the frame's rivals (Localizer::HeadingStandsOut)
-  // weighs at least this: chance refused it, so the model above weighs it as a weak or negative likeness, though the
-  // rule accepted no wrong key image on michigan_seasons and corridor_conditions (docs/localize.md). 0: not weighed so.
-  double heading_stands_out = 0.0;
-
   std::vector<double> rank_alone;
   std::vector<double> rank_given;
   double ranked_intercept = 0.0;
   double ranked_per_significance = 0.0;
   double ranked_per_link_share = 0.0;
+
+  // A comparison accepted because its heading mode stands out against the frame's rivals (Localizer::HeadingStandsOut)
+  // weighs at least this: chance refused it, so the model above weighs it as a weak or negative likeness, though the
+  // rule accepted no wrong key image of michigan_seasons' 2,640 and none more than two places off on
+  // corridor_conditions (docs/measurements/localization-conditions.md, "A heading that stands out"). 0: not weighed so.
+  double heading_stands_out = 0.0;
 };
 
 // The buckets of ranks the model weighs: [0], [1, 2], [3, 4], [5, 9], [10, ...) (the relocalization compares the 5
