@@ -169,6 +169,20 @@ std::vector<int> BuildCorridorMap(const fs::path& data, const fs::path& map) {
   return sources;
 }
 
+// A run of corridor_conditions' repeat frames in the order `repeat_of` gives (run frame f is repeat frame
+// repeat_of[f]), as a folder `run` of links to them; returns `run`.
+fs::path LinkRun(const fs::path& data, const std::vector<int>& repeat_of, const fs::path& run) {
+  fs::create_directories(run);
+  for (size_t f = 0; f < repeat_of.size(); ++f) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "%07d.jpg", repeat_of[f]);
+    char link[32];
+    std::snprintf(link, sizeof(link), "%07zu.jpg", f);
+    fs::create_symlink(data / "repeat" / name, run / link);
+  }
+  return run;
+}
+
 // The frames of `vmap localize ARGS --csv` steered by (tracking or relocalized): (source_index, key) each.
 std::vector<std::pair<int, int>> SteeredFrames(const std::string& args, const fs::path& csv) {
   const auto r = RunVmap("localize " + args + " -q --csv " + ::vmap::testing::Quote(csv));
@@ -225,15 +239,7 @@ TEST(VmapXfeat, ARobotCarriedOffIsNotSteeredByThePlaceItLeft) {
   std::vector<int> repeat_of;  // run frame -> repeat frame (repeat frame i was taken where teach frame i was)
   for (int i = 90; i <= 110; ++i) repeat_of.push_back(i);
   for (int i = 20; i <= 25; ++i) repeat_of.push_back(i);
-  const fs::path run = dir.path() / "run";
-  fs::create_directories(run);
-  for (size_t f = 0; f < repeat_of.size(); ++f) {
-    char name[32];
-    std::snprintf(name, sizeof(name), "%07d.jpg", repeat_of[f]);
-    char link[32];
-    std::snprintf(link, sizeof(link), "%07zu.jpg", f);
-    fs::create_symlink(data / "repeat" / name, run / link);
-  }
+  const fs::path run = LinkRun(data, repeat_of, dir.path() / "run");
   auto steered_far = [&](const std::string& flags) {
     return SteeredFar(sources,
                       SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(run) + " --start-key " +
@@ -368,15 +374,7 @@ TEST(VmapXfeat, AKeyImageTheBeliefPutsBehindIsLeft) {
   std::vector<int> repeat_of;  // run frame -> repeat frame
   for (int i = 100; i <= 110; ++i) repeat_of.push_back(i);
   for (int i = 20; i <= 30; ++i) repeat_of.push_back(i);
-  const fs::path run = dir.path() / "run";
-  fs::create_directories(run);
-  for (size_t f = 0; f < repeat_of.size(); ++f) {
-    char name[32];
-    std::snprintf(name, sizeof(name), "%07d.jpg", repeat_of[f]);
-    char link[32];
-    std::snprintf(link, sizeof(link), "%07zu.jpg", f);
-    fs::create_symlink(data / "repeat" / name, run / link);
-  }
+  const fs::path run = LinkRun(data, repeat_of, dir.path() / "run");
   auto steered_right = [&](const std::string& flags) {
     std::vector<std::pair<int, int>> steered =
         SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(run) + " --start-key " +
