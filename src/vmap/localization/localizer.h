@@ -110,6 +110,8 @@ class Localizer {
   LocalizationResult Track(const Frame& frame, const ImageFeatures& features);
   // The frame tracked at route `position`, the estimate having been at `from`.
   LocalizationResult TrackedAt(LocalizationResult result, int from, int position, const ImageFeatures& features);
+  // Relocalization (localizer_relocalize.cc): the frame compared with the best-ranked key images, placed on the segment
+  // before or after the best accepted one.
   LocalizationResult Relocalize(const Frame& frame, const ImageFeatures& features);
   // Without an estimate: relocalized, and when nothing verifies, matched guided where the estimate was dropped
   // (LocalizerOptions::guided_while_lost).

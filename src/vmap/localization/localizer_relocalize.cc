@@ -1,0 +1,101 @@
+// The Localizer without an estimate: the frame compared with the route's best-ranked key images, accepted by chance or
+// against its rivals, and placed on the segment before or after the best of them; when nothing verifies, matched guided
+// where the estimate was dropped.
+#include <vector>
+
+#include "vmap/localization/localizer.h"
+
+namespace vmap {
+
+LocalizationResult Localizer::Reacquire(const Frame& frame, const ImageFeatures& features) {
+  LocalizationResult found = Relocalize(frame, features);
+  const int dropped = dropped_position_;
+  if (dropped < 0 || found.status != LocalizationStatus::kLost) return found;
+  // Nothing verified anywhere the ranking looked. The frames were lost where the tracker last held them, on evidence
+  // too weak for chance: a frame's own guided comparison there may be accepted (a dark stretch of a corridor), though
+  // the belief, weighed by those frames' weak evidence, no longer singles the place out.
+  const int guided = TrackGuided(frame, features, dropped, /*whatever_the_belief=*/true);
+  if (guided < 0) return found;
+  LocalizationResult tracked;
+  tracked.candidates = std::move(found.candidates);
+  return TrackedAt(std::move(tracked), dropped, guided, features);
+}
+
+std::vector<int> Localizer::CompareBestRanked(const Frame& frame, const ImageFeatures& features) {
+  RankRoute(frame, features);
+  const int count = std::min<int>(options_.relocalization_candidates, static_cast<int>(ranked_.size()));
+  std::vector<int> positions;
+  for (int i = 0; i < count; ++i) {
+    positions.push_back(ranked_[i].key);  // the ranking holds the route's key images in route order
+    CompareOnce(features, route_[ranked_[i].key]);
+  }
+  return positions;
+}
+
+LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures& features) {
+  LocalizationResult result;
+  const std::vector<int> positions = CompareBestRanked(frame, features);
+  // Across seasons the link share refuses every key image: the frame's own rivals decide then.
+  const int standout = AcceptAgainstRivals(frame, features);
+  KeyComparison best;
+  int best_position = -1;
+  for (size_t i = 0; i < positions.size(); ++i) {
+    const int position = positions[i];
+    const KeyComparison c = CompareOnce(features, route_[position]);
+    result.candidates.push_back(
+        {route_[position], ranked_[i].score, c.accepted, c.similarity, c.num_verified, c.log10_nfa});
+    if (IsBetterMatch(c, best)) {
+      best = c;
+      best_position = position;
+    }
+  }
+  if (best_position < 0 && standout >= 0) {
+    best_position = standout;
+    best = CompareOnce(features, route_[standout]);
+  }
+  if (best_position < 0) {
+    result.status = LocalizationStatus::kLost;
+    return result;  // no estimate: key and next_key stay -1
+  }
+  // The frame is near the best key image: on the segment before it or after it. Each neighbour's verified
+  // matches with the frame are weighed against those of its link with the best key image: a frame between the
+  // neighbour and the key shares more with the neighbour than the key does, one beyond the key shares less. The
+  // ratio makes segments of different lengths comparable (a raw count favours the shorter one).
+  int position = best_position;
+  // The segment before the key image only where the two share a scene: a frame is not between two unrelated places.
+  if (position > 0 && scene_link_after_[position - 1]) {
+    const KeyComparison before = CompareOnce(features, route_[position - 1]);
+    const bool has_next = position + 1 < static_cast<int>(route_.size());
+    const KeyComparison after = has_next ? CompareOnce(features, route_[position + 1]) : KeyComparison();
+    if (before.accepted && (!has_next || !after.accepted)) {
+      position -= 1;
+    } else if (before.accepted) {
+      const double before_share = SharedWithLink(before, route_[position - 1], route_[position]);
+      const double after_share = SharedWithLink(after, route_[position], route_[position + 1]);
+      if (before_share > 0 && after_share > 0 ? before_share > after_share : IsBetterMatch(before, after))
+        position -= 1;
+    } else if (standout >= 0 && before.matched) {
+      // Accepted against its rivals: its neighbours are refused by the link share as it was; the one that shares the
+      // larger part of its link with the key image is on the frame's side.
+      const double after_share =
+          has_next && after.matched ? SharedWithLink(after, route_[position], route_[position + 1]) : 0.0;
+      if (SharedWithLink(before, route_[position - 1], route_[position]) > after_share) position -= 1;
+    }
+  }
+  position_ = position;
+  lost_in_a_row_ = 0;
+  result.status = LocalizationStatus::kRelocalized;
+  Describe(result, position_, features);
+  return result;
+}
+
+double Localizer::SharedWithLink(const KeyComparison& comparison, int key_a, int key_b) const {
+  for (const Link& link : map_.links) {
+    if ((link.from_key == key_a && link.to_key == key_b) || (link.from_key == key_b && link.to_key == key_a)) {
+      return link.num_verified > 0 ? static_cast<double>(comparison.num_verified) / link.num_verified : 0.0;
+    }
+  }
+  return 0.0;  // no link between them: not comparable
+}
+
+}  // namespace vmap
