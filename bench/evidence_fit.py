@@ -13,8 +13,8 @@ the log odds of an unmatched one; subtracting the log prior odds gives log likel
 pooled, and the false acceptance rate (wrong among those accepted) of the localizer's acceptance rule and of the
 fitted ratio above 0.
 
-With --rank, also the ranking's evidence on the corridor (EvidenceModel::rank_alone and the model of a comparison given
-its rank; docs/localize.md, "The ranking is evidence").
+With --rank, also the ranking's evidence (EvidenceModel::rank_alone and the model of a comparison given its rank;
+docs/localize.md, "The ranking is evidence"), on the corridor and on michigan's 5-place routes.
 
 usage: bench/evidence_fit.py DIR [--corridor-map-orb MAP] [--corridor-map-xfeat MAP] [--lo -5] [--hi 12] [--rank]"""
 import argparse, csv, json, math, os, sys
@@ -130,7 +130,7 @@ def main():
     parser.add_argument("--lo", type=float, default=-5.0)
     parser.add_argument("--hi", type=float, default=12.0)
     parser.add_argument("--rank", action="store_true",
-                        help="also the ranking's evidence on the corridor (the dump's `rank` column)")
+                        help="also the ranking's evidence (the dump's `rank` column)")
     args = parser.parse_args()
     pooled = []
     for matcher in ("orb", "xfeat"):
@@ -156,6 +156,9 @@ def main():
         if os.path.exists(path):
             rows = load(path, lambda r: int(r["key"]) == int(r["source_index"]))
             report("michigan %s" % matcher, rows, args.lo, args.hi)
+            if args.rank:  # 5-place routes: ranks 0-4 only, the buckets past them are empty
+                report_rank("michigan %s" % matcher, path, lambda r: int(r["key"]) == int(r["source_index"]), args.lo,
+                            args.hi)
             pooled += rows
     if pooled:
         report("pooled", pooled, args.lo, args.hi)

@@ -211,7 +211,7 @@ def elsewhere(vmap, matcher, tau_flags, localize_flags, work, csv_dir):
     return tally
 
 
-def michigan(vmap, matcher, localize_flags, work, evidence_dir=None, build_flags=()):
+def michigan(vmap, matcher, localize_flags, work, evidence_dir=None, build_flags=(), csv_dir=None):
     images = os.path.join(SHARED, "michigan_seasons", "images")
     sessions = ["%02d" % s for s in range(1, 13)]
     folders = {}
@@ -230,7 +230,10 @@ def michigan(vmap, matcher, localize_flags, work, evidence_dir=None, build_flags
         for b in sessions:
             if a == b:
                 continue
-            doc = localize(vmap, map_directory, folders[b], localize_flags, os.path.join(work, "run.json"))
+            flags = list(localize_flags)
+            if csv_dir:
+                flags += ["--csv", os.path.join(csv_dir, "michigan_%s_%s_to_%s.csv" % (matcher, b, a))]
+            doc = localize(vmap, map_directory, folders[b], flags, os.path.join(work, "run.json"))
             tally.add(doc, lambda f: {f["source_index"]}, "%s->%s" % (b, a))
             if evidence_dir:
                 dump_evidence(map_directory, folders[b], os.path.join(evidence_dir, "michigan_%s.csv" % matcher),
@@ -256,7 +259,7 @@ def main():
     parser.add_argument("--start-key", default="0", help="vmap localize --start-key (none: not passed)")
     parser.add_argument("--repeat-stride", type=int, default=1, help="corridor: every Nth repeat frame (a faster robot)")
     parser.add_argument("--work", help="keep maps here (reused) instead of a temporary folder")
-    parser.add_argument("--csv-dir", help="write each corridor run's CSV here")
+    parser.add_argument("--csv-dir", help="write each run's CSV here (michigan: michigan_MATCHER_REPEAT_to_TEACH.csv per route; the last binary's when several)")
     parser.add_argument("--evidence-dir", help="write every frame's comparisons with every key image here")
     args = parser.parse_args()
     if args.start_key != "none":
@@ -286,7 +289,7 @@ def main():
                            "%s: started elsewhere than --start-key (%s), %s" % (
                                vmap, ", ".join("%s from %d" % e for e in ELSEWHERE), matcher))
                 if "michigan" in sets:
-                    report(michigan(vmap, matcher, localize_flags, work, args.evidence_dir, build_flags),
+                    report(michigan(vmap, matcher, localize_flags, work, args.evidence_dir, build_flags, args.csv_dir),
                            "%s: michigan 132 routes, %s" % (vmap, matcher))
 
 
