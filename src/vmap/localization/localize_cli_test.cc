@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -329,6 +330,18 @@ TEST(LocalizeCli, AStartKeyTracksTheRepeatRunsFirstFrames) {
   EXPECT_GE(steered[0], steered[1] + 2) << "started at key image 0 " << steered[0] << ", anywhere " << steered[1];
 }
 
+// Of a corridor run from repeat frame `first` (CorridorRuns with teach frames): its frames steered by more than 8 teach
+// frames from their own (far) and those within 8 (near).
+std::pair<int, int> SteeredFarAndNear(const std::vector<std::pair<std::string, int>>& run, int first) {
+  int far = 0, near = 0;
+  for (size_t i = 0; i < run.size(); ++i) {
+    if (!SteeredBy(run[i])) continue;
+    const int repeat_frame = first + static_cast<int>(i);  // at teach frame repeat_frame
+    (std::abs(run[i].second - repeat_frame) > 8 ? far : near) += 1;
+  }
+  return {far, near};
+}
+
 TEST(LocalizeCli, AStartKeyIsAHintARunStartedElsewhereOverrides) {
   // corridor_conditions with ORB from repeat frame 20, started with --start-key 0 as a user does by habit
   // (docs/localize.md, "The start is a hint"): the start's prior alone steered frames 23-25 by key images 1-2 (teach
@@ -336,16 +349,23 @@ TEST(LocalizeCli, AStartKeyIsAHintARunStartedElsewhereOverrides) {
   const auto runs =
       CorridorRuns({" --start-key 0 --first 20", " --start-key 0 --first 20 --no-start-is-hint"}, 33, true);
   if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
-  std::vector<int> far(2, 0), near(2, 0);
-  for (int r = 0; r < 2; ++r) {
-    for (size_t i = 0; i < runs[r].size(); ++i) {
-      if (!SteeredBy(runs[r][i])) continue;
-      const int repeat_frame = 20 + static_cast<int>(i);  // at teach frame repeat_frame
-      (std::abs(runs[r][i].second - repeat_frame) > 8 ? far : near)[r] += 1;
-    }
-  }
-  EXPECT_LT(far[0], far[1]) << "steered by far from their place: a hint " << far[0] << ", a prior " << far[1];
-  EXPECT_GE(near[0], near[1] + 4) << "steered by near their place: a hint " << near[0] << ", a prior " << near[1];
+  const auto [far, near] = SteeredFarAndNear(runs[0], 20);
+  const auto [prior_far, prior_near] = SteeredFarAndNear(runs[1], 20);
+  EXPECT_LT(far, prior_far) << "steered by far from their place: a hint " << far << ", a prior " << prior_far;
+  EXPECT_GE(near, prior_near + 4) << "steered by near their place: a hint " << near << ", a prior " << prior_near;
+}
+
+TEST(LocalizeCli, AStartKeyNeedsTheFramesEvidence) {
+  // corridor_conditions with ORB from repeat frame 20, started with --start-key 0 (docs/localize.md, "The start needs
+  // the frames' evidence"): before the start was confirmed, frame 23 verified key image 1 (teach frame 4) by chance
+  // (log10 NFA -1.1) while the frames' evidence alone held 0.04 of its belief near it, less than a flat belief; the
+  // start's prior alone made it confident, and it was steered by 19 teach frames off.
+  const auto runs =
+      CorridorRuns({" --start-key 0 --first 20", " --start-key 0 --first 20 --no-start-needs-evidence"}, 33, true);
+  if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  const int far = SteeredFarAndNear(runs[0], 20).first, prior_far = SteeredFarAndNear(runs[1], 20).first;
+  EXPECT_LT(far, prior_far) << "steered by far from their place: with the evidence " << far << ", without "
+                            << prior_far;
 }
 
 TEST(LocalizeCli, MatchingInTheWindowOfThePredictionTracksFramesTheContinuityMisses) {

@@ -145,6 +145,10 @@ class Localizer {
   // The start is a hint (LocalizerOptions::start_is_hint): the frames' evidence alone (evidence_belief_) singles out
   // a place more than kNear route positions from `position` and holds less than min_confidence near it.
   bool EvidencePointsAway(int position) const;
+  // The start needs the frames' evidence (LocalizerOptions::start_needs_evidence): while the start is unconfirmed,
+  // evidence_belief_ holds less within kNear of `position` than a flat belief would, on a route where those positions
+  // hold at most half of it.
+  bool EvidenceWeighsAgainst(int position) const;
   void Question(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
   // Compares the frame with the best-ranked key images of the route (relocalization_candidates of them), in
   // rank order; returns the ranking's route positions compared.

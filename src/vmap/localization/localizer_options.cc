@@ -72,6 +72,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "--start-key: steer by a frame even where the frames' evidence alone, without the start's prior, "
                  "singles out a place more than two key images away (otherwise it is uncertain)"},
                 start_is_hint);
+  visitor.Visit({"start_needs_evidence", "!--no-start-needs-evidence",
+                 "--start-key: steer by a frame before the start is confirmed even where the frames' evidence alone "
+                 "holds less near its key image than a flat belief would (otherwise it is uncertain)"},
+                start_needs_evidence);
   visitor.Visit({"max_lost_frames", "--max-lost", "Lost frames in a row before the estimate is dropped"},
                 max_lost_frames);
   visitor.Visit({"relocalization_candidates", "--candidates", "Best-ranked key images verified when relocalizing"},

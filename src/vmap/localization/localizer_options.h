@@ -189,6 +189,14 @@ struct LocalizerOptions {
   // start key image's neighbours while its frames point elsewhere (docs/localize.md, "The start is a hint"). Without
   // `start_key` both beliefs are one. Off: the start's prior alone decides.
   bool start_is_hint = true;
+  // With start_is_hint, a frame is also `uncertain` while the start is unconfirmed where the frames' evidence alone
+  // holds less near its key image than a flat belief would: the frames weigh against the place, and only the start's
+  // prior holds it there. Across lighting a chance match near the start key image is accepted now and then, and the
+  // prior made it confident (corridor_conditions from repeat frame 20 with ORB: frame 23 steered by key image 1, teach
+  // frame 4; docs/localize.md, "The start needs the frames' evidence"). Only on routes where a key image and the two
+  // either side hold at most half the key images (as a place can be singled out there). Off: only a place the
+  // evidence singles out elsewhere makes the frame uncertain.
+  bool start_needs_evidence = true;
   // Lost frames in a row (each one also failed to relocalize) after which the estimate is dropped: key and
   // next_key then read -1 until a frame is relocalized.
   int max_lost_frames = 5;
