@@ -259,7 +259,8 @@ def main():
     parser.add_argument("--start-key", default="0", help="vmap localize --start-key (none: not passed)")
     parser.add_argument("--repeat-stride", type=int, default=1, help="corridor: every Nth repeat frame (a faster robot)")
     parser.add_argument("--work", help="keep maps here (reused) instead of a temporary folder")
-    parser.add_argument("--csv-dir", help="write each run's CSV here (michigan: michigan_MATCHER_REPEAT_to_TEACH.csv per route; the last binary's when several)")
+    parser.add_argument("--csv-dir", help="write each run's CSV here (michigan: michigan_MATCHER_REPEAT_to_TEACH.csv per route); with several binaries, "
+                        "each binary's in DIR/binaryN (N: its place in --vmap, from 0)")
     parser.add_argument("--evidence-dir", help="write every frame's comparisons with every key image here")
     args = parser.parse_args()
     if args.start_key != "none":
@@ -269,27 +270,33 @@ def main():
     print(HEADER)
     sets = args.sets.split(",")
     localize_flags = args.localize.split()
+    binaries = args.vmap.split(",")
     with tempfile.TemporaryDirectory(prefix="vmap_route_conditions_") as scratch:
-        for index, vmap in enumerate(args.vmap.split(",")):
+        for index, vmap in enumerate(binaries):
             work = os.path.join(args.work or scratch, "binary%d" % index)
             os.makedirs(work, exist_ok=True)
+            # Side by side, each binary's CSVs apart: they are compared frame by frame.
+            csv_dir = args.csv_dir and (os.path.join(args.csv_dir, "binary%d" % index) if len(binaries) > 1
+                                        else args.csv_dir)
+            if csv_dir:
+                os.makedirs(csv_dir, exist_ok=True)
             for matcher in args.matchers.split(","):
                 if "corridor" in sets:
                     tally, keys = corridor(vmap, matcher, tau_flags, localize_flags, args.repeat_stride, work,
-                                           args.csv_dir, args.evidence_dir)
+                                           csv_dir, args.evidence_dir)
                     report(tally, "%s: corridor, %s, %d key images%s" % (
                         vmap, matcher, keys, ", repeat stride %d" % args.repeat_stride if args.repeat_stride > 1
                         else ""))
                 if "kidnapped" in sets:
-                    report(kidnapped(vmap, matcher, tau_flags, localize_flags, work, args.csv_dir),
+                    report(kidnapped(vmap, matcher, tau_flags, localize_flags, work, csv_dir),
                            "%s: kidnapped corridor (repeat %s), %s" % (
                                vmap, ", ".join("%d-%d" % s for s in KIDNAPPED), matcher))
                 if "elsewhere" in sets:
-                    report(elsewhere(vmap, matcher, tau_flags, localize_flags, work, args.csv_dir),
+                    report(elsewhere(vmap, matcher, tau_flags, localize_flags, work, csv_dir),
                            "%s: started elsewhere than --start-key (%s), %s" % (
                                vmap, ", ".join("%s from %d" % e for e in ELSEWHERE), matcher))
                 if "michigan" in sets:
-                    report(michigan(vmap, matcher, localize_flags, work, args.evidence_dir, build_flags, args.csv_dir),
+                    report(michigan(vmap, matcher, localize_flags, work, args.evidence_dir, build_flags, csv_dir),
                            "%s: michigan 132 routes, %s" % (vmap, matcher))
 
 
