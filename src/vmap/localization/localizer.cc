@@ -379,10 +379,11 @@ bool Localizer::TakesJump(int from, int to, int lost_frames) {
   return false;
 }
 
-double Localizer::NearDensity(int position) const {
+double Localizer::NearDensity(int position) const { return belief_.MassWithin(position, kNear) / NearWidth(position); }
+
+int Localizer::NearWidth(int position) const {
   const int last = static_cast<int>(route_.size()) - 1;
-  const int width = std::min(last, position + kNear) - std::max(0, position - kNear) + 1;
-  return belief_.MassWithin(position, kNear) / width;
+  return std::min(last, position + kNear) - std::max(0, position - kNear) + 1;
 }
 
 bool Localizer::NoLikelierChance(const KeyComparison& to, const KeyComparison& from) const {

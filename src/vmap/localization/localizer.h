@@ -209,6 +209,8 @@ class Localizer {
   int OutVerifiedFrom(const LocalizationResult& result) const;
   // The belief's mass per route position within kNear of `position` (fewer positions at the route's ends).
   double NearDensity(int position) const;
+  // The route positions within kNear of `position` (fewer at the route's ends).
+  int NearWidth(int position) const;
 
   // The frame's verified matches with key_a over those of the map's link between key_a and key_b (0 when
   // they have no link).

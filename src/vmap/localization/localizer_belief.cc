@@ -91,12 +91,10 @@ bool Localizer::EvidencePointsAway(int position) const {
 
 bool Localizer::EvidenceWeighsAgainst(int position) const {
   if (!start_unconfirmed_ || !options_.start_needs_evidence || options_.belief.min_confidence <= 0.0) return false;
-  const int positions = static_cast<int>(evidence_belief_.probabilities().size());
-  const int width = std::min(positions - 1, position + kNear) - std::max(0, position - kNear) + 1;
   // A flat belief holds `flat` there: below it, the frames' comparisons moved mass away from the place. Where the place
   // and its neighbours hold more than half the route (michigan_seasons' routes of 5 places), near and elsewhere are not
   // told apart, as a place cannot be singled out there (SinglesOut: twice a flat belief).
-  const double flat = static_cast<double>(width) / positions;
+  const double flat = static_cast<double>(NearWidth(position)) / route_.size();
   return 2.0 * flat <= 1.0 && evidence_belief_.MassWithin(position, kNear) < flat;
 }
 
