@@ -14,9 +14,11 @@ pooled, and the false acceptance rate (wrong among those accepted) of the locali
 fitted ratio above 0.
 
 With --rank, also the ranking's evidence (EvidenceModel::rank_alone and the model of a comparison given its rank;
-docs/localize.md, "The ranking is evidence"), on the corridor and on michigan's 5-place routes.
+docs/localize.md, "The ranking is evidence"), on the corridor and on michigan's 5-place routes; --rank-by standout
+buckets the key images by how far their votes stand out of the frame's instead of by rank.
 
-usage: bench/evidence_fit.py DIR [--corridor-map-orb MAP] [--corridor-map-xfeat MAP] [--lo -5] [--hi 12] [--rank]"""
+usage: bench/evidence_fit.py DIR [--corridor-map-orb MAP] [--corridor-map-xfeat MAP] [--lo -5] [--hi 12] [--rank]
+                             [--rank-by rank|standout]"""
 import argparse, csv, json, math, os, sys
 
 import numpy as np
@@ -89,37 +91,77 @@ def report(name, rows, lo, hi):
 
 
 RANK_BUCKETS = ((0, 0), (1, 2), (3, 4), (5, 9), (10, 1 << 30))  # localization/route_evidence.cc, RankBucket
+# By how far a key image's votes stand out of the frame's: (votes - median) / sqrt(median), the median's counting noise
+# (binary descriptors; measured, not weighed: docs/measurements/localization-conditions.md, "ORB's ranking by how its
+# votes stand out"); a frame whose median is 0 is left out (its ranking would weigh nothing).
+STANDOUT_EDGES = (0.5, 1.5, 2.5, 3.5)
 
 
 def rank_bucket(rank):
     return next(b for b, (lo, hi) in enumerate(RANK_BUCKETS) if lo <= rank <= hi)
 
 
-def report_rank(name, path, right_of, lo, hi):
+def standout_bucket(standout):
+    return sum(1 for edge in STANDOUT_EDGES if standout >= edge)
+
+
+def frame_medians(path):
+    """The median ranking score of each frame of the dump (its rows grouped by everything but the key's columns)."""
+    scores = {}
+    with open(path) as f:
+        for r in csv.DictReader(f):
+            scores.setdefault(frame_of(r), []).append(float(r["rank_score"]))
+    return {frame: float(np.median(s)) for frame, s in scores.items()}
+
+
+def frame_of(r):
+    return (r.get("teach"), r.get("repeat"), r["frame"])
+
+
+def report_rank(name, path, right_of, lo, hi, by_standout=False):
     """The ranking as evidence (EvidenceModel::rank_alone, rank_given): the log ratio of each rank bucket alone, and a
-    matched comparison's model given its rank (bucket indicators beside s and the share; the last bucket the base)."""
-    alone_right, alone_wrong = [0] * len(RANK_BUCKETS), [0] * len(RANK_BUCKETS)
+    matched comparison's model given its rank (bucket indicators beside s and the share; the last bucket the base).
+    by_standout: the buckets by how far the key image's votes stand out of the frame's (STANDOUT_EDGES), the last the
+    highest; the base then is the first (the lowest)."""
+    buckets = len(STANDOUT_EDGES) + 1 if by_standout else len(RANK_BUCKETS)
+    base = 0 if by_standout else buckets - 1
+    medians = frame_medians(path) if by_standout else {}
+    alone_right, alone_wrong = [0] * buckets, [0] * buckets
     x, y = [], []
     with open(path) as f:
         for r in csv.DictReader(f):
             right = 1 if right_of(r) else 0
-            bucket = rank_bucket(int(r["rank"]))
+            if by_standout:
+                median = medians[frame_of(r)]
+                if median <= 0:
+                    continue
+                bucket = standout_bucket((float(r["rank_score"]) - median) / math.sqrt(median))
+            else:
+                bucket = rank_bucket(int(r["rank"]))
             (alone_right if right else alone_wrong)[bucket] += 1
             if int(r["matched"]):
                 s = min(max(-float(r["log10_nfa"]), lo), hi)
                 link = int(r["link_verified"])
                 share = min(1.0, int(r["verified"]) / link) if link > 0 else 0.0
-                x.append([1.0, s, share] + [1.0 if bucket == b else 0.0 for b in range(len(RANK_BUCKETS) - 1)])
+                x.append([1.0, s, share] + [1.0 if bucket == b else 0.0 for b in range(buckets) if b != base])
                 y.append(right)
     right, wrong = sum(alone_right), sum(alone_wrong)
     prior = math.log(right / wrong)
-    alone = [math.log(((alone_right[b] + 0.5) / right) / ((alone_wrong[b] + 0.5) / wrong)) for b in range(len(RANK_BUCKETS))]
+    alone = [math.log(((alone_right[b] + 0.5) / right) / ((alone_wrong[b] + 0.5) / wrong)) for b in range(buckets)]
     w = logistic(np.array(x), np.array(y, dtype=float))
-    print("%s, the ranking: rank_alone (ranks %s) = %s" % (
-        name, ", ".join("%d-%d" % b if b[1] < 1 << 20 else "%d+" % b[0] for b in RANK_BUCKETS),
-        ", ".join("%.2f" % a for a in alone)))
-    print("    given the rank: llr = %.3f + %.3f s + %.3f share + rank_given (%s, 0)" % (
-        w[0] - prior, w[1], w[2], ", ".join("%.2f" % c for c in w[3:])))
+    given = list(w[3:])
+    given.insert(base, 0.0)
+    if by_standout:
+        names = ["<%.1f" % STANDOUT_EDGES[0]] + ["%.1f-%.1f" % e for e in zip(STANDOUT_EDGES, STANDOUT_EDGES[1:])]
+        names.append(">=%.1f" % STANDOUT_EDGES[-1])
+        label = "(votes - median) / sqrt(median)"
+    else:
+        names = ["%d-%d" % b if b[1] < 1 << 20 else "%d+" % b[0] for b in RANK_BUCKETS]
+        label = "ranks"
+    print("%s, the ranking: rank_alone (%s %s) = %s  [right %s, wrong %s]" % (
+        name, label, ", ".join(names), ", ".join("%.2f" % a for a in alone), alone_right, alone_wrong))
+    print("    given the rank: llr = %.3f + %.3f s + %.3f share + rank_given (%s)" % (
+        w[0] - prior, w[1], w[2], ", ".join("%.2f" % c for c in given)))
 
 
 def main():
@@ -131,6 +173,9 @@ def main():
     parser.add_argument("--hi", type=float, default=12.0)
     parser.add_argument("--rank", action="store_true",
                         help="also the ranking's evidence (the dump's `rank` column)")
+    parser.add_argument("--rank-by", choices=("rank", "standout"), default="rank",
+                        help="the ranking's buckets: by rank (float descriptors) or by how far the votes stand out of "
+                             "the frame's, (votes - median) / sqrt(median) (binary descriptors)")
     args = parser.parse_args()
     pooled = []
     for matcher in ("orb", "xfeat"):
@@ -150,7 +195,7 @@ def main():
             rows = load(path, right)
             report("corridor %s" % matcher, rows, args.lo, args.hi)
             if args.rank:
-                report_rank("corridor %s" % matcher, path, right, args.lo, args.hi)
+                report_rank("corridor %s" % matcher, path, right, args.lo, args.hi, args.rank_by == "standout")
             pooled += rows
         path = os.path.join(args.directory, "michigan_%s.csv" % matcher)
         if os.path.exists(path):
@@ -158,7 +203,7 @@ def main():
             report("michigan %s" % matcher, rows, args.lo, args.hi)
             if args.rank:  # 5-place routes: ranks 0-4 only, the buckets past them are empty
                 report_rank("michigan %s" % matcher, path, lambda r: int(r["key"]) == int(r["source_index"]), args.lo,
-                            args.hi)
+                            args.hi, args.rank_by == "standout")
             pooled += rows
     if pooled:
         report("pooled", pooled, args.lo, args.hi)
