@@ -167,6 +167,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   belief_confident_ = SinglesOut(belief_.Peak());
   confident_peak_before_ = std::exchange(confident_peak_, belief_confident_ ? belief_.Peak() : -1);
   steps_on_ = 0;
+  stepped_back_from_ = -1;
   pointed_before_ = std::exchange(pointed_, -1);
   LocalizationResult result = has_estimate() ? Track(frame, features) : Reacquire(frame, features);
   CompareRivalPlace(result, features);
@@ -344,13 +345,17 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
       if (c.accepted) found_verified = std::max(found_verified, c.num_verified);
     }
     if (found.status == LocalizationStatus::kRelocalized && found_verified > best.num_verified) {
-      if (TakesJump(position, found.route_position, lost_before)) return found;
+      if (TakesJump(position, found.route_position, lost_before)) {
+        if (found.route_position < position) stepped_back_from_ = position;
+        return found;
+      }
       // A far place verifies more, on one frame: no jump yet. The key image behind, all that still verifies where the
       // frames were, holds the tracker as a lost frame's estimate is held: not steered by (the robot may have been
       // carried off; the next frame is asked again and decides).
       doubted = lone_step_back && options_.doubt_lone_step_back;
     }
   }
+  if (best_position < position) stepped_back_from_ = position;
   result = TrackedAt(std::move(result), position, best_position, features);
   if (doubted) result.status = LocalizationStatus::kUncertain;
   return result;

@@ -130,7 +130,15 @@ class Localizer {
   // image on, to k: back when the belief holds more on segment k - 2 than on segment k (two key images that look alike,
   // one teach frame apart or across seasons, are not told apart by one frame's matches; the frames before it and the
   // motion prior are). Two on: back when it holds more on segment k - 1 than on k (one key image a frame is likelier).
+  // The key image passed need not verify (LocalizerOptions::hold_unearned_step_on) where the map's link to the one
+  // reached is of one scene: the frame then stays tracking on the segment before the key image reached, which verified.
   void SettleStepOn(LocalizationResult& result, const ImageFeatures& features);
+  // A step back needs the belief (LocalizerOptions::step_back_needs_belief): a frame the tracker moved back from key
+  // image l to k (at most kNear key images; stepped_back_from_) returns to l when the belief, after the frame's
+  // evidence, holds more on segment l (past l) than on segment k - 1 (before k) and than a flat belief, and
+  // min_confidence within kNear of l, and l verifies; not when k verifies beyond the evidence's bound. The mirror of
+  // SettleStepOn.
+  void SettleStepBack(LocalizationResult& result, const ImageFeatures& features);
   // The mirror of SettleStepOn (LocalizerOptions::step_on_by_belief): a frame tracked at key image k moves on to k + 1
   // when the belief holds more on the segments from k + 1 on than on segments k and k - 1 (the frame is past k + 1
   // more likely than before it) and k + 1 verifies; again for k + 2, up to `lookahead` key images. Only where the
@@ -286,6 +294,9 @@ class Localizer {
   int pointed_before_ = -1;  // the previous frame's
   // How many key images Track moved the estimate on this frame (LocalizerOptions::lookahead); 0: none.
   int steps_on_ = 0;
+  // The route position a step back of this frame left (Track's step back, or the recheck's relocalization behind the
+  // tracked estimate); -1: none.
+  int stepped_back_from_ = -1;
   EvidenceModel evidence_;  // by the kind of the matcher's descriptors
   struct Memo {
     KeyComparison comparison;

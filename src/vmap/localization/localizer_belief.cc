@@ -101,6 +101,7 @@ bool Localizer::EvidenceWeighsAgainst(int position) const {
 void Localizer::Believe(LocalizationResult& result, const Frame& frame, const ImageFeatures& features) {
   WeighComparisons();
   SettleStepOn(result, features);
+  SettleStepBack(result, features);
   StepOnByBelief(result, features);
   Question(result, frame, features);
   const std::vector<double>& p = belief_.probabilities();
@@ -149,13 +150,45 @@ void Localizer::SettleStepOn(LocalizationResult& result, const ImageFeatures& fe
   const bool back = steps_on_ >= 2
                         ? p[passed] > p[reached]
                         : p[reached - 2] > p[reached] && p[reached - 2] > 1.0 / static_cast<double>(p.size());
-  if (!back || !CompareOnce(features, route_[passed]).accepted) return;
+  // The key image passed need not verify (hold_unearned_step_on) where the map joins it to the one reached by a link of
+  // one scene: that one, now `next_key`, verifies, and the frame is on the segment between them (not between two
+  // unrelated places: a --tau 1 map's).
+  const bool hold = options_.hold_unearned_step_on && scene_link_after_[passed];
+  if (!back || (!hold && !CompareOnce(features, route_[passed]).accepted)) return;
   LocalizationResult settled;
   settled.candidates = std::move(result.candidates);
   Describe(settled, passed, features);
   settled.status = LocalizationStatus::kTracking;
   result = std::move(settled);
   position_ = passed;
+  step_back_ruled_out_ = {};
+}
+
+void Localizer::SettleStepBack(LocalizationResult& result, const ImageFeatures& features) {
+  const int left = stepped_back_from_;
+  const int reached = result.route_position;
+  if (!options_.step_back_needs_belief || left < 0 || options_.belief.window <= 0 || !IsPlaced(result.status) ||
+      reached >= left || left - reached > kNear) {
+    return;
+  }
+  // Beyond the evidence's bound the key image reached is the same scene beyond doubt (the same season: redkitchen's
+  // hand-held camera reverses, verifying at log10 NFA -200 to -460), and the counts decide, as NoLikelierChance has it.
+  if (result.to_key.accepted && result.to_key.log10_nfa <= -evidence_.max_significance) return;
+  // Segment `left` is past the key image left, segment reached - 1 before the key image reached; the segments between
+  // are the frame's either way (two key images a frame apart that look alike are not told apart by one frame).
+  const std::vector<double>& p = belief_.probabilities();
+  const double before_reached = reached > 0 ? p[reached - 1] : 0.0;
+  // Only where the belief holds the frame near the key image left as it would to steer by it (min_confidence): a
+  // step back is not traded for an uncertain frame.
+  const bool undo = p[left] > before_reached && p[left] > 1.0 / static_cast<double>(p.size()) &&
+                    belief_.MassWithin(left, kNear) >= options_.belief.min_confidence;
+  if (!undo || !CompareOnce(features, route_[left]).accepted) return;
+  LocalizationResult settled;
+  settled.candidates = std::move(result.candidates);
+  Describe(settled, left, features);
+  settled.status = LocalizationStatus::kTracking;
+  result = std::move(settled);
+  position_ = left;
   step_back_ruled_out_ = {};
 }
 

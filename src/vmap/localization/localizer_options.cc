@@ -108,6 +108,13 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Never move a tracked frame on to the next key image because the belief puts it past that key "
                  "image (only the verified counts step on)"},
                 step_on_by_belief);
+  visitor.Visit({"hold_unearned_step_on", "!--no-hold-unearned-step-on",
+                 "Keep a step on the belief undoes when the key image it passed does not verify (as before)"},
+                hold_unearned_step_on);
+  visitor.Visit({"step_back_needs_belief", "!--no-step-back-needs-belief",
+                 "Step back to the previous key image on the counts and the log10 NFA alone, whatever the belief (as "
+                 "before)"},
+                step_back_needs_belief);
   visitor.Visit({"guided_matching", "!--no-guided-matching",
                  "ORB: never match a frame again with looser matching at the key images the belief holds"},
                 guided_matching);

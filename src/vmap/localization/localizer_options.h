@@ -128,6 +128,21 @@ struct LocalizerOptions {
   // Only where the ranking weighs the belief (`rank_evidence`, XFeat): ORB's belief holds nothing the counts did not
   // (docs/localize.md, "A key image the belief puts behind is left"). Off: only the counts step on.
   bool step_on_by_belief = true;
+  // A step on the belief undoes (Localizer::SettleStepOn: after the frame's evidence it holds more behind the key image
+  // left than past the one reached) is undone also when the key image it passed does not verify: the tracker stays on
+  // the segment before the key image reached, tracking (that key image, now `next_key`, verified). Across lighting the
+  // key image passed often does not verify while one ahead does (ORB's guided matching over the lookahead:
+  // corridor_conditions frame 49 went on to key image 21 while the belief held 0.016 there, and the next frame stepped
+  // back). Only where the map's link between the two key images is of one scene (a --tau 1 map of unrelated places has
+  // no segment between them). Off: such a step on stays (docs/localize.md).
+  bool hold_unearned_step_on = true;
+  // A step back (Track's, or the recheck's relocalization within two key images behind) is undone when the belief,
+  // after the frame's evidence, holds more on the segment past the key image left than on the segment before the key
+  // image reached (and than a flat belief), holds `min_confidence` near the key image left, and that key image
+  // verifies: the mirror of a step on that needs the belief. Not where the key image reached verifies beyond the
+  // evidence's bound (the same scene beyond doubt: a hand-held camera that reverses in the same season). Off: the
+  // counts and the log10 NFA alone step back (docs/localize.md).
+  bool step_back_needs_belief = true;
   // Guided matching (ORB maps): a frame that verifies nothing at the tracked key images while the belief singles
   // out that place is matched with them again, and only with them, keeping one-way best matches too (no cross
   // check); the a-contrario test, which counts every tentative match, decides as before (docs/localize.md,

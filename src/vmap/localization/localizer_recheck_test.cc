@@ -374,6 +374,62 @@ TEST(Localizer, OneKeyImageOnNeedsTheBeliefNotToHoldMoreBehind) {
   }
 }
 
+// The same when the key image left does not verify (LocalizerOptions::hold_unearned_step_on): across lighting the
+// tracker moves on to a key image ahead that verifies weakly while the one it held is refused, and the belief puts the
+// frame behind (corridor_conditions frame 49: guided on to key image 21 while the belief held 0.016 there; the next
+// frame stepped back). The frame stays on the segment before the key image reached, tracking: that key image, now
+// `next_key`, verified. Without the rule the frame moves on.
+TEST(Localizer, AStepOnPastAKeyImageThatDoesNotVerifyNeedsTheBeliefToo) {
+  const LocalizationMap& m = Dense();
+  for (const bool hold : {true, false}) {
+    LocalizerOptions options = MapLocalizerOptions(m);
+    options.hold_unearned_step_on = hold;
+    Localizer localizer(m.map, m.keys, *m.matcher, options);
+    int index = 0;
+    LocalizationResult r;
+    for (int source_index : {1, 3, 5}) r = LocalizeImage(localizer, source_index, index++);
+    ASSERT_EQ(r.status, LocalizationStatus::kTracking);
+    const int p = r.route_position;
+    ASSERT_GE(p, 1);
+    ASSERT_LT(p + 2, static_cast<int>(m.map.key_images.size()));
+    // Key image p verifies as many matches as p + 1 but at the edge of chance (refused), p + 1 just within it.
+    KeyComparison at_key = GivenComparison(p, true, 22, 0.5);
+    at_key.accepted = false;
+    r = LocalizeImage(localizer, 7, index++,
+                      {at_key, GivenComparison(p + 1, true, 22, -1.0), GivenComparison(p + 2, false, 0, 0.0)});
+    EXPECT_EQ(r.status, LocalizationStatus::kTracking) << hold;
+    EXPECT_EQ(r.route_position, hold ? p : p + 1) << hold;
+  }
+}
+
+// A step back needs the belief too (LocalizerOptions::step_back_needs_belief), the mirror of a step on: a frame the
+// tracker moves back because the key image behind verifies a few more matches, less likely by chance, returns when
+// the belief holds more past the key image left than before the one reached and the key image left verifies (two key
+// images that look alike are not told apart by one frame; corridor_conditions frame 64 stepped back from key image 26
+// to 25 on 25 matches at log10 NFA -0.3 against 21 at 0.8 while the belief held 0.95 past 26). Without the rule the
+// frame steps back.
+TEST(Localizer, AStepBackNeedsTheBeliefNotToHoldMorePastTheKeyImageLeft) {
+  const LocalizationMap& m = Dense();
+  for (const bool needs_belief : {true, false}) {
+    LocalizerOptions options = MapLocalizerOptions(m);
+    options.step_back_needs_belief = needs_belief;
+    Localizer localizer(m.map, m.keys, *m.matcher, options);
+    int index = 0;
+    LocalizationResult r;
+    for (int source_index : {1, 3, 5}) r = LocalizeImage(localizer, source_index, index++);
+    ASSERT_EQ(r.status, LocalizationStatus::kTracking);
+    const int p = r.route_position;
+    ASSERT_GE(p, 2);
+    ASSERT_LT(p + 1, static_cast<int>(m.map.key_images.size()));
+    // Key images p - 1 and p both verify weakly, p - 1 by a few matches more at a lower log10 NFA; p + 1 does not.
+    r = LocalizeImage(localizer, 5, index++,
+                      {GivenComparison(p - 2, false, 0, 0.0), GivenComparison(p - 1, true, 25, -0.5),
+                       GivenComparison(p, true, 21, 0.5), GivenComparison(p + 1, false, 0, 0.0)});
+    EXPECT_EQ(r.status, LocalizationStatus::kTracking) << needs_belief;
+    EXPECT_EQ(r.route_position, needs_belief ? p : p - 1) << needs_belief;
+  }
+}
+
 // The belief moves the estimate (LocalizerOptions::belief.window): frames that verify against no key image (here
 // the drive's frames through fog and glare) after a run of frames that singled out a place are not lost but placed
 // at the belief's peak, carried along the route by its motion model, as a best guess not to steer by
