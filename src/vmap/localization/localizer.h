@@ -117,6 +117,10 @@ class Localizer {
   // (LocalizerOptions::guided_while_lost).
   LocalizationResult Reacquire(const Frame& frame, const ImageFeatures& features);
   void Describe(LocalizationResult& result, int position, const ImageFeatures& features);
+  // The belief's rules moving the tracker on the frame's own evidence: the result becomes the frame described at route
+  // `position` with `status` (its relocalization candidates kept), and the tracker goes on from there.
+  void MoveTrackerTo(LocalizationResult& result, int position, LocalizationStatus status,
+                     const ImageFeatures& features);
   // The belief's step (localizer_belief.cc): weighs the evidence of every comparison of the frame, then sets the
   // result's confidence and, when the belief does not single out the tracked position, the status kUncertain.
   void Believe(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);

@@ -136,6 +136,17 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
   }
 }
 
+void Localizer::MoveTrackerTo(LocalizationResult& result, int position, LocalizationStatus status,
+                              const ImageFeatures& features) {
+  LocalizationResult moved;
+  moved.candidates = std::move(result.candidates);
+  Describe(moved, position, features);
+  moved.status = status;
+  result = std::move(moved);
+  position_ = position;
+  step_back_ruled_out_ = {};
+}
+
 void Localizer::SettleStepOn(LocalizationResult& result, const ImageFeatures& features) {
   const int reached = result.route_position;
   if (steps_on_ <= 0 || options_.belief.window <= 0 || result.status != LocalizationStatus::kTracking || reached < 2) {
@@ -155,13 +166,7 @@ void Localizer::SettleStepOn(LocalizationResult& result, const ImageFeatures& fe
   // unrelated places: a --tau 1 map's).
   const bool hold = options_.hold_unearned_step_on && scene_link_after_[passed];
   if (!back || (!hold && !CompareOnce(features, route_[passed]).accepted)) return;
-  LocalizationResult settled;
-  settled.candidates = std::move(result.candidates);
-  Describe(settled, passed, features);
-  settled.status = LocalizationStatus::kTracking;
-  result = std::move(settled);
-  position_ = passed;
-  step_back_ruled_out_ = {};
+  MoveTrackerTo(result, passed, LocalizationStatus::kTracking, features);
 }
 
 void Localizer::SettleStepBack(LocalizationResult& result, const ImageFeatures& features) {
@@ -183,13 +188,7 @@ void Localizer::SettleStepBack(LocalizationResult& result, const ImageFeatures& 
   const bool undo = p[left] > before_reached && p[left] > 1.0 / static_cast<double>(p.size()) &&
                     belief_.MassWithin(left, kNear) >= options_.belief.min_confidence;
   if (!undo || !CompareOnce(features, route_[left]).accepted) return;
-  LocalizationResult settled;
-  settled.candidates = std::move(result.candidates);
-  Describe(settled, left, features);
-  settled.status = LocalizationStatus::kTracking;
-  result = std::move(settled);
-  position_ = left;
-  step_back_ruled_out_ = {};
+  MoveTrackerTo(result, left, LocalizationStatus::kTracking, features);
 }
 
 void Localizer::StepOnByBelief(LocalizationResult& result, const ImageFeatures& features) {
@@ -217,13 +216,7 @@ void Localizer::StepOnByBelief(LocalizationResult& result, const ImageFeatures& 
     to = q + 1;
   }
   if (to == from) return;
-  LocalizationResult moved;
-  moved.candidates = std::move(result.candidates);
-  Describe(moved, to, features);
-  moved.status = result.status;
-  result = std::move(moved);
-  position_ = to;
-  step_back_ruled_out_ = {};
+  MoveTrackerTo(result, to, result.status, features);
 }
 
 void Localizer::Question(LocalizationResult& result, const Frame& frame, const ImageFeatures& features) {
