@@ -5,7 +5,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -156,33 +155,6 @@ std::vector<int> RightKeys(const std::vector<int>& sources, int repeat) {
   return keys;
 }
 
-// An XFeat map of corridor_conditions' teach run in `map`; returns its key images' teach frames.
-std::vector<int> BuildCorridorMap(const fs::path& data, const fs::path& map) {
-  const auto built = RunVmap("build " + ::vmap::testing::Quote(data / "teach") + " --matcher xfeat --weights " +
-                             FoldedWeights() + " -q -o " + ::vmap::testing::Quote(map));
-  EXPECT_EQ(built.status, 0) << built.output;
-  std::vector<int> sources;
-  std::ifstream map_file(map / "map.json");
-  if (!map_file) return sources;
-  const nlohmann::json map_json = nlohmann::json::parse(map_file);
-  for (const auto& key : map_json["key_images"]) sources.push_back(key["source_index"].get<int>());
-  return sources;
-}
-
-// A run of corridor_conditions' repeat frames in the order `repeat_of` gives (run frame f is repeat frame
-// repeat_of[f]), as a folder `run` of links to them; returns `run`.
-fs::path LinkRun(const fs::path& data, const std::vector<int>& repeat_of, const fs::path& run) {
-  fs::create_directories(run);
-  for (size_t f = 0; f < repeat_of.size(); ++f) {
-    char name[32];
-    std::snprintf(name, sizeof(name), "%07d.jpg", repeat_of[f]);
-    char link[32];
-    std::snprintf(link, sizeof(link), "%07zu.jpg", f);
-    fs::create_symlink(data / "repeat" / name, run / link);
-  }
-  return run;
-}
-
 // The frames of `vmap localize ARGS --csv` steered by (tracking or relocalized): (source_index, key) each.
 std::vector<std::pair<int, int>> SteeredFrames(const std::string& args, const fs::path& csv) {
   const auto r = RunVmap("localize " + args + " -q --csv " + ::vmap::testing::Quote(csv));
@@ -201,52 +173,98 @@ std::vector<std::pair<int, int>> SteeredFrames(const std::string& args, const fs
   return steered;
 }
 
-// How many of `steered` (run frame, key) are at a key image more than 2 from every right one; `repeat_of` gives a run
-// frame's repeat frame.
-int SteeredFar(const std::vector<int>& sources, const std::vector<std::pair<int, int>>& steered,
-               const std::function<int(int)>& repeat_of) {
-  int far = 0;
-  for (const auto& [frame, key] : steered) {
-    int nearest = 1 << 20;
-    for (int k : RightKeys(sources, repeat_of(frame))) nearest = std::min(nearest, std::abs(key - k));
-    far += nearest > 2;
+// corridor_conditions' repeat run (its frame i taken where the teach run's frame i was) against an XFeat map of its
+// teach run, built for each test in a temporary folder. Counts frames steered by as (repeat frame, key) pairs.
+class XfeatCorridorRun : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    SKIP_WITHOUT_SHARED();
+    if (!fs::exists(data_)) GTEST_SKIP() << data_ << " is not present";
+    const auto built = RunVmap("build " + ::vmap::testing::Quote(data_ / "teach") + " --matcher xfeat --weights " +
+                               FoldedWeights() + " -q -o " + ::vmap::testing::Quote(map_));
+    ASSERT_EQ(built.status, 0) << built.output;
+    std::ifstream map_file(map_ / "map.json");
+    const nlohmann::json map_json = nlohmann::json::parse(map_file);
+    for (const auto& key : map_json["key_images"]) sources_.push_back(key["source_index"].get<int>());
+    ASSERT_FALSE(sources_.empty());
   }
-  return far;
-}
 
-// How many of `steered` (repeat frame, key) are at a right key image.
-int SteeredRight(const std::vector<int>& sources, const std::vector<std::pair<int, int>>& steered) {
-  int right = 0;
-  for (const auto& [frame, key] : steered) {
-    const std::vector<int> keys = RightKeys(sources, frame);
-    right += std::find(keys.begin(), keys.end(), key) != keys.end();
+  // The key image at or before teach frame `frame`: where a run of the repeat from frame `frame` is started.
+  int KeyBefore(int frame) const { return KeysAround(sources_, frame).front(); }
+
+  // The frames steered by when repeat frames `first`-`last` are localized, started at `start_key`, with `flags`.
+  std::vector<std::pair<int, int>> SteeredOnRepeat(int first, int last, int start_key, const std::string& flags) {
+    return SteeredFrames(::vmap::testing::Quote(map_) + " " + ::vmap::testing::Quote(data_ / "repeat") + " --first " +
+                             std::to_string(first) + " --last " + std::to_string(last) + " --start-key " +
+                             std::to_string(start_key) + flags,
+                         dir_.path() / "run.csv");
   }
-  return right;
+
+  // The frames steered by when repeat frames taken in the order `repeat_of` gives (a robot carried off: run frame f
+  // is repeat frame repeat_of[f]) are localized, started at `start_key`, with `flags`.
+  std::vector<std::pair<int, int>> SteeredOnRun(const std::vector<int>& repeat_of, int start_key,
+                                                const std::string& flags) {
+    const fs::path run = dir_.path() / "run";
+    if (!fs::exists(run)) {  // a folder of links to the repeat's frames, named in the run's order
+      fs::create_directories(run);
+      for (size_t f = 0; f < repeat_of.size(); ++f) {
+        char name[32];
+        std::snprintf(name, sizeof(name), "%07d.jpg", repeat_of[f]);
+        char link[32];
+        std::snprintf(link, sizeof(link), "%07zu.jpg", f);
+        fs::create_symlink(data_ / "repeat" / name, run / link);
+      }
+    }
+    std::vector<std::pair<int, int>> steered =
+        SteeredFrames(::vmap::testing::Quote(map_) + " " + ::vmap::testing::Quote(run) + " --start-key " +
+                          std::to_string(start_key) + flags,
+                      dir_.path() / "run.csv");
+    for (auto& [frame, key] : steered) frame = repeat_of.at(frame);
+    return steered;
+  }
+
+  // How many of `steered` (repeat frame, key) are at a key image more than 2 from every right one.
+  int Far(const std::vector<std::pair<int, int>>& steered) const {
+    int far = 0;
+    for (const auto& [frame, key] : steered) {
+      int nearest = 1 << 20;
+      for (int k : RightKeys(sources_, frame)) nearest = std::min(nearest, std::abs(key - k));
+      far += nearest > 2;
+    }
+    return far;
+  }
+
+  // How many of `steered` (repeat frame, key) are at a right key image.
+  int Right(const std::vector<std::pair<int, int>>& steered) const {
+    int right = 0;
+    for (const auto& [frame, key] : steered) {
+      const std::vector<int> keys = RightKeys(sources_, frame);
+      right += std::find(keys.begin(), keys.end(), key) != keys.end();
+    }
+    return right;
+  }
+
+  const fs::path data_ = fs::path(SharedDir()) / "data/corridor_conditions";
+  const TempDir dir_{"corridor"};
+  const fs::path map_ = dir_.path() / "map";
+  std::vector<int> sources_;  // the map's key images' teach frames
+};
+
+// The frames of a run carried from repeat frame `from_first`-`from_last` to `to_first`-`to_last`.
+std::vector<int> CarriedRun(int from_first, int from_last, int to_first, int to_last) {
+  std::vector<int> repeat_of;
+  for (int i = from_first; i <= from_last; ++i) repeat_of.push_back(i);
+  for (int i = to_first; i <= to_last; ++i) repeat_of.push_back(i);
+  return repeat_of;
 }
 
 // A robot carried off (docs/localize.md, "A lone step back is doubted"): corridor_conditions' repeat frames 90-110 and
-// then 20-25 as one run (carried 70 frames back) against an XFeat map of its teach run, started at teach frame 90's
-// key image. On the first frame after the jump nothing verifies at the key images where the run was but the one
-// behind, while a far key image verifies more: the robot must not be steered by the place it left.
-TEST(VmapXfeat, ARobotCarriedOffIsNotSteeredByThePlaceItLeft) {
-  SKIP_WITHOUT_SHARED();
-  const fs::path data = fs::path(SharedDir()) / "data/corridor_conditions";
-  if (!fs::exists(data)) GTEST_SKIP() << data << " is not present";
-  const TempDir dir("kidnapped");
-  const fs::path map = dir.path() / "map";
-  const std::vector<int> sources = BuildCorridorMap(data, map);
-  ASSERT_FALSE(sources.empty());
-  std::vector<int> repeat_of;  // run frame -> repeat frame (repeat frame i was taken where teach frame i was)
-  for (int i = 90; i <= 110; ++i) repeat_of.push_back(i);
-  for (int i = 20; i <= 25; ++i) repeat_of.push_back(i);
-  const fs::path run = LinkRun(data, repeat_of, dir.path() / "run");
-  auto steered_far = [&](const std::string& flags) {
-    return SteeredFar(sources,
-                      SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(run) + " --start-key " +
-                                        std::to_string(KeysAround(sources, 90).front()) + flags,
-                                    dir.path() / "run.csv"),
-                      [&](int frame) { return repeat_of.at(frame); });
-  };
+// then 20-25 as one run (carried 70 frames back), started at teach frame 90's key image. On the first frame after the
+// jump nothing verifies at the key images where the run was but the one behind, while a far key image verifies more:
+// the robot must not be steered by the place it left.
+TEST_F(XfeatCorridorRun, ARobotCarriedOffIsNotSteeredByThePlaceItLeft) {
+  const std::vector<int> run = CarriedRun(90, 110, 20, 25);
+  auto steered_far = [&](const std::string& flags) { return Far(SteeredOnRun(run, KeyBefore(90), flags)); };
   EXPECT_EQ(steered_far(""), 0);
   // The lone step back measured with the ranking's evidence off: with it the belief leaves the old place before a
   // lone step back could steer by it (docs/localize.md, "The ranking is evidence").
@@ -255,51 +273,23 @@ TEST(VmapXfeat, ARobotCarriedOffIsNotSteeredByThePlaceItLeft) {
       << "the test no longer reaches a lone step back";
 }
 
-// A step on across lighting (docs/localize.md, "A step on needs more than a tie"): corridor_conditions' repeat frames
-// 26-40 against an XFeat map of its teach run, started at teach frame 26's key image. Key images 8 and 9 (teach frames
-// 35 and 36) verify 27 matches each with repeat frame 32; S took the tracker on to 9, a key image early for frames
-// 32-33 (their teach frames i-2..i+2 lie before key image 9).
-TEST(VmapXfeat, AStepOnOnATieIsNotTaken) {
-  SKIP_WITHOUT_SHARED();
-  const fs::path data = fs::path(SharedDir()) / "data/corridor_conditions";
-  if (!fs::exists(data)) GTEST_SKIP() << data << " is not present";
-  const TempDir dir("step_on");
-  const fs::path map = dir.path() / "map";
-  const std::vector<int> sources = BuildCorridorMap(data, map);
-  ASSERT_FALSE(sources.empty());
-  // Frames steered by at a right key image.
-  auto steered_right = [&](const std::string& flags) {
-    return SteeredRight(sources,
-                        SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(data / "repeat") +
-                                          " --first 26 --last 40 --start-key " +
-                                          std::to_string(KeysAround(sources, 26).front()) + flags,
-                                      dir.path() / "run.csv"));
-  };
+// A step on across lighting (docs/localize.md, "A step on needs more than a tie"): repeat frames 26-40, started at
+// teach frame 26's key image. Key images 8 and 9 (teach frames 35 and 36) verify 27 matches each with repeat frame 32;
+// S took the tracker on to 9, a key image early for frames 32-33 (their teach frames i-2..i+2 lie before key image 9).
+TEST_F(XfeatCorridorRun, AStepOnOnATieIsNotTaken) {
+  auto steered_right = [&](const std::string& flags) { return Right(SteeredOnRepeat(26, 40, KeyBefore(26), flags)); };
   const int needs_more = steered_right(""), on_tie = steered_right(" --step-on-on-tie");
   EXPECT_GE(needs_more, on_tie + 2) << "steered by at a right key image: needs more " << needs_more << ", on a tie "
                                     << on_tie;
 }
 
-// Where the corridor repeats itself (docs/localize.md, "A rival place is asked again"): corridor_conditions' repeat
-// frames 90-104 against an XFeat map of its teach run, started at key image 0 (a run started elsewhere than --start-key
-// says). From frame 95 the run is held at key images 12-13 (right: 28-31), which verify 21-32 matches there, as many
-// as the right ones do; on frame 95 key image 31 verified more. Asked again on the frames after it, the right place
-// out-verifies the tracked one again and the tracker goes there two frames sooner (frame 101, not 103).
-TEST(VmapXfeat, AFarPlaceThatVerifiedMoreIsAskedAgain) {
-  SKIP_WITHOUT_SHARED();
-  const fs::path data = fs::path(SharedDir()) / "data/corridor_conditions";
-  if (!fs::exists(data)) GTEST_SKIP() << data << " is not present";
-  const TempDir dir("rival_place");
-  const fs::path map = dir.path() / "map";
-  const std::vector<int> sources = BuildCorridorMap(data, map);
-  ASSERT_FALSE(sources.empty());
-  auto steered_far = [&](const std::string& flags) {
-    return SteeredFar(sources,
-                      SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(data / "repeat") +
-                                        " --first 90 --last 104 --start-key 0" + flags,
-                                    dir.path() / "run.csv"),
-                      [](int frame) { return frame; });
-  };
+// Where the corridor repeats itself (docs/localize.md, "A rival place is asked again"): repeat frames 90-104, started
+// at key image 0 (a run started elsewhere than --start-key says). From frame 95 the run is held at key images 12-13
+// (right: 28-31), which verify 21-32 matches there, as many as the right ones do; on frame 95 key image 31 verified
+// more. Asked again on the frames after it, the right place out-verifies the tracked one again and the tracker goes
+// there two frames sooner (frame 101, not 103).
+TEST_F(XfeatCorridorRun, AFarPlaceThatVerifiedMoreIsAskedAgain) {
+  auto steered_far = [&](const std::string& flags) { return Far(SteeredOnRepeat(90, 104, 0, flags)); };
   // Measured with the ranking's evidence off: with it no frame is steered by at key images 12-13 whether the rival is
   // asked again or not, only the run's first frame is far (docs/localize.md, "The ranking is evidence").
   const int asked = steered_far(" --no-rank-evidence"),
@@ -308,81 +298,37 @@ TEST(VmapXfeat, AFarPlaceThatVerifiedMoreIsAskedAgain) {
                                   << not_asked;
 }
 
-// The ranking is evidence (docs/localize.md): corridor_conditions' repeat frames 70-82 against an XFeat map of its
-// teach run, started at teach frame 70's key image. Frames 76-77 verify key image 29 (where the corridor repeats
-// itself) at log10 NFA -18 and -19, and on frame 78 the comparisons alone leave the belief in doubt at the right key
-// image; the frame's ranking puts the right key images 23, 25 and 22 first.
-TEST(VmapXfeat, TheRankingWeighsTheBelief) {
-  SKIP_WITHOUT_SHARED();
-  const fs::path data = fs::path(SharedDir()) / "data/corridor_conditions";
-  if (!fs::exists(data)) GTEST_SKIP() << data << " is not present";
-  const TempDir dir("rank_evidence");
-  const fs::path map = dir.path() / "map";
-  const std::vector<int> sources = BuildCorridorMap(data, map);
-  ASSERT_FALSE(sources.empty());
-  auto steered_right = [&](const std::string& flags) {
-    return SteeredRight(sources,
-                        SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(data / "repeat") +
-                                          " --first 70 --last 82 --start-key " +
-                                          std::to_string(KeysAround(sources, 70).front()) + flags,
-                                      dir.path() / "run.csv"));
-  };
+// The ranking is evidence (docs/localize.md): repeat frames 70-82, started at teach frame 70's key image. Frames 76-77
+// verify key image 29 (where the corridor repeats itself) at log10 NFA -18 and -19, and on frame 78 the comparisons
+// alone leave the belief in doubt at the right key image; the frame's ranking puts the right key images 23, 25 and 22
+// first.
+TEST_F(XfeatCorridorRun, TheRankingWeighsTheBelief) {
+  auto steered_right = [&](const std::string& flags) { return Right(SteeredOnRepeat(70, 82, KeyBefore(70), flags)); };
   const int ranked = steered_right(""), comparisons_alone = steered_right(" --no-rank-evidence");
   EXPECT_GE(ranked, comparisons_alone + 1) << "steered by at a right key image: with the ranking " << ranked
                                            << ", the comparisons alone " << comparisons_alone;
 }
 
-// One frame's ranking is not yet a place (docs/localize.md, "The ranking is evidence"): corridor_conditions' repeat
-// frames 44-60, started at teach frame 45's key image. Frames 51-54 are dark and verify little anywhere; on frame 53
-// key image 29 ranks first and verifies 22 matches at log10 NFA -19, and the belief singles out its place on that frame
-// alone. Moved there on one frame, frame 54 was relocalized at key image 29 (right: 14-15).
-TEST(VmapXfeat, OneFramesRankingIsNotYetAPlace) {
-  SKIP_WITHOUT_SHARED();
-  const fs::path data = fs::path(SharedDir()) / "data/corridor_conditions";
-  if (!fs::exists(data)) GTEST_SKIP() << data << " is not present";
-  const TempDir dir("two_frames");
-  const fs::path map = dir.path() / "map";
-  const std::vector<int> sources = BuildCorridorMap(data, map);
-  ASSERT_FALSE(sources.empty());
-  auto steered_far = [&](const std::string& flags) {
-    return SteeredFar(sources,
-                      SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(data / "repeat") +
-                                        " --first 44 --last 60 --start-key " +
-                                        std::to_string(KeysAround(sources, 45).front()) + flags,
-                                    dir.path() / "run.csv"),
-                      [](int frame) { return frame; });
-  };
+// One frame's ranking is not yet a place (docs/localize.md, "The ranking is evidence"): repeat frames 44-60, started at
+// teach frame 45's key image. Frames 51-54 are dark and verify little anywhere; on frame 53 key image 29 ranks first
+// and verifies 22 matches at log10 NFA -19, and the belief singles out its place on that frame alone. Moved there on
+// one frame, frame 54 was relocalized at key image 29 (right: 14-15).
+TEST_F(XfeatCorridorRun, OneFramesRankingIsNotYetAPlace) {
+  auto steered_far = [&](const std::string& flags) { return Far(SteeredOnRepeat(44, 60, KeyBefore(45), flags)); };
   EXPECT_EQ(steered_far(""), 0);
   EXPECT_GE(steered_far(" --belief-moves-on-one-frame"), 1)
       << "the test no longer reaches a place one frame singles out";
 }
 
-// A key image the belief puts behind is left (docs/localize.md): corridor_conditions' repeat frames 100-110 and then
-// 20-30 as one run (a robot carried back 90 frames) against an XFeat map of its teach run, started at teach frame 100's
-// key image. After the jump the tracker is relocalized a key image or two short of the right ones (key images 2-4 are
-// teach frames 6-13, the right ones 4-8), and the counts never step it on: across lighting XFeat verifies as many
-// matches (18-28) at the key image behind as at those ahead, while the belief, weighed by the frames' comparisons and
-// rankings, already holds most of its mass past the next key image.
-TEST(VmapXfeat, AKeyImageTheBeliefPutsBehindIsLeft) {
-  SKIP_WITHOUT_SHARED();
-  const fs::path data = fs::path(SharedDir()) / "data/corridor_conditions";
-  if (!fs::exists(data)) GTEST_SKIP() << data << " is not present";
-  const TempDir dir("carried_back");
-  const fs::path map = dir.path() / "map";
-  const std::vector<int> sources = BuildCorridorMap(data, map);
-  ASSERT_FALSE(sources.empty());
-  std::vector<int> repeat_of;  // run frame -> repeat frame
-  for (int i = 100; i <= 110; ++i) repeat_of.push_back(i);
-  for (int i = 20; i <= 30; ++i) repeat_of.push_back(i);
-  const fs::path run = LinkRun(data, repeat_of, dir.path() / "run");
-  auto steered_right = [&](const std::string& flags) {
-    std::vector<std::pair<int, int>> steered =
-        SteeredFrames(::vmap::testing::Quote(map) + " " + ::vmap::testing::Quote(run) + " --start-key " +
-                          std::to_string(KeysAround(sources, 100).front()) + flags,
-                      dir.path() / "run.csv");
-    for (auto& [frame, key] : steered) frame = repeat_of.at(frame);
-    return SteeredRight(sources, steered);
-  };
+// A key image the belief puts behind is left (docs/localize.md): repeat frames 100-110 and then 20-30 as one run (a
+// robot carried back 90 frames), started at teach frame 100's key image. After the jump the tracker is relocalized a
+// key image or two short of the right ones (key images 2-4 are teach frames 6-13, the right ones 4-8), and the counts
+// never step it on: across lighting XFeat verifies as many matches (18-28) at the key image behind as at those ahead,
+// while the belief, weighed by the frames' comparisons and rankings, already holds most of its mass past the next key
+// image.
+TEST_F(XfeatCorridorRun, AKeyImageTheBeliefPutsBehindIsLeft) {
+  const std::vector<int> run = CarriedRun(100, 110, 20, 30);
+  auto steered_right = [&](const std::string& flags) { return Right(SteeredOnRun(run, KeyBefore(100), flags)); };
   const int left = steered_right(""), kept = steered_right(" --no-step-on-by-belief");
   EXPECT_GE(left, kept + 4) << "steered by at a right key image: the belief stepping on " << left
                             << ", the counts alone " << kept;
