@@ -345,27 +345,52 @@ std::pair<int, int> SteeredFarAndNear(const std::vector<std::pair<std::string, i
 TEST(LocalizeCli, AStartKeyIsAHintARunStartedElsewhereOverrides) {
   // corridor_conditions with ORB from repeat frame 20, started with --start-key 0 as a user does by habit
   // (docs/localize.md, "The start is a hint"): the start's prior alone steered frames 23-25 by key images 1-2 (teach
-  // frames 2-5) and lost the frames after them; checked over the route, the frames find teach frames 20 on.
-  const auto runs =
-      CorridorRuns({" --start-key 0 --first 20", " --start-key 0 --first 20 --no-start-is-hint"}, 33, true);
+  // frames 2-5) and lost the frames after them; checked over the route, the frames find teach frames 20 on. Measured
+  // as when it was chosen, without ORB's ranking weighed: the ranking of the frames checked over the route finds the
+  // place too (10 frames steered by near their place, 0 far, with the hint or without). With the defaults: none far,
+  // as many near as the hint alone.
+  const std::string alone = " --start-key 0 --first 20 --no-rank-evidence";
+  const auto runs = CorridorRuns({alone, alone + " --no-start-is-hint", " --start-key 0 --first 20"}, 33, true);
   if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   const auto [far, near] = SteeredFarAndNear(runs[0], 20);
   const auto [prior_far, prior_near] = SteeredFarAndNear(runs[1], 20);
   EXPECT_LT(far, prior_far) << "steered by far from their place: a hint " << far << ", a prior " << prior_far;
   EXPECT_GE(near, prior_near + 4) << "steered by near their place: a hint " << near << ", a prior " << prior_near;
+  const auto [default_far, default_near] = SteeredFarAndNear(runs[2], 20);
+  EXPECT_EQ(default_far, 0);
+  EXPECT_GE(default_near, near) << "steered by near their place: the defaults " << default_near << ", the hint alone "
+                                << near;
 }
 
 TEST(LocalizeCli, AStartKeyNeedsTheFramesEvidence) {
   // corridor_conditions with ORB from repeat frame 20, started with --start-key 0 (docs/localize.md, "The start needs
   // the frames' evidence"): before the start was confirmed, frame 23 verified key image 1 (teach frame 4) by chance
   // (log10 NFA -1.1) while the frames' evidence alone held 0.04 of its belief near it, less than a flat belief; the
-  // start's prior alone made it confident, and it was steered by 19 teach frames off.
-  const auto runs =
-      CorridorRuns({" --start-key 0 --first 20", " --start-key 0 --first 20 --no-start-needs-evidence"}, 33, true);
+  // start's prior alone made it confident, and it was steered by 19 teach frames off. Measured as when it was chosen,
+  // without ORB's ranking weighed (with it frame 23 is uncertain at key image 9, its place, whether the rule is on or
+  // off). With the defaults: none far.
+  const std::string alone = " --start-key 0 --first 20 --no-rank-evidence";
+  const auto runs = CorridorRuns({alone, alone + " --no-start-needs-evidence", " --start-key 0 --first 20"}, 33, true);
   if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   const int far = SteeredFarAndNear(runs[0], 20).first, prior_far = SteeredFarAndNear(runs[1], 20).first;
   EXPECT_LT(far, prior_far) << "steered by far from their place: with the evidence " << far << ", without "
                             << prior_far;
+  EXPECT_EQ(SteeredFarAndNear(runs[2], 20).first, 0);
+}
+
+TEST(LocalizeCli, OrbsRankingWeighsTheBeliefOfTheFramesAfterIt) {
+  // corridor_conditions with ORB (docs/localize.md, "ORB's ranking only withholds its own frame"): the dark frames
+  // 40-42 were lost or uncertain at key image 15 on the comparisons alone; the rankings of the frames that were ranked
+  // weigh the belief (by how far each key image's votes stand out, after the frame's own moves), and frames 41-42 are
+  // tracked at key image 15, their place. None is steered by far from its place either way.
+  const auto runs = CorridorRuns({"", " --no-rank-evidence"}, 45, true);
+  if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  const auto [far, near] = SteeredFarAndNear(runs[0], 0);
+  const auto [alone_far, alone_near] = SteeredFarAndNear(runs[1], 0);
+  EXPECT_EQ(far, 0);
+  EXPECT_EQ(alone_far, 0);
+  EXPECT_GE(near, alone_near + 2) << "steered by near their place: the ranking weighed " << near << ", not "
+                                  << alone_near;
 }
 
 TEST(LocalizeCli, MatchingInTheWindowOfThePredictionTracksFramesTheContinuityMisses) {
@@ -447,10 +472,16 @@ TEST(LocalizeCli, GuidedMatchingOverTheLookaheadKeepsUpWithTheRobot) {
 TEST(LocalizeCli, GuidedMatchingAsksWhereTheEstimateWasDroppedWhileLost) {
   // corridor_conditions with ORB (docs/localize.md, "Guided matching while lost"): nothing verifies on frames 36-41,
   // the estimate is dropped and the belief flattens; frame 43's guided comparison with key image 16, where the
-  // tracker held the frames, is accepted and steered by.
-  const std::vector<int> steered = SteeredOnCorridor({"", " --no-guided-while-lost"}, 45);
-  if (steered.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  // tracker held the frames, is accepted and steered by. Measured as when it was chosen, without ORB's ranking weighed:
+  // with it frames 41-42 are tracked at key image 15 and the estimate is not dropped. With the defaults: none steered
+  // by far from its place, as many steered by as the rule alone.
+  const auto runs = CorridorRuns({" --no-rank-evidence", " --no-rank-evidence --no-guided-while-lost", ""}, 45, true);
+  if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  std::vector<int> steered;
+  for (const auto& run : runs) steered.push_back(static_cast<int>(std::count_if(run.begin(), run.end(), SteeredBy)));
   EXPECT_GE(steered[0], steered[1] + 1) << "asked while lost " << steered[0] << ", not " << steered[1];
+  EXPECT_EQ(SteeredFarAndNear(runs[2], 0).first, 0);
+  EXPECT_GE(steered[2], steered[0]) << "steered by: the defaults " << steered[2] << ", the rule alone " << steered[0];
 }
 
 TEST(LocalizeCli, AFarPlaceALostFrameVerifiedIsAskedAgain) {
@@ -459,15 +490,17 @@ TEST(LocalizeCli, AFarPlaceALostFrameVerifiedIsAskedAgain) {
   // verifies where the tracker holds the frames; the run's frame 25 (repeat frame 84) verifies key image 36, a far
   // place one frame does not move the tracker to, and the ranking did not bring it back on the frames after it. Asked
   // again, its evidence moves the belief and the tracker there two frames later; without it the frames stay uncertain
-  // until the estimate is dropped (repeat frame 93).
+  // until the estimate is dropped (repeat frame 93). Measured as when it was chosen, without ORB's ranking weighed (the
+  // rankings of the frames after the jump bring the belief there too).
   std::vector<int> repeat_frames;
   for (int i = 30; i <= 50; ++i) repeat_frames.push_back(i);
   for (int i = 80; i <= 95; ++i) repeat_frames.push_back(i);
-  const auto runs = CorridorRuns({" --start-key 10", " --start-key 10 --no-rival-place-when-not-steered"}, 0,
+  const std::string alone = " --start-key 10 --no-rank-evidence";
+  const auto runs = CorridorRuns({alone, alone + " --no-rival-place-when-not-steered", " --start-key 10"}, 0,
                                  /*teach_frames=*/true, repeat_frames);
   if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
-  std::vector<int> near(2, 0), far(2, 0);
-  for (int r = 0; r < 2; ++r) {
+  std::vector<int> near(3, 0), far(3, 0);
+  for (int r = 0; r < 3; ++r) {
     for (size_t i = 21; i < runs[r].size(); ++i) {  // the frames after the jump
       if (!SteeredBy(runs[r][i])) continue;
       (std::abs(runs[r][i].second - repeat_frames[i]) <= 5 ? near : far)[r] += 1;
@@ -475,6 +508,10 @@ TEST(LocalizeCli, AFarPlaceALostFrameVerifiedIsAskedAgain) {
   }
   EXPECT_EQ(far[0], 0);
   EXPECT_GE(near[0], near[1] + 4) << "steered by near their place: asked again " << near[0] << ", not " << near[1];
+  // With the defaults: none far, as many near as the rule alone.
+  EXPECT_EQ(far[2], 0);
+  EXPECT_GE(near[2], near[0]) << "steered by near their place: the defaults " << near[2] << ", the rule alone "
+                              << near[0];
 }
 
 // michigan_seasons as a route (docs/localize.md, "A heading that stands out against the frame's rivals"): a --tau 1

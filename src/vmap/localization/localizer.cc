@@ -156,7 +156,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   const auto start = std::chrono::steady_clock::now();
   comparisons_.clear();
   ranked_.clear();
-  rank_of_position_.clear();
+  bucket_of_position_.clear();
   for (KeyComparison& c : ahead) {
     if (c.key >= 0 && c.key < static_cast<int>(keys_.features.size())) comparisons_.push_back({std::move(c), false});
   }

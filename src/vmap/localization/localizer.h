@@ -126,9 +126,12 @@ class Localizer {
   void Believe(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
   void WeighComparisons();
   // Where the frame was ranked and the evidence model weighs the ranking: weighs every route position by its key
-  // image's rank (once a frame), and the comparisons already weighed without it by what their rank changes. Returns
-  // whether it weighed anything.
+  // image's bucket in the ranking (once a frame), and the comparisons already weighed without it by what their bucket
+  // changes. Returns whether it weighed anything.
   bool WeighRanking();
+  // The frame's ranking weighs the belief before the belief's rules move the tracker (XFeat's:
+  // EvidenceModel::ranking_moves_own_frame); ORB's weighs it after them.
+  bool RankingMovesOwnFrame() const { return !evidence_.rank_alone.empty() && evidence_.ranking_moves_own_frame; }
   // A frame the tracker moved on (it is tracked at the key image it is nearest) goes back one key image when the
   // belief says so. The belief's positions are segments: a frame at key image k is on segment k - 1 or k. One key
   // image on, to k: back when the belief holds more on segment k - 2 than on segment k (two key images that look alike,
@@ -316,8 +319,9 @@ class Localizer {
   // The previous frame's headings (px) against the key images it was compared with: (key, heading), those with one.
   std::vector<std::pair<int, double>> previous_headings_;
   std::vector<RankedKey> ranked_;  // the route ranked for the frame being localized (RankRoute); empty: not yet
-  // The frame's ranking weighs the belief (WeighRanking): each route position's 0-based rank in it; empty: not yet.
-  std::vector<int> rank_of_position_;
+  // The frame's ranking weighs the belief (WeighRanking): each route position's bucket in it (RankingBuckets); empty:
+  // not yet.
+  std::vector<int> bucket_of_position_;
   // The belief's peak after the motion step, before the frame's evidence, when it singled out a place (-1: it did
   // not), on this frame and the one before (RouteBeliefOptions::move_needs_two_frames).
   int confident_peak_ = -1;

@@ -17,7 +17,7 @@ constexpr double kRecordedMass = 0.01;
 }  // namespace
 
 void Localizer::WeighComparisons() {
-  bool weighed = WeighRanking();
+  bool weighed = RankingMovesOwnFrame() && WeighRanking();
   for (Memo& m : comparisons_) {
     if (!m.used || (m.weighed && (!m.by_heading || m.weighed_by_heading))) continue;
     const int key = m.comparison.key;
@@ -28,15 +28,15 @@ void Localizer::WeighComparisons() {
     }
     double log_ratio = 0.0;
     if (!m.weighed) {
-      m.weighed_ranked = !rank_of_position_.empty();
-      const int rank = m.weighed_ranked ? rank_of_position_[position] : -1;
-      log_ratio = EvidenceLogRatio(evidence_, m.comparison, link_verified_[key], rank);
+      m.weighed_ranked = !bucket_of_position_.empty();
+      const int bucket = m.weighed_ranked ? bucket_of_position_[position] : -1;
+      log_ratio = EvidenceLogRatio(evidence_, m.comparison, link_verified_[key], bucket);
       if (m.by_heading) log_ratio = std::max(log_ratio, evidence_.heading_stands_out);
     } else {
       // Weighed before the heading accepted it: what the acceptance adds.
-      const int rank = m.weighed_ranked ? rank_of_position_[position] : -1;
+      const int bucket = m.weighed_ranked ? bucket_of_position_[position] : -1;
       log_ratio = std::max(
-          0.0, evidence_.heading_stands_out - EvidenceLogRatio(evidence_, m.comparison, link_verified_[key], rank));
+          0.0, evidence_.heading_stands_out - EvidenceLogRatio(evidence_, m.comparison, link_verified_[key], bucket));
     }
     m.weighed = weighed = true;
     m.weighed_by_heading = m.by_heading;
@@ -50,15 +50,15 @@ void Localizer::WeighComparisons() {
 }
 
 bool Localizer::WeighRanking() {
-  if (ranked_.empty() || !rank_of_position_.empty() || evidence_.rank_alone.empty()) return false;
-  rank_of_position_.assign(route_.size(), static_cast<int>(route_.size()));
+  if (ranked_.empty() || !bucket_of_position_.empty() || evidence_.rank_alone.empty()) return false;
   // The ranking holds the route's key images in route order: ranked_[r].key is a route position.
-  for (size_t r = 0; r < ranked_.size(); ++r) rank_of_position_[ranked_[r].key] = static_cast<int>(r);
+  bucket_of_position_ = RankingBuckets(evidence_, ranked_, static_cast<int>(route_.size()));
   auto weigh = [&](int position, double log_ratio) {
     belief_.Weigh(position, log_ratio);
     if (start_unconfirmed_) evidence_belief_.Weigh(position, log_ratio);
   };
-  for (size_t p = 0; p < route_.size(); ++p) weigh(static_cast<int>(p), RankLogRatio(evidence_, rank_of_position_[p]));
+  for (size_t p = 0; p < route_.size(); ++p)
+    weigh(static_cast<int>(p), RankLogRatio(evidence_, bucket_of_position_[p]));
   // A comparison weighed before the frame was ranked said what its rank now says in part: it weighs what it adds to
   // the rank instead.
   for (Memo& m : comparisons_) {
@@ -67,7 +67,7 @@ bool Localizer::WeighRanking() {
     const int key = m.comparison.key;
     const int position = route_position_of_key_[key];
     if (position < 0) continue;
-    weigh(position, EvidenceLogRatio(evidence_, m.comparison, link_verified_[key], rank_of_position_[position]) -
+    weigh(position, EvidenceLogRatio(evidence_, m.comparison, link_verified_[key], bucket_of_position_[position]) -
                         EvidenceLogRatio(evidence_, m.comparison, link_verified_[key]));
   }
   return true;
@@ -104,20 +104,35 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
   SettleStepBack(result, features);
   StepOnByBelief(result, features);
   Question(result, frame, features);
+  // Not to steer by at route `position`: the belief holds less than min_confidence near it, or the frames' evidence
+  // alone points away from it or weighs against it while the start is unconfirmed.
+  auto withholds = [&](int position) {
+    return belief_.MassWithin(position, kNear) < options_.belief.min_confidence || EvidencePointsAway(position) ||
+           EvidenceWeighsAgainst(position);
+  };
+  // ORB's ranking of the frame weighs the belief only now (EvidenceModel::ranking_moves_own_frame off): the rules above
+  // moved the tracker on the frame's comparisons and the frames before it, and the frame's own ranking may withhold
+  // the frame (judged with it and without it), never move it or steer by it; the frames after it are weighed by it as
+  // by any evidence.
+  const int position = result.route_position;
+  const bool withheld_unranked = position >= 0 && withholds(position);
+  const int evidence_peak_unranked = evidence_belief_.Peak();
+  if (!RankingMovesOwnFrame() && WeighRanking()) {
+    belief_.Normalize();
+    if (start_unconfirmed_) evidence_belief_.Normalize();
+  }
   const std::vector<double>& p = belief_.probabilities();
   for (size_t i = 0; i < p.size() && i < route_.size(); ++i) {
     if (p[i] >= kRecordedMass) result.belief.emplace_back(route_[i], std::round(1000.0 * p[i]) / 1000.0);
   }
-  if (result.route_position < 0) return;
-  result.confidence = belief_.MassWithin(result.route_position, kNear);
+  if (position < 0) return;
+  result.confidence = belief_.MassWithin(position, kNear);
   const bool placed = IsPlaced(result.status);
-  if (placed && (result.confidence < options_.belief.min_confidence || EvidencePointsAway(result.route_position) ||
-                 EvidenceWeighsAgainst(result.route_position))) {
-    result.status = LocalizationStatus::kUncertain;
-  }
-  // Confirmed: the frames' evidence alone leans most near the place the frame is steered by.
+  if (placed && (withheld_unranked || withholds(position))) result.status = LocalizationStatus::kUncertain;
+  // Confirmed: the frames' evidence alone leans most near the place the frame is steered by (with the frame's ranking
+  // and without it).
   if (start_unconfirmed_ && placed && result.status != LocalizationStatus::kUncertain &&
-      std::abs(evidence_belief_.Peak() - result.route_position) <= kNear) {
+      std::abs(evidence_belief_.Peak() - position) <= kNear && std::abs(evidence_peak_unranked - position) <= kNear) {
     start_unconfirmed_ = false;
   }
   // An uncertain frame's key images are the best guess: the belief's peak when the belief singles it out and holds
@@ -193,11 +208,12 @@ void Localizer::SettleStepBack(LocalizationResult& result, const ImageFeatures& 
 
 void Localizer::StepOnByBelief(LocalizationResult& result, const ImageFeatures& features) {
   // A flat belief (the frames before this one singled out no place) does not move the tracker: one frame's evidence
-  // leans anywhere (a run's first frame). Only where the ranking weighs the belief (XFeat) does the belief know more
-  // than the counts the tracker stepped by; ORB's is weighed by those comparisons alone (redkitchen's teach/repeat run
-  // lost 2 frames steered by at a right key image with it).
-  if (!options_.step_on_by_belief || evidence_.rank_alone.empty() || options_.belief.window <= 0 ||
-      !belief_confident_ || !IsPlaced(result.status) || result.route_position < 0) {
+  // leans anywhere (a run's first frame). Only where the frame's ranking weighs the belief before its moves (XFeat)
+  // does the belief know more than the counts the tracker stepped by; ORB's frame is weighed by those comparisons alone
+  // until its moves are made (with it, before ORB's ranking was weighed, redkitchen's teach/repeat run lost 2 frames
+  // steered by at a right key image; a step on by the belief added back-jumps with ORB's ranking weighed).
+  if (!options_.step_on_by_belief || !RankingMovesOwnFrame() || options_.belief.window <= 0 || !belief_confident_ ||
+      !IsPlaced(result.status) || result.route_position < 0) {
     return;
   }
   const std::vector<double>& p = belief_.probabilities();
@@ -250,7 +266,7 @@ void Localizer::Question(LocalizationResult& result, const Frame& frame, const I
   // corridor repeats itself ranks first on a dark frame. One frame's evidence is not yet a place: the belief moves the
   // estimate only where it had singled out the place before the evidence of the frame before this one too. (ORB's
   // belief, weighed by its comparisons alone, moves on one frame: two cost corridor_conditions' runs frames.)
-  if (options_.belief.move_needs_two_frames && !evidence_.rank_alone.empty() &&
+  if (options_.belief.move_needs_two_frames && RankingMovesOwnFrame() &&
       (confident_peak_before_ < 0 || std::abs(confident_peak_before_ - peak) > kNear)) {
     return;
   }

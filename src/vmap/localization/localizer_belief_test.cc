@@ -133,5 +133,41 @@ TEST(RouteEvidence, GrowsWithSignificanceAndTheLinkShare) {
   }
 }
 
+// ORB's ranking weighs a key image by how far its votes stand out of the frame's: a blank frame (no votes at its
+// median key image) weighs nothing, and a key image far above the median weighs more than one at it.
+TEST(RouteEvidence, BinaryDescriptorsWeighTheRankingByHowTheVotesStandOut) {
+  const EvidenceModel model = BinaryDescriptorEvidence();
+  ASSERT_FALSE(model.standout_edges.empty());
+  std::vector<RankedKey> ranked;
+  for (int k = 0; k < 9; ++k) ranked.push_back({8 - k, k == 0 ? 60.0 : 16.0});  // best first; median 16
+  const std::vector<int> buckets = RankingBuckets(model, ranked, 9);
+  EXPECT_GT(buckets[8], buckets[0]) << "(60 - 16) / 4 = 11 stands out";
+  EXPECT_GT(RankLogRatio(model, buckets[8]), RankLogRatio(model, buckets[0]));
+  for (RankedKey& r : ranked) r.score = r.key == 8 ? 60.0 : 0.0;
+  for (const int bucket : RankingBuckets(model, ranked, 9)) EXPECT_EQ(bucket, -1) << "a blank frame";
+}
+
+// Where the belief weighs a share of the joint model (EvidenceModel::rank_weight), a compared key image weighs that
+// share of it as one not compared does: its comparison adds the share of what it adds to its bucket, and the rest of
+// its model without the ranking (halving the ranking alone left a compared key image in the lowest bucket above the
+// joint model: ORB's kidnapped run started at its frame 51 was steered by 14 key images off).
+TEST(RouteEvidence, AComparedKeyImageWeighsTheSameShareOfTheJointModel) {
+  const EvidenceModel model = BinaryDescriptorEvidence();
+  ASSERT_LT(model.rank_weight, 1.0);
+  EvidenceModel whole = model;
+  whole.rank_weight = 1.0;
+  KeyComparison chance;
+  chance.matched = true;
+  chance.num_verified = 15;
+  chance.log10_nfa = 10.0;
+  for (int bucket = 0; bucket < static_cast<int>(model.rank_alone.size()); ++bucket) {
+    const double joint = RankLogRatio(whole, bucket) + EvidenceLogRatio(whole, chance, 100, bucket);
+    const double alone = EvidenceLogRatio(model, chance, 100);
+    EXPECT_NEAR(RankLogRatio(model, bucket) + EvidenceLogRatio(model, chance, 100, bucket),
+                model.rank_weight * joint + (1.0 - model.rank_weight) * alone, 1e-12)
+        << "bucket " << bucket;
+  }
+}
+
 }  // namespace
 }  // namespace vmap

@@ -59,7 +59,7 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "(otherwise only frames steered by remember one)"},
                 rival_place_when_not_steered);
   visitor.Visit({"rank_evidence", "!--no-rank-evidence",
-                 "XFeat: never weigh the belief by the relocalization's ranking of a frame (the comparisons alone)"},
+                 "never weigh the belief by the relocalization's ranking of a frame (the comparisons alone)"},
                 rank_evidence);
   visitor.Visit({"start_key", "--start-key",
                  "The key image the run starts at (teach and repeat: 0, the route's first): the tracker starts there "

@@ -83,9 +83,11 @@ struct LocalizerOptions {
   // asked again while the frames are not steered by"). Off: only frames steered by remember one.
   bool rival_place_when_not_steered = true;
   // Where a frame was ranked (a relocalization, a question of the belief, a rival), the ranking weighs the belief too:
-  // each key image by its rank, and a comparison by what it adds to its rank (EvidenceModel::rank_alone; fitted for
-  // float descriptors, XFeat, on every pair of corridor_conditions: docs/localize.md, "The ranking is evidence"). Off:
-  // the comparisons alone weigh it.
+  // each key image by its bucket in the ranking, and a comparison by what it adds to its bucket (EvidenceModel::
+  // rank_alone; fitted on every pair of corridor_conditions: docs/localize.md, "The ranking is evidence"). XFeat's by
+  // rank; ORB's by how far a key image's votes stand out of the frame's, at half the joint model, and after the
+  // belief's rules moved the tracker: the frame's own ranking only withholds it ("ORB's ranking only withholds its own
+  // frame"). Off: the comparisons alone weigh it.
   bool rank_evidence = true;
   // Key images compared beyond `next_key` when the frame has passed it (1 or 2: the issue's "next one or two").
   int lookahead = 2;

@@ -191,14 +191,25 @@ TEST(Localizer, AFarRelocalizationOnOneFrameDoesNotCarryTheTrackerAway) {
     EXPECT_TRUE(Brackets(m.map, 7, back.key)) << "at key " << back.key;
     EXPECT_EQ(back.status, min_confidence > 0 ? LocalizationStatus::kTracking : LocalizationStatus::kRelocalized);
   }
-  // Two frames pointing far, but the belief, weighed by both, still holds more near the start (frames 41 and 43 see
-  // the start's far plane too): the tracker stays, and the next frame at the start is tracked.
-  Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
-  int index = 0;
-  for (int source_index : {1, 3, 5, 41, 43}) LocalizeImage(localizer, source_index, index++);
-  const LocalizationResult back = LocalizeImage(localizer, 7, index++);
-  EXPECT_TRUE(Brackets(m.map, 7, back.key)) << "at key " << back.key;
-  EXPECT_EQ(back.status, LocalizationStatus::kTracking);
+  // Two frames pointing far, but the belief, weighed by their comparisons, still holds more near the start (frames 41
+  // and 43 see the start's far plane too): the tracker stays, and the next frame at the start is tracked. Their
+  // rankings do not see it (both put key images 19-22 first, the start's outside their best eight): weighed by them
+  // (ORB's, rank_evidence) the belief follows the two frames there, as a far move on two frames should; the frame at
+  // the start after them is then not steered by anywhere but at its place.
+  for (const bool rank_evidence : {false, true}) {
+    LocalizerOptions options = MapLocalizerOptions(m);
+    options.rank_evidence = rank_evidence;
+    Localizer localizer(m.map, m.keys, *m.matcher, options);
+    int index = 0;
+    for (int source_index : {1, 3, 5, 41, 43}) LocalizeImage(localizer, source_index, index++);
+    const LocalizationResult back = LocalizeImage(localizer, 7, index++);
+    if (!rank_evidence) {
+      EXPECT_TRUE(Brackets(m.map, 7, back.key)) << "at key " << back.key;
+      EXPECT_EQ(back.status, LocalizationStatus::kTracking);
+    } else {
+      EXPECT_TRUE(!MaySteerBy(back) || Brackets(m.map, 7, back.key)) << "steered by at key " << back.key;
+    }
+  }
 }
 
 // An uncertain frame's best guess is the belief's peak only when the frames before it had singled out a place: one
@@ -212,34 +223,41 @@ TEST(Localizer, AFlatBeliefMakesNoBestGuessOfOneFramesEvidence) {
   const int count = static_cast<int>(m.map.key_images.size());
   const auto [far_before, far_after] = KeysAround(m.map, 41);
   ASSERT_GT(far_before, 10);
-  Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
-  auto localize = [&](int source_index, int index, bool far_seen) {
-    std::vector<KeyComparison> given(count);
-    for (int key = 0; key < count; ++key) {
-      KeyComparison& c = given[key];
-      c.key = key;
-      c.similarity = 0.3;
-      if (key <= 4) {
-        c.matched = c.accepted = true;  // weakly: 20 verified matches, likely by chance
-        c.num_verified = 20;
-        c.log10_nfa = 3.0;
-      } else if (far_seen && key >= far_before - 1 && key <= far_after + 1) {
-        c.matched = true;  // many matches, refused (as the link share refuses another season's)
-        c.num_verified = 100;
-        c.log10_nfa = -40.0;
+  // The frames' comparisons are given, their rankings are the images' own (the first frame's, of source 1, puts the
+  // start first: the belief is no longer flat after it, and the second frame is tracked at the start, not doubted);
+  // measured with the ranking not weighed, and with the defaults for what it guards.
+  for (const bool rank_evidence : {false, true}) {
+    LocalizerOptions options = MapLocalizerOptions(m);
+    options.rank_evidence = rank_evidence;
+    Localizer localizer(m.map, m.keys, *m.matcher, options);
+    auto localize = [&](int source_index, int index, bool far_seen) {
+      std::vector<KeyComparison> given(count);
+      for (int key = 0; key < count; ++key) {
+        KeyComparison& c = given[key];
+        c.key = key;
+        c.similarity = 0.3;
+        if (key <= 4) {
+          c.matched = c.accepted = true;  // weakly: 20 verified matches, likely by chance
+          c.num_verified = 20;
+          c.log10_nfa = 3.0;
+        } else if (far_seen && key >= far_before - 1 && key <= far_after + 1) {
+          c.matched = true;  // many matches, refused (as the link share refuses another season's)
+          c.num_verified = 100;
+          c.log10_nfa = -40.0;
+        }
       }
-    }
-    ::vmap::testing::MemorySource source({SidewaysDrive().frames[source_index]}, {source_index});
-    Frame frame = *source.Next();
-    frame.index = index;
-    return localizer.Localize(frame, *m.matcher->Extract(frame.gray), std::move(given));
-  };
-  const LocalizationResult first = localize(1, 0, false);
-  ASSERT_EQ(first.status, LocalizationStatus::kUncertain) << first.confidence;
-  ASSERT_LE(first.key, 4);
-  const LocalizationResult second = localize(41, 1, true);
-  EXPECT_EQ(second.status, LocalizationStatus::kUncertain);
-  EXPECT_LE(second.key, 4) << "the tracker's key image, not the peak of one frame's evidence";
+      ::vmap::testing::MemorySource source({SidewaysDrive().frames[source_index]}, {source_index});
+      Frame frame = *source.Next();
+      frame.index = index;
+      return localizer.Localize(frame, *m.matcher->Extract(frame.gray), std::move(given));
+    };
+    const LocalizationResult first = localize(1, 0, false);
+    ASSERT_EQ(first.status, LocalizationStatus::kUncertain) << first.confidence;
+    ASSERT_LE(first.key, 4);
+    const LocalizationResult second = localize(41, 1, true);
+    if (!rank_evidence) EXPECT_EQ(second.status, LocalizationStatus::kUncertain);
+    EXPECT_LE(second.key, 4) << "the tracker's key image, not the peak of one frame's evidence";
+  }
 }
 
 // While frames are lost the robot moves on unseen: a relocalization after them may be further from the tracked

@@ -10,6 +10,16 @@ namespace vmap {
 EvidenceModel BinaryDescriptorEvidence() {
   EvidenceModel model{-1.0, 1.59, 0.383, 1.52, -15.0, 40.0};
   model.heading_stands_out = 3.0;
+  // By standout, fitted on corridor_conditions (bench/evidence_fit.py --rank --rank-by standout; michigan's 5-place
+  // routes measure -0.82 / +0.32 / +1.14 / +2.15 / +3.40 alike).
+  model.standout_edges = {0.5, 1.5, 2.5, 3.5};
+  model.rank_alone = {-1.11, 0.31, 0.98, 1.77, 3.14};
+  model.rank_given = {0.0, 1.43, 1.96, 2.51, 2.79};
+  model.ranked_intercept = -0.392;
+  model.ranked_per_significance = 0.303;
+  model.ranked_per_link_share = 2.524;
+  model.rank_weight = 0.5;
+  model.ranking_moves_own_frame = false;
   return model;
 }
 EvidenceModel FloatDescriptorEvidence() {
@@ -24,21 +34,40 @@ EvidenceModel FloatDescriptorEvidence() {
 
 int RankBucket(int rank) { return rank <= 0 ? 0 : rank <= 2 ? 1 : rank <= 4 ? 2 : rank <= 9 ? 3 : 4; }
 
-double EvidenceLogRatio(const EvidenceModel& model, const KeyComparison& comparison, int link_verified, int rank) {
+std::vector<int> RankingBuckets(const EvidenceModel& model, const std::vector<RankedKey>& ranked, int positions) {
+  std::vector<int> buckets(positions, -1);
+  if (model.rank_alone.empty() || ranked.empty()) return buckets;
+  if (model.standout_edges.empty()) {
+    for (size_t r = 0; r < ranked.size(); ++r) buckets[ranked[r].key] = RankBucket(static_cast<int>(r));
+    return buckets;
+  }
+  // The ranking is best first: its median is read off it (the mean of the two middle ones for an even count).
+  const size_t n = ranked.size();
+  const double median = 0.5 * (ranked[(n - 1) / 2].score + ranked[n / 2].score);
+  if (median <= 0.0) return buckets;
+  for (const RankedKey& r : ranked) {
+    const double standout = (r.score - median) / std::sqrt(median);
+    buckets[r.key] = static_cast<int>(std::count_if(model.standout_edges.begin(), model.standout_edges.end(),
+                                                    [&](double e) { return standout >= e; }));
+  }
+  return buckets;
+}
+
+double EvidenceLogRatio(const EvidenceModel& model, const KeyComparison& comparison, int link_verified, int bucket) {
   if (!comparison.matched) return model.unmatched;
   const double significance = std::clamp(-comparison.log10_nfa, model.min_significance, model.max_significance);
   const double share =
       link_verified > 0 ? std::min(1.0, static_cast<double>(comparison.num_verified) / link_verified) : 0.0;
-  if (rank < 0 || model.rank_alone.empty()) {
-    return model.intercept + model.per_significance * significance + model.per_link_share * share;
-  }
-  const int bucket = RankBucket(rank);
-  return model.ranked_intercept + model.ranked_per_significance * significance + model.ranked_per_link_share * share +
-         model.rank_given[bucket] - model.rank_alone[bucket];
+  const double alone = model.intercept + model.per_significance * significance + model.per_link_share * share;
+  if (bucket < 0 || model.rank_alone.empty()) return alone;
+  const double given = model.ranked_intercept + model.ranked_per_significance * significance +
+                       model.ranked_per_link_share * share + model.rank_given[bucket] - model.rank_alone[bucket];
+  if (model.rank_weight >= 1.0) return given;
+  return model.rank_weight * given + (1.0 - model.rank_weight) * alone;
 }
 
-double RankLogRatio(const EvidenceModel& model, int rank) {
-  return model.rank_alone.empty() ? 0.0 : model.rank_alone[RankBucket(rank)];
+double RankLogRatio(const EvidenceModel& model, int bucket) {
+  return model.rank_alone.empty() || bucket < 0 ? 0.0 : model.rank_weight * model.rank_alone[bucket];
 }
 
 }  // namespace vmap

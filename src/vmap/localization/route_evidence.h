@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "vmap/localization/key_comparison.h"
+#include "vmap/localization/key_image_ranking.h"
 
 namespace vmap {
 
@@ -28,16 +29,32 @@ struct EvidenceModel {
 
   // Where the frame was ranked (KeyImageRanking, for a relocalization or a question), the ranking is evidence too: a
   // frame's own key images come first far more often than chance puts a wrong one there, and a comparison says less
-  // once its rank is known (the two measure the same likeness). By the rank's bucket (kRankBuckets): `rank_alone`, the
-  // log ratio of a key image ranked there (every key image of the route, compared or not); a matched comparison of it
-  // then weighs ranked_intercept + ranked_per_significance * s + ranked_per_link_share * share + rank_given[bucket]
-  // minus rank_alone[bucket] (its rank is weighed already); an unmatched one `unmatched`. Empty: the ranking is not
-  // weighed (binary descriptors: not fitted).
+  // once its ranking is known (the two measure the same likeness). By the key image's bucket in the ranking
+  // (RankingBuckets): `rank_alone`, the log ratio of a key image in that bucket (every key image of the route, compared
+  // or not); a matched comparison of it then weighs ranked_intercept + ranked_per_significance * s +
+  // ranked_per_link_share * share + rank_given[bucket] minus rank_alone[bucket] (its bucket is weighed already); an
+  // unmatched one `unmatched`. Empty: the ranking is not weighed.
   std::vector<double> rank_alone;
   std::vector<double> rank_given;
   double ranked_intercept = 0.0;
   double ranked_per_significance = 0.0;
   double ranked_per_link_share = 0.0;
+  // The buckets: empty, by rank (RankBucket: XFeat's scores are alike across routes); else by how far a key image's
+  // votes stand out of the frame's, (votes - median) / sqrt(median) (a count's noise grows as its square root), the
+  // bucket being how many of these edges it reaches. ORB's votes by rank did not carry from the corridor's 46 key
+  // images to michigan's 5 (rank 3-4: +1.24 against -0.95); by standout they do (docs/measurements/
+  // localization-conditions.md, "ORB's ranking by how its votes stand out").
+  std::vector<double> standout_edges;
+  // The share of the joint model (the ranking and the comparisons given it) the belief weighs, the rest the comparisons
+  // alone: a key image weighs rank_weight * rank_alone, a comparison rank_weight of what it adds to its bucket and
+  // 1 - rank_weight of its model without the ranking, so that a compared key image weighs the same share of the joint
+  // model as one not compared (halving rank_alone alone left a compared key image in the lowest bucket 0.55 above the
+  // joint model: ORB's kidnapped run started at its frame 51 was steered by 14 key images off).
+  double rank_weight = 1.0;
+  // The frame's own ranking weighs the belief before the belief's rules move the tracker (Localizer::Believe). Off:
+  // only after them, so that it may withhold the frame (uncertain) but moves nothing until the next frame's evidence
+  // agrees with it; the frames after it are weighed by it as by any evidence.
+  bool ranking_moves_own_frame = true;
 
   // A comparison accepted because its heading mode stands out against the frame's rivals (Localizer::HeadingStandsOut)
   // weighs at least this: chance refused it, so the model above weighs it as a weak or negative likeness, though the
@@ -46,19 +63,25 @@ struct EvidenceModel {
   double heading_stands_out = 0.0;
 };
 
-// The buckets of ranks the model weighs: [0], [1, 2], [3, 4], [5, 9], [10, ...) (the relocalization compares the 5
-// best, --candidates). Returns the bucket of 0-based rank `rank`.
+// The buckets of ranks the model weighs by rank: [0], [1, 2], [3, 4], [5, 9], [10, ...) (the relocalization compares
+// the 5 best, --candidates). Returns the bucket of 0-based rank `rank`.
 int RankBucket(int rank);
+// Each route position's bucket in the frame's ranking (`ranked`, best first, RankedKey::key a route position), by
+// rank or by standout (EvidenceModel::standout_edges); -1 where the ranking says nothing: the model does not weigh
+// it, or a frame whose median key image has no votes (a blank frame: its ranking orders ties and noise).
+std::vector<int> RankingBuckets(const EvidenceModel& model, const std::vector<RankedKey>& ranked, int positions);
 
 // The fitted models: for binary descriptors (ORB) and for the others (XFeat, ALIKED, LoFTR).
 EvidenceModel BinaryDescriptorEvidence();
 EvidenceModel FloatDescriptorEvidence();
 
 // `link_verified`: the verified matches of the key image's link with its route neighbour (the smaller of two; 0
-// when it has none, and then the share counts as 0). `rank`: the key image's 0-based rank when the frame was ranked
-// and the model weighs the ranking (then what the comparison adds to RankLogRatio), -1 otherwise.
-double EvidenceLogRatio(const EvidenceModel& model, const KeyComparison& comparison, int link_verified, int rank = -1);
-// The log ratio of a key image ranked `rank` (0-based) among the route's key images; 0 when the model has none.
-double RankLogRatio(const EvidenceModel& model, int rank);
+// when it has none, and then the share counts as 0). `bucket`: the key image's bucket in the frame's ranking
+// (RankingBuckets) when the model weighs it (then what the comparison adds to RankLogRatio), -1 otherwise.
+double EvidenceLogRatio(const EvidenceModel& model, const KeyComparison& comparison, int link_verified,
+                        int bucket = -1);
+// The log ratio of a key image in the ranking's `bucket` (rank_weight of rank_alone); 0 for -1 or when the model
+// weighs no ranking.
+double RankLogRatio(const EvidenceModel& model, int bucket);
 
 }  // namespace vmap
