@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <string>
 #include <utility>
 
 #include <gtest/gtest.h>
@@ -348,8 +349,9 @@ TEST(LocalizeCli, AStartKeyIsAHintARunStartedElsewhereOverrides) {
   // frames 2-5) and lost the frames after them; checked over the route, the frames find teach frames 20 on. Measured
   // as when it was chosen, without ORB's ranking weighed: the ranking of the frames checked over the route finds the
   // place too (10 frames steered by near their place, 0 far, with the hint or without). With the defaults: none far,
-  // as many near as the hint alone.
-  const std::string alone = " --start-key 0 --first 20 --no-rank-evidence";
+  // as many near as the hint alone. Nor a lost frame's relocalization matched guided (--no-guided-relocalization),
+  // which relocalizes frames 22-24 near their place with the hint or without.
+  const std::string alone = " --start-key 0 --first 20 --no-rank-evidence --no-guided-relocalization";
   const auto runs = CorridorRuns({alone, alone + " --no-start-is-hint", " --start-key 0 --first 20"}, 33, true);
   if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   const auto [far, near] = SteeredFarAndNear(runs[0], 20);
@@ -368,8 +370,9 @@ TEST(LocalizeCli, AStartKeyNeedsTheFramesEvidence) {
   // (log10 NFA -1.1) while the frames' evidence alone held 0.04 of its belief near it, less than a flat belief; the
   // start's prior alone made it confident, and it was steered by 19 teach frames off. Measured as when it was chosen,
   // without ORB's ranking weighed (with it frame 23 is uncertain at key image 9, its place, whether the rule is on or
-  // off). With the defaults: none far.
-  const std::string alone = " --start-key 0 --first 20 --no-rank-evidence";
+  // off), nor a lost frame's relocalization matched guided (--no-guided-relocalization, as above). With the defaults:
+  // none far.
+  const std::string alone = " --start-key 0 --first 20 --no-rank-evidence --no-guided-relocalization";
   const auto runs = CorridorRuns({alone, alone + " --no-start-needs-evidence", " --start-key 0 --first 20"}, 33, true);
   if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   const int far = SteeredFarAndNear(runs[0], 20).first, prior_far = SteeredFarAndNear(runs[1], 20).first;

@@ -304,6 +304,12 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     // ahead, or the estimate was wrong). Look for it over the whole route at once; keep the estimate when
     // that fails too.
     LocalizationResult found = Relocalize(frame, features);
+    // Nothing verified there either: the ranking's best asked again with the looser matching (a dark stretch of the
+    // place the robot was carried to verifies only so).
+    if (found.status != LocalizationStatus::kRelocalized && options_.guided_relocalization &&
+        GuideRelocalization(features)) {
+      found = Relocalize(frame, features);
+    }
     const bool relocalized = found.status == LocalizationStatus::kRelocalized;
     if (relocalized && TakesJump(position, found.route_position, lost_before)) return found;
     // Lost, or found far from where the frames were on this frame's evidence alone: the estimate stays (uncertain,

@@ -155,6 +155,28 @@ int Localizer::TrackGuided(const Frame& frame, const ImageFeatures& features, in
   return found;
 }
 
+bool Localizer::GuideRelocalization(const ImageFeatures& features) {
+  // Decided by chance only, as every guided comparison (TrackGuided).
+  if (!guided_matcher_ || options_.acceptance != AcceptanceRule::kChance) return false;
+  bool accepted = false;
+  const int count = std::min<int>(options_.relocalization_candidates, static_cast<int>(ranked_.size()));
+  for (int i = 0; i < count; ++i) {
+    const int key = route_[ranked_[i].key];  // the ranking holds the route's key images in route order
+    const KeyComparison first = CompareOnce(features, key);
+    // As TrackGuided: chance asked again, never the link share.
+    if (first.accepted || first.num_verified < options_.min_link_share * link_verified_[key]) continue;
+    WeighComparisons();  // the first comparison's evidence, before the guided one replaces it
+    KeyComparison guided =
+        CompareImage(features, *keys_.features[key], guided_matcher_->Match(features, *keys_.features[key]), key);
+    if (!guided.accepted) continue;
+    for (Memo& m : comparisons_) {
+      if (m.comparison.key == key) m = {std::move(guided), true, true};
+    }
+    accepted = true;
+  }
+  return accepted;
+}
+
 std::optional<double> Localizer::PreviousHeading(int key) const {
   const auto previous = std::find_if(previous_headings_.begin(), previous_headings_.end(),
                                      [&](const std::pair<int, double>& h) { return h.first == key; });

@@ -121,6 +121,9 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"guided_while_lost", "!--no-guided-while-lost",
                  "ORB: never match a frame guided at the key image the tracker held once the estimate is dropped"},
                 guided_while_lost);
+  visitor.Visit({"guided_relocalization", "!--no-guided-relocalization",
+                 "ORB: never match a lost frame guided at the key images its relocalization ranked best"},
+                guided_relocalization);
   visitor.Visit({"guided_lookahead", "!--no-guided-lookahead",
                  "ORB: match a frame guided at the key image and the next one only, ranked by verified matches (not "
                  "over the lookahead, ranked by the one-way matches' NFA where chance accepts none)"},

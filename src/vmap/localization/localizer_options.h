@@ -156,6 +156,14 @@ struct LocalizerOptions {
   // when its own guided comparison is accepted; a frame that a ranked key image verifies is relocalized first
   // (docs/localize.md). Off: a dropped estimate is only relocalized.
   bool guided_while_lost = true;
+  // Guided relocalization: a tracked frame that verifies nothing at the tracked key images, guided there too, and whose
+  // relocalization verifies nothing either, is matched guided with the ranking's best key images
+  // (relocalization_candidates of them) whose first comparison verified the link share, and relocalized again on what
+  // chance accepts of them. The a-contrario test decides as for every guided comparison, and a place far from the
+  // tracked estimate still needs two frames (TakesJump). A robot carried back (corridor_conditions' kidnapped run,
+  // repeat frames 22-24) is relocalized frames sooner (docs/measurements/localization-conditions.md, "A lost frame's
+  // relocalization is matched guided"). Off: a lost frame's relocalization compares the cross-checked matches only.
+  bool guided_relocalization = true;
   // Guided matching over the lookahead: it asks the tracked key image and the `lookahead` key images after it (the
   // tracker's own reach), and ranks what it accepts by a measure common to the key images asked: those chance accepts
   // by their verified matches (as the tracker ranks), and when chance accepts none, those the continuity of the heading

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -289,6 +291,56 @@ TEST(Localizer, FollowsAReversedRouteWhenTheFramesComeBackwards) {
     previous_key = r.key;
     if (r.next_key >= 0) {
       EXPECT_EQ(r.next_key, r.key - 1);
+    }
+  }
+}
+
+// A lost frame's relocalization is matched guided (LocalizerOptions::guided_relocalization): across lighting a frame
+// the robot was carried to verifies nothing with cross-checked matches, at the tracked key images or at the ranking's
+// best, while its one-way guided matches with the ranking's best pass chance (corridor_conditions' kidnapped run,
+// repeat frame 24: key image 9 at log10 NFA +0.9 cross-checked, -10.3 guided). Here the far frame's first comparisons
+// are given as chance refuses them, those at the tracked place below the link share too (guided matching there does
+// not ask): the frame is relocalized where it is, and lost without the rule.
+TEST(Localizer, ALostFramesRelocalizationIsMatchedGuidedAtTheRankingsBest) {
+  const LocalizationMap& m = Map().opened;
+  const int num_keys = static_cast<int>(m.map.key_images.size());
+  for (const bool guided : {true, false}) {
+    LocalizerOptions options = MapLocalizerOptions(m);
+    ASSERT_TRUE(options.guided_relocalization) << "the default";
+    options.guided_relocalization = guided;
+    // The tracker's own decisions: a far place taken on one frame (TakesJump), and no frame made uncertain.
+    options.belief.window = 0;
+    options.belief.min_confidence = 0.0;
+    Localizer localizer(m.map, m.keys, *m.matcher, options);
+    int index = 0;
+    LocalizationResult r;
+    for (int source_index : {1, 3, 5})
+      r = LocalizeImage(localizer, SidewaysDrive().frames[source_index], index++, source_index);
+    ASSERT_EQ(r.status, LocalizationStatus::kTracking);
+    const int tracked = r.route_position;
+    const int far_frame = 51;
+    ASSERT_FALSE(Brackets(m.map, far_frame, r.key)) << "a far place";
+    std::vector<KeyComparison> refused;
+    for (int key = 0; key < num_keys; ++key) {
+      KeyComparison c;
+      c.key = key;
+      c.matched = true;
+      c.num_tentative = 300;
+      c.num_verified = std::abs(key - tracked) <= 2 ? 0 : 200;
+      c.similarity = 0.1;
+      c.log10_nfa = 5.0;
+      refused.push_back(c);
+    }
+    const Frame frame = MakeFrame(SidewaysDrive().frames[far_frame], index++, far_frame);
+    r = localizer.Localize(frame, *m.matcher->Extract(frame.gray), refused);
+    if (guided) {
+      EXPECT_EQ(r.status, LocalizationStatus::kRelocalized);
+      EXPECT_TRUE(Brackets(m.map, far_frame, r.key)) << "at key " << r.key;
+      const KeyComparison& accepted = r.to_key.accepted ? r.to_key : r.to_next;
+      EXPECT_TRUE(accepted.accepted);
+      EXPECT_LE(accepted.log10_nfa, options.max_log10_nfa);
+    } else {
+      EXPECT_EQ(r.status, LocalizationStatus::kLost);
     }
   }
 }
