@@ -307,7 +307,7 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     // Nothing verified there either: the ranking's best asked again with the looser matching (a dark stretch of the
     // place the robot was carried to verifies only so).
     if (found.status != LocalizationStatus::kRelocalized && options_.guided_relocalization &&
-        GuideRelocalization(features)) {
+        GuideRelocalization(frame, features)) {
       found = Relocalize(frame, features);
     }
     const bool relocalized = found.status == LocalizationStatus::kRelocalized;

@@ -92,10 +92,10 @@ class Localizer {
   // `whatever_the_belief`: asked though the belief does not single the place out (guided_while_lost).
   int TrackGuided(const Frame& frame, const ImageFeatures& features, int position, bool whatever_the_belief = false);
   // Guided relocalization (LocalizerOptions::guided_relocalization): the frame matched again with guided_matcher_ at
-  // the ranking's best key images (relocalization_candidates of them) whose first comparison chance refused and the
-  // link share did not; each comparison chance accepts replaces its key image's memo (the first one's evidence weighed
-  // first). Returns whether any was accepted.
-  bool GuideRelocalization(const ImageFeatures& features);
+  // the ranking's best key images (CompareBestRanked) whose first comparison chance refused and the link share did
+  // not; each comparison chance accepts replaces its key image's memo (the first one's evidence weighed first).
+  // Returns whether any was accepted.
+  bool GuideRelocalization(const Frame& frame, const ImageFeatures& features);
   // The previous frame's heading (px) against key image `key`; none when that frame was not compared with it.
   std::optional<double> PreviousHeading(int key) const;
   // The continuity of the heading (LocalizerOptions::continuity_share): `guided`, the guided matches of the frame

@@ -155,13 +155,12 @@ int Localizer::TrackGuided(const Frame& frame, const ImageFeatures& features, in
   return found;
 }
 
-bool Localizer::GuideRelocalization(const ImageFeatures& features) {
+bool Localizer::GuideRelocalization(const Frame& frame, const ImageFeatures& features) {
   // Decided by chance only, as every guided comparison (TrackGuided).
   if (!guided_matcher_ || options_.acceptance != AcceptanceRule::kChance) return false;
   bool accepted = false;
-  const int count = std::min<int>(options_.relocalization_candidates, static_cast<int>(ranked_.size()));
-  for (int i = 0; i < count; ++i) {
-    const int key = route_[ranked_[i].key];  // the ranking holds the route's key images in route order
+  for (const int position : CompareBestRanked(frame, features)) {
+    const int key = route_[position];
     const KeyComparison first = CompareOnce(features, key);
     // As TrackGuided: chance asked again, never the link share.
     if (first.accepted || first.num_verified < options_.min_link_share * link_verified_[key]) continue;
@@ -169,9 +168,9 @@ bool Localizer::GuideRelocalization(const ImageFeatures& features) {
     KeyComparison guided =
         CompareImage(features, *keys_.features[key], guided_matcher_->Match(features, *keys_.features[key]), key);
     if (!guided.accepted) continue;
-    for (Memo& m : comparisons_) {
-      if (m.comparison.key == key) m = {std::move(guided), true, true};
-    }
+    const auto memo =
+        std::find_if(comparisons_.begin(), comparisons_.end(), [&](const Memo& m) { return m.comparison.key == key; });
+    *memo = {std::move(guided), true, true};  // CompareOnce made it
     accepted = true;
   }
   return accepted;

@@ -314,8 +314,9 @@ TEST(Localizer, ALostFramesRelocalizationIsMatchedGuidedAtTheRankingsBest) {
     Localizer localizer(m.map, m.keys, *m.matcher, options);
     int index = 0;
     LocalizationResult r;
-    for (int source_index : {1, 3, 5})
+    for (int source_index : {1, 3, 5}) {
       r = LocalizeImage(localizer, SidewaysDrive().frames[source_index], index++, source_index);
+    }
     ASSERT_EQ(r.status, LocalizationStatus::kTracking);
     const int tracked = r.route_position;
     const int far_frame = 51;

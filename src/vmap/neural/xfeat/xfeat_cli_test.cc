@@ -204,16 +204,15 @@ class XfeatCorridorRun : public ::testing::Test {
   // is repeat frame repeat_of[f]) are localized, started at `start_key`, with `flags`.
   std::vector<std::pair<int, int>> SteeredOnRun(const std::vector<int>& repeat_of, int start_key,
                                                 const std::string& flags) {
-    const fs::path run = dir_.path() / "run";
-    if (!fs::exists(run)) {  // a folder of links to the repeat's frames, named in the run's order
-      fs::create_directories(run);
-      for (size_t f = 0; f < repeat_of.size(); ++f) {
-        char name[32];
-        std::snprintf(name, sizeof(name), "%07d.jpg", repeat_of[f]);
-        char link[32];
-        std::snprintf(link, sizeof(link), "%07zu.jpg", f);
-        fs::create_symlink(data_ / "repeat" / name, run / link);
-      }
+    const fs::path run = dir_.path() / "run";  // a folder of links to the repeat's frames, named in the run's order
+    fs::remove_all(run);
+    fs::create_directories(run);
+    for (size_t f = 0; f < repeat_of.size(); ++f) {
+      char name[32];
+      std::snprintf(name, sizeof(name), "%07d.jpg", repeat_of[f]);
+      char link[32];
+      std::snprintf(link, sizeof(link), "%07zu.jpg", f);
+      fs::create_symlink(data_ / "repeat" / name, run / link);
     }
     std::vector<std::pair<int, int>> steered =
         SteeredFrames(::vmap::testing::Quote(map_) + " " + ::vmap::testing::Quote(run) + " --start-key " +
