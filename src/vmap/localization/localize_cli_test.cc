@@ -279,18 +279,21 @@ bool SteeredBy(const std::pair<std::string, int>& frame) {
   return frame.first == "tracking" || frame.first == "relocalized";
 }
 
+// How many times a run's steered-by frames go back to an earlier key image (or its teach frame).
+int BackJumps(const std::vector<std::pair<std::string, int>>& run) {
+  int jumps = 0, steered_key = -1;
+  for (const auto& frame : run) {
+    if (!SteeredBy(frame)) continue;
+    jumps += frame.second < steered_key;
+    steered_key = frame.second;
+  }
+  return jumps;
+}
+
 // As CorridorRuns, how many times each run's steered-by frames go back to an earlier key image.
 std::vector<int> BackJumpsOnCorridor(const std::vector<std::string>& flags, int last) {
   std::vector<int> back_jumps;
-  for (const auto& run : CorridorRuns(flags, last)) {
-    int jumps = 0, steered_key = -1;
-    for (const auto& frame : run) {
-      if (!SteeredBy(frame)) continue;
-      jumps += frame.second < steered_key;
-      steered_key = frame.second;
-    }
-    back_jumps.push_back(jumps);
-  }
+  for (const auto& run : CorridorRuns(flags, last)) back_jumps.push_back(BackJumps(run));
   return back_jumps;
 }
 
@@ -394,6 +397,28 @@ TEST(LocalizeCli, OrbsRankingWeighsTheBeliefOfTheFramesAfterIt) {
   EXPECT_EQ(alone_far, 0);
   EXPECT_GE(near, alone_near + 2) << "steered by near their place: the ranking weighed " << near << ", not "
                                   << alone_near;
+}
+
+TEST(LocalizeCli, AFrameVerifiedWhereItsRankingPutsItIsSteeredBy) {
+  // corridor_conditions with ORB (docs/localize.md, "A frame verified where its ranking puts it"): frame 47 is
+  // relocalized a frame after its key image stopped verifying, and its comparison passes chance where the belief with
+  // its ranking singles the place out; the belief before its ranking, still at the key image left, doubted it. The rule
+  // changes nothing else: each frame it changes is one the belief doubted, now steered by at the same key image, and
+  // nothing is steered by far from its place or back.
+  const auto runs = CorridorRuns({"", " --no-verified-ranking-steers"}, 49, true);
+  if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  ASSERT_EQ(runs[0].size(), runs[1].size());
+  int released = 0;
+  for (size_t i = 0; i < runs[0].size(); ++i) {
+    if (runs[0][i] == runs[1][i]) continue;
+    EXPECT_EQ(runs[1][i].first, "uncertain") << "frame " << i;
+    EXPECT_TRUE(SteeredBy(runs[0][i])) << "frame " << i << ": " << runs[0][i].first;
+    EXPECT_EQ(runs[0][i].second, runs[1][i].second) << "frame " << i;
+    ++released;
+  }
+  EXPECT_GE(released, 1) << "no doubted frame steered by";
+  EXPECT_EQ(SteeredFarAndNear(runs[0], 0).first, 0);
+  EXPECT_LE(BackJumps(runs[0]), BackJumps(runs[1]));
 }
 
 TEST(LocalizeCli, MatchingInTheWindowOfThePredictionTracksFramesTheContinuityMisses) {

@@ -14,6 +14,11 @@ namespace {
 // The positions a result records its belief at (LocalizationResult::belief): those holding at least this.
 constexpr double kRecordedMass = 0.01;
 
+// Accepted by the a-contrario test itself (not by the heading's or the guided tests' looser ones).
+bool PassesChance(const KeyComparison& comparison, double max_log10_nfa) {
+  return comparison.accepted && comparison.log10_nfa <= max_log10_nfa;
+}
+
 }  // namespace
 
 void Localizer::WeighComparisons() {
@@ -99,6 +104,7 @@ bool Localizer::EvidenceWeighsAgainst(int position) const {
 }
 
 void Localizer::Believe(LocalizationResult& result, const Frame& frame, const ImageFeatures& features) {
+  const bool placed_by_tracker = IsPlaced(result.status);
   WeighComparisons();
   SettleStepOn(result, features);
   SettleStepBack(result, features);
@@ -117,7 +123,8 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
   const int position = result.route_position;
   const bool withheld_unranked = position >= 0 && withholds(position);
   const int evidence_peak_unranked = evidence_belief_.Peak();
-  if (!RankingMovesOwnFrame() && WeighRanking()) {
+  const bool ranked_now = !RankingMovesOwnFrame() && WeighRanking();
+  if (ranked_now) {
     belief_.Normalize();
     if (start_unconfirmed_) evidence_belief_.Normalize();
   }
@@ -148,6 +155,17 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
     guess.belief = std::move(result.belief);
     guess.confidence = belief_.MassWithin(peak, kNear);
     result = std::move(guess);
+  }
+  // Doubted only by the belief before the frame's own ranking (the tracker placed the frame, and the rules above
+  // withhold nothing with the ranking): the frame's comparison at its key images passes chance where the belief with
+  // its ranking singles the place out and the tracker is. Chance, the ranking and the tracker agree; the mass before
+  // the ranking is the frames before's, left where they were.
+  if (ranked_now && options_.verified_ranking_steers && placed_by_tracker &&
+      result.status == LocalizationStatus::kUncertain && position_ >= 0 &&
+      std::abs(position_ - result.route_position) <= kNear && std::abs(peak - result.route_position) <= kNear &&
+      (PassesChance(result.to_key, options_.max_log10_nfa) || PassesChance(result.to_next, options_.max_log10_nfa)) &&
+      SinglesOut(result.route_position) && !withholds(result.route_position)) {
+    result.status = LocalizationStatus::kRelocalized;
   }
 }
 

@@ -61,6 +61,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"rank_evidence", "!--no-rank-evidence",
                  "never weigh the belief by the relocalization's ranking of a frame (the comparisons alone)"},
                 rank_evidence);
+  visitor.Visit({"verified_ranking_steers", "!--no-verified-ranking-steers",
+                 "never steer by an ORB frame the belief doubts before the frame's own ranking, even where its key "
+                 "images pass chance and the belief with its ranking singles them out"},
+                verified_ranking_steers);
   visitor.Visit({"start_key", "--start-key",
                  "The key image the run starts at (teach and repeat: 0, the route's first): the tracker starts there "
                  "and the belief leans there, which the frames' evidence overrides (-1 = anywhere)"},

@@ -89,6 +89,13 @@ struct LocalizerOptions {
   // belief's rules moved the tracker: the frame's own ranking only withholds it ("ORB's ranking only withholds its own
   // frame"). Off: the comparisons alone weigh it.
   bool rank_evidence = true;
+  // ORB's frame that only the belief before its own ranking doubts is steered by where its comparison at its key images
+  // passes chance, the belief with its ranking singles that place out (the peak within two key images) and the tracker
+  // is there: the frame's verified evidence and its ranking agree, and what doubted it is mass the frames before left
+  // elsewhere (corridor_conditions frame 47: steered by at key image 19, whose next key image 20 its relocalization
+  // verified a frame after key image 16 stopped verifying, the belief before its ranking still at 15; docs/localize.md,
+  // "A frame verified where its ranking puts it"). Off: doubted as before.
+  bool verified_ranking_steers = true;
   // Key images compared beyond `next_key` when the frame has passed it (1 or 2: the issue's "next one or two").
   int lookahead = 2;
   // While tracking, also compare the key image before `key` when the frame is nearer `key` than `next_key`
