@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -542,6 +543,88 @@ TEST(LocalizeCli, AFarPlaceALostFrameVerifiedIsAskedAgain) {
                               << near[0];
 }
 
+// michigan_seasons' images (`names`: "SSPP", session SS's place PP) linked into `folder` as frames 1.png, 2.png, ...
+fs::path MichiganFrames(const fs::path& folder, const std::vector<std::string>& names) {
+  fs::create_directories(folder);
+  for (size_t i = 0; i < names.size(); ++i) {
+    fs::create_symlink(Shared() / "data/michigan_seasons/images" / (names[i] + ".png"),
+                       folder / (std::to_string(i + 1) + ".png"));
+  }
+  return folder;
+}
+
+// Session `s`'s five places, in route order.
+fs::path MichiganSession(const fs::path& folder, int s) {
+  std::vector<std::string> names;
+  for (int place = 1; place <= 5; ++place) {
+    char name[8];
+    std::snprintf(name, sizeof(name), "%02d%02d", s, place);
+    names.push_back(name);
+  }
+  return MichiganFrames(folder, names);
+}
+
+// Session `s`'s --tau 1 map in `dir`: one key image a place.
+fs::path MichiganMap(const fs::path& dir, int s) {
+  const fs::path map = dir / ("map" + std::to_string(s));
+  std::string out;
+  EXPECT_EQ(RunVmap("build " + Quote(MichiganSession(dir / ("map_session" + std::to_string(s)), s)) + " -o " +
+                        Quote(map) + " --tau 1 -q",
+                    &out),
+            0)
+      << out;
+  return map;
+}
+
+// The sessions' five places each, in `dir`.
+std::vector<fs::path> MichiganSessions(const fs::path& dir, const std::vector<int>& sessions) {
+  std::vector<fs::path> folders;
+  for (int s : sessions) folders.push_back(MichiganSession(dir / ("session" + std::to_string(s)), s));
+  return folders;
+}
+
+// `query` localized against `map` from key image `start_key` with `flags`: how many frames are steered by at the key
+// image `key_of(frame)` and how many elsewhere.
+std::pair<int, int> SteeredAtAndElsewhere(const fs::path& map, const fs::path& query, int start_key,
+                                          const std::string& flags, const std::function<int(int)>& key_of,
+                                          const fs::path& csv) {
+  std::pair<int, int> counts = {0, 0};
+  std::string out;
+  EXPECT_EQ(RunVmap("localize " + Quote(map) + " " + Quote(query) + " --start-key " + std::to_string(start_key) +
+                        " -q --csv " + Quote(csv) + flags,
+                    &out),
+            0)
+      << out;
+  const std::vector<std::string> rows = Lines(csv);
+  for (size_t r = 1; r < rows.size(); ++r) {
+    // frame,source_index,timestamp,source_name,status,key,...
+    std::stringstream row(rows[r]);
+    std::vector<std::string> cells;
+    for (std::string cell; cells.size() < 6 && std::getline(row, cell, ',');) cells.push_back(cell);
+    if (cells.size() < 6) {
+      ADD_FAILURE() << rows[r];
+      continue;
+    }
+    if (!SteeredBy({cells[4], 0})) continue;
+    (std::stoi(cells[5]) == key_of(std::stoi(cells[0])) ? counts.first : counts.second) += 1;
+  }
+  return counts;
+}
+
+// Each query session's frame i, taken at key image i's place, against `map` from key image 0: frames steered by at
+// their place and elsewhere, over the sessions.
+std::pair<int, int> SteeredOnMichiganRoutes(const fs::path& map, const std::vector<fs::path>& queries,
+                                            const std::string& flags, const fs::path& csv) {
+  std::pair<int, int> counts = {0, 0};
+  for (const fs::path& query : queries) {
+    const std::pair<int, int> run = SteeredAtAndElsewhere(
+        map, query, 0, flags, [](int frame) { return frame; }, csv);
+    counts.first += run.first;
+    counts.second += run.second;
+  }
+  return counts;
+}
+
 // michigan_seasons as a route (docs/localize.md, "A heading that stands out against the frame's rivals"): a --tau 1
 // map of session 01's five places, another session's five localized against it from key image 0. Across seasons chance
 // refuses ORB's verified sets at most right key images, but their matches agree on one displacement (the heading
@@ -549,47 +632,52 @@ TEST(LocalizeCli, AFarPlaceALostFrameVerifiedIsAskedAgain) {
 TEST(LocalizeCli, AHeadingThatStandsOutAgainstTheFramesRivalsLocalizesAcrossSeasons) {
   SKIP_WITHOUT_SHARED();
   ::vmap::testing::ScopedTempDir tmp;
-  std::string out;
-  auto session = [&](int s) {
-    const fs::path folder = tmp.path() / ("session" + std::to_string(s));
-    fs::create_directories(folder);
-    for (int place = 1; place <= 5; ++place) {
-      char name[16];
-      std::snprintf(name, sizeof(name), "%02d%02d.png", s, place);
-      fs::create_symlink(Shared() / "data/michigan_seasons/images" / name, folder / (std::to_string(place) + ".png"));
-    }
-    return folder;
-  };
-  const fs::path map = tmp.path() / "map";
-  ASSERT_EQ(RunVmap("build " + Quote(session(1)) + " -o " + Quote(map) + " --tau 1 -q", &out), 0) << out;
-  const std::vector<fs::path> queries = {session(2), session(5), session(7), session(9), session(11)};
-  auto right_and_wrong = [&](const std::string& flags) -> std::pair<int, int> {
-    std::pair<int, int> counts = {0, 0};
-    for (const fs::path& query : queries) {
-      const fs::path csv = tmp.path() / "run.csv";
-      EXPECT_EQ(RunVmap("localize " + Quote(map) + " " + Quote(query) + " --start-key 0 -q --csv " + Quote(csv) + flags,
-                        &out),
-                0)
-          << out;
-      const std::vector<std::string> rows = Lines(csv);
-      for (size_t r = 1; r < rows.size(); ++r) {
-        // frame,source_index,timestamp,source_name,status,key,...: frame i was taken at key image i's place
-        std::stringstream row(rows[r]);
-        std::vector<std::string> cells;
-        for (std::string cell; cells.size() < 6 && std::getline(row, cell, ',');) cells.push_back(cell);
-        if (cells.size() < 6) {
-          ADD_FAILURE() << rows[r];
-          continue;
-        }
-        if (!SteeredBy({cells[4], 0})) continue;
-        (std::stoi(cells[5]) == std::stoi(cells[0]) ? counts.first : counts.second) += 1;
-      }
-    }
-    return counts;
-  };
-  const std::pair<int, int> with = right_and_wrong(""), without = right_and_wrong(" --min-heading-rival-ratio 0");
+  const fs::path map = MichiganMap(tmp.path(), 1);
+  const std::vector<fs::path> queries = MichiganSessions(tmp.path(), {2, 5, 7, 9, 11});
+  const fs::path csv = tmp.path() / "run.csv";
+  const std::pair<int, int> with = SteeredOnMichiganRoutes(map, queries, "", csv),
+                            without = SteeredOnMichiganRoutes(map, queries, " --min-heading-rival-ratio 0", csv);
   EXPECT_GE(with.first, without.first + 4) << "with the heading " << with.first << ", without " << without.first;
   EXPECT_EQ(with.second, 0) << "steered by at another place";
+}
+
+// A lost frame steps on where its ranking and its heading agree (docs/measurements/localization-conditions.md): the
+// same map, sessions whose frames nothing verifies, relocalized or guided, at a place or two, and whose ranking and
+// heading modes both name the tracker's next key image there: steered by at their place, none elsewhere.
+TEST(LocalizeCli, ALostFrameStepsOnWhereItsRankingAndItsHeadingAgree) {
+  SKIP_WITHOUT_SHARED();
+  ::vmap::testing::ScopedTempDir tmp;
+  const fs::path map = MichiganMap(tmp.path(), 1);
+  const std::vector<fs::path> queries = MichiganSessions(tmp.path(), {4, 6, 7, 9, 12});
+  const fs::path csv = tmp.path() / "run.csv";
+  const std::pair<int, int> with = SteeredOnMichiganRoutes(map, queries, "", csv),
+                            without = SteeredOnMichiganRoutes(map, queries, " --no-step-on-where-evidence-agrees", csv);
+  EXPECT_GE(with.first, without.first + 4) << "with the rule " << with.first << ", without " << without.first;
+  EXPECT_EQ(with.second, 0) << "steered by at another place";
+}
+
+// The rule above needs the frame's own evidence, not the motion prior: a robot that stops at a place, whose frames
+// nothing verifies, is not walked on to the next key image. Session 12's map, from key image 2 (place 3): the place-3
+// images of sessions 02 and 06 repeated (their ranking and heading name place 4: stepped on from the start key image by
+// a rule that does not ask for a frame steered by before it), and session 12's own place-3 image, steered by, then
+// those of sessions 01 and 05 (stepped on by a rule that asks no evidence of the frame). Six of michigan's 660 place
+// images name the next place so and are stepped on once after a steered frame (docs/measurements/
+// localization-conditions.md, "A lost frame steps on where its ranking and its heading agree").
+TEST(LocalizeCli, ALostFrameOfARobotThatStopsIsNotSteppedOn) {
+  SKIP_WITHOUT_SHARED();
+  ::vmap::testing::ScopedTempDir tmp;
+  const fs::path map = MichiganMap(tmp.path(), 12);
+  const fs::path csv = tmp.path() / "run.csv";
+  const std::vector<std::vector<std::string>> stops = {std::vector<std::string>(5, "0203"),
+                                                       std::vector<std::string>(5, "0603"),
+                                                       {"1203", "0103", "0103", "0103", "0103"},
+                                                       {"1203", "0503", "0503", "0503", "0503"}};
+  for (const std::vector<std::string>& frames : stops) {
+    const fs::path query = MichiganFrames(tmp.path() / (frames.front() + "_" + frames.back()), frames);
+    const std::pair<int, int> run = SteeredAtAndElsewhere(
+        map, query, 2, "", [](int) { return 2; }, csv);
+    EXPECT_EQ(run.second, 0) << frames.front() << ", then " << frames.back() << ": steered by at another place";
+  }
 }
 
 TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {

@@ -145,6 +145,7 @@ void Localizer::Reset() {
   rival_frames_left_ = 0;
   position_ = start_position_;
   lost_in_a_row_ = 0;
+  steered_before_ = -1;
   dropped_position_ = -1;
   frames_since_drop_ = 0;
   step_back_ruled_out_ = {};
@@ -190,6 +191,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
     if (std::isfinite(m.comparison.heading.px))
       previous_headings_.emplace_back(m.comparison.key, m.comparison.heading.px);
   }
+  steered_before_ = IsPlaced(result.status) ? result.route_position : -1;
   result.frame_index = frame.index;
   result.source_index = frame.source_index;
   result.timestamp = frame.timestamp;
@@ -312,6 +314,14 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     }
     const bool relocalized = found.status == LocalizationStatus::kRelocalized;
     if (relocalized && TakesJump(position, found.route_position, lost_before)) return found;
+    // Nothing verified anywhere: the frame's ranking and heading modes, each too weak for chance alone, step it on
+    // where both name the key image after the one the frame before was steered by at (the robot seen there, this frame
+    // names where it goes next; a robot that stops shows the same place again, which names the same key image).
+    if (!relocalized && steered_before_ == position && options_.step_on_where_evidence_agrees &&
+        EvidenceAgreesOnNext(position)) {
+      result.candidates = std::move(found.candidates);
+      return TrackedAt(std::move(result), position, position + 1, features);
+    }
     // Lost, or found far from where the frames were on this frame's evidence alone: the estimate stays (uncertain,
     // the best guess, until the next frame confirms the far place).
     result.status = relocalized ? LocalizationStatus::kUncertain : LocalizationStatus::kLost;
@@ -365,6 +375,21 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   result = TrackedAt(std::move(result), position, best_position, features);
   if (doubted) result.status = LocalizationStatus::kUncertain;
   return result;
+}
+
+bool Localizer::EvidenceAgreesOnNext(int position) const {
+  // Measured with binary descriptors only (across seasons ORB's chance refuses most right key images; XFeat's rarely).
+  const int next = position + 1;
+  if (!heading_accepts_ || next >= static_cast<int>(route_.size()) || ranked_.size() < 2) return false;
+  // The ranking holds the route's key images in route order: ranked_[r].key is a route position.
+  if (ranked_[0].key != next || ranked_[0].score <= ranked_[1].score) return false;
+  int next_votes = -1, other_votes = -1;
+  for (const Memo& m : comparisons_) {
+    if (!m.used || route_position_of_key_[m.comparison.key] < 0) continue;
+    int& votes = m.comparison.key == route_[next] ? next_votes : other_votes;
+    votes = std::max(votes, m.comparison.heading.votes);
+  }
+  return next_votes > other_votes;
 }
 
 LocalizationResult Localizer::TrackedAt(LocalizationResult result, int from, int position,

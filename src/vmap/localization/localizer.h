@@ -96,6 +96,10 @@ class Localizer {
   // not; each comparison chance accepts replaces its key image's memo (the first one's evidence weighed first).
   // Returns whether any was accepted.
   bool GuideRelocalization(const Frame& frame, const ImageFeatures& features);
+  // A lost frame steps on where its evidence agrees (LocalizerOptions::step_on_where_evidence_agrees): whether the
+  // frame's ranking (ranked by its relocalization) and its comparisons' heading modes each single out the key image
+  // at route `position + 1`, the tracker's next.
+  bool EvidenceAgreesOnNext(int position) const;
   // The previous frame's heading (px) against key image `key`; none when that frame was not compared with it.
   std::optional<double> PreviousHeading(int key) const;
   // The continuity of the heading (LocalizerOptions::continuity_share): `guided`, the guided matches of the frame
@@ -269,6 +273,8 @@ class Localizer {
   int position_ = -1;        // route position of `key`; -1: no estimate
   int start_position_ = -1;  // route position of LocalizerOptions::start_key; -1: none
   int lost_in_a_row_ = 0;
+  // The route position the frame before this one was steered by at (tracking or relocalized); -1: it was not.
+  int steered_before_ = -1;
   // Where the estimate was last dropped (route position; -1: none) and the frames since, while guided_while_lost
   // still asks there.
   int dropped_position_ = -1;

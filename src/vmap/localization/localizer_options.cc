@@ -128,6 +128,9 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"guided_relocalization", "!--no-guided-relocalization",
                  "ORB: never match a lost frame guided at the key images its relocalization ranked best"},
                 guided_relocalization);
+  visitor.Visit({"step_on_where_evidence_agrees", "!--no-step-on-where-evidence-agrees",
+                 "ORB: never step a lost frame on to the next key image where its ranking and its heading mode agree"},
+                step_on_where_evidence_agrees);
   visitor.Visit({"guided_lookahead", "!--no-guided-lookahead",
                  "ORB: match a frame guided at the key image and the next one only, ranked by verified matches (not "
                  "over the lookahead, ranked by the one-way matches' NFA where chance accepts none)"},
