@@ -179,7 +179,8 @@ struct LocalizerOptions {
   // is wrong in 63 % of the lost frames); both together, at the one key image a robot seen at the one before reaches
   // next, have not. The frame's own evidence must name that key image, so a robot that stops is not walked on by the
   // motion prior (docs/measurements/localization-conditions.md, "A lost frame steps on where its ranking and its
-  // heading agree"). Off: such a frame is lost.
+  // heading agree"). Such a frame is placed, not steered by: its heading is that of comparisons chance and the heading
+  // rule refused (guidance "none"; "The frames it places are not steered by"). Off: such a frame is lost.
   bool step_on_where_evidence_agrees = true;
   // Guided matching over the lookahead: it asks the tracked key image and the `lookahead` key images after it (the
   // tracker's own reach), and ranks what it accepts by a measure common to the key images asked: those chance accepts
