@@ -645,7 +645,8 @@ TEST(LocalizeCli, AHeadingThatStandsOutAgainstTheFramesRivalsLocalizesAcrossSeas
 
 // A lost frame steps on where its ranking and its heading agree (docs/measurements/localization-conditions.md): the
 // same map, sessions whose frames nothing verifies, relocalized or guided, at a place or two, and whose ranking and
-// heading modes both name the tracker's next key image there: steered by at their place, none elsewhere.
+// heading modes both name the tracker's next key image there: placed at their place, none elsewhere (placed, not
+// steered by: AFrameTheEvidenceStepsOnIsNotSteeredByItsHeading).
 TEST(LocalizeCli, ALostFrameStepsOnWhereItsRankingAndItsHeadingAgree) {
   SKIP_WITHOUT_SHARED();
   ::vmap::testing::ScopedTempDir tmp;
