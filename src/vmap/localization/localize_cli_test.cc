@@ -44,6 +44,28 @@ std::vector<std::string> Lines(const fs::path& file) {
   return lines;
 }
 
+// The cells of column `name` in a CSV `vmap localize` wrote, one a frame.
+std::vector<std::string> CsvColumn(const fs::path& csv, const std::string& name) {
+  auto split = [](const std::string& line) {
+    std::vector<std::string> cells;
+    std::stringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+    if (!line.empty() && line.back() == ',') cells.emplace_back();
+    return cells;
+  };
+  const std::vector<std::string> rows = Lines(csv);
+  if (rows.empty()) return {};
+  const std::vector<std::string> header = split(rows[0]);
+  const size_t column = std::find(header.begin(), header.end(), name) - header.begin();
+  EXPECT_LT(column, header.size()) << name << " is not a column of " << csv;
+  std::vector<std::string> cells;
+  for (size_t r = 1; r < rows.size(); ++r) {
+    const std::vector<std::string> row = split(rows[r]);
+    cells.push_back(column < row.size() ? row[column] : "");
+  }
+  return cells;
+}
+
 // A map of the first 240 frames of lab_floor.mp4, built once by the binary for the tests of this file.
 const fs::path& LabMap() {
   static ::vmap::testing::ScopedTempDir directory;
@@ -259,15 +281,10 @@ std::vector<std::vector<std::pair<std::string, int>>> CorridorRuns(const std::ve
     const fs::path csv = tmp.path() / "run.csv";
     EXPECT_EQ(RunVmap("localize " + Quote(tmp.path() / "map") + " " + query + " -q --csv " + Quote(csv) + f, &out), 0)
         << out;
+    const std::vector<std::string> status = CsvColumn(csv, "status"),
+                                   keys = CsvColumn(csv, teach_frames ? "key_frame" : "key");
     std::vector<std::pair<std::string, int>> frames;
-    const std::vector<std::string> rows = Lines(csv);
-    for (size_t r = 1; r < rows.size(); ++r) {
-      // frame,source_index,timestamp,source_name,status,key,next_key,key_frame,...
-      std::stringstream row(rows[r]);
-      std::vector<std::string> cells;
-      for (std::string cell; cells.size() < 8 && std::getline(row, cell, ',');) cells.push_back(cell);
-      if (cells.size() == 8) frames.emplace_back(cells[4], std::stoi(cells[teach_frames ? 7 : 5]));
-    }
+    for (size_t i = 0; i < status.size() && i < keys.size(); ++i) frames.emplace_back(status[i], std::stoi(keys[i]));
     runs.push_back(std::move(frames));
   }
   return runs;
@@ -597,18 +614,11 @@ std::pair<int, int> SteeredAtAndElsewhere(const fs::path& map, const fs::path& q
                     &out),
             0)
       << out;
-  const std::vector<std::string> rows = Lines(csv);
-  for (size_t r = 1; r < rows.size(); ++r) {
-    // frame,source_index,timestamp,source_name,status,key,...
-    std::stringstream row(rows[r]);
-    std::vector<std::string> cells;
-    for (std::string cell; cells.size() < 6 && std::getline(row, cell, ',');) cells.push_back(cell);
-    if (cells.size() < 6) {
-      ADD_FAILURE() << rows[r];
-      continue;
-    }
-    if (!SteeredBy({cells[4], 0})) continue;
-    (std::stoi(cells[5]) == key_of(std::stoi(cells[0])) ? counts.first : counts.second) += 1;
+  const std::vector<std::string> frames = CsvColumn(csv, "frame"), status = CsvColumn(csv, "status"),
+                                 keys = CsvColumn(csv, "key");
+  for (size_t i = 0; i < frames.size(); ++i) {
+    if (!SteeredBy({status[i], 0})) continue;
+    (std::stoi(keys[i]) == key_of(std::stoi(frames[i])) ? counts.first : counts.second) += 1;
   }
   return counts;
 }
@@ -657,28 +667,6 @@ TEST(LocalizeCli, ALostFrameStepsOnWhereItsRankingAndItsHeadingAgree) {
                             without = SteeredOnMichiganRoutes(map, queries, " --no-step-on-where-evidence-agrees", csv);
   EXPECT_GE(with.first, without.first + 4) << "with the rule " << with.first << ", without " << without.first;
   EXPECT_EQ(with.second, 0) << "steered by at another place";
-}
-
-// The cells of column `name` in a CSV `vmap localize` wrote, one a frame.
-std::vector<std::string> CsvColumn(const fs::path& csv, const std::string& name) {
-  auto split = [](const std::string& line) {
-    std::vector<std::string> cells;
-    std::stringstream row(line);
-    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
-    if (!line.empty() && line.back() == ',') cells.emplace_back();
-    return cells;
-  };
-  const std::vector<std::string> rows = Lines(csv);
-  if (rows.empty()) return {};
-  const std::vector<std::string> header = split(rows[0]);
-  const size_t column = std::find(header.begin(), header.end(), name) - header.begin();
-  EXPECT_LT(column, header.size()) << name << " is not a column of " << csv;
-  std::vector<std::string> cells;
-  for (size_t r = 1; r < rows.size(); ++r) {
-    const std::vector<std::string> row = split(rows[r]);
-    cells.push_back(column < row.size() ? row[column] : "");
-  }
-  return cells;
 }
 
 // The frames the rule above places have no heading to steer by: the heading is that of comparisons chance and the

@@ -145,7 +145,7 @@ void Localizer::Reset() {
   rival_frames_left_ = 0;
   position_ = start_position_;
   lost_in_a_row_ = 0;
-  steered_before_ = -1;
+  placed_before_ = -1;
   dropped_position_ = -1;
   frames_since_drop_ = 0;
   step_back_ruled_out_ = {};
@@ -191,7 +191,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
     if (std::isfinite(m.comparison.heading.px))
       previous_headings_.emplace_back(m.comparison.key, m.comparison.heading.px);
   }
-  steered_before_ = IsPlaced(result.status) ? result.route_position : -1;
+  placed_before_ = IsPlaced(result.status) ? result.route_position : -1;
   result.frame_index = frame.index;
   result.source_index = frame.source_index;
   result.timestamp = frame.timestamp;
@@ -315,15 +315,15 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     const bool relocalized = found.status == LocalizationStatus::kRelocalized;
     if (relocalized && TakesJump(position, found.route_position, lost_before)) return found;
     // Nothing verified anywhere: the frame's ranking and heading modes, each too weak for chance alone, step it on
-    // where both name the key image after the one the frame before was steered by at (the robot seen there, this frame
+    // where both name the key image after the one the frame before was placed at (the robot seen there, this frame
     // names where it goes next; a robot that stops shows the same place again, which names the same key image).
-    if (!relocalized && steered_before_ == position && options_.step_on_where_evidence_agrees &&
+    if (!relocalized && placed_before_ == position && options_.step_on_where_evidence_agrees &&
         EvidenceAgreesOnNext(position)) {
       result.candidates = std::move(found.candidates);
       LocalizationResult placed = TrackedAt(std::move(result), position, position + 1, features);
       // Placed, but not steered by (guidance "none"): the place is the two measures' agreement, the heading that of
       // comparisons chance and the heading rule refused. On michigan_seasons 13 of the 37 frames placed so had a
-      // heading against their key image more than 35 px off the hand label, against 25 of the 337 frames placed
+      // heading against their key image more than 35 px off the hand label, against 25 of the 336 frames placed
       // otherwise. heading_key_px stays, as a lost frame's does: what the comparison measured, not to steer by.
       placed.heading_px = placed.heading_deg = kNaN;
       placed.translation_known = false;

@@ -273,8 +273,8 @@ class Localizer {
   int position_ = -1;        // route position of `key`; -1: no estimate
   int start_position_ = -1;  // route position of LocalizerOptions::start_key; -1: none
   int lost_in_a_row_ = 0;
-  // The route position the frame before this one was steered by at (tracking or relocalized); -1: it was not.
-  int steered_before_ = -1;
+  // The route position the frame before this one was placed at (tracking or relocalized); -1: it was not.
+  int placed_before_ = -1;
   // Where the estimate was last dropped (route position; -1: none) and the frames since, while guided_while_lost
   // still asks there.
   int dropped_position_ = -1;

@@ -172,15 +172,16 @@ struct LocalizerOptions {
   // relocalization is matched guided"). Off: a lost frame's relocalization compares the cross-checked matches only.
   bool guided_relocalization = true;
   // A lost frame steps on where its own weak evidence agrees (ORB maps): a frame that nothing verifies, relocalized or
-  // guided, right after a frame steered by at the tracked key image, moves on to the key image after it when the
-  // frame's ranking puts that key image first and its heading mode holds more votes there than at any other key image
-  // compared, each strictly (a tie singles out nothing). Across seasons (michigan_seasons) chance refuses most right
-  // key images, and each of the two measures of the frame's likeness names a wrong key image often (the ranking's first
-  // is wrong in 63 % of the lost frames); both together, at the one key image a robot seen at the one before reaches
-  // next, have not. The frame's own evidence must name that key image, so a robot that stops is not walked on by the
-  // motion prior (docs/measurements/localization-conditions.md, "A lost frame steps on where its ranking and its
-  // heading agree"). Such a frame is placed, not steered by: its heading is that of comparisons chance and the heading
-  // rule refused (guidance "none"; "The frames it places are not steered by"). Off: such a frame is lost.
+  // guided, right after a frame placed (tracking or relocalized) at the tracked key image, moves on to the key image
+  // after it when the frame's ranking puts that key image first and its heading mode holds more votes there than at any
+  // other key image compared, each strictly (a tie singles out nothing). Across seasons (michigan_seasons) chance
+  // refuses most right key images, and each of the two measures of the frame's likeness names a wrong key image often
+  // (the ranking's first is wrong in 63 % of the lost frames); both together, at the one key image a robot seen at the
+  // one before reaches next, have not. The frame's own evidence must name that key image, so a robot that stops is not
+  // walked on by the motion prior (docs/measurements/localization-conditions.md, "A lost frame steps on where its
+  // ranking and its heading agree"). Such a frame is placed, not steered by: its heading is that of comparisons chance
+  // and the heading rule refused (guidance "none"; "The frames it places are not steered by"). Off: such a frame is
+  // lost.
   bool step_on_where_evidence_agrees = true;
   // Guided matching over the lookahead: it asks the tracked key image and the `lookahead` key images after it (the
   // tracker's own reach), and ranks what it accepts by a measure common to the key images asked: those chance accepts
