@@ -730,6 +730,37 @@ TEST(LocalizeCli, ALostFrameOfARobotThatStopsIsNotSteppedOn) {
   }
 }
 
+TEST(LocalizeCli, ComparisonThreadsChangeNoResult) {
+  // corridor_conditions with ORB: its frames are refused at their tracked key images, compared with their rivals,
+  // relocalized and questioned, and the comparisons they are about to make are made meanwhile on a second core
+  // (LocalizerOptions::comparison_threads; docs/measurements/localization-conditions.md, "Where ORB's corridor time
+  // goes"). Every CSV column but the time is as when each comparison is made in turn (one thread).
+  const fs::path data = Shared() / "data/corridor_conditions";
+  if (Shared().empty() || !fs::exists(data)) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  ::vmap::testing::ScopedTempDir tmp;
+  std::string out;
+  ASSERT_EQ(RunVmap("build " + Quote(data / "teach") + " -q -o " + Quote(tmp.path() / "map"), &out), 0) << out;
+  // Per run, each column but the time, by name.
+  std::vector<std::map<std::string, std::vector<std::string>>> runs;
+  for (const std::string flags : {"", " --comparison-threads 1"}) {
+    const fs::path csv = tmp.path() / "run.csv";
+    ASSERT_EQ(RunVmap("localize " + Quote(tmp.path() / "map") + " " + Quote(data / "repeat") + " --last 59 -q --csv " +
+                          Quote(csv) + flags,
+                      &out),
+              0)
+        << out;
+    std::stringstream header(Lines(csv).at(0));
+    std::map<std::string, std::vector<std::string>> columns;
+    for (std::string name; std::getline(header, name, ',');) {
+      if (name != "seconds") columns[name] = CsvColumn(csv, name);
+    }
+    runs.push_back(std::move(columns));
+  }
+  ASSERT_EQ(runs[0].at("status").size(), 60u);
+  EXPECT_GT(runs[0].size(), 40u);
+  for (const auto& [name, cells] : runs[0]) EXPECT_EQ(cells, runs[1].at(name)) << name;
+}
+
 TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
   ::vmap::testing::ScopedTempDir tmp;
   ::vmap::testing::SyntheticOptions synthetic;

@@ -116,6 +116,11 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
       window_matcher_ = CreateMatcher(guided);
     }
   }
+  if (options_.comparison_threads > 1) {
+    speculation_ = std::make_unique<SpeculativeComparisons>(
+        [this](const ImageFeatures& features, int key) { return Compare(features, key); },
+        options_.comparison_threads - 1);
+  }
   Reset();  // at the start key image, when there is one
 }
 
@@ -155,6 +160,13 @@ void Localizer::Reset() {
 LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& features,
                                        std::vector<KeyComparison> ahead) {
   const auto start = std::chrono::steady_clock::now();
+  // The comparisons made meanwhile read `features`: those not taken are done with before the frame is.
+  struct FinishSpeculation {
+    SpeculativeComparisons* speculation;
+    ~FinishSpeculation() {
+      if (speculation) speculation->Finish();
+    }
+  } finish_speculation{speculation_.get()};
   comparisons_.clear();
   ranked_.clear();
   bucket_of_position_.clear();
@@ -196,6 +208,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   result.source_index = frame.source_index;
   result.timestamp = frame.timestamp;
   result.source_name = frame.source_name;
+  if (speculation_) speculation_->Finish();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

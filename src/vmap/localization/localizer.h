@@ -36,6 +36,7 @@
 #include "vmap/localization/map_verifier_options.h"
 #include "vmap/localization/route_belief.h"
 #include "vmap/localization/route_evidence.h"
+#include "vmap/localization/speculative_comparisons.h"
 #include "vmap/map/visual_map.h"
 #include "vmap/sources/frame_source.h"
 
@@ -83,6 +84,10 @@ class Localizer {
                              int key) const;
   // Each key image is compared with a frame at most once per Localize call.
   KeyComparison CompareOnce(const ImageFeatures& features, int key);
+  // The frame's comparisons with the key images at route `positions` (those on the route, not compared yet), which
+  // it is about to make, in that order: made meanwhile on the other comparison threads (speculation_), CompareOnce
+  // takes them.
+  void CompareMeanwhile(const ImageFeatures& features, const std::vector<int>& positions);
   // Guided matching (LocalizerOptions::guided_matching): the frame matched again with guided_matcher_ at route
   // `position` and the `lookahead` after it (guided_lookahead; else the one after it), the belief singling out that
   // place, each only where its first comparison verified at least the link share (min_link_share; chance alone refused
@@ -337,6 +342,9 @@ class Localizer {
   // not), on this frame and the one before (RouteBeliefOptions::move_needs_two_frames).
   int confident_peak_ = -1;
   int confident_peak_before_ = -1;
+  // Comparisons of the frame being localized made meanwhile on helper threads (CompareMeanwhile); null with one
+  // comparison thread. Last: stopped before the members its comparisons read are destroyed.
+  std::unique_ptr<SpeculativeComparisons> speculation_;
 };
 
 }  // namespace vmap

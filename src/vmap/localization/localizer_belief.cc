@@ -265,6 +265,9 @@ void Localizer::Question(LocalizationResult& result, const Frame& frame, const I
   // The key image stops explaining the frame: look where the belief has it, behind and ahead of its peak (the key
   // images whose evidence weighs the positions within `window` of it).
   auto compare_around = [&](int centre) {
+    std::vector<int> meanwhile;  // the first is compared at once; the helper starts from the last
+    for (int q = std::min(last, centre + window + 1); q > std::max(0, centre - window); --q) meanwhile.push_back(q);
+    CompareMeanwhile(features, meanwhile);
     for (int q = std::max(0, centre - window); q <= std::min(last, centre + window + 1); ++q) {
       CompareOnce(features, route_[q]);
     }

@@ -110,6 +110,10 @@ int Localizer::TrackGuided(const Frame& frame, const ImageFeatures& features, in
   double best_guided_log10_nfa = 0.0;
   bool best_by_chance = false;
   std::shared_ptr<const ImageFeatures> window_features;  // window_matcher_'s, extracted when first needed
+  // Every key image of the loop below is compared first: those after `position` are made meanwhile.
+  std::vector<int> after;
+  for (int p = std::min(last, position + reach); p > position; --p) after.push_back(p);
+  CompareMeanwhile(features, after);
   for (int p = position; p <= std::min(last, position + reach); ++p) {
     const int key = route_[p];
     // Only where chance refused the first comparison and the link share did not: guided matching asks chance again,
@@ -224,8 +228,21 @@ KeyComparison Localizer::CompareOnce(const ImageFeatures& features, int key) {
       return m.comparison;
     }
   }
-  comparisons_.push_back({Compare(features, key), true});
+  std::optional<KeyComparison> made = speculation_ ? speculation_->Take(key) : std::nullopt;
+  comparisons_.push_back({made ? std::move(*made) : Compare(features, key), true});
   return comparisons_.back().comparison;
+}
+
+void Localizer::CompareMeanwhile(const ImageFeatures& features, const std::vector<int>& positions) {
+  if (!speculation_) return;
+  std::vector<int> keys;
+  for (int p : positions) {
+    if (p < 0 || p >= static_cast<int>(route_.size())) continue;
+    const int key = route_[p];
+    if (std::none_of(comparisons_.begin(), comparisons_.end(), [&](const Memo& m) { return m.comparison.key == key; }))
+      keys.push_back(key);
+  }
+  if (!keys.empty()) speculation_->Add(features, keys);
 }
 
 }  // namespace vmap

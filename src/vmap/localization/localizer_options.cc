@@ -171,6 +171,11 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.VisitNested("translation", translation);
   visitor.Visit({"similarity"}, EnumField(similarity, kSimilarityModeNames, ParseSimilarityMode));
   visitor.Visit({"route"}, route);
+  visitor.Visit(OptionField{"comparison_threads", "--comparison-threads",
+                            "Threads comparing a frame with key images (1: one comparison after another); the "
+                            "results do not depend on it"}
+                    .NotRecorded(),
+                comparison_threads);
 }
 
 void LocalizerOptions::Check() const {
@@ -280,6 +285,10 @@ void LocalizerOptions::Check() const {
   CheckField("verifier", verifier);
   CheckField("heading", heading);
   CheckField("translation", translation);
+  if (comparison_threads < 1 || comparison_threads > 64) {
+    throw OptionError("comparison_threads",
+                      fmt::format("{} must be 1 to 64 (default {})", comparison_threads, defaults.comparison_threads));
+  }
   if (experience_candidates < 0 || experience_candidates > 1000) {
     throw OptionError("experience_candidates", fmt::format("{} must be 0 (teach key images only) to 1000 (default {})",
                                                            experience_candidates, defaults.experience_candidates));

@@ -266,6 +266,10 @@ struct LocalizerOptions {
   // those with the most tentative matches with the frame (matching is cheap, verification is not). 0: the
   // teach key images only. 2 by default: a frame rarely fits more than the one or two views of its season.
   int experience_candidates = 2;
+  // How a run is carried out, not what it decides: threads comparing a frame with key images, the Localizer's own
+  // included. Those beyond it make the comparisons the frame is about to make meanwhile (speculative_comparisons.h),
+  // with the same results. 1: no thread of its own, one comparison after another.
+  int comparison_threads = 2;
 
   // As a localization run records them (its "options"; not the camera, which the map gives) and the flags of
   // `vmap localize`. The verifier, the translation thresholds and the similarity follow the map

@@ -25,6 +25,9 @@ std::vector<int> Localizer::CompareBestRanked(const Frame& frame, const ImageFea
   RankRoute(frame, features);
   const int count = std::min<int>(options_.relocalization_candidates, static_cast<int>(ranked_.size()));
   std::vector<int> positions;
+  std::vector<int> meanwhile;  // the first is compared at once; the helper starts from the last
+  for (int i = count - 1; i > 0; --i) meanwhile.push_back(ranked_[i].key);
+  CompareMeanwhile(features, meanwhile);
   for (int i = 0; i < count; ++i) {
     positions.push_back(ranked_[i].key);  // the ranking holds the route's key images in route order
     CompareOnce(features, route_[ranked_[i].key]);
@@ -64,6 +67,7 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
   int position = best_position;
   // The segment before the key image only where the two share a scene: a frame is not between two unrelated places.
   if (position > 0 && scene_link_after_[position - 1]) {
+    CompareMeanwhile(features, {position + 1});
     const KeyComparison before = CompareOnce(features, route_[position - 1]);
     const bool has_next = position + 1 < static_cast<int>(route_.size());
     const KeyComparison after = has_next ? CompareOnce(features, route_[position + 1]) : KeyComparison();

@@ -462,6 +462,7 @@ TEST(Localizer, OptionsAreChecked) {
   };
   auto path = [&](auto change) { return testing::OptionErrorPath([&] { with(change).Check(); }); };
   EXPECT_EQ(path([](LocalizerOptions& o) { o.min_verified = 5; }), "min_verified");
+  EXPECT_EQ(path([](LocalizerOptions& o) { o.comparison_threads = 0; }), "comparison_threads");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.min_similarity = 1.5; }), "min_similarity");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.max_log10_nfa = std::nan(""); }), "max_log10_nfa");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.recheck_link_share = -0.1; }), "recheck_link_share");
