@@ -706,6 +706,30 @@ TEST(LocalizeCli, AFrameTheEvidenceStepsOnIsNotSteeredByItsHeading) {
   EXPECT_GE(placed_without_heading, 4);
 }
 
+// The same after lost frames (docs/measurements/localization-conditions.md, "A frame after lost frames steps on where
+// its evidence agrees"): session 11's map, sessions whose first frame nothing verifies at the start key image and
+// whose second frame's ranking and heading name key image 1 where the first frame's did not: placed at their place
+// (not steered by: guidance "none", no heading), none elsewhere; lost without the rule.
+TEST(LocalizeCli, AFrameAfterLostFramesStepsOnWhereItsEvidenceAgrees) {
+  SKIP_WITHOUT_SHARED();
+  ::vmap::testing::ScopedTempDir tmp;
+  const fs::path map = MichiganMap(tmp.path(), 11);
+  const std::vector<fs::path> queries = MichiganSessions(tmp.path(), {1, 2, 3, 6, 10});
+  const fs::path csv = tmp.path() / "run.csv";
+  const std::pair<int, int> without = SteeredOnMichiganRoutes(map, queries, " --no-step-on-after-lost-frames", csv);
+  const std::pair<int, int> with = SteeredOnMichiganRoutes(map, queries, "", csv);
+  EXPECT_GE(with.first, without.first + 2) << "with the rule " << with.first << ", without " << without.first;
+  EXPECT_EQ(with.second, 0) << "placed at another place";
+  std::string out;
+  ASSERT_EQ(RunVmap("localize " + Quote(map) + " " + Quote(queries[1]) + " --start-key 0 -q --csv " + Quote(csv), &out),
+            0)
+      << out;
+  EXPECT_EQ(CsvColumn(csv, "status")[1], "tracking");
+  EXPECT_EQ(CsvColumn(csv, "key")[1], "1");
+  EXPECT_EQ(CsvColumn(csv, "guidance")[1], "none");
+  EXPECT_EQ(CsvColumn(csv, "heading_px")[1], "");
+}
+
 // The rule above needs the frame's own evidence, not the motion prior: a robot that stops at a place, whose frames
 // nothing verifies, is not walked on to the next key image. Session 12's map, from key image 2 (place 3): the place-3
 // images of sessions 02 and 06 repeated (their ranking and heading name place 4: stepped on from the start key image by

@@ -22,6 +22,11 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // match: the step back is not checked again until the frame moves back (Localizer::Track). Chosen on lab_floor
 // (docs/measurements/code-choices.md, "Ruling out a step back").
 constexpr double kClearlyWorse = 0.7;
+// What a lost frame's ranking and heading mode agreeing on a key image tell of it (log of the likelihood ratio):
+// on michigan_seasons' ORB frames nothing verifies, both name the right key image in 20.2 % of the frames and each
+// wrong one in 2.0 % (docs/measurements/localization-conditions.md, "A lost frame steps on where its ranking and its
+// heading agree"): ten times likelier at the right key image.
+constexpr double kAgreementLogRatio = 2.302585092994046;  // ln 10
 
 // The link's verified matches pass chance as a comparison's must (acceptance.h), one test: the two key images share a
 // scene. Without its matches in memory (a map loaded without them) it is taken to.
@@ -151,6 +156,7 @@ void Localizer::Reset() {
   position_ = start_position_;
   lost_in_a_row_ = 0;
   placed_before_ = -1;
+  ranking_first_before_ = heading_mode_before_ = -1;
   dropped_position_ = -1;
   frames_since_drop_ = 0;
   step_back_ruled_out_ = {};
@@ -204,6 +210,8 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
       previous_headings_.emplace_back(m.comparison.key, m.comparison.heading.px);
   }
   placed_before_ = IsPlaced(result.status) ? result.route_position : -1;
+  ranking_first_before_ = RankingFirst();
+  heading_mode_before_ = HeadingMode();
   result.frame_index = frame.index;
   result.source_index = frame.source_index;
   result.timestamp = frame.timestamp;
@@ -333,14 +341,23 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     if (!relocalized && placed_before_ == position && options_.step_on_where_evidence_agrees &&
         EvidenceAgreesOnNext(position)) {
       result.candidates = std::move(found.candidates);
-      LocalizationResult placed = TrackedAt(std::move(result), position, position + 1, features);
-      // Placed, but not steered by (guidance "none"): the place is the two measures' agreement, the heading that of
-      // comparisons chance and the heading rule refused. On michigan_seasons 13 of the 37 frames placed so had a
-      // heading against their key image more than 35 px off the hand label, against 25 of the 336 frames placed
-      // otherwise. heading_key_px stays, as a lost frame's does: what the comparison measured, not to steer by.
-      placed.heading_px = placed.heading_deg = kNaN;
-      placed.translation_known = false;
-      return placed;
+      return PlacedByAgreement(TrackedAt(std::move(result), position, position + 1, features));
+    }
+    // After lost frames the same agreement steps the frame on, where the frame before, lost too, named that key image
+    // by neither measure: a robot that stops shows the same place on every frame, which names the same key image.
+    // The frames before left the belief where chance put it; the agreement is weighed there first, by what it tells a
+    // right key image from a wrong one on the lost frames of michigan_seasons (kAgreementLogRatio).
+    if (!relocalized && placed_before_ != position && lost_before > 0 && options_.step_on_after_lost_frames &&
+        EvidenceAgreesOnNext(position) && ranking_first_before_ != position + 1 &&
+        heading_mode_before_ != position + 1) {
+      belief_.Weigh(position + 1, kAgreementLogRatio);
+      belief_.Normalize();
+      if (start_unconfirmed_) {
+        evidence_belief_.Weigh(position + 1, kAgreementLogRatio);
+        evidence_belief_.Normalize();
+      }
+      result.candidates = std::move(found.candidates);
+      return PlacedByAgreement(TrackedAt(std::move(result), position, position + 1, features));
     }
     // Lost, or found far from where the frames were on this frame's evidence alone: the estimate stays (uncertain,
     // the best guess, until the next frame confirms the far place).
@@ -400,16 +417,42 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
 bool Localizer::EvidenceAgreesOnNext(int position) const {
   // Measured with binary descriptors only (across seasons ORB's chance refuses most right key images; XFeat's rarely).
   const int next = position + 1;
-  if (!heading_accepts_ || next >= static_cast<int>(route_.size()) || ranked_.size() < 2) return false;
+  return heading_accepts_ && next < static_cast<int>(route_.size()) && RankingFirst() == next && HeadingMode() == next;
+}
+
+int Localizer::RankingFirst() const {
   // The ranking holds the route's key images in route order: ranked_[r].key is a route position.
-  if (ranked_[0].key != next || ranked_[0].score <= ranked_[1].score) return false;
-  int next_votes = -1, other_votes = -1;
+  if (ranked_.size() < 2 || ranked_[0].score <= ranked_[1].score) return -1;
+  return ranked_[0].key;
+}
+
+int Localizer::HeadingMode() const {
+  int mode = -1, mode_votes = -1, rival_votes = -1;
   for (const Memo& m : comparisons_) {
-    if (!m.used || route_position_of_key_[m.comparison.key] < 0) continue;
-    int& votes = m.comparison.key == route_[next] ? next_votes : other_votes;
-    votes = std::max(votes, m.comparison.heading.votes);
+    const int position = m.used ? route_position_of_key_[m.comparison.key] : -1;
+    if (position < 0) continue;
+    const int votes = m.comparison.heading.votes;
+    if (position == mode) {
+      mode_votes = std::max(mode_votes, votes);
+    } else if (votes > mode_votes) {
+      rival_votes = std::max(rival_votes, mode_votes);
+      mode = position;
+      mode_votes = votes;
+    } else {
+      rival_votes = std::max(rival_votes, votes);
+    }
   }
-  return next_votes > other_votes;
+  return mode_votes > rival_votes ? mode : -1;
+}
+
+LocalizationResult Localizer::PlacedByAgreement(LocalizationResult placed) {
+  // Placed, but not steered by (guidance "none"): the place is the two measures' agreement, the heading that of
+  // comparisons chance and the heading rule refused. On michigan_seasons 13 of the 37 frames placed so had a heading
+  // against their key image more than 35 px off the hand label, against 25 of the 336 frames placed otherwise.
+  // heading_key_px stays, as a lost frame's does: what the comparison measured, not to steer by.
+  placed.heading_px = placed.heading_deg = kNaN;
+  placed.translation_known = false;
+  return placed;
 }
 
 LocalizationResult Localizer::TrackedAt(LocalizationResult result, int from, int position,

@@ -105,6 +105,13 @@ class Localizer {
   // frame's ranking (ranked by its relocalization) and its comparisons' heading modes each single out the key image
   // at route `position + 1`, the tracker's next.
   bool EvidenceAgreesOnNext(int position) const;
+  // A frame placed where its ranking and its heading agree is not steered by: `placed` without its heading.
+  static LocalizationResult PlacedByAgreement(LocalizationResult placed);
+  // The route position the frame's ranking (ranked by its relocalization) puts first, strictly; -1: none (not ranked,
+  // or a tie).
+  int RankingFirst() const;
+  // The route position of the key image whose comparison holds the most heading votes, strictly; -1: none.
+  int HeadingMode() const;
   // The previous frame's heading (px) against key image `key`; none when that frame was not compared with it.
   std::optional<double> PreviousHeading(int key) const;
   // The continuity of the heading (LocalizerOptions::continuity_share): `guided`, the guided matches of the frame
@@ -280,6 +287,9 @@ class Localizer {
   int lost_in_a_row_ = 0;
   // The route position the frame before this one was placed at (tracking or relocalized); -1: it was not.
   int placed_before_ = -1;
+  // What the frame before this one named by its own evidence: its RankingFirst() and its HeadingMode() (-1: none).
+  int ranking_first_before_ = -1;
+  int heading_mode_before_ = -1;
   // Where the estimate was last dropped (route position; -1: none) and the frames since, while guided_while_lost
   // still asks there.
   int dropped_position_ = -1;

@@ -131,6 +131,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"step_on_where_evidence_agrees", "!--no-step-on-where-evidence-agrees",
                  "ORB: never step a lost frame on to the next key image where its ranking and its heading mode agree"},
                 step_on_where_evidence_agrees);
+  visitor.Visit({"step_on_after_lost_frames", "!--no-step-on-after-lost-frames",
+                 "ORB: never step a frame after lost frames on to the next key image where its ranking and its heading "
+                 "mode agree (and the frame before's named it by neither)"},
+                step_on_after_lost_frames);
   visitor.Visit({"guided_lookahead", "!--no-guided-lookahead",
                  "ORB: match a frame guided at the key image and the next one only, ranked by verified matches (not "
                  "over the lookahead, ranked by the one-way matches' NFA where chance accepts none)"},

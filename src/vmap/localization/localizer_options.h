@@ -183,6 +183,14 @@ struct LocalizerOptions {
   // and the heading rule refused (guidance "none"; "The frames it places are not steered by"). Off: such a frame is
   // lost.
   bool step_on_where_evidence_agrees = true;
+  // The same after lost frames (ORB maps): a frame that nothing verifies, after one or more frames lost at the tracked
+  // key image, moves on to the key image after it where its ranking and its heading mode agree on it as above, and the
+  // frame before named it by neither (a robot that stops shows the same place again, which names the same key image).
+  // The frames lost before it left the belief where chance put it: the agreement is weighed there first, ten times
+  // likelier at the right key image than at a wrong one on michigan_seasons' lost frames. Placed, not steered by, as
+  // above (docs/measurements/localization-conditions.md, "A frame after lost frames steps on where its evidence
+  // agrees"). Off: such a frame is lost.
+  bool step_on_after_lost_frames = true;
   // Guided matching over the lookahead: it asks the tracked key image and the `lookahead` key images after it (the
   // tracker's own reach), and ranks what it accepts by a measure common to the key images asked: those chance accepts
   // by their verified matches (as the tracker ranks), and when chance accepts none, those the continuity of the heading
