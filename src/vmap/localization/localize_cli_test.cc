@@ -754,22 +754,25 @@ TEST(LocalizeCli, ALostFrameOfARobotThatStopsIsNotSteppedOn) {
   }
 }
 
-TEST(LocalizeCli, ComparisonThreadsChangeNoResult) {
+TEST(LocalizeCli, ComparisonsMadeOnOtherThreadsChangeNoResult) {
   // corridor_conditions with ORB: its frames are refused at their tracked key images, compared with their rivals,
-  // relocalized and questioned, and the comparisons they are about to make are made meanwhile on a second core
+  // relocalized and questioned. The comparisons a frame is about to make are made meanwhile on a second core
   // (LocalizerOptions::comparison_threads; docs/measurements/localization-conditions.md, "Where ORB's corridor time
-  // goes"). Every CSV column but the time is as when each comparison is made in turn (one thread).
+  // goes"), and the extraction threads compare each frame ahead with the key images the estimate before it was at
+  // (LocalizeSequenceOptions::compare_ahead). Every result is as when each comparison is made in turn, bit for bit:
+  // the CSV's columns but the time, and the JSON's confidence and belief, whose sums run over the frame's comparisons.
   const fs::path data = Shared() / "data/corridor_conditions";
   if (Shared().empty() || !fs::exists(data)) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   ::vmap::testing::ScopedTempDir tmp;
   std::string out;
   ASSERT_EQ(RunVmap("build " + Quote(data / "teach") + " -q -o " + Quote(tmp.path() / "map"), &out), 0) << out;
-  // Per run, each column but the time, by name.
+  // Per run, each CSV column but the time, by name, and each JSON frame but its time.
   std::vector<std::map<std::string, std::vector<std::string>>> runs;
-  for (const std::string flags : {"", " --comparison-threads 1"}) {
-    const fs::path csv = tmp.path() / "run.csv";
+  std::vector<nlohmann::json> json_frames;
+  for (const std::string flags : {"", " --comparison-threads 1", " --comparison-threads 1 --no-compare-ahead"}) {
+    const fs::path csv = tmp.path() / "run.csv", json = tmp.path() / "run.json";
     ASSERT_EQ(RunVmap("localize " + Quote(tmp.path() / "map") + " " + Quote(data / "repeat") + " --last 59 -q --csv " +
-                          Quote(csv) + flags,
+                          Quote(csv) + " --json " + Quote(json) + flags,
                       &out),
               0)
         << out;
@@ -779,10 +782,20 @@ TEST(LocalizeCli, ComparisonThreadsChangeNoResult) {
       if (name != "seconds") columns[name] = CsvColumn(csv, name);
     }
     runs.push_back(std::move(columns));
+    std::ifstream in(json);
+    nlohmann::json frames = nlohmann::json::parse(in).at("frames");
+    for (nlohmann::json& frame : frames) frame.erase("seconds");
+    json_frames.push_back(std::move(frames));
   }
   ASSERT_EQ(runs[0].at("status").size(), 60u);
   EXPECT_GT(runs[0].size(), 40u);
-  for (const auto& [name, cells] : runs[0]) EXPECT_EQ(cells, runs[1].at(name)) << name;
+  for (size_t r = 1; r < runs.size(); ++r) {
+    for (const auto& [name, cells] : runs[0]) EXPECT_EQ(cells, runs[r].at(name)) << "run " << r << ": " << name;
+    ASSERT_EQ(json_frames[0].size(), json_frames[r].size());
+    for (size_t f = 0; f < json_frames[0].size(); ++f) {
+      EXPECT_EQ(json_frames[0][f], json_frames[r][f]) << "run " << r << ", frame " << f;
+    }
+  }
 }
 
 TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {

@@ -26,7 +26,11 @@ void LocalizeSequenceOptions::VisitFields(OptionFieldVisitor& visitor) {
       OptionField{"extraction_threads", "--threads", "Feature-extraction threads (0 = one per core)"}.NotRecorded(),
       extraction_threads);
   visitor.Visit(OptionField{"prefetch_frames"}.NotRecorded(), prefetch_frames);
-  visitor.Visit(OptionField{"compare_ahead"}.NotRecorded(), compare_ahead);
+  visitor.Visit(OptionField{"compare_ahead", "!--no-compare-ahead",
+                            "Extraction threads do not compare frames with the likely key images ahead (the results "
+                            "are the same)"}
+                    .NotRecorded(),
+                compare_ahead);
   visitor.Visit(OptionField{"show_progress"}.NotRecorded(), show_progress);
 }
 

@@ -3,9 +3,9 @@
 // on worker threads (core/ordered_pipeline.h), a few frames ahead, while the calling thread runs the Localizer on them
 // in order. The workers also compare each frame with the key images of the latest estimate (Localizer::LikelyKeys),
 // since most frames are compared with the same two key images as the frame before: the calling thread then only
-// decides, and compares what the workers did not guess. The results are the same as without (comparisons are
-// deterministic). Memory stays flat: only the frames in flight are held, and each result goes to the caller as soon as
-// it is known.
+// decides, and compares what the workers did not guess. The results are the same as without, bit for bit (comparisons
+// are deterministic, and the Localizer records one only when the frame asks for it). Memory stays flat: only the frames
+// in flight are held, and each result goes to the caller as soon as it is known.
 
 #include <functional>
 
@@ -26,7 +26,8 @@ struct LocalizeSequenceOptions {
   bool show_progress = true;  // a progress line on a terminal
 
   int ExtractionThreads() const;
-  // How a run is carried out: none is recorded; extraction_threads has its flag (--threads).
+  // How a run is carried out: none is recorded; extraction_threads has its flag (--threads), compare_ahead
+  // --no-compare-ahead.
   void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };

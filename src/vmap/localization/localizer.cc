@@ -174,11 +174,9 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
     }
   } finish_speculation{speculation_.get()};
   comparisons_.clear();
+  made_ahead_ = std::move(ahead);
   ranked_.clear();
   bucket_of_position_.clear();
-  for (KeyComparison& c : ahead) {
-    if (c.key >= 0 && c.key < static_cast<int>(keys_.features.size())) comparisons_.push_back({std::move(c), false});
-  }
   belief_.Predict();
   if (start_unconfirmed_) evidence_belief_.Predict();
   // Guided matching asks where the estimate was dropped for max_lost_frames frames (guided_while_lost).
@@ -197,11 +195,10 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   if (IsPlaced(result.status)) {
     dropped_position_ = -1;  // steered by again: the drop is behind
   }
-  result.comparisons =
-      static_cast<int>(std::count_if(comparisons_.begin(), comparisons_.end(), [](const Memo& m) { return m.used; }));
+  result.comparisons = static_cast<int>(comparisons_.size());
   if (result.key >= 0 && result.to_key.key == result.key) {
     result.key_rank = 1 + static_cast<int>(std::count_if(comparisons_.begin(), comparisons_.end(), [&](const Memo& m) {
-                        return m.used && m.comparison.key != result.key && FitsBetter(m.comparison, result.to_key);
+                        return m.comparison.key != result.key && FitsBetter(m.comparison, result.to_key);
                       }));
   }
   previous_headings_.clear();
@@ -429,7 +426,7 @@ int Localizer::RankingFirst() const {
 int Localizer::HeadingMode() const {
   int mode = -1, mode_votes = -1, rival_votes = -1;
   for (const Memo& m : comparisons_) {
-    const int position = m.used ? route_position_of_key_[m.comparison.key] : -1;
+    const int position = route_position_of_key_[m.comparison.key];
     if (position < 0) continue;
     const int votes = m.comparison.heading.votes;
     if (position == mode) {

@@ -56,8 +56,8 @@ class Localizer {
 
   // Localizes the next frame of the stream. `features` come from the map's matcher on frame.gray (they may
   // be extracted on another thread: see LocalizeSequence). `ahead` may hold comparisons of this frame that
-  // were already made (Compare, on another thread, with the LikelyKeys of an earlier state): they are used
-  // instead of comparing again, which gives the same result.
+  // were already made (Compare, on another thread, with the LikelyKeys of an earlier state): each is used where
+  // the frame asks for its key image instead of comparing again, which gives the same result, bit for bit.
   LocalizationResult Localize(const Frame& frame, const ImageFeatures& features, std::vector<KeyComparison> ahead = {});
 
   // The key images the next frame will most likely be compared with: `key` and `next_key` of the current
@@ -333,7 +333,6 @@ class Localizer {
   EvidenceModel evidence_;  // by the kind of the matcher's descriptors
   struct Memo {
     KeyComparison comparison;
-    bool used = false;            // counted in LocalizationResult::comparisons
     bool weighed = false;         // its evidence is in the belief
     bool weighed_ranked = false;  // weighed given the frame's ranking (EvidenceModel::rank_alone)
     // Accepted by its heading mode against the frame's rivals (HeadingStandsOut), and weighed as such
@@ -341,7 +340,10 @@ class Localizer {
     bool by_heading = false;
     bool weighed_by_heading = false;
   };
-  std::vector<Memo> comparisons_;  // of the frame being localized
+  std::vector<Memo> comparisons_;  // of the frame being localized, in the order CompareOnce was asked for them
+  // Comparisons of the frame made before it reached Localize (`ahead`), which CompareOnce takes when it asks for them:
+  // which ones there are depends on the workers' timing, so they enter comparisons_ only then.
+  std::vector<KeyComparison> made_ahead_;
   // The previous frame's headings (px) against the key images it was compared with: (key, heading), those with one.
   std::vector<std::pair<int, double>> previous_headings_;
   std::vector<RankedKey> ranked_;  // the route ranked for the frame being localized (RankRoute); empty: not yet

@@ -24,7 +24,7 @@ bool PassesChance(const KeyComparison& comparison, double max_log10_nfa) {
 void Localizer::WeighComparisons() {
   bool weighed = RankingMovesOwnFrame() && WeighRanking();
   for (Memo& m : comparisons_) {
-    if (!m.used || (m.weighed && (!m.by_heading || m.weighed_by_heading))) continue;
+    if (m.weighed && (!m.by_heading || m.weighed_by_heading)) continue;
     const int key = m.comparison.key;
     const int position = route_position_of_key_[key];
     if (position < 0) {

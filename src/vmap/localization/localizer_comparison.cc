@@ -154,7 +154,7 @@ int Localizer::TrackGuided(const Frame& frame, const ImageFeatures& features, in
   if (found < 0) return -1;
   // The guided comparison replaces the first one's memo (CompareOnce made it above).
   for (Memo& m : comparisons_) {
-    if (m.comparison.key == best.key) m = {std::move(best), true, true};
+    if (m.comparison.key == best.key) m = {std::move(best), /*weighed=*/true};
   }
   return found;
 }
@@ -174,7 +174,7 @@ bool Localizer::GuideRelocalization(const Frame& frame, const ImageFeatures& fea
     if (!guided.accepted) continue;
     const auto memo =
         std::find_if(comparisons_.begin(), comparisons_.end(), [&](const Memo& m) { return m.comparison.key == key; });
-    *memo = {std::move(guided), true, true};  // CompareOnce made it
+    *memo = {std::move(guided), /*weighed=*/true};  // CompareOnce made it
     accepted = true;
   }
   return accepted;
@@ -222,14 +222,21 @@ KeyComparison Localizer::CompareInWindow(const ImageFeatures& window_features, i
 }
 
 KeyComparison Localizer::CompareOnce(const ImageFeatures& features, int key) {
-  for (Memo& m : comparisons_) {
-    if (m.comparison.key == key) {
-      m.used = true;
-      return m.comparison;
-    }
+  for (const Memo& m : comparisons_) {
+    if (m.comparison.key == key) return m.comparison;
   }
-  std::optional<KeyComparison> made = speculation_ ? speculation_->Take(key) : std::nullopt;
-  comparisons_.push_back({made ? std::move(*made) : Compare(features, key), true});
+  // Made before the frame got here (LocalizeSequence's workers), meanwhile (speculation_) or now: recorded only when
+  // asked for, so the memo holds what the frame asked for in the order it asked, and every sum over it is as when
+  // each comparison is made in turn.
+  std::optional<KeyComparison> made;
+  const auto ahead =
+      std::find_if(made_ahead_.begin(), made_ahead_.end(), [&](const KeyComparison& c) { return c.key == key; });
+  if (ahead != made_ahead_.end()) {
+    made = std::move(*ahead);
+  } else if (speculation_) {
+    made = speculation_->Take(key);
+  }
+  comparisons_.push_back({made ? std::move(*made) : Compare(features, key)});
   return comparisons_.back().comparison;
 }
 
@@ -239,7 +246,9 @@ void Localizer::CompareMeanwhile(const ImageFeatures& features, const std::vecto
   for (int p : positions) {
     if (p < 0 || p >= static_cast<int>(route_.size())) continue;
     const int key = route_[p];
-    if (std::none_of(comparisons_.begin(), comparisons_.end(), [&](const Memo& m) { return m.comparison.key == key; }))
+    const auto has_key = [&](const KeyComparison& c) { return c.key == key; };
+    if (std::none_of(comparisons_.begin(), comparisons_.end(), [&](const Memo& m) { return has_key(m.comparison); }) &&
+        std::none_of(made_ahead_.begin(), made_ahead_.end(), has_key))
       keys.push_back(key);
   }
   if (!keys.empty()) speculation_->Add(features, keys);

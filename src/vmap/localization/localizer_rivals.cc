@@ -33,7 +33,7 @@ int Localizer::RivalVerified(const Frame& frame, const ImageFeatures& features, 
   int rival_verified = -1;
   for (const Memo& m : comparisons_) {
     const int q = route_position_of_key_[m.comparison.key];
-    if (m.used && q >= 0 && std::abs(q - position) > kNear) {
+    if (q >= 0 && std::abs(q - position) > kNear) {
       rival_verified = std::max(rival_verified, m.comparison.num_verified);
     }
   }
@@ -83,8 +83,7 @@ bool Localizer::HeadingStandsOut(const Frame& frame, const ImageFeatures& featur
   int rival_votes = -1;
   for (const Memo& m : comparisons_) {
     const int q = route_position_of_key_[m.comparison.key];
-    if (m.used && q >= 0 && IsHeadingRival(position, q))
-      rival_votes = std::max(rival_votes, m.comparison.heading.votes);
+    if (q >= 0 && IsHeadingRival(position, q)) rival_votes = std::max(rival_votes, m.comparison.heading.votes);
   }
   return rival_votes >= 0 && comparison.heading.votes >= options_.min_heading_rival_ratio * rival_votes;
 }
@@ -93,7 +92,7 @@ int Localizer::AcceptByHeading(const Frame& frame, const ImageFeatures& features
   int best = -1;  // index in comparisons_ (HeadingStandsOut may grow it)
   for (size_t i = 0; i < comparisons_.size(); ++i) {
     const Memo& m = comparisons_[i];
-    if (!m.used || route_position_of_key_[m.comparison.key] < 0) continue;
+    if (route_position_of_key_[m.comparison.key] < 0) continue;
     if (best < 0 || m.comparison.heading.votes > comparisons_[best].comparison.heading.votes)
       best = static_cast<int>(i);
   }
@@ -139,7 +138,7 @@ int Localizer::AcceptAgainstRivals(const Frame& frame, const ImageFeatures& feat
   int best = -1;  // index in comparisons_ (CompareOnce below may grow it)
   for (size_t i = 0; i < comparisons_.size(); ++i) {
     const Memo& m = comparisons_[i];
-    if (!m.used || position_of(m) < 0) continue;
+    if (position_of(m) < 0) continue;
     if (m.comparison.accepted) return -1;  // the link share accepted one: nothing to decide here
     if (best < 0 || m.comparison.num_verified > comparisons_[best].comparison.num_verified) best = static_cast<int>(i);
   }
@@ -182,7 +181,7 @@ int Localizer::OutVerifiedFrom(const LocalizationResult& result) const {
   for (const Memo& m : comparisons_) {
     const KeyComparison& c = m.comparison;
     const int p = route_position_of_key_[c.key];
-    if (!m.used || !c.accepted || p < 0 || std::abs(p - result.route_position) <= kNear) continue;
+    if (!c.accepted || p < 0 || std::abs(p - result.route_position) <= kNear) continue;
     if (c.num_verified > most) {
       most = c.num_verified;
       rival = p;
