@@ -295,6 +295,9 @@ std::vector<std::vector<std::pair<std::string, int>>> CorridorRuns(const std::ve
 // that stands out against the frame's rivals").
 const std::string kWithoutHeading = " --min-heading-rival-ratio 0";
 
+// A frame placed on the route (tracking or relocalized), as bench/route_conditions.py counts it: where the goals ask
+// the frame to be. A frame the agreement of its ranking and its heading places is placed but not steered by (guidance
+// "none": AFrameTheEvidenceStepsOnIsNotSteeredByItsHeading); these tests' "steered" counts include it.
 bool SteeredBy(const std::pair<std::string, int>& frame) {
   return frame.first == "tracking" || frame.first == "relocalized";
 }

@@ -133,7 +133,7 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                 step_on_where_evidence_agrees);
   visitor.Visit({"step_on_after_lost_frames", "!--no-step-on-after-lost-frames",
                  "ORB: never step a frame after lost frames on to the next key image where its ranking and its heading "
-                 "mode agree (and the frame before's named it by neither)"},
+                 "mode agree and the frame before named it by neither"},
                 step_on_after_lost_frames);
   visitor.Visit({"guided_lookahead", "!--no-guided-lookahead",
                  "ORB: match a frame guided at the key image and the next one only, ranked by verified matches (not "
