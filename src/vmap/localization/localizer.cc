@@ -335,23 +335,17 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     // Nothing verified anywhere: the frame's ranking and heading modes, each too weak for chance alone, step it on
     // where both name the key image after the one the frame before was placed at (the robot seen there, this frame
     // names where it goes next; a robot that stops shows the same place again, which names the same key image).
-    if (!relocalized && placed_before_ == position && options_.step_on_where_evidence_agrees &&
-        EvidenceAgreesOnNext(position)) {
-      result.candidates = std::move(found.candidates);
-      return PlacedByAgreement(TrackedAt(std::move(result), position, position + 1, features));
-    }
-    // After lost frames the same agreement steps the frame on, where the frame before, lost too, named that key image
-    // by neither measure: a robot that stops shows the same place on every frame, which names the same key image.
-    // The frames before left the belief where chance put it; the agreement is weighed there first, by what it tells a
-    // right key image from a wrong one on the lost frames of michigan_seasons (kAgreementLogRatio).
-    if (!relocalized && placed_before_ != position && lost_before > 0 && options_.step_on_after_lost_frames &&
-        EvidenceAgreesOnNext(position) && ranking_first_before_ != position + 1 &&
-        heading_mode_before_ != position + 1) {
-      belief_.Weigh(position + 1, kAgreementLogRatio);
-      belief_.Normalize();
-      if (start_unconfirmed_) {
-        evidence_belief_.Weigh(position + 1, kAgreementLogRatio);
-        evidence_belief_.Normalize();
+    const bool after_placed = placed_before_ == position && options_.step_on_where_evidence_agrees;
+    // After lost frames, where the frame before, lost too, named that key image by neither measure: a robot that
+    // stops shows the same place on every frame, which names the same key image.
+    const bool after_lost = placed_before_ != position && lost_before > 0 && options_.step_on_after_lost_frames &&
+                            ranking_first_before_ != position + 1 && heading_mode_before_ != position + 1;
+    if (!relocalized && (after_placed || after_lost) && EvidenceAgreesOnNext(position)) {
+      // The lost frames before left the belief where chance put it: the agreement is weighed there first, by what it
+      // tells a right key image from a wrong one on the lost frames of michigan_seasons (kAgreementLogRatio).
+      if (after_lost) {
+        WeighBeliefs(position + 1, kAgreementLogRatio);
+        NormalizeBeliefs();
       }
       result.candidates = std::move(found.candidates);
       return PlacedByAgreement(TrackedAt(std::move(result), position, position + 1, features));

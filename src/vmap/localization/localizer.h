@@ -146,6 +146,10 @@ class Localizer {
   // result's confidence and, when the belief does not single out the tracked position, the status kUncertain.
   void Believe(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
   void WeighComparisons();
+  // The belief, and while the start is unconfirmed the frames' evidence's own (evidence_belief_), weighed at route
+  // `position` by `log_ratio`, and normalized once the frame's weights are in.
+  void WeighBeliefs(int position, double log_ratio);
+  void NormalizeBeliefs();
   // Where the frame was ranked and the evidence model weighs the ranking: weighs every route position by its key
   // image's bucket in the ranking (once a frame), and the comparisons already weighed without it by what their bucket
   // changes. Returns whether it weighed anything.

@@ -45,25 +45,27 @@ void Localizer::WeighComparisons() {
     }
     m.weighed = weighed = true;
     m.weighed_by_heading = m.by_heading;
-    belief_.Weigh(position, log_ratio);
-    if (start_unconfirmed_) evidence_belief_.Weigh(position, log_ratio);
+    WeighBeliefs(position, log_ratio);
   }
-  if (weighed) {
-    belief_.Normalize();
-    if (start_unconfirmed_) evidence_belief_.Normalize();
-  }
+  if (weighed) NormalizeBeliefs();
+}
+
+void Localizer::WeighBeliefs(int position, double log_ratio) {
+  belief_.Weigh(position, log_ratio);
+  if (start_unconfirmed_) evidence_belief_.Weigh(position, log_ratio);
+}
+
+void Localizer::NormalizeBeliefs() {
+  belief_.Normalize();
+  if (start_unconfirmed_) evidence_belief_.Normalize();
 }
 
 bool Localizer::WeighRanking() {
   if (ranked_.empty() || !bucket_of_position_.empty() || evidence_.rank_alone.empty()) return false;
   // The ranking holds the route's key images in route order: ranked_[r].key is a route position.
   bucket_of_position_ = RankingBuckets(evidence_, ranked_, static_cast<int>(route_.size()));
-  auto weigh = [&](int position, double log_ratio) {
-    belief_.Weigh(position, log_ratio);
-    if (start_unconfirmed_) evidence_belief_.Weigh(position, log_ratio);
-  };
   for (size_t p = 0; p < route_.size(); ++p)
-    weigh(static_cast<int>(p), RankLogRatio(evidence_, bucket_of_position_[p]));
+    WeighBeliefs(static_cast<int>(p), RankLogRatio(evidence_, bucket_of_position_[p]));
   // A comparison weighed before the frame was ranked said what its rank now says in part: it weighs what it adds to
   // the rank instead.
   for (Memo& m : comparisons_) {
@@ -72,8 +74,9 @@ bool Localizer::WeighRanking() {
     const int key = m.comparison.key;
     const int position = route_position_of_key_[key];
     if (position < 0) continue;
-    weigh(position, EvidenceLogRatio(evidence_, m.comparison, link_verified_[key], bucket_of_position_[position]) -
-                        EvidenceLogRatio(evidence_, m.comparison, link_verified_[key]));
+    WeighBeliefs(position,
+                 EvidenceLogRatio(evidence_, m.comparison, link_verified_[key], bucket_of_position_[position]) -
+                     EvidenceLogRatio(evidence_, m.comparison, link_verified_[key]));
   }
   return true;
 }
@@ -124,10 +127,7 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
   const bool withheld_unranked = position >= 0 && withholds(position);
   const int evidence_peak_unranked = evidence_belief_.Peak();
   const bool ranked_now = !RankingMovesOwnFrame() && WeighRanking();
-  if (ranked_now) {
-    belief_.Normalize();
-    if (start_unconfirmed_) evidence_belief_.Normalize();
-  }
+  if (ranked_now) NormalizeBeliefs();
   const std::vector<double>& p = belief_.probabilities();
   for (size_t i = 0; i < p.size() && i < route_.size(); ++i) {
     if (p[i] >= kRecordedMass) result.belief.emplace_back(route_[i], std::round(1000.0 * p[i]) / 1000.0);
