@@ -297,36 +297,36 @@ const std::string kWithoutHeading = " --min-heading-rival-ratio 0";
 
 // A frame placed on the route (tracking or relocalized), as bench/route_conditions.py counts it: where the goals ask
 // the frame to be. A frame the agreement of its ranking and its heading places is placed but not steered by (guidance
-// "none": AFrameTheEvidenceStepsOnIsNotSteeredByItsHeading); these tests' "steered" counts include it.
-bool SteeredBy(const std::pair<std::string, int>& frame) {
+// "none": AFrameTheEvidenceStepsOnIsNotSteeredByItsHeading); the counts below are of placed frames.
+bool Placed(const std::pair<std::string, int>& frame) {
   return frame.first == "tracking" || frame.first == "relocalized";
 }
 
-// How many times a run's steered-by frames go back to an earlier key image (or its teach frame).
+// How many times a run's placed frames go back to an earlier key image (or its teach frame).
 int BackJumps(const std::vector<std::pair<std::string, int>>& run) {
-  int jumps = 0, steered_key = -1;
+  int jumps = 0, placed_key = -1;
   for (const auto& frame : run) {
-    if (!SteeredBy(frame)) continue;
-    jumps += frame.second < steered_key;
-    steered_key = frame.second;
+    if (!Placed(frame)) continue;
+    jumps += frame.second < placed_key;
+    placed_key = frame.second;
   }
   return jumps;
 }
 
-// As CorridorRuns, how many times each run's steered-by frames go back to an earlier key image.
+// As CorridorRuns, how many times each run's placed frames go back to an earlier key image.
 std::vector<int> BackJumpsOnCorridor(const std::vector<std::string>& flags, int last) {
   std::vector<int> back_jumps;
   for (const auto& run : CorridorRuns(flags, last)) back_jumps.push_back(BackJumps(run));
   return back_jumps;
 }
 
-// As CorridorRuns, how many frames are steered by (tracking or relocalized) in each run.
-std::vector<int> SteeredOnCorridor(const std::vector<std::string>& flags, int last = 39) {
-  std::vector<int> steered;
+// As CorridorRuns, how many frames are placed (tracking or relocalized) in each run.
+std::vector<int> PlacedOnCorridor(const std::vector<std::string>& flags, int last = 39) {
+  std::vector<int> placed;
   for (const auto& run : CorridorRuns(flags, last)) {
-    steered.push_back(static_cast<int>(std::count_if(run.begin(), run.end(), SteeredBy)));
+    placed.push_back(static_cast<int>(std::count_if(run.begin(), run.end(), Placed)));
   }
-  return steered;
+  return placed;
 }
 
 TEST(LocalizeCli, GuidedMatchingTracksFramesChanceRefusedAcrossLighting) {
@@ -334,35 +334,35 @@ TEST(LocalizeCli, GuidedMatchingTracksFramesChanceRefusedAcrossLighting) {
   // matches verify too few at the tracked key images for chance while the belief holds them there are matched
   // again with those key images only, one-way best matches kept, and the a-contrario test accepts some of them
   // (the continuity of the heading and the window off, to see guided matching's own).
-  const std::vector<int> steered =
-      SteeredOnCorridor({" --continuity-share 0 --no-window-matching", " --no-guided-matching"});
-  if (steered.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
-  EXPECT_GE(steered[0], steered[1] + 4) << "guided " << steered[0] << ", without " << steered[1];
+  const std::vector<int> placed =
+      PlacedOnCorridor({" --continuity-share 0 --no-window-matching", " --no-guided-matching"});
+  if (placed.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  EXPECT_GE(placed[0], placed[1] + 4) << "guided " << placed[0] << ", without " << placed[1];
 }
 
 TEST(LocalizeCli, TheHeadingsContinuityTracksGuidedFramesChanceRefuses) {
   // corridor_conditions with ORB (docs/localize.md, "Continuity of the heading"): a guided comparison chance refuses
   // is accepted when its matches move as the previous frame's heading against the key image predicts.
-  const std::vector<int> steered =
-      SteeredOnCorridor({" --no-window-matching", " --continuity-share 0 --no-window-matching"});
-  if (steered.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
-  EXPECT_GE(steered[0], steered[1] + 4) << "with the continuity " << steered[0] << ", without " << steered[1];
+  const std::vector<int> placed =
+      PlacedOnCorridor({" --no-window-matching", " --continuity-share 0 --no-window-matching"});
+  if (placed.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  EXPECT_GE(placed[0], placed[1] + 4) << "with the continuity " << placed[0] << ", without " << placed[1];
 }
 
 TEST(LocalizeCli, AStartKeyTracksTheRepeatRunsFirstFrames) {
   // corridor_conditions with ORB (docs/localize.md, "The start"): the repeat run starts where the teach run did;
   // started there, the belief singles that place out and guided matching asks there on the first frames.
-  const std::vector<int> steered = SteeredOnCorridor({" --start-key 0", ""});
-  if (steered.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
-  EXPECT_GE(steered[0], steered[1] + 2) << "started at key image 0 " << steered[0] << ", anywhere " << steered[1];
+  const std::vector<int> placed = PlacedOnCorridor({" --start-key 0", ""});
+  if (placed.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  EXPECT_GE(placed[0], placed[1] + 2) << "started at key image 0 " << placed[0] << ", anywhere " << placed[1];
 }
 
-// Of a corridor run from repeat frame `first` (CorridorRuns with teach frames): its frames steered by more than 8 teach
+// Of a corridor run from repeat frame `first` (CorridorRuns with teach frames): its frames placed more than 8 teach
 // frames from their own (far) and those within 8 (near).
-std::pair<int, int> SteeredFarAndNear(const std::vector<std::pair<std::string, int>>& run, int first) {
+std::pair<int, int> PlacedFarAndNear(const std::vector<std::pair<std::string, int>>& run, int first) {
   int far = 0, near = 0;
   for (size_t i = 0; i < run.size(); ++i) {
-    if (!SteeredBy(run[i])) continue;
+    if (!Placed(run[i])) continue;
     const int repeat_frame = first + static_cast<int>(i);  // at teach frame repeat_frame
     (std::abs(run[i].second - repeat_frame) > 8 ? far : near) += 1;
   }
@@ -380,13 +380,13 @@ TEST(LocalizeCli, AStartKeyIsAHintARunStartedElsewhereOverrides) {
   const std::string alone = " --start-key 0 --first 20 --no-rank-evidence --no-guided-relocalization";
   const auto runs = CorridorRuns({alone, alone + " --no-start-is-hint", " --start-key 0 --first 20"}, 33, true);
   if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
-  const auto [far, near] = SteeredFarAndNear(runs[0], 20);
-  const auto [prior_far, prior_near] = SteeredFarAndNear(runs[1], 20);
-  EXPECT_LT(far, prior_far) << "steered by far from their place: a hint " << far << ", a prior " << prior_far;
-  EXPECT_GE(near, prior_near + 4) << "steered by near their place: a hint " << near << ", a prior " << prior_near;
-  const auto [default_far, default_near] = SteeredFarAndNear(runs[2], 20);
+  const auto [far, near] = PlacedFarAndNear(runs[0], 20);
+  const auto [prior_far, prior_near] = PlacedFarAndNear(runs[1], 20);
+  EXPECT_LT(far, prior_far) << "placed far from their place: a hint " << far << ", a prior " << prior_far;
+  EXPECT_GE(near, prior_near + 4) << "placed near their place: a hint " << near << ", a prior " << prior_near;
+  const auto [default_far, default_near] = PlacedFarAndNear(runs[2], 20);
   EXPECT_EQ(default_far, 0);
-  EXPECT_GE(default_near, near) << "steered by near their place: the defaults " << default_near << ", the hint alone "
+  EXPECT_GE(default_near, near) << "placed near their place: the defaults " << default_near << ", the hint alone "
                                 << near;
 }
 
@@ -401,10 +401,9 @@ TEST(LocalizeCli, AStartKeyNeedsTheFramesEvidence) {
   const std::string alone = " --start-key 0 --first 20 --no-rank-evidence --no-guided-relocalization";
   const auto runs = CorridorRuns({alone, alone + " --no-start-needs-evidence", " --start-key 0 --first 20"}, 33, true);
   if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
-  const int far = SteeredFarAndNear(runs[0], 20).first, prior_far = SteeredFarAndNear(runs[1], 20).first;
-  EXPECT_LT(far, prior_far) << "steered by far from their place: with the evidence " << far << ", without "
-                            << prior_far;
-  EXPECT_EQ(SteeredFarAndNear(runs[2], 20).first, 0);
+  const int far = PlacedFarAndNear(runs[0], 20).first, prior_far = PlacedFarAndNear(runs[1], 20).first;
+  EXPECT_LT(far, prior_far) << "placed far from their place: with the evidence " << far << ", without " << prior_far;
+  EXPECT_EQ(PlacedFarAndNear(runs[2], 20).first, 0);
 }
 
 TEST(LocalizeCli, OrbsRankingWeighsTheBeliefOfTheFramesAfterIt) {
@@ -414,12 +413,11 @@ TEST(LocalizeCli, OrbsRankingWeighsTheBeliefOfTheFramesAfterIt) {
   // tracked at key image 15, their place. None is steered by far from its place either way.
   const auto runs = CorridorRuns({"", " --no-rank-evidence"}, 45, true);
   if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
-  const auto [far, near] = SteeredFarAndNear(runs[0], 0);
-  const auto [alone_far, alone_near] = SteeredFarAndNear(runs[1], 0);
+  const auto [far, near] = PlacedFarAndNear(runs[0], 0);
+  const auto [alone_far, alone_near] = PlacedFarAndNear(runs[1], 0);
   EXPECT_EQ(far, 0);
   EXPECT_EQ(alone_far, 0);
-  EXPECT_GE(near, alone_near + 2) << "steered by near their place: the ranking weighed " << near << ", not "
-                                  << alone_near;
+  EXPECT_GE(near, alone_near + 2) << "placed near their place: the ranking weighed " << near << ", not " << alone_near;
 }
 
 TEST(LocalizeCli, AFrameVerifiedWhereItsRankingPutsItIsSteeredBy) {
@@ -435,12 +433,12 @@ TEST(LocalizeCli, AFrameVerifiedWhereItsRankingPutsItIsSteeredBy) {
   for (size_t i = 0; i < runs[0].size(); ++i) {
     if (runs[0][i] == runs[1][i]) continue;
     EXPECT_EQ(runs[1][i].first, "uncertain") << "frame " << i;
-    EXPECT_TRUE(SteeredBy(runs[0][i])) << "frame " << i << ": " << runs[0][i].first;
+    EXPECT_TRUE(Placed(runs[0][i])) << "frame " << i << ": " << runs[0][i].first;
     EXPECT_EQ(runs[0][i].second, runs[1][i].second) << "frame " << i;
     ++released;
   }
-  EXPECT_GE(released, 1) << "no doubted frame steered by";
-  EXPECT_EQ(SteeredFarAndNear(runs[0], 0).first, 0);
+  EXPECT_GE(released, 1) << "no doubted frame placed";
+  EXPECT_EQ(PlacedFarAndNear(runs[0], 0).first, 0);
   EXPECT_LE(BackJumps(runs[0]), BackJumps(runs[1]));
 }
 
@@ -450,10 +448,10 @@ TEST(LocalizeCli, MatchingInTheWindowOfThePredictionTracksFramesTheContinuityMis
   // against the key image, and accepted by that matching's own measured threshold (frames 80 and 81). Guided matching
   // asks the key image and the next only, as when the window was measured (over the lookahead, 2026-11-29, the two
   // runs steered by 66 and 65 of the first 86 frames).
-  const std::vector<int> steered =
-      SteeredOnCorridor({" --no-guided-lookahead", " --no-window-matching --no-guided-lookahead"}, 85);
-  if (steered.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
-  EXPECT_GE(steered[0], steered[1] + 2) << "with the window " << steered[0] << ", without " << steered[1];
+  const std::vector<int> placed =
+      PlacedOnCorridor({" --no-guided-lookahead", " --no-window-matching --no-guided-lookahead"}, 85);
+  if (placed.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  EXPECT_GE(placed[0], placed[1] + 2) << "with the window " << placed[0] << ", without " << placed[1];
 }
 
 TEST(LocalizeCli, AStepBackOnTheEdgeOfChanceIsNotTaken) {
@@ -514,7 +512,7 @@ TEST(LocalizeCli, GuidedMatchingOverTheLookaheadKeepsUpWithTheRobot) {
   for (const auto& run : runs) {
     int count = 0;
     for (size_t i = 0; i < run.size(); ++i)
-      count += SteeredBy(run[i]) && std::abs(run[i].second - static_cast<int>(i)) <= 3;
+      count += Placed(run[i]) && std::abs(run[i].second - static_cast<int>(i)) <= 3;
     near.push_back(count);
   }
   EXPECT_GE(near[0], near[1] + 2) << "within 3 teach frames: over the lookahead " << near[0] << ", not " << near[1];
@@ -528,11 +526,11 @@ TEST(LocalizeCli, GuidedMatchingAsksWhereTheEstimateWasDroppedWhileLost) {
   // by far from its place, as many steered by as the rule alone.
   const auto runs = CorridorRuns({" --no-rank-evidence", " --no-rank-evidence --no-guided-while-lost", ""}, 45, true);
   if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
-  std::vector<int> steered;
-  for (const auto& run : runs) steered.push_back(static_cast<int>(std::count_if(run.begin(), run.end(), SteeredBy)));
-  EXPECT_GE(steered[0], steered[1] + 1) << "asked while lost " << steered[0] << ", not " << steered[1];
-  EXPECT_EQ(SteeredFarAndNear(runs[2], 0).first, 0);
-  EXPECT_GE(steered[2], steered[0]) << "steered by: the defaults " << steered[2] << ", the rule alone " << steered[0];
+  std::vector<int> placed;
+  for (const auto& run : runs) placed.push_back(static_cast<int>(std::count_if(run.begin(), run.end(), Placed)));
+  EXPECT_GE(placed[0], placed[1] + 1) << "asked while lost " << placed[0] << ", not " << placed[1];
+  EXPECT_EQ(PlacedFarAndNear(runs[2], 0).first, 0);
+  EXPECT_GE(placed[2], placed[0]) << "placed: the defaults " << placed[2] << ", the rule alone " << placed[0];
 }
 
 TEST(LocalizeCli, AFarPlaceALostFrameVerifiedIsAskedAgain) {
@@ -553,16 +551,15 @@ TEST(LocalizeCli, AFarPlaceALostFrameVerifiedIsAskedAgain) {
   std::vector<int> near(3, 0), far(3, 0);
   for (int r = 0; r < 3; ++r) {
     for (size_t i = 21; i < runs[r].size(); ++i) {  // the frames after the jump
-      if (!SteeredBy(runs[r][i])) continue;
+      if (!Placed(runs[r][i])) continue;
       (std::abs(runs[r][i].second - repeat_frames[i]) <= 5 ? near : far)[r] += 1;
     }
   }
   EXPECT_EQ(far[0], 0);
-  EXPECT_GE(near[0], near[1] + 4) << "steered by near their place: asked again " << near[0] << ", not " << near[1];
+  EXPECT_GE(near[0], near[1] + 4) << "placed near their place: asked again " << near[0] << ", not " << near[1];
   // With the defaults: none far, as many near as the rule alone.
   EXPECT_EQ(far[2], 0);
-  EXPECT_GE(near[2], near[0]) << "steered by near their place: the defaults " << near[2] << ", the rule alone "
-                              << near[0];
+  EXPECT_GE(near[2], near[0]) << "placed near their place: the defaults " << near[2] << ", the rule alone " << near[0];
 }
 
 // michigan_seasons' images (`names`: "SSPP", session SS's place PP) linked into `folder` as frames 1.png, 2.png, ...
@@ -605,11 +602,11 @@ std::vector<fs::path> MichiganSessions(const fs::path& dir, const std::vector<in
   return folders;
 }
 
-// `query` localized against `map` from key image `start_key` with `flags`: how many frames are steered by at the key
+// `query` localized against `map` from key image `start_key` with `flags`: how many frames are placed at the key
 // image `key_of(frame)` and how many elsewhere.
-std::pair<int, int> SteeredAtAndElsewhere(const fs::path& map, const fs::path& query, int start_key,
-                                          const std::string& flags, const std::function<int(int)>& key_of,
-                                          const fs::path& csv) {
+std::pair<int, int> PlacedAtAndElsewhere(const fs::path& map, const fs::path& query, int start_key,
+                                         const std::string& flags, const std::function<int(int)>& key_of,
+                                         const fs::path& csv) {
   std::pair<int, int> counts = {0, 0};
   std::string out;
   EXPECT_EQ(RunVmap("localize " + Quote(map) + " " + Quote(query) + " --start-key " + std::to_string(start_key) +
@@ -620,19 +617,19 @@ std::pair<int, int> SteeredAtAndElsewhere(const fs::path& map, const fs::path& q
   const std::vector<std::string> frames = CsvColumn(csv, "frame"), status = CsvColumn(csv, "status"),
                                  keys = CsvColumn(csv, "key");
   for (size_t i = 0; i < frames.size(); ++i) {
-    if (!SteeredBy({status[i], 0})) continue;
+    if (!Placed({status[i], 0})) continue;
     (std::stoi(keys[i]) == key_of(std::stoi(frames[i])) ? counts.first : counts.second) += 1;
   }
   return counts;
 }
 
-// Each query session's frame i, taken at key image i's place, against `map` from key image 0: frames steered by at
+// Each query session's frame i, taken at key image i's place, against `map` from key image 0: frames placed at
 // their place and elsewhere, over the sessions.
-std::pair<int, int> SteeredOnMichiganRoutes(const fs::path& map, const std::vector<fs::path>& queries,
-                                            const std::string& flags, const fs::path& csv) {
+std::pair<int, int> PlacedOnMichiganRoutes(const fs::path& map, const std::vector<fs::path>& queries,
+                                           const std::string& flags, const fs::path& csv) {
   std::pair<int, int> counts = {0, 0};
   for (const fs::path& query : queries) {
-    const std::pair<int, int> run = SteeredAtAndElsewhere(
+    const std::pair<int, int> run = PlacedAtAndElsewhere(
         map, query, 0, flags, [](int frame) { return frame; }, csv);
     counts.first += run.first;
     counts.second += run.second;
@@ -650,10 +647,10 @@ TEST(LocalizeCli, AHeadingThatStandsOutAgainstTheFramesRivalsLocalizesAcrossSeas
   const fs::path map = MichiganMap(tmp.path(), 1);
   const std::vector<fs::path> queries = MichiganSessions(tmp.path(), {2, 5, 7, 9, 11});
   const fs::path csv = tmp.path() / "run.csv";
-  const std::pair<int, int> with = SteeredOnMichiganRoutes(map, queries, "", csv),
-                            without = SteeredOnMichiganRoutes(map, queries, " --min-heading-rival-ratio 0", csv);
+  const std::pair<int, int> with = PlacedOnMichiganRoutes(map, queries, "", csv),
+                            without = PlacedOnMichiganRoutes(map, queries, " --min-heading-rival-ratio 0", csv);
   EXPECT_GE(with.first, without.first + 4) << "with the heading " << with.first << ", without " << without.first;
-  EXPECT_EQ(with.second, 0) << "steered by at another place";
+  EXPECT_EQ(with.second, 0) << "placed at another place";
 }
 
 // A lost frame steps on where its ranking and its heading agree (docs/measurements/localization-conditions.md): the
@@ -666,10 +663,10 @@ TEST(LocalizeCli, ALostFrameStepsOnWhereItsRankingAndItsHeadingAgree) {
   const fs::path map = MichiganMap(tmp.path(), 1);
   const std::vector<fs::path> queries = MichiganSessions(tmp.path(), {4, 6, 7, 9, 12});
   const fs::path csv = tmp.path() / "run.csv";
-  const std::pair<int, int> with = SteeredOnMichiganRoutes(map, queries, "", csv),
-                            without = SteeredOnMichiganRoutes(map, queries, " --no-step-on-where-evidence-agrees", csv);
+  const std::pair<int, int> with = PlacedOnMichiganRoutes(map, queries, "", csv),
+                            without = PlacedOnMichiganRoutes(map, queries, " --no-step-on-where-evidence-agrees", csv);
   EXPECT_GE(with.first, without.first + 4) << "with the rule " << with.first << ", without " << without.first;
-  EXPECT_EQ(with.second, 0) << "steered by at another place";
+  EXPECT_EQ(with.second, 0) << "placed at another place";
 }
 
 // The frames the rule above places have no heading to steer by: the heading is that of comparisons chance and the
@@ -697,7 +694,7 @@ TEST(LocalizeCli, AFrameTheEvidenceStepsOnIsNotSteeredByItsHeading) {
     ASSERT_EQ(with.at("status").size(), without.at("status").size());
     for (size_t i = 0; i < with.at("status").size(); ++i) {
       const std::string frame = query.filename().string() + " frame " + std::to_string(i);
-      if (without.at("status")[i] == "lost" && SteeredBy({with.at("status")[i], 0})) {
+      if (without.at("status")[i] == "lost" && Placed({with.at("status")[i], 0})) {
         EXPECT_EQ(with.at("guidance")[i], "none") << frame;
         EXPECT_EQ(with.at("heading_px")[i], "") << frame;
         ++placed_without_heading;
@@ -719,8 +716,8 @@ TEST(LocalizeCli, AFrameAfterLostFramesStepsOnWhereItsEvidenceAgrees) {
   const fs::path map = MichiganMap(tmp.path(), 11);
   const std::vector<fs::path> queries = MichiganSessions(tmp.path(), {1, 2, 3, 6, 10});
   const fs::path csv = tmp.path() / "run.csv";
-  const std::pair<int, int> without = SteeredOnMichiganRoutes(map, queries, " --no-step-on-after-lost-frames", csv);
-  const std::pair<int, int> with = SteeredOnMichiganRoutes(map, queries, "", csv);
+  const std::pair<int, int> without = PlacedOnMichiganRoutes(map, queries, " --no-step-on-after-lost-frames", csv);
+  const std::pair<int, int> with = PlacedOnMichiganRoutes(map, queries, "", csv);
   EXPECT_GE(with.first, without.first + 2) << "with the rule " << with.first << ", without " << without.first;
   EXPECT_EQ(with.second, 0) << "placed at another place";
   std::string out;
@@ -751,7 +748,7 @@ TEST(LocalizeCli, ALostFrameOfARobotThatStopsIsNotSteppedOn) {
                                                        {"1203", "0503", "0503", "0503", "0503"}};
   for (const std::vector<std::string>& frames : stops) {
     const fs::path query = MichiganFrames(tmp.path() / (frames.front() + "_" + frames.back()), frames);
-    const std::pair<int, int> run = SteeredAtAndElsewhere(
+    const std::pair<int, int> run = PlacedAtAndElsewhere(
         map, query, 2, "", [](int) { return 2; }, csv);
     EXPECT_EQ(run.second, 0) << frames.front() << ", then " << frames.back() << ": steered by at another place";
   }
