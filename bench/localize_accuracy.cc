@@ -1,10 +1,10 @@
 // Localization measured against truth (docs/measurements/localization.md): the bracket test and the ranking recall.
 //
 //   localize_accuracy SEQUENCE [--last N] [--tau T] [--ranking auto|votes|thumbnails] [--candidates K]
-//                     [--acceptance chance,counts] [--variants RULE/RECHECK/SHARE,...]
+//                     [--acceptance chance,counts] [--variants RULE/RECHECK/SHARE,...] [--orb-features N]
 //
-// Builds a map of the even frames of SEQUENCE (`vmap build --stride 2`, default options) in a temporary
-// folder and localizes the odd frames against it:
+// Builds a map of the even frames of SEQUENCE (`vmap build --stride 2`, default options but --orb-features) in a
+// temporary folder and localizes the odd frames against it:
 //  - streaming (tracking, relocalizing when lost): the share of odd frames localized at one of the two key
 //    images that bracket it in the input (KeysAround), and the status counts;
 //  - every frame relocalized from scratch (Localizer::Reset before each): the same share, the time per
@@ -31,6 +31,7 @@
 
 #include "vmap/core/runtime.h"
 #include "vmap/features/matcher_registry.h"
+#include "vmap/features/orb_matcher.h"
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localize_sequence.h"
@@ -147,7 +148,7 @@ int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
                  "usage: localize_accuracy SEQUENCE [--last N] [--tau T] [--ranking R] [--candidates K] "
-                 "[--acceptance chance,counts] [--variants RULE/RECHECK/SHARE,...]\n");
+                 "[--acceptance chance,counts] [--variants RULE/RECHECK/SHARE,...] [--orb-features N]\n");
     return 2;
   }
   const std::string input = argv[1];
@@ -156,6 +157,7 @@ int main(int argc, char** argv) {
   double tau = 0.5;
   std::string ranking = "auto";
   std::vector<bench::LocalizerVariant> variants;
+  MatcherOptions matcher_options;  // ORB with its defaults unless --orb-features
   for (int i = 2; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--last"))
       last = std::atoi(argv[i + 1]);
@@ -175,6 +177,8 @@ int main(int argc, char** argv) {
       step_back = false, --i;
     else if (!std::strcmp(argv[i], "--streaming-only"))
       streaming_only = true, --i;
+    else if (!std::strcmp(argv[i], "--orb-features"))
+      matcher_options.Of<OrbMatcherOptions>().num_features = std::atoi(argv[i + 1]);
   }
   vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   const fs::path map_directory = fs::temp_directory_path() / ("vmap_localize_accuracy_" + std::to_string(getpid()));
@@ -182,7 +186,7 @@ int main(int argc, char** argv) {
   fs::create_directories(map_directory);
 
   // The map: even frames.
-  const auto matcher = CreateMatcher({});
+  const auto matcher = CreateMatcher(matcher_options);
   MapBuilderOptions build_options;
   build_options.key_images.tau = tau;
   build_options.show_progress = false;

@@ -2,7 +2,8 @@
 //
 //   localize_repeat TUM_SEQUENCE --teach FIRST:LAST --repeat FIRST:LAST [--stride N]
 //                   [--max-distance M] [--max-angle DEG] [--acceptance chance,counts]
-//                   [--variants counts/0/0,chance/0.5/0.25] [--orb-fast-threshold T] [--no-window-matching 1]
+//                   [--variants counts/0/0,chance/0.5/0.25] [--orb-fast-threshold T] [--orb-features N]
+//                   [--no-window-matching 1]
 //
 // Builds a map of the teach frames (default options) and localizes the repeat frames against it. The
 // sequence's groundtruth.txt (TUM: timestamp tx ty tz qx qy qz qw, camera to world) judges each repeat frame:
@@ -168,7 +169,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path sequence = argv[1];
-  MatcherOptions matcher_options;  // ORB with its defaults unless --orb-fast-threshold
+  MatcherOptions matcher_options;  // ORB with its defaults unless --orb-fast-threshold / --orb-features
   std::pair<int, int> teach{0, 499}, repeat{500, 999};
   int stride = 1;
   double max_distance = 0.5, max_angle = 30.0;
@@ -201,6 +202,8 @@ int main(int argc, char** argv) {
       window_matching = std::atoi(argv[i + 1]) == 0;
     } else if (!std::strcmp(argv[i], "--orb-fast-threshold")) {
       matcher_options.Of<OrbMatcherOptions>().fast_threshold = std::atoi(argv[i + 1]);
+    } else if (!std::strcmp(argv[i], "--orb-features")) {
+      matcher_options.Of<OrbMatcherOptions>().num_features = std::atoi(argv[i + 1]);
     }
   }
   vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
