@@ -22,11 +22,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <opencv2/core.hpp>
 
 #include "vmap/core/runtime.h"
@@ -145,41 +145,31 @@ void Measure(const std::string& input, const LocalizationMap& opened, const Loca
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2) {
-    std::fprintf(stderr,
-                 "usage: localize_accuracy SEQUENCE [--last N] [--tau T] [--ranking R] [--candidates K] "
-                 "[--acceptance chance,counts] [--variants RULE/RECHECK/SHARE,...] [--orb-features N]\n");
-    return 2;
-  }
-  const std::string input = argv[1];
+  // CLI11, as the vmap binary parses its flags: a flag it does not know, or one without its value, is an error
+  // (a hand-written loop over pairs ignored a last `--streaming-only` and any misspelled flag).
+  CLI::App app{
+      "localize_accuracy: how many frames of a sequence the localizer brackets, against a map of its even frames"};
+  std::string input;
   int last = -1, candidates = 5, lookahead = 2;
   bool step_back = true, streaming_only = false;
   double tau = 0.5;
-  std::string ranking = "auto";
-  std::vector<bench::LocalizerVariant> variants;
+  std::string ranking = "auto", acceptance, variant_list;
   MatcherOptions matcher_options;  // ORB with its defaults unless --orb-features
-  for (int i = 2; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--last"))
-      last = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--tau"))
-      tau = std::atof(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--ranking"))
-      ranking = argv[i + 1];
-    else if (!std::strcmp(argv[i], "--candidates"))
-      candidates = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--acceptance"))
-      variants = bench::ParseAcceptanceVariants(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--variants"))
-      variants = bench::ParseLocalizerVariants(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--lookahead"))
-      lookahead = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--no-step-back"))
-      step_back = false, --i;
-    else if (!std::strcmp(argv[i], "--streaming-only"))
-      streaming_only = true, --i;
-    else if (!std::strcmp(argv[i], "--orb-features"))
-      matcher_options.Of<OrbMatcherOptions>().num_features = std::atoi(argv[i + 1]);
-  }
+  app.add_option("sequence", input, "the sequence (a TUM RGB-D folder, an image folder or a video)")->required();
+  app.add_option("--last", last, "the last frame read (-1: all)");
+  app.add_option("--tau", tau, "the map's key image threshold");
+  app.add_option("--ranking", ranking, "the key image ranking");
+  app.add_option("--candidates", candidates, "relocalization candidates");
+  app.add_option("--acceptance", acceptance, "acceptance variants to compare: chance,counts");
+  app.add_option("--variants", variant_list, "localizer variants to compare: RULE/RECHECK/SHARE,...");
+  app.add_option("--lookahead", lookahead, "the tracker's lookahead");
+  app.add_flag("!--no-step-back", step_back, "never step back to the key image behind");
+  app.add_flag("--streaming-only", streaming_only, "only the streaming pass (not the relocalization of every frame)");
+  app.add_option("--orb-features", matcher_options.Of<OrbMatcherOptions>().num_features, "the map's ORB features");
+  CLI11_PARSE(app, argc, argv);
+  std::vector<bench::LocalizerVariant> variants;
+  if (!acceptance.empty()) variants = bench::ParseAcceptanceVariants(acceptance);
+  if (!variant_list.empty()) variants = bench::ParseLocalizerVariants(variant_list);
   vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   const fs::path map_directory = fs::temp_directory_path() / ("vmap_localize_accuracy_" + std::to_string(getpid()));
   fs::remove_all(map_directory);

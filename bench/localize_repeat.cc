@@ -20,7 +20,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -28,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <opencv2/core.hpp>
 
 #include "vmap/core/runtime.h"
@@ -79,9 +79,9 @@ bool Near(const Pose& a, const Pose& b, double max_distance, double max_angle_de
          std::acos(std::clamp(cosine, -1.0, 1.0)) * 180.0 / M_PI <= max_angle_deg;
 }
 
-std::pair<int, int> Range(const char* text) {
+std::pair<int, int> Range(const std::string& text) {
   int first = 0, last = -1;
-  std::sscanf(text, "%d:%d", &first, &last);
+  std::sscanf(text.c_str(), "%d:%d", &first, &last);
   return {first, last};
 }
 
@@ -162,50 +162,43 @@ void Judge(const fs::path& sequence, const LocalizationMap& opened, const Locali
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2) {
-    std::fprintf(stderr,
-                 "usage: localize_repeat TUM_SEQUENCE --teach A:B --repeat C:D [--stride N] "
-                 "[--acceptance chance,counts] [--variants RULE/RECHECK/SHARE,...]\n");
-    return 2;
-  }
-  const fs::path sequence = argv[1];
+  // CLI11, as the vmap binary parses its flags: a flag it does not know, or one without its value, is an error.
+  CLI::App app{
+      "localize_repeat: a map of a TUM sequence's teach frames, its repeat frames localized and judged by the "
+      "ground truth"};
+  fs::path sequence;
   MatcherOptions matcher_options;  // ORB with its defaults unless --orb-fast-threshold / --orb-features
-  std::pair<int, int> teach{0, 499}, repeat{500, 999};
+  std::string teach_range = "0:499", repeat_range = "500:999", acceptance, variant_list;
   int stride = 1;
   double max_distance = 0.5, max_angle = 30.0;
   std::string ranking = "auto";
-  std::vector<bench::LocalizerVariant> variants;
-  bool window_matching = LocalizerOptions().window_matching;  // --no-window-matching 1: off
+  bool window_matching = LocalizerOptions().window_matching;
   int descriptors = RankingOptions().max_descriptors_per_key, candidates = LocalizerOptions().relocalization_candidates;
-  for (int i = 2; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--teach"))
-      teach = Range(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--repeat"))
-      repeat = Range(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--stride"))
-      stride = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--max-distance"))
-      max_distance = std::atof(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--max-angle"))
-      max_angle = std::atof(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--ranking"))
-      ranking = argv[i + 1];
-    else if (!std::strcmp(argv[i], "--descriptors"))
-      descriptors = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--candidates"))
-      candidates = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--acceptance")) {
-      variants = bench::ParseAcceptanceVariants(argv[i + 1]);
-    } else if (!std::strcmp(argv[i], "--variants")) {
-      variants = bench::ParseLocalizerVariants(argv[i + 1]);
-    } else if (!std::strcmp(argv[i], "--no-window-matching")) {
-      window_matching = std::atoi(argv[i + 1]) == 0;
-    } else if (!std::strcmp(argv[i], "--orb-fast-threshold")) {
-      matcher_options.Of<OrbMatcherOptions>().fast_threshold = std::atoi(argv[i + 1]);
-    } else if (!std::strcmp(argv[i], "--orb-features")) {
-      matcher_options.Of<OrbMatcherOptions>().num_features = std::atoi(argv[i + 1]);
-    }
-  }
+  app.add_option("sequence", sequence, "the TUM RGB-D sequence (with groundtruth.txt)")->required();
+  const auto is_range = [](const std::string& text) -> std::string {
+    int first = 0, last = 0;
+    char rest = 0;
+    return std::sscanf(text.c_str(), "%d:%d%c", &first, &last, &rest) == 2 ? "" : "expects FIRST:LAST, e.g. 0:499";
+  };
+  app.add_option("--teach", teach_range, "the teach frames, A:B")->check(is_range);
+  app.add_option("--repeat", repeat_range, "the repeat frames, C:D")->check(is_range);
+  app.add_option("--stride", stride, "every n-th frame");
+  app.add_option("--max-distance", max_distance, "a key image is right within this distance (m)");
+  app.add_option("--max-angle", max_angle, "and this angle (degrees)");
+  app.add_option("--ranking", ranking, "the key image ranking");
+  app.add_option("--descriptors", descriptors, "the ranking's descriptors per key image");
+  app.add_option("--candidates", candidates, "relocalization candidates");
+  app.add_option("--acceptance", acceptance, "acceptance variants to compare: chance,counts");
+  app.add_option("--variants", variant_list, "localizer variants to compare: RULE/RECHECK/SHARE,...");
+  app.add_flag("!--no-window-matching", window_matching, "no matching by the prediction's window");
+  app.add_option("--orb-fast-threshold", matcher_options.Of<OrbMatcherOptions>().fast_threshold,
+                 "ORB's FAST threshold");
+  app.add_option("--orb-features", matcher_options.Of<OrbMatcherOptions>().num_features, "the map's ORB features");
+  CLI11_PARSE(app, argc, argv);
+  const std::pair<int, int> teach = Range(teach_range), repeat = Range(repeat_range);
+  std::vector<bench::LocalizerVariant> variants;
+  if (!acceptance.empty()) variants = bench::ParseAcceptanceVariants(acceptance);
+  if (!variant_list.empty()) variants = bench::ParseLocalizerVariants(variant_list);
   vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   const auto poses = ReadGroundTruth(sequence / "groundtruth.txt");
   if (poses.empty()) {
