@@ -206,6 +206,7 @@ KeyImageStore LoadKeyImageStore(const fs::path& map_directory, const VisualMap& 
   options.Check();
   const auto start = std::chrono::steady_clock::now();
   KeyImageStore store;
+  store.directory = map_directory;
   // The views are stored and cached as further key images, after the map's own.
   std::vector<KeyImage> images = map.key_images;
   for (const Experience& e : experiences) {

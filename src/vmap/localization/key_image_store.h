@@ -58,6 +58,9 @@ struct KeyImageStore {
   std::vector<std::vector<KeyImageView>> views;
   KeyImageCacheState cache = KeyImageCacheState::kOff;
   double seconds = 0.0;  // time to load or compute them
+  // The map directory the key images were read from (LoadKeyImageStore): a lost frame's key images are extracted
+  // again from there with more features (LocalizerOptions::lost_frame_features). Empty: a store built otherwise.
+  std::filesystem::path directory;
 };
 
 // Reads (or computes and caches) the features of every key image of `map`, read from `map_directory`, and of

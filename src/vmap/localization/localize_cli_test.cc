@@ -447,9 +447,13 @@ TEST(LocalizeCli, MatchingInTheWindowOfThePredictionTracksFramesTheContinuityMis
   // chance nor the continuity of the heading accepts is matched again only around the previous frame's heading
   // against the key image, and accepted by that matching's own measured threshold (frames 80 and 81). Guided matching
   // asks the key image and the next only, as when the window was measured (over the lookahead, 2026-11-29, the two
-  // runs steered by 66 and 65 of the first 86 frames).
+  // runs steered by 66 and 65 of the first 86 frames), and a lost frame is not compared again with more features (one
+  // of the frames the window tracks is relocalized so without the window: docs/measurements/
+  // localization-conditions.md, "A lost frame compared again with more features").
   const std::vector<int> placed =
-      PlacedOnCorridor({" --no-guided-lookahead", " --no-window-matching --no-guided-lookahead"}, 85);
+      PlacedOnCorridor({" --no-guided-lookahead --lost-frame-features 0",
+                        " --no-window-matching --no-guided-lookahead --lost-frame-features 0"},
+                       85);
   if (placed.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   EXPECT_GE(placed[0], placed[1] + 2) << "with the window " << placed[0] << ", without " << placed[1];
 }
@@ -647,10 +651,16 @@ TEST(LocalizeCli, AHeadingThatStandsOutAgainstTheFramesRivalsLocalizesAcrossSeas
   const fs::path map = MichiganMap(tmp.path(), 1);
   const std::vector<fs::path> queries = MichiganSessions(tmp.path(), {2, 5, 7, 9, 11});
   const fs::path csv = tmp.path() / "run.csv";
-  const std::pair<int, int> with = PlacedOnMichiganRoutes(map, queries, "", csv),
-                            without = PlacedOnMichiganRoutes(map, queries, " --min-heading-rival-ratio 0", csv);
+  // Measured as the rule was chosen, without the lost frames' comparisons with more features (some of the frames it
+  // accepts verify with them: ALostFrameComparedAgainWithMoreFeaturesIsRelocalized); with the defaults, none placed
+  // elsewhere.
+  const std::string before = " --lost-frame-features 0";
+  const std::pair<int, int> with = PlacedOnMichiganRoutes(map, queries, before, csv),
+                            without =
+                                PlacedOnMichiganRoutes(map, queries, before + " --min-heading-rival-ratio 0", csv);
   EXPECT_GE(with.first, without.first + 4) << "with the heading " << with.first << ", without " << without.first;
   EXPECT_EQ(with.second, 0) << "placed at another place";
+  EXPECT_EQ(PlacedOnMichiganRoutes(map, queries, "", csv).second, 0) << "with the defaults, placed elsewhere";
 }
 
 // A lost frame steps on where its ranking and its heading agree (docs/measurements/localization-conditions.md): the
@@ -663,10 +673,15 @@ TEST(LocalizeCli, ALostFrameStepsOnWhereItsRankingAndItsHeadingAgree) {
   const fs::path map = MichiganMap(tmp.path(), 1);
   const std::vector<fs::path> queries = MichiganSessions(tmp.path(), {4, 6, 7, 9, 12});
   const fs::path csv = tmp.path() / "run.csv";
-  const std::pair<int, int> with = PlacedOnMichiganRoutes(map, queries, "", csv),
-                            without = PlacedOnMichiganRoutes(map, queries, " --no-step-on-where-evidence-agrees", csv);
+  // Measured as the rule was chosen, without the lost frames' comparisons with more features (some of its frames verify
+  // with them: ALostFrameComparedAgainWithMoreFeaturesIsRelocalized); with the defaults, none placed elsewhere.
+  const std::string before = " --lost-frame-features 0";
+  const std::pair<int, int> with = PlacedOnMichiganRoutes(map, queries, before, csv),
+                            without = PlacedOnMichiganRoutes(map, queries,
+                                                             before + " --no-step-on-where-evidence-agrees", csv);
   EXPECT_GE(with.first, without.first + 4) << "with the rule " << with.first << ", without " << without.first;
   EXPECT_EQ(with.second, 0) << "placed at another place";
+  EXPECT_EQ(PlacedOnMichiganRoutes(map, queries, "", csv).second, 0) << "with the defaults, placed elsewhere";
 }
 
 // The frames the rule above places have no heading to steer by: the heading is that of comparisons chance and the
@@ -679,7 +694,10 @@ TEST(LocalizeCli, AFrameTheEvidenceStepsOnIsNotSteeredByItsHeading) {
   int placed_without_heading = 0;
   for (const fs::path& query : MichiganSessions(tmp.path(), {4, 6, 7, 9, 12})) {
     std::map<std::string, std::map<std::string, std::vector<std::string>>> runs;
-    for (const std::string flags : {"", " --no-step-on-where-evidence-agrees"}) {
+    // Measured as the rule was chosen, without the lost frames' comparisons with more features (some of its frames are
+    // relocalized by them, with a heading chance accepted); with the defaults, a frame not steered by has no heading.
+    for (const std::string flags :
+         {" --lost-frame-features 0", " --lost-frame-features 0 --no-step-on-where-evidence-agrees", ""}) {
       const fs::path csv = tmp.path() / "run.csv";
       std::string out;
       ASSERT_EQ(RunVmap("localize " + Quote(map) + " " + Quote(query) + " --start-key 0 -q --csv " + Quote(csv) + flags,
@@ -689,8 +707,12 @@ TEST(LocalizeCli, AFrameTheEvidenceStepsOnIsNotSteeredByItsHeading) {
       for (const std::string column : {"status", "key", "guidance", "heading_px"})
         runs[flags][column] = CsvColumn(csv, column);
     }
-    const auto& with = runs[""];
-    const auto& without = runs[" --no-step-on-where-evidence-agrees"];
+    const auto& with = runs[" --lost-frame-features 0"];
+    const auto& without = runs[" --lost-frame-features 0 --no-step-on-where-evidence-agrees"];
+    const auto& defaults = runs[""];
+    for (size_t i = 0; i < defaults.at("status").size(); ++i) {
+      if (defaults.at("guidance")[i] == "none") EXPECT_EQ(defaults.at("heading_px")[i], "") << "defaults, frame " << i;
+    }
     ASSERT_EQ(with.at("status").size(), without.at("status").size());
     for (size_t i = 0; i < with.at("status").size(); ++i) {
       const std::string frame = query.filename().string() + " frame " + std::to_string(i);
@@ -751,6 +773,32 @@ TEST(LocalizeCli, ALostFrameOfARobotThatStopsIsNotSteppedOn) {
     const std::pair<int, int> run = PlacedAtAndElsewhere(
         map, query, 2, "", [](int) { return 2; }, csv);
     EXPECT_EQ(run.second, 0) << frames.front() << ", then " << frames.back() << ": steered by at another place";
+  }
+}
+
+// A lost frame compared again with more features (docs/measurements/localization-conditions.md, "A lost frame compared
+// again with more features"): session 6's map, sessions with frames that verify nothing with the map's 500 features at
+// any key image, and whose right key image's comparison with more features on both sides passes chance: relocalized at
+// their place, none elsewhere; lost without it. Session 1's frame 1 (place 2) is one.
+TEST(LocalizeCli, ALostFrameComparedAgainWithMoreFeaturesIsRelocalized) {
+  SKIP_WITHOUT_SHARED();
+  ::vmap::testing::ScopedTempDir tmp;
+  const fs::path map = MichiganMap(tmp.path(), 6);
+  const std::vector<fs::path> queries = MichiganSessions(tmp.path(), {1, 3, 7, 8, 11});
+  const fs::path csv = tmp.path() / "run.csv";
+  const std::pair<int, int> without = PlacedOnMichiganRoutes(map, queries, " --lost-frame-features 0", csv);
+  const std::pair<int, int> with = PlacedOnMichiganRoutes(map, queries, "", csv);
+  EXPECT_GE(with.first, without.first + 4) << "with the rule " << with.first << ", without " << without.first;
+  EXPECT_EQ(with.second, 0) << "placed at another place";
+  for (const std::string flags : {"", " --lost-frame-features 0"}) {
+    std::string out;
+    ASSERT_EQ(
+        RunVmap("localize " + Quote(map) + " " + Quote(queries[0]) + " --start-key 0 -q --csv " + Quote(csv) + flags,
+                &out),
+        0)
+        << out;
+    EXPECT_EQ(CsvColumn(csv, "status")[1], flags.empty() ? "relocalized" : "lost") << flags;
+    if (flags.empty()) EXPECT_EQ(CsvColumn(csv, "key")[1], "1");
   }
 }
 

@@ -121,6 +121,15 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
       window_matcher_ = CreateMatcher(guided);
     }
   }
+  if (options_.lost_frame_features > 0 && matcher_.name() == OrbMatcherOptions::kModelName &&
+      !keys_.directory.empty()) {
+    MatcherOptions more;
+    more.type = OrbMatcherOptions::kModelName;
+    more.model(more.type).FromJson(nlohmann::json::parse(matcher_.DescribeOptionsJson()), "the map's matcher");
+    more.Of<OrbMatcherOptions>().num_features = options_.lost_frame_features;
+    lost_frame_matcher_ = CreateMatcher(more);
+    lost_frame_key_features_.assign(num_keys, nullptr);
+  }
   if (options_.comparison_threads > 1) {
     speculation_ = std::make_unique<SpeculativeComparisons>(
         [this](const ImageFeatures& features, int key) { return Compare(features, key); },
@@ -328,6 +337,11 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     // place the robot was carried to verifies only so).
     if (found.status != LocalizationStatus::kRelocalized && options_.guided_relocalization &&
         GuideRelocalization(frame, features)) {
+      found = Relocalize(frame, features);
+    }
+    // Nothing verified with the map's features: the ranking's best compared again with more (across seasons too few of
+    // 500 features match a right key image's for chance).
+    if (found.status != LocalizationStatus::kRelocalized && CompareLostFrameAgain(frame, features)) {
       found = Relocalize(frame, features);
     }
     const bool relocalized = found.status == LocalizationStatus::kRelocalized;

@@ -101,6 +101,14 @@ class Localizer {
   // not; each comparison chance accepts replaces its key image's memo (the first one's evidence weighed first).
   // Returns whether any was accepted.
   bool GuideRelocalization(const Frame& frame, const ImageFeatures& features);
+  // A lost frame compared again with more features (LocalizerOptions::lost_frame_features): the frame's features
+  // extracted again by lost_frame_matcher_ and compared with the ranking's best key images (CompareBestRanked) whose
+  // first comparison chance refused and the link share did not, against their features extracted again likewise
+  // (LostFrameKeyFeatures); each comparison chance accepts replaces its key image's memo (the first one's evidence
+  // weighed first). Returns whether any was accepted.
+  bool CompareLostFrameAgain(const Frame& frame, const ImageFeatures& features);
+  // Key image `key`'s features as lost_frame_matcher_ extracts them, read from the map's directory when first needed.
+  const ImageFeatures& LostFrameKeyFeatures(int key);
   // A lost frame steps on where its evidence agrees (LocalizerOptions::step_on_where_evidence_agrees): whether the
   // frame's ranking (ranked by its relocalization) and its comparisons' heading modes each single out the key image
   // at route `position + 1`, the tracker's next.
@@ -273,6 +281,10 @@ class Localizer {
   // The frame's features for matching by the prediction (LocalizerOptions::window_fast_threshold, window_features);
   // null: the map's.
   std::unique_ptr<Matcher> window_matcher_;
+  // The map's ORB with lost_frame_features features (LocalizerOptions::lost_frame_features); null: not asked, not ORB,
+  // or the key images' directory unknown. The key images' features it extracted, per key image (null: not yet).
+  std::unique_ptr<Matcher> lost_frame_matcher_;
+  std::vector<std::shared_ptr<const ImageFeatures>> lost_frame_key_features_;
   LocalizerOptions options_;
   std::vector<int> route_;
   std::vector<int> route_position_of_key_;  // -1 for key images off the route

@@ -135,6 +135,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "ORB: never step a frame after lost frames on to the next key image where its ranking and its heading "
                  "mode agree and the frame before named it by neither"},
                 step_on_after_lost_frames);
+  visitor.Visit({"lost_frame_features", "--lost-frame-features",
+                 "ORB: a lost frame's features extracted again, this many, and compared with the ranking's best key "
+                 "images extracted again likewise (0 = never)"},
+                lost_frame_features);
   visitor.Visit({"guided_lookahead", "!--no-guided-lookahead",
                  "ORB: match a frame guided at the key image and the next one only, ranked by verified matches (not "
                  "over the lookahead, ranked by the one-way matches' NFA where chance accepts none)"},
@@ -289,6 +293,10 @@ void LocalizerOptions::Check() const {
   CheckField("verifier", verifier);
   CheckField("heading", heading);
   CheckField("translation", translation);
+  if (lost_frame_features < 0 || lost_frame_features > 100000) {
+    throw OptionError("lost_frame_features", fmt::format("{} must be 0 to 100000 (default {})", lost_frame_features,
+                                                         defaults.lost_frame_features));
+  }
   if (comparison_threads < 1 || comparison_threads > 64) {
     throw OptionError("comparison_threads",
                       fmt::format("{} must be 1 to 64 (default {})", comparison_threads, defaults.comparison_threads));

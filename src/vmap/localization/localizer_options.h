@@ -191,6 +191,17 @@ struct LocalizerOptions {
   // above (docs/measurements/localization-conditions.md, "A frame after lost frames steps on where its evidence
   // agrees"). Off: such a frame is lost.
   bool step_on_after_lost_frames = true;
+  // A lost frame compared again with more features (ORB maps whose key image files are at hand): a frame that verifies
+  // nothing at the tracked key images, nor at the ranking's best when relocalized, guided too, has its features
+  // extracted again, `lost_frame_features` of them, and is compared with the ranking's best key images
+  // (relocalization_candidates) whose first comparison chance refused and the link share did not, their features
+  // extracted again likewise from the map's key image files (once each, when first needed). It is relocalized again on
+  // what chance accepts of them (max_log10_nfa, as any comparison), and a place far from the tracked estimate still
+  // needs two frames (TakesJump). Across seasons 500 features match too few of a right key image's for chance
+  // (michigan_seasons' lost ORB frames verify 14 of 147 tentative matches at their right key image, as many as at the
+  // wrong ones); with 4,000 on both sides 26 of its 274 lost frames are placed at their place, none elsewhere
+  // (docs/measurements/localization-conditions.md, "A lost frame compared again with more features"). 0: never.
+  int lost_frame_features = 4000;
   // Guided matching over the lookahead: it asks the tracked key image and the `lookahead` key images after it (the
   // tracker's own reach), and ranks what it accepts by a measure common to the key images asked: those chance accepts
   // by their verified matches (as the tracker ranks), and when chance accepts none, those the continuity of the heading

@@ -1,9 +1,12 @@
 // The Localizer without an estimate: the frame compared with the route's best-ranked key images, accepted by chance or
 // against its rivals, and placed on the segment before or after the best of them; when nothing verifies, matched guided
 // where the estimate was dropped.
+#include <algorithm>
 #include <vector>
 
+#include "vmap/core/error.h"
 #include "vmap/localization/localizer.h"
+#include "vmap/map/map_io.h"
 
 namespace vmap {
 
@@ -91,6 +94,46 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
   result.status = LocalizationStatus::kRelocalized;
   Describe(result, position_, features);
   return result;
+}
+
+bool Localizer::CompareLostFrameAgain(const Frame& frame, const ImageFeatures& features) {
+  // Decided by chance only, as a guided comparison (the counts rule would take the extra matches as evidence).
+  if (!lost_frame_matcher_ || options_.acceptance != AcceptanceRule::kChance) return false;
+  std::shared_ptr<const ImageFeatures> more;  // the frame's, extracted when first needed
+  bool accepted = false;
+  for (const int position : CompareBestRanked(frame, features)) {
+    const int key = route_[position];
+    const KeyComparison first = CompareOnce(features, key);
+    // As GuideRelocalization: chance asked again, never the link share.
+    if (first.accepted || first.num_verified < options_.min_link_share * link_verified_[key]) continue;
+    const ImageFeatures* key_image = nullptr;
+    try {
+      key_image = &LostFrameKeyFeatures(key);
+    } catch (const InputError&) {
+      // The map's key image files are not at hand (its features came from the cache): its lost frames stay as they are.
+      lost_frame_matcher_.reset();
+      return accepted;
+    }
+    const ImageFeatures& key_features = *key_image;
+    if (!more) more = lost_frame_matcher_->ExtractFrame(frame.gray, frame.color);
+    WeighComparisons();  // the first comparison's evidence, before this one replaces it
+    KeyComparison again = CompareImage(*more, key_features, lost_frame_matcher_->Match(*more, key_features), key);
+    if (!again.accepted) continue;
+    const auto memo =
+        std::find_if(comparisons_.begin(), comparisons_.end(), [&](const Memo& m) { return m.comparison.key == key; });
+    *memo = {std::move(again), /*weighed=*/true};  // CompareOnce made it
+    accepted = true;
+  }
+  return accepted;
+}
+
+const ImageFeatures& Localizer::LostFrameKeyFeatures(int key) {
+  std::shared_ptr<const ImageFeatures>& features = lost_frame_key_features_[key];
+  if (!features) {
+    const cv::Mat gray = ReadKeyImage(keys_.directory, map_.key_images[key], /*grayscale=*/true);
+    features = lost_frame_matcher_->ExtractFrame(gray, cv::Mat());
+  }
+  return *features;
 }
 
 double Localizer::SharedWithLink(const KeyComparison& comparison, int key_a, int key_b) const {

@@ -308,6 +308,8 @@ TEST(Localizer, ALostFramesRelocalizationIsMatchedGuidedAtTheRankingsBest) {
     LocalizerOptions options = MapLocalizerOptions(m);
     ASSERT_TRUE(options.guided_relocalization) << "the default";
     options.guided_relocalization = guided;
+    // Guided matching alone: compared again with more features, the frame is relocalized without it too.
+    options.lost_frame_features = 0;
     // The tracker's own decisions: a far place taken on one frame (TakesJump), and no frame made uncertain.
     options.belief.window = 0;
     options.belief.min_confidence = 0.0;
@@ -469,6 +471,7 @@ TEST(Localizer, OptionsAreChecked) {
   auto path = [&](auto change) { return testing::OptionErrorPath([&] { with(change).Check(); }); };
   EXPECT_EQ(path([](LocalizerOptions& o) { o.min_verified = 5; }), "min_verified");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.comparison_threads = 0; }), "comparison_threads");
+  EXPECT_EQ(path([](LocalizerOptions& o) { o.lost_frame_features = -1; }), "lost_frame_features");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.min_similarity = 1.5; }), "min_similarity");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.max_log10_nfa = std::nan(""); }), "max_log10_nfa");
   EXPECT_EQ(path([](LocalizerOptions& o) { o.recheck_link_share = -0.1; }), "recheck_link_share");
