@@ -30,12 +30,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/runtime.h"
@@ -50,54 +50,54 @@
 using namespace vmap;
 
 int main(int argc, char** argv) {
-  InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
-  if (argc < 3) {
-    std::fprintf(stderr, "usage: evidence_dump MAP QUERY [--stride N] [--last N]\n");
-    return 2;
-  }
+  // CLI11, as the vmap binary parses its flags: a flag it does not know, or one without its value, is an error.
+  CLI::App app{"evidence_dump: every frame of a query against every key image of a map, one CSV row per pair"};
+  std::string map_path, query_path, window_list;
   FrameSourceOptions query_options;
   // ORB only, an experiment (docs/localize.md, "guided matching"): the frame's features and the matching of the
   // comparisons made with other options than the map's (OrbMatcherOptions' defaults otherwise).
   OrbMatcherOptions frame_orb, match_orb;
-  bool orb_override = false, guided = false;
+  bool guided = false;
   int window_frame_fast = 0, window_frame_features = 0;
   double window_frame_clahe = 0.0;
+  app.add_option("map", map_path, "the map directory")->required();
+  app.add_option("query", query_path, "the query run (a video, an image folder, a TUM or KITTI sequence)")->required();
+  app.add_option("--stride", query_options.stride, "every n-th frame of the query");
+  app.add_option("--last", query_options.last, "the query's last frame");
+  // The ORB experiment's options: any of them given, the comparisons use frame_orb / match_orb.
+  const std::vector<CLI::Option*> orb_experiment = {
+      app.add_option("--cross-check", match_orb.cross_check, "ORB matching with a cross check (0|1)"),
+      app.add_option("--ratio", match_orb.ratio, "ORB matching's ratio test"),
+      app.add_option("--frame-fast", frame_orb.fast_threshold, "the frame's FAST threshold"),
+      app.add_option("--frame-features", frame_orb.num_features, "the frame's ORB features"),
+      app.add_option("--frame-edge", frame_orb.edge_threshold, "the frame's ORB edge threshold (px)"),
+      app.add_option("--frame-grid-cell", frame_orb.grid_cell, "the frame's ORB grid cell (px)"),
+      app.add_option("--frame-min-fast", frame_orb.min_fast_threshold, "the frame's ORB fallback FAST threshold"),
+      app.add_option("--frame-clahe", frame_orb.clahe_clip, "the frame's CLAHE clip limit")};
+  app.add_option("--guided", guided, "also the guided comparison's columns (0|1)");
+  app.add_option("--windowed", window_list, "windows for matching by the prediction: W[:Z[:D[:R[:L]]]][,...]");
+  app.add_option("--window-frame-fast", window_frame_fast, "the window matching's frame FAST threshold");
+  app.add_option("--window-frame-features", window_frame_features, "the window matching's frame features");
+  app.add_option("--window-frame-clahe", window_frame_clahe, "the window matching's frame CLAHE clip limit");
+  CLI11_PARSE(app, argc, argv);
+  const bool orb_override =
+      std::any_of(orb_experiment.begin(), orb_experiment.end(), [](const CLI::Option* o) { return o->count() > 0; });
   std::vector<std::vector<double>> windows;  // share of the width, zoom, max distance, ratio, level difference
-  for (int i = 3; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--stride")) query_options.stride = std::stoi(argv[i + 1]);
-    if (!std::strcmp(argv[i], "--last")) query_options.last = std::stoi(argv[i + 1]);
-    if (!std::strcmp(argv[i], "--cross-check"))
-      match_orb.cross_check = std::stoi(argv[i + 1]) != 0, orb_override = true;
-    if (!std::strcmp(argv[i], "--ratio")) match_orb.ratio = std::stod(argv[i + 1]), orb_override = true;
-    if (!std::strcmp(argv[i], "--frame-fast")) frame_orb.fast_threshold = std::stoi(argv[i + 1]), orb_override = true;
-    if (!std::strcmp(argv[i], "--frame-features")) frame_orb.num_features = std::stoi(argv[i + 1]), orb_override = true;
-    if (!std::strcmp(argv[i], "--frame-edge")) frame_orb.edge_threshold = std::stoi(argv[i + 1]), orb_override = true;
-    if (!std::strcmp(argv[i], "--frame-grid-cell")) frame_orb.grid_cell = std::stoi(argv[i + 1]), orb_override = true;
-    if (!std::strcmp(argv[i], "--frame-min-fast"))
-      frame_orb.min_fast_threshold = std::stoi(argv[i + 1]), orb_override = true;
-    if (!std::strcmp(argv[i], "--frame-clahe")) frame_orb.clahe_clip = std::stod(argv[i + 1]), orb_override = true;
-    if (!std::strcmp(argv[i], "--guided")) guided = std::stoi(argv[i + 1]) != 0;
-    if (!std::strcmp(argv[i], "--window-frame-fast")) window_frame_fast = std::stoi(argv[i + 1]);
-    if (!std::strcmp(argv[i], "--window-frame-features")) window_frame_features = std::stoi(argv[i + 1]);
-    if (!std::strcmp(argv[i], "--window-frame-clahe")) window_frame_clahe = std::stod(argv[i + 1]);
-    if (!std::strcmp(argv[i], "--windowed")) {
-      std::string list = argv[i + 1];
-      for (size_t at = 0; at < list.size();) {
-        const size_t comma = std::min(list.find(',', at), list.size());
-        const std::string spec = list.substr(at, comma - at);
-        std::vector<double> values = {0.0625, 0.0, 64, 0.9, 1};
-        size_t field = 0;
-        for (size_t from = 0; from <= spec.size() && field < values.size(); ++field) {
-          const size_t colon = std::min(spec.find(':', from), spec.size());
-          values[field] = std::stod(spec.substr(from, colon - from));
-          from = colon + 1;
-        }
-        windows.push_back(values);
-        at = comma + 1;
-      }
+  for (size_t at = 0; at < window_list.size();) {
+    const size_t comma = std::min(window_list.find(',', at), window_list.size());
+    const std::string spec = window_list.substr(at, comma - at);
+    std::vector<double> values = {0.0625, 0.0, 64, 0.9, 1};
+    size_t field = 0;
+    for (size_t from = 0; from <= spec.size() && field < values.size(); ++field) {
+      const size_t colon = std::min(spec.find(':', from), spec.size());
+      values[field] = std::stod(spec.substr(from, colon - from));
+      from = colon + 1;
     }
+    windows.push_back(values);
+    at = comma + 1;
   }
-  const LocalizationMap opened = OpenLocalizationMap(argv[1], {});
+  InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
+  const LocalizationMap opened = OpenLocalizationMap(map_path, {});
   query_options.resize = QueryResize(opened.map, "");
   const LocalizerOptions options = FollowMap(opened, MapLocalizerOptions(opened), query_options.resize);
   const std::unique_ptr<Matcher> frame_matcher = orb_override ? CreateOrbMatcher(frame_orb) : nullptr;
@@ -136,7 +136,7 @@ int main(int argc, char** argv) {
   }
   // The relocalization's ranking of every key image, as the localizer ranks the route.
   const KeyImageRanking ranking(opened.keys.features, opened.keys.thumbnails, options.ranking);
-  auto source = OpenFrameSource(argv[2], query_options);
+  auto source = OpenFrameSource(query_path, query_options);
   std::printf(
       "frame,source_index,key,matched,accepted,tentative,verified,similarity,log10_nfa,link_verified,"
       "heading_confidence,heading_votes,heading_px,heading_voters,prev_heading_px,near_S,near_L%s%s",
