@@ -22,6 +22,7 @@
 // links, or counts of verified matches and S). A frame tracked with far fewer verified matches than its key
 // image shares with its neighbours is relocalized too, and moved when another key image verifies more.
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -96,16 +97,18 @@ class Localizer {
   // none is accepted or guided matching does not apply.
   // `whatever_the_belief`: asked though the belief does not single the place out (guided_while_lost).
   int TrackGuided(const Frame& frame, const ImageFeatures& features, int position, bool whatever_the_belief = false);
-  // Guided relocalization (LocalizerOptions::guided_relocalization): the frame matched again with guided_matcher_ at
-  // the ranking's best key images (CompareBestRanked) whose first comparison chance refused and the link share did
-  // not; each comparison chance accepts replaces its key image's memo (the first one's evidence weighed first).
-  // Returns whether any was accepted.
+  // The ranking's best key images (CompareBestRanked) whose first comparison chance refused and the link share did
+  // not, compared again by `again` (nullopt: ask no further); each second comparison chance accepts replaces its key
+  // image's memo (the first one's evidence weighed first). Returns whether any was accepted. Chance decides alone, as
+  // for every comparison made again: the counts rule would take the extra matches as evidence.
+  bool CompareBestRankedAgain(const Frame& frame, const ImageFeatures& features,
+                              const std::function<std::optional<KeyComparison>(int key)>& again);
+  // Guided relocalization (LocalizerOptions::guided_relocalization): CompareBestRankedAgain with the frame matched
+  // again by guided_matcher_.
   bool GuideRelocalization(const Frame& frame, const ImageFeatures& features);
-  // A lost frame compared again with more features (LocalizerOptions::lost_frame_features): the frame's features
-  // extracted again by lost_frame_matcher_ and compared with the ranking's best key images (CompareBestRanked) whose
-  // first comparison chance refused and the link share did not, against their features extracted again likewise
-  // (LostFrameKeyFeatures); each comparison chance accepts replaces its key image's memo (the first one's evidence
-  // weighed first). Returns whether any was accepted.
+  // A lost frame compared again with more features (LocalizerOptions::lost_frame_features): CompareBestRankedAgain
+  // with the frame's features extracted again by lost_frame_matcher_ and the key image's likewise
+  // (LostFrameKeyFeatures).
   bool CompareLostFrameAgain(const Frame& frame, const ImageFeatures& features);
   // Key image `key`'s features as lost_frame_matcher_ extracts them, read from the map's directory when first needed.
   const ImageFeatures& LostFrameKeyFeatures(int key);

@@ -159,25 +159,33 @@ int Localizer::TrackGuided(const Frame& frame, const ImageFeatures& features, in
   return found;
 }
 
-bool Localizer::GuideRelocalization(const Frame& frame, const ImageFeatures& features) {
-  // Decided by chance only, as every guided comparison (TrackGuided).
-  if (!guided_matcher_ || options_.acceptance != AcceptanceRule::kChance) return false;
+bool Localizer::CompareBestRankedAgain(const Frame& frame, const ImageFeatures& features,
+                                       const std::function<std::optional<KeyComparison>(int key)>& again) {
+  if (options_.acceptance != AcceptanceRule::kChance) return false;
   bool accepted = false;
   for (const int position : CompareBestRanked(frame, features)) {
     const int key = route_[position];
     const KeyComparison first = CompareOnce(features, key);
     // As TrackGuided: chance asked again, never the link share.
     if (first.accepted || first.num_verified < options_.min_link_share * link_verified_[key]) continue;
-    WeighComparisons();  // the first comparison's evidence, before the guided one replaces it
-    KeyComparison guided =
-        CompareImage(features, *keys_.features[key], guided_matcher_->Match(features, *keys_.features[key]), key);
-    if (!guided.accepted) continue;
+    std::optional<KeyComparison> second = again(key);
+    if (!second) break;
+    WeighComparisons();  // the first comparison's evidence, before the second one replaces it
+    if (!second->accepted) continue;
     const auto memo =
         std::find_if(comparisons_.begin(), comparisons_.end(), [&](const Memo& m) { return m.comparison.key == key; });
-    *memo = {std::move(guided), /*weighed=*/true};  // CompareOnce made it
+    *memo = {std::move(*second), /*weighed=*/true};  // CompareOnce made it
     accepted = true;
   }
   return accepted;
+}
+
+bool Localizer::GuideRelocalization(const Frame& frame, const ImageFeatures& features) {
+  if (!guided_matcher_) return false;
+  return CompareBestRankedAgain(frame, features, [&](int key) -> std::optional<KeyComparison> {
+    const ImageFeatures& key_image = *keys_.features[key];
+    return CompareImage(features, key_image, guided_matcher_->Match(features, key_image), key);
+  });
 }
 
 std::optional<double> Localizer::PreviousHeading(int key) const {

@@ -97,34 +97,20 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
 }
 
 bool Localizer::CompareLostFrameAgain(const Frame& frame, const ImageFeatures& features) {
-  // Decided by chance only, as a guided comparison (the counts rule would take the extra matches as evidence).
-  if (!lost_frame_matcher_ || options_.acceptance != AcceptanceRule::kChance) return false;
+  if (!lost_frame_matcher_) return false;
   std::shared_ptr<const ImageFeatures> more;  // the frame's, extracted when first needed
-  bool accepted = false;
-  for (const int position : CompareBestRanked(frame, features)) {
-    const int key = route_[position];
-    const KeyComparison first = CompareOnce(features, key);
-    // As GuideRelocalization: chance asked again, never the link share.
-    if (first.accepted || first.num_verified < options_.min_link_share * link_verified_[key]) continue;
+  return CompareBestRankedAgain(frame, features, [&](int key) -> std::optional<KeyComparison> {
     const ImageFeatures* key_image = nullptr;
     try {
       key_image = &LostFrameKeyFeatures(key);
     } catch (const InputError&) {
       // The map's key image files are not at hand (its features came from the cache): its lost frames stay as they are.
       lost_frame_matcher_.reset();
-      return accepted;
+      return std::nullopt;
     }
-    const ImageFeatures& key_features = *key_image;
     if (!more) more = lost_frame_matcher_->ExtractFrame(frame.gray, frame.color);
-    WeighComparisons();  // the first comparison's evidence, before this one replaces it
-    KeyComparison again = CompareImage(*more, key_features, lost_frame_matcher_->Match(*more, key_features), key);
-    if (!again.accepted) continue;
-    const auto memo =
-        std::find_if(comparisons_.begin(), comparisons_.end(), [&](const Memo& m) { return m.comparison.key == key; });
-    *memo = {std::move(again), /*weighed=*/true};  // CompareOnce made it
-    accepted = true;
-  }
-  return accepted;
+    return CompareImage(*more, *key_image, lost_frame_matcher_->Match(*more, *key_image), key);
+  });
 }
 
 const ImageFeatures& Localizer::LostFrameKeyFeatures(int key) {
