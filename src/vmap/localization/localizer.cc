@@ -41,6 +41,15 @@ bool OfOneScene(const Link& link, cv::Size from_size, cv::Size to_size, double m
   return ChanceOfComparison(pair, from_size, to_size, 1).log10_nfa <= max_log10_nfa;
 }
 
+// The options of the map's ORB matcher, for a matcher that changes one of them (guided, window and lost-frame
+// matching): the rest as the key images were extracted.
+MatcherOptions MapOrbOptions(const Matcher& map_matcher) {
+  MatcherOptions options;
+  options.type = OrbMatcherOptions::kModelName;
+  options.model(options.type).FromJson(nlohmann::json::parse(map_matcher.DescribeOptionsJson()), "the map's matcher");
+  return options;
+}
+
 }  // namespace
 
 Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matcher& matcher, LocalizerOptions options)
@@ -109,9 +118,7 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   nfa_ranks_key_images_ = binary;
   heading_accepts_ = binary;
   if (options_.guided_matching && matcher_.name() == OrbMatcherOptions::kModelName) {
-    MatcherOptions guided;
-    guided.type = OrbMatcherOptions::kModelName;
-    guided.model(guided.type).FromJson(nlohmann::json::parse(matcher_.DescribeOptionsJson()), "the map's matcher");
+    MatcherOptions guided = MapOrbOptions(matcher_);
     guided.Of<OrbMatcherOptions>().cross_check = false;
     guided_matcher_ = CreateMatcher(guided);
     if (options_.window_matching && (options_.window_fast_threshold > 0 || options_.window_features > 0)) {
@@ -123,9 +130,7 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   }
   if (options_.lost_frame_features > 0 && matcher_.name() == OrbMatcherOptions::kModelName &&
       !keys_.directory.empty()) {
-    MatcherOptions more;
-    more.type = OrbMatcherOptions::kModelName;
-    more.model(more.type).FromJson(nlohmann::json::parse(matcher_.DescribeOptionsJson()), "the map's matcher");
+    MatcherOptions more = MapOrbOptions(matcher_);
     more.Of<OrbMatcherOptions>().num_features = options_.lost_frame_features;
     lost_frame_matcher_ = CreateMatcher(more);
     lost_frame_key_features_.assign(num_keys, nullptr);
@@ -417,47 +422,6 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   result = TrackedAt(std::move(result), position, best_position, features);
   if (doubted) result.status = LocalizationStatus::kUncertain;
   return result;
-}
-
-bool Localizer::EvidenceAgreesOnNext(int position) const {
-  // Measured with binary descriptors only (across seasons ORB's chance refuses most right key images; XFeat's rarely).
-  const int next = position + 1;
-  return heading_accepts_ && next < static_cast<int>(route_.size()) && RankingFirst() == next && HeadingMode() == next;
-}
-
-int Localizer::RankingFirst() const {
-  // The ranking holds the route's key images in route order: ranked_[r].key is a route position.
-  if (ranked_.size() < 2 || ranked_[0].score <= ranked_[1].score) return -1;
-  return ranked_[0].key;
-}
-
-int Localizer::HeadingMode() const {
-  int mode = -1, mode_votes = -1, rival_votes = -1;
-  for (const Memo& m : comparisons_) {
-    const int position = route_position_of_key_[m.comparison.key];
-    if (position < 0) continue;
-    const int votes = m.comparison.heading.votes;
-    if (position == mode) {
-      mode_votes = std::max(mode_votes, votes);
-    } else if (votes > mode_votes) {
-      rival_votes = std::max(rival_votes, mode_votes);
-      mode = position;
-      mode_votes = votes;
-    } else {
-      rival_votes = std::max(rival_votes, votes);
-    }
-  }
-  return mode_votes > rival_votes ? mode : -1;
-}
-
-LocalizationResult Localizer::PlacedByAgreement(LocalizationResult placed) {
-  // Placed, but not steered by (guidance "none"): the place is the two measures' agreement, the heading that of
-  // comparisons chance and the heading rule refused. On michigan_seasons 13 of the 37 frames placed so had a heading
-  // against their key image more than 35 px off the hand label, against 25 of the 336 frames placed otherwise.
-  // heading_key_px stays, as a lost frame's does: what the comparison measured, not to steer by.
-  placed.heading_px = placed.heading_deg = kNaN;
-  placed.translation_known = false;
-  return placed;
 }
 
 LocalizationResult Localizer::TrackedAt(LocalizationResult result, int from, int position,
