@@ -186,7 +186,8 @@ TEST(MapBuilder, LookAheadGivesTheSerialMapAndWastesFewComparisons) {
 
 TEST(MapBuilder, BlackFramesGiveLinksBelowTauNotCrashes) {
   std::vector<cv::Mat> frames(Sequence().frames.begin(), Sequence().frames.begin() + 6);
-  frames[3] = cv::Mat::zeros(frames[0].size(), CV_8UC3);
+  // A new buffer: assigning zeros() to frames[3] would blacken the shared sequence's frame in place.
+  frames[3] = cv::Mat(frames[0].size(), CV_8UC3, cv::Scalar::all(0));
   const auto matcher = CreateOrbMatcher({});
   MemorySource source(frames);
   const VisualMap map = BuildMap(source, *matcher, Options(0.5));
