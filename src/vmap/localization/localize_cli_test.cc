@@ -738,10 +738,15 @@ TEST(LocalizeCli, AFrameAfterLostFramesStepsOnWhereItsEvidenceAgrees) {
   const fs::path map = MichiganMap(tmp.path(), 11);
   const std::vector<fs::path> queries = MichiganSessions(tmp.path(), {1, 2, 3, 6, 10});
   const fs::path csv = tmp.path() / "run.csv";
-  const std::pair<int, int> without = PlacedOnMichiganRoutes(map, queries, " --no-step-on-after-lost-frames", csv);
-  const std::pair<int, int> with = PlacedOnMichiganRoutes(map, queries, "", csv);
+  // Measured as the rule was chosen, without a lost frame's heading with more features (it places one of these frames
+  // without the rule: ALostFramesHeadingWithMoreFeaturesPlacesIt); with the defaults, none placed elsewhere.
+  const std::string before = " --no-lost-frame-heading";
+  const std::pair<int, int> without =
+      PlacedOnMichiganRoutes(map, queries, before + " --no-step-on-after-lost-frames", csv);
+  const std::pair<int, int> with = PlacedOnMichiganRoutes(map, queries, before, csv);
   EXPECT_GE(with.first, without.first + 2) << "with the rule " << with.first << ", without " << without.first;
   EXPECT_EQ(with.second, 0) << "placed at another place";
+  EXPECT_EQ(PlacedOnMichiganRoutes(map, queries, "", csv).second, 0) << "with the defaults, placed elsewhere";
   std::string out;
   ASSERT_EQ(RunVmap("localize " + Quote(map) + " " + Quote(queries[1]) + " --start-key 0 -q --csv " + Quote(csv), &out),
             0)
@@ -800,6 +805,41 @@ TEST(LocalizeCli, ALostFrameComparedAgainWithMoreFeaturesIsRelocalized) {
     EXPECT_EQ(CsvColumn(csv, "status")[1], flags.empty() ? "relocalized" : "lost") << flags;
     if (flags.empty()) EXPECT_EQ(CsvColumn(csv, "key")[1], "1");
   }
+}
+
+// A lost frame's heading with more features (docs/measurements/localization-conditions.md): session 10's map, sessions
+// with frames whose comparisons with more features chance refuses at every key image, but whose heading mode stands
+// out there against the other key images compared so: placed at their place and steered by (a heading to steer by),
+// none elsewhere; lost without it.
+TEST(LocalizeCli, ALostFramesHeadingWithMoreFeaturesPlacesIt) {
+  SKIP_WITHOUT_SHARED();
+  ::vmap::testing::ScopedTempDir tmp;
+  const fs::path map = MichiganMap(tmp.path(), 10);
+  const std::vector<fs::path> queries = MichiganSessions(tmp.path(), {2, 5, 6, 9, 12});
+  const fs::path csv = tmp.path() / "run.csv";
+  const std::pair<int, int> without = PlacedOnMichiganRoutes(map, queries, " --no-lost-frame-heading", csv);
+  const std::pair<int, int> with = PlacedOnMichiganRoutes(map, queries, "", csv);
+  EXPECT_GE(with.first, without.first + 6) << "with the rule " << with.first << ", without " << without.first;
+  EXPECT_EQ(with.second, 0) << "placed at another place";
+  int steered_with_heading = 0;
+  for (const fs::path& query : queries) {
+    std::map<std::string, std::vector<std::string>> runs[2];
+    for (const int rule : {0, 1}) {
+      std::string out;
+      ASSERT_EQ(RunVmap("localize " + Quote(map) + " " + Quote(query) + " --start-key 0 -q --csv " + Quote(csv) +
+                            (rule ? "" : " --no-lost-frame-heading"),
+                        &out),
+                0)
+          << out;
+      for (const std::string column : {"status", "guidance", "heading_px"}) runs[rule][column] = CsvColumn(csv, column);
+    }
+    for (size_t i = 0; i < runs[1].at("status").size(); ++i) {
+      if (runs[0].at("status")[i] != "lost" || !Placed({runs[1].at("status")[i], 0})) continue;
+      EXPECT_NE(runs[1].at("guidance")[i], "none") << query.filename() << " frame " << i;
+      if (!runs[1].at("heading_px")[i].empty()) ++steered_with_heading;
+    }
+  }
+  EXPECT_GE(steered_with_heading, 6);
 }
 
 TEST(LocalizeCli, ComparisonsMadeOnOtherThreadsChangeNoResult) {

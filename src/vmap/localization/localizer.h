@@ -110,6 +110,9 @@ class Localizer {
   // with the frame's features extracted again by lost_frame_matcher_ and the key image's likewise
   // (LostFrameKeyFeatures).
   bool CompareLostFrameAgain(const Frame& frame, const ImageFeatures& features);
+  // Where chance accepts none of them, the comparison with more features whose heading mode stands out against the
+  // others made so (LocalizerOptions::lost_frame_heading) is accepted as by HeadingStandsOut.
+  bool AcceptLostFrameByHeading(const std::vector<KeyComparison>& compared);
   // Key image `key`'s features as lost_frame_matcher_ extracts them, read from the map's directory when first needed.
   const ImageFeatures& LostFrameKeyFeatures(int key);
   // A lost frame steps on where its evidence agrees (LocalizerOptions::step_on_where_evidence_agrees): whether the

@@ -139,6 +139,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "ORB: a lost frame's features extracted again, this many, and compared with the ranking's best key "
                  "images extracted again likewise (0 = never)"},
                 lost_frame_features);
+  visitor.Visit({"lost_frame_heading", "!--no-lost-frame-heading",
+                 "ORB: never accept a lost frame's comparison with more features by its heading mode standing out "
+                 "against the others made so (only chance decides on them)"},
+                lost_frame_heading);
   visitor.Visit({"guided_lookahead", "!--no-guided-lookahead",
                  "ORB: match a frame guided at the key image and the next one only, ranked by verified matches (not "
                  "over the lookahead, ranked by the one-way matches' NFA where chance accepts none)"},

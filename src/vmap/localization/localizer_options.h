@@ -202,6 +202,13 @@ struct LocalizerOptions {
   // wrong ones); with 4,000 on both sides 26 of its 274 lost frames are placed at their place, none elsewhere
   // (docs/measurements/localization-conditions.md, "A lost frame compared again with more features"). 0: never.
   int lost_frame_features = 4000;
+  // Where chance accepts none of those comparisons with more features, the one whose heading mode stands out against
+  // the others made so is accepted as a heading that stands out against the frame's rivals is (min_heading_votes,
+  // min_heading_rival_ratio, the link share; its rivals among the comparisons with more features only: 4,000 features
+  // give any key image's mode more votes than 500 do). michigan_seasons' lost ORB frames: their right key image's mode
+  // holds 31 votes (median), the best wrong one's 18 (docs/measurements/localization-conditions.md, "A lost frame's
+  // heading with more features"). Off: only chance decides on them.
+  bool lost_frame_heading = true;
   // Guided matching over the lookahead: it asks the tracked key image and the `lookahead` key images after it (the
   // tracker's own reach), and ranks what it accepts by a measure common to the key images asked: those chance accepts
   // by their verified matches (as the tracker ranks), and when chance accepts none, those the continuity of the heading

@@ -99,7 +99,8 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
 bool Localizer::CompareLostFrameAgain(const Frame& frame, const ImageFeatures& features) {
   if (!lost_frame_matcher_) return false;
   std::shared_ptr<const ImageFeatures> more;  // the frame's, extracted when first needed
-  return CompareBestRankedAgain(frame, features, [&](int key) -> std::optional<KeyComparison> {
+  std::vector<KeyComparison> compared;        // with more features, chance's verdict aside
+  const bool by_chance = CompareBestRankedAgain(frame, features, [&](int key) -> std::optional<KeyComparison> {
     const ImageFeatures* key_image = nullptr;
     try {
       key_image = &LostFrameKeyFeatures(key);
@@ -109,8 +110,38 @@ bool Localizer::CompareLostFrameAgain(const Frame& frame, const ImageFeatures& f
       return std::nullopt;
     }
     if (!more) more = lost_frame_matcher_->ExtractFrame(frame.gray, frame.color);
-    return CompareImage(*more, *key_image, lost_frame_matcher_->Match(*more, *key_image), key);
+    compared.push_back(CompareImage(*more, *key_image, lost_frame_matcher_->Match(*more, *key_image), key));
+    return compared.back();
   });
+  return by_chance || AcceptLostFrameByHeading(compared);
+}
+
+bool Localizer::AcceptLostFrameByHeading(const std::vector<KeyComparison>& compared) {
+  if (!options_.lost_frame_heading || !heading_accepts_ || options_.min_heading_rival_ratio <= 0.0) return false;
+  // As HeadingStandsOut, with the frame's rivals among the comparisons made with as many features: a heading mode of
+  // 4,000 features holds more votes at any key image than one of 500 (michigan_seasons' wrong key images 16-21, where
+  // 500 features give them at most 15), so a rival of 500 would let almost any mode stand out.
+  const auto best = std::max_element(
+      compared.begin(), compared.end(),
+      [](const KeyComparison& a, const KeyComparison& b) { return a.heading.votes < b.heading.votes; });
+  if (best == compared.end() || !best->matched || best->heading.votes < options_.min_heading_votes ||
+      best->num_verified < options_.min_link_share * link_verified_[best->key]) {
+    return false;
+  }
+  const int position = route_position_of_key_[best->key];
+  int rival_votes = -1;
+  for (const KeyComparison& c : compared) {
+    const int q = route_position_of_key_[c.key];
+    if (q >= 0 && IsHeadingRival(position, q)) rival_votes = std::max(rival_votes, c.heading.votes);
+  }
+  if (rival_votes < 0 || best->heading.votes < options_.min_heading_rival_ratio * rival_votes) return false;
+  for (Memo& m : comparisons_) {
+    if (m.comparison.key != best->key) continue;
+    // Weighed already as its first comparison was: WeighComparisons adds what the heading's acceptance adds.
+    m.comparison = *best;
+    m.comparison.accepted = m.by_heading = true;
+  }
+  return true;
 }
 
 const ImageFeatures& Localizer::LostFrameKeyFeatures(int key) {
