@@ -396,9 +396,11 @@ TEST(LocalizeCli, AStartKeyNeedsTheFramesEvidence) {
   // (log10 NFA -1.1) while the frames' evidence alone held 0.04 of its belief near it, less than a flat belief; the
   // start's prior alone made it confident, and it was steered by 19 teach frames off. Measured as when it was chosen,
   // without ORB's ranking weighed (with it frame 23 is uncertain at key image 9, its place, whether the rule is on or
-  // off), nor a lost frame's relocalization matched guided (--no-guided-relocalization, as above). With the defaults:
-  // none far.
-  const std::string alone = " --start-key 0 --first 20 --no-rank-evidence --no-guided-relocalization";
+  // off), nor a lost frame's relocalization matched guided (--no-guided-relocalization, as above), nor the comparisons
+  // away from the tracker verified with fewer iterations (--far-comparison-iterations 0: with them no frame is placed
+  // far without the rule either). With the defaults: none far.
+  const std::string alone =
+      " --start-key 0 --first 20 --no-rank-evidence --no-guided-relocalization --far-comparison-iterations 0";
   const auto runs = CorridorRuns({alone, alone + " --no-start-needs-evidence", " --start-key 0 --first 20"}, 33, true);
   if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   const int far = PlacedFarAndNear(runs[0], 20).first, prior_far = PlacedFarAndNear(runs[1], 20).first;

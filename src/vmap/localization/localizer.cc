@@ -117,6 +117,7 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   start_checked_over_route_ = binary;
   nfa_ranks_key_images_ = binary;
   heading_accepts_ = binary;
+  binary_descriptors_ = binary;
   if (options_.guided_matching && matcher_.name() == OrbMatcherOptions::kModelName) {
     MatcherOptions guided = MapOrbOptions(matcher_);
     guided.Of<OrbMatcherOptions>().cross_check = false;
@@ -137,7 +138,7 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   }
   if (options_.comparison_threads > 1) {
     speculation_ = std::make_unique<SpeculativeComparisons>(
-        [this](const ImageFeatures& features, int key) { return Compare(features, key); },
+        [this](const ImageFeatures& features, int key) { return Compare(features, key, FarComparisonIterations(key)); },
         options_.comparison_threads - 1);
   }
   Reset();  // at the start key image, when there is one
@@ -188,6 +189,11 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
     }
   } finish_speculation{speculation_.get()};
   comparisons_.clear();
+  frame_start_position_ = position_;
+  // The comparisons made ahead verified in full: those the frame verifies with fewer iterations are made again.
+  ahead.erase(std::remove_if(ahead.begin(), ahead.end(),
+                             [&](const KeyComparison& c) { return FarComparisonIterations(c.key) > 0; }),
+              ahead.end());
   made_ahead_ = std::move(ahead);
   ranked_.clear();
   bucket_of_position_.clear();

@@ -64,9 +64,11 @@ class Localizer {
   // The key images the next frame will most likely be compared with: `key` and `next_key` of the current
   // estimate (none without an estimate).
   std::vector<int> LikelyKeys() const;
-  // The frame's features against key image `key`, as Localize compares them. Thread-safe (const, and the
-  // matcher's Match and the verifier are), so frames can be compared ahead on other threads.
-  KeyComparison Compare(const ImageFeatures& features, int key) const;
+  // The frame's features against key image `key`, as Localize compares them, its verifier's iterations at most
+  // `max_iterations` where above 0 (as Localize verifies those away from the tracker: FarComparisonIterations).
+  // Thread-safe (const, and the matcher's Match and the verifier are), so frames can be compared ahead on other
+  // threads.
+  KeyComparison Compare(const ImageFeatures& features, int key, int max_iterations = 0) const;
 
   // Adds the relative pose, its translation sigma and whether the translation is known to a comparison of
   // the teach key image (experience 0) that matched, when the options have a camera. Localize does it for the
@@ -82,7 +84,10 @@ class Localizer {
  private:
   // The frame against one image of key image `key` (the key image itself or a view), from their matches.
   KeyComparison CompareImage(const ImageFeatures& features, const ImageFeatures& image, const TentativeMatches& matches,
-                             int key) const;
+                             int key, int max_iterations = 0) const;
+  // The verifier's iterations for the frame's comparison with key image `key` (LocalizerOptions::
+  // far_comparison_iterations): the cap for a key image away from the tracker's, 0 (the verifier's own) otherwise.
+  int FarComparisonIterations(int key) const;
   // Each key image is compared with a frame at most once per Localize call.
   KeyComparison CompareOnce(const ImageFeatures& features, int key);
   // The frame's comparisons with the key images at route `positions` (those on the route, not compared yet), which
@@ -303,8 +308,14 @@ class Localizer {
   // Binary descriptors (ORB): a heading mode that stands out against the frame's rivals accepts a comparison
   // (min_heading_rival_ratio; measured on ORB only).
   bool heading_accepts_ = false;
+  // ORB: the comparisons away from the tracker are verified with fewer iterations (far_comparison_iterations; XFeat's
+  // scored matches are verified on their best, MapVerifierOptions' loop_points, and were not measured so).
+  bool binary_descriptors_ = false;
   std::unique_ptr<KeyImageRanking> ranking_;
-  int position_ = -1;        // route position of `key`; -1: no estimate
+  int position_ = -1;  // route position of `key`; -1: no estimate
+  // position_ when the frame being localized started (FarComparisonIterations): fixed for the frame, so that a
+  // comparison's result does not depend on when the frame makes it, on which thread.
+  int frame_start_position_ = -1;
   int start_position_ = -1;  // route position of LocalizerOptions::start_key; -1: none
   int lost_in_a_row_ = 0;
   // The route position the frame before this one was placed at (tracking or relocalized); -1: it was not.

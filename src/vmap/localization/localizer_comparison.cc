@@ -10,9 +10,9 @@
 
 namespace vmap {
 
-KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
+KeyComparison Localizer::Compare(const ImageFeatures& features, int key, int max_iterations) const {
   const ImageFeatures& key_image = *keys_.features[key];
-  KeyComparison best = CompareImage(features, key_image, matcher_.Match(features, key_image), key);
+  KeyComparison best = CompareImage(features, key_image, matcher_.Match(features, key_image), key, max_iterations);
   if (keys_.views.empty() || keys_.views[key].empty() || options_.experience_candidates == 0) return best;
   // Every view is matched (cheap); the few with the most tentative matches are verified.
   const std::vector<KeyImageView>& views = keys_.views[key];
@@ -25,7 +25,7 @@ KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return matches[a].size() > matches[b].size(); });
   order.resize(std::min<size_t>(order.size(), options_.experience_candidates));
   for (int v : order) {
-    KeyComparison c = CompareImage(features, *views[v].features, matches[v], key);
+    KeyComparison c = CompareImage(features, *views[v].features, matches[v], key, max_iterations);
     if (!FitsBetter(c, best)) continue;
     c.experience = views[v].experience;
     // Headings add up: x_frame - x_key = (x_frame - x_view) + (x_view - x_key).
@@ -40,11 +40,13 @@ KeyComparison Localizer::Compare(const ImageFeatures& features, int key) const {
 }
 
 KeyComparison Localizer::CompareImage(const ImageFeatures& features, const ImageFeatures& image,
-                                      const TentativeMatches& matches, int key) const {
+                                      const TentativeMatches& matches, int key, int max_iterations) const {
   // As ComparePair, on matches made already.
   const int denominator = SimilarityDenominator(options_.similarity, static_cast<int>(matches.size()),
                                                 features.num_features(), image.num_features());
-  const PairComparison pair = VerifyMatches(matches, denominator, options_.verifier);
+  VerifierOptions verifier = options_.verifier;
+  if (max_iterations > 0) verifier.max_iterations = std::min(verifier.max_iterations, max_iterations);
+  const PairComparison pair = VerifyMatches(matches, denominator, verifier);
   KeyComparison c;
   c.key = key;
   c.matched = pair.matched;
@@ -244,8 +246,19 @@ KeyComparison Localizer::CompareOnce(const ImageFeatures& features, int key) {
   } else if (speculation_) {
     made = speculation_->Take(key);
   }
-  comparisons_.push_back({made ? std::move(*made) : Compare(features, key)});
+  comparisons_.push_back({made ? std::move(*made) : Compare(features, key, FarComparisonIterations(key))});
   return comparisons_.back().comparison;
+}
+
+int Localizer::FarComparisonIterations(int key) const {
+  if (options_.far_comparison_iterations <= 0 || !binary_descriptors_) return 0;
+  // The tracker's own key images are verified in full: the one behind the estimate (a step back), the estimate's, the
+  // `lookahead` after it and the next key image of the furthest step on (its guidance). Without an estimate (a run's
+  // start, a drop) the frame is relocalized: all in full.
+  const int p = route_position_of_key_[key];
+  const int from = frame_start_position_;
+  if (from < 0 || (p >= from - 1 && p <= from + options_.lookahead + 1)) return 0;
+  return options_.far_comparison_iterations;
 }
 
 void Localizer::CompareMeanwhile(const ImageFeatures& features, const std::vector<int>& positions) {

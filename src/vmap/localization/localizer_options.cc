@@ -143,6 +143,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "ORB: never accept a lost frame's comparison with more features by its heading mode standing out "
                  "against the others made so (only chance decides on them)"},
                 lost_frame_heading);
+  visitor.Visit({"far_comparison_iterations", "--far-comparison-iterations",
+                 "ORB: verify the frame's comparisons with key images away from the tracker's (more than one behind "
+                 "or lookahead + 1 ahead) with at most this many MAGSAC iterations (0 = the verifier's)"},
+                far_comparison_iterations);
   visitor.Visit({"guided_lookahead", "!--no-guided-lookahead",
                  "ORB: match a frame guided at the key image and the next one only, ranked by verified matches (not "
                  "over the lookahead, ranked by the one-way matches' NFA where chance accepts none)"},
@@ -300,6 +304,11 @@ void LocalizerOptions::Check() const {
   if (lost_frame_features < 0 || lost_frame_features > 100000) {
     throw OptionError("lost_frame_features", fmt::format("{} must be 0 to 100000 (default {})", lost_frame_features,
                                                          defaults.lost_frame_features));
+  }
+  if (far_comparison_iterations < 0 || far_comparison_iterations > 10000000) {
+    throw OptionError("far_comparison_iterations",
+                      fmt::format("{} must be 0 to 10000000 (default {})", far_comparison_iterations,
+                                  defaults.far_comparison_iterations));
   }
   if (comparison_threads < 1 || comparison_threads > 64) {
     throw OptionError("comparison_threads",

@@ -209,6 +209,16 @@ struct LocalizerOptions {
   // holds 31 votes (median), the best wrong one's 18 (docs/measurements/localization-conditions.md, "A lost frame's
   // heading with more features"). Off: only chance decides on them.
   bool lost_frame_heading = true;
+  // ORB: the frame's comparisons with key images away from the tracker's (more than one route position behind the
+  // estimate the frame starts from, or more than `lookahead` + 1 ahead of it: the frame's rivals, the ranking's
+  // candidates, the belief's window elsewhere) are verified with at most this many MAGSAC iterations, not the
+  // verifier's 5,000. Across lighting nearly all are refused (corridor_conditions' sets: 6 of 830 accepted), each after
+  // all 5,000 (MAGSAC's confidence is never reached on a third of ~54 matches), yet each is read: the rules that accept
+  // a tracked key image against its rivals, and the belief. At 2,000 every figure holds (michigan ORB 503 -> 508) and
+  // corridor ORB takes 8 % less CPU; at 1,500 and below the corridor's sets lose frames (docs/measurements/
+  // localization-conditions.md, "Fewer iterations for the comparisons away from the tracker"). 0: every comparison
+  // with the verifier's.
+  int far_comparison_iterations = 2000;
   // Guided matching over the lookahead: it asks the tracked key image and the `lookahead` key images after it (the
   // tracker's own reach), and ranks what it accepts by a measure common to the key images asked: those chance accepts
   // by their verified matches (as the tracker ranks), and when chance accepts none, those the continuity of the heading

@@ -267,7 +267,11 @@ TEST(Localizer, AFlatBeliefMakesNoBestGuessOfOneFramesEvidence) {
 TEST(Localizer, AfterLostFramesARelocalizationAsFarAsTheRobotCouldGoIsTakenAtOnce) {
   const LocalizationMap& m = Dense();
   const int count = static_cast<int>(m.map.key_images.size());
-  Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
+  LocalizerOptions options = MapLocalizerOptions(m);
+  // The comparisons given stand for the frame's own, verified in full (a far one would be made again with fewer
+  // iterations).
+  options.far_comparison_iterations = 0;
+  Localizer localizer(m.map, m.keys, *m.matcher, options);
   int index = 0;
   LocalizationResult r;
   for (int source_index : {1, 3, 5, 7, 9}) r = LocalizeImage(localizer, source_index, index++);
@@ -307,7 +311,11 @@ TEST(Localizer, AfterLostFramesARelocalizationAsFarAsTheRobotCouldGoIsTakenAtOnc
 TEST(Localizer, AFarPlaceOneFramePointedAtIsAskedAgainOnTheNextFrame) {
   const LocalizationMap& m = Dense();
   const int count = static_cast<int>(m.map.key_images.size());
-  Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
+  LocalizerOptions options = MapLocalizerOptions(m);
+  // The comparisons given stand for the frame's own, verified in full (a far one would be made again with fewer
+  // iterations).
+  options.far_comparison_iterations = 0;
+  Localizer localizer(m.map, m.keys, *m.matcher, options);
   int index = 0;
   LocalizationResult r;
   for (int source_index : {1, 3, 5}) r = LocalizeImage(localizer, source_index, index++);
@@ -350,6 +358,9 @@ TEST(Localizer, TwoKeyImagesOnInOneFrameNeedsTheBeliefToAgree) {
   for (const int window : {2, 0}) {
     LocalizerOptions options = MapLocalizerOptions(m);
     options.belief.window = window;
+    // The comparisons given stand for the frame's own, verified in full (a far one would be made again with fewer
+    // iterations).
+    options.far_comparison_iterations = 0;
     Localizer localizer(m.map, m.keys, *m.matcher, options);
     int index = 0;
     LocalizationResult r;
@@ -543,6 +554,56 @@ TEST(Localizer, AFrameThatSharesAsMuchAsTheMapsLinksIsNotRelocalized) {
   LocalizerOptions options = MapLocalizerOptions(m);
   options.acceptance = AcceptanceRule::kChance;
   ExpectTrackedAlongTheDrive(m, options);
+}
+
+// ORB's comparisons with key images away from the tracker's (LocalizerOptions::far_comparison_iterations) are verified
+// with fewer MAGSAC iterations; those of the tracker's own key images, and every one of a frame without an estimate, in
+// full. Here the cap is one iteration, which verifies fewer matches than the full run at some far key image: a frame
+// tracked near the start, then a frame from far along the route, its tracked key images given refused, relocalized;
+// its far candidates are as Compare gives them with that cap. Without an estimate, as Compare gives them in full.
+TEST(Localizer, TheComparisonsAwayFromTheTrackerAreVerifiedWithFewerIterations) {
+  const LocalizationMap& m = Dense();
+  LocalizerOptions options = MapLocalizerOptions(m);
+  options.far_comparison_iterations = 1;
+  // The candidates as first compared: not compared again guided or with more features.
+  options.guided_relocalization = false;
+  options.lost_frame_features = 0;
+  options.belief.window = 0;  // the tracker's own decisions
+  options.belief.min_confidence = 0.0;
+  Localizer localizer(m.map, m.keys, *m.matcher, options);
+  int index = 0;
+  LocalizationResult r;
+  for (int source_index : {1, 3, 5}) r = LocalizeImage(localizer, source_index, index++);
+  ASSERT_EQ(r.status, LocalizationStatus::kTracking);
+  const int tracked = r.route_position;  // the route is the key images in order
+  const int last_near = tracked + options.lookahead + 1;
+  const int far_frame = 51;
+  std::vector<KeyComparison> refused;
+  for (int key = std::max(0, tracked - 1); key <= last_near; ++key)
+    refused.push_back(GivenComparison(key, false, 0, 0));
+  ::vmap::testing::MemorySource source({SidewaysDrive().frames[far_frame]}, {far_frame});
+  Frame frame = *source.Next();
+  frame.index = index++;
+  const auto features = m.matcher->Extract(frame.gray);
+  r = localizer.Localize(frame, *features, refused);
+  int far = 0, capped_differs = 0;
+  for (const RelocalizationCandidate& c : r.candidates) {
+    if (c.key >= tracked - 1 && c.key <= last_near) continue;  // given
+    const KeyComparison expected = localizer.Compare(*features, c.key, options.far_comparison_iterations);
+    EXPECT_EQ(c.num_verified, expected.num_verified) << "key " << c.key;
+    EXPECT_EQ(c.log10_nfa, expected.log10_nfa) << "key " << c.key;
+    ++far;
+    capped_differs += localizer.Compare(*features, c.key).num_verified != expected.num_verified;
+  }
+  ASSERT_GT(far, 0) << "relocalized at far key images";
+  ASSERT_GT(capped_differs, 0) << "one iteration verifies as many as the full run: the test cannot tell";
+  localizer.Reset();
+  ASSERT_FALSE(localizer.has_estimate());
+  r = localizer.Localize(frame, *features);
+  ASSERT_FALSE(r.candidates.empty());
+  for (const RelocalizationCandidate& c : r.candidates) {
+    EXPECT_EQ(c.num_verified, localizer.Compare(*features, c.key).num_verified) << "key " << c.key;
+  }
 }
 
 }  // namespace
