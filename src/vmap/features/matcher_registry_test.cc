@@ -88,7 +88,9 @@ TEST(MatcherRegistry, EveryModelsOptionsRoundTripThroughJson) {
     const nlohmann::json default_json = defaults->ToJson();
     ASSERT_EQ(json.size(), default_json.size());
     for (const auto& [key, value] : default_json.items()) {
-      if (key != "type") EXPECT_NE(json[key], value) << key;
+      if (key != "type") {
+        EXPECT_NE(json[key], value) << key;
+      }
     }
     auto back = model.default_options();
     back->FromJson(json, "options.matcher");
@@ -173,7 +175,9 @@ TEST(MatcherRegistry, APluginThatWasMissingLoadsOnALaterCall) {
   EXPECT_TRUE(MatcherPluginLoaded());
   // Its table has a row for every registered model that needs it.
   for (const auto& model : MatcherModels()) {
-    if (model.needs_torch) EXPECT_NE(table->Find(model.name), nullptr) << model.name;
+    if (model.needs_torch) {
+      EXPECT_NE(table->Find(model.name), nullptr) << model.name;
+    }
   }
 #else
   GTEST_SKIP() << "built without LibTorch";

@@ -29,7 +29,9 @@ TEST(PointFeaturesBytes, RoundTripIsExact) {
     EXPECT_EQ(decoded->image_size, original.image_size);
     EXPECT_EQ(decoded->keypoints, original.keypoints);
     ASSERT_EQ(decoded->descriptors.rows, count);
-    if (count > 0) EXPECT_EQ(cv::norm(decoded->descriptors, original.descriptors, cv::NORM_INF), 0.0);
+    if (count > 0) {
+      EXPECT_EQ(cv::norm(decoded->descriptors, original.descriptors, cv::NORM_INF), 0.0);
+    }
   }
 }
 

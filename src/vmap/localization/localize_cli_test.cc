@@ -713,7 +713,9 @@ TEST(LocalizeCli, AFrameTheEvidenceStepsOnIsNotSteeredByItsHeading) {
     const auto& without = runs[" --lost-frame-features 0 --no-step-on-where-evidence-agrees"];
     const auto& defaults = runs[""];
     for (size_t i = 0; i < defaults.at("status").size(); ++i) {
-      if (defaults.at("guidance")[i] == "none") EXPECT_EQ(defaults.at("heading_px")[i], "") << "defaults, frame " << i;
+      if (defaults.at("guidance")[i] == "none") {
+        EXPECT_EQ(defaults.at("heading_px")[i], "") << "defaults, frame " << i;
+      }
     }
     ASSERT_EQ(with.at("status").size(), without.at("status").size());
     for (size_t i = 0; i < with.at("status").size(); ++i) {
@@ -805,7 +807,9 @@ TEST(LocalizeCli, ALostFrameComparedAgainWithMoreFeaturesIsRelocalized) {
         0)
         << out;
     EXPECT_EQ(CsvColumn(csv, "status")[1], flags.empty() ? "relocalized" : "lost") << flags;
-    if (flags.empty()) EXPECT_EQ(CsvColumn(csv, "key")[1], "1");
+    if (flags.empty()) {
+      EXPECT_EQ(CsvColumn(csv, "key")[1], "1");
+    }
   }
 }
 

@@ -255,7 +255,9 @@ TEST(Localizer, AFlatBeliefMakesNoBestGuessOfOneFramesEvidence) {
     ASSERT_EQ(first.status, LocalizationStatus::kUncertain) << first.confidence;
     ASSERT_LE(first.key, 4);
     const LocalizationResult second = localize(41, 1, true);
-    if (!rank_evidence) EXPECT_EQ(second.status, LocalizationStatus::kUncertain);
+    if (!rank_evidence) {
+      EXPECT_EQ(second.status, LocalizationStatus::kUncertain);
+    }
     EXPECT_LE(second.key, 4) << "the tracker's key image, not the peak of one frame's evidence";
   }
 }

@@ -457,7 +457,9 @@ TEST(Localizer, ComparingAheadOnTheWorkersChangesNothing) {
     EXPECT_EQ(a.comparisons, b.comparisons);
     // Bit for bit: the belief sums the frame's comparisons in the order the localizer asked for them.
     EXPECT_EQ(std::isnan(a.confidence), std::isnan(b.confidence)) << "frame " << f;
-    if (!std::isnan(a.confidence)) EXPECT_EQ(a.confidence, b.confidence) << "frame " << f;
+    if (!std::isnan(a.confidence)) {
+      EXPECT_EQ(a.confidence, b.confidence) << "frame " << f;
+    }
     EXPECT_EQ(a.belief, b.belief) << "frame " << f;
     EXPECT_EQ(a.key_rank, b.key_rank) << "frame " << f;
     EXPECT_EQ(LocalizationGuidance(a), LocalizationGuidance(b)) << "frame " << f;

@@ -8,7 +8,13 @@ namespace vmap {
 // The coefficients as bench/evidence_fit.py fitted them (docs/localize.md, "The belief over the route"; the ranking's:
 // "The ranking is evidence", bench/evidence_fit.py --rank).
 EvidenceModel BinaryDescriptorEvidence() {
-  EvidenceModel model{-1.0, 1.59, 0.383, 1.52, -15.0, 40.0};
+  EvidenceModel model;
+  model.unmatched = -1.0;
+  model.intercept = 1.59;
+  model.per_significance = 0.383;
+  model.per_link_share = 1.52;
+  model.min_significance = -15.0;
+  model.max_significance = 40.0;
   model.heading_stands_out = 3.0;
   // By standout, fitted on corridor_conditions (bench/evidence_fit.py --rank --rank-by standout; michigan's 5-place
   // routes measure -0.82 / +0.32 / +1.14 / +2.15 / +3.40 alike).
@@ -23,7 +29,13 @@ EvidenceModel BinaryDescriptorEvidence() {
   return model;
 }
 EvidenceModel FloatDescriptorEvidence() {
-  EvidenceModel model{-1.0, -2.66, 0.086, 3.75, -15.0, 40.0};
+  EvidenceModel model;
+  model.unmatched = -1.0;
+  model.intercept = -2.66;
+  model.per_significance = 0.086;
+  model.per_link_share = 3.75;
+  model.min_significance = -15.0;
+  model.max_significance = 40.0;
   model.rank_alone = {3.22, 1.53, 0.86, 0.19, -1.15};
   model.rank_given = {3.51, 2.09, 1.54, 1.00, 0.0};
   model.ranked_intercept = -2.76;
