@@ -202,7 +202,8 @@ TEST(LocalizeCli, AFrameAfterLostFramesStepsOnWhereItsEvidenceAgrees) {
   const std::vector<fs::path> queries = MichiganSessions(tmp.path(), {1, 2, 3, 6, 10});
   const fs::path csv = tmp.path() / "run.csv";
   // Measured as the rule was chosen, without a lost frame's heading with more features (it places one of these frames
-  // without the rule: ALostFramesHeadingWithMoreFeaturesPlacesIt); with the defaults, none placed elsewhere.
+  // without the rule: ALostFramesHeadingWithMoreFeaturesPlacesIt, and with its ratio of 1.75 session 02's frame 1
+  // too, steered by at its place); with the defaults, none placed elsewhere.
   const std::string before = " --no-lost-frame-heading";
   const std::pair<int, int> without =
       PlacedOnMichiganRoutes(map, queries, before + " --no-step-on-after-lost-frames", csv);
@@ -211,8 +212,10 @@ TEST(LocalizeCli, AFrameAfterLostFramesStepsOnWhereItsEvidenceAgrees) {
   EXPECT_EQ(with.second, 0) << "placed at another place";
   EXPECT_EQ(PlacedOnMichiganRoutes(map, queries, "", csv).second, 0) << "with the defaults, placed elsewhere";
   std::string out;
-  ASSERT_EQ(RunVmap("localize " + Quote(map) + " " + Quote(queries[1]) + " --start-key 0 -q --csv " + Quote(csv), &out),
-            0)
+  ASSERT_EQ(
+      RunVmap("localize " + Quote(map) + " " + Quote(queries[1]) + " --start-key 0 -q --csv " + Quote(csv) + before,
+              &out),
+      0)
       << out;
   EXPECT_EQ(CsvColumn(csv, "status")[1], "tracking");
   EXPECT_EQ(CsvColumn(csv, "key")[1], "1");
@@ -305,6 +308,23 @@ TEST(LocalizeCli, ALostFramesHeadingWithMoreFeaturesPlacesIt) {
     }
   }
   EXPECT_GE(steered_with_heading, 6);
+}
+
+// The same rule with a ratio of its own (docs/measurements/localization-conditions.md, "A lost frame's heading with a
+// ratio of its own"): session 02's map, sessions 03, 10 and 11, each with a lost frame whose heading mode with more
+// features holds 1.75 to 2 times every rival's: placed at their place and steered by with the default 1.75, none
+// elsewhere; lost with the heading rule's 2.
+TEST(LocalizeCli, ALostFramesHeadingWithARatioOfItsOwnPlacesMore) {
+  SKIP_WITHOUT_SHARED();
+  ::vmap::testing::ScopedTempDir tmp;
+  const fs::path map = MichiganMap(tmp.path(), 2);
+  const std::vector<fs::path> queries = MichiganSessions(tmp.path(), {3, 10, 11});
+  const fs::path csv = tmp.path() / "run.csv";
+  const std::pair<int, int> at_two = PlacedOnMichiganRoutes(map, queries, " --lost-frame-heading-rival-ratio 2", csv);
+  const std::pair<int, int> by_default = PlacedOnMichiganRoutes(map, queries, "", csv);
+  EXPECT_GE(by_default.first, at_two.first + 3) << "by default " << by_default.first << ", at 2 " << at_two.first;
+  EXPECT_EQ(by_default.second, 0) << "placed at another place";
+  EXPECT_EQ(at_two.second, 0) << "placed at another place";
 }
 
 }  // namespace

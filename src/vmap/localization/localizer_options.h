@@ -209,6 +209,11 @@ struct LocalizerOptions {
   // holds 31 votes (median), the best wrong one's 18 (docs/measurements/localization-conditions.md, "A lost frame's
   // heading with more features"). Off: only chance decides on them.
   bool lost_frame_heading = true;
+  // That rule's ratio, in place of min_heading_rival_ratio (whose 0 still turns both off): with 4,000 features a
+  // lost frame's right key image stands out less against its best rival than at 500, and no wrong one reaches even
+  // 1.5 times its rivals on the sets measured (docs/measurements/localization-conditions.md, "A lost frame's heading
+  // with a ratio of its own"). 0: never.
+  double lost_frame_heading_rival_ratio = 1.75;
   // ORB: the frame's comparisons with key images away from the tracker's (more than one route position behind the
   // estimate the frame starts from, or more than `lookahead` + 1 ahead of it: the frame's rivals, the ranking's
   // candidates, the belief's window elsewhere) are verified with at most this many MAGSAC iterations, not the

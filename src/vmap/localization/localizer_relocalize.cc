@@ -117,7 +117,10 @@ bool Localizer::CompareLostFrameAgain(const Frame& frame, const ImageFeatures& f
 }
 
 bool Localizer::AcceptLostFrameByHeading(const std::vector<KeyComparison>& compared) {
-  if (!options_.lost_frame_heading || !heading_accepts_ || options_.min_heading_rival_ratio <= 0.0) return false;
+  if (!options_.lost_frame_heading || !heading_accepts_ || options_.min_heading_rival_ratio <= 0.0 ||
+      options_.lost_frame_heading_rival_ratio <= 0.0) {
+    return false;
+  }
   // As HeadingStandsOut, with the frame's rivals among the comparisons made with as many features: a heading mode of
   // 4,000 features holds more votes at any key image than one of 500 (michigan_seasons' wrong key images 16-21, where
   // 500 features give them at most 15), so a rival of 500 would let almost any mode stand out.
@@ -134,7 +137,7 @@ bool Localizer::AcceptLostFrameByHeading(const std::vector<KeyComparison>& compa
     const int q = route_position_of_key_[c.key];
     if (q >= 0 && IsHeadingRival(position, q)) rival_votes = std::max(rival_votes, c.heading.votes);
   }
-  if (rival_votes < 0 || best->heading.votes < options_.min_heading_rival_ratio * rival_votes) return false;
+  if (rival_votes < 0 || best->heading.votes < options_.lost_frame_heading_rival_ratio * rival_votes) return false;
   for (Memo& m : comparisons_) {
     if (m.comparison.key != best->key) continue;
     // Weighed already as its first comparison was: WeighComparisons adds what the heading's acceptance adds.
