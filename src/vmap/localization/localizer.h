@@ -22,6 +22,7 @@
 // links, or counts of verified matches and S). A frame tracked with far fewer verified matches than its key
 // image shares with its neighbours is relocalized too, and moved when another key image verifies more.
 
+#include <algorithm>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -245,6 +246,23 @@ class Localizer {
   // Route position `q` is a heading rival of `position`: more than kNear away, or nearer but not joined to it by links
   // of one scene (scene_link_after_): another place, whose matches agree with the frame's only by chance.
   bool IsHeadingRival(int position, int q) const;
+  // What both heading rules (HeadingStandsOut, AcceptLostFrameByHeading) ask of the comparison itself: matched, at
+  // least min_heading_votes heading votes, and the link share's verified matches.
+  bool HeadingMayStandOut(const KeyComparison& comparison) const;
+  // And of its rivals: the comparison at route `position` holds at least `ratio` times the heading votes of every
+  // heading rival among `compared` (the frame's memos, or its comparisons with more features). Without a rival it does
+  // not stand out: the frame cannot tell.
+  template <typename Compared>
+  bool OutvotesHeadingRivals(const KeyComparison& comparison, int position, const Compared& compared,
+                             double ratio) const {
+    int rival_votes = -1;
+    for (const auto& c : compared) {
+      const KeyComparison& rival = ComparisonOf(c);
+      const int q = route_position_of_key_[rival.key];
+      if (q >= 0 && IsHeadingRival(position, q)) rival_votes = std::max(rival_votes, rival.heading.votes);
+    }
+    return rival_votes >= 0 && comparison.heading.votes >= ratio * rival_votes;
+  }
   // When nothing else is accepted: the comparison whose heading mode holds the most votes, if HeadingStandsOut.
   // Returns its route position, -1 when none.
   int AcceptByHeading(const Frame& frame, const ImageFeatures& features);
@@ -374,6 +392,8 @@ class Localizer {
     bool weighed_by_heading = false;
   };
   std::vector<Memo> comparisons_;  // of the frame being localized, in the order CompareOnce was asked for them
+  static const KeyComparison& ComparisonOf(const Memo& memo) { return memo.comparison; }
+  static const KeyComparison& ComparisonOf(const KeyComparison& comparison) { return comparison; }
   // Comparisons of the frame made before it reached Localize (`ahead`), which CompareOnce takes when it asks for them:
   // which ones there are depends on the workers' timing, so they enter comparisons_ only then.
   std::vector<KeyComparison> made_ahead_;

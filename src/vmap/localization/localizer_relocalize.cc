@@ -127,17 +127,11 @@ bool Localizer::AcceptLostFrameByHeading(const std::vector<KeyComparison>& compa
   const auto best = std::max_element(
       compared.begin(), compared.end(),
       [](const KeyComparison& a, const KeyComparison& b) { return a.heading.votes < b.heading.votes; });
-  if (best == compared.end() || !best->matched || best->heading.votes < options_.min_heading_votes ||
-      best->num_verified < options_.min_link_share * link_verified_[best->key]) {
+  if (best == compared.end() || !HeadingMayStandOut(*best) ||
+      !OutvotesHeadingRivals(*best, route_position_of_key_[best->key], compared,
+                             options_.lost_frame_heading_rival_ratio)) {
     return false;
   }
-  const int position = route_position_of_key_[best->key];
-  int rival_votes = -1;
-  for (const KeyComparison& c : compared) {
-    const int q = route_position_of_key_[c.key];
-    if (q >= 0 && IsHeadingRival(position, q)) rival_votes = std::max(rival_votes, c.heading.votes);
-  }
-  if (rival_votes < 0 || best->heading.votes < options_.lost_frame_heading_rival_ratio * rival_votes) return false;
   for (Memo& m : comparisons_) {
     if (m.comparison.key != best->key) continue;
     // Weighed already as its first comparison was: WeighComparisons adds what the heading's acceptance adds.

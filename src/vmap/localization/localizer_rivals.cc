@@ -59,18 +59,18 @@ bool Localizer::IsHeadingRival(int position, int q) const {
   return false;
 }
 
-bool Localizer::HeadingStandsOut(const Frame& frame, const ImageFeatures& features, const KeyComparison& comparison,
-                                 int position) {
-  if (!heading_accepts_ || options_.acceptance != AcceptanceRule::kChance || options_.min_heading_rival_ratio <= 0.0 ||
-      !comparison.matched || comparison.heading.votes < options_.min_heading_votes) {
-    return false;
-  }
+bool Localizer::HeadingMayStandOut(const KeyComparison& comparison) const {
   // The heading answers chance only, never the link share: a frame that shares little with a key image's place sees
   // its scene from elsewhere, and the scene's matches agree there too (redkitchen's teach/repeat run: 2 -> 57 frames
   // steered by wrong when the heading overrode the share).
-  const int key = comparison.key;
-  if (comparison.log10_nfa <= options_.max_log10_nfa ||
-      comparison.num_verified < options_.min_link_share * link_verified_[key]) {
+  return comparison.matched && comparison.heading.votes >= options_.min_heading_votes &&
+         comparison.num_verified >= options_.min_link_share * link_verified_[comparison.key];
+}
+
+bool Localizer::HeadingStandsOut(const Frame& frame, const ImageFeatures& features, const KeyComparison& comparison,
+                                 int position) {
+  if (!heading_accepts_ || options_.acceptance != AcceptanceRule::kChance || options_.min_heading_rival_ratio <= 0.0 ||
+      comparison.log10_nfa <= options_.max_log10_nfa || !HeadingMayStandOut(comparison)) {
     return false;
   }
   // The likeliest other place, as the frame's descriptors tell, is always among the rivals.
@@ -80,12 +80,7 @@ bool Localizer::HeadingStandsOut(const Frame& frame, const ImageFeatures& featur
       break;
     }
   }
-  int rival_votes = -1;
-  for (const Memo& m : comparisons_) {
-    const int q = route_position_of_key_[m.comparison.key];
-    if (q >= 0 && IsHeadingRival(position, q)) rival_votes = std::max(rival_votes, m.comparison.heading.votes);
-  }
-  return rival_votes >= 0 && comparison.heading.votes >= options_.min_heading_rival_ratio * rival_votes;
+  return OutvotesHeadingRivals(comparison, position, comparisons_, options_.min_heading_rival_ratio);
 }
 
 int Localizer::AcceptByHeading(const Frame& frame, const ImageFeatures& features) {
