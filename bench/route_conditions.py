@@ -33,9 +33,15 @@ start").
 With --build "FLAGS", every map is built with these flags too (e.g. ORB's extraction: "--orb-grid-cell 30
 --orb-edge-threshold 16"); the localizer follows what the map records.
 
+With --seeds 0,1,2,3, each binary localizes every run once per seed of the verifier (`vmap localize --verifier-seed
+S`; the maps as built, once), one row per seed, then a row of each column's mean and [min-max] over the seeds: ORB's
+near comparisons sit at chance's boundary and the seed moves corridor ORB's right frames by 5-7 (sd), so a change of
+a few frames is judged on the means (docs/measurements/localization-conditions.md, "The verifier's seed: the spread
+of every figure"). Default: the map's seed only, the flag not passed (binaries before the flag take no --seeds).
+
 usage: bench/route_conditions.py --vmap build/vmap[,old/vmap] [--sets corridor,kidnapped,elsewhere,michigan] [--matchers orb,xfeat]
                                  [--tau T] [--start-key K|none] [--build "FLAGS"] [--localize "FLAGS"] [--repeat-stride N] [--work DIR] [--csv-dir DIR]
-                                 [--evidence-dir DIR]
+                                 [--evidence-dir DIR] [--seeds S,S,...]
 (from the repository root; ../shared must be there)"""
 import argparse, json, os, subprocess, sys, tempfile
 
@@ -248,6 +254,22 @@ def report(tally, name):
         print("    " + line)
 
 
+def spread_row(tallies, name):
+    """One row over the tallies of several seeds: each column's mean and, in brackets, its min and max."""
+    def column(values, percent=False):
+        mean = sum(values) / len(values)
+        text = "%.1f [%d-%d]" % (mean, min(values), max(values))
+        if percent:
+            text += " (%.1f %%)" % (100.0 * mean / max(1, tallies[0].frames))
+        return text
+    fps = [t.frames / t.seconds if t.seconds > 0 else 0.0 for t in tallies]
+    return "| %s | %d | %s | %s | %s | %s | %s | %s | %.1f | %s |" % (
+        name, tallies[0].frames, column([t.right for t in tallies], True),
+        column([t.right_sure for t in tallies], True), column([t.wrong for t in tallies]),
+        column([t.confidently_far for t in tallies]), column([t.uncertain for t in tallies]),
+        column([t.lost for t in tallies]), sum(fps) / len(fps), column([t.back_jumps for t in tallies]))
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--vmap", default="build/vmap", help="comma-separated binaries, compared side by side")
@@ -258,11 +280,17 @@ def main():
     parser.add_argument("--localize", default="", help="more flags for vmap localize")
     parser.add_argument("--start-key", default="0", help="vmap localize --start-key (none: not passed)")
     parser.add_argument("--repeat-stride", type=int, default=1, help="corridor: every Nth repeat frame (a faster robot)")
+    parser.add_argument("--seeds", help="comma-separated seeds of the verifier (vmap localize --verifier-seed): each "
+                        "run once per seed on the same maps, then the mean [min-max] of each column (default: the "
+                        "map's seed only, no flag passed)")
     parser.add_argument("--work", help="keep maps here (reused) instead of a temporary folder")
     parser.add_argument("--csv-dir", help="write each run's CSV here (michigan: michigan_MATCHER_REPEAT_to_TEACH.csv per route); with several binaries, "
-                        "each binary's in DIR/binaryN (N: its place in --vmap, from 0)")
+                        "each binary's in DIR/binaryN (N: its place in --vmap, from 0); with --seeds, each seed's in "
+                        "seedS below that")
     parser.add_argument("--evidence-dir", help="write every frame's comparisons with every key image here")
     args = parser.parse_args()
+    if args.seeds and args.evidence_dir:
+        parser.error("--evidence-dir dumps evidence_dump's comparisons, which take no seed of the localizer's: give it without --seeds")
     if args.start_key != "none":
         args.localize += " --start-key " + args.start_key
     tau_flags = (["--tau", args.tau] if args.tau else []) + args.build.split()
@@ -271,33 +299,48 @@ def main():
     sets = args.sets.split(",")
     localize_flags = args.localize.split()
     binaries = args.vmap.split(",")
+    seeds = args.seeds.split(",") if args.seeds else [None]
     with tempfile.TemporaryDirectory(prefix="vmap_route_conditions_") as scratch:
         for index, vmap in enumerate(binaries):
             work = os.path.join(args.work or scratch, "binary%d" % index)
             os.makedirs(work, exist_ok=True)
             # Side by side, each binary's CSVs apart: they are compared frame by frame.
-            csv_dir = args.csv_dir and (os.path.join(args.csv_dir, "binary%d" % index) if len(binaries) > 1
-                                        else args.csv_dir)
-            if csv_dir:
-                os.makedirs(csv_dir, exist_ok=True)
+            binary_csv_dir = args.csv_dir and (os.path.join(args.csv_dir, "binary%d" % index) if len(binaries) > 1
+                                               else args.csv_dir)
+
+            def runs(name, run_set):
+                """`run_set(flags, csv_dir)` once per seed (the map's alone: once, without the flag), reported."""
+                tallies = []
+                for seed in seeds:
+                    flags = localize_flags + (["--verifier-seed", seed] if seed is not None else [])
+                    csv_dir = binary_csv_dir and (os.path.join(binary_csv_dir, "seed" + seed) if seed is not None
+                                                  else binary_csv_dir)
+                    if csv_dir:
+                        os.makedirs(csv_dir, exist_ok=True)
+                    tallies.append(run_set(flags, csv_dir))
+                    report(tallies[-1], name + (", seed " + seed if seed is not None else ""))
+                if len(tallies) > 1:
+                    print(spread_row(tallies, "%s, seeds %s: mean [min-max]" % (name, ",".join(seeds))), flush=True)
+
             for matcher in args.matchers.split(","):
                 if "corridor" in sets:
-                    tally, keys = corridor(vmap, matcher, tau_flags, localize_flags, args.repeat_stride, work,
-                                           csv_dir, args.evidence_dir)
-                    report(tally, "%s: corridor, %s, %d key images%s" % (
+                    keys = len(corridor_map(vmap, matcher, tau_flags, work)[1])
+                    runs("%s: corridor, %s, %d key images%s" % (
                         vmap, matcher, keys, ", repeat stride %d" % args.repeat_stride if args.repeat_stride > 1
-                        else ""))
+                        else ""), lambda flags, csv_dir: corridor(vmap, matcher, tau_flags, flags, args.repeat_stride,
+                                                                  work, csv_dir, args.evidence_dir)[0])
                 if "kidnapped" in sets:
-                    report(kidnapped(vmap, matcher, tau_flags, localize_flags, work, csv_dir),
-                           "%s: kidnapped corridor (repeat %s), %s" % (
-                               vmap, ", ".join("%d-%d" % s for s in KIDNAPPED), matcher))
+                    runs("%s: kidnapped corridor (repeat %s), %s" % (vmap, ", ".join("%d-%d" % s for s in KIDNAPPED),
+                                                                    matcher),
+                         lambda flags, csv_dir: kidnapped(vmap, matcher, tau_flags, flags, work, csv_dir))
                 if "elsewhere" in sets:
-                    report(elsewhere(vmap, matcher, tau_flags, localize_flags, work, csv_dir),
-                           "%s: started elsewhere than --start-key (%s), %s" % (
-                               vmap, ", ".join("%s from %d" % e for e in ELSEWHERE), matcher))
+                    runs("%s: started elsewhere than --start-key (%s), %s" % (
+                        vmap, ", ".join("%s from %d" % e for e in ELSEWHERE), matcher),
+                        lambda flags, csv_dir: elsewhere(vmap, matcher, tau_flags, flags, work, csv_dir))
                 if "michigan" in sets:
-                    report(michigan(vmap, matcher, localize_flags, work, args.evidence_dir, build_flags, csv_dir),
-                           "%s: michigan 132 routes, %s" % (vmap, matcher))
+                    runs("%s: michigan 132 routes, %s" % (vmap, matcher),
+                         lambda flags, csv_dir: michigan(vmap, matcher, flags, work, args.evidence_dir, build_flags,
+                                                         csv_dir))
 
 
 if __name__ == "__main__":

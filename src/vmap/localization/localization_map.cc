@@ -46,6 +46,7 @@ LocalizerOptions FollowMap(const LocalizationMap& opened, LocalizerOptions optio
   const VisualMap& map = opened.map;
   const LocalizerOptions from_map = MapLocalizerOptions(opened);
   options.verifier = from_map.verifier;
+  if (options.verifier_seed >= 0) options.verifier.seed = options.verifier_seed;
   options.similarity = from_map.similarity;
   options.translation = from_map.translation;
   const std::string map_size = QueryResize(map, "");

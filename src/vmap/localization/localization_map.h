@@ -39,9 +39,10 @@ LocalizerOptions MapLocalizerOptions(const LocalizationMap& opened);
 // and frames are compared at one size; "" for a map that records none).
 std::string QueryResize(const VisualMap& map, const std::string& resize);
 
-// `options` made to follow the map (MapLocalizerOptions): its verifier and definition of S, and its camera when
-// the frames are localized at the map's frame size (`query_resize`, QueryResize's), since the camera describes
-// frames of that size; otherwise headings stay in pixels, without relative poses (a warning says so).
+// `options` made to follow the map (MapLocalizerOptions): its verifier (seeded with `options.verifier_seed` when
+// that is not -1) and definition of S, and its camera when the frames are localized at the map's frame size
+// (`query_resize`, QueryResize's), since the camera describes frames of that size; otherwise headings stay in pixels,
+// without relative poses (a warning says so).
 LocalizerOptions FollowMap(const LocalizationMap& opened, LocalizerOptions options, const std::string& query_resize);
 
 }  // namespace vmap

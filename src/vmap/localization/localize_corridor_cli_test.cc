@@ -340,6 +340,27 @@ TEST(LocalizeCli, AFarPlaceALostFrameVerifiedIsAskedAgain) {
   EXPECT_GE(near[2], near[0]) << "placed near their place: the defaults " << near[2] << ", the rule alone " << near[0];
 }
 
+// `vmap localize` of `map` on corridor_conditions' first `last` + 1 repeat frames with more `flags`, into `csv` and
+// `json`: each CSV column but the time, by name (none when the run fails).
+std::map<std::string, std::vector<std::string>> RepeatColumnsButTheTime(const fs::path& map, int last,
+                                                                        const std::string& flags, const fs::path& csv,
+                                                                        const fs::path& json) {
+  std::string out;
+  const fs::path repeat = Shared() / "data/corridor_conditions/repeat";
+  if (RunVmap("localize " + Quote(map) + " " + Quote(repeat) + " --last " + std::to_string(last) + " -q --csv " +
+                  Quote(csv) + " --json " + Quote(json) + flags,
+              &out) != 0) {
+    ADD_FAILURE() << out;
+    return {};
+  }
+  std::stringstream header(Lines(csv).at(0));
+  std::map<std::string, std::vector<std::string>> columns;
+  for (std::string name; std::getline(header, name, ',');) {
+    if (name != "seconds") columns[name] = CsvColumn(csv, name);
+  }
+  return columns;
+}
+
 TEST(LocalizeCli, ComparisonsMadeOnOtherThreadsChangeNoResult) {
   // corridor_conditions with ORB: its frames are refused at their tracked key images, compared with their rivals,
   // relocalized and questioned. The comparisons a frame is about to make are made meanwhile on a second core
@@ -357,17 +378,8 @@ TEST(LocalizeCli, ComparisonsMadeOnOtherThreadsChangeNoResult) {
   std::vector<nlohmann::json> json_frames;
   for (const std::string flags : {"", " --comparison-threads 1", " --comparison-threads 1 --no-compare-ahead"}) {
     const fs::path csv = tmp.path() / "run.csv", json = tmp.path() / "run.json";
-    ASSERT_EQ(RunVmap("localize " + Quote(tmp.path() / "map") + " " + Quote(data / "repeat") + " --last 59 -q --csv " +
-                          Quote(csv) + " --json " + Quote(json) + flags,
-                      &out),
-              0)
-        << out;
-    std::stringstream header(Lines(csv).at(0));
-    std::map<std::string, std::vector<std::string>> columns;
-    for (std::string name; std::getline(header, name, ',');) {
-      if (name != "seconds") columns[name] = CsvColumn(csv, name);
-    }
-    runs.push_back(std::move(columns));
+    runs.push_back(RepeatColumnsButTheTime(tmp.path() / "map", 59, flags, csv, json));
+    ASSERT_FALSE(runs.back().empty());
     std::ifstream in(json);
     nlohmann::json frames = nlohmann::json::parse(in).at("frames");
     for (nlohmann::json& frame : frames) frame.erase("seconds");
@@ -382,6 +394,34 @@ TEST(LocalizeCli, ComparisonsMadeOnOtherThreadsChangeNoResult) {
       EXPECT_EQ(json_frames[0][f], json_frames[r][f]) << "run " << r << ", frame " << f;
     }
   }
+}
+
+// The verifier's seed in the frames' comparisons (--verifier-seed; default: the map's, as map.json records it): the
+// map's seed given explicitly localizes as the default, every CSV column but the time the same; another seed draws
+// other samples, and ORB's corridor comparisons (a third of ~54 matches inliers) verify other matches somewhere.
+TEST(LocalizeCli, TheVerifiersSeedIsTheMapsUnlessAnotherIsGiven) {
+  const fs::path data = Shared() / "data/corridor_conditions";
+  if (Shared().empty() || !fs::exists(data)) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  ::vmap::testing::ScopedTempDir tmp;
+  std::string out;
+  ASSERT_EQ(RunVmap("build " + Quote(data / "teach") + " -q -o " + Quote(tmp.path() / "map"), &out), 0) << out;
+  std::ifstream map_json(tmp.path() / "map" / "map.json");
+  const int map_seed = nlohmann::json::parse(map_json).at("options").at("verifier").at("seed").get<int>();
+  // Per run, each CSV column but the time, by name, and the verifier's seed the run records.
+  std::vector<std::map<std::string, std::vector<std::string>>> runs;
+  std::vector<int> recorded_seeds;
+  for (const std::string& flags : {std::string(), " --verifier-seed " + std::to_string(map_seed),
+                                   " --verifier-seed " + std::to_string(map_seed + 1)}) {
+    const fs::path csv = tmp.path() / "run.csv", json = tmp.path() / "run.json";
+    runs.push_back(RepeatColumnsButTheTime(tmp.path() / "map", 9, flags, csv, json));
+    ASSERT_FALSE(runs.back().empty());
+    std::ifstream in(json);
+    recorded_seeds.push_back(nlohmann::json::parse(in).at("options").at("verifier").at("seed").get<int>());
+  }
+  ASSERT_EQ(runs[0].at("status").size(), 10u);
+  for (const auto& [name, cells] : runs[0]) EXPECT_EQ(cells, runs[1].at(name)) << "the map's seed given: " << name;
+  EXPECT_NE(runs[0].at("verified"), runs[2].at("verified")) << "another seed verified the same matches everywhere";
+  EXPECT_EQ(recorded_seeds, (std::vector<int>{map_seed, map_seed, map_seed + 1}));
 }
 
 }  // namespace

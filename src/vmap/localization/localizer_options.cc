@@ -188,6 +188,9 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.VisitNested("belief", belief);
   visitor.VisitNested("heading", heading);
   visitor.VisitNested("verifier", verifier, Nesting{false, {"max_samples_to_reject"}});
+  visitor.Visit({"verifier_seed", "--verifier-seed",
+                 "The seed of the verifier's sampling in the frames' comparisons (-1 = the map's verifier's)"},
+                verifier_seed);
   visitor.VisitNested("translation", translation);
   visitor.Visit({"similarity"}, EnumField(similarity, kSimilarityModeNames, ParseSimilarityMode));
   visitor.Visit({"route"}, route);
@@ -309,6 +312,10 @@ void LocalizerOptions::Check() const {
   CheckField("ranking", ranking);
   CheckField("belief", belief);
   CheckField("verifier", verifier);
+  if (verifier_seed < -1) {
+    throw OptionError("verifier_seed", fmt::format("{} is neither -1 (the map's) nor a seed >= 0 (default {})",
+                                                   verifier_seed, defaults.verifier_seed));
+  }
   CheckField("heading", heading);
   CheckField("translation", translation);
   if (lost_frame_features < 0 || lost_frame_features > 100000) {

@@ -293,6 +293,12 @@ struct LocalizerOptions {
   // The map's verifier (as map.json records it), except that localization caps its iterations (see
   // MapVerifierOptions): a frame that shares little with a key image must fail fast.
   VerifierOptions verifier;
+  // The seed of that verifier's random sampling in the frames' comparisons, ORB's and XFeat's alike (FollowMap sets
+  // verifier.seed to it); -1: the map's. ORB's near comparisons sit at chance's boundary (a third of ~54 matches
+  // inliers on the corridor): another seed flips ~6 % of their decisions and moves corridor ORB's right frames by
+  // 5-7 (sd), so a rule worth a few frames is judged over several seeds (bench/route_conditions.py --seeds;
+  // docs/measurements/localization-conditions.md, "The verifier's seed: the spread of every figure").
+  int verifier_seed = -1;
   SimilarityMode similarity = SimilarityMode::kInlierRatio;
   // Key-image indices to follow, in order (PlanRoute gives one); empty = every key image in map order.
   std::vector<int> route;
@@ -314,8 +320,8 @@ struct LocalizerOptions {
 
   // As a localization run records them (its "options"; not the camera, which the map gives) and the flags of
   // `vmap localize`. The verifier, the translation thresholds and the similarity follow the map
-  // (MapVerifierOptions, FollowMap): they are recorded, but have no flags here, and the verifier records no
-  // early stop (localization verifies each comparison in full).
+  // (MapVerifierOptions, FollowMap): they are recorded, but have no flags here (the verifier's seed has its own,
+  // verifier_seed), and the verifier records no early stop (localization verifies each comparison in full).
   void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
