@@ -424,5 +424,22 @@ TEST(LocalizeCli, TheVerifiersSeedIsTheMapsUnlessAnotherIsGiven) {
   EXPECT_EQ(recorded_seeds, (std::vector<int>{map_seed, map_seed, map_seed + 1}));
 }
 
+// A lost frame's heading below the rule's ratio only where the route's order expects the frame
+// (docs/measurements/localization-conditions.md, "A lost frame's heading near where the route expects it"): the
+// corridor's frame 20, lost, holds 1.52 times its rival's heading votes at key image 10, four ahead of its estimate.
+// With the defaults (near ratio 1.5) it is refused there, every frame as without the near ratio; at 1.5 everywhere it
+// is accepted and the belief spreads (frame 20 uncertain).
+TEST(LocalizeCli, ALostFramesWeakerHeadingFarFromTheEstimateIsRefused) {
+  const auto runs = CorridorRuns({"", " --lost-frame-heading-near-ratio 0",
+                                  " --lost-frame-heading-rival-ratio 1.5 --lost-frame-heading-near-ratio 0"},
+                                 21);
+  if (runs.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  ASSERT_EQ(runs[0].size(), 22u);
+  EXPECT_EQ(runs[0], runs[1]);
+  EXPECT_TRUE(Placed(runs[0][20])) << runs[0][20].first;
+  EXPECT_NE(runs[2][20], runs[0][20])
+      << "at 1.5 everywhere frame 20 is as with the guard: the test no longer probes it";
+}
+
 }  // namespace
 }  // namespace vmap

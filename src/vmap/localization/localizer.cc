@@ -354,6 +354,11 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     // 500 features match a right key image's for chance).
     if (found.status != LocalizationStatus::kRelocalized && CompareLostFrameAgain(frame, features)) {
       found = Relocalize(frame, features);
+      // Placed by a heading that stands out less than the rule's ratio: placed, not steered by, as a frame placed by
+      // agreement (michigan_seasons: 7 of the 17 frames placed so more than 35 px off the hand label).
+      if (lost_frame_heading_near_ && found.status == LocalizationStatus::kRelocalized) {
+        found = PlacedByAgreement(std::move(found));
+      }
     }
     const bool relocalized = found.status == LocalizationStatus::kRelocalized;
     if (relocalized && TakesJump(position, found.route_position, lost_before)) return found;
@@ -441,9 +446,10 @@ LocalizationResult Localizer::TrackedAt(LocalizationResult result, int from, int
 }
 
 bool Localizer::TakesJump(int from, int to, int lost_frames) {
-  // While lost the robot moved on unseen: up to `lookahead` key images a frame, as the tracker would have followed.
-  const int reach = kNear + options_.lookahead * lost_frames;
-  if (options_.belief.window <= 0 || options_.belief.min_confidence <= 0.0 || std::abs(to - from) <= reach) return true;
+  if (options_.belief.window <= 0 || options_.belief.min_confidence <= 0.0 ||
+      std::abs(to - from) <= JumpReach(lost_frames)) {
+    return true;
+  }
   if (pointed_before_ >= 0 && std::abs(to - pointed_before_) <= kNear) {
     // Two frames in a row point there; the belief, weighed by both, must not hold less near it than near `from`.
     WeighComparisons();

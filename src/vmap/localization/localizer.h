@@ -118,6 +118,8 @@ class Localizer {
   bool CompareLostFrameAgain(const Frame& frame, const ImageFeatures& features);
   // Where chance accepts none of them, the comparison with more features whose heading mode stands out against the
   // others made so (LocalizerOptions::lost_frame_heading) is accepted as by HeadingStandsOut.
+  // Below lost_frame_heading_rival_ratio, down to lost_frame_heading_near_ratio, only within JumpReach of the
+  // estimate the frame starts from; the frame is then not steered by (lost_frame_heading_near_).
   bool AcceptLostFrameByHeading(const std::vector<KeyComparison>& compared);
   // Key image `key`'s features as lost_frame_matcher_ extracts them, read from the map's directory when first needed.
   const ImageFeatures& LostFrameKeyFeatures(int key);
@@ -274,6 +276,9 @@ class Localizer {
   // position `from` to `to`; when not, remembers `to` for the next frame. Only with the belief on (belief.window and
   // min_confidence above 0).
   bool TakesJump(int from, int to, int lost_frames);
+  // How far from the tracked estimate a place is near enough to need no second frame: kNear, plus `lookahead` for each
+  // of the `lost_frames` frames lost since (the robot moved on unseen, as the tracker would have followed).
+  int JumpReach(int lost_frames) const { return kNear + options_.lookahead * lost_frames; }
   // Remembers the far place the frame's comparisons verified more at than the key images it is steered by (or, for a
   // frame not steered by, than its key images: rival_place_when_not_steered) as rival_place_, or counts down the one
   // remembered.
@@ -313,6 +318,8 @@ class Localizer {
   // The map's ORB with lost_frame_features features (LocalizerOptions::lost_frame_features); null: not asked, not ORB,
   // or the key images' directory unknown. The key images' features it extracted, per key image (null: not yet).
   std::unique_ptr<Matcher> lost_frame_matcher_;
+  // This frame was accepted by AcceptLostFrameByHeading below lost_frame_heading_rival_ratio: placed, not steered by.
+  bool lost_frame_heading_near_ = false;
   std::vector<std::shared_ptr<const ImageFeatures>> lost_frame_key_features_;
   LocalizerOptions options_;
   std::vector<int> route_;

@@ -147,6 +147,11 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "ORB: a lost frame's comparison with more features is accepted by its heading mode when that holds "
                  "this many times the votes of every rival among them (0: never)"},
                 lost_frame_heading_rival_ratio);
+  visitor.Visit(
+      {"lost_frame_heading_near_ratio", "--lost-frame-heading-near-ratio",
+       "ORB: below --lost-frame-heading-rival-ratio, down to this, a lost frame's heading is accepted within a "
+       "jump's reach of the estimate only, placed but not steered by (0: none)"},
+      lost_frame_heading_near_ratio);
   visitor.Visit({"far_comparison_iterations", "--far-comparison-iterations",
                  "ORB: verify the frame's comparisons with key images away from the tracker's (more than one behind "
                  "or lookahead + 1 ahead) with at most this many MAGSAC iterations (0 = the verifier's)"},
@@ -249,6 +254,12 @@ void LocalizerOptions::Check() const {
     throw OptionError("lost_frame_heading_rival_ratio",
                       fmt::format("{} is not 0 (never) nor in [1, 1000] (default {})", lost_frame_heading_rival_ratio,
                                   defaults.lost_frame_heading_rival_ratio));
+  }
+  if (!(lost_frame_heading_near_ratio == 0.0 ||
+        (lost_frame_heading_near_ratio >= 1.0 && lost_frame_heading_near_ratio <= 1000.0))) {
+    throw OptionError("lost_frame_heading_near_ratio",
+                      fmt::format("{} is not 0 (none) nor in [1, 1000] (default {})", lost_frame_heading_near_ratio,
+                                  defaults.lost_frame_heading_near_ratio));
   }
   if (!(min_heading_votes >= 3 && min_heading_votes <= 100000)) {
     throw OptionError("min_heading_votes", fmt::format("{} is outside [3, 100000] (default {})", min_heading_votes,

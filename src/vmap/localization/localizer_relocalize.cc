@@ -2,6 +2,7 @@
 // against its rivals, and placed on the segment before or after the best of them; when nothing verifies, matched guided
 // where the estimate was dropped.
 #include <algorithm>
+#include <cstdlib>
 #include <vector>
 
 #include "vmap/core/error.h"
@@ -97,6 +98,7 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
 }
 
 bool Localizer::CompareLostFrameAgain(const Frame& frame, const ImageFeatures& features) {
+  lost_frame_heading_near_ = false;
   if (!lost_frame_matcher_) return false;
   std::shared_ptr<const ImageFeatures> more;  // the frame's, extracted when first needed
   std::vector<KeyComparison> compared;        // with more features, chance's verdict aside
@@ -127,10 +129,15 @@ bool Localizer::AcceptLostFrameByHeading(const std::vector<KeyComparison>& compa
   const auto best = std::max_element(
       compared.begin(), compared.end(),
       [](const KeyComparison& a, const KeyComparison& b) { return a.heading.votes < b.heading.votes; });
-  if (best == compared.end() || !HeadingMayStandOut(*best) ||
-      !OutvotesHeadingRivals(*best, route_position_of_key_[best->key], compared,
-                             options_.lost_frame_heading_rival_ratio)) {
-    return false;
+  if (best == compared.end() || !HeadingMayStandOut(*best)) return false;
+  const int position = route_position_of_key_[best->key];
+  if (!OutvotesHeadingRivals(*best, position, compared, options_.lost_frame_heading_rival_ratio)) {
+    // Standing out less, a heading is a weaker witness: only where the route's order expects the frame (the corridor's
+    // frame 20 at 1.5: a near rival four key images ahead of its estimate), and its heading is not steered by.
+    lost_frame_heading_near_ = options_.lost_frame_heading_near_ratio > 0.0 && frame_start_position_ >= 0 &&
+                               std::abs(position - frame_start_position_) <= JumpReach(lost_in_a_row_) &&
+                               OutvotesHeadingRivals(*best, position, compared, options_.lost_frame_heading_near_ratio);
+    if (!lost_frame_heading_near_) return false;
   }
   for (Memo& m : comparisons_) {
     if (m.comparison.key != best->key) continue;
