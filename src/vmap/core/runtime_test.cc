@@ -62,7 +62,10 @@ TEST(Runtime, SetsOpenCvThreads) {
 }
 
 TEST(Runtime, KeepsLargeFreedBlocksInTheHeap) {
-  constexpr size_t kLarge = size_t(64) << 20;  // above glibc's largest dynamic mmap threshold (32 MiB)
+  // Above glibc's largest dynamic mmap threshold (32 MiB), and larger than all the heap's free memory (fordblks),
+  // which earlier tests in this process may have left there (a whole-binary run): no free chunk can serve it, so
+  // only the mmap settings decide whether it is a mmap of its own.
+  const size_t kLarge = mallinfo2().fordblks + (size_t(64) << 20);
   mallopt(M_MMAP_MAX, 65536);                  // glibc's default
   EXPECT_TRUE(AllocationIsMapped(kLarge)) << "the control: by default such a block is a mmap of its own";
   InitializeRuntime(Nothing());
