@@ -66,7 +66,7 @@ TEST(Runtime, KeepsLargeFreedBlocksInTheHeap) {
   // which earlier tests in this process may have left there (a whole-binary run): no free chunk can serve it, so
   // only the mmap settings decide whether it is a mmap of its own.
   const size_t kLarge = mallinfo2().fordblks + (size_t(64) << 20);
-  mallopt(M_MMAP_MAX, 65536);                  // glibc's default
+  mallopt(M_MMAP_MAX, 65536);  // glibc's default
   EXPECT_TRUE(AllocationIsMapped(kLarge)) << "the control: by default such a block is a mmap of its own";
   InitializeRuntime(Nothing());
   EXPECT_TRUE(AllocationIsMapped(kLarge)) << "keep_freed_memory off changes nothing";
