@@ -100,23 +100,15 @@ struct Case {
   std::function<Outcome(const fs::path& dir, const fs::path& binary)> run;
 };
 
-// The binary run through GNU time (which forks it from a small process, so that its peak memory is its own and
-// not this process's, as a child spawned from here would report) and prlimit (6 GB of address space).
+// The binary run under prlimit (6 GB of address space); RunBounded measures its own peak memory.
 Outcome Timed(const fs::path& binary, const std::vector<std::string>& arguments,
               const std::vector<std::string>& environment = {}) {
   Outcome outcome;
-  std::vector<std::string> limited = {"-f", "\nPEAK_KB %M", "/usr/bin/prlimit", "--as=" + std::to_string(6ull << 30),
-                                      binary.string()};
+  std::vector<std::string> limited = {"--as=" + std::to_string(6ull << 30), binary.string()};
   limited.insert(limited.end(), arguments.begin(), arguments.end());
   const auto start = std::chrono::steady_clock::now();
-  outcome.run = vmap::testing::RunBounded("/usr/bin/time", limited, 60, environment);
+  outcome.run = vmap::testing::RunBounded("/usr/bin/prlimit", limited, 60, environment);
   outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const size_t peak = outcome.run.output.rfind("PEAK_KB ");
-  outcome.run.max_rss_bytes = peak == std::string::npos ? 0 : std::stol(outcome.run.output.substr(peak + 8)) * 1024;
-  // GNU time's own line when the program was killed by a signal.
-  const size_t signal_line = outcome.run.output.find("Command terminated by signal");
-  if (signal_line != std::string::npos)
-    outcome.run.status = 128 + std::stoi(outcome.run.output.substr(signal_line + 29));
   return outcome;
 }
 

@@ -18,6 +18,7 @@ packages=(
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   libsqlite3-dev libzstd-dev liblz4-dev libbz2-dev python3-rosbag  # recordings (python3-rosbag: test fixtures)
   ffmpeg                        # only used by tests: videos with a display rotation, live streams on the loopback
+  time                          # GNU time: tests and benchmarks measure a run's own peak memory with it
   pybind11-dev python3-numpy python3-pytest  # the Python module (python/, docs/python.md) and its tests
 )
 ros_packages=(

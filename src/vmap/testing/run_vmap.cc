@@ -4,17 +4,21 @@
 #include <poll.h>
 #include <signal.h>
 #include <spawn.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <utility>
 
 extern char** environ;
 
 namespace vmap::testing {
+namespace {
+// Begins the line GNU time adds to a bounded run's output: the peak memory (KB), user and system CPU seconds.
+constexpr char kUsageMarker[] = "vmap-testing-usage:";
+}  // namespace
 
 std::filesystem::path VmapBinary() { return VMAP_BINARY; }
 
@@ -54,7 +58,11 @@ BoundedRun RunBounded(const std::filesystem::path& binary, const std::vector<std
   std::vector<char*> envp;
   for (std::string& v : variables) envp.push_back(v.data());
   envp.push_back(nullptr);
-  std::vector<std::string> storage = {binary.string()};
+  // Through GNU time, which forks the binary from a small process of its own: a child spawned from here would report
+  // as its peak this process's (exec records the memory it replaces, and posix_spawn's child shares this process's
+  // until it execs), which in a test binary that ran other tests before may be hundreds of MB.
+  std::vector<std::string> storage = {"/usr/bin/time", "-q", "-f", std::string("\n") + kUsageMarker + " %M %U %S",
+                                      binary.string()};
   storage.insert(storage.end(), arguments.begin(), arguments.end());
   std::vector<char*> argv;
   for (std::string& a : storage) argv.push_back(a.data());
@@ -97,9 +105,18 @@ BoundedRun RunBounded(const std::filesystem::path& binary, const std::vector<std
   }
   close(pipe_fds[0]);
   int status = 0;
-  struct rusage usage {};
-  wait4(pid, &status, 0, &usage);
-  run.max_rss_bytes = usage.ru_maxrss * 1024L;
+  waitpid(pid, &status, 0);
+  const size_t usage_line = run.output.rfind(std::string("\n") + kUsageMarker + " ");
+  if (usage_line != std::string::npos) {
+    long peak_kb = 0;
+    double user_seconds = 0, system_seconds = 0;
+    std::sscanf(run.output.c_str() + usage_line + 1 + std::strlen(kUsageMarker), "%ld %lf %lf", &peak_kb, &user_seconds,
+                &system_seconds);
+    run.max_rss_bytes = peak_kb * 1024L;
+    run.cpu_seconds = user_seconds + system_seconds;
+    run.output.erase(usage_line);
+  }
+  // GNU time exits with the binary's status, or 128 + the signal that ended it.
   run.status = !run.timed_out && WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   if (run.timed_out) run.output += "\n(timed out after " + std::to_string(timeout_seconds) + " s)";
   return run;
@@ -148,17 +165,11 @@ bool BackgroundVmap::Running() const {
   return waitid(P_PID, pid_, &info, WEXITED | WNOHANG | WNOWAIT) == 0 && info.si_pid == 0;
 }
 
-int BackgroundVmap::Wait(long* max_rss_kb, double* cpu_seconds) {
+int BackgroundVmap::Wait() {
   if (pid_ <= 0) return -1;
   int status = 0;
-  struct rusage usage {};
-  wait4(pid_, &status, 0, &usage);
+  waitpid(pid_, &status, 0);
   waited_ = true;
-  if (max_rss_kb) *max_rss_kb = usage.ru_maxrss;
-  if (cpu_seconds) {
-    *cpu_seconds =
-        usage.ru_utime.tv_sec + usage.ru_stime.tv_sec + (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) / 1e6;
-  }
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 

@@ -26,13 +26,15 @@ CliResult RunVmap(const std::string& arguments, const std::string& environment =
 int RunVmap(const std::string& arguments, std::string* output);
 
 // The binary run with `arguments` (no shell: one argument each) for at most `timeout_seconds`: a run still going
-// then is killed and reported as timed out (status -1). Its peak memory (maximum resident set) in
-// `max_rss_bytes` when given: what hostile inputs may cost, asserted by the tests of issue 38.
+// then is killed and reported as timed out (status -1); a run a signal ended has status 128 + the signal. Its own
+// peak memory (maximum resident set) and CPU time, measured by GNU time (/usr/bin/time): what hostile inputs may
+// cost, asserted by the tests of issue 38.
 struct BoundedRun {
   int status = -1;
   bool timed_out = false;
   long max_rss_bytes = 0;
-  std::string output;  // stdout and stderr together
+  double cpu_seconds = 0;  // user and system
+  std::string output;      // stdout and stderr together
 };
 BoundedRun RunVmapBounded(const std::vector<std::string>& arguments, double timeout_seconds);
 // The same for any `binary` (another build of vmap: bench/hostile_bench compares two), with `environment`
@@ -54,9 +56,9 @@ class BackgroundVmap {
   void Signal(int signal_number) const;
   // Whether it has not exited yet (it is not reaped).
   bool Running() const;
-  // The exit status, or 128 + the signal that ended it; the peak memory in `max_rss_kb` and the CPU time it used
-  // (user and system) in `cpu_seconds` when given.
-  int Wait(long* max_rss_kb = nullptr, double* cpu_seconds = nullptr);
+  // The exit status, or 128 + the signal that ended it. (Its peak memory is not measured: spawned from here, its
+  // peak would be this process's; RunVmapBounded measures a run's own.)
+  int Wait();
 
  private:
   int pid_ = -1;
