@@ -352,11 +352,13 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     }
     // Nothing verified with the map's features: the ranking's best compared again with more (across seasons too few of
     // 500 features match a right key image's for chance).
-    if (found.status != LocalizationStatus::kRelocalized && CompareLostFrameAgain(frame, features)) {
+    const SecondLook look = found.status == LocalizationStatus::kRelocalized ? SecondLook::kNothing
+                                                                             : CompareLostFrameAgain(frame, features);
+    if (look != SecondLook::kNothing) {
       found = Relocalize(frame, features);
       // Placed by a heading that stands out less than the rule's ratio: placed, not steered by, as a frame placed by
       // agreement (michigan_seasons: 7 of the 17 frames placed so more than 35 px off the hand label).
-      if (lost_frame_heading_near_ && found.status == LocalizationStatus::kRelocalized) {
+      if (look == SecondLook::kPlacedOnly && found.status == LocalizationStatus::kRelocalized) {
         found = PlacedByAgreement(std::move(found));
       }
     }

@@ -115,12 +115,15 @@ class Localizer {
   // A lost frame compared again with more features (LocalizerOptions::lost_frame_features): CompareBestRankedAgain
   // with the frame's features extracted again by lost_frame_matcher_ and the key image's likewise
   // (LostFrameKeyFeatures).
-  bool CompareLostFrameAgain(const Frame& frame, const ImageFeatures& features);
+  // What it found: nothing, a comparison accepted, or one accepted by a heading that stands out less
+  // (AcceptLostFrameByHeading), whose frame is placed, not steered by.
+  enum class SecondLook { kNothing, kAccepted, kPlacedOnly };
+  SecondLook CompareLostFrameAgain(const Frame& frame, const ImageFeatures& features);
   // Where chance accepts none of them, the comparison with more features whose heading mode stands out against the
-  // others made so (LocalizerOptions::lost_frame_heading) is accepted as by HeadingStandsOut.
+  // others made so (LocalizerOptions::lost_frame_heading) is accepted as by HeadingStandsOut (kAccepted).
   // Below lost_frame_heading_rival_ratio, down to lost_frame_heading_near_ratio, only within JumpReach of the
-  // estimate the frame starts from; the frame is then not steered by (lost_frame_heading_near_).
-  bool AcceptLostFrameByHeading(const std::vector<KeyComparison>& compared);
+  // estimate the frame starts from (kPlacedOnly).
+  SecondLook AcceptLostFrameByHeading(const std::vector<KeyComparison>& compared);
   // Key image `key`'s features as lost_frame_matcher_ extracts them, read from the map's directory when first needed.
   const ImageFeatures& LostFrameKeyFeatures(int key);
   // A lost frame steps on where its evidence agrees (LocalizerOptions::step_on_where_evidence_agrees): whether the
@@ -251,19 +254,18 @@ class Localizer {
   // What both heading rules (HeadingStandsOut, AcceptLostFrameByHeading) ask of the comparison itself: matched, at
   // least min_heading_votes heading votes, and the link share's verified matches.
   bool HeadingMayStandOut(const KeyComparison& comparison) const;
-  // And of its rivals: the comparison at route `position` holds at least `ratio` times the heading votes of every
-  // heading rival among `compared` (the frame's memos, or its comparisons with more features). Without a rival it does
-  // not stand out: the frame cannot tell.
+  // And of its rivals: the most heading votes of a heading rival of route `position` among `compared` (the frame's
+  // memos, or its comparisons with more features), which each rule's ratio of the comparison's votes must reach; -1
+  // without a rival (a route too short): the frame cannot tell, and no heading stands out.
   template <typename Compared>
-  bool OutvotesHeadingRivals(const KeyComparison& comparison, int position, const Compared& compared,
-                             double ratio) const {
+  int MostHeadingRivalVotes(int position, const Compared& compared) const {
     int rival_votes = -1;
     for (const auto& c : compared) {
       const KeyComparison& rival = ComparisonOf(c);
       const int q = route_position_of_key_[rival.key];
       if (q >= 0 && IsHeadingRival(position, q)) rival_votes = std::max(rival_votes, rival.heading.votes);
     }
-    return rival_votes >= 0 && comparison.heading.votes >= ratio * rival_votes;
+    return rival_votes;
   }
   // When nothing else is accepted: the comparison whose heading mode holds the most votes, if HeadingStandsOut.
   // Returns its route position, -1 when none.
@@ -318,8 +320,6 @@ class Localizer {
   // The map's ORB with lost_frame_features features (LocalizerOptions::lost_frame_features); null: not asked, not ORB,
   // or the key images' directory unknown. The key images' features it extracted, per key image (null: not yet).
   std::unique_ptr<Matcher> lost_frame_matcher_;
-  // This frame was accepted by AcceptLostFrameByHeading below lost_frame_heading_rival_ratio: placed, not steered by.
-  bool lost_frame_heading_near_ = false;
   std::vector<std::shared_ptr<const ImageFeatures>> lost_frame_key_features_;
   LocalizerOptions options_;
   std::vector<int> route_;

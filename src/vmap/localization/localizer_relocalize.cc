@@ -97,9 +97,8 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
   return result;
 }
 
-bool Localizer::CompareLostFrameAgain(const Frame& frame, const ImageFeatures& features) {
-  lost_frame_heading_near_ = false;
-  if (!lost_frame_matcher_) return false;
+Localizer::SecondLook Localizer::CompareLostFrameAgain(const Frame& frame, const ImageFeatures& features) {
+  if (!lost_frame_matcher_) return SecondLook::kNothing;
   std::shared_ptr<const ImageFeatures> more;  // the frame's, extracted when first needed
   std::vector<KeyComparison> compared;        // with more features, chance's verdict aside
   const bool by_chance = CompareBestRankedAgain(frame, features, [&](int key) -> std::optional<KeyComparison> {
@@ -115,13 +114,13 @@ bool Localizer::CompareLostFrameAgain(const Frame& frame, const ImageFeatures& f
     compared.push_back(CompareImage(*more, *key_image, lost_frame_matcher_->Match(*more, *key_image), key));
     return compared.back();
   });
-  return by_chance || AcceptLostFrameByHeading(compared);
+  return by_chance ? SecondLook::kAccepted : AcceptLostFrameByHeading(compared);
 }
 
-bool Localizer::AcceptLostFrameByHeading(const std::vector<KeyComparison>& compared) {
+Localizer::SecondLook Localizer::AcceptLostFrameByHeading(const std::vector<KeyComparison>& compared) {
   if (!options_.lost_frame_heading || !heading_accepts_ || options_.min_heading_rival_ratio <= 0.0 ||
       options_.lost_frame_heading_rival_ratio <= 0.0) {
-    return false;
+    return SecondLook::kNothing;
   }
   // As HeadingStandsOut, with the frame's rivals among the comparisons made with as many features: a heading mode of
   // 4,000 features holds more votes at any key image than one of 500 (michigan_seasons' wrong key images 16-21, where
@@ -129,15 +128,19 @@ bool Localizer::AcceptLostFrameByHeading(const std::vector<KeyComparison>& compa
   const auto best = std::max_element(
       compared.begin(), compared.end(),
       [](const KeyComparison& a, const KeyComparison& b) { return a.heading.votes < b.heading.votes; });
-  if (best == compared.end() || !HeadingMayStandOut(*best)) return false;
+  if (best == compared.end() || !HeadingMayStandOut(*best)) return SecondLook::kNothing;
   const int position = route_position_of_key_[best->key];
-  if (!OutvotesHeadingRivals(*best, position, compared, options_.lost_frame_heading_rival_ratio)) {
+  const int rival_votes = MostHeadingRivalVotes(position, compared);
+  if (rival_votes < 0) return SecondLook::kNothing;
+  SecondLook look = SecondLook::kAccepted;
+  if (best->heading.votes < options_.lost_frame_heading_rival_ratio * rival_votes) {
     // Standing out less, a heading is a weaker witness: only where the route's order expects the frame (the corridor's
     // frame 20 at 1.5: a near rival four key images ahead of its estimate), and its heading is not steered by.
-    lost_frame_heading_near_ = options_.lost_frame_heading_near_ratio > 0.0 && frame_start_position_ >= 0 &&
-                               std::abs(position - frame_start_position_) <= JumpReach(lost_in_a_row_) &&
-                               OutvotesHeadingRivals(*best, position, compared, options_.lost_frame_heading_near_ratio);
-    if (!lost_frame_heading_near_) return false;
+    const bool near = options_.lost_frame_heading_near_ratio > 0.0 && frame_start_position_ >= 0 &&
+                      std::abs(position - frame_start_position_) <= JumpReach(lost_in_a_row_) &&
+                      best->heading.votes >= options_.lost_frame_heading_near_ratio * rival_votes;
+    if (!near) return SecondLook::kNothing;
+    look = SecondLook::kPlacedOnly;
   }
   for (Memo& m : comparisons_) {
     if (m.comparison.key != best->key) continue;
@@ -145,7 +148,7 @@ bool Localizer::AcceptLostFrameByHeading(const std::vector<KeyComparison>& compa
     m.comparison = *best;
     m.comparison.accepted = m.by_heading = true;
   }
-  return true;
+  return look;
 }
 
 const ImageFeatures& Localizer::LostFrameKeyFeatures(int key) {

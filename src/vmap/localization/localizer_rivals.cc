@@ -80,7 +80,8 @@ bool Localizer::HeadingStandsOut(const Frame& frame, const ImageFeatures& featur
       break;
     }
   }
-  return OutvotesHeadingRivals(comparison, position, comparisons_, options_.min_heading_rival_ratio);
+  const int rival_votes = MostHeadingRivalVotes(position, comparisons_);
+  return rival_votes >= 0 && comparison.heading.votes >= options_.min_heading_rival_ratio * rival_votes;
 }
 
 int Localizer::AcceptByHeading(const Frame& frame, const ImageFeatures& features) {
