@@ -84,6 +84,11 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                 max_lost_frames);
   visitor.Visit({"relocalization_candidates", "--candidates", "Best-ranked key images verified when relocalizing"},
                 relocalization_candidates);
+  visitor.Visit({"relocalization_likelier_reach", "--relocalization-likelier-reach",
+                 "Route positions from a relocalization's most verified candidate within which an accepted one "
+                 "likelier by chance (lower log10 NFA, within the evidence's bound) places the frame (0 = the most "
+                 "verified)"},
+                relocalization_likelier_reach);
   visitor.Visit({"experience_candidates", "--experience-candidates",
                  "Maps with experiences: views of a key image verified besides it, those with the most tentative "
                  "matches (0 = the teach key images only)"},
@@ -319,6 +324,11 @@ void LocalizerOptions::Check() const {
     throw OptionError("relocalization_candidates",
                       fmt::format("{} must be 1 to 10000 (default {})", relocalization_candidates,
                                   defaults.relocalization_candidates));
+  }
+  if (relocalization_likelier_reach < 0 || relocalization_likelier_reach > 1000000) {
+    throw OptionError("relocalization_likelier_reach",
+                      fmt::format("{} must be 0 to 1000000 (default {})", relocalization_likelier_reach,
+                                  defaults.relocalization_likelier_reach));
   }
   CheckField("ranking", ranking);
   CheckField("belief", belief);

@@ -295,6 +295,13 @@ struct LocalizerOptions {
   int max_lost_frames = 5;
   // Best-ranked key images verified when relocalizing.
   int relocalization_candidates = 5;
+  // Among the accepted candidates within this many route positions of the one that verified the most, the likeliest
+  // by chance (lowest log10 NFA, clamped at the evidence's bound as NoLikelierChance has it: beyond it the count
+  // decides) is where a relocalization places the frame. Across lighting a key image the frame has passed verifies more
+  // of the scene than the one it is at (corridor_conditions with XFeat at the verifier's seed 3: frame 21 at key image
+  // 3, 25 verified, where key image 5 verified 18 at a lower NFA; frames 21-32 held 2-3 key images behind). 0: the most
+  // verified.
+  int relocalization_likelier_reach = 2;
   RankingOptions ranking;
   // The belief over the route (route_belief.h): its motion model and when a frame is uncertain.
   RouteBeliefOptions belief;

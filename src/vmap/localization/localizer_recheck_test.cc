@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <limits>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/localization/localizer.h"
+#include "vmap/localization/route_evidence.h"
 #include "vmap/testing/localization_test_util.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"
@@ -302,6 +304,52 @@ TEST(Localizer, AfterLostFramesARelocalizationAsFarAsTheRobotCouldGoIsTakenAtOnc
   r = localize(2 * far + 1, true);
   EXPECT_EQ(r.status, LocalizationStatus::kRelocalized);
   EXPECT_LE(std::abs(r.route_position - far), 1) << "at route position " << r.route_position;
+}
+
+// Across lighting a key image the frame has passed verifies more of the scene than the one it is at
+// (corridor_conditions with XFeat at the verifier's seed 3: key image 3 verified 25 matches, key image 5, where the
+// frame was, 18 at a lower log10 NFA). A relocalization places the frame at the likelier chance among the accepted
+// candidates near the most verified one (relocalization_likelier_reach); where both verify beyond the evidence's bound
+// (the same scene beyond doubt, as a same-season frame is) the count decides as before. The first frame of a run, its
+// comparisons given.
+TEST(Localizer, ARelocalizationNearTheMostVerifiedCandidatePlacesTheFrameAtTheLikelierChance) {
+  const LocalizationMap& m = Dense();
+  const int count = static_cast<int>(m.map.key_images.size());
+  const int at = KeysAround(m.map, 25).second;  // the frame is between key images 12 and 13, ranked 11-15
+  const int passed = at - 2;                    // the route is the key images in order
+  ASSERT_GE(passed, 0);
+  struct Case {
+    int reach;
+    double at_log10_nfa, passed_log10_nfa;
+    int expected;
+  };
+  const double bound = -BinaryDescriptorEvidence().max_significance;  // the Dense map's ORB
+  for (const Case& t : {Case{2, -30.0, -5.0, at}, Case{0, -30.0, -5.0, passed}, Case{1, -30.0, -5.0, passed},
+                        Case{2, bound - 20.0, bound - 5.0, passed}}) {
+    LocalizerOptions options = MapLocalizerOptions(m);
+    ASSERT_EQ(options.relocalization_likelier_reach, 2) << "the default";
+    options.relocalization_likelier_reach = t.reach;
+    options.belief.window = 0;  // the relocalization's own place, not the belief's best guess
+    Localizer localizer(m.map, m.keys, *m.matcher, options);
+    std::vector<KeyComparison> given;
+    for (int key = 0; key < count; ++key) {
+      given.push_back(key == at       ? GivenComparison(key, true, 30, t.at_log10_nfa)
+                      : key == passed ? GivenComparison(key, true, 40, t.passed_log10_nfa)
+                                      : GivenComparison(key, false, 0, 0.0));
+    }
+    const LocalizationResult r = LocalizeImage(localizer, 25, 0, std::move(given));
+    const auto candidate = [&](int key) {
+      return std::any_of(r.candidates.begin(), r.candidates.end(),
+                         [&](const RelocalizationCandidate& c) { return c.key == key && c.accepted; });
+    };
+    std::string keys;
+    for (const auto& c : r.candidates) keys += std::to_string(c.key) + (c.accepted ? "+ " : " ");
+    ASSERT_TRUE(candidate(at) && candidate(passed))
+        << "both ranked among the frame's candidates: " << keys << " at " << at;
+    EXPECT_TRUE(r.status == LocalizationStatus::kRelocalized || r.status == LocalizationStatus::kUncertain);
+    EXPECT_EQ(r.key, t.expected) << "reach " << t.reach << ", log10 NFA " << t.at_log10_nfa << " at key image " << at
+                                 << ", " << t.passed_log10_nfa << " at " << passed;
+  }
 }
 
 // A far relocalization one frame pointed at is asked again on the next frame, even when that frame still verifies

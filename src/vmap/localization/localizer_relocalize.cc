@@ -46,14 +46,26 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
   const int standout = AcceptAgainstRivals(frame, features);
   KeyComparison best;
   int best_position = -1;
+  std::vector<KeyComparison> compared;
   for (size_t i = 0; i < positions.size(); ++i) {
     const int position = positions[i];
-    const KeyComparison c = CompareOnce(features, route_[position]);
+    compared.push_back(CompareOnce(features, route_[position]));
+    const KeyComparison& c = compared.back();
     result.candidates.push_back(
         {route_[position], ranked_[i].score, c.accepted, c.similarity, c.num_verified, c.log10_nfa});
     if (IsBetterMatch(c, best)) {
       best = c;
       best_position = position;
+    }
+  }
+  // Near the most verified candidate the likelier chance places the frame: across lighting a key image passed verifies
+  // more of the scene than the one the frame is at.
+  const int most_verified = best_position;
+  for (size_t i = 0; most_verified >= 0 && i < positions.size(); ++i) {
+    if (compared[i].accepted && std::abs(positions[i] - most_verified) <= options_.relocalization_likelier_reach &&
+        !NoLikelierChance(best, compared[i])) {
+      best = compared[i];
+      best_position = positions[i];
     }
   }
   if (best_position < 0 && standout >= 0) {
