@@ -74,7 +74,7 @@ TEST(Runtime, KeepsLargeFreedBlocksInTheHeap) {
   options.keep_freed_memory = true;
   InitializeRuntime(options);
   EXPECT_FALSE(AllocationIsMapped(kLarge));
-  // Give the process back glibc's settings and the freed block: with the trim threshold left at 1 GiB the 64 MiB
+  // Give the process back glibc's settings and the freed block: with the trim threshold left at 1 GiB the freed block
   // stays in the heap, and the control above fails when the test runs again in this process (--gtest_repeat).
   mallopt(M_MMAP_MAX, 65536);
   mallopt(M_TRIM_THRESHOLD, 128 * 1024);

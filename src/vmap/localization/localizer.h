@@ -112,12 +112,12 @@ class Localizer {
   // Guided relocalization (LocalizerOptions::guided_relocalization): CompareBestRankedAgain with the frame matched
   // again by guided_matcher_.
   bool GuideRelocalization(const Frame& frame, const ImageFeatures& features);
+  // What a lost frame's second look found: nothing, a comparison accepted, or one accepted by a heading that stands
+  // out less (AcceptLostFrameByHeading), whose frame is placed, not steered by.
+  enum class SecondLook { kNothing, kAccepted, kPlacedOnly };
   // A lost frame compared again with more features (LocalizerOptions::lost_frame_features): CompareBestRankedAgain
   // with the frame's features extracted again by lost_frame_matcher_ and the key image's likewise
   // (LostFrameKeyFeatures).
-  // What it found: nothing, a comparison accepted, or one accepted by a heading that stands out less
-  // (AcceptLostFrameByHeading), whose frame is placed, not steered by.
-  enum class SecondLook { kNothing, kAccepted, kPlacedOnly };
   SecondLook CompareLostFrameAgain(const Frame& frame, const ImageFeatures& features);
   // Where chance accepts none of them, the comparison with more features whose heading mode stands out against the
   // others made so (LocalizerOptions::lost_frame_heading) is accepted as by HeadingStandsOut (kAccepted).
