@@ -105,18 +105,23 @@ TEST(LocalizeCli, GuidedMatchingTracksFramesChanceRefusedAcrossLighting) {
   // corridor_conditions with ORB (docs/localize.md, "Guided matching by the belief"): frames whose cross-checked
   // matches verify too few at the tracked key images for chance while the belief holds them there are matched
   // again with those key images only, one-way best matches kept, and the a-contrario test accepts some of them
-  // (the continuity of the heading and the window off, to see guided matching's own).
+  // (the continuity of the heading and the window off, to see guided matching's own; the rule for lost frames' weak
+  // headings where the route goes next off too, which places frames without guided matching: 26 guided, 23 without).
   const std::vector<int> placed =
-      PlacedOnCorridor({" --continuity-share 0 --no-window-matching", " --no-guided-matching"});
+      PlacedOnCorridor({" --continuity-share 0 --no-window-matching --lost-frame-next-heading-ratio 0",
+                        " --no-guided-matching --lost-frame-next-heading-ratio 0"});
   if (placed.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   EXPECT_GE(placed[0], placed[1] + 4) << "guided " << placed[0] << ", without " << placed[1];
 }
 
 TEST(LocalizeCli, TheHeadingsContinuityTracksGuidedFramesChanceRefuses) {
   // corridor_conditions with ORB (docs/localize.md, "Continuity of the heading"): a guided comparison chance refuses
-  // is accepted when its matches move as the previous frame's heading against the key image predicts.
+  // is accepted when its matches move as the previous frame's heading against the key image predicts. Without the rule
+  // for lost frames' weak headings where the route goes next, which places frames without the continuity too (with it
+  // on: 29 placed with the continuity, 26 without).
   const std::vector<int> placed =
-      PlacedOnCorridor({" --no-window-matching", " --continuity-share 0 --no-window-matching"});
+      PlacedOnCorridor({" --no-window-matching --lost-frame-next-heading-ratio 0",
+                        " --continuity-share 0 --no-window-matching --lost-frame-next-heading-ratio 0"});
   if (placed.empty()) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
   EXPECT_GE(placed[0], placed[1] + 4) << "with the continuity " << placed[0] << ", without " << placed[1];
 }

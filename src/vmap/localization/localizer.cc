@@ -135,6 +135,7 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
     more.Of<OrbMatcherOptions>().num_features = options_.lost_frame_features;
     lost_frame_matcher_ = CreateMatcher(more);
     lost_frame_key_features_.assign(num_keys, nullptr);
+    keeps_features_before_ = options_.lost_frame_next_heading_ratio > 0.0 && options_.still_frame_share > 0.0;
   }
   if (options_.comparison_threads > 1) {
     speculation_ = std::make_unique<SpeculativeComparisons>(
@@ -171,6 +172,7 @@ void Localizer::Reset() {
   position_ = start_position_;
   lost_in_a_row_ = 0;
   placed_before_ = -1;
+  features_before_.clear();
   ranking_first_before_ = heading_mode_before_ = -1;
   dropped_position_ = -1;
   frames_since_drop_ = 0;
@@ -227,6 +229,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
       previous_headings_.emplace_back(m.comparison.key, m.comparison.heading.px);
   }
   placed_before_ = IsPlaced(result.status) ? result.route_position : -1;
+  if (keeps_features_before_) features_before_ = matcher_.SerializeFeatures(features);
   ranking_first_before_ = RankingFirst();
   heading_mode_before_ = HeadingMode();
   result.frame_index = frame.index;

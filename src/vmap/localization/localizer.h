@@ -26,6 +26,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "vmap/features/matcher.h"
@@ -46,6 +47,10 @@ namespace vmap {
 
 // Throws InputError when LocalizerOptions::start_key is not a key image of `map` on the options' route.
 void CheckStartKey(const VisualMap& map, const LocalizerOptions& options);
+
+// A frame stands still against the frame before (LocalizerOptions::still_frame_share): at least `share` of their
+// matches by `matcher` (unverified) moved less than half a pixel. No match, or `share` 0: not still.
+bool StandsStill(const Matcher& matcher, const ImageFeatures& before, const ImageFeatures& frame, double share);
 
 class Localizer {
  public:
@@ -122,8 +127,12 @@ class Localizer {
   // Where chance accepts none of them, the comparison with more features whose heading mode stands out against the
   // others made so (LocalizerOptions::lost_frame_heading) is accepted as by HeadingStandsOut (kAccepted).
   // Below lost_frame_heading_rival_ratio, down to lost_frame_heading_near_ratio, only within JumpReach of the
-  // estimate the frame starts from (kPlacedOnly).
-  SecondLook AcceptLostFrameByHeading(const std::vector<KeyComparison>& compared);
+  // estimate the frame starts from (kPlacedOnly); down to lost_frame_next_heading_ratio, only at the key image the
+  // frame before was placed at or the next, and never the next for a frame that stands still (kPlacedOnly).
+  SecondLook AcceptLostFrameByHeading(const std::vector<KeyComparison>& compared, const ImageFeatures& features);
+  // The frame stands still against the frame before (StandsStill); false when the frame before's features were not
+  // kept.
+  bool StillSinceFrameBefore(const ImageFeatures& features) const;
   // Key image `key`'s features as lost_frame_matcher_ extracts them, read from the map's directory when first needed.
   const ImageFeatures& LostFrameKeyFeatures(int key);
   // A lost frame steps on where its evidence agrees (LocalizerOptions::step_on_where_evidence_agrees): whether the
@@ -345,6 +354,10 @@ class Localizer {
   int lost_in_a_row_ = 0;
   // The route position the frame before this one was placed at (tracking or relocalized); -1: it was not.
   int placed_before_ = -1;
+  // The frame before's features as the matcher serializes them, kept where lost_frame_next_heading_ratio may ask
+  // whether a frame stands still (StillSinceFrameBefore); empty: not kept, or no frame before.
+  std::string features_before_;
+  bool keeps_features_before_ = false;
   // What the frame before this one named by its own evidence: its RankingFirst() and its HeadingMode() (-1: none).
   int ranking_first_before_ = -1;
   int heading_mode_before_ = -1;

@@ -157,6 +157,16 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
        "ORB: below --lost-frame-heading-rival-ratio, down to this, a lost frame's heading is accepted within a "
        "jump's reach of the estimate only, placed but not steered by (0: none)"},
       lost_frame_heading_near_ratio);
+  visitor.Visit(
+      {"lost_frame_next_heading_ratio", "--lost-frame-next-heading-ratio",
+       "ORB: below --lost-frame-heading-near-ratio, down to this, a lost frame's heading is accepted where it "
+       "names the key image the frame before was placed at or the one after it, placed but not steered by "
+       "(0: none)"},
+      lost_frame_next_heading_ratio);
+  visitor.Visit({"still_frame_share", "--still-frame-share",
+                 "a frame whose matches with the frame before moved less than half a pixel in this share stands "
+                 "still, and is not stepped on by --lost-frame-next-heading-ratio (0: no frame is still)"},
+                still_frame_share);
   visitor.Visit({"far_comparison_iterations", "--far-comparison-iterations",
                  "ORB: verify the frame's comparisons with key images away from the tracker's (more than one behind "
                  "or lookahead + 1 ahead) with at most this many MAGSAC iterations (0 = the verifier's)"},
@@ -265,6 +275,16 @@ void LocalizerOptions::Check() const {
     throw OptionError("lost_frame_heading_near_ratio",
                       fmt::format("{} is not 0 (none) nor in [1, 1000] (default {})", lost_frame_heading_near_ratio,
                                   defaults.lost_frame_heading_near_ratio));
+  }
+  if (!(lost_frame_next_heading_ratio == 0.0 ||
+        (lost_frame_next_heading_ratio >= 1.0 && lost_frame_next_heading_ratio <= 1000.0))) {
+    throw OptionError("lost_frame_next_heading_ratio",
+                      fmt::format("{} is not 0 (none) nor in [1, 1000] (default {})", lost_frame_next_heading_ratio,
+                                  defaults.lost_frame_next_heading_ratio));
+  }
+  if (!(still_frame_share >= 0.0 && still_frame_share <= 1.0)) {
+    throw OptionError("still_frame_share",
+                      fmt::format("{} is outside [0, 1] (default {})", still_frame_share, defaults.still_frame_share));
   }
   if (!(min_heading_votes >= 3 && min_heading_votes <= 100000)) {
     throw OptionError("min_heading_votes", fmt::format("{} is outside [3, 100000] (default {})", min_heading_votes,

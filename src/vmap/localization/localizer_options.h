@@ -222,6 +222,21 @@ struct LocalizerOptions {
   // label (docs/measurements/localization-conditions.md, "A lost frame's heading near where the route expects it").
   // 0: none below lost_frame_heading_rival_ratio.
   double lost_frame_heading_near_ratio = 1.5;
+  // Below that ratio, down to this one, the lost frame's heading is accepted where the route's order expects the frame
+  // after one placed at the estimate: the frame before was placed at the estimate the frame starts from, and the
+  // heading names that key image or the one after it; the frame is placed, not steered by. michigan_seasons' lost ORB
+  // frames after a placed one: at 1.2 36 such headings name their place and none another (1.15: 38 / 1; within a
+  // jump's reach, as the near ratio asks, 46 / 10: the wrong ones name the key image before the estimate, or are a
+  // run's first frames), and the route's order is a motion prior: a robot that stops and shows its place again may be
+  // stepped on, which a frame standing still (still_frame_share) is not (docs/measurements/
+  // localization-conditions.md, "A lost frame's heading where the route goes next, and a robot that stops"). 0: none.
+  double lost_frame_next_heading_ratio = 1.2;
+  // A frame stands still where at least this share of its matches with the frame before (the map's matcher, unverified)
+  // moved less than half a pixel: stopped frames of michigan_seasons, the corridor and lab_floor, identical or with a
+  // camera's noise, 281 / 281 pairs at 0.8; moving ones 2 / 397, none at the corridor's repeat (at most 0.26 of its
+  // matches so). The rule above does not step a still frame on to the key image after the frame before's. 0: no frame
+  // is still.
+  double still_frame_share = 0.8;
   // ORB: the frame's comparisons with key images away from the tracker's (more than one route position behind the
   // estimate the frame starts from, or more than `lookahead` + 1 ahead of it: the frame's rivals, the ranking's
   // candidates, the belief's window elsewhere) are verified with at most this many MAGSAC iterations, not the

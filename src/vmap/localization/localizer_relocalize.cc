@@ -126,10 +126,11 @@ Localizer::SecondLook Localizer::CompareLostFrameAgain(const Frame& frame, const
     compared.push_back(CompareImage(*more, *key_image, lost_frame_matcher_->Match(*more, *key_image), key));
     return compared.back();
   });
-  return by_chance ? SecondLook::kAccepted : AcceptLostFrameByHeading(compared);
+  return by_chance ? SecondLook::kAccepted : AcceptLostFrameByHeading(compared, features);
 }
 
-Localizer::SecondLook Localizer::AcceptLostFrameByHeading(const std::vector<KeyComparison>& compared) {
+Localizer::SecondLook Localizer::AcceptLostFrameByHeading(const std::vector<KeyComparison>& compared,
+                                                          const ImageFeatures& features) {
   if (!options_.lost_frame_heading || !heading_accepts_ || options_.min_heading_rival_ratio <= 0.0 ||
       options_.lost_frame_heading_rival_ratio <= 0.0) {
     return SecondLook::kNothing;
@@ -151,7 +152,15 @@ Localizer::SecondLook Localizer::AcceptLostFrameByHeading(const std::vector<KeyC
     const bool near = options_.lost_frame_heading_near_ratio > 0.0 && frame_start_position_ >= 0 &&
                       std::abs(position - frame_start_position_) <= JumpReach(lost_in_a_row_) &&
                       best->heading.votes >= options_.lost_frame_heading_near_ratio * rival_votes;
-    if (!near) return SecondLook::kNothing;
+    // Weaker still, only where the frame after one placed at the estimate is expected: at that key image, or the next
+    // as a robot moving on goes (the wrong names of weaker headings point back, or are a run's first frames). A robot
+    // that stops shows the same place again: a frame standing still stays.
+    const bool next =
+        !near && options_.lost_frame_next_heading_ratio > 0.0 && placed_before_ >= 0 &&
+        placed_before_ == frame_start_position_ &&
+        best->heading.votes >= options_.lost_frame_next_heading_ratio * rival_votes &&
+        (position == placed_before_ || (position == placed_before_ + 1 && !StillSinceFrameBefore(features)));
+    if (!near && !next) return SecondLook::kNothing;
     look = SecondLook::kPlacedOnly;
   }
   for (Memo& m : comparisons_) {
@@ -161,6 +170,24 @@ Localizer::SecondLook Localizer::AcceptLostFrameByHeading(const std::vector<KeyC
     m.comparison.accepted = m.by_heading = true;
   }
   return look;
+}
+
+bool StandsStill(const Matcher& matcher, const ImageFeatures& before, const ImageFeatures& frame, double share) {
+  // Half a pixel: a camera's noise moves a still frame's matches less (michigan_seasons with noise: >= 97 % of them),
+  // while a robot moving at the corridor's pace moves its median match 1.9 px a frame.
+  constexpr double kStillPx = 0.5;
+  if (share <= 0.0) return false;
+  const TentativeMatches matches = matcher.Match(before, frame);
+  if (matches.size() == 0) return false;
+  size_t still = 0;
+  for (size_t i = 0; i < matches.size(); ++i) still += cv::norm(matches.points1[i] - matches.points0[i]) < kStillPx;
+  return still >= share * matches.size();
+}
+
+bool Localizer::StillSinceFrameBefore(const ImageFeatures& features) const {
+  if (features_before_.empty()) return false;
+  const std::shared_ptr<const ImageFeatures> before = matcher_.DeserializeFeatures(features_before_);
+  return before && StandsStill(matcher_, *before, features, options_.still_frame_share);
 }
 
 const ImageFeatures& Localizer::LostFrameKeyFeatures(int key) {

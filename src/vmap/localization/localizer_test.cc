@@ -432,6 +432,30 @@ TEST(Localizer, SameInputSameResults) {
   }
 }
 
+// The test of standing still that keeps a lost frame's weak heading from stepping a stopped robot on
+// (LocalizerOptions::still_frame_share): the same image again, or a copy with a camera's noise, stands still against
+// it; the next frame of a drive, a few pixels on, does not; nor does anything with the share 0.
+TEST(Localizer, AFrameStandsStillAgainstItsOwnImageOrANoisyCopyNotTheNextFrame) {
+  const Matcher& matcher = *Map().opened.matcher;
+  const auto features_of = [&](const cv::Mat& bgr) {
+    cv::Mat gray;
+    cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
+    return matcher.Extract(gray);
+  };
+  const cv::Mat& image = SidewaysDrive().frames[20];
+  cv::Mat noise(image.size(), CV_16SC3), noisy;
+  cv::RNG(20).fill(noise, cv::RNG::UNIFORM, -6, 7);
+  image.convertTo(noisy, CV_16SC3);
+  cv::Mat(noisy + noise).convertTo(noisy, CV_8UC3);  // saturated
+  const auto frame = features_of(image), again = features_of(image), copy = features_of(noisy),
+             next = features_of(SidewaysDrive().frames[21]);
+  const double share = LocalizerOptions().still_frame_share;
+  EXPECT_TRUE(StandsStill(matcher, *frame, *again, share));
+  EXPECT_TRUE(StandsStill(matcher, *frame, *copy, share));
+  EXPECT_FALSE(StandsStill(matcher, *frame, *next, share));
+  EXPECT_FALSE(StandsStill(matcher, *frame, *again, 0.0));
+}
+
 TEST(Localizer, ComparingAheadOnTheWorkersChangesNothing) {
   const LocalizationMap& m = Map().opened;
   std::vector<LocalizationResult> runs[2];
