@@ -55,7 +55,7 @@ def noisy_image(work, session, place, copy, noise):
 
 
 def folder_of(path, frames):
-    """A folder of links to `frames`, in order (1.png, 2.png, ...)."""
+    """A folder of links to `frames`, in order (01.png, 02.png, ...)."""
     if not os.path.isdir(path):
         os.makedirs(path + ".tmp", exist_ok=True)
         for i, frame in enumerate(frames):

@@ -229,7 +229,15 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
       previous_headings_.emplace_back(m.comparison.key, m.comparison.heading.px);
   }
   placed_before_ = IsPlaced(result.status) ? result.route_position : -1;
-  if (keeps_features_before_) features_before_ = matcher_.SerializeFeatures(features);
+  // Kept as the matcher serializes them: features are polymorphic and the caller's go with the frame; only a placed
+  // frame's, since the next frame asks whether it stands still only after one placed at its estimate.
+  if (keeps_features_before_) {
+    if (placed_before_ >= 0) {
+      features_before_ = matcher_.SerializeFeatures(features);
+    } else {
+      features_before_.clear();
+    }
+  }
   ranking_first_before_ = RankingFirst();
   heading_mode_before_ = HeadingMode();
   result.frame_index = frame.index;

@@ -355,7 +355,7 @@ class Localizer {
   // The route position the frame before this one was placed at (tracking or relocalized); -1: it was not.
   int placed_before_ = -1;
   // The frame before's features as the matcher serializes them, kept where lost_frame_next_heading_ratio may ask
-  // whether a frame stands still (StillSinceFrameBefore); empty: not kept, or no frame before.
+  // whether a frame stands still (StillSinceFrameBefore); empty: not kept, or the frame before was not placed.
   std::string features_before_;
   bool keeps_features_before_ = false;
   // What the frame before this one named by its own evidence: its RankingFirst() and its HeadingMode() (-1: none).
