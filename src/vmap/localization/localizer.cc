@@ -231,13 +231,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   placed_before_ = IsPlaced(result.status) ? result.route_position : -1;
   // Kept as the matcher serializes them: features are polymorphic and the caller's go with the frame; only a placed
   // frame's, since the next frame asks whether it stands still only after one placed at its estimate.
-  if (keeps_features_before_) {
-    if (placed_before_ >= 0) {
-      features_before_ = matcher_.SerializeFeatures(features);
-    } else {
-      features_before_.clear();
-    }
-  }
+  if (keeps_features_before_) features_before_ = placed_before_ >= 0 ? matcher_.SerializeFeatures(features) : "";
   ranking_first_before_ = RankingFirst();
   heading_mode_before_ = HeadingMode();
   result.frame_index = frame.index;
