@@ -178,6 +178,7 @@ void Localizer::Reset() {
   frames_since_drop_ = 0;
   step_back_ruled_out_ = {};
   previous_headings_.clear();
+  heading_before_is_a_guess_ = false;
 }
 
 LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& features,
@@ -224,6 +225,12 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
                       }));
   }
   previous_headings_.clear();
+  // A guess must not be tracked from: after an uncertain frame that moved the estimate more than kNear (a
+  // relocalization the belief doubts, such as one chance refused), the continuity would accept the next frame at the
+  // guessed place on the guess's own heading there; the frames after it confirm or refute the place on evidence chance
+  // weighs (docs/measurements/localization-conditions.md, "A guess chance refused is not tracked from").
+  heading_before_is_a_guess_ = result.status == LocalizationStatus::kUncertain && position_ >= 0 &&
+                               frame_start_position_ >= 0 && std::abs(position_ - frame_start_position_) > kNear;
   for (const Memo& m : comparisons_) {
     if (std::isfinite(m.comparison.heading.px))
       previous_headings_.emplace_back(m.comparison.key, m.comparison.heading.px);

@@ -419,6 +419,9 @@ class Localizer {
   std::vector<KeyComparison> made_ahead_;
   // The previous frame's headings (px) against the key images it was compared with: (key, heading), those with one.
   std::vector<std::pair<int, double>> previous_headings_;
+  // The previous frame was uncertain and moved the estimate more than kNear: its headings are a guess's, which the
+  // continuity does not hold this frame to.
+  bool heading_before_is_a_guess_ = false;
   std::vector<RankedKey> ranked_;  // the route ranked for the frame being localized (RankRoute); empty: not yet
   // The frame's ranking weighs the belief (WeighRanking): each route position's bucket in it (RankingBuckets); empty:
   // not yet.

@@ -129,7 +129,7 @@ int Localizer::TrackGuided(const Frame& frame, const ImageFeatures& features, in
     const bool by_chance = c.accepted;
     const double guided_log10_nfa = c.log10_nfa;
     const std::optional<double> predicted_dx = PreviousHeading(key);
-    if (c.matched && !c.accepted && predicted_dx &&
+    if (c.matched && !c.accepted && predicted_dx && !heading_before_is_a_guess_ &&
         HoldsContinuity(first, matches, *predicted_dx, features.image_size())) {
       c.accepted = true;
     }
