@@ -12,6 +12,8 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "vmap/testing/localize_cli_test_util.h"
 #include "vmap/testing/run_vmap.h"
@@ -285,6 +287,43 @@ TEST(LocalizeCli, ALostFrameOfARobotThatStopsIsNotSteppedOn) {
         map, query, 2, "", [](int) { return 2; }, csv);
     EXPECT_EQ(run.second, 0) << frames.front() << ", then " << frames.back() << ": steered by at another place";
   }
+}
+
+// A robot that stops, seen by a camera with noise, is not stepped on by the agreement rules either (docs/measurements/
+// localization-conditions.md, "A still frame after lost frames is not stepped on either"): session 09's map, session
+// 11's places 1 to 3, then four copies of place 3 with uniform noise of +-6 grey levels (as bench/stop_check.py's
+// noisy row). The copies' weak evidence names place 4: without the test of standing still the agreement after a
+// placed frame steps the first copy on, and the agreement after lost frames the third to place 5; with it, none.
+TEST(LocalizeCli, ANoisyCopyOfAStoppedRobotsFrameIsNotSteppedOnWhereItsEvidenceAgrees) {
+  SKIP_WITHOUT_SHARED();
+  ::vmap::testing::ScopedTempDir tmp;
+  const fs::path map = MichiganMap(tmp.path(), 9);
+  const fs::path query = MichiganFrames(tmp.path() / "stop", {"1101", "1102", "1103"});
+  const cv::Mat image = cv::imread((Shared() / "data/michigan_seasons/images/1103.png").string(), cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(image.empty());
+  constexpr int kStopFrames = 4, kStopKey = 2;
+  for (int copy = 0; copy < kStopFrames; ++copy) {
+    cv::Mat noise(image.size(), CV_16S), noisy;
+    cv::RNG(10 + copy).fill(noise, cv::RNG::UNIFORM, -6, 7);
+    image.convertTo(noisy, CV_16S);
+    cv::Mat(noisy + noise).convertTo(noisy, CV_8U);  // saturated
+    ASSERT_TRUE(cv::imwrite((query / (std::to_string(4 + copy) + ".png")).string(), noisy));
+  }
+  const fs::path csv = tmp.path() / "run.csv";
+  const auto stepped_on = [&](const std::string& flags) {
+    std::string out;
+    EXPECT_EQ(
+        RunVmap("localize " + Quote(map) + " " + Quote(query) + " --start-key 0 -q --csv " + Quote(csv) + flags, &out),
+        0)
+        << out;
+    const std::vector<std::string> status = CsvColumn(csv, "status"), keys = CsvColumn(csv, "key");
+    EXPECT_EQ(status.size(), 3u + kStopFrames);
+    int stepped = 0;
+    for (size_t f = 3; f < status.size(); ++f) stepped += Placed({status[f], 0}) && std::stoi(keys[f]) > kStopKey;
+    return stepped;
+  };
+  EXPECT_GE(stepped_on(" --still-frame-share 0"), 2) << "the premise: without the test, the copies are stepped on";
+  EXPECT_EQ(stepped_on(""), 0);
 }
 
 // A lost frame compared again with more features (docs/measurements/localization-conditions.md, "A lost frame compared

@@ -135,8 +135,12 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
     more.Of<OrbMatcherOptions>().num_features = options_.lost_frame_features;
     lost_frame_matcher_ = CreateMatcher(more);
     lost_frame_key_features_.assign(num_keys, nullptr);
-    keeps_features_before_ = options_.lost_frame_next_heading_ratio > 0.0 && options_.still_frame_share > 0.0;
   }
+  // The rules that step a frame on to the next key image ask whether it stands still (StillSinceFrameBefore).
+  const bool steps_on_next =
+      (lost_frame_matcher_ && options_.lost_frame_next_heading_ratio > 0.0) ||
+      (heading_accepts_ && (options_.step_on_where_evidence_agrees || options_.step_on_after_lost_frames));
+  keeps_features_before_ = steps_on_next && options_.still_frame_share > 0.0;
   if (options_.comparison_threads > 1) {
     speculation_ = std::make_unique<SpeculativeComparisons>(
         [this](const ImageFeatures& features, int key) { return Compare(features, key, FarComparisonIterations(key)); },
@@ -236,9 +240,10 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
       previous_headings_.emplace_back(m.comparison.key, m.comparison.heading.px);
   }
   placed_before_ = IsPlaced(result.status) ? result.route_position : -1;
-  // Kept as the matcher serializes them: features are polymorphic and the caller's go with the frame; only a placed
-  // frame's, since the next frame asks whether it stands still only after one placed at its estimate.
-  if (keeps_features_before_) features_before_ = placed_before_ >= 0 ? matcher_.SerializeFeatures(features) : "";
+  // Kept as the matcher serializes them: features are polymorphic and the caller's go with the frame; only while the
+  // run has an estimate, since the next frame asks whether it stands still only when tracked from it (after a frame
+  // placed there, or lost there).
+  if (keeps_features_before_) features_before_ = has_estimate() ? matcher_.SerializeFeatures(features) : "";
   ranking_first_before_ = RankingFirst();
   heading_mode_before_ = HeadingMode();
   result.frame_index = frame.index;
@@ -384,7 +389,10 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     // stops shows the same place on every frame, which names the same key image.
     const bool after_lost = placed_before_ != position && lost_before > 0 && options_.step_on_after_lost_frames &&
                             ranking_first_before_ != position + 1 && heading_mode_before_ != position + 1;
-    if (!relocalized && (after_placed || after_lost) && EvidenceAgreesOnNext(position)) {
+    // A robot that stops shows the same place again, and a noisy copy of it can name the next key image as a lost
+    // frame's weak evidence often does: a frame standing still is not stepped on.
+    if (!relocalized && (after_placed || after_lost) && EvidenceAgreesOnNext(position) &&
+        !StillSinceFrameBefore(features)) {
       // The lost frames before left the belief where chance put it: the agreement is weighed there first, by what it
       // tells a right key image from a wrong one on the lost frames of michigan_seasons (kAgreementLogRatio).
       if (after_lost) {

@@ -354,8 +354,8 @@ class Localizer {
   int lost_in_a_row_ = 0;
   // The route position the frame before this one was placed at (tracking or relocalized); -1: it was not.
   int placed_before_ = -1;
-  // The frame before's features as the matcher serializes them, kept where lost_frame_next_heading_ratio may ask
-  // whether a frame stands still (StillSinceFrameBefore); empty: not kept, or the frame before was not placed.
+  // The frame before's features as the matcher serializes them, kept where a rule that steps a frame on may ask
+  // whether it stands still (StillSinceFrameBefore); empty: not kept, or the run had no estimate after that frame.
   std::string features_before_;
   bool keeps_features_before_ = false;
   // What the frame before this one named by its own evidence: its RankingFirst() and its HeadingMode() (-1: none).

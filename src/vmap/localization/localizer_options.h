@@ -234,8 +234,10 @@ struct LocalizerOptions {
   // A frame stands still where at least this share of its matches with the frame before (the map's matcher, unverified)
   // moved less than half a pixel: stopped frames of michigan_seasons, the corridor and lab_floor, identical or with a
   // camera's noise, 281 / 281 pairs at 0.8; moving ones 2 / 397, none at the corridor's repeat (at most 0.26 of its
-  // matches so). The rule above does not step a still frame on to the key image after the frame before's. 0: no frame
-  // is still.
+  // matches so). The rule above does not step a still frame on to the key image after the frame before's, nor do the
+  // agreement rules (step_on_where_evidence_agrees, step_on_after_lost_frames: the only steps of a stopped robot the
+  // stop check measured on main; docs/measurements/localization-conditions.md, "A still frame after lost frames is not
+  // stepped on either"). 0: no frame is still.
   double still_frame_share = 0.8;
   // ORB: the frame's comparisons with key images away from the tracker's (more than one route position behind the
   // estimate the frame starts from, or more than `lookahead` + 1 ahead of it: the frame's rivals, the ranking's
