@@ -126,9 +126,10 @@ class Localizer {
   SecondLook CompareLostFrameAgain(const Frame& frame, const ImageFeatures& features);
   // Where chance accepts none of them, the comparison with more features whose heading mode stands out against the
   // others made so (LocalizerOptions::lost_frame_heading) is accepted as by HeadingStandsOut (kAccepted).
-  // Below lost_frame_heading_rival_ratio, down to lost_frame_heading_near_ratio, only within JumpReach of the
-  // estimate the frame starts from (kPlacedOnly); down to lost_frame_next_heading_ratio, only at the key image the
-  // frame before was placed at or the next, and never the next for a frame that stands still (kPlacedOnly).
+  // Below lost_frame_heading_rival_ratio, down to lost_frame_heading_near_ratio, only from kNear behind the estimate
+  // the frame starts from to JumpReach ahead of it (kPlacedOnly); down to lost_frame_next_heading_ratio, only at the
+  // key image the frame before was placed at or the next, and never the next for a frame that stands still
+  // (kPlacedOnly).
   SecondLook AcceptLostFrameByHeading(const std::vector<KeyComparison>& compared, const ImageFeatures& features);
   // The frame stands still against the frame before (StandsStill); false when the frame before's features were not
   // kept.

@@ -215,8 +215,9 @@ struct LocalizerOptions {
   // with a ratio of its own"). 0: never.
   double lost_frame_heading_rival_ratio = 1.75;
   // Below that ratio, down to this one, the lost frame's heading is accepted only where the route's order expects the
-  // frame, within a jump's reach of the estimate it starts from (Localizer::JumpReach: kNear, plus lookahead for each
-  // frame lost since), and the frame is placed but not steered by. At 1.5 without the reach the corridor's frame 20
+  // frame, within a jump's reach ahead of the estimate it starts from (Localizer::JumpReach: kNear, plus lookahead for
+  // each frame lost since; behind it kNear only: lost frames move the robot on), and the frame is placed but not
+  // steered by. At 1.5 without the reach the corridor's frame 20
   // accepted key image 10, four ahead of its estimate, and the belief spread (two frames uncertain); within it
   // michigan_seasons' frames placed so are at their place, but 7 of their 20 headings are more than 35 px off the hand
   // label (docs/measurements/localization-conditions.md, "A lost frame's heading near where the route expects it").

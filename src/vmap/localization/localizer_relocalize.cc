@@ -148,9 +148,12 @@ Localizer::SecondLook Localizer::AcceptLostFrameByHeading(const std::vector<KeyC
   SecondLook look = SecondLook::kAccepted;
   if (best->heading.votes < options_.lost_frame_heading_rival_ratio * rival_votes) {
     // Standing out less, a heading is a weaker witness: only where the route's order expects the frame (the corridor's
-    // frame 20 at 1.5: a near rival four key images ahead of its estimate), and its heading is not steered by.
-    const bool near = options_.lost_frame_heading_near_ratio > 0.0 && frame_start_position_ >= 0 &&
-                      std::abs(position - frame_start_position_) <= JumpReach(lost_in_a_row_) &&
+    // frame 20 at 1.5: a near rival four key images ahead of its estimate), and its heading is not steered by. Lost
+    // frames move the robot on unseen, not back: behind the estimate the reach stays kNear (the kidnapped run's frame
+    // 54 at the verifier's seed 11 took key image 14, six behind, and the frames after it were tracked there).
+    const int offset = position - frame_start_position_;
+    const bool near = options_.lost_frame_heading_near_ratio > 0.0 && frame_start_position_ >= 0 && offset >= -kNear &&
+                      offset <= JumpReach(lost_in_a_row_) &&
                       best->heading.votes >= options_.lost_frame_heading_near_ratio * rival_votes;
     // Weaker still, only where the frame after one placed at the estimate is expected: at that key image, or the next
     // as a robot moving on goes (the wrong names of weaker headings point back, or are a run's first frames). A robot
