@@ -481,23 +481,4 @@ bool Localizer::TakesJump(int from, int to, int lost_frames) {
   return false;
 }
 
-double Localizer::NearDensity(int position) const { return belief_.MassWithin(position, kNear) / NearWidth(position); }
-
-int Localizer::NearWidth(int position) const {
-  const int last = static_cast<int>(route_.size()) - 1;
-  return std::min(last, position + kNear) - std::max(0, position - kNear) + 1;
-}
-
-bool Localizer::NoLikelierChance(const KeyComparison& to, const KeyComparison& from) const {
-  // Beyond the evidence's bound both are the same scene beyond doubt (redkitchen's frames verify at -200 to -460), and
-  // the count alone ranks them, as the bracket test chose.
-  const double beyond_doubt = -evidence_.max_significance;
-  return std::max(to.log10_nfa, beyond_doubt) <= std::max(from.log10_nfa, beyond_doubt);
-}
-
-bool Localizer::SharesLittle(const KeyComparison& comparison) const {
-  const int reference = link_verified_[comparison.key];
-  return reference > 0 && comparison.num_verified < options_.recheck_link_share * reference;
-}
-
 }  // namespace vmap

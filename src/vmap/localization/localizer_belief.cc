@@ -310,4 +310,11 @@ void Localizer::Question(LocalizationResult& result, const Frame& frame, const I
   if (verified) lost_in_a_row_ = 0;
 }
 
+double Localizer::NearDensity(int position) const { return belief_.MassWithin(position, kNear) / NearWidth(position); }
+
+int Localizer::NearWidth(int position) const {
+  const int last = static_cast<int>(route_.size()) - 1;
+  return std::min(last, position + kNear) - std::max(0, position - kNear) + 1;
+}
+
 }  // namespace vmap

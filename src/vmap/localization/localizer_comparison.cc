@@ -275,4 +275,16 @@ void Localizer::CompareMeanwhile(const ImageFeatures& features, const std::vecto
   if (!keys.empty()) speculation_->Add(features, keys);
 }
 
+bool Localizer::NoLikelierChance(const KeyComparison& to, const KeyComparison& from) const {
+  // Beyond the evidence's bound both are the same scene beyond doubt (redkitchen's frames verify at -200 to -460), and
+  // the count alone ranks them, as the bracket test chose.
+  const double beyond_doubt = -evidence_.max_significance;
+  return std::max(to.log10_nfa, beyond_doubt) <= std::max(from.log10_nfa, beyond_doubt);
+}
+
+bool Localizer::SharesLittle(const KeyComparison& comparison) const {
+  const int reference = link_verified_[comparison.key];
+  return reference > 0 && comparison.num_verified < options_.recheck_link_share * reference;
+}
+
 }  // namespace vmap
