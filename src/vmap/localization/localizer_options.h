@@ -217,10 +217,10 @@ struct LocalizerOptions {
   // Below that ratio, down to this one, the lost frame's heading is accepted only where the route's order expects the
   // frame, within a jump's reach ahead of the estimate it starts from (Localizer::JumpReach: kNear, plus lookahead for
   // each frame lost since; behind it kNear only: lost frames move the robot on), and the frame is placed but not
-  // steered by. At 1.5 without the reach the corridor's frame 20
-  // accepted key image 10, four ahead of its estimate, and the belief spread (two frames uncertain); within it
-  // michigan_seasons' frames placed so are at their place, but 7 of their 20 headings are more than 35 px off the hand
-  // label (docs/measurements/localization-conditions.md, "A lost frame's heading near where the route expects it").
+  // steered by. At 1.5 without the reach the corridor's frame 20 accepted key image 10, four ahead of its estimate,
+  // and the belief spread (two frames uncertain); within it michigan_seasons' frames placed so are at their place, but
+  // 7 of their 20 headings are more than 35 px off the hand label (docs/measurements/localization-conditions.md, "A
+  // lost frame's heading near where the route expects it").
   // 0: none below lost_frame_heading_rival_ratio.
   double lost_frame_heading_near_ratio = 1.5;
   // Below that ratio, down to this one, the lost frame's heading is accepted where the route's order expects the frame
