@@ -9,22 +9,15 @@
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localizer.h"
 #include "vmap/testing/localization_test_util.h"
+#include "vmap/testing/localizer_test_util.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {
 namespace {
 
+using ::vmap::testing::MakeFrame;
 using ::vmap::testing::SidewaysDrive;
-
-Frame MakeFrame(const cv::Mat& image, int index, int source_index) {
-  Frame frame;
-  frame.index = index;
-  frame.source_index = source_index;
-  cv::cvtColor(image, frame.gray, cv::COLOR_BGR2GRAY);
-  frame.color = image;
-  return frame;
-}
 
 TEST(Localizer, HeadingIsTheHorizontalShiftOfTheSceneInPixels) {
   // A map of one key image: the frame is at the route's end and the heading refers to that key image.

@@ -7,35 +7,17 @@
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
-#include "vmap/features/orb_matcher.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localizer.h"
 #include "vmap/testing/localization_test_util.h"
+#include "vmap/testing/localizer_test_util.h"
 #include "vmap/testing/option_error.h"
-#include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
 namespace {
 
-// A map of the drive's even frames (ORB, tau 0.8: many key images).
-struct StartMap {
-  ::vmap::testing::ScopedTempDir directory;
-  LocalizationMap opened;
-  StartMap() {
-    const auto matcher = CreateOrbMatcher({});
-    MapBuilderOptions options;
-    options.show_progress = false;
-    options.key_images.tau = 0.8;
-    ::vmap::testing::MemorySource source(::vmap::testing::DriveFrames(0, 2), ::vmap::testing::DriveIndices(0, 2));
-    ::vmap::testing::BuildMapDirectory(source, *matcher, options, directory.path() / "map");
-    opened = OpenLocalizationMap(directory.path() / "map", {});
-  }
-};
-
-const LocalizationMap& Started() {
-  static const StartMap map;
-  return map.opened;
-}
+using ::vmap::testing::Brackets;
+using ::vmap::testing::DenseDriveMap;
 
 // Drive frame `source_index` (or a blank image when -1) localized as the `index`-th frame of a stream.
 LocalizationResult LocalizeDrive(Localizer& localizer, int source_index, int index) {
@@ -45,17 +27,12 @@ LocalizationResult LocalizeDrive(Localizer& localizer, int source_index, int ind
   ::vmap::testing::MemorySource source({image}, {std::max(source_index, 0)});
   Frame frame = *source.Next();
   frame.index = index;
-  const auto features = Started().matcher->Extract(frame.gray);
+  const auto features = DenseDriveMap().matcher->Extract(frame.gray);
   return localizer.Localize(frame, *features);
 }
 
-bool Bracketed(int source_index, int key) {
-  const auto [before, after] = KeysAround(Started().map, source_index);
-  return key >= 0 && (key == before || key == after);
-}
-
 TEST(Localizer, AStartKeyStartsTheTrackerThere) {
-  const LocalizationMap& m = Started();
+  const LocalizationMap& m = DenseDriveMap();
   ASSERT_GE(m.map.key_images.size(), 8u);
   LocalizerOptions anywhere = MapLocalizerOptions(m);
   ASSERT_EQ(anywhere.start_key, -1) << "anywhere by default";
@@ -69,7 +46,7 @@ TEST(Localizer, AStartKeyStartsTheTrackerThere) {
   // The first frame is tracked from the start key image, not relocalized over the whole route.
   const LocalizationResult first = LocalizeDrive(started, 1, 0);
   EXPECT_EQ(first.status, LocalizationStatus::kTracking);
-  EXPECT_TRUE(Bracketed(1, first.key)) << first.key;
+  EXPECT_TRUE(Brackets(m.map, 1, first.key)) << first.key;
   EXPECT_EQ(LocalizeDrive(elsewhere, 1, 0).status, LocalizationStatus::kRelocalized);
   // Reset starts again there.
   LocalizeDrive(started, 21, 1);
@@ -78,7 +55,7 @@ TEST(Localizer, AStartKeyStartsTheTrackerThere) {
 }
 
 TEST(Localizer, AFrameNothingVerifiesAtTheStartIsAtTheStartKeyImage) {
-  const LocalizationMap& m = Started();
+  const LocalizationMap& m = DenseDriveMap();
   LocalizerOptions options = MapLocalizerOptions(m);
   options.start_key = 2;
   Localizer started(m.map, m.keys, *m.matcher, options);
@@ -92,7 +69,7 @@ TEST(Localizer, AFrameNothingVerifiesAtTheStartIsAtTheStartKeyImage) {
 // A soft prior: a run that starts mid-route with the start key image at the route's start is where it is from its
 // second frame on, as a run without a start key image is.
 TEST(Localizer, ARunStartedElsewhereIsNotTrappedAtTheStartKey) {
-  const LocalizationMap& m = Started();
+  const LocalizationMap& m = DenseDriveMap();
   LocalizerOptions at_start = MapLocalizerOptions(m);
   at_start.start_key = 0;
   Localizer started(m.map, m.keys, *m.matcher, at_start);
@@ -102,15 +79,15 @@ TEST(Localizer, ARunStartedElsewhereIsNotTrappedAtTheStartKey) {
     const LocalizationResult r = LocalizeDrive(started, source_index, index);
     const LocalizationResult a = LocalizeDrive(anywhere, source_index, index);
     if (index == 0) continue;  // the first frame may doubt a far place (uncertain), the second confirms it
-    EXPECT_TRUE(Bracketed(source_index, r.key)) << source_index << " at key " << r.key;
-    EXPECT_TRUE(Bracketed(source_index, a.key)) << source_index << " at key " << a.key;
+    EXPECT_TRUE(Brackets(m.map, source_index, r.key)) << source_index << " at key " << r.key;
+    EXPECT_TRUE(Brackets(m.map, source_index, a.key)) << source_index << " at key " << a.key;
     steered += IsPlaced(r.status);
   }
   EXPECT_EQ(steered, index - 1);
 }
 
 TEST(Localizer, TheStartIsChecked) {
-  const LocalizationMap& m = Started();
+  const LocalizationMap& m = DenseDriveMap();
   auto path = [](auto change) {
     return testing::OptionErrorPath([&] {
       LocalizerOptions options;

@@ -1,76 +1,42 @@
+// The Localizer along the sideways drive: its frames tracked between the key images around them, forwards and
+// backwards, with the comparisons each frame needs and the same results however they are made; and its options.
 #include "vmap/localization/localizer.h"
 
+#include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/core/error.h"
-#include "vmap/features/orb_matcher.h"
 #include "vmap/geometry/chance_model.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/testing/localization_test_util.h"
+#include "vmap/testing/localizer_test_util.h"
 #include "vmap/testing/option_error.h"
-#include "vmap/testing/scoped_temp_dir.h"
-#include "vmap/testing/synthetic_scene.h"
 
 namespace vmap {
 namespace {
 
+using ::vmap::testing::Brackets;
+using ::vmap::testing::DenseDriveMap;
 using ::vmap::testing::DriveFrames;
 using ::vmap::testing::DriveIndices;
+using ::vmap::testing::EvenDriveMap;
+using ::vmap::testing::GivenComparison;
+using ::vmap::testing::LocalizeOnDenseMap;
+using ::vmap::testing::LocalizeOnEvenMap;
 using ::vmap::testing::SidewaysDrive;
-
-// The map of the even frames, built once for all tests of this file.
-struct EvenMap {
-  ::vmap::testing::ScopedTempDir directory;
-  LocalizationMap opened;
-  EvenMap() {
-    const auto matcher = CreateOrbMatcher({});
-    MapBuilderOptions options;
-    options.show_progress = false;
-    ::vmap::testing::MemorySource source(DriveFrames(0, 2), DriveIndices(0, 2));
-    ::vmap::testing::BuildMapDirectory(source, *matcher, options, directory.path() / "map");
-    opened = OpenLocalizationMap(directory.path() / "map", {});
-  }
-};
-
-const EvenMap& Map() {
-  static const EvenMap map;
-  return map;
-}
-
-Frame MakeFrame(const cv::Mat& image, int index, int source_index) {
-  Frame frame;
-  frame.index = index;
-  frame.source_index = source_index;
-  cv::cvtColor(image, frame.gray, cv::COLOR_BGR2GRAY);
-  frame.color = image;
-  return frame;
-}
-
-LocalizationResult LocalizeImage(Localizer& localizer, const cv::Mat& image, int index, int source_index) {
-  const Frame frame = MakeFrame(image, index, source_index);
-  const auto features = Map().opened.matcher->Extract(frame.gray);
-  return localizer.Localize(frame, *features);
-}
-
-bool Brackets(const VisualMap& map, int source_index, int key) {
-  const auto [before, after] = KeysAround(map, source_index);
-  return key >= 0 && (key == before || key == after);
-}
 
 TEST(Localizer, TheMapHasSeveralKeyImages) {
   // The tests below are only meaningful with a route of several segments.
-  EXPECT_GE(Map().opened.map.key_images.size(), 4u);
+  EXPECT_GE(EvenDriveMap().map.key_images.size(), 4u);
 }
 
 TEST(Localizer, EveryOddFrameIsLocalizedBetweenTheKeyImagesAroundIt) {
-  const LocalizationMap& m = Map().opened;
+  const LocalizationMap& m = EvenDriveMap();
   Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
   ::vmap::testing::MemorySource source(DriveFrames(1, 2), DriveIndices(1, 2));
   LocalizeSequenceOptions run;
@@ -107,14 +73,14 @@ TEST(Localizer, EveryOddFrameIsLocalizedBetweenTheKeyImagesAroundIt) {
 }
 
 TEST(Localizer, ProgressGrowsAlongASegment) {
-  const LocalizationMap& m = Map().opened;
+  const LocalizationMap& m = EvenDriveMap();
   Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
   // Correlate the estimated progress with the true position between the two key images.
   std::vector<double> estimated, truth;
   const auto frames = DriveFrames(1, 2);
   const auto indices = DriveIndices(1, 2);
   for (size_t i = 0; i < frames.size(); ++i) {
-    const LocalizationResult r = LocalizeImage(localizer, frames[i], static_cast<int>(i), indices[i]);
+    const LocalizationResult r = LocalizeOnEvenMap(localizer, frames[i], static_cast<int>(i), indices[i]);
     const auto [before, after] = KeysAround(m.map, indices[i]);
     if (r.key != before || r.next_key != after || !std::isfinite(r.progress)) continue;
     const double a = m.map.key_images[before].source_index, b = m.map.key_images[after].source_index;
@@ -129,154 +95,8 @@ TEST(Localizer, ProgressGrowsAlongASegment) {
   EXPECT_GT(covariance / (std_e.at<double>(0) * std_t.at<double>(0)), 0.5);
 }
 
-TEST(Localizer, RelocalizesAFrameFromTheMiddleAfterReset) {
-  const LocalizationMap& m = Map().opened;
-  Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
-  for (int source_index : {37, 11, 53, 25}) {
-    localizer.Reset();
-    ASSERT_FALSE(localizer.has_estimate());
-    const LocalizationResult r = LocalizeImage(localizer, SidewaysDrive().frames[source_index], 0, source_index);
-    EXPECT_EQ(r.status, LocalizationStatus::kRelocalized);
-    EXPECT_TRUE(Brackets(m.map, source_index, r.key)) << "frame " << source_index << " at key " << r.key;
-    EXPECT_FALSE(r.candidates.empty());
-    EXPECT_TRUE(localizer.has_estimate());
-  }
-}
-
-TEST(Localizer, AnUnrelatedImageIsLostAndTheEstimateIsDroppedAfterMaxLostFrames) {
-  const LocalizationMap& m = Map().opened;
-  LocalizerOptions options = MapLocalizerOptions(m);
-  options.max_lost_frames = 2;
-  // The tracker's own rule; the belief would place blind frames after a confident run at its best guess
-  // (Localizer.FramesThatVerifyNothingAfterAConfidentRunAreCarriedByTheBelief).
-  options.belief.window = 0;
-  Localizer localizer(m.map, m.keys, *m.matcher, options);
-  // Noise shares no scene point with the map.
-  cv::Mat noise(SidewaysDrive().frames[0].size(), CV_8UC3);
-  cv::RNG rng(3);
-  rng.fill(noise, cv::RNG::UNIFORM, 0, 255);
-  LocalizationResult r = LocalizeImage(localizer, noise, 0, 0);
-  EXPECT_EQ(r.status, LocalizationStatus::kLost);
-  EXPECT_EQ(r.key, -1);
-  EXPECT_EQ(r.key_rank, -1) << "no key image: no rank";
-  EXPECT_FALSE(MaySteerBy(r));
-  EXPECT_EQ(r.next_key, -1);
-  EXPECT_FALSE(localizer.has_estimate());
-
-  r = LocalizeImage(localizer, SidewaysDrive().frames[21], 1, 21);
-  EXPECT_EQ(r.status, LocalizationStatus::kRelocalized);
-  const int key = r.key;
-  for (int i = 0; i < 2; ++i) {
-    r = LocalizeImage(localizer, noise, 2 + i, 0);
-    EXPECT_EQ(r.status, LocalizationStatus::kLost);
-    EXPECT_EQ(r.key, key) << "a lost frame keeps the last estimate";
-    EXPECT_TRUE(localizer.has_estimate());
-  }
-  r = LocalizeImage(localizer, noise, 4, 0);
-  EXPECT_EQ(r.status, LocalizationStatus::kLost);
-  EXPECT_FALSE(localizer.has_estimate()) << "dropped after max_lost_frames + 1 lost frames in a row";
-  // A frame inside a segment: one right after a key image is as much "at the end of the segment before" it
-  // (RelocalizesAFrameFromTheMiddleAfterReset covers the choice between the two segments).
-  r = LocalizeImage(localizer, SidewaysDrive().frames[33], 5, 33);
-  EXPECT_EQ(r.status, LocalizationStatus::kRelocalized);
-  EXPECT_TRUE(Brackets(m.map, 33, r.key));
-}
-
-// The drive's odd frames with all but a vertical strip `visible` of the width wide hidden behind noise: little
-// of the scene is left, and the noise adds tentative matches that chance explains, so S is low.
-std::vector<cv::Mat> MostlyHidden(double visible) {
-  std::vector<cv::Mat> frames = DriveFrames(1, 2);
-  cv::RNG rng(17);
-  for (cv::Mat& frame : frames) {
-    cv::Mat noise(frame.size(), frame.type());
-    rng.fill(noise, cv::RNG::UNIFORM, 0, 255);
-    const int first_hidden = static_cast<int>(visible * frame.cols);
-    const cv::Rect covered(first_hidden, 0, frame.cols - first_hidden, frame.rows);
-    frame = frame.clone();
-    noise(covered).copyTo(frame(covered));
-  }
-  return frames;
-}
-
-std::vector<LocalizationResult> LocalizeAll(const LocalizerOptions& options, std::vector<cv::Mat> frames,
-                                            std::vector<int> indices) {
-  const LocalizationMap& m = Map().opened;
-  Localizer localizer(m.map, m.keys, *m.matcher, options);
-  ::vmap::testing::MemorySource source(std::move(frames), std::move(indices));
-  LocalizeSequenceOptions run;
-  run.show_progress = false;
-  std::vector<LocalizationResult> results;
-  LocalizeSequence(source, *m.matcher, localizer, run,
-                   [&](const Frame&, const LocalizationResult& r) { results.push_back(r); });
-  return results;
-}
-
-TEST(Localizer, AFrameThatShowsLittleOfTheSceneIsStillLocalizedByItsChance) {
-  // The earlier rule (S >= 0.3) loses frames that keep a few dozen verified matches among many chance ones;
-  // the chance of those verified matches says they see the scene.
-  const LocalizationMap& m = Map().opened;
-  LocalizerOptions chance = MapLocalizerOptions(m);
-  ASSERT_EQ(chance.acceptance, AcceptanceRule::kChance) << "the default";
-  chance.min_link_share = 0.0;  // chance alone: the test is about its rule
-  chance.min_heading_rival_ratio = 0.0;
-  chance.belief.window = 0;  // frames placed by the acceptance rule, not by the belief's best guess
-  LocalizerOptions counts = chance;
-  counts.acceptance = AcceptanceRule::kCounts;
-  const std::vector<LocalizationResult> by_chance = LocalizeAll(chance, MostlyHidden(0.35), DriveIndices(1, 2));
-  const std::vector<LocalizationResult> by_counts = LocalizeAll(counts, MostlyHidden(0.35), DriveIndices(1, 2));
-  ASSERT_EQ(by_chance.size(), 30u);
-  int chance_localized = 0, bracketed = 0, counts_localized = 0, low_similarity = 0;
-  for (size_t i = 0; i < by_chance.size(); ++i) {
-    const LocalizationResult& r = by_chance[i];
-    counts_localized += by_counts[i].status != LocalizationStatus::kLost;
-    if (r.status == LocalizationStatus::kLost) continue;
-    ++chance_localized;
-    bracketed += Brackets(m.map, r.source_index, r.key);
-    EXPECT_LE(r.to_key.log10_nfa, chance.max_log10_nfa);
-    low_similarity += r.to_key.similarity < counts.min_similarity;
-  }
-  // The visible strip shares the far plane with key images well behind, so a frame may be placed there: it
-  // does see them, but the bracket counts it wrong. Nearly all are at a key image around them.
-  EXPECT_GE(10 * bracketed, 9 * chance_localized);
-  EXPECT_GE(low_similarity, 3) << "frames S would have refused were localized";
-  EXPECT_GT(bracketed, counts_localized) << "the earlier rule gives up on more of them";
-  std::printf(
-      "mostly hidden frames localized: %d by chance (%d at a key image around them), %d by counts; %d with "
-      "S < %.1f\n",
-      chance_localized, bracketed, counts_localized, low_similarity, counts.min_similarity);
-}
-
-TEST(Localizer, ASceneOfOtherTexturesIsNeverAccepted) {
-  // The same kind of scene (planes with blobs and boxes, the same drive), other textures: nothing is shared,
-  // though the images look alike and give ORB plenty of tentative matches.
-  ::vmap::testing::SyntheticOptions other;
-  other.num_frames = 60;
-  other.step = 0.05;
-  other.yaw_per_frame = 0.003;
-  other.seed = 8;
-  const auto elsewhere = ::vmap::testing::RenderSyntheticSequence(other);
-  std::vector<cv::Mat> frames;
-  std::vector<int> indices;
-  for (int i = 1; i < other.num_frames; i += 2) {
-    frames.push_back(elsewhere.frames[i]);
-    indices.push_back(i);
-  }
-  LocalizerOptions chance = MapLocalizerOptions(Map().opened);
-  chance.acceptance = AcceptanceRule::kChance;
-  int candidates = 0;
-  for (const LocalizationResult& r : LocalizeAll(chance, frames, indices)) {
-    EXPECT_EQ(r.status, LocalizationStatus::kLost) << "frame " << r.source_index << " at key " << r.key;
-    for (const RelocalizationCandidate& c : r.candidates) {
-      EXPECT_FALSE(c.accepted);
-      EXPECT_GT(c.log10_nfa, 0.0);
-      ++candidates;
-    }
-  }
-  EXPECT_GE(candidates, 30) << "every frame was relocalized against the best-ranked key images";
-}
-
 TEST(Localizer, FollowsAReversedRouteWhenTheFramesComeBackwards) {
-  const LocalizationMap& m = Map().opened;
+  const LocalizationMap& m = EvenDriveMap();
   LocalizerOptions options = MapLocalizerOptions(m);
   for (int k = static_cast<int>(m.map.key_images.size()) - 1; k >= 0; --k) options.route.push_back(k);
   Localizer localizer(m.map, m.keys, *m.matcher, options);
@@ -284,7 +104,7 @@ TEST(Localizer, FollowsAReversedRouteWhenTheFramesComeBackwards) {
   int frame_index = 22;
   for (int source_index = 59; source_index > 0; source_index -= 2) {
     const LocalizationResult r =
-        LocalizeImage(localizer, SidewaysDrive().frames[source_index], frame_index++, source_index);
+        LocalizeOnEvenMap(localizer, SidewaysDrive().frames[source_index], frame_index++, source_index);
     EXPECT_NE(r.status, LocalizationStatus::kLost) << "frame " << source_index;
     EXPECT_TRUE(Brackets(m.map, source_index, r.key)) << "frame " << source_index << " at key " << r.key;
     EXPECT_LE(r.key, previous_key);
@@ -295,74 +115,18 @@ TEST(Localizer, FollowsAReversedRouteWhenTheFramesComeBackwards) {
   }
 }
 
-// A lost frame's relocalization is matched guided (LocalizerOptions::guided_relocalization): across lighting a frame
-// the robot was carried to verifies nothing with cross-checked matches, at the tracked key images or at the ranking's
-// best, while its one-way guided matches with the ranking's best pass chance (corridor_conditions' kidnapped run,
-// repeat frame 24: key image 9 at log10 NFA +0.9 cross-checked, -10.3 guided). Here the far frame's first comparisons
-// are given as chance refuses them, those at the tracked place below the link share too (guided matching there does
-// not ask): the frame is relocalized where it is, and lost without the rule.
-TEST(Localizer, ALostFramesRelocalizationIsMatchedGuidedAtTheRankingsBest) {
-  const LocalizationMap& m = Map().opened;
-  const int num_keys = static_cast<int>(m.map.key_images.size());
-  for (const bool guided : {true, false}) {
-    LocalizerOptions options = MapLocalizerOptions(m);
-    ASSERT_TRUE(options.guided_relocalization) << "the default";
-    options.guided_relocalization = guided;
-    // Guided matching alone: compared again with more features, the frame is relocalized without it too.
-    options.lost_frame_features = 0;
-    // The tracker's own decisions: a far place taken on one frame (TakesJump), and no frame made uncertain.
-    options.belief.window = 0;
-    options.belief.min_confidence = 0.0;
-    // The comparisons given stand for the frame's own, verified in full (a far one would be made again with fewer
-    // iterations).
-    options.far_comparison_iterations = 0;
-    Localizer localizer(m.map, m.keys, *m.matcher, options);
-    int index = 0;
-    LocalizationResult r;
-    for (int source_index : {1, 3, 5}) {
-      r = LocalizeImage(localizer, SidewaysDrive().frames[source_index], index++, source_index);
-    }
-    ASSERT_EQ(r.status, LocalizationStatus::kTracking);
-    const int tracked = r.route_position;
-    const int far_frame = 51;
-    ASSERT_FALSE(Brackets(m.map, far_frame, r.key)) << "a far place";
-    std::vector<KeyComparison> refused;
-    for (int key = 0; key < num_keys; ++key) {
-      KeyComparison c;
-      c.key = key;
-      c.matched = true;
-      c.num_tentative = 300;
-      c.num_verified = std::abs(key - tracked) <= 2 ? 0 : 200;
-      c.similarity = 0.1;
-      c.log10_nfa = 5.0;
-      refused.push_back(c);
-    }
-    const Frame frame = MakeFrame(SidewaysDrive().frames[far_frame], index++, far_frame);
-    r = localizer.Localize(frame, *m.matcher->Extract(frame.gray), refused);
-    if (guided) {
-      EXPECT_EQ(r.status, LocalizationStatus::kRelocalized);
-      EXPECT_TRUE(Brackets(m.map, far_frame, r.key)) << "at key " << r.key;
-      const KeyComparison& accepted = r.to_key.accepted ? r.to_key : r.to_next;
-      EXPECT_TRUE(accepted.accepted);
-      EXPECT_LE(accepted.log10_nfa, options.max_log10_nfa);
-    } else {
-      EXPECT_EQ(r.status, LocalizationStatus::kLost);
-    }
-  }
-}
-
 // Near `key` the key image before it is compared too, in case the frame is behind `key`. Once that comparison
 // finds it clearly worse, it is spared while the frame does not move back (here: the same frame again), and
 // made again once the frame does (here: back at the previous key image, where the estimate must go).
 TEST(Localizer, AStepBackRuledOutIsCheckedAgainOnceTheFrameMovesBack) {
-  const LocalizationMap& m = Map().opened;
+  const LocalizationMap& m = EvenDriveMap();
   const std::vector<KeyImage>& keys = m.map.key_images;
   ASSERT_GE(keys.size(), 4u);
   Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
   const auto& frames = SidewaysDrive().frames;
   int frame_index = 0;
   auto localize = [&](int source_index) {
-    return LocalizeImage(localizer, frames[source_index], frame_index++, source_index);
+    return LocalizeOnEvenMap(localizer, frames[source_index], frame_index++, source_index);
   };
   const int k = 2;
   const int at = keys[k].source_index;
@@ -386,7 +150,7 @@ TEST(Localizer, AStepBackRuledOutIsCheckedAgainOnceTheFrameMovesBack) {
 // A pose costs as much as a verification, and only the target's guides the robot: the other comparisons carry
 // their verified matches, from which AddPose gives the same pose on demand.
 TEST(Localizer, OnlyTheTargetComparisonIsPosed) {
-  const LocalizationMap& m = Map().opened;
+  const LocalizationMap& m = EvenDriveMap();
   LocalizerOptions options = MapLocalizerOptions(m);
   const cv::Matx33d K = SidewaysDrive().K;
   options.camera = Camera::Make(K(0, 0), K(1, 1), K(0, 2), K(1, 2));
@@ -395,7 +159,7 @@ TEST(Localizer, OnlyTheTargetComparisonIsPosed) {
   const auto indices = DriveIndices(1, 2);
   int checked = 0;
   for (size_t i = 0; i < frames.size(); ++i) {
-    const LocalizationResult r = LocalizeImage(localizer, frames[i], static_cast<int>(i), indices[i]);
+    const LocalizationResult r = LocalizeOnEvenMap(localizer, frames[i], static_cast<int>(i), indices[i]);
     if (r.next_key < 0 || !r.to_key.matched || !r.to_next.matched) continue;
     ++checked;
     EXPECT_TRUE(r.to_next.pose.valid) << "frame " << indices[i];
@@ -415,13 +179,63 @@ TEST(Localizer, OnlyTheTargetComparisonIsPosed) {
   EXPECT_GE(checked, 20);
 }
 
+// ORB's comparisons with key images away from the tracker's (LocalizerOptions::far_comparison_iterations) are verified
+// with fewer MAGSAC iterations; those of the tracker's own key images, and every one of a frame without an estimate, in
+// full. Here the cap is one iteration, which verifies fewer matches than the full run at some far key image: a frame
+// tracked near the start, then a frame from far along the route, its tracked key images given refused, relocalized;
+// its far candidates are as Compare gives them with that cap. Without an estimate, as Compare gives them in full.
+TEST(Localizer, TheComparisonsAwayFromTheTrackerAreVerifiedWithFewerIterations) {
+  const LocalizationMap& m = DenseDriveMap();
+  LocalizerOptions options = MapLocalizerOptions(m);
+  options.far_comparison_iterations = 1;
+  // The candidates as first compared: not compared again guided or with more features.
+  options.guided_relocalization = false;
+  options.lost_frame_features = 0;
+  options.belief.window = 0;  // the tracker's own decisions
+  options.belief.min_confidence = 0.0;
+  Localizer localizer(m.map, m.keys, *m.matcher, options);
+  int index = 0;
+  LocalizationResult r;
+  for (int source_index : {1, 3, 5}) r = LocalizeOnDenseMap(localizer, source_index, index++);
+  ASSERT_EQ(r.status, LocalizationStatus::kTracking);
+  const int tracked = r.route_position;  // the route is the key images in order
+  const int last_near = tracked + options.lookahead + 1;
+  const int far_frame = 51;
+  std::vector<KeyComparison> refused;
+  for (int key = std::max(0, tracked - 1); key <= last_near; ++key)
+    refused.push_back(GivenComparison(key, false, 0, 0));
+  ::vmap::testing::MemorySource source({SidewaysDrive().frames[far_frame]}, {far_frame});
+  Frame frame = *source.Next();
+  frame.index = index++;
+  const auto features = m.matcher->Extract(frame.gray);
+  r = localizer.Localize(frame, *features, refused);
+  int far = 0, capped_differs = 0;
+  for (const RelocalizationCandidate& c : r.candidates) {
+    if (c.key >= tracked - 1 && c.key <= last_near) continue;  // given
+    const KeyComparison expected = localizer.Compare(*features, c.key, options.far_comparison_iterations);
+    EXPECT_EQ(c.num_verified, expected.num_verified) << "key " << c.key;
+    EXPECT_EQ(c.log10_nfa, expected.log10_nfa) << "key " << c.key;
+    ++far;
+    capped_differs += localizer.Compare(*features, c.key).num_verified != expected.num_verified;
+  }
+  ASSERT_GT(far, 0) << "relocalized at far key images";
+  ASSERT_GT(capped_differs, 0) << "one iteration verifies as many as the full run: the test cannot tell";
+  localizer.Reset();
+  ASSERT_FALSE(localizer.has_estimate());
+  r = localizer.Localize(frame, *features);
+  ASSERT_FALSE(r.candidates.empty());
+  for (const RelocalizationCandidate& c : r.candidates) {
+    EXPECT_EQ(c.num_verified, localizer.Compare(*features, c.key).num_verified) << "key " << c.key;
+  }
+}
+
 TEST(Localizer, SameInputSameResults) {
-  const LocalizationMap& m = Map().opened;
+  const LocalizationMap& m = EvenDriveMap();
   std::vector<LocalizationResult> runs[2];
   for (auto& results : runs) {
     Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
     for (int source_index : {9, 11, 13, 41, 43}) {
-      results.push_back(LocalizeImage(localizer, SidewaysDrive().frames[source_index], 0, source_index));
+      results.push_back(LocalizeOnEvenMap(localizer, SidewaysDrive().frames[source_index], 0, source_index));
     }
   }
   for (size_t i = 0; i < runs[0].size(); ++i) {
@@ -436,7 +250,7 @@ TEST(Localizer, SameInputSameResults) {
 // (LocalizerOptions::still_frame_share): the same image again, or a copy with a camera's noise, stands still against
 // it; the next frame of a drive, a few pixels on, does not; nor does anything with the share 0.
 TEST(Localizer, AFrameStandsStillAgainstItsOwnImageOrANoisyCopyNotTheNextFrame) {
-  const Matcher& matcher = *Map().opened.matcher;
+  const Matcher& matcher = *EvenDriveMap().matcher;
   const auto features_of = [&](const cv::Mat& bgr) {
     cv::Mat gray;
     cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
@@ -457,7 +271,7 @@ TEST(Localizer, AFrameStandsStillAgainstItsOwnImageOrANoisyCopyNotTheNextFrame) 
 }
 
 TEST(Localizer, ComparingAheadOnTheWorkersChangesNothing) {
-  const LocalizationMap& m = Map().opened;
+  const LocalizationMap& m = EvenDriveMap();
   std::vector<LocalizationResult> runs[2];
   for (int i = 0; i < 2; ++i) {
     Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
@@ -491,7 +305,7 @@ TEST(Localizer, ComparingAheadOnTheWorkersChangesNothing) {
 }
 
 TEST(Localizer, OptionsAreChecked) {
-  const LocalizationMap& m = Map().opened;
+  const LocalizationMap& m = EvenDriveMap();
   auto with = [&](auto change) {
     LocalizerOptions options = MapLocalizerOptions(m);
     change(options);

@@ -1,0 +1,215 @@
+// The promises of docs/promises.md for the output folders (maps, sweeps, reports), each tested on the binary with
+// several inputs:
+// 1. vmap replaces only what it can prove it wrote, never its input;
+// 3. an interrupted run (SIGINT, SIGTERM, SIGKILL) leaves nothing behind.
+
+#include <signal.h>
+
+#include <chrono>
+#include <fstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "vmap/map/map_io.h"
+#include "vmap/testing/promises_test_util.h"
+#include "vmap/testing/run_vmap.h"
+#include "vmap/testing/scoped_temp_dir.h"
+
+namespace vmap {
+namespace fs = std::filesystem;
+using testing::BuildMapWithBinary;
+using testing::EntriesStartingWith;
+using testing::Quote;
+using testing::ReadText;
+using testing::RunVmap;
+using testing::WriteSyntheticInput;
+
+namespace {
+
+// Waits until `directory` holds an entry starting with `prefix` (the run has started writing).
+bool AppearsWithin(const fs::path& directory, const std::string& prefix, double seconds) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (!EntriesStartingWith(directory, prefix).empty()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return false;
+}
+
+}  // namespace
+
+// ---- 1. Ownership -------------------------------------------------------------------------------------------
+
+TEST(Promises, OutputsVmapCannotProveItsOwnAreNeverReplaced) {
+  testing::ScopedTempDir tmp;
+  WriteSyntheticInput(tmp.path() / "in", 6);
+  const std::string in = Quote(tmp.path() / "in");
+  // The issue's case: a project folder with a map.json that is not a vmap map.
+  const fs::path project = tmp.path() / "p";
+  fs::create_directories(project / "src");
+  fs::create_directories(project / ".git");
+  std::ofstream(project / "map.json") << R"({"type":"FeatureCollection"})";
+  std::ofstream(project / "src/app.js") << "x";
+  // A folder with a sweep.json that is not vmap's, a vmap map given as a sweep's output, a folder with a
+  // report.html of its own, a plain file, a link to a vmap map.
+  fs::create_directories(tmp.path() / "results");
+  std::ofstream(tmp.path() / "results/sweep.json") << "{}";
+  std::ofstream(tmp.path() / "results/data.csv") << "1,2";
+  BuildMapWithBinary(tmp.path() / "in", tmp.path() / "real_map");
+  fs::create_directories(tmp.path() / "site");
+  std::ofstream(tmp.path() / "site/report.html") << "<p>my page</p>";
+  std::ofstream(tmp.path() / "notes.txt") << "notes";
+  fs::create_directory_symlink(tmp.path() / "real_map", tmp.path() / "map_link");
+  struct Case {
+    std::string arguments, expected;
+  };
+  const std::vector<Case> cases = {
+      {"build " + in + " -o " + Quote(project), "is not a vmap map"},
+      {"build " + in + " -o " + Quote(tmp.path() / "results"), "it has no map.json"},
+      {"sweep " + in + " --thresholds 0.5 -o " + Quote(tmp.path() / "results"), "not a vmap sweep's"},
+      {"sweep " + in + " --thresholds 0.5 -o " + Quote(tmp.path() / "real_map"), "it has no sweep.json"},
+      {"sweep " + in + " --thresholds 0.5 --report " + Quote(tmp.path() / "site"), "is not a vmap sweep"},
+      {"build " + in + " -o " + Quote(tmp.path() / "notes.txt"), "is not a directory"},
+      {"build " + in + " -o " + Quote(tmp.path() / "map_link"), "symbolic link"},
+  };
+  for (const Case& c : cases) {
+    std::string out;
+    EXPECT_EQ(RunVmap(c.arguments, &out), 2) << c.arguments << "\n" << out;
+    EXPECT_NE(out.find("vmap: error: output '"), std::string::npos) << out;
+    EXPECT_NE(out.find(c.expected), std::string::npos) << c.arguments << "\n" << out;
+  }
+  EXPECT_EQ(ReadText(project / "src/app.js"), "x");
+  EXPECT_TRUE(fs::is_directory(project / ".git"));
+  EXPECT_EQ(ReadText(tmp.path() / "results/data.csv"), "1,2");
+  EXPECT_EQ(ReadText(tmp.path() / "site/report.html"), "<p>my page</p>");
+  EXPECT_EQ(ReadText(tmp.path() / "notes.txt"), "notes");
+  EXPECT_NO_THROW(ReadMap(tmp.path() / "real_map"));
+  EXPECT_TRUE(fs::is_symlink(tmp.path() / "map_link"));
+  EXPECT_TRUE(EntriesStartingWith(tmp.path(), ".").empty()) << "no temporary left";
+}
+
+TEST(Promises, VmapReplacesWhatItWrote) {
+  testing::ScopedTempDir tmp;
+  WriteSyntheticInput(tmp.path() / "in", 6);
+  const std::string in = Quote(tmp.path() / "in");
+  std::string out;
+  for (int run = 0; run < 2; ++run) {
+    ASSERT_EQ(RunVmap("build " + in + " -o " + Quote(tmp.path() / "m") + " --report", &out), 0) << out;
+    ASSERT_EQ(RunVmap("sweep " + in + " --thresholds 0.4,0.8 -o " + Quote(tmp.path() / "s") + " --maps --report " +
+                          Quote(tmp.path() / "s"),
+                      &out),
+              0)
+        << out;
+    ASSERT_EQ(RunVmap("sweep " + in + " --thresholds 0.4,0.8 --report " + Quote(tmp.path() / "page"), &out), 0) << out;
+    ASSERT_EQ(RunVmap("report " + Quote(tmp.path() / "m"), &out), 0) << out;
+  }
+  EXPECT_TRUE(fs::exists(tmp.path() / "page/report.html"));
+  EXPECT_TRUE(fs::exists(tmp.path() / "page/sweep.json")) << "a report folder of its own is a sweep folder";
+  EXPECT_TRUE(fs::exists(tmp.path() / "s/report.html"));
+  EXPECT_TRUE(EntriesStartingWith(tmp.path(), ".").empty());
+  EXPECT_TRUE(EntriesStartingWith(tmp.path() / "m", ".").empty());
+}
+
+TEST(Promises, TheInputIsNeverInsideTheOutputNorTheOutputInsideTheInput) {
+  testing::ScopedTempDir tmp;
+  WriteSyntheticInput(tmp.path() / "in", 6);
+  BuildMapWithBinary(tmp.path() / "in", tmp.path() / "s");
+  BuildMapWithBinary(tmp.path() / "in", tmp.path() / "old_map");
+  fs::create_directory_symlink(tmp.path() / "s/keys", tmp.path() / "keys_link");
+  const std::string before = ReadText(tmp.path() / "s/map.json");
+  struct Case {
+    std::string arguments, expected;
+  };
+  const std::vector<Case> cases = {
+      // The issue's case: `cp -r old_map s; vmap build s/keys -o s`.
+      {"build " + Quote(tmp.path() / "s/keys") + " -o " + Quote(tmp.path() / "s"), "is or holds the input"},
+      {"build " + Quote(tmp.path() / "keys_link") + " -o " + Quote(tmp.path() / "s"), "is or holds the input"},
+      {"build " + Quote(tmp.path() / "s/keys/../keys") + " -o " + Quote(tmp.path() / "s/"), "is or holds the input"},
+      {"sweep " + Quote(tmp.path() / "s/keys") + " --thresholds 0.5 -o " + Quote(tmp.path() / "s/keys"),
+       "is or holds the input"},
+      {"build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "in/map"), "lies inside the input"},
+      {"sweep " + Quote(tmp.path() / "in") + " --thresholds 0.5 --report " + Quote(tmp.path() / "in"),
+       "is or holds the input"},
+  };
+  for (const Case& c : cases) {
+    std::string out;
+    EXPECT_EQ(RunVmap(c.arguments, &out), 2) << c.arguments << "\n" << out;
+    EXPECT_NE(out.find(c.expected), std::string::npos) << c.arguments << "\n" << out;
+  }
+  EXPECT_EQ(ReadText(tmp.path() / "s/map.json"), before);
+  EXPECT_NO_THROW(ReadMap(tmp.path() / "s"));
+  EXPECT_FALSE(fs::exists(tmp.path() / "in/map"));
+}
+
+// ---- 3. Interrupted runs ------------------------------------------------------------------------------------
+
+TEST(Promises, SigintOrSigtermLeaveNothingBehindAndTheOldOutputIntact) {
+  testing::ScopedTempDir tmp;
+  WriteSyntheticInput(tmp.path() / "in", 150);
+  BuildMapWithBinary(tmp.path() / "in", tmp.path() / "m", "--last 9");
+  const std::string old_map = ReadText(tmp.path() / "m/map.json");
+  struct Case {
+    std::vector<std::string> arguments;
+    fs::path watched;    // where the run's temporary appears
+    std::string prefix;  // its name's start
+    int signal_number;
+  };
+  const std::string in = (tmp.path() / "in").string();
+  const std::vector<Case> cases = {
+      {{"build", in, "-o", (tmp.path() / "m").string(), "--threads", "1"}, tmp.path(), ".m.partial-", SIGINT},
+      {{"sweep", in, "--thresholds", "0.3,0.6,0.9", "-o", (tmp.path() / "s").string(), "--maps", "--threads", "1"},
+       tmp.path(),
+       ".s.partial-",
+       SIGTERM},
+      {{"build", in, "-o", (tmp.path() / "m2").string(), "--threads", "1"}, tmp.path(), ".m2.partial-", SIGHUP},
+  };
+  for (const Case& c : cases) {
+    testing::BackgroundVmap process(c.arguments, tmp.path() / "log.txt");
+    ASSERT_TRUE(AppearsWithin(c.watched, c.prefix, 30.0)) << c.arguments[0];
+    process.Signal(c.signal_number);
+    EXPECT_EQ(process.Wait(), 128 + c.signal_number) << ReadText(tmp.path() / "log.txt");
+    EXPECT_NE(ReadText(tmp.path() / "log.txt").find("vmap: interrupted"), std::string::npos);
+    EXPECT_EQ(EntriesStartingWith(tmp.path(), "."), std::vector<std::string>())
+        << c.arguments[0] << " left a temporary";
+  }
+  EXPECT_EQ(ReadText(tmp.path() / "m/map.json"), old_map) << "the old map is intact";
+  EXPECT_FALSE(fs::exists(tmp.path() / "s"));
+  EXPECT_FALSE(fs::exists(tmp.path() / "m2"));
+}
+
+TEST(Promises, AnInterruptedReportLeavesTheMapAsItWas) {
+  testing::ScopedTempDir tmp;
+  WriteSyntheticInput(tmp.path() / "in", 150);
+  BuildMapWithBinary(tmp.path() / "in", tmp.path() / "m", "--tau 0.99");  // many key images: a report of some length
+  ASSERT_GT(ReadMap(tmp.path() / "m").key_images.size(), 20u);
+  testing::BackgroundVmap process({"report", (tmp.path() / "m").string()}, tmp.path() / "log.txt");
+  ASSERT_TRUE(AppearsWithin(tmp.path() / "m", ".report.partial-", 30.0));
+  process.Signal(SIGINT);
+  EXPECT_EQ(process.Wait(), 128 + SIGINT) << ReadText(tmp.path() / "log.txt");
+  EXPECT_TRUE(EntriesStartingWith(tmp.path() / "m", ".").empty());
+  EXPECT_FALSE(fs::exists(tmp.path() / "m/report"));
+  EXPECT_FALSE(fs::exists(tmp.path() / "m/report.html"));
+  EXPECT_NO_THROW(ReadMap(tmp.path() / "m"));
+}
+
+TEST(Promises, TemporariesOfAKilledRunAreRemovedByTheNextRun) {
+  testing::ScopedTempDir tmp;
+  WriteSyntheticInput(tmp.path() / "in", 150);
+  testing::BackgroundVmap process(
+      {"build", (tmp.path() / "in").string(), "-o", (tmp.path() / "m").string(), "--threads", "1"},
+      tmp.path() / "log.txt");
+  ASSERT_TRUE(AppearsWithin(tmp.path(), ".m.partial-", 30.0));
+  process.Signal(SIGKILL);  // no clean-up is possible
+  EXPECT_EQ(process.Wait(), 128 + SIGKILL);
+  const std::vector<std::string> left = EntriesStartingWith(tmp.path(), ".m.partial-");
+  ASSERT_EQ(left.size(), 1u);
+  // A live process's temporary (pid 1 always runs) is not touched.
+  fs::create_directories(tmp.path() / ".m.partial-1-77");
+  BuildMapWithBinary(tmp.path() / "in", tmp.path() / "m", "--last 9");
+  EXPECT_FALSE(fs::exists(tmp.path() / left[0]));
+  EXPECT_TRUE(fs::exists(tmp.path() / ".m.partial-1-77"));
+  EXPECT_NO_THROW(ReadMap(tmp.path() / "m"));
+}
+
+}  // namespace vmap
