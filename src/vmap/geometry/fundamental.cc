@@ -10,6 +10,7 @@
 #include "vmap/core/error.h"
 #include "vmap/core/json_fields.h"
 #include "vmap/geometry/magsac.h"
+#include "vmap/geometry/seeded_usac.h"
 
 namespace vmap {
 
@@ -99,14 +100,8 @@ FundamentalResult EstimateFromSamples(const std::vector<cv::Point2f>& points0, c
                                options.max_iterations, mask);
   } else {
     // The presets of OpenCV 4.6's flag-based call (usac::setParameters), with the seed made explicit.
-    cv::UsacParams params;
-    params.confidence = options.confidence;
-    params.maxIterations = options.max_iterations;
-    params.threshold = options.threshold;
-    params.randomGeneratorState = options.seed;
-    params.isParallel = false;
-    params.sampler = cv::SAMPLING_UNIFORM;
-    params.neighborsSearch = cv::NEIGH_GRID;
+    cv::UsacParams params =
+        SeededUsacParams(options.confidence, options.max_iterations, options.threshold, options.seed);
     switch (options.method) {
       case VerifierMethod::kMagsac:
         params.score = cv::SCORE_METHOD_MAGSAC;

@@ -8,6 +8,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/core/json_fields.h"
+#include "vmap/geometry/seeded_usac.h"
 
 namespace vmap {
 
@@ -25,14 +26,7 @@ HomographyCheck CheckHomography(const std::vector<cv::Point2f>& from, const std:
   CV_Assert(from.size() == to.size());
   HomographyCheck check;
   if (from.size() < 4) return check;
-  cv::UsacParams params;
-  params.confidence = options.confidence;
-  params.maxIterations = options.max_iterations;
-  params.threshold = options.threshold;
-  params.randomGeneratorState = options.seed;
-  params.isParallel = false;
-  params.sampler = cv::SAMPLING_UNIFORM;
-  params.neighborsSearch = cv::NEIGH_GRID;
+  cv::UsacParams params = SeededUsacParams(options.confidence, options.max_iterations, options.threshold, options.seed);
   params.score = cv::SCORE_METHOD_MSAC;
   params.loMethod = cv::LOCAL_OPTIM_INNER_AND_ITER_LO;
   params.loSampleSize = 14;

@@ -12,6 +12,7 @@
 #include "vmap/core/error.h"
 #include "vmap/core/json_fields.h"
 #include "vmap/geometry/pose_refinement.h"
+#include "vmap/geometry/seeded_usac.h"
 
 namespace vmap {
 
@@ -149,14 +150,7 @@ namespace {
 RelativePose EssentialHypothesis(const std::vector<cv::Point2d>& y_from, const std::vector<cv::Point2d>& y_to,
                                  double normalised_threshold, const PoseOptions& options, int seed) {
   RelativePose pose;
-  cv::UsacParams params;
-  params.confidence = options.confidence;
-  params.maxIterations = options.max_iterations;
-  params.threshold = normalised_threshold;
-  params.randomGeneratorState = seed;
-  params.isParallel = false;
-  params.sampler = cv::SAMPLING_UNIFORM;
-  params.neighborsSearch = cv::NEIGH_GRID;
+  cv::UsacParams params = SeededUsacParams(options.confidence, options.max_iterations, normalised_threshold, seed);
   params.score = cv::SCORE_METHOD_MSAC;
   // No local optimisation inside USAC: the refinement after it does that on the matches' geometric error,
   // and the dropped LO saved a third of the time with the same poses on kitti07 and redkitchen.
