@@ -129,7 +129,7 @@ class Localizer {
   // Below lost_frame_heading_rival_ratio, down to lost_frame_heading_near_ratio, only from kNear behind the estimate
   // the frame starts from to JumpReach ahead of it (kPlacedOnly); down to lost_frame_next_heading_ratio, only at the
   // key image the frame before was placed at or the next, and never the next for a frame that stands still
-  // (kPlacedOnly).
+  // (kPlacedOnly). Whatever the ratio, never beyond kNear of the estimate for a frame that stands still.
   SecondLook AcceptLostFrameByHeading(const std::vector<KeyComparison>& compared, const ImageFeatures& features);
   // The frame stands still against the frame before (StandsStill); false when the frame before's features were not
   // kept.

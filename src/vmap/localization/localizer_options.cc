@@ -165,7 +165,8 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
       lost_frame_next_heading_ratio);
   visitor.Visit({"still_frame_share", "--still-frame-share",
                  "a frame whose matches with the frame before moved less than half a pixel in this share stands "
-                 "still, and is not stepped on by --lost-frame-next-heading-ratio (0: no frame is still)"},
+                 "still: it is not stepped on, nor placed beyond two key images of its estimate by a lost frame's "
+                 "heading (0: no frame is still)"},
                 still_frame_share);
   visitor.Visit({"far_comparison_iterations", "--far-comparison-iterations",
                  "ORB: verify the frame's comparisons with key images away from the tracker's (more than one behind "

@@ -238,7 +238,10 @@ struct LocalizerOptions {
   // matches so). The rule above does not step a still frame on to the key image after the frame before's, nor do the
   // agreement rules (step_on_where_evidence_agrees, step_on_after_lost_frames: the only steps of a stopped robot the
   // stop check measured on main; docs/measurements/localization-conditions.md, "A still frame after lost frames is not
-  // stepped on either"). 0: no frame is still.
+  // stepped on either"), nor is a still frame placed by a lost frame's heading beyond kNear of its estimate, at any
+  // ratio above (its votes are the frame before's evidence counted again: 24 noisy copies of a stopped michigan frame,
+  // 22 frames placed three key images on -> 1, by chance; "A still frame is not placed far by a lost frame's
+  // heading"). 0: no frame is still.
   double still_frame_share = 0.8;
   // ORB: the frame's comparisons with key images away from the tracker's (more than one route position behind the
   // estimate the frame starts from, or more than `lookahead` + 1 ahead of it: the frame's rivals, the ranking's

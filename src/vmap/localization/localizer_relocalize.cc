@@ -166,6 +166,14 @@ Localizer::SecondLook Localizer::AcceptLostFrameByHeading(const std::vector<KeyC
     if (!near && !next) return SecondLook::kNothing;
     look = SecondLook::kPlacedOnly;
   }
+  // A robot that stops cannot have moved several key images on: a frame standing still against the frame before shows
+  // the place that frame showed, and its heading votes are that evidence counted again, which placed nothing there.
+  // Beyond kNear of the estimate it is not placed by them, whichever ratio accepts it (bench/stop_check.py's noisy
+  // row, 12->04 p2: the stopped robot relocalized three key images on by foliage's votes at 1.75 times its place's).
+  if (frame_start_position_ >= 0 && std::abs(position - frame_start_position_) > kNear &&
+      StillSinceFrameBefore(features)) {
+    return SecondLook::kNothing;
+  }
   for (Memo& m : comparisons_) {
     if (m.comparison.key != best->key) continue;
     // Weighed already as its first comparison was: WeighComparisons adds what the heading's acceptance adds.
