@@ -112,7 +112,9 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   ranking_ = std::make_unique<KeyImageRanking>(features, thumbnails, options_.ranking);
   const cv::Mat descriptors = keys_.features.front()->descriptors();
   const bool binary = !descriptors.empty() && descriptors.depth() == CV_8U;
-  evidence_ = binary ? BinaryDescriptorEvidence() : FloatDescriptorEvidence();
+  evidence_ = binary                      ? BinaryDescriptorEvidence()
+              : options_.rank_by_standout ? FloatDescriptorEvidence()
+                                          : FloatDescriptorEvidenceByRank();
   if (!options_.rank_evidence) evidence_.rank_alone.clear();
   start_checked_over_route_ = binary;
   nfa_ranks_key_images_ = binary;
@@ -140,7 +142,9 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   const bool steps_on_next =
       (lost_frame_matcher_ && options_.lost_frame_next_heading_ratio > 0.0) ||
       (heading_accepts_ && (options_.step_on_where_evidence_agrees || options_.step_on_after_lost_frames));
-  keeps_features_before_ = steps_on_next && options_.still_frame_share > 0.0;
+  // So do the questions of a frame that may have been carried off (SceneChangedSinceFrameBefore).
+  const bool asks_scene_change = !binary && options_.scene_change_log10_nfa < 0.0;
+  keeps_features_before_ = (steps_on_next && options_.still_frame_share > 0.0) || asks_scene_change;
   if (options_.comparison_threads > 1) {
     speculation_ = std::make_unique<SpeculativeComparisons>(
         [this](const ImageFeatures& features, int key) { return Compare(features, key, FarComparisonIterations(key)); },
@@ -429,7 +433,13 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     }
   }
   bool doubted = false;  // a lone step back, while a far relocalization verified more (doubt_lone_step_back)
-  if (!AcceptedAgainstRivals(best) && (SharesLittle(best) || pointed_before_ >= 0 || rival_beats)) {
+  // Carried off since the frame before (scene_change_log10_nfa): the key image left may still accept a few chance
+  // matches, which one frame steered by there would follow. Asked only where those are all the frame holds there
+  // (scene_change_tracked_log10_nfa): a frame far beyond chance at its key image is there, whatever the frame before.
+  const bool scene_changed = !AcceptedAgainstRivals(best) &&
+                             best.log10_nfa > options_.scene_change_tracked_log10_nfa &&
+                             SceneChangedSinceFrameBefore(features);
+  if (!AcceptedAgainstRivals(best) && (SharesLittle(best) || pointed_before_ >= 0 || rival_beats || scene_changed)) {
     // Accepted, but with much less than neighbouring key images share: the frame may be elsewhere on the
     // route, in view of this key image's scene. Moved when a ranked key image verifies more matches (a
     // relocalization that is not taken leaves nothing behind: the tracked estimate is set below). Also asked when
@@ -448,7 +458,7 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
       // A far place verifies more, on one frame: no jump yet. The key image behind, all that still verifies where the
       // frames were, holds the tracker as a lost frame's estimate is held: not steered by (the robot may have been
       // carried off; the next frame is asked again and decides).
-      doubted = lone_step_back && options_.doubt_lone_step_back;
+      doubted = (lone_step_back && options_.doubt_lone_step_back) || scene_changed;
     }
   }
   if (best_position < position) stepped_back_from_ = position;

@@ -134,6 +134,9 @@ class Localizer {
   // The frame stands still against the frame before (StandsStill); false when the frame before's features were not
   // kept.
   bool StillSinceFrameBefore(const ImageFeatures& features) const;
+  // The frame does not share the frame before's scene as consecutive frames of a moving robot do (its comparison with
+  // it above scene_change_log10_nfa); false when the frame before's features were not kept, or on binary descriptors.
+  bool SceneChangedSinceFrameBefore(const ImageFeatures& features) const;
   // Key image `key`'s features as lost_frame_matcher_ extracts them, read from the map's directory when first needed.
   const ImageFeatures& LostFrameKeyFeatures(int key);
   // A lost frame steps on where its evidence agrees (LocalizerOptions::step_on_where_evidence_agrees): whether the

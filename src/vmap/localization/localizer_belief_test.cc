@@ -147,6 +147,21 @@ TEST(RouteEvidence, BinaryDescriptorsWeighTheRankingByHowTheVotesStandOut) {
   for (const int bucket : RankingBuckets(model, ranked, 9)) EXPECT_EQ(bucket, -1) << "a blank frame";
 }
 
+// XFeat's ranking too (docs/localize.md, "XFeat's ranking by how its votes stand out"): the first key image of a dark
+// frame whose votes barely stand out of the rest (corridor_conditions' frame 50 at the verifier's seed 5: 65 against
+// 62, 61, ...) weighs less than a first far above them; by rank (the model before) both weighed the same.
+TEST(RouteEvidence, FloatDescriptorsWeighTheRankingByHowTheVotesStandOut) {
+  auto first_weighs = [](const EvidenceModel& model, double first_votes) {
+    std::vector<RankedKey> ranked;
+    for (int k = 0; k < 33; ++k) ranked.push_back({k, k == 0 ? first_votes : k < 3 ? 62.0 : 50.0});  // median 50
+    return RankLogRatio(model, RankingBuckets(model, ranked, 33)[0]);
+  };
+  const EvidenceModel model = FloatDescriptorEvidence();
+  EXPECT_LT(first_weighs(model, 65.0), first_weighs(model, 90.0)) << "(65 - 50) / 7.1 = 2.1 against 5.7";
+  EXPECT_LT(first_weighs(model, 65.0), first_weighs(FloatDescriptorEvidenceByRank(), 65.0))
+      << "by rank the first weighs the most whatever its votes";
+}
+
 // Where the belief weighs a share of the joint model (EvidenceModel::rank_weight), a compared key image weighs that
 // share of it as one not compared does: its comparison adds the share of what it adds to its bucket, and the rest of
 // its model without the ranking (halving the ranking alone left a compared key image in the lowest bucket above the

@@ -46,6 +46,14 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Relocalize a tracked frame with fewer verified matches than this fraction of its key image's "
                  "link, and move it where more verify (0: never)"},
                 recheck_link_share);
+  visitor.Visit({"scene_change_log10_nfa", "--scene-change-log10-nfa",
+                 "Float descriptors: relocalize a tracked frame whose comparison with the frame before has a log10 "
+                 "NFA above this (the robot was carried), uncertain where a far place verifies more (0: never)"},
+                scene_change_log10_nfa);
+  visitor.Visit({"scene_change_tracked_log10_nfa", "--scene-change-tracked-log10-nfa",
+                 "Ask a frame that does not share the frame before's scene again only where its tracked key image's "
+                 "comparison has a log10 NFA above this (-1000: nearly every such frame)"},
+                scene_change_tracked_log10_nfa);
   visitor.Visit({"doubt_lone_step_back", "!--no-doubt-lone-step-back",
                  "Track a frame that stepped back because nothing at or ahead of the key image verified, though a far "
                  "key image verifies more (otherwise it is uncertain)"},
@@ -61,6 +69,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"rank_evidence", "!--no-rank-evidence",
                  "never weigh the belief by the relocalization's ranking of a frame (the comparisons alone)"},
                 rank_evidence);
+  visitor.Visit({"rank_by_standout", "!--no-rank-by-standout",
+                 "weigh the belief by an XFeat (float-descriptor) frame's ranking by the key image's rank, not by how "
+                 "far its votes stand out of the frame's (ORB's always by how far they stand out)"},
+                rank_by_standout);
   visitor.Visit({"verified_ranking_steers", "!--no-verified-ranking-steers",
                  "never steer by an ORB frame the belief doubts before the frame's own ranking, even where its key "
                  "images pass chance and the belief with its ranking singles them out"},
@@ -282,6 +294,15 @@ void LocalizerOptions::Check() const {
     throw OptionError("lost_frame_next_heading_ratio",
                       fmt::format("{} is not 0 (none) nor in [1, 1000] (default {})", lost_frame_next_heading_ratio,
                                   defaults.lost_frame_next_heading_ratio));
+  }
+  if (!(scene_change_log10_nfa >= -1000.0 && scene_change_log10_nfa <= 0.0)) {
+    throw OptionError("scene_change_log10_nfa", fmt::format("{} is outside [-1000, 0] (default {})",
+                                                            scene_change_log10_nfa, defaults.scene_change_log10_nfa));
+  }
+  if (!(scene_change_tracked_log10_nfa >= -1000.0 && scene_change_tracked_log10_nfa <= 0.0)) {
+    throw OptionError("scene_change_tracked_log10_nfa",
+                      fmt::format("{} is outside [-1000, 0] (default {})", scene_change_tracked_log10_nfa,
+                                  defaults.scene_change_tracked_log10_nfa));
   }
   if (!(still_frame_share >= 0.0 && still_frame_share <= 1.0)) {
     throw OptionError("still_frame_share",

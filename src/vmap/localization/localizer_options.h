@@ -62,6 +62,27 @@ struct LocalizerOptions {
   // ranked key image that verifies more matches, if one does: a frame that verifies against a far key image of
   // the same room must not stay there. 0: never (tracking keeps any accepted key image).
   double recheck_link_share = 0.5;
+  // A robot carried elsewhere (a kidnapping, a stretch the camera did not see) still verifies a few chance matches at
+  // the key image it left: across lighting XFeat accepts them there (corridor_conditions' kidnapped run at the
+  // verifier's seed 1: frame 51, carried 30 frames on, tracked on 16 verified at log10 NFA -0.25, 10 key images off).
+  // Consecutive frames of a moving robot share their scene far beyond chance (XFeat, the corridor at seeds 0-3: log10
+  // NFA -50 to -190 between a frame and the one before; -5 to -16 where the run was carried). A tracked frame whose
+  // comparison with the frame before (the map's matcher, verified as a key image's) has a log10 NFA above this is
+  // relocalized as one sharing little with its key image is, and is `uncertain`, not steered by, where a far place
+  // verifies more (the jump itself still needs two frames: Localizer::TakesJump). Float descriptors only (XFeat; ORB
+  // was not measured). 0: never (docs/measurements/localization-conditions.md, "XFeat over the verifier's seeds 4-7,
+  // and three rules measured, none kept", rule 2).
+  double scene_change_log10_nfa = -30.0;
+  // ... and only where the tracked key image's own comparison with the frame has a log10 NFA above this: a frame held
+  // there by little beyond chance. A michigan_seasons route's places never share a scene, so there the frame before
+  // asks every frame again, and a right frame tracked far beyond chance (02 -> 03 frame 2: -320) had its step on undone
+  // by its ranking (with rank_by_standout, michigan XFeat at the verifier's seed 0: 653 -> 646 right and not uncertain,
+  // 6 -> 11 wrong). The
+  // frames the rule is for are tracked at -0.25 to -6.1 (the kidnapped run's frame 51 after the carry; michigan 03 ->
+  // 08's places 4 and 5 at seed 2); the right frames it undid, at -13.8 to -320 (docs/measurements/
+  // localization-conditions.md, "Rules 2 and 3 together, rule 2 narrowed": michigan 653 -> 655, 6 -> 2 wrong; the
+  // corridor's sets as the rule unnarrowed at seeds 0-7). -1000: nearly every tracked frame.
+  double scene_change_tracked_log10_nfa = -10.0;
   // A lone step back (taken because nothing at or ahead of `key` verified, `key` refused by chance itself and not only
   // by the link share: the key image the frames were at no longer sees the frame's scene) is `uncertain`, not tracked,
   // when that frame's relocalization (above) finds a key image verifying more far away (a jump one frame does not make:
@@ -84,11 +105,17 @@ struct LocalizerOptions {
   bool rival_place_when_not_steered = true;
   // Where a frame was ranked (a relocalization, a question of the belief, a rival), the ranking weighs the belief too:
   // each key image by its bucket in the ranking, and a comparison by what it adds to its bucket (EvidenceModel::
-  // rank_alone; fitted on every pair of corridor_conditions: docs/localize.md, "The ranking is evidence"). XFeat's by
-  // rank; ORB's by how far a key image's votes stand out of the frame's, at half the joint model, and after the
-  // belief's rules moved the tracker: the frame's own ranking only withholds it ("ORB's ranking only withholds its own
-  // frame"). Off: the comparisons alone weigh it.
+  // rank_alone; fitted on every pair of corridor_conditions: docs/localize.md, "The ranking is evidence"). Both by how
+  // far a key image's votes stand out of the frame's (XFeat's: rank_by_standout); ORB's at half the joint model, after
+  // the belief's rules moved the tracker: the frame's own ranking only withholds it ("ORB's ranking only withholds its
+  // own frame"). Off: the comparisons alone weigh it.
   bool rank_evidence = true;
+  // XFeat's (float descriptors') ranking weighs the belief by how far a key image's votes stand out of the frame's, as
+  // ORB's, not by its rank: a dark frame's first key image whose votes barely stand out (65 against 62, 61, ...) is
+  // no place, and by rank it moved the belief to the corridor's end in one frame (corridor_conditions XFeat over the
+  // verifier's seeds 0-7: frames confidently > 2 key images off 5 -> 0; docs/localize.md, "XFeat's ranking by how its
+  // votes stand out"). Off: by rank, as before.
+  bool rank_by_standout = true;
   // ORB's frame that only the belief before its own ranking doubts is steered by where its comparison at its key images
   // passes chance, the belief with its ranking singles that place out (the peak within two key images) and the tracker
   // is there: the frame's verified evidence and its ranking agree, and what doubted it is mass the frames before left

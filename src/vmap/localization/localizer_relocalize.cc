@@ -201,6 +201,19 @@ bool Localizer::StillSinceFrameBefore(const ImageFeatures& features) const {
   return before && StandsStill(matcher_, *before, features, options_.still_frame_share);
 }
 
+bool Localizer::SceneChangedSinceFrameBefore(const ImageFeatures& features) const {
+  if (binary_descriptors_ || options_.scene_change_log10_nfa >= 0.0 || features_before_.empty()) return false;
+  const std::shared_ptr<const ImageFeatures> before = matcher_.DeserializeFeatures(features_before_);
+  if (!before) return false;
+  // Verified and judged by chance as a comparison with a key image is, one test (not one of the frame's many).
+  const TentativeMatches matches = matcher_.Match(*before, features);
+  const int denominator = SimilarityDenominator(options_.similarity, static_cast<int>(matches.size()),
+                                                before->num_features(), features.num_features());
+  const PairComparison pair = VerifyMatches(matches, denominator, options_.verifier);
+  return !pair.matched || ChanceOfComparison(pair, features.image_size(), before->image_size(), 1).log10_nfa >
+                              options_.scene_change_log10_nfa;
+}
+
 const ImageFeatures& Localizer::LostFrameKeyFeatures(int key) {
   std::shared_ptr<const ImageFeatures>& features = lost_frame_key_features_[key];
   if (!features) {

@@ -29,6 +29,21 @@ EvidenceModel BinaryDescriptorEvidence() {
   return model;
 }
 EvidenceModel FloatDescriptorEvidence() {
+  EvidenceModel model = FloatDescriptorEvidenceByRank();
+  // By standout, as ORB's, fitted on corridor_conditions (bench/evidence_fit.py --rank --rank-by standout --lo -15 --hi
+  // 40): a key image ranked first on a dark frame whose votes barely stand out (65 against 62, 61, ... and a median
+  // near 50) was weighed as one far above the rest (+3.22 by rank), and one frame's ranking moved the belief to the
+  // route's end (docs/measurements/localization-conditions.md, "XFeat over the verifier's seeds 4-7, and three rules
+  // measured, none kept", rule 3).
+  model.standout_edges = {0.5, 1.5, 2.5, 3.5};
+  model.rank_alone = {-1.34, 0.22, 0.84, 1.91, 4.19};
+  model.rank_given = {0.0, 1.32, 1.76, 2.64, 4.74};
+  model.ranked_intercept = -2.799;
+  model.ranked_per_significance = 0.013;
+  model.ranked_per_link_share = 3.052;
+  return model;
+}
+EvidenceModel FloatDescriptorEvidenceByRank() {
   EvidenceModel model;
   model.unmatched = -1.0;
   model.intercept = -2.66;

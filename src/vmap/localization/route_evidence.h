@@ -39,11 +39,12 @@ struct EvidenceModel {
   double ranked_intercept = 0.0;
   double ranked_per_significance = 0.0;
   double ranked_per_link_share = 0.0;
-  // The buckets: empty, by rank (RankBucket: XFeat's scores are alike across routes); else by how far a key image's
-  // votes stand out of the frame's, (votes - median) / sqrt(median) (a count's noise grows as its square root), the
-  // bucket being how many of these edges it reaches. ORB's votes by rank did not carry from the corridor's 46 key
-  // images to michigan's 5 (rank 3-4: +1.24 against -0.95); by standout they do (docs/measurements/
-  // localization-conditions.md, "ORB's ranking by how its votes stand out").
+  // The buckets: empty, by rank (RankBucket); else by how far a key image's votes stand out of the frame's,
+  // (votes - median) / sqrt(median) (a count's noise grows as its square root), the bucket being how many of these
+  // edges it reaches. ORB's votes by rank did not carry from the corridor's 46 key images to michigan's 5 (rank 3-4:
+  // +1.24 against -0.95); by standout they do (docs/measurements/localization-conditions.md, "ORB's ranking by how its
+  // votes stand out"). XFeat's by standout too: by rank, the first of a dark frame whose votes barely stand out weighed
+  // as much as one far above the rest ("XFeat's ranking by how its votes stand out").
   std::vector<double> standout_edges;
   // The share of the joint model (the ranking and the comparisons given it) the belief weighs, the rest the comparisons
   // alone: a key image weighs rank_weight * rank_alone, a comparison rank_weight of what it adds to its bucket and
@@ -71,9 +72,12 @@ int RankBucket(int rank);
 // it, or a frame whose median key image has no votes (a blank frame: its ranking orders ties and noise).
 std::vector<int> RankingBuckets(const EvidenceModel& model, const std::vector<RankedKey>& ranked, int positions);
 
-// The fitted models: for binary descriptors (ORB) and for the others (XFeat, ALIKED, LoFTR).
+// The fitted models: for binary descriptors (ORB) and for the others (XFeat, ALIKED, LoFTR); both weigh the ranking by
+// how far a key image's votes stand out. FloatDescriptorEvidenceByRank: the others' ranking by rank, as before
+// (LocalizerOptions::rank_by_standout off).
 EvidenceModel BinaryDescriptorEvidence();
 EvidenceModel FloatDescriptorEvidence();
+EvidenceModel FloatDescriptorEvidenceByRank();
 
 // `link_verified`: the verified matches of the key image's link with its route neighbour (the smaller of two; 0
 // when it has none, and then the share counts as 0). `bucket`: the key image's bucket in the frame's ranking

@@ -266,9 +266,10 @@ TEST_F(XfeatCorridorRun, ARobotCarriedOffIsNotSteeredByThePlaceItLeft) {
   auto steered_far = [&](const std::string& flags) { return Far(SteeredOnRun(run, KeyBefore(90), flags)); };
   EXPECT_EQ(steered_far(""), 0);
   // The lone step back measured with the ranking's evidence off: with it the belief leaves the old place before a
-  // lone step back could steer by it (docs/localize.md, "The ranking is evidence").
+  // lone step back could steer by it (docs/localize.md, "The ranking is evidence"); and without the question of a frame
+  // held by little that does not see the frame before's scene, which doubts the same frame (docs/localize.md).
   EXPECT_EQ(steered_far(" --no-rank-evidence"), 0);
-  EXPECT_GE(steered_far(" --no-rank-evidence --no-doubt-lone-step-back"), 1)
+  EXPECT_GE(steered_far(" --no-rank-evidence --no-doubt-lone-step-back --scene-change-log10-nfa 0"), 1)
       << "the test no longer reaches a lone step back";
 }
 
@@ -319,6 +320,18 @@ TEST_F(XfeatCorridorRun, OneFramesRankingIsNotYetAPlace) {
       << "the test no longer reaches a place one frame singles out";
 }
 
+// XFeat's ranking by how its votes stand out (docs/localize.md): repeat frames 44-60 at the verifier's seed 5, started
+// at teach frame 45's key image. Frames 49-51 are dark; by rank key image 32 (the corridor's end) ranked first on
+// frames 49 and 50 with 63-65 votes against 62, 61, ... and weighed as a first far above the rest: the belief moved
+// there and frames 52-54 were steered by at key images 30-31 (right: 14-15).
+TEST_F(XfeatCorridorRun, ARankingThatBarelyStandsOutIsNoPlace) {
+  auto steered_far = [&](const std::string& flags) {
+    return Far(SteeredOnRepeat(44, 60, KeyBefore(45), " --verifier-seed 5" + flags));
+  };
+  EXPECT_EQ(steered_far(""), 0);
+  EXPECT_GE(steered_far(" --no-rank-by-standout"), 1) << "the test no longer reaches the frames the rank misplaced";
+}
+
 // A key image the belief puts behind is left (docs/localize.md): repeat frames 100-110 and then 20-30 as one run (a
 // robot carried back 90 frames), started at teach frame 100's key image. After the jump the tracker is relocalized a
 // key image or two short of the right ones (key images 2-4 are teach frames 6-13, the right ones 4-8), and the counts
@@ -331,6 +344,86 @@ TEST_F(XfeatCorridorRun, AKeyImageTheBeliefPutsBehindIsLeft) {
   const int left = steered_right(""), kept = steered_right(" --no-step-on-by-belief");
   EXPECT_GE(left, kept + 4) << "steered by at a right key image: the belief stepping on " << left
                             << ", the counts alone " << kept;
+}
+
+// A robot carried on without the place it left refusing it (docs/localize.md, "A frame that does not see the frame
+// before's scene is asked again"): repeat frames 44-50 and then 80-84 as one run (carried 30 frames on), started at
+// teach frame 44's key image. At the verifier's seeds 1 and 3 the first frame after the jump verifies 16 chance matches
+// at key image 14, the place it left (log10 NFA -0.25 and -2.4), and was tracked there, 9 key images short of the right
+// ones; its comparison with the frame before (log10 NFA -12.6 and -15.2, where consecutive frames of the corridor
+// verify at -50 to -190) asks where it is, and a far place verifies more: uncertain, not steered by.
+TEST_F(XfeatCorridorRun, AFrameThatDoesNotSeeTheFrameBeforesSceneIsAskedAgain) {
+  const std::vector<int> run = CarriedRun(44, 50, 80, 84);
+  for (const std::string seed : {"1", "3"}) {
+    auto steered_far = [&](const std::string& flags) {
+      return Far(SteeredOnRun(run, KeyBefore(44), " --verifier-seed " + seed + flags));
+    };
+    EXPECT_EQ(steered_far(""), 0) << "seed " << seed;
+    EXPECT_GE(steered_far(" --scene-change-log10-nfa 0"), 1)
+        << "seed " << seed << ": the test no longer reaches a frame tracked at the place the robot left";
+  }
+}
+
+// michigan_seasons' session `query` (its five places) against an XFeat map of session `teach`'s, built in `dir` as
+// bench/route_conditions.py builds it (`--tau 1`): `vmap localize`'s map and images arguments; "" without the data.
+std::string MichiganRoute(const fs::path& dir, const std::string& query, const std::string& teach) {
+  const fs::path images = fs::path(SharedDir()) / "data/michigan_seasons/images";
+  if (!fs::exists(images)) return "";
+  for (const std::string& session : {query, teach}) {
+    fs::create_directories(dir / session);
+    for (int place = 1; place <= 5; ++place) {
+      fs::create_symlink(images / (session + "0" + std::to_string(place) + ".png"),
+                         dir / session / (std::to_string(place) + ".png"));
+    }
+  }
+  const auto built = RunVmap("build " + ::vmap::testing::Quote(dir / teach) + " --tau 1 --matcher xfeat --weights " +
+                             FoldedWeights() + " -q -o " + ::vmap::testing::Quote(dir / "map"));
+  EXPECT_EQ(built.status, 0) << built.output;
+  return ::vmap::testing::Quote(dir / "map") + " " + ::vmap::testing::Quote(dir / query);
+}
+
+// Frames steered by at key images more than `off` from their place (michigan: frame i's is key image i).
+int SteeredOff(const std::vector<std::pair<int, int>>& frames, int off) {
+  return static_cast<int>(
+      std::count_if(frames.begin(), frames.end(), [&](const auto& f) { return std::abs(f.second - f.first) > off; }));
+}
+
+// The same rule across seasons: michigan_seasons' session 03 against an XFeat map of session 08's five places (`--tau
+// 1`), at the verifier's seed 2. Place 3 verifies nothing anywhere (lost at key image 1); place 4 verifies 17 chance
+// matches at key image 1 (log10 NFA -5.5) and was tracked there, and place 5 likewise (19 at -6.1), three key images
+// off: the tracker never compared the key images ahead, which verify 139 and 329 matches. Two places of a route share
+// no scene: each frame held by little beyond chance is asked where it is, and places 4 and 5 are at key images 3 and 4.
+TEST(VmapXfeat, AFrameOfAnotherPlaceThanTheFrameBeforeIsAskedWhereItIs) {
+  SKIP_WITHOUT_SHARED();
+  const TempDir dir("michigan");
+  const std::string route = MichiganRoute(dir.path(), "03", "08");
+  if (route.empty()) GTEST_SKIP() << "michigan_seasons is not present";
+  auto steered = [&](const std::string& flags) {
+    return SteeredFrames(route + " --verifier-seed 2" + flags, dir.path() / "run.csv");
+  };
+  const std::vector<std::pair<int, int>> asked = steered("");
+  EXPECT_EQ(SteeredOff(asked, 2), 0) << ::testing::PrintToString(asked);
+  EXPECT_GE(SteeredOff(steered(" --scene-change-log10-nfa 0"), 2), 1) << "the test no longer reaches a frame tracked far";
+}
+
+// ... but not a frame its key image holds far beyond chance (docs/localize.md, the same rule): michigan_seasons'
+// session 02 against session 03's map at the verifier's seed 0 (place p's key image is p - 1). Place 3 is tracked at
+// key image 2 at log10 NFA -320, its comparison with place 2 as weak as every michigan frame's with the one before;
+// asked again (as before the rule was narrowed: --scene-change-tracked-log10-nfa -1000), the frame's ranking undid its
+// step on, and places 3-5 were steered by a key image behind (at 1, 2 and 3, at log10 NFA -8.2 to -2.9).
+TEST(VmapXfeat, AFrameItsKeyImageHoldsFarBeyondChanceIsNotAskedAgain) {
+  SKIP_WITHOUT_SHARED();
+  const TempDir dir("michigan");
+  const std::string route = MichiganRoute(dir.path(), "02", "03");
+  if (route.empty()) GTEST_SKIP() << "michigan_seasons is not present";
+  auto steered = [&](const std::string& flags) {
+    return SteeredFrames(route + " --start-key 0 --verifier-seed 0" + flags, dir.path() / "run.csv");
+  };
+  const std::vector<std::pair<int, int>> held = steered("");
+  EXPECT_EQ(held.size(), 5u) << ::testing::PrintToString(held);
+  EXPECT_EQ(SteeredOff(held, 0), 0) << ::testing::PrintToString(held);
+  EXPECT_GE(SteeredOff(steered(" --scene-change-tracked-log10-nfa -1000"), 0), 1)
+      << "the test no longer reaches a right frame whose step on the question undid";
 }
 
 }  // namespace
