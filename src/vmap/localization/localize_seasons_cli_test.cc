@@ -94,7 +94,7 @@ int PlacedNotSteeredByOnlyWith(const fs::path& dir, int map_session, const std::
   int placed = 0;
   for (const fs::path& query : MichiganSessions(dir, sessions)) {
     std::vector<std::vector<std::string>> status, keys, guidance, heading;
-    for (const std::string run_flags : {flags, flags + rule_off}) {
+    for (const std::string& run_flags : {flags, flags + rule_off}) {
       const fs::path csv = dir / "run.csv";
       std::string out;
       EXPECT_EQ(
@@ -111,7 +111,9 @@ int PlacedNotSteeredByOnlyWith(const fs::path& dir, int map_session, const std::
     EXPECT_EQ(status[1].size(), status[0].size());
     for (size_t f = 0; f < status[0].size() && f < status[1].size(); ++f) {
       const bool placed_here = Placed({status[0][f], 0}) && !Placed({status[1][f], 0});
-      if (Placed({status[0][f], 0})) EXPECT_EQ(keys[0][f], std::to_string(f)) << query << " frame " << f;
+      if (Placed({status[0][f], 0})) {
+        EXPECT_EQ(keys[0][f], std::to_string(f)) << query << " frame " << f;
+      }
       if (!placed_here) {
         EXPECT_EQ(status[0][f], status[1][f]) << query << " frame " << f;
         EXPECT_EQ(guidance[0][f], guidance[1][f]) << query << " frame " << f;

@@ -77,11 +77,10 @@ struct LocalizerOptions {
   // there by little beyond chance. A michigan_seasons route's places never share a scene, so there the frame before
   // asks every frame again, and a right frame tracked far beyond chance (02 -> 03 frame 2: -320) had its step on undone
   // by its ranking (with rank_by_standout, michigan XFeat at the verifier's seed 0: 653 -> 646 right and not uncertain,
-  // 6 -> 11 wrong). The
-  // frames the rule is for are tracked at -0.25 to -6.1 (the kidnapped run's frame 51 after the carry; michigan 03 ->
-  // 08's places 4 and 5 at seed 2); the right frames it undid, at -13.8 to -320 (docs/measurements/
-  // localization-conditions.md, "Rules 2 and 3 together, rule 2 narrowed": michigan 653 -> 655, 6 -> 2 wrong; the
-  // corridor's sets as the rule unnarrowed at seeds 0-7). -1000: nearly every tracked frame.
+  // 6 -> 11 wrong). The frames the rule is for are tracked at -0.25 to -6.1 (the kidnapped run's frame 51 after the
+  // carry; michigan 03 -> 08's places 4 and 5 at seed 2); the right frames it undid, at -13.8 to -2546
+  // (docs/measurements/localization-conditions.md, "Rules 2 and 3 together, rule 2 narrowed": michigan at seed 0 653
+  // -> 655, 6 -> 2 wrong; the corridor's sets as the rule unnarrowed at seeds 0-7). -1000: nearly every tracked frame.
   double scene_change_tracked_log10_nfa = -10.0;
   // A lone step back (taken because nothing at or ahead of `key` verified, `key` refused by chance itself and not only
   // by the link share: the key image the frames were at no longer sees the frame's scene) is `uncertain`, not tracked,

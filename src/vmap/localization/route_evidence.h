@@ -44,7 +44,7 @@ struct EvidenceModel {
   // edges it reaches. ORB's votes by rank did not carry from the corridor's 46 key images to michigan's 5 (rank 3-4:
   // +1.24 against -0.95); by standout they do (docs/measurements/localization-conditions.md, "ORB's ranking by how its
   // votes stand out"). XFeat's by standout too: by rank, the first of a dark frame whose votes barely stand out weighed
-  // as much as one far above the rest ("XFeat's ranking by how its votes stand out").
+  // as much as one far above the rest (docs/localize.md, "XFeat's ranking by how its votes stand out").
   std::vector<double> standout_edges;
   // The share of the joint model (the ranking and the comparisons given it) the belief weighs, the rest the comparisons
   // alone: a key image weighs rank_weight * rank_alone, a comparison rank_weight of what it adds to its bucket and
