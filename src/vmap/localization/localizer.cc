@@ -436,10 +436,10 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   // Carried off since the frame before (scene_change_log10_nfa): the key image left may still accept a few chance
   // matches, which one frame steered by there would follow. Asked only where those are all the frame holds there
   // (scene_change_tracked_log10_nfa): a frame far beyond chance at its key image is there, whatever the frame before.
-  const bool scene_changed = !AcceptedAgainstRivals(best) &&
-                             best.log10_nfa > options_.scene_change_tracked_log10_nfa &&
+  const bool rivals_decided = AcceptedAgainstRivals(best);
+  const bool scene_changed = !rivals_decided && best.log10_nfa > options_.scene_change_tracked_log10_nfa &&
                              SceneChangedSinceFrameBefore(features);
-  if (!AcceptedAgainstRivals(best) && (SharesLittle(best) || pointed_before_ >= 0 || rival_beats || scene_changed)) {
+  if (!rivals_decided && (SharesLittle(best) || pointed_before_ >= 0 || rival_beats || scene_changed)) {
     // Accepted, but with much less than neighbouring key images share: the frame may be elsewhere on the
     // route, in view of this key image's scene. Moved when a ranked key image verifies more matches (a
     // relocalization that is not taken leaves nothing behind: the tracked estimate is set below). Also asked when

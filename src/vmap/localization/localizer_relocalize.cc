@@ -206,10 +206,7 @@ bool Localizer::SceneChangedSinceFrameBefore(const ImageFeatures& features) cons
   const std::shared_ptr<const ImageFeatures> before = matcher_.DeserializeFeatures(features_before_);
   if (!before) return false;
   // Verified and judged by chance as a comparison with a key image is, one test (not one of the frame's many).
-  const TentativeMatches matches = matcher_.Match(*before, features);
-  const int denominator = SimilarityDenominator(options_.similarity, static_cast<int>(matches.size()),
-                                                before->num_features(), features.num_features());
-  const PairComparison pair = VerifyMatches(matches, denominator, options_.verifier);
+  const PairComparison pair = ComparePair(matcher_, *before, features, options_.verifier, options_.similarity);
   return !pair.matched || ChanceOfComparison(pair, features.image_size(), before->image_size(), 1).log10_nfa >
                               options_.scene_change_log10_nfa;
 }
