@@ -8,6 +8,7 @@
 #include "vmap/cli/option_binder.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/features/orb_matcher.h"
+#include "vmap/pipelines/simulate_pipeline.h"
 
 namespace vmap::cli {
 namespace {
@@ -104,6 +105,23 @@ TEST(OptionFlags, MatcherFlagsAreRecordedByModelAndKey) {
   } catch (const InputError& error) {
     EXPECT_EQ(std::string(error.what()).rfind("--orb-features must be 1 to 100000", 0), 0u) << error.what();
   }
+}
+
+// `vmap simulate` takes `vmap localize`'s flags for its localizer (the options struct's fields, visited once), so a
+// rule can be turned off in the closed loop as in a localization run; the struct reaches every trial
+// (ClosedLoop.TheLocalizersOptionsReachEveryTrialsLocalizer).
+TEST(OptionFlags, TheSimulatorTakesTheLocalizersFlags) {
+  SimulatePipelineOptions pipeline;
+  CLI::App app;
+  OptionFlags flags;
+  AddOptionFlags(&app, pipeline, flags);
+  app.parse("--no-rank-by-standout --scene-change-log10-nfa -40 --scene-change-tracked-log10-nfa -500 --candidates 7",
+            false);
+  const LocalizerOptions& localizer = pipeline.simulation.localizer;
+  EXPECT_FALSE(localizer.rank_by_standout);
+  EXPECT_EQ(localizer.scene_change_log10_nfa, -40.0);
+  EXPECT_EQ(localizer.scene_change_tracked_log10_nfa, -500.0);
+  EXPECT_EQ(localizer.relocalization_candidates, 7);
 }
 
 }  // namespace

@@ -8,10 +8,8 @@
 #include <cmath>
 #include <fstream>
 
-#include <CLI/CLI.hpp>
 #include <gtest/gtest.h>
 
-#include "vmap/cli/option_binder.h"
 #include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
@@ -74,20 +72,21 @@ TEST(ClosedLoop, TheSameOptionsGiveTheSameRuns) {
   }
 }
 
-// The localizer's flags are the simulator's, as `vmap localize` has them, and reach every trial's localizer through
-// the options struct (PrepareTrials: the session's options, following the map). The two XFeat rules of main 8d40433
-// were told apart in the simulator across seasons so (docs/measurements/localization-conditions.md, "The simulator
-// across seasons: which rule reaches it"): --no-rank-by-standout gave back main c56a22f's runs in every sample,
-// --scene-change-log10-nfa 0 changed none.
-TEST(ClosedLoop, TheLocalizersFlagsReachEveryTrialsLocalizer) {
-  testing::ScopedTempDir temp("closed_loop_flags");
+// The localizer's options reach every trial's localizer through the options struct (PrepareTrials: the session's
+// options, following the map), as `vmap localize` hands them on. The two XFeat rules of main 8d40433 were told apart
+// in the simulator across seasons so (docs/measurements/localization-conditions.md, "The simulator across seasons:
+// which rule reaches it"): --no-rank-by-standout gave back main c56a22f's runs in every sample,
+// --scene-change-log10-nfa 0 changed none. The flags themselves: OptionFlags.TheSimulatorTakesTheLocalizersFlags.
+TEST(ClosedLoop, TheLocalizersOptionsReachEveryTrialsLocalizer) {
+  testing::ScopedTempDir temp("closed_loop_options");
   SimulatePipelineOptions pipeline = StraightRoute(temp.path(), 3.0);
-  CLI::App app;
-  cli::OptionFlags flags;
-  cli::AddOptionFlags(&app, pipeline, flags);
-  app.parse("--no-rank-by-standout --scene-change-log10-nfa -40 --scene-change-tracked-log10-nfa -500 "
-            "--candidates 7 --camera-width 320 --camera-height 240",
-            false);
+  pipeline.simulation.camera.width = 320;  // a quarter of the pixels: only the options are checked
+  pipeline.simulation.camera.height = 240;
+  LocalizerOptions& given = pipeline.simulation.localizer;
+  given.rank_by_standout = false;
+  given.scene_change_log10_nfa = -40.0;
+  given.scene_change_tracked_log10_nfa = -500.0;
+  given.relocalization_candidates = 7;
   const std::unique_ptr<PreparedTrials> prepared =
       PrepareTrials(pipeline.simulation, pipeline.matcher, temp.path() / "map");
   const LocalizerOptions& localizer = prepared->context.localizer;
@@ -95,7 +94,7 @@ TEST(ClosedLoop, TheLocalizersFlagsReachEveryTrialsLocalizer) {
   EXPECT_EQ(localizer.scene_change_log10_nfa, -40.0);
   EXPECT_EQ(localizer.scene_change_tracked_log10_nfa, -500.0);
   EXPECT_EQ(localizer.relocalization_candidates, 7);
-  EXPECT_EQ(localizer.route, prepared->context.taught.keys);  // the taught route, whatever the flags
+  EXPECT_EQ(localizer.route, prepared->context.taught.keys);  // the taught route, whatever was given
 }
 
 }  // namespace
