@@ -13,6 +13,7 @@
 #include "vmap/core/error.h"
 #include "vmap/sources/binary_file.h"
 #include "vmap/sources/chunk_decompression.h"
+#include "vmap/sources/indexed_file_reader.h"
 #include "vmap/sources/recording_reader.h"
 
 namespace vmap {
@@ -66,7 +67,7 @@ class Fields {
   uint64_t at_ = 0;
 };
 
-class McapReader : public RecordingReader {
+class McapReader : public IndexedFileReader {
  public:
   McapReader(BinaryFile file, const RecordingLimits& limits)
       : file_(std::move(file)), limits_(limits), budget_(limits, file_.size()) {
@@ -91,28 +92,11 @@ class McapReader : public RecordingReader {
     budget_.Reset();
   }
 
-  bool Next(const std::set<std::string>& topics, RecordedMessage* message) override {
-    return NextMessage(&topics, message);
-  }
-
-  std::vector<RecordingTopic> Topics() override {
-    std::vector<RecordingTopic> summarized;
-    if (TopicsFromSummary(&summarized)) return summarized;
-    Rewind();
-    std::vector<RecordingTopic> list = CountTopicsByReading([this](RecordedMessage* message, std::string* type) {
-      if (!NextMessage(nullptr, message)) return false;
-      *type = type_of_last_;
-      return true;
-    });
-    Rewind();
-    return list;
-  }
-
  private:
   // The topics as the summary section counts them (Statistics: messages per channel; Chunk Index: which
   // channels each chunk holds, and its first and last log time), without reading the chunks; false when the
   // file has no summary (a recording cut short) or it lacks those records.
-  bool TopicsFromSummary(std::vector<RecordingTopic>* topics) {
+  bool TopicsFromIndex(std::vector<RecordingTopic>* topics) override {
     constexpr uint64_t kFooterSize = 9 + 20;
     try {
       if (file_.size() < 8 + kFooterSize + 8) return false;
@@ -207,7 +191,7 @@ class McapReader : public RecordingReader {
     }
   }
 
-  bool NextMessage(const std::set<std::string>* topics, RecordedMessage* message) {
+  bool NextMessage(const std::set<std::string>* topics, RecordedMessage* message) override {
     for (;;) {
       if (chunk_position_ < chunk_.size()) {
         const uint64_t at = chunk_position_;
@@ -354,7 +338,6 @@ class McapReader : public RecordingReader {
   uint64_t chunk_offset_ = 0;
   std::map<uint16_t, std::string> schemas_;
   std::map<uint16_t, Channel> channels_;
-  std::string type_of_last_;
 };
 
 }  // namespace

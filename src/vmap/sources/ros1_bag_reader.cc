@@ -18,6 +18,7 @@
 #include "vmap/core/error.h"
 #include "vmap/sources/binary_file.h"
 #include "vmap/sources/chunk_decompression.h"
+#include "vmap/sources/indexed_file_reader.h"
 #include "vmap/sources/recording_reader.h"
 
 namespace vmap {
@@ -74,7 +75,7 @@ class RecordHeader {
   std::map<std::string, std::string> fields_;
 };
 
-class Ros1BagReader : public RecordingReader {
+class Ros1BagReader : public IndexedFileReader {
  public:
   Ros1BagReader(const std::string& path, const RecordingLimits& limits)
       : file_(path), limits_(limits), budget_(limits, file_.size()) {
@@ -99,28 +100,11 @@ class Ros1BagReader : public RecordingReader {
     budget_.Reset();
   }
 
-  bool Next(const std::set<std::string>& topics, RecordedMessage* message) override {
-    return NextMessage(&topics, message);
-  }
-
-  std::vector<RecordingTopic> Topics() override {
-    std::vector<RecordingTopic> indexed;
-    if (TopicsFromIndex(&indexed)) return indexed;
-    Rewind();
-    std::vector<RecordingTopic> list = CountTopicsByReading([this](RecordedMessage* message, std::string* type) {
-      if (!NextMessage(nullptr, message)) return false;
-      *type = type_of_last_;
-      return true;
-    });
-    Rewind();
-    return list;
-  }
-
  private:
   // The topics as the bag's index at its end counts them (connection and chunk info records), without reading
   // the chunks; false when the bag has no index (still being recorded, or cut short) or it does not add up.
   // First and last times are those of the chunks holding the topic's messages.
-  bool TopicsFromIndex(std::vector<RecordingTopic>* topics) {
+  bool TopicsFromIndex(std::vector<RecordingTopic>* topics) override {
     try {
       uint8_t length[4];
       file_.Read(kMagicSize, 4, length, "the bag header");
@@ -192,7 +176,7 @@ class Ros1BagReader : public RecordingReader {
   }
 
   // The next message on `topics` (nullptr: every message, its data left out: a count).
-  bool NextMessage(const std::set<std::string>* topics, RecordedMessage* message) {
+  bool NextMessage(const std::set<std::string>* topics, RecordedMessage* message) override {
     for (;;) {
       if (chunk_position_ < chunk_.size()) {
         if (NextInChunk(topics, message)) return true;
@@ -328,7 +312,6 @@ class Ros1BagReader : public RecordingReader {
   std::vector<uint8_t> header_bytes_, record_data_, compressed_;
   RecordHeader header_;
   std::map<uint32_t, Connection> connections_;
-  std::string type_of_last_;
 };
 
 }  // namespace
