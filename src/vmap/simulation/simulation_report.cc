@@ -7,34 +7,14 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "vmap/core/atomic_output.h"
+#include "vmap/report/html_util.h"
 #include "vmap/simulation/simulation_output.h"
 
 namespace vmap {
 
 namespace {
 
-std::string Escape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '&':
-        out += "&amp;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
+using report::HtmlEscape;
 
 std::string Metres(double value) { return std::isfinite(value) ? fmt::format("{:.3f}", value) : "-"; }
 
@@ -91,14 +71,14 @@ void WriteSimulationReport(const SimulationResult& result, const SimulationOptio
   std::string html = R"(<!doctype html><html><head><meta charset="utf-8"><title>vmap simulate</title><style>
 body{font-family:sans-serif;margin:2em;max-width:960px}table{border-collapse:collapse}td,th{padding:2px 8px;border-bottom:1px solid #ddd;text-align:right}
 th{background:#f4f4f4}.fail{color:#c00}h2{margin-top:1.5em}</style></head><body>)";
-  html += fmt::format("<h1>vmap simulate: {}</h1>", Escape(result.route.name));
+  html += fmt::format("<h1>vmap simulate: {}</h1>", HtmlEscape(result.route.name));
   html += "<table>";
   auto row = [&](const std::string& name, const std::string& value) {
     html += fmt::format("<tr><th style='text-align:left'>{}</th><td style='text-align:left'>{}</td></tr>", name, value);
   };
-  row("route", fmt::format("{} ({:.1f} m{})", Escape(result.route.name), result.route.path.length(),
+  row("route", fmt::format("{} ({:.1f} m{})", HtmlEscape(result.route.name), result.route.path.length(),
                            result.route.corridor.closed() ? ", closed corridor" : ""));
-  row("matcher, law", fmt::format("{}, {}", Escape(result.matcher), ControlLawName(options.controller.law)));
+  row("matcher, law", fmt::format("{}, {}", HtmlEscape(result.matcher), ControlLawName(options.controller.law)));
   row("teach run",
       fmt::format("{} frames, {} key images, {:.1f} s", result.teach_frames, result.key_images, result.teach_seconds));
   row("reached the goal", fmt::format("{} of {} ({:.1f} %) within {} m", s.successes, s.trials, 100.0 * s.success_rate,
@@ -130,7 +110,7 @@ th{background:#f4f4f4}.fail{color:#c00}h2{margin-top:1.5em}</style></head><body>
         "<tr{}><td>{}</td><td>{:.3f}</td><td>{:.1f}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} "
         "of "
         "{}</td><td>{:.1f}</td></tr>",
-        t.success ? "" : " class='fail'", t.index, t.start_lateral, t.start_heading_deg, Escape(t.end),
+        t.success ? "" : " class='fail'", t.index, t.start_lateral, t.start_heading_deg, HtmlEscape(t.end),
         Metres(t.final_error), Metres(t.lateral_rms_second_half), Metres(t.lateral_max), Metres(t.settled_at),
         t.frames_lost, t.frames, 1e3 * t.mean_step_seconds);
   }
