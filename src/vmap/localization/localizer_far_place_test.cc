@@ -23,6 +23,7 @@ namespace {
 using ::vmap::testing::Brackets;
 using ::vmap::testing::DenseDriveMap;
 using ::vmap::testing::GivenComparison;
+using ::vmap::testing::LocalizeFramesOnDenseMap;
 using ::vmap::testing::LocalizeOnDenseMap;
 using ::vmap::testing::SidewaysDrive;
 
@@ -55,8 +56,7 @@ TEST(Localizer, AOneFrameJumpIsUncertainUntilTheFramesThatFollowConfirmIt) {
     EXPECT_FALSE(min_confidence > 0 && MaySteerBy(jumped));
     // With the belief the tracker moves once two frames point at the new place and the belief agrees (frame 41 and
     // 43 see the start's far plane too, so it takes a frame or two more); steered by from there on.
-    LocalizationResult r;
-    for (int source_index : {43, 45, 47, 49}) r = LocalizeOnDenseMap(localizer, source_index, index++);
+    LocalizationResult r = LocalizeFramesOnDenseMap(localizer, {43, 45, 47, 49}, &index);
     EXPECT_EQ(r.status, LocalizationStatus::kTracking);
     EXPECT_TRUE(Brackets(m.map, 49, r.key)) << "at key " << r.key;
     EXPECT_GT(r.confidence, 0.5);
@@ -75,7 +75,7 @@ TEST(Localizer, AFarRelocalizationOnOneFrameDoesNotCarryTheTrackerAway) {
     options.belief.min_confidence = min_confidence;
     Localizer localizer(m.map, m.keys, *m.matcher, options);
     int index = 0;
-    for (int source_index : {1, 3, 5}) LocalizeOnDenseMap(localizer, source_index, index++);
+    LocalizeFramesOnDenseMap(localizer, {1, 3, 5}, &index);
     const LocalizationResult far = LocalizeOnDenseMap(localizer, 41, index++);
     EXPECT_FALSE(min_confidence > 0 && MaySteerBy(far));
     const LocalizationResult back = LocalizeOnDenseMap(localizer, 7, index++);
@@ -92,7 +92,7 @@ TEST(Localizer, AFarRelocalizationOnOneFrameDoesNotCarryTheTrackerAway) {
     options.rank_evidence = rank_evidence;
     Localizer localizer(m.map, m.keys, *m.matcher, options);
     int index = 0;
-    for (int source_index : {1, 3, 5, 41, 43}) LocalizeOnDenseMap(localizer, source_index, index++);
+    LocalizeFramesOnDenseMap(localizer, {1, 3, 5, 41, 43}, &index);
     const LocalizationResult back = LocalizeOnDenseMap(localizer, 7, index++);
     if (!rank_evidence) {
       EXPECT_TRUE(Brackets(m.map, 7, back.key)) << "at key " << back.key;
@@ -166,8 +166,7 @@ TEST(Localizer, AfterLostFramesARelocalizationAsFarAsTheRobotCouldGoIsTakenAtOnc
   options.far_comparison_iterations = 0;
   Localizer localizer(m.map, m.keys, *m.matcher, options);
   int index = 0;
-  LocalizationResult r;
-  for (int source_index : {1, 3, 5, 7, 9}) r = LocalizeOnDenseMap(localizer, source_index, index++);
+  LocalizationResult r = LocalizeFramesOnDenseMap(localizer, {1, 3, 5, 7, 9}, &index);
   ASSERT_EQ(r.status, LocalizationStatus::kTracking);
   const int far = r.route_position + 8;  // the route is the key images in order
   ASSERT_LT(far + 2, count);
@@ -210,8 +209,7 @@ TEST(Localizer, AFarPlaceOneFramePointedAtIsAskedAgainOnTheNextFrame) {
   options.far_comparison_iterations = 0;
   Localizer localizer(m.map, m.keys, *m.matcher, options);
   int index = 0;
-  LocalizationResult r;
-  for (int source_index : {1, 3, 5}) r = LocalizeOnDenseMap(localizer, source_index, index++);
+  LocalizationResult r = LocalizeFramesOnDenseMap(localizer, {1, 3, 5}, &index);
   ASSERT_EQ(r.status, LocalizationStatus::kTracking);
   const int p = r.route_position;  // the route is the key images in order
   const int far = p + 8;
@@ -257,8 +255,7 @@ TEST(Localizer, FramesThatVerifyNothingAfterAConfidentRunAreCarriedByTheBelief) 
     options.belief.window = window;
     Localizer localizer(m.map, m.keys, *m.matcher, options);
     int index = 0;
-    LocalizationResult r;
-    for (int source_index : {1, 3, 5, 7, 9}) r = LocalizeOnDenseMap(localizer, source_index, index++);
+    LocalizationResult r = LocalizeFramesOnDenseMap(localizer, {1, 3, 5, 7, 9}, &index);
     ASSERT_EQ(r.status, LocalizationStatus::kTracking);
     const int tracked_position = r.route_position;
     for (int blind = 0; blind < 3; ++blind) {

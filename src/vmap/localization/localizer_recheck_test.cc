@@ -18,6 +18,7 @@ using ::vmap::testing::Brackets;
 using ::vmap::testing::DenseDriveMap;
 using ::vmap::testing::DriveFrames;
 using ::vmap::testing::DriveIndices;
+using ::vmap::testing::LocalizeFramesOnDenseMap;
 using ::vmap::testing::LocalizeOnDenseMap;
 
 // Tracked at the start of the drive, then a frame far ahead: it still sees the start's far plane, so chance
@@ -25,10 +26,8 @@ using ::vmap::testing::LocalizeOnDenseMap;
 LocalizationResult AfterAJump(const LocalizerOptions& options, int jump_to) {
   const LocalizationMap& m = DenseDriveMap();
   Localizer localizer(m.map, m.keys, *m.matcher, options);
-  LocalizationResult r;
   int index = 0;
-  for (int source_index : {1, 3, jump_to}) r = LocalizeOnDenseMap(localizer, source_index, index++);
-  return r;
+  return LocalizeFramesOnDenseMap(localizer, {1, 3, jump_to}, &index);
 }
 
 // Localizes the drive's odd frames with `options`: the first frame is relocalized, every other one tracked, and each

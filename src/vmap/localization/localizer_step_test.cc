@@ -12,6 +12,7 @@ namespace {
 
 using ::vmap::testing::DenseDriveMap;
 using ::vmap::testing::GivenComparison;
+using ::vmap::testing::LocalizeFramesOnDenseMap;
 using ::vmap::testing::LocalizeOnDenseMap;
 
 // A frame the tracker moves two key images on (LocalizerOptions::lookahead 2) because the second verifies a match or
@@ -28,8 +29,7 @@ TEST(Localizer, TwoKeyImagesOnInOneFrameNeedsTheBeliefToAgree) {
     options.far_comparison_iterations = 0;
     Localizer localizer(m.map, m.keys, *m.matcher, options);
     int index = 0;
-    LocalizationResult r;
-    for (int source_index : {1, 3, 5}) r = LocalizeOnDenseMap(localizer, source_index, index++);
+    LocalizationResult r = LocalizeFramesOnDenseMap(localizer, {1, 3, 5}, &index);
     ASSERT_EQ(r.status, LocalizationStatus::kTracking);
     const int p = r.route_position;
     ASSERT_LT(p + 3, static_cast<int>(m.map.key_images.size()));
@@ -54,8 +54,7 @@ TEST(Localizer, OneKeyImageOnNeedsTheBeliefNotToHoldMoreBehind) {
     options.belief.window = window;
     Localizer localizer(m.map, m.keys, *m.matcher, options);
     int index = 0;
-    LocalizationResult r;
-    for (int source_index : {1, 3, 5}) r = LocalizeOnDenseMap(localizer, source_index, index++);
+    LocalizationResult r = LocalizeFramesOnDenseMap(localizer, {1, 3, 5}, &index);
     ASSERT_EQ(r.status, LocalizationStatus::kTracking);
     const int p = r.route_position;
     ASSERT_GE(p, 1);
@@ -81,8 +80,7 @@ TEST(Localizer, AStepOnPastAKeyImageThatDoesNotVerifyNeedsTheBeliefToo) {
     options.hold_unearned_step_on = hold;
     Localizer localizer(m.map, m.keys, *m.matcher, options);
     int index = 0;
-    LocalizationResult r;
-    for (int source_index : {1, 3, 5}) r = LocalizeOnDenseMap(localizer, source_index, index++);
+    LocalizationResult r = LocalizeFramesOnDenseMap(localizer, {1, 3, 5}, &index);
     ASSERT_EQ(r.status, LocalizationStatus::kTracking);
     const int p = r.route_position;
     ASSERT_GE(p, 1);
@@ -110,8 +108,7 @@ TEST(Localizer, AStepBackNeedsTheBeliefNotToHoldMorePastTheKeyImageLeft) {
     options.step_back_needs_belief = needs_belief;
     Localizer localizer(m.map, m.keys, *m.matcher, options);
     int index = 0;
-    LocalizationResult r;
-    for (int source_index : {1, 3, 5}) r = LocalizeOnDenseMap(localizer, source_index, index++);
+    LocalizationResult r = LocalizeFramesOnDenseMap(localizer, {1, 3, 5}, &index);
     ASSERT_EQ(r.status, LocalizationStatus::kTracking);
     const int p = r.route_position;
     ASSERT_GE(p, 2);

@@ -26,7 +26,7 @@ using ::vmap::testing::DriveFrames;
 using ::vmap::testing::DriveIndices;
 using ::vmap::testing::EvenDriveMap;
 using ::vmap::testing::GivenComparison;
-using ::vmap::testing::LocalizeOnDenseMap;
+using ::vmap::testing::LocalizeFramesOnDenseMap;
 using ::vmap::testing::LocalizeOnEvenMap;
 using ::vmap::testing::SidewaysDrive;
 
@@ -195,8 +195,7 @@ TEST(Localizer, TheComparisonsAwayFromTheTrackerAreVerifiedWithFewerIterations) 
   options.belief.min_confidence = 0.0;
   Localizer localizer(m.map, m.keys, *m.matcher, options);
   int index = 0;
-  LocalizationResult r;
-  for (int source_index : {1, 3, 5}) r = LocalizeOnDenseMap(localizer, source_index, index++);
+  LocalizationResult r = LocalizeFramesOnDenseMap(localizer, {1, 3, 5}, &index);
   ASSERT_EQ(r.status, LocalizationStatus::kTracking);
   const int tracked = r.route_position;  // the route is the key images in order
   const int last_near = tracked + options.lookahead + 1;

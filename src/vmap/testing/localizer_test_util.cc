@@ -65,6 +65,12 @@ LocalizationResult LocalizeOnDenseMap(Localizer& localizer, int source_index, in
   return localizer.Localize(frame, *features, std::move(given));
 }
 
+LocalizationResult LocalizeFramesOnDenseMap(Localizer& localizer, const std::vector<int>& source_indices, int* index) {
+  LocalizationResult r;
+  for (const int source_index : source_indices) r = LocalizeOnDenseMap(localizer, source_index, (*index)++);
+  return r;
+}
+
 bool Brackets(const VisualMap& map, int source_index, int key) {
   const auto [before, after] = KeysAround(map, source_index);
   return key >= 0 && (key == before || key == after);

@@ -30,6 +30,10 @@ LocalizationResult LocalizeOnEvenMap(Localizer& localizer, const cv::Mat& image,
 LocalizationResult LocalizeOnDenseMap(Localizer& localizer, int source_index, int index,
                                       std::vector<KeyComparison> given = {});
 
+// Drive frames `source_indices` localized by `localizer` (of DenseDriveMap()) one after the other as the next frames
+// of a stream, `*index` counting them; the last frame's result.
+LocalizationResult LocalizeFramesOnDenseMap(Localizer& localizer, const std::vector<int>& source_indices, int* index);
+
 // Whether `key` is one of the key images of `map` around the source's frame `source_index` (KeysAround).
 bool Brackets(const VisualMap& map, int source_index, int key);
 
