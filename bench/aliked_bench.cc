@@ -11,7 +11,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -33,19 +32,12 @@
 #include "vmap/sources/frame_source.h"
 
 #include "cpu_time.h"
+#include "wall_time.h"
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 using vmap::Median;
-
-template <typename F>
-double TimeSeconds(F&& f) {
-  const auto start = Clock::now();
-  f();
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+using vmap::bench::TimeSeconds;
 
 // CPU seconds of the whole process (all threads): on a loaded machine this moves much less than wall time.
 template <typename F>

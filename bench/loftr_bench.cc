@@ -7,7 +7,6 @@
 // mutual-nearest-neighbour pair (random weights pass no real threshold); speed does not depend on the values.
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -21,16 +20,12 @@
 #include "vmap/core/runtime.h"
 #include "vmap/neural/loftr/loftr_matcher.h"
 
+#include "wall_time.h"
+
 namespace {
 
 using vmap::Median;
-
-template <typename F>
-double TimeSeconds(F&& f) {
-  const auto start = std::chrono::steady_clock::now();
-  f();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
+using vmap::bench::TimeSeconds;
 
 }  // namespace
 

@@ -34,18 +34,14 @@
 #include "vmap/neural/xfeat/xfeat_weights.h"
 #include "vmap/sources/frame_source.h"
 
+#include "wall_time.h"
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
 using vmap::Median;
-
-template <typename F>
-double TimeSeconds(F&& f) {
-  const auto start = Clock::now();
-  f();
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+using vmap::bench::TimeSeconds;
 
 struct Pair {
   std::string name;
