@@ -167,9 +167,7 @@ int main(int argc, char** argv) {
   app.add_flag("--streaming-only", streaming_only, "only the streaming pass (not the relocalization of every frame)");
   app.add_option("--orb-features", matcher_options.Of<OrbMatcherOptions>().num_features, "the map's ORB features");
   CLI11_PARSE(app, argc, argv);
-  std::vector<bench::LocalizerVariant> variants;
-  if (!acceptance.empty()) variants = bench::ParseAcceptanceVariants(acceptance);
-  if (!variant_list.empty()) variants = bench::ParseLocalizerVariants(variant_list);
+  const std::vector<bench::LocalizerVariant> variants = bench::VariantsToCompare(acceptance, variant_list);
   vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   const fs::path map_directory = fs::temp_directory_path() / ("vmap_localize_accuracy_" + std::to_string(getpid()));
   fs::remove_all(map_directory);
@@ -194,7 +192,6 @@ int main(int argc, char** argv) {
   std::printf("%s: map of %d even frames, %zu key images (tau %.2f)\n", input.c_str(), map.num_frames,
               map.key_images.size(), tau);
 
-  if (variants.empty()) variants.push_back({});
   FrameSourceOptions odd = even;
   odd.first = 1;
   for (const bench::LocalizerVariant& variant : variants) {

@@ -196,9 +196,7 @@ int main(int argc, char** argv) {
   app.add_option("--orb-features", matcher_options.Of<OrbMatcherOptions>().num_features, "the map's ORB features");
   CLI11_PARSE(app, argc, argv);
   const std::pair<int, int> teach = Range(teach_range), repeat = Range(repeat_range);
-  std::vector<bench::LocalizerVariant> variants;
-  if (!acceptance.empty()) variants = bench::ParseAcceptanceVariants(acceptance);
-  if (!variant_list.empty()) variants = bench::ParseLocalizerVariants(variant_list);
+  const std::vector<bench::LocalizerVariant> variants = bench::VariantsToCompare(acceptance, variant_list);
   vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   const auto poses = ReadGroundTruth(sequence / "groundtruth.txt");
   if (poses.empty()) {
@@ -226,7 +224,6 @@ int main(int argc, char** argv) {
       "teach frames %d-%d: %zu key images; repeat frames %d-%d (stride %d); near = within %.2f m and %.0f deg\n",
       teach.first, teach.second, map.key_images.size(), repeat.first, repeat.second, stride, max_distance, max_angle);
 
-  if (variants.empty()) variants.push_back({});
   for (const bench::LocalizerVariant& variant : variants) {
     std::printf("--- %s\n", variant.Name().c_str());
     LocalizerOptions localizer_options = MapLocalizerOptions(opened);

@@ -74,4 +74,14 @@ inline std::vector<LocalizerVariant> ParseLocalizerVariants(const std::string& l
   return variants;
 }
 
+// The variants of the bench's --acceptance and --variants lists (--variants when both are given); the localizer's
+// defaults alone when neither is.
+inline std::vector<LocalizerVariant> VariantsToCompare(const std::string& acceptance, const std::string& variant_list) {
+  std::vector<LocalizerVariant> variants;
+  if (!acceptance.empty()) variants = ParseAcceptanceVariants(acceptance);
+  if (!variant_list.empty()) variants = ParseLocalizerVariants(variant_list);
+  if (variants.empty()) variants.push_back({});
+  return variants;
+}
+
 }  // namespace vmap::bench
