@@ -179,7 +179,7 @@ void Localizer::Reset() {
   rival_frames_left_ = 0;
   position_ = start_position_;
   lost_in_a_row_ = 0;
-  placed_before_ = -1;
+  placed_before_ = steered_before_ = moved_back_to_ = -1;
   features_before_.clear();
   ranking_first_before_ = heading_mode_before_ = -1;
   dropped_position_ = -1;
@@ -244,6 +244,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
       previous_headings_.emplace_back(m.comparison.key, m.comparison.heading.px);
   }
   placed_before_ = IsPlaced(result.status) ? result.route_position : -1;
+  RememberMoveBack(result);
   // Kept as the matcher serializes them: features are polymorphic and the caller's go with the frame; only while the
   // run has an estimate, since the next frame asks whether it stands still only when tracked from it (after a frame
   // placed there, or lost there).
@@ -432,14 +433,17 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
       if (c.accepted && c.num_verified > best.num_verified) rival_beats = true;
     }
   }
-  bool doubted = false;  // a lone step back, while a far relocalization verified more (doubt_lone_step_back)
+  bool doubted = false;  // a lone step back, a changed scene or a move back, while a far relocalization verified more
   // Carried off since the frame before (scene_change_log10_nfa): the key image left may still accept a few chance
   // matches, which one frame steered by there would follow. Asked only where those are all the frame holds there
   // (scene_change_tracked_log10_nfa): a frame far beyond chance at its key image is there, whatever the frame before.
   const bool rivals_decided = AcceptedAgainstRivals(best);
   const bool scene_changed = !rivals_decided && best.log10_nfa > options_.scene_change_tracked_log10_nfa &&
                              SceneChangedSinceFrameBefore(features);
-  if (!rivals_decided && (SharesLittle(best) || pointed_before_ >= 0 || rival_beats || scene_changed)) {
+  // Where the run moved back (ask_where_moved_back), a look-alike key image behind holds the tracker.
+  const bool moved_back =
+      options_.ask_where_moved_back && !binary_descriptors_ && moved_back_to_ >= 0 && best_position == moved_back_to_;
+  if (!rivals_decided && (SharesLittle(best) || pointed_before_ >= 0 || rival_beats || scene_changed || moved_back)) {
     // Accepted, but with much less than neighbouring key images share: the frame may be elsewhere on the
     // route, in view of this key image's scene. Moved when a ranked key image verifies more matches (a
     // relocalization that is not taken leaves nothing behind: the tracked estimate is set below). Also asked when
@@ -458,7 +462,8 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
       // A far place verifies more, on one frame: no jump yet. The key image behind, all that still verifies where the
       // frames were, holds the tracker as a lost frame's estimate is held: not steered by (the robot may have been
       // carried off; the next frame is asked again and decides).
-      doubted = (lone_step_back && options_.doubt_lone_step_back) || scene_changed;
+      doubted = (lone_step_back && options_.doubt_lone_step_back) || scene_changed ||
+                (moved_back && options_.doubt_where_moved_back);
     }
   }
   if (best_position < position) stepped_back_from_ = position;

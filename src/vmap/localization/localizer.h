@@ -298,6 +298,9 @@ class Localizer {
   // frame not steered by, than its key images: rival_place_when_not_steered) as rival_place_, or counts down the one
   // remembered.
   void RememberRivalPlace(const LocalizationResult& result);
+  // Remembers the key image a frame placed behind the last frame placed moved the run back to as moved_back_to_, while
+  // the frames after it are placed there (ask_where_moved_back).
+  void RememberMoveBack(const LocalizationResult& result);
   // A frame not steered by compares the rival place (it and the key image after it), whose evidence then weighs the
   // belief; Track compares it for the frames it tracks (rival_place_when_not_steered).
   void CompareRivalPlace(const LocalizationResult& result, const ImageFeatures& features);
@@ -358,6 +361,11 @@ class Localizer {
   int lost_in_a_row_ = 0;
   // The route position the frame before this one was placed at (tracking or relocalized); -1: it was not.
   int placed_before_ = -1;
+  // The route position of the last frame placed, whatever the frames after it (-1: none since the start or a reset),
+  // and the route position a placed frame moved back to behind it, while the frames after it are placed there (-1:
+  // none; LocalizerOptions::ask_where_moved_back).
+  int steered_before_ = -1;
+  int moved_back_to_ = -1;
   // The frame before's features as the matcher serializes them, kept where a rule that steps a frame on may ask
   // whether it stands still (StillSinceFrameBefore); empty: not kept, or the run had no estimate after that frame.
   std::string features_before_;

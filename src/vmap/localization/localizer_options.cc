@@ -58,6 +58,14 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Track a frame that stepped back because nothing at or ahead of the key image verified, though a far "
                  "key image verifies more (otherwise it is uncertain)"},
                 doubt_lone_step_back);
+  visitor.Visit({"ask_where_moved_back", "!--no-ask-where-moved-back",
+                 "Float descriptors: never relocalize a tracked frame for being at a key image behind the last one a "
+                 "frame was steered by (otherwise it is, and each frame after it held there)"},
+                ask_where_moved_back);
+  visitor.Visit({"doubt_where_moved_back", "!--no-doubt-where-moved-back",
+                 "Track a frame asked where it is for being where the run moved back (--no-ask-where-moved-back) "
+                 "though its relocalization finds a far key image verifying more (otherwise it is uncertain)"},
+                doubt_where_moved_back);
   visitor.Visit({"rival_place_frames", "--rival-place-frames",
                  "Frames a far key image that verified more than the one a frame was steered by is compared again; "
                  "a tracked frame it out-verifies again is relocalized (0 = never)"},

@@ -89,6 +89,21 @@ struct LocalizerOptions {
   // carried elsewhere must not be steered by the place it left while the frames after it decide (docs/localize.md, "A
   // lone step back is doubted"). Off: it is tracked there.
   bool doubt_lone_step_back = true;
+  // Float descriptors (XFeat): a tracked frame at a key image behind the last one a frame was steered by (the run moved
+  // back: a step back, a relocalization behind, a robot carried back), and each frame after it tracked there, is
+  // relocalized as one that shares little with its key image is, until the tracker leaves that key image. The route
+  // goes forwards, and across lighting XFeat verifies as much at a key image where the corridor repeats itself as at
+  // the right one: corridor_conditions' key image 3 (teach frame 9) verifies 19-30 matches at log10 NFA -5 to -27 with
+  // repeat frames 20-34 (right: key images 4-10). Moved back there, the tracker compares only the key images after it,
+  // which verify less, and is held (the kidnapped run at the verifier's seed 6: 7 frames steered by 3-5 key images
+  // behind); its relocalization compares the ranking's best key images and their neighbours, and moves the frame to
+  // one that verifies more (a far one still takes two frames: Localizer::TakesJump). A frame steered by where the
+  // frames before were, or ahead of them, is not asked (docs/measurements/localization-conditions.md, "A frame where
+  // the run moved back is asked where it is"). Off: such a frame is asked only as any other is.
+  bool ask_where_moved_back = true;
+  // ... and such a frame is `uncertain`, not steered by, where its relocalization finds a far key image verifying more
+  // (the place the run moved back to is doubted as the place a carried robot left is: doubt_lone_step_back).
+  bool doubt_where_moved_back = true;
   // A place elsewhere on the route that verified more matches than the key images a frame was steered by (a key image
   // more than two route positions away) is a rival: for this many frames it is compared again (it and the key image
   // after it), and a tracked frame it out-verifies again is relocalized, as a frame that shares little with its key

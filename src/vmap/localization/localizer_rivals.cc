@@ -2,7 +2,7 @@
 // season, and across seasons they refuse every key image a frame is compared with, the right one too. The key image
 // that stands far above those compared elsewhere on the route is then accepted: it is the frame's place, not only
 // its scene, as far as the frame itself can tell. And the rival place (LocalizerOptions::rival_place_frames) compared
-// by the frames not steered by.
+// by the frames not steered by, and the place the run moved back to (LocalizerOptions::ask_where_moved_back).
 #include <algorithm>
 #include <cstdlib>
 
@@ -166,6 +166,16 @@ void Localizer::RememberRivalPlace(const LocalizationResult& result) {
   if (rival < 0) return;
   rival_place_ = rival;
   rival_frames_left_ = options_.rival_place_frames;
+}
+
+void Localizer::RememberMoveBack(const LocalizationResult& result) {
+  if (!IsPlaced(result.status)) return;  // an uncertain or lost frame moves nothing the frames after it follow
+  if (steered_before_ >= 0 && result.route_position < steered_before_) {
+    moved_back_to_ = result.route_position;
+  } else if (result.route_position != moved_back_to_) {
+    moved_back_to_ = -1;  // moved on, or placed elsewhere ahead
+  }
+  steered_before_ = result.route_position;
 }
 
 int Localizer::OutVerifiedFrom(const LocalizationResult& result) const {

@@ -364,6 +364,22 @@ TEST_F(XfeatCorridorRun, AFrameThatDoesNotSeeTheFrameBeforesSceneIsAskedAgain) {
   }
 }
 
+// A frame where the run moved back is asked where it is (docs/localize.md): repeat frames 100-110 and then 20-40 as one
+// run (a robot carried back 80 frames), started at teach frame 100's key image, at the verifier's seed 6. After the
+// carry the frames are relocalized at key image 3 (teach frame 9; right: 4-5), which verifies as much as the right
+// key images up to repeat frame 34; the tracker compared only the key images after it, which verify less, stepped on
+// to 4 and back to 3 on frame 28, and steered frames 28-34 at key image 3 (right: 6-8). Asked on the frames after the
+// move back, frame 22 is relocalized at key image 5, and the run follows the right key images.
+TEST_F(XfeatCorridorRun, AFrameWhereTheRunMovedBackIsAskedWhereItIs) {
+  const std::vector<int> run = CarriedRun(100, 110, 20, 40);
+  auto steered_far = [&](const std::string& flags) {
+    return Far(SteeredOnRun(run, KeyBefore(100), " --verifier-seed 6" + flags));
+  };
+  EXPECT_EQ(steered_far(""), 0);
+  EXPECT_GE(steered_far(" --no-ask-where-moved-back"), 1)
+      << "the test no longer reaches the frames held at the key image the run moved back to";
+}
+
 // michigan_seasons' session `query` (its five places) against an XFeat map of session `teach`'s, built in `dir` as
 // bench/route_conditions.py builds it (`--tau 1`): `vmap localize`'s map and images arguments; "" without the data.
 std::string MichiganRoute(const fs::path& dir, const std::string& query, const std::string& teach) {
