@@ -104,7 +104,7 @@ struct LocalizerOptions {
   bool ask_where_moved_back = true;
   // ... and such a frame is `uncertain`, not steered by, where its relocalization finds a far key image verifying more
   // (the place the run moved back to is doubted as the place a carried robot left is: doubt_lone_step_back). Seeds 0-7:
-  // 3 -> 1 far frames (the corridor from frame 20 at seed 5), 5 right frames uncertain in 64 runs.
+  // 3 -> 1 far frames (the corridor from frame 20 at seed 5), 5 right frames uncertain in 48 runs.
   bool doubt_where_moved_back = true;
   // A place elsewhere on the route that verified more matches than the key images a frame was steered by (a key image
   // more than two route positions away) is a rival: for this many frames it is compared again (it and the key image
