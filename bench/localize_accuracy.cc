@@ -76,8 +76,10 @@ void Measure(const std::string& input, const LocalizationMap& opened, const Loca
                              std::to_string(r.key) + " (bracket " + std::to_string(before) + "," +
                              std::to_string(after) + ")");
           }
+          // Frames past the last key image (or before the first) have no segment: KeysAround gives -1 on that
+          // side, which a result at the route's end matches (its next_key is -1 too).
           const auto [before, after] = KeysAround(map, frame.source_index);
-          if (r.key == before && r.next_key == after && before != after && std::isfinite(r.progress)) {
+          if (before >= 0 && after > before && r.key == before && r.next_key == after && std::isfinite(r.progress)) {
             const double a = map.key_images[before].source_index, b = map.key_images[after].source_index;
             progress_error += std::abs(r.progress - (frame.source_index - a) / (b - a));
             ++progress_count;

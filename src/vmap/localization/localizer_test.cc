@@ -82,7 +82,7 @@ TEST(Localizer, ProgressGrowsAlongASegment) {
   for (size_t i = 0; i < frames.size(); ++i) {
     const LocalizationResult r = LocalizeOnEvenMap(localizer, frames[i], static_cast<int>(i), indices[i]);
     const auto [before, after] = KeysAround(m.map, indices[i]);
-    if (r.key != before || r.next_key != after || !std::isfinite(r.progress)) continue;
+    if (before < 0 || after <= before || r.key != before || r.next_key != after || !std::isfinite(r.progress)) continue;
     const double a = m.map.key_images[before].source_index, b = m.map.key_images[after].source_index;
     estimated.push_back(r.progress);
     truth.push_back((indices[i] - a) / (b - a));
