@@ -21,6 +21,9 @@ held-out robot corridor's goal is none). Several vmap binaries
 (`--vmap A,B`) run one after the other on the same maps' inputs (each builds its own maps), so they compare side by
 side.
 
+Under each row, its frames confidently > 2 places off and its back-jumps are named, the first 8 (--named-frames N:
+the first N; 0: all of them).
+
 With --evidence-dir DIR, also every frame of each run against every key image of its map
 (build/bench/evidence_dump) into DIR/corridor_MATCHER.csv and DIR/michigan_MATCHER.csv, the input of
 bench/evidence_fit.py.
@@ -41,7 +44,7 @@ of every figure"). Default: the map's seed only, the flag not passed (binaries b
 
 usage: bench/route_conditions.py --vmap build/vmap[,old/vmap] [--sets corridor,kidnapped,elsewhere,michigan] [--matchers orb,xfeat]
                                  [--tau T] [--start-key K|none] [--build "FLAGS"] [--localize "FLAGS"] [--repeat-stride N] [--work DIR] [--csv-dir DIR]
-                                 [--evidence-dir DIR] [--seeds S,S,...]
+                                 [--evidence-dir DIR] [--seeds S,S,...] [--named-frames N]
 (from the repository root; ../shared must be there)"""
 import argparse, json, os, subprocess, sys, tempfile
 
@@ -80,7 +83,7 @@ class Tally:
         self.frames = self.right = self.right_sure = self.wrong = self.confidently_far = self.uncertain = self.lost = 0
         self.back_jumps = 0
         self.seconds = 0.0
-        self.far = []
+        self.far = []  # the far frames and back-jumps, in the order they came: report() names the first ones
 
     def add(self, doc, right_keys_of, label, name_of=lambda f: "frame %d" % f["source_index"]):
         """`right_keys_of(frame)`: the set of right key images of that frame; `name_of(frame)`: how `far` names it."""
@@ -90,8 +93,7 @@ class Tally:
             if f["status"] in ("tracking", "relocalized"):
                 if steered_key is not None and f["key"] < steered_key:
                     self.back_jumps += 1
-                    if len(self.far) < 8:
-                        self.far.append("%s %s: back-jump to key %d from %d" % (label, name_of(f), f["key"], steered_key))
+                    self.far.append("%s %s: back-jump to key %d from %d" % (label, name_of(f), f["key"], steered_key))
                 steered_key = f["key"]
             right = right_keys_of(f)
             status = f["status"]
@@ -109,9 +111,8 @@ class Tally:
             self.wrong += 1
             if min(abs(f["key"] - k) for k in right) > 2:
                 self.confidently_far += 1
-                if len(self.far) < 8:
-                    self.far.append("%s %s at key %d (right %s)" % (label, name_of(f), f["key"],
-                                                                    ",".join(map(str, sorted(right)))))
+                self.far.append("%s %s at key %d (right %s)" % (label, name_of(f), f["key"],
+                                                                ",".join(map(str, sorted(right)))))
         self.seconds += doc["summary"]["seconds"]
 
     def row(self, name):
@@ -247,10 +248,10 @@ def michigan(vmap, matcher, localize_flags, work, evidence_dir=None, build_flags
     return tally
 
 
-def report(tally, name):
-    """Prints the tally's row and the frames it names (far, back-jumps)."""
+def report(tally, name, named_frames):
+    """Prints the tally's row and the first `named_frames` frames it names (far, back-jumps; 0: all of them)."""
     print(tally.row(name), flush=True)
-    for line in tally.far:
+    for line in tally.far[:named_frames or None]:
         print("    " + line)
 
 
@@ -288,6 +289,8 @@ def main():
                         "each binary's in DIR/binaryN (N: its place in --vmap, from 0); with --seeds, each seed's in "
                         "seedS below that")
     parser.add_argument("--evidence-dir", help="write every frame's comparisons with every key image here")
+    parser.add_argument("--named-frames", type=int, default=8, help="under each row, name at most this many of its "
+                        "frames confidently > 2 places off and back-jumps, the first ones (0: all of them)")
     args = parser.parse_args()
     if args.seeds and args.evidence_dir:
         parser.error("--evidence-dir dumps evidence_dump's comparisons, which take no seed of the localizer's: give it without --seeds")
@@ -318,7 +321,7 @@ def main():
                     if csv_dir:
                         os.makedirs(csv_dir, exist_ok=True)
                     tallies.append(run_set(flags, csv_dir))
-                    report(tallies[-1], name + (", seed " + seed if seed is not None else ""))
+                    report(tallies[-1], name + (", seed " + seed if seed is not None else ""), args.named_frames)
                 if len(tallies) > 1:
                     print(spread_row(tallies, "%s, seeds %s: mean [min-max]" % (name, ",".join(seeds))), flush=True)
 
