@@ -36,9 +36,8 @@
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/map/map_io.h"
-#include "vmap/mapping/batch_build.h"
-#include "vmap/mapping/recorded_options.h"
 
+#include "bench_map.h"
 #include "localizer_variants.h"
 
 namespace fs = std::filesystem;
@@ -172,24 +171,14 @@ int main(int argc, char** argv) {
   const std::vector<bench::LocalizerVariant> variants = bench::VariantsToCompare(acceptance, variant_list);
   vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   const fs::path map_directory = fs::temp_directory_path() / ("vmap_localize_accuracy_" + std::to_string(getpid()));
-  fs::remove_all(map_directory);
-  fs::create_directories(map_directory);
 
   // The map: even frames.
-  const auto matcher = CreateMatcher(matcher_options);
   MapBuilderOptions build_options;
   build_options.key_images.tau = tau;
-  build_options.show_progress = false;
   FrameSourceOptions even;
   even.stride = 2;
   even.last = last;
-  {
-    auto source = OpenFrameSource(input, even);
-    const VisualMap built =
-        BuildMap(*source, *matcher, build_options, map_directory, DescribeMapOptions(*matcher, build_options, even));
-    WriteMapFiles(built, map_directory);
-  }
-  LocalizationMap opened = OpenLocalizationMap(map_directory, {});
+  LocalizationMap opened = bench::BuildAndOpenMap(input, even, matcher_options, build_options, map_directory);
   const VisualMap& map = opened.map;
   std::printf("%s: map of %d even frames, %zu key images (tau %.2f)\n", input.c_str(), map.num_frames,
               map.key_images.size(), tau);

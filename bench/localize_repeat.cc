@@ -36,9 +36,8 @@
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/map/map_io.h"
-#include "vmap/mapping/batch_build.h"
-#include "vmap/mapping/recorded_options.h"
 
+#include "bench_map.h"
 #include "localizer_variants.h"
 
 namespace fs = std::filesystem;
@@ -204,21 +203,10 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path map_directory = fs::temp_directory_path() / ("vmap_localize_repeat_" + std::to_string(getpid()));
-  fs::remove_all(map_directory);
-  fs::create_directories(map_directory);
-  {
-    const auto matcher = CreateMatcher(matcher_options);
-    MapBuilderOptions options;
-    options.show_progress = false;
-    FrameSourceOptions source_options;
-    source_options.first = teach.first;
-    source_options.last = teach.second;
-    auto source = OpenFrameSource(sequence.string(), source_options);
-    const VisualMap built =
-        BuildMap(*source, *matcher, options, map_directory, DescribeMapOptions(*matcher, options, source_options));
-    WriteMapFiles(built, map_directory);
-  }
-  LocalizationMap opened = OpenLocalizationMap(map_directory, {});
+  FrameSourceOptions teach_frames;
+  teach_frames.first = teach.first;
+  teach_frames.last = teach.second;
+  LocalizationMap opened = bench::BuildAndOpenMap(sequence.string(), teach_frames, matcher_options, {}, map_directory);
   const VisualMap& map = opened.map;
   std::printf(
       "teach frames %d-%d: %zu key images; repeat frames %d-%d (stride %d); near = within %.2f m and %.0f deg\n",
