@@ -1,6 +1,7 @@
 #include "vmap/map/map_writer.h"
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -48,6 +49,44 @@ std::string KeyImageFileName(const Frame& frame) {
 [[noreturn]] void CannotWrite(const fs::path& file, const std::string& reason) {
   throw InputError("cannot write '" + file.string() + "' (" + reason +
                    "); check the free space and the permissions of the output directory");
+}
+
+// A record of the evaluations' file: Evaluation's fields one after another, in this process's byte order (the
+// file never leaves it). Not the struct as laid out in memory: its padding bytes are never initialised, and
+// valgrind reported them written. `f(field)` for each field of `e`, in the record's order.
+template <typename E, typename F>
+constexpr void ForEachRecordField(E& e, F&& f) {
+  f(e.key_frame);
+  f(e.frame);
+  f(e.similarity);
+  f(e.num_tentative);
+  f(e.num_verified);
+  f(e.matched);
+}
+constexpr std::size_t RecordSize() {
+  std::size_t size = 0;
+  const Evaluation e;
+  ForEachRecordField(e, [&](const auto& field) { size += sizeof field; });
+  return size;
+}
+static_assert(RecordSize() == kEvaluationRecordSize);
+
+std::array<char, kEvaluationRecordSize> EvaluationRecord(const Evaluation& e) {
+  std::array<char, kEvaluationRecordSize> record;
+  char* out = record.data();
+  ForEachRecordField(e, [&](const auto& field) {
+    std::memcpy(out, &field, sizeof field);
+    out += sizeof field;
+  });
+  return record;
+}
+Evaluation EvaluationOfRecord(const char* in) {
+  Evaluation e;
+  ForEachRecordField(e, [&](auto& field) {
+    std::memcpy(&field, in, sizeof field);
+    in += sizeof field;
+  });
+  return e;
 }
 
 }  // namespace
@@ -107,8 +146,8 @@ std::string MapWriter::AddKeyImage(std::shared_ptr<const Frame> frame) {
 void MapWriter::FlushKeyImages() { key_images_->Flush(); }
 
 void MapWriter::AddEvaluation(const Evaluation& evaluation) {
-  // The record is the struct as laid out in memory: the file never leaves this process.
-  if (std::fwrite(&evaluation, sizeof evaluation, 1, evaluations_) != 1) {
+  const std::array<char, kEvaluationRecordSize> record = EvaluationRecord(evaluation);
+  if (std::fwrite(record.data(), record.size(), 1, evaluations_) != 1) {
     CannotWrite(directory_ / kEvaluationsSpillFileName, std::strerror(errno));
   }
   ++num_evaluations_;
@@ -120,12 +159,13 @@ EvaluationSource MapWriter::Evaluations() {
   const long count = num_evaluations_;
   return [spill, count](const std::function<void(const Evaluation&)>& fn) {
     std::ifstream in(spill, std::ios::binary);
-    std::vector<Evaluation> chunk(4096);
+    constexpr long kChunk = 4096;  // records read at once
+    std::vector<char> chunk(kChunk * kEvaluationRecordSize);
     for (long done = 0; done < count;) {
-      const long n = std::min<long>(count - done, static_cast<long>(chunk.size()));
-      in.read(reinterpret_cast<char*>(chunk.data()), static_cast<std::streamsize>(n * sizeof(Evaluation)));
+      const long n = std::min(count - done, kChunk);
+      in.read(chunk.data(), static_cast<std::streamsize>(n * kEvaluationRecordSize));
       if (!in) throw InputError("cannot read back '" + spill.string() + "', vmap's own file; was it removed?");
-      for (long i = 0; i < n; ++i) fn(chunk[i]);
+      for (long i = 0; i < n; ++i) fn(EvaluationOfRecord(chunk.data() + i * kEvaluationRecordSize));
       done += n;
     }
   };

@@ -8,6 +8,7 @@
 // that file column by column (WriteMapJson). Key images and links, which grow with the map itself, stay in
 // memory.
 
+#include <cstddef>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -24,6 +25,8 @@ namespace vmap {
 
 // The evaluations' file while a map is built; removed once map.json is written.
 inline constexpr const char* kEvaluationsSpillFileName = "evaluations.partial";
+// The bytes of one evaluation in that file: its fields alone, no padding (map_writer.cc).
+inline constexpr std::size_t kEvaluationRecordSize = 4 * sizeof(int) + sizeof(double) + sizeof(bool);
 
 // Where Snapshot() commits its maps.
 struct SnapshotTarget {

@@ -83,6 +83,10 @@ TEST(MapWriter, ASnapshotIsACompleteMapAtTheFinalPathAndTheBuildGoesOn) {
   MapWriter writer(output.path(), SnapshotTarget{final_path, policy});
   for (int f = 1; f < 10; ++f) writer.AddEvaluation({0, f, 0.9, 10, 9, true});
   writer.Snapshot(ChainMap(writer, 2, 10));
+  // The evaluations' file (flushed by the snapshot) holds the fields alone: not the struct with its padding,
+  // whose bytes are never initialised.
+  EXPECT_EQ(fs::file_size(output.path() / kEvaluationsSpillFileName), 9 * kEvaluationRecordSize);
+  EXPECT_LT(kEvaluationRecordSize, sizeof(Evaluation));
   {
     const VisualMap snapshot = ReadMap(final_path);
     EXPECT_EQ(snapshot.num_frames, 10);

@@ -77,7 +77,8 @@ struct Link {
   bool planar = false;
 };
 
-// One comparison S(key, frame) made while building: what a user looks at to choose tau.
+// One comparison S(key, frame) made while building: what a user looks at to choose tau. A new field goes into
+// the build's evaluations file too (map_writer.cc, ForEachRecordField; kEvaluationRecordSize).
 struct Evaluation {
   int key_frame = 0;
   int frame = 0;
