@@ -228,6 +228,10 @@ class Localizer {
   // hold at most half of it.
   bool EvidenceWeighsAgainst(int position) const;
   void Question(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
+  // A frame placed more than kNear route positions behind where the tracker was, where an accepted key image within
+  // kNear of that estimate, beyond a little chance, verified nearly as many matches as the place: the frame is
+  // `uncertain` and the tracker stays (LocalizerOptions::doubt_jump_back; localizer_jump_back.cc).
+  void DoubtJumpBack(LocalizationResult& result);
   // Compares the frame with the best-ranked key images of the route (relocalization_candidates of them), in
   // rank order; returns the ranking's route positions compared.
   std::vector<int> CompareBestRanked(const Frame& frame, const ImageFeatures& features);

@@ -113,6 +113,7 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
   SettleStepBack(result, features);
   StepOnByBelief(result, features);
   Question(result, frame, features);
+  DoubtJumpBack(result);
   // Not to steer by at route `position`: the belief holds less than min_confidence near it, or the frames' evidence
   // alone points away from it or weighs against it while the start is unconfirmed.
   auto withholds = [&](int position) {

@@ -106,6 +106,17 @@ struct LocalizerOptions {
   // (the place the run moved back to is doubted as the place a carried robot left is: doubt_lone_step_back). Seeds 0-7:
   // 3 -> 1 far frames (the corridor from frame 20 at seed 5), 5 right frames uncertain in 48 runs.
   bool doubt_where_moved_back = true;
+  // Float descriptors (XFeat): a frame placed more than two route positions behind the tracked estimate (a
+  // relocalization or a move of the belief behind it) is `uncertain`, and the tracker stays, where an accepted key
+  // image within two route positions of the estimate, verifying beyond a little chance (log10 NFA at most -10),
+  // verified at least 0.7 times the matches of the place the frame jumped to. The route goes forwards, and across
+  // lighting XFeat verifies as much at corridor_conditions' key image 3 as at the right key images 7-8 (repeat frame 30
+  // at the verifier's seed 10: key image 3 32 matches at log10 NFA -22.0, key image 8 30 at -19.7; relocalized back
+  // there, frames 30-33 were steered by 4-6 key images off). A jump back no clearer than where the frames were is the
+  // look-alike's as likely as the robot's (docs/measurements/localization-conditions.md, "A jump back no clearer than
+  // where the frames were is doubted": XFeat's corridor sets over the verifier's seeds 0-11, frames confidently more
+  // than 2 key images off 17 -> 11, 69 of 72 CSVs the same). Off: such a frame is placed where it jumped.
+  bool doubt_jump_back = true;
   // A place elsewhere on the route that verified more matches than the key images a frame was steered by (a key image
   // more than two route positions away) is a rival: for this many frames it is compared again (it and the key image
   // after it), and a tracked frame it out-verifies again is relocalized, as a frame that shares little with its key

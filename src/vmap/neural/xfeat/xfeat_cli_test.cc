@@ -380,6 +380,23 @@ TEST_F(XfeatCorridorRun, AFrameWhereTheRunMovedBackIsAskedWhereItIs) {
       << "the test no longer reaches the frames held at the key image the run moved back to";
 }
 
+// A jump back no clearer than where the frames were is doubted (docs/localize.md): repeat frames 20-36 started at key
+// image 0 (bench/route_conditions.py's corridor from 20), at the verifier's seeds 10 and 5. Repeat frame 30 (seed 10)
+// verifies 32 matches at key image 3 and 30 at the right key image 8; the frame before pointing back there, it was
+// relocalized at key image 2, and frames 30-33 were steered by at 2-3 (right: 7-8). At seed 5 the belief moved frame 29
+// back to key image 3 (28 matches; key image 7 24). Doubted, such a frame is uncertain and the tracker stays with the
+// right key images.
+TEST_F(XfeatCorridorRun, AJumpBackNoClearerThanWhereTheFramesWereIsDoubted) {
+  for (const std::string seed : {"10", "5"}) {
+    auto steered_far = [&](const std::string& flags) {
+      return Far(SteeredOnRepeat(20, 36, 0, " --verifier-seed " + seed + flags));
+    };
+    EXPECT_EQ(steered_far(""), 0) << "seed " << seed;
+    EXPECT_GE(steered_far(" --no-doubt-jump-back"), 1)
+        << "seed " << seed << ": the test no longer reaches a frame placed by a jump back";
+  }
+}
+
 // michigan_seasons' session `query` (its five places) against an XFeat map of session `teach`'s, built in `dir` as
 // bench/route_conditions.py builds it (`--tau 1`): `vmap localize`'s map and images arguments; "" without the data.
 std::string MichiganRoute(const fs::path& dir, const std::string& query, const std::string& teach) {
