@@ -227,6 +227,11 @@ class Localizer {
   // evidence_belief_ holds less within kNear of `position` than a flat belief would, on a route where those positions
   // hold at most half of it.
   bool EvidenceWeighsAgainst(int position) const;
+  // While the start is unconfirmed, with float descriptors (LocalizerOptions::start_place_stands_out,
+  // localizer_start_place.cc): a key image more than kNear from the frame's place (one it compared, or the best-ranked
+  // such key image, compared now without weighing the belief) verified at least as many matches as its accepted key
+  // images, or weighs at least as much by the evidence model: the frame cannot tell its place from a far one.
+  bool StartPlaceTiesFar(const LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
   void Question(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
   // A frame placed more than kNear route positions behind where the tracker was, where an accepted key image within
   // kNear of that estimate, beyond a little chance, verified nearly as many matches as the place: the frame is

@@ -136,7 +136,9 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
   if (position < 0) return;
   result.confidence = belief_.MassWithin(position, kNear);
   const bool placed = IsPlaced(result.status);
-  if (placed && (withheld_unranked || withholds(position))) result.status = LocalizationStatus::kUncertain;
+  if (placed && (withheld_unranked || withholds(position) || StartPlaceTiesFar(result, frame, features))) {
+    result.status = LocalizationStatus::kUncertain;
+  }
   // Confirmed: the frames' evidence alone leans most near the place the frame is steered by (with the frame's ranking
   // and without it).
   if (start_unconfirmed_ && placed && result.status != LocalizationStatus::kUncertain &&

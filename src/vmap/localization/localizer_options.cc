@@ -104,6 +104,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "--start-key: steer by a frame before the start is confirmed even where the frames' evidence alone "
                  "holds less near its key image than a flat belief would (otherwise it is uncertain)"},
                 start_needs_evidence);
+  visitor.Visit({"start_place_stands_out", "!--no-start-place-stands-out",
+                 "--start-key, float descriptors: steer by a frame before the start is confirmed even where a key "
+                 "image more than two places away verifies as much (otherwise it is uncertain)"},
+                start_place_stands_out);
   visitor.Visit({"max_lost_frames", "--max-lost", "Lost frames in a row before the estimate is dropped"},
                 max_lost_frames);
   visitor.Visit({"relocalization_candidates", "--candidates", "Best-ranked key images verified when relocalizing"},

@@ -397,6 +397,23 @@ TEST_F(XfeatCorridorRun, AJumpBackNoClearerThanWhereTheFramesWereIsDoubted) {
   }
 }
 
+// A run started elsewhere confirms a place that stands out (docs/localize.md): repeat frames 50-62 started at key
+// image 0 (bench/route_conditions.py's corridor from 50), at the verifier's seeds 10 and 11. Frame 53 verifies key
+// image 29 (the route's dark end; right: 14-15), frame 54 key images 29-30 with as many matches as key image 16 (22):
+// frame 54 was relocalized at 29 and frame 55 tracked at 29-30, which confirmed the start there. Neither stands out of
+// a far place (frame 55: key image 15, compared for the question, verifies 30): both uncertain, and frame 57 confirms
+// the start at key image 15.
+TEST_F(XfeatCorridorRun, ARunStartedElsewhereConfirmsAPlaceThatStandsOut) {
+  for (const std::string seed : {"10", "11"}) {
+    auto steered_far = [&](const std::string& flags) {
+      return Far(SteeredOnRepeat(50, 62, 0, " --verifier-seed " + seed + flags));
+    };
+    EXPECT_EQ(steered_far(""), 0) << "seed " << seed;
+    EXPECT_GE(steered_far(" --no-start-place-stands-out"), 1)
+        << "seed " << seed << ": the test no longer reaches the frames placed at the route's dark end";
+  }
+}
+
 // michigan_seasons' session `query` (its five places) against an XFeat map of session `teach`'s, built in `dir` as
 // bench/route_conditions.py builds it (`--tau 1`): `vmap localize`'s map and images arguments; "" without the data.
 std::string MichiganRoute(const fs::path& dir, const std::string& query, const std::string& teach) {
