@@ -453,7 +453,8 @@ TEST(VmapXfeat, AFrameOfAnotherPlaceThanTheFrameBeforeIsAskedWhereItIs) {
   };
   const std::vector<std::pair<int, int>> asked = steered("");
   EXPECT_EQ(SteeredOff(asked, 2), 0) << ::testing::PrintToString(asked);
-  EXPECT_GE(SteeredOff(steered(" --scene-change-log10-nfa 0"), 2), 1) << "the test no longer reaches a frame tracked far";
+  EXPECT_GE(SteeredOff(steered(" --scene-change-log10-nfa 0"), 2), 1)
+      << "the test no longer reaches a frame tracked far";
 }
 
 // ... but not a frame its key image holds far beyond chance (docs/localize.md, the same rule): michigan_seasons'
