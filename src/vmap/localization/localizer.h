@@ -243,6 +243,8 @@ class Localizer {
 
   // The route's key images ranked for the frame (KeyImageRanking), best first; ranked once per frame.
   const std::vector<RankedKey>& RankRoute(const Frame& frame, const ImageFeatures& features);
+  // The same ranking computed without keeping it: whether the frame was ranked is part of what the belief weighs.
+  std::vector<RankedKey> RouteRanking(const Frame& frame, const ImageFeatures& features) const;
   // When no comparison of the frame is accepted: accepts the one with the most verified matches if it stands out
   // against its rivals, those compared more than kNear route positions away, the best-ranked of them always among
   // them (LocalizerOptions::min_rival_ratio; compared now when it was not). Returns its route position, -1 when none

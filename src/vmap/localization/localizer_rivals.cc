@@ -10,13 +10,15 @@
 
 namespace vmap {
 
+std::vector<RankedKey> Localizer::RouteRanking(const Frame& frame, const ImageFeatures& features) const {
+  const cv::Mat thumbnail = ranking_->method() == RankingMethod::kThumbnails
+                                ? ThumbnailDescriptor(frame.gray, options_.ranking.thumbnail_width)
+                                : cv::Mat();
+  return ranking_->Rank(features, thumbnail);
+}
+
 const std::vector<RankedKey>& Localizer::RankRoute(const Frame& frame, const ImageFeatures& features) {
-  if (ranked_.empty()) {
-    const cv::Mat thumbnail = ranking_->method() == RankingMethod::kThumbnails
-                                  ? ThumbnailDescriptor(frame.gray, options_.ranking.thumbnail_width)
-                                  : cv::Mat();
-    ranked_ = ranking_->Rank(features, thumbnail);
-  }
+  if (ranked_.empty()) ranked_ = RouteRanking(frame, features);
   return ranked_;
 }
 

@@ -42,10 +42,7 @@ bool Localizer::StartPlaceTiesFar(const LocalizationResult& result, const Frame&
   // The likeliest far place, as the frame's descriptors tell, when the frame did not compare it: compared now, without
   // weighing the belief (nor the frame's ranking, when the frame was not ranked): the frames' evidence is what the
   // belief weighed; this only asks whether the frame can tell its place from a far one.
-  const cv::Mat thumbnail = ranking_->method() == RankingMethod::kThumbnails
-                                ? ThumbnailDescriptor(frame.gray, options_.ranking.thumbnail_width)
-                                : cv::Mat();
-  const std::vector<RankedKey> ranked = ranked_.empty() ? ranking_->Rank(features, thumbnail) : ranked_;
+  const std::vector<RankedKey> ranked = ranked_.empty() ? RouteRanking(frame, features) : ranked_;
   for (const RankedKey& r : ranked) {  // route positions, best first
     if (!far(r.key)) continue;
     const int key = route_[r.key];
