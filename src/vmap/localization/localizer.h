@@ -300,7 +300,7 @@ class Localizer {
   // alike) does not move the tracker; two frames in a row pointing there do, when the belief, weighed by both, holds
   // at least as much per position near it as near the tracked estimate. Returns whether the tracker moves from route
   // position `from` to `to`; when not, remembers `to` for the next frame. Only with the belief on (belief.window and
-  // min_confidence above 0).
+  // min_confidence above 0; localizer_takes_jump.cc).
   bool TakesJump(int from, int to, int lost_frames);
   // How far from the tracked estimate a place is near enough to need no second frame: kNear, plus `lookahead` for each
   // of the `lost_frames` frames lost since (the robot moved on unseen, as the tracker would have followed).
