@@ -237,6 +237,11 @@ class Localizer {
   // kNear of that estimate, beyond a little chance, verified nearly as many matches as the place: the frame is
   // `uncertain` and the tracker stays (LocalizerOptions::doubt_jump_back; localizer_jump_back.cc).
   void DoubtJumpBack(LocalizationResult& result);
+  // Track's lookahead stopped at the key image after `best_position`: where `best` and that key image both verify by
+  // little beyond chance, the key image past it is compared, and becomes `best` where it verifies more beyond chance
+  // (LocalizerOptions::look_past_weak_next; localizer_look_past.cc).
+  void LookPastWeakNext(const Frame& frame, const ImageFeatures& features, int position, KeyComparison& best,
+                        int& best_position);
   // Compares the frame with the best-ranked key images of the route (relocalization_candidates of them), in
   // rank order; returns the ranking's route positions compared.
   std::vector<int> CompareBestRanked(const Frame& frame, const ImageFeatures& features);

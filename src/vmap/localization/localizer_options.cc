@@ -70,6 +70,11 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Float descriptors: place a frame more than two key images behind the tracked estimate even where "
                  "the key images near the estimate verify nearly as much (otherwise it is uncertain)"},
                 doubt_jump_back);
+  visitor.Visit({"look_past_weak_next", "!--no-look-past-weak-next",
+                 "Float descriptors: never look past a next key image that verifies by little beyond chance while the "
+                 "tracked one does too (otherwise the key image past it is compared, and stepped on to where it "
+                 "verifies more beyond chance)"},
+                look_past_weak_next);
   visitor.Visit({"rival_place_frames", "--rival-place-frames",
                  "Frames a far key image that verified more than the one a frame was steered by is compared again; "
                  "a tracked frame it out-verifies again is relocalized (0 = never)"},

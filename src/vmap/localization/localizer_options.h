@@ -117,6 +117,16 @@ struct LocalizerOptions {
   // where the frames were is doubted": XFeat's corridor sets over the verifier's seeds 0-11, frames confidently more
   // than 2 key images off 17 -> 11, 69 of 72 CSVs the same). Off: such a frame is placed where it jumped.
   bool doubt_jump_back = true;
+  // Float descriptors (XFeat): where the lookahead stops at a next key image that verifies by little beyond chance
+  // (log10 NFA above -10, or refused) while the tracked key image does too, the key image past it is compared, and the
+  // tracker steps on to it where it verifies more matches than the tracked one, beyond a little chance (log10 NFA at
+  // most -10). Across lighting a next key image that sees little of the frame (corridor_conditions' key image 5, teach
+  // frame 23) held the tracker at the look-alike key images 3-4 behind it while the key image past it (6) verified
+  // 25-29 matches at -15 to -17, and repeat frame 30 was steered by 3 key images behind (docs/measurements/
+  // localization-conditions.md, "A tracker held at a look-alike looks past a weak next key image": XFeat's corridor
+  // sets over the verifier's seeds 0-15, frames confidently more than 2 key images off 11 -> 3). Off: the lookahead
+  // stops at the first key image that does not beat the tracked one.
+  bool look_past_weak_next = true;
   // A place elsewhere on the route that verified more matches than the key images a frame was steered by (a key image
   // more than two route positions away) is a rival: for this many frames it is compared again (it and the key image
   // after it), and a tracked frame it out-verifies again is relocalized, as a frame that shares little with its key

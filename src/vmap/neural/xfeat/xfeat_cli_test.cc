@@ -414,6 +414,22 @@ TEST_F(XfeatCorridorRun, ARunStartedElsewhereConfirmsAPlaceThatStandsOut) {
   }
 }
 
+// A tracker held at a look-alike looks past a weak next key image (docs/localize.md): repeat frames 20-34 started at
+// key image 0 (bench/route_conditions.py's corridor from 20), at the verifier's seeds 14 and 8. Key image 5 (teach
+// frame 23) sees little of repeat frames 25-30, key image 6 verifies 25-29 matches at log10 NFA -15 to -17; stopped at
+// 5, the tracker was held at the look-alike key images 3-4 (seed 14: frames 28-30 and 32 steered by at key image 3;
+// seed 8: frame 30 at 4; right: 6-8). Looking past key image 5, it steps on to 6 on frame 26 or 27.
+TEST_F(XfeatCorridorRun, ATrackerHeldAtALookAlikeLooksPastAWeakNextKeyImage) {
+  for (const std::string seed : {"14", "8"}) {
+    auto steered_far = [&](const std::string& flags) {
+      return Far(SteeredOnRepeat(20, 34, 0, " --verifier-seed " + seed + flags));
+    };
+    EXPECT_EQ(steered_far(""), 0) << "seed " << seed;
+    EXPECT_GE(steered_far(" --no-look-past-weak-next"), 1)
+        << "seed " << seed << ": the test no longer reaches the frames held at the look-alike key images";
+  }
+}
+
 // michigan_seasons' session `query` (its five places) against an XFeat map of session `teach`'s, built in `dir` as
 // bench/route_conditions.py builds it (`--tau 1`): `vmap localize`'s map and images arguments; "" without the data.
 std::string MichiganRoute(const fs::path& dir, const std::string& query, const std::string& teach) {

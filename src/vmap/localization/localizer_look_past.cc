@@ -1,0 +1,42 @@
+// A tracker held by little beyond chance looks past a next key image that verifies by little beyond chance too
+// (LocalizerOptions::look_past_weak_next): it steps on to the key image past it where that one verifies more.
+#include "vmap/localization/localizer.h"
+
+namespace vmap {
+
+namespace {
+
+// A comparison verifies beyond a little chance at a log10 NFA of at most this (the bar of
+// LocalizerOptions::scene_change_tracked_log10_nfa and of the doubted jump back, localizer_jump_back.cc).
+constexpr double kBeyondLittleChance = -10.0;
+
+bool BeyondLittleChance(const KeyComparison& comparison) {
+  return comparison.accepted && comparison.log10_nfa <= kBeyondLittleChance;
+}
+
+}  // namespace
+
+void Localizer::LookPastWeakNext(const Frame& frame, const ImageFeatures& features, int position, KeyComparison& best,
+                                 int& best_position) {
+  const int next = best_position + 1, past = best_position + 2;
+  // Asked only where the lookahead stopped at `next` (it compared it, and it did not beat `best`) and `best` holds the
+  // frame by little beyond chance.
+  if (!options_.look_past_weak_next || binary_descriptors_ || !best.accepted || BeyondLittleChance(best) ||
+      next > position + options_.lookahead || past >= static_cast<int>(route_.size())) {
+    return;
+  }
+  // Why: across lighting XFeat verifies 15-25 matches at every key image near the frame, and a next key image that
+  // sees little of the frame (corridor_conditions' key image 5, teach frame 23: 15-22 matches at log10 NFA -8 to 0 on
+  // 16 of 18 repeat frames 25-30) stops the lookahead while the key image past it verifies clearly (key image 6, teach
+  // frame 25: 25-29 at -15 to -17 on frames 26-27). The tracker stayed at key image 3 or 4 (teach frames 9 and 13, the
+  // look-alikes of repeat frames 20-34) and repeat frame 30 was steered by there, 3 key images behind the right 7-8
+  // (the verifier's seeds 8, 9 and 14; docs/measurements/localization-conditions.md, "A tracker held at a look-alike
+  // looks past a weak next key image"). The route goes forwards: a tracker held behind falls further behind.
+  if (BeyondLittleChance(CompareOnce(features, route_[next]))) return;
+  const KeyComparison beyond = CompareTracked(frame, features, past);
+  if (!BeyondLittleChance(beyond) || beyond.num_verified <= best.num_verified || !IsBetterMatch(beyond, best)) return;
+  best = beyond;
+  best_position = past;
+}
+
+}  // namespace vmap
