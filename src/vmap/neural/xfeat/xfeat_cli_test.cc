@@ -316,7 +316,7 @@ TEST_F(XfeatCorridorRun, TheRankingWeighsTheBelief) {
 TEST_F(XfeatCorridorRun, OneFramesRankingIsNotYetAPlace) {
   auto steered_far = [&](const std::string& flags) { return Far(SteeredOnRepeat(44, 60, KeyBefore(45), flags)); };
   EXPECT_EQ(steered_far(""), 0);
-  EXPECT_GE(steered_far(" --belief-moves-on-one-frame"), 1)
+  EXPECT_GE(steered_far(" --belief-moves-on-one-frame --no-look-past-weak-next"), 1)
       << "the test no longer reaches a place one frame singles out";
 }
 
@@ -341,7 +341,8 @@ TEST_F(XfeatCorridorRun, ARankingThatBarelyStandsOutIsNoPlace) {
 TEST_F(XfeatCorridorRun, AKeyImageTheBeliefPutsBehindIsLeft) {
   const std::vector<int> run = CarriedRun(100, 110, 20, 30);
   auto steered_right = [&](const std::string& flags) { return Right(SteeredOnRun(run, KeyBefore(100), flags)); };
-  const int left = steered_right(""), kept = steered_right(" --no-step-on-by-belief");
+  const int left = steered_right(" --no-look-past-weak-next"),
+            kept = steered_right(" --no-step-on-by-belief --no-look-past-weak-next");
   EXPECT_GE(left, kept + 4) << "steered by at a right key image: the belief stepping on " << left
                             << ", the counts alone " << kept;
 }
@@ -392,7 +393,7 @@ TEST_F(XfeatCorridorRun, AJumpBackNoClearerThanWhereTheFramesWereIsDoubted) {
       return Far(SteeredOnRepeat(20, 36, 0, " --verifier-seed " + seed + flags));
     };
     EXPECT_EQ(steered_far(""), 0) << "seed " << seed;
-    EXPECT_GE(steered_far(" --no-doubt-jump-back"), 1)
+    EXPECT_GE(steered_far(" --no-doubt-jump-back --no-look-past-weak-next"), 1)
         << "seed " << seed << ": the test no longer reaches a frame placed by a jump back";
   }
 }
@@ -469,7 +470,7 @@ TEST(VmapXfeat, AFrameOfAnotherPlaceThanTheFrameBeforeIsAskedWhereItIs) {
   };
   const std::vector<std::pair<int, int>> asked = steered("");
   EXPECT_EQ(SteeredOff(asked, 2), 0) << ::testing::PrintToString(asked);
-  EXPECT_GE(SteeredOff(steered(" --scene-change-log10-nfa 0"), 2), 1)
+  EXPECT_GE(SteeredOff(steered(" --scene-change-log10-nfa 0 --no-look-past-weak-next"), 2), 1)
       << "the test no longer reaches a frame tracked far";
 }
 
