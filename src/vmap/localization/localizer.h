@@ -230,8 +230,12 @@ class Localizer {
   // While the start is unconfirmed, with float descriptors (LocalizerOptions::start_place_stands_out,
   // localizer_start_place.cc): a key image more than kNear from the frame's place (one it compared, or the best-ranked
   // such key image, compared now without weighing the belief) verified at least as many matches as its accepted key
-  // images, or weighs at least as much by the evidence model: the frame cannot tell its place from a far one.
+  // images, or weighs at least as much by the evidence model: the frame cannot tell its place from a far one. Before
+  // that, a frame not ranked weighs evidence_belief_ by its ranking (start_evidence_ranks_frame).
   bool StartPlaceTiesFar(const LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
+  // evidence_belief_ alone weighed by the frame's ranking `ranked`, as WeighRanking weighs both beliefs for a frame
+  // ranked before its moves (localizer_start_place.cc).
+  void WeighEvidenceByRanking(const std::vector<RankedKey>& ranked);
   void Question(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
   // A frame placed more than kNear route positions behind where the tracker was, where an accepted key image within
   // kNear of that estimate, beyond a little chance, verified nearly as many matches as the place: the frame is

@@ -136,7 +136,10 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
   if (position < 0) return;
   result.confidence = belief_.MassWithin(position, kNear);
   const bool placed = IsPlaced(result.status);
-  if (placed && (withheld_unranked || withholds(position) || StartPlaceTiesFar(result, frame, features))) {
+  // Asked first: it may weigh the frames' evidence alone by the frame's ranking (start_evidence_ranks_frame), which
+  // `withholds` then reads.
+  const bool ties_far = placed && StartPlaceTiesFar(result, frame, features);
+  if (placed && (ties_far || withheld_unranked || withholds(position))) {
     result.status = LocalizationStatus::kUncertain;
   }
   // Confirmed: the frames' evidence alone leans most near the place the frame is steered by (with the frame's ranking

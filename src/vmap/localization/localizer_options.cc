@@ -113,6 +113,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "--start-key, float descriptors: steer by a frame before the start is confirmed even where a key "
                  "image more than two places away verifies as much (otherwise it is uncertain)"},
                 start_place_stands_out);
+  visitor.Visit({"start_evidence_ranks_frame", "!--no-start-evidence-ranks-frame",
+                 "--start-key, float descriptors: before the start is confirmed, the frames' evidence alone weighs a "
+                 "tracked frame by its comparisons only (otherwise by its ranking too)"},
+                start_evidence_ranks_frame);
   visitor.Visit({"max_lost_frames", "--max-lost", "Lost frames in a row before the estimate is dropped"},
                 max_lost_frames);
   visitor.Visit({"relocalization_candidates", "--candidates", "Best-ranked key images verified when relocalizing"},

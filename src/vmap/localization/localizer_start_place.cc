@@ -4,6 +4,12 @@
 // tracker. corridor_conditions from repeat frame 50 at the verifier's seed 10: frame 54 verified key image 16 (right)
 // with 22 matches and key images 29-30 with 21-22, was relocalized at 29 and confirmed the start there, 14 key images
 // off (docs/measurements/localization-conditions.md, "A run started elsewhere confirms a place that stands out").
+// The frames' evidence alone holds a frame the tracker placed without ranking it only where the tracker compared it
+// (LocalizerOptions::start_evidence_ranks_frame): its ranking weighs that belief too. The corridor from repeat frame 90
+// at the verifier's seed 12: frames 91-92 were moved to key image 12-13 (right 28-30), frame 92 tracked there verified
+// key image 13 with 24 matches and 29, compared for the question alone, with 23; its comparisons at 12-14 swung the
+// frames' evidence from 28 to 12, which confirmed the start there, 15 key images off ("A start confirmed at a
+// look-alike is asked by the frame's ranking").
 #include <algorithm>
 #include <cstdlib>
 
@@ -13,8 +19,8 @@ namespace vmap {
 
 bool Localizer::StartPlaceTiesFar(const LocalizationResult& result, const Frame& frame, const ImageFeatures& features) {
   const int position = result.route_position;
-  if (!options_.start_place_stands_out || !start_unconfirmed_ || binary_descriptors_ ||
-      options_.belief.min_confidence <= 0.0 || position < 0) {
+  if (!(options_.start_place_stands_out || options_.start_evidence_ranks_frame) || !start_unconfirmed_ ||
+      binary_descriptors_ || options_.belief.min_confidence <= 0.0 || position < 0) {
     return false;
   }
   // Where the place and its neighbours hold more than half the route (michigan_seasons' routes of 5 places), near and
@@ -31,6 +37,9 @@ bool Localizer::StartPlaceTiesFar(const LocalizationResult& result, const Frame&
     verified = std::max(verified, c->num_verified);
   }
   if (verified < 0) return false;
+  const std::vector<RankedKey> ranked = ranked_.empty() ? RouteRanking(frame, features) : ranked_;
+  if (options_.start_evidence_ranks_frame && ranked_.empty()) WeighEvidenceByRanking(ranked);
+  if (!options_.start_place_stands_out) return false;
   auto ties = [&](const KeyComparison& c) {
     return c.accepted &&
            (c.num_verified >= verified || EvidenceLogRatio(evidence_, c, link_verified_[c.key]) >= weight);
@@ -40,9 +49,8 @@ bool Localizer::StartPlaceTiesFar(const LocalizationResult& result, const Frame&
     if (far(route_position_of_key_[m.comparison.key]) && ties(m.comparison)) return true;
   }
   // The likeliest far place, as the frame's descriptors tell, when the frame did not compare it: compared now, without
-  // weighing the belief (nor the frame's ranking, when the frame was not ranked): the frames' evidence is what the
-  // belief weighed; this only asks whether the frame can tell its place from a far one.
-  const std::vector<RankedKey> ranked = ranked_.empty() ? RouteRanking(frame, features) : ranked_;
+  // weighing either belief (nor the belief by the frame's ranking, when the frame was not ranked): the frames' evidence
+  // is what the beliefs weighed; this only asks whether the frame can tell its place from a far one.
   for (const RankedKey& r : ranked) {  // route positions, best first
     if (!far(r.key)) continue;
     const int key = route_[r.key];
@@ -52,6 +60,24 @@ bool Localizer::StartPlaceTiesFar(const LocalizationResult& result, const Frame&
     return ties(Compare(features, key));
   }
   return false;
+}
+
+void Localizer::WeighEvidenceByRanking(const std::vector<RankedKey>& ranked) {
+  if (evidence_.rank_alone.empty()) return;
+  // As WeighRanking weighs both beliefs for a ranked frame: every route position by its bucket, and the comparisons
+  // weighed without the ranking by what their bucket changes.
+  const std::vector<int> buckets = RankingBuckets(evidence_, ranked, static_cast<int>(route_.size()));
+  for (size_t p = 0; p < route_.size(); ++p) {
+    evidence_belief_.Weigh(static_cast<int>(p), RankLogRatio(evidence_, buckets[p]));
+  }
+  for (const Memo& m : comparisons_) {
+    const int key = m.comparison.key;
+    const int q = route_position_of_key_[key];
+    if (q < 0 || !m.weighed || m.weighed_ranked) continue;
+    evidence_belief_.Weigh(q, EvidenceLogRatio(evidence_, m.comparison, link_verified_[key], buckets[q]) -
+                                  EvidenceLogRatio(evidence_, m.comparison, link_verified_[key]));
+  }
+  evidence_belief_.Normalize();
 }
 
 }  // namespace vmap

@@ -431,6 +431,19 @@ TEST_F(XfeatCorridorRun, ATrackerHeldAtALookAlikeLooksPastAWeakNextKeyImage) {
   }
 }
 
+// A start confirmed at a look-alike is asked by the frame's ranking (docs/localize.md): repeat frames 90-100 started at
+// key image 0 (the corridor from 90), at the verifier's seed 12. Frame 91 moved the tracker to key image 12 (right:
+// 28-30), and frames 92-94 tracked at 13, whose comparisons alone swung the frames' evidence there: the start was
+// confirmed 15 key images off. Weighed by their ranking too, the frames' evidence stays near 28-29: they are uncertain.
+TEST_F(XfeatCorridorRun, AStartConfirmedAtALookAlikeIsAskedByTheFramesRanking) {
+  auto steered_far = [&](const std::string& flags) {
+    return Far(SteeredOnRepeat(90, 100, 0, " --verifier-seed 12" + flags));
+  };
+  EXPECT_EQ(steered_far(""), 0);
+  EXPECT_GE(steered_far(" --no-start-evidence-ranks-frame"), 1)
+      << "the test no longer reaches the frames tracked at key image 13";
+}
+
 // michigan_seasons' session `query` (its five places) against an XFeat map of session `teach`'s, built in `dir` as
 // bench/route_conditions.py builds it (`--tau 1`): `vmap localize`'s map and images arguments; "" without the data.
 std::string MichiganRoute(const fs::path& dir, const std::string& query, const std::string& teach) {
