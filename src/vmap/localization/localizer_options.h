@@ -387,16 +387,16 @@ struct LocalizerOptions {
   // started elsewhere confirms a place that stands out"). Only on routes where a key image and the two either side
   // hold at most half the route (as start_needs_evidence). Off: a frame confirms the start by the beliefs alone.
   bool start_place_stands_out = true;
-  // With start_is_hint and float descriptors (XFeat), while the start is unconfirmed a frame placed without being ranked
-  // (the tracker's) weighs the frames' evidence alone (not the belief: the tracker is as without it) by its ranking, as
-  // a ranked frame weighs both: that evidence otherwise holds a tracked frame's comparisons only where the tracker
-  // compared them, and a tracker moved to a look-alike by a guess pulls it there. The corridor from repeat frame 90 at
-  // the verifier's seed 12: frame 92 tracked at key image 13 (right: 28-30) swung it from 28 to 12 and confirmed the
-  // start 15 key images off, frames 92-94 steered by there; with it they are uncertain. Over the verifier's seeds 0-15
-  // on the runs started elsewhere, frames steered by more than 2 key images off 10 -> 7, none new, 63 of 64 CSVs the
-  // same (docs/measurements/localization-conditions.md, "A start confirmed at a look-alike is asked by the frame's
-  // ranking"). Only on routes where a key image and the two either side hold at most half the route (as
-  // start_needs_evidence). Off: the frames' evidence weighs a tracked frame by its comparisons alone.
+  // With start_is_hint and float descriptors (XFeat), while the start is unconfirmed a frame placed without being
+  // ranked (the tracker's) weighs the frames' evidence alone (not the belief: the tracker is as without it) by its
+  // ranking, as a ranked frame weighs both: that evidence otherwise holds a tracked frame's comparisons only where the
+  // tracker compared them, and a tracker moved to a look-alike by a guess pulls it there. The corridor from repeat
+  // frame 90 at the verifier's seed 12: frame 92 tracked at key image 13 (right: 28-30) swung it from 28 to 12 and
+  // confirmed the start 15 key images off, frames 92-94 steered by there; with it they are uncertain. Over the
+  // verifier's seeds 0-15 on the runs started elsewhere, frames steered by more than 2 key images off 10 -> 7, none
+  // new, 63 of 64 CSVs the same (docs/measurements/localization-conditions.md, "A start confirmed at a look-alike is
+  // asked by the frame's ranking"). Only on routes where a key image and the two either side hold at most half the
+  // route (as start_needs_evidence). Off: the frames' evidence weighs a tracked frame by its comparisons alone.
   bool start_evidence_ranks_frame = true;
   // Lost frames in a row (each one also failed to relocalize) after which the estimate is dropped: key and
   // next_key then read -1 until a frame is relocalized.

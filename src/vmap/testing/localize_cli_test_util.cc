@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "vmap/testing/run_vmap.h"
 #include "vmap/testing/shared_data.h"
 
 namespace vmap::testing {
@@ -42,6 +43,18 @@ std::vector<std::string> CsvColumn(const std::filesystem::path& csv, const std::
 
 bool Placed(const std::pair<std::string, int>& frame) {
   return frame.first == "tracking" || frame.first == "relocalized";
+}
+
+std::vector<std::pair<int, int>> SteeredFrames(const std::string& args, const std::filesystem::path& csv) {
+  const CliResult run = RunVmap("localize " + args + " -q --csv " + Quote(csv));
+  EXPECT_EQ(run.status, 0) << run.output;
+  const std::vector<std::string> status = CsvColumn(csv, "status"), source = CsvColumn(csv, "source_index"),
+                                 key = CsvColumn(csv, "key");
+  std::vector<std::pair<int, int>> steered;
+  for (size_t f = 0; f < status.size(); ++f) {
+    if (Placed({status[f], 0})) steered.emplace_back(std::stoi(source[f]), std::stoi(key[f]));
+  }
+  return steered;
 }
 
 }  // namespace vmap::testing

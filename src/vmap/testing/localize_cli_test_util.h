@@ -1,6 +1,6 @@
 #pragma once
 // Test helpers of the `vmap localize` end-to-end tests (localization/localize*_cli_test.cc): the shared folder as a
-// path, the lines and columns of the files a run writes, and which frames a run placed.
+// path, the lines and columns of the files a run writes, and which frames a run placed or steered by.
 
 #include <filesystem>
 #include <string>
@@ -23,5 +23,8 @@ std::vector<std::string> CsvColumn(const std::filesystem::path& csv, const std::
 // its heading places is placed but not steered by (guidance "none": AFrameTheEvidenceStepsOnIsNotSteeredByItsHeading);
 // the tests count placed frames.
 bool Placed(const std::pair<std::string, int>& frame);
+
+// Runs `vmap localize ARGS -q --csv CSV` and returns the frames it placed (Placed): (source_index, key) each.
+std::vector<std::pair<int, int>> SteeredFrames(const std::string& args, const std::filesystem::path& csv);
 
 }  // namespace vmap::testing

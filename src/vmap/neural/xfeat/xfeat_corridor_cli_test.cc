@@ -1,0 +1,326 @@
+// `vmap localize` with XFeat on corridor_conditions' repeat run (frame i taken where the teach run's frame i was),
+// through the built binary: each test a slice of the runs bench/route_conditions.py measures, where a rule of the
+// localizer keeps frames from being steered by at the wrong key image (docs/localize.md).
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "vmap/testing/localize_cli_test_util.h"
+#include "vmap/testing/run_vmap.h"
+#include "vmap/testing/scoped_temp_dir.h"
+#include "vmap/testing/shared_data.h"
+
+namespace vmap::neural {
+namespace {
+
+using testing::RunVmap;
+using testing::SharedDir;
+using ::vmap::testing::SteeredFrames;
+using TempDir = testing::ScopedTempDir;
+namespace fs = std::filesystem;
+
+std::string FoldedWeights() { return SharedDir() + "/weights/xfeat/xfeat_folded.pt"; }
+
+// The key images bracketing teach frame `frame` (the last at or before it, the first at or after it), of a map whose
+// key images are teach frames `sources` (ascending).
+std::vector<int> KeysAround(const std::vector<int>& sources, int frame) {
+  std::vector<int> keys;
+  for (int k = static_cast<int>(sources.size()) - 1; k >= 0; --k) {
+    if (sources[k] <= frame) {
+      keys.push_back(k);
+      break;
+    }
+  }
+  for (int k = 0; k < static_cast<int>(sources.size()); ++k) {
+    if (sources[k] >= frame) {
+      keys.push_back(k);
+      break;
+    }
+  }
+  return keys;
+}
+
+// The right key images of corridor_conditions' repeat frame `repeat`: those bracketing its teach frames i-2..i+2
+// (bench/route_conditions.py's count).
+std::vector<int> RightKeys(const std::vector<int>& sources, int repeat) {
+  std::vector<int> keys;
+  for (int j = repeat - 2; j <= repeat + 2; ++j) {
+    for (int k : KeysAround(sources, j)) keys.push_back(k);
+  }
+  return keys;
+}
+
+// corridor_conditions' repeat run (its frame i taken where the teach run's frame i was) against an XFeat map of its
+// teach run, built for each test in a temporary folder. Counts frames steered by as (repeat frame, key) pairs.
+class XfeatCorridorRun : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    SKIP_WITHOUT_SHARED();
+    if (!fs::exists(data_)) GTEST_SKIP() << data_ << " is not present";
+    const auto built = RunVmap("build " + ::vmap::testing::Quote(data_ / "teach") + " --matcher xfeat --weights " +
+                               FoldedWeights() + " -q -o " + ::vmap::testing::Quote(map_));
+    ASSERT_EQ(built.status, 0) << built.output;
+    std::ifstream map_file(map_ / "map.json");
+    const nlohmann::json map_json = nlohmann::json::parse(map_file);
+    for (const auto& key : map_json["key_images"]) sources_.push_back(key["source_index"].get<int>());
+    ASSERT_FALSE(sources_.empty());
+  }
+
+  // The key image at or before teach frame `frame`: where a run of the repeat from frame `frame` is started.
+  int KeyBefore(int frame) const { return KeysAround(sources_, frame).front(); }
+
+  // The frames steered by when repeat frames `first`-`last` are localized, started at `start_key`, with `flags`.
+  std::vector<std::pair<int, int>> SteeredOnRepeat(int first, int last, int start_key, const std::string& flags) {
+    return SteeredFrames(::vmap::testing::Quote(map_) + " " + ::vmap::testing::Quote(data_ / "repeat") + " --first " +
+                             std::to_string(first) + " --last " + std::to_string(last) + " --start-key " +
+                             std::to_string(start_key) + flags,
+                         dir_.path() / "run.csv");
+  }
+
+  // The frames steered by when repeat frames taken in the order `repeat_of` gives (a robot carried off: run frame f
+  // is repeat frame repeat_of[f]) are localized, started at `start_key`, with `flags`.
+  std::vector<std::pair<int, int>> SteeredOnRun(const std::vector<int>& repeat_of, int start_key,
+                                                const std::string& flags) {
+    const fs::path run = dir_.path() / "run";  // a folder of links to the repeat's frames, named in the run's order
+    fs::remove_all(run);
+    fs::create_directories(run);
+    for (size_t f = 0; f < repeat_of.size(); ++f) {
+      char name[32];
+      std::snprintf(name, sizeof(name), "%07d.jpg", repeat_of[f]);
+      char link[32];
+      std::snprintf(link, sizeof(link), "%07zu.jpg", f);
+      fs::create_symlink(data_ / "repeat" / name, run / link);
+    }
+    std::vector<std::pair<int, int>> steered =
+        SteeredFrames(::vmap::testing::Quote(map_) + " " + ::vmap::testing::Quote(run) + " --start-key " +
+                          std::to_string(start_key) + flags,
+                      dir_.path() / "run.csv");
+    for (auto& [frame, key] : steered) frame = repeat_of.at(frame);
+    return steered;
+  }
+
+  // How many of `steered` (repeat frame, key) are at a key image more than 2 from every right one.
+  int Far(const std::vector<std::pair<int, int>>& steered) const {
+    int far = 0;
+    for (const auto& [frame, key] : steered) {
+      int nearest = 1 << 20;
+      for (int k : RightKeys(sources_, frame)) nearest = std::min(nearest, std::abs(key - k));
+      far += nearest > 2;
+    }
+    return far;
+  }
+
+  // The shape of a test of a rule that keeps frames from being steered by far: with the defaults no frame `steered`
+  // gives is more than 2 key images off, with `rule_off` (the rule's flag off, and those of later rules that mend the
+  // same frames) at least one is; else the slice no longer reaches the frames it was chosen for, `premise`.
+  void ExpectNoFarFrameButWithout(const std::string& rule_off, const std::string& premise,
+                                  const std::function<std::vector<std::pair<int, int>>(const std::string&)>& steered) {
+    EXPECT_EQ(Far(steered("")), 0);
+    EXPECT_GE(Far(steered(rule_off)), 1) << "the test no longer reaches " << premise;
+  }
+
+  // How many of `steered` (repeat frame, key) are at a right key image.
+  int Right(const std::vector<std::pair<int, int>>& steered) const {
+    int right = 0;
+    for (const auto& [frame, key] : steered) {
+      const std::vector<int> keys = RightKeys(sources_, frame);
+      right += std::find(keys.begin(), keys.end(), key) != keys.end();
+    }
+    return right;
+  }
+
+  const fs::path data_ = fs::path(SharedDir()) / "data/corridor_conditions";
+  const TempDir dir_{"corridor"};
+  const fs::path map_ = dir_.path() / "map";
+  std::vector<int> sources_;  // the map's key images' teach frames
+};
+
+// The frames of a run carried from repeat frame `from_first`-`from_last` to `to_first`-`to_last`.
+std::vector<int> CarriedRun(int from_first, int from_last, int to_first, int to_last) {
+  std::vector<int> repeat_of;
+  for (int i = from_first; i <= from_last; ++i) repeat_of.push_back(i);
+  for (int i = to_first; i <= to_last; ++i) repeat_of.push_back(i);
+  return repeat_of;
+}
+
+// A robot carried off (docs/localize.md, "A lone step back is doubted"): corridor_conditions' repeat frames 90-110 and
+// then 20-25 as one run (carried 70 frames back), started at teach frame 90's key image. On the first frame after the
+// jump nothing verifies at the key images where the run was but the one behind, while a far key image verifies more:
+// the robot must not be steered by the place it left.
+TEST_F(XfeatCorridorRun, ARobotCarriedOffIsNotSteeredByThePlaceItLeft) {
+  const std::vector<int> run = CarriedRun(90, 110, 20, 25);
+  auto steered_far = [&](const std::string& flags) { return Far(SteeredOnRun(run, KeyBefore(90), flags)); };
+  EXPECT_EQ(steered_far(""), 0);
+  // The lone step back measured with the ranking's evidence off: with it the belief leaves the old place before a
+  // lone step back could steer by it (docs/localize.md, "The ranking is evidence"); and without the question of a frame
+  // held by little that does not see the frame before's scene, which doubts the same frame (docs/localize.md).
+  EXPECT_EQ(steered_far(" --no-rank-evidence"), 0);
+  EXPECT_GE(steered_far(" --no-rank-evidence --no-doubt-lone-step-back --scene-change-log10-nfa 0"), 1)
+      << "the test no longer reaches a lone step back";
+}
+
+// A step on across lighting (docs/localize.md, "A step on needs more than a tie"): repeat frames 26-40, started at
+// teach frame 26's key image. Key images 8 and 9 (teach frames 35 and 36) verify 27 matches each with repeat frame 32;
+// S took the tracker on to 9, a key image early for frames 32-33 (their teach frames i-2..i+2 lie before key image 9).
+TEST_F(XfeatCorridorRun, AStepOnOnATieIsNotTaken) {
+  auto steered_right = [&](const std::string& flags) { return Right(SteeredOnRepeat(26, 40, KeyBefore(26), flags)); };
+  const int needs_more = steered_right(""), on_tie = steered_right(" --step-on-on-tie");
+  EXPECT_GE(needs_more, on_tie + 2) << "steered by at a right key image: needs more " << needs_more << ", on a tie "
+                                    << on_tie;
+}
+
+// Where the corridor repeats itself (docs/localize.md, "A rival place is asked again"): repeat frames 90-104, started
+// at key image 0 (a run started elsewhere than --start-key says). From frame 95 the run is held at key images 12-13
+// (right: 28-31), which verify 21-32 matches there, as many as the right ones do; on frame 95 key image 31 verified
+// more. Asked again on the frames after it, the right place out-verifies the tracked one again and the tracker goes
+// there two frames sooner (frame 101, not 103).
+TEST_F(XfeatCorridorRun, AFarPlaceThatVerifiedMoreIsAskedAgain) {
+  auto steered_far = [&](const std::string& flags) { return Far(SteeredOnRepeat(90, 104, 0, flags)); };
+  // Measured with the ranking's evidence off: with it no frame is steered by at key images 12-13 whether the rival is
+  // asked again or not, only the run's first frame is far (docs/localize.md, "The ranking is evidence").
+  const int asked = steered_far(" --no-rank-evidence"),
+            not_asked = steered_far(" --no-rank-evidence --rival-place-frames 0");
+  EXPECT_LE(asked, not_asked - 2) << "steered by more than 2 key images off: asked again " << asked << ", not "
+                                  << not_asked;
+}
+
+// The ranking is evidence (docs/localize.md): repeat frames 70-82, started at teach frame 70's key image. Frames 76-77
+// verify key image 29 (where the corridor repeats itself) at log10 NFA -18 and -19, and on frame 78 the comparisons
+// alone leave the belief in doubt at the right key image; the frame's ranking puts the right key images 23, 25 and 22
+// first.
+TEST_F(XfeatCorridorRun, TheRankingWeighsTheBelief) {
+  auto steered_right = [&](const std::string& flags) { return Right(SteeredOnRepeat(70, 82, KeyBefore(70), flags)); };
+  const int ranked = steered_right(""), comparisons_alone = steered_right(" --no-rank-evidence");
+  EXPECT_GE(ranked, comparisons_alone + 1) << "steered by at a right key image: with the ranking " << ranked
+                                           << ", the comparisons alone " << comparisons_alone;
+}
+
+// One frame's ranking is not yet a place (docs/localize.md, "The ranking is evidence"): repeat frames 44-60, started at
+// teach frame 45's key image. Frames 51-54 are dark and verify little anywhere; on frame 53 key image 29 ranks first
+// and verifies 22 matches at log10 NFA -19, and the belief singles out its place on that frame alone. Moved there on
+// one frame, frame 54 was relocalized at key image 29 (right: 14-15).
+TEST_F(XfeatCorridorRun, OneFramesRankingIsNotYetAPlace) {
+  ExpectNoFarFrameButWithout(" --belief-moves-on-one-frame --no-look-past-weak-next", "a place one frame singles out",
+                             [&](const std::string& flags) { return SteeredOnRepeat(44, 60, KeyBefore(45), flags); });
+}
+
+// XFeat's ranking by how its votes stand out (docs/localize.md): repeat frames 44-60 at the verifier's seed 5, started
+// at teach frame 45's key image. Frames 49-51 are dark; by rank key image 32 (the corridor's end) ranked first on
+// frames 49 and 50 with 63-65 votes against 62, 61, ... and weighed as a first far above the rest: the belief moved
+// there and frames 52-54 were steered by at key images 30-31 (right: 14-15).
+TEST_F(XfeatCorridorRun, ARankingThatBarelyStandsOutIsNoPlace) {
+  ExpectNoFarFrameButWithout(" --no-rank-by-standout", "the frames the rank misplaced", [&](const std::string& flags) {
+    return SteeredOnRepeat(44, 60, KeyBefore(45), " --verifier-seed 5" + flags);
+  });
+}
+
+// A key image the belief puts behind is left (docs/localize.md): repeat frames 100-110 and then 20-30 as one run (a
+// robot carried back 90 frames), started at teach frame 100's key image. After the jump the tracker is relocalized a
+// key image or two short of the right ones (key images 2-4 are teach frames 6-13, the right ones 4-8), and the counts
+// never step it on: across lighting XFeat verifies as many matches (18-28) at the key image behind as at those ahead,
+// while the belief, weighed by the frames' comparisons and rankings, already holds most of its mass past the next key
+// image.
+TEST_F(XfeatCorridorRun, AKeyImageTheBeliefPutsBehindIsLeft) {
+  const std::vector<int> run = CarriedRun(100, 110, 20, 30);
+  auto steered_right = [&](const std::string& flags) { return Right(SteeredOnRun(run, KeyBefore(100), flags)); };
+  const int left = steered_right(" --no-look-past-weak-next"),
+            kept = steered_right(" --no-step-on-by-belief --no-look-past-weak-next");
+  EXPECT_GE(left, kept + 4) << "steered by at a right key image: the belief stepping on " << left
+                            << ", the counts alone " << kept;
+}
+
+// A robot carried on without the place it left refusing it (docs/localize.md, "A frame that does not see the frame
+// before's scene is asked again"): repeat frames 44-50 and then 80-84 as one run (carried 30 frames on), started at
+// teach frame 44's key image. At the verifier's seeds 1 and 3 the first frame after the jump verifies 16 chance matches
+// at key image 14, the place it left (log10 NFA -0.25 and -2.4), and was tracked there, 9 key images short of the right
+// ones; its comparison with the frame before (log10 NFA -12.6 and -15.2, where consecutive frames of the corridor
+// verify at -50 to -190) asks where it is, and a far place verifies more: uncertain, not steered by.
+TEST_F(XfeatCorridorRun, AFrameThatDoesNotSeeTheFrameBeforesSceneIsAskedAgain) {
+  const std::vector<int> run = CarriedRun(44, 50, 80, 84);
+  for (const std::string seed : {"1", "3"}) {
+    SCOPED_TRACE("verifier seed " + seed);
+    ExpectNoFarFrameButWithout(
+        " --scene-change-log10-nfa 0", "a frame tracked at the place the robot left",
+        [&](const std::string& flags) { return SteeredOnRun(run, KeyBefore(44), " --verifier-seed " + seed + flags); });
+  }
+}
+
+// A frame where the run moved back is asked where it is (docs/localize.md): repeat frames 100-110 and then 20-40 as one
+// run (a robot carried back 80 frames), started at teach frame 100's key image, at the verifier's seed 6. After the
+// carry the frames are relocalized at key image 3 (teach frame 9; right: 4-5), which verifies as much as the right
+// key images up to repeat frame 34; the tracker compared only the key images after it, which verify less, stepped on
+// to 4 and back to 3 on frame 28, and steered frames 28-34 at key image 3 (right: 6-8). Asked on the frames after the
+// move back, frame 22 is relocalized at key image 5, and the run follows the right key images.
+TEST_F(XfeatCorridorRun, AFrameWhereTheRunMovedBackIsAskedWhereItIs) {
+  const std::vector<int> run = CarriedRun(100, 110, 20, 40);
+  ExpectNoFarFrameButWithout(
+      " --no-ask-where-moved-back", "the frames held at the key image the run moved back to",
+      [&](const std::string& flags) { return SteeredOnRun(run, KeyBefore(100), " --verifier-seed 6" + flags); });
+}
+
+// A jump back no clearer than where the frames were is doubted (docs/localize.md): repeat frames 20-36 started at key
+// image 0 (bench/route_conditions.py's corridor from 20), at the verifier's seeds 10 and 5. Repeat frame 30 (seed 10)
+// verifies 32 matches at key image 3 and 30 at the right key image 8; the frame before pointing back there, it was
+// relocalized at key image 2, and frames 30-33 were steered by at 2-3 (right: 7-8). At seed 5 the belief moved frame 29
+// back to key image 3 (28 matches; key image 7 24). Doubted, such a frame is uncertain and the tracker stays with the
+// right key images.
+TEST_F(XfeatCorridorRun, AJumpBackNoClearerThanWhereTheFramesWereIsDoubted) {
+  for (const std::string seed : {"10", "5"}) {
+    SCOPED_TRACE("verifier seed " + seed);
+    ExpectNoFarFrameButWithout(
+        " --no-doubt-jump-back --no-look-past-weak-next", "a frame placed by a jump back",
+        [&](const std::string& flags) { return SteeredOnRepeat(20, 36, 0, " --verifier-seed " + seed + flags); });
+  }
+}
+
+// A run started elsewhere confirms a place that stands out (docs/localize.md): repeat frames 50-62 started at key
+// image 0 (bench/route_conditions.py's corridor from 50), at the verifier's seeds 10 and 11. Frame 53 verifies key
+// image 29 (the route's dark end; right: 14-15), frame 54 key images 29-30 with as many matches as key image 16 (22):
+// frame 54 was relocalized at 29 and frame 55 tracked at 29-30, which confirmed the start there. Neither stands out of
+// a far place (frame 55: key image 15, compared for the question, verifies 30): both uncertain, and frame 57 confirms
+// the start at key image 15.
+TEST_F(XfeatCorridorRun, ARunStartedElsewhereConfirmsAPlaceThatStandsOut) {
+  for (const std::string seed : {"10", "11"}) {
+    SCOPED_TRACE("verifier seed " + seed);
+    ExpectNoFarFrameButWithout(
+        " --no-start-place-stands-out", "the frames placed at the route's dark end",
+        [&](const std::string& flags) { return SteeredOnRepeat(50, 62, 0, " --verifier-seed " + seed + flags); });
+  }
+}
+
+// A tracker held at a look-alike looks past a weak next key image (docs/localize.md): repeat frames 20-34 started at
+// key image 0 (bench/route_conditions.py's corridor from 20), at the verifier's seeds 14 and 8. Key image 5 (teach
+// frame 23) sees little of repeat frames 25-30, key image 6 verifies 25-29 matches at log10 NFA -15 to -17; stopped at
+// 5, the tracker was held at the look-alike key images 3-4 (seed 14: frames 28-30 and 32 steered by at key image 3;
+// seed 8: frame 30 at 4; right: 6-8). Looking past key image 5, it steps on to 6 on frame 26 or 27.
+TEST_F(XfeatCorridorRun, ATrackerHeldAtALookAlikeLooksPastAWeakNextKeyImage) {
+  for (const std::string seed : {"14", "8"}) {
+    SCOPED_TRACE("verifier seed " + seed);
+    ExpectNoFarFrameButWithout(
+        " --no-look-past-weak-next", "the frames held at the look-alike key images",
+        [&](const std::string& flags) { return SteeredOnRepeat(20, 34, 0, " --verifier-seed " + seed + flags); });
+  }
+}
+
+// A start confirmed at a look-alike is asked by the frame's ranking (docs/localize.md): repeat frames 90-100 started at
+// key image 0 (the corridor from 90), at the verifier's seed 12. Frame 91 moved the tracker to key image 12 (right:
+// 28-30), and frames 92-94 tracked at 13, whose comparisons alone swung the frames' evidence there: the start was
+// confirmed 15 key images off. Weighed by their ranking too, the frames' evidence stays near 28-29: they are uncertain.
+TEST_F(XfeatCorridorRun, AStartConfirmedAtALookAlikeIsAskedByTheFramesRanking) {
+  ExpectNoFarFrameButWithout(
+      " --no-start-evidence-ranks-frame", "the frames tracked at key image 13",
+      [&](const std::string& flags) { return SteeredOnRepeat(90, 100, 0, " --verifier-seed 12" + flags); });
+}
+
+}  // namespace
+}  // namespace vmap::neural
