@@ -345,6 +345,10 @@ class Localizer {
   // "Near" a route position: within two (key images two apart often both see the frame); the tolerance of the
   // goal "no frame confidently at a key image more than 2 places away".
   static constexpr int kNear = 2;
+  // A comparison verifies beyond a little chance at a log10 NFA of at most this (the bar of
+  // LocalizerOptions::scene_change_tracked_log10_nfa), read by the doubted jump back and the look past a weak next key
+  // image: across lighting a place the robot left still accepts a few chance matches at -6 or so.
+  static constexpr double kBeyondLittleChance = -10.0;
 
   const VisualMap& map_;
   const KeyImageStore& keys_;

@@ -13,11 +13,10 @@ namespace {
 // to: the jump is no clearer than the look-alike it may be (the share below which a key image is clearly the worse
 // match, Localizer::Track's kClearlyWorse).
 constexpr double kNotClearlyWorse = 0.7;
-// ... counting only a key image near the estimate that verifies beyond a little chance (log10 NFA at most this, the bar
-// of LocalizerOptions::scene_change_tracked_log10_nfa): the place a carried robot left, or one a run's wrong start put
-// it at, still accepts a few chance matches across lighting (the kidnapped run at the verifier's seed 9, carried back
-// from repeat frame 110 to 22: 23 at log10 NFA -6.3 near where it was, 27 at -15.0 where it is).
-constexpr double kBeyondLittleChance = -10.0;
+// ... counting only a key image near the estimate that verifies beyond a little chance (kBeyondLittleChance): the place
+// a carried robot left, or one a run's wrong start put it at, still accepts a few chance matches across lighting (the
+// kidnapped run at the verifier's seed 9, carried back from repeat frame 110 to 22: 23 at log10 NFA -6.3 near where it
+// was, 27 at -15.0 where it is).
 
 int AcceptedVerified(const KeyComparison& comparison) { return comparison.accepted ? comparison.num_verified : 0; }
 

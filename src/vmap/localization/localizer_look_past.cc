@@ -4,20 +4,9 @@
 
 namespace vmap {
 
-namespace {
-
-// A comparison verifies beyond a little chance at a log10 NFA of at most this (the bar of
-// LocalizerOptions::scene_change_tracked_log10_nfa and of the doubted jump back, localizer_jump_back.cc).
-constexpr double kBeyondLittleChance = -10.0;
-
-bool BeyondLittleChance(const KeyComparison& comparison) {
-  return comparison.accepted && comparison.log10_nfa <= kBeyondLittleChance;
-}
-
-}  // namespace
-
 void Localizer::LookPastWeakNext(const Frame& frame, const ImageFeatures& features, int position, KeyComparison& best,
                                  int& best_position) {
+  auto BeyondLittleChance = [](const KeyComparison& c) { return c.accepted && c.log10_nfa <= kBeyondLittleChance; };
   const int next = best_position + 1, past = best_position + 2;
   // Asked only where the lookahead stopped at `next` (it compared it, and it did not beat `best`) and `best` holds the
   // frame by little beyond chance.
