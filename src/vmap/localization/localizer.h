@@ -227,12 +227,17 @@ class Localizer {
   // evidence_belief_ holds less within kNear of `position` than a flat belief would, on a route where those positions
   // hold at most half of it.
   bool EvidenceWeighsAgainst(int position) const;
-  // While the start is unconfirmed, with float descriptors (LocalizerOptions::start_place_stands_out,
-  // localizer_start_place.cc): a key image more than kNear from the frame's place (one it compared, or the best-ranked
-  // such key image, compared now without weighing the belief) verified at least as many matches as its accepted key
-  // images, or weighs at least as much by the evidence model: the frame cannot tell its place from a far one. Before
-  // that, a frame not ranked weighs evidence_belief_ by its ranking (start_evidence_ranks_frame).
-  bool StartPlaceTiesFar(const LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
+  // While the start is unconfirmed, with float descriptors, for a frame accepted at its place (else nullopt): the
+  // frame's ranking, made now where the frame was not ranked, when it then weighs evidence_belief_
+  // (LocalizerOptions::start_evidence_ranks_frame; localizer_start_place.cc).
+  std::optional<std::vector<RankedKey>> RankForUnconfirmedStart(const LocalizationResult& result, const Frame& frame,
+                                                                const ImageFeatures& features);
+  // For such a frame (LocalizerOptions::start_place_stands_out): a key image more than kNear from the frame's place
+  // (one it compared, or the best of `ranked` that is that far, compared now without weighing the belief) verified at
+  // least as many matches as its accepted key images, or weighs at least as much by the evidence model: the frame
+  // cannot tell its place from a far one.
+  bool StartPlaceTiesFar(const LocalizationResult& result, const ImageFeatures& features,
+                         const std::vector<RankedKey>& ranked);
   // evidence_belief_ alone weighed by the frame's ranking `ranked`, as WeighRanking weighs both beliefs for a frame
   // ranked before its moves (localizer_start_place.cc).
   void WeighEvidenceByRanking(const std::vector<RankedKey>& ranked);

@@ -136,9 +136,10 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
   if (position < 0) return;
   result.confidence = belief_.MassWithin(position, kNear);
   const bool placed = IsPlaced(result.status);
-  // Asked first: it may weigh the frames' evidence alone by the frame's ranking (start_evidence_ranks_frame), which
-  // `withholds` then reads.
-  const bool ties_far = placed && StartPlaceTiesFar(result, frame, features);
+  // Ranked first: the ranking may weigh the frames' evidence alone (start_evidence_ranks_frame), which `withholds` then
+  // reads.
+  const auto start_ranking = placed ? RankForUnconfirmedStart(result, frame, features) : std::nullopt;
+  const bool ties_far = start_ranking && StartPlaceTiesFar(result, features, *start_ranking);
   if (placed && (ties_far || withheld_unranked || withholds(position))) {
     result.status = LocalizationStatus::kUncertain;
   }

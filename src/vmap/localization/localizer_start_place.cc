@@ -12,20 +12,37 @@
 // look-alike is asked by the frame's ranking").
 #include <algorithm>
 #include <cstdlib>
+#include <optional>
+#include <vector>
 
 #include "vmap/localization/localizer.h"
 
 namespace vmap {
 
-bool Localizer::StartPlaceTiesFar(const LocalizationResult& result, const Frame& frame, const ImageFeatures& features) {
+std::optional<std::vector<RankedKey>> Localizer::RankForUnconfirmedStart(const LocalizationResult& result,
+                                                                         const Frame& frame,
+                                                                         const ImageFeatures& features) {
   const int position = result.route_position;
   if (!(options_.start_place_stands_out || options_.start_evidence_ranks_frame) || !start_unconfirmed_ ||
       binary_descriptors_ || options_.belief.min_confidence <= 0.0 || position < 0) {
-    return false;
+    return std::nullopt;
   }
   // Where the place and its neighbours hold more than half the route (michigan_seasons' routes of 5 places), near and
   // far are not told apart, as in EvidenceWeighsAgainst.
-  if (2 * NearWidth(position) > static_cast<int>(route_.size())) return false;
+  if (2 * NearWidth(position) > static_cast<int>(route_.size())) return std::nullopt;
+  if (!(result.to_key.accepted && result.to_key.key >= 0) && !(result.to_next.accepted && result.to_next.key >= 0)) {
+    return std::nullopt;  // nothing accepted at the place: nothing to tell from a far one
+  }
+  if (!ranked_.empty()) return ranked_;
+  std::vector<RankedKey> ranked = RouteRanking(frame, features);
+  if (options_.start_evidence_ranks_frame) WeighEvidenceByRanking(ranked);
+  return ranked;
+}
+
+bool Localizer::StartPlaceTiesFar(const LocalizationResult& result, const ImageFeatures& features,
+                                  const std::vector<RankedKey>& ranked) {
+  if (!options_.start_place_stands_out) return false;
+  const int position = result.route_position;
   // What the frame holds at its place: the most verified matches and the most evidence (the comparison alone, as the
   // evidence model weighs it) of its accepted key images.
   int verified = -1;
@@ -36,10 +53,6 @@ bool Localizer::StartPlaceTiesFar(const LocalizationResult& result, const Frame&
     weight = verified < 0 ? w : std::max(weight, w);
     verified = std::max(verified, c->num_verified);
   }
-  if (verified < 0) return false;
-  const std::vector<RankedKey> ranked = ranked_.empty() ? RouteRanking(frame, features) : ranked_;
-  if (options_.start_evidence_ranks_frame && ranked_.empty()) WeighEvidenceByRanking(ranked);
-  if (!options_.start_place_stands_out) return false;
   auto ties = [&](const KeyComparison& c) {
     return c.accepted &&
            (c.num_verified >= verified || EvidenceLogRatio(evidence_, c, link_verified_[c.key]) >= weight);
