@@ -247,8 +247,8 @@ class Localizer {
   // `uncertain` and the tracker stays (LocalizerOptions::doubt_jump_back; localizer_jump_back.cc).
   void DoubtJumpBack(LocalizationResult& result);
   // Track's lookahead stopped at the key image after `best_position`: where `best` and that key image both verify by
-  // little beyond chance, the key image past it is compared, and becomes `best` where it verifies more beyond chance
-  // (LocalizerOptions::look_past_weak_next; localizer_look_past.cc).
+  // little beyond chance, the key image past it is compared, and becomes `best` where it verifies more, clearly beyond
+  // chance (LocalizerOptions::look_past_weak_next, look_past_max_log10_nfa; localizer_look_past.cc).
   void LookPastWeakNext(const Frame& frame, const ImageFeatures& features, int position, KeyComparison& best,
                         int& best_position);
   // Compares the frame with the best-ranked key images of the route (relocalization_candidates of them), in

@@ -1,5 +1,6 @@
 // A tracker held by little beyond chance looks past a next key image that verifies by little beyond chance too
-// (LocalizerOptions::look_past_weak_next): it steps on to the key image past it where that one verifies more.
+// (LocalizerOptions::look_past_weak_next): it steps on to the key image past it where that one verifies more, clearly
+// (LocalizerOptions::look_past_max_log10_nfa).
 #include "vmap/localization/localizer.h"
 
 namespace vmap {
@@ -23,7 +24,13 @@ void Localizer::LookPastWeakNext(const Frame& frame, const ImageFeatures& featur
   // looks past a weak next key image"). The route goes forwards: a tracker held behind falls further behind.
   if (BeyondLittleChance(CompareOnce(features, route_[next]))) return;
   const KeyComparison beyond = CompareTracked(frame, features, past);
-  if (!BeyondLittleChance(beyond) || beyond.num_verified <= best.num_verified || !IsBetterMatch(beyond, best)) return;
+  // Stepped on to only where it verifies clearly (look_past_max_log10_nfa): at corridor_conditions' repeat frames 90-94
+  // key image 31 (teach frame 101) verifies 22-28 matches at -10.2 to -11.5 past the weak key image 30, and the tracker
+  // at 28-29 (right) stepped on a key image early; the key image past that mends the held tracker verifies at -15 to -17.
+  if (!beyond.accepted || beyond.log10_nfa > options_.look_past_max_log10_nfa ||
+      beyond.num_verified <= best.num_verified || !IsBetterMatch(beyond, best)) {
+    return;
+  }
   best = beyond;
   best_position = past;
 }

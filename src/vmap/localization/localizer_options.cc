@@ -75,6 +75,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "tracked one does too (otherwise the key image past it is compared, and stepped on to where it "
                  "verifies more beyond chance)"},
                 look_past_weak_next);
+  visitor.Visit({"look_past_max_log10_nfa", "--look-past-max-log10-nfa",
+                 "Float descriptors: the log10 NFA at most which the key image past a weak next one must verify to be "
+                 "stepped on to (--no-look-past-weak-next; -10: beyond a little chance)"},
+                look_past_max_log10_nfa);
   visitor.Visit({"rival_place_frames", "--rival-place-frames",
                  "Frames a far key image that verified more than the one a frame was steered by is compared again; "
                  "a tracked frame it out-verifies again is relocalized (0 = never)"},

@@ -127,6 +127,14 @@ struct LocalizerOptions {
   // sets over the verifier's seeds 0-15, frames confidently more than 2 key images off 11 -> 3). Off: the lookahead
   // stops at the first key image that does not beat the tracked one.
   bool look_past_weak_next = true;
+  // Float descriptors (XFeat), look_past_weak_next: the key image past the weak next one is stepped on to only where it
+  // verifies clearly, at log10 NFA at most this (-10: beyond a little chance, the rule as it was first written). The
+  // key image past that mends a tracker held at a look-alike verifies at -15.3 to -16.9 (corridor_conditions' key
+  // image 6 on repeat frames 26-27 of the corridor from 20, the verifier's seeds 8, 9, 14, 16 and 18), while 9 of the
+  // 10 steps one key image early at repeat frames 90-94 of the corridor (to key image 31, teach frame 101, where 28-29
+  // are right) were taken at -10.2 to -11.5 over seeds 0-19 (docs/measurements/localization-conditions.md, "The look
+  // past needs the key image past to verify clearly": the corridor's right and not uncertain 104.10 -> 104.95 a seed).
+  double look_past_max_log10_nfa = -13.0;
   // A place elsewhere on the route that verified more matches than the key images a frame was steered by (a key image
   // more than two route positions away) is a rival: for this many frames it is compared again (it and the key image
   // after it), and a tracked frame it out-verifies again is relocalized, as a frame that shares little with its key
