@@ -135,6 +135,14 @@ struct LocalizerOptions {
   // are right) were taken at -10.2 to -11.5 over seeds 0-19 (docs/measurements/localization-conditions.md, "The look
   // past needs the key image past to verify clearly": the corridor's right and not uncertain 104.10 -> 104.95 a seed).
   double look_past_max_log10_nfa = -13.0;
+  // Float descriptors (XFeat): a frame relocalized more than two route positions from where the run was last steered
+  // by, at key images that verify by little beyond chance (neither at a log10 NFA of at most -10), is `uncertain`.
+  // Across lighting such a relocalization is a look-alike's more often than the robot's: over XFeat's corridor sets at
+  // the verifier's seeds 0-27, 13 of the 49 relocalizations so were right and 2 were more than 2 key images off (the
+  // corridor's dark stretch, repeat frame 54 at key image 30 where 14-15 are right, seed 26), the rest 1-2 off
+  // (docs/measurements/localization-conditions.md, "A relocalization away on little chance is doubted"). Off: such a
+  // frame is steered by.
+  bool doubt_relocalization_on_little_chance = true;
   // A place elsewhere on the route that verified more matches than the key images a frame was steered by (a key image
   // more than two route positions away) is a rival: for this many frames it is compared again (it and the key image
   // after it), and a tracked frame it out-verifies again is relocalized, as a frame that shares little with its key

@@ -342,5 +342,15 @@ TEST_F(XfeatCorridorRun, AStartConfirmedAtALookAlikeIsAskedByTheFramesRanking) {
       [&](const std::string& flags) { return SteeredOnRepeat(90, 100, 0, " --verifier-seed 12" + flags); });
 }
 
+// A relocalization away on little chance is doubted (docs/localize.md): repeat frames 44-58 at the verifier's seed 26,
+// the corridor's dark stretch. Frame 48 was tracked at key image 14; frames 49-53 were uncertain, and frame 54 was
+// relocalized at key image 30 (right: 14-15) on 21 matches at log10 NFA -3.1, its next key image at +0.5: steered by
+// 16 key images from where the run last was. Doubted, it is uncertain.
+TEST_F(XfeatCorridorRun, ARelocalizationAwayOnLittleChanceIsDoubted) {
+  ExpectNoFarFrameButWithout(
+      " --no-doubt-relocalization-on-little-chance", "frame 54 relocalized at key image 30",
+      [&](const std::string& flags) { return SteeredOnRepeat(44, 58, KeyBefore(44), " --verifier-seed 26" + flags); });
+}
+
 }  // namespace
 }  // namespace vmap::neural
