@@ -26,7 +26,7 @@ void Localizer::LookPastWeakNext(const Frame& frame, const ImageFeatures& featur
   const KeyComparison beyond = CompareTracked(frame, features, past);
   // Stepped on to only where it verifies clearly (look_past_max_log10_nfa): at corridor_conditions' repeat frames 90-94
   // key image 31 (teach frame 101) verifies 22-28 matches at -10.2 to -11.5 past the weak key image 30, and the tracker
-  // at 28-29 (right) stepped on a key image early; the key image past that mends the held tracker verifies at -15 to -17.
+  // at 28-29 (right) stepped on a key image early; the key image past that mends a held tracker verifies at -15 to -17.
   if (!beyond.accepted || beyond.log10_nfa > options_.look_past_max_log10_nfa ||
       beyond.num_verified <= best.num_verified || !IsBetterMatch(beyond, best)) {
     return;

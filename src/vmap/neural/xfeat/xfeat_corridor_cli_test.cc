@@ -312,11 +312,11 @@ TEST_F(XfeatCorridorRun, ATrackerHeldAtALookAlikeLooksPastAWeakNextKeyImage) {
   }
 }
 
-// The look past needs the key image past to verify clearly (docs/localize.md, "A tracker held at a look-alike looks past
-// a weak next key image"): repeat frames 86-100, started at teach frame 86's key image, at the verifier's seeds 3 and
-// 14. Key image 30 (teach frame 97) sees little of repeat frames 92-94, key image 31 (teach frame 101) verifies 28 and 22
-// matches at log10 NFA -11.2 and -11.5 on frame 92: looked past at beyond a little chance (-10), the tracker stepped on
-// to 31 and was steered by at 30-31 on frames 92-95 (right: 28-29, and 30 for 94-95), a key image early.
+// The look past needs the key image past to verify clearly (docs/localize.md, "A tracker held at a look-alike looks
+// past a weak next key image"): repeat frames 86-100, started at teach frame 86's key image, at the verifier's seeds 3
+// and 14. Key image 30 (teach frame 97) sees little of repeat frames 92-94, key image 31 (teach frame 101) verifies 28
+// and 22 matches at log10 NFA -11.2 and -11.5 on frame 92: looked past at beyond a little chance (-10), the tracker
+// stepped on to 31 and was steered by at 30-31 on frames 92-95 (right: 28-29, and 30 for 94-95), a key image early.
 TEST_F(XfeatCorridorRun, TheLookPastNeedsTheKeyImagePastToVerifyClearly) {
   for (const std::string seed : {"3", "14"}) {
     SCOPED_TRACE("verifier seed " + seed);
