@@ -138,7 +138,7 @@ struct LocalizerOptions {
   // Float descriptors (XFeat): a frame relocalized more than two route positions from where the run was last steered
   // by, at key images that verify by little beyond chance (neither at a log10 NFA of at most -10), is `uncertain`.
   // Across lighting such a relocalization is a look-alike's more often than the robot's: over XFeat's corridor sets at
-  // the verifier's seeds 0-27, 13 of the 47 relocalizations so were right and 2 were more than 2 key images off (the
+  // the verifier's seeds 0-27, 12 of the 46 relocalizations so were right and 2 were more than 2 key images off (the
   // corridor's dark stretch, repeat frame 54 at key image 30 where 14-15 are right, seed 26), the rest 1-2 off
   // (docs/measurements/localization-conditions.md, "A relocalization away on little chance is doubted"). Off: such a
   // frame is steered by.
