@@ -15,4 +15,8 @@ bool FitsBetter(const KeyComparison& a, const KeyComparison& b) {
   return a.similarity > b.similarity;
 }
 
+bool PassesChance(const KeyComparison& comparison, double max_log10_nfa) {
+  return comparison.accepted && comparison.log10_nfa <= max_log10_nfa;
+}
+
 }  // namespace vmap

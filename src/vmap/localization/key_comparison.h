@@ -53,5 +53,8 @@ bool IsBetterMatch(const KeyComparison& a, const KeyComparison& b);
 // Which of two images of one key image (the key image, a view) fits a frame better: IsBetterMatch, and when
 // neither is accepted, more verified matches (the heading is still reported), then higher S. Ties keep `b`.
 bool FitsBetter(const KeyComparison& a, const KeyComparison& b);
+// Accepted, and its verified set at a log10 NFA of at most `max_log10_nfa`: beyond that much chance (a bar stricter
+// than the acceptance rule's, such as Localizer::kBeyondLittleChance).
+bool PassesChance(const KeyComparison& comparison, double max_log10_nfa);
 
 }  // namespace vmap

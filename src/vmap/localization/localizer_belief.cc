@@ -14,11 +14,6 @@ namespace {
 // The positions a result records its belief at (LocalizationResult::belief): those holding at least this.
 constexpr double kRecordedMass = 0.01;
 
-// Accepted by the a-contrario test itself (not by the heading's or the guided tests' looser ones).
-bool PassesChance(const KeyComparison& comparison, double max_log10_nfa) {
-  return comparison.accepted && comparison.log10_nfa <= max_log10_nfa;
-}
-
 }  // namespace
 
 void Localizer::WeighComparisons() {

@@ -33,8 +33,8 @@ void Localizer::DoubtJumpBack(LocalizationResult& result) {
   int near = 0;
   for (const Memo& m : comparisons_) {
     const int p = route_position_of_key_[m.comparison.key];
-    if (p > to + 1 && std::abs(p - from) <= kNear && m.comparison.log10_nfa <= kBeyondLittleChance) {
-      near = std::max(near, AcceptedVerified(m.comparison));
+    if (p > to + 1 && std::abs(p - from) <= kNear && PassesChance(m.comparison, kBeyondLittleChance)) {
+      near = std::max(near, m.comparison.num_verified);
     }
   }
   if (near == 0 || near < kNotClearlyWorse * jumped_to) return;

@@ -18,7 +18,7 @@ bool Localizer::RelocalizedAwayOnLittleChance(const LocalizationResult& result) 
     return false;
   }
   for (const KeyComparison* c : {&result.to_key, &result.to_next}) {
-    if (c->key >= 0 && c->accepted && c->log10_nfa <= kBeyondLittleChance) return false;
+    if (c->key >= 0 && PassesChance(*c, kBeyondLittleChance)) return false;
   }
   return true;
 }

@@ -7,12 +7,12 @@ namespace vmap {
 
 void Localizer::LookPastWeakNext(const Frame& frame, const ImageFeatures& features, int position, KeyComparison& best,
                                  int& best_position) {
-  auto BeyondLittleChance = [](const KeyComparison& c) { return c.accepted && c.log10_nfa <= kBeyondLittleChance; };
   const int next = best_position + 1, past = best_position + 2;
   // Asked only where the lookahead stopped at `next` (it compared it, and it did not beat `best`) and `best` holds the
   // frame by little beyond chance.
-  if (!options_.look_past_weak_next || binary_descriptors_ || !best.accepted || BeyondLittleChance(best) ||
-      next > position + options_.lookahead || past >= static_cast<int>(route_.size())) {
+  if (!options_.look_past_weak_next || binary_descriptors_ || !best.accepted ||
+      PassesChance(best, kBeyondLittleChance) || next > position + options_.lookahead ||
+      past >= static_cast<int>(route_.size())) {
     return;
   }
   // Why: across lighting XFeat verifies 15-25 matches at every key image near the frame, and a next key image that
@@ -22,13 +22,13 @@ void Localizer::LookPastWeakNext(const Frame& frame, const ImageFeatures& featur
   // look-alikes of repeat frames 20-34) and repeat frame 30 was steered by there, 3 key images behind the right 7-8
   // (the verifier's seeds 8, 9 and 14; docs/measurements/localization-conditions.md, "A tracker held at a look-alike
   // looks past a weak next key image"). The route goes forwards: a tracker held behind falls further behind.
-  if (BeyondLittleChance(CompareOnce(features, route_[next]))) return;
+  if (PassesChance(CompareOnce(features, route_[next]), kBeyondLittleChance)) return;
   const KeyComparison beyond = CompareTracked(frame, features, past);
   // Stepped on to only where it verifies clearly (look_past_max_log10_nfa): at corridor_conditions' repeat frames 90-94
   // key image 31 (teach frame 101) verifies 22-28 matches at -10.2 to -11.5 past the weak key image 30, and the tracker
   // at 28-29 (right) stepped on a key image early; the key image past that mends a held tracker verifies at -15 to -17.
-  if (!beyond.accepted || beyond.log10_nfa > options_.look_past_max_log10_nfa ||
-      beyond.num_verified <= best.num_verified || !IsBetterMatch(beyond, best)) {
+  if (!PassesChance(beyond, options_.look_past_max_log10_nfa) || beyond.num_verified <= best.num_verified ||
+      !IsBetterMatch(beyond, best)) {
     return;
   }
   best = beyond;

@@ -379,6 +379,11 @@ void LocalizerOptions::Check() const {
                       fmt::format("{} is outside [-1000, 1000] (default {})", continuity_max_log10_nfa,
                                   defaults.continuity_max_log10_nfa));
   }
+  if (!(look_past_max_log10_nfa >= -1000.0 && look_past_max_log10_nfa <= 0.0)) {
+    throw OptionError("look_past_max_log10_nfa",
+                      fmt::format("{} is outside [-1000, 0] (default {})", look_past_max_log10_nfa,
+                                  defaults.look_past_max_log10_nfa));
+  }
   if (lookahead < 1 || lookahead > 2) {
     throw OptionError("lookahead", fmt::format("{} is not 1 or 2 (default {})", lookahead, defaults.lookahead));
   }
