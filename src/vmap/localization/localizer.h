@@ -244,6 +244,7 @@ class Localizer {
   // A frame relocalized more than kNear route positions from steered_before_, at key images that verify by little
   // beyond chance (LocalizerOptions::doubt_relocalization_on_little_chance; localizer_little_chance.cc).
   bool RelocalizedAwayOnLittleChance(const LocalizationResult& result) const;
+  bool StartAwayLacksBelief(const LocalizationResult& result) const;
   void Question(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
   // A frame placed more than kNear route positions behind where the tracker was, where an accepted key image within
   // kNear of that estimate, beyond a little chance, verified nearly as many matches as the place: the frame is

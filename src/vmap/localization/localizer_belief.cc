@@ -135,7 +135,8 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
   // reads.
   const auto start_ranking = placed ? RankForUnconfirmedStart(result, frame, features) : std::nullopt;
   const bool ties_far = start_ranking && StartPlaceTiesFar(result, features, *start_ranking);
-  if (placed && (ties_far || withheld_unranked || withholds(position) || RelocalizedAwayOnLittleChance(result))) {
+  if (placed && (ties_far || withheld_unranked || withholds(position) || RelocalizedAwayOnLittleChance(result) ||
+                 StartAwayLacksBelief(result))) {
     result.status = LocalizationStatus::kUncertain;
   }
   // Confirmed: the frames' evidence alone leans most near the place the frame is steered by (with the frame's ranking

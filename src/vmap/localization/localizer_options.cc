@@ -125,6 +125,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "--start-key, float descriptors: before the start is confirmed, the frames' evidence alone weighs a "
                  "tracked frame by its comparisons only (otherwise by its ranking too)"},
                 start_evidence_ranks_frame);
+  visitor.Visit({"start_away_min_confidence", "--start-away-min-confidence",
+                 "--start-key, float descriptors: before the start is confirmed, the belief a frame placed more than "
+                 "two key images from the start key image needs near its place to be steered by (0: as any frame)"},
+                start_away_min_confidence);
   visitor.Visit({"max_lost_frames", "--max-lost", "Lost frames in a row before the estimate is dropped"},
                 max_lost_frames);
   visitor.Visit({"relocalization_candidates", "--candidates", "Best-ranked key images verified when relocalizing"},
@@ -383,6 +387,11 @@ void LocalizerOptions::Check() const {
     throw OptionError("look_past_max_log10_nfa",
                       fmt::format("{} is outside [-1000, 0] (default {})", look_past_max_log10_nfa,
                                   defaults.look_past_max_log10_nfa));
+  }
+  if (!(start_away_min_confidence >= 0.0 && start_away_min_confidence <= 1.0)) {
+    throw OptionError("start_away_min_confidence",
+                      fmt::format("{} is outside [0, 1] (default {})", start_away_min_confidence,
+                                  defaults.start_away_min_confidence));
   }
   if (lookahead < 1 || lookahead > 2) {
     throw OptionError("lookahead", fmt::format("{} is not 1 or 2 (default {})", lookahead, defaults.lookahead));

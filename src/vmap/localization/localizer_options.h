@@ -414,6 +414,19 @@ struct LocalizerOptions {
   // asked by the frame's ranking"). Only on routes where a key image and the two either side hold at most half the
   // route (as start_needs_evidence). Off: the frames' evidence weighs a tracked frame by its comparisons alone.
   bool start_evidence_ranks_frame = true;
+  // With start_is_hint and float descriptors (XFeat), while the start is unconfirmed a frame placed more than two route
+  // positions from the start key image is also `uncertain`, and does not confirm the start, where the belief holds less
+  // than this near it: a place away from where the user said the run starts must win the belief from the start's prior,
+  // not half of it. Across lighting two frames of a dark stretch can verify a look-alike far off beyond chance
+  // (corridor_conditions from repeat frame 50 at the verifier's seeds 22 and 35: frames 53-54 verify key image 29 at
+  // log10 NFA -9.6 to -19.4, right: 13-15); the jump was taken and the start confirmed there with 0.61-0.73 near it
+  // (seed 35: frames 55-56 tracked at 30 with 0.83 and 0.62). Starts confirmed at the right place away from the start
+  // key image held 0.70-1.0 (4 of 118 below 0.9, over the verifier's seeds 0-39). Over those seeds the runs started
+  // elsewhere: 4 frames steered by more than 2 key images off -> 0, right and not uncertain 190.65 -> 190.28 a seed
+  // (the 4 slower starts wait 1-6 frames); runs started at the start key image the same in every CSV
+  // (docs/measurements/localization-conditions.md, "A start away from the start key image needs the belief"). Only on
+  // routes where a key image and the two either side hold at most half the route (as start_needs_evidence). 0: off.
+  double start_away_min_confidence = 0.9;
   // Lost frames in a row (each one also failed to relocalize) after which the estimate is dropped: key and
   // next_key then read -1 until a frame is relocalized.
   int max_lost_frames = 5;

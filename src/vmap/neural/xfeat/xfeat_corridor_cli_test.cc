@@ -352,5 +352,19 @@ TEST_F(XfeatCorridorRun, ARelocalizationAwayOnLittleChanceIsDoubted) {
       [&](const std::string& flags) { return SteeredOnRepeat(44, 58, KeyBefore(44), " --verifier-seed 26" + flags); });
 }
 
+// A start away from the start key image needs the belief (docs/localize.md): repeat frames 50-60 started at key image 0
+// (the corridor from 50), at the verifier's seeds 35 and 22. Frames 50-53 are the corridor's dark stretch and verify
+// chance's count everywhere; frames 53-54 verify key image 29 (right: 13-15) at log10 NFA -9.6 to -19.4, the jump is
+// taken on frame 54 and the start confirmed there on a belief of 0.61-0.73 near it (seed 35: frames 55-56 tracked at
+// 30). Needing 0.9 there, they are uncertain until the frames verify the right place.
+TEST_F(XfeatCorridorRun, AStartAwayFromTheStartKeyImageNeedsTheBelief) {
+  for (const std::string seed : {"35", "22"}) {
+    SCOPED_TRACE("verifier seed " + seed);
+    ExpectNoFarFrameButWithout(
+        " --start-away-min-confidence 0", "frame 54 relocalized at key image 29",
+        [&](const std::string& flags) { return SteeredOnRepeat(50, 60, 0, " --verifier-seed " + seed + flags); });
+  }
+}
+
 }  // namespace
 }  // namespace vmap::neural
