@@ -243,7 +243,7 @@ class Localizer {
   void WeighEvidenceByRanking(const std::vector<RankedKey>& ranked);
   // A frame relocalized more than kNear route positions from steered_before_, at key images that verify by little
   // beyond chance (LocalizerOptions::doubt_relocalization_on_little_chance; localizer_little_chance.cc).
-  bool RelocalizedAwayOnLittleChance(const LocalizationResult& result) const;
+  bool PlacedAwayOnLittleChance(const LocalizationResult& result) const;
   bool StartAwayLacksBelief(const LocalizationResult& result) const;
   void Question(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
   // A frame placed more than kNear route positions behind where the tracker was, where an accepted key image within

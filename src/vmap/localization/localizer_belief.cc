@@ -135,7 +135,7 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
   // reads.
   const auto start_ranking = placed ? RankForUnconfirmedStart(result, frame, features) : std::nullopt;
   const bool ties_far = start_ranking && StartPlaceTiesFar(result, features, *start_ranking);
-  if (placed && (ties_far || withheld_unranked || withholds(position) || RelocalizedAwayOnLittleChance(result) ||
+  if (placed && (ties_far || withheld_unranked || withholds(position) || PlacedAwayOnLittleChance(result) ||
                  StartAwayLacksBelief(result))) {
     result.status = LocalizationStatus::kUncertain;
   }

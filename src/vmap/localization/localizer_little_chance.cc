@@ -4,17 +4,19 @@
 // verifier's seed 26: repeat frames 50-53 were uncertain, and frame 54 was relocalized at key image 30 (right: 14-15)
 // on 21 matches at log10 NFA -3.1 (the next key image +0.5), steered by 16 key images from frame 48's key image 14
 // (docs/measurements/localization-conditions.md, "A relocalization away on little chance is doubted"). A frame
-// relocalized near the place steered by, or one whose key images verify beyond a little chance, is not asked.
+// relocalized near the place steered by, or one whose key images verify beyond a little chance, is not asked. A frame
+// tracked that far is asked too: an uncertain frame moved the tracker there, a relocalization nothing steered by yet
+// (the corridor from repeat frame 20 at the verifier's seed 48: frame 52 moved it to key image 31, right: 14-15, and
+// frame 53 was tracked there on 24 matches at -8.2; "A frame tracked away on little chance is doubted").
 #include <cstdlib>
 
 #include "vmap/localization/localizer.h"
 
 namespace vmap {
 
-bool Localizer::RelocalizedAwayOnLittleChance(const LocalizationResult& result) const {
-  if (!options_.doubt_relocalization_on_little_chance || binary_descriptors_ ||
-      result.status != LocalizationStatus::kRelocalized || result.route_position < 0 || steered_before_ < 0 ||
-      std::abs(result.route_position - steered_before_) <= kNear) {
+bool Localizer::PlacedAwayOnLittleChance(const LocalizationResult& result) const {
+  if (!options_.doubt_relocalization_on_little_chance || binary_descriptors_ || !IsPlaced(result.status) ||
+      result.route_position < 0 || steered_before_ < 0 || std::abs(result.route_position - steered_before_) <= kNear) {
     return false;
   }
   for (const KeyComparison* c : {&result.to_key, &result.to_next}) {

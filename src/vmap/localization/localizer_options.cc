@@ -80,8 +80,9 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "stepped on to (--no-look-past-weak-next; -10: beyond a little chance)"},
                 look_past_max_log10_nfa);
   visitor.Visit({"doubt_relocalization_on_little_chance", "!--no-doubt-relocalization-on-little-chance",
-                 "Float descriptors: steer by a frame relocalized more than two key images from where the run was "
-                 "last steered by even where its key images verify by little beyond chance (else it is uncertain)"},
+                 "Float descriptors: steer by a frame relocalized (or tracked) more than two key images from where "
+                 "the run was last steered by even where its key images verify by little beyond chance (else it is "
+                 "uncertain)"},
                 doubt_relocalization_on_little_chance);
   visitor.Visit({"rival_place_frames", "--rival-place-frames",
                  "Frames a far key image that verified more than the one a frame was steered by is compared again; "

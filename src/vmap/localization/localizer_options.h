@@ -140,8 +140,11 @@ struct LocalizerOptions {
   // Across lighting such a relocalization is a look-alike's more often than the robot's: over XFeat's corridor sets at
   // the verifier's seeds 0-27, 12 of the 46 relocalizations so were right and 2 were more than 2 key images off (the
   // corridor's dark stretch, repeat frame 54 at key image 30 where 14-15 are right, seed 26), the rest 1-2 off
-  // (docs/measurements/localization-conditions.md, "A relocalization away on little chance is doubted"). Off: such a
-  // frame is steered by.
+  // (docs/measurements/localization-conditions.md, "A relocalization away on little chance is doubted"). So is a frame
+  // tracked that far, at such key images: the tracker is there because an uncertain frame moved it, a relocalization
+  // nothing steered by yet (the corridor from repeat frame 20 at the verifier's seed 48: frame 52 moved the tracker to
+  // key image 31 uncertain, frame 53 was tracked there at -8.2, right: 14-15; over seeds 0-39 the tracked ones so were
+  // 3 right and 8 wrong; "A frame tracked away on little chance is doubted"). Off: such a frame is steered by.
   bool doubt_relocalization_on_little_chance = true;
   // A place elsewhere on the route that verified more matches than the key images a frame was steered by (a key image
   // more than two route positions away) is a rival: for this many frames it is compared again (it and the key image

@@ -352,6 +352,16 @@ TEST_F(XfeatCorridorRun, ARelocalizationAwayOnLittleChanceIsDoubted) {
       [&](const std::string& flags) { return SteeredOnRepeat(44, 58, KeyBefore(44), " --verifier-seed 26" + flags); });
 }
 
+// A frame tracked away on little chance is doubted (docs/localize.md, "A relocalization away on little chance is
+// doubted"): repeat frames 40-56 at the verifier's seed 48, started at teach frame 40's key image. Frame 50 is tracked
+// at key image 13; in the dark stretch frame 52 moves the tracker to key image 31 uncertain, and frame 53 was tracked
+// there on 24 matches at log10 NFA -8.2, its next key image at +4.8 (right: 14-15). Doubted, it is uncertain.
+TEST_F(XfeatCorridorRun, AFrameTrackedAwayOnLittleChanceIsDoubted) {
+  ExpectNoFarFrameButWithout(
+      " --no-doubt-relocalization-on-little-chance", "frame 53 tracked at key image 31",
+      [&](const std::string& flags) { return SteeredOnRepeat(40, 56, KeyBefore(40), " --verifier-seed 48" + flags); });
+}
+
 // A start away from the start key image needs the belief (docs/localize.md): repeat frames 50-60 started at key image 0
 // (the corridor from 50), at the verifier's seeds 35 and 22. Frames 50-53 are the corridor's dark stretch and verify
 // chance's count everywhere; frames 53-54 verify key image 29 (right: 13-15) at log10 NFA -9.6 to -19.4, the jump is
