@@ -444,7 +444,10 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   // Where the run moved back (ask_where_moved_back), a look-alike key image behind holds the tracker.
   const bool moved_back =
       options_.ask_where_moved_back && !binary_descriptors_ && moved_back_to_ >= 0 && best_position == moved_back_to_;
-  if (!rivals_decided && (SharesLittle(best) || pointed_before_ >= 0 || rival_beats || scene_changed || moved_back)) {
+  // Where uncertain frames moved the tracker far behind the place last steered by (ask_where_guessed_back), the same.
+  const bool guessed_back = TrackedFromAGuessBehind(position);
+  if (!rivals_decided &&
+      (SharesLittle(best) || pointed_before_ >= 0 || rival_beats || scene_changed || moved_back || guessed_back)) {
     // Accepted, but with much less than neighbouring key images share: the frame may be elsewhere on the
     // route, in view of this key image's scene. Moved when a ranked key image verifies more matches (a
     // relocalization that is not taken leaves nothing behind: the tracked estimate is set below). Also asked when

@@ -330,6 +330,9 @@ class Localizer {
   // Remembers the key image a frame placed behind the last frame placed moved the run back to as moved_back_to_, while
   // the frames after it are placed there (ask_where_moved_back).
   void RememberMoveBack(const LocalizationResult& result);
+  // The tracker starts the frame at route `position`, more than kNear behind the place the last frame steered by was
+  // at: uncertain frames moved it there (ask_where_guessed_back; localizer_guessed_back.cc).
+  bool TrackedFromAGuessBehind(int position) const;
   // A frame not steered by compares the rival place (it and the key image after it), whose evidence then weighs the
   // belief; Track compares it for the frames it tracks (rival_place_when_not_steered).
   void CompareRivalPlace(const LocalizationResult& result, const ImageFeatures& features);

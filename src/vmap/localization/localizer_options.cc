@@ -66,6 +66,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Track a frame asked where it is for being where the run moved back (--no-ask-where-moved-back) "
                  "though its relocalization finds a far key image verifying more (otherwise it is uncertain)"},
                 doubt_where_moved_back);
+  visitor.Visit({"ask_where_guessed_back", "!--no-ask-where-guessed-back",
+                 "Float descriptors: never relocalize a tracked frame for being tracked from a guess more than two key "
+                 "images behind where the last frame steered by was (otherwise it is)"},
+                ask_where_guessed_back);
   visitor.Visit({"doubt_jump_back", "!--no-doubt-jump-back",
                  "Float descriptors: place a frame more than two key images behind the tracked estimate even where "
                  "the key images near the estimate verify nearly as much (otherwise it is uncertain)"},

@@ -268,6 +268,24 @@ TEST_F(XfeatCorridorRun, AFrameWhereTheRunMovedBackIsAskedWhereItIs) {
       [&](const std::string& flags) { return SteeredOnRun(run, KeyBefore(100), " --verifier-seed 6" + flags); });
 }
 
+// A frame tracked from a guess behind is asked where it is (docs/localize.md): repeat frames 100-110 and then 20-30 as
+// one run (a robot carried back 80 frames), started at teach frame 100's key image, at the verifier's seeds 5, 10 and
+// 11. Repeat frames 20-21 verify most at key image 3 (teach frame 9; right: 4-5) and are uncertain there; repeat frame
+// 22 was tracked at 3 from that guess, where only key image 4 after it (which sees little of the frame) was compared,
+// and steered by a key image early (seed 10: and repeat frame 30 uncertain at key image 2). Asked where it is, it is
+// relocalized at key image 4 or 5.
+TEST_F(XfeatCorridorRun, AFrameTrackedFromAGuessBehindIsAskedWhereItIs) {
+  const std::vector<int> run = CarriedRun(100, 110, 20, 30);
+  for (const std::string seed : {"5", "10", "11"}) {
+    SCOPED_TRACE("verifier seed " + seed);
+    auto steered_right = [&](const std::string& flags) {
+      return Right(SteeredOnRun(run, KeyBefore(100), " --verifier-seed " + seed + flags));
+    };
+    const int asked = steered_right(""), tracked = steered_right(" --no-ask-where-guessed-back");
+    EXPECT_GE(asked, tracked + 1) << "steered by at a right key image: asked " << asked << ", tracked " << tracked;
+  }
+}
+
 // A jump back no clearer than where the frames were is doubted (docs/localize.md): repeat frames 20-36 started at key
 // image 0 (bench/route_conditions.py's corridor from 20), at the verifier's seeds 10 and 5. Repeat frame 30 (seed 10)
 // verifies 32 matches at key image 3 and 30 at the right key image 8; the frame before pointing back there, it was
