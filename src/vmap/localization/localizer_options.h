@@ -110,8 +110,8 @@ struct LocalizerOptions {
   // frame steered by was (uncertain frames moved it there: a far relocalization not yet taken, the belief) is
   // relocalized as one that shares little with its key image is, and moved where it verifies more nearby; a far place
   // verifying more leaves it tracked (the frames before were not steered by: no move back of the run's to doubt).
-  // Across lighting the guess is often a look-alike behind: the kidnapped run's repeat frame 22 was tracked at key image
-  // 3 (right: 4-6) from the uncertain frames before at 19 of the verifier's seeds 0-31 (docs/measurements/
+  // Across lighting the guess is often a look-alike behind: the kidnapped run's repeat frame 22 was tracked at key
+  // image 3 (right: 4-6) from the uncertain frames before at 19 of the verifier's seeds 0-31 (docs/measurements/
   // localization-conditions.md, "A frame tracked from a guess behind is asked where it is"). Off: asked as any other.
   bool ask_where_guessed_back = true;
   // Float descriptors (XFeat): a frame placed more than two route positions behind the tracked estimate (a
