@@ -311,7 +311,8 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
         !best.accepted ||
         ((!options_.step_on_needs_more || ahead.num_verified > best.num_verified) &&
          (!nfa_ranks_key_images_ || !options_.step_on_needs_lower_nfa || NoLikelierChance(ahead, best)));
-    if (!IsBetterMatch(ahead, best) || !beats_best) {
+    const std::optional<bool> to_last = StepsOnToLastKeyImage(ahead, best, position + step);
+    if (to_last ? !*to_last : (!IsBetterMatch(ahead, best) || !beats_best)) {
       // A frame that verifies against nothing so far may still have passed the next key image quickly.
       if (best.accepted || step > 1) break;
       continue;

@@ -250,6 +250,10 @@ class Localizer {
   // kNear of that estimate, beyond a little chance, verified nearly as many matches as the place: the frame is
   // `uncertain` and the tracker stays (LocalizerOptions::doubt_jump_back; localizer_jump_back.cc).
   void DoubtJumpBack(LocalizationResult& result);
+  // The tracker at the key image before the route's last, `tracked` its comparison: whether it steps on to the last
+  // one, `ahead` (LocalizerOptions::step_on_to_last_by_chance); nullopt where the rule does not decide.
+  std::optional<bool> StepsOnToLastKeyImage(const KeyComparison& ahead, const KeyComparison& tracked,
+                                            int ahead_position) const;
   // Track's lookahead stopped at the key image after `best_position`: where `best` and that key image both verify by
   // little beyond chance, the key image past it is compared, and becomes `best` where it verifies more, clearly beyond
   // chance (LocalizerOptions::look_past_weak_next, look_past_max_log10_nfa; localizer_look_past.cc).

@@ -83,6 +83,14 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Float descriptors: the log10 NFA at most which the key image past a weak next one must verify to be "
                  "stepped on to (--no-look-past-weak-next; -10: beyond a little chance)"},
                 look_past_max_log10_nfa);
+  visitor.Visit({"step_on_to_last_by_chance", "!--no-step-on-to-last-by-chance",
+                 "Float descriptors: step on to the route's last key image by the count, as to any other (otherwise "
+                 "from the key image before it where it verifies at a log10 NFA lower by --step-on-to-last-lead)"},
+                step_on_to_last_by_chance);
+  visitor.Visit({"step_on_to_last_log10_nfa_lead", "--step-on-to-last-lead",
+                 "Float descriptors: how much lower a log10 NFA the route's last key image must verify at than the "
+                 "tracked key image before it to be stepped on to (--no-step-on-to-last-by-chance)"},
+                step_on_to_last_log10_nfa_lead);
   visitor.Visit({"doubt_relocalization_on_little_chance", "!--no-doubt-relocalization-on-little-chance",
                  "Float descriptors: steer by a frame relocalized (or tracked) more than two key images from where "
                  "the run was last steered by even where its key images verify by little beyond chance (else it is "
@@ -397,6 +405,11 @@ void LocalizerOptions::Check() const {
     throw OptionError("start_away_min_confidence",
                       fmt::format("{} is outside [0, 1] (default {})", start_away_min_confidence,
                                   defaults.start_away_min_confidence));
+  }
+  if (!(step_on_to_last_log10_nfa_lead >= 0.0 && step_on_to_last_log10_nfa_lead <= 1000.0)) {
+    throw OptionError("step_on_to_last_log10_nfa_lead",
+                      fmt::format("{} is outside [0, 1000] (default {})", step_on_to_last_log10_nfa_lead,
+                                  defaults.step_on_to_last_log10_nfa_lead));
   }
   if (lookahead < 1 || lookahead > 2) {
     throw OptionError("lookahead", fmt::format("{} is not 1 or 2 (default {})", lookahead, defaults.lookahead));

@@ -143,6 +143,19 @@ struct LocalizerOptions {
   // are right) were taken at -10.2 to -11.5 over seeds 0-19 (docs/measurements/localization-conditions.md, "The look
   // past needs the key image past to verify clearly": the corridor's right and not uncertain 104.10 -> 104.95 a seed).
   double look_past_max_log10_nfa = -13.0;
+  // Float descriptors (XFeat): the tracker at the key image before the route's last steps on to the last one where it
+  // verifies at a log10 NFA lower than the tracked key image's by step_on_to_last_log10_nfa_lead, whatever the count
+  // (and never by the count alone). Nothing lies past the route's last key image: on corridor_conditions' last segment
+  // XFeat verifies more matches with the key image before it on the frames past it (repeat frame 110, where only the
+  // last is right, was steered by at the one before at 15 of the verifier's seeds 0-31) and a few more with the last
+  // on frames 97-99, a key image early (23 times), while chance tells them apart the right way
+  // (docs/measurements/localization-conditions.md, "The route's last key image is stepped on to by chance"). Off:
+  // stepped on to by the count, as every other key image.
+  bool step_on_to_last_by_chance = true;
+  // step_on_to_last_by_chance: how much lower (in log10 NFA) the route's last key image must verify than the tracked
+  // one. 6 (a millionth): at 4-5 the tracker steps on at corridor_conditions' repeat frame 97 at seed 8 (28 matches at
+  // -17.9 against 28 at -12.9), a key image early.
+  double step_on_to_last_log10_nfa_lead = 6.0;
   // Float descriptors (XFeat): a frame relocalized more than two route positions from where the run was last steered
   // by, at key images that verify by little beyond chance (neither at a log10 NFA of at most -10), is `uncertain`.
   // Across lighting such a relocalization is a look-alike's more often than the robot's: over XFeat's corridor sets at
