@@ -5,7 +5,7 @@
 namespace vmap {
 
 std::optional<bool> Localizer::StepsOnToLastKeyImage(const KeyComparison& ahead, const KeyComparison& tracked,
-                                                      int ahead_position) const {
+                                                     int ahead_position) const {
   const int last = static_cast<int>(route_.size()) - 1;
   if (!options_.step_on_to_last_by_chance || binary_descriptors_ || !tracked.accepted || ahead_position != last ||
       position_ != last - 1) {
@@ -19,9 +19,9 @@ std::optional<bool> Localizer::StepsOnToLastKeyImage(const KeyComparison& ahead,
   // -17.9, 29 at -13.2 against 26 at -17.0), and the lookahead stepped on to it a key image early. By the count, frame
   // 110 was steered by at 31 at 15 of the verifier's seeds 0-31, frames 97-99 at 32 23 times
   // (docs/measurements/localization-conditions.md, "The route's last key image is stepped on to by chance").
-  // Stepped on to where it verifies at a log10 NFA lower than the tracked key image's by step_on_to_last_log10_nfa_lead,
-  // whatever the count: a lead of 4-5 would take repeat frame 97 at seed 8 (28 matches at -17.9 against 31's 28 at
-  // -12.9), a key image early.
+  // Stepped on to where it verifies at a log10 NFA lower than the tracked key image's by
+  // step_on_to_last_log10_nfa_lead, whatever the count: a lead of 4-5 would take repeat frame 97 at seed 8 (28 matches
+  // at -17.9 against 31's 28 at -12.9), a key image early.
   return ahead.accepted && ahead.log10_nfa <= tracked.log10_nfa - options_.step_on_to_last_log10_nfa_lead;
 }
 

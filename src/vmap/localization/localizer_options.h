@@ -162,10 +162,9 @@ struct LocalizerOptions {
   // the verifier's seeds 0-27, 12 of the 46 relocalizations so were right and 2 were more than 2 key images off (the
   // corridor's dark stretch, repeat frame 54 at key image 30 where 14-15 are right, seed 26), the rest 1-2 off
   // (docs/measurements/localization-conditions.md, "A relocalization away on little chance is doubted"). So is a frame
-  // tracked that far, at such key images: the tracker is there because an uncertain frame moved it, a relocalization
-  // nothing steered by yet (the corridor from repeat frame 20 at the verifier's seed 48: frame 52 moved the tracker to
-  // key image 31 uncertain, frame 53 was tracked there at -8.2, right: 14-15; over seeds 0-39 the tracked ones so were
-  // 3 right and 8 wrong; "A frame tracked away on little chance is doubted"). Off: such a frame is steered by.
+  // tracked that far on such key images, where an uncertain frame moved the tracker (seed 48's corridor from repeat
+  // frame 20: frame 53 at key image 31 at -8.2, right: 14-15; over seeds 0-39 such frames were 3 right, 8 wrong; "A
+  // frame tracked away on little chance is doubted"). Off: such a frame is steered by.
   bool doubt_relocalization_on_little_chance = true;
   // A place elsewhere on the route that verified more matches than the key images a frame was steered by (a key image
   // more than two route positions away) is a rival: for this many frames it is compared again (it and the key image
@@ -440,16 +439,11 @@ struct LocalizerOptions {
   bool start_evidence_ranks_frame = true;
   // With start_is_hint and float descriptors (XFeat), while the start is unconfirmed a frame placed more than two route
   // positions from the start key image is also `uncertain`, and does not confirm the start, where the belief holds less
-  // than this near it: a place away from where the user said the run starts must win the belief from the start's prior,
-  // not half of it. Across lighting two frames of a dark stretch can verify a look-alike far off beyond chance
-  // (corridor_conditions from repeat frame 50 at the verifier's seeds 22 and 35: frames 53-54 verify key image 29 at
-  // log10 NFA -9.6 to -19.4, right: 13-15); the jump was taken and the start confirmed there with 0.61-0.73 near it
-  // (seed 35: frames 55-56 tracked at 30 with 0.83 and 0.62). Starts confirmed at the right place away from the start
-  // key image held 0.70-1.0 (4 of 118 below 0.9, over the verifier's seeds 0-39). Over those seeds the runs started
-  // elsewhere: 4 frames steered by more than 2 key images off -> 0, right and not uncertain 190.65 -> 190.28 a seed
-  // (the 4 slower starts wait 1-6 frames); runs started at the start key image the same in every CSV
-  // (docs/measurements/localization-conditions.md, "A start away from the start key image needs the belief"). Only on
-  // routes where a key image and the two either side hold at most half the route (as start_needs_evidence). 0: off.
+  // than this near it: a place away from where the user said the run starts must win the belief, not half of it. Two
+  // dark frames confirmed corridor_conditions' corridor from repeat frame 50 at key image 29 (right: 13-15) with
+  // 0.61-0.73 (the verifier's seeds 22 and 35); right starts away held 0.70-1.0, 4 of 118 below 0.9 (seeds 0-39;
+  // docs/measurements/localization-conditions.md, "A start away from the start key image needs the belief"). Only where
+  // a key image and the two either side hold at most half the route (as start_needs_evidence). 0: off.
   double start_away_min_confidence = 0.9;
   // Lost frames in a row (each one also failed to relocalize) after which the estimate is dropped: key and
   // next_key then read -1 until a frame is relocalized.

@@ -394,12 +394,12 @@ TEST_F(XfeatCorridorRun, AStartAwayFromTheStartKeyImageNeedsTheBelief) {
   }
 }
 
-// The route's last key image is stepped on to by chance (docs/localize.md): repeat frames 94-110, started at teach frame
-// 94's key image, at the verifier's seeds 3, 4 and 10. Key image 31 (teach frame 101) verifies more matches than the
-// route's last, 32 (teach frame 108), with repeat frame 110, where only 32 is right: by the count the tracker stayed at
-// 31 (seeds 3 and 10). At seed 4 32 verified a few more than 31 on frame 97 at a higher log10 NFA, and frames 98-99
-// (right: 29-31) were steered by at 32. Measured: 17 against 16, 16 against 14, 17 against 16 steered by at a right key
-// image.
+// The route's last key image is stepped on to by chance (docs/localize.md): repeat frames 94-110, started at teach
+// frame 94's key image, at the verifier's seeds 3, 4 and 10. Key image 31 (teach frame 101) verifies more matches than
+// the route's last, 32 (teach frame 108), with repeat frame 110, where only 32 is right: by the count the tracker
+// stayed at 31 (seeds 3 and 10). At seed 4 32 verified a few more than 31 on frame 97 at a higher log10 NFA, and frames
+// 98-99 (right: 29-31) were steered by at 32. Measured: 17 against 16, 16 against 14, 17 against 16 steered by at a
+// right key image.
 TEST_F(XfeatCorridorRun, TheRoutesLastKeyImageIsSteppedOnToByChance) {
   for (const std::string seed : {"3", "4", "10"}) {
     SCOPED_TRACE("verifier seed " + seed);
