@@ -347,6 +347,9 @@ class Localizer {
   double NearDensity(int position) const;
   // The route positions within kNear of `position` (fewer at the route's ends).
   int NearWidth(int position) const;
+  // Whether a place can be singled out at route `position`: it and the two key images either side hold at most half
+  // the route (not on michigan_seasons' routes of 5 places).
+  bool TellsNearFromFar(int position) const;
 
   // The frame's verified matches with key_a over those of the map's link between key_a and key_b (0 when
   // they have no link).

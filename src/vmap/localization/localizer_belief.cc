@@ -98,7 +98,7 @@ bool Localizer::EvidenceWeighsAgainst(int position) const {
   // and its neighbours hold more than half the route (michigan_seasons' routes of 5 places), near and elsewhere are not
   // told apart, as a place cannot be singled out there (SinglesOut: twice a flat belief).
   const double flat = static_cast<double>(NearWidth(position)) / route_.size();
-  return 2.0 * flat <= 1.0 && evidence_belief_.MassWithin(position, kNear) < flat;
+  return TellsNearFromFar(position) && evidence_belief_.MassWithin(position, kNear) < flat;
 }
 
 void Localizer::Believe(LocalizationResult& result, const Frame& frame, const ImageFeatures& features) {
@@ -314,6 +314,10 @@ void Localizer::Question(LocalizationResult& result, const Frame& frame, const I
 }
 
 double Localizer::NearDensity(int position) const { return belief_.MassWithin(position, kNear) / NearWidth(position); }
+
+bool Localizer::TellsNearFromFar(int position) const {
+  return 2 * NearWidth(position) <= static_cast<int>(route_.size());
+}
 
 int Localizer::NearWidth(int position) const {
   const int last = static_cast<int>(route_.size()) - 1;

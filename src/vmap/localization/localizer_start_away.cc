@@ -17,10 +17,7 @@ bool Localizer::StartAwayLacksBelief(const LocalizationResult& result) const {
       start_position_ < 0 || std::abs(position - start_position_) <= kNear || !IsPlaced(result.status)) {
     return false;
   }
-  // Where the place and its neighbours hold more than half the route (michigan_seasons' routes of 5 places), near and
-  // far are not told apart, as in EvidenceWeighsAgainst.
-  if (2 * NearWidth(position) > static_cast<int>(route_.size())) return false;
-  return belief_.MassWithin(position, kNear) < options_.start_away_min_confidence;
+  return TellsNearFromFar(position) && belief_.MassWithin(position, kNear) < options_.start_away_min_confidence;
 }
 
 }  // namespace vmap

@@ -29,7 +29,7 @@ std::optional<std::vector<RankedKey>> Localizer::RankForUnconfirmedStart(const L
   }
   // Where the place and its neighbours hold more than half the route (michigan_seasons' routes of 5 places), near and
   // far are not told apart, as in EvidenceWeighsAgainst.
-  if (2 * NearWidth(position) > static_cast<int>(route_.size())) return std::nullopt;
+  if (!TellsNearFromFar(position)) return std::nullopt;
   if (!(result.to_key.accepted && result.to_key.key >= 0) && !(result.to_next.accepted && result.to_next.key >= 0)) {
     return std::nullopt;  // nothing accepted at the place: nothing to tell from a far one
   }
