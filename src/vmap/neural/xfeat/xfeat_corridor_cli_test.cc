@@ -385,8 +385,8 @@ TEST_F(XfeatCorridorRun, AFrameTrackedAwayOnLittleChanceIsDoubted) {
 // A frame tracked on from near where the run was steered is not doubted for its little chance (docs/localize.md, "A
 // relocalization away on little chance is doubted"): repeat frames 44-60, started at teach frame 44's key image, at the
 // verifier's seeds 8 and 13. Frame 50 is steered by at key image 13; frames 51-53 are the dark stretch's, uncertain,
-// and the tracker starts frame 54 within two key images of 13. Frames 54-55 are tracked at key image 16 at log10 NFA
-// -2.7 to -7.3; three key images from 13 they were doubted, and frame 55 is right there (14-16).
+// and the tracker starts frame 54 within two key images of 13. Frames 54-55 are tracked at key image 16 (in the whole
+// corridor run at log10 NFA -2.7 to -7.3); three key images from 13 they were doubted, and 55 is right there (14-16).
 TEST_F(XfeatCorridorRun, AFrameTrackedOnFromNearWhereTheRunWasSteeredIsNotDoubted) {
   for (const std::string seed : {"8", "13"}) {
     SCOPED_TRACE("verifier seed " + seed);
