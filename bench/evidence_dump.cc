@@ -30,6 +30,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <memory>
 #include <optional>
 #include <string>
@@ -49,7 +50,7 @@
 
 using namespace vmap;
 
-int main(int argc, char** argv) {
+int Dump(int argc, char** argv) {
   // CLI11, as the vmap binary parses its flags: a flag it does not know, or one without its value, is an error.
   CLI::App app{"evidence_dump: every frame of a query against every key image of a map, one CSV row per pair"};
   std::string map_path, query_path, window_list;
@@ -223,4 +224,14 @@ int main(int argc, char** argv) {
     previous_heading.swap(heading);
   }
   return 0;
+}
+
+// A map, a query or a plugin that cannot be opened is reported as the vmap binary reports it, not by std::terminate.
+int main(int argc, char** argv) {
+  try {
+    return Dump(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "evidence_dump: error: %s\n", e.what());
+    return 1;
+  }
 }

@@ -137,6 +137,7 @@ def dump_evidence(map_directory, query, output, prefix=""):
     lines = text.splitlines()
     header = [l for l in lines if l.startswith("frame,")]
     rows = [l for l in lines if l and l[0].isdigit()]
+    os.makedirs(os.path.dirname(output) or ".", exist_ok=True)
     new = not os.path.exists(output)
     with open(output, "a") as f:
         if new:
