@@ -13,6 +13,13 @@ alone.
 
 Each pair is `vmap match --matcher M --json` (cached in --work: a second run reads them back).
 
+With --learn, also the pattern as the teach run alone shows it (what a map could learn without a user's mask): teach
+frame i (every 6th) against teach frames i + 20 and i + 45, other places; every tentative match that does not move
+marks its 8 x 8 px cell in the first image; the cells marked by at least 2, 3 and 5 such matches are the learnt
+pattern. Printed: how many of those matches lie outside the circle (with --circle), and per threshold the cells, those
+whose centre lies inside the circle, and the share of the repeat-against-teach pairs' verified matches with a point in
+a learnt cell.
+
 With --evidence CSV --map MAP/map.json (every repeat frame against every key image of the corridor's map:
 build/bench/evidence_dump, or bench/route_conditions.py --evidence-dir), also the key images that verify everywhere:
 per key image, the median verified matches and log10 NFA of its comparisons with frames of other places (more than two
@@ -21,25 +28,61 @@ the log10 NFA tells right from other places (the area under the ROC curve) raw a
 The medians come from the repeat run itself, so the second area is what knowing each key image's chance at best adds.
 
 usage: bench/fixed_pattern.py --vmap build/vmap [--matcher xfeat] [--circle 74.5,60,64] [--step 2] [--far-offset 40]
-                              [--still-px 1.6] [--work DIR] [--evidence CSV --map MAP/map.json]   (from the repository root; ../shared must be there)"""
+                              [--still-px 1.6] [--work DIR] [--learn] [--evidence CSV --map MAP/map.json]   (from the repository root; ../shared must be there)"""
 import argparse, csv, json, math, os, statistics, subprocess, sys, tempfile
 
 CORRIDOR = "../shared/data/corridor_conditions"
 FRAMES = 111
 
 
-def verified_matches(vmap, matcher, teach, repeat, work):
-    """The F-verified matches of teach frame `teach` (image0) with repeat frame `repeat` (image1): (x0, y0, x1, y1)."""
-    output = os.path.join(work, "%s_t%d_r%d.json" % (matcher, teach, repeat))
+def matches(vmap, matcher, teach, other, work, run="repeat", verified=True):
+    """The matches of teach frame `teach` (image0) with frame `other` of `run` (image1), F-verified ones or all the
+    tentative ones: (x0, y0, x1, y1)."""
+    output = os.path.join(work, "%s_t%d_%s%d.json" % (matcher, teach, run[0], other))
     if not os.path.exists(output):
         done = subprocess.run([vmap, "match", "--matcher", matcher, os.path.join(CORRIDOR, "teach", "%07d.jpg" % teach),
-                               os.path.join(CORRIDOR, "repeat", "%07d.jpg" % repeat), "--json", output],
+                               os.path.join(CORRIDOR, run, "%07d.jpg" % other), "--json", output],
                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         if done.returncode != 0:
-            sys.exit("failed: vmap match t%d r%d\n%s" % (teach, repeat, done.stdout))
+            sys.exit("failed: vmap match teach %d %s %d\n%s" % (teach, run, other, done.stdout))
     with open(output) as f:
         pair = json.load(f)
-    return [(m["x0"], m["y0"], m["x1"], m["y1"]) for m in pair["matches"] if m["inlier"]]
+    return [(m["x0"], m["y0"], m["x1"], m["y1"]) for m in pair["matches"] if m["inlier"] or not verified]
+
+
+def cell(x, y):
+    return int(x) // 8, int(y) // 8
+
+
+def learn_pattern(args, circle, work, pairs_by_set):
+    """The cells the teach run's still matches between other places mark, and what they would take of `pairs_by_set`
+    (set name -> list of verified match lists)."""
+    hits, still, outside = {}, 0, 0
+    for teach in range(0, FRAMES, 6):
+        for later in (teach + 20, teach + 45):
+            if later >= FRAMES:
+                continue
+            for x0, y0, x1, y1 in matches(args.vmap, args.matcher, teach, later, work, run="teach", verified=False):
+                if math.hypot(x1 - x0, y1 - y0) >= args.still_px:
+                    continue
+                still += 1
+                outside += circle is not None and math.hypot(x0 - circle[0], y0 - circle[1]) > circle[2]
+                hits[cell(x0, y0)] = hits.get(cell(x0, y0), 0) + 1
+    print("\nthe teach run's still tentative matches between other places: %d%s" % (
+        still, ", %d outside the circle" % outside if circle else ""))
+    print("\n| cells marked by at least | cells (of %d) | centre inside the circle | verified matches in them: %s |" % (
+        20 * 15, " | ".join(pairs_by_set)))
+    print("|---|---|---|" + "---|" * len(pairs_by_set))
+    for least in (2, 3, 5):
+        learnt = {c for c, n in hits.items() if n >= least}
+        inside = sum(math.hypot(cx * 8 + 4 - circle[0], cy * 8 + 4 - circle[1]) < circle[2]
+                     for cx, cy in learnt) if circle else "-"
+        shares = []
+        for pairs in pairs_by_set.values():
+            total = sum(len(p) for p in pairs) or 1
+            taken = sum(cell(x0, y0) in learnt or cell(x1, y1) in learnt for p in pairs for x0, y0, x1, y1 in p)
+            shares.append("%.0f %%" % (100.0 * taken / total))
+        print("| %d | %d | %s | %s |" % (least, len(learnt), inside, " | ".join(shares)))
 
 
 def tally(matches, still_px, circle):
@@ -108,6 +151,7 @@ def main():
     parser.add_argument("--far-offset", type=int, default=40)
     parser.add_argument("--still-px", type=float, default=1.6)
     parser.add_argument("--work", help="where the pairs' JSON files are kept (default: a temporary folder)")
+    parser.add_argument("--learn", action="store_true", help="also the pattern the teach run alone shows")
     parser.add_argument("--evidence", help="evidence_dump's CSV of the corridor's repeat run against its map")
     parser.add_argument("--map", help="that map's map.json")
     args = parser.parse_args()
@@ -116,13 +160,11 @@ def main():
     circle = [float(v) for v in args.circle.split(",")] if args.circle else None
     work = args.work or tempfile.mkdtemp(prefix="fixed_pattern_")
     os.makedirs(work, exist_ok=True)
-    sets = {"same place": [], "another place": []}
+    pairs = {"same place": [], "another place": []}
     for repeat in range(0, FRAMES, args.step):
-        sets["same place"].append(tally(verified_matches(args.vmap, args.matcher, repeat, repeat, work),
-                                        args.still_px, circle))
-        far = (repeat + args.far_offset) % FRAMES
-        sets["another place"].append(tally(verified_matches(args.vmap, args.matcher, far, repeat, work),
-                                           args.still_px, circle))
+        pairs["same place"].append(matches(args.vmap, args.matcher, repeat, repeat, work))
+        pairs["another place"].append(matches(args.vmap, args.matcher, (repeat + args.far_offset) % FRAMES, repeat, work))
+    sets = {name: [tally(p, args.still_px, circle) for p in found] for name, found in pairs.items()}
     print("| pairs | n | verified (mean) | not moving | not moving or outside the circle | the rest |")
     print("|---|---|---|---|---|---|")
     for name, rows in sets.items():
@@ -139,6 +181,8 @@ def main():
     by_rest = sum(rest(s) > rest(o) for s, o in zip(same, other))
     print("\nthe same place verifies more than the other: %d of %d frames by all verified matches, %d by the rest" % (
         by_all, len(same), by_rest))
+    if args.learn:
+        learn_pattern(args, circle, work, pairs)
     if args.evidence:
         key_images_that_verify_everywhere(args.evidence, args.map)
 
