@@ -28,11 +28,14 @@ the log10 NFA tells right from other places (the area under the ROC curve) raw a
 The medians come from the repeat run itself, so the second area is what knowing each key image's chance at best adds.
 
 usage: bench/fixed_pattern.py --vmap build/vmap [--matcher xfeat] [--circle 74.5,60,64] [--step 2] [--far-offset 40]
-                              [--still-px 1.6] [--work DIR] [--learn] [--evidence CSV --map MAP/map.json]   (from the repository root; ../shared must be there)"""
+                              [--still-px 1.6] [--work DIR] [--learn] [--evidence CSV --map MAP/map.json]
+(from the repository root; ../shared must be there)"""
 import argparse, csv, json, math, os, statistics, subprocess, sys, tempfile
 
 CORRIDOR = "../shared/data/corridor_conditions"
 FRAMES = 111
+CELL = 8  # px: the learnt pattern's cells
+CELLS = (160 // CELL) * (120 // CELL)  # of corridor_conditions' 160 x 120 frames
 
 
 def matches(vmap, matcher, teach, other, work, run="repeat", verified=True):
@@ -40,8 +43,9 @@ def matches(vmap, matcher, teach, other, work, run="repeat", verified=True):
     tentative ones: (x0, y0, x1, y1)."""
     output = os.path.join(work, "%s_t%d_%s%d.json" % (matcher, teach, run[0], other))
     if not os.path.exists(output):
-        done = subprocess.run([vmap, "match", "--matcher", matcher, os.path.join(CORRIDOR, "teach", "%07d.jpg" % teach),
-                               os.path.join(CORRIDOR, run, "%07d.jpg" % other), "--json", output],
+        image0 = os.path.join(CORRIDOR, "teach", "%07d.jpg" % teach)
+        image1 = os.path.join(CORRIDOR, run, "%07d.jpg" % other)
+        done = subprocess.run([vmap, "match", "--matcher", matcher, image0, image1, "--json", output],
                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         if done.returncode != 0:
             sys.exit("failed: vmap match teach %d %s %d\n%s" % (teach, run, other, done.stdout))
@@ -51,7 +55,7 @@ def matches(vmap, matcher, teach, other, work, run="repeat", verified=True):
 
 
 def cell(x, y):
-    return int(x) // 8, int(y) // 8
+    return int(x) // CELL, int(y) // CELL
 
 
 def learn_pattern(args, circle, work, pairs_by_set):
@@ -70,12 +74,12 @@ def learn_pattern(args, circle, work, pairs_by_set):
                 hits[cell(x0, y0)] = hits.get(cell(x0, y0), 0) + 1
     print("\nthe teach run's still tentative matches between other places: %d%s" % (
         still, ", %d outside the circle" % outside if circle else ""))
-    print("\n| cells marked by at least | cells (of %d) | centre inside the circle | verified matches in them: %s |" % (
-        20 * 15, " | ".join(pairs_by_set)))
+    print("\n| cells marked by at least | cells (of %d) | centre inside the circle | verified matches in them: %s |"
+          % (CELLS, " | ".join(pairs_by_set)))
     print("|---|---|---|" + "---|" * len(pairs_by_set))
     for least in (2, 3, 5):
         learnt = {c for c, n in hits.items() if n >= least}
-        inside = sum(math.hypot(cx * 8 + 4 - circle[0], cy * 8 + 4 - circle[1]) < circle[2]
+        inside = sum(math.hypot((cx + 0.5) * CELL - circle[0], (cy + 0.5) * CELL - circle[1]) < circle[2]
                      for cx, cy in learnt) if circle else "-"
         shares = []
         for pairs in pairs_by_set.values():
@@ -135,7 +139,9 @@ def key_images_that_verify_everywhere(evidence_path, map_path):
     for k, s in enumerate(sources):
         median_nfa[k] = statistics.median(n for _, n in elsewhere[k])
         print("| %d | %d | %.1f | %.1f |" % (k, s, statistics.median(v for v, _ in elsewhere[k]), median_nfa[k]))
-    for name, score in (("log10 NFA", lambda k, n: n), ("log10 NFA less its key image's median", lambda k, n: n - median_nfa[k])):
+    scores = (("log10 NFA", lambda k, n: n),
+              ("log10 NFA less its key image's median", lambda k, n: n - median_nfa[k]))
+    for name, score in scores:
         right = [score(k, n) for is_right, k, n in pairs if is_right]
         other = [score(k, n) for is_right, k, n in pairs if not is_right]
         print("area under the ROC curve, right against other places, by %s: %.3f (%d right, %d other)" % (
@@ -163,7 +169,8 @@ def main():
     pairs = {"same place": [], "another place": []}
     for repeat in range(0, FRAMES, args.step):
         pairs["same place"].append(matches(args.vmap, args.matcher, repeat, repeat, work))
-        pairs["another place"].append(matches(args.vmap, args.matcher, (repeat + args.far_offset) % FRAMES, repeat, work))
+        other = (repeat + args.far_offset) % FRAMES
+        pairs["another place"].append(matches(args.vmap, args.matcher, other, repeat, work))
     sets = {name: [tally(p, args.still_px, circle) for p in found] for name, found in pairs.items()}
     print("| pairs | n | verified (mean) | not moving | not moving or outside the circle | the rest |")
     print("|---|---|---|---|---|---|")
