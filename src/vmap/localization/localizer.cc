@@ -177,6 +177,9 @@ void Localizer::Reset() {
   confident_peak_ = confident_peak_before_ = -1;
   rival_place_ = -1;
   rival_frames_left_ = 0;
+  stalled_position_ = -1;
+  stalled_frames_ = 0;
+  stall_questioned_ = false;
   position_ = start_position_;
   lost_in_a_row_ = 0;
   placed_before_ = steered_before_ = moved_back_to_ = -1;
@@ -221,7 +224,10 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   CompareRivalPlace(result, features);
   // A hint is checked: the frame's evidence over the whole route weighs where the run is.
   if (start_unconfirmed_ && start_checked_over_route_) CompareBestRanked(frame, features);
+  QuestionStalledTracker(result, frame, features);
   Believe(result, frame, features);
+  DoubtStalledTracker(result);
+  CountStall(result);
   RememberRivalPlace(result);
   if (IsPlaced(result.status)) {
     dropped_position_ = -1;  // steered by again: the drop is behind

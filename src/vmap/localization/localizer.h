@@ -245,6 +245,17 @@ class Localizer {
   // beyond chance (LocalizerOptions::doubt_relocalization_on_little_chance; localizer_little_chance.cc).
   bool PlacedAwayOnLittleChance(const LocalizationResult& result) const;
   bool StartAwayLacksBelief(const LocalizationResult& result) const;
+  // A tracker held at one key image (LocalizerOptions::stalled_tracker_frames; localizer_stalled_tracker.cc): the frame,
+  // tracked there as the stalled_frames_ before it were, has its next key image verify nothing beyond a little chance.
+  bool HeldWhereNextSeesNothing(const LocalizationResult& result) const;
+  // The frame that makes the tracker held stalled_tracker_frames frames in a row is compared with the route's
+  // best-ranked key images: their evidence and the ranking's weigh the belief, which the rules after it read.
+  void QuestionStalledTracker(const LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
+  // The questioned frame is steered by only where its ranking puts its first key image within kNear of it: a key image
+  // that verifies everywhere does not rank first where the robot is not.
+  void DoubtStalledTracker(LocalizationResult& result) const;
+  // Counts the frames in a row the tracker was held so, after the frame's result is final.
+  void CountStall(const LocalizationResult& result);
   void Question(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
   // A frame placed more than kNear route positions behind where the tracker was, where an accepted key image within
   // kNear of that estimate, beyond a little chance, verified nearly as many matches as the place: the frame is
@@ -368,6 +379,9 @@ class Localizer {
   // LocalizerOptions::scene_change_tracked_log10_nfa), read by the doubted jump back and the look past a weak next key
   // image: across lighting a place the robot left still accepts a few chance matches at -6 or so.
   static constexpr double kBeyondLittleChance = -10.0;
+  // A next key image whose comparison is above this log10 NFA (or unmatched) sees nothing of the frame beyond what chance
+  // gives a place the robot left (stalled_tracker_frames).
+  static constexpr double kWithinLittleChance = -6.0;
 
   const VisualMap& map_;
   const KeyImageStore& keys_;
@@ -447,6 +461,11 @@ class Localizer {
   bool belief_confident_ = false;
   // A far route position that verified more than the place the last frames were steered by (rival_place_frames);
   // -1: none. Compared again for rival_frames_left_ more frames.
+  // The route position the tracker was held at and the frames in a row it was held there (HeldWhereNextSeesNothing);
+  // 0: not held.
+  int stalled_position_ = -1;
+  int stalled_frames_ = 0;
+  bool stall_questioned_ = false;  // the frame being localized was questioned so
   int rival_place_ = -1;
   int rival_frames_left_ = 0;
   int pointed_ = -1;         // the far route position this frame's relocalization pointed at; -1: none

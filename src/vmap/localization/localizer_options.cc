@@ -100,6 +100,11 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Frames a far key image that verified more than the one a frame was steered by is compared again; "
                  "a tracked frame it out-verifies again is relocalized (0 = never)"},
                 rival_place_frames);
+  visitor.Visit({"stalled_tracker_frames", "--stalled-tracker-frames",
+                 "Float descriptors: frames in a row a tracker held at one key image, the next one verifying nothing "
+                 "beyond a little chance, before the frame is compared with the best-ranked key images of the route "
+                 "(0 = never)"},
+                stalled_tracker_frames);
   visitor.Visit({"rival_place_when_not_steered", "!--no-rival-place-when-not-steered",
                  "Remember and compare a far key image a lost or uncertain frame verified as a rival place too "
                  "(otherwise only frames steered by remember one)"},
@@ -395,6 +400,10 @@ void LocalizerOptions::Check() const {
     throw OptionError("continuity_max_log10_nfa",
                       fmt::format("{} is outside [-1000, 1000] (default {})", continuity_max_log10_nfa,
                                   defaults.continuity_max_log10_nfa));
+  }
+  if (stalled_tracker_frames < 0 || stalled_tracker_frames > 1000) {
+    throw OptionError("stalled_tracker_frames", fmt::format("{} is outside [0, 1000] (default {}; 0: never)",
+                                                            stalled_tracker_frames, defaults.stalled_tracker_frames));
   }
   if (!(look_past_max_log10_nfa >= -1000.0 && look_past_max_log10_nfa <= 0.0)) {
     throw OptionError("look_past_max_log10_nfa",

@@ -172,6 +172,16 @@ struct LocalizerOptions {
   // image is. Where the corridor repeats itself, a wrong place verifies as much as a right one, and is questioned
   // only when something else is compared (docs/localize.md, "A rival place is asked again"). 0: never.
   int rival_place_frames = 3;
+  // Float descriptors (XFeat): a tracker held this many frames in a row at one key image, each steered by while the
+  // next key image verified nothing beyond a little chance (log10 NFA above -6), is questioned: the frame is ranked over
+  // the route and compared with the best-ranked key images, whose evidence weighs the belief, as a relocalization's
+  // would. A key image that verifies everywhere (corridor_conditions' 12-13, where a quarter to two thirds of a frame's
+  // verified matches are the fisheye's rim matching itself) otherwise holds a robot that started elsewhere: the kidnapped
+  // run from its frame 51 at the verifier's seed 75 was tracked there for 21 frames (repeat frames 90-110, right: 27-32)
+  // and never compared anywhere else. On XFeat's corridor sets at seeds 0-7 the tracker held so at most 6 frames in a row
+  // at a right key image (docs/measurements/localization-conditions.md, "A tracker held where the next key image sees
+  // nothing is questioned"). 0: never.
+  int stalled_tracker_frames = 7;
   // A frame not steered by (lost or uncertain) remembers a rival place too: any far key image its comparisons accepted
   // (it verifies more than the frame's key images, which verify nothing a robot may steer by), and compares the one
   // remembered, as a tracked frame does. A robot carried along the route verifies nothing where the tracker holds it,

@@ -432,5 +432,26 @@ TEST_F(XfeatCorridorRun, TheRoutesLastKeyImageIsSteppedOnToByChance) {
   }
 }
 
+// A tracker held where the next key image sees nothing is questioned (docs/localize.md): repeat frames 80-110 started at
+// key image 0 (the kidnapped run from its frame 51), at the verifier's seed 75. The start is confirmed on frame 90 at
+// key image 12, one of the corridor's key images that verify with nearly every frame (the fisheye's rim matching
+// itself), and the tracker compares only 12-13 and the key image after: without the question it holds every frame to
+// 110 there (right: 27-32). Held seven frames while the next key image verifies nothing beyond a little chance, the
+// frame is compared with the best-ranked key images of the route, and the frames after it are steered by where they are.
+TEST_F(XfeatCorridorRun, ATrackerHeldWhereTheNextKeyImageSeesNothingIsQuestioned) {
+  auto steered = [&](const std::string& flags) { return SteeredOnRepeat(80, 110, 0, " --verifier-seed 75" + flags); };
+  const std::vector<std::pair<int, int>> questioned = steered("");
+  const std::vector<std::pair<int, int>> held = steered(" --stalled-tracker-frames 0");
+  ASSERT_GE(Far(held), 15) << "the test no longer reaches a tracker held at key images 12-13";
+  // Only the frames held before the question may be far: at most the seven of the default.
+  EXPECT_LE(Far(questioned), 7);
+  EXPECT_GE(Right(questioned), Right(held) + 8);
+  for (const auto& [frame, key] : questioned) {
+    if (frame >= 100) {
+      EXPECT_EQ(Right({{frame, key}}), 1) << "repeat frame " << frame << " at key image " << key;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace vmap::neural
