@@ -138,10 +138,12 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
     lost_frame_matcher_ = CreateMatcher(more);
     lost_frame_key_features_.assign(num_keys, nullptr);
   }
-  // The rules that step a frame on to the next key image ask whether it stands still (StillSinceFrameBefore).
+  // The rules that step a frame on to the next key image ask whether it stands still (StillSinceFrameBefore), and so
+  // does the question of a held tracker (a stop holds it).
   const bool steps_on_next =
       (lost_frame_matcher_ && options_.lost_frame_next_heading_ratio > 0.0) ||
-      (heading_accepts_ && (options_.step_on_where_evidence_agrees || options_.step_on_after_lost_frames));
+      (heading_accepts_ && (options_.step_on_where_evidence_agrees || options_.step_on_after_lost_frames)) ||
+      (!binary && options_.stalled_tracker_frames > 0);
   // So do the questions of a frame that may have been carried off (SceneChangedSinceFrameBefore).
   const bool asks_scene_change = !binary && options_.scene_change_log10_nfa < 0.0;
   keeps_features_before_ = (steps_on_next && options_.still_frame_share > 0.0) || asks_scene_change;
@@ -179,7 +181,7 @@ void Localizer::Reset() {
   rival_frames_left_ = 0;
   stalled_position_ = -1;
   stalled_frames_ = 0;
-  stall_questioned_ = false;
+  stall_questioned_ = held_still_ = false;
   position_ = start_position_;
   lost_in_a_row_ = 0;
   placed_before_ = steered_before_ = moved_back_to_ = -1;

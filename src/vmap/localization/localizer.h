@@ -247,6 +247,7 @@ class Localizer {
   bool StartAwayLacksBelief(const LocalizationResult& result) const;
   // A tracker held at one key image (LocalizerOptions::stalled_tracker_frames; localizer_stalled_tracker.cc): the frame,
   // tracked there as the stalled_frames_ before it were, has its next key image verify nothing beyond a little chance.
+  // A frame that stands still against the frame before (a robot that stopped) neither adds to the hold nor is asked.
   bool HeldWhereNextSeesNothing(const LocalizationResult& result) const;
   // The frame that makes the tracker held stalled_tracker_frames frames in a row is compared with the route's
   // best-ranked key images: their evidence and the ranking's weigh the belief, which the rules after it read.
@@ -466,6 +467,7 @@ class Localizer {
   int stalled_position_ = -1;
   int stalled_frames_ = 0;
   bool stall_questioned_ = false;  // the frame being localized was questioned so
+  bool held_still_ = false;        // the frame being localized was held and stands still (StillSinceFrameBefore)
   int rival_place_ = -1;
   int rival_frames_left_ = 0;
   int pointed_ = -1;         // the far route position this frame's relocalization pointed at; -1: none

@@ -22,7 +22,10 @@ bool Localizer::HeldWhereNextSeesNothing(const LocalizationResult& result) const
 
 void Localizer::QuestionStalledTracker(const LocalizationResult& result, const Frame& frame,
                                        const ImageFeatures& features) {
-  if (!HeldWhereNextSeesNothing(result) || result.route_position != stalled_position_ ||
+  // A robot that stopped shows the same place on every frame: the hold is the stop's, and the frame's evidence (its
+  // ranking the same each frame) would be weighed again as if new.
+  held_still_ = HeldWhereNextSeesNothing(result) && StillSinceFrameBefore(features);
+  if (held_still_ || !HeldWhereNextSeesNothing(result) || result.route_position != stalled_position_ ||
       stalled_frames_ + 1 < options_.stalled_tracker_frames) {
     return;
   }
@@ -38,6 +41,8 @@ void Localizer::DoubtStalledTracker(LocalizationResult& result) const {
 
 void Localizer::CountStall(const LocalizationResult& result) {
   const bool questioned = std::exchange(stall_questioned_, false);
+  // A still frame neither adds to the hold nor ends it.
+  if (std::exchange(held_still_, false) && result.route_position == stalled_position_) return;
   // A frame the question withheld leaves the tracker where it was held: the frames after it are questioned too.
   if (questioned && !IsPlaced(result.status) && position_ == stalled_position_) {
     ++stalled_frames_;

@@ -453,5 +453,22 @@ TEST_F(XfeatCorridorRun, ATrackerHeldWhereTheNextKeyImageSeesNothingIsQuestioned
   }
 }
 
+// A robot that stops is not a held tracker (docs/localize.md, "A tracker held where the next key image sees nothing is
+// questioned"): repeat frames 0-29, frame 30 shown 25 times (a stop), then 31-40, started at key image 0, at the
+// verifier's seed 1. The stop holds the tracker at key image 8 (right) with the next key image at chance's level;
+// weighed again on every frame, the same frame's ranking (its first key image elsewhere) withheld 17 of the stopped
+// frames and moved the belief's guess to key images 2-3. A frame that stands still against the frame before neither
+// adds to the hold nor is asked: every frame is steered by as without the rule.
+TEST_F(XfeatCorridorRun, ARobotThatStopsIsNotAHeldTracker) {
+  std::vector<int> run;
+  for (int i = 0; i <= 29; ++i) run.push_back(i);
+  for (int i = 0; i < 25; ++i) run.push_back(30);
+  for (int i = 31; i <= 40; ++i) run.push_back(i);
+  const std::vector<std::pair<int, int>> steered = SteeredOnRun(run, 0, " --verifier-seed 1");
+  const auto stopped = std::count_if(steered.begin(), steered.end(), [](const auto& s) { return s.first == 30; });
+  EXPECT_EQ(stopped, 25) << "stopped frames steered by";
+  EXPECT_EQ(steered, SteeredOnRun(run, 0, " --verifier-seed 1 --stalled-tracker-frames 0"));
+}
+
 }  // namespace
 }  // namespace vmap::neural
