@@ -245,9 +245,10 @@ class Localizer {
   // beyond chance (LocalizerOptions::doubt_relocalization_on_little_chance; localizer_little_chance.cc).
   bool PlacedAwayOnLittleChance(const LocalizationResult& result) const;
   bool StartAwayLacksBelief(const LocalizationResult& result) const;
-  // A tracker held at one key image (LocalizerOptions::stalled_tracker_frames; localizer_stalled_tracker.cc): the frame,
-  // tracked there as the stalled_frames_ before it were, has its next key image verify nothing beyond a little chance.
-  // A frame that stands still against the frame before (a robot that stopped) neither adds to the hold nor is asked.
+  // A tracker held at one key image (LocalizerOptions::stalled_tracker_frames; localizer_stalled_tracker.cc): the
+  // frame, tracked there as the stalled_frames_ before it were, has its next key image verify nothing beyond a little
+  // chance. A frame that stands still against the frame before (a robot that stopped) neither adds to the hold nor is
+  // asked.
   bool HeldWhereNextSeesNothing(const LocalizationResult& result) const;
   // The frame that makes the tracker held stalled_tracker_frames frames in a row is compared with the route's
   // best-ranked key images: their evidence and the ranking's weigh the belief, which the rules after it read.
@@ -380,8 +381,8 @@ class Localizer {
   // LocalizerOptions::scene_change_tracked_log10_nfa), read by the doubted jump back and the look past a weak next key
   // image: across lighting a place the robot left still accepts a few chance matches at -6 or so.
   static constexpr double kBeyondLittleChance = -10.0;
-  // A next key image whose comparison is above this log10 NFA (or unmatched) sees nothing of the frame beyond what chance
-  // gives a place the robot left (stalled_tracker_frames).
+  // A next key image whose comparison is above this log10 NFA (or unmatched) sees nothing of the frame beyond what
+  // chance gives a place the robot left (stalled_tracker_frames).
   static constexpr double kWithinLittleChance = -6.0;
 
   const VisualMap& map_;

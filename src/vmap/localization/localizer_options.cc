@@ -233,7 +233,7 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"still_frame_share", "--still-frame-share",
                  "a frame whose matches with the frame before moved less than half a pixel in this share stands "
                  "still: it is not stepped on, nor placed beyond two key images of its estimate by a lost frame's "
-                 "heading (0: no frame is still)"},
+                 "heading, nor counted in a held tracker (0: no frame is still)"},
                 still_frame_share);
   visitor.Visit({"far_comparison_iterations", "--far-comparison-iterations",
                  "ORB: verify the frame's comparisons with key images away from the tracker's (more than one behind "

@@ -173,14 +173,16 @@ struct LocalizerOptions {
   // only when something else is compared (docs/localize.md, "A rival place is asked again"). 0: never.
   int rival_place_frames = 3;
   // Float descriptors (XFeat): a tracker held this many frames in a row at one key image, each steered by while the
-  // next key image verified nothing beyond a little chance (log10 NFA above -6), is questioned: the frame is ranked over
-  // the route and compared with the best-ranked key images, whose evidence weighs the belief, as a relocalization's
-  // would. A key image that verifies everywhere (corridor_conditions' 12-13, where a quarter to two thirds of a frame's
-  // verified matches are the fisheye's rim matching itself) otherwise holds a robot that started elsewhere: the kidnapped
-  // run from its frame 51 at the verifier's seed 75 was tracked there for 21 frames (repeat frames 90-110, right: 27-32)
-  // and never compared anywhere else. On XFeat's corridor sets at seeds 0-7 the tracker held so at most 6 frames in a row
-  // at a right key image (docs/measurements/localization-conditions.md, "A tracker held where the next key image sees
-  // nothing is questioned"). 0: never.
+  // next key image verified nothing beyond a little chance (log10 NFA above -6), is questioned: the frame is ranked
+  // over the route and compared with the best-ranked key images, whose evidence weighs the belief, as a
+  // relocalization's would. A key image that verifies everywhere (corridor_conditions' 12-13, where a quarter to two
+  // thirds of a frame's verified matches are the fisheye's rim matching itself) otherwise holds a robot that started
+  // elsewhere: the kidnapped run from its frame 51 at the verifier's seed 75 was tracked there for 21 frames (repeat
+  // frames 90-110, right: 27-32) and never compared anywhere else. On XFeat's corridor sets at seeds 0-7 the tracker
+  // held so at most 6 frames in a row at a right key image (docs/measurements/localization-conditions.md, "A tracker
+  // held where the next key image sees nothing is questioned"). A still frame (still_frame_share: a robot that stopped)
+  // neither adds to the hold nor is questioned: its ranking, the same on every frame of a stop, would be weighed again
+  // as new. 0: never.
   int stalled_tracker_frames = 7;
   // A frame not steered by (lost or uncertain) remembers a rival place too: any far key image its comparisons accepted
   // (it verifies more than the frame's key images, which verify nothing a robot may steer by), and compares the one
@@ -354,7 +356,7 @@ struct LocalizerOptions {
   // stepped on either"), nor is a still frame placed by a lost frame's heading beyond kNear of its estimate, at any
   // ratio above (its votes are the frame before's evidence counted again: 24 noisy copies of a stopped michigan frame,
   // 22 frames placed three key images on -> 1, by chance; "A still frame is not placed far by a lost frame's
-  // heading"). 0: no frame is still.
+  // heading"), nor does it add to a held tracker (stalled_tracker_frames). 0: no frame is still.
   double still_frame_share = 0.8;
   // ORB: the frame's comparisons with key images away from the tracker's (more than one route position behind the
   // estimate the frame starts from, or more than `lookahead` + 1 ahead of it: the frame's rivals, the ranking's

@@ -1,9 +1,9 @@
 // A tracker held at one key image while the next one sees nothing of the frames is questioned
-// (LocalizerOptions::stalled_tracker_frames). Why: the tracker compares only its key image and the next, and a key image
-// that verifies with every frame (a camera that sees its own lens rim matches itself everywhere) keeps accepting frames
-// the robot took far from it; the frames' evidence never reaches the belief from elsewhere, and nothing questions a
-// belief it alone weighs. A robot moving on sees its next key image within a few frames; one held longer is asked where
-// it is over the whole route, as a relocalization would ask.
+// (LocalizerOptions::stalled_tracker_frames). Why: the tracker compares only its key image and the next, and a key
+// image that verifies with every frame (a camera that sees its own lens rim matches itself everywhere) keeps accepting
+// frames the robot took far from it; the frames' evidence never reaches the belief from elsewhere, and nothing
+// questions a belief it alone weighs. A robot moving on sees its next key image within a few frames; one held longer is
+// asked where it is over the whole route, as a relocalization would ask.
 #include <cstdlib>
 #include <utility>
 

@@ -432,12 +432,13 @@ TEST_F(XfeatCorridorRun, TheRoutesLastKeyImageIsSteppedOnToByChance) {
   }
 }
 
-// A tracker held where the next key image sees nothing is questioned (docs/localize.md): repeat frames 80-110 started at
-// key image 0 (the kidnapped run from its frame 51), at the verifier's seed 75. The start is confirmed on frame 90 at
-// key image 12, one of the corridor's key images that verify with nearly every frame (the fisheye's rim matching
+// A tracker held where the next key image sees nothing is questioned (docs/localize.md): repeat frames 80-110 started
+// at key image 0 (the kidnapped run from its frame 51), at the verifier's seed 75. The start is confirmed on frame 90
+// at key image 12, one of the corridor's key images that verify with nearly every frame (the fisheye's rim matching
 // itself), and the tracker compares only 12-13 and the key image after: without the question it holds every frame to
 // 110 there (right: 27-32). Held seven frames while the next key image verifies nothing beyond a little chance, the
-// frame is compared with the best-ranked key images of the route, and the frames after it are steered by where they are.
+// frame is compared with the best-ranked key images of the route, and the frames after it are steered by where they
+// are.
 TEST_F(XfeatCorridorRun, ATrackerHeldWhereTheNextKeyImageSeesNothingIsQuestioned) {
   auto steered = [&](const std::string& flags) { return SteeredOnRepeat(80, 110, 0, " --verifier-seed 75" + flags); };
   const std::vector<std::pair<int, int>> questioned = steered("");
@@ -456,7 +457,7 @@ TEST_F(XfeatCorridorRun, ATrackerHeldWhereTheNextKeyImageSeesNothingIsQuestioned
 // A robot that stops is not a held tracker (docs/localize.md, "A tracker held where the next key image sees nothing is
 // questioned"): repeat frames 0-29, frame 30 shown 25 times (a stop), then 31-40, started at key image 0, at the
 // verifier's seed 1. The stop holds the tracker at key image 8 (right) with the next key image at chance's level;
-// weighed again on every frame, the same frame's ranking (its first key image elsewhere) withheld 17 of the stopped
+// weighed again on every frame, the same frame's ranking (its first key image elsewhere) withheld 19 of the stopped
 // frames and moved the belief's guess to key images 2-3. A frame that stands still against the frame before neither
 // adds to the hold nor is asked: every frame is steered by as without the rule.
 TEST_F(XfeatCorridorRun, ARobotThatStopsIsNotAHeldTracker) {
