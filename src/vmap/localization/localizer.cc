@@ -181,6 +181,8 @@ void Localizer::Reset() {
   rival_frames_left_ = 0;
   stalled_position_ = -1;
   stalled_frames_ = 0;
+  stall_bar_ = options_.stalled_tracker_frames;
+  placed_in_a_row_ = 0;
   stall_questioned_ = held_still_ = false;
   position_ = start_position_;
   lost_in_a_row_ = 0;
@@ -252,6 +254,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
       previous_headings_.emplace_back(m.comparison.key, m.comparison.heading.px);
   }
   placed_before_ = IsPlaced(result.status) ? result.route_position : -1;
+  placed_in_a_row_ = IsPlaced(result.status) ? placed_in_a_row_ + 1 : 0;
   RememberMoveBack(result);
   // Kept as the matcher serializes them: features are polymorphic and the caller's go with the frame; only while the
   // run has an estimate, since the next frame asks whether it stands still only when tracked from it (after a frame

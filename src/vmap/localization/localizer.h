@@ -467,6 +467,10 @@ class Localizer {
   // 0: not held.
   int stalled_position_ = -1;
   int stalled_frames_ = 0;
+  // The hold at stalled_position_ is questioned at this many frames: stalled_tracker_frames, or
+  // unsettled_stalled_tracker_frames where it began within two frames of a frame not steered by.
+  int stall_bar_ = 0;
+  int placed_in_a_row_ = 0;        // frames placed (tracking or relocalized) in a row before this one
   bool stall_questioned_ = false;  // the frame being localized was questioned so
   bool held_still_ = false;        // the frame being localized was held and stands still (StillSinceFrameBefore)
   int rival_place_ = -1;

@@ -105,6 +105,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "beyond a little chance, before the frame is compared with the best-ranked key images of the route "
                  "(0 = never)"},
                 stalled_tracker_frames);
+  visitor.Visit({"unsettled_stalled_tracker_frames", "--unsettled-stalled-tracker-frames",
+                 "Float descriptors: the same for a hold that begins within two frames of a frame not steered by or "
+                 "of the run's start (at most --stalled-tracker-frames; 0 = as --stalled-tracker-frames)"},
+                unsettled_stalled_tracker_frames);
   visitor.Visit({"rival_place_when_not_steered", "!--no-rival-place-when-not-steered",
                  "Remember and compare a far key image a lost or uncertain frame verified as a rival place too "
                  "(otherwise only frames steered by remember one)"},
@@ -404,6 +408,11 @@ void LocalizerOptions::Check() const {
   if (stalled_tracker_frames < 0 || stalled_tracker_frames > 1000) {
     throw OptionError("stalled_tracker_frames", fmt::format("{} is outside [0, 1000] (default {}; 0: never)",
                                                             stalled_tracker_frames, defaults.stalled_tracker_frames));
+  }
+  if (unsettled_stalled_tracker_frames < 0 || unsettled_stalled_tracker_frames > 1000) {
+    throw OptionError("unsettled_stalled_tracker_frames",
+                      fmt::format("{} is outside [0, 1000] (default {}; 0: as stalled_tracker_frames)",
+                                  unsettled_stalled_tracker_frames, defaults.unsettled_stalled_tracker_frames));
   }
   if (!(look_past_max_log10_nfa >= -1000.0 && look_past_max_log10_nfa <= 0.0)) {
     throw OptionError("look_past_max_log10_nfa",

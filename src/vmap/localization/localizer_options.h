@@ -184,6 +184,15 @@ struct LocalizerOptions {
   // neither adds to the hold nor is questioned: its ranking, the same on every frame of a stop, would be weighed again
   // as new. 0: never.
   int stalled_tracker_frames = 7;
+  // A hold that begins within two frames of a frame not steered by (lost or uncertain) or of the run's start is
+  // questioned at this many frames instead (at most stalled_tracker_frames): a place just taken rests on a frame or two
+  // of evidence, not on a run of them. The kidnapped run from its frame 51 at the verifier's seed 75 confirms its start
+  // at key image 12, one of the key images that verify everywhere, and is held at 12-13 from the next frame: questioned
+  // at the seventh frame, 7 frames were steered by there (right: 27-31), at the third 3. Over the verifier's seeds
+  // 0-19 and 68-115 (408 runs) it changes 7 runs: the runs started elsewhere +10 frames at a right key image, the
+  // kidnapped run -2, and 4 fewer far frames (docs/measurements/localization-conditions.md, "A hold that begins after a
+  // frame not steered by is questioned sooner"). 0: as stalled_tracker_frames.
+  int unsettled_stalled_tracker_frames = 3;
   // A frame not steered by (lost or uncertain) remembers a rival place too: any far key image its comparisons accepted
   // (it verifies more than the frame's key images, which verify nothing a robot may steer by), and compares the one
   // remembered, as a tracked frame does. A robot carried along the route verifies nothing where the tracker holds it,

@@ -4,6 +4,7 @@
 // frames the robot took far from it; the frames' evidence never reaches the belief from elsewhere, and nothing
 // questions a belief it alone weighs. A robot moving on sees its next key image within a few frames; one held longer is
 // asked where it is over the whole route, as a relocalization would ask.
+#include <algorithm>
 #include <cstdlib>
 #include <utility>
 
@@ -26,7 +27,7 @@ void Localizer::QuestionStalledTracker(const LocalizationResult& result, const F
   // ranking the same each frame) would be weighed again as if new.
   held_still_ = HeldWhereNextSeesNothing(result) && StillSinceFrameBefore(features);
   if (held_still_ || !HeldWhereNextSeesNothing(result) || result.route_position != stalled_position_ ||
-      stalled_frames_ + 1 < options_.stalled_tracker_frames) {
+      stalled_frames_ + 1 < stall_bar_) {
     return;
   }
   CompareBestRanked(frame, features);
@@ -53,7 +54,14 @@ void Localizer::CountStall(const LocalizationResult& result) {
     stalled_frames_ = 0;
     return;
   }
-  stalled_frames_ = result.route_position == stalled_position_ ? stalled_frames_ + 1 : 1;
+  if (result.route_position != stalled_position_) {
+    stalled_frames_ = 0;
+    // Frames placed in a row before this one: at most one, and a frame within two of this one was not steered by.
+    const bool unsettled = placed_in_a_row_ <= 1 && options_.unsettled_stalled_tracker_frames > 0;
+    stall_bar_ = unsettled ? std::min(options_.unsettled_stalled_tracker_frames, options_.stalled_tracker_frames)
+                           : options_.stalled_tracker_frames;
+  }
+  ++stalled_frames_;
   stalled_position_ = result.route_position;
 }
 
