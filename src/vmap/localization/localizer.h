@@ -259,9 +259,10 @@ class Localizer {
   // Counts the frames in a row the tracker was held so, after the frame's result is final.
   void CountStall(const LocalizationResult& result);
   void Question(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
-  // A frame placed more than kNear route positions behind where the tracker was, where an accepted key image within
-  // kNear of that estimate, beyond a little chance, verified nearly as many matches as the place: the frame is
-  // `uncertain` and the tracker stays (LocalizerOptions::doubt_jump_back; localizer_jump_back.cc).
+  // A frame placed more than kNear route positions behind where the tracker was (and behind the place last steered
+  // by), where an accepted key image within kNear of that estimate, beyond a little chance, verified nearly as many
+  // matches as the place: the frame is `uncertain` and the tracker stays (LocalizerOptions::doubt_jump_back,
+  // judge_jump_back_from_steered_place; localizer_jump_back.cc).
   void DoubtJumpBack(LocalizationResult& result);
   // The tracker at the key image before the route's last, `tracked` its comparison: whether it steps on to the last
   // one, `ahead` (LocalizerOptions::step_on_to_last_by_chance); nullopt where the rule does not decide.

@@ -1,5 +1,6 @@
-// A frame placed far behind the tracked estimate where the key images near that estimate verify nearly as much
-// (LocalizerOptions::doubt_jump_back): doubted, not steered by, and the tracker stays.
+// A frame placed far behind the tracked estimate, and behind the place last steered by, where the key images near that
+// estimate verify nearly as much (LocalizerOptions::doubt_jump_back, judge_jump_back_from_steered_place): doubted, not
+// steered by, and the tracker stays.
 #include <algorithm>
 #include <cstdlib>
 
@@ -28,6 +29,9 @@ void Localizer::DoubtJumpBack(LocalizationResult& result) {
       to >= from - kNear) {
     return;
   }
+  // Where the robot was last seen is the place last steered by; uncertain frames may have moved the tracker far ahead
+  // of it (a far relocalization not taken), and a frame back near that place has not jumped back.
+  if (options_.judge_jump_back_from_steered_place && steered_before_ >= 0 && to >= steered_before_ - kNear) return;
   const int jumped_to = std::max(AcceptedVerified(result.to_key), AcceptedVerified(result.to_next));
   // The most verified by an accepted key image within kNear of the estimate beyond a little chance, past the place.
   int near = 0;

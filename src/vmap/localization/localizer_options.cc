@@ -74,6 +74,11 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Float descriptors: place a frame more than two key images behind the tracked estimate even where "
                  "the key images near the estimate verify nearly as much (otherwise it is uncertain)"},
                 doubt_jump_back);
+  visitor.Visit({"judge_jump_back_from_steered_place", "!--no-judge-jump-back-from-steered-place",
+                 "Float descriptors: doubt a frame placed behind the tracked estimate (--no-doubt-jump-back) even "
+                 "where it is at or ahead of the place the run was last steered by (otherwise it is no jump back: "
+                 "uncertain frames moved the tracker ahead)"},
+                judge_jump_back_from_steered_place);
   visitor.Visit({"look_past_weak_next", "!--no-look-past-weak-next",
                  "Float descriptors: never look past a next key image that verifies by little beyond chance while the "
                  "tracked one does too (otherwise the key image past it is compared, and stepped on to where it "

@@ -125,6 +125,17 @@ struct LocalizerOptions {
   // where the frames were is doubted": XFeat's corridor sets over the verifier's seeds 0-11, frames confidently more
   // than 2 key images off 17 -> 11, 69 of 72 CSVs the same). Off: such a frame is placed where it jumped.
   bool doubt_jump_back = true;
+  // Float descriptors (XFeat), doubt_jump_back: a jump back is judged from the place the run was last steered by too,
+  // not only from the tracked estimate: a frame placed at or ahead of that place (or at most two route positions
+  // behind it) is no jump back, wherever uncertain frames left the tracker. After corridor_conditions' dark stretch an
+  // unconfirmed relocalization left the tracker at key image 29-30 (the route's end, whose key images verify with
+  // nearly every frame through the lens rim's matches) while the run was last steered by at 14; frames 56-60 verified
+  // 24-35 matches at the right key images 15-16 at log10 NFA -10 to -32, each doubted as a jump back from 30, and the
+  // tracker stayed there for five frames (the verifier's seed 106; docs/measurements/localization-conditions.md, "A
+  // jump back is judged from where the run was steered": over the verifier's seeds 0-19 and 32-139, 14 of 768 CSVs
+  // change, each a frame withheld or wrong now steered by at a right key image). Off: judged from the tracked estimate
+  // alone.
+  bool judge_jump_back_from_steered_place = true;
   // Float descriptors (XFeat): where the lookahead stops at a next key image that verifies by little beyond chance
   // (log10 NFA above -10, or refused) while the tracked key image does too, the key image past it is compared, and the
   // tracker steps on to it where it verifies more matches than the tracked one, beyond a little chance (log10 NFA at

@@ -309,6 +309,28 @@ TEST_F(XfeatCorridorRun, AJumpBackNoClearerThanWhereTheFramesWereIsDoubted) {
   }
 }
 
+// A jump back is judged from where the run was steered (docs/localize.md): repeat frames 0-62 started at key image 0
+// (bench/route_conditions.py's corridor run), at the verifier's seed 106. After the dark stretch an unconfirmed
+// relocalization left the tracker at key image 30 (the route's end) while the run was last steered by at key image 14
+// (frame 49); frames 56-60 verified the right key images 15-16 at log10 NFA -10 to -32, and each was doubted as a jump
+// back from 30: uncertain, the tracker held at 30. Judged from the place last steered by, frames 56-60 are steered by
+// at the right key images.
+TEST_F(XfeatCorridorRun, AJumpBackIsJudgedFromWhereTheRunWasSteered) {
+  auto steered_after_dark = [&](const std::string& flags) {
+    std::vector<std::pair<int, int>> after;
+    for (const auto& steered : SteeredOnRepeat(0, 62, 0, " --verifier-seed 106" + flags)) {
+      if (steered.first >= 54 && steered.first <= 60) after.push_back(steered);
+    }
+    return after;
+  };
+  const auto judged = steered_after_dark(""),
+             from_tracker = steered_after_dark(" --no-judge-jump-back-from-steered-place");
+  EXPECT_EQ(Far(judged), 0);
+  EXPECT_GE(Right(judged), 4);
+  EXPECT_GE(Right(judged), Right(from_tracker) + 4)
+      << "the test no longer reaches the frames doubted as a jump back from the route's end";
+}
+
 // A run started elsewhere confirms a place that stands out (docs/localize.md): repeat frames 50-62 started at key
 // image 0 (bench/route_conditions.py's corridor from 50), at the verifier's seeds 10 and 11. Frame 53 verifies key
 // image 29 (the route's dark end; right: 14-15), frame 54 key images 29-30 with as many matches as key image 16 (22):
