@@ -12,7 +12,7 @@ namespace {
 
 // The key images near the tracked estimate verify at least this share of the matches of those the frame jumped back
 // to: the jump is no clearer than the look-alike it may be (the share below which a key image is clearly the worse
-// match, Localizer::Track's kClearlyWorse).
+// match, Localizer::Track's kClearlyWorse (localizer_track.cc)).
 constexpr double kNotClearlyWorse = 0.7;
 // ... counting only a key image near the estimate that verifies beyond a little chance (kBeyondLittleChance): the place
 // a carried robot left, or one a run's wrong start put it at, still accepts a few chance matches across lighting (the
