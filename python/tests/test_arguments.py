@@ -114,7 +114,7 @@ def test_keywords_are_field_names_with_the_flags_as_aliases():
 
 
 def test_errors_name_options_by_keyword(tmp_path):
-    with pytest.raises(vmap.Error, match=r"^verifier_threshold \(verifier, pixels\) must be in"):
+    with pytest.raises(vmap.Error, match=r"^verifier_threshold -1 px is outside \(0, 100\] \(default 0\.5 px\)$"):
         vmap.Matcher(threshold=-1)
     with pytest.raises(vmap.Error, match="^tau 1.5 is outside"):
         vmap.build_map("nowhere.mp4", tmp_path / "out", tau=1.5)

@@ -244,25 +244,24 @@ TEST(Cli, OptionErrorsNameTheFlagsThatSetTheFields) {
     std::string message;  // the whole error line
   };
   const std::vector<Case> cases = {
-      {build + "--pose-threshold -1", "vmap: error: --pose-threshold -1 px is outside (0, 100]; the default is 1\n"},
+      {build + "--pose-threshold -1", "vmap: error: --pose-threshold -1 px is outside (0, 100] (default 1 px)\n"},
       {build + "--max-translation-sigma 0",
-       "vmap: error: --max-translation-sigma 0 deg is outside (0, 180]; the default is 3\n"},
+       "vmap: error: --max-translation-sigma 0 deg is outside (0, 180] (default 3 deg)\n"},
       {build + "--min-translation-parallax -1",
-       "vmap: error: --min-translation-parallax -1 px must be >= 0; the default is 3\n"},
-      {build + "--threads 999", "vmap: error: --threads must be 0 to 256 (0 = one per core)\n"},
+       "vmap: error: --min-translation-parallax -1 px is less than 0 (default 3 px)\n"},
+      {build + "--threads 999", "vmap: error: --threads 999 is outside [0, 256] (default 0; 0: one per core)\n"},
       {build + "--min-key-displacement 200",
-       "vmap: error: --min-key-displacement 200 px is outside [0, 100]; the default is 1, 0 turns the check off\n"},
+       "vmap: error: --min-key-displacement 200 px is outside [0, 100] (default 1 px; 0 turns the check off)\n"},
       {build + "--exhaustive --search bisect",
        "vmap: error: --exhaustive is the paper's frame-by-frame scan and --search bisect skips frames; drop one\n"},
       {build + "--first 3 --last 1", "vmap: error: --last 1 is before --first 3\n"},
-      {build + "--seed -3", "vmap: error: --seed must be >= 0 (default 0)\n"},
-      {build + "--stream-timeout 0",
-       "vmap: error: --stream-timeout must be more than 0 and at most 3600 seconds (default 10)\n"},
-      {build + "--xfeat-top-k 0", "vmap: error: --xfeat-top-k 0 must be at least 1 (upstream default 4096)\n"},
+      {build + "--seed -3", "vmap: error: --seed -3 is less than 0 (default 0)\n"},
+      {build + "--stream-timeout 0", "vmap: error: --stream-timeout 0 s is outside (0, 3600] (default 10 s)\n"},
+      {build + "--xfeat-top-k 0", "vmap: error: --xfeat-top-k 0 is less than 1 (default 4096)\n"},
       {build + "--aliked-top-k -1",
        "vmap: error: --aliked-top-k must be >= 0 (0 = threshold mode with --aliked-score-threshold; default 1000)\n"},
       {"match " + Quote(tmp.path() / "in/frame_0.png") + " " + Quote(tmp.path() / "in/frame_1.png") + " --confidence 2",
-       "vmap: error: --confidence must be in (0, 1) (default 0.999)\n"},
+       "vmap: error: --confidence 2 is outside (0, 1) (default 0.999)\n"},
   };
   for (const Case& c : cases) {
     std::string output;

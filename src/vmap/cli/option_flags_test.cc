@@ -103,7 +103,7 @@ TEST(OptionFlags, MatcherFlagsAreRecordedByModelAndKey) {
     flags.Run([&] { options.Check(); });
     FAIL() << "expected InputError";
   } catch (const InputError& error) {
-    EXPECT_EQ(std::string(error.what()).rfind("--orb-features must be 1 to 100000", 0), 0u) << error.what();
+    EXPECT_EQ(std::string(error.what()).rfind("--orb-features 0 is outside [1, 100000]", 0), 0u) << error.what();
   }
 }
 

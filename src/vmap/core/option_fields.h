@@ -13,11 +13,14 @@
 //
 // and a struct holding another visits it by name (`visitor.VisitNested("verifier", verifier)`): its fields'
 // paths become "verifier.threshold", the paths OptionError names. Readers and writers are visitors; none of
-// them knows the struct.
+// them knows the struct. A number field also says which values it takes (`.Within(0, 1000).Or(-1)`), from which
+// the struct's Check() tests it (core/option_ranges.h) and the message names them.
 
+#include <cmath>
 #include <cstddef>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -27,6 +30,26 @@
 #include "vmap/core/error.h"
 
 namespace vmap {
+
+// The values a number field takes: [min, max] (either end excluded, max infinite for "at least min"), and one
+// value outside it that means something of its own (-1: "the map's"; 0: "never").
+struct OptionRange {
+  bool is_set = false;  // a field without a range takes any value its type holds
+  double min = -std::numeric_limits<double>::infinity();
+  double max = std::numeric_limits<double>::infinity();
+  bool min_excluded = false;
+  bool max_excluded = false;
+  std::optional<double> also;
+  // What the ends or `also` mean, for the message: "0: never". The field's help says it too, for the flag.
+  const char* meaning = nullptr;
+  const char* unit = nullptr;  // written after the value and the default: "-1 px is outside (0, 100]"
+
+  bool Contains(double value) const {  // NaN and infinities are outside every range
+    if (also && value == *also) return true;
+    return std::isfinite(value) && (min_excluded ? value > min : value >= min) &&
+           (max_excluded ? value < max : value <= max);
+  }
+};
 
 struct OptionField {
   const char* key;           // the name in JSON and, unless `name` is set, in option paths
@@ -45,6 +68,7 @@ struct OptionField {
   // A positional argument of the command line (required; its flag is its name, "input"): what a command works
   // on, not one of its options (the Python module takes it as an argument, not a keyword).
   bool positional = false;
+  OptionRange range = {};
 
   // Attributes beyond the first three, set by name: OptionField{"camera", "--camera", "..."}.EmptyAs("input").
   OptionField HideDefault() const { return With(&OptionField::show_default, false); }
@@ -55,6 +79,22 @@ struct OptionField {
   OptionField EmptyAs(const char* json_name) const { return With(&OptionField::empty_as, json_name); }
   OptionField ListingNames() const { return With(&OptionField::lists_names, true); }
   OptionField Positional() const { return With(&OptionField::positional, true).HideDefault().NotRecorded(); }
+  // The values the field takes: Within(0, 1) is [0, 1]; AtLeast(1) is 1 or more; then ExcludingMin() makes it
+  // (0, 1], ExcludingMax() [0, 1); Or(0) takes 0 besides; Meaning("0: never") says what a value means; Unit("px")
+  // is the value's unit.
+  OptionField Within(double min, double max) const {
+    OptionField copy = *this;
+    copy.range.is_set = true;
+    copy.range.min = min;
+    copy.range.max = max;
+    return copy;
+  }
+  OptionField AtLeast(double min) const { return Within(min, std::numeric_limits<double>::infinity()); }
+  OptionField ExcludingMin() const { return WithRange(&OptionRange::min_excluded, true); }
+  OptionField ExcludingMax() const { return WithRange(&OptionRange::max_excluded, true); }
+  OptionField Or(double value) const { return WithRange(&OptionRange::also, std::optional<double>(value)); }
+  OptionField Meaning(const char* text) const { return WithRange(&OptionRange::meaning, text); }
+  OptionField Unit(const char* unit) const { return WithRange(&OptionRange::unit, unit); }
 
   const char* path_name() const { return name != nullptr ? name : key; }
 
@@ -63,6 +103,12 @@ struct OptionField {
   OptionField With(T OptionField::*member, T value) const {
     OptionField copy = *this;
     copy.*member = value;
+    return copy;
+  }
+  template <typename T>
+  OptionField WithRange(T OptionRange::*member, T value) const {
+    OptionField copy = *this;
+    copy.range.*member = value;
     return copy;
   }
 };

@@ -4,39 +4,15 @@
 #include <optional>
 #include <vector>
 
-#include <fmt/format.h>
-
 #include "vmap/core/error.h"
 #include "vmap/core/numeric.h"
+#include "vmap/core/option_ranges.h"
 #include "vmap/geometry/relative_pose.h"
 #include "vmap/geometry/sampson_error.h"
 
 namespace vmap {
 
-void EvaluationOptions::Check() const {
-  const EvaluationOptions defaults;  // the defaults the messages give, as declared
-  if (!(max_rotation_error_deg > 0 && max_rotation_error_deg <= 180)) {
-    throw OptionError("max_rotation_error_deg", fmt::format("{} deg is outside (0, 180]; the default is {}",
-                                                            max_rotation_error_deg, defaults.max_rotation_error_deg));
-  }
-  if (!(max_translation_error_deg > 0 && max_translation_error_deg <= 180)) {
-    throw OptionError("max_translation_error_deg",
-                      fmt::format("{} deg is outside (0, 180]; the default is {}", max_translation_error_deg,
-                                  defaults.max_translation_error_deg));
-  }
-  if (!(min_parallax_px >= 0 && std::isfinite(min_parallax_px))) {
-    throw OptionError("min_parallax_px",
-                      fmt::format("{} px must be >= 0; the default is {}", min_parallax_px, defaults.min_parallax_px));
-  }
-  if (!(sampson_threshold_px > 0 && std::isfinite(sampson_threshold_px))) {
-    throw OptionError("sampson_threshold_px", fmt::format("{} px must be > 0; the default is {}", sampson_threshold_px,
-                                                          defaults.sampson_threshold_px));
-  }
-  if (!(max_time_difference >= 0 && std::isfinite(max_time_difference))) {
-    throw OptionError("max_time_difference", fmt::format("{} s must be >= 0; the default is {}", max_time_difference,
-                                                         defaults.max_time_difference));
-  }
-}
+void EvaluationOptions::Check() const { CheckFieldRanges(*this); }
 
 namespace {
 
@@ -165,19 +141,32 @@ LinkEvaluation EvaluateLink(const VisualMap& map, int index, const GroundTruth& 
 }
 
 void EvaluationOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Visit({"max_rotation_error_deg", "--max-rotation-error", "Usable: rotation error below this (deg)"},
+  visitor.Visit(OptionField{"max_rotation_error_deg", "--max-rotation-error", "Usable: rotation error below this (deg)"}
+                    .Within(0, 180)
+                    .ExcludingMin()
+                    .Unit("deg"),
                 max_rotation_error_deg);
-  visitor.Visit({"max_translation_error_deg", "--max-translation-error",
-                 "Usable: translation direction error below this (deg) where the parallax is enough"},
+  visitor.Visit(OptionField{"max_translation_error_deg", "--max-translation-error",
+                            "Usable: translation direction error below this (deg) where the parallax is enough"}
+                    .Within(0, 180)
+                    .ExcludingMin()
+                    .Unit("deg"),
                 max_translation_error_deg);
-  visitor.Visit(
-      {"min_parallax_px", "--min-parallax", "True parallax (px) from which the translation direction is judged"},
-      min_parallax_px);
-  visitor.Visit({"sampson_threshold_px", "--sampson-threshold",
-                 "A match is on its true epipolar line within this Sampson error (px)"},
+  visitor.Visit(OptionField{"min_parallax_px", "--min-parallax",
+                            "True parallax (px) from which the translation direction is judged"}
+                    .AtLeast(0)
+                    .Unit("px"),
+                min_parallax_px);
+  visitor.Visit(OptionField{"sampson_threshold_px", "--sampson-threshold",
+                            "A match is on its true epipolar line within this Sampson error (px)"}
+                    .AtLeast(0)
+                    .ExcludingMin()
+                    .Unit("px"),
                 sampson_threshold_px);
-  visitor.Visit({"max_time_difference", "--max-time-difference",
-                 "Seconds between a key image and its ground-truth pose (tum, euroc)"},
+  visitor.Visit(OptionField{"max_time_difference", "--max-time-difference",
+                            "Seconds between a key image and its ground-truth pose (tum, euroc)"}
+                    .AtLeast(0)
+                    .Unit("s"),
                 max_time_difference);
 }
 

@@ -46,7 +46,7 @@ TEST(MatcherOptionsFromJson, UnknownOrMissingMatchersAreClearErrors) {
       message(R"({"type": "orb", "num_features": "many"})").find("num_features must be an integer (it is string)"),
       std::string::npos);
   // Named by its JSON key, as the model's options are.
-  EXPECT_NE(message(R"({"type": "orb", "num_features": 0})").find("orb.num_features must be 1 to 100000"),
+  EXPECT_NE(message(R"({"type": "orb", "num_features": 0})").find("orb.num_features 0 is outside [1, 100000]"),
             std::string::npos);
 }
 

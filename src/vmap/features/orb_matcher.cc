@@ -6,8 +6,6 @@
 #include <cstring>
 #include <limits>
 
-#include <fmt/format.h>
-
 #if defined(__x86_64__)
 #include <immintrin.h>
 #endif
@@ -17,53 +15,49 @@
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/core/option_ranges.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/features/orb_extraction.h"
 
 namespace vmap {
 
 void OrbMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Visit({"num_features", "--orb-features", "ORB: features per image"}, num_features);
-  visitor.Visit({"scale_factor", "--orb-scale-factor", "ORB: pyramid scale factor"}, scale_factor);
-  visitor.Visit({"num_levels", "--orb-levels", "ORB: pyramid levels"}, num_levels);
-  visitor.Visit({"fast_threshold", "--orb-fast-threshold", "ORB: FAST threshold"}, fast_threshold);
-  visitor.Visit({"edge_threshold", "--orb-edge-threshold", "ORB: border without features (px)"}, edge_threshold);
-  visitor.Visit({"grid_cell", "--orb-grid-cell",
-                 "ORB: 0 = OpenCV's detector; N = FAST per N px cell at every pyramid level, spread over cells "
-                 "and levels (edge threshold per level)"},
-                grid_cell);
-  visitor.Visit({"min_fast_threshold", "--orb-min-fast-threshold",
-                 "ORB grid: FAST threshold in cells where --orb-fast-threshold finds none"},
+  visitor.Visit(OptionField{"num_features", "--orb-features", "ORB: features per image"}.Within(1, 100000),
+                num_features);
+  visitor.Visit(
+      OptionField{"scale_factor", "--orb-scale-factor", "ORB: pyramid scale factor"}.Within(1, 4).ExcludingMin(),
+      scale_factor);
+  visitor.Visit(OptionField{"num_levels", "--orb-levels", "ORB: pyramid levels"}.Within(1, 32), num_levels);
+  visitor.Visit(OptionField{"fast_threshold", "--orb-fast-threshold", "ORB: FAST threshold"}.Within(1, 255),
+                fast_threshold);
+  visitor.Visit(
+      OptionField{"edge_threshold", "--orb-edge-threshold", "ORB: border without features (px)"}.Within(0, 1000).Unit(
+          "px"),
+      edge_threshold);
+  visitor.Visit(
+      OptionField{"grid_cell", "--orb-grid-cell",
+                  "ORB: 0 = OpenCV's detector; N = FAST per N px cell at every pyramid level, spread over cells "
+                  "and levels (edge threshold per level)"}
+          .Within(0, 10000)
+          .Unit("px")
+          .Meaning("0: OpenCV's detector"),
+      grid_cell);
+  visitor.Visit(OptionField{"min_fast_threshold", "--orb-min-fast-threshold",
+                            "ORB grid: FAST threshold in cells where --orb-fast-threshold finds none"}
+                    .Within(1, 255),
                 min_fast_threshold);
-  visitor.Visit({"clahe_clip", "--orb-clahe", "ORB: CLAHE (8x8 tiles) before extraction, its clip limit; 0 = off"},
-                clahe_clip);
+  visitor.Visit(
+      OptionField{"clahe_clip", "--orb-clahe", "ORB: CLAHE (8x8 tiles) before extraction, its clip limit; 0 = off"}
+          .Within(0, 1000)
+          .Meaning("0: off"),
+      clahe_clip);
   visitor.Visit({"cross_check", "!--no-cross-check", "ORB: keep one-way best matches too"}, cross_check);
-  visitor.Visit({"ratio", "--ratio", "ORB: Lowe's ratio test (0 = off), e.g. 0.8"}, ratio);
+  visitor.Visit(OptionField{"ratio", "--ratio", "ORB: Lowe's ratio test (0 = off), e.g. 0.8"}.Within(0, 1).Meaning(
+                    "0 disables the ratio test"),
+                ratio);
 }
 
-void OrbMatcherOptions::Check() const {
-  const OrbMatcherOptions defaults;  // the defaults the messages give, as declared
-  if (num_features < 1 || num_features > 100000) {
-    throw OptionError("num_features", fmt::format("must be 1 to 100000 (default {})", defaults.num_features));
-  }
-  if (!(scale_factor > 1.0 && scale_factor <= 4.0)) {
-    throw OptionError("scale_factor", fmt::format("must be in (1, 4] (default {})", defaults.scale_factor));
-  }
-  if (num_levels < 1 || num_levels > 32)
-    throw OptionError("num_levels", fmt::format("must be 1 to 32 (default {})", defaults.num_levels));
-  if (edge_threshold < 0 || edge_threshold > 1000) {
-    throw OptionError("edge_threshold", fmt::format("must be 0 to 1000 pixels (default {})", defaults.edge_threshold));
-  }
-  if (fast_threshold < 1 || fast_threshold > 255) {
-    throw OptionError("fast_threshold", fmt::format("must be 1 to 255 (default {})", defaults.fast_threshold));
-  }
-  if (grid_cell < 0 || grid_cell > 10000) throw OptionError("grid_cell", "must be 0 (OpenCV's detector) to 10000 px");
-  if (min_fast_threshold < 1 || min_fast_threshold > 255) {
-    throw OptionError("min_fast_threshold", fmt::format("must be 1 to 255 (default {})", defaults.min_fast_threshold));
-  }
-  if (!(clahe_clip >= 0.0 && clahe_clip <= 1000.0)) throw OptionError("clahe_clip", "must be 0 (off) to 1000");
-  if (!(ratio >= 0.0 && ratio <= 1.0)) throw OptionError("ratio", "must be in [0, 1] (0 disables the ratio test)");
-}
+void OrbMatcherOptions::Check() const { CheckFieldRanges(*this); }
 
 namespace {
 

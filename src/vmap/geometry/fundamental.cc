@@ -9,6 +9,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/core/json_fields.h"
+#include "vmap/core/option_ranges.h"
 #include "vmap/geometry/magsac.h"
 #include "vmap/geometry/seeded_usac.h"
 
@@ -21,27 +22,11 @@ VerifierMethod ParseVerifierMethod(const std::string& name) {
 std::string VerifierMethodName(VerifierMethod method) { return EnumToName(kVerifierMethodNames, method); }
 
 void VerifierOptions::Check() const {
+  CheckFieldRanges(*this);
   const VerifierOptions defaults;  // the defaults the messages give, as declared
-  if (!(threshold > 0.0 && threshold <= 100.0)) {
-    throw OptionError("threshold",
-                      fmt::format("(verifier, pixels) must be in (0, 100] (default {})", defaults.threshold));
-  }
-  if (!(confidence > 0.0 && confidence < 1.0))
-    throw OptionError("confidence", fmt::format("must be in (0, 1) (default {})", defaults.confidence));
-  if (max_iterations < 1 || max_iterations > 10000000) {
-    throw OptionError("max_iterations", fmt::format("must be 1 to 10000000 (default {})", defaults.max_iterations));
-  }
-  if (seed < 0) throw OptionError("seed", fmt::format("must be >= 0 (default {})", defaults.seed));
-  if (min_matches < 8) throw OptionError("min_matches", "must be >= 8: the 8-point algorithm needs 8 matches");
   if (loop_points < 0 || (loop_points > 0 && loop_points < 16) || loop_points > 1000000) {
     throw OptionError("loop_points",
                       fmt::format("must be 0 (every match) or 16 to 1000000 (default {})", defaults.loop_points));
-  }
-  if (max_samples_to_reject < 1 || max_samples_to_reject > 10000000) {
-    throw OptionError("max_samples_to_reject",
-                      fmt::format("must be 1 to 10000000 (default {}; max_iterations or more keeps the confidence "
-                                  "criterion)",
-                                  defaults.max_samples_to_reject));
   }
 }
 
@@ -155,15 +140,24 @@ FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0, c
 void VerifierOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(OptionField{"method", "--verifier", "Fundamental matrix estimator: "}.ListingNames(),
                 EnumField(method, kVerifierMethodNames, ParseVerifierMethod));
-  visitor.Visit({"threshold", "--threshold", "Verifier inlier threshold in pixels"}, threshold);
-  visitor.Visit({"confidence", "--confidence", "Verifier confidence"}, confidence);
-  visitor.Visit({"max_iterations", "--max-iters", "Verifier maximum iterations"}, max_iterations);
-  visitor.Visit({"seed", "--seed", "Verifier random seed (same seed, same map)"}, seed);
-  visitor.Visit({"min_matches"}, min_matches);
-  visitor.Visit({"max_samples_to_reject", "--max-samples-to-reject",
-                 "Samples after which S < tau is settled when decisions stop early (--max-iters or more: the "
-                 "confidence criterion alone; ignored with --exhaustive)"},
-                max_samples_to_reject);
+  visitor.Visit(
+      OptionField{"threshold", "--threshold", "Verifier inlier threshold in pixels"}.Within(0, 100).ExcludingMin().Unit(
+          "px"),
+      threshold);
+  visitor.Visit(
+      OptionField{"confidence", "--confidence", "Verifier confidence"}.Within(0, 1).ExcludingMin().ExcludingMax(),
+      confidence);
+  visitor.Visit(OptionField{"max_iterations", "--max-iters", "Verifier maximum iterations"}.Within(1, 10000000),
+                max_iterations);
+  visitor.Visit(OptionField{"seed", "--seed", "Verifier random seed (same seed, same map)"}.AtLeast(0), seed);
+  visitor.Visit(OptionField{"min_matches"}.AtLeast(8).Meaning("the 8-point algorithm needs 8 matches"), min_matches);
+  visitor.Visit(
+      OptionField{"max_samples_to_reject", "--max-samples-to-reject",
+                  "Samples after which S < tau is settled when decisions stop early (--max-iters or more: the "
+                  "confidence criterion alone; ignored with --exhaustive)"}
+          .Within(1, 10000000)
+          .Meaning("max_iterations or more keeps the confidence criterion"),
+      max_samples_to_reject);
 }
 
 }  // namespace vmap

@@ -4,44 +4,39 @@
 #include <cmath>
 #include <numeric>
 
-#include <fmt/format.h>
-
 #include "vmap/core/error.h"
 #include "vmap/core/numeric.h"
+#include "vmap/core/option_ranges.h"
 
 namespace vmap {
 
 void HeadingOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Visit(
-      {"window_px", "--heading-window", "Heading: width of the window of horizontal displacements that votes (px)"},
-      window_px);
-  visitor.Visit({"window_dy_px", "--heading-window-dy",
-                 "Heading: height of the window in vertical displacement (px; 0 = by x alone)"},
+  visitor.Visit(OptionField{"window_px", "--heading-window",
+                            "Heading: width of the window of horizontal displacements that votes (px)"}
+                    .Within(0, 10000)
+                    .ExcludingMin()
+                    .Unit("px"),
+                window_px);
+  visitor.Visit(OptionField{"window_dy_px", "--heading-window-dy",
+                            "Heading: height of the window in vertical displacement (px; 0 = by x alone)"}
+                    .Within(0, 10000)
+                    .Unit("px")
+                    .Meaning("0: by x alone"),
                 window_dy_px);
-  visitor.Visit({"min_votes", "--heading-min-votes", "Heading: the fewest agreeing matches for an estimate"},
-                min_votes);
-  visitor.Visit({"min_verified", "--heading-min-verified",
-                 "Heading: with at least this many F-verified matches, their median displacement (0 = always the "
-                 "mode of all matches)"},
-                min_verified);
+  visitor.Visit(
+      OptionField{"min_votes", "--heading-min-votes", "Heading: the fewest agreeing matches for an estimate"}.Within(
+          1, 100000),
+      min_votes);
+  visitor.Visit(
+      OptionField{"min_verified", "--heading-min-verified",
+                  "Heading: with at least this many F-verified matches, their median displacement (0 = always the "
+                  "mode of all matches)"}
+          .Within(0, 100000)
+          .Meaning("0: always the mode"),
+      min_verified);
 }
 
-void HeadingOptions::Check() const {
-  const HeadingOptions defaults;  // the defaults the messages give, as declared
-  if (!(window_px > 0.0 && window_px <= 10000.0)) {
-    throw OptionError("window_px", fmt::format("must be in (0, 10000] pixels (default {})", defaults.window_px));
-  }
-  if (!(window_dy_px >= 0.0 && window_dy_px <= 10000.0)) {
-    throw OptionError("window_dy_px",
-                      fmt::format("must be 0 to 10000 pixels (0 = by x alone; default {})", defaults.window_dy_px));
-  }
-  if (min_votes < 1 || min_votes > 100000)
-    throw OptionError("min_votes", fmt::format("must be 1 to 100000 (default {})", defaults.min_votes));
-  if (min_verified < 0 || min_verified > 100000) {
-    throw OptionError("min_verified",
-                      fmt::format("must be 0 to 100000 (0 = always the mode; default {})", defaults.min_verified));
-  }
-}
+void HeadingOptions::Check() const { CheckFieldRanges(*this); }
 
 std::string HeadingMethodName(HeadingMethod method) { return EnumToName(kHeadingMethodNames, method); }
 

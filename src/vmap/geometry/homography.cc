@@ -2,21 +2,18 @@
 
 #include <cmath>
 
-#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/calib3d.hpp>
 
 #include "vmap/core/error.h"
 #include "vmap/core/json_fields.h"
+#include "vmap/core/option_ranges.h"
 #include "vmap/geometry/seeded_usac.h"
 
 namespace vmap {
 
 void HomographyOptions::Check() const {
-  if (!(threshold > 0.0)) throw OptionError("threshold", fmt::format("{} px must be > 0", threshold));
-  if (!(min_share > 0.0 && min_share <= 1.0)) {
-    throw OptionError("min_share", fmt::format("{} must be in (0, 1]", min_share));
-  }
+  CheckFieldRanges(*this);
   if (!(confidence > 0.0 && confidence < 1.0)) throw OptionError("confidence", "must be in (0, 1)");
   if (max_iterations < 1) throw OptionError("max_iterations", "must be >= 1");
 }
@@ -55,8 +52,8 @@ HomographyCheck CheckHomography(const std::vector<cv::Point2f>& from, const std:
 }
 
 void HomographyOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Visit({"threshold"}, threshold);
-  visitor.Visit({"min_share"}, min_share);
+  visitor.Visit(OptionField{"threshold"}.AtLeast(0).ExcludingMin().Unit("px"), threshold);
+  visitor.Visit(OptionField{"min_share"}.Within(0, 1).ExcludingMin(), min_share);
 }
 
 }  // namespace vmap

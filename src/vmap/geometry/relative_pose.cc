@@ -11,6 +11,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/core/json_fields.h"
+#include "vmap/core/option_ranges.h"
 #include "vmap/geometry/pose_refinement.h"
 #include "vmap/geometry/seeded_usac.h"
 
@@ -21,13 +22,8 @@ PoseMethod ParsePoseMethod(const std::string& name) { return ParseEnum(kPoseMeth
 std::string PoseMethodName(PoseMethod method) { return EnumToName(kPoseMethodNames, method); }
 
 void PoseOptions::Check() const {
+  CheckFieldRanges(*this);
   const PoseOptions defaults;  // the defaults the messages give, as declared
-  if (!(threshold > 0.0 && threshold <= 100.0)) {
-    throw OptionError("threshold",
-                      fmt::format("{} px is outside (0, 100]; the default is {}", threshold, defaults.threshold));
-  }
-  if (!(confidence > 0.0 && confidence < 1.0)) throw OptionError("confidence", "must be in (0, 1)");
-  if (max_iterations < 1) throw OptionError("max_iterations", "must be >= 1");
   if (!(refine_inlier_factor >= 1.0)) throw OptionError("refine_inlier_factor", "must be >= 1");
   if (starts < 0 || starts > 100)
     throw OptionError("starts", fmt::format("must be in [0, 100] (default {})", defaults.starts));
@@ -321,13 +317,17 @@ void PoseOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Relative pose of each link, with a camera: essential (E on normalised points) or "
                  "fundamental (E = K^T F K)"},
                 EnumField(method, kPoseMethodNames, ParsePoseMethod));
-  visitor.Visit({"threshold", "--pose-threshold", "Inlier threshold of the essential matrix, pixels"}, threshold);
+  visitor.Visit(OptionField{"threshold", "--pose-threshold", "Inlier threshold of the essential matrix, pixels"}
+                    .Within(0, 100)
+                    .ExcludingMin()
+                    .Unit("px"),
+                threshold);
   visitor.Visit(OptionField{"matches", "--pose-matches",
                             "Matches the essential matrix is estimated on: all (tentative) or verified (F's inliers)"}
                     .Named("use_all_matches"),
                 EnumField(use_all_matches, kPoseMatchesNames, ParsePoseMatches));
-  visitor.Visit({"confidence"}, confidence);
-  visitor.Visit({"max_iterations"}, max_iterations);
+  visitor.Visit(OptionField{"confidence"}.Within(0, 1).ExcludingMin().ExcludingMax(), confidence);
+  visitor.Visit(OptionField{"max_iterations"}.AtLeast(1), max_iterations);
   visitor.Visit({"seed"}, seed);
 }
 

@@ -2,50 +2,45 @@
 
 #include <cmath>
 
-#include <fmt/format.h>
-
 #include "vmap/core/error.h"
 #include "vmap/core/numeric.h"
+#include "vmap/core/option_ranges.h"
 
 namespace vmap {
 
-void TranslationOptions::Check() const {
-  const TranslationOptions defaults;  // the defaults the messages give, as declared
-  if (!(max_sigma_deg > 0.0 && max_sigma_deg <= 180.0)) {
-    throw OptionError("max_sigma_deg", fmt::format("{} deg is outside (0, 180]; the default is {}", max_sigma_deg,
-                                                   defaults.max_sigma_deg));
-  }
-  if (!(min_parallax_px >= 0.0 && std::isfinite(min_parallax_px))) {
-    throw OptionError("min_parallax_px",
-                      fmt::format("{} px must be >= 0; the default is {}", min_parallax_px, defaults.min_parallax_px));
-  }
-  if (!(rival_angle_deg >= 0.0 && rival_angle_deg < 180.0)) {
-    throw OptionError("rival_angle_deg", fmt::format("{} deg is outside [0, 180); the default is {}", rival_angle_deg,
-                                                     defaults.rival_angle_deg));
-  }
-  if (!(min_rival_cost_gap >= 0.0 && std::isfinite(min_rival_cost_gap))) {
-    throw OptionError("min_rival_cost_gap", fmt::format("{} must be >= 0 (0: never ambiguous); the default is {}",
-                                                        min_rival_cost_gap, defaults.min_rival_cost_gap));
-  }
-}
+void TranslationOptions::Check() const { CheckFieldRanges(*this); }
 
 void TranslationOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Visit({"max_sigma_deg", "--max-translation-sigma",
-                 "Degrees: a link whose translation direction is less certain than this is marked translation "
-                 "unknown (a robot gets its rotation only)"},
-                max_sigma_deg);
-  visitor.Visit({"min_parallax_px", "--min-translation-parallax",
-                 "Pixels: a link whose verified matches moved less than this once its rotation is undone (median) "
-                 "is marked translation unknown"},
-                min_parallax_px);
-  visitor.Visit({"rival_angle_deg", "--rival-translation-angle",
-                 "Degrees: another minimum of a link's pose cost whose translation points further away than this "
-                 "is a rival (see --min-rival-cost-gap)"},
-                rival_angle_deg);
-  visitor.Visit({"min_rival_cost_gap", "--min-rival-cost-gap",
-                 "A link whose rival minimum costs less than this more than its pose (robust Sampson cost) is "
-                 "marked translation unknown: its direction is ambiguous (0: never)"},
-                min_rival_cost_gap);
+  visitor.Visit(
+      OptionField{"max_sigma_deg", "--max-translation-sigma",
+                  "Degrees: a link whose translation direction is less certain than this is marked translation "
+                  "unknown (a robot gets its rotation only)"}
+          .Within(0, 180)
+          .ExcludingMin()
+          .Unit("deg"),
+      max_sigma_deg);
+  visitor.Visit(
+      OptionField{"min_parallax_px", "--min-translation-parallax",
+                  "Pixels: a link whose verified matches moved less than this once its rotation is undone (median) "
+                  "is marked translation unknown"}
+          .AtLeast(0)
+          .Unit("px"),
+      min_parallax_px);
+  visitor.Visit(
+      OptionField{"rival_angle_deg", "--rival-translation-angle",
+                  "Degrees: another minimum of a link's pose cost whose translation points further away than this "
+                  "is a rival (see --min-rival-cost-gap)"}
+          .Within(0, 180)
+          .ExcludingMax()
+          .Unit("deg"),
+      rival_angle_deg);
+  visitor.Visit(
+      OptionField{"min_rival_cost_gap", "--min-rival-cost-gap",
+                  "A link whose rival minimum costs less than this more than its pose (robust Sampson cost) is "
+                  "marked translation unknown: its direction is ambiguous (0: never)"}
+          .AtLeast(0)
+          .Meaning("0: never ambiguous"),
+      min_rival_cost_gap);
 }
 
 bool TranslationKnown(double sigma_deg, double parallax_px, const TranslationOptions& options) {

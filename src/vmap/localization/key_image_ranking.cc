@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/core/option_ranges.h"
 #include "vmap/features/float_matcher.h"
 #include "vmap/features/orb_matcher.h"
 
@@ -19,30 +19,13 @@ std::string RankingMethodName(RankingMethod method) { return EnumToName(kRanking
 void RankingOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(OptionField{"method", "--ranking", "Relocalization ranking: "}.ListingNames(),
                 EnumField(method, kRankingMethodNames, ParseRankingMethod));
-  visitor.Visit({"max_hamming_fraction"}, max_hamming_fraction);
-  visitor.Visit({"min_cosine"}, min_cosine);
-  visitor.Visit({"max_descriptors_per_key"}, max_descriptors_per_key);
-  visitor.Visit({"thumbnail_width"}, thumbnail_width);
+  visitor.Visit(OptionField{"max_hamming_fraction"}.Within(0, 0.5).ExcludingMin(), max_hamming_fraction);
+  visitor.Visit(OptionField{"min_cosine"}.Within(-1, 1).ExcludingMin().ExcludingMax(), min_cosine);
+  visitor.Visit(OptionField{"max_descriptors_per_key"}.Within(0, 100000).Meaning("0: all"), max_descriptors_per_key);
+  visitor.Visit(OptionField{"thumbnail_width"}.Within(8, 512), thumbnail_width);
 }
 
-void RankingOptions::Check() const {
-  const RankingOptions defaults;  // the defaults the messages give, as declared
-  if (!(max_hamming_fraction > 0.0 && max_hamming_fraction <= 0.5)) {
-    throw OptionError("max_hamming_fraction", fmt::format("{} is outside (0, 0.5] (default {})", max_hamming_fraction,
-                                                          defaults.max_hamming_fraction));
-  }
-  if (!(min_cosine > -1.0 && min_cosine < 1.0)) {
-    throw OptionError("min_cosine", fmt::format("{} is outside (-1, 1) (default {})", min_cosine, defaults.min_cosine));
-  }
-  if (max_descriptors_per_key < 0 || max_descriptors_per_key > 100000) {
-    throw OptionError("max_descriptors_per_key",
-                      fmt::format("must be 0 (all) to 100000 (default {})", defaults.max_descriptors_per_key));
-  }
-  if (thumbnail_width < 8 || thumbnail_width > 512) {
-    throw OptionError("thumbnail_width",
-                      fmt::format("{} is outside [8, 512] (default {})", thumbnail_width, defaults.thumbnail_width));
-  }
-}
+void RankingOptions::Check() const { CheckFieldRanges(*this); }
 
 cv::Mat ThumbnailDescriptor(const cv::Mat& gray, int width) {
   CV_Assert(!gray.empty() && gray.type() == CV_8UC1);

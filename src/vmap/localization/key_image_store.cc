@@ -8,13 +8,13 @@
 #include <fstream>
 #include <thread>
 
-#include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/option_ranges.h"
 #include "vmap/core/parallel_for.h"
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/map/map_io.h"
@@ -186,20 +186,12 @@ std::string KeyImageCacheStateName(KeyImageCacheState state) {
 
 void KeyImageStoreOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(OptionField{"use_cache"}.NotRecorded(), use_cache);
-  visitor.Visit(OptionField{"thumbnail_width"}.NotRecorded(), thumbnail_width);
-  visitor.Visit(OptionField{"extraction_threads"}.NotRecorded(), extraction_threads);
+  visitor.Visit(OptionField{"thumbnail_width"}.NotRecorded().Within(8, 512), thumbnail_width);
+  visitor.Visit(OptionField{"extraction_threads"}.NotRecorded().Within(0, 256).Meaning("0: one per core"),
+                extraction_threads);
 }
 
-void KeyImageStoreOptions::Check() const {
-  const KeyImageStoreOptions defaults;  // the defaults the messages give, as declared
-  if (thumbnail_width < 8 || thumbnail_width > 512) {
-    throw OptionError("thumbnail_width",
-                      fmt::format("{} is outside [8, 512] (default {})", thumbnail_width, defaults.thumbnail_width));
-  }
-  if (extraction_threads < 0 || extraction_threads > 256) {
-    throw OptionError("extraction_threads", "must be 0 to 256 (0 = one per core)");
-  }
-}
+void KeyImageStoreOptions::Check() const { CheckFieldRanges(*this); }
 
 KeyImageStore LoadKeyImageStore(const fs::path& map_directory, const VisualMap& map, const Matcher& matcher,
                                 const KeyImageStoreOptions& options, const std::vector<Experience>& experiences) {

@@ -235,12 +235,13 @@ TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
     std::string arguments, expected;
   };
   const std::vector<Case> cases = {
-      {localize + "--threads 40000", "--threads must be 0 to 256"},
-      {localize + "--acceptance counts --min-verified 3", "--min-verified 3 must be 8"},
+      {localize + "--threads 40000", "--threads 40000 is outside [0, 256] (default 0; 0: one per core)"},
+      {localize + "--acceptance counts --min-verified 3", "--min-verified 3 is outside [8, 100000]"},
       {localize + "--acceptance counts --min-similarity nan", "--min-similarity nan is outside [0, 1]"},
-      {localize + "--candidates 0", "--candidates 0 must be 1 to 10000"},
-      {localize + "--max-lost -1", "--max-lost -1 must be 0 to 1000000"},
-      {localize + "--lookahead 3", "lookahead 3 is not 1 or 2"},
+      {localize + "--candidates 0", "--candidates 0 is outside [1, 10000]"},
+      {localize + "--max-lost -1", "--max-lost -1 is outside [0, 1000000]"},
+      {localize + "--lookahead 3", "--lookahead 3 is outside [1, 2] (default 2)"},
+      {localize + "--min-rival-ratio 0.5", "--min-rival-ratio 0.5 is not 0 nor in [1, 1000] (default 2; 0: never)"},
       {localize + "--ranking bow", "unknown ranking 'bow'"},
       {localize + "--acceptance bow", "unknown acceptance rule 'bow'"},
       {localize + "--max-log10-nfa nan", "--max-log10-nfa nan is outside"},
@@ -253,9 +254,10 @@ TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
       {localize + "--step-back-max-log10-nfa nan", "--step-back-max-log10-nfa nan is outside"},
       {localize + "--to 99", "key image 99 does not exist"},
       {localize + "--start-key 99", "start key image 99 (--start-key) does not exist"},
-      {localize + "--start-key -2", "--start-key -2 is not -1"},
+      {localize + "--start-key -2", "--start-key -2 is less than -1"},
       {"localize " + Quote(tmp.path() / "m") + " " + Quote(tmp.path() / "missing.mp4"), "does not exist"},
-      {"route " + Quote(tmp.path() / "m") + " --min-backward-verified 2", "--min-backward-verified 2 must be 8"},
+      {"route " + Quote(tmp.path() / "m") + " --min-backward-verified 2",
+       "--min-backward-verified 2 is outside [8, 100000]"},
   };
   for (const Case& c : cases) {
     EXPECT_EQ(RunVmap(c.arguments, &out), 2) << c.arguments << "\n" << out;

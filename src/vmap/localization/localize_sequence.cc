@@ -7,9 +7,8 @@
 #include <optional>
 #include <thread>
 
-#include <fmt/format.h>
-
 #include "vmap/core/error.h"
+#include "vmap/core/option_ranges.h"
 #include "vmap/core/ordered_pipeline.h"
 #include "vmap/core/progress.h"
 #include "vmap/sources/read_ahead_source.h"
@@ -22,10 +21,12 @@ int LocalizeSequenceOptions::ExtractionThreads() const {
 }
 
 void LocalizeSequenceOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Visit(
-      OptionField{"extraction_threads", "--threads", "Feature-extraction threads (0 = one per core)"}.NotRecorded(),
-      extraction_threads);
-  visitor.Visit(OptionField{"prefetch_frames"}.NotRecorded(), prefetch_frames);
+  visitor.Visit(OptionField{"extraction_threads", "--threads", "Feature-extraction threads (0 = one per core)"}
+                    .NotRecorded()
+                    .Within(0, 256)
+                    .Meaning("0: one per core"),
+                extraction_threads);
+  visitor.Visit(OptionField{"prefetch_frames"}.NotRecorded().Within(1, 1024), prefetch_frames);
   visitor.Visit(OptionField{"compare_ahead", "!--no-compare-ahead",
                             "Extraction threads do not compare frames with the likely key images ahead (the results "
                             "are the same)"}
@@ -34,15 +35,7 @@ void LocalizeSequenceOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(OptionField{"show_progress"}.NotRecorded(), show_progress);
 }
 
-void LocalizeSequenceOptions::Check() const {
-  const LocalizeSequenceOptions defaults;  // the defaults the messages give, as declared
-  if (extraction_threads < 0 || extraction_threads > 256) {
-    throw OptionError("extraction_threads", "must be 0 to 256 (0 = one per core)");
-  }
-  if (prefetch_frames < 1 || prefetch_frames > 1024) {
-    throw OptionError("prefetch_frames", fmt::format("must be 1 to 1024 (default {})", defaults.prefetch_frames));
-  }
-}
+void LocalizeSequenceOptions::Check() const { CheckFieldRanges(*this); }
 
 namespace {
 

@@ -1,8 +1,7 @@
 #include "vmap/localization/localizer_options.h"
 
-#include <fmt/format.h>
-
 #include "vmap/core/error.h"
+#include "vmap/core/option_ranges.h"
 
 namespace vmap {
 
@@ -12,48 +11,75 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "chance, --max-log10-nfa, and many against the map's links, --min-link-share) or "
                  "counts (the earlier rule: --min-verified and --min-similarity)"},
                 EnumField(acceptance, kAcceptanceRuleNames, ParseAcceptanceRule));
-  visitor.Visit({"max_log10_nfa", "--max-log10-nfa",
-                 "--acceptance chance: accept when log10 of the number of false alarms is at most this"},
+  visitor.Visit(OptionField{"max_log10_nfa", "--max-log10-nfa",
+                            "--acceptance chance: accept when log10 of the number of false alarms is at most this"}
+                    .Within(-1000, 1000)
+                    .Meaning("0: accept what chance explains less than once"),
                 max_log10_nfa);
-  visitor.Visit({"min_verified", "--min-verified",
-                 "--acceptance counts: verified matches a frame needs to be localized at a key image"},
+  visitor.Visit(OptionField{"min_verified", "--min-verified",
+                            "--acceptance counts: verified matches a frame needs to be localized at a key image"}
+                    .Within(8, 100000)
+                    .Meaning("8: the fewest matches F can be verified with"),
                 min_verified);
+  visitor.Visit(OptionField{"min_similarity", "--min-similarity",
+                            "--acceptance counts: S a frame needs to be localized at a key image"}
+                    .Within(0, 1),
+                min_similarity);
   visitor.Visit(
-      {"min_similarity", "--min-similarity", "--acceptance counts: S a frame needs to be localized at a key image"},
-      min_similarity);
-  visitor.Visit({"min_link_share", "--min-link-share",
-                 "--acceptance chance: verified matches a frame also needs, as a fraction of those of the key "
-                 "image's link with its route neighbour (0: chance alone)"},
-                min_link_share);
-  visitor.Visit({"min_rival_ratio", "--min-rival-ratio",
-                 "--acceptance chance: a key image refused by --min-link-share alone is accepted when it verifies "
-                 "this many times the matches of every key image compared more than two route positions away (the "
-                 "tracked ones each, else the best of a relocalization's; 0: never)"},
-                min_rival_ratio);
-  visitor.Visit({"rival_max_log10_nfa", "--rival-max-log10-nfa",
-                 "--acceptance chance: the log10 number of false alarms a key image accepted against its rivals "
-                 "(--min-rival-ratio) needs at most"},
-                rival_max_log10_nfa);
-  visitor.Visit({"min_heading_rival_ratio", "--min-heading-rival-ratio",
-                 "--acceptance chance, binary descriptors: a key image chance refuses is accepted when its heading "
-                 "mode holds this many times the votes of every rival compared (far, or near without a link of one "
-                 "scene; 0: never)"},
-                min_heading_rival_ratio);
-  visitor.Visit({"min_heading_votes", "--min-heading-votes",
-                 "The matches a heading mode needs to be accepted against its rivals (--min-heading-rival-ratio)"},
-                min_heading_votes);
-  visitor.Visit({"recheck_link_share", "--recheck-link-share",
-                 "Relocalize a tracked frame with fewer verified matches than this fraction of its key image's "
-                 "link, and move it where more verify (0: never)"},
-                recheck_link_share);
-  visitor.Visit({"scene_change_log10_nfa", "--scene-change-log10-nfa",
-                 "Float descriptors: relocalize a tracked frame whose comparison with the frame before has a log10 "
-                 "NFA above this (the robot was carried), uncertain where a far place verifies more (0: never)"},
-                scene_change_log10_nfa);
-  visitor.Visit({"scene_change_tracked_log10_nfa", "--scene-change-tracked-log10-nfa",
-                 "Ask a frame that does not share the frame before's scene again only where its tracked key image's "
-                 "comparison has a log10 NFA above this (-1000: nearly every such frame)"},
-                scene_change_tracked_log10_nfa);
+      OptionField{"min_link_share", "--min-link-share",
+                  "--acceptance chance: verified matches a frame also needs, as a fraction of those of the key "
+                  "image's link with its route neighbour (0: chance alone)"}
+          .Within(0, 10)
+          .Meaning("0: chance alone decides"),
+      min_link_share);
+  visitor.Visit(
+      OptionField{"min_rival_ratio", "--min-rival-ratio",
+                  "--acceptance chance: a key image refused by --min-link-share alone is accepted when it verifies "
+                  "this many times the matches of every key image compared more than two route positions away (the "
+                  "tracked ones each, else the best of a relocalization's; 0: never)"}
+          .Within(1, 1000)
+          .Or(0)
+          .Meaning("0: never"),
+      min_rival_ratio);
+  visitor.Visit(
+      OptionField{"rival_max_log10_nfa", "--rival-max-log10-nfa",
+                  "--acceptance chance: the log10 number of false alarms a key image accepted against its rivals "
+                  "(--min-rival-ratio) needs at most"}
+          .Within(-1000, 0),
+      rival_max_log10_nfa);
+  visitor.Visit(
+      OptionField{"min_heading_rival_ratio", "--min-heading-rival-ratio",
+                  "--acceptance chance, binary descriptors: a key image chance refuses is accepted when its heading "
+                  "mode holds this many times the votes of every rival compared (far, or near without a link of one "
+                  "scene; 0: never)"}
+          .Within(1, 1000)
+          .Or(0)
+          .Meaning("0: never"),
+      min_heading_rival_ratio);
+  visitor.Visit(
+      OptionField{"min_heading_votes", "--min-heading-votes",
+                  "The matches a heading mode needs to be accepted against its rivals (--min-heading-rival-ratio)"}
+          .Within(3, 100000),
+      min_heading_votes);
+  visitor.Visit(
+      OptionField{"recheck_link_share", "--recheck-link-share",
+                  "Relocalize a tracked frame with fewer verified matches than this fraction of its key image's "
+                  "link, and move it where more verify (0: never)"}
+          .Within(0, 10)
+          .Meaning("0: never relocalize a tracked frame"),
+      recheck_link_share);
+  visitor.Visit(
+      OptionField{"scene_change_log10_nfa", "--scene-change-log10-nfa",
+                  "Float descriptors: relocalize a tracked frame whose comparison with the frame before has a log10 "
+                  "NFA above this (the robot was carried), uncertain where a far place verifies more (0: never)"}
+          .Within(-1000, 0),
+      scene_change_log10_nfa);
+  visitor.Visit(
+      OptionField{"scene_change_tracked_log10_nfa", "--scene-change-tracked-log10-nfa",
+                  "Ask a frame that does not share the frame before's scene again only where its tracked key image's "
+                  "comparison has a log10 NFA above this (-1000: nearly every such frame)"}
+          .Within(-1000, 0),
+      scene_change_tracked_log10_nfa);
   visitor.Visit({"doubt_lone_step_back", "!--no-doubt-lone-step-back",
                  "Track a frame that stepped back because nothing at or ahead of the key image verified, though a far "
                  "key image verifies more (otherwise it is uncertain)"},
@@ -84,18 +110,22 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "tracked one does too (otherwise the key image past it is compared, and stepped on to where it "
                  "verifies more beyond chance)"},
                 look_past_weak_next);
-  visitor.Visit({"look_past_max_log10_nfa", "--look-past-max-log10-nfa",
-                 "Float descriptors: the log10 NFA at most which the key image past a weak next one must verify to be "
-                 "stepped on to (--no-look-past-weak-next; -10: beyond a little chance)"},
-                look_past_max_log10_nfa);
+  visitor.Visit(
+      OptionField{"look_past_max_log10_nfa", "--look-past-max-log10-nfa",
+                  "Float descriptors: the log10 NFA at most which the key image past a weak next one must verify to be "
+                  "stepped on to (--no-look-past-weak-next; -10: beyond a little chance)"}
+          .Within(-1000, 0),
+      look_past_max_log10_nfa);
   visitor.Visit({"step_on_to_last_by_chance", "!--no-step-on-to-last-by-chance",
                  "Float descriptors: step on to the route's last key image by the count, as to any other (otherwise "
                  "from the key image before it where it verifies at a log10 NFA lower by --step-on-to-last-lead)"},
                 step_on_to_last_by_chance);
-  visitor.Visit({"step_on_to_last_log10_nfa_lead", "--step-on-to-last-lead",
-                 "Float descriptors: how much lower a log10 NFA the route's last key image must verify at than the "
-                 "tracked key image before it to be stepped on to (--no-step-on-to-last-by-chance)"},
-                step_on_to_last_log10_nfa_lead);
+  visitor.Visit(
+      OptionField{"step_on_to_last_log10_nfa_lead", "--step-on-to-last-lead",
+                  "Float descriptors: how much lower a log10 NFA the route's last key image must verify at than the "
+                  "tracked key image before it to be stepped on to (--no-step-on-to-last-by-chance)"}
+          .Within(0, 1000),
+      step_on_to_last_log10_nfa_lead);
   visitor.Visit({"doubt_relocalization_on_little_chance", "!--no-doubt-relocalization-on-little-chance",
                  "Float descriptors: steer by a frame relocalized (or tracked) more than two key images from where "
                  "the run was last steered by even where its key images verify by little beyond chance (else it is "
@@ -105,15 +135,21 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Frames a far key image that verified more than the one a frame was steered by is compared again; "
                  "a tracked frame it out-verifies again is relocalized (0 = never)"},
                 rival_place_frames);
-  visitor.Visit({"stalled_tracker_frames", "--stalled-tracker-frames",
-                 "Float descriptors: frames in a row a tracker held at one key image, the next one verifying nothing "
-                 "beyond a little chance, before the frame is compared with the best-ranked key images of the route "
-                 "(0 = never)"},
-                stalled_tracker_frames);
-  visitor.Visit({"unsettled_stalled_tracker_frames", "--unsettled-stalled-tracker-frames",
-                 "Float descriptors: the same for a hold that begins within two frames of a frame not steered by or "
-                 "of the run's start (at most --stalled-tracker-frames; 0 = as --stalled-tracker-frames)"},
-                unsettled_stalled_tracker_frames);
+  visitor.Visit(
+      OptionField{"stalled_tracker_frames", "--stalled-tracker-frames",
+                  "Float descriptors: frames in a row a tracker held at one key image, the next one verifying nothing "
+                  "beyond a little chance, before the frame is compared with the best-ranked key images of the route "
+                  "(0 = never)"}
+          .Within(0, 1000)
+          .Meaning("0: never"),
+      stalled_tracker_frames);
+  visitor.Visit(
+      OptionField{"unsettled_stalled_tracker_frames", "--unsettled-stalled-tracker-frames",
+                  "Float descriptors: the same for a hold that begins within two frames of a frame not steered by or "
+                  "of the run's start (at most --stalled-tracker-frames; 0 = as --stalled-tracker-frames)"}
+          .Within(0, 1000)
+          .Meaning("0: as stalled_tracker_frames"),
+      unsettled_stalled_tracker_frames);
   visitor.Visit({"rival_place_when_not_steered", "!--no-rival-place-when-not-steered",
                  "Remember and compare a far key image a lost or uncertain frame verified as a rival place too "
                  "(otherwise only frames steered by remember one)"},
@@ -129,13 +165,20 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "never steer by an ORB frame the belief doubts before the frame's own ranking, even where its key "
                  "images pass chance and the belief with its ranking singles them out"},
                 verified_ranking_steers);
-  visitor.Visit({"start_key", "--start-key",
-                 "The key image the run starts at (teach and repeat: 0, the route's first): the tracker starts there "
-                 "and the belief leans there, which the frames' evidence overrides (-1 = anywhere)"},
-                start_key);
-  visitor.Visit({"start_mass", "--start-mass",
-                 "--start-key: the share of the belief at the start key image at the first frame (the rest flat)"},
-                start_mass);
+  visitor.Visit(
+      OptionField{"start_key", "--start-key",
+                  "The key image the run starts at (teach and repeat: 0, the route's first): the tracker starts there "
+                  "and the belief leans there, which the frames' evidence overrides (-1 = anywhere)"}
+          .AtLeast(-1)
+          .Meaning("-1: anywhere"),
+      start_key);
+  visitor.Visit(
+      OptionField{"start_mass", "--start-mass",
+                  "--start-key: the share of the belief at the start key image at the first frame (the rest flat)"}
+          .Within(0, 1)
+          .ExcludingMax()
+          .Meaning("1 would trap a run started elsewhere"),
+      start_mass);
   visitor.Visit({"start_is_hint", "!--no-start-is-hint",
                  "--start-key: steer by a frame even where the frames' evidence alone, without the start's prior, "
                  "singles out a place more than two key images away (otherwise it is uncertain)"},
@@ -152,29 +195,45 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "--start-key, float descriptors: before the start is confirmed, the frames' evidence alone weighs a "
                  "tracked frame by its comparisons only (otherwise by its ranking too)"},
                 start_evidence_ranks_frame);
-  visitor.Visit({"start_away_min_confidence", "--start-away-min-confidence",
-                 "--start-key, float descriptors: before the start is confirmed, the belief a frame placed more than "
-                 "two key images from the start key image needs near its place to be steered by (0: as any frame)"},
-                start_away_min_confidence);
-  visitor.Visit({"max_lost_frames", "--max-lost", "Lost frames in a row before the estimate is dropped"},
-                max_lost_frames);
-  visitor.Visit({"relocalization_candidates", "--candidates", "Best-ranked key images verified when relocalizing"},
-                relocalization_candidates);
-  visitor.Visit({"relocalization_likelier_reach", "--relocalization-likelier-reach",
-                 "Route positions from a relocalization's most verified candidate within which an accepted one "
-                 "likelier by chance (lower log10 NFA, within the evidence's bound) places the frame (0 = the most "
-                 "verified)"},
-                relocalization_likelier_reach);
-  visitor.Visit({"experience_candidates", "--experience-candidates",
-                 "Maps with experiences: views of a key image verified besides it, those with the most tentative "
-                 "matches (0 = the teach key images only)"},
-                experience_candidates);
-  visitor.Visit({"lookahead", "--lookahead", "Key images beyond the next compared while tracking (1 or 2)"}, lookahead);
+  visitor.Visit(
+      OptionField{"start_away_min_confidence", "--start-away-min-confidence",
+                  "--start-key, float descriptors: before the start is confirmed, the belief a frame placed more than "
+                  "two key images from the start key image needs near its place to be steered by (0: as any frame)"}
+          .Within(0, 1),
+      start_away_min_confidence);
+  visitor.Visit(
+      OptionField{"max_lost_frames", "--max-lost", "Lost frames in a row before the estimate is dropped"}.Within(
+          0, 1000000),
+      max_lost_frames);
+  visitor.Visit(
+      OptionField{"relocalization_candidates", "--candidates", "Best-ranked key images verified when relocalizing"}
+          .Within(1, 10000),
+      relocalization_candidates);
+  visitor.Visit(
+      OptionField{"relocalization_likelier_reach", "--relocalization-likelier-reach",
+                  "Route positions from a relocalization's most verified candidate within which an accepted one "
+                  "likelier by chance (lower log10 NFA, within the evidence's bound) places the frame (0 = the most "
+                  "verified)"}
+          .Within(0, 1000000),
+      relocalization_likelier_reach);
+  visitor.Visit(
+      OptionField{"experience_candidates", "--experience-candidates",
+                  "Maps with experiences: views of a key image verified besides it, those with the most tentative "
+                  "matches (0 = the teach key images only)"}
+          .Within(0, 1000)
+          .Meaning("0: teach key images only"),
+      experience_candidates);
+  visitor.Visit(
+      OptionField{"lookahead", "--lookahead", "Key images beyond the next compared while tracking (1 or 2)"}.Within(1,
+                                                                                                                    2),
+      lookahead);
   visitor.Visit({"step_back", "!--no-step-back", "Never move the estimate back to the previous key image"}, step_back);
-  visitor.Visit({"step_back_max_log10_nfa", "--step-back-max-log10-nfa",
-                 "A step back to the previous key image when nothing at or ahead of the key image verifies: its log10 "
-                 "NFA at most this (stricter than --max-log10-nfa: the route goes forwards)"},
-                step_back_max_log10_nfa);
+  visitor.Visit(
+      OptionField{"step_back_max_log10_nfa", "--step-back-max-log10-nfa",
+                  "A step back to the previous key image when nothing at or ahead of the key image verifies: its log10 "
+                  "NFA at most this (stricter than --max-log10-nfa: the route goes forwards)"}
+          .Within(-1000, 1000),
+      step_back_max_log10_nfa);
   visitor.Visit({"step_back_needs_more", "!--step-back-on-tie",
                  "Step back to the previous key image on a tie of verified matches (S decides, as before)"},
                 step_back_needs_more);
@@ -216,276 +275,135 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "ORB: never step a frame after lost frames on to the next key image where its ranking and its heading "
                  "mode agree and the frame before named it by neither"},
                 step_on_after_lost_frames);
-  visitor.Visit({"lost_frame_features", "--lost-frame-features",
-                 "ORB: a lost frame's features extracted again, this many, and compared with the ranking's best key "
-                 "images extracted again likewise (0 = never)"},
-                lost_frame_features);
+  visitor.Visit(
+      OptionField{"lost_frame_features", "--lost-frame-features",
+                  "ORB: a lost frame's features extracted again, this many, and compared with the ranking's best key "
+                  "images extracted again likewise (0 = never)"}
+          .Within(0, 100000),
+      lost_frame_features);
   visitor.Visit({"lost_frame_heading", "!--no-lost-frame-heading",
                  "ORB: never accept a lost frame's comparison with more features by its heading mode standing out "
                  "against the others made so (only chance decides on them)"},
                 lost_frame_heading);
-  visitor.Visit({"lost_frame_heading_rival_ratio", "--lost-frame-heading-rival-ratio",
-                 "ORB: a lost frame's comparison with more features is accepted by its heading mode when that holds "
-                 "this many times the votes of every rival among them (0: never)"},
-                lost_frame_heading_rival_ratio);
   visitor.Visit(
-      {"lost_frame_heading_near_ratio", "--lost-frame-heading-near-ratio",
-       "ORB: below --lost-frame-heading-rival-ratio, down to this, a lost frame's heading is accepted within a "
-       "jump's reach of the estimate only, placed but not steered by (0: none)"},
+      OptionField{"lost_frame_heading_rival_ratio", "--lost-frame-heading-rival-ratio",
+                  "ORB: a lost frame's comparison with more features is accepted by its heading mode when that holds "
+                  "this many times the votes of every rival among them (0: never)"}
+          .Within(1, 1000)
+          .Or(0)
+          .Meaning("0: never"),
+      lost_frame_heading_rival_ratio);
+  visitor.Visit(
+      OptionField{
+          "lost_frame_heading_near_ratio", "--lost-frame-heading-near-ratio",
+          "ORB: below --lost-frame-heading-rival-ratio, down to this, a lost frame's heading is accepted within a "
+          "jump's reach of the estimate only, placed but not steered by (0: none)"}
+          .Within(1, 1000)
+          .Or(0)
+          .Meaning("0: none"),
       lost_frame_heading_near_ratio);
   visitor.Visit(
-      {"lost_frame_next_heading_ratio", "--lost-frame-next-heading-ratio",
-       "ORB: below --lost-frame-heading-near-ratio, down to this, a lost frame's heading is accepted where it "
-       "names the key image the frame before was placed at or the one after it, placed but not steered by "
-       "(0: none)"},
+      OptionField{
+          "lost_frame_next_heading_ratio", "--lost-frame-next-heading-ratio",
+          "ORB: below --lost-frame-heading-near-ratio, down to this, a lost frame's heading is accepted where it "
+          "names the key image the frame before was placed at or the one after it, placed but not steered by "
+          "(0: none)"}
+          .Within(1, 1000)
+          .Or(0)
+          .Meaning("0: none"),
       lost_frame_next_heading_ratio);
-  visitor.Visit({"still_frame_share", "--still-frame-share",
-                 "a frame whose matches with the frame before moved less than half a pixel in this share stands "
-                 "still: it is not stepped on, nor placed beyond two key images of its estimate by a lost frame's "
-                 "heading, nor counted in a held tracker (0: no frame is still)"},
-                still_frame_share);
-  visitor.Visit({"far_comparison_iterations", "--far-comparison-iterations",
-                 "ORB: verify the frame's comparisons with key images away from the tracker's (more than one behind "
-                 "or lookahead + 1 ahead) with at most this many MAGSAC iterations (0 = the verifier's)"},
-                far_comparison_iterations);
+  visitor.Visit(
+      OptionField{"still_frame_share", "--still-frame-share",
+                  "a frame whose matches with the frame before moved less than half a pixel in this share stands "
+                  "still: it is not stepped on, nor placed beyond two key images of its estimate by a lost frame's "
+                  "heading, nor counted in a held tracker (0: no frame is still)"}
+          .Within(0, 1),
+      still_frame_share);
+  visitor.Visit(
+      OptionField{"far_comparison_iterations", "--far-comparison-iterations",
+                  "ORB: verify the frame's comparisons with key images away from the tracker's (more than one behind "
+                  "or lookahead + 1 ahead) with at most this many MAGSAC iterations (0 = the verifier's)"}
+          .Within(0, 10000000),
+      far_comparison_iterations);
   visitor.Visit({"guided_lookahead", "!--no-guided-lookahead",
                  "ORB: match a frame guided at the key image and the next one only, ranked by verified matches (not "
                  "over the lookahead, ranked by the one-way matches' NFA where chance accepts none)"},
                 guided_lookahead);
-  visitor.Visit({"continuity_share", "--continuity-share",
-                 "ORB, guided matching: accept a comparison chance refuses when this share of its matches move as the "
-                 "previous frame's heading against the key image predicts (0 = never)"},
-                continuity_share);
-  visitor.Visit({"continuity_heading_confidence", "--continuity-heading-confidence",
-                 "The continuity rule: the least share of the first comparison's matches in its heading mode"},
-                continuity_heading_confidence);
-  visitor.Visit({"continuity_max_log10_nfa", "--continuity-max-log10-nfa",
-                 "The continuity rule: the first comparison's log10 NFA at most this"},
+  visitor.Visit(
+      OptionField{"continuity_share", "--continuity-share",
+                  "ORB, guided matching: accept a comparison chance refuses when this share of its matches move as the "
+                  "previous frame's heading against the key image predicts (0 = never)"}
+          .Within(0, 1)
+          .Meaning("0: never"),
+      continuity_share);
+  visitor.Visit(
+      OptionField{"continuity_heading_confidence", "--continuity-heading-confidence",
+                  "The continuity rule: the least share of the first comparison's matches in its heading mode"}
+          .Within(0, 1),
+      continuity_heading_confidence);
+  visitor.Visit(OptionField{"continuity_max_log10_nfa", "--continuity-max-log10-nfa",
+                            "The continuity rule: the first comparison's log10 NFA at most this"}
+                    .Within(-1000, 1000),
                 continuity_max_log10_nfa);
   visitor.Visit({"window_matching", "!--no-window-matching",
                  "ORB, guided matching: never match a frame again within a window around the previous frame's heading"},
                 window_matching);
-  visitor.Visit({"window_width", "--window-width",
-                 "ORB, guided matching: the window of matching by the prediction, a share of the image's width"},
-                window_width);
-  visitor.Visit({"window_zoom", "--window-zoom",
-                 "ORB, matching by the prediction: the window grows by this share of a feature's distance from the "
-                 "image's centre"},
-                window_zoom);
-  visitor.Visit({"window_fast_threshold", "--window-fast-threshold",
-                 "ORB, matching by the prediction: the frame's FAST threshold for it (0 = the map's features)"},
-                window_fast_threshold);
-  visitor.Visit({"window_features", "--window-features",
-                 "ORB, matching by the prediction: the frame's features for it (0 = the map's number)"},
+  visitor.Visit(
+      OptionField{"window_width", "--window-width",
+                  "ORB, guided matching: the window of matching by the prediction, a share of the image's width"}
+          .Within(0, 1)
+          .ExcludingMin(),
+      window_width);
+  visitor.Visit(
+      OptionField{"window_zoom", "--window-zoom",
+                  "ORB, matching by the prediction: the window grows by this share of a feature's distance from the "
+                  "image's centre"}
+          .Within(0, 10),
+      window_zoom);
+  visitor.Visit(
+      OptionField{"window_fast_threshold", "--window-fast-threshold",
+                  "ORB, matching by the prediction: the frame's FAST threshold for it (0 = the map's features)"}
+          .Within(0, 255)
+          .Meaning("0: the map's"),
+      window_fast_threshold);
+  visitor.Visit(OptionField{"window_features", "--window-features",
+                            "ORB, matching by the prediction: the frame's features for it (0 = the map's number)"}
+                    .Within(0, 100000)
+                    .Meaning("0: the map's"),
                 window_features);
-  visitor.Visit({"window_max_log10_nfa", "--window-max-log10-nfa",
-                 "ORB, matching by the prediction: accept when the window's matches' log10 NFA is at most this"},
-                window_max_log10_nfa);
+  visitor.Visit(
+      OptionField{"window_max_log10_nfa", "--window-max-log10-nfa",
+                  "ORB, matching by the prediction: accept when the window's matches' log10 NFA is at most this"}
+          .Within(-1000, 1000),
+      window_max_log10_nfa);
   visitor.VisitNested("ranking", ranking);
   visitor.VisitNested("belief", belief);
   visitor.VisitNested("heading", heading);
   visitor.VisitNested("verifier", verifier, Nesting{false, {"max_samples_to_reject"}});
-  visitor.Visit({"verifier_seed", "--verifier-seed",
-                 "The seed of the verifier's sampling in the frames' comparisons (-1 = the map's verifier's)"},
-                verifier_seed);
+  visitor.Visit(
+      OptionField{"verifier_seed", "--verifier-seed",
+                  "The seed of the verifier's sampling in the frames' comparisons (-1 = the map's verifier's)"}
+          .AtLeast(-1)
+          .Meaning("-1: the map's"),
+      verifier_seed);
   visitor.VisitNested("translation", translation);
   visitor.Visit({"similarity"}, EnumField(similarity, kSimilarityModeNames, ParseSimilarityMode));
   visitor.Visit({"route"}, route);
   visitor.Visit(OptionField{"comparison_threads", "--comparison-threads",
                             "Threads comparing a frame with key images (1: one comparison after another); the "
                             "results do not depend on it"}
-                    .NotRecorded(),
+                    .NotRecorded()
+                    .Within(1, 64),
                 comparison_threads);
 }
 
 void LocalizerOptions::Check() const {
-  const LocalizerOptions defaults;  // the defaults the messages give, as declared
-  if (min_verified < 8 || min_verified > 100000) {
-    throw OptionError("min_verified", fmt::format("{} must be 8 (the fewest matches F can be verified with) to "
-                                                  "100000 (default {})",
-                                                  min_verified, defaults.min_verified));
-  }
-  if (!(min_similarity >= 0.0 && min_similarity <= 1.0)) {
-    throw OptionError("min_similarity",
-                      fmt::format("{} is outside [0, 1] (default {})", min_similarity, defaults.min_similarity));
-  }
-  if (!(max_log10_nfa >= -1000.0 && max_log10_nfa <= 1000.0)) {
-    throw OptionError("max_log10_nfa", fmt::format("{} is outside [-1000, 1000] (default {}; 0: accept what "
-                                                   "chance explains less than once)",
-                                                   max_log10_nfa, defaults.max_log10_nfa));
-  }
-  if (!(step_back_max_log10_nfa >= -1000.0 && step_back_max_log10_nfa <= 1000.0)) {
-    throw OptionError("step_back_max_log10_nfa",
-                      fmt::format("{} is outside [-1000, 1000] (default {})", step_back_max_log10_nfa,
-                                  defaults.step_back_max_log10_nfa));
-  }
-  if (!(recheck_link_share >= 0.0 && recheck_link_share <= 10.0)) {
-    throw OptionError("recheck_link_share",
-                      fmt::format("{} is outside [0, 10] (default {}; 0: never relocalize a tracked frame)",
-                                  recheck_link_share, defaults.recheck_link_share));
-  }
-  if (!(min_link_share >= 0.0 && min_link_share <= 10.0)) {
-    throw OptionError("min_link_share", fmt::format("{} is outside [0, 10] (default {}; 0: chance alone decides)",
-                                                    min_link_share, defaults.min_link_share));
-  }
-  if (!(min_rival_ratio == 0.0 || (min_rival_ratio >= 1.0 && min_rival_ratio <= 1000.0))) {
-    throw OptionError("min_rival_ratio", fmt::format("{} is not 0 (never) nor in [1, 1000] (default {})",
-                                                     min_rival_ratio, defaults.min_rival_ratio));
-  }
-  if (!(rival_max_log10_nfa >= -1000.0 && rival_max_log10_nfa <= 0.0)) {
-    throw OptionError("rival_max_log10_nfa", fmt::format("{} is outside [-1000, 0] (default {})", rival_max_log10_nfa,
-                                                         defaults.rival_max_log10_nfa));
-  }
-  if (!(min_heading_rival_ratio == 0.0 || (min_heading_rival_ratio >= 1.0 && min_heading_rival_ratio <= 1000.0))) {
-    throw OptionError("min_heading_rival_ratio",
-                      fmt::format("{} is not 0 (never) nor in [1, 1000] (default {})", min_heading_rival_ratio,
-                                  defaults.min_heading_rival_ratio));
-  }
-  if (!(lost_frame_heading_rival_ratio == 0.0 ||
-        (lost_frame_heading_rival_ratio >= 1.0 && lost_frame_heading_rival_ratio <= 1000.0))) {
-    throw OptionError("lost_frame_heading_rival_ratio",
-                      fmt::format("{} is not 0 (never) nor in [1, 1000] (default {})", lost_frame_heading_rival_ratio,
-                                  defaults.lost_frame_heading_rival_ratio));
-  }
-  if (!(lost_frame_heading_near_ratio == 0.0 ||
-        (lost_frame_heading_near_ratio >= 1.0 && lost_frame_heading_near_ratio <= 1000.0))) {
-    throw OptionError("lost_frame_heading_near_ratio",
-                      fmt::format("{} is not 0 (none) nor in [1, 1000] (default {})", lost_frame_heading_near_ratio,
-                                  defaults.lost_frame_heading_near_ratio));
-  }
-  if (!(lost_frame_next_heading_ratio == 0.0 ||
-        (lost_frame_next_heading_ratio >= 1.0 && lost_frame_next_heading_ratio <= 1000.0))) {
-    throw OptionError("lost_frame_next_heading_ratio",
-                      fmt::format("{} is not 0 (none) nor in [1, 1000] (default {})", lost_frame_next_heading_ratio,
-                                  defaults.lost_frame_next_heading_ratio));
-  }
-  if (!(scene_change_log10_nfa >= -1000.0 && scene_change_log10_nfa <= 0.0)) {
-    throw OptionError("scene_change_log10_nfa", fmt::format("{} is outside [-1000, 0] (default {})",
-                                                            scene_change_log10_nfa, defaults.scene_change_log10_nfa));
-  }
-  if (!(scene_change_tracked_log10_nfa >= -1000.0 && scene_change_tracked_log10_nfa <= 0.0)) {
-    throw OptionError("scene_change_tracked_log10_nfa",
-                      fmt::format("{} is outside [-1000, 0] (default {})", scene_change_tracked_log10_nfa,
-                                  defaults.scene_change_tracked_log10_nfa));
-  }
-  if (!(still_frame_share >= 0.0 && still_frame_share <= 1.0)) {
-    throw OptionError("still_frame_share",
-                      fmt::format("{} is outside [0, 1] (default {})", still_frame_share, defaults.still_frame_share));
-  }
-  if (!(min_heading_votes >= 3 && min_heading_votes <= 100000)) {
-    throw OptionError("min_heading_votes", fmt::format("{} is outside [3, 100000] (default {})", min_heading_votes,
-                                                       defaults.min_heading_votes));
-  }
-  if (!(continuity_share >= 0.0 && continuity_share <= 1.0)) {
-    throw OptionError("continuity_share", fmt::format("{} is outside [0, 1] (default {}; 0: never)", continuity_share,
-                                                      defaults.continuity_share));
-  }
-  if (!(continuity_heading_confidence >= 0.0 && continuity_heading_confidence <= 1.0)) {
-    throw OptionError("continuity_heading_confidence",
-                      fmt::format("{} is outside [0, 1] (default {})", continuity_heading_confidence,
-                                  defaults.continuity_heading_confidence));
-  }
-  if (!(window_width > 0.0 && window_width <= 1.0)) {
-    throw OptionError("window_width",
-                      fmt::format("{} is outside (0, 1] (default {})", window_width, defaults.window_width));
-  }
-  if (!(window_zoom >= 0.0 && window_zoom <= 10.0)) {
-    throw OptionError("window_zoom",
-                      fmt::format("{} is outside [0, 10] (default {})", window_zoom, defaults.window_zoom));
-  }
-  if (window_fast_threshold < 0 || window_fast_threshold > 255) {
-    throw OptionError("window_fast_threshold", fmt::format("{} is outside [0, 255] (default {}; 0: the map's)",
-                                                           window_fast_threshold, defaults.window_fast_threshold));
-  }
-  if (window_features < 0 || window_features > 100000) {
-    throw OptionError("window_features", fmt::format("{} is outside [0, 100000] (default {}; 0: the map's)",
-                                                     window_features, defaults.window_features));
-  }
-  if (!(window_max_log10_nfa >= -1000.0 && window_max_log10_nfa <= 1000.0)) {
-    throw OptionError("window_max_log10_nfa", fmt::format("{} is outside [-1000, 1000] (default {})",
-                                                          window_max_log10_nfa, defaults.window_max_log10_nfa));
-  }
-  if (!(continuity_max_log10_nfa >= -1000.0 && continuity_max_log10_nfa <= 1000.0)) {
-    throw OptionError("continuity_max_log10_nfa",
-                      fmt::format("{} is outside [-1000, 1000] (default {})", continuity_max_log10_nfa,
-                                  defaults.continuity_max_log10_nfa));
-  }
-  if (stalled_tracker_frames < 0 || stalled_tracker_frames > 1000) {
-    throw OptionError("stalled_tracker_frames", fmt::format("{} is outside [0, 1000] (default {}; 0: never)",
-                                                            stalled_tracker_frames, defaults.stalled_tracker_frames));
-  }
-  if (unsettled_stalled_tracker_frames < 0 || unsettled_stalled_tracker_frames > 1000) {
-    throw OptionError("unsettled_stalled_tracker_frames",
-                      fmt::format("{} is outside [0, 1000] (default {}; 0: as stalled_tracker_frames)",
-                                  unsettled_stalled_tracker_frames, defaults.unsettled_stalled_tracker_frames));
-  }
-  if (!(look_past_max_log10_nfa >= -1000.0 && look_past_max_log10_nfa <= 0.0)) {
-    throw OptionError("look_past_max_log10_nfa",
-                      fmt::format("{} is outside [-1000, 0] (default {})", look_past_max_log10_nfa,
-                                  defaults.look_past_max_log10_nfa));
-  }
-  if (!(start_away_min_confidence >= 0.0 && start_away_min_confidence <= 1.0)) {
-    throw OptionError("start_away_min_confidence",
-                      fmt::format("{} is outside [0, 1] (default {})", start_away_min_confidence,
-                                  defaults.start_away_min_confidence));
-  }
-  if (!(step_on_to_last_log10_nfa_lead >= 0.0 && step_on_to_last_log10_nfa_lead <= 1000.0)) {
-    throw OptionError("step_on_to_last_log10_nfa_lead",
-                      fmt::format("{} is outside [0, 1000] (default {})", step_on_to_last_log10_nfa_lead,
-                                  defaults.step_on_to_last_log10_nfa_lead));
-  }
-  if (lookahead < 1 || lookahead > 2) {
-    throw OptionError("lookahead", fmt::format("{} is not 1 or 2 (default {})", lookahead, defaults.lookahead));
-  }
-  if (start_key < -1) {
-    throw OptionError("start_key", fmt::format("{} is not -1 (anywhere) nor a key image (default {})", start_key,
-                                               defaults.start_key));
-  }
-  if (!(start_mass >= 0.0 && start_mass < 1.0)) {
-    throw OptionError("start_mass", fmt::format("{} is outside [0, 1) (default {}; 1 would trap a run started "
-                                                "elsewhere)",
-                                                start_mass, defaults.start_mass));
-  }
-  if (max_lost_frames < 0 || max_lost_frames > 1000000) {
-    throw OptionError("max_lost_frames",
-                      fmt::format("{} must be 0 to 1000000 (default {})", max_lost_frames, defaults.max_lost_frames));
-  }
-  if (relocalization_candidates < 1 || relocalization_candidates > 10000) {
-    throw OptionError("relocalization_candidates",
-                      fmt::format("{} must be 1 to 10000 (default {})", relocalization_candidates,
-                                  defaults.relocalization_candidates));
-  }
-  if (relocalization_likelier_reach < 0 || relocalization_likelier_reach > 1000000) {
-    throw OptionError("relocalization_likelier_reach",
-                      fmt::format("{} must be 0 to 1000000 (default {})", relocalization_likelier_reach,
-                                  defaults.relocalization_likelier_reach));
-  }
+  CheckFieldRanges(*this);
   CheckField("ranking", ranking);
   CheckField("belief", belief);
   CheckField("verifier", verifier);
-  if (verifier_seed < -1) {
-    throw OptionError("verifier_seed", fmt::format("{} is neither -1 (the map's) nor a seed >= 0 (default {})",
-                                                   verifier_seed, defaults.verifier_seed));
-  }
   CheckField("heading", heading);
   CheckField("translation", translation);
-  if (lost_frame_features < 0 || lost_frame_features > 100000) {
-    throw OptionError("lost_frame_features", fmt::format("{} must be 0 to 100000 (default {})", lost_frame_features,
-                                                         defaults.lost_frame_features));
-  }
-  if (far_comparison_iterations < 0 || far_comparison_iterations > 10000000) {
-    throw OptionError("far_comparison_iterations",
-                      fmt::format("{} must be 0 to 10000000 (default {})", far_comparison_iterations,
-                                  defaults.far_comparison_iterations));
-  }
-  if (comparison_threads < 1 || comparison_threads > 64) {
-    throw OptionError("comparison_threads",
-                      fmt::format("{} must be 1 to 64 (default {})", comparison_threads, defaults.comparison_threads));
-  }
-  if (experience_candidates < 0 || experience_candidates > 1000) {
-    throw OptionError("experience_candidates", fmt::format("{} must be 0 (teach key images only) to 1000 (default {})",
-                                                           experience_candidates, defaults.experience_candidates));
-  }
 }
 
 }  // namespace vmap

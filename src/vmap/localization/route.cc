@@ -6,23 +6,19 @@
 #include <fmt/format.h>
 
 #include "vmap/core/error.h"
+#include "vmap/core/option_ranges.h"
 
 namespace vmap {
 
 void RouteOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Visit(
-      {"min_backward_verified", "--min-backward-verified", "Verified matches a link needs to be followed backwards"},
-      min_backward_verified);
+  visitor.Visit(OptionField{"min_backward_verified", "--min-backward-verified",
+                            "Verified matches a link needs to be followed backwards"}
+                    .Within(8, 100000)
+                    .Meaning("8: the fewest matches F can be verified with"),
+                min_backward_verified);
 }
 
-void RouteOptions::Check() const {
-  const RouteOptions defaults;  // the defaults the messages give, as declared
-  if (min_backward_verified < 8 || min_backward_verified > 100000) {
-    throw OptionError("min_backward_verified",
-                      fmt::format("{} must be 8 (the fewest matches F can be verified with) to 100000 (default {})",
-                                  min_backward_verified, defaults.min_backward_verified));
-  }
-}
+void RouteOptions::Check() const { CheckFieldRanges(*this); }
 
 Route PlanRoute(const VisualMap& map, int from, int to, const RouteOptions& options) {
   options.Check();

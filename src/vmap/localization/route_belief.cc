@@ -4,51 +4,41 @@
 #include <cmath>
 #include <numeric>
 
-#include <fmt/format.h>
-
 #include "vmap/core/error.h"
+#include "vmap/core/option_ranges.h"
 
 namespace vmap {
 
 void RouteBeliefOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Visit({"min_confidence", "--min-confidence",
-                 "A frame is uncertain (not to steer by) when the belief over the route holds less than this near "
-                 "its key image (0: never)"},
-                min_confidence);
-  visitor.Visit({"window", "--belief-window",
-                 "When the belief doubts the key image, compare key images this many places around the belief's "
-                 "peak and move there when it is singled out (0: the belief never moves the estimate)"},
-                window);
+  visitor.Visit(
+      OptionField{"min_confidence", "--min-confidence",
+                  "A frame is uncertain (not to steer by) when the belief over the route holds less than this near "
+                  "its key image (0: never)"}
+          .Within(0, 1)
+          .Meaning("0: never uncertain"),
+      min_confidence);
+  visitor.Visit(
+      OptionField{"window", "--belief-window",
+                  "When the belief doubts the key image, compare key images this many places around the belief's "
+                  "peak and move there when it is singled out (0: the belief never moves the estimate)"}
+          .Within(0, 50)
+          .Meaning("0: the belief never moves the estimate"),
+      window);
   visitor.Visit(
       {"move_needs_two_frames", "!--belief-moves-on-one-frame",
        "Move the estimate to the belief's peak when the belief singles it out on one frame (not two running)"},
       move_needs_two_frames);
-  visitor.Visit({"stay"}, stay);
-  visitor.Visit({"forward"}, forward);
-  visitor.Visit({"forward2"}, forward2);
-  visitor.Visit({"back"}, back);
-  visitor.Visit({"jump"}, jump);
+  // The motion model's probabilities.
+  visitor.Visit(OptionField{"stay"}.Within(0, 1), stay);
+  visitor.Visit(OptionField{"forward"}.Within(0, 1), forward);
+  visitor.Visit(OptionField{"forward2"}.Within(0, 1), forward2);
+  visitor.Visit(OptionField{"back"}.Within(0, 1), back);
+  visitor.Visit(OptionField{"jump"}.Within(0, 1).ExcludingMin().Meaning(
+                    "above 0: a belief that cannot jump can be stuck for ever"),
+                jump);
 }
 
-void RouteBeliefOptions::Check() const {
-  const RouteBeliefOptions defaults;  // the defaults the messages give, as declared
-  const std::pair<const char*, double> steps[] = {
-      {"stay", stay}, {"forward", forward}, {"forward2", forward2}, {"back", back}, {"jump", jump}};
-  for (const auto& [name, value] : steps) {
-    if (!(value >= 0.0 && value <= 1.0)) {
-      throw OptionError(name, fmt::format("{} is outside [0, 1] (a probability of the motion model)", value));
-    }
-  }
-  if (!(jump > 0.0)) throw OptionError("jump", "must be above 0: a belief that cannot jump can be stuck for ever");
-  if (window < 0 || window > 50) {
-    throw OptionError("window",
-                      fmt::format("{} is outside [0, 50] (default 2; 0: the belief never moves the estimate)", window));
-  }
-  if (!(min_confidence >= 0.0 && min_confidence <= 1.0)) {
-    throw OptionError("min_confidence",
-                      fmt::format("{} is outside [0, 1] (default 0.5; 0: never uncertain)", min_confidence));
-  }
-}
+void RouteBeliefOptions::Check() const { CheckFieldRanges(*this); }
 
 RouteBelief::RouteBelief(int positions, const RouteBeliefOptions& options) : options_(options) {
   options_.Check();

@@ -10,6 +10,7 @@
 #include "vmap/core/error.h"
 #include "vmap/core/json_fields.h"
 #include "vmap/core/numeric.h"
+#include "vmap/core/option_ranges.h"
 
 namespace vmap {
 
@@ -20,15 +21,11 @@ SimilarityMode ParseSimilarityMode(const std::string& name) {
 std::string SimilarityModeName(SimilarityMode mode) { return EnumToName(kSimilarityModeNames, mode); }
 
 void KeyImageOptions::Check() const {
-  const KeyImageOptions defaults;  // the defaults the messages give, as declared
+  // tau's default is the matcher's (BuildOptions), so its message gives the paper's values instead.
   if (!(tau > 0.0 && tau <= 1.0)) {
     throw OptionError("tau", fmt::format("{} is outside (0, 1]; the paper uses 0.1 to 0.9", tau));
   }
-  if (!(min_key_displacement >= 0.0 && min_key_displacement <= 100.0)) {
-    throw OptionError("min_key_displacement",
-                      fmt::format("{} px is outside [0, 100]; the default is {}, 0 turns the check off",
-                                  min_key_displacement, defaults.min_key_displacement));
-  }
+  CheckFieldRanges(*this);
 }
 
 PairComparison ComparePair(const Matcher& matcher, const ImageFeatures& features0, const ImageFeatures& features1,
@@ -224,10 +221,14 @@ void KeyImageOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "S = verified / tentative matches (inlier-ratio) or / features detected (feature-ratio)"},
                 EnumField(similarity, kSimilarityModeNames, ParseSimilarityMode));
   visitor.Visit({"final_key", "!--no-final-key", "Do not make the last frame a key image"}, final_key);
-  visitor.Visit({"min_key_displacement", "--min-key-displacement",
-                 "Pixels: a frame whose matches with the key image moved less (median) repeats its view and is "
-                 "never made a key image; 0 = off (Algorithm 1 as published)"},
-                min_key_displacement);
+  visitor.Visit(
+      OptionField{"min_key_displacement", "--min-key-displacement",
+                  "Pixels: a frame whose matches with the key image moved less (median) repeats its view and is "
+                  "never made a key image; 0 = off (Algorithm 1 as published)"}
+          .Within(0, 100)
+          .Unit("px")
+          .Meaning("0 turns the check off"),
+      min_key_displacement);
 }
 
 }  // namespace vmap

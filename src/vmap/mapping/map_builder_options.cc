@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <thread>
 
-#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/error.h"
 #include "vmap/core/json_fields.h"
+#include "vmap/core/option_ranges.h"
 
 namespace vmap {
 
@@ -20,21 +20,14 @@ KeySearch ResolveKeySearch(const MapBuilderOptions& options) {
 }
 
 void MapBuilderOptions::Check() const {
-  const MapBuilderOptions defaults;  // the defaults the messages give, as declared
+  CheckFieldRanges(*this);
   CheckField("key_images", key_images);
   CheckField("verifier", verifier);
   CheckField("link_analysis", link_analysis);
   if (prefetch_frames < 1 || prefetch_frames > 1024) throw OptionError("prefetch_frames", "must be 1 to 1024");
-  if (extraction_threads < 0 || extraction_threads > kMaxExtractionThreads) {
-    throw OptionError("extraction_threads",
-                      "must be 0 to " + std::to_string(kMaxExtractionThreads) + " (0 = one per core)");
-  }
   if (exhaustive && key_search == KeySearch::kBisect) {
     throw OptionError("exhaustive", "is the paper's frame-by-frame scan and key_search bisect skips frames; drop one",
                       {"key_search"});
-  }
-  if (search_window < 2 || search_window > 4096) {
-    throw OptionError("search_window", fmt::format("must be 2 to 4096 frames (default {})", defaults.search_window));
   }
 }
 
@@ -56,7 +49,9 @@ void MapBuilderOptions::VisitFields(OptionFieldVisitor& visitor) {
                 EnumField(quality_mean, kQualityMeanNames, ParseQualityMean));
   visitor.Visit(
       OptionField{"extraction_threads", "--threads", "Feature-extraction threads, 0 to 256 (0 = one per core)"}
-          .NotRecorded(),
+          .NotRecorded()
+          .Within(0, kMaxExtractionThreads)
+          .Meaning("0: one per core"),
       extraction_threads);
   visitor.VisitNested("link_analysis", link_analysis, at_top_level);
   visitor.VisitNested("verifier", verifier);
@@ -70,8 +65,11 @@ void MapBuilderOptions::VisitFields(OptionFieldVisitor& visitor) {
                             "distance) or auto (sequential; docs/measurements/deep-matchers.md)"}
                     .Named("key_search"),
                 EnumField(key_search, kKeySearchNames, ParseKeySearch));
-  visitor.Visit({"search_window", "--search-window", "bisect: frames compared ahead at most (held in memory)"},
-                search_window);
+  visitor.Visit(
+      OptionField{"search_window", "--search-window", "bisect: frames compared ahead at most (held in memory)"}
+          .Within(2, 4096)
+          .Unit("frames"),
+      search_window);
 }
 
 }  // namespace vmap

@@ -220,7 +220,7 @@ TEST(MapBuilder, OptionChecksNameTheirFields) {
   try {
     options.Check();
   } catch (const OptionError& error) {
-    EXPECT_STREQ(error.what(), "extraction_threads must be 0 to 256 (0 = one per core)");
+    EXPECT_STREQ(error.what(), "extraction_threads 999 is outside [0, 256] (default 0; 0: one per core)");
   }
   options = MapBuilderOptions();
   options.key_images.tau = 0.0;

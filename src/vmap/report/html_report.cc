@@ -3,11 +3,11 @@
 #include <optional>
 #include <sstream>
 
-#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
+#include "vmap/core/option_ranges.h"
 #include "vmap/map/map_io.h"
 #include "vmap/mapping/recorded_options.h"
 #include "vmap/report/html_page.h"
@@ -63,36 +63,20 @@ cv::Mat DrawMapLink(const fs::path& map_directory, const VisualMap& map, int lin
 }
 
 void MapReportOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Visit({"thumbnail_width", "--thumbnail-width", "Width of the key-image thumbnails in pixels"},
+  visitor.Visit(OptionField{"thumbnail_width", "--thumbnail-width", "Width of the key-image thumbnails in pixels"}
+                    .Within(32, 4096)
+                    .Unit("px"),
                 thumbnail_width);
-  visitor.Visit({"figure_width", "--figure-width", "Width of the match figures in pixels"}, figure_width);
-  visitor.Visit({"jpeg_quality"}, jpeg_quality);
+  visitor.Visit(
+      OptionField{"figure_width", "--figure-width", "Width of the match figures in pixels"}.Within(64, 8192).Unit("px"),
+      figure_width);
+  visitor.Visit(OptionField{"jpeg_quality"}.Within(1, 100), jpeg_quality);
   visitor.Visit({"route_video", "!--no-video", "Skip report/route.mp4, the video of the key images in order"},
                 route_video);
-  visitor.Visit({"route_fps"}, route_fps);
+  visitor.Visit(OptionField{"route_fps"}.Within(0, 120).ExcludingMin().Meaning("key images per second"), route_fps);
 }
 
-void MapReportOptions::Check() const {
-  const MapReportOptions defaults;  // the defaults the messages give, as declared
-  if (thumbnail_width < 32 || thumbnail_width > 4096) {
-    throw OptionError("thumbnail_width", fmt::format("is {}; use 32 to 4096 pixels (default {})", thumbnail_width,
-                                                     defaults.thumbnail_width));
-  }
-  if (figure_width < 64 || figure_width > 8192) {
-    throw OptionError("figure_width",
-                      fmt::format("is {}; use 64 to 8192 pixels (default {})", figure_width, defaults.figure_width));
-  }
-  if (jpeg_quality < 1 || jpeg_quality > 100) {
-    throw OptionError("jpeg_quality",
-                      fmt::format("is {}; use 1 to 100 (default {})", jpeg_quality, defaults.jpeg_quality));
-  }
-  if (!(route_fps > 0.0 && route_fps <= 120.0)) {
-    throw OptionError(
-        "route_fps",
-        "is " + FormatExact(route_fps) +
-            fmt::format("; use more than 0 and at most 120 key images per second (default {})", defaults.route_fps));
-  }
-}
+void MapReportOptions::Check() const { CheckFieldRanges(*this); }
 
 namespace {
 

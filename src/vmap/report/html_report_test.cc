@@ -183,11 +183,11 @@ TEST(MapReportTest, BadOptionsNameTheFieldAndWriteNothing) {
   report_test::WriteSyntheticMap(dir);
   const std::set<std::string> before = Listing(dir);
   const std::vector<std::pair<std::string, std::function<void(MapReportOptions&)>>> cases = {
-      {"thumbnail_width is 31", [](MapReportOptions& o) { o.thumbnail_width = 31; }},
-      {"figure_width is 8193", [](MapReportOptions& o) { o.figure_width = 8193; }},
-      {"jpeg_quality is 0", [](MapReportOptions& o) { o.jpeg_quality = 0; }},
-      {"route_fps is 0", [](MapReportOptions& o) { o.route_fps = 0.0; }},
-      {"route_fps is nan", [](MapReportOptions& o) { o.route_fps = std::nan(""); }},
+      {"thumbnail_width 31 px is outside [32, 4096]", [](MapReportOptions& o) { o.thumbnail_width = 31; }},
+      {"figure_width 8193 px is outside [64, 8192]", [](MapReportOptions& o) { o.figure_width = 8193; }},
+      {"jpeg_quality 0 is outside [1, 100]", [](MapReportOptions& o) { o.jpeg_quality = 0; }},
+      {"route_fps 0 is outside (0, 120]", [](MapReportOptions& o) { o.route_fps = 0.0; }},
+      {"route_fps nan is outside (0, 120]", [](MapReportOptions& o) { o.route_fps = std::nan(""); }},
   };
   EXPECT_NO_THROW(MapReportOptions{}.Check());
   for (const auto& [message, spoil] : cases) {

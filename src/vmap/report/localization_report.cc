@@ -11,6 +11,7 @@
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/option_ranges.h"
 #include "vmap/map/map_io.h"
 #include "vmap/report/belief_plot.h"
 #include "vmap/report/html_page.h"
@@ -209,25 +210,12 @@ std::string SimilarityPlot(const LocalizationRun& run) {
 }  // namespace
 
 void LocalizationReportOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Visit({"pairs"}, pairs);
-  visitor.Visit({"pair_width"}, pair_width);
-  visitor.Visit({"jpeg_quality"}, jpeg_quality);
+  visitor.Visit(OptionField{"pairs"}.Within(0, 200), pairs);
+  visitor.Visit(OptionField{"pair_width"}.Within(64, 8192).Unit("px"), pair_width);
+  visitor.Visit(OptionField{"jpeg_quality"}.Within(1, 100), jpeg_quality);
 }
 
-void LocalizationReportOptions::Check() const {
-  const LocalizationReportOptions defaults;  // the defaults the messages give, as declared
-  if (pairs < 0 || pairs > 200) {
-    throw OptionError("pairs", fmt::format("is {}; use 0 to 200 (default {})", pairs, defaults.pairs));
-  }
-  if (pair_width < 64 || pair_width > 8192) {
-    throw OptionError("pair_width",
-                      fmt::format("is {}; use 64 to 8192 pixels (default {})", pair_width, defaults.pair_width));
-  }
-  if (jpeg_quality < 1 || jpeg_quality > 100) {
-    throw OptionError("jpeg_quality",
-                      fmt::format("is {}; use 1 to 100 (default {})", jpeg_quality, defaults.jpeg_quality));
-  }
-}
+void LocalizationReportOptions::Check() const { CheckFieldRanges(*this); }
 
 namespace {
 

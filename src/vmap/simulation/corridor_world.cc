@@ -10,6 +10,7 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/core/image_header.h"
+#include "vmap/core/option_ranges.h"
 #include "vmap/simulation/procedural_texture.h"
 #include "vmap/sources/frame_source.h"
 
@@ -86,18 +87,13 @@ struct CentreLine {
 }  // namespace
 
 void CorridorOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Visit({"width", "--corridor-width", "Corridor width between the walls (m)"}, width);
-  visitor.Visit({"wall_height", "--wall-height", "Wall height (m)"}, wall_height);
+  visitor.Visit(
+      OptionField{"width", "--corridor-width", "Corridor width between the walls (m)"}.Within(0.5, 50).Unit("m"),
+      width);
+  visitor.Visit(OptionField{"wall_height", "--wall-height", "Wall height (m)"}.Within(0.2, 50).Unit("m"), wall_height);
 }
 
-void CorridorOptions::Check() const {
-  if (!(width >= 0.5 && width <= 50.0)) {
-    throw OptionError("width", fmt::format("{} m is outside [0.5, 50]; the default is 3", width));
-  }
-  if (!(wall_height >= 0.2 && wall_height <= 50.0)) {
-    throw OptionError("wall_height", fmt::format("{} m is outside [0.2, 50]; the default is 2", wall_height));
-  }
-}
+void CorridorOptions::Check() const { CheckFieldRanges(*this); }
 
 std::vector<cv::Mat> ReadTextureFolder(const fs::path& directory, const std::string& what) {
   std::error_code ec;

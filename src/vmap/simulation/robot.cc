@@ -2,36 +2,33 @@
 
 #include <cmath>
 
-#include <fmt/format.h>
-
 #include "vmap/core/error.h"
+#include "vmap/core/option_ranges.h"
 
 namespace vmap {
 
 void CameraRigOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Visit({"width", "--camera-width", "Camera image width (pixels)"}, width);
-  visitor.Visit({"height", "--camera-height", "Camera image height (pixels)"}, height);
-  visitor.Visit({"horizontal_fov_deg", "--fov", "Camera horizontal field of view (degrees)"}, horizontal_fov_deg);
-  visitor.Visit({"mount_height", "--camera-mount-height", "Camera height above the floor (m)"}, mount_height);
-  visitor.Visit({"pitch_deg", "--camera-pitch", "Camera tilt, down positive (degrees)"}, pitch_deg);
+  visitor.Visit(OptionField{"width", "--camera-width", "Camera image width (pixels)"}.Within(64, 4096).Unit("px"),
+                width);
+  visitor.Visit(OptionField{"height", "--camera-height", "Camera image height (pixels)"}.Within(48, 4096).Unit("px"),
+                height);
+  visitor.Visit(
+      OptionField{"horizontal_fov_deg", "--fov", "Camera horizontal field of view (degrees)"}.Within(20, 150).Unit(
+          "degrees"),
+      horizontal_fov_deg);
+  visitor.Visit(OptionField{"mount_height", "--camera-mount-height", "Camera height above the floor (m)"}
+                    .Within(0, 10)
+                    .ExcludingMin()
+                    .Unit("m"),
+                mount_height);
+  visitor.Visit(OptionField{"pitch_deg", "--camera-pitch", "Camera tilt, down positive (degrees)"}.Within(-45, 45).Unit(
+                    "degrees"),
+                pitch_deg);
 }
 
 void CameraRigOptions::Check() const {
-  if (width < 64 || width > 4096)
-    throw OptionError("width", fmt::format("{} px is outside [64, 4096]; the default is 640", width));
-  if (height < 48 || height > 4096)
-    throw OptionError("height", fmt::format("{} px is outside [48, 4096]; the default is 480", height));
-  if (!(horizontal_fov_deg >= 20.0 && horizontal_fov_deg <= 150.0)) {
-    throw OptionError("horizontal_fov_deg",
-                      fmt::format("{} degrees is outside [20, 150]; the default is 70", horizontal_fov_deg));
-  }
-  if (!(pitch_deg >= -45.0 && pitch_deg <= 45.0)) {
-    throw OptionError("pitch_deg", fmt::format("{} degrees is outside [-45, 45]; the default is 0", pitch_deg));
-  }
-  // The mount height is checked against the walls by the simulation (SimulationOptions::Check).
-  if (!(mount_height > 0.0 && mount_height <= 10.0)) {
-    throw OptionError("mount_height", fmt::format("{} m is outside (0, 10]; the default is 0.5", mount_height));
-  }
+  // The mount height is checked against the walls too, by the simulation (SimulationOptions::Check).
+  CheckFieldRanges(*this);
 }
 
 cv::Matx33d CameraMatrix(const CameraRigOptions& options) {
@@ -57,30 +54,28 @@ PinholeView CameraView(const CameraRigOptions& options, const Pose2d& pose) {
 }
 
 void RobotNoiseOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Visit({"speed_noise", "--speed-noise", "Actuation: relative standard deviation of the executed speed"},
-                speed_noise);
-  visitor.Visit({"turn_noise", "--turn-noise", "Actuation: standard deviation of the executed turn rate (rad/s)"},
-                turn_noise);
-  visitor.Visit({"odometry_scale_error", "--odometry-scale-error",
-                 "Odometry measures distances this much too long (0.05 = 5 %; negative: too short)"},
+  visitor.Visit(
+      OptionField{"speed_noise", "--speed-noise", "Actuation: relative standard deviation of the executed speed"}
+          .Within(0, 1),
+      speed_noise);
+  visitor.Visit(
+      OptionField{"turn_noise", "--turn-noise", "Actuation: standard deviation of the executed turn rate (rad/s)"}
+          .Within(0, 1),
+      turn_noise);
+  visitor.Visit(OptionField{"odometry_scale_error", "--odometry-scale-error",
+                            "Odometry measures distances this much too long (0.05 = 5 %; negative: too short)"}
+                    .Within(-0.5, 0.5),
                 odometry_scale_error);
-  visitor.Visit({"odometry_noise", "--odometry-noise", "Odometry: relative standard deviation of each step's distance"},
-                odometry_noise);
-  visitor.Visit({"odometry_yaw_bias", "--odometry-yaw-bias", "Odometry: heading drift (rad/s)"}, odometry_yaw_bias);
+  visitor.Visit(
+      OptionField{"odometry_noise", "--odometry-noise", "Odometry: relative standard deviation of each step's distance"}
+          .Within(0, 1),
+      odometry_noise);
+  visitor.Visit(
+      OptionField{"odometry_yaw_bias", "--odometry-yaw-bias", "Odometry: heading drift (rad/s)"}.Within(-1, 1),
+      odometry_yaw_bias);
 }
 
-void RobotNoiseOptions::Check() const {
-  auto check = [](const char* field, double value, double low, double high, double fallback) {
-    if (!(value >= low && value <= high)) {
-      throw OptionError(field, fmt::format("{} is outside [{}, {}]; the default is {}", value, low, high, fallback));
-    }
-  };
-  check("speed_noise", speed_noise, 0.0, 1.0, 0.02);
-  check("turn_noise", turn_noise, 0.0, 1.0, 0.02);
-  check("odometry_scale_error", odometry_scale_error, -0.5, 0.5, 0.0);
-  check("odometry_noise", odometry_noise, 0.0, 1.0, 0.01);
-  check("odometry_yaw_bias", odometry_yaw_bias, -1.0, 1.0, 0.0);
-}
+void RobotNoiseOptions::Check() const { CheckFieldRanges(*this); }
 
 DifferentialDriveRobot::DifferentialDriveRobot(Pose2d pose, const RobotNoiseOptions& noise, unsigned seed)
     : pose_(pose), noise_(noise), rng_(seed) {

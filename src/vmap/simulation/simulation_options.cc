@@ -5,25 +5,43 @@
 #include <fmt/format.h>
 
 #include "vmap/core/error.h"
+#include "vmap/core/option_ranges.h"
 
 namespace vmap {
 
 void SimulationOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"route", "--route", "Route: straight, turn, s-curve, loop, or a CSV of x,y waypoints (m)"}, route);
-  visitor.Visit({"trials", "--trials", "Repeat runs from random offsets"}, trials);
-  visitor.Visit({"seed", "--seed", "Seed of the offsets and the noise"}, seed);
-  visitor.Visit({"max_lateral_offset", "--lateral-offset", "Largest sideways start offset (m; uniform in +-)"},
-                max_lateral_offset);
-  visitor.Visit({"max_heading_offset_deg", "--heading-offset", "Largest start heading offset (degrees; uniform in +-)"},
-                max_heading_offset_deg);
-  visitor.Visit({"teach_speed", "--teach-speed", "Speed of the teach run (m/s)"}, teach_speed);
-  visitor.Visit({"rate", "--rate", "Frames and control steps per second (Hz)"}, rate);
-  visitor.Visit({"goal_tolerance", "--goal-tolerance", "A trial succeeds when it stops this near the goal (m)"},
-                goal_tolerance);
-  visitor.Visit({"time_limit_factor", "--time-limit", "A trial ends after this many teach durations, plus 20 s"},
-                time_limit_factor);
-  visitor.Visit({"robot_radius", "--robot-radius", "Robot half width: nearer a wall than this is a crash (m)"},
-                robot_radius);
+  visitor.Visit(OptionField{"trials", "--trials", "Repeat runs from random offsets"}.Within(1, 100000), trials);
+  visitor.Visit(OptionField{"seed", "--seed", "Seed of the offsets and the noise"}.AtLeast(0), seed);
+  visitor.Visit(
+      OptionField{"max_lateral_offset", "--lateral-offset", "Largest sideways start offset (m; uniform in +-)"}
+          .Within(0, 50)
+          .Unit("m"),
+      max_lateral_offset);
+  visitor.Visit(
+      OptionField{"max_heading_offset_deg", "--heading-offset", "Largest start heading offset (degrees; uniform in +-)"}
+          .Within(0, 90)
+          .Unit("degrees"),
+      max_heading_offset_deg);
+  visitor.Visit(
+      OptionField{"teach_speed", "--teach-speed", "Speed of the teach run (m/s)"}.Within(0.01, 10).Unit("m/s"),
+      teach_speed);
+  visitor.Visit(OptionField{"rate", "--rate", "Frames and control steps per second (Hz)"}.Within(1, 100).Unit("Hz"),
+                rate);
+  visitor.Visit(
+      OptionField{"goal_tolerance", "--goal-tolerance", "A trial succeeds when it stops this near the goal (m)"}
+          .Within(0.01, 100)
+          .Unit("m"),
+      goal_tolerance);
+  visitor.Visit(
+      OptionField{"time_limit_factor", "--time-limit", "A trial ends after this many teach durations, plus 20 s"}
+          .Within(1, 100),
+      time_limit_factor);
+  visitor.Visit(
+      OptionField{"robot_radius", "--robot-radius", "Robot half width: nearer a wall than this is a crash (m)"}
+          .Within(0, 5)
+          .Unit("m"),
+      robot_radius);
   visitor.Visit({"teach_textures", "--teach-textures", "Folder of photographs on the teach world's walls and floor"},
                 teach_textures);
   visitor.Visit({"repeat_textures", "--repeat-textures",
@@ -31,7 +49,10 @@ void SimulationOptions::VisitFields(OptionFieldVisitor& visitor) {
                 repeat_textures);
   visitor.Visit({"use_odometry", "!--no-odometry", "Do not give the repeat run's odometry to the controller"},
                 use_odometry);
-  visitor.Visit(OptionField{"threads", "--threads", "Trials run at once (0 = one per core)"}.NotRecorded(), threads);
+  visitor.Visit(
+      OptionField{"threads", "--threads", "Trials run at once (0 = one per core)"}.NotRecorded().Within(0, 256).Meaning(
+          "0: one per core"),
+      threads);
   visitor.VisitNested("corridor", corridor, Nesting{true, {}});
   visitor.VisitNested("camera", camera);
   visitor.VisitNested("noise", noise, Nesting{true, {}});
@@ -41,24 +62,7 @@ void SimulationOptions::VisitFields(OptionFieldVisitor& visitor) {
 
 void SimulationOptions::Check() const {
   if (route.empty()) throw OptionError("route", "is empty; give straight, turn, s-curve, loop or a CSV file");
-  if (trials < 1 || trials > 100000)
-    throw OptionError("trials", fmt::format("{} is outside [1, 100000]; the default is 10", trials));
-  auto check = [](const char* field, double value, double low, double high, const char* unit, double fallback) {
-    if (!(value >= low && value <= high)) {
-      throw OptionError(field,
-                        fmt::format("{} {} is outside [{}, {}]; the default is {}", value, unit, low, high, fallback));
-    }
-  };
-  check("max_lateral_offset", max_lateral_offset, 0.0, 50.0, "m", 0.5);
-  check("max_heading_offset_deg", max_heading_offset_deg, 0.0, 90.0, "degrees", 10.0);
-  check("teach_speed", teach_speed, 0.01, 10.0, "m/s", 0.3);
-  check("rate", rate, 1.0, 100.0, "Hz", 10.0);
-  check("goal_tolerance", goal_tolerance, 0.01, 100.0, "m", 0.3);
-  check("time_limit_factor", time_limit_factor, 1.0, 100.0, "", 3.0);
-  check("robot_radius", robot_radius, 0.0, 5.0, "m", 0.15);
-  if (seed < 0) throw OptionError("seed", fmt::format("{} is negative; give 0 or more (the default is 1)", seed));
-  if (threads < 0 || threads > 256)
-    throw OptionError("threads", fmt::format("{} is outside [0, 256] (0 = one per core)", threads));
+  CheckFieldRanges(*this);
   CheckField("corridor", corridor);
   CheckField("camera", camera);
   CheckField("noise", noise);

@@ -4,7 +4,6 @@
 #include <cctype>
 #include <filesystem>
 
-#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -12,6 +11,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/core/json_fields.h"
+#include "vmap/core/option_ranges.h"
 #include "vmap/sources/dataset_camera.h"
 #include "vmap/sources/internal.h"
 
@@ -23,8 +23,7 @@ SourceFormat ParseSourceFormat(const std::string& name) { return ParseEnum(kSour
 std::string SourceFormatName(SourceFormat format) { return EnumToName(kSourceFormatNames, format); }
 
 void FrameSourceOptions::Check() const {
-  const FrameSourceOptions defaults;  // the defaults the messages give, as declared
-  if (first < 0) throw OptionError("first", "must be >= 0 (got " + std::to_string(first) + ")");
+  CheckFieldRanges(*this);
   if (last < -1) {
     throw OptionError("last", std::to_string(last) +
                                   " is not a frame; give a 0-based frame index, or -1 for the "
@@ -33,15 +32,10 @@ void FrameSourceOptions::Check() const {
   if (last >= 0 && last < first) {
     throw OptionError("last", std::to_string(last) + " is before first " + std::to_string(first), {"first"});
   }
-  if (stride < 1) throw OptionError("stride", "must be >= 1 (got " + std::to_string(stride) + ")");
   if (max_frame_pixels < static_cast<long>(kMinFrameSide) * kMinFrameSide) {
     throw OptionError("max_frame_pixels", "must be at least " + std::to_string(kMinFrameSide * kMinFrameSide));
   }
   if (!resize.empty()) internal::TargetSize(cv::Size(640, 480), *this);  // validates the text
-  if (!(stream_timeout_seconds > 0.0 && stream_timeout_seconds <= 3600.0)) {
-    throw OptionError("stream_timeout_seconds", fmt::format("must be more than 0 and at most 3600 seconds (default {})",
-                                                            defaults.stream_timeout_seconds));
-  }
 }
 
 namespace internal {
@@ -283,9 +277,9 @@ std::unique_ptr<FrameSource> OpenFrameSource(const std::string& path, const Fram
 void FrameSourceOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(OptionField{"format", "--format", "Input layout: "}.ListingNames(),
                 EnumField(format, kSourceFormatNames, ParseSourceFormat));
-  visitor.Visit({"first", "--first", "First frame (0-based)"}, first);
+  visitor.Visit(OptionField{"first", "--first", "First frame (0-based)"}.AtLeast(0), first);
   visitor.Visit({"last", "--last", "Last frame, inclusive (-1 = end)"}, last);
-  visitor.Visit({"stride", "--stride", "Use every N-th frame"}, stride);
+  visitor.Visit(OptionField{"stride", "--stride", "Use every N-th frame"}.AtLeast(1), stride);
   visitor.Visit(OptionField{"resize", "--resize", "Resize frames: WxH, or the longest side (e.g. 640)"}.HideDefault(),
                 resize);
   visitor.Visit({"strict", "--strict", "Frames of a different size are an error, not a warning"}, strict);
@@ -312,7 +306,10 @@ void FrameSourceOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(OptionField{"stream_timeout_seconds", "--stream-timeout",
                             "Live inputs: seconds without a frame after which the stream has ended (and the longest "
                             "opening it may take)"}
-                    .NotRecorded(),
+                    .NotRecorded()
+                    .Within(0, 3600)
+                    .ExcludingMin()
+                    .Unit("s"),
                 stream_timeout_seconds);
 }
 

@@ -198,11 +198,11 @@ TEST(FrameSourceOptions, EveryOptionHasARange) {
     std::string expected;
   };
   const std::vector<Case> cases = {
-      {[](FrameSourceOptions& o) { o.first = -1; }, "first must be >= 0"},
+      {[](FrameSourceOptions& o) { o.first = -1; }, "first -1 is less than 0"},
       {[](FrameSourceOptions& o) { o.last = -5; }, "last -5 is not a frame"},
       {[](FrameSourceOptions& o) { o.last = -2; }, "-1 for the end"},
       {[](FrameSourceOptions& o) { o.first = 10, o.last = 3; }, "last 3 is before first 10"},
-      {[](FrameSourceOptions& o) { o.stride = 0; }, "stride must be >= 1"},
+      {[](FrameSourceOptions& o) { o.stride = 0; }, "stride 0 is less than 1"},
       {[](FrameSourceOptions& o) { o.resize = "100000x100000"; }, "resize 100000x100000: each side must be 32"},
       {[](FrameSourceOptions& o) { o.resize = "16x16"; }, "each side must be 32 to 16384"},
       {[](FrameSourceOptions& o) { o.resize = "16000x16000"; }, "more than 67108864 pixels"},

@@ -220,10 +220,16 @@ TEST(AlikedMatcher, BadOptionsAndDevicesAreClearErrors) {
   EXPECT_EQ(ExpectInputError([&] { CreateAlikedMatcher(options); }).find("top_k must be >= 0"), 0u);
   options = Options("t16");
   options.min_similarity = 1.5;
-  EXPECT_EQ(ExpectInputError([&] { CreateAlikedMatcher(options); }).find("min_similarity must be"), 0u);
+  EXPECT_EQ(ExpectInputError([&] {
+              CreateAlikedMatcher(options);
+            }).find("min_similarity 1.5 is outside [-1, 1] (default 0.75; a cosine similarity)"),
+            0u);
   options = Options("t16");
   options.longest_side = 16;
-  EXPECT_EQ(ExpectInputError([&] { CreateAlikedMatcher(options); }).find("longest_side 16 is too small"), 0u);
+  EXPECT_EQ(ExpectInputError([&] {
+              CreateAlikedMatcher(options);
+            }).find("longest_side 16 is not 0 nor at least 32 (default 0; 0: native size)"),
+            0u);
   options = Options("t16");
   options.weights = SharedDir() + "/weights/aliked/aliked-n16.pt";  // the other model's file
   EXPECT_NE(ExpectInputError([&] { CreateAlikedMatcher(options); }).find("fits --aliked-model n16"), std::string::npos);

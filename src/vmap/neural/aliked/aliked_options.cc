@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "vmap/core/error.h"
+#include "vmap/core/option_ranges.h"
 
 namespace vmap {
 
@@ -23,19 +24,7 @@ void AlikedMatcherOptions::Check() const {
     throw OptionError("score_threshold", fmt::format("must be in [0, 1) (0 = the mean score, as upstream; default {})",
                                                      defaults.score_threshold));
   }
-  if (max_keypoints < 1)
-    throw OptionError("max_keypoints", fmt::format("must be >= 1 (default {})", defaults.max_keypoints));
-  if (!(min_similarity >= -1.0 && min_similarity <= 1.0)) {
-    throw OptionError("min_similarity",
-                      fmt::format("must be a cosine similarity in [-1, 1] (default {})", defaults.min_similarity));
-  }
-  if (longest_side != 0 && longest_side < 32) {
-    throw OptionError("longest_side",
-                      std::to_string(longest_side) + " is too small; use 0 (native size) or at least 32");
-  }
-  if (num_threads < 0)
-    throw OptionError("threads",
-                      fmt::format("must be >= 0 (0 = LibTorch's default; default {})", defaults.num_threads));
+  CheckFieldRanges(*this);
 }
 
 void AlikedMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
@@ -47,13 +36,23 @@ void AlikedMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(
       {"score_threshold", "--aliked-score-threshold", "ALIKED: keypoint score threshold when --aliked-top-k is 0"},
       score_threshold);
-  visitor.Visit({"max_keypoints", "--aliked-max-keypoints", "ALIKED: most keypoints when --aliked-top-k is 0"},
-                max_keypoints);
-  visitor.Visit({"min_similarity", "--aliked-min-similarity", "ALIKED: least cosine similarity of a match"},
+  visitor.Visit(
+      OptionField{"max_keypoints", "--aliked-max-keypoints", "ALIKED: most keypoints when --aliked-top-k is 0"}.AtLeast(
+          1),
+      max_keypoints);
+  visitor.Visit(OptionField{"min_similarity", "--aliked-min-similarity", "ALIKED: least cosine similarity of a match"}
+                    .Within(-1, 1)
+                    .Meaning("a cosine similarity"),
                 min_similarity);
-  visitor.Visit({"longest_side", "--aliked-size", "ALIKED: shrink images to this longest side first (0 = native size)"},
-                longest_side);
-  visitor.Visit({"threads", "--aliked-threads", "ALIKED: LibTorch threads per call (0 = LibTorch default)"},
+  visitor.Visit(
+      OptionField{"longest_side", "--aliked-size", "ALIKED: shrink images to this longest side first (0 = native size)"}
+          .AtLeast(32)
+          .Or(0)
+          .Meaning("0: native size"),
+      longest_side);
+  visitor.Visit(OptionField{"threads", "--aliked-threads", "ALIKED: LibTorch threads per call (0 = LibTorch default)"}
+                    .AtLeast(0)
+                    .Meaning("0: LibTorch's default"),
                 num_threads);
 }
 

@@ -194,13 +194,13 @@ TEST(XfeatMatcher, BadInputIsRefusedClearly) {
   XfeatMatcherOptions bad = SharedOptions();
   bad.top_k = 0;
   // Named by the JSON keys of the fields.
-  EXPECT_EQ(ExpectInputError([&] { bad.Check(); }).find("top_k 0 must be at least 1"), 0u);
+  EXPECT_EQ(ExpectInputError([&] { bad.Check(); }).find("top_k 0 is less than 1"), 0u);
   bad = SharedOptions();
   bad.min_similarity = 1.5;
-  EXPECT_EQ(ExpectInputError([&] { bad.Check(); }).find("min_similarity must be in [-1, 1)"), 0u);
+  EXPECT_EQ(ExpectInputError([&] { bad.Check(); }).find("min_similarity 1.5 is outside [-1, 1)"), 0u);
   bad = SharedOptions();
   bad.detection_threshold = -0.1;
-  EXPECT_EQ(ExpectInputError([&] { bad.Check(); }).find("detection_threshold must be in [0, 1)"), 0u);
+  EXPECT_EQ(ExpectInputError([&] { bad.Check(); }).find("detection_threshold -0.1 is outside [0, 1)"), 0u);
   bad = SharedOptions();
   bad.device = "tpu";
   EXPECT_EQ(ExpectInputError([&] { bad.Check(); }).find("device 'tpu' is not a device"), 0u);

@@ -1,6 +1,7 @@
 #include "vmap/neural/xfeat/xfeat_options.h"
 
 #include "vmap/core/error.h"
+#include "vmap/core/option_ranges.h"
 
 namespace vmap {
 
@@ -8,30 +9,29 @@ void XfeatMatcherOptions::Check() const {
   if (device != "cpu" && device != "cuda") {
     throw OptionError("device", "'" + device + "' is not a device; use cpu or cuda");
   }
-  if (top_k < 1) {
-    throw OptionError("top_k", std::to_string(top_k) + " must be at least 1 (upstream default 4096)");
-  }
-  if (!(detection_threshold >= 0.0 && detection_threshold < 1.0)) {
-    throw OptionError("detection_threshold", "must be in [0, 1) (a heatmap value; upstream 0.05)");
-  }
-  if (!(min_similarity >= -1.0 && min_similarity < 1.0)) {
-    throw OptionError("min_similarity",
-                      "must be in [-1, 1) (a cosine similarity; upstream 0.82, -1 keeps every "
-                      "mutual nearest neighbour)");
-  }
-  if (num_threads < 0) throw OptionError("threads", "must be >= 0 (0 = LibTorch's default)");
+  CheckFieldRanges(*this);
 }
 
 void XfeatMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"weights", "--weights", "Weights file of the deep matcher (see `vmap weights`)", false, true},
                 weights);
   visitor.Visit({"device", "--device", "Deep matchers' device: cpu or cuda"}, device);
-  visitor.Visit({"top_k", "--xfeat-top-k", "XFeat: keypoints kept per image, best first"}, top_k);
-  visitor.Visit({"detection_threshold", "--xfeat-threshold", "XFeat: keypoint heatmap threshold"}, detection_threshold);
-  visitor.Visit({"min_similarity", "--xfeat-min-similarity",
-                 "XFeat: mutual nearest neighbours need a cosine similarity above this (<= 0: no minimum)"},
+  visitor.Visit(OptionField{"top_k", "--xfeat-top-k", "XFeat: keypoints kept per image, best first"}.AtLeast(1), top_k);
+  visitor.Visit(OptionField{"detection_threshold", "--xfeat-threshold", "XFeat: keypoint heatmap threshold"}
+                    .Within(0, 1)
+                    .ExcludingMax()
+                    .Meaning("a heatmap value; upstream 0.05"),
+                detection_threshold);
+  visitor.Visit(OptionField{"min_similarity", "--xfeat-min-similarity",
+                            "XFeat: mutual nearest neighbours need a cosine similarity above this (<= 0: no minimum)"}
+                    .Within(-1, 1)
+                    .ExcludingMax()
+                    .Meaning("a cosine similarity; upstream 0.82, -1 keeps every mutual nearest neighbour"),
                 min_similarity);
-  visitor.Visit({"threads", "--xfeat-threads", "XFeat: LibTorch threads per call (0 = LibTorch default)"}, num_threads);
+  visitor.Visit(OptionField{"threads", "--xfeat-threads", "XFeat: LibTorch threads per call (0 = LibTorch default)"}
+                    .AtLeast(0)
+                    .Meaning("0: LibTorch's default"),
+                num_threads);
 }
 
 }  // namespace vmap
