@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "vmap/core/option_ranges.h"
+
 namespace vmap::cli {
 
 namespace {
@@ -103,7 +105,16 @@ void OptionBinder::Bind(CLI::App* command, OptionFlags& option_flags) const {
             using Value = std::remove_pointer_t<T>;
             std::vector<Value*> values;
             for (const Target& target : targets.values) values.push_back(std::get<T>(target));
-            return BindValues(command, flag, targets.field, values);
+            CLI::Option* option = BindValues(command, flag, targets.field, values);
+            if constexpr (std::is_same_v<Value, int> || std::is_same_v<Value, double>) {
+              // The values the field takes, after its type: "--lookahead INT in [1, 2]=2", "FLOAT 0 or [1, 1000]".
+              if (targets.field.range.is_set) {
+                const OptionRange& range = targets.field.range;
+                option->type_name(option->get_type_name() + (range.also ? " " : " in ") +
+                                  RangeText(range, std::is_same_v<Value, int>));
+              }
+            }
+            return option;
           }
         },
         targets.values.front());

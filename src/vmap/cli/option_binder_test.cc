@@ -18,8 +18,8 @@ struct Part {
   int budget = 100;
   std::string weights;
   void VisitFields(OptionFieldVisitor& visitor) {
-    visitor.Visit({"threshold", "--threshold", "Threshold"}, threshold);
-    visitor.Visit({"budget", "--budget", "Budget"}, budget);
+    visitor.Visit(OptionField{"threshold", "--threshold", "Threshold"}.Within(0, 1).ExcludingMin(), threshold);
+    visitor.Visit(OptionField{"budget", "--budget", "Budget"}.Within(1, 1000).Or(0), budget);
     visitor.Visit({"weights", "--weights", "Weights file"}, weights);
   }
 };
@@ -65,6 +65,10 @@ TEST(OptionBinder, BindsEachFlaggedFieldAndRecordsItsPath) {
   EXPECT_EQ(app.get_option("--shape")->get_description(), "Outline: round or square");
   EXPECT_EQ(app.get_option("--shape")->get_default_str(), "round");
   EXPECT_EQ(app.get_option("--budget")->get_default_str(), "100");
+  // ... and the values a number field takes, after its type.
+  EXPECT_EQ(app.get_option("--threshold")->get_type_name(), "FLOAT in (0, 1]");
+  EXPECT_EQ(app.get_option("--budget")->get_type_name(), "INT 0 or [1, 1000]");
+  EXPECT_EQ(app.get_option("--threads")->get_type_name(), "INT");
 }
 
 TEST(OptionBinder, AnUnknownEnumNameIsTheParsersError) {

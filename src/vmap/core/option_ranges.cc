@@ -8,8 +8,7 @@
 
 #include "vmap/core/error.h"
 
-namespace vmap::option_ranges_internal {
-
+namespace vmap {
 namespace {
 
 // A bound as the field's type writes it: an int field's 100000 is "100000", not "1e+05".
@@ -36,6 +35,8 @@ std::string Describe(const OptionRange& range, bool integral) {
 }
 
 }  // namespace
+
+namespace option_ranges_internal {
 
 void RangeChecker::OnField(const OptionField& field, std::optional<double>& value) {
   if (value) {
@@ -72,4 +73,13 @@ void RangeChecker::ThrowOutside() const {
   throw OptionError(outside.path, problem);
 }
 
-}  // namespace vmap::option_ranges_internal
+}  // namespace option_ranges_internal
+
+std::string RangeText(const OptionRange& range, bool integral) {
+  const std::string interval = fmt::format("{}{}, {}{}", range.min_excluded ? "(" : "[", Number(range.min, integral),
+                                           std::isinf(range.max) ? "inf" : Number(range.max, integral),
+                                           range.max_excluded || std::isinf(range.max) ? ")" : "]");
+  return range.also ? Number(*range.also, integral) + " or " + interval : interval;
+}
+
+}  // namespace vmap

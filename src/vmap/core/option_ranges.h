@@ -59,6 +59,10 @@ class RangeChecker : public OptionFieldVisitor {
 
 }  // namespace option_ranges_internal
 
+// The values a range takes, as a command's help shows them: "[1, 2]", "(0, 1]", "[-1, inf)", "0 or [1, 1000]".
+// `integral`: the field is an int (its bounds written as integers).
+std::string RangeText(const OptionRange& range, bool integral);
+
 // Throws OptionError for the first of `options`' own number fields outside its range: "<path> <value> [unit] is
 // outside [min, max] (default <d> [unit]; <meaning>)".
 template <typename Options>

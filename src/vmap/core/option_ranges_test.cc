@@ -108,5 +108,15 @@ TEST(OptionRanges, LeavesANestedStructToItsOwnCheckWhichNamesItWithin) {
   EXPECT_EQ(Message(options), "part.budget 0 is outside [1, 100] (default 10)");
 }
 
+TEST(OptionRanges, RangeTextIsWhatAHelpShows) {
+  const auto text = [](const OptionField& field, bool integral) { return RangeText(field.range, integral); };
+  EXPECT_EQ(text(OptionField{"a"}.Within(1, 100000), true), "[1, 100000]");
+  EXPECT_EQ(text(OptionField{"a"}.Within(0, 1).ExcludingMin(), false), "(0, 1]");
+  EXPECT_EQ(text(OptionField{"a"}.Within(0, 1).ExcludingMax(), false), "[0, 1)");
+  EXPECT_EQ(text(OptionField{"a"}.AtLeast(-1), true), "[-1, inf)");
+  EXPECT_EQ(text(OptionField{"a"}.Within(1, 1000).Or(0), false), "0 or [1, 1000]");
+  EXPECT_EQ(text(OptionField{"a"}.Within(0.05, 100), false), "[0.05, 100]");
+}
+
 }  // namespace
 }  // namespace vmap
