@@ -241,6 +241,7 @@ TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
       {localize + "--candidates 0", "--candidates 0 is outside [1, 10000]"},
       {localize + "--max-lost -1", "--max-lost -1 is outside [0, 1000000]"},
       {localize + "--lookahead 3", "--lookahead 3 is outside [1, 2] (default 2)"},
+      {localize + "--rival-place-frames -1", "--rival-place-frames -1 is outside [0, 1000] (default 3; 0: never)"},
       {localize + "--min-rival-ratio 0.5", "--min-rival-ratio 0.5 is not 0 nor in [1, 1000] (default 2; 0: never)"},
       {localize + "--ranking bow", "unknown ranking 'bow'"},
       {localize + "--acceptance bow", "unknown acceptance rule 'bow'"},

@@ -131,10 +131,13 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "the run was last steered by even where its key images verify by little beyond chance (else it is "
                  "uncertain)"},
                 doubt_relocalization_on_little_chance);
-  visitor.Visit({"rival_place_frames", "--rival-place-frames",
-                 "Frames a far key image that verified more than the one a frame was steered by is compared again; "
-                 "a tracked frame it out-verifies again is relocalized (0 = never)"},
-                rival_place_frames);
+  visitor.Visit(
+      OptionField{"rival_place_frames", "--rival-place-frames",
+                  "Frames a far key image that verified more than the one a frame was steered by is compared again; "
+                  "a tracked frame it out-verifies again is relocalized (0 = never)"}
+          .Within(0, 1000)
+          .Meaning("0: never"),
+      rival_place_frames);
   visitor.Visit(
       OptionField{"stalled_tracker_frames", "--stalled-tracker-frames",
                   "Float descriptors: frames in a row a tracker held at one key image, the next one verifying nothing "
