@@ -55,7 +55,8 @@ void RangeChecker::Test(const OptionField& field, double value, bool integral, b
     return;
   }
   if (optional_unset || outside_ || field.range.Contains(value)) return;
-  outside_ = Outside{Path(field), integral ? Number(value, true) : fmt::format("{}", value), field.range, integral};
+  outside_ =
+      Outside{Path(field), integral ? Number(value, true) : fmt::format("{}", value), value, field.range, integral};
 }
 
 void RangeChecker::ThrowOutside() const {
@@ -63,7 +64,7 @@ void RangeChecker::ThrowOutside() const {
   const OptionRange& range = outside.range;
   const std::string unit = range.unit != nullptr ? std::string(" ") + range.unit : "";
   // An infinite value within an unbounded range is outside it only by being infinite.
-  const bool unbounded_infinity = std::isinf(range.max) && outside.value == "inf";
+  const bool unbounded_infinity = std::isinf(range.max) && std::isinf(outside.number) && outside.number > 0;
   std::string problem =
       outside.value + unit + " " + (unbounded_infinity ? "is not finite" : Describe(range, outside.integral));
   std::vector<std::string> notes;

@@ -44,7 +44,8 @@ class RangeChecker : public OptionFieldVisitor {
 
  private:
   struct Outside {
-    std::string path, value;
+    std::string path, value;  // the value as written
+    double number;
     OptionRange range;
     bool integral;
   };
