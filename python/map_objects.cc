@@ -171,6 +171,14 @@ void BindMapObjects(py::module_& m) {
           },
           "The input's intrinsics as map.json records them; None without")
       .def_property_readonly(
+          "camera_mask",
+          [](const MapHandle& h) -> py::object {
+            if (h.map.camera_mask.empty()) return py::none();
+            return ImageArray(h.map.camera_mask);
+          },
+          "Where features may be found, HxW uint8 at the frames' size (0: none may be, 255: they may); None for a "
+          "map built without --camera-mask")
+      .def_property_readonly(
           "options", [](const MapHandle& h) { return JsonToPython(h.map.options_json); },
           "Every option that shaped the map, as map.json records them")
       .def_property_readonly("statistics",

@@ -35,6 +35,40 @@ def test_build_map_writes_the_cli_map(maps):
         assert (module_dir / key["image"]).read_bytes() == (cli_dir / key["image"]).read_bytes()
     assert built.num_frames == cli["num_frames"] == len(range(0, 60, 2))
     assert len(built.key_images) == cli["num_key_images"] and built.quality == cli["quality"]
+    assert built.camera_mask is None and "camera_mask" not in cli["input"]
+
+
+def write_grey_png(path, pixels):
+    """An 8-bit grey PNG of a uint8 HxW array (zlib and the PNG chunks; no imaging library needed)."""
+    import struct
+    import zlib
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+
+    height, width = pixels.shape
+    rows = b"".join(b"\x00" + pixels[y].astype(np.uint8).tobytes() for y in range(height))
+    header = struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0)
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(rows)) +
+                     chunk(b"IEND", b""))
+
+
+def test_a_camera_mask_is_kept_as_the_cli_keeps_it(tmp_path):
+    needs_shared()
+    mask = np.full((480, 640), 255, dtype=np.uint8)
+    mask[:, :160] = 0
+    write_grey_png(tmp_path / "mask.png", mask)
+    cli_dir, module_dir = tmp_path / "cli_map", tmp_path / "module_map"
+    run_cli("build", VIDEO, "-o", cli_dir, "--camera-mask", tmp_path / "mask.png",
+            *[f"--{k}={v}" for k, v in STRETCH.items()])
+    vmap.build_map(str(VIDEO), module_dir, camera_mask=str(tmp_path / "mask.png"), **STRETCH)
+    assert without_run_fields(map_json(module_dir)) == without_run_fields(map_json(cli_dir))
+    assert map_json(cli_dir)["input"]["camera_mask"] == "camera_mask.png"
+    assert (module_dir / "camera_mask.png").read_bytes() == (cli_dir / "camera_mask.png").read_bytes()
+    kept = vmap.read_map(module_dir).camera_mask
+    assert kept.shape == (480, 640) and kept.dtype == np.uint8
+    np.testing.assert_array_equal(kept, mask)
+    assert vmap.read_map(module_dir).key_images[0].num_features > 0
 
 
 def test_read_map_gives_the_map_json_as_numpy(maps):

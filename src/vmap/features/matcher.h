@@ -49,6 +49,13 @@ class Matcher {
   virtual std::shared_ptr<const ImageFeatures> ExtractFrame(const cv::Mat& gray, const cv::Mat& bgr) const {
     return Extract(gray);
   }
+  // Features only where `keep` (CV_8UC1, the image's size) is non-zero: within a camera mask
+  // (features/camera_mask.h, which calls it). Null when the matcher cannot leave features out (LoFTR's are dense):
+  // its matches are then filtered instead.
+  virtual std::shared_ptr<const ImageFeatures> ExtractFrameWithin(const cv::Mat& gray, const cv::Mat& bgr,
+                                                                  const cv::Mat& keep) const {
+    return nullptr;
+  }
   // Features must come from this matcher's Extract.
   virtual TentativeMatches Match(const ImageFeatures& features0, const ImageFeatures& features1) const = 0;
   // The matcher's settings, recorded in map.json.

@@ -5,6 +5,7 @@
 #include "vmap/core/error.h"
 #include "vmap/core/json_fields.h"
 #include "vmap/core/options_json.h"
+#include "vmap/features/camera_mask.h"
 #include "vmap/features/matcher_plugin.h"
 #include "vmap/features/orb_matcher.h"
 
@@ -75,7 +76,7 @@ MatcherOptions::MatcherOptions() {
   for (const auto& model : MatcherModels()) models_.emplace(model.name, model.default_options());
 }
 
-MatcherOptions::MatcherOptions(const MatcherOptions& other) : type(other.type) {
+MatcherOptions::MatcherOptions(const MatcherOptions& other) : type(other.type), camera_mask(other.camera_mask) {
   for (const auto& [name, options] : other.models_) models_.emplace(name, options->Clone());
 }
 
@@ -103,6 +104,12 @@ void MatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
     return text;
   }();
   visitor.Visit(OptionField{"type", "--matcher", help.c_str()}.Named("matcher").NotRecorded(), type);
+  // Not recorded as a path: a map keeps the mask itself (camera_mask.png) and the matcher's record its digest.
+  visitor.Visit(OptionField{"camera_mask", "--camera-mask",
+                            "An image of the frames' size, black where no features may be (COLMAP's camera mask): a "
+                            "fisheye's dark rim, the robot's own body. A map keeps it and localizes within it"}
+                    .NotRecorded(),
+                camera_mask);
   // Every model's fields, as "<model>.<key>" (the paths Check() names); a flag several models share (--weights,
   // --device) sets the field of each, whichever matcher is chosen.
   for (const auto& model : MatcherModels()) visitor.VisitNested(model.name.c_str(), *models_.at(model.name));
@@ -120,9 +127,11 @@ std::unique_ptr<Matcher> CreateMatcher(const MatcherOptions& options) {
   options.Check();
   const MatcherModel& model = FindMatcherModel(options.type);
   // An option found wrong only now (a device the machine lacks) is named as Check() names it.
-  return NameOptionErrorsWithin(model.name, [&] {
+  std::unique_ptr<Matcher> matcher = NameOptionErrorsWithin(model.name, [&] {
     return model.create ? model.create(options.selected()) : CreatePluginMatcher(options.selected());
   });
+  if (options.camera_mask.empty()) return matcher;
+  return WithCameraMask(std::move(matcher), CameraMask::Read(options.camera_mask));
 }
 
 }  // namespace vmap

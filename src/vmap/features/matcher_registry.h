@@ -131,6 +131,8 @@ std::string MatcherModelNames();
 class MatcherOptions {
  public:
   std::string type = "orb";  // a registered model name (MatcherModelNames)
+  // An image file: the matcher extracts features only where it is not black (features/camera_mask.h); "" = none.
+  std::string camera_mask;
 
   MatcherOptions();
   MatcherOptions(const MatcherOptions& other);
@@ -170,8 +172,8 @@ class MatcherOptions {
 // image every few frames elsewhere. Throws InputError for an unknown type.
 double DefaultTau(const std::string& matcher_type);
 
-// Throws InputError when the matcher cannot be created (unknown type, a deep matcher without LibTorch, weights
-// missing).
+// Within options.camera_mask when one is given (WithCameraMask). Throws InputError when the matcher cannot be
+// created (unknown type, a deep matcher without LibTorch, weights missing, a mask that cannot be read).
 std::unique_ptr<Matcher> CreateMatcher(const MatcherOptions& options);
 
 }  // namespace vmap

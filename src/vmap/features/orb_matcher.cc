@@ -16,6 +16,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/core/option_ranges.h"
+#include "vmap/features/camera_mask.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/features/orb_extraction.h"
 
@@ -83,13 +84,34 @@ struct SerializedKeyPoint {
   int32_t octave;
 };
 
+void KeepWithin(const cv::Mat& keep, OrbFeatures& features) {
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+  for (size_t i = 0; i < features.keypoints.size(); ++i) {
+    if (!KeptByMask(keep, features.keypoints[i].pt)) continue;
+    keypoints.push_back(features.keypoints[i]);
+    descriptors.push_back(features.binary_descriptors.row(static_cast<int>(i)));
+  }
+  features.keypoints = std::move(keypoints);
+  features.binary_descriptors = descriptors;
+}
+
 class OrbMatcher : public Matcher {
  public:
   explicit OrbMatcher(const OrbMatcherOptions& options) : options_(options) { options_.Check(); }
 
   std::string name() const override { return "orb"; }
 
-  std::shared_ptr<const ImageFeatures> Extract(const cv::Mat& gray) const override {
+  std::shared_ptr<const ImageFeatures> Extract(const cv::Mat& gray) const override { return ExtractWithin(gray, {}); }
+
+  // OpenCV's detector looks for corners only within the mask (at every level of its pyramid), so the best
+  // num_features are found where the mask keeps pixels; the grid's keypoints outside it are dropped.
+  std::shared_ptr<const ImageFeatures> ExtractFrameWithin(const cv::Mat& gray, const cv::Mat&,
+                                                          const cv::Mat& keep) const override {
+    return ExtractWithin(gray, keep);
+  }
+
+  std::shared_ptr<const ImageFeatures> ExtractWithin(const cv::Mat& gray, const cv::Mat& keep) const {
     auto features = std::make_shared<OrbFeatures>();
     features->size = gray.size();
     if (gray.empty()) return features;
@@ -107,6 +129,7 @@ class OrbMatcher : public Matcher {
       grid.fast_threshold = options_.fast_threshold;
       grid.min_fast_threshold = options_.min_fast_threshold;
       ExtractOrbOnGrid(image, grid, features->keypoints, features->binary_descriptors);
+      if (!keep.empty()) KeepWithin(keep, *features);
       return features;
     }
     // A detector per call: cv::ORB is not documented as thread-safe, and creating one is cheap.
@@ -117,7 +140,8 @@ class OrbMatcher : public Matcher {
     const double smallest_level =
         std::min(gray.cols, gray.rows) / std::pow(options_.scale_factor, options_.num_levels - 1);
     if (smallest_level < 1.0) return features;
-    orb->detectAndCompute(image, cv::noArray(), features->keypoints, features->binary_descriptors);
+    // An empty mask is OpenCV's "everywhere".
+    orb->detectAndCompute(image, keep, features->keypoints, features->binary_descriptors);
     if (features->binary_descriptors.empty()) features->keypoints.clear();
     return features;
   }

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "vmap/features/camera_mask.h"
 #include "vmap/features/matcher_options_json.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/map/map_io.h"
@@ -22,6 +23,11 @@ LocalizationMap OpenLocalizationMap(RecordedMap read, const std::filesystem::pat
   opened.options = std::move(read.options);
   opened.matcher =
       CreateMatcher(MatcherOptionsFromJson(opened.options.matcher_json, (directory / kMapFileName).string()));
+  // The frames are extracted within the mask the key images were (the robot's camera is the teach run's).
+  if (!opened.map.camera_mask.empty()) {
+    opened.matcher = WithCameraMask(
+        std::move(opened.matcher), CameraMask(opened.map.camera_mask, "the map's " + std::string(kCameraMaskFileName)));
+  }
   opened.experiences = opened.map.experiences;
   opened.keys = LoadKeyImageStore(directory, opened.map, *opened.matcher, options, opened.experiences);
   return opened;

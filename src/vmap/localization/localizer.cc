@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/features/camera_mask.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/features/orb_matcher.h"
 
@@ -114,19 +115,19 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   if (options_.guided_matching && matcher_.name() == OrbMatcherOptions::kModelName) {
     MatcherOptions guided = MapOrbOptions(matcher_);
     guided.Of<OrbMatcherOptions>().cross_check = false;
-    guided_matcher_ = CreateMatcher(guided);
+    guided_matcher_ = WithCameraMaskOf(matcher_, CreateMatcher(guided));
     if (options_.window_matching && (options_.window_fast_threshold > 0 || options_.window_features > 0)) {
       OrbMatcherOptions& orb = guided.Of<OrbMatcherOptions>();
       if (options_.window_fast_threshold > 0) orb.fast_threshold = options_.window_fast_threshold;
       if (options_.window_features > 0) orb.num_features = options_.window_features;
-      window_matcher_ = CreateMatcher(guided);
+      window_matcher_ = WithCameraMaskOf(matcher_, CreateMatcher(guided));
     }
   }
   if (options_.lost_frame_features > 0 && matcher_.name() == OrbMatcherOptions::kModelName &&
       !keys_.directory.empty()) {
     MatcherOptions more = MapOrbOptions(matcher_);
     more.Of<OrbMatcherOptions>().num_features = options_.lost_frame_features;
-    lost_frame_matcher_ = CreateMatcher(more);
+    lost_frame_matcher_ = WithCameraMaskOf(matcher_, CreateMatcher(more));
     lost_frame_key_features_.assign(num_keys, nullptr);
   }
   // The rules that step a frame on to the next key image ask whether it stands still (StillSinceFrameBefore), and so

@@ -67,6 +67,37 @@ ContainedFile OpenMapFile(const fs::path& directory, const std::string& relative
   Malformed(reported, named + " " + why_not);
 }
 
+// The camera mask map.json names: the map's own file, an 8-bit grey image of the frames' size (its size read from
+// its header before it is decoded), something kept.
+cv::Mat ReadCameraMask(const std::string& name, const Fields& fields, const fs::path& directory, const fs::path& file,
+                       cv::Size frame_size) {
+  if (name != kCameraMaskFileName)
+    fields.Fail("input.camera_mask", std::string("must be \"") + kCameraMaskFileName + "\"");
+  if (frame_size.empty()) fields.Fail("input.camera_mask", "needs input.frame_size, which the map does not record");
+  const ContainedFile image = OpenMapFile(directory, name, "camera mask", file, "input.camera_mask");
+  const std::optional<cv::Size> size = ImageHeaderSize(image);
+  std::string bytes;
+  // A PNG of a frame's size takes far less than 64 MiB; more is not a mask vmap wrote.
+  if (!size || *size != frame_size || image.size() > (64ull << 20) || !image.ReadAll(&bytes)) {
+    Malformed(file, "input.camera_mask '" + name + "' is not a PNG of the frames' size " +
+                        std::to_string(frame_size.width) + "x" + std::to_string(frame_size.height) +
+                        "; rebuild the map with `vmap build --camera-mask`");
+  }
+  cv::Mat mask;
+  try {
+    mask = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, bytes.data()), cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception&) {
+  }
+  if (mask.empty() || mask.type() != CV_8UC1 || mask.size() != frame_size) {
+    Malformed(file, "input.camera_mask '" + name + "' is not an 8-bit grey image that decodes; rebuild the map");
+  }
+  mask = mask != 0;
+  if (cv::countNonZero(mask) == 0) {
+    Malformed(file, "input.camera_mask '" + name + "' is black everywhere: no feature could be found; rebuild the map");
+  }
+  return mask;
+}
+
 void ReadKeyImages(const json& doc, const Fields& fields, const fs::path& directory, const fs::path& file,
                    VisualMap* map) {
   const json& keys = fields.Array(fields.Required(doc, "", "key_images"), "key_images");
@@ -328,6 +359,9 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
     if (!known) fields.Fail("coverage.end", "must be " + ListEnumNames(kCoverageEndNames));
     read.end = *known;
     map.coverage = read;
+  }
+  if (const json* mask = input ? Fields::Find(*input, "camera_mask") : nullptr; mask && !mask->is_null()) {
+    map.camera_mask = ReadCameraMask(fields.String(*mask, "input.camera_mask"), fields, directory, file, frame_size);
   }
   ReadKeyImages(doc, fields, directory, file, &map);
   ReadLinks(doc, fields, directory, file, &map);

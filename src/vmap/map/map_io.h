@@ -26,6 +26,8 @@ namespace vmap {
 inline constexpr int kMapSchemaVersion = 2;
 inline constexpr const char* kMapFileName = "map.json";
 inline constexpr const char* kCorrespondencesFileName = "correspondences.bin";
+// The map's camera mask (VisualMap::camera_mask), when it has one: an 8-bit grey PNG, black where no features may be.
+inline constexpr const char* kCameraMaskFileName = "camera_mask.png";
 // Limits a map must respect to be read, far above what vmap writes: they bound the memory a crafted map
 // can make a reader take.
 inline constexpr std::uint64_t kMaxMapJsonBytes = 1ull << 30;  // 1 GiB
@@ -38,6 +40,8 @@ inline constexpr std::uint64_t kMaxMapJsonValues = 1ull << 23;
 // Writes map.json and correspondences.bin into `directory` (which must exist; key images are written by
 // the builder). Each file is written atomically.
 void WriteMapFiles(const VisualMap& map, const std::filesystem::path& directory);
+// Writes kCameraMaskFileName into `directory` when the map has a camera mask (before map.json, which names it).
+void WriteCameraMask(const VisualMap& map, const std::filesystem::path& directory);
 
 // Calls its argument with each evaluation of a map, in order; may be called several times (once per column
 // of map.json). A map being built keeps its evaluations in a file (MapWriter) and reads them back this way.

@@ -283,3 +283,48 @@ TEST(MapIo, CoverageIsWrittenOnlyWhenKnownAndReadBack) {
 }
 
 }  // namespace vmap
+
+namespace vmap {
+
+// A map built within a camera mask keeps it beside map.json, and reads it back only as what vmap wrote: the map's own
+// file, of the frames' size, something kept.
+TEST(MapIo, CameraMaskRoundTripsAndIsCheckedWhenRead) {
+  testing::ScopedTempDir tmp;
+  VisualMap map = SmallMap(tmp.path());
+  map.camera_mask = cv::Mat(map.input.frame_size, CV_8UC1, cv::Scalar(255));
+  map.camera_mask.colRange(0, 10).setTo(0);
+  WriteMapFiles(map, tmp.path());
+  ASSERT_TRUE(fs::exists(tmp.path() / kCameraMaskFileName));
+  const VisualMap back = ReadMap(tmp.path());
+  ASSERT_EQ(back.camera_mask.size(), map.camera_mask.size());
+  EXPECT_EQ(cv::countNonZero(back.camera_mask != map.camera_mask), 0);
+  std::ifstream in(tmp.path() / kMapFileName);
+  const nlohmann::json doc = nlohmann::json::parse(in);
+  EXPECT_EQ(doc.at("input").at("camera_mask"), kCameraMaskFileName);
+
+  const cv::Mat good = map.camera_mask;
+  cv::imwrite((tmp.path() / kCameraMaskFileName).string(), cv::Mat(24, 32, CV_8UC1, cv::Scalar(255)));
+  EXPECT_NE(ReadMapError(tmp.path()).find("is not a PNG of the frames' size 64x48"), std::string::npos)
+      << ReadMapError(tmp.path());
+  cv::imwrite((tmp.path() / kCameraMaskFileName).string(), cv::Mat(48, 64, CV_8UC1, cv::Scalar(0)));
+  EXPECT_NE(ReadMapError(tmp.path()).find("is black everywhere"), std::string::npos) << ReadMapError(tmp.path());
+  cv::imwrite((tmp.path() / kCameraMaskFileName).string(), cv::Mat(48, 64, CV_8UC3, cv::Scalar(255, 255, 255)));
+  EXPECT_NE(ReadMapError(tmp.path()).find("is not an 8-bit grey image"), std::string::npos) << ReadMapError(tmp.path());
+  fs::remove(tmp.path() / kCameraMaskFileName);
+  EXPECT_NE(
+      ReadMapError(tmp.path()).find("camera mask '" + (tmp.path() / kCameraMaskFileName).string() + "' is missing"),
+      std::string::npos)
+      << ReadMapError(tmp.path());
+
+  cv::imwrite((tmp.path() / kCameraMaskFileName).string(), good);
+  nlohmann::json named = doc;
+  named["input"]["camera_mask"] = "../mask.png";
+  testing::WriteText(tmp.path() / kMapFileName, named.dump());
+  EXPECT_NE(ReadMapError(tmp.path()).find("'input.camera_mask' must be \"camera_mask.png\""), std::string::npos)
+      << ReadMapError(tmp.path());
+  named["input"]["camera_mask"] = nullptr;  // no mask
+  testing::WriteText(tmp.path() / kMapFileName, named.dump());
+  EXPECT_TRUE(ReadMap(tmp.path()).camera_mask.empty());
+}
+
+}  // namespace vmap

@@ -187,6 +187,7 @@ void MapWriter::WriteMapAndCorrespondences(const VisualMap& map, const fs::path&
     fs::rename(partial, file, ec);
     if (ec) CannotWrite(file, ec.message());
   };
+  WriteCameraMask(map, directory);
   write(directory / kCorrespondencesFileName, [&](std::ostream& out) { out << CorrespondencesBinary(map); });
   const EvaluationSource evaluations = Evaluations();
   write(directory / kMapFileName, [&](std::ostream& out) { WriteMapJson(out, map, evaluations); });

@@ -126,6 +126,9 @@ struct VisualMap {
   std::optional<Coverage> coverage;  // absent for a map of a whole input (file, folder, dataset)
   // Other runs of the route added to the map (map/experiences.h); checked by ReadMap like every other field.
   std::vector<Experience> experiences;
+  // Where features may be (features/camera_mask.h): CV_8UC1 of input.frame_size, 0 where none may be, 255
+  // elsewhere; empty for a map built without a camera mask. Written as kCameraMaskFileName beside map.json.
+  cv::Mat camera_mask;
 };
 
 enum class QualityMean { kArithmetic, kHarmonic };

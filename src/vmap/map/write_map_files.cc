@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/file_name_encoding.h"
@@ -34,6 +35,7 @@ json MapDocument(const VisualMap& map, const std::vector<long>& offsets, bool wi
                   {"frame_size", SizeJson(map.input.frame_size)},
                   {"fps", map.input.fps}};
   doc["input"]["camera"] = map.input.camera ? CameraToJson(*map.input.camera) : json(nullptr);
+  if (!map.camera_mask.empty()) doc["input"]["camera_mask"] = kCameraMaskFileName;
   doc["conventions"] = MapConventionsJson();
   doc["options"] = map.options_json.empty() ? json::object() : json::parse(map.options_json);
   doc["num_frames"] = map.num_frames;
@@ -172,7 +174,15 @@ std::string CorrespondencesBinary(const VisualMap& map) {
   return binary;
 }
 
+void WriteCameraMask(const VisualMap& map, const fs::path& directory) {
+  if (map.camera_mask.empty()) return;
+  std::vector<uchar> png;
+  cv::imencode(".png", map.camera_mask, png);
+  WriteFileAtomically(directory / kCameraMaskFileName, std::string(png.begin(), png.end()));
+}
+
 void WriteMapFiles(const VisualMap& map, const fs::path& directory) {
+  WriteCameraMask(map, directory);
   WriteFileAtomically(directory / kCorrespondencesFileName, CorrespondencesBinary(map));
   std::ostringstream text;
   WriteMapJson(text, map);

@@ -7,15 +7,19 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/error.h"
+#include "vmap/features/camera_mask.h"
 
 namespace vmap {
 
-VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source, const MapBuilderOptions& options,
-                     const std::string& options_json, double seconds, bool analyze_links,
-                     const LinkVerifier* link_verifier, double tau, LinkAnalysisCache* analysis_cache,
-                     MapWriter* key_image_files) {
+VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source, const Matcher& matcher,
+                     const MapBuilderOptions& options, const std::string& options_json, double seconds,
+                     bool analyze_links, const LinkVerifier* link_verifier, double tau,
+                     LinkAnalysisCache* analysis_cache, MapWriter* key_image_files) {
   VisualMap map;
   map.input = source.info();
+  if (const CameraMask* mask = CameraMaskOf(matcher); mask && !map.input.frame_size.empty()) {
+    map.camera_mask = mask->For(map.input.frame_size);
+  }
   map.options_json = options_json;
   map.num_frames = selector.num_frames();
   map.skipped_frames = source.skipped_frames();

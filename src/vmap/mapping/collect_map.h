@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "vmap/features/matcher.h"
 #include "vmap/map/map_writer.h"
 #include "vmap/map/visual_map.h"
 #include "vmap/mapping/key_image_selector.h"
@@ -18,9 +19,10 @@ namespace vmap {
 // `analyze_links`: also each link's pose, parallax and homography test (only maps that are kept need them),
 // reusing those of `analysis_cache` where the links did not change. `key_image_files`: the writer the key images
 // went to, from which the links' cross-check (LinkAnalysisOptions::pose_check_features) reads them back.
-VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source, const MapBuilderOptions& options,
-                     const std::string& options_json, double seconds, bool analyze_links,
-                     const LinkVerifier* link_verifier = nullptr, double tau = 0.0,
+// The map keeps the camera mask `matcher` extracted within (CameraMaskOf), at the frames' size.
+VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source, const Matcher& matcher,
+                     const MapBuilderOptions& options, const std::string& options_json, double seconds,
+                     bool analyze_links, const LinkVerifier* link_verifier = nullptr, double tau = 0.0,
                      LinkAnalysisCache* analysis_cache = nullptr, MapWriter* key_image_files = nullptr);
 
 // Throws the InputError of a build that took no frame of `source` (none could be used, or none was there):

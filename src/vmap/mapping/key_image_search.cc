@@ -169,7 +169,7 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
     link_verifier->Finish();
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  VisualMap map = CollectMap(selector, source, options, options_json, seconds, /*analyze_links=*/true,
+  VisualMap map = CollectMap(selector, source, matcher, options, options_json, seconds, /*analyze_links=*/true,
                              link_verifier.get(), options.key_images.tau, /*analysis_cache=*/nullptr, writer.get());
   map.num_frames = frames_read;
   map.evaluations = std::move(evaluations);

@@ -11,6 +11,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/core/progress.h"
+#include "vmap/core/stopwatch.h"
 #include "vmap/map/map_writer.h"
 #include "vmap/mapping/collect_map.h"
 #include "vmap/mapping/feature_pipeline.h"
@@ -26,10 +27,6 @@ std::vector<double> Sorted(std::vector<double> values) {
   return values;
 }
 
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 }  // namespace
 
 // The streaming state of a build: the pipeline, one selector per tau, the link verifier and the sinks.
@@ -38,6 +35,7 @@ class MapBuilder::Impl {
   Impl(const FrameSource& source, const Matcher& matcher, const MapBuilderOptions& options, std::vector<double> taus,
        std::vector<MapWriter*> writers, std::string options_json)
       : source_(source),
+        matcher_(matcher),
         options_(options),
         taus_(std::move(taus)),
         sorted_taus_(Sorted(taus_)),
@@ -115,7 +113,7 @@ class MapBuilder::Impl {
       // Nothing to write before Algorithm 1 has taken its first frame.
       if (!writers_[i] || selectors_[i]->key_images().empty()) continue;
       VisualMap map =
-          CollectMap(*selectors_[i], source_, options_, options_json_, SecondsSince(start_),
+          CollectMap(*selectors_[i], source_, matcher_, options_, options_json_, SecondsSince(start_),
                      /*analyze_links=*/true, link_verifier_.get(), taus_[i], &link_analyses_[i], writers_[i]);
       map.coverage = CurrentCoverage(CoverageEnd::kSnapshot);
       writers_[i]->Snapshot(map);
@@ -142,7 +140,7 @@ class MapBuilder::Impl {
     const double seconds = SecondsSince(start_);
     std::vector<VisualMap> maps;
     for (size_t i = 0; i < selectors_.size(); ++i) {
-      VisualMap map = CollectMap(*selectors_[i], source_, options_, options_json_, seconds, analyze_links,
+      VisualMap map = CollectMap(*selectors_[i], source_, matcher_, options_, options_json_, seconds, analyze_links,
                                  link_verifier_.get(), taus_[i], &link_analyses_[i], writers_[i]);
       // A map of a whole file says nothing more (its map.json stays as it was); a live input's says what it
       // covers.
@@ -211,6 +209,7 @@ class MapBuilder::Impl {
   }
 
   const FrameSource& source_;
+  const Matcher& matcher_;
   const MapBuilderOptions options_;
   const std::vector<double> taus_;  // selector i's is taus_[i]
   const std::vector<double> sorted_taus_;

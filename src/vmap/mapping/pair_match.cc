@@ -2,15 +2,9 @@
 
 #include <chrono>
 
+#include "vmap/core/stopwatch.h"
+
 namespace vmap {
-
-namespace {
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace
 
 PairMatch MatchPair(const Matcher& matcher, const PairImage& image0, const PairImage& image1,
                     const VerifierOptions& verifier, const HeadingOptions& heading, const Camera* camera) {

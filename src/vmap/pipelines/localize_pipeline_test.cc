@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "vmap/features/camera_mask.h"
+#include "vmap/localization/localization_map.h"
 #include "vmap/pipelines/build_pipeline.h"
 #include "vmap/testing/localization_test_util.h"
 #include "vmap/testing/option_error.h"
@@ -23,9 +25,13 @@ struct Drive {
   fs::path map = tmp.path() / "map";
   fs::path repeat = tmp.path() / "repeat";
 
-  Drive() {
+  explicit Drive(const cv::Mat& camera_mask = cv::Mat()) {
     testing::WriteImageFolder(testing::SidewaysDrive(), tmp.path() / "teach");
     BuildPipelineOptions build;
+    if (!camera_mask.empty()) {
+      build.matcher.camera_mask = (tmp.path() / "mask.png").string();
+      cv::imwrite(build.matcher.camera_mask, camera_mask);
+    }
     build.input = (tmp.path() / "teach").string();
     build.output = map.string();
     build.source.stride = 2;
@@ -48,6 +54,33 @@ struct Drive {
     return options;
   }
 };
+
+// A map built within a camera mask keeps it, and its key images and the frames are extracted within it: the
+// frames localize as they do on a map without one (the mask hides a quarter of a scene that has features there).
+TEST(LocalizePipeline, AMapBuiltWithinACameraMaskLocalizesWithinIt) {
+  const cv::Size size = testing::SidewaysDrive().frames.at(0).size();
+  cv::Mat mask(size, CV_8UC1, cv::Scalar(255));
+  mask.colRange(0, size.width / 4).setTo(0);
+  Drive drive(mask);
+  const LocalizePipelineResult run = RunLocalizePipeline(drive.Options(), nullptr);
+  ASSERT_EQ(run.map.camera_mask.size(), size);
+  EXPECT_EQ(cv::countNonZero(run.map.camera_mask != mask), 0);
+  int placed = 0;
+  for (const LocalizationResult& frame : run.run.frames) placed += IsPlaced(frame.status);
+  EXPECT_GE(placed, static_cast<int>(run.run.frames.size()) * 9 / 10);
+
+  const LocalizationMap opened = OpenLocalizationMap(drive.map, KeyImageStoreOptions{});
+  ASSERT_NE(CameraMaskOf(*opened.matcher), nullptr);
+  ASSERT_GE(opened.keys.features.size(), 2u);
+  const TentativeMatches matches = opened.matcher->Match(*opened.keys.features[0], *opened.keys.features[1]);
+  ASSERT_GT(matches.size(), 10u);
+  for (const cv::Point2f& p : matches.points0) EXPECT_GE(p.x, size.width / 4 - 0.5f);
+  const cv::Mat first = cv::imread((drive.repeat / "frame_1.png").string(), cv::IMREAD_GRAYSCALE);
+  const TentativeMatches frame_matches =
+      opened.matcher->Match(*opened.matcher->Extract(first), *opened.keys.features[0]);
+  ASSERT_GT(frame_matches.size(), 10u);
+  for (const cv::Point2f& p : frame_matches.points0) EXPECT_GE(p.x, size.width / 4 - 0.5f);
+}
 
 // The robot's loop (one image at a time through the session) localizes every frame as the whole run does.
 TEST(LocalizePipeline, TheSessionFrameByFrameEqualsTheRun) {

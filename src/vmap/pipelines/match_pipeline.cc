@@ -11,6 +11,7 @@
 #include "vmap/core/error.h"
 #include "vmap/core/file_name_encoding.h"
 #include "vmap/core/image_header.h"
+#include "vmap/core/stopwatch.h"
 #include "vmap/pipelines/output_policies.h"
 #include "vmap/sources/dataset_camera.h"
 #include "vmap/sources/frame_source.h"
@@ -91,10 +92,6 @@ cv::Mat ReadColor(const std::string& path, cv::Size size) {
   }
   if (bgr.size() != size) throw InputError("image '" + path + "' changed while it was read; read it again");
   return bgr;
-}
-
-double Seconds(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 // The camera of `camera` for images of `size`; both images must have that size for a bearing to mean one thing.
@@ -185,7 +182,7 @@ MatchPipelineResult RunMatchPipeline(const MatchPipelineOptions& options) {
   // 4. The matcher.
   const auto start = std::chrono::steady_clock::now();
   const std::unique_ptr<Matcher> matcher = CreateMatcher(options.pair.matcher);
-  result.load_seconds = Seconds(start);
+  result.load_seconds = SecondsSince(start);
   result.matcher = matcher->name();
   result.matcher_options_json = matcher->DescribeOptionsJson();
 

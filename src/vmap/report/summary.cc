@@ -38,6 +38,11 @@ std::string FormatMapSummary(const VisualMap& map, QualityMean mean) {
     text += fmt::format("translation     known on {} of {} links; the others give a robot their rotation only\n", known,
                         map.links.size());
   }
+  if (!map.camera_mask.empty()) {
+    text += fmt::format("camera mask     {}x{}, features on {:.1f}% of the pixels (camera_mask.png)\n",
+                        map.camera_mask.cols, map.camera_mask.rows,
+                        100.0 * cv::countNonZero(map.camera_mask) / double(map.camera_mask.total()));
+  }
   text += fmt::format("quality Q       {:.4f} ({} mean)\n", s.quality, QualityMeanName(mean));
   if (map.seconds > 0) {
     text += fmt::format("time            {:.2f} s ({:.1f} frames/s)\n", map.seconds, s.num_frames / map.seconds);

@@ -45,6 +45,13 @@ TEST(Summary, MapSummaryHasThePapersNumbers) {
   EXPECT_NE(text.find("key images (m)  3 (1.5% of frames)"), std::string::npos) << text;
   EXPECT_NE(text.find("min 40  max 60  mean 50.0"), std::string::npos) << text;
   EXPECT_NE(text.find("100.0 frames/s"), std::string::npos) << text;
+  EXPECT_EQ(text.find("camera mask"), std::string::npos) << text;
+
+  map.camera_mask = cv::Mat(48, 64, CV_8UC1, cv::Scalar(255));
+  map.camera_mask.colRange(0, 16).setTo(0);
+  EXPECT_NE(
+      FormatMapSummary(map, QualityMean::kArithmetic).find("camera mask     64x48, features on 75.0% of the pixels"),
+      std::string::npos);
 }
 
 TEST(Summary, SweepTablesMarkTheBestTau) {

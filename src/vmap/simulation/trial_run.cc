@@ -6,15 +6,12 @@
 
 #include "vmap/control/guidance_signals.h"
 #include "vmap/control/taught_route.h"
+#include "vmap/core/stopwatch.h"
 #include "vmap/simulation/teach_run.h"
 
 namespace vmap {
 
 namespace {
-
-double Seconds(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
 
 // The trial's start: the route's start offset sideways and turned, drawn from the seed and the index, and the seed
 // of the robot's noise drawn after them.
@@ -106,7 +103,7 @@ bool TrialRun::Continues() {
 Frame TrialRun::Render() {
   const auto render_start = std::chrono::steady_clock::now();
   Frame frame = RenderFrame(*context_.world, context_.options.camera, robot_.pose(), step_, time());
-  render_total_ += Seconds(render_start);
+  render_total_ += SecondsSince(render_start);
   return frame;
 }
 

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/features/camera_mask.h"
 #include "vmap/features/float_matcher.h"
 #include "vmap/features/matcher_plugin.h"
 #include "vmap/features/point_features_bytes.h"
@@ -70,6 +71,19 @@ class AlikedMatcher : public Matcher {
     cv::Mat rgb;
     cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
     return ExtractPixels(rgb);
+  }
+
+  // The keypoints outside the mask are dropped after detection (top_k is taken over the whole image).
+  std::shared_ptr<const ImageFeatures> ExtractFrameWithin(const cv::Mat& gray, const cv::Mat& bgr,
+                                                          const cv::Mat& keep) const override {
+    const auto all = std::static_pointer_cast<const AlikedFeatures>(ExtractFrame(gray, bgr));
+    std::vector<cv::Point2f> points;
+    cv::Mat rows;
+    for (int i : KeptPointIndices(keep, all->keypoints())) {
+      points.push_back(all->keypoints()[i]);
+      rows.push_back(all->descriptors().row(i));
+    }
+    return std::make_shared<AlikedFeatures>(std::move(points), rows, all->image_size());
   }
 
   TentativeMatches Match(const ImageFeatures& features0, const ImageFeatures& features1) const override {

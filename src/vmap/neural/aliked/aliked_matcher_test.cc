@@ -14,6 +14,7 @@
 #include "vmap/core/error.h"
 #include "vmap/mapping/pair_match.h"
 #include "vmap/testing/golden_util.h"
+#include "vmap/testing/masked_extraction.h"
 
 namespace vmap {
 namespace {
@@ -118,6 +119,14 @@ TEST(AlikedMatcher, ColourImagesGiveTheReferencesMatches) {
   const TentativeMatches from_grey =
       matcher->Match(*matcher->Extract(images[0].gray), *matcher->Extract(images[1].gray));
   EXPECT_LT(CommonCount(AsSet(from_grey.points0, from_grey.points1), reference) + 10, CommonCount(ours, reference));
+}
+
+TEST(AlikedMatcher, ExtractsWithinACameraMask) {
+  SKIP_WITHOUT_SHARED();
+  const std::string dir = PairDir("t16", "rccar_000000_000006");
+  testing::ExpectFeaturesWithinTheMask(*CreateAlikedMatcher(Options("t16")),
+                                       cv::imread(dir + "/input0.png", cv::IMREAD_GRAYSCALE),
+                                       cv::imread(dir + "/input1.png", cv::IMREAD_GRAYSCALE));
 }
 
 TEST(AlikedMatcher, ShrinkingMapsKeypointsBackToTheOriginalImage) {

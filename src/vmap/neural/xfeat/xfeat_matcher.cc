@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/features/camera_mask.h"
 #include "vmap/features/float_matcher.h"
 #include "vmap/features/matcher_plugin.h"
 #include "vmap/features/point_features_bytes.h"
@@ -76,6 +77,22 @@ class XfeatMatcher : public Matcher {
       throw InputError("XFeat needs the colour image as 8-bit BGR of the grey image's size");
     }
     return ExtractPixels(bgr);
+  }
+
+  // The keypoints outside the mask are dropped after detection: the top_k best of the heat map are taken over the
+  // whole image, so a mask leaves fewer where top_k binds (it does not on the small frames of corridor_conditions).
+  std::shared_ptr<const ImageFeatures> ExtractFrameWithin(const cv::Mat& gray, const cv::Mat& bgr,
+                                                          const cv::Mat& keep) const override {
+    const auto all = std::static_pointer_cast<const XfeatFeatures>(ExtractFrame(gray, bgr));
+    const std::vector<int> kept = KeptPointIndices(keep, all->keypoints());
+    std::vector<cv::Point2f> points;
+    points.reserve(kept.size());
+    for (int i : kept) points.push_back(all->keypoints()[i]);
+    torch::InferenceMode guard;
+    const torch::Tensor index = torch::tensor(std::vector<int64_t>(kept.begin(), kept.end()), torch::kInt64)
+                                    .to(all->descriptor_tensor().device());
+    return std::make_shared<XfeatFeatures>(
+        std::move(points), all->descriptor_tensor().index_select(0, index).contiguous(), all->image_size());
   }
 
   TentativeMatches Match(const ImageFeatures& features0, const ImageFeatures& features1) const override {

@@ -17,6 +17,7 @@
 #include "vmap/features/matcher_registry.h"
 #include "vmap/mapping/pair_match.h"
 #include "vmap/testing/golden_util.h"
+#include "vmap/testing/masked_extraction.h"
 
 namespace vmap {
 namespace {
@@ -122,6 +123,14 @@ TEST(XfeatMatcher, FrameWithoutColourIsItsGreyImage) {
   ASSERT_EQ(from_frame->num_features(), from_gray->num_features());
   EXPECT_EQ(cv::norm(from_frame->descriptors(), from_gray->descriptors(), cv::NORM_INF), 0.0);
   EXPECT_NE(ExpectInputError([&] { matcher->ExtractFrame(gray, gray); }).find("8-bit BGR"), std::string::npos);
+}
+
+TEST(XfeatMatcher, ExtractsWithinACameraMask) {
+  SKIP_WITHOUT_SHARED();
+  const auto matcher = CreateXfeatMatcher(SharedOptions());
+  const std::string dir = PairDir("rccar_000000_000006");
+  testing::ExpectFeaturesWithinTheMask(*matcher, cv::imread(dir + "/input0.png", cv::IMREAD_GRAYSCALE),
+                                       cv::imread(dir + "/input1.png", cv::IMREAD_GRAYSCALE));
 }
 
 TEST(XfeatMatcher, OptionsShapeTheOutputAndAreRecorded) {
