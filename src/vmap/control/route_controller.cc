@@ -7,6 +7,7 @@
 #include "vmap/control/guidance_signals.h"
 #include "vmap/core/error.h"
 #include "vmap/core/numeric.h"
+#include "vmap/core/stopwatch.h"
 
 namespace vmap {
 
@@ -134,7 +135,7 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
     step.localized = localized_;
     step.route_position = position_;
     last_command_ = step.command;
-    step.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    step.seconds = SecondsSince(start);
     return step;
   };
   if (reached_goal_) return finish({}, ControllerState::kReachedGoal);

@@ -115,8 +115,12 @@ class CameraMaskedMatcher : public Matcher {
 
   std::shared_ptr<const ImageFeatures> ExtractFrameWithin(const cv::Mat& gray, const cv::Mat& bgr,
                                                           const cv::Mat& keep) const override {
-    cv::Mat within = mask_.For(gray.size());
-    if (!keep.empty()) cv::bitwise_and(within, keep, within);
+    cv::Mat within = mask_.For(gray.size());  // may be the mask itself: never written to
+    if (!keep.empty()) {
+      cv::Mat both;
+      cv::bitwise_and(within, keep, both);
+      within = both;
+    }
     std::shared_ptr<const ImageFeatures> features = matcher_->ExtractFrameWithin(gray, bgr, within);
     // A matcher that cannot leave features out has its matches filtered (Match).
     return features ? features : matcher_->ExtractFrame(gray, bgr);

@@ -95,6 +95,31 @@ TEST(CameraMask, OrbFindsItsFeaturesWithinTheMask) {
   EXPECT_GE(masked_features->num_features(), plain_features->num_features() * 9 / 10);
 }
 
+// A masked matcher within another mask keeps features where both keep pixels, and neither mask is changed by it.
+TEST(CameraMask, TwoMasksKeepWhereBothKeep) {
+  cv::Mat image, next;
+  cv::cvtColor(testing::SidewaysDrive().frames.at(0), image, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(testing::SidewaysDrive().frames.at(2), next, cv::COLOR_BGR2GRAY);
+  cv::Mat top_masked(image.size(), CV_8UC1, cv::Scalar(255));
+  top_masked.rowRange(0, image.rows / 2).setTo(0);
+  // A mask's copies share its pixels (cv::Mat): were a matcher to write into them, `left` would show it.
+  const CameraMask left(LeftHalfMasked(image.size()), "left");
+  const auto inner = WithCameraMask(CreateMatcher(MatcherOptions()), left);
+  const auto both =
+      WithCameraMask(WithCameraMask(CreateMatcher(MatcherOptions()), left), CameraMask(top_masked, "top"));
+  const TentativeMatches matches = both->Match(*both->Extract(image), *both->Extract(next));
+  ASSERT_GT(matches.size(), 10u);
+  for (const cv::Point2f& p : matches.points0) {
+    EXPECT_GE(p.x, image.cols / 2 - 0.5f);
+    EXPECT_GE(p.y, image.rows / 2 - 0.5f);
+  }
+  EXPECT_EQ(cv::countNonZero(left.image()), static_cast<int>(image.total() / 2));
+  const TentativeMatches inner_matches = inner->Match(*inner->Extract(image), *inner->Extract(next));
+  int top = 0;
+  for (const cv::Point2f& p : inner_matches.points0) top += p.y < image.rows / 2 - 1;
+  EXPECT_GT(top, 10);  // the left mask alone keeps the top half
+}
+
 // A matcher that cannot leave features out: its matches with an end outside the mask are dropped.
 class EveryPixelMatcher : public Matcher {
  public:

@@ -16,6 +16,7 @@
 #include "vmap/core/error.h"
 #include "vmap/core/option_ranges.h"
 #include "vmap/core/parallel_for.h"
+#include "vmap/core/stopwatch.h"
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/map/map_io.h"
 
@@ -239,7 +240,7 @@ KeyImageStore LoadKeyImageStore(const fs::path& map_directory, const VisualMap& 
     store.features.resize(map.key_images.size());
     store.thumbnails.resize(map.key_images.size());
   }
-  store.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  store.seconds = SecondsSince(start);
   return store;
 }
 

@@ -11,6 +11,7 @@
 #include "vmap/core/option_ranges.h"
 #include "vmap/core/ordered_pipeline.h"
 #include "vmap/core/progress.h"
+#include "vmap/core/stopwatch.h"
 #include "vmap/sources/read_ahead_source.h"
 
 namespace vmap {
@@ -79,7 +80,7 @@ LocalizationSummary LocalizeSequence(FrameSource& source, const Matcher& matcher
     ExtractedFrame item;
     const auto extract_start = std::chrono::steady_clock::now();
     item.features = matcher.ExtractFrame(frame.gray, frame.color);
-    item.extract_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - extract_start).count();
+    item.extract_seconds = SecondsSince(extract_start);
     if (ahead) item.ahead = ahead(*item.features);
     item.frame = std::move(frame);
     return item;
@@ -130,7 +131,7 @@ LocalizationSummary LocalizeSequence(FrameSource& source, const Matcher& matcher
   }
   progress.Finish();
   summary.skipped_frames = source.skipped_frames();
-  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.seconds = SecondsSince(start);
   summary.frames_per_second = summary.seconds > 0 ? summary.frames / summary.seconds : 0.0;
   if (summary.frames > 0) {
     summary.mean_extract_seconds = extract_seconds / summary.frames;

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/core/stopwatch.h"
 #include "vmap/features/camera_mask.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/features/orb_matcher.h"
@@ -259,7 +260,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   result.timestamp = frame.timestamp;
   result.source_name = frame.source_name;
   if (speculation_) speculation_->Finish();
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = SecondsSince(start);
   return result;
 }
 

@@ -71,8 +71,9 @@ ContainedFile OpenMapFile(const fs::path& directory, const std::string& relative
 // its header before it is decoded), something kept.
 cv::Mat ReadCameraMask(const std::string& name, const Fields& fields, const fs::path& directory, const fs::path& file,
                        cv::Size frame_size) {
-  if (name != kCameraMaskFileName)
+  if (name != kCameraMaskFileName) {
     fields.Fail("input.camera_mask", std::string("must be \"") + kCameraMaskFileName + "\"");
+  }
   if (frame_size.empty()) fields.Fail("input.camera_mask", "needs input.frame_size, which the map does not record");
   const ContainedFile image = OpenMapFile(directory, name, "camera mask", file, "input.camera_mask");
   const std::optional<cv::Size> size = ImageHeaderSize(image);

@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/error.h"
+#include "vmap/core/stopwatch.h"
 #include "vmap/features/camera_mask.h"
 
 namespace vmap {
@@ -48,8 +49,7 @@ VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source
   }
   AnalyzeLinks(map, options.link_analysis, options.ExtractionThreads(), analysis_cache,
                pose_check ? &*pose_check : nullptr);
-  const double analysis_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - analysis_start).count();
+  const double analysis_seconds = SecondsSince(analysis_start);
   spdlog::debug("pose, parallax and homography test of {} links in {:.3f} s ({} analysed before)", map.links.size(),
                 analysis_seconds, analysis_cache ? analysis_cache->hits() - reused_before : 0);
   map.seconds += analysis_seconds;  // part of building the map

@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/progress.h"
+#include "vmap/core/stopwatch.h"
 #include "vmap/map/map_writer.h"
 #include "vmap/mapping/collect_map.h"
 #include "vmap/mapping/key_image_selector.h"
@@ -168,7 +169,7 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
     }
     link_verifier->Finish();
   }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = SecondsSince(start);
   VisualMap map = CollectMap(selector, source, matcher, options, options_json, seconds, /*analyze_links=*/true,
                              link_verifier.get(), options.key_images.tau, /*analysis_cache=*/nullptr, writer.get());
   map.num_frames = frames_read;

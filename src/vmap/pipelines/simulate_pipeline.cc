@@ -10,6 +10,7 @@
 #include "vmap/control/taught_route.h"
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
+#include "vmap/core/stopwatch.h"
 #include "vmap/map/map_io.h"
 #include "vmap/pipelines/build_pipeline.h"
 #include "vmap/pipelines/output_policies.h"
@@ -107,7 +108,7 @@ std::unique_ptr<PreparedTrials> PrepareTrials(const SimulationOptions& options, 
   RenderedFrameSource frames(*prepared->teach_world, options.camera, teach.poses, teach.seconds_per_frame, build.input);
   RunBuildPipeline(build, &frames);
   prepared->teach_frames = static_cast<int>(teach.poses.size());
-  prepared->teach_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  prepared->teach_seconds = SecondsSince(start);
   prepared->teach_odometry = teach.odometry;
 
   // 4. The map opened for localization, and the route with its taught profile (from the teach odometry). Each
@@ -174,7 +175,7 @@ SimulatePipelineResult RunSimulatePipeline(const SimulatePipelineOptions& option
   // 5. The trials, independent of each other.
   run.trials = RunTrials(context, simulation.trials, simulation.threads, on_trial);
   run.summary = Summarize(run.trials);
-  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  run.seconds = SecondsSince(start);
 
   // 6. The outputs.
   if (!options.map.empty()) map_directory.Commit();

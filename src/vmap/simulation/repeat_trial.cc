@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "vmap/core/stopwatch.h"
 #include "vmap/simulation/trial_run.h"
 
 namespace vmap {
@@ -19,8 +20,7 @@ TrialResult RunTrial(const TrialContext& context, int index) {
     const OdometrySample odometry = run.odometry();
     const ControlStep step =
         controller.Update(run.time(), localization, context.options.use_odometry ? &odometry : nullptr);
-    run.Record(localization, step,
-               std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start).count());
+    run.Record(localization, step, SecondsSince(step_start));
     if (step.state == ControllerState::kReachedGoal) break;
     run.Drive(step.command);
   }

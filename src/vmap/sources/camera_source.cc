@@ -11,6 +11,7 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/error.h"
+#include "vmap/core/stopwatch.h"
 #include "vmap/sources/internal.h"
 
 namespace vmap::internal {
@@ -43,7 +44,7 @@ class V4l2CameraSource : public FrameSource {
       if (options_.last >= 0 && position_ > options_.last) return std::nullopt;
       const auto asked = std::chrono::steady_clock::now();
       if (!capture_.read(color) || color.empty()) {
-        const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - asked).count();
+        const double waited = SecondsSince(asked);
         if (waited >= options_.stream_timeout_seconds || ++failures_ > 16) {
           spdlog::warn("camera '{}' stopped delivering frames; ending the input", info_.path);
           return std::nullopt;
@@ -69,7 +70,7 @@ class V4l2CameraSource : public FrameSource {
       frame.index = delivered_++;
       frame.source_index = static_cast<int>(index);
       frame.source_name = fmt::format("frame_{:06d}", index);
-      frame.timestamp = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+      frame.timestamp = SecondsSince(start_);
       FitToSequence(frame, &info_, options_, &size_warnings_);
       return frame;
     }
