@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <string_view>
 #include <utility>
 
 #include <fmt/format.h>
@@ -12,6 +13,7 @@
 
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/fnv1a.h"
 #include "vmap/core/image_header.h"
 
 namespace vmap {
@@ -52,14 +54,10 @@ CameraMask::CameraMask(const cv::Mat& image, std::string source) : source_(std::
 }
 
 std::string CameraMask::Describe() const {
-  // FNV-1a, 64 bits, over the pixels row by row: a record notices another mask, it does not resist an adversary.
-  uint64_t hash = 0xcbf29ce484222325ull;
+  // The pixels row by row (a row of a cv::Mat may be followed by padding).
+  uint64_t hash = kFnv1aOffsetBasis;
   for (int r = 0; r < image_.rows; ++r) {
-    const uchar* row = image_.ptr<uchar>(r);
-    for (int c = 0; c < image_.cols; ++c) {
-      hash ^= row[c];
-      hash *= 0x100000001b3ull;
-    }
+    hash = Fnv1a(std::string_view(image_.ptr<char>(r), static_cast<size_t>(image_.cols)), hash);
   }
   return fmt::format("{}x{} {:.1f}% {:016x}", image_.cols, image_.rows, 100.0 * kept_share_, hash);
 }

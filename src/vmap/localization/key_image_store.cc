@@ -14,6 +14,7 @@
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/fnv1a.h"
 #include "vmap/core/option_ranges.h"
 #include "vmap/core/parallel_for.h"
 #include "vmap/core/stopwatch.h"
@@ -27,15 +28,6 @@ namespace {
 
 // Bump when the layout below changes: older caches are then recomputed.
 constexpr char kCacheMagic[16] = {'v', 'm', 'a', 'p', '-', 'l', 'o', 'c', 'a', 'l', 'i', 'z', 'e', '-', 'v', '1'};
-
-// FNV-1a, 64 bits: the cache needs to notice a change, not to resist an adversary.
-uint64_t Fnv1a(std::string_view bytes, uint64_t hash = 0xcbf29ce484222325ull) {
-  for (unsigned char c : bytes) {
-    hash ^= c;
-    hash *= 0x100000001b3ull;
-  }
-  return hash;
-}
 
 std::string ReadWholeFile(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
