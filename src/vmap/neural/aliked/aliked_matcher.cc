@@ -59,24 +59,22 @@ class AlikedMatcher : public Matcher {
   bool reads_color() const override { return true; }
 
   std::shared_ptr<const ImageFeatures> Extract(const cv::Mat& gray) const override {
-    if (gray.empty() || gray.type() != CV_8UC1) throw InputError("ALIKED needs an 8-bit single-channel image");
-    return ExtractPixels(gray);
+    return ExtractPixels(PixelsOfFrame(gray, cv::Mat()));
   }
 
   std::shared_ptr<const ImageFeatures> ExtractFrame(const cv::Mat& gray, const cv::Mat& bgr) const override {
-    if (bgr.empty()) return Extract(gray);
-    if (bgr.type() != CV_8UC3 || bgr.size() != gray.size()) {
-      throw InputError("ALIKED needs the colour image as 8-bit BGR of the grey image's size");
-    }
-    cv::Mat rgb;
-    cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
-    return ExtractPixels(rgb);
+    return ExtractPixels(PixelsOfFrame(gray, bgr));
   }
 
-  // The keypoints outside the mask are dropped after detection (top_k is taken over the whole image).
+  // The mask reaches the detector: its peaks outside are suppressed before the top_k best are taken, so the mask keeps
+  // the whole budget within it. The sub-pixel refinement moves a peak by up to dkd radius pixels, so a keypoint at
+  // the mask's edge may end outside it; those are dropped after.
   std::shared_ptr<const ImageFeatures> ExtractFrameWithin(const cv::Mat& gray, const cv::Mat& bgr,
                                                           const cv::Mat& keep) const override {
-    const auto all = std::static_pointer_cast<const AlikedFeatures>(ExtractFrame(gray, bgr));
+    if (keep.type() != CV_8UC1 || keep.size() != gray.size()) {
+      throw std::invalid_argument("AlikedMatcher::ExtractFrameWithin: the mask must be 8-bit, of the image's size");
+    }
+    const auto all = std::static_pointer_cast<const AlikedFeatures>(ExtractPixels(PixelsOfFrame(gray, bgr), keep));
     std::vector<cv::Point2f> points;
     cv::Mat rows;
     for (int i : KeptPointIndices(keep, all->keypoints())) {
@@ -130,8 +128,22 @@ class AlikedMatcher : public Matcher {
   }
 
  private:
+  // What the network reads of a frame: its colour image as RGB when given (checked), else its grey one.
+  static cv::Mat PixelsOfFrame(const cv::Mat& gray, const cv::Mat& bgr) {
+    if (gray.empty() || gray.type() != CV_8UC1) throw InputError("ALIKED needs an 8-bit single-channel image");
+    if (bgr.empty()) return gray;
+    if (bgr.type() != CV_8UC3 || bgr.size() != gray.size()) {
+      throw InputError("ALIKED needs the colour image as 8-bit BGR of the grey image's size");
+    }
+    cv::Mat rgb;
+    cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+    return rgb;
+  }
+
   // `image`: 8-bit grey or RGB.
-  std::shared_ptr<const ImageFeatures> ExtractPixels(const cv::Mat& image) const {
+  // `keep`: a camera mask of the image's size, empty: none; DkdOptions::keep is it at the network image's pixels
+  // (each at the image pixel its centre maps to, as the keypoints are mapped back).
+  std::shared_ptr<const ImageFeatures> ExtractPixels(const cv::Mat& image, const cv::Mat& keep = cv::Mat()) const {
     cv::Mat net_image = image;
     const int longest = std::max(image.cols, image.rows);
     if (options_.longest_side > 0 && longest > options_.longest_side) {
@@ -150,7 +162,9 @@ class AlikedMatcher : public Matcher {
             .to(torch::kFloat32)
             .div_(255.0);
     const auto maps = model_.ExtractDenseMaps(tensor);
-    const auto detected = neural::DetectKeypoints(maps.score_map, dkd_);
+    neural::DkdOptions dkd = dkd_;
+    if (!keep.empty()) dkd.keep = KeepAtNetworkPixels(keep, net_image.size(), maps.score_map);
+    const auto detected = neural::DetectKeypoints(maps.score_map, dkd);
     const auto described = model_.Describe(maps, detected.keypoints);
 
     const auto keypoints = detected.keypoints.to(torch::kCPU).contiguous();
@@ -169,6 +183,22 @@ class AlikedMatcher : public Matcher {
     cv::Mat rows(static_cast<int>(n), static_cast<int>(descriptors.size(1)), CV_32F,
                  const_cast<float*>(descriptors.data_ptr<float>()));
     return std::make_shared<AlikedFeatures>(std::move(points), rows.clone(), image.size());
+  }
+
+  // The score map's (1, 1, H, W) 0/1 mask: a network pixel is kept where the image pixel its centre maps to is.
+  static torch::Tensor KeepAtNetworkPixels(const cv::Mat& keep, cv::Size net_size, const torch::Tensor& score_map) {
+    const int64_t height = score_map.size(2), width = score_map.size(3);
+    const float sx = float(keep.cols) / float(net_size.width), sy = float(keep.rows) / float(net_size.height);
+    auto mask = torch::zeros({1, 1, height, width}, torch::kFloat32);
+    float* m = mask.data_ptr<float>();
+    for (int64_t y = 0; y < height; ++y) {
+      const long image_y = std::lrint((float(y) + 0.5f) * sy - 0.5f);
+      for (int64_t x = 0; x < width; ++x) {
+        const long image_x = std::lrint((float(x) + 0.5f) * sx - 0.5f);
+        m[y * width + x] = KeptByMask(keep, cv::Point2f(float(image_x), float(image_y))) ? 1.f : 0.f;
+      }
+    }
+    return mask;
   }
 
   // OpenMP thread counts belong to the calling thread, so they are set on every call, not once.

@@ -134,6 +134,7 @@ DkdResult DetectKeypoints(const torch::Tensor& score_map, const DkdOptions& opti
   nms.index_put_({Slice(), Slice(), Slice(), Slice(0, r)}, 0.0);
   nms.index_put_({Slice(), Slice(), Slice(std::max<int64_t>(0, height - r)), Slice()}, 0.0);
   nms.index_put_({Slice(), Slice(), Slice(), Slice(std::max<int64_t>(0, width - r))}, 0.0);
+  if (options.keep.defined()) nms.mul_(options.keep.to(nms.device(), nms.scalar_type()));
   auto flat_nms = nms.view({-1});
   const auto scores_flat = score_map.reshape({-1});
 

@@ -23,6 +23,10 @@ struct DkdOptions {
   // Upstream's top-k returns suppressed pixels (NMS score 0) when an image has fewer than top_k peaks; with
   // this set they are dropped. The golden comparisons turn it off.
   bool drop_suppressed = true;
+  // A camera mask at the score map's size, (1, 1, H, W) float: 1 where a peak may be, 0 where none may. The peaks
+  // outside it are suppressed before the top_k best are taken, so the mask keeps the whole budget within it (with
+  // drop_suppressed). Undefined: everywhere.
+  torch::Tensor keep;
 };
 
 struct DkdResult {

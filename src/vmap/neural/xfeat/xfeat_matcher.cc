@@ -6,7 +6,6 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/error.h"
-#include "vmap/features/camera_mask.h"
 #include "vmap/features/float_matcher.h"
 #include "vmap/features/matcher_plugin.h"
 #include "vmap/features/point_features_bytes.h"
@@ -67,32 +66,21 @@ class XfeatMatcher : public Matcher {
   bool reads_color() const override { return true; }
 
   std::shared_ptr<const ImageFeatures> Extract(const cv::Mat& gray) const override {
-    if (gray.empty() || gray.type() != CV_8UC1) throw InputError("XFeat needs an 8-bit single-channel image");
-    return ExtractPixels(gray);
+    return ExtractPixels(PixelsOfFrame(gray, cv::Mat()));
   }
 
   std::shared_ptr<const ImageFeatures> ExtractFrame(const cv::Mat& gray, const cv::Mat& bgr) const override {
-    if (bgr.empty()) return Extract(gray);
-    if (bgr.type() != CV_8UC3 || bgr.size() != gray.size()) {
-      throw InputError("XFeat needs the colour image as 8-bit BGR of the grey image's size");
-    }
-    return ExtractPixels(bgr);
+    return ExtractPixels(PixelsOfFrame(gray, bgr));
   }
 
-  // The keypoints outside the mask are dropped after detection: the top_k best of the heat map are taken over the
-  // whole image, so a mask leaves fewer where top_k binds (it does not on the small frames of corridor_conditions).
+  // The mask reaches the detector: the peaks outside it are dropped before the top_k best are taken, so the mask keeps
+  // the whole budget within it (dropping keypoints after detection left a fraction of top_k where it binds).
   std::shared_ptr<const ImageFeatures> ExtractFrameWithin(const cv::Mat& gray, const cv::Mat& bgr,
                                                           const cv::Mat& keep) const override {
-    const auto all = std::static_pointer_cast<const XfeatFeatures>(ExtractFrame(gray, bgr));
-    const std::vector<int> kept = KeptPointIndices(keep, all->keypoints());
-    std::vector<cv::Point2f> points;
-    points.reserve(kept.size());
-    for (int i : kept) points.push_back(all->keypoints()[i]);
-    torch::InferenceMode guard;
-    const torch::Tensor index = torch::tensor(std::vector<int64_t>(kept.begin(), kept.end()), torch::kInt64)
-                                    .to(all->descriptor_tensor().device());
-    return std::make_shared<XfeatFeatures>(
-        std::move(points), all->descriptor_tensor().index_select(0, index).contiguous(), all->image_size());
+    if (keep.type() != CV_8UC1 || keep.size() != gray.size()) {
+      throw std::invalid_argument("XfeatMatcher::ExtractFrameWithin: the mask must be 8-bit, of the image's size");
+    }
+    return ExtractPixels(PixelsOfFrame(gray, bgr), keep);
   }
 
   TentativeMatches Match(const ImageFeatures& features0, const ImageFeatures& features1) const override {
@@ -153,8 +141,19 @@ class XfeatMatcher : public Matcher {
   }
 
  private:
+  // What the network reads of a frame: its colour image when given (checked), else its grey one.
+  static cv::Mat PixelsOfFrame(const cv::Mat& gray, const cv::Mat& bgr) {
+    if (gray.empty() || gray.type() != CV_8UC1) throw InputError("XFeat needs an 8-bit single-channel image");
+    if (bgr.empty()) return gray;
+    if (bgr.type() != CV_8UC3 || bgr.size() != gray.size()) {
+      throw InputError("XFeat needs the colour image as 8-bit BGR of the grey image's size");
+    }
+    return bgr;
+  }
+
   // `image`: 8-bit, 1 channel (grey) or 3 (BGR, in upstream's channel order; the network averages them).
-  std::shared_ptr<const ImageFeatures> ExtractPixels(const cv::Mat& image) const {
+  // `keep`: a camera mask of the image's size (XfeatDetectOptions::keep), empty: none.
+  std::shared_ptr<const ImageFeatures> ExtractPixels(const cv::Mat& image, const cv::Mat& keep = cv::Mat()) const {
     if (image.cols < kMinimumSide || image.rows < kMinimumSide) {
       throw InputError("image of " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
                        " is smaller than the 32x32 XFeat needs");
@@ -170,6 +169,10 @@ class XfeatMatcher : public Matcher {
     neural::XfeatDetectOptions detect;
     detect.top_k = options_.top_k;
     detect.detection_threshold = options_.detection_threshold;
+    if (!keep.empty()) {
+      const cv::Mat pixels_kept = keep.isContinuous() ? keep : keep.clone();
+      detect.keep = torch::from_blob(pixels_kept.data, {keep.rows, keep.cols}, torch::kUInt8).clone();
+    }
     const neural::XfeatDetections found = model_.DetectAndCompute(tensor, detect);
     const auto keypoints = found.keypoints.to(torch::kCPU).contiguous();
     std::vector<cv::Point2f> points;

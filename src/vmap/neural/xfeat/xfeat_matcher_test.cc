@@ -7,6 +7,7 @@
 #include <map>
 #include <set>
 #include <thread>
+#include <utility>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -14,6 +15,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/features/camera_mask.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/mapping/pair_match.h"
 #include "vmap/testing/golden_util.h"
@@ -127,10 +129,47 @@ TEST(XfeatMatcher, FrameWithoutColourIsItsGreyImage) {
 
 TEST(XfeatMatcher, ExtractsWithinACameraMask) {
   SKIP_WITHOUT_SHARED();
-  const auto matcher = CreateXfeatMatcher(SharedOptions());
+  // Every peak, so that top_k does not bind: where it does, the mask gives peaks that the whole image's top_k leaves
+  // out (KeepsItsTopKWithinACameraMask).
+  XfeatMatcherOptions options = SharedOptions();
+  options.top_k = 100000;
+  const auto matcher = CreateXfeatMatcher(options);
   const std::string dir = PairDir("rccar_000000_000006");
   testing::ExpectFeaturesWithinTheMask(*matcher, cv::imread(dir + "/input0.png", cv::IMREAD_GRAYSCALE),
                                        cv::imread(dir + "/input1.png", cv::IMREAD_GRAYSCALE));
+}
+
+// Where top_k binds (a KITTI frame has thousands of peaks), a camera mask keeps the whole budget within it: the top_k
+// best peaks inside the mask, where dropping the keypoints after detection left about half of top_k.
+TEST(XfeatMatcher, KeepsItsTopKWithinACameraMask) {
+  SKIP_WITHOUT_SHARED();
+  const cv::Mat gray = cv::imread(PairDir("kitti07_000010_000014") + "/input0.png", cv::IMREAD_GRAYSCALE);
+  cv::Mat keep(gray.size(), CV_8UC1, cv::Scalar(255));
+  keep.colRange(0, gray.cols / 2).setTo(0);
+  XfeatMatcherOptions options = SharedOptions();
+  options.top_k = 300;
+  const auto matcher = CreateXfeatMatcher(options);
+  options.top_k = 100000;  // every peak, best first
+  const auto every = CreateXfeatMatcher(options)->Extract(gray);
+
+  const auto within = matcher->ExtractFrameWithin(gray, cv::Mat(), keep);
+  ASSERT_EQ(within->num_features(), 300);
+  EXPECT_LT(KeptPointIndices(keep, testing::KeypointsOf(*matcher, *matcher->Extract(gray))).size(), 200u);
+  // The 300 best of the peaks inside the mask, each with the descriptor it has without a mask.
+  const std::vector<cv::Point2f> every_point = testing::KeypointsOf(*matcher, *every);
+  const std::vector<int> inside = KeptPointIndices(keep, every_point);
+  ASSERT_GT(inside.size(), 300u);
+  std::map<std::pair<float, float>, int> best;
+  for (size_t i = 0; i < 300; ++i) best[std::make_pair(every_point[inside[i]].x, every_point[inside[i]].y)] = inside[i];
+  const std::vector<cv::Point2f> within_point = testing::KeypointsOf(*matcher, *within);
+  const cv::Mat every_rows = every->descriptors(), within_rows = within->descriptors();
+  for (int j = 0; j < within->num_features(); ++j) {
+    const cv::Point2f p = within_point[j];
+    EXPECT_TRUE(KeptByMask(keep, p));
+    const auto found = best.find({p.x, p.y});
+    ASSERT_NE(found, best.end()) << "feature " << j << " is not among the best inside the mask";
+    EXPECT_EQ(cv::norm(within_rows.row(j), every_rows.row(found->second), cv::NORM_INF), 0.0);
+  }
 }
 
 TEST(XfeatMatcher, OptionsShapeTheOutputAndAreRecorded) {

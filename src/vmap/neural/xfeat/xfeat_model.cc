@@ -57,6 +57,26 @@ torch::Tensor LocalMaximaOnCpu(const torch::Tensor& heatmap, double threshold) {
   return torch::from_blob(xy.data(), {static_cast<int64_t>(xy.size() / 2), 2}, torch::kInt64).clone();
 }
 
+// The peaks (N, 2) int64 (x, y) in network pixels whose keypoint, scaled to the given image as DetectAndCompute
+// scales it and rounded to a pixel as KeptByMask (features/camera_mask.h) rounds it, lies where `keep` is nonzero.
+torch::Tensor PeaksWithin(const torch::Tensor& keep, const torch::Tensor& peaks, const torch::Tensor& scale) {
+  const auto mask = keep.to(torch::kCPU, torch::kUInt8).contiguous();
+  const auto xy = peaks.to(torch::kCPU).contiguous();
+  const auto factor = scale.to(torch::kCPU);
+  const float scale_x = factor[0].item<float>(), scale_y = factor[1].item<float>();
+  const int64_t rows = mask.size(0), cols = mask.size(1);
+  const uint8_t* pixels = mask.data_ptr<uint8_t>();
+  const int64_t* p = xy.data_ptr<int64_t>();
+  std::vector<int64_t> kept;
+  for (int64_t i = 0; i < xy.size(0); ++i) {
+    const long x = std::lrint(static_cast<float>(p[2 * i]) * scale_x);
+    const long y = std::lrint(static_cast<float>(p[2 * i + 1]) * scale_y);
+    if (x >= 0 && y >= 0 && x < cols && y < rows && pixels[y * cols + x] != 0) kept.push_back(i);
+  }
+  const auto index = torch::from_blob(kept.data(), {static_cast<int64_t>(kept.size())}, torch::kInt64).clone();
+  return peaks.index_select(0, index.to(peaks.device()));
+}
+
 // LibTorch's bicubic convolution coefficients (A = -0.75) for a fractional position t.
 std::array<float, 4> CubicCoefficients(float t) {
   constexpr float A = -0.75f;
@@ -275,6 +295,11 @@ XfeatDetections XfeatModel::DetectAndCompute(const torch::Tensor& image, const X
     const auto is_peak = heatmap.eq(local_max).logical_and_(heatmap.gt(options.detection_threshold));
     nms_keypoints = is_peak[0].nonzero().slice(1, 1, 3).flip({-1});
   }
+  // Back to the given image: float32 (x, y) times float32 (W / W', H / H'), as upstream scales them.
+  const auto scale = torch::tensor(
+      {static_cast<float>(double(width) / double(net_width)), static_cast<float>(double(height) / double(net_height))},
+      torch::TensorOptions().dtype(torch::kFloat32).device(device_));
+  if (options.keep.defined()) nms_keypoints = PeaksWithin(options.keep, nms_keypoints, scale);
   if (options.keep_intermediates) {
     out.heatmap = heatmap;
     out.nms_keypoints = nms_keypoints;
@@ -313,10 +338,6 @@ XfeatDetections XfeatModel::DetectAndCompute(const torch::Tensor& image, const X
     descriptors = SampleAt(descriptor_map, keypoints.unsqueeze(0), net_height, net_width, kBicubic)[0];
     descriptors = F::normalize(descriptors, F::NormalizeFuncOptions().p(2).dim(-1).eps(1e-12));
   }
-  // Back to the given image: float32 (x, y) times float32 (W / W', H / H'), as upstream scales them.
-  const auto scale = torch::tensor(
-      {static_cast<float>(double(width) / double(net_width)), static_cast<float>(double(height) / double(net_height))},
-      torch::TensorOptions().dtype(torch::kFloat32).device(device_));
   out.keypoints = keypoints.mul(scale);
   out.scores = kept_scores;
   out.descriptors = descriptors.contiguous();
