@@ -149,9 +149,15 @@ def dump_evidence(map_directory, query, output, prefix=""):
 CORRIDOR = os.path.join(SHARED, "corridor_conditions")
 
 
+def flags_tag(flags):
+    """Build flags as part of a map folder's name: joined without dashes, a path's slashes as underscores (a
+    --camera-mask FILE stays one folder)."""
+    return "".join(flags).replace("-", "").replace("/", "_")
+
+
 def corridor_map(vmap, matcher, tau_flags, work):
     """The map of the corridor's teach run (built once per binary) and its key images' teach frames."""
-    map_directory = os.path.join(work, "corridor_%s_%s" % (matcher, "".join(tau_flags).replace("-", "")))
+    map_directory = os.path.join(work, "corridor_%s_%s" % (matcher, flags_tag(tau_flags)))
     built = build(vmap, os.path.join(CORRIDOR, "teach"), matcher, tau_flags, map_directory)
     return map_directory, [k["source_index"] for k in built["key_images"]]
 
@@ -233,7 +239,7 @@ def michigan(vmap, matcher, localize_flags, work, evidence_dir=None, build_flags
         folders[s] = folder
     tally = Tally()
     for a in sessions:
-        map_directory = os.path.join(work, "michigan_%s_map_%s%s" % (matcher, a, "".join(build_flags).replace("-", "")))
+        map_directory = os.path.join(work, "michigan_%s_map_%s%s" % (matcher, a, flags_tag(build_flags)))
         build(vmap, folders[a], matcher, ["--tau", "1"] + list(build_flags), map_directory)
         for b in sessions:
             if a == b:
