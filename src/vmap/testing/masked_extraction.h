@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
+#include "vmap/features/camera_mask.h"
 #include "vmap/features/matcher.h"
 #include "vmap/features/point_features_bytes.h"
 
@@ -25,6 +26,32 @@ inline std::vector<cv::Point2f> KeypointsOf(const Matcher& matcher, const ImageF
   return rows ? rows->keypoints : std::vector<cv::Point2f>();
 }
 
+// Each of `within`'s features lies where `keep` keeps and is one of `every`'s: the same position, and its descriptor
+// within `tolerance` (float rounding: a network may describe its keypoints as one batch). Returns, for each, its index
+// in `every` (-1 where none is found, a failure already).
+inline std::vector<int> ExpectEachFoundWithoutTheMask(const Matcher& matcher, const ImageFeatures& within,
+                                                      const ImageFeatures& every, const cv::Mat& keep,
+                                                      double tolerance) {
+  std::map<std::pair<float, float>, int> found_without_mask;
+  const std::vector<cv::Point2f> every_point = KeypointsOf(matcher, every), within_point = KeypointsOf(matcher, within);
+  for (size_t i = 0; i < every_point.size(); ++i) found_without_mask[{every_point[i].x, every_point[i].y}] = int(i);
+  const cv::Mat every_rows = every.descriptors(), within_rows = within.descriptors();
+  EXPECT_EQ(within_rows.rows, within.num_features());
+  std::vector<int> index(within_point.size(), -1);
+  for (size_t j = 0; j < within_point.size(); ++j) {
+    EXPECT_TRUE(KeptByMask(keep, within_point[j])) << "feature " << j << " lies outside the mask";
+    const auto found = found_without_mask.find({within_point[j].x, within_point[j].y});
+    if (found == found_without_mask.end()) {
+      ADD_FAILURE() << "feature " << j << " is not one found without the mask";
+      continue;
+    }
+    index[j] = found->second;
+    EXPECT_LE(cv::norm(within_rows.row(int(j)), every_rows.row(found->second), cv::NORM_INF), tolerance)
+        << "feature " << j;
+  }
+  return index;
+}
+
 // `image0` with its left half masked: each of its features is one the matcher finds without the mask (the same
 // position, the same descriptor but for float rounding: a network describes its keypoints as one batch), fewer of
 // them, and its matches with `image1` lie on the kept half, where those of the whole image do not all lie.
@@ -34,16 +61,7 @@ inline void ExpectFeaturesWithinTheMask(const Matcher& matcher, const cv::Mat& i
   const auto all = matcher.Extract(image0);
   const auto within = matcher.ExtractFrameWithin(image0, cv::Mat(), mask);
   ASSERT_NE(within, nullptr);
-  const cv::Mat all_rows = all->descriptors(), within_rows = within->descriptors();
-  ASSERT_EQ(within_rows.rows, within->num_features());
-  std::map<std::pair<float, float>, int> found_without_mask;
-  const std::vector<cv::Point2f> all_points = KeypointsOf(matcher, *all), within_points = KeypointsOf(matcher, *within);
-  for (size_t i = 0; i < all_points.size(); ++i) found_without_mask[{all_points[i].x, all_points[i].y}] = int(i);
-  for (int j = 0; j < within_rows.rows; ++j) {
-    const auto found = found_without_mask.find({within_points[j].x, within_points[j].y});
-    ASSERT_NE(found, found_without_mask.end()) << "feature " << j << " is not one found without the mask";
-    EXPECT_LT(cv::norm(within_rows.row(j), all_rows.row(found->second), cv::NORM_INF), 1e-5) << "feature " << j;
-  }
+  ExpectEachFoundWithoutTheMask(matcher, *within, *all, mask, 1e-5);
   EXPECT_GT(within->num_features(), all->num_features() / 5);
   EXPECT_LT(within->num_features(), all->num_features() * 4 / 5);
 

@@ -4,9 +4,7 @@
 #include "vmap/neural/aliked/aliked_matcher.h"
 
 #include <array>
-#include <map>
 #include <thread>
-#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -154,18 +152,8 @@ TEST(AlikedMatcher, KeepsItsTopKWithinACameraMask) {
   EXPECT_GE(within->num_features(), 290);
   EXPECT_LE(within->num_features(), 300);
   EXPECT_LT(KeptPointIndices(keep, testing::KeypointsOf(*matcher, *matcher->Extract(gray))).size(), 200u);
-  // Each a peak found without the mask, with its descriptor there.
-  std::map<std::pair<float, float>, int> found;
-  const std::vector<cv::Point2f> every_point = testing::KeypointsOf(*matcher, *every);
-  for (size_t i = 0; i < every_point.size(); ++i) found[std::make_pair(every_point[i].x, every_point[i].y)] = int(i);
-  const std::vector<cv::Point2f> within_point = testing::KeypointsOf(*matcher, *within);
-  for (int j = 0; j < within->num_features(); ++j) {
-    EXPECT_TRUE(KeptByMask(keep, within_point[j]));
-    const auto it = found.find(std::make_pair(within_point[j].x, within_point[j].y));
-    ASSERT_NE(it, found.end()) << "feature " << j << " is not one found without the mask";
-    // The same but for float rounding: the network describes its keypoints as one batch.
-    EXPECT_LT(cv::norm(within->descriptors().row(j), every->descriptors().row(it->second), cv::NORM_INF), 1e-5);
-  }
+  // Each a peak found without the mask, with its descriptor there (but for float rounding).
+  testing::ExpectEachFoundWithoutTheMask(*matcher, *within, *every, keep, 1e-5);
 }
 
 TEST(AlikedMatcher, ShrinkingMapsKeypointsBackToTheOriginalImage) {

@@ -169,10 +169,7 @@ class XfeatMatcher : public Matcher {
     neural::XfeatDetectOptions detect;
     detect.top_k = options_.top_k;
     detect.detection_threshold = options_.detection_threshold;
-    if (!keep.empty()) {
-      const cv::Mat pixels_kept = keep.isContinuous() ? keep : keep.clone();
-      detect.keep = torch::from_blob(pixels_kept.data, {keep.rows, keep.cols}, torch::kUInt8).clone();
-    }
+    detect.keep = keep;
     const neural::XfeatDetections found = model_.DetectAndCompute(tensor, detect);
     const auto keypoints = found.keypoints.to(torch::kCPU).contiguous();
     std::vector<cv::Point2f> points;

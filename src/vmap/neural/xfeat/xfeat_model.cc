@@ -1,10 +1,11 @@
 #include "vmap/neural/xfeat/xfeat_model.h"
 
 #include <array>
-#include <cmath>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
+
+#include "vmap/features/camera_mask.h"
 
 namespace vmap::neural {
 
@@ -58,20 +59,16 @@ torch::Tensor LocalMaximaOnCpu(const torch::Tensor& heatmap, double threshold) {
 }
 
 // The peaks (N, 2) int64 (x, y) in network pixels whose keypoint, scaled to the given image as DetectAndCompute
-// scales it and rounded to a pixel as KeptByMask (features/camera_mask.h) rounds it, lies where `keep` is nonzero.
-torch::Tensor PeaksWithin(const torch::Tensor& keep, const torch::Tensor& peaks, const torch::Tensor& scale) {
-  const auto mask = keep.to(torch::kCPU, torch::kUInt8).contiguous();
+// scales it (float32), is kept by the camera mask `keep`.
+torch::Tensor PeaksWithin(const cv::Mat& keep, const torch::Tensor& peaks, const torch::Tensor& scale) {
   const auto xy = peaks.to(torch::kCPU).contiguous();
   const auto factor = scale.to(torch::kCPU);
   const float scale_x = factor[0].item<float>(), scale_y = factor[1].item<float>();
-  const int64_t rows = mask.size(0), cols = mask.size(1);
-  const uint8_t* pixels = mask.data_ptr<uint8_t>();
   const int64_t* p = xy.data_ptr<int64_t>();
   std::vector<int64_t> kept;
   for (int64_t i = 0; i < xy.size(0); ++i) {
-    const long x = std::lrint(static_cast<float>(p[2 * i]) * scale_x);
-    const long y = std::lrint(static_cast<float>(p[2 * i + 1]) * scale_y);
-    if (x >= 0 && y >= 0 && x < cols && y < rows && pixels[y * cols + x] != 0) kept.push_back(i);
+    const cv::Point2f keypoint(static_cast<float>(p[2 * i]) * scale_x, static_cast<float>(p[2 * i + 1]) * scale_y);
+    if (KeptByMask(keep, keypoint)) kept.push_back(i);
   }
   const auto index = torch::from_blob(kept.data(), {static_cast<int64_t>(kept.size())}, torch::kInt64).clone();
   return peaks.index_select(0, index.to(peaks.device()));
@@ -299,7 +296,7 @@ XfeatDetections XfeatModel::DetectAndCompute(const torch::Tensor& image, const X
   const auto scale = torch::tensor(
       {static_cast<float>(double(width) / double(net_width)), static_cast<float>(double(height) / double(net_height))},
       torch::TensorOptions().dtype(torch::kFloat32).device(device_));
-  if (options.keep.defined()) nms_keypoints = PeaksWithin(options.keep, nms_keypoints, scale);
+  if (!options.keep.empty()) nms_keypoints = PeaksWithin(options.keep, nms_keypoints, scale);
   if (options.keep_intermediates) {
     out.heatmap = heatmap;
     out.nms_keypoints = nms_keypoints;

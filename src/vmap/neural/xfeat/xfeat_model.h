@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/core.hpp>
 #include <torch/torch.h>
 
 #include "vmap/neural/state_dict.h"
@@ -39,10 +40,10 @@ struct XfeatDetectOptions {
   int64_t top_k = 4096;
   double detection_threshold = 0.05;
   bool keep_intermediates = false;  // fills the fields marked "intermediate" (for the golden tests)
-  // A camera mask: (H, W) uint8 on the CPU, the image's size, 0 where no keypoint may be (a keypoint is kept where
-  // its position rounded to a pixel is nonzero). The peaks outside it are dropped before the top_k best are taken,
-  // so the mask keeps the whole budget within it. Undefined: everywhere.
-  torch::Tensor keep;
+  // A camera mask: CV_8UC1 of the image's size, 0 where no keypoint may be (KeptByMask, features/camera_mask.h). The
+  // peaks outside it are dropped before the top_k best are taken, so the mask keeps the whole budget within it.
+  // Empty: everywhere.
+  cv::Mat keep;
   // On the CPU the network, the NMS and the descriptor sampling have faster equivalents of upstream's
   // LibTorch ops; these use upstream's ops (as on a GPU) instead, for tests that compare the two.
   bool upstream_network_ops = false;
