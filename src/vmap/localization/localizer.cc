@@ -174,6 +174,8 @@ void Localizer::Reset() {
   rival_frames_left_ = 0;
   stalled_position_ = -1;
   stalled_frames_ = 0;
+  frames_since_start_ = 0;
+  recent_positions_.clear();
   stall_bar_ = options_.stalled_tracker_frames;
   placed_in_a_row_ = 0;
   stall_questioned_ = held_still_ = false;
@@ -225,6 +227,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   Believe(result, frame, features);
   DoubtStalledTracker(result);
   CountStall(result);
+  RememberPace();
   RememberRivalPlace(result);
   if (IsPlaced(result.status)) {
     dropped_position_ = -1;  // steered by again: the drop is behind

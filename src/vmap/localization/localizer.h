@@ -23,6 +23,7 @@
 // image shares with its neighbours is relocalized too, and moved when another key image verifies more.
 
 #include <algorithm>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -273,6 +274,17 @@ class Localizer {
   // chance (LocalizerOptions::look_past_weak_next, look_past_max_log10_nfa; localizer_look_past.cc).
   void LookPastWeakNext(const Frame& frame, const ImageFeatures& features, int position, KeyComparison& best,
                         int& best_position);
+  // A key image further on than the tracker's next that verifies the frame more than the tracked one does, clearly
+  // (log10 NFA at most LocalizerOptions::look_past_max_log10_nfa): the step LookPastWeakNext and LookFurtherWhenLagging
+  // take.
+  bool ClearlyBeats(const KeyComparison& further, const KeyComparison& tracked) const;
+  // Up to lagging_start_frames frames after the run's first, a tracker at `best_position` that lags (recent_positions_)
+  // and holds the frame by less than clearly compares the two key images after the next one, and the better becomes
+  // `best` where it verifies more, clearly (LocalizerOptions::lagging_tracker_frames; localizer_lagging_tracker.cc).
+  void LookFurtherWhenLagging(const Frame& frame, const ImageFeatures& features, KeyComparison& best,
+                              int& best_position);
+  // Counts the frame and remembers where the tracker was, after the frame's result is final.
+  void RememberPace();
   // Compares the frame with the best-ranked key images of the route (relocalization_candidates of them), in
   // rank order; returns the ranking's route positions compared.
   std::vector<int> CompareBestRanked(const Frame& frame, const ImageFeatures& features);
@@ -471,6 +483,10 @@ class Localizer {
   // The hold at stalled_position_ is questioned at this many frames: stalled_tracker_frames, or
   // unsettled_stalled_tracker_frames where it began within two frames of a frame not steered by.
   int stall_bar_ = 0;
+  // The frames localized since the run's start, and the tracker's route positions after the last lagging_tracker_frames
+  // of them (LookFurtherWhenLagging).
+  int frames_since_start_ = 0;
+  std::deque<int> recent_positions_;
   int placed_in_a_row_ = 0;        // frames placed (tracking or relocalized) in a row before this one
   bool stall_questioned_ = false;  // the frame being localized was questioned so
   bool held_still_ = false;        // the frame being localized was held and stands still (StillSinceFrameBefore)

@@ -27,12 +27,14 @@ void Localizer::LookPastWeakNext(const Frame& frame, const ImageFeatures& featur
   // Stepped on to only where it verifies clearly (look_past_max_log10_nfa): at corridor_conditions' repeat frames 90-94
   // key image 31 (teach frame 101) verifies 22-28 matches at -10.2 to -11.5 past the weak key image 30, and the tracker
   // at 28-29 (right) stepped on a key image early; the key image past that mends a held tracker verifies at -15 to -17.
-  if (!PassesChance(beyond, options_.look_past_max_log10_nfa) || beyond.num_verified <= best.num_verified ||
-      !IsBetterMatch(beyond, best)) {
-    return;
-  }
+  if (!ClearlyBeats(beyond, best)) return;
   best = beyond;
   best_position = past;
+}
+
+bool Localizer::ClearlyBeats(const KeyComparison& further, const KeyComparison& tracked) const {
+  return PassesChance(further, options_.look_past_max_log10_nfa) && further.num_verified > tracked.num_verified &&
+         IsBetterMatch(further, tracked);
 }
 
 }  // namespace vmap

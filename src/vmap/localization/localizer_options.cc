@@ -153,6 +153,21 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
           .Within(0, 1000)
           .Meaning("0: as stalled_tracker_frames"),
       unsettled_stalled_tracker_frames);
+  visitor.Visit(
+      OptionField{"lagging_tracker_frames", "--lagging-tracker-frames",
+                  "Float descriptors: early in the run (--lagging-start-frames), a tracker that moved on fewer "
+                  "than two key images over this many frames, held by little, also compares the two key images after "
+                  "the next one and steps on to one that verifies more, clearly (--look-past-max-log10-nfa; 0 = never)"}
+          .Within(0, 1000)
+          .Meaning("0: never"),
+      lagging_tracker_frames);
+  visitor.Visit(
+      OptionField{
+          "lagging_start_frames", "--lagging-start-frames",
+          "Float descriptors: up to how many frames after the run's first a lagging tracker looks further ahead "
+          "(--lagging-tracker-frames)"}
+          .Within(0, 100000),
+      lagging_start_frames);
   visitor.Visit({"rival_place_when_not_steered", "!--no-rival-place-when-not-steered",
                  "Remember and compare a far key image a lost or uncertain frame verified as a rival place too "
                  "(otherwise only frames steered by remember one)"},

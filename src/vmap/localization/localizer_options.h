@@ -204,6 +204,23 @@ struct LocalizerOptions {
   // kidnapped run -2, and 4 fewer far frames (docs/measurements/localization-conditions.md, "A hold that begins after a
   // frame not steered by is questioned sooner"). 0: as stalled_tracker_frames.
   int unsettled_stalled_tracker_frames = 3;
+  // Float descriptors (XFeat): up to lagging_start_frames frames after the run's first, a tracker that moved on fewer
+  // than two key images over the last this many frames, held at a key image that verifies the frame by less than
+  // clearly (log10 NFA above look_past_max_log10_nfa), also compares the two key images after the next one, and steps
+  // on to the better of them where it verifies more matches than the tracked one, clearly. A run's first place rests on
+  // a frame or two of evidence, and the start key image's prior holds the belief behind it: a robot further on than
+  // --start-key says may be placed short, at a look-alike of where it is, and the tracker compares only the key images
+  // just after it. corridor_conditions from repeat frame 20 is started at key image 2 (right: 4-5) at every seed; key
+  // image 3 (teach frame 9) verifies nearly every frame to repeat frame 33 while the next ones see little, and at the
+  // verifier's seeds 54, 127, 136 and 153 the tracker was still at 3-4 on repeat frames 27-31 (right: 6-8): 6 frames
+  // steered by more than two key images off. Looking further on frame 26 or 27 it finds key image 6 at log10 NFA -16 to
+  // -18 and steps on. Only at the start: a tracker that followed the route, or was relocalized after a carry, is as
+  // slow where key images lie far apart (corridor_conditions' 27-29 at repeat frames 84-95), and the key images further
+  // on there, the route's end, are look-alikes that verify clearly (docs/measurements/localization-conditions.md, "A
+  // tracker lagging the run's start looks further ahead"). 0: never.
+  int lagging_tracker_frames = 6;
+  // lagging_tracker_frames: a tracker is asked so up to this many frames after the run's first.
+  int lagging_start_frames = 10;
   // A frame not steered by (lost or uncertain) remembers a rival place too: any far key image its comparisons accepted
   // (it verifies more than the frame's key images, which verify nothing a robot may steer by), and compares the one
   // remembered, as a tracked frame does. A robot carried along the route verifies nothing where the tracker holds it,

@@ -302,8 +302,10 @@ TEST_F(XfeatCorridorRun, AJumpBackNoClearerThanWhereTheFramesWereIsDoubted) {
   for (const std::string seed : {"10", "5"}) {
     SCOPED_TRACE("verifier seed " + seed);
     ExpectNoFarFrameButWithout(
-        // The later rule that questions a hold begun after a frame not steered by mends these frames too: as any hold.
-        " --no-doubt-jump-back --no-look-past-weak-next --unsettled-stalled-tracker-frames 7",
+        // The later rules that question a hold begun after a frame not steered by and that look further ahead from a
+        // tracker lagging the run's start mend these frames too: off as well.
+        " --no-doubt-jump-back --no-look-past-weak-next --unsettled-stalled-tracker-frames 7"
+        " --lagging-tracker-frames 0",
         "a frame placed by a jump back",
         [&](const std::string& flags) { return SteeredOnRepeat(20, 36, 0, " --verifier-seed " + seed + flags); });
   }
@@ -356,7 +358,8 @@ TEST_F(XfeatCorridorRun, ATrackerHeldAtALookAlikeLooksPastAWeakNextKeyImage) {
   for (const std::string seed : {"14", "8"}) {
     SCOPED_TRACE("verifier seed " + seed);
     ExpectNoFarFrameButWithout(
-        " --no-look-past-weak-next", "the frames held at the look-alike key images",
+        // The later rule that looks further ahead from a tracker lagging the run's start mends these frames too.
+        " --no-look-past-weak-next --lagging-tracker-frames 0", "the frames held at the look-alike key images",
         [&](const std::string& flags) { return SteeredOnRepeat(20, 34, 0, " --verifier-seed " + seed + flags); });
   }
 }
@@ -424,6 +427,20 @@ TEST_F(XfeatCorridorRun, AFrameTrackedOnFromNearWhereTheRunWasSteeredIsNotDoubte
     const auto frame55 = std::find_if(steered.begin(), steered.end(), [](const auto& s) { return s.first == 55; });
     ASSERT_NE(frame55, steered.end()) << "repeat frame 55 is not steered by";
     EXPECT_EQ(Right({*frame55}), 1) << "repeat frame 55 is steered by at key image " << frame55->second;
+  }
+}
+
+// A tracker lagging the run's start looks further ahead (docs/localize.md): repeat frames 20-36 started at key image 0
+// (the corridor from 20), at the verifier's seeds 153 and 54. Frame 20 is placed at key image 2 (right: 4-5), key
+// image 3 (teach frame 9) verifies nearly every frame after it, and the tracker stayed at 3-4 to frame 31 (right from
+// frame 27: 6-8): frames 28-31 were steered by more than two key images off. Lagging six frames after the start, the
+// tracker compares the two key images after the next one and steps on to 6 on frame 26 or 27.
+TEST_F(XfeatCorridorRun, ATrackerLaggingTheRunsStartLooksFurtherAhead) {
+  for (const std::string seed : {"153", "54"}) {
+    SCOPED_TRACE("verifier seed " + seed);
+    ExpectNoFarFrameButWithout(
+        " --lagging-tracker-frames 0", "a start placed short and held at key images 3-4",
+        [&](const std::string& flags) { return SteeredOnRepeat(20, 36, 0, " --verifier-seed " + seed + flags); });
   }
 }
 
