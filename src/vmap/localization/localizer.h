@@ -483,8 +483,8 @@ class Localizer {
   // The hold at stalled_position_ is questioned at this many frames: stalled_tracker_frames, or
   // unsettled_stalled_tracker_frames where it began within two frames of a frame not steered by.
   int stall_bar_ = 0;
-  // The frames localized since the run's start, and the tracker's route positions after the last lagging_tracker_frames
-  // of them (LookFurtherWhenLagging).
+  // The frames localized since the run's start (counted up to lagging_start_frames + 1), and the tracker's route
+  // positions after the last lagging_tracker_frames of them (LookFurtherWhenLagging).
   int frames_since_start_ = 0;
   std::deque<int> recent_positions_;
   int placed_in_a_row_ = 0;        // frames placed (tracking or relocalized) in a row before this one

@@ -46,7 +46,8 @@ void Localizer::LookFurtherWhenLagging(const Frame& frame, const ImageFeatures& 
 }
 
 void Localizer::RememberPace() {
-  ++frames_since_start_;
+  // Counted only as far as the rule reads it: a long run does not overflow the count.
+  if (frames_since_start_ <= options_.lagging_start_frames) ++frames_since_start_;
   if (position_ < 0) {
     recent_positions_.clear();
     return;
