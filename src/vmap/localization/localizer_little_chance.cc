@@ -4,7 +4,8 @@
 // verifier's seed 26: repeat frames 50-53 were uncertain, and frame 54 was relocalized at key image 30 (right: 14-15)
 // on 21 matches at log10 NFA -3.1 (the next key image +0.5), steered by 16 key images from frame 48's key image 14
 // (docs/measurements/localization-conditions.md, "A relocalization away on little chance is doubted"). A frame
-// relocalized near the place steered by, or one whose key images verify beyond a little chance, is not asked. A frame
+// relocalized near the place steered by, or one whose key image verifies beyond a little chance, is not asked; nor
+// one whose next key image does, where the belief singles the place out (away_next_key_min_confidence). A frame
 // tracked that far is asked too: an uncertain frame moved the tracker there, a relocalization nothing steered by yet
 // (the corridor from repeat frame 20 at the verifier's seed 48: frame 52 moved it to key image 31, right: 14-15, and
 // frame 53 was tracked there on 24 matches at -8.2; "A frame tracked away on little chance is doubted").
@@ -29,10 +30,13 @@ bool Localizer::PlacedAwayOnLittleChance(const LocalizationResult& result) const
       std::abs(result.route_position - frame_start_position_) <= kNear) {
     return false;
   }
-  for (const KeyComparison* c : {&result.to_key, &result.to_next}) {
-    if (c->key >= 0 && PassesChance(*c, kBeyondLittleChance)) return false;
-  }
-  return true;
+  auto beyond_little_chance = [](const KeyComparison& c) { return c.key >= 0 && PassesChance(c, kBeyondLittleChance); };
+  if (beyond_little_chance(result.to_key)) return false;
+  // The next key image vouches for the place only where the belief singles it out: corridor_conditions' dark frames
+  // verify the route's end, key images 29-31, through the lens rim (seeds 87, 165 and 167: frame 55 at key image 29 at
+  // log10 NFA -7.5 to -9.3, key image 30 at -15.4, the belief 0.55-0.74 near it; right: 14-16).
+  const bool next_may_vouch = belief_.MassWithin(result.route_position, kNear) >= options_.away_next_key_min_confidence;
+  return !(next_may_vouch && beyond_little_chance(result.to_next));
 }
 
 }  // namespace vmap

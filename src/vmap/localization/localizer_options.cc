@@ -132,6 +132,14 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "uncertain)"},
                 doubt_relocalization_on_little_chance);
   visitor.Visit(
+      OptionField{"away_next_key_min_confidence", "--away-next-key-min-confidence",
+                  "Float descriptors: the belief a frame placed more than two key images from where the run was last "
+                  "steered by needs near it for its next key image's evidence to vouch for it (below, its own key "
+                  "image must verify beyond a little chance, else it is uncertain; 0: the next key image always "
+                  "vouches)"}
+          .Within(0, 1),
+      away_next_key_min_confidence);
+  visitor.Visit(
       OptionField{"rival_place_frames", "--rival-place-frames",
                   "Frames a far key image that verified more than the one a frame was steered by is compared again; "
                   "a tracked frame it out-verifies again is relocalized (0 = never)"}

@@ -177,6 +177,15 @@ struct LocalizerOptions {
   // (seed 48's corridor from repeat frame 20: frame 53 at key image 31 at -8.2, right: 14-15; "A frame tracked away on
   // little chance is doubted"; "Tracked on from near the place steered by"). Off: such a frame is steered by.
   bool doubt_relocalization_on_little_chance = true;
+  // With doubt_relocalization_on_little_chance: the next key image's evidence vouches for such a frame only where the
+  // belief holds at least this near it; below, the key image the frame is steered by must itself verify beyond a
+  // little chance. corridor_conditions' dark repeat frame 55 (right: key images 14-16) was placed at key image 29 at
+  // log10 NFA -7.5 to -9.3 on the strength of key image 30's -15.4, with 0.55-0.74 of the belief near it, 15 key images
+  // from where the run was last steered (the verifier's seeds 87, 165 and 167); over seeds 0-19 the 4 right frames
+  // placed so far with less than 0.9 near them verified their own key image at -14.6 to -29.3
+  // (docs/measurements/localization-conditions.md, "A far place vouched for by its next key image needs the belief").
+  // 0: the next key image vouches whatever the belief.
+  double away_next_key_min_confidence = 0.9;
   // A place elsewhere on the route that verified more matches than the key images a frame was steered by (a key image
   // more than two route positions away) is a rival: for this many frames it is compared again (it and the key image
   // after it), and a tracked frame it out-verifies again is relocalized, as a frame that shares little with its key

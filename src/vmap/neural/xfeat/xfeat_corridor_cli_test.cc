@@ -1,157 +1,19 @@
 // `vmap localize` with XFeat on corridor_conditions' repeat run (frame i taken where the teach run's frame i was),
 // through the built binary: each test a slice of the runs bench/route_conditions.py measures, where a rule of the
-// localizer keeps frames from being steered by at the wrong key image (docs/localize.md).
+// localizer keeps frames from being steered by at the wrong key image (docs/localize.md). The dark stretch's rules
+// (repeat frames 50-55): xfeat_corridor_dark_stretch_cli_test.cc; the fixture: xfeat_corridor_run.h.
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
-#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
-#include "vmap/testing/localize_cli_test_util.h"
-#include "vmap/testing/run_vmap.h"
-#include "vmap/testing/scoped_temp_dir.h"
-#include "vmap/testing/shared_data.h"
+#include "vmap/neural/xfeat/xfeat_corridor_run.h"
 
 namespace vmap::neural {
 namespace {
-
-using testing::RunVmap;
-using testing::SharedDir;
-using ::vmap::testing::SteeredFrames;
-using TempDir = testing::ScopedTempDir;
-namespace fs = std::filesystem;
-
-std::string FoldedWeights() { return SharedDir() + "/weights/xfeat/xfeat_folded.pt"; }
-
-// The key images bracketing teach frame `frame` (the last at or before it, the first at or after it), of a map whose
-// key images are teach frames `sources` (ascending).
-std::vector<int> KeysAround(const std::vector<int>& sources, int frame) {
-  std::vector<int> keys;
-  for (int k = static_cast<int>(sources.size()) - 1; k >= 0; --k) {
-    if (sources[k] <= frame) {
-      keys.push_back(k);
-      break;
-    }
-  }
-  for (int k = 0; k < static_cast<int>(sources.size()); ++k) {
-    if (sources[k] >= frame) {
-      keys.push_back(k);
-      break;
-    }
-  }
-  return keys;
-}
-
-// The right key images of corridor_conditions' repeat frame `repeat`: those bracketing its teach frames i-2..i+2
-// (bench/route_conditions.py's count).
-std::vector<int> RightKeys(const std::vector<int>& sources, int repeat) {
-  std::vector<int> keys;
-  for (int j = repeat - 2; j <= repeat + 2; ++j) {
-    for (int k : KeysAround(sources, j)) keys.push_back(k);
-  }
-  return keys;
-}
-
-// corridor_conditions' repeat run (its frame i taken where the teach run's frame i was) against an XFeat map of its
-// teach run, built for each test in a temporary folder. Counts frames steered by as (repeat frame, key) pairs.
-class XfeatCorridorRun : public ::testing::Test {
- protected:
-  void SetUp() override {
-    SKIP_WITHOUT_SHARED();
-    if (!fs::exists(data_)) GTEST_SKIP() << data_ << " is not present";
-    const auto built = RunVmap("build " + ::vmap::testing::Quote(data_ / "teach") + " --matcher xfeat --weights " +
-                               FoldedWeights() + " -q -o " + ::vmap::testing::Quote(map_));
-    ASSERT_EQ(built.status, 0) << built.output;
-    std::ifstream map_file(map_ / "map.json");
-    const nlohmann::json map_json = nlohmann::json::parse(map_file);
-    for (const auto& key : map_json["key_images"]) sources_.push_back(key["source_index"].get<int>());
-    ASSERT_FALSE(sources_.empty());
-  }
-
-  // The key image at or before teach frame `frame`: where a run of the repeat from frame `frame` is started.
-  int KeyBefore(int frame) const { return KeysAround(sources_, frame).front(); }
-
-  // The frames steered by when repeat frames `first`-`last` are localized, started at `start_key`, with `flags`.
-  std::vector<std::pair<int, int>> SteeredOnRepeat(int first, int last, int start_key, const std::string& flags) {
-    return SteeredFrames(::vmap::testing::Quote(map_) + " " + ::vmap::testing::Quote(data_ / "repeat") + " --first " +
-                             std::to_string(first) + " --last " + std::to_string(last) + " --start-key " +
-                             std::to_string(start_key) + flags,
-                         dir_.path() / "run.csv");
-  }
-
-  // The frames steered by when repeat frames taken in the order `repeat_of` gives (a robot carried off: run frame f
-  // is repeat frame repeat_of[f]) are localized, started at `start_key`, with `flags`.
-  std::vector<std::pair<int, int>> SteeredOnRun(const std::vector<int>& repeat_of, int start_key,
-                                                const std::string& flags) {
-    const fs::path run = dir_.path() / "run";  // a folder of links to the repeat's frames, named in the run's order
-    fs::remove_all(run);
-    fs::create_directories(run);
-    for (size_t f = 0; f < repeat_of.size(); ++f) {
-      char name[32];
-      std::snprintf(name, sizeof(name), "%07d.jpg", repeat_of[f]);
-      char link[32];
-      std::snprintf(link, sizeof(link), "%07zu.jpg", f);
-      fs::create_symlink(data_ / "repeat" / name, run / link);
-    }
-    std::vector<std::pair<int, int>> steered =
-        SteeredFrames(::vmap::testing::Quote(map_) + " " + ::vmap::testing::Quote(run) + " --start-key " +
-                          std::to_string(start_key) + flags,
-                      dir_.path() / "run.csv");
-    for (auto& [frame, key] : steered) frame = repeat_of.at(frame);
-    return steered;
-  }
-
-  // How many of `steered` (repeat frame, key) are at a key image more than 2 from every right one.
-  int Far(const std::vector<std::pair<int, int>>& steered) const {
-    int far = 0;
-    for (const auto& [frame, key] : steered) {
-      int nearest = 1 << 20;
-      for (int k : RightKeys(sources_, frame)) nearest = std::min(nearest, std::abs(key - k));
-      far += nearest > 2;
-    }
-    return far;
-  }
-
-  // The shape of a test of a rule that keeps frames from being steered by far: with the defaults no frame `steered`
-  // gives is more than 2 key images off, with `rule_off` (the rule's flag off, and those of later rules that mend the
-  // same frames) at least one is; else the slice no longer reaches the frames it was chosen for, `premise`.
-  void ExpectNoFarFrameButWithout(const std::string& rule_off, const std::string& premise,
-                                  const std::function<std::vector<std::pair<int, int>>(const std::string&)>& steered) {
-    EXPECT_EQ(Far(steered("")), 0);
-    EXPECT_GE(Far(steered(rule_off)), 1) << "the test no longer reaches " << premise;
-  }
-
-  // How many of `steered` (repeat frame, key) are at a right key image.
-  int Right(const std::vector<std::pair<int, int>>& steered) const {
-    int right = 0;
-    for (const auto& [frame, key] : steered) {
-      const std::vector<int> keys = RightKeys(sources_, frame);
-      right += std::find(keys.begin(), keys.end(), key) != keys.end();
-    }
-    return right;
-  }
-
-  const fs::path data_ = fs::path(SharedDir()) / "data/corridor_conditions";
-  const TempDir dir_{"corridor"};
-  const fs::path map_ = dir_.path() / "map";
-  std::vector<int> sources_;  // the map's key images' teach frames
-};
-
-// The frames of a run carried from repeat frame `from_first`-`from_last` to `to_first`-`to_last`.
-std::vector<int> CarriedRun(int from_first, int from_last, int to_first, int to_last) {
-  std::vector<int> repeat_of;
-  for (int i = from_first; i <= from_last; ++i) repeat_of.push_back(i);
-  for (int i = to_first; i <= to_last; ++i) repeat_of.push_back(i);
-  return repeat_of;
-}
 
 // A robot carried off (docs/localize.md, "A lone step back is doubted"): corridor_conditions' repeat frames 90-110 and
 // then 20-25 as one run (carried 70 frames back), started at teach frame 90's key image. On the first frame after the
@@ -311,28 +173,6 @@ TEST_F(XfeatCorridorRun, AJumpBackNoClearerThanWhereTheFramesWereIsDoubted) {
   }
 }
 
-// A jump back is judged from where the run was steered (docs/localize.md): repeat frames 0-62 started at key image 0
-// (bench/route_conditions.py's corridor run), at the verifier's seed 106. After the dark stretch an unconfirmed
-// relocalization left the tracker at key image 30 (the route's end) while the run was last steered by at key image 14
-// (frame 49); frames 56-60 verified the right key images 15-16 at log10 NFA -10 to -32, and each was doubted as a jump
-// back from 30: uncertain, the tracker held at 30. Judged from the place last steered by, frames 56-60 are steered by
-// at the right key images.
-TEST_F(XfeatCorridorRun, AJumpBackIsJudgedFromWhereTheRunWasSteered) {
-  auto steered_after_dark = [&](const std::string& flags) {
-    std::vector<std::pair<int, int>> after;
-    for (const auto& steered : SteeredOnRepeat(0, 62, 0, " --verifier-seed 106" + flags)) {
-      if (steered.first >= 54 && steered.first <= 60) after.push_back(steered);
-    }
-    return after;
-  };
-  const auto judged = steered_after_dark(""),
-             from_tracker = steered_after_dark(" --no-judge-jump-back-from-steered-place");
-  EXPECT_EQ(Far(judged), 0);
-  EXPECT_GE(Right(judged), 4);
-  EXPECT_GE(Right(judged), Right(from_tracker) + 4)
-      << "the test no longer reaches the frames doubted as a jump back from the route's end";
-}
-
 // A run started elsewhere confirms a place that stands out (docs/localize.md): repeat frames 50-62 started at key
 // image 0 (bench/route_conditions.py's corridor from 50), at the verifier's seeds 10 and 11. Frame 53 verifies key
 // image 29 (the route's dark end; right: 14-15), frame 54 key images 29-30 with as many matches as key image 16 (22):
@@ -392,42 +232,6 @@ TEST_F(XfeatCorridorRun, AStartConfirmedAtALookAlikeIsAskedByTheFramesRanking) {
   ExpectNoFarFrameButWithout(
       " --no-start-evidence-ranks-frame", "the frames tracked at key image 13",
       [&](const std::string& flags) { return SteeredOnRepeat(90, 100, 0, " --verifier-seed 12" + flags); });
-}
-
-// A relocalization away on little chance is doubted (docs/localize.md): repeat frames 44-58 at the verifier's seed 26,
-// the corridor's dark stretch. Frame 48 was tracked at key image 14; frames 49-53 were uncertain, and frame 54 was
-// relocalized at key image 30 (right: 14-15) on 21 matches at log10 NFA -3.1, its next key image at +0.5: steered by
-// 16 key images from where the run last was. Doubted, it is uncertain.
-TEST_F(XfeatCorridorRun, ARelocalizationAwayOnLittleChanceIsDoubted) {
-  ExpectNoFarFrameButWithout(
-      " --no-doubt-relocalization-on-little-chance", "frame 54 relocalized at key image 30",
-      [&](const std::string& flags) { return SteeredOnRepeat(44, 58, KeyBefore(44), " --verifier-seed 26" + flags); });
-}
-
-// A frame tracked away on little chance is doubted (docs/localize.md, "A relocalization away on little chance is
-// doubted"): repeat frames 40-56 at the verifier's seed 48, started at teach frame 40's key image. Frame 50 is tracked
-// at key image 13; in the dark stretch frame 52 moves the tracker to key image 31 uncertain, and frame 53 was tracked
-// there on 24 matches at log10 NFA -8.2, its next key image at +4.8 (right: 14-15). Doubted, it is uncertain.
-TEST_F(XfeatCorridorRun, AFrameTrackedAwayOnLittleChanceIsDoubted) {
-  ExpectNoFarFrameButWithout(
-      " --no-doubt-relocalization-on-little-chance", "frame 53 tracked at key image 31",
-      [&](const std::string& flags) { return SteeredOnRepeat(40, 56, KeyBefore(40), " --verifier-seed 48" + flags); });
-}
-
-// A frame tracked on from near where the run was steered is not doubted for its little chance (docs/localize.md, "A
-// relocalization away on little chance is doubted"): repeat frames 44-60, started at teach frame 44's key image, at the
-// verifier's seeds 8 and 13. Frame 50 is steered by at key image 13; frames 51-53 are the dark stretch's, uncertain,
-// and the tracker starts frame 54 within two key images of 13. Frames 54-55 are tracked at key image 16 (in the whole
-// corridor run at log10 NFA -2.7 to -7.3); three key images from 13 they were doubted, and 55 is right there (14-16).
-TEST_F(XfeatCorridorRun, AFrameTrackedOnFromNearWhereTheRunWasSteeredIsNotDoubted) {
-  for (const std::string seed : {"8", "13"}) {
-    SCOPED_TRACE("verifier seed " + seed);
-    const std::vector<std::pair<int, int>> steered = SteeredOnRepeat(44, 60, KeyBefore(44), " --verifier-seed " + seed);
-    EXPECT_EQ(Far(steered), 0);
-    const auto frame55 = std::find_if(steered.begin(), steered.end(), [](const auto& s) { return s.first == 55; });
-    ASSERT_NE(frame55, steered.end()) << "repeat frame 55 is not steered by";
-    EXPECT_EQ(Right({*frame55}), 1) << "repeat frame 55 is steered by at key image " << frame55->second;
-  }
 }
 
 // A tracker lagging the run's start looks further ahead (docs/localize.md): repeat frames 20-36 started at key image 0
