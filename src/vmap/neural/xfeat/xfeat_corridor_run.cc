@@ -38,8 +38,8 @@ std::vector<int> KeysAround(const std::vector<int>& sources, int frame) {
   return keys;
 }
 
-}  // namespace
-
+// The right key images of corridor_conditions' repeat frame `repeat`: those bracketing its teach frames i-2..i+2
+// (bench/route_conditions.py's count).
 std::vector<int> RightKeys(const std::vector<int>& sources, int repeat) {
   std::vector<int> keys;
   for (int j = repeat - 2; j <= repeat + 2; ++j) {
@@ -47,6 +47,8 @@ std::vector<int> RightKeys(const std::vector<int>& sources, int repeat) {
   }
   return keys;
 }
+
+}  // namespace
 
 std::vector<int> CarriedRun(int from_first, int from_last, int to_first, int to_last) {
   std::vector<int> repeat_of;

@@ -17,10 +17,6 @@
 
 namespace vmap::neural {
 
-// The right key images of corridor_conditions' repeat frame `repeat`, of a map whose key images are teach frames
-// `sources` (ascending): those bracketing its teach frames i-2..i+2 (bench/route_conditions.py's count).
-std::vector<int> RightKeys(const std::vector<int>& sources, int repeat);
-
 // The frames of a run carried from repeat frame `from_first`-`from_last` to `to_first`-`to_last`.
 std::vector<int> CarriedRun(int from_first, int from_last, int to_first, int to_last);
 
