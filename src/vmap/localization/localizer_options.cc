@@ -176,6 +176,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
           "(--lagging-tracker-frames)"}
           .Within(0, 100000),
       lagging_start_frames);
+  visitor.Visit({"lagging_step_weighs_belief", "!--no-lagging-step-weighs-belief",
+                 "a lagging tracker's step further ahead moves the tracker only, not the belief (it weighs the place "
+                 "stepped to ten to one otherwise)"},
+                lagging_step_weighs_belief);
   visitor.Visit({"rival_place_when_not_steered", "!--no-rival-place-when-not-steered",
                  "Remember and compare a far key image a lost or uncertain frame verified as a rival place too "
                  "(otherwise only frames steered by remember one)"},

@@ -230,6 +230,17 @@ struct LocalizerOptions {
   int lagging_tracker_frames = 6;
   // lagging_tracker_frames: a tracker is asked so up to this many frames after the run's first.
   int lagging_start_frames = 10;
+  // The lagging tracker's step weighs the belief too, ten to one at the key image stepped to: the start key image's
+  // prior still holds the belief behind the tracker, and a frame after the step that shares little with its key image
+  // (where key images lie far apart) was relocalized back to the look-alike, where the belief still was
+  // (corridor_conditions from repeat frame 20, the verifier's seed 188: stepped on from key image 3 to 5 on frame 26,
+  // frame 29 verified key image 7 at log10 NFA -3.6 and was relocalized back at 3, frame 32 tracked at 2, both steered
+  // by; right: 6-8). Weighed, the belief holds 0.87 near key image 5 on frame 26 rather than 0.65, frame 29 stays at 7
+  // and frames 31-36 are steered by at 8. Ten to one, as a lost frame's ranking and heading agreeing weigh it: the step
+  // is the tracker's move, which the frame's comparisons, weighed as any, do not tell the belief
+  // (docs/measurements/localization-conditions.md, "A lagging tracker's step moves the belief too"). Off: the step
+  // moves the tracker only.
+  bool lagging_step_weighs_belief = true;
   // A frame not steered by (lost or uncertain) remembers a rival place too: any far key image its comparisons accepted
   // (it verifies more than the frame's key images, which verify nothing a robot may steer by), and compares the one
   // remembered, as a tracked frame does. A robot carried along the route verifies nothing where the tracker holds it,

@@ -248,6 +248,17 @@ TEST_F(XfeatCorridorRun, ATrackerLaggingTheRunsStartLooksFurtherAhead) {
   }
 }
 
+// A lagging tracker's step moves the belief too (docs/localize.md, "A tracker lagging the run's start looks further
+// ahead"): repeat frames 20-36 started at key image 0 (the corridor from 20), at the verifier's seed 188. The tracker
+// steps on from key image 3 to 5 on frame 26; frame 29 shares little with key image 7 (the key images there lie far
+// apart), and the belief, still held near key image 3 by the start's prior, relocalized it back there (right: 6-8);
+// frame 32 was tracked at key image 2. Weighed at key image 5 by the step, the belief keeps the frames on.
+TEST_F(XfeatCorridorRun, ALaggingTrackersStepMovesTheBeliefToo) {
+  ExpectNoFarFrameButWithout(
+      " --no-lagging-step-weighs-belief", "frames relocalized back to key image 3 after the step",
+      [&](const std::string& flags) { return SteeredOnRepeat(20, 36, 0, " --verifier-seed 188" + flags); });
+}
+
 // A start away from the start key image needs the belief (docs/localize.md): repeat frames 50-60 started at key image 0
 // (the corridor from 50), at the verifier's seeds 35 and 22. Frames 50-53 are the corridor's dark stretch and verify
 // chance's count everywhere; frames 53-54 verify key image 29 (right: 13-15) at log10 NFA -9.6 to -19.4, the jump is
