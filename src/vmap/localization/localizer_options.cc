@@ -282,6 +282,12 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Never move a tracked frame on to the next key image because the belief puts it past that key "
                  "image (only the verified counts step on)"},
                 step_on_by_belief);
+  visitor.Visit(
+      OptionField{"step_on_by_belief_ahead", "--step-on-by-belief-ahead",
+                  "step_on_by_belief: the positions past each key image ahead whose belief is weighed against the two "
+                  "at and behind the key image the tracker is at (3: as before 2026-12-04)"}
+          .Within(1, 5),
+      step_on_by_belief_ahead);
   visitor.Visit({"hold_unearned_step_on", "!--no-hold-unearned-step-on",
                  "Keep a step on the belief undoes when the key image it passed does not verify (as before)"},
                 hold_unearned_step_on);

@@ -309,6 +309,16 @@ struct LocalizerOptions {
   // Only where the ranking weighs the belief (`rank_evidence`, XFeat): ORB's belief holds nothing the counts did not
   // (docs/localize.md, "A key image the belief puts behind is left"). Off: only the counts step on.
   bool step_on_by_belief = true;
+  // step_on_by_belief: the belief on this many positions from the key image ahead is weighed against the belief on the
+  // two at and behind the key image the tracker is at: as many on each side. Three against two moved the tracker on by
+  // the windows' widths alone where the belief is spread (a run's first frames across lighting): corridor_conditions at
+  // the verifier's seed 241, the tracker stepped on from key image 5 to 6, 7 and 9 on repeat frames 21-23 with the
+  // belief's peak at 4, and frame 23 was steered by at 9 (right: 4-6). Over seeds 232-255 two against two: the corridor
+  // 104.21 -> 104.50 a seed, the kidnapped run 95.25 -> 95.54, started elsewhere 194.04 -> 194.38, far frames 2 -> 0;
+  // held out, seeds 184-231: 104.38 -> 104.54, 96.25 -> 96.42, 191.31 -> 191.46
+  // (docs/measurements/localization-conditions.md, "The belief's step on weighs as many positions on each side").
+  // 3: the rule as it was before 2026-12-04.
+  int step_on_by_belief_ahead = 2;
   // A step on the belief undoes (Localizer::SettleStepOn: after the frame's evidence it holds more behind the key image
   // left than past the one reached) is undone also when the key image it passed does not verify: the tracker stays on
   // the segment before the key image reached, tracking (that key image, now `next_key`, verified). Across lighting the

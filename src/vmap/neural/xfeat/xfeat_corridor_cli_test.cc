@@ -259,6 +259,16 @@ TEST_F(XfeatCorridorRun, ALaggingTrackersStepMovesTheBeliefToo) {
       [&](const std::string& flags) { return SteeredOnRepeat(20, 36, 0, " --verifier-seed 188" + flags); });
 }
 
+// The belief's step on weighs as many positions on each side (docs/localize.md, "A key image the belief puts behind is
+// left"): repeat frames 0-30 from key image 0, at the verifier's seed 241. The belief spread over key images 3-11 on
+// frames 21-23 with its peak at 4; weighing three positions ahead against two behind, it stepped the tracker on from
+// key image 5 to 6, 7 and 9, and frame 23 was steered by at 9 (right: 4-6). Two against two, the tracker stays at 5.
+TEST_F(XfeatCorridorRun, TheBeliefsStepOnWeighsAsManyPositionsOnEachSide) {
+  ExpectNoFarFrameButWithout(
+      " --step-on-by-belief-ahead 3", "frame 23 stepped on to key image 9 by the belief",
+      [&](const std::string& flags) { return SteeredOnRepeat(0, 30, 0, " --verifier-seed 241" + flags); });
+}
+
 // A start away from the start key image needs the belief (docs/localize.md): repeat frames 50-60 started at key image 0
 // (the corridor from 50), at the verifier's seeds 35 and 22. Frames 50-53 are the corridor's dark stretch and verify
 // chance's count everywhere; frames 53-54 verify key image 29 (right: 13-15) at log10 NFA -9.6 to -19.4, the jump is
