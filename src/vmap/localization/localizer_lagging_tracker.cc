@@ -16,9 +16,6 @@ namespace {
 // The key images compared past the next one: the next one was compared by the lookahead, and a place two key images
 // short (corridor_conditions' start from repeat frame 20) is mended by the second after it.
 constexpr int kFurther = 2;
-// What the step weighs the belief by at the key image stepped to (log of the likelihood ratio; why:
-// LocalizerOptions::lagging_step_weighs_belief).
-constexpr double kStepLogRatio = 2.302585092994046;  // ln 10
 
 }  // namespace
 
@@ -47,7 +44,7 @@ void Localizer::LookFurtherWhenLagging(const Frame& frame, const ImageFeatures& 
   best = further_best;
   best_position = further_position;
   if (options_.lagging_step_weighs_belief) {
-    WeighBeliefs(further_position, kStepLogRatio);
+    WeighBeliefs(further_position, kAgreementLogRatio);  // why: lagging_step_weighs_belief
     NormalizeBeliefs();
   }
 }

@@ -15,11 +15,6 @@ namespace {
 // match: the step back is not checked again until the frame moves back (Localizer::Track). Chosen on lab_floor
 // (docs/measurements/code-choices.md, "Ruling out a step back").
 constexpr double kClearlyWorse = 0.7;
-// What a lost frame's ranking and heading mode agreeing on a key image tell of it (log of the likelihood ratio):
-// on michigan_seasons' ORB frames nothing verifies, both name the right key image in 20.2 % of the frames and each
-// wrong one in 2.0 % (docs/measurements/localization-conditions.md, "A lost frame steps on where its ranking and its
-// heading agree"): ten times likelier at the right key image.
-constexpr double kAgreementLogRatio = 2.302585092994046;  // ln 10
 
 }  // namespace
 
