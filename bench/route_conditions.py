@@ -4,6 +4,10 @@
 corridor: ../shared/data/corridor_conditions: a map of teach/ (`vmap build`), repeat/ localized against it; repeat
   frame i was taken where teach frame i was, and a frame is right when its key image is one of those around any
   teach frame i-2..i+2 (the key images bracketing it, with the data set's +-2 frames).
+places: corridor_conditions as a map of places, as a path taught once per place (the issue's snowy park: 101 places a
+  few metres apart, frame i of the repeat at key image i of a `--tau 1` map): every third teach frame a key image
+  (`vmap build --tau 1 --stride 3`) and every third repeat frame localized against it, so the run passes a key image
+  every frame; right as the corridor's (the data set's +-2 frames).
 michigan: ../shared/data/michigan_seasons as routes: for every ordered pair of sessions (a, b), a map of session a's
   five places in order (`--tau 1`: every place a key image) and session b's five places localized against it
   (frame i right at key image i). 132 routes of 5 frames.
@@ -42,7 +46,7 @@ near comparisons sit at chance's boundary and the seed moves corridor ORB's righ
 a few frames is judged on the means (docs/measurements/localization-conditions.md, "The verifier's seed: the spread
 of every figure"). Default: the map's seed only, the flag not passed (binaries before the flag take no --seeds).
 
-usage: bench/route_conditions.py --vmap build/vmap[,old/vmap] [--sets corridor,kidnapped,elsewhere,michigan] [--matchers orb,xfeat]
+usage: bench/route_conditions.py --vmap build/vmap[,old/vmap] [--sets corridor,kidnapped,elsewhere,places,michigan] [--matchers orb,xfeat]
                                  [--tau T] [--start-key K|none] [--build "FLAGS"] [--localize "FLAGS"] [--repeat-stride N] [--work DIR] [--csv-dir DIR]
                                  [--evidence-dir DIR] [--seeds S,S,...] [--named-frames N]
 (from the repository root; ../shared must be there)"""
@@ -184,6 +188,11 @@ def corridor(vmap, matcher, tau_flags, localize_flags, stride, work, csv_dir, ev
     tally = tally or Tally()
     tally.add(doc, lambda f: corridor_right_keys(key_sources, f["source_index"]), label)
     return tally, len(key_sources)
+
+
+# The places set's map and repeat: every third frame, every teach frame kept a key image.
+PLACES_BUILD = ["--tau", "1", "--stride", "3"]
+PLACES_STRIDE = 3
 
 
 # The kidnapped run's stretches of repeat frames, first and last included, in the order the robot saw them.
@@ -339,6 +348,12 @@ def main():
                         vmap, matcher, keys, ", repeat stride %d" % args.repeat_stride if args.repeat_stride > 1
                         else ""), lambda flags, csv_dir: corridor(vmap, matcher, tau_flags, flags, args.repeat_stride,
                                                                   work, csv_dir, args.evidence_dir)[0])
+                if "places" in sets:
+                    places_flags = PLACES_BUILD + build_flags
+                    keys = len(corridor_map(vmap, matcher, places_flags, work)[1])
+                    runs("%s: corridor as places (every third frame, --tau 1), %s, %d key images" % (vmap, matcher, keys),
+                         lambda flags, csv_dir: corridor(vmap, matcher, places_flags, flags, PLACES_STRIDE, work, csv_dir,
+                                                         label="places")[0])
                 if "kidnapped" in sets:
                     runs("%s: kidnapped corridor (repeat %s), %s" % (vmap, ", ".join("%d-%d" % s for s in KIDNAPPED),
                                                                     matcher),

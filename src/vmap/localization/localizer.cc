@@ -145,6 +145,9 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
         [this](const ImageFeatures& features, int key) { return Compare(features, key, FarComparisonIterations(key)); },
         options_.comparison_threads - 1);
   }
+  std::vector<int> route_source_indices;
+  for (const int k : route_) route_source_indices.push_back(map_.key_images[k].source_index);
+  teach_frames_per_position_ = TeachFramesPerPosition(route_source_indices);
   Reset();  // at the start key image, when there is one
 }
 
@@ -175,6 +178,7 @@ void Localizer::Reset() {
   stalled_position_ = -1;
   stalled_frames_ = 0;
   frames_since_start_ = 0;
+  source_index_before_ = -1;
   recent_positions_.clear();
   stall_bar_ = options_.stalled_tracker_frames;
   placed_in_a_row_ = 0;
@@ -210,8 +214,16 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   made_ahead_ = std::move(ahead);
   ranked_.clear();
   bucket_of_position_.clear();
-  belief_.Predict();
-  if (start_unconfirmed_) evidence_belief_.Predict();
+  // The run's first frame is one step from its start, as the model was fitted: how far it is from the frame before
+  // is not known.
+  const int motion_steps =
+      source_index_before_ < 0 ? 1
+      : options_.belief.motion_steps_per_frame > 0
+          ? options_.belief.motion_steps_per_frame
+          : MotionStepsPerFrame(frame.source_index - source_index_before_, teach_frames_per_position_);
+  source_index_before_ = frame.source_index;
+  belief_.Predict(motion_steps);
+  if (start_unconfirmed_) evidence_belief_.Predict(motion_steps);
   // Guided matching asks where the estimate was dropped for max_lost_frames frames (guided_while_lost).
   if (dropped_position_ >= 0 && ++frames_since_drop_ > options_.max_lost_frames) dropped_position_ = -1;
   belief_confident_ = SinglesOut(belief_.Peak());

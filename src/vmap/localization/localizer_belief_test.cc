@@ -97,6 +97,52 @@ TEST(RouteBelief, AStartLeansItThereAndTheEvidenceOverridesIt) {
   EXPECT_GT(belief.MassWithin(belief.Peak(), 1), 0.9);
 }
 
+// A run that passes a key image every frame (a map of every place it passes) with evidence at the key image it is at:
+// moved one step of the motion model a frame, the belief stays behind the evidence and holds a key image the run left
+// while that key image still matches; moved as many steps as the map's spacing says, it keeps up.
+TEST(RouteBelief, ItKeepsUpWithARunThatPassesAKeyImageEveryFrame) {
+  auto peak_after = [](int steps) {
+    RouteBelief belief(30, RouteBeliefOptions{});
+    belief.Start(0, 0.5);
+    for (int key = 0; key < 12; ++key) {
+      belief.Predict(steps);
+      belief.Weigh(key, 3.0);
+      belief.Normalize();
+    }
+    // Key image 11 keeps matching (a look-alike of what follows) as much as the key images the run goes on past.
+    for (int key = 12; key < 18; ++key) {
+      belief.Predict(steps);
+      belief.Weigh(11, 2.0);
+      belief.Weigh(key, 2.0);
+      belief.Normalize();
+    }
+    return belief.Peak();
+  };
+  EXPECT_LE(peak_after(1), 12);
+  EXPECT_GE(peak_after(MotionStepsPerFrame(1, 1.0)), 16);
+}
+
+TEST(RouteBelief, TheMotionStepsFollowTheMapsSpacingAndTheRunsFrameStep) {
+  // Key images about 3 teach frames apart (the spacing the model was fitted on): one step a frame.
+  EXPECT_DOUBLE_EQ(TeachFramesPerPosition({0, 2, 6, 9, 13, 23}), 4.6);
+  EXPECT_DOUBLE_EQ(TeachFramesPerPosition({0, 2, 5, 8, 12}), 3.0);
+  EXPECT_EQ(MotionStepsPerFrame(1, 3.0), 1);
+  EXPECT_EQ(MotionStepsPerFrame(1, 2.3), 1);
+  // A video's sparse map, or a frame at an unknown step: never fewer than one.
+  EXPECT_EQ(MotionStepsPerFrame(1, 82.0), 1);
+  EXPECT_EQ(MotionStepsPerFrame(0, 3.0), 1);
+  EXPECT_EQ(MotionStepsPerFrame(-5, 3.0), 1);
+  // A map of every place (--tau 1), and a sparse map run at a third of the frames (--stride 3): a key image a frame.
+  EXPECT_EQ(MotionStepsPerFrame(1, 1.0), 3);
+  EXPECT_EQ(MotionStepsPerFrame(3, 3.0), 3);
+  // Bounded; a route of one key image has no spacing.
+  EXPECT_EQ(MotionStepsPerFrame(100, 1.0), kMaxMotionSteps);
+  EXPECT_DOUBLE_EQ(TeachFramesPerPosition({7}), 0.0);
+  EXPECT_EQ(MotionStepsPerFrame(1, 0.0), 1);
+  // A route driven backwards through the map spaces its key images the same.
+  EXPECT_DOUBLE_EQ(TeachFramesPerPosition({9, 6, 3, 0}), 3.0);
+}
+
 TEST(RouteBelief, OptionsAreChecked) {
   auto path = [](auto change) {
     return testing::OptionErrorPath([&] {
@@ -109,6 +155,8 @@ TEST(RouteBelief, OptionsAreChecked) {
   EXPECT_EQ(path([](RouteBeliefOptions& o) { o.stay = -0.1; }), "stay");
   EXPECT_EQ(path([](RouteBeliefOptions& o) { o.min_confidence = 1.5; }), "min_confidence");
   EXPECT_EQ(path([](RouteBeliefOptions& o) { o.window = -1; }), "window");
+  EXPECT_EQ(path([](RouteBeliefOptions& o) { o.motion_steps_per_frame = kMaxMotionSteps + 1; }),
+            "motion_steps_per_frame");
   EXPECT_NO_THROW(RouteBeliefOptions{}.Check());
 }
 

@@ -73,6 +73,8 @@ TEST(Localizer, AFarRelocalizationOnOneFrameDoesNotCarryTheTrackerAway) {
   for (const double min_confidence : {0.5, 0.0}) {
     LocalizerOptions options = MapLocalizerOptions(m);
     options.belief.min_confidence = min_confidence;
+    // One motion step a frame: the frames are picked from the drive, their input indices are not its pace.
+    options.belief.motion_steps_per_frame = 1;
     Localizer localizer(m.map, m.keys, *m.matcher, options);
     int index = 0;
     LocalizeFramesOnDenseMap(localizer, {1, 3, 5}, &index);
@@ -90,6 +92,8 @@ TEST(Localizer, AFarRelocalizationOnOneFrameDoesNotCarryTheTrackerAway) {
   for (const bool rank_evidence : {false, true}) {
     LocalizerOptions options = MapLocalizerOptions(m);
     options.rank_evidence = rank_evidence;
+    // One motion step a frame: the frames are picked from the drive, their input indices are not its pace.
+    options.belief.motion_steps_per_frame = 1;
     Localizer localizer(m.map, m.keys, *m.matcher, options);
     int index = 0;
     LocalizeFramesOnDenseMap(localizer, {1, 3, 5, 41, 43}, &index);

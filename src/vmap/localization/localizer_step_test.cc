@@ -52,6 +52,8 @@ TEST(Localizer, OneKeyImageOnNeedsTheBeliefNotToHoldMoreBehind) {
   for (const int window : {2, 0}) {
     LocalizerOptions options = MapLocalizerOptions(m);
     options.belief.window = window;
+    // One motion step a frame: the frames are picked from the drive, their input indices are not its pace.
+    options.belief.motion_steps_per_frame = 1;
     Localizer localizer(m.map, m.keys, *m.matcher, options);
     int index = 0;
     LocalizationResult r = LocalizeFramesOnDenseMap(localizer, {1, 3, 5}, &index);
@@ -78,6 +80,8 @@ TEST(Localizer, AStepOnPastAKeyImageThatDoesNotVerifyNeedsTheBeliefToo) {
   for (const bool hold : {true, false}) {
     LocalizerOptions options = MapLocalizerOptions(m);
     options.hold_unearned_step_on = hold;
+    // One motion step a frame: the frames are picked from the drive, their input indices are not its pace.
+    options.belief.motion_steps_per_frame = 1;
     Localizer localizer(m.map, m.keys, *m.matcher, options);
     int index = 0;
     LocalizationResult r = LocalizeFramesOnDenseMap(localizer, {1, 3, 5}, &index);

@@ -36,6 +36,13 @@ void RouteBeliefOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(OptionField{"jump"}.Within(0, 1).ExcludingMin().Meaning(
                     "above 0: a belief that cannot jump can be stuck for ever"),
                 jump);
+  visitor.Visit(
+      OptionField{"motion_steps_per_frame", "--motion-steps-per-frame",
+                  "The motion model's steps a frame (0: from the map, the teach frames between its key images "
+                  "against the run's frame step)"}
+          .Within(0, kMaxMotionSteps)
+          .Meaning("0: from the map and the run"),
+      motion_steps_per_frame);
 }
 
 void RouteBeliefOptions::Check() const { CheckFieldRanges(*this); }
@@ -55,7 +62,26 @@ void RouteBelief::Start(int position, double mass) {
   p_[position] += mass;
 }
 
-void RouteBelief::Predict() {
+double TeachFramesPerPosition(const std::vector<int>& route_source_indices) {
+  if (route_source_indices.size() < 2) return 0.0;
+  long apart = 0;
+  for (size_t p = 1; p < route_source_indices.size(); ++p) {
+    apart += std::abs(route_source_indices[p] - route_source_indices[p - 1]);
+  }
+  return static_cast<double>(apart) / static_cast<double>(route_source_indices.size() - 1);
+}
+
+int MotionStepsPerFrame(int frame_step, double teach_frames_per_position) {
+  if (!(teach_frames_per_position > 0.0)) return 1;
+  const double steps = std::max(frame_step, 1) * kTeachFramesPerMotionStep / teach_frames_per_position;
+  return std::clamp(static_cast<int>(std::lround(steps)), 1, kMaxMotionSteps);
+}
+
+void RouteBelief::Predict(int steps) {
+  for (int step = 0; step < steps; ++step) PredictOneStep();
+}
+
+void RouteBelief::PredictOneStep() {
   const int n = static_cast<int>(p_.size());
   const double total = options_.stay + options_.forward + options_.forward2 + options_.back + options_.jump;
   const double steps[4][2] = {{0, options_.stay / total},

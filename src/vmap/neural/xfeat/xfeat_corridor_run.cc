@@ -61,7 +61,7 @@ void XfeatCorridorRun::SetUp() {
   SKIP_WITHOUT_SHARED();
   if (!fs::exists(data_)) GTEST_SKIP() << data_ << " is not present";
   const auto built = testing::RunVmap("build " + Quote(data_ / "teach") + " --matcher xfeat --weights " +
-                                      FoldedWeights() + " -q -o " + Quote(map_));
+                                      FoldedWeights() + BuildFlags() + " -q -o " + Quote(map_));
   ASSERT_EQ(built.status, 0) << built.output;
   std::ifstream map_file(map_ / "map.json");
   const nlohmann::json map_json = nlohmann::json::parse(map_file);

@@ -27,6 +27,8 @@ class XfeatCorridorRun : public ::testing::Test {
   using Steered = std::vector<std::pair<int, int>>;
 
   void SetUp() override;
+  // `vmap build`'s flags beyond the matcher's (" --tau 1 --stride 3": a map of places); none: the matcher's map.
+  virtual std::string BuildFlags() const { return ""; }
 
   // The key image at or before teach frame `frame`: where a run of the repeat from frame `frame` is started.
   int KeyBefore(int frame) const;
