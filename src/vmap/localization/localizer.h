@@ -456,7 +456,7 @@ class Localizer {
     int next_verified = 0;
   } step_back_ruled_out_;
   RouteBelief belief_;
-  // The median teach frames between the route's consecutive key images, and the input index of the frame before this
+  // The mean teach frames between the route's consecutive key images, and the input index of the frame before this
   // one (-1: none yet): together the motion model's steps a frame (MotionStepsPerFrame).
   double teach_frames_per_position_ = 0.0;
   int source_index_before_ = -1;

@@ -137,6 +137,7 @@ TEST(RouteBelief, TheMotionStepsFollowTheMapsSpacingAndTheRunsFrameStep) {
   EXPECT_EQ(MotionStepsPerFrame(3, 3.0), 3);
   // Bounded; a route of one key image has no spacing.
   EXPECT_EQ(MotionStepsPerFrame(100, 1.0), kMaxMotionSteps);
+  EXPECT_EQ(MotionStepsPerFrame(2'000'000'000, 1e-9), kMaxMotionSteps);
   EXPECT_DOUBLE_EQ(TeachFramesPerPosition({7}), 0.0);
   EXPECT_EQ(MotionStepsPerFrame(1, 0.0), 1);
   // A route driven backwards through the map spaces its key images the same.
