@@ -74,7 +74,7 @@ double TeachFramesPerPosition(const std::vector<int>& route_source_indices) {
 int MotionStepsPerFrame(int frame_step, double teach_frames_per_position) {
   if (!(teach_frames_per_position > 0.0)) return 1;
   const double steps = std::max(frame_step, 1) * kTeachFramesPerMotionStep / teach_frames_per_position;
-  return std::clamp(static_cast<int>(std::lround(std::min<double>(steps, kMaxMotionSteps))), 1, kMaxMotionSteps);
+  return std::max(1, static_cast<int>(std::lround(std::min<double>(steps, kMaxMotionSteps))));
 }
 
 void RouteBelief::Predict(int steps) {
