@@ -8,6 +8,11 @@ places: corridor_conditions as a map of places, as a path taught once per place 
   few metres apart, frame i of the repeat at key image i of a `--tau 1` map): every third teach frame a key image
   (`vmap build --tau 1 --stride 3`) and every third repeat frame localized against it, so the run passes a key image
   every frame; right as the corridor's (the data set's +-2 frames).
+third-rate: the corridor's repeat at a third of the teach run's frame rate, as its own recording: every third repeat
+  frame in a folder of links numbered on, 0.3 s apart (a timestamps.txt), against a map of the teach run's frames 0.1 s
+  apart (the same key images as the corridor's: a folder of links with its timestamps.txt), so its input indices say a
+  frame and its times say three (a camera at a lower frame rate, a node that drops frames while it localizes).
+  third-rate-places: the same repeat against the places map built from the timed teach run (a key image a frame).
 michigan: ../shared/data/michigan_seasons as routes: for every ordered pair of sessions (a, b), a map of session a's
   five places in order (`--tau 1`: every place a key image) and session b's five places localized against it
   (frame i right at key image i). 132 routes of 5 frames.
@@ -46,7 +51,7 @@ near comparisons sit at chance's boundary and the seed moves corridor ORB's righ
 a few frames is judged on the means (docs/measurements/localization-conditions.md, "The verifier's seed: the spread
 of every figure"). Default: the map's seed only, the flag not passed (binaries before the flag take no --seeds).
 
-usage: bench/route_conditions.py --vmap build/vmap[,old/vmap] [--sets corridor,kidnapped,elsewhere,places,michigan] [--matchers orb,xfeat]
+usage: bench/route_conditions.py --vmap build/vmap[,old/vmap] [--sets corridor,kidnapped,elsewhere,places,third-rate,third-rate-places,michigan] [--matchers orb,xfeat]
                                  [--tau T] [--start-key K|none] [--build "FLAGS"] [--localize "FLAGS"] [--repeat-stride N] [--work DIR] [--csv-dir DIR]
                                  [--evidence-dir DIR] [--seeds S,S,...] [--named-frames N]
 (from the repository root; ../shared must be there)"""
@@ -193,6 +198,45 @@ def corridor(vmap, matcher, tau_flags, localize_flags, stride, work, csv_dir, ev
 # The places set's map and repeat: every third frame, every teach frame kept a key image.
 PLACES_BUILD = ["--tau", "1", "--stride", "3"]
 PLACES_STRIDE = 3
+
+
+# The third-rate sets' frame times: the teach run's frames (its rate is not known; any will do, both runs share it).
+TEACH_SECONDS_PER_FRAME = 0.1
+THIRD_RATE_STRIDE = 3
+
+
+def linked_folder(folder, frames, seconds_per_frame):
+    """A folder of links to `frames` (paths), numbered on from 0, with a timestamps.txt of frames `seconds_per_frame`
+    apart: a recording of its own."""
+    os.makedirs(folder, exist_ok=True)
+    with open(os.path.join(folder, "timestamps.txt"), "w") as times:
+        for number, frame in enumerate(frames):
+            name = "%07d.jpg" % number
+            link = os.path.join(folder, name)
+            if not os.path.exists(link):
+                os.symlink(os.path.abspath(frame), link)
+            times.write("%s %.6f\n" % (name, number * seconds_per_frame))
+    return folder
+
+
+def third_rate(vmap, matcher, map_flags, localize_flags, work, csv_dir, label):
+    teach = linked_folder(os.path.join(work, "timed_teach"),
+                          [os.path.join(CORRIDOR, "teach", "%07d.jpg" % i) for i in range(111)],
+                          TEACH_SECONDS_PER_FRAME)
+    repeat_of = list(range(0, 111, THIRD_RATE_STRIDE))  # run frame -> repeat frame
+    repeat = linked_folder(os.path.join(work, "third_rate_repeat"),
+                           [os.path.join(CORRIDOR, "repeat", "%07d.jpg" % i) for i in repeat_of],
+                           TEACH_SECONDS_PER_FRAME * THIRD_RATE_STRIDE)
+    map_directory = os.path.join(work, "timed_corridor_%s_%s" % (matcher, flags_tag(map_flags)))
+    key_sources = [k["source_index"] for k in build(vmap, teach, matcher, map_flags, map_directory)["key_images"]]
+    flags = list(localize_flags)
+    if csv_dir:
+        flags += ["--csv", os.path.join(csv_dir, "%s_%s.csv" % (label, matcher))]
+    doc = localize(vmap, map_directory, repeat, flags, os.path.join(work, "run.json"))
+    tally = Tally()
+    tally.add(doc, lambda f: corridor_right_keys(key_sources, repeat_of[f["source_index"]]), label,
+              lambda f: "run frame %d (repeat %d)" % (f["source_index"], repeat_of[f["source_index"]]))
+    return tally
 
 
 # The kidnapped run's stretches of repeat frames, first and last included, in the order the robot saw them.
@@ -354,6 +398,13 @@ def main():
                     runs("%s: corridor as places (every third frame, --tau 1), %s, %d key images" % (vmap, matcher, keys),
                          lambda flags, csv_dir: corridor(vmap, matcher, places_flags, flags, PLACES_STRIDE, work, csv_dir,
                                                          label="places")[0])
+                if "third-rate" in sets:
+                    runs("%s: corridor at a third of the teach run's frame rate, timed, %s" % (vmap, matcher),
+                         lambda flags, csv_dir: third_rate(vmap, matcher, tau_flags, flags, work, csv_dir, "third_rate"))
+                if "third-rate-places" in sets:
+                    runs("%s: corridor at a third of the teach run's frame rate, timed, against places, %s" % (
+                        vmap, matcher), lambda flags, csv_dir: third_rate(vmap, matcher, PLACES_BUILD + build_flags,
+                                                                          flags, work, csv_dir, "third_rate_places"))
                 if "kidnapped" in sets:
                     runs("%s: kidnapped corridor (repeat %s), %s" % (vmap, ", ".join("%d-%d" % s for s in KIDNAPPED),
                                                                     matcher),

@@ -165,6 +165,7 @@ nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationRes
   }
   frame["confidence"] = Number(r.confidence);
   frame["key_rank"] = r.key_rank;
+  frame["motion_steps"] = r.motion_steps;
   json belief = json::array();
   for (const auto& [key, mass] : r.belief) belief.push_back({key, mass});
   frame["belief"] = belief;
@@ -313,6 +314,7 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
       r.seconds = f.value("seconds", 0.0);
       r.confidence = NumberOr(f, "confidence", std::nan(""));
       r.key_rank = f.value("key_rank", -1);
+      r.motion_steps = f.value("motion_steps", 0);
       if (f.contains("belief") && f["belief"].is_array()) {
         for (const json& b : f["belief"]) r.belief.emplace_back(b.at(0).get<int>(), b.at(1).get<double>());
       }

@@ -59,6 +59,7 @@ LocalizationRun SampleRun() {
   tracked.candidates = {{0, 120.0, true, 0.75, 150, -42.5}, {1, 80.0, true, 0.5, 50, -3.25}};
   tracked.confidence = 0.875;
   tracked.key_rank = 2;
+  tracked.motion_steps = 3;
   LocalizationResult lost;
   lost.frame_index = 1;
   lost.source_index = 4;
@@ -176,6 +177,7 @@ TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
   EXPECT_EQ(doc["frames"][0]["key_rank"], 2);
   EXPECT_TRUE(doc["frames"][1]["confidence"].is_null());
   EXPECT_EQ(doc["frames"][1]["key_rank"], -1);
+  EXPECT_EQ(doc["frames"][0]["motion_steps"], 3);
   EXPECT_EQ(doc["summary"]["uncertain"], 1);
   EXPECT_EQ(doc["frames"][0]["key_frame"], 0);
   EXPECT_EQ(doc["frames"][0]["next_key_frame"], 40);
@@ -209,6 +211,8 @@ TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
   EXPECT_EQ(r.key_rank, 2);
   EXPECT_TRUE(std::isnan(back.frames[1].confidence));
   EXPECT_EQ(back.frames[1].key_rank, -1);
+  EXPECT_EQ(r.motion_steps, 3);
+  EXPECT_EQ(back.frames[1].motion_steps, 0);
   EXPECT_EQ(back.frames[2].status, LocalizationStatus::kUncertain);
   EXPECT_DOUBLE_EQ(back.frames[2].confidence, 0.125);
 }

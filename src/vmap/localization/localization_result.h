@@ -81,6 +81,9 @@ struct LocalizationResult {
   // The rank of `key` among the key images the frame was compared with, by the evidence of this frame alone
   // (1: the best match; 2: one other key image matched better...). -1 when unknown (nothing compared).
   int key_rank = -1;
+  // The times the belief's motion model moved it before this frame's evidence (MotionPace: the route positions the
+  // run passed since the frame before, three steps a position). 0 when unknown.
+  int motion_steps = 0;
   // The belief over the route after this frame: (key image, mass) for each route position holding at least 1 % of
   // it (position p at its key image, the start of segment p), in route order; empty when not computed. The
   // report's plot of the belief over time (report/belief_plot.h) draws it; the JSON lists it, the CSV does not.

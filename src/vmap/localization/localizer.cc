@@ -146,8 +146,12 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
         options_.comparison_threads - 1);
   }
   std::vector<int> route_source_indices;
-  for (const int k : route_) route_source_indices.push_back(map_.key_images[k].source_index);
-  teach_frames_per_position_ = TeachFramesPerPosition(route_source_indices);
+  std::vector<double> route_timestamps;
+  for (const int k : route_) {
+    route_source_indices.push_back(map_.key_images[k].source_index);
+    route_timestamps.push_back(map_.key_images[k].timestamp);
+  }
+  pace_ = MotionPace(route_source_indices, route_timestamps, options_.belief.motion_steps_per_frame);
   Reset();  // at the start key image, when there is one
 }
 
@@ -178,7 +182,7 @@ void Localizer::Reset() {
   stalled_position_ = -1;
   stalled_frames_ = 0;
   frames_since_start_ = 0;
-  source_index_before_ = -1;
+  pace_.Reset();
   recent_positions_.clear();
   stall_bar_ = options_.stalled_tracker_frames;
   placed_in_a_row_ = 0;
@@ -214,14 +218,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   made_ahead_ = std::move(ahead);
   ranked_.clear();
   bucket_of_position_.clear();
-  // The run's first frame is one step from its start, as the model was fitted: how far it is from the frame before
-  // is not known.
-  const int motion_steps =
-      source_index_before_ < 0 ? 1
-      : options_.belief.motion_steps_per_frame > 0
-          ? options_.belief.motion_steps_per_frame
-          : MotionStepsPerFrame(frame.source_index - source_index_before_, teach_frames_per_position_);
-  source_index_before_ = frame.source_index;
+  const int motion_steps = pace_.Steps(frame.source_index, frame.timestamp);
   belief_.Predict(motion_steps);
   if (start_unconfirmed_) evidence_belief_.Predict(motion_steps);
   // Guided matching asks where the estimate was dropped for max_lost_frames frames (guided_while_lost).
@@ -270,6 +267,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   if (keeps_features_before_) features_before_ = has_estimate() ? matcher_.SerializeFeatures(features) : "";
   ranking_first_before_ = RankingFirst();
   heading_mode_before_ = HeadingMode();
+  result.motion_steps = motion_steps;
   result.frame_index = frame.index;
   result.source_index = frame.source_index;
   result.timestamp = frame.timestamp;

@@ -38,6 +38,7 @@
 #include "vmap/localization/localization_result.h"
 #include "vmap/localization/localizer_options.h"
 #include "vmap/localization/map_verifier_options.h"
+#include "vmap/localization/motion_pace.h"
 #include "vmap/localization/route_belief.h"
 #include "vmap/localization/route_evidence.h"
 #include "vmap/localization/speculative_comparisons.h"
@@ -456,10 +457,7 @@ class Localizer {
     int next_verified = 0;
   } step_back_ruled_out_;
   RouteBelief belief_;
-  // The mean teach frames between the route's consecutive key images, and the input index of the frame before this
-  // one (-1: none yet): together the motion model's steps a frame (MotionStepsPerFrame).
-  double teach_frames_per_position_ = 0.0;
-  int source_index_before_ = -1;
+  MotionPace pace_;  // the motion model's steps a frame
   // The belief the frames' evidence alone would hold: the same motion and comparisons as belief_, from a flat start
   // (without the start key image's prior). Kept only while the start is unconfirmed, the only time it is read.
   RouteBelief evidence_belief_;

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "vmap/localization/motion_pace.h"
 #include "vmap/localization/route_belief.h"
 #include "vmap/localization/route_evidence.h"
 #include "vmap/testing/option_error.h"
@@ -120,28 +121,6 @@ TEST(RouteBelief, ItKeepsUpWithARunThatPassesAKeyImageEveryFrame) {
   };
   EXPECT_LE(peak_after(1), 12);
   EXPECT_GE(peak_after(MotionStepsPerFrame(1, 1.0)), 16);
-}
-
-TEST(RouteBelief, TheMotionStepsFollowTheMapsSpacingAndTheRunsFrameStep) {
-  // Key images about 3 teach frames apart (the spacing the model was fitted on): one step a frame.
-  EXPECT_DOUBLE_EQ(TeachFramesPerPosition({0, 2, 6, 9, 13, 23}), 4.6);
-  EXPECT_DOUBLE_EQ(TeachFramesPerPosition({0, 2, 5, 8, 12}), 3.0);
-  EXPECT_EQ(MotionStepsPerFrame(1, 3.0), 1);
-  EXPECT_EQ(MotionStepsPerFrame(1, 2.3), 1);
-  // A video's sparse map, or a frame at an unknown step: never fewer than one.
-  EXPECT_EQ(MotionStepsPerFrame(1, 82.0), 1);
-  EXPECT_EQ(MotionStepsPerFrame(0, 3.0), 1);
-  EXPECT_EQ(MotionStepsPerFrame(-5, 3.0), 1);
-  // A map of every place (--tau 1), and a sparse map run at a third of the frames (--stride 3): a key image a frame.
-  EXPECT_EQ(MotionStepsPerFrame(1, 1.0), 3);
-  EXPECT_EQ(MotionStepsPerFrame(3, 3.0), 3);
-  // Bounded; a route of one key image has no spacing.
-  EXPECT_EQ(MotionStepsPerFrame(100, 1.0), kMaxMotionSteps);
-  EXPECT_EQ(MotionStepsPerFrame(2'000'000'000, 1e-9), kMaxMotionSteps);
-  EXPECT_DOUBLE_EQ(TeachFramesPerPosition({7}), 0.0);
-  EXPECT_EQ(MotionStepsPerFrame(1, 0.0), 1);
-  // A route driven backwards through the map spaces its key images the same.
-  EXPECT_DOUBLE_EQ(TeachFramesPerPosition({9, 6, 3, 0}), 3.0);
 }
 
 TEST(RouteBelief, OptionsAreChecked) {

@@ -6,6 +6,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/core/option_ranges.h"
+#include "vmap/localization/motion_pace.h"
 
 namespace vmap {
 
@@ -38,8 +39,8 @@ void RouteBeliefOptions::VisitFields(OptionFieldVisitor& visitor) {
                 jump);
   visitor.Visit(
       OptionField{"motion_steps_per_frame", "--motion-steps-per-frame",
-                  "The motion model's steps a frame (0: from the map, the teach frames between its key images "
-                  "against the run's frame step)"}
+                  "The motion model's steps a frame (0: from the map and the run: the time between frames against "
+                  "the time between key images where both have timestamps, else input frames)"}
           .Within(0, kMaxMotionSteps)
           .Meaning("0: from the map and the run"),
       motion_steps_per_frame);
@@ -60,21 +61,6 @@ void RouteBelief::Start(int position, double mass) {
   if (position < 0 || position >= static_cast<int>(p_.size())) return;
   for (double& v : p_) v *= 1.0 - mass;
   p_[position] += mass;
-}
-
-double TeachFramesPerPosition(const std::vector<int>& route_source_indices) {
-  if (route_source_indices.size() < 2) return 0.0;
-  long apart = 0;
-  for (size_t p = 1; p < route_source_indices.size(); ++p) {
-    apart += std::abs(route_source_indices[p] - route_source_indices[p - 1]);
-  }
-  return static_cast<double>(apart) / static_cast<double>(route_source_indices.size() - 1);
-}
-
-int MotionStepsPerFrame(int frame_step, double teach_frames_per_position) {
-  if (!(teach_frames_per_position > 0.0)) return 1;
-  const double steps = std::max(frame_step, 1) * kTeachFramesPerMotionStep / teach_frames_per_position;
-  return std::max(1, static_cast<int>(std::lround(std::min<double>(steps, kMaxMotionSteps))));
 }
 
 void RouteBelief::Predict(int steps) {

@@ -27,12 +27,12 @@ struct RouteBeliefOptions {
   double back = 0.05;
   double jump = 0.02;
   // The motion model's steps a frame: a frame that passes more of the route than one step of the model covers is
-  // moved by it several times. The probabilities above were fitted on a map whose key images lie about
-  // kTeachFramesPerMotionStep teach frames apart, localized frame by frame; a run against a map of every place it
-  // passes (`vmap build --tau 1` of places, as a park path taught once per place), or one that skips frames
-  // (--stride), passes a key image or more every frame, and a belief that expects one every third frame stays behind
+  // moved by it several times. The probabilities above were fitted where the run passed a key image every third
+  // frame (kMotionStepsPerPosition); a run against a map of every place it passes (`vmap build --tau 1` of places,
+  // as a park path taught once per place), or one that skips frames (--stride, a lower frame rate, a node that drops
+  // frames), passes a key image or more every frame, and a belief that expects one every third frame stays behind
   // its evidence and holds the tracker at a key image the run has left (docs/localize.md, "The motion model's pace").
-  // 0: from the map and the run (MotionStepsPerFrame).
+  // 0: from the map and the run (MotionPace: by time where both have timestamps, else by input index).
   int motion_steps_per_frame = 0;
   // A frame whose belief holds less than this within two positions of its key image is uncertain
   // (LocalizationStatus::kUncertain: not to steer by). 0: never uncertain.
@@ -51,24 +51,6 @@ struct RouteBeliefOptions {
   void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };
-
-// The teach frames one step of RouteBeliefOptions' motion model covers (corridor_conditions' default XFeat map, where
-// it was fitted: key images 3.4 teach frames apart on average, the repeat localized frame by frame; any spacing
-// from 2.25 teach frames up gives one step a frame).
-inline constexpr double kTeachFramesPerMotionStep = 3.0;
-// No frame is moved by more steps than this: a long gap in the input (a stretch of a video not decoded) spreads the
-// belief no further than eight steps do, and costs no more.
-inline constexpr int kMaxMotionSteps = 8;
-
-// The mean number of teach frames between consecutive key images of a route, from their indices in the teach input
-// (`source_index`, which --stride leaves as the input's): the pace at which a run at the teach run's speed passes
-// them (the median would count a handheld camera's bursts of key images a frame apart as the whole route's pace);
-// 0 for a route of fewer than two key images.
-double TeachFramesPerPosition(const std::vector<int>& route_source_indices);
-// The motion model's steps for a frame `frame_step` input frames after the one before it (its `source_index` less
-// that one's; 1 where unknown), on a route whose key images lie `teach_frames_per_position` teach frames apart: the
-// repeat is taken to pass the route at the teach run's pace and frame rate (a teach-and-repeat robot's). At least 1.
-int MotionStepsPerFrame(int frame_step, double teach_frames_per_position);
 
 class RouteBelief {
  public:

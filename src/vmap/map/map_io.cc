@@ -33,8 +33,9 @@ std::optional<cv::Size> KeyImageSize(const ContainedFile& file) { return ImageHe
 
 std::optional<cv::Size> KeyImageFileSize(const fs::path& file) {
   std::string why_not;
-  const std::optional<ContainedFile> opened = ContainedFile::Open(
-      file.parent_path().empty() ? fs::path(".") : file.parent_path(), file.filename().string(), &why_not);
+  // The input's own file, wherever it is: a folder of links to a recording's images gives the map its files, as the
+  // folder of the images does (ReadMap checks the copy inside the map).
+  const std::optional<ContainedFile> opened = ContainedFile::OpenRegular(file, &why_not);
   if (!opened) return std::nullopt;
   return KeyImageSize(*opened);
 }

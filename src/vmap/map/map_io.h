@@ -58,7 +58,8 @@ std::string CorrespondencesBinary(const VisualMap& map);
 std::string CoverageEndName(CoverageEnd end);
 
 // The width and height a key-image file's header announces (PNG, or JPEG: a key image copied from the input's
-// own file), as ReadMap checks them; nullopt when the file is neither or cannot be read.
+// own file, which may be a link), as ReadMap checks them; nullopt when the file is neither, is not a regular file or
+// cannot be read.
 std::optional<cv::Size> KeyImageFileSize(const std::filesystem::path& file);
 
 // The file of key image `key` of the map in `map_directory`, checked again as ReadMap checks it (inside the map

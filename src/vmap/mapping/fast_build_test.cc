@@ -202,7 +202,8 @@ TEST(KeyImageSearch, OptionsAndDefaults) {
   }
 }
 
-// Key images of an image folder are the input's own files; of frames that were resized, PNG files.
+// Key images of an image folder are the input's own files (also through links); of frames that were resized, PNG
+// files.
 TEST(FastBuild, KeyImagesAreTheInputFilesWhenTheyCanBe) {
   testing::ScopedTempDir temp;
   testing::SyntheticOptions scene;
@@ -225,6 +226,22 @@ TEST(FastBuild, KeyImagesAreTheInputFilesWhenTheyCanBe) {
       const fs::path original = temp.path() / "images" / key.source_name;
       EXPECT_EQ(fs::path(key.image_file).extension(), ".png");
       EXPECT_EQ(bytes(temp.path() / "map" / key.image_file), bytes(original)) << key.image_file;
+    }
+  }
+  {
+    // A folder of links to a recording's images (a run cut or reordered without copying it) gives the same files.
+    fs::create_directory(temp.path() / "links");
+    for (const auto& entry : fs::directory_iterator(temp.path() / "images")) {
+      fs::create_symlink(entry.path(), temp.path() / "links" / entry.path().filename());
+    }
+    auto source = OpenFrameSource((temp.path() / "links").string());
+    fs::create_directory(temp.path() / "linked");
+    const VisualMap map = BuildMap(*source, *matcher, options, temp.path() / "linked");
+    ASSERT_GE(map.key_images.size(), 2u);
+    for (const KeyImage& key : map.key_images) {
+      EXPECT_FALSE(fs::is_symlink(temp.path() / "linked" / key.image_file)) << key.image_file;
+      EXPECT_EQ(bytes(temp.path() / "linked" / key.image_file), bytes(temp.path() / "images" / key.source_name))
+          << key.image_file;
     }
   }
   {

@@ -1,6 +1,8 @@
 #include "vmap/pipelines/localize_pipeline.h"
 
 #include <filesystem>
+#include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -9,6 +11,8 @@
 
 #include "vmap/features/camera_mask.h"
 #include "vmap/localization/localization_map.h"
+#include "vmap/localization/motion_pace.h"
+#include "vmap/map/map_io.h"
 #include "vmap/pipelines/build_pipeline.h"
 #include "vmap/testing/localization_test_util.h"
 #include "vmap/testing/option_error.h"
@@ -19,19 +23,34 @@ namespace vmap {
 namespace {
 namespace fs = std::filesystem;
 
+// How the drive's map is built: within a camera mask; the teach folder with a timestamps.txt, its frames
+// `seconds_per_frame` apart (0: none); at Algorithm 1's `tau` (unset: the matcher's).
+struct DriveOptions {
+  cv::Mat camera_mask;
+  double seconds_per_frame = 0.0;
+  std::optional<double> tau;
+};
+
 // A map of the drive's even frames, and its odd frames as the repeat run.
 struct Drive {
   testing::ScopedTempDir tmp;
   fs::path map = tmp.path() / "map";
   fs::path repeat = tmp.path() / "repeat";
 
-  explicit Drive(const cv::Mat& camera_mask = cv::Mat()) {
+  explicit Drive(const DriveOptions& drive = {}) {
     testing::WriteImageFolder(testing::SidewaysDrive(), tmp.path() / "teach");
-    BuildPipelineOptions build;
-    if (!camera_mask.empty()) {
-      build.matcher.camera_mask = (tmp.path() / "mask.png").string();
-      cv::imwrite(build.matcher.camera_mask, camera_mask);
+    if (drive.seconds_per_frame > 0.0) {
+      std::ofstream times(tmp.path() / "teach" / "timestamps.txt");
+      for (size_t i = 0; i < testing::SidewaysDrive().frames.size(); ++i) {
+        times << "frame_" << i + 1 << ".png " << drive.seconds_per_frame * static_cast<double>(i) << "\n";
+      }
     }
+    BuildPipelineOptions build;
+    if (!drive.camera_mask.empty()) {
+      build.matcher.camera_mask = (tmp.path() / "mask.png").string();
+      cv::imwrite(build.matcher.camera_mask, drive.camera_mask);
+    }
+    build.tau = drive.tau;
     build.input = (tmp.path() / "teach").string();
     build.output = map.string();
     build.source.stride = 2;
@@ -61,7 +80,9 @@ TEST(LocalizePipeline, AMapBuiltWithinACameraMaskLocalizesWithinIt) {
   const cv::Size size = testing::SidewaysDrive().frames.at(0).size();
   cv::Mat mask(size, CV_8UC1, cv::Scalar(255));
   mask.colRange(0, size.width / 4).setTo(0);
-  Drive drive(mask);
+  DriveOptions masked;
+  masked.camera_mask = mask;
+  Drive drive(masked);
   const LocalizePipelineResult run = RunLocalizePipeline(drive.Options(), nullptr);
   ASSERT_EQ(run.map.camera_mask.size(), size);
   EXPECT_EQ(cv::countNonZero(run.map.camera_mask != mask), 0);
@@ -108,6 +129,51 @@ TEST(LocalizePipeline, TheSessionFrameByFrameEqualsTheRun) {
     EXPECT_EQ(result.key, expected.key) << i;
     EXPECT_EQ(result.next_key, expected.next_key) << i;
     EXPECT_EQ(result.to_key.num_verified, expected.to_key.num_verified) << i;
+  }
+}
+
+// A robot's loop that localizes one camera frame in four (or a camera at a quarter of the teach run's frame rate)
+// passes four times as much of the route a frame as its frames' count says: given the frames' times, the belief's
+// motion model moves as far as the time since the frame before says, at the teach run's pace between key images.
+TEST(LocalizePipeline, TheSessionPacesTheBeliefByTheFramesTimes) {
+  DriveOptions timed_places;  // a map of places: every other teach frame a key image
+  timed_places.seconds_per_frame = 0.1;
+  timed_places.tau = 1.0;
+  Drive drive(timed_places);
+  const VisualMap map = ReadMap(drive.map);
+  std::vector<int> source_indices;
+  std::vector<double> times;
+  for (const KeyImage& key : map.key_images) {
+    source_indices.push_back(key.source_index);
+    times.push_back(key.timestamp);
+  }
+  ASSERT_GT(TeachSecondsPerPosition(times), 0.0) << "the map keeps its key images' times";
+  const int by_time = MotionStepsPerFrame(0.4, TeachSecondsPerPosition(times));
+  const int by_count = MotionStepsPerFrame(1, TeachFramesPerPosition(source_indices));
+  ASSERT_GT(by_time, by_count) << "the drive's key images are too far apart for a frame in four to tell";
+
+  auto steps_of_every_fourth_frame = [&](bool with_times) {
+    LocalizePipelineOptions options = drive.Options();
+    options.query.clear();
+    LocalizationSession session(options);
+    std::vector<int> steps;
+    for (size_t i = 0; i < testing::SidewaysDrive().frames.size(); i += 4) {
+      const cv::Mat gray = cv::imread(
+          (drive.tmp.path() / "teach" / ("frame_" + std::to_string(i + 1) + ".png")).string(), cv::IMREAD_GRAYSCALE);
+      steps.push_back(
+          session.Localize(gray, with_times ? std::optional<double>(0.1 * static_cast<double>(i)) : std::nullopt)
+              .motion_steps);
+    }
+    return steps;
+  };
+  const std::vector<int> timed = steps_of_every_fourth_frame(true);
+  const std::vector<int> counted = steps_of_every_fourth_frame(false);
+  ASSERT_GT(timed.size(), 5u);
+  EXPECT_EQ(timed[0], 1) << "a run's first frame";
+  EXPECT_EQ(counted[0], 1);
+  for (size_t f = 1; f < timed.size(); ++f) {
+    EXPECT_EQ(timed[f], by_time) << f;
+    EXPECT_EQ(counted[f], by_count) << f;
   }
 }
 

@@ -1,0 +1,65 @@
+#include "vmap/localization/motion_pace.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+namespace vmap {
+
+double TeachFramesPerPosition(const std::vector<int>& route_source_indices) {
+  if (route_source_indices.size() < 2) return 0.0;
+  long apart = 0;
+  for (size_t p = 1; p < route_source_indices.size(); ++p) {
+    apart += std::abs(route_source_indices[p] - route_source_indices[p - 1]);
+  }
+  return static_cast<double>(apart) / static_cast<double>(route_source_indices.size() - 1);
+}
+
+double TeachSecondsPerPosition(const std::vector<double>& route_timestamps) {
+  if (route_timestamps.size() < 2) return 0.0;
+  int rising = 0, falling = 0;
+  double apart = 0.0;
+  for (size_t p = 1; p < route_timestamps.size(); ++p) {
+    if (!(route_timestamps[p - 1] >= 0.0 && route_timestamps[p] >= 0.0)) return 0.0;  // NaN included
+    const double step = route_timestamps[p] - route_timestamps[p - 1];
+    rising += step > 0.0;
+    falling += step < 0.0;
+    apart += std::abs(step);
+  }
+  const int steps = static_cast<int>(route_timestamps.size()) - 1;
+  if (rising != steps && falling != steps) return 0.0;
+  const double mean = apart / steps;
+  return std::isfinite(mean) ? mean : 0.0;
+}
+
+int MotionStepsPerFrame(double travelled, double teach_per_position) {
+  if (!(travelled > 0.0 && teach_per_position > 0.0)) return 1;
+  // Bounded before rounding: a huge gap cannot overflow lround.
+  const double steps = std::min(travelled / teach_per_position * kMotionStepsPerPosition, double{kMaxMotionSteps});
+  return std::max(1, static_cast<int>(std::lround(steps)));
+}
+
+MotionPace::MotionPace(const std::vector<int>& route_source_indices, const std::vector<double>& route_timestamps,
+                       int fixed_steps)
+    : teach_frames_per_position_(TeachFramesPerPosition(route_source_indices)),
+      teach_seconds_per_position_(TeachSecondsPerPosition(route_timestamps)),
+      fixed_steps_(fixed_steps) {}
+
+void MotionPace::Reset() { started_ = false; }
+
+int MotionPace::Steps(int source_index, double timestamp) {
+  if (!(timestamp >= 0.0 && std::isfinite(timestamp))) timestamp = -1.0;
+  const bool first = !started_;
+  const double frames = static_cast<double>(source_index) - source_index_before_;
+  const double seconds = timestamp - timestamp_before_;
+  const bool timed = timestamp >= 0.0 && timestamp_before_ >= 0.0 && seconds > 0.0;
+  started_ = true;
+  source_index_before_ = source_index;
+  timestamp_before_ = timestamp;
+  if (first) return 1;  // as the model was fitted: how far the run's first frame is from a frame before is not known
+  if (fixed_steps_ > 0) return fixed_steps_;
+  if (timed && teach_seconds_per_position_ > 0.0) return MotionStepsPerFrame(seconds, teach_seconds_per_position_);
+  return MotionStepsPerFrame(std::max(frames, 1.0), teach_frames_per_position_);
+}
+
+}  // namespace vmap

@@ -1,0 +1,65 @@
+#pragma once
+// The pace at which a run passes the route's key images: how many times a frame applies the route belief's motion
+// model (RouteBeliefOptions). The model was fitted where the run passed a key image every third frame; a run that
+// passes one every frame (a map of places, a frame rate a third of the teach run's, a node that drops frames while it
+// localizes) must move the belief three times as far a frame, or the belief stays behind its evidence
+// (docs/localize.md, "The motion model's pace").
+//
+// A run is taken to pass the route at the teach run's speed (a teach-and-repeat robot's). The time between two
+// frames says how far it went when both runs have timestamps, whatever either's frame rate; else the input indices
+// do, which assumes the teach run's frame rate too.
+
+#include <vector>
+
+namespace vmap {
+
+// The motion model's steps per route position passed: it was fitted on corridor_conditions' default XFeat map (key
+// images 3.4 teach frames apart on average), localized frame by frame: one step a frame (any spacing from 2.25
+// teach frames up still gives one step a frame).
+inline constexpr double kMotionStepsPerPosition = 3.0;
+// No frame is moved by more steps than this: a long gap in the input (a stretch of a video not decoded, a robot
+// that stood still without frames) spreads the belief no further than eight steps do, and costs no more.
+inline constexpr int kMaxMotionSteps = 8;
+
+// The mean spacing of a route's consecutive key images in the teach input: their input indices (`source_index`,
+// which --stride leaves as the input's) or their timestamps. The mean, not the median: a handheld camera's bursts of
+// key images a frame apart are not the whole route's pace. A route may run backwards through the map. 0 (unknown)
+// for a route of fewer than two key images; for timestamps also when a key image has none (below 0) or the times do
+// not all rise or all fall along the route (key images of several recordings).
+double TeachFramesPerPosition(const std::vector<int>& route_source_indices);
+double TeachSecondsPerPosition(const std::vector<double>& route_timestamps);
+
+// The motion model's steps for a frame that went `travelled` since the frame before, in the unit of
+// `teach_per_position` (input frames or seconds): kMotionStepsPerPosition per position passed, rounded, 1 to
+// kMaxMotionSteps. 1 where either is unknown (not above 0).
+int MotionStepsPerFrame(double travelled, double teach_per_position);
+
+// A run's pace, frame by frame: by time where the route's key images and both frames have timestamps that rise,
+// else by input index.
+class MotionPace {
+ public:
+  MotionPace() = default;  // one step a frame
+  // The route's key images' input indices and timestamps (below 0: none), in route order; `fixed_steps` above 0:
+  // that many steps every frame but the first (RouteBeliefOptions::motion_steps_per_frame).
+  MotionPace(const std::vector<int>& route_source_indices, const std::vector<double>& route_timestamps,
+             int fixed_steps = 0);
+
+  // The next frame starts a run: it is one step from the start (how far it is from a frame before is not known).
+  void Reset();
+  // The motion model's steps for the run's next frame, at input index `source_index` and time `timestamp` (below 0:
+  // none).
+  int Steps(int source_index, double timestamp);
+
+  double teach_frames_per_position() const { return teach_frames_per_position_; }
+  double teach_seconds_per_position() const { return teach_seconds_per_position_; }
+
+ private:
+  double teach_frames_per_position_ = 0.0;
+  double teach_seconds_per_position_ = 0.0;
+  int fixed_steps_ = 0;
+  bool started_ = false;  // a frame of the run was seen: the two below are its
+  int source_index_before_ = 0;
+  double timestamp_before_ = -1.0;  // below 0: none
+};
+
+}  // namespace vmap
