@@ -201,6 +201,7 @@ TEST(LocalizationMessage, CarriesTheTargetsPoseAsAQuaternion) {
   result.to_next.pose.R =
       cv::Matx33d(std::cos(angle), 0, std::sin(angle), 0, 1, 0, -std::sin(angle), 0, std::cos(angle));
   result.to_next.pose.t = cv::Vec3d(0.0, 0.0, 1.0);
+  result.motion_steps = 3;
   std_msgs::Header header;
   header.frame_id = "cam";
   const vmap_ros::Localization message = LocalizationMessage(header, result, {0, 1, 2, 3, 4}, ControlSummary{});
@@ -212,6 +213,7 @@ TEST(LocalizationMessage, CarriesTheTargetsPoseAsAQuaternion) {
   EXPECT_EQ(message.route_length, 5);
   EXPECT_EQ(message.status, vmap_ros::Localization::TRACKING);
   EXPECT_EQ(message.status_name, "tracking");
+  EXPECT_EQ(message.motion_steps, 3);
 }
 
 }  // namespace

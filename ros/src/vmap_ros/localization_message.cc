@@ -32,6 +32,7 @@ vmap_ros::Localization LocalizationMessage(const std_msgs::Header& header, const
   message.progress = result.progress;
   message.confidence = result.confidence;
   message.key_rank = result.key_rank;
+  message.motion_steps = result.motion_steps;
   message.heading_px = result.heading_px;
   message.heading_deg = result.heading_deg;
   message.heading_key_px = result.heading_key_px;
