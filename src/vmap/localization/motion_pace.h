@@ -50,9 +50,6 @@ class MotionPace {
   // none).
   int Steps(int source_index, double timestamp);
 
-  double teach_frames_per_position() const { return teach_frames_per_position_; }
-  double teach_seconds_per_position() const { return teach_seconds_per_position_; }
-
  private:
   double teach_frames_per_position_ = 0.0;
   double teach_seconds_per_position_ = 0.0;
