@@ -13,6 +13,12 @@ third-rate: the corridor's repeat at a third of the teach run's frame rate, as i
   apart (the same key images as the corridor's: a folder of links with its timestamps.txt), so its input indices say a
   frame and its times say three (a camera at a lower frame rate, a node that drops frames while it localizes).
   third-rate-places: the same repeat against the places map built from the timed teach run (a key image a frame).
+speed: the corridor's repeat driven at 1 to 4 times the teach speed (teach frames passed a frame: 1,1,2,2,3,3,4,4,4,4,
+  3,3,2,2,1,1, again and again), the camera at the teach run's frame rate: its frames, a folder of links numbered on,
+  0.1 s apart, against the timed teach run's map, so its indices and times say a frame of the teach run and it went
+  one to four. speed-odometry: the same with both runs' odometry, from the frame alignment (a straight line, teach frame
+  i at 0.1 i m, the repeat's frame where its teach frame was: perfect odometry), given to vmap localize
+  (--teach-odometry, --odometry). speed-places, speed-odometry-places: the same against the places map.
 michigan: ../shared/data/michigan_seasons as routes: for every ordered pair of sessions (a, b), a map of session a's
   five places in order (`--tau 1`: every place a key image) and session b's five places localized against it
   (frame i right at key image i). 132 routes of 5 frames.
@@ -51,7 +57,7 @@ near comparisons sit at chance's boundary and the seed moves corridor ORB's righ
 a few frames is judged on the means (docs/measurements/localization-conditions.md, "The verifier's seed: the spread
 of every figure"). Default: the map's seed only, the flag not passed (binaries before the flag take no --seeds).
 
-usage: bench/route_conditions.py --vmap build/vmap[,old/vmap] [--sets corridor,kidnapped,elsewhere,places,third-rate,third-rate-places,michigan] [--matchers orb,xfeat]
+usage: bench/route_conditions.py --vmap build/vmap[,old/vmap] [--sets corridor,kidnapped,elsewhere,places,third-rate,third-rate-places,speed,speed-odometry,speed-places,speed-odometry-places,michigan] [--matchers orb,xfeat]
                                  [--tau T] [--start-key K|none] [--build "FLAGS"] [--localize "FLAGS"] [--repeat-stride N] [--work DIR] [--csv-dir DIR]
                                  [--evidence-dir DIR] [--seeds S,S,...] [--named-frames N]
 (from the repository root; ../shared must be there)"""
@@ -219,17 +225,27 @@ def linked_folder(folder, frames, seconds_per_frame):
     return folder
 
 
-def third_rate(vmap, matcher, map_flags, localize_flags, work, csv_dir, label):
+def timed_repeat(vmap, matcher, map_flags, localize_flags, work, csv_dir, label, repeat_of, seconds_per_frame,
+                 with_odometry=False):
+    """The repeat frames `repeat_of` (run frame -> repeat frame) as a recording of their own, `seconds_per_frame`
+    apart, against a map of the timed teach run built with `map_flags`. `with_odometry`: both runs' odometry as the
+    frame alignment gives it (a straight line, teach frame i at i x TEACH_METRES_PER_FRAME; repeat frame i where teach
+    frame i was), passed to vmap localize (--teach-odometry, --odometry): perfect odometry."""
     teach = linked_folder(os.path.join(work, "timed_teach"),
                           [os.path.join(CORRIDOR, "teach", "%07d.jpg" % i) for i in range(111)],
                           TEACH_SECONDS_PER_FRAME)
-    repeat_of = list(range(0, 111, THIRD_RATE_STRIDE))  # run frame -> repeat frame
-    repeat = linked_folder(os.path.join(work, "third_rate_repeat"),
-                           [os.path.join(CORRIDOR, "repeat", "%07d.jpg" % i) for i in repeat_of],
-                           TEACH_SECONDS_PER_FRAME * THIRD_RATE_STRIDE)
+    repeat = linked_folder(os.path.join(work, label + "_repeat"),
+                           [os.path.join(CORRIDOR, "repeat", "%07d.jpg" % i) for i in repeat_of], seconds_per_frame)
     map_directory = os.path.join(work, "timed_corridor_%s_%s" % (matcher, flags_tag(map_flags)))
     key_sources = [k["source_index"] for k in build(vmap, teach, matcher, map_flags, map_directory)["key_images"]]
     flags = list(localize_flags)
+    if with_odometry:
+        teach_odometry = os.path.join(work, "timed_teach_odometry.csv")
+        write_odometry(teach_odometry, [(i * TEACH_SECONDS_PER_FRAME, i * TEACH_METRES_PER_FRAME) for i in range(111)])
+        repeat_odometry = os.path.join(work, label + "_odometry.csv")
+        write_odometry(repeat_odometry, [(f * seconds_per_frame, i * TEACH_METRES_PER_FRAME)
+                                         for f, i in enumerate(repeat_of)])
+        flags += ["--teach-odometry", teach_odometry, "--odometry", repeat_odometry]
     if csv_dir:
         flags += ["--csv", os.path.join(csv_dir, "%s_%s.csv" % (label, matcher))]
     doc = localize(vmap, map_directory, repeat, flags, os.path.join(work, "run.json"))
@@ -237,6 +253,38 @@ def third_rate(vmap, matcher, map_flags, localize_flags, work, csv_dir, label):
     tally.add(doc, lambda f: corridor_right_keys(key_sources, repeat_of[f["source_index"]]), label,
               lambda f: "run frame %d (repeat %d)" % (f["source_index"], repeat_of[f["source_index"]]))
     return tally
+
+
+def write_odometry(path, poses):
+    """A CSV of timestamp,x,y,yaw as vmap reads it: `poses` (seconds, metres along a straight line)."""
+    with open(path, "w") as f:
+        f.write("timestamp,x,y,yaw\n")
+        for seconds, metres in poses:
+            f.write("%.6f,%.6f,0,0\n" % (seconds, metres))
+
+
+def third_rate(vmap, matcher, map_flags, localize_flags, work, csv_dir, label):
+    return timed_repeat(vmap, matcher, map_flags, localize_flags, work, csv_dir, label,
+                        list(range(0, 111, THIRD_RATE_STRIDE)), TEACH_SECONDS_PER_FRAME * THIRD_RATE_STRIDE)
+
+
+# The speed sets' repeat: teach frames passed a frame, in a cycle (1 to 4 times the teach speed, 2.5 on average),
+# the camera at the teach run's frame rate.
+SPEED_STRIDES = (1, 1, 2, 2, 3, 3, 4, 4, 4, 4, 3, 3, 2, 2, 1, 1)
+TEACH_METRES_PER_FRAME = 0.1  # any will do: both runs' odometry share it
+
+
+def speed_repeat_frames():
+    frames, i = [], 0
+    while i <= 110:
+        frames.append(i)
+        i += SPEED_STRIDES[(len(frames) - 1) % len(SPEED_STRIDES)]
+    return frames
+
+
+def speed(vmap, matcher, map_flags, localize_flags, work, csv_dir, label, with_odometry):
+    return timed_repeat(vmap, matcher, map_flags, localize_flags, work, csv_dir, label, speed_repeat_frames(),
+                        TEACH_SECONDS_PER_FRAME, with_odometry)
 
 
 # The kidnapped run's stretches of repeat frames, first and last included, in the order the robot saw them.
@@ -405,6 +453,16 @@ def main():
                     runs("%s: corridor at a third of the teach run's frame rate, timed, against places, %s" % (
                         vmap, matcher), lambda flags, csv_dir: third_rate(vmap, matcher, PLACES_BUILD + build_flags,
                                                                           flags, work, csv_dir, "third_rate_places"))
+                for odometry in (False, True):
+                    for places in (False, True):
+                        name = "speed" + ("-odometry" if odometry else "") + ("-places" if places else "")
+                        if name in sets:
+                            runs("%s: corridor driven at 1-4 times the teach speed, timed%s%s, %s" % (
+                                vmap, ", with both runs' odometry" if odometry else "",
+                                ", against places" if places else "", matcher),
+                                lambda flags, csv_dir, places=places, odometry=odometry, name=name: speed(
+                                    vmap, matcher, PLACES_BUILD + build_flags if places else tau_flags, flags, work,
+                                    csv_dir, name.replace("-", "_"), odometry))
                 if "kidnapped" in sets:
                     runs("%s: kidnapped corridor (repeat %s), %s" % (vmap, ", ".join("%d-%d" % s for s in KIDNAPPED),
                                                                     matcher),

@@ -49,6 +49,26 @@ py::object ResultObject(const VisualMap& map, const LocalizationResult& result) 
   return Namespace(fields);
 }
 
+// The robot's odometry pose at a frame, (x, y, yaw) in metres and radians, or None.
+std::optional<OdometrySample> OdometryArgument(const py::object& odometry, std::optional<double> timestamp) {
+  if (odometry.is_none()) return std::nullopt;
+  const auto why =
+      "odometry must be (x, y, yaw): the robot's odometry pose at the frame in metres and radians, or None";
+  if (!py::isinstance<py::sequence>(odometry) || py::isinstance<py::str>(odometry) || py::len(odometry) != 3) {
+    throw InputError(why);
+  }
+  const py::sequence values = odometry.cast<py::sequence>();
+  OdometrySample sample;
+  sample.timestamp = timestamp.value_or(0.0);
+  sample.x = FloatArgument(values[0], "odometry x");
+  sample.y = FloatArgument(values[1], "odometry y");
+  sample.yaw = FloatArgument(values[2], "odometry yaw");
+  if (!(std::isfinite(sample.x) && std::isfinite(sample.y) && std::isfinite(sample.yaw))) {
+    throw InputError(std::string(why) + "; a value is not finite");
+  }
+  return sample;
+}
+
 // The localization session of a map, for frames given one at a time.
 class FrameLocalizer {
  public:
@@ -65,17 +85,18 @@ class FrameLocalizer {
     });
   }
 
-  py::object Localize(const py::object& image, const py::object& timestamp) {
+  py::object Localize(const py::object& image, const py::object& timestamp, const py::object& odometry) {
     const ImageInput input = ImageView(image, "image");
     std::optional<double> seconds;
     if (!timestamp.is_none()) {
       seconds = FloatArgument(timestamp, "timestamp");
       if (!std::isfinite(*seconds)) throw InputError("timestamp is not finite; give the frame's time in seconds");
     }
+    const std::optional<OdometrySample> pose = OdometryArgument(odometry, seconds);
     LocalizationResult result;
     {
       py::gil_scoped_release release;
-      result = session_->Localize(input.image, seconds);
+      result = session_->Localize(input.image, seconds, pose);
     }
     return ResultObject(session_->map(), result);
   }
@@ -89,8 +110,9 @@ class FrameLocalizer {
 py::list LocalizeFunction(const py::object& map, const py::object& query, const py::kwargs& kwargs) {
   LocalizePipelineOptions options;
   KeywordOptions keywords("localize");
-  // The outputs are the CLI's; so is the odometry, whose columns a result does not have.
-  keywords.Add(options, {"map", "query", "csv", "json", "report", "odometry", "odometry_topic"});
+  // The outputs are the CLI's. The odometry's columns are not a result's, but its poses pace the belief (with the
+  // teach odometry).
+  keywords.Add(options, {"map", "query", "csv", "json", "report"});
   keywords.Parse(kwargs);
   options.map = MapDirectory(map).string();
   options.query = TextArgument(query, "localize(): input");
@@ -113,8 +135,11 @@ void BindLocalization(py::module_& m) {
                              "options of `vmap localize` as keywords (candidates=..., ranking=..., ...).")
       .def(py::init<const py::object&, const py::kwargs&>(), py::arg("map"))
       .def("localize", &FrameLocalizer::Localize, py::arg("image"), py::arg("timestamp") = py::none(),
+           py::arg("odometry") = py::none(),
            "Localizes the next frame (uint8 HxW grey or HxWx3 BGR; brought to the map's frame size; timestamp in "
-           "seconds or None). Returns an object whose attributes are the columns of `vmap localize --csv` (status, "
+           "seconds or None; odometry the robot's pose (x, y, yaw) in metres and radians at the frame, or None: with "
+           "the teach odometry, teach_odometry=..., the belief moves by the distance driven). Returns an object whose "
+           "attributes are the columns of `vmap localize --csv` (status, "
            "key, next_key, similarity, heading_px, ...), with F, R and t as numpy arrays (None when unknown).")
       .def("reset", &FrameLocalizer::Reset, "Forgets the estimate: the next frame is relocalized.");
   m.def("localize", &LocalizeFunction, py::arg("map"), py::arg("input"),

@@ -20,21 +20,27 @@ def run_isolated(code):
     return done
 
 
-@pytest.mark.parametrize("timestamp", ["'now'", "[1.0]", "object()", "10**400", "b'1'", "float('nan')", "True"])
-def test_a_bad_timestamp_is_an_exception(maps, timestamp):
-    cli_dir, _, _ = maps
+def localize_in_isolation(cli_dir, arguments):
+    """Localizes the map's first key image with `arguments` (Python source) in a fresh interpreter: what it raised, or
+    'accepted'."""
     done = run_isolated(f"""
 m = vmap.read_map({str(cli_dir)!r})
 localizer = vmap.Localizer(m, no_cache=True)
 try:
-    localizer.localize(m.key_images[0].gray, timestamp={timestamp})
+    localizer.localize(m.key_images[0].gray, {arguments})
 except (TypeError, vmap.Error) as e:
     print(type(e).__name__, e)
 else:
     print('accepted')
 """)
     assert done.returncode == 0, done.stderr
-    assert "accepted" not in done.stdout and "timestamp" in done.stdout, done.stdout
+    return done.stdout
+
+
+@pytest.mark.parametrize("timestamp", ["'now'", "[1.0]", "object()", "10**400", "b'1'", "float('nan')", "True"])
+def test_a_bad_timestamp_is_an_exception(maps, timestamp):
+    said = localize_in_isolation(maps[0], f"timestamp={timestamp}")
+    assert "accepted" not in said and "timestamp" in said, said
 
 
 def test_a_good_timestamp_is_recorded(maps):
@@ -43,6 +49,35 @@ def test_a_good_timestamp_is_recorded(maps):
     localizer = vmap.Localizer(m, no_cache=True)
     assert localizer.localize(m.key_images[0].gray, timestamp=12.5).timestamp == 12.5
     assert localizer.localize(m.key_images[1].gray, timestamp=np.float32(13)).timestamp == 13.0
+
+
+@pytest.mark.parametrize("odometry", ["(1.0, 2.0)", "'abc'", "(1, 2, float('nan'))", "object()", "[1, 2, 'x']",
+                                      "(1, 2, 10**400)"])
+def test_a_bad_odometry_pose_is_an_exception(maps, odometry):
+    said = localize_in_isolation(maps[0], f"timestamp=1.0, odometry={odometry}")
+    assert "accepted" not in said and "odometry" in said, said
+
+
+def test_the_odometry_paces_the_belief_with_the_teach_odometry(maps, tmp_path):
+    """The robot's pose with each frame, against the teach run's odometry: the belief moves by the distance driven
+    (three steps a key image's worth), whatever the frames' times say."""
+    cli_dir, _, _ = maps
+    m = vmap.read_map(cli_dir)
+    times = [k.timestamp for k in m.key_images]
+    assert len(times) >= 3 and all(t is not None for t in times)
+    teach = tmp_path / "teach_odometry.csv"
+    # The teach run at 1 m/s along x: a key image's worth is the mean time between key images, in metres.
+    teach.write_text("timestamp,x,y,yaw\n" + "".join(f"{t:.6f},{t:.6f},0,0\n" for t in
+                                                     [times[0] - 1.0] + times + [times[-1] + 1.0]))
+    per_key = (times[-1] - times[0]) / (len(times) - 1)
+    taught = vmap.Localizer(m, no_cache=True, teach_odometry=str(teach))
+    untaught = vmap.Localizer(m, no_cache=True)
+    for localizer in (taught, untaught):
+        localizer.localize(m.key_images[0].gray, timestamp=times[0], odometry=(0.0, 0.0, 0.0))
+    # Two key images' worth driven in a tenth of a key image's time.
+    second = dict(image=m.key_images[1].gray, timestamp=times[0] + 0.1 * per_key, odometry=(2.0 * per_key, 0.0, 0.0))
+    assert taught.localize(**second).motion_steps == 6
+    assert untaught.localize(**second).motion_steps == 1
 
 
 def test_huge_broadcast_images_are_refused_before_any_copy():

@@ -2,6 +2,7 @@
 // is checked against `vmap localize` on the same frames.
 
 #include <cmath>
+#include <fstream>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -9,9 +10,11 @@
 #include <fmt/format.h>
 #include <geometry_msgs/Twist.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <std_msgs/Bool.h>
 #include <std_srvs/Trigger.h>
 
+#include "vmap/sources/odometry.h"
 #include "vmap/testing/run_vmap.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/shared_data.h"
@@ -81,17 +84,20 @@ struct Published {
   }
 };
 
+// The robot has odometry in both runs (the teach run's beside the map, as the teach node writes it; `odom` in the
+// repeat): the node paces the belief by the distance driven as `vmap localize` does on the bag's odometry.
 TEST(RepeatNode, LocalizesThePlayedFramesAsVmapLocalizeDoes) {
   SKIP_WITHOUT_SHARED();
   ScopedTempDir dir("ros_repeat");
   const fs::path video = fs::path(SharedDir()) / "data/lab_floor/lab_floor.mp4";
   const fs::path teach = dir.path() / "teach.bag", repeat = dir.path() / "repeat.bag", map = dir.path() / "map";
-  WriteVideoBag(video, 0, 199, teach);
-  const std::vector<ros::Time> stamps = WriteVideoBag(video, 20, 139, repeat);
+  WriteVideoBag(video, 0, 199, teach, "bgr8", 0.05);
+  const std::vector<ros::Time> stamps = WriteVideoBag(video, 20, 139, repeat, "bgr8", 0.05);
   std::string output;
   ASSERT_EQ(RunVmap("build -q " + Quote(teach) + " -o " + Quote(map), &output), 0) << output;
+  std::ofstream(map / "teach_odometry.csv") << OdometryCsv(ReadOdometry(teach.string(), ""));
 
-  const auto node = StartVmapNode("/repeat_test", {"image:=/camera/image_raw"}, dir.path() / "node.log");
+  const auto node = StartVmapNode("/repeat_test", {"image:=/camera/image_raw", "odom:=/odom"}, dir.path() / "node.log");
   ASSERT_TRUE(WaitForNodeServices("/repeat_test/vmap")) << node->Log();
   ros::NodeHandle handle;
   Published published;
@@ -109,6 +115,7 @@ TEST(RepeatNode, LocalizesThePlayedFramesAsVmapLocalizeDoes) {
   start.request.start = -1;
   ASSERT_TRUE(ros::service::call("/repeat_test/vmap/repeat/start", start)) << node->Log();
   ASSERT_TRUE(start.response.success) << start.response.message;
+  EXPECT_NE(start.response.message.find("teach odometry"), std::string::npos) << start.response.message;
   ASSERT_FALSE(start.response.route.empty());
   EXPECT_EQ(start.response.route.front(), 0);
   // Our subscription is connected before the first frame is played.
@@ -163,12 +170,15 @@ TEST(RepeatNode, LocalizesThePlayedFramesAsVmapLocalizeDoes) {
   // `vmap localize` on the frames the node processed.
   WriteBagSubset(repeat, processed, dir.path() / "processed.bag");
   ASSERT_EQ(RunVmap("localize -q " + Quote(map) + " " + Quote(dir.path() / "processed.bag") + " --csv " +
-                        Quote(dir.path() / "cli.csv"),
+                        Quote(dir.path() / "cli.csv") + " --json " + Quote(dir.path() / "cli.json"),
                     &output),
             0)
       << output;
   const auto rows = ReadCsv(dir.path() / "cli.csv");
   ASSERT_EQ(rows.size(), messages.size());
+  const nlohmann::json cli_run = nlohmann::json::parse(testing::ReadText(dir.path() / "cli.json"));
+  ASSERT_EQ(cli_run.at("frames").size(), messages.size());
+  int paced_on = 0;
   int localized_frames = 0;
   for (size_t i = 0; i < rows.size(); ++i) {
     const auto& row = rows[i];
@@ -185,6 +195,8 @@ TEST(RepeatNode, LocalizesThePlayedFramesAsVmapLocalizeDoes) {
     EXPECT_EQ(Number(message.progress), row.at("progress"));
     EXPECT_EQ(message.translation_known ? "1" : "0", row.at("translation_known"));
     EXPECT_EQ(message.guidance, row.at("guidance"));
+    EXPECT_EQ(message.motion_steps, cli_run.at("frames")[i].at("motion_steps").get<int>());
+    paced_on += message.motion_steps > 1;
     if (message.pose_valid) {
       EXPECT_EQ(fmt::format("{:.9g}", message.pose.position.x), row.at("tx"));
     }
@@ -192,6 +204,7 @@ TEST(RepeatNode, LocalizesThePlayedFramesAsVmapLocalizeDoes) {
   }
   // The frames are the map's own place: most localize.
   EXPECT_GT(localized_frames, static_cast<int>(rows.size()) * 9 / 10);
+  RecordProperty("frames_paced_on", paced_on);
 
   std_srvs::Trigger stop;
   ASSERT_TRUE(ros::service::call("/repeat_test/vmap/repeat/stop", stop));

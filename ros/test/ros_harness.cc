@@ -228,7 +228,7 @@ bool WaitForNodeServices(const std::string& node, std::chrono::seconds timeout) 
 }
 
 std::vector<ros::Time> WriteVideoBag(const fs::path& video, int first, int last, const fs::path& bag,
-                                     const std::string& encoding, bool odometry) {
+                                     const std::string& encoding, double odometry_metres_per_frame) {
   FrameSourceOptions options;
   options.first = first;
   options.last = last;
@@ -261,11 +261,11 @@ std::vector<ros::Time> WriteVideoBag(const fs::path& video, int first, int last,
       messages.push_back({"/camera/camera_info", "sensor_msgs/CameraInfo", static_cast<int64_t>(stamp.toNSec()),
                           ros_node::SerializeMessage(info)});
     }
-    if (odometry) {
+    if (odometry_metres_per_frame > 0.0) {
       nav_msgs::Odometry pose;
       pose.header.stamp = stamp;
       pose.header.frame_id = "odom";
-      pose.pose.pose.position.x = 0.05 * static_cast<double>(stamps.size());
+      pose.pose.pose.position.x = odometry_metres_per_frame * static_cast<double>(stamps.size());
       pose.pose.pose.orientation.w = 1.0;
       messages.push_back(
           {"/odom", "nav_msgs/Odometry", static_cast<int64_t>(stamp.toNSec()), ros_node::SerializeMessage(pose)});

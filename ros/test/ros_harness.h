@@ -77,11 +77,11 @@ bool WaitForNodeServices(const std::string& node, std::chrono::seconds timeout =
 
 // A camera recording for the tests: frames [first, last] of a video as sensor_msgs/Image (`encoding`: bgr8 or
 // mono8) on /camera/image_raw with the video's intrinsics as CameraInfo on /camera/camera_info, stamped from
-// 1000 s plus the video's time; with `odometry`, a nav_msgs/Odometry on /odom at each frame's stamp (the robot
-// 5 cm further along x at each frame). Returns the frames' stamps.
+// 1000 s plus the video's time; with `odometry_metres_per_frame` above 0, a nav_msgs/Odometry on /odom at each
+// frame's stamp (the robot that much further along x at each frame). Returns the frames' stamps.
 std::vector<ros::Time> WriteVideoBag(const std::filesystem::path& video, int first, int last,
                                      const std::filesystem::path& bag, const std::string& encoding = "bgr8",
-                                     bool odometry = false);
+                                     double odometry_metres_per_frame = 0.0);
 
 // The frames of `bag` whose image stamps are in `stamps`, with every camera_info message, as a new bag (what a
 // node processed, for `vmap localize` to localize the same frames).

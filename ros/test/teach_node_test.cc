@@ -33,7 +33,7 @@ TEST(TeachNode, BuildsFromAPlayedBagTheMapVmapBuildBuilds) {
   ScopedTempDir dir("ros_teach");
   const fs::path bag = dir.path() / "teach.bag";
   const std::vector<ros::Time> stamps =
-      WriteVideoBag(fs::path(SharedDir()) / "data/lab_floor/lab_floor.mp4", 0, 239, bag, "bgr8", /*odometry=*/true);
+      WriteVideoBag(fs::path(SharedDir()) / "data/lab_floor/lab_floor.mp4", 0, 239, bag, "bgr8", 0.05);
   std::string output;
   ASSERT_EQ(RunVmap("build -q " + Quote(bag) + " -o " + Quote(dir.path() / "cli_map"), &output), 0) << output;
 

@@ -15,7 +15,6 @@
 #include "vmap_ros/localization_message.h"
 #include "vmap_ros/parameter_reader.h"
 #include "vmap_ros/service_answers.h"
-#include "vmap_ros/teach_odometry.h"
 #include "vmap_ros/vmap_node.h"
 
 namespace vmap::ros_node {
@@ -47,14 +46,12 @@ bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::St
     options.session.run.show_progress = false;
     ControllerOptions controller;
     parameters.Read(controller);  // the controller's flags (vmap simulate's)
-    // The teach run's odometry, when the robot had one (teach_odometry.h), for the taught speeds and turns.
-    std::string teach_odometry, teach_odometry_topic;
-    private_node_.getParam("teach_odometry", teach_odometry);
-    private_node_.getParam("teach_odometry_topic", teach_odometry_topic);
-    const std::vector<OdometrySample> taught = TeachOdometryFor(options.map, teach_odometry, teach_odometry_topic);
-    run = std::make_unique<RepeatRun>(options, controller, taught);
-    taught_with = taught.empty() ? "the map alone (no teach odometry)"
-                                 : fmt::format("the teach odometry ({} samples)", taught.size());
+    // The teach run's odometry (~teach_odometry, read with the session's options; else the map folder's), when the
+    // robot had one, for the taught speeds and turns and the localizer's pace.
+    run = std::make_unique<RepeatRun>(options, controller);
+    const size_t taught = run->teach_odometry().size();
+    taught_with =
+        taught == 0 ? "the map alone (no teach odometry)" : fmt::format("the teach odometry ({} samples)", taught);
   } catch (const InputError& error) {
     return Fail(response, "repeat/start: " + parameters.Message(error));
   } catch (const std::exception& error) {
@@ -170,11 +167,11 @@ void VmapNode::RepeatFrame(const Arrival& arrival) {
   const double time = image.stamp > 0.0 ? image.stamp : ros::Time::now().toSec();
   RepeatStep step;
   ControlSummary control;
+  const std::optional<OdometrySample> odometry = odometry_.At(time);
   if (mode == Mode::kPaused) {
-    step.localization = repeat_->Localize(image);
+    step.localization = repeat_->Localize(image, odometry ? &*odometry : nullptr);
     control.state = "paused";
   } else {
-    const std::optional<OdometrySample> odometry = odometry_.At(time);
     step = repeat_->Step(image, time, odometry ? &*odometry : nullptr);
     control.state = ControllerStateName(step.control.state);
     control.steering = step.control.steering;

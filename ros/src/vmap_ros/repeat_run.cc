@@ -11,17 +11,16 @@
 
 namespace vmap::ros_node {
 
-RepeatRun::RepeatRun(const LocalizePipelineOptions& options, const ControllerOptions& controller,
-                     const std::vector<OdometrySample>& teach_odometry)
+RepeatRun::RepeatRun(const LocalizePipelineOptions& options, const ControllerOptions& controller)
     : session_(options),
       route_(session_.localizer().route()),
-      controller_(MakeTaughtRoute(session_.map(), route_, teach_odometry), controller) {
+      controller_(MakeTaughtRoute(session_.map(), route_, session_.teach_odometry()), controller) {
   key_images_.resize(session_.map().key_images.size());
 }
 
 RepeatStep RepeatRun::Step(const CameraImage& image, double time, const OdometrySample* odometry) {
   RepeatStep step;
-  step.localization = Localize(image);
+  step.localization = Localize(image, odometry);
   // The controller's clock must advance: a camera whose stamps repeat (or a bag played in a loop) gets the
   // smallest step forward instead.
   time = std::max(time, last_time_ + 1e-3);
@@ -30,10 +29,11 @@ RepeatStep RepeatRun::Step(const CameraImage& image, double time, const Odometry
   return step;
 }
 
-LocalizationResult RepeatRun::Localize(const CameraImage& image) {
+LocalizationResult RepeatRun::Localize(const CameraImage& image, const OdometrySample* odometry) {
   const cv::Mat& pixels = image.color.empty() ? image.gray : image.color;
   frame_ = FrameFromImage(pixels, frames_, session_.map().input.frame_size, "the camera image");
   frame_.timestamp = image.stamp;
+  if (odometry) frame_.odometry = *odometry;
   Localizer& localizer = session_.localizer();
   const auto features = session_.matcher().ExtractFrame(frame_.gray, frame_.color);
   // While tracking, the frame is compared with key and next_key: the two comparisons run side by side (the

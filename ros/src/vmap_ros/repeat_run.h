@@ -25,20 +25,22 @@ struct RepeatStep {
 
 class RepeatRun {
  public:
-  // Opens the map of `options` (its key images' features: seconds for a large map without a cache), plans the route
-  // from `from` to `to` and sets up the controller on it (the taught profile from the map: the key images'
-  // timestamps and the links' poses, or the teach run's odometry when given). Throws InputError naming the map and what
-  // is wrong (missing, malformed, a key image it has not, no route, no camera and no ~focal_px) and OptionError for a
-  // bad controller option. `teach_odometry` (may be empty): the teach run's odometry on the key images' clock, for the
-  // taught speeds and turns.
-  RepeatRun(const LocalizePipelineOptions& options, const ControllerOptions& controller,
-            const std::vector<OdometrySample>& teach_odometry = {});
+  // Opens the map of `options` (its key images' features: seconds for a large map without a cache) and the teach
+  // run's odometry (`options.session.teach_odometry`, else the map folder's teach_odometry.csv, if any), plans the
+  // route from `from` to `to` and sets up the controller on it (the taught profile from the map: the key images'
+  // timestamps and the links' poses, or the teach run's odometry when there is one; the localizer paced by it). Throws
+  // InputError naming the map and what is wrong (missing, malformed, a key image it has not, no route, no camera and no
+  // ~focal_px, a teach odometry that cannot be read) and OptionError for a bad controller option.
+  RepeatRun(const LocalizePipelineOptions& options, const ControllerOptions& controller);
 
   // Localizes the next camera frame of the run (brought to the map's frame size: frame()) and asks the controller
   // for its command at `time` (seconds), with the robot's odometry at that time when it has one (else null).
+  // The odometry also paces the localizer's belief (with the teach odometry: the distance driven between frames).
   RepeatStep Step(const CameraImage& image, double time, const OdometrySample* odometry);
   // Localizes the frame only (a paused run keeps its estimate up to date; the controller is not asked).
-  LocalizationResult Localize(const CameraImage& image);
+  LocalizationResult Localize(const CameraImage& image, const OdometrySample* odometry = nullptr);
+  // The teach run's odometry (empty: none).
+  const std::vector<OdometrySample>& teach_odometry() const { return session_.teach_odometry(); }
   // The controller starts again (after a pause): it commands nothing until a frame is localized.
   void ResetController() { controller_.Reset(); }
 

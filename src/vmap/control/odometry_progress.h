@@ -25,6 +25,7 @@ class OdometryProgress {
   // The frame's odometry; call once per frame, in order. Lost and uncertain frames keep the key image of the
   // last one steered by.
   FrameOdometry Update(const LocalizationResult& result);
+  const OdometryTrack& track() const { return track_; }
 
  private:
   OdometryTrack track_;

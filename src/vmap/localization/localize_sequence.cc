@@ -52,7 +52,8 @@ using CompareAheadFn = std::function<std::vector<KeyComparison>(const ImageFeatu
 }  // namespace
 
 LocalizationSummary LocalizeSequence(FrameSource& source, const Matcher& matcher, Localizer& localizer,
-                                     const LocalizeSequenceOptions& options, const LocalizationCallback& on_frame) {
+                                     const LocalizeSequenceOptions& options, const LocalizationCallback& on_frame,
+                                     const OdometryTrack* odometry) {
   options.Check();
   const auto start = std::chrono::steady_clock::now();
   LocalizationSummary summary;
@@ -86,6 +87,7 @@ LocalizationSummary LocalizeSequence(FrameSource& source, const Matcher& matcher
     return item;
   };
   auto localize = [&](ExtractedFrame& item) {
+    if (odometry && item.frame.timestamp >= 0.0) item.frame.odometry = odometry->At(item.frame.timestamp);
     const LocalizationResult result = localizer.Localize(item.frame, *item.features, std::move(item.ahead));
     {
       std::lock_guard<std::mutex> lock(likely_mutex);

@@ -13,6 +13,7 @@
 #include "vmap/features/matcher.h"
 #include "vmap/localization/localizer.h"
 #include "vmap/sources/frame_source.h"
+#include "vmap/sources/odometry.h"
 
 namespace vmap {
 
@@ -50,8 +51,10 @@ struct LocalizationSummary {
 using LocalizationCallback = std::function<void(const Frame& frame, const LocalizationResult& result)>;
 
 // Runs `localizer` over every frame of `source` (features from `matcher`, which must be the map's) and
-// calls `on_frame` for each frame in order, on the calling thread.
+// calls `on_frame` for each frame in order, on the calling thread. `odometry` (may be null): the run's odometry,
+// each frame's pose at its timestamp (Frame::odometry) paces the localizer's belief.
 LocalizationSummary LocalizeSequence(FrameSource& source, const Matcher& matcher, Localizer& localizer,
-                                     const LocalizeSequenceOptions& options, const LocalizationCallback& on_frame);
+                                     const LocalizeSequenceOptions& options, const LocalizationCallback& on_frame,
+                                     const OdometryTrack* odometry = nullptr);
 
 }  // namespace vmap

@@ -14,6 +14,7 @@
 #include "vmap/features/camera_mask.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/features/orb_matcher.h"
+#include "vmap/sources/odometry.h"
 
 namespace vmap {
 
@@ -157,6 +158,18 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
 
 Localizer::~Localizer() = default;
 
+void Localizer::PaceByTeachOdometry(const std::vector<OdometrySample>& teach_odometry) {
+  std::vector<double> route_distances;
+  if (!teach_odometry.empty()) {
+    const OdometryTrack track(teach_odometry);
+    for (const int k : route_) {
+      const double t = map_.key_images[k].timestamp;
+      route_distances.push_back(t >= 0.0 ? track.DistanceAt(t) : std::numeric_limits<double>::quiet_NaN());
+    }
+  }
+  pace_.SetTeachDistances(route_distances);
+}
+
 void CheckStartKey(const VisualMap& map, const LocalizerOptions& options) {
   const int key = options.start_key, num_keys = static_cast<int>(map.key_images.size());
   if (key < 0) return;
@@ -218,7 +231,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   made_ahead_ = std::move(ahead);
   ranked_.clear();
   bucket_of_position_.clear();
-  const int motion_steps = pace_.Steps(frame.source_index, frame.timestamp);
+  const int motion_steps = pace_.Steps(frame.source_index, frame.timestamp, frame.odometry);
   belief_.Predict(motion_steps);
   if (start_unconfirmed_) evidence_belief_.Predict(motion_steps);
   // Guided matching asks where the estimate was dropped for max_lost_frames frames (guided_while_lost).

@@ -32,6 +32,26 @@ double TeachSecondsPerPosition(const std::vector<double>& route_timestamps) {
   return std::isfinite(mean) ? mean : 0.0;
 }
 
+double TeachMetresPerPosition(const std::vector<double>& route_distances) {
+  // The key images the odometry covers, by route position: a teach odometry that started a moment after the camera
+  // (the ROS node's teach run), or paused, still spaces the others.
+  int first = -1, last = -1;
+  bool growing = true, shrinking = true;
+  for (int p = 0; p < static_cast<int>(route_distances.size()); ++p) {
+    if (!std::isfinite(route_distances[p])) continue;
+    if (last >= 0) {
+      growing = growing && route_distances[p] >= route_distances[last];
+      shrinking = shrinking && route_distances[p] <= route_distances[last];
+    } else {
+      first = p;
+    }
+    last = p;
+  }
+  if (last <= first || (!growing && !shrinking)) return 0.0;
+  // Distances along one odometry: the stretch's length is its ends' difference.
+  return std::abs(route_distances[last] - route_distances[first]) / static_cast<double>(last - first);
+}
+
 int MotionStepsPerFrame(double travelled, double teach_per_position) {
   if (!(travelled > 0.0 && teach_per_position > 0.0)) return 1;
   // Bounded before rounding: a huge gap cannot overflow lround.
@@ -45,19 +65,33 @@ MotionPace::MotionPace(const std::vector<int>& route_source_indices, const std::
       teach_seconds_per_position_(TeachSecondsPerPosition(route_timestamps)),
       fixed_steps_(fixed_steps) {}
 
-void MotionPace::Reset() { started_ = false; }
+void MotionPace::SetTeachDistances(const std::vector<double>& route_distances) {
+  teach_metres_per_position_ = TeachMetresPerPosition(route_distances);
+}
 
-int MotionPace::Steps(int source_index, double timestamp) {
+void MotionPace::Reset() {
+  started_ = false;
+  odometry_before_.reset();
+}
+
+int MotionPace::Steps(int source_index, double timestamp, const std::optional<OdometrySample>& odometry) {
   if (!(timestamp >= 0.0 && std::isfinite(timestamp))) timestamp = -1.0;
   const bool first = !started_;
   const double frames = static_cast<double>(source_index) - source_index_before_;
   const double seconds = timestamp - timestamp_before_;
   const bool timed = timestamp >= 0.0 && timestamp_before_ >= 0.0 && seconds > 0.0;
+  const bool driven = odometry && odometry_before_;
+  const double metres = driven ? std::hypot(odometry->x - odometry_before_->x, odometry->y - odometry_before_->y) : 0.0;
   started_ = true;
   source_index_before_ = source_index;
   timestamp_before_ = timestamp;
+  odometry_before_ = odometry;
   if (first) return 1;  // as the model was fitted: how far the run's first frame is from a frame before is not known
   if (fixed_steps_ > 0) return fixed_steps_;
+  // A robot that stood still (metres 0) takes the one step every frame takes: the rules were fitted so.
+  if (driven && std::isfinite(metres) && teach_metres_per_position_ > 0.0) {
+    return MotionStepsPerFrame(metres, teach_metres_per_position_);
+  }
   if (timed && teach_seconds_per_position_ > 0.0) return MotionStepsPerFrame(seconds, teach_seconds_per_position_);
   return MotionStepsPerFrame(std::max(frames, 1.0), teach_frames_per_position_);
 }

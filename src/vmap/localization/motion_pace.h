@@ -5,11 +5,16 @@
 // localizes) must move the belief three times as far a frame, or the belief stays behind its evidence
 // (docs/localize.md, "The motion model's pace").
 //
-// A run is taken to pass the route at the teach run's speed (a teach-and-repeat robot's). The time between two
-// frames says how far it went when both runs have timestamps, whatever either's frame rate; else the input indices
-// do, which assumes the teach run's frame rate too.
+// Where both runs have odometry (the teach run's beside its map, the repeat's with each frame), the distance driven
+// between two frames says how far the run went, whatever its speed. Else a run is taken to pass the route at the
+// teach run's speed (a teach-and-repeat robot's): the time between two frames says how far it went when both runs
+// have timestamps, whatever either's frame rate; else the input indices do, which assumes the teach run's frame rate
+// too.
 
+#include <optional>
 #include <vector>
+
+#include "vmap/sources/odometry_sample.h"
 
 namespace vmap {
 
@@ -28,14 +33,20 @@ inline constexpr int kMaxMotionSteps = 8;
 // not all rise or all fall along the route (key images of several recordings).
 double TeachFramesPerPosition(const std::vector<int>& route_source_indices);
 double TeachSecondsPerPosition(const std::vector<double>& route_timestamps);
+// The mean distance driven between a route's consecutive key images: `route_distances`, the teach odometry's metres
+// driven at each key image in route order (NaN: the odometry does not cover it), over the key images it covers. 0
+// (unknown) where it covers fewer than two, where their distances do not all grow (or all shrink: a route backwards
+// through the map) along the route, or where the odometry did not move between them.
+double TeachMetresPerPosition(const std::vector<double>& route_distances);
 
 // The motion model's steps for a frame that went `travelled` since the frame before, in the unit of
-// `teach_per_position` (input frames or seconds): kMotionStepsPerPosition per position passed, rounded, 1 to
+// `teach_per_position` (input frames, seconds or metres): kMotionStepsPerPosition per position passed, rounded, 1 to
 // kMaxMotionSteps. 1 where either is unknown (not above 0).
 int MotionStepsPerFrame(double travelled, double teach_per_position);
 
-// A run's pace, frame by frame: by time where the route's key images and both frames have timestamps that rise,
-// else by input index.
+// A run's pace, frame by frame: by the distance driven where the route's key images have teach odometry and both
+// frames odometry, else by time where the route's key images and both frames have timestamps that rise, else by
+// input index.
 class MotionPace {
  public:
   MotionPace() = default;  // one step a frame
@@ -44,19 +55,27 @@ class MotionPace {
   MotionPace(const std::vector<int>& route_source_indices, const std::vector<double>& route_timestamps,
              int fixed_steps = 0);
 
+  // The teach odometry's metres driven at each of the route's key images, in route order (TeachMetresPerPosition).
+  void SetTeachDistances(const std::vector<double>& route_distances);
+  bool by_distance() const { return teach_metres_per_position_ > 0.0; }
+
   // The next frame starts a run: it is one step from the start (how far it is from a frame before is not known).
   void Reset();
-  // The motion model's steps for the run's next frame, at input index `source_index` and time `timestamp` (below 0:
-  // none).
-  int Steps(int source_index, double timestamp);
+  // The motion model's steps for the run's next frame, at input index `source_index`, time `timestamp` (below 0:
+  // none) and the robot's odometry pose `odometry` (none: the robot has no odometry at that time). The distance
+  // driven between two frames is the straight line between their odometry poses: frames are close enough in time
+  // that the path between them is straight, and a robot's odometry gives its pose, not a running distance.
+  int Steps(int source_index, double timestamp, const std::optional<OdometrySample>& odometry = std::nullopt);
 
  private:
   double teach_frames_per_position_ = 0.0;
   double teach_seconds_per_position_ = 0.0;
+  double teach_metres_per_position_ = 0.0;
   int fixed_steps_ = 0;
   bool started_ = false;  // a frame of the run was seen: the two below are its
   int source_index_before_ = 0;
   double timestamp_before_ = -1.0;  // below 0: none
+  std::optional<OdometrySample> odometry_before_;
 };
 
 }  // namespace vmap

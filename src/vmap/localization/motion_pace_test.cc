@@ -85,5 +85,58 @@ TEST(MotionPace, TheTimeBetweenFramesSaysHowFarTheRunWentWhateverItsFrameRate) {
   EXPECT_EQ(pace.Steps(91, 9.3), 3);
 }
 
+TEST(MotionPace, TheTeachOdometrysDistanceIsKnownWhereItCoversTheRouteOneWay) {
+  EXPECT_NEAR(TeachMetresPerPosition({1.0, 1.5, 2.2, 2.5}), 0.5, 1e-12);
+  EXPECT_NEAR(TeachMetresPerPosition({2.5, 2.2, 1.5, 1.0}), 0.5, 1e-12) << "a route backwards through the map";
+  EXPECT_NEAR(TeachMetresPerPosition({1.0, 1.0, 2.0}), 0.5, 1e-12) << "two key images where the robot turned in place";
+  const double none = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NEAR(TeachMetresPerPosition({none, 1.0, none, 2.0, none}), 0.5, 1e-12)
+      << "key images the odometry does not cover: the others space the route";
+  EXPECT_DOUBLE_EQ(TeachMetresPerPosition({none, 1.0, none}), 0.0) << "one key image covered";
+  EXPECT_DOUBLE_EQ(TeachMetresPerPosition({none, none}), 0.0);
+  EXPECT_DOUBLE_EQ(TeachMetresPerPosition({1.0, 2.0, 1.5}), 0.0) << "key images of two recordings";
+  EXPECT_DOUBLE_EQ(TeachMetresPerPosition({3.0, 3.0}), 0.0) << "an odometry that did not move";
+  EXPECT_DOUBLE_EQ(TeachMetresPerPosition({3.0}), 0.0);
+}
+
+OdometrySample Pose(double x, double y = 0.0) {
+  OdometrySample pose;
+  pose.x = x;
+  pose.y = y;
+  return pose;
+}
+
+// A robot that repeats the route faster or slower than it was taught, its camera at the teach run's frame rate: the
+// times and indices say a frame's worth of the teach run, its odometry how far it went.
+TEST(MotionPace, TheDistanceDrivenSaysHowFarTheRunWentWhateverItsSpeed) {
+  MotionPace pace = TeachRunPace(true);                    // a key image every 0.3 s, every third frame
+  pace.SetTeachDistances({0.0, 0.3, 0.6, 0.9, 1.2, 1.5});  // at 1 m/s: 0.3 m a key image
+  ASSERT_TRUE(pace.by_distance());
+  EXPECT_EQ(pace.Steps(0, 0.0, Pose(0.0)), 1) << "a run's first frame";
+  EXPECT_EQ(pace.Steps(1, 0.1, Pose(0.3)), 3) << "three times the teach speed";
+  EXPECT_EQ(pace.Steps(2, 0.2, Pose(0.3, 0.2)), 2) << "sideways, a straight line";
+  EXPECT_EQ(pace.Steps(3, 0.3, Pose(0.3, 0.2)), 1) << "standing still: the one step every frame takes";
+  // A frame without odometry, and the one after it: by time.
+  EXPECT_EQ(pace.Steps(4, 0.4, std::nullopt), 1);
+  EXPECT_EQ(pace.Steps(5, 0.7, Pose(5.0)), 3);
+  EXPECT_EQ(pace.Steps(6, 0.8, Pose(5.6)), 6);
+  // A new run: its first frame one step, whatever the odometry says of the frame before.
+  pace.Reset();
+  EXPECT_EQ(pace.Steps(7, 0.9, Pose(9.0)), 1);
+  EXPECT_EQ(pace.Steps(8, 1.0, Pose(9.1)), 1);
+
+  // Without the teach odometry (or where it does not run one way along the route), by time as before.
+  MotionPace by_time = TeachRunPace(true);
+  by_time.SetTeachDistances({0.0, 0.3, 0.2, 0.9, 1.2, 1.5});
+  EXPECT_FALSE(by_time.by_distance());
+  EXPECT_EQ(by_time.Steps(0, 0.0, Pose(0.0)), 1);
+  EXPECT_EQ(by_time.Steps(1, 0.1, Pose(0.3)), 1);
+  // A fixed count is that count.
+  MotionPace fixed = TeachRunPace(true, 2);
+  fixed.SetTeachDistances({0.0, 0.3, 0.6, 0.9, 1.2, 1.5});
+  EXPECT_EQ(fixed.Steps(0, 0.0, Pose(0.0)), 1);
+  EXPECT_EQ(fixed.Steps(1, 0.1, Pose(0.9)), 2);
+}
+
 }  // namespace
 }  // namespace vmap

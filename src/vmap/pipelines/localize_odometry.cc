@@ -36,6 +36,15 @@ std::optional<OdometryProgress> OpenQueryOdometry(const std::string& path, const
   return OdometryProgress(OdometryTrack(std::move(samples)));
 }
 
+std::vector<OdometrySample> ReadTeachOdometry(const std::filesystem::path& map, const std::string& given,
+                                              const std::string& topic) {
+  if (!given.empty()) return ReadOdometry(given, topic);
+  std::error_code error;
+  const std::filesystem::path beside = map / kTeachOdometryFileName;
+  if (std::filesystem::is_regular_file(beside, error)) return ReadOdometryCsv(beside);
+  return {};
+}
+
 std::string OdometryCsvColumns() { return ",odometry_x,odometry_y,odometry_yaw,odometry_distance,key_distance"; }
 
 std::string OdometryCsvCells(const FrameOdometry& odometry) {

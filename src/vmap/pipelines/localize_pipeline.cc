@@ -50,6 +50,18 @@ void LocalizationSessionOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(OptionField{"cache", "!--no-cache", "Do not read or write the key-image cache in the map directory"}
                     .NotRecorded(),
                 cache);
+  visitor.Visit(OptionField{"teach_odometry", "--teach-odometry",
+                            "The teach run's odometry: a CSV of timestamp,x,y,yaw (s, m, rad) or a recording with a "
+                            "nav_msgs/Odometry topic, on the key images' clock; with the frames' odometry the belief "
+                            "moves by the distance driven (default: the map folder's teach_odometry.csv, if any)"}
+                    .HideDefault()
+                    .NotRecorded(),
+                teach_odometry);
+  visitor.Visit(OptionField{"teach_odometry_topic", "--teach-odometry-topic",
+                            "The teach recording's nav_msgs/Odometry topic to read (default: its only one)"}
+                    .HideDefault()
+                    .NotRecorded(),
+                teach_odometry_topic);
 }
 
 void LocalizationSessionOptions::Check() const {
@@ -127,14 +139,17 @@ LocalizationSession::LocalizationSession(const LocalizePipelineOptions& options)
   options.Check();
 
   // 2. The outputs and the query, before any reading.
-  CheckOutputs({{options.csv, "csv"}, {options.json, "json"}},
-               {MapInputs(options.map), NamedInput(options.query, "the query"),
-                NamedInput(options.report, "the report folder")});
+  CheckOutputs(
+      {{options.csv, "csv"}, {options.json, "json"}},
+      {MapInputs(options.map), NamedInput(options.query, "the query"), NamedInput(options.report, "the report folder"),
+       NamedInput(options.odometry, "the odometry"), NamedInput(options.session.teach_odometry, "the teach odometry")});
   if (!options.report.empty()) CheckLocalizationReportDirectory(options.report, options.map, options.query);
   if (!options.query.empty()) CheckQueryIsNoFifo(options.query);
 
-  // 3. The map, read once.
+  // 3. The map, read once, and the teach run's odometry.
   RecordedMap read = ReadRecordedMap(options.map);
+  teach_odometry_ =
+      ReadTeachOdometry(options.map, options.session.teach_odometry, options.session.teach_odometry_topic);
 
   // 4. The route.
   LocalizerOptions localizer = options.session.localizer;
@@ -157,15 +172,34 @@ LocalizationSession::LocalizationSession(const LocalizePipelineOptions& options)
   options_ = FollowMap(*opened_, localizer, query_options_.resize);
   options_.Check();
   localizer_ = std::make_unique<Localizer>(opened_->map, opened_->keys, *opened_->matcher, options_);
+  localizer_->PaceByTeachOdometry(teach_odometry_);
+  if (!teach_odometry_.empty()) {
+    const std::string read_from = options.session.teach_odometry.empty()
+                                      ? (std::filesystem::path(options.map) / kTeachOdometryFileName).string()
+                                      : options.session.teach_odometry;
+    if (localizer_->paced_by_odometry()) {
+      spdlog::info(
+          "teach odometry  {} samples from {}: with the frames' odometry the belief moves by the distance driven",
+          teach_odometry_.size(), read_from);
+    } else {
+      // Said, not refused: the teach odometry still gives the controller its taught profile where it covers the route.
+      spdlog::warn(
+          "the teach odometry {} does not cover two of the route's key images at their times, or not along "
+          "one direction; the belief is paced by time, or by input index",
+          read_from);
+    }
+  }
 }
 
 LocalizationSession::~LocalizationSession() = default;
 LocalizationSession::LocalizationSession(LocalizationSession&&) noexcept = default;
 LocalizationSession& LocalizationSession::operator=(LocalizationSession&&) noexcept = default;
 
-LocalizationResult LocalizationSession::Localize(const cv::Mat& image, std::optional<double> timestamp) {
+LocalizationResult LocalizationSession::Localize(const cv::Mat& image, std::optional<double> timestamp,
+                                                 const std::optional<OdometrySample>& odometry) {
   Frame frame = FrameFromImage(image, frames_, opened_->map.input.frame_size, "image");
   if (timestamp) frame.timestamp = *timestamp;
+  frame.odometry = odometry;
   const auto features = opened_->matcher->ExtractFrame(frame.gray, frame.color);
   LocalizationResult result = localizer_->Localize(frame, *features);
   ++frames_;
@@ -184,7 +218,8 @@ LocalizePipelineResult RunLocalizePipeline(const LocalizePipelineOptions& option
   const LocalizationMap& opened = session.opened();
   const VisualMap& map = opened.map;
 
-  // 8. The odometry: with it, its columns come last on every row (CSV and JSON).
+  // 8. The odometry: with it, its columns come last on every row (CSV and JSON), and each frame's pose paces the
+  // belief where the session has the teach odometry.
   std::optional<OdometryProgress> odometry = OpenQueryOdometry(options.odometry, options.odometry_topic, options.query);
   nlohmann::json odometry_json = nlohmann::json::array();
 
@@ -210,24 +245,27 @@ LocalizePipelineResult RunLocalizePipeline(const LocalizePipelineOptions& option
   const LocalizationReportOptions report_options;
   const bool record = !options.report.empty() && !QueryCanBeReadAgain(run.info);
   RecordedFrames recorded;
-  run.summary = LocalizeSequence(query, *opened.matcher, session.localizer(), run_options,
-                                 [&](const Frame& frame, const LocalizationResult& frame_result) {
-                                   std::string row = LocalizationCsvRow(map, frame_result, run.info.experiences);
-                                   if (odometry) {
-                                     const FrameOdometry at = odometry->Update(frame_result);
-                                     row.insert(row.size() - 1, OdometryCsvCells(at));
-                                     odometry_json.push_back(OdometryJson(frame_result.frame_index, at));
-                                   }
-                                   if (!options.csv.empty()) csv += row;
-                                   run.frames.push_back(frame_result);
-                                   if (record && report_options.pairs > 0) {
-                                     recorded[frame_result.frame_index] = ColorImage(frame);
-                                     if (recorded.size() > static_cast<size_t>(report_options.pairs)) {
-                                       recorded.erase(recorded.begin());
-                                     }
-                                   }
-                                   if (on_frame) on_frame(frame, frame_result);
-                                 });
+  const OdometryTrack* odometry_track = odometry ? &odometry->track() : nullptr;
+  run.summary = LocalizeSequence(
+      query, *opened.matcher, session.localizer(), run_options,
+      [&](const Frame& frame, const LocalizationResult& frame_result) {
+        std::string row = LocalizationCsvRow(map, frame_result, run.info.experiences);
+        if (odometry) {
+          const FrameOdometry at = odometry->Update(frame_result);
+          row.insert(row.size() - 1, OdometryCsvCells(at));
+          odometry_json.push_back(OdometryJson(frame_result.frame_index, at));
+        }
+        if (!options.csv.empty()) csv += row;
+        run.frames.push_back(frame_result);
+        if (record && report_options.pairs > 0) {
+          recorded[frame_result.frame_index] = ColorImage(frame);
+          if (recorded.size() > static_cast<size_t>(report_options.pairs)) {
+            recorded.erase(recorded.begin());
+          }
+        }
+        if (on_frame) on_frame(frame, frame_result);
+      },
+      odometry_track);
   run.info.frame_size = query.info().frame_size;
 
   // 10. The outputs.

@@ -32,6 +32,11 @@ struct LocalizationSessionOptions {
   int to = -1;                  // its last; -1 = the last
   LocalizeSequenceOptions run;  // how a sequence's frames are read and their features extracted
   bool cache = true;            // read and write the key-image cache in the map directory
+  // The teach run's odometry (ReadTeachOdometry): a CSV or a recording with a nav_msgs/Odometry topic; "" = the map
+  // folder's teach_odometry.csv, if any. With it and each frame's odometry, the localizer's motion model moves by the
+  // distance driven (localization/motion_pace.h).
+  std::string teach_odometry;
+  std::string teach_odometry_topic;  // "" = the recording's only one
 
   // The fields above, each once, by the paths their checks name ("min_verified", "ranking.method",
   // "extraction_threads").
@@ -79,11 +84,12 @@ class LocalizationSession {
   // take seconds):
   //   1. check the options;
   //   2. check the outputs (none may overwrite the map, the query or each other) and the query (no FIFO);
-  //   3. read the map, once (ReadRecordedMap);
+  //   3. read the map, once (ReadRecordedMap), and the teach run's odometry, if any (ReadTeachOdometry);
   //   4. plan the route (from, to);
   //   5. open the query, at the map's frame size unless `source.resize` says otherwise;
   //   6. create the map's matcher and load its key images and experiences (cached in the map directory);
-  //   7. make the localizer follow the map: its verifier, S, translation thresholds and camera.
+  //   7. make the localizer follow the map: its verifier, S, translation thresholds and camera, and its pace the
+  //      teach odometry.
   // Throws InputError (OptionError for an option) naming what is wrong and how to fix it.
   explicit LocalizationSession(const LocalizePipelineOptions& options);
   ~LocalizationSession();
@@ -94,14 +100,19 @@ class LocalizationSession {
   const VisualMap& map() const { return opened_->map; }
   const Matcher& matcher() const { return *opened_->matcher; }
   const LocalizerOptions& localizer_options() const { return options_; }  // following the map
+  // The teach run's odometry the localizer is paced by (empty: none), on the key images' clock.
+  const std::vector<OdometrySample>& teach_odometry() const { return teach_odometry_; }
   Localizer& localizer() { return *localizer_; }
   // The query's frames as opened (resize resolved); null without a query.
   FrameSource* query() { return query_.get(); }
   const FrameSourceOptions& query_options() const { return query_options_; }
 
   // The robot's loop: one image (uint8 grey or BGR, of any size: brought to the map's frame size), the next
-  // frame of the run; `timestamp` in seconds when known. Features are extracted with the map's matcher.
-  LocalizationResult Localize(const cv::Mat& image, std::optional<double> timestamp = std::nullopt);
+  // frame of the run; `timestamp` in seconds when known; `odometry` the robot's odometry pose at the frame's time
+  // when it has one (with the teach odometry, the belief moves by the distance driven). Features are extracted with
+  // the map's matcher.
+  LocalizationResult Localize(const cv::Mat& image, std::optional<double> timestamp = std::nullopt,
+                              const std::optional<OdometrySample>& odometry = std::nullopt);
   // Forgets the estimate: the next frame is relocalized.
   void Reset();
 
@@ -112,6 +123,7 @@ class LocalizationSession {
   std::unique_ptr<LocalizationMap> opened_;
   LocalizerOptions options_;
   std::unique_ptr<Localizer> localizer_;
+  std::vector<OdometrySample> teach_odometry_;
   FrameSourceOptions query_options_;
   std::unique_ptr<FrameSource> query_;
   int frames_ = 0;  // frames given to Localize: the next one's index
@@ -120,7 +132,7 @@ class LocalizationSession {
 // Localizes every frame of `options.query` (LocalizationSession, then LocalizeSequence) and writes the outputs
 // asked for. `on_frame` sees each frame and its result, in order, as soon as it is known. Stages, in order:
 //   1-7. the session's set-up (above);
-//   8. open the query's odometry, if any;
+//   8. open the query's odometry, if any (each frame's pose paces the belief, with the teach odometry);
 //   9. localize every frame, keeping the CSV's rows (with the odometry's columns) and, for a report whose query
 //      cannot be read again, the last frames it shows;
 //  10. write the CSV, the JSON and the report.

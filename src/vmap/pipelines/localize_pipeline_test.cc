@@ -9,11 +9,14 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "vmap/core/error.h"
 #include "vmap/features/camera_mask.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/motion_pace.h"
 #include "vmap/map/map_io.h"
 #include "vmap/pipelines/build_pipeline.h"
+#include "vmap/pipelines/localize_odometry.h"
+#include "vmap/sources/odometry.h"
 #include "vmap/testing/localization_test_util.h"
 #include "vmap/testing/option_error.h"
 #include "vmap/testing/scoped_temp_dir.h"
@@ -132,24 +135,40 @@ TEST(LocalizePipeline, TheSessionFrameByFrameEqualsTheRun) {
   }
 }
 
-// A robot's loop that localizes one camera frame in four (or a camera at a quarter of the teach run's frame rate)
-// passes four times as much of the route a frame as its frames' count says: given the frames' times, the belief's
-// motion model moves as far as the time since the frame before says, at the teach run's pace between key images.
-TEST(LocalizePipeline, TheSessionPacesTheBeliefByTheFramesTimes) {
-  DriveOptions timed_places;  // a map of places: every other teach frame a key image
+// A map of places, its teach run timed: every other teach frame a key image, 0.1 s apart.
+DriveOptions TimedPlaces() {
+  DriveOptions timed_places;
   timed_places.seconds_per_frame = 0.1;
   timed_places.tau = 1.0;
-  Drive drive(timed_places);
-  const VisualMap map = ReadMap(drive.map);
+  return timed_places;
+}
+
+// The mean spacing of a map's key images in its teach run (the whole map the route): input frames and seconds.
+struct TeachSpacing {
+  double frames = 0.0;
+  double seconds = 0.0;
+};
+
+TeachSpacing TeachSpacingOf(const fs::path& map_directory) {
+  const VisualMap map = ReadMap(map_directory);
   std::vector<int> source_indices;
   std::vector<double> times;
   for (const KeyImage& key : map.key_images) {
     source_indices.push_back(key.source_index);
     times.push_back(key.timestamp);
   }
-  ASSERT_GT(TeachSecondsPerPosition(times), 0.0) << "the map keeps its key images' times";
-  const int by_time = MotionStepsPerFrame(0.4, TeachSecondsPerPosition(times));
-  const int by_count = MotionStepsPerFrame(1, TeachFramesPerPosition(source_indices));
+  return {TeachFramesPerPosition(source_indices), TeachSecondsPerPosition(times)};
+}
+
+// A robot's loop that localizes one camera frame in four (or a camera at a quarter of the teach run's frame rate)
+// passes four times as much of the route a frame as its frames' count says: given the frames' times, the belief's
+// motion model moves as far as the time since the frame before says, at the teach run's pace between key images.
+TEST(LocalizePipeline, TheSessionPacesTheBeliefByTheFramesTimes) {
+  Drive drive(TimedPlaces());
+  const TeachSpacing spacing = TeachSpacingOf(drive.map);
+  ASSERT_GT(spacing.seconds, 0.0) << "the map keeps its key images' times";
+  const int by_time = MotionStepsPerFrame(0.4, spacing.seconds);
+  const int by_count = MotionStepsPerFrame(1, spacing.frames);
   ASSERT_GT(by_time, by_count) << "the drive's key images are too far apart for a frame in four to tell";
 
   auto steps_of_every_fourth_frame = [&](bool with_times) {
@@ -174,6 +193,90 @@ TEST(LocalizePipeline, TheSessionPacesTheBeliefByTheFramesTimes) {
   for (size_t f = 1; f < timed.size(); ++f) {
     EXPECT_EQ(timed[f], by_time) << f;
     EXPECT_EQ(counted[f], by_count) << f;
+  }
+}
+
+// A robot that repeats the route four times as fast as it was taught, its camera at about the teach run's frame rate:
+// its frames' times say about a frame's worth of the teach run; its odometry, against the teach run's beside the map,
+// says four. The whole run (the query's odometry file) and the robot's loop (a pose with each frame) pace the belief
+// alike.
+TEST(LocalizePipeline, TheOdometryPacesTheBeliefByTheDistanceDriven) {
+  Drive drive(TimedPlaces());
+  constexpr double kMetresPerTeachFrame = 0.05;
+  constexpr double kRepeatSecondsPerFrame = 0.12;  // the teach run's 0.1 would put the pace by time at a half step
+  auto pose_at = [](double seconds, double metres) {
+    OdometrySample pose;
+    pose.timestamp = seconds;
+    pose.x = metres;
+    return pose;
+  };
+  std::vector<OdometrySample> teach;
+  for (size_t i = 0; i < testing::SidewaysDrive().frames.size(); ++i) {
+    teach.push_back(pose_at(0.1 * static_cast<double>(i), kMetresPerTeachFrame * static_cast<double>(i)));
+  }
+  // The fast repeat: every fourth teach frame, at that frame's place.
+  const fs::path fast = drive.tmp.path() / "fast";
+  fs::create_directories(fast);
+  std::vector<OdometrySample> repeat;
+  std::ofstream times(fast / "timestamps.txt");
+  for (size_t i = 0, f = 0; i < testing::SidewaysDrive().frames.size(); i += 4, ++f) {
+    const std::string name = "frame_" + std::to_string(f + 1) + ".png";
+    fs::copy_file(drive.tmp.path() / "teach" / ("frame_" + std::to_string(i + 1) + ".png"), fast / name);
+    times << name << " " << kRepeatSecondsPerFrame * static_cast<double>(f) << "\n";
+    repeat.push_back(
+        pose_at(kRepeatSecondsPerFrame * static_cast<double>(f), kMetresPerTeachFrame * static_cast<double>(i)));
+  }
+  times.close();
+  const fs::path repeat_odometry = drive.tmp.path() / "repeat_odometry.csv";
+  std::ofstream(repeat_odometry) << OdometryCsv(repeat);
+
+  // The odometry is 0.05 m a teach frame in both runs: a repeat frame drove four teach frames' worth.
+  const TeachSpacing spacing = TeachSpacingOf(drive.map);
+  const int by_distance = MotionStepsPerFrame(4, spacing.frames);
+  const int by_time = MotionStepsPerFrame(kRepeatSecondsPerFrame, spacing.seconds);
+  ASSERT_GT(by_distance, by_time) << "the drive's key images are too far apart for four frames to tell";
+
+  // Without the teach odometry: by time, whatever the query's odometry.
+  LocalizePipelineOptions options = drive.Options();
+  options.query = fast.string();
+  options.odometry = repeat_odometry.string();
+  const LocalizePipelineResult untaught = RunLocalizePipeline(options);
+  ASSERT_GT(untaught.run.frames.size(), 5u);
+  for (size_t f = 1; f < untaught.run.frames.size(); ++f) EXPECT_EQ(untaught.run.frames[f].motion_steps, by_time) << f;
+
+  // The teach odometry beside the map (as the ROS node's teach run writes it): by the distance driven.
+  std::ofstream(drive.map / kTeachOdometryFileName) << OdometryCsv(teach);
+  const LocalizePipelineResult taught = RunLocalizePipeline(options);
+  ASSERT_EQ(taught.run.frames.size(), untaught.run.frames.size());
+  EXPECT_EQ(taught.run.frames[0].motion_steps, 1) << "a run's first frame";
+  for (size_t f = 1; f < taught.run.frames.size(); ++f) EXPECT_EQ(taught.run.frames[f].motion_steps, by_distance) << f;
+
+  // The robot's loop, a pose with each frame: the same steps and places; without poses, by time.
+  LocalizePipelineOptions session_options = drive.Options();
+  session_options.query.clear();
+  LocalizationSession session(session_options);
+  ASSERT_EQ(session.teach_odometry().size(), teach.size());
+  for (size_t f = 0; f < taught.run.frames.size(); ++f) {
+    const cv::Mat gray =
+        cv::imread((fast / ("frame_" + std::to_string(f + 1) + ".png")).string(), cv::IMREAD_GRAYSCALE);
+    const LocalizationResult result = session.Localize(gray, repeat[f].timestamp, repeat[f]);
+    EXPECT_EQ(result.motion_steps, taught.run.frames[f].motion_steps) << f;
+    EXPECT_EQ(result.key, taught.run.frames[f].key) << f;
+    EXPECT_EQ(result.status, taught.run.frames[f].status) << f;
+  }
+  session.Reset();
+  session.Localize(cv::imread((fast / "frame_1.png").string(), cv::IMREAD_GRAYSCALE), 0.0);
+  EXPECT_EQ(session.Localize(cv::imread((fast / "frame_2.png").string(), cv::IMREAD_GRAYSCALE), kRepeatSecondsPerFrame)
+                .motion_steps,
+            by_time);
+
+  // A teach odometry named that cannot be read is refused, by name.
+  options.session.teach_odometry = (drive.tmp.path() / "no_such_odometry.csv").string();
+  try {
+    RunLocalizePipeline(options);
+    ADD_FAILURE() << "a missing teach odometry was read";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("no_such_odometry.csv"), std::string::npos) << error.what();
   }
 }
 

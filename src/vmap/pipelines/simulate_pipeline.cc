@@ -124,6 +124,7 @@ std::unique_ptr<PreparedTrials> PrepareTrials(const SimulationOptions& options, 
   context.world = &*prepared->repeat_world;
   context.map = &map;
   context.taught = MakeTaughtRoute(map.map, {}, teach.odometry);
+  context.teach_odometry = teach.odometry;
   context.localizer = prepared->session->localizer_options();
   context.localizer.route = context.taught.keys;
   context.teach_duration = teach.odometry.back().timestamp;

@@ -10,9 +10,12 @@ namespace vmap {
 TrialResult RunTrial(const TrialContext& context, int index) {
   TrialRun run(context, index);
   Localizer localizer(context.map->map, context.map->keys, *context.map->matcher, context.localizer);
+  // The robot's odometry paces the belief as it does on the robot (the ROS node's repeat run).
+  if (context.options.use_odometry) localizer.PaceByTeachOdometry(context.teach_odometry);
   RouteController controller(context.taught, context.options.controller);
   while (run.Continues()) {
-    const Frame frame = run.Render();
+    Frame frame = run.Render();
+    if (context.options.use_odometry) frame.odometry = run.odometry();
     if (context.after_frame) context.after_frame();
     const auto step_start = std::chrono::steady_clock::now();
     const auto features = context.map->matcher->ExtractFrame(frame.gray, frame.color);

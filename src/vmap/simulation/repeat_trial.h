@@ -80,8 +80,9 @@ struct TrialContext {
   const LocalizationMap* map = nullptr;
   LocalizerOptions localizer;  // following the map, along taught.keys
   TaughtRoute taught;
-  std::vector<Pose2d> key_image_poses;  // where the teach run took each key image
-  double teach_duration = 0.0;          // seconds
+  std::vector<OdometrySample> teach_odometry;  // the teach run's: with the repeat's, the localizer's pace
+  std::vector<Pose2d> key_image_poses;         // where the teach run took each key image
+  double teach_duration = 0.0;                 // seconds
   SimulationOptions options;
   std::function<void()> after_frame;  // optional, after each rendered frame; may throw to stop the trial
 };

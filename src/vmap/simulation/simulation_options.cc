@@ -47,8 +47,9 @@ void SimulationOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"repeat_textures", "--repeat-textures",
                  "Folder of the same photographs in another season, for the repeat world (default: the teach ones)"},
                 repeat_textures);
-  visitor.Visit({"use_odometry", "!--no-odometry", "Do not give the repeat run's odometry to the controller"},
-                use_odometry);
+  visitor.Visit(
+      {"use_odometry", "!--no-odometry", "Do not give the repeat run's odometry to the controller and the localizer"},
+      use_odometry);
   visitor.Visit(
       OptionField{"threads", "--threads", "Trials run at once (0 = one per core)"}.NotRecorded().Within(0, 256).Meaning(
           "0: one per core"),

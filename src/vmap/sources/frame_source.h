@@ -14,6 +14,7 @@
 #include "vmap/core/natural_less.h"  // NaturalLess, which the layouts sort by
 #include "vmap/core/option_fields.h"
 #include "vmap/geometry/camera.h"
+#include "vmap/sources/odometry_sample.h"
 
 namespace vmap {
 
@@ -85,6 +86,9 @@ struct Frame {
   cv::Mat gray;             // 8-bit, one channel: what the matchers see
   cv::Mat color;            // 8-bit BGR when the input is colour; may be empty (then use gray)
   bool resized = false;     // the decoded image was resized (--resize, or a size that differs from the first)
+  // The robot's odometry pose at the frame's time, where a repeat run has odometry beside its frames (none from the
+  // input itself): the localizer's motion model moves by the distance driven (localization/motion_pace.h).
+  std::optional<OdometrySample> odometry;
 };
 
 struct SequenceInfo {

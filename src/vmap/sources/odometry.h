@@ -10,16 +10,10 @@
 #include <string>
 #include <vector>
 
+#include "vmap/sources/odometry_sample.h"
 #include "vmap/sources/recording_reader.h"
 
 namespace vmap {
-
-struct OdometrySample {
-  double timestamp = 0.0;  // seconds, on the clock of the frames' timestamps
-  double x = 0.0;          // metres
-  double y = 0.0;
-  double yaw = 0.0;  // radians
-};
 
 // The pose at `timestamp`, interpolated linearly between the two samples around it (yaw along the shorter
 // arc); nullopt outside [first, last] sample or for an empty list. `samples` must be sorted by timestamp.
