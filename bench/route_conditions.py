@@ -18,7 +18,8 @@ speed: the corridor's repeat driven at 1 to 4 times the teach speed (teach frame
   0.1 s apart, against the timed teach run's map, so its indices and times say a frame of the teach run and it went
   one to four. speed-odometry: the same with both runs' odometry, from the frame alignment (a straight line, teach frame
   i at 0.1 i m, the repeat's frame where its teach frame was: perfect odometry), given to vmap localize
-  (--teach-odometry, --odometry). speed-places, speed-odometry-places: the same against the places map.
+  (--teach-odometry, --odometry); --odometry-scale S makes the repeat's S times as long (a scale error).
+  speed-places, speed-odometry-places: the same against the places map.
 michigan: ../shared/data/michigan_seasons as routes: for every ordered pair of sessions (a, b), a map of session a's
   five places in order (`--tau 1`: every place a key image) and session b's five places localized against it
   (frame i right at key image i). 132 routes of 5 frames.
@@ -58,7 +59,7 @@ a few frames is judged on the means (docs/measurements/localization-conditions.m
 of every figure"). Default: the map's seed only, the flag not passed (binaries before the flag take no --seeds).
 
 usage: bench/route_conditions.py --vmap build/vmap[,old/vmap] [--sets corridor,kidnapped,elsewhere,places,third-rate,third-rate-places,speed,speed-odometry,speed-places,speed-odometry-places,michigan] [--matchers orb,xfeat]
-                                 [--tau T] [--start-key K|none] [--build "FLAGS"] [--localize "FLAGS"] [--repeat-stride N] [--work DIR] [--csv-dir DIR]
+                                 [--tau T] [--start-key K|none] [--build "FLAGS"] [--localize "FLAGS"] [--repeat-stride N] [--odometry-scale S] [--work DIR] [--csv-dir DIR]
                                  [--evidence-dir DIR] [--seeds S,S,...] [--named-frames N]
 (from the repository root; ../shared must be there)"""
 import argparse, json, os, subprocess, sys, tempfile
@@ -226,11 +227,12 @@ def linked_folder(folder, frames, seconds_per_frame):
 
 
 def timed_repeat(vmap, matcher, map_flags, localize_flags, work, csv_dir, label, repeat_of, seconds_per_frame,
-                 with_odometry=False):
+                 with_odometry=False, odometry_scale=1.0):
     """The repeat frames `repeat_of` (run frame -> repeat frame) as a recording of their own, `seconds_per_frame`
     apart, against a map of the timed teach run built with `map_flags`. `with_odometry`: both runs' odometry as the
     frame alignment gives it (a straight line, teach frame i at i x TEACH_METRES_PER_FRAME; repeat frame i where teach
-    frame i was), passed to vmap localize (--teach-odometry, --odometry): perfect odometry."""
+    frame i was), passed to vmap localize (--teach-odometry, --odometry): perfect odometry; the repeat's measuring
+    every distance `odometry_scale` times as long (a wheel odometry's scale error)."""
     teach = linked_folder(os.path.join(work, "timed_teach"),
                           [os.path.join(CORRIDOR, "teach", "%07d.jpg" % i) for i in range(111)],
                           TEACH_SECONDS_PER_FRAME)
@@ -242,8 +244,8 @@ def timed_repeat(vmap, matcher, map_flags, localize_flags, work, csv_dir, label,
     if with_odometry:
         teach_odometry = os.path.join(work, "timed_teach_odometry.csv")
         write_odometry(teach_odometry, [(i * TEACH_SECONDS_PER_FRAME, i * TEACH_METRES_PER_FRAME) for i in range(111)])
-        repeat_odometry = os.path.join(work, label + "_odometry.csv")
-        write_odometry(repeat_odometry, [(f * seconds_per_frame, i * TEACH_METRES_PER_FRAME)
+        repeat_odometry = os.path.join(work, "%s_odometry_%g.csv" % (label, odometry_scale))
+        write_odometry(repeat_odometry, [(f * seconds_per_frame, i * TEACH_METRES_PER_FRAME * odometry_scale)
                                          for f, i in enumerate(repeat_of)])
         flags += ["--teach-odometry", teach_odometry, "--odometry", repeat_odometry]
     if csv_dir:
@@ -282,9 +284,9 @@ def speed_repeat_frames():
     return frames
 
 
-def speed(vmap, matcher, map_flags, localize_flags, work, csv_dir, label, with_odometry):
+def speed(vmap, matcher, map_flags, localize_flags, work, csv_dir, label, with_odometry, odometry_scale=1.0):
     return timed_repeat(vmap, matcher, map_flags, localize_flags, work, csv_dir, label, speed_repeat_frames(),
-                        TEACH_SECONDS_PER_FRAME, with_odometry)
+                        TEACH_SECONDS_PER_FRAME, with_odometry, odometry_scale)
 
 
 # The kidnapped run's stretches of repeat frames, first and last included, in the order the robot saw them.
@@ -389,6 +391,8 @@ def main():
     parser.add_argument("--localize", default="", help="more flags for vmap localize")
     parser.add_argument("--start-key", default="0", help="vmap localize --start-key (none: not passed)")
     parser.add_argument("--repeat-stride", type=int, default=1, help="corridor: every Nth repeat frame (a faster robot)")
+    parser.add_argument("--odometry-scale", type=float, default=1.0, help="speed-odometry sets: the repeat's odometry "
+                        "measures every distance this many times as long as it is (a wheel odometry's scale error)")
     parser.add_argument("--seeds", help="comma-separated seeds of the verifier (vmap localize --verifier-seed): each "
                         "run once per seed on the same maps, then the mean [min-max] of each column (default: the "
                         "map's seed only, no flag passed)")
@@ -457,12 +461,14 @@ def main():
                     for places in (False, True):
                         name = "speed" + ("-odometry" if odometry else "") + ("-places" if places else "")
                         if name in sets:
-                            runs("%s: corridor driven at 1-4 times the teach speed, timed%s%s, %s" % (
-                                vmap, ", with both runs' odometry" if odometry else "",
+                            scale = ", the repeat's %g times as long" % args.odometry_scale if (
+                                odometry and args.odometry_scale != 1.0) else ""
+                            runs("%s: corridor driven at 1-4 times the teach speed, timed%s%s%s, %s" % (
+                                vmap, ", with both runs' odometry" if odometry else "", scale,
                                 ", against places" if places else "", matcher),
                                 lambda flags, csv_dir, places=places, odometry=odometry, name=name: speed(
                                     vmap, matcher, PLACES_BUILD + build_flags if places else tau_flags, flags, work,
-                                    csv_dir, name.replace("-", "_"), odometry))
+                                    csv_dir, name.replace("-", "_"), odometry, args.odometry_scale))
                 if "kidnapped" in sets:
                     runs("%s: kidnapped corridor (repeat %s), %s" % (vmap, ", ".join("%d-%d" % s for s in KIDNAPPED),
                                                                     matcher),
