@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/sources/recording_reader.h"
 
@@ -39,10 +40,15 @@ std::optional<OdometryProgress> OpenQueryOdometry(const std::string& path, const
 std::vector<OdometrySample> ReadTeachOdometry(const std::filesystem::path& map, const std::string& given,
                                               const std::string& topic) {
   if (!given.empty()) return ReadOdometry(given, topic);
-  std::error_code error;
-  const std::filesystem::path beside = map / kTeachOdometryFileName;
-  if (std::filesystem::is_regular_file(beside, error)) return ReadOdometryCsv(beside);
-  return {};
+  // A map folder may come from elsewhere: its file is read only where it is a regular file inside it, as the map's
+  // own files are.
+  std::string why_not;
+  if (!ContainedFile::Open(map, kTeachOdometryFileName, &why_not)) {
+    if (why_not == "is missing") return {};
+    throw InputError(fmt::format("the map's {} {}; remove it, or give the teach odometry with --teach-odometry",
+                                 (map / kTeachOdometryFileName).string(), why_not));
+  }
+  return ReadOdometryCsv(map / kTeachOdometryFileName);
 }
 
 std::string OdometryCsvColumns() { return ",odometry_x,odometry_y,odometry_yaw,odometry_distance,key_distance"; }

@@ -280,6 +280,25 @@ TEST(LocalizePipeline, TheOdometryPacesTheBeliefByTheDistanceDriven) {
   }
 }
 
+// The teach odometry beside a map is the map's file: a link out of the map folder is refused, by name, as the map's
+// own files are; without one the map localizes as it is.
+TEST(LocalizePipeline, TheTeachOdometryBesideAMapIsReadOnlyInsideIt) {
+  Drive drive;
+  const fs::path outside = drive.tmp.path() / "elsewhere.csv";
+  std::ofstream(outside) << "timestamp,x,y,yaw\n0,0,0,0\n1,1,0,0\n";
+  fs::create_symlink(outside, drive.map / kTeachOdometryFileName);
+  try {
+    RunLocalizePipeline(drive.Options());
+    ADD_FAILURE() << "a teach odometry out of the map folder was read";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find(kTeachOdometryFileName), std::string::npos) << message;
+    EXPECT_NE(message.find("outside"), std::string::npos) << message;
+  }
+  fs::remove(drive.map / kTeachOdometryFileName);
+  EXPECT_GT(RunLocalizePipeline(drive.Options()).run.frames.size(), 0u);
+}
+
 // Options a user gives that the acceptance rule does not read are refused, by field.
 TEST(LocalizePipeline, GivenOptionsTheAcceptanceRuleIgnoresAreRefused) {
   LocalizationSessionOptions options;
