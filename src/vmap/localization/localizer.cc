@@ -158,7 +158,7 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
 
 Localizer::~Localizer() = default;
 
-void Localizer::PaceByTeachOdometry(const std::vector<OdometrySample>& teach_odometry) {
+bool Localizer::PaceByTeachOdometry(const std::vector<OdometrySample>& teach_odometry) {
   std::vector<double> route_distances;
   if (!teach_odometry.empty()) {
     const OdometryTrack track(teach_odometry);
@@ -168,6 +168,7 @@ void Localizer::PaceByTeachOdometry(const std::vector<OdometrySample>& teach_odo
     }
   }
   pace_.SetTeachDistances(route_distances);
+  return pace_.by_distance();
 }
 
 void CheckStartKey(const VisualMap& map, const LocalizerOptions& options) {

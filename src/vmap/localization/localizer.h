@@ -86,10 +86,8 @@ class Localizer {
   // The teach run's odometry (its samples on the key images' clock): where a frame has odometry too (Frame::odometry),
   // the motion model moves by the distance driven since the frame before against the teach odometry's distance
   // between the route's key images (localization/motion_pace.h: TeachMetresPerPosition). Empty, covering fewer than two
-  // of the route's key images, or not along one direction: the pace by time or index, as without it.
-  void PaceByTeachOdometry(const std::vector<OdometrySample>& teach_odometry);
-  // Whether the motion model can move by the distance driven (PaceByTeachOdometry covered the route).
-  bool paced_by_odometry() const { return pace_.by_distance(); }
+  // of the route's key images, or not along one direction: the pace by time or index, as without it (returns false).
+  bool PaceByTeachOdometry(const std::vector<OdometrySample>& teach_odometry);
 
   // Forgets the estimate: the next frame is relocalized, or starts again at LocalizerOptions::start_key.
   void Reset();

@@ -172,12 +172,12 @@ LocalizationSession::LocalizationSession(const LocalizePipelineOptions& options)
   options_ = FollowMap(*opened_, localizer, query_options_.resize);
   options_.Check();
   localizer_ = std::make_unique<Localizer>(opened_->map, opened_->keys, *opened_->matcher, options_);
-  localizer_->PaceByTeachOdometry(teach_odometry_);
+  const bool paced_by_odometry = localizer_->PaceByTeachOdometry(teach_odometry_);
   if (!teach_odometry_.empty()) {
     const std::string read_from = options.session.teach_odometry.empty()
                                       ? (std::filesystem::path(options.map) / kTeachOdometryFileName).string()
                                       : options.session.teach_odometry;
-    if (localizer_->paced_by_odometry()) {
+    if (paced_by_odometry) {
       spdlog::info(
           "teach odometry  {} samples from {}: with the frames' odometry the belief moves by the distance driven",
           teach_odometry_.size(), read_from);
