@@ -285,6 +285,10 @@ class Localizer {
   // (log10 NFA at most LocalizerOptions::look_past_max_log10_nfa): the step LookPastWeakNext and LookFurtherWhenLagging
   // take.
   bool ClearlyBeats(const KeyComparison& further, const KeyComparison& tracked) const;
+  // Compares route positions `first` to `last` (those on the route) and steps on to the one that ClearlyBeats `best`
+  // and fits best, weighing the belief there ten to one where `weigh_belief`; false where none does.
+  bool StepOnWhereClearlyBetter(const Frame& frame, const ImageFeatures& features, int first, int last,
+                                bool weigh_belief, KeyComparison& best, int& best_position);
   // Up to lagging_start_frames frames after the run's first, a tracker at `best_position` that lags (recent_positions_)
   // and holds the frame by less than clearly compares the two key images after the next one, and the better becomes
   // `best` where it verifies more, clearly (LocalizerOptions::lagging_tracker_frames; localizer_lagging_tracker.cc).
@@ -292,6 +296,17 @@ class Localizer {
                               int& best_position);
   // Counts the frame and remembers where the tracker was, after the frame's result is final.
   void RememberPace();
+  // Where the distance driven puts the robot is driven_past_positions or more route positions past `best_position`:
+  // the key images there are compared, and the better becomes `best` where it verifies more, clearly
+  // (localizer_driven_ahead.cc).
+  void LookWhereDriven(const Frame& frame, const ImageFeatures& features, KeyComparison& best, int& best_position);
+  // The route position whose teach odometry is nearest `teach_metres` (-1: none), and the teach odometry's metres
+  // where the distance driven since driven_from_ puts the robot (none: not known).
+  int NearestRoutePosition(double teach_metres) const;
+  std::optional<double> TeachMetresDriven() const;
+  // After the frame's result is final: where the distance driven is counted from (the tracker was at
+  // `position_before` when the frame began).
+  void RememberWhereDriven(int position_before);
   // Compares the frame with the best-ranked key images of the route (relocalization_candidates of them), in
   // rank order; returns the ranking's route positions compared.
   std::vector<int> CompareBestRanked(const Frame& frame, const ImageFeatures& features);
@@ -464,6 +479,18 @@ class Localizer {
   } step_back_ruled_out_;
   RouteBelief belief_;
   MotionPace pace_;  // the motion model's steps a frame
+  // The teach odometry's metres driven at each route position (NaN: not covered; empty: no teach odometry), and
+  // whether they grow (1) or shrink (-1) along the route (0: the pace is not by the distance driven).
+  std::vector<double> route_teach_metres_;
+  int route_teach_direction_ = 0;
+  // Where LookWhereDriven counts the distance driven from: the teach odometry's metres where the robot was taken to
+  // be, the robot's metres driven then (MotionPace::metres_driven) and their stretch. None: not known.
+  struct DrivenFrom {
+    double teach_metres = 0.0;
+    double metres = 0.0;
+    int stretch = -1;
+  };
+  std::optional<DrivenFrom> driven_from_;
   // The belief the frames' evidence alone would hold: the same motion and comparisons as belief_, from a flat start
   // (without the start key image's prior). Kept only while the start is unconfirmed, the only time it is read.
   RouteBelief evidence_belief_;

@@ -30,23 +30,8 @@ void Localizer::LookFurtherWhenLagging(const Frame& frame, const ImageFeatures& 
   // of a step back).
   const int moved = recent_positions_.back() - recent_positions_.front();
   if (moved < 0 || moved >= 2) return;
-  const int last = static_cast<int>(route_.size()) - 1;
-  KeyComparison further_best;
-  int further_position = -1;
-  for (int q = best_position + 2; q <= std::min(last, best_position + 1 + kFurther); ++q) {
-    const KeyComparison further = CompareTracked(frame, features, q);
-    if (ClearlyBeats(further, best) && (further_position < 0 || IsBetterMatch(further, further_best))) {
-      further_best = further;
-      further_position = q;
-    }
-  }
-  if (further_position < 0) return;
-  best = further_best;
-  best_position = further_position;
-  if (options_.lagging_step_weighs_belief) {
-    WeighBeliefs(further_position, kAgreementLogRatio);  // why: lagging_step_weighs_belief
-    NormalizeBeliefs();
-  }
+  StepOnWhereClearlyBetter(frame, features, best_position + 2, best_position + 1 + kFurther,
+                           options_.lagging_step_weighs_belief, best, best_position);
 }
 
 void Localizer::RememberPace() {

@@ -1,6 +1,8 @@
 // A tracker held by little beyond chance looks past a next key image that verifies by little beyond chance too
 // (LocalizerOptions::look_past_weak_next): it steps on to the key image past it where that one verifies more, clearly
 // (LocalizerOptions::look_past_max_log10_nfa).
+#include <algorithm>
+
 #include "vmap/localization/localizer.h"
 
 namespace vmap {
@@ -35,6 +37,29 @@ void Localizer::LookPastWeakNext(const Frame& frame, const ImageFeatures& featur
 bool Localizer::ClearlyBeats(const KeyComparison& further, const KeyComparison& tracked) const {
   return PassesChance(further, options_.look_past_max_log10_nfa) && further.num_verified > tracked.num_verified &&
          IsBetterMatch(further, tracked);
+}
+
+bool Localizer::StepOnWhereClearlyBetter(const Frame& frame, const ImageFeatures& features, int first, int last,
+                                         bool weigh_belief, KeyComparison& best, int& best_position) {
+  KeyComparison found;
+  int found_position = -1;
+  for (int q = first; q <= std::min(last, static_cast<int>(route_.size()) - 1); ++q) {
+    const KeyComparison there = CompareTracked(frame, features, q);
+    if (ClearlyBeats(there, best) && (found_position < 0 || IsBetterMatch(there, found))) {
+      found = there;
+      found_position = q;
+    }
+  }
+  if (found_position < 0) return false;
+  best = found;
+  best_position = found_position;
+  // The step is the tracker's move, which the frame's comparisons, weighed as any, do not tell the belief: the
+  // evidence of the key image stepped from still holds it there (lagging_step_weighs_belief).
+  if (weigh_belief) {
+    WeighBeliefs(found_position, kAgreementLogRatio);
+    NormalizeBeliefs();
+  }
+  return true;
 }
 
 }  // namespace vmap

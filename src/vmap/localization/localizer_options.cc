@@ -180,6 +180,14 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "a lagging tracker's step further ahead moves the tracker only, not the belief (it weighs the place "
                  "stepped to ten to one otherwise)"},
                 lagging_step_weighs_belief);
+  visitor.Visit(
+      OptionField{"driven_past_positions", "--driven-past-positions",
+                  "With the teach run's odometry and the robot's: route positions a tracker lags where the distance "
+                  "driven puts the robot before the key images there are compared, and stepped on to where one "
+                  "verifies more, clearly (0 = never)"}
+          .Within(0, 1000)
+          .Meaning("0: never"),
+      driven_past_positions);
   visitor.Visit({"rival_place_when_not_steered", "!--no-rival-place-when-not-steered",
                  "Remember and compare a far key image a lost or uncertain frame verified as a rival place too "
                  "(otherwise only frames steered by remember one)"},

@@ -241,6 +241,19 @@ struct LocalizerOptions {
   // (docs/measurements/localization-conditions.md, "A lagging tracker's step moves the belief too"). Off: the step
   // moves the tracker only.
   bool lagging_step_weighs_belief = true;
+  // Where the route's key images have the teach run's odometry and the frames the robot's (the motion model's pace by
+  // the distance driven), a tracker this many route positions or more behind where the distance driven puts the robot
+  // compares the key images there (the one the teach odometry puts nearest and its two neighbours) and steps on to the
+  // best of them where it verifies more matches than the tracked key image, clearly (log10 NFA at most
+  // look_past_max_log10_nfa), the belief weighed there ten to one as a lagging tracker's step weighs it. The distance
+  // is counted from where the tracker last stepped on to a key image at or ahead of the odometry's place, or was
+  // relocalized. The tracker compares only its key image and the next, and a look-alike of the place the robot
+  // reached keeps verifying there while the robot drives on: corridor_conditions' repeat at one to four times the
+  // teach speed against its map of places was held at key image 29, a look-alike of the route's end, over its last
+  // three frames (right: 32-36) at the verifier's seeds 3 and 11, while key images 33 and 35 verified 38 and 47
+  // matches at log10 NFA -24 and -48 where the odometry put the robot (docs/measurements/localization-conditions.md,
+  // "A tracker behind the distance driven looks where the odometry says"). 0: never.
+  int driven_past_positions = 2;
   // A frame not steered by (lost or uncertain) remembers a rival place too: any far key image its comparisons accepted
   // (it verifies more than the frame's key images, which verify nothing a robot may steer by), and compares the one
   // remembered, as a tracked frame does. A robot carried along the route verifies nothing where the tracker holds it,

@@ -49,6 +49,7 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   }
   LookPastWeakNext(frame, features, position, best, best_position);
   LookFurtherWhenLagging(frame, features, best, best_position);
+  LookWhereDriven(frame, features, best, best_position);
   // Not moved on, and nearer `key` than `next_key`: the frame may be behind `key` (a robot that reversed, a
   // hand-held camera swinging back, a relocalization one key image too far). Move back when the previous key
   // image is the better match. Checked only near `key`, where it can be true, to spare a comparison.

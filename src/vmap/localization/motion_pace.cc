@@ -72,6 +72,13 @@ void MotionPace::SetTeachDistances(const std::vector<double>& route_distances) {
 void MotionPace::Reset() {
   started_ = false;
   odometry_before_.reset();
+  metres_driven_ = 0.0;
+  ++driving_stretch_;
+}
+
+std::optional<double> MotionPace::metres_driven() const {
+  if (!odometry_before_ || !std::isfinite(odometry_before_->x + odometry_before_->y)) return std::nullopt;
+  return metres_driven_;
 }
 
 int MotionPace::Steps(int source_index, double timestamp, const std::optional<OdometrySample>& odometry) {
@@ -82,6 +89,13 @@ int MotionPace::Steps(int source_index, double timestamp, const std::optional<Od
   const bool timed = timestamp >= 0.0 && timestamp_before_ >= 0.0 && seconds > 0.0;
   const bool driven = odometry && odometry_before_;
   const double metres = driven ? std::hypot(odometry->x - odometry_before_->x, odometry->y - odometry_before_->y) : 0.0;
+  if (driven && std::isfinite(metres)) {
+    metres_driven_ += metres;
+  } else {
+    // A frame without odometry (or the first after one, or a pose that is not a number): a stretch begins.
+    metres_driven_ = 0.0;
+    ++driving_stretch_;
+  }
   started_ = true;
   source_index_before_ = source_index;
   timestamp_before_ = timestamp;

@@ -66,6 +66,12 @@ class MotionPace {
   // driven between two frames is the straight line between their odometry poses: frames are close enough in time
   // that the path between them is straight, and a robot's odometry gives its pose, not a running distance.
   int Steps(int source_index, double timestamp, const std::optional<OdometrySample>& odometry = std::nullopt);
+  // The metres the robot drove since the first frame of the current stretch of frames that each had odometry, summed
+  // over the straight lines between them, up to the last frame Steps was given; none where that frame had no odometry.
+  // A stretch that lost its odometry begins again at 0: differences are taken within one stretch only
+  // (driving_stretch()).
+  std::optional<double> metres_driven() const;
+  int driving_stretch() const { return driving_stretch_; }
 
  private:
   double teach_frames_per_position_ = 0.0;
@@ -76,6 +82,8 @@ class MotionPace {
   int source_index_before_ = 0;
   double timestamp_before_ = -1.0;  // below 0: none
   std::optional<OdometrySample> odometry_before_;
+  double metres_driven_ = 0.0;
+  int driving_stretch_ = 0;
 };
 
 }  // namespace vmap

@@ -1,6 +1,8 @@
 #include "vmap/localization/motion_pace.h"
 
+#include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -136,6 +138,41 @@ TEST(MotionPace, TheDistanceDrivenSaysHowFarTheRunWentWhateverItsSpeed) {
   fixed.SetTeachDistances({0.0, 0.3, 0.6, 0.9, 1.2, 1.5});
   EXPECT_EQ(fixed.Steps(0, 0.0, Pose(0.0)), 1);
   EXPECT_EQ(fixed.Steps(1, 0.1, Pose(0.9)), 2);
+}
+
+TEST(MotionPace, TheMetresDrivenAddUpWithinAStretchOfFramesWithOdometry) {
+  MotionPace pace = TeachRunPace(true);
+  pace.SetTeachDistances({0.0, 0.3, 0.6, 0.9, 1.2, 1.5});
+  EXPECT_FALSE(pace.metres_driven()) << "before any frame";
+  pace.Steps(0, 0.0, Pose(1.0));
+  const int stretch = pace.driving_stretch();
+  EXPECT_DOUBLE_EQ(pace.metres_driven().value(), 0.0) << "a stretch begins at its first frame";
+  pace.Steps(1, 0.1, Pose(1.3));
+  pace.Steps(2, 0.2, Pose(1.3, 0.4));
+  EXPECT_NEAR(pace.metres_driven().value(), 0.7, 1e-9) << "the straight lines between the frames, summed";
+  pace.Steps(3, 0.3, Pose(1.3, 0.4));
+  EXPECT_NEAR(pace.metres_driven().value(), 0.7, 1e-9) << "standing still";
+  EXPECT_EQ(pace.driving_stretch(), stretch);
+  // A frame without odometry ends the stretch: how far the robot went meanwhile is not known.
+  pace.Steps(4, 0.4, std::nullopt);
+  EXPECT_FALSE(pace.metres_driven());
+  pace.Steps(5, 0.5, Pose(3.0));
+  EXPECT_NE(pace.driving_stretch(), stretch);
+  EXPECT_DOUBLE_EQ(pace.metres_driven().value(), 0.0);
+  pace.Steps(6, 0.6, Pose(3.2));
+  EXPECT_NEAR(pace.metres_driven().value(), 0.2, 1e-9);
+  // A pose that is not a number, and a new run, begin a stretch too.
+  const int before_nan = pace.driving_stretch();
+  pace.Steps(7, 0.7, Pose(std::nan("")));
+  EXPECT_FALSE(pace.metres_driven());
+  pace.Steps(8, 0.8, Pose(4.0));
+  EXPECT_GT(pace.driving_stretch(), before_nan);
+  EXPECT_DOUBLE_EQ(pace.metres_driven().value(), 0.0);
+  const int before_reset = pace.driving_stretch();
+  pace.Reset();
+  pace.Steps(9, 0.9, Pose(4.5));
+  EXPECT_GT(pace.driving_stretch(), before_reset);
+  EXPECT_DOUBLE_EQ(pace.metres_driven().value(), 0.0);
 }
 
 }  // namespace

@@ -60,8 +60,8 @@ std::vector<int> CarriedRun(int from_first, int from_last, int to_first, int to_
 void XfeatCorridorRun::SetUp() {
   SKIP_WITHOUT_SHARED();
   if (!fs::exists(data_)) GTEST_SKIP() << data_ << " is not present";
-  const auto built = testing::RunVmap("build " + Quote(data_ / "teach") + " --matcher xfeat --weights " +
-                                      FoldedWeights() + BuildFlags() + " -q -o " + Quote(map_));
+  const auto built = testing::RunVmap("build " + Quote(Teach()) + " --matcher xfeat --weights " + FoldedWeights() +
+                                      BuildFlags() + " -q -o " + Quote(map_));
   ASSERT_EQ(built.status, 0) << built.output;
   std::ifstream map_file(map_ / "map.json");
   const nlohmann::json map_json = nlohmann::json::parse(map_file);

@@ -29,6 +29,8 @@ class XfeatCorridorRun : public ::testing::Test {
   void SetUp() override;
   // `vmap build`'s flags beyond the matcher's (" --tau 1 --stride 3": a map of places); none: the matcher's map.
   virtual std::string BuildFlags() const { return ""; }
+  // The recording the map is built of: the teach run's own folder, or one a test made of it (with times).
+  virtual std::filesystem::path Teach() const { return data_ / "teach"; }
 
   // The key image at or before teach frame `frame`: where a run of the repeat from frame `frame` is started.
   int KeyBefore(int frame) const;
