@@ -1,6 +1,9 @@
 #include "vmap/pipelines/localize_odometry.h"
 
 #include <cmath>
+#include <cstdint>
+#include <optional>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -42,13 +45,30 @@ std::vector<OdometrySample> ReadTeachOdometry(const std::filesystem::path& map, 
   if (!given.empty()) return ReadOdometry(given, topic);
   // A map folder may come from elsewhere: its file is read only where it is a regular file inside it, as the map's
   // own files are.
+  const std::string name = (map / kTeachOdometryFileName).string();
   std::string why_not;
-  if (!ContainedFile::Open(map, kTeachOdometryFileName, &why_not)) {
+  const std::optional<ContainedFile> file = ContainedFile::Open(map, kTeachOdometryFileName, &why_not);
+  if (!file) {
     if (why_not == "is missing") return {};
-    throw InputError(fmt::format("the map's {} {}; remove it, or give the teach odometry with --teach-odometry",
-                                 (map / kTeachOdometryFileName).string(), why_not));
+    throw InputError(
+        fmt::format("the map's {} {}; remove it, or give the teach odometry with --teach-odometry", name, why_not));
   }
-  return ReadOdometryCsv(map / kTeachOdometryFileName);
+  // Read through the descriptor that was checked: the path could name another file by now. Held whole, so bounded:
+  // the CSV reader takes at most 10 million lines, well under this.
+  constexpr std::uint64_t kMaxBytes = std::uint64_t{1} << 30;
+  if (file->size() > kMaxBytes) {
+    throw InputError(
+        fmt::format("the map's {} is larger than 1 GiB; remove it, or give the teach odometry with "
+                    "--teach-odometry",
+                    name));
+  }
+  std::string text;
+  if (!file->ReadAll(&text)) {
+    throw InputError(
+        fmt::format("cannot read the map's {}; remove it, or give the teach odometry with --teach-odometry", name));
+  }
+  std::istringstream in(text);
+  return ParseOdometryCsv(in, name);
 }
 
 std::string OdometryCsvColumns() { return ",odometry_x,odometry_y,odometry_yaw,odometry_distance,key_distance"; }

@@ -59,10 +59,15 @@ std::string OdometryCsv(const std::vector<OdometrySample>& samples) {
 }
 
 std::vector<OdometrySample> ReadOdometryCsv(const std::filesystem::path& path) {
-  const std::string name = path.string();
   std::ifstream in(path);
-  if (!in)
-    throw InputError(fmt::format("cannot read the odometry CSV '{}'; give a file of timestamp,x,y,yaw lines", name));
+  if (!in) {
+    throw InputError(
+        fmt::format("cannot read the odometry CSV '{}'; give a file of timestamp,x,y,yaw lines", path.string()));
+  }
+  return ParseOdometryCsv(in, path.string());
+}
+
+std::vector<OdometrySample> ParseOdometryCsv(std::istream& in, const std::string& name) {
   std::vector<OdometrySample> samples;
   std::string line;
   long number = 0;

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <istream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,6 +30,9 @@ inline constexpr const char* kOdometryType = "nav_msgs/Odometry";
 // and line: a value that is not a finite number, fewer than four columns, timestamps that go backwards, no
 // sample at all, more than 10 million lines.
 std::vector<OdometrySample> ReadOdometryCsv(const std::filesystem::path& path);
+// The same CSV's text from `in`, `name` naming it in errors (a file opened already: a map folder's, read through the
+// descriptor that checked it).
+std::vector<OdometrySample> ParseOdometryCsv(std::istream& in, const std::string& name);
 // The text of such a CSV (with its header line), every value to full precision: ReadOdometryCsv reads the same
 // samples back.
 std::string OdometryCsv(const std::vector<OdometrySample>& samples);
