@@ -168,16 +168,6 @@ bool Localizer::PaceByTeachOdometry(const std::vector<OdometrySample>& teach_odo
     }
   }
   pace_.SetTeachDistances(route_distances);
-  route_teach_metres_.clear();
-  route_teach_direction_ = 0;
-  if (pace_.by_distance()) {
-    route_teach_metres_ = route_distances;
-    // TeachMetresPerPosition found them all growing or all shrinking where they are known.
-    auto known = [](double d) { return std::isfinite(d); };
-    const double first = *std::find_if(route_distances.begin(), route_distances.end(), known);
-    const double last = *std::find_if(route_distances.rbegin(), route_distances.rend(), known);
-    route_teach_direction_ = last > first ? 1 : -1;
-  }
   return pace_.by_distance();
 }
 
@@ -207,7 +197,6 @@ void Localizer::Reset() {
   stalled_frames_ = 0;
   frames_since_start_ = 0;
   pace_.Reset();
-  driven_from_.reset();
   recent_positions_.clear();
   stall_bar_ = options_.stalled_tracker_frames;
   placed_in_a_row_ = 0;

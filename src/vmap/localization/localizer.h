@@ -300,12 +300,8 @@ class Localizer {
   // the key images there are compared, and the better becomes `best` where it verifies more, clearly
   // (localizer_driven_ahead.cc).
   void LookWhereDriven(const Frame& frame, const ImageFeatures& features, KeyComparison& best, int& best_position);
-  // The route position whose teach odometry is nearest `teach_metres` (-1: none), and the teach odometry's metres
-  // where the distance driven since driven_from_ puts the robot (none: not known).
-  int NearestRoutePosition(double teach_metres) const;
-  std::optional<double> TeachMetresDriven() const;
-  // After the frame's result is final: where the distance driven is counted from (the tracker was at
-  // `position_before` when the frame began).
+  // After the frame's result is final: where the distance driven is counted from (pace_.CountDrivenFrom; the tracker
+  // was at `position_before` when the frame began).
   void RememberWhereDriven(int position_before);
   // Compares the frame with the best-ranked key images of the route (relocalization_candidates of them), in
   // rank order; returns the ranking's route positions compared.
@@ -478,19 +474,7 @@ class Localizer {
     int next_verified = 0;
   } step_back_ruled_out_;
   RouteBelief belief_;
-  MotionPace pace_;  // the motion model's steps a frame
-  // The teach odometry's metres driven at each route position (NaN: not covered; empty: no teach odometry), and
-  // whether they grow (1) or shrink (-1) along the route (0: the pace is not by the distance driven).
-  std::vector<double> route_teach_metres_;
-  int route_teach_direction_ = 0;
-  // Where LookWhereDriven counts the distance driven from: the teach odometry's metres where the robot was taken to
-  // be, the robot's metres driven then (MotionPace::metres_driven) and their stretch. None: not known.
-  struct DrivenFrom {
-    double teach_metres = 0.0;
-    double metres = 0.0;
-    int stretch = -1;
-  };
-  std::optional<DrivenFrom> driven_from_;
+  MotionPace pace_;  // the motion model's steps a frame, and where the distance driven puts the robot
   // The belief the frames' evidence alone would hold: the same motion and comparisons as belief_, from a flat start
   // (without the start key image's prior). Kept only while the start is unconfirmed, the only time it is read.
   RouteBelief evidence_belief_;

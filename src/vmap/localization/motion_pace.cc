@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 
 namespace vmap {
 
@@ -67,6 +68,16 @@ MotionPace::MotionPace(const std::vector<int>& route_source_indices, const std::
 
 void MotionPace::SetTeachDistances(const std::vector<double>& route_distances) {
   teach_metres_per_position_ = TeachMetresPerPosition(route_distances);
+  route_teach_metres_.clear();
+  route_teach_direction_ = 0;
+  driven_from_.reset();
+  if (!by_distance()) return;
+  route_teach_metres_ = route_distances;
+  // TeachMetresPerPosition found them all growing or all shrinking where they are known.
+  auto known = [](double d) { return std::isfinite(d); };
+  const double first = *std::find_if(route_distances.begin(), route_distances.end(), known);
+  const double last = *std::find_if(route_distances.rbegin(), route_distances.rend(), known);
+  route_teach_direction_ = last > first ? 1 : -1;
 }
 
 void MotionPace::Reset() {
@@ -74,6 +85,7 @@ void MotionPace::Reset() {
   odometry_before_.reset();
   metres_driven_ = 0.0;
   ++driving_stretch_;
+  driven_from_.reset();
 }
 
 std::optional<double> MotionPace::metres_driven() const {
@@ -108,6 +120,52 @@ int MotionPace::Steps(int source_index, double timestamp, const std::optional<Od
   }
   if (timed && teach_seconds_per_position_ > 0.0) return MotionStepsPerFrame(seconds, teach_seconds_per_position_);
   return MotionStepsPerFrame(std::max(frames, 1.0), teach_frames_per_position_);
+}
+
+std::optional<double> MotionPace::teach_metres_driven() const {
+  const std::optional<double> metres = metres_driven();
+  if (!metres || !driven_from_ || driven_from_->stretch != driving_stretch_) return std::nullopt;
+  return driven_from_->teach_metres + route_teach_direction_ * (*metres - driven_from_->metres);
+}
+
+bool MotionPace::Covers(int position) const {
+  return position >= 0 && position < static_cast<int>(route_teach_metres_.size()) &&
+         std::isfinite(route_teach_metres_[position]);
+}
+
+void MotionPace::CountDrivenFrom(int position) {
+  const std::optional<double> metres = metres_driven();
+  if (!metres || !Covers(position)) {
+    driven_from_.reset();
+    return;
+  }
+  driven_from_ = DrivenFrom{route_teach_metres_[position], *metres, driving_stretch_};
+}
+
+void MotionPace::PlaceDrivenOnSegment(int position) {
+  const std::optional<double> driven = teach_metres_driven();
+  if (!driven || !Covers(position)) return;
+  const int size = static_cast<int>(route_teach_metres_.size());
+  const double at_key = route_teach_metres_[position];
+  const double segment_end = position + 1 < size && std::isfinite(route_teach_metres_[position + 1])
+                                 ? route_teach_metres_[position + 1]
+                                 : at_key;
+  const double low = std::min(at_key, segment_end), high = std::max(at_key, segment_end);
+  driven_from_->teach_metres = std::clamp(*driven, low, high);
+  driven_from_->metres = *metres_driven();
+}
+
+int MotionPace::NearestPosition(double teach_metres) const {
+  int nearest = -1;
+  double nearest_gap = std::numeric_limits<double>::infinity();
+  for (int q = 0; q < static_cast<int>(route_teach_metres_.size()); ++q) {
+    const double gap = std::abs(route_teach_metres_[q] - teach_metres);  // NaN (not covered) never nearer
+    if (gap < nearest_gap) {
+      nearest_gap = gap;
+      nearest = q;
+    }
+  }
+  return nearest;
 }
 
 }  // namespace vmap

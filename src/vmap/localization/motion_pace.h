@@ -55,7 +55,8 @@ class MotionPace {
   MotionPace(const std::vector<int>& route_source_indices, const std::vector<double>& route_timestamps,
              int fixed_steps = 0);
 
-  // The teach odometry's metres driven at each of the route's key images, in route order (TeachMetresPerPosition).
+  // The teach odometry's metres driven at each of the route's key images, in route order (TeachMetresPerPosition;
+  // NaN: not covered).
   void SetTeachDistances(const std::vector<double>& route_distances);
   bool by_distance() const { return teach_metres_per_position_ > 0.0; }
 
@@ -73,6 +74,24 @@ class MotionPace {
   std::optional<double> metres_driven() const;
   int driving_stretch() const { return driving_stretch_; }
 
+  // Where on the teach run the distance driven puts the robot, where the pace is by the distance driven: counted from
+  // a route position's key image (CountDrivenFrom) and taken onto a segment of the route (PlaceDrivenOnSegment), both
+  // at the last frame Steps was given. The teach odometry's metres there; none where the count was not begun, the
+  // frame had no odometry, or the stretch of odometry it was begun in ended.
+  std::optional<double> teach_metres_driven() const;
+  // Counts the distance driven from route position `position`'s key image: forgotten where the teach odometry does
+  // not cover it or the frame had no odometry.
+  void CountDrivenFrom(int position);
+  // Takes the count onto the segment from route position `position` to the next (its key image's teach metres where
+  // the next is not covered or there is none): where it is on the segment it stays, else it is moved to the nearer
+  // end. Nothing where the count is not known.
+  void PlaceDrivenOnSegment(int position);
+  // Whether the teach odometry covers route position `position`'s key image (where the pace is by the distance
+  // driven).
+  bool Covers(int position) const;
+  // The route position whose teach odometry is nearest `teach_metres` (-1: none covered).
+  int NearestPosition(double teach_metres) const;
+
  private:
   double teach_frames_per_position_ = 0.0;
   double teach_seconds_per_position_ = 0.0;
@@ -84,6 +103,18 @@ class MotionPace {
   std::optional<OdometrySample> odometry_before_;
   double metres_driven_ = 0.0;
   int driving_stretch_ = 0;
+  // The teach odometry's metres at each route position where the pace is by the distance driven (else empty), and
+  // whether they grow (1) or shrink (-1) along the route.
+  std::vector<double> route_teach_metres_;
+  int route_teach_direction_ = 0;
+  // Where the count of the distance driven began: the teach metres the robot was taken to be at, the robot's
+  // metres_driven() then and their stretch.
+  struct DrivenFrom {
+    double teach_metres = 0.0;
+    double metres = 0.0;
+    int stretch = -1;
+  };
+  std::optional<DrivenFrom> driven_from_;
 };
 
 }  // namespace vmap

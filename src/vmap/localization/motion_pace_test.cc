@@ -175,5 +175,58 @@ TEST(MotionPace, TheMetresDrivenAddUpWithinAStretchOfFramesWithOdometry) {
   EXPECT_DOUBLE_EQ(pace.metres_driven().value(), 0.0);
 }
 
+// Where on the teach run the distance driven puts the robot: counted from a key image, kept within a stretch of
+// odometry, taken onto a segment of the route.
+TEST(MotionPace, TheDistanceDrivenPutsTheRobotOnTheTeachRun) {
+  MotionPace pace = TeachRunPace(true);
+  pace.SetTeachDistances({10.0, 10.3, std::nan(""), 10.9, 11.2, 11.5});  // key image 2 not covered
+  pace.Steps(0, 0.0, Pose(0.0));
+  EXPECT_FALSE(pace.teach_metres_driven()) << "not counted yet";
+  pace.CountDrivenFrom(1);
+  EXPECT_DOUBLE_EQ(pace.teach_metres_driven().value(), 10.3);
+  pace.Steps(1, 0.1, Pose(0.5));
+  EXPECT_NEAR(pace.teach_metres_driven().value(), 10.8, 1e-9);
+  EXPECT_EQ(pace.NearestPosition(10.8), 3) << "the uncovered key image is never nearest";
+  EXPECT_EQ(pace.NearestPosition(-4.0), 0);
+  EXPECT_EQ(pace.NearestPosition(99.0), 5);
+  // Taken onto the segment from key image 3 to 4 (10.9 to 11.2): moved to its nearer end, the count then driven on.
+  pace.PlaceDrivenOnSegment(3);
+  EXPECT_DOUBLE_EQ(pace.teach_metres_driven().value(), 10.9);
+  pace.Steps(2, 0.2, Pose(0.6));
+  EXPECT_NEAR(pace.teach_metres_driven().value(), 11.0, 1e-9);
+  pace.PlaceDrivenOnSegment(3);
+  EXPECT_NEAR(pace.teach_metres_driven().value(), 11.0, 1e-9) << "on the segment: stays";
+  pace.PlaceDrivenOnSegment(5);  // the last key image: a segment of its own place
+  EXPECT_DOUBLE_EQ(pace.teach_metres_driven().value(), 11.5);
+  // Not covered: not counted from, nor placed on.
+  EXPECT_FALSE(pace.Covers(2));
+  EXPECT_FALSE(pace.Covers(-1));
+  EXPECT_FALSE(pace.Covers(6));
+  pace.PlaceDrivenOnSegment(2);
+  EXPECT_DOUBLE_EQ(pace.teach_metres_driven().value(), 11.5);
+  pace.CountDrivenFrom(2);
+  EXPECT_FALSE(pace.teach_metres_driven());
+  // A stretch of odometry that ends ends the count.
+  pace.CountDrivenFrom(0);
+  pace.Steps(3, 0.3, std::nullopt);
+  pace.Steps(4, 0.4, Pose(0.9));
+  EXPECT_FALSE(pace.teach_metres_driven());
+
+  // A route backwards through the teach run: the teach metres shrink as the robot drives on.
+  MotionPace backwards = TeachRunPace(true);
+  backwards.SetTeachDistances({1.5, 1.2, 0.9, 0.6, 0.3, 0.0});
+  backwards.Steps(0, 0.0, Pose(0.0));
+  backwards.CountDrivenFrom(0);
+  backwards.Steps(1, 0.1, Pose(0.0, 0.4));
+  EXPECT_NEAR(backwards.teach_metres_driven().value(), 1.1, 1e-9);
+  EXPECT_EQ(backwards.NearestPosition(1.1), 1);
+  // Without the teach odometry nothing is counted.
+  MotionPace by_time = TeachRunPace(true);
+  by_time.Steps(0, 0.0, Pose(0.0));
+  by_time.CountDrivenFrom(0);
+  EXPECT_FALSE(by_time.teach_metres_driven());
+  EXPECT_EQ(by_time.NearestPosition(0.0), -1);
+}
+
 }  // namespace
 }  // namespace vmap
