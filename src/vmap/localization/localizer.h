@@ -300,6 +300,9 @@ class Localizer {
   // the key images there are compared, and the better becomes `best` where it verifies more, clearly
   // (localizer_driven_ahead.cc).
   void LookWhereDriven(const Frame& frame, const ImageFeatures& features, KeyComparison& best, int& best_position);
+  // Where the distance driven puts the robot within a route position of `tracked` and further from `elsewhere`: the
+  // odometry vouches for the tracked key image, and a relocalization to `elsewhere` is not taken on one frame.
+  bool DrivenVouchesFor(int tracked, int elsewhere) const;
   // After the frame's result is final: where the distance driven is counted from (pace_.CountDrivenFrom; the tracker
   // was at `position_before` when the frame began).
   void RememberWhereDriven(int position_before);

@@ -2,7 +2,9 @@
 // the tracker compares only its key image and the ones just after it, and where one of them looks like the place the
 // robot has reached, it keeps verifying while the robot drives on; the belief, moved by the distance driven, is held
 // back by that evidence alone, since nothing is compared where the robot is. The teach run's odometry at each key
-// image says where on the route the distance driven since the tracker reached its key image puts the robot.
+// image says where on the route the distance driven since the tracker reached its key image puts the robot. Where it
+// puts the robot at the tracked key image, the odometry also vouches for the tracker against a relocalization that
+// one frame's near tie would take elsewhere.
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -24,6 +26,14 @@ void Localizer::LookWhereDriven(const Frame& frame, const ImageFeatures& feature
   // to, as a lagging tracker's step weighs it: the look-alike's evidence holds it where the tracker was.
   StepOnWhereClearlyBetter(frame, features, std::max(best_position + 2, driven - 1), driven + 1, true, best,
                            best_position);
+}
+
+bool Localizer::DrivenVouchesFor(int tracked, int elsewhere) const {
+  if (options_.driven_past_positions <= 0) return false;
+  const std::optional<double> teach_metres = pace_.teach_metres_driven();
+  if (!teach_metres) return false;
+  const int driven = pace_.NearestPosition(*teach_metres);
+  return driven >= 0 && std::abs(tracked - driven) <= 1 && std::abs(elsewhere - driven) > std::abs(tracked - driven);
 }
 
 void Localizer::RememberWhereDriven(int position_before) {

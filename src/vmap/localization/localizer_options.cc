@@ -184,7 +184,8 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
       OptionField{"driven_past_positions", "--driven-past-positions",
                   "With the teach run's odometry and the robot's: route positions a tracker lags where the distance "
                   "driven puts the robot before the key images there are compared, and stepped on to where one "
-                  "verifies more, clearly (0 = never)"}
+                  "verifies more, clearly; where it puts the robot at the tracked key image, a relocalization "
+                  "further from it is not taken (0 = never, neither)"}
           .Within(0, 1000)
           .Meaning("0: never"),
       driven_past_positions);

@@ -252,7 +252,13 @@ struct LocalizerOptions {
   // teach speed against its map of places was held at key image 29, a look-alike of the route's end, over its last
   // three frames (right: 32-36) at the verifier's seeds 3 and 11, while key images 33 and 35 verified 38 and 47
   // matches at log10 NFA -24 and -48 where the odometry put the robot (docs/measurements/localization-conditions.md,
-  // "A tracker behind the distance driven looks where the odometry says"). 0: never.
+  // "A tracker behind the distance driven looks where the odometry says"). Where the distance driven puts the robot
+  // within a route position of the tracker's key image, it also vouches for it: a relocalization the frame is asked
+  // for (SharesLittle and the other doubts of Track) that would take the tracker further from that place is not taken
+  // on that frame, whatever it verifies: the seed's noise makes a near tie of a look-alike a few key images back
+  // (the same run at the verifier's seed 7: repeat frame 20 relocalized back to key image 3 on 29 verified matches
+  // against 28 at key image 6, right: 6-8, where the odometry put the robot; "The distance driven vouches for the
+  // tracked key image"). 0: never, neither rule.
   int driven_past_positions = 2;
   // A frame not steered by (lost or uncertain) remembers a rival place too: any far key image its comparisons accepted
   // (it verifies more than the frame's key images, which verify nothing a robot may steer by), and compares the one

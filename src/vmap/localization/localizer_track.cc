@@ -188,7 +188,8 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     for (const RelocalizationCandidate& c : found.candidates) {
       if (c.accepted) found_verified = std::max(found_verified, c.num_verified);
     }
-    if (found.status == LocalizationStatus::kRelocalized && found_verified > best.num_verified) {
+    if (found.status == LocalizationStatus::kRelocalized && found_verified > best.num_verified &&
+        !DrivenVouchesFor(best_position, found.route_position)) {
       if (TakesJump(position, found.route_position, lost_before)) {
         if (found.route_position < position) stepped_back_from_ = position;
         return found;

@@ -107,5 +107,14 @@ TEST_F(XfeatCorridorSpeedRun, ATrackerBehindTheDistanceDrivenLooksWhereTheOdomet
                              [&](const std::string& flags) { return SteeredOnSpeedRun(" --verifier-seed 3" + flags); });
 }
 
+// The distance driven vouches for the tracked key image (docs/localize.md): at the verifier's seed 7 the tracker steps
+// on from key image 4 to 6 at run frame 8 (repeat frame 20, right: 6-8), where the odometry puts the robot, and the
+// relocalization the frame is also asked for places it at key image 3, one verified match more: a near tie, taken
+// back against the distance driven. The odometry keeps the tracker.
+TEST_F(XfeatCorridorSpeedRun, TheDistanceDrivenVouchesForTheTrackedKeyImageAgainstANearTieElsewhere) {
+  ExpectNoFarFrameButWithout(" --driven-past-positions 0", "repeat frame 20 relocalized back at key image 3",
+                             [&](const std::string& flags) { return SteeredOnSpeedRun(" --verifier-seed 7" + flags); });
+}
+
 }  // namespace
 }  // namespace vmap::neural
