@@ -6,9 +6,7 @@
 // puts the robot at the tracked key image, the odometry also vouches for the tracker against a relocalization that
 // one frame's near tie would take elsewhere.
 #include <algorithm>
-#include <cmath>
 #include <cstdlib>
-#include <optional>
 
 #include "vmap/localization/localizer.h"
 
@@ -18,9 +16,7 @@ void Localizer::LookWhereDriven(const Frame& frame, const ImageFeatures& feature
                                 int& best_position) {
   const int past = options_.driven_past_positions;
   if (past <= 0 || !best.accepted) return;
-  const std::optional<double> teach_metres = pace_.teach_metres_driven();
-  if (!teach_metres) return;
-  const int driven = pace_.NearestPosition(*teach_metres);
+  const int driven = pace_.DrivenPosition();
   if (driven < 0 || driven - best_position < past) return;
   // The key image after the tracked one was compared by the lookahead. The belief is weighed where the tracker steps
   // to, as a lagging tracker's step weighs it: the look-alike's evidence holds it where the tracker was.
@@ -30,17 +26,15 @@ void Localizer::LookWhereDriven(const Frame& frame, const ImageFeatures& feature
 
 bool Localizer::DrivenVouchesFor(int tracked, int elsewhere) const {
   if (options_.driven_past_positions <= 0) return false;
-  const std::optional<double> teach_metres = pace_.teach_metres_driven();
-  if (!teach_metres) return false;
-  const int driven = pace_.NearestPosition(*teach_metres);
+  const int driven = pace_.DrivenPosition();
   return driven >= 0 && std::abs(tracked - driven) <= 1 && std::abs(elsewhere - driven) > std::abs(tracked - driven);
 }
 
 void Localizer::RememberWhereDriven(int position_before) {
-  const std::optional<double> driven = pace_.teach_metres_driven();
+  const int driven = pace_.DrivenPosition();
   // A stretch of odometry begins, or the tracker was relocalized (more than kNear either way): counted from its key
   // image (forgotten where the tracker is lost or the teach odometry does not cover its key image).
-  if (!driven || std::abs(position_ - position_before) > kNear || !pace_.Covers(position_)) {
+  if (driven < 0 || std::abs(position_ - position_before) > kNear || !pace_.Covers(position_)) {
     pace_.CountDrivenFrom(position_);
     return;
   }
@@ -48,7 +42,7 @@ void Localizer::RememberWhereDriven(int position_before) {
   // is taken to be on the tracker's segment, where the distance puts it if that is on the segment. A tracker that
   // stayed, or stepped on behind, leaves the count as it was: the robot drives on.
   const bool moved = position_ != position_before;
-  if (moved && position_ >= pace_.NearestPosition(*driven) - 1) pace_.PlaceDrivenOnSegment(position_);
+  if (moved && position_ >= driven - 1) pace_.PlaceDrivenOnSegment(position_);
 }
 
 }  // namespace vmap

@@ -168,4 +168,9 @@ int MotionPace::NearestPosition(double teach_metres) const {
   return nearest;
 }
 
+int MotionPace::DrivenPosition() const {
+  const std::optional<double> teach_metres = teach_metres_driven();
+  return teach_metres ? NearestPosition(*teach_metres) : -1;
+}
+
 }  // namespace vmap

@@ -91,6 +91,8 @@ class MotionPace {
   bool Covers(int position) const;
   // The route position whose teach odometry is nearest `teach_metres` (-1: none covered).
   int NearestPosition(double teach_metres) const;
+  // The route position whose teach odometry is nearest teach_metres_driven() (-1: not known).
+  int DrivenPosition() const;
 
  private:
   double teach_frames_per_position_ = 0.0;

@@ -189,6 +189,7 @@ TEST(MotionPace, TheDistanceDrivenPutsTheRobotOnTheTeachRun) {
   EXPECT_EQ(pace.NearestPosition(10.8), 3) << "the uncovered key image is never nearest";
   EXPECT_EQ(pace.NearestPosition(-4.0), 0);
   EXPECT_EQ(pace.NearestPosition(99.0), 5);
+  EXPECT_EQ(pace.DrivenPosition(), 3);
   // Taken onto the segment from key image 3 to 4 (10.9 to 11.2): moved to its nearer end, the count then driven on.
   pace.PlaceDrivenOnSegment(3);
   EXPECT_DOUBLE_EQ(pace.teach_metres_driven().value(), 10.9);
@@ -226,6 +227,7 @@ TEST(MotionPace, TheDistanceDrivenPutsTheRobotOnTheTeachRun) {
   by_time.CountDrivenFrom(0);
   EXPECT_FALSE(by_time.teach_metres_driven());
   EXPECT_EQ(by_time.NearestPosition(0.0), -1);
+  EXPECT_EQ(by_time.DrivenPosition(), -1);
 }
 
 }  // namespace
