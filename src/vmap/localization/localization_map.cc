@@ -40,6 +40,7 @@ LocalizerOptions MapLocalizerOptions(const LocalizationMap& opened) {
   options.similarity = recorded.key_images.similarity;
   options.camera = opened.map.input.camera;
   options.translation = recorded.link_analysis.translation;
+  options.map_tau = recorded.key_images.tau;
   return options;
 }
 
@@ -55,6 +56,8 @@ LocalizerOptions FollowMap(const LocalizationMap& opened, LocalizerOptions optio
   if (options.verifier_seed >= 0) options.verifier.seed = options.verifier_seed;
   options.similarity = from_map.similarity;
   options.translation = from_map.translation;
+  options.map_tau = from_map.map_tau;
+  if (options.link_share_tau == 0.0) options.link_share_tau = DefaultTau(opened.matcher->name());
   const std::string map_size = QueryResize(map, "");
   if (from_map.camera && !map_size.empty() && query_resize == map_size) {
     options.camera = from_map.camera;

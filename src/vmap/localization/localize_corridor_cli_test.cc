@@ -423,5 +423,43 @@ TEST(LocalizeCli, TheKidnappedRunIsNotPlacedFarOnAHeadingChanceRefused) {
   }
 }
 
+TEST(LocalizeCli, AMapOfEveryFrameMeasuresTheLinkShareAtTheMatchersSpacing) {
+  // corridor_conditions with ORB against a map of every teach frame (`--tau 1`; docs/localize.md, "A map of every
+  // frame"): neighbouring key images are nearly one image, and their links verify more than a frame of the other
+  // lighting does at the right key image, which the link share then refused. Measured at the spacing of ORB's default
+  // tau, the share accepts the right key images (at the map's seed: 66 frames steered by at a key image within two
+  // teach frames of the frame's, none further; with the map's own links, --link-share-tau 1: 44, one further).
+  const fs::path data = Shared() / "data/corridor_conditions";
+  if (Shared().empty() || !fs::exists(data)) GTEST_SKIP() << "../shared/data/corridor_conditions is not present";
+  ::vmap::testing::ScopedTempDir tmp;
+  std::string out;
+  ASSERT_EQ(RunVmap("build " + Quote(data / "teach") + " --tau 1 -q -o " + Quote(tmp.path() / "map"), &out), 0) << out;
+  std::vector<std::pair<int, int>> right_and_far;
+  for (const std::string flags : {"", " --link-share-tau 1"}) {
+    const fs::path csv = tmp.path() / "run.csv";
+    ASSERT_EQ(RunVmap("localize " + Quote(tmp.path() / "map") + " " + Quote(data / "repeat") + " --start-key 0 -q " +
+                          "--csv " + Quote(csv) + flags,
+                      &out),
+              0)
+        << out;
+    const std::vector<std::string> status = CsvColumn(csv, "status"), teach_frame = CsvColumn(csv, "key_frame");
+    ASSERT_EQ(status.size(), 111u);
+    // Right: within the data set's two frames; far: more than two key images (teach frames) beyond those.
+    int right = 0, far = 0;
+    for (size_t i = 0; i < status.size(); ++i) {
+      if (!Placed({status[i], 0})) continue;
+      const int off = std::abs(std::stoi(teach_frame[i]) - static_cast<int>(i));
+      right += off <= 2;
+      far += off > 4;
+    }
+    right_and_far.emplace_back(right, far);
+  }
+  const auto [right, far] = right_and_far[0];
+  const auto [right_by_links, far_by_links] = right_and_far[1];
+  EXPECT_GE(right, right_by_links + 15) << "at the matcher's spacing " << right << ", by the map's links "
+                                        << right_by_links;
+  EXPECT_LE(far, far_by_links) << "at the matcher's spacing " << far << ", by the map's links " << far_by_links;
+}
+
 }  // namespace
 }  // namespace vmap

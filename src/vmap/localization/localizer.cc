@@ -21,6 +21,7 @@ namespace vmap {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // The link's verified matches pass chance as a comparison's must (acceptance.h), one test: the two key images share a
 // scene. Without its matches in memory (a map loaded without them) it is taken to.
@@ -79,7 +80,9 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   CheckStartKey(map_, options_);
   if (options_.start_key >= 0) start_position_ = route_position_of_key_[options_.start_key];
   link_verified_.assign(num_keys, 0);
+  share_reference_.assign(num_keys, 0);  // before the comparisons below, which read it
   scene_link_after_.assign(route_.size(), false);
+  std::vector<std::optional<SharedByKeys>> link_after(route_.size());
   for (const Link& link : map_.links) {
     const int a = link.from_key, b = link.to_key;
     if (a < 0 || b < 0 || a >= num_keys || b >= num_keys || route_position_of_key_[a] < 0 ||
@@ -90,11 +93,28 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
     // A link chance refuses joins two places, not one scene (a --tau 1 map of unrelated places). Its verified count
     // still bounds the link share: what two unrelated places verify by chance is a floor a frame must pass (with XFeat,
     // whose chance model passes at most wrong key images, dropping it cost michigan 653 -> 581, 5 frames far).
-    scene_link_after_[std::min(route_position_of_key_[a], route_position_of_key_[b])] =
+    const int before = std::min(route_position_of_key_[a], route_position_of_key_[b]);
+    scene_link_after_[before] =
         OfOneScene(link, keys_.features[a]->image_size(), keys_.features[b]->image_size(), options_.max_log10_nfa);
-    for (const int k : {a, b}) {
-      link_verified_[k] = link_verified_[k] > 0 ? std::min(link_verified_[k], link.num_verified) : link.num_verified;
-    }
+    link_after[before] = SharedByKeys{link.similarity, link.num_verified};
+  }
+  // The map's links, and the acceptance's reference: the same, or on a map denser than link_share_tau spaces key
+  // images, the links a map of that tau would hold, each key image compared as a frame is (the teach key image alone).
+  const auto compare = [&](int p, int q) -> std::optional<SharedByKeys> {
+    const ImageFeatures& from = *keys_.features[route_[p]];
+    const ImageFeatures& to = *keys_.features[route_[q]];
+    const KeyComparison c = CompareImage(from, to, matcher_.Match(from, to), route_[q]);
+    if (!c.matched) return std::nullopt;
+    return SharedByKeys{c.similarity, c.num_verified};
+  };
+  const std::vector<int> links = LinkShareReference(link_after, compare, kInfinity, 1);
+  const bool denser = options_.link_share_tau > 0.0 && options_.map_tau > options_.link_share_tau;
+  const std::vector<int> spaced = denser ? LinkShareReference(link_after, compare, options_.link_share_tau,
+                                                              kLinkShareReach, options_.comparison_threads)
+                                         : links;
+  for (size_t p = 0; p < route_.size(); ++p) {
+    link_verified_[route_[p]] = links[p];
+    share_reference_[route_[p]] = spaced[p];
   }
   // Only the route's key images take part in the ranking.
   std::vector<std::shared_ptr<const ImageFeatures>> features;

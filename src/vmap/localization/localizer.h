@@ -35,6 +35,7 @@
 #include "vmap/localization/key_comparison.h"
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/localization/key_image_store.h"
+#include "vmap/localization/link_share_reference.h"
 #include "vmap/localization/localization_result.h"
 #include "vmap/localization/localizer_options.h"
 #include "vmap/localization/map_verifier_options.h"
@@ -405,12 +406,17 @@ class Localizer {
   // NFA is at most `from`'s, both clamped at the evidence's bound (-max_significance), beyond which both are the same
   // scene beyond doubt (LocalizerOptions::step_back_needs_lower_nfa, step_on_needs_lower_nfa).
   bool NoLikelierChance(const KeyComparison& to, const KeyComparison& from) const;
+  // The verified matches a comparison with key image `key` needs by the link share (min_link_share).
+  double LinkShareBar(int key) const { return options_.min_link_share * share_reference_[key]; }
   // A tracked comparison shares less with its key image than the map's links do (recheck_link_share).
   bool SharesLittle(const KeyComparison& comparison) const;
 
   // "Near" a route position: within two (key images two apart often both see the frame); the tolerance of the
   // goal "no frame confidently at a key image more than 2 places away".
   static constexpr int kNear = 2;
+  // The furthest a key image is compared along the route for the link share's reference (link_share_tau): at most
+  // this many comparisons a key image when the localizer starts.
+  static constexpr int kLinkShareReach = 10;
   // A comparison verifies beyond a little chance at a log10 NFA of at most this (the bar of
   // LocalizerOptions::scene_change_tracked_log10_nfa), read by the doubted jump back and the look past a weak next key
   // image: across lighting a place the robot left still accepts a few chance matches at -6 or so.
@@ -436,6 +442,12 @@ class Localizer {
   // Per key image: the verified matches of its link with a route neighbour, the smaller of the two; 0 when it
   // has no verified link on the route (the comparisons against the map's links are then skipped).
   std::vector<int> link_verified_;
+  // Per key image: what the acceptance's link share measures against (LocalizerOptions::link_share_tau):
+  // link_verified_, or on a map denser than that tau spaces its key images, its links as a map of that tau would hold
+  // them. The recheck and the evidence keep link_verified_: on a map of every frame a frame tracked with less than its
+  // near-duplicate links share is still asked whether a key image on verifies more (the tracker lags a key image a
+  // frame otherwise).
+  std::vector<int> share_reference_;
   // Per route position p: the map's link between p and p + 1 is of one scene (its verified matches pass chance, as a
   // comparison's must). A --tau 1 map of unrelated places has links chance refuses; a teach run's are of one scene.
   std::vector<bool> scene_link_after_;

@@ -61,10 +61,9 @@ KeyComparison Localizer::CompareImage(const ImageFeatures& features, const Image
                       .log10_nfa;
   }
   c.accepted =
-      pair.matched &&
-      (options_.acceptance == AcceptanceRule::kChance
-           ? c.log10_nfa <= options_.max_log10_nfa && pair.num_verified >= options_.min_link_share * link_verified_[key]
-           : pair.num_verified >= options_.min_verified && pair.similarity >= options_.min_similarity);
+      pair.matched && (options_.acceptance == AcceptanceRule::kChance
+                           ? c.log10_nfa <= options_.max_log10_nfa && pair.num_verified >= LinkShareBar(key)
+                           : pair.num_verified >= options_.min_verified && pair.similarity >= options_.min_similarity);
   // The heading from every tentative match (verified first, then rejected), key image -> frame.
   std::vector<cv::Point2f> key_points, frame_points;
   SplitCorrespondences(pair.correspondences, &frame_points, &key_points);
@@ -122,7 +121,7 @@ int Localizer::TrackGuided(const Frame& frame, const ImageFeatures& features, in
     // never the share (a frame that shares little with the key image's scene, seen from elsewhere, stays refused:
     // redkitchen's teach/repeat run, docs/localize.md).
     const KeyComparison first = CompareOnce(features, key);
-    if (first.num_verified < options_.min_link_share * link_verified_[key]) continue;
+    if (first.num_verified < LinkShareBar(key)) continue;
     WeighComparisons();  // the first comparisons' evidence, before a guided one replaces its key image's
     const TentativeMatches matches = guided_matcher_->Match(features, *keys_.features[key]);
     KeyComparison c = CompareImage(features, *keys_.features[key], matches, key);
@@ -169,7 +168,7 @@ bool Localizer::CompareBestRankedAgain(const Frame& frame, const ImageFeatures& 
     const int key = route_[position];
     const KeyComparison first = CompareOnce(features, key);
     // As TrackGuided: chance asked again, never the link share.
-    if (first.accepted || first.num_verified < options_.min_link_share * link_verified_[key]) continue;
+    if (first.accepted || first.num_verified < LinkShareBar(key)) continue;
     std::optional<KeyComparison> second = again(key);
     if (!second) break;
     WeighComparisons();  // the first comparison's evidence, before the second one replaces it

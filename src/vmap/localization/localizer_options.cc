@@ -33,6 +33,14 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
           .Meaning("0: chance alone decides"),
       min_link_share);
   visitor.Visit(
+      OptionField{"link_share_tau", "--link-share-tau",
+                  "--acceptance chance: on a map built with a higher tau (--tau 1: every frame a key image), "
+                  "--min-link-share measures against a key image's link as a map of this tau would hold it (0: the "
+                  "matcher's default tau; 1: the map's own links)"}
+          .Within(0, 1)
+          .Meaning("0: the map's matcher's default tau"),
+      link_share_tau);
+  visitor.Visit(
       OptionField{"min_rival_ratio", "--min-rival-ratio",
                   "--acceptance chance: a key image refused by --min-link-share alone is accepted when it verifies "
                   "this many times the matches of every key image compared more than two route positions away (the "
@@ -433,6 +441,7 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
       verifier_seed);
   visitor.VisitNested("translation", translation);
   visitor.Visit({"similarity"}, EnumField(similarity, kSimilarityModeNames, ParseSimilarityMode));
+  visitor.Visit(OptionField{"map_tau"}.Within(0, 1), map_tau);
   visitor.Visit({"route"}, route);
   visitor.Visit(OptionField{"comparison_threads", "--comparison-threads",
                             "Threads comparing a frame with key images (1: one comparison after another); the "

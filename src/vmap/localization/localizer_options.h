@@ -33,6 +33,15 @@ struct LocalizerOptions {
   AcceptanceRule acceptance = AcceptanceRule::kChance;
   double max_log10_nfa = 0.0;
   double min_link_share = 0.4;  // 0: chance alone decides (a key image without a link on the route: likewise)
+  // The link share's reference where the map's key images are denser than this tau spaces them (a map of every frame,
+  // `--tau 1`: neighbours nearly the same image, whose link verifies about twice what a frame of another run does at
+  // the right key image): a key image's link as a map of this tau would hold it, the key image compared, when the
+  // localizer starts, with those on along the route while S still reaches this tau (link_share_reference.h). Only
+  // for maps built with a tau above it (`map_tau`). 0: the map's matcher's default tau (FollowMap gives it; a
+  // Localizer given 0 keeps the map's links); 1: the map's links always.
+  double link_share_tau = 0.0;
+  // The tau the map's key images were selected with (its key_images.tau; follows the map, FollowMap); 0: not known.
+  double map_tau = 0.0;
   int min_verified = 20;
   double min_similarity = 0.3;
   // Across seasons the link share refuses the right key image: the map's links are of one season, and a frame of
@@ -587,7 +596,7 @@ struct LocalizerOptions {
   int comparison_threads = 2;
 
   // As a localization run records them (its "options"; not the camera, which the map gives) and the flags of
-  // `vmap localize`. The verifier, the translation thresholds and the similarity follow the map
+  // `vmap localize`. The verifier, the translation thresholds, the similarity and map_tau follow the map
   // (MapVerifierOptions, FollowMap): they are recorded, but have no flags here (the verifier's seed has its own,
   // verifier_seed), and the verifier records no early stop (localization verifies each comparison in full).
   void VisitFields(OptionFieldVisitor& visitor);

@@ -66,7 +66,7 @@ bool Localizer::HeadingMayStandOut(const KeyComparison& comparison) const {
   // its scene from elsewhere, and the scene's matches agree there too (redkitchen's teach/repeat run: 2 -> 57 frames
   // steered by wrong when the heading overrode the share).
   return comparison.matched && comparison.heading.votes >= options_.min_heading_votes &&
-         comparison.num_verified >= options_.min_link_share * link_verified_[comparison.key];
+         comparison.num_verified >= LinkShareBar(comparison.key);
 }
 
 bool Localizer::HeadingStandsOut(const Frame& frame, const ImageFeatures& features, const KeyComparison& comparison,
@@ -128,7 +128,7 @@ KeyComparison Localizer::CompareTracked(const Frame& frame, const ImageFeatures&
 
 bool Localizer::AcceptedAgainstRivals(const KeyComparison& comparison) const {
   return comparison.accepted && options_.acceptance == AcceptanceRule::kChance &&
-         comparison.num_verified < options_.min_link_share * link_verified_[comparison.key];
+         comparison.num_verified < LinkShareBar(comparison.key);
 }
 
 int Localizer::AcceptAgainstRivals(const Frame& frame, const ImageFeatures& features) {

@@ -84,8 +84,8 @@ void LocalizationSessionOptions::CheckGiven(const std::vector<std::string>& give
     }
   }
   if (localizer.acceptance != AcceptanceRule::kChance) {
-    for (const char* path :
-         {"min_link_share", "min_rival_ratio", "rival_max_log10_nfa", "min_heading_rival_ratio", "min_heading_votes"}) {
+    for (const char* path : {"min_link_share", "link_share_tau", "min_rival_ratio", "rival_max_log10_nfa",
+                             "min_heading_rival_ratio", "min_heading_votes"}) {
       if (was_given(path)) {
         throw OptionError(path, "belongs to acceptance chance; give that, or leave it out", {"acceptance"});
       }
