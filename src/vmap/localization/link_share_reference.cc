@@ -1,10 +1,8 @@
 #include "vmap/localization/link_share_reference.h"
 
 #include <algorithm>
-#include <atomic>
-#include <exception>
-#include <mutex>
-#include <thread>
+
+#include "vmap/core/parallel_for.h"
 
 namespace vmap {
 
@@ -12,8 +10,8 @@ std::vector<int> LinkShareReference(const std::vector<std::optional<SharedByKeys
                                     const std::function<std::optional<SharedByKeys>(int p, int q)>& compare, double tau,
                                     int max_reach, int threads) {
   const int n = static_cast<int>(link_after.size());
-  // Per position p: the verified matches with p + 2, p + 3, ... while S reaches tau. Each walk is independent of the
-  // others, so they run on `threads` threads; the result does not depend on which.
+  // Per position p: the verified matches with p + 2, p + 3, ... while S reaches tau. The walks are independent of
+  // each other: the result does not depend on which thread made which.
   std::vector<std::vector<int>> walked(n);
   const auto walk = [&](int p) {
     if (p + 1 >= n || !link_after[p] || link_after[p]->similarity < tau) return;
@@ -23,25 +21,7 @@ std::vector<int> LinkShareReference(const std::vector<std::optional<SharedByKeys
       walked[p].push_back(shared->num_verified);
     }
   };
-  std::atomic<int> next{0};
-  std::exception_ptr failure;
-  std::mutex failure_mutex;
-  const auto work = [&] {
-    for (int p = next++; p < n; p = next++) {
-      try {
-        walk(p);
-      } catch (...) {
-        const std::lock_guard<std::mutex> lock(failure_mutex);
-        if (!failure) failure = std::current_exception();
-        next = n;
-      }
-    }
-  };
-  std::vector<std::thread> helpers;
-  for (int t = 1; t < std::min(threads, n); ++t) helpers.emplace_back(work);
-  work();
-  for (std::thread& helper : helpers) helper.join();
-  if (failure) std::rethrow_exception(failure);
+  ParallelFor(n, threads, [&](size_t p) { walk(static_cast<int>(p)); });
 
   std::vector<int> forward(n, -1), backward(n, -1);
   for (int p = 0; p + 1 < n; ++p) {

@@ -29,9 +29,8 @@ struct SharedByKeys {
 // count of the furthest q <= p + `max_reach` such that p and every q' in (p, q] reach S >= `tau` (the link p, p + 1 by
 // its own S; a link missing ends the walk); the backward one that of the first position whose walk reached p. Where the
 // link after p is below `tau`, p compares nothing: the map is spaced already, and its links are the reference, as
-// before. The walks run on `threads` threads
-// (`compare` must be thread-safe then); the result is the same for any number. An exception `compare` throws is
-// rethrown.
+// before. The walks run on `threads` threads (ParallelFor; `compare` must be thread-safe then), with the same result
+// for any number; an exception `compare` throws is rethrown.
 std::vector<int> LinkShareReference(const std::vector<std::optional<SharedByKeys>>& link_after,
                                     const std::function<std::optional<SharedByKeys>(int p, int q)>& compare, double tau,
                                     int max_reach, int threads = 1);

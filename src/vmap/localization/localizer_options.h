@@ -1,6 +1,7 @@
 #pragma once
 // The options of the Localizer (localizer.h): how a comparison accepts a frame, how tracking and relocalization
-// search the route, and what the map lends them (verifier, similarity, camera, translation thresholds).
+// search the route, and what the map lends them (verifier, similarity, camera, translation thresholds). Guided
+// matching's and the start's are in structs of their own, read as this one's (the same JSON paths and flags).
 
 #include <optional>
 #include <vector>
@@ -12,12 +13,14 @@
 #include "vmap/geometry/translation_evidence.h"
 #include "vmap/localization/acceptance.h"
 #include "vmap/localization/key_image_ranking.h"
+#include "vmap/localization/localizer_guided_options.h"
+#include "vmap/localization/localizer_start_options.h"
 #include "vmap/localization/route_belief.h"
 #include "vmap/mapping/key_image_selector.h"
 
 namespace vmap {
 
-struct LocalizerOptions {
+struct LocalizerOptions : GuidedMatchingOptions, StartOptions {
   // When a comparison accepts the frame at a key image (acceptance.h, docs/localization-acceptance.md).
   // kChance (default): matching and verification succeed, the verified set is unlikely by chance (log10 of its
   // number of false alarms, every comparison a frame can make counted as a test, at most `max_log10_nfa`; 0:
@@ -33,12 +36,10 @@ struct LocalizerOptions {
   AcceptanceRule acceptance = AcceptanceRule::kChance;
   double max_log10_nfa = 0.0;
   double min_link_share = 0.4;  // 0: chance alone decides (a key image without a link on the route: likewise)
-  // The link share's reference where the map's key images are denser than this tau spaces them (a map of every frame,
-  // `--tau 1`: neighbours nearly the same image, whose link verifies about twice what a frame of another run does at
-  // the right key image): a key image's link as a map of this tau would hold it, the key image compared, when the
-  // localizer starts, with those on along the route while S still reaches this tau (link_share_reference.h). Only
-  // for maps built with a tau above it (`map_tau`). 0: the map's matcher's default tau (FollowMap gives it; a
-  // Localizer given 0 keeps the map's links); 1: the map's links always.
+  // The link share's reference on a map built with a tau above this (`map_tau`; `--tau 1`: neighbours nearly one image,
+  // whose link verifies about twice what a frame of another run does at the right key image): a key image's link as a
+  // map of this tau would hold it, found when the localizer starts (link_share_reference.h). 0: the map's matcher's
+  // default tau (FollowMap gives it; a Localizer given 0 keeps the map's links); 1: the map's links always.
   double link_share_tau = 0.0;
   // The tau the map's key images were selected with (its key_images.tau; follows the map, FollowMap); 0: not known.
   double map_tau = 0.0;
@@ -362,25 +363,6 @@ struct LocalizerOptions {
   // evidence's bound (the same scene beyond doubt: a hand-held camera that reverses in the same season). Off: the
   // counts and the log10 NFA alone step back (docs/localize.md).
   bool step_back_needs_belief = true;
-  // Guided matching (ORB maps): a frame that verifies nothing at the tracked key images while the belief singles
-  // out that place is matched with them again, and only with them, keeping one-way best matches too (no cross
-  // check); the a-contrario test, which counts every tentative match, decides as before (docs/localize.md,
-  // "Guided matching by the belief"). Off: never.
-  bool guided_matching = true;
-  // Guided matching after the estimate was dropped (`max_lost_frames`): for as many frames again, until a frame is
-  // steered by, a frame that verifies nothing is still matched guided at the key image the tracker last held (or holds
-  // again) and the one after it, whatever the belief (flat by then: nothing verified for frames), and tracked there
-  // when its own guided comparison is accepted; a frame that a ranked key image verifies is relocalized first
-  // (docs/localize.md). Off: a dropped estimate is only relocalized.
-  bool guided_while_lost = true;
-  // Guided relocalization: a tracked frame that verifies nothing at the tracked key images, guided there too, and whose
-  // relocalization verifies nothing either, is matched guided with the ranking's best key images
-  // (relocalization_candidates of them) whose first comparison verified the link share, and relocalized again on what
-  // chance accepts of them. The a-contrario test decides as for every guided comparison, and a place far from the
-  // tracked estimate still needs two frames (TakesJump). A robot carried back (corridor_conditions' kidnapped run,
-  // repeat frames 22-24) is relocalized frames sooner (docs/measurements/localization-conditions.md, "A lost frame's
-  // relocalization is matched guided"). Off: a lost frame's relocalization compares the cross-checked matches only.
-  bool guided_relocalization = true;
   // A lost frame steps on where its own weak evidence agrees (ORB maps): a frame that nothing verifies, relocalized or
   // guided, right after a frame placed (tracking or relocalized) at the tracked key image, moves on to the key image
   // after it when the frame's ranking puts that key image first and its heading mode holds more votes there than at any
@@ -463,95 +445,6 @@ struct LocalizerOptions {
   // localization-conditions.md, "Fewer iterations for the comparisons away from the tracker"). 0: every comparison
   // with the verifier's.
   int far_comparison_iterations = 2000;
-  // Guided matching over the lookahead: it asks the tracked key image and the `lookahead` key images after it (the
-  // tracker's own reach), and ranks what it accepts by a measure common to the key images asked: those chance accepts
-  // by their verified matches (as the tracker ranks), and when chance accepts none, those the continuity of the heading
-  // or the window accepted by the log10 NFA of their one-way guided matches, the one test made the same way at each
-  // key image (the verified counts of those two tests are not comparable with each other: the window's come from
-  // features extracted again). A robot that passes a key image a frame (corridor_conditions frames 97-99) is otherwise
-  // held one key image behind by a comparison the continuity accepts. Off: the key image and the next one only,
-  // ranked by verified matches.
-  bool guided_lookahead = true;
-  // The continuity of the heading (guided matching only): a guided comparison chance refuses is accepted when the
-  // frame moves as the previous frame did against the same key image. At least `continuity_share` of its tentative
-  // matches move by the previous frame's heading against that key image (within 1/40 of the image's width across,
-  // 1/20 of its height up or down: a robot turns slowly, chance matches have no reason to), its first comparison's
-  // heading mode holds at least `continuity_heading_confidence` of its matches and that comparison's log10 NFA is at
-  // most `continuity_max_log10_nfa`. Measured against wrong key images with the prediction a run would have there
-  // (docs/localize.md, "Continuity of the heading"). 0 share: never.
-  double continuity_share = 0.18;
-  double continuity_heading_confidence = 0.43;
-  double continuity_max_log10_nfa = 7.5;
-  // Matching guided by the prediction (guided matching only, where the continuity rule did not accept): the frame's
-  // features extracted again (FAST threshold `window_fast_threshold`, `window_features` of them; 0: the map's) and
-  // matched with the key image only within a window around the previous frame's heading against it
-  // (features/orb_matcher.h, MatchOrbInWindow: `window_width` of the image's width across and 1/20 of its height up
-  // or down, both widened by `window_zoom` times the feature's distance from the image's centre; pyramid levels at
-  // most 1 apart, Hamming distance at most 64, ratio 0.9 among the window's candidates). Accepted when the a-contrario
-  // count of those matches is at most `window_max_log10_nfa` and the first comparison passes the continuity rule's
-  // guards (continuity_heading_confidence, continuity_max_log10_nfa). Such matches agree with the prediction by
-  // construction, so that count is no chance: the threshold was measured against wrong key images with the prediction
-  // a run would have there (docs/localize.md, "Matching guided by the prediction"). Off: never.
-  bool window_matching = true;
-  double window_width = 0.1;
-  double window_zoom = 0.15;
-  int window_fast_threshold = 7;
-  int window_features = 1000;
-  double window_max_log10_nfa = -1.5;
-  // The key image the run starts at (a teach-and-repeat robot starts where the teach run started: the route's
-  // first key image), or -1: anywhere (the first frame is relocalized over the whole route). The tracker starts
-  // there and the belief holds `start_mass` there (the rest spread over the route as a flat belief): a soft prior,
-  // which the frames' evidence overrides when the run starts elsewhere (docs/localize.md, "The start"). 0.8 rather
-  // than 0.5: XFeat's first frames across lighting weigh far key images too, and half the belief did not keep them
-  // near the start (corridor_conditions frames 5-6; a run started elsewhere pays a frame or two more of doubt).
-  int start_key = -1;
-  double start_mass = 0.8;
-  // The start key image is a hint, not evidence: a frame is `uncertain`, not steered by, where the belief the frames'
-  // evidence alone would hold (the same comparisons, weighed from a flat start) singles out a place more than two key
-  // images from it and holds less than min_confidence near it. The start's prior lends confidence where the frames do
-  // not tell, never against what they tell: a robot started elsewhere than `start_key` says is not steered by the
-  // start key image's neighbours while its frames point elsewhere (docs/localize.md, "The start is a hint"). Without
-  // `start_key` both beliefs are one. Off: the start's prior alone decides.
-  bool start_is_hint = true;
-  // With start_is_hint, a frame is also `uncertain` while the start is unconfirmed where the frames' evidence alone
-  // holds less near its key image than a flat belief would: the frames weigh against the place, and only the start's
-  // prior holds it there. Across lighting a chance match near the start key image is accepted now and then, and the
-  // prior made it confident (corridor_conditions from repeat frame 20 with ORB: frame 23 steered by key image 1, teach
-  // frame 4; docs/localize.md, "The start needs the frames' evidence"). Only on routes where a key image and the two
-  // either side hold at most half the key images (as a place can be singled out there). Off: only a place the
-  // evidence singles out elsewhere makes the frame uncertain.
-  bool start_needs_evidence = true;
-  // With start_is_hint and float descriptors (XFeat), while the start is unconfirmed a frame placed (tracking or
-  // relocalized) is also `uncertain`, and does not confirm the start, where a key image more than two route positions
-  // from its place verified at least as many matches as its own accepted key images, or weighs at least as much by the
-  // evidence model: one the frame compared, or else the best-ranked key image that far, compared for this question
-  // alone (not weighed: the belief and the tracker are as without the rule). Across lighting XFeat verifies as much at
-  // corridor_conditions' look-alike stretches as at the right key images, and a run started elsewhere has no run of
-  // frames behind it to tell them apart: over the verifier's seeds 0-11 the runs started elsewhere had 16 frames
-  // steered by more than 2 key images off, 9 with the rule (7 of them placed so before the start was confirmed; none
-  // new), at the price of 23 right frames uncertain in 48 runs (docs/measurements/localization-conditions.md, "A run
-  // started elsewhere confirms a place that stands out"). Only on routes where a key image and the two either side
-  // hold at most half the route (as start_needs_evidence). Off: a frame confirms the start by the beliefs alone.
-  bool start_place_stands_out = true;
-  // With start_is_hint and float descriptors (XFeat), while the start is unconfirmed a frame placed without being
-  // ranked (the tracker's) weighs the frames' evidence alone (not the belief: the tracker is as without it) by its
-  // ranking, as a ranked frame weighs both: that evidence otherwise holds a tracked frame's comparisons only where the
-  // tracker compared them, and a tracker moved to a look-alike by a guess pulls it there. The corridor from repeat
-  // frame 90 at the verifier's seed 12: frame 92 tracked at key image 13 (right: 28-30) swung it from 28 to 12 and
-  // confirmed the start 15 key images off, frames 92-94 steered by there; with it they are uncertain. Over the
-  // verifier's seeds 0-15 on the runs started elsewhere, frames steered by more than 2 key images off 10 -> 7, none
-  // new, 63 of 64 CSVs the same (docs/measurements/localization-conditions.md, "A start confirmed at a look-alike is
-  // asked by the frame's ranking"). Only on routes where a key image and the two either side hold at most half the
-  // route (as start_needs_evidence). Off: the frames' evidence weighs a tracked frame by its comparisons alone.
-  bool start_evidence_ranks_frame = true;
-  // With start_is_hint and float descriptors (XFeat), while the start is unconfirmed a frame placed more than two route
-  // positions from the start key image is also `uncertain`, and does not confirm the start, where the belief holds less
-  // than this near it: a place away from where the user said the run starts must win the belief, not half of it. Two
-  // dark frames confirmed corridor_conditions' corridor from repeat frame 50 at key image 29 (right: 13-15) with
-  // 0.61-0.73 (the verifier's seeds 22 and 35); right starts away held 0.70-1.0, 4 of 118 below 0.9 (seeds 0-39;
-  // docs/measurements/localization-conditions.md, "A start away from the start key image needs the belief"). Only where
-  // a key image and the two either side hold at most half the route (as start_needs_evidence). 0: off.
-  double start_away_min_confidence = 0.9;
   // Lost frames in a row (each one also failed to relocalize) after which the estimate is dropped: key and
   // next_key then read -1 until a frame is relocalized.
   int max_lost_frames = 5;
