@@ -52,9 +52,14 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
       keys_(keys),
       matcher_(matcher),
       options_(std::move(options)),
+      comparer_(keys, matcher, options_),
+      continuity_(options_),
       belief_(std::max<int>(1, options_.route.empty() ? map.key_images.size() : options_.route.size()),
               options_.belief),
-      evidence_belief_(belief_) {
+      evidence_belief_(belief_),
+      comparisons_([this](const ImageFeatures& features,
+                          int key) { return Compare(features, key, FarComparisonIterations(key)); },
+                   options_.comparison_threads - 1) {
   options_.Check();
   const int num_keys = static_cast<int>(map_.key_images.size());
   if (num_keys == 0) throw InputError("the map has no key images; nothing to localize against");
@@ -80,7 +85,6 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   CheckStartKey(map_, options_);
   if (options_.start_key >= 0) start_position_ = route_position_of_key_[options_.start_key];
   link_verified_.assign(num_keys, 0);
-  share_reference_.assign(num_keys, 0);  // before the comparisons below, which read it
   scene_link_after_.assign(route_.size(), false);
   std::vector<std::optional<SharedByKeys>> link_after(route_.size());
   for (const Link& link : map_.links) {
@@ -103,7 +107,7 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   const auto compare = [&](int p, int q) -> std::optional<SharedByKeys> {
     const ImageFeatures& from = *keys_.features[route_[p]];
     const ImageFeatures& to = *keys_.features[route_[q]];
-    const KeyComparison c = CompareImage(from, to, matcher_.Match(from, to), route_[q]);
+    const KeyComparison c = comparer_.CompareImage(from, to, matcher_.Match(from, to), route_[q]);
     if (!c.matched) return std::nullopt;
     return SharedByKeys{c.similarity, c.num_verified};
   };
@@ -112,10 +116,12 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   const std::vector<int> spaced = denser ? LinkShareReference(link_after, compare, options_.link_share_tau,
                                                               kLinkShareReach, options_.comparison_threads)
                                          : links;
+  std::vector<int> share_reference(num_keys, 0);
   for (size_t p = 0; p < route_.size(); ++p) {
     link_verified_[route_[p]] = links[p];
-    share_reference_[route_[p]] = spaced[p];
+    share_reference[route_[p]] = spaced[p];
   }
+  comparer_.SetShareReference(std::move(share_reference));
   // Only the route's key images take part in the ranking.
   std::vector<std::shared_ptr<const ImageFeatures>> features;
   std::vector<cv::Mat> thumbnails;
@@ -161,11 +167,6 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
   // So do the questions of a frame that may have been carried off (SceneChangedSinceFrameBefore).
   const bool asks_scene_change = !binary && options_.scene_change_log10_nfa < 0.0;
   keeps_features_before_ = (steps_on_next && options_.still_frame_share > 0.0) || asks_scene_change;
-  if (options_.comparison_threads > 1) {
-    speculation_ = std::make_unique<SpeculativeComparisons>(
-        [this](const ImageFeatures& features, int key) { return Compare(features, key, FarComparisonIterations(key)); },
-        options_.comparison_threads - 1);
-  }
   std::vector<int> route_source_indices;
   std::vector<double> route_timestamps;
   for (const int k : route_) {
@@ -229,27 +230,23 @@ void Localizer::Reset() {
   dropped_position_ = -1;
   frames_since_drop_ = 0;
   step_back_ruled_out_ = {};
-  previous_headings_.clear();
-  heading_before_is_a_guess_ = false;
+  continuity_.Reset();
 }
 
 LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& features,
                                        std::vector<KeyComparison> ahead) {
   const auto start = std::chrono::steady_clock::now();
   // The comparisons made meanwhile read `features`: those not taken are done with before the frame is.
-  struct FinishSpeculation {
-    SpeculativeComparisons* speculation;
-    ~FinishSpeculation() {
-      if (speculation) speculation->Finish();
-    }
-  } finish_speculation{speculation_.get()};
-  comparisons_.clear();
+  struct FinishComparisons {
+    FrameComparisons& comparisons;
+    ~FinishComparisons() { comparisons.Finish(); }
+  } finish_comparisons{comparisons_};
   frame_start_position_ = position_;
   // The comparisons made ahead verified in full: those the frame verifies with fewer iterations are made again.
   ahead.erase(std::remove_if(ahead.begin(), ahead.end(),
                              [&](const KeyComparison& c) { return FarComparisonIterations(c.key) > 0; }),
               ahead.end());
-  made_ahead_ = std::move(ahead);
+  comparisons_.Begin(std::move(ahead));
   ranked_.clear();
   bucket_of_position_.clear();
   const int motion_steps = pace_.Steps(frame.source_index, frame.timestamp, frame.odometry);
@@ -282,17 +279,13 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
                         return m.comparison.key != result.key && FitsBetter(m.comparison, result.to_key);
                       }));
   }
-  previous_headings_.clear();
   // A guess must not be tracked from: after an uncertain frame that moved the estimate more than kNear (a
   // relocalization the belief doubts, such as one chance refused), the continuity would accept the next frame at the
   // guessed place on the guess's own heading there; the frames after it confirm or refute the place on evidence chance
   // weighs (docs/measurements/localization-conditions.md, "A guess chance refused is not tracked from").
-  heading_before_is_a_guess_ = result.status == LocalizationStatus::kUncertain && position_ >= 0 &&
-                               frame_start_position_ >= 0 && std::abs(position_ - frame_start_position_) > kNear;
-  for (const Memo& m : comparisons_) {
-    if (std::isfinite(m.comparison.heading.px))
-      previous_headings_.emplace_back(m.comparison.key, m.comparison.heading.px);
-  }
+  continuity_.Remember(comparisons_, result.status == LocalizationStatus::kUncertain && position_ >= 0 &&
+                                         frame_start_position_ >= 0 &&
+                                         std::abs(position_ - frame_start_position_) > kNear);
   placed_before_ = IsPlaced(result.status) ? result.route_position : -1;
   placed_in_a_row_ = IsPlaced(result.status) ? placed_in_a_row_ + 1 : 0;
   RememberMoveBack(result);
@@ -307,7 +300,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   result.source_index = frame.source_index;
   result.timestamp = frame.timestamp;
   result.source_name = frame.source_name;
-  if (speculation_) speculation_->Finish();
+  comparisons_.Finish();
   result.seconds = SecondsSince(start);
   return result;
 }
@@ -323,10 +316,10 @@ std::vector<int> Localizer::LikelyKeys() const {
 void Localizer::Describe(LocalizationResult& result, int position, const ImageFeatures& features) {
   result.route_position = position;
   result.key = route_[position];
-  result.to_key = CompareOnce(features, result.key);
+  result.to_key = comparisons_.Once(features, result.key);
   const bool at_end = position + 1 >= static_cast<int>(route_.size());
   result.next_key = at_end ? -1 : route_[position + 1];
-  result.to_next = at_end ? KeyComparison() : CompareOnce(features, result.next_key);
+  result.to_next = at_end ? KeyComparison() : comparisons_.Once(features, result.next_key);
   KeyComparison& target = at_end ? result.to_key : result.to_next;
   AddPose(target);
   result.heading_px = target.heading.px;

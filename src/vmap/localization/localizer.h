@@ -31,8 +31,11 @@
 #include <vector>
 
 #include "vmap/features/matcher.h"
+#include "vmap/localization/frame_comparisons.h"
+#include "vmap/localization/heading_continuity.h"
 #include "vmap/localization/key_bracket.h"
 #include "vmap/localization/key_comparison.h"
+#include "vmap/localization/key_image_comparer.h"
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/localization/key_image_store.h"
 #include "vmap/localization/link_share_reference.h"
@@ -42,7 +45,6 @@
 #include "vmap/localization/motion_pace.h"
 #include "vmap/localization/route_belief.h"
 #include "vmap/localization/route_evidence.h"
-#include "vmap/localization/speculative_comparisons.h"
 #include "vmap/map/visual_map.h"
 #include "vmap/sources/frame_source.h"
 
@@ -73,16 +75,17 @@ class Localizer {
   // The key images the next frame will most likely be compared with: `key` and `next_key` of the current
   // estimate (none without an estimate).
   std::vector<int> LikelyKeys() const;
-  // The frame's features against key image `key`, as Localize compares them, its verifier's iterations at most
-  // `max_iterations` where above 0 (as Localize verifies those away from the tracker: FarComparisonIterations).
-  // Thread-safe (const, and the matcher's Match and the verifier are), so frames can be compared ahead on other
-  // threads.
-  KeyComparison Compare(const ImageFeatures& features, int key, int max_iterations = 0) const;
+  // The frame's features against key image `key`, as Localize compares them (KeyImageComparer), its verifier's
+  // iterations at most `max_iterations` where above 0 (as Localize verifies those away from the tracker:
+  // FarComparisonIterations). Thread-safe, so frames can be compared ahead on other threads.
+  KeyComparison Compare(const ImageFeatures& features, int key, int max_iterations = 0) const {
+    return comparer_.Compare(features, key, max_iterations);
+  }
 
   // Adds the relative pose, its translation sigma and whether the translation is known to a comparison of
   // the teach key image (experience 0) that matched, when the options have a camera. Localize does it for the
   // target comparison of each result.
-  void AddPose(KeyComparison& comparison) const;
+  void AddPose(KeyComparison& comparison) const { comparer_.AddPose(comparison); }
 
   // The teach run's odometry (its samples on the key images' clock): where a frame has odometry too (Frame::odometry),
   // the motion model moves by the distance driven since the frame before against the teach odometry's distance
@@ -97,17 +100,11 @@ class Localizer {
   RankingMethod ranking_method() const { return ranking_->method(); }
 
  private:
-  // The frame against one image of key image `key` (the key image itself or a view), from their matches.
-  KeyComparison CompareImage(const ImageFeatures& features, const ImageFeatures& image, const TentativeMatches& matches,
-                             int key, int max_iterations = 0) const;
   // The verifier's iterations for the frame's comparison with key image `key` (LocalizerOptions::
   // far_comparison_iterations): the cap for a key image away from the tracker's, 0 (the verifier's own) otherwise.
   int FarComparisonIterations(int key) const;
-  // Each key image is compared with a frame at most once per Localize call.
-  KeyComparison CompareOnce(const ImageFeatures& features, int key);
-  // The frame's comparisons with the key images at route `positions` (those on the route, not compared yet), which
-  // it is about to make, in that order: made meanwhile on the other comparison threads (speculation_), CompareOnce
-  // takes them.
+  // The frame's comparisons with the key images at route `positions` (those on the route), which it is about to make,
+  // in that order: made meanwhile on the other comparison threads (FrameComparisons::Meanwhile).
   void CompareMeanwhile(const ImageFeatures& features, const std::vector<int>& positions);
   // Guided matching (LocalizerOptions::guided_matching): the frame matched again with guided_matcher_ at route
   // `position` and the `lookahead` after it (guided_lookahead; else the one after it), the belief singling out that
@@ -159,22 +156,6 @@ class Localizer {
   int RankingFirst() const;
   // The route position of the key image whose comparison holds the most heading votes, strictly; -1: none.
   int HeadingMode() const;
-  // The previous frame's heading (px) against key image `key`; none when that frame was not compared with it.
-  std::optional<double> PreviousHeading(int key) const;
-  // The continuity of the heading (LocalizerOptions::continuity_share): `guided`, the guided matches of the frame
-  // with a key image whose first comparison is `first`, move by `predicted_dx`, the previous frame's heading against
-  // that key image.
-  bool HoldsContinuity(const KeyComparison& first, const TentativeMatches& guided, double predicted_dx,
-                       cv::Size size) const;
-  // The first comparison's heading mode and log10 NFA are within the continuity rule's guards
-  // (continuity_heading_confidence, continuity_max_log10_nfa).
-  bool PassesContinuityGuards(const KeyComparison& first) const;
-  // Matching guided by the prediction (LocalizerOptions::window_matching): the frame (`window_features`:
-  // window_matcher_'s features of it, or the frame's own; `size`, its size) against key image `key`, matched only
-  // within the window around `predicted_dx`, the previous frame's heading against it; accepted by
-  // window_max_log10_nfa.
-  KeyComparison CompareInWindow(const ImageFeatures& window_features, int key, double predicted_dx,
-                                cv::Size size) const;
   LocalizationResult Track(const Frame& frame, const ImageFeatures& features);
   // The frame tracked at route `position`, the estimate having been at `from`.
   LocalizationResult TrackedAt(LocalizationResult result, int from, int position, const ImageFeatures& features);
@@ -321,7 +302,7 @@ class Localizer {
   // is accepted.
   int AcceptAgainstRivals(const Frame& frame, const ImageFeatures& features);
 
-  // A tracked comparison: CompareOnce, and when only the link share refuses it, judged against the frame's rivals
+  // A tracked comparison: comparisons_.Once, and when only the link share refuses it, judged against the frame's rivals
   // as a relocalized one is (AcceptAgainstRivals), on its own: at least min_rival_ratio times the verified matches of
   // every key image compared more than kNear route positions from it, the best-ranked such one among them (compared
   // now when it was not). Accepted so, it stays accepted for the rest of the frame.
@@ -406,8 +387,6 @@ class Localizer {
   // NFA is at most `from`'s, both clamped at the evidence's bound (-max_significance), beyond which both are the same
   // scene beyond doubt (LocalizerOptions::step_back_needs_lower_nfa, step_on_needs_lower_nfa).
   bool NoLikelierChance(const KeyComparison& to, const KeyComparison& from) const;
-  // The verified matches a comparison with key image `key` needs by the link share (min_link_share).
-  double LinkShareBar(int key) const { return options_.min_link_share * share_reference_[key]; }
   // A tracked comparison shares less with its key image than the map's links do (recheck_link_share).
   bool SharesLittle(const KeyComparison& comparison) const;
 
@@ -437,17 +416,18 @@ class Localizer {
   std::unique_ptr<Matcher> lost_frame_matcher_;
   std::vector<std::shared_ptr<const ImageFeatures>> lost_frame_key_features_;
   LocalizerOptions options_;
+  // How the frame is compared with a key image, and what the acceptance's link share measures each key image against
+  // (LocalizerOptions::link_share_tau): link_verified_, or on a map denser than that tau spaces its key images, its
+  // links as a map of that tau would hold them. The recheck and the evidence keep link_verified_: on a map of every
+  // frame a frame tracked with less than its near-duplicate links share is still asked whether a key image on verifies
+  // more (the tracker lags a key image a frame otherwise).
+  KeyImageComparer comparer_;
+  HeadingContinuity continuity_;  // the previous frame's headings, which guided matching predicts the frame's by
   std::vector<int> route_;
   std::vector<int> route_position_of_key_;  // -1 for key images off the route
   // Per key image: the verified matches of its link with a route neighbour, the smaller of the two; 0 when it
   // has no verified link on the route (the comparisons against the map's links are then skipped).
   std::vector<int> link_verified_;
-  // Per key image: what the acceptance's link share measures against (LocalizerOptions::link_share_tau):
-  // link_verified_, or on a map denser than that tau spaces its key images, its links as a map of that tau would hold
-  // them. The recheck and the evidence keep link_verified_: on a map of every frame a frame tracked with less than its
-  // near-duplicate links share is still asked whether a key image on verifies more (the tracker lags a key image a
-  // frame otherwise).
-  std::vector<int> share_reference_;
   // Per route position p: the map's link between p and p + 1 is of one scene (its verified matches pass chance, as a
   // comparison's must). A --tau 1 map of unrelated places has links chance refuses; a teach run's are of one scene.
   std::vector<bool> scene_link_after_;
@@ -534,26 +514,9 @@ class Localizer {
   // tracked estimate); -1: none.
   int stepped_back_from_ = -1;
   EvidenceModel evidence_;  // by the kind of the matcher's descriptors
-  struct Memo {
-    KeyComparison comparison;
-    bool weighed = false;         // its evidence is in the belief
-    bool weighed_ranked = false;  // weighed given the frame's ranking (EvidenceModel::rank_alone)
-    // Accepted by its heading mode against the frame's rivals (HeadingStandsOut), and weighed as such
-    // (EvidenceModel::heading_stands_out).
-    bool by_heading = false;
-    bool weighed_by_heading = false;
-  };
-  std::vector<Memo> comparisons_;  // of the frame being localized, in the order CompareOnce was asked for them
+  using Memo = FrameComparisons::Memo;
   static const KeyComparison& ComparisonOf(const Memo& memo) { return memo.comparison; }
   static const KeyComparison& ComparisonOf(const KeyComparison& comparison) { return comparison; }
-  // Comparisons of the frame made before it reached Localize (`ahead`), which CompareOnce takes when it asks for them:
-  // which ones there are depends on the workers' timing, so they enter comparisons_ only then.
-  std::vector<KeyComparison> made_ahead_;
-  // The previous frame's headings (px) against the key images it was compared with: (key, heading), those with one.
-  std::vector<std::pair<int, double>> previous_headings_;
-  // The previous frame was uncertain and moved the estimate more than kNear: its headings are a guess's, which the
-  // continuity does not hold this frame to.
-  bool heading_before_is_a_guess_ = false;
   std::vector<RankedKey> ranked_;  // the route ranked for the frame being localized (RankRoute); empty: not yet
   // The frame's ranking weighs the belief (WeighRanking): each route position's bucket in it (RankingBuckets); empty:
   // not yet.
@@ -562,9 +525,9 @@ class Localizer {
   // not), on this frame and the one before (RouteBeliefOptions::move_needs_two_frames).
   int confident_peak_ = -1;
   int confident_peak_before_ = -1;
-  // Comparisons of the frame being localized made meanwhile on helper threads (CompareMeanwhile); null with one
-  // comparison thread. Last: stopped before the members its comparisons read are destroyed.
-  std::unique_ptr<SpeculativeComparisons> speculation_;
+  // The frame's comparisons, each made once (made meanwhile on comparison_threads - 1 helper threads). Last: its
+  // helpers are stopped before the members their comparisons read are destroyed.
+  FrameComparisons comparisons_;
 };
 
 }  // namespace vmap

@@ -201,7 +201,7 @@ void Localizer::SettleStepOn(LocalizationResult& result, const ImageFeatures& fe
   // one scene: that one, now `next_key`, verifies, and the frame is on the segment between them (not between two
   // unrelated places: a --tau 1 map's).
   const bool hold = options_.hold_unearned_step_on && scene_link_after_[passed];
-  if (!back || (!hold && !CompareOnce(features, route_[passed]).accepted)) return;
+  if (!back || (!hold && !comparisons_.Once(features, route_[passed]).accepted)) return;
   MoveTrackerTo(result, passed, LocalizationStatus::kTracking, features);
 }
 
@@ -223,7 +223,7 @@ void Localizer::SettleStepBack(LocalizationResult& result, const ImageFeatures& 
   // step back is not traded for an uncertain frame.
   const bool undo = p[left] > before_reached && p[left] > 1.0 / static_cast<double>(p.size()) &&
                     belief_.MassWithin(left, kNear) >= options_.belief.min_confidence;
-  if (!undo || !CompareOnce(features, route_[left]).accepted) return;
+  if (!undo || !comparisons_.Once(features, route_[left]).accepted) return;
   MoveTrackerTo(result, left, LocalizationStatus::kTracking, features);
 }
 
@@ -250,7 +250,7 @@ void Localizer::StepOnByBelief(LocalizationResult& result, const ImageFeatures& 
     // At key image q the frame is on segment q - 1 or q; past key image q + 1, on q + 1 or after (the belief's mass on
     // as many positions each side: LocalizerOptions::step_on_by_belief_ahead).
     if (mass(q + 1, q + 1 + options_.step_on_by_belief_ahead) <= mass(q - 1, q + 1)) break;
-    if (!CompareOnce(features, route_[q + 1]).accepted) break;
+    if (!comparisons_.Once(features, route_[q + 1]).accepted) break;
     to = q + 1;
   }
   if (to == from) return;
@@ -273,7 +273,7 @@ void Localizer::Question(LocalizationResult& result, const Frame& frame, const I
     for (int q = std::min(last, centre + window + 1); q > std::max(0, centre - window); --q) meanwhile.push_back(q);
     CompareMeanwhile(features, meanwhile);
     for (int q = std::max(0, centre - window); q <= std::min(last, centre + window + 1); ++q) {
-      CompareOnce(features, route_[q]);
+      comparisons_.Once(features, route_[q]);
     }
     WeighComparisons();
   };

@@ -24,7 +24,7 @@ void Localizer::LookPastWeakNext(const Frame& frame, const ImageFeatures& featur
   // look-alikes of repeat frames 20-34) and repeat frame 30 was steered by there, 3 key images behind the right 7-8
   // (the verifier's seeds 8, 9 and 14; docs/measurements/localization-conditions.md, "A tracker held at a look-alike
   // looks past a weak next key image"). The route goes forwards: a tracker held behind falls further behind.
-  if (PassesChance(CompareOnce(features, route_[next]), kBeyondLittleChance)) return;
+  if (PassesChance(comparisons_.Once(features, route_[next]), kBeyondLittleChance)) return;
   const KeyComparison beyond = CompareTracked(frame, features, past);
   // Stepped on to only where it verifies clearly (look_past_max_log10_nfa): at corridor_conditions' repeat frames 90-94
   // key image 31 (teach frame 101) verifies 22-28 matches at -10.2 to -11.5 past the weak key image 30, and the tracker

@@ -34,7 +34,7 @@ std::vector<int> Localizer::CompareBestRanked(const Frame& frame, const ImageFea
   CompareMeanwhile(features, meanwhile);
   for (int i = 0; i < count; ++i) {
     positions.push_back(ranked_[i].key);  // the ranking holds the route's key images in route order
-    CompareOnce(features, route_[ranked_[i].key]);
+    comparisons_.Once(features, route_[ranked_[i].key]);
   }
   return positions;
 }
@@ -49,7 +49,7 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
   std::vector<KeyComparison> compared;
   for (size_t i = 0; i < positions.size(); ++i) {
     const int position = positions[i];
-    compared.push_back(CompareOnce(features, route_[position]));
+    compared.push_back(comparisons_.Once(features, route_[position]));
     const KeyComparison& c = compared.back();
     result.candidates.push_back(
         {route_[position], ranked_[i].score, c.accepted, c.similarity, c.num_verified, c.log10_nfa});
@@ -70,7 +70,7 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
   }
   if (best_position < 0 && standout >= 0) {
     best_position = standout;
-    best = CompareOnce(features, route_[standout]);
+    best = comparisons_.Once(features, route_[standout]);
   }
   if (best_position < 0) {
     result.status = LocalizationStatus::kLost;
@@ -84,9 +84,9 @@ LocalizationResult Localizer::Relocalize(const Frame& frame, const ImageFeatures
   // The segment before the key image only where the two share a scene: a frame is not between two unrelated places.
   if (position > 0 && scene_link_after_[position - 1]) {
     CompareMeanwhile(features, {position + 1});
-    const KeyComparison before = CompareOnce(features, route_[position - 1]);
+    const KeyComparison before = comparisons_.Once(features, route_[position - 1]);
     const bool has_next = position + 1 < static_cast<int>(route_.size());
-    const KeyComparison after = has_next ? CompareOnce(features, route_[position + 1]) : KeyComparison();
+    const KeyComparison after = has_next ? comparisons_.Once(features, route_[position + 1]) : KeyComparison();
     if (before.accepted && (!has_next || !after.accepted)) {
       position -= 1;
     } else if (before.accepted) {
@@ -123,7 +123,7 @@ Localizer::SecondLook Localizer::CompareLostFrameAgain(const Frame& frame, const
       return std::nullopt;
     }
     if (!more) more = lost_frame_matcher_->ExtractFrame(frame.gray, frame.color);
-    compared.push_back(CompareImage(*more, *key_image, lost_frame_matcher_->Match(*more, *key_image), key));
+    compared.push_back(comparer_.CompareImage(*more, *key_image, lost_frame_matcher_->Match(*more, *key_image), key));
     return compared.back();
   });
   return by_chance ? SecondLook::kAccepted : AcceptLostFrameByHeading(compared, features);

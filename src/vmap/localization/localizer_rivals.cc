@@ -28,7 +28,7 @@ int Localizer::RivalVerified(const Frame& frame, const ImageFeatures& features, 
   // a relocalization makes five).
   for (const RankedKey& r : RankRoute(frame, features)) {
     if (std::abs(r.key - position) > kNear) {
-      CompareOnce(features, route_[r.key]);  // the ranking holds the route's key images in route order
+      comparisons_.Once(features, route_[r.key]);  // the ranking holds the route's key images in route order
       break;
     }
   }
@@ -66,7 +66,7 @@ bool Localizer::HeadingMayStandOut(const KeyComparison& comparison) const {
   // its scene from elsewhere, and the scene's matches agree there too (redkitchen's teach/repeat run: 2 -> 57 frames
   // steered by wrong when the heading overrode the share).
   return comparison.matched && comparison.heading.votes >= options_.min_heading_votes &&
-         comparison.num_verified >= LinkShareBar(comparison.key);
+         comparison.num_verified >= comparer_.LinkShareBar(comparison.key);
 }
 
 bool Localizer::HeadingStandsOut(const Frame& frame, const ImageFeatures& features, const KeyComparison& comparison,
@@ -78,7 +78,7 @@ bool Localizer::HeadingStandsOut(const Frame& frame, const ImageFeatures& featur
   // The likeliest other place, as the frame's descriptors tell, is always among the rivals.
   for (const RankedKey& r : RankRoute(frame, features)) {
     if (IsHeadingRival(position, r.key)) {
-      CompareOnce(features, route_[r.key]);  // the ranking holds the route's key images in route order
+      comparisons_.Once(features, route_[r.key]);  // the ranking holds the route's key images in route order
       break;
     }
   }
@@ -106,7 +106,7 @@ int Localizer::AcceptByHeading(const Frame& frame, const ImageFeatures& features
 
 KeyComparison Localizer::CompareTracked(const Frame& frame, const ImageFeatures& features, int position) {
   const int key = route_[position];
-  KeyComparison c = CompareOnce(features, key);
+  KeyComparison c = comparisons_.Once(features, key);
   if (c.accepted) return c;
   // Refused: its rivals are compared now, and Track's key images after the tracked one and before it meanwhile.
   std::vector<int> tracked;
@@ -128,12 +128,12 @@ KeyComparison Localizer::CompareTracked(const Frame& frame, const ImageFeatures&
 
 bool Localizer::AcceptedAgainstRivals(const KeyComparison& comparison) const {
   return comparison.accepted && options_.acceptance == AcceptanceRule::kChance &&
-         comparison.num_verified < LinkShareBar(comparison.key);
+         comparison.num_verified < comparer_.LinkShareBar(comparison.key);
 }
 
 int Localizer::AcceptAgainstRivals(const Frame& frame, const ImageFeatures& features) {
   auto position_of = [&](const Memo& m) { return route_position_of_key_[m.comparison.key]; };
-  int best = -1;  // index in comparisons_ (CompareOnce below may grow it)
+  int best = -1;  // index in comparisons_ (comparisons_.Once below may grow it)
   for (size_t i = 0; i < comparisons_.size(); ++i) {
     const Memo& m = comparisons_[i];
     if (position_of(m) < 0) continue;
@@ -154,7 +154,7 @@ void Localizer::CompareRivalPlace(const LocalizationResult& result, const ImageF
   const bool steered = IsPlaced(result.status);
   if (!options_.rival_place_when_not_steered || steered || rival_place_ < 0) return;
   const int last = static_cast<int>(route_.size()) - 1;
-  for (int q = rival_place_; q <= std::min(last, rival_place_ + 1); ++q) CompareOnce(features, route_[q]);
+  for (int q = rival_place_; q <= std::min(last, rival_place_ + 1); ++q) comparisons_.Once(features, route_[q]);
 }
 
 void Localizer::RememberRivalPlace(const LocalizationResult& result) {

@@ -160,7 +160,7 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   bool rival_beats = false;
   if (rival_place_ >= 0 && std::abs(rival_place_ - best_position) > kNear) {
     for (int q = rival_place_; q <= std::min(last, rival_place_ + 1); ++q) {
-      const KeyComparison c = CompareOnce(features, route_[q]);
+      const KeyComparison c = comparisons_.Once(features, route_[q]);
       if (c.accepted && c.num_verified > best.num_verified) rival_beats = true;
     }
   }
