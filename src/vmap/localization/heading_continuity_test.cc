@@ -63,8 +63,8 @@ TEST(HeadingContinuity, HoldsWhenEnoughMatchesMoveAsPredictedAndTheFirstComparis
   // The guards: the first comparison's heading mode and its chance.
   EXPECT_FALSE(continuity.Holds(WithHeading(1, 30.0, options.continuity_heading_confidence / 2, -3.0),
                                 Moving(30, 30.0, 70), 30.0, size));
-  EXPECT_FALSE(continuity.Holds(WithHeading(1, 30.0, 0.9, options.continuity_max_log10_nfa + 1.0),
-                                Moving(30, 30.0, 70), 30.0, size));
+  EXPECT_FALSE(continuity.Holds(WithHeading(1, 30.0, 0.9, options.continuity_max_log10_nfa + 1.0), Moving(30, 30.0, 70),
+                                30.0, size));
 }
 
 }  // namespace

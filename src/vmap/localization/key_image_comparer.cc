@@ -5,10 +5,10 @@
 #include <utility>
 
 #include "vmap/features/orb_matcher.h"
+#include "vmap/geometry/heading.h"
 #include "vmap/geometry/pose_refinement.h"
 #include "vmap/geometry/relative_pose.h"
 #include "vmap/geometry/translation_evidence.h"
-#include "vmap/geometry/heading.h"
 #include "vmap/localization/acceptance.h"
 #include "vmap/mapping/key_image_selector.h"
 
@@ -47,7 +47,7 @@ KeyComparison KeyImageComparer::Compare(const ImageFeatures& features, int key, 
 }
 
 KeyComparison KeyImageComparer::CompareImage(const ImageFeatures& features, const ImageFeatures& image,
-                                      const TentativeMatches& matches, int key, int max_iterations) const {
+                                             const TentativeMatches& matches, int key, int max_iterations) const {
   // As ComparePair, on matches made already.
   const int denominator = SimilarityDenominator(options_.similarity, static_cast<int>(matches.size()),
                                                 features.num_features(), image.num_features());
@@ -107,7 +107,7 @@ void KeyImageComparer::AddPose(KeyComparison& c) const {
 }
 
 KeyComparison KeyImageComparer::CompareInWindow(const ImageFeatures& window_features, int key, double predicted_dx,
-                                         cv::Size size) const {
+                                                cv::Size size) const {
   MatchWindow window;
   window.predicted_dx = predicted_dx;
   window.half_width = options_.window_width * size.width;
