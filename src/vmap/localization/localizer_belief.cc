@@ -146,8 +146,9 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
     start_unconfirmed_ = false;
   }
   // An uncertain frame's key images are the best guess: the belief's peak when the belief singles it out and holds
-  // more there than near the tracker's key image (the tracker goes on from its own; nothing steers by this frame).
-  // A flat belief's peak is no better a guess than the tracker's (corridor_conditions, docs/localize.md).
+  // more there than near the tracker's key image (the tracker goes on from its own, but from a jump the belief
+  // withholds; nothing steers by this frame). A flat belief's peak is no better a guess than the tracker's
+  // (corridor_conditions, docs/localize.md).
   const int peak = belief_.Peak();
   if (options_.belief.window > 0 && result.status == LocalizationStatus::kUncertain && peak != result.route_position &&
       belief_confident_ && SinglesOut(peak) && belief_.MassWithin(peak, kNear) > result.confidence) {
@@ -158,6 +159,14 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
     guess.belief = std::move(result.belief);
     guess.confidence = belief_.MassWithin(peak, kNear);
     result = std::move(guess);
+    // The tracker jumped on this frame, and the belief withholds the place it jumped to and guesses one nearer where
+    // the run was last steered by: the jump is not taken (jump_needs_belief).
+    if (options_.jump_needs_belief && frame_start_position_ >= 0 && position_ >= 0 && steered_before_ >= 0 &&
+        std::abs(position_ - frame_start_position_) > kNear && std::abs(position_ - peak) > kNear &&
+        std::abs(peak - steered_before_) < std::abs(position_ - steered_before_)) {
+      position_ = peak;
+      step_back_ruled_out_ = {};
+    }
   }
   // Doubted only by the belief before the frame's own ranking (the tracker placed the frame, and the rules above
   // withhold nothing with the ranking): the frame's comparison at its key images passes chance where the belief with

@@ -104,6 +104,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Float descriptors: never relocalize a tracked frame for being tracked from a guess more than two key "
                  "images behind where the last frame steered by was (otherwise it is)"},
                 ask_where_guessed_back);
+  visitor.Visit({"jump_needs_belief", "!--no-jump-needs-belief",
+                 "Keep the tracker where a far relocalization took it though the belief withholds the frame and "
+                 "guesses a place nearer where the run was last steered by (otherwise the tracker goes to the guess)"},
+                jump_needs_belief);
   visitor.Visit({"doubt_jump_back", "!--no-doubt-jump-back",
                  "Float descriptors: place a frame more than two key images behind the tracked estimate even where "
                  "the key images near the estimate verify nearly as much (otherwise it is uncertain)"},
