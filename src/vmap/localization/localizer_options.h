@@ -135,15 +135,8 @@ struct LocalizerOptions : GuidedMatchingOptions, StartOptions {
   // where the frames were is doubted": XFeat's corridor sets over the verifier's seeds 0-11, frames confidently more
   // than 2 key images off 17 -> 11, 69 of 72 CSVs the same). Off: such a frame is placed where it jumped.
   bool doubt_jump_back = true;
-  // A jump the belief withholds is not the tracker's: a frame on which the tracker moved more than two route positions
-  // (a far relocalization taken) and that is `uncertain`, reported at the belief's guess more than
-  // two positions from where the tracker went and nearer the place the run was last steered by, leaves the tracker at
-  // the guess too. Otherwise the tracker goes on from the place the belief refused, and the next frame, compared with
-  // it and the key image after it alone, may be steered by there: after corridor_conditions' dark stretch the route's
-  // end (key images 29-30, whose lens rim matches verify with nearly every frame) took the tracker while the belief
-  // guessed the right key image 15, and frame 55 was steered by at 29 (XFeat, the verifier's seed 256;
-  // docs/measurements/localization-conditions.md, "A jump the belief withholds is not the tracker's"). Off: the tracker
-  // stays where the jump took it.
+  // A jump the belief withholds is not the tracker's: the tracker goes to the belief's guess where that is nearer the
+  // place last steered by (docs/localize.md; seed 256's frame 55). Off: it stays where the jump took it.
   bool jump_needs_belief = true;
   // Float descriptors (XFeat), doubt_jump_back: a jump back is judged from the place the run was last steered by too,
   // not only from the tracked estimate: a frame placed at or ahead of that place (or at most two route positions
