@@ -57,6 +57,8 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
       belief_(std::max<int>(1, options_.route.empty() ? map.key_images.size() : options_.route.size()),
               options_.belief),
       evidence_belief_(belief_),
+      lagging_start_(options_.lagging_tracker_frames, options_.lagging_start_frames),
+      stall_(options_.stalled_tracker_frames, options_.unsettled_stalled_tracker_frames),
       comparisons_([this](const ImageFeatures& features,
                           int key) { return Compare(features, key, FarComparisonIterations(key)); },
                    options_.comparison_threads - 1) {
@@ -155,8 +157,8 @@ Localizer::Localizer(const VisualMap& map, const KeyImageStore& keys, const Matc
       !keys_.directory.empty()) {
     MatcherOptions more = MapOrbOptions(matcher_);
     more.Of<OrbMatcherOptions>().num_features = options_.lost_frame_features;
-    lost_frame_matcher_ = WithCameraMaskOf(matcher_, CreateMatcher(more));
-    lost_frame_key_features_.assign(num_keys, nullptr);
+    lost_frame_matcher_ =
+        std::make_unique<LostFrameMatcher>(WithCameraMaskOf(matcher_, CreateMatcher(more)), map_, keys_.directory);
   }
   // The rules that step a frame on to the next key image ask whether it stands still (StillSinceFrameBefore), and so
   // does the question of a held tracker (a stop holds it).
@@ -214,14 +216,10 @@ void Localizer::Reset() {
   confident_peak_ = confident_peak_before_ = -1;
   rival_place_ = -1;
   rival_frames_left_ = 0;
-  stalled_position_ = -1;
-  stalled_frames_ = 0;
-  frames_since_start_ = 0;
+  stall_.Reset();
+  lagging_start_.Reset();
   pace_.Reset();
-  recent_positions_.clear();
-  stall_bar_ = options_.stalled_tracker_frames;
   placed_in_a_row_ = 0;
-  stall_questioned_ = held_still_ = false;
   position_ = start_position_;
   lost_in_a_row_ = 0;
   placed_before_ = steered_before_ = moved_back_to_ = -1;
@@ -266,8 +264,9 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   QuestionStalledTracker(result, frame, features);
   Believe(result, frame, features);
   DoubtStalledTracker(result);
-  CountStall(result);
-  RememberPace();
+  stall_.Count(result.route_position, IsPlaced(result.status), HeldWhereNextSeesNothing(result), position_,
+               placed_in_a_row_);
+  lagging_start_.Remember(position_);
   RememberWhereDriven(frame_start_position_);
   RememberRivalPlace(result);
   if (IsPlaced(result.status)) {

@@ -22,8 +22,6 @@
 // links, or counts of verified matches and S). A frame tracked with far fewer verified matches than its key
 // image shares with its neighbours is relocalized too, and moved when another key image verifies more.
 
-#include <algorithm>
-#include <deque>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -38,13 +36,16 @@
 #include "vmap/localization/key_image_comparer.h"
 #include "vmap/localization/key_image_ranking.h"
 #include "vmap/localization/key_image_store.h"
+#include "vmap/localization/lagging_start.h"
 #include "vmap/localization/link_share_reference.h"
 #include "vmap/localization/localization_result.h"
 #include "vmap/localization/localizer_options.h"
+#include "vmap/localization/lost_frame_matcher.h"
 #include "vmap/localization/map_verifier_options.h"
 #include "vmap/localization/motion_pace.h"
 #include "vmap/localization/route_belief.h"
 #include "vmap/localization/route_evidence.h"
+#include "vmap/localization/stalled_tracker.h"
 #include "vmap/map/visual_map.h"
 #include "vmap/sources/frame_source.h"
 
@@ -127,8 +128,7 @@ class Localizer {
   // out less (AcceptLostFrameByHeading), whose frame is placed, not steered by.
   enum class SecondLook { kNothing, kAccepted, kPlacedOnly };
   // A lost frame compared again with more features (LocalizerOptions::lost_frame_features): CompareBestRankedAgain
-  // with the frame's features extracted again by lost_frame_matcher_ and the key image's likewise
-  // (LostFrameKeyFeatures).
+  // with the frame's and the key image's features extracted again by lost_frame_matcher_.
   SecondLook CompareLostFrameAgain(const Frame& frame, const ImageFeatures& features);
   // Where chance accepts none of them, the comparison with more features whose heading mode stands out against the
   // others made so (LocalizerOptions::lost_frame_heading) is accepted as by HeadingStandsOut (kAccepted).
@@ -143,8 +143,6 @@ class Localizer {
   // The frame does not share the frame before's scene as consecutive frames of a moving robot do (its comparison with
   // it above scene_change_log10_nfa); false when the frame before's features were not kept, or on binary descriptors.
   bool SceneChangedSinceFrameBefore(const ImageFeatures& features) const;
-  // Key image `key`'s features as lost_frame_matcher_ extracts them, read from the map's directory when first needed.
-  const ImageFeatures& LostFrameKeyFeatures(int key);
   // A lost frame steps on where its evidence agrees (LocalizerOptions::step_on_where_evidence_agrees): whether the
   // frame's ranking (ranked by its relocalization) and its comparisons' heading modes each single out the key image
   // at route `position + 1`, the tracker's next.
@@ -204,8 +202,6 @@ class Localizer {
   // more likely than before it) and k + 1 verifies; again for k + 2, up to `lookahead` key images. Only where the
   // belief singled out a place before the frame's evidence (belief_confident_).
   void StepOnByBelief(LocalizationResult& result, const ImageFeatures& features);
-  // When the belief doubts the frame's position: compares around the belief's peak (over the whole route when
-  // it is flat) and moves the estimate to the peak when the belief singles it out.
   // The belief singles out route `position` (not only holds min_confidence near it: also far more than a flat
   // belief would).
   bool SinglesOut(int position) const { return SinglesOut(belief_, position); }
@@ -236,7 +232,7 @@ class Localizer {
   bool PlacedAwayOnLittleChance(const LocalizationResult& result) const;
   bool StartAwayLacksBelief(const LocalizationResult& result) const;
   // A tracker held at one key image (LocalizerOptions::stalled_tracker_frames; localizer_stalled_tracker.cc): the
-  // frame, tracked there as the stalled_frames_ before it were, has its next key image verify nothing beyond a little
+  // frame, tracked there as the frames before it were (stall_), has its next key image verify nothing beyond a little
   // chance. A frame that stands still against the frame before (a robot that stopped) neither adds to the hold nor is
   // asked.
   bool HeldWhereNextSeesNothing(const LocalizationResult& result) const;
@@ -246,8 +242,8 @@ class Localizer {
   // The questioned frame is steered by only where its ranking puts its first key image within kNear of it: a key image
   // that verifies everywhere does not rank first where the robot is not.
   void DoubtStalledTracker(LocalizationResult& result) const;
-  // Counts the frames in a row the tracker was held so, after the frame's result is final.
-  void CountStall(const LocalizationResult& result);
+  // When the belief doubts the frame's position: compares around the belief's peak (over the whole route when
+  // it is flat) and moves the estimate to the peak when the belief singles it out.
   void Question(LocalizationResult& result, const Frame& frame, const ImageFeatures& features);
   // A frame placed more than kNear route positions behind where the tracker was (and behind the place last steered
   // by), where an accepted key image within kNear of that estimate, beyond a little chance, verified nearly as many
@@ -271,13 +267,11 @@ class Localizer {
   // and fits best, weighing the belief there ten to one where `weigh_belief`; false where none does.
   bool StepOnWhereClearlyBetter(const Frame& frame, const ImageFeatures& features, int first, int last,
                                 bool weigh_belief, KeyComparison& best, int& best_position);
-  // Up to lagging_start_frames frames after the run's first, a tracker at `best_position` that lags (recent_positions_)
+  // Up to lagging_start_frames frames after the run's first, a tracker at `best_position` that lags (lagging_start_)
   // and holds the frame by less than clearly compares the two key images after the next one, and the better becomes
   // `best` where it verifies more, clearly (LocalizerOptions::lagging_tracker_frames; localizer_lagging_tracker.cc).
   void LookFurtherWhenLagging(const Frame& frame, const ImageFeatures& features, KeyComparison& best,
                               int& best_position);
-  // Counts the frame and remembers where the tracker was, after the frame's result is final.
-  void RememberPace();
   // Where the distance driven puts the robot is driven_past_positions or more route positions past `best_position`:
   // the key images there are compared, and the better becomes `best` where it verifies more, clearly
   // (localizer_driven_ahead.cc).
@@ -332,16 +326,9 @@ class Localizer {
   // And of its rivals: the most heading votes of a heading rival of route `position` among `compared` (the frame's
   // memos, or its comparisons with more features), which each rule's ratio of the comparison's votes must reach; -1
   // without a rival (a route too short): the frame cannot tell, and no heading stands out.
+  // Defined for FrameComparisons and std::vector<KeyComparison> (localizer_rivals.cc).
   template <typename Compared>
-  int MostHeadingRivalVotes(int position, const Compared& compared) const {
-    int rival_votes = -1;
-    for (const auto& c : compared) {
-      const KeyComparison& rival = ComparisonOf(c);
-      const int q = route_position_of_key_[rival.key];
-      if (q >= 0 && IsHeadingRival(position, q)) rival_votes = std::max(rival_votes, rival.heading.votes);
-    }
-    return rival_votes;
-  }
+  int MostHeadingRivalVotes(int position, const Compared& compared) const;
   // When nothing else is accepted: the comparison whose heading mode holds the most votes, if HeadingStandsOut.
   // Returns its route position, -1 when none.
   int AcceptByHeading(const Frame& frame, const ImageFeatures& features);
@@ -408,25 +395,19 @@ class Localizer {
   const KeyImageStore& keys_;
   const Matcher& matcher_;
   std::unique_ptr<Matcher> guided_matcher_;  // ORB without the cross check; null: no guided matching
-  // The frame's features for matching by the prediction (LocalizerOptions::window_fast_threshold, window_features);
-  // null: the map's.
-  std::unique_ptr<Matcher> window_matcher_;
-  // The map's ORB with lost_frame_features features (LocalizerOptions::lost_frame_features); null: not asked, not ORB,
-  // or the key images' directory unknown. The key images' features it extracted, per key image (null: not yet).
-  std::unique_ptr<Matcher> lost_frame_matcher_;
-  std::vector<std::shared_ptr<const ImageFeatures>> lost_frame_key_features_;
+  std::unique_ptr<Matcher> window_matcher_;  // the window matching's features (window_features); null: the map's
+  // A lost frame's second look (LocalizerOptions::lost_frame_features); null: not asked, not ORB, or the key images'
+  // directory unknown or unreadable.
+  std::unique_ptr<LostFrameMatcher> lost_frame_matcher_;
   LocalizerOptions options_;
-  // How the frame is compared with a key image, and what the acceptance's link share measures each key image against
-  // (LocalizerOptions::link_share_tau): link_verified_, or on a map denser than that tau spaces its key images, its
-  // links as a map of that tau would hold them. The recheck and the evidence keep link_verified_: on a map of every
-  // frame a frame tracked with less than its near-duplicate links share is still asked whether a key image on verifies
-  // more (the tracker lags a key image a frame otherwise).
-  KeyImageComparer comparer_;
+  KeyImageComparer comparer_;     // its link share's reference: link_verified_, or at link_share_tau's spacing
   HeadingContinuity continuity_;  // the previous frame's headings, which guided matching predicts the frame's by
   std::vector<int> route_;
   std::vector<int> route_position_of_key_;  // -1 for key images off the route
   // Per key image: the verified matches of its link with a route neighbour, the smaller of the two; 0 when it
-  // has no verified link on the route (the comparisons against the map's links are then skipped).
+  // has no verified link on the route (the comparisons against the map's links are then skipped). The recheck and the
+  // evidence read these even where the comparer's reference is at link_share_tau's spacing: on a map of every frame a
+  // frame tracked with less than its near-duplicate links share is still asked whether a key image on verifies more.
   std::vector<int> link_verified_;
   // Per route position p: the map's link between p and p + 1 is of one scene (its verified matches pass chance, as a
   // comparison's must). A --tau 1 map of unrelated places has links chance refuses; a teach run's are of one scene.
@@ -477,33 +458,20 @@ class Localizer {
   // the evidence belief's peak, the evidence belief may make a frame uncertain, and with binary descriptors every frame
   // is also compared with the best-ranked key images of the whole route.
   bool start_unconfirmed_ = false;
-  // Binary descriptors (ORB): a wrong key image's comparison weighs against it, so comparing the whole route checks
-  // the start. Float descriptors (XFeat) verify chance matches at most wrong key images, which the evidence credits:
-  // comparing the whole route at the start pulled the evidence belief to chance places (docs/localize.md).
+  // ORB: a wrong key image's comparison weighs against it, so comparing the whole route checks the start (XFeat's
+  // chance matches at most wrong key images pulled the evidence belief to chance places: docs/localize.md).
   bool start_checked_over_route_ = false;
-  // Binary descriptors (ORB): across lighting their verified sets at wrong key images almost never pass chance, so
-  // the log10 NFA ranks the key images near the frame as the verified count does; XFeat's pass chance at most wrong
-  // key images, and its NFA does not (a step on needing a lower NFA too held XFeat's corridor frames a key image back).
+  // ORB: the log10 NFA ranks the key images near the frame as the verified count does (its verified sets at wrong key
+  // images almost never pass chance; XFeat's do, and a step on needing a lower NFA held its frames a key image back).
   bool nfa_ranks_key_images_ = false;
   // After the frame's motion step, before its evidence: the belief held at least min_confidence near its peak
   // (the frames before this one singled out a place). A flat belief does not move the estimate.
   bool belief_confident_ = false;
+  LaggingStart lagging_start_;  // where the tracker was after the run's last few first frames
+  StalledTracker stall_;        // the frames in a row the tracker was held where the next key image sees nothing
+  int placed_in_a_row_ = 0;     // frames placed (tracking or relocalized) in a row before this one
   // A far route position that verified more than the place the last frames were steered by (rival_place_frames);
   // -1: none. Compared again for rival_frames_left_ more frames.
-  // The route position the tracker was held at and the frames in a row it was held there (HeldWhereNextSeesNothing);
-  // 0: not held.
-  int stalled_position_ = -1;
-  int stalled_frames_ = 0;
-  // The hold at stalled_position_ is questioned at this many frames: stalled_tracker_frames, or
-  // unsettled_stalled_tracker_frames where it began within two frames of a frame not steered by.
-  int stall_bar_ = 0;
-  // The frames localized since the run's start (counted up to lagging_start_frames + 1), and the tracker's route
-  // positions after the last lagging_tracker_frames of them (LookFurtherWhenLagging).
-  int frames_since_start_ = 0;
-  std::deque<int> recent_positions_;
-  int placed_in_a_row_ = 0;        // frames placed (tracking or relocalized) in a row before this one
-  bool stall_questioned_ = false;  // the frame being localized was questioned so
-  bool held_still_ = false;        // the frame being localized was held and stands still (StillSinceFrameBefore)
   int rival_place_ = -1;
   int rival_frames_left_ = 0;
   int pointed_ = -1;         // the far route position this frame's relocalization pointed at; -1: none
@@ -515,8 +483,6 @@ class Localizer {
   int stepped_back_from_ = -1;
   EvidenceModel evidence_;  // by the kind of the matcher's descriptors
   using Memo = FrameComparisons::Memo;
-  static const KeyComparison& ComparisonOf(const Memo& memo) { return memo.comparison; }
-  static const KeyComparison& ComparisonOf(const KeyComparison& comparison) { return comparison; }
   std::vector<RankedKey> ranked_;  // the route ranked for the frame being localized (RankRoute); empty: not yet
   // The frame's ranking weighs the belief (WeighRanking): each route position's bucket in it (RankingBuckets); empty:
   // not yet.

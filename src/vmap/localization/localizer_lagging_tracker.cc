@@ -5,8 +5,6 @@
 // after it, the look-alike keeps verifying, and the robot moves away from where the frames are steered by. A tracker
 // that has not moved on two key images in several of the run's first frames is asked whether the route further on
 // verifies the frame clearly.
-#include <algorithm>
-
 #include "vmap/localization/localizer.h"
 
 namespace vmap {
@@ -21,30 +19,12 @@ constexpr int kFurther = 2;
 
 void Localizer::LookFurtherWhenLagging(const Frame& frame, const ImageFeatures& features, KeyComparison& best,
                                        int& best_position) {
-  const int frames = options_.lagging_tracker_frames;
-  if (frames <= 0 || binary_descriptors_ || !best.accepted || frames_since_start_ > options_.lagging_start_frames ||
-      static_cast<int>(recent_positions_.size()) < frames || PassesChance(best, options_.look_past_max_log10_nfa)) {
+  if (binary_descriptors_ || !best.accepted || !lagging_start_.Lags() ||
+      PassesChance(best, options_.look_past_max_log10_nfa)) {
     return;
   }
-  // Lagging: the tracker is no more than one key image further on than `frames` frames ago (a move back is the rules'
-  // of a step back).
-  const int moved = recent_positions_.back() - recent_positions_.front();
-  if (moved < 0 || moved >= 2) return;
   StepOnWhereClearlyBetter(frame, features, best_position + 2, best_position + 1 + kFurther,
                            options_.lagging_step_weighs_belief, best, best_position);
-}
-
-void Localizer::RememberPace() {
-  // Counted only as far as the rule reads it: a long run does not overflow the count.
-  if (frames_since_start_ <= options_.lagging_start_frames) ++frames_since_start_;
-  if (position_ < 0) {
-    recent_positions_.clear();
-    return;
-  }
-  recent_positions_.push_back(position_);
-  while (static_cast<int>(recent_positions_.size()) > std::max(1, options_.lagging_tracker_frames)) {
-    recent_positions_.pop_front();
-  }
 }
 
 }  // namespace vmap

@@ -7,7 +7,6 @@
 
 #include "vmap/core/error.h"
 #include "vmap/localization/localizer.h"
-#include "vmap/map/map_io.h"
 
 namespace vmap {
 
@@ -116,14 +115,15 @@ Localizer::SecondLook Localizer::CompareLostFrameAgain(const Frame& frame, const
   const bool by_chance = CompareBestRankedAgain(frame, features, [&](int key) -> std::optional<KeyComparison> {
     const ImageFeatures* key_image = nullptr;
     try {
-      key_image = &LostFrameKeyFeatures(key);
+      key_image = &lost_frame_matcher_->KeyFeatures(key);
     } catch (const InputError&) {
       // The map's key image files are not at hand (its features came from the cache): its lost frames stay as they are.
       lost_frame_matcher_.reset();
       return std::nullopt;
     }
-    if (!more) more = lost_frame_matcher_->ExtractFrame(frame.gray, frame.color);
-    compared.push_back(comparer_.CompareImage(*more, *key_image, lost_frame_matcher_->Match(*more, *key_image), key));
+    const Matcher& matcher = lost_frame_matcher_->matcher();
+    if (!more) more = matcher.ExtractFrame(frame.gray, frame.color);
+    compared.push_back(comparer_.CompareImage(*more, *key_image, matcher.Match(*more, *key_image), key));
     return compared.back();
   });
   return by_chance ? SecondLook::kAccepted : AcceptLostFrameByHeading(compared, features);
@@ -209,15 +209,6 @@ bool Localizer::SceneChangedSinceFrameBefore(const ImageFeatures& features) cons
   const PairComparison pair = ComparePair(matcher_, *before, features, options_.verifier, options_.similarity);
   return !pair.matched || ChanceOfComparison(pair, features.image_size(), before->image_size(), 1).log10_nfa >
                               options_.scene_change_log10_nfa;
-}
-
-const ImageFeatures& Localizer::LostFrameKeyFeatures(int key) {
-  std::shared_ptr<const ImageFeatures>& features = lost_frame_key_features_[key];
-  if (!features) {
-    const cv::Mat gray = ReadKeyImage(keys_.directory, map_.key_images[key], /*grayscale=*/true);
-    features = lost_frame_matcher_->ExtractFrame(gray, cv::Mat());
-  }
-  return *features;
 }
 
 double Localizer::SharedWithLink(const KeyComparison& comparison, int key_a, int key_b) const {

@@ -61,6 +61,27 @@ bool Localizer::IsHeadingRival(int position, int q) const {
   return false;
 }
 
+namespace {
+
+const KeyComparison& ComparisonOf(const FrameComparisons::Memo& memo) { return memo.comparison; }
+const KeyComparison& ComparisonOf(const KeyComparison& comparison) { return comparison; }
+
+}  // namespace
+
+template <typename Compared>
+int Localizer::MostHeadingRivalVotes(int position, const Compared& compared) const {
+  int rival_votes = -1;
+  for (const auto& c : compared) {
+    const KeyComparison& rival = ComparisonOf(c);
+    const int q = route_position_of_key_[rival.key];
+    if (q >= 0 && IsHeadingRival(position, q)) rival_votes = std::max(rival_votes, rival.heading.votes);
+  }
+  return rival_votes;
+}
+
+template int Localizer::MostHeadingRivalVotes(int, const FrameComparisons&) const;
+template int Localizer::MostHeadingRivalVotes(int, const std::vector<KeyComparison>&) const;
+
 bool Localizer::HeadingMayStandOut(const KeyComparison& comparison) const {
   // The heading answers chance only, never the link share: a frame that shares little with a key image's place sees
   // its scene from elsewhere, and the scene's matches agree there too (redkitchen's teach/repeat run: 2 -> 57 frames
