@@ -217,6 +217,12 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "images pass chance and the belief with its ranking singles them out"},
                 verified_ranking_steers);
   visitor.Visit(
+      {"steer_where_belief_stays", "!--no-steer-where-belief-stays",
+       "never steer by a frame a far place left uncertain for want of a second frame, even where the belief "
+       "still singles out the tracker's place, a key image there verifies beyond a little chance and no far one "
+       "verifies --min-rival-ratio times as many matches"},
+      steer_where_belief_stays);
+  visitor.Visit(
       OptionField{"start_key", "--start-key",
                   "The key image the run starts at (teach and repeat: 0, the route's first): the tracker starts there "
                   "and the belief leans there, which the frames' evidence overrides (-1 = anywhere)"}

@@ -302,6 +302,13 @@ struct LocalizerOptions : GuidedMatchingOptions, StartOptions, LostFrameOptions 
   // verified a frame after key image 16 stopped verifying, the belief before its ranking still at 15; docs/localize.md,
   // "A frame verified where its ranking puts it"). Off: doubted as before.
   bool verified_ranking_steers = true;
+  // A frame left uncertain because a far place it verified needs a second frame (TakesJump) is steered by where the
+  // belief, the frame's evidence weighed, still singles out a place within two key images of the tracker and not
+  // behind the place the run was last steered by, and a comparison there verifies beyond a little chance (log10 NFA at
+  // most -10; the link share aside) while no far comparison verifies min_rival_ratio times as many matches (a far place
+  // that stands out so is a robot carried off): a far place the belief does not follow is no reason to doubt the place
+  // it holds (docs/localize.md, "A far place the belief does not follow"). Off: uncertain as before.
+  bool steer_where_belief_stays = true;
   // Key images compared beyond `next_key` when the frame has passed it (1 or 2: the "next one or two").
   int lookahead = 2;
   // While tracking, also compare the key image before `key` when the frame is nearer `key` than `next_key`

@@ -355,5 +355,29 @@ TEST_F(XfeatCorridorRun, ARobotThatStopsIsNotAHeldTracker) {
   EXPECT_EQ(steered, SteeredOnRun(run, 0, " --verifier-seed 1 --stalled-tracker-frames 0"));
 }
 
+// A far place the belief does not follow (docs/localize.md): repeat frames 70-82 at the verifier's seed 257, started at
+// teach frame 70's key image. On frames 77 and 78 the key images near the tracker verify beyond a little chance but
+// short of the link share (frame 77: key image 22, 22 matches at log10 NFA -17; frame 78: key image 23 at -15), and the
+// relocalization's best is the route's end (key image 29 at -20, 32 at -6), a far place that needs a second frame:
+// each frame was uncertain while the belief, their evidence weighed, held 0.98-1.0 near key image 22. Steered by there,
+// both are right (21-24).
+TEST_F(XfeatCorridorRun, AFarPlaceTheBeliefDoesNotFollowLeavesTheFrameSteeredBy) {
+  auto steered = [&](const std::string& flags) {
+    return SteeredOnRepeat(70, 82, KeyBefore(70), " --verifier-seed 257" + flags);
+  };
+  auto frames_77_78 = [](const Steered& all) {
+    Steered some;
+    for (const auto& s : all) {
+      if (s.first == 77 || s.first == 78) some.push_back(s);
+    }
+    return some;
+  };
+  const Steered stays = steered(""), doubted = steered(" --no-steer-where-belief-stays");
+  EXPECT_TRUE(frames_77_78(doubted).empty()) << "the test no longer reaches frames a far place left uncertain";
+  EXPECT_EQ(Right(frames_77_78(stays)), 2);
+  EXPECT_EQ(Far(stays), 0);
+  EXPECT_EQ(Right(stays), Right(doubted) + 2);
+}
+
 }  // namespace
 }  // namespace vmap::neural
