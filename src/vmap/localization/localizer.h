@@ -304,8 +304,9 @@ class Localizer {
   // Accepted against the frame's rivals: accepted, though with fewer verified matches than the link share asks.
   bool AcceptedAgainstRivals(const KeyComparison& comparison) const;
 
-  // The most verified matches of a key image compared with the frame more than kNear route positions from
-  // `position`, the best-ranked such key image compared first when it was not; -1: none (a route too short).
+  // The most verified matches of the frame's (accepted, where `accepted_only`) comparisons more than kNear route
+  // positions from `position`, -1: none; RivalVerified's of all, the best-ranked such key image compared first.
+  int MostVerifiedAway(int position, bool accepted_only) const;
   int RivalVerified(const Frame& frame, const ImageFeatures& features, int position);
   // The comparison may be accepted against the frame's rivals (kChance, min_rival_ratio > 0, matched and its log10
   // NFA at most rival_max_log10_nfa), and does stand out when it verifies min_rival_ratio times its rivals' best.
@@ -325,8 +326,8 @@ class Localizer {
   bool HeadingMayStandOut(const KeyComparison& comparison) const;
   // And of its rivals: the most heading votes of a heading rival of route `position` among `compared` (the frame's
   // memos, or its comparisons with more features), which each rule's ratio of the comparison's votes must reach; -1
-  // without a rival (a route too short): the frame cannot tell, and no heading stands out.
-  // Defined for FrameComparisons and std::vector<KeyComparison> (localizer_rivals.cc).
+  // without a rival (a route too short): the frame cannot tell, and no heading stands out. Defined for both in
+  // localizer_rivals.cc.
   template <typename Compared>
   int MostHeadingRivalVotes(int position, const Compared& compared) const;
   // When nothing else is accepted: the comparison whose heading mode holds the most votes, if HeadingStandsOut.

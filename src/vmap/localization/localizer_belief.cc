@@ -182,7 +182,7 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
   // A far place refused on one frame (TakesJump: pointed_) that the belief, with the frame's evidence, does not follow:
   // the frame is steered by where the belief singles out a place within kNear of the tracker, not behind the place the
   // run was last steered by, and a comparison there verifies beyond a little chance, the link share aside, while no
-  // far comparison verifies min_rival_ratio times as many (steer_where_belief_stays).
+  // accepted far comparison stands out against it by min_rival_ratio (steer_where_belief_stays).
   if (options_.steer_where_belief_stays && pointed_ >= 0 && result.status == LocalizationStatus::kUncertain &&
       position_ >= 0 && std::abs(position_ - result.route_position) <= kNear &&
       (steered_before_ < 0 || result.route_position >= steered_before_) &&
@@ -192,14 +192,8 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
     for (const KeyComparison* c : {&result.to_key, &result.to_next}) {
       if (c->matched && c->log10_nfa <= kBeyondLittleChance) near_verified = std::max(near_verified, c->num_verified);
     }
-    int far_verified = 0;  // of the accepted comparisons more than kNear from it
-    for (const Memo& m : comparisons_) {
-      const int q = route_position_of_key_[m.comparison.key];
-      if (m.comparison.accepted && q >= 0 && std::abs(q - result.route_position) > kNear) {
-        far_verified = std::max(far_verified, m.comparison.num_verified);
-      }
-    }
-    if (near_verified > 0 && far_verified < options_.min_rival_ratio * near_verified) {
+    if (near_verified > 0 &&
+        !StandsOut(MostVerifiedAway(result.route_position, /*accepted_only=*/true), near_verified)) {
       result.status = LocalizationStatus::kTracking;
     }
   }

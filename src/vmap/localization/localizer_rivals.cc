@@ -32,14 +32,18 @@ int Localizer::RivalVerified(const Frame& frame, const ImageFeatures& features, 
       break;
     }
   }
-  int rival_verified = -1;
+  return MostVerifiedAway(position, /*accepted_only=*/false);
+}
+
+int Localizer::MostVerifiedAway(int position, bool accepted_only) const {
+  int most = -1;
   for (const Memo& m : comparisons_) {
     const int q = route_position_of_key_[m.comparison.key];
-    if (q >= 0 && std::abs(q - position) > kNear) {
-      rival_verified = std::max(rival_verified, m.comparison.num_verified);
+    if (q >= 0 && std::abs(q - position) > kNear && (m.comparison.accepted || !accepted_only)) {
+      most = std::max(most, m.comparison.num_verified);
     }
   }
-  return rival_verified;
+  return most;
 }
 
 bool Localizer::MayStandOut(const KeyComparison& comparison) const {
