@@ -78,20 +78,24 @@ void AddBuildCommand(CLI::App& app) {
                       [&localizer](const std::string& rule) { localizer.acceptance = ParseAcceptanceRule(rule); },
                       "--add-experience-to: when a repeat frame is seen at a key image, as vmap localize "
                       "decides it: chance or counts"))
-          ->default_str(AcceptanceRuleName(localizer.acceptance)),
+          ->default_str(AcceptanceRuleName(localizer.acceptance))
+          ->group(kAddExperienceSection),
       flags
           .AddOption(command, "--max-log10-nfa", localizer.max_log10_nfa, "experience.localizer.max_log10_nfa",
                      "--add-experience-to, --acceptance chance: accept when log10 of the number of false alarms "
                      "is at most this")
-          ->capture_default_str(),
+          ->capture_default_str()
+          ->group(kAddExperienceSection),
       flags
           .AddOption(command, "--min-verified", localizer.min_verified, "experience.localizer.min_verified",
                      "--add-experience-to, --acceptance counts: verified matches a frame needs")
-          ->capture_default_str(),
+          ->capture_default_str()
+          ->group(kAddExperienceSection),
       flags
           .AddOption(command, "--min-similarity", localizer.min_similarity, "experience.localizer.min_similarity",
                      "--add-experience-to, --acceptance counts: S a frame needs")
-          ->capture_default_str()};
+          ->capture_default_str()
+          ->group(kAddExperienceSection)};
   command->callback([state] { state->flags.Run([&] { RunBuild(*state); }); });
 }
 

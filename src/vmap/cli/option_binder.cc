@@ -71,7 +71,7 @@ void OptionBinder::OnField(const OptionField& field, std::vector<int>& /*value*/
 
 void OptionBinder::AddTarget(const OptionField& field, Target value) {
   if (*field.flag == '\0') return;
-  auto [it, added] = flags_.try_emplace(field.flag, Targets{field, {}, {}});
+  auto [it, added] = flags_.try_emplace(field.flag, Targets{field, {}, {}, section()});
   if (added) order_.push_back(field.flag);
   Targets& targets = it->second;
   if (!targets.values.empty() && targets.values.front().index() != value.index()) {
@@ -118,6 +118,7 @@ void OptionBinder::Bind(CLI::App* command, OptionFlags& option_flags) const {
           }
         },
         targets.values.front());
+    if (!targets.section.empty()) option->group(targets.section);
     for (const std::string& path : targets.paths) option_flags.Record(path, option);
   }
 }

@@ -17,7 +17,9 @@
 namespace vmap::cli {
 
 // Collects the fields by flag, then binds each flag once (Bind): a flag several fields share (the matchers'
-// --weights, --device) sets each of them. Flags come in the order the fields are first visited.
+// --weights, --device) sets each of them. Flags come in the order the fields are first visited, under the heading
+// of the section their first field was visited in (OptionFieldVisitor::Section; CLI11's option groups, which
+// --help lists in the order each first appears).
 class OptionBinder final : public OptionFieldVisitor {
  public:
   // Every field of `options` under `path` ("verifier"; "" for the struct the command checks).
@@ -42,6 +44,7 @@ class OptionBinder final : public OptionFieldVisitor {
     OptionField field;
     std::vector<Target> values;
     std::vector<std::string> paths;  // of each value
+    std::string section;             // the --help heading it is listed under; "" = the command's "Options"
   };
 
   void AddTarget(const OptionField& field, Target value);

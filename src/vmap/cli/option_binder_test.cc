@@ -98,5 +98,66 @@ TEST(OptionBinder, SkipsWhatTheHolderLeavesOutAndSharesAFlagBetweenFields) {
   EXPECT_EQ(flags.FlagOf("second.threshold"), "--threshold");
 }
 
+// A struct's sections are --help's headings: a nested struct's ends with it, and one the holder begins goes on into
+// a nested struct that begins none.
+struct Sectioned {
+  int budget = 1;
+  int seed = 0;
+  int threads = 0;
+  Part part;
+  Whole whole;
+  void VisitFields(OptionFieldVisitor& visitor) {
+    visitor.Visit({"budget", "--budget", "Budget"}, budget);  // no section: the command's "Options"
+    visitor.Section("Parts");
+    visitor.VisitNested("part", part, Nesting{false, {"budget"}});
+    visitor.VisitNested("whole", whole, Nesting{false, {"extraction_threads", "part"}});
+    visitor.Visit({"seed", "--seed", "Seed"}, seed);
+    visitor.Section(kRunSection);
+    visitor.Visit({"threads", "--threads", "Threads"}, threads);
+  }
+};
+
+struct SectionedInside {
+  int first = 0;
+  Sectioned sectioned;
+  int last = 0;
+  void VisitFields(OptionFieldVisitor& visitor) {
+    visitor.Section("Outside");
+    visitor.Visit({"first", "--first", "First"}, first);
+    visitor.VisitNested("", sectioned);
+    visitor.Visit({"last", "--last", "Last"}, last);
+  }
+};
+
+TEST(OptionBinder, ListsEachFlagUnderItsSectionInHelp) {
+  CLI::App app;
+  OptionFlags flags;
+  SectionedInside options;
+  AddOptionFlags(&app, options, flags);
+  EXPECT_EQ(app.get_option("--first")->get_group(), "Outside");
+  EXPECT_EQ(app.get_option("--budget")->get_group(), "Outside");  // the holder's, where the nested struct has none yet
+  EXPECT_EQ(app.get_option("--threshold")->get_group(), "Parts");
+  EXPECT_EQ(app.get_option("--shape")->get_group(), "Parts");
+  EXPECT_EQ(app.get_option("--seed")->get_group(), "Parts");
+  EXPECT_EQ(app.get_option("--threads")->get_group(), kRunSection);
+  EXPECT_EQ(app.get_option("--last")->get_group(), "Outside");  // the nested struct's sections ended with it
+  // --help lists the headings in the order each first appears.
+  const std::string help = app.help();
+  const size_t outside = help.find("Outside:"), parts = help.find("Parts:"), run = help.find(kRunSection);
+  ASSERT_NE(outside, std::string::npos);
+  ASSERT_NE(parts, std::string::npos);
+  ASSERT_NE(run, std::string::npos);
+  EXPECT_LT(outside, parts);
+  EXPECT_LT(parts, run);
+  EXPECT_LT(help.find("--threshold"), run);
+  EXPECT_GT(help.find("--threads"), run);
+
+  CLI::App plain;
+  OptionFlags plain_flags;
+  Sectioned sectioned;
+  AddOptionFlags(&plain, sectioned, plain_flags);
+  EXPECT_EQ(plain.get_option("--budget")->get_group(), "Options");
+}
+
 }  // namespace
 }  // namespace vmap::cli

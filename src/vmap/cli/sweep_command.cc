@@ -38,7 +38,8 @@ void AddSweepCommand(CLI::App& app) {
                         .AddOption(command, "--gt", options.gt.path, "gt.path",
                                    "Add a usable-links column (see `vmap eval`): with no FILE, the input's own "
                                    "ground truth; or a kitti, tum or euroc poses file")
-                        ->expected(0, 1);
+                        ->expected(0, 1)
+                        ->group(kGroundTruthSection);
   command->callback([state, gt] {
     state->options.evaluate = gt->count() > 0;
     state->flags.Run([&] { RunSweep(*state); });

@@ -9,6 +9,7 @@ ControlLaw ParseControlLaw(const std::string& name) { return ParseEnum(kControlL
 std::string ControlLawName(ControlLaw law) { return EnumToName(kControlLawNames, law); }
 
 void ControllerOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Section("Controller: velocity commands from localization");
   visitor.Visit(OptionField{"law", "--law", "Steering law: "}.ListingNames(),
                 EnumField(law, kControlLawNames, ParseControlLaw));
   visitor.Visit(OptionField{"speed", "--speed", "Forward speed where the teach run's is unknown (m/s)"}

@@ -24,6 +24,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "vmap/core/enum_names.h"
@@ -141,6 +142,10 @@ class EnumField {
   std::string names_;
 };
 
+// The --help section of how a command is carried out rather than what it computes (threads, caches, seeds), which
+// several options structs share (OptionFieldVisitor::Section).
+inline constexpr char kRunSection[] = "Run: threads, caches and seeds";
+
 // How a nested struct is visited (OptionFieldVisitor::VisitNested).
 struct Nesting {
   // Its fields are written at the level of the struct holding it (map.json's "tau", not "key_images.tau"),
@@ -182,16 +187,25 @@ class OptionFieldVisitor {
   template <typename Options>
   void VisitNested(const char* name, Options& options, const Nesting& nesting = {}) {
     if (Skipped(name)) return;
+    // A section begun inside a nested struct ends with it; one that does not begin any goes on in its holder's.
+    const std::string holder_section = section_;
     if (*name == '\0' && nesting.skip.empty()) {
       options.VisitFields(*this);
-      return;
+    } else {
+      levels_.push_back({name, nesting});
+      OnEnter(name, nesting.json_inline || *name == '\0');
+      options.VisitFields(*this);
+      OnLeave(nesting.json_inline || *name == '\0');
+      levels_.pop_back();
     }
-    levels_.push_back({name, nesting});
-    OnEnter(name, nesting.json_inline || *name == '\0');
-    options.VisitFields(*this);
-    OnLeave(nesting.json_inline || *name == '\0');
-    levels_.pop_back();
+    section_ = holder_section;
   }
+
+  // The fields visited after this, up to the next Section or the end of the struct, belong to a section titled
+  // `title` ("Acceptance: when a frame is at a key image"): a command's --help lists its flags under such headings.
+  // Only the flag binder reads it; JSON and keywords do not depend on it.
+  void Section(std::string title) { section_ = std::move(title); }
+  const std::string& section() const { return section_; }  // "": none (a command's plain "Options")
 
   // The field's path from the struct visited first: "link_analysis.pose.threshold".
   std::string Path(const OptionField& field) const {
@@ -233,6 +247,7 @@ class OptionFieldVisitor {
   }
 
   std::vector<Level> levels_;
+  std::string section_;
 };
 
 }  // namespace vmap

@@ -97,6 +97,7 @@ const ModelOptions& MatcherOptions::model(const std::string& name) const {
 }
 
 void MatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Section("Matcher and features (the flags of the --matcher chosen apply)");
   // "Feature matcher: orb, aliked, loftr or xfeat" and each model's summary on a line of its own.
   static const std::string help = [] {
     std::string text = "Feature matcher: " + MatcherModelNames();

@@ -138,6 +138,7 @@ FundamentalResult EstimateFundamental(const std::vector<cv::Point2f>& points0, c
 }
 
 void VerifierOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Section("Verifier: the fundamental matrix");
   visitor.Visit(OptionField{"method", "--verifier", "Fundamental matrix estimator: "}.ListingNames(),
                 EnumField(method, kVerifierMethodNames, ParseVerifierMethod));
   visitor.Visit(

@@ -11,6 +11,7 @@
 namespace vmap {
 
 void HeadingOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Section("Heading: the horizontal offset to steer by");
   visitor.Visit(OptionField{"window_px", "--heading-window",
                             "Heading: width of the window of horizontal displacements that votes (px)"}
                     .Within(0, 10000)

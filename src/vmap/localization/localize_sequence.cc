@@ -22,6 +22,7 @@ int LocalizeSequenceOptions::ExtractionThreads() const {
 }
 
 void LocalizeSequenceOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Section(kRunSection);
   visitor.Visit(OptionField{"extraction_threads", "--threads", "Feature-extraction threads (0 = one per core)"}
                     .NotRecorded()
                     .Within(0, 256)

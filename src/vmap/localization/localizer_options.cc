@@ -4,8 +4,55 @@
 #include "vmap/core/option_ranges.h"
 
 namespace vmap {
+namespace {
+
+constexpr char kRulesSection[] =
+    "Rules across seasons and lighting (each on by default and measured: docs/localize.md; a flag turns one off to "
+    "measure it)";
+
+}  // namespace
 
 void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
+  // The sections --help lists the flags under, the everyday ones first; the rules each have a flag to turn them off
+  // for a measurement, not to tune.
+  visitor.Section("Start: where on the route the run begins");
+  visitor.Visit(
+      OptionField{"start_key", "--start-key",
+                  "The key image the run starts at (teach and repeat: 0, the route's first): the tracker starts there "
+                  "and the belief leans there, which the frames' evidence overrides (-1 = anywhere)"}
+          .AtLeast(-1)
+          .Meaning("-1: anywhere"),
+      start_key);
+  visitor.Visit(
+      OptionField{"start_mass", "--start-mass",
+                  "--start-key: the share of the belief at the start key image at the first frame (the rest flat)"}
+          .Within(0, 1)
+          .ExcludingMax()
+          .Meaning("1 would trap a run started elsewhere"),
+      start_mass);
+  visitor.Visit({"start_is_hint", "!--no-start-is-hint",
+                 "--start-key: steer by a frame even where the frames' evidence alone, without the start's prior, "
+                 "singles out a place more than two key images away (otherwise it is uncertain)"},
+                start_is_hint);
+  visitor.Visit({"start_needs_evidence", "!--no-start-needs-evidence",
+                 "--start-key: steer by a frame before the start is confirmed even where the frames' evidence alone "
+                 "holds less near its key image than a flat belief would (otherwise it is uncertain)"},
+                start_needs_evidence);
+  visitor.Visit({"start_place_stands_out", "!--no-start-place-stands-out",
+                 "--start-key, float descriptors: steer by a frame before the start is confirmed even where a key "
+                 "image more than two places away verifies as much (otherwise it is uncertain)"},
+                start_place_stands_out);
+  visitor.Visit({"start_evidence_ranks_frame", "!--no-start-evidence-ranks-frame",
+                 "--start-key, float descriptors: before the start is confirmed, the frames' evidence alone weighs a "
+                 "tracked frame by its comparisons only (otherwise by its ranking too)"},
+                start_evidence_ranks_frame);
+  visitor.Visit(
+      OptionField{"start_away_min_confidence", "--start-away-min-confidence",
+                  "--start-key, float descriptors: before the start is confirmed, the belief a frame placed more than "
+                  "two key images from the start key image needs near its place to be steered by (0: as any frame)"}
+          .Within(0, 1),
+      start_away_min_confidence);
+  visitor.Section("Acceptance: when a frame is at a key image");
   visitor.Visit({"acceptance", "--acceptance",
                  "When a frame is seen at a key image: chance (its verified matches are unlikely by "
                  "chance, --max-log10-nfa, and many against the map's links, --min-link-share) or "
@@ -69,6 +116,75 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                   "The matches a heading mode needs to be accepted against its rivals (--min-heading-rival-ratio)"}
           .Within(3, 100000),
       min_heading_votes);
+  visitor.Section("Tracking and relocalization");
+  visitor.Visit(
+      OptionField{"max_lost_frames", "--max-lost", "Lost frames in a row before the estimate is dropped"}.Within(
+          0, 1000000),
+      max_lost_frames);
+  visitor.Visit(
+      OptionField{"relocalization_candidates", "--candidates", "Best-ranked key images verified when relocalizing"}
+          .Within(1, 10000),
+      relocalization_candidates);
+  visitor.Visit(
+      OptionField{"relocalization_likelier_reach", "--relocalization-likelier-reach",
+                  "Route positions from a relocalization's most verified candidate within which an accepted one "
+                  "likelier by chance (lower log10 NFA, within the evidence's bound) places the frame (0 = the most "
+                  "verified)"}
+          .Within(0, 1000000),
+      relocalization_likelier_reach);
+  visitor.Visit(
+      OptionField{"experience_candidates", "--experience-candidates",
+                  "Maps with experiences: views of a key image verified besides it, those with the most tentative "
+                  "matches (0 = the teach key images only)"}
+          .Within(0, 1000)
+          .Meaning("0: teach key images only"),
+      experience_candidates);
+  visitor.Visit(
+      OptionField{"lookahead", "--lookahead", "Key images beyond the next compared while tracking (1 or 2)"}.Within(1,
+                                                                                                                    2),
+      lookahead);
+  visitor.Visit({"step_back", "!--no-step-back", "Never move the estimate back to the previous key image"}, step_back);
+  visitor.Visit(
+      OptionField{"step_back_max_log10_nfa", "--step-back-max-log10-nfa",
+                  "A step back to the previous key image when nothing at or ahead of the key image verifies: its log10 "
+                  "NFA at most this (stricter than --max-log10-nfa: the route goes forwards)"}
+          .Within(-1000, 1000),
+      step_back_max_log10_nfa);
+  visitor.Visit({"step_back_needs_more", "!--step-back-on-tie",
+                 "Step back to the previous key image on a tie of verified matches (S decides, as before)"},
+                step_back_needs_more);
+  visitor.Visit({"step_back_needs_lower_nfa", "!--step-back-on-count",
+                 "Step back to the previous key image on more verified matches alone, whatever their log10 NFA (as "
+                 "before)"},
+                step_back_needs_lower_nfa);
+  visitor.Visit({"step_on_needs_more", "!--step-on-on-tie",
+                 "Step on to the next key image on a tie of verified matches (S decides, as before)"},
+                step_on_needs_more);
+  visitor.Visit({"step_on_needs_lower_nfa", "!--step-on-on-count",
+                 "ORB: step on to the next key image on more verified matches alone, whatever their log10 NFA (as "
+                 "before)"},
+                step_on_needs_lower_nfa);
+  visitor.Visit({"step_on_by_belief", "!--no-step-on-by-belief",
+                 "Never move a tracked frame on to the next key image because the belief puts it past that key "
+                 "image (only the verified counts step on)"},
+                step_on_by_belief);
+  visitor.Visit(
+      OptionField{"step_on_by_belief_ahead", "--step-on-by-belief-ahead",
+                  "step_on_by_belief: the positions past each key image ahead whose belief is weighed against the two "
+                  "at and behind the key image the tracker is at (3: as before 2026-12-04)"}
+          .Within(1, 5),
+      step_on_by_belief_ahead);
+  visitor.Visit({"hold_unearned_step_on", "!--no-hold-unearned-step-on",
+                 "Keep a step on the belief undoes when the key image it passed does not verify (as before)"},
+                hold_unearned_step_on);
+  visitor.Visit({"step_back_needs_belief", "!--no-step-back-needs-belief",
+                 "Step back to the previous key image on the counts and the log10 NFA alone, whatever the belief (as "
+                 "before)"},
+                step_back_needs_belief);
+  visitor.VisitNested("ranking", ranking);
+  visitor.VisitNested("belief", belief);
+  visitor.VisitNested("heading", heading);
+  visitor.Section(kRulesSection);
   visitor.Visit(
       OptionField{"recheck_link_share", "--recheck-link-share",
                   "Relocalize a tracked frame with fewer verified matches than this fraction of its key image's "
@@ -222,106 +338,7 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
        "still singles out the tracker's place, a key image there verifies beyond a little chance and no far one "
        "verifies --min-rival-ratio times as many matches"},
       steer_where_belief_stays);
-  visitor.Visit(
-      OptionField{"start_key", "--start-key",
-                  "The key image the run starts at (teach and repeat: 0, the route's first): the tracker starts there "
-                  "and the belief leans there, which the frames' evidence overrides (-1 = anywhere)"}
-          .AtLeast(-1)
-          .Meaning("-1: anywhere"),
-      start_key);
-  visitor.Visit(
-      OptionField{"start_mass", "--start-mass",
-                  "--start-key: the share of the belief at the start key image at the first frame (the rest flat)"}
-          .Within(0, 1)
-          .ExcludingMax()
-          .Meaning("1 would trap a run started elsewhere"),
-      start_mass);
-  visitor.Visit({"start_is_hint", "!--no-start-is-hint",
-                 "--start-key: steer by a frame even where the frames' evidence alone, without the start's prior, "
-                 "singles out a place more than two key images away (otherwise it is uncertain)"},
-                start_is_hint);
-  visitor.Visit({"start_needs_evidence", "!--no-start-needs-evidence",
-                 "--start-key: steer by a frame before the start is confirmed even where the frames' evidence alone "
-                 "holds less near its key image than a flat belief would (otherwise it is uncertain)"},
-                start_needs_evidence);
-  visitor.Visit({"start_place_stands_out", "!--no-start-place-stands-out",
-                 "--start-key, float descriptors: steer by a frame before the start is confirmed even where a key "
-                 "image more than two places away verifies as much (otherwise it is uncertain)"},
-                start_place_stands_out);
-  visitor.Visit({"start_evidence_ranks_frame", "!--no-start-evidence-ranks-frame",
-                 "--start-key, float descriptors: before the start is confirmed, the frames' evidence alone weighs a "
-                 "tracked frame by its comparisons only (otherwise by its ranking too)"},
-                start_evidence_ranks_frame);
-  visitor.Visit(
-      OptionField{"start_away_min_confidence", "--start-away-min-confidence",
-                  "--start-key, float descriptors: before the start is confirmed, the belief a frame placed more than "
-                  "two key images from the start key image needs near its place to be steered by (0: as any frame)"}
-          .Within(0, 1),
-      start_away_min_confidence);
-  visitor.Visit(
-      OptionField{"max_lost_frames", "--max-lost", "Lost frames in a row before the estimate is dropped"}.Within(
-          0, 1000000),
-      max_lost_frames);
-  visitor.Visit(
-      OptionField{"relocalization_candidates", "--candidates", "Best-ranked key images verified when relocalizing"}
-          .Within(1, 10000),
-      relocalization_candidates);
-  visitor.Visit(
-      OptionField{"relocalization_likelier_reach", "--relocalization-likelier-reach",
-                  "Route positions from a relocalization's most verified candidate within which an accepted one "
-                  "likelier by chance (lower log10 NFA, within the evidence's bound) places the frame (0 = the most "
-                  "verified)"}
-          .Within(0, 1000000),
-      relocalization_likelier_reach);
-  visitor.Visit(
-      OptionField{"experience_candidates", "--experience-candidates",
-                  "Maps with experiences: views of a key image verified besides it, those with the most tentative "
-                  "matches (0 = the teach key images only)"}
-          .Within(0, 1000)
-          .Meaning("0: teach key images only"),
-      experience_candidates);
-  visitor.Visit(
-      OptionField{"lookahead", "--lookahead", "Key images beyond the next compared while tracking (1 or 2)"}.Within(1,
-                                                                                                                    2),
-      lookahead);
-  visitor.Visit({"step_back", "!--no-step-back", "Never move the estimate back to the previous key image"}, step_back);
-  visitor.Visit(
-      OptionField{"step_back_max_log10_nfa", "--step-back-max-log10-nfa",
-                  "A step back to the previous key image when nothing at or ahead of the key image verifies: its log10 "
-                  "NFA at most this (stricter than --max-log10-nfa: the route goes forwards)"}
-          .Within(-1000, 1000),
-      step_back_max_log10_nfa);
-  visitor.Visit({"step_back_needs_more", "!--step-back-on-tie",
-                 "Step back to the previous key image on a tie of verified matches (S decides, as before)"},
-                step_back_needs_more);
-  visitor.Visit({"step_back_needs_lower_nfa", "!--step-back-on-count",
-                 "Step back to the previous key image on more verified matches alone, whatever their log10 NFA (as "
-                 "before)"},
-                step_back_needs_lower_nfa);
-  visitor.Visit({"step_on_needs_more", "!--step-on-on-tie",
-                 "Step on to the next key image on a tie of verified matches (S decides, as before)"},
-                step_on_needs_more);
-  visitor.Visit({"step_on_needs_lower_nfa", "!--step-on-on-count",
-                 "ORB: step on to the next key image on more verified matches alone, whatever their log10 NFA (as "
-                 "before)"},
-                step_on_needs_lower_nfa);
-  visitor.Visit({"step_on_by_belief", "!--no-step-on-by-belief",
-                 "Never move a tracked frame on to the next key image because the belief puts it past that key "
-                 "image (only the verified counts step on)"},
-                step_on_by_belief);
-  visitor.Visit(
-      OptionField{"step_on_by_belief_ahead", "--step-on-by-belief-ahead",
-                  "step_on_by_belief: the positions past each key image ahead whose belief is weighed against the two "
-                  "at and behind the key image the tracker is at (3: as before 2026-12-04)"}
-          .Within(1, 5),
-      step_on_by_belief_ahead);
-  visitor.Visit({"hold_unearned_step_on", "!--no-hold-unearned-step-on",
-                 "Keep a step on the belief undoes when the key image it passed does not verify (as before)"},
-                hold_unearned_step_on);
-  visitor.Visit({"step_back_needs_belief", "!--no-step-back-needs-belief",
-                 "Step back to the previous key image on the counts and the log10 NFA alone, whatever the belief (as "
-                 "before)"},
-                step_back_needs_belief);
+  visitor.Section("Binary descriptors (ORB): matching again where the belief points, lost frames");
   visitor.Visit({"guided_matching", "!--no-guided-matching",
                  "ORB: never match a frame again with looser matching at the key images the belief holds"},
                 guided_matching);
@@ -439,10 +456,8 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                   "ORB, matching by the prediction: accept when the window's matches' log10 NFA is at most this"}
           .Within(-1000, 1000),
       window_max_log10_nfa);
-  visitor.VisitNested("ranking", ranking);
-  visitor.VisitNested("belief", belief);
-  visitor.VisitNested("heading", heading);
   visitor.VisitNested("verifier", verifier, Nesting{false, {"max_samples_to_reject"}});
+  visitor.Section(kRunSection);
   visitor.Visit(
       OptionField{"verifier_seed", "--verifier-seed",
                   "The seed of the verifier's sampling in the frames' comparisons (-1 = the map's verifier's)"}

@@ -11,6 +11,7 @@
 namespace vmap {
 
 void RouteBeliefOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Section("The belief over the route");
   visitor.Visit(
       OptionField{"min_confidence", "--min-confidence",
                   "A frame is uncertain (not to steer by) when the belief over the route holds less than this near "

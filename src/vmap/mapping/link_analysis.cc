@@ -249,6 +249,7 @@ void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int thread
 }
 
 void LinkAnalysisOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Section("Links: the relative pose of each link (with --camera)");
   visitor.VisitNested("pose", pose);
   visitor.VisitNested("homography", homography);
   visitor.VisitNested("translation", translation);

@@ -17,6 +17,7 @@ void AddExperiencePipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
                     .Positional()
                     .NotRecorded(),
                 input);
+  visitor.Section(kAddExperienceSection);
   visitor.Visit(OptionField{"map", "--add-experience-to",
                             "Add the input, a repeat run of the route, to this map as another experience: each key "
                             "image gains the frame that localized at it best (docs/experiences.md)"}

@@ -11,6 +11,9 @@
 
 namespace vmap {
 
+// The --help section of --add-experience-to and the repeat run's acceptance (`vmap build` binds those by hand).
+inline constexpr char kAddExperienceSection[] = "Adding an experience to a map (docs/experiences.md)";
+
 struct AddExperiencePipelineOptions {
   std::string input;  // the repeat run
   std::string map;    // the map it is added to

@@ -97,6 +97,7 @@ void BuildPipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(
       OptionField{"input", "input", "Video file, image folder, TUM RGB-D, EuRoC or KITTI sequence"}.Positional(),
       input);
+  visitor.Section("Output");
   visitor.Visit(OptionField{"output", "-o,--output", "Map directory to write (default: <input name>_map)"}
                     .HideDefault()
                     .NotRecorded(),
@@ -105,8 +106,10 @@ void BuildPipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.VisitNested("", matcher);
   // The verifier's options first, as `vmap build --help` has always listed them.
   visitor.VisitNested("verifier", map.verifier);
+  visitor.Section("Key images");
   visitor.Visit(OptionField{"tau", "-t,--tau", tau_help.c_str()}.HideDefault().NotRecorded(), tau);
   visitor.VisitNested("", map, Nesting{false, {"verifier"}});
+  visitor.Section("Output");
   visitor.Visit(OptionField{"report", "--report", "Also write report.html into the map directory"}.NotRecorded(),
                 report);
   visitor.Visit(OptionField{"snapshot_every", "--snapshot-every",

@@ -14,6 +14,7 @@ namespace vmap {
 namespace fs = std::filesystem;
 
 void GroundTruthOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Section(kGroundTruthSection);
   visitor.Visit(OptionField{"path", "--gt",
                             "Ground-truth poses (default: the input's own: KITTI poses.txt, TUM groundtruth.txt, EuRoC "
                             "state_groundtruth_estimate0/data.csv). Formats: kitti, tum, euroc"}

@@ -12,6 +12,9 @@
 
 namespace vmap {
 
+// The --help section of the ground truth's flags (GroundTruthOptions, and `vmap sweep --gt`, bound by hand).
+inline constexpr char kGroundTruthSection[] = "Ground truth";
+
 // Which ground truth: a poses file, or the input's own (KITTI poses.txt, TUM groundtruth.txt, EuRoC's).
 struct GroundTruthOptions {
   std::string path;  // "" = the input's own

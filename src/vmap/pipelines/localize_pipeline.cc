@@ -37,8 +37,7 @@ void CheckQueryIsNoFifo(const std::string& query) {
 }  // namespace
 
 void LocalizationSessionOptions::VisitFields(OptionFieldVisitor& visitor) {
-  // The verifier and the translation thresholds follow the map (FollowMap): no field of the session's.
-  visitor.VisitNested("", localizer, Nesting{false, {"verifier", "translation"}});
+  visitor.Section("Route and odometry");
   visitor.Visit(OptionField{"from", "--from", "Follow the route from this key image (default: the first)"}
                     .HideDefault()
                     .NotRecorded(),
@@ -46,10 +45,6 @@ void LocalizationSessionOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(
       OptionField{"to", "--to", "Follow the route to this key image (default: the last)"}.HideDefault().NotRecorded(),
       to);
-  visitor.VisitNested("", run);
-  visitor.Visit(OptionField{"cache", "!--no-cache", "Do not read or write the key-image cache in the map directory"}
-                    .NotRecorded(),
-                cache);
   visitor.Visit(OptionField{"teach_odometry", "--teach-odometry",
                             "The teach run's odometry: a CSV of timestamp,x,y,yaw (s, m, rad) or a recording with a "
                             "nav_msgs/Odometry topic, on the key images' clock; with the frames' odometry the belief "
@@ -62,6 +57,13 @@ void LocalizationSessionOptions::VisitFields(OptionFieldVisitor& visitor) {
                     .HideDefault()
                     .NotRecorded(),
                 teach_odometry_topic);
+  // The verifier and the translation thresholds follow the map (FollowMap): no field of the session's.
+  visitor.VisitNested("", localizer, Nesting{false, {"verifier", "translation"}});
+  visitor.Section(kRunSection);
+  visitor.VisitNested("", run);
+  visitor.Visit(OptionField{"cache", "!--no-cache", "Do not read or write the key-image cache in the map directory"}
+                    .NotRecorded(),
+                cache);
 }
 
 void LocalizationSessionOptions::Check() const {
@@ -98,6 +100,7 @@ void LocalizePipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(
       OptionField{"query", "query", "Video, image folder, TUM/EuRoC/KITTI sequence, or a single image"}.Positional(),
       query);
+  visitor.Section("Output");
   visitor.Visit(OptionField{"csv", "--csv", "Write one row per frame to this CSV file"}.HideDefault().NotRecorded(),
                 csv);
   visitor.Visit(OptionField{"json", "--json", "Write the run (summary and every frame) to this JSON file"}
@@ -110,6 +113,7 @@ void LocalizePipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
                 report);
   visitor.VisitNested("", source);
   visitor.VisitNested("", session);
+  visitor.Section("Route and odometry");
   visitor.Visit(OptionField{"odometry", "--odometry",
                             "Odometry of the query: a CSV of timestamp,x,y,yaw (s, m, rad) or a recording with a "
                             "nav_msgs/Odometry topic (default: the query recording's own, if any)"}

@@ -55,6 +55,7 @@ fs::path TemporaryMapFolder() {
 void SimulatePipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.VisitNested("", simulation);
   visitor.VisitNested("", matcher);
+  visitor.Section("Output");
   visitor.Visit(OptionField{"json", "--json", "Write the run (options, summary, every trial) to this JSON file"}
                     .HideDefault()
                     .NotRecorded(),

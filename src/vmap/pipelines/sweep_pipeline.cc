@@ -41,6 +41,7 @@ void SweepPipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
                     .Positional()
                     .NotRecorded(),
                 input);
+  visitor.Section("Sweep: the thresholds and what is written");
   visitor.Visit(OptionField{"thresholds", "--thresholds", "start:stop:step or a list a,b,c"}.NotRecorded(), thresholds);
   visitor.Visit(OptionField{"output", "-o,--output", "Directory for sweep.md, sweep.csv and sweep.json"}
                     .HideDefault()

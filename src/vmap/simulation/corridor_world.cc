@@ -87,6 +87,7 @@ struct CentreLine {
 }  // namespace
 
 void CorridorOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Section("Simulated corridor");
   visitor.Visit(
       OptionField{"width", "--corridor-width", "Corridor width between the walls (m)"}.Within(0.5, 50).Unit("m"),
       width);

@@ -8,6 +8,7 @@
 namespace vmap {
 
 void CameraRigOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Section("Simulated camera");
   visitor.Visit(OptionField{"width", "--camera-width", "Camera image width (pixels)"}.Within(64, 4096).Unit("px"),
                 width);
   visitor.Visit(OptionField{"height", "--camera-height", "Camera image height (pixels)"}.Within(48, 4096).Unit("px"),
@@ -54,6 +55,7 @@ PinholeView CameraView(const CameraRigOptions& options, const Pose2d& pose) {
 }
 
 void RobotNoiseOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Section("Simulated robot: motion and odometry noise");
   visitor.Visit(
       OptionField{"speed_noise", "--speed-noise", "Actuation: relative standard deviation of the executed speed"}
           .Within(0, 1),

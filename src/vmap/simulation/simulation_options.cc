@@ -10,6 +10,7 @@
 namespace vmap {
 
 void SimulationOptions::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Section("Simulation: the route and the trials");
   visitor.Visit({"route", "--route", "Route: straight, turn, s-curve, loop, or a CSV of x,y waypoints (m)"}, route);
   visitor.Visit(OptionField{"trials", "--trials", "Repeat runs from random offsets"}.Within(1, 100000), trials);
   visitor.Visit(OptionField{"seed", "--seed", "Seed of the offsets and the noise"}.AtLeast(0), seed);
