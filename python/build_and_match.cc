@@ -121,11 +121,12 @@ class PairMatcher {
 }  // namespace
 
 void BindBuildAndMatch(py::module_& m) {
-  m.def("build_map", &BuildMapFunction, py::arg("input"), py::arg("output_dir"),
-        "Builds a map as `vmap build INPUT -o OUTPUT_DIR` does (the build pipeline), its options as keywords "
-        "named as their fields (verifier_max_iterations=...) or as the CLI's flags (max_iters=...; "
-        "vmap.build_map_options() lists them), and returns it (vmap.read_map). Ctrl-C abandons the build and leaves "
-        "OUTPUT_DIR as it was.");
+  static const std::string build_map_doc = KeywordDocstring<BuildPipelineOptions>(
+      "Builds a map as `vmap build INPUT -o OUTPUT_DIR` does (the build pipeline), its options as keywords named as "
+      "their fields (verifier_max_iterations=...) or as the CLI's flags (max_iters=...; vmap.build_map_options() "
+      "lists them), and returns it (vmap.read_map). Ctrl-C abandons the build and leaves OUTPUT_DIR as it was.",
+      kBuildMapSkipped);
+  m.def("build_map", &BuildMapFunction, py::arg("input"), py::arg("output_dir"), build_map_doc.c_str());
   m.def(
       "build_map_options",
       [] {
@@ -136,9 +137,10 @@ void BindBuildAndMatch(py::module_& m) {
       },
       "The keywords vmap.build_map accepts.");
 
-  py::class_<PairMatcher>(m, "Matcher",
-                          "A matcher and verifier as `vmap match` sets them up (the same keywords as vmap.match), "
-                          "for matching many pairs.")
+  static const std::string matcher_doc = KeywordDocstring<PairMatchOptions>(
+      "A matcher and verifier as `vmap match` sets them up (the same keywords as vmap.match), for matching many "
+      "pairs.");
+  py::class_<PairMatcher>(m, "Matcher", matcher_doc.c_str())
       .def(py::init<const py::kwargs&>())
       .def("match", &PairMatcher::Match, py::arg("image0"), py::arg("image1"),
            "Matches two uint8 images (HxW grey or HxWx3 BGR); see vmap.match.")
@@ -150,9 +152,9 @@ void BindBuildAndMatch(py::module_& m) {
         return PairMatcher(kwargs).Match(image0, image1);
       },
       py::arg("image0"), py::arg("image1"),
-      "Matches one pair as `vmap match` does (keywords: its options, e.g. matcher='orb', verifier_threshold=0.5). "
-      "Returns num_tentative, num_verified, verified, similarity, F (3x3 or None), matches (N x 4 float32: x0 y0 "
-      "x1 y1), scores, inliers (N bools) and time_s.");
+      "Matches one pair as `vmap match` does (keywords: its options, e.g. matcher='orb', verifier_threshold=0.5; "
+      "help(vmap.Matcher) lists them). Returns num_tentative, num_verified, verified, similarity, F (3x3 or None), "
+      "matches (N x 4 float32: x0 y0 x1 y1), scores, inliers (N bools) and time_s.");
 }
 
 }  // namespace vmap::python

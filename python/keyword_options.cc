@@ -1,9 +1,13 @@
 #include "keyword_options.h"
 
 #include <algorithm>
+#include <sstream>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 #include "vmap/core/option_names.h"
+#include "vmap/core/option_ranges.h"
 
 #include "argument_errors.h"
 
@@ -35,6 +39,15 @@ std::vector<std::string> FlagKeywords(std::string flag, bool* negated) {
 
 bool IsOption(const OptionField& field) { return field.flag[0] == '-' || field.flag[0] == '!'; }
 
+// "int in [1, 2]", "float 0 or [1, 1000]": the type and the values the field takes, as --help gives them.
+std::string NumberType(const OptionField& field, bool integral) {
+  const std::string type = integral ? "int" : "float";
+  if (!field.range.is_set) return type;
+  return type + (field.range.also ? " " : " in ") + RangeText(field.range, integral);
+}
+
+std::string QuotedText(const std::string& text) { return "'" + text + "'"; }
+
 }  // namespace
 
 void KeywordOptions::OnEnter(const char* name, bool json_inline) { prefixes_.push_back(json_inline ? "" : name); }
@@ -42,25 +55,30 @@ void KeywordOptions::OnEnter(const char* name, bool json_inline) { prefixes_.pus
 void KeywordOptions::OnLeave(bool /*json_inline*/) { prefixes_.pop_back(); }
 
 void KeywordOptions::OnField(const OptionField& field, int& value) {
-  AddField(field, [&value](const py::handle& v, const std::string& what) { value = IntArgument(v, what); });
+  AddField(field, {NumberType(field, true), std::to_string(value)},
+           [&value](const py::handle& v, const std::string& what) { value = IntArgument(v, what); });
 }
 
 void KeywordOptions::OnField(const OptionField& field, double& value) {
-  AddField(field, [&value](const py::handle& v, const std::string& what) { value = FloatArgument(v, what); });
+  AddField(field, {NumberType(field, false), fmt::format("{}", value)},
+           [&value](const py::handle& v, const std::string& what) { value = FloatArgument(v, what); });
 }
 
 void KeywordOptions::OnField(const OptionField& field, bool& value) {
   AddField(
-      field, [&value](const py::handle& v, const std::string& what) { value = BoolArgument(v, what); },
+      field, {"bool", value ? "True" : "False"},
+      [&value](const py::handle& v, const std::string& what) { value = BoolArgument(v, what); },
       [&value](bool on) { value = on; });
 }
 
 void KeywordOptions::OnField(const OptionField& field, std::optional<double>& value) {
-  AddField(field, [&value](const py::handle& v, const std::string& what) { value = FloatArgument(v, what); });
+  AddField(field, {NumberType(field, false), value ? fmt::format("{}", *value) : "None"},
+           [&value](const py::handle& v, const std::string& what) { value = FloatArgument(v, what); });
 }
 
 void KeywordOptions::OnField(const OptionField& field, std::string& value) {
-  AddField(field, [&value](const py::handle& v, const std::string& what) { value = TextArgument(v, what); });
+  AddField(field, {"str", QuotedText(value)},
+           [&value](const py::handle& v, const std::string& what) { value = TextArgument(v, what); });
 }
 
 void KeywordOptions::OnField(const OptionField& field, std::vector<int>& /*value*/) {
@@ -68,25 +86,39 @@ void KeywordOptions::OnField(const OptionField& field, std::vector<int>& /*value
 }
 
 void KeywordOptions::OnField(const OptionField& field, const EnumField& value) {
-  AddField(field, [value](const py::handle& v, const std::string& what) {
-    if (!PyUnicode_Check(v.ptr()))
-      throw ArgumentTypeError(what + " takes a str (" + value.names() + "), not " + TypeName(v));
-    value.Parse(v.cast<std::string>());
-  });
+  AddField(field, {"str", QuotedText(value.name()), value.names()},
+           [value](const py::handle& v, const std::string& what) {
+             if (!PyUnicode_Check(v.ptr()))
+               throw ArgumentTypeError(what + " takes a str (" + value.names() + "), not " + TypeName(v));
+             value.Parse(v.cast<std::string>());
+           });
 }
 
-void KeywordOptions::AddField(const OptionField& field, Setter set, std::function<void(bool)> set_bool) {
+void KeywordOptions::AddField(const OptionField& field, const Described& described, Setter set,
+                              std::function<void(bool)> set_bool) {
   if (!IsOption(field)) return;  // no flag, or a positional argument: not an option a call takes by keyword
   std::string keyword;
   for (const std::string& prefix : prefixes_) {
     if (!prefix.empty()) keyword += prefix + "_";
   }
   keyword += field.path_name();
-  fields_.push_back({keyword, Path(field), std::move(set), std::move(set_bool)});
+  bool negated = false;
+  const std::vector<std::string> aliases = FlagKeywords(field.flag, &negated);
+  // The docstring's line: a negated flag's help says what its keyword does, so that keyword stands for the field.
+  std::string signature;
+  if (negated && !aliases.empty()) {
+    signature = aliases.front() + ": bool = " + (described.value == "True" ? "False" : "True") + " (the opposite of " +
+                keyword + ")";
+  } else {
+    // A default the help describes ("default: the first") is None's, what keeps it.
+    signature = keyword + ": " + described.type + " = " + (field.show_default ? described.value : "None");
+    if (!aliases.empty() && aliases.front() != keyword) signature += " (or " + aliases.front() + "=)";
+  }
+  fields_.push_back({keyword, Path(field), std::move(set), std::move(set_bool), section(), signature,
+                     field.lists_names ? field.help + described.names : field.help});
   const size_t index = fields_.size() - 1;
   AddKeyword(keyword, index, false);
-  bool negated = false;
-  for (const std::string& alias : FlagKeywords(field.flag, &negated)) {
+  for (const std::string& alias : aliases) {
     if (negated && !fields_[index].set_bool) throw std::logic_error("flag " + std::string(field.flag) + " is no bool");
     AddKeyword(alias, index, negated);
   }
@@ -109,6 +141,24 @@ std::vector<std::string> KeywordOptions::Keywords() const {
   std::vector<std::string> keywords;
   for (const auto& [keyword, entry] : keywords_) keywords.push_back(keyword);
   return keywords;  // a std::map's keys: sorted
+}
+
+std::string KeywordOptions::Documentation() const {
+  // The sections in the order each first appears, the fields in each in the order visited: --help's layout.
+  std::vector<std::string> sections;
+  for (const Field& field : fields_) {
+    if (std::find(sections.begin(), sections.end(), field.section) == sections.end()) sections.push_back(field.section);
+  }
+  std::ostringstream text;
+  for (const std::string& section : sections) {
+    text << "\n" << (section.empty() ? "Options" : section) << ":\n";
+    for (const Field& field : fields_) {
+      if (field.section != section) continue;
+      text << "    " << field.signature << "\n";
+      if (!field.help.empty()) text << "        " << field.help << "\n";
+    }
+  }
+  return text.str();
 }
 
 void KeywordOptions::Parse(const py::kwargs& kwargs) {

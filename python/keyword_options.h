@@ -40,6 +40,10 @@ class KeywordOptions final : public OptionFieldVisitor {
 
   // The keywords accepted (fields' names and flags' names), sorted.
   std::vector<std::string> Keywords() const;
+  // The keywords for a docstring, under the headings of the command's --help (OptionFieldVisitor::Section), in
+  // its order: "name: type = default" (the flag's name after "or" where it differs), then the flag's help. A
+  // negated flag's field is given by the flag's keyword (no_cache: bool = False), which its help describes.
+  std::string Documentation() const;
   // The paths of the fields Parse set ("min_verified"), for the checks of what was given.
   const std::vector<std::string>& Given() const { return given_; }
 
@@ -65,13 +69,24 @@ class KeywordOptions final : public OptionFieldVisitor {
     std::string path;     // as its checks name it
     Setter set;
     std::function<void(bool)> set_bool;  // bool fields: for the negated flag's keyword (no_cache=True)
+    // For Documentation(): the section, "name: type = default" (what the call takes), the flag's help.
+    std::string section;
+    std::string signature;
+    std::string help;
+  };
+  // How a field's value reads in a docstring: its Python type (with the values it takes) and its default.
+  struct Described {
+    std::string type;
+    std::string value;
+    std::string names = {};  // an enum's: "a, b or c", which a help that lists them ends with
   };
   struct Keyword {
     std::vector<size_t> fields;  // indices into fields_ (a flag several fields share sets each)
     bool negated = false;        // the keyword of a "!--no-x" flag: True sets the field false
   };
 
-  void AddField(const OptionField& field, Setter set, std::function<void(bool)> set_bool = {});
+  void AddField(const OptionField& field, const Described& described, Setter set,
+                std::function<void(bool)> set_bool = {});
   void AddKeyword(const std::string& keyword, size_t field, bool negated);
   std::string KeywordOf(const std::string& path) const;  // "" when no field has it
 
@@ -81,5 +96,15 @@ class KeywordOptions final : public OptionFieldVisitor {
   std::vector<std::string> prefixes_;  // of the structs entered: their names where their record nests them
   std::vector<std::string> given_;
 };
+
+// A docstring: `summary`, then the keywords a function takes from a default `Options` (but `skip`), by section
+// (KeywordOptions::Documentation), so that help(vmap.localize) lists what `vmap localize --help` does.
+template <typename Options>
+std::string KeywordDocstring(const std::string& summary, std::vector<const char*> skip = {}) {
+  Options options;
+  KeywordOptions keywords("");
+  keywords.Add(options, std::move(skip));
+  return summary + "\n\nKeywords (None keeps the default):\n" + keywords.Documentation();
+}
 
 }  // namespace vmap::python

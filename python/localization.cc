@@ -107,12 +107,14 @@ class FrameLocalizer {
   std::unique_ptr<LocalizationSession> session_;
 };
 
+// The localize pipeline's fields vmap.localize takes by keyword: not its positional arguments, nor the CLI's outputs.
+// The odometry's columns are not a result's, but its poses pace the belief (with the teach odometry).
+const std::vector<const char*> kLocalizeSkipped = {"map", "query", "csv", "json", "report"};
+
 py::list LocalizeFunction(const py::object& map, const py::object& query, const py::kwargs& kwargs) {
   LocalizePipelineOptions options;
   KeywordOptions keywords("localize");
-  // The outputs are the CLI's. The odometry's columns are not a result's, but its poses pace the belief (with the
-  // teach odometry).
-  keywords.Add(options, {"map", "query", "csv", "json", "report"});
+  keywords.Add(options, kLocalizeSkipped);
   keywords.Parse(kwargs);
   options.map = MapDirectory(map).string();
   options.query = TextArgument(query, "localize(): input");
@@ -130,9 +132,10 @@ py::list LocalizeFunction(const py::object& map, const py::object& query, const 
 }  // namespace
 
 void BindLocalization(py::module_& m) {
-  py::class_<FrameLocalizer>(m, "Localizer",
-                             "Localizes frames one at a time against a map (a vmap.Map or its directory), with the "
-                             "options of `vmap localize` as keywords (candidates=..., ranking=..., ...).")
+  static const std::string localizer_doc = KeywordDocstring<LocalizationSessionOptions>(
+      "Localizes frames one at a time against a map (a vmap.Map or its directory), with the options of `vmap "
+      "localize` as keywords (candidates=..., ranking=..., ...).");
+  py::class_<FrameLocalizer>(m, "Localizer", localizer_doc.c_str())
       .def(py::init<const py::object&, const py::kwargs&>(), py::arg("map"))
       .def("localize", &FrameLocalizer::Localize, py::arg("image"), py::arg("timestamp") = py::none(),
            py::arg("odometry") = py::none(),
@@ -142,9 +145,11 @@ void BindLocalization(py::module_& m) {
            "attributes are the columns of `vmap localize --csv` (status, "
            "key, next_key, similarity, heading_px, ...), with F, R and t as numpy arrays (None when unknown).")
       .def("reset", &FrameLocalizer::Reset, "Forgets the estimate: the next frame is relocalized.");
-  m.def("localize", &LocalizeFunction, py::arg("map"), py::arg("input"),
-        "Localizes every frame of INPUT (video, image folder, dataset or one image) as `vmap localize MAP INPUT` "
-        "does, with its options as keywords; returns one result per frame (see Localizer.localize).");
+  static const std::string localize_doc = KeywordDocstring<LocalizePipelineOptions>(
+      "Localizes every frame of INPUT (video, image folder, dataset or one image) as `vmap localize MAP INPUT` does, "
+      "with its options as keywords; returns one result per frame (see Localizer.localize).",
+      kLocalizeSkipped);
+  m.def("localize", &LocalizeFunction, py::arg("map"), py::arg("input"), localize_doc.c_str());
 }
 
 }  // namespace vmap::python

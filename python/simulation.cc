@@ -36,11 +36,12 @@ py::object SimulateFunction(const py::kwargs& kwargs) {
 }  // namespace
 
 void BindSimulation(py::module_& m) {
-  m.def("simulate", &SimulateFunction,
-        "Teaches a route in a simulated corridor and repeats it from random offsets with vmap's localizer and route "
-        "controller in the loop, as `vmap simulate` does, with its options as keywords (route='turn', trials=10, "
-        "law='tracker', matcher='orb', json=..., report=..., map=...). Returns the run as `vmap simulate --json` "
-        "writes it: a dict with options, route, teach, summary and every trial with its samples.");
+  static const std::string doc = KeywordDocstring<SimulatePipelineOptions>(
+      "Teaches a route in a simulated corridor and repeats it from random offsets with vmap's localizer and route "
+      "controller in the loop, as `vmap simulate` does, with its options as keywords (route='turn', trials=10, "
+      "law='tracker', matcher='orb', json=..., report=..., map=...). Returns the run as `vmap simulate --json` "
+      "writes it: a dict with options, route, teach, summary and every trial with its samples.");
+  m.def("simulate", &SimulateFunction, doc.c_str());
 }
 
 }  // namespace vmap::python

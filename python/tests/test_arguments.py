@@ -2,6 +2,7 @@
 vmap.Error), a bad value a vmap.Error, never a crash; an image's size is checked before any copy. Options are
 keywords named as their fields, with the CLI's flag names as aliases."""
 import os
+import re
 import subprocess
 import sys
 
@@ -146,6 +147,40 @@ def test_keywords_are_field_names_with_the_flags_as_aliases():
     b = vmap.Matcher(threshold=1.5, seed=7)
     image = np.zeros((64, 64), np.uint8)
     assert a.name == b.name == "orb" and a.match(image, image).num_tentative == b.match(image, image).num_tentative
+
+
+def documented_keywords(doc):
+    """The keywords a docstring's "Keywords" part lists: 'name: type = default (or alias=)' lines."""
+    line_of_keyword = re.compile(r"^    (\w+): (int|float|bool|str)\b.* = \S+(?: \((?:or (\w+)=|the opposite of (\w+))\))?$")
+    names = set()
+    for line in doc.split("Keywords (None keeps the default):")[1].splitlines():
+        match = line_of_keyword.match(line)
+        if match:
+            names.update(name for name in (match.group(1), match.group(3), match.group(4)) if name)
+    return names
+
+
+def test_help_lists_every_keyword_under_the_headings_of_the_commands_help():
+    doc = vmap.build_map.__doc__
+    documented = documented_keywords(doc)
+    accepted = set(vmap.build_map_options())
+    # Every keyword taken is documented, by its field's name or its flag's.
+    assert documented == accepted
+    # The headings of `vmap build --help`, in its order; a negated flag by the keyword its help describes.
+    headings = [h for h in ("Input:", "Matcher and features", "Verifier: the fundamental matrix:", "Key images:")]
+    positions = [doc.index("\n" + h) for h in headings]
+    assert positions == sorted(positions)
+    assert ("    no_final_key: bool = False (the opposite of final_key)\n"
+            "        Do not make the last frame a key image") in doc
+    assert "    verifier_max_iterations: int in [1, 10000000] = 100000 (or max_iters=)" in doc
+    # The localizer's: what a user sets first, the rules after, and a default the help describes is None's.
+    doc = vmap.localize.__doc__
+    assert doc.index("\nRoute and odometry:") < doc.index("\nAcceptance: when a frame is at a key image:") < \
+        doc.index("\nRules across seasons and lighting") < doc.index("\nRun: threads, caches and seeds:")
+    assert "    from: int = None\n        Follow the route from this key image (default: the first)" in doc
+    assert "csv" not in documented_keywords(doc)  # the CLI's outputs are not the function's
+    assert documented_keywords(vmap.Localizer.__doc__) <= documented_keywords(doc)
+    assert "matcher: str = 'orb'" in vmap.Matcher.__doc__ and "route: str = " in vmap.simulate.__doc__
 
 
 def test_errors_name_options_by_keyword(tmp_path):

@@ -168,12 +168,12 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "Never move a tracked frame on to the next key image because the belief puts it past that key "
                  "image (only the verified counts step on)"},
                 step_on_by_belief);
-  visitor.Visit(
-      OptionField{"step_on_by_belief_ahead", "--step-on-by-belief-ahead",
-                  "step_on_by_belief: the positions past each key image ahead whose belief is weighed against the two "
-                  "at and behind the key image the tracker is at (3: as before 2026-12-04)"}
-          .Within(1, 5),
-      step_on_by_belief_ahead);
+  visitor.Visit(OptionField{"step_on_by_belief_ahead", "--step-on-by-belief-ahead",
+                            "The step on by the belief (--no-step-on-by-belief): the positions past each key image "
+                            "ahead whose belief is weighed against the two "
+                            "at and behind the key image the tracker is at (3: as before 2026-12-04)"}
+                    .Within(1, 5),
+                step_on_by_belief_ahead);
   visitor.Visit({"hold_unearned_step_on", "!--no-hold-unearned-step-on",
                  "Keep a step on the belief undoes when the key image it passed does not verify (as before)"},
                 hold_unearned_step_on);
@@ -305,7 +305,7 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
           .Within(0, 100000),
       lagging_start_frames);
   visitor.Visit({"lagging_step_weighs_belief", "!--no-lagging-step-weighs-belief",
-                 "a lagging tracker's step further ahead moves the tracker only, not the belief (it weighs the place "
+                 "A lagging tracker's step further ahead moves the tracker only, not the belief (it weighs the place "
                  "stepped to ten to one otherwise)"},
                 lagging_step_weighs_belief);
   visitor.Visit(
@@ -322,19 +322,19 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "(otherwise only frames steered by remember one)"},
                 rival_place_when_not_steered);
   visitor.Visit({"rank_evidence", "!--no-rank-evidence",
-                 "never weigh the belief by the relocalization's ranking of a frame (the comparisons alone)"},
+                 "Never weigh the belief by the relocalization's ranking of a frame (the comparisons alone)"},
                 rank_evidence);
   visitor.Visit({"rank_by_standout", "!--no-rank-by-standout",
-                 "weigh the belief by an XFeat (float-descriptor) frame's ranking by the key image's rank, not by how "
+                 "Weigh the belief by an XFeat (float-descriptor) frame's ranking by the key image's rank, not by how "
                  "far its votes stand out of the frame's (ORB's always by how far they stand out)"},
                 rank_by_standout);
   visitor.Visit({"verified_ranking_steers", "!--no-verified-ranking-steers",
-                 "never steer by an ORB frame the belief doubts before the frame's own ranking, even where its key "
+                 "Never steer by an ORB frame the belief doubts before the frame's own ranking, even where its key "
                  "images pass chance and the belief with its ranking singles them out"},
                 verified_ranking_steers);
   visitor.Visit(
       {"steer_where_belief_stays", "!--no-steer-where-belief-stays",
-       "never steer by a frame a far place left uncertain for want of a second frame, even where the belief "
+       "Never steer by a frame a far place left uncertain for want of a second frame, even where the belief "
        "still singles out the tracker's place, a key image there verifies beyond a little chance and no far one "
        "verifies --min-rival-ratio times as many matches"},
       steer_where_belief_stays);
@@ -394,7 +394,7 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
       lost_frame_next_heading_ratio);
   visitor.Visit(
       OptionField{"still_frame_share", "--still-frame-share",
-                  "a frame whose matches with the frame before moved less than half a pixel in this share stands "
+                  "A frame whose matches with the frame before moved less than half a pixel in this share stands "
                   "still: it is not stepped on, nor placed beyond two key images of its estimate by a lost frame's "
                   "heading, nor counted in a held tracker (0: no frame is still)"}
           .Within(0, 1),
