@@ -53,8 +53,6 @@ fs::path TemporaryMapFolder() {
 }  // namespace
 
 void SimulatePipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.VisitNested("", simulation);
-  visitor.VisitNested("", matcher);
   visitor.Section("Output");
   visitor.Visit(OptionField{"json", "--json", "Write the run (options, summary, every trial) to this JSON file"}
                     .HideDefault()
@@ -66,6 +64,8 @@ void SimulatePipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
                 report);
   visitor.Visit(OptionField{"map", "--map", "Keep the teach run's map in this directory"}.HideDefault().NotRecorded(),
                 map);
+  visitor.VisitNested("", simulation);
+  visitor.VisitNested("", matcher);
 }
 
 void SimulatePipelineOptions::Check() const {
