@@ -1,11 +1,14 @@
 // End-to-end tests of the vmap binary: real sequences in every layout, and every kind of bad input.
 
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "vmap/core/option_fields.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/map/map_io.h"
 #include "vmap/testing/run_vmap.h"
@@ -309,6 +312,32 @@ TEST(Cli, DifferentFrameSizesWarnOrFailWhenStrict) {
   EXPECT_EQ(RunVmap("build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "m2") + " --strict", &out), 2)
       << out;
   EXPECT_NE(out.find("frame_3.png"), std::string::npos) << out;
+}
+
+// `vmap --help` lists the commands under headings, the teach-and-repeat workflow first; a command's --help lists its
+// flags under the headings of its options' field lists, what a user sets every day before the localizer's rules.
+TEST(Cli, HelpListsCommandsAndFlagsUnderHeadings) {
+  std::string out;
+  ASSERT_EQ(RunVmap("--help", &out), 0) << out;
+  const std::vector<std::string> in_order = {"Teach and repeat:", "  build",         "  localize",
+                                             "  simulate",        "Look into a map", "  info",
+                                             "  match",           "Set up:",         "  weights"};
+  size_t at = 0;
+  for (const std::string& text : in_order) {
+    const size_t found = out.find(text, at);
+    ASSERT_NE(found, std::string::npos) << text << " after position " << at << " in\n" << out;
+    at = found;
+  }
+  ASSERT_EQ(RunVmap("localize --help", &out), 0) << out;
+  at = 0;
+  for (const std::string& text :
+       {"Output:", "  --csv", "Input:", "  --first", "Route and odometry:", "  --from", "  --odometry ",
+        "Start: where on the route", "  --start-key", "Acceptance:", "Rules across seasons and lighting",
+        "  --no-doubt-jump-back", kRunSection, "  --threads", "  --no-cache"}) {
+    const size_t found = out.find(text, at);
+    ASSERT_NE(found, std::string::npos) << text << " after position " << at << " in\n" << out;
+    at = found;
+  }
 }
 
 }  // namespace vmap

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <initializer_list>
 #include <new>
 #include <stdexcept>
 
@@ -26,17 +27,19 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", quiet, "Only warnings and errors; no progress line");
   app.parse_complete_callback([&] { vmap::ConfigureLogging(quiet ? "quiet" : verbose ? "debug" : "info"); });
 
-  vmap::cli::AddBuildCommand(app);
-  vmap::cli::AddInfoCommand(app);
-  vmap::cli::AddSweepCommand(app);
-  vmap::cli::AddMatchCommand(app);
-  vmap::cli::AddWeightsCommand(app);
-  vmap::cli::AddReportCommand(app);
-  vmap::cli::AddDrawCommand(app);
-  vmap::cli::AddEvalCommand(app);
-  vmap::cli::AddLocalizeCommand(app);
-  vmap::cli::AddRouteCommand(app);
-  vmap::cli::AddSimulateCommand(app);
+  // `vmap --help` lists the commands under these headings, in this order: the teach-and-repeat workflow first.
+  const auto add = [&app](const char* heading, std::initializer_list<void (*)(CLI::App&)> commands) {
+    for (const auto command : commands) {
+      command(app);
+      app.get_subcommands({}).back()->group(heading);
+    }
+  };
+  add("Teach and repeat", {vmap::cli::AddBuildCommand, vmap::cli::AddLocalizeCommand, vmap::cli::AddRouteCommand,
+                           vmap::cli::AddSimulateCommand});
+  add("Look into a map, a run or an image pair",
+      {vmap::cli::AddInfoCommand, vmap::cli::AddReportCommand, vmap::cli::AddEvalCommand, vmap::cli::AddSweepCommand,
+       vmap::cli::AddMatchCommand, vmap::cli::AddDrawCommand});
+  add("Set up", {vmap::cli::AddWeightsCommand});
 
   // Every failure ends as "vmap: error: ..." with status 2; 0 is success, --help and --version included.
   try {
