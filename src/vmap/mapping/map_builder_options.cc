@@ -48,14 +48,6 @@ void MapBuilderOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.VisitNested("key_images", key_images, at_top_level);
   visitor.Visit(OptionField{"quality_mean", "--quality", "Mean used by the quality Q: "}.ListingNames(),
                 EnumField(quality_mean, kQualityMeanNames, ParseQualityMean));
-  visitor.Section(kRunSection);
-  visitor.Visit(
-      OptionField{"extraction_threads", "--threads", "Feature-extraction threads, 0 to 256 (0 = one per core)"}
-          .NotRecorded()
-          .Within(0, kMaxExtractionThreads)
-          .Meaning("0: one per core"),
-      extraction_threads);
-  visitor.Section("Key images");
   visitor.VisitNested("link_analysis", link_analysis, at_top_level);
   visitor.VisitNested("verifier", verifier);
   visitor.Visit({"exhaustive", "--exhaustive",
@@ -73,6 +65,13 @@ void MapBuilderOptions::VisitFields(OptionFieldVisitor& visitor) {
           .Within(2, 4096)
           .Unit("frames"),
       search_window);
+  visitor.Section(kRunSection);
+  visitor.Visit(
+      OptionField{"extraction_threads", "--threads", "Feature-extraction threads, 0 to 256 (0 = one per core)"}
+          .NotRecorded()
+          .Within(0, kMaxExtractionThreads)
+          .Meaning("0: one per core"),
+      extraction_threads);
 }
 
 }  // namespace vmap
