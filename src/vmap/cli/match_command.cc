@@ -68,7 +68,7 @@ void AddMatchCommand(CLI::App& app) {
       "Match one image pair: tentative matches (in original image pixels, with confidence), the verified "
       "subset and F, and the heading (x in image1 minus x in image0; degrees with --camera)");
   AddOptionFlags(command, flags->options, flags->option_flags);
-  command->add_flag("--list", flags->list, "Print every match: x0 y0 x1 y1 score inlier");
+  command->add_flag("--list", flags->list, "Print every match: x0 y0 x1 y1 score inlier")->group(kOutputSection);
   command->callback([flags] { flags->option_flags.Run([&] { RunMatch(*flags); }); });
 }
 

@@ -142,8 +142,10 @@ class EnumField {
   std::string names_;
 };
 
-// The --help section of how a command is carried out rather than what it computes (threads, caches, seeds), which
-// several options structs share (OptionFieldVisitor::Section).
+// The --help sections several options structs share (OptionFieldVisitor::Section): what a command writes, what it
+// reads, and how it is carried out rather than what it computes (threads, caches, seeds).
+inline constexpr char kOutputSection[] = "Output";
+inline constexpr char kInputSection[] = "Input";
 inline constexpr char kRunSection[] = "Run: threads, caches and seeds";
 
 // How a nested struct is visited (OptionFieldVisitor::VisitNested).

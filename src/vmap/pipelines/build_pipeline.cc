@@ -97,7 +97,7 @@ void BuildPipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(
       OptionField{"input", "input", "Video file, image folder, TUM RGB-D, EuRoC or KITTI sequence"}.Positional(),
       input);
-  visitor.Section("Output");
+  visitor.Section(kOutputSection);
   visitor.Visit(OptionField{"output", "-o,--output", "Map directory to write (default: <input name>_map)"}
                     .HideDefault()
                     .NotRecorded(),
@@ -109,7 +109,7 @@ void BuildPipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Section("Key images");
   visitor.Visit(OptionField{"tau", "-t,--tau", tau_help.c_str()}.HideDefault().NotRecorded(), tau);
   visitor.VisitNested("", map, Nesting{false, {"verifier"}});
-  visitor.Section("Output");
+  visitor.Section(kOutputSection);
   visitor.Visit(OptionField{"report", "--report", "Also write report.html into the map directory"}.NotRecorded(),
                 report);
   visitor.Visit(OptionField{"snapshot_every", "--snapshot-every",

@@ -100,7 +100,7 @@ void LocalizePipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(
       OptionField{"query", "query", "Video, image folder, TUM/EuRoC/KITTI sequence, or a single image"}.Positional(),
       query);
-  visitor.Section("Output");
+  visitor.Section(kOutputSection);
   visitor.Visit(OptionField{"csv", "--csv", "Write one row per frame to this CSV file"}.HideDefault().NotRecorded(),
                 csv);
   visitor.Visit(OptionField{"json", "--json", "Write the run (summary and every frame) to this JSON file"}

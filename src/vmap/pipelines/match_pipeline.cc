@@ -33,12 +33,12 @@ void PairMatchOptions::Check() const {
 void MatchPipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(OptionField{"image0", "image0", "First image"}.Positional(), image0);
   visitor.Visit(OptionField{"image1", "image1", "Second image"}.Positional(), image1);
-  visitor.Section("Output");
+  visitor.Section(kOutputSection);
   visitor.Visit(OptionField{"json", "--json", "Also write every match, the inlier mask and F to this JSON file"}
                     .HideDefault()
                     .NotRecorded(),
                 json);
-  visitor.Section("Input");
+  visitor.Section(kInputSection);
   visitor.Visit(OptionField{"camera", "--camera",
                             "Intrinsics of both images (fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]] or a calibration "
                             "file): the heading also in degrees"}

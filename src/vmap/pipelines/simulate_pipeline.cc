@@ -53,7 +53,7 @@ fs::path TemporaryMapFolder() {
 }  // namespace
 
 void SimulatePipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Section("Output");
+  visitor.Section(kOutputSection);
   visitor.Visit(OptionField{"json", "--json", "Write the run (options, summary, every trial) to this JSON file"}
                     .HideDefault()
                     .NotRecorded(),

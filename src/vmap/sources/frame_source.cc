@@ -275,7 +275,7 @@ std::unique_ptr<FrameSource> OpenFrameSource(const std::string& path, const Fram
 }
 
 void FrameSourceOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Section("Input");
+  visitor.Section(kInputSection);
   visitor.Visit(OptionField{"format", "--format", "Input layout: "}.ListingNames(),
                 EnumField(format, kSourceFormatNames, ParseSourceFormat));
   visitor.Visit(OptionField{"first", "--first", "First frame (0-based)"}.AtLeast(0), first);
