@@ -55,29 +55,30 @@ void KeywordOptions::OnEnter(const char* name, bool json_inline) { prefixes_.pus
 void KeywordOptions::OnLeave(bool /*json_inline*/) { prefixes_.pop_back(); }
 
 void KeywordOptions::OnField(const OptionField& field, int& value) {
-  AddField(field, {NumberType(field, true), std::to_string(value)},
+  AddField(field, documenting_ ? Described{NumberType(field, true), std::to_string(value)} : Described{},
            [&value](const py::handle& v, const std::string& what) { value = IntArgument(v, what); });
 }
 
 void KeywordOptions::OnField(const OptionField& field, double& value) {
-  AddField(field, {NumberType(field, false), fmt::format("{}", value)},
+  AddField(field, documenting_ ? Described{NumberType(field, false), fmt::format("{}", value)} : Described{},
            [&value](const py::handle& v, const std::string& what) { value = FloatArgument(v, what); });
 }
 
 void KeywordOptions::OnField(const OptionField& field, bool& value) {
   AddField(
-      field, {"bool", value ? "True" : "False"},
+      field, documenting_ ? Described{"bool", value ? "True" : "False"} : Described{},
       [&value](const py::handle& v, const std::string& what) { value = BoolArgument(v, what); },
       [&value](bool on) { value = on; });
 }
 
 void KeywordOptions::OnField(const OptionField& field, std::optional<double>& value) {
-  AddField(field, {NumberType(field, false), value ? fmt::format("{}", *value) : "None"},
+  AddField(field,
+           documenting_ ? Described{NumberType(field, false), value ? fmt::format("{}", *value) : "None"} : Described{},
            [&value](const py::handle& v, const std::string& what) { value = FloatArgument(v, what); });
 }
 
 void KeywordOptions::OnField(const OptionField& field, std::string& value) {
-  AddField(field, {"str", QuotedText(value)},
+  AddField(field, documenting_ ? Described{"str", QuotedText(value)} : Described{},
            [&value](const py::handle& v, const std::string& what) { value = TextArgument(v, what); });
 }
 
@@ -86,7 +87,7 @@ void KeywordOptions::OnField(const OptionField& field, std::vector<int>& /*value
 }
 
 void KeywordOptions::OnField(const OptionField& field, const EnumField& value) {
-  AddField(field, {"str", QuotedText(value.name()), value.names()},
+  AddField(field, documenting_ ? Described{"str", QuotedText(value.name()), value.names()} : Described{},
            [value](const py::handle& v, const std::string& what) {
              if (!PyUnicode_Check(v.ptr()))
                throw ArgumentTypeError(what + " takes a str (" + value.names() + "), not " + TypeName(v));
@@ -104,18 +105,21 @@ void KeywordOptions::AddField(const OptionField& field, const Described& describ
   keyword += field.path_name();
   bool negated = false;
   const std::vector<std::string> aliases = FlagKeywords(field.flag, &negated);
-  // The docstring's line: a negated flag's help says what its keyword does, so that keyword stands for the field.
-  std::string signature;
-  if (negated && !aliases.empty()) {
-    signature = aliases.front() + ": bool = " + (described.value == "True" ? "False" : "True") + " (the opposite of " +
-                keyword + ")";
-  } else {
-    // A default the help describes ("default: the first") is None's, what keeps it.
-    signature = keyword + ": " + described.type + " = " + (field.show_default ? described.value : "None");
-    if (!aliases.empty() && aliases.front() != keyword) signature += " (or " + aliases.front() + "=)";
+  Field entry{keyword, Path(field), std::move(set), std::move(set_bool)};
+  if (documenting_) {
+    // The docstring's line: a negated flag's help says what its keyword does, so that keyword stands for the field.
+    entry.section = section();
+    if (negated && !aliases.empty()) {
+      entry.signature = aliases.front() + ": bool = " + (described.value == "True" ? "False" : "True") +
+                        " (the opposite of " + keyword + ")";
+    } else {
+      // A default the help describes ("default: the first") is None's, what keeps it.
+      entry.signature = keyword + ": " + described.type + " = " + (field.show_default ? described.value : "None");
+      if (!aliases.empty() && aliases.front() != keyword) entry.signature += " (or " + aliases.front() + "=)";
+    }
+    entry.help = field.help + (field.lists_names ? described.names : "");
   }
-  fields_.push_back({keyword, Path(field), std::move(set), std::move(set_bool), section(), signature,
-                     field.lists_names ? field.help + described.names : field.help});
+  fields_.push_back(std::move(entry));
   const size_t index = fields_.size() - 1;
   AddKeyword(keyword, index, false);
   for (const std::string& alias : aliases) {
@@ -144,6 +148,7 @@ std::vector<std::string> KeywordOptions::Keywords() const {
 }
 
 std::string KeywordOptions::Documentation() const {
+  if (!documenting_) throw std::logic_error("KeywordOptions::Documentation needs a documenting KeywordOptions");
   // The sections in the order each first appears, the fields in each in the order visited: --help's layout.
   std::vector<std::string> sections;
   for (const Field& field : fields_) {

@@ -23,8 +23,10 @@ namespace vmap::python {
 
 class KeywordOptions final : public OptionFieldVisitor {
  public:
-  // `function`: the Python function's name, for messages ("build_map").
-  explicit KeywordOptions(std::string function) : function_(std::move(function)) {}
+  // `function`: the Python function's name, for messages ("build_map"). `documenting`: also keep each field's line
+  // for Documentation() (KeywordDocstring, once when the module loads); a call's parsing skips that work.
+  explicit KeywordOptions(std::string function, bool documenting = false)
+      : function_(std::move(function)), documenting_(documenting) {}
 
   // The fields of `options` (a struct with VisitFields), but those whose key is in `skip` (the call's positional
   // arguments, a front end's own options). `options` must outlive Parse.
@@ -43,6 +45,7 @@ class KeywordOptions final : public OptionFieldVisitor {
   // The keywords for a docstring, under the headings of the command's --help (OptionFieldVisitor::Section), in
   // its order: "name: type = default" (the flag's name after "or" where it differs), then the flag's help. A
   // negated flag's field is given by the flag's keyword (no_cache: bool = False), which its help describes.
+  // Needs `documenting`.
   std::string Documentation() const;
   // The paths of the fields Parse set ("min_verified"), for the checks of what was given.
   const std::vector<std::string>& Given() const { return given_; }
@@ -91,6 +94,7 @@ class KeywordOptions final : public OptionFieldVisitor {
   std::string KeywordOf(const std::string& path) const;  // "" when no field has it
 
   std::string function_;
+  bool documenting_ = false;
   std::vector<Field> fields_;
   std::map<std::string, Keyword> keywords_;
   std::vector<std::string> prefixes_;  // of the structs entered: their names where their record nests them
@@ -102,7 +106,7 @@ class KeywordOptions final : public OptionFieldVisitor {
 template <typename Options>
 std::string KeywordDocstring(const std::string& summary, std::vector<const char*> skip = {}) {
   Options options;
-  KeywordOptions keywords("");
+  KeywordOptions keywords("", /*documenting=*/true);
   keywords.Add(options, std::move(skip));
   return summary + "\n\nKeywords (None keeps the default):\n" + keywords.Documentation();
 }

@@ -167,7 +167,7 @@ def test_help_lists_every_keyword_under_the_headings_of_the_commands_help():
     # Every keyword taken is documented, by its field's name or its flag's.
     assert documented == accepted
     # The headings of `vmap build --help`, in its order; a negated flag by the keyword its help describes.
-    headings = [h for h in ("Input:", "Matcher and features", "Verifier: the fundamental matrix:", "Key images:")]
+    headings = ("Input:", "Matcher and features", "Verifier: the fundamental matrix:", "Key images:")
     positions = [doc.index("\n" + h) for h in headings]
     assert positions == sorted(positions)
     assert ("    no_final_key: bool = False (the opposite of final_key)\n"
