@@ -319,6 +319,10 @@ TEST(Cli, DifferentFrameSizesWarnOrFailWhenStrict) {
 TEST(Cli, HelpListsCommandsAndFlagsUnderHeadings) {
   std::string out;
   ASSERT_EQ(RunVmap("--help", &out), 0) << out;
+  // `vmap` alone prints the same list, not an error.
+  std::string bare;
+  ASSERT_EQ(RunVmap("", &bare), 0) << bare;
+  EXPECT_EQ(bare, out);
   const std::vector<std::string> in_order = {"Teach and repeat:", "  build",         "  localize",
                                              "  simulate",        "Look into a map", "  info",
                                              "  match",           "Set up:",         "  weights"};

@@ -18,7 +18,8 @@ int main(int argc, char** argv) {
   // First, while this is the only thread: signal handling (an interrupted command removes its unfinished
   // outputs and exits with 128 + the signal), OpenCV's threads, malloc, FFmpeg's log (see runtime.h).
   vmap::InitializeRuntime();
-  CLI::App app{"vmap: visual maps for vision-only robot navigation (key images linked by fundamental matrices)"};
+  CLI::App app{"vmap: visual maps for vision-only robot navigation (key images linked by fundamental matrices)",
+               "vmap"};
   app.set_version_flag("--version", std::string("vmap ") + VMAP_VERSION);
   app.require_subcommand(1);
   app.fallthrough();  // global flags may follow the subcommand
@@ -41,6 +42,11 @@ int main(int argc, char** argv) {
        vmap::cli::AddMatchCommand, vmap::cli::AddDrawCommand});
   add("Set up", {vmap::cli::AddWeightsCommand});
 
+  // `vmap` alone lists the commands, as `colmap` and `git` do: a first try is not an error.
+  if (argc == 1) {
+    std::fputs(app.help().c_str(), stdout);
+    return 0;
+  }
   // Every failure ends as "vmap: error: ..." with status 2; 0 is success, --help and --version included.
   try {
     vmap::cli::RefuseEmptyArguments(argc, argv);
