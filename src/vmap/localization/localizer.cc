@@ -213,6 +213,7 @@ void Localizer::Reset() {
   if (start_position_ >= 0) belief_.Start(start_position_, options_.start_mass);
   start_unconfirmed_ = start_position_ >= 0 && options_.start_is_hint;
   pointed_ = pointed_before_ = -1;
+  start_question_.reset();
   confident_peak_ = confident_peak_before_ = -1;
   rival_place_ = -1;
   rival_frames_left_ = 0;

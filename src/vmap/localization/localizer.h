@@ -224,6 +224,9 @@ class Localizer {
   // cannot tell its place from a far one.
   bool StartPlaceTiesFar(const LocalizationResult& result, const ImageFeatures& features,
                          const std::vector<RankedKey>& ranked);
+  // The far key image StartPlaceTiesFar compared for its question alone, weighed into both beliefs once the frame is
+  // decided (LocalizerOptions::start_question_weighs); nothing when it compared none.
+  void WeighStartQuestion();
   // evidence_belief_ alone weighed by the frame's ranking `ranked`, as WeighRanking weighs both beliefs for a frame
   // ranked before its moves (localizer_start_place.cc).
   void WeighEvidenceByRanking(const std::vector<RankedKey>& ranked);
@@ -475,6 +478,8 @@ class Localizer {
   // -1: none. Compared again for rival_frames_left_ more frames.
   int rival_place_ = -1;
   int rival_frames_left_ = 0;
+  // The comparison StartPlaceTiesFar made for its question alone this frame, until WeighStartQuestion weighs it.
+  std::optional<KeyComparison> start_question_;
   int pointed_ = -1;         // the far route position this frame's relocalization pointed at; -1: none
   int pointed_before_ = -1;  // the previous frame's
   // How many key images Track moved the estimate on this frame (LocalizerOptions::lookahead); 0: none.

@@ -197,6 +197,7 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
       result.status = LocalizationStatus::kTracking;
     }
   }
+  WeighStartQuestion();  // the frames after this one carry it
 }
 
 void Localizer::MoveTrackerTo(LocalizationResult& result, int position, LocalizationStatus status,

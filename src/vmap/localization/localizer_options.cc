@@ -42,6 +42,10 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
                  "--start-key, float descriptors: steer by a frame before the start is confirmed even where a key "
                  "image more than two places away verifies as much (otherwise it is uncertain)"},
                 start_place_stands_out);
+  visitor.Visit({"start_question_weighs", "!--no-start-question-weighs",
+                 "--start-key, float descriptors: the far key image compared to ask whether the start's place stands "
+                 "out is not weighed into the belief (otherwise it weighs it once the frame is decided)"},
+                start_question_weighs);
   visitor.Visit({"start_evidence_ranks_frame", "!--no-start-evidence-ranks-frame",
                  "--start-key, float descriptors: before the start is confirmed, the frames' evidence alone weighs a "
                  "tracked frame by its comparisons only (otherwise by its ranking too)"},

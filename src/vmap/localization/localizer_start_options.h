@@ -40,6 +40,16 @@ struct StartOptions {
   // started elsewhere confirms a place that stands out"). Only on routes where a key image and the two either side
   // hold at most half the route (as start_needs_evidence). Off: a frame confirms the start by the beliefs alone.
   bool start_place_stands_out = true;
+  // With start_place_stands_out, the far key image compared for its question alone is evidence like any comparison: it
+  // weighs both beliefs once the frame is decided (the frame's own status and key images as without it), so the
+  // frames after it carry what it verified. Left unweighed, a run started elsewhere whose tracker reached a look-alike
+  // had the right place weighed mostly where the tracker compared it: the kidnapped run from its frame 51 (repeat frame
+  // 80, started at key image 0) at the verifier's seeds 75, 216, 227 and 228 was steered by at key images 11-13
+  // (right: 23-31) on 20 frames; weighed, none, and the belief finds the right place on the run's first frames. It is
+  // weighed whichever way it points: where the tracker is right, a look-alike's comparison pulls the belief too, and a
+  // few first frames of a run are uncertain rather than steered by (docs/measurements/localization-conditions.md, "The
+  // start's question weighs the belief"). Off: the question's comparison is not weighed.
+  bool start_question_weighs = true;
   // With start_is_hint and float descriptors (XFeat), while the start is unconfirmed a frame placed without being
   // ranked (the tracker's) weighs the frames' evidence alone (not the belief: the tracker is as without it) by its
   // ranking, as a ranked frame weighs both: that evidence otherwise holds a tracked frame's comparisons only where the

@@ -10,9 +10,14 @@
 // key image 13 with 24 matches and 29, compared for the question alone, with 23; its comparisons at 12-14 swung the
 // frames' evidence from 28 to 12, which confirmed the start there, 15 key images off ("A start confirmed at a
 // look-alike is asked by the frame's ranking").
+// The far key image compared for the question alone weighs both beliefs once the frame is decided
+// (LocalizerOptions::start_question_weighs): unweighed, a tracker held at a look-alike kept the right place out of the
+// belief, the frames uncertain at the look-alike until a relocalization found it ("The start's question weighs the
+// belief").
 #include <algorithm>
 #include <cstdlib>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "vmap/localization/localizer.h"
@@ -61,18 +66,32 @@ bool Localizer::StartPlaceTiesFar(const LocalizationResult& result, const ImageF
   for (const Memo& m : comparisons_) {
     if (far(route_position_of_key_[m.comparison.key]) && ties(m.comparison)) return true;
   }
-  // The likeliest far place, as the frame's descriptors tell, when the frame did not compare it: compared now, without
-  // weighing either belief (nor the belief by the frame's ranking, when the frame was not ranked): the frames' evidence
-  // is what the beliefs weighed; this only asks whether the frame can tell its place from a far one.
+  // The likeliest far place, as the frame's descriptors tell, when the frame did not compare it: compared now. It asks
+  // whether the frame can tell its place from a far one; the beliefs weigh it only once the frame is decided
+  // (WeighStartQuestion), so that the frame's own decisions are as the frames' evidence before it made them.
   for (const RankedKey& r : ranked) {  // route positions, best first
     if (!far(r.key)) continue;
     const int key = route_[r.key];
     for (const Memo& m : comparisons_) {
       if (m.comparison.key == key) return false;  // compared above
     }
-    return ties(Compare(features, key));
+    KeyComparison question = Compare(features, key);
+    const bool tie = ties(question);
+    if (options_.start_question_weighs) start_question_ = std::move(question);
+    return tie;
   }
   return false;
+}
+
+void Localizer::WeighStartQuestion() {
+  if (!start_question_) return;
+  const KeyComparison question = *std::exchange(start_question_, std::nullopt);
+  const int position = route_position_of_key_[question.key];
+  if (position < 0) return;
+  // As WeighComparisons weighs a comparison of the frame: given the frame's ranking where it was ranked.
+  const int bucket = bucket_of_position_.empty() ? -1 : bucket_of_position_[position];
+  WeighBeliefs(position, EvidenceLogRatio(evidence_, question, link_verified_[question.key], bucket));
+  NormalizeBeliefs();
 }
 
 void Localizer::WeighEvidenceByRanking(const std::vector<RankedKey>& ranked) {
