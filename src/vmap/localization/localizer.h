@@ -54,10 +54,6 @@ namespace vmap {
 // Throws InputError when LocalizerOptions::start_key is not a key image of `map` on the options' route.
 void CheckStartKey(const VisualMap& map, const LocalizerOptions& options);
 
-// A frame stands still against the frame before (LocalizerOptions::still_frame_share): at least `share` of their
-// matches by `matcher` (unverified) moved less than half a pixel. No match, or `share` 0: not still.
-bool StandsStill(const Matcher& matcher, const ImageFeatures& before, const ImageFeatures& frame, double share);
-
 class Localizer {
  public:
   // `keys` must hold the features of `map`'s key images computed by `matcher` (LoadKeyImageStore).
@@ -224,8 +220,7 @@ class Localizer {
   // cannot tell its place from a far one.
   bool StartPlaceTiesFar(const LocalizationResult& result, const ImageFeatures& features,
                          const std::vector<RankedKey>& ranked);
-  // The far key image StartPlaceTiesFar compared for its question alone, weighed into both beliefs once the frame is
-  // decided (LocalizerOptions::start_question_weighs); nothing when it compared none.
+  // Weighs start_question_ into both beliefs once the frame is decided (LocalizerOptions::start_question_weighs).
   void WeighStartQuestion();
   // evidence_belief_ alone weighed by the frame's ranking `ranked`, as WeighRanking weighs both beliefs for a frame
   // ranked before its moves (localizer_start_place.cc).

@@ -13,6 +13,7 @@
 #include "vmap/geometry/chance_model.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localize_sequence.h"
+#include "vmap/localization/still_frame.h"
 #include "vmap/testing/localization_test_util.h"
 #include "vmap/testing/localizer_test_util.h"
 #include "vmap/testing/option_error.h"
