@@ -121,7 +121,13 @@ std::vector<std::string> WeightsSearchPaths(const std::string& preset) {
 std::string LocateWeights(const std::string& preset, const std::string& explicit_path) {
   if (!explicit_path.empty()) {
     if (IsFile(explicit_path)) return explicit_path;
-    throw OptionError("weights", "file '" + explicit_path + "' does not exist");
+    std::error_code error;
+    if (!fs::exists(explicit_path, error)) {
+      throw OptionError("weights", "file '" + explicit_path + "' does not exist");
+    }
+    throw OptionError("weights", "'" + explicit_path +
+                                     "' is not a regular file (a folder, a device or a FIFO); give "
+                                     "the weights file");
   }
   const auto paths = WeightsSearchPaths(preset);
   for (const auto& path : paths) {

@@ -150,10 +150,11 @@ LocalizationSession::LocalizationSession(const LocalizePipelineOptions& options)
   if (!options.report.empty()) CheckLocalizationReportDirectory(options.report, options.map, options.query);
   if (!options.query.empty()) CheckQueryIsNoFifo(options.query);
 
-  // 3. The map, read once, and the teach run's odometry.
+  // 3. The map, read once, and the runs' odometry.
   RecordedMap read = ReadRecordedMap(options.map);
   teach_odometry_ =
       ReadTeachOdometry(options.map, options.session.teach_odometry, options.session.teach_odometry_topic);
+  query_odometry_ = OpenQueryOdometry(options.odometry, options.odometry_topic, options.query);
 
   // 4. The route.
   LocalizerOptions localizer = options.session.localizer;
@@ -224,7 +225,7 @@ LocalizePipelineResult RunLocalizePipeline(const LocalizePipelineOptions& option
 
   // 8. The odometry: with it, its columns come last on every row (CSV and JSON), and each frame's pose paces the
   // belief where the session has the teach odometry.
-  std::optional<OdometryProgress> odometry = OpenQueryOdometry(options.odometry, options.odometry_topic, options.query);
+  std::optional<OdometryProgress> odometry = std::move(session.query_odometry_);
   nlohmann::json odometry_json = nlohmann::json::array();
 
   // 9. Every frame.

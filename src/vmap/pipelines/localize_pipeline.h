@@ -13,6 +13,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "vmap/control/odometry_progress.h"
 #include "vmap/core/option_fields.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/localization/localization_output.h"
@@ -84,7 +85,8 @@ class LocalizationSession {
   // take seconds):
   //   1. check the options;
   //   2. check the outputs (none may overwrite the map, the query or each other) and the query (no FIFO);
-  //   3. read the map, once (ReadRecordedMap), and the teach run's odometry, if any (ReadTeachOdometry);
+  //   3. read the map, once (ReadRecordedMap), the teach run's odometry, if any (ReadTeachOdometry), and the
+  //      query's (`odometry`, a pipeline's: OpenQueryOdometry), so that a bad file is refused before any work;
   //   4. plan the route (from, to);
   //   5. open the query, at the map's frame size unless `source.resize` says otherwise;
   //   6. create the map's matcher and load its key images and experiences (cached in the map directory);
@@ -124,6 +126,7 @@ class LocalizationSession {
   LocalizerOptions options_;
   std::unique_ptr<Localizer> localizer_;
   std::vector<OdometrySample> teach_odometry_;
+  std::optional<OdometryProgress> query_odometry_;  // RunLocalizePipeline's, taken there
   FrameSourceOptions query_options_;
   std::unique_ptr<FrameSource> query_;
   int frames_ = 0;  // frames given to Localize: the next one's index
@@ -132,7 +135,8 @@ class LocalizationSession {
 // Localizes every frame of `options.query` (LocalizationSession, then LocalizeSequence) and writes the outputs
 // asked for. `on_frame` sees each frame and its result, in order, as soon as it is known. Stages, in order:
 //   1-7. the session's set-up (above);
-//   8. open the query's odometry, if any (each frame's pose paces the belief, with the teach odometry);
+//   8. take the query's odometry the session read, if any (each frame's pose paces the belief, with the teach
+//      odometry);
 //   9. localize every frame, keeping the CSV's rows (with the odometry's columns) and, for a report whose query
 //      cannot be read again, the last frames it shows;
 //  10. write the CSV, the JSON and the report.

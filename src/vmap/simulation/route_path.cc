@@ -2,11 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
+#include <cstdint>
 #include <sstream>
 
 #include <fmt/format.h>
 
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 
 namespace vmap {
@@ -182,9 +183,10 @@ void CheckCorridor(const RoutePath& corridor, double width, const std::string& w
 
 SimulatedRoute ReadRouteCsv(const std::filesystem::path& path, double corridor_width, double extension) {
   const std::string name = path.string();
-  std::ifstream in(path);
-  if (!in)
-    throw InputError(fmt::format("cannot read the route CSV '{}'; give a file of x,y waypoints in metres", name));
+  // Only a regular file, held whole, so bounded (a FIFO would block, /dev/zero is one endless line): 100,000 lines of
+  // waypoints are well under this size.
+  std::istringstream in(
+      ReadNamedFile(path, std::uint64_t{16} << 20, "route CSV", "give a file of x,y waypoints in metres"));
   std::vector<cv::Point2d> points;
   std::vector<int> lines;
   std::string line;

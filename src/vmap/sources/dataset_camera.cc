@@ -259,7 +259,14 @@ EurocSensor ReadEurocSensor(const std::string& sensor_yaml) {
 }
 
 Camera ReadCameraFile(const std::string& path) {
-  if (!fs::is_regular_file(path)) throw InputError("calibration file '" + path + "' does not exist");
+  std::error_code error;
+  if (!fs::exists(path, error)) {
+    throw InputError("calibration file '" + path + "' does not exist; give a calibration file");
+  }
+  if (!fs::is_regular_file(path, error)) {
+    throw InputError("calibration file '" + path +
+                     "' is not a regular file (a folder, a device or a FIFO); give a calibration file");
+  }
   const std::string extension = Lower(fs::path(path).extension().string());
   if (extension == ".yaml" || extension == ".yml") {
     const std::string text = ReadText(path);

@@ -2,13 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
-#include <fstream>
 #include <limits>
 #include <sstream>
 
 #include <fmt/format.h>
 
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/sources/message_buffer.h"
 
@@ -59,11 +60,10 @@ std::string OdometryCsv(const std::vector<OdometrySample>& samples) {
 }
 
 std::vector<OdometrySample> ReadOdometryCsv(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) {
-    throw InputError(
-        fmt::format("cannot read the odometry CSV '{}'; give a file of timestamp,x,y,yaw lines", path.string()));
-  }
+  // Only a regular file, held whole, so bounded: neither a FIFO nor a device is ever read (a FIFO would block,
+  // /dev/zero is one endless line). The parser takes at most 10 million lines, well under this size.
+  std::istringstream in(
+      ReadNamedFile(path, std::uint64_t{1} << 30, "odometry CSV", "give a file of timestamp,x,y,yaw lines"));
   return ParseOdometryCsv(in, path.string());
 }
 
