@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -95,16 +96,25 @@ class FrameLocalizer {
     const std::optional<OdometrySample> pose = OdometryArgument(odometry, seconds);
     LocalizationResult result;
     {
+      // Python threads may share one Localizer: its frames are one run, so they take turns (the session is not
+      // thread-safe: two frames at once deadlocked in its speculative comparisons). The GIL is released first, so
+      // that the thread waiting here holds nothing the one localizing needs.
       py::gil_scoped_release release;
+      const std::lock_guard<std::mutex> lock(mutex_);
       result = session_->Localize(input.image, seconds, pose);
     }
     return ResultObject(session_->map(), result);
   }
 
-  void Reset() { session_->Reset(); }
+  void Reset() {
+    py::gil_scoped_release release;
+    const std::lock_guard<std::mutex> lock(mutex_);
+    session_->Reset();
+  }
 
  private:
   std::unique_ptr<LocalizationSession> session_;
+  std::mutex mutex_;  // one frame (or reset) at a time
 };
 
 // The localize pipeline's fields vmap.localize takes by keyword: not its positional arguments, nor the CLI's outputs.

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import vmap
-from conftest import CLI, STRETCH, VIDEO, map_json, needs_shared, run_cli
+from conftest import CLI, SHARED, STRETCH, VIDEO, map_json, needs_shared, run_cli
 
 # Fields that differ between two runs of the same build: the wall time and what records it.
 RUN_FIELDS = {"seconds"}
@@ -173,6 +173,36 @@ def test_localizer_frame_by_frame_equals_vmap_localize(maps, tmp_path):
     results = [localizer.localize(key.gray) for key in m.key_images]
     assert_same_localization(results, csv_rows(csv_file))
     assert results[0].status == "relocalized" and results[0].key == 0
+
+
+def test_threads_sharing_a_localizer_take_turns(tmp_path):
+    """Two Python threads localizing frames on one Localizer: each call returns, none deadlocks (they did, in the
+    localizer's speculative comparisons, on this map of three corridor frames that verify little). In a child
+    process, so that a deadlock fails the test instead of hanging it."""
+    needs_shared()
+    frames = tmp_path / "frames"
+    frames.mkdir()
+    for i in (0, 5, 10):
+        (frames / f"{i:07d}.jpg").symlink_to(SHARED / "data" / "corridor_conditions" / "teach" / f"{i:07d}.jpg")
+    run_cli("build", frames, "-o", tmp_path / "map")
+    script = ("import threading, vmap\n"
+              f"m = vmap.read_map({str(tmp_path / 'map')!r})\n"
+              "localizer = vmap.Localizer(m)\n"
+              "images = [key.gray for key in m.key_images]\n"
+              "done = []\n"
+              "def work(t):\n"
+              "    for j in range(30):\n"
+              "        done.append(localizer.localize(images[(t + j) % len(images)]).status)\n"
+              "    localizer.reset()\n"
+              "threads = [threading.Thread(target=work, args=(t,)) for t in range(2)]\n"
+              "[t.start() for t in threads]\n"
+              "[t.join() for t in threads]\n"
+              "print(len(done), sum(s != 'lost' for s in done))\n")
+    child = subprocess.run([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=os.environ,
+                           timeout=60)
+    assert child.returncode == 0
+    calls, placed = map(int, child.stdout.split())
+    assert calls == 60 and placed > 0  # the map's own key images: most are placed
 
 
 def test_results_have_the_csv_columns(maps, tmp_path):

@@ -78,7 +78,9 @@ struct LocalizePipelineResult {
   bool with_camera = false;  // the map's camera applied: headings in degrees and relative poses
 };
 
-// A map opened for localization, with a localizer on it, and the query when the options name one.
+// A map opened for localization, with a localizer on it, and the query when the options name one. Its frames are one
+// run, given in order: one thread at a time (a host that shares a session between threads serializes the calls, as
+// the Python module's Localizer does).
 class LocalizationSession {
  public:
   // The set-up, stages in order; everything that can fail fast does before the key images are loaded (which may
