@@ -27,7 +27,7 @@ namespace fs = std::filesystem;
 namespace {
 
 // Bump when the layout below changes: older caches are then recomputed.
-constexpr char kCacheMagic[16] = {'v', 'm', 'a', 'p', '-', 'l', 'o', 'c', 'a', 'l', 'i', 'z', 'e', '-', 'v', '1'};
+constexpr char kCacheMagic[16] = {'v', 'm', 'a', 'p', '-', 'l', 'o', 'c', 'a', 'l', 'i', 'z', 'e', '-', 'v', '2'};
 
 std::string ReadWholeFile(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -35,9 +35,26 @@ std::string ReadWholeFile(const fs::path& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-uint64_t Fingerprint(const fs::path& map_directory, const Matcher& matcher, const KeyImageStoreOptions& options) {
+// Which file `relative` is now: its size and time of last change, as make and ninja tell a changed input (a key image
+// copied over another one keeps map.json as it was). Reading every image to hash it would cost about what extracting
+// ORB's features does.
+std::string FileIdentity(const fs::path& map_directory, const std::string& relative) {
+  std::error_code error;
+  const fs::path path = map_directory / relative;
+  const auto size = fs::file_size(path, error);
+  if (error) return relative + " ?";
+  const auto changed = fs::last_write_time(path, error);
+  if (error) return relative + " ?";
+  return relative + " " + std::to_string(size) + " " + std::to_string(changed.time_since_epoch().count());
+}
+
+// `images`: the key images and the experiences' views, whose files the cache's features were extracted from.
+uint64_t Fingerprint(const fs::path& map_directory, const std::vector<KeyImage>& images, const Matcher& matcher,
+                     const KeyImageStoreOptions& options) {
   uint64_t hash = Fnv1a(std::string_view(kCacheMagic, sizeof(kCacheMagic)));
   hash = Fnv1a(ReadWholeFile(map_directory / kMapFileName), hash);
+  for (const KeyImage& image : images) hash = Fnv1a(FileIdentity(map_directory, image.image_file), hash);
+  hash = Fnv1a(FileIdentity(map_directory, kCameraMaskFileName), hash);
   hash = Fnv1a(matcher.DescribeOptionsJson(), hash);
   // Another vmap or OpenCV may extract differently.
   hash = Fnv1a(std::string(VMAP_VERSION) + " " + CV_VERSION, hash);
@@ -58,6 +75,7 @@ class Reader {
   bool Read(T& value) {
     if (file_.size() - position_ < sizeof(T) || !file_.Read(position_, &value, sizeof(T))) return false;
     position_ += sizeof(T);
+    checksum_ = Fnv1a(std::string_view(reinterpret_cast<const char*>(&value), sizeof(T)), checksum_);
     return true;
   }
   bool View(uint64_t size, std::string_view& view) {
@@ -66,9 +84,15 @@ class Reader {
     if (!file_.Read(position_, buffer_.data(), size)) return false;
     view = buffer_;
     position_ += size;
+    checksum_ = Fnv1a(view, checksum_);
     return true;
   }
-  bool AtEnd() const { return position_ == file_.size(); }
+  // The file ends here with the checksum of every byte before it: a cache damaged in place is recomputed, not read.
+  bool AtChecksummedEnd() {
+    const uint64_t expected = checksum_;
+    uint64_t stored = 0;
+    return Read(stored) && stored == expected && position_ == file_.size();
+  }
 
  private:
   // One key image's features: far above the largest matcher's (some MB).
@@ -76,6 +100,7 @@ class Reader {
   const ContainedFile& file_;
   uint64_t position_ = 0;
   std::string buffer_;
+  uint64_t checksum_ = kFnv1aOffsetBasis;  // of the bytes read so far
 };
 
 bool ReadCache(const fs::path& map_directory, uint64_t fingerprint, const Matcher& matcher, size_t num_keys,
@@ -119,7 +144,7 @@ bool ReadCache(const fs::path& map_directory, uint64_t fingerprint, const Matche
     features.push_back(std::move(f));
     thumbnails.push_back(thumbnail);
   }
-  if (!reader.AtEnd()) return false;
+  if (!reader.AtChecksummedEnd()) return false;
   store.features = std::move(features);
   store.thumbnails = std::move(thumbnails);
   return true;
@@ -140,6 +165,7 @@ std::string EncodeCache(uint64_t fingerprint, const Matcher& matcher, const KeyI
     Append(out, static_cast<uint64_t>(bytes.size()));
     out.append(bytes);
   }
+  Append(out, Fnv1a(out));
   return out;
 }
 
@@ -202,7 +228,7 @@ KeyImageStore LoadKeyImageStore(const fs::path& map_directory, const VisualMap& 
     }
   }
   const fs::path cache_file = map_directory / kLocalizationCacheFileName;
-  const uint64_t fingerprint = options.use_cache ? Fingerprint(map_directory, matcher, options) : 0;
+  const uint64_t fingerprint = options.use_cache ? Fingerprint(map_directory, images, matcher, options) : 0;
   if (options.use_cache && ReadCache(map_directory, fingerprint, matcher, images.size(), store)) {
     store.cache = KeyImageCacheState::kHit;
   } else {

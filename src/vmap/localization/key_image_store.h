@@ -3,9 +3,11 @@
 // computed once per map and kept in a cache file inside the map directory.
 //
 // The cache, MAP/localization_cache.bin, is written atomically. It starts with a fingerprint of map.json's
-// bytes, the matcher's recorded options (Matcher::DescribeOptionsJson), the thumbnail width and the vmap and
-// OpenCV versions, and is used only when all are unchanged: a rebuilt map, another matcher setting, another
-// vmap or a newer cache format makes it stale, and it is then recomputed and replaced. A map directory that cannot be
+// bytes, the size and time of last change of each key image's file (and of the experiences' views and the camera
+// mask), the matcher's recorded options (Matcher::DescribeOptionsJson), the thumbnail width and the vmap and
+// OpenCV versions, and ends with a checksum of its bytes; it is used only when all are unchanged: a rebuilt map, a
+// key image replaced, another matcher setting, another vmap, a newer cache format or a damaged cache makes it
+// stale, and it is then recomputed and replaced. A map directory that cannot be
 // written is not an error (the features are then computed at every start). Matchers that cannot serialise their
 // features (Matcher::SerializeFeatures returns "") get no cache.
 

@@ -1,6 +1,8 @@
 #include "vmap/localization/key_image_store.h"
 
+#include <chrono>
 #include <fstream>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -85,6 +87,42 @@ TEST(KeyImageStore, AChangedMapOrMatcherMakesTheCacheStale) {
   const KeyImageStore wide = LoadKeyImageStore(m.path, m.map, *other, wider);
   EXPECT_EQ(wide.cache, KeyImageCacheState::kWritten);
   EXPECT_EQ(wide.thumbnails[0].cols, 64 * 48);
+}
+
+TEST(KeyImageStore, AReplacedKeyImageMakesTheCacheStale) {
+  SmallMap m;
+  const auto matcher = CreateOrbMatcher({});
+  ASSERT_EQ(LoadKeyImageStore(m.path, m.map, *matcher, {}).cache, KeyImageCacheState::kWritten);
+  ASSERT_EQ(LoadKeyImageStore(m.path, m.map, *matcher, {}).cache, KeyImageCacheState::kHit);
+  // Key image 1's file copied over key image 0's: map.json is as it was, the features are not.
+  const fs::path first = m.path / m.map.key_images[0].image_file;
+  fs::copy_file(m.path / m.map.key_images[1].image_file, first, fs::copy_options::overwrite_existing);
+  fs::last_write_time(first, fs::last_write_time(first) + std::chrono::seconds(1));  // a coarse clock's copy too
+  const KeyImageStore reloaded = LoadKeyImageStore(m.path, m.map, *matcher, {});
+  EXPECT_EQ(reloaded.cache, KeyImageCacheState::kWritten);
+  EXPECT_EQ(cv::norm(reloaded.features[0]->descriptors(), reloaded.features[1]->descriptors(), cv::NORM_HAMMING), 0.0);
+  EXPECT_EQ(LoadKeyImageStore(m.path, m.map, *matcher, {}).cache, KeyImageCacheState::kHit);
+}
+
+TEST(KeyImageStore, ACacheDamagedInPlaceIsRecomputed) {
+  SmallMap m;
+  const auto matcher = CreateOrbMatcher({});
+  const KeyImageStore fresh = LoadKeyImageStore(m.path, m.map, *matcher, {});
+  const fs::path cache = m.path / kLocalizationCacheFileName;
+  // Bytes in the middle of the features flipped, the size unchanged: every piece still parses.
+  {
+    std::fstream file(cache, std::ios::in | std::ios::out | std::ios::binary);
+    const auto middle = static_cast<std::streamoff>(fs::file_size(cache) / 2);
+    std::string bytes(64, '\0');
+    file.seekg(middle);
+    file.read(bytes.data(), 64);
+    for (char& c : bytes) c = static_cast<char>(~c);
+    file.seekp(middle);
+    file.write(bytes.data(), 64);
+  }
+  const KeyImageStore again = LoadKeyImageStore(m.path, m.map, *matcher, {});
+  EXPECT_EQ(again.cache, KeyImageCacheState::kWritten);
+  ExpectSameFeatures(fresh, again);
 }
 
 TEST(KeyImageStore, ACorruptCacheIsRecomputedAndNoCacheMeansNoFile) {
