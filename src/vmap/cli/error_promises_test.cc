@@ -173,6 +173,8 @@ TEST(Promises, AbsurdOptionsAreRefusedBeforeAnyWork) {
       {build + "--loftr-threshold nan", "--loftr-threshold must be in [0, 1]"},
       {build + "--loftr-threshold -inf", "--loftr-threshold must be in [0, 1]"},
       {build + "--loftr-threads 100000", "--loftr-threads 100000 is outside [0, 256]"},
+      {build + "--matcher xfeat --xfeat-threads 10000", "--xfeat-threads 10000 is outside [0, 256]"},
+      {build + "--matcher aliked --aliked-threads 100000", "--aliked-threads 100000 is outside [0, 256]"},
       {build + "--last -5", "--last -5 is not a frame"},
       {build + "--first -1", "--first -1 is less than 0"},
       {build + "--stride 0", "--stride 0 is less than 1"},

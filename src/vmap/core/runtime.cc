@@ -13,22 +13,21 @@ extern "C" {
 
 #include "vmap/core/error.h"
 #include "vmap/core/interrupt.h"
+#include "vmap/core/option_ranges.h"
 
 namespace vmap {
 
 void RuntimeOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Visit(OptionField{"opencv_threads"}.NotRecorded(), opencv_threads);
+  // At most 256, as every thread count of vmap's: far more threads than cores only costs (a pool of 100,000 crashed
+  // at exit).
+  visitor.Visit(OptionField{"opencv_threads"}.NotRecorded().Within(0, 256).Meaning("0: OpenCV's default"),
+                opencv_threads);
   visitor.Visit(OptionField{"keep_freed_memory"}.NotRecorded(), keep_freed_memory);
   visitor.Visit(OptionField{"quiet_ffmpeg"}.NotRecorded(), quiet_ffmpeg);
   visitor.Visit(OptionField{"handle_interrupts"}.NotRecorded(), handle_interrupts);
 }
 
-void RuntimeOptions::Check() const {
-  if (opencv_threads < 0) {
-    throw OptionError("opencv_threads",
-                      "is " + std::to_string(opencv_threads) + "; use 1 or more threads, or 0 for OpenCV's default");
-  }
-}
+void RuntimeOptions::Check() const { CheckFieldRanges(*this); }
 
 void InitializeRuntime(const RuntimeOptions& options) {
   options.Check();

@@ -51,7 +51,7 @@ void AlikedMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
           .Meaning("0: native size"),
       longest_side);
   visitor.Visit(OptionField{"threads", "--aliked-threads", "ALIKED: LibTorch threads per call (0 = LibTorch default)"}
-                    .AtLeast(0)
+                    .Within(0, 256)
                     .Meaning("0: LibTorch's default"),
                 num_threads);
 }

@@ -29,7 +29,7 @@ void XfeatMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
                     .Meaning("a cosine similarity; upstream 0.82, -1 keeps every mutual nearest neighbour"),
                 min_similarity);
   visitor.Visit(OptionField{"threads", "--xfeat-threads", "XFeat: LibTorch threads per call (0 = LibTorch default)"}
-                    .AtLeast(0)
+                    .Within(0, 256)
                     .Meaning("0: LibTorch's default"),
                 num_threads);
 }
