@@ -1,6 +1,7 @@
 #include "vmap/localization/localization_output.h"
 
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <limits>
 #include <optional>
@@ -46,6 +47,42 @@ LocalizationStatus ParseStatus(const std::string& name, const std::filesystem::p
 double NumberOr(const json& object, const char* name, double fallback) {
   auto it = object.find(name);
   return it != object.end() && it->is_number() ? it->get<double>() : fallback;
+}
+
+// A run's file, and where in it a field is (`frames[3]`), for the messages of a run that was edited.
+struct RunPlace {
+  const std::filesystem::path& file;
+  std::string where;
+  [[noreturn]] void Refuse(const char* name, const std::string& must) const {
+    const std::string field = *name == '\0' ? where : where.empty() ? std::string(name) : where + "." + name;
+    throw InputError(
+        fmt::format("'{}': {} {}; write it again with `vmap localize --json`", file.string(), field, must));
+  }
+};
+
+// An integer of a run (a frame or key image index, a count) named `name`: one an int holds (not 2^31, which would wrap
+// to a negative index, nor 0.5 or true).
+int IntOf(const json& value, const char* name, const RunPlace& place) {
+  const bool fits = value.is_number_unsigned()  ? value.get<std::uint64_t>() <= std::numeric_limits<int>::max()
+                    : value.is_number_integer() ? value.get<std::int64_t>() >= std::numeric_limits<int>::min() &&
+                                                      value.get<std::int64_t>() <= std::numeric_limits<int>::max()
+                                                : false;
+  if (!fits) place.Refuse(name, "must be a whole number from -2147483648 to 2147483647, and is " + value.dump());
+  return value.get<int>();
+}
+
+// An integer field of a run: `fallback` when absent or null.
+int IntOr(const json& object, const char* name, int fallback, const RunPlace& place) {
+  const auto it = object.find(name);
+  return it == object.end() || it->is_null() ? fallback : IntOf(*it, name, place);
+}
+
+// A text field of a run: `fallback` when absent or null.
+std::string TextOr(const json& object, const char* name, const std::string& fallback, const RunPlace& place) {
+  const auto it = object.find(name);
+  if (it == object.end() || it->is_null()) return fallback;
+  if (!it->is_string()) place.Refuse(name, "must be a string, and is " + it->dump());
+  return it->get<std::string>();
 }
 
 // The pose to the key image the heading is measured against: next_key's, or key's at the route's end.
@@ -234,20 +271,22 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
   if (!why_not.empty()) {
     throw InputError("'" + file.string() + "' " + why_not + "; give the --json file of `vmap localize`");
   }
-  if (!doc.is_object() || doc.value("format", "") != "vmap-localization") {
+  const RunPlace top{file, ""};
+  if (!doc.is_object() || !doc.contains("format") || !doc["format"].is_string() ||
+      doc["format"] != "vmap-localization") {
     throw InputError("'" + file.string() + "' is not a localization run (no format \"vmap-localization\")");
   }
-  if (doc.value("schema_version", 0) > kLocalizationSchemaVersion) {
+  if (IntOr(doc, "schema_version", 0, top) > kLocalizationSchemaVersion) {
     throw InputError("'" + file.string() + "' was written by a newer vmap; update vmap");
   }
   LocalizationRun run;
   try {
     const json& map = doc.at("map");
-    run.info.map_directory = DecodeFileName(map.value("directory", ""));
-    run.info.matcher = map.value("matcher", "");
+    run.info.map_directory = DecodeFileName(TextOr(map, "directory", "", RunPlace{file, "map"}));
+    run.info.matcher = TextOr(map, "matcher", "", RunPlace{file, "map"});
     const json& query = doc.at("query");
-    run.info.query = DecodeFileName(query.value("path", ""));
-    run.info.query_format = ParseSourceFormat(query.value("format", "auto"));
+    run.info.query = DecodeFileName(TextOr(query, "path", "", RunPlace{file, "query"}));
+    run.info.query_format = ParseSourceFormat(TextOr(query, "format", "auto", RunPlace{file, "query"}));
     run.info.source.first = query.value("first", 0);
     run.info.source.last = query.value("last", -1);
     run.info.source.stride = query.value("stride", 1);
@@ -274,23 +313,29 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
     run.summary.max_localize_seconds = s.value("max_localize_seconds", 0.0);
     run.summary.mean_extract_seconds = s.value("mean_extract_seconds", 0.0);
     run.summary.comparisons = s.value("comparisons", 0L);
-    for (const json& f : doc.at("frames")) {
+    const json& frames = doc.at("frames");
+    if (!frames.is_array()) top.Refuse("frames", "must be a list");
+    for (size_t i = 0; i < frames.size(); ++i) {
+      const json& f = frames[i];
+      const RunPlace place{file, fmt::format("frames[{}]", i)};
+      if (!f.is_object()) place.Refuse("", "must be an object");
       LocalizationResult r;
-      r.frame_index = f.at("frame").get<int>();
-      r.source_index = f.value("source_index", r.frame_index);
+      if (!f.contains("frame")) place.Refuse("frame", "is missing");
+      r.frame_index = IntOr(f, "frame", -1, place);
+      r.source_index = IntOr(f, "source_index", r.frame_index, place);
       r.timestamp = NumberOr(f, "timestamp", -1.0);
       r.source_name = DecodeFileName(f.value("source_name", ""));
       r.status = ParseStatus(f.at("status").get<std::string>(), file);
-      r.key = f.value("key", -1);
-      r.next_key = f.value("next_key", -1);
+      r.key = IntOr(f, "key", -1, place);
+      r.next_key = IntOr(f, "next_key", -1, place);
       r.to_key.key = r.key;
       r.to_key.similarity = NumberOr(f, "similarity", 0.0);
-      r.to_key.num_verified = f.value("verified", 0);
-      r.to_key.num_tentative = f.value("tentative", 0);
+      r.to_key.num_verified = IntOr(f, "verified", 0, place);
+      r.to_key.num_tentative = IntOr(f, "tentative", 0, place);
       r.to_next.key = r.next_key;
       r.to_next.similarity = NumberOr(f, "next_similarity", 0.0);
-      r.to_next.num_verified = f.value("next_verified", 0);
-      r.to_next.num_tentative = f.value("next_tentative", 0);
+      r.to_next.num_verified = IntOr(f, "next_verified", 0, place);
+      r.to_next.num_tentative = IntOr(f, "next_tentative", 0, place);
       r.translation_known = f.value("translation_known", false);
       r.to_key.log10_nfa = NumberOr(f, "log10_nfa", std::numeric_limits<double>::infinity());
       r.to_next.log10_nfa = NumberOr(f, "next_log10_nfa", std::numeric_limits<double>::infinity());
@@ -305,18 +350,21 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
       r.progress = NumberOr(f, "progress", std::nan(""));
       if (f.contains("candidates") && f["candidates"].is_array()) {
         for (const json& c : f["candidates"]) {
-          r.candidates.push_back({c.value("key", -1), c.value("score", 0.0), c.value("accepted", false),
-                                  c.value("similarity", 0.0), c.value("verified", 0),
+          r.candidates.push_back({IntOr(c, "key", -1, place), c.value("score", 0.0), c.value("accepted", false),
+                                  c.value("similarity", 0.0), IntOr(c, "verified", 0, place),
                                   NumberOr(c, "log10_nfa", std::numeric_limits<double>::infinity())});
         }
       }
-      r.comparisons = f.value("comparisons", 0);
+      r.comparisons = IntOr(f, "comparisons", 0, place);
       r.seconds = f.value("seconds", 0.0);
       r.confidence = NumberOr(f, "confidence", std::nan(""));
-      r.key_rank = f.value("key_rank", -1);
-      r.motion_steps = f.value("motion_steps", 0);
+      r.key_rank = IntOr(f, "key_rank", -1, place);
+      r.motion_steps = IntOr(f, "motion_steps", 0, place);
       if (f.contains("belief") && f["belief"].is_array()) {
-        for (const json& b : f["belief"]) r.belief.emplace_back(b.at(0).get<int>(), b.at(1).get<double>());
+        for (const json& b : f["belief"]) {
+          if (!b.is_array() || b.size() != 2) place.Refuse("belief", "must be a list of [key, mass] pairs");
+          r.belief.emplace_back(IntOf(b[0], "belief's key", place), b.at(1).get<double>());
+        }
       }
       run.frames.push_back(std::move(r));
     }

@@ -1,9 +1,12 @@
 #include "vmap/localization/localization_output.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <sstream>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -13,6 +16,7 @@
 #include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
+namespace fs = std::filesystem;
 namespace {
 
 VisualMap TwoKeyMap() {
@@ -249,6 +253,47 @@ TEST(LocalizationOutput, ReadingSomethingElseIsAClearError) {
   }
   WriteFileAtomically(tmp.path() / "broken.json", "{\"format\": \"vmap-localization\", \"frames\": 3}");
   EXPECT_THROW(ReadLocalizationRun(tmp.path() / "broken.json"), InputError);
+}
+
+// A run edited by hand: each field of the wrong kind is refused with its place in the file, never read as something
+// else (2^31 was key image -2147483648, true and -0.5 were key images 1 and 0) nor let through as a raw JSON error.
+TEST(LocalizationOutput, AnEditedRunNamesTheFieldItGotWrong) {
+  ::vmap::testing::ScopedTempDir tmp;
+  const nlohmann::json good = nlohmann::json::parse(LocalizationRunJson(TwoKeyMap(), SampleRun()));
+  const fs::path file = tmp.path() / "run.json";
+  auto error_of = [&](const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json doc = good;
+    edit(doc);
+    WriteFileAtomically(file, doc.dump());
+    try {
+      ReadLocalizationRun(file);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(error_of([](nlohmann::json&) {}), "accepted");
+  for (const nlohmann::json& key :
+       {nlohmann::json(2147483648u), nlohmann::json(-0.5), nlohmann::json(true), nlohmann::json("1")}) {
+    EXPECT_NE(error_of([&](nlohmann::json& d) {
+                d["frames"][1]["key"] = key;
+              }).find("run.json': frames[1].key must be a whole number"),
+              std::string::npos)
+        << key;
+  }
+  EXPECT_NE(error_of([](nlohmann::json& d) { d["format"] = nullptr; }).find("is not a localization run"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of([](nlohmann::json& d) { d["schema_version"] = "2"; }).find("schema_version must be a whole number"),
+      std::string::npos);
+  EXPECT_NE(error_of([](nlohmann::json& d) { d["query"]["path"] = 7; }).find("query.path must be a string"),
+            std::string::npos);
+  EXPECT_NE(error_of([](nlohmann::json& d) {
+              d["frames"][0]["belief"] = {{0.5, 0.5}};
+            }).find("frames[0].belief's key must be a whole number"),
+            std::string::npos);
+  EXPECT_NE(error_of([](nlohmann::json& d) { d["frames"][2] = 3; }).find("frames[2] must be an object"),
+            std::string::npos);
 }
 
 }  // namespace
