@@ -35,7 +35,8 @@ void FrameSourceOptions::Check() const {
   if (max_frame_pixels < static_cast<long>(kMinFrameSide) * kMinFrameSide) {
     throw OptionError("max_frame_pixels", "must be at least " + std::to_string(kMinFrameSide * kMinFrameSide));
   }
-  if (!resize.empty()) internal::TargetSize(cv::Size(640, 480), *this);  // validates the text
+  // The text and its sides; what a longest side makes of the frames is checked on the first frame (TargetSize).
+  if (!resize.empty()) internal::ParseResize(*this);
 }
 
 namespace internal {
@@ -90,9 +91,8 @@ bool IsImageFile(const std::string& path) {
   return std::any_of(std::begin(kExtensions), std::end(kExtensions), [&](const char* e) { return ext == e; });
 }
 
-cv::Size TargetSize(const cv::Size& native, const FrameSourceOptions& options) {
+cv::Size ParseResize(const FrameSourceOptions& options) {
   const std::string& resize = options.resize;
-  if (resize.empty()) return native;
   const std::string range = std::to_string(kMinFrameSide) + " to " + std::to_string(kMaxResizeSide);
   int width = 0, height = 0;
   char extra = 0;
@@ -111,19 +111,28 @@ cv::Size TargetSize(const cv::Size& native, const FrameSourceOptions& options) {
     if (longest < kMinFrameSide || longest > kMaxResizeSide) {
       throw OptionError("resize", resize + ": the longest side must be " + range + " pixels");
     }
-    const double scale = static_cast<double>(longest) / std::max(native.width, native.height);
-    const cv::Size target(std::max(1, static_cast<int>(std::lround(native.width * scale))),
-                          std::max(1, static_cast<int>(std::lround(native.height * scale))));
-    if (std::min(target.width, target.height) < kMinFrameSide ||
-        static_cast<long>(target.width) * target.height > options.max_frame_pixels) {
-      throw OptionError("resize", resize + " turns frames of " + std::to_string(native.width) + "x" +
-                                      std::to_string(native.height) + " into " + std::to_string(target.width) + "x" +
-                                      std::to_string(target.height) + "; give WxH with sides of " + range +
-                                      " pixels instead");
-    }
-    return target;
+    return {longest, 0};
   }
   throw OptionError("resize", "'" + resize + "' is not WxH (e.g. 640x480) or a longest side (e.g. 640)");
+}
+
+cv::Size TargetSize(const cv::Size& native, const FrameSourceOptions& options) {
+  if (options.resize.empty()) return native;
+  const cv::Size parsed = ParseResize(options);
+  if (parsed.height > 0) return parsed;
+  // A longest side: the other follows the frames' own shape, which only they tell.
+  const double scale = static_cast<double>(parsed.width) / std::max(native.width, native.height);
+  const cv::Size target(std::max(1, static_cast<int>(std::lround(native.width * scale))),
+                        std::max(1, static_cast<int>(std::lround(native.height * scale))));
+  if (std::min(target.width, target.height) < kMinFrameSide ||
+      static_cast<long>(target.width) * target.height > options.max_frame_pixels) {
+    throw OptionError("resize", options.resize + " turns frames of " + std::to_string(native.width) + "x" +
+                                    std::to_string(native.height) + " into " + std::to_string(target.width) + "x" +
+                                    std::to_string(target.height) + "; give WxH with sides of " +
+                                    std::to_string(kMinFrameSide) + " to " + std::to_string(kMaxResizeSide) +
+                                    " pixels instead");
+  }
+  return target;
 }
 
 void FitFrame(Frame& frame, const cv::Size& target, const cv::Size& first_native, const FrameSourceOptions& options,

@@ -108,6 +108,26 @@ TEST(ImageFolder, FirstLastStrideAndResize) {
   EXPECT_THROW(options.Check(), InputError);
 }
 
+// A longest side is judged on the frames' own shape, not on an assumed 640x480: 12000 makes 800x100 frames 12000x1500
+// (18 megapixels, allowed), though it would make 640x480 ones 12000x9000 (more than the 64 allowed); 40 makes them
+// 40x5, refused naming their size.
+TEST(ImageFolder, ALongestSideIsJudgedOnTheFramesOwnShape) {
+  testing::ScopedTempDir tmp;
+  for (int i = 0; i < 2; ++i) {
+    cv::Mat wide(100, 800, CV_8UC1);
+    cv::randu(wide, 0, 255);
+    cv::imwrite((tmp.path() / ("frame_" + std::to_string(i) + ".png")).string(), wide);
+  }
+  FrameSourceOptions options;
+  options.resize = "12000";
+  EXPECT_NO_THROW(options.Check());
+  EXPECT_EQ(OpenFrameSource(tmp.path().string(), options)->Next()->gray.size(), cv::Size(12000, 1500));
+  options.resize = "40";
+  EXPECT_NO_THROW(options.Check());
+  const std::string error = OpenError(tmp.path().string(), options);
+  EXPECT_NE(error.find("turns frames of 800x100 into 40x5"), std::string::npos) << error;
+}
+
 TEST(ImageFolder, FramesOfAnotherSizeAreResizedOrRejectedWhenStrict) {
   testing::ScopedTempDir tmp;
   testing::WriteImageFolder(Sequence(), tmp.path());

@@ -35,6 +35,10 @@ bool IsStreamUrl(const std::string& path);
 std::unique_ptr<FrameSource> OpenRecordingSource(const std::string& path, const FrameSourceOptions& options,
                                                  std::optional<Camera>* camera);
 
+// The --resize text, checked without the frames: {W, H} for WxH (each side in range, within max_frame_pixels), {L, 0}
+// for a longest side L in range. Throws OptionError naming the text otherwise.
+cv::Size ParseResize(const FrameSourceOptions& options);
+
 // Size frames are delivered at, given the first frame's native size and the --resize option. Throws
 // OptionError when `resize` is malformed or out of its range, or would make these frames degenerate.
 cv::Size TargetSize(const cv::Size& native, const FrameSourceOptions& options);
