@@ -64,6 +64,15 @@ TEST(MatchCli, ReportsTheHeadingInPixelsAndWithACameraInDegrees) {
   EXPECT_NEAR(json["heading_px"].get<double>(), -shift, 1.5);
   // A shift of s px is a turn of about atan(s / f) near the image's centre.
   EXPECT_NEAR(json["heading_deg"].get<double>(), -std::atan(shift / fx) * 180.0 / M_PI, 0.3);
+  // A camera within the accepted ranges whose distortion (k4 = 999) does not invert at the heading's point: the
+  // degrees are unknown, said as such (they printed as "-nan deg"), and null in the JSON.
+  ASSERT_EQ(RunVmap(reversed + " --camera 800,800,511.5,191.5,0,0,0,0,0,999,0,0 --json " + Quote(tmp.path() / "k.json"),
+                    &out),
+            0)
+      << out;
+  EXPECT_EQ(out.find("nan"), std::string::npos) << out;
+  EXPECT_NE(out.find("deg unknown"), std::string::npos) << out;
+  EXPECT_TRUE(nlohmann::json::parse(std::ifstream(tmp.path() / "k.json"))["heading_deg"].is_null());
 }
 
 TEST(MatchCli, HeadingOptionErrorsNameTheirFlags) {

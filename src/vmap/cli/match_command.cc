@@ -2,6 +2,7 @@
 // matcher on one's own images and to compare matches across implementations, and the heading of IMAGE1 against
 // IMAGE0 (geometry/heading.h; docs/seasons.md).
 
+#include <cmath>
 #include <cstdio>
 
 #include <fmt/format.h>
@@ -40,8 +41,11 @@ void RunMatch(const MatchFlags& flags) {
     }
   }
   if (heading.valid()) {
-    std::printf("heading     %.1f px%s (%s: %d of %d matches, confidence %.3f)\n", heading.px,
-                result.with_camera ? fmt::format(", {:.3f} deg", heading.deg).c_str() : "",
+    // A camera whose distortion does not invert at the heading's point gives no bearing (NaN): said, not printed.
+    const std::string degrees = !result.with_camera          ? ""
+                                : std::isfinite(heading.deg) ? fmt::format(", {:.3f} deg", heading.deg)
+                                                             : ", deg unknown";
+    std::printf("heading     %.1f px%s (%s: %d of %d matches, confidence %.3f)\n", heading.px, degrees.c_str(),
                 HeadingMethodName(heading.method).c_str(), heading.votes, heading.num_voters, heading.confidence);
   } else {
     std::printf("heading     none (fewer than %d matches agree)\n", options.pair.heading.min_votes);
