@@ -1,6 +1,7 @@
 #include "vmap/features/orb_matcher.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -13,6 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
 
 #include "vmap/core/error.h"
 #include "vmap/core/option_ranges.h"
@@ -132,14 +134,19 @@ class OrbMatcher : public Matcher {
       if (!keep.empty()) KeepWithin(keep, *features);
       return features;
     }
+    // OpenCV's pyramid fails on a level that rounds to no pixel (and then gave no features at all): the levels that
+    // keep one are used, and the user told once.
+    const int levels = LevelsWithPixels(std::min(gray.cols, gray.rows));
+    if (levels < options_.num_levels && !warned_levels_.exchange(true)) {
+      spdlog::warn(
+          "ORB: with scale factor {} only {} of the {} levels of a {}x{} frame keep a pixel; using {} "
+          "(--orb-levels, --orb-scale-factor)",
+          options_.scale_factor, levels, options_.num_levels, gray.cols, gray.rows, levels);
+    }
     // A detector per call: cv::ORB is not documented as thread-safe, and creating one is cheap.
     cv::Ptr<cv::ORB> orb =
-        cv::ORB::create(options_.num_features, static_cast<float>(options_.scale_factor), options_.num_levels,
+        cv::ORB::create(options_.num_features, static_cast<float>(options_.scale_factor), levels,
                         options_.edge_threshold, 0, 2, cv::ORB::HARRIS_SCORE, 31, options_.fast_threshold);
-    // OpenCV's pyramid fails on a level that rounds to no pixel: such an image has no ORB features.
-    const double smallest_level =
-        std::min(gray.cols, gray.rows) / std::pow(options_.scale_factor, options_.num_levels - 1);
-    if (smallest_level < 1.0) return features;
     // An empty mask is OpenCV's "everywhere".
     orb->detectAndCompute(image, keep, features->keypoints, features->binary_descriptors);
     if (features->binary_descriptors.empty()) features->keypoints.clear();
@@ -216,7 +223,15 @@ class OrbMatcher : public Matcher {
   }
 
  private:
+  // The pyramid's levels whose image keeps at least one pixel on a frame whose shorter side is `shorter_side`.
+  int LevelsWithPixels(int shorter_side) const {
+    int levels = 1;
+    while (levels < options_.num_levels && shorter_side / std::pow(options_.scale_factor, levels) >= 1.0) ++levels;
+    return levels;
+  }
+
   OrbMatcherOptions options_;
+  mutable std::atomic<bool> warned_levels_{false};  // said once per matcher, not once per frame
 };
 
 // The distance matrix is produced one query row at a time, into 16-bit distances padded to a multiple of

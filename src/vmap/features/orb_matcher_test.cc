@@ -153,6 +153,26 @@ TEST(OrbMatcher, BlackImageHasNoFeaturesAndNoMatches) {
   EXPECT_EQ(matcher->Match(*black, *black).size(), 0u);
 }
 
+// Levels beyond the pyramid's last pixel (scale factor 2 on a 160x120 frame: the 8th level rounds to none) are left
+// out: the frame keeps the features of the levels that exist (it had none at all), as with 7 levels asked for.
+TEST(OrbMatcher, LevelsBeyondTheLastPixelAreLeftOut) {
+  testing::SyntheticOptions scene;
+  scene.num_frames = 1;
+  cv::Mat gray;
+  cv::cvtColor(testing::RenderSyntheticSequence(scene).frames[0], gray, cv::COLOR_BGR2GRAY);
+  cv::resize(gray, gray, cv::Size(160, 120), 0, 0, cv::INTER_AREA);
+  OrbMatcherOptions eight;
+  eight.scale_factor = 2.0;
+  eight.num_levels = 8;
+  OrbMatcherOptions seven = eight;
+  seven.num_levels = 7;
+  const auto with_eight = CreateOrbMatcher(eight)->Extract(gray);
+  const auto with_seven = CreateOrbMatcher(seven)->Extract(gray);
+  EXPECT_GT(with_seven->num_features(), 20);
+  ASSERT_EQ(with_eight->num_features(), with_seven->num_features());
+  EXPECT_EQ(cv::norm(with_eight->descriptors(), with_seven->descriptors(), cv::NORM_HAMMING), 0.0);
+}
+
 TEST(OrbMatcher, OptionsAreChecked) {
   // Named by the JSON keys of the fields; within MatcherOptions, after the model's name.
   OrbMatcherOptions options;
