@@ -203,6 +203,16 @@ TEST(LocalizeCli, ReportOfARun) {
   // A file that is not a run is refused with a message.
   EXPECT_EQ(RunVmap("report " + Quote(LabMap() / "map.json"), &out), 2) << out;
   EXPECT_NE(out.find("is not a localization run"), std::string::npos) << out;
+  // A run that names no query (query.path removed), reported from the folder that holds it: no input is "", the working
+  // folder, so its report is written (it was refused as lying inside the input).
+  nlohmann::json doc = nlohmann::json::parse(std::ifstream(json));
+  doc["query"].erase("path");
+  fs::create_directory(tmp.path() / "runs");
+  std::ofstream(tmp.path() / "runs/no_query.json") << doc.dump();
+  const ::vmap::testing::CliResult no_query =
+      ::vmap::testing::RunVmap("report runs/no_query.json", "cd " + Quote(tmp.path()) + " &&");
+  EXPECT_EQ(no_query.status, 0) << no_query.output;
+  EXPECT_TRUE(fs::exists(tmp.path() / "runs/no_query_report" / kReportFileName)) << no_query.output;
 }
 
 TEST(LocalizeCli, EvalCorridorRuns) {

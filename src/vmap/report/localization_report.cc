@@ -224,7 +224,9 @@ OutputPolicy ReportPolicy(const fs::path& map_directory, const std::string& quer
   OutputPolicy policy;
   policy.why_not_ours = WhyNotALocalizationReport;
   policy.kind = "a vmap localization report";
-  policy.inputs = {map_directory, query};
+  policy.inputs = {map_directory};
+  // A run that names no query (a run JSON without query.path) has none to keep apart: "" would be the working folder.
+  if (!query.empty()) policy.inputs.push_back(query);
   return policy;
 }
 
@@ -390,7 +392,8 @@ void WriteLocalizationReport(const fs::path& run_file, const fs::path& directory
     if (fs::exists(beside / kMapFileName)) map_directory = beside;
   }
   const fs::path query = run.info.query;
-  if (!fs::exists(query) && query.is_relative() && fs::exists(run_file.parent_path() / query)) {
+  // A relative query is looked for beside the run too; a run that names none has none ("" beside it is its folder).
+  if (!query.empty() && !fs::exists(query) && query.is_relative() && fs::exists(run_file.parent_path() / query)) {
     run.info.query = (run_file.parent_path() / query).string();
   }
   const VisualMap map = ReadMap(map_directory);
