@@ -141,6 +141,19 @@ TEST(MapIo, EveryFieldIsCheckedAndTheMessageNamesIt) {
       {[](json& d) { d["evaluations"].erase("key_frame"); }, "'evaluations.key_frame' is missing"},
       // Fields that contradict each other or describe nothing a camera makes.
       {[](json& d) { d["links"] = json::array(); }, "'links' is empty although the map has 3 key images"},
+      {[](json& d) { d["key_images"][2]["image"] = d["key_images"][0]["image"]; },
+       "'key_images[2].image' names the file of key_images[0]"},
+      {[](json& d) {
+         d["links"][1]["F"] = json::array({0, 0, 0, 0, 0, 0, 0, 0, 0});
+       },
+       "'links[1].F' is all zeros"},
+      {[](json& d) { d["links"][1]["correspondences"]["offset"] = d["links"][0]["correspondences"]["offset"]; },
+       "overlaps the records of links[0]"},
+      {[](json& d) {
+         d["links"][0]["pose"] = nullptr;
+         d["links"][0]["translation_known"] = true;
+       },
+       "links[0].translation_known is true without a pose"},
       {[](json& d) {
          d["input"]["frame_size"] = {0, 48};
        },

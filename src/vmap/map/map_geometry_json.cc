@@ -57,7 +57,10 @@ void ReadLinkGeometryFields(const json& object, Link& link, const std::string& f
   link.translation_sigma_deg = number("translation_sigma_deg");
   link.translation_rival_cost_gap = number("translation_rival_cost_gap");
   const auto known = object.find("translation_known");
+  if (known != object.end() && !known->is_boolean())
+    Malformed(file, where + ".translation_known must be true or false");
   link.translation_known = known == object.end() ? link.has_pose : known->get<bool>();
+  if (link.translation_known && !link.has_pose) Malformed(file, where + ".translation_known is true without a pose");
   link.parallax = number("parallax_px");
   link.parallax_without_rotation = object.value("parallax_rotation_removed", false);
   link.homography_share = number("homography_share");

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <optional>
 
 #include <nlohmann/json.hpp>
@@ -106,6 +107,7 @@ void ReadKeyImages(const json& doc, const Fields& fields, const fs::path& direct
   if (static_cast<long>(keys.size()) > map->num_frames) {
     fields.Fail("key_images", "lists more key images than there are frames (num_frames)");
   }
+  std::map<std::string, size_t> key_of_file;  // each key image has a file of its own, as vmap writes them
   for (size_t i = 0; i < keys.size(); ++i) {
     const std::string where = "key_images[" + std::to_string(i) + "]";
     const json& entry = fields.Object(keys[i], where);
@@ -128,6 +130,10 @@ void ReadKeyImages(const json& doc, const Fields& fields, const fs::path& direct
     }
     if (!IsPlainRelativePath(k.image_file)) {
       Malformed(file, where + " image '" + k.image_file + "' points outside the map directory");
+    }
+    const auto [named, first] = key_of_file.emplace(fs::path(k.image_file).lexically_normal().string(), i);
+    if (!first) {
+      fields.Fail(where + ".image", "names the file of key_images[" + std::to_string(named->second) + "]");
     }
     // Only the header is read here: the image must be a PNG (as vmap writes) or a JPEG (the input's own file,
     // copied) of the map's frame size, so that whoever decodes it later does not meet a decompression bomb.
@@ -194,6 +200,9 @@ void ReadLinks(const json& doc, const Fields& fields, const fs::path& directory,
             return Fields::NumberIn(v, -std::numeric_limits<double>::max(), std::numeric_limits<double>::max());
           });
       if (!nine_numbers) fields.Fail(where + ".F", "must be null or a list of 9 finite numbers");
+      if (std::all_of(F->begin(), F->end(), [](const json& v) { return v.get<double>() == 0.0; })) {
+        fields.Fail(where + ".F", "is all zeros, which no fundamental matrix is; null says there is none");
+      }
       l.has_fundamental = true;
       for (int k = 0; k < 9; ++k) l.F(k / 3, k % 3) = (*F)[k].get<double>();
     }
@@ -211,6 +220,19 @@ void ReadLinks(const json& doc, const Fields& fields, const fs::path& directory,
     map->links.push_back(std::move(l));
   }
   if (links.empty()) return;
+  // Each link's records are its own (vmap writes them one link after the other).
+  std::vector<size_t> by_offset;
+  for (size_t i = 0; i < ranges.size(); ++i) {
+    if (ranges[i].second > 0) by_offset.push_back(i);
+  }
+  std::sort(by_offset.begin(), by_offset.end(), [&](size_t a, size_t b) { return ranges[a] < ranges[b]; });
+  for (size_t j = 1; j < by_offset.size(); ++j) {
+    const auto [offset, count] = ranges[by_offset[j - 1]];
+    if (offset + count > ranges[by_offset[j]].first) {
+      fields.Fail("links[" + std::to_string(by_offset[j]) + "].correspondences",
+                  "overlaps the records of links[" + std::to_string(by_offset[j - 1]) + "]");
+    }
+  }
 
   const fs::path binary_file = directory / kCorrespondencesFileName;
   const ContainedFile binary = OpenMapFile(directory, kCorrespondencesFileName, "", file, "");
