@@ -1,6 +1,7 @@
 #include "vmap/core/option_ranges.h"
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <fmt/format.h>
@@ -77,9 +78,13 @@ void RangeChecker::ThrowOutside() const {
 }  // namespace option_ranges_internal
 
 std::string RangeText(const OptionRange& range, bool integral) {
+  // An int without a bound of its own ends where an int does: a larger number is no value of it (CLI11 refuses it).
+  const bool unbounded = std::isinf(range.max);
+  const std::string max = !unbounded ? Number(range.max, integral)
+                          : integral ? Number(std::numeric_limits<int>::max(), true)
+                                     : "inf";
   const std::string interval = fmt::format("{}{}, {}{}", range.min_excluded ? "(" : "[", Number(range.min, integral),
-                                           std::isinf(range.max) ? "inf" : Number(range.max, integral),
-                                           range.max_excluded || std::isinf(range.max) ? ")" : "]");
+                                           max, range.max_excluded || (unbounded && !integral) ? ")" : "]");
   return range.also ? Number(*range.also, integral) + " or " + interval : interval;
 }
 

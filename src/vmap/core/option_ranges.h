@@ -60,7 +60,8 @@ class RangeChecker : public OptionFieldVisitor {
 
 }  // namespace option_ranges_internal
 
-// The values a range takes, as a command's help shows them: "[1, 2]", "(0, 1]", "[-1, inf)", "0 or [1, 1000]".
+// The values a range takes, as a command's help shows them: "[1, 2]", "(0, 1]", "[-1, inf)" (an int's:
+// "[-1, 2147483647]"), "0 or [1, 1000]".
 // `integral`: the field is an int (its bounds written as integers).
 std::string RangeText(const OptionRange& range, bool integral);
 

@@ -113,7 +113,8 @@ TEST(OptionRanges, RangeTextIsWhatAHelpShows) {
   EXPECT_EQ(text(OptionField{"a"}.Within(1, 100000), true), "[1, 100000]");
   EXPECT_EQ(text(OptionField{"a"}.Within(0, 1).ExcludingMin(), false), "(0, 1]");
   EXPECT_EQ(text(OptionField{"a"}.Within(0, 1).ExcludingMax(), false), "[0, 1)");
-  EXPECT_EQ(text(OptionField{"a"}.AtLeast(-1), true), "[-1, inf)");
+  EXPECT_EQ(text(OptionField{"a"}.AtLeast(-1), true), "[-1, 2147483647]");  // an int's own end
+  EXPECT_EQ(text(OptionField{"a"}.AtLeast(-1), false), "[-1, inf)");
   EXPECT_EQ(text(OptionField{"a"}.Within(1, 1000).Or(0), false), "0 or [1, 1000]");
   EXPECT_EQ(text(OptionField{"a"}.Within(0.05, 100), false), "[0.05, 100]");
 }
