@@ -272,8 +272,8 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
     throw InputError("'" + file.string() + "' " + why_not + "; give the --json file of `vmap localize`");
   }
   const RunPlace top{file, ""};
-  if (!doc.is_object() || !doc.contains("format") || !doc["format"].is_string() ||
-      doc["format"] != "vmap-localization") {
+  // Compared as JSON: a format of another kind is simply not this one.
+  if (!doc.is_object() || !doc.contains("format") || doc["format"] != "vmap-localization") {
     throw InputError("'" + file.string() + "' is not a localization run (no format \"vmap-localization\")");
   }
   if (IntOr(doc, "schema_version", 0, top) > kLocalizationSchemaVersion) {

@@ -120,14 +120,9 @@ std::vector<std::string> WeightsSearchPaths(const std::string& preset) {
 
 std::string LocateWeights(const std::string& preset, const std::string& explicit_path) {
   if (!explicit_path.empty()) {
-    if (IsFile(explicit_path)) return explicit_path;
-    std::error_code error;
-    if (!fs::exists(explicit_path, error)) {
-      throw OptionError("weights", "file '" + explicit_path + "' does not exist");
-    }
-    throw OptionError("weights", "'" + explicit_path +
-                                     "' is not a regular file (a folder, a device or a FIFO); give "
-                                     "the weights file");
+    std::string why_not;
+    if (ContainedFile::OpenRegular(explicit_path, &why_not)) return explicit_path;
+    throw OptionError("weights", "file '" + explicit_path + "' " + why_not + "; give the weights file");
   }
   const auto paths = WeightsSearchPaths(preset);
   for (const auto& path : paths) {

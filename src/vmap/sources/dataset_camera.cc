@@ -259,13 +259,10 @@ EurocSensor ReadEurocSensor(const std::string& sensor_yaml) {
 }
 
 Camera ReadCameraFile(const std::string& path) {
-  std::error_code error;
-  if (!fs::exists(path, error)) {
-    throw InputError("calibration file '" + path + "' does not exist; give a calibration file");
-  }
-  if (!fs::is_regular_file(path, error)) {
-    throw InputError("calibration file '" + path +
-                     "' is not a regular file (a folder, a device or a FIFO); give a calibration file");
+  // Refused as ReadText refuses a file (a FIFO would hang cv::FileStorage, which the other formats go to).
+  std::string why_not;
+  if (!ContainedFile::OpenRegular(path, &why_not)) {
+    throw InputError("calibration file '" + path + "' " + why_not + "; give a calibration file");
   }
   const std::string extension = Lower(fs::path(path).extension().string());
   if (extension == ".yaml" || extension == ".yml") {
