@@ -147,6 +147,7 @@ TEST(MapIo, EveryFieldIsCheckedAndTheMessageNamesIt) {
          d["links"][1]["F"] = json::array({0, 0, 0, 0, 0, 0, 0, 0, 0});
        },
        "'links[1].F' is all zeros"},
+      {[](json& d) { d["links"][1]["verified"] = 0; }, "'links[1].similarity' is more than 0 while 'verified' is 0"},
       {[](json& d) { d["links"][1]["correspondences"]["offset"] = d["links"][0]["correspondences"]["offset"]; },
        "overlaps the records of links[0]"},
       {[](json& d) {

@@ -194,6 +194,10 @@ void ReadLinks(const json& doc, const Fields& fields, const fs::path& directory,
         fields.Integer(fields.Required(entry, where, "tentative"), where + ".tentative", 0, kMaxMatchesPerLink));
     l.num_verified = static_cast<int>(
         fields.Integer(fields.Required(entry, where, "verified"), where + ".verified", 0, l.num_tentative));
+    // S is the verified matches over a count (key_image_selector.cc), whatever the similarity mode.
+    if (l.num_verified == 0 && l.similarity > 0) {
+      fields.Fail(where + ".similarity", "is more than 0 while 'verified' is 0; the similarity is the verified share");
+    }
     if (const json* F = Fields::Find(entry, "F"); F && !F->is_null()) {
       const bool nine_numbers =
           F->is_array() && F->size() == 9 && std::all_of(F->begin(), F->end(), [](const json& v) {
