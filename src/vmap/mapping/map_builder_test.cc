@@ -204,6 +204,11 @@ TEST(MapBuilder, ParsesThresholdRanges) {
   ASSERT_EQ(taus.size(), 9u);
   EXPECT_DOUBLE_EQ(taus.front(), 0.1);
   EXPECT_DOUBLE_EQ(taus.back(), 0.9);
+  EXPECT_EQ(taus[2], 0.3);  // exactly the double "0.3" reads as, not 0.1 + 2 * 0.1
+  // A tau as small as `vmap build --tau` takes stays itself in a range.
+  const std::vector<double> tiny = ParseThresholds("1e-300:1e-299:1e-300");
+  ASSERT_EQ(tiny.size(), 10u);
+  EXPECT_EQ(tiny.front(), 1e-300);
   EXPECT_EQ(ParseThresholds("0.2,0.5").size(), 2u);
   EXPECT_THROW(ParseThresholds("0.1:1.5:0.2"), InputError);
   EXPECT_THROW(ParseThresholds("abc"), InputError);

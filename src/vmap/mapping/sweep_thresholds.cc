@@ -1,5 +1,6 @@
 #include "vmap/mapping/sweep_thresholds.h"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -27,7 +28,14 @@ std::vector<double> ParseThresholds(const std::string& text) {
       throw OptionError("thresholds", fmt::format("'{}' gives {:.0f} thresholds, more than {}; use a larger step", text,
                                                   count, kMaxThresholds));
     }
-    for (int i = 0; i < static_cast<int>(count); ++i) taus.push_back(std::round((start + i * step) * 1e9) / 1e9);
+    // 12 significant digits drop the sum's noise (0.1 + 2 * 0.1 is 0.30000000000000004) and keep a tiny tau tiny,
+    // which a fixed number of decimals would round to 0.
+    for (int i = 0; i < static_cast<int>(count); ++i) {
+      const std::string rounded = fmt::format("{:.12g}", start + i * step);
+      double tau = 0.0;
+      std::from_chars(rounded.data(), rounded.data() + rounded.size(), tau);  // no locale: fmt wrote a '.'
+      taus.push_back(tau);
+    }
   } else {
     std::stringstream list(text);
     std::string item;
