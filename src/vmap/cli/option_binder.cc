@@ -107,9 +107,20 @@ void OptionBinder::Bind(CLI::App* command, OptionFlags& option_flags) const {
             for (const Target& target : targets.values) values.push_back(std::get<T>(target));
             CLI::Option* option = BindValues(command, flag, targets.field, values);
             if constexpr (std::is_same_v<Value, int> || std::is_same_v<Value, double>) {
+              // CLI11 answers "abc", "1.5" or "2147483648" with "Could not convert"; say what the flag takes instead.
+              // The text is read by CLI11's own conversion, so every spelling it accepts still passes.
+              const OptionRange& range = targets.field.range;
+              const std::string takes =
+                  std::string(std::is_same_v<Value, int> ? "an integer" : "a number") +
+                  (!range.is_set ? "" : (range.also ? ": " : " in ") + RangeText(range, std::is_same_v<Value, int>));
+              option->check(CLI::Validator(
+                  [takes](std::string& text) -> std::string {
+                    Value parsed{};
+                    return CLI::detail::lexical_cast(text, parsed) ? "" : text + " is not " + takes;
+                  },
+                  ""));
               // The values the field takes, after its type: "--lookahead INT in [1, 2]=2", "FLOAT 0 or [1, 1000]".
-              if (targets.field.range.is_set) {
-                const OptionRange& range = targets.field.range;
+              if (range.is_set) {
                 option->type_name(option->get_type_name() + (range.also ? " " : " in ") +
                                   RangeText(range, std::is_same_v<Value, int>));
               }

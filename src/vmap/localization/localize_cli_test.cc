@@ -266,6 +266,10 @@ TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
       {localize + "--to 99", "key image 99 does not exist"},
       {localize + "--start-key 99", "start key image 99 (--start-key) does not exist"},
       {localize + "--start-key -2", "--start-key -2 is less than -1"},
+      // Numbers no int holds are refused by what the flag takes, not by CLI11's "Could not convert".
+      {localize + "--verifier-seed 2147483648", "--verifier-seed: 2147483648 is not an integer in [-1, 2147483647]"},
+      {localize + "--start-key 1.5", "--start-key: 1.5 is not an integer in [-1, 2147483647]"},
+      {localize + "--min-rival-ratio x", "--min-rival-ratio: x is not a number: 0 or [1, 1000]"},
       {"localize " + Quote(tmp.path() / "m") + " " + Quote(tmp.path() / "missing.mp4"), "does not exist"},
       {"route " + Quote(tmp.path() / "m") + " --min-backward-verified 2",
        "--min-backward-verified 2 is outside [8, 100000]"},
