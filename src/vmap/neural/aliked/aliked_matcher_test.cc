@@ -271,7 +271,8 @@ TEST(AlikedMatcher, BadOptionsAndDevicesAreClearErrors) {
   EXPECT_NE(ExpectInputError([&] { CreateAlikedMatcher(options); }).find("fits --aliked-model n16"), std::string::npos);
   options = Options("t16");
   options.weights = SharedDir() + "/weights/aliked/no-such-file.pt";
-  EXPECT_NE(ExpectInputError([&] { CreateAlikedMatcher(options); }).find("is missing; give the weights file"), std::string::npos);
+  EXPECT_NE(ExpectInputError([&] { CreateAlikedMatcher(options); }).find("is missing; give the weights file"),
+            std::string::npos);
   if (!torch::cuda::is_available()) {
     options = Options("t16");
     options.device = "cuda";

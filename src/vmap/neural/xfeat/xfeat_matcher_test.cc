@@ -245,7 +245,8 @@ TEST(XfeatMatcher, BadInputIsRefusedClearly) {
   EXPECT_EQ(ExpectInputError([&] { bad.Check(); }).find("device 'tpu' is not a device"), 0u);
   bad = SharedOptions();
   bad.weights = SharedDir() + "/no/such/file.pt";
-  EXPECT_NE(ExpectInputError([&] { CreateXfeatMatcher(bad); }).find("is missing; give the weights file"), std::string::npos);
+  EXPECT_NE(ExpectInputError([&] { CreateXfeatMatcher(bad); }).find("is missing; give the weights file"),
+            std::string::npos);
 }
 
 }  // namespace
