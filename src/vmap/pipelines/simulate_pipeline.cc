@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 
@@ -9,6 +10,7 @@
 
 #include "vmap/control/taught_route.h"
 #include "vmap/core/atomic_output.h"
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/core/stopwatch.h"
 #include "vmap/map/map_io.h"
@@ -42,6 +44,20 @@ std::vector<fs::path> TextureFolders(const SimulationOptions& options) {
     if (!path.empty()) folders.emplace_back(path);
   }
   return folders;
+}
+
+// Whether the folders `a` and `b`, existing or not, are the same or one lies inside the other.
+bool OneHoldsTheOther(const fs::path& a, const fs::path& b) {
+  const auto resolved = [](const fs::path& path) {
+    std::error_code ec;
+    const fs::path full = fs::weakly_canonical(fs::absolute(path), ec);
+    return full.has_filename() ? full : full.parent_path();  // "R/" as "R"
+  };
+  const fs::path first = resolved(a), second = resolved(b);
+  const auto prefix_of = [](const fs::path& outer, const fs::path& inner) {
+    return std::mismatch(outer.begin(), outer.end(), inner.begin(), inner.end()).first == outer.end();
+  };
+  return prefix_of(first, second) || prefix_of(second, first) || IsSameOrInside(a, b) || IsSameOrInside(b, a);
 }
 
 // Where a map nobody asked to keep is built: a folder of its own per run, also when runs share a process.
@@ -139,13 +155,24 @@ SimulatePipelineResult RunSimulatePipeline(const SimulatePipelineOptions& option
   const auto start = std::chrono::steady_clock::now();
   const SimulationOptions& simulation = options.simulation;
 
-  // 1. The options and the outputs: none may overwrite the route, the textures or each other.
+  // 1. The options and the outputs: none may overwrite the route, the textures or each other (the JSON is
+  //    written last, so it may not land on the map's files or in the report's folder).
   options.Check();
   std::vector<std::vector<OutputInput>> inputs = {NamedInput(simulation.teach_textures, "--teach-textures"),
-                                                  NamedInput(simulation.repeat_textures, "--repeat-textures")};
+                                                  NamedInput(simulation.repeat_textures, "--repeat-textures"),
+                                                  NamedInput(options.report, "the report folder")};
   if (FindEnum(kRouteShapeNames, simulation.route) == std::nullopt)
     inputs.push_back(NamedInput(simulation.route, "--route"));
+  if (!options.map.empty()) inputs.push_back(MapInputs(options.map));
   CheckOutputs({{options.json, "json"}}, inputs);
+  // The map kept and the report are folders of their own: the one committed second would replace or refuse the
+  // other, after all the work.
+  if (!options.map.empty() && !options.report.empty() && OneHoldsTheOther(options.map, options.report)) {
+    throw OptionError("map",
+                      "'" + options.map + "' and the report folder '" + options.report +
+                          "' lie one in the other; give two separate folders",
+                      {"report"});
+  }
 
   // 2. The folders, claimed before any work: the report's, and the map's (kept only with options.map; until the
   //    end it is built in a hidden folder beside it, which goes if the run fails).

@@ -81,5 +81,33 @@ TEST(SimulateCli, BadInputIsOneErrorLineAndWritesNothing) {
   ExpectRefused("--law pid", "pid");
 }
 
+// Outputs that would land on each other are refused before the teach run: each was once found written over
+// (the JSON as the map's map.json, the JSON inside the report) or refused only after all the trials.
+TEST(SimulateCli, OutputsThatWouldLandOnEachOtherAreRefusedBeforeAnyWork) {
+  ::vmap::testing::ScopedTempDir temp("simulate_outputs");
+  const fs::path route = WriteRoute(temp.path(), "0,0\n4,0\n");
+  const fs::path map = temp.path() / "map", report = temp.path() / "report";
+  fs::create_directory(map);
+  fs::create_directory(report);
+  struct Case {
+    std::string outputs, expected;
+  };
+  const Case cases[] = {
+      {"--map " + Quote(map) + " --json " + Quote(map / "map.json"), "would overwrite the map's map.json"},
+      {"--report " + Quote(report) + " --json " + Quote(report / "report.html"), "lies inside the report folder"},
+      {"--report " + Quote(report) + " --map " + Quote(report / "map"), "lie one in the other"},
+      {"--map " + Quote(map) + " --report " + Quote(map / "report"), "lie one in the other"},
+      {"--map " + Quote(map) + " --report " + Quote(map.string() + "/"), "lie one in the other"},
+  };
+  for (const Case& c : cases) {
+    std::string out;
+    EXPECT_EQ(RunVmap("simulate --route " + Quote(route) + " --trials 1 " + c.outputs, &out), 2) << c.outputs;
+    EXPECT_EQ(out.rfind("vmap: error: ", 0), 0u) << out;
+    EXPECT_NE(out.find(c.expected), std::string::npos) << out;
+    EXPECT_TRUE(fs::is_empty(map)) << c.outputs;
+    EXPECT_TRUE(fs::is_empty(report)) << c.outputs;
+  }
+}
+
 }  // namespace
 }  // namespace vmap
