@@ -6,6 +6,7 @@
 #include "vmap/core/runtime.h"
 
 #include "vmap_ros/rosconsole_sink.h"
+#include "vmap_ros/terminate_signal.h"
 #include "vmap_ros/vmap_node.h"
 
 int main(int argc, char** argv) {
@@ -16,6 +17,7 @@ int main(int argc, char** argv) {
   vmap::InitializeRuntime(runtime);
   ros::init(argc, argv, "vmap");
   vmap::ros_node::LogThroughRosconsole();
+  vmap::ros_node::ShutDownOnTerminateSignal();
   ros::NodeHandle node;
   ros::NodeHandle private_node("~");
   vmap::ros_node::VmapNode vmap_node(node, private_node);

@@ -7,6 +7,7 @@
 
 #include "vmap_ros/rosconsole_sink.h"
 #include "vmap_ros/simulator_node.h"
+#include "vmap_ros/terminate_signal.h"
 
 int main(int argc, char** argv) {
   vmap::RuntimeOptions runtime;
@@ -14,6 +15,7 @@ int main(int argc, char** argv) {
   vmap::InitializeRuntime(runtime);
   ros::init(argc, argv, "vmap_simulator");
   vmap::ros_node::LogThroughRosconsole();
+  vmap::ros_node::ShutDownOnTerminateSignal();
   ros::NodeHandle node;
   ros::NodeHandle private_node("~");
   const int status = vmap::ros_node::RunSimulatorNode(node, private_node);

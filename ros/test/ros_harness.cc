@@ -114,9 +114,9 @@ int ChildProcess::Wait(std::chrono::seconds timeout) {
   return status_;
 }
 
-int ChildProcess::Stop(std::chrono::seconds grace) {
+int ChildProcess::Stop(std::chrono::seconds grace, int signal) {
   if (!Running()) return status_;
-  kill(-pid_, SIGINT);
+  kill(-pid_, signal);
   if (Wait(grace) == -1 && Running()) {
     kill(-pid_, SIGKILL);
     int status = 0;

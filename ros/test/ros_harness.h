@@ -4,6 +4,7 @@
 // without timing assumptions (every wait is for a condition, with a generous deadline).
 
 #include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -26,8 +27,9 @@ class ChildProcess {
   bool Running();
   // Waits for it to exit; its exit status, or -1 when it did not exit in `timeout` (then it runs on).
   int Wait(std::chrono::seconds timeout);
-  // SIGINT, up to `grace` to exit, then SIGKILL. Returns the exit status (-1 after SIGKILL or a signal).
-  int Stop(std::chrono::seconds grace = std::chrono::seconds(10));
+  // `signal` (SIGINT: what roslaunch sends first; SIGTERM: its escalation, and systemd's and docker's stop), up
+  // to `grace` to exit, then SIGKILL. Returns the exit status (-1 after SIGKILL or a signal).
+  int Stop(std::chrono::seconds grace = std::chrono::seconds(10), int signal = SIGINT);
   std::string Log() const;  // what it printed so far
   const std::filesystem::path& log() const { return log_; }
 

@@ -96,6 +96,46 @@ TEST(TeachNode, BuildsFromAPlayedBagTheMapVmapBuildBuilds) {
   EXPECT_TRUE(node->Running());
 }
 
+// SIGTERM (roslaunch's escalation, systemd's and docker's stop) ends a teach run as SIGINT does: its map is
+// written with every frame the node took, not lost with the process.
+TEST(TeachNode, ATerminateSignalFinishesTheTeachRunsMap) {
+  SKIP_WITHOUT_SHARED();
+  ScopedTempDir dir("ros_teach_sigterm");
+  const fs::path bag = dir.path() / "teach.bag";
+  const std::vector<ros::Time> stamps =
+      WriteVideoBag(fs::path(SharedDir()) / "data/lab_floor/lab_floor.mp4", 0, 29, bag, "bgr8", 0.05);
+  const auto node = StartVmapNode("/teach_term", {"image:=/camera/image_raw", "odom:=/odom", "_teach_queue:=100"},
+                                  dir.path() / "node.log");
+  ASSERT_TRUE(WaitForNodeServices("/teach_term/vmap")) << node->Log();
+  ros::NodeHandle handle;
+  std::mutex mutex;
+  uint32_t frames = 0;
+  const ros::Subscriber subscriber = handle.subscribe<vmap_ros::TeachProgress>(
+      "/teach_term/vmap/teach/progress", 100, [&](const vmap_ros::TeachProgress::ConstPtr& message) {
+        std::lock_guard<std::mutex> lock(mutex);
+        frames = message->frames;
+      });
+  vmap_ros::StartTeach start;
+  start.request.map = (dir.path() / "map").string();
+  ASSERT_TRUE(ros::service::call("/teach_term/vmap/teach/start", start));
+  ASSERT_TRUE(start.response.success) << start.response.message;
+  ASSERT_TRUE(WaitFor([&] { return subscriber.getNumPublishers() > 0; }, kTimeout));
+  const auto player = PlayBag(bag, 1.0, dir.path() / "play.log");
+  ASSERT_EQ(player->Wait(std::chrono::seconds(120)), 0) << player->Log();
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(mutex);
+        return frames == stamps.size();
+      },
+      kTimeout))
+      << node->Log();
+
+  EXPECT_EQ(node->Stop(std::chrono::seconds(60), SIGTERM), 0) << node->Log();
+  const VisualMap map = ReadMap(dir.path() / "map");
+  EXPECT_EQ(map.num_frames, static_cast<int>(stamps.size()));
+  EXPECT_GE(map.key_images.size(), 2u);
+}
+
 TEST(TeachNode, RefusesAFolderThatIsNotAMapAndLeavesItAsItWas) {
   ScopedTempDir dir("ros_teach_refuse");
   fs::create_directories(dir.path() / "notes");
