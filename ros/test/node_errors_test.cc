@@ -4,6 +4,7 @@
 
 #include <fstream>
 #include <mutex>
+#include <thread>
 
 #include <gtest/gtest.h>
 #include <sensor_msgs/CameraInfo.h>
@@ -17,6 +18,7 @@
 #include "ros_harness.h"
 #include "vmap_ros/Localization.h"
 #include "vmap_ros/StartRepeat.h"
+#include "vmap_ros/StartTeach.h"
 
 namespace vmap::ros_testing {
 namespace {
@@ -167,6 +169,66 @@ TEST(NodeErrors, BadMessagesMapsAndCallsAreAnsweredAndTheNodeRunsOn) {
   EXPECT_FALSE((Trigger(ns + "/vmap/repeat/stop", &success), success));
   EXPECT_TRUE(node->Running()) << node->Log();
   EXPECT_EQ(node->Stop(), 0) << node->Log();  // SIGINT: a clean exit
+}
+
+// A teach run is no repeat run: the repeat services called during one are refused and the teach run goes on (they
+// crashed the node). Two starts called at once are one run, not two.
+TEST(NodeErrors, RepeatCallsDuringATeachRunAndStartsAtOnceAreRefused) {
+  SKIP_WITHOUT_SHARED();
+  ScopedTempDir dir("ros_modes");
+  const std::string ns = "/modes_test";
+  const auto node = StartVmapNode(ns, {"image:=/modes/image_raw"}, dir.path() / "node.log");
+  ASSERT_TRUE(WaitForNodeServices(ns + "/vmap")) << node->Log();
+  vmap_ros::StartTeach teach;
+  teach.request.map = (dir.path() / "taught").string();
+  ASSERT_TRUE(ros::service::call(ns + "/vmap/teach/start", teach));
+  ASSERT_TRUE(teach.response.success) << teach.response.message;
+  bool success = true;
+  for (const char* service : {"/vmap/repeat/pause", "/vmap/repeat/resume", "/vmap/repeat/stop"}) {
+    EXPECT_NE(Trigger(ns + service, &success).find("no repeat run is in progress"), std::string::npos) << service;
+    EXPECT_FALSE(success) << service;
+  }
+  EXPECT_TRUE(node->Running()) << node->Log();
+  // Still the teach run's to stop (no frame came, so it has no map to write).
+  EXPECT_EQ(Trigger(ns + "/vmap/teach/stop", &success).find("no teach run is in progress"), std::string::npos);
+
+  // Values the services and parameters do not take.
+  vmap_ros::StartRepeat repeat;
+  repeat.request.map = (dir.path() / "map").string();
+  repeat.request.start = -2;
+  repeat.request.goal = -1;
+  ASSERT_TRUE(ros::service::call(ns + "/vmap/repeat/start", repeat));
+  EXPECT_FALSE(repeat.response.success);
+  EXPECT_NE(repeat.response.message.find("start -2 and goal -1: each is a key image"), std::string::npos)
+      << repeat.response.message;
+  ros::param::set(ns + "/vmap/teach_queue", 1.5);
+  ASSERT_TRUE(ros::service::call(ns + "/vmap/teach/start", teach));
+  EXPECT_FALSE(teach.response.success);
+  EXPECT_NE(teach.response.message.find("~teach_queue must be an integer"), std::string::npos)
+      << teach.response.message;
+  ros::param::del(ns + "/vmap/teach_queue");
+
+  // A repeat run's start reads its map for a while: a teach run started meanwhile is refused, or starts first and
+  // the repeat run is refused, never both.
+  const fs::path bag = dir.path() / "teach.bag";
+  WriteVideoBag(fs::path(SharedDir()) / "data/lab_floor/lab_floor.mp4", 0, 29, bag);
+  std::string output;
+  ASSERT_EQ(RunVmap("build -q " + Quote(bag) + " -o " + Quote(dir.path() / "map"), &output), 0) << output;
+  repeat.request.start = -1;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    std::thread repeat_call([&] { ASSERT_TRUE(ros::service::call(ns + "/vmap/repeat/start", repeat)); });
+    ASSERT_TRUE(ros::service::call(ns + "/vmap/teach/start", teach));
+    repeat_call.join();
+    EXPECT_NE(repeat.response.success, teach.response.success) << repeat.response.message << "\n"
+                                                               << teach.response.message;
+    const std::string refused = repeat.response.success ? teach.response.message : repeat.response.message;
+    EXPECT_TRUE(refused.find("in progress") != std::string::npos ||
+                refused.find("another run is starting") != std::string::npos)
+        << refused;
+    Trigger(ns + (repeat.response.success ? "/vmap/repeat/stop" : "/vmap/teach/stop"), &success);
+  }
+  EXPECT_TRUE(node->Running()) << node->Log();
+  EXPECT_EQ(node->Stop(), 0) << node->Log();
 }
 
 }  // namespace

@@ -28,9 +28,19 @@ std::string RouteText(const std::vector<int>& route) {
 }  // namespace
 
 bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::StartRepeat::Response& response) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (mode_ != Mode::kIdle) return Fail(response, "repeat/start: " + Busy());
+  if (const std::string busy = ClaimForStart(); !busy.empty()) return Fail(response, "repeat/start: " + busy);
+  // Until the run is set, a start that fails gives the node back idle.
+  struct Claim {
+    VmapNode* node;
+    bool kept = false;
+    ~Claim() {
+      if (!kept) node->ReleaseClaim();
+    }
+  } claim{this};
+  if (request.start < -1 || request.goal < -1) {
+    return Fail(response, fmt::format("repeat/start: start {} and goal {}: each is a key image of the map, or -1 "
+                                      "(the map's first, its last)",
+                                      request.start, request.goal));
   }
   LocalizePipelineOptions options;
   options.map = MapOf(request.map);
@@ -66,6 +76,7 @@ bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::St
     std::lock_guard<std::mutex> lock(mutex_);
     repeat_ = std::move(run);
     mode_ = Mode::kRepeating;
+    claim.kept = true;
     localized_once_ = false;
     goal_reached_ = false;
     mailbox_.Reset(1);
@@ -86,8 +97,8 @@ bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::St
 
 bool VmapNode::PauseRepeat(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (mode_ == Mode::kIdle) return Fail(response, "repeat/pause: no repeat run is in progress");
   if (mode_ == Mode::kPaused) return Fail(response, "repeat/pause: the repeat run is paused already");
+  if (mode_ != Mode::kRepeating) return Fail(response, "repeat/pause: no repeat run is in progress");
   mode_ = Mode::kPaused;
   PublishStop();
   return Succeed(response, "repeat run paused: the robot stops; frames are still localized");
@@ -110,7 +121,9 @@ bool VmapNode::StopRepeat(std_srvs::Trigger::Request&, std_srvs::Trigger::Respon
   {
     std::lock_guard<std::mutex> run_lock(run_mutex_);  // the frame in progress ends first
     std::lock_guard<std::mutex> lock(mutex_);
-    if (mode_ == Mode::kIdle) return Fail(response, "repeat/stop: no repeat run is in progress");
+    if (mode_ != Mode::kRepeating && mode_ != Mode::kPaused) {
+      return Fail(response, "repeat/stop: no repeat run is in progress");
+    }
     frames = repeat_->frames();
     mode_ = Mode::kIdle;
     repeat_.reset();

@@ -1,6 +1,7 @@
 // The node's teach run (vmap_node.h): services, the camera's frames into the build pipeline, progress.
 
 #include <fmt/format.h>
+#include <xmlrpcpp/XmlRpcValue.h>
 
 #include "vmap/core/error.h"
 
@@ -22,10 +23,15 @@ constexpr const char* kRecordingOnly[] = {"format", "topic", "until_interrupted"
 }  // namespace
 
 bool VmapNode::StartTeach(vmap_ros::StartTeach::Request& request, vmap_ros::StartTeach::Response& response) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (mode_ != Mode::kIdle) return Fail(response, "teach/start: " + Busy());
-  }
+  if (const std::string busy = ClaimForStart(); !busy.empty()) return Fail(response, "teach/start: " + busy);
+  // Until the run is set, a start that fails gives the node back idle.
+  struct Claim {
+    VmapNode* node;
+    bool kept = false;
+    ~Claim() {
+      if (!kept) node->ReleaseClaim();
+    }
+  } claim{this};
   const std::string map = MapOf(request.map);
   if (map.empty()) return Fail(response, "teach/start: no map; give one in the request or set ~map");
   ParameterReader parameters(private_node_);
@@ -47,8 +53,13 @@ bool VmapNode::StartTeach(vmap_ros::StartTeach::Request& request, vmap_ros::Star
     options.map.show_progress = false;
     options.map.after_frame = [this] { PublishTeachProgress(); };
     int capacity = kTeachQueue;
-    private_node_.getParam("teach_queue", capacity);
-    if (capacity < 1) throw InputError("~teach_queue must be at least 1 (frames held while the builder is busy)");
+    if (XmlRpc::XmlRpcValue queue; private_node_.getParam("teach_queue", queue)) {
+      // Read as a value first: getParam into an int leaves the default for "x" or 1.5, silently.
+      if (queue.getType() != XmlRpc::XmlRpcValue::TypeInt || static_cast<int>(queue) < 1) {
+        throw InputError("~teach_queue must be an integer of at least 1 (frames held while the builder is busy)");
+      }
+      capacity = static_cast<int>(queue);
+    }
     run = std::make_unique<TeachRun>(options, static_cast<size_t>(capacity));
   } catch (const InputError& error) {
     return Fail(response, "teach/start: " + parameters.Message(error));
@@ -65,6 +76,7 @@ bool VmapNode::StartTeach(vmap_ros::StartTeach::Request& request, vmap_ros::Star
     teach_frames_ = 0;
     teach_dropped_ = 0;
     mode_ = Mode::kTeaching;
+    claim.kept = true;
   }
   {
     std::lock_guard<std::mutex> lock(teach_odometry_mutex_);

@@ -161,6 +161,8 @@ std::string VmapNode::Busy() const {
   switch (mode_) {
     case Mode::kIdle:
       return "";
+    case Mode::kStarting:
+      return "another run is starting; try again when its start has answered";
     case Mode::kTeaching:
       return fmt::format("a teach run is in progress; call {}/teach/stop first", private_node_.getNamespace());
     case Mode::kFinishing:
@@ -171,6 +173,18 @@ std::string VmapNode::Busy() const {
   }
   return fmt::format("a repeat run is in progress (goal {}); call {}/repeat/stop first", repeat_->route().back(),
                      private_node_.getNamespace());
+}
+
+std::string VmapNode::ClaimForStart() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (mode_ != Mode::kIdle) return Busy();
+  mode_ = Mode::kStarting;
+  return "";
+}
+
+void VmapNode::ReleaseClaim() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (mode_ == Mode::kStarting) mode_ = Mode::kIdle;
 }
 
 std::string VmapNode::MapOf(const std::string& requested) const {

@@ -55,8 +55,10 @@ class VmapNode {
   VmapNode& operator=(const VmapNode&) = delete;
 
  private:
-  // kFinishing: a teach run's map is being written; no run starts meanwhile.
-  enum class Mode { kIdle, kTeaching, kFinishing, kRepeating, kPaused };
+  // kStarting: a start service is reading its parameters and map, the node claimed so that a second start called
+  // meanwhile is refused (two starts at once both succeeded). kFinishing: a teach run's map is being written; no
+  // run starts meanwhile.
+  enum class Mode { kIdle, kStarting, kTeaching, kFinishing, kRepeating, kPaused };
   struct Arrival {
     topic_tools::ShapeShifter::ConstPtr message;
     ros::WallTime time;  // when the callback got it
@@ -70,6 +72,10 @@ class VmapNode {
   void Work();
   // Why a run cannot start now ("a teach run is in progress; ..."); "" when the node is idle. Under mutex_.
   std::string Busy() const;
+  // Claims the idle node for a run being started ("" when claimed, else why not: Busy()); ReleaseClaim gives it
+  // back idle when the start fails.
+  std::string ClaimForStart();
+  void ReleaseClaim();
   std::string MapOf(const std::string& requested) const;
   // Logs an error of a message: at once when its problem differs from the last one logged, else at most every
   // few seconds (a camera sending one malformed message 30 times a second would flood the log).
