@@ -2,16 +2,20 @@
 
 #include <cstdint>
 #include <cstring>
+#include <functional>
 
 namespace vmap {
 
 namespace {
 
+// Reads `bytes` bytes at `offset`; false when the file or buffer ends before them.
+using ReadBytes = std::function<bool(std::uint64_t offset, void* data, std::size_t bytes)>;
+
 // The width and height a PNG file's header announces, or nullopt when the file is not a PNG.
-std::optional<cv::Size> PngSize(const ContainedFile& file) {
+std::optional<cv::Size> PngSize(const ReadBytes& read) {
   unsigned char header[24];
   static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-  if (!file.Read(0, header, sizeof(header)) || std::memcmp(header, kSignature, 8) != 0 ||
+  if (!read(0, header, sizeof(header)) || std::memcmp(header, kSignature, 8) != 0 ||
       std::memcmp(header + 12, "IHDR", 4) != 0) {
     return std::nullopt;
   }
@@ -27,12 +31,12 @@ std::optional<cv::Size> PngSize(const ContainedFile& file) {
 // The width and height of a baseline or progressive JPEG file's frame header (SOFn), or nullopt when the file
 // is not a JPEG. Walks the marker segments from the start; at most 64 segments and 1 MiB are looked at, since
 // the frame header comes before any image data.
-std::optional<cv::Size> JpegSize(const ContainedFile& file) {
+std::optional<cv::Size> JpegSize(const ReadBytes& read) {
   unsigned char bytes[9];
-  if (!file.Read(0, bytes, 2) || bytes[0] != 0xFF || bytes[1] != 0xD8) return std::nullopt;
+  if (!read(0, bytes, 2) || bytes[0] != 0xFF || bytes[1] != 0xD8) return std::nullopt;
   std::uint64_t at = 2;
   for (int segment = 0; segment < 64 && at < (1u << 20); ++segment) {
-    if (!file.Read(at, bytes, 4) || bytes[0] != 0xFF) return std::nullopt;
+    if (!read(at, bytes, 4) || bytes[0] != 0xFF) return std::nullopt;
     const int marker = bytes[1];
     const int length = (bytes[2] << 8) | bytes[3];
     if (marker == 0xFF) {  // fill byte
@@ -41,7 +45,7 @@ std::optional<cv::Size> JpegSize(const ContainedFile& file) {
     }
     // SOF0..SOF15 except DHT (C4), JPG (C8) and DAC (CC): precision, height, width.
     if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC) {
-      if (!file.Read(at + 4, bytes, 5)) return std::nullopt;
+      if (!read(at + 4, bytes, 5)) return std::nullopt;
       return cv::Size((bytes[3] << 8) | bytes[4], (bytes[1] << 8) | bytes[2]);
     }
     if (marker == 0xD9 || marker == 0xDA || length < 2) return std::nullopt;  // end or scan before a frame
@@ -53,8 +57,21 @@ std::optional<cv::Size> JpegSize(const ContainedFile& file) {
 }  // namespace
 
 std::optional<cv::Size> ImageHeaderSize(const ContainedFile& file) {
-  if (auto size = PngSize(file)) return size;
-  return JpegSize(file);
+  const ReadBytes read = [&file](std::uint64_t offset, void* data, std::size_t bytes) {
+    return file.Read(offset, data, bytes);
+  };
+  if (auto size = PngSize(read)) return size;
+  return JpegSize(read);
+}
+
+std::optional<cv::Size> ImageHeaderSize(const std::uint8_t* encoded, std::size_t size) {
+  const ReadBytes read = [encoded, size](std::uint64_t offset, void* data, std::size_t bytes) {
+    if (offset > size || bytes > size - offset) return false;
+    std::memcpy(data, encoded + offset, bytes);
+    return true;
+  };
+  if (auto announced = PngSize(read)) return announced;
+  return JpegSize(read);
 }
 
 }  // namespace vmap

@@ -3,6 +3,8 @@
 // announcing 32000 x 32000 pixels is refused before a decoder allocates a gigabyte for it. OpenCV has such a
 // limit too (OPENCV_IO_MAX_IMAGE_PIXELS), but reads it once when the library loads, and at 2^30 pixels.
 
+#include <cstddef>
+#include <cstdint>
 #include <optional>
 
 #include <opencv2/core.hpp>
@@ -14,5 +16,7 @@ namespace vmap {
 // The width and height of a PNG (IHDR) or a baseline or progressive JPEG (SOFn), or nullopt when the file is
 // neither (or is cut short): then only the decoder's own checks apply. Sides beyond 2^20 are returned as 2^20.
 std::optional<cv::Size> ImageHeaderSize(const ContainedFile& file);
+// The same of an encoded image held in memory (a ROS CompressedImage message's data).
+std::optional<cv::Size> ImageHeaderSize(const std::uint8_t* encoded, std::size_t size);
 
 }  // namespace vmap

@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/core/image_header.h"
+#include "vmap/sources/frame_source.h"
 #include "vmap/sources/message_buffer.h"
 
 namespace vmap {
@@ -131,6 +134,14 @@ DecodedImage DecodeImageMessage(const uint8_t* data, size_t size, const std::str
     const uint8_t* compressed = buffer.Bytes(&bytes);
     const cv::Mat encoded(1, static_cast<int>(std::min<size_t>(bytes, INT32_MAX)), CV_8UC1,
                           const_cast<uint8_t*>(compressed));
+    // A few bytes may announce 32000 x 32000 pixels: refused by the header, before the decoder allocates them.
+    const std::optional<cv::Size> announced = ImageHeaderSize(compressed, bytes);
+    if (announced && static_cast<long>(announced->width) * announced->height > kMaxFramePixels) {
+      throw InputError(
+          fmt::format("{} holds a compressed image whose header announces {}x{}, more than vmap's limit of "
+                      "{} pixels per frame",
+                      what, announced->width, announced->height, kMaxFramePixels));
+    }
     cv::Mat decoded;
     try {
       if (bytes > 0) decoded = cv::imdecode(encoded, cv::IMREAD_UNCHANGED);

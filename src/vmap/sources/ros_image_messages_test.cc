@@ -111,6 +111,28 @@ TEST(RosImageMessages, CompressedJpegAndPng) {
   }
 }
 
+// A compressed image of a few bytes may announce 32000 x 32000 pixels (a gigabyte once decoded): refused by its
+// header, before the decoder allocates anything.
+TEST(RosImageMessages, ACompressedImageAnnouncingTooManyPixelsIsRefusedByItsHeader) {
+  std::vector<uint8_t> png;
+  cv::imencode(".png", TestImage(), png);
+  for (const int at : {16, 20}) {  // IHDR's width, then its height, big-endian
+    png[at] = 0;
+    png[at + 1] = 0;
+    png[at + 2] = 32000 >> 8;
+    png[at + 3] = 32000 & 0xff;
+  }
+  for (MessageEncoding encoding : kEncodings) {
+    const std::vector<uint8_t> data = testing::SerializeCompressedImage(encoding, 1.0, "png", png);
+    try {
+      Decode(data, encoding, kCompressedImageType);
+      ADD_FAILURE() << "decoded";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("header announces 32000x32000"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(RosImageMessages, MalformedMessagesAreInputErrorsNeverCrashes) {
   const cv::Mat bgr = TestImage();
   for (MessageEncoding encoding : kEncodings) {
