@@ -60,7 +60,7 @@ py::array_t<bool> InlierMask(const Link& link) {
 
 cv::Mat ReadKeyImageWithoutGil(const KeyImageRef& ref, bool grayscale) {
   py::gil_scoped_release release;
-  return ReadKeyImage(ref.handle->directory, ref.key(), grayscale);
+  return ReadKeyImage(ref.handle->directory, ref.key(), grayscale, ref.handle->map.input.frame_size);
 }
 
 }  // namespace

@@ -71,6 +71,27 @@ def test_a_camera_mask_is_kept_as_the_cli_keeps_it(tmp_path):
     assert vmap.read_map(module_dir).key_images[0].num_features > 0
 
 
+def test_a_key_image_replaced_after_read_map_is_refused_not_decoded(maps, tmp_path):
+    # A map rebuilt into the folder of one a program holds: the old links must not be paired with new images, and
+    # a file announcing 32000 x 32000 pixels must not be decoded (a gigabyte).
+    import shutil
+    cli_dir, _, _ = maps
+    copy = tmp_path / "map"
+    shutil.copytree(cli_dir, copy)
+    m = vmap.read_map(copy)
+    width, height = map_json(copy)["input"]["frame_size"]
+    key_file = copy / m.key_images[0].image_file
+    write_grey_png(key_file, np.zeros((height // 2, width // 2), dtype=np.uint8))
+    with pytest.raises(vmap.Error, match="not the map's frame size .*changed since the map was read"):
+        m.key_images[0].gray
+    data = bytearray(key_file.read_bytes())
+    data[16:24] = (32000).to_bytes(4, "big") * 2  # IHDR's width and height
+    key_file.write_bytes(bytes(data))
+    with pytest.raises(vmap.Error, match="is 32000x32000"):
+        m.key_images[0].image
+    assert m.key_images[1].gray.shape == (height, width)
+
+
 def test_read_map_gives_the_map_json_as_numpy(maps):
     cli_dir, _, _ = maps
     record = map_json(cli_dir)

@@ -423,12 +423,36 @@ fs::path KeyImageFile(const fs::path& map_directory, const KeyImage& key) {
   return OpenMapFile(map_directory, key.image_file, "key image", map_directory / kMapFileName, "key image").path();
 }
 
-cv::Mat ReadKeyImage(const fs::path& map_directory, const KeyImage& key, bool grayscale) {
-  const fs::path file = KeyImageFile(map_directory, key);
+cv::Mat ReadKeyImage(const fs::path& map_directory, const KeyImage& key, bool grayscale, const cv::Size& frame_size) {
+  if (!IsPlainRelativePath(key.image_file)) {
+    Malformed(map_directory / kMapFileName, "key image '" + key.image_file + "' points outside the map directory");
+  }
+  const ContainedFile opened =
+      OpenMapFile(map_directory, key.image_file, "key image", map_directory / kMapFileName, "key image");
+  const fs::path& file = opened.path();
+  // The map reader checked this header, but the file may have been replaced since (a map rebuilt into the same
+  // folder while a program holds the old one): checked again, and the bytes checked are the bytes decoded.
+  const std::optional<cv::Size> size = ImageHeaderSize(opened);
+  const bool fits = size && (frame_size.empty() ? static_cast<long>(size->width) * size->height <= kMaxKeyImagePixels
+                                                : *size == frame_size);
+  if (!fits) {
+    throw InputError("key image '" + file.string() + "' is " +
+                     (size
+                          ? std::to_string(size->width) + "x" + std::to_string(size->height) +
+                                (frame_size.empty() ? ", more pixels than a frame"
+                                                    : ", not the map's frame size " + std::to_string(frame_size.width) +
+                                                          "x" + std::to_string(frame_size.height))
+                          : std::string("not a PNG or JPEG image")) +
+                     ": it changed since the map was read; read the map again, or rebuild it with `vmap build`");
+  }
+  std::string bytes;
   cv::Mat image;
   std::string why;
   try {
-    image = cv::imread(file.string(), grayscale ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
+    if (opened.ReadAll(&bytes)) {
+      image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, bytes.data()),
+                           grayscale ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
+    }
   } catch (const cv::Exception& error) {
     why = " (" + LibraryMessage(error) + ")";
   }

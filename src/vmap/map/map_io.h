@@ -68,8 +68,10 @@ std::optional<cv::Size> KeyImageFileSize(const std::filesystem::path& file);
 std::filesystem::path KeyImageFile(const std::filesystem::path& map_directory, const KeyImage& key);
 
 // Decodes key image `key` (in colour, or grey straight from the decoder as the image sources read frames).
-// Throws InputError naming the file when it is gone, leads outside the map or cannot be decoded.
-cv::Mat ReadKeyImage(const std::filesystem::path& map_directory, const KeyImage& key, bool grayscale = false);
+// Throws InputError naming the file when it is gone, leads outside the map, cannot be decoded, or its header
+// announces another size than `frame_size` (the map's input.frame_size; when empty, more pixels than a frame).
+cv::Mat ReadKeyImage(const std::filesystem::path& map_directory, const KeyImage& key, bool grayscale = false,
+                     const cv::Size& frame_size = {});
 
 // Reads a map directory that vmap may not have written (a map someone sent). Throws InputError naming the file,
 // the field and what is wrong when it is missing or malformed. It never reads outside the directory (no

@@ -66,10 +66,15 @@ TEST(MapIo, ReadKeyImageDecodesTheKeyImagesReadMapChecked) {
   escaping.image_file = "../outside.png";
   EXPECT_NE(ErrorOf([&] { ReadKeyImage(tmp.path(), escaping); }).find("points outside the map directory"),
             std::string::npos);
+  // Replaced by an image of another size: refused by its header when the map's frame size is given.
+  cv::imwrite((tmp.path() / "keys/9.png").string(), cv::Mat(24, 32, CV_8UC1, cv::Scalar(9)));
+  EXPECT_EQ(ReadKeyImage(tmp.path(), map.key_images[1]).size(), cv::Size(32, 24));
+  const std::string resized = ErrorOf([&] { ReadKeyImage(tmp.path(), map.key_images[1], false, cv::Size(64, 48)); });
+  EXPECT_NE(resized.find("keys/9.png' is 32x24, not the map's frame size 64x48"), std::string::npos) << resized;
   std::ofstream(tmp.path() / "keys/9.png", std::ios::trunc) << "not a png";
   const std::string undecodable = ErrorOf([&] { ReadKeyImage(tmp.path(), map.key_images[1]); });
-  EXPECT_NE(undecodable.find("keys/9.png' cannot be decoded"), std::string::npos) << undecodable;
-  EXPECT_NE(undecodable.find("rebuild the map"), std::string::npos) << undecodable;
+  EXPECT_NE(undecodable.find("keys/9.png' is not a PNG or JPEG image"), std::string::npos) << undecodable;
+  EXPECT_NE(undecodable.find("rebuild it with `vmap build`"), std::string::npos) << undecodable;
   fs::remove(tmp.path() / "keys/9.png");
   const std::string missing = ErrorOf([&] { KeyImageFile(tmp.path(), map.key_images[1]); });
   EXPECT_NE(missing.find("keys/9.png' is missing"), std::string::npos) << missing;
