@@ -1,6 +1,7 @@
 // vmap simulate: teaches a route in a simulated corridor and repeats it from random offsets with vmap's localizer
 // and route controller in the loop (pipelines/simulate_pipeline.h); prints the summary.
 
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -43,8 +44,12 @@ void RunSimulate(const SimulateFlags& flags) {
             << fmt::format("reached goal    {} of {} ({}) within {} m\n", s.successes, s.trials,
                            Percent(s.success_rate), flags.options.simulation.goal_tolerance)
             << fmt::format("final error     {:.3f} m mean\n", s.mean_final_error)
-            << fmt::format("lateral error   second half: RMS {:.3f} m mean, {:.3f} m worst; {} of trials <= 0.1 m\n",
-                           s.mean_lateral_rms_second_half, s.worst_lateral_rms_second_half, Percent(s.share_converged))
+            << (std::isnan(s.mean_lateral_rms_second_half)
+                    ? std::string("lateral error   second half: no trial has samples past half the route\n")
+                    : fmt::format("lateral error   second half: RMS {:.3f} m mean, {:.3f} m worst; {} of trials <= "
+                                  "0.1 m\n",
+                                  s.mean_lateral_rms_second_half, s.worst_lateral_rms_second_half,
+                                  Percent(s.share_converged)))
             << fmt::format("frames lost     {} of {}\n", s.frames_lost, s.frames)
             << fmt::format("control step    {:.1f} ms mean, {:.1f} ms max (features, localization, control)\n",
                            1e3 * s.mean_step_seconds, 1e3 * s.max_step_seconds)

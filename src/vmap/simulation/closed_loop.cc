@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -39,7 +40,12 @@ SimulationSummary Summarize(const std::vector<TrialResult>& trials) {
     render_total += trial.mean_render_seconds * trial.frames;
     summary.max_step_seconds = std::max(summary.max_step_seconds, trial.max_step_seconds);
   }
-  if (with_second_half > 0) summary.mean_lateral_rms_second_half /= with_second_half;
+  if (with_second_half > 0) {
+    summary.mean_lateral_rms_second_half /= with_second_half;
+  } else {  // no figure rather than 0 m, which would read as a perfect run
+    summary.mean_lateral_rms_second_half = summary.worst_lateral_rms_second_half =
+        std::numeric_limits<double>::quiet_NaN();
+  }
   summary.share_converged /= std::max(1, summary.trials);
   summary.success_rate = static_cast<double>(summary.successes) / std::max(1, summary.trials);
   if (summary.frames > 0) summary.mean_step_seconds = step_total / summary.frames;

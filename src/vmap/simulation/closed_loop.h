@@ -20,9 +20,10 @@ struct SimulationSummary {
   int trials = 0;
   int successes = 0;  // stopped at the goal within goal_tolerance
   double success_rate = 0.0;
-  double mean_final_error = 0.0;               // m, over all trials
-  double mean_lateral_rms_second_half = 0.0;   // m, over trials that reached the second half
-  double worst_lateral_rms_second_half = 0.0;  // m
+  double mean_final_error = 0.0;  // m, over all trials
+  // m, over trials that reached the second half; NaN when none did (a route too short to have samples past it)
+  double mean_lateral_rms_second_half = 0.0;
+  double worst_lateral_rms_second_half = 0.0;  // m; NaN when no trial reached the second half
   double share_converged = 0.0;                // trials whose second-half lateral RMS is at most 0.1 m
   long frames = 0;
   long frames_lost = 0;
