@@ -142,10 +142,15 @@ void BindBuildAndMatch(py::module_& m) {
       "pairs.");
   py::class_<PairMatcher>(m, "Matcher", matcher_doc.c_str())
       .def(py::init<const py::kwargs&>())
-      .def("match", &PairMatcher::Match, py::arg("image0"), py::arg("image1"),
-           "Matches two uint8 images (HxW grey or HxWx3 BGR); see vmap.match.")
-      .def_property_readonly("name", &PairMatcher::name)
-      .def_property_readonly("options", &PairMatcher::options);
+      .def(
+          "match",
+          [](py::handle self, const py::object& image0, const py::object& image1) {
+            return Constructed<PairMatcher>(self, "Matcher").Match(image0, image1);
+          },
+          py::arg("image0"), py::arg("image1"), "Matches two uint8 images (HxW grey or HxWx3 BGR); see vmap.match.")
+      .def_property_readonly("name", [](py::handle self) { return Constructed<PairMatcher>(self, "Matcher").name(); })
+      .def_property_readonly("options",
+                             [](py::handle self) { return Constructed<PairMatcher>(self, "Matcher").options(); });
   m.def(
       "match",
       [](const py::object& image0, const py::object& image1, const py::kwargs& kwargs) {

@@ -147,14 +147,20 @@ void BindLocalization(py::module_& m) {
       "localize` as keywords (candidates=..., ranking=..., ...).");
   py::class_<FrameLocalizer>(m, "Localizer", localizer_doc.c_str())
       .def(py::init<const py::object&, const py::kwargs&>(), py::arg("map"))
-      .def("localize", &FrameLocalizer::Localize, py::arg("image"), py::arg("timestamp") = py::none(),
-           py::arg("odometry") = py::none(),
-           "Localizes the next frame (uint8 HxW grey or HxWx3 BGR; brought to the map's frame size; timestamp in "
-           "seconds or None; odometry the robot's pose (x, y, yaw) in metres and radians at the frame, or None: with "
-           "the teach odometry, teach_odometry=..., the belief moves by the distance driven). Returns an object whose "
-           "attributes are the columns of `vmap localize --csv` (status, "
-           "key, next_key, similarity, heading_px, ...), with F, R and t as numpy arrays (None when unknown).")
-      .def("reset", &FrameLocalizer::Reset, "Forgets the estimate: the next frame is relocalized.");
+      .def(
+          "localize",
+          [](py::handle self, const py::object& image, const py::object& timestamp, const py::object& odometry) {
+            return Constructed<FrameLocalizer>(self, "Localizer").Localize(image, timestamp, odometry);
+          },
+          py::arg("image"), py::arg("timestamp") = py::none(), py::arg("odometry") = py::none(),
+          "Localizes the next frame (uint8 HxW grey or HxWx3 BGR; brought to the map's frame size; timestamp in "
+          "seconds or None; odometry the robot's pose (x, y, yaw) in metres and radians at the frame, or None: with "
+          "the teach odometry, teach_odometry=..., the belief moves by the distance driven). Returns an object whose "
+          "attributes are the columns of `vmap localize --csv` (status, "
+          "key, next_key, similarity, heading_px, ...), with F, R and t as numpy arrays (None when unknown).")
+      .def(
+          "reset", [](py::handle self) { Constructed<FrameLocalizer>(self, "Localizer").Reset(); },
+          "Forgets the estimate: the next frame is relocalized.");
   static const std::string localize_doc = KeywordDocstring<LocalizePipelineOptions>(
       "Localizes every frame of INPUT (video, image folder, dataset or one image) as `vmap localize MAP INPUT` does, "
       "with its options as keywords; returns one result per frame (see Localizer.localize).",

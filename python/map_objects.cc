@@ -80,124 +80,148 @@ std::filesystem::path MapDirectory(const py::object& map_or_path) {
   return std::filesystem::path(TextArgument(map_or_path, "map"));
 }
 
+namespace {
+
+// Views of a map come from vmap.read_map only. pybind11's own __new__ would give an object with no C++ value
+// behind it, which crashed the interpreter on first use; the objects vmap returns are made without __new__.
+template <typename Class>
+Class& MadeByReadMapOnly(Class&& bound, const char* name) {
+  bound.def_static("__new__", [name](const py::args&, const py::kwargs&) -> py::object {
+    throw py::type_error(std::string("vmap.") + name +
+                         " objects come from vmap.read_map(...); they are not made directly");
+  });
+  return bound;
+}
+
+}  // namespace
+
 void BindMapObjects(py::module_& m) {
-  py::class_<KeyImageRef>(m, "KeyImage", "A key image of a map (map.json's key_images[index]).")
-      .def_property_readonly("index", [](const KeyImageRef& k) { return k.index; })
-      .def_property_readonly("frame_index", [](const KeyImageRef& k) { return k.key().frame_index; })
-      .def_property_readonly("source_index", [](const KeyImageRef& k) { return k.key().source_index; })
-      .def_property_readonly("timestamp", [](const KeyImageRef& k) { return NoneIfNegative(k.key().timestamp); })
-      .def_property_readonly("source_name", [](const KeyImageRef& k) { return k.key().source_name; })
-      .def_property_readonly("image_file", [](const KeyImageRef& k) { return k.key().image_file; })
-      .def_property_readonly("num_features", [](const KeyImageRef& k) { return k.key().num_features; })
-      .def_property_readonly("reason", [](const KeyImageRef& k) { return k.key().reason; })
-      .def_property_readonly(
-          "image", [](const KeyImageRef& k) { return ImageArray(ReadKeyImageWithoutGil(k, false)); },
-          "The key image, HxWx3 BGR uint8 (decoded from its file on each access).")
-      .def_property_readonly(
-          "gray", [](const KeyImageRef& k) { return ImageArray(ReadKeyImageWithoutGil(k, true)); },
-          "The key image in grey, HxW uint8, straight from the decoder as vmap's sources read frames.")
-      .def("__repr__", [](const KeyImageRef& k) {
-        return fmt::format("<vmap.KeyImage {}: frame {}, {}>", k.index, k.key().frame_index, k.key().reason);
-      });
+  MadeByReadMapOnly(
+      py::class_<KeyImageRef>(m, "KeyImage", "A key image of a map (map.json's key_images[index]).")
+          .def_property_readonly("index", [](const KeyImageRef& k) { return k.index; })
+          .def_property_readonly("frame_index", [](const KeyImageRef& k) { return k.key().frame_index; })
+          .def_property_readonly("source_index", [](const KeyImageRef& k) { return k.key().source_index; })
+          .def_property_readonly("timestamp", [](const KeyImageRef& k) { return NoneIfNegative(k.key().timestamp); })
+          .def_property_readonly("source_name", [](const KeyImageRef& k) { return k.key().source_name; })
+          .def_property_readonly("image_file", [](const KeyImageRef& k) { return k.key().image_file; })
+          .def_property_readonly("num_features", [](const KeyImageRef& k) { return k.key().num_features; })
+          .def_property_readonly("reason", [](const KeyImageRef& k) { return k.key().reason; })
+          .def_property_readonly(
+              "image", [](const KeyImageRef& k) { return ImageArray(ReadKeyImageWithoutGil(k, false)); },
+              "The key image, HxWx3 BGR uint8 (decoded from its file on each access).")
+          .def_property_readonly(
+              "gray", [](const KeyImageRef& k) { return ImageArray(ReadKeyImageWithoutGil(k, true)); },
+              "The key image in grey, HxW uint8, straight from the decoder as vmap's sources read frames.")
+          .def("__repr__",
+               [](const KeyImageRef& k) {
+                 return fmt::format("<vmap.KeyImage {}: frame {}, {}>", k.index, k.key().frame_index, k.key().reason);
+               }),
+      "KeyImage");
 
-  py::class_<LinkRef>(m, "Link", "A link between consecutive key images (map.json's links[index]).")
-      .def_property_readonly("index", [](const LinkRef& l) { return l.index; })
-      .def_property_readonly("from_key", [](const LinkRef& l) { return l.link().from_key; })
-      .def_property_readonly("to_key", [](const LinkRef& l) { return l.link().to_key; })
-      .def_property_readonly(
-          "from_frame", [](const LinkRef& l) { return l.handle->map.key_images.at(l.link().from_key).frame_index; })
-      .def_property_readonly("to_frame",
-                             [](const LinkRef& l) { return l.handle->map.key_images.at(l.link().to_key).frame_index; })
-      .def_property_readonly("below_tau", [](const LinkRef& l) { return l.link().below_tau; })
-      .def_property_readonly("similarity", [](const LinkRef& l) { return l.link().similarity; })
-      .def_property_readonly("tentative", [](const LinkRef& l) { return l.link().num_tentative; })
-      .def_property_readonly("verified", [](const LinkRef& l) { return l.link().num_verified; })
-      .def_property_readonly("num_tentative", [](const LinkRef& l) { return l.link().num_tentative; })
-      .def_property_readonly("num_verified", [](const LinkRef& l) { return l.link().num_verified; })
-      .def_property_readonly(
-          "F", [](const LinkRef& l) { return MatrixArray(l.link().F, l.link().has_fundamental); },
-          "3x3: x_to^T F x_from = 0 in pixels; None when matching failed")
-      .def_property_readonly("has_pose", [](const LinkRef& l) { return l.link().has_pose; })
-      .def_property_readonly(
-          "R", [](const LinkRef& l) { return MatrixArray(l.link().R, l.link().has_pose); },
-          "X_to = R X_from + t (with the map's camera); None without")
-      .def_property_readonly("t", [](const LinkRef& l) { return VectorArray(l.link().t, l.link().has_pose); })
-      .def_property_readonly("pose_inliers", [](const LinkRef& l) { return l.link().pose_inliers; })
-      .def_property_readonly("parallax", [](const LinkRef& l) { return NoneIfNegative(l.link().parallax); })
-      .def_property_readonly("parallax_without_rotation",
-                             [](const LinkRef& l) { return l.link().parallax_without_rotation; })
-      .def_property_readonly("homography_share",
-                             [](const LinkRef& l) { return NoneIfNegative(l.link().homography_share); })
-      .def_property_readonly("planar", [](const LinkRef& l) { return l.link().planar; })
-      .def_property_readonly(
-          "correspondences", [](const LinkRef& l) { return CorrespondenceArray(l.link()); },
-          "N x 4 float32 (x0 y0 x1 y1), the verified ones first")
-      .def_property_readonly(
-          "inliers", [](const LinkRef& l) { return InlierMask(l.link()); },
-          "N bools: the correspondence is an inlier of F")
-      .def("__repr__", [](const LinkRef& l) {
-        return fmt::format("<vmap.Link {} -> {}: S {:.3f}, {} / {} verified{}>", l.link().from_key, l.link().to_key,
-                           l.link().similarity, l.link().num_verified, l.link().num_tentative,
-                           l.link().below_tau ? ", below tau" : "");
-      });
+  MadeByReadMapOnly(
+      py::class_<LinkRef>(m, "Link", "A link between consecutive key images (map.json's links[index]).")
+          .def_property_readonly("index", [](const LinkRef& l) { return l.index; })
+          .def_property_readonly("from_key", [](const LinkRef& l) { return l.link().from_key; })
+          .def_property_readonly("to_key", [](const LinkRef& l) { return l.link().to_key; })
+          .def_property_readonly(
+              "from_frame", [](const LinkRef& l) { return l.handle->map.key_images.at(l.link().from_key).frame_index; })
+          .def_property_readonly(
+              "to_frame", [](const LinkRef& l) { return l.handle->map.key_images.at(l.link().to_key).frame_index; })
+          .def_property_readonly("below_tau", [](const LinkRef& l) { return l.link().below_tau; })
+          .def_property_readonly("similarity", [](const LinkRef& l) { return l.link().similarity; })
+          .def_property_readonly("tentative", [](const LinkRef& l) { return l.link().num_tentative; })
+          .def_property_readonly("verified", [](const LinkRef& l) { return l.link().num_verified; })
+          .def_property_readonly("num_tentative", [](const LinkRef& l) { return l.link().num_tentative; })
+          .def_property_readonly("num_verified", [](const LinkRef& l) { return l.link().num_verified; })
+          .def_property_readonly(
+              "F", [](const LinkRef& l) { return MatrixArray(l.link().F, l.link().has_fundamental); },
+              "3x3: x_to^T F x_from = 0 in pixels; None when matching failed")
+          .def_property_readonly("has_pose", [](const LinkRef& l) { return l.link().has_pose; })
+          .def_property_readonly(
+              "R", [](const LinkRef& l) { return MatrixArray(l.link().R, l.link().has_pose); },
+              "X_to = R X_from + t (with the map's camera); None without")
+          .def_property_readonly("t", [](const LinkRef& l) { return VectorArray(l.link().t, l.link().has_pose); })
+          .def_property_readonly("pose_inliers", [](const LinkRef& l) { return l.link().pose_inliers; })
+          .def_property_readonly("parallax", [](const LinkRef& l) { return NoneIfNegative(l.link().parallax); })
+          .def_property_readonly("parallax_without_rotation",
+                                 [](const LinkRef& l) { return l.link().parallax_without_rotation; })
+          .def_property_readonly("homography_share",
+                                 [](const LinkRef& l) { return NoneIfNegative(l.link().homography_share); })
+          .def_property_readonly("planar", [](const LinkRef& l) { return l.link().planar; })
+          .def_property_readonly(
+              "correspondences", [](const LinkRef& l) { return CorrespondenceArray(l.link()); },
+              "N x 4 float32 (x0 y0 x1 y1), the verified ones first")
+          .def_property_readonly(
+              "inliers", [](const LinkRef& l) { return InlierMask(l.link()); },
+              "N bools: the correspondence is an inlier of F")
+          .def("__repr__",
+               [](const LinkRef& l) {
+                 return fmt::format("<vmap.Link {} -> {}: S {:.3f}, {} / {} verified{}>", l.link().from_key,
+                                    l.link().to_key, l.link().similarity, l.link().num_verified, l.link().num_tentative,
+                                    l.link().below_tau ? ", below tau" : "");
+               }),
+      "Link");
 
-  py::class_<MapHandle, std::shared_ptr<MapHandle>>(m, "Map", "A map directory as vmap.read_map reads it.")
-      .def_property_readonly("directory", [](const MapHandle& h) { return h.directory; })
-      .def_property_readonly("key_images",
-                             [](const std::shared_ptr<MapHandle>& h) {
-                               std::vector<KeyImageRef> keys;
-                               for (size_t i = 0; i < h->map.key_images.size(); ++i) keys.push_back({h, int(i)});
-                               return keys;
-                             })
-      .def_property_readonly("links",
-                             [](const std::shared_ptr<MapHandle>& h) {
-                               std::vector<LinkRef> links;
-                               for (size_t i = 0; i < h->map.links.size(); ++i) links.push_back({h, int(i)});
-                               return links;
-                             })
-      .def_property_readonly(
-          "quality", [](const MapHandle& h) { return h.map.quality; }, "Q of the paper")
-      .def_property_readonly("num_frames", [](const MapHandle& h) { return h.map.num_frames; })
-      .def_property_readonly("skipped_frames", [](const MapHandle& h) { return h.map.skipped_frames; })
-      .def_property_readonly("seconds", [](const MapHandle& h) { return h.map.seconds; })
-      .def_property_readonly(
-          "input", [](const MapHandle& h) { return JsonToPython(MapToJson(h.map))["input"]; },
-          "map.json's input: path, format, native_size, frame_size, fps, camera")
-      .def_property_readonly(
-          "camera",
-          [](const MapHandle& h) -> py::object {
-            if (!h.map.input.camera) return py::none();
-            return JsonToPython(CameraToJson(*h.map.input.camera).dump());
-          },
-          "The input's intrinsics as map.json records them; None without")
-      .def_property_readonly(
-          "camera_mask",
-          [](const MapHandle& h) -> py::object {
-            if (h.map.camera_mask.empty()) return py::none();
-            return ImageArray(h.map.camera_mask);
-          },
-          "Where features may be found, HxW uint8 at the frames' size (0: none may be, 255: they may); None for a "
-          "map built without --camera-mask")
-      .def_property_readonly(
-          "options", [](const MapHandle& h) { return JsonToPython(h.map.options_json); },
-          "Every option that shaped the map, as map.json records them")
-      .def_property_readonly("statistics",
-                             [](const MapHandle& h) {
-                               const MapStatistics s = ComputeStatistics(h.map, h.options.builder.quality_mean);
-                               py::dict d;
-                               d["num_frames"] = s.num_frames, d["num_key_images"] = s.num_key_images;
-                               d["min_verified"] = s.min_verified, d["max_verified"] = s.max_verified;
-                               d["mean_verified"] = s.mean_verified, d["mean_similarity"] = s.mean_similarity;
-                               d["quality"] = s.quality, d["below_tau_links"] = s.below_tau_links;
-                               return d;
-                             })
-      .def_property_readonly(
-          "json", [](const MapHandle& h) { return JsonToPython(MapToJson(h.map)); },
-          "The whole map.json document as a dict")
-      .def("__repr__", [](const MapHandle& h) {
-        return fmt::format("<vmap.Map '{}': {} frames, {} key images, Q {:.4f}>", h.directory.string(),
-                           h.map.num_frames, h.map.key_images.size(), h.map.quality);
-      });
+  MadeByReadMapOnly(
+      py::class_<MapHandle, std::shared_ptr<MapHandle>>(m, "Map", "A map directory as vmap.read_map reads it.")
+          .def_property_readonly("directory", [](const MapHandle& h) { return h.directory; })
+          .def_property_readonly("key_images",
+                                 [](const std::shared_ptr<MapHandle>& h) {
+                                   std::vector<KeyImageRef> keys;
+                                   for (size_t i = 0; i < h->map.key_images.size(); ++i) keys.push_back({h, int(i)});
+                                   return keys;
+                                 })
+          .def_property_readonly("links",
+                                 [](const std::shared_ptr<MapHandle>& h) {
+                                   std::vector<LinkRef> links;
+                                   for (size_t i = 0; i < h->map.links.size(); ++i) links.push_back({h, int(i)});
+                                   return links;
+                                 })
+          .def_property_readonly(
+              "quality", [](const MapHandle& h) { return h.map.quality; }, "Q of the paper")
+          .def_property_readonly("num_frames", [](const MapHandle& h) { return h.map.num_frames; })
+          .def_property_readonly("skipped_frames", [](const MapHandle& h) { return h.map.skipped_frames; })
+          .def_property_readonly("seconds", [](const MapHandle& h) { return h.map.seconds; })
+          .def_property_readonly(
+              "input", [](const MapHandle& h) { return JsonToPython(MapToJson(h.map))["input"]; },
+              "map.json's input: path, format, native_size, frame_size, fps, camera")
+          .def_property_readonly(
+              "camera",
+              [](const MapHandle& h) -> py::object {
+                if (!h.map.input.camera) return py::none();
+                return JsonToPython(CameraToJson(*h.map.input.camera).dump());
+              },
+              "The input's intrinsics as map.json records them; None without")
+          .def_property_readonly(
+              "camera_mask",
+              [](const MapHandle& h) -> py::object {
+                if (h.map.camera_mask.empty()) return py::none();
+                return ImageArray(h.map.camera_mask);
+              },
+              "Where features may be found, HxW uint8 at the frames' size (0: none may be, 255: they may); None for a "
+              "map built without --camera-mask")
+          .def_property_readonly(
+              "options", [](const MapHandle& h) { return JsonToPython(h.map.options_json); },
+              "Every option that shaped the map, as map.json records them")
+          .def_property_readonly("statistics",
+                                 [](const MapHandle& h) {
+                                   const MapStatistics s = ComputeStatistics(h.map, h.options.builder.quality_mean);
+                                   py::dict d;
+                                   d["num_frames"] = s.num_frames, d["num_key_images"] = s.num_key_images;
+                                   d["min_verified"] = s.min_verified, d["max_verified"] = s.max_verified;
+                                   d["mean_verified"] = s.mean_verified, d["mean_similarity"] = s.mean_similarity;
+                                   d["quality"] = s.quality, d["below_tau_links"] = s.below_tau_links;
+                                   return d;
+                                 })
+          .def_property_readonly(
+              "json", [](const MapHandle& h) { return JsonToPython(MapToJson(h.map)); },
+              "The whole map.json document as a dict")
+          .def("__repr__",
+               [](const MapHandle& h) {
+                 return fmt::format("<vmap.Map '{}': {} frames, {} key images, Q {:.4f}>", h.directory.string(),
+                                    h.map.num_frames, h.map.key_images.size(), h.map.quality);
+               }),
+      "Map");
 
   m.def(
       "read_map", [](const std::filesystem::path& directory) { return ReadMapHandle(directory); }, py::arg("directory"),

@@ -206,3 +206,35 @@ def test_the_quickstart_example_runs(tmp_path):
                           env=env, cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert "links:" in done.stdout and "match:" in done.stdout and "frame " in done.stdout, done.stdout
+
+
+def test_objects_made_by_new_alone_are_refused_not_followed():
+    """Class.__new__(Class) makes an object whose __init__ never ran: using one crashed the interpreter (Matcher,
+    Link) or read garbage (KeyImage). Each is now a TypeError; the map's views cannot be made that way at all."""
+    done = run_isolated("""
+import numpy as np
+grey = np.zeros((64, 64), np.uint8)
+uses = {
+    "Matcher.match": lambda: vmap.Matcher.__new__(vmap.Matcher).match(grey, grey),
+    "Matcher.name": lambda: vmap.Matcher.__new__(vmap.Matcher).name,
+    "Matcher.match on another type": lambda: vmap.Matcher.match(42, grey, grey),
+    "Localizer.localize": lambda: vmap.Localizer.__new__(vmap.Localizer).localize(grey),
+    "Localizer.reset": lambda: vmap.Localizer.__new__(vmap.Localizer).reset(),
+    "KeyImage": lambda: vmap.KeyImage.__new__(vmap.KeyImage).image,
+    "Link": lambda: vmap.Link.__new__(vmap.Link).F,
+    "Map": lambda: vmap.Map.__new__(vmap.Map).key_images,
+}
+for name, use in uses.items():
+    try:
+        use()
+        print(name, "accepted")
+    except TypeError as error:
+        print(name, "TypeError", error)
+""")
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert len(lines) == 8, done.stdout
+    for line in lines:
+        assert " TypeError " in line, line
+    assert "a vmap.Matcher made with vmap.Matcher(...) was expected" in lines[0]
+    assert "vmap.KeyImage objects come from vmap.read_map" in lines[5]
