@@ -7,6 +7,7 @@
 #include <thread>
 
 #include <gtest/gtest.h>
+#include <geometry_msgs/Twist.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <std_srvs/Trigger.h>
@@ -122,11 +123,25 @@ TEST(NodeErrors, BadMessagesMapsAndCallsAreAnsweredAndTheNodeRunsOn) {
   const auto logged = [&](const std::string& text) {
     return WaitFor([&] { return node->Log().find(text) != std::string::npos; }, kTimeout);
   };
+  // A frame that is no image stops the robot: the base is not left with the last command.
+  int stops = 0;
+  const ros::Subscriber commands = handle.subscribe<geometry_msgs::Twist>(
+      ns + "/cmd_vel", 100, [&](const geometry_msgs::Twist::ConstPtr& twist) {
+        std::lock_guard<std::mutex> lock(mutex);
+        stops += twist->linear.x == 0.0 && twist->angular.z == 0.0 ? 1 : 0;
+      });
+  ASSERT_TRUE(WaitFor([&] { return commands.getNumPublishers() > 0; }, kTimeout));
 
   sensor_msgs::Image short_data = GreyImage(640, 480, 1.0);
   short_data.data.resize(1000);
   images.publish(short_data);
   EXPECT_TRUE(logged("640x480 mono8 with step 640 needs more than its 1000 bytes")) << node->Log();
+  EXPECT_TRUE(WaitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(mutex);
+        return stops > 0;
+      },
+      kTimeout));
   sensor_msgs::Image short_step = GreyImage(640, 480, 2.0);
   short_step.encoding = "bgr8";  // 640 bytes a row cannot hold 640 BGR pixels
   images.publish(short_step);

@@ -173,6 +173,9 @@ void VmapNode::RepeatFrame(const Arrival& arrival) {
   } catch (const InputError& error) {
     ++malformed_;
     LogMessageError(fmt::format("{}; frame skipped ({} so far)", error.what(), malformed_), error.what());
+    // Not steered by what cannot be seen: the base would otherwise keep the last command for as long as the
+    // camera sends frames that are no images.
+    if (mode == Mode::kRepeating) PublishStop();
     return;
   }
   // The controller's clock is the camera's (an odometry topic stamps by the same clock); the arrival time for a

@@ -211,8 +211,15 @@ void VmapNode::Work() {
     try {
       if (repeat_) RepeatFrame(*arrival);
     } catch (const std::exception& error) {
-      // Not one error of a frame ends the node: the next frame is another chance.
-      ROS_ERROR("frame skipped: %s", error.what());
+      // Not one error of a frame ends the node: the next frame is another chance. Meanwhile the robot stops, and
+      // the same error is logged once in a while, not for every frame.
+      LogMessageError(std::string("frame skipped: ") + error.what(), error.what());
+      bool repeating = false;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        repeating = mode_ == Mode::kRepeating;
+      }
+      if (repeating) PublishStop();
     }
   }
 }
