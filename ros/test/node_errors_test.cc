@@ -6,8 +6,8 @@
 #include <mutex>
 #include <thread>
 
-#include <gtest/gtest.h>
 #include <geometry_msgs/Twist.h>
+#include <gtest/gtest.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <std_srvs/Trigger.h>
@@ -125,8 +125,8 @@ TEST(NodeErrors, BadMessagesMapsAndCallsAreAnsweredAndTheNodeRunsOn) {
   };
   // A frame that is no image stops the robot: the base is not left with the last command.
   int stops = 0;
-  const ros::Subscriber commands = handle.subscribe<geometry_msgs::Twist>(
-      ns + "/cmd_vel", 100, [&](const geometry_msgs::Twist::ConstPtr& twist) {
+  const ros::Subscriber commands =
+      handle.subscribe<geometry_msgs::Twist>(ns + "/cmd_vel", 100, [&](const geometry_msgs::Twist::ConstPtr& twist) {
         std::lock_guard<std::mutex> lock(mutex);
         stops += twist->linear.x == 0.0 && twist->angular.z == 0.0 ? 1 : 0;
       });
@@ -222,6 +222,13 @@ TEST(NodeErrors, RepeatCallsDuringATeachRunAndStartsAtOnceAreRefused) {
   EXPECT_NE(teach.response.message.find("~teach_queue must be an integer"), std::string::npos)
       << teach.response.message;
   ros::param::del(ns + "/vmap/teach_queue");
+  ros::param::set(ns + "/vmap/topic", "/camera/image_raw");  // vmap localize's flag for recordings, set after start-up
+  repeat.request.start = -1;
+  ASSERT_TRUE(ros::service::call(ns + "/vmap/repeat/start", repeat));
+  EXPECT_FALSE(repeat.response.success);
+  EXPECT_NE(repeat.response.message.find("~topic is vmap's option for recordings"), std::string::npos)
+      << repeat.response.message;
+  ros::param::del(ns + "/vmap/topic");
 
   // A repeat run's start reads its map for a while: a teach run started meanwhile is refused, or starts first and
   // the repeat run is refused, never both.

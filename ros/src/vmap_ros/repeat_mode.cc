@@ -45,10 +45,12 @@ bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::St
   LocalizePipelineOptions options;
   options.map = MapOf(request.map);
   if (options.map.empty()) return Fail(response, "repeat/start: no map; give one in the request or set ~map");
+  WarnAboutUnknownParameters(private_node_, KnownParameters());  // set since the node started, too
   ParameterReader parameters(private_node_);
   std::unique_ptr<RepeatRun> run;
   std::string taught_with;
   try {
+    RefuseRecordingParameters();
     parameters.Read(options.session);  // vmap localize's flags, --from and --to included
     options.session.CheckGiven({parameters.given().begin(), parameters.given().end()});
     if (request.start >= 0) options.session.from = request.start;

@@ -17,9 +17,6 @@ namespace {
 // Frames held while the map builder is busy, by default: two seconds of a 30 Hz camera.
 constexpr int kTeachQueue = 60;
 
-// `vmap build`'s flags that name what a recording is read from: the node's input is its camera topic.
-constexpr const char* kRecordingOnly[] = {"format", "topic", "until_interrupted"};
-
 }  // namespace
 
 bool VmapNode::StartTeach(vmap_ros::StartTeach::Request& request, vmap_ros::StartTeach::Response& response) {
@@ -34,19 +31,13 @@ bool VmapNode::StartTeach(vmap_ros::StartTeach::Request& request, vmap_ros::Star
   } claim{this};
   const std::string map = MapOf(request.map);
   if (map.empty()) return Fail(response, "teach/start: no map; give one in the request or set ~map");
+  WarnAboutUnknownParameters(private_node_, KnownParameters());  // set since the node started, too
   ParameterReader parameters(private_node_);
   std::unique_ptr<TeachRun> run;
   try {
     BuildPipelineOptions options;
     parameters.Read(options);
-    for (const char* name : kRecordingOnly) {
-      if (private_node_.hasParam(name)) {
-        throw InputError(
-            fmt::format("~{} is vmap build's option for recordings; the node's camera is the `image` "
-                        "topic: remap it, and drop ~{}",
-                        name, name));
-      }
-    }
+    RefuseRecordingParameters();
     options.input = image_topic_;
     options.output = map;
     options.until_interrupted = false;

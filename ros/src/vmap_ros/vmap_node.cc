@@ -101,6 +101,18 @@ VmapNode::~VmapNode() {
   }
 }
 
+void VmapNode::RefuseRecordingParameters() const {
+  // The flags of `vmap build` and `vmap localize` that name what a recording is read from.
+  for (const char* name : {"format", "topic", "until_interrupted"}) {
+    if (private_node_.hasParam(name)) {
+      throw InputError(
+          fmt::format("~{} is vmap's option for recordings; the node's camera is the `image` topic: "
+                      "remap it, and drop ~{}",
+                      name, name));
+    }
+  }
+}
+
 std::set<std::string> VmapNode::KnownParameters() const {
   ParameterNames names;
   BuildPipelineOptions teach;

@@ -72,6 +72,8 @@ class VmapNode {
   void Work();
   // Why a run cannot start now ("a teach run is in progress; ..."); "" when the node is idle. Under mutex_.
   std::string Busy() const;
+  // Throws InputError for a parameter that names a recording to read (~topic, ~format): the node reads its topics.
+  void RefuseRecordingParameters() const;
   // Claims the idle node for a run being started ("" when claimed, else why not: Busy()); ReleaseClaim gives it
   // back idle when the start fails.
   std::string ClaimForStart();
