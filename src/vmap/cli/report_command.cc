@@ -21,7 +21,10 @@ void AddReportCommand(CLI::App& app) {
       "page); or, given the --json file of `vmap localize`, the report of that localization run");
   AddOptionFlags(command, state->options, state->flags);
   command->callback([state] {
-    state->flags.Run([&] { std::cout << "report          " << RunReportPipeline(state->options).string() << "\n"; });
+    state->flags.Run([&] {
+      const std::string written = RunReportPipeline(state->options).string();  // nothing printed if it throws
+      std::cout << "report          " << written << "\n";
+    });
   });
 }
 

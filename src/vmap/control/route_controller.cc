@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "vmap/control/guidance_signals.h"
 #include "vmap/core/error.h"
@@ -16,8 +18,16 @@ std::string ControllerStateName(ControllerState state) { return EnumToName(kCont
 RouteController::RouteController(TaughtRoute route, ControllerOptions options)
     : route_(std::move(route)), options_(options) {
   options_.Check();
-  if (route_.keys.size() < 2 || route_.segments.size() + 1 != route_.keys.size()) {
-    throw InputError("a route to follow needs at least two key images (MakeTaughtRoute gives one)");
+  if (route_.keys.size() < 2) {
+    throw InputError(route_.keys.empty()
+                         ? std::string("a route to follow needs at least two key images, and this one has none")
+                         : "a route to follow needs at least two key images, and this one is key image " +
+                               std::to_string(route_.keys.front()) +
+                               " alone: give a goal other than its start (--to and --from; a repeat run's goal and "
+                               "start)");
+  }
+  if (route_.segments.size() + 1 != route_.keys.size()) {
+    throw std::invalid_argument("RouteController: a TaughtRoute has a segment between each two of its key images");
   }
   focal_px_ = options_.focal_px > 0.0 ? options_.focal_px : route_.focal_px;
   if (options_.law == ControlLaw::kTracker && route_.metric()) tracking_.emplace(route_);

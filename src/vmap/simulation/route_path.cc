@@ -196,6 +196,7 @@ SimulatedRoute ReadRouteCsv(const std::filesystem::path& path, double corridor_w
     ++number;
     if (number > 100000) throw InputError(fmt::format("route CSV '{}': more than 100000 lines", name));
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // a UTF-8 byte order mark
     const size_t first = line.find_first_not_of(" \t");
     if (first == std::string::npos || line[first] == '#') continue;
     std::vector<std::string> fields;
@@ -215,7 +216,8 @@ SimulatedRoute ReadRouteCsv(const std::filesystem::path& path, double corridor_w
         header_allowed = false;
         continue;
       }
-      throw InputError(fmt::format("route CSV '{}' line {}: '{}' is not 'x,y' (two numbers in metres)", name, number,
+      // Quoted with escapes ({:?}): a binary file's bytes are not sent to the terminal.
+      throw InputError(fmt::format("route CSV '{}' line {}: {:?} is not 'x,y' (two numbers in metres)", name, number,
                                    line.substr(0, 80)));
     }
     header_allowed = false;
@@ -226,8 +228,9 @@ SimulatedRoute ReadRouteCsv(const std::filesystem::path& path, double corridor_w
                       name, number, fields[0], fields[1]));
     }
     if (!points.empty() && cv::norm(cv::Point2d(x, y) - points.back()) < 1e-3) {
-      throw InputError(fmt::format("route CSV '{}' line {}: waypoint ({}, {}) repeats the one before; remove it", name,
-                                   number, x, y));
+      throw InputError(
+          fmt::format("route CSV '{}' line {}: waypoint ({}, {}) lies within 1 mm of the one before; remove it", name,
+                      number, x, y));
     }
     points.emplace_back(x, y);
     lines.push_back(number);

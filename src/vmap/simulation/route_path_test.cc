@@ -71,6 +71,11 @@ TEST(RoutePath, ReadsWaypointCsvs) {
   const auto loop = temp.path() / "loop.csv";
   std::ofstream(loop) << "0,0\n8,0\n8,8\n0,8\n0,0\n";
   EXPECT_TRUE(ReadRouteCsv(loop, 3.0).corridor.closed());
+  // A spreadsheet's UTF-8 byte order mark before the first waypoint: no header, the waypoint.
+  const auto marked = temp.path() / "marked.csv";
+  std::ofstream(marked) << "\xEF\xBB\xBF"
+                           "1,0\n5,0\n";
+  EXPECT_DOUBLE_EQ(ReadRouteCsv(marked, 3.0).path.length(), 4.0);
 }
 
 TEST(RoutePath, MalformedAndNonsenseCsvsAreRefusedNamingTheLine) {
@@ -80,7 +85,10 @@ TEST(RoutePath, MalformedAndNonsenseCsvsAreRefusedNamingTheLine) {
   EXPECT_NE(ErrorOfCsv("0,0\n5\n").find("line 2"), std::string::npos);
   EXPECT_NE(ErrorOfCsv("0,0\nnan,3\n").find("finite"), std::string::npos);
   EXPECT_NE(ErrorOfCsv("0,0\n1e300,0\n").find("finite"), std::string::npos);
-  EXPECT_NE(ErrorOfCsv("0,0\n0,0\n").find("repeats"), std::string::npos);
+  EXPECT_NE(ErrorOfCsv("0,0\n0,0\n").find("within 1 mm of the one before"), std::string::npos);
+  // A binary line is quoted with escapes, not sent to the terminal as it is.
+  const std::string binary = ErrorOfCsv("0,0\n\x01\x1b[2J,\x7f\n");
+  EXPECT_NE(binary.find("line 2: \"\\x01\\x1b[2J,\\x7f\""), std::string::npos) << binary;
   // Folding back on itself: a hairpin narrower than the corridor, a crossing.
   EXPECT_NE(ErrorOfCsv("0,0\n10,0\n0,0.5\n").find("too sharply"), std::string::npos);
   EXPECT_NE(ErrorOfCsv("0,0\n10,0\n10,10\n5,10\n5,-10\n").find("within"), std::string::npos);
