@@ -8,18 +8,15 @@
 
 namespace vmap::python {
 
-// The C++ object of `self`, an instance of a bound class with a constructor. Class.__new__(Class) alone makes an
-// object whose __init__ never ran: nothing stands behind it, and a method following it crashed the interpreter.
-// Such an object (or another type's) is a TypeError instead.
+// `object`, the C++ side of a bound class's instance, once its __init__ ran. Class.__new__(Class) alone makes an
+// instance that pybind11 gives uninitialised memory when a method is called on it (a crash); such an object was
+// never registered as an instance, which is what tells it apart. A TypeError instead.
 template <typename T>
-T& Constructed(pybind11::handle self, const char* name) {
-  if (pybind11::isinstance<T>(self)) {
-    auto* instance = reinterpret_cast<pybind11::detail::instance*>(self.ptr());
-    const pybind11::detail::value_and_holder held =
-        instance->get_value_and_holder(pybind11::detail::get_type_info(typeid(T)), /*throw_if_missing=*/false);
-    if (held && held.holder_constructed()) return *held.value_ptr<T>();
+T& Constructed(T& object, const char* name) {
+  if (!pybind11::detail::get_object_handle(&object, pybind11::detail::get_type_info(typeid(T)))) {
+    throw pybind11::type_error(std::string("a vmap.") + name + " made with vmap." + name + "(...) was expected");
   }
-  throw pybind11::type_error(std::string("a vmap.") + name + " made with vmap." + name + "(...) was expected");
+  return object;
 }
 
 void BindMapObjects(pybind11::module_& module);     // map_objects.cc: Map, KeyImage, Link, read_map

@@ -144,13 +144,12 @@ void BindBuildAndMatch(py::module_& m) {
       .def(py::init<const py::kwargs&>())
       .def(
           "match",
-          [](py::handle self, const py::object& image0, const py::object& image1) {
-            return Constructed<PairMatcher>(self, "Matcher").Match(image0, image1);
+          [](const PairMatcher& self, const py::object& image0, const py::object& image1) {
+            return Constructed(self, "Matcher").Match(image0, image1);
           },
           py::arg("image0"), py::arg("image1"), "Matches two uint8 images (HxW grey or HxWx3 BGR); see vmap.match.")
-      .def_property_readonly("name", [](py::handle self) { return Constructed<PairMatcher>(self, "Matcher").name(); })
-      .def_property_readonly("options",
-                             [](py::handle self) { return Constructed<PairMatcher>(self, "Matcher").options(); });
+      .def_property_readonly("name", [](const PairMatcher& self) { return Constructed(self, "Matcher").name(); })
+      .def_property_readonly("options", [](const PairMatcher& self) { return Constructed(self, "Matcher").options(); });
   m.def(
       "match",
       [](const py::object& image0, const py::object& image1, const py::kwargs& kwargs) {

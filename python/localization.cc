@@ -149,8 +149,8 @@ void BindLocalization(py::module_& m) {
       .def(py::init<const py::object&, const py::kwargs&>(), py::arg("map"))
       .def(
           "localize",
-          [](py::handle self, const py::object& image, const py::object& timestamp, const py::object& odometry) {
-            return Constructed<FrameLocalizer>(self, "Localizer").Localize(image, timestamp, odometry);
+          [](FrameLocalizer& self, const py::object& image, const py::object& timestamp, const py::object& odometry) {
+            return Constructed(self, "Localizer").Localize(image, timestamp, odometry);
           },
           py::arg("image"), py::arg("timestamp") = py::none(), py::arg("odometry") = py::none(),
           "Localizes the next frame (uint8 HxW grey or HxWx3 BGR; brought to the map's frame size; timestamp in "
@@ -159,7 +159,7 @@ void BindLocalization(py::module_& m) {
           "attributes are the columns of `vmap localize --csv` (status, "
           "key, next_key, similarity, heading_px, ...), with F, R and t as numpy arrays (None when unknown).")
       .def(
-          "reset", [](py::handle self) { Constructed<FrameLocalizer>(self, "Localizer").Reset(); },
+          "reset", [](FrameLocalizer& self) { Constructed(self, "Localizer").Reset(); },
           "Forgets the estimate: the next frame is relocalized.");
   static const std::string localize_doc = KeywordDocstring<LocalizePipelineOptions>(
       "Localizes every frame of INPUT (video, image folder, dataset or one image) as `vmap localize MAP INPUT` does, "

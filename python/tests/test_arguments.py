@@ -229,7 +229,7 @@ for name, use in uses.items():
         use()
         print(name, "accepted")
     except TypeError as error:
-        print(name, "TypeError", error)
+        print(name, "TypeError", str(error).splitlines()[0])
 """)
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()
