@@ -181,6 +181,9 @@ TEST(EvalCli, CameraOptionAndMissingGroundTruthOrIntrinsics) {
   std::ofstream(tmp.path() / "junk.txt") << "hello world\n";
   EXPECT_EQ(RunVmap("eval " + Quote(tmp.path() / "posed") + " --gt " + Quote(tmp.path() / "junk.txt"), &out), 2);
   EXPECT_NE(out.find("--gt-format"), std::string::npos) << out;
+  // A format without the file it describes would be ignored: the input's own ground truth has its own.
+  EXPECT_EQ(RunVmap("eval " + Quote(tmp.path() / "posed") + " --gt-format tum", &out), 2);
+  EXPECT_NE(out.find("--gt-format needs --gt"), std::string::npos) << out;
 }
 
 }  // namespace vmap

@@ -38,7 +38,16 @@ void EvalPipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.VisitNested("", evaluation);
 }
 
-void EvalPipelineOptions::Check() const { evaluation.Check(); }
+void EvalPipelineOptions::Check() const {
+  evaluation.Check();
+  // The input's own ground truth is read in the input's own format: a format without --gt would be ignored.
+  if (gt.path.empty() && gt.format != GroundTruthFormat::kAuto) {
+    throw OptionError("gt.format",
+                      "needs path, the ground-truth file it describes (the input's own is read in its own "
+                      "format)",
+                      {"path"});
+  }
+}
 
 EvalPipelineResult RunEvalPipeline(const EvalPipelineOptions& options) {
   // 1. The options, the outputs, the camera option.

@@ -65,8 +65,12 @@ DecodedImage ConvertRawImage(const RawImage& raw, const std::string& what) {
     throw InputError(what + " has image encoding '" + e +
                      "'; vmap reads mono8, mono16, rgb8, bgr8, rgba8, bgra8 and bayer_*8 (or a compressed topic)");
   }
+  if (raw.width == 0 || raw.height == 0) {
+    throw InputError(what + " is an empty image (" + std::to_string(raw.width) + "x" + std::to_string(raw.height) +
+                     " " + e + ")");
+  }
   const size_t row_bytes = size_t{raw.width} * CV_ELEM_SIZE(type);
-  if (raw.width == 0 || raw.height == 0 || raw.width > INT32_MAX || raw.height > INT32_MAX || raw.step < row_bytes ||
+  if (raw.width > INT32_MAX || raw.height > INT32_MAX || raw.step < row_bytes ||
       raw.size / std::max<size_t>(raw.step, 1) < raw.height) {
     throw InputError(what + " is malformed: " + std::to_string(raw.width) + "x" + std::to_string(raw.height) + " " + e +
                      " with step " + std::to_string(raw.step) + " needs more than its " + std::to_string(raw.size) +

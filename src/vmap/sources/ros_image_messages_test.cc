@@ -150,6 +150,12 @@ TEST(RosImageMessages, MalformedMessagesAreInputErrorsNeverCrashes) {
       } catch (const InputError&) {
       }
     }
+    try {
+      Decode(testing::SerializeImage(encoding, 1.0, "c", cv::Mat(0, 0, CV_8UC3), "bgr8"), encoding);
+      ADD_FAILURE() << "an empty image decoded";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("is an empty image (0x0 bgr8)"), std::string::npos) << e.what();
+    }
     std::vector<uint8_t> yuv = testing::SerializeImage(encoding, 1.0, "c", bgr, "yuv422");
     try {
       Decode(yuv, encoding);
