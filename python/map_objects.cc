@@ -224,8 +224,11 @@ void BindMapObjects(py::module_& m) {
       "Map");
 
   m.def(
-      "read_map", [](const std::filesystem::path& directory) { return ReadMapHandle(directory); }, py::arg("directory"),
-      "Reads a map directory written by `vmap build` (or vmap.build_map).");
+      "read_map",
+      [](const py::object& directory) {
+        return ReadMapHandle(std::filesystem::path(TextArgument(directory, "read_map(): directory")));
+      },
+      py::arg("directory"), "Reads a map directory written by `vmap build` (or vmap.build_map).");
 }
 
 }  // namespace vmap::python

@@ -40,8 +40,13 @@ PYBIND11_MODULE(vmap, m) {
 
   // vmap's log (spdlog's "vmap" logger) to stderr at info, as the CLI; vmap.set_log_level changes it.
   vmap::ConfigureLogging("info");
-  m.def("set_log_level", &vmap::ConfigureLogging, py::arg("level"),
-        "vmap's log: 'quiet' (warnings and errors; no progress line), 'info' (the default) or 'debug'.");
+  m.def(
+      "set_log_level",
+      [](const py::object& level) {
+        vmap::ConfigureLogging(vmap::python::TextArgument(level, "set_log_level(): level"));
+      },
+      py::arg("level"),
+      "vmap's log: 'quiet' (warnings and errors; no progress line), 'info' (the default) or 'debug'.");
   m.def(
       "initialize_runtime",
       [](int opencv_threads, bool keep_freed_memory, bool quiet_ffmpeg) {

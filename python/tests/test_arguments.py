@@ -238,3 +238,12 @@ for name, use in uses.items():
         assert " TypeError " in line, line
     assert "a vmap.Matcher made with vmap.Matcher(...) was expected" in lines[0]
     assert "vmap.KeyImage objects come from vmap.read_map" in lines[5]
+
+
+def test_module_functions_check_their_text_arguments():
+    with pytest.raises(vmap.ArgumentTypeError, match=r"read_map\(\): directory takes a str"):
+        vmap.read_map(None)
+    with pytest.raises(vmap.Error, match="NUL"):
+        vmap.read_map("a\0b")
+    with pytest.raises(vmap.ArgumentTypeError, match=r"set_log_level\(\): level takes a str"):
+        vmap.set_log_level(None)
