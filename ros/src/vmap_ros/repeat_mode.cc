@@ -29,14 +29,7 @@ std::string RouteText(const std::vector<int>& route) {
 
 bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::StartRepeat::Response& response) {
   if (const std::string busy = ClaimForStart(); !busy.empty()) return Fail(response, "repeat/start: " + busy);
-  // Until the run is set, a start that fails gives the node back idle.
-  struct Claim {
-    VmapNode* node;
-    bool kept = false;
-    ~Claim() {
-      if (!kept) node->ReleaseClaim();
-    }
-  } claim{this};
+  StartClaim claim(this);  // until the run is set: a start that fails gives the node back idle
   if (request.start < -1 || request.goal < -1) {
     return Fail(response, fmt::format("repeat/start: start {} and goal {}: each is a key image of the map, or -1 "
                                       "(the map's first, its last)",
@@ -78,7 +71,7 @@ bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::St
     std::lock_guard<std::mutex> lock(mutex_);
     repeat_ = std::move(run);
     mode_ = Mode::kRepeating;
-    claim.kept = true;
+    claim.Keep();
     localized_once_ = false;
     goal_reached_ = false;
     mailbox_.Reset(1);

@@ -21,14 +21,7 @@ constexpr int kTeachQueue = 60;
 
 bool VmapNode::StartTeach(vmap_ros::StartTeach::Request& request, vmap_ros::StartTeach::Response& response) {
   if (const std::string busy = ClaimForStart(); !busy.empty()) return Fail(response, "teach/start: " + busy);
-  // Until the run is set, a start that fails gives the node back idle.
-  struct Claim {
-    VmapNode* node;
-    bool kept = false;
-    ~Claim() {
-      if (!kept) node->ReleaseClaim();
-    }
-  } claim{this};
+  StartClaim claim(this);  // until the run is set: a start that fails gives the node back idle
   const std::string map = MapOf(request.map);
   if (map.empty()) return Fail(response, "teach/start: no map; give one in the request or set ~map");
   WarnAboutUnknownParameters(private_node_, KnownParameters());  // set since the node started, too
@@ -67,7 +60,7 @@ bool VmapNode::StartTeach(vmap_ros::StartTeach::Request& request, vmap_ros::Star
     teach_frames_ = 0;
     teach_dropped_ = 0;
     mode_ = Mode::kTeaching;
-    claim.kept = true;
+    claim.Keep();
   }
   {
     std::lock_guard<std::mutex> lock(teach_odometry_mutex_);

@@ -74,10 +74,23 @@ class VmapNode {
   std::string Busy() const;
   // Throws InputError for a parameter that names a recording to read (~topic, ~format): the node reads its topics.
   void RefuseRecordingParameters() const;
-  // Claims the idle node for a run being started ("" when claimed, else why not: Busy()); ReleaseClaim gives it
-  // back idle when the start fails.
+  // Claims the idle node for a run being started ("" when claimed, else why not: Busy()); a StartClaim made then
+  // gives it back idle when the start fails, unless kept once the run is set.
   std::string ClaimForStart();
   void ReleaseClaim();
+  class StartClaim {
+   public:
+    explicit StartClaim(VmapNode* node) : node_(node) {}
+    StartClaim(const StartClaim&) = delete;
+    StartClaim& operator=(const StartClaim&) = delete;
+    ~StartClaim() {
+      if (node_) node_->ReleaseClaim();
+    }
+    void Keep() { node_ = nullptr; }
+
+   private:
+    VmapNode* node_;
+  };
   std::string MapOf(const std::string& requested) const;
   // Logs an error of a message: at once when its problem differs from the last one logged, else at most every
   // few seconds (a camera sending one malformed message 30 times a second would flood the log).
