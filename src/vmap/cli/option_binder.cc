@@ -110,9 +110,9 @@ void OptionBinder::Bind(CLI::App* command, OptionFlags& option_flags) const {
               // CLI11 answers "abc", "1.5" or "2147483648" with "Could not convert"; say what the flag takes instead.
               // The text is read by CLI11's own conversion, so every spelling it accepts still passes.
               const OptionRange& range = targets.field.range;
-              const std::string takes =
-                  std::string(std::is_same_v<Value, int> ? "an integer" : "a number") +
-                  (!range.is_set ? "" : (range.also ? ": " : " in ") + RangeText(range, std::is_same_v<Value, int>));
+              const std::string values = range.is_set ? RangeText(range, std::is_same_v<Value, int>) : "";
+              const std::string takes = std::string(std::is_same_v<Value, int> ? "an integer" : "a number") +
+                                        (!range.is_set ? "" : (range.also ? ": " : " in ") + values);
               option->check(CLI::Validator(
                   [takes](std::string& text) -> std::string {
                     Value parsed{};
@@ -120,10 +120,7 @@ void OptionBinder::Bind(CLI::App* command, OptionFlags& option_flags) const {
                   },
                   ""));
               // The values the field takes, after its type: "--lookahead INT in [1, 2]=2", "FLOAT 0 or [1, 1000]".
-              if (range.is_set) {
-                option->type_name(option->get_type_name() + (range.also ? " " : " in ") +
-                                  RangeText(range, std::is_same_v<Value, int>));
-              }
+              if (range.is_set) option->type_name(option->get_type_name() + (range.also ? " " : " in ") + values);
             }
             return option;
           }

@@ -54,24 +54,24 @@ std::optional<cv::Size> JpegSize(const ReadBytes& read) {
   return std::nullopt;
 }
 
-}  // namespace
-
-std::optional<cv::Size> ImageHeaderSize(const ContainedFile& file) {
-  const ReadBytes read = [&file](std::uint64_t offset, void* data, std::size_t bytes) {
-    return file.Read(offset, data, bytes);
-  };
+std::optional<cv::Size> HeaderSize(const ReadBytes& read) {
   if (auto size = PngSize(read)) return size;
   return JpegSize(read);
 }
 
+}  // namespace
+
+std::optional<cv::Size> ImageHeaderSize(const ContainedFile& file) {
+  return HeaderSize(
+      [&file](std::uint64_t offset, void* data, std::size_t bytes) { return file.Read(offset, data, bytes); });
+}
+
 std::optional<cv::Size> ImageHeaderSize(const std::uint8_t* encoded, std::size_t size) {
-  const ReadBytes read = [encoded, size](std::uint64_t offset, void* data, std::size_t bytes) {
+  return HeaderSize([encoded, size](std::uint64_t offset, void* data, std::size_t bytes) {
     if (offset > size || bytes > size - offset) return false;
     std::memcpy(data, encoded + offset, bytes);
     return true;
-  };
-  if (auto announced = PngSize(read)) return announced;
-  return JpegSize(read);
+  });
 }
 
 }  // namespace vmap

@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -46,6 +47,19 @@ namespace {
 constexpr long kMaxInt = std::numeric_limits<int>::max();
 // A key image of a map that does not record its frame size may have at most the pixels of a frame.
 constexpr long kMaxKeyImagePixels = kMaxFramePixels;
+
+// Why a key image whose header announces `size` (nullopt: neither PNG nor JPEG) is not one of a map whose frames are
+// `frame_size` (empty: a map that does not record it), or "": read before anything is decoded.
+std::string KeyImageSizeProblem(const std::optional<cv::Size>& size, const cv::Size& frame_size) {
+  if (!size) return "is not a PNG or JPEG image";
+  const bool fits =
+      frame_size.empty() ? static_cast<long>(size->width) * size->height <= kMaxKeyImagePixels : *size == frame_size;
+  if (fits) return "";
+  return fmt::format("is {}x{}, {}", size->width, size->height,
+                     frame_size.empty()
+                         ? std::string("more pixels than a frame")
+                         : fmt::format("not the map's frame size {}x{}", frame_size.width, frame_size.height));
+}
 constexpr int kRecordBytes = 4 * sizeof(float);
 
 // Opens a file of the map, or throws the message that fits why it cannot be.
@@ -138,17 +152,8 @@ void ReadKeyImages(const json& doc, const Fields& fields, const fs::path& direct
     // Only the header is read here: the image must be a PNG (as vmap writes) or a JPEG (the input's own file,
     // copied) of the map's frame size, so that whoever decodes it later does not meet a decompression bomb.
     const ContainedFile image = OpenMapFile(directory, k.image_file, "key image", file, where + ".image");
-    const std::optional<cv::Size> size = KeyImageSize(image);
-    if (!size) Malformed(file, where + ".image '" + k.image_file + "' is not a PNG or JPEG image");
-    const cv::Size expected = map->input.frame_size;
-    const bool fits = expected.width > 0 && expected.height > 0
-                          ? *size == expected
-                          : static_cast<long>(size->width) * size->height <= kMaxKeyImagePixels;
-    if (!fits) {
-      Malformed(file, where + ".image '" + k.image_file + "' is " + std::to_string(size->width) + "x" +
-                          std::to_string(size->height) + ", not the map's frame size " +
-                          std::to_string(expected.width) + "x" + std::to_string(expected.height));
-    }
+    const std::string problem = KeyImageSizeProblem(KeyImageSize(image), map->input.frame_size);
+    if (!problem.empty()) Malformed(file, where + ".image '" + k.image_file + "' " + problem);
     map->key_images.push_back(std::move(k));
   }
   if (map->key_images.empty() && map->num_frames > 0) Malformed(file, "no key images");
@@ -416,33 +421,30 @@ VisualMap ReadMap(const fs::path& directory) {
       [&] { return ReadCheckedMap(directory); });
 }
 
-fs::path KeyImageFile(const fs::path& map_directory, const KeyImage& key) {
+namespace {
+
+// The key image's file, opened inside the map directory, or the InputError that says why it cannot be.
+ContainedFile OpenKeyImage(const fs::path& map_directory, const KeyImage& key) {
   if (!IsPlainRelativePath(key.image_file)) {
     Malformed(map_directory / kMapFileName, "key image '" + key.image_file + "' points outside the map directory");
   }
-  return OpenMapFile(map_directory, key.image_file, "key image", map_directory / kMapFileName, "key image").path();
+  return OpenMapFile(map_directory, key.image_file, "key image", map_directory / kMapFileName, "key image");
+}
+
+}  // namespace
+
+fs::path KeyImageFile(const fs::path& map_directory, const KeyImage& key) {
+  return OpenKeyImage(map_directory, key).path();
 }
 
 cv::Mat ReadKeyImage(const fs::path& map_directory, const KeyImage& key, bool grayscale, const cv::Size& frame_size) {
-  if (!IsPlainRelativePath(key.image_file)) {
-    Malformed(map_directory / kMapFileName, "key image '" + key.image_file + "' points outside the map directory");
-  }
-  const ContainedFile opened =
-      OpenMapFile(map_directory, key.image_file, "key image", map_directory / kMapFileName, "key image");
+  const ContainedFile opened = OpenKeyImage(map_directory, key);
   const fs::path& file = opened.path();
   // The map reader checked this header, but the file may have been replaced since (a map rebuilt into the same
   // folder while a program holds the old one): checked again, and the bytes checked are the bytes decoded.
-  const std::optional<cv::Size> size = ImageHeaderSize(opened);
-  const bool fits = size && (frame_size.empty() ? static_cast<long>(size->width) * size->height <= kMaxKeyImagePixels
-                                                : *size == frame_size);
-  if (!fits) {
-    throw InputError("key image '" + file.string() + "' is " +
-                     (size
-                          ? std::to_string(size->width) + "x" + std::to_string(size->height) +
-                                (frame_size.empty() ? ", more pixels than a frame"
-                                                    : ", not the map's frame size " + std::to_string(frame_size.width) +
-                                                          "x" + std::to_string(frame_size.height))
-                          : std::string("not a PNG or JPEG image")) +
+  const std::string problem = KeyImageSizeProblem(KeyImageSize(opened), frame_size);
+  if (!problem.empty()) {
+    throw InputError("key image '" + file.string() + "' " + problem +
                      ": it changed since the map was read; read the map again, or rebuild it with `vmap build`");
   }
   std::string bytes;
