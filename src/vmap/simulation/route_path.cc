@@ -221,6 +221,14 @@ SimulatedRoute ReadRouteCsv(const std::filesystem::path& path, double corridor_w
                                    line.substr(0, 80)));
     }
     header_allowed = false;
+    if (fields.size() > 2) {
+      // Read as x,y, a "t,x,y" or "id,x,y" file would be a different route without a word; the direction of
+      // travel comes from the waypoints, so a heading column has nothing to add.
+      throw InputError(fmt::format(
+          "route CSV '{}' line {}: {} values; a route CSV holds two, x,y in metres (keep only those columns, "
+          "e.g. cut -d, -f1,2)",
+          name, number, fields.size()));
+    }
     if (!std::isfinite(x) || !std::isfinite(y) || std::abs(x) > 1e4 || std::abs(y) > 1e4) {
       throw InputError(
           fmt::format("route CSV '{}' line {}: waypoint ({}, {}) is not a finite number of metres within "

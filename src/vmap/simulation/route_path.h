@@ -79,7 +79,8 @@ SimulatedRoute MakeRoute(RouteShape shape, double extension = 3.0);
 // A route from a CSV of waypoints "x,y" (metres; a header line of non-numbers and lines starting with # are
 // skipped), joined by straight segments. It is a loop (a closed corridor) when its last waypoint is its first.
 // Throws InputError naming the file and line: fewer than two waypoints, a value that is not a finite number, a
-// line without two values, consecutive waypoints at the same place, a route longer than 2 km; and CheckCorridor's.
+// line without exactly two values (x,y; a third column such as a heading or a time is refused, not dropped),
+// consecutive waypoints at the same place, a route longer than 2 km; and CheckCorridor's.
 SimulatedRoute ReadRouteCsv(const std::filesystem::path& path, double corridor_width, double extension = 3.0);
 
 // Checks that a corridor of `width` along `corridor` neither folds on a sharp turn nor overlaps itself; throws

@@ -83,6 +83,10 @@ TEST(RoutePath, MalformedAndNonsenseCsvsAreRefusedNamingTheLine) {
   EXPECT_NE(ErrorOfCsv("").find("at least two"), std::string::npos);
   EXPECT_NE(ErrorOfCsv("0,0\n1,abc\n").find("line 2"), std::string::npos);
   EXPECT_NE(ErrorOfCsv("0,0\n5\n").find("line 2"), std::string::npos);
+  // A third column (t,x,y or x,y,yaw) is refused, not dropped: read as x,y, t,x,y would be another route.
+  // Its header line is skipped as any header is.
+  EXPECT_NE(ErrorOfCsv("x,y,yaw\n0,0,0\n5,0,0\n").find("line 2: 3 values"), std::string::npos);
+  EXPECT_NE(ErrorOfCsv("0,0\n5,0,1.57\n").find("line 2: 3 values"), std::string::npos);
   EXPECT_NE(ErrorOfCsv("0,0\nnan,3\n").find("finite"), std::string::npos);
   EXPECT_NE(ErrorOfCsv("0,0\n1e300,0\n").find("finite"), std::string::npos);
   EXPECT_NE(ErrorOfCsv("0,0\n0,0\n").find("within 1 mm of the one before"), std::string::npos);
