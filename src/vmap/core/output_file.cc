@@ -1,5 +1,6 @@
 #include "vmap/core/output_file.h"
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -45,6 +46,18 @@ std::optional<fs::path> HardLinkInside(const fs::path& file, const fs::path& fol
   return std::nullopt;
 }
 
+// Whether the regular file `path` is a program: an ELF binary or a script ("#!"). Judged by its first bytes, not
+// by its execute bits, which every file on a FAT or exFAT stick (where robots often write) carries.
+bool IsProgram(const fs::path& path) {
+  const int fd = open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) return false;
+  char head[4] = {};
+  const ssize_t read_bytes = read(fd, head, sizeof(head));
+  close(fd);
+  return (read_bytes >= 2 && head[0] == '#' && head[1] == '!') ||
+         (read_bytes == 4 && head[0] == '\x7f' && head[1] == 'E' && head[2] == 'L' && head[3] == 'F');
+}
+
 }  // namespace
 
 std::string WhyNotReplaceable(const fs::path& path) {
@@ -61,6 +74,9 @@ std::string WhyNotReplaceable(const fs::path& path) {
   if ((status.st_mode & (S_IWUSR | S_IWGRP | S_IWOTH)) == 0 || access(path.c_str(), W_OK) != 0) {
     return "is read-only; make it writable or give another path";
   }
+  // No output of vmap is a program, so one in the way is a slip of the path (--json build/vmap), not an
+  // earlier run's output.
+  if (IsProgram(path)) return "is a program (an executable or a script), which vmap never replaces; give another path";
   return "";
 }
 

@@ -28,6 +28,7 @@ struct OutputInput {
 //   the files they reach), or to another of `outputs`;
 // - exists and is a symbolic link, a device, a FIFO, a socket or a folder (vmap never renames over those);
 // - exists and is not writable (read-only, or no write permission bit even for root);
+// - exists and is a program (an ELF binary, a "#!" script): never an output of vmap's;
 // - has a parent that is not an existing folder.
 void CheckOutputFiles(const std::vector<OutputFile>& outputs, const std::vector<OutputInput>& inputs);
 

@@ -82,11 +82,17 @@ TEST(OutputFile, OnlyWritableRegularFilesAreReplaced) {
   std::ofstream(tmp.path() / "readonly.csv") << "kept";
   fs::permissions(tmp.path() / "readonly.csv", fs::perms::owner_read);
   ASSERT_EQ(mkfifo((tmp.path() / "fifo.csv").c_str(), 0600), 0);
+  std::ofstream(tmp.path() / "script.json") << "#!/bin/sh\necho hi\n";
+  std::ofstream(tmp.path() / "binary.json") << "\x7f"
+                                               "ELF\x02\x01";
   const auto refusal = [&](const fs::path& output) { return Refusal({{output, "-o"}}, {}); };
   EXPECT_EQ(refusal(tmp.path() / "old.csv"), "");
   EXPECT_NE(refusal(tmp.path() / "link.csv").find("is a symbolic link"), std::string::npos);
   EXPECT_NE(refusal(tmp.path() / "readonly.csv").find("is read-only"), std::string::npos);
   EXPECT_NE(refusal(tmp.path() / "fifo.csv").find("is not a regular file"), std::string::npos);
+  // A program in the way is a slip of the path, never an earlier run's output; whatever its mode bits.
+  EXPECT_NE(refusal(tmp.path() / "script.json").find("is a program"), std::string::npos);
+  EXPECT_NE(refusal(tmp.path() / "binary.json").find("is a program"), std::string::npos);
   EXPECT_NE(refusal("/dev/null").find("is not a regular file"), std::string::npos);
   EXPECT_NE(refusal(tmp.path()).find("is a folder"), std::string::npos);
   EXPECT_NE(refusal(tmp.path() / "missing/out.csv").find("does not exist"), std::string::npos);
@@ -105,6 +111,8 @@ TEST(OutputFile, OnlyWritableRegularFilesAreReplaced) {
   EXPECT_NE(write_refusal(tmp.path() / "link.csv").find("symbolic link"), std::string::npos);
   EXPECT_NE(write_refusal(tmp.path() / "readonly.csv").find("read-only"), std::string::npos);
   EXPECT_NE(write_refusal(tmp.path() / "fifo.csv").find("not a regular file"), std::string::npos);
+  EXPECT_NE(write_refusal(tmp.path() / "binary.json").find("is a program"), std::string::npos);
+  EXPECT_EQ(ReadAll(tmp.path() / "script.json"), "#!/bin/sh\necho hi\n");
   EXPECT_NE(write_refusal("/dev/null").find("not a regular file"), std::string::npos);
   EXPECT_TRUE(fs::is_symlink(tmp.path() / "link.csv"));
   EXPECT_EQ(ReadAll(tmp.path() / "target.csv"), "target");
