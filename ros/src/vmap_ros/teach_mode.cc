@@ -76,6 +76,9 @@ bool VmapNode::StopTeach(std_srvs::Trigger::Request&, std_srvs::Trigger::Respons
   std::unique_ptr<TeachRun> run;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (mode_ == Mode::kFinishing) {
+      return Fail(response, "teach/stop: the teach run is stopping already; its map is being written");
+    }
     if (mode_ != Mode::kTeaching) return Fail(response, "teach/stop: no teach run is in progress");
     run = std::move(teach_);
     mode_ = Mode::kFinishing;  // no other run starts while this map is written

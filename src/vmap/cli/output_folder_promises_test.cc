@@ -131,7 +131,16 @@ TEST(Promises, TheInputIsNeverInsideTheOutputNorTheOutputInsideTheInput) {
       {"build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "in/map"), "lies inside the input"},
       {"sweep " + Quote(tmp.path() / "in") + " --thresholds 0.5 --report " + Quote(tmp.path() / "in"),
        "is or holds the input"},
+      // The files a build reads besides its recording: a camera mask or a calibration kept in the old map's folder.
+      {"build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "s") + " --camera-mask " +
+           Quote(tmp.path() / "s/mask.png"),
+       "is or holds the input"},
+      {"build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "s") + " --camera " +
+           Quote(tmp.path() / "s/camera.yaml"),
+       "is or holds the input"},
   };
+  std::ofstream(tmp.path() / "s/mask.png") << "the user's mask";
+  std::ofstream(tmp.path() / "s/camera.yaml") << "the user's calibration";
   for (const Case& c : cases) {
     std::string out;
     EXPECT_EQ(RunVmap(c.arguments, &out), 2) << c.arguments << "\n" << out;
@@ -140,6 +149,8 @@ TEST(Promises, TheInputIsNeverInsideTheOutputNorTheOutputInsideTheInput) {
   EXPECT_EQ(ReadText(tmp.path() / "s/map.json"), before);
   EXPECT_NO_THROW(ReadMap(tmp.path() / "s"));
   EXPECT_FALSE(fs::exists(tmp.path() / "in/map"));
+  EXPECT_EQ(ReadText(tmp.path() / "s/mask.png"), "the user's mask");
+  EXPECT_EQ(ReadText(tmp.path() / "s/camera.yaml"), "the user's calibration");
 }
 
 // ---- 3. Interrupted runs ------------------------------------------------------------------------------------

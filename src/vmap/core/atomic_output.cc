@@ -369,6 +369,36 @@ void AtomicOutputDirectory::CheckReplaceable(const fs::path& final_path, const O
 
 void AtomicOutputDirectory::Commit() {
   if (committed_) return;
+  if (temp_path_.empty()) throw std::logic_error("AtomicOutputDirectory::Commit after its directory was kept");
+  try {
+    MoveIntoPlace();
+  } catch (const InputError& error) {
+    if (!policy_.keep_if_commit_fails) throw;
+    throw InputError(std::string(error.what()) + "; " + KeepUnplaced());
+  }
+}
+
+std::string AtomicOutputDirectory::KeepUnplaced() {
+  // A visible name that no later run takes for a dead process's temporary (RemoveStaleTemporaries); where even
+  // that rename fails (the folder became unwritable), the temporary stays as it is, no longer this process's to
+  // remove.
+  const std::string stamp = std::to_string(
+      std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count());
+  fs::path kept = final_path_;
+  kept += ".unplaced-" + stamp;
+  std::error_code exists;
+  for (int n = 2; fs::exists(fs::symlink_status(kept, exists)); ++n) {
+    kept = final_path_;
+    kept += ".unplaced-" + stamp + "-" + std::to_string(n);
+  }
+  std::lock_guard<std::mutex> lock(Temporaries().mutex);
+  if (rename(temp_path_.c_str(), kept.c_str()) != 0) kept = temp_path_;
+  Temporaries().paths.erase(temp_path_);
+  temp_path_.clear();  // the destructor leaves it
+  return "the finished output is kept at '" + kept.string() + "': move it into place yourself";
+}
+
+void AtomicOutputDirectory::MoveIntoPlace() {
   // Another vmap writing into the folder being replaced (`build --add-experience-to` a map) finishes first:
   // replacing it now would throw its work away while it still thinks it is writing it.
   std::optional<DirectoryWriteLock> writers;

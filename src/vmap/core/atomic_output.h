@@ -64,6 +64,11 @@ struct OutputPolicy {
   // directories they resolve to, through symbolic links and bind mounts).
   std::vector<std::filesystem::path> inputs;
 
+  // When the finished directory cannot be moved into place (the folder became unwritable or someone else's while
+  // vmap worked), keep it under a visible sibling name, "NAME.unplaced-TIME", which the error names, instead of
+  // removing it: for outputs that cost a run that cannot be made again (a teach run's map).
+  bool keep_if_commit_fails = false;
+
   // For a directory inside one already proven to be vmap's (a map's report/ assets): anything goes.
   static OutputPolicy InsideVmapOutput();
 };
@@ -86,10 +91,14 @@ class AtomicOutputDirectory {
   const std::filesystem::path& final_path() const { return final_path_; }
 
   // Moves the finished directory into place, replacing an older one in one atomic step where the file system
-  // can (renameat2 RENAME_EXCHANGE), so that the final path always holds a complete directory.
+  // can (renameat2 RENAME_EXCHANGE), so that the final path always holds a complete directory. Throws InputError
+  // when it cannot (the directory is then removed, or kept: OutputPolicy::keep_if_commit_fails).
   void Commit();
 
  private:
+  void MoveIntoPlace();
+  // Keeps the uncommitted directory for the user (keep_if_commit_fails); returns the sentence saying where.
+  std::string KeepUnplaced();
   void CheckReplaceable() const;
   static void CheckReplaceable(const std::filesystem::path& final_path, const OutputPolicy& policy);
   friend void CheckOutputDirectory(const std::filesystem::path& final_path, const OutputPolicy& policy);

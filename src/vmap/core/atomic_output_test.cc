@@ -131,6 +131,35 @@ TEST(AtomicOutput, NeverReplacesADirectoryItCannotProveItsOwn) {
   empty.Commit();
 }
 
+TEST(AtomicOutput, AnOutputThatCannotBePlacedIsKeptWhenThePolicySaysSo) {
+  testing::ScopedTempDir tmp;
+  const fs::path target = tmp.path() / "map";
+  OutputPolicy policy = MarkerPolicy();
+  policy.keep_if_commit_fails = true;
+  std::string error;
+  {
+    AtomicOutputDirectory dir(target, policy);
+    std::ofstream(dir.path() / "map.json") << "finished";
+    // While vmap worked, a folder of someone else's appeared where the output goes.
+    fs::create_directories(target);
+    std::ofstream(target / "notes.txt") << "mine";
+    try {
+      dir.Commit();
+    } catch (const InputError& e) {
+      error = e.what();
+    }
+  }
+  EXPECT_EQ(ReadAll(target / "notes.txt"), "mine");
+  const size_t at = error.find("the finished output is kept at '");
+  ASSERT_NE(at, std::string::npos) << error;
+  const std::string kept = error.substr(at + 32, error.find('\'', at + 32) - at - 32);
+  EXPECT_NE(kept.find("map.unplaced-"), std::string::npos) << kept;
+  EXPECT_EQ(ReadAll(fs::path(kept) / "map.json"), "finished");
+  // Neither the object's end nor a later run's clean-up of dead processes' temporaries removes it.
+  RemoveStaleTemporaries(target);
+  EXPECT_TRUE(fs::exists(fs::path(kept) / "map.json"));
+}
+
 TEST(AtomicOutput, TheProofIsCheckedAgainWhenCommitting) {
   testing::ScopedTempDir tmp;
   const fs::path target = tmp.path() / "map";

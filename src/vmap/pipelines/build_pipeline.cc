@@ -57,13 +57,17 @@ VisualMap BuildStreaming(const BuildPipelineOptions& pipeline, FrameSource& inpu
                          const MapBuilderOptions& options, const AtomicOutputDirectory& directory,
                          const std::string& options_json, bool* interrupted) {
   std::optional<SnapshotTarget> snapshots;
-  if (pipeline.snapshot_every > 0) snapshots = SnapshotTarget{directory.final_path(), MapOutputPolicy(pipeline.input)};
+  if (pipeline.snapshot_every > 0) {
+    snapshots = SnapshotTarget{directory.final_path(), MapOutputPolicy(pipeline.FilesRead())};
+    snapshots->policy.keep_if_commit_fails = false;  // the next snapshot, or the map itself, takes its place
+  }
   MapWriter writer(directory.path(), snapshots);
   // Decoded on a thread of its own, while this one runs Algorithm 1 (see BuildMap).
   ReadAheadSource source(input, options.prefetch_frames);
   MapBuilder builder(source, matcher, options, &writer, options_json);
   using Clock = std::chrono::steady_clock;
   auto last_snapshot = Clock::now();
+  std::string snapshot_problem;  // why the last snapshot failed; "" when it was written
   *interrupted = false;
   for (;;) {
     if (pipeline.until_interrupted && InputEndRequested()) {
@@ -79,9 +83,25 @@ VisualMap BuildStreaming(const BuildPipelineOptions& pipeline, FrameSource& inpu
     if (options.after_frame) options.after_frame();
     // Between frames: a source that waits long for its next frame delays the snapshot as long.
     if (snapshots && std::chrono::duration<double>(Clock::now() - last_snapshot).count() >= pipeline.snapshot_every) {
-      builder.Snapshot();
+      // A snapshot that cannot be written (the folder unwritable for a while, the disk full) is a warning, once
+      // for each new reason: ending the run for it would lose every frame of a drive that cannot be made again.
+      std::string problem;
+      try {
+        builder.Snapshot();
+        spdlog::debug("snapshot written to {}", directory.final_path().string());
+      } catch (const InputError& error) {
+        problem = error.what();
+      } catch (const std::filesystem::filesystem_error& error) {
+        problem = error.what();
+      }
+      if (!problem.empty() && problem != snapshot_problem) {
+        spdlog::warn("snapshot not written; the run goes on and tries again every {} s: {}", pipeline.snapshot_every,
+                     problem);
+      } else if (problem.empty() && !snapshot_problem.empty()) {
+        spdlog::info("snapshot written to {} again", directory.final_path().string());
+      }
+      snapshot_problem = problem;
       last_snapshot = Clock::now();
-      spdlog::debug("snapshot written to {}", directory.final_path().string());
     }
   }
   if (*interrupted) spdlog::info("input ended by SIGINT: finishing the map from the frames seen");
@@ -157,6 +177,14 @@ void BuildPipelineOptions::Check() const {
   }
 }
 
+std::vector<std::string> BuildPipelineOptions::FilesRead() const {
+  std::vector<std::string> files = {input, matcher.camera_mask};
+  // --camera is a file, or intrinsics given as numbers, or "none".
+  std::error_code ec;
+  if (!source.camera.empty() && std::filesystem::exists(source.camera, ec)) files.push_back(source.camera);
+  return files;
+}
+
 BuildPipelineResult RunBuildPipeline(const BuildPipelineOptions& pipeline, FrameSource* given_source) {
   // 1. The options, τ resolved; the progress line where the log shows information.
   pipeline.Check();
@@ -166,7 +194,7 @@ BuildPipelineResult RunBuildPipeline(const BuildPipelineOptions& pipeline, Frame
   result.directory = pipeline.OutputDirectory();
 
   // 2. The output, claimed before any work: one that is not vmap's, or that holds the input, is refused here.
-  AtomicOutputDirectory directory(result.directory, MapOutputPolicy(pipeline.input));
+  AtomicOutputDirectory directory(result.directory, MapOutputPolicy(pipeline.FilesRead()));
 
   // 3. The matcher (a deep model loads its weights here).
   const std::unique_ptr<Matcher> matcher = CreateMatcher(pipeline.matcher);

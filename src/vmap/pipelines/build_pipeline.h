@@ -40,6 +40,9 @@ struct BuildPipelineOptions {
   MapBuilderOptions ResolvedMapOptions() const;
   // `output`, or the default next to the working directory.
   std::filesystem::path OutputDirectory() const;
+  // What the build reads, which its output may not replace: the input, and the camera and camera mask files when
+  // it is given them.
+  std::vector<std::string> FilesRead() const;
 };
 
 struct BuildPipelineResult {

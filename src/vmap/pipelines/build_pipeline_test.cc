@@ -1,6 +1,7 @@
 #include "vmap/pipelines/build_pipeline.h"
 
 #include <filesystem>
+#include <fstream>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -66,6 +67,42 @@ TEST(BuildPipeline, TauGivenIsRecordedAndAfterFrameSeesEveryFrame) {
   const BuildPipelineResult built = RunBuildPipeline(Quiet(options));
   EXPECT_EQ(frames, built.map.num_frames);
   EXPECT_EQ(ReadRecordedMap(tmp.path() / "map").options.builder.key_images.tau, 0.3);
+}
+
+// A teach run cannot be made again: a snapshot that cannot be written is a warning, not the run's end, and a
+// finished map that cannot be put in place is kept beside it, where the error says.
+TEST(BuildPipeline, NeitherAFailedSnapshotNorAFailedCommitLosesTheRun) {
+  testing::ScopedTempDir tmp;
+  testing::WriteImageFolder(testing::SidewaysDrive(), tmp.path() / "teach");
+  BuildPipelineOptions options;
+  options.input = (tmp.path() / "teach").string();
+  options.output = (tmp.path() / "map").string();
+  options.snapshot_every = 1e-6;  // a snapshot after every frame
+  int frames = 0;
+  bool taken = false;
+  options.map.after_frame = [&] {
+    ++frames;
+    // Once a snapshot is there, the folder becomes someone else's: no snapshot nor the map may replace it.
+    if (taken || !fs::exists(tmp.path() / "map/map.json")) return;
+    taken = true;
+    fs::remove_all(tmp.path() / "map");
+    fs::create_directory(tmp.path() / "map");
+    std::ofstream(tmp.path() / "map/notes.txt") << "mine";
+  };
+  std::string error;
+  try {
+    RunBuildPipeline(Quiet(options));
+  } catch (const InputError& e) {
+    error = e.what();
+  }
+  ASSERT_TRUE(taken);
+  EXPECT_EQ(testing::ReadText(tmp.path() / "map/notes.txt"), "mine");
+  const size_t at = error.find("kept at '");
+  ASSERT_NE(at, std::string::npos) << error;
+  const fs::path kept = error.substr(at + 9, error.find('\'', at + 9) - at - 9);
+  const RecordedMap read = ReadRecordedMap(kept);
+  EXPECT_EQ(read.map.num_frames, frames);
+  EXPECT_GE(read.map.key_images.size(), 2u);
 }
 
 // The output defaults to "<input name>_map" beside the working directory.

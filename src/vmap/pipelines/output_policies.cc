@@ -13,11 +13,15 @@
 namespace vmap {
 namespace fs = std::filesystem;
 
-OutputPolicy MapOutputPolicy(const std::string& input) {
+OutputPolicy MapOutputPolicy(const std::vector<std::string>& inputs) {
   OutputPolicy policy;
   policy.why_not_ours = WhyNotAVmapMap;
   policy.kind = "a vmap map";
-  policy.inputs = {input};
+  for (const std::string& input : inputs) {
+    if (!input.empty()) policy.inputs.emplace_back(input);
+  }
+  // A map costs a run, and a teach run cannot be made again: one that cannot be put in place is kept beside.
+  policy.keep_if_commit_fails = true;
   return policy;
 }
 

@@ -10,9 +10,11 @@
 
 namespace vmap {
 
-// What a map's folder may replace: an empty folder or a map (a sweep) that vmap wrote, never one that is,
-// holds or lies inside the input.
-OutputPolicy MapOutputPolicy(const std::string& input);
+// What a map's folder may replace: an empty folder or a map that vmap wrote, never one that is, holds or lies
+// inside one of `inputs` (the recording, and any file the build reads: a camera file, a camera mask). A finished
+// map that cannot be moved into place is kept beside it (OutputPolicy::keep_if_commit_fails).
+OutputPolicy MapOutputPolicy(const std::vector<std::string>& inputs);
+// The same for a sweep's folder, which the sweep's `input` may not be, hold or lie inside.
 OutputPolicy SweepOutputPolicy(const std::string& input);
 
 // Every file of the map at `map_directory`, whether it exists yet or not: map.json, correspondences.bin,
