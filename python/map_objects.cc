@@ -183,7 +183,8 @@ void BindMapObjects(py::module_& m) {
           .def_property_readonly("skipped_frames", [](const MapHandle& h) { return h.map.skipped_frames; })
           .def_property_readonly("seconds", [](const MapHandle& h) { return h.map.seconds; })
           .def_property_readonly(
-              "input", [](const MapHandle& h) { return JsonToPython(MapToJson(h.map))["input"]; },
+              // py::object, not the accessor that ["input"] returns: it would outlive the dict it indexes.
+              "input", [](const MapHandle& h) -> py::object { return JsonToPython(MapToJson(h.map))["input"]; },
               "map.json's input: path, format, native_size, frame_size, fps, camera")
           .def_property_readonly(
               "camera",

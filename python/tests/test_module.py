@@ -118,6 +118,9 @@ def test_read_map_gives_the_map_json_as_numpy(maps):
     assert m.camera is not None and m.camera == record["input"]["camera"]
     assert m.options == record["options"]
     assert m.options["source"]["first"] == 0 and m.options["source"]["stride"] == 2
+    # Indexed into at once, the dict outlives the map's JSON it came from (it once pointed at a freed one).
+    assert m.input["fps"] == record["input"]["fps"]
+    assert vmap.read_map(cli_dir).input["frame_size"] == record["input"]["frame_size"]
 
 
 def key_image_file(directory, index):

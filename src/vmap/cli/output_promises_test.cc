@@ -73,6 +73,8 @@ TEST(OutputPromises, SingleFileOutputsNeverReplaceAnInputOrASpecialFile) {
   const std::string map = Quote(m), query = Quote(in / "frame_1.png");
   std::ofstream(tmp.path() / "gt.txt") << "1 0 0 0 0 1 0 0 0 0 1 0\n";
   std::ofstream(tmp.path() / "target.csv") << "keep me";
+  std::ofstream(tmp.path() / "calib.txt") << "500 500 16 12\n";
+  fs::copy_file(in / "frame_1.png", tmp.path() / "mask.png");
   fs::create_symlink(tmp.path() / "target.csv", tmp.path() / "link.csv");
   fs::create_symlink(tmp.path() / "target.png", tmp.path() / "link.png");
   std::ofstream(tmp.path() / "readonly.csv") << "keep me too";
@@ -109,6 +111,19 @@ TEST(OutputPromises, SingleFileOutputsNeverReplaceAnInputOrASpecialFile) {
            "would overwrite the input image"},
           {"draw " + map + " --link 0 -o " + Quote(m / "keys/000001.png"), "lies inside the map's keys"},
           {"draw " + map + " --link 0 -o " + Quote(tmp.path() / "link.png"), "is a symbolic link"},
+          // The map's other files, whether this map has them or not, and the files an option names.
+          {localize + " --csv " + Quote(m / "camera_mask.png"), "would overwrite the map's camera_mask.png"},
+          {localize + " --csv " + Quote(m / "teach_odometry.csv"), "would overwrite the map's teach_odometry.csv"},
+          {localize + " --json " + Quote(m / "experiences"), "the map's experiences"},
+          {"draw " + map + " --link 0 -o " + Quote(m / "camera_mask.png"), "the map's camera_mask.png"},
+          {localize + " --camera " + Quote(tmp.path() / "calib.txt") + " --csv " + Quote(tmp.path() / "calib.txt"),
+           "would overwrite the camera file"},
+          {"match " + query + " " + Quote(in / "frame_2.png") + " --camera " + Quote(tmp.path() / "calib.txt") +
+               " --json " + Quote(tmp.path() / "calib.txt"),
+           "would overwrite the camera file"},
+          {"match " + query + " " + Quote(in / "frame_2.png") + " --camera-mask " + Quote(tmp.path() / "mask.png") +
+               " --json " + Quote(tmp.path() / "mask.png"),
+           "would overwrite a file the matcher reads"},
       },
       tmp.path());
   EXPECT_EQ(ReadText(tmp.path() / "target.csv"), "keep me");

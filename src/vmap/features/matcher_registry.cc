@@ -116,6 +116,18 @@ void MatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
   for (const auto& model : MatcherModels()) visitor.VisitNested(model.name.c_str(), *models_.at(model.name));
 }
 
+std::vector<std::string> MatcherOptions::FilesRead() const {
+  std::vector<std::string> files;
+  if (!camera_mask.empty()) files.push_back(camera_mask);
+  // Every deep model names its file "weights" (the plugin's options are known here only as JSON).
+  const nlohmann::json model_options = selected().ToJson();
+  if (const auto weights = model_options.find("weights");
+      weights != model_options.end() && weights->is_string() && !weights->get<std::string>().empty()) {
+    files.push_back(weights->get<std::string>());
+  }
+  return files;
+}
+
 void MatcherOptions::Check() const {
   FindMatcherModel(type);
   // The options of every matcher, used or not: an absurd value (NaN, out of range) is a mistake either way.

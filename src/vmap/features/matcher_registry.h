@@ -159,6 +159,9 @@ class MatcherOptions {
   // (Matcher::DescribeOptionsJson).
   void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field as "<model>.<key>" ("orb.num_features")
+  // The files the selected matcher reads, which no output may replace: the camera mask and the model's weights
+  // file, those given.
+  std::vector<std::string> FilesRead() const;
 
  private:
   std::map<std::string, std::unique_ptr<ModelOptions>> models_;

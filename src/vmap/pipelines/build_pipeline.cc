@@ -178,7 +178,8 @@ void BuildPipelineOptions::Check() const {
 }
 
 std::vector<std::string> BuildPipelineOptions::FilesRead() const {
-  std::vector<std::string> files = {input, matcher.camera_mask};
+  std::vector<std::string> files = matcher.FilesRead();
+  files.push_back(input);
   // --camera is a file, or intrinsics given as numbers, or "none".
   std::error_code ec;
   if (!source.camera.empty() && std::filesystem::exists(source.camera, ec)) files.push_back(source.camera);

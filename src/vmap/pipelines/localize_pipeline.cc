@@ -146,7 +146,8 @@ LocalizationSession::LocalizationSession(const LocalizePipelineOptions& options)
   CheckOutputs(
       {{options.csv, "csv"}, {options.json, "json"}},
       {MapInputs(options.map), NamedInput(options.query, "the query"), NamedInput(options.report, "the report folder"),
-       NamedInput(options.odometry, "the odometry"), NamedInput(options.session.teach_odometry, "the teach odometry")});
+       NamedInput(options.odometry, "the odometry"), NamedInput(options.session.teach_odometry, "the teach odometry"),
+       ExistingInputs({options.source.camera}, "the camera file")});
   if (!options.report.empty()) CheckLocalizationReportDirectory(options.report, options.map, options.query);
   if (!options.query.empty()) CheckQueryIsNoFifo(options.query);
 

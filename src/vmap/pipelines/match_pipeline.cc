@@ -169,7 +169,9 @@ MatchPipelineResult RunMatchPipeline(const MatchPipelineOptions& options) {
   // 1. The options and the output.
   options.Check();
   CheckOutputs({{options.json, "json"}},
-               {NamedInput(options.image0, "the input image"), NamedInput(options.image1, "the input image")});
+               {NamedInput(options.image0, "the input image"), NamedInput(options.image1, "the input image"),
+                ExistingInputs({options.camera}, "the camera file"),
+                ExistingInputs(options.pair.matcher.FilesRead(), "a file the matcher reads")});
 
   // 2. Both images, in grey.
   MatchPipelineResult result;

@@ -6,7 +6,9 @@
 
 #include "vmap/evaluation/evaluation_json.h"
 #include "vmap/localization/key_image_store.h"
+#include "vmap/map/experiences.h"
 #include "vmap/map/map_io.h"
+#include "vmap/pipelines/localize_odometry.h"
 #include "vmap/report/html_report.h"
 #include "vmap/report/summary.h"
 
@@ -37,8 +39,9 @@ std::vector<OutputInput> MapInputs(const std::string& map_directory) {
   if (map_directory.empty()) return {};
   const fs::path directory(map_directory);
   std::set<std::string> names = {
-      kMapFileName,        kCorrespondencesFileName,  "keys", kReportFileName, kReportAssetsDirectory,
-      kEvaluationFileName, kLocalizationCacheFileName};
+      kMapFileName,          kCorrespondencesFileName,  "keys",          kCameraMaskFileName,
+      kExperiencesDirectory, kTeachOdometryFileName,    kReportFileName, kReportAssetsDirectory,
+      kEvaluationFileName,   kLocalizationCacheFileName};
   std::vector<OutputInput> inputs;
   for (const std::string& name : names) inputs.push_back({directory / name, "the map's " + name});
   return inputs;
@@ -47,6 +50,15 @@ std::vector<OutputInput> MapInputs(const std::string& map_directory) {
 std::vector<OutputInput> NamedInput(const std::string& path, const std::string& what) {
   if (path.empty()) return {};
   return {{fs::path(path), what}};
+}
+
+std::vector<OutputInput> ExistingInputs(const std::vector<std::string>& paths, const std::string& what) {
+  std::vector<OutputInput> inputs;
+  for (const std::string& path : paths) {
+    std::error_code ec;
+    if (!path.empty() && fs::exists(fs::symlink_status(path, ec))) inputs.push_back({fs::path(path), what});
+  }
+  return inputs;
 }
 
 void CheckOutputs(const std::vector<OutputFile>& outputs, const std::vector<std::vector<OutputInput>>& inputs) {

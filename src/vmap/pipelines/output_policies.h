@@ -18,13 +18,17 @@ OutputPolicy MapOutputPolicy(const std::vector<std::string>& inputs);
 OutputPolicy SweepOutputPolicy(const std::string& input);
 
 // Every file of the map at `map_directory`, whether it exists yet or not: map.json, correspondences.bin,
-// keys/, the key-image cache, eval.json, report.html and report/. Another name inside the map folder (an
+// keys/, camera_mask.png, experiences/, teach_odometry.csv, the key-image cache, eval.json, report.html and
+// report/. Another name inside the map folder (an
 // output written there by an earlier run) is not the map's, and may be written.
 std::vector<OutputInput> MapInputs(const std::string& map_directory);
 
 // A file or folder a pipeline reads, described by `what` for messages ("the query"); none when `path` is
 // empty.
 std::vector<OutputInput> NamedInput(const std::string& path, const std::string& what);
+// Each of `paths` that exists, described by `what`: for options that name a file or give values instead (--camera
+// takes a calibration file or "fx,fy,cx,cy").
+std::vector<OutputInput> ExistingInputs(const std::vector<std::string>& paths, const std::string& what);
 
 // CheckOutputFiles over the inputs put together. A pipeline names each output by its options field ({path,
 // "csv"}): the refusal is an OptionError of that field, named by each front end as it names the field.
