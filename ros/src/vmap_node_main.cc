@@ -10,20 +10,24 @@
 #include "vmap_ros/vmap_node.h"
 
 int main(int argc, char** argv) {
-  // First, while this is the only thread (core/runtime.h). ROS handles SIGINT itself: a run in progress is ended
-  // by the node, not by vmap's handler.
+  // First, while this is the only thread (core/runtime.h). A signal asks the node to stop (terminate_signal.h): a
+  // run in progress is ended by the node, not by vmap's handler nor roscpp's.
   vmap::RuntimeOptions runtime;
   runtime.handle_interrupts = false;
   vmap::InitializeRuntime(runtime);
-  ros::init(argc, argv, "vmap");
+  ros::init(argc, argv, "vmap", ros::init_options::NoSigintHandler);
   vmap::ros_node::LogThroughRosconsole();
-  vmap::ros_node::ShutDownOnTerminateSignal();
+  vmap::ros_node::StopOnSignals();
   ros::NodeHandle node;
   ros::NodeHandle private_node("~");
   vmap::ros_node::VmapNode vmap_node(node, private_node);
   // Services that take seconds (a map loading, a teach run finishing) keep one thread; the camera has another.
   ros::AsyncSpinner spinner(3);
   spinner.start();
-  ros::waitForShutdown();
-  return 0;
+  vmap::ros_node::WaitForStop();
+  // While ROS is up: the robot's last command a stop, a teach run's map written, and both said in the log.
+  const bool finished = vmap_node.Stop();
+  spinner.stop();
+  ros::shutdown();
+  return finished ? 0 : 1;
 }

@@ -11,11 +11,11 @@
 
 int main(int argc, char** argv) {
   vmap::RuntimeOptions runtime;
-  runtime.handle_interrupts = false;  // ROS handles SIGINT
+  runtime.handle_interrupts = false;  // a signal asks the node to stop (terminate_signal.h)
   vmap::InitializeRuntime(runtime);
-  ros::init(argc, argv, "vmap_simulator");
+  ros::init(argc, argv, "vmap_simulator", ros::init_options::NoSigintHandler);
   vmap::ros_node::LogThroughRosconsole();
-  vmap::ros_node::ShutDownOnTerminateSignal();
+  vmap::ros_node::StopOnSignals();
   ros::NodeHandle node;
   ros::NodeHandle private_node("~");
   const int status = vmap::ros_node::RunSimulatorNode(node, private_node);

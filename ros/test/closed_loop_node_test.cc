@@ -74,5 +74,58 @@ TEST(ClosedLoopNode, ASimulatedRobotDrivenThroughRosReachesTheGoalAsInProcess) {
   EXPECT_TRUE(node->Running());
 }
 
+// The simulator node checks what it will write before it teaches (its result and map may not land on what it reads,
+// nor on each other), and a signal stops it in its teach run, promptly and with a shell's status.
+TEST(ClosedLoopNode, TheSimulatorRefusesOutputsOverItsInputsAndStopsOnASignal) {
+  ScopedTempDir dir("ros_simulator_refusals");
+  RosMaster::Get();
+  std::ofstream(dir.path() / "route.csv") << "x,y\n0,0\n6,0\n";
+  const std::string route = (dir.path() / "route.csv").string(), map = (dir.path() / "map").string();
+  fs::create_directory(dir.path() / "textures");
+  struct Case {
+    std::vector<std::string> parameters;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {{"_route:=" + route, "_map:=" + map, "_result:=" + route}, "~result '" + route + "' would overwrite"},
+      {{"_route:=" + route, "_map:=" + map, "_result:=" + map + "/map.json"}, "~result"},
+      {{"_route:=" + route, "_map:=" + (dir.path() / "textures").string(),
+        "_teach_textures:=" + (dir.path() / "textures").string()},
+       "is or holds the input"},
+      {{"_route:=" + route, "_map:=" + dir.path().string()}, "is or holds the input"},
+      {{"_route:=" + route, "_map:=" + map, "_answer_timeout:=nan"}, "~answer_timeout"},
+      {{"_route:=" + route, "_map:=" + map, "_trial:=1.5"}, "~trial"},
+  };
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const Case& c = cases[i];
+    // A namespace each: the master keeps a node's private parameters after it exits.
+    std::vector<std::string> arguments = {SimulatorBinary().string(), "__ns:=/refusals" + std::to_string(i),
+                                          "__name:=simulator"};
+    arguments.insert(arguments.end(), c.parameters.begin(), c.parameters.end());
+    ChildProcess simulator(arguments, dir.path() / ("simulator" + std::to_string(i) + ".log"));
+    EXPECT_EQ(simulator.Wait(std::chrono::seconds(60)), 2) << simulator.Log();
+    EXPECT_NE(simulator.Log().find(c.expected), std::string::npos) << c.expected << "\n" << simulator.Log();
+    EXPECT_EQ(simulator.Log().find("teaching route"), std::string::npos) << simulator.Log();  // refused first
+  }
+  EXPECT_FALSE(fs::exists(map));
+  EXPECT_EQ(testing::ReadText(dir.path() / "route.csv"), "x,y\n0,0\n6,0\n");
+
+  // SIGINT in the teach run: out within seconds, status 130, no map.
+  ChildProcess simulator({SimulatorBinary().string(), "__ns:=/interrupted", "__name:=simulator", "_route:=loop",
+                          "_map:=" + map, "_result:=" + (dir.path() / "result.json").string()},
+                         dir.path() / "interrupted.log");
+  // The teach run has begun once its map's hidden folder is there (the log's lines wait in stdout's buffer).
+  const auto teaching = [&] {
+    for (const auto& entry : fs::directory_iterator(dir.path())) {
+      if (entry.path().filename().string().rfind(".map.partial-", 0) == 0) return true;
+    }
+    return false;
+  };
+  ASSERT_TRUE(WaitFor(teaching, std::chrono::seconds(60))) << simulator.Log();
+  EXPECT_EQ(simulator.Stop(std::chrono::seconds(10), SIGINT), 130) << simulator.Log();
+  EXPECT_FALSE(fs::exists(map));
+  EXPECT_FALSE(fs::exists(dir.path() / "result.json"));
+}
+
 }  // namespace
 }  // namespace vmap::ros_testing

@@ -6,6 +6,7 @@
 #include <map>
 #include <mutex>
 #include <sstream>
+#include <thread>
 
 #include <fmt/format.h>
 #include <geometry_msgs/Twist.h>
@@ -210,6 +211,95 @@ TEST(RepeatNode, LocalizesThePlayedFramesAsVmapLocalizeDoes) {
   ASSERT_TRUE(ros::service::call("/repeat_test/vmap/repeat/stop", stop));
   EXPECT_TRUE(stop.response.success) << stop.response.message;
   EXPECT_TRUE(node->Running());
+}
+
+// Spins this process's callbacks for `seconds`.
+void SpinFor(double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    ros::spinOnce();
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+}
+
+// The robot never keeps a command the node no longer stands behind: a pause stops it after the frame in progress
+// (whose command once came after the pause's stop), a camera gone quiet stops it after ~camera_timeout, and so does
+// the node's own end (whose stop once came after ROS was down, or never).
+TEST(RepeatNode, APauseAQuietCameraAndTheNodesEndStopTheRobot) {
+  SKIP_WITHOUT_SHARED();
+  ScopedTempDir dir("ros_repeat_stops");
+  const fs::path video = fs::path(SharedDir()) / "data/lab_floor/lab_floor.mp4";
+  const fs::path teach = dir.path() / "teach.bag", map = dir.path() / "map";
+  // Two stretches of the route, the second after the first: the robot drives on in each (no odometry, which would
+  // start again from zero in the second).
+  const fs::path first = dir.path() / "first.bag", second = dir.path() / "second.bag";
+  WriteVideoBag(video, 0, 199, teach, "bgr8", 0.05);
+  WriteVideoBag(video, 20, 119, first, "bgr8", 0.0);
+  WriteVideoBag(video, 120, 179, second, "bgr8", 0.0);
+  std::string output;
+  ASSERT_EQ(RunVmap("build -q " + Quote(teach) + " -o " + Quote(map), &output), 0) << output;
+
+  const auto node = StartVmapNode("/stops", {"image:=/camera/image_raw", "odom:=/odom", "_camera_timeout:=0.5"},
+                                  dir.path() / "node.log");
+  ASSERT_TRUE(WaitForNodeServices("/stops/vmap")) << node->Log();
+  ros::NodeHandle handle;
+  Published published;
+  const ros::Subscriber commands = handle.subscribe("/stops/cmd_vel", 1000, &Published::OnCommand, &published);
+  ASSERT_TRUE(WaitFor([&] { return commands.getNumPublishers() > 0; }, std::chrono::seconds(60)));
+  const auto count = [&] {
+    std::lock_guard<std::mutex> lock(published.mutex);
+    return published.commands.size();
+  };
+  const auto moving_since = [&](size_t first) {
+    std::lock_guard<std::mutex> lock(published.mutex);
+    for (size_t i = first; i < published.commands.size(); ++i) {
+      if (published.commands[i].linear.x != 0.0) return true;
+    }
+    return false;
+  };
+  const auto last_is_stop = [&] {
+    std::lock_guard<std::mutex> lock(published.mutex);
+    return !published.commands.empty() && published.commands.back().linear.x == 0.0 &&
+           published.commands.back().angular.z == 0.0;
+  };
+  vmap_ros::StartRepeat start;
+  start.request.map = map.string();
+  start.request.goal = -1;
+  start.request.start = -1;
+  ASSERT_TRUE(ros::service::call("/stops/vmap/repeat/start", start)) << node->Log();
+  ASSERT_TRUE(start.response.success) << start.response.message;
+
+  // 1. Pauses while frames come: once a pause has answered, the robot's last command is a stop and stays one.
+  auto player = PlayBag(first, 1.0, dir.path() / "play.log");
+  ASSERT_TRUE(WaitFor([&] { return moving_since(0); }, std::chrono::seconds(60))) << node->Log();
+  for (int i = 0; i < 4 && player->Running(); ++i) {
+    std_srvs::Trigger pause, resume;
+    ASSERT_TRUE(ros::service::call("/stops/vmap/repeat/pause", pause));
+    ASSERT_TRUE(pause.response.success) << pause.response.message;
+    SpinFor(0.3);
+    EXPECT_TRUE(last_is_stop()) << "pause " << i;
+    const size_t before = count();
+    ASSERT_TRUE(ros::service::call("/stops/vmap/repeat/resume", resume));
+    ASSERT_TRUE(resume.response.success) << resume.response.message;
+    WaitFor([&] { return moving_since(before) || !player->Running(); }, std::chrono::seconds(30));
+  }
+  ASSERT_EQ(player->Wait(std::chrono::seconds(120)), 0) << player->Log();
+  const size_t logged = node->Log().size();
+
+  // 2. The camera goes quiet: stopped after ~camera_timeout, said in the log.
+  EXPECT_TRUE(WaitFor(last_is_stop, std::chrono::seconds(10))) << node->Log();
+  EXPECT_TRUE(WaitFor([&] { return node->Log().find("no camera frame on", logged) != std::string::npos; },
+                      std::chrono::seconds(10)))
+      << node->Log();
+
+  // 3. Frames again, the robot drives; the node is stopped (SIGINT): its last command is a stop.
+  const size_t before = count();
+  player = PlayBag(second, 1.0, dir.path() / "play2.log");
+  ASSERT_TRUE(WaitFor([&] { return moving_since(before); }, std::chrono::seconds(60))) << node->Log();
+  EXPECT_EQ(node->Stop(std::chrono::seconds(30), SIGINT), 0) << node->Log();
+  SpinFor(0.5);
+  EXPECT_TRUE(last_is_stop()) << node->Log();
+  EXPECT_NE(node->Log().find("the robot is stopped"), std::string::npos) << node->Log();
 }
 
 }  // namespace

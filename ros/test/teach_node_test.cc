@@ -134,6 +134,9 @@ TEST(TeachNode, ATerminateSignalFinishesTheTeachRunsMap) {
   const VisualMap map = ReadMap(dir.path() / "map");
   EXPECT_EQ(map.num_frames, static_cast<int>(stamps.size()));
   EXPECT_GE(map.key_images.size(), 2u);
+  // As ~teach/stop writes it: the odometry beside the map, and the log says so while ROS is still up to log it.
+  EXPECT_TRUE(fs::is_regular_file(dir.path() / "map/teach_odometry.csv")) << node->Log();
+  EXPECT_NE(node->Log().find("teach run stopped: map"), std::string::npos) << node->Log();
 }
 
 TEST(TeachNode, RefusesAFolderThatIsNotAMapAndLeavesItAsItWas) {

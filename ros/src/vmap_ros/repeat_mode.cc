@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <geometry_msgs/Twist.h>
 #include <std_msgs/Bool.h>
+#include <xmlrpcpp/XmlRpcValue.h>
 
 #include "vmap/core/error.h"
 #include "vmap/sources/odometry.h"
@@ -20,12 +21,30 @@
 namespace vmap::ros_node {
 namespace {
 
+// The default of ~camera_timeout: a robot at 0.3 m/s drives 30 cm on its last command before it stops.
+constexpr double kCameraTimeout = 1.0;
+
 std::string RouteText(const std::vector<int>& route) {
   if (route.empty()) return "an empty route";
   return fmt::format("key image {} to {} ({} key images)", route.front(), route.back(), route.size());
 }
 
 }  // namespace
+
+double VmapNode::ReadCameraTimeout() const {
+  XmlRpc::XmlRpcValue value;
+  if (!private_node_.getParam("camera_timeout", value)) return kCameraTimeout;
+  // Read as a value first: getParam into a double leaves the default for "x", silently.
+  double seconds = -1.0;
+  if (value.getType() == XmlRpc::XmlRpcValue::TypeDouble) seconds = static_cast<double>(value);
+  if (value.getType() == XmlRpc::XmlRpcValue::TypeInt) seconds = static_cast<int>(value);
+  if (!(seconds >= 0.0 && seconds <= 3600.0)) {
+    throw InputError(
+        "~camera_timeout must be a number of seconds in [0, 3600]: how long the robot keeps its last command "
+        "without a camera frame (0: for ever)");
+  }
+  return seconds;
+}
 
 bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::StartRepeat::Response& response) {
   if (const std::string busy = ClaimForStart(); !busy.empty()) return Fail(response, "repeat/start: " + busy);
@@ -42,6 +61,7 @@ bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::St
   ParameterReader parameters(private_node_);
   std::unique_ptr<RepeatRun> run;
   std::string taught_with;
+  double camera_timeout = 0.0;
   try {
     RefuseRecordingParameters();
     parameters.Read(options.session);  // vmap localize's flags, --from and --to included
@@ -51,6 +71,7 @@ bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::St
     options.session.run.show_progress = false;
     ControllerOptions controller;
     parameters.Read(controller);  // the controller's flags (vmap simulate's)
+    camera_timeout = ReadCameraTimeout();
     // The teach run's odometry (~teach_odometry, read with the session's options; else the map folder's), when the
     // robot had one, for the taught speeds and turns and the localizer's pace.
     run = std::make_unique<RepeatRun>(options, controller);
@@ -74,6 +95,9 @@ bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::St
     claim.Keep();
     localized_once_ = false;
     goal_reached_ = false;
+    camera_timeout_ = camera_timeout;
+    last_frame_ = ros::WallTime::now();
+    quiet_stopped_ = false;
     mailbox_.Reset(1);
   }
   odometry_.Clear();
@@ -91,6 +115,8 @@ bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::St
 }
 
 bool VmapNode::PauseRepeat(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+  // The frame in progress ends first, or its command would reach the robot after the stop below.
+  std::lock_guard<std::mutex> run_lock(run_mutex_);
   std::lock_guard<std::mutex> lock(mutex_);
   if (mode_ == Mode::kPaused) return Fail(response, "repeat/pause: the repeat run is paused already");
   if (mode_ != Mode::kRepeating) return Fail(response, "repeat/pause: no repeat run is in progress");
@@ -162,6 +188,8 @@ void VmapNode::RepeatFrame(const Arrival& arrival) {
     mode = mode_;
   }
   if (mode == Mode::kIdle) return;
+  last_frame_ = ros::WallTime::now();
+  quiet_stopped_ = false;
   CameraImage image;
   try {
     image = DecodeCameraImage(*arrival.message, image_topic_);

@@ -14,9 +14,11 @@
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <std_msgs/Bool.h>
+#include <xmlrpcpp/XmlRpcValue.h>
 
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
+#include "vmap/core/option_ranges.h"
 #include "vmap/pipelines/simulate_pipeline.h"
 #include "vmap/simulation/teach_run.h"
 #include "vmap/simulation/trial_run.h"
@@ -24,6 +26,7 @@
 #include "vmap_ros/Localization.h"
 #include "vmap_ros/parameter_reader.h"
 #include "vmap_ros/teach_odometry.h"
+#include "vmap_ros/terminate_signal.h"
 
 namespace vmap::ros_node {
 namespace {
@@ -33,34 +36,74 @@ namespace fs = std::filesystem;
 // The simulation's clock starts at 0; ROS reads a zero stamp as "no stamp", so the topics' stamps start here.
 constexpr double kStampOffset = 1000.0;
 
-struct SimulatorParameters {
-  SimulationOptions simulation;
-  MatcherOptions matcher;
+// The node's own parameters, as fields: read, typed and range-checked as every option is (parameter_reader.h).
+struct SimulatorNodeOptions {
   int trial = 0;
-  std::string map;
-  std::string result;
   double answer_timeout = 60.0;
+
+  void VisitFields(OptionFieldVisitor& visitor) {
+    visitor.Visit(OptionField{"trial", "--trial", "The index of `vmap simulate`'s trial to run"}.AtLeast(0), trial);
+    visitor.Visit(
+        OptionField{"answer_timeout", "--answer-timeout", "Seconds to wait for the vmap node's answer to a frame"}
+            .Within(0.01, 86400)
+            .Unit("s"),
+        answer_timeout);
+  }
+  void Check() const { CheckFieldRanges(*this); }
+};
+
+struct SimulatorParameters {
+  SimulatePipelineOptions pipeline;  // the simulation, the matcher, the map (~map) and the result (~result)
+  SimulatorNodeOptions node;
 };
 
 SimulatorParameters ReadParameters(const ros::NodeHandle& private_node) {
   SimulatorParameters parameters;
+  SimulatePipelineOptions& pipeline = parameters.pipeline;
   ParameterReader reader(private_node);
   try {
-    reader.Read(parameters.simulation);
-    reader.Read(parameters.matcher);
-    parameters.simulation.trials = 1;
-    parameters.simulation.Check();
+    // --map and --json are `vmap simulate`'s; the node's result is ~result.
+    reader.Read(pipeline);
+    reader.Read(parameters.node);
+    parameters.node.Check();
+    if (private_node.hasParam("json") || private_node.hasParam("report")) {
+      throw InputError("~json and ~report are `vmap simulate`'s; the node writes its trial to ~result");
+    }
+    XmlRpc::XmlRpcValue result;
+    if (private_node.getParam("result", result)) {
+      if (result.getType() != XmlRpc::XmlRpcValue::TypeString) {
+        throw InputError("~result must be a string: the JSON file the trial is written to");
+      }
+      pipeline.json = static_cast<std::string>(result);
+    }
+    pipeline.simulation.trials = 1;
+    if (pipeline.map.empty()) throw InputError("~map must name a folder for the teach run's map (new or empty)");
+    // Before the teach run: the map's folder, the result, and what they may not replace.
+    try {
+      CheckSimulateOutputs(pipeline);
+    } catch (const OptionError& error) {
+      if (error.path() == "json") throw InputError("~result " + error.problem());  // `vmap simulate --json`'s check
+      throw;
+    }
   } catch (const InputError& error) {
     throw InputError(reader.Message(error));
   }
-  private_node.getParam("trial", parameters.trial);
-  private_node.getParam("map", parameters.map);
-  private_node.getParam("result", parameters.result);
-  private_node.getParam("answer_timeout", parameters.answer_timeout);
-  if (parameters.trial < 0) throw InputError("~trial must be 0 or more (the index of `vmap simulate`'s trial)");
-  if (parameters.map.empty()) throw InputError("~map must name a folder for the teach run's map (new or empty)");
+  ParameterNames names;
+  names.Add(pipeline);
+  names.Add(parameters.node);
+  std::set<std::string> known = names.names();
+  known.insert("result");
+  WarnAboutUnknownParameters(private_node, known);
   return parameters;
 }
+
+// Thrown from the teach run's frames when the node is asked to stop.
+struct StopRequestedError : std::runtime_error {
+  StopRequestedError() : std::runtime_error("stopped by a signal") {}
+};
+
+// The exit status of a node stopped by a signal, as a shell reports one (130 for SIGINT).
+int StoppedStatus() { return StopSignal() != 0 ? 128 + StopSignal() : 1; }
 
 // The vmap node's answers to the frames, as they arrive.
 class Answers {
@@ -185,26 +228,32 @@ nlohmann::json TrialJson(const TrialResult& trial) {
           {"duration", trial.duration}};
 }
 
-}  // namespace
-
-int RunSimulatorNode(ros::NodeHandle& node, ros::NodeHandle& private_node) {
+int RunTheSimulator(ros::NodeHandle& node, ros::NodeHandle& private_node) {
   SimulatorParameters parameters;
   std::unique_ptr<PreparedTrials> prepared;
   try {
     parameters = ReadParameters(private_node);
-    fs::create_directories(parameters.map);
-    ROS_INFO("teaching route %s into %s", parameters.simulation.route.c_str(), parameters.map.c_str());
-    prepared = PrepareTrials(parameters.simulation, parameters.matcher, parameters.map);
+    const SimulatePipelineOptions& pipeline = parameters.pipeline;
+    ROS_INFO("teaching route %s into %s", pipeline.simulation.route.c_str(), pipeline.map.c_str());
+    prepared = PrepareTrials(pipeline.simulation, pipeline.matcher, pipeline.map, [] {
+      if (StopRequested()) throw StopRequestedError();
+    });
     // The teach run's odometry beside its map, as the vmap node's teach run writes it (teach_odometry.h).
-    WriteTeachOdometry(parameters.map, prepared->teach_odometry);
+    WriteTeachOdometry(pipeline.map, prepared->teach_odometry);
+  } catch (const StopRequestedError&) {
+    ROS_WARN("vmap simulator: stopped during the teach run; its map was not written");
+    return StoppedStatus();
   } catch (const std::exception& error) {
     ROS_ERROR("vmap simulator: %s", error.what());
     return 2;
   }
+  const int trial = parameters.node.trial;
+  const double answer_timeout = parameters.node.answer_timeout;
+  const std::string& result_file = parameters.pipeline.json;
   const TrialContext& context = prepared->context;
   ROS_INFO("map written: %zu key images from %d frames; running trial %d in process for reference",
-           prepared->map().map.key_images.size(), prepared->teach_frames, parameters.trial);
-  const TrialResult in_process = RunTrial(context, parameters.trial);
+           prepared->map().map.key_images.size(), prepared->teach_frames, trial);
+  const TrialResult in_process = RunTrial(context, trial);
 
   // The robot on ROS.
   ros::Publisher camera = node.advertise<sensor_msgs::Image>("camera/image_raw", 1);
@@ -219,17 +268,21 @@ int RunSimulatorNode(ros::NodeHandle& node, ros::NodeHandle& private_node) {
   std_msgs::Bool map_ready;
   map_ready.data = true;
   ready.publish(map_ready);
-  ROS_INFO("waiting for a vmap node on %s (start its repeat run on %s)", camera.getTopic().c_str(),
-           parameters.map.c_str());
-  while (ros::ok() && (camera.getNumSubscribers() == 0 || localizations.getNumPublishers() == 0 ||
-                       commands.getNumPublishers() == 0)) {
-    ros::WallDuration(0.01).sleep();
+  const auto waiting = [&] {
+    return camera.getNumSubscribers() == 0 || localizations.getNumPublishers() == 0 || commands.getNumPublishers() == 0;
+  };
+  // Said again every 30 s: a remapped topic that does not meet the vmap node's would otherwise wait in silence.
+  for (int seconds = 0; !StopRequested() && waiting(); seconds += 30) {
+    ROS_INFO("waiting for a vmap node on %s, %s and %s (start its repeat run on %s)%s", camera.getTopic().c_str(),
+             localizations.getTopic().c_str(), commands.getTopic().c_str(), parameters.pipeline.map.c_str(),
+             seconds > 0 ? fmt::format(": {} s so far", seconds).c_str() : "");
+    for (int i = 0; i < 3000 && !StopRequested() && waiting(); ++i) ros::WallDuration(0.01).sleep();
   }
 
-  const Camera rig = RigCamera(parameters.simulation.camera);
-  TrialRun run(context, parameters.trial);
+  const Camera rig = RigCamera(parameters.pipeline.simulation.camera);
+  TrialRun run(context, trial);
   std::string failure;
-  while (ros::ok() && run.Continues()) {
+  while (!StopRequested() && run.Continues()) {
     const Frame frame = run.Render();
     const ros::Time stamp(kStampOffset + run.time());
     odometry.publish(OdometryMessage(run.odometry(), stamp));
@@ -238,9 +291,10 @@ int RunSimulatorNode(ros::NodeHandle& node, ros::NodeHandle& private_node) {
     const auto sent = std::chrono::steady_clock::now();
     vmap_ros::Localization message;
     geometry_msgs::Twist command;
-    if (!answers.Wait(stamp, parameters.answer_timeout, &message, &command)) {
-      failure =
-          fmt::format("no answer from the vmap node to frame {} within {} s", run.step(), parameters.answer_timeout);
+    if (!answers.Wait(stamp, answer_timeout, &message, &command)) {
+      if (StopRequested()) break;
+      failure = fmt::format("no answer from the vmap node to frame {} within {} s (~answer_timeout)", run.step(),
+                            answer_timeout);
       break;
     }
     LocalizationResult localization;
@@ -250,21 +304,43 @@ int RunSimulatorNode(ros::NodeHandle& node, ros::NodeHandle& private_node) {
     if (step.state == ControllerState::kReachedGoal) break;
     run.Drive(step.command);
   }
+  if (StopRequested()) {
+    ROS_WARN("vmap simulator: stopped during trial %d after %d frames; no result written", trial, run.step());
+    return StoppedStatus();
+  }
   const TrialResult through_ros = run.Finish();
   nlohmann::json result = {{"route", context.route->name},
-                           {"trial", parameters.trial},
+                           {"trial", trial},
                            {"key_images", prepared->map().map.key_images.size()},
                            {"ros", TrialJson(through_ros)},
                            {"in_process", TrialJson(in_process)}};
   if (!failure.empty()) result["failure"] = failure;
-  if (!parameters.result.empty()) WriteFileAtomically(parameters.result, result.dump(2) + "\n");
-  ROS_INFO("trial %d through ROS: %s, %.3f m from the goal (in process: %s, %.3f m)", parameters.trial,
-           through_ros.end.c_str(), through_ros.final_error, in_process.end.c_str(), in_process.final_error);
+  if (!result_file.empty()) {
+    try {
+      WriteFileAtomically(result_file, result.dump(2) + "\n");
+    } catch (const std::exception& error) {
+      ROS_ERROR("vmap simulator: the result could not be written: %s", error.what());
+      return 2;
+    }
+  }
+  ROS_INFO("trial %d through ROS: %s, %.3f m from the goal (in process: %s, %.3f m)", trial, through_ros.end.c_str(),
+           through_ros.final_error, in_process.end.c_str(), in_process.final_error);
   if (!failure.empty()) {
     ROS_ERROR("vmap simulator: %s", failure.c_str());
     return 2;
   }
   return 0;
+}
+
+}  // namespace
+
+int RunSimulatorNode(ros::NodeHandle& node, ros::NodeHandle& private_node) {
+  try {
+    return RunTheSimulator(node, private_node);
+  } catch (const StopRequestedError&) {  // from a trial's frames (the context's after_frame)
+    ROS_WARN("vmap simulator: stopped during a trial; no result written");
+    return StoppedStatus();
+  }
 }
 
 }  // namespace vmap::ros_node

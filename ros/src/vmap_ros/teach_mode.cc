@@ -84,6 +84,12 @@ bool VmapNode::StopTeach(std_srvs::Trigger::Request&, std_srvs::Trigger::Respons
     mode_ = Mode::kFinishing;  // no other run starts while this map is written
   }
   UnsubscribeCamera();
+  std::string answer;
+  const bool written = FinishTeach(std::move(run), &answer);
+  return written ? Succeed(response, answer) : Fail(response, "teach/stop: " + answer);
+}
+
+bool VmapNode::FinishTeach(std::unique_ptr<TeachRun> run, std::string* answer_text) {
   odometry_subscriber_.shutdown();
   std::vector<OdometrySample> odometry;
   {
@@ -92,7 +98,7 @@ bool VmapNode::StopTeach(std_srvs::Trigger::Request&, std_srvs::Trigger::Respons
     odometry.swap(teach_odometry_);
   }
   const long received = run->source().received();
-  std::string answer;
+  std::string& answer = *answer_text;
   bool success = true;
   try {
     const BuildPipelineResult result = run->Stop();
@@ -106,13 +112,13 @@ bool VmapNode::StopTeach(std_srvs::Trigger::Request&, std_srvs::Trigger::Respons
     }
   } catch (const std::exception& error) {
     success = false;
-    answer = fmt::format("teach/stop: the map could not be written ({} frames received): {}", received, error.what());
+    answer = fmt::format("the map could not be written ({} frames received): {}", received, error.what());
   }
   {
     std::lock_guard<std::mutex> lock(mutex_);
     mode_ = Mode::kIdle;
   }
-  return success ? Succeed(response, answer) : Fail(response, answer);
+  return success;
 }
 
 void VmapNode::PublishTeachProgress() {

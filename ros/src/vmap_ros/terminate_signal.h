@@ -1,11 +1,18 @@
 #pragma once
-// SIGTERM ends a node as SIGINT does. roscpp handles only SIGINT, but roslaunch escalates to SIGTERM after 15 s
-// and systemd and `docker stop` send it first: killed by it, a teach run would lose the map it was building.
+// How a vmap node ends: SIGINT (Ctrl-C, roslaunch) and SIGTERM (roslaunch 15 s later, systemd, `docker stop`) ask it
+// to stop, and the node stops its robot and finishes a teach run's map while ROS is still up. roscpp's own SIGINT
+// handler shuts ROS down at once, after which a node can neither publish a last zero command nor log; and roscpp
+// leaves SIGTERM to kill the process, losing the map. Call after ros::init(..., ros::init_options::NoSigintHandler).
 
 namespace vmap::ros_node {
 
-// After ros::init: SIGTERM requests the same shutdown as SIGINT (ros::waitForShutdown returns, the node's
-// destructor finishes its run).
-void ShutDownOnTerminateSignal();
+// SIGINT and SIGTERM set the stop request (async-signal-safe: one flag).
+void StopOnSignals();
+// The signal that asked to stop (SIGINT, SIGTERM), or 0.
+int StopSignal();
+// A signal asked to stop, or ROS is shutting down (`rosnode kill`, the master gone for good).
+bool StopRequested();
+// Sleeps until StopRequested().
+void WaitForStop();
 
 }  // namespace vmap::ros_node

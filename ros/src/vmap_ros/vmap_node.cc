@@ -81,25 +81,45 @@ VmapNode::VmapNode(const ros::NodeHandle& node, const ros::NodeHandle& private_n
            camera_info_topic_.c_str(), private_node_.getNamespace().c_str(), private_node_.getNamespace().c_str());
 }
 
-VmapNode::~VmapNode() {
+bool VmapNode::Stop() {
+  if (stopped_) return true;
+  stopped_ = true;
+  // The worker first: a frame in progress publishes its command before the stop below, never after it.
   stopping_ = true;
   mailbox_.Close();
   if (worker_.joinable()) worker_.join();
   std::unique_ptr<TeachRun> teach;
+  bool repeating = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    teach = std::move(teach_);
-  }
-  if (teach) {
-    ROS_WARN("the node is shutting down during a teach run: finishing its map");
-    try {
-      const BuildPipelineResult result = teach->Stop();
-      ROS_INFO("map %s written: %zu key images", result.directory.string().c_str(), result.map.key_images.size());
-    } catch (const std::exception& error) {
-      ROS_ERROR("the teach run's map could not be written: %s", error.what());
+    repeating = mode_ == Mode::kRepeating || mode_ == Mode::kPaused;
+    if (mode_ == Mode::kTeaching) {
+      teach = std::move(teach_);
+      mode_ = Mode::kFinishing;
     }
   }
+  if (repeating) {
+    PublishStop();
+    ROS_INFO("the node is stopping during a repeat run: the robot is stopped");
+  }
+  bool written = true;
+  if (teach) {
+    ROS_WARN("the node is stopping during a teach run: finishing its map");
+    UnsubscribeCamera();
+    std::string answer;
+    written = FinishTeach(std::move(teach), &answer);
+    if (written) {
+      ROS_INFO("%s", answer.c_str());
+    } else {
+      ROS_ERROR("%s", answer.c_str());
+    }
+  }
+  // The stop command is sent by the publisher's connections; a moment for it before ROS goes down.
+  if (repeating) ros::WallDuration(0.2).sleep();
+  return written;
 }
+
+VmapNode::~VmapNode() { Stop(); }
 
 void VmapNode::RefuseRecordingParameters() const {
   // The flags of `vmap build` and `vmap localize` that name what a recording is read from.
@@ -122,7 +142,7 @@ std::set<std::string> VmapNode::KnownParameters() const {
   names.Add(repeat);
   names.Add(controller);
   std::set<std::string> known = names.names();
-  known.insert({"map", "teach_queue", "teach_odometry", "teach_odometry_topic"});
+  known.insert({"map", "teach_queue", "teach_odometry", "teach_odometry_topic", "camera_timeout"});
   return known;
 }
 
@@ -215,10 +235,28 @@ void VmapNode::LogMessageError(const std::string& text, const std::string& probl
   ROS_ERROR("%s", text.c_str());
 }
 
+void VmapNode::StopIfCameraQuiet() {
+  double quiet = 0.0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (mode_ != Mode::kRepeating || quiet_stopped_ || camera_timeout_ <= 0.0) return;
+    quiet = (ros::WallTime::now() - last_frame_).toSec();
+    if (quiet < camera_timeout_) return;
+  }
+  std::lock_guard<std::mutex> run_lock(run_mutex_);  // no frame's command after this stop
+  PublishStop();
+  quiet_stopped_ = true;
+  ROS_WARN("no camera frame on %s for %.1f s (~camera_timeout): the robot is stopped until frames come again",
+           image_topic_.c_str(), quiet);
+}
+
 void VmapNode::Work() {
   while (!stopping_) {
     std::optional<Arrival> arrival = mailbox_.Take(kWorkerPoll);
-    if (!arrival) continue;
+    if (!arrival) {
+      StopIfCameraQuiet();
+      continue;
+    }
     std::lock_guard<std::mutex> run_lock(run_mutex_);
     try {
       if (repeat_) RepeatFrame(*arrival);

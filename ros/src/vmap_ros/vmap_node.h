@@ -49,7 +49,10 @@ class VmapNode {
  public:
   // `node`: the namespace of the topics (image, camera_info, cmd_vel); `private_node`: "~".
   VmapNode(const ros::NodeHandle& node, const ros::NodeHandle& private_node);
-  // A teach run still going is finished: its map is written (as when ~teach/stop is called).
+  // Ends the node's work while ROS is still up: a repeat run's robot gets a zero command, a teach run still going is
+  // finished (its map and odometry written, as ~teach/stop writes them). Returns false when that map could not be
+  // written. Once; the destructor calls it when main did not.
+  bool Stop();
   ~VmapNode();
   VmapNode(const VmapNode&) = delete;
   VmapNode& operator=(const VmapNode&) = delete;
@@ -101,6 +104,9 @@ class VmapNode {
   // teach_mode.cc
   bool StartTeach(vmap_ros::StartTeach::Request& request, vmap_ros::StartTeach::Response& response);
   bool StopTeach(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  // Stops `run` (taken from teach_) and writes its map and the odometry recorded meanwhile; returns whether it was
+  // written, and `answer` says what was written or why not. Leaves the node idle.
+  bool FinishTeach(std::unique_ptr<TeachRun> run, std::string* answer);
   void PublishTeachProgress();
 
   // repeat_mode.cc
@@ -111,6 +117,10 @@ class VmapNode {
   void OnOdometry(const nav_msgs::Odometry::ConstPtr& odometry);
   void RepeatFrame(const Arrival& arrival);
   void PublishStop();
+  // A repeat run's camera that has sent no frame for ~camera_timeout seconds: the robot stops until frames come.
+  void StopIfCameraQuiet();
+  // ~camera_timeout, checked (InputError); kCameraTimeout when unset.
+  double ReadCameraTimeout() const;
 
   ros::NodeHandle node_;
   ros::NodeHandle private_node_;
@@ -129,6 +139,7 @@ class VmapNode {
 
   Mailbox<Arrival> mailbox_{1};
   std::atomic<bool> stopping_{false};
+  bool stopped_ = false;  // Stop() has run
   std::thread worker_;
 
   // mutex_ guards mode_ and the runs' pointers. run_mutex_ is held while the worker processes a frame, so that a
@@ -140,6 +151,10 @@ class VmapNode {
   std::unique_ptr<TeachRun> teach_;
   bool localized_once_ = false;
   bool goal_reached_ = false;
+  // The camera watchdog (worker thread only, but for camera_timeout_, set at a start before frames come).
+  double camera_timeout_ = 1.0;  // seconds; 0 = none
+  ros::WallTime last_frame_;     // when the repeat run started or last processed a frame
+  bool quiet_stopped_ = false;   // the watchdog stopped the robot and no frame has come since
   OdometryBuffer odometry_;
   // A teach run's odometry, written beside its map (teach_odometry.h).
   std::mutex teach_odometry_mutex_;

@@ -55,10 +55,11 @@ class EndInputOnSigintWhile {
 // Streams the input through a MapBuilder: snapshots while it runs, the end of the input when the host asks.
 VisualMap BuildStreaming(const BuildPipelineOptions& pipeline, FrameSource& input, const Matcher& matcher,
                          const MapBuilderOptions& options, const AtomicOutputDirectory& directory,
-                         const std::string& options_json, bool* interrupted) {
+                         const std::string& options_json, const std::vector<std::string>& files_read,
+                         bool* interrupted) {
   std::optional<SnapshotTarget> snapshots;
   if (pipeline.snapshot_every > 0) {
-    snapshots = SnapshotTarget{directory.final_path(), MapOutputPolicy(pipeline.FilesRead())};
+    snapshots = SnapshotTarget{directory.final_path(), MapOutputPolicy(files_read)};
     snapshots->policy.keep_if_commit_fails = false;  // the next snapshot, or the map itself, takes its place
   }
   MapWriter writer(directory.path(), snapshots);
@@ -186,7 +187,8 @@ std::vector<std::string> BuildPipelineOptions::FilesRead() const {
   return files;
 }
 
-BuildPipelineResult RunBuildPipeline(const BuildPipelineOptions& pipeline, FrameSource* given_source) {
+BuildPipelineResult RunBuildPipeline(const BuildPipelineOptions& pipeline, FrameSource* given_source,
+                                     const std::vector<std::string>& source_files) {
   // 1. The options, τ resolved; the progress line where the log shows information.
   pipeline.Check();
   MapBuilderOptions options = pipeline.ResolvedMapOptions();
@@ -195,7 +197,9 @@ BuildPipelineResult RunBuildPipeline(const BuildPipelineOptions& pipeline, Frame
   result.directory = pipeline.OutputDirectory();
 
   // 2. The output, claimed before any work: one that is not vmap's, or that holds the input, is refused here.
-  AtomicOutputDirectory directory(result.directory, MapOutputPolicy(pipeline.FilesRead()));
+  std::vector<std::string> files_read = pipeline.FilesRead();
+  files_read.insert(files_read.end(), source_files.begin(), source_files.end());
+  AtomicOutputDirectory directory(result.directory, MapOutputPolicy(files_read));
 
   // 3. The matcher (a deep model loads its weights here).
   const std::unique_ptr<Matcher> matcher = CreateMatcher(pipeline.matcher);
@@ -212,7 +216,8 @@ BuildPipelineResult RunBuildPipeline(const BuildPipelineOptions& pipeline, Frame
   const std::string options_json = DescribeMapOptions(*matcher, options, source_options);
   result.map = ResolveKeySearch(options) == KeySearch::kBisect
                    ? BuildMap(source, *matcher, options, directory.path(), options_json)
-                   : BuildStreaming(pipeline, source, *matcher, options, directory, options_json, &result.interrupted);
+                   : BuildStreaming(pipeline, source, *matcher, options, directory, options_json, files_read,
+                                    &result.interrupted);
 
   // 6. The report.
   if (pipeline.report) WriteMapReport(directory.path());

@@ -61,7 +61,9 @@ struct BuildPipelineResult {
 //      after_frame hook), or by bisection (key_search bisect);
 //   6. write the report when asked;
 //   7. commit the folder.
-// Throws InputError (OptionError for an option) and leaves the output as it was on any failure.
-BuildPipelineResult RunBuildPipeline(const BuildPipelineOptions& options, FrameSource* source = nullptr);
+// Throws InputError (OptionError for an option) and leaves the output as it was on any failure. `source_files`: with
+// `source`, the files its frames come from (a simulator's route and textures), which the output may not replace.
+BuildPipelineResult RunBuildPipeline(const BuildPipelineOptions& options, FrameSource* source = nullptr,
+                                     const std::vector<std::string>& source_files = {});
 
 }  // namespace vmap

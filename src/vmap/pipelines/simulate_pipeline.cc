@@ -38,12 +38,22 @@ std::string WhyNotASimulationReport(const fs::path& directory) {
   return ec ? "it cannot be listed: " + ec.message() : "";
 }
 
-std::vector<fs::path> TextureFolders(const SimulationOptions& options) {
-  std::vector<fs::path> folders;
+// The files the simulation reads, which no output may replace: the texture folders and a route's CSV.
+std::vector<std::string> SimulationFilesRead(const SimulationOptions& options) {
+  std::vector<std::string> files;
   for (const std::string& path : {options.teach_textures, options.repeat_textures}) {
-    if (!path.empty()) folders.emplace_back(path);
+    if (!path.empty()) files.push_back(path);
   }
-  return folders;
+  if (FindEnum(kRouteShapeNames, options.route) == std::nullopt) files.push_back(options.route);
+  return files;
+}
+
+// What the map's folder may replace: a vmap map that holds none of the files the simulation reads.
+OutputPolicy MapPolicy(const SimulatePipelineOptions& options) {
+  std::vector<std::string> files_read = SimulationFilesRead(options.simulation);
+  const std::vector<std::string> matcher_files = options.matcher.FilesRead();
+  files_read.insert(files_read.end(), matcher_files.begin(), matcher_files.end());
+  return MapOutputPolicy(files_read);
 }
 
 // Whether the folders `a` and `b`, existing or not, are the same or one lies inside the other.
@@ -123,7 +133,7 @@ std::unique_ptr<PreparedTrials> PrepareTrials(const SimulationOptions& options, 
   build.map.show_progress = false;
   build.map.after_frame = after_frame;
   RenderedFrameSource frames(*prepared->teach_world, options.camera, teach.poses, teach.seconds_per_frame, build.input);
-  RunBuildPipeline(build, &frames);
+  RunBuildPipeline(build, &frames, SimulationFilesRead(options));
   prepared->teach_frames = static_cast<int>(teach.poses.size());
   prepared->teach_seconds = SecondsSince(start);
   prepared->teach_odometry = teach.odometry;
@@ -150,14 +160,11 @@ std::unique_ptr<PreparedTrials> PrepareTrials(const SimulationOptions& options, 
   return prepared;
 }
 
-SimulatePipelineResult RunSimulatePipeline(const SimulatePipelineOptions& options,
-                                           const std::function<void(const TrialResult&)>& on_trial) {
-  const auto start = std::chrono::steady_clock::now();
-  const SimulationOptions& simulation = options.simulation;
-
-  // 1. The options and the outputs: none may overwrite the route, the textures or each other (the JSON is
-  //    written last, so it may not land on the map's files or in the report's folder).
+void CheckSimulateOutputs(const SimulatePipelineOptions& options) {
+  // None may overwrite the route, the textures or each other (the JSON is written last, so it may not land on the
+  // map's files or in the report's folder).
   options.Check();
+  const SimulationOptions& simulation = options.simulation;
   std::vector<std::vector<OutputInput>> inputs = {NamedInput(simulation.teach_textures, "--teach-textures"),
                                                   NamedInput(simulation.repeat_textures, "--repeat-textures"),
                                                   NamedInput(options.report, "the report folder")};
@@ -173,20 +180,28 @@ SimulatePipelineResult RunSimulatePipeline(const SimulatePipelineOptions& option
                           "' lie one in the other; give two separate folders",
                       {"report"});
   }
+  // The map's folder: refused now when it is not vmap's or holds what the simulation reads, not after the teach run.
+  if (!options.map.empty()) CheckOutputDirectory(options.map, MapPolicy(options));
+}
+
+SimulatePipelineResult RunSimulatePipeline(const SimulatePipelineOptions& options,
+                                           const std::function<void(const TrialResult&)>& on_trial) {
+  const auto start = std::chrono::steady_clock::now();
+  const SimulationOptions& simulation = options.simulation;
+
+  // 1. The options and the outputs.
+  CheckSimulateOutputs(options);
 
   // 2. The folders, claimed before any work: the report's, and the map's (kept only with options.map; until the
   //    end it is built in a hidden folder beside it, which goes if the run fails).
   OutputPolicy report_policy;
   report_policy.why_not_ours = WhyNotASimulationReport;
   report_policy.kind = "a vmap simulate report";
-  report_policy.inputs = TextureFolders(simulation);
+  for (const std::string& file : SimulationFilesRead(simulation)) report_policy.inputs.emplace_back(file);
   std::unique_ptr<AtomicOutputDirectory> report;
   if (!options.report.empty()) report = std::make_unique<AtomicOutputDirectory>(options.report, report_policy);
-  OutputPolicy map_policy;
-  map_policy.why_not_ours = WhyNotAVmapMap;
-  map_policy.kind = "a vmap map";
-  map_policy.inputs = report_policy.inputs;
-  AtomicOutputDirectory map_directory(options.map.empty() ? TemporaryMapFolder() : fs::path(options.map), map_policy);
+  AtomicOutputDirectory map_directory(options.map.empty() ? TemporaryMapFolder() : fs::path(options.map),
+                                      MapPolicy(options));
 
   // 3-4. The route, the worlds, the teach run and its map, the trials' context.
   const std::unique_ptr<PreparedTrials> prepared =

@@ -70,6 +70,12 @@ struct SimulatePipelineResult {
   SimulationResult simulation;
 };
 
+// Stage 1 of RunSimulatePipeline, for hosts that run the stages themselves (the ROS simulator node): checks the
+// options, that no output (json, map, report) may replace what the run reads (the route, the textures) or another
+// output, and that the map's folder is absent, empty or a vmap map. Throws OptionError naming the field, or
+// InputError for the map's folder.
+void CheckSimulateOutputs(const SimulatePipelineOptions& options);
+
 // Teaches and repeats, stages in order:
 //   1. check the options and the outputs (none may overwrite the route, the textures or each other);
 //   2. claim the report and map folders (a temporary map folder without options.map), before any work;

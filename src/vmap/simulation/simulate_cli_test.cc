@@ -107,6 +107,14 @@ TEST(SimulateCli, OutputsThatWouldLandOnEachOtherAreRefusedBeforeAnyWork) {
     EXPECT_TRUE(fs::is_empty(map)) << c.outputs;
     EXPECT_TRUE(fs::is_empty(report)) << c.outputs;
   }
+  // The map's folder may not hold the route it teaches: replaced, it would take the route with it.
+  const fs::path kept = temp.path() / "kept";
+  fs::create_directory(kept);
+  const fs::path inside = WriteRoute(kept, "0,0\n4,0\n");
+  std::string out;
+  EXPECT_EQ(RunVmap("simulate --route " + Quote(inside) + " --trials 1 --map " + Quote(kept), &out), 2) << out;
+  EXPECT_NE(out.find("is or holds the input"), std::string::npos) << out;
+  EXPECT_TRUE(fs::is_regular_file(inside));
 }
 
 }  // namespace
