@@ -133,8 +133,9 @@ void ReadKeyImages(const json& doc, const Fields& fields, const fs::path& direct
     }
     k.source_index = static_cast<int>(fields.Integer(entry, where, "source_index", 0, kMaxInt, k.frame_index));
     const json* timestamp = Fields::Find(entry, "timestamp");
-    k.timestamp =
-        timestamp && !timestamp->is_null() ? fields.Number(*timestamp, where + ".timestamp", 0.0, 1e12) : -1.0;
+    k.timestamp = timestamp && !timestamp->is_null()
+                      ? fields.Number(*timestamp, where + ".timestamp", 0.0, kMaxTimestampSeconds)
+                      : -1.0;
     k.source_name = DecodeFileName(fields.String(entry, where, "source_name"));
     k.image_file = DecodeFileName(fields.String(fields.Required(entry, where, "image"), where + ".image"));
     k.num_features = static_cast<int>(fields.Integer(entry, where, "num_features", 0, kMaxInt, 0));

@@ -215,8 +215,11 @@ SourceFormat DetectSourceFormat(const std::string& path, SourceFormat requested)
 
 std::string FindCalibrationFile(const std::string& input_path, SourceFormat format) {
   const fs::path p(input_path);
+  // Whatever is there by that name: one that is no regular file (a FIFO, /dev/zero) is refused by the reader, not
+  // taken for no calibration.
   const auto existing = [](const fs::path& candidate) {
-    return fs::is_regular_file(candidate) ? candidate.string() : std::string();
+    std::error_code ec;
+    return fs::exists(fs::symlink_status(candidate, ec)) ? candidate.string() : std::string();
   };
   switch (format) {
     case SourceFormat::kKitti:

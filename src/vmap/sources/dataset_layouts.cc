@@ -18,11 +18,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// Every entry named as an image, by its name alone: one that is no regular file (a dangling link, a link loop, a
+// FIFO, a folder) is then skipped by the source with a warning and counted, not left out without a word.
 std::vector<std::string> ImagesIn(const fs::path& directory) {
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(directory)) {
-    if (entry.is_regular_file() && IsImageFile(entry.path().string()))
-      names.push_back(entry.path().filename().string());
+    if (IsImageFile(entry.path().string())) names.push_back(entry.path().filename().string());
   }
   std::sort(names.begin(), names.end(), NaturalLess);
   return names;
@@ -40,10 +41,11 @@ std::istringstream ListFile(const fs::path& path, const std::string& what) {
   return std::istringstream(ReadNamedFile(path, uint64_t{256} << 20, what, "give the sequence's own " + what));
 }
 
-// An optional list file: absent, or not a regular file, is no list.
+// An optional list file: absent is no list; there, it is read as ListFile reads one (a FIFO or a device is refused,
+// not taken for no list).
 std::optional<std::istringstream> OptionalListFile(const fs::path& path, const std::string& what) {
   std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) return std::nullopt;
+  if (!fs::exists(fs::symlink_status(path, ec))) return std::nullopt;
   return ListFile(path, what);
 }
 

@@ -36,6 +36,9 @@ inline constexpr int kMinFrameSide = 32;
 inline constexpr int kMaxResizeSide = 16384;
 // The default of FrameSourceOptions::max_frame_pixels: 8192 x 8192 (64 megapixels).
 inline constexpr long kMaxFramePixels = 8192L * 8192L;
+// A timestamp beyond this many seconds (31,700 years) is not one: nanoseconds or microseconds given as seconds. A map
+// records its key images' stamps within it, and a source refuses a list of frames that has one beyond.
+inline constexpr double kMaxTimestampSeconds = 1e12;
 // A frame rate above this is not a camera's: the sources report 0 (unknown) instead, as map.json records it.
 inline constexpr double kMaxFramesPerSecond = 1e6;
 

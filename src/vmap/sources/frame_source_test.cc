@@ -1,5 +1,7 @@
 #include "vmap/sources/frame_source.h"
 
+#include <sys/stat.h>
+
 #include <cstdlib>
 #include <fstream>
 #include <functional>
@@ -195,6 +197,35 @@ TEST(ImageFolder, BadFramesAreSkippedWithAWarningAndCounted) {
   ASSERT_EQ(small_frames.size(), 2u);
   EXPECT_EQ(small_frames[0].source_name, "frame_13.png");
   EXPECT_EQ(limited->skipped_frames(), 12);
+}
+
+// An entry named as an image that is no file to read is skipped and counted like a bad frame: a link loop once ended
+// the whole run, a dangling link or a FIFO was left out without a word.
+TEST(ImageFolder, EntriesThatAreNoFilesAreSkippedAndCounted) {
+  testing::ScopedTempDir tmp;
+  testing::WriteImageFolder(Sequence(), tmp.path());  // 12 frames
+  fs::create_symlink("frame_20.png", tmp.path() / "frame_20.png");  // a loop
+  fs::create_symlink(tmp.path() / "nowhere.png", tmp.path() / "frame_21.png");
+  ASSERT_EQ(mkfifo((tmp.path() / "frame_22.png").c_str(), 0600), 0);
+  fs::create_symlink("loop", tmp.path() / "loop");  // not an image's name: not a frame
+  auto source = OpenFrameSource(tmp.path().string());
+  EXPECT_EQ(ReadAll(*source).size(), 12u);
+  EXPECT_EQ(source->skipped_frames(), 3);
+}
+
+// Stamps that cannot be seconds (nanoseconds since 1970) are refused before any work: a map of them could not be read
+// back. A timestamps file that is a FIFO is refused, not taken for no timestamps.
+TEST(ImageFolder, TimestampsThatAreNoSecondsOrNoFileAreRefused) {
+  testing::ScopedTempDir tmp;
+  testing::WriteImageFolder(Sequence(), tmp.path() / "frames");
+  std::ofstream stamps(tmp.path() / "frames/timestamps.txt");
+  for (int i = 1; i <= 12; ++i) stamps << "frame_" << i << ".png " << 1700000000000000000LL + i * 50000000LL << "\n";
+  stamps.close();
+  EXPECT_NE(OpenError((tmp.path() / "frames").string()).find("in nanoseconds or microseconds?"), std::string::npos)
+      << OpenError((tmp.path() / "frames").string());
+  fs::remove(tmp.path() / "frames/timestamps.txt");
+  ASSERT_EQ(mkfifo((tmp.path() / "frames/timestamps.txt").c_str(), 0600), 0);
+  EXPECT_NE(OpenError((tmp.path() / "frames").string()).find("timestamps"), std::string::npos);
 }
 
 TEST(ImageFolder, AFolderOfOnlyBadFramesIsAClearError) {

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
@@ -27,6 +28,15 @@ class ImageListSource : public FrameSource {
                                      std::to_string(entries_.size()) + " frames of '" + path + "'");
     }
     info_.expected_frames = (end_ - next_ + options.stride - 1) / options.stride;
+    // Refused before any work: a map of such stamps could not be read back (map.json's own bound).
+    for (const ImageEntry& entry : entries_) {
+      if (entry.timestamp > kMaxTimestampSeconds) {
+        throw InputError(
+            fmt::format("'{}': the timestamp of '{}' is {} s, more than {:g} s (31,700 years): are the timestamps in "
+                        "nanoseconds or microseconds? Give them in seconds",
+                        path, entry.path, entry.timestamp, kMaxTimestampSeconds));
+      }
+    }
   }
 
   std::optional<Frame> Next() override {
