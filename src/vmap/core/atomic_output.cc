@@ -436,7 +436,17 @@ void AtomicOutputDirectory::MoveIntoPlace() {
   }
   committed_ = true;
   lock.unlock();
-  if (!old.empty()) RemoveAndUnregister(old);
+  if (!old.empty()) {
+    RemoveAndUnregister(old);
+    // The new output is in place; what is left of the old one (files this user may not delete) is said, not hidden.
+    std::error_code ec;
+    if (fs::exists(fs::symlink_status(old, ec))) {
+      spdlog::warn(
+          "the output '{}' replaced the old one, but the old one could not be removed all; what is left of it "
+          "is in '{}': remove it yourself",
+          final_path_.string(), old.string());
+    }
+  }
 }
 
 }  // namespace vmap

@@ -65,9 +65,11 @@ std::optional<ContainedFile> ContainedFile::Open(const fs::path& directory, cons
   const int fd = open(real.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOFOLLOW);
   struct stat file_stat;
   if (fd < 0 || fstat(fd, &file_stat) != 0 || !S_ISREG(file_stat.st_mode)) {
-    const bool missing = fd < 0 && errno == ENOENT;
+    const int error = errno;
     if (fd >= 0) close(fd);
-    *why_not = missing ? "is missing" : fd < 0 ? "cannot be opened" : "is not a regular file";
+    *why_not = fd < 0 && error == ENOENT ? "is missing"
+               : fd < 0                  ? "cannot be opened (" + std::string(std::strerror(error)) + ")"
+                                         : "is not a regular file";
     return std::nullopt;
   }
   return ContainedFile(path, fd, static_cast<std::uint64_t>(file_stat.st_size));

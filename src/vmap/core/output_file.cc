@@ -4,6 +4,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <optional>
 
 #include "vmap/core/contained_file.h"
@@ -56,6 +58,24 @@ bool IsProgram(const fs::path& path) {
   close(fd);
   return (read_bytes >= 2 && head[0] == '#' && head[1] == '!') ||
          (read_bytes == 4 && head[0] == '\x7f' && head[1] == 'E' && head[2] == 'L' && head[3] == 'F');
+}
+
+// Why a file cannot be created beside `path` as the output's temporary will be (a name too long, a folder this user
+// may not write, a read-only or pseudo file system), found by creating one and removing it at once: so that the
+// refusal comes before the work, not after it. "" when it can.
+std::string WhyNotCreatable(const fs::path& path) {
+  const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  // The temporary's own name pattern (core/atomic_output.h): one left by a kill in between is removed by the next run.
+  const fs::path probe =
+      parent / ("." + path.filename().string() + ".tmp-" + std::to_string(getpid()) + "-" + std::to_string(0));
+  const int fd = open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0600);
+  if (fd < 0) {
+    if (errno == EEXIST) return "";  // this process's own temporary of the same output: the folder takes files
+    return std::strerror(errno);
+  }
+  close(fd);
+  unlink(probe.c_str());
+  return "";
 }
 
 }  // namespace
@@ -116,6 +136,10 @@ void CheckOutputFiles(const std::vector<OutputFile>& outputs, const std::vector<
     std::error_code ec;
     if (!fs::is_directory(parent, ec)) {
       throw OptionError(output.flag, path + ": its folder '" + parent.string() + "' does not exist; create it first");
+    }
+    if (const std::string problem = WhyNotCreatable(output.path); !problem.empty()) {
+      throw OptionError(output.flag, path + " cannot be written: " + problem +
+                                         "; give a path in a folder where this user may create files");
     }
   }
 }

@@ -29,7 +29,9 @@ struct OutputInput {
 // - exists and is a symbolic link, a device, a FIFO, a socket or a folder (vmap never renames over those);
 // - exists and is not writable (read-only, or no write permission bit even for root);
 // - exists and is a program (an ELF binary, a "#!" script): never an output of vmap's;
-// - has a parent that is not an existing folder.
+// - has a parent that is not an existing folder;
+// - cannot be created there (a name too long, a folder this user may not write, a read-only file system): tried by
+//   creating the output's temporary and removing it at once.
 void CheckOutputFiles(const std::vector<OutputFile>& outputs, const std::vector<OutputInput>& inputs);
 
 // Why the existing `path` may not be replaced by a regular file ("is a symbolic link; ..."), or "" when it may

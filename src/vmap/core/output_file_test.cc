@@ -8,6 +8,7 @@
 
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
+#include "vmap/testing/promises_test_util.h"
 #include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
@@ -96,6 +97,13 @@ TEST(OutputFile, OnlyWritableRegularFilesAreReplaced) {
   EXPECT_NE(refusal("/dev/null").find("is not a regular file"), std::string::npos);
   EXPECT_NE(refusal(tmp.path()).find("is a folder"), std::string::npos);
   EXPECT_NE(refusal(tmp.path() / "missing/out.csv").find("does not exist"), std::string::npos);
+  // What the file system will refuse, refused before the work: a name too long, a folder no file can be made in.
+  EXPECT_NE(refusal(tmp.path() / (std::string(300, 'a') + ".json")).find("cannot be written: File name too long"),
+            std::string::npos);
+  EXPECT_NE(refusal("/proc/vmap_out.json").find("cannot be written"), std::string::npos);
+  EXPECT_EQ(refusal(tmp.path() / "new.csv"), "");
+  EXPECT_FALSE(fs::exists(tmp.path() / "new.csv"));
+  EXPECT_TRUE(testing::EntriesStartingWith(tmp.path(), ".new.csv").empty());
 
   // WriteFileAtomically, which every output goes through, holds to the same rule on its own.
   const auto write_refusal = [&](const fs::path& output) {

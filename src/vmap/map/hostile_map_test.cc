@@ -57,6 +57,12 @@ TEST(MapIo, KeyImagePathsCannotLeaveTheMapDirectory) {
     WriteMapFiles(map, map_dir);
     EXPECT_NE(ReadMapError(map_dir).find("points outside the map directory"), std::string::npos) << bad;
   }
+  // Nor lie where a report replaces everything.
+  fs::create_directories(map_dir / "report");
+  cv::imwrite((map_dir / "report/000000.png").string(), cv::Mat(4, 4, CV_8U));
+  map.key_images[0].image_file = "report/000000.png";
+  WriteMapFiles(map, map_dir);
+  EXPECT_NE(ReadMapError(map_dir).find("lies in report/"), std::string::npos) << ReadMapError(map_dir);
 }
 
 TEST(MapIo, CorrespondenceRangesAreChecked) {

@@ -80,6 +80,11 @@ ContainedFile OpenMapFile(const fs::path& directory, const std::string& relative
   if (why_not.rfind("resolves outside", 0) == 0) {
     Malformed(reported, named + " resolves outside the map directory (a symbolic link leads out)");
   }
+  // The file is there and may be fine: what is in the way is this user's access to it, not the map.
+  if (why_not.rfind("cannot be opened", 0) == 0) {
+    throw InputError("map '" + directory.string() + "': '" + path.string() + "' " + why_not +
+                     "; check that this user may read it (its permissions and its folder's)");
+  }
   Malformed(reported, named + " " + why_not);
 }
 
@@ -145,6 +150,10 @@ void ReadKeyImages(const json& doc, const Fields& fields, const fs::path& direct
     }
     if (!IsPlainRelativePath(k.image_file)) {
       Malformed(file, where + " image '" + k.image_file + "' points outside the map directory");
+    }
+    // `vmap report` replaces report/ whole: a key image kept there would go with it.
+    if (*fs::path(k.image_file).lexically_normal().begin() == "report") {
+      Malformed(file, where + " image '" + k.image_file + "' lies in report/, which `vmap report` replaces");
     }
     const auto [named, first] = key_of_file.emplace(fs::path(k.image_file).lexically_normal().string(), i);
     if (!first) {
@@ -329,6 +338,10 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
   const fs::path file = directory / kMapFileName;
   const ContainedJson parsed = ReadContainedJson(directory, kMapFileName, kMaxMapJsonBytes, kMaxMapJsonValues);
   if (parsed.missing) throw InputError("'" + directory.string() + "' is not a map: " + file.string() + " is missing");
+  if (parsed.why_not.find(" cannot be opened") != std::string::npos) {
+    throw InputError("map '" + directory.string() + "': " + parsed.why_not +
+                     "; check that this user may read it (its permissions and its folder's)");
+  }
   if (!parsed.document) Malformed(file, parsed.why_not);
   const json& doc = *parsed.document;
   if (!doc.is_object() || doc.value("format", json()) != "vmap-map") {

@@ -203,7 +203,7 @@ TEST(ImageFolder, BadFramesAreSkippedWithAWarningAndCounted) {
 // the whole run, a dangling link or a FIFO was left out without a word.
 TEST(ImageFolder, EntriesThatAreNoFilesAreSkippedAndCounted) {
   testing::ScopedTempDir tmp;
-  testing::WriteImageFolder(Sequence(), tmp.path());  // 12 frames
+  testing::WriteImageFolder(Sequence(), tmp.path());                // 12 frames
   fs::create_symlink("frame_20.png", tmp.path() / "frame_20.png");  // a loop
   fs::create_symlink(tmp.path() / "nowhere.png", tmp.path() / "frame_21.png");
   ASSERT_EQ(mkfifo((tmp.path() / "frame_22.png").c_str(), 0600), 0);
