@@ -67,7 +67,10 @@ cv::Mat ReadKeyImageWithoutGil(const KeyImageRef& ref, bool grayscale) {
 
 std::shared_ptr<MapHandle> ReadMapHandle(const std::filesystem::path& directory) {
   auto handle = std::make_shared<MapHandle>();
-  handle->directory = directory;
+  // Absolute: key images read later, and a Localizer made from the map, find it after os.chdir.
+  std::error_code ec;
+  handle->directory = std::filesystem::absolute(directory, ec);
+  if (ec) handle->directory = directory;
   py::gil_scoped_release release;
   RecordedMap read = ReadRecordedMap(directory);
   handle->map = std::move(read.map);

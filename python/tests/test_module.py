@@ -118,6 +118,8 @@ def test_read_map_gives_the_map_json_as_numpy(maps):
     assert m.camera is not None and m.camera == record["input"]["camera"]
     assert m.options == record["options"]
     assert m.options["source"]["first"] == 0 and m.options["source"]["stride"] == 2
+    # Its folder is kept absolute: key images are still found after a change of the working directory.
+    assert pathlib.Path(m.directory).is_absolute()
     # Indexed into at once, the dict outlives the map's JSON it came from (it once pointed at a freed one).
     assert m.input["fps"] == record["input"]["fps"]
     assert vmap.read_map(cli_dir).input["frame_size"] == record["input"]["frame_size"]

@@ -216,11 +216,18 @@ TEST(OutputPromises, JsonOutputsTakeNamesThatAreNotUtf8) {
   fs::rename(tmp.path() / "m", tmp.path() / "m\xE9");
   const std::string map = Quote(tmp.path() / "m\xE9");
   std::string out;
-  ASSERT_EQ(RunVmap("localize " + map + " " + Quote(odd) + " --json " + Quote(tmp.path() / "run.json"), &out), 0)
+  ASSERT_EQ(RunVmap("localize " + map + " " + Quote(odd) + " --json " + Quote(tmp.path() / "run.json") + " --csv " +
+                        Quote(tmp.path() / "run.csv"),
+                    &out),
+            0)
       << out;
   const nlohmann::json run = nlohmann::json::parse(ReadText(tmp.path() / "run.json"));
   EXPECT_NE(run["query"]["path"].get<std::string>().find("caf%E9"), std::string::npos);
   EXPECT_NE(run["frames"][0]["source_name"].get<std::string>().find("%FF_2.png"), std::string::npos);
+  // The CSV names the frames as the JSON does (it once wrote the raw bytes, which a UTF-8 reader refuses).
+  const std::string csv = ReadText(tmp.path() / "run.csv");
+  EXPECT_NE(csv.find(",%FF_2.png,"), std::string::npos) << csv;
+  EXPECT_EQ(csv.find('\xFF'), std::string::npos);
   ASSERT_EQ(RunVmap("route " + map + " --json " + Quote(tmp.path() / "route.json"), &out), 0) << out;
   EXPECT_NE(ReadText(tmp.path() / "route.json").find("m%E9"), std::string::npos);
   ASSERT_EQ(RunVmap("report " + Quote(tmp.path() / "run.json") + " -o " + Quote(tmp.path() / "r"), &out), 0) << out;

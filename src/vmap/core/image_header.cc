@@ -1,8 +1,10 @@
 #include "vmap/core/image_header.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <functional>
+#include <string>
 
 namespace vmap {
 
@@ -64,6 +66,18 @@ std::optional<cv::Size> HeaderSize(const ReadBytes& read) {
 std::optional<cv::Size> ImageHeaderSize(const ContainedFile& file) {
   return HeaderSize(
       [&file](std::uint64_t offset, void* data, std::size_t bytes) { return file.Read(offset, data, bytes); });
+}
+
+bool IsCutShortJpeg(const ContainedFile& file) {
+  unsigned char start[2] = {};
+  if (file.size() < 4 || !file.Read(0, start, 2) || start[0] != 0xFF || start[1] != 0xD8) return false;
+  const std::uint64_t window = std::min<std::uint64_t>(file.size() - 2, std::uint64_t{64} << 10);
+  std::string tail(window, '\0');
+  if (!file.Read(file.size() - window, tail.data(), tail.size())) return false;
+  for (size_t i = tail.size() - 1; i > 0; --i) {
+    if (static_cast<unsigned char>(tail[i - 1]) == 0xFF && static_cast<unsigned char>(tail[i]) == 0xD9) return false;
+  }
+  return true;
 }
 
 std::optional<cv::Size> ImageHeaderSize(const std::uint8_t* encoded, std::size_t size) {

@@ -37,4 +37,29 @@ TEST(ImageHeader, SizesAreReadWithoutDecoding) {
   EXPECT_EQ(SizeOf(tmp.path() / "cut.png"), std::nullopt);
 }
 
+// A JPEG cut short decodes without an error, its missing rows grey: told by its missing end-of-image marker.
+TEST(ImageHeader, AJpegCutShortIsToldFromAWholeOne) {
+  testing::ScopedTempDir tmp;
+  cv::Mat noise(240, 320, CV_8UC3);
+  cv::randu(noise, 0, 255);
+  ASSERT_TRUE(cv::imwrite((tmp.path() / "whole.jpg").string(), noise));
+  std::ifstream in(tmp.path() / "whole.jpg", std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::ofstream(tmp.path() / "half.jpg", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  std::ofstream(tmp.path() / "trailer.jpg", std::ios::binary) << bytes << std::string(1000, 'x');
+  ASSERT_TRUE(cv::imwrite((tmp.path() / "a.png").string(), noise));
+  const auto cut_short = [&](const char* name) {
+    std::string why_not;
+    const std::optional<ContainedFile> file = ContainedFile::OpenRegular(tmp.path() / name, &why_not);
+    EXPECT_TRUE(file) << why_not;
+    return file && IsCutShortJpeg(*file);
+  };
+  EXPECT_FALSE(cut_short("whole.jpg"));
+  EXPECT_TRUE(cut_short("half.jpg"));
+  EXPECT_FALSE(cut_short("trailer.jpg"));  // data after the marker (a camera's own) is no cut
+  EXPECT_FALSE(cut_short("a.png"));
+  // The half decodes all the same: why the marker is asked for.
+  EXPECT_FALSE(cv::imread((tmp.path() / "half.jpg").string()).empty());
+}
+
 }  // namespace vmap

@@ -120,7 +120,7 @@ std::string LocalizationCsvHeader(bool experiences) {
 std::string LocalizationCsvRow(const VisualMap& map, const LocalizationResult& r, bool experiences) {
   std::string row = fmt::format(
       "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.6f}", r.frame_index, r.source_index,
-      r.timestamp >= 0 ? fmt::format("{:.6f}", r.timestamp) : std::string(), CsvText(r.source_name),
+      r.timestamp >= 0 ? fmt::format("{:.6f}", r.timestamp) : std::string(), CsvText(EncodeFileName(r.source_name)),
       LocalizationStatusName(r.status), r.key, r.next_key, KeyFrame(map, r.key), KeyFrame(map, r.next_key),
       r.to_key.key >= 0 ? CsvNumber(r.to_key.similarity) : "", r.to_key.num_verified, r.to_key.num_tentative,
       r.to_next.key >= 0 ? CsvNumber(r.to_next.similarity) : "", r.to_next.num_verified, r.to_next.num_tentative,

@@ -164,6 +164,9 @@ void ReadKeyImages(const json& doc, const Fields& fields, const fs::path& direct
     const ContainedFile image = OpenMapFile(directory, k.image_file, "key image", file, where + ".image");
     const std::string problem = KeyImageSizeProblem(KeyImageSize(image), map->input.frame_size);
     if (!problem.empty()) Malformed(file, where + ".image '" + k.image_file + "' " + problem);
+    if (IsCutShortJpeg(image)) {
+      Malformed(file, where + ".image '" + k.image_file + "' is a JPEG cut short (no end-of-image marker)");
+    }
     map->key_images.push_back(std::move(k));
   }
   if (map->key_images.empty() && map->num_frames > 0) Malformed(file, "no key images");
@@ -456,7 +459,8 @@ cv::Mat ReadKeyImage(const fs::path& map_directory, const KeyImage& key, bool gr
   const fs::path& file = opened.path();
   // The map reader checked this header, but the file may have been replaced since (a map rebuilt into the same
   // folder while a program holds the old one): checked again, and the bytes checked are the bytes decoded.
-  const std::string problem = KeyImageSizeProblem(KeyImageSize(opened), frame_size);
+  std::string problem = KeyImageSizeProblem(KeyImageSize(opened), frame_size);
+  if (problem.empty() && IsCutShortJpeg(opened)) problem = "is a JPEG cut short (no end-of-image marker)";
   if (!problem.empty()) {
     throw InputError("key image '" + file.string() + "' " + problem +
                      ": it changed since the map was read; read the map again, or rebuild it with `vmap build`");

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -89,8 +91,16 @@ Camera ReadKittiCalib(const std::string& path, const std::string& projection) {
     std::string name;
     if (!(fields >> name) || name != projection + ":") continue;
     std::vector<double> P;
-    double v;
-    while (fields >> v) P.push_back(v);
+    std::string token;
+    while (fields >> token) {
+      char* end = nullptr;
+      const double v = std::strtod(token.c_str(), &end);
+      if (end == token.c_str() || *end != '\0' || !std::isfinite(v)) {
+        throw InputError("'" + path + "': " + projection + "'s value " + std::to_string(P.size() + 1) + ", '" +
+                         token.substr(0, 40) + "', is not a finite number");
+      }
+      P.push_back(v);
+    }
     if (P.size() != 12) {
       throw InputError("'" + path + "': " + projection + " has " + std::to_string(P.size()) +
                        " numbers; a KITTI projection matrix has 12 (3x4, row-major)");

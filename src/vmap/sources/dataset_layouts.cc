@@ -2,6 +2,8 @@
 // KITTI odometry (image_0/ + times.txt).
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -177,8 +179,20 @@ std::vector<ImageEntry> ListKitti(const std::string& sequence_directory) {
   if (names.empty()) throw InputError("'" + images.string() + "' holds no images; the sequence is empty");
   std::vector<double> times;
   if (std::optional<std::istringstream> in = OptionalListFile(sequence / "times.txt", "KITTI times.txt")) {
-    double t;
-    while (*in >> t) times.push_back(t);
+    std::string line;
+    for (int number = 1; std::getline(*in, line); ++number) {
+      line = Trim(line);
+      if (line.empty()) continue;
+      char* end = nullptr;
+      const double t = std::strtod(line.c_str(), &end);
+      if (end == line.c_str() || *end != '\0' || !std::isfinite(t) || t < 0.0) {
+        spdlog::warn("{} line {}: {:?} is not a time in seconds; ignoring the timestamps",
+                     (sequence / "times.txt").string(), number, line.substr(0, 40));
+        times.clear();
+        break;
+      }
+      times.push_back(t);
+    }
   }
   if (!times.empty() && times.size() != names.size()) {
     spdlog::warn("{} has {} times for {} images; ignoring the timestamps", (sequence / "times.txt").string(),

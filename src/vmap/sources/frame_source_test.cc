@@ -200,7 +200,7 @@ TEST(ImageFolder, BadFramesAreSkippedWithAWarningAndCounted) {
 }
 
 // An entry named as an image that is no file to read is skipped and counted like a bad frame: a link loop once ended
-// the whole run, a dangling link or a FIFO was left out without a word.
+// the whole run, a dangling link or a FIFO was left out without a word, a JPEG cut short was used half grey.
 TEST(ImageFolder, EntriesThatAreNoFilesAreSkippedAndCounted) {
   testing::ScopedTempDir tmp;
   testing::WriteImageFolder(Sequence(), tmp.path());                // 12 frames
@@ -208,9 +208,14 @@ TEST(ImageFolder, EntriesThatAreNoFilesAreSkippedAndCounted) {
   fs::create_symlink(tmp.path() / "nowhere.png", tmp.path() / "frame_21.png");
   ASSERT_EQ(mkfifo((tmp.path() / "frame_22.png").c_str(), 0600), 0);
   fs::create_symlink("loop", tmp.path() / "loop");  // not an image's name: not a frame
+  // A JPEG cut short, which libjpeg would decode with its lower half grey.
+  std::vector<unsigned char> jpeg;
+  cv::imencode(".jpg", Sequence().frames[0], jpeg);
+  std::ofstream(tmp.path() / "frame_23.jpg", std::ios::binary)
+      .write(reinterpret_cast<const char*>(jpeg.data()), static_cast<std::streamsize>(jpeg.size() / 2));
   auto source = OpenFrameSource(tmp.path().string());
   EXPECT_EQ(ReadAll(*source).size(), 12u);
-  EXPECT_EQ(source->skipped_frames(), 3);
+  EXPECT_EQ(source->skipped_frames(), 4);
 }
 
 // Stamps that cannot be seconds (nanoseconds since 1970) are refused before any work: a map of them could not be read
@@ -344,6 +349,17 @@ TEST(Kitti, ReadsImage0AndTimes) {
   const auto frames = ReadAll(*source);
   ASSERT_EQ(frames.size(), 3u);
   EXPECT_NEAR(frames[2].timestamp, 0.2072, 1e-9);
+
+  // A times.txt line that is no time: the timestamps are ignored with a warning, and the frames are read; a calib.txt
+  // value that is no number names itself.
+  std::ofstream(tmp.path() / "times.txt") << "0\nnan\n0.2\n";
+  auto untimed = OpenFrameSource(tmp.path().string());
+  const auto untimed_frames = ReadAll(*untimed);
+  ASSERT_EQ(untimed_frames.size(), 3u);
+  EXPECT_LT(untimed_frames[2].timestamp, 0.0);
+  std::ofstream(tmp.path() / "calib.txt") << "P0: nan 0 0 0 0 1 0 0 0 0 1 0\n";
+  EXPECT_NE(OpenError(tmp.path().string()).find("P0's value 1, 'nan', is not a finite number"), std::string::npos)
+      << OpenError(tmp.path().string());
 }
 
 TEST(Video, ReadsEveryFrameWithTimestamps) {

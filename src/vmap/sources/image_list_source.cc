@@ -61,6 +61,10 @@ class ImageListSource : public FrameSource {
           continue;
         }
       }
+      if (IsCutShortJpeg(*file)) {
+        Skip(entry, "it is a JPEG cut short (no end-of-image marker)");
+        continue;
+      }
       // Grey straight from the decoder, as the matchers' reference implementations read images.
       try {
         frame.gray = cv::imread(entry.path, cv::IMREAD_GRAYSCALE);
