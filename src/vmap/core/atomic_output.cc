@@ -58,7 +58,8 @@ void RemoveAndUnregister(const fs::path& path) {
 
 constexpr const char* kTemporaryTags[] = {"partial", "old", "tmp"};
 
-// ".NAME.TAG-PID-N": the pid says whose it is (see RemoveStaleTemporaries), N keeps one process's apart.
+}  // namespace
+
 fs::path TemporarySibling(const fs::path& path, const char* tag) {
   static std::mutex mutex;
   static std::mt19937 random{std::random_device{}()};
@@ -71,6 +72,8 @@ fs::path TemporarySibling(const fs::path& path, const char* tag) {
   return parent /
          ("." + path.filename().string() + "." + tag + "-" + std::to_string(getpid()) + "-" + std::to_string(suffix));
 }
+
+namespace {
 
 bool AllDigits(const std::string& text) {
   return !text.empty() && text.size() <= 18 && text.find_first_not_of("0123456789") == std::string::npos;

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <optional>
 
+#include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 
@@ -64,13 +65,11 @@ bool IsProgram(const fs::path& path) {
 // may not write, a read-only or pseudo file system), found by creating one and removing it at once: so that the
 // refusal comes before the work, not after it. "" when it can.
 std::string WhyNotCreatable(const fs::path& path) {
-  const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
-  // The temporary's own name pattern (core/atomic_output.h): one left by a kill in between is removed by the next run.
-  const fs::path probe =
-      parent / ("." + path.filename().string() + ".tmp-" + std::to_string(getpid()) + "-" + std::to_string(0));
+  // Named as the output's temporaries are: one left by a kill in between is removed by the next run.
+  const fs::path probe = TemporarySibling(path, "tmp");
   const int fd = open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0600);
   if (fd < 0) {
-    if (errno == EEXIST) return "";  // this process's own temporary of the same output: the folder takes files
+    if (errno == EEXIST) return "";  // a name already taken there: the folder takes files
     return std::strerror(errno);
   }
   close(fd);
