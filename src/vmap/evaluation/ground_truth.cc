@@ -11,6 +11,7 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/sources/dataset_camera.h"
+#include "vmap/sources/kitti_frame_number.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -243,8 +244,10 @@ std::optional<GroundTruth> FindGroundTruth(const std::string& input_path, Source
 
 std::optional<cv::Matx44d> KeyImagePose(const GroundTruth& truth, const KeyImage& key, double max_time_difference) {
   if (truth.format == GroundTruthFormat::kKitti) {
-    if (key.source_index < 0 || key.source_index >= static_cast<int>(truth.camera_to_world.size())) return std::nullopt;
-    return truth.camera_to_world[key.source_index];
+    // By the image's own number: the position in the listing is another frame's once an image is missing.
+    const int line = KittiFrameNumber(key.source_name).value_or(key.source_index);
+    if (line < 0 || line >= static_cast<int>(truth.camera_to_world.size())) return std::nullopt;
+    return truth.camera_to_world[line];
   }
   if (key.timestamp < 0 || truth.timestamps.empty()) return std::nullopt;
   const auto after = std::lower_bound(truth.timestamps.begin(), truth.timestamps.end(), key.timestamp);

@@ -4,7 +4,8 @@
 // Every format holds camera-to-world poses T_wc (X_world = R_wc X_cam + t_wc); they differ in how a pose
 // is tied to a frame and in the order of the quaternion:
 //   kitti  poses.txt: one line per image of the sequence, 12 numbers = the 3x4 matrix [R_wc | t_wc] row by
-//          row, of camera 0 (the left grey camera); line i belongs to image i (a key image's source_index).
+//          row, of camera 0 (the left grey camera); line i belongs to image i: the key image whose file is
+//          numbered i (000123.png), else the one whose source_index is i.
 //   tum    groundtruth.txt: "timestamp tx ty tz qx qy qz qw" (quaternion x, y, z, w) of the camera; tied to
 //          a key image by its timestamp (the nearest pose within max_time_difference, as TUM's associate.py).
 //   euroc  state_groundtruth_estimate0/data.csv: "timestamp_ns, px, py, pz, qw, qx, qy, qz, ..." (quaternion
@@ -52,8 +53,8 @@ GroundTruth ReadGroundTruth(const std::string& path, GroundTruthFormat format = 
 // state_groundtruth_estimate0/data.csv with its cam0/sensor.yaml. Nullopt when the input has none.
 std::optional<GroundTruth> FindGroundTruth(const std::string& input_path, SourceFormat format);
 
-// The camera-to-world pose of a key image: by source_index (kitti) or by timestamp. Nullopt when the
-// ground truth has no pose for it (past its end, no timestamp, or no pose within max_time_difference).
+// The camera-to-world pose of a key image: by its file's frame number or source_index (kitti), or by timestamp. Nullopt
+// when the ground truth has no pose for it (past its end, no timestamp, or no pose within max_time_difference).
 std::optional<cv::Matx44d> KeyImagePose(const GroundTruth& truth, const KeyImage& key, double max_time_difference);
 
 // The relative pose from camera a to camera b given their camera-to-world poses: X_b = R X_a + t.

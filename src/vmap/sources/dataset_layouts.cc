@@ -14,6 +14,7 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/sources/internal.h"
+#include "vmap/sources/kitti_frame_number.h"
 
 namespace vmap::internal {
 namespace fs = std::filesystem;
@@ -194,14 +195,29 @@ std::vector<ImageEntry> ListKitti(const std::string& sequence_directory) {
       times.push_back(t);
     }
   }
-  if (!times.empty() && times.size() != names.size()) {
-    spdlog::warn("{} has {} times for {} images; ignoring the timestamps", (sequence / "times.txt").string(),
-                 times.size(), names.size());
-    times.clear();
+  // An image takes the time of its frame number (000123.png: line 123), so a sequence with images missing
+  // keeps every time right; by position only when the names are no numbers within times.txt.
+  std::vector<size_t> time_lines(names.size());
+  bool numbered = !times.empty();
+  for (size_t i = 0; i < names.size() && numbered; ++i) {
+    const std::optional<int> number = KittiFrameNumber(names[i]);
+    numbered = number && static_cast<size_t>(*number) < times.size();
+    if (numbered) time_lines[i] = static_cast<size_t>(*number);
+  }
+  if (numbered && names.size() != times.size()) {
+    spdlog::info("{} holds {} of the {} images {} times; each takes the time of its number", images.string(),
+                 names.size(), times.size(), (sequence / "times.txt").string());
+  } else if (!numbered && !times.empty()) {
+    if (times.size() != names.size()) {
+      spdlog::warn("{} has {} times for {} images; ignoring the timestamps", (sequence / "times.txt").string(),
+                   times.size(), names.size());
+      times.clear();
+    }
+    for (size_t i = 0; i < names.size(); ++i) time_lines[i] = i;
   }
   std::vector<ImageEntry> entries;
   for (size_t i = 0; i < names.size(); ++i) {
-    entries.push_back({(images / names[i]).string(), times.empty() ? -1.0 : times[i]});
+    entries.push_back({(images / names[i]).string(), times.empty() ? -1.0 : times[time_lines[i]]});
   }
   return entries;
 }

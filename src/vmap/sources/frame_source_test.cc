@@ -350,6 +350,14 @@ TEST(Kitti, ReadsImage0AndTimes) {
   ASSERT_EQ(frames.size(), 3u);
   EXPECT_NEAR(frames[2].timestamp, 0.2072, 1e-9);
 
+  // An image missing from the sequence: each other image keeps the time of its own number.
+  fs::rename(tmp.path() / "image_0/000001.png", tmp.path() / "000001.png");
+  const auto gapped_frames = ReadAll(*OpenFrameSource(tmp.path().string()));
+  ASSERT_EQ(gapped_frames.size(), 2u);
+  EXPECT_EQ(gapped_frames[1].source_name, "000002.png");
+  EXPECT_NEAR(gapped_frames[1].timestamp, 0.2072, 1e-9);
+  fs::rename(tmp.path() / "000001.png", tmp.path() / "image_0/000001.png");
+
   // A times.txt line that is no time: the timestamps are ignored with a warning, and the frames are read; a calib.txt
   // value that is no number names itself.
   std::ofstream(tmp.path() / "times.txt") << "0\nnan\n0.2\n";
