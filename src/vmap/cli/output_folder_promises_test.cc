@@ -3,7 +3,10 @@
 // 1. vmap replaces only what it can prove it wrote, never its input;
 // 3. an interrupted run (SIGINT, SIGTERM, SIGKILL) leaves nothing behind.
 
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
+#include <sys/resource.h>
 
 #include <chrono>
 #include <fstream>
@@ -189,6 +192,38 @@ TEST(Promises, SigintOrSigtermLeaveNothingBehindAndTheOldOutputIntact) {
   EXPECT_FALSE(fs::exists(tmp.path() / "m2"));
 }
 
+// A write that fails part way: the file size limit stands in for a full disk (both fail write(2) in mid-file, and
+// cv::imwrite once reported a PNG cut short by a full disk as written). The build fails naming the reason, and the
+// old map stays as it was, whether a key image is copied from the input or encoded (--resize).
+TEST(Promises, AWriteThatFailsPartWayKeepsTheOldMapAndSaysWhy) {
+  testing::ScopedTempDir tmp;
+  WriteSyntheticInput(tmp.path() / "in", 12);
+  BuildMapWithBinary(tmp.path() / "in", tmp.path() / "m", "--last 5");
+  const std::string old_map = ReadText(tmp.path() / "m/map.json");
+  struct rlimit old_limit {};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  const auto old_handler = signal(SIGXFSZ, SIG_IGN);  // ignored, it is ignored in vmap too: write(2) fails instead
+  struct rlimit small = old_limit;
+  small.rlim_cur = 2048;
+  std::vector<std::string> outputs;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+  for (const char* extra : {"", " --resize 300"}) {
+    std::string out;
+    const int status = RunVmap("build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "m") + extra, &out);
+    outputs.push_back(std::to_string(status) + " " + out);
+  }
+  setrlimit(RLIMIT_FSIZE, &old_limit);
+  signal(SIGXFSZ, old_handler);
+  for (const std::string& output : outputs) {
+    EXPECT_EQ(output.rfind("2 ", 0), 0u) << output;
+    EXPECT_NE(output.find("cannot write key image '"), std::string::npos) << output;
+    EXPECT_NE(output.find("(File too large)"), std::string::npos) << output;
+    EXPECT_EQ(output.find("libpng"), std::string::npos) << output;
+  }
+  EXPECT_EQ(ReadText(tmp.path() / "m/map.json"), old_map) << "the old map is intact";
+  EXPECT_EQ(EntriesStartingWith(tmp.path(), "."), std::vector<std::string>()) << "a temporary was left";
+}
+
 TEST(Promises, AnInterruptedReportLeavesTheMapAsItWas) {
   testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 150);
@@ -217,9 +252,19 @@ TEST(Promises, TemporariesOfAKilledRunAreRemovedByTheNextRun) {
   ASSERT_EQ(left.size(), 1u);
   // A live process's temporary (pid 1 always runs) is not touched.
   fs::create_directories(tmp.path() / ".m.partial-1-77");
+  // Nor one whose pid runs nowhere here (beyond Linux's largest pid) but that its owner holds locked, as a vmap in
+  // another container sharing the folder does; the same unlocked is a killed process's.
+  const fs::path elsewhere = tmp.path() / ".m.partial-4194305-1", killed = tmp.path() / ".m.partial-4194305-2";
+  fs::create_directories(elsewhere);
+  fs::create_directories(killed);
+  const int held = open(elsewhere.c_str(), O_RDONLY | O_CLOEXEC);
+  ASSERT_EQ(flock(held, LOCK_SH), 0);
   BuildMapWithBinary(tmp.path() / "in", tmp.path() / "m", "--last 9");
+  close(held);
   EXPECT_FALSE(fs::exists(tmp.path() / left[0]));
   EXPECT_TRUE(fs::exists(tmp.path() / ".m.partial-1-77"));
+  EXPECT_TRUE(fs::exists(elsewhere));
+  EXPECT_FALSE(fs::exists(killed));
   EXPECT_NO_THROW(ReadMap(tmp.path() / "m"));
 }
 

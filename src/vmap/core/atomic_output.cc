@@ -3,16 +3,17 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <stdio.h>  // renameat2, RENAME_EXCHANGE (glibc >= 2.28)
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <random>
-#include <set>
 #include <thread>
 
 #include <spdlog/spdlog.h>
@@ -27,10 +28,43 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The temporaries this process created and has not yet committed or removed.
+// A temporary's lock: a shared flock(2) held on it for as long as it is this process's. The pid in its name tells
+// another vmap only whether a process of that pid runs in *its* PID namespace; two containers sharing a volume, or
+// two hosts sharing a file system, would each take the other's running work for a killed process's leftovers. The
+// lock is seen wherever the file is (local file systems, and NFS, which turns it into a byte-range lock).
+int HoldLock(const fs::path& path) {
+  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
+  if (fd >= 0 && flock(fd, LOCK_SH | LOCK_NB) != 0) {
+    close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+// Whether some process holds the lock of the temporary at `path` (its owner is alive, wherever it runs).
+bool LockIsHeld(const fs::path& path) {
+  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
+  if (fd < 0) return false;
+  const bool held = flock(fd, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+  close(fd);
+  return held;
+}
+
+// The temporaries this process created and has not yet committed or removed, each with its lock (-1: none).
 struct TemporaryRegistry {
   std::mutex mutex;
-  std::set<fs::path> paths;
+  std::map<fs::path, int> paths;
+
+  // Both with the mutex held.
+  void Add(const fs::path& path) {
+    if (paths.count(path) == 0) paths[path] = HoldLock(path);
+  }
+  void Remove(const fs::path& path) {
+    const auto found = paths.find(path);
+    if (found == paths.end()) return;
+    if (found->second >= 0) close(found->second);
+    paths.erase(found);
+  }
 };
 
 // Never destroyed: an interrupted process cleans up from another thread while main() may be returning.
@@ -45,7 +79,7 @@ template <typename Create>
 auto CreateRegistered(const fs::path& path, Create&& create) -> decltype(create()) {
   std::lock_guard<std::mutex> lock(Temporaries().mutex);
   auto created = create();
-  if (created) Temporaries().paths.insert(path);
+  if (created) Temporaries().Add(path);
   return created;
 }
 
@@ -53,7 +87,7 @@ void RemoveAndUnregister(const fs::path& path) {
   std::error_code ignored;
   fs::remove_all(path, ignored);
   std::lock_guard<std::mutex> lock(Temporaries().mutex);
-  Temporaries().paths.erase(path);
+  Temporaries().Remove(path);
 }
 
 constexpr const char* kTemporaryTags[] = {"partial", "old", "tmp"};
@@ -117,7 +151,7 @@ void RemoveStaleTemporaries(const fs::path& path) {
   std::error_code ec;
   for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
     const long pid = TemporaryOwner(it->path().filename().string(), name);
-    if (pid == 0 || ProcessRuns(pid)) continue;
+    if (pid == 0 || ProcessRuns(pid) || LockIsHeld(it->path())) continue;
     std::error_code removed;
     fs::remove_all(it->path(), removed);
     if (!removed) {
@@ -130,7 +164,8 @@ int RemoveTemporaryOutputsForExit() {
   // Locked for good: nothing new is created or committed while the process ends.
   Temporaries().mutex.lock();
   int removed = 0;
-  for (const fs::path& path : Temporaries().paths) {
+  for (const auto& registered : Temporaries().paths) {
+    const fs::path& path = registered.first;
     // Another thread may still be writing into a directory: a retry takes what appeared meanwhile. Once the
     // directory itself is gone, nothing recreates it (only the constructor does, under the lock held here).
     std::error_code ec;
@@ -198,9 +233,9 @@ void WriteFileAtomically(const fs::path& path, std::string_view content,
                      "); check that it is not a folder and "
                      "that its directory is writable");
   }
-  Temporaries().paths.erase(temp);
+  Temporaries().Remove(temp);
   for (TemporaryDirectory* directory : completes) {
-    Temporaries().paths.erase(directory->path_);
+    Temporaries().Remove(directory->path_);
     directory->completed_ = true;
   }
 }
@@ -260,9 +295,9 @@ void TemporaryDirectory::MoveTo(const fs::path& from, const fs::path& to) {
     std::error_code ignored;
     fs::remove_all(path_, ignored);
   }
-  Temporaries().paths.erase(path_);
+  Temporaries().Remove(path_);
   path_ = to;
-  Temporaries().paths.insert(path_);
+  Temporaries().Add(path_);
 }
 
 OutputPolicy OutputPolicy::InsideVmapOutput() {
@@ -396,7 +431,7 @@ std::string AtomicOutputDirectory::KeepUnplaced() {
   }
   std::lock_guard<std::mutex> lock(Temporaries().mutex);
   if (rename(temp_path_.c_str(), kept.c_str()) != 0) kept = temp_path_;
-  Temporaries().paths.erase(temp_path_);
+  Temporaries().Remove(temp_path_);
   temp_path_.clear();  // the destructor leaves it
   return "the finished output is kept at '" + kept.string() + "': move it into place yourself";
 }
@@ -404,9 +439,16 @@ std::string AtomicOutputDirectory::KeepUnplaced() {
 void AtomicOutputDirectory::MoveIntoPlace() {
   // Another vmap writing into the folder being replaced (`build --add-experience-to` a map) finishes first:
   // replacing it now would throw its work away while it still thinks it is writing it.
+  // Not a temporary of this process's own (`vmap simulate` builds its map into one): no other process writes into
+  // it, and the lock this process holds on it (HoldLock) would have this one wait for itself.
   std::optional<DirectoryWriteLock> writers;
   std::error_code exists_ec;
-  if (fs::is_directory(fs::symlink_status(final_path_, exists_ec))) writers.emplace(final_path_, "the output");
+  bool ours = false;
+  {
+    std::lock_guard<std::mutex> lock(Temporaries().mutex);
+    ours = Temporaries().paths.count(final_path_) > 0;
+  }
+  if (!ours && fs::is_directory(fs::symlink_status(final_path_, exists_ec))) writers.emplace(final_path_, "the output");
   CheckReplaceable();  // the folder may have changed while vmap worked
   fs::path old;        // where the replaced directory ends up, to be removed
   std::unique_lock<std::mutex> lock(Temporaries().mutex);
@@ -418,7 +460,7 @@ void AtomicOutputDirectory::MoveIntoPlace() {
   };
   if (!replacing) {
     if (rename(temp_path_.c_str(), final_path_.c_str()) != 0) fail(ErrnoText());
-    Temporaries().paths.erase(temp_path_);
+    Temporaries().Remove(temp_path_);
   } else if (renameat2(AT_FDCWD, temp_path_.c_str(), AT_FDCWD, final_path_.c_str(), RENAME_EXCHANGE) == 0) {
     old = temp_path_;  // still registered: it now holds the replaced directory
   } else if (errno == EINVAL || errno == ENOSYS || errno == ENOTSUP) {
@@ -426,14 +468,14 @@ void AtomicOutputDirectory::MoveIntoPlace() {
     // the two renames is excluded by the registry's lock; only SIGKILL could leave the old copy aside.
     old = TemporarySibling(final_path_, "old");
     if (rename(final_path_.c_str(), old.c_str()) != 0) fail(ErrnoText());
-    Temporaries().paths.insert(old);
+    Temporaries().Add(old);
     if (rename(temp_path_.c_str(), final_path_.c_str()) != 0) {
       const std::string reason = ErrnoText();
       rename(old.c_str(), final_path_.c_str());  // put the old directory back
-      Temporaries().paths.erase(old);
+      Temporaries().Remove(old);
       fail(reason);
     }
-    Temporaries().paths.erase(temp_path_);
+    Temporaries().Remove(temp_path_);
   } else {
     fail(ErrnoText());
   }

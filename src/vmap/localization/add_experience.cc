@@ -11,6 +11,7 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/directory_lock.h"
 #include "vmap/core/error.h"
+#include "vmap/core/image_file.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/map/map_io.h"
 
@@ -132,11 +133,7 @@ AddExperienceSummary AddExperience(const fs::path& map_directory, FrameSource& s
         }
         for (int key : picker.Offer(result)) {
           const fs::path file = views_directory / view_file(key);
-          if (!cv::imwrite(file.string(), ColorImage(frame))) {
-            throw InputError("cannot write '" + file.string() +
-                             "'; check the free space and the permissions of the "
-                             "map directory");
-          }
+          WriteImageFile(file, ColorImage(frame), "the view");
         }
       });
   summary.frames = run.frames;

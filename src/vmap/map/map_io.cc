@@ -14,6 +14,7 @@
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/file_identity.h"
 #include "vmap/core/file_name_encoding.h"
 #include "vmap/core/image_header.h"
 #include "vmap/map/map_geometry_json.h"
@@ -195,6 +196,12 @@ void ReadLinks(const json& doc, const Fields& fields, const fs::path& directory,
         static_cast<int>(fields.Integer(fields.Required(entry, where, "from"), where + ".from", 0, num_keys - 1));
     l.to_key = static_cast<int>(fields.Integer(fields.Required(entry, where, "to"), where + ".to", 0, num_keys - 1));
     if (l.to_key <= l.from_key) fields.Fail(where + ".to", "must name a key image after 'from'");
+    // A map's links chain its key images in order; a gap would leave two stretches that no route joins.
+    if (l.from_key != static_cast<long>(i) || l.to_key != static_cast<long>(i) + 1) {
+      fields.Fail(where, fmt::format("joins key images {} and {}; it must join key images {} and {}, as a map's links "
+                                     "chain its key images in order",
+                                     l.from_key, l.to_key, i, i + 1));
+    }
     for (const auto& [name, key] : {std::pair<const char*, int>{"from_frame", l.from_key}, {"to_frame", l.to_key}}) {
       const json* frame = Fields::Find(entry, name);
       if (frame && fields.Integer(*frame, Fields::Join(where, name), 0, kMaxInt) != map->key_images[key].frame_index) {
@@ -240,6 +247,15 @@ void ReadLinks(const json& doc, const Fields& fields, const fs::path& directory,
     ranges.emplace_back(offset, count);
     if (count > 0) records_referenced = std::max(records_referenced, offset + count);
     map->links.push_back(std::move(l));
+  }
+  // The builder links each key image to the next one it was chosen after: a missing link cannot come from it, and
+  // would leave localization and routes two stretches that nothing joins.
+  if (num_keys > 1 && links.empty()) {
+    fields.Fail("links", fmt::format("is empty although the map has {} key images", num_keys));
+  }
+  if (num_keys > 1 && static_cast<long>(links.size()) < num_keys - 1) {
+    fields.Fail("links", fmt::format("ends at key image {} of the map's {}: key image {} has no link to key image {}",
+                                     links.size(), num_keys, links.size(), links.size() + 1));
   }
   if (links.empty()) return;
   // Each link's records are its own (vmap writes them one link after the other).
@@ -415,11 +431,6 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
   }
   ReadKeyImages(doc, fields, directory, file, &map);
   ReadLinks(doc, fields, directory, file, &map);
-  // The builder links each key image to the next one it was chosen after: several key images and no link at
-  // all cannot come from it, and would leave localization nothing to follow.
-  if (map.key_images.size() > 1 && map.links.empty()) {
-    fields.Fail("links", "is empty although the map has " + std::to_string(map.key_images.size()) + " key images");
-  }
   ReadEvaluations(doc, fields, &map);
   if (const json* experiences = Fields::Find(doc, "experiences")) {
     map.experiences = ExperiencesFromJson(*experiences, map, directory, file);
@@ -430,12 +441,34 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
 }  // namespace
 
 VisualMap ReadMap(const fs::path& directory) {
-  return RethrowAsInputError(
-      [&] {
-        return ErrorContext{"cannot read the map '" + directory.string() + "'",
-                            "check that it exists and that you may read it"};
-      },
-      [&] { return ReadCheckedMap(directory); });
+  // A run writing snapshots of the map (`build --snapshot-every`, the ROS teach node) replaces its folder whole, by a
+  // rename, while this reads its files one after the other: a read during which the folder changed is read again, so
+  // that a reader gets one snapshot or the next, never a mix of the two (nor a "malformed" for the mix).
+  constexpr int kAttempts = 10;
+  for (int attempt = 1;; ++attempt) {
+    const std::optional<FileIdentity> before = IdentityOf(directory);
+    const auto unchanged = [&] {
+      const std::optional<FileIdentity> now = IdentityOf(directory);
+      return SameFile(now, before) || (!now && !before);  // still the same folder, or still none
+    };
+    try {
+      VisualMap map = RethrowAsInputError(
+          [&] {
+            return ErrorContext{"cannot read the map '" + directory.string() + "'",
+                                "check that it exists and that you may read it"};
+          },
+          [&] { return ReadCheckedMap(directory); });
+      if (unchanged()) return map;
+    } catch (const InputError&) {
+      if (unchanged()) throw;
+    }
+    if (attempt == kAttempts) {
+      throw InputError(
+          fmt::format("the map '{}' was replaced {} times while it was read (a run writing snapshots of "
+                      "it?); read it again later",
+                      directory.string(), kAttempts));
+    }
+  }
 }
 
 namespace {

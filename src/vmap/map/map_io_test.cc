@@ -2,9 +2,15 @@
 // key images read and their sizes from their headers, and what makes a folder a vmap map.
 #include "vmap/map/map_io.h"
 
+#include <fcntl.h>
+#include <stdio.h>  // renameat2, RENAME_EXCHANGE
+
+#include <atomic>
+#include <chrono>
 #include <fstream>
 #include <functional>
 #include <sstream>
+#include <thread>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -40,6 +46,45 @@ TEST(MapIo, RoundTripKeepsEverything) {
   EXPECT_DOUBLE_EQ(back.quality, 0.42);
   // Correspondences are 16 bytes each, as documented.
   EXPECT_EQ(fs::file_size(tmp.path() / kCorrespondencesFileName), 6u * 16u);
+}
+
+// A run writing snapshots replaces the map's folder whole (a rename exchange) while readers read it: each read gets
+// one map or the other, whole, never a mix (whose files disagree: it used to be called malformed).
+TEST(MapIo, AReaderOfAMapReplacedWhileItReadsGetsOneMapOrTheOther) {
+  testing::ScopedTempDir tmp;
+  const fs::path read_here = tmp.path() / "map", other = tmp.path() / "next";
+  WriteMapFiles(SmallMap(read_here), read_here);
+  VisualMap longer = SmallMap(other);
+  for (Link& link : longer.links) link.correspondences.insert(link.correspondences.end(), 3, {{1, 2}, {3, 4}});
+  WriteMapFiles(longer, other);
+  std::atomic<bool> done{false};
+  std::atomic<int> exchanges{0};
+  std::thread snapshots([&] {
+    while (!done) {
+      ASSERT_EQ(renameat2(AT_FDCWD, read_here.c_str(), AT_FDCWD, other.c_str(), RENAME_EXCHANGE), 0);
+      ++exchanges;
+      std::this_thread::sleep_for(std::chrono::microseconds(500));
+    }
+  });
+  int reads[2] = {0, 0};
+  std::string failure;
+  for (int i = 0; i < 400 && failure.empty(); ++i) {
+    try {
+      const VisualMap map = ReadMap(read_here);
+      ++reads[map.links.at(0).correspondences.size() == 3 ? 0 : 1];
+      for (const Link& link : map.links) {
+        if (link.correspondences.size() != map.links[0].correspondences.size()) failure = "a mix of the two maps";
+      }
+    } catch (const InputError& e) {
+      failure = e.what();
+    }
+  }
+  done = true;
+  snapshots.join();
+  EXPECT_EQ(failure, "");
+  EXPECT_GT(exchanges, 100);
+  EXPECT_GT(reads[0], 0);
+  EXPECT_GT(reads[1], 0);
 }
 
 TEST(MapIo, ReadKeyImageDecodesTheKeyImagesReadMapChecked) {

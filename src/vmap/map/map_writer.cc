@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/core/image_file.h"
 #include "vmap/core/serial_worker.h"
 #include "vmap/map/map_io.h"
 
@@ -97,14 +98,8 @@ class MapWriter::KeyImageFiles {
  public:
   void Add(fs::path file, std::shared_ptr<const Frame> frame) {
     worker_.Post([file = std::move(file), frame = std::move(frame)] {
-      std::error_code copy_error;
-      const bool written = KeepsSourceFile(*frame) ? fs::copy_file(frame->source_path, file,
-                                                                   fs::copy_options::overwrite_existing, copy_error)
-                                                   : cv::imwrite(file.string(), ColorImage(*frame));
-      if (!written) {
-        throw InputError("cannot write key image '" + file.string() + "'" +
-                         (copy_error ? ": " + copy_error.message() : std::string()));
-      }
+      if (KeepsSourceFile(*frame)) return CopyImageFile(frame->source_path, file, "key image");
+      WriteImageFile(file, ColorImage(*frame), "key image");
     });
   }
 

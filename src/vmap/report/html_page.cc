@@ -10,6 +10,7 @@
 
 #include "vmap/core/error.h"
 #include "vmap/core/file_name_encoding.h"
+#include "vmap/core/image_file.h"
 #include "vmap/report/html_util.h"
 #include "vmap/report/report_assets.h"
 
@@ -133,9 +134,7 @@ std::string Numbered(int index) {
 }
 
 void WriteJpeg(const fs::path& file, const cv::Mat& image, int quality) {
-  if (!cv::imwrite(file.string(), image, {cv::IMWRITE_JPEG_QUALITY, quality})) {
-    throw InputError("cannot write '" + file.string() + "'; check that the map directory is writable");
-  }
+  WriteImageFile(file, image, "the report's image", {cv::IMWRITE_JPEG_QUALITY, quality});
 }
 
 cv::Mat ScaledToWidth(const cv::Mat& image, int width) {
