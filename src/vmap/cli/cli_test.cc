@@ -342,6 +342,12 @@ TEST(Cli, HelpListsCommandsAndFlagsUnderHeadings) {
     ASSERT_NE(found, std::string::npos) << text << " after position " << at << " in\n" << out;
     at = found;
   }
+  // A mistyped command is named, with the commands there are; a global flag before the command is no command.
+  ASSERT_EQ(RunVmap("-q buidl x.mp4", &out), 2) << out;
+  EXPECT_NE(out.find("vmap: error: 'buidl' is not a vmap command; the commands are build, localize, route"),
+            std::string::npos)
+      << out;
+  ASSERT_EQ(RunVmap("-q info --help", &out), 0) << out;
 }
 
 }  // namespace vmap

@@ -42,6 +42,21 @@ double ChildrenCpuSeconds() {
 
 // ---- 4. Every error is vmap's -------------------------------------------------------------------------------
 
+// A file name may hold an ESC or a carriage return: warnings and errors print it escaped, so that it can neither
+// drive the terminal nor overwrite the line that names it.
+TEST(Promises, ControlCharactersInFileNamesReachTheTerminalEscaped) {
+  testing::ScopedTempDir tmp;
+  WriteSyntheticInput(tmp.path() / "in", 8);
+  std::ofstream(tmp.path() / "in/frame_5\x1b[2J\r.png", std::ios::trunc) << "garbage";
+  std::string out;
+  ASSERT_EQ(RunVmap("build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "m"), &out), 0) << out;
+  EXPECT_NE(out.find("frame_5\\x1b[2J\\r.png"), std::string::npos) << out;
+  EXPECT_EQ(out.find_first_of("\x1b\r"), std::string::npos) << out;
+  ASSERT_EQ(RunVmap("info " + Quote(tmp.path() / "no\x1b]0;title\x07map"), &out), 2) << out;
+  EXPECT_NE(out.find("no\\x1b]0;title\\x07map"), std::string::npos) << out;
+  EXPECT_EQ(out.find_first_of("\x1b\x07"), std::string::npos) << out;
+}
+
 TEST(Promises, BadFramesAreSkippedWithAWarningAndCounted) {
   testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 10);

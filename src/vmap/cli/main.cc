@@ -5,6 +5,8 @@
 #include <initializer_list>
 #include <new>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -13,6 +15,7 @@
 #include "vmap/core/error.h"
 #include "vmap/core/logging.h"
 #include "vmap/core/runtime.h"
+#include "vmap/core/terminal_text.h"
 
 int main(int argc, char** argv) {
   // First, while this is the only thread: signal handling (an interrupted command removes its unfinished
@@ -50,13 +53,17 @@ int main(int argc, char** argv) {
   // Every failure ends as "vmap: error: ..." with status 2; 0 is success, --help and --version included.
   try {
     vmap::cli::RefuseEmptyArguments(argc, argv);
+    std::vector<std::string> commands;
+    for (const CLI::App* command : app.get_subcommands({})) commands.push_back(command->get_name());
+    vmap::cli::RefuseUnknownCommand(argc, argv, commands);
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);  // --help, --version
-    std::fprintf(stderr, "vmap: error: %s; see `vmap --help` or `vmap COMMAND --help`\n", e.what());
+    std::fprintf(stderr, "vmap: error: %s; see `vmap --help` or `vmap COMMAND --help`\n",
+                 vmap::TerminalSafe(e.what()).c_str());
     return 2;
   } catch (const vmap::InputError& e) {
-    std::fprintf(stderr, "vmap: error: %s\n", e.what());
+    std::fprintf(stderr, "vmap: error: %s\n", vmap::TerminalSafe(e.what()).c_str());
     return 2;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "vmap: error: out of memory; try a smaller input or smaller options (--resize)\n");
@@ -66,7 +73,8 @@ int main(int argc, char** argv) {
     return 2;
   } catch (const std::exception& e) {
     // A library error that no stage turned into vmap's: still an error message, and a bug to report.
-    std::fprintf(stderr, "vmap: error: %s (an unexpected error: please report it)\n", e.what());
+    std::fprintf(stderr, "vmap: error: %s (an unexpected error: please report it)\n",
+                 vmap::TerminalSafe(e.what()).c_str());
     return 2;
   }
   return 0;

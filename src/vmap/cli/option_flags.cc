@@ -1,5 +1,6 @@
 #include "vmap/cli/option_flags.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "vmap/core/option_names.h"
@@ -58,6 +59,18 @@ void RefuseEmptyArguments(int argc, const char* const* argv) {
       throw InputError(previous + " is empty; give it a value or leave it out");
     }
     throw InputError("argument " + std::to_string(i) + " is empty; give a path or leave it out");
+  }
+}
+
+void RefuseUnknownCommand(int argc, const char* const* argv, const std::vector<std::string>& commands) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string argument = argv[i];
+    if (argument == "--") return;
+    if (argument.empty() || argument[0] == '-') continue;
+    if (std::find(commands.begin(), commands.end(), argument) != commands.end()) return;
+    std::string list;
+    for (const std::string& command : commands) list += (list.empty() ? "" : ", ") + command;
+    throw InputError("'" + argument + "' is not a vmap command; the commands are " + list + " (see `vmap --help`)");
   }
 }
 

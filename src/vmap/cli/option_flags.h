@@ -19,6 +19,10 @@ namespace vmap::cli {
 // or as the default, and no option or path of vmap has an empty value. Checked once, for every command alike.
 void RefuseEmptyArguments(int argc, const char* const* argv);
 
+// Throws InputError naming the command when the first argument that is no flag is none of `commands` ("vmap
+// buidl"): CLI11 would say only that a subcommand is required. The global options before it are flags alone.
+void RefuseUnknownCommand(int argc, const char* const* argv, const std::vector<std::string>& commands);
+
 class OptionFlags {
  public:
   // `option` sets the field at `path` ("extraction_threads", "key_images.tau", "orb.num_features"), as the

@@ -143,8 +143,12 @@ void Run(const WeightsFlags& flags) {
     const FileFits fits = ModelsFittingFile(flags.import_file);
     const auto is_model = [&](const std::string& fit) { return fit.substr(0, fit.find(" (")) == flags.model; };
     if (std::none_of(fits.fits.begin(), fits.fits.end(), is_model)) {
-      throw InputError("'" + flags.import_file + "' does not fit --model " + flags.model +
-                       (fits.fits.empty() ? std::string(" (nor any other model") : " (it fits " + Join(fits.fits)) +
+      // Another model's file: which one is the answer; the other models' refusals would bury it.
+      if (!fits.fits.empty()) {
+        throw InputError("'" + flags.import_file + "' does not fit --model " + flags.model + " (it fits " +
+                         Join(fits.fits) + "); give --model as the file fits");
+      }
+      throw InputError("'" + flags.import_file + "' does not fit --model " + flags.model + " (nor any other model" +
                        (fits.refusals.empty() ? "" : "; " + Join(fits.refusals_by_model())) + ")");
     }
 #endif

@@ -104,7 +104,8 @@ TEST(AlikedCli, WeightsListsImportsAndVerifiesAlikedFiles) {
   // The wrong model's file is refused and nothing enters the cache.
   auto r = RunVmap("weights --import " + n16 + " --model aliked-t16", env);
   EXPECT_NE(r.status, 0) << r.output;
-  EXPECT_NE(r.output.find("it fits aliked-n16"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("(it fits aliked-n16); give --model as the file fits"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("XFeat"), std::string::npos) << "the other models' refusals bury the answer\n" << r.output;
   EXPECT_FALSE(fs::exists(cache.path() / "aliked-t16.pth"));
   r = RunVmap("weights --import " + t16 + " --model aliked-t16", env);
   ASSERT_EQ(r.status, 0) << r.output;
