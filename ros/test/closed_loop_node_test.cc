@@ -110,6 +110,20 @@ TEST(ClosedLoopNode, TheSimulatorRefusesOutputsOverItsInputsAndStopsOnASignal) {
   EXPECT_FALSE(fs::exists(map));
   EXPECT_EQ(testing::ReadText(dir.path() / "route.csv"), "x,y\n0,0\n6,0\n");
 
+  // A texture folder that holds no image is named as the node's parameter, not as `vmap simulate`'s flag.
+  const fs::path notes = dir.path() / "notes";
+  fs::create_directory(notes);
+  std::ofstream(notes / "notes.txt") << "not an image";
+  ChildProcess textured({SimulatorBinary().string(), "__ns:=/refused_textures", "__name:=simulator", "_route:=" + route,
+                         "_map:=" + map, "_teach_textures:=" + notes.string()},
+                        dir.path() / "textures.log");
+  EXPECT_EQ(textured.Wait(std::chrono::seconds(60)), 2) << textured.Log();
+  EXPECT_NE(textured.Log().find("~teach_textures '" + notes.string() + "': 'notes.txt' is not an image"),
+            std::string::npos)
+      << textured.Log();
+  EXPECT_EQ(textured.Log().find("--teach-textures"), std::string::npos) << textured.Log();
+  EXPECT_FALSE(fs::exists(map));
+
   // SIGINT in the teach run: out within seconds, status 130, no map.
   ChildProcess simulator({SimulatorBinary().string(), "__ns:=/interrupted", "__name:=simulator", "_route:=loop",
                           "_map:=" + map, "_result:=" + (dir.path() / "result.json").string()},

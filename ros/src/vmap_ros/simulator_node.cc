@@ -57,10 +57,10 @@ struct SimulatorParameters {
   SimulatorNodeOptions node;
 };
 
-SimulatorParameters ReadParameters(const ros::NodeHandle& private_node) {
+// `reader` names the parameters in the errors of what it read, here and later (a texture folder's).
+SimulatorParameters ReadParameters(const ros::NodeHandle& private_node, ParameterReader& reader) {
   SimulatorParameters parameters;
   SimulatePipelineOptions& pipeline = parameters.pipeline;
-  ParameterReader reader(private_node);
   try {
     // --map and --json are `vmap simulate`'s; the node's result is ~result.
     reader.Read(pipeline);
@@ -231,8 +231,9 @@ nlohmann::json TrialJson(const TrialResult& trial) {
 int RunTheSimulator(ros::NodeHandle& node, ros::NodeHandle& private_node) {
   SimulatorParameters parameters;
   std::unique_ptr<PreparedTrials> prepared;
+  ParameterReader reader(private_node);
   try {
-    parameters = ReadParameters(private_node);
+    parameters = ReadParameters(private_node, reader);
     const SimulatePipelineOptions& pipeline = parameters.pipeline;
     ROS_INFO("teaching route %s into %s", pipeline.simulation.route.c_str(), pipeline.map.c_str());
     prepared = PrepareTrials(pipeline.simulation, pipeline.matcher, pipeline.map, [] {
@@ -243,6 +244,9 @@ int RunTheSimulator(ros::NodeHandle& node, ros::NodeHandle& private_node) {
   } catch (const StopRequestedError&) {
     ROS_WARN("vmap simulator: stopped during the teach run; its map was not written");
     return StoppedStatus();
+  } catch (const InputError& error) {  // named as the parameters name it (~teach_textures)
+    ROS_ERROR("vmap simulator: %s", reader.Message(error).c_str());
+    return 2;
   } catch (const std::exception& error) {
     ROS_ERROR("vmap simulator: %s", error.what());
     return 2;

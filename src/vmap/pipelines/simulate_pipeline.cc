@@ -106,16 +106,13 @@ std::unique_ptr<PreparedTrials> PrepareTrials(const SimulationOptions& options, 
   matcher_options.Check();
   auto prepared = std::make_unique<PreparedTrials>();
   prepared->route = LoadSimulatedRoute(options);
-  if (options.teach_textures.empty() && !options.repeat_textures.empty()) {
-    throw InputError("--repeat-textures replaces the teach textures in another season; give --teach-textures too");
-  }
   const std::vector<cv::Mat> teach_images =
       options.teach_textures.empty()
           ? ProceduralTextures(TexturesToCover(prepared->route.corridor.length(), options.corridor), kTextureSeed)
-          : ReadTextureFolder(options.teach_textures, "--teach-textures");
+          : ReadTextureFolder(options.teach_textures, "teach_textures");
   const std::vector<cv::Mat> repeat_images = options.repeat_textures.empty()
                                                  ? std::vector<cv::Mat>{}
-                                                 : ReadTextureFolder(options.repeat_textures, "--repeat-textures");
+                                                 : ReadTextureFolder(options.repeat_textures, "repeat_textures");
 
   // 2. The worlds: the repeat world shows the repeat textures in the teach world's panels.
   prepared->teach_world.emplace(prepared->route.corridor, options.corridor, teach_images);

@@ -96,10 +96,10 @@ void CorridorOptions::VisitFields(OptionFieldVisitor& visitor) {
 
 void CorridorOptions::Check() const { CheckFieldRanges(*this); }
 
-std::vector<cv::Mat> ReadTextureFolder(const fs::path& directory, const std::string& what) {
+std::vector<cv::Mat> ReadTextureFolder(const fs::path& directory, const std::string& field) {
   std::error_code ec;
   if (!fs::is_directory(directory, ec)) {
-    throw InputError(fmt::format("{} '{}' is not a folder; give a folder of images", what, directory.string()));
+    throw OptionError(field, fmt::format("'{}' is not a folder; give a folder of images", directory.string()));
   }
   std::vector<std::string> names;
   for (const fs::directory_entry& entry : fs::directory_iterator(directory, ec)) {
@@ -108,11 +108,11 @@ std::vector<cv::Mat> ReadTextureFolder(const fs::path& directory, const std::str
     if (entry.is_directory(ec)) continue;
     names.push_back(name);
     if (static_cast<int>(names.size()) > kMaxTextures) {
-      throw InputError(fmt::format("{} '{}' holds more than {} files; give at most {} images", what, directory.string(),
-                                   kMaxTextures, kMaxTextures));
+      throw OptionError(field, fmt::format("'{}' holds more than {} files; give at most {} images", directory.string(),
+                                           kMaxTextures, kMaxTextures));
     }
   }
-  if (ec) throw InputError(fmt::format("cannot list {} '{}': {}", what, directory.string(), ec.message()));
+  if (ec) throw OptionError(field, fmt::format("'{}' cannot be listed: {}", directory.string(), ec.message()));
   std::sort(names.begin(), names.end(), NaturalLess);
   std::vector<cv::Mat> images;
   for (const std::string& name : names) {
@@ -120,14 +120,16 @@ std::vector<cv::Mat> ReadTextureFolder(const fs::path& directory, const std::str
     std::string why_not;
     std::optional<ContainedFile> file = ContainedFile::OpenRegular(path, &why_not);
     if (!file)
-      throw InputError(fmt::format("{}: '{}' {}; the folder must hold images only", what, path.string(), why_not));
+      throw OptionError(
+          field, fmt::format("'{}': '{}' {}; the folder must hold images only", directory.string(), name, why_not));
     if (const std::optional<cv::Size> size = ImageHeaderSize(*file);
         size && static_cast<long>(size->width) * size->height > kMaxTexturePixels) {
-      throw InputError(fmt::format("{}: '{}' announces {}x{} pixels, more than 64 megapixels; scale it down", what,
-                                   path.string(), size->width, size->height));
+      throw OptionError(field, fmt::format("'{}': '{}' announces {}x{} pixels, more than 64 megapixels; scale it down",
+                                           directory.string(), name, size->width, size->height));
     }
     std::string bytes;
-    if (!file->ReadAll(&bytes)) throw InputError(fmt::format("{}: cannot read '{}'", what, path.string()));
+    if (!file->ReadAll(&bytes))
+      throw OptionError(field, fmt::format("'{}': '{}' cannot be read", directory.string(), name));
     cv::Mat image;
     try {
       image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, bytes.data()), cv::IMREAD_COLOR);
@@ -135,9 +137,9 @@ std::vector<cv::Mat> ReadTextureFolder(const fs::path& directory, const std::str
       image.release();
     }
     if (image.empty() || image.cols < 16 || image.rows < 16) {
-      throw InputError(fmt::format(
-          "{}: '{}' is not an image OpenCV can decode (at least 16x16 pixels); the folder must hold images only", what,
-          path.string()));
+      throw OptionError(field, fmt::format("'{}': '{}' is not an image OpenCV can decode (at least 16x16 pixels); the "
+                                           "folder must hold images only",
+                                           directory.string(), name));
     }
     const int longer = std::max(image.cols, image.rows);
     if (longer > kMaxTextureSide) {
@@ -147,8 +149,8 @@ std::vector<cv::Mat> ReadTextureFolder(const fs::path& directory, const std::str
     images.push_back(image);
   }
   if (images.empty()) {
-    throw InputError(
-        fmt::format("{} '{}' holds no images; give a folder of photographs (png, jpg, ...)", what, directory.string()));
+    throw OptionError(
+        field, fmt::format("'{}' holds no images; give a folder of photographs (png, jpg, ...)", directory.string()));
   }
   return images;
 }

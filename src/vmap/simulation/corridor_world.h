@@ -30,11 +30,11 @@ struct CorridorOptions {
   void Check() const;  // throws OptionError naming the bad field
 };
 
-// The images of `directory` in natural order, for `what` ("--teach-textures") in messages. Every regular file
-// whose name does not start with '.' must be an image OpenCV decodes; larger ones are scaled to 2048 pixels on
-// their longer side. Throws InputError naming the file: a file that is not an image, a folder without images or
-// with more than 1000, an image of more than 64 megapixels.
-std::vector<cv::Mat> ReadTextureFolder(const std::filesystem::path& directory, const std::string& what);
+// The images of `directory`, the option `field` ("teach_textures"), in natural order. Every regular file whose
+// name does not start with '.' must be an image OpenCV decodes; larger ones are scaled to 2048 pixels on their
+// longer side. Throws an OptionError of `field` naming the file (so each front end names the option its way): a
+// file that is not an image, a folder without images or with more than 1000, an image of more than 64 megapixels.
+std::vector<cv::Mat> ReadTextureFolder(const std::filesystem::path& directory, const std::string& field);
 
 // `count` procedural textures (procedural_texture.h) drawn from `seed`: for worlds without photographs.
 std::vector<cv::Mat> ProceduralTextures(int count, unsigned seed);

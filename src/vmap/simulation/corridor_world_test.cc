@@ -37,19 +37,20 @@ TEST(CorridorWorld, TextureFoldersAreReadInNaturalOrderAndOnlyImagesAccepted) {
   cv::imwrite((temp.path() / "img10.png").string(), cv::Mat(20, 30, CV_8UC3, cv::Scalar(10, 10, 10)));
   cv::imwrite((temp.path() / "img2.png").string(), cv::Mat(20, 40, CV_8UC3, cv::Scalar(20, 20, 20)));
   std::ofstream(temp.path() / ".hidden") << "ignored";
-  const std::vector<cv::Mat> images = ReadTextureFolder(temp.path(), "--teach-textures");
+  const std::vector<cv::Mat> images = ReadTextureFolder(temp.path(), "teach_textures");
   ASSERT_EQ(images.size(), 2u);
   EXPECT_EQ(images[0].cols, 40);  // img2 first
   std::ofstream(temp.path() / "notes.txt") << "not an image";
   try {
-    ReadTextureFolder(temp.path(), "--teach-textures");
+    ReadTextureFolder(temp.path(), "teach_textures");
     FAIL() << "a text file was taken for a texture";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("notes.txt"), std::string::npos) << e.what();
+  } catch (const OptionError& e) {
+    EXPECT_EQ(e.path(), "teach_textures");  // each front end names the option its way
+    EXPECT_NE(e.problem().find("'notes.txt' is not an image"), std::string::npos) << e.what();
   }
   testing::ScopedTempDir empty("textures_empty");
-  EXPECT_THROW(ReadTextureFolder(empty.path(), "--teach-textures"), InputError);
-  EXPECT_THROW(ReadTextureFolder(empty.path() / "missing", "--teach-textures"), InputError);
+  EXPECT_THROW(ReadTextureFolder(empty.path(), "teach_textures"), InputError);
+  EXPECT_THROW(ReadTextureFolder(empty.path() / "missing", "teach_textures"), InputError);
 }
 
 }  // namespace

@@ -70,6 +70,10 @@ void SimulationOptions::Check() const {
   CheckField("noise", noise);
   CheckField("controller", controller);
   CheckField("localizer", localizer);
+  if (teach_textures.empty() && !repeat_textures.empty()) {
+    throw OptionError("repeat_textures", "replaces the teach textures in another season; give teach_textures too",
+                      {"teach_textures"});
+  }
   if (!(camera.mount_height < corridor.wall_height)) {
     throw OptionError("camera.mount_height",
                       fmt::format("{} m puts the camera above the {} m walls; lower it or raise --wall-height",
