@@ -166,6 +166,15 @@ TEST(KeyImageSearch, BisectMapStaysValidWhereSimilarityIsNotMonotone) {
       EXPECT_GE(link.similarity, 0.5);
     }
   }
+  // The map is the same whatever the number of threads: the frames probed are not chosen by it (they once were,
+  // and a dip was stepped over with one thread and found with two).
+  for (int threads : {1, 3, 8}) {
+    KnownSimilarityMatcher other_matcher(dipping);
+    MemorySource other_source(IndexFrames(60));
+    MapBuilderOptions options = Options(0.5, KeySearch::kBisect);
+    options.extraction_threads = threads;
+    EXPECT_EQ(KeyFrames(BuildMap(other_source, other_matcher, options)), KeyFrames(map)) << threads << " threads";
+  }
 }
 
 TEST(KeyImageSearch, OptionsAndDefaults) {

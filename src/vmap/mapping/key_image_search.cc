@@ -27,7 +27,11 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
   const VerifierOptions verifier = DecisionVerifier(options);
   const std::vector<double> taus =
       verifier.own_magsac ? std::vector<double>{options.key_images.tau} : std::vector<double>{};
-  const int workers = options.ExtractionThreads();
+  // Frames compared with the key per round, each on a thread of its own. Fixed, not the number of threads: which
+  // frames are probed decides which key images are found where S does not fall monotonically, and the map must be
+  // the same whatever --threads is (it was not: 6 key images with one thread, 7 with two, on lab_floor's 300 frames).
+  // Two is what this project's 2-core machine ran before, so its bisect maps are unchanged.
+  constexpr int kProbes = 2;
   const int window = options.search_window;
 
   std::map<int, FrameRecord> frames;  // frames read that the search may still need, by index
@@ -121,13 +125,13 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
     for (;;) {
       const FrameRecord key = *selector.current_key();
       frames.erase(frames.begin(), frames.lower_bound(last_pass));  // the selector holds the key itself
-      // Gallop: offsets step .. 2^(workers - 1) step, at most `window` ahead.
+      // Gallop: offsets step .. 2^(kProbes - 1) step, at most `window` ahead.
       int first_fail = -1;
       while (first_fail < 0 && read_until(last_pass + 1) > last_pass) {
-        const int reach = std::min(window, step << std::min(workers - 1, 20));
+        const int reach = std::min(window, step << std::min(kProbes - 1, 20));
         std::vector<int> positions;
-        for (int i = 1; i <= workers; ++i) {
-          const int position = read_until(last_pass + std::max(1, reach * i / workers));
+        for (int i = 1; i <= kProbes; ++i) {
+          const int position = read_until(last_pass + std::max(1, reach * i / kProbes));
           if (positions.empty() || position > positions.back()) positions.push_back(position);
         }
         first_fail = probe(key, positions, &last_pass);
@@ -137,11 +141,11 @@ VisualMap SearchKeyImages(FrameSource& source, const Matcher& matcher, const Map
         if (last_pass > fed) selector.Add(frames.at(last_pass), compare_cached);
         break;
       }
-      // Bisect: the frames between the last passing and the first failing frame, split into workers + 1 parts.
+      // Bisect: the frames between the last passing and the first failing frame, split into kProbes + 1 parts.
       while (first_fail - last_pass > 1) {
         std::vector<int> positions;
-        for (int i = 1; i <= workers; ++i) {
-          const int position = last_pass + (first_fail - last_pass) * i / (workers + 1);
+        for (int i = 1; i <= kProbes; ++i) {
+          const int position = last_pass + (first_fail - last_pass) * i / (kProbes + 1);
           if (position > last_pass && position < first_fail && (positions.empty() || position > positions.back())) {
             positions.push_back(position);
           }
