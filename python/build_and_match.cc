@@ -18,6 +18,7 @@
 
 #include "argument_errors.h"
 #include "bindings.h"
+#include "gil_release.h"
 #include "keyword_options.h"
 #include "map_objects.h"
 #include "numpy_convert.h"
@@ -43,7 +44,7 @@ std::shared_ptr<MapHandle> BuildMapFunction(const py::object& input, const py::o
   // Ctrl-C between frames: KeyboardInterrupt, and the output left as it was.
   options.map.after_frame = RaisePendingSignals;
   keywords.Run([&] {
-    py::gil_scoped_release release;
+    GilRelease release;
     RunBuildPipeline(options);
   });
   return ReadMapHandle(options.output);
@@ -57,7 +58,7 @@ class PairMatcher {
     keywords.Add(options_);
     keywords.Parse(kwargs);
     keywords.Run([&] {
-      py::gil_scoped_release release;
+      GilRelease release;
       options_.Check();
       matcher_ = CreateMatcher(options_.matcher);
     });
@@ -67,7 +68,7 @@ class PairMatcher {
     const ImageInput input0 = ImageView(image0, "image0"), input1 = ImageView(image1, "image1");
     PairMatch pair;
     {
-      py::gil_scoped_release release;
+      GilRelease release;
       const Frame frame0 = FrameFromImage(input0.image, 0, {}, "image0");
       const Frame frame1 = FrameFromImage(input1.image, 1, {}, "image1");
       pair = MatchPair(*matcher_, {frame0.gray, frame0.color}, {frame1.gray, frame1.color}, options_.verifier,

@@ -17,6 +17,7 @@
 
 #include "argument_errors.h"
 #include "bindings.h"
+#include "gil_release.h"
 #include "keyword_options.h"
 #include "map_objects.h"
 #include "numpy_convert.h"
@@ -80,7 +81,7 @@ class FrameLocalizer {
     keywords.Parse(kwargs);
     options.map = MapDirectory(map).string();
     keywords.Run([&] {
-      py::gil_scoped_release release;
+      GilRelease release;
       options.session.CheckGiven(keywords.Given());
       session_ = std::make_unique<LocalizationSession>(options);
     });
@@ -99,7 +100,7 @@ class FrameLocalizer {
       // Python threads may share one Localizer: its frames are one run, so they take turns (the session is not
       // thread-safe: two frames at once deadlocked in its speculative comparisons). The GIL is released first, so
       // that the thread waiting here holds nothing the one localizing needs.
-      py::gil_scoped_release release;
+      GilRelease release;
       const std::lock_guard<std::mutex> lock(mutex_);
       result = session_->Localize(input.image, seconds, pose);
     }
@@ -107,7 +108,7 @@ class FrameLocalizer {
   }
 
   void Reset() {
-    py::gil_scoped_release release;
+    GilRelease release;
     const std::lock_guard<std::mutex> lock(mutex_);
     session_->Reset();
   }
@@ -130,7 +131,7 @@ py::list LocalizeFunction(const py::object& map, const py::object& query, const 
   options.query = TextArgument(query, "localize(): input");
   LocalizePipelineResult run;
   keywords.Run([&] {
-    py::gil_scoped_release release;
+    GilRelease release;
     options.session.CheckGiven(keywords.Given());
     run = RunLocalizePipeline(options, [](const Frame&, const LocalizationResult&) { RaisePendingSignals(); });
   });

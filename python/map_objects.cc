@@ -16,6 +16,7 @@
 
 #include "argument_errors.h"
 #include "bindings.h"
+#include "gil_release.h"
 #include "numpy_convert.h"
 
 namespace py = pybind11;
@@ -59,11 +60,23 @@ py::array_t<bool> InlierMask(const Link& link) {
 }
 
 cv::Mat ReadKeyImageWithoutGil(const KeyImageRef& ref, bool grayscale) {
-  py::gil_scoped_release release;
+  GilRelease release;
+  ref.handle->CheckUnchanged();
   return ReadKeyImage(ref.handle->directory, ref.key(), grayscale, ref.handle->map.input.frame_size);
 }
 
 }  // namespace
+
+void MapHandle::CheckUnchanged() const {
+  // The folder by its inode (a Localizer adds its cache to it); map.json by its time too.
+  if (SameFile(IdentityOf(directory), folder_identity) && IdentityOf(directory / kMapFileName) == map_json_identity) {
+    return;
+  }
+  throw InputError(
+      fmt::format("the map '{}' was replaced or removed since vmap.read_map read it; read it again "
+                  "with vmap.read_map",
+                  directory.string()));
+}
 
 std::shared_ptr<MapHandle> ReadMapHandle(const std::filesystem::path& directory) {
   auto handle = std::make_shared<MapHandle>();
@@ -71,15 +84,23 @@ std::shared_ptr<MapHandle> ReadMapHandle(const std::filesystem::path& directory)
   std::error_code ec;
   handle->directory = std::filesystem::absolute(directory, ec);
   if (ec) handle->directory = directory;
-  py::gil_scoped_release release;
+  GilRelease release;
+  handle->folder_identity = IdentityOf(handle->directory);
+  handle->map_json_identity = IdentityOf(handle->directory / kMapFileName);
   RecordedMap read = ReadRecordedMap(directory);
   handle->map = std::move(read.map);
   handle->options = std::move(read.options);
+  // A map built into the folder while it was read: what was read may mix the two.
+  handle->CheckUnchanged();
   return handle;
 }
 
 std::filesystem::path MapDirectory(const py::object& map_or_path) {
-  if (py::isinstance<MapHandle>(map_or_path)) return map_or_path.cast<const MapHandle&>().directory;
+  if (py::isinstance<MapHandle>(map_or_path)) {
+    const MapHandle& handle = map_or_path.cast<const MapHandle&>();
+    handle.CheckUnchanged();  // a Localizer of a Map reads the folder again: it must be the map the Map shows
+    return handle.directory;
+  }
   return std::filesystem::path(TextArgument(map_or_path, "map"));
 }
 

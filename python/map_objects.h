@@ -4,10 +4,12 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "vmap/core/file_identity.h"
 #include "vmap/map/visual_map.h"
 #include "vmap/mapping/recorded_options.h"
 
@@ -17,6 +19,13 @@ struct MapHandle {
   std::filesystem::path directory;
   VisualMap map;
   RecordedOptions options;  // what the map records of the options that shaped it, typed
+  // The folder's and its map.json's identities when it was read. vmap replaces a map's folder whole (a rename), so
+  // another folder at the path is another map, whose key images do not belong to these links; map.json's time
+  // tells a copy that took the inode of a removed folder.
+  std::optional<FileIdentity> folder_identity, map_json_identity;
+
+  // Throws InputError when the folder at `directory` is no longer the one read (a map built into it since).
+  void CheckUnchanged() const;
 };
 
 // Reads the map in `directory` (the GIL released meanwhile).

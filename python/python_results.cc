@@ -1,5 +1,7 @@
 #include "python_results.h"
 
+#include "gil_release.h"
+
 namespace py = pybind11;
 
 namespace vmap::python {
@@ -35,7 +37,32 @@ py::object JsonToPython(const nlohmann::json& value) {
 
 py::object Namespace(const py::dict& fields) { return py::module_::import("types").attr("SimpleNamespace")(**fields); }
 
+namespace {
+
+// Python's main thread, the only one that runs signal handlers: known at import (threading.main_thread()).
+unsigned long MainThread() {
+  static const unsigned long main_thread = [] {
+    py::gil_scoped_acquire acquire;
+    return py::module_::import("threading").attr("main_thread")().attr("ident").cast<unsigned long>();
+  }();
+  return main_thread;
+}
+
+}  // namespace
+
+void RememberMainThread() { MainThread(); }
+
 void RaisePendingSignals() {
+  if (PythonIsExiting()) {
+    // SystemExit, which a thread ends with silently. The GIL is free to take: the exit waits for the calls in C++
+    // (gil_release.h) before the interpreter is finalized.
+    py::gil_scoped_acquire acquire;
+    PyErr_SetNone(PyExc_SystemExit);
+    throw py::error_already_set();
+  }
+  // Another thread has no signal to raise, and takes no GIL here: while the interpreter exits, a daemon thread
+  // taking it from here was ended by CPython in a way that aborted the process.
+  if (PyThread_get_thread_ident() != MainThread()) return;
   py::gil_scoped_acquire acquire;
   if (PyErr_CheckSignals() != 0) throw py::error_already_set();
 }

@@ -18,4 +18,7 @@ pybind11::object Namespace(const pybind11::dict& fields);
 // work that polls it between frames. Called without the GIL, on the thread that runs Python's signal handlers.
 void RaisePendingSignals();
 
+// Notes Python's main thread for RaisePendingSignals; called once, at import, with the GIL held.
+void RememberMainThread();
+
 }  // namespace vmap::python

@@ -8,6 +8,7 @@
 #include "vmap/simulation/simulation_output.h"
 
 #include "bindings.h"
+#include "gil_release.h"
 #include "keyword_options.h"
 #include "python_results.h"
 
@@ -26,7 +27,7 @@ py::object SimulateFunction(const py::kwargs& kwargs) {
   options.after_frame = RaisePendingSignals;
   nlohmann::json record;
   keywords.Run([&] {
-    py::gil_scoped_release release;
+    GilRelease release;
     const SimulatePipelineResult result = RunSimulatePipeline(options);
     record = SimulationJson(result.simulation, options.simulation);
   });

@@ -14,6 +14,8 @@
 
 #include "argument_errors.h"
 #include "bindings.h"
+#include "gil_release.h"
+#include "python_results.h"
 
 namespace py = pybind11;
 
@@ -37,6 +39,9 @@ PYBIND11_MODULE(vmap, m) {
       PyErr_SetString(error.ptr(), e.what());
     }
   });
+
+  vmap::python::RememberMainThread();
+  vmap::python::StopCallsWhenPythonExits();
 
   // vmap's log (spdlog's "vmap" logger) to stderr at info, as the CLI; vmap.set_log_level changes it.
   vmap::ConfigureLogging("info");

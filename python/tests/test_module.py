@@ -90,6 +90,20 @@ def test_a_key_image_replaced_after_read_map_is_refused_not_decoded(maps, tmp_pa
     with pytest.raises(vmap.Error, match="is 32000x32000"):
         m.key_images[0].image
     assert m.key_images[1].gray.shape == (height, width)
+    # The whole folder replaced, as vmap builds a map into it: even key images of the same size are not this Map's.
+    copy.rename(tmp_path / "old_map")
+    shutil.copytree(cli_dir, copy)
+    with pytest.raises(vmap.Error, match="was replaced or removed since vmap.read_map read it"):
+        m.key_images[1].gray
+    with pytest.raises(vmap.Error, match="was replaced or removed"):
+        vmap.Localizer(m)
+    assert vmap.read_map(copy).key_images[1].gray.shape == (height, width)
+    # Removed, and another map copied there: the new folder may take the old one's inode, not its map.json's time.
+    m = vmap.read_map(copy)
+    shutil.rmtree(copy)
+    shutil.copytree(maps[1], copy)
+    with pytest.raises(vmap.Error, match="was replaced or removed"):
+        m.key_images[1].gray
 
 
 def test_read_map_gives_the_map_json_as_numpy(maps):
@@ -287,6 +301,33 @@ def test_ctrl_c_interrupts_a_build(tmp_path):
     assert child.returncode == 0 and out.strip() == "interrupted"
     assert not output.exists()
     assert not [p.name for p in tmp_path.iterdir()]  # no temporary left behind either
+
+
+def test_the_interpreter_exits_cleanly_while_daemon_threads_are_in_vmap(maps, tmp_path):
+    """Daemon threads (a GUI's, a rospy node's workers) inside vmap calls when the program ends: the calls stop at
+    their next frame, and the program exits with its own status and without a word, not "Aborted" or a
+    segmentation fault, and leaves no temporary output behind."""
+    script = (
+        "import threading, time, numpy as np, vmap\n"
+        "vmap.set_log_level('quiet')\n"
+        "rng = np.random.default_rng(0)\n"
+        "a = rng.integers(0, 255, (240, 320), dtype=np.uint8)\n"
+        "def matching():\n"
+        "    m = vmap.Matcher()\n"
+        "    while True:\n"
+        "        m.match(a, a)\n"
+        f"def building():\n    vmap.build_map({str(VIDEO)!r}, {str(tmp_path / 'map')!r})\n"
+        f"def localizing():\n    vmap.localize({str(maps[0])!r}, {str(VIDEO)!r})\n"
+        "for work in (matching, building, localizing):\n"
+        "    threading.Thread(target=work, daemon=True).start()\n"
+        "time.sleep(3)\n"
+        "print('main thread ends', flush=True)\n")
+    for attempt in range(2):
+        done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=os.environ,
+                              timeout=120)
+        assert done.returncode == 0 and done.stdout.strip() == "main thread ends", done.stderr
+        assert done.stderr == ""
+        assert not [p.name for p in tmp_path.iterdir()]
 
 
 def test_ctrl_c_interrupts_a_simulation(tmp_path):

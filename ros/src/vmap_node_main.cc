@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "vmap", ros::init_options::NoSigintHandler);
   vmap::ros_node::LogThroughRosconsole();
   vmap::ros_node::StopOnSignals();
+  if (!vmap::ros_node::WaitForMaster()) return 128 + vmap::ros_node::StopSignal();
   ros::NodeHandle node;
   ros::NodeHandle private_node("~");
   vmap::ros_node::VmapNode vmap_node(node, private_node);

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "vmap_simulator", ros::init_options::NoSigintHandler);
   vmap::ros_node::LogThroughRosconsole();
   vmap::ros_node::StopOnSignals();
+  if (!vmap::ros_node::WaitForMaster()) return 128 + vmap::ros_node::StopSignal();
   ros::NodeHandle node;
   ros::NodeHandle private_node("~");
   const int status = vmap::ros_node::RunSimulatorNode(node, private_node);

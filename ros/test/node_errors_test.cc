@@ -2,6 +2,7 @@
 // services called in the wrong state. Each gets a clear answer or log line; the node keeps running, and nothing
 // on disk is lost.
 
+#include <csignal>
 #include <fstream>
 #include <mutex>
 #include <thread>
@@ -49,6 +50,25 @@ sensor_msgs::Image GreyImage(int width, int height, double stamp) {
   image.step = width;
   image.data.assign(static_cast<size_t>(width) * height, 128);
   return image;
+}
+
+// Started before its master, a node waits for it, says where it looks, and still stops on SIGINT or SIGTERM with a
+// shell's status (roscpp would retry the master for ever, and the nodes' own handlers only set a flag).
+TEST(NodeErrors, ANodeWaitingForItsMasterStopsOnASignal) {
+  ScopedTempDir dir("ros_no_master");
+  const std::vector<std::pair<fs::path, int>> cases = {{VmapNodeBinary(), SIGTERM}, {SimulatorBinary(), SIGINT}};
+  for (const auto& [binary, signal] : cases) {
+    ChildProcess node({binary.string(), "__master:=http://127.0.0.1:9", "__name:=waiting"},
+                      dir.path() / (binary.filename().string() + ".log"));
+    // No master here: WaitFor, which spins this test's own node, is of no use.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (node.Log().find("waiting for the ROS master at http://127.0.0.1:9") == std::string::npos &&
+           std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    ASSERT_NE(node.Log().find("waiting for the ROS master at http://127.0.0.1:9"), std::string::npos) << node.Log();
+    EXPECT_EQ(node.Stop(std::chrono::seconds(5), signal), 128 + signal) << node.Log();
+  }
 }
 
 TEST(NodeErrors, BadMessagesMapsAndCallsAreAnsweredAndTheNodeRunsOn) {

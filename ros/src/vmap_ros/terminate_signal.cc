@@ -27,4 +27,13 @@ void WaitForStop() {
   while (!StopRequested()) ros::WallDuration(0.05).sleep();
 }
 
+bool WaitForMaster() {
+  for (int tries = 0; stop_signal == 0 && !ros::master::check(); ++tries) {
+    if (tries % 200 == 0)
+      ROS_WARN("waiting for the ROS master at %s (is roscore running?)", ros::master::getURI().c_str());
+    ros::WallDuration(0.05).sleep();
+  }
+  return stop_signal == 0;
+}
+
 }  // namespace vmap::ros_node

@@ -14,5 +14,9 @@ int StopSignal();
 bool StopRequested();
 // Sleeps until StopRequested().
 void WaitForStop();
+// Waits until the ROS master answers, saying where it looks every 10 s; false when a signal asks to stop first.
+// Call before the first NodeHandle: roscpp would otherwise retry the master for ever, and the handlers above only
+// set a flag, so a node started before roscore was deaf to SIGINT and SIGTERM.
+bool WaitForMaster();
 
 }  // namespace vmap::ros_node
