@@ -160,7 +160,7 @@ TEST(GroundTruth, LinesThatAreNoPoseAreRefusedNamingTheLine) {
   EXPECT_EQ(ReadGroundTruth((tmp.path() / "printed.txt").string()).camera_to_world.size(), 2u);
 }
 
-TEST(GroundTruth, KeyImagesTakeTheirPoseBySourceIndexOrByNearestTimestamp) {
+TEST(GroundTruth, KeyImagesTakeTheirPoseByFrameNumberOrByNearestTimestamp) {
   GroundTruth kitti;
   kitti.format = GroundTruthFormat::kKitti;
   for (int i = 0; i < 5; ++i) {
@@ -170,6 +170,15 @@ TEST(GroundTruth, KeyImagesTakeTheirPoseBySourceIndexOrByNearestTimestamp) {
   }
   EXPECT_EQ(Translation(*KeyImagePose(kitti, Key(3, -1), 0.02))[2], 3.0);
   EXPECT_FALSE(KeyImagePose(kitti, Key(5, -1), 0.02));
+  // A KITTI image's file number wins over its position in the listing, which images missing from the
+  // sequence shift (000004.png read as the fourth image is still frame 4).
+  KeyImage numbered = Key(3, -1);
+  numbered.source_name = "000004.png";
+  EXPECT_EQ(Translation(*KeyImagePose(kitti, numbered, 0.02))[2], 4.0);
+  numbered.source_name = "000005.png";
+  EXPECT_FALSE(KeyImagePose(kitti, numbered, 0.02));
+  numbered.source_name = "left_4.png";  // no number: by position
+  EXPECT_EQ(Translation(*KeyImagePose(kitti, numbered, 0.02))[2], 3.0);
 
   GroundTruth tum = kitti;
   tum.format = GroundTruthFormat::kTum;
