@@ -23,6 +23,7 @@ packages=(
 )
 ros_packages=(
   ros-core                      # rosmaster, rosout, rostopic, roslaunch, rosbag play and record
+  rosbash                       # rosrun (docs/ros.md runs the simulator node and the node with it)
   libroscpp-dev libtopic-tools-dev libcv-bridge-dev  # the node: roscpp, any image type (ShapeShifter), the debug image
   libsensor-msgs-dev libgeometry-msgs-dev libnav-msgs-dev libstd-msgs-dev libstd-srvs-dev  # message headers
   ros-sensor-msgs ros-geometry-msgs ros-nav-msgs ros-std-msgs ros-std-srvs  # their .msg files (genmsg, rostopic)
