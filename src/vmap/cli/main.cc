@@ -6,9 +6,11 @@
 #include <new>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <opencv2/core.hpp>
 
 #include "vmap/cli/commands.h"
 #include "vmap/cli/option_flags.h"
@@ -20,7 +22,12 @@
 int main(int argc, char** argv) {
   // First, while this is the only thread: signal handling (an interrupted command removes its unfinished
   // outputs and exits with 128 + the signal), OpenCV's threads, malloc, FFmpeg's log (see runtime.h).
-  vmap::InitializeRuntime();
+  try {
+    vmap::InitializeRuntime();
+  } catch (const std::exception& e) {  // a thread that cannot start (the process limit reached)
+    std::fprintf(stderr, "vmap: error: %s\n", vmap::cli::ThreadErrorMessage(e).c_str());
+    return 2;
+  }
   CLI::App app{"vmap: visual maps for vision-only robot navigation (key images linked by fundamental matrices)",
                "vmap"};
   app.set_version_flag("--version", std::string("vmap ") + VMAP_VERSION);
@@ -70,6 +77,22 @@ int main(int argc, char** argv) {
     return 2;
   } catch (const std::length_error&) {  // a size no allocation could take: out of memory all the same
     std::fprintf(stderr, "vmap: error: out of memory; try a smaller input or smaller options (--resize)\n");
+    return 2;
+  } catch (const cv::Exception& e) {
+    if (e.code == cv::Error::StsNoMem) {  // OpenCV's own allocator failed ("Insufficient memory")
+      std::fprintf(stderr, "vmap: error: out of memory; try a smaller input or smaller options (--resize)\n");
+    } else {
+      std::fprintf(stderr, "vmap: error: %s (an unexpected error: please report it)\n",
+                   vmap::TerminalSafe(vmap::LibraryMessage(e)).c_str());
+    }
+    return 2;
+  } catch (const std::system_error& e) {
+    if (e.code() != std::errc::resource_unavailable_try_again) {
+      std::fprintf(stderr, "vmap: error: %s (an unexpected error: please report it)\n",
+                   vmap::TerminalSafe(e.what()).c_str());
+    } else {
+      std::fprintf(stderr, "vmap: error: %s\n", vmap::cli::ThreadErrorMessage(e).c_str());
+    }
     return 2;
   } catch (const std::exception& e) {
     // A library error that no stage turned into vmap's: still an error message, and a bug to report.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <system_error>
 
 #include "vmap/core/option_names.h"
 
@@ -72,6 +73,14 @@ void RefuseUnknownCommand(int argc, const char* const* argv, const std::vector<s
     for (const std::string& command : commands) list += (list.empty() ? "" : ", ") + command;
     throw InputError("'" + argument + "' is not a vmap command; the commands are " + list + " (see `vmap --help`)");
   }
+}
+
+std::string ThreadErrorMessage(const std::exception& error) {
+  const auto* system = dynamic_cast<const std::system_error*>(&error);
+  if (system == nullptr || system->code() != std::errc::resource_unavailable_try_again) return error.what();
+  return "cannot start a thread (" + system->code().message() +
+         "): this user's limit of processes and threads is reached (ulimit -u); use fewer --threads, or raise the "
+         "limit";
 }
 
 }  // namespace vmap::cli

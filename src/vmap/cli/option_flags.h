@@ -23,6 +23,10 @@ void RefuseEmptyArguments(int argc, const char* const* argv);
 // buidl"): CLI11 would say only that a subcommand is required. The global options before it are flags alone.
 void RefuseUnknownCommand(int argc, const char* const* argv, const std::vector<std::string>& commands);
 
+// The message of a thread that could not start (std::system_error, "Resource temporarily unavailable"): this
+// user's process limit is reached. Other errors' own text.
+std::string ThreadErrorMessage(const std::exception& error);
+
 class OptionFlags {
  public:
   // `option` sets the field at `path` ("extraction_threads", "key_images.tau", "orb.num_features"), as the

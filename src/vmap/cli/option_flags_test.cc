@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <system_error>
 
 #include <gtest/gtest.h>
 
@@ -122,6 +123,18 @@ TEST(OptionFlags, TheSimulatorTakesTheLocalizersFlags) {
   EXPECT_EQ(localizer.scene_change_log10_nfa, -40.0);
   EXPECT_EQ(localizer.scene_change_tracked_log10_nfa, -500.0);
   EXPECT_EQ(localizer.relocalization_candidates, 7);
+}
+
+// A thread that cannot start (this user's process limit reached) is said as such, with what to do; any other
+// error keeps its own text.
+TEST(OptionFlags, AThreadThatCannotStartIsNamedWithTheLimit) {
+  const std::system_error no_thread(std::make_error_code(std::errc::resource_unavailable_try_again));
+  const std::string message = ThreadErrorMessage(no_thread);
+  EXPECT_EQ(message.rfind("cannot start a thread (Resource temporarily unavailable)", 0), 0u) << message;
+  EXPECT_NE(message.find("(ulimit -u); use fewer --threads"), std::string::npos) << message;
+  EXPECT_EQ(ThreadErrorMessage(std::runtime_error("other")), "other");
+  EXPECT_EQ(ThreadErrorMessage(std::system_error(std::make_error_code(std::errc::permission_denied), "x")),
+            std::system_error(std::make_error_code(std::errc::permission_denied), "x").what());
 }
 
 }  // namespace

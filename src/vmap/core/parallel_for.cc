@@ -24,7 +24,13 @@ void ParallelFor(size_t count, int threads, const std::function<void(size_t)>& j
   };
   const size_t helpers = std::min<size_t>(static_cast<size_t>(std::max(threads, 1)), std::max<size_t>(count, 1)) - 1;
   std::vector<std::thread> workers;
-  for (size_t k = 0; k < helpers; ++k) workers.emplace_back(run);
+  try {
+    for (size_t k = 0; k < helpers; ++k) workers.emplace_back(run);
+  } catch (...) {  // a thread that cannot start (the process limit): the ones started end before the error goes on
+    next = count;
+    for (std::thread& worker : workers) worker.join();
+    throw;
+  }
   run();
   for (std::thread& worker : workers) worker.join();
   if (error) std::rethrow_exception(error);

@@ -18,6 +18,7 @@
 #include "vmap/geometry/relative_pose.h"
 #include "vmap/mapping/batch_build.h"
 #include "vmap/report/evaluation_summary.h"
+#include "vmap/sources/kitti_frame_number.h"
 #include "vmap/testing/option_error.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"
@@ -176,9 +177,15 @@ TEST(MapEvaluation, FirstAndStrideTieKeyImagesToTheirSourceIndex) {
   EXPECT_EQ(map.key_images[1].source_index, 3 + 2 * map.key_images[1].frame_index);
   const MapEvaluation right = EvaluateMap(map, Kitti().truth, *map.input.camera, EvaluationOptions());
   ExpectAllUsable(right);
-  // Tied by frame index instead, the true motion would be half the real one: the rotations no longer agree.
+  // Tied by frame index instead, the true motion would be half the real one: the rotations no longer agree. (A
+  // KITTI key image is tied by the number of its file, which is its source index here; without a number in the
+  // name, by its source index.)
   VisualMap by_frame = map;
-  for (KeyImage& key : by_frame.key_images) key.source_index = key.frame_index;
+  for (KeyImage& key : by_frame.key_images) {
+    EXPECT_EQ(KittiFrameNumber(key.source_name), key.source_index) << key.source_name;
+    key.source_name = "frame.png";
+    key.source_index = key.frame_index;
+  }
   const MapEvaluation wrong = EvaluateMap(by_frame, Kitti().truth, *map.input.camera, EvaluationOptions());
   EXPECT_GT(wrong.summary.rotation_error_deg_median, 4 * right.summary.rotation_error_deg_median);
   EXPECT_GT(wrong.summary.rotation_error_deg_median, 1.0);

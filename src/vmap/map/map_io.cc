@@ -30,6 +30,14 @@ using nlohmann::json;
 
 namespace {
 
+// What to do about a map file that is there but cannot be opened, by the reason the system gave.
+std::string CannotOpenHint(const std::string& why_not) {
+  if (why_not.find("Too many open files") != std::string::npos) {
+    return "; this process may open no more files: raise the limit (ulimit -n)";
+  }
+  return "; check that this user may read it (its permissions and its folder's)";
+}
+
 // A key image's size from its header: PNG, or JPEG (a key image copied from the input's own file).
 std::optional<cv::Size> KeyImageSize(const ContainedFile& file) { return ImageHeaderSize(file); }
 }  // namespace
@@ -83,8 +91,7 @@ ContainedFile OpenMapFile(const fs::path& directory, const std::string& relative
   }
   // The file is there and may be fine: what is in the way is this user's access to it, not the map.
   if (why_not.rfind("cannot be opened", 0) == 0) {
-    throw InputError("map '" + directory.string() + "': '" + path.string() + "' " + why_not +
-                     "; check that this user may read it (its permissions and its folder's)");
+    throw InputError("map '" + directory.string() + "': '" + path.string() + "' " + why_not + CannotOpenHint(why_not));
   }
   Malformed(reported, named + " " + why_not);
 }
@@ -358,8 +365,7 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
   const ContainedJson parsed = ReadContainedJson(directory, kMapFileName, kMaxMapJsonBytes, kMaxMapJsonValues);
   if (parsed.missing) throw InputError("'" + directory.string() + "' is not a map: " + file.string() + " is missing");
   if (parsed.why_not.find(" cannot be opened") != std::string::npos) {
-    throw InputError("map '" + directory.string() + "': " + parsed.why_not +
-                     "; check that this user may read it (its permissions and its folder's)");
+    throw InputError("map '" + directory.string() + "': " + parsed.why_not + CannotOpenHint(parsed.why_not));
   }
   if (!parsed.document) Malformed(file, parsed.why_not);
   const json& doc = *parsed.document;
