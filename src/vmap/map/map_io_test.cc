@@ -48,27 +48,36 @@ TEST(MapIo, RoundTripKeepsEverything) {
   EXPECT_EQ(fs::file_size(tmp.path() / kCorrespondencesFileName), 6u * 16u);
 }
 
-// A run writing snapshots replaces the map's folder whole (a rename exchange) while readers read it: each read gets
-// one map or the other, whole, never a mix (whose files disagree: it used to be called malformed).
+// A run writing snapshots replaces the map's folder whole (a rename exchange with a new folder) while readers read
+// it: each read gets one snapshot or the next, whole, never a mix (whose files disagree: it used to be called
+// malformed). As the writer does, every snapshot is a new folder; they alternate between two maps.
 TEST(MapIo, AReaderOfAMapReplacedWhileItReadsGetsOneMapOrTheOther) {
   testing::ScopedTempDir tmp;
-  const fs::path read_here = tmp.path() / "map", other = tmp.path() / "next";
-  WriteMapFiles(SmallMap(read_here), read_here);
-  VisualMap longer = SmallMap(other);
-  for (Link& link : longer.links) link.correspondences.insert(link.correspondences.end(), 3, {{1, 2}, {3, 4}});
-  WriteMapFiles(longer, other);
+  const fs::path read_here = tmp.path() / "map";
+  const auto write_snapshot = [](const fs::path& folder, bool longer) {
+    VisualMap map = SmallMap(folder);
+    if (longer) {
+      for (Link& link : map.links) link.correspondences.insert(link.correspondences.end(), 3, {{1, 2}, {3, 4}});
+    }
+    WriteMapFiles(map, folder);
+  };
+  write_snapshot(read_here, false);
   std::atomic<bool> done{false};
-  std::atomic<int> exchanges{0};
-  std::thread snapshots([&] {
-    while (!done) {
-      ASSERT_EQ(renameat2(AT_FDCWD, read_here.c_str(), AT_FDCWD, other.c_str(), RENAME_EXCHANGE), 0);
-      ++exchanges;
-      std::this_thread::sleep_for(std::chrono::microseconds(500));
+  std::atomic<int> snapshots{0};
+  std::thread writer([&] {
+    for (int k = 1; !done && k < 5000; ++k) {
+      const fs::path next = tmp.path() / ("snapshot" + std::to_string(k));
+      write_snapshot(next, k % 2 == 1);
+      ASSERT_EQ(renameat2(AT_FDCWD, next.c_str(), AT_FDCWD, read_here.c_str(), RENAME_EXCHANGE), 0);
+      ++snapshots;
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
   });
   int reads[2] = {0, 0};
   std::string failure;
-  for (int i = 0; i < 400 && failure.empty(); ++i) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (failure.empty() && (snapshots < 50 || reads[0] + reads[1] < 300) &&
+         std::chrono::steady_clock::now() < deadline) {
     try {
       const VisualMap map = ReadMap(read_here);
       ++reads[map.links.at(0).correspondences.size() == 3 ? 0 : 1];
@@ -80,9 +89,9 @@ TEST(MapIo, AReaderOfAMapReplacedWhileItReadsGetsOneMapOrTheOther) {
     }
   }
   done = true;
-  snapshots.join();
+  writer.join();
   EXPECT_EQ(failure, "");
-  EXPECT_GT(exchanges, 100);
+  EXPECT_GE(snapshots, 50);
   EXPECT_GT(reads[0], 0);
   EXPECT_GT(reads[1], 0);
 }
