@@ -17,6 +17,7 @@
 #include "vmap/core/file_identity.h"
 #include "vmap/core/file_name_encoding.h"
 #include "vmap/core/image_header.h"
+#include "vmap/map/map_files.h"
 #include "vmap/map/map_geometry_json.h"
 #include "vmap/map/map_json_fields.h"
 #include "vmap/sources/frame_source.h"
@@ -24,7 +25,9 @@
 namespace vmap {
 namespace fs = std::filesystem;
 using internal::Fields;
+using internal::KeyImageSizeProblem;
 using internal::Malformed;
+using internal::OpenMapFile;
 using internal::SizeField;
 using nlohmann::json;
 
@@ -38,42 +41,13 @@ std::string CannotOpenHint(const std::string& why_not) {
   return "; check that this user may read it (its permissions and its folder's)";
 }
 
-// A key image's size from its header: PNG, or JPEG (a key image copied from the input's own file).
-std::optional<cv::Size> KeyImageSize(const ContainedFile& file) { return ImageHeaderSize(file); }
-}  // namespace
-
-std::optional<cv::Size> KeyImageFileSize(const fs::path& file) {
-  std::string why_not;
-  // The input's own file, wherever it is: a folder of links to a recording's images gives the map its files, as the
-  // folder of the images does (ReadMap checks the copy inside the map).
-  const std::optional<ContainedFile> opened = ContainedFile::OpenRegular(file, &why_not);
-  if (!opened) return std::nullopt;
-  return KeyImageSize(*opened);
-}
-
-namespace {
-
 constexpr long kMaxInt = std::numeric_limits<int>::max();
-// A key image of a map that does not record its frame size may have at most the pixels of a frame.
-constexpr long kMaxKeyImagePixels = kMaxFramePixels;
-
-// Why a key image whose header announces `size` (nullopt: neither PNG nor JPEG) is not one of a map whose frames are
-// `frame_size` (empty: a map that does not record it), or "": read before anything is decoded.
-std::string KeyImageSizeProblem(const std::optional<cv::Size>& size, const cv::Size& frame_size) {
-  if (!size) return "is not a PNG or JPEG image";
-  const bool fits =
-      frame_size.empty() ? static_cast<long>(size->width) * size->height <= kMaxKeyImagePixels : *size == frame_size;
-  if (fits) return "";
-  return fmt::format("is {}x{}, {}", size->width, size->height,
-                     frame_size.empty()
-                         ? std::string("more pixels than a frame")
-                         : fmt::format("not the map's frame size {}x{}", frame_size.width, frame_size.height));
-}
 constexpr int kRecordBytes = 4 * sizeof(float);
 
-// Opens a file of the map, or throws the message that fits why it cannot be.
-ContainedFile OpenMapFile(const fs::path& directory, const std::string& relative, const std::string& what,
-                          const fs::path& map_json, const std::string& field) {
+}  // namespace
+
+ContainedFile internal::OpenMapFile(const fs::path& directory, const std::string& relative, const std::string& what,
+                                    const fs::path& map_json, const std::string& field) {
   std::string why_not;
   std::optional<ContainedFile> file = ContainedFile::Open(directory, relative, &why_not);
   if (file) return std::move(*file);
@@ -95,6 +69,8 @@ ContainedFile OpenMapFile(const fs::path& directory, const std::string& relative
   }
   Malformed(reported, named + " " + why_not);
 }
+
+namespace {
 
 // The camera mask map.json names: the map's own file, an 8-bit grey image of the frames' size (its size read from
 // its header before it is decoded), something kept.
@@ -170,7 +146,7 @@ void ReadKeyImages(const json& doc, const Fields& fields, const fs::path& direct
     // Only the header is read here: the image must be a PNG (as vmap writes) or a JPEG (the input's own file,
     // copied) of the map's frame size, so that whoever decodes it later does not meet a decompression bomb.
     const ContainedFile image = OpenMapFile(directory, k.image_file, "key image", file, where + ".image");
-    const std::string problem = KeyImageSizeProblem(KeyImageSize(image), map->input.frame_size);
+    const std::string problem = KeyImageSizeProblem(ImageHeaderSize(image), map->input.frame_size);
     if (!problem.empty()) Malformed(file, where + ".image '" + k.image_file + "' " + problem);
     if (IsCutShortJpeg(image)) {
       Malformed(file, where + ".image '" + k.image_file + "' is a JPEG cut short (no end-of-image marker)");
@@ -475,51 +451,6 @@ VisualMap ReadMap(const fs::path& directory) {
                       directory.string(), kAttempts));
     }
   }
-}
-
-namespace {
-
-// The key image's file, opened inside the map directory, or the InputError that says why it cannot be.
-ContainedFile OpenKeyImage(const fs::path& map_directory, const KeyImage& key) {
-  if (!IsPlainRelativePath(key.image_file)) {
-    Malformed(map_directory / kMapFileName, "key image '" + key.image_file + "' points outside the map directory");
-  }
-  return OpenMapFile(map_directory, key.image_file, "key image", map_directory / kMapFileName, "key image");
-}
-
-}  // namespace
-
-fs::path KeyImageFile(const fs::path& map_directory, const KeyImage& key) {
-  return OpenKeyImage(map_directory, key).path();
-}
-
-cv::Mat ReadKeyImage(const fs::path& map_directory, const KeyImage& key, bool grayscale, const cv::Size& frame_size) {
-  const ContainedFile opened = OpenKeyImage(map_directory, key);
-  const fs::path& file = opened.path();
-  // The map reader checked this header, but the file may have been replaced since (a map rebuilt into the same
-  // folder while a program holds the old one): checked again, and the bytes checked are the bytes decoded.
-  std::string problem = KeyImageSizeProblem(KeyImageSize(opened), frame_size);
-  if (problem.empty() && IsCutShortJpeg(opened)) problem = "is a JPEG cut short (no end-of-image marker)";
-  if (!problem.empty()) {
-    throw InputError("key image '" + file.string() + "' " + problem +
-                     ": it changed since the map was read; read the map again, or rebuild it with `vmap build`");
-  }
-  std::string bytes;
-  cv::Mat image;
-  std::string why;
-  try {
-    if (opened.ReadAll(&bytes)) {
-      image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, bytes.data()),
-                           grayscale ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
-    }
-  } catch (const cv::Exception& error) {
-    why = " (" + LibraryMessage(error) + ")";
-  }
-  if (image.empty()) {
-    throw InputError("key image '" + file.string() + "' cannot be decoded" + why +
-                     "; rebuild the map with `vmap build`");
-  }
-  return image;
 }
 
 std::string WhyNotAVmapMap(const fs::path& directory) {
