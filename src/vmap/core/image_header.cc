@@ -61,6 +61,28 @@ std::optional<cv::Size> HeaderSize(const ReadBytes& read) {
   return JpegSize(read);
 }
 
+// Whether `size` bytes start as a JPEG and their last 64 KiB hold no end-of-image marker.
+bool CutShortJpeg(const ReadBytes& read, std::uint64_t size) {
+  unsigned char start[2] = {};
+  if (size < 4 || !read(0, start, 2) || start[0] != 0xFF || start[1] != 0xD8) return false;
+  const std::uint64_t window = std::min<std::uint64_t>(size - 2, std::uint64_t{64} << 10);
+  std::string tail(window, '\0');
+  if (!read(size - window, tail.data(), tail.size())) return false;
+  for (size_t i = tail.size() - 1; i > 0; --i) {
+    if (static_cast<unsigned char>(tail[i - 1]) == 0xFF && static_cast<unsigned char>(tail[i]) == 0xD9) return false;
+  }
+  return true;
+}
+
+// The reader of an encoded image held in memory.
+ReadBytes InMemory(const std::uint8_t* encoded, std::size_t size) {
+  return [encoded, size](std::uint64_t offset, void* data, std::size_t bytes) {
+    if (offset > size || bytes > size - offset) return false;
+    std::memcpy(data, encoded + offset, bytes);
+    return true;
+  };
+}
+
 }  // namespace
 
 std::optional<cv::Size> ImageHeaderSize(const ContainedFile& file) {
@@ -69,23 +91,17 @@ std::optional<cv::Size> ImageHeaderSize(const ContainedFile& file) {
 }
 
 bool IsCutShortJpeg(const ContainedFile& file) {
-  unsigned char start[2] = {};
-  if (file.size() < 4 || !file.Read(0, start, 2) || start[0] != 0xFF || start[1] != 0xD8) return false;
-  const std::uint64_t window = std::min<std::uint64_t>(file.size() - 2, std::uint64_t{64} << 10);
-  std::string tail(window, '\0');
-  if (!file.Read(file.size() - window, tail.data(), tail.size())) return false;
-  for (size_t i = tail.size() - 1; i > 0; --i) {
-    if (static_cast<unsigned char>(tail[i - 1]) == 0xFF && static_cast<unsigned char>(tail[i]) == 0xD9) return false;
-  }
-  return true;
+  return CutShortJpeg(
+      [&file](std::uint64_t offset, void* data, std::size_t bytes) { return file.Read(offset, data, bytes); },
+      file.size());
+}
+
+bool IsCutShortJpeg(const std::uint8_t* encoded, std::size_t size) {
+  return CutShortJpeg(InMemory(encoded, size), size);
 }
 
 std::optional<cv::Size> ImageHeaderSize(const std::uint8_t* encoded, std::size_t size) {
-  return HeaderSize([encoded, size](std::uint64_t offset, void* data, std::size_t bytes) {
-    if (offset > size || bytes > size - offset) return false;
-    std::memcpy(data, encoded + offset, bytes);
-    return true;
-  });
+  return HeaderSize(InMemory(encoded, size));
 }
 
 }  // namespace vmap

@@ -23,5 +23,7 @@ std::optional<cv::Size> ImageHeaderSize(const std::uint8_t* encoded, std::size_t
 // the entropy-coded data never holds: a 0xFF there is followed by 0x00 or a restart marker). libjpeg decodes such a
 // file without an error, its missing rows filled grey, which would then be matched as if seen.
 bool IsCutShortJpeg(const ContainedFile& file);
+// The same of an encoded image held in memory (the bytes about to be decoded).
+bool IsCutShortJpeg(const std::uint8_t* encoded, std::size_t size);
 
 }  // namespace vmap

@@ -6,6 +6,7 @@
 
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/image_decode.h"
 #include "vmap/core/image_header.h"
 #include "vmap/map/map_files.h"
 #include "vmap/map/map_io.h"
@@ -55,28 +56,24 @@ fs::path KeyImageFile(const fs::path& map_directory, const KeyImage& key) {
 cv::Mat ReadKeyImage(const fs::path& map_directory, const KeyImage& key, bool grayscale, const cv::Size& frame_size) {
   const ContainedFile opened = OpenKeyImage(map_directory, key);
   const fs::path& file = opened.path();
-  // The map reader checked this header, but the file may have been replaced since (a map rebuilt into the same
-  // folder while a program holds the old one): checked again, and the bytes checked are the bytes decoded.
-  std::string problem = internal::KeyImageSizeProblem(ImageHeaderSize(opened), frame_size);
-  if (problem.empty() && IsCutShortJpeg(opened)) problem = "is a JPEG cut short (no end-of-image marker)";
-  if (!problem.empty()) {
-    throw InputError("key image '" + file.string() + "' " + problem +
-                     ": it changed since the map was read; read the map again, or rebuild it with `vmap build`");
+  // The map reader checked this file, but it may have been replaced or rewritten since (a map rebuilt into the same
+  // folder while a program holds the old one): its header is checked again before anything is read, and what is
+  // decoded is the bytes read once.
+  const auto changed = [&file](const std::string& problem) {
+    return InputError("key image '" + file.string() + "' " + problem +
+                      ": it changed since the map was read; read the map again, or rebuild it with `vmap build`");
+  };
+  if (std::string problem = internal::KeyImageSizeProblem(ImageHeaderSize(opened), frame_size); !problem.empty()) {
+    throw changed(problem);
   }
-  std::string bytes;
-  cv::Mat image;
-  std::string why;
-  try {
-    if (opened.ReadAll(&bytes)) {
-      image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, bytes.data()),
-                           grayscale ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
-    }
-  } catch (const cv::Exception& error) {
-    why = " (" + LibraryMessage(error) + ")";
-  }
-  if (image.empty()) {
-    throw InputError("key image '" + file.string() + "' cannot be decoded" + why +
-                     "; rebuild the map with `vmap build`");
+  std::string why_not;
+  const cv::Mat image = DecodeImageFile(opened, grayscale ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR,
+                                        frame_size.empty() ? kMaxFramePixels : frame_size.area(), &why_not);
+  if (image.empty())
+    throw InputError("key image '" + file.string() + "' " + why_not + "; rebuild the map with `vmap build`");
+  if (!frame_size.empty() && image.size() != frame_size) {
+    throw changed(fmt::format("is {}x{}, not the map's frame size {}x{}", image.cols, image.rows, frame_size.width,
+                              frame_size.height));
   }
   return image;
 }

@@ -10,6 +10,7 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/core/file_name_encoding.h"
+#include "vmap/core/image_decode.h"
 #include "vmap/core/image_header.h"
 #include "vmap/core/stopwatch.h"
 #include "vmap/pipelines/output_policies.h"
@@ -52,9 +53,9 @@ void MatchPipelineOptions::Check() const { pair.Check(); }
 
 namespace {
 
-cv::Mat ReadGray(const std::string& path) {
-  // IMREAD_GRAYSCALE, not cvtColor: the decoder's conversion is what the reference implementations see.
-  // A FIFO or a device is refused before OpenCV opens it (and would wait or read forever).
+// The image file `path`, opened as a regular file (a FIFO or a device is refused before a decoder waits on it) and
+// decoded from its bytes with `flags`; throws InputError naming it and why not.
+cv::Mat ReadImage(const std::string& path, int flags) {
   std::string why_not;
   const std::optional<ContainedFile> file = ContainedFile::OpenRegular(path, &why_not);
   if (!file) throw InputError("image '" + path + "' " + why_not + "; give an image file");
@@ -67,14 +68,15 @@ cv::Mat ReadGray(const std::string& path) {
                        "; give images of a usable size");
     }
   }
-  cv::Mat gray;
-  try {
-    gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  } catch (const cv::Exception& e) {
-    throw InputError("cannot read image '" + path + "' (" + LibraryMessage(e) +
-                     "); check that it is an image of a usable size");
-  }
-  if (gray.empty()) throw InputError("cannot read image '" + path + "'; check the path and that it is an image");
+  const cv::Mat image = DecodeImageFile(*file, flags, kMaxFramePixels, &why_not);
+  if (image.empty())
+    throw InputError("image '" + path + "' " + why_not + "; check that it is an image of a usable size");
+  return image;
+}
+
+// IMREAD_GRAYSCALE, not cvtColor: the decoder's conversion is what the reference implementations see.
+cv::Mat ReadGray(const std::string& path) {
+  cv::Mat gray = ReadImage(path, cv::IMREAD_GRAYSCALE);
   const std::string size_problem = FrameSizeProblem(gray.size());
   if (!size_problem.empty()) {
     throw InputError("image '" + path + "' is " + std::to_string(gray.cols) + "x" + std::to_string(gray.rows) + ", " +
@@ -86,12 +88,7 @@ cv::Mat ReadGray(const std::string& path) {
 // The image ReadGray accepted, decoded as 8-bit BGR as upstream's models read files (a grey file gives three
 // equal channels).
 cv::Mat ReadColor(const std::string& path, cv::Size size) {
-  cv::Mat bgr;
-  try {
-    bgr = cv::imread(path, cv::IMREAD_COLOR);
-  } catch (const cv::Exception& e) {
-    throw InputError("cannot read image '" + path + "' (" + LibraryMessage(e) + "); check that it is an image");
-  }
+  cv::Mat bgr = ReadImage(path, cv::IMREAD_COLOR);
   if (bgr.size() != size) throw InputError("image '" + path + "' changed while it was read; read it again");
   return bgr;
 }

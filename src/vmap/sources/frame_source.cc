@@ -9,7 +9,9 @@
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/image_decode.h"
 #include "vmap/core/json_fields.h"
 #include "vmap/core/option_ranges.h"
 #include "vmap/sources/dataset_camera.h"
@@ -65,15 +67,16 @@ std::string FrameSizeProblem(const cv::Size& size, const FrameSourceOptions& opt
 cv::Mat ColorImage(const Frame& frame) {
   if (!frame.color.empty()) return frame.color;
   if (!frame.source_path.empty()) {
-    cv::Mat color;
-    try {
-      color = cv::imread(frame.source_path, cv::IMREAD_COLOR);
-    } catch (const cv::Exception&) {
-      // The file decoded as grey a moment ago; if it no longer does, the grey frame is what there is.
-    }
+    // The file decoded as grey a moment ago; if it no longer does (it was replaced meanwhile), the grey frame is what
+    // there is. Opened as every frame's file is: a FIFO put in its place would block the decoder.
+    std::string why_not;
+    const std::optional<ContainedFile> file = ContainedFile::OpenRegular(frame.source_path, &why_not);
+    const cv::Mat color = file ? DecodeImageFile(*file, cv::IMREAD_COLOR, kMaxFramePixels, &why_not) : cv::Mat();
     if (!color.empty()) {
-      if (color.size() != frame.gray.size()) cv::resize(color, color, frame.gray.size(), 0, 0, cv::INTER_AREA);
-      return color;
+      if (color.size() == frame.gray.size()) return color;
+      cv::Mat resized;
+      cv::resize(color, resized, frame.gray.size(), 0, 0, cv::INTER_AREA);
+      return resized;
     }
   }
   cv::Mat color;

@@ -84,6 +84,15 @@ TEST(ImageFolder, ReadsInNaturalOrder) {
   cv::cvtColor(Sequence().frames[9], expected, cv::COLOR_BGR2GRAY);
   EXPECT_LE(cv::norm(frames[9].gray, expected, cv::NORM_INF), 1.0);
   EXPECT_EQ(ColorImage(frames[9]).channels(), 3);
+  // A frame's file replaced by a FIFO after the frame was read: its colour is not waited for (cv::imread by the path
+  // blocked for ever on the FIFO's open), the grey frame is what there is.
+  fs::remove(tmp.path() / "frame_10.png");
+  ASSERT_EQ(mkfifo((tmp.path() / "frame_10.png").c_str(), 0600), 0);
+  const cv::Mat from_grey = ColorImage(frames[9]);
+  ASSERT_EQ(from_grey.type(), CV_8UC3);
+  cv::Mat grey_again;
+  cv::cvtColor(from_grey, grey_again, cv::COLOR_BGR2GRAY);
+  EXPECT_EQ(cv::norm(grey_again, frames[9].gray, cv::NORM_INF), 0.0);
 }
 
 TEST(ImageFolder, FirstLastStrideAndResize) {

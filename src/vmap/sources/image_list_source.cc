@@ -8,6 +8,7 @@
 
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/image_decode.h"
 #include "vmap/core/image_header.h"
 #include "vmap/sources/internal.h"
 
@@ -61,20 +62,10 @@ class ImageListSource : public FrameSource {
           continue;
         }
       }
-      if (IsCutShortJpeg(*file)) {
-        Skip(entry, "it is a JPEG cut short (no end-of-image marker)");
-        continue;
-      }
       // Grey straight from the decoder, as the matchers' reference implementations read images.
-      try {
-        frame.gray = cv::imread(entry.path, cv::IMREAD_GRAYSCALE);
-      } catch (const cv::Exception& error) {
-        // OpenCV refuses some files outright, e.g. a header announcing more than 2^30 pixels.
-        Skip(entry, "cannot decode it (" + LibraryMessage(error) + ")");
-        continue;
-      }
+      frame.gray = DecodeImageFile(*file, cv::IMREAD_GRAYSCALE, options_.max_frame_pixels, &why_not);
       if (frame.gray.empty()) {
-        Skip(entry, "cannot decode it (corrupt or not an image)");
+        Skip(entry, "it " + why_not);
         continue;
       }
       const std::string size_problem = FrameSizeProblem(frame.gray.size(), options_);
