@@ -118,7 +118,7 @@ TEST(ClosedLoopNode, TheSimulatorRefusesOutputsOverItsInputsAndStopsOnASignal) {
                          "_map:=" + map, "_teach_textures:=" + notes.string()},
                         dir.path() / "textures.log");
   EXPECT_EQ(textured.Wait(std::chrono::seconds(60)), 2) << textured.Log();
-  EXPECT_NE(textured.Log().find("~teach_textures '" + notes.string() + "': 'notes.txt' is not an image"),
+  EXPECT_NE(textured.Log().find("~teach_textures '" + notes.string() + "': 'notes.txt' cannot be decoded"),
             std::string::npos)
       << textured.Log();
   EXPECT_EQ(textured.Log().find("--teach-textures"), std::string::npos) << textured.Log();

@@ -3,10 +3,11 @@
 #include <algorithm>
 #include <future>
 
-#include <opencv2/imgcodecs.hpp>
+#include <ros/console.h>
 
 #include "vmap/control/taught_route.h"
-#include "vmap/core/contained_file.h"
+#include "vmap/core/error.h"
+#include "vmap/map/map_io.h"
 #include "vmap/sources/image_frame.h"
 
 namespace vmap::ros_node {
@@ -56,11 +57,12 @@ cv::Mat RepeatRun::KeyImage(int key) {
   if (key < 0 || key >= static_cast<int>(key_images_.size())) return {};
   cv::Mat& image = key_images_[key];
   if (image.empty()) {
-    std::string why_not, bytes;
-    const std::optional<ContainedFile> file =
-        ContainedFile::Open(directory(), map().key_images[key].image_file, &why_not);
-    if (file && file->ReadAll(&bytes)) {
-      image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, bytes.data()), cv::IMREAD_COLOR);
+    // Read as every reader of a map reads a key image (checked again: the map may have changed on disk since); a
+    // key image that cannot be read leaves the debug figure without it, the run goes on.
+    try {
+      image = ReadKeyImage(directory(), map().key_images[key], /*grayscale=*/false, map().input.frame_size);
+    } catch (const InputError& error) {
+      ROS_WARN_THROTTLE(10.0, "%s", error.what());
     }
   }
   return image;

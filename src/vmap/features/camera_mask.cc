@@ -14,7 +14,7 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/core/fnv1a.h"
-#include "vmap/core/image_header.h"
+#include "vmap/core/image_decode.h"
 
 namespace vmap {
 
@@ -24,20 +24,8 @@ CameraMask CameraMask::Read(const std::filesystem::path& file) {
   const std::optional<ContainedFile> opened = ContainedFile::OpenRegular(file, &why_not);
   if (!opened) throw InputError(fmt::format("camera mask '{}' {}: {}", file.string(), why_not, fix));
   // A frame has at most 8192 x 8192 pixels (sources/frame_source.h); a larger mask is refused before decoding.
-  const std::optional<cv::Size> size = ImageHeaderSize(*opened);
-  std::string bytes;
-  if ((size && double(size->width) * size->height > 8192.0 * 8192.0) || opened->size() > (256ull << 20) ||
-      !opened->ReadAll(&bytes)) {
-    throw InputError(fmt::format("camera mask '{}' is larger than any frame: {}", file.string(), fix));
-  }
-  cv::Mat image;
-  try {
-    image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, bytes.data()), cv::IMREAD_GRAYSCALE);
-  } catch (const cv::Exception&) {
-  }
-  if (image.empty()) {
-    throw InputError(fmt::format("camera mask '{}' is not an image OpenCV reads: {}", file.string(), fix));
-  }
+  const cv::Mat image = DecodeImageFile(*opened, cv::IMREAD_GRAYSCALE, 8192L * 8192L, &why_not);
+  if (image.empty()) throw InputError(fmt::format("camera mask '{}' {}: {}", file.string(), why_not, fix));
   return CameraMask(image, "camera mask '" + file.string() + "'");
 }
 

@@ -9,7 +9,7 @@
 
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
-#include "vmap/core/image_header.h"
+#include "vmap/core/image_decode.h"
 #include "vmap/core/option_ranges.h"
 #include "vmap/simulation/procedural_texture.h"
 #include "vmap/sources/frame_source.h"
@@ -122,24 +122,14 @@ std::vector<cv::Mat> ReadTextureFolder(const fs::path& directory, const std::str
     if (!file)
       throw OptionError(
           field, fmt::format("'{}': '{}' {}; the folder must hold images only", directory.string(), name, why_not));
-    if (const std::optional<cv::Size> size = ImageHeaderSize(*file);
-        size && static_cast<long>(size->width) * size->height > kMaxTexturePixels) {
-      throw OptionError(field, fmt::format("'{}': '{}' announces {}x{} pixels, more than 64 megapixels; scale it down",
-                                           directory.string(), name, size->width, size->height));
+    cv::Mat image = DecodeImageFile(*file, cv::IMREAD_COLOR, kMaxTexturePixels, &why_not);
+    if (image.empty()) {
+      throw OptionError(field, fmt::format("'{}': '{}' {}; the folder must hold images only, of at most 64 megapixels",
+                                           directory.string(), name, why_not));
     }
-    std::string bytes;
-    if (!file->ReadAll(&bytes))
-      throw OptionError(field, fmt::format("'{}': '{}' cannot be read", directory.string(), name));
-    cv::Mat image;
-    try {
-      image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, bytes.data()), cv::IMREAD_COLOR);
-    } catch (const cv::Exception&) {
-      image.release();
-    }
-    if (image.empty() || image.cols < 16 || image.rows < 16) {
-      throw OptionError(field, fmt::format("'{}': '{}' is not an image OpenCV can decode (at least 16x16 pixels); the "
-                                           "folder must hold images only",
-                                           directory.string(), name));
+    if (image.cols < 16 || image.rows < 16) {
+      throw OptionError(field, fmt::format("'{}': '{}' is {}x{}; a texture needs at least 16x16 pixels",
+                                           directory.string(), name, image.cols, image.rows));
     }
     const int longer = std::max(image.cols, image.rows);
     if (longer > kMaxTextureSide) {

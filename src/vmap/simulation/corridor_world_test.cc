@@ -46,7 +46,7 @@ TEST(CorridorWorld, TextureFoldersAreReadInNaturalOrderAndOnlyImagesAccepted) {
     FAIL() << "a text file was taken for a texture";
   } catch (const OptionError& e) {
     EXPECT_EQ(e.path(), "teach_textures");  // each front end names the option its way
-    EXPECT_NE(e.problem().find("'notes.txt' is not an image"), std::string::npos) << e.what();
+    EXPECT_NE(e.problem().find("'notes.txt' cannot be decoded"), std::string::npos) << e.what();
   }
   testing::ScopedTempDir empty("textures_empty");
   EXPECT_THROW(ReadTextureFolder(empty.path(), "teach_textures"), InputError);

@@ -133,6 +133,22 @@ TEST(RosImageMessages, ACompressedImageAnnouncingTooManyPixelsIsRefusedByItsHead
   }
 }
 
+// A JPEG cut short decodes without an error, its missing rows grey: refused as a frame from a file is.
+TEST(RosImageMessages, ACompressedJpegCutShortIsRefused) {
+  std::vector<uint8_t> jpeg;
+  cv::imencode(".jpg", TestImage(), jpeg);
+  jpeg.resize(jpeg.size() / 2);
+  for (MessageEncoding encoding : kEncodings) {
+    const std::vector<uint8_t> data = testing::SerializeCompressedImage(encoding, 1.0, "jpeg", jpeg);
+    try {
+      Decode(data, encoding, kCompressedImageType);
+      ADD_FAILURE() << "decoded";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("holds a JPEG cut short"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(RosImageMessages, MalformedMessagesAreInputErrorsNeverCrashes) {
   const cv::Mat bgr = TestImage();
   for (MessageEncoding encoding : kEncodings) {
