@@ -174,6 +174,22 @@ def test_match_takes_the_cli_options(maps, tmp_path):
     assert bgr.num_tentative > 0 and bgr.F.shape == (3, 3)
 
 
+def test_a_deep_matcher_runs_from_the_module_as_from_the_cli(maps, tmp_path):
+    """The module loads the LibTorch plugin from beside itself (it raised 'cannot open shared object file')."""
+    cli_dir, _, _ = maps
+    weights = SHARED / "weights" / "xfeat" / "xfeat_folded.pt"
+    if not weights.is_file():
+        pytest.skip(f"{weights} not found")
+    m = vmap.read_map(cli_dir)
+    out = tmp_path / "match.json"
+    run_cli("match", key_image_file(cli_dir, 0), key_image_file(cli_dir, 1), "--json", out, "--matcher", "xfeat",
+            "--weights", weights)
+    cli = json.loads(out.read_text())
+    result = vmap.match(m.key_images[0].image, m.key_images[1].image, matcher="xfeat", weights=str(weights))
+    assert result.num_verified > 20
+    assert (result.num_tentative, result.num_verified) == (cli["num_tentative"], cli["num_verified"])
+
+
 def csv_rows(path):
     import csv
     with open(path) as f:

@@ -6,13 +6,14 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/error.h"
+#include "vmap/core/file_name_encoding.h"
 
 namespace vmap {
 
 namespace {
 
-// The files a map recorded (weights) may not exist here: cleared, the model then searches its weights
-// directories.
+// The files a map recorded (weights), written percent-encoded (file_name_encoding.h), may not exist here: cleared,
+// the model then searches its weights directories.
 class ForgetMissingFiles final : public OptionFieldVisitor {
  public:
   explicit ForgetMissingFiles(const std::string& model) : model_(model) {}
@@ -24,7 +25,9 @@ class ForgetMissingFiles final : public OptionFieldVisitor {
   void OnField(const OptionField&, std::vector<int>&) override {}
   void OnField(const OptionField&, const EnumField&) override {}
   void OnField(const OptionField& field, std::string& value) override {
-    if (!field.is_local_file || value.empty() || std::filesystem::exists(value)) return;
+    if (!field.is_local_file || value.empty()) return;
+    value = DecodeFileName(value);
+    if (std::filesystem::exists(value)) return;
     spdlog::info("the map's {} {} '{}' are not here; searching the weights directories", model_, field.key, value);
     value.clear();
   }

@@ -42,7 +42,7 @@ const MatcherPluginTable* OpenPlugin() {
   if (!library) {
     throw InputError("the deep matchers need LibTorch, through '" + path + "', which cannot be loaded (" + dlerror() +
                      "); build vmap with -DVMAP_WITH_TORCH=ON (scripts/build.sh does) and keep libvmap_torch.so "
-                     "beside the vmap binary");
+                     "beside the program that loads it (the vmap binary, the Python module, the ROS nodes)");
   }
   using Entry = const MatcherPluginTable* (*)();
   const auto entry = reinterpret_cast<Entry>(dlsym(library, "vmap_matcher_plugin_table"));

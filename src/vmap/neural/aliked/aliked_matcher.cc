@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/core/file_name_encoding.h"
 #include "vmap/features/camera_mask.h"
 #include "vmap/features/float_matcher.h"
 #include "vmap/features/matcher_plugin.h"
@@ -101,12 +102,11 @@ class AlikedMatcher : public Matcher {
   std::string DescribeOptionsJson() const override {
     nlohmann::json j{{"type", "aliked"},
                      {"model", "aliked-" + model_.config().name},
-                     {"weights", weights_path_},
+                     {"weights", EncodeFileName(weights_path_)},
                      {"device", options_.device},
                      {"top_k", options_.top_k},
                      {"min_similarity", options_.min_similarity},
                      {"longest_side", options_.longest_side},
-                     {"threads", options_.num_threads},
                      {"nms_radius", dkd_.radius},
                      {"sub_pixel", dkd_.sub_pixel}};
     if (options_.top_k == 0) {

@@ -106,8 +106,7 @@ class LoftrMatcher : public Matcher {
                      {"border_removal", c.border_removal},
                      {"coarse_stride", c.coarse_stride},
                      {"fine_level", c.has_fine},
-                     {"temp_bug_fix", c.temp_bug_fix},
-                     {"threads", options_.num_threads}};
+                     {"temp_bug_fix", c.temp_bug_fix}};
     return j.dump();
   }
 

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <torch/torch.h>
 
+#include "vmap/core/file_name_encoding.h"
 #include "vmap/testing/golden_util.h"
 #include "vmap/testing/localization_test_util.h"
 #include "vmap/testing/localize_cli_test_util.h"
@@ -63,6 +64,37 @@ TEST(VmapXfeat, BuildRecordsTheMatcherAndItsOptions) {
   for (const auto& link : j["links"]) EXPECT_GT(link["verified"].get<int>(), 50) << link;
   const auto info = RunVmap("info " + map.string());
   EXPECT_EQ(info.status, 0) << info.output;
+}
+
+// A weights file whose name is not UTF-8 is recorded percent-encoded (JSON must be UTF-8: the map's writer raised
+// nlohmann's type_error 316, "an unexpected error") and found again from it; the threads per call, a run setting
+// that changes no result, are not recorded (two maps of the same input differed by them alone).
+TEST(VmapXfeat, AMapRecordsItsWeightsWhateverTheirNameAndNotItsThreads) {
+  SKIP_WITHOUT_SHARED();
+  TempDir dir("weights_name");
+  const fs::path weights = dir.path() / "xfeat\xff.pt";
+  fs::copy_file(SharedDir() + "/weights/xfeat/xfeat_folded.pt", weights);
+  const std::string input = SharedDir() + "/data/rccar_room/images --last 6 -q --matcher xfeat";
+  for (const char* threads : {"1", "2"}) {
+    const auto r = RunVmap("build " + input + " --xfeat-threads " + threads + " --weights '" + weights.string() +
+                           "' -o " + (dir.path() / ("map" + std::string(threads))).string());
+    ASSERT_EQ(r.status, 0) << r.output;
+  }
+  const auto map_json = [&](const char* name) {
+    std::ifstream file(dir.path() / name / "map.json");
+    auto j = nlohmann::json::parse(file);
+    j.erase("seconds");  // the run's time, the one field two runs may differ by
+    return j;
+  };
+  EXPECT_EQ(map_json("map1"), map_json("map2"));
+  const auto j = map_json("map1");
+  EXPECT_EQ(j["options"]["matcher"]["weights"], EncodeFileName(weights.string()));
+  EXPECT_FALSE(j["options"]["matcher"].contains("threads")) << j["options"]["matcher"];
+  const auto localize = RunVmap("localize " + (dir.path() / "map1").string() + " " + SharedDir() +
+                                "/data/rccar_room/images --last 2 --no-cache -v");
+  ASSERT_EQ(localize.status, 0) << localize.output;
+  EXPECT_EQ(localize.output.find("are not here; searching the weights directories"), std::string::npos)
+      << localize.output;
 }
 
 TEST(VmapXfeat, BadOptionsAndMissingCudaAreRefused) {

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/core/file_name_encoding.h"
 #include "vmap/features/float_matcher.h"
 #include "vmap/features/matcher_plugin.h"
 #include "vmap/features/point_features_bytes.h"
@@ -114,13 +115,12 @@ class XfeatMatcher : public Matcher {
 
   std::string DescribeOptionsJson() const override {
     nlohmann::json j{{"type", "xfeat"},
-                     {"weights", weights_path_},
+                     {"weights", EncodeFileName(weights_path_)},
                      {"weights_layout", neural::XfeatLayoutName(layout_)},
                      {"device", options_.device},
                      {"top_k", options_.top_k},
                      {"detection_threshold", options_.detection_threshold},
-                     {"min_similarity", options_.min_similarity},
-                     {"threads", options_.num_threads}};
+                     {"min_similarity", options_.min_similarity}};
     return j.dump();
   }
 
