@@ -107,19 +107,28 @@ double RouteController::GoalLogScaleThreshold() const {
 }
 
 VelocityCommand RouteController::Limit(VelocityCommand wanted, double dt) const {
+  // std::clamp passes a NaN through: a command that is no number is no motion.
+  if (!std::isfinite(wanted.linear)) wanted.linear = 0.0;
+  if (!std::isfinite(wanted.angular)) wanted.angular = 0.0;
   wanted.linear = std::clamp(wanted.linear, -options_.max_speed, options_.max_speed);
   wanted.angular = std::clamp(wanted.angular, -options_.max_angular_speed, options_.max_angular_speed);
-  if (dt > 0.0) {
-    const double dv = options_.max_acceleration * dt, dw = options_.max_angular_acceleration * dt;
-    wanted.linear = std::clamp(wanted.linear, last_command_.linear - dv, last_command_.linear + dv);
-    wanted.angular = std::clamp(wanted.angular, last_command_.angular - dw, last_command_.angular + dw);
-  }
+  // From the last command by at most what the accelerations allow in the time since it: none at the first step (the
+  // robot starts from rest) nor at a stamp that did not advance, where the first command was 20 times the limit.
+  const double dv = options_.max_acceleration * dt, dw = options_.max_angular_acceleration * dt;
+  wanted.linear = std::clamp(wanted.linear, last_command_.linear - dv, last_command_.linear + dv);
+  wanted.angular = std::clamp(wanted.angular, last_command_.angular - dw, last_command_.angular + dw);
   return wanted;
 }
 
 ControlStep RouteController::Update(double time, const LocalizationResult& localization,
                                     const OdometrySample* odometry) {
   const auto start = std::chrono::steady_clock::now();
+  if (!std::isfinite(time)) throw std::invalid_argument("RouteController::Update: the time must be a finite number");
+  // An odometry sample that is no pose (a NaN from a driver) is none: it would turn every later command into NaN.
+  if (odometry != nullptr &&
+      !(std::isfinite(odometry->x) && std::isfinite(odometry->y) && std::isfinite(odometry->yaw))) {
+    odometry = nullptr;
+  }
   ControlStep step;
   const double dt = last_time_ ? std::max(0.0, time - *last_time_) : 0.0;
   last_time_ = time;
@@ -138,9 +147,19 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
     last_odometry_ = *odometry;
   }
   if (tracking_) tracking_->Predict(driven, turned);
+  // Only frames verified at a key image of this route are steered by: a lost or uncertain frame's key images are
+  // a guess (LocalizationGuidance), and so is a heading without them.
+  const bool located = IsPlaced(localization.status);
+  const int position = located ? route_.PositionOf(localization.key) : -1;
+  const double heading_offset = HeadingOffset(localization, focal_px_);
+  const bool usable = position >= 0 && std::isfinite(heading_offset);
   auto finish = [&](VelocityCommand wanted, ControllerState state) {
-    step.command = Limit(wanted, dt);
-    if (state == ControllerState::kReachedGoal) step.command = {};
+    // At the goal the robot stops, as fast as the decelerations allow: a stop in one step would put it short of
+    // where a real base stops (0.36 m at 0.6 m/s and 0.5 m/s^2, beyond the simulator's 0.3 m tolerance).
+    step.command = Limit(state == ControllerState::kReachedGoal ? VelocityCommand{} : wanted, dt);
+    // What a lost robot slows down from: the speed it was given, not the speed it should have had (a robot turning
+    // on the spot drove forward when it lost the route).
+    if (usable) lost_speed_ = step.command.linear;
     step.state = state;
     step.localized = localized_;
     step.route_position = position_;
@@ -150,12 +169,6 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
   };
   if (reached_goal_) return finish({}, ControllerState::kReachedGoal);
 
-  // Only frames verified at a key image of this route are steered by: a lost or uncertain frame's key images are
-  // a guess (LocalizationGuidance), and so is a heading without them.
-  const bool located = IsPlaced(localization.status);
-  const int position = located ? route_.PositionOf(localization.key) : -1;
-  const double heading_offset = HeadingOffset(localization, focal_px_);
-  const bool usable = position >= 0 && std::isfinite(heading_offset);
   const int last = static_cast<int>(route_.keys.size()) - 1;
 
   // The search for the route: after standing search_after_seconds without a usable frame, sweep the heading.
@@ -229,26 +242,28 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
         ++position_;
       }
     }
-    const double elapsed = last_usable_time_ ? time - *last_usable_time_ : options_.lost_stop_seconds;
+    // A stamp before the last usable frame's (a clock reset) counts as no time: never more than the speed it had.
+    const double elapsed = last_usable_time_ ? std::max(0.0, time - *last_usable_time_) : options_.lost_stop_seconds;
     const double share =
-        options_.lost_stop_seconds > 0.0 ? std::max(0.0, 1.0 - elapsed / options_.lost_stop_seconds) : 0.0;
+        options_.lost_stop_seconds > 0.0 ? std::clamp(1.0 - elapsed / options_.lost_stop_seconds, 0.0, 1.0) : 0.0;
     const double speed = lost_speed_ * share;
     step.steering = speed != 0.0 ? "taught" : "none";
     double turn = speed != 0.0 ? TaughtTurnRate(position_, speed) : 0.0;
-    if (speed != 0.0 && tracking_ && tracking_->started()) {
-      // The estimate goes on with the robot's motion: it steers while the robot slows down.
+    if (tracking_ && tracking_->started()) {
+      // The estimate goes on with the robot's motion (reported standing too): it steers while the robot slows down.
       const PathLocation at = tracking_->Locate();
       step.lateral_estimate = at.lateral;
       step.heading_error_estimate = at.heading_error;
       step.arc_estimate = at.s;
-      turn = PathFollowingTurnRate(at, speed, options_.convergence_distance);
-      step.steering = "tracker";
+      if (speed != 0.0) {
+        turn = PathFollowingTurnRate(at, speed, options_.convergence_distance);
+        step.steering = "tracker";
+      }
     }
     return finish(search({speed, turn}), ControllerState::kLost);
   }
 
   const double speed = NominalSpeed(position_);
-  lost_speed_ = speed;
   step.heading_offset = heading_offset;
   search({});  // usable: the search, if any, is over
   if (tracking_ && tracking_->started()) {

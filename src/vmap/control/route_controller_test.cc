@@ -55,6 +55,14 @@ ControllerOptions NoRateLimits() {
   return options;
 }
 
+// A controller that saw a frame 0.1 s before the test's first: a first frame's command is the robot's first from rest,
+// which the accelerations limit to none; after it, NoRateLimits' accelerations allow any command.
+RouteController Running(const TaughtRoute& route, const ControllerOptions& options) {
+  RouteController controller(route, options);
+  controller.Update(-0.1, Lost());
+  return controller;
+}
+
 TEST(RouteController, StartsOnlyOnceLocalized) {
   RouteController controller(StraightRoute(), NoRateLimits());
   ControlStep step = controller.Update(0.0, Lost());
@@ -75,7 +83,7 @@ TEST(RouteController, BearnavTurnsAgainstTheHeading) {
   ControllerOptions options = NoRateLimits();
   options.law = ControlLaw::kBearnav;
   options.heading_gain = 2.0;
-  RouteController controller(StraightRoute(), options);
+  RouteController controller = Running(StraightRoute(), options);
   // The scene appears 5 degrees right: the robot points left and turns right (clockwise, w < 0).
   const ControlStep step = controller.Update(0.0, Tracked(0, 5.0));
   EXPECT_EQ(step.steering, "bearnav");
@@ -91,22 +99,22 @@ TEST(RouteController, TaughtTurnRateIsFedForward) {
   // Half-way along the stretch (progress 0.5), on the taught path: the next key image looks 0.2 rad further left
   // than the robot (heading offset -0.2 rad), as it should; only the taught rate turns the robot.
   const double on_path_deg = -0.2 * 180.0 / M_PI;
-  RouteController controller(route, options);
+  RouteController controller = Running(route, options);
   ControlStep step = controller.Update(0.0, Tracked(1, on_path_deg));
   EXPECT_NEAR(step.command.angular, 0.2, 1e-12);
   // Pointing 0.1 rad further left than that: the heading term turns it back.
-  RouteController off(route, options);
+  RouteController off = Running(route, options);
   EXPECT_NEAR(off.Update(0.0, Tracked(1, on_path_deg + 0.1 * 180.0 / M_PI)).command.angular, 0.2 - 0.1, 1e-12);
   // With the length from odometry: curvature times speed.
   route.segments[1].length = 1.0;
-  RouteController with_length(route, options);
+  RouteController with_length = Running(route, options);
   step = with_length.Update(0.0, Tracked(1, on_path_deg));
   EXPECT_DOUBLE_EQ(step.command.linear, 0.5);  // the taught speed, 1 m in 2 s
   EXPECT_NEAR(step.command.angular, 0.4 / 1.0 * 0.5, 1e-12);
 }
 
 TEST(RouteController, ServoSteersToTheKeyImagesLineWhenTheTranslationIsKnown) {
-  RouteController controller(StraightRoute(), NoRateLimits());
+  RouteController controller = Running(StraightRoute(), NoRateLimits());
   LocalizationResult result = Tracked(0, 0.0);
   // The next key image 1.5 m ahead and 0.4 m to the left, looking as the robot does.
   result.translation_known = true;
@@ -134,7 +142,7 @@ TEST(RouteController, TrackerFollowsTheTaughtPathWhereTheRouteIsMetric) {
   ASSERT_TRUE(route.metric());
   ControllerOptions options = NoRateLimits();
   options.law = ControlLaw::kTracker;
-  RouteController controller(route, options);
+  RouteController controller = Running(route, options);
   // The first frame places the estimate on the path at the key image, turned as the heading says:
   // the robot points 10 degrees left of the path and turns right.
   ControlStep step = controller.Update(0.0, Tracked(1, 10.0));
@@ -158,7 +166,7 @@ TEST(RouteController, TrackerFollowsTheTaughtPathWhereTheRouteIsMetric) {
 }
 
 TEST(RouteController, TurnsOnTheSpotWhenFacingFarOff) {
-  RouteController controller(StraightRoute(), NoRateLimits());
+  RouteController controller = Running(StraightRoute(), NoRateLimits());
   const ControlStep step = controller.Update(0.0, Tracked(0, -60.0));
   EXPECT_EQ(step.state, ControllerState::kTurning);
   EXPECT_EQ(step.command.linear, 0.0);
@@ -168,7 +176,7 @@ TEST(RouteController, TurnsOnTheSpotWhenFacingFarOff) {
 TEST(RouteController, LostSlowsToAStopAndResumes) {
   ControllerOptions options = NoRateLimits();
   options.lost_stop_seconds = 1.0;
-  RouteController controller(StraightRoute(), options);
+  RouteController controller = Running(StraightRoute(), options);
   controller.Update(0.0, Tracked(1, 0.0));
   ControlStep step = controller.Update(0.5, Lost());
   EXPECT_EQ(step.state, ControllerState::kLost);
@@ -220,7 +228,7 @@ TEST(RouteController, AccelerationIsLimited) {
 }
 
 TEST(RouteController, StopsWhereTheGoalLooksAsLargeAsInItsKeyImage) {
-  RouteController controller(StraightRoute(), NoRateLimits());
+  RouteController controller = Running(StraightRoute(), NoRateLimits());
   LocalizationResult at_goal = Tracked(3, 0.0);
   at_goal.to_key.verified = testing::ZoomedMatches(0.9);  // still 10 % smaller: drive on, at the goal speed
   ControlStep step = controller.Update(0.0, at_goal);
@@ -334,6 +342,87 @@ TEST(RouteController, BadOptionsAndRoutesAreRefused) {
     EXPECT_NE(std::string(error.what()).find("key image 4 alone: give a goal other than its start"), std::string::npos)
         << error.what();
   }
+}
+
+// The accelerations hold from rest: the first command and one at a stamp that did not advance change nothing (the first
+// was 1.0 m/s from standstill whatever the limits, 20 times them).
+TEST(RouteController, TheFirstCommandAndOneAtAStampThatDidNotAdvanceKeepTheAccelerations) {
+  RouteController controller(StraightRoute(), ControllerOptions());
+  ControlStep step = controller.Update(5.0, Tracked(1, 30.0));
+  EXPECT_EQ(step.state, ControllerState::kFollowing);
+  EXPECT_EQ(step.command.linear, 0.0);
+  EXPECT_EQ(step.command.angular, 0.0);
+  step = controller.Update(5.1, Tracked(1, 30.0));
+  EXPECT_NEAR(step.command.linear, 0.05, 1e-12);
+  EXPECT_NEAR(step.command.angular, -0.3, 1e-12);  // 3 rad/s^2 for 0.1 s
+  for (double stamp : {5.1, 4.0}) {                // the same stamp again, and one before it
+    const ControlStep again = controller.Update(stamp, Tracked(1, -30.0));
+    EXPECT_NEAR(again.command.linear, 0.05, 1e-12) << stamp;
+    EXPECT_NEAR(again.command.angular, -0.3, 1e-12) << stamp;
+  }
+}
+
+// A lost robot slows down from the speed it was given: one turning on the spot stays on the spot (it drove forward at
+// up to 0.18 m/s), and a stamp from before its last usable frame never speeds it up (it drove at 1.8 times its speed).
+TEST(RouteController, ALostRobotSlowsDownFromTheSpeedItWasGiven) {
+  RouteController turning = Running(StraightRoute(), NoRateLimits());
+  EXPECT_EQ(turning.Update(0.0, Tracked(1, 60.0)).state, ControllerState::kTurning);
+  for (double t = 0.1; t < 1.5; t += 0.1) {
+    const ControlStep step = turning.Update(t, Lost());
+    EXPECT_EQ(step.state, ControllerState::kLost);
+    EXPECT_EQ(step.command.linear, 0.0) << t;
+  }
+  RouteController driving = Running(StraightRoute(), NoRateLimits());
+  EXPECT_DOUBLE_EQ(driving.Update(10.0, Tracked(1, 0.0)).command.linear, 0.3);
+  const ControlStep earlier = driving.Update(9.0, Lost());
+  EXPECT_EQ(earlier.state, ControllerState::kLost);
+  EXPECT_LE(earlier.command.linear, 0.3);
+}
+
+// What is no number never reaches the wheels: a NaN time is refused, an odometry sample holding one is ignored (one
+// made every later turn rate NaN).
+TEST(RouteController, InputsThatAreNoNumbersNeverMakeACommandThatIsNone) {
+  TaughtRoute route = StraightRoute();
+  for (int k = 0; k < 4; ++k) route.key_poses.push_back({10.0 + 2.0 * k, 1.0 * k, 0.0, 0.0});
+  for (int i = 0; i <= 30; ++i) route.path.push_back({10.0 + 0.2 * i, 0.1 * i, 0.0, 0.0});
+  for (TaughtSegment& segment : route.segments) segment.length = 1.0;
+  ControllerOptions options = NoRateLimits();
+  options.law = ControlLaw::kTracker;
+  RouteController controller = Running(route, options);
+  EXPECT_THROW(controller.Update(std::nan(""), Tracked(1, 0.0)), std::invalid_argument);
+  const double nan = std::nan("");
+  const OdometrySample odometry[] = {
+      {0.0, 0.0, 0.0, 0.0}, {0.1, nan, 0.0, 0.0}, {0.2, 0.06, 0.0, nan}, {0.3, 0.09, 0.0, 0.0}};
+  for (int i = 0; i < 4; ++i) {
+    for (const LocalizationResult& result : {Tracked(1, 5.0), Lost()}) {
+      const ControlStep step =
+          controller.Update(0.1 * i + (result.status == LocalizationStatus::kLost ? 0.05 : 0.0), result, &odometry[i]);
+      EXPECT_TRUE(std::isfinite(step.command.linear) && std::isfinite(step.command.angular)) << i;
+    }
+  }
+}
+
+// At the goal the robot stops within the decelerations, and the controller says it reached the goal meanwhile (the
+// stop was one step, 6 m/s^2 at twice the speed, which put the simulated robot short of where a base stops).
+TEST(RouteController, TheGoalStopKeepsTheDecelerations) {
+  ControllerOptions options;
+  options.max_acceleration = 0.5;
+  RouteController controller(StraightRoute(), options);
+  LocalizationResult at_goal = Tracked(3, 0.0);
+  at_goal.to_key.verified = testing::ZoomedMatches(0.9);
+  double t = 0.0;
+  for (; t < 1.0; t += 0.1) controller.Update(t, at_goal);  // up to the goal speed, 0.15 m/s
+  at_goal.to_key.verified = testing::ZoomedMatches(1.0);
+  std::vector<double> speeds;
+  for (; speeds.empty() || speeds.back() > 0.0; t += 0.1) {
+    const ControlStep step = controller.Update(t, at_goal);
+    if (step.state == ControllerState::kReachedGoal) speeds.push_back(step.command.linear);
+    ASSERT_LT(t, 3.0);
+  }
+  ASSERT_EQ(speeds.size(), 3u);
+  EXPECT_NEAR(speeds[0], 0.10, 1e-9);
+  EXPECT_NEAR(speeds[1], 0.05, 1e-9);
+  EXPECT_EQ(speeds[2], 0.0);
 }
 
 }  // namespace
