@@ -38,6 +38,33 @@ def test_build_map_writes_the_cli_map(maps):
     assert built.camera_mask is None and "camera_mask" not in cli["input"]
 
 
+def test_a_host_programs_locale_changes_no_number(maps, tmp_path):
+    """Python's locale.setlocale(LC_ALL, "") under a locale with a decimal comma: the camera's numbers are read as
+    written and the map is the CLI's (k1 was read as -7 instead of -0.0076, and the report's numbers had commas)."""
+    cli_dir, _, _ = maps
+    locales = tmp_path / "locales"
+    locales.mkdir()
+    made = subprocess.run(["localedef", "-i", "de_DE", "-f", "UTF-8", str(locales / "de_DE.UTF-8")],
+                          capture_output=True)
+    if made.returncode != 0:
+        pytest.skip("localedef cannot make de_DE.UTF-8 here")
+    camera = ",".join(str(v) for v in map_json(cli_dir)["input"]["camera"]["params"])
+    program = (f"import locale, vmap\n"
+               f"locale.setlocale(locale.LC_ALL, '')\n"
+               f"assert locale.localeconv()['decimal_point'] == ',', locale.localeconv()\n"
+               f"vmap.build_map({str(VIDEO)!r}, {str(tmp_path / 'map')!r}, camera={camera!r}, report=True, "
+               f"**{STRETCH!r})\n")
+    env = dict(os.environ, LOCPATH=str(locales), LC_ALL="de_DE.UTF-8")
+    run = subprocess.run([sys.executable, "-c", program], env=env, capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr
+    cli, module = map_json(cli_dir), map_json(tmp_path / "map")
+    assert module["input"]["camera"]["params"] == cli["input"]["camera"]["params"]
+    assert without_run_fields(module["links"]) == without_run_fields(cli["links"])
+    report = (tmp_path / "map" / "report.html").read_text()
+    import re
+    assert not re.search(r'data-[a-z-]+="-?[0-9]+,[0-9]', report), "a number with a decimal comma in the report"
+
+
 def write_grey_png(path, pixels):
     """An 8-bit grey PNG of a uint8 HxW array (zlib and the PNG chunks; no imaging library needed)."""
     import struct

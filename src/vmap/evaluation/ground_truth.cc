@@ -10,6 +10,7 @@
 
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/number_text.h"
 #include "vmap/sources/dataset_camera.h"
 #include "vmap/sources/kitti_frame_number.h"
 
@@ -36,13 +37,9 @@ std::vector<double> LineNumbers(std::string line, const std::string& path, int n
   std::vector<double> values;
   std::string token;
   while (in >> token) {
-    try {
-      size_t used = 0;
-      values.push_back(std::stod(token, &used));
-      if (used != token.size()) throw std::invalid_argument(token);
-    } catch (const std::exception&) {
-      throw InputError(fmt::format("ground truth '{}' line {}: '{}' is not a number", path, number, token));
-    }
+    const std::optional<double> value = ParseNumber(token);
+    if (!value) throw InputError(fmt::format("ground truth '{}' line {}: '{}' is not a number", path, number, token));
+    values.push_back(*value);
   }
   return values;
 }

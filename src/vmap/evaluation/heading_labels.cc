@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "vmap/core/error.h"
+#include "vmap/core/number_text.h"
 
 namespace vmap {
 
@@ -21,12 +22,11 @@ std::vector<HeadingLabel> ReadHeadingLabels(const std::string& csv_path) {
     std::getline(row, label.repeat_image, ',');
     std::getline(row, label.teach_image, ',');
     std::getline(row, dx, ',');
-    try {
-      label.dx_px = std::stod(dx);
-      if (label.repeat_image.empty() || label.teach_image.empty()) throw std::invalid_argument("image");
-    } catch (const std::exception&) {
+    const std::optional<double> dx_px = ParseNumber(dx);
+    if (!dx_px || label.repeat_image.empty() || label.teach_image.empty()) {
       throw InputError(csv_path + " line " + std::to_string(number) + " is not 'repeat_image,teach_image,dx_px'");
     }
+    label.dx_px = *dx_px;
     labels.push_back(std::move(label));
   }
   return labels;

@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/error.h"
+#include "vmap/core/number_text.h"
 
 namespace vmap {
 
@@ -174,15 +175,13 @@ std::vector<double> NumbersIn(const std::string& text) {
   std::vector<double> numbers;
   std::string token;
   while (in >> token) {
-    try {
-      size_t used = 0;
-      numbers.push_back(std::stod(token, &used));
-      if (used != token.size()) throw std::invalid_argument(token);
-    } catch (const std::exception&) {
+    const std::optional<double> number = ParseNumber(token);
+    if (!number) {
       throw OptionError("camera", "'" + text + "': '" + token +
                                       "' is not a number; give fx,fy,cx,cy[,k1,k2,p1,p2[,k3[,k4,k5,k6]]] or a "
                                       "calibration file");
     }
+    numbers.push_back(*number);
   }
   return numbers;
 }

@@ -1,23 +1,25 @@
 #include "vmap/mapping/sweep_thresholds.h"
 
-#include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
 #include "vmap/core/error.h"
+#include "vmap/core/number_text.h"
 #include "vmap/mapping/key_image_selector.h"
 
 namespace vmap {
 
 std::vector<double> ParseThresholds(const std::string& text) {
   std::vector<double> taus;
-  double start, stop, step;
-  char extra;
-  if (std::sscanf(text.c_str(), "%lf:%lf:%lf%c", &start, &stop, &step, &extra) == 3) {
+  // start:stop:step, three numbers.
+  std::vector<std::optional<double>> range;
+  std::stringstream parts(text);
+  for (std::string part; std::getline(parts, part, ':');) range.push_back(ParseNumber(part));
+  if (range.size() == 3 && range[0] && range[1] && range[2] && text.back() != ':') {
+    const double start = *range[0], stop = *range[1], step = *range[2];
     if (!std::isfinite(start) || !std::isfinite(stop) || !(step > 0) || !std::isfinite(step) || stop < start) {
       throw OptionError("thresholds", "'" + text + "' must be start:stop:step with step > 0 and stop >= start");
     }
@@ -32,21 +34,17 @@ std::vector<double> ParseThresholds(const std::string& text) {
     // which a fixed number of decimals would round to 0.
     for (int i = 0; i < static_cast<int>(count); ++i) {
       const std::string rounded = fmt::format("{:.12g}", start + i * step);
-      double tau = 0.0;
-      std::from_chars(rounded.data(), rounded.data() + rounded.size(), tau);  // no locale: fmt wrote a '.'
-      taus.push_back(tau);
+      taus.push_back(*ParseNumber(rounded));  // fmt writes no locale's decimal comma
     }
   } else {
     std::stringstream list(text);
     std::string item;
     while (std::getline(list, item, ',')) {
-      try {
-        size_t used = 0;
-        taus.push_back(std::stod(item, &used));
-        if (used != item.size()) throw std::invalid_argument(item);
-      } catch (const std::exception&) {
+      const std::optional<double> tau = ParseNumber(item);
+      if (!tau) {
         throw OptionError("thresholds", "'" + text + "' is not start:stop:step (0.1:0.9:0.1) or a list (0.2,0.5)");
       }
+      taus.push_back(*tau);
       if (taus.size() > kMaxThresholds) {
         throw OptionError("thresholds",
                           "'" + text + "' lists more than " + std::to_string(kMaxThresholds) + " thresholds");

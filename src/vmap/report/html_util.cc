@@ -1,8 +1,10 @@
 #include "vmap/report/html_util.h"
 
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
+
+#include <fmt/format.h>
+
+#include "vmap/core/number_text.h"
 
 namespace vmap::report {
 
@@ -35,21 +37,20 @@ std::string HtmlEscape(std::string_view text) {
 
 std::string FormatFixed(double value, int decimals) {
   if (!std::isfinite(value)) return "n/a";
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
-  std::string text(buffer);
+  // fmt, not printf: the same text whatever the process's locale (a decimal comma in the HTML's numbers broke them).
+  std::string text = fmt::format("{:.{}f}", value, decimals);
   // "-0.00" reads as a sign error in a table.
   if (text[0] == '-' && text.find_first_not_of("-0.") == std::string::npos) text.erase(0, 1);
   return text;
 }
 
 std::string FormatExact(double value) {
-  char buffer[64];
+  std::string text;
   for (int precision = 6; precision <= 17; ++precision) {
-    std::snprintf(buffer, sizeof(buffer), "%.*g", precision, value);
-    if (std::strtod(buffer, nullptr) == value) break;
+    text = fmt::format("{:.{}g}", value, precision);
+    if (ParseNumber(text) == value) break;
   }
-  return buffer;
+  return text;
 }
 
 std::string UrlPath(const std::string& generic_path) {

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/core/error.h"
@@ -43,10 +44,8 @@ cv::Point2d Scaled(const cv::Point2f& p, double s, const cv::Point2d& offset) {
 std::string MatchCaption(const Link& link) {
   const int drawn = static_cast<int>(link.correspondences.size());
   const int rejected = std::max(0, std::max(link.num_tentative, drawn) - link.num_verified);
-  char text[256];
-  std::snprintf(text, sizeof(text), "S = %.3f | %d verified (green), %d rejected (blue) of %d tentative",
-                link.similarity, link.num_verified, rejected, link.num_tentative);
-  return text;
+  return fmt::format("S = {:.3f} | {} verified (green), {} rejected (blue) of {} tentative", link.similarity,
+                     link.num_verified, rejected, link.num_tentative);
 }
 
 void MatchFigureOptions::VisitFields(OptionFieldVisitor& visitor) {

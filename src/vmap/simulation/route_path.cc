@@ -9,6 +9,7 @@
 
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/number_text.h"
 
 namespace vmap {
 
@@ -204,11 +205,9 @@ SimulatedRoute ReadRouteCsv(const std::filesystem::path& path, double corridor_w
     std::string field;
     while (std::getline(stream, field, ',')) fields.push_back(field);
     auto number_of = [&](const std::string& text, double* value) {
-      const char* begin = text.c_str();
-      char* end = nullptr;
-      *value = std::strtod(begin, &end);
-      while (end != nullptr && (*end == ' ' || *end == '\t')) ++end;
-      return end != begin && end != nullptr && *end == '\0';
+      const std::optional<double> number = ParseNumber(text);
+      if (number) *value = *number;
+      return number.has_value();
     };
     double x = 0.0, y = 0.0;
     if (fields.size() < 2 || !number_of(fields[0], &x) || !number_of(fields[1], &y)) {

@@ -13,6 +13,7 @@
 
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/number_text.h"
 #include "vmap/sources/internal.h"
 #include "vmap/sources/recording_reader.h"
 
@@ -67,11 +68,9 @@ std::vector<double> YamlList(const std::string& text, const std::string& key, co
   std::istringstream in(body);
   std::string token;
   while (in >> token) {
-    try {
-      numbers.push_back(std::stod(token));
-    } catch (const std::exception&) {
-      throw InputError("'" + file + "': '" + key + "' holds '" + token + "', which is not a number");
-    }
+    const std::optional<double> number = ParseNumber(token);
+    if (!number) throw InputError("'" + file + "': '" + key + "' holds '" + token + "', which is not a number");
+    numbers.push_back(*number);
   }
   return numbers;
 }
@@ -93,13 +92,12 @@ Camera ReadKittiCalib(const std::string& path, const std::string& projection) {
     std::vector<double> P;
     std::string token;
     while (fields >> token) {
-      char* end = nullptr;
-      const double v = std::strtod(token.c_str(), &end);
-      if (end == token.c_str() || *end != '\0' || !std::isfinite(v)) {
+      const std::optional<double> v = ParseNumber(token);
+      if (!v || !std::isfinite(*v)) {
         throw InputError("'" + path + "': " + projection + "'s value " + std::to_string(P.size() + 1) + ", '" +
                          token.substr(0, 40) + "', is not a finite number");
       }
-      P.push_back(v);
+      P.push_back(*v);
     }
     if (P.size() != 12) {
       throw InputError("'" + path + "': " + projection + " has " + std::to_string(P.size()) +
@@ -128,17 +126,13 @@ Camera ReadIntrinsicsText(const std::string& path) {
     std::string name;
     if (!(fields >> name)) continue;
     std::string value_text;
-    double value = 0;
     if (!(fields >> value_text)) {
       throw InputError(
           fmt::format("'{}' line {}: '{}' has no value; write 'name value' (e.g. fx 525.0)", path, number, name));
     }
-    try {
-      value = std::stod(value_text);
-    } catch (const std::exception&) {
-      throw InputError(fmt::format("'{}' line {}: '{}' is not a number", path, number, value_text));
-    }
-    values[Lower(name)] = value;
+    const std::optional<double> value = ParseNumber(value_text);
+    if (!value) throw InputError(fmt::format("'{}' line {}: '{}' is not a number", path, number, value_text));
+    values[Lower(name)] = *value;
   }
   if (values.count("f") && !values.count("fx")) values["fx"] = values["fy"] = values["f"];
   for (const char* required : {"fx", "fy", "cx", "cy"}) {

@@ -13,6 +13,7 @@
 
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/number_text.h"
 #include "vmap/sources/internal.h"
 #include "vmap/sources/kitti_frame_number.h"
 
@@ -184,15 +185,14 @@ std::vector<ImageEntry> ListKitti(const std::string& sequence_directory) {
     for (int number = 1; std::getline(*in, line); ++number) {
       line = Trim(line);
       if (line.empty()) continue;
-      char* end = nullptr;
-      const double t = std::strtod(line.c_str(), &end);
-      if (end == line.c_str() || *end != '\0' || !std::isfinite(t) || t < 0.0) {
+      const std::optional<double> t = ParseNumber(line);
+      if (!t || !std::isfinite(*t) || *t < 0.0) {
         spdlog::warn("{} line {}: {:?} is not a time in seconds; ignoring the timestamps",
                      (sequence / "times.txt").string(), number, line.substr(0, 40));
         times.clear();
         break;
       }
-      times.push_back(t);
+      times.push_back(*t);
     }
   }
   // An image takes the time of its frame number (000123.png: line 123), so a sequence with images missing

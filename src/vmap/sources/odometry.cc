@@ -11,6 +11,7 @@
 
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/number_text.h"
 #include "vmap/sources/message_buffer.h"
 
 namespace vmap {
@@ -41,12 +42,10 @@ std::optional<OdometrySample> InterpolateOdometry(const std::vector<OdometrySamp
 
 namespace {
 
-bool ParseNumber(const std::string& text, double* value) {
-  const char* begin = text.c_str();
-  char* end = nullptr;
-  *value = std::strtod(begin, &end);
-  while (end != nullptr && (*end == ' ' || *end == '\t')) ++end;
-  return end != begin && end != nullptr && *end == '\0';
+bool ReadNumber(const std::string& text, double* value) {
+  const std::optional<double> number = ParseNumber(text);
+  if (number) *value = *number;
+  return number.has_value();
 }
 
 }  // namespace
@@ -82,7 +81,7 @@ std::vector<OdometrySample> ParseOdometryCsv(std::istream& in, const std::string
     for (std::string field; std::getline(stream, field, ',');) fields.push_back(field);
     double values[4];
     bool numbers = fields.size() >= 4;
-    for (int i = 0; numbers && i < 4; ++i) numbers = ParseNumber(fields[i], &values[i]);
+    for (int i = 0; numbers && i < 4; ++i) numbers = ReadNumber(fields[i], &values[i]);
     if (!numbers) {
       if (header_allowed && fields.size() >= 4) {
         header_allowed = false;
