@@ -180,6 +180,12 @@ TEST(OdometryBuffer, InterpolatesBetweenSamplesAndGivesNoneOutsideThem) {
   ASSERT_TRUE(buffer.At(2.3).has_value());   // a frame a little newer: the last sample
   EXPECT_EQ(buffer.At(2.3)->x, 1.0);
   EXPECT_FALSE(buffer.At(2.6).has_value());  // odometry that stopped
+  // A stray stamp from the future, then the odometry as before: read anew, not ignored for good.
+  EXPECT_FALSE(buffer.Add({1e6, 5.0, 5.0, 0.0}));
+  EXPECT_TRUE(buffer.Add({2.5, 2.0, 0.0, 0.0}));
+  EXPECT_FALSE(buffer.Add({2.6, 2.1, 0.0, 0.0}));
+  ASSERT_TRUE(buffer.At(2.55).has_value());
+  EXPECT_NEAR(buffer.At(2.55)->x, 2.05, 1e-12);
 }
 
 TEST(Parameters, AreTheFlagsNamesWithUnderscores) {

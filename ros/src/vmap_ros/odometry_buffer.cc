@@ -4,11 +4,17 @@
 
 namespace vmap::ros_node {
 
-void OdometryBuffer::Add(const OdometrySample& sample) {
+bool OdometryBuffer::Add(const OdometrySample& sample) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!samples_.empty() && sample.timestamp <= samples_.back().timestamp) return;
+  bool restarted = false;
+  if (!samples_.empty() && sample.timestamp <= samples_.back().timestamp) {
+    if (sample.timestamp > samples_.back().timestamp - kRestartSeconds) return false;
+    samples_.clear();
+    restarted = true;
+  }
   samples_.push_back(sample);
   while (samples_.front().timestamp < sample.timestamp - keep_seconds_) samples_.pop_front();
+  return restarted;
 }
 
 std::optional<OdometrySample> OdometryBuffer::At(double timestamp) const {

@@ -17,7 +17,11 @@ class OdometryBuffer {
   explicit OdometryBuffer(double keep_seconds = 10.0, double max_gap_seconds = 0.5)
       : keep_seconds_(keep_seconds), max_gap_seconds_(max_gap_seconds) {}
 
-  void Add(const OdometrySample& sample);  // samples in time order; an older one than the newest is ignored
+  // Samples in time order: one a little older than the newest (out of order) is ignored; one more than
+  // kRestartSeconds older restarts the buffer (a bag played in a loop, a clock reset, or the newest a stray stamp from
+  // the future, after which every sample was ignored for good), and Add returns true.
+  static constexpr double kRestartSeconds = 1.0;
+  bool Add(const OdometrySample& sample);
   std::optional<OdometrySample> At(double timestamp) const;
   void Clear();
 

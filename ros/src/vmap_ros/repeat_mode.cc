@@ -166,10 +166,23 @@ void VmapNode::OnOdometry(const nav_msgs::Odometry::ConstPtr& odometry) {
   sample.yaw = std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
   if (std::isfinite(sample.timestamp) && std::isfinite(sample.x) && std::isfinite(sample.y) &&
       std::isfinite(sample.yaw)) {
-    odometry_.Add(sample);
+    if (odometry_.Add(sample)) {
+      ROS_WARN_THROTTLE(5.0,
+                        "the odometry on %s went back in time by more than %g s (a bag played in a loop? a clock "
+                        "reset?): read anew from this message",
+                        node_.resolveName("odom").c_str(), OdometryBuffer::kRestartSeconds);
+    }
     std::lock_guard<std::mutex> lock(teach_odometry_mutex_);
-    if (recording_teach_odometry_ && (teach_odometry_.empty() || sample.timestamp > teach_odometry_.back().timestamp)) {
-      teach_odometry_.push_back(sample);
+    if (recording_teach_odometry_) {
+      if (teach_odometry_.empty() || sample.timestamp > teach_odometry_.back().timestamp) {
+        teach_odometry_.push_back(sample);
+      } else {
+        // The map's odometry is one path in time order: a sample from before the last one kept cannot join it.
+        ROS_WARN_THROTTLE(5.0,
+                          "an Odometry message on %s is stamped %.3f s, not after the last kept (%.3f s): the teach "
+                          "run's odometry keeps its path in time order and leaves it out (a bag played in a loop?)",
+                          node_.resolveName("odom").c_str(), sample.timestamp, teach_odometry_.back().timestamp);
+      }
     }
   } else {
     LogMessageError("an Odometry message on " + node_.resolveName("odom") +

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <spdlog/spdlog.h>
+
 #include "vmap/control/guidance_signals.h"
 #include "vmap/core/error.h"
 #include "vmap/core/numeric.h"
@@ -143,6 +145,17 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
       const double middle = last_odometry_->yaw + 0.5 * WrapAngle(odometry->yaw - last_odometry_->yaw);
       driven = dx * std::cos(middle) + dy * std::sin(middle);
       turned = WrapAngle(odometry->yaw - last_odometry_->yaw);
+      // A step no robot held to these speeds drives in the time (an odometry reset, a glitch of 1e300 m) is no
+      // motion: it would move the tracker's estimate past the goal, or overflow it into NaN for the rest of the run.
+      const double slack = 3.0 * std::max(dt, 0.1);
+      if (std::hypot(dx, dy) > 0.2 + options_.max_speed * slack ||
+          std::abs(turned) > 0.2 + options_.max_angular_speed * slack) {
+        spdlog::warn(
+            "the odometry jumped by {:.3g} m and {:.3g} rad in {:.3g} s, more than the robot can drive: the "
+            "step is not taken as motion",
+            std::hypot(dx, dy), turned, dt);
+        driven = turned = 0.0;
+      }
     }
     last_odometry_ = *odometry;
   }
@@ -271,8 +284,9 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
     step.lateral_estimate = at.lateral;
     step.heading_error_estimate = at.heading_error;
     step.arc_estimate = at.s;
-    // The goal is the goal key image's (above); an estimate well past the end of the path stops the robot too.
-    if (at.s >= tracking_->path_length() - 1e-6 && PastTheEnd(tracking_->pose()) > 0.5) {
+    // The goal is the goal key image's (above); an estimate well past the end of the path stops the robot too, where
+    // the localizer places the robot on the last stretch (odometry alone ended runs half-way).
+    if (position_ >= last - 1 && at.s >= tracking_->path_length() - 1e-6 && PastTheEnd(tracking_->pose()) > 0.5) {
       reached_goal_ = true;
       return finish({}, ControllerState::kReachedGoal);
     }

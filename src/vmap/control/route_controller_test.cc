@@ -402,6 +402,31 @@ TEST(RouteController, InputsThatAreNoNumbersNeverMakeACommandThatIsNone) {
   }
 }
 
+// An odometry step no robot drives in the time (a glitch of 1e300 m, a reset by 5 m) is no motion: steering went on
+// as NaN, then 0, for the rest of the run, and a jump forward put the tracker's estimate past the goal, which ended
+// the run half-way.
+TEST(RouteController, AnOdometryJumpIsNoMotion) {
+  TaughtRoute route = StraightRoute();
+  for (int k = 0; k < 4; ++k) route.key_poses.push_back({10.0 + 2.0 * k, 1.0 * k, 0.0, 0.0});
+  for (int i = 0; i <= 30; ++i) route.path.push_back({10.0 + 0.2 * i, 0.1 * i, 0.0, 0.0});
+  for (TaughtSegment& segment : route.segments) segment.length = 1.0;
+  ControllerOptions options = NoRateLimits();
+  options.law = ControlLaw::kTracker;
+  for (const double jump : {1e300, 5.0}) {
+    RouteController controller = Running(route, options);
+    double x = 0.0;
+    for (int i = 0; i < 30; ++i) {
+      const double t = 0.1 * i;
+      x += 0.03;
+      const OdometrySample odometry{t, i >= 10 ? x + jump : x, 0.0, 0.0};
+      const ControlStep step = controller.Update(t, Tracked(1, 10.0), &odometry);
+      ASSERT_TRUE(std::isfinite(step.command.angular)) << jump << " " << i;
+      EXPECT_EQ(step.state, ControllerState::kFollowing) << jump << " " << i;
+      EXPECT_LT(step.command.angular, 0.0) << jump << " " << i;  // still steers towards the path
+    }
+  }
+}
+
 // At the goal the robot stops within the decelerations, and the controller says it reached the goal meanwhile (the
 // stop was one step, 6 m/s^2 at twice the speed, which put the simulated robot short of where a base stops).
 TEST(RouteController, TheGoalStopKeepsTheDecelerations) {
