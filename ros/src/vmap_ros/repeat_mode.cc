@@ -83,6 +83,13 @@ bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::St
   } catch (const std::exception& error) {
     return Fail(response, std::string("repeat/start: ") + error.what());
   }
+  if (const std::vector<std::string> unread = TeachParametersSet(); !unread.empty()) {
+    ROS_WARN(
+        "repeat/start: %s %s teach runs' (the map's frame size, camera, mask and matcher come from the map); a "
+        "repeat run does not read %s",
+        fmt::format("{}", fmt::join(unread, ", ")).c_str(), unread.size() == 1 ? "is" : "are",
+        unread.size() == 1 ? "it" : "them");
+  }
   response.route = run->route();
   const std::optional<Camera> map_camera = run->options().camera;
   const std::string started = fmt::format("repeat run started on map {}: {}, the taught profile from {}", options.map,

@@ -110,6 +110,15 @@ bool VmapNode::FinishTeach(std::unique_ptr<TeachRun> run, std::string* answer_te
       WriteTeachOdometry(result.directory, odometry);
       answer += fmt::format(", and {} odometry samples beside it ({})", odometry.size(), kTeachOdometryFileName);
     }
+    if (!result.map.input.camera) {
+      // Said here, not first at repeat/start ("~focal_px must be given"), when the teach run could still be redone.
+      const std::string without = fmt::format(
+          "; the map has no camera (no CameraInfo came on {} and ~camera was not set): its headings are in pixels, "
+          "and a repeat run on it needs ~focal_px",
+          camera_info_topic_);
+      ROS_WARN("teach run: %s", without.substr(2).c_str());
+      answer += without;
+    }
   } catch (const std::exception& error) {
     success = false;
     answer = fmt::format("the map could not be written ({} frames received): {}", received, error.what());

@@ -28,7 +28,17 @@ TopicFrameSource::TopicFrameSource(std::string topic, const FrameSourceOptions& 
 }
 
 void TopicFrameSource::Put(const topic_tools::ShapeShifter::ConstPtr& message) {
-  const double now = ros::Time::now().toSec();
+  double now = ros::Time::now().toSec();
+  // ROS time reads 0 with /use_sim_time set and no /clock: frames without stamps would all be stamped 0.
+  if (now <= 0.0) {
+    now = ros::WallTime::now().toSec();
+    if (!clock_warned_.exchange(true)) {
+      spdlog::warn(
+          "the ROS clock reads 0 (/use_sim_time is set and nothing publishes /clock?): {}'s frames without a "
+          "stamp are stamped by the wall clock",
+          topic_);
+    }
+  }
   if (mailbox_.Put(Received{message, now})) ++received_;
 }
 
@@ -40,6 +50,14 @@ void TopicFrameSource::SetCamera(const std::optional<Camera>& camera) {
 }
 
 void TopicFrameSource::End() { mailbox_.Close(); }
+
+void TopicFrameSource::Skip(const std::string& why) {
+  ++skipped_;
+  const auto now = std::chrono::steady_clock::now();
+  if (last_skip_warning_ && now - *last_skip_warning_ < std::chrono::duration<double>(kSkipWarningSeconds)) return;
+  last_skip_warning_ = now;
+  spdlog::warn("{}; skipping it ({} frame{} skipped so far)", why, skipped_, skipped_ == 1 ? "" : "s");
+}
 
 std::optional<Frame> TopicFrameSource::Next() {
   pulled_ = true;
@@ -56,15 +74,12 @@ std::optional<Frame> TopicFrameSource::Next() {
     try {
       image = DecodeCameraImage(*received->message, topic_);
     } catch (const InputError& error) {
-      ++skipped_;
-      spdlog::warn("{}; skipping it", error.what());
+      Skip(error.what());
       continue;
     }
     const std::string size_problem = FrameSizeProblem(image.gray.size(), options_);
     if (!size_problem.empty()) {
-      ++skipped_;
-      spdlog::warn("{}: frame {} is {}x{}, {}; skipping it", topic_, index, image.gray.cols, image.gray.rows,
-                   size_problem);
+      Skip(fmt::format("{}: frame {} is {}x{}, {}", topic_, index, image.gray.cols, image.gray.rows, size_problem));
       continue;
     }
     Frame frame;

@@ -5,6 +5,7 @@
 // numbering): a bag played to the node gives the map `vmap build` gives on the bag.
 
 #include <atomic>
+#include <chrono>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -63,6 +64,12 @@ class TopicFrameSource final : public FrameSource {
   int delivered_ = 0;
   int skipped_ = 0;
   int size_warnings_ = 0;
+  std::atomic<bool> clock_warned_{false};
+  // Skipped frames are said at most once every kSkipWarningSeconds (docs/ros.md), with the count so far: a camera
+  // sending nothing but broken frames wrote a warning a frame.
+  static constexpr double kSkipWarningSeconds = 5.0;
+  std::optional<std::chrono::steady_clock::time_point> last_skip_warning_;
+  void Skip(const std::string& why);
 };
 
 }  // namespace vmap::ros_node

@@ -133,6 +133,22 @@ void VmapNode::RefuseRecordingParameters() const {
   }
 }
 
+std::vector<std::string> VmapNode::TeachParametersSet() const {
+  ParameterNames teach, repeat;
+  BuildPipelineOptions build;
+  LocalizationSessionOptions session;
+  ControllerOptions controller;
+  teach.Add(build);
+  repeat.Add(session);
+  repeat.Add(controller);
+  std::vector<std::string> set;
+  for (const std::string& name : teach.names()) {
+    if (repeat.names().count(name) == 0 && private_node_.hasParam(name)) set.push_back("~" + name);
+  }
+  if (private_node_.hasParam("teach_queue")) set.push_back("~teach_queue");
+  return set;
+}
+
 std::set<std::string> VmapNode::KnownParameters() const {
   ParameterNames names;
   BuildPipelineOptions teach;

@@ -77,6 +77,9 @@ class VmapNode {
   std::string Busy() const;
   // Throws InputError for a parameter that names a recording to read (~topic, ~format): the node reads its topics.
   void RefuseRecordingParameters() const;
+  // The teach runs' parameters that are set (~tau, ~resize, ~camera, ...), which a repeat run does not read: it takes
+  // them from the map. Said at repeat/start, so that a value there is not taken to apply.
+  std::vector<std::string> TeachParametersSet() const;
   // Claims the idle node for a run being started ("" when claimed, else why not: Busy()); a StartClaim made then
   // gives it back idle when the start fails, unless kept once the run is set.
   std::string ClaimForStart();
