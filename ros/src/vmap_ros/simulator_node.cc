@@ -25,7 +25,6 @@
 
 #include "vmap_ros/Localization.h"
 #include "vmap_ros/parameter_reader.h"
-#include "vmap_ros/teach_odometry.h"
 #include "vmap_ros/terminate_signal.h"
 
 namespace vmap::ros_node {
@@ -239,8 +238,6 @@ int RunTheSimulator(ros::NodeHandle& node, ros::NodeHandle& private_node) {
     prepared = PrepareTrials(pipeline.simulation, pipeline.matcher, pipeline.map, [] {
       if (StopRequested()) throw StopRequestedError();
     });
-    // The teach run's odometry beside its map, as the vmap node's teach run writes it (teach_odometry.h).
-    WriteTeachOdometry(pipeline.map, prepared->teach_odometry);
   } catch (const StopRequestedError&) {
     ROS_WARN("vmap simulator: stopped during the teach run; its map was not written");
     return StoppedStatus();

@@ -15,6 +15,7 @@
 #include "vmap/core/stopwatch.h"
 #include "vmap/map/map_io.h"
 #include "vmap/pipelines/build_pipeline.h"
+#include "vmap/pipelines/localize_odometry.h"
 #include "vmap/pipelines/output_policies.h"
 #include "vmap/simulation/simulation_output.h"
 #include "vmap/simulation/teach_run.h"
@@ -154,6 +155,10 @@ std::unique_ptr<PreparedTrials> PrepareTrials(const SimulationOptions& options, 
   context.teach_duration = teach.odometry.back().timestamp;
   context.options = options;
   context.after_frame = after_frame;
+  // 5. The teach run's odometry beside its map, as a robot's teach run writes it (the ROS node's), so that a map kept
+  //    (--map) repeats with its taught profile and the localizer's pace; written once the trials' session is open,
+  //    which reads the map as it was built.
+  WriteFileAtomically(map_directory / kTeachOdometryFileName, OdometryCsv(teach.odometry));
   return prepared;
 }
 

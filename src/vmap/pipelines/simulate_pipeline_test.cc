@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include "vmap/pipelines/localize_odometry.h"
+#include "vmap/sources/odometry.h"
 #include "vmap/testing/scoped_temp_dir.h"
 
 namespace vmap {
@@ -49,6 +51,10 @@ TEST(ClosedLoop, AShortStraightRouteIsRepeatedFromOffsetsToTheGoal) {
   }
   EXPECT_EQ(result.summary.successes, 2);
   EXPECT_TRUE(std::filesystem::is_regular_file(temp.path() / "map" / "map.json"));  // kept, as asked
+  // With its teach odometry, as a robot's teach run keeps it: a repeat on the kept map has the taught profile.
+  const std::vector<OdometrySample> odometry = ReadOdometryCsv(temp.path() / "map" / kTeachOdometryFileName);
+  ASSERT_GE(odometry.size(), 2u);
+  EXPECT_NEAR(odometry.back().x - odometry.front().x, 6.0, 0.5);  // the 6 m straight route
 }
 
 TEST(ClosedLoop, TheSameOptionsGiveTheSameRuns) {
