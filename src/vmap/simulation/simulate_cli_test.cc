@@ -79,6 +79,10 @@ TEST(SimulateCli, BadInputIsOneErrorLineAndWritesNothing) {
   ExpectRefused("--heading-gain -1", "--heading-gain");
   ExpectRefused("--rate inf", "--rate");
   ExpectRefused("--law pid", "pid");
+  // A robot as wide as the corridor is named as the radius (the offset was blamed, told to be at most -3.50 m).
+  ExpectRefused("--robot-radius 1.5 --lateral-offset 0", "--robot-radius 1.5 m makes the robot 3 m wide");
+  // Hexadecimal is no number of metres (strtod read 0x4 as 4).
+  ExpectRefused("--route " + Quote(WriteRoute(temp.path(), "0,0\n0x4,0\n")), "line 2");
 }
 
 // Outputs that would land on each other are refused before the teach run: each was once found written over

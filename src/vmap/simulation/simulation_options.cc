@@ -79,8 +79,14 @@ void SimulationOptions::Check() const {
                       fmt::format("{} m puts the camera above the {} m walls; lower it or raise --wall-height",
                                   camera.mount_height, corridor.wall_height));
   }
-  // A start offset must leave the robot inside the corridor.
+  // The robot must fit the corridor, and a start offset must leave it inside.
   const double room = 0.5 * corridor.width - robot_radius;
+  if (!(room > 0.0)) {
+    throw OptionError("robot_radius",
+                      fmt::format("{} m makes the robot {} m wide, no narrower than the {} m corridor; give a smaller "
+                                  "radius or a wider --corridor-width",
+                                  robot_radius, 2 * robot_radius, corridor.width));
+  }
   if (!(max_lateral_offset < room)) {
     throw OptionError("max_lateral_offset",
                       fmt::format("{} m does not fit the corridor: a robot {} m wide starts at most {:.2f} m off the "
