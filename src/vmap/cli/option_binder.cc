@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "vmap/core/error.h"
 #include "vmap/core/option_ranges.h"
 
 namespace vmap::cli {
@@ -20,8 +21,13 @@ CLI::Option* BindEnum(CLI::App* command, const std::string& flag, const OptionFi
   return command
       ->add_option_function<std::string>(
           flag,
-          [values](const std::string& text) {
-            for (const EnumField& value : values) value.Parse(text);
+          [values, flag](const std::string& text) {
+            try {
+              for (const EnumField& value : values) value.Parse(text);
+            } catch (const InputError& error) {
+              // Named as a number flag's error is ("--law: unknown control law 'TRACKER'; use ...").
+              throw InputError(flag.substr(flag.rfind(',') + 1) + ": " + error.what());
+            }
           },
           Help(field, values.front().names()))
       ->default_str(values.front().name());

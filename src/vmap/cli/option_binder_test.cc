@@ -71,13 +71,14 @@ TEST(OptionBinder, BindsEachFlaggedFieldAndRecordsItsPath) {
   EXPECT_EQ(app.get_option("--threads")->get_type_name(), "INT");
 }
 
-TEST(OptionBinder, AnUnknownEnumNameIsTheParsersError) {
+// The parser's error, named by the flag as a number flag's error is (it named no flag: "unknown control law ...").
+TEST(OptionBinder, AnUnknownEnumNameIsTheParsersErrorNamedByTheFlag) {
   CLI::App app;
   OptionFlags flags;
   Whole whole;
   AddOptionFlags(&app, whole, flags);
   EXPECT_EQ(testing::InputErrorMessage([&] { app.parse("--shape oval", false); }),
-            "unknown shape 'oval'; use round or square");
+            "--shape: unknown shape 'oval'; use round or square");
 }
 
 TEST(OptionBinder, SkipsWhatTheHolderLeavesOutAndSharesAFlagBetweenFields) {

@@ -26,6 +26,15 @@ TaughtRoute StraightRoute() {
   return route;
 }
 
+// The straight route with its teach odometry: key images 1 m apart along x, taken 2 s apart.
+TaughtRoute MetricStraightRoute() {
+  TaughtRoute route = StraightRoute();
+  for (int k = 0; k < 4; ++k) route.key_poses.push_back({10.0 + 2.0 * k, 1.0 * k, 0.0, 0.0});
+  for (int i = 0; i <= 30; ++i) route.path.push_back({10.0 + 0.2 * i, 0.1 * i, 0.0, 0.0});
+  for (TaughtSegment& segment : route.segments) segment.length = 1.0;
+  return route;
+}
+
 LocalizationResult Tracked(int key, double heading_deg) {
   LocalizationResult result;
   result.status = LocalizationStatus::kTracking;
@@ -134,11 +143,7 @@ TEST(RouteController, ServoSteersToTheKeyImagesLineWhenTheTranslationIsKnown) {
 }
 
 TEST(RouteController, TrackerFollowsTheTaughtPathWhereTheRouteIsMetric) {
-  // The straight route with its teach odometry: key images 1 m apart along x, taken 2 s apart.
-  TaughtRoute route = StraightRoute();
-  for (int k = 0; k < 4; ++k) route.key_poses.push_back({10.0 + 2.0 * k, 1.0 * k, 0.0, 0.0});
-  for (int i = 0; i <= 30; ++i) route.path.push_back({10.0 + 0.2 * i, 0.1 * i, 0.0, 0.0});
-  for (TaughtSegment& segment : route.segments) segment.length = 1.0;
+  const TaughtRoute route = MetricStraightRoute();
   ASSERT_TRUE(route.metric());
   ControllerOptions options = NoRateLimits();
   options.law = ControlLaw::kTracker;
@@ -382,10 +387,7 @@ TEST(RouteController, ALostRobotSlowsDownFromTheSpeedItWasGiven) {
 // What is no number never reaches the wheels: a NaN time is refused, an odometry sample holding one is ignored (one
 // made every later turn rate NaN).
 TEST(RouteController, InputsThatAreNoNumbersNeverMakeACommandThatIsNone) {
-  TaughtRoute route = StraightRoute();
-  for (int k = 0; k < 4; ++k) route.key_poses.push_back({10.0 + 2.0 * k, 1.0 * k, 0.0, 0.0});
-  for (int i = 0; i <= 30; ++i) route.path.push_back({10.0 + 0.2 * i, 0.1 * i, 0.0, 0.0});
-  for (TaughtSegment& segment : route.segments) segment.length = 1.0;
+  const TaughtRoute route = MetricStraightRoute();
   ControllerOptions options = NoRateLimits();
   options.law = ControlLaw::kTracker;
   RouteController controller = Running(route, options);
@@ -406,10 +408,7 @@ TEST(RouteController, InputsThatAreNoNumbersNeverMakeACommandThatIsNone) {
 // as NaN, then 0, for the rest of the run, and a jump forward put the tracker's estimate past the goal, which ended
 // the run half-way.
 TEST(RouteController, AnOdometryJumpIsNoMotion) {
-  TaughtRoute route = StraightRoute();
-  for (int k = 0; k < 4; ++k) route.key_poses.push_back({10.0 + 2.0 * k, 1.0 * k, 0.0, 0.0});
-  for (int i = 0; i <= 30; ++i) route.path.push_back({10.0 + 0.2 * i, 0.1 * i, 0.0, 0.0});
-  for (TaughtSegment& segment : route.segments) segment.length = 1.0;
+  const TaughtRoute route = MetricStraightRoute();
   ControllerOptions options = NoRateLimits();
   options.law = ControlLaw::kTracker;
   for (const double jump : {1e300, 5.0}) {

@@ -5,9 +5,11 @@
 namespace vmap {
 
 std::optional<double> ParseNumber(std::string_view text) {
-  const size_t first = text.find_first_not_of(" \t");
+  // White space around it as strtod skips it before and a line's end leaves it after ("-10\r" of a CRLF file).
+  constexpr std::string_view kSpace = " \t\r\n\v\f";
+  const size_t first = text.find_first_not_of(kSpace);
   if (first == std::string_view::npos) return std::nullopt;
-  text = text.substr(first, text.find_last_not_of(" \t") + 1 - first);
+  text = text.substr(first, text.find_last_not_of(kSpace) + 1 - first);
   // std::from_chars reads no locale (the reason it is used here) and no leading '+', which strtod takes.
   if (text.size() > 1 && text[0] == '+' && text[1] != '-') text.remove_prefix(1);
   double value = 0.0;

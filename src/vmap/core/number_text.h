@@ -9,8 +9,8 @@
 
 namespace vmap {
 
-// The whole of `text`, spaces and tabs around it aside, as a number ("-1.5e-3", "+2", "inf", "nan", as strtod reads
-// them in the C locale; no hexadecimal); nullopt when it is none or anything else follows it.
+// The whole of `text`, white space around it aside (a CRLF line's "\r"), as a number ("-1.5e-3", "+2", "inf", "nan", as
+// strtod reads them in the C locale; no hexadecimal); nullopt when it is none or anything else follows it.
 std::optional<double> ParseNumber(std::string_view text);
 
 }  // namespace vmap

@@ -13,6 +13,7 @@ namespace vmap {
 TEST(NumberText, ReadsTheWholeTextAsStrtodDoesInTheCLocale) {
   EXPECT_EQ(ParseNumber("525.06"), 525.06);
   EXPECT_EQ(ParseNumber(" -7.613e-3\t"), -7.613e-3);
+  EXPECT_EQ(ParseNumber("-10\r"), -10.0);  // a CRLF file's line
   EXPECT_EQ(ParseNumber("+2"), 2.0);
   EXPECT_EQ(ParseNumber("1e5"), 1e5);
   EXPECT_TRUE(std::isinf(*ParseNumber("inf")));
