@@ -303,7 +303,7 @@ int RunTheSimulator(ros::NodeHandle& node, ros::NodeHandle& private_node) {
     FromMessages(message, command, &localization, &step);
     run.Record(localization, step, std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count());
     // At the goal the controller slows the robot down within its decelerations: the robot stops where that ends.
-    if (step.state == ControllerState::kReachedGoal && step.command.linear == 0.0 && step.command.angular == 0.0) break;
+    if (step.state == ControllerState::kReachedGoal && step.command.stops()) break;
     run.Drive(step.command);
   }
   if (StopRequested()) {

@@ -3,9 +3,9 @@
 // motors on ROS topics, so that a vmap node drives it through ROS as it would drive a robot.
 //
 // At start-up it teaches the route (the corridor rendered along it, the map built into ~map as `vmap simulate`
-// builds it, the teach run's odometry beside it as the vmap node's teach run writes it: teach_odometry.h), and
-// publishes ~ready (latched). Then, once a vmap node listens to its camera, it runs repeat trial ~trial of
-// `vmap simulate`'s options: for each control step it publishes the rendered frame (camera/image_raw, bgr8, with
+// builds it, the teach run's odometry beside it as the vmap node's teach run writes it: pipelines/localize_odometry.h),
+// and publishes ~ready (latched). Then, once a vmap node listens to its camera, it runs repeat trial ~trial of `vmap
+// simulate`'s options: for each control step it publishes the rendered frame (camera/image_raw, bgr8, with
 // camera/camera_info) and the robot's odometry (odom, before the frame), waits for the vmap node's command
 // (cmd_vel) and localization message (localization) for that frame, and drives the robot by it: lock-step, so the
 // machine's speed changes nothing. The trial ends as `vmap simulate`'s do (the goal reached, the corridor left, the

@@ -4,11 +4,11 @@
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include "vmap/core/error.h"
+#include "vmap/pipelines/localize_odometry.h"
 
 #include "vmap_ros/TeachProgress.h"
 #include "vmap_ros/parameter_reader.h"
 #include "vmap_ros/service_answers.h"
-#include "vmap_ros/teach_odometry.h"
 #include "vmap_ros/vmap_node.h"
 
 namespace vmap::ros_node {

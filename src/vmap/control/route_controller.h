@@ -49,6 +49,8 @@ std::string ControllerStateName(ControllerState state);
 struct VelocityCommand {
   double linear = 0.0;   // m/s along the robot's forward axis (negative: reversing)
   double angular = 0.0;  // rad/s, counter-clockwise seen from above
+
+  bool stops() const { return linear == 0.0 && angular == 0.0; }
 };
 
 // What the controller did with one frame.

@@ -74,6 +74,11 @@ bool CutShortJpeg(const ReadBytes& read, std::uint64_t size) {
   return true;
 }
 
+// The reader of an open file.
+ReadBytes FromFile(const ContainedFile& file) {
+  return [&file](std::uint64_t offset, void* data, std::size_t bytes) { return file.Read(offset, data, bytes); };
+}
+
 // The reader of an encoded image held in memory.
 ReadBytes InMemory(const std::uint8_t* encoded, std::size_t size) {
   return [encoded, size](std::uint64_t offset, void* data, std::size_t bytes) {
@@ -85,16 +90,9 @@ ReadBytes InMemory(const std::uint8_t* encoded, std::size_t size) {
 
 }  // namespace
 
-std::optional<cv::Size> ImageHeaderSize(const ContainedFile& file) {
-  return HeaderSize(
-      [&file](std::uint64_t offset, void* data, std::size_t bytes) { return file.Read(offset, data, bytes); });
-}
+std::optional<cv::Size> ImageHeaderSize(const ContainedFile& file) { return HeaderSize(FromFile(file)); }
 
-bool IsCutShortJpeg(const ContainedFile& file) {
-  return CutShortJpeg(
-      [&file](std::uint64_t offset, void* data, std::size_t bytes) { return file.Read(offset, data, bytes); },
-      file.size());
-}
+bool IsCutShortJpeg(const ContainedFile& file) { return CutShortJpeg(FromFile(file), file.size()); }
 
 bool IsCutShortJpeg(const std::uint8_t* encoded, std::size_t size) {
   return CutShortJpeg(InMemory(encoded, size), size);

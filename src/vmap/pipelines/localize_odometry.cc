@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/sources/recording_reader.h"
@@ -38,6 +39,10 @@ std::optional<OdometryProgress> OpenQueryOdometry(const std::string& path, const
   std::vector<OdometrySample> samples = ReadOdometryTopic(query, topic);
   spdlog::info("odometry        {} samples from {}", samples.size(), topic.empty() ? topics.front() : topic);
   return OdometryProgress(OdometryTrack(std::move(samples)));
+}
+
+void WriteTeachOdometry(const std::filesystem::path& map, const std::vector<OdometrySample>& samples) {
+  WriteFileAtomically(map / kTeachOdometryFileName, OdometryCsv(samples));
 }
 
 std::vector<OdometrySample> ReadTeachOdometry(const std::filesystem::path& map, const std::string& given,

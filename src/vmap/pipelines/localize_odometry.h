@@ -31,6 +31,9 @@ inline constexpr const char* kTeachOdometryFileName = "teach_odometry.csv";
 // InputError naming the file when it cannot be read.
 std::vector<OdometrySample> ReadTeachOdometry(const std::filesystem::path& map, const std::string& given,
                                               const std::string& topic);
+// Writes `samples` as the map folder's teach odometry (the CSV ReadTeachOdometry reads), atomically: the ROS node's
+// teach run and the simulator's teach run.
+void WriteTeachOdometry(const std::filesystem::path& map, const std::vector<OdometrySample>& samples);
 
 // ",odometry_x,odometry_y,odometry_yaw,odometry_distance,key_distance" and a frame's cells (empty when the
 // odometry does not cover the frame).

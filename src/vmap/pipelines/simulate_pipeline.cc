@@ -158,7 +158,7 @@ std::unique_ptr<PreparedTrials> PrepareTrials(const SimulationOptions& options, 
   // 5. The teach run's odometry beside its map, as a robot's teach run writes it (the ROS node's), so that a map kept
   //    (--map) repeats with its taught profile and the localizer's pace; written once the trials' session is open,
   //    which reads the map as it was built.
-  WriteFileAtomically(map_directory / kTeachOdometryFileName, OdometryCsv(teach.odometry));
+  WriteTeachOdometry(map_directory, teach.odometry);
   return prepared;
 }
 

@@ -25,7 +25,7 @@ TrialResult RunTrial(const TrialContext& context, int index) {
         controller.Update(run.time(), localization, context.options.use_odometry ? &odometry : nullptr);
     run.Record(localization, step, SecondsSince(step_start));
     // At the goal the controller slows the robot down within its decelerations: the robot stops where that ends.
-    if (step.state == ControllerState::kReachedGoal && step.command.linear == 0.0 && step.command.angular == 0.0) break;
+    if (step.state == ControllerState::kReachedGoal && step.command.stops()) break;
     run.Drive(step.command);
   }
   return run.Finish();

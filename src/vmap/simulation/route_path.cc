@@ -204,13 +204,9 @@ SimulatedRoute ReadRouteCsv(const std::filesystem::path& path, double corridor_w
     std::stringstream stream(line);
     std::string field;
     while (std::getline(stream, field, ',')) fields.push_back(field);
-    auto number_of = [&](const std::string& text, double* value) {
-      const std::optional<double> number = ParseNumber(text);
-      if (number) *value = *number;
-      return number.has_value();
-    };
-    double x = 0.0, y = 0.0;
-    if (fields.size() < 2 || !number_of(fields[0], &x) || !number_of(fields[1], &y)) {
+    const std::optional<double> read_x = fields.size() >= 2 ? ParseNumber(fields[0]) : std::nullopt;
+    const std::optional<double> read_y = fields.size() >= 2 ? ParseNumber(fields[1]) : std::nullopt;
+    if (!read_x || !read_y) {
       if (header_allowed && fields.size() >= 2) {  // a header line such as "x,y"
         header_allowed = false;
         continue;
@@ -228,6 +224,7 @@ SimulatedRoute ReadRouteCsv(const std::filesystem::path& path, double corridor_w
           "e.g. cut -d, -f1,2)",
           name, number, fields.size()));
     }
+    const double x = *read_x, y = *read_y;
     if (!std::isfinite(x) || !std::isfinite(y) || std::abs(x) > 1e4 || std::abs(y) > 1e4) {
       throw InputError(
           fmt::format("route CSV '{}' line {}: waypoint ({}, {}) is not a finite number of metres within "

@@ -154,7 +154,7 @@ void TrialRun::Record(const LocalizationResult& localization, const ControlStep&
   if (step.state == ControllerState::kReachedGoal) {
     trial_.reached_goal = true;
     // The trial ends where the robot stands still: the controller slows it down within its decelerations.
-    if (step.command.linear == 0.0 && step.command.angular == 0.0) trial_.end = "reached goal";
+    if (step.command.stops()) trial_.end = "reached goal";
   }
 }
 

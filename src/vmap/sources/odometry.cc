@@ -40,16 +40,6 @@ std::optional<OdometrySample> InterpolateOdometry(const std::vector<OdometrySamp
   return result;
 }
 
-namespace {
-
-bool ReadNumber(const std::string& text, double* value) {
-  const std::optional<double> number = ParseNumber(text);
-  if (number) *value = *number;
-  return number.has_value();
-}
-
-}  // namespace
-
 std::string OdometryCsv(const std::vector<OdometrySample>& samples) {
   std::string csv = "timestamp,x,y,yaw\n";
   for (const OdometrySample& sample : samples) {
@@ -81,7 +71,11 @@ std::vector<OdometrySample> ParseOdometryCsv(std::istream& in, const std::string
     for (std::string field; std::getline(stream, field, ',');) fields.push_back(field);
     double values[4];
     bool numbers = fields.size() >= 4;
-    for (int i = 0; numbers && i < 4; ++i) numbers = ReadNumber(fields[i], &values[i]);
+    for (int i = 0; numbers && i < 4; ++i) {
+      const std::optional<double> value = ParseNumber(fields[i]);
+      numbers = value.has_value();
+      values[i] = value.value_or(0.0);
+    }
     if (!numbers) {
       if (header_allowed && fields.size() >= 4) {
         header_allowed = false;
