@@ -141,6 +141,53 @@ TEST(TeachNode, ATerminateSignalFinishesTheTeachRunsMap) {
   EXPECT_NE(node->Log().find("teach run stopped: map"), std::string::npos) << node->Log();
 }
 
+// SIGKILL (or the power) gives the node no time to finish: what is left is the last snapshot, and it holds the
+// odometry of its stretch beside its map, for the repeat runs' taught speeds and the localizer's pace.
+TEST(TeachNode, AKilledTeachRunLeavesItsLastSnapshotWithItsOdometry) {
+  SKIP_WITHOUT_SHARED();
+  ScopedTempDir dir("ros_teach_sigkill");
+  const fs::path bag = dir.path() / "teach.bag";
+  const std::vector<ros::Time> stamps =
+      WriteVideoBag(fs::path(SharedDir()) / "data/lab_floor/lab_floor.mp4", 0, 39, bag, "bgr8", 0.05);
+  const auto node = StartVmapNode(
+      "/teach_kill", {"image:=/camera/image_raw", "odom:=/odom", "_teach_queue:=100", "_snapshot_every:=0.2"},
+      dir.path() / "node.log");
+  ASSERT_TRUE(WaitForNodeServices("/teach_kill/vmap")) << node->Log();
+  ros::NodeHandle handle;
+  std::mutex mutex;
+  uint32_t frames = 0;
+  const ros::Subscriber subscriber = handle.subscribe<vmap_ros::TeachProgress>(
+      "/teach_kill/vmap/teach/progress", 100, [&](const vmap_ros::TeachProgress::ConstPtr& message) {
+        std::lock_guard<std::mutex> lock(mutex);
+        frames = message->frames;
+      });
+  vmap_ros::StartTeach start;
+  start.request.map = (dir.path() / "map").string();
+  ASSERT_TRUE(ros::service::call("/teach_kill/vmap/teach/start", start));
+  ASSERT_TRUE(start.response.success) << start.response.message;
+  ASSERT_TRUE(WaitFor([&] { return subscriber.getNumPublishers() > 0; }, kTimeout));
+  const auto player = PlayBag(bag, 1.0, dir.path() / "play.log");
+  ASSERT_EQ(player->Wait(std::chrono::seconds(120)), 0) << player->Log();
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(mutex);
+        return frames == stamps.size();
+      },
+      kTimeout))
+      << node->Log();
+
+  node->Stop(std::chrono::seconds(10), SIGKILL);
+  const VisualMap map = ReadMap(dir.path() / "map");
+  ASSERT_TRUE(map.coverage.has_value());
+  EXPECT_EQ(map.coverage->end, CoverageEnd::kSnapshot);
+  EXPECT_GE(map.num_frames, 2);
+  const std::vector<OdometrySample> odometry = ReadOdometryCsv(dir.path() / "map" / "teach_odometry.csv");
+  ASSERT_FALSE(odometry.empty());
+  EXPECT_LE(odometry.size(), stamps.size());
+  EXPECT_GE(odometry.front().timestamp, stamps.front().toSec());
+  EXPECT_LE(odometry.back().timestamp, stamps.back().toSec());
+}
+
 TEST(TeachNode, RefusesAFolderThatIsNotAMapAndLeavesItAsItWas) {
   ScopedTempDir dir("ros_teach_refuse");
   fs::create_directories(dir.path() / "notes");

@@ -1,5 +1,9 @@
 // The node's teach run (vmap_node.h): services, the camera's frames into the build pipeline, progress.
 
+#include <filesystem>
+#include <mutex>
+#include <vector>
+
 #include <fmt/format.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
@@ -36,6 +40,16 @@ bool VmapNode::StartTeach(vmap_ros::StartTeach::Request& request, vmap_ros::Star
     options.until_interrupted = false;
     options.map.show_progress = false;
     options.map.after_frame = [this] { PublishTeachProgress(); };
+    // The odometry so far rides with every snapshot, so that a node killed between them (SIGKILL, power) leaves a
+    // map and the odometry of the same stretch.
+    options.write_beside_map = [this](const std::filesystem::path& folder) {
+      std::vector<OdometrySample> odometry;
+      {
+        std::lock_guard<std::mutex> lock(teach_odometry_mutex_);
+        odometry = teach_odometry_;
+      }
+      if (!odometry.empty()) WriteTeachOdometry(folder, odometry);
+    };
     int capacity = kTeachQueue;
     if (XmlRpc::XmlRpcValue queue; private_node_.getParam("teach_queue", queue)) {
       // Read as a value first: getParam into an int leaves the default for "x" or 1.5, silently.
@@ -91,24 +105,27 @@ bool VmapNode::StopTeach(std_srvs::Trigger::Request&, std_srvs::Trigger::Respons
 
 bool VmapNode::FinishTeach(std::unique_ptr<TeachRun> run, std::string* answer_text) {
   odometry_subscriber_.shutdown();
-  std::vector<OdometrySample> odometry;
   {
     std::lock_guard<std::mutex> lock(teach_odometry_mutex_);
-    recording_teach_odometry_ = false;
-    odometry.swap(teach_odometry_);
+    recording_teach_odometry_ = false;  // the map, written by Stop, takes what came until here
   }
   const long received = run->source().received();
   std::string& answer = *answer_text;
   bool success = true;
   try {
     const BuildPipelineResult result = run->Stop();
+    size_t odometry_samples = 0;
+    {
+      std::lock_guard<std::mutex> lock(teach_odometry_mutex_);
+      odometry_samples = teach_odometry_.size();
+      std::vector<OdometrySample>().swap(teach_odometry_);
+    }
     teach_dropped_ += static_cast<long>(run->source().dropped());
     answer = fmt::format("teach run stopped: map {} written, {} key images from {} frames ({} dropped, {} skipped)",
                          result.directory.string(), result.map.key_images.size(), teach_frames_.load(),
                          teach_dropped_.load(), run->source().skipped_frames());
-    if (!odometry.empty()) {
-      WriteTeachOdometry(result.directory, odometry);
-      answer += fmt::format(", and {} odometry samples beside it ({})", odometry.size(), kTeachOdometryFileName);
+    if (odometry_samples > 0) {
+      answer += fmt::format(", and {} odometry samples beside it ({})", odometry_samples, kTeachOdometryFileName);
     }
     if (!result.map.input.camera) {
       // Said here, not first at repeat/start ("~focal_px must be given"), when the teach run could still be redone.

@@ -159,7 +159,7 @@ class VmapNode {
   ros::WallTime last_frame_;     // when the repeat run started or last processed a frame
   bool quiet_stopped_ = false;   // the watchdog stopped the robot and no frame has come since
   OdometryBuffer odometry_;
-  // A teach run's odometry, written beside its map (WriteTeachOdometry, pipelines/localize_odometry.h).
+  // A teach run's odometry, written into each of its snapshots and its map (BuildPipelineOptions::write_beside_map).
   std::mutex teach_odometry_mutex_;
   bool recording_teach_odometry_ = false;
   std::vector<OdometrySample> teach_odometry_;

@@ -205,6 +205,7 @@ void MapWriter::Snapshot(const VisualMap& map) {
     }
   }
   WriteMapAndCorrespondences(map, snapshot.path());
+  if (snapshots_->write_beside) snapshots_->write_beside(snapshot.path());
   snapshot.Commit();
 }
 

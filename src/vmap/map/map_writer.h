@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -32,6 +33,8 @@ inline constexpr std::size_t kEvaluationRecordSize = 4 * sizeof(int) + sizeof(do
 struct SnapshotTarget {
   std::filesystem::path final_path;  // the map directory being built (`vmap build -o`)
   OutputPolicy policy;               // what may be replaced there (the previous snapshot is a vmap map)
+  // Writes the host's own files into each snapshot's folder before it is committed (may be empty).
+  std::function<void(const std::filesystem::path& snapshot_folder)> write_beside;
 };
 
 class MapWriter {

@@ -59,7 +59,7 @@ VisualMap BuildStreaming(const BuildPipelineOptions& pipeline, FrameSource& inpu
                          bool* interrupted) {
   std::optional<SnapshotTarget> snapshots;
   if (pipeline.snapshot_every > 0) {
-    snapshots = SnapshotTarget{directory.final_path(), MapOutputPolicy(files_read)};
+    snapshots = SnapshotTarget{directory.final_path(), MapOutputPolicy(files_read), pipeline.write_beside_map};
     snapshots->policy.keep_if_commit_fails = false;  // the next snapshot, or the map itself, takes its place
   }
   MapWriter writer(directory.path(), snapshots);
@@ -219,8 +219,9 @@ BuildPipelineResult RunBuildPipeline(const BuildPipelineOptions& pipeline, Frame
                    : BuildStreaming(pipeline, source, *matcher, options, directory, options_json, files_read,
                                     &result.interrupted);
 
-  // 6. The report.
+  // 6. The report, and the host's files.
   if (pipeline.report) WriteMapReport(directory.path());
+  if (pipeline.write_beside_map) pipeline.write_beside_map(directory.path());
 
   // 7. The map in place.
   directory.Commit();

@@ -4,6 +4,7 @@
 // input, build (frame by frame, with snapshots while it runs, or by bisection), write the report, commit.
 
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -29,6 +30,10 @@ struct BuildPipelineOptions {
   // The input ends when the host says so (InputEndRequested, core/interrupt.h: the CLI's first SIGINT), and the map
   // is finished from the frames seen: for cameras and streams. The host turns that on (EndInputOnSigint).
   bool until_interrupted = false;
+  // The host's own files, written into the map folder before each snapshot and the map itself are committed, so
+  // that a run killed between snapshots keeps them with the map they belong to (the ROS teach run's odometry). Not
+  // an option: no flag or JSON field. Throws as a file of the map that cannot be written does.
+  std::function<void(const std::filesystem::path& map_folder)> write_beside_map;
 
   // The fields above, each once: the positional input, -o, the input's, the matchers', τ, the builder's and the
   // verifier's options, --report, --snapshot-every, --until-interrupted. Every field's path is the one its check
@@ -59,7 +64,7 @@ struct BuildPipelineResult {
 //   4. open the input;
 //   5. build the map: frame by frame through a MapBuilder (snapshots, the host's end of input, the builder's
 //      after_frame hook), or by bisection (key_search bisect);
-//   6. write the report when asked;
+//   6. write the report when asked, and the host's files (write_beside_map);
 //   7. commit the folder.
 // Throws InputError (OptionError for an option) and leaves the output as it was on any failure. `source_files`: with
 // `source`, the files its frames come from (a simulator's route and textures), which the output may not replace.

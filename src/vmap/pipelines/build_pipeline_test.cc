@@ -105,6 +105,36 @@ TEST(BuildPipeline, NeitherAFailedSnapshotNorAFailedCommitLosesTheRun) {
   EXPECT_GE(read.map.key_images.size(), 2u);
 }
 
+// The host's files ride with each snapshot and the map: at every frame, the folder on disk holds the file of the
+// snapshot it holds, so a run killed between snapshots keeps both of the same moment.
+TEST(BuildPipeline, TheHostsFilesAreInEverySnapshotAndInTheMap) {
+  testing::ScopedTempDir tmp;
+  testing::WriteImageFolder(testing::SidewaysDrive(), tmp.path() / "teach");
+  BuildPipelineOptions options;
+  options.input = (tmp.path() / "teach").string();
+  options.output = (tmp.path() / "map").string();
+  options.snapshot_every = 1e-6;  // a snapshot after every frame
+  int frames = 0, written = 0;
+  std::vector<int> snapshot_frames;  // the frame count in the host's file of each snapshot seen on disk
+  options.map.after_frame = [&] {
+    ++frames;
+    if (!fs::exists(tmp.path() / "map/map.json")) return;
+    snapshot_frames.push_back(std::stoi(testing::ReadText(tmp.path() / "map/host.txt")));
+  };
+  options.write_beside_map = [&](const fs::path& folder) {
+    ++written;
+    EXPECT_NE(folder, tmp.path() / "map");  // into the folder about to be committed, never the committed one
+    std::ofstream(folder / "host.txt") << frames;
+  };
+  const BuildPipelineResult built = RunBuildPipeline(Quiet(options));
+  ASSERT_GE(snapshot_frames.size(), 2u);
+  for (size_t i = 1; i < snapshot_frames.size(); ++i) EXPECT_GE(snapshot_frames[i], snapshot_frames[i - 1]);
+  EXPECT_GT(snapshot_frames.back(), snapshot_frames.front());
+  EXPECT_GT(written, static_cast<int>(snapshot_frames.size()));  // the snapshots seen, and the map
+  EXPECT_EQ(testing::ReadText(tmp.path() / "map/host.txt"), std::to_string(built.map.num_frames));
+  EXPECT_EQ(ReadRecordedMap(tmp.path() / "map").map.num_frames, built.map.num_frames);
+}
+
 // The output defaults to "<input name>_map" beside the working directory.
 TEST(BuildPipeline, OutputDefaultsToTheInputsName) {
   BuildPipelineOptions options;
