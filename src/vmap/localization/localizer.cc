@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
 
 #include "vmap/core/error.h"
 #include "vmap/core/stopwatch.h"
@@ -22,6 +23,20 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// What the map's camera gave a result: bearings and poses, gone where the camera does not describe the frame.
+void ForgetCamera(KeyComparison& comparison) {
+  comparison.heading.deg = kNaN;
+  comparison.pose = RelativePose{};
+  comparison.translation_sigma_deg = kNaN;
+  comparison.translation_known = false;
+}
+void ForgetCamera(LocalizationResult& result) {
+  ForgetCamera(result.to_key);
+  ForgetCamera(result.to_next);
+  result.heading_deg = result.heading_key_deg = kNaN;
+  result.translation_known = false;
+}
 
 // The link's verified matches pass chance as a comparison's must (acceptance.h), one test: the two key images share a
 // scene. Without its matches in memory (a map loaded without them) it is taken to.
@@ -300,6 +315,19 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   result.source_index = frame.source_index;
   result.timestamp = frame.timestamp;
   result.source_name = frame.source_name;
+  // A frame of another shape than the teach run's frames was stretched to the map's size: the map's camera does not
+  // describe it, so its headings are in pixels only and it has no pose (as with --resize to another size).
+  if (options_.camera && AspectRatiosDiffer(frame.native_size, map_.input.native_size)) {
+    if (!warned_stretched_) {
+      spdlog::warn(
+          "frame {} is {}x{}, another shape than the map's frames ({}x{}): stretched to the map's size, it "
+          "gets headings in pixels only and no relative poses (the map's camera does not describe it)",
+          frame.source_name, frame.native_size.width, frame.native_size.height, map_.input.native_size.width,
+          map_.input.native_size.height);
+      warned_stretched_ = true;
+    }
+    ForgetCamera(result);
+  }
   comparisons_.Finish();
   result.seconds = SecondsSince(start);
   return result;

@@ -414,6 +414,7 @@ class Localizer {
   // Binary descriptors (ORB): a heading mode that stands out against the frame's rivals accepts a comparison
   // (min_heading_rival_ratio; measured on ORB only).
   bool heading_accepts_ = false;
+  bool warned_stretched_ = false;  // a frame of another shape than the map's was said
   // ORB: the comparisons away from the tracker are verified with fewer iterations (far_comparison_iterations; XFeat's
   // scored matches are verified on their best, MapVerifierOptions' loop_points, and were not measured so).
   bool binary_descriptors_ = false;

@@ -111,6 +111,27 @@ TEST(Localizer, WithACameraTheHeadingIsInDegreesAndThePoseIsTheTrueOne) {
   EXPECT_FALSE(p.to_key.pose.valid);
   EXPECT_FALSE(p.translation_known);
   EXPECT_EQ(LocalizationGuidance(p), "heading only: no pose");
+
+  // A frame of another shape, stretched to the map's size: the map's camera does not describe it. One of the map's
+  // shape at twice the size: it does.
+  const cv::Size teach = m.map.input.native_size;
+  ASSERT_FALSE(teach.empty());
+  Frame stretched = frame, scaled = frame;
+  stretched.native_size = cv::Size(teach.width, teach.width);
+  scaled.native_size = cv::Size(2 * teach.width, 2 * teach.height);
+  Localizer of_another_shape(m.map, m.keys, *m.matcher, options);
+  const LocalizationResult s = of_another_shape.Localize(stretched, *m.matcher->Extract(frame.gray));
+  EXPECT_EQ(s.status, r.status);
+  EXPECT_EQ(s.heading_px, r.heading_px);
+  EXPECT_TRUE(std::isnan(s.heading_deg));
+  EXPECT_TRUE(std::isnan(s.heading_key_deg));
+  EXPECT_FALSE(s.to_key.pose.valid);
+  EXPECT_FALSE(s.translation_known);
+  EXPECT_EQ(LocalizationGuidance(s), "heading only: no pose");
+  Localizer of_the_same_shape(m.map, m.keys, *m.matcher, options);
+  const LocalizationResult t = of_the_same_shape.Localize(scaled, *m.matcher->Extract(frame.gray));
+  EXPECT_EQ(t.heading_deg, r.heading_deg);
+  EXPECT_TRUE(t.to_key.pose.valid);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 
 #include <nlohmann/json.hpp>
@@ -23,6 +24,12 @@ namespace fs = std::filesystem;
 SourceFormat ParseSourceFormat(const std::string& name) { return ParseEnum(kSourceFormatNames, name, "format"); }
 
 std::string SourceFormatName(SourceFormat format) { return EnumToName(kSourceFormatNames, format); }
+
+bool AspectRatiosDiffer(const cv::Size& a, const cv::Size& b) {
+  if (a.empty() || b.empty()) return false;
+  const double ratio = (static_cast<double>(a.width) * b.height) / (static_cast<double>(b.width) * a.height);
+  return std::abs(ratio - 1.0) > 0.01;
+}
 
 void FrameSourceOptions::Check() const {
   CheckFieldRanges(*this);
@@ -141,6 +148,7 @@ cv::Size TargetSize(const cv::Size& native, const FrameSourceOptions& options) {
 void FitFrame(Frame& frame, const cv::Size& target, const cv::Size& first_native, const FrameSourceOptions& options,
               int* warnings) {
   const cv::Size native = frame.gray.size();
+  frame.native_size = native;
   if (native != first_native) {
     const std::string message = "frame " + std::to_string(frame.source_index) + " (" + frame.source_name + ") is " +
                                 std::to_string(native.width) + "x" + std::to_string(native.height) +

@@ -89,10 +89,15 @@ struct Frame {
   cv::Mat gray;             // 8-bit, one channel: what the matchers see
   cv::Mat color;            // 8-bit BGR when the input is colour; may be empty (then use gray)
   bool resized = false;     // the decoded image was resized (--resize, or a size that differs from the first)
+  cv::Size native_size;     // the decoded image's size, before any resizing; empty when not known
   // The robot's odometry pose at the frame's time, where a repeat run has odometry beside its frames (none from the
   // input itself): the localizer's motion model moves by the distance driven (localization/motion_pace.h).
   std::optional<OdometrySample> odometry;
 };
+
+// Whether images of these sizes have other shapes (aspect ratios more than 1 % apart): resized to one size, one of
+// them is stretched, so that a camera describing one does not describe the other. False when either is empty.
+bool AspectRatiosDiffer(const cv::Size& a, const cv::Size& b);
 
 struct SequenceInfo {
   std::string path;  // as given by the user

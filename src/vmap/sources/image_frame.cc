@@ -21,6 +21,7 @@ Frame FrameFromImage(const cv::Mat& image, int index, const cv::Size& size, cons
                      "; give an image of a usable size");
   }
   Frame frame;
+  frame.native_size = image.size();
   frame.index = index;
   frame.source_index = index;
   frame.source_name = fmt::format("frame_{:06d}", index);  // as a video names its frames
