@@ -19,8 +19,16 @@ ImageInput ImageView(const py::object& object, const std::string& what) {
   }
   const py::array array = py::reinterpret_borrow<py::array>(object);
   if (!array.dtype().is(py::dtype::of<std::uint8_t>())) {
-    throw InputError(what + " has dtype " + py::str(array.dtype()).cast<std::string>() +
-                     "; give a uint8 image (HxW grey or HxWx3 BGR), e.g. image.astype(numpy.uint8)");
+    // A type, as numpy's own casting errors are; the conversion depends on the values' range, which astype alone
+    // does not scale (a float image in [0, 1] would become black).
+    const char kind = array.dtype().kind();
+    const std::string conversion = kind == 'f' ? "(image * 255).clip(0, 255).astype(numpy.uint8) for values in [0, 1], "
+                                                 "image.clip(0, 255).astype(numpy.uint8) for values in [0, 255]"
+                                   : kind == 'b'
+                                       ? "image.astype(numpy.uint8) * 255"
+                                       : "scaled to 0..255 first, e.g. (image >> 8).astype(numpy.uint8) for 16 bits";
+    throw ArgumentTypeError(what + " has dtype " + py::str(array.dtype()).cast<std::string>() +
+                            "; give a uint8 image (HxW grey or HxWx3 BGR): " + conversion);
   }
   const int channels = array.ndim() == 3 ? static_cast<int>(array.shape(2)) : 1;
   if ((array.ndim() != 2 && array.ndim() != 3) || (channels != 1 && channels != 3 && channels != 4)) {

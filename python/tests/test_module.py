@@ -318,8 +318,10 @@ def test_bad_input_raises_vmap_errors(tmp_path):
     with pytest.raises(vmap.Error, match="nowhere"):
         vmap.read_map(tmp_path / "nowhere")
     image = np.zeros((480, 640), np.uint8)
-    with pytest.raises(vmap.Error, match="uint8"):
+    with pytest.raises(vmap.ArgumentTypeError, match=r"uint8.*\* 255"):
         vmap.match(image.astype(np.float32), image)
+    with pytest.raises(TypeError, match=">> 8"):
+        vmap.match(image.astype(np.uint16), image)
     with pytest.raises(vmap.Error, match="shape"):
         vmap.match(np.zeros((480, 640, 2), np.uint8), image)
     with pytest.raises(vmap.Error, match="image0"):

@@ -1,5 +1,6 @@
 // vmap: builds visual maps (key images linked by fundamental matrices) from teach-run videos.
 
+#include <csignal>
 #include <cstdio>
 #include <exception>
 #include <initializer_list>
@@ -20,6 +21,10 @@
 #include "vmap/core/terminal_text.h"
 
 int main(int argc, char** argv) {
+  // A file beyond `ulimit -f` and a reader gone away (`vmap ... | head`) are then errors of the write that met them,
+  // so that the command says so and removes its unfinished outputs: by default either signal kills it silently.
+  std::signal(SIGXFSZ, SIG_IGN);
+  std::signal(SIGPIPE, SIG_IGN);
   // First, while this is the only thread: signal handling (an interrupted command removes its unfinished
   // outputs and exits with 128 + the signal), OpenCV's threads, malloc, FFmpeg's log (see runtime.h).
   try {

@@ -64,6 +64,15 @@ TEST(Promises, OutputsVmapCannotProveItsOwnAreNeverReplaced) {
   std::ofstream(tmp.path() / "site/report.html") << "<p>my page</p>";
   std::ofstream(tmp.path() / "notes.txt") << "notes";
   fs::create_directory_symlink(tmp.path() / "real_map", tmp.path() / "map_link");
+  // A run.json of `vmap localize --json` among a user's files, and a localization report the user added a file to.
+  std::string log;
+  const std::string localize = "localize " + Quote(tmp.path() / "real_map") + " " + in;
+  fs::create_directories(tmp.path() / "thesis");
+  ASSERT_EQ(RunVmap(localize + " --json " + Quote(tmp.path() / "thesis/run.json"), &log), 0) << log;
+  std::ofstream(tmp.path() / "thesis/thesis.tex") << "draft";
+  ASSERT_EQ(RunVmap(localize + " --report " + Quote(tmp.path() / "page"), &log), 0) << log;
+  ASSERT_EQ(RunVmap(localize + " --report " + Quote(tmp.path() / "added"), &log), 0) << log;
+  std::ofstream(tmp.path() / "added/notes.txt") << "mine";
   struct Case {
     std::string arguments, expected;
   };
@@ -75,6 +84,11 @@ TEST(Promises, OutputsVmapCannotProveItsOwnAreNeverReplaced) {
       {"sweep " + in + " --thresholds 0.5 --report " + Quote(tmp.path() / "site"), "is not a vmap sweep"},
       {"build " + in + " -o " + Quote(tmp.path() / "notes.txt"), "is not a directory"},
       {"build " + in + " -o " + Quote(tmp.path() / "map_link"), "symbolic link"},
+      {localize + " --report " + Quote(tmp.path() / "thesis"), "it has no report.html"},
+      {"report " + Quote(tmp.path() / "thesis/run.json") + " -o " + Quote(tmp.path() / "thesis"),
+       "holds the input"},
+      {localize + " --report " + Quote(tmp.path() / "added"), "it holds 'notes.txt'"},
+      {"report " + Quote(tmp.path() / "page/run.json") + " -o " + Quote(tmp.path() / "page"), "page/run.json"},
   };
   for (const Case& c : cases) {
     std::string out;
@@ -87,6 +101,8 @@ TEST(Promises, OutputsVmapCannotProveItsOwnAreNeverReplaced) {
   EXPECT_EQ(ReadText(tmp.path() / "results/data.csv"), "1,2");
   EXPECT_EQ(ReadText(tmp.path() / "site/report.html"), "<p>my page</p>");
   EXPECT_EQ(ReadText(tmp.path() / "notes.txt"), "notes");
+  EXPECT_EQ(ReadText(tmp.path() / "thesis/thesis.tex"), "draft");
+  EXPECT_EQ(ReadText(tmp.path() / "added/notes.txt"), "mine");
   EXPECT_NO_THROW(ReadMap(tmp.path() / "real_map"));
   EXPECT_TRUE(fs::is_symlink(tmp.path() / "map_link"));
   EXPECT_TRUE(EntriesStartingWith(tmp.path(), ".").empty()) << "no temporary left";
@@ -202,7 +218,9 @@ TEST(Promises, AWriteThatFailsPartWayKeepsTheOldMapAndSaysWhy) {
   const std::string old_map = ReadText(tmp.path() / "m/map.json");
   struct rlimit old_limit {};
   ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old_limit), 0);
-  const auto old_handler = signal(SIGXFSZ, SIG_IGN);  // ignored, it is ignored in vmap too: write(2) fails instead
+  // Left at its default, as a shell leaves it: vmap ignores it itself, so that write(2) fails instead of the signal
+  // killing it with its temporaries left.
+  const auto old_handler = signal(SIGXFSZ, SIG_DFL);
   struct rlimit small = old_limit;
   small.rlim_cur = 2048;
   std::vector<std::string> outputs;
@@ -237,6 +255,25 @@ TEST(Promises, AnInterruptedReportLeavesTheMapAsItWas) {
   EXPECT_FALSE(fs::exists(tmp.path() / "m/report"));
   EXPECT_FALSE(fs::exists(tmp.path() / "m/report.html"));
   EXPECT_NO_THROW(ReadMap(tmp.path() / "m"));
+}
+
+// A report whose page may not be replaced (here a link to the user's own page) is refused before report/ is: a
+// refusal writes nothing.
+TEST(Promises, AReportRefusedForItsPageLeavesItsImagesAsTheyWere) {
+  testing::ScopedTempDir tmp;
+  WriteSyntheticInput(tmp.path() / "in", 8);
+  BuildMapWithBinary(tmp.path() / "in", tmp.path() / "m", "--report");
+  std::ofstream(tmp.path() / "m/report/marker") << "old";
+  std::ofstream(tmp.path() / "mine.html") << "<p>mine</p>";
+  fs::remove(tmp.path() / "m/report.html");
+  fs::create_symlink(tmp.path() / "mine.html", tmp.path() / "m/report.html");
+  std::string out;
+  EXPECT_EQ(RunVmap("report " + Quote(tmp.path() / "m"), &out), 2) << out;
+  EXPECT_NE(out.find("report.html"), std::string::npos) << out;
+  EXPECT_NE(out.find("symbolic link"), std::string::npos) << out;
+  EXPECT_EQ(ReadText(tmp.path() / "m/report/marker"), "old");
+  EXPECT_EQ(ReadText(tmp.path() / "mine.html"), "<p>mine</p>");
+  EXPECT_TRUE(EntriesStartingWith(tmp.path() / "m", ".").empty());
 }
 
 TEST(Promises, TemporariesOfAKilledRunAreRemovedByTheNextRun) {

@@ -1,7 +1,11 @@
 #include "vmap/geometry/camera.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -186,10 +190,21 @@ std::vector<double> NumbersIn(const std::string& text) {
   return numbers;
 }
 
-// A matrix node as OpenCV writes it (!!opencv-matrix) or a plain list of numbers.
+// A matrix node as OpenCV writes it (!!opencv-matrix), as ROS's camera_calibration writes it ({rows, cols, data}),
+// or a plain list of numbers.
 std::vector<double> NodeNumbers(const cv::FileNode& node) {
   std::vector<double> values;
   if (node.empty() || node.isNone()) return values;
+  if (node.isMap() && node["dt"].empty() && node["data"].isSeq()) {
+    values = NodeNumbers(node["data"]);
+    const cv::FileNode rows = node["rows"], cols = node["cols"];
+    if (rows.isInt() && cols.isInt() &&
+        static_cast<int>(rows) * static_cast<int>(cols) != static_cast<int>(values.size())) {
+      throw InputError(fmt::format("a {}x{} matrix holds {} numbers", static_cast<int>(rows), static_cast<int>(cols),
+                                   values.size()));
+    }
+    return values;
+  }
   if (node.isMap()) {
     cv::Mat m;
     node >> m;
@@ -234,11 +249,28 @@ Camera ParseCameraText(const std::string& text) {
 }
 
 Camera ReadOpenCvCameraFile(const std::string& path) {
+  static const std::string kFormats =
+      "give OpenCV's calibration (camera_matrix, distortion_coefficients as !!opencv-matrix or lists), ROS "
+      "camera_calibration's YAML (ost.yaml), a TUM intrinsics.txt, a KITTI calib.txt or fx,fy,cx,cy";
   cv::FileStorage fs;
   try {
-    if (!fs.open(path, cv::FileStorage::READ)) throw InputError("cannot read camera file '" + path + "'");
+    // A YAML file without OpenCV's "%YAML:1.0" first line (ROS's ost.yaml, most hand-written ones) is read as one
+    // with it: OpenCV's parser refuses it otherwise.
+    std::string extension = std::filesystem::path(path).extension().string();
+    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (extension == ".yaml" || extension == ".yml") {
+      std::ifstream in(path, std::ios::binary);
+      std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      if (text.rfind("%YAML", 0) != 0) text = "%YAML:1.0\n" + text;
+      if (!fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY)) {
+        throw InputError("cannot read camera file '" + path + "'");
+      }
+    } else if (!fs.open(path, cv::FileStorage::READ)) {
+      throw InputError("cannot read camera file '" + path + "'");
+    }
   } catch (const cv::Exception& e) {
-    throw InputError("camera file '" + path + "' is not an OpenCV YAML/JSON/XML file (" + e.err + ")");
+    throw InputError("camera file '" + path + "' is not a YAML, JSON or XML file OpenCV reads (" + e.err + "); " +
+                     kFormats);
   }
   std::vector<double> K, distortion;
   try {
@@ -246,7 +278,10 @@ Camera ReadOpenCvCameraFile(const std::string& path) {
     distortion = NodeNumbers(FirstOf(fs, {"distortion_coefficients", "dist_coeffs", "distCoeffs", "D"}));
   } catch (const cv::Exception& e) {
     throw InputError("camera file '" + path + "': camera_matrix or distortion_coefficients is malformed (" + e.err +
-                     ")");
+                     "); " + kFormats);
+  } catch (const InputError& e) {
+    throw InputError("camera file '" + path + "': camera_matrix or distortion_coefficients is malformed (" +
+                     std::string(e.what()) + "); " + kFormats);
   }
   if (K.size() != 9) {
     throw InputError("camera file '" + path +

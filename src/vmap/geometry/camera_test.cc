@@ -1,6 +1,7 @@
 #include "vmap/geometry/camera.h"
 
 #include <filesystem>
+#include <fstream>
 
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
@@ -98,6 +99,26 @@ TEST(Camera, ReadsOpenCvCalibrationFilesInYamlAndJson) {
     FAIL() << "a file without camera_matrix was accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("camera_matrix"), std::string::npos) << e.what();
+  }
+  // What ROS's camera_calibration writes (ost.yaml): no "%YAML:1.0" line, matrices as {rows, cols, data}.
+  std::ofstream(tmp.path() / "ost.yaml") << "image_width: 640\nimage_height: 480\ncamera_name: narrow_stereo\n"
+                                            "camera_matrix:\n  rows: 3\n  cols: 3\n"
+                                            "  data: [612.5, 0, 331.25, 0, 611.0, 242.75, 0, 0, 1]\n"
+                                            "distortion_model: plumb_bob\ndistortion_coefficients:\n  rows: 1\n"
+                                            "  cols: 5\n  data: [-0.21, 0.07, 0.0012, -0.0008, -0.011]\n"
+                                            "rectification_matrix:\n  rows: 3\n  cols: 3\n"
+                                            "  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n";
+  const Camera ros = ReadOpenCvCameraFile((tmp.path() / "ost.yaml").string());
+  EXPECT_EQ(ros.K(), K);
+  EXPECT_EQ(ros.size, cv::Size(640, 480));
+  EXPECT_DOUBLE_EQ(ros.k3, -0.011);
+  std::ofstream(tmp.path() / "short.yaml") << "camera_matrix:\n  rows: 3\n  cols: 3\n  data: [612.5, 0, 331.25]\n";
+  try {
+    ReadOpenCvCameraFile((tmp.path() / "short.yaml").string());
+    FAIL() << "a 3x3 matrix of 3 numbers was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("a 3x3 matrix holds 3 numbers"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("ost.yaml"), std::string::npos) << e.what() << " names the formats";
   }
 }
 

@@ -32,6 +32,7 @@ OutputPolicy SweepOutputPolicy(const std::string& input) {
   policy.why_not_ours = WhyNotAVmapSweep;
   policy.kind = "a vmap sweep";
   policy.inputs = {input};
+  policy.keep_if_commit_fails = true;  // its maps, as a map's build keeps its map: the error says where
   return policy;
 }
 

@@ -3,7 +3,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 
 #include <fmt/format.h>
@@ -71,11 +70,10 @@ bool OneHoldsTheOther(const fs::path& a, const fs::path& b) {
   return prefix_of(first, second) || prefix_of(second, first) || IsSameOrInside(a, b) || IsSameOrInside(b, a);
 }
 
-// Where a map nobody asked to keep is built: a folder of its own per run, also when runs share a process.
-fs::path TemporaryMapFolder() {
-  static std::atomic<int> runs{0};
-  return fs::temp_directory_path() / fmt::format("vmap-simulate-map-{}-{}", ::getpid(), runs++);
-}
+// Where a map nobody asked to keep is built: never committed, it lives in the temporary folder AtomicOutputDirectory
+// makes of this name, one of its own per run (.vmap-simulate-map.partial-PID-N), also when runs share a process. One
+// name for every run, so that each removes those a killed run left (RemoveStaleTemporaries).
+fs::path TemporaryMapFolder() { return fs::temp_directory_path() / "vmap-simulate-map"; }
 
 }  // namespace
 

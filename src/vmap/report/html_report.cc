@@ -8,6 +8,7 @@
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
 #include "vmap/core/option_ranges.h"
+#include "vmap/core/output_file.h"
 #include "vmap/map/map_io.h"
 #include "vmap/mapping/recorded_options.h"
 #include "vmap/report/html_page.h"
@@ -216,6 +217,9 @@ void WriteMapReport(const fs::path& map_directory) { WriteMapReport(map_director
 
 void WriteMapReport(const fs::path& map_directory, const MapReportOptions& report_options) {
   report_options.Check();
+  // report.html is checked before report/ is replaced: a page that may not be replaced (a link, read-only) refuses
+  // the report before anything is written.
+  CheckOutputFiles({{map_directory / kReportFileName, kReportFileName}}, {});
   const RecordedMap read = ReadRecordedMap(map_directory);
   const VisualMap& map = read.map;
   // Every image path is checked before anything is written.

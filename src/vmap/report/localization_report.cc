@@ -220,13 +220,14 @@ void LocalizationReportOptions::Check() const { CheckFieldRanges(*this); }
 namespace {
 
 // The whole folder is replaced at once, and only when it is empty or an older report of a run.
-OutputPolicy ReportPolicy(const fs::path& map_directory, const std::string& query) {
+OutputPolicy ReportPolicy(const fs::path& map_directory, const std::string& query, const fs::path& run_file = {}) {
   OutputPolicy policy;
   policy.why_not_ours = WhyNotALocalizationReport;
   policy.kind = "a vmap localization report";
   policy.inputs = {map_directory};
   // A run that names no query (a run JSON without query.path) has none to keep apart: "" would be the working folder.
   if (!query.empty()) policy.inputs.push_back(query);
+  if (!run_file.empty()) policy.inputs.push_back(run_file);  // `vmap report RUN.json -o DIR`: DIR may not hold it
   return policy;
 }
 
@@ -380,7 +381,17 @@ std::string WhyNotALocalizationReport(const fs::path& directory) {
   if (!parsed.document->is_object() || parsed.document->value("format", nlohmann::json()) != "vmap-localization") {
     return std::string("its ") + kLocalizationReportRunFileName + " is not a vmap localization run";
   }
-  return "";
+  // A run.json is also what `vmap localize --json DIR/run.json` writes, into a folder that may hold anything else:
+  // a report is the folder that holds its page too, and nothing but what a report writes.
+  if (!fs::is_regular_file(directory / kReportFileName)) return std::string("it has no ") + kReportFileName;
+  std::error_code ec;
+  for (const fs::directory_entry& entry : fs::directory_iterator(directory, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name != kReportFileName && name != kLocalizationReportRunFileName && name != kReportAssetsDirectory) {
+      return "it holds '" + name + "', which a localization report never holds";
+    }
+  }
+  return ec ? "it cannot be listed: " + ec.message() : "";
 }
 
 void WriteLocalizationReport(const fs::path& run_file, const fs::path& directory,
@@ -398,6 +409,7 @@ void WriteLocalizationReport(const fs::path& run_file, const fs::path& directory
   }
   const VisualMap map = ReadMap(map_directory);
   CheckRunFitsMap(run, map, run_file);
+  CheckOutputDirectory(directory, ReportPolicy(map_directory, run.info.query, run_file));
   WriteLocalizationReport(run, map, map_directory, directory, options);
 }
 

@@ -2,6 +2,7 @@
 // KITTI odometry (image_0/ + times.txt).
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -9,6 +10,7 @@
 #include <optional>
 #include <sstream>
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/contained_file.h"
@@ -101,6 +103,30 @@ std::vector<ImageEntry> ListImageFolder(const std::string& directory_text) {
     }
   }
   if (names.empty()) {
+    // Two common mistakes, named: a map folder given as a run, and the folder a video or a recording lies in.
+    if (fs::is_regular_file(directory / "map.json") && fs::is_directory(directory / "keys")) {
+      throw InputError("'" + directory_text +
+                       "' is a vmap map (map.json, keys/), not a run to read frames from; give the video, image folder "
+                       "or recording it was built from (`vmap info` names it), and the map where a command takes one "
+                       "(vmap localize MAP QUERY)");
+    }
+    std::vector<std::string> runs;
+    std::error_code ec;
+    for (const fs::directory_entry& entry : fs::directory_iterator(directory, ec)) {
+      std::string extension = entry.path().extension().string();
+      for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      if (entry.is_regular_file(ec) &&
+          (extension == ".mp4" || extension == ".avi" || extension == ".mkv" || extension == ".mov" ||
+           extension == ".webm" || extension == ".bag" || extension == ".mcap")) {
+        runs.push_back(entry.path().string());
+      }
+    }
+    if (!runs.empty()) {
+      std::sort(runs.begin(), runs.end());
+      std::string named = "'" + runs.front() + "'";
+      if (runs.size() > 1) named += fmt::format(" and {} more", runs.size() - 1);
+      throw InputError("'" + directory_text + "' holds no images but a video or recording: give it, e.g. " + named);
+    }
     throw InputError("'" + directory_text +
                      "' holds no images (.png, .jpg, .bmp, .tif, ...) and is not a TUM (rgb.txt), EuRoC "
                      "(mav0/cam0/data.csv) or KITTI (image_0/ + times.txt) sequence; point to the folder with the "

@@ -165,6 +165,14 @@ TEST(ImageFolder, UnknownLayoutsAndEmptyFoldersAreClearErrors) {
   video.format = SourceFormat::kVideo;
   EXPECT_EQ(testing::OptionErrorPath([&] { OpenFrameSource(tmp.path().string(), video); }), "format");
   EXPECT_NE(OpenError((tmp.path() / "missing").string()).find("does not exist"), std::string::npos);
+  // The folder a video lies in, and a map folder given as a run: each named as what it is.
+  std::ofstream(tmp.path() / "drive.MP4") << "not decoded: named only";
+  EXPECT_NE(OpenError(tmp.path().string()).find("give it, e.g. '" + (tmp.path() / "drive.MP4").string() + "'"),
+            std::string::npos)
+      << OpenError(tmp.path().string());
+  fs::create_directories(tmp.path() / "map/keys");
+  std::ofstream(tmp.path() / "map/map.json") << "{}";
+  EXPECT_NE(OpenError((tmp.path() / "map").string()).find("is a vmap map"), std::string::npos);
 }
 
 TEST(ImageFolder, UndecodableImageIsSkippedAndCounted) {
