@@ -85,8 +85,7 @@ TEST(Promises, OutputsVmapCannotProveItsOwnAreNeverReplaced) {
       {"build " + in + " -o " + Quote(tmp.path() / "notes.txt"), "is not a directory"},
       {"build " + in + " -o " + Quote(tmp.path() / "map_link"), "symbolic link"},
       {localize + " --report " + Quote(tmp.path() / "thesis"), "it has no report.html"},
-      {"report " + Quote(tmp.path() / "thesis/run.json") + " -o " + Quote(tmp.path() / "thesis"),
-       "holds the input"},
+      {"report " + Quote(tmp.path() / "thesis/run.json") + " -o " + Quote(tmp.path() / "thesis"), "holds the input"},
       {localize + " --report " + Quote(tmp.path() / "added"), "it holds 'notes.txt'"},
       {"report " + Quote(tmp.path() / "page/run.json") + " -o " + Quote(tmp.path() / "page"), "page/run.json"},
   };
@@ -136,6 +135,11 @@ TEST(Promises, TheInputIsNeverInsideTheOutputNorTheOutputInsideTheInput) {
   BuildMapWithBinary(tmp.path() / "in", tmp.path() / "s");
   BuildMapWithBinary(tmp.path() / "in", tmp.path() / "old_map");
   fs::create_directory_symlink(tmp.path() / "s/keys", tmp.path() / "keys_link");
+  // A folder of links to the map's own key images, as `cp -s` or a dataset tool makes one.
+  fs::create_directories(tmp.path() / "linked/images");
+  for (const fs::directory_entry& key : fs::directory_iterator(tmp.path() / "s/keys")) {
+    fs::create_symlink(key.path(), tmp.path() / "linked/images" / key.path().filename());
+  }
   const std::string before = ReadText(tmp.path() / "s/map.json");
   struct Case {
     std::string arguments, expected;
@@ -145,6 +149,9 @@ TEST(Promises, TheInputIsNeverInsideTheOutputNorTheOutputInsideTheInput) {
       {"build " + Quote(tmp.path() / "s/keys") + " -o " + Quote(tmp.path() / "s"), "is or holds the input"},
       {"build " + Quote(tmp.path() / "keys_link") + " -o " + Quote(tmp.path() / "s"), "is or holds the input"},
       {"build " + Quote(tmp.path() / "s/keys/../keys") + " -o " + Quote(tmp.path() / "s/"), "is or holds the input"},
+      {"build " + Quote(tmp.path() / "linked") + " -o " + Quote(tmp.path() / "s"), "is or holds the input"},
+      {"sweep " + Quote(tmp.path() / "linked") + " --thresholds 0.5 --maps -o " + Quote(tmp.path() / "s/keys"),
+       "is or holds the input"},
       {"sweep " + Quote(tmp.path() / "s/keys") + " --thresholds 0.5 -o " + Quote(tmp.path() / "s/keys"),
        "is or holds the input"},
       {"build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "in/map"), "lies inside the input"},

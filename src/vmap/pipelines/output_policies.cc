@@ -15,12 +15,33 @@
 namespace vmap {
 namespace fs = std::filesystem;
 
+namespace {
+
+// The symbolic links in an input folder and in its folders one level down (a sequence's images/, rgb/): frames
+// read through them live wherever they point, perhaps in the very map being replaced, which the folder alone does
+// not say. The checks compare each by the file it reaches.
+void AddLinksInFolder(const fs::path& folder, std::vector<fs::path>* inputs) {
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) return;
+  constexpr int kMostEntries = 1000000;  // a bound on the scan, far beyond any sequence
+  int entries = 0;
+  for (fs::recursive_directory_iterator it(folder, ec), end; !ec && it != end && ++entries < kMostEntries;
+       it.increment(ec)) {
+    if (it->is_symlink(ec)) inputs->push_back(it->path());
+    if (it.depth() >= 1) it.disable_recursion_pending();
+  }
+}
+
+}  // namespace
+
 OutputPolicy MapOutputPolicy(const std::vector<std::string>& inputs) {
   OutputPolicy policy;
   policy.why_not_ours = WhyNotAVmapMap;
   policy.kind = "a vmap map";
   for (const std::string& input : inputs) {
-    if (!input.empty()) policy.inputs.emplace_back(input);
+    if (input.empty()) continue;
+    policy.inputs.emplace_back(input);
+    AddLinksInFolder(input, &policy.inputs);
   }
   // A map costs a run, and a teach run cannot be made again: one that cannot be put in place is kept beside.
   policy.keep_if_commit_fails = true;
@@ -32,6 +53,7 @@ OutputPolicy SweepOutputPolicy(const std::string& input) {
   policy.why_not_ours = WhyNotAVmapSweep;
   policy.kind = "a vmap sweep";
   policy.inputs = {input};
+  AddLinksInFolder(input, &policy.inputs);
   policy.keep_if_commit_fails = true;  // its maps, as a map's build keeps its map: the error says where
   return policy;
 }
