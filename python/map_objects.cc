@@ -166,6 +166,16 @@ void BindMapObjects(py::module_& m) {
               "X_to = R X_from + t (with the map's camera); None without")
           .def_property_readonly("t", [](const LinkRef& l) { return VectorArray(l.link().t, l.link().has_pose); })
           .def_property_readonly("pose_inliers", [](const LinkRef& l) { return l.link().pose_inliers; })
+          .def_property_readonly(
+              "translation_known", [](const LinkRef& l) { return l.link().translation_known; },
+              "t's direction is to be trusted; otherwise a robot gets the rotation only (False without a pose)")
+          .def_property_readonly(
+              "translation_sigma_deg", [](const LinkRef& l) { return NoneIfNegative(l.link().translation_sigma_deg); },
+              "how well the matches determine t's direction, degrees; None when not computed")
+          .def_property_readonly(
+              "translation_rival_cost_gap",
+              [](const LinkRef& l) { return NoneIfNegative(l.link().translation_rival_cost_gap); },
+              "how much more the cheapest other minimum of the pose's cost costs; None when there is none")
           .def_property_readonly("parallax", [](const LinkRef& l) { return NoneIfNegative(l.link().parallax); })
           .def_property_readonly("parallax_without_rotation",
                                  [](const LinkRef& l) { return l.link().parallax_without_rotation; })

@@ -154,6 +154,9 @@ def test_read_map_gives_the_map_json_as_numpy(maps):
         assert int(link.inliers.sum()) == entry["verified"]
         # lab_floor has intrinsics: every link has its relative pose.
         assert link.R.shape == (3, 3) and link.t.shape == (3,)
+        assert link.translation_known == entry["translation_known"]
+        assert link.translation_sigma_deg == pytest.approx(entry["translation_sigma_deg"])
+        assert link.translation_rival_cost_gap == pytest.approx(entry["translation_rival_cost_gap"])
         np.testing.assert_allclose(link.R @ link.R.T, np.eye(3), atol=1e-9)
     assert m.quality == record["quality"]
     assert m.camera is not None and m.camera == record["input"]["camera"]
