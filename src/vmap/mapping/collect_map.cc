@@ -15,7 +15,8 @@ namespace vmap {
 VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source, const Matcher& matcher,
                      const MapBuilderOptions& options, const std::string& options_json, double seconds,
                      bool analyze_links, const LinkVerifier* link_verifier, double tau,
-                     LinkAnalysisCache* analysis_cache, MapWriter* key_image_files) {
+                     LinkAnalysisCache* analysis_cache, MapWriter* key_image_files,
+                     const std::function<void()>& link_done) {
   VisualMap map;
   map.input = source.info();
   if (const CameraMask* mask = CameraMaskOf(matcher); mask && !map.input.frame_size.empty()) {
@@ -48,7 +49,7 @@ VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source
                                  options.verifier};
   }
   AnalyzeLinks(map, options.link_analysis, options.ExtractionThreads(), analysis_cache,
-               pose_check ? &*pose_check : nullptr);
+               pose_check ? &*pose_check : nullptr, link_done);
   const double analysis_seconds = SecondsSince(analysis_start);
   spdlog::debug("pose, parallax and homography test of {} links in {:.3f} s ({} analysed before)", map.links.size(),
                 analysis_seconds, analysis_cache ? analysis_cache->hits() - reused_before : 0);

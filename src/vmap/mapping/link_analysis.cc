@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -181,7 +182,13 @@ void CopyAnalysis(const Link& from, Link& to) {
 }  // namespace
 
 void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int threads, LinkAnalysisCache* cache,
-                  const PoseCheckInputs* inputs) {
+                  const PoseCheckInputs* inputs, const std::function<void()>& link_done) {
+  std::mutex link_done_mutex;
+  const auto done = [&] {
+    if (!link_done) return;
+    std::lock_guard<std::mutex> lock(link_done_mutex);
+    link_done();
+  };
   const Camera* camera = map.input.camera ? &*map.input.camera : nullptr;
   const auto frames_of = [&map](const Link& link) {
     return std::make_pair(map.key_images.at(link.from_key).frame_index, map.key_images.at(link.to_key).frame_index);
@@ -195,6 +202,7 @@ void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int thread
       if (it != cache->entries_.end() && it->second.fingerprint == fingerprints[i]) {
         CopyAnalysis(it->second.analysed, map.links[i]);
         ++cache->hits_;
+        done();
         continue;
       }
     }
@@ -228,12 +236,14 @@ void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int thread
     ParallelFor(end - begin, threads, [&](size_t k) {
       Link& link = map.links[todo[begin + k]];
       AnalyzeLink(link, camera, options);
-      if (!cross_check || !link.has_pose) return;
-      Link denser = MakeLink(ComparePair(*denser_matcher, *features.at(link.from_key), *features.at(link.to_key),
-                                         inputs->verifier, SimilarityMode::kInlierRatio),
-                             link.from_key, link.to_key, link.below_tau);
-      Analyze(denser, camera, options, /*test_homography=*/false);
-      CrossCheckLinkPose(link, denser, *camera, options.translation);
+      if (cross_check && link.has_pose) {
+        Link denser = MakeLink(ComparePair(*denser_matcher, *features.at(link.from_key), *features.at(link.to_key),
+                                           inputs->verifier, SimilarityMode::kInlierRatio),
+                               link.from_key, link.to_key, link.below_tau);
+        Analyze(denser, camera, options, /*test_homography=*/false);
+        CrossCheckLinkPose(link, denser, *camera, options.translation);
+      }
+      done();
     });
   }
 

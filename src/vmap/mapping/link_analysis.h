@@ -67,7 +67,8 @@ class LinkAnalysisCache {
   long hits() const { return hits_; }  // links that were not analysed again
 
  private:
-  friend void AnalyzeLinks(VisualMap&, const LinkAnalysisOptions&, int, LinkAnalysisCache*, const PoseCheckInputs*);
+  friend void AnalyzeLinks(VisualMap&, const LinkAnalysisOptions&, int, LinkAnalysisCache*, const PoseCheckInputs*,
+                           const std::function<void()>&);
   struct Entry {
     uint64_t fingerprint = 0;  // of what the analysis reads: the counts, F and the correspondences
     Link analysed;             // only the fields AnalyzeLink fills are used (no correspondences kept)
@@ -80,8 +81,10 @@ class LinkAnalysisCache {
 // (links are independent: the result does not depend on the number of threads). With `cache`, links analysed
 // by an earlier call are not analysed again, and the cache keeps only this map's links (memory stays flat).
 // With `inputs`, a camera and options.pose_check_features > 0, each posed link is also cross-checked
-// against the pose of denser features of its key images (CrossCheckLinkPose).
+// against the pose of denser features of its key images (CrossCheckLinkPose). `link_done` (may be empty) is called
+// once per link as it is done, one call at a time: a progress line's.
 void AnalyzeLinks(VisualMap& map, const LinkAnalysisOptions& options, int threads = 1,
-                  LinkAnalysisCache* cache = nullptr, const PoseCheckInputs* inputs = nullptr);
+                  LinkAnalysisCache* cache = nullptr, const PoseCheckInputs* inputs = nullptr,
+                  const std::function<void()>& link_done = {});
 
 }  // namespace vmap

@@ -90,10 +90,17 @@ TEST(LinkAnalysisCache, ASecondCollectionReusesEveryUnchangedLink) {
   EXPECT_EQ(cache.hits(), 0);
   ExpectSameAnalysis(first, AnalysedMap());
 
+  // Each link is said done once, whether analysed or reused (a progress line counts them).
   VisualMap second = Unanalysed();
-  AnalyzeLinks(second, options, 2, &cache);
+  long done = 0;
+  AnalyzeLinks(second, options, 2, &cache, nullptr, [&] { ++done; });
   EXPECT_EQ(cache.hits(), static_cast<long>(second.links.size()));
+  EXPECT_EQ(done, static_cast<long>(second.links.size()));
   ExpectSameAnalysis(second, AnalysedMap());
+  VisualMap third = Unanalysed();
+  done = 0;
+  AnalyzeLinks(third, options, 2, nullptr, nullptr, [&] { ++done; });
+  EXPECT_EQ(done, static_cast<long>(third.links.size()));
 }
 
 TEST(LinkAnalysisCache, AChangedLinkIsAnalysedAgain) {

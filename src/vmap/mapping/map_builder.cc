@@ -138,16 +138,25 @@ class MapBuilder::Impl {
     spdlog::debug("{} pairs matched and verified for {} evaluations, {} abandoned; {} links verified in full",
                   pairs_matched_.load(), evaluations, pairs_abandoned_.load(), links_verified_);
     const double seconds = SecondsSince(start_);
+    // The links' pose tests (and their cross-check on denser features) may take longer than the frames did: a line
+    // of their own, so that the frames' 100 % is not followed by silence.
+    long links = 0;
+    for (const auto& selector : selectors_) links += std::max(0L, static_cast<long>(selector->key_images().size()) - 1);
+    ProgressLine link_progress(selectors_.size() == 1 ? "links" : "sweep links", analyze_links ? links : 0, "links",
+                               ProgressOptions{options_.show_progress && analyze_links});
+    long links_done = 0;
+    const auto link_done = [&] { link_progress.Update(++links_done); };
     std::vector<VisualMap> maps;
     for (size_t i = 0; i < selectors_.size(); ++i) {
       VisualMap map = CollectMap(*selectors_[i], source_, matcher_, options_, options_json_, seconds, analyze_links,
-                                 link_verifier_.get(), taus_[i], &link_analyses_[i], writers_[i]);
+                                 link_verifier_.get(), taus_[i], &link_analyses_[i], writers_[i], link_done);
       // A map of a whole file says nothing more (its map.json stays as it was); a live input's says what it
       // covers.
       if (end != CoverageEnd::kInputEnded || source_.info().expected_frames < 0) map.coverage = CurrentCoverage(end);
       if (writers_[i]) writers_[i]->Finish(map, with_evaluations ? &map.evaluations : nullptr);
       maps.push_back(std::move(map));
     }
+    link_progress.Finish();
     return maps;
   }
 
