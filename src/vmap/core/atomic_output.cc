@@ -225,6 +225,10 @@ void WriteFileAtomically(const fs::path& path, std::string_view content,
                      "); check the free space and the "
                      "permissions of its directory");
   };
+  // A file replaced keeps its permissions (a private 0600 --json stays private), as an editor's save keeps them.
+  if (struct stat existing {}; stat(path.c_str(), &existing) == 0 && S_ISREG(existing.st_mode)) {
+    fchmod(fd, existing.st_mode & 07777);
+  }
   for (size_t written = 0; written < content.size();) {
     const ssize_t n = write(fd, content.data() + written, content.size() - written);
     if (n < 0 && errno == EINTR) continue;

@@ -249,6 +249,11 @@ TEST(AtomicOutput, WriteFileAtomicallyWritesContentAndNoTemporaries) {
   EXPECT_THROW(WriteFileAtomically(tmp.path() / "folder", "x"), InputError);
   EXPECT_TRUE(fs::is_directory(tmp.path() / "folder/inside"));
   EXPECT_EQ(CountEntries(tmp.path()), 2);
+  // A private file stays private when replaced.
+  fs::permissions(tmp.path() / "f.json", fs::perms::owner_read | fs::perms::owner_write);
+  WriteFileAtomically(tmp.path() / "f.json", "{\"a\": 3}");
+  EXPECT_EQ(ReadAll(tmp.path() / "f.json"), "{\"a\": 3}");
+  EXPECT_EQ(fs::status(tmp.path() / "f.json").permissions(), fs::perms::owner_read | fs::perms::owner_write);
 }
 
 TEST(AtomicOutputDeathTest, RemovingTemporariesForExitTakesEveryUnfinishedOutput) {
