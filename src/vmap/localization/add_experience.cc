@@ -12,6 +12,7 @@
 #include "vmap/core/directory_lock.h"
 #include "vmap/core/error.h"
 #include "vmap/core/image_file.h"
+#include "vmap/core/output_file.h"
 #include "vmap/localization/localization_map.h"
 #include "vmap/map/map_io.h"
 
@@ -73,6 +74,8 @@ AddExperienceSummary AddExperience(const fs::path& map_directory, FrameSource& s
   // writer's map.json is written over with a copy that lacks their work.
   const DirectoryWriteLock lock(map_directory, "the map");
   const fs::path& map_path = lock.path();  // its real path: nothing below is written through a link
+  // map.json is replaced at the end: one that may not be (read-only, a link) refuses the run before the work.
+  CheckOutputFiles({{map_path / kMapFileName, "the map's map.json"}}, {});
   KeyImageStoreOptions store_options;
   store_options.use_cache = false;
   store_options.thumbnail_width = options.localizer.ranking.thumbnail_width;

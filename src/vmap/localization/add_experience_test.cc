@@ -236,11 +236,20 @@ TEST(AddExperience, AFailureLeavesTheMapAsItWas) {
   EXPECT_THROW(AddExperience(map.path, elsewhere, "elsewhere", Quiet()), InputError);
   EXPECT_EQ(Snapshot(map.path), before);
 
-  // map.json cannot be replaced (read-only): the views written before are removed again.
+  // map.json cannot be replaced (read-only): refused before a frame is read, and nothing written.
   fs::permissions(map.path / kMapFileName, fs::perms::owner_write | fs::perms::group_write | fs::perms::others_write,
                   fs::perm_options::remove);
   MemorySource repeat(Frames(2, 4, /*other_season=*/true));
-  EXPECT_THROW(AddExperience(map.path, repeat, "repeat", Quiet()), InputError);
+  try {
+    AddExperience(map.path, repeat, "repeat", Quiet());
+    FAIL() << "an experience was added to a read-only map.json";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("map.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("read-only"), std::string::npos) << e.what();
+  }
+  const std::optional<Frame> first = repeat.Next();
+  ASSERT_TRUE(first.has_value());
+  EXPECT_EQ(first->index, 0) << "frames were read before the refusal";
   EXPECT_EQ(Snapshot(map.path), before);
 }
 
