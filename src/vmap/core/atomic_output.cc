@@ -226,7 +226,7 @@ void WriteFileAtomically(const fs::path& path, std::string_view content,
                      "permissions of its directory");
   };
   // A file replaced keeps its permissions (a private 0600 --json stays private), as an editor's save keeps them.
-  if (struct stat existing {}; stat(path.c_str(), &existing) == 0 && S_ISREG(existing.st_mode)) {
+  if (struct stat existing{}; stat(path.c_str(), &existing) == 0 && S_ISREG(existing.st_mode)) {
     fchmod(fd, existing.st_mode & 07777);
   }
   for (size_t written = 0; written < content.size();) {

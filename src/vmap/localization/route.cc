@@ -89,6 +89,14 @@ Route PlanRoute(const VisualMap& map, int from, int to, const RouteOptions& opti
           fmt::format("link {} (key {} -> {}) has no F: no verified guidance between them; "
                       "the robot relocalizes after it",
                       s.link, s.from_key, s.to_key));
+    } else if (const Link& link = map.links[s.link];
+               !s.backwards && link.num_verified < options.min_backward_verified) {
+      // Followed forwards, as the teach run drove it, but on as little evidence as a backward step is refused on (a
+      // cut in the recording, a scene that changed): said, so that a planner knows where the guidance is weak.
+      route.warnings.push_back(
+          fmt::format("link {} (key {} -> {}) is verified by {} matches only (backwards it needs {}): its guidance "
+                      "is weak, and the robot may have to relocalize after it",
+                      s.link, s.from_key, s.to_key, link.num_verified, options.min_backward_verified));
     }
   }
   return route;

@@ -38,7 +38,7 @@ std::string ErrorOf(const VisualMap& map, int from, int to) {
   return "";
 }
 
-TEST(Route, ForwardsIsTheTeachRunsOrderAndWarnsAboutLinksWithoutF) {
+TEST(Route, ForwardsIsTheTeachRunsOrderAndWarnsAboutLinksWithoutFOrWithLittleEvidence) {
   const Route route = PlanRoute(ChainMap(), 1, 5);
   EXPECT_EQ(route.keys, (std::vector<int>{1, 2, 3, 4, 5}));
   ASSERT_EQ(route.steps.size(), 4u);
@@ -48,8 +48,11 @@ TEST(Route, ForwardsIsTheTeachRunsOrderAndWarnsAboutLinksWithoutF) {
   }
   EXPECT_TRUE(route.steps[1].unverified);
   EXPECT_FALSE(route.steps[0].unverified);
-  ASSERT_EQ(route.warnings.size(), 1u);
+  ASSERT_EQ(route.warnings.size(), 2u);
   EXPECT_NE(route.warnings[0].find("link 2"), std::string::npos) << route.warnings[0];
+  EXPECT_NE(route.warnings[1].find("link 4 (key 4 -> 5) is verified by 12 matches only"), std::string::npos)
+      << route.warnings[1];
+  EXPECT_EQ(PlanRoute(ChainMap(), 3, 4).warnings.size(), 0u);
 }
 
 TEST(Route, BackwardsOnlyOverVerifiedLinks) {
