@@ -40,8 +40,14 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
          (!nfa_ranks_key_images_ || !options_.step_on_needs_lower_nfa || NoLikelierChance(ahead, best)));
     const std::optional<bool> to_last = StepsOnToLastKeyImage(ahead, best, position + step);
     if (to_last ? !*to_last : (!IsBetterMatch(ahead, best) || !beats_best)) {
-      // A frame that verifies against nothing so far may still have passed the next key image quickly.
-      if (best.accepted || step > 1) break;
+      // A frame that verifies against nothing so far may still have passed the next key image quickly. With ORB, one
+      // that verifies exactly as much with the key image ahead as with the best may have passed both: where key
+      // images crowd (rccar_room's fast turn, a key image every frame or two), each sees the frame's scene alike,
+      // and only the one after them tells. Not with XFeat, whose key images near a frame tie often across lighting
+      // (corridor_conditions: one right frame fewer with it, docs/localize.md).
+      const bool tie =
+          binary_descriptors_ && best.accepted && ahead.accepted && ahead.num_verified == best.num_verified;
+      if ((best.accepted || step > 1) && !tie) break;
       continue;
     }
     best = ahead;
