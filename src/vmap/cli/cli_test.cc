@@ -156,6 +156,21 @@ TEST(Cli, OneFrameSequenceIsAMapWithOneKeyImage) {
   EXPECT_TRUE(map.links.empty());
 }
 
+// A tau that keeps most frames is said (the map is nearly the run itself); one that keeps few is not, nor --tau 1.
+TEST(Cli, AMapOfMostFramesIsSaid) {
+  testing::ScopedTempDir tmp;
+  WriteSyntheticInput(tmp.path() / "in", 24, 0.08);
+  const std::string build = "build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "m");
+  std::string out;
+  ASSERT_EQ(RunVmap(build + " --tau 0.99", &out), 0) << out;
+  ASSERT_GT(2 * ReadMap(tmp.path() / "m").key_images.size(), 24u) << out;
+  EXPECT_NE(out.find("frames became key images at tau 0.99"), std::string::npos) << out;
+  for (const char* tau : {"0.3", "1"}) {
+    ASSERT_EQ(RunVmap(build + " --tau " + tau, &out), 0) << out;
+    EXPECT_EQ(out.find("frames became key images"), std::string::npos) << out;
+  }
+}
+
 TEST(Cli, VerboseLogSaysWhyEachKeyImageWasChosenAndQuietSaysNothing) {
   testing::ScopedTempDir tmp;
   WriteSyntheticInput(tmp.path() / "in", 30, 0.08);

@@ -157,6 +157,7 @@ fs::path BuildPipelineOptions::OutputDirectory() const {
 
 void BuildPipelineOptions::Check() const {
   source.Check();
+  matcher.Check();  // first: τ's default is the matcher's
   try {
     ResolvedMapOptions().Check();
   } catch (const OptionError& error) {
@@ -164,7 +165,6 @@ void BuildPipelineOptions::Check() const {
     if (error.path() == "key_images.tau") throw OptionError("tau", error.problem());
     throw;
   }
-  matcher.Check();
   if (!(snapshot_every >= 0.0 && snapshot_every <= kMaxSnapshotEvery)) {
     throw OptionError("snapshot_every",
                       fmt::format("must be 0 (no snapshots) to {} seconds", static_cast<int>(kMaxSnapshotEvery)));
@@ -218,6 +218,17 @@ BuildPipelineResult RunBuildPipeline(const BuildPipelineOptions& pipeline, Frame
                    ? BuildMap(source, *matcher, options, directory.path(), options_json)
                    : BuildStreaming(pipeline, source, *matcher, options, directory, options_json, files_read,
                                     &result.interrupted);
+
+  // A tau too high for the input or the matcher keeps most frames (XFeat's default on rccar_room: 290 of 329): the map
+  // is then nearly the run itself, as large and as slow to localize against. Said, with what to do; --tau 1 asks it.
+  const size_t key_images = result.map.key_images.size();
+  const int frames = result.map.num_frames;
+  if (options.key_images.tau < 1.0 && frames >= 20 && 2 * key_images > static_cast<size_t>(frames)) {
+    spdlog::warn(
+        "{} of {} frames became key images at tau {}: the map is nearly the run itself; a lower --tau keeps "
+        "fewer (vmap sweep INPUT --thresholds 0.2:0.8:0.1 shows how many each keeps)",
+        key_images, frames, options.key_images.tau);
+  }
 
   // 6. The report, and the host's files.
   if (pipeline.report) WriteMapReport(directory.path());
