@@ -214,6 +214,8 @@ void WriteFileAtomically(const fs::path& path, std::string_view content,
     if (fd < 0 && errno != EEXIST) break;
   }
   if (fd < 0) {
+    if (errno == ENAMETOOLONG && path.filename().native().size() <= 255)
+      throw InputError("cannot write '" + path.string() + "': " + kNameTooLongForTemporary);
     throw InputError("cannot write '" + path.string() + "' (" + ErrnoText() +
                      "); check that its directory exists and is writable, or choose another output path");
   }
@@ -376,6 +378,8 @@ AtomicOutputDirectory::AtomicOutputDirectory(fs::path final_path, OutputPolicy p
     };
     if (CreateRegistered(candidate, create)) {
       temp_path_ = candidate;
+    } else if (errno == ENAMETOOLONG && final_path_.filename().native().size() <= 255) {
+      throw InputError("cannot create '" + final_path_.string() + "': " + kNameTooLongForTemporary);
     } else if (errno != EEXIST) {
       throw InputError("cannot create a directory next to '" + final_path_.string() + "' (" + ErrnoText() +
                        "); check that '" + parent.string() + "' exists and is writable");

@@ -4,6 +4,9 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <functional>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -248,6 +251,19 @@ TEST(AtomicOutput, WriteFileAtomicallyWritesContentAndNoTemporaries) {
   fs::create_directories(tmp.path() / "folder/inside");
   EXPECT_THROW(WriteFileAtomically(tmp.path() / "folder", "x"), InputError);
   EXPECT_TRUE(fs::is_directory(tmp.path() / "folder/inside"));
+  EXPECT_EQ(CountEntries(tmp.path()), 2);
+  // A name the system takes but its temporary's is too long for: said so, with the length that works.
+  const std::string long_name(245, 'n');
+  for (const auto& write :
+       std::vector<std::function<void()>>{[&] { WriteFileAtomically(tmp.path() / (long_name + ".json"), "x"); },
+                                          [&] { AtomicOutputDirectory(tmp.path() / long_name, OutputPolicy{}); }}) {
+    try {
+      write();
+      ADD_FAILURE() << "a name too long for its temporary was written";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("at most 230 bytes"), std::string::npos) << e.what();
+    }
+  }
   EXPECT_EQ(CountEntries(tmp.path()), 2);
   // A private file stays private when replaced.
   fs::permissions(tmp.path() / "f.json", fs::perms::owner_read | fs::perms::owner_write);

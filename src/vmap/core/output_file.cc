@@ -70,6 +70,7 @@ std::string WhyNotCreatable(const fs::path& path) {
   const int fd = open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0600);
   if (fd < 0) {
     if (errno == EEXIST) return "";  // a name already taken there: the folder takes files
+    if (errno == ENAMETOOLONG && path.filename().native().size() <= 255) return kNameTooLongForTemporary;
     return std::strerror(errno);
   }
   close(fd);
@@ -138,7 +139,9 @@ void CheckOutputFiles(const std::vector<OutputFile>& outputs, const std::vector<
     }
     if (const std::string problem = WhyNotCreatable(output.path); !problem.empty()) {
       throw OptionError(output.flag, path + " cannot be written: " + problem +
-                                         "; give a path in a folder where this user may create files");
+                                         (problem == kNameTooLongForTemporary
+                                              ? ""
+                                              : "; give a path in a folder where this user may create files"));
     }
   }
 }

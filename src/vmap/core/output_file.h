@@ -38,4 +38,10 @@ void CheckOutputFiles(const std::vector<OutputFile>& outputs, const std::vector<
 // (it is a writable regular file, or absent). The part of CheckOutputFiles that WriteFileAtomically repeats.
 std::string WhyNotReplaceable(const std::filesystem::path& path);
 
+// Why an output whose name the system takes cannot be written all the same: vmap writes a temporary beside it first
+// (.NAME.tmp-PID-N, .NAME.partial-PID-N), about 20 bytes longer, and a name holds at most 255 bytes.
+inline constexpr const char* kNameTooLongForTemporary =
+    "its name is too long for the temporary vmap writes beside it first (.NAME.tmp-PID-N, about 20 bytes longer; a "
+    "file name holds 255 bytes): give a name of at most 230 bytes";
+
 }  // namespace vmap
