@@ -98,39 +98,55 @@ TEST(TeachNode, BuildsFromAPlayedBagTheMapVmapBuildBuilds) {
   EXPECT_TRUE(node->Running());
 }
 
+// A teach run of the node in namespace `ns` (its parameters `parameters`) into DIR/map, fed a bag of lab_floor's first
+// `frames` frames at their recorded rate; returns once the node took every frame, with the node running.
+struct PlayedTeach {
+  std::unique_ptr<ChildProcess> node;
+  std::vector<ros::Time> stamps;
+};
+void TeachFromPlayedBag(const std::string& ns, const std::vector<std::string>& parameters, const fs::path& dir,
+                        int frames, PlayedTeach* played) {
+  const fs::path bag = dir / "teach.bag";
+  played->stamps =
+      WriteVideoBag(fs::path(SharedDir()) / "data/lab_floor/lab_floor.mp4", 0, frames - 1, bag, "bgr8", 0.05);
+  std::vector<std::string> arguments = {"image:=/camera/image_raw", "odom:=/odom"};
+  arguments.insert(arguments.end(), parameters.begin(), parameters.end());
+  played->node = StartVmapNode(ns, arguments, dir / "node.log");
+  ChildProcess& node = *played->node;
+  ASSERT_TRUE(WaitForNodeServices(ns + "/vmap")) << node.Log();
+  ros::NodeHandle handle;
+  std::mutex mutex;
+  uint32_t taken = 0;
+  const ros::Subscriber subscriber = handle.subscribe<vmap_ros::TeachProgress>(
+      ns + "/vmap/teach/progress", 100, [&](const vmap_ros::TeachProgress::ConstPtr& message) {
+        std::lock_guard<std::mutex> lock(mutex);
+        taken = message->frames;
+      });
+  vmap_ros::StartTeach start;
+  start.request.map = (dir / "map").string();
+  ASSERT_TRUE(ros::service::call(ns + "/vmap/teach/start", start));
+  ASSERT_TRUE(start.response.success) << start.response.message;
+  ASSERT_TRUE(WaitFor([&] { return subscriber.getNumPublishers() > 0; }, kTimeout));
+  const auto player = PlayBag(bag, 1.0, dir / "play.log");
+  ASSERT_EQ(player->Wait(std::chrono::seconds(120)), 0) << player->Log();
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(mutex);
+        return taken == played->stamps.size();
+      },
+      kTimeout))
+      << node.Log();
+}
+
 // SIGTERM (roslaunch's escalation, systemd's and docker's stop) ends a teach run as SIGINT does: its map is
 // written with every frame the node took, not lost with the process.
 TEST(TeachNode, ATerminateSignalFinishesTheTeachRunsMap) {
   SKIP_WITHOUT_SHARED();
   ScopedTempDir dir("ros_teach_sigterm");
-  const fs::path bag = dir.path() / "teach.bag";
-  const std::vector<ros::Time> stamps =
-      WriteVideoBag(fs::path(SharedDir()) / "data/lab_floor/lab_floor.mp4", 0, 29, bag, "bgr8", 0.05);
-  const auto node = StartVmapNode("/teach_term", {"image:=/camera/image_raw", "odom:=/odom", "_teach_queue:=100"},
-                                  dir.path() / "node.log");
-  ASSERT_TRUE(WaitForNodeServices("/teach_term/vmap")) << node->Log();
-  ros::NodeHandle handle;
-  std::mutex mutex;
-  uint32_t frames = 0;
-  const ros::Subscriber subscriber = handle.subscribe<vmap_ros::TeachProgress>(
-      "/teach_term/vmap/teach/progress", 100, [&](const vmap_ros::TeachProgress::ConstPtr& message) {
-        std::lock_guard<std::mutex> lock(mutex);
-        frames = message->frames;
-      });
-  vmap_ros::StartTeach start;
-  start.request.map = (dir.path() / "map").string();
-  ASSERT_TRUE(ros::service::call("/teach_term/vmap/teach/start", start));
-  ASSERT_TRUE(start.response.success) << start.response.message;
-  ASSERT_TRUE(WaitFor([&] { return subscriber.getNumPublishers() > 0; }, kTimeout));
-  const auto player = PlayBag(bag, 1.0, dir.path() / "play.log");
-  ASSERT_EQ(player->Wait(std::chrono::seconds(120)), 0) << player->Log();
-  ASSERT_TRUE(WaitFor(
-      [&] {
-        std::lock_guard<std::mutex> lock(mutex);
-        return frames == stamps.size();
-      },
-      kTimeout))
-      << node->Log();
+  PlayedTeach played;
+  ASSERT_NO_FATAL_FAILURE(TeachFromPlayedBag("/teach_term", {"_teach_queue:=100"}, dir.path(), 30, &played));
+  const auto& node = played.node;
+  const std::vector<ros::Time>& stamps = played.stamps;
 
   EXPECT_EQ(node->Stop(std::chrono::seconds(60), SIGTERM), 0) << node->Log();
   const VisualMap map = ReadMap(dir.path() / "map");
@@ -146,35 +162,11 @@ TEST(TeachNode, ATerminateSignalFinishesTheTeachRunsMap) {
 TEST(TeachNode, AKilledTeachRunLeavesItsLastSnapshotWithItsOdometry) {
   SKIP_WITHOUT_SHARED();
   ScopedTempDir dir("ros_teach_sigkill");
-  const fs::path bag = dir.path() / "teach.bag";
-  const std::vector<ros::Time> stamps =
-      WriteVideoBag(fs::path(SharedDir()) / "data/lab_floor/lab_floor.mp4", 0, 39, bag, "bgr8", 0.05);
-  const auto node = StartVmapNode(
-      "/teach_kill", {"image:=/camera/image_raw", "odom:=/odom", "_teach_queue:=100", "_snapshot_every:=0.2"},
-      dir.path() / "node.log");
-  ASSERT_TRUE(WaitForNodeServices("/teach_kill/vmap")) << node->Log();
-  ros::NodeHandle handle;
-  std::mutex mutex;
-  uint32_t frames = 0;
-  const ros::Subscriber subscriber = handle.subscribe<vmap_ros::TeachProgress>(
-      "/teach_kill/vmap/teach/progress", 100, [&](const vmap_ros::TeachProgress::ConstPtr& message) {
-        std::lock_guard<std::mutex> lock(mutex);
-        frames = message->frames;
-      });
-  vmap_ros::StartTeach start;
-  start.request.map = (dir.path() / "map").string();
-  ASSERT_TRUE(ros::service::call("/teach_kill/vmap/teach/start", start));
-  ASSERT_TRUE(start.response.success) << start.response.message;
-  ASSERT_TRUE(WaitFor([&] { return subscriber.getNumPublishers() > 0; }, kTimeout));
-  const auto player = PlayBag(bag, 1.0, dir.path() / "play.log");
-  ASSERT_EQ(player->Wait(std::chrono::seconds(120)), 0) << player->Log();
-  ASSERT_TRUE(WaitFor(
-      [&] {
-        std::lock_guard<std::mutex> lock(mutex);
-        return frames == stamps.size();
-      },
-      kTimeout))
-      << node->Log();
+  PlayedTeach played;
+  ASSERT_NO_FATAL_FAILURE(
+      TeachFromPlayedBag("/teach_kill", {"_teach_queue:=100", "_snapshot_every:=0.2"}, dir.path(), 40, &played));
+  const auto& node = played.node;
+  const std::vector<ros::Time>& stamps = played.stamps;
 
   node->Stop(std::chrono::seconds(10), SIGKILL);
   const VisualMap map = ReadMap(dir.path() / "map");
