@@ -120,6 +120,7 @@ TEST(Promises, VmapReplacesWhatItWrote) {
               0)
         << out;
     ASSERT_EQ(RunVmap("sweep " + in + " --thresholds 0.4,0.8 --report " + Quote(tmp.path() / "page"), &out), 0) << out;
+    EXPECT_NE(out.find("report written to " + (tmp.path() / "page").string()), std::string::npos) << out;
     ASSERT_EQ(RunVmap("report " + Quote(tmp.path() / "m"), &out), 0) << out;
   }
   EXPECT_TRUE(fs::exists(tmp.path() / "page/report.html"));

@@ -23,6 +23,11 @@ void RunSweep(const SweepCommand& command) {
   if (!command.options.output.empty()) {
     std::cout << "\nwritten to " << command.options.output << " (sweep.md, sweep.csv, sweep.json)\n";
   }
+  // A report in a folder of its own: said as the output is.
+  if (!command.options.report.empty() && command.options.report != command.options.output) {
+    std::cout << (command.options.output.empty() ? "\n" : "") << "report written to " << command.options.report
+              << " (report.html)\n";
+  }
 }
 
 }  // namespace

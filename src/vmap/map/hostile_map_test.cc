@@ -34,6 +34,13 @@ TEST(MapIo, MissingOrMalformedMapsNameTheProblem) {
   testing::ScopedTempDir tmp;
   EXPECT_NE(ReadMapError(tmp.path() / "nope").find("does not exist"), std::string::npos);
   EXPECT_NE(ReadMapError(tmp.path()).find("map.json is missing"), std::string::npos);
+  // A sweep's folder (`vmap sweep --maps`): its maps, one level down, named.
+  fs::create_directories(tmp.path() / "sweep/tau_0.50");
+  WriteMapFiles(SmallMap(tmp.path() / "sweep/tau_0.50"), tmp.path() / "sweep/tau_0.50");
+  EXPECT_NE(ReadMapError(tmp.path() / "sweep")
+                .find("the maps are in its folders, e.g. '" + (tmp.path() / "sweep/tau_0.50").string() + "'"),
+            std::string::npos)
+      << ReadMapError(tmp.path() / "sweep");
 
   WriteMapFiles(SmallMap(tmp.path()), tmp.path());
   fs::remove(tmp.path() / "keys/9.png");

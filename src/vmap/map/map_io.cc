@@ -339,7 +339,17 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
   }
   const fs::path file = directory / kMapFileName;
   const ContainedJson parsed = ReadContainedJson(directory, kMapFileName, kMaxMapJsonBytes, kMaxMapJsonValues);
-  if (parsed.missing) throw InputError("'" + directory.string() + "' is not a map: " + file.string() + " is missing");
+  if (parsed.missing) {
+    // A sweep's folder holds its maps one level down (`vmap sweep --maps`): named, rather than only what is missing.
+    std::string within;
+    for (const fs::directory_entry& entry : fs::directory_iterator(directory, ec)) {
+      if (fs::is_regular_file(entry.path() / kMapFileName, ec) && (within.empty() || entry.path().string() < within)) {
+        within = entry.path().string();
+      }
+    }
+    throw InputError("'" + directory.string() + "' is not a map: " + file.string() + " is missing" +
+                     (within.empty() ? "" : "; the maps are in its folders, e.g. '" + within + "'"));
+  }
   if (parsed.why_not.find(" cannot be opened") != std::string::npos) {
     throw InputError("map '" + directory.string() + "': " + parsed.why_not + CannotOpenHint(parsed.why_not));
   }

@@ -1,12 +1,14 @@
 #include "vmap/mapping/batch_build.h"
 
 #include <algorithm>
+#include <chrono>
 #include <memory>
 #include <optional>
 
 #include <fmt/format.h>
 
 #include "vmap/core/error.h"
+#include "vmap/core/stopwatch.h"
 #include "vmap/map/map_writer.h"
 #include "vmap/mapping/key_image_search.h"
 #include "vmap/mapping/map_builder.h"
@@ -23,6 +25,7 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
                          const std::vector<double>& taus, const std::vector<fs::path>& directories,
                          std::vector<VisualMap>* maps, const std::string& options_json) {
   options.Check();
+  const auto start = std::chrono::steady_clock::now();
   std::vector<std::unique_ptr<MapWriter>> writers;
   std::vector<MapWriter*> sinks;
   for (const fs::path& directory : directories) {
@@ -42,6 +45,8 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
   std::vector<VisualMap> built = builder.FinishAll(CoverageEnd::kInputEnded, analyze_links, /*with_evaluations=*/true);
 
   SweepResult result;
+  // The sweep's own time: its maps' links are analysed one after another, so no map's seconds is the sweep's.
+  result.seconds = SecondsSince(start);
   result.options_json = options_json;
   result.input = frames.info();
   result.features_extracted = builder.features_extracted();
@@ -49,7 +54,6 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
   result.links_verified = builder.links_verified();
   for (size_t i = 0; i < built.size(); ++i) {
     VisualMap& map = built[i];
-    result.seconds = std::max(result.seconds, map.seconds);
     const MapStatistics stats = ComputeStatistics(map, options.quality_mean);
     result.num_frames = map.num_frames;
     SweepRow row;

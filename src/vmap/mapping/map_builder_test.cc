@@ -113,7 +113,12 @@ TEST(MapBuilder, SweepExtractsEachFrameOnceAndEqualsSeparateBuilds) {
   CountingMatcher matcher(CreateOrbMatcher({}));
   MemorySource source(Sequence().frames);
   std::vector<VisualMap> maps;
+  const auto start = std::chrono::steady_clock::now();
   const SweepResult sweep = SweepThresholds(source, matcher, Options(0.5), taus, &maps);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // The sweep's time is its own, all of it: its maps' links are analysed one after another.
+  EXPECT_LE(sweep.seconds, wall);
+  EXPECT_GE(sweep.seconds, 0.9 * wall);
   EXPECT_EQ(matcher.extracted.load(), 50);
   EXPECT_EQ(sweep.features_extracted, 50);
   ASSERT_EQ(sweep.rows.size(), 3u);
