@@ -251,7 +251,8 @@ Camera ParseCameraText(const std::string& text) {
 Camera ReadOpenCvCameraFile(const std::string& path) {
   static const std::string kFormats =
       "give OpenCV's calibration (camera_matrix, distortion_coefficients as !!opencv-matrix or lists), ROS "
-      "camera_calibration's YAML (ost.yaml), a TUM intrinsics.txt, a KITTI calib.txt or fx,fy,cx,cy";
+      "camera_calibration's YAML (ost.yaml), COLMAP's cameras.txt, a TUM intrinsics.txt, a KITTI calib.txt or "
+      "fx,fy,cx,cy";
   cv::FileStorage fs;
   try {
     // A YAML file without OpenCV's "%YAML:1.0" first line (ROS's ost.yaml, most hand-written ones) is read as one

@@ -7,7 +7,9 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -111,6 +113,63 @@ Camera ReadKittiCalib(const std::string& path, const std::string& projection) {
   }
   throw InputError("'" + path + "' has no " + projection + ": line (KITTI calib.txt: P0: followed by 12 numbers)");
 }
+
+namespace {
+
+// COLMAP's cameras.txt ("CAMERA_ID MODEL WIDTH HEIGHT PARAMS[]", a camera a line): its first camera, or nullopt when
+// the text is none (a first line whose second word is no model name, such as intrinsics.txt's "fx 525.0").
+// COLMAP puts the centre of the top-left pixel at (0.5, 0.5), OpenCV and vmap at (0, 0): the principal point moves
+// by half a pixel. SIMPLE_RADIAL and RADIAL are OpenCV's model with k1 (and k2) only.
+std::optional<Camera> ReadColmapCameras(const std::string& path, const std::string& text) {
+  static const std::map<std::string, size_t> kParameters = {{"SIMPLE_PINHOLE", 3}, {"PINHOLE", 4}, {"SIMPLE_RADIAL", 4},
+                                                            {"RADIAL", 5},         {"OPENCV", 8},  {"FULL_OPENCV", 12},
+                                                            {"OPENCV_FISHEYE", 8}};
+  std::istringstream lines(text);
+  std::string line;
+  for (int number = 1; std::getline(lines, line); ++number) {
+    std::istringstream fields(StripComment(line));
+    std::string id, model;
+    if (!(fields >> id)) continue;
+    if (!(fields >> model) || model.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZ_") != std::string::npos) {
+      return std::nullopt;
+    }
+    const auto known = kParameters.find(model);
+    if (known == kParameters.end()) {
+      throw InputError(
+          fmt::format("'{}' line {}: COLMAP camera model {} is not read; give SIMPLE_PINHOLE, PINHOLE, "
+                      "SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV or OPENCV_FISHEYE",
+                      path, number, model));
+    }
+    std::vector<double> values;
+    for (std::string word; fields >> word;) {
+      const std::optional<double> value = ParseNumber(word);
+      if (!value) throw InputError(fmt::format("'{}' line {}: '{}' is not a number", path, number, word));
+      values.push_back(*value);
+    }
+    if (values.size() != 2 + known->second) {
+      throw InputError(fmt::format("'{}' line {}: a COLMAP {} camera is WIDTH HEIGHT and {} parameters, not {} numbers",
+                                   path, number, model, known->second, values.size()));
+    }
+    const cv::Size size(static_cast<int>(values[0]), static_cast<int>(values[1]));
+    std::vector<double> p(values.begin() + 2, values.end());
+    const bool one_focal = model == "SIMPLE_PINHOLE" || model == "SIMPLE_RADIAL" || model == "RADIAL";
+    const size_t cx = one_focal ? 1 : 2;
+    p[cx] -= 0.5;
+    p[cx + 1] -= 0.5;
+    Camera camera;
+    if (model == "SIMPLE_RADIAL" || model == "RADIAL") {
+      camera = Camera::Make(p[0], p[0], p[1], p[2], {p[3], model == "RADIAL" ? p[4] : 0.0, 0.0, 0.0}, size);
+    } else {
+      camera = Camera::FromParams(ParseCameraModel(model), p, size);
+    }
+    camera.origin = path;
+    camera.Check();
+    return camera;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
 
 Camera ReadIntrinsicsText(const std::string& path) {
   std::istringstream lines(ReadText(path));
@@ -280,6 +339,7 @@ Camera ReadCameraFile(const std::string& path) {
   if (extension == ".json" || extension == ".xml" || extension == ".gz") return ReadOpenCvCameraFile(path);
   const std::string text = ReadText(path);
   if (text.find("P0:") != std::string::npos) return ReadKittiCalib(path, "P0");
+  if (std::optional<Camera> colmap = ReadColmapCameras(path, text)) return *colmap;
   return ReadIntrinsicsText(path);
 }
 

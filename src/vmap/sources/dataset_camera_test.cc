@@ -1,6 +1,9 @@
 #include "vmap/sources/dataset_camera.h"
 
 #include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -132,6 +135,42 @@ TEST(DatasetCamera, IntrinsicsTextBesideAnImageFolderOrItsParent) {
   }
   EXPECT_THROW(ParseCameraOption("no/such/file.yaml"), InputError);
   EXPECT_DOUBLE_EQ(ParseCameraOption("500,501,320,240").fy, 501);
+}
+
+// COLMAP's cameras.txt, as COLMAP writes it: its first camera, the principal point moved from COLMAP's pixel centres
+// (the top-left one at 0.5, 0.5) to OpenCV's (at 0, 0).
+TEST(DatasetCamera, ReadsColmapCamerasTxt) {
+  testing::ScopedTempDir tmp;
+  const std::string header =
+      "# Camera list with one line of data per camera:\n#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
+      "# Number of cameras: 1\n";
+  WriteText(tmp.path() / "pinhole/cameras.txt", header + "1 PINHOLE 640 480 525.5 524.5 320.5 240.5\n");
+  const Camera pinhole = ReadCameraFile((tmp.path() / "pinhole/cameras.txt").string());
+  EXPECT_EQ(pinhole.K(), cv::Matx33d(525.5, 0, 320, 0, 524.5, 240, 0, 0, 1));
+  EXPECT_EQ(pinhole.size, cv::Size(640, 480));
+  WriteText(tmp.path() / "radial/cameras.txt", header + "1 SIMPLE_RADIAL 640 480 500 320 240 -0.125\n");
+  const Camera radial = ReadCameraFile((tmp.path() / "radial/cameras.txt").string());
+  EXPECT_EQ(radial.fx, 500);
+  EXPECT_EQ(radial.fy, 500);
+  EXPECT_EQ(radial.cx, 319.5);
+  EXPECT_EQ(radial.k1, -0.125);
+  EXPECT_EQ(radial.k2, 0.0);
+  WriteText(tmp.path() / "fisheye/cameras.txt", "1 OPENCV_FISHEYE 640 480 300 301 320 240 0.1 0.01 0.001 0.0001\n");
+  const Camera fisheye = ReadCameraFile((tmp.path() / "fisheye/cameras.txt").string());
+  EXPECT_TRUE(fisheye.is_fisheye());
+  EXPECT_EQ(fisheye.k4, 0.0001);
+  for (const auto& [text, expected] : std::vector<std::pair<std::string, std::string>>{
+           {"1 THIN_PRISM_FISHEYE 640 480 1 2 3 4 5 6 7 8 9 10 11 12\n", "model THIN_PRISM_FISHEYE is not read"},
+           {"1 PINHOLE 640 480 525 525 320\n", "WIDTH HEIGHT and 4 parameters, not 5 numbers"},
+           {"1 PINHOLE 640 480 525 x 320 240\n", "'x' is not a number"}}) {
+    WriteText(tmp.path() / "bad/cameras.txt", text);
+    try {
+      ReadCameraFile((tmp.path() / "bad/cameras.txt").string());
+      ADD_FAILURE() << "accepted " << text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(DatasetCamera, FrameSourceCarriesTheCameraScaledWithResize) {
