@@ -21,7 +21,9 @@
 #include "vmap/core/contained_file.h"
 #include "vmap/core/directory_lock.h"
 #include "vmap/core/error.h"
+#include "vmap/core/file_sync.h"
 #include "vmap/core/output_file.h"
+#include "vmap/core/temporary_name.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -90,71 +92,7 @@ void RemoveAndUnregister(const fs::path& path) {
   Temporaries().Remove(path);
 }
 
-constexpr const char* kTemporaryTags[] = {"partial", "old", "tmp"};
-
-}  // namespace
-
-fs::path TemporarySibling(const fs::path& path, const char* tag) {
-  static std::mutex mutex;
-  static std::mt19937 random{std::random_device{}()};
-  unsigned suffix;
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    suffix = random() % 1000000;
-  }
-  const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
-  return parent /
-         ("." + path.filename().string() + "." + tag + "-" + std::to_string(getpid()) + "-" + std::to_string(suffix));
-}
-
-namespace {
-
-bool AllDigits(const std::string& text) {
-  return !text.empty() && text.size() <= 18 && text.find_first_not_of("0123456789") == std::string::npos;
-}
-
-// The pid in a temporary's name ".NAME.TAG-PID-N" of `name`, or 0 when `file_name` is not one.
-long TemporaryOwner(const std::string& file_name, const std::string& name) {
-  const std::string prefix = "." + name + ".";
-  if (file_name.compare(0, prefix.size(), prefix) != 0) return 0;
-  const std::string rest = file_name.substr(prefix.size());
-  for (const char* tag : kTemporaryTags) {
-    const std::string tag_prefix = std::string(tag) + "-";
-    if (rest.compare(0, tag_prefix.size(), tag_prefix) != 0) continue;
-    const std::string numbers = rest.substr(tag_prefix.size());
-    const size_t dash = numbers.find('-');
-    if (dash == std::string::npos) return 0;
-    const std::string pid = numbers.substr(0, dash), suffix = numbers.substr(dash + 1);
-    if (!AllDigits(pid) || !AllDigits(suffix)) return 0;
-    return std::stol(pid);
-  }
-  return 0;
-}
-
-// Whether a process with this pid exists (ours included; EPERM means it exists and is another user's).
-bool ProcessRuns(long pid) {
-  if (pid <= 0 || pid > 0x7fffffffL) return true;  // not a pid we can ask about: leave it alone
-  return kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH;
-}
-
 std::string ErrnoText() { return std::strerror(errno); }
-
-// Durability across a power loss: a rename is put on disk before the data it names unless the data is synced first
-// (ext4 orders it for a replaced file only, not for a folder), and the rename itself only once its directory is.
-// Best effort: a file system that cannot sync (some FUSE and network ones) is written to as before.
-void SyncDirectory(const fs::path& directory) {
-  const int fd = open(directory.empty() ? "." : directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0) return;
-  fsync(fd);
-  close(fd);
-}
-// Every file written into a temporary folder, in one call: cheaper than one fsync a file (a map's key images).
-void SyncFileSystemOf(const fs::path& directory) {
-  const int fd = open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0) return;
-  syncfs(fd);
-  close(fd);
-}
 
 [[noreturn]] void Refuse(const fs::path& path, const std::string& why_and_fix) {
   throw InputError("output '" + path.string() + "' " + why_and_fix);

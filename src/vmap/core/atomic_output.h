@@ -113,10 +113,6 @@ class AtomicOutputDirectory {
 // writes the directory only at its end, to refuse a wrong one at its start. Throws InputError.
 void CheckOutputDirectory(const std::filesystem::path& final_path, const OutputPolicy& policy);
 
-// A name for a temporary beside `path`, ".NAME.TAG-PID-N" (TAG: "partial", "old" or "tmp"): the pid says whose it
-// is (RemoveStaleTemporaries), N keeps one process's apart. Nothing is created.
-std::filesystem::path TemporarySibling(const std::filesystem::path& path, const char* tag);
-
 // Removes the temporaries of dead processes next to `path` (".NAME.partial-PID-N" and the like, NAME being
 // `path`'s file name). Called by every output before it writes; exposed for tests.
 void RemoveStaleTemporaries(const std::filesystem::path& path);

@@ -11,6 +11,7 @@
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/temporary_name.h"
 
 namespace vmap {
 namespace fs = std::filesystem;

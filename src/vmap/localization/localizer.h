@@ -10,12 +10,12 @@
 //   ranked cheaply (KeyImageRanking), the best few are verified like the map's own links (the map's matcher
 //   and fundamental-matrix verifier), and the best verified one, with the better of its two neighbours on
 //   the route, gives the segment.
-// - Tracking: the frame is compared with `key` and `next_key`; when `next_key` is the better match the
-//   estimate moves on (and then one key image further is compared too, to move on twice when the robot went
-//   fast): the key-image switching of teach-and-repeat systems. Near `key`, the key image before it is
-//   compared too, and the estimate moves back when that is the better match. A frame that verifies against
-//   none of them is relocalized at once (the robot may have turned back or skipped ahead); when that fails
-//   too it is lost and the estimate is kept, and after `max_lost_frames` lost frames in a row it is dropped.
+// - Tracking: the frame is compared with `key` and `next_key`; when `next_key` is the better match the estimate moves
+//   on (and then one key image further is compared too, to move on twice when the robot went fast): the key-image
+//   switching of teach-and-repeat systems. Near `key`, the key image before it is compared too, and the estimate moves
+//   back when that is the better match. A frame that verifies against none of them is relocalized at once (the robot
+//   may have turned back or skipped ahead); when that fails too it is lost and the estimate is kept, and after
+//   `max_lost_frames` lost frames in a row it is dropped.
 //
 // "Better match" is measured by the verified matches (inliers of F) and S, as in the map; "verified" by the
 // acceptance rule (acceptance.h: how unlikely the verified matches are by chance and how many against the map's
@@ -446,8 +446,7 @@ class Localizer {
   // The step back last ruled out (Track): at route position `position`, on the frame before this one, with the
   // frame's verified matches with the next key image at that last check. position -1: none.
   struct StepBackRuledOut {
-    int position = -1;
-    int next_verified = 0;
+    int position = -1, next_verified = 0;
   } step_back_ruled_out_;
   RouteBelief belief_;
   MotionPace pace_;  // the motion model's steps a frame, and where the distance driven puts the robot

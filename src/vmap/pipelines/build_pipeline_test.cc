@@ -24,6 +24,16 @@ BuildPipelineOptions Quiet(BuildPipelineOptions options) {
   return options;
 }
 
+// A teach run written into FOLDER/teach, built into FOLDER/map with a snapshot after every frame.
+BuildPipelineOptions SnapshotAfterEveryFrame(const fs::path& folder) {
+  testing::WriteImageFolder(testing::SidewaysDrive(), folder / "teach");
+  BuildPipelineOptions options;
+  options.input = (folder / "teach").string();
+  options.output = (folder / "map").string();
+  options.snapshot_every = 1e-6;
+  return options;
+}
+
 // The same teach run as a folder and as the host's own frames: the same map, committed where asked.
 TEST(BuildPipeline, BuildsFromAPathOrFromTheHostsFramesAlike) {
   testing::ScopedTempDir tmp;
@@ -73,11 +83,7 @@ TEST(BuildPipeline, TauGivenIsRecordedAndAfterFrameSeesEveryFrame) {
 // finished map that cannot be put in place is kept beside it, where the error says.
 TEST(BuildPipeline, NeitherAFailedSnapshotNorAFailedCommitLosesTheRun) {
   testing::ScopedTempDir tmp;
-  testing::WriteImageFolder(testing::SidewaysDrive(), tmp.path() / "teach");
-  BuildPipelineOptions options;
-  options.input = (tmp.path() / "teach").string();
-  options.output = (tmp.path() / "map").string();
-  options.snapshot_every = 1e-6;  // a snapshot after every frame
+  BuildPipelineOptions options = SnapshotAfterEveryFrame(tmp.path());
   int frames = 0;
   bool taken = false;
   options.map.after_frame = [&] {
@@ -109,11 +115,7 @@ TEST(BuildPipeline, NeitherAFailedSnapshotNorAFailedCommitLosesTheRun) {
 // snapshot it holds, so a run killed between snapshots keeps both of the same moment.
 TEST(BuildPipeline, TheHostsFilesAreInEverySnapshotAndInTheMap) {
   testing::ScopedTempDir tmp;
-  testing::WriteImageFolder(testing::SidewaysDrive(), tmp.path() / "teach");
-  BuildPipelineOptions options;
-  options.input = (tmp.path() / "teach").string();
-  options.output = (tmp.path() / "map").string();
-  options.snapshot_every = 1e-6;  // a snapshot after every frame
+  BuildPipelineOptions options = SnapshotAfterEveryFrame(tmp.path());
   int frames = 0, written = 0;
   std::vector<int> snapshot_frames;  // the frame count in the host's file of each snapshot seen on disk
   options.map.after_frame = [&] {
