@@ -10,6 +10,7 @@
 #include "vmap/core/error.h"
 #include "vmap/core/logging.h"
 #include "vmap/core/runtime.h"
+#include "vmap/core/temporary_name.h"
 #include "vmap/features/matcher_registry.h"
 
 #include "argument_errors.h"
@@ -36,7 +37,7 @@ PYBIND11_MODULE(vmap, m) {
     } catch (const vmap::python::ArgumentTypeError& e) {
       PyErr_SetString(argument_type_error.ptr(), e.what());
     } catch (const vmap::InputError& e) {
-      PyErr_SetString(error.ptr(), e.what());
+      PyErr_SetString(error.ptr(), vmap::NameOutputsNotTemporaries(e.what()).c_str());
     }
   });
 

@@ -18,6 +18,7 @@
 #include "vmap/core/error.h"
 #include "vmap/core/logging.h"
 #include "vmap/core/runtime.h"
+#include "vmap/core/temporary_name.h"
 #include "vmap/core/terminal_text.h"
 
 int main(int argc, char** argv) {
@@ -75,7 +76,7 @@ int main(int argc, char** argv) {
                  vmap::TerminalSafe(e.what()).c_str());
     return 2;
   } catch (const vmap::InputError& e) {
-    std::fprintf(stderr, "vmap: error: %s\n", vmap::TerminalSafe(e.what()).c_str());
+    std::fprintf(stderr, "vmap: error: %s\n", vmap::TerminalSafe(vmap::NameOutputsNotTemporaries(e.what())).c_str());
     return 2;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "vmap: error: out of memory; try a smaller input or smaller options (--resize)\n");

@@ -2,9 +2,12 @@
 // names (ground truth, runs, queries), each tested on the binary: a refusal is one "vmap: error:" line with
 // status 2, names the file, and leaves every input as it was.
 
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -13,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/map/map_io.h"
+#include "vmap/testing/promises_test_util.h"
 #include "vmap/testing/run_vmap.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/synthetic_scene.h"
@@ -231,6 +235,57 @@ TEST(OutputPromises, JsonOutputsTakeNamesThatAreNotUtf8) {
   ASSERT_EQ(RunVmap("route " + map + " --json " + Quote(tmp.path() / "route.json"), &out), 0) << out;
   EXPECT_NE(ReadText(tmp.path() / "route.json").find("m%E9"), std::string::npos);
   ASSERT_EQ(RunVmap("report " + Quote(tmp.path() / "run.json") + " -o " + Quote(tmp.path() / "r"), &out), 0) << out;
+}
+
+// A localize whose outputs cannot all be written (the file size limit stands in for a full disk) puts none in place:
+// the outputs of the run before stay as they were, though the ones written first fitted.
+TEST(OutputPromises, ALocalizeThatCannotWriteAllItsOutputsReplacesNone) {
+  testing::ScopedTempDir tmp;
+  BuildMap(tmp.path());
+  const fs::path csv = tmp.path() / "run.csv";
+  const fs::path json = tmp.path() / "run.json";
+  const fs::path report = tmp.path() / "r";
+  const std::string localize = "localize " + Quote(tmp.path() / "m") + " " + Quote(tmp.path() / "in") + " --csv " +
+                               Quote(csv) + " --json " + Quote(json);
+  std::string out;
+  ASSERT_EQ(RunVmap(localize + " --report " + Quote(report), &out), 0) << out;
+  uintmax_t largest_image = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(report)) {
+    if (entry.is_regular_file() && entry.path().extension() == ".jpg")
+      largest_image = std::max(largest_image, entry.file_size());
+  }
+  const uintmax_t csv_size = fs::file_size(csv);
+  const uintmax_t json_size = fs::file_size(json);
+  ASSERT_LT(csv_size, json_size);
+  ASSERT_LT(json_size, largest_image) << "the report's images must be the largest files for this test";
+  struct stat report_before {};
+  ASSERT_EQ(stat((report / "report.html").c_str(), &report_before), 0);
+
+  struct Case {
+    std::string extra;
+    uintmax_t limit;  // bytes a file may have: the first outputs fit, a later one does not
+  };
+  for (const Case& c : {Case{"", (csv_size + json_size) / 2}, Case{" --report " + Quote(report), json_size + 1}}) {
+    std::ofstream(csv) << "old\n";
+    std::ofstream(json) << "old\n";
+    struct rlimit old_limit {};
+    ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old_limit), 0);
+    const auto old_handler = signal(SIGXFSZ, SIG_DFL);  // as a shell leaves it: vmap ignores it itself
+    struct rlimit small = old_limit;
+    small.rlim_cur = c.limit;
+    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+    const int status = RunVmap(localize + c.extra, &out);
+    setrlimit(RLIMIT_FSIZE, &old_limit);
+    signal(SIGXFSZ, old_handler);
+    EXPECT_EQ(status, 2) << c.extra << "\n" << out;
+    EXPECT_NE(out.find("(File too large)"), std::string::npos) << out;
+    EXPECT_EQ(ReadText(csv), "old\n") << c.extra;
+    EXPECT_EQ(ReadText(json), "old\n") << c.extra;
+    struct stat report_after {};
+    ASSERT_EQ(stat((report / "report.html").c_str(), &report_after), 0);
+    EXPECT_EQ(report_after.st_ino, report_before.st_ino) << "the report was replaced";
+    EXPECT_TRUE(testing::EntriesStartingWith(tmp.path(), ".").empty()) << "a temporary was left";
+  }
 }
 
 }  // namespace vmap

@@ -14,7 +14,9 @@
 #include <mutex>
 #include <optional>
 #include <random>
+#include <stdexcept>
 #include <thread>
+#include <utility>
 
 #include <spdlog/spdlog.h>
 
@@ -136,6 +138,11 @@ int RemoveTemporaryOutputsForExit() {
 
 void WriteFileAtomically(const fs::path& path, std::string_view content,
                          const std::vector<TemporaryDirectory*>& completes) {
+  PendingFile(path, content).Commit(completes);
+}
+
+PendingFile::PendingFile(fs::path destination, std::string_view content) : path_(std::move(destination)) {
+  const fs::path& path = path_;
   // Refused before anything is written, and again before the rename (the path may have changed meanwhile).
   if (const std::string why_not = WhyNotReplaceable(path); !why_not.empty()) Refuse(path, why_not);
   RemoveStaleTemporaries(path);
@@ -176,18 +183,28 @@ void WriteFileAtomically(const fs::path& path, std::string_view content,
     written += static_cast<size_t>(n);
   }
   // A file inside a temporary folder is synced with the folder, when the folder is committed.
-  bool inside_temporary = false;
   {
     std::lock_guard<std::mutex> lock(Temporaries().mutex);
-    inside_temporary = Temporaries().paths.count(path.parent_path()) > 0;
+    inside_temporary_ = Temporaries().paths.count(path.parent_path()) > 0;
   }
-  if (!inside_temporary && fsync(fd) != 0 && errno != EINVAL && errno != EROFS) fail("writing");
+  if (!inside_temporary_ && fsync(fd) != 0 && errno != EINVAL && errno != EROFS) fail("writing");
   if (close(fd) != 0) {
     fd = -1;
     const std::string reason = ErrnoText();
     RemoveAndUnregister(temp);
     throw InputError("writing '" + path.string() + "' failed (" + reason + "); check the free space");
   }
+  temp_ = temp;
+}
+
+PendingFile::~PendingFile() {
+  if (!temp_.empty()) RemoveAndUnregister(temp_);
+}
+
+void PendingFile::Commit(const std::vector<TemporaryDirectory*>& completes) {
+  if (temp_.empty()) throw std::logic_error("PendingFile::Commit called twice for '" + path_.string() + "'");
+  const fs::path& path = path_;
+  const fs::path temp = std::exchange(temp_, fs::path());  // removed below on failure, never by the destructor
   if (const std::string why_not = WhyNotReplaceable(path); !why_not.empty()) {
     RemoveAndUnregister(temp);
     Refuse(path, why_not);
@@ -208,7 +225,7 @@ void WriteFileAtomically(const fs::path& path, std::string_view content,
     directory->completed_ = true;
   }
   lock.unlock();
-  if (!inside_temporary) SyncDirectory(path.parent_path());
+  if (!inside_temporary_) SyncDirectory(path.parent_path());
 }
 
 TemporaryDirectory::TemporaryDirectory(const fs::path& near) {

@@ -27,6 +27,26 @@ class TemporaryDirectory;
 void WriteFileAtomically(const std::filesystem::path& path, std::string_view content,
                          const std::vector<TemporaryDirectory*>& completes = {});
 
+// WriteFileAtomically in two steps: the temporary file is written (and synced) when the object is made, and renamed
+// into place by Commit(). A command with several outputs (`vmap localize --csv --json --report`) writes them all
+// before it puts any in place, so that a failure while writing one (a full disk) replaces none of the earlier
+// run's. Removed when destroyed uncommitted, or when the process is interrupted. Throws InputError as
+// WriteFileAtomically does.
+class PendingFile {
+ public:
+  PendingFile(std::filesystem::path path, std::string_view content);
+  ~PendingFile();
+  PendingFile(const PendingFile&) = delete;
+  PendingFile& operator=(const PendingFile&) = delete;
+
+  void Commit(const std::vector<TemporaryDirectory*>& completes = {});
+
+ private:
+  std::filesystem::path path_;
+  std::filesystem::path temp_;  // empty once committed
+  bool inside_temporary_ = false;
+};
+
 // A folder of this process's own work, ".NAME.partial-PID-N" beside `near` (NAME its file name), that becomes
 // part of an output by a rename: an experience's views, written before they are moved into a map. It is
 // removed when the object is destroyed or the process interrupted (wherever MoveTo put it) until a
@@ -46,8 +66,7 @@ class TemporaryDirectory {
   void MoveTo(const std::filesystem::path& from, const std::filesystem::path& to);
 
  private:
-  friend void WriteFileAtomically(const std::filesystem::path&, std::string_view,
-                                  const std::vector<TemporaryDirectory*>&);
+  friend class PendingFile;
   std::filesystem::path path_;
   bool completed_ = false;
 };

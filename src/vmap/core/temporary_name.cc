@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <mutex>
 #include <random>
+#include <regex>
 
 namespace vmap {
 namespace fs = std::filesystem;
@@ -48,6 +49,12 @@ long TemporaryOwner(const std::string& file_name, const std::string& name) {
     return std::stol(pid);
   }
   return 0;
+}
+
+std::string NameOutputsNotTemporaries(const std::string& message) {
+  // TemporarySibling's names, at the start of a path component, with a component after them.
+  static const std::regex kInsideTemporary(R"((^|[/'" ])\.([^/'"]+)\.(partial|old|tmp)-[0-9]+-[0-9]+(?=/))");
+  return std::regex_replace(message, kInsideTemporary, "$1$2");
 }
 
 bool ProcessRuns(long pid) {

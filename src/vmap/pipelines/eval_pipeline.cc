@@ -1,6 +1,7 @@
 #include "vmap/pipelines/eval_pipeline.h"
 
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 #include <spdlog/spdlog.h>
@@ -82,13 +83,18 @@ EvalPipelineResult RunEvalPipeline(const EvalPipelineOptions& options) {
                  evaluation.summary.evaluated_links, evaluation.summary.links);
   }
 
-  // 5. The records.
+  // 5. The records: both written before either is put in place, so that a failure while writing one (a full disk)
+  // leaves both as they were.
   const std::string json = EvaluationToJson(evaluation);
+  std::optional<PendingFile> saved;
   if (options.save) {
     result.saved_to = (fs::path(options.map) / kEvaluationFileName).string();
-    WriteFileAtomically(result.saved_to, json);
+    saved.emplace(result.saved_to, json);
   }
-  if (!options.json.empty()) WriteFileAtomically(options.json, json);
+  std::optional<PendingFile> json_file;
+  if (!options.json.empty()) json_file.emplace(options.json, json);
+  if (saved) saved->Commit();
+  if (json_file) json_file->Commit();
   return result;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 #include <utility>
 
 #include <fmt/format.h>
@@ -39,12 +40,19 @@ void CheckQueryIsNoFifo(const std::string& query) {
 void LocalizationSessionOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Section("Route and odometry");
   visitor.Visit(OptionField{"from", "--from", "Follow the route from this key image (default: the first)"}
+                    .AtLeast(0)
+                    .Or(-1)
+                    .Meaning("-1: the first")
                     .HideDefault()
                     .NotRecorded(),
                 from);
-  visitor.Visit(
-      OptionField{"to", "--to", "Follow the route to this key image (default: the last)"}.HideDefault().NotRecorded(),
-      to);
+  visitor.Visit(OptionField{"to", "--to", "Follow the route to this key image (default: the last)"}
+                    .AtLeast(0)
+                    .Or(-1)
+                    .Meaning("-1: the last")
+                    .HideDefault()
+                    .NotRecorded(),
+                to);
   visitor.Visit(OptionField{"teach_odometry", "--teach-odometry",
                             "The teach run's odometry: a CSV of timestamp,x,y,yaw (s, m, rad) or a recording with a "
                             "nav_msgs/Odometry topic, on the key images' clock; with the frames' odometry the belief "
@@ -274,8 +282,12 @@ LocalizePipelineResult RunLocalizePipeline(const LocalizePipelineOptions& option
       odometry_track);
   run.info.frame_size = query.info().frame_size;
 
-  // 10. The outputs.
-  if (!options.csv.empty()) WriteFileAtomically(options.csv, csv);
+  // 10. The outputs: all written before any is put in place, so that a failure while writing one (a full disk)
+  // leaves every output of an earlier run as it was. The report, the one most likely to be refused as it is put in
+  // place (its folder changed meanwhile), goes first.
+  std::optional<PendingFile> csv_file;
+  if (!options.csv.empty()) csv_file.emplace(options.csv, csv);
+  std::optional<PendingFile> json_file;
   if (!options.json.empty()) {
     std::string json = LocalizationRunJson(map, run);
     if (odometry) {
@@ -283,11 +295,13 @@ LocalizePipelineResult RunLocalizePipeline(const LocalizePipelineOptions& option
       document["odometry"] = std::move(odometry_json);
       json = document.dump(1) + "\n";
     }
-    WriteFileAtomically(options.json, json);
+    json_file.emplace(options.json, json);
   }
   if (!options.report.empty()) {
-    WriteLocalizationReport(run, map, options.map, options.report, report_options, recorded);
+    PrepareLocalizationReport(run, map, options.map, options.report, report_options, recorded)->Commit();
   }
+  if (json_file) json_file->Commit();
+  if (csv_file) csv_file->Commit();
   result.with_camera = session.localizer_options().camera.has_value();
   result.map = std::move(session.opened_->map);  // the session, done, is not used again
   return result;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -221,13 +222,14 @@ SimulatePipelineResult RunSimulatePipeline(const SimulatePipelineOptions& option
   run.summary = Summarize(run.trials);
   run.seconds = SecondsSince(start);
 
-  // 6. The outputs.
+  // 6. The outputs: all written before any is put in place, so that a failure while writing one (a full disk)
+  // leaves every output of an earlier run as it was.
+  if (report) WriteSimulationReport(run, simulation, report->path());
+  std::optional<PendingFile> json_file;
+  if (!options.json.empty()) json_file.emplace(options.json, SimulationJson(run, simulation).dump() + "\n");
   if (!options.map.empty()) map_directory.Commit();
-  if (report) {
-    WriteSimulationReport(run, simulation, report->path());
-    report->Commit();
-  }
-  if (!options.json.empty()) WriteFileAtomically(options.json, SimulationJson(run, simulation).dump() + "\n");
+  if (report) report->Commit();
+  if (json_file) json_file->Commit();
   return result;
 }
 

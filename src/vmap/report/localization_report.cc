@@ -251,9 +251,18 @@ bool QueryCanBeReadAgain(const LocalizationRunInfo& info) {
 void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, const fs::path& map_directory,
                              const fs::path& directory, const LocalizationReportOptions& options,
                              const RecordedFrames& recorded) {
+  PrepareLocalizationReport(run, map, map_directory, directory, options, recorded)->Commit();
+}
+
+std::unique_ptr<AtomicOutputDirectory> PrepareLocalizationReport(const LocalizationRun& run, const VisualMap& map,
+                                                                 const fs::path& map_directory,
+                                                                 const fs::path& directory,
+                                                                 const LocalizationReportOptions& options,
+                                                                 const RecordedFrames& recorded) {
   options.Check();
   for (const KeyImage& k : map.key_images) KeyImageFile(map_directory, k);
-  AtomicOutputDirectory output(directory, ReportPolicy(map_directory, run.info.query));
+  auto prepared = std::make_unique<AtomicOutputDirectory>(directory, ReportPolicy(map_directory, run.info.query));
+  AtomicOutputDirectory& output = *prepared;
   const fs::path assets = output.path() / kReportAssetsDirectory;
   fs::create_directory(assets);  // not create_directories: see AtomicOutputDirectory::path()
   fs::create_directory(assets / "frames");
@@ -370,7 +379,7 @@ void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map, c
   html << "</div>\n</section>\n" << report::PageEnd();
   WriteFileAtomically(output.path() / kReportFileName, html.str());
   WriteFileAtomically(output.path() / kLocalizationReportRunFileName, LocalizationRunJson(map, run));
-  output.Commit();
+  return prepared;
 }
 
 std::string WhyNotALocalizationReport(const fs::path& directory) {

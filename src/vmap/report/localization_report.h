@@ -12,10 +12,12 @@
 
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <string>
 
 #include <opencv2/core.hpp>
 
+#include "vmap/core/atomic_output.h"
 #include "vmap/core/option_fields.h"
 #include "vmap/localization/localization_output.h"
 #include "vmap/map/visual_map.h"
@@ -49,6 +51,13 @@ bool QueryCanBeReadAgain(const LocalizationRunInfo& info);
 void WriteLocalizationReport(const LocalizationRun& run, const VisualMap& map,
                              const std::filesystem::path& map_directory, const std::filesystem::path& directory,
                              const LocalizationReportOptions& options = {}, const RecordedFrames& recorded = {});
+// WriteLocalizationReport's work but its last step: the report written into its temporary folder, which Commit()
+// puts in place. `vmap localize` writes all its outputs before it puts any in place (PendingFile).
+std::unique_ptr<AtomicOutputDirectory> PrepareLocalizationReport(const LocalizationRun& run, const VisualMap& map,
+                                                                 const std::filesystem::path& map_directory,
+                                                                 const std::filesystem::path& directory,
+                                                                 const LocalizationReportOptions& options = {},
+                                                                 const RecordedFrames& recorded = {});
 
 // Throws InputError when `directory` may not receive the report of a run against `map_directory` of `query`
 // (the check WriteLocalizationReport makes): for `vmap localize --report`, to refuse before the run.
