@@ -53,8 +53,9 @@ std::shared_ptr<MapHandle> BuildMapFunction(const py::object& input, const py::o
 // A matcher and a verifier, created once and used for any number of pairs (a deep model's weights load once).
 class PairMatcher {
  public:
-  explicit PairMatcher(const py::kwargs& kwargs) {
-    KeywordOptions keywords("Matcher");
+  // `caller`: the Python name errors are given under ("Matcher", or "match" for vmap.match's matcher of one pair).
+  explicit PairMatcher(const py::kwargs& kwargs, const char* caller = "Matcher") {
+    KeywordOptions keywords(caller);
     keywords.Add(options_);
     keywords.Parse(kwargs);
     keywords.Run([&] {
@@ -154,7 +155,7 @@ void BindBuildAndMatch(py::module_& m) {
   m.def(
       "match",
       [](const py::object& image0, const py::object& image1, const py::kwargs& kwargs) {
-        return PairMatcher(kwargs).Match(image0, image1);
+        return PairMatcher(kwargs, "match").Match(image0, image1);
       },
       py::arg("image0"), py::arg("image1"),
       "Matches one pair as `vmap match` does (keywords: its options, e.g. matcher='orb', verifier_threshold=0.5; "

@@ -115,8 +115,11 @@ except vmap.Error as e:
 
 
 def test_wrong_types_are_type_errors_and_vmap_errors(tmp_path):
-    with pytest.raises(TypeError, match="threshold takes a number, not str"):
+    # Named by the function called: match(), not the Matcher it makes for the pair.
+    with pytest.raises(TypeError, match=r"^match\(\): threshold takes a number, not str"):
         vmap.match(np.zeros((8, 8), np.uint8), np.zeros((8, 8), np.uint8), threshold="1")
+    with pytest.raises(vmap.Error, match="matcher 'ORB' is unknown; matchers are named in lower case: use orb"):
+        vmap.match(np.zeros((8, 8), np.uint8), np.zeros((8, 8), np.uint8), matcher="ORB")
     with pytest.raises(vmap.Error, match="no_cache takes True or False"):
         vmap.Localizer(tmp_path, no_cache=1)
     with pytest.raises(TypeError, match="verifier takes a str"):

@@ -3,12 +3,15 @@
 
 #include <iostream>
 #include <memory>
+#include <stdexcept>
+#include <string>
 
 #include <fmt/format.h>
 
 #include "vmap/cli/commands.h"
 #include "vmap/cli/option_binder.h"
 #include "vmap/core/error.h"
+#include "vmap/core/option_ranges.h"
 #include "vmap/pipelines/add_experience_pipeline.h"
 #include "vmap/pipelines/build_pipeline.h"
 #include "vmap/report/summary.h"
@@ -56,6 +59,35 @@ void RunBuild(const BuildCommand& command) {
             << built.directory.string() << "\n";
 }
 
+// The type and the values a localizer field takes as its flag's help shows them ("FLOAT in [-1000, 1000]"), from its
+// declaration (LocalizerOptions::VisitFields): the flags below are bound by hand, with help of their own, but take
+// the values the field declares.
+std::string TypeWithRange(LocalizerOptions localizer, const std::string& key) {
+  class Finder : public OptionFieldVisitor {
+   public:
+    explicit Finder(std::string key) : key_(std::move(key)) {}
+    std::string found;
+
+   protected:
+    void OnField(const OptionField& field, int& /*value*/) override { Take(field, "INT", true); }
+    void OnField(const OptionField& field, double& /*value*/) override { Take(field, "FLOAT", false); }
+    void OnField(const OptionField& /*field*/, bool& /*value*/) override {}
+    void OnField(const OptionField& /*field*/, std::string& /*value*/) override {}
+    void OnField(const OptionField& /*field*/, std::vector<int>& /*value*/) override {}
+    void OnField(const OptionField& /*field*/, const EnumField& /*value*/) override {}
+
+   private:
+    void Take(const OptionField& field, const char* type, bool integral) {
+      if (Path(field) != key_ || !field.range.is_set) return;
+      found = std::string(type) + (field.range.also ? " " : " in ") + RangeText(field.range, integral);
+    }
+    std::string key_;
+  } finder(key);
+  finder.VisitNested("", localizer);
+  if (finder.found.empty()) throw std::logic_error("the localizer declares no range for " + key);
+  return finder.found;
+}
+
 }  // namespace
 
 void AddBuildCommand(CLI::App& app) {
@@ -84,16 +116,19 @@ void AddBuildCommand(CLI::App& app) {
           .AddOption(command, "--max-log10-nfa", localizer.max_log10_nfa, "experience.localizer.max_log10_nfa",
                      "--add-experience-to, --acceptance chance: accept when log10 of the number of false alarms "
                      "is at most this")
+          ->type_name(TypeWithRange(localizer, "max_log10_nfa"))
           ->capture_default_str()
           ->group(kAddExperienceSection),
       flags
           .AddOption(command, "--min-verified", localizer.min_verified, "experience.localizer.min_verified",
                      "--add-experience-to, --acceptance counts: verified matches a frame needs")
+          ->type_name(TypeWithRange(localizer, "min_verified"))
           ->capture_default_str()
           ->group(kAddExperienceSection),
       flags
           .AddOption(command, "--min-similarity", localizer.min_similarity, "experience.localizer.min_similarity",
                      "--add-experience-to, --acceptance counts: S a frame needs")
+          ->type_name(TypeWithRange(localizer, "min_similarity"))
           ->capture_default_str()
           ->group(kAddExperienceSection)};
   command->callback([state] { state->flags.Run([&] { RunBuild(*state); }); });

@@ -1,6 +1,8 @@
 // End-to-end tests of the vmap binary: real sequences in every layout, and every kind of bad input.
 
 #include <fstream>
+#include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -232,7 +234,9 @@ TEST(Cli, BadInputGivesAClearErrorAndWritesNothing) {
       {"build " + in + out_dir + " --tau 0", "outside (0, 1]"},
       {"build " + in + out_dir + " --tau 1.5", "outside (0, 1]"},
       {"build " + in + out_dir + " --verifier lmeds", "unknown verifier 'lmeds'"},
-      {"build " + in + out_dir + " --matcher sift", "unknown matcher 'sift'"},
+      {"build " + in + out_dir + " --matcher sift", "--matcher 'sift' is unknown; use orb, aliked"},
+      {"build " + in + out_dir + " --matcher ORB",
+       "--matcher 'ORB' is unknown; matchers are named in lower case: use orb"},
       {"build " + in + out_dir + " --similarity cosine", "unknown similarity"},
       {"build " + in + out_dir + " --format tum", "rgb.txt"},
       {"build " + in + out_dir + " --stride 0", "--stride"},
@@ -331,6 +335,28 @@ TEST(Cli, DifferentFrameSizesWarnOrFailWhenStrict) {
 
 // `vmap --help` lists the commands under headings, the teach-and-repeat workflow first; a command's --help lists its
 // flags under the headings of its options' field lists, what a user sets every day before the localizer's rules.
+// Every number a flag takes is bounded (promise 5), and its help says the values: "--tau FLOAT in (0, 1]".
+TEST(Cli, EveryNumericFlagsHelpSaysTheValuesItTakes) {
+  const std::regex unbounded(R"(^\s+(-[a-zA-Z], )?(--[a-z0-9-]+) (INT|FLOAT)(=|\s*$|\s\s))");
+  for (const char* command :
+       {"build", "localize", "route", "simulate", "info", "report", "eval", "sweep", "match", "draw", "weights"}) {
+    std::string out;
+    ASSERT_EQ(RunVmap(std::string(command) + " --help", &out), 0) << out;
+    std::istringstream lines(out);
+    int numeric = 0;
+    for (std::string line; std::getline(lines, line);) {
+      std::smatch found;
+      if (std::regex_search(line, found, unbounded)) {
+        ADD_FAILURE() << command << " " << found[2] << ": " << line;
+      }
+      if (line.find(" INT ") != std::string::npos || line.find(" FLOAT ") != std::string::npos) ++numeric;
+    }
+    if (std::string(command) == "build") {
+      EXPECT_GT(numeric, 20) << out;
+    }
+  }
+}
+
 TEST(Cli, HelpListsCommandsAndFlagsUnderHeadings) {
   std::string out;
   ASSERT_EQ(RunVmap("--help", &out), 0) << out;
@@ -349,7 +375,7 @@ TEST(Cli, HelpListsCommandsAndFlagsUnderHeadings) {
   }
   ASSERT_EQ(RunVmap("localize --help", &out), 0) << out;
   at = 0;
-  for (const std::string& text :
+  for (const char* text :
        {"Output:", "  --csv", "Input:", "  --first", "Route and odometry:", "  --from", "  --odometry ",
         "Start: where on the route", "  --start-key", "Acceptance:", "Rules across seasons and lighting",
         "  --no-doubt-jump-back", kRunSection, "  --threads", "  --no-cache"}) {

@@ -1,6 +1,7 @@
 #include "vmap/features/matcher_registry.h"
 
 #include <algorithm>
+#include <cctype>
 
 #include "vmap/core/error.h"
 #include "vmap/core/json_fields.h"
@@ -129,7 +130,18 @@ std::vector<std::string> MatcherOptions::FilesRead() const {
 }
 
 void MatcherOptions::Check() const {
-  FindMatcherModel(type);
+  // Named as the field is given ("--matcher" on the command line), as an enum flag's error is.
+  const auto registered = [](const std::string& name) {
+    const auto& models = MatcherModels();
+    return std::any_of(models.begin(), models.end(), [&](const MatcherModel& model) { return model.name == name; });
+  };
+  if (!registered(type)) {
+    std::string lower = type;
+    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+    throw OptionError("matcher", "'" + type + "' is unknown; " +
+                                     (registered(lower) ? "matchers are named in lower case: use " + lower
+                                                        : "use " + MatcherModelNames()));
+  }
   // The options of every matcher, used or not: an absurd value (NaN, out of range) is a mistake either way.
   for (const auto& [name, options] : models_) CheckField(name, *options);
 }

@@ -80,7 +80,7 @@ TEST(MapWriter, ASnapshotIsACompleteMapAtTheFinalPathAndTheBuildGoesOn) {
   OutputPolicy policy;
   policy.why_not_ours = WhyNotAVmapMap;
   AtomicOutputDirectory output(final_path, policy);
-  MapWriter writer(output.path(), SnapshotTarget{final_path, policy});
+  MapWriter writer(output.path(), SnapshotTarget{final_path, policy, {}});
   for (int f = 1; f < 10; ++f) writer.AddEvaluation({0, f, 0.9, 10, 9, true});
   writer.Snapshot(ChainMap(writer, 2, 10));
   // The evaluations' file (flushed by the snapshot) holds the fields alone: not the struct with its padding,

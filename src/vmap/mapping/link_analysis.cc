@@ -263,9 +263,11 @@ void LinkAnalysisOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.VisitNested("pose", pose);
   visitor.VisitNested("homography", homography);
   visitor.VisitNested("translation", translation);
-  visitor.Visit({"pose_check_features", "--pose-check-features",
-                 "ORB features per key image for a second estimate of each link's pose: its translation is known "
-                 "only where both estimates agree (0: the link's own matches only)"},
+  visitor.Visit(OptionField{"pose_check_features", "--pose-check-features",
+                            "ORB features per key image for a second estimate of each link's pose: its translation is "
+                            "known only where both estimates agree (0: the link's own matches only)"}
+                    .Within(0, 100000)
+                    .Meaning("0: the link's own matches only"),
                 pose_check_features);
 }
 

@@ -264,7 +264,7 @@ TEST(MapBuilder, WritesThroughItsSinkWithoutKeepingEvaluationsAndSnapshotsHalfWa
   policy.why_not_ours = WhyNotAVmapMap;
   AtomicOutputDirectory output(final_path, policy);
   MemorySource source(Sequence().frames);
-  MapWriter writer(output.path(), SnapshotTarget{final_path, policy});
+  MapWriter writer(output.path(), SnapshotTarget{final_path, policy, {}});
   MapBuilder builder(source, *matcher, Options(0.7), &writer);
   const int half = static_cast<int>(Sequence().frames.size()) / 2;
   for (int i = 0; i < half; ++i) builder.Add(*source.Next());

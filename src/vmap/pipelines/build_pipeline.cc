@@ -136,6 +136,8 @@ void BuildPipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(OptionField{"snapshot_every", "--snapshot-every",
                             "Seconds between snapshots: the map so far, written to the output directory while the "
                             "run goes on (0 = none)"}
+                    .Within(0, kMaxSnapshotEvery)
+                    .Meaning("0: none")
                     .NotRecorded(),
                 snapshot_every);
   visitor.Visit(OptionField{"until_interrupted", "--until-interrupted",

@@ -42,8 +42,14 @@ nlohmann::json RouteJson(const RoutePipelineOptions& options, const RoutePipelin
 
 void RoutePipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(OptionField{"map", "map", "Map directory written by `vmap build`"}.Positional(), map);
-  visitor.Visit(OptionField{"from", "--from", "Start key image"}.NotRecorded(), from);
-  visitor.Visit(OptionField{"to", "--to", "Goal key image (default: the last)"}.HideDefault().NotRecorded(), to);
+  visitor.Visit(OptionField{"from", "--from", "Start key image"}.AtLeast(0).NotRecorded(), from);
+  visitor.Visit(OptionField{"to", "--to", "Goal key image (default: the last)"}
+                    .AtLeast(0)
+                    .Or(-1)
+                    .Meaning("-1: the last")
+                    .HideDefault()
+                    .NotRecorded(),
+                to);
   visitor.Visit(OptionField{"json", "--json", "Also write the route to this JSON file"}.HideDefault().NotRecorded(),
                 json);
   visitor.VisitNested("", route);

@@ -49,7 +49,11 @@ std::string MatchCaption(const Link& link) {
 }
 
 void MatchFigureOptions::VisitFields(OptionFieldVisitor& visitor) {
-  visitor.Visit({"max_width", "--width", "Scale the figure down to at most this width (0: full size)"}, max_width);
+  visitor.Visit(OptionField{"max_width", "--width", "Scale the figure down to at most this width (0: full size)"}
+                    .Within(64, 16384)
+                    .Or(0)
+                    .Meaning("0: full size"),
+                max_width);
   visitor.Visit(OptionField{"title"}.NotRecorded(), title);
   visitor.Visit({"caption", "!--no-caption", "Leave out the caption band under the images"}, caption);
 }

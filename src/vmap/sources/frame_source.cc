@@ -32,12 +32,12 @@ bool AspectRatiosDiffer(const cv::Size& a, const cv::Size& b) {
 }
 
 void FrameSourceOptions::Check() const {
-  CheckFieldRanges(*this);
-  if (last < -1) {
+  if (last < -1) {  // first: a message of its own, which says what -1 means
     throw OptionError("last", std::to_string(last) +
                                   " is not a frame; give a 0-based frame index, or -1 for the "
                                   "end of the sequence");
   }
+  CheckFieldRanges(*this);
   if (last >= 0 && last < first) {
     throw OptionError("last", std::to_string(last) + " is before first " + std::to_string(first), {"first"});
   }
@@ -299,7 +299,9 @@ void FrameSourceOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(OptionField{"format", "--format", "Input layout: "}.ListingNames(),
                 EnumField(format, kSourceFormatNames, ParseSourceFormat));
   visitor.Visit(OptionField{"first", "--first", "First frame (0-based)"}.AtLeast(0), first);
-  visitor.Visit({"last", "--last", "Last frame, inclusive (-1 = end)"}, last);
+  visitor.Visit(
+      OptionField{"last", "--last", "Last frame, inclusive (-1 = end)"}.AtLeast(0).Or(-1).Meaning("-1: to the end"),
+      last);
   visitor.Visit(OptionField{"stride", "--stride", "Use every N-th frame"}.AtLeast(1), stride);
   visitor.Visit(OptionField{"resize", "--resize", "Resize frames: WxH, or the longest side (e.g. 640)"}.HideDefault(),
                 resize);

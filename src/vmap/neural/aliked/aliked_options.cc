@@ -32,9 +32,16 @@ void AlikedMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit({"weights", "--weights", "Weights file of the deep matcher (see `vmap weights`)", false, true},
                 weights);
   visitor.Visit({"device", "--device", "Deep matchers' device: cpu or cuda"}, device);
-  visitor.Visit({"top_k", "--aliked-top-k", "ALIKED: keypoints per image (0 = score threshold mode)"}, top_k);
+  visitor.Visit(OptionField{"top_k", "--aliked-top-k", "ALIKED: keypoints per image (0 = score threshold mode)"}
+                    .AtLeast(0)
+                    .Meaning("0: score threshold mode"),
+                top_k);
   visitor.Visit(
-      {"score_threshold", "--aliked-score-threshold", "ALIKED: keypoint score threshold when --aliked-top-k is 0"},
+      OptionField{"score_threshold", "--aliked-score-threshold",
+                  "ALIKED: keypoint score threshold when --aliked-top-k is 0 (0 = the mean score, as upstream)"}
+          .Within(0, 1)
+          .ExcludingMax()
+          .Meaning("0: the mean score, as upstream"),
       score_threshold);
   visitor.Visit(
       OptionField{"max_keypoints", "--aliked-max-keypoints", "ALIKED: most keypoints when --aliked-top-k is 0"}.AtLeast(

@@ -1,6 +1,6 @@
 #include "vmap/neural/loftr/loftr_options.h"
 
-#include <cmath>
+#include <limits>
 
 #include "vmap/core/error.h"
 #include "vmap/core/option_ranges.h"
@@ -15,10 +15,6 @@ void LoftrMatcherOptions::Check() const {
     throw OptionError("device", "'" + device + "' is not a device; use cpu or cuda");
   }
   CheckFieldRanges(*this);
-  if (!std::isfinite(threshold) || threshold > 1.0) {
-    // 0 is allowed: it keeps every mutual nearest neighbour (used to reproduce the random-weight golden).
-    throw OptionError("threshold", "must be in [0, 1] (negative: the preset's)");
-  }
 }
 
 void LoftrMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
@@ -29,8 +25,14 @@ void LoftrMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(
       OptionField{"longest_side", "--loftr-size", "LoFTR: longest image side fed to the network"}.Within(32, 4096),
       longest_side);
-  visitor.Visit({"threshold", "--loftr-threshold", "LoFTR: coarse confidence threshold (default: preset's)", false},
-                threshold);
+  // 0 is taken: it keeps every mutual nearest neighbour (used to reproduce the random-weight golden).
+  visitor.Visit(
+      OptionField{"threshold", "--loftr-threshold", "LoFTR: coarse confidence threshold (below 0 = the preset's)"}
+          .Within(-std::numeric_limits<double>::infinity(), 1)
+          .ExcludingMin()
+          .Meaning("below 0: the preset's")
+          .HideDefault(),
+      threshold);
   visitor.Visit(OptionField{"threads", "--loftr-threads", "LoFTR: LibTorch threads per call (0 = LibTorch default)"}
                     .Within(0, 256)
                     .Meaning("0: LibTorch's default"),
