@@ -180,7 +180,8 @@ def test_help_lists_every_keyword_under_the_headings_of_the_commands_help():
     doc = vmap.localize.__doc__
     assert doc.index("\nRoute and odometry:") < doc.index("\nAcceptance: when a frame is at a key image:") < \
         doc.index("\nRules across seasons and lighting") < doc.index("\nRun: threads, caches and seeds:")
-    assert "    from: int = None\n        Follow the route from this key image (default: the first)" in doc
+    assert ("    from: int -1 or [0, 2147483647] = None\n"
+            "        Follow the route from this key image (default: the first)") in doc
     assert "csv" not in documented_keywords(doc)  # the CLI's outputs are not the function's
     assert documented_keywords(vmap.Localizer.__doc__) <= documented_keywords(doc)
     assert "matcher: str = 'orb'" in vmap.Matcher.__doc__ and "route: str = " in vmap.simulate.__doc__

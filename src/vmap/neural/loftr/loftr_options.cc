@@ -1,7 +1,5 @@
 #include "vmap/neural/loftr/loftr_options.h"
 
-#include <limits>
-
 #include "vmap/core/error.h"
 #include "vmap/core/option_ranges.h"
 
@@ -28,8 +26,7 @@ void LoftrMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
   // 0 is taken: it keeps every mutual nearest neighbour (used to reproduce the random-weight golden).
   visitor.Visit(
       OptionField{"threshold", "--loftr-threshold", "LoFTR: coarse confidence threshold (below 0 = the preset's)"}
-          .Within(-std::numeric_limits<double>::infinity(), 1)
-          .ExcludingMin()
+          .Within(-1, 1)
           .Meaning("below 0: the preset's")
           .HideDefault(),
       threshold);
