@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   ros::NodeHandle node;
   ros::NodeHandle private_node("~");
   vmap::ros_node::VmapNode vmap_node(node, private_node);
+  vmap::ros_node::StopOnShutdownRequests([&vmap_node] { vmap_node.HaltRobot(); });
   // Services that take seconds (a map loading, a teach run finishing) keep one thread; the camera has another.
   ros::AsyncSpinner spinner(3);
   spinner.start();

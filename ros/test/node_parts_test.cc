@@ -16,6 +16,7 @@
 #include "vmap/sources/ros_image_messages.h"
 
 #include "vmap_ros/camera_messages.h"
+#include "vmap_ros/control_clock.h"
 #include "vmap_ros/localization_message.h"
 #include "vmap_ros/mailbox.h"
 #include "vmap_ros/odometry_buffer.h"
@@ -186,6 +187,37 @@ TEST(OdometryBuffer, InterpolatesBetweenSamplesAndGivesNoneOutsideThem) {
   EXPECT_FALSE(buffer.Add({2.6, 2.1, 0.0, 0.0}));
   ASSERT_TRUE(buffer.At(2.55).has_value());
   EXPECT_NEAR(buffer.At(2.55)->x, 2.05, 1e-12);
+}
+
+// The controller's time follows the camera's stamps while they advance; where they go back or stand still it follows
+// the wall clock, so that a robot lost then still slows to a stop within lost_stop.
+TEST(ControlClock, FollowsTheCameraWhileItAdvancesElseTheWallClock) {
+  ControlClock clock;
+  bool by_wall = true;
+  EXPECT_DOUBLE_EQ(clock.Tick(100.0, 5000.0, &by_wall), 100.0);
+  EXPECT_FALSE(by_wall);
+  EXPECT_NEAR(clock.Tick(100.05, 5000.9, &by_wall), 100.05, 1e-9) << "the camera's clock, not the wall's";
+  EXPECT_FALSE(by_wall);
+  // A bag played again from its start: 1000 s back. The frames keep coming 50 ms apart on the wall clock.
+  double time = 0.0;
+  for (int i = 1; i <= 20; ++i)
+    time = clock.Tick(i == 1 ? -900.0 : -900.0 + 0.05 * (i - 1), 5000.9 + 0.05 * i, &by_wall);
+  EXPECT_NEAR(time, 100.05 + 0.05 + 19 * 0.05, 1e-9) << "one wall step, then the camera's again";
+  // Stamps of 0 (/use_sim_time without /clock): the wall clock's steps.
+  ControlClock sim_time;
+  sim_time.Tick(0.0, 10.0, &by_wall);
+  for (int i = 1; i <= 40; ++i) time = sim_time.Tick(0.0, 10.0 + 0.05 * i, &by_wall);
+  EXPECT_TRUE(by_wall);
+  EXPECT_NEAR(time, 2.0, 1e-9);
+  // A jump forward is a gap of at most kMaxControlStep; one stamp twice and a wall clock that stood still advance
+  // by kMinControlStep.
+  ControlClock jumps;
+  jumps.Tick(1.0, 1.0, &by_wall);
+  EXPECT_DOUBLE_EQ(jumps.Tick(1e9, 1.1, &by_wall), 1.0 + kMaxControlStep);
+  EXPECT_FALSE(by_wall);
+  EXPECT_DOUBLE_EQ(jumps.Tick(1e9, 1.1, &by_wall), 1.0 + kMaxControlStep + kMinControlStep);
+  EXPECT_TRUE(by_wall);
+  EXPECT_DOUBLE_EQ(jumps.Tick(std::nan(""), std::nan(""), &by_wall), 1.0 + kMaxControlStep + 2 * kMinControlStep);
 }
 
 TEST(Parameters, AreTheFlagsNamesWithUnderscores) {

@@ -302,5 +302,73 @@ TEST(RepeatNode, APauseAQuietCameraAndTheNodesEndStopTheRobot) {
   EXPECT_NE(node->Log().find("the robot is stopped"), std::string::npos) << node->Log();
 }
 
+// A run stopped is no longer localized (the latched ~localized says so to a subscriber that comes later); and a node
+// the master shuts down (another node started under its name: two launch files) stops its robot before it goes, where
+// roscpp's own answer had left the robot on its last command.
+TEST(RepeatNode, ARunStoppedIsNotLocalizedAndANodeTheMasterShutsDownStopsTheRobotFirst) {
+  SKIP_WITHOUT_SHARED();
+  ScopedTempDir dir("ros_repeat_clash");
+  const fs::path video = fs::path(SharedDir()) / "data/lab_floor/lab_floor.mp4";
+  const fs::path teach = dir.path() / "teach.bag", map = dir.path() / "map", repeat = dir.path() / "repeat.bag";
+  WriteVideoBag(video, 0, 199, teach, "bgr8", 0.05);
+  WriteVideoBag(video, 20, 139, repeat, "bgr8", 0.0);
+  std::string output;
+  ASSERT_EQ(RunVmap("build -q " + Quote(teach) + " -o " + Quote(map), &output), 0) << output;
+
+  const auto node = StartVmapNode("/clash", {"image:=/camera/image_raw", "odom:=/odom"}, dir.path() / "node.log");
+  ASSERT_TRUE(WaitForNodeServices("/clash/vmap")) << node->Log();
+  ros::NodeHandle handle;
+  Published published;
+  const ros::Subscriber commands = handle.subscribe("/clash/cmd_vel", 1000, &Published::OnCommand, &published);
+  ASSERT_TRUE(WaitFor([&] { return commands.getNumPublishers() > 0; }, std::chrono::seconds(60)));
+  const auto moving = [&] {
+    std::lock_guard<std::mutex> lock(published.mutex);
+    return !published.commands.empty() && published.commands.back().linear.x != 0.0;
+  };
+  const auto start_and_drive = [&] {
+    vmap_ros::StartRepeat start;
+    start.request.map = map.string();
+    start.request.goal = -1;
+    start.request.start = -1;
+    ASSERT_TRUE(ros::service::call("/clash/vmap/repeat/start", start)) << node->Log();
+    ASSERT_TRUE(start.response.success) << start.response.message;
+    auto player = PlayBag(repeat, 1.0, dir.path() / "play.log");
+    ASSERT_TRUE(WaitFor(moving, std::chrono::seconds(60))) << node->Log();
+    player->Stop(std::chrono::seconds(5));
+  };
+
+  // 1. Localized, then stopped: a subscriber that comes after the stop reads false.
+  start_and_drive();
+  std_srvs::Trigger stop;
+  ASSERT_TRUE(ros::service::call("/clash/vmap/repeat/stop", stop));
+  ASSERT_TRUE(stop.response.success) << stop.response.message;
+  Published later;
+  const ros::Subscriber localized = handle.subscribe("/clash/vmap/localized", 10, &Published::OnLocalized, &later);
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(later.mutex);
+        return !later.localized.empty();
+      },
+      std::chrono::seconds(10)));
+  {
+    std::lock_guard<std::mutex> lock(later.mutex);
+    EXPECT_FALSE(later.localized.back()) << "a run stopped read as localized";
+  }
+
+  // 2. Driving again; a second node under the same name: the first one's last command is a stop, and it exits.
+  start_and_drive();
+  const auto second = StartVmapNode("/clash", {}, dir.path() / "second.log");
+  EXPECT_EQ(node->Wait(std::chrono::seconds(60)), 0) << node->Log();
+  SpinFor(0.5);
+  {
+    std::lock_guard<std::mutex> lock(published.mutex);
+    ASSERT_FALSE(published.commands.empty());
+    EXPECT_EQ(published.commands.back().linear.x, 0.0) << node->Log();
+    EXPECT_EQ(published.commands.back().angular.z, 0.0);
+  }
+  EXPECT_NE(node->Log().find("the ROS master asks this node to shut down"), std::string::npos) << node->Log();
+  EXPECT_NE(node->Log().find("the robot is stopped"), std::string::npos) << node->Log();
+}
+
 }  // namespace
 }  // namespace vmap::ros_testing

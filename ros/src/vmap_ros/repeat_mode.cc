@@ -160,6 +160,10 @@ bool VmapNode::StopRepeat(std_srvs::Trigger::Request&, std_srvs::Trigger::Respon
   UnsubscribeCamera();
   odometry_subscriber_.shutdown();
   PublishStop();
+  // Latched: a subscriber that comes later must not read a run that is over as localized.
+  std_msgs::Bool localized;
+  localized.data = false;
+  localized_.publish(localized);
   return Succeed(response, fmt::format("repeat run stopped after {} frames", frames));
 }
 
@@ -199,7 +203,23 @@ void VmapNode::OnOdometry(const nav_msgs::Odometry::ConstPtr& odometry) {
   }
 }
 
-void VmapNode::PublishStop() { cmd_vel_.publish(geometry_msgs::Twist()); }
+void VmapNode::PublishStop() { PublishCommand(geometry_msgs::Twist()); }
+
+void VmapNode::PublishCommand(const geometry_msgs::Twist& command) {
+  std::lock_guard<std::mutex> lock(command_mutex_);
+  cmd_vel_.publish(halted_ ? geometry_msgs::Twist() : command);
+}
+
+void VmapNode::HaltRobot() {
+  bool repeating = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    repeating = mode_ == Mode::kRepeating || mode_ == Mode::kPaused;
+  }
+  std::lock_guard<std::mutex> lock(command_mutex_);
+  halted_ = true;
+  if (repeating) cmd_vel_.publish(geometry_msgs::Twist());
+}
 
 void VmapNode::RepeatFrame(const Arrival& arrival) {
   Mode mode;
@@ -231,12 +251,12 @@ void VmapNode::RepeatFrame(const Arrival& arrival) {
     step.localization = repeat_->Localize(image, odometry ? &*odometry : nullptr);
     control.state = "paused";
   } else {
-    step = repeat_->Step(image, time, odometry ? &*odometry : nullptr);
+    step = repeat_->Step(image, time, arrival.time.toSec(), odometry ? &*odometry : nullptr);
     control.state = ControllerStateName(step.control.state);
     control.steering = step.control.steering;
     control.command.linear.x = step.control.command.linear;
     control.command.angular.z = step.control.command.angular;
-    cmd_vel_.publish(control.command);
+    PublishCommand(control.command);
     if (step.control.localized && !localized_once_) {
       localized_once_ = true;
       std_msgs::Bool message;

@@ -19,14 +19,18 @@ RepeatRun::RepeatRun(const LocalizePipelineOptions& options, const ControllerOpt
   key_images_.resize(session_.map().key_images.size());
 }
 
-RepeatStep RepeatRun::Step(const CameraImage& image, double time, const OdometrySample* odometry) {
+RepeatStep RepeatRun::Step(const CameraImage& image, double time, double wall_time, const OdometrySample* odometry) {
   RepeatStep step;
   step.localization = Localize(image, odometry);
-  // The controller's clock must advance: a camera whose stamps repeat (or a bag played in a loop) gets the
-  // smallest step forward instead.
-  time = std::max(time, last_time_ + 1e-3);
-  last_time_ = time;
-  step.control = controller_.Update(time, step.localization, odometry);
+  bool by_wall_clock = false;
+  const double controller_time = clock_.Tick(time, wall_time, &by_wall_clock);
+  if (by_wall_clock) {
+    ROS_WARN_THROTTLE(10.0,
+                      "the camera's clock did not advance (stamped %.3f s; a bag played in a loop? a clock reset? "
+                      "/use_sim_time without /clock?): the controller keeps time by the wall clock meanwhile",
+                      time);
+  }
+  step.control = controller_.Update(controller_time, step.localization, odometry);
   return step;
 }
 

@@ -14,6 +14,7 @@
 #include "vmap/pipelines/localize_pipeline.h"
 
 #include "vmap_ros/camera_messages.h"
+#include "vmap_ros/control_clock.h"
 
 namespace vmap::ros_node {
 
@@ -34,9 +35,11 @@ class RepeatRun {
   RepeatRun(const LocalizePipelineOptions& options, const ControllerOptions& controller);
 
   // Localizes the next camera frame of the run (brought to the map's frame size: frame()) and asks the controller
-  // for its command at `time` (seconds), with the robot's odometry at that time when it has one (else null).
-  // The odometry also paces the localizer's belief (with the teach odometry: the distance driven between frames).
-  RepeatStep Step(const CameraImage& image, double time, const OdometrySample* odometry);
+  // for its command at `time` (seconds, the camera's clock), with the robot's odometry at that time when it has one
+  // (else null). The odometry also paces the localizer's belief (with the teach odometry: the distance driven between
+  // frames). `wall_time`: when the frame arrived (seconds), which keeps the controller's time where the camera's clock
+  // does not advance (ControlClock: warned once in a while).
+  RepeatStep Step(const CameraImage& image, double time, double wall_time, const OdometrySample* odometry);
   // Localizes the frame only (a paused run keeps its estimate up to date; the controller is not asked).
   LocalizationResult Localize(const CameraImage& image, const OdometrySample* odometry = nullptr);
   // The teach run's odometry (empty: none).
@@ -60,7 +63,7 @@ class RepeatRun {
   LocalizationSession session_;
   std::vector<int> route_;
   RouteController controller_;
-  double last_time_ = -1e300;
+  ControlClock clock_;
   std::vector<cv::Mat> key_images_;
   Frame frame_;
   int frames_ = 0;

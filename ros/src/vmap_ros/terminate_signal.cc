@@ -1,13 +1,17 @@
 #include "vmap_ros/terminate_signal.h"
 
+#include <atomic>
 #include <csignal>
+#include <string>
 
 #include <ros/ros.h>
+#include <ros/xmlrpc_manager.h>
 
 namespace vmap::ros_node {
 namespace {
 
 volatile std::sig_atomic_t stop_signal = 0;
+std::atomic<bool> master_asked_to_stop{false};
 
 }  // namespace
 
@@ -21,7 +25,23 @@ void StopOnSignals() {
 
 int StopSignal() { return stop_signal; }
 
-bool StopRequested() { return stop_signal != 0 || !ros::ok() || ros::isShuttingDown(); }
+void StopOnShutdownRequests(std::function<void()> first) {
+  ros::XMLRPCManager& server = *ros::XMLRPCManager::instance();
+  server.unbind("shutdown");
+  server.bind("shutdown", [first = std::move(first)](XmlRpc::XmlRpcValue& params, XmlRpc::XmlRpcValue& result) {
+    std::string reason = "no reason given";
+    if (params.getType() == XmlRpc::XmlRpcValue::TypeArray && params.size() > 1 &&
+        params[1].getType() == XmlRpc::XmlRpcValue::TypeString) {
+      reason = static_cast<std::string>(params[1]);
+    }
+    ROS_WARN("the ROS master asks this node to shut down (%s): it stops", reason.c_str());
+    first();
+    master_asked_to_stop = true;
+    result = ros::xmlrpc::responseInt(1, "", 0);
+  });
+}
+
+bool StopRequested() { return stop_signal != 0 || master_asked_to_stop || !ros::ok() || ros::isShuttingDown(); }
 
 void WaitForStop() {
   // The master is asked every 2 s: a node whose master went away goes on over the connections it has, but one that
@@ -38,7 +58,8 @@ void WaitForStop() {
     } else if (!reachable && now) {
       ROS_ERROR(
           "a ROS master is back at %s, but this node is not registered with it (ROS 1 nodes do not register "
-          "again): its services and topics are unknown there; restart the node (roslaunch: respawn=\"true\")",
+          "again): its services and topics are unknown there, while the connections it has go on; restart the node "
+          "when the robot may stop (it does not exit by itself, so respawn=\"true\" does not restart it)",
           ros::master::getURI().c_str());
     }
     reachable = now;

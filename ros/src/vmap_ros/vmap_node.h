@@ -53,6 +53,10 @@ class VmapNode {
   // finished (its map and odometry written, as ~teach/stop writes them). Returns false when that map could not be
   // written. Once; the destructor calls it when main did not.
   bool Stop();
+  // A repeat run's robot gets a zero command at once, and no other command from then on: for a node about to lose its
+  // connections (the ROS master asked it to shut down: another node registered under its name, `rosnode kill`),
+  // before Stop() does the rest. Callable from any thread.
+  void HaltRobot();
   ~VmapNode();
   VmapNode(const VmapNode&) = delete;
   VmapNode& operator=(const VmapNode&) = delete;
@@ -120,6 +124,8 @@ class VmapNode {
   void OnOdometry(const nav_msgs::Odometry::ConstPtr& odometry);
   void RepeatFrame(const Arrival& arrival);
   void PublishStop();
+  // Every command goes out here: none but zero once HaltRobot() has run.
+  void PublishCommand(const geometry_msgs::Twist& command);
   // A repeat run's camera that has sent no frame for ~camera_timeout seconds: the robot stops until frames come.
   void StopIfCameraQuiet();
   // ~camera_timeout, checked (InputError); kCameraTimeout when unset.
@@ -142,6 +148,8 @@ class VmapNode {
 
   Mailbox<Arrival> mailbox_{1};
   std::atomic<bool> stopping_{false};
+  std::mutex command_mutex_;  // guards halted_ and orders the commands around it
+  bool halted_ = false;
   bool stopped_ = false;  // Stop() has run
   std::thread worker_;
 

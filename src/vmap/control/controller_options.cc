@@ -1,5 +1,7 @@
 #include "vmap/control/controller_options.h"
 
+#include <fmt/format.h>
+
 #include "vmap/core/error.h"
 #include "vmap/core/option_ranges.h"
 
@@ -50,11 +52,13 @@ void ControllerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(OptionField{"bearing_gain", "--bearing-gain",
                             "Servo: turn rate per radian of bearing to the target key image (1/s)"}
                     .Within(0, 100)
+                    .ExcludingMin()  // k_b > 0 > k_l: the unicycle law's stability condition (docs/drive.md)
                     .Unit("1/s"),
                 bearing_gain);
   visitor.Visit(OptionField{"line_gain", "--line-gain",
                             "Servo: turn rate per radian between the bearing and the target's heading (1/s, negative)"}
                     .Within(-100, 0)
+                    .ExcludingMax()
                     .Unit("1/s"),
                 line_gain);
   visitor.Visit(OptionField{"pose_agreement_deg", "--pose-agreement",
@@ -128,6 +132,14 @@ void ControllerOptions::VisitFields(OptionFieldVisitor& visitor) {
       focal_px);
 }
 
-void ControllerOptions::Check() const { CheckFieldRanges(*this); }
+void ControllerOptions::Check() const {
+  CheckFieldRanges(*this);
+  // The command never exceeds max_speed: a speed above it would be taken as max_speed, silently.
+  if (speed > max_speed) {
+    throw OptionError("speed",
+                      fmt::format("{} m/s is above max_speed {} m/s; lower it, or raise max_speed", speed, max_speed),
+                      {"max_speed"});
+  }
+}
 
 }  // namespace vmap

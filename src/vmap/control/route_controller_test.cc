@@ -1,6 +1,8 @@
 #include "vmap/control/route_controller.h"
 
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -331,9 +333,17 @@ TEST(RouteController, BadOptionsAndRoutesAreRefused) {
   ControllerOptions options;
   options.speed = std::nan("");
   EXPECT_THROW(RouteController(StraightRoute(), options), OptionError);
+  // k_b > 0 > k_l, the servo law's stability condition: a gain of 0 is refused too.
+  for (const auto& [bearing, line] : std::vector<std::pair<double, double>>{{1.5, 0.5}, {1.5, 0.0}, {0.0, -0.6}}) {
+    options = {};
+    options.bearing_gain = bearing;
+    options.line_gain = line;
+    EXPECT_THROW(RouteController(StraightRoute(), options), OptionError) << bearing << " " << line;
+  }
   options = {};
-  options.line_gain = 0.5;
-  EXPECT_THROW(RouteController(StraightRoute(), options), OptionError);
+  options.speed = 5.0;
+  options.max_speed = 1.0;
+  EXPECT_THROW(RouteController(StraightRoute(), options), OptionError) << "a speed above the largest";
   TaughtRoute no_camera = StraightRoute();
   no_camera.focal_px = std::nan("");
   EXPECT_THROW(RouteController(no_camera, ControllerOptions{}), OptionError);

@@ -47,9 +47,16 @@ int BayerCode(const std::string& encoding) {
 DecodedImage ConvertRawImage(const RawImage& raw, const std::string& what) {
   int type = -1, code = -1;
   const std::string& e = raw.encoding;
+  // A depth camera's images (REP 118) have the encodings of no grey camera: a topic remapped to the depth image by
+  // mistake localized as if its depths were grey levels, and steered the robot.
+  if (e == "16UC1" || e == "32FC1") {
+    throw InputError(what + " has image encoding '" + e +
+                     "', a depth image's (REP 118); vmap localizes by the intensity image: give the camera's colour or "
+                     "grey topic (mono8, mono16, rgb8, bgr8, ...)");
+  }
   if (e == "mono8" || e == "8UC1")
     type = CV_8UC1;
-  else if (e == "mono16" || e == "16UC1")
+  else if (e == "mono16")
     type = CV_16UC1;
   else if (e == "bgr8" || e == "8UC3")
     type = CV_8UC3;

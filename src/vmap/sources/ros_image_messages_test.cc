@@ -179,6 +179,17 @@ TEST(RosImageMessages, MalformedMessagesAreInputErrorsNeverCrashes) {
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find("mono8, mono16, rgb8"), std::string::npos) << e.what();
     }
+    // A depth image (REP 118) is not a grey one, whatever its numbers look like.
+    for (const char* depth : {"16UC1", "32FC1"}) {
+      const int type = std::string(depth) == "16UC1" ? CV_16UC1 : CV_32FC1;
+      try {
+        Decode(testing::SerializeImage(encoding, 1.0, "c", cv::Mat(bgr.size(), type, cv::Scalar(1000)), depth),
+               encoding);
+        ADD_FAILURE() << depth << " decoded";
+      } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("a depth image's (REP 118)"), std::string::npos) << e.what();
+      }
+    }
   }
 }
 
