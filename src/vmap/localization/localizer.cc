@@ -235,6 +235,7 @@ void Localizer::Reset() {
   stall_.Reset();
   lagging_start_.Reset();
   pace_.Reset();
+  lookahead_ = options_.lookahead;
   placed_in_a_row_ = 0;
   position_ = start_position_;
   lost_in_a_row_ = 0;
@@ -256,6 +257,8 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
     ~FinishComparisons() { comparisons.Finish(); }
   } finish_comparisons{comparisons_};
   frame_start_position_ = position_;
+  const int motion_steps = pace_.Steps(frame.source_index, frame.timestamp, frame.odometry);
+  lookahead_ = pace_.Lookahead(position_, options_.lookahead);
   // The comparisons made ahead verified in full: those the frame verifies with fewer iterations are made again.
   ahead.erase(std::remove_if(ahead.begin(), ahead.end(),
                              [&](const KeyComparison& c) { return FarComparisonIterations(c.key) > 0; }),
@@ -263,7 +266,6 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   comparisons_.Begin(std::move(ahead));
   ranked_.clear();
   bucket_of_position_.clear();
-  const int motion_steps = pace_.Steps(frame.source_index, frame.timestamp, frame.odometry);
   belief_.Predict(motion_steps);
   if (start_unconfirmed_) evidence_belief_.Predict(motion_steps);
   // Guided matching asks where the estimate was dropped for max_lost_frames frames (guided_while_lost).

@@ -420,9 +420,9 @@ class Localizer {
   bool binary_descriptors_ = false;
   std::unique_ptr<KeyImageRanking> ranking_;
   int position_ = -1;  // route position of `key`; -1: no estimate
-  // position_ when the frame being localized started (FarComparisonIterations): fixed for the frame, so that a
-  // comparison's result does not depend on when the frame makes it, on which thread.
-  int frame_start_position_ = -1;
+  // position_ and the lookahead (MotionPace::Lookahead) when the frame being localized started: fixed for the frame, so
+  // that a comparison's result (FarComparisonIterations) does not depend on when or on which thread it is made.
+  int frame_start_position_ = -1, lookahead_ = 2;
   int start_position_ = -1;  // route position of LocalizerOptions::start_key; -1: none
   int lost_in_a_row_ = 0;
   // The route position the frame before this one was placed at (tracking or relocalized); -1: it was not.

@@ -274,7 +274,7 @@ void Localizer::StepOnByBelief(LocalizationResult& result, const ImageFeatures& 
     return sum;
   };
   int to = from;
-  for (int q = from; q < last && q + 1 - from <= options_.lookahead; ++q) {
+  for (int q = from; q < last && q + 1 - from <= lookahead_; ++q) {
     // At key image q the frame is on segment q - 1 or q; past key image q + 1, on q + 1 or after (the belief's mass on
     // as many positions each side: LocalizerOptions::step_on_by_belief_ahead).
     if (mass(q + 1, q + 1 + options_.step_on_by_belief_ahead) <= mass(q - 1, q + 1)) break;

@@ -14,7 +14,7 @@ int Localizer::TrackGuided(const Frame& frame, const ImageFeatures& features, in
   // Looser matching is decided by chance only (the counts rule would take its extra matches as evidence).
   if (!guided_matcher_ || options_.acceptance != AcceptanceRule::kChance) return -1;
   if (!whatever_the_belief && (!belief_confident_ || std::abs(belief_.Peak() - position) > kNear)) return -1;
-  const int reach = options_.guided_lookahead ? options_.lookahead : 1;
+  const int reach = options_.guided_lookahead ? lookahead_ : 1;
   int found = -1;
   KeyComparison best;
   // The best's one-way guided comparison: its log10 NFA, and whether chance accepted it.
@@ -101,7 +101,7 @@ int Localizer::FarComparisonIterations(int key) const {
   // start, a drop) the frame is relocalized: all in full.
   const int p = route_position_of_key_[key];
   const int from = frame_start_position_;
-  if (from < 0 || (p >= from - 1 && p <= from + options_.lookahead + 1)) return 0;
+  if (from < 0 || (p >= from - 1 && p <= from + lookahead_ + 1)) return 0;
   return options_.far_comparison_iterations;
 }
 

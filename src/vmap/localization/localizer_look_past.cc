@@ -13,7 +13,7 @@ void Localizer::LookPastWeakNext(const Frame& frame, const ImageFeatures& featur
   // Asked only where the lookahead stopped at `next` (it compared it, and it did not beat `best`) and `best` holds the
   // frame by little beyond chance.
   if (!options_.look_past_weak_next || binary_descriptors_ || !best.accepted ||
-      PassesChance(best, kBeyondLittleChance) || next > position + options_.lookahead ||
+      PassesChance(best, kBeyondLittleChance) || next > position + lookahead_ ||
       past >= static_cast<int>(route_.size())) {
     return;
   }

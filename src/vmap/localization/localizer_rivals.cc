@@ -135,7 +135,7 @@ KeyComparison Localizer::CompareTracked(const Frame& frame, const ImageFeatures&
   if (c.accepted) return c;
   // Refused: its rivals are compared now, and Track's key images after the tracked one and before it meanwhile.
   std::vector<int> tracked;
-  for (int step = 1; step <= options_.lookahead; ++step) tracked.push_back(position_ + step);
+  for (int step = 1; step <= lookahead_; ++step) tracked.push_back(position_ + step);
   tracked.push_back(position_ - 1);
   CompareMeanwhile(features, tracked);
   const bool by_verified = MayStandOut(c) && StandsOut(c.num_verified, RivalVerified(frame, features, position));

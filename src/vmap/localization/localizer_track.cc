@@ -29,8 +29,8 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   const KeyComparison at_key = compare_at(position);
   KeyComparison best = at_key;
   int best_position = position;
-  // Move on while the key image ahead is the better match, at most `lookahead` key images.
-  for (int step = 1; step <= options_.lookahead && position + step <= last; ++step) {
+  // Move on while the key image ahead is the better match, at most `lookahead` key images (more where they crowd).
+  for (int step = 1; step <= lookahead_ && position + step <= last; ++step) {
     const KeyComparison ahead = compare_at(position + step);
     // A tie is no step on: the frame is as near the one as the other, on the segment it is on. With ORB, neither is a
     // step on that chance explains better than the key image left behind (a frame a teach frame short of it).
@@ -47,7 +47,10 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
       // (corridor_conditions: one right frame fewer with it, docs/localize.md).
       const bool tie =
           binary_descriptors_ && best.accepted && ahead.accepted && ahead.num_verified == best.num_verified;
-      if ((best.accepted || step > 1) && !tie) break;
+      // Where the run passed the whole lookahead since the frame before (key images crowd within the frames it passed:
+      // MotionPace::PassedLookahead), each of them sees the frame's scene alike, and one that verifies a little less by
+      // chance says nothing of those after it: all are compared.
+      if ((best.accepted || step > 1) && !tie && !pace_.PassedLookahead(position, options_.lookahead)) break;
       continue;
     }
     best = ahead;

@@ -62,7 +62,8 @@ int MotionStepsPerFrame(double travelled, double teach_per_position) {
 
 MotionPace::MotionPace(const std::vector<int>& route_source_indices, const std::vector<double>& route_timestamps,
                        int fixed_steps)
-    : teach_frames_per_position_(TeachFramesPerPosition(route_source_indices)),
+    : route_source_indices_(route_source_indices),
+      teach_frames_per_position_(TeachFramesPerPosition(route_source_indices)),
       teach_seconds_per_position_(TeachSecondsPerPosition(route_timestamps)),
       fixed_steps_(fixed_steps) {}
 
@@ -112,14 +113,57 @@ int MotionPace::Steps(int source_index, double timestamp, const std::optional<Od
   source_index_before_ = source_index;
   timestamp_before_ = timestamp;
   odometry_before_ = odometry;
+  teach_frames_passed_ = 0.0;
   if (first) return 1;  // as the model was fitted: how far the run's first frame is from a frame before is not known
   if (fixed_steps_ > 0) return fixed_steps_;
+  // The positions passed, in the unit the teach run is known in, and as teach frames.
+  const auto passed = [&](double travelled, double teach_per_position) {
+    if (travelled > 0.0 && std::isfinite(travelled)) {
+      teach_frames_passed_ = travelled / teach_per_position * teach_frames_per_position_;
+    }
+    return MotionStepsPerFrame(travelled, teach_per_position);
+  };
   // A robot that stood still (metres 0) takes the one step every frame takes: the rules were fitted so.
-  if (driven && std::isfinite(metres) && teach_metres_per_position_ > 0.0) {
-    return MotionStepsPerFrame(metres, teach_metres_per_position_);
+  if (driven && std::isfinite(metres) && teach_metres_per_position_ > 0.0)
+    return passed(metres, teach_metres_per_position_);
+  if (timed && teach_seconds_per_position_ > 0.0) return passed(seconds, teach_seconds_per_position_);
+  if (teach_frames_per_position_ > 0.0) return passed(std::max(frames, 1.0), teach_frames_per_position_);
+  return 1;
+}
+
+namespace {
+
+// The teach frames a run passed, whole: frames are counted, and the time between two frames jitters (rccar_room's
+// 0.19 s at 0.1 s a teach frame is two frames).
+long WholeFrames(double teach_frames_passed) {
+  return std::isfinite(teach_frames_passed) ? std::lround(std::min(teach_frames_passed, 1e9)) : 0;
+}
+
+// The key images from the one after `position` on that the run may have reached since the frame before (at least 1):
+// those within the teach frames it passed of the next one, where the frame before was at the furthest on the tracked
+// segment. At most kMaxMotionSteps; 0 where nothing is known.
+int ReachPassed(const std::vector<int>& route_source_indices, int position, double teach_frames_passed) {
+  const int next = position + 1;
+  const int last = static_cast<int>(route_source_indices.size()) - 1;
+  const long passed = WholeFrames(teach_frames_passed);
+  if (position < 0 || next > last || passed <= 0) return 0;
+  int reach = 1;
+  while (next + reach <= last && reach < kMaxMotionSteps &&
+         std::abs(route_source_indices[next + reach] - route_source_indices[next]) <= passed) {
+    ++reach;
   }
-  if (timed && teach_seconds_per_position_ > 0.0) return MotionStepsPerFrame(seconds, teach_seconds_per_position_);
-  return MotionStepsPerFrame(std::max(frames, 1.0), teach_frames_per_position_);
+  return reach;
+}
+
+}  // namespace
+
+int MotionPace::Lookahead(int position, int lookahead) const {
+  return std::max(lookahead, ReachPassed(route_source_indices_, position, teach_frames_passed_));
+}
+
+bool MotionPace::PassedLookahead(int position, int lookahead) const {
+  return WholeFrames(teach_frames_passed_) >= 2 &&
+         ReachPassed(route_source_indices_, position, teach_frames_passed_) >= lookahead;
 }
 
 std::optional<double> MotionPace::teach_metres_driven() const {

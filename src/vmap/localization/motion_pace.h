@@ -67,6 +67,18 @@ class MotionPace {
   // driven between two frames is the straight line between their odometry poses: frames are close enough in time
   // that the path between them is straight, and a robot's odometry gives its pose, not a running distance.
   int Steps(int source_index, double timestamp, const std::optional<OdometrySample>& odometry = std::nullopt);
+  // How many key images past route position `position` the tracker compares on the run's last frame (given to Steps):
+  // `lookahead`, or more where the key images after the next one crowd within the teach frames the run passed since
+  // the frame before (by time, distance or index, as Steps; the key images' input indices give the teach frames). A
+  // repeat at three times the teach speed, or at a third of its frame rate, passes three teach frames a frame, and
+  // where the teach run made a key image every frame (rccar_room's fast turn) three key images: a lookahead of two
+  // leaves it behind (docs/localize.md, "The lookahead where key images crowd"). At most kMaxMotionSteps.
+  int Lookahead(int position, int lookahead) const;
+  // Whether the run passed, since the frame before, more than a teach frame and every key image of the `lookahead`
+  // after the next one: the frame may then be past any of them, and one that verifies a little less than the key image
+  // before it says nothing of those after it (Localizer::Track compares them all).
+  bool PassedLookahead(int position, int lookahead) const;
+
   // The metres the robot drove since the first frame of the current stretch of frames that each had odometry, summed
   // over the straight lines between them, up to the last frame Steps was given; none where that frame had no odometry.
   // A stretch that lost its odometry begins again at 0: differences are taken within one stretch only
@@ -95,13 +107,15 @@ class MotionPace {
   int DrivenPosition() const;
 
  private:
+  std::vector<int> route_source_indices_;
   double teach_frames_per_position_ = 0.0;
   double teach_seconds_per_position_ = 0.0;
   double teach_metres_per_position_ = 0.0;
   int fixed_steps_ = 0;
   bool started_ = false;  // a frame of the run was seen: the two below are its
   int source_index_before_ = 0;
-  double timestamp_before_ = -1.0;  // below 0: none
+  double teach_frames_passed_ = 0.0;  // on the last frame: 0 where not known (the first frame, a fixed pace)
+  double timestamp_before_ = -1.0;    // below 0: none
   std::optional<OdometrySample> odometry_before_;
   double metres_driven_ = 0.0;
   int driving_stretch_ = 0;

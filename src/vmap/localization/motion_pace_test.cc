@@ -33,6 +33,64 @@ TEST(MotionPace, TheStepsFollowTheMapsSpacingAndTheRunsFrameStep) {
   EXPECT_DOUBLE_EQ(TeachFramesPerPosition({9, 6, 3, 0}), 3.0);
 }
 
+// The tracker looks past the next key image as far as the run went since the frame before: further than its lookahead
+// only where key images crowd within the teach frames passed (rccar_room's fast turn: a key image every frame).
+TEST(MotionPace, TheLookaheadReachesTheKeyImagesCrowdedWithinTheFramesPassed) {
+  // Key images 3-4 teach frames apart, then one every frame from route position 4 (input frames 13 to 18).
+  const std::vector<int> route = {0, 3, 6, 10, 13, 14, 15, 16, 17, 18, 22, 26};
+  const std::vector<double> no_times(route.size(), -1.0);
+  MotionPace pace(route, no_times);
+  EXPECT_EQ(pace.Lookahead(3, 2), 2) << "before a first frame nothing was passed";
+  pace.Steps(0, -1.0);
+  EXPECT_EQ(pace.Lookahead(3, 2), 2) << "the run's first frame: how far it went is not known";
+  // Every frame (one teach frame a frame): the lookahead, wherever it is.
+  pace.Steps(1, -1.0);
+  for (int position = 0; position < static_cast<int>(route.size()); ++position) {
+    EXPECT_EQ(pace.Lookahead(position, 2), 2) << position;
+  }
+  EXPECT_EQ(pace.Lookahead(0, 1), 1);
+  EXPECT_EQ(pace.Lookahead(3, 1), 2) << "a lookahead of one reaches the key image a frame after the next";
+  EXPECT_FALSE(pace.PassedLookahead(3, 2)) << "a frame a frame: the tracker's own rules";
+  // Every third frame: three teach frames a frame. Where the key images crowd, the three after the next one (at 14,
+  // 15 and 16, within three frames of 13) are reached; where they do not, the lookahead stays.
+  pace.Steps(4, -1.0);
+  EXPECT_EQ(pace.Lookahead(3, 2), 4);
+  EXPECT_EQ(pace.Lookahead(6, 2), 3) << "17 and 18 after the next one, 16: the last crowded ones";
+  EXPECT_EQ(pace.Lookahead(0, 2), 2);
+  EXPECT_EQ(pace.Lookahead(10, 2), 2) << "the next key image is the route's last";
+  EXPECT_EQ(pace.Lookahead(11, 2), 2) << "at the route's end";
+  EXPECT_EQ(pace.Lookahead(-1, 2), 2) << "no estimate";
+  // The whole lookahead passed: the key images after the next one within the three frames, where they crowd and also
+  // where they lie three frames apart; not at the route's end.
+  EXPECT_TRUE(pace.PassedLookahead(3, 2));
+  EXPECT_TRUE(pace.PassedLookahead(0, 2));
+  EXPECT_FALSE(pace.PassedLookahead(9, 2)) << "26 is four frames after the next one, 22";
+  EXPECT_FALSE(pace.PassedLookahead(10, 2));
+  // A long gap in the input: bounded.
+  pace.Steps(104, -1.0);
+  EXPECT_EQ(pace.Lookahead(0, 2), kMaxMotionSteps);
+  // By time: three teach frames' time a frame (the teach run at 10 frames/s), whatever the input indices say.
+  std::vector<double> times;
+  for (const int frame : route) times.push_back(frame * 0.1);
+  MotionPace timed(route, times);
+  timed.Steps(0, 5.0);
+  timed.Steps(1, 5.31);
+  EXPECT_EQ(timed.Lookahead(3, 2), 4);
+  timed.Steps(2, 5.41);
+  EXPECT_EQ(timed.Lookahead(3, 2), 2);
+  EXPECT_FALSE(timed.PassedLookahead(3, 2));
+  // The time between frames jitters: 0.19 s at 0.1 s a teach frame is two frames (rccar_room every second frame).
+  timed.Steps(3, 5.60);
+  EXPECT_EQ(timed.Lookahead(3, 2), 3);
+  EXPECT_TRUE(timed.PassedLookahead(3, 2));
+  // A fixed pace says nothing of the teach frames passed.
+  MotionPace fixed(route, no_times, 3);
+  fixed.Steps(0, -1.0);
+  fixed.Steps(3, -1.0);
+  EXPECT_EQ(fixed.Lookahead(3, 2), 2);
+  EXPECT_FALSE(fixed.PassedLookahead(3, 2));
+}
+
 TEST(MotionPace, TheTeachRunsTimeIsKnownOnlyWhereItRunsOneWayAlongTheRoute) {
   EXPECT_NEAR(TeachSecondsPerPosition({10.0, 10.3, 10.6, 11.2}), 0.4, 1e-12);
   EXPECT_DOUBLE_EQ(TeachSecondsPerPosition({0.9, 0.6, 0.3, 0.0}), 0.3) << "a route backwards through the map";
