@@ -258,7 +258,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   } finish_comparisons{comparisons_};
   frame_start_position_ = position_;
   const int motion_steps = pace_.Steps(frame.source_index, frame.timestamp, frame.odometry);
-  lookahead_ = pace_.Lookahead(position_, options_.lookahead);
+  lookahead_ = options_.lookahead_by_pace ? pace_.Lookahead(position_, options_.lookahead) : options_.lookahead;
   // The comparisons made ahead verified in full: those the frame verifies with fewer iterations are made again.
   ahead.erase(std::remove_if(ahead.begin(), ahead.end(),
                              [&](const KeyComparison& c) { return FarComparisonIterations(c.key) > 0; }),

@@ -147,6 +147,9 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
       OptionField{"lookahead", "--lookahead", "Key images beyond the next compared while tracking (1 or 2)"}.Within(1,
                                                                                                                     2),
       lookahead);
+  visitor.Visit({"lookahead_by_pace", "!--no-lookahead-by-pace",
+                 "Look no further than --lookahead key images, however many teach frames the run passed a frame"},
+                lookahead_by_pace);
   visitor.Visit({"step_back", "!--no-step-back", "Never move the estimate back to the previous key image"}, step_back);
   visitor.Visit(
       OptionField{"step_back_max_log10_nfa", "--step-back-max-log10-nfa",

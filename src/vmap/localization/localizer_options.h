@@ -311,6 +311,11 @@ struct LocalizerOptions : GuidedMatchingOptions, StartOptions, LostFrameOptions 
   bool steer_where_belief_stays = true;
   // Key images compared beyond `next_key` when the frame has passed it (1 or 2: the "next one or two").
   int lookahead = 2;
+  // The lookahead reaches the key images within the teach frames the run passed since the frame before, and where it
+  // passed the whole lookahead every key image of it is compared (MotionPace::Lookahead, PassedLookahead;
+  // docs/localize.md, "The lookahead where key images crowd"). Off: `lookahead` key images, the first that verifies
+  // no more than the best ending the look.
+  bool lookahead_by_pace = true;
   // While tracking, also compare the key image before `key` when the frame is nearer `key` than `next_key`
   // (fewer than a third of their verified matches are with `next_key`), and move back when it is the better
   // match: the frame may be behind `key`. A check that finds it clearly worse is repeated on the frames that

@@ -50,7 +50,8 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
       // Where the run passed the whole lookahead since the frame before (key images crowd within the frames it passed:
       // MotionPace::PassedLookahead), each of them sees the frame's scene alike, and one that verifies a little less by
       // chance says nothing of those after it: all are compared.
-      if ((best.accepted || step > 1) && !tie && !pace_.PassedLookahead(position, options_.lookahead)) break;
+      const bool passed_all = options_.lookahead_by_pace && pace_.PassedLookahead(position, options_.lookahead);
+      if ((best.accepted || step > 1) && !tie && !passed_all) break;
       continue;
     }
     best = ahead;

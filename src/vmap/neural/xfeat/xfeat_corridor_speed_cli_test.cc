@@ -112,7 +112,9 @@ TEST_F(XfeatCorridorSpeedRun, ATrackerBehindTheDistanceDrivenLooksWhereTheOdomet
 // relocalization the frame is also asked for places it at key image 3, one verified match more: a near tie, taken
 // back against the distance driven. The odometry keeps the tracker.
 TEST_F(XfeatCorridorSpeedRun, TheDistanceDrivenVouchesForTheTrackedKeyImageAgainstANearTieElsewhere) {
-  ExpectNoFarFrameButWithout(" --driven-past-positions 0", "repeat frame 20 relocalized back at key image 3",
+  // The lookahead by the pace reaches key image 6 on its own there: it is left out so that the test reaches the case.
+  ExpectNoFarFrameButWithout(" --driven-past-positions 0 --no-lookahead-by-pace",
+                             "repeat frame 20 relocalized back at key image 3",
                              [&](const std::string& flags) { return SteeredOnSpeedRun(" --verifier-seed 7" + flags); });
 }
 
