@@ -60,7 +60,12 @@ TEST(Localizer, AFrameTrackedAtAFarKeyImageOfTheSameSceneIsMovedWhereItVerifiesB
   LocalizerOptions refuse = MapLocalizerOptions(m);
   refuse.recheck_link_share = 0.0;
   // The tracker's own decisions: an uncertain frame's key would be the belief's best guess (the test below).
-  for (LocalizerOptions* o : {&recheck, &hold, &refuse}) o->belief.window = 0;
+  // The frames' input indices jump (1, 3, then 41 or 57), which the lookahead by the pace would take for frames driven
+  // and track to: the tracker is kept to its lookahead, so that the jump reaches the rules tested.
+  for (LocalizerOptions* o : {&recheck, &hold, &refuse}) {
+    o->belief.window = 0;
+    o->lookahead_by_pace = false;
+  }
   for (int jump_to : {41, 57}) {
     const LocalizationResult refused = AfterAJump(refuse, jump_to);
     // Relocalized, and doubted by the belief over the route on this first frame after the jump (the test below).
@@ -98,6 +103,7 @@ TEST(Localizer, AKeyImageThatStandsOutAgainstTheFramesRivalsIsAcceptedWhenTheLin
     options.min_rival_ratio = ratio;
     options.belief.window = 0;  // the acceptance alone
     options.belief.min_confidence = 0.0;
+    options.lookahead_by_pace = false;  // the frames are 8 input frames apart: kept to relocalizations, as written
     Localizer localizer(m.map, m.keys, *m.matcher, options);
     int index = 0, localized = 0;
     for (int source_index : {1, 9, 17, 25, 33}) {
