@@ -94,6 +94,16 @@ std::optional<double> MotionPace::metres_driven() const {
   return metres_driven_;
 }
 
+namespace {
+
+// The teach frames a run passed, whole: frames are counted, and the time between two frames jitters (rccar_room's
+// 0.19 s at 0.1 s a teach frame is two frames).
+long WholeFrames(double teach_frames_passed) {
+  return std::isfinite(teach_frames_passed) ? std::lround(std::min(teach_frames_passed, 1e9)) : 0;
+}
+
+}  // namespace
+
 int MotionPace::Steps(int source_index, double timestamp, const std::optional<OdometrySample>& odometry) {
   if (!(timestamp >= 0.0 && std::isfinite(timestamp))) timestamp = -1.0;
   const bool first = !started_;
@@ -113,13 +123,13 @@ int MotionPace::Steps(int source_index, double timestamp, const std::optional<Od
   source_index_before_ = source_index;
   timestamp_before_ = timestamp;
   odometry_before_ = odometry;
-  teach_frames_passed_ = 0.0;
+  teach_frames_passed_ = 0;
   if (first) return 1;  // as the model was fitted: how far the run's first frame is from a frame before is not known
   if (fixed_steps_ > 0) return fixed_steps_;
   // The positions passed, in the unit the teach run is known in, and as teach frames.
   const auto passed = [&](double travelled, double teach_per_position) {
     if (travelled > 0.0 && std::isfinite(travelled)) {
-      teach_frames_passed_ = travelled / teach_per_position * teach_frames_per_position_;
+      teach_frames_passed_ = WholeFrames(travelled / teach_per_position * teach_frames_per_position_);
     }
     return MotionStepsPerFrame(travelled, teach_per_position);
   };
@@ -133,19 +143,12 @@ int MotionPace::Steps(int source_index, double timestamp, const std::optional<Od
 
 namespace {
 
-// The teach frames a run passed, whole: frames are counted, and the time between two frames jitters (rccar_room's
-// 0.19 s at 0.1 s a teach frame is two frames).
-long WholeFrames(double teach_frames_passed) {
-  return std::isfinite(teach_frames_passed) ? std::lround(std::min(teach_frames_passed, 1e9)) : 0;
-}
-
 // The key images from the one after `position` on that the run may have reached since the frame before (at least 1):
 // those within the teach frames it passed of the next one, where the frame before was at the furthest on the tracked
 // segment. At most kMaxMotionSteps; 0 where nothing is known.
-int ReachPassed(const std::vector<int>& route_source_indices, int position, double teach_frames_passed) {
+int ReachPassed(const std::vector<int>& route_source_indices, int position, long passed) {
   const int next = position + 1;
   const int last = static_cast<int>(route_source_indices.size()) - 1;
-  const long passed = WholeFrames(teach_frames_passed);
   if (position < 0 || next > last || passed <= 0) return 0;
   int reach = 1;
   while (next + reach <= last && reach < kMaxMotionSteps &&
@@ -162,8 +165,7 @@ int MotionPace::Lookahead(int position, int lookahead) const {
 }
 
 bool MotionPace::PassedLookahead(int position, int lookahead) const {
-  return WholeFrames(teach_frames_passed_) >= 2 &&
-         ReachPassed(route_source_indices_, position, teach_frames_passed_) >= lookahead;
+  return teach_frames_passed_ >= 2 && ReachPassed(route_source_indices_, position, teach_frames_passed_) >= lookahead;
 }
 
 std::optional<double> MotionPace::teach_metres_driven() const {

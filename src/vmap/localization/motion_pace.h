@@ -114,8 +114,8 @@ class MotionPace {
   int fixed_steps_ = 0;
   bool started_ = false;  // a frame of the run was seen: the two below are its
   int source_index_before_ = 0;
-  double teach_frames_passed_ = 0.0;  // on the last frame: 0 where not known (the first frame, a fixed pace)
-  double timestamp_before_ = -1.0;    // below 0: none
+  long teach_frames_passed_ = 0;    // whole, on the last frame: 0 where not known (the first frame, a fixed pace)
+  double timestamp_before_ = -1.0;  // below 0: none
   std::optional<OdometrySample> odometry_before_;
   double metres_driven_ = 0.0;
   int driving_stretch_ = 0;
