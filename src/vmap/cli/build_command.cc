@@ -11,7 +11,6 @@
 #include "vmap/cli/commands.h"
 #include "vmap/cli/option_binder.h"
 #include "vmap/core/error.h"
-#include "vmap/core/option_ranges.h"
 #include "vmap/pipelines/add_experience_pipeline.h"
 #include "vmap/pipelines/build_pipeline.h"
 #include "vmap/report/summary.h"
@@ -79,7 +78,7 @@ std::string TypeWithRange(LocalizerOptions localizer, const std::string& key) {
    private:
     void Take(const OptionField& field, const char* type, bool integral) {
       if (Path(field) != key_ || !field.range.is_set) return;
-      found = std::string(type) + (field.range.also ? " " : " in ") + RangeText(field.range, integral);
+      found = TypeWithValues(type, field.range, integral);
     }
     std::string key_;
   } finder(key);

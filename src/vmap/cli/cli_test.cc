@@ -357,6 +357,23 @@ TEST(Cli, EveryNumericFlagsHelpSaysTheValuesItTakes) {
   }
 }
 
+TEST(Cli, HelpNamesEverySwitchAsItIsTyped) {
+  // CLI11 alone writes "--no-odometry{false}": the value the switch stores, which no user types.
+  const std::regex flag_column(R"(^\s+(-[a-zA-Z],)?--[a-z0-9-]+\{)");
+  for (const char* command :
+       {"build", "localize", "route", "simulate", "info", "report", "eval", "sweep", "match", "draw", "weights"}) {
+    std::string out;
+    ASSERT_EQ(RunVmap(std::string(command) + " --help", &out), 0) << out;
+    std::istringstream lines(out);
+    for (std::string line; std::getline(lines, line);) {
+      if (std::regex_search(line, flag_column)) ADD_FAILURE() << command << ": " << line;
+    }
+  }
+  std::string out;
+  ASSERT_EQ(RunVmap("simulate --help", &out), 0) << out;
+  EXPECT_NE(out.find("  --no-odometry "), std::string::npos) << out;
+}
+
 TEST(Cli, HelpListsCommandsAndFlagsUnderHeadings) {
   std::string out;
   ASSERT_EQ(RunVmap("--help", &out), 0) << out;

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <exception>
 #include <initializer_list>
+#include <memory>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -14,6 +15,7 @@
 #include <opencv2/core.hpp>
 
 #include "vmap/cli/commands.h"
+#include "vmap/cli/help_formatter.h"
 #include "vmap/cli/option_flags.h"
 #include "vmap/core/error.h"
 #include "vmap/core/logging.h"
@@ -36,6 +38,7 @@ int main(int argc, char** argv) {
   }
   CLI::App app{"vmap: visual maps for vision-only robot navigation (key images linked by fundamental matrices)",
                "vmap"};
+  app.formatter(std::make_shared<vmap::cli::HelpFormatter>());  // before the commands: each takes it on
   app.set_version_flag("--version", std::string("vmap ") + VMAP_VERSION);
   app.require_subcommand(1);
   app.fallthrough();  // global flags may follow the subcommand

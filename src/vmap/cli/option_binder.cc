@@ -71,6 +71,11 @@ CLI::Option* BindValues(CLI::App* command, const std::string& flag, const Option
 
 }  // namespace
 
+std::string TypeWithValues(const std::string& type, const OptionRange& range, bool integral) {
+  if (!range.is_set) return type;
+  return type + (range.also ? " " : " in ") + RangeText(range, integral);
+}
+
 void OptionBinder::OnField(const OptionField& field, std::vector<int>& /*value*/) {
   if (*field.flag != '\0') throw std::logic_error(std::string("flag ") + field.flag + ": a list field has no flag");
 }
@@ -125,8 +130,7 @@ void OptionBinder::Bind(CLI::App* command, OptionFlags& option_flags) const {
                     return CLI::detail::lexical_cast(text, parsed) ? "" : text + " is not " + takes;
                   },
                   ""));
-              // The values the field takes, after its type: "--lookahead INT in [1, 2]=2", "FLOAT 0 or [1, 1000]".
-              if (range.is_set) option->type_name(option->get_type_name() + (range.also ? " " : " in ") + values);
+              option->type_name(TypeWithValues(option->get_type_name(), range, std::is_same_v<Value, int>));
             }
             return option;
           }

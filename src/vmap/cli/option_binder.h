@@ -53,6 +53,10 @@ class OptionBinder final : public OptionFieldVisitor {
   std::vector<std::string> order_;  // as first visited
 };
 
+// A numeric flag's type and the values its field takes, as its --help shows them: "INT in [1, 2]",
+// "FLOAT 0 or [1, 1000]"; the type alone where the field declares no range.
+std::string TypeWithValues(const std::string& type, const OptionRange& range, bool integral);
+
 // Binds the flags of every field of `options` (see OptionBinder::Add).
 template <typename Options>
 void AddOptionFlags(CLI::App* command, Options& options, OptionFlags& option_flags, const char* path = "",

@@ -158,18 +158,18 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
           .Within(-1000, 1000),
       step_back_max_log10_nfa);
   visitor.Visit({"step_back_needs_more", "!--step-back-on-tie",
-                 "Step back to the previous key image on a tie of verified matches (S decides, as before)"},
+                 "Step back to the previous key image on a tie of verified matches (S decides: the earlier rule)"},
                 step_back_needs_more);
   visitor.Visit({"step_back_needs_lower_nfa", "!--step-back-on-count",
-                 "Step back to the previous key image on more verified matches alone, whatever their log10 NFA (as "
-                 "before)"},
+                 "Step back to the previous key image on more verified matches alone, whatever their log10 NFA (the "
+                 "earlier rule)"},
                 step_back_needs_lower_nfa);
   visitor.Visit({"step_on_needs_more", "!--step-on-on-tie",
-                 "Step on to the next key image on a tie of verified matches (S decides, as before)"},
+                 "Step on to the next key image on a tie of verified matches (S decides: the earlier rule)"},
                 step_on_needs_more);
   visitor.Visit({"step_on_needs_lower_nfa", "!--step-on-on-count",
-                 "ORB: step on to the next key image on more verified matches alone, whatever their log10 NFA (as "
-                 "before)"},
+                 "ORB: step on to the next key image on more verified matches alone, whatever their log10 NFA (the "
+                 "earlier rule)"},
                 step_on_needs_lower_nfa);
   visitor.Visit({"step_on_by_belief", "!--no-step-on-by-belief",
                  "Never move a tracked frame on to the next key image because the belief puts it past that key "
@@ -178,15 +178,15 @@ void LocalizerOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(OptionField{"step_on_by_belief_ahead", "--step-on-by-belief-ahead",
                             "The step on by the belief (--no-step-on-by-belief): the positions past each key image "
                             "ahead whose belief is weighed against the two "
-                            "at and behind the key image the tracker is at (3: as before 2026-12-04)"}
+                            "at and behind the key image the tracker is at (3: the earlier rule)"}
                     .Within(1, 5),
                 step_on_by_belief_ahead);
   visitor.Visit({"hold_unearned_step_on", "!--no-hold-unearned-step-on",
-                 "Keep a step on the belief undoes when the key image it passed does not verify (as before)"},
+                 "Keep a step on the belief undoes when the key image it passed does not verify (the earlier rule)"},
                 hold_unearned_step_on);
   visitor.Visit({"step_back_needs_belief", "!--no-step-back-needs-belief",
-                 "Step back to the previous key image on the counts and the log10 NFA alone, whatever the belief (as "
-                 "before)"},
+                 "Step back to the previous key image on the counts and the log10 NFA alone, whatever the belief (the "
+                 "earlier rule)"},
                 step_back_needs_belief);
   visitor.VisitNested("ranking", ranking);
   visitor.VisitNested("belief", belief);
