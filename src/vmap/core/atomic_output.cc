@@ -322,6 +322,11 @@ AtomicOutputDirectory::AtomicOutputDirectory(fs::path final_path, OutputPolicy p
   CheckReplaceable();
   const fs::path parent = final_path_.has_parent_path() ? final_path_.parent_path() : fs::path(".");
   RemoveStaleTemporaries(final_path_);
+  std::error_code missing;
+  for (fs::path folder = parent; !folder.empty() && !fs::exists(fs::symlink_status(folder, missing));
+       folder = folder.parent_path()) {
+    created_parents_.push_back(folder);
+  }
   for (int attempt = 0; attempt < 100 && temp_path_.empty(); ++attempt) {
     const fs::path candidate = TemporarySibling(final_path_, "partial");
     // The parent is created under the registry's lock too: when it lies in another temporary output (a
@@ -345,7 +350,12 @@ AtomicOutputDirectory::AtomicOutputDirectory(fs::path final_path, OutputPolicy p
 }
 
 AtomicOutputDirectory::~AtomicOutputDirectory() {
-  if (!committed_ && !temp_path_.empty()) RemoveAndUnregister(temp_path_);
+  if (committed_) return;
+  if (!temp_path_.empty()) RemoveAndUnregister(temp_path_);
+  // rmdir, not remove_all: a folder something else wrote into since is no longer only this output's.
+  for (const fs::path& folder : created_parents_) {
+    if (rmdir(folder.c_str()) != 0) break;
+  }
 }
 
 void AtomicOutputDirectory::CheckReplaceable() const { CheckReplaceable(final_path_, policy_); }

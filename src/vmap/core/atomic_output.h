@@ -125,6 +125,9 @@ class AtomicOutputDirectory {
   std::filesystem::path final_path_;
   OutputPolicy policy_;
   std::filesystem::path temp_path_;
+  // The folders above the output that did not exist and were created for it, nearest first: an output that is
+  // never committed takes them with it (where they are still empty), as `-o runs/today/map` of a failed run.
+  std::vector<std::filesystem::path> created_parents_;
   bool committed_ = false;
 };
 

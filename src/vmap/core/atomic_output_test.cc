@@ -90,6 +90,31 @@ TEST(AtomicOutput, UncommittedDirectoryLeavesNothingAndKeepsTheOldOne) {
   EXPECT_EQ(CountEntries(tmp.path()), 1);
 }
 
+TEST(AtomicOutput, AnUncommittedDirectoryTakesTheFoldersCreatedForItWithIt) {
+  testing::ScopedTempDir tmp;
+  // Neither runs/ nor runs/today/ exists: a failed output leaves neither behind.
+  { AtomicOutputDirectory dir(tmp.path() / "runs" / "today" / "map", MarkerPolicy()); }
+  EXPECT_EQ(CountEntries(tmp.path()), 0);
+  // A folder that existed stays, and so does one something else wrote into meanwhile.
+  fs::create_directory(tmp.path() / "runs");
+  {
+    AtomicOutputDirectory dir(tmp.path() / "runs" / "today" / "map", MarkerPolicy());
+    std::ofstream(tmp.path() / "runs" / "today" / "notes.txt") << "not vmap's";
+  }
+  EXPECT_TRUE(fs::exists(tmp.path() / "runs" / "today" / "notes.txt"));
+  EXPECT_EQ(CountEntries(tmp.path() / "runs" / "today"), 1);
+  fs::remove_all(tmp.path() / "runs" / "today");
+  { AtomicOutputDirectory dir(tmp.path() / "runs" / "today" / "map", MarkerPolicy()); }
+  EXPECT_TRUE(fs::exists(tmp.path() / "runs"));
+  EXPECT_EQ(CountEntries(tmp.path() / "runs"), 0);
+  // Committed, they are the output's.
+  {
+    AtomicOutputDirectory dir(tmp.path() / "new" / "map", MarkerPolicy());
+    dir.Commit();
+  }
+  EXPECT_TRUE(fs::is_directory(tmp.path() / "new" / "map"));
+}
+
 TEST(AtomicOutput, CommitReplacesAnOlderDirectoryAndLeavesNothingElse) {
   testing::ScopedTempDir tmp;
   const fs::path target = tmp.path() / "map";
