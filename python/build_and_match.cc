@@ -1,6 +1,7 @@
 // vmap.build_map, vmap.Matcher and vmap.match: the build pipeline and one pair's matching, their options as
 // keywords (keyword_options.h).
 
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -84,7 +85,7 @@ class PairMatcher {
       float* row = matches.mutable_data(k);
       row[0] = pair.matches.points0[k].x, row[1] = pair.matches.points0[k].y;
       row[2] = pair.matches.points1[k].x, row[3] = pair.matches.points1[k].y;
-      scores.mutable_at(k) = pair.matches.scores.empty() ? 0.0f : pair.matches.scores[k];
+      scores.mutable_at(k) = pair.matches.scores.empty() ? std::nanf("") : pair.matches.scores[k];  // unscored
       inliers.mutable_at(k) = verified && pair.fundamental.inlier_mask[k] != 0;
     }
     // Named as `vmap match --json` names them; a field added there is one more line here.

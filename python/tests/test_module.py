@@ -188,6 +188,9 @@ def test_match_equals_vmap_match(maps, tmp_path):
     expected = np.array([[k["x0"], k["y0"], k["x1"], k["y1"]] for k in cli["matches"]], dtype=np.float32)
     np.testing.assert_array_equal(result.matches, expected)
     np.testing.assert_array_equal(result.inliers, np.array([k["inlier"] for k in cli["matches"]]))
+    # ORB scores no match: null in the JSON, NaN here (a 0 would read as the worst score).
+    assert all(k["score"] is None for k in cli["matches"])
+    assert np.isnan(result.scores).all()
 
 
 def test_match_takes_the_cli_options(maps, tmp_path):

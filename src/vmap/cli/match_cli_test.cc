@@ -43,6 +43,11 @@ TEST(MatchCli, ReportsTheHeadingInPixelsAndWithACameraInDegrees) {
   EXPECT_NE(out.find("heading     "), std::string::npos) << out;
   auto json = nlohmann::json::parse(std::ifstream(tmp.path() / "m.json"));
   ASSERT_TRUE(json["heading_px"].is_number()) << json.dump();
+  // ORB scores no match: null, not a 0 that would read as the worst score; nan in --list, as numpy reads it.
+  ASSERT_FALSE(json["matches"].empty());
+  for (const auto& match : json["matches"]) EXPECT_TRUE(match["score"].is_null()) << match.dump();
+  ASSERT_EQ(RunVmap(pair + " --list", &out), 0) << out;
+  EXPECT_NE(out.find(" nan 1\n"), std::string::npos) << out;
   EXPECT_NEAR(json["heading_px"].get<double>(), shift, 1.5);
   EXPECT_TRUE(json["heading_deg"].is_null()) << "no camera, no degrees";
   // A pure shift: F holds with many inliers, whose median is the heading.

@@ -54,10 +54,11 @@ void RunMatch(const MatchFlags& flags) {
               result.load_seconds, result.pair.extract_seconds, result.pair.match_seconds, result.pair.verify_seconds,
               result.pair.heading_seconds);
   if (flags.list) {
+    // A matcher that scores no match (ORB) gives nan, as numpy reads it: a 0 would read as the worst score.
     std::printf("# x0 y0 x1 y1 score inlier\n");
     for (size_t k = 0; k < matches.size(); ++k) {
       std::printf("%.3f %.3f %.3f %.3f %.6g %d\n", matches.points0[k].x, matches.points0[k].y, matches.points1[k].x,
-                  matches.points1[k].y, matches.scores.empty() ? 0.0 : matches.scores[k],
+                  matches.points1[k].y, matches.scores.empty() ? std::nan("") : matches.scores[k],
                   fundamental.success ? int(fundamental.inlier_mask[k]) : 0);
     }
   }

@@ -135,12 +135,13 @@ void WriteMatchJson(const MatchPipelineOptions& options, const MatchPipelineResu
   }
   auto& list = j["matches"] = nlohmann::json::array();
   for (size_t k = 0; k < matches.size(); ++k) {
-    list.push_back({{"x0", matches.points0[k].x},
-                    {"y0", matches.points0[k].y},
-                    {"x1", matches.points1[k].x},
-                    {"y1", matches.points1[k].y},
-                    {"score", matches.scores.empty() ? 0.0f : matches.scores[k]},
-                    {"inlier", fundamental.success && fundamental.inlier_mask[k] != 0}});
+    list.push_back(
+        {{"x0", matches.points0[k].x},
+         {"y0", matches.points0[k].y},
+         {"x1", matches.points1[k].x},
+         {"y1", matches.points1[k].y},
+         {"score", matches.scores.empty() ? nlohmann::json() : nlohmann::json(matches.scores[k])},  // null: unscored
+         {"inlier", fundamental.success && fundamental.inlier_mask[k] != 0}});
   }
   // x in image1 minus x in image0 at the scene both show; null without an estimate.
   j["heading_px"] = NumberOrNull(heading.px);
