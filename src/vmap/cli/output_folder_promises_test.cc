@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "vmap/map/map_io.h"
+#include "vmap/pipelines/localize_odometry.h"
 #include "vmap/testing/promises_test_util.h"
 #include "vmap/testing/run_vmap.h"
 #include "vmap/testing/scoped_temp_dir.h"
@@ -128,6 +129,26 @@ TEST(Promises, VmapReplacesWhatItWrote) {
   EXPECT_TRUE(fs::exists(tmp.path() / "s/report.html"));
   EXPECT_TRUE(EntriesStartingWith(tmp.path(), ".").empty());
   EXPECT_TRUE(EntriesStartingWith(tmp.path() / "m", ".").empty());
+}
+
+// A rebuilt map keeps what its folder held besides the map: the teach odometry a host put there, a user's notes, a
+// run's outputs. They were removed without a word, and the taught speeds and turns with the teach odometry.
+TEST(Promises, ARebuiltMapKeepsWhatItsFolderHeldBesidesTheMap) {
+  testing::ScopedTempDir tmp;
+  WriteSyntheticInput(tmp.path() / "in", 6);
+  const std::string build = "build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "m");
+  std::string out;
+  ASSERT_EQ(RunVmap(build + " --report", &out), 0) << out;
+  std::ofstream(tmp.path() / "m" / kTeachOdometryFileName) << "time,x,y,yaw\n0,0,0,0\n";
+  std::ofstream(tmp.path() / "m" / "notes.txt") << "taught on Monday";
+  ASSERT_EQ(RunVmap(build + " --tau 0.6", &out), 0) << out;
+  EXPECT_NE(out.find("replaced a vmap map and keeps what it held besides its own files: notes.txt, teach_odometry.csv"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(ReadText(tmp.path() / "m" / "notes.txt"), "taught on Monday");
+  EXPECT_EQ(ReadText(tmp.path() / "m" / kTeachOdometryFileName), "time,x,y,yaw\n0,0,0,0\n");
+  EXPECT_FALSE(fs::exists(tmp.path() / "m" / "report.html")) << "the old map's report is the old map's";
+  EXPECT_TRUE(EntriesStartingWith(tmp.path(), ".").empty());
 }
 
 TEST(Promises, TheInputIsNeverInsideTheOutputNorTheOutputInsideTheInput) {

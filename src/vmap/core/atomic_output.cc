@@ -7,17 +7,18 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
-#include <map>
+#include <functional>
 #include <mutex>
 #include <optional>
-#include <random>
 #include <stdexcept>
-#include <thread>
 #include <utility>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/contained_file.h"
@@ -26,73 +27,15 @@
 #include "vmap/core/file_sync.h"
 #include "vmap/core/output_file.h"
 #include "vmap/core/temporary_name.h"
+#include "vmap/core/temporary_registry.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
+using internal::CreateRegistered;
+using internal::RemoveAndUnregister;
+using internal::Temporaries;
 
 namespace {
-
-// A temporary's lock: a shared flock(2) held on it for as long as it is this process's. The pid in its name tells
-// another vmap only whether a process of that pid runs in *its* PID namespace; two containers sharing a volume, or
-// two hosts sharing a file system, would each take the other's running work for a killed process's leftovers. The
-// lock is seen wherever the file is (local file systems, and NFS, which turns it into a byte-range lock).
-int HoldLock(const fs::path& path) {
-  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
-  if (fd >= 0 && flock(fd, LOCK_SH | LOCK_NB) != 0) {
-    close(fd);
-    return -1;
-  }
-  return fd;
-}
-
-// Whether some process holds the lock of the temporary at `path` (its owner is alive, wherever it runs).
-bool LockIsHeld(const fs::path& path) {
-  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
-  if (fd < 0) return false;
-  const bool held = flock(fd, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK;
-  close(fd);
-  return held;
-}
-
-// The temporaries this process created and has not yet committed or removed, each with its lock (-1: none).
-struct TemporaryRegistry {
-  std::mutex mutex;
-  std::map<fs::path, int> paths;
-
-  // Both with the mutex held.
-  void Add(const fs::path& path) {
-    if (paths.count(path) == 0) paths[path] = HoldLock(path);
-  }
-  void Remove(const fs::path& path) {
-    const auto found = paths.find(path);
-    if (found == paths.end()) return;
-    if (found->second >= 0) close(found->second);
-    paths.erase(found);
-  }
-};
-
-// Never destroyed: an interrupted process cleans up from another thread while main() may be returning.
-TemporaryRegistry& Temporaries() {
-  static TemporaryRegistry* registry = new TemporaryRegistry;
-  return *registry;
-}
-
-// Creates a temporary and registers it in one step under the registry's lock, so that an interruption
-// never finds one created and not yet registered (it would stay behind).
-template <typename Create>
-auto CreateRegistered(const fs::path& path, Create&& create) -> decltype(create()) {
-  std::lock_guard<std::mutex> lock(Temporaries().mutex);
-  auto created = create();
-  if (created) Temporaries().Add(path);
-  return created;
-}
-
-void RemoveAndUnregister(const fs::path& path) {
-  std::error_code ignored;
-  fs::remove_all(path, ignored);
-  std::lock_guard<std::mutex> lock(Temporaries().mutex);
-  Temporaries().Remove(path);
-}
 
 std::string ErrnoText() { return std::strerror(errno); }
 
@@ -100,41 +43,41 @@ std::string ErrnoText() { return std::strerror(errno); }
   throw InputError("output '" + path.string() + "' " + why_and_fix);
 }
 
-}  // namespace
+// A visible sibling name of `final_path` that no later run takes for a dead process's temporary
+// (RemoveStaleTemporaries), and that nothing holds yet: "NAME.TAG-TIME".
+fs::path VisibleSibling(const fs::path& final_path, const std::string& tag) {
+  const std::string stamp = std::to_string(
+      std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count());
+  fs::path visible = final_path;
+  visible += "." + tag + "-" + stamp;
+  std::error_code exists;
+  for (int n = 2; fs::exists(fs::symlink_status(visible, exists)); ++n) {
+    visible = final_path;
+    visible += "." + tag + "-" + stamp + "-" + std::to_string(n);
+  }
+  return visible;
+}
 
-void RemoveStaleTemporaries(const fs::path& path) {
-  const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
-  const std::string name = path.filename().string();
+// Moves the entries of `from` that are not the output's own, and that `to` holds none of, into `to`. Returns the
+// names moved; those that could not be are added to `failed`.
+std::vector<std::string> CarryOver(const fs::path& from, const fs::path& to,
+                                   const std::function<bool(const std::string&)>& is_own,
+                                   std::vector<std::string>* failed) {
+  std::vector<std::string> names, carried;
   std::error_code ec;
-  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
-    const long pid = TemporaryOwner(it->path().filename().string(), name);
-    if (pid == 0 || ProcessRuns(pid) || LockIsHeld(it->path())) continue;
-    std::error_code removed;
-    fs::remove_all(it->path(), removed);
-    if (!removed) {
-      spdlog::info("removed '{}', left behind by vmap process {}, which was killed", it->path().string(), pid);
-    }
+  for (fs::directory_iterator it(from, ec), end; !ec && it != end; it.increment(ec)) {
+    names.push_back(it->path().filename().string());
   }
+  if (ec) failed->push_back("its list of files (" + ec.message() + ")");
+  for (const std::string& name : names) {
+    std::error_code exists;
+    if (is_own(name) || fs::exists(fs::symlink_status(to / name, exists))) continue;
+    (rename((from / name).c_str(), (to / name).c_str()) == 0 ? &carried : failed)->push_back(name);
+  }
+  return carried;
 }
 
-int RemoveTemporaryOutputsForExit() {
-  // Locked for good: nothing new is created or committed while the process ends.
-  Temporaries().mutex.lock();
-  int removed = 0;
-  for (const auto& registered : Temporaries().paths) {
-    const fs::path& path = registered.first;
-    // Another thread may still be writing into a directory: a retry takes what appeared meanwhile. Once the
-    // directory itself is gone, nothing recreates it (only the constructor does, under the lock held here).
-    std::error_code ec;
-    for (int attempt = 0; attempt < 1000 && fs::exists(fs::symlink_status(path, ec)); ++attempt) {
-      if (attempt > 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-      fs::remove_all(path, ec);
-    }
-    ++removed;
-  }
-  Temporaries().paths.clear();
-  return removed;
-}
+}  // namespace
 
 void WriteFileAtomically(const fs::path& path, std::string_view content,
                          const std::vector<TemporaryDirectory*>& completes) {
@@ -420,15 +363,7 @@ std::string AtomicOutputDirectory::KeepUnplaced() {
   // A visible name that no later run takes for a dead process's temporary (RemoveStaleTemporaries); where even
   // that rename fails (the folder became unwritable), the temporary stays as it is, no longer this process's to
   // remove.
-  const std::string stamp = std::to_string(
-      std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count());
-  fs::path kept = final_path_;
-  kept += ".unplaced-" + stamp;
-  std::error_code exists;
-  for (int n = 2; fs::exists(fs::symlink_status(kept, exists)); ++n) {
-    kept = final_path_;
-    kept += ".unplaced-" + stamp + "-" + std::to_string(n);
-  }
+  fs::path kept = VisibleSibling(final_path_, "unplaced");
   std::lock_guard<std::mutex> lock(Temporaries().mutex);
   if (rename(temp_path_.c_str(), kept.c_str()) != 0) kept = temp_path_;
   Temporaries().Remove(temp_path_);
@@ -480,10 +415,29 @@ void AtomicOutputDirectory::MoveIntoPlace() {
   } else {
     fail(ErrnoText());
   }
+  // Under the registry's lock: an interruption, which removes the replaced directory, waits until they are moved.
+  std::vector<std::string> carried, not_carried;
+  if (!old.empty() && policy_.is_own_entry) carried = CarryOver(old, final_path_, policy_.is_own_entry, &not_carried);
   committed_ = true;
+  if (!not_carried.empty()) {
+    // Not removed with what they are in: the replaced directory stays, under a name the user sees.
+    const fs::path kept = VisibleSibling(final_path_, "replaced");
+    if (rename(old.c_str(), kept.c_str()) == 0) {
+      Temporaries().Remove(old);
+      old = kept;
+    }
+  }
   lock.unlock();
   SyncDirectory(final_path_.parent_path());
-  if (!old.empty()) {
+  if (!carried.empty()) {
+    std::sort(carried.begin(), carried.end());
+    spdlog::info("'{}' replaced {} and keeps what it held besides its own files: {}", final_path_.string(),
+                 policy_.kind, fmt::format("{}", fmt::join(carried, ", ")));
+  }
+  if (!not_carried.empty()) {
+    spdlog::warn("'{}' replaced {}, but could not keep {} from it; the replaced one is at '{}': take them from there",
+                 final_path_.string(), policy_.kind, fmt::format("{}", fmt::join(not_carried, ", ")), old.string());
+  } else if (!old.empty()) {
     RemoveAndUnregister(old);
     // The new output is in place; what is left of the old one (files this user may not delete) is said, not hidden.
     std::error_code ec;

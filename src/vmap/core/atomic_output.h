@@ -88,6 +88,12 @@ struct OutputPolicy {
   // removing it: for outputs that cost a run that cannot be made again (a teach run's map).
   bool keep_if_commit_fails = false;
 
+  // Whether an entry of a replaced directory, by its name, is the output's own (a map's map.json, keys/). Its other
+  // entries (a user's notes, a run's CSV, the teach odometry put beside a map) are moved into the new directory
+  // where it holds none of that name, and said at info level: a rebuild keeps what it did not write. Null: the
+  // replaced directory goes whole.
+  std::function<bool(const std::string& name)> is_own_entry;
+
   // For a directory inside one already proven to be vmap's (a map's report/ assets): anything goes.
   static OutputPolicy InsideVmapOutput();
 };

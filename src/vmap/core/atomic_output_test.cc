@@ -127,6 +127,39 @@ TEST(AtomicOutput, CommitReplacesAnOlderDirectoryAndLeavesNothingElse) {
   EXPECT_EQ(CountEntries(tmp.path()), 1) << "the old directory is removed";
 }
 
+// A rebuild keeps what it did not write: the replaced directory's entries that are not the output's own move into the
+// new one, where it holds none of that name; its own go with it.
+TEST(AtomicOutput, ReplacingADirectoryKeepsWhatItHeldBesidesTheOutputsOwnFiles) {
+  testing::ScopedTempDir tmp;
+  const fs::path target = tmp.path() / "map";
+  MakeOwned(target);  // owner.txt, old.txt
+  std::ofstream(target / "notes.txt") << "the user's";
+  std::ofstream(target / "both.txt") << "old";
+  fs::create_directory(target / "runs");
+  std::ofstream(target / "runs" / "a.csv") << "a run";
+  OutputPolicy policy = MarkerPolicy();
+  policy.is_own_entry = [](const std::string& name) { return name == "owner.txt" || name == "old.txt"; };
+  {
+    AtomicOutputDirectory dir(target, policy);
+    std::ofstream(dir.path() / "owner.txt") << "vmap";
+    std::ofstream(dir.path() / "both.txt") << "new";
+    dir.Commit();
+  }
+  EXPECT_EQ(ReadAll(target / "notes.txt"), "the user's");
+  EXPECT_EQ(ReadAll(target / "runs" / "a.csv"), "a run");
+  EXPECT_EQ(ReadAll(target / "both.txt"), "new") << "the new output's file of that name wins";
+  EXPECT_FALSE(fs::exists(target / "old.txt")) << "the output's own entries go with the replaced one";
+  EXPECT_EQ(CountEntries(target), 4);
+  EXPECT_EQ(CountEntries(tmp.path()), 1) << "nothing left beside it";
+  // Without the policy's say, the replaced directory goes whole, as before.
+  {
+    AtomicOutputDirectory dir(target, MarkerPolicy());
+    std::ofstream(dir.path() / "owner.txt") << "vmap";
+    dir.Commit();
+  }
+  EXPECT_EQ(CountEntries(target), 1);
+}
+
 TEST(AtomicOutput, RefusesToReplaceAFileOrASymbolicLink) {
   testing::ScopedTempDir tmp;
   std::ofstream(tmp.path() / "file") << "x";

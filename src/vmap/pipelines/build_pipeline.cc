@@ -154,7 +154,17 @@ MapBuilderOptions BuildPipelineOptions::ResolvedMapOptions() const {
 }
 
 fs::path BuildPipelineOptions::OutputDirectory() const {
-  return output.empty() ? fs::path(fs::path(input).filename().stem().string() + "_map") : fs::path(output);
+  if (!output.empty()) return output;
+  // Named after the input's last component, however it was written: "run1/" (as tab completion writes it) and
+  // "run1/." are run1, not "" (every such input's map was "_map", one replacing the other) or ".".
+  fs::path named = fs::path(input).lexically_normal();
+  if (named.filename().empty()) named = named.parent_path();
+  if (named.filename().empty() || named.filename() == "." || named.filename() == "..") {
+    std::error_code ec;
+    named = fs::absolute(input, ec).lexically_normal();
+    if (named.filename().empty()) named = named.parent_path();
+  }
+  return fs::path(named.filename().stem().string() + "_map");
 }
 
 void BuildPipelineOptions::Check() const {

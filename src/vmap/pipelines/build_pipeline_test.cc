@@ -142,6 +142,13 @@ TEST(BuildPipeline, OutputDefaultsToTheInputsName) {
   BuildPipelineOptions options;
   options.input = "/data/teach.mp4";
   EXPECT_EQ(options.OutputDirectory(), fs::path("teach_map"));
+  // A folder as tab completion writes it, or with a "." after it: its name, not "" (every such map was "_map").
+  for (const char* folder : {"runs/run1/", "runs/run1/.", "runs/run1//", "runs/./run1"}) {
+    options.input = folder;
+    EXPECT_EQ(options.OutputDirectory(), fs::path("run1_map")) << folder;
+  }
+  options.input = ".";
+  EXPECT_EQ(options.OutputDirectory(), fs::path(fs::current_path().filename().string() + "_map"));
   options.output = "elsewhere";
   EXPECT_EQ(options.OutputDirectory(), fs::path("elsewhere"));
 }

@@ -32,6 +32,37 @@ void AddLinksInFolder(const fs::path& folder, std::vector<fs::path>* inputs) {
   }
 }
 
+// The files of every map an output lies in, whichever command writes it: `vmap simulate --json MAP/map.json` or a
+// --csv into MAP/keys/ would otherwise replace a map's own file, where the command's inputs do not name the map.
+std::vector<OutputInput> FilesOfMapsAround(const std::vector<OutputFile>& outputs) {
+  constexpr int kLevels = 4;  // MAP/experiences/ID/keys/FILE, the deepest a map's files lie
+  std::vector<OutputInput> files;
+  for (const OutputFile& output : outputs) {
+    if (output.path.empty()) continue;
+    std::error_code ec;
+    fs::path folder = fs::absolute(output.path, ec).parent_path();
+    for (int level = 0; level < kLevels && !ec && folder.has_relative_path(); ++level, folder = folder.parent_path()) {
+      std::error_code missing;  // set where there is no map.json, which is no reason to stop looking further up
+      if (fs::is_regular_file(folder / kMapFileName, missing) && WhyNotAVmapMap(folder).empty()) {
+        const std::vector<OutputInput> map = MapInputs(folder.string());
+        files.insert(files.end(), map.begin(), map.end());
+      }
+    }
+  }
+  return files;
+}
+
+// The files a map consists of, and those derived from it (its cache, its report, its evaluation): a rebuilt map
+// replaces them all. The teach odometry is not among them: it is the teach run's, put beside the map by a host (the
+// ROS node, the simulator) or by hand, and a rebuild of the same run needs it as much.
+const std::set<std::string>& MapFileNames() {
+  static const std::set<std::string> names = {
+      kMapFileName,           kCorrespondencesFileName, "keys",
+      kCameraMaskFileName,    kExperiencesDirectory,    kReportFileName,
+      kReportAssetsDirectory, kEvaluationFileName,      kLocalizationCacheFileName};
+  return names;
+}
+
 }  // namespace
 
 OutputPolicy MapOutputPolicy(const std::vector<std::string>& inputs) {
@@ -45,6 +76,8 @@ OutputPolicy MapOutputPolicy(const std::vector<std::string>& inputs) {
   }
   // A map costs a run, and a teach run cannot be made again: one that cannot be put in place is kept beside.
   policy.keep_if_commit_fails = true;
+  // A rebuild keeps the teach odometry, notes and runs' outputs the folder held besides the map.
+  policy.is_own_entry = [](const std::string& name) { return MapFileNames().count(name) > 0; };
   return policy;
 }
 
@@ -61,12 +94,9 @@ OutputPolicy SweepOutputPolicy(const std::string& input) {
 std::vector<OutputInput> MapInputs(const std::string& map_directory) {
   if (map_directory.empty()) return {};
   const fs::path directory(map_directory);
-  std::set<std::string> names = {
-      kMapFileName,          kCorrespondencesFileName,  "keys",          kCameraMaskFileName,
-      kExperiencesDirectory, kTeachOdometryFileName,    kReportFileName, kReportAssetsDirectory,
-      kEvaluationFileName,   kLocalizationCacheFileName};
   std::vector<OutputInput> inputs;
-  for (const std::string& name : names) inputs.push_back({directory / name, "the map's " + name});
+  for (const std::string& name : MapFileNames()) inputs.push_back({directory / name, "the map's " + name});
+  inputs.push_back({directory / kTeachOdometryFileName, std::string("the map's ") + kTeachOdometryFileName});
   return inputs;
 }
 
@@ -87,6 +117,8 @@ std::vector<OutputInput> ExistingInputs(const std::vector<std::string>& paths, c
 void CheckOutputs(const std::vector<OutputFile>& outputs, const std::vector<std::vector<OutputInput>>& inputs) {
   std::vector<OutputInput> all;
   for (const auto& group : inputs) all.insert(all.end(), group.begin(), group.end());
+  const std::vector<OutputInput> maps = FilesOfMapsAround(outputs);
+  all.insert(all.end(), maps.begin(), maps.end());
   CheckOutputFiles(outputs, all);
 }
 

@@ -12,7 +12,8 @@ namespace vmap {
 
 // What a map's folder may replace: an empty folder or a map that vmap wrote, never one that is, holds or lies
 // inside one of `inputs` (the recording, and any file the build reads: a camera file, a camera mask). A finished
-// map that cannot be moved into place is kept beside it (OutputPolicy::keep_if_commit_fails).
+// map that cannot be moved into place is kept beside it (OutputPolicy::keep_if_commit_fails). What the replaced
+// folder held besides the map (the teach odometry, a user's notes, runs' outputs) moves into the new one.
 OutputPolicy MapOutputPolicy(const std::vector<std::string>& inputs);
 // The same for a sweep's folder, which the sweep's `input` may not be, hold or lie inside.
 OutputPolicy SweepOutputPolicy(const std::string& input);
@@ -30,7 +31,8 @@ std::vector<OutputInput> NamedInput(const std::string& path, const std::string& 
 // takes a calibration file or "fx,fy,cx,cy").
 std::vector<OutputInput> ExistingInputs(const std::vector<std::string>& paths, const std::string& what);
 
-// CheckOutputFiles over the inputs put together. A pipeline names each output by its options field ({path,
+// CheckOutputFiles over the inputs put together, and over the files of any map an output lies in (a map's own
+// files are never an output's, whichever command writes it). A pipeline names each output by its options field ({path,
 // "csv"}): the refusal is an OptionError of that field, named by each front end as it names the field.
 void CheckOutputs(const std::vector<OutputFile>& outputs, const std::vector<std::vector<OutputInput>>& inputs);
 
