@@ -42,13 +42,19 @@ std::shared_ptr<MapHandle> BuildMapFunction(const py::object& input, const py::o
   keywords.Parse(kwargs);
   options.input = TextArgument(input, "build_map(): input");
   options.output = TextArgument(output, "build_map(): output_dir");
+  // The CLI's default folder beside the input is not taken from an empty string: the map would replace one the call
+  // never named.
+  if (options.output.empty()) {
+    throw InputError("build_map(): output_dir '' names no folder; give the folder to write the map into");
+  }
   // Ctrl-C between frames: KeyboardInterrupt, and the output left as it was.
   options.map.after_frame = RaisePendingSignals;
+  BuildPipelineResult built;
   keywords.Run([&] {
     GilRelease release;
-    RunBuildPipeline(options);
+    built = RunBuildPipeline(options);
   });
-  return ReadMapHandle(options.output);
+  return ReadBuiltMapHandle(built.directory, built.map);
 }
 
 // A matcher and a verifier, created once and used for any number of pairs (a deep model's weights load once).

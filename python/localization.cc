@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -56,7 +57,8 @@ std::optional<OdometrySample> OdometryArgument(const py::object& odometry, std::
   if (odometry.is_none()) return std::nullopt;
   const auto why =
       "odometry must be (x, y, yaw): the robot's odometry pose at the frame in metres and radians, or None";
-  if (!py::isinstance<py::sequence>(odometry) || py::isinstance<py::str>(odometry) || py::len(odometry) != 3) {
+  if (!py::isinstance<py::sequence>(odometry) || py::isinstance<py::str>(odometry) ||
+      py::isinstance<py::bytes>(odometry) || py::len(odometry) != 3) {
     throw InputError(why);
   }
   const py::sequence values = odometry.cast<py::sequence>();
@@ -93,6 +95,13 @@ class FrameLocalizer {
     if (!timestamp.is_none()) {
       seconds = FloatArgument(timestamp, "timestamp");
       if (!std::isfinite(*seconds)) throw InputError("timestamp is not finite; give the frame's time in seconds");
+      // A negative time is the library's "none" (a frame without one), which would drop it without a word.
+      if (*seconds < 0.0) {
+        throw InputError(
+            fmt::format("timestamp {} is negative; give the frame's time in seconds from 0 (as ROS stamps "
+                        "are), or None",
+                        *seconds));
+      }
     }
     const std::optional<OdometrySample> pose = OdometryArgument(odometry, seconds);
     LocalizationResult result;

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -67,11 +69,13 @@ cv::Mat ReadKeyImageWithoutGil(const KeyImageRef& ref, bool grayscale) {
 
 }  // namespace
 
-void MapHandle::CheckUnchanged() const {
+bool MapHandle::Unchanged() const {
   // The folder by its inode (a Localizer adds its cache to it); map.json by its time too.
-  if (SameFile(IdentityOf(directory), folder_identity) && IdentityOf(directory / kMapFileName) == map_json_identity) {
-    return;
-  }
+  return SameFile(IdentityOf(directory), folder_identity) && IdentityOf(directory / kMapFileName) == map_json_identity;
+}
+
+void MapHandle::CheckUnchanged() const {
+  if (Unchanged()) return;
   throw InputError(
       fmt::format("the map '{}' was replaced or removed since vmap.read_map read it; read it again "
                   "with vmap.read_map",
@@ -92,6 +96,31 @@ std::shared_ptr<MapHandle> ReadMapHandle(const std::filesystem::path& directory)
   handle->options = std::move(read.options);
   // A map built into the folder while it was read: what was read may mix the two.
   handle->CheckUnchanged();
+  return handle;
+}
+
+std::shared_ptr<MapHandle> ReadBuiltMapHandle(const std::filesystem::path& directory, const VisualMap& built) {
+  const auto replaced = [&](const std::string& why) {
+    return InputError(fmt::format(
+        "the map built into '{}' was replaced or removed before build_map() could read it back ({}): another "
+        "build into the same folder? give each build a folder of its own",
+        directory.string(), why));
+  };
+  std::shared_ptr<MapHandle> handle;
+  try {
+    handle = ReadMapHandle(directory);
+  } catch (const InputError& error) {
+    throw replaced(error.what());
+  }
+  // Key images at other frames, or of another input: another build's map, committed after this one's.
+  const auto frames = [](const VisualMap& map) {
+    std::vector<std::pair<int, int>> indices;
+    for (const KeyImage& key : map.key_images) indices.emplace_back(key.frame_index, key.source_index);
+    return indices;
+  };
+  if (handle->map.input.path != built.input.path || frames(handle->map) != frames(built)) {
+    throw replaced("its key images are not the ones built");
+  }
   return handle;
 }
 

@@ -24,12 +24,18 @@ struct MapHandle {
   // tells a copy that took the inode of a removed folder.
   std::optional<FileIdentity> folder_identity, map_json_identity;
 
-  // Throws InputError when the folder at `directory` is no longer the one read (a map built into it since).
+  // Whether the folder at `directory` is still the one read (no map built into it since).
+  bool Unchanged() const;
+  // Throws InputError when it is not.
   void CheckUnchanged() const;
 };
 
 // Reads the map in `directory` (the GIL released meanwhile).
 std::shared_ptr<MapHandle> ReadMapHandle(const std::filesystem::path& directory);
+
+// Reads back the map a build just committed to `directory`, which `built` is: another build into the same folder
+// may have replaced it since (two threads given one output), and then the map read is not the one built.
+std::shared_ptr<MapHandle> ReadBuiltMapHandle(const std::filesystem::path& directory, const VisualMap& built);
 
 // The map directory a Python argument names: a vmap.Map or a path.
 std::filesystem::path MapDirectory(const pybind11::object& map_or_path);

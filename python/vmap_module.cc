@@ -55,11 +55,16 @@ PYBIND11_MODULE(vmap, m) {
       "vmap's log: 'quiet' (warnings and errors; no progress line), 'info' (the default) or 'debug'.");
   m.def(
       "initialize_runtime",
-      [](int opencv_threads, bool keep_freed_memory, bool quiet_ffmpeg) {
+      [](const py::object& opencv_threads, const py::object& keep_freed_memory, const py::object& quiet_ffmpeg) {
+        // Type-checked as every argument of the module is; None keeps the default.
+        using vmap::python::BoolArgument;
+        using vmap::python::IntArgument;
         vmap::RuntimeOptions options;
-        options.opencv_threads = opencv_threads;
-        options.keep_freed_memory = keep_freed_memory;
-        options.quiet_ffmpeg = quiet_ffmpeg;
+        if (!opencv_threads.is_none()) options.opencv_threads = IntArgument(opencv_threads, "opencv_threads");
+        if (!keep_freed_memory.is_none()) {
+          options.keep_freed_memory = BoolArgument(keep_freed_memory, "keep_freed_memory");
+        }
+        if (!quiet_ffmpeg.is_none()) options.quiet_ffmpeg = BoolArgument(quiet_ffmpeg, "quiet_ffmpeg");
         options.handle_interrupts = false;  // Python handles signals
         options.Check();
         vmap::InitializeRuntime(options);

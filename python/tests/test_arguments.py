@@ -38,7 +38,8 @@ else:
     return done.stdout
 
 
-@pytest.mark.parametrize("timestamp", ["'now'", "[1.0]", "object()", "10**400", "b'1'", "float('nan')", "True"])
+@pytest.mark.parametrize("timestamp", ["'now'", "[1.0]", "object()", "10**400", "b'1'", "float('nan')", "True",
+                                       "-5.0"])
 def test_a_bad_timestamp_is_an_exception(maps, timestamp):
     said = localize_in_isolation(maps[0], f"timestamp={timestamp}")
     assert "accepted" not in said and "timestamp" in said, said
@@ -53,7 +54,7 @@ def test_a_good_timestamp_is_recorded(maps):
 
 
 @pytest.mark.parametrize("odometry", ["(1.0, 2.0)", "'abc'", "(1, 2, float('nan'))", "object()", "[1, 2, 'x']",
-                                      "(1, 2, 10**400)"])
+                                      "(1, 2, 10**400)", "b'abc'"])
 def test_a_bad_odometry_pose_is_an_exception(maps, odometry):
     said = localize_in_isolation(maps[0], f"timestamp=1.0, odometry={odometry}")
     assert "accepted" not in said and "odometry" in said, said
@@ -251,3 +252,70 @@ def test_module_functions_check_their_text_arguments():
         vmap.read_map("a\0b")
     with pytest.raises(vmap.ArgumentTypeError, match=r"set_log_level\(\): level takes a str"):
         vmap.set_log_level(None)
+
+
+def test_build_map_into_no_folder_is_refused_before_any_work(tmp_path, monkeypatch):
+    # The CLI's default folder beside the input (lab_floor_map) would replace a map the call never named.
+    needs_shared()
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(vmap.Error, match="output_dir '' names no folder"):
+        vmap.build_map(str(VIDEO), "", first=0, last=9)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_two_builds_into_one_folder_never_return_the_other_ones_map(tmp_path):
+    # Each returns its own map or says the folder was another build's too; the one read back once was the other's.
+    needs_shared()
+    import threading
+
+    def key_images(output, first):
+        m = vmap.build_map(str(VIDEO), str(output), first=first, last=first + 9)
+        return [k.source_index for k in m.key_images]
+
+    alone = {first: key_images(tmp_path / f"alone_{first}", first) for first in (0, 100)}
+    assert alone[0] != alone[100]
+    for round_ in range(3):
+        output = tmp_path / f"shared_{round_}"
+        outcomes = {}
+
+        def build(first):
+            try:
+                outcomes[first] = key_images(output, first)
+            except vmap.Error as e:
+                outcomes[first] = str(e)
+
+        threads = [threading.Thread(target=build, args=(first,)) for first in (0, 100)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        for first, outcome in outcomes.items():
+            if isinstance(outcome, str):
+                assert "give each build a folder of its own" in outcome, outcome
+            else:
+                assert outcome == alone[first], (first, outcome)
+
+
+def test_initialize_runtime_checks_its_arguments_as_every_function_does():
+    done = run_isolated("""
+for kwargs in ({'opencv_threads': 2**40}, {'keep_freed_memory': 0}, {'quiet_ffmpeg': 'yes'}, {'opencv_threads': 1.5}):
+    try:
+        vmap.initialize_runtime(**kwargs)
+        print('accepted', kwargs)
+    except vmap.Error as e:
+        print(type(e).__name__, kwargs)
+vmap.initialize_runtime(opencv_threads=None, keep_freed_memory=None, quiet_ffmpeg=None)
+print('defaults')
+""")
+    assert done.returncode == 0, done.stderr
+    assert "accepted" not in done.stdout, done.stdout
+    assert done.stdout.count("ArgumentTypeError") == 3, done.stdout  # the wrong types; 2**40 is out of range
+    assert done.stdout.endswith("defaults\n"), done.stdout
+
+
+def test_a_route_end_or_start_that_is_no_key_image_names_its_keyword(maps):
+    m = vmap.read_map(maps[0])
+    last = len(m.key_images) - 1
+    for keyword in ("from", "to", "start_key"):
+        with pytest.raises(vmap.Error, match=rf"{keyword} 99 is no key image: the map has key images 0 to {last}"):
+            vmap.Localizer(m, no_cache=True, **{keyword: 99})
