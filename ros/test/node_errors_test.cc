@@ -116,7 +116,7 @@ TEST(NodeErrors, BadMessagesMapsAndCallsAreAnsweredAndTheNodeRunsOn) {
   start.request.goal = 1000;
   ASSERT_TRUE(ros::service::call(ns + "/vmap/repeat/start", start));
   EXPECT_FALSE(start.response.success);
-  EXPECT_NE(start.response.message.find("key image 1000 does not exist"), std::string::npos) << start.response.message;
+  EXPECT_NE(start.response.message.find("goal 1000 is no key image"), std::string::npos) << start.response.message;
   start.request.goal = -1;
   ASSERT_TRUE(ros::service::call(ns + "/vmap/repeat/start", start));
   ASSERT_TRUE(start.response.success) << start.response.message;

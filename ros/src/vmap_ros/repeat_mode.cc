@@ -79,6 +79,13 @@ bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::St
     taught_with =
         taught == 0 ? "the map alone (no teach odometry)" : fmt::format("the teach odometry ({} samples)", taught);
   } catch (const InputError& error) {
+    // The request's start and goal set the session's from and to: an error of either names the request's field.
+    if (const auto* option = dynamic_cast<const OptionError*>(&error)) {
+      if (option->path() == "to" && request.goal >= 0) return Fail(response, "repeat/start: goal " + option->problem());
+      if (option->path() == "from" && request.start >= 0) {
+        return Fail(response, "repeat/start: start " + option->problem());
+      }
+    }
     return Fail(response, "repeat/start: " + parameters.Message(error));
   } catch (const std::exception& error) {
     return Fail(response, std::string("repeat/start: ") + error.what());

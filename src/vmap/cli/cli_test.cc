@@ -1,6 +1,7 @@
 // End-to-end tests of the vmap binary: real sequences in every layout, and every kind of bad input.
 
 #include <fstream>
+#include <functional>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -33,6 +34,17 @@ void WriteSyntheticInput(const fs::path& directory, int num_frames, double step 
   options.num_frames = num_frames;
   options.step = step;
   testing::WriteImageFolder(testing::RenderSyntheticSequence(options), directory);
+}
+
+// Calls `check` with every line of every command's --help.
+void ForEveryHelpLine(const std::function<void(const std::string& command, const std::string& line)>& check) {
+  for (const char* command :
+       {"build", "localize", "route", "simulate", "info", "report", "eval", "sweep", "match", "draw", "weights"}) {
+    std::string out;
+    ASSERT_EQ(RunVmap(std::string(command) + " --help", &out), 0) << out;
+    std::istringstream lines(out);
+    for (std::string line; std::getline(lines, line);) check(command, line);
+  }
 }
 
 }  // namespace
@@ -338,40 +350,46 @@ TEST(Cli, DifferentFrameSizesWarnOrFailWhenStrict) {
 // Every number a flag takes is bounded (promise 5), and its help says the values: "--tau FLOAT in (0, 1]".
 TEST(Cli, EveryNumericFlagsHelpSaysTheValuesItTakes) {
   const std::regex unbounded(R"(^\s+(-[a-zA-Z], )?(--[a-z0-9-]+) (INT|FLOAT)(=|\s*$|\s\s))");
-  for (const char* command :
-       {"build", "localize", "route", "simulate", "info", "report", "eval", "sweep", "match", "draw", "weights"}) {
-    std::string out;
-    ASSERT_EQ(RunVmap(std::string(command) + " --help", &out), 0) << out;
-    std::istringstream lines(out);
-    int numeric = 0;
-    for (std::string line; std::getline(lines, line);) {
-      std::smatch found;
-      if (std::regex_search(line, found, unbounded)) {
-        ADD_FAILURE() << command << " " << found[2] << ": " << line;
-      }
-      if (line.find(" INT ") != std::string::npos || line.find(" FLOAT ") != std::string::npos) ++numeric;
+  int build_numeric = 0;
+  ForEveryHelpLine([&](const std::string& command, const std::string& line) {
+    std::smatch found;
+    if (std::regex_search(line, found, unbounded)) ADD_FAILURE() << command << " " << found[2] << ": " << line;
+    if (command == "build" && (line.find(" INT ") != std::string::npos || line.find(" FLOAT ") != std::string::npos)) {
+      ++build_numeric;
     }
-    if (std::string(command) == "build") {
-      EXPECT_GT(numeric, 20) << out;
-    }
-  }
+  });
+  EXPECT_GT(build_numeric, 20);
 }
 
 TEST(Cli, HelpNamesEverySwitchAsItIsTyped) {
   // CLI11 alone writes "--no-odometry{false}": the value the switch stores, which no user types.
   const std::regex flag_column(R"(^\s+(-[a-zA-Z],)?--[a-z0-9-]+\{)");
-  for (const char* command :
-       {"build", "localize", "route", "simulate", "info", "report", "eval", "sweep", "match", "draw", "weights"}) {
-    std::string out;
-    ASSERT_EQ(RunVmap(std::string(command) + " --help", &out), 0) << out;
-    std::istringstream lines(out);
-    for (std::string line; std::getline(lines, line);) {
-      if (std::regex_search(line, flag_column)) ADD_FAILURE() << command << ": " << line;
-    }
-  }
+  ForEveryHelpLine([&](const std::string& command, const std::string& line) {
+    if (std::regex_search(line, flag_column)) ADD_FAILURE() << command << ": " << line;
+  });
   std::string out;
   ASSERT_EQ(RunVmap("simulate --help", &out), 0) << out;
   EXPECT_NE(out.find("  --no-odometry "), std::string::npos) << out;
+}
+
+// A frame number copied from a file name (000010.png) is that frame: CLI11 alone read "010" as octal 8, "09" as no
+// number, and "0x10" as 16.
+TEST(Cli, IntegersAreDecimalWithOrWithoutLeadingZeros) {
+  testing::ScopedTempDir tmp;
+  WriteSyntheticInput(tmp.path() / "in", 14);
+  std::string out;
+  ASSERT_EQ(
+      RunVmap("build " + Quote(tmp.path() / "in") + " --first 010 --last 0013 -q -o " + Quote(tmp.path() / "m"), &out),
+      0)
+      << out;
+  EXPECT_EQ(ReadMap(tmp.path() / "m").key_images.front().source_index, 10);
+  ASSERT_EQ(
+      RunVmap("build " + Quote(tmp.path() / "in") + " --first 09 --last 13 -q -o " + Quote(tmp.path() / "m"), &out), 0)
+      << out;
+  EXPECT_EQ(ReadMap(tmp.path() / "m").key_images.front().source_index, 9);
+  EXPECT_EQ(RunVmap("build " + Quote(tmp.path() / "in") + " --stride 0x2 -o " + Quote(tmp.path() / "x"), &out), 2);
+  EXPECT_NE(out.find("--stride: 0x2 is not a decimal integer"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(tmp.path() / "x"));
 }
 
 TEST(Cli, HelpListsCommandsAndFlagsUnderHeadings) {

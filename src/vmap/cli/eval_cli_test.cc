@@ -134,6 +134,23 @@ TEST(EvalCli, CameraOptionAndMissingGroundTruthOrIntrinsics) {
   EXPECT_FALSE(ReadMap(tmp.path() / "plain").input.camera);
   EXPECT_EQ(RunVmap("eval " + Quote(tmp.path() / "plain"), &out), 2);
   EXPECT_NE(out.find("--gt"), std::string::npos) << out;
+  // An input not found from here (built elsewhere, from a relative path), or none recorded: said so, where the second
+  // was "cannot make absolute path (an unexpected error)".
+  for (const char* recorded : {"frames_elsewhere", ""}) {
+    nlohmann::json doc = ReadJson(tmp.path() / "plain" / kMapFileName);
+    doc["input"]["path"] = recorded;
+    std::ofstream(tmp.path() / "plain" / kMapFileName) << doc.dump();
+    EXPECT_EQ(RunVmap("eval " + Quote(tmp.path() / "plain"), &out), 2) << out;
+    EXPECT_NE(out.find(*recorded ? "'frames_elsewhere' is not found from here" : "the map records no input"),
+              std::string::npos)
+        << out;
+    EXPECT_EQ(out.find("unexpected"), std::string::npos) << out;
+  }
+  {
+    nlohmann::json doc = ReadJson(tmp.path() / "plain" / kMapFileName);
+    doc["input"]["path"] = (tmp.path() / "frames").string();
+    std::ofstream(tmp.path() / "plain" / kMapFileName) << doc.dump();
+  }
   // Ground truth given, intrinsics not: the error says how to give them.
   testing::WriteKittiSequence(sequence, tmp.path() / "kitti");
   const std::string poses = Quote(tmp.path() / "kitti/poses.txt");

@@ -15,6 +15,7 @@
 #include <opencv2/core.hpp>
 
 #include "vmap/cli/commands.h"
+#include "vmap/cli/decimal_integers.h"
 #include "vmap/cli/help_formatter.h"
 #include "vmap/cli/option_flags.h"
 #include "vmap/core/error.h"
@@ -60,6 +61,7 @@ int main(int argc, char** argv) {
       {vmap::cli::AddInfoCommand, vmap::cli::AddReportCommand, vmap::cli::AddEvalCommand, vmap::cli::AddSweepCommand,
        vmap::cli::AddMatchCommand, vmap::cli::AddDrawCommand});
   add("Set up", {vmap::cli::AddWeightsCommand});
+  vmap::cli::ReadIntegerFlagsAsDecimal(app);
 
   // `vmap` alone lists the commands, as `colmap` and `git` do: a first try is not an error.
   if (argc == 1) {

@@ -151,6 +151,16 @@ void Run(const WeightsFlags& flags) {
       throw InputError("'" + flags.import_file + "' does not fit --model " + flags.model + " (nor any other model" +
                        (fits.refusals.empty() ? "" : "; " + Join(fits.refusals_by_model())) + ")");
     }
+    // The published id is the official file's: a file of another layout (XFeat's BatchNorm-folded one, which
+    // shared/weights holds) never has it, and is no corrupt copy; --no-verify takes it on its structure.
+    const auto in_other_layout = std::find_if(fits.fits.begin(), fits.fits.end(), [&](const std::string& fit) {
+      return is_model(fit) && fit.find(" layout)") != std::string::npos &&
+             fit.find("(official layout)") == std::string::npos;
+    });
+    if (in_other_layout != fits.fits.end() && !expected.empty()) {
+      throw InputError("'" + flags.import_file + "' is " + *in_other_layout + ", not the published " + known.file_name +
+                       " whose git blob id vmap checks; import it with --no-verify (its structure " + "is checked)");
+    }
 #endif
     const std::string path = neural::ImportWeights(flags.import_file, flags.model, expected, cache);
     std::printf("imported %s -> %s (%s)\n", flags.import_file.c_str(), path.c_str(),

@@ -32,11 +32,28 @@ std::optional<Camera> ParseEvaluationCamera(const std::string& camera_option) {
   return camera;
 }
 
+// Why the map's input cannot be looked into for what lies beside it (its ground truth, its calibration), or "": no
+// path recorded, or one not found from here (a relative path is relative to where the map was built).
+std::string WhyInputUnreachable(const VisualMap& map) {
+  if (map.input.path.empty()) return "the map records no input";
+  std::error_code ec;
+  if (!fs::exists(map.input.path, ec)) {
+    return "the map's input '" + map.input.path +
+           "' is not found from here (a relative path is relative to the folder the map was built in: run there)";
+  }
+  return "";
+}
+
 Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option) {
   std::optional<Camera> camera = ParseEvaluationCamera(camera_option);
   if (map.input.camera) {
     if (camera) spdlog::warn("the map records its camera, which is used; --camera is for maps that have none");
     return *map.input.camera;
+  }
+  const std::string unreachable = WhyInputUnreachable(map);
+  if (!camera && !unreachable.empty()) {
+    throw OptionError("camera", "is needed: the map has no camera and " + unreachable +
+                                    "; give the intrinsics fx,fy,cx,cy (or a calibration file)");
   }
   if (!camera) camera = FindDatasetCamera(map.input.path, map.input.format);
   if (!camera) {
@@ -51,6 +68,9 @@ Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option) 
 
 GroundTruth MapGroundTruth(const VisualMap& map, const std::string& gt_path, GroundTruthFormat format) {
   if (!gt_path.empty()) return NameOptionErrorsWithin("gt", [&] { return ReadGroundTruth(gt_path, format); });
+  if (const std::string unreachable = WhyInputUnreachable(map); !unreachable.empty()) {
+    throw OptionError("gt.path", "is needed: " + unreachable + "; or give a poses file");
+  }
   std::optional<GroundTruth> truth = FindGroundTruth(map.input.path, map.input.format);
   if (!truth) {
     throw OptionError("gt.path", "is needed: the map's input '" + map.input.path +

@@ -308,7 +308,7 @@ std::vector<double> Displacements(const NormalizedMatches& matches, const cv::Ma
 bool ParsePoseMatches(const std::string& name) {
   const std::optional<bool> all = FindEnum(kPoseMatchesNames, name);
   if (!all)
-    throw InputError("--pose-matches '" + name + "': use all (every tentative match) or verified (F's inliers)");
+    throw InputError("unknown pose matches '" + name + "'; use all (every tentative match) or verified (F's inliers)");
   return *all;
 }
 

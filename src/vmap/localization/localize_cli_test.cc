@@ -166,7 +166,7 @@ TEST(LocalizeCli, RouteForwardsAndBackwards) {
             std::string::npos)
       << out;
   ASSERT_EQ(RunVmap("route " + Quote(LabMap()) + " --from 0 --to 99", &out), 2) << out;
-  EXPECT_NE(out.find("key image 99 does not exist"), std::string::npos) << out;
+  EXPECT_NE(out.find("--to 99 is no key image"), std::string::npos) << out;
   // A localization that follows the route backwards.
   ASSERT_EQ(RunVmap("localize " + Quote(LabMap()) + " " + Quote(Shared() / "data/lab_floor/lab_floor.mp4") +
                         " --from 3 --to 0 --last 5",
@@ -263,8 +263,8 @@ TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
       {localize + "--window-width 0", "--window-width 0 is outside (0, 1]"},
       {localize + "--window-max-log10-nfa nan", "--window-max-log10-nfa nan is outside"},
       {localize + "--step-back-max-log10-nfa nan", "--step-back-max-log10-nfa nan is outside"},
-      {localize + "--to 99", "key image 99 does not exist"},
-      {localize + "--start-key 99", "start key image 99 (--start-key) does not exist"},
+      {localize + "--to 99", "--to 99 is no key image: the map has key images 0 to"},
+      {localize + "--start-key 99", "--start-key 99 is no key image: the map has key images 0 to"},
       {localize + "--start-key -2", "--start-key -2 is less than -1"},
       // Numbers no int holds are refused by what the flag takes, not by CLI11's "Could not convert".
       {localize + "--verifier-seed 2147483648", "--verifier-seed: 2147483648 is not an integer in [-1, 2147483647]"},

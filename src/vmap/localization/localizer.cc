@@ -213,12 +213,12 @@ void CheckStartKey(const VisualMap& map, const LocalizerOptions& options) {
   const int key = options.start_key, num_keys = static_cast<int>(map.key_images.size());
   if (key < 0) return;
   if (key >= num_keys) {
-    throw InputError(fmt::format("start key image {} (--start-key) does not exist; the map has key images 0 to {}", key,
-                                 num_keys - 1));
+    throw OptionError("start_key",
+                      fmt::format("{} is no key image: the map has key images 0 to {}", key, num_keys - 1));
   }
   if (!options.route.empty() && std::find(options.route.begin(), options.route.end(), key) == options.route.end()) {
-    throw InputError(fmt::format("start key image {} (--start-key) is not on the route (key images {} to {})", key,
-                                 options.route.front(), options.route.back()));
+    throw OptionError("start_key", fmt::format("{} is not on the route (key images {} to {})", key,
+                                               options.route.front(), options.route.back()));
   }
 }
 

@@ -20,6 +20,12 @@ void RouteOptions::VisitFields(OptionFieldVisitor& visitor) {
 
 void RouteOptions::Check() const { CheckFieldRanges(*this); }
 
+void CheckRouteEnd(const VisualMap& map, int key, const char* field) {
+  const int last = static_cast<int>(map.key_images.size()) - 1;
+  if (key > last)
+    throw OptionError(field, fmt::format("{} is no key image: the map has key images 0 to {}", key, last));
+}
+
 Route PlanRoute(const VisualMap& map, int from, int to, const RouteOptions& options) {
   options.Check();
   const int num_keys = static_cast<int>(map.key_images.size());

@@ -322,6 +322,9 @@ TEST(MapIo, KeyImagesMustBeThePngsOfTheMapsFrameSize) {
   std::ofstream(key, std::ios::trunc) << "GIF89a";
   EXPECT_NE(ReadMapError(tmp.path()).find("'keys/9.png' is not a PNG or JPEG image"), std::string::npos)
       << ReadMapError(tmp.path());
+  // The file is at fault, not map.json, which names it rightly.
+  EXPECT_NE(ReadMapError(tmp.path()).find("has a damaged key image"), std::string::npos) << ReadMapError(tmp.path());
+  EXPECT_EQ(ReadMapError(tmp.path()).find("malformed"), std::string::npos) << ReadMapError(tmp.path());
   cv::imwrite(key.string(), cv::Mat(10, 12, CV_8U, cv::Scalar(3)));
   EXPECT_NE(ReadMapError(tmp.path()).find("is 12x10, not the map's frame size 64x48"), std::string::npos)
       << ReadMapError(tmp.path());

@@ -146,11 +146,14 @@ void ReadKeyImages(const json& doc, const Fields& fields, const fs::path& direct
     // Only the header is read here: the image must be a PNG (as vmap writes) or a JPEG (the input's own file,
     // copied) of the map's frame size, so that whoever decodes it later does not meet a decompression bomb.
     const ContainedFile image = OpenMapFile(directory, k.image_file, "key image", file, where + ".image");
+    // The file is at fault, not map.json, which names it rightly.
+    const auto damaged = [&](const std::string& problem) {
+      throw InputError("map '" + directory.string() + "' has a damaged key image: '" + k.image_file + "' " + problem +
+                       " (" + where + ".image); rebuild the map with `vmap build`");
+    };
     const std::string problem = KeyImageSizeProblem(ImageHeaderSize(image), map->input.frame_size);
-    if (!problem.empty()) Malformed(file, where + ".image '" + k.image_file + "' " + problem);
-    if (IsCutShortJpeg(image)) {
-      Malformed(file, where + ".image '" + k.image_file + "' is a JPEG cut short (no end-of-image marker)");
-    }
+    if (!problem.empty()) damaged(problem);
+    if (IsCutShortJpeg(image)) damaged("is a JPEG cut short (no end-of-image marker)");
     map->key_images.push_back(std::move(k));
   }
   if (map->key_images.empty() && map->num_frames > 0) Malformed(file, "no key images");
@@ -368,7 +371,7 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
   VisualMap map;
   const json* input = Fields::Find(doc, "input");
   // Every map since schema 2 records its input: how it was made, and the frame size and camera it is read at.
-  if (!input && version >= 2) fields.Fail("input", "is missing; rebuild the map with `vmap build`");
+  if (!input && version >= 2) fields.Fail("input", "is missing");  // Fail gives the fix
   if (input) {
     fields.Object(*input, "input");
     map.input.path = DecodeFileName(fields.String(*input, "input", "path"));

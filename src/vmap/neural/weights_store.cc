@@ -149,7 +149,9 @@ std::string ImportWeights(const std::string& source, const std::string& preset, 
     const std::string actual = GitBlobId(source);
     if (actual != expected_blob_id) {
       throw InputError("'" + source + "' is not the expected " + preset + " weights: its git blob id is " + actual +
-                       ", expected " + expected_blob_id + ". The file is corrupt, truncated or another version.");
+                       ", expected " + expected_blob_id +
+                       ". The file is corrupt, truncated or another version; a copy you trust imports with "
+                       "--no-verify, its structure checked.");
     }
   }
   std::error_code error;

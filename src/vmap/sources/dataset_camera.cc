@@ -344,7 +344,9 @@ Camera ReadCameraFile(const std::string& path) {
 }
 
 Camera ParseCameraOption(const std::string& value) {
-  if (fs::exists(value)) return ReadCameraFile(value);
+  // A name no file can have (too long) is not one: the value is then judged as numbers, and refused as the camera's.
+  std::error_code not_a_file;
+  if (fs::exists(value, not_a_file)) return ReadCameraFile(value);
   const bool looks_numeric = !value.empty() && value.find_first_not_of("0123456789.,;eE+- \t") == std::string::npos;
   if (!looks_numeric) {
     throw OptionError(

@@ -134,6 +134,14 @@ TEST(DatasetCamera, IntrinsicsTextBesideAnImageFolderOrItsParent) {
     EXPECT_NE(std::string(e.what()).find("'cy'"), std::string::npos) << e.what();
   }
   EXPECT_THROW(ParseCameraOption("no/such/file.yaml"), InputError);
+  // A value longer than a file name can be is the camera's error, not a file system error for the caller to blame
+  // on its input.
+  try {
+    ParseCameraOption(std::string(300, 'x'));
+    FAIL() << "accepted a camera of 300 x";
+  } catch (const OptionError& e) {
+    EXPECT_EQ(e.path(), "camera");
+  }
   EXPECT_DOUBLE_EQ(ParseCameraOption("500,501,320,240").fy, 501);
 }
 

@@ -185,13 +185,23 @@ std::unique_ptr<FrameSource> OpenDetected(const std::string& path, const fs::pat
 // intrinsics are checked against the native size and scaled to the delivered (--resize) size.
 class CameraSource : public FrameSource {
  public:
-  CameraSource(std::unique_ptr<FrameSource> inner, Camera camera)
-      : inner_(std::move(inner)), camera_(std::move(camera)), info_(inner_->info()) {}
+  // `given`: the user's --camera; else one vmap found beside the input (intrinsics.txt, calib.txt, a CameraInfo).
+  CameraSource(std::unique_ptr<FrameSource> inner, Camera camera, bool given)
+      : inner_(std::move(inner)), camera_(std::move(camera)), given_(given), info_(inner_->info()) {}
 
   std::optional<Frame> Next() override {
     std::optional<Frame> frame = inner_->Next();
     info_ = inner_->info();
-    if (frame && !scaled_) scaled_ = CameraForFrames(camera_, info_.native_size, info_.frame_size);
+    if (frame && !scaled_) {
+      try {
+        scaled_ = CameraForFrames(camera_, info_.native_size, info_.frame_size);
+      } catch (const OptionError& error) {
+        if (given_) throw;
+        // Not the user's --camera, which an OptionError of "camera" would blame: the file found is at fault.
+        throw InputError("the camera found with the input " + error.problem() +
+                         "; correct it, or give the camera yourself (--camera; none: no camera)");
+      }
+    }
     info_.camera = scaled_;
     return frame;
   }
@@ -201,6 +211,7 @@ class CameraSource : public FrameSource {
  private:
   std::unique_ptr<FrameSource> inner_;
   Camera camera_;
+  bool given_;
   std::optional<Camera> scaled_;
   SequenceInfo info_;
 };
@@ -210,7 +221,7 @@ std::unique_ptr<FrameSource> OpenDetectedFrameSource(const std::string& path, co
     std::unique_ptr<FrameSource> live =
         internal::IsStreamUrl(path) ? internal::OpenStream(path, options) : internal::OpenV4l2Camera(path, options);
     if (options.camera.empty() || options.camera == "none") return live;
-    return std::make_unique<CameraSource>(std::move(live), ParseCameraOption(options.camera));
+    return std::make_unique<CameraSource>(std::move(live), ParseCameraOption(options.camera), true);
   }
   std::error_code ec;
   if (!fs::exists(path, ec)) {
@@ -234,7 +245,7 @@ std::unique_ptr<FrameSource> OpenDetectedFrameSource(const std::string& path, co
     std::unique_ptr<FrameSource> single =
         internal::OpenImageList({{path, -1.0}}, path, SourceFormat::kImageFolder, options);
     if (options.camera.empty() || options.camera == "none") return single;
-    return std::make_unique<CameraSource>(std::move(single), ParseCameraOption(options.camera));
+    return std::make_unique<CameraSource>(std::move(single), ParseCameraOption(options.camera), true);
   }
   const SourceFormat format = DetectSourceFormat(path, options.format);
   std::optional<Camera> recording_camera;  // a recording's CameraInfo, read only when no --camera overrides it
@@ -248,7 +259,7 @@ std::unique_ptr<FrameSource> OpenDetectedFrameSource(const std::string& path, co
   } else if (options.camera != "none")
     camera = ParseCameraOption(options.camera);
   if (!camera) return source;
-  return std::make_unique<CameraSource>(std::move(source), *camera);
+  return std::make_unique<CameraSource>(std::move(source), *camera, !options.camera.empty());
 }
 
 std::unique_ptr<FrameSource> OpenDetected(const std::string& path, const fs::path& p, SourceFormat format,

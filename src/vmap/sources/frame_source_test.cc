@@ -6,6 +6,7 @@
 #include <fstream>
 #include <functional>
 #include <iomanip>
+#include <limits>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -93,6 +94,28 @@ TEST(ImageFolder, ReadsInNaturalOrder) {
   cv::Mat grey_again;
   cv::cvtColor(from_grey, grey_again, cv::COLOR_BGR2GRAY);
   EXPECT_EQ(cv::norm(grey_again, frames[9].gray, cv::NORM_INF), 0.0);
+}
+
+// A calibration vmap found with the input that does not fit the frames is the file's fault, not the --camera option's
+// (which the user never gave): an error of the input naming the file and the ways out.
+TEST(ImageFolder, ACameraFoundWithTheInputThatDoesNotFitIsNotBlamedOnTheCameraOption) {
+  testing::ScopedTempDir tmp;
+  testing::WriteImageFolder(Sequence(), tmp.path());
+  std::ofstream(tmp.path() / "intrinsics.txt") << "fx 525\nfy 525\ncx 3080\ncy 236\n";
+  try {
+    OpenFrameSource(tmp.path().string(), FrameSourceOptions())->Next();
+    ADD_FAILURE() << "a principal point outside the frames was accepted";
+  } catch (const OptionError& error) {
+    ADD_FAILURE() << "blamed on an option: " << error.what();
+  } catch (const InputError& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("intrinsics.txt"), std::string::npos) << what;
+    EXPECT_NE(what.find("none: no camera"), std::string::npos) << what;
+  }
+  // Given as --camera, the same file is the option's error.
+  FrameSourceOptions given;
+  given.camera = (tmp.path() / "intrinsics.txt").string();
+  EXPECT_THROW(OpenFrameSource(tmp.path().string(), given)->Next(), OptionError);
 }
 
 TEST(ImageFolder, FirstLastStrideAndResize) {
@@ -461,6 +484,23 @@ TEST(SharedData, LabFloorVideo) {
   ASSERT_EQ(frames.size(), 60u);
   EXPECT_EQ(frames[0].gray.size(), cv::Size(640, 480));
   EXPECT_NEAR(frames[30].timestamp, 1.0, 1e-3);  // 30 fps
+}
+
+// The largest last frame the range allows reads to the end, as -1 does: last + 1 overflowed, and the range was empty.
+TEST(SharedData, TheLargestLastFrameIsTheEnd) {
+  const fs::path shared = testing::SharedDir();
+  if (shared.empty()) GTEST_SKIP() << "../shared is not present";
+  testing::ScopedTempDir tmp;
+  testing::WriteImageFolder(Sequence(), tmp.path());
+  for (const fs::path& input : {tmp.path(), shared / "data/lab_floor/lab_floor.mp4"}) {
+    FrameSourceOptions options;
+    options.first = 3;
+    const long to_the_end = OpenFrameSource(input.string(), options)->info().expected_frames;
+    options.last = std::numeric_limits<int>::max();
+    ASSERT_NO_THROW(options.Check());
+    EXPECT_EQ(OpenFrameSource(input.string(), options)->info().expected_frames, to_the_end) << input;
+    EXPECT_GT(to_the_end, 0) << input;
+  }
 }
 
 // vmap decodes videos with FFmpeg itself; its frames and timestamps must be those of cv::VideoCapture, so

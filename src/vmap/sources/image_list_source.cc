@@ -23,7 +23,8 @@ class ImageListSource : public FrameSource {
     info_.path = path;
     info_.format = format;
     next_ = options.first;
-    end_ = options.last >= 0 ? std::min<long>(options.last + 1, entries_.size()) : static_cast<long>(entries_.size());
+    end_ = options.last >= 0 ? std::min<long>(static_cast<long>(options.last) + 1, entries_.size())
+                             : static_cast<long>(entries_.size());
     if (next_ >= end_) {
       throw OptionError("first", std::to_string(options.first) + " leaves none of the " +
                                      std::to_string(entries_.size()) + " frames of '" + path + "'");

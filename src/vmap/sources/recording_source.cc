@@ -63,7 +63,8 @@ class RecordingSource : public FrameSource {
       throw OptionError("first", fmt::format("{} leaves none of the {} frames of {} in '{}'", options.first,
                                              topic.message_count, topic.name, path));
     }
-    long end = options.last >= 0 ? std::min<long>(options.last + 1, topic.message_count) : topic.message_count;
+    long end = options.last >= 0 ? std::min<long>(static_cast<long>(options.last) + 1, topic.message_count)
+                                 : topic.message_count;
     info_.expected_frames = end > options.first ? (end - options.first + options.stride - 1) / options.stride : 0;
     info_.fps = MessageRate(topic);
     if (info_.fps > kMaxFramesPerSecond) {

@@ -70,7 +70,7 @@ class VideoSource : public FrameSource {
     }
     if (live_) frame_count_ = -1;  // what a stream announces is not what it will send
     if (frame_count_ > 0) {
-      long end = options.last >= 0 ? std::min<long>(options.last + 1, frame_count_) : frame_count_;
+      long end = options.last >= 0 ? std::min<long>(static_cast<long>(options.last) + 1, frame_count_) : frame_count_;
       info_.expected_frames = end > options.first ? (end - options.first + options.stride - 1) / options.stride : 0;
     }
   }

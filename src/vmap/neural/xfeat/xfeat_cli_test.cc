@@ -131,7 +131,11 @@ TEST(VmapXfeat, WeightsKnowsXfeatAndItsLayouts) {
   // and then used from the cache.
   r = RunVmap("weights --import " + FoldedWeights() + " --model xfeat", env);
   EXPECT_NE(r.status, 0) << r.output;
-  EXPECT_NE(r.output.find("git blob id"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("is xfeat (folded layout), not the published xfeat.pt whose git blob id vmap checks; import "
+                          "it with --no-verify"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("corrupt"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(cache.path() / "xfeat.pt"));
   r = RunVmap("weights --import " + FoldedWeights() + " --model xfeat --no-verify", env);
   ASSERT_EQ(r.status, 0) << r.output;
