@@ -392,6 +392,18 @@ TEST(Cli, IntegersAreDecimalWithOrWithoutLeadingZeros) {
   EXPECT_FALSE(fs::exists(tmp.path() / "x"));
 }
 
+// A timestamps file that leaves a frame without a time gives the frames none, and says so: it was silent.
+TEST(Cli, ATimestampsFileThatMissesAFrameIsSaid) {
+  testing::ScopedTempDir tmp;
+  WriteSyntheticInput(tmp.path() / "in", 4);
+  std::ofstream(tmp.path() / "in" / "timestamps.txt") << "frame_1.png 0.0\nframe_2.png nan\nframe_3.png 0.2\n"
+                                                         "frame_4.png 0.3\n";
+  std::string out;
+  ASSERT_EQ(RunVmap("build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "m"), &out), 0) << out;
+  EXPECT_NE(out.find("gives no time to image 'frame_2.png' (line 2 is no 'NAME SECONDS')"), std::string::npos) << out;
+  EXPECT_LT(ReadMap(tmp.path() / "m").key_images.front().timestamp, 0.0) << "no frame has a time";
+}
+
 TEST(Cli, HelpListsCommandsAndFlagsUnderHeadings) {
   std::string out;
   ASSERT_EQ(RunVmap("--help", &out), 0) << out;

@@ -273,6 +273,7 @@ TEST(LocalizeCli, AbsurdOptionsAreRefusedBeforeAnyWork) {
       {"localize " + Quote(tmp.path() / "m") + " " + Quote(tmp.path() / "missing.mp4"), "does not exist"},
       {"route " + Quote(tmp.path() / "m") + " --min-backward-verified 2",
        "--min-backward-verified 2 is outside [8, 100000]"},
+      {"route " + Quote(tmp.path() / "m") + " --to -2", "--to -2 is"},
   };
   for (const Case& c : cases) {
     EXPECT_EQ(RunVmap(c.arguments, &out), 2) << c.arguments << "\n" << out;

@@ -1,5 +1,8 @@
 #include "vmap/mapping/recorded_options.h"
 
+#include <algorithm>
+#include <string>
+
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/error.h"
@@ -26,6 +29,29 @@ std::string DescribeMapOptions(const Matcher& matcher, const MapBuilderOptions& 
   return ToJson(record).dump();
 }
 
+namespace {
+
+// The key of the record that holds the field at `path` of an options struct: the record writes some nested structs'
+// fields at the top ("tau" for key_images.tau), so the path's shortest ending that the record has.
+std::string RecordKey(const nlohmann::json& record, const std::string& path) {
+  for (size_t from = 0; from < path.size();) {
+    const nlohmann::json* value = &record;
+    for (size_t at = from; value != nullptr && at <= path.size();) {
+      const size_t dot = std::min(path.find('.', at), path.size());
+      const std::string key = path.substr(at, dot - at);
+      value = value->is_object() && value->contains(key) ? &(*value)[key] : nullptr;
+      at = dot + 1;
+    }
+    if (value != nullptr) return path.substr(from);
+    const size_t dot = path.find('.', from);
+    if (dot == std::string::npos) break;
+    from = dot + 1;
+  }
+  return path;
+}
+
+}  // namespace
+
 RecordedOptions RecordedOptionsFromJson(const std::string& options_json, const std::string& where) {
   nlohmann::json record;
   try {
@@ -40,6 +66,18 @@ RecordedOptions RecordedOptionsFromJson(const std::string& options_json, const s
   const JsonFieldReader matcher = fields.Object("matcher");
   matcher.Read("type", &options.matcher_type);
   options.matcher_json = matcher.object().dump();
+  // A value no build takes (a hand edit) is the map's error, named by its key here, not later an option's error of
+  // the command reading the map ("map_tau 7 is outside [0, 1]" from localize, whose map_tau the user never gave).
+  const auto check = [&](const auto& recorded, const nlohmann::json& in, const std::string& at) {
+    try {
+      recorded.Check();
+    } catch (const OptionError& error) {
+      throw InputError(where + "." + at + RecordKey(in, error.path()) + " " + error.problem() +
+                       "; rebuild the map with `vmap build`");
+    }
+  };
+  check(options.builder, record, "");
+  check(options.source, record.value("source", nlohmann::json::object()), "source.");
   return options;
 }
 

@@ -142,6 +142,13 @@ TEST(RecordedOptions, AMalformedRecordNamesTheField) {
             "verified)");
   EXPECT_EQ(error(R"({"source": []})"), "map 'm/map.json': options.source must be a JSON object (it is array)");
   EXPECT_EQ(error("[1]"), "map 'm/map.json': options is not a JSON object (it is array)");
+  // Values no build takes: the map's error, by the record's key, where localize once blamed its own map_tau.
+  EXPECT_NE(error(R"({"tau": 7})").find("map 'm/map.json': options.tau 7 is outside (0, 1]"), std::string::npos)
+      << error(R"({"tau": 7})");
+  EXPECT_NE(error(R"({"tau": 7})").find("rebuild the map with `vmap build`"), std::string::npos);
+  EXPECT_NE(error(R"({"source": {"stride": 0}})").find("map 'm/map.json': options.source.stride 0 is less than 1"),
+            std::string::npos)
+      << error(R"({"source": {"stride": 0}})");
   EXPECT_EQ(error("{"), "map 'm/map.json': options is not valid JSON");
 }
 

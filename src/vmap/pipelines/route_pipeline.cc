@@ -5,6 +5,7 @@
 
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/file_name_encoding.h"
+#include "vmap/core/option_ranges.h"
 #include "vmap/map/map_io.h"
 #include "vmap/pipelines/output_policies.h"
 
@@ -55,7 +56,10 @@ void RoutePipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.VisitNested("", route);
 }
 
-void RoutePipelineOptions::Check() const { route.Check(); }
+void RoutePipelineOptions::Check() const {
+  CheckFieldRanges(*this);  // --to -2 was taken for the last key image
+  route.Check();
+}
 
 RoutePipelineResult RunRoutePipeline(const RoutePipelineOptions& options) {
   // 1. The options and the output.

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -63,24 +64,36 @@ void RequireExists(const fs::path& image, const std::string& list, int line) {
 }
 
 // "timestamps.txt" beside an image folder (or in its parent): "file_name seconds" per line.
-std::map<std::string, double> ReadTimestampsFile(const fs::path& directory) {
-  std::map<std::string, double> stamps;
+// An image folder's timestamps.txt ("NAME SECONDS" a line), in the folder or beside it.
+struct TimestampsFile {
+  fs::path path;
+  std::map<std::string, double> stamps;  // by file name
+  int first_bad_line = 0;                // the first line that is no "NAME SECONDS" of a finite time (0: none)
+};
+
+TimestampsFile ReadTimestampsFile(const fs::path& directory) {
+  TimestampsFile read;
   for (const fs::path& candidate : {directory / "timestamps.txt", directory.parent_path() / "timestamps.txt"}) {
     std::optional<std::istringstream> file = OptionalListFile(candidate, "timestamps file");
     if (!file) continue;
+    read = {candidate, {}, 0};
     std::istream& in = *file;
     std::string line;
-    while (std::getline(in, line)) {
+    for (int number = 1; std::getline(in, line); ++number) {
       line = Trim(line);
       if (line.empty() || line[0] == '#') continue;
       std::istringstream fields(line);
       std::string name;
       double seconds;
-      if (fields >> name >> seconds) stamps[fs::path(name).filename().string()] = seconds;
+      if (fields >> name >> seconds && std::isfinite(seconds)) {
+        read.stamps[fs::path(name).filename().string()] = seconds;
+      } else if (read.first_bad_line == 0) {
+        read.first_bad_line = number;
+      }
     }
-    if (!stamps.empty()) break;
+    if (!read.stamps.empty()) break;
   }
-  return stamps;
+  return read;
 }
 
 }  // namespace
@@ -132,9 +145,19 @@ std::vector<ImageEntry> ListImageFolder(const std::string& directory_text) {
                      "(mav0/cam0/data.csv) or KITTI (image_0/ + times.txt) sequence; point to the folder with the "
                      "frames, or give its format");
   }
-  const std::map<std::string, double> stamps = ReadTimestampsFile(directory);
-  const bool use_stamps = !stamps.empty() && std::all_of(names.begin(), names.end(),
-                                                         [&](const std::string& n) { return stamps.count(n) > 0; });
+  const TimestampsFile timestamps = ReadTimestampsFile(directory);
+  const std::map<std::string, double>& stamps = timestamps.stamps;
+  const auto unstamped =
+      std::find_if(names.begin(), names.end(), [&](const std::string& n) { return !stamps.count(n); });
+  const bool use_stamps = !stamps.empty() && unstamped == names.end();
+  if (!stamps.empty() && !use_stamps) {
+    // Every frame or none: a time for some frames only would make the pace jump where it is missing.
+    spdlog::warn("'{}' gives no time to image '{}'{}: the frames get no timestamps; fix the file",
+                 timestamps.path.string(), *unstamped,
+                 timestamps.first_bad_line > 0
+                     ? fmt::format(" (line {} is no 'NAME SECONDS')", timestamps.first_bad_line)
+                     : std::string());
+  }
   std::vector<ImageEntry> entries;
   entries.reserve(names.size());
   for (const std::string& name : names) {
@@ -182,11 +205,13 @@ std::vector<ImageEntry> ListEuroc(const std::string& data_csv) {
       throw InputError("'" + data_csv + "' line " + std::to_string(number) +
                        " is not 'timestamp_ns,filename' (EuRoC format); fix that line");
     }
+    // The whole field, in decimal: std::stoll took "12abc" for 12 and seconds ("1403636580.1") for 1403636580 ns.
+    const std::string field = Trim(line.substr(0, comma));
     long long nanoseconds = 0;
-    try {
-      nanoseconds = std::stoll(line.substr(0, comma));
-    } catch (const std::exception&) {
-      throw InputError("'" + data_csv + "' line " + std::to_string(number) + " has no integer timestamp");
+    const auto [end, error] = std::from_chars(field.data(), field.data() + field.size(), nanoseconds);
+    if (field.empty() || error != std::errc() || end != field.data() + field.size()) {
+      throw InputError("'" + data_csv + "' line " + std::to_string(number) + ": '" + field +
+                       "' is no timestamp in integer nanoseconds (EuRoC format); fix that line");
     }
     const std::string file = Trim(line.substr(comma + 1));
     RequireExists(images / file, data_csv, number);

@@ -373,6 +373,21 @@ TEST(Euroc, ReadsDataCsv) {
   EXPECT_NEAR(frames[2].timestamp - frames[0].timestamp, 0.1, 1e-6);
 }
 
+// A timestamp is the whole field in integer nanoseconds: std::stoll read "12abc" as 12 and seconds as nanoseconds.
+TEST(Euroc, ATimestampThatIsNoIntegerOfNanosecondsIsRefusedByItsLine) {
+  for (const char* stamp : {"12abc", "1403636580.100000", "0x10", ""}) {
+    testing::ScopedTempDir tmp;
+    const fs::path cam = tmp.path() / "mav0" / "cam0";
+    fs::create_directories(cam / "data");
+    cv::imwrite((cam / "data" / "a.png").string(), Sequence().frames[0]);
+    std::ofstream(cam / "data.csv") << "#timestamp [ns],filename\n" << stamp << ",a.png\n";
+    const std::string error = OpenError(tmp.path().string());
+    EXPECT_NE(error.find("line 2: '" + std::string(stamp) + "' is no timestamp in integer nanoseconds"),
+              std::string::npos)
+        << stamp << ": " << error;
+  }
+}
+
 TEST(Kitti, ReadsImage0AndTimes) {
   testing::ScopedTempDir tmp;
   fs::create_directories(tmp.path() / "image_0");
