@@ -23,6 +23,7 @@
 
 namespace vmap {
 namespace fs = std::filesystem;
+using testing::CliResult;
 using testing::Quote;
 using testing::ReadText;
 using testing::RunVmap;
@@ -207,6 +208,22 @@ TEST(OutputPromises, ReportsOfASingleImageNeedNotReadItAgain) {
   fs::remove(image);  // gone: the report of the run file must not need it
   ASSERT_EQ(RunVmap("report " + Quote(tmp.path() / "run.json") + " -o " + Quote(tmp.path() / "r2"), &out), 0) << out;
   EXPECT_NE(ReadText(tmp.path() / "r2/report.html").find("No frames to show"), std::string::npos);
+}
+
+// A run made with relative paths is reported from any folder: its map and query were looked for from where
+// `vmap report` ran and beside the run only, and the report said to build a map that exists.
+TEST(OutputPromises, ARunsReportIsMadeFromAnyFolder) {
+  testing::ScopedTempDir tmp;
+  BuildMap(tmp.path());
+  fs::create_directories(tmp.path() / "work" / "reps");
+  const std::string in_work = "cd " + Quote(tmp.path() / "work") + " &&";
+  CliResult run = RunVmap("localize ../m ../in/frame_3.png --report reps/r1", in_work);
+  ASSERT_EQ(run.status, 0) << run.output;
+  CliResult report = RunVmap("report r1/run.json -o again", "cd " + Quote(tmp.path() / "work" / "reps") + " &&");
+  ASSERT_EQ(report.status, 0) << report.output;
+  EXPECT_TRUE(fs::exists(tmp.path() / "work" / "reps" / "again" / "report.html"));
+  EXPECT_NE(ReadText(tmp.path() / "work" / "reps" / "again" / "report.html").find("../m"), std::string::npos)
+      << "the map named as the run named it";
 }
 
 // Names that are not UTF-8 are percent-encoded in every JSON vmap writes, as in map.json.

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <optional>
@@ -15,6 +16,7 @@
 #include "vmap/core/options_json.h"
 
 namespace vmap {
+namespace fs = std::filesystem;
 
 namespace {
 using nlohmann::json;
@@ -217,11 +219,18 @@ std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run
   doc["schema_version"] = kLocalizationSchemaVersion;
   doc["vmap_version"] = VMAP_VERSION;
   // Paths percent-encoded where they are not UTF-8, as in map.json (file_name_encoding.h).
+  const auto absolute = [](const std::string& path) {
+    std::error_code ec;
+    const std::string made = path.empty() ? "" : fs::absolute(path, ec).lexically_normal().string();
+    return ec ? path : made;
+  };
   doc["map"] = {{"directory", EncodeFileName(info.map_directory)},
+                {"absolute_directory", EncodeFileName(absolute(info.map_directory))},
                 {"key_images", map.key_images.size()},
                 {"matcher", info.matcher},
                 {"input", EncodeFileName(map.input.path)}};
   doc["query"] = {{"path", EncodeFileName(info.query)},
+                  {"absolute_path", EncodeFileName(absolute(info.query))},
                   {"format", SourceFormatName(info.query_format)},
                   {"first", info.source.first},
                   {"last", info.source.last},
@@ -283,9 +292,11 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
   try {
     const json& map = doc.at("map");
     run.info.map_directory = DecodeFileName(TextOr(map, "directory", "", RunPlace{file, "map"}));
+    run.info.map_absolute_directory = DecodeFileName(TextOr(map, "absolute_directory", "", RunPlace{file, "map"}));
     run.info.matcher = TextOr(map, "matcher", "", RunPlace{file, "map"});
     const json& query = doc.at("query");
     run.info.query = DecodeFileName(TextOr(query, "path", "", RunPlace{file, "query"}));
+    run.info.query_absolute_path = DecodeFileName(TextOr(query, "absolute_path", "", RunPlace{file, "query"}));
     run.info.query_format = ParseSourceFormat(TextOr(query, "format", "auto", RunPlace{file, "query"}));
     run.info.source.first = query.value("first", 0);
     run.info.source.last = query.value("last", -1);

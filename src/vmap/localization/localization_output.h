@@ -40,6 +40,9 @@ inline constexpr std::uint64_t kMaxRunJsonValues = 1ull << 24;
 struct LocalizationRunInfo {
   std::string map_directory;
   std::string query;  // the query's path as given
+  // The two as absolute paths where the run was made: a run read back elsewhere (`vmap report RUN.json` from another
+  // folder) finds them by these. Written from the two above; read back empty from a run that has none.
+  std::string map_absolute_directory, query_absolute_path;
   SourceFormat query_format = SourceFormat::kAuto;
   FrameSourceOptions source;        // first, last, stride, resize
   cv::Size frame_size;              // of the query frames as localized

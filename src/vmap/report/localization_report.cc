@@ -406,16 +406,21 @@ std::string WhyNotALocalizationReport(const fs::path& directory) {
 void WriteLocalizationReport(const fs::path& run_file, const fs::path& directory,
                              const LocalizationReportOptions& options) {
   LocalizationRun run = ReadLocalizationRun(run_file);
-  fs::path map_directory = run.info.map_directory;
-  if (!fs::exists(map_directory / kMapFileName) && map_directory.is_relative()) {
-    const fs::path beside = run_file.parent_path() / map_directory;
-    if (fs::exists(beside / kMapFileName)) map_directory = beside;
-  }
-  const fs::path query = run.info.query;
-  // A relative query is looked for beside the run too; a run that names none has none ("" beside it is its folder).
-  if (!query.empty() && !fs::exists(query) && query.is_relative() && fs::exists(run_file.parent_path() / query)) {
-    run.info.query = (run_file.parent_path() / query).string();
-  }
+  // A relative path is relative to where the run was made: looked for from here, beside the run, then as the absolute
+  // path the run recorded (a report made from another folder found neither, and advised building a map).
+  const auto locate = [&](const fs::path& given, const fs::path& absolute, const fs::path& marker) {
+    const auto found = [&](const fs::path& path) {
+      std::error_code ec;
+      return !path.empty() && fs::exists(marker.empty() ? path : path / marker, ec);
+    };
+    if (given.empty() || found(given) || !given.is_relative()) return given;
+    for (const fs::path& candidate : {run_file.parent_path() / given, absolute}) {
+      if (found(candidate)) return candidate;
+    }
+    return given;
+  };
+  const fs::path map_directory = locate(run.info.map_directory, run.info.map_absolute_directory, kMapFileName);
+  run.info.query = locate(run.info.query, run.info.query_absolute_path, "").string();
   const VisualMap map = ReadMap(map_directory);
   CheckRunFitsMap(run, map, run_file);
   CheckOutputDirectory(directory, ReportPolicy(map_directory, run.info.query, run_file));
