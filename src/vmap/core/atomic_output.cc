@@ -315,6 +315,13 @@ void AtomicOutputDirectory::CheckReplaceable(const fs::path& final_path, const O
              "lies inside the input '" + input.string() + "'; write the output somewhere else than into the input");
     }
   }
+  // Replaced, it would leave the shell that ran vmap in a removed folder, where `ls` shows nothing.
+  std::error_code here_ec;
+  const fs::path here = fs::current_path(here_ec);
+  if (!here_ec && IsSameOrInside(here, final_path)) {
+    Refuse(final_path, "is or holds the folder vmap runs in ('" + here.string() +
+                           "'), which replacing it would remove from under you; give another path, e.g. a new folder");
+  }
   std::error_code ec;
   const fs::file_status status = fs::symlink_status(final_path, ec);
   if (ec && status.type() != fs::file_type::not_found) {

@@ -160,6 +160,21 @@ TEST(AtomicOutput, ReplacingADirectoryKeepsWhatItHeldBesidesTheOutputsOwnFiles) 
   EXPECT_EQ(CountEntries(target), 1);
 }
 
+// `vmap build X -o .` in an empty folder replaced the folder the shell was in: its `ls` showed nothing after.
+TEST(AtomicOutput, NeverReplacesTheFolderItRunsInNorOneHoldingIt) {
+  testing::ScopedTempDir tmp;
+  const fs::path target = tmp.path() / "map";
+  fs::create_directories(target / "sub");
+  const fs::path before = fs::current_path();
+  for (const fs::path& here : {target, target / "sub"}) {
+    fs::current_path(here);
+    const std::string refusal = RefusalOf(target, MarkerPolicy());
+    fs::current_path(before);
+    EXPECT_NE(refusal.find("is or holds the folder vmap runs in"), std::string::npos) << here << ": " << refusal;
+  }
+  EXPECT_EQ(RefusalOf(target, MarkerPolicy()).find("runs in"), std::string::npos);
+}
+
 TEST(AtomicOutput, RefusesToReplaceAFileOrASymbolicLink) {
   testing::ScopedTempDir tmp;
   std::ofstream(tmp.path() / "file") << "x";

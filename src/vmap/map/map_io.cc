@@ -95,11 +95,11 @@ cv::Mat ReadCameraMask(const std::string& name, const Fields& fields, const fs::
   } catch (const cv::Exception&) {
   }
   if (mask.empty() || mask.type() != CV_8UC1 || mask.size() != frame_size) {
-    Malformed(file, "input.camera_mask '" + name + "' is not an 8-bit grey image that decodes; rebuild the map");
+    Malformed(file, "input.camera_mask '" + name + "' is not an 8-bit grey image that decodes");
   }
   mask = mask != 0;
   if (cv::countNonZero(mask) == 0) {
-    Malformed(file, "input.camera_mask '" + name + "' is black everywhere: no feature could be found; rebuild the map");
+    Malformed(file, "input.camera_mask '" + name + "' is black everywhere: no feature could be found");
   }
   return mask;
 }
