@@ -1,8 +1,10 @@
 #include "vmap/localization/localization_map.h"
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
+#include "vmap/core/error.h"
 #include "vmap/features/camera_mask.h"
 #include "vmap/features/matcher_options_json.h"
 #include "vmap/features/matcher_registry.h"
@@ -10,6 +12,26 @@
 #include "vmap/mapping/recorded_options.h"
 
 namespace vmap {
+
+namespace {
+
+// The map's camera_mask.png against the digest its matcher's record keeps ("1226x370 91.8% 40a71bd7e5820fc9"): a
+// mask swapped since (another of the same size) would extract the frames elsewhere than the key images were. Only
+// where the record is of the same size: a mask given at another size was resized to the frames' before it was kept.
+void CheckRecordedMask(const CameraMask& mask, const std::string& matcher_json,
+                       const std::filesystem::path& directory) {
+  const nlohmann::json record = nlohmann::json::parse(matcher_json, nullptr, false);
+  if (!record.is_object() || !record.contains("camera_mask") || !record["camera_mask"].is_string()) return;
+  const std::string recorded = record["camera_mask"].get<std::string>(), kept = mask.Describe();
+  const auto size_of = [](const std::string& digest) { return digest.substr(0, digest.find(' ')); };
+  if (size_of(recorded) != size_of(kept) || recorded == kept) return;
+  throw InputError(fmt::format(
+      "map '{}': {} is not the mask the map was built with (its record says {}, the file is {}); put the map's mask "
+      "back, or rebuild the map with `vmap build`",
+      directory.string(), kCameraMaskFileName, recorded, kept));
+}
+
+}  // namespace
 
 LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, const KeyImageStoreOptions& options) {
   return OpenLocalizationMap(ReadRecordedMap(directory), directory, options);
@@ -25,8 +47,9 @@ LocalizationMap OpenLocalizationMap(RecordedMap read, const std::filesystem::pat
       CreateMatcher(MatcherOptionsFromJson(opened.options.matcher_json, (directory / kMapFileName).string()));
   // The frames are extracted within the mask the key images were (the robot's camera is the teach run's).
   if (!opened.map.camera_mask.empty()) {
-    opened.matcher = WithCameraMask(
-        std::move(opened.matcher), CameraMask(opened.map.camera_mask, "the map's " + std::string(kCameraMaskFileName)));
+    const CameraMask mask(opened.map.camera_mask, "the map's " + std::string(kCameraMaskFileName));
+    CheckRecordedMask(mask, opened.options.matcher_json, directory);
+    opened.matcher = WithCameraMask(std::move(opened.matcher), mask);
   }
   opened.experiences = opened.map.experiences;
   opened.keys = LoadKeyImageStore(directory, opened.map, *opened.matcher, options, opened.experiences);

@@ -106,6 +106,27 @@ TEST(LocalizePipeline, AMapBuiltWithinACameraMaskLocalizesWithinIt) {
   for (const cv::Point2f& p : frame_matches.points0) EXPECT_GE(p.x, size.width / 4 - 0.5f);
 }
 
+// A mask swapped for another of the same size since the build would extract the frames elsewhere than the key images
+// were: refused against the digest the map's record keeps, naming the file and the fix.
+TEST(LocalizePipeline, AMapWhoseCameraMaskWasSwappedIsRefused) {
+  const cv::Size size = testing::SidewaysDrive().frames.at(0).size();
+  cv::Mat mask(size, CV_8UC1, cv::Scalar(255));
+  mask.colRange(0, size.width / 4).setTo(0);
+  DriveOptions masked;
+  masked.camera_mask = mask;
+  Drive drive(masked);
+  mask.colRange(0, size.width / 2).setTo(0);
+  cv::imwrite((drive.map / kCameraMaskFileName).string(), mask);
+  try {
+    RunLocalizePipeline(drive.Options(), nullptr);
+    ADD_FAILURE() << "a swapped camera mask was accepted";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("camera_mask.png is not the mask the map was built with"),
+              std::string::npos)
+        << error.what();
+  }
+}
+
 // The robot's loop (one image at a time through the session) localizes every frame as the whole run does.
 TEST(LocalizePipeline, TheSessionFrameByFrameEqualsTheRun) {
   Drive drive;
