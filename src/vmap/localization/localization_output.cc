@@ -298,14 +298,17 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
     run.info.query = DecodeFileName(TextOr(query, "path", "", RunPlace{file, "query"}));
     run.info.query_absolute_path = DecodeFileName(TextOr(query, "absolute_path", "", RunPlace{file, "query"}));
     run.info.query_format = ParseSourceFormat(TextOr(query, "format", "auto", RunPlace{file, "query"}));
-    run.info.source.first = query.value("first", 0);
-    run.info.source.last = query.value("last", -1);
-    run.info.source.stride = query.value("stride", 1);
-    run.info.source.resize = query.value("resize", "");
-    run.info.source.topic = query.value("topic", "");
-    run.info.source.camera_topic = query.value("camera_topic", "");
+    // Read as ints are (IntOf): 4294967299 wrapped to 3 and 1e12 to a negative frame, named by no file or field.
+    const RunPlace in_query{file, "query"};
+    run.info.source.first = IntOr(query, "first", 0, in_query);
+    run.info.source.last = IntOr(query, "last", -1, in_query);
+    run.info.source.stride = IntOr(query, "stride", 1, in_query);
+    run.info.source.resize = TextOr(query, "resize", "", in_query);
+    run.info.source.topic = TextOr(query, "topic", "", in_query);
+    run.info.source.camera_topic = TextOr(query, "camera_topic", "", in_query);
     if (query.contains("frame_size") && query["frame_size"].size() == 2) {
-      run.info.frame_size = {query["frame_size"][0].get<int>(), query["frame_size"][1].get<int>()};
+      run.info.frame_size = {IntOf(query["frame_size"][0], "frame_size", in_query),
+                             IntOf(query["frame_size"][1], "frame_size", in_query)};
     }
     run.info.ranking = doc.value("ranking", "");
     run.info.cache = doc.value("key_image_cache", "");

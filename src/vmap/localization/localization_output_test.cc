@@ -288,6 +288,19 @@ TEST(LocalizationOutput, AnEditedRunNamesTheFieldItGotWrong) {
       std::string::npos);
   EXPECT_NE(error_of([](nlohmann::json& d) { d["query"]["path"] = 7; }).find("query.path must be a string"),
             std::string::npos);
+  // The query's range too: 4294967299 was frame 3, 1e12 a negative frame.
+  for (const nlohmann::json& first : {nlohmann::json(4294967299u), nlohmann::json(1e12)}) {
+    EXPECT_NE(error_of([&](nlohmann::json& d) {
+                d["query"]["first"] = first;
+              }).find("run.json': query.first must be a whole number"),
+              std::string::npos)
+        << first;
+  }
+  // A run records its map and query as absolute paths too, read back beside the paths as given.
+  ASSERT_EQ(error_of([](nlohmann::json&) {}), "accepted");
+  const LocalizationRun back = ReadLocalizationRun(file);
+  EXPECT_TRUE(fs::path(back.info.map_absolute_directory).is_absolute()) << back.info.map_absolute_directory;
+  EXPECT_TRUE(fs::path(back.info.query_absolute_path).is_absolute()) << back.info.query_absolute_path;
   EXPECT_NE(error_of([](nlohmann::json& d) {
               d["frames"][0]["belief"] = {{0.5, 0.5}};
             }).find("frames[0].belief's key must be a whole number"),
