@@ -404,6 +404,20 @@ TEST(Cli, ATimestampsFileThatMissesAFrameIsSaid) {
   EXPECT_LT(ReadMap(tmp.path() / "m").key_images.front().timestamp, 0.0) << "no frame has a time";
 }
 
+// CLI11's words where they read badly: a flag given twice ("At Most 1 required but received 2"), and arguments not
+// expected, which it listed backwards ("0.3 --tua").
+TEST(Cli, AFlagGivenTwiceAndArgumentsNotExpectedAreSaidPlainly) {
+  testing::ScopedTempDir tmp;
+  WriteSyntheticInput(tmp.path() / "in", 2);
+  const std::string build = "build " + Quote(tmp.path() / "in") + " -o " + Quote(tmp.path() / "m");
+  std::string out;
+  EXPECT_EQ(RunVmap(build + " --last 1 --last 0", &out), 2);
+  EXPECT_NE(out.find("vmap: error: --last is given 2 times; give it once"), std::string::npos) << out;
+  EXPECT_EQ(RunVmap(build + " --tua 0.3", &out), 2);
+  EXPECT_NE(out.find("these arguments were not expected: --tua 0.3;"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(tmp.path() / "m"));
+}
+
 TEST(Cli, HelpListsCommandsAndFlagsUnderHeadings) {
   std::string out;
   ASSERT_EQ(RunVmap("--help", &out), 0) << out;

@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);  // --help, --version
     std::fprintf(stderr, "vmap: error: %s; see `vmap --help` or `vmap COMMAND --help`\n",
-                 vmap::TerminalSafe(e.what()).c_str());
+                 vmap::TerminalSafe(vmap::cli::ParseErrorText(e, app)).c_str());
     return 2;
   } catch (const vmap::InputError& e) {
     std::fprintf(stderr, "vmap: error: %s\n", vmap::TerminalSafe(vmap::NameOutputsNotTemporaries(e.what())).c_str());

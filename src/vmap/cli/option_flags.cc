@@ -1,6 +1,7 @@
 #include "vmap/cli/option_flags.h"
 
 #include <algorithm>
+#include <regex>
 #include <stdexcept>
 #include <system_error>
 
@@ -61,6 +62,27 @@ void RefuseEmptyArguments(int argc, const char* const* argv) {
     }
     throw InputError("argument " + std::to_string(i) + " is empty; give a path or leave it out");
   }
+}
+
+std::string ParseErrorText(const CLI::ParseError& error, const CLI::App& app) {
+  const std::string text = error.what();
+  static const std::regex given_twice(R"(^(.+): At Most 1 required but received (\d+)$)");
+  std::smatch found;
+  if (dynamic_cast<const CLI::ArgumentMismatch*>(&error) != nullptr && std::regex_match(text, found, given_twice)) {
+    return found[1].str() + " is given " + found[2].str() + " times; give it once";
+  }
+  if (dynamic_cast<const CLI::ExtrasError*>(&error) != nullptr) {
+    std::vector<std::string> extras = app.remaining();
+    for (const CLI::App* command : app.get_subcommands()) {
+      for (const std::string& extra : command->remaining()) extras.push_back(extra);
+    }
+    if (!extras.empty()) {
+      std::string listed;
+      for (const std::string& extra : extras) listed += (listed.empty() ? "" : " ") + extra;
+      return (extras.size() > 1 ? "these arguments were not expected: " : "this argument was not expected: ") + listed;
+    }
+  }
+  return text;
 }
 
 void RefuseUnknownCommand(int argc, const char* const* argv, const std::vector<std::string>& commands) {

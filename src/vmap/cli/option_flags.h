@@ -23,6 +23,11 @@ void RefuseEmptyArguments(int argc, const char* const* argv);
 // buidl"): CLI11 would say only that a subcommand is required. The global options before it are flags alone.
 void RefuseUnknownCommand(int argc, const char* const* argv, const std::vector<std::string>& commands);
 
+// CLI11's message for `error` in vmap's words where it reads badly: a flag given twice ("--last is given 2 times;
+// give it once", where CLI11 says "At Most 1 required but received 2"), and arguments not expected in the order they
+// were given (CLI11 lists them backwards). Otherwise CLI11's own. `app`: the application that threw it.
+std::string ParseErrorText(const CLI::ParseError& error, const CLI::App& app);
+
 // The message of a thread that could not start (std::system_error, "Resource temporarily unavailable"): this
 // user's process limit is reached. Other errors' own text.
 std::string ThreadErrorMessage(const std::exception& error);

@@ -249,10 +249,21 @@ std::unique_ptr<FrameSource> OpenDetectedFrameSource(const std::string& path, co
   }
   const SourceFormat format = DetectSourceFormat(path, options.format);
   std::optional<Camera> recording_camera;  // a recording's CameraInfo, read only when no --camera overrides it
-  std::unique_ptr<FrameSource> source =
-      format == SourceFormat::kRecording
-          ? internal::OpenRecordingSource(path, options, options.camera.empty() ? &recording_camera : nullptr)
-          : OpenDetected(path, p, format, options);
+  std::unique_ptr<FrameSource> source;
+  try {
+    source = format == SourceFormat::kRecording
+                 ? internal::OpenRecordingSource(path, options, options.camera.empty() ? &recording_camera : nullptr)
+                 : OpenDetected(path, p, format, options);
+  } catch (const OptionError&) {
+    throw;
+  } catch (const InputError& error) {
+    // A format given that the input is not ("--format tum video.mp4" said "line 1 is not 'timestamp filename'"): the
+    // format is at fault where the input looks like another.
+    const SourceFormat detected = DetectSourceFormat(path, SourceFormat::kAuto);
+    if (options.format == SourceFormat::kAuto || detected == format) throw;
+    throw OptionError("format", SourceFormatName(format) + ": " + error.what() + "; '" + path + "' looks like " +
+                                    SourceFormatName(detected) + ": give that format, or leave the format out");
+  }
   std::optional<Camera> camera;
   if (options.camera.empty()) {
     camera = format == SourceFormat::kRecording ? recording_camera : FindDatasetCamera(path, format);

@@ -118,6 +118,24 @@ TEST(ImageFolder, ACameraFoundWithTheInputThatDoesNotFitIsNotBlamedOnTheCameraOp
   EXPECT_THROW(OpenFrameSource(tmp.path().string(), given)->Next(), OptionError);
 }
 
+// A format given that the input is not is the format's error, naming the one the input looks like ("--format tum" on a
+// video said only that its line 1 is no 'timestamp filename').
+TEST(ImageFolder, AFormatTheInputIsNotIsTheFormatsError) {
+  testing::ScopedTempDir tmp;
+  testing::WriteImageFolder(Sequence(), tmp.path());
+  FrameSourceOptions options;
+  options.format = SourceFormat::kTum;
+  try {
+    OpenFrameSource(tmp.path().string(), options);
+    ADD_FAILURE() << "an image folder opened as TUM";
+  } catch (const OptionError& error) {
+    EXPECT_EQ(error.path(), "format");
+    EXPECT_NE(std::string(error.what()).find("looks like images: give that format, or leave the format out"),
+              std::string::npos)
+        << error.what();
+  }
+}
+
 TEST(ImageFolder, FirstLastStrideAndResize) {
   testing::ScopedTempDir tmp;
   testing::WriteImageFolder(Sequence(), tmp.path());
