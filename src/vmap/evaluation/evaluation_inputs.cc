@@ -50,12 +50,13 @@ Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option) 
     if (camera) spdlog::warn("the map records its camera, which is used; --camera is for maps that have none");
     return *map.input.camera;
   }
-  const std::string unreachable = WhyInputUnreachable(map);
-  if (!camera && !unreachable.empty()) {
-    throw OptionError("camera", "is needed: the map has no camera and " + unreachable +
-                                    "; give the intrinsics fx,fy,cx,cy (or a calibration file)");
+  if (!camera) {
+    if (const std::string unreachable = WhyInputUnreachable(map); !unreachable.empty()) {
+      throw OptionError("camera", "is needed: the map has no camera and " + unreachable +
+                                      "; give the intrinsics fx,fy,cx,cy (or a calibration file)");
+    }
+    camera = FindDatasetCamera(map.input.path, map.input.format);
   }
-  if (!camera) camera = FindDatasetCamera(map.input.path, map.input.format);
   if (!camera) {
     throw OptionError("camera", "is needed: the map has no camera and its input '" + map.input.path +
                                     "' brings none; give the intrinsics fx,fy,cx,cy (or a calibration file)");

@@ -15,6 +15,7 @@
 #include "vmap/features/camera_mask.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/features/orb_matcher.h"
+#include "vmap/localization/route.h"
 #include "vmap/sources/odometry.h"
 
 namespace vmap {
@@ -210,12 +211,9 @@ bool Localizer::PaceByTeachOdometry(const std::vector<OdometrySample>& teach_odo
 }
 
 void CheckStartKey(const VisualMap& map, const LocalizerOptions& options) {
-  const int key = options.start_key, num_keys = static_cast<int>(map.key_images.size());
+  const int key = options.start_key;
   if (key < 0) return;
-  if (key >= num_keys) {
-    throw OptionError("start_key",
-                      fmt::format("{} is no key image: the map has key images 0 to {}", key, num_keys - 1));
-  }
+  CheckKeyImageOption(map, key, "start_key");
   if (!options.route.empty() && std::find(options.route.begin(), options.route.end(), key) == options.route.end()) {
     throw OptionError("start_key", fmt::format("{} is not on the route (key images {} to {})", key,
                                                options.route.front(), options.route.back()));

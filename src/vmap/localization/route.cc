@@ -20,7 +20,7 @@ void RouteOptions::VisitFields(OptionFieldVisitor& visitor) {
 
 void RouteOptions::Check() const { CheckFieldRanges(*this); }
 
-void CheckRouteEnd(const VisualMap& map, int key, const char* field) {
+void CheckKeyImageOption(const VisualMap& map, int key, const char* field) {
   const int last = static_cast<int>(map.key_images.size()) - 1;
   if (key > last)
     throw OptionError(field, fmt::format("{} is no key image: the map has key images 0 to {}", key, last));

@@ -47,8 +47,8 @@ struct Route {
 // backwards, key images no link joins).
 Route PlanRoute(const VisualMap& map, int from, int to, const RouteOptions& options = {});
 
-// Throws OptionError of `field` (the options' "from" or "to") when `key` is no key image of `map`: before PlanRoute,
-// whose refusal cannot say which option named the key image. A negative key (the options' default) passes.
-void CheckRouteEnd(const VisualMap& map, int key, const char* field);
+// Throws OptionError of `field` (the options' "from", "to", "start_key") when `key` is no key image of `map`: before
+// PlanRoute, whose refusal cannot say which option named the key image. A negative key (the options' default) passes.
+void CheckKeyImageOption(const VisualMap& map, int key, const char* field);
 
 }  // namespace vmap

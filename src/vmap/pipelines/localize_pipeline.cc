@@ -143,8 +143,8 @@ void LocalizePipelineOptions::Check() const {
 std::vector<int> RouteOf(const VisualMap& map, const LocalizationSessionOptions& options, std::vector<int> route) {
   if (options.from < 0 && options.to < 0) return route;
   const int last = static_cast<int>(map.key_images.size()) - 1;
-  CheckRouteEnd(map, options.from, "from");
-  CheckRouteEnd(map, options.to, "to");
+  CheckKeyImageOption(map, options.from, "from");
+  CheckKeyImageOption(map, options.to, "to");
   return PlanRoute(map, options.from >= 0 ? options.from : 0, options.to >= 0 ? options.to : last).keys;
 }
 

@@ -77,12 +77,18 @@ struct Drive {
   }
 };
 
+// A camera mask of the drive's frames that hides their `columns` leftmost columns.
+cv::Mat MaskHiding(int columns) {
+  cv::Mat mask(testing::SidewaysDrive().frames.at(0).size(), CV_8UC1, cv::Scalar(255));
+  mask.colRange(0, columns).setTo(0);
+  return mask;
+}
+
 // A map built within a camera mask keeps it, and its key images and the frames are extracted within it: the
 // frames localize as they do on a map without one (the mask hides a quarter of a scene that has features there).
 TEST(LocalizePipeline, AMapBuiltWithinACameraMaskLocalizesWithinIt) {
   const cv::Size size = testing::SidewaysDrive().frames.at(0).size();
-  cv::Mat mask(size, CV_8UC1, cv::Scalar(255));
-  mask.colRange(0, size.width / 4).setTo(0);
+  const cv::Mat mask = MaskHiding(size.width / 4);
   DriveOptions masked;
   masked.camera_mask = mask;
   Drive drive(masked);
@@ -109,14 +115,11 @@ TEST(LocalizePipeline, AMapBuiltWithinACameraMaskLocalizesWithinIt) {
 // A mask swapped for another of the same size since the build would extract the frames elsewhere than the key images
 // were: refused against the digest the map's record keeps, naming the file and the fix.
 TEST(LocalizePipeline, AMapWhoseCameraMaskWasSwappedIsRefused) {
-  const cv::Size size = testing::SidewaysDrive().frames.at(0).size();
-  cv::Mat mask(size, CV_8UC1, cv::Scalar(255));
-  mask.colRange(0, size.width / 4).setTo(0);
+  const int width = testing::SidewaysDrive().frames.at(0).cols;
   DriveOptions masked;
-  masked.camera_mask = mask;
+  masked.camera_mask = MaskHiding(width / 4);
   Drive drive(masked);
-  mask.colRange(0, size.width / 2).setTo(0);
-  cv::imwrite((drive.map / kCameraMaskFileName).string(), mask);
+  cv::imwrite((drive.map / kCameraMaskFileName).string(), MaskHiding(width / 2));
   try {
     RunLocalizePipeline(drive.Options(), nullptr);
     ADD_FAILURE() << "a swapped camera mask was accepted";

@@ -71,8 +71,8 @@ RoutePipelineResult RunRoutePipeline(const RoutePipelineOptions& options) {
   result.map = ReadMap(options.map);
 
   // 3. The route.
-  CheckRouteEnd(result.map, options.from, "from");
-  CheckRouteEnd(result.map, options.to, "to");
+  CheckKeyImageOption(result.map, options.from, "from");
+  CheckKeyImageOption(result.map, options.to, "to");
   result.to = options.to >= 0 ? options.to : static_cast<int>(result.map.key_images.size()) - 1;
   result.route = PlanRoute(result.map, options.from, result.to, options.route);
   for (const std::string& warning : result.route.warnings) spdlog::warn("{}", warning);
