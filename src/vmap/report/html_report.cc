@@ -26,6 +26,9 @@ using report::DurationText;
 using report::FormatExact;
 using report::FormatFixed;
 using report::HtmlEscape;
+using report::IsMapReportFile;
+using report::kMatchFiguresFolder;
+using report::kThumbnailsFolder;
 using report::MapReportFiles;
 using report::Numbered;
 using report::OptionsSection;
@@ -151,7 +154,8 @@ std::string KeyImagesSection(const VisualMap& map, const MapReportFiles& assets)
                               (timestamp.empty() ? "" : " | t = " + timestamp);
     html << "<figure id=\"key-" << i << "\" title=\""
          << HtmlEscape(Displayable(k.source_name) + (k.reason.empty() ? "" : ": " + k.reason))
-         << "\"><img loading=\"lazy\" decoding=\"async\" src=\"" << AssetUrl("keys/" + Numbered(i)) << "\" width=\""
+         << "\"><img loading=\"lazy\" decoding=\"async\" src=\""
+         << AssetUrl(std::string(kThumbnailsFolder) + "/" + Numbered(i)) << "\" width=\""
          << assets.thumbnail_sizes[i].width << "\" height=\"" << assets.thumbnail_sizes[i].height
          << "\" alt=\"key image " << i << "\" data-label=\"" << HtmlEscape(label) << "\"><figcaption><b>#" << i
          << "</b> frame " << k.frame_index << (timestamp.empty() ? "" : " &middot; " + HtmlEscape(timestamp))
@@ -169,7 +173,7 @@ std::string RoutePreviewSection(const VisualMap& map, const MapReportFiles& asse
   if (!assets.video_file.empty()) {
     html << "<figure><video id=\"route-video\" src=\"" << AssetUrl(assets.video_file) << "\" width=\""
          << assets.video_size.width << "\" height=\"" << assets.video_size.height << "\" poster=\""
-         << AssetUrl("keys/" + Numbered(0))
+         << AssetUrl(std::string(kThumbnailsFolder) + "/" + Numbered(0))
          << "\" controls muted loop playsinline preload=\"metadata\"></video><figcaption class=\"note\">The key images "
             "in order, "
          << FormatExact(route_fps) << " per second (" << HtmlEscape(assets.video_file)
@@ -177,7 +181,8 @@ std::string RoutePreviewSection(const VisualMap& map, const MapReportFiles& asse
   }
   if (m > 0) {
     html << "<figure><img id=\"route-image\" alt=\"key image\" width=\"" << assets.thumbnail_sizes[0].width
-         << "\" height=\"" << assets.thumbnail_sizes[0].height << "\" src=\"" << AssetUrl("keys/" + Numbered(0))
+         << "\" height=\"" << assets.thumbnail_sizes[0].height << "\" src=\""
+         << AssetUrl(std::string(kThumbnailsFolder) + "/" + Numbered(0))
          << "\"><figcaption><div class=\"controls\"><button id=\"route-play\" type=\"button\">Play</button>"
          << "<input id=\"route-slider\" type=\"range\" min=\"0\" max=\"" << m - 1 << "\" value=\"0\" "
          << "aria-label=\"key image\"></div><span id=\"route-label\" class=\"note\"></span></figcaption></figure>\n";
@@ -198,7 +203,8 @@ std::string MatchFiguresSection(const VisualMap& map, const MapReportFiles& asse
     const Link& l = map.links[i];
     html << "<figure class=\"match-figure" << (l.below_tau ? " below-tau" : "") << "\" id=\"link-" << i
          << "\" data-from=\"" << l.from_key << "\" data-to=\"" << l.to_key << "\"><img loading=\"lazy\" "
-         << "decoding=\"async\" src=\"" << AssetUrl("links/" + Numbered(static_cast<int>(i))) << "\" width=\""
+         << "decoding=\"async\" src=\""
+         << AssetUrl(std::string(kMatchFiguresFolder) + "/" + Numbered(static_cast<int>(i))) << "\" width=\""
          << assets.figure_sizes[i].width << "\" height=\"" << assets.figure_sizes[i].height << "\" alt=\"link " << i
          << "\"><figcaption>" << (l.below_tau ? "BELOW &tau; &middot; " : "") << "Link " << i << ": "
          << HtmlEscape(LinkTitle(map, static_cast<int>(i))) << " &middot; S = " << FormatFixed(l.similarity, 3)
@@ -228,8 +234,12 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
   const MapStatistics stats = ComputeStatistics(map, read.options.builder.quality_mean);
   const std::optional<MapEvaluation> evaluation = ReadMatchingEvaluation(map_directory, map);
 
-  // Inside a map that ReadMap has just recognised as vmap's: the old report/ is vmap's too.
-  AtomicOutputDirectory assets_directory(map_directory / kReportAssetsDirectory, OutputPolicy::InsideVmapOutput());
+  // Inside a map that ReadMap has just recognised as vmap's: the old report/ is vmap's too. What a user put there
+  // besides the report's own files stays.
+  OutputPolicy assets_policy = OutputPolicy::InsideVmapOutput();
+  assets_policy.kind = "a map's report";
+  assets_policy.is_own_entry = IsMapReportFile;
+  AtomicOutputDirectory assets_directory(map_directory / kReportAssetsDirectory, assets_policy);
   const MapReportFiles assets = WriteMapReportFiles(map_directory, map, report_options, assets_directory.path());
 
   const std::string input_name =

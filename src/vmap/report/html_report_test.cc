@@ -152,6 +152,19 @@ TEST(MapReportTest, RewritingReplacesTheReportAndLeavesNoTemporaryFiles) {
   }
 }
 
+TEST(MapReportTest, RewritingKeepsWhatAUserPutInReportBesidesItsOwnFiles) {
+  ScopedTempDir temp;
+  const fs::path dir = temp.path() / "map";
+  report_test::WriteSyntheticMap(dir);
+  WriteMapReport(dir);
+  std::ofstream(dir / "report/notes.txt") << "the lighting changed at key 3";
+  std::ofstream(dir / "report/keys/stale.jpg") << "not the report's any more";
+  WriteMapReport(dir);
+  EXPECT_EQ(ReadText(dir / "report/notes.txt"), "the lighting changed at key 3");
+  EXPECT_FALSE(fs::exists(dir / "report/keys/stale.jpg"));  // keys/ is the report's own: replaced whole
+  EXPECT_TRUE(fs::exists(dir / "report/keys/000000.jpg"));
+}
+
 TEST(MapReportTest, MissingOrMalformedMapsGiveClearErrorsAndWriteNothing) {
   ScopedTempDir temp;
   const fs::path missing = temp.path() / "no_such_map";

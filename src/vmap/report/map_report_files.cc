@@ -23,8 +23,9 @@ class RouteVideo {
   RouteVideo(const fs::path& directory, const cv::Size& frame_size, double fps)
       // H.264 with 4:2:0 sampling needs even sides.
       : size_(std::max(2, frame_size.width & ~1), std::max(2, frame_size.height & ~1)) {
-    const std::pair<const char*, int> candidates[] = {{"route.mp4", cv::VideoWriter::fourcc('a', 'v', 'c', '1')},
-                                                      {"route.webm", cv::VideoWriter::fourcc('V', 'P', '9', '0')}};
+    const std::pair<const char*, int> candidates[] = {
+        {kRouteVideoNames[0], cv::VideoWriter::fourcc('a', 'v', 'c', '1')},
+        {kRouteVideoNames[1], cv::VideoWriter::fourcc('V', 'P', '9', '0')}};
     for (const auto& [name, fourcc] : candidates) {
       try {
         if (writer_.open((directory / name).string(), cv::CAP_FFMPEG, fourcc, fps, size_)) {
@@ -75,10 +76,18 @@ class RouteVideo {
 
 }  // namespace
 
+bool IsMapReportFile(const std::string& name) {
+  if (name == kThumbnailsFolder || name == kMatchFiguresFolder) return true;
+  for (const char* video : kRouteVideoNames) {
+    if (name == video) return true;
+  }
+  return false;
+}
+
 MapReportFiles WriteMapReportFiles(const fs::path& map_directory, const VisualMap& map, const MapReportOptions& options,
                                    const fs::path& directory) {
-  fs::create_directory(directory / "keys");  // not create_directories: see AtomicOutputDirectory::path()
-  fs::create_directory(directory / "links");
+  fs::create_directory(directory / kThumbnailsFolder);  // not create_directories: see AtomicOutputDirectory::path()
+  fs::create_directory(directory / kMatchFiguresFolder);
 
   // Consecutive links share a key image: keep the last two decoded. (cv::Mat copies share the pixels, so a
   // returned image stays valid after it leaves the cache.)
@@ -94,7 +103,7 @@ MapReportFiles WriteMapReportFiles(const fs::path& map_directory, const VisualMa
   std::unique_ptr<RouteVideo> video;
   for (size_t i = 0; i < map.key_images.size(); ++i) {
     const cv::Mat thumb = ScaledToWidth(key_image(static_cast<int>(i)), options.thumbnail_width);
-    WriteJpeg(directory / "keys" / Numbered(static_cast<int>(i)), thumb, options.jpeg_quality);
+    WriteJpeg(directory / kThumbnailsFolder / Numbered(static_cast<int>(i)), thumb, options.jpeg_quality);
     assets.thumbnail_sizes.push_back(thumb.size());
     if (i == 0 && options.route_video && map.key_images.size() > 1) {
       video = std::make_unique<RouteVideo>(directory, thumb.size(), options.route_fps);
@@ -113,7 +122,7 @@ MapReportFiles WriteMapReportFiles(const fs::path& map_directory, const VisualMa
     figure_options.max_width = options.figure_width;
     figure_options.title = "link " + std::to_string(i) + ": " + LinkTitle(map, static_cast<int>(i));
     const cv::Mat figure = DrawMatchFigure(key_image(l.from_key), key_image(l.to_key), l, figure_options);
-    WriteJpeg(directory / "links" / Numbered(static_cast<int>(i)), figure, options.jpeg_quality);
+    WriteJpeg(directory / kMatchFiguresFolder / Numbered(static_cast<int>(i)), figure, options.jpeg_quality);
     assets.figure_sizes.push_back(figure.size());
   }
   return assets;

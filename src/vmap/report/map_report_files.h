@@ -21,6 +21,16 @@ struct MapReportFiles {
   cv::Size video_size;
 };
 
+// The names of the entries WriteMapReportFiles writes: the thumbnails' folder, the figures' folder, the route
+// video under either of its names.
+inline constexpr const char* kThumbnailsFolder = "keys";
+inline constexpr const char* kMatchFiguresFolder = "links";
+inline constexpr const char* kRouteVideoNames[] = {"route.mp4", "route.webm"};
+
+// Whether an entry of report/, by its name, is one the report writes: a new report replaces those and keeps what
+// else a user put there.
+bool IsMapReportFile(const std::string& name);
+
 // Writes the key-image thumbnails, the route video and the match figures into `directory` (report/ while
 // it is being written).
 MapReportFiles WriteMapReportFiles(const std::filesystem::path& map_directory, const VisualMap& map,
