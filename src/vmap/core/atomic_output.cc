@@ -268,7 +268,8 @@ AtomicOutputDirectory::AtomicOutputDirectory(fs::path final_path, OutputPolicy p
   std::error_code missing;
   for (fs::path folder = parent; !folder.empty() && !fs::exists(fs::symlink_status(folder, missing));
        folder = folder.parent_path()) {
-    created_parents_.push_back(folder);
+    // "ghost/.." names no folder of its own: create_directories makes "ghost", the one to remove on failure.
+    if (folder.filename() != ".." && folder.filename() != ".") created_parents_.push_back(folder);
   }
   for (int attempt = 0; attempt < 100 && temp_path_.empty(); ++attempt) {
     const fs::path candidate = TemporarySibling(final_path_, "partial");

@@ -107,6 +107,10 @@ TEST(AtomicOutput, AnUncommittedDirectoryTakesTheFoldersCreatedForItWithIt) {
   { AtomicOutputDirectory dir(tmp.path() / "runs" / "today" / "map", MarkerPolicy()); }
   EXPECT_TRUE(fs::exists(tmp.path() / "runs"));
   EXPECT_EQ(CountEntries(tmp.path() / "runs"), 0);
+  // "ghost/../map": creating its parent made ghost/, which goes too.
+  fs::remove_all(tmp.path() / "runs");
+  { AtomicOutputDirectory dir(tmp.path() / "ghost" / ".." / "map", MarkerPolicy()); }
+  EXPECT_EQ(CountEntries(tmp.path()), 0);
   // Committed, they are the output's.
   {
     AtomicOutputDirectory dir(tmp.path() / "new" / "map", MarkerPolicy());
