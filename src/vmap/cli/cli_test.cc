@@ -416,6 +416,11 @@ TEST(Cli, AFlagGivenTwiceAndArgumentsNotExpectedAreSaidPlainly) {
   EXPECT_EQ(RunVmap(build + " --tua 0.3", &out), 2);
   EXPECT_NE(out.find("these arguments were not expected: --tua 0.3;"), std::string::npos) << out;
   EXPECT_FALSE(fs::exists(tmp.path() / "m"));
+  // The flag not expected is said before the input it left missing.
+  EXPECT_EQ(RunVmap("build -x", &out), 2);
+  EXPECT_NE(out.find("this argument was not expected: -x;"), std::string::npos) << out;
+  EXPECT_EQ(RunVmap("build", &out), 2);
+  EXPECT_NE(out.find("input is required"), std::string::npos) << out;
 }
 
 TEST(Cli, HelpListsCommandsAndFlagsUnderHeadings) {

@@ -176,6 +176,7 @@ TEST(Promises, AbsurdOptionsAreRefusedBeforeAnyWork) {
       {build + "--threads abc", "--threads"},
       {build + "--threads 99999999999999", "--threads"},
       {sweep + "--thresholds 0.1:0.9:1e-6", "gives 800001 thresholds, more than 100"},
+      {sweep + "--thresholds 0.1:0.9:1e-300", "gives 8e+299 thresholds, more than 100"},
       {sweep + "--thresholds 0.5,0.5", "gives tau = 0.5 twice"},
       {sweep + "--thresholds nan:1:0.1", "must be start:stop:step"},
       {sweep + "--thresholds 0.1:0.9:inf", "must be start:stop:step"},

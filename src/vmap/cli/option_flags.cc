@@ -71,7 +71,9 @@ std::string ParseErrorText(const CLI::ParseError& error, const CLI::App& app) {
   if (dynamic_cast<const CLI::ArgumentMismatch*>(&error) != nullptr && std::regex_match(text, found, given_twice)) {
     return found[1].str() + " is given " + found[2].str() + " times; give it once";
   }
-  if (dynamic_cast<const CLI::ExtrasError*>(&error) != nullptr) {
+  // An argument not expected explains a required one missing too (`vmap build -x`): it is said first.
+  if (dynamic_cast<const CLI::ExtrasError*>(&error) != nullptr ||
+      dynamic_cast<const CLI::RequiredError*>(&error) != nullptr) {
     std::vector<std::string> extras = app.remaining();
     for (const CLI::App* command : app.get_subcommands()) {
       for (const std::string& extra : command->remaining()) extras.push_back(extra);

@@ -27,7 +27,7 @@ std::vector<double> ParseThresholds(const std::string& text) {
     // allocated, so that a tiny step is refused rather than filling the memory.
     const double count = std::floor((stop - start) / step + 1e-9) + 1;
     if (count > kMaxThresholds) {
-      throw OptionError("thresholds", fmt::format("'{}' gives {:.0f} thresholds, more than {}; use a larger step", text,
+      throw OptionError("thresholds", fmt::format("'{}' gives {:.7g} thresholds, more than {}; use a larger step", text,
                                                   count, kMaxThresholds));
     }
     // 12 significant digits drop the sum's noise (0.1 + 2 * 0.1 is 0.30000000000000004) and keep a tiny tau tiny,
