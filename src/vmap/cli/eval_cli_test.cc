@@ -66,6 +66,14 @@ TEST(EvalCli, Kitti07LinksAreUsableAndTheReportShowsThem) {
   // Also written into the map, where the report finds it.
   ASSERT_TRUE(fs::exists(map / kEvaluationFileName));
   EXPECT_EQ(ReadEvaluation((map / kEvaluationFileName).string()).summary.usable_links, summary["usable_links"]);
+  // --json naming the map's own eval.json writes it once, as the map's; with --no-save it is refused.
+  fs::remove(map / kEvaluationFileName);
+  ASSERT_EQ(RunVmap("eval " + Quote(map) + " --json " + Quote(map / ".." / "map" / kEvaluationFileName), &out), 0)
+      << out;
+  EXPECT_EQ(ReadJson(map / kEvaluationFileName)["summary"], summary);
+  EXPECT_EQ(RunVmap("eval " + Quote(map) + " --no-save --json " + Quote(map / kEvaluationFileName), &out), 2);
+  EXPECT_NE(out.find("is the map's own evaluation, and --no-save asks to leave that as it is"), std::string::npos)
+      << out;
 
   ASSERT_EQ(RunVmap("report " + Quote(map) + " --no-video", &out), 0) << out;
   std::ifstream in(map / "report.html");

@@ -111,7 +111,7 @@ TEST(OutputPromises, SingleFileOutputsNeverReplaceAnInputOrASpecialFile) {
           {"route " + map + " --json /dev/null", "is not a regular file"},
           {"eval " + map + " --gt " + Quote(tmp.path() / "gt.txt") + " --json " + Quote(tmp.path() / "gt.txt"),
            "would overwrite the ground truth"},
-          {"eval " + map + " --json " + Quote(m / "eval.json"), "would overwrite the map's eval.json"},
+          {"eval " + map + " --no-save --json " + Quote(m / "eval.json"), "is the map's own evaluation"},
           {"match " + query + " " + Quote(in / "frame_2.png") + " --json " + Quote(tmp.path() / "hardlink.png"),
            "would overwrite the input image"},
           {"draw " + map + " --link 0 -o " + Quote(m / "keys/000001.png"), "lies inside the map's keys"},

@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/atomic_output.h"
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/map/map_io.h"
 #include "vmap/pipelines/output_policies.h"
@@ -53,7 +54,21 @@ void EvalPipelineOptions::Check() const {
 EvalPipelineResult RunEvalPipeline(const EvalPipelineOptions& options) {
   // 1. The options, the outputs, the camera option.
   options.Check();
-  CheckOutputs({{options.json, "json"}},
+  // `--json MAP/eval.json` names the file eval keeps in the map: it is written once, as the map's.
+  std::string json_output = options.json;
+  const fs::path json_folder =
+      fs::path(json_output).parent_path().empty() ? fs::path(".") : fs::path(json_output).parent_path();
+  if (!json_output.empty() && fs::path(json_output).filename() == kEvaluationFileName &&
+      IsSameOrInside(json_folder, options.map) && IsSameOrInside(options.map, json_folder)) {
+    if (!options.save) {
+      throw OptionError("json",
+                        "'" + options.json + "' is the map's own evaluation, and save asks to leave that as it is: " +
+                            "drop one of the two",
+                        {"save"});
+    }
+    json_output.clear();
+  }
+  CheckOutputs({{json_output, "json"}},
                {MapInputs(options.map), NamedInput(options.gt.path, "the ground truth"),
                 fs::is_regular_file(options.camera) ? NamedInput(options.camera, "the camera file")
                                                     : std::vector<OutputInput>{}});
@@ -92,7 +107,7 @@ EvalPipelineResult RunEvalPipeline(const EvalPipelineOptions& options) {
     saved.emplace(result.saved_to, json);
   }
   std::optional<PendingFile> json_file;
-  if (!options.json.empty()) json_file.emplace(options.json, json);
+  if (!json_output.empty()) json_file.emplace(json_output, json);
   if (saved) saved->Commit();
   if (json_file) json_file->Commit();
   return result;
