@@ -1,7 +1,8 @@
 #pragma once
 // Writers of one folder exclude each other: `vmap build --add-experience-to MAP` rewrites MAP/map.json and adds
 // MAP/experiences/<id>/, `vmap build -o MAP` replaces MAP, and two of them at once would each undo the other's
-// work (each reads map.json, then writes it back with only its own experience). Each writer holds an
+// work (each reads map.json, then writes it back with only its own experience); `vmap report MAP` writes a page
+// describing the map it read. Each writer holds an
 // exclusive flock(2) on the folder itself while it reads what it will change and writes it. The kernel drops
 // the lock when the process ends however it ends (a crash, SIGKILL), so no stale lock ever needs removing,
 // and nothing is added to the folder. Readers take no lock: writers only ever rename complete files into place.
