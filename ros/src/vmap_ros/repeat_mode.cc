@@ -212,6 +212,11 @@ void VmapNode::OnOdometry(const nav_msgs::Odometry::ConstPtr& odometry) {
 
 void VmapNode::PublishStop() { PublishCommand(geometry_msgs::Twist()); }
 
+void VmapNode::StopBetweenFrames() {
+  if (repeat_) repeat_->ControllerStopped();
+  PublishStop();
+}
+
 void VmapNode::PublishCommand(const geometry_msgs::Twist& command) {
   std::lock_guard<std::mutex> lock(command_mutex_);
   cmd_vel_.publish(halted_ ? geometry_msgs::Twist() : command);
@@ -245,7 +250,7 @@ void VmapNode::RepeatFrame(const Arrival& arrival) {
     LogMessageError(fmt::format("{}; frame skipped ({} so far)", error.what(), malformed_), error.what());
     // Not steered by what cannot be seen: the base would otherwise keep the last command for as long as the
     // camera sends frames that are no images.
-    if (mode == Mode::kRepeating) PublishStop();
+    if (mode == Mode::kRepeating) StopBetweenFrames();
     return;
   }
   // The controller's clock is the camera's (an odometry topic stamps by the same clock); the arrival time for a

@@ -46,6 +46,8 @@ class RepeatRun {
   const std::vector<OdometrySample>& teach_odometry() const { return session_.teach_odometry(); }
   // The controller starts again (after a pause): it commands nothing until a frame is localized.
   void ResetController() { controller_.Reset(); }
+  // The robot was stopped outside the controller (RouteController::Stopped).
+  void ControllerStopped() { controller_.Stopped(); }
 
   const VisualMap& map() const { return session_.map(); }
   const std::filesystem::path& directory() const { return session_.opened().directory; }

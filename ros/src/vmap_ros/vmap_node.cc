@@ -260,7 +260,7 @@ void VmapNode::StopIfCameraQuiet() {
     if (quiet < camera_timeout_) return;
   }
   std::lock_guard<std::mutex> run_lock(run_mutex_);  // no frame's command after this stop
-  PublishStop();
+  StopBetweenFrames();
   quiet_stopped_ = true;
   ROS_WARN("no camera frame on %s for %.1f s (~camera_timeout): the robot is stopped until frames come again",
            image_topic_.c_str(), quiet);
@@ -285,7 +285,7 @@ void VmapNode::Work() {
         std::lock_guard<std::mutex> lock(mutex_);
         repeating = mode_ == Mode::kRepeating;
       }
-      if (repeating) PublishStop();
+      if (repeating) StopBetweenFrames();
     }
   }
 }

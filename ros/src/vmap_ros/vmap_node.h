@@ -124,6 +124,9 @@ class VmapNode {
   void OnOdometry(const nav_msgs::Odometry::ConstPtr& odometry);
   void RepeatFrame(const Arrival& arrival);
   void PublishStop();
+  // A stop between two frames of a repeat run that the controller did not command (a frame that cannot be read, a
+  // quiet camera): the controller is told, so that it starts again from rest. Called with run_mutex_ held.
+  void StopBetweenFrames();
   // Every command goes out here: none but zero once HaltRobot() has run.
   void PublishCommand(const geometry_msgs::Twist& command);
   // A repeat run's camera that has sent no frame for ~camera_timeout seconds: the robot stops until frames come.

@@ -58,6 +58,12 @@ void RouteController::Reset() {
   search_direction_ = 1.0;
 }
 
+void RouteController::Stopped() {
+  last_time_.reset();  // the next step is a first one: from rest, with no time driven at the last command
+  last_command_ = {};
+  lost_speed_ = 0.0;
+}
+
 double RouteController::NominalSpeed(int position) const {
   const int last = static_cast<int>(route_.segments.size()) - 1;
   const TaughtSegment& segment = route_.segments[std::clamp(position, 0, last)];
@@ -86,10 +92,15 @@ double RouteController::TaughtTurnRate(int position, double speed) const {
 double RouteController::PastTheEnd(const cv::Vec3d& pose) const {
   const std::vector<OdometrySample>& path = route_.path;
   const cv::Point2d end(path.back().x, path.back().y);
-  cv::Point2d direction = end - cv::Point2d(path[path.size() - 2].x, path[path.size() - 2].y);
-  if (cv::norm(direction) <= 0.0) return 0.0;
-  direction /= cv::norm(direction);
-  return (cv::Point2d(pose[0], pose[1]) - end).dot(direction);
+  // The direction the teach run arrived in, from a sample a little before the end: a robot taught by hand stood at
+  // the goal for the last samples, which give none.
+  constexpr double kBaseline = 0.05;  // m
+  for (auto sample = path.rbegin() + 1; sample != path.rend(); ++sample) {
+    const cv::Point2d direction = end - cv::Point2d(sample->x, sample->y);
+    const double length = cv::norm(direction);
+    if (length >= kBaseline) return (cv::Point2d(pose[0], pose[1]) - end).dot(direction / length);
+  }
+  return 0.0;
 }
 
 double RouteController::RemainingTurn(int position, double progress) const {
@@ -100,10 +111,12 @@ double RouteController::RemainingTurn(int position, double progress) const {
   return turn * (1.0 - (std::isfinite(progress) ? std::clamp(progress, 0.0, 1.0) : 0.0));
 }
 
+double RouteController::GoalScaleSign() const { return route_.segments.back().backwards ? -1.0 : 1.0; }
+
 double RouteController::GoalLogScaleThreshold() const {
   const double tolerance = std::log1p(-options_.goal_scale_tolerance);
   // The last stretch's growth, where the map measured it: a share of it is a share of the stretch's length.
-  const double growth = route_.segments.back().log_scale;
+  const double growth = GoalScaleSign() * route_.segments.back().log_scale;
   if (!(growth < 0.0) || options_.goal_scale_share <= 0.0) return tolerance;
   return std::max(tolerance, options_.goal_scale_share * growth);
 }
@@ -139,7 +152,6 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
   double driven = last_command_.linear * dt;
   double turned = last_command_.angular * dt;
   if (odometry != nullptr) {
-    driven = turned = 0.0;
     if (last_odometry_) {
       const double dx = odometry->x - last_odometry_->x, dy = odometry->y - last_odometry_->y;
       const double middle = last_odometry_->yaw + 0.5 * WrapAngle(odometry->yaw - last_odometry_->yaw);
@@ -158,6 +170,10 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
       }
     }
     last_odometry_ = *odometry;
+  } else {
+    // The commands count the frames without odometry (a driver's dropout): the next sample begins a count of its
+    // own, or the odometry's step over the gap would count the gap's motion a second time.
+    last_odometry_.reset();
   }
   if (tracking_) tracking_->Predict(driven, turned);
   // Only frames verified at a key image of this route are steered by: a lost or uncertain frame's key images are
@@ -235,7 +251,8 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
       goal_log_scales_.push_back(step.goal_log_scale);
       if (goal_log_scales_.size() > kGoalFrames) goal_log_scales_.pop_front();
       if (goal_log_scales_.size() == kGoalFrames &&
-          Median(std::vector<double>(goal_log_scales_.begin(), goal_log_scales_.end())) >= GoalLogScaleThreshold()) {
+          GoalScaleSign() * Median(std::vector<double>(goal_log_scales_.begin(), goal_log_scales_.end())) >=
+              GoalLogScaleThreshold()) {
         reached_goal_ = true;
         step.steering = "none";
         return finish({}, ControllerState::kReachedGoal);

@@ -91,6 +91,11 @@ class RouteController {
   // Forgets everything: the next frame starts the run again (starting state).
   void Reset();
 
+  // The robot was told to stop outside the controller (a frame that could not be read, a camera gone quiet): the
+  // next command starts from rest, as a first one does, and the time stopped is not taken as driven at the last
+  // command. Where the robot is on the route stays.
+  void Stopped();
+
   const TaughtRoute& route() const { return route_; }
   const ControllerOptions& options() const { return options_; }
 
@@ -103,7 +108,11 @@ class RouteController {
   // share of it still ahead (1 - progress); 0 at the goal or where the turn is unknown.
   double RemainingTurn(int position, double progress) const;
   VelocityCommand Limit(VelocityCommand wanted, double dt) const;
-  // The goal's apparent log scale at and above which the goal is reached (goal_scale_tolerance, goal_scale_share).
+  // +1 where the goal's scene grows as the robot nears the goal, -1 where it shrinks: a route driven backwards
+  // reverses with the camera facing as it was taught, away from the goal.
+  double GoalScaleSign() const;
+  // The goal's apparent log scale, times GoalScaleSign(), at and above which the goal is reached
+  // (goal_scale_tolerance, goal_scale_share).
   double GoalLogScaleThreshold() const;
   // How far beyond the end of the metric path `pose` is, along its last stretch (m; negative before it).
   double PastTheEnd(const cv::Vec3d& pose) const;
