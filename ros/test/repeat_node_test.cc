@@ -296,6 +296,12 @@ TEST(RepeatNode, APauseAQuietCameraAndTheNodesEndStopTheRobot) {
   const size_t before = count();
   player = PlayBag(second, 1.0, dir.path() / "play2.log");
   ASSERT_TRUE(WaitFor([&] { return moving_since(before); }, std::chrono::seconds(60))) << node->Log();
+  {
+    // The controller was told of the stop: the first command after it starts from rest, as a first command does
+    // (it was the cruise speed again at once).
+    std::lock_guard<std::mutex> lock(published.mutex);
+    EXPECT_EQ(published.commands[before].linear.x, 0.0) << node->Log();
+  }
   EXPECT_EQ(node->Stop(std::chrono::seconds(30), SIGINT), 0) << node->Log();
   SpinFor(0.5);
   EXPECT_TRUE(last_is_stop()) << node->Log();
