@@ -10,6 +10,7 @@
 
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/folder_path.h"
 #include "vmap/core/number_text.h"
 #include "vmap/sources/dataset_camera.h"
 #include "vmap/sources/kitti_frame_number.h"
@@ -213,9 +214,9 @@ std::optional<GroundTruth> FindGroundTruth(const std::string& input_path, Source
       if (fs::is_regular_file(p / "poses.txt"))
         return ReadGroundTruth((p / "poses.txt").string(), GroundTruthFormat::kKitti);
       // The official layout: dataset/sequences/07/ and dataset/poses/07.txt.
-      const fs::path sequence = fs::absolute(p).lexically_normal();
-      const fs::path name = sequence.has_filename() ? sequence.filename() : sequence.parent_path().filename();
-      const fs::path official = sequence.parent_path().parent_path() / "poses" / (name.string() + ".txt");
+      const fs::path sequence = NormalizedFolderPath(p);
+      const fs::path official =
+          sequence.parent_path().parent_path() / "poses" / (sequence.filename().string() + ".txt");
       if (fs::is_regular_file(official)) return ReadGroundTruth(official.string(), GroundTruthFormat::kKitti);
       return std::nullopt;
     }

@@ -214,6 +214,12 @@ TEST(GroundTruth, FindsKittiPosesInTheOfficialLayout) {
       FindGroundTruth((tmp.path() / "dataset/sequences/07").string(), SourceFormat::kKitti);
   ASSERT_TRUE(truth);
   EXPECT_EQ(truth->camera_to_world.size(), 2u);
+  // The sequence named with a trailing slash (tab completion) or as "07/.": the same folder.
+  for (const char* name : {"dataset/sequences/07/", "dataset/sequences/07/."}) {
+    const std::optional<GroundTruth> same = FindGroundTruth((tmp.path() / name).string(), SourceFormat::kKitti);
+    ASSERT_TRUE(same) << name;
+    EXPECT_EQ(same->camera_to_world.size(), 2u) << name;
+  }
   EXPECT_EQ(ParseGroundTruthFormat("euroc"), GroundTruthFormat::kEuroc);
   EXPECT_THROW(ParseGroundTruthFormat("colmap"), InputError);
 }

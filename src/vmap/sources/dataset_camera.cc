@@ -15,6 +15,7 @@
 
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/folder_path.h"
 #include "vmap/core/number_text.h"
 #include "vmap/sources/internal.h"
 #include "vmap/sources/recording_reader.h"
@@ -297,7 +298,7 @@ std::string FindCalibrationFile(const std::string& input_path, SourceFormat form
       return existing((fs::is_directory(p) ? p : p.parent_path()) / "intrinsics.txt");
     case SourceFormat::kImageFolder: {
       std::string found = existing(p / "intrinsics.txt");
-      if (found.empty()) found = existing(p.parent_path() / "intrinsics.txt");
+      if (found.empty()) found = existing(NormalizedFolderPath(p).parent_path() / "intrinsics.txt");
       return found;
     }
     case SourceFormat::kVideo:

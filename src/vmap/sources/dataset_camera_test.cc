@@ -1,6 +1,7 @@
 #include "vmap/sources/dataset_camera.h"
 
 #include <fstream>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -9,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/sources/frame_source.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/shared_data.h"
 
@@ -178,6 +180,23 @@ TEST(DatasetCamera, ReadsColmapCamerasTxt) {
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
     }
+  }
+}
+
+// "run/images/" as tab completion writes it, and "run/images/.", are the folder "run/images": what lies beside it in
+// "run" (its times and its camera) is found as for "run/images" (the slash lost both, without a word).
+TEST(DatasetCamera, WhatLiesBesideAnImageFolderIsFoundHoweverTheFolderIsNamed) {
+  testing::ScopedTempDir tmp;
+  WriteImages(tmp.path() / "run/images", 3, {64, 48});
+  WriteText(tmp.path() / "run/intrinsics.txt", "fx 50\nfy 50\ncx 31.5\ncy 23.5\n");
+  WriteText(tmp.path() / "run/timestamps.txt", "000000.png 10.0\n000001.png 10.5\n000002.png 11.25\n");
+  for (const std::string name : {"run/images", "run/images/", "run/images/."}) {
+    auto source = OpenFrameSource((tmp.path() / name).string());
+    std::vector<double> times;
+    while (std::optional<Frame> frame = source->Next()) times.push_back(frame->timestamp);
+    EXPECT_EQ(times, (std::vector<double>{10.0, 10.5, 11.25})) << name;
+    ASSERT_TRUE(source->info().camera) << name;
+    EXPECT_DOUBLE_EQ(source->info().camera->fx, 50.0) << name;
   }
 }
 

@@ -16,6 +16,7 @@
 
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/folder_path.h"
 #include "vmap/core/number_text.h"
 #include "vmap/sources/internal.h"
 #include "vmap/sources/kitti_frame_number.h"
@@ -73,7 +74,8 @@ struct TimestampsFile {
 
 TimestampsFile ReadTimestampsFile(const fs::path& directory) {
   TimestampsFile read;
-  for (const fs::path& candidate : {directory / "timestamps.txt", directory.parent_path() / "timestamps.txt"}) {
+  for (const fs::path& candidate :
+       {directory / "timestamps.txt", NormalizedFolderPath(directory).parent_path() / "timestamps.txt"}) {
     std::optional<std::istringstream> file = OptionalListFile(candidate, "timestamps file");
     if (!file) continue;
     read = {candidate, {}, 0};
