@@ -44,16 +44,36 @@ int BayerCode(const std::string& encoding) {
   return -1;
 }
 
+// A depth camera's images (REP 118) have the encodings of no grey camera: a topic remapped to the depth image by
+// mistake localized as if its depths were grey levels, and steered the robot.
+constexpr const char* kGiveTheIntensityImage =
+    "vmap localizes by the intensity image: give the camera's colour or grey topic (mono8, mono16, rgb8, bgr8, ...)";
+
+void RefuseDepthImage(const std::string& encoding, const std::string& what) {
+  if (encoding == "16UC1" || encoding == "32FC1") {
+    throw InputError(what + " has image encoding '" + encoding + "', a depth image's (REP 118); " +
+                     kGiveTheIntensityImage);
+  }
+}
+
+// A CompressedImage's format names the image's encoding before a ';' ("16UC1; png compressed ",
+// compressed_image_transport's); compressed_depth_image_transport writes "16UC1; compressedDepth" (a header before
+// the PNG, or RVL) and older ones "compressedDepth" alone.
+void RefuseCompressedDepthImage(const std::string& format, const std::string& what) {
+  const size_t separator = format.find(';');
+  std::string encoding = format.substr(0, separator);
+  encoding.erase(0, encoding.find_first_not_of(' '));
+  encoding.erase(encoding.find_last_not_of(' ') + 1);
+  RefuseDepthImage(encoding, what);
+  if (format.find("compressedDepth") != std::string::npos) {
+    throw InputError(what + " has format '" + format + "', a compressed depth image's; " + kGiveTheIntensityImage);
+  }
+}
+
 DecodedImage ConvertRawImage(const RawImage& raw, const std::string& what) {
   int type = -1, code = -1;
   const std::string& e = raw.encoding;
-  // A depth camera's images (REP 118) have the encodings of no grey camera: a topic remapped to the depth image by
-  // mistake localized as if its depths were grey levels, and steered the robot.
-  if (e == "16UC1" || e == "32FC1") {
-    throw InputError(what + " has image encoding '" + e +
-                     "', a depth image's (REP 118); vmap localizes by the intensity image: give the camera's colour or "
-                     "grey topic (mono8, mono16, rgb8, bgr8, ...)");
-  }
+  RefuseDepthImage(e, what);
   if (e == "mono8" || e == "8UC1")
     type = CV_8UC1;
   else if (e == "mono16")
@@ -141,6 +161,7 @@ DecodedImage DecodeImageMessage(const uint8_t* data, size_t size, const std::str
     image = ConvertRawImage(ReadRawImage(buffer), what);
   } else {
     const std::string format = buffer.String();
+    RefuseCompressedDepthImage(format, what);
     size_t bytes = 0;
     const uint8_t* compressed = buffer.Bytes(&bytes);
     const cv::Mat encoded(1, static_cast<int>(std::min<size_t>(bytes, INT32_MAX)), CV_8UC1,

@@ -111,6 +111,28 @@ TEST(RosImageMessages, CompressedJpegAndPng) {
   }
 }
 
+// A depth topic through compressed_image_transport ("16UC1; png compressed ") or compressed_depth_image_transport
+// is refused as its raw images are, whatever the PNG decodes to; the colour transport's formats are read.
+TEST(RosImageMessages, ACompressedDepthImageIsRefusedAsItsRawImagesAre) {
+  cv::Mat depth(48, 64, CV_16UC1, cv::Scalar(1500));
+  std::vector<uint8_t> png;
+  cv::imencode(".png", depth, png);
+  for (MessageEncoding encoding : kEncodings) {
+    for (const char* format :
+         {"16UC1; png compressed ", "32FC1; compressedDepth", "16UC1; compressedDepth png", "compressedDepth"}) {
+      const std::vector<uint8_t> data = testing::SerializeCompressedImage(encoding, 1.0, format, png);
+      try {
+        Decode(data, encoding, kCompressedImageType);
+        ADD_FAILURE() << format << " decoded";
+      } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("depth image's"), std::string::npos) << e.what();
+      }
+    }
+    const std::vector<uint8_t> colour = testing::SerializeCompressedImage(encoding, 1.0, "bgr8; png compressed ", png);
+    EXPECT_FALSE(Decode(colour, encoding, kCompressedImageType).gray.empty());
+  }
+}
+
 // A compressed image of a few bytes may announce 32000 x 32000 pixels (a gigabyte once decoded): refused by its
 // header, before the decoder allocates anything.
 TEST(RosImageMessages, ACompressedImageAnnouncingTooManyPixelsIsRefusedByItsHeader) {
