@@ -160,6 +160,19 @@ std::vector<ImageEntry> ListImageFolder(const std::string& directory_text) {
                      ? fmt::format(" (line {} is no 'NAME SECONDS')", timestamps.first_bad_line)
                      : std::string());
   }
+  // The times say the order the frames were taken in, where the names sort otherwise (names that are not in the
+  // order of capture: "b_1.png" after "a_2.png").
+  if (use_stamps) {
+    const auto earlier = [&](const std::string& x, const std::string& y) { return stamps.at(x) < stamps.at(y); };
+    const auto out_of_order = std::is_sorted_until(names.begin(), names.end(), earlier);
+    if (out_of_order != names.end()) {
+      spdlog::info(
+          "the images of '{}' are taken in the order of their times in '{}': their names sort otherwise "
+          "('{}' after '{}')",
+          directory.string(), timestamps.path.string(), *out_of_order, *(out_of_order - 1));
+      std::stable_sort(names.begin(), names.end(), earlier);
+    }
+  }
   std::vector<ImageEntry> entries;
   entries.reserve(names.size());
   for (const std::string& name : names) {

@@ -69,6 +69,12 @@ TEST(NaturalSort, DigitRunsCompareAsNumbers) {
   EXPECT_TRUE(NaturalLess("1", "01"));  // equal value: shorter first, so the order is total
   EXPECT_FALSE(NaturalLess("same", "same"));
   EXPECT_TRUE(NaturalLess("x99999999999999999999999", "x100000000000000000000000"));
+  // Frames named by their times in seconds: the decimals compare as decimals.
+  EXPECT_TRUE(NaturalLess("1700000000.05.png", "1700000000.5.png"));
+  EXPECT_FALSE(NaturalLess("1700000000.9.png", "1700000000.15.png"));
+  EXPECT_TRUE(NaturalLess("1700000000.15.png", "1700000000.9.png"));
+  EXPECT_TRUE(NaturalLess("9.99.png", "10.05.png"));
+  EXPECT_TRUE(NaturalLess("frame.9.png", "frame.10.png"));  // no number before the point: numbers
 }
 
 TEST(ImageFolder, ReadsInNaturalOrder) {
@@ -289,6 +295,21 @@ TEST(ImageFolder, TimestampsThatAreNoSecondsOrNoFileAreRefused) {
   fs::remove(tmp.path() / "frames/timestamps.txt");
   ASSERT_EQ(mkfifo((tmp.path() / "frames/timestamps.txt").c_str(), 0600), 0);
   EXPECT_NE(OpenError((tmp.path() / "frames").string()).find("timestamps"), std::string::npos);
+}
+
+// The times in timestamps.txt say the order the frames were taken in, where the names sort otherwise.
+TEST(ImageFolder, FramesAreReadInTheOrderOfTheirTimesWhereTheNamesSortOtherwise) {
+  testing::ScopedTempDir tmp;
+  testing::WriteImageFolder(Sequence(), tmp.path() / "frames");  // frame_1.png .. frame_12.png
+  std::ofstream stamps(tmp.path() / "frames/timestamps.txt");
+  for (int i = 1; i <= 12; ++i) stamps << "frame_" << i << ".png " << (i % 2 == 0 ? 100.0 + i : 200.0 + i) << "\n";
+  stamps.close();
+  const auto frames = ReadAll(*OpenFrameSource((tmp.path() / "frames").string()));
+  ASSERT_EQ(frames.size(), 12u);
+  EXPECT_EQ(frames.front().source_name, "frame_2.png");
+  EXPECT_EQ(frames[5].source_name, "frame_12.png");
+  EXPECT_EQ(frames[6].source_name, "frame_1.png");
+  for (size_t i = 1; i < frames.size(); ++i) EXPECT_LT(frames[i - 1].timestamp, frames[i].timestamp) << i;
 }
 
 TEST(ImageFolder, AFolderOfOnlyBadFramesIsAClearError) {
