@@ -23,7 +23,7 @@ class IndexedFileReader : public RecordingReader {
     Rewind();
     std::vector<RecordingTopic> list = CountTopicsByReading([this](RecordedMessage* message, std::string* type) {
       if (!NextMessage(nullptr, message)) return false;
-      *type = type_of_last_;
+      *type = message->type;
       return true;
     });
     Rewind();
@@ -34,11 +34,9 @@ class IndexedFileReader : public RecordingReader {
   // The topics as the index at the file's end counts them, without reading the chunks; false when the file has no
   // index or it does not add up (the messages are then counted).
   virtual bool TopicsFromIndex(std::vector<RecordingTopic>* topics) = 0;
-  // The next message on `topics` (nullptr: every message, for a count), in stored order; false at the end. Sets
-  // type_of_last_.
+  // The next message on `topics` (nullptr: every message, for a count), in stored order, with its type; false at
+  // the end.
   virtual bool NextMessage(const std::set<std::string>* topics, RecordedMessage* message) = 0;
-
-  std::string type_of_last_;  // the type of the topic of the message NextMessage read last
 };
 
 }  // namespace vmap

@@ -312,7 +312,7 @@ class McapReader : public IndexedFileReader {
     const std::string& topic = channel->second.topic;
     if (topics && !topics->empty() && !topics->count(topic)) return false;
     const auto schema = schemas_.find(channel->second.schema);
-    type_of_last_ = schema == schemas_.end() ? "" : schema->second;
+    message->type = schema == schemas_.end() ? "" : schema->second;
     if (topics && channel->second.encoding != "cdr") {
       throw InputError("MCAP file '" + file_.path() + "': topic " + topic + " is encoded as '" +
                        channel->second.encoding + "'; vmap reads ROS 2 messages encoded as cdr");

@@ -31,6 +31,10 @@ struct RecordingTopic {
 
 struct RecordedMessage {
   std::string topic;
+  // The message's type as the recording names it for the message's connection or channel: a topic may have several,
+  // of other types (a publisher that changed type during the recording). Empty where the format names it per topic
+  // only (rosbag2).
+  std::string type;
   int64_t log_time_ns = 0;
   uint64_t offset = 0;  // where the message (or its chunk) is in the file: for messages naming the damage
   std::vector<uint8_t> data;

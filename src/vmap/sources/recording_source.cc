@@ -93,8 +93,15 @@ class RecordingSource : public FrameSource {
       if (index < options_.first || (index - options_.first) % options_.stride != 0) continue;
       DecodedImage image;
       const std::string name = MessageName(index, topic_.name, info_.path);
+      // Each message by its own connection's type: a topic may have had publishers of either image type.
+      const std::string& type = message.type.empty() ? topic_.type : message.type;
+      if (!IsImageType(type)) {
+        ++skipped_;
+        spdlog::warn("{} is a {}, not an image; skipping it", name, type);
+        continue;
+      }
       try {
-        image = DecodeImageMessage(message.data.data(), message.data.size(), topic_.type, reader_->encoding(), name);
+        image = DecodeImageMessage(message.data.data(), message.data.size(), type, reader_->encoding(), name);
       } catch (const InputError& error) {
         ++skipped_;
         spdlog::warn("{}; skipping it", error.what());

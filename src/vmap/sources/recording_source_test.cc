@@ -189,6 +189,40 @@ TEST(RecordingSource, TopicsAreListedAndChosen) {
 
 // A recording cut short, or with bytes overwritten, gives the frames before the damage (with a warning) or an
 // InputError naming the file; never a crash, never a read past the end.
+// A topic whose publisher changed type during the recording (raw, then compressed): each message is decoded by its
+// own channel's type (they were all decoded as the first one's, and half were skipped as truncated).
+TEST(RecordingSource, EachMessageIsDecodedByItsOwnChannelsType) {
+  testing::ScopedTempDir tmp;
+  std::vector<TestMessage> messages;
+  for (int i = 0; i < kFrames; ++i) {
+    const int64_t time = 1'000'000'000 + i * 100'000'000LL;
+    if (i < kFrames / 2) {
+      messages.push_back({"/cam/image", "sensor_msgs/Image", time,
+                          testing::SerializeImage(MessageEncoding::kCdr, Stamp(i), "cam", FrameImage(i), "bgr8")});
+    } else {
+      std::vector<uint8_t> png;
+      cv::imencode(".png", FrameImage(i), png);
+      messages.push_back({"/cam/image", "sensor_msgs/CompressedImage", time,
+                          testing::SerializeCompressedImage(MessageEncoding::kCdr, Stamp(i), "png", png)});
+    }
+  }
+  for (const bool summary : {true, false}) {  // the topics from the index, then counted by reading
+    const std::string path = (tmp.path() / (summary ? "indexed.mcap" : "cut.mcap")).string();
+    testing::WriteMcap(path, messages, "none", 4, summary);
+    FrameSourceOptions options;
+    options.topic = "/cam/image";
+    const std::vector<Frame> frames = ReadAll(path, options);
+    ASSERT_EQ(frames.size(), static_cast<size_t>(kFrames)) << path;
+    for (int i = 0; i < kFrames; ++i) {
+      cv::Mat grey;
+      cv::cvtColor(FrameImage(i), grey, cv::COLOR_BGR2GRAY);
+      ASSERT_EQ(frames[i].gray.size(), kSize) << path << " frame " << i;
+      EXPECT_LE(cv::norm(frames[i].gray, grey, cv::NORM_INF), 1.0) << path << " frame " << i;
+      EXPECT_DOUBLE_EQ(frames[i].timestamp, Stamp(i)) << path << " frame " << i;
+    }
+  }
+}
+
 TEST(RecordingSource, DamagedRecordingsGiveTheFramesBeforeTheDamageOrAnError) {
   testing::ScopedTempDir dir("recording_damage");
   for (const Container& container : kContainers) {

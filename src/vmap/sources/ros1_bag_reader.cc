@@ -294,7 +294,7 @@ class Ros1BagReader : public IndexedFileReader {
     const std::string& topic = connection->second.topic;
     if (topics && !topics->empty() && !topics->count(topic)) return false;
     message->topic = topic;
-    type_of_last_ = connection->second.type;
+    message->type = connection->second.type;
     const uint64_t time = header_.Number<uint64_t>("time", 8);  // uint32 seconds, then uint32 nanoseconds
     message->log_time_ns = static_cast<int64_t>(time & 0xffffffffu) * 1000000000 + static_cast<int64_t>(time >> 32);
     message->offset = offset;

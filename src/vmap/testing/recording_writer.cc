@@ -169,7 +169,7 @@ void WriteMcap(const std::string& path, const std::vector<TestMessage>& messages
   PutString(header, "ros2");
   PutString(header, "vmap-test");
   PutRecord(file, 0x01, header);
-  std::map<std::string, uint16_t> channels;
+  std::map<std::string, uint16_t> channels;  // a channel per topic and type, as a publisher per type would have
   std::string pending, chunk_indexes, definitions;
   std::set<uint16_t> in_chunk_channels;
   uint32_t chunk_count = 0;
@@ -214,10 +214,11 @@ void WriteMcap(const std::string& path, const std::vector<TestMessage>& messages
     in_chunk = 0;
   };
   for (const TestMessage& message : messages) {
-    auto channel = channels.find(message.topic);
+    const std::string channel_key = message.topic + '\n' + message.type;
+    auto channel = channels.find(channel_key);
     if (channel == channels.end()) {
       const auto id = static_cast<uint16_t>(channels.size() + 1);
-      channel = channels.emplace(message.topic, id).first;
+      channel = channels.emplace(channel_key, id).first;
       std::string schema, record;
       Put16(schema, id);
       PutString(schema, Ros2Type(message.type));
