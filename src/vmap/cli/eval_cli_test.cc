@@ -132,6 +132,29 @@ TEST(EvalCli, SweepWithGroundTruthAddsAUsableLinksColumn) {
   EXPECT_EQ(out.find("usable links"), std::string::npos) << out;
 }
 
+// A map built from a relative path is evaluated from any folder: it records the input's absolute path too.
+TEST(EvalCli, AMapBuiltFromARelativePathIsEvaluatedFromAnyFolder) {
+  testing::ScopedTempDir tmp;
+  testing::WriteKittiSequence(Synthetic(), tmp.path() / "seq");
+  fs::create_directory(tmp.path() / "elsewhere");
+  std::string out;
+  const testing::CliResult built = testing::RunVmap("build seq -q -o map", "cd " + Quote(tmp.path()) + " &&");
+  ASSERT_EQ(built.status, 0) << built.output;
+  EXPECT_EQ(ReadMap(tmp.path() / "map").input.path, "seq");
+  const testing::CliResult evaluated =
+      testing::RunVmap("eval ../map --no-table --no-save", "cd " + Quote(tmp.path() / "elsewhere") + " &&");
+  EXPECT_EQ(evaluated.status, 0) << evaluated.output;
+  EXPECT_NE(evaluated.output.find("usable links"), std::string::npos) << evaluated.output;
+  // Found neither from here nor where it was: both said.
+  fs::rename(tmp.path() / "seq", tmp.path() / "moved");
+  const testing::CliResult moved =
+      testing::RunVmap("eval ../map --no-table --no-save", "cd " + Quote(tmp.path() / "elsewhere") + " &&");
+  EXPECT_EQ(moved.status, 2) << moved.output;
+  EXPECT_NE(moved.output.find("'seq' is not found from here nor at '" + (tmp.path() / "seq").string() + "'"),
+            std::string::npos)
+      << moved.output;
+}
+
 TEST(EvalCli, CameraOptionAndMissingGroundTruthOrIntrinsics) {
   testing::ScopedTempDir tmp;
   const testing::SyntheticSequence sequence = Synthetic();
@@ -147,6 +170,7 @@ TEST(EvalCli, CameraOptionAndMissingGroundTruthOrIntrinsics) {
   for (const char* recorded : {"frames_elsewhere", ""}) {
     nlohmann::json doc = ReadJson(tmp.path() / "plain" / kMapFileName);
     doc["input"]["path"] = recorded;
+    doc["input"].erase("absolute_path");  // a map of before it was recorded
     std::ofstream(tmp.path() / "plain" / kMapFileName) << doc.dump();
     EXPECT_EQ(RunVmap("eval " + Quote(tmp.path() / "plain"), &out), 2) << out;
     EXPECT_NE(out.find(*recorded ? "'frames_elsewhere' is not found from here" : "the map records no input"),

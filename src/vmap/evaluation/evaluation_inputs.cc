@@ -32,17 +32,31 @@ std::optional<Camera> ParseEvaluationCamera(const std::string& camera_option) {
   return camera;
 }
 
-// Why the map's input cannot be looked into for what lies beside it (its ground truth, its calibration), or "": no
-// path recorded, or one not found from here (a relative path is relative to where the map was built).
-std::string WhyInputUnreachable(const VisualMap& map) {
-  if (map.input.path.empty()) return "the map records no input";
+namespace {
+
+// The map's input as found from here: its path as given where it names something from here, else the absolute path
+// the map recorded where that does (a relative path is relative to the folder the map was built in); "" when neither.
+std::string InputFromHere(const VisualMap& map) {
   std::error_code ec;
-  if (!fs::exists(map.input.path, ec)) {
-    return "the map's input '" + map.input.path +
-           "' is not found from here (a relative path is relative to the folder the map was built in: run there)";
+  for (const std::string& path : {map.input.path, map.input.absolute_path}) {
+    if (!path.empty() && fs::exists(path, ec)) return path;
   }
   return "";
 }
+
+// Why the map's input cannot be looked into for what lies beside it (its ground truth, its calibration), or "".
+std::string WhyInputUnreachable(const VisualMap& map) {
+  if (map.input.path.empty()) return "the map records no input";
+  if (InputFromHere(map).empty()) {
+    return "the map's input '" + map.input.path + "' is not found from here" +
+           (map.input.absolute_path.empty() ? std::string(" (a relative path is relative to the folder the map was "
+                                                          "built in: run there)")
+                                            : " nor at '" + map.input.absolute_path + "'");
+  }
+  return "";
+}
+
+}  // namespace
 
 Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option) {
   std::optional<Camera> camera = ParseEvaluationCamera(camera_option);
@@ -55,7 +69,7 @@ Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option) 
       throw OptionError("camera", "is needed: the map has no camera and " + unreachable +
                                       "; give the intrinsics fx,fy,cx,cy (or a calibration file)");
     }
-    camera = FindDatasetCamera(map.input.path, map.input.format);
+    camera = FindDatasetCamera(InputFromHere(map), map.input.format);
   }
   if (!camera) {
     throw OptionError("camera", "is needed: the map has no camera and its input '" + map.input.path +
@@ -72,7 +86,7 @@ GroundTruth MapGroundTruth(const VisualMap& map, const std::string& gt_path, Gro
   if (const std::string unreachable = WhyInputUnreachable(map); !unreachable.empty()) {
     throw OptionError("gt.path", "is needed: " + unreachable + "; or give a poses file");
   }
-  std::optional<GroundTruth> truth = FindGroundTruth(map.input.path, map.input.format);
+  std::optional<GroundTruth> truth = FindGroundTruth(InputFromHere(map), map.input.format);
   if (!truth) {
     throw OptionError("gt.path", "is needed: the map's input '" + map.input.path +
                                      "' has no ground truth beside it (KITTI poses.txt, TUM groundtruth.txt, EuRoC "

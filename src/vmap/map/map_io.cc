@@ -376,6 +376,10 @@ VisualMap ReadCheckedMap(const fs::path& directory) {
     fields.Object(*input, "input");
     map.input.path = DecodeFileName(fields.String(*input, "input", "path"));
     if (map.input.path.find('\0') != std::string::npos) fields.Fail("input.path", "holds a NUL character");
+    map.input.absolute_path = DecodeFileName(fields.String(*input, "input", "absolute_path"));
+    if (map.input.absolute_path.find('\0') != std::string::npos) {
+      fields.Fail("input.absolute_path", "holds a NUL character");
+    }
     const std::string format = fields.String(*input, "input", "format");
     try {
       map.input.format = ParseSourceFormat(format.empty() ? "auto" : format);

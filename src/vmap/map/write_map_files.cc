@@ -34,6 +34,7 @@ json MapDocument(const VisualMap& map, const std::vector<long>& offsets, bool wi
                   {"native_size", SizeJson(map.input.native_size)},
                   {"frame_size", SizeJson(map.input.frame_size)},
                   {"fps", map.input.fps}};
+  if (!map.input.absolute_path.empty()) doc["input"]["absolute_path"] = EncodeFileName(map.input.absolute_path);
   doc["input"]["camera"] = map.input.camera ? CameraToJson(*map.input.camera) : json(nullptr);
   if (!map.camera_mask.empty()) doc["input"]["camera_mask"] = kCameraMaskFileName;
   doc["conventions"] = MapConventionsJson();

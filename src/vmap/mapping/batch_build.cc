@@ -49,6 +49,7 @@ SweepResult RunSelectors(FrameSource& source, const Matcher& matcher, const MapB
   result.seconds = SecondsSince(start);
   result.options_json = options_json;
   result.input = frames.info();
+  result.input.absolute_path = AbsoluteInputPath(result.input.path);
   result.features_extracted = builder.features_extracted();
   result.pairs_matched = builder.pairs_matched();
   result.links_verified = builder.links_verified();

@@ -19,6 +19,7 @@ VisualMap CollectMap(const KeyImageSelector& selector, const FrameSource& source
                      const std::function<void()>& link_done) {
   VisualMap map;
   map.input = source.info();
+  map.input.absolute_path = AbsoluteInputPath(map.input.path);
   if (const CameraMask* mask = CameraMaskOf(matcher); mask && !map.input.frame_size.empty()) {
     map.camera_mask = mask->For(map.input.frame_size);
   }

@@ -12,6 +12,7 @@
 
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/folder_path.h"
 #include "vmap/core/image_decode.h"
 #include "vmap/core/json_fields.h"
 #include "vmap/core/option_ranges.h"
@@ -60,6 +61,12 @@ bool IsStreamUrl(const std::string& path) {
 }  // namespace internal
 
 bool IsLiveInput(const std::string& path) { return internal::IsStreamUrl(path) || path.rfind("/dev/video", 0) == 0; }
+
+std::string AbsoluteInputPath(const std::string& path) {
+  std::error_code ec;
+  if (path.empty() || IsLiveInput(path) || !fs::exists(path, ec)) return "";
+  return NormalizedFolderPath(path).string();
+}
 
 std::string FrameSizeProblem(const cv::Size& size, const FrameSourceOptions& options) {
   if (size.width < kMinFrameSide || size.height < kMinFrameSide) {

@@ -101,6 +101,9 @@ bool AspectRatiosDiffer(const cv::Size& a, const cv::Size& b);
 
 struct SequenceInfo {
   std::string path;  // as given by the user
+  // `path` made absolute where it named a file or folder when it was read (empty for a live input): a relative path
+  // is relative to the folder it was given in, and a map records both (AbsoluteInputPath).
+  std::string absolute_path;
   SourceFormat format = SourceFormat::kAuto;
   long expected_frames = -1;  // frames that will be delivered (after first/last/stride); -1 if unknown
   cv::Size native_size;       // the first frame's size as stored
@@ -126,6 +129,9 @@ class FrameSource {
 // rtsp://, rtsps://, tcp://, http://, https://, srt://), read through FFmpeg, or a V4L2 camera device
 // (/dev/video0), read through OpenCV. OpenFrameSource opens these too.
 bool IsLiveInput(const std::string& path);
+
+// `path` made absolute and normal where it names a file or folder from here; "" for a live input or one not found.
+std::string AbsoluteInputPath(const std::string& path);
 
 // Detects the layout of `path` (or uses options.format) and opens it. Throws InputError with a message
 // that names the path and says what to do when it cannot.
