@@ -2,8 +2,11 @@
 // services called in the wrong state. Each gets a clear answer or log line; the node keeps running, and nothing
 // on disk is lost.
 
+#include <atomic>
+#include <chrono>
 #include <csignal>
 #include <fstream>
+#include <functional>
 #include <mutex>
 #include <thread>
 
@@ -271,6 +274,79 @@ TEST(NodeErrors, RepeatCallsDuringATeachRunAndStartsAtOnceAreRefused) {
     Trigger(ns + (repeat.response.success ? "/vmap/repeat/stop" : "/vmap/teach/stop"), &success);
   }
   EXPECT_TRUE(node->Running()) << node->Log();
+  EXPECT_EQ(node->Stop(), 0) << node->Log();
+}
+
+// Starts and stops called at once from several clients while the camera sends frames: each service is answered on
+// a spinner thread of its own, and a stop that unsubscribed the camera while a start subscribed it corrupted the
+// node's memory (it crashed within seconds). The node stays up and a repeat run started afterwards is localized.
+TEST(NodeErrors, StartsAndStopsCalledAtOnceNeverBreakTheNode) {
+  SKIP_WITHOUT_SHARED();
+  ScopedTempDir dir("ros_transitions");
+  const std::string ns = "/transitions_test";
+  const fs::path bag = dir.path() / "teach.bag", map = dir.path() / "map";
+  WriteVideoBag(fs::path(SharedDir()) / "data/lab_floor/lab_floor.mp4", 0, 59, bag);
+  std::string output;
+  ASSERT_EQ(RunVmap("build -q " + Quote(bag) + " -o " + Quote(map), &output), 0) << output;
+  const auto node = StartVmapNode(ns, {"image:=/transitions/image_raw"}, dir.path() / "node.log");
+  ASSERT_TRUE(WaitForNodeServices(ns + "/vmap")) << node->Log();
+  ros::NodeHandle handle;
+  ros::Publisher images = handle.advertise<sensor_msgs::Image>("/transitions/image_raw", 10);
+  std::atomic<bool> done{false};
+  std::thread camera([&] {
+    for (double stamp = 1.0; !done; stamp += 0.02) {
+      images.publish(GreyImage(640, 480, stamp));
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+  const auto hammer = [&](const std::function<void()>& call) {
+    return std::thread([&, call] {
+      const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(8);
+      while (std::chrono::steady_clock::now() < end && node->Running()) call();
+    });
+  };
+  std::vector<std::thread> clients;
+  clients.push_back(hammer([&] {
+    vmap_ros::StartRepeat start;
+    start.request.map = map.string();
+    start.request.start = start.request.goal = -1;
+    ros::service::call(ns + "/vmap/repeat/start", start);
+  }));
+  clients.push_back(hammer([&] {
+    vmap_ros::StartTeach start;
+    start.request.map = (dir.path() / "taught").string();
+    ros::service::call(ns + "/vmap/teach/start", start);
+  }));
+  for (const char* stop : {"/vmap/repeat/stop", "/vmap/teach/stop", "/vmap/repeat/pause"}) {
+    clients.push_back(hammer([&, stop] {
+      std_srvs::Trigger call;
+      ros::service::call(ns + stop, call);
+    }));
+  }
+  for (std::thread& client : clients) client.join();
+  done = true;
+  camera.join();
+  ASSERT_TRUE(node->Running()) << node->Log();
+  bool success = false;
+  Trigger(ns + "/vmap/teach/stop", &success);
+  Trigger(ns + "/vmap/repeat/stop", &success);
+  vmap_ros::StartRepeat start;
+  start.request.map = map.string();
+  start.request.start = start.request.goal = -1;
+  ASSERT_TRUE(ros::service::call(ns + "/vmap/repeat/start", start));
+  EXPECT_TRUE(start.response.success) << start.response.message;
+  std::atomic<int> localized{0};
+  const ros::Subscriber localizations = handle.subscribe<vmap_ros::Localization>(
+      ns + "/vmap/localization", 10, [&](const vmap_ros::Localization::ConstPtr&) { ++localized; });
+  images.publish(GreyImage(640, 480, 100.0));
+  EXPECT_TRUE(WaitFor(
+      [&] {
+        images.publish(GreyImage(640, 480, 100.0 + 0.1 * localized));
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        return localized > 0;
+      },
+      kTimeout))
+      << node->Log();
   EXPECT_EQ(node->Stop(), 0) << node->Log();
 }
 

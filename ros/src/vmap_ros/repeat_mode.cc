@@ -49,6 +49,7 @@ double VmapNode::ReadCameraTimeout() const {
 bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::StartRepeat::Response& response) {
   if (const std::string busy = ClaimForStart(); !busy.empty()) return Fail(response, "repeat/start: " + busy);
   StartClaim claim(this);  // until the run is set: a start that fails gives the node back idle
+  const std::lock_guard<std::mutex> transition(transitions_mutex_);
   if (request.start < -1 || request.goal < -1) {
     return Fail(response, fmt::format("repeat/start: start {} and goal {}: each is a key image of the map, or -1 "
                                       "(the map's first, its last)",
@@ -152,6 +153,7 @@ bool VmapNode::ResumeRepeat(std_srvs::Trigger::Request&, std_srvs::Trigger::Resp
 }
 
 bool VmapNode::StopRepeat(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+  const std::lock_guard<std::mutex> transition(transitions_mutex_);
   int frames = 0;
   {
     std::lock_guard<std::mutex> run_lock(run_mutex_);  // the frame in progress ends first

@@ -26,6 +26,7 @@ constexpr int kTeachQueue = 60;
 bool VmapNode::StartTeach(vmap_ros::StartTeach::Request& request, vmap_ros::StartTeach::Response& response) {
   if (const std::string busy = ClaimForStart(); !busy.empty()) return Fail(response, "teach/start: " + busy);
   StartClaim claim(this);  // until the run is set: a start that fails gives the node back idle
+  const std::lock_guard<std::mutex> transition(transitions_mutex_);
   const std::string map = MapOf(request.map);
   if (map.empty()) return Fail(response, "teach/start: no map; give one in the request or set ~map");
   WarnAboutUnknownParameters(private_node_, KnownParameters());  // set since the node started, too
@@ -87,6 +88,14 @@ bool VmapNode::StartTeach(vmap_ros::StartTeach::Request& request, vmap_ros::Star
 }
 
 bool VmapNode::StopTeach(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+  {
+    // Said at once, not after the map being written.
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (mode_ == Mode::kFinishing) {
+      return Fail(response, "teach/stop: the teach run is stopping already; its map is being written");
+    }
+  }
+  const std::lock_guard<std::mutex> transition(transitions_mutex_);
   std::unique_ptr<TeachRun> run;
   {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -84,8 +84,10 @@ VmapNode::VmapNode(const ros::NodeHandle& node, const ros::NodeHandle& private_n
 bool VmapNode::Stop() {
   if (stopped_) return true;
   stopped_ = true;
+  stopping_ = true;  // no run starts from here on (ClaimForStart)
+  // A start or stop in progress ends first: a teach run it started is finished below, not dropped.
+  const std::lock_guard<std::mutex> transition(transitions_mutex_);
   // The worker first: a frame in progress publishes its command before the stop below, never after it.
-  stopping_ = true;
   mailbox_.Close();
   if (worker_.joinable()) worker_.join();
   std::unique_ptr<TeachRun> teach;
@@ -225,6 +227,7 @@ std::string VmapNode::Busy() const {
 
 std::string VmapNode::ClaimForStart() {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (stopping_) return "the node is stopping";
   if (mode_ != Mode::kIdle) return Busy();
   mode_ = Mode::kStarting;
   return "";

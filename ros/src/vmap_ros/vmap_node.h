@@ -156,6 +156,10 @@ class VmapNode {
   bool stopped_ = false;  // Stop() has run
   std::thread worker_;
 
+  // One start or stop of a run at a time, and Stop() after any in progress: the services are answered on several
+  // spinner threads, and a stop that unsubscribed while a start subscribed corrupted the subscribers (a crash), or
+  // left the new run without its camera. Taken before run_mutex_ and mutex_; the callbacks never take it.
+  std::mutex transitions_mutex_;
   // mutex_ guards mode_ and the runs' pointers. run_mutex_ is held while the worker processes a frame, so that a
   // service that ends a repeat run waits for its frame (taken first when both are needed).
   std::mutex run_mutex_;
