@@ -18,7 +18,9 @@ ImageInput ImageView(const py::object& object, const std::string& what) {
                             ", not a numpy array; give a uint8 image (HxW grey or HxWx3 BGR)");
   }
   const py::array array = py::reinterpret_borrow<py::array>(object);
-  if (!array.dtype().is(py::dtype::of<std::uint8_t>())) {
+  // By kind and size, not by the dtype object: an array that went through pickle (a multiprocessing queue) has an
+  // equal dtype of its own, and pybind11 2.10 has no dtype equality.
+  if (array.dtype().kind() != 'u' || array.dtype().itemsize() != 1) {
     // A type, as numpy's own casting errors are; the conversion depends on the values' range, which astype alone
     // does not scale (a float image in [0, 1] would become black).
     const char kind = array.dtype().kind();

@@ -336,6 +336,11 @@ def test_bad_input_raises_vmap_errors(tmp_path):
         vmap.match(image, image, matcher="sift")
     # No features: a result, not an error.
     assert vmap.match(image, image).num_tentative == 0
+    # An image that went through pickle (a multiprocessing queue) has a dtype object of its own: still uint8.
+    import pickle
+    unpickled = pickle.loads(pickle.dumps(image))
+    assert unpickled.dtype is not image.dtype
+    assert vmap.match(unpickled, image).num_tentative == 0
 
 
 def test_ctrl_c_interrupts_a_build(tmp_path):
