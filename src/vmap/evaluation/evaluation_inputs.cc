@@ -82,7 +82,10 @@ Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option) 
 }
 
 GroundTruth MapGroundTruth(const VisualMap& map, const std::string& gt_path, GroundTruthFormat format) {
-  if (!gt_path.empty()) return NameOptionErrorsWithin("gt", [&] { return ReadGroundTruth(gt_path, format); });
+  if (!gt_path.empty()) {
+    return NameOptionErrorsWithin(
+        "gt", [&] { return ReadGivenGroundTruth(gt_path, format, InputFromHere(map), map.input.format); });
+  }
   if (const std::string unreachable = WhyInputUnreachable(map); !unreachable.empty()) {
     throw OptionError("gt.path", "is needed: " + unreachable + "; or give a poses file");
   }

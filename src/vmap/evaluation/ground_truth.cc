@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
@@ -130,6 +131,18 @@ GroundTruthFormat DetectFormat(const std::string& text, const std::string& path)
                                   "qw' (TUM) or 'timestamp_ns,px,py,pz,qw,qx,qy,qz,...' (EuRoC); give the format");
 }
 
+// An EuRoC sequence's cam0 folder, from the input as given (the sequence, mav0/, or cam0/data.csv).
+fs::path EurocCam0(const fs::path& input) {
+  if (!fs::is_directory(input)) return input.parent_path();
+  return fs::exists(input / "mav0/cam0") ? input / "mav0/cam0" : input / "cam0";
+}
+
+// Where cam0 sits on the body (T_BS of its sensor.yaml); nullopt where the folder has none.
+std::optional<cv::Matx44d> EurocBodyToCamera(const fs::path& cam0) {
+  if (!fs::is_regular_file(cam0 / "sensor.yaml")) return std::nullopt;
+  return ReadEurocSensor((cam0 / "sensor.yaml").string()).T_BS;
+}
+
 }  // namespace
 
 GroundTruthFormat DetectGroundTruthFormat(const std::string& path) {
@@ -226,18 +239,34 @@ std::optional<GroundTruth> FindGroundTruth(const std::string& input_path, Source
       return std::nullopt;
     }
     case SourceFormat::kEuroc: {
-      fs::path cam0 =
-          fs::is_directory(p) ? (fs::exists(p / "mav0/cam0") ? p / "mav0/cam0" : p / "cam0") : p.parent_path();
+      const fs::path cam0 = EurocCam0(p);
       const fs::path file = cam0.parent_path() / "state_groundtruth_estimate0" / "data.csv";
       if (!fs::is_regular_file(file)) return std::nullopt;
-      cv::Matx44d body_to_camera = cv::Matx44d::eye();
-      if (fs::is_regular_file(cam0 / "sensor.yaml"))
-        body_to_camera = ReadEurocSensor((cam0 / "sensor.yaml").string()).T_BS;
-      return ReadGroundTruth(file.string(), GroundTruthFormat::kEuroc, body_to_camera);
+      return ReadGroundTruth(file.string(), GroundTruthFormat::kEuroc,
+                             EurocBodyToCamera(cam0).value_or(cv::Matx44d::eye()));
     }
     default:
       return std::nullopt;
   }
+}
+
+GroundTruth ReadGivenGroundTruth(const std::string& path, GroundTruthFormat format, const std::string& input_path,
+                                 SourceFormat input_format) {
+  if (format == GroundTruthFormat::kAuto) format = DetectGroundTruthFormat(path);
+  if (format != GroundTruthFormat::kEuroc) return ReadGroundTruth(path, format);
+  // mav0/state_groundtruth_estimate0/data.csv: mav0/cam0/sensor.yaml lies beside it.
+  std::optional<cv::Matx44d> body_to_camera =
+      EurocBodyToCamera(NormalizedFolderPath(path).parent_path().parent_path() / "cam0");
+  if (!body_to_camera && !input_path.empty() && input_format == SourceFormat::kEuroc) {
+    body_to_camera = EurocBodyToCamera(EurocCam0(input_path));
+  }
+  if (!body_to_camera) {
+    spdlog::warn(
+        "the EuRoC ground truth '{}' gives the body's (IMU's) poses, and no cam0/sensor.yaml beside it or in the "
+        "map's input says where the camera sits on the body (T_BS): the body's poses are taken as the camera's",
+        path);
+  }
+  return ReadGroundTruth(path, format, body_to_camera.value_or(cv::Matx44d::eye()));
 }
 
 std::optional<cv::Matx44d> KeyImagePose(const GroundTruth& truth, const KeyImage& key, double max_time_difference) {

@@ -53,6 +53,12 @@ GroundTruth ReadGroundTruth(const std::string& path, GroundTruthFormat format = 
 // state_groundtruth_estimate0/data.csv with its cam0/sensor.yaml. Nullopt when the input has none.
 std::optional<GroundTruth> FindGroundTruth(const std::string& input_path, SourceFormat format);
 
+// A ground-truth file the user gave (--gt): ReadGroundTruth, with EuRoC's body poses turned into cam0's by the T_BS of
+// the cam0/sensor.yaml beside it (mav0/cam0 for mav0/state_groundtruth_estimate0/data.csv) or, where none is, of the
+// input's (an EuRoC sequence); a warning where neither says it.
+GroundTruth ReadGivenGroundTruth(const std::string& path, GroundTruthFormat format, const std::string& input_path,
+                                 SourceFormat input_format);
+
 // The camera-to-world pose of a key image: by its file's frame number or source_index (kitti), or by timestamp. Nullopt
 // when the ground truth has no pose for it (past its end, no timestamp, or no pose within max_time_difference).
 std::optional<cv::Matx44d> KeyImagePose(const GroundTruth& truth, const KeyImage& key, double max_time_difference);

@@ -250,6 +250,15 @@ TEST(MapEvaluation, EurocBodyPosesAreTurnedIntoCameraPoses) {
   const std::string file = (tmp.path() / "euroc/mav0/state_groundtruth_estimate0/data.csv").string();
   const GroundTruth body = ReadGroundTruth(file, GroundTruthFormat::kEuroc);
   EXPECT_LT(EvaluateMap(map, body, *map.input.camera, EvaluationOptions()).summary.verified_within_mean, 0.5);
+  // The same file given as --gt: its cam0/sensor.yaml beside it says where the camera sits (it was taken as the
+  // body's poses, and the links looked bad).
+  ExpectAllUsable(
+      EvaluateMap(map, MapGroundTruth(map, file, GroundTruthFormat::kAuto), *map.input.camera, EvaluationOptions()));
+  // A copy elsewhere: the map's input (an EuRoC sequence) says it.
+  fs::copy_file(file, tmp.path() / "euroc_poses.csv");
+  ExpectAllUsable(EvaluateMap(map,
+                              MapGroundTruth(map, (tmp.path() / "euroc_poses.csv").string(), GroundTruthFormat::kEuroc),
+                              *map.input.camera, EvaluationOptions()));
 }
 
 TEST(MapEvaluation, OptionsAreCheckedAndTheDocumentRoundTrips) {
