@@ -1,5 +1,8 @@
 #include "vmap/pipelines/report_pipeline.h"
 
+#include <optional>
+
+#include "vmap/core/directory_lock.h"
 #include "vmap/report/localization_report.h"
 
 namespace vmap {
@@ -35,6 +38,11 @@ fs::path RunReportPipeline(const ReportPipelineOptions& options) {
     WriteLocalizationReport(target, output);
     return output / kReportFileName;
   }
+  // A writer of the map's folder: a rebuild replacing the map meanwhile waits, and so does the report for one under
+  // way, so that the page put in the map describes that map. (Not in WriteMapReport: a build writes its report into
+  // its own temporary, which it holds locked itself.)
+  std::optional<DirectoryWriteLock> writing;
+  if (fs::is_directory(target, ec)) writing.emplace(target, "the map");
   WriteMapReport(target, options.map_report);
   return target / kReportFileName;
 }

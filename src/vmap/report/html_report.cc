@@ -6,7 +6,6 @@
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/atomic_output.h"
-#include "vmap/core/directory_lock.h"
 #include "vmap/core/error.h"
 #include "vmap/core/option_ranges.h"
 #include "vmap/core/output_file.h"
@@ -227,9 +226,6 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
   // report.html is checked before report/ is replaced: a page that may not be replaced (a link, read-only) refuses
   // the report before anything is written.
   CheckOutputFiles({{map_directory / kReportFileName, kReportFileName}}, {});
-  // A writer of the map's folder: a rebuild replacing the map meanwhile waits, and so does this for one under way,
-  // so that the page put in the map describes that map.
-  const DirectoryWriteLock writing(map_directory, "the map");
   const RecordedMap read = ReadRecordedMap(map_directory);
   const VisualMap& map = read.map;
   // Every image path is checked before anything is written.

@@ -1,21 +1,16 @@
 #include "vmap/report/html_report.h"
 
 #include <algorithm>
-#include <atomic>
-#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <functional>
-#include <optional>
 #include <set>
-#include <thread>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "vmap/core/directory_lock.h"
 #include "vmap/core/error.h"
 #include "vmap/map/map_io.h"
 #include "vmap/report/report_assets.h"
@@ -168,25 +163,6 @@ TEST(MapReportTest, RewritingKeepsWhatAUserPutInReportBesidesItsOwnFiles) {
   EXPECT_EQ(ReadText(dir / "report/notes.txt"), "the lighting changed at key 3");
   EXPECT_FALSE(fs::exists(dir / "report/keys/stale.jpg"));  // keys/ is the report's own: replaced whole
   EXPECT_TRUE(fs::exists(dir / "report/keys/000000.jpg"));
-}
-
-TEST(MapReportTest, WaitsForAWriterOfTheMapAndWritesNothingMeanwhile) {
-  ScopedTempDir temp;
-  const fs::path dir = temp.path() / "map";
-  report_test::WriteSyntheticMap(dir);
-  const std::set<std::string> before = Listing(dir);
-  std::optional<DirectoryWriteLock> rebuild(std::in_place, dir, "the map");  // another writer, in effect
-  std::atomic<bool> done{false};
-  std::thread report([&] {
-    WriteMapReport(dir);
-    done = true;
-  });
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  EXPECT_FALSE(done);
-  EXPECT_EQ(Listing(dir), before);
-  rebuild.reset();
-  report.join();
-  EXPECT_TRUE(fs::is_regular_file(dir / kReportFileName));
 }
 
 TEST(MapReportTest, MissingOrMalformedMapsGiveClearErrorsAndWriteNothing) {
