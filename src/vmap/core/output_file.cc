@@ -24,15 +24,6 @@ bool SameFile(const fs::path& a, const fs::path& b) {
   return stat(a.c_str(), &sa) == 0 && stat(b.c_str(), &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
 }
 
-// Whether two outputs that may not exist yet name the same file: the same inode, or the same normalised path.
-bool SameOutput(const fs::path& a, const fs::path& b) {
-  if (SameFile(a, b)) return true;
-  std::error_code ec;
-  const fs::path ca = fs::weakly_canonical(fs::absolute(a, ec), ec);
-  const fs::path cb = fs::weakly_canonical(fs::absolute(b, ec), ec);
-  return !ca.empty() && ca == cb;
-}
-
 // A file inside the folder `folder` (at any depth, links not followed) that is `file` under another name: a hard
 // link. Only asked for an existing output that has several links, so the walk is rare.
 std::optional<fs::path> HardLinkInside(const fs::path& file, const fs::path& folder) {
@@ -80,6 +71,14 @@ std::string WhyNotCreatable(const fs::path& path) {
 }
 
 }  // namespace
+
+bool SameOutput(const fs::path& a, const fs::path& b) {
+  if (SameFile(a, b)) return true;
+  std::error_code ec;
+  const fs::path ca = fs::weakly_canonical(fs::absolute(a, ec), ec);
+  const fs::path cb = fs::weakly_canonical(fs::absolute(b, ec), ec);
+  return !ca.empty() && ca == cb;
+}
 
 std::string WhyNotReplaceable(const fs::path& path) {
   struct stat status;

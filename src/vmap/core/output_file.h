@@ -22,6 +22,10 @@ struct OutputInput {
   std::string what;
 };
 
+// Whether two outputs that may not exist yet name the same file: the same inode, or the same path once links, "." and
+// ".." are resolved.
+bool SameOutput(const std::filesystem::path& a, const std::filesystem::path& b);
+
 // Throws OptionError (an InputError) of the output's option, naming its path and what is in the way, when an
 // output (those with an empty path are skipped):
 // - resolves to an input or into a folder input (symbolic links, "..", hard links and bind mounts compared by

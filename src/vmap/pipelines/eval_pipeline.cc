@@ -7,7 +7,6 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/atomic_output.h"
-#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/map/map_io.h"
 #include "vmap/pipelines/output_policies.h"
@@ -56,10 +55,7 @@ EvalPipelineResult RunEvalPipeline(const EvalPipelineOptions& options) {
   options.Check();
   // `--json MAP/eval.json` names the file eval keeps in the map: it is written once, as the map's.
   std::string json_output = options.json;
-  const fs::path json_folder =
-      fs::path(json_output).parent_path().empty() ? fs::path(".") : fs::path(json_output).parent_path();
-  if (!json_output.empty() && fs::path(json_output).filename() == kEvaluationFileName &&
-      IsSameOrInside(json_folder, options.map) && IsSameOrInside(options.map, json_folder)) {
+  if (!json_output.empty() && SameOutput(json_output, fs::path(options.map) / kEvaluationFileName)) {
     if (!options.save) {
       throw OptionError("json",
                         "'" + options.json + "' is the map's own evaluation, and save asks to leave that as it is: " +

@@ -27,10 +27,8 @@ using report::FormatExact;
 using report::FormatFixed;
 using report::HtmlEscape;
 using report::IsMapReportFile;
-using report::kMatchFiguresFolder;
-using report::kThumbnailsFolder;
 using report::MapReportFiles;
-using report::Numbered;
+using report::MatchFigureFile;
 using report::OptionsSection;
 using report::OptionText;
 using report::PageEnd;
@@ -39,6 +37,7 @@ using report::ParseOptions;
 using report::Row;
 using report::SimilarityPlot;
 using report::SizeText;
+using report::ThumbnailFile;
 using report::TimestampText;
 using report::UrlPath;
 using report::VerifiedPlot;
@@ -154,8 +153,7 @@ std::string KeyImagesSection(const VisualMap& map, const MapReportFiles& assets)
                               (timestamp.empty() ? "" : " | t = " + timestamp);
     html << "<figure id=\"key-" << i << "\" title=\""
          << HtmlEscape(Displayable(k.source_name) + (k.reason.empty() ? "" : ": " + k.reason))
-         << "\"><img loading=\"lazy\" decoding=\"async\" src=\""
-         << AssetUrl(std::string(kThumbnailsFolder) + "/" + Numbered(i)) << "\" width=\""
+         << "\"><img loading=\"lazy\" decoding=\"async\" src=\"" << AssetUrl(ThumbnailFile(i)) << "\" width=\""
          << assets.thumbnail_sizes[i].width << "\" height=\"" << assets.thumbnail_sizes[i].height
          << "\" alt=\"key image " << i << "\" data-label=\"" << HtmlEscape(label) << "\"><figcaption><b>#" << i
          << "</b> frame " << k.frame_index << (timestamp.empty() ? "" : " &middot; " + HtmlEscape(timestamp))
@@ -173,7 +171,7 @@ std::string RoutePreviewSection(const VisualMap& map, const MapReportFiles& asse
   if (!assets.video_file.empty()) {
     html << "<figure><video id=\"route-video\" src=\"" << AssetUrl(assets.video_file) << "\" width=\""
          << assets.video_size.width << "\" height=\"" << assets.video_size.height << "\" poster=\""
-         << AssetUrl(std::string(kThumbnailsFolder) + "/" + Numbered(0))
+         << AssetUrl(ThumbnailFile(0))
          << "\" controls muted loop playsinline preload=\"metadata\"></video><figcaption class=\"note\">The key images "
             "in order, "
          << FormatExact(route_fps) << " per second (" << HtmlEscape(assets.video_file)
@@ -181,8 +179,7 @@ std::string RoutePreviewSection(const VisualMap& map, const MapReportFiles& asse
   }
   if (m > 0) {
     html << "<figure><img id=\"route-image\" alt=\"key image\" width=\"" << assets.thumbnail_sizes[0].width
-         << "\" height=\"" << assets.thumbnail_sizes[0].height << "\" src=\""
-         << AssetUrl(std::string(kThumbnailsFolder) + "/" + Numbered(0))
+         << "\" height=\"" << assets.thumbnail_sizes[0].height << "\" src=\"" << AssetUrl(ThumbnailFile(0))
          << "\"><figcaption><div class=\"controls\"><button id=\"route-play\" type=\"button\">Play</button>"
          << "<input id=\"route-slider\" type=\"range\" min=\"0\" max=\"" << m - 1 << "\" value=\"0\" "
          << "aria-label=\"key image\"></div><span id=\"route-label\" class=\"note\"></span></figcaption></figure>\n";
@@ -203,8 +200,7 @@ std::string MatchFiguresSection(const VisualMap& map, const MapReportFiles& asse
     const Link& l = map.links[i];
     html << "<figure class=\"match-figure" << (l.below_tau ? " below-tau" : "") << "\" id=\"link-" << i
          << "\" data-from=\"" << l.from_key << "\" data-to=\"" << l.to_key << "\"><img loading=\"lazy\" "
-         << "decoding=\"async\" src=\""
-         << AssetUrl(std::string(kMatchFiguresFolder) + "/" + Numbered(static_cast<int>(i))) << "\" width=\""
+         << "decoding=\"async\" src=\"" << AssetUrl(MatchFigureFile(static_cast<int>(i))) << "\" width=\""
          << assets.figure_sizes[i].width << "\" height=\"" << assets.figure_sizes[i].height << "\" alt=\"link " << i
          << "\"><figcaption>" << (l.below_tau ? "BELOW &tau; &middot; " : "") << "Link " << i << ": "
          << HtmlEscape(LinkTitle(map, static_cast<int>(i))) << " &middot; S = " << FormatFixed(l.similarity, 3)

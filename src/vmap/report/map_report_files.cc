@@ -76,6 +76,10 @@ class RouteVideo {
 
 }  // namespace
 
+std::string ThumbnailFile(int key) { return std::string(kThumbnailsFolder) + "/" + Numbered(key); }
+
+std::string MatchFigureFile(int link) { return std::string(kMatchFiguresFolder) + "/" + Numbered(link); }
+
 bool IsMapReportFile(const std::string& name) {
   if (name == kThumbnailsFolder || name == kMatchFiguresFolder) return true;
   for (const char* video : kRouteVideoNames) {
@@ -103,7 +107,7 @@ MapReportFiles WriteMapReportFiles(const fs::path& map_directory, const VisualMa
   std::unique_ptr<RouteVideo> video;
   for (size_t i = 0; i < map.key_images.size(); ++i) {
     const cv::Mat thumb = ScaledToWidth(key_image(static_cast<int>(i)), options.thumbnail_width);
-    WriteJpeg(directory / kThumbnailsFolder / Numbered(static_cast<int>(i)), thumb, options.jpeg_quality);
+    WriteJpeg(directory / ThumbnailFile(static_cast<int>(i)), thumb, options.jpeg_quality);
     assets.thumbnail_sizes.push_back(thumb.size());
     if (i == 0 && options.route_video && map.key_images.size() > 1) {
       video = std::make_unique<RouteVideo>(directory, thumb.size(), options.route_fps);
@@ -122,7 +126,7 @@ MapReportFiles WriteMapReportFiles(const fs::path& map_directory, const VisualMa
     figure_options.max_width = options.figure_width;
     figure_options.title = "link " + std::to_string(i) + ": " + LinkTitle(map, static_cast<int>(i));
     const cv::Mat figure = DrawMatchFigure(key_image(l.from_key), key_image(l.to_key), l, figure_options);
-    WriteJpeg(directory / kMatchFiguresFolder / Numbered(static_cast<int>(i)), figure, options.jpeg_quality);
+    WriteJpeg(directory / MatchFigureFile(static_cast<int>(i)), figure, options.jpeg_quality);
     assets.figure_sizes.push_back(figure.size());
   }
   return assets;

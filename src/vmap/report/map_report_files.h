@@ -27,6 +27,11 @@ inline constexpr const char* kThumbnailsFolder = "keys";
 inline constexpr const char* kMatchFiguresFolder = "links";
 inline constexpr const char* kRouteVideoNames[] = {"route.mp4", "route.webm"};
 
+// A key image's thumbnail and a link's match figure as named inside report/ ("keys/000012.jpg"): where
+// WriteMapReportFiles writes them and what the page links to.
+std::string ThumbnailFile(int key);
+std::string MatchFigureFile(int link);
+
 // Whether an entry of report/, by its name, is one the report writes: a new report replaces those and keeps what
 // else a user put there.
 bool IsMapReportFile(const std::string& name);
