@@ -55,6 +55,19 @@ cv::Matx44d FromRotationTranslation(const cv::Matx33d& R, const cv::Vec3d& t) {
   return T;
 }
 
+// KITTI prints its matrices to 6 or 7 digits, so their rotations are a rounding away from orthonormal; the
+// nearest rotation (Frobenius norm, from the SVD) keeps that rounding out of the relative poses built from them.
+cv::Matx44d WithNearestRotation(cv::Matx44d T) {
+  cv::Matx33d u, vt;
+  cv::Matx31d w;
+  cv::SVD::compute(cv::Matx33d(T.get_minor<3, 3>(0, 0)), w, u, vt);
+  const cv::Matx33d R = u * vt;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) T(r, c) = R(r, c);
+  }
+  return T;
+}
+
 }  // namespace
 
 cv::Matx33d QuaternionToRotation(double w, double x, double y, double z) {
@@ -183,7 +196,7 @@ GroundTruth ReadGroundTruth(const std::string& path, GroundTruthFormat format, c
         cv::Matx44d T = cv::Matx44d::eye();
         for (int i = 0; i < 12; ++i) T(i / 4, i % 4) = v[i];
         check(WhyNotAPose(T));
-        truth.camera_to_world.push_back(T);
+        truth.camera_to_world.push_back(WithNearestRotation(T));
         break;
       }
       case GroundTruthFormat::kTum: {

@@ -2,10 +2,12 @@
 
 #include <fstream>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 
 #include "vmap/core/error.h"
+#include "vmap/geometry/relative_pose.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/shared_data.h"
 
@@ -75,6 +77,33 @@ TEST(GroundTruth, RelativePoseMapsPointsFromTheFirstCameraToTheSecond) {
   const cv::Vec4d X_b = T_wb.inv() * X_w;
   const cv::Vec3d predicted = R * cv::Vec3d(X_a[0], X_a[1], X_a[2]) + t;
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(predicted[i], X_b[i], 1e-12);
+}
+
+// KITTI's rotations are printed to 6 digits. Read as they are, the relative rotation between two of them is a
+// rounding away from orthonormal, and a perfect estimate of it was scored some 0.005 degrees wrong.
+TEST(GroundTruth, KittiRotationsAreReadAsRotations) {
+  cv::Matx33d Ra, Rb;
+  cv::Rodrigues(cv::Vec3d(0.01, 1.2, -0.02), Ra);
+  cv::Rodrigues(cv::Vec3d(0.012, 1.25, -0.018), Rb);
+  std::string text;
+  for (const cv::Matx33d& R : {Ra, Rb}) {
+    for (int r = 0; r < 3; ++r) text += fmt::format("{:.6e} {:.6e} {:.6e} {} ", R(r, 0), R(r, 1), R(r, 2), r);
+    text += "\n";
+  }
+  testing::ScopedTempDir tmp;
+  WriteText(tmp.path() / "rounded.txt", text);
+  const GroundTruth truth = ReadGroundTruth((tmp.path() / "rounded.txt").string(), GroundTruthFormat::kKitti);
+  ASSERT_EQ(truth.camera_to_world.size(), 2u);
+  for (const cv::Matx44d& T : truth.camera_to_world) {
+    const cv::Matx33d R = T.get_minor<3, 3>(0, 0);
+    EXPECT_LT(cv::norm(R.t() * R - cv::Matx33d::eye(), cv::NORM_INF), 1e-14);
+    EXPECT_NEAR(cv::determinant(R), 1.0, 1e-14);
+  }
+  EXPECT_NEAR(truth.camera_to_world[0](0, 0), Ra(0, 0), 1e-6);  // the nearest rotation, not another one
+  cv::Matx33d R_true;
+  cv::Vec3d t_true;
+  RelativeFromCameraToWorld(truth.camera_to_world[0], truth.camera_to_world[1], &R_true, &t_true);
+  EXPECT_NEAR(RotationAngleDeg(R_true), RotationAngleDeg(Ra.t() * Rb), 1e-4);
 }
 
 TEST(GroundTruth, DetectsAndReadsTheThreeFormats) {

@@ -265,8 +265,12 @@ cv::Matx33d FundamentalFromPose(const cv::Matx33d& R, const cv::Vec3d& t, const 
 }
 
 double RotationAngleDeg(const cv::Matx33d& R) {
-  const double c = std::clamp((cv::trace(R) - 1.0) / 2.0, -1.0, 1.0);
-  return std::acos(c) * 180.0 / CV_PI;
+  // The cosine alone (acos of (tr R - 1) / 2) loses small angles, since it changes with their square: a matrix
+  // rounded a 1e-7 below orthonormal read as 0.05 degrees. The sine, from the skew-symmetric part, keeps them,
+  // and is zero for the symmetric error that rounding leaves.
+  const double s = 0.5 * cv::norm(cv::Vec3d(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1)));
+  const double c = (cv::trace(R) - 1.0) / 2.0;
+  return std::atan2(s, c) * 180.0 / CV_PI;
 }
 
 double AngleBetweenDeg(const cv::Vec3d& a, const cv::Vec3d& b) {

@@ -149,7 +149,7 @@ RelativePose EnforceCheirality(const RelativePose& pose, const NormalizedMatches
 cv::Matx33d FundamentalFromPose(const cv::Matx33d& R, const cv::Vec3d& t, const cv::Matx33d& K);
 cv::Matx33d CrossMatrix(const cv::Vec3d& v);
 
-// The angle of a rotation, in degrees.
+// The angle of a rotation, in degrees; accurate to float precision for small angles too.
 double RotationAngleDeg(const cv::Matx33d& R);
 // The angle between two directions, in degrees (0 to 180).
 double AngleBetweenDeg(const cv::Vec3d& a, const cv::Vec3d& b);

@@ -414,4 +414,17 @@ TEST(RelativePose, PlanarSceneHasARivalMinimum) {
   EXPECT_LT(gap, TranslationOptions().min_rival_cost_gap);
 }
 
+// Small angles are where link rotation errors live; the cosine alone read 1e-6 degrees as 1.2e-6, and this
+// identity rounded below 1 as 0.05 degrees.
+TEST(RelativePose, RotationAngleIsAccurateFromZeroToAHalfTurn) {
+  for (const double degrees : {1e-6, 1e-4, 0.01, 1.0, 45.0, 90.0, 179.0, 180.0}) {
+    cv::Matx33d R;
+    cv::Rodrigues(cv::normalize(cv::Vec3d(0.3, -1.0, 0.2)) * (degrees * CV_PI / 180.0), R);
+    EXPECT_NEAR(RotationAngleDeg(R), degrees, degrees * 1e-6 + 1e-9) << degrees;
+  }
+  // A symmetric error, as rounding a matrix's entries leaves, is no rotation.
+  const cv::Matx33d rounded(1.0 - 3e-7, 2e-7, -1e-7, 2e-7, 1.0 - 4e-7, 5e-8, -1e-7, 5e-8, 1.0 - 1e-7);
+  EXPECT_LT(RotationAngleDeg(rounded), 1e-9);
+}
+
 }  // namespace vmap
