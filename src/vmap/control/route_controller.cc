@@ -145,7 +145,16 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
     odometry = nullptr;
   }
   ControlStep step;
-  const double dt = last_time_ ? std::max(0.0, time - *last_time_) : 0.0;
+  if (last_time_ && time < *last_time_) {
+    // A clock that went back: the stamps kept move back with it, so the time lost or searching so far still counts.
+    // Kept as they were, a robot lost before a reset of 100 s drove blind at its speed for those 100 s.
+    const double back = time - *last_time_;
+    for (std::optional<double>* stamp : {&last_time_, &last_usable_time_, &unusable_since_}) {
+      if (*stamp) **stamp += back;
+    }
+    line_angle_time_ += back;
+  }
+  const double dt = last_time_ ? time - *last_time_ : 0.0;
   last_time_ = time;
   // Metres driven (signed: negative when reversing) and radians turned since the last step: by odometry, or by the
   // last command where there is none (0 at the first step).
@@ -272,8 +281,7 @@ ControlStep RouteController::Update(double time, const LocalizationResult& local
         ++position_;
       }
     }
-    // A stamp before the last usable frame's (a clock reset) counts as no time: never more than the speed it had.
-    const double elapsed = last_usable_time_ ? std::max(0.0, time - *last_usable_time_) : options_.lost_stop_seconds;
+    const double elapsed = last_usable_time_ ? time - *last_usable_time_ : options_.lost_stop_seconds;
     const double share =
         options_.lost_stop_seconds > 0.0 ? std::clamp(1.0 - elapsed / options_.lost_stop_seconds, 0.0, 1.0) : 0.0;
     const double speed = lost_speed_ * share;

@@ -85,7 +85,8 @@ class RouteController {
   RouteController(TaughtRoute route, ControllerOptions options);
 
   // One control step at time `time` (seconds, increasing) with the localization of the frame taken then and,
-  // when the robot has it, its odometry at that time (nullptr: vision alone).
+  // when the robot has it, its odometry at that time (nullptr: vision alone). A time before the last step's (a
+  // clock reset, a bag played again) is a step of no duration: the times the controller measures go on from it.
   ControlStep Update(double time, const LocalizationResult& localization, const OdometrySample* odometry = nullptr);
 
   // Forgets everything: the next frame starts the run again (starting state).

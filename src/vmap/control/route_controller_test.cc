@@ -196,6 +196,26 @@ TEST(RouteController, LostSlowsToAStopAndResumes) {
   EXPECT_DOUBLE_EQ(step.command.linear, 0.3);
 }
 
+// A clock that goes back (sim time restarted, a bag played again) takes nothing from the time lost: the robot lost
+// for 0.5 s before a reset of 100 s has slowed half-way, and stops 0.5 s after it, not 100 s later.
+TEST(RouteController, AClockThatGoesBackKeepsTheTimeLost) {
+  ControllerOptions options = NoRateLimits();
+  options.lost_stop_seconds = 1.0;
+  RouteController controller = Running(StraightRoute(), options);
+  controller.Update(100.0, Tracked(1, 0.0));
+  EXPECT_NEAR(controller.Update(100.5, Lost()).command.linear, 0.15, 1e-12);
+  EXPECT_NEAR(controller.Update(0.0, Lost()).command.linear, 0.15, 1e-12);  // no time passed at the reset
+  EXPECT_NEAR(controller.Update(0.25, Lost()).command.linear, 0.075, 1e-12);
+  EXPECT_EQ(controller.Update(0.6, Lost()).command.linear, 0.0);
+  // The search starts 2 s after the last usable frame, counted across the reset.
+  RouteController searching(StraightRoute(), NoRateLimits());
+  searching.Update(50.0, Lost());
+  searching.Update(51.0, Lost());
+  EXPECT_NE(searching.Update(1.0, Lost()).steering, "search");
+  EXPECT_NE(searching.Update(1.9, Lost()).steering, "search");
+  EXPECT_EQ(searching.Update(2.1, Lost()).steering, "search");
+}
+
 TEST(RouteController, SearchesForTheRouteWhenStandingUnlocalized) {
   RouteController controller(StraightRoute(), NoRateLimits());
   ControlStep step;
