@@ -477,11 +477,11 @@ class Localizer {
   std::optional<KeyComparison> start_question_;
   int pointed_ = -1;         // the far route position this frame's relocalization pointed at; -1: none
   int pointed_before_ = -1;  // the previous frame's
-  // How many key images Track moved the estimate on this frame (LocalizerOptions::lookahead); 0: none.
-  int steps_on_ = 0;
+  int steps_on_ = 0;         // how many key images Track moved the estimate on this frame (LocalizerOptions::lookahead)
   // The route position a step back of this frame left (Track's step back, or the recheck's relocalization behind the
   // tracked estimate); -1: none.
   int stepped_back_from_ = -1;
+  bool blind_ = false;      // the frame has fewer features than a key image must verify: its evidence weighs nothing
   EvidenceModel evidence_;  // by the kind of the matcher's descriptors
   using Memo = FrameComparisons::Memo;
   std::vector<RankedKey> ranked_;  // the route ranked for the frame being localized (RankRoute); empty: not yet

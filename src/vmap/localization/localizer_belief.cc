@@ -20,6 +20,14 @@ void Localizer::WeighComparisons() {
   bool weighed = RankingMovesOwnFrame() && WeighRanking();
   for (Memo& m : comparisons_) {
     if (m.weighed && (!m.by_heading || m.weighed_by_heading)) continue;
+    // A blind frame verifies nothing anywhere, which says nothing of where it is: calibrated on frames that could
+    // verify, nothing verified weighs against the key image, and two black frames took the belief from the tracked
+    // key image (confidence 0.95 to 0.25) and the next real frame was withheld.
+    if (blind_) {
+      m.weighed = true;
+      m.weighed_by_heading = m.by_heading;
+      continue;
+    }
     const int key = m.comparison.key;
     const int position = route_position_of_key_[key];
     if (position < 0) {
@@ -56,7 +64,7 @@ void Localizer::NormalizeBeliefs() {
 }
 
 bool Localizer::WeighRanking() {
-  if (ranked_.empty() || !bucket_of_position_.empty() || evidence_.rank_alone.empty()) return false;
+  if (blind_ || ranked_.empty() || !bucket_of_position_.empty() || evidence_.rank_alone.empty()) return false;
   // The ranking holds the route's key images in route order: ranked_[r].key is a route position.
   bucket_of_position_ = RankingBuckets(evidence_, ranked_, static_cast<int>(route_.size()));
   for (size_t p = 0; p < route_.size(); ++p)
@@ -294,6 +302,9 @@ void Localizer::Question(LocalizationResult& result, const Frame& frame, const I
            belief_.MassWithin(result.route_position, kNear) < min_confidence;
   };
   if (window <= 0 || min_confidence <= 0.0 || !doubted()) return;
+  // A blind frame is no evidence that the estimate is wrong: moved to the belief's peak, which trails the tracker, it
+  // put the tracker back a key image.
+  if (blind_) return;
   // The key image stops explaining the frame: look where the belief has it, behind and ahead of its peak (the key
   // images whose evidence weighs the positions within `window` of it).
   auto compare_around = [&](int centre) {

@@ -290,5 +290,33 @@ TEST(Localizer, FramesThatVerifyNothingAfterAConfidentRunAreCarriedByTheBelief) 
   }
 }
 
+// A blind frame (black: a lens cap, a tunnel, a camera's first frames) has no features to verify with, which says
+// nothing of where the robot is: it is lost where the run was, and the belief keeps what the run's frames said. Taken
+// as evidence, nothing verified weighed against the tracked key image and the belief's peak, which trails the tracker,
+// took the estimate back a key image.
+TEST(Localizer, ABlindFrameIsLostWhereTheRunWasAndWeighsNothing) {
+  const LocalizationMap& m = DenseDriveMap();
+  Localizer localizer(m.map, m.keys, *m.matcher, MapLocalizerOptions(m));
+  int index = 0;
+  LocalizationResult r = LocalizeFramesOnDenseMap(localizer, {1, 3, 5, 7, 9, 11, 13}, &index);
+  ASSERT_EQ(r.status, LocalizationStatus::kTracking);
+  const int tracked_position = r.route_position;
+  const double confidence = r.confidence;
+  const cv::Mat black = cv::Mat::zeros(SidewaysDrive().frames[0].size(), CV_8UC3);
+  for (int blind = 0; blind < 2; ++blind) {
+    Frame frame;
+    frame.index = index++;
+    cv::cvtColor(black, frame.gray, cv::COLOR_BGR2GRAY);
+    frame.color = black;
+    r = localizer.Localize(frame, *m.matcher->Extract(frame.gray));
+    EXPECT_EQ(r.status, LocalizationStatus::kLost) << blind;
+    EXPECT_EQ(r.route_position, tracked_position) << blind;
+    EXPECT_GE(r.confidence, 0.9 * confidence) << blind;
+  }
+  r = LocalizeOnDenseMap(localizer, 15, index++);
+  EXPECT_EQ(r.status, LocalizationStatus::kTracking);
+  EXPECT_TRUE(Brackets(m.map, 15, r.key)) << "at key " << r.key;
+}
+
 }  // namespace
 }  // namespace vmap

@@ -77,6 +77,9 @@ TEST(Localizer, AnUnrelatedImageIsLostAndTheEstimateIsDroppedAfterMaxLostFrames)
   r = LocalizeOnEvenMap(localizer, noise, 4, 0);
   EXPECT_EQ(r.status, LocalizationStatus::kLost);
   EXPECT_FALSE(localizer.has_estimate()) << "dropped after max_lost_frames + 1 lost frames in a row";
+  EXPECT_EQ(r.key, -1) << "the frame that drops the estimate shows it dropped";
+  EXPECT_EQ(r.route_position, -1);
+  EXPECT_EQ(r.key_rank, -1);
   // A frame inside a segment: one right after a key image is as much "at the end of the segment before" it
   // (RelocalizesAFrameFromTheMiddleAfterReset covers the choice between the two segments).
   r = LocalizeOnEvenMap(localizer, SidewaysDrive().frames[33], 5, 33);

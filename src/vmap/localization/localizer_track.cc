@@ -154,15 +154,18 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     result.candidates = std::move(found.candidates);
     position_ = position;
     lost_in_a_row_ = lost_before + 1;
-    Describe(result, position, features);
-    if (lost_in_a_row_ > options_.max_lost_frames) {
-      // The estimate is dropped; the belief is kept (its evidence still says where the frames were).
-      if (options_.guided_while_lost) dropped_position_ = position;
-      frames_since_drop_ = 0;
-      position_ = -1;
-      lost_in_a_row_ = 0;
-      step_back_ruled_out_ = {};
+    if (lost_in_a_row_ <= options_.max_lost_frames) {
+      Describe(result, position, features);
+      return result;
     }
+    // The estimate is dropped, from this frame on (as max_lost_frames says); the belief is kept (its evidence still
+    // says where the frames were). A far place found on this frame's evidence alone is asked again by the next frame.
+    result.status = LocalizationStatus::kLost;
+    if (options_.guided_while_lost) dropped_position_ = position;
+    frames_since_drop_ = 0;
+    position_ = -1;
+    lost_in_a_row_ = 0;
+    step_back_ruled_out_ = {};
     return result;
   }
   // A rival place (rival_place_frames) asked again: where it verifies more than the tracked key image, the frame may be

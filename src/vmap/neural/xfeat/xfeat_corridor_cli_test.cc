@@ -406,5 +406,31 @@ TEST_F(XfeatCorridorRun, AFarPlaceTheBeliefDoesNotFollowLeavesTheFrameSteeredBy)
   EXPECT_EQ(Right(stays), Right(doubted) + 2);
 }
 
+// The corridor's first 41 frames as the route (`vmap build --last 40`).
+class XfeatCorridorStartRun : public XfeatCorridorRun {
+ protected:
+  std::string BuildFlags() const override { return " --last 40"; }
+};
+
+// Black frames (a camera's exposure dropping out) in a run tracked at the right key images (docs/localize.md, "A blind
+// frame is no evidence"): lost where the run was, and the frames after them tracked on where they are. Weighed as
+// evidence, the black frames' "nothing verified" took the belief from the tracked key image, and two of repeat frames
+// 21-24 were steered by, one of them at a right key image.
+TEST_F(XfeatCorridorStartRun, FramesAfterBlackFramesAreTrackedWhereTheyAre) {
+  std::vector<int> run;
+  for (int frame = 0; frame <= 40; ++frame) {
+    run.push_back(frame);
+    if (frame == 20) run.insert(run.end(), {kBlackFrame, kBlackFrame});
+  }
+  const Steered steered = SteeredOnRun(run, 0, "");
+  Steered after;
+  for (const auto& s : steered) {
+    EXPECT_NE(s.first, kBlackFrame) << "a black frame is steered by at key image " << s.second;
+    if (s.first >= 21 && s.first <= 24) after.push_back(s);
+  }
+  EXPECT_EQ(Far(steered), 0);
+  EXPECT_EQ(Right(after), 4) << after.size() << " of repeat frames 21-24 steered by";
+}
+
 }  // namespace
 }  // namespace vmap::neural

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "vmap/testing/localize_cli_test_util.h"
 #include "vmap/testing/run_vmap.h"
@@ -89,6 +90,15 @@ XfeatCorridorRun::Steered XfeatCorridorRun::SteeredOnRun(const std::vector<int>&
     std::snprintf(name, sizeof(name), "%07d.jpg", repeat_of[f]);
     char link[32];
     std::snprintf(link, sizeof(link), "%07zu.jpg", f);
+    if (repeat_of[f] == kBlackFrame) {
+      const cv::Mat first = cv::imread((data_ / "repeat" / "0000000.jpg").string());
+      if (first.empty()) {
+        ADD_FAILURE() << "corridor_conditions' repeat/0000000.jpg cannot be read";
+        return {};
+      }
+      cv::imwrite((run / link).string(), cv::Mat::zeros(first.size(), first.type()));
+      continue;
+    }
     fs::create_symlink(data_ / "repeat" / name, run / link);
   }
   Steered steered = testing::SteeredFrames(

@@ -39,7 +39,9 @@ class XfeatCorridorRun : public ::testing::Test {
   Steered SteeredOnRepeat(int first, int last, int start_key, const std::string& flags);
 
   // The frames steered by when repeat frames taken in the order `repeat_of` gives (a robot carried off: run frame f
-  // is repeat frame repeat_of[f]) are localized, started at `start_key`, with `flags`.
+  // is repeat frame repeat_of[f]; kBlackFrame: a black frame there) are localized, started at `start_key`, with
+  // `flags`.
+  static constexpr int kBlackFrame = -1;
   Steered SteeredOnRun(const std::vector<int>& repeat_of, int start_key, const std::string& flags);
 
   // How many of `steered` (repeat frame, key) are at a key image more than 2 from every right one.
