@@ -14,6 +14,7 @@
 #include "vmap/core/option_fields.h"
 #include "vmap/geometry/fundamental.h"
 #include "vmap/map/map_io.h"
+#include "vmap/mapping/recorded_options.h"
 #include "vmap/testing/run_vmap.h"
 #include "vmap/testing/scoped_temp_dir.h"
 #include "vmap/testing/shared_data.h"
@@ -119,6 +120,8 @@ TEST(Cli, SweepWritesThePapersTable) {
     previous = row["key_images"].get<int>();
     const VisualMap map = ReadMap(tmp.path() / "sweep" / row["map"].get<std::string>());
     EXPECT_EQ(static_cast<int>(map.key_images.size()), row["key_images"].get<int>());
+    // Each map records its own tau (vmap info, report and localize read it), not the default's 0.5.
+    EXPECT_DOUBLE_EQ(RecordedOptionsFromJson(map.options_json, "map").builder.key_images.tau, row["tau"].get<double>());
   }
   EXPECT_TRUE(fs::exists(tmp.path() / "sweep/sweep.csv"));
   EXPECT_TRUE(fs::exists(tmp.path() / "sweep/sweep.md"));

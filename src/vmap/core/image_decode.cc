@@ -19,8 +19,8 @@ cv::Mat DecodeImageFile(const ContainedFile& file, int flags, long max_pixels, s
     return {};
   }
   const auto* encoded = reinterpret_cast<const std::uint8_t*>(bytes.data());
-  if (IsCutShortJpeg(encoded, bytes.size())) {
-    *why_not = "is a JPEG cut short (no end-of-image marker)";
+  if (const char* cut = CutShortImage(encoded, bytes.size())) {
+    *why_not = std::string("is ") + cut;
     return {};
   }
   if (const std::optional<cv::Size> announced = ImageHeaderSize(encoded, bytes.size());

@@ -74,6 +74,24 @@ bool CutShortJpeg(const ReadBytes& read, std::uint64_t size) {
   return true;
 }
 
+// Whether `size` bytes start as a PNG and their last 64 KiB hold no IEND chunk (its type and fixed CRC, AE 42 60 82).
+bool CutShortPng(const ReadBytes& read, std::uint64_t size) {
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
+  static const std::string kEnd = {'I', 'E', 'N', 'D', '\xAE', '\x42', '\x60', '\x82'};
+  unsigned char start[8] = {};
+  if (size < 8 || !read(0, start, 8) || std::memcmp(start, kSignature, 8) != 0) return false;
+  const std::uint64_t window = std::min<std::uint64_t>(size - 8, std::uint64_t{64} << 10);
+  std::string tail(window, '\0');
+  if (!read(size - window, tail.data(), tail.size())) return false;
+  return tail.find(kEnd) == std::string::npos;
+}
+
+const char* CutShort(const ReadBytes& read, std::uint64_t size) {
+  if (CutShortJpeg(read, size)) return "a JPEG cut short (no end-of-image marker)";
+  if (CutShortPng(read, size)) return "a PNG cut short (no IEND chunk)";
+  return nullptr;
+}
+
 // The reader of an open file.
 ReadBytes FromFile(const ContainedFile& file) {
   return [&file](std::uint64_t offset, void* data, std::size_t bytes) { return file.Read(offset, data, bytes); };
@@ -92,10 +110,10 @@ ReadBytes InMemory(const std::uint8_t* encoded, std::size_t size) {
 
 std::optional<cv::Size> ImageHeaderSize(const ContainedFile& file) { return HeaderSize(FromFile(file)); }
 
-bool IsCutShortJpeg(const ContainedFile& file) { return CutShortJpeg(FromFile(file), file.size()); }
+const char* CutShortImage(const ContainedFile& file) { return CutShort(FromFile(file), file.size()); }
 
-bool IsCutShortJpeg(const std::uint8_t* encoded, std::size_t size) {
-  return CutShortJpeg(InMemory(encoded, size), size);
+const char* CutShortImage(const std::uint8_t* encoded, std::size_t size) {
+  return CutShort(InMemory(encoded, size), size);
 }
 
 std::optional<cv::Size> ImageHeaderSize(const std::uint8_t* encoded, std::size_t size) {

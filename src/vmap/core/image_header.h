@@ -19,11 +19,12 @@ std::optional<cv::Size> ImageHeaderSize(const ContainedFile& file);
 // The same of an encoded image held in memory (a ROS CompressedImage message's data).
 std::optional<cv::Size> ImageHeaderSize(const std::uint8_t* encoded, std::size_t size);
 
-// Whether the file is a JPEG cut short: it starts as one, and its last 64 KiB hold no end-of-image marker (FF D9, which
-// the entropy-coded data never holds: a 0xFF there is followed by 0x00 or a restart marker). libjpeg decodes such a
-// file without an error, its missing rows filled grey, which would then be matched as if seen.
-bool IsCutShortJpeg(const ContainedFile& file);
+// What the file is when it is an image cut short (as a full disk or a recording cut off leaves one), or nullptr: a JPEG
+// whose last 64 KiB hold no end-of-image marker (FF D9, which the entropy-coded data never holds: a 0xFF there is
+// followed by 0x00 or a restart marker), which libjpeg decodes without an error, its missing rows filled grey and then
+// matched as if seen; a PNG whose last 64 KiB hold no IEND chunk, which a header check alone would take for whole.
+const char* CutShortImage(const ContainedFile& file);
 // The same of an encoded image held in memory (the bytes about to be decoded).
-bool IsCutShortJpeg(const std::uint8_t* encoded, std::size_t size);
+const char* CutShortImage(const std::uint8_t* encoded, std::size_t size);
 
 }  // namespace vmap

@@ -37,8 +37,9 @@ TEST(ImageHeader, SizesAreReadWithoutDecoding) {
   EXPECT_EQ(SizeOf(tmp.path() / "cut.png"), std::nullopt);
 }
 
-// A JPEG cut short decodes without an error, its missing rows grey: told by its missing end-of-image marker.
-TEST(ImageHeader, AJpegCutShortIsToldFromAWholeOne) {
+// A JPEG cut short decodes without an error, its missing rows grey: told by its missing end-of-image marker; a PNG by
+// its missing IEND chunk.
+TEST(ImageHeader, AJpegOrPngCutShortIsToldFromAWholeOne) {
   testing::ScopedTempDir tmp;
   cv::Mat noise(240, 320, CV_8UC3);
   cv::randu(noise, 0, 255);
@@ -52,12 +53,19 @@ TEST(ImageHeader, AJpegCutShortIsToldFromAWholeOne) {
     std::string why_not;
     const std::optional<ContainedFile> file = ContainedFile::OpenRegular(tmp.path() / name, &why_not);
     EXPECT_TRUE(file) << why_not;
-    return file && IsCutShortJpeg(*file);
+    return file && CutShortImage(*file) != nullptr;
   };
   EXPECT_FALSE(cut_short("whole.jpg"));
   EXPECT_TRUE(cut_short("half.jpg"));
   EXPECT_FALSE(cut_short("trailer.jpg"));  // data after the marker (a camera's own) is no cut
   EXPECT_FALSE(cut_short("a.png"));
+  // A PNG cut short (a full disk while a map was written): its header is whole, its IEND chunk missing.
+  std::ifstream png_in(tmp.path() / "a.png", std::ios::binary);
+  const std::string png((std::istreambuf_iterator<char>(png_in)), std::istreambuf_iterator<char>());
+  std::ofstream(tmp.path() / "half.png", std::ios::binary) << png.substr(0, png.size() / 2);
+  std::ofstream(tmp.path() / "trailer.png", std::ios::binary) << png << std::string(1000, 'x');
+  EXPECT_TRUE(cut_short("half.png"));
+  EXPECT_FALSE(cut_short("trailer.png"));
   // The half decodes all the same: why the marker is asked for.
   EXPECT_FALSE(cv::imread((tmp.path() / "half.jpg").string()).empty());
 }

@@ -122,6 +122,7 @@ std::vector<Experience> ExperiencesFromJson(const json& value, const VisualMap& 
       if (!size || (expected.area() > 0 && *size != expected)) {
         reader.Fail(at + ".image", "'" + v.image_file + "' is not a PNG or JPEG of the map's frame size");
       }
+      if (const char* cut = CutShortImage(*file)) reader.Fail(at + ".image", "'" + v.image_file + "' is " + cut);
       e.views.push_back(std::move(v));
     }
     experiences.push_back(std::move(e));

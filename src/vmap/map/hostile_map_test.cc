@@ -328,6 +328,13 @@ TEST(MapIo, KeyImagesMustBeThePngsOfTheMapsFrameSize) {
   cv::imwrite(key.string(), cv::Mat(10, 12, CV_8U, cv::Scalar(3)));
   EXPECT_NE(ReadMapError(tmp.path()).find("is 12x10, not the map's frame size 64x48"), std::string::npos)
       << ReadMapError(tmp.path());
+  // A PNG of the right size cut short (a full disk): refused when the map is read, not when it is first decoded.
+  cv::Mat noise(48, 64, CV_8U);
+  cv::randu(noise, 0, 255);
+  cv::imwrite(key.string(), noise);
+  fs::resize_file(key, fs::file_size(key) / 2);
+  EXPECT_NE(ReadMapError(tmp.path()).find("'keys/9.png' is a PNG cut short"), std::string::npos)
+      << ReadMapError(tmp.path());
   // A PNG header announcing 40000 x 40000 pixels: refused from its 24 bytes, never decoded.
   const unsigned char header[] = {0x89, 'P', 'N', 'G',  '\r', '\n', 0x1A, '\n', 0,    0, 0, 13, 'I', 'H', 'D',
                                   'R',  0,   0,   0x9C, 0x40, 0,    0,    0x9C, 0x40, 8, 0, 0,  0,   0};

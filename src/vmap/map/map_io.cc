@@ -153,7 +153,7 @@ void ReadKeyImages(const json& doc, const Fields& fields, const fs::path& direct
     };
     const std::string problem = KeyImageSizeProblem(ImageHeaderSize(image), map->input.frame_size);
     if (!problem.empty()) damaged(problem);
-    if (IsCutShortJpeg(image)) damaged("is a JPEG cut short (no end-of-image marker)");
+    if (const char* cut = CutShortImage(image)) damaged(std::string("is ") + cut);
     map->key_images.push_back(std::move(k));
   }
   if (map->key_images.empty() && map->num_frames > 0) Malformed(file, "no key images");

@@ -18,6 +18,7 @@
 #include "vmap/mapping/key_image_selector.h"
 #include "vmap/mapping/link_analysis.h"
 #include "vmap/mapping/link_verifier.h"
+#include "vmap/mapping/recorded_options.h"
 
 namespace vmap {
 namespace {
@@ -25,6 +26,13 @@ namespace {
 std::vector<double> Sorted(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   return values;
+}
+
+// The record of each tau's map: the options given, at that tau (a sweep's maps each record their own).
+std::vector<std::string> RecordedAtEachTau(const std::string& options_json, const std::vector<double>& taus) {
+  std::vector<std::string> recorded;
+  for (const double tau : taus) recorded.push_back(RecordedAtTau(options_json, tau));
+  return recorded;
 }
 
 }  // namespace
@@ -40,7 +48,7 @@ class MapBuilder::Impl {
         taus_(std::move(taus)),
         sorted_taus_(Sorted(taus_)),
         writers_(std::move(writers)),
-        options_json_(std::move(options_json)),
+        options_json_(RecordedAtEachTau(options_json, taus_)),
         start_(std::chrono::steady_clock::now()),
         verifier_(DecisionVerifier(options)),
         stops_early_(verifier_.own_magsac),
@@ -113,7 +121,7 @@ class MapBuilder::Impl {
       // Nothing to write before Algorithm 1 has taken its first frame.
       if (!writers_[i] || selectors_[i]->key_images().empty()) continue;
       VisualMap map =
-          CollectMap(*selectors_[i], source_, matcher_, options_, options_json_, SecondsSince(start_),
+          CollectMap(*selectors_[i], source_, matcher_, options_, options_json_[i], SecondsSince(start_),
                      /*analyze_links=*/true, link_verifier_.get(), taus_[i], &link_analyses_[i], writers_[i]);
       map.coverage = CurrentCoverage(CoverageEnd::kSnapshot);
       writers_[i]->Snapshot(map);
@@ -148,7 +156,7 @@ class MapBuilder::Impl {
     const auto link_done = [&] { link_progress.Update(++links_done); };
     std::vector<VisualMap> maps;
     for (size_t i = 0; i < selectors_.size(); ++i) {
-      VisualMap map = CollectMap(*selectors_[i], source_, matcher_, options_, options_json_, seconds, analyze_links,
+      VisualMap map = CollectMap(*selectors_[i], source_, matcher_, options_, options_json_[i], seconds, analyze_links,
                                  link_verifier_.get(), taus_[i], &link_analyses_[i], writers_[i], link_done);
       // A map of a whole file says nothing more (its map.json stays as it was); a live input's says what it
       // covers.
@@ -223,7 +231,7 @@ class MapBuilder::Impl {
   const std::vector<double> taus_;  // selector i's is taus_[i]
   const std::vector<double> sorted_taus_;
   std::vector<MapWriter*> writers_;
-  const std::string options_json_;
+  const std::vector<std::string> options_json_;  // each tau's map's record of its options
   const std::chrono::steady_clock::time_point start_;
   const VerifierOptions verifier_;
   const bool stops_early_;

@@ -29,6 +29,13 @@ std::string DescribeMapOptions(const Matcher& matcher, const MapBuilderOptions& 
   return ToJson(record).dump();
 }
 
+std::string RecordedAtTau(const std::string& options_json, double tau) {
+  if (options_json.empty()) return options_json;
+  nlohmann::json record = nlohmann::json::parse(options_json);
+  record["tau"] = tau;  // key_images.tau, written at the top (ToJson)
+  return record.dump();
+}
+
 namespace {
 
 // The key of the record that holds the field at `path` of an options struct: the record writes some nested structs'

@@ -27,6 +27,8 @@ nlohmann::json ToJson(const RecordedOptions& options);
 // sweep.json's "options").
 std::string DescribeMapOptions(const Matcher& matcher, const MapBuilderOptions& options,
                                const FrameSourceOptions& source);
+// `options_json`, a record, with the threshold `tau` in place of its own (empty stays empty).
+std::string RecordedAtTau(const std::string& options_json, double tau);
 // Reads a record (fields it lacks keep their defaults). Throws InputError naming `where` and the key of a
 // value of the wrong kind or an enum name this vmap does not know.
 RecordedOptions RecordedOptionsFromJson(const std::string& options_json, const std::string& where);

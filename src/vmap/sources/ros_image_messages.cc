@@ -176,9 +176,7 @@ DecodedImage DecodeImageMessage(const uint8_t* data, size_t size, const std::str
     }
     // libjpeg decodes a JPEG cut short (a message truncated by its sender or a recording cut off) with its missing
     // rows grey, which would then be matched as if seen.
-    if (IsCutShortJpeg(compressed, bytes)) {
-      throw InputError(what + " holds a JPEG cut short (no end-of-image marker)");
-    }
+    if (const char* cut = CutShortImage(compressed, bytes)) throw InputError(what + " holds " + cut);
     cv::Mat decoded;
     try {
       if (bytes > 0) decoded = cv::imdecode(encoded, cv::IMREAD_UNCHANGED);
