@@ -159,8 +159,9 @@ cv::Mat RenderPolygons(const std::vector<TexturedPolygon>& polygons, const Pinho
       }
     }
     const double s = std::ldexp(1.0, level);
-    // Level pixel (a, b) is level-0 pixel (s a + (s - 1) / 2, s b + (s - 1) / 2) (pyrDown keeps pixel centres).
-    const cv::Matx33d to_level0(s, 0, (s - 1) / 2, 0, s, (s - 1) / 2, 0, 0, 1);
+    // Level pixel (a, b) is level-0 pixel (s a, s b): pyrDown's kernel centres level pixel a on the pixel 2a below it
+    // (not between 2a and 2a + 1, as a box filter's would).
+    const cv::Matx33d to_level0(s, 0, 0, 0, s, 0, 0, 0, 1);
     cv::Matx34d camera;
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 3; ++c) camera(r, c) = view.R(r, c);

@@ -72,6 +72,30 @@ TEST(PlaneRenderer, DistantTexturesAreReadFromTheirMipLevel) {
   EXPECT_LT(stddev[0], 10.0);
 }
 
+// A mip level shows the texture where level 0 does: pyrDown centres level-k pixel a on level-0 pixel 2^k a. Mapped as
+// a box filter's (2^k a + (2^k - 1) / 2), level 2 drew this edge 0.3 px off, and a wall moved as its level changed.
+TEST(PlaneRenderer, AMipLevelShowsTheTextureWhereLevelZeroDoes) {
+  cv::Mat image(512, 512, CV_8UC3, cv::Scalar(0, 0, 0));
+  image.colRange(256, 512).setTo(cv::Scalar(255, 255, 255));
+  // 512 texels across 114 px: level 2.
+  const TexturedPolygon quad =
+      TexturedQuad({-1, -1, 1.75}, {1, -1, 1.75}, {1, 1, 1.75}, {-1, 1, 1.75}, std::make_shared<Texture>(image));
+  // Where row 60 crosses mid-grey, to a fraction of a pixel.
+  const auto edge = [&](bool mipmaps) {
+    RenderOptions options;
+    options.mipmaps = mipmaps;
+    const cv::Mat frame = RenderPolygons({quad}, Camera(), options);
+    for (int x = 20; x + 1 < 140; ++x) {
+      const double a = frame.at<cv::Vec3b>(60, x)[0], b = frame.at<cv::Vec3b>(60, x + 1)[0];
+      if (a < 127.5 && b >= 127.5) return x + (127.5 - a) / (b - a);
+    }
+    return -1.0;
+  };
+  const double sharp = edge(false);
+  ASSERT_NEAR(sharp, 79.5, 1.0);
+  EXPECT_NEAR(edge(true), sharp, 0.1);
+}
+
 TEST(PlaneRenderer, ATrapezoidShowsItsWholeTextureRegion) {
   // The texture's region [16, 48] x [0, 63] stretched onto a trapezoid: its centre column lands mid-way.
   cv::Mat image(64, 64, CV_8UC3, cv::Scalar(0, 0, 255));

@@ -70,6 +70,8 @@ struct TrialResult {
   double max_step_seconds = 0.0;
   double mean_render_seconds = 0.0;
   double duration = 0.0;  // simulated seconds
+  // One per frame, and the pose that ended the trial when no frame was taken there (its last frame's fields, with
+  // the pose, time, s and lateral of the end).
   std::vector<TrialSample> samples;
 };
 

@@ -38,14 +38,16 @@ Pose2d RoutePath::At(double s) const {
 RoutePath::Projection RoutePath::Project(const cv::Point2d& p, double s_min, double s_max) const {
   Projection best;
   double best_distance = std::numeric_limits<double>::infinity();
-  for (size_t i = 1; i < points_.size(); ++i) {
-    if (cumulative_[i] < s_min || cumulative_[i - 1] > s_max) continue;
-    const cv::Point2d a = points_[i - 1], d = points_[i] - a;
-    const double span = d.dot(d);
-    if (span <= 0.0) continue;
+  // A closed path's last segment joins its last point to its first, from arc length length() on: without it, a
+  // point beside that segment was measured from the nearest corner (a CSV loop's last side "left the corridor").
+  const size_t segments = points_.size() - (closed_ ? 0 : 1);
+  for (size_t i = 1; i <= segments; ++i) {
+    const cv::Point2d a = points_[i - 1], d = points_[i % points_.size()] - a;
+    const double start = cumulative_[i - 1], span = d.dot(d);
+    if (start + std::sqrt(span) < s_min || start > s_max || span <= 0.0) continue;
     double w = std::clamp((p - a).dot(d) / span, 0.0, 1.0);
-    const double s = std::clamp(cumulative_[i - 1] + w * std::sqrt(span), s_min, s_max);
-    w = (s - cumulative_[i - 1]) / std::sqrt(span);
+    const double s = std::clamp(start + w * std::sqrt(span), s_min, s_max);
+    w = (s - start) / std::sqrt(span);
     const cv::Point2d q = a + w * d;
     const double distance = cv::norm(p - q);
     if (distance < best_distance) {

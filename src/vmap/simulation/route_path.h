@@ -40,7 +40,8 @@ class RoutePath {
     double lateral = 0.0;  // signed distance to it, left of the path positive
   };
   // The nearest point of the path to `p`; within [s_min, s_max] of arc length when given (a loop passes a place
-  // twice: the caller's progress tells which pass is meant).
+  // twice: the caller's progress tells which pass is meant). On a closed path, the segment from the last point back
+  // to the first is part of it, at arc lengths from length() on.
   Projection Project(const cv::Point2d& p, double s_min = -std::numeric_limits<double>::infinity(),
                      double s_max = std::numeric_limits<double>::infinity()) const;
 

@@ -1,7 +1,9 @@
 // `vmap simulate` as a user runs it: a short run that writes its JSON and report, and every kind of bad input
 // answered with one error line, status 2 and nothing written.
 
+#include <cmath>
 #include <fstream>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -44,6 +46,59 @@ TEST(SimulateCli, RunsTrialsAndWritesItsJsonAndReport) {
   EXPECT_TRUE(fs::is_regular_file(report / "report.html"));
   EXPECT_TRUE(fs::is_regular_file(report / "top_view.png"));
   EXPECT_TRUE(fs::is_regular_file(map / "map.json"));
+}
+
+// Each trial's end, final error and last sample's pose (x, y, lateral) of `vmap simulate ARGS --json`.
+struct TrialEnd {
+  std::string end;
+  double final_error = 0.0;
+  double x = 0.0, y = 0.0, lateral = 0.0;
+};
+std::vector<TrialEnd> SimulateTrials(const std::string& arguments) {
+  ::vmap::testing::ScopedTempDir temp("simulate_end");
+  const fs::path json = temp.path() / "run.json";
+  std::string out;
+  EXPECT_EQ(
+      RunVmap("simulate " + arguments + " --camera-width 160 --camera-height 120 --threads 1 -q --json " + Quote(json),
+              &out),
+      0)
+      << out;
+  std::ifstream in(json);
+  const nlohmann::json run = nlohmann::json::parse(in);
+  std::vector<TrialEnd> ends;
+  for (const nlohmann::json& trial : run["trials"]) {
+    const nlohmann::json& samples = trial["samples"];
+    ends.push_back(
+        {trial["end"], trial["final_error_m"], samples["x"].back(), samples["y"].back(), samples["lateral"].back()});
+  }
+  return ends;
+}
+
+// Where the robot is is searched along the corridor within what a step can drive, and all round a closed one: a robot
+// driving 3 m a step "left the corridor" at its first (searched within 2 m ahead), and one on a CSV loop's last side
+// did too (its closing segment was not searched).
+TEST(SimulateCli, ARobotOnTheCentreLineStaysInTheCorridor) {
+  ::vmap::testing::ScopedTempDir temp("simulate_centre");
+  const std::string exact = " --trials 1 --lateral-offset 0 --heading-offset 0 --speed-noise 0 --turn-noise 0";
+  const TrialEnd fast = SimulateTrials(exact + " --rate 1 --teach-speed 3 --max-speed 4 --max-acceleration 100").at(0);
+  EXPECT_EQ(fast.end, "reached goal") << "at " << fast.x << ", " << fast.y;
+  const fs::path square = WriteRoute(temp.path(), "x,y\n0,0\n6,0\n6,6\n0,6\n0,0\n");
+  const TrialEnd loop = SimulateTrials(exact + " --route " + Quote(square)).at(0);
+  EXPECT_EQ(loop.end, "reached goal") << "at " << loop.x << ", " << loop.y;
+}
+
+// A trial that ends between frames (the robot left the corridor) records where it ended: its last sample is the pose
+// final_error measures, outside the corridor, not the frame's before it (0.03 m short at the default speed and rate).
+TEST(SimulateCli, TheLastSampleIsWhereTheTrialEnded) {
+  int left = 0;
+  for (const TrialEnd& trial : SimulateTrials(
+           " --trials 4 --corridor-width 1.0 --robot-radius 0.42 --lateral-offset 0.05 --heading-offset 45")) {
+    if (trial.end != "left the corridor") continue;
+    ++left;
+    EXPECT_GE(std::abs(trial.lateral), 0.08 - 0.0005) << "the room either side of the centre line, to the JSON's mm";
+    EXPECT_NEAR(std::hypot(trial.x - 10.0, trial.y), trial.final_error, 0.005);  // the straight route's goal: (10, 0)
+  }
+  EXPECT_GE(left, 1) << "no trial left the corridor: the test no longer reaches its case";
 }
 
 // Runs `vmap simulate ARGS --json J --report R` expecting a refusal: one `vmap: error:` line naming `expected`,

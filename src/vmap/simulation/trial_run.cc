@@ -78,6 +78,7 @@ TrialRun::TrialRun(const TrialContext& context, int index)
   dt_ = 1.0 / options.rate;
   time_limit_ = options.time_limit_factor * context.teach_duration + 20.0;
   room_ = 0.5 * options.corridor.width - options.robot_radius;
+  reach_ = std::max(1.0, 2.0 * options.controller.max_speed * dt_);
   corridor_s_ = context.route->path_start;
 }
 
@@ -86,9 +87,10 @@ bool TrialRun::Continues() {
   const SimulatedRoute& route = *context_.route;
   const Pose2d& truth = robot_.pose();
   // Where the robot is on the route and in the corridor, searched near where it was (a loop passes twice).
-  const RoutePath::Projection on_route = route.path.Project({truth.x, truth.y}, s_ - 1.0, s_ + 2.0);
+  // Within 2 m ahead, whatever the speed, a step of 5 m "left the corridor" on the centre line.
+  const RoutePath::Projection on_route = route.path.Project({truth.x, truth.y}, s_ - reach_, s_ + reach_ + 1.0);
   const RoutePath::Projection in_corridor =
-      route.corridor.Project({truth.x, truth.y}, corridor_s_ - 1.0, corridor_s_ + 2.0);
+      route.corridor.Project({truth.x, truth.y}, corridor_s_ - reach_, corridor_s_ + reach_ + 1.0);
   s_ = on_route.s;
   corridor_s_ = in_corridor.s;
   lateral_ = on_route.lateral;
@@ -170,6 +172,17 @@ TrialResult TrialRun::Finish() {
   trial_.final_error = std::hypot(last.x - goal.x, last.y - goal.y);
   trial_.success = trial_.reached_goal && trial_.final_error <= context_.options.goal_tolerance;
   trial_.duration = robot_.time();
+  // The pose that ended the trial (left the corridor, time limit) came after the last frame's: recorded too, as where
+  // the last frame's command took the robot, so the samples and the top view show the end that final_error measures.
+  if (!trial_.samples.empty() && trial_.samples.back().time < time()) {
+    TrialSample end = trial_.samples.back();
+    end.time = time();
+    end.pose = last;
+    end.s = s_;
+    end.lateral = lateral_;
+    end.step_seconds = 0.0;
+    trial_.samples.push_back(end);
+  }
   if (trial_.frames > 0) {
     trial_.mean_step_seconds = step_total_ / trial_.frames;
     trial_.mean_render_seconds = render_total_ / trial_.frames;

@@ -57,6 +57,9 @@ class TrialRun {
   double dt_ = 0.0;
   double time_limit_ = 0.0;
   double room_ = 0.0;  // how far from the corridor's centre line the robot may be
+  // How far along the route one step may take the robot (twice the top speed's step, for the speed noise, and at
+  // least 1 m): where it is on the route is searched within that of where it was.
+  double reach_ = 0.0;
   int step_ = 0;
   double s_ = 0.0;         // arc length along the route of the nearest point
   double corridor_s_ = 0;  // and along the corridor
