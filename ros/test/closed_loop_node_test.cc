@@ -3,13 +3,16 @@
 
 #include <fstream>
 
+#include <geometry_msgs/Twist.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <sensor_msgs/Image.h>
 #include <std_msgs/Bool.h>
 
 #include "vmap/testing/scoped_temp_dir.h"
 
 #include "ros_harness.h"
+#include "vmap_ros/Localization.h"
 #include "vmap_ros/StartRepeat.h"
 
 namespace vmap::ros_testing {
@@ -72,6 +75,53 @@ TEST(ClosedLoopNode, ASimulatedRobotDrivenThroughRosReachesTheGoalAsInProcess) {
   EXPECT_LE(ros.at("lateral_rms_second_half").get<double>(), 0.1);
   EXPECT_GT(std::abs(ros.at("start_lateral").get<double>()), 0.05);  // it started off the path
   EXPECT_TRUE(node->Running());
+}
+
+// The simulator drives each frame by the vmap node's answer to it, paired by stamp (docs/ros.md): this test is the
+// vmap node, answering frame k < 10 with 0.3 m/s (k even) or 0.1 m/s (k odd) and the goal at frame 10, after a stop
+// on cmd_vel before the first frame (as a node publishes between frames), and without a cmd_vel message for frame 5
+// (as a paused node's frame). Paired by count, frame 5 was driven by frame 4's command.
+TEST(ClosedLoopNode, EachFrameIsDrivenByTheCommandAnsweredToIt) {
+  ScopedTempDir dir("ros_paired");
+  std::ofstream(dir.path() / "route.csv") << "x,y\n0,0\n4,0\n";
+  RosMaster::Get();
+  ros::NodeHandle handle;
+  ros::Publisher localization = handle.advertise<vmap_ros::Localization>("/paired/localization", 100);
+  ros::Publisher cmd_vel = handle.advertise<geometry_msgs::Twist>("/paired_robot/cmd_vel", 100);
+  int frames = 0;
+  const ros::Subscriber camera = handle.subscribe<sensor_msgs::Image>(
+      "/paired_robot/camera/image_raw", 10, [&](const sensor_msgs::Image::ConstPtr& image) {
+        const int k = frames++;
+        if (k == 0) cmd_vel.publish(geometry_msgs::Twist());
+        vmap_ros::Localization answer;
+        answer.header.stamp = image->header.stamp;
+        answer.status = vmap_ros::Localization::TRACKING;
+        answer.status_name = "tracking";
+        answer.key = 0;
+        answer.next_key = 1;
+        answer.localized = true;
+        answer.controller_state = k < 10 ? "following" : "reached goal";
+        answer.command.linear.x = k < 10 ? (k % 2 == 0 ? 0.3 : 0.1) : 0.0;
+        if (k != 5) cmd_vel.publish(answer.command);
+        localization.publish(answer);
+      });
+  ChildProcess simulator(
+      {SimulatorBinary().string(), "__ns:=/paired_robot", "__name:=simulator", "localization:=/paired/localization",
+       "_route:=" + (dir.path() / "route.csv").string(), "_lateral_offset:=0", "_heading_offset:=0", "_speed_noise:=0",
+       "_turn_noise:=0", "_answer_timeout:=10", "_map:=" + (dir.path() / "map").string(),
+       "_result:=" + (dir.path() / "result.json").string()},
+      dir.path() / "simulator.log");
+  ASSERT_TRUE(WaitFor([&] { return !simulator.Running(); }, std::chrono::seconds(600))) << simulator.Log();
+  ASSERT_EQ(simulator.Wait(std::chrono::seconds(10)), 0) << simulator.Log();
+  nlohmann::json result;
+  std::ifstream(dir.path() / "result.json") >> result;
+  const nlohmann::json& ros = result.at("ros");
+  SCOPED_TRACE(result.dump(2));
+  EXPECT_EQ(ros.at("end"), "reached goal");
+  EXPECT_EQ(ros.at("frames"), 11);
+  // Ten steps of 0.1 s, five at 0.3 m/s and five at 0.1 m/s, from the route's start 4 m from its goal, exactly (no
+  // noise, no start offset).
+  EXPECT_NEAR(ros.at("final_error").get<double>(), 4.0 - 0.1 * (5 * 0.3 + 5 * 0.1), 1e-3);
 }
 
 // The simulator node checks what it will write before it teaches (its result and map may not land on what it reads,

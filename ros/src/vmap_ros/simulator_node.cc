@@ -1,10 +1,13 @@
 #include "vmap_ros/simulator_node.h"
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <filesystem>
+#include <functional>
 #include <mutex>
+#include <optional>
 
 #include <fmt/format.h>
 #include <geometry_msgs/Twist.h>
@@ -104,45 +107,48 @@ struct StopRequestedError : std::runtime_error {
 // The exit status of a node stopped by a signal, as a shell reports one (130 for SIGINT).
 int StoppedStatus() { return StopSignal() != 0 ? 128 + StopSignal() : 1; }
 
-// The vmap node's answers to the frames, as they arrive.
+// The vmap node's answer to the frame awaited: its localization message, stamped as the frame, which carries the
+// command the node published for it on cmd_vel. Paired by stamp, not by counting cmd_vel messages: the node also
+// publishes a stop between frames (a pause, a quiet camera, a malformed frame), after which every frame was driven by
+// the command of the frame before it.
 class Answers {
  public:
   void OnLocalization(const vmap_ros::Localization::ConstPtr& message) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      last_localization_ = *message;
-      ++localizations_;
+      if (message->header.stamp != awaited_) return;
+      answer_ = *message;
     }
     changed_.notify_all();
   }
-  void OnCommand(const geometry_msgs::Twist::ConstPtr& message) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      last_command_ = *message;
-      ++commands_;
-    }
-    changed_.notify_all();
+  // The frame stamped `stamp` is about to be sent: an answer to it may come before Wait is called.
+  void Await(const ros::Time& stamp) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    awaited_ = stamp;
+    answer_.reset();
   }
-  // Waits for the localization message of the frame stamped `stamp` and the command sent before it (the node
-  // sends a frame's command, then its localization, on two connections: either may arrive first).
-  bool Wait(const ros::Time& stamp, double timeout, vmap_ros::Localization* localization,
-            geometry_msgs::Twist* command) {
+  // Waits up to `seconds` for the answer to the frame awaited; calls `resend` every time `resend_wanted()` says so
+  // while waiting (a vmap node restarted, whose new subscription never saw the frame).
+  std::optional<vmap_ros::Localization> Wait(double seconds, const std::function<bool()>& resend_wanted,
+                                             const std::function<void()>& resend) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
     std::unique_lock<std::mutex> lock(mutex_);
-    const bool answered = changed_.wait_for(lock, std::chrono::duration<double>(timeout), [&] {
-      return localizations_ > 0 && last_localization_.header.stamp == stamp && commands_ >= localizations_;
-    });
-    *localization = last_localization_;
-    *command = last_command_;
-    return answered;
+    while (!answer_ && std::chrono::steady_clock::now() < deadline && !StopRequested()) {
+      changed_.wait_for(lock, std::chrono::milliseconds(100), [&] { return answer_.has_value(); });
+      if (!answer_ && resend_wanted()) {
+        lock.unlock();
+        resend();
+        lock.lock();
+      }
+    }
+    return answer_;
   }
 
  private:
   std::mutex mutex_;
   std::condition_variable changed_;
-  vmap_ros::Localization last_localization_;
-  geometry_msgs::Twist last_command_;
-  long localizations_ = 0;
-  long commands_ = 0;
+  ros::Time awaited_;
+  std::optional<vmap_ros::Localization> answer_;
 };
 
 sensor_msgs::Image ImageMessage(const Frame& frame, const ros::Time& stamp) {
@@ -187,8 +193,7 @@ nav_msgs::Odometry OdometryMessage(const OdometrySample& odometry, const ros::Ti
 }
 
 // The localization and the controller's step a trial records, from the vmap node's messages.
-void FromMessages(const vmap_ros::Localization& message, const geometry_msgs::Twist& command,
-                  LocalizationResult* localization, ControlStep* step) {
+void FromMessage(const vmap_ros::Localization& message, LocalizationResult* localization, ControlStep* step) {
   localization->key = message.key;
   localization->next_key = message.next_key;
   switch (message.status) {
@@ -208,8 +213,8 @@ void FromMessages(const vmap_ros::Localization& message, const geometry_msgs::Tw
   step->steering = message.steering;
   step->localized = message.localized;
   step->target_key = message.next_key >= 0 ? message.next_key : message.key;
-  step->command.linear = command.linear.x;
-  step->command.angular = command.angular.z;
+  step->command.linear = message.command.linear.x;
+  step->command.angular = message.command.angular.z;
 }
 
 nlohmann::json TrialJson(const TrialResult& trial) {
@@ -257,12 +262,18 @@ int RunTheSimulator(ros::NodeHandle& node, ros::NodeHandle& private_node) {
   const TrialResult in_process = RunTrial(context, trial);
 
   // The robot on ROS.
-  ros::Publisher camera = node.advertise<sensor_msgs::Image>("camera/image_raw", 1);
+  // A subscriber that connects while a frame waits for its answer (a vmap node restarted) is sent the frame again.
+  std::atomic<bool> camera_subscribed{false};
+  ros::Publisher camera = node.advertise<sensor_msgs::Image>(
+      "camera/image_raw", 1, [&](const ros::SingleSubscriberPublisher&) { camera_subscribed = true; });
   ros::Publisher camera_info = node.advertise<sensor_msgs::CameraInfo>("camera/camera_info", 1);
   ros::Publisher odometry = node.advertise<nav_msgs::Odometry>("odom", 10);
   ros::Publisher ready = private_node.advertise<std_msgs::Bool>("ready", 1, /*latch=*/true);
   Answers answers;
-  const ros::Subscriber commands = node.subscribe("cmd_vel", 100, &Answers::OnCommand, &answers);
+  // The commands travel in the localization messages too; subscribed to meet the vmap node's publisher (a remapping
+  // that does not meet it is said while waiting).
+  const ros::Subscriber commands = node.subscribe<geometry_msgs::Twist>(
+      "cmd_vel", 100, boost::function<void(const geometry_msgs::Twist::ConstPtr&)>([](const auto&) {}));
   const ros::Subscriber localizations = node.subscribe("localization", 100, &Answers::OnLocalization, &answers);
   ros::AsyncSpinner spinner(1);
   spinner.start();
@@ -286,13 +297,18 @@ int RunTheSimulator(ros::NodeHandle& node, ros::NodeHandle& private_node) {
   while (!StopRequested() && run.Continues()) {
     const Frame frame = run.Render();
     const ros::Time stamp(kStampOffset + run.time());
-    odometry.publish(OdometryMessage(run.odometry(), stamp));
-    camera_info.publish(CameraInfoMessage(rig, stamp));
-    camera.publish(ImageMessage(frame, stamp));
+    const auto send = [&] {
+      camera_subscribed = false;
+      odometry.publish(OdometryMessage(run.odometry(), stamp));
+      camera_info.publish(CameraInfoMessage(rig, stamp));
+      camera.publish(ImageMessage(frame, stamp));
+    };
+    answers.Await(stamp);
+    send();
     const auto sent = std::chrono::steady_clock::now();
-    vmap_ros::Localization message;
-    geometry_msgs::Twist command;
-    if (!answers.Wait(stamp, answer_timeout, &message, &command)) {
+    const std::optional<vmap_ros::Localization> message = answers.Wait(
+        answer_timeout, [&] { return camera_subscribed.load(); }, send);
+    if (!message) {
       if (StopRequested()) break;
       failure = fmt::format("no answer from the vmap node to frame {} within {} s (~answer_timeout)", run.step(),
                             answer_timeout);
@@ -300,7 +316,7 @@ int RunTheSimulator(ros::NodeHandle& node, ros::NodeHandle& private_node) {
     }
     LocalizationResult localization;
     ControlStep step;
-    FromMessages(message, command, &localization, &step);
+    FromMessage(*message, &localization, &step);
     run.Record(localization, step, std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count());
     // At the goal the controller slows the robot down within its decelerations: the robot stops where that ends.
     if (step.state == ControllerState::kReachedGoal && step.command.stops()) break;
@@ -310,7 +326,8 @@ int RunTheSimulator(ros::NodeHandle& node, ros::NodeHandle& private_node) {
     ROS_WARN("vmap simulator: stopped during trial %d after %d frames; no result written", trial, run.step());
     return StoppedStatus();
   }
-  const TrialResult through_ros = run.Finish();
+  TrialResult through_ros = run.Finish();
+  if (!failure.empty() && through_ros.end.empty()) through_ros.end = "no answer";
   nlohmann::json result = {{"route", context.route->name},
                            {"trial", trial},
                            {"key_images", prepared->map().map.key_images.size()},
