@@ -145,6 +145,10 @@ void CheckOutputDirectory(const std::filesystem::path& final_path, const OutputP
 // `path`'s file name). Called by every output before it writes; exposed for tests.
 void RemoveStaleTemporaries(const std::filesystem::path& path);
 
+// The pid of another live vmap process writing the output at `path` (its ".NAME.partial-PID-N" beside it: a build
+// that will replace it), or 0.
+long OtherWriterOf(const std::filesystem::path& path);
+
 // Removes every temporary output this process still has, and keeps them from being created or committed from
 // then on: for the last moments of an interrupted process only. Returns how many were removed.
 int RemoveTemporaryOutputsForExit();

@@ -79,6 +79,20 @@ void RemoveStaleTemporaries(const fs::path& path) {
   }
 }
 
+long OtherWriterOf(const fs::path& path) {
+  const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  const std::string name = path.filename().string();
+  const std::string partial = "." + name + ".partial-";
+  std::error_code ec;
+  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string file_name = it->path().filename().string();
+    if (file_name.rfind(partial, 0) != 0) continue;
+    const long pid = TemporaryOwner(file_name, name);
+    if (pid != 0 && pid != static_cast<long>(getpid()) && ProcessRuns(pid)) return pid;
+  }
+  return 0;
+}
+
 int RemoveTemporaryOutputsForExit() {
   // Locked for good: nothing new is created or committed while the process ends.
   Temporaries().mutex.lock();

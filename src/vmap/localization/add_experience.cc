@@ -74,6 +74,14 @@ AddExperienceSummary AddExperience(const fs::path& map_directory, FrameSource& s
   // writer's map.json is written over with a copy that lacks their work.
   const DirectoryWriteLock lock(map_directory, "the map");
   const fs::path& map_path = lock.path();  // its real path: nothing below is written through a link
+  // A build started before this add replaces the map once it ends, without the experience: it said it was added,
+  // and was gone (the build claims the folder only when it puts its map in place).
+  if (const long builder = OtherWriterOf(map_path); builder != 0) {
+    throw InputError(
+        fmt::format("'{}' is being rebuilt by vmap process {}, which will replace the map and drop what is "
+                    "added to it now: add the experience once that build has finished",
+                    map_path.string(), builder));
+  }
   // map.json is replaced at the end: one that may not be (read-only, a link) refuses the run before the work.
   CheckOutputFiles({{map_path / kMapFileName, "the map's map.json"}}, {});
   KeyImageStoreOptions store_options;

@@ -1,6 +1,8 @@
 // `vmap build REPEAT --add-experience-to MAP` and `vmap localize` of a map with experiences, end to end on the
 // michigan seasonal images: one session a map of its 5 places, another session added as an experience.
 
+#include <unistd.h>
+
 #include <fstream>
 #include <sstream>
 
@@ -91,6 +93,34 @@ TEST(AddExperienceCli, AddsASessionAndLocalizeReportsTheExperienceUsed) {
       EXPECT_TRUE(frame["experience"] == 0 || frame["experience"] == 1);
     }
   }
+}
+
+// A map and its experience are replaced together, and never by surprise: an add while a build started before it is
+// replacing the map is refused (the build's map, put in place after, lacked it: the add had said it was added); a
+// build over a map with experiences says that it drops them; a killed add's temporary is no user file the rebuilt
+// map keeps.
+TEST(AddExperienceCli, AnExperienceIsNeverAddedToAMapABuildIsReplacing) {
+  SKIP_WITHOUT_SHARED();
+  ::vmap::testing::ScopedTempDir tmp("experience_rebuilt");
+  const fs::path map = tmp.path() / "map", repeat = SessionFolder(tmp.path(), 2);
+  std::string out;
+  ASSERT_EQ(RunVmap("build " + Quote(SessionFolder(tmp.path(), 1)) + " -o " + Quote(map) + " -q", &out), 0) << out;
+  // A build of this process (alive) writing the map's replacement beside it.
+  const fs::path building = tmp.path() / (".map.partial-" + std::to_string(getpid()) + "-0");
+  fs::create_directories(building);
+  EXPECT_EQ(RunVmap("build " + Quote(repeat) + " --add-experience-to " + Quote(map), &out), 2) << out;
+  EXPECT_NE(out.find("is being rebuilt by vmap process " + std::to_string(getpid())), std::string::npos) << out;
+  fs::remove(building);
+  ASSERT_EQ(RunVmap("build " + Quote(repeat) + " --add-experience-to " + Quote(map) + " -q", &out), 0) << out;
+  ASSERT_TRUE(fs::is_directory(map / "experiences/1"));
+  // Left by an add that was killed (no such process).
+  const fs::path dead = map / ".experiences.partial-999999999-0";
+  fs::create_directories(dead);
+  ASSERT_EQ(RunVmap("build " + Quote(SessionFolder(tmp.path(), 3)) + " -o " + Quote(map), &out), 0) << out;
+  EXPECT_NE(out.find("holds 1 experience(s) of other runs, which the new map replaces"), std::string::npos) << out;
+  EXPECT_EQ(out.find(".experiences.partial"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(dead));
+  EXPECT_FALSE(fs::exists(map / "experiences"));
 }
 
 }  // namespace

@@ -10,8 +10,10 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/atomic_output.h"
+#include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
 #include "vmap/core/interrupt.h"
+#include "vmap/map/map_io.h"
 #include "vmap/map/map_writer.h"
 #include "vmap/mapping/batch_build.h"
 #include "vmap/mapping/map_builder.h"
@@ -199,6 +201,23 @@ std::vector<std::string> BuildPipelineOptions::FilesRead() const {
   return files;
 }
 
+namespace {
+
+// Said before the work, so that a user who wanted to keep them can stop: the experiences of a map the build replaces
+// are dropped with it (their views were matched to its key images, which the new map's are not).
+void WarnOfExperiencesReplaced(const std::string& map_directory) {
+  const ContainedJson map_json = ReadContainedJson(map_directory, kMapFileName, kMaxMapJsonBytes, kMaxMapJsonValues);
+  if (!map_json.document || !map_json.document->is_object()) return;
+  const auto experiences = map_json.document->find("experiences");
+  if (experiences == map_json.document->end() || !experiences->is_array() || experiences->empty()) return;
+  spdlog::warn(
+      "'{}' holds {} experience(s) of other runs, which the new map replaces with the old one: add them again "
+      "with `vmap build RUN --add-experience-to {}` once it is built",
+      map_directory, experiences->size(), map_directory);
+}
+
+}  // namespace
+
 BuildPipelineResult RunBuildPipeline(const BuildPipelineOptions& pipeline, FrameSource* given_source,
                                      const std::vector<std::string>& source_files) {
   // 1. The options, τ resolved; the progress line where the log shows information.
@@ -212,6 +231,7 @@ BuildPipelineResult RunBuildPipeline(const BuildPipelineOptions& pipeline, Frame
   std::vector<std::string> files_read = pipeline.FilesRead();
   files_read.insert(files_read.end(), source_files.begin(), source_files.end());
   AtomicOutputDirectory directory(result.directory, MapOutputPolicy(files_read));
+  WarnOfExperiencesReplaced(result.directory);
 
   // 3. The matcher (a deep model loads its weights here).
   const std::unique_ptr<Matcher> matcher = CreateMatcher(pipeline.matcher);

@@ -4,6 +4,7 @@
 #include <set>
 #include <string>
 
+#include "vmap/core/temporary_name.h"
 #include "vmap/evaluation/evaluation_json.h"
 #include "vmap/localization/key_image_store.h"
 #include "vmap/map/experiences.h"
@@ -77,7 +78,15 @@ OutputPolicy MapOutputPolicy(const std::vector<std::string>& inputs) {
   // A map costs a run, and a teach run cannot be made again: one that cannot be put in place is kept beside.
   policy.keep_if_commit_fails = true;
   // A rebuild keeps the teach odometry, notes and runs' outputs the folder held besides the map.
-  policy.is_own_entry = [](const std::string& name) { return MapFileNames().count(name) > 0; };
+  // An own file's temporary (".experiences.partial-PID-N" of an add that was killed) is its too: carried into the new
+  // map, it was kept as if it were the user's.
+  policy.is_own_entry = [](const std::string& name) {
+    if (MapFileNames().count(name) > 0) return true;
+    for (const std::string& own : MapFileNames()) {
+      if (TemporaryOwner(name, own) != 0) return true;
+    }
+    return false;
+  };
   return policy;
 }
 
