@@ -50,6 +50,16 @@ std::string FormatMapSummary(const VisualMap& map, QualityMean mean) {
   return text;
 }
 
+namespace {
+
+// A threshold as the user gave it: two decimals (0.50), more where two would read two thresholds alike (0.101, 0.104).
+std::string TauText(double tau) {
+  const std::string two = fmt::format("{:.2f}", tau);
+  return std::stod(two) == tau ? two : fmt::format("{:.12g}", tau);
+}
+
+}  // namespace
+
 std::string SweepToMarkdown(const SweepResult& sweep) {
   std::string text =
       fmt::format("Threshold sweep of {} ({} frames, {:.1f} s)\n\n", sweep.input.path, sweep.num_frames, sweep.seconds);
@@ -62,9 +72,10 @@ std::string SweepToMarkdown(const SweepResult& sweep) {
   for (size_t i = 0; i < sweep.rows.size(); ++i) {
     const SweepRow& r = sweep.rows[i];
     const bool best = static_cast<int>(i) == sweep.best_row;
-    text += fmt::format("| {}{:.2f}{} | {} | {:.1f} | {} | {} | {:.1f} | {:.3f} | {}{:.4f}{} |", best ? "**" : "",
-                        r.tau, best ? "**" : "", r.num_key_images, r.key_image_percent, r.min_verified, r.max_verified,
-                        r.mean_verified, r.mean_similarity, best ? "**" : "", r.quality, best ? "**" : "");
+    text +=
+        fmt::format("| {}{}{} | {} | {:.1f} | {} | {} | {:.1f} | {:.3f} | {}{:.4f}{} |", best ? "**" : "",
+                    TauText(r.tau), best ? "**" : "", r.num_key_images, r.key_image_percent, r.min_verified,
+                    r.max_verified, r.mean_verified, r.mean_similarity, best ? "**" : "", r.quality, best ? "**" : "");
     if (has_usable) {
       const int links = std::max(0, r.num_key_images - 1);
       text += r.usable_links < 0 ? " - |"
@@ -73,7 +84,7 @@ std::string SweepToMarkdown(const SweepResult& sweep) {
     }
     text += "\n";
   }
-  if (sweep.best_row >= 0) text += fmt::format("\nBest tau by Q: {:.2f}\n", sweep.rows[sweep.best_row].tau);
+  if (sweep.best_row >= 0) text += fmt::format("\nBest tau by Q: {}\n", TauText(sweep.rows[sweep.best_row].tau));
   return text;
 }
 

@@ -68,4 +68,16 @@ TEST(Summary, SweepTablesMarkTheBestTau) {
   EXPECT_EQ(json["rows"][1]["key_images"], 20);
 }
 
+// Thresholds two decimals would read alike keep their own: two rows of "0.10" did not say which was best.
+TEST(Summary, SweepTablesTellCloseThresholdsApart) {
+  SweepResult sweep = TwoRows();
+  sweep.rows[0].tau = 0.101;
+  sweep.rows[1].tau = 0.104;
+  sweep.best_row = 1;
+  const std::string md = SweepToMarkdown(sweep);
+  EXPECT_NE(md.find("| 0.101 | 5 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| **0.104** | 20 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("Best tau by Q: 0.104"), std::string::npos) << md;
+}
+
 }  // namespace vmap
