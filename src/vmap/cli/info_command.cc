@@ -2,6 +2,11 @@
 
 #include <filesystem>
 #include <iostream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "vmap/cli/commands.h"
 #include "vmap/map/map_io.h"
@@ -30,6 +35,12 @@ void AddInfoCommand(CLI::App& app) {
     const VisualMap& map = read.map;
     const RecordedOptions& options = read.options;
     std::cout << FormatMapSummary(map, options.builder.quality_mean);
+    if (!map.experiences.empty()) {
+      std::vector<std::string> views;
+      for (const Experience& experience : map.experiences) views.push_back(std::to_string(experience.views.size()));
+      std::cout << fmt::format("experiences     {} ({} views of the {} key images)\n", map.experiences.size(),
+                               fmt::join(views, ", "), map.key_images.size());
+    }
     if (!options.matcher_type.empty()) {
       std::cout << "matcher         " << options.matcher_type << ", verifier "
                 << VerifierMethodName(options.builder.verifier.method) << ", tau " << options.builder.key_images.tau

@@ -113,6 +113,8 @@ TEST(AddExperienceCli, AnExperienceIsNeverAddedToAMapABuildIsReplacing) {
   fs::remove(building);
   ASSERT_EQ(RunVmap("build " + Quote(repeat) + " --add-experience-to " + Quote(map) + " -q", &out), 0) << out;
   ASSERT_TRUE(fs::is_directory(map / "experiences/1"));
+  ASSERT_EQ(RunVmap("info " + Quote(map), &out), 0) << out;
+  EXPECT_NE(out.find("experiences     1 ("), std::string::npos) << out;
   // Left by an add that was killed (no such process).
   const fs::path dead = map / ".experiences.partial-999999999-0";
   fs::create_directories(dead);

@@ -5,6 +5,7 @@
 #include <optional>
 #include <set>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/contained_file.h"
@@ -110,6 +111,12 @@ std::vector<Experience> ExperiencesFromJson(const json& value, const VisualMap& 
       if (!timestamp.is_null() && v.timestamp < 0) reader.Fail(at + ".timestamp", "must be null or >= 0");
       v.source_name = reader.String(views[j], at, "source_name");
       v.heading_px = reader.Number(views[j], at, "heading_px");
+      // A heading is where the scene moved within the frame: one beyond its width (1e308) is damage, and would be
+      // steered by.
+      const int width = map.input.frame_size.width;
+      if (width > 0 && !(std::abs(v.heading_px) <= width)) {
+        reader.Fail(at + ".heading_px", fmt::format("{:g} is beyond the frames' width of {} px", v.heading_px, width));
+      }
       v.num_verified = static_cast<int>(reader.Integer(views[j], at, "verified", 0, kMaxInt));
       v.image_file = reader.String(views[j], at, "image");
       if (!IsPlainRelativePath(v.image_file)) reader.Fail(at + ".image", "points outside the map directory");

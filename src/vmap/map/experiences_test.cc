@@ -100,6 +100,9 @@ TEST(Experiences, RefusesMalformedEntriesNamingTheField) {
   bad[0]["views"][0]["heading_px"] = "left";
   expect_refused(bad, "experiences[0].views[0].heading_px");
   bad = good;
+  bad[0]["views"][0]["heading_px"] = 1.7e308;  // a number, but no heading within the frame: damage
+  expect_refused(bad, "experiences[0].views[0].heading_px' 1.7e+308 is beyond the frames' width of 64 px");
+  bad = good;
   bad[0]["views"][0]["image"] = "../outside.png";
   expect_refused(bad, "points outside the map directory");
   bad = good;
