@@ -1,6 +1,7 @@
 // The node's parts that need no ROS master: the mailbox, camera messages as frames, the odometry buffer, parameter
 // names, the localization message's pose.
 
+#include <chrono>
 #include <cmath>
 #include <thread>
 
@@ -187,6 +188,29 @@ TEST(OdometryBuffer, InterpolatesBetweenSamplesAndGivesNoneOutsideThem) {
   EXPECT_FALSE(buffer.Add({2.6, 2.1, 0.0, 0.0}));
   ASSERT_TRUE(buffer.At(2.55).has_value());
   EXPECT_NEAR(buffer.At(2.55)->x, 2.05, 1e-12);
+}
+
+// ~odom_wait: a frame newer than the newest sample waits for the sample of its time while the odometry comes (the
+// simulator publishes it just before the frame, on another connection: read before it came, the frame took the sample
+// before it, and two runs of one trial drove apart), and not at all once the odometry has stopped.
+TEST(OdometryBuffer, AFrameWaitsForTheOdometryOfItsTimeWhileItComes) {
+  OdometryBuffer buffer(10.0, 0.5);
+  buffer.Add({1.0, 0.0, 0.0, 0.0});
+  std::thread sender([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    buffer.Add({1.1, 0.5, 0.0, 0.0});
+  });
+  const auto start = std::chrono::steady_clock::now();
+  buffer.WaitFor(1.1, 30.0);
+  const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  sender.join();
+  EXPECT_LT(waited, 20.0) << "woken by the sample, not the timeout";
+  ASSERT_TRUE(buffer.At(1.1).has_value());
+  EXPECT_EQ(buffer.At(1.1)->x, 0.5) << "the sample of the frame's time, not the one before it";
+  // Odometry that stopped (the newest 0.5 s or more before the frame): no wait.
+  const auto stopped = std::chrono::steady_clock::now();
+  buffer.WaitFor(5.0, 30.0);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - stopped).count(), 20.0);
 }
 
 // The controller's time follows the camera's stamps while they advance; where they go back or stand still it follows

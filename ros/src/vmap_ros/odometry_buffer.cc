@@ -1,10 +1,15 @@
 #include "vmap_ros/odometry_buffer.h"
 
 #include <algorithm>
+#include <chrono>
 
 namespace vmap::ros_node {
 
 bool OdometryBuffer::Add(const OdometrySample& sample) {
+  struct NotifyAfter {
+    std::condition_variable& added;
+    ~NotifyAfter() { added.notify_all(); }
+  } notify{added_};
   std::lock_guard<std::mutex> lock(mutex_);
   bool restarted = false;
   if (!samples_.empty() && sample.timestamp <= samples_.back().timestamp) {
@@ -31,6 +36,16 @@ std::optional<OdometrySample> OdometryBuffer::At(double timestamp) const {
                                       [](const OdometrySample& s, double t) { return s.timestamp < t; });
   if (after == samples_.begin()) return *after;
   return InterpolateOdometry({*(after - 1), *after}, timestamp);
+}
+
+void OdometryBuffer::WaitFor(double timestamp, double seconds) const {
+  if (!(seconds > 0.0)) return;
+  std::unique_lock<std::mutex> lock(mutex_);
+  const auto comes = [&] {
+    return !samples_.empty() && samples_.back().timestamp < timestamp &&
+           timestamp - samples_.back().timestamp <= max_gap_seconds_;
+  };
+  added_.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return !comes(); });
 }
 
 void OdometryBuffer::Clear() {

@@ -2,6 +2,7 @@
 // The robot's recent odometry (nav_msgs/Odometry as it arrives), for the controller to read at each camera frame's
 // time: interpolated between the samples around it, or the last one when the frame is a little newer.
 
+#include <condition_variable>
 #include <deque>
 #include <mutex>
 #include <optional>
@@ -23,12 +24,17 @@ class OdometryBuffer {
   static constexpr double kRestartSeconds = 1.0;
   bool Add(const OdometrySample& sample);
   std::optional<OdometrySample> At(double timestamp) const;
+  // Waits up to `seconds` for a sample at or after `timestamp` while the newest is before it and the odometry still
+  // comes (the newest within the gap At accepts): a frame whose odometry travels on another connection reads the
+  // sample of its own time, not the one before it.
+  void WaitFor(double timestamp, double seconds) const;
   void Clear();
 
  private:
   double keep_seconds_;
   double max_gap_seconds_;
   mutable std::mutex mutex_;
+  mutable std::condition_variable added_;
   std::deque<OdometrySample> samples_;
 };
 

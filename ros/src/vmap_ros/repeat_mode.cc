@@ -31,17 +31,15 @@ std::string RouteText(const std::vector<int>& route) {
 
 }  // namespace
 
-double VmapNode::ReadCameraTimeout() const {
+double VmapNode::ReadSeconds(const char* name, double unset, const char* meaning) const {
   XmlRpc::XmlRpcValue value;
-  if (!private_node_.getParam("camera_timeout", value)) return kCameraTimeout;
+  if (!private_node_.getParam(name, value)) return unset;
   // Read as a value first: getParam into a double leaves the default for "x", silently.
   double seconds = -1.0;
   if (value.getType() == XmlRpc::XmlRpcValue::TypeDouble) seconds = static_cast<double>(value);
   if (value.getType() == XmlRpc::XmlRpcValue::TypeInt) seconds = static_cast<int>(value);
   if (!(seconds >= 0.0 && seconds <= 3600.0)) {
-    throw InputError(
-        "~camera_timeout must be a number of seconds in [0, 3600]: how long the robot keeps its last command "
-        "without a camera frame (0: for ever)");
+    throw InputError(fmt::format("~{} must be a number of seconds in [0, 3600]: {}", name, meaning));
   }
   return seconds;
 }
@@ -62,7 +60,7 @@ bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::St
   ParameterReader parameters(private_node_);
   std::unique_ptr<RepeatRun> run;
   std::string taught_with;
-  double camera_timeout = 0.0;
+  double camera_timeout = 0.0, odom_wait = 0.0;
   try {
     RefuseRecordingParameters();
     parameters.Read(options.session);  // vmap localize's flags, --from and --to included
@@ -72,7 +70,9 @@ bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::St
     options.session.run.show_progress = false;
     ControllerOptions controller;
     parameters.Read(controller);  // the controller's flags (vmap simulate's)
-    camera_timeout = ReadCameraTimeout();
+    camera_timeout = ReadSeconds("camera_timeout", kCameraTimeout,
+                                 "how long the robot keeps its last command without a camera frame (0: for ever)");
+    odom_wait = ReadSeconds("odom_wait", 0.0, "how long a frame waits for the odometry of its time (0: not at all)");
     // The teach run's odometry (~teach_odometry, read with the session's options; else the map folder's), when the
     // robot had one, for the taught speeds and turns and the localizer's pace.
     run = std::make_unique<RepeatRun>(options, controller);
@@ -111,6 +111,7 @@ bool VmapNode::StartRepeat(vmap_ros::StartRepeat::Request& request, vmap_ros::St
     localized_once_ = false;
     goal_reached_ = false;
     camera_timeout_ = camera_timeout;
+    odom_wait_ = odom_wait;
     last_frame_ = ros::WallTime::now();
     quiet_stopped_ = false;
     mailbox_.Reset(1);
@@ -260,6 +261,7 @@ void VmapNode::RepeatFrame(const Arrival& arrival) {
   const double time = image.stamp > 0.0 ? image.stamp : ros::Time::now().toSec();
   RepeatStep step;
   ControlSummary control;
+  odometry_.WaitFor(time, odom_wait_);
   const std::optional<OdometrySample> odometry = odometry_.At(time);
   if (mode == Mode::kPaused) {
     step.localization = repeat_->Localize(image, odometry ? &*odometry : nullptr);

@@ -160,7 +160,7 @@ std::set<std::string> VmapNode::KnownParameters() const {
   names.Add(repeat);
   names.Add(controller);
   std::set<std::string> known = names.names();
-  known.insert({"map", "teach_queue", "teach_odometry", "teach_odometry_topic", "camera_timeout"});
+  known.insert({"map", "teach_queue", "teach_odometry", "teach_odometry_topic", "camera_timeout", "odom_wait"});
   return known;
 }
 

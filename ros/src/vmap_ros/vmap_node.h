@@ -131,8 +131,9 @@ class VmapNode {
   void PublishCommand(const geometry_msgs::Twist& command);
   // A repeat run's camera that has sent no frame for ~camera_timeout seconds: the robot stops until frames come.
   void StopIfCameraQuiet();
-  // ~camera_timeout, checked (InputError); kCameraTimeout when unset.
-  double ReadCameraTimeout() const;
+  // The private parameter `name`, seconds in [0, 3600], checked (InputError saying what it is: `meaning`);
+  // `unset` when it is not set.
+  double ReadSeconds(const char* name, double unset, const char* meaning) const;
 
   ros::NodeHandle node_;
   ros::NodeHandle private_node_;
@@ -171,6 +172,7 @@ class VmapNode {
   bool goal_reached_ = false;
   // The camera watchdog (worker thread only, but for camera_timeout_, set at a start before frames come).
   double camera_timeout_ = 1.0;  // seconds; 0 = none
+  double odom_wait_ = 0.0;       // ~odom_wait: seconds a frame waits for the odometry of its time; 0 = none
   ros::WallTime last_frame_;     // when the repeat run started or last processed a frame
   bool quiet_stopped_ = false;   // the watchdog stopped the robot and no frame has come since
   OdometryBuffer odometry_;
