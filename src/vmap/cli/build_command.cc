@@ -3,10 +3,14 @@
 
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "vmap/cli/commands.h"
 #include "vmap/cli/option_binder.h"
@@ -24,7 +28,41 @@ struct BuildCommand {
   AddExperiencePipelineOptions add;
   OptionFlags flags;
   std::vector<const CLI::Option*> acceptance;  // the repeat run's flags: they go with --add-experience-to only
+  std::set<std::string> add_paths;             // the paths of the fields --add-experience-to reads
 };
+
+// The paths of the fields an options struct's flags set.
+class FieldPaths final : public OptionFieldVisitor {
+ public:
+  std::set<std::string> paths;
+
+ protected:
+  void OnField(const OptionField& field, int& /*value*/) override { paths.insert(Path(field)); }
+  void OnField(const OptionField& field, double& /*value*/) override { paths.insert(Path(field)); }
+  void OnField(const OptionField& field, bool& /*value*/) override { paths.insert(Path(field)); }
+  void OnField(const OptionField& field, std::string& /*value*/) override { paths.insert(Path(field)); }
+  void OnField(const OptionField& field, std::vector<int>& /*value*/) override { paths.insert(Path(field)); }
+  void OnField(const OptionField& field, const EnumField& /*value*/) override { paths.insert(Path(field)); }
+  void OnField(const OptionField& field, std::optional<double>& /*value*/) override { paths.insert(Path(field)); }
+};
+
+// The flags given that set only how a map is built (its matcher's options, tau, the verifier, a mask): an experience
+// is matched with the map's own options, and these were taken and ignored.
+std::vector<std::string> BuildOnlyFlagsGiven(const BuildCommand& command) {
+  std::set<std::string> read_by_add, build_only;
+  const std::vector<std::string> given = command.flags.Given();
+  for (const std::string& path : given) {
+    // --threads sets the add's extraction threads too (RunAddExperience).
+    if (command.add_paths.count(path) > 0 || path.rfind("experience.", 0) == 0 || path == "extraction_threads") {
+      read_by_add.insert(command.flags.FlagOf(path));
+    }
+  }
+  for (const std::string& path : given) {
+    const std::string flag = command.flags.FlagOf(path);
+    if (!flag.empty() && read_by_add.count(flag) == 0) build_only.insert(flag);
+  }
+  return {build_only.begin(), build_only.end()};
+}
 
 // vmap build REPEAT --add-experience-to MAP: the input is localized against MAP and added as an experience.
 void RunAddExperience(const BuildCommand& command) {
@@ -37,8 +75,16 @@ void RunAddExperience(const BuildCommand& command) {
         "--add-experience-to takes a whole recorded run; drop --snapshot-every, --until-interrupted "
         "and --report");
   }
-  const AddExperienceSummary added = RunAddExperiencePipeline(command.add);
-  std::cout << fmt::format("experience      {} of map {}\n", added.experience.id, command.add.map)
+  if (const std::vector<std::string> ignored = BuildOnlyFlagsGiven(command); !ignored.empty()) {
+    throw InputError(
+        fmt::format("{} set how a map is built; --add-experience-to matches the run with the map's own "
+                    "options: drop {}",
+                    fmt::join(ignored, ", "), ignored.size() == 1 ? "it" : "them"));
+  }
+  AddExperiencePipelineOptions add = command.add;
+  add.experience.run.extraction_threads = build.map.extraction_threads;
+  const AddExperienceSummary added = RunAddExperiencePipeline(add);
+  std::cout << fmt::format("experience      {} of map {}\n", added.experience.id, add.map)
             << fmt::format("frames          {} ({} lost)\n", added.frames, added.lost)
             << fmt::format("views           {} of {} key images\n", added.experience.views.size(),
                            added.num_key_images);
@@ -96,6 +142,9 @@ void AddBuildCommand(CLI::App& app) {
   OptionBinder binder;
   binder.Add("", state->build);
   binder.Add("", state->add, Nesting{false, {"experience"}});
+  FieldPaths add_paths;
+  add_paths.VisitNested("", state->add, Nesting{false, {"experience"}});
+  state->add_paths = std::move(add_paths.paths);
   binder.Bind(command, state->flags);
   // When a frame of the repeat run is seen at a key image, as `vmap localize` decides it (localize.md): four of
   // the localizer's options, with help that says they belong to --add-experience-to.

@@ -111,7 +111,14 @@ TEST(AddExperienceCli, AnExperienceIsNeverAddedToAMapABuildIsReplacing) {
   EXPECT_EQ(RunVmap("build " + Quote(repeat) + " --add-experience-to " + Quote(map), &out), 2) << out;
   EXPECT_NE(out.find("is being rebuilt by vmap process " + std::to_string(getpid())), std::string::npos) << out;
   fs::remove(building);
-  ASSERT_EQ(RunVmap("build " + Quote(repeat) + " --add-experience-to " + Quote(map) + " -q", &out), 0) << out;
+  // A flag that sets how a map is built is refused, not taken and ignored: the run is matched with the map's options.
+  EXPECT_EQ(
+      RunVmap("build " + Quote(repeat) + " --add-experience-to " + Quote(map) + " --orb-features 2000 --tau 0.3", &out),
+      2)
+      << out;
+  EXPECT_NE(out.find("--orb-features, --tau set how a map is built"), std::string::npos) << out;
+  ASSERT_EQ(RunVmap("build " + Quote(repeat) + " --add-experience-to " + Quote(map) + " --threads 1 -q", &out), 0)
+      << out;
   ASSERT_TRUE(fs::is_directory(map / "experiences/1"));
   ASSERT_EQ(RunVmap("info " + Quote(map), &out), 0) << out;
   EXPECT_NE(out.find("experiences     1 ("), std::string::npos) << out;
