@@ -264,7 +264,7 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   comparisons_.Begin(std::move(ahead));
   ranked_.clear();
   bucket_of_position_.clear();
-  blind_ = features.num_features() < options_.min_verified;
+  blind_ = features.num_features() < options_.verifier.min_matches;
   belief_.Predict(motion_steps);
   if (start_unconfirmed_) evidence_belief_.Predict(motion_steps);
   // Guided matching asks where the estimate was dropped for max_lost_frames frames (guided_while_lost).

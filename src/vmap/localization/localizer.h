@@ -481,7 +481,7 @@ class Localizer {
   // The route position a step back of this frame left (Track's step back, or the recheck's relocalization behind the
   // tracked estimate); -1: none.
   int stepped_back_from_ = -1;
-  bool blind_ = false;      // the frame has fewer features than a key image must verify: its evidence weighs nothing
+  bool blind_ = false;      // the frame has fewer features than a comparison needs: its evidence weighs nothing
   EvidenceModel evidence_;  // by the kind of the matcher's descriptors
   using Memo = FrameComparisons::Memo;
   std::vector<RankedKey> ranked_;  // the route ranked for the frame being localized (RankRoute); empty: not yet
