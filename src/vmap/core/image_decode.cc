@@ -19,14 +19,15 @@ cv::Mat DecodeImageFile(const ContainedFile& file, int flags, long max_pixels, s
     return {};
   }
   const auto* encoded = reinterpret_cast<const std::uint8_t*>(bytes.data());
-  if (const char* cut = CutShortImage(encoded, bytes.size())) {
-    *why_not = std::string("is ") + cut;
-    return {};
-  }
   if (const std::optional<cv::Size> announced = ImageHeaderSize(encoded, bytes.size());
       announced && static_cast<long>(announced->width) * announced->height > max_pixels) {
     *why_not = fmt::format("announces {}x{} in its header, more than {} pixels", announced->width, announced->height,
                            max_pixels);
+    return {};
+  }
+  // After the announced size: a header alone (a decompression bomb) is cut short too, and its size says more.
+  if (const char* cut = CutShortImage(encoded, bytes.size())) {
+    *why_not = std::string("is ") + cut;
     return {};
   }
   cv::Mat image;
