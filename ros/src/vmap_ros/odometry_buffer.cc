@@ -6,19 +6,18 @@
 namespace vmap::ros_node {
 
 bool OdometryBuffer::Add(const OdometrySample& sample) {
-  struct NotifyAfter {
-    std::condition_variable& added;
-    ~NotifyAfter() { added.notify_all(); }
-  } notify{added_};
-  std::lock_guard<std::mutex> lock(mutex_);
   bool restarted = false;
-  if (!samples_.empty() && sample.timestamp <= samples_.back().timestamp) {
-    if (sample.timestamp > samples_.back().timestamp - kRestartSeconds) return false;
-    samples_.clear();
-    restarted = true;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!samples_.empty() && sample.timestamp <= samples_.back().timestamp) {
+      if (sample.timestamp > samples_.back().timestamp - kRestartSeconds) return false;
+      samples_.clear();
+      restarted = true;
+    }
+    samples_.push_back(sample);
+    while (samples_.front().timestamp < sample.timestamp - keep_seconds_) samples_.pop_front();
   }
-  samples_.push_back(sample);
-  while (samples_.front().timestamp < sample.timestamp - keep_seconds_) samples_.pop_front();
+  added_.notify_all();
   return restarted;
 }
 

@@ -52,10 +52,7 @@ std::vector<std::string> BuildOnlyFlagsGiven(const BuildCommand& command) {
   std::set<std::string> read_by_add, build_only;
   const std::vector<std::string> given = command.flags.Given();
   for (const std::string& path : given) {
-    // --threads sets the add's extraction threads too (RunAddExperience).
-    if (command.add_paths.count(path) > 0 || path.rfind("experience.", 0) == 0 || path == "extraction_threads") {
-      read_by_add.insert(command.flags.FlagOf(path));
-    }
+    if (command.add_paths.count(path) > 0) read_by_add.insert(command.flags.FlagOf(path));
   }
   for (const std::string& path : given) {
     const std::string flag = command.flags.FlagOf(path);
@@ -81,10 +78,8 @@ void RunAddExperience(const BuildCommand& command) {
                     "options: drop {}",
                     fmt::join(ignored, ", "), ignored.size() == 1 ? "it" : "them"));
   }
-  AddExperiencePipelineOptions add = command.add;
-  add.experience.run.extraction_threads = build.map.extraction_threads;
-  const AddExperienceSummary added = RunAddExperiencePipeline(add);
-  std::cout << fmt::format("experience      {} of map {}\n", added.experience.id, add.map)
+  const AddExperienceSummary added = RunAddExperiencePipeline(command.add);
+  std::cout << fmt::format("experience      {} of map {}\n", added.experience.id, command.add.map)
             << fmt::format("frames          {} ({} lost)\n", added.frames, added.lost)
             << fmt::format("views           {} of {} key images\n", added.experience.views.size(),
                            added.num_key_images);
@@ -142,17 +137,21 @@ void AddBuildCommand(CLI::App& app) {
   OptionBinder binder;
   binder.Add("", state->build);
   binder.Add("", state->add, Nesting{false, {"experience"}});
+  // --threads sets the repeat run's extraction threads too; the run's other flag is localize's alone.
+  const Nesting run_threads{false, {"compare_ahead"}};
+  binder.Add("experience.run", state->add.experience.run, run_threads);
   FieldPaths add_paths;
   add_paths.VisitNested("", state->add, Nesting{false, {"experience"}});
-  state->add_paths = std::move(add_paths.paths);
+  add_paths.VisitNested("experience.run", state->add.experience.run, run_threads);
   binder.Bind(command, state->flags);
   // When a frame of the repeat run is seen at a key image, as `vmap localize` decides it (localize.md): four of
   // the localizer's options, with help that says they belong to --add-experience-to.
   LocalizerOptions& localizer = state->add.experience.localizer;
   OptionFlags& flags = state->flags;
+  const auto read_by_add = [&add_paths](const char* path) { return *add_paths.paths.insert(path).first; };
   state->acceptance = {
       flags
-          .Record("experience.localizer.acceptance",
+          .Record(read_by_add("experience.localizer.acceptance"),
                   command->add_option_function<std::string>(
                       "--acceptance",
                       [&localizer](const std::string& rule) { localizer.acceptance = ParseAcceptanceRule(rule); },
@@ -161,24 +160,28 @@ void AddBuildCommand(CLI::App& app) {
           ->default_str(AcceptanceRuleName(localizer.acceptance))
           ->group(kAddExperienceSection),
       flags
-          .AddOption(command, "--max-log10-nfa", localizer.max_log10_nfa, "experience.localizer.max_log10_nfa",
+          .AddOption(command, "--max-log10-nfa", localizer.max_log10_nfa,
+                     read_by_add("experience.localizer.max_log10_nfa"),
                      "--add-experience-to, --acceptance chance: accept when log10 of the number of false alarms "
                      "is at most this")
           ->type_name(TypeWithRange(localizer, "max_log10_nfa"))
           ->capture_default_str()
           ->group(kAddExperienceSection),
       flags
-          .AddOption(command, "--min-verified", localizer.min_verified, "experience.localizer.min_verified",
+          .AddOption(command, "--min-verified", localizer.min_verified,
+                     read_by_add("experience.localizer.min_verified"),
                      "--add-experience-to, --acceptance counts: verified matches a frame needs")
           ->type_name(TypeWithRange(localizer, "min_verified"))
           ->capture_default_str()
           ->group(kAddExperienceSection),
       flags
-          .AddOption(command, "--min-similarity", localizer.min_similarity, "experience.localizer.min_similarity",
+          .AddOption(command, "--min-similarity", localizer.min_similarity,
+                     read_by_add("experience.localizer.min_similarity"),
                      "--add-experience-to, --acceptance counts: S a frame needs")
           ->type_name(TypeWithRange(localizer, "min_similarity"))
           ->capture_default_str()
           ->group(kAddExperienceSection)};
+  state->add_paths = std::move(add_paths.paths);
   command->callback([state] { state->flags.Run([&] { RunBuild(*state); }); });
 }
 

@@ -64,33 +64,48 @@ void RemoveAndUnregister(const fs::path& path) {
 using internal::LockIsHeld;
 using internal::Temporaries;
 
-void RemoveStaleTemporaries(const fs::path& path) {
+namespace {
+
+// Calls visit(temporary, owner_pid) for each temporary beside `path` (".NAME.TAG-PID-N", core/temporary_name.h)
+// until it returns false.
+template <typename Visit>
+void ForEachTemporaryOf(const fs::path& path, Visit&& visit) {
   const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
   const std::string name = path.filename().string();
   std::error_code ec;
   for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
     const long pid = TemporaryOwner(it->path().filename().string(), name);
-    if (pid == 0 || ProcessRuns(pid) || LockIsHeld(it->path())) continue;
-    std::error_code removed;
-    fs::remove_all(it->path(), removed);
-    if (!removed) {
-      spdlog::info("removed '{}', left behind by vmap process {}, which was killed", it->path().string(), pid);
-    }
+    if (pid != 0 && !visit(it->path(), pid)) return;
   }
 }
 
+// Whether the process that made `temporary` still runs: its pid in this PID namespace, or its lock wherever it runs.
+bool OwnerIsAlive(const fs::path& temporary, long pid) { return ProcessRuns(pid) || LockIsHeld(temporary); }
+
+}  // namespace
+
+void RemoveStaleTemporaries(const fs::path& path) {
+  ForEachTemporaryOf(path, [](const fs::path& temporary, long pid) {
+    if (OwnerIsAlive(temporary, pid)) return true;
+    std::error_code removed;
+    fs::remove_all(temporary, removed);
+    if (!removed) {
+      spdlog::info("removed '{}', left behind by vmap process {}, which was killed", temporary.string(), pid);
+    }
+    return true;
+  });
+}
+
 long OtherWriterOf(const fs::path& path) {
-  const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
-  const std::string name = path.filename().string();
-  const std::string partial = "." + name + ".partial-";
-  std::error_code ec;
-  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string file_name = it->path().filename().string();
-    if (file_name.rfind(partial, 0) != 0) continue;
-    const long pid = TemporaryOwner(file_name, name);
-    if (pid != 0 && pid != static_cast<long>(getpid()) && ProcessRuns(pid)) return pid;
-  }
-  return 0;
+  const std::string partial = "." + path.filename().string() + ".partial-";
+  long writer = 0;
+  ForEachTemporaryOf(path, [&](const fs::path& temporary, long pid) {
+    const bool other_live_partial = temporary.filename().string().rfind(partial, 0) == 0 &&
+                                    pid != static_cast<long>(getpid()) && OwnerIsAlive(temporary, pid);
+    if (other_live_partial) writer = pid;
+    return !other_live_partial;
+  });
+  return writer;
 }
 
 int RemoveTemporaryOutputsForExit() {
