@@ -170,6 +170,7 @@ nlohmann::json LocalizationFrameJson(const VisualMap& map, const LocalizationRes
       {"timestamp", r.timestamp >= 0 ? json(r.timestamp) : json(nullptr)},
       {"source_name", EncodeFileName(r.source_name)},
       {"status", LocalizationStatusName(r.status)},
+      {"withheld_by", r.withheld_by == Withholding::kNone ? json(nullptr) : json(WithholdingName(r.withheld_by))},
       {"key", r.key},
       {"next_key", r.next_key},
       {"key_frame", KeyFrame(map, r.key)},
@@ -340,6 +341,10 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
       r.timestamp = NumberOr(f, "timestamp", -1.0);
       r.source_name = DecodeFileName(f.value("source_name", ""));
       r.status = ParseStatus(f.at("status").get<std::string>(), file);
+      // Runs written before the rules were named have none.
+      if (f.contains("withheld_by") && f["withheld_by"].is_string()) {
+        r.withheld_by = FindEnum(kWithholdingNames, f["withheld_by"].get<std::string>()).value_or(Withholding::kNone);
+      }
       r.key = IntOr(f, "key", -1, place);
       r.next_key = IntOr(f, "next_key", -1, place);
       r.to_key.key = r.key;

@@ -72,6 +72,7 @@ LocalizationRun SampleRun() {
   uncertain.frame_index = 2;
   uncertain.source_index = 5;
   uncertain.status = LocalizationStatus::kUncertain;
+  uncertain.withheld_by = Withholding::kJumpBack;
   uncertain.confidence = 0.125;
   uncertain.key_rank = 1;
   run.frames = {tracked, lost, uncertain};
@@ -148,7 +149,7 @@ TEST(LocalizationOutput, CsvHasTheNamedColumnsAndOneRowPerFrame) {
   EXPECT_TRUE(ends_with(row0, ",-42.5,-3.25,0.875,2")) << row0;
   EXPECT_TRUE(ends_with(row1, ",,-1")) << row1;
   EXPECT_NE(row2.find(",uncertain,"), std::string::npos) << row2;
-  EXPECT_NE(row2.find(",none: position uncertain,"), std::string::npos) << row2;
+  EXPECT_NE(row2.find(",none: position uncertain (jump back),"), std::string::npos) << row2;
   const std::string with_experiences = LocalizationCsvHeader(true);
   EXPECT_NE(with_experiences.find(",experience,next_experience,confidence,key_rank\n"), std::string::npos);
 }
@@ -175,7 +176,9 @@ TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
   EXPECT_DOUBLE_EQ(doc["frames"][0]["translation_sigma_deg"].get<double>(), 2.5);
   EXPECT_EQ(doc["frames"][0]["guidance"], "heading and translation");
   EXPECT_EQ(doc["frames"][1]["guidance"], "none: lost");
-  EXPECT_EQ(doc["frames"][2]["guidance"], "none: position uncertain");
+  EXPECT_EQ(doc["frames"][2]["guidance"], "none: position uncertain (jump back)");
+  EXPECT_EQ(doc["frames"][2]["withheld_by"], "jump back");
+  EXPECT_TRUE(doc["frames"][0]["withheld_by"].is_null()) << "a tracked frame is withheld by nothing";
   EXPECT_EQ(doc["frames"][2]["status"], "uncertain");
   EXPECT_DOUBLE_EQ(doc["frames"][0]["confidence"].get<double>(), 0.875);
   EXPECT_EQ(doc["frames"][0]["key_rank"], 2);
@@ -218,6 +221,8 @@ TEST(LocalizationOutput, JsonReadsBackWithItsSummary) {
   EXPECT_EQ(r.motion_steps, 3);
   EXPECT_EQ(back.frames[1].motion_steps, 0);
   EXPECT_EQ(back.frames[2].status, LocalizationStatus::kUncertain);
+  EXPECT_EQ(back.frames[2].withheld_by, Withholding::kJumpBack);
+  EXPECT_EQ(back.frames[0].withheld_by, Withholding::kNone);
   EXPECT_DOUBLE_EQ(back.frames[2].confidence, 0.125);
 }
 

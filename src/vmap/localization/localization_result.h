@@ -25,6 +25,31 @@ inline constexpr EnumName<LocalizationStatus> kLocalizationStatusNames[] = {
     {LocalizationStatus::kLost, "lost"},
     {LocalizationStatus::kUncertain, "uncertain"}};
 std::string LocalizationStatusName(LocalizationStatus status);
+
+// The rule that made a frame uncertain (LocalizationResult::withheld_by): what an audit of a run needs to tell a
+// doubt of the belief from one of the tracker. docs/localize.md describes each rule.
+enum class Withholding {
+  kNone,                  // not uncertain
+  kBelief,                // the belief holds too little near the place, or the frames' evidence points away
+  kStartUnconfirmed,      // the run's start place ties a far one, or lies where the belief has not followed
+  kLittleChance,          // placed away from the belief by comparisons little beyond chance
+  kFarPlaceOnOneFrame,    // a far place verified on this frame alone: a jump needs the next frame too
+  kFarPlaceVerifiesMore,  // tracked, while a far place verified more on this frame
+  kJumpBack,              // a jump back that the key images near the estimate verify against
+  kStalledTracker,        // held at a key image while the ranking puts the frame elsewhere
+  kBeliefMoved,           // the belief moved the estimate off the tracker's place, and no key image verifies there
+};
+inline constexpr EnumName<Withholding> kWithholdingNames[] = {
+    {Withholding::kNone, ""},
+    {Withholding::kBelief, "belief"},
+    {Withholding::kStartUnconfirmed, "start unconfirmed"},
+    {Withholding::kLittleChance, "little chance"},
+    {Withholding::kFarPlaceOnOneFrame, "far place on one frame"},
+    {Withholding::kFarPlaceVerifiesMore, "far place verifies more"},
+    {Withholding::kJumpBack, "jump back"},
+    {Withholding::kStalledTracker, "stalled tracker"},
+    {Withholding::kBeliefMoved, "belief moved"}};
+std::string WithholdingName(Withholding rule);
 // Placed: verified at a key image of the route and not doubted, the only frames a robot may steer by (with a
 // heading: MaySteerBy) and the only ones that move the estimate's own key image.
 constexpr bool IsPlaced(LocalizationStatus status) {
@@ -47,7 +72,8 @@ struct LocalizationResult {
   double timestamp = -1.0;
   std::string source_name;
   LocalizationStatus status = LocalizationStatus::kLost;
-  int key = -1;             // the key image the frame is at (the last reached), -1 when unknown
+  Withholding withheld_by = Withholding::kNone;  // why the frame is uncertain; kNone for any other status
+  int key = -1;                                  // the key image the frame is at (the last reached), -1 when unknown
   int next_key = -1;        // the key image ahead on the route; -1 at the route's end or when unknown
   int route_position = -1;  // index of `key` in the route
   KeyComparison to_key;     // the frame against `key`
@@ -92,9 +118,9 @@ struct LocalizationResult {
 
 // What a controller may use of a result: "heading and translation", "heading only: translation unknown"
 // (a pose whose translation direction is not to be trusted), "heading only: no pose" (no camera, or no pose
-// to the target), or nothing to steer by: "none: lost" (kLost), "none: position uncertain" (kUncertain: the
-// key images are a guess), "none" (no heading). Every value that starts with "none" means: do not steer by
-// this frame.
+// to the target), or nothing to steer by: "none: lost" (kLost), "none: position uncertain (RULE)" (kUncertain: the
+// key images are a guess; RULE names withheld_by, and is left out where none is set), "none" (no heading). Every value
+// that starts with "none" means: do not steer by this frame.
 std::string LocalizationGuidance(const LocalizationResult& result);
 // Whether a controller may steer by the result: tracking or relocalized, with a heading to the target
 // (LocalizationGuidance does not start with "none").

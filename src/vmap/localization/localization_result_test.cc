@@ -22,6 +22,10 @@ TEST(LocalizationGuidance, SaysNotToSteerByALostOrUncertainFrame) {
   EXPECT_TRUE(MaySteerBy(r));
   r.status = LocalizationStatus::kUncertain;
   EXPECT_EQ(LocalizationGuidance(r), "none: position uncertain");
+  r.withheld_by = Withholding::kStalledTracker;
+  EXPECT_EQ(LocalizationGuidance(r), "none: position uncertain (stalled tracker)");
+  EXPECT_FALSE(MaySteerBy(r));
+  r.withheld_by = Withholding::kNone;
   EXPECT_FALSE(MaySteerBy(r));
   r.status = LocalizationStatus::kLost;
   EXPECT_EQ(LocalizationGuidance(r), "none: lost");

@@ -289,6 +289,8 @@ LocalizationResult Localizer::Localize(const Frame& frame, const ImageFeatures& 
   if (IsPlaced(result.status)) {
     dropped_position_ = -1;  // steered by again: the drop is behind
   }
+  // A frame the rules above withheld and a later one placed again is not withheld.
+  if (result.status != LocalizationStatus::kUncertain) result.withheld_by = Withholding::kNone;
   result.comparisons = static_cast<int>(comparisons_.size());
   if (result.key >= 0 && result.to_key.key == result.key) {
     result.key_rank = 1 + static_cast<int>(std::count_if(comparisons_.begin(), comparisons_.end(), [&](const Memo& m) {

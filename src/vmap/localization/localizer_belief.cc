@@ -143,9 +143,22 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
   // reads.
   const auto start_ranking = placed ? RankForUnconfirmedStart(result, frame, features) : std::nullopt;
   const bool ties_far = start_ranking && StartPlaceTiesFar(result, features, *start_ranking);
-  if (placed && (ties_far || withheld_unranked || withholds(position) || PlacedAwayOnLittleChance(result) ||
-                 StartAwayLacksBelief(result))) {
-    result.status = LocalizationStatus::kUncertain;
+  if (placed) {
+    // The first rule that withholds the frame names it.
+    Withholding rule = Withholding::kNone;
+    if (ties_far) {
+      rule = Withholding::kStartUnconfirmed;
+    } else if (withheld_unranked || withholds(position)) {
+      rule = Withholding::kBelief;
+    } else if (PlacedAwayOnLittleChance(result)) {
+      rule = Withholding::kLittleChance;
+    } else if (StartAwayLacksBelief(result)) {
+      rule = Withholding::kStartUnconfirmed;
+    }
+    if (rule != Withholding::kNone) {
+      result.status = LocalizationStatus::kUncertain;
+      result.withheld_by = rule;
+    }
   }
   // Confirmed: the frames' evidence alone leans most near the place the frame is steered by (with the frame's ranking
   // and without it).
@@ -164,6 +177,7 @@ void Localizer::Believe(LocalizationResult& result, const Frame& frame, const Im
     guess.candidates = std::move(result.candidates);
     Describe(guess, peak, features);
     guess.status = LocalizationStatus::kUncertain;
+    guess.withheld_by = result.withheld_by;
     guess.belief = std::move(result.belief);
     guess.confidence = belief_.MassWithin(peak, kNear);
     result = std::move(guess);
@@ -346,6 +360,12 @@ void Localizer::Question(LocalizationResult& result, const Frame& frame, const I
   Describe(moved, peak, features);
   const bool verified = moved.to_key.accepted || moved.to_next.accepted;
   moved.status = verified && !jumped ? LocalizationStatus::kRelocalized : LocalizationStatus::kUncertain;
+  // A frame already withheld keeps the rule that withheld it: the move only gives its best guess.
+  if (jumped) {
+    moved.withheld_by = Withholding::kFarPlaceOnOneFrame;
+  } else if (!verified) {
+    moved.withheld_by = result.withheld_by != Withholding::kNone ? result.withheld_by : Withholding::kBeliefMoved;
+  }
   result = std::move(moved);
   if (jumped) return;
   position_ = peak;

@@ -53,6 +53,10 @@ TEST(Localizer, AOneFrameJumpIsUncertainUntilTheFramesThatFollowConfirmIt) {
       EXPECT_TRUE(Brackets(m.map, 41, jumped.key)) << "at key " << jumped.key;
     }
     EXPECT_EQ(jumped.status, min_confidence > 0 ? LocalizationStatus::kUncertain : LocalizationStatus::kRelocalized);
+    // The rule is named, for an audit of the run: the belief, which does not hold the place the tracker took the frame
+    // to, gives its own guess, where no key image verifies.
+    EXPECT_EQ(jumped.withheld_by, min_confidence > 0 ? Withholding::kBeliefMoved : Withholding::kNone);
+    if (min_confidence > 0) EXPECT_EQ(LocalizationGuidance(jumped), "none: position uncertain (belief moved)");
     EXPECT_FALSE(min_confidence > 0 && MaySteerBy(jumped));
     // With the belief the tracker moves once two frames point at the new place and the belief agrees (frame 41 and
     // 43 see the start's far plane too, so it takes a frame or two more); steered by from there on.
@@ -277,6 +281,7 @@ TEST(Localizer, FramesThatVerifyNothingAfterAConfidentRunAreCarriedByTheBelief) 
       EXPECT_FALSE(MaySteerBy(r)) << window;
       if (window > 0) {
         EXPECT_EQ(r.status, LocalizationStatus::kUncertain) << blind;
+        EXPECT_EQ(r.withheld_by, Withholding::kBeliefMoved) << "moved by the belief, nothing verified";
         EXPECT_GE(r.confidence, 0.5) << blind;
         EXPECT_GE(r.route_position, tracked_position - 1) << "carried along the route, not lost";
         EXPECT_LE(r.route_position, tracked_position + 4);

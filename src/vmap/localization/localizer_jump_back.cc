@@ -43,6 +43,7 @@ void Localizer::DoubtJumpBack(LocalizationResult& result) {
   }
   if (near == 0 || near < kNotClearlyWorse * jumped_to) return;
   result.status = LocalizationStatus::kUncertain;
+  result.withheld_by = Withholding::kJumpBack;
   position_ = from;
   step_back_ruled_out_ = {};
 }

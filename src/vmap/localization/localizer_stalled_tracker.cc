@@ -33,7 +33,10 @@ void Localizer::QuestionStalledTracker(const LocalizationResult& result, const F
 void Localizer::DoubtStalledTracker(LocalizationResult& result) const {
   if (!stall_.questioned() || !IsPlaced(result.status)) return;
   const int first = RankingFirst();
-  if (first < 0 || std::abs(first - result.route_position) > kNear) result.status = LocalizationStatus::kUncertain;
+  if (first < 0 || std::abs(first - result.route_position) > kNear) {
+    result.status = LocalizationStatus::kUncertain;
+    result.withheld_by = Withholding::kStalledTracker;
+  }
 }
 
 }  // namespace vmap

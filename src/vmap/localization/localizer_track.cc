@@ -151,6 +151,7 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
     // Lost, or found far from where the frames were on this frame's evidence alone: the estimate stays (uncertain,
     // the best guess, until the next frame confirms the far place).
     result.status = relocalized ? LocalizationStatus::kUncertain : LocalizationStatus::kLost;
+    if (relocalized) result.withheld_by = Withholding::kFarPlaceOnOneFrame;
     result.candidates = std::move(found.candidates);
     position_ = position;
     lost_in_a_row_ = lost_before + 1;
@@ -216,7 +217,10 @@ LocalizationResult Localizer::Track(const Frame& frame, const ImageFeatures& fea
   }
   if (best_position < position) stepped_back_from_ = position;
   result = TrackedAt(std::move(result), position, best_position, features);
-  if (doubted) result.status = LocalizationStatus::kUncertain;
+  if (doubted) {
+    result.status = LocalizationStatus::kUncertain;
+    result.withheld_by = Withholding::kFarPlaceVerifiesMore;
+  }
   return result;
 }
 
