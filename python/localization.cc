@@ -32,7 +32,9 @@ namespace {
 
 // A result as vmap localize's JSON lists a frame (the CSV's columns), with F, R and t as numpy arrays.
 py::object ResultObject(const VisualMap& map, const LocalizationResult& result) {
-  nlohmann::json record = LocalizationFrameJson(map, result);
+  // A map with experiences adds the columns that say whether each comparison was with a view (F and the counts are
+  // then against it), as the CLI's JSON does.
+  nlohmann::json record = LocalizationFrameJson(map, result, !map.experiences.empty());
   py::dict fields;
   for (const auto& [key, value] : record.items()) {
     if (key == "pose") continue;

@@ -252,6 +252,27 @@ def test_localize_equals_vmap_localize(maps, tmp_path):
     assert tracked and all(r.F.shape == (3, 3) for r in tracked if r.next_key >= 0)
 
 
+def test_localize_on_a_map_with_experiences_says_which_view_each_comparison_used(maps, tmp_path):
+    import shutil
+    cli_dir, _, _ = maps
+    experienced = tmp_path / "experienced"
+    shutil.copytree(cli_dir, experienced)
+    # The stretch's odd frames, added as experience 1: frames queried from it verify best against their own view.
+    run_cli("build", VIDEO, "--add-experience-to", experienced, "--first=1", "--last=59", "--stride=2")
+    csv_file = tmp_path / "run.csv"
+    run_cli("localize", experienced, VIDEO, "--first=1", "--last=58", "--stride=3", "--csv", csv_file, "--no-cache")
+    rows = csv_rows(csv_file)
+    results = vmap.localize(vmap.read_map(experienced), str(VIDEO), first=1, last=58, stride=3, no_cache=True)
+    assert_same_localization(results, rows)
+    for result, row in zip(results, rows):
+        for name in ("experience", "next_experience"):
+            value = getattr(result, name)
+            assert (value is None) == (row[name] == ""), name
+            if value is not None:
+                assert value == int(row[name]), name
+    assert any(r.experience == 1 or r.next_experience == 1 for r in results), "no comparison used a view"
+
+
 def test_localizer_frame_by_frame_equals_vmap_localize(maps, tmp_path):
     cli_dir, _, _ = maps
     m = vmap.read_map(cli_dir)

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -173,6 +174,29 @@ TEST(LocalizeCli, RouteForwardsAndBackwards) {
                     &out),
             0)
       << out;
+}
+
+// `vmap localize --from --to` follows the route `vmap route` plans with the same --min-backward-verified: a route
+// that one accepts, the other follows; one it refuses, the other refuses naming the link and the option.
+TEST(LocalizeCli, ARouteIsPlannedAsVmapRoutePlansIt) {
+  SKIP_WITHOUT_SHARED();
+  const VisualMap map = ReadMap(LabMap());
+  ASSERT_GE(map.key_images.size(), 4u);
+  int weakest = map.links[0].num_verified;
+  for (int link = 0; link < 3; ++link) weakest = std::min(weakest, map.links[link].num_verified);
+  ASSERT_GE(weakest, 8);
+  const std::string video = Quote(Shared() / "data/lab_floor/lab_floor.mp4");
+  const std::string strict = " --from 3 --to 0 --min-backward-verified " + std::to_string(weakest + 1);
+  const std::string loose = " --from 3 --to 0 --min-backward-verified " + std::to_string(weakest);
+  std::string out;
+  EXPECT_EQ(RunVmap("route " + Quote(LabMap()) + strict, &out), 2) << out;
+  ASSERT_EQ(RunVmap("localize " + Quote(LabMap()) + " " + video + strict + " --last 2 -q", &out), 2) << out;
+  EXPECT_NE(
+      out.find(fmt::format("verified by {} matches only, fewer than min_backward_verified ({}", weakest, weakest + 1)),
+      std::string::npos)
+      << out;
+  EXPECT_EQ(RunVmap("route " + Quote(LabMap()) + loose, &out), 0) << out;
+  EXPECT_EQ(RunVmap("localize " + Quote(LabMap()) + " " + video + loose + " --last 2 -q", &out), 0) << out;
 }
 
 TEST(LocalizeCli, ReportOfARun) {

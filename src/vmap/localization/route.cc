@@ -51,8 +51,11 @@ Route PlanRoute(const VisualMap& map, int from, int to, const RouteOptions& opti
       refusals.push_back(
           {std::min(l.from_key, l.to_key), std::max(l.from_key, l.to_key),
            fmt::format("link {} (key {} -> {}) is {}", i, l.from_key, l.to_key,
-                       !l.has_fundamental ? std::string("not verified (matching failed)")
-                                          : fmt::format("verified by {} matches only", l.num_verified))});
+                       !l.has_fundamental
+                           ? std::string("not verified (matching failed)")
+                           : fmt::format("verified by {} matches only, fewer than min_backward_verified ({}; "
+                                         "--min-backward-verified)",
+                                         l.num_verified, options.min_backward_verified))});
     }
   }
   // Breadth-first: fewest steps; ties go to the lower link index, so the result is deterministic.

@@ -53,6 +53,7 @@ void LocalizationSessionOptions::VisitFields(OptionFieldVisitor& visitor) {
                     .HideDefault()
                     .NotRecorded(),
                 to);
+  visitor.VisitNested("", route);
   visitor.Visit(OptionField{"teach_odometry", "--teach-odometry",
                             "The teach run's odometry: a CSV of timestamp,x,y,yaw (s, m, rad) or a recording with a "
                             "nav_msgs/Odometry topic, on the key images' clock; with the frames' odometry the belief "
@@ -77,6 +78,7 @@ void LocalizationSessionOptions::VisitFields(OptionFieldVisitor& visitor) {
 void LocalizationSessionOptions::Check() const {
   run.Check();
   localizer.Check();
+  route.Check();
   // -1 stands for "not given"; any other negative key image is refused as the route refuses it.
   for (const auto& [name, key] : {std::pair<const char*, int>{"from", from}, {"to", to}}) {
     if (key < -1) throw OptionError(name, fmt::format("{} is no key image; give 0 or more", key));
@@ -145,7 +147,7 @@ std::vector<int> RouteOf(const VisualMap& map, const LocalizationSessionOptions&
   const int last = static_cast<int>(map.key_images.size()) - 1;
   CheckKeyImageOption(map, options.from, "from");
   CheckKeyImageOption(map, options.to, "to");
-  return PlanRoute(map, options.from >= 0 ? options.from : 0, options.to >= 0 ? options.to : last).keys;
+  return PlanRoute(map, options.from >= 0 ? options.from : 0, options.to >= 0 ? options.to : last, options.route).keys;
 }
 
 LocalizationSession::LocalizationSession(const LocalizePipelineOptions& options) {

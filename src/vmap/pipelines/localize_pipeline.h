@@ -19,6 +19,7 @@
 #include "vmap/localization/localization_output.h"
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/localization/localizer.h"
+#include "vmap/localization/route.h"
 #include "vmap/sources/frame_source.h"
 
 namespace vmap {
@@ -31,6 +32,7 @@ struct LocalizationSessionOptions {
   LocalizerOptions localizer;
   int from = -1;                // the route's first key image; -1 = the first
   int to = -1;                  // its last; -1 = the last
+  RouteOptions route;           // how that route is planned: as `vmap route` plans it
   LocalizeSequenceOptions run;  // how a sequence's frames are read and their features extracted
   bool cache = true;            // read and write the key-image cache in the map directory
   // The teach run's odometry (ReadTeachOdometry): a CSV or a recording with a nav_msgs/Odometry topic; "" = the map
