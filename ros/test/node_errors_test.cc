@@ -228,8 +228,11 @@ TEST(NodeErrors, RepeatCallsDuringATeachRunAndStartsAtOnceAreRefused) {
     EXPECT_FALSE(success) << service;
   }
   EXPECT_TRUE(node->Running()) << node->Log();
-  // Still the teach run's to stop (no frame came, so it has no map to write).
-  EXPECT_EQ(Trigger(ns + "/vmap/teach/stop", &success).find("no teach run is in progress"), std::string::npos);
+  // Still the teach run's to stop (no frame came, so it has no map to write), said in the node's words: its topic.
+  const std::string stopped = Trigger(ns + "/vmap/teach/stop", &success);
+  EXPECT_FALSE(success);
+  EXPECT_NE(stopped.find("no frame came on /modes/image_raw during the run"), std::string::npos) << stopped;
+  EXPECT_EQ(stopped.find("--first"), std::string::npos) << stopped;
 
   // Values the services and parameters do not take.
   vmap_ros::StartRepeat repeat;
@@ -253,6 +256,21 @@ TEST(NodeErrors, RepeatCallsDuringATeachRunAndStartsAtOnceAreRefused) {
   EXPECT_NE(repeat.response.message.find("~topic is vmap's option for recordings"), std::string::npos)
       << repeat.response.message;
   ros::param::del(ns + "/vmap/topic");
+  // vmap build's -o and a stream's timeout: the node's map is the request's, its input the image topic.
+  teach.request.map = (dir.path() / "never").string();
+  for (const char* name : {"output", "stream_timeout"}) {
+    if (name == std::string("output")) {
+      ros::param::set(ns + "/vmap/output", std::string("elsewhere"));
+    } else {
+      ros::param::set(ns + "/vmap/stream_timeout", 2.0);
+    }
+    ASSERT_TRUE(ros::service::call(ns + "/vmap/teach/start", teach));
+    EXPECT_FALSE(teach.response.success) << name;
+    EXPECT_NE(teach.response.message.find(std::string("~") + name + " is vmap"), std::string::npos)
+        << teach.response.message;
+    ros::param::del(ns + "/vmap/" + name);
+  }
+  EXPECT_FALSE(fs::exists(dir.path() / "never"));
 
   // A repeat run's start reads its map for a while: a teach run started meanwhile is refused, or starts first and
   // the repeat run is refused, never both.

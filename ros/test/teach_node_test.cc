@@ -5,6 +5,7 @@
 #include <mutex>
 
 #include <gtest/gtest.h>
+#include <opencv2/videoio.hpp>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <std_srvs/Trigger.h>
@@ -178,6 +179,113 @@ TEST(TeachNode, AKilledTeachRunLeavesItsLastSnapshotWithItsOdometry) {
   EXPECT_LE(odometry.size(), stamps.size());
   EXPECT_GE(odometry.front().timestamp, stamps.front().toSec());
   EXPECT_LE(odometry.back().timestamp, stamps.back().toSec());
+}
+
+// A second teach run into the same map is a new run: its map takes the camera of its own CameraInfo (not the first
+// run's, which the node still holds), and keeps no odometry of the first run when it received none itself.
+TEST(TeachNode, ASecondTeachRunTakesItsOwnCameraAndNoOdometryOfTheFirst) {
+  SKIP_WITHOUT_SHARED();
+  ScopedTempDir dir("ros_teach_again");
+  PlayedTeach played;
+  ASSERT_NO_FATAL_FAILURE(TeachFromPlayedBag("/teach_again", {"_teach_queue:=100"}, dir.path(), 20, &played));
+  std_srvs::Trigger stop;
+  ASSERT_TRUE(ros::service::call("/teach_again/vmap/teach/stop", stop));
+  ASSERT_TRUE(stop.response.success) << stop.response.message;
+  ASSERT_TRUE(fs::is_regular_file(dir.path() / "map/teach_odometry.csv"));
+  const std::optional<Camera> first_camera = ReadMap(dir.path() / "map").input.camera;
+  ASSERT_TRUE(first_camera.has_value());
+
+  ros::NodeHandle handle;
+  std::mutex mutex;
+  uint32_t taken = 0;
+  const ros::Subscriber progress = handle.subscribe<vmap_ros::TeachProgress>(
+      "/teach_again/vmap/teach/progress", 100, [&](const vmap_ros::TeachProgress::ConstPtr& message) {
+        std::lock_guard<std::mutex> lock(mutex);
+        taken = message->frames;
+      });
+  vmap_ros::StartTeach start;
+  start.request.map = (dir.path() / "map").string();
+  ASSERT_TRUE(ros::service::call("/teach_again/vmap/teach/start", start));
+  ASSERT_TRUE(start.response.success) << start.response.message;
+  ros::Publisher images = handle.advertise<sensor_msgs::Image>("/camera/image_raw", 100);
+  ros::Publisher infos = handle.advertise<sensor_msgs::CameraInfo>("/camera/camera_info", 100);
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        return images.getNumSubscribers() > 0 && infos.getNumSubscribers() > 0 && progress.getNumPublishers() > 0;
+      },
+      kTimeout));
+  // Another camera (a longer lens), its CameraInfo with every frame as a driver sends it.
+  const double fx = 1.5 * first_camera->fx;
+  cv::VideoCapture video((fs::path(SharedDir()) / "data/lab_floor/lab_floor.mp4").string());
+  constexpr uint32_t kFrames = 12;
+  for (uint32_t i = 0; i < kFrames; ++i) {
+    cv::Mat pixels;
+    ASSERT_TRUE(video.read(pixels));
+    sensor_msgs::Image image;
+    image.header.stamp = ros::Time(2000.0 + 0.1 * i);
+    image.height = pixels.rows;
+    image.width = pixels.cols;
+    image.encoding = "bgr8";
+    image.step = static_cast<uint32_t>(pixels.cols * pixels.elemSize());
+    image.data.assign(pixels.data, pixels.data + image.step * image.height);
+    sensor_msgs::CameraInfo info;
+    info.header = image.header;
+    info.width = image.width;
+    info.height = image.height;
+    info.K = {fx, 0, first_camera->cx, 0, fx, first_camera->cy, 0, 0, 1};
+    infos.publish(info);
+    images.publish(image);
+    ros::Duration(0.05).sleep();
+  }
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(mutex);
+        return taken == kFrames;
+      },
+      kTimeout))
+      << played.node->Log();
+  ASSERT_TRUE(ros::service::call("/teach_again/vmap/teach/stop", stop));
+  ASSERT_TRUE(stop.response.success) << stop.response.message;
+  const VisualMap map = ReadMap(dir.path() / "map");
+  EXPECT_EQ(map.num_frames, static_cast<int>(kFrames));
+  ASSERT_TRUE(map.input.camera.has_value());
+  EXPECT_DOUBLE_EQ(map.input.camera->fx, fx) << "the run's own CameraInfo";
+  EXPECT_FALSE(fs::exists(dir.path() / "map/teach_odometry.csv")) << "the first run's odometry";
+  EXPECT_EQ(stop.response.message.find("odometry"), std::string::npos) << stop.response.message;
+}
+
+// A build that fails during the run (here ~strict and a frame of another size) is said in the log when it happens, not
+// first when the run is stopped: from then on the camera's frames go nowhere.
+TEST(TeachNode, ARunWhoseBuildFailsSaysSoAtOnce) {
+  ScopedTempDir dir("ros_teach_fails");
+  const auto node =
+      StartVmapNode("/teach_fails", {"image:=/fails/image_raw", "_strict:=true"}, dir.path() / "node.log");
+  ASSERT_TRUE(WaitForNodeServices("/teach_fails/vmap")) << node->Log();
+  vmap_ros::StartTeach start;
+  start.request.map = (dir.path() / "map").string();
+  ASSERT_TRUE(ros::service::call("/teach_fails/vmap/teach/start", start));
+  ASSERT_TRUE(start.response.success) << start.response.message;
+  ros::NodeHandle handle;
+  ros::Publisher images = handle.advertise<sensor_msgs::Image>("/fails/image_raw", 10);
+  ASSERT_TRUE(WaitFor([&] { return images.getNumSubscribers() > 0; }, kTimeout));
+  for (int i = 0; i < 4; ++i) {
+    sensor_msgs::Image image;
+    image.header.stamp = ros::Time(1.0 + 0.1 * i);
+    image.width = i < 3 ? 64 : 96;
+    image.height = i < 3 ? 48 : 72;
+    image.encoding = "mono8";
+    image.step = image.width;
+    image.data.assign(image.step * image.height, static_cast<uint8_t>(40 * i));
+    images.publish(image);
+    ros::Duration(0.1).sleep();
+  }
+  EXPECT_TRUE(WaitFor([&] { return node->Log().find("the teach run failed") != std::string::npos; }, kTimeout))
+      << node->Log();
+  std_srvs::Trigger stop;
+  ASSERT_TRUE(ros::service::call("/teach_fails/vmap/teach/stop", stop));
+  EXPECT_FALSE(stop.response.success);
+  EXPECT_NE(stop.response.message.find("strict"), std::string::npos) << stop.response.message;
+  EXPECT_TRUE(node->Running());
 }
 
 TEST(TeachNode, RefusesAFolderThatIsNotAMapAndLeavesItAsItWas) {

@@ -51,6 +51,7 @@ bool VmapNode::StartTeach(vmap_ros::StartTeach::Request& request, vmap_ros::Star
       }
       if (!odometry.empty()) WriteTeachOdometry(folder, odometry);
     };
+    options.files_beside_map = {kTeachOdometryFileName};
     int capacity = kTeachQueue;
     if (XmlRpc::XmlRpcValue queue; private_node_.getParam("teach_queue", queue)) {
       // Read as a value first: getParam into an int leaves the default for "x" or 1.5, silently.
@@ -67,7 +68,8 @@ bool VmapNode::StartTeach(vmap_ros::StartTeach::Request& request, vmap_ros::Star
   }
   {
     std::lock_guard<std::mutex> camera_lock(camera_mutex_);
-    if (camera_) run->source().SetCamera(camera_);  // the latest CameraInfo, if the topic went quiet before
+    // The latest CameraInfo, if the topic went quiet before: one of this run replaces it (the camera may have changed).
+    if (camera_) run->source().SetFallbackCamera(camera_);
   }
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -138,16 +140,25 @@ bool VmapNode::FinishTeach(std::unique_ptr<TeachRun> run, std::string* answer_te
     }
     if (!result.map.input.camera) {
       // Said here, not first at repeat/start ("~focal_px must be given"), when the teach run could still be redone.
+      const std::string why = run->source().camera_refused()
+                                  ? std::string("~camera is none")
+                                  : fmt::format("no CameraInfo came on {} and ~camera was not set", camera_info_topic_);
       const std::string without = fmt::format(
-          "; the map has no camera (no CameraInfo came on {} and ~camera was not set): its headings are in pixels, "
-          "and a repeat run on it needs ~focal_px",
-          camera_info_topic_);
+          "; the map has no camera ({}): its headings are in pixels, and a repeat run on it needs ~focal_px", why);
       ROS_WARN("teach run: %s", without.substr(2).c_str());
       answer += without;
     }
   } catch (const std::exception& error) {
     success = false;
-    answer = fmt::format("the map could not be written ({} frames received): {}", received, error.what());
+    if (received == 0) {
+      // The pipeline's reason names the CLI's flags; the node's cause is its topic.
+      answer = fmt::format(
+          "no frame came on {} during the run, so there is no map to write (a map already there is kept); check "
+          "that the camera publishes on it (rostopic hz {})",
+          image_topic_, image_topic_);
+    } else {
+      answer = fmt::format("the map could not be written ({} frames received): {}", received, error.what());
+    }
   }
   {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -10,7 +10,17 @@ namespace vmap::ros_node {
 
 TeachRun::TeachRun(const BuildPipelineOptions& options, size_t capacity)
     : source_(std::make_unique<TopicFrameSource>(options.input, options.source, capacity)) {
-  result_ = std::async(std::launch::async, [this, options] { return RunBuildPipeline(options, source_.get()); });
+  result_ = std::async(std::launch::async, [this, options] {
+    try {
+      return RunBuildPipeline(options, source_.get());
+    } catch (const std::exception& error) {
+      // Said when it happens, not first at ~teach/stop: the camera's frames are no longer taken from here on.
+      if (source_->pulled()) {
+        spdlog::error("the teach run failed and takes no more frames: {}; call ~teach/stop", error.what());
+      }
+      throw;
+    }
+  });
   // The pipeline asks for its first frame once it is set up; an error before that is the start's.
   while (!source_->pulled()) {
     if (result_.wait_for(std::chrono::milliseconds(20)) == std::future_status::ready) {

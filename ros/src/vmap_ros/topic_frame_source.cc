@@ -24,6 +24,7 @@ TopicFrameSource::TopicFrameSource(std::string topic, const FrameSourceOptions& 
   if (!options_.camera.empty()) {
     camera_given_ = true;
     if (options_.camera != "none") camera_ = ParseCameraOption(options_.camera);
+    camera_changed_ = camera_.has_value();
   }
 }
 
@@ -47,6 +48,14 @@ void TopicFrameSource::SetCamera(const std::optional<Camera>& camera) {
   if (camera_given_) return;
   camera_given_ = true;
   camera_ = camera;
+  camera_changed_ = true;
+}
+
+void TopicFrameSource::SetFallbackCamera(const std::optional<Camera>& camera) {
+  std::lock_guard<std::mutex> lock(camera_mutex_);
+  if (camera_given_) return;
+  camera_ = camera;
+  camera_changed_ = true;
 }
 
 void TopicFrameSource::End() { mailbox_.Close(); }
@@ -90,8 +99,11 @@ std::optional<Frame> TopicFrameSource::Next() {
     frame.source_name = fmt::format("frame_{:06d}", index);
     frame.timestamp = image.stamp > 0.0 ? image.stamp : received->arrival;
     FitFrameToSequence(frame, &info_, options_, &size_warnings_);
-    if (!info_.camera) {
-      std::lock_guard<std::mutex> lock(camera_mutex_);
+    if (std::lock_guard<std::mutex> lock(camera_mutex_); camera_changed_) {
+      // The map's camera is the source's when the map is written: a CameraInfo of the run replaces a fallback taken
+      // on the frames before it.
+      camera_changed_ = false;
+      info_.camera.reset();
       if (camera_) {
         try {
           info_.camera = CameraForFrames(*camera_, info_.native_size, info_.frame_size);

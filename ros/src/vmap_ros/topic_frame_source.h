@@ -30,6 +30,10 @@ class TopicFrameSource final : public FrameSource {
   // The camera of the topic's CameraInfo (nullopt: uncalibrated), unless the options give one; the first one since
   // the source was made wins, as `vmap build` takes a bag's first CameraInfo.
   void SetCamera(const std::optional<Camera>& camera);
+  // A camera from before the run (the topic's last CameraInfo): taken until a CameraInfo of the run replaces it.
+  void SetFallbackCamera(const std::optional<Camera>& camera);
+  // The options refuse the topic's camera (--camera none).
+  bool camera_refused() const { return options_.camera == "none"; }
   // Ends the input: Next() returns the messages already received, then nullopt.
   void End();
 
@@ -58,6 +62,7 @@ class TopicFrameSource final : public FrameSource {
   std::mutex camera_mutex_;
   bool camera_given_ = false;  // by the options (--camera), or a CameraInfo already taken
   std::optional<Camera> camera_;
+  bool camera_changed_ = false;  // camera_ is not yet the frames' (Next)
 
   SequenceInfo info_;  // written by Next() alone
   long position_ = 0;  // messages taken from the mailbox, malformed ones included

@@ -125,13 +125,18 @@ VmapNode::~VmapNode() { Stop(); }
 
 void VmapNode::RefuseRecordingParameters() const {
   // The flags of `vmap build` and `vmap localize` that name what a recording is read from.
-  for (const char* name : {"format", "topic", "until_interrupted"}) {
+  for (const char* name : {"format", "topic", "until_interrupted", "stream_timeout"}) {
     if (private_node_.hasParam(name)) {
       throw InputError(
-          fmt::format("~{} is vmap's option for recordings; the node's camera is the `image` topic: "
+          fmt::format("~{} is vmap's option for recordings and streams; the node's camera is the `image` topic: "
                       "remap it, and drop ~{}",
                       name, name));
     }
+  }
+  if (private_node_.hasParam("output")) {
+    throw InputError(
+        "~output is vmap build's -o; the node's map is the one its request names, or ~map: set that, "
+        "and drop ~output");
   }
 }
 

@@ -105,7 +105,6 @@ class MapBuilder::Impl {
   void Add(Frame frame) {
     if (finished_) throw std::logic_error("MapBuilder::Add after Finish");
     if (first_source_index_ < 0) first_source_index_ = frame.source_index;
-    last_source_index_ = frame.source_index;
     while (!pipeline_->TryPush(frame)) {
       std::optional<PipelineItem> item = pipeline_->Next();  // a frame is in flight: one comes out
       if (!item) throw std::logic_error("FeaturePipeline ended while frames were in flight");
@@ -194,6 +193,8 @@ class MapBuilder::Impl {
   }
 
   void Process(PipelineItem& item) {
+    // A snapshot covers the frames processed, not those still in flight.
+    last_source_index_ = item.record.frame->source_index;
     for (size_t i = 0; i < selectors_.size(); ++i) {
       selectors_[i]->Add(item.record, CompareFor(taus_[i], item.comparisons));
     }

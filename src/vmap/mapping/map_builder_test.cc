@@ -275,6 +275,8 @@ TEST(MapBuilder, WritesThroughItsSinkWithoutKeepingEvaluationsAndSnapshotsHalfWa
   ASSERT_TRUE(snapshot.coverage);
   EXPECT_EQ(snapshot.coverage->end, CoverageEnd::kSnapshot);
   EXPECT_EQ(snapshot.coverage->first_source_index, 0);
+  // The frames it covers are those it holds (in order from 0 here), not those still in flight.
+  EXPECT_EQ(snapshot.coverage->last_source_index, snapshot.num_frames - 1);
   // Its key images are the first ones of the finished map.
   ASSERT_LE(snapshot.key_images.size(), expected.key_images.size());
   for (size_t k = 0; k < snapshot.key_images.size(); ++k) {

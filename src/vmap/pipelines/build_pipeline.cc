@@ -61,7 +61,8 @@ VisualMap BuildStreaming(const BuildPipelineOptions& pipeline, FrameSource& inpu
                          bool* interrupted) {
   std::optional<SnapshotTarget> snapshots;
   if (pipeline.snapshot_every > 0) {
-    snapshots = SnapshotTarget{directory.final_path(), MapOutputPolicy(files_read), pipeline.write_beside_map};
+    snapshots = SnapshotTarget{directory.final_path(), MapOutputPolicy(files_read, pipeline.files_beside_map),
+                               pipeline.write_beside_map};
     snapshots->policy.keep_if_commit_fails = false;  // the next snapshot, or the map itself, takes its place
   }
   MapWriter writer(directory.path(), snapshots);
@@ -230,7 +231,7 @@ BuildPipelineResult RunBuildPipeline(const BuildPipelineOptions& pipeline, Frame
   // 2. The output, claimed before any work: one that is not vmap's, or that holds the input, is refused here.
   std::vector<std::string> files_read = pipeline.FilesRead();
   files_read.insert(files_read.end(), source_files.begin(), source_files.end());
-  AtomicOutputDirectory directory(result.directory, MapOutputPolicy(files_read));
+  AtomicOutputDirectory directory(result.directory, MapOutputPolicy(files_read, pipeline.files_beside_map));
   WarnOfExperiencesReplaced(result.directory);
 
   // 3. The matcher (a deep model loads its weights here).

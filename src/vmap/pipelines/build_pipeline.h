@@ -34,6 +34,9 @@ struct BuildPipelineOptions {
   // that a run killed between snapshots keeps them with the map they belong to (the ROS teach run's odometry). Not
   // an option: no flag or JSON field. Throws as a file of the map that cannot be written does.
   std::function<void(const std::filesystem::path& map_folder)> write_beside_map;
+  // The names of the files write_beside_map writes: this run's own, so that a map it replaces keeps none of them (an
+  // earlier teach run's odometry is not this run's, even where this run wrote none). A rebuild keeps the others.
+  std::vector<std::string> files_beside_map;
 
   // The fields above, each once: the positional input, -o, the input's, the matchers', τ, the builder's and the
   // verifier's options, --report, --snapshot-every, --until-interrupted. Every field's path is the one its check

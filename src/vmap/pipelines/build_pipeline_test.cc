@@ -137,6 +137,27 @@ TEST(BuildPipeline, TheHostsFilesAreInEverySnapshotAndInTheMap) {
   EXPECT_EQ(ReadRecordedMap(tmp.path() / "map").map.num_frames, built.map.num_frames);
 }
 
+// A host's file is its run's own: a map rebuilt keeps what the folder held besides the map (the teach odometry a
+// rebuild of the same run needs), but a host that writes the file itself (the ROS node's new teach run) keeps none of
+// an earlier run's, even when it writes none this time (no odometry came).
+TEST(BuildPipeline, AnEarlierRunsFileOfTheHostIsNotKeptByARunThatWritesIt) {
+  testing::ScopedTempDir tmp;
+  testing::WriteImageFolder(testing::SidewaysDrive(), tmp.path() / "teach");
+  BuildPipelineOptions options;
+  options.input = (tmp.path() / "teach").string();
+  options.output = (tmp.path() / "map").string();
+  RunBuildPipeline(Quiet(options));
+  std::ofstream(tmp.path() / "map/teach_odometry.csv") << "timestamp,x,y,yaw\n0,0,0,0\n";
+  std::ofstream(tmp.path() / "map/notes.txt") << "mine\n";
+  RunBuildPipeline(Quiet(options));
+  EXPECT_TRUE(fs::exists(tmp.path() / "map/teach_odometry.csv")) << "a rebuild keeps it";
+  options.files_beside_map = {"teach_odometry.csv"};
+  options.write_beside_map = [](const fs::path&) {};  // no odometry this run
+  RunBuildPipeline(Quiet(options));
+  EXPECT_FALSE(fs::exists(tmp.path() / "map/teach_odometry.csv")) << "an earlier run's odometry";
+  EXPECT_EQ(testing::ReadText(tmp.path() / "map/notes.txt"), "mine\n");
+}
+
 // The output defaults to "<input name>_map" beside the working directory.
 TEST(BuildPipeline, OutputDefaultsToTheInputsName) {
   BuildPipelineOptions options;

@@ -1,5 +1,6 @@
 #include "vmap/pipelines/output_policies.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <set>
 #include <string>
@@ -66,7 +67,7 @@ const std::set<std::string>& MapFileNames() {
 
 }  // namespace
 
-OutputPolicy MapOutputPolicy(const std::vector<std::string>& inputs) {
+OutputPolicy MapOutputPolicy(const std::vector<std::string>& inputs, const std::vector<std::string>& files_beside_map) {
   OutputPolicy policy;
   policy.why_not_ours = WhyNotAVmapMap;
   policy.kind = "a vmap map";
@@ -80,8 +81,9 @@ OutputPolicy MapOutputPolicy(const std::vector<std::string>& inputs) {
   // A rebuild keeps the teach odometry, notes and runs' outputs the folder held besides the map.
   // An own file's temporary (".experiences.partial-PID-N" of an add that was killed) is its too: carried into the new
   // map, it was kept as if it were the user's.
-  policy.is_own_entry = [](const std::string& name) {
+  policy.is_own_entry = [files_beside_map](const std::string& name) {
     if (MapFileNames().count(name) > 0) return true;
+    if (std::find(files_beside_map.begin(), files_beside_map.end(), name) != files_beside_map.end()) return true;
     for (const std::string& own : MapFileNames()) {
       if (TemporaryOwner(name, own) != 0) return true;
     }

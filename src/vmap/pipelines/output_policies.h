@@ -14,7 +14,8 @@ namespace vmap {
 // inside one of `inputs` (the recording, and any file the build reads: a camera file, a camera mask). A finished
 // map that cannot be moved into place is kept beside it (OutputPolicy::keep_if_commit_fails). What the replaced
 // folder held besides the map (the teach odometry, a user's notes, runs' outputs) moves into the new one.
-OutputPolicy MapOutputPolicy(const std::vector<std::string>& inputs);
+OutputPolicy MapOutputPolicy(const std::vector<std::string>& inputs,
+                             const std::vector<std::string>& files_beside_map = {});
 // The same for a sweep's folder, which the sweep's `input` may not be, hold or lie inside.
 OutputPolicy SweepOutputPolicy(const std::string& input);
 
