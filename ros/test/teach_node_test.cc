@@ -288,6 +288,53 @@ TEST(TeachNode, ARunWhoseBuildFailsSaysSoAtOnce) {
   EXPECT_TRUE(node->Running());
 }
 
+// Frames whose stamps go back are taken as they arrive (a live map does not wait for late frames); since `vmap build`
+// on a bag of them orders them by stamp, the node says so, once.
+TEST(TeachNode, FramesStampedOutOfOrderAreSaidOnce) {
+  ScopedTempDir dir("ros_teach_order");
+  const auto node = StartVmapNode("/teach_order", {"image:=/order/image_raw"}, dir.path() / "node.log");
+  ASSERT_TRUE(WaitForNodeServices("/teach_order/vmap")) << node->Log();
+  ros::NodeHandle handle;
+  uint32_t taken = 0;
+  std::mutex mutex;
+  const ros::Subscriber progress = handle.subscribe<vmap_ros::TeachProgress>(
+      "/teach_order/vmap/teach/progress", 100, [&](const vmap_ros::TeachProgress::ConstPtr& message) {
+        std::lock_guard<std::mutex> lock(mutex);
+        taken = message->frames;
+      });
+  vmap_ros::StartTeach start;
+  start.request.map = (dir.path() / "map").string();
+  ASSERT_TRUE(ros::service::call("/teach_order/vmap/teach/start", start));
+  ASSERT_TRUE(start.response.success) << start.response.message;
+  ros::Publisher images = handle.advertise<sensor_msgs::Image>("/order/image_raw", 10);
+  ASSERT_TRUE(WaitFor([&] { return images.getNumSubscribers() > 0 && progress.getNumPublishers() > 0; }, kTimeout));
+  const std::vector<double> stamps = {2.0, 1.0, 3.0, 2.5};
+  for (size_t i = 0; i < stamps.size(); ++i) {
+    sensor_msgs::Image image;
+    image.header.stamp = ros::Time(stamps[i]);
+    image.width = 64;
+    image.height = 48;
+    image.encoding = "mono8";
+    image.step = image.width;
+    image.data.assign(image.step * image.height, static_cast<uint8_t>(50 * i));
+    images.publish(image);
+    ros::Duration(0.1).sleep();
+  }
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(mutex);
+        return taken == stamps.size();
+      },
+      kTimeout))
+      << node->Log();
+  std_srvs::Trigger stop;
+  ASSERT_TRUE(ros::service::call("/teach_order/vmap/teach/stop", stop));
+  const std::string log = node->Log();
+  const size_t said = log.find("before the frame before it");
+  ASSERT_NE(said, std::string::npos) << log;
+  EXPECT_EQ(log.find("before the frame before it", said + 1), std::string::npos) << "once: " << log;
+}
+
 TEST(TeachNode, RefusesAFolderThatIsNotAMapAndLeavesItAsItWas) {
   ScopedTempDir dir("ros_teach_refuse");
   fs::create_directories(dir.path() / "notes");

@@ -98,6 +98,16 @@ std::optional<Frame> TopicFrameSource::Next() {
     frame.source_index = static_cast<int>(index);
     frame.source_name = fmt::format("frame_{:06d}", index);
     frame.timestamp = image.stamp > 0.0 ? image.stamp : received->arrival;
+    // Taken as they come: a live map cannot wait for late frames. `vmap build` on a bag of them orders a few at a time
+    // by stamp, and makes another map; said once.
+    if (frame.timestamp < last_stamp_ && !out_of_order_warned_) {
+      out_of_order_warned_ = true;
+      spdlog::warn(
+          "{}: frame {} is stamped {:.6f} s, before the frame before it ({:.6f} s): frames are taken in the order "
+          "they arrive (vmap build on a bag of them orders them by stamp, and its map may differ)",
+          topic_, index, frame.timestamp, last_stamp_);
+    }
+    last_stamp_ = frame.timestamp;
     FitFrameToSequence(frame, &info_, options_, &size_warnings_);
     if (std::lock_guard<std::mutex> lock(camera_mutex_); camera_changed_) {
       // The map's camera is the source's when the map is written: a CameraInfo of the run replaces a fallback taken

@@ -69,6 +69,8 @@ class TopicFrameSource final : public FrameSource {
   int delivered_ = 0;
   int skipped_ = 0;
   int size_warnings_ = 0;
+  double last_stamp_ = -1.0;          // of the frame before (Next)
+  bool out_of_order_warned_ = false;  // Next
   std::atomic<bool> clock_warned_{false};
   // Skipped frames are said at most once every kSkipWarningSeconds (docs/ros.md), with the count so far: a camera
   // sending nothing but broken frames wrote a warning a frame.
