@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "vmap/map/map_io.h"
 #include "vmap/testing/promises_test_util.h"
@@ -86,6 +87,7 @@ TEST(OutputPromises, SingleFileOutputsNeverReplaceAnInputOrASpecialFile) {
   fs::permissions(tmp.path() / "readonly.csv", fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
   ASSERT_EQ(mkfifo((tmp.path() / "fifo.csv").c_str(), 0600), 0);
   fs::create_hard_link(in / "frame_2.png", tmp.path() / "hardlink.png");
+  fs::create_directories(m / "report/links");  // as `vmap report` writes it
   const std::string localize = "localize " + map + " " + query;
   ExpectRefused(
       {
@@ -121,6 +123,8 @@ TEST(OutputPromises, SingleFileOutputsNeverReplaceAnInputOrASpecialFile) {
           {localize + " --csv " + Quote(m / "teach_odometry.csv"), "would overwrite the map's teach_odometry.csv"},
           {localize + " --json " + Quote(m / "experiences"), "the map's experiences"},
           {"draw " + map + " --link 0 -o " + Quote(m / "camera_mask.png"), "the map's camera_mask.png"},
+          // What `vmap report` replaces in report/; a user's own figure beside it is allowed (below).
+          {"draw " + map + " --link 0 -o " + Quote(m / "report/links/mine.png"), "the map's report/links"},
           {localize + " --camera " + Quote(tmp.path() / "calib.txt") + " --csv " + Quote(tmp.path() / "calib.txt"),
            "would overwrite the camera file"},
           {"match " + query + " " + Quote(in / "frame_2.png") + " --camera " + Quote(tmp.path() / "calib.txt") +
@@ -135,6 +139,10 @@ TEST(OutputPromises, SingleFileOutputsNeverReplaceAnInputOrASpecialFile) {
   EXPECT_TRUE(fs::is_fifo(tmp.path() / "fifo.csv"));
   EXPECT_TRUE(fs::is_character_file("/dev/null"));
   EXPECT_FALSE(fs::exists(tmp.path() / "a.csv"));
+  // report.md invites a user's files into the map's report/, which no command reads: an exported figure is written.
+  std::string out;
+  EXPECT_EQ(RunVmap("draw " + map + " --link 0 -o " + Quote(m / "report/link0.png"), &out), 0) << out;
+  EXPECT_FALSE(cv::imread((m / "report/link0.png").string()).empty());
 }
 
 TEST(OutputPromises, UserNamedFilesAreReadOnlyWhenRegularAndBounded) {

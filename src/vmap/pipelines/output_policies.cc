@@ -12,6 +12,7 @@
 #include "vmap/map/map_io.h"
 #include "vmap/pipelines/localize_odometry.h"
 #include "vmap/report/html_report.h"
+#include "vmap/report/map_report_files.h"
 #include "vmap/report/summary.h"
 
 namespace vmap {
@@ -106,7 +107,17 @@ std::vector<OutputInput> MapInputs(const std::string& map_directory) {
   if (map_directory.empty()) return {};
   const fs::path directory(map_directory);
   std::vector<OutputInput> inputs;
-  for (const std::string& name : MapFileNames()) inputs.push_back({directory / name, "the map's " + name});
+  for (const std::string& name : MapFileNames()) {
+    if (name != kReportAssetsDirectory) inputs.push_back({directory / name, "the map's " + name});
+  }
+  // Of the report's folder, only what `vmap report` replaces: a user's files beside them stay (an exported figure,
+  // report.md), and a command may write them there.
+  const fs::path report = directory / kReportAssetsDirectory;
+  std::vector<std::string> replaced = {report::kThumbnailsFolder, report::kMatchFiguresFolder};
+  replaced.insert(replaced.end(), std::begin(report::kRouteVideoNames), std::end(report::kRouteVideoNames));
+  for (const std::string& name : replaced) {
+    inputs.push_back({report / name, std::string("the map's ") + kReportAssetsDirectory + "/" + name});
+  }
   inputs.push_back({directory / kTeachOdometryFileName, std::string("the map's ") + kTeachOdometryFileName});
   return inputs;
 }

@@ -20,8 +20,8 @@ OutputPolicy MapOutputPolicy(const std::vector<std::string>& inputs,
 OutputPolicy SweepOutputPolicy(const std::string& input);
 
 // Every file of the map at `map_directory`, whether it exists yet or not: map.json, correspondences.bin,
-// keys/, camera_mask.png, experiences/, teach_odometry.csv, the key-image cache, eval.json, report.html and
-// report/. Another name inside the map folder (an
+// keys/, camera_mask.png, experiences/, teach_odometry.csv, the key-image cache, eval.json, report.html and what
+// `vmap report` replaces in report/ (keys/, links/, the route video). Another name inside the map folder (an
 // output written there by an earlier run) is not the map's, and may be written.
 std::vector<OutputInput> MapInputs(const std::string& map_directory);
 
