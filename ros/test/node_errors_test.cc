@@ -43,18 +43,6 @@ std::string Trigger(const std::string& service, bool* success) {
   return call.response.message;
 }
 
-sensor_msgs::Image GreyImage(int width, int height, double stamp) {
-  sensor_msgs::Image image;
-  image.header.stamp = ros::Time(stamp);
-  image.header.frame_id = "camera";
-  image.width = width;
-  image.height = height;
-  image.encoding = "mono8";
-  image.step = width;
-  image.data.assign(static_cast<size_t>(width) * height, 128);
-  return image;
-}
-
 // Started before its master, a node waits for it, says where it looks, and still stops on SIGINT or SIGTERM with a
 // shell's status (roscpp would retry the master for ever, and the nodes' own handlers only set a flag).
 TEST(NodeErrors, ANodeWaitingForItsMasterStopsOnASignal) {

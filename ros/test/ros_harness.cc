@@ -227,6 +227,18 @@ bool WaitForNodeServices(const std::string& node, std::chrono::seconds timeout) 
       timeout);
 }
 
+sensor_msgs::Image GreyImage(int width, int height, double stamp, uint8_t level) {
+  sensor_msgs::Image image;
+  image.header.stamp = ros::Time(stamp);
+  image.header.frame_id = "camera";
+  image.width = width;
+  image.height = height;
+  image.encoding = "mono8";
+  image.step = width;
+  image.data.assign(static_cast<size_t>(width) * height, level);
+  return image;
+}
+
 std::vector<ros::Time> WriteVideoBag(const fs::path& video, int first, int last, const fs::path& bag,
                                      const std::string& encoding, double odometry_metres_per_frame) {
   FrameSourceOptions options;

@@ -12,6 +12,7 @@
 
 #include <opencv2/core.hpp>
 #include <ros/ros.h>
+#include <sensor_msgs/Image.h>
 
 namespace vmap::ros_testing {
 
@@ -89,6 +90,9 @@ std::vector<ros::Time> WriteVideoBag(const std::filesystem::path& video, int fir
 // node processed, for `vmap localize` to localize the same frames).
 void WriteBagSubset(const std::filesystem::path& bag, const std::vector<ros::Time>& stamps,
                     const std::filesystem::path& subset);
+
+// A mono8 image of one grey level, stamped `stamp` seconds.
+sensor_msgs::Image GreyImage(int width, int height, double stamp, uint8_t level = 128);
 
 // The vmap_node and vmap_simulator binaries of this build.
 std::filesystem::path VmapNodeBinary();

@@ -269,14 +269,7 @@ TEST(TeachNode, ARunWhoseBuildFailsSaysSoAtOnce) {
   ros::Publisher images = handle.advertise<sensor_msgs::Image>("/fails/image_raw", 10);
   ASSERT_TRUE(WaitFor([&] { return images.getNumSubscribers() > 0; }, kTimeout));
   for (int i = 0; i < 4; ++i) {
-    sensor_msgs::Image image;
-    image.header.stamp = ros::Time(1.0 + 0.1 * i);
-    image.width = i < 3 ? 64 : 96;
-    image.height = i < 3 ? 48 : 72;
-    image.encoding = "mono8";
-    image.step = image.width;
-    image.data.assign(image.step * image.height, static_cast<uint8_t>(40 * i));
-    images.publish(image);
+    images.publish(i < 3 ? GreyImage(64, 48, 1.0 + 0.1 * i, 40 * i) : GreyImage(96, 72, 1.0 + 0.1 * i));
     ros::Duration(0.1).sleep();
   }
   EXPECT_TRUE(WaitFor([&] { return node->Log().find("the teach run failed") != std::string::npos; }, kTimeout))
@@ -310,14 +303,7 @@ TEST(TeachNode, FramesStampedOutOfOrderAreSaidOnce) {
   ASSERT_TRUE(WaitFor([&] { return images.getNumSubscribers() > 0 && progress.getNumPublishers() > 0; }, kTimeout));
   const std::vector<double> stamps = {2.0, 1.0, 3.0, 2.5};
   for (size_t i = 0; i < stamps.size(); ++i) {
-    sensor_msgs::Image image;
-    image.header.stamp = ros::Time(stamps[i]);
-    image.width = 64;
-    image.height = 48;
-    image.encoding = "mono8";
-    image.step = image.width;
-    image.data.assign(image.step * image.height, static_cast<uint8_t>(50 * i));
-    images.publish(image);
+    images.publish(GreyImage(64, 48, stamps[i], static_cast<uint8_t>(50 * i)));
     ros::Duration(0.1).sleep();
   }
   ASSERT_TRUE(WaitFor(
