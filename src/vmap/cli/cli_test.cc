@@ -148,6 +148,11 @@ TEST(Cli, ASweepsMapIsTheMapOfItsTau) {
     EXPECT_EQ(built.links[i].homography_share, swept.links[i].homography_share);
     EXPECT_EQ(built.links[i].planar, swept.links[i].planar);
   }
+  // The sweep's own record names the τ it tried, not the matcher's default (0.5 here would look like one of them).
+  std::ifstream in(tmp.path() / "sweep/sweep.json");
+  const nlohmann::json sweep = nlohmann::json::parse(in);
+  EXPECT_FALSE(sweep["options"].contains("tau")) << sweep["options"];
+  EXPECT_EQ(sweep["options"]["thresholds"], nlohmann::json::array({0.3, 0.5, 0.7}));
 }
 
 TEST(Cli, LoftrBuildsAMapEndToEnd) {

@@ -5,6 +5,7 @@
 #include <optional>
 #include <vector>
 
+#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/atomic_output.h"
@@ -122,6 +123,12 @@ SweepResult RunSweepPipeline(const SweepPipelineOptions& options) {
   const bool keep_maps = options.write_maps || options.evaluate;
   SweepResult sweep = SweepThresholds(*source, *matcher, map_options, taus, keep_maps ? &maps : nullptr,
                                       options.write_maps ? directory->path() : fs::path(), options_json);
+  // The sweep's record names the τ it tried, not the one its options were described with (the matcher's default,
+  // which each map written replaces with its own).
+  nlohmann::json recorded = nlohmann::json::parse(options_json);
+  recorded.erase("tau");
+  recorded["thresholds"] = taus;
+  sweep.options_json = recorded.dump();
 
   // 6. Every τ's map against the same ground truth, with the default usability criterion of `vmap eval`.
   std::vector<MapEvaluation> evaluations;
