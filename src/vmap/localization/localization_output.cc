@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 #include <optional>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -295,6 +296,7 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
     run.info.map_directory = DecodeFileName(TextOr(map, "directory", "", RunPlace{file, "map"}));
     run.info.map_absolute_directory = DecodeFileName(TextOr(map, "absolute_directory", "", RunPlace{file, "map"}));
     run.info.matcher = TextOr(map, "matcher", "", RunPlace{file, "map"});
+    run.recorded_map.key_images = IntOr(map, "key_images", -1, RunPlace{file, "map"});
     const json& query = doc.at("query");
     run.info.query = DecodeFileName(TextOr(query, "path", "", RunPlace{file, "query"}));
     run.info.query_absolute_path = DecodeFileName(TextOr(query, "absolute_path", "", RunPlace{file, "query"}));
@@ -386,6 +388,13 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
         }
       }
       run.frames.push_back(std::move(r));
+      // Runs written before key_frame was recorded have none to check.
+      if (f.contains("key_frame") && f.contains("next_key_frame")) {
+        run.recorded_map.key_frames.emplace_back(
+            std::make_pair(IntOr(f, "key_frame", -1, place), IntOr(f, "next_key_frame", -1, place)));
+      } else {
+        run.recorded_map.key_frames.emplace_back();
+      }
     }
   } catch (const json::exception&) {
     throw InputError("'" + file.string() +
@@ -407,6 +416,26 @@ void CheckRunFitsMap(const LocalizationRun& run, const VisualMap& map, const std
                       "is of another map, or was edited; localize again with `vmap localize --json`",
                       file.string(), r.frame_index, key, run.info.map_directory, num_keys - 1));
     }
+  }
+  const RunMapRecord& recorded = run.recorded_map;
+  if (recorded.key_images >= 0 && recorded.key_images != num_keys) {
+    throw InputError(
+        fmt::format("'{}' was made against the map '{}' when it had {} key images, and it has {} now: "
+                    "the map was built again since; localize again with `vmap localize --json`",
+                    file.string(), run.info.map_directory, recorded.key_images, num_keys));
+  }
+  for (size_t i = 0; i < run.frames.size() && i < recorded.key_frames.size(); ++i) {
+    if (!recorded.key_frames[i]) continue;
+    const LocalizationResult& r = run.frames[i];
+    const std::pair<int, int> now(KeyFrame(map, r.key), KeyFrame(map, r.next_key));
+    if (now == *recorded.key_frames[i]) continue;
+    const bool key_moved = now.first != recorded.key_frames[i]->first;
+    throw InputError(fmt::format(
+        "'{}': frame {} was localized at {} key image {}, map frame {}, and key image {} of the map '{}' is map "
+        "frame {} now: the map was built again since; localize again with `vmap localize --json`",
+        file.string(), r.frame_index, key_moved ? "the" : "the next", key_moved ? r.key : r.next_key,
+        key_moved ? recorded.key_frames[i]->first : recorded.key_frames[i]->second, key_moved ? r.key : r.next_key,
+        run.info.map_directory, key_moved ? now.first : now.second));
   }
 }
 

@@ -19,7 +19,9 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -54,10 +56,19 @@ struct LocalizationRunInfo {
   bool experiences = false;         // the map has experiences: frames say which one fitted
 };
 
+// What a run's file recorded of its map (ReadLocalizationRun), to tell a map built again since the run from the
+// one it was made against: key indices alone fit a rebuilt map as well, and would pair frames with other images.
+struct RunMapRecord {
+  int key_images = -1;  // how many the map had; -1: not recorded
+  // Per frame (as LocalizationRun::frames): the map frame of its key and next key image (-1: none), when recorded.
+  std::vector<std::optional<std::pair<int, int>>> key_frames;
+};
+
 struct LocalizationRun {
   LocalizationRunInfo info;
   LocalizationSummary summary;
   std::vector<LocalizationResult> frames;
+  RunMapRecord recorded_map;  // empty for a run made in this process
 };
 
 // The localizer's options as JSON text (for LocalizationRunInfo::options_json).
@@ -79,7 +90,9 @@ std::string LocalizationRunJson(const VisualMap& map, const LocalizationRun& run
 LocalizationRun ReadLocalizationRun(const std::filesystem::path& file);
 
 // Throws InputError naming `file` (the run's) and the frame when a frame of `run` names a key image `map` does
-// not have (its key, next key or a candidate's): a run of another map, or an edited file.
+// not have (its key, next key or a candidate's): a run of another map, or an edited file. Also when the run
+// recorded a number of key images, or a frame's key_frame / next_key_frame, other than `map`'s: a map built again
+// since the run.
 void CheckRunFitsMap(const LocalizationRun& run, const VisualMap& map, const std::filesystem::path& file);
 
 }  // namespace vmap

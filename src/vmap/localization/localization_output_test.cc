@@ -246,6 +246,42 @@ TEST(LocalizationOutput, ARunNamingKeyImagesItsMapLacksIsRefused) {
   EXPECT_THROW(CheckRunFitsMap(bad_candidate, map, "run.json"), InputError);
 }
 
+// A run read back against its map built again since: the key indices fit the new map, and name other images.
+TEST(LocalizationOutput, ARunOfAMapBuiltAgainSinceIsRefused) {
+  ::vmap::testing::ScopedTempDir tmp;
+  const fs::path file = tmp.path() / "run.json";
+  WriteFileAtomically(file, LocalizationRunJson(TwoKeyMap(), SampleRun()));
+  const LocalizationRun back = ReadLocalizationRun(file);
+  EXPECT_NO_THROW(CheckRunFitsMap(back, TwoKeyMap(), file));
+  EXPECT_NO_THROW(CheckRunFitsMap(SampleRun(), TwoKeyMap(), file)) << "a run made here records no map";
+
+  VisualMap more = TwoKeyMap();
+  more.key_images.push_back(more.key_images.back());
+  more.key_images.back().frame_index = 80;
+  try {
+    CheckRunFitsMap(back, more, file);
+    ADD_FAILURE() << "a run of 2 key images was accepted against a map of 3";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(file.string()), std::string::npos) << what;
+    EXPECT_NE(what.find("'map'"), std::string::npos) << what;
+    EXPECT_NE(what.find("had 2 key images, and it has 3 now"), std::string::npos) << what;
+    EXPECT_NE(what.find("localize again"), std::string::npos) << what;
+  }
+
+  VisualMap moved = TwoKeyMap();
+  moved.key_images[1].frame_index = 28;
+  try {
+    CheckRunFitsMap(back, moved, file);
+    ADD_FAILURE() << "a run whose next key image was map frame 40 was accepted against one at frame 28";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("next key image 1, map frame 40"), std::string::npos) << what;
+    EXPECT_NE(what.find("map frame 28 now"), std::string::npos) << what;
+    EXPECT_NE(what.find("localize again"), std::string::npos) << what;
+  }
+}
+
 TEST(LocalizationOutput, ReadingSomethingElseIsAClearError) {
   ::vmap::testing::ScopedTempDir tmp;
   EXPECT_THROW(ReadLocalizationRun(tmp.path() / "missing.json"), InputError);

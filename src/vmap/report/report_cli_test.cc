@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "vmap/core/atomic_output.h"
+#include "vmap/localization/localization_output.h"
 #include "vmap/report/html_report.h"
 #include "vmap/testing/report_test_util.h"
 #include "vmap/testing/run_vmap.h"
@@ -19,6 +21,25 @@ namespace {
 namespace fs = std::filesystem;
 using report_test::ReadText;
 using testing::ScopedTempDir;
+
+// Writes `file`, a run of one tracking frame at key image 0 (1 where the map has it) of `map` read from `directory`,
+// whose query `query` need not exist.
+void WriteRun(const fs::path& file, const VisualMap& map, const fs::path& directory, const std::string& query,
+              const std::string& source_name = "") {
+  LocalizationRun run;
+  run.info.map_directory = directory.string();
+  run.info.query = query;
+  run.info.matcher = "orb";
+  LocalizationResult frame;
+  frame.status = LocalizationStatus::kTracking;
+  frame.key = map.key_images.size() > 2 ? 1 : 0;
+  frame.next_key = frame.key + 1;
+  frame.source_name = source_name;
+  run.frames = {frame};
+  run.summary.frames = 1;
+  run.summary.tracking = 1;
+  WriteFileAtomically(file, LocalizationRunJson(map, run));
+}
 
 class ReportCliTest : public ::testing::Test {
  protected:
@@ -84,6 +105,31 @@ TEST_F(ReportCliTest, ReportWritesIntoTheMapOrExplainsWhatIsMissing) {
   EXPECT_EQ(none.status, 2);
   EXPECT_NE(none.output.find("nothing"), std::string::npos) << none.output;
   EXPECT_FALSE(fs::exists(temp.path() / "nothing"));
+}
+
+// A run reported against its map built again since (more key images, key 1 now another frame): its frames were
+// paired with the rebuilt map's key images and its run.json rewritten to say so.
+TEST_F(ReportCliTest, ARunOfAMapBuiltAgainSinceIsRefused) {
+  ScopedTempDir temp;
+  const fs::path map = temp.path() / "map";
+  report_test::SyntheticMapOptions options;
+  options.num_frames = 19;  // key images at frames 0, 9 and 18
+  const VisualMap teach = report_test::WriteSyntheticMap(map, options);
+  ASSERT_EQ(teach.key_images.size(), 3u);
+  const fs::path file = temp.path() / "run.json";
+  WriteRun(file, teach, map, (temp.path() / "gone.mp4").string());
+  const testing::CliResult before = testing::RunVmap("report '" + file.string() + "'");
+  ASSERT_EQ(before.status, 0) << before.output;
+  fs::remove_all(temp.path() / "run_report");
+
+  options.frames_per_key = 2;
+  const VisualMap rebuilt = report_test::WriteSyntheticMap(map, options);
+  ASSERT_EQ(rebuilt.key_images.size(), 10u);
+  const testing::CliResult after = testing::RunVmap("report '" + file.string() + "'");
+  EXPECT_EQ(after.status, 2) << after.output;
+  EXPECT_NE(after.output.find("had 3 key images, and it has 10 now"), std::string::npos) << after.output;
+  EXPECT_NE(after.output.find("localize again"), std::string::npos) << after.output;
+  EXPECT_FALSE(fs::exists(temp.path() / "run_report")) << "a report pairing frames with other key images";
 }
 
 }  // namespace
