@@ -74,6 +74,16 @@ TEST(Promises, OutputsVmapCannotProveItsOwnAreNeverReplaced) {
   ASSERT_EQ(RunVmap(localize + " --report " + Quote(tmp.path() / "page"), &log), 0) << log;
   ASSERT_EQ(RunVmap(localize + " --report " + Quote(tmp.path() / "added"), &log), 0) << log;
   std::ofstream(tmp.path() / "added/notes.txt") << "mine";
+  // Reports the user added to inside their report/ folder: a file, a folder, a file among the frames. The report
+  // replaces report/ whole, and deleted them without a word.
+  for (const char* copy : {"inner_file", "inner_folder", "inner_frame"}) {
+    fs::copy(tmp.path() / "page", tmp.path() / copy, fs::copy_options::recursive);
+  }
+  std::ofstream(tmp.path() / "inner_file/report/notes.txt") << "inner notes";
+  fs::create_directories(tmp.path() / "inner_folder/report/mine");
+  std::ofstream(tmp.path() / "inner_folder/report/mine/figure.txt") << "figure";
+  fs::create_directories(tmp.path() / "inner_frame/report/frames");
+  std::ofstream(tmp.path() / "inner_frame/report/frames/annotated.png") << "annotated";
   struct Case {
     std::string arguments, expected;
   };
@@ -88,6 +98,10 @@ TEST(Promises, OutputsVmapCannotProveItsOwnAreNeverReplaced) {
       {localize + " --report " + Quote(tmp.path() / "thesis"), "it has no report.html"},
       {"report " + Quote(tmp.path() / "thesis/run.json") + " -o " + Quote(tmp.path() / "thesis"), "holds the input"},
       {localize + " --report " + Quote(tmp.path() / "added"), "it holds 'notes.txt'"},
+      {localize + " --report " + Quote(tmp.path() / "inner_file"), "it holds 'report/notes.txt'"},
+      {"report " + Quote(tmp.path() / "page/run.json") + " -o " + Quote(tmp.path() / "inner_folder"),
+       "it holds 'report/mine'"},
+      {localize + " --report " + Quote(tmp.path() / "inner_frame"), "it holds 'report/frames/annotated.png'"},
       {"report " + Quote(tmp.path() / "page/run.json") + " -o " + Quote(tmp.path() / "page"), "page/run.json"},
   };
   for (const Case& c : cases) {
@@ -103,6 +117,9 @@ TEST(Promises, OutputsVmapCannotProveItsOwnAreNeverReplaced) {
   EXPECT_EQ(ReadText(tmp.path() / "notes.txt"), "notes");
   EXPECT_EQ(ReadText(tmp.path() / "thesis/thesis.tex"), "draft");
   EXPECT_EQ(ReadText(tmp.path() / "added/notes.txt"), "mine");
+  EXPECT_EQ(ReadText(tmp.path() / "inner_file/report/notes.txt"), "inner notes");
+  EXPECT_EQ(ReadText(tmp.path() / "inner_folder/report/mine/figure.txt"), "figure");
+  EXPECT_EQ(ReadText(tmp.path() / "inner_frame/report/frames/annotated.png"), "annotated");
   EXPECT_NO_THROW(ReadMap(tmp.path() / "real_map"));
   EXPECT_TRUE(fs::is_symlink(tmp.path() / "map_link"));
   EXPECT_TRUE(EntriesStartingWith(tmp.path(), ".").empty()) << "no temporary left";

@@ -382,6 +382,42 @@ std::unique_ptr<AtomicOutputDirectory> PrepareLocalizationReport(const Localizat
   return prepared;
 }
 
+namespace {
+
+// The folder goes whole when the report is replaced, report/ with it: a file of the user's inside report/ (notes, an
+// exported figure) would go too. A report's report/ holds frames/ and nothing else, and frames/ only NNNNNN.jpg.
+std::string WhyNotReportAssets(const fs::path& directory) {
+  const fs::path assets = directory / kReportAssetsDirectory;
+  std::error_code ec;
+  const fs::file_status status = fs::symlink_status(assets, ec);
+  if (status.type() == fs::file_type::not_found) return "";
+  const auto foreign = [](const std::string& name) {
+    return "it holds '" + name + "', which a localization report never holds";
+  };
+  if (!fs::is_directory(status)) return foreign(kReportAssetsDirectory);
+  for (const fs::directory_entry& entry : fs::directory_iterator(assets, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name != "frames" || !entry.is_directory() || entry.is_symlink()) {
+      return foreign(std::string(kReportAssetsDirectory) + "/" + name);
+    }
+  }
+  if (ec) return "its " + std::string(kReportAssetsDirectory) + " cannot be listed: " + ec.message();
+  const fs::path frames = assets / "frames";
+  if (!fs::exists(frames)) return "";
+  for (const fs::directory_entry& entry : fs::directory_iterator(frames, ec)) {
+    const std::string name = entry.path().filename().string();
+    const std::string stem = name.size() > 4 ? name.substr(0, name.size() - 4) : "";
+    const bool numbered = !stem.empty() && name.compare(stem.size(), 4, ".jpg") == 0 &&
+                          stem.find_first_not_of("0123456789") == std::string::npos;
+    if (!numbered || !entry.is_regular_file() || entry.is_symlink()) {
+      return foreign(std::string(kReportAssetsDirectory) + "/frames/" + name);
+    }
+  }
+  return ec ? "its " + std::string(kReportAssetsDirectory) + "/frames cannot be listed: " + ec.message() : "";
+}
+
+}  // namespace
+
 std::string WhyNotALocalizationReport(const fs::path& directory) {
   const ContainedJson parsed =
       ReadContainedJson(directory, kLocalizationReportRunFileName, kMaxRunJsonBytes, kMaxRunJsonValues);
@@ -400,7 +436,8 @@ std::string WhyNotALocalizationReport(const fs::path& directory) {
       return "it holds '" + name + "', which a localization report never holds";
     }
   }
-  return ec ? "it cannot be listed: " + ec.message() : "";
+  if (ec) return "it cannot be listed: " + ec.message();
+  return WhyNotReportAssets(directory);
 }
 
 void WriteLocalizationReport(const fs::path& run_file, const fs::path& directory,

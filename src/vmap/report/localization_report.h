@@ -8,7 +8,8 @@
 //   DIR/report/frames/NNNNNN.jpg  those pairs (NNNNNN = frame index)
 //   DIR/run.json                  the run (as `vmap localize --json` writes it)
 // DIR is written as a whole and replaced atomically, and only when it is empty or an older report of a run
-// (its run.json says so), never a folder that is, holds or lies inside the map or the query.
+// (its run.json says so, and it holds nothing a report does not write, inside report/ neither), never a folder
+// that is, holds or lies inside the map or the query.
 
 #include <filesystem>
 #include <map>
