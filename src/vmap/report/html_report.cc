@@ -259,8 +259,11 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
   html += OptionsSection(options, "Every option used to build this map");
   html += PageEnd();
 
+  // The page is written before report/ goes in place, and put in place right after it: a page that cannot be
+  // written (a full disk) leaves the old report whole, not new figures under the old page.
+  PendingFile page(map_directory / kReportFileName, html);
   assets_directory.Commit();
-  WriteFileAtomically(map_directory / kReportFileName, html);
+  page.Commit();
 }
 
 }  // namespace vmap

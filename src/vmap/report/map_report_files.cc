@@ -4,9 +4,11 @@
 #include <map>
 #include <memory>
 
+#include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "vmap/core/error.h"
 #include "vmap/map/map_io.h"
 #include "vmap/report/html_page.h"
 #include "vmap/report/match_figure.h"
@@ -20,9 +22,10 @@ namespace {
 // VP9 in WebM; both play in current browsers. Without either, the page keeps only the step-through player.
 class RouteVideo {
  public:
-  RouteVideo(const fs::path& directory, const cv::Size& frame_size, double fps)
+  // `shown`: the folder the video is in once the report is in place, for messages.
+  RouteVideo(const fs::path& directory, const fs::path& shown, const cv::Size& frame_size, double fps)
       // H.264 with 4:2:0 sampling needs even sides.
-      : size_(std::max(2, frame_size.width & ~1), std::max(2, frame_size.height & ~1)) {
+      : size_(std::max(2, frame_size.width & ~1), std::max(2, frame_size.height & ~1)), shown_(shown) {
     const std::pair<const char*, int> candidates[] = {
         {kRouteVideoNames[0], cv::VideoWriter::fourcc('a', 'v', 'c', '1')},
         {kRouteVideoNames[1], cv::VideoWriter::fourcc('V', 'P', '9', '0')}};
@@ -53,21 +56,44 @@ class RouteVideo {
     ++frames_;
   }
 
-  // Closes the file; false (and no file) when nothing usable was written.
+  // Closes the file; false (and no file) when nothing usable was written. Throws InputError naming the video when
+  // it does not read back whole: cv::VideoWriter ignores failed writes (a full disk, the file size limit), and a
+  // video cut short would be put in place as the report's.
   bool Finish() {
     if (!writer_.isOpened()) return false;
     writer_.release();
     std::error_code ec;
-    if (frames_ > 0 && fs::file_size(path_, ec) > 0 && !ec) return true;
+    if (frames_ == 0 || fs::file_size(path_, ec) == 0 || ec) {
+      fs::remove(path_, ec);
+      return false;
+    }
+    const int read_back = FramesReadBack();
+    if (read_back == frames_) return true;
     fs::remove(path_, ec);
-    return false;
+    throw InputError(fmt::format(
+        "cannot write the route video '{}': {} of its {} frames read back (a full disk, or the file size limit?); "
+        "free some space, or leave the video out with --no-video",
+        (shown_ / file_name_).string(), read_back, frames_));
   }
 
   const std::string& file_name() const { return file_name_; }
   const cv::Size& size() const { return size_; }
 
  private:
+  // Decoded, not taken from the container's frame count, which a file cut short may still claim whole.
+  int FramesReadBack() const {
+    try {
+      cv::VideoCapture capture(path_.string(), cv::CAP_FFMPEG);
+      int count = 0;
+      for (cv::Mat frame; capture.isOpened() && capture.read(frame) && !frame.empty();) ++count;
+      return count;
+    } catch (const cv::Exception&) {
+      return 0;
+    }
+  }
+
   cv::Size size_;
+  fs::path shown_;
   cv::VideoWriter writer_;
   std::string file_name_;
   fs::path path_;
@@ -110,7 +136,8 @@ MapReportFiles WriteMapReportFiles(const fs::path& map_directory, const VisualMa
     WriteJpeg(directory / ThumbnailFile(static_cast<int>(i)), thumb, options.jpeg_quality);
     assets.thumbnail_sizes.push_back(thumb.size());
     if (i == 0 && options.route_video && map.key_images.size() > 1) {
-      video = std::make_unique<RouteVideo>(directory, thumb.size(), options.route_fps);
+      video = std::make_unique<RouteVideo>(directory, map_directory / kReportAssetsDirectory, thumb.size(),
+                                           options.route_fps);
     }
     if (video) {
       video->Add(thumb, "key " + std::to_string(i) + "  frame " + std::to_string(map.key_images[i].frame_index));

@@ -1,10 +1,13 @@
 // `vmap report` and `vmap draw` as a user runs them.
 
+#include <sys/resource.h>
 #include <sys/wait.h>
 
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -130,6 +133,76 @@ TEST_F(ReportCliTest, ARunOfAMapBuiltAgainSinceIsRefused) {
   EXPECT_NE(after.output.find("had 3 key images, and it has 10 now"), std::string::npos) << after.output;
   EXPECT_NE(after.output.find("localize again"), std::string::npos) << after.output;
   EXPECT_FALSE(fs::exists(temp.path() / "run_report")) << "a report pairing frames with other key images";
+}
+
+// The largest file under `directory`, in bytes.
+std::uintmax_t LargestFile(const fs::path& directory) {
+  std::uintmax_t largest = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(directory)) {
+    if (entry.is_regular_file()) largest = std::max(largest, entry.file_size());
+  }
+  return largest;
+}
+
+// `vmap report MAP extra` under a file size limit of `limit` bytes: a write that fails part way, as on a full disk.
+testing::CliResult ReportUnderSizeLimit(const fs::path& map, const std::string& extra, rlim_t limit) {
+  struct rlimit old_limit {};
+  EXPECT_EQ(getrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  const auto old_handler = std::signal(SIGXFSZ, SIG_DFL);  // as a shell leaves it: vmap ignores it itself
+  struct rlimit small = old_limit;
+  small.rlim_cur = limit;
+  EXPECT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+  const testing::CliResult result = testing::RunVmap("report '" + map.string() + "' " + extra);
+  setrlimit(RLIMIT_FSIZE, &old_limit);
+  std::signal(SIGXFSZ, old_handler);
+  return result;
+}
+
+// A report whose writing failed part way was put in place half: a route video cut short was accepted (cv::VideoWriter
+// ignores failed writes), and report/ was replaced before report.html failed to be written.
+TEST_F(ReportCliTest, AReportWhoseWritingFailsPartWayLeavesTheOldOne) {
+  ScopedTempDir temp;
+  const fs::path map = temp.path() / "map";
+  report_test::SyntheticMapOptions options;
+  options.frames_per_key = 2;  // many key images: a route video larger than every picture and the page
+  options.frame_size = {640, 480};
+  report_test::WriteSyntheticMap(map, options);
+  const testing::CliResult made =
+      testing::RunVmap("report '" + map.string() + "' --figure-width 200 --thumbnail-width 640");
+  ASSERT_EQ(made.status, 0) << made.output;
+  const std::string page = ReadText(map / kReportFileName);
+  const std::string video = ReadText(map / "report/route.mp4");
+  const std::string thumbnail = ReadText(map / "report/keys/000000.jpg");
+  const std::uintmax_t pictures = std::max(LargestFile(map / "report/keys"), LargestFile(map / "report/links"));
+  ASSERT_GT(video.size(), std::max<std::uintmax_t>(pictures, page.size()) + 1024);
+
+  // The video cut short, everything else written whole.
+  const testing::CliResult cut_video = ReportUnderSizeLimit(map, "--figure-width 200 --thumbnail-width 640",
+                                                            std::max<std::uintmax_t>(pictures, page.size()) + 512);
+  EXPECT_EQ(cut_video.status, 2) << cut_video.output;
+  EXPECT_NE(cut_video.output.find("cannot write the route video '" + (map / "report/route.mp4").string() + "'"),
+            std::string::npos)
+      << cut_video.output;
+  EXPECT_TRUE(ReadText(map / "report/route.mp4") == video) << "the old video was replaced";
+  EXPECT_TRUE(ReadText(map / kReportFileName) == page) << "the old page was replaced";
+
+  // The pictures written whole (smaller thumbnails, no video), the page cut short: sizes taken from the report of
+  // a copy.
+  const std::string smaller = "--figure-width 200 --thumbnail-width 100 --no-video";
+  const fs::path copy = temp.path() / "copy";
+  fs::copy(map, copy, fs::copy_options::recursive);
+  ASSERT_EQ(testing::RunVmap("report '" + copy.string() + "' " + smaller).status, 0);
+  const std::uintmax_t small_pictures = LargestFile(copy / "report");
+  ASSERT_GT(ReadText(copy / kReportFileName).size(), small_pictures + 1024);
+  const testing::CliResult cut_page = ReportUnderSizeLimit(map, smaller, small_pictures + 512);
+  EXPECT_EQ(cut_page.status, 2) << cut_page.output;
+  EXPECT_NE(cut_page.output.find(kReportFileName), std::string::npos) << cut_page.output;
+  EXPECT_TRUE(ReadText(map / kReportFileName) == page) << "the old page was replaced";
+  EXPECT_TRUE(ReadText(map / "report/keys/000000.jpg") == thumbnail) << "the old page's pictures were replaced";
+  EXPECT_TRUE(fs::exists(map / "report/route.mp4")) << "the old page's video was removed";
+  for (const auto& entry : fs::directory_iterator(map)) {
+    EXPECT_NE(entry.path().filename().string()[0], '.') << "a temporary was left: " << entry.path();
+  }
 }
 
 }  // namespace
