@@ -21,6 +21,7 @@
 
 namespace vmap {
 namespace fs = std::filesystem;
+using report::Displayable;
 using report::FormatFixed;
 using report::HtmlEscape;
 using report::kBlue;
@@ -309,9 +310,13 @@ std::unique_ptr<AtomicOutputDirectory> PrepareLocalizationReport(const Localizat
   const double n = s.frames > 0 ? static_cast<double>(s.frames) : 1.0;
   const std::string assets_url = std::string(kReportAssetsDirectory) + "/";
   std::ostringstream html;
+  // Paths as the run recorded them, in bytes: a name that is not UTF-8 is shown percent-encoded, as the map's page
+  // shows it, not as bytes the UTF-8 page would turn into replacement characters.
+  const std::string query_name = Displayable(run.info.query);
+  const std::string map_name = Displayable(run.info.map_directory);
   html << report::PageStart(
-      "vmap localization: " + run.info.query, "Localization of " + run.info.query,
-      "against the map " + run.info.map_directory + " (" + std::to_string(map.key_images.size()) + " key images)",
+      "vmap localization: " + query_name, "Localization of " + query_name,
+      "against the map " + map_name + " (" + std::to_string(map.key_images.size()) + " key images)",
       {{"summary", "Summary"},
        {"keys", "Key image over time"},
        {"similarity", "Similarity"},
@@ -323,8 +328,8 @@ std::unique_ptr<AtomicOutputDirectory> PrepareLocalizationReport(const Localizat
        << report::Card(FormatFixed(100.0 * s.uncertain / n, 1) + " %", "uncertain")
        << report::Card(FormatFixed(100.0 * s.lost / n, 1) + " %", "lost")
        << report::Card(FormatFixed(s.frames_per_second, 1), "frames/s") << "</div>\n<table class=\"summary\">\n"
-       << report::Row("Map", HtmlEscape(run.info.map_directory))
-       << report::Row("Query", HtmlEscape(run.info.query) + " (" + HtmlEscape(SourceFormatName(run.info.query_format)) +
+       << report::Row("Map", HtmlEscape(map_name))
+       << report::Row("Query", HtmlEscape(query_name) + " (" + HtmlEscape(SourceFormatName(run.info.query_format)) +
                                    ", " + HtmlEscape(report::SizeText(run.info.frame_size)) + ")")
        << report::Row("Matcher", HtmlEscape(run.info.matcher))
        << report::Row("Relocalization ranking", HtmlEscape(run.info.ranking))
@@ -361,7 +366,7 @@ std::unique_ptr<AtomicOutputDirectory> PrepareLocalizationReport(const Localizat
          << r.frame_index << "\"><img loading=\"lazy\" decoding=\"async\" src=\""
          << UrlPath(assets_url + "frames/" + report::Numbered(r.frame_index)) << "\" width=\"" << size.width
          << "\" height=\"" << size.height << "\" alt=\"frame " << r.frame_index << "\"><figcaption>Frame "
-         << r.frame_index << " (" << HtmlEscape(r.source_name) << "): " << LocalizationStatusName(r.status)
+         << r.frame_index << " (" << HtmlEscape(Displayable(r.source_name)) << "): " << LocalizationStatusName(r.status)
          << (r.key >= 0 ? fmt::format(" &middot; key {} (S = {})", r.key, FormatFixed(r.to_key.similarity, 3)) : "")
          << (r.next_key >= 0
                  ? fmt::format(" &middot; next {} (S = {})", r.next_key, FormatFixed(r.to_next.similarity, 3))
@@ -369,7 +374,7 @@ std::unique_ptr<AtomicOutputDirectory> PrepareLocalizationReport(const Localizat
          << "</figcaption></figure>\n";
   }
   if (written.empty() && recorded.empty() && !QueryCanBeReadAgain(run.info) && !run.frames.empty()) {
-    html << "<p class=\"note\">No frames to show: the query " << HtmlEscape(run.info.query)
+    html << "<p class=\"note\">No frames to show: the query " << HtmlEscape(query_name)
          << " is a live input, a single image or a stream that cannot be read a second time, and this report was "
             "made from the run's file alone (<code>vmap localize --report</code> keeps the last frames of such a "
             "query).</p>\n";

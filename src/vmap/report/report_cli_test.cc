@@ -13,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "vmap/core/atomic_output.h"
+#include "vmap/core/file_name_encoding.h"
 #include "vmap/localization/localization_output.h"
 #include "vmap/report/html_report.h"
 #include "vmap/testing/report_test_util.h"
@@ -133,6 +134,22 @@ TEST_F(ReportCliTest, ARunOfAMapBuiltAgainSinceIsRefused) {
   EXPECT_NE(after.output.find("had 3 key images, and it has 10 now"), std::string::npos) << after.output;
   EXPECT_NE(after.output.find("localize again"), std::string::npos) << after.output;
   EXPECT_FALSE(fs::exists(temp.path() / "run_report")) << "a report pairing frames with other key images";
+}
+
+// A run whose query and frame names are Latin-1 bytes: written raw into the UTF-8 page, they showed as replacement
+// characters. Shown percent-encoded, as the map's page shows them.
+TEST_F(ReportCliTest, ARunWithNamesThatAreNotUtf8HasAUtf8Page) {
+  ScopedTempDir temp;
+  const fs::path map = temp.path() / "map";
+  const VisualMap built = report_test::WriteSyntheticMap(map);
+  const fs::path file = temp.path() / "run.json";
+  WriteRun(file, built, map, (temp.path() / "caf\xE9 query.mp4").string(), "frame_\xE9t\xE9");
+  const testing::CliResult made = testing::RunVmap("report '" + file.string() + "'");
+  ASSERT_EQ(made.status, 0) << made.output;
+  const std::string page = ReadText(temp.path() / "run_report" / kReportFileName);
+  EXPECT_TRUE(IsValidUtf8(page));
+  EXPECT_NE(page.find("<title>vmap localization: " + (temp.path() / "caf%E9 query.mp4").string()), std::string::npos);
+  EXPECT_GE(report_test::CountOccurrences(page, "caf%E9 query.mp4"), 3) << "title, heading and the Query row";
 }
 
 // The largest file under `directory`, in bytes.
