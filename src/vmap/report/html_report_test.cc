@@ -345,5 +345,30 @@ TEST(SweepReportTest, PlotsShowKeyImagesAndQualityAgainstTau) {
   EXPECT_NEAR(best[0].y, 0.7, 0.005);
 }
 
+// Thresholds given out of order (--thresholds 0.6,0.2,0.8,0.4): the lines were drawn in that order, a zigzag.
+TEST(SweepReportTest, PlotsDrawTheThresholdsInOrderOfTau) {
+  ScopedTempDir temp;
+  SweepResult sweep = SyntheticSweep(temp.path());
+  sweep.rows = {sweep.rows[2], sweep.rows[0], sweep.rows[3], sweep.rows[1]};
+  sweep.best_row = 3;
+  WriteSweepReport(sweep, temp.path());
+  const std::string html = ReadText(temp.path() / kReportFileName);
+  const std::string keys_svg = report_test::SvgById(html, "keys-plot");
+  const std::string quality_svg = report_test::SvgById(html, "quality-plot");
+  const auto m = report_test::PolylinePoints(keys_svg, "points=", report_test::ParsePlotAxes(keys_svg));
+  const std::string quality_group = quality_svg.substr(quality_svg.find("class=\"series quality\""));
+  const auto q = report_test::PolylinePoints(quality_group.substr(0, quality_group.find("</g>")),
+                                             "points=", report_test::ParsePlotAxes(quality_svg));
+  ASSERT_EQ(m.size(), 4u);
+  ASSERT_EQ(q.size(), 4u);
+  const double taus[] = {0.2, 0.4, 0.6, 0.8};
+  const int keys[] = {5, 9, 20, 41};
+  for (size_t i = 0; i < 4; ++i) {
+    EXPECT_NEAR(m[i].x, taus[i], 0.005) << i;
+    EXPECT_NEAR(m[i].y, keys[i], 0.2) << i;
+    EXPECT_NEAR(q[i].x, taus[i], 0.005) << i;
+  }
+}
+
 }  // namespace
 }  // namespace vmap

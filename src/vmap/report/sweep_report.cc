@@ -168,7 +168,12 @@ std::string SweepPlotsSection(const SweepResult& sweep) {
   compression_line.css_class = "compression";
   for (PlotSeries* s : {&keys_line, &quality_line, &similarity_line, &compression_line}) s->segments.emplace_back();
   double y_high = 1.0;
-  for (const SweepRow& r : sweep.rows) {
+  // Drawn in the order of tau, not in the order the thresholds were given (0.5,0.2,0.35 drew a zigzag).
+  std::vector<const SweepRow*> by_tau;
+  for (const SweepRow& r : sweep.rows) by_tau.push_back(&r);
+  std::stable_sort(by_tau.begin(), by_tau.end(), [](const SweepRow* a, const SweepRow* b) { return a->tau < b->tau; });
+  for (const SweepRow* row : by_tau) {
+    const SweepRow& r = *row;
     keys_line.segments[0].emplace_back(r.tau, r.num_key_images);
     quality_line.segments[0].emplace_back(r.tau, r.quality);
     similarity_line.segments[0].emplace_back(r.tau, r.mean_similarity);
