@@ -7,6 +7,8 @@
 
 #include "vmap/core/contained_file.h"
 #include "vmap/core/file_name_encoding.h"
+#include "vmap/core/number_text.h"
+#include "vmap/report/html_util.h"
 
 namespace vmap {
 
@@ -58,6 +60,13 @@ std::string TauText(double tau) {
   return std::stod(two) == tau ? two : fmt::format("{:.12g}", tau);
 }
 
+// A threshold in sweep.csv: four decimals (0.3000), all its digits where four would not read back as it (0.12341
+// and 0.12344 both read 0.1234, and the rows could not be told apart nor matched with sweep.json's).
+std::string CsvTau(double tau) {
+  const std::string four = fmt::format("{:.4f}", tau);
+  return ParseNumber(four) == tau ? four : report::FormatExact(tau);
+}
+
 }  // namespace
 
 std::string SweepToMarkdown(const SweepResult& sweep) {
@@ -94,7 +103,7 @@ std::string SweepToCsv(const SweepResult& sweep) {
       "below_tau_links,usable_links,best\n";
   for (size_t i = 0; i < sweep.rows.size(); ++i) {
     const SweepRow& r = sweep.rows[i];
-    text += fmt::format("{:.4f},{},{:.4f},{},{},{:.4f},{:.6f},{:.6f},{},{},{}\n", r.tau, r.num_key_images,
+    text += fmt::format("{},{},{:.4f},{},{},{:.4f},{:.6f},{:.6f},{},{},{}\n", CsvTau(r.tau), r.num_key_images,
                         r.key_image_percent, r.min_verified, r.max_verified, r.mean_verified, r.mean_similarity,
                         r.quality, r.below_tau_links, r.usable_links >= 0 ? std::to_string(r.usable_links) : "",
                         static_cast<int>(i) == sweep.best_row ? 1 : 0);

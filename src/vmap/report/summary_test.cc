@@ -80,4 +80,16 @@ TEST(Summary, SweepTablesTellCloseThresholdsApart) {
   EXPECT_NE(md.find("Best tau by Q: 0.104"), std::string::npos) << md;
 }
 
+// sweep.csv wrote both 0.12341 and 0.12344 as 0.1234: two rows of one threshold, neither matching sweep.json's.
+TEST(Summary, SweepCsvTellsCloseThresholdsApart) {
+  SweepResult sweep = TwoRows();
+  sweep.rows[0].tau = 0.12341;
+  sweep.rows[1].tau = 0.12344;
+  const std::string csv = SweepToCsv(sweep);
+  EXPECT_NE(csv.find("\n0.12341,5,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\n0.12344,20,"), std::string::npos) << csv;
+  sweep.rows[0].tau = 0.5;
+  EXPECT_NE(SweepToCsv(sweep).find("\n0.5000,5,"), std::string::npos) << "a threshold four decimals hold keeps them";
+}
+
 }  // namespace vmap
