@@ -48,12 +48,14 @@ struct Box {
 };
 
 // Data ranges widen to the enclosing round ticks; a fixed range is kept exactly (a frame axis ends at the
-// last frame) and gets the round ticks inside it. Integer axes keep a step of at least 1.
+// last frame, the key images of a 3-key map are -1 to 2) and gets the round ticks inside it. Integer axes keep a
+// step of at least 1.
 AxisTicks AxisFor(const std::optional<cv::Point2d>& fixed, double data_low, double data_high, bool integer) {
   double low = fixed ? fixed->x : data_low;
   double high = fixed ? fixed->y : data_high;
   if (!(low <= high)) low = 0.0, high = 1.0;
-  if (integer && high - low < 4.0) high = low + 4.0;  // fewer than 5 integers: still 1-steps, never 0.5
+  // Data spanning fewer than 5 integers: room for 1-steps, never 0.5.
+  if (integer && !fixed && high - low < 4.0) high = low + 4.0;
   AxisTicks ticks = NiceTicks(low, high);
   if (integer && ticks.step < 1.0) ticks = NiceTicks(low, high, 2);
   if (fixed && high > low) {

@@ -68,6 +68,34 @@ TEST(SvgPlotTest, PlottedPointsMapBackToTheData) {
   EXPECT_GE(axes.x_max, 12);
 }
 
+// The key plot of a 3-key map (keys -1 to 2, fixed) showed -1 to 3: the padding of a short integer range is for
+// ranges fitted to the data only.
+TEST(SvgPlotTest, AFixedIntegerRangeIsNotPadded) {
+  SvgPlot fixed("fixed", "frame", "key");
+  fixed.SetIntegerY(true);
+  fixed.SetYRange(-1.0, 2.0);
+  PlotSeries keys;
+  keys.segments = {{{0, 0}, {5, 1}, {9, 2}}};
+  fixed.Add(keys);
+  const report_test::PlotAxes fixed_axes = report_test::ParsePlotAxes(fixed.Render());
+  EXPECT_EQ(fixed_axes.y_min, -1.0);
+  EXPECT_EQ(fixed_axes.y_max, 2.0);
+  SvgPlot one("one", "frame", "key");
+  one.SetIntegerY(true);
+  one.SetYRange(0.0, 1.0);
+  one.Add(keys);
+  const std::string one_svg = one.Render();
+  EXPECT_EQ(report_test::ParsePlotAxes(one_svg).y_max, 1.0);
+  EXPECT_EQ(one_svg.find(">0.5<"), std::string::npos) << "an integer axis has no half steps";
+  // Fitted to the data, a short integer range still gets room for whole steps.
+  SvgPlot fitted("fitted", "frame", "key");
+  fitted.SetIntegerY(true);
+  fitted.Add(keys);
+  const report_test::PlotAxes fitted_axes = report_test::ParsePlotAxes(fitted.Render());
+  EXPECT_EQ(fitted_axes.y_min, 0.0);
+  EXPECT_EQ(fitted_axes.y_max, 4.0);
+}
+
 TEST(SvgPlotTest, EscapesLabelsAndNames) {
   SvgPlot plot("p", "x <frames>", "y & \"S\"");
   PlotSeries line;
