@@ -3,6 +3,7 @@
 #include <optional>
 
 #include "vmap/core/directory_lock.h"
+#include "vmap/core/error.h"
 #include "vmap/report/localization_report.h"
 
 namespace vmap {
@@ -22,6 +23,31 @@ void ReportPipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
 
 void ReportPipelineOptions::Check() const { map_report.Check(); }
 
+namespace {
+
+// The options of one kind of report given for the other are refused, not ignored: `vmap report MAP -o elsewhere`
+// wrote into the map, and a run's report took --figure-width without using it.
+void RefuseOptionsOfTheOtherReport(const ReportPipelineOptions& options, bool is_run) {
+  if (!is_run) {
+    if (!options.output.empty()) {
+      const std::string page = (fs::path(options.target) / kReportFileName).string();
+      throw OptionError("output", "is for the report of a localization run; a map's report is written into the map ('" +
+                                      page + "'): leave it out, or give the run's --json file");
+    }
+    return;
+  }
+  const MapReportOptions map_defaults;
+  const auto refuse = [&](const char* field, const char* what) {
+    throw OptionError(field, std::string("is for a map's report, and '") + options.target +
+                                 "' is a localization run, whose report has no " + what + ": leave it out");
+  };
+  if (options.map_report.thumbnail_width != map_defaults.thumbnail_width) refuse("thumbnail_width", "thumbnails");
+  if (options.map_report.figure_width != map_defaults.figure_width) refuse("figure_width", "match figures");
+  if (options.map_report.route_video != map_defaults.route_video) refuse("route_video", "route video");
+}
+
+}  // namespace
+
 fs::path RunReportPipeline(const ReportPipelineOptions& options) {
   // 1. The options.
   options.Check();
@@ -30,6 +56,7 @@ fs::path RunReportPipeline(const ReportPipelineOptions& options) {
   const fs::path target(options.target);
   std::error_code ec;
   const bool is_run = fs::exists(target, ec) && !fs::is_directory(target, ec);
+  RefuseOptionsOfTheOtherReport(options, is_run);
 
   // 3. The report.
   if (is_run) {

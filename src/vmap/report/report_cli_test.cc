@@ -152,6 +152,32 @@ TEST_F(ReportCliTest, ARunWithNamesThatAreNotUtf8HasAUtf8Page) {
   EXPECT_GE(report_test::CountOccurrences(page, "caf%E9 query.mp4"), 3) << "title, heading and the Query row";
 }
 
+// Options of one kind of report given for the other were ignored: `vmap report MAP -o elsewhere` wrote into the
+// map, and a run's report took --figure-width, --thumbnail-width and --no-video and exited 0.
+TEST_F(ReportCliTest, OptionsOfTheOtherKindOfReportAreRefused) {
+  ScopedTempDir temp;
+  const fs::path map = temp.path() / "map";
+  const VisualMap built = report_test::WriteSyntheticMap(map);
+  const fs::path elsewhere = temp.path() / "elsewhere";
+  const testing::CliResult map_output =
+      testing::RunVmap("report '" + map.string() + "' -o '" + elsewhere.string() + "'");
+  EXPECT_EQ(map_output.status, 2);
+  EXPECT_NE(map_output.output.find("-o"), std::string::npos) << map_output.output;
+  EXPECT_NE(map_output.output.find("a map's report is written into the map"), std::string::npos) << map_output.output;
+  EXPECT_FALSE(fs::exists(elsewhere));
+  EXPECT_FALSE(fs::exists(map / kReportFileName));
+
+  const fs::path file = temp.path() / "run.json";
+  WriteRun(file, built, map, (temp.path() / "gone.mp4").string());
+  for (const std::string flag : {"--figure-width 500", "--thumbnail-width 100", "--no-video"}) {
+    const testing::CliResult run = testing::RunVmap("report '" + file.string() + "' " + flag);
+    EXPECT_EQ(run.status, 2) << flag << "\n" << run.output;
+    EXPECT_NE(run.output.find(flag.substr(0, flag.find(' ')) + " is for a map's report"), std::string::npos)
+        << run.output;
+    EXPECT_FALSE(fs::exists(temp.path() / "run_report")) << flag;
+  }
+}
+
 // The largest file under `directory`, in bytes.
 std::uintmax_t LargestFile(const fs::path& directory) {
   std::uintmax_t largest = 0;
