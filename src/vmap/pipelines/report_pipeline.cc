@@ -55,7 +55,18 @@ fs::path RunReportPipeline(const ReportPipelineOptions& options) {
   // 2. A map or a run.
   const fs::path target(options.target);
   std::error_code ec;
-  const bool is_run = fs::exists(target, ec) && !fs::is_directory(target, ec);
+  const bool exists = fs::exists(target, ec);
+  // Named as what it was meant to be: the map's report checked its page's folder first, and advised creating it.
+  const fs::path named = target.has_filename() ? target : target.parent_path();  // "run.json/" names run.json
+  if (!exists && named != target && fs::is_regular_file(named, ec)) {
+    throw InputError("'" + target.string() + "' names the file '" + named.string() + "' as a folder; give '" +
+                     named.string() + "'");
+  }
+  if (!exists && named.extension() == ".json") {
+    throw InputError("the localization run '" + target.string() +
+                     "' does not exist; give the --json file of `vmap localize`");
+  }
+  const bool is_run = exists && !fs::is_directory(target, ec);
   RefuseOptionsOfTheOtherReport(options, is_run);
 
   // 3. The report.

@@ -22,7 +22,8 @@ struct ReportPipelineOptions {
 // Stages, in order:
 //   1. check the options;
 //   2. tell a map from a run (anything but a folder is taken for a run, whose reader refuses what is not a
-//      regular file); the options of the other kind of report are refused (OptionError), not ignored;
+//      regular file; a .json that does not exist is a run that does not exist, anything else a map); the options of
+//      the other kind of report are refused (OptionError), not ignored;
 //   3. write the report: into the map, or into the run's report folder.
 // Returns the report's page.
 std::filesystem::path RunReportPipeline(const ReportPipelineOptions& options);

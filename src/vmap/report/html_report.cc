@@ -219,10 +219,11 @@ void WriteMapReport(const fs::path& map_directory) { WriteMapReport(map_director
 
 void WriteMapReport(const fs::path& map_directory, const MapReportOptions& report_options) {
   report_options.Check();
+  // The map is read first: a map that does not exist is named as such, not as a page whose folder is missing.
+  const RecordedMap read = ReadRecordedMap(map_directory);
   // report.html is checked before report/ is replaced: a page that may not be replaced (a link, read-only) refuses
   // the report before anything is written.
   CheckOutputFiles({{map_directory / kReportFileName, kReportFileName}}, {});
-  const RecordedMap read = ReadRecordedMap(map_directory);
   const VisualMap& map = read.map;
   // Every image path is checked before anything is written.
   for (const KeyImage& k : map.key_images) KeyImageFile(map_directory, k);

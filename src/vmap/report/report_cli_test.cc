@@ -152,6 +152,26 @@ TEST_F(ReportCliTest, ARunWithNamesThatAreNotUtf8HasAUtf8Page) {
   EXPECT_GE(report_test::CountOccurrences(page, "caf%E9 query.mp4"), 3) << "title, heading and the Query row";
 }
 
+// `vmap report no_such_map` said "its folder 'no_such_map' does not exist; create it first", and so did a run file
+// that does not exist: the page's folder was checked before the map was read.
+TEST_F(ReportCliTest, AMapOrRunThatDoesNotExistIsNamedAsSuch) {
+  ScopedTempDir temp;
+  const fs::path map = temp.path() / "no_such_map";
+  const testing::CliResult no_map = testing::RunVmap("report '" + map.string() + "'");
+  EXPECT_EQ(no_map.status, 2);
+  EXPECT_NE(no_map.output.find("map directory '" + map.string() + "' does not exist; build one with `vmap build`"),
+            std::string::npos)
+      << no_map.output;
+  EXPECT_EQ(no_map.output.find("create it"), std::string::npos) << no_map.output;
+  const fs::path run = temp.path() / "nonexist.json";
+  const testing::CliResult no_run = testing::RunVmap("report '" + run.string() + "'");
+  EXPECT_EQ(no_run.status, 2);
+  EXPECT_NE(no_run.output.find("the localization run '" + run.string() + "' does not exist"), std::string::npos)
+      << no_run.output;
+  EXPECT_EQ(no_run.output.find("create it"), std::string::npos) << no_run.output;
+  EXPECT_TRUE(fs::is_empty(temp.path())) << "nothing written";
+}
+
 // Options of one kind of report given for the other were ignored: `vmap report MAP -o elsewhere` wrote into the
 // map, and a run's report took --figure-width, --thumbnail-width and --no-video and exited 0.
 TEST_F(ReportCliTest, OptionsOfTheOtherKindOfReportAreRefused) {
