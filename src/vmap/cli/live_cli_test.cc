@@ -149,7 +149,8 @@ struct LiveRun {
   std::unique_ptr<Child> vmap;
   std::unique_ptr<Child> sender;
 
-  void Start(const std::vector<std::string>& flags, double seconds) {
+  // `frame_rate` > 0: the video resampled to that many frames a second (a slow camera, a thin link).
+  void Start(const std::vector<std::string>& flags, double seconds, double frame_rate = 0.0) {
     std::vector<std::string> arguments = {testing::VmapBinary().string(), "build",
                                           fmt::format("tcp://127.0.0.1:{}?listen=1", port), "-o", output.string()};
     arguments.insert(arguments.end(), flags.begin(), flags.end());
@@ -158,11 +159,12 @@ struct LiveRun {
     ASSERT_TRUE(WaitFor([&] { return Listening(port) || !vmap->running(); }, 20)) << Read(tmp.path() / "vmap.log");
     ASSERT_TRUE(vmap->running()) << Read(tmp.path() / "vmap.log");
     const std::string video = (fs::path(testing::SharedDir()) / "data/lab_floor/lab_floor.mp4").string();
-    sender = std::make_unique<Child>(
-        std::vector<std::string>{"ffmpeg", "-nostdin", "-loglevel", "error", "-re", "-i", video, "-t",
-                                 fmt::format("{}", seconds), "-an", "-c:v", "mpeg2video", "-q:v", "4", "-g", "10", "-f",
-                                 "mpegts", fmt::format("tcp://127.0.0.1:{}", port)},
-        tmp.path() / "ffmpeg.log");
+    std::vector<std::string> command = {
+        "ffmpeg", "-nostdin", "-loglevel", "error", "-re", "-i", video, "-t", fmt::format("{}", seconds), "-an"};
+    if (frame_rate > 0) command.insert(command.end(), {"-vf", fmt::format("fps={}", frame_rate)});
+    command.insert(command.end(), {"-c:v", "mpeg2video", "-q:v", "4", "-g", "10", "-f", "mpegts",
+                                   fmt::format("tcp://127.0.0.1:{}", port)});
+    sender = std::make_unique<Child>(command, tmp.path() / "ffmpeg.log");
     ASSERT_TRUE(sender->started());
   }
   std::string log() { return Read(tmp.path() / "vmap.log") + "\nffmpeg: " + Read(tmp.path() / "ffmpeg.log"); }
@@ -203,6 +205,18 @@ TEST(LiveCli, SnapshotsAreReadableMapsWhileTheStreamRunsAndTheEndFinishesTheMap)
   EXPECT_EQ(map.coverage->first_source_index, 0);
   EXPECT_EQ(map.coverage->last_source_index, map.num_frames - 1);
   EXPECT_EQ(run.Entries(), std::vector<std::string>{"live_map"});
+}
+
+// A slow stream (2 frames/s) that sends all along is not taken for one that stopped: opening it probes more of it than
+// it sends within --stream-timeout, and every frame it sent is in the map (before: 2 of 20, and the sender cut off).
+TEST(LiveCli, ASlowStreamIsReadToItsEnd) {
+  REQUIRE_SHARED_AND_FFMPEG();
+  LiveRun run;
+  run.Start({"--stream-timeout", "2"}, 10, 2);
+  ASSERT_EQ(run.vmap->Wait(120), 0) << run.log();
+  EXPECT_EQ(run.sender->Wait(30), 0) << "the sender was cut off\n" << run.log();
+  const VisualMap map = ReadMap(run.output);
+  EXPECT_GE(map.num_frames, 19) << "of the 20 sent\n" << run.log();
 }
 
 TEST(LiveCli, UntilInterruptedSigintEndsTheInputAndTheMapIsFinishedFromWhatWasSeen) {

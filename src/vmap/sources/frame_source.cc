@@ -356,8 +356,8 @@ void FrameSourceOptions::VisitFields(OptionFieldVisitor& visitor) {
                     .OmitEmpty(),
                 camera_topic);
   visitor.Visit(OptionField{"stream_timeout_seconds", "--stream-timeout",
-                            "Live inputs: seconds without a frame after which the stream has ended (and the longest "
-                            "opening it may take)"}
+                            "Live inputs: seconds in which nothing arrives after which the stream has ended (and the "
+                            "longest wait for it to start sending)"}
                     .NotRecorded()
                     .Within(0, 3600)
                     .ExcludingMin()

@@ -121,11 +121,18 @@ class VideoSource : public FrameSource {
   }
 
   // FFmpeg polls this while it waits for data: a live stream that sent nothing for the timeout, or whose run
-  // was asked to end, ends (reads fail as at the end of a file).
+  // was asked to end, ends (reads fail as at the end of a file). Any byte received counts, not only a whole packet:
+  // opening a stream probes several seconds of it, which a slow stream (2 frames/s) takes longer than the timeout
+  // to send, while it is sending all along.
   static int InterruptCallback(void* opaque) {
-    const VideoSource& self = *static_cast<const VideoSource*>(opaque);
+    VideoSource& self = *static_cast<VideoSource*>(opaque);
     if (self.options_.stop_requested && self.options_.stop_requested()) return 1;
-    const double idle = std::chrono::duration<double>(std::chrono::steady_clock::now() - self.last_data_).count();
+    const auto now = std::chrono::steady_clock::now();
+    if (self.watched_ && self.watched_->pb && self.watched_->pb->bytes_read != self.bytes_seen_) {
+      self.bytes_seen_ = self.watched_->pb->bytes_read;
+      self.last_data_ = now;
+    }
+    const double idle = std::chrono::duration<double>(now - self.last_data_).count();
     return idle > self.options_.stream_timeout_seconds ? 1 : 0;
   }
 
@@ -136,8 +143,12 @@ class VideoSource : public FrameSource {
       last_data_ = std::chrono::steady_clock::now();
       format->interrupt_callback.callback = &VideoSource::InterruptCallback;
       format->interrupt_callback.opaque = this;
+      watched_ = format;
     }
-    if (avformat_open_input(&format, path.c_str(), nullptr, nullptr) < 0) CannotOpen(path);  // frees `format`
+    if (avformat_open_input(&format, path.c_str(), nullptr, nullptr) < 0) {
+      watched_ = nullptr;  // freed
+      CannotOpen(path);
+    }
     format_.reset(format);
     if (avformat_find_stream_info(format_.get(), nullptr) < 0) CannotOpen(path);
     const AVCodec* codec = nullptr;
@@ -257,7 +268,9 @@ class VideoSource : public FrameSource {
 
   FrameSourceOptions options_;
   const bool live_;
-  std::chrono::steady_clock::time_point last_data_;  // live: when the stream last delivered a packet
+  std::chrono::steady_clock::time_point last_data_;  // live: when the stream last delivered a byte
+  const AVFormatContext* watched_ = nullptr;         // live: the context whose bytes InterruptCallback counts
+  int64_t bytes_seen_ = 0;                           // of watched_, when last_data_ was set
   SequenceInfo info_;
   std::unique_ptr<AVFormatContext, FormatCloser> format_;
   std::unique_ptr<AVCodecContext, CodecFreer> codec_;
