@@ -28,7 +28,8 @@ class ForgetMissingFiles final : public OptionFieldVisitor {
     if (!field.is_local_file || value.empty()) return;
     value = DecodeFileName(value);
     if (std::filesystem::exists(value)) return;
-    spdlog::info("the map's {} {} '{}' are not here; searching the weights directories", model_, field.key, value);
+    // A warning: the file found instead may hold other weights than the map was built with.
+    spdlog::warn("the map's {} {} '{}' are not here; searching the weights directories", model_, field.key, value);
     value.clear();
   }
 

@@ -119,14 +119,21 @@ std::vector<std::string> WeightsSearchPaths(const std::string& preset) {
 }
 
 std::string LocateWeights(const std::string& preset, const std::string& explicit_path) {
+  // Absolute: a map records the file its matcher used, and a relative name would be read from wherever a later
+  // command runs (another file of that name, or none and another search).
+  const auto absolute = [](const std::string& path) {
+    std::error_code ec;
+    const std::filesystem::path full = std::filesystem::absolute(path, ec);
+    return ec ? path : full.lexically_normal().string();
+  };
   if (!explicit_path.empty()) {
     std::string why_not;
-    if (ContainedFile::OpenRegular(explicit_path, &why_not)) return explicit_path;
+    if (ContainedFile::OpenRegular(explicit_path, &why_not)) return absolute(explicit_path);
     throw OptionError("weights", "file '" + explicit_path + "' " + why_not + "; give the weights file");
   }
   const auto paths = WeightsSearchPaths(preset);
   for (const auto& path : paths) {
-    if (IsFile(path)) return path;
+    if (IsFile(path)) return absolute(path);
   }
   const auto& known = KnownWeightsFor(preset);
   std::string message = "no weights for " + ModelFlag(known) + "; searched:";

@@ -65,6 +65,18 @@ TEST_F(WeightsStoreTest, GitBlobIdOfFiles) {
   EXPECT_THROW(GitBlobId((cache_ / "absent").string()), InputError);
 }
 
+// A weights file given by a relative name is located by its absolute path: a map records it, and a command run
+// elsewhere would otherwise read another file of that name, or none.
+TEST_F(WeightsStoreTest, AWeightsFileGivenRelativeIsLocatedByItsAbsolutePath) {
+  const fs::path file = WriteFile("relative.ckpt", "weights\n");
+  const fs::path before = fs::current_path();
+  fs::current_path(file.parent_path());
+  const std::string located = LocateWeights("outdoor", file.filename().string());
+  fs::current_path(before);
+  EXPECT_EQ(located, file.string());
+  EXPECT_TRUE(fs::path(located).is_absolute());
+}
+
 TEST_F(WeightsStoreTest, CacheDirectoryFollowsEnvironment) {
   EXPECT_EQ(WeightsCacheDir(), cache_.string());
   EXPECT_EQ(WeightsSearchPaths("outdoor").front(), cache_.string() + "/outdoor_ds.ckpt");
