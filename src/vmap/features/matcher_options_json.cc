@@ -37,9 +37,32 @@ class ForgetMissingFiles final : public OptionFieldVisitor {
   const std::string& model_;
 };
 
+// Sets the model's `device` field, where it has one.
+class SetDevice final : public OptionFieldVisitor {
+ public:
+  explicit SetDevice(const std::string& device) : device_(device) {}
+  bool found = false;
+
+ protected:
+  void OnField(const OptionField&, int&) override {}
+  void OnField(const OptionField&, double&) override {}
+  void OnField(const OptionField&, bool&) override {}
+  void OnField(const OptionField&, std::vector<int>&) override {}
+  void OnField(const OptionField&, const EnumField&) override {}
+  void OnField(const OptionField& field, std::string& value) override {
+    if (std::string(field.key) != "device") return;
+    value = device_;
+    found = true;
+  }
+
+ private:
+  const std::string& device_;
+};
+
 }  // namespace
 
-MatcherOptions MatcherOptionsFromJson(const std::string& matcher_json, const std::string& map_file) {
+MatcherOptions MatcherOptionsFromJson(const std::string& matcher_json, const std::string& map_file,
+                                      const std::string& device) {
   nlohmann::json doc;
   try {
     doc = nlohmann::json::parse(matcher_json);
@@ -67,6 +90,13 @@ MatcherOptions MatcherOptionsFromJson(const std::string& matcher_json, const std
   }
   ForgetMissingFiles forget(options.type);
   model.VisitFields(forget);
+  if (!device.empty()) {
+    SetDevice set(device);
+    model.VisitFields(set);
+    if (!set.found && device != "cpu") {
+      throw InputError("device " + device + ": the map's matcher " + options.type + " runs on the CPU only");
+    }
+  }
   options.Check();
   return options;
 }

@@ -11,7 +11,9 @@ namespace vmap {
 // `matcher_json` is the JSON object of map.json's `options.matcher`. Fields the record lacks keep their
 // defaults; a weights file recorded where the map was built that is not here is dropped (the weights
 // directories are searched instead). Throws InputError naming `map_file` when the type is missing or unknown
-// to this vmap, or a field is of the wrong type.
-MatcherOptions MatcherOptionsFromJson(const std::string& matcher_json, const std::string& map_file);
+// to this vmap, or a field is of the wrong type. `device` ("cpu", "cuda"; "" = the recorded one) is where this run
+// computes: a run setting, not the map's (a map taught on a GPU is followed on a robot without one).
+MatcherOptions MatcherOptionsFromJson(const std::string& matcher_json, const std::string& map_file,
+                                      const std::string& device = "");
 
 }  // namespace vmap

@@ -38,13 +38,13 @@ LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, cons
 }
 
 LocalizationMap OpenLocalizationMap(RecordedMap read, const std::filesystem::path& directory,
-                                    const KeyImageStoreOptions& options) {
+                                    const KeyImageStoreOptions& options, const std::string& device) {
   LocalizationMap opened;
   opened.directory = directory;
   opened.map = std::move(read.map);
   opened.options = std::move(read.options);
   opened.matcher =
-      CreateMatcher(MatcherOptionsFromJson(opened.options.matcher_json, (directory / kMapFileName).string()));
+      CreateMatcher(MatcherOptionsFromJson(opened.options.matcher_json, (directory / kMapFileName).string(), device));
   // The frames are extracted within the mask the key images were (the robot's camera is the teach run's).
   if (!opened.map.camera_mask.empty()) {
     const CameraMask mask(opened.map.camera_mask, "the map's " + std::string(kCameraMaskFileName));

@@ -28,8 +28,9 @@ struct LocalizationMap {
 // Throws InputError naming the file and the fix when any of it fails.
 LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, const KeyImageStoreOptions& options);
 // The same for a map already read from `directory` (ReadRecordedMap): a map is read once.
+// `device`: where the matcher computes in this run ("" = where the map's was; MatcherOptionsFromJson).
 LocalizationMap OpenLocalizationMap(RecordedMap read, const std::filesystem::path& directory,
-                                    const KeyImageStoreOptions& options);
+                                    const KeyImageStoreOptions& options, const std::string& device = "");
 
 // Localizer options that follow the map: its verifier (iterations capped, see MapVerifierOptions) and its
 // definition of S; the rest are LocalizerOptions' defaults.

@@ -73,12 +73,20 @@ void LocalizationSessionOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(OptionField{"cache", "!--no-cache", "Do not read or write the key-image cache in the map directory"}
                     .NotRecorded(),
                 cache);
+  visitor.Visit(OptionField{"device", "--device",
+                            "Deep matchers: where this run computes, cpu or cuda (default: where the map's did)"}
+                    .HideDefault()
+                    .NotRecorded(),
+                device);
 }
 
 void LocalizationSessionOptions::Check() const {
   run.Check();
   localizer.Check();
   route.Check();
+  if (!device.empty() && device != "cpu" && device != "cuda") {
+    throw OptionError("device", fmt::format("'{}' is not a device; use cpu or cuda", device));
+  }
   // -1 stands for "not given"; any other negative key image is refused as the route refuses it.
   for (const auto& [name, key] : {std::pair<const char*, int>{"from", from}, {"to", to}}) {
     if (key < -1) throw OptionError(name, fmt::format("{} is no key image; give 0 or more", key));
@@ -184,7 +192,8 @@ LocalizationSession::LocalizationSession(const LocalizePipelineOptions& options)
   KeyImageStoreOptions store_options;
   store_options.use_cache = options.session.cache;
   store_options.thumbnail_width = localizer.ranking.thumbnail_width;
-  opened_ = std::make_unique<LocalizationMap>(OpenLocalizationMap(std::move(read), options.map, store_options));
+  opened_ = std::make_unique<LocalizationMap>(
+      OpenLocalizationMap(std::move(read), options.map, store_options, options.session.device));
 
   // 7. The localizer, following the map: its verifier, definition of S, translation thresholds and camera.
   options_ = FollowMap(*opened_, localizer, query_options_.resize);

@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -113,6 +115,60 @@ TEST(VmapXfeat, BadOptionsAndMissingCudaAreRefused) {
     EXPECT_EQ(r.status, 2) << r.output;
     EXPECT_NE(r.output.find("--device cuda"), std::string::npos) << r.output;
   }
+}
+
+// The device is where a run computes, not part of the map: a map taught with --device cuda (on a GPU workstation) is
+// followed on the CPU with --device cpu, and every frame is localized as on a map taught on the CPU.
+TEST(VmapXfeat, AMapTaughtOnAGpuIsFollowedOnTheCpu) {
+  SKIP_WITHOUT_SHARED();
+  TempDir dir;
+  const std::string input = SharedDir() + "/data/rccar_room/images --last 6";
+  auto r = RunVmap("build " + input + " --matcher xfeat -q -o " + (dir.path() / "cpu").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  // The same map as a GPU would have recorded it.
+  fs::create_directories(dir.path() / "cuda");
+  fs::copy(dir.path() / "cpu", dir.path() / "cuda", fs::copy_options::recursive);
+  std::string text;
+  {
+    std::ifstream in(dir.path() / "cuda/map.json");
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const size_t device = text.find("\"device\": \"cpu\"");
+  ASSERT_NE(device, std::string::npos);
+  text.replace(device, std::string("\"device\": \"cpu\"").size(), "\"device\": \"cuda\"");
+  std::ofstream(dir.path() / "cuda/map.json") << text;
+  fs::remove(dir.path() / "cuda/localization_cache.bin");
+  const auto localize = [&](const std::string& map, const std::string& flags) {
+    const fs::path csv = dir.path() / (map + ".csv");
+    const auto run =
+        RunVmap("localize " + (dir.path() / map).string() + " " + input + " -q --csv " + csv.string() + " " + flags);
+    EXPECT_EQ(run.status, 0) << run.output;
+    // Each row but its `seconds`, the time the frame took.
+    std::ifstream in(csv);
+    std::vector<std::vector<std::string>> rows;
+    for (std::string line; std::getline(in, line);) {
+      std::vector<std::string> cells;
+      std::stringstream cells_of(line);
+      for (std::string cell; std::getline(cells_of, cell, ',');) cells.push_back(cell);
+      rows.push_back(std::move(cells));
+    }
+    if (rows.empty()) return rows;
+    const auto seconds = std::find(rows.front().begin(), rows.front().end(), "seconds") - rows.front().begin();
+    for (auto& row : rows) {
+      if (seconds < static_cast<long>(row.size())) row.erase(row.begin() + seconds);
+    }
+    return rows;
+  };
+  const auto on_cpu = localize("cpu", "");
+  ASSERT_GE(on_cpu.size(), 7u);
+  EXPECT_EQ(localize("cuda", "--device cpu"), on_cpu);
+  if (!torch::cuda::is_available()) {
+    r = RunVmap("localize " + (dir.path() / "cuda").string() + " " + input + " -q");
+    EXPECT_EQ(r.status, 2) << r.output;
+  }
+  r = RunVmap("localize " + (dir.path() / "cpu").string() + " " + input + " -q --device gpu");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("--device 'gpu' is not a device"), std::string::npos) << r.output;
 }
 
 TEST(VmapXfeat, WeightsKnowsXfeatAndItsLayouts) {
