@@ -71,6 +71,14 @@ fs::path RunReportPipeline(const ReportPipelineOptions& options) {
 
   // 3. The report.
   if (is_run) {
+    // The run a report keeps of itself: its default report would go inside that report, which could then never be
+    // replaced (it holds a folder no localization report holds).
+    const fs::path parent = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+    if (options.output.empty() && target.filename() == kLocalizationReportRunFileName &&
+        fs::is_regular_file(parent / kReportFileName, ec)) {
+      throw InputError("'" + target.string() + "' is the run kept in the report '" + parent.string() +
+                       "': its report would go inside that one; give -o with a folder outside it");
+    }
     const fs::path output =
         options.output.empty() ? target.parent_path() / (target.stem().string() + "_report") : fs::path(options.output);
     WriteLocalizationReport(target, output);

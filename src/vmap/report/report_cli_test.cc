@@ -136,6 +136,26 @@ TEST_F(ReportCliTest, ARunOfAMapBuiltAgainSinceIsRefused) {
   EXPECT_FALSE(fs::exists(temp.path() / "run_report")) << "a report pairing frames with other key images";
 }
 
+// The run a report keeps of itself (REPORT/run.json): its report by default went inside REPORT, which could then never
+// be replaced. It is refused, saying to write it elsewhere; written elsewhere, it is the run's report.
+TEST_F(ReportCliTest, TheRunKeptInAReportIsNotReportedInsideIt) {
+  ScopedTempDir temp;
+  const fs::path map = temp.path() / "map";
+  const VisualMap teach = report_test::WriteSyntheticMap(map, {});
+  WriteRun(temp.path() / "run.json", teach, map, (temp.path() / "gone.mp4").string());
+  ASSERT_EQ(testing::RunVmap("report '" + (temp.path() / "run.json").string() + "'").status, 0);
+  const fs::path kept = temp.path() / "run_report" / "run.json";
+  ASSERT_TRUE(fs::is_regular_file(kept));
+  const testing::CliResult nested = testing::RunVmap("report '" + kept.string() + "'");
+  EXPECT_EQ(nested.status, 2) << nested.output;
+  EXPECT_NE(nested.output.find("is the run kept in the report"), std::string::npos) << nested.output;
+  EXPECT_FALSE(fs::exists(temp.path() / "run_report" / "run_report"));
+  const testing::CliResult elsewhere =
+      testing::RunVmap("report '" + kept.string() + "' -o '" + (temp.path() / "again").string() + "'");
+  EXPECT_EQ(elsewhere.status, 0) << elsewhere.output;
+  EXPECT_TRUE(fs::is_regular_file(temp.path() / "again" / kReportFileName));
+}
+
 // A run whose query and frame names are Latin-1 bytes: written raw into the UTF-8 page, they showed as replacement
 // characters. Shown percent-encoded, as the map's page shows them.
 TEST_F(ReportCliTest, ARunWithNamesThatAreNotUtf8HasAUtf8Page) {
