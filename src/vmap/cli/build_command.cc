@@ -14,6 +14,7 @@
 
 #include "vmap/cli/commands.h"
 #include "vmap/cli/option_binder.h"
+#include "vmap/cli/other_matcher_flags.h"
 #include "vmap/core/error.h"
 #include "vmap/pipelines/add_experience_pipeline.h"
 #include "vmap/pipelines/build_pipeline.h"
@@ -94,6 +95,8 @@ void RunBuild(const BuildCommand& command) {
           "frames localize; they go with --add-experience-to MAP");
     }
   }
+  command.build.Check();  // a value out of range is said first
+  RefuseOtherMatchersFlags(command.flags, command.build.matcher.type);
   const BuildPipelineResult built = RunBuildPipeline(command.build);
   std::cout << FormatMapSummary(built.map, command.build.map.quality_mean) << "map             "
             << built.directory.string() << "\n";

@@ -327,6 +327,15 @@ TEST(Cli, OptionErrorsNameTheFlagsThatSetTheFields) {
        "vmap: error: --aliked-top-k must be >= 0 (0 = threshold mode with --aliked-score-threshold; default 1000)\n"},
       {"match " + Quote(tmp.path() / "in/frame_0.png") + " " + Quote(tmp.path() / "in/frame_1.png") + " --confidence 2",
        "vmap: error: --confidence 2 is outside (0, 1) (default 0.999)\n"},
+      // A flag of a matcher the run does not use was taken and ignored.
+      {build + "--aliked-top-k 5",
+       "vmap: error: --aliked-top-k is an option of aliked, and the matcher is orb: drop it, or give --matcher "
+       "aliked\n"},
+      {build + "--matcher xfeat --loftr-size 320",
+       "vmap: error: --loftr-size is an option of loftr, and the matcher is xfeat: drop it, or give --matcher loftr\n"},
+      {"sweep " + Quote(tmp.path() / "in") + " --weights " + Quote(tmp.path() / "w.pt"),
+       "vmap: error: --weights is an option of aliked, loftr, xfeat, and the matcher is orb: drop it, or give "
+       "--matcher aliked\n"},
   };
   for (const Case& c : cases) {
     std::string output;

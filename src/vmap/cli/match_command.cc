@@ -9,6 +9,7 @@
 
 #include "vmap/cli/commands.h"
 #include "vmap/cli/option_binder.h"
+#include "vmap/cli/other_matcher_flags.h"
 #include "vmap/pipelines/match_pipeline.h"
 
 namespace vmap::cli {
@@ -74,7 +75,13 @@ void AddMatchCommand(CLI::App& app) {
       "subset and F, and the heading (x in image1 minus x in image0; degrees with --camera)");
   AddOptionFlags(command, flags->options, flags->option_flags);
   command->add_flag("--list", flags->list, "Print every match: x0 y0 x1 y1 score inlier")->group(kOutputSection);
-  command->callback([flags] { flags->option_flags.Run([&] { RunMatch(*flags); }); });
+  command->callback([flags] {
+    flags->option_flags.Run([&] {
+      flags->options.Check();  // a value out of range is said first
+      RefuseOtherMatchersFlags(flags->option_flags, flags->options.pair.matcher.type);
+      RunMatch(*flags);
+    });
+  });
 }
 
 }  // namespace vmap::cli

@@ -11,6 +11,7 @@
 
 #include "vmap/cli/commands.h"
 #include "vmap/cli/option_binder.h"
+#include "vmap/cli/other_matcher_flags.h"
 #include "vmap/core/progress.h"
 #include "vmap/pipelines/simulate_pipeline.h"
 
@@ -70,7 +71,13 @@ void AddSimulateCommand(CLI::App& app) {
       "Teach a route in a simulated corridor and repeat it from random offsets, vmap's localizer and controller in "
       "the loop");
   AddOptionFlags(command, flags->options, flags->option_flags);
-  command->callback([flags] { flags->option_flags.Run([&] { RunSimulate(*flags); }); });
+  command->callback([flags] {
+    flags->option_flags.Run([&] {
+      flags->options.Check();  // a value out of range is said first
+      RefuseOtherMatchersFlags(flags->option_flags, flags->options.matcher.type);
+      RunSimulate(*flags);
+    });
+  });
 }
 
 }  // namespace vmap::cli

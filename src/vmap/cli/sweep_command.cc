@@ -5,6 +5,7 @@
 
 #include "vmap/cli/commands.h"
 #include "vmap/cli/option_binder.h"
+#include "vmap/cli/other_matcher_flags.h"
 #include "vmap/pipelines/sweep_pipeline.h"
 #include "vmap/report/summary.h"
 
@@ -47,7 +48,11 @@ void AddSweepCommand(CLI::App& app) {
                         ->group(kGroundTruthSection);
   command->callback([state, gt] {
     state->options.evaluate = gt->count() > 0;
-    state->flags.Run([&] { RunSweep(*state); });
+    state->flags.Run([&] {
+      state->options.Check();  // a value out of range is said first
+      RefuseOtherMatchersFlags(state->flags, state->options.matcher.type);
+      RunSweep(*state);
+    });
   });
 }
 
