@@ -1,6 +1,8 @@
 #include "vmap/features/matcher_options_json.h"
 
 #include <filesystem>
+#include <functional>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
@@ -12,11 +14,10 @@ namespace vmap {
 
 namespace {
 
-// The files a map recorded (weights), written percent-encoded (file_name_encoding.h), may not exist here: cleared,
-// the model then searches its weights directories.
-class ForgetMissingFiles final : public OptionFieldVisitor {
+// Calls `visit` on each text field of a model's options (its weights file, its device).
+class TextFields final : public OptionFieldVisitor {
  public:
-  explicit ForgetMissingFiles(const std::string& model) : model_(model) {}
+  explicit TextFields(std::function<void(const OptionField&, std::string&)> visit) : visit_(std::move(visit)) {}
 
  protected:
   void OnField(const OptionField&, int&) override {}
@@ -24,39 +25,10 @@ class ForgetMissingFiles final : public OptionFieldVisitor {
   void OnField(const OptionField&, bool&) override {}
   void OnField(const OptionField&, std::vector<int>&) override {}
   void OnField(const OptionField&, const EnumField&) override {}
-  void OnField(const OptionField& field, std::string& value) override {
-    if (!field.is_local_file || value.empty()) return;
-    value = DecodeFileName(value);
-    if (std::filesystem::exists(value)) return;
-    // A warning: the file found instead may hold other weights than the map was built with.
-    spdlog::warn("the map's {} {} '{}' are not here; searching the weights directories", model_, field.key, value);
-    value.clear();
-  }
+  void OnField(const OptionField& field, std::string& value) override { visit_(field, value); }
 
  private:
-  const std::string& model_;
-};
-
-// Sets the model's `device` field, where it has one.
-class SetDevice final : public OptionFieldVisitor {
- public:
-  explicit SetDevice(const std::string& device) : device_(device) {}
-  bool found = false;
-
- protected:
-  void OnField(const OptionField&, int&) override {}
-  void OnField(const OptionField&, double&) override {}
-  void OnField(const OptionField&, bool&) override {}
-  void OnField(const OptionField&, std::vector<int>&) override {}
-  void OnField(const OptionField&, const EnumField&) override {}
-  void OnField(const OptionField& field, std::string& value) override {
-    if (std::string(field.key) != "device") return;
-    value = device_;
-    found = true;
-  }
-
- private:
-  const std::string& device_;
+  std::function<void(const OptionField&, std::string&)> visit_;
 };
 
 }  // namespace
@@ -88,12 +60,27 @@ MatcherOptions MatcherOptionsFromJson(const std::string& matcher_json, const std
   } catch (const InputError& error) {
     throw InputError("map '" + map_file + "': " + error.what() + "; rebuild the map");
   }
-  ForgetMissingFiles forget(options.type);
-  model.VisitFields(forget);
+  // The files a map recorded (weights), written percent-encoded (file_name_encoding.h), may not exist here: cleared,
+  // the model then searches its weights directories.
+  TextFields forget_missing_files([&](const OptionField& field, std::string& value) {
+    if (!field.is_local_file || value.empty()) return;
+    value = DecodeFileName(value);
+    if (std::filesystem::exists(value)) return;
+    // A warning: the file found instead may hold other weights than the map was built with.
+    spdlog::warn("the map's {} {} '{}' are not here; searching the weights directories", options.type, field.key,
+                 value);
+    value.clear();
+  });
+  model.VisitFields(forget_missing_files);
   if (!device.empty()) {
-    SetDevice set(device);
-    model.VisitFields(set);
-    if (!set.found && device != "cpu") {
+    bool has_device = false;
+    TextFields set_device([&](const OptionField& field, std::string& value) {
+      if (std::string(field.key) != "device") return;
+      value = device;
+      has_device = true;
+    });
+    model.VisitFields(set_device);
+    if (!has_device && device != "cpu") {
       throw InputError("device " + device + ": the map's matcher " + options.type + " runs on the CPU only");
     }
   }
