@@ -34,23 +34,29 @@ void CheckRecordedMask(const CameraMask& mask, const std::string& matcher_json,
 }  // namespace
 
 LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, const KeyImageStoreOptions& options) {
-  return OpenLocalizationMap(ReadRecordedMap(directory), directory, options);
+  RecordedMap read = ReadRecordedMap(directory);
+  std::unique_ptr<Matcher> matcher = CreateMapMatcher(read, directory);
+  return OpenLocalizationMap(std::move(read), directory, options, std::move(matcher));
+}
+
+std::unique_ptr<Matcher> CreateMapMatcher(const RecordedMap& read, const std::filesystem::path& directory,
+                                          const std::string& device) {
+  std::unique_ptr<Matcher> matcher =
+      CreateMatcher(MatcherOptionsFromJson(read.options.matcher_json, (directory / kMapFileName).string(), device));
+  // The frames are extracted within the mask the key images were.
+  if (read.map.camera_mask.empty()) return matcher;
+  const CameraMask mask(read.map.camera_mask, "the map's " + std::string(kCameraMaskFileName));
+  CheckRecordedMask(mask, read.options.matcher_json, directory);
+  return WithCameraMask(std::move(matcher), mask);
 }
 
 LocalizationMap OpenLocalizationMap(RecordedMap read, const std::filesystem::path& directory,
-                                    const KeyImageStoreOptions& options, const std::string& device) {
+                                    const KeyImageStoreOptions& options, std::unique_ptr<Matcher> matcher) {
   LocalizationMap opened;
   opened.directory = directory;
   opened.map = std::move(read.map);
   opened.options = std::move(read.options);
-  opened.matcher =
-      CreateMatcher(MatcherOptionsFromJson(opened.options.matcher_json, (directory / kMapFileName).string(), device));
-  // The frames are extracted within the mask the key images were (the robot's camera is the teach run's).
-  if (!opened.map.camera_mask.empty()) {
-    const CameraMask mask(opened.map.camera_mask, "the map's " + std::string(kCameraMaskFileName));
-    CheckRecordedMask(mask, opened.options.matcher_json, directory);
-    opened.matcher = WithCameraMask(std::move(opened.matcher), mask);
-  }
+  opened.matcher = std::move(matcher);
   opened.experiences = opened.map.experiences;
   opened.keys = LoadKeyImageStore(directory, opened.map, *opened.matcher, options, opened.experiences);
   return opened;

@@ -27,10 +27,14 @@ struct LocalizationMap {
 // (MatcherOptionsFromJson) and loads its key images and views.
 // Throws InputError naming the file and the fix when any of it fails.
 LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, const KeyImageStoreOptions& options);
-// The same for a map already read from `directory` (ReadRecordedMap): a map is read once.
-// `device`: where the matcher computes in this run ("" = where the map's was; MatcherOptionsFromJson).
+// The same for a map already read from `directory` (ReadRecordedMap): a map is read once. `matcher`: the map's
+// (CreateMapMatcher), created before so that the caller could open its frames as the matcher reads them.
 LocalizationMap OpenLocalizationMap(RecordedMap read, const std::filesystem::path& directory,
-                                    const KeyImageStoreOptions& options, const std::string& device = "");
+                                    const KeyImageStoreOptions& options, std::unique_ptr<Matcher> matcher);
+// The matcher a map was built with, from its record (MatcherOptionsFromJson), within the map's camera mask (the
+// robot's camera is the teach run's). `device`: where it computes in this run ("" = where the map's did).
+std::unique_ptr<Matcher> CreateMapMatcher(const RecordedMap& read, const std::filesystem::path& directory,
+                                          const std::string& device = "");
 
 // Localizer options that follow the map: its verifier (iterations capped, see MapVerifierOptions) and its
 // definition of S; the rest are LocalizerOptions' defaults.

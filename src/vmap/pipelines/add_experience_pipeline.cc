@@ -53,8 +53,11 @@ AddExperienceSummary RunAddExperiencePipeline(const AddExperiencePipelineOptions
                       {"matcher"});
   }
 
-  // 3. The repeat run.
-  const std::unique_ptr<FrameSource> source = OpenFrameSource(options.input, options.source);
+  // 3. The repeat run, in colour: its frames become the views, written in colour, and a matcher that reads colour
+  // reads them so (the map's matcher is created with the map, under its lock).
+  FrameSourceOptions source_options = options.source;
+  source_options.decode_color = true;
+  const std::unique_ptr<FrameSource> source = OpenFrameSource(options.input, source_options);
 
   // 4. The experience.
   AddExperienceOptions experience = options.experience;
