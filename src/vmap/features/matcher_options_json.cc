@@ -33,8 +33,30 @@ class TextFields final : public OptionFieldVisitor {
 
 }  // namespace
 
+void MatcherRunSettings::VisitFields(OptionFieldVisitor& visitor) {
+  visitor.Visit(OptionField{"device", "--device",
+                            "Deep matchers: where the map's matcher computes in this run, cpu or cuda (default: where "
+                            "the map's did)"}
+                    .HideDefault()
+                    .NotRecorded(),
+                device);
+  visitor.Visit(OptionField{"weights", "--weights",
+                            "Deep matchers: the weights file of the map's model this run reads (default: the map's; "
+                            "see `vmap weights`)"}
+                    .LocalFile()
+                    .HideDefault()
+                    .NotRecorded(),
+                weights);
+}
+
+void MatcherRunSettings::Check() const {
+  if (!device.empty() && device != "cpu" && device != "cuda") {
+    throw OptionError("device", "'" + device + "' is not a device; use cpu or cuda");
+  }
+}
+
 MatcherOptions MatcherOptionsFromJson(const std::string& matcher_json, const std::string& map_file,
-                                      const std::string& device) {
+                                      const MatcherRunSettings& run) {
   nlohmann::json doc;
   try {
     doc = nlohmann::json::parse(matcher_json);
@@ -64,6 +86,7 @@ MatcherOptions MatcherOptionsFromJson(const std::string& matcher_json, const std
   // the model then searches its weights directories.
   TextFields forget_missing_files([&](const OptionField& field, std::string& value) {
     if (!field.is_local_file || value.empty()) return;
+    if (std::string(field.key) == "weights" && !run.weights.empty()) return;  // the run's, set below
     value = DecodeFileName(value);
     if (std::filesystem::exists(value)) return;
     // A warning: the file found instead may hold other weights than the map was built with.
@@ -72,17 +95,24 @@ MatcherOptions MatcherOptionsFromJson(const std::string& matcher_json, const std
     value.clear();
   });
   model.VisitFields(forget_missing_files);
-  if (!device.empty()) {
-    bool has_device = false;
-    TextFields set_device([&](const OptionField& field, std::string& value) {
-      if (std::string(field.key) != "device") return;
-      value = device;
+  bool has_device = false, has_weights = false;
+  TextFields set_run([&](const OptionField& field, std::string& value) {
+    const std::string key = field.key;
+    if (key == "device" && !run.device.empty()) {
+      value = run.device;
       has_device = true;
-    });
-    model.VisitFields(set_device);
-    if (!has_device && device != "cpu") {
-      throw InputError("device " + device + ": the map's matcher " + options.type + " runs on the CPU only");
     }
+    if (key == "weights" && field.is_local_file && !run.weights.empty()) {
+      value = run.weights;
+      has_weights = true;
+    }
+  });
+  model.VisitFields(set_run);
+  if (!run.device.empty() && !has_device && run.device != "cpu") {
+    throw InputError("device " + run.device + ": the map's matcher " + options.type + " runs on the CPU only");
+  }
+  if (!run.weights.empty() && !has_weights) {
+    throw InputError("--weights " + run.weights + ": the map's matcher " + options.type + " reads no weights");
   }
   options.Check();
   return options;

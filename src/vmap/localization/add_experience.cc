@@ -67,7 +67,7 @@ std::string SizeText(const cv::Size& size) { return fmt::format("{}x{}", size.wi
 }  // namespace
 
 AddExperienceSummary AddExperience(const fs::path& map_directory, FrameSource& source, const std::string& source_path,
-                                   const AddExperienceOptions& options) {
+                                   const AddExperienceOptions& options, const MatcherRunSettings& matcher_run) {
   options.Check();
   // Another writer of this map (another add, a `build -o` replacing it) finishes first; the map is read only
   // once this one holds the lock, so that the experience it adds is numbered after the others and no other
@@ -87,7 +87,7 @@ AddExperienceSummary AddExperience(const fs::path& map_directory, FrameSource& s
   KeyImageStoreOptions store_options;
   store_options.use_cache = false;
   store_options.thumbnail_width = options.localizer.ranking.thumbnail_width;
-  const LocalizationMap opened = OpenLocalizationMap(map_path, store_options);
+  const LocalizationMap opened = OpenLocalizationMap(map_path, store_options, matcher_run);
   const VisualMap& map = opened.map;
   const fs::path map_file = map_path / kMapFileName;
   // map.json as it is now: everything but `experiences` is written back as it was.

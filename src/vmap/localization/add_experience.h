@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "vmap/features/matcher_options_json.h"
 #include "vmap/localization/localize_sequence.h"
 #include "vmap/localization/localizer.h"
 #include "vmap/map/experiences.h"
@@ -56,8 +57,10 @@ struct AddExperienceSummary {
 
 // Adds the frames of `source` (the repeat run; `source_path` is recorded) to the map in `map_directory`.
 // Throws InputError, leaving the map as it was, when the map cannot be read, the frames are not of the map's
-// frame size, or no frame localized at any key image.
+// frame size, or no frame localized at any key image. `matcher_run`: where the map's matcher computes and the weights
+// it reads in this run (CreateMapMatcher).
 AddExperienceSummary AddExperience(const std::filesystem::path& map_directory, FrameSource& source,
-                                   const std::string& source_path, const AddExperienceOptions& options);
+                                   const std::string& source_path, const AddExperienceOptions& options,
+                                   const MatcherRunSettings& matcher_run = {});
 
 }  // namespace vmap

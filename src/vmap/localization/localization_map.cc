@@ -33,16 +33,26 @@ void CheckRecordedMask(const CameraMask& mask, const std::string& matcher_json,
 
 }  // namespace
 
-LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, const KeyImageStoreOptions& options) {
+LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, const KeyImageStoreOptions& options,
+                                    const MatcherRunSettings& matcher_run) {
   RecordedMap read = ReadRecordedMap(directory);
-  std::unique_ptr<Matcher> matcher = CreateMapMatcher(read, directory);
+  std::unique_ptr<Matcher> matcher = CreateMapMatcher(read, directory, matcher_run);
   return OpenLocalizationMap(std::move(read), directory, options, std::move(matcher));
 }
 
 std::unique_ptr<Matcher> CreateMapMatcher(const RecordedMap& read, const std::filesystem::path& directory,
-                                          const std::string& device) {
-  std::unique_ptr<Matcher> matcher =
-      CreateMatcher(MatcherOptionsFromJson(read.options.matcher_json, (directory / kMapFileName).string(), device));
+                                          const MatcherRunSettings& run) {
+  const MatcherOptions options = MatcherOptionsFromJson(read.options.matcher_json, (directory / kMapFileName).string(), run);
+  std::unique_ptr<Matcher> matcher;
+  try {
+    matcher = CreateMatcher(options);
+  } catch (const InputError& error) {
+    if (run.weights.empty()) throw;
+    // The loader's fix may name another model; the map's is fixed, so the file is what must change.
+    throw InputError(fmt::format("--weights {}: not weights of the map's {} ({}); pass weights of that model, or "
+                                 "leave --weights out to read the map's",
+                                 run.weights, options.type, error.what()));
+  }
   // The frames are extracted within the mask the key images were.
   if (read.map.camera_mask.empty()) return matcher;
   const CameraMask mask(read.map.camera_mask, "the map's " + std::string(kCameraMaskFileName));

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "vmap/features/matcher.h"
+#include "vmap/features/matcher_options_json.h"
 #include "vmap/localization/key_image_store.h"
 #include "vmap/localization/localizer.h"
 #include "vmap/map/visual_map.h"
@@ -26,15 +27,17 @@ struct LocalizationMap {
 // Reads the map with its experiences and its options (ReadRecordedMap), creates its matcher
 // (MatcherOptionsFromJson) and loads its key images and views.
 // Throws InputError naming the file and the fix when any of it fails.
-LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, const KeyImageStoreOptions& options);
+LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, const KeyImageStoreOptions& options,
+                                    const MatcherRunSettings& matcher_run = {});
 // The same for a map already read from `directory` (ReadRecordedMap): a map is read once. `matcher`: the map's
 // (CreateMapMatcher), created before so that the caller could open its frames as the matcher reads them.
 LocalizationMap OpenLocalizationMap(RecordedMap read, const std::filesystem::path& directory,
                                     const KeyImageStoreOptions& options, std::unique_ptr<Matcher> matcher);
 // The matcher a map was built with, from its record (MatcherOptionsFromJson), within the map's camera mask (the
-// robot's camera is the teach run's). `device`: where it computes in this run ("" = where the map's did).
+// robot's camera is the teach run's), computing where `run` says and reading the weights it names (weights of
+// another model than the map's are refused, naming the file).
 std::unique_ptr<Matcher> CreateMapMatcher(const RecordedMap& read, const std::filesystem::path& directory,
-                                          const std::string& device = "");
+                                          const MatcherRunSettings& run = {});
 
 // Localizer options that follow the map: its verifier (iterations capped, see MapVerifierOptions) and its
 // definition of S; the rest are LocalizerOptions' defaults.

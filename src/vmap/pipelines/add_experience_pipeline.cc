@@ -28,6 +28,7 @@ void AddExperiencePipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
                     .HideDefault()
                     .NotRecorded(),
                 matcher);
+  visitor.VisitNested("", matcher_run);
   visitor.VisitNested("", source);
   // Its own level, so that a command that takes a few of its options can leave the rest out.
   visitor.VisitNested("experience", experience, Nesting{/*json_inline=*/true, {}});
@@ -35,6 +36,7 @@ void AddExperiencePipelineOptions::VisitFields(OptionFieldVisitor& visitor) {
 
 void AddExperiencePipelineOptions::Check() const {
   source.Check();
+  matcher_run.Check();
   CheckField("experience", experience);
 }
 
@@ -62,7 +64,7 @@ AddExperienceSummary RunAddExperiencePipeline(const AddExperiencePipelineOptions
   // 4. The experience.
   AddExperienceOptions experience = options.experience;
   experience.run.show_progress = experience.run.show_progress && spdlog::should_log(spdlog::level::info);
-  return AddExperience(options.map, *source, options.input, experience);
+  return AddExperience(options.map, *source, options.input, experience, options.matcher_run);
 }
 
 }  // namespace vmap

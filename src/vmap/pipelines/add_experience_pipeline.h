@@ -22,9 +22,12 @@ struct AddExperiencePipelineOptions {
   std::string matcher;
   FrameSourceOptions source;
   AddExperienceOptions experience;  // how the run is localized against the map
+  // Where the map's matcher computes and the weights file it reads, as `vmap localize` takes them (--device,
+  // --weights): "" = the map's.
+  MatcherRunSettings matcher_run;
 
   // The fields above, each once ("input", "map", "matcher", the input's, "experience.localizer.min_verified",
-  // "experience.run.extraction_threads").
+  // "experience.run.extraction_threads", "device", "weights").
   void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };

@@ -73,20 +73,14 @@ void LocalizationSessionOptions::VisitFields(OptionFieldVisitor& visitor) {
   visitor.Visit(OptionField{"cache", "!--no-cache", "Do not read or write the key-image cache in the map directory"}
                     .NotRecorded(),
                 cache);
-  visitor.Visit(OptionField{"device", "--device",
-                            "Deep matchers: where this run computes, cpu or cuda (default: where the map's did)"}
-                    .HideDefault()
-                    .NotRecorded(),
-                device);
+  visitor.VisitNested("", matcher_run);
 }
 
 void LocalizationSessionOptions::Check() const {
   run.Check();
   localizer.Check();
   route.Check();
-  if (!device.empty() && device != "cpu" && device != "cuda") {
-    throw OptionError("device", fmt::format("'{}' is not a device; use cpu or cuda", device));
-  }
+  matcher_run.Check();
   // -1 stands for "not given"; any other negative key image is refused as the route refuses it.
   for (const auto& [name, key] : {std::pair<const char*, int>{"from", from}, {"to", to}}) {
     if (key < -1) throw OptionError(name, fmt::format("{} is no key image; give 0 or more", key));
@@ -167,7 +161,8 @@ LocalizationSession::LocalizationSession(const LocalizePipelineOptions& options)
       {{options.csv, "csv"}, {options.json, "json"}},
       {MapInputs(options.map), NamedInput(options.query, "the query"), NamedInput(options.report, "the report folder"),
        NamedInput(options.odometry, "the odometry"), NamedInput(options.session.teach_odometry, "the teach odometry"),
-       ExistingInputs({options.source.camera}, "the camera file")});
+       ExistingInputs({options.source.camera}, "the camera file"),
+       ExistingInputs({options.session.matcher_run.weights}, "the weights file")});
   if (!options.report.empty()) CheckLocalizationReportDirectory(options.report, options.map, options.query);
   if (!options.query.empty()) CheckQueryIsNoFifo(options.query);
 
@@ -183,7 +178,7 @@ LocalizationSession::LocalizationSession(const LocalizePipelineOptions& options)
   CheckStartKey(read.map, localizer);
 
   // 5. The map's matcher (a deep model loads its weights here).
-  std::unique_ptr<Matcher> matcher = CreateMapMatcher(read, options.map, options.session.device);
+  std::unique_ptr<Matcher> matcher = CreateMapMatcher(read, options.map, options.session.matcher_run);
 
   // 6. The query: frames are compared with key images at the map's size unless told otherwise, in colour where the
   // matcher reads the key images in colour.

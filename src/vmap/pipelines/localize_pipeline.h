@@ -35,9 +35,7 @@ struct LocalizationSessionOptions {
   RouteOptions route;           // how that route is planned: as `vmap route` plans it
   LocalizeSequenceOptions run;  // how a sequence's frames are read and their features extracted
   bool cache = true;            // read and write the key-image cache in the map directory
-  // Where a deep matcher computes in this run: cpu or cuda; "" = where the map's did (a map taught on a GPU is
-  // followed on a robot without one).
-  std::string device;
+  MatcherRunSettings matcher_run;  // where a deep matcher computes in this run, and the weights it reads
   // The teach run's odometry (ReadTeachOdometry): a CSV or a recording with a nav_msgs/Odometry topic; "" = the map
   // folder's teach_odometry.csv, if any. With it and each frame's odometry, the localizer's motion model moves by the
   // distance driven (localization/motion_pace.h).

@@ -99,6 +99,51 @@ TEST(VmapXfeat, AMapRecordsItsWeightsWhateverTheirNameAndNotItsThreads) {
       << localize.output;
 }
 
+// A map built where its weights lay is followed where they lie elsewhere: --weights names the file, with no search and
+// no warning, and the frames localize as with the map's own file. Weights of another model are refused naming the
+// file, and so is --weights for a map whose matcher reads none; --add-experience-to takes it as localize does.
+TEST(VmapXfeat, LocalizeReadsTheWeightsItIsGivenOfTheMapsModel) {
+  SKIP_WITHOUT_SHARED();
+  TempDir dir;
+  const fs::path built_with = dir.path() / "built_with.pt", robots = dir.path() / "robots.pt";
+  fs::copy_file(FoldedWeights(), built_with);
+  const std::string input = SharedDir() + "/data/rccar_room/images --last 5";
+  const std::string map = (dir.path() / "map").string();
+  auto r = RunVmap("build " + input + " --matcher xfeat --weights " + built_with.string() + " -q -o " + map);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto localize_csv = [&](const std::string& flags, const std::string& name) {
+    const fs::path csv = dir.path() / name;
+    const auto run = RunVmap("localize " + map + " " + input + " --no-cache --csv " + csv.string() + " " + flags);
+    EXPECT_EQ(run.status, 0) << run.output;
+    EXPECT_EQ(run.output.find("are not here"), std::string::npos) << run.output;
+    std::ifstream in(csv);
+    std::vector<std::string> rows;
+    for (std::string line; std::getline(in, line);) rows.push_back(line.substr(0, line.rfind(',')));  // not seconds
+    return rows;
+  };
+  const auto with_map_weights = localize_csv("", "map.csv");
+  ASSERT_GE(with_map_weights.size(), 6u);
+  fs::rename(built_with, robots);
+  EXPECT_EQ(localize_csv("--weights " + robots.string(), "robot.csv"), with_map_weights);
+
+  r = RunVmap("localize " + map + " " + input + " -q --weights " + SharedDir() + "/weights/aliked/aliked-n16.pt");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("aliked-n16.pt: not weights of the map's xfeat"), std::string::npos) << r.output;
+  r = RunVmap("build " + SharedDir() + "/data/rccar_room/images --last 5 --add-experience-to " + map +
+              " -q --weights " + SharedDir() + "/weights/aliked/aliked-n16.pt");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("not weights of the map's xfeat"), std::string::npos) << r.output;
+  r = RunVmap("build " + SharedDir() + "/data/rccar_room/images --last 5 --add-experience-to " + map +
+              " -q --weights " + robots.string());
+  EXPECT_EQ(r.status, 0) << r.output;
+
+  const std::string orb_map = (dir.path() / "orb").string();
+  ASSERT_EQ(RunVmap("build " + input + " -q -o " + orb_map).status, 0);
+  r = RunVmap("localize " + orb_map + " " + input + " -q --weights " + robots.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("the map's matcher orb reads no weights"), std::string::npos) << r.output;
+}
+
 TEST(VmapXfeat, BadOptionsAndMissingCudaAreRefused) {
   SKIP_WITHOUT_SHARED();
   const std::string pair = SharedDir() + "/golden/xfeat/rccar_000000_000006";
