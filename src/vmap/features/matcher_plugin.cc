@@ -1,13 +1,19 @@
 #include "vmap/features/matcher_plugin.h"
 
 #include <dlfcn.h>
+#include <elf.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <stdexcept>
 #include <string>
+
+#include <fmt/format.h>
 
 #include "vmap/core/error.h"
 
@@ -37,6 +43,10 @@ const MatcherPluginTable* OpenPlugin() {
   if (vmap_matcher_plugin_table) return vmap_matcher_plugin_table();
 #ifdef VMAP_WITH_TORCH
   const std::string path = PluginPath().string();
+  if (const std::string problem = IncompleteSharedLibraryProblem(path); !problem.empty()) {
+    throw InputError("the deep matchers need LibTorch, through '" + path + "', which " + problem +
+                     "; rebuild vmap (scripts/build.sh) or install it again");
+  }
   // Never closed: matchers and features made by the plugin may live until the process ends.
   void* library = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!library) {
@@ -45,9 +55,15 @@ const MatcherPluginTable* OpenPlugin() {
                      "beside the program that loads it (the vmap binary, the Python module, the ROS nodes)");
   }
   using Entry = const MatcherPluginTable* (*)();
+  using Abi = const char* (*)();
   const auto entry = reinterpret_cast<Entry>(dlsym(library, "vmap_matcher_plugin_table"));
-  if (!entry) {
-    throw InputError("'" + path + "' is not a vmap LibTorch plugin (no vmap_matcher_plugin_table); rebuild vmap");
+  const auto abi = reinterpret_cast<Abi>(dlsym(library, "vmap_matcher_plugin_abi"));
+  if (!entry || !abi) {
+    throw InputError("'" + path + "' is not a vmap LibTorch plugin (no vmap_matcher_plugin_table or ABI); rebuild vmap");
+  }
+  if (const std::string theirs = abi(), ours = MatcherPluginAbi(); theirs != ours) {
+    throw InputError("'" + path + "' was built for another vmap (" + theirs + ") than this one (" + ours +
+                     "); rebuild vmap so that libvmap_torch.so and the program that loads it come from one build");
   }
   return entry();
 #else
@@ -66,6 +82,31 @@ MatcherPluginTable& MutableRegisteredPluginMatchers() {
 }
 
 }  // namespace
+
+std::string IncompleteSharedLibraryProblem(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  std::error_code error;
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  if (!file || error) return "cannot be read";
+  const auto read_at = [&file](std::uint64_t offset, void* into, std::size_t bytes) {
+    file.seekg(static_cast<std::streamoff>(offset));
+    return static_cast<bool>(file.read(static_cast<char*>(into), static_cast<std::streamsize>(bytes)));
+  };
+  Elf64_Ehdr header{};
+  if (!read_at(0, &header, sizeof(header)) || std::memcmp(header.e_ident, ELFMAG, SELFMAG) != 0 ||
+      header.e_ident[EI_CLASS] != ELFCLASS64 || header.e_phentsize != sizeof(Elf64_Phdr)) {
+    return "is no 64-bit ELF shared library";
+  }
+  // The program headers, then every segment they have the loader map from the file.
+  std::uint64_t end = std::uint64_t{header.e_phoff} + std::uint64_t{header.e_phnum} * sizeof(Elf64_Phdr);
+  for (int i = 0; end <= size && i < header.e_phnum; ++i) {
+    Elf64_Phdr segment{};
+    if (!read_at(header.e_phoff + i * sizeof(Elf64_Phdr), &segment, sizeof(segment))) return "cannot be read";
+    if (segment.p_type == PT_LOAD) end = std::max(end, std::uint64_t{segment.p_offset} + segment.p_filesz);
+  }
+  if (end <= size) return "";
+  return fmt::format("is {} bytes, its segments end at byte {}: it is cut short", size, end);
+}
 
 const PluginMatcherModel* MatcherPluginTable::Find(const std::string& name) const {
   for (const auto& model : models) {

@@ -48,7 +48,23 @@ struct PluginMatcherRegistration {
 // The rows registered in this binary (what the plugin's entry point returns).
 const MatcherPluginTable& RegisteredPluginMatchers();
 
+// What the binary and the plugin must agree on to share the table: the compiler and its C++ library ABI, vmap's version
+// and the layout of every type that crosses. Each side computes its own; a plugin of another build whose types differ
+// would otherwise be read with the wrong layout (a crash at best).
+inline std::string MatcherPluginAbi() {
+  return std::string("vmap ") + VMAP_VERSION + ", g++ " + __VERSION__ + ", cxx11 abi " +
+         std::to_string(_GLIBCXX_USE_CXX11_ABI) + ", layout " + std::to_string(sizeof(MatcherPluginTable)) + "/" +
+         std::to_string(sizeof(PluginMatcherModel)) + "/" + std::to_string(sizeof(MatcherOptions)) + "/" +
+         std::to_string(sizeof(TentativeMatches)) + "/" + std::to_string(sizeof(std::string));
+}
+
+// What a file that should be a shared library lacks of itself: "" when its ELF headers and every segment they announce
+// lie within it; otherwise why not ("is 2.1 MB, its segments end at 9.8 MB: it is cut short"). The dynamic loader maps
+// the announced segments before it checks anything, and a segment beyond the end of the file is a bus error.
+std::string IncompleteSharedLibraryProblem(const std::string& path);
+
 }  // namespace vmap
 
-// The symbol the plugin exports, and the loader looks up.
+// The symbols the plugin exports, and the loader looks up: its table, and its MatcherPluginAbi().
 extern "C" const vmap::MatcherPluginTable* vmap_matcher_plugin_table();
+extern "C" const char* vmap_matcher_plugin_abi();

@@ -5,8 +5,11 @@
 #include <fstream>
 #include <iterator>
 #include <set>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "vmap/core/error.h"
 #include "vmap/features/matcher_options_json.h"
@@ -187,6 +190,44 @@ TEST(MatcherRegistry, APluginThatWasMissingLoadsOnALaterCall) {
       EXPECT_NE(table->Find(model.name), nullptr) << model.name;
     }
   }
+#else
+  GTEST_SKIP() << "built without LibTorch";
+#endif
+}
+
+// A plugin cut short (a copy interrupted, a full disk) or of another build is refused naming the file and the fix: the
+// loader would map segments beyond the file's end (a bus error), or read a table of another layout.
+TEST(MatcherRegistry, APluginCutShortOrOfAnotherBuildIsRefusedNotLoaded) {
+#if defined(VMAP_WITH_TORCH)
+  const std::filesystem::path built = testing::VmapBinary().parent_path() / "libvmap_torch.so";
+  if (!std::filesystem::exists(built)) GTEST_SKIP() << "the plugin is not built";
+  const testing::ScopedTempDir tmp("plugin");
+  const std::filesystem::path vmap = tmp.path() / "vmap", plugin = tmp.path() / "libvmap_torch.so";
+  std::filesystem::copy_file(testing::VmapBinary(), vmap);
+  const cv::Mat image(120, 160, CV_8U, cv::Scalar(90));
+  cv::imwrite((tmp.path() / "a.png").string(), image);
+  const std::vector<std::string> match = {"match", (tmp.path() / "a.png").string(), (tmp.path() / "a.png").string(),
+                                          "--matcher", "xfeat"};
+  {
+    std::ifstream whole(built, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(whole)), std::istreambuf_iterator<char>());
+    bytes.resize(bytes.size() / 2);
+    std::ofstream(plugin, std::ios::binary) << bytes;
+  }
+  EXPECT_NE(IncompleteSharedLibraryProblem(plugin.string()).find("it is cut short"), std::string::npos);
+  EXPECT_EQ(IncompleteSharedLibraryProblem(built.string()), "");
+  auto run = testing::RunBounded(vmap, match, 60);
+  EXPECT_EQ(run.status, 2) << run.output;
+  EXPECT_NE(run.output.find(plugin.string() + "', which is "), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("it is cut short; rebuild vmap"), std::string::npos) << run.output;
+
+  std::filesystem::remove(plugin);
+  std::filesystem::copy_file(VMAP_FOREIGN_PLUGIN, plugin);
+  run = testing::RunBounded(vmap, match, 60);
+  EXPECT_EQ(run.status, 2) << run.output;
+  EXPECT_NE(run.output.find("was built for another vmap (vmap 0.0.0, another build) than this one (vmap "),
+            std::string::npos)
+      << run.output;
 #else
   GTEST_SKIP() << "built without LibTorch";
 #endif

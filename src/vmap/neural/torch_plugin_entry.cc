@@ -3,6 +3,13 @@
 
 #include "vmap/features/matcher_plugin.h"
 
+#include <string>
+
 extern "C" __attribute__((visibility("default"))) const vmap::MatcherPluginTable* vmap_matcher_plugin_table() {
   return &vmap::RegisteredPluginMatchers();
+}
+
+extern "C" __attribute__((visibility("default"))) const char* vmap_matcher_plugin_abi() {
+  static const std::string abi = vmap::MatcherPluginAbi();
+  return abi.c_str();
 }
