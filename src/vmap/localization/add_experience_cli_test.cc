@@ -95,6 +95,41 @@ TEST(AddExperienceCli, AddsASessionAndLocalizeReportsTheExperienceUsed) {
   }
 }
 
+// A report shows what S was measured against: a frame compared best with an experience's view is drawn beside that
+// view, and named so; the map's report lists its experiences.
+TEST(AddExperienceCli, ReportsShowTheViewComparedAndListTheExperiences) {
+  SKIP_WITHOUT_SHARED();
+  ::vmap::testing::ScopedTempDir tmp;
+  const fs::path map = tmp.path() / "map";
+  std::string out;
+  ASSERT_EQ(RunVmap("build " + Quote(SessionFolder(tmp.path(), 1)) + " -o " + Quote(map) + " -q", &out), 0) << out;
+  const fs::path repeat = SessionFolder(tmp.path(), 2);
+  ASSERT_EQ(RunVmap("build " + Quote(repeat) + " --add-experience-to " + Quote(map) + " --acceptance chance", &out), 0)
+      << out;
+  // The repeat run itself: its frames are the views.
+  const fs::path json = tmp.path() / "run.json", report = tmp.path() / "report";
+  ASSERT_EQ(RunVmap("localize " + Quote(map) + " " + Quote(repeat) + " --json " + Quote(json) + " --report " +
+                        Quote(report) + " --acceptance chance -q",
+                    &out),
+            0)
+      << out;
+  const nlohmann::json run = nlohmann::json::parse(ReadText(json));
+  const std::string page = ReadText(report / "report.html");
+  int from_views = 0;
+  for (const auto& frame : run["frames"]) {
+    if (frame["key"].get<int>() < 0 || frame["experience"] != 1) continue;
+    ++from_views;
+    const std::string caption = "key " + std::to_string(frame["key"].get<int>()) + " (experience 1) (S = ";
+    EXPECT_NE(page.find(caption), std::string::npos) << caption << "\n" << page;
+  }
+  EXPECT_GE(from_views, 1) << run.dump();
+
+  ASSERT_EQ(RunVmap("report " + Quote(map), &out), 0) << out;
+  const std::string map_page = ReadText(map / "report.html");
+  EXPECT_NE(map_page.find("<h2>Experiences (1)</h2>"), std::string::npos);
+  EXPECT_NE(map_page.find(repeat.string()), std::string::npos);
+}
+
 // A map and its experience are replaced together, and never by surprise: an add while a build started before it is
 // replacing the map is refused (the build's map, put in place after, lacked it: the add had said it was added); a
 // build over a map with experiences says that it drops them; a killed add's temporary is no user file the rebuilt

@@ -357,6 +357,9 @@ LocalizationRun ReadLocalizationRun(const std::filesystem::path& file) {
       r.to_next.similarity = NumberOr(f, "next_similarity", 0.0);
       r.to_next.num_verified = IntOr(f, "next_verified", 0, place);
       r.to_next.num_tentative = IntOr(f, "next_tentative", 0, place);
+      // A map with experiences names the view compared (0: the key image itself); a report draws it.
+      r.to_key.experience = IntOr(f, "experience", 0, place);
+      r.to_next.experience = IntOr(f, "next_experience", 0, place);
       r.translation_known = f.value("translation_known", false);
       r.to_key.log10_nfa = NumberOr(f, "log10_nfa", std::numeric_limits<double>::infinity());
       r.to_next.log10_nfa = NumberOr(f, "next_log10_nfa", std::numeric_limits<double>::infinity());

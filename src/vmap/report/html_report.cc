@@ -1,8 +1,14 @@
 #include "vmap/report/html_report.h"
 
+#include <algorithm>
 #include <optional>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "vmap/core/atomic_output.h"
@@ -213,6 +219,48 @@ std::string MatchFiguresSection(const VisualMap& map, const MapReportFiles& asse
   return html.str();
 }
 
+// The page's sections, for its navigation: the experiences' where the map has any.
+std::vector<std::pair<std::string, std::string>> Sections(const VisualMap& map) {
+  std::vector<std::pair<std::string, std::string>> sections = {
+      {"summary", "Summary"},       {"similarity", "Similarity"}, {"key-images", "Key images"},
+      {"route-preview", "Route preview"}, {"link-table", "Links"}, {"links", "Match figures"}};
+  if (!map.experiences.empty()) sections.emplace_back("experiences", "Experiences");
+  sections.emplace_back("options", "Options");
+  return sections;
+}
+
+// Other runs of the route added to the map (map/experiences.h): which key images each gave a view, and how well the
+// views matched their key images when they were chosen.
+std::string ExperiencesSection(const VisualMap& map) {
+  std::ostringstream html;
+  html << "<section id=\"experiences\"><h2>Experiences (" << map.experiences.size() << ")</h2>\n"
+       << "<p class=\"note\">Repeat runs added with <code>vmap build RUN --add-experience-to MAP</code>: a frame is "
+          "compared with each key image and its views, and S is measured against the one that fits best.</p>\n"
+       << "<table class=\"summary\"><thead><tr><th class=\"num\">experience</th><th>run</th>"
+          "<th class=\"num\">views</th><th class=\"num\">median verified</th><th>key images without a view</th>"
+          "</tr></thead><tbody>\n";
+  for (const Experience& e : map.experiences) {
+    std::vector<int> verified;
+    std::vector<bool> has_view(map.key_images.size(), false);
+    for (const ExperienceView& view : e.views) {
+      verified.push_back(view.num_verified);
+      has_view.at(view.key) = true;
+    }
+    std::sort(verified.begin(), verified.end());
+    std::vector<int> without;
+    for (size_t k = 0; k < has_view.size(); ++k) {
+      if (!has_view[k]) without.push_back(static_cast<int>(k));
+    }
+    html << "<tr><td class=\"num\">" << e.id << "</td><td>" << HtmlEscape(Displayable(e.source))
+         << "</td><td class=\"num\">" << e.views.size() << " of " << map.key_images.size()
+         << "</td><td class=\"num\">" << (verified.empty() ? "" : std::to_string(verified[verified.size() / 2]))
+         << "</td><td>" << (without.empty() ? "none" : HtmlEscape(fmt::format("{}", fmt::join(without, ", "))))
+         << "</td></tr>\n";
+  }
+  html << "</tbody></table>\n</section>\n";
+  return html.str();
+}
+
 }  // namespace
 
 void WriteMapReport(const fs::path& map_directory) { WriteMapReport(map_directory, MapReportOptions{}); }
@@ -244,19 +292,14 @@ void WriteMapReport(const fs::path& map_directory, const MapReportOptions& repor
   std::string html = PageStart("vmap report: " + input_name, "Visual map of " + input_name,
                                std::to_string(map.key_images.size()) + " key images from " +
                                    std::to_string(map.num_frames) + " frames, Q = " + FormatFixed(map.quality, 3),
-                               {{"summary", "Summary"},
-                                {"similarity", "Similarity"},
-                                {"key-images", "Key images"},
-                                {"route-preview", "Route preview"},
-                                {"link-table", "Links"},
-                                {"links", "Match figures"},
-                                {"options", "Options"}});
+                               Sections(map));
   html += SummarySection(map, stats, options, read.options.builder.key_images.tau);
   html += SimilaritySection(map, read.options.builder.key_images.tau);
   html += KeyImagesSection(map, assets);
   html += RoutePreviewSection(map, assets, report_options.route_fps);
   html += LinkTableHtml(map, evaluation ? &*evaluation : nullptr);
   html += MatchFiguresSection(map, assets, evaluation ? &*evaluation : nullptr);
+  if (!map.experiences.empty()) html += ExperiencesSection(map);
   html += OptionsSection(options, "Every option used to build this map");
   html += PageEnd();
 

@@ -70,20 +70,41 @@ cv::Mat ToHeight(const cv::Mat& image, int height) {
   return scaled;
 }
 
+// The image a frame was compared with at a key image, and its label: the teach run's key image, or the view of the
+// experience that fit best, which the frame's S was measured against.
+struct ComparedImage {
+  cv::Mat image;
+  std::string label;  // " (experience 2)" for a view, "" for the key image
+};
+ComparedImage ReadComparedImage(const fs::path& map_directory, const VisualMap& map, const KeyComparison& c) {
+  KeyImage image = map.key_images.at(c.key);
+  std::string label;
+  for (const Experience& e : map.experiences) {
+    if (e.id != c.experience) continue;
+    for (const ExperienceView& view : e.views) {
+      if (view.key != c.key) continue;
+      image.image_file = view.image_file;
+      label = fmt::format(" (experience {})", e.id);
+    }
+  }
+  return {ReadKeyImage(map_directory, image), label};
+}
+
 // The frame, its key image and the next key image side by side, each labelled; red frame when lost.
-cv::Mat DrawPair(const cv::Mat& frame, const cv::Mat& key, const cv::Mat& next, const LocalizationResult& r,
+cv::Mat DrawPair(const cv::Mat& frame, const ComparedImage& key, const ComparedImage& next, const LocalizationResult& r,
                  int width) {
   const int height = frame.rows;
   std::vector<cv::Mat> panels = {frame};
   std::vector<std::string> labels = {fmt::format("frame {} ({})", r.frame_index, LocalizationStatusName(r.status))};
-  if (!key.empty()) {
-    panels.push_back(ToHeight(key, height));
-    labels.push_back(fmt::format("key {}  S {:.2f}  {} verified", r.key, r.to_key.similarity, r.to_key.num_verified));
+  if (!key.image.empty()) {
+    panels.push_back(ToHeight(key.image, height));
+    labels.push_back(fmt::format("key {}{}  S {:.2f}  {} verified", r.key, key.label, r.to_key.similarity,
+                                 r.to_key.num_verified));
   }
-  if (!next.empty()) {
-    panels.push_back(ToHeight(next, height));
-    labels.push_back(
-        fmt::format("next {}  S {:.2f}  {} verified", r.next_key, r.to_next.similarity, r.to_next.num_verified));
+  if (!next.image.empty()) {
+    panels.push_back(ToHeight(next.image, height));
+    labels.push_back(fmt::format("next {}{}  S {:.2f}  {} verified", r.next_key, next.label, r.to_next.similarity,
+                                 r.to_next.num_verified));
   }
   const int gap = 6;
   int total = 0;
@@ -268,16 +289,21 @@ std::unique_ptr<AtomicOutputDirectory> PrepareLocalizationReport(const Localizat
   fs::create_directory(assets);  // not create_directories: see AtomicOutputDirectory::path()
   fs::create_directory(assets / "frames");
 
-  std::vector<std::pair<int, cv::Size>> written;  // run.frames index, image size
+  struct WrittenPair {
+    size_t index;  // into run.frames
+    cv::Size size;
+    std::string key_label, next_label;  // ComparedImage::label
+  };
+  std::vector<WrittenPair> written;
   const auto write_pair = [&](size_t index, const cv::Mat& frame_image) {
     const LocalizationResult& r = run.frames[index];
     const bool known_key = r.key >= 0 && r.key < static_cast<int>(map.key_images.size());
     const bool known_next = r.next_key >= 0 && r.next_key < static_cast<int>(map.key_images.size());
-    const cv::Mat key = known_key ? ReadKeyImage(map_directory, map.key_images[r.key]) : cv::Mat();
-    const cv::Mat next_key = known_next ? ReadKeyImage(map_directory, map.key_images[r.next_key]) : cv::Mat();
+    const ComparedImage key = known_key ? ReadComparedImage(map_directory, map, r.to_key) : ComparedImage{};
+    const ComparedImage next_key = known_next ? ReadComparedImage(map_directory, map, r.to_next) : ComparedImage{};
     const cv::Mat pair = DrawPair(frame_image, key, next_key, r, options.pair_width);
     report::WriteJpeg(assets / "frames" / report::Numbered(r.frame_index), pair, options.jpeg_quality);
-    written.emplace_back(static_cast<int>(index), pair.size());
+    written.push_back({index, pair.size(), key.label, next_key.label});
   };
   const bool read_again = recorded.empty() && QueryCanBeReadAgain(run.info);
   // The frames the run kept, in frame order: the last options.pairs of them.
@@ -358,19 +384,22 @@ std::unique_ptr<AtomicOutputDirectory> PrepareLocalizationReport(const Localizat
           "and against the next one; the estimate moves on when the next key image becomes the better match.</p>\n"
        << SimilarityPlot(run) << "</section>\n";
   html << "<section id=\"frames\"><h2>Frames and key images</h2>\n<p class=\"note\">A few frames of the query beside "
-          "the key image they were localized at and the next key image (lost frames in a red frame).</p>\n"
+          "the key image they were localized at and the next key image, or the view of an experience where that fit "
+          "best (lost frames in a red frame).</p>\n"
        << "<div class=\"links\">\n";
-  for (const auto& [index, size] : written) {
+  for (const auto& [index, size, key_label, next_label] : written) {
     const LocalizationResult& r = run.frames[index];
     html << "<figure class=\"match-figure" << (r.status == LocalizationStatus::kLost ? " lost" : "") << "\" id=\"frame-"
          << r.frame_index << "\"><img loading=\"lazy\" decoding=\"async\" src=\""
          << UrlPath(assets_url + "frames/" + report::Numbered(r.frame_index)) << "\" width=\"" << size.width
          << "\" height=\"" << size.height << "\" alt=\"frame " << r.frame_index << "\"><figcaption>Frame "
          << r.frame_index << " (" << HtmlEscape(Displayable(r.source_name)) << "): " << LocalizationStatusName(r.status)
-         << (r.key >= 0 ? fmt::format(" &middot; key {} (S = {})", r.key, FormatFixed(r.to_key.similarity, 3)) : "")
-         << (r.next_key >= 0
-                 ? fmt::format(" &middot; next {} (S = {})", r.next_key, FormatFixed(r.to_next.similarity, 3))
-                 : "")
+         << (r.key >= 0 ? fmt::format(" &middot; key {}{} (S = {})", r.key, key_label,
+                                      FormatFixed(r.to_key.similarity, 3))
+                        : "")
+         << (r.next_key >= 0 ? fmt::format(" &middot; next {}{} (S = {})", r.next_key, next_label,
+                                           FormatFixed(r.to_next.similarity, 3))
+                             : "")
          << "</figcaption></figure>\n";
   }
   if (written.empty() && recorded.empty() && !QueryCanBeReadAgain(run.info) && !run.frames.empty()) {
