@@ -97,12 +97,9 @@ void Verify(const std::string& path) {
               known_as.empty() ? "no (not byte-identical to a known published copy)" : ("yes: " + known_as).c_str());
 #ifdef VMAP_WITH_TORCH
   const FileFits fits = ModelsFittingFile(path);
-  // A file no model can read at all is an error; say why (every model refuses an unreadable file the same way).
-  if (fits.fits.empty() && !fits.refusals.empty() && fits.refusals.size() == LoadMatcherPlugin().models.size()) {
-    throw InputError(fits.refusals.front());
-  }
   std::printf("  fits         %s\n", fits.fits.empty() ? "no known model" : Join(fits.fits).c_str());
   if (fits.fits.empty()) {
+    // Each model's reason: the file is the weights of none, whichever the user meant it for.
     throw InputError("'" + path + "' is not usable as weights of any deep matcher (" + Join(fits.refusals_by_model()) +
                      ")");
   }

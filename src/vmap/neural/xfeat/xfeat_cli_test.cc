@@ -228,6 +228,14 @@ TEST(VmapXfeat, WeightsKnowsXfeatAndItsLayouts) {
   r = RunVmap("weights --verify " + FoldedWeights(), env);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("xfeat (folded layout)"), std::string::npos) << r.output;
+  // A file of no model's is refused with every model's reason, not the first model's alone.
+  const fs::path not_weights = cache.path() / "notes.txt";
+  std::ofstream(not_weights) << "not weights\n";
+  r = RunVmap("weights --verify " + not_weights.string(), env);
+  EXPECT_EQ(r.status, 2) << r.output;
+  for (const char* model : {"aliked: ", "loftr: ", "xfeat: "}) {
+    EXPECT_NE(r.output.find(model), std::string::npos) << model << "\n" << r.output;
+  }
   // The folded file is not the published xfeat.pt: refused by its git blob id, imported without the check,
   // and then used from the cache.
   r = RunVmap("weights --import " + FoldedWeights() + " --model xfeat", env);
