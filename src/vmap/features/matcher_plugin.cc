@@ -59,7 +59,8 @@ const MatcherPluginTable* OpenPlugin() {
   const auto entry = reinterpret_cast<Entry>(dlsym(library, "vmap_matcher_plugin_table"));
   const auto abi = reinterpret_cast<Abi>(dlsym(library, "vmap_matcher_plugin_abi"));
   if (!entry || !abi) {
-    throw InputError("'" + path + "' is not a vmap LibTorch plugin (no vmap_matcher_plugin_table or ABI); rebuild vmap");
+    throw InputError("'" + path +
+                     "' is not a vmap LibTorch plugin (no vmap_matcher_plugin_table or ABI); rebuild vmap");
   }
   if (const std::string theirs = abi(), ours = MatcherPluginAbi(); theirs != ours) {
     throw InputError("'" + path + "' was built for another vmap (" + theirs + ") than this one (" + ours +

@@ -42,16 +42,18 @@ LocalizationMap OpenLocalizationMap(const std::filesystem::path& directory, cons
 
 std::unique_ptr<Matcher> CreateMapMatcher(const RecordedMap& read, const std::filesystem::path& directory,
                                           const MatcherRunSettings& run) {
-  const MatcherOptions options = MatcherOptionsFromJson(read.options.matcher_json, (directory / kMapFileName).string(), run);
+  const MatcherOptions options =
+      MatcherOptionsFromJson(read.options.matcher_json, (directory / kMapFileName).string(), run);
   std::unique_ptr<Matcher> matcher;
   try {
     matcher = CreateMatcher(options);
   } catch (const InputError& error) {
     if (run.weights.empty()) throw;
     // The loader's fix may name another model; the map's is fixed, so the file is what must change.
-    throw InputError(fmt::format("--weights {}: not weights of the map's {} ({}); pass weights of that model, or "
-                                 "leave --weights out to read the map's",
-                                 run.weights, options.type, error.what()));
+    throw InputError(
+        fmt::format("--weights {}: not weights of the map's {} ({}); pass weights of that model, or "
+                    "leave --weights out to read the map's",
+                    run.weights, options.type, error.what()));
   }
   // The frames are extracted within the mask the key images were.
   if (read.map.camera_mask.empty()) return matcher;

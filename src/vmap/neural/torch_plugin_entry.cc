@@ -1,9 +1,9 @@
 // The entry point of libvmap_torch.so (and of the neural tests, which link the same objects): the table each
 // model's LibTorch part registered into (PluginMatcherRegistration in neural/<model>/<model>_matcher.cc).
 
-#include "vmap/features/matcher_plugin.h"
-
 #include <string>
+
+#include "vmap/features/matcher_plugin.h"
 
 extern "C" __attribute__((visibility("default"))) const vmap::MatcherPluginTable* vmap_matcher_plugin_table() {
   return &vmap::RegisteredPluginMatchers();

@@ -30,11 +30,11 @@ struct LocalizationSessionOptions {
   // The localizer's options; its verifier, definition of S, translation thresholds and camera follow the map
   // (FollowMap): they have no field here.
   LocalizerOptions localizer;
-  int from = -1;                // the route's first key image; -1 = the first
-  int to = -1;                  // its last; -1 = the last
-  RouteOptions route;           // how that route is planned: as `vmap route` plans it
-  LocalizeSequenceOptions run;  // how a sequence's frames are read and their features extracted
-  bool cache = true;            // read and write the key-image cache in the map directory
+  int from = -1;                   // the route's first key image; -1 = the first
+  int to = -1;                     // its last; -1 = the last
+  RouteOptions route;              // how that route is planned: as `vmap route` plans it
+  LocalizeSequenceOptions run;     // how a sequence's frames are read and their features extracted
+  bool cache = true;               // read and write the key-image cache in the map directory
   MatcherRunSettings matcher_run;  // where a deep matcher computes in this run, and the weights it reads
   // The teach run's odometry (ReadTeachOdometry): a CSV or a recording with a nav_msgs/Odometry topic; "" = the map
   // folder's teach_odometry.csv, if any. With it and each frame's odometry, the localizer's motion model moves by the

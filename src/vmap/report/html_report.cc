@@ -222,8 +222,9 @@ std::string MatchFiguresSection(const VisualMap& map, const MapReportFiles& asse
 // The page's sections, for its navigation: the experiences' where the map has any.
 std::vector<std::pair<std::string, std::string>> Sections(const VisualMap& map) {
   std::vector<std::pair<std::string, std::string>> sections = {
-      {"summary", "Summary"},       {"similarity", "Similarity"}, {"key-images", "Key images"},
-      {"route-preview", "Route preview"}, {"link-table", "Links"}, {"links", "Match figures"}};
+      {"summary", "Summary"},       {"similarity", "Similarity"},
+      {"key-images", "Key images"}, {"route-preview", "Route preview"},
+      {"link-table", "Links"},      {"links", "Match figures"}};
   if (!map.experiences.empty()) sections.emplace_back("experiences", "Experiences");
   sections.emplace_back("options", "Options");
   return sections;
@@ -252,10 +253,9 @@ std::string ExperiencesSection(const VisualMap& map) {
       if (!has_view[k]) without.push_back(static_cast<int>(k));
     }
     html << "<tr><td class=\"num\">" << e.id << "</td><td>" << HtmlEscape(Displayable(e.source))
-         << "</td><td class=\"num\">" << e.views.size() << " of " << map.key_images.size()
-         << "</td><td class=\"num\">" << (verified.empty() ? "" : std::to_string(verified[verified.size() / 2]))
-         << "</td><td>" << (without.empty() ? "none" : HtmlEscape(fmt::format("{}", fmt::join(without, ", "))))
-         << "</td></tr>\n";
+         << "</td><td class=\"num\">" << e.views.size() << " of " << map.key_images.size() << "</td><td class=\"num\">"
+         << (verified.empty() ? "" : std::to_string(verified[verified.size() / 2])) << "</td><td>"
+         << (without.empty() ? "none" : HtmlEscape(fmt::format("{}", fmt::join(without, ", ")))) << "</td></tr>\n";
   }
   html << "</tbody></table>\n</section>\n";
   return html.str();

@@ -98,8 +98,8 @@ cv::Mat DrawPair(const cv::Mat& frame, const ComparedImage& key, const ComparedI
   std::vector<std::string> labels = {fmt::format("frame {} ({})", r.frame_index, LocalizationStatusName(r.status))};
   if (!key.image.empty()) {
     panels.push_back(ToHeight(key.image, height));
-    labels.push_back(fmt::format("key {}{}  S {:.2f}  {} verified", r.key, key.label, r.to_key.similarity,
-                                 r.to_key.num_verified));
+    labels.push_back(
+        fmt::format("key {}{}  S {:.2f}  {} verified", r.key, key.label, r.to_key.similarity, r.to_key.num_verified));
   }
   if (!next.image.empty()) {
     panels.push_back(ToHeight(next.image, height));
@@ -394,9 +394,9 @@ std::unique_ptr<AtomicOutputDirectory> PrepareLocalizationReport(const Localizat
          << UrlPath(assets_url + "frames/" + report::Numbered(r.frame_index)) << "\" width=\"" << size.width
          << "\" height=\"" << size.height << "\" alt=\"frame " << r.frame_index << "\"><figcaption>Frame "
          << r.frame_index << " (" << HtmlEscape(Displayable(r.source_name)) << "): " << LocalizationStatusName(r.status)
-         << (r.key >= 0 ? fmt::format(" &middot; key {}{} (S = {})", r.key, key_label,
-                                      FormatFixed(r.to_key.similarity, 3))
-                        : "")
+         << (r.key >= 0
+                 ? fmt::format(" &middot; key {}{} (S = {})", r.key, key_label, FormatFixed(r.to_key.similarity, 3))
+                 : "")
          << (r.next_key >= 0 ? fmt::format(" &middot; next {}{} (S = {})", r.next_key, next_label,
                                            FormatFixed(r.to_next.similarity, 3))
                              : "")

@@ -37,9 +37,10 @@ void AlikedMatcherOptions::VisitFields(OptionFieldVisitor& visitor) {
                     .Meaning("0: score threshold mode"),
                 top_k);
   visitor.Visit(
-      OptionField{"score_threshold", "--aliked-score-threshold",
-                  "ALIKED: keypoint score threshold when --aliked-top-k is 0 (0, or one no peak passes: the mean score, "
-                  "as upstream)"}
+      OptionField{
+          "score_threshold", "--aliked-score-threshold",
+          "ALIKED: keypoint score threshold when --aliked-top-k is 0 (0, or one no peak passes: the mean score, "
+          "as upstream)"}
           .Within(0, 1)
           .ExcludingMax()
           .Meaning("0: the mean score, as upstream"),
