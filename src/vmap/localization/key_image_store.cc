@@ -8,12 +8,14 @@
 #include <fstream>
 #include <thread>
 
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/contained_file.h"
 #include "vmap/core/error.h"
+#include "vmap/core/file_name_encoding.h"
 #include "vmap/core/fnv1a.h"
 #include "vmap/core/option_ranges.h"
 #include "vmap/core/parallel_for.h"
@@ -56,6 +58,11 @@ uint64_t Fingerprint(const fs::path& map_directory, const std::vector<KeyImage>&
   for (const KeyImage& image : images) hash = Fnv1a(FileIdentity(map_directory, image.image_file), hash);
   hash = Fnv1a(FileIdentity(map_directory, kCameraMaskFileName), hash);
   hash = Fnv1a(matcher.DescribeOptionsJson(), hash);
+  // The weights file a deep matcher read, which its record names: weights replaced in place extract otherwise.
+  const nlohmann::json record = nlohmann::json::parse(matcher.DescribeOptionsJson(), nullptr, false);
+  if (record.is_object() && record.contains("weights") && record["weights"].is_string()) {
+    hash = Fnv1a(FileIdentity(map_directory, DecodeFileName(record["weights"].get<std::string>())), hash);
+  }
   // Another vmap or OpenCV may extract differently.
   hash = Fnv1a(std::string(VMAP_VERSION) + " " + CV_VERSION, hash);
   return Fnv1a(std::to_string(options.thumbnail_width), hash);

@@ -2,6 +2,7 @@
 // michigan_seasons' routes (corridor_conditions' runs: xfeat_corridor_cli_test.cc).
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -268,10 +269,19 @@ TEST(VmapXfeat, SecondLocalizeStartReadsTheKeyImagesFromTheCache) {
   SKIP_WITHOUT_SHARED();
   const TempDir dir("cache");
   const std::string input = SharedDir() + "/data/rccar_room/images";
+  const fs::path weights = dir.path() / "xfeat.pt";
+  fs::copy_file(FoldedWeights(), weights);
   const auto r = RunVmap("build " + input + " --last 8 --tau 0.6 --matcher xfeat --xfeat-top-k 1000 --weights " +
-                         FoldedWeights() + " -q -o " + (dir.path() / "map").string());
+                         weights.string() + " -q -o " + (dir.path() / "map").string());
   ASSERT_EQ(r.status, 0) << r.output;
   ::vmap::testing::ExpectSecondLocalizeReadsTheCache(dir.path() / "map", input, "--last 8");
+  // Weights replaced in place (here: written again) may extract otherwise: the cache is not read.
+  fs::last_write_time(weights, fs::last_write_time(weights) + std::chrono::seconds(5));
+  const fs::path json = dir.path() / "after.json";
+  const auto again =
+      RunVmap("localize " + (dir.path() / "map").string() + " " + input + " --last 2 -q --json " + json.string());
+  ASSERT_EQ(again.status, 0) << again.output;
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(json))["key_image_cache"], "written");
 }
 
 // michigan_seasons' session `query` (its five places) against an XFeat map of session `teach`'s, built in `dir` as
