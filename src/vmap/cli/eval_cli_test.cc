@@ -86,6 +86,49 @@ TEST(EvalCli, Kitti07LinksAreUsableAndTheReportShowsThem) {
   EXPECT_NE(out.find("SIMPLE_PINHOLE"), std::string::npos) << out;
 }
 
+// Ground truth that does not belong to the map is said so, whatever gives its key images poses: an image folder
+// numbered from 1 (ffmpeg's %06d) is matched to KITTI poses by position, not by its files' numbers (a frame off), the
+// table names the input frames the poses are of, and ground truth of another run warns of its matches.
+TEST(EvalCli, GroundTruthIsMatchedToTheMapsOwnFramesOrSaidNotToFit) {
+  SKIP_WITHOUT_SHARED();
+  testing::ScopedTempDir tmp;
+  const fs::path folder = tmp.path() / "numbered_from_1";
+  fs::create_directories(folder);
+  for (int i = 0; i <= 40; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06d.png", i);
+    char link[32];
+    std::snprintf(link, sizeof(link), "%06d.png", i + 1);
+    fs::create_symlink(Shared() / "data/kitti07/image_0" / name, folder / link);
+  }
+  const std::string camera = " --camera 707.0912,707.0912,601.8873,183.1104";
+  const fs::path map = tmp.path() / "map";
+  std::string out;
+  ASSERT_EQ(RunVmap("build " + Quote(folder) + " -q -o " + Quote(map), &out), 0) << out;
+  ASSERT_EQ(RunVmap("eval " + Quote(map) + " --gt " + Quote(Shared() / "data/kitti07/poses.txt") + camera, &out), 0)
+      << out;
+  EXPECT_GE(ReadJson(map / "eval.json")["summary"]["verified_within_threshold_mean"].get<double>(), 0.9) << out;
+  EXPECT_EQ(out.find("of the verified matches lie within"), std::string::npos) << out;
+
+  const fs::path strided = tmp.path() / "strided";
+  ASSERT_EQ(
+      RunVmap("build " + Quote(Shared() / "data/kitti07") + " --first 20 --last 60 --stride 2 -q -o " + Quote(strided),
+              &out),
+      0)
+      << out;
+  ASSERT_EQ(RunVmap("eval " + Quote(strided), &out), 0) << out;
+  EXPECT_NE(out.find("|     20-"), std::string::npos) << out;  // link 0 from input frame 20, the map's frame 0
+
+  // redkitchen's ground truth against kitti07's times: poses, but the matches lie off its epipolar lines.
+  ASSERT_EQ(
+      RunVmap("eval " + Quote(strided) + " --gt " + Quote(Shared() / "data/redkitchen/groundtruth.txt") + " --no-save",
+              &out),
+      0)
+      << out;
+  EXPECT_NE(out.find("of the verified matches lie within 2 px of the ground truth's epipolar lines"), std::string::npos)
+      << out;
+}
+
 TEST(EvalCli, RedkitchenIsEvaluatedByTimestamp) {
   SKIP_WITHOUT_SHARED();
   testing::ScopedTempDir tmp;

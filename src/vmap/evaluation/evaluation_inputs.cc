@@ -83,8 +83,11 @@ Camera EvaluationCamera(const VisualMap& map, const std::string& camera_option) 
 
 GroundTruth MapGroundTruth(const VisualMap& map, const std::string& gt_path, GroundTruthFormat format) {
   if (!gt_path.empty()) {
-    return NameOptionErrorsWithin(
+    GroundTruth given = NameOptionErrorsWithin(
         "gt", [&] { return ReadGivenGroundTruth(gt_path, format, InputFromHere(map), map.input.format); });
+    // KITTI poses of another input (an image folder): by position, unless the map does not say what its input was.
+    given.lines_by_file_number = map.input.format == SourceFormat::kKitti || map.input.format == SourceFormat::kAuto;
+    return given;
   }
   if (const std::string unreachable = WhyInputUnreachable(map); !unreachable.empty()) {
     throw OptionError("gt.path", "is needed: " + unreachable + "; or give a poses file");

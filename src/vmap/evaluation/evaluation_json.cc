@@ -131,10 +131,15 @@ class KeyReader {
 
 }  // namespace
 
+// The evaluation's layout: a reader of another refuses it, as one written before the version was checked (1 since the
+// format began).
+constexpr int kEvaluationSchemaVersion = 1;
+
 std::string EvaluationToJson(const MapEvaluation& evaluation) {
   json doc;
   doc["format"] = "vmap-eval";
-  doc["schema_version"] = 1;
+  doc["schema_version"] = kEvaluationSchemaVersion;
+  doc["vmap_version"] = VMAP_VERSION;
   // Paths percent-encoded where they are not UTF-8, as in map.json (file_name_encoding.h).
   doc["map"] = EncodeFileName(evaluation.map_path);
   doc["ground_truth"] = {{"path", EncodeFileName(evaluation.ground_truth_path)},
@@ -167,6 +172,12 @@ MapEvaluation ReadEvaluation(const std::string& path) {
   if (!doc.is_object() || doc.value("format", "") != "vmap-eval" || !doc.contains("links") ||
       !doc["links"].is_array() || !doc.contains("summary") || !doc["summary"].is_object()) {
     throw InputError("'" + path + "' is not an evaluation written by `vmap eval`; run `vmap eval` again");
+  }
+  if (!doc.contains("schema_version") || !doc["schema_version"].is_number_integer() ||
+      doc["schema_version"].get<std::int64_t>() != kEvaluationSchemaVersion) {
+    throw InputError("evaluation '" + path + "' is of schema version " + doc.value("schema_version", json()).dump() +
+                     ", which this vmap does not read (it reads " + std::to_string(kEvaluationSchemaVersion) +
+                     "); run `vmap eval` again");
   }
   MapEvaluation evaluation;
   try {

@@ -284,8 +284,10 @@ GroundTruth ReadGivenGroundTruth(const std::string& path, GroundTruthFormat form
 
 std::optional<cv::Matx44d> KeyImagePose(const GroundTruth& truth, const KeyImage& key, double max_time_difference) {
   if (truth.format == GroundTruthFormat::kKitti) {
-    // By the image's own number: the position in the listing is another frame's once an image is missing.
-    const int line = KittiFrameNumber(key.source_name).value_or(key.source_index);
+    // By the image's own number where it is the frame's: the position in the listing is another frame's once an
+    // image is missing.
+    const int line =
+        truth.lines_by_file_number ? KittiFrameNumber(key.source_name).value_or(key.source_index) : key.source_index;
     if (line < 0 || line >= static_cast<int>(truth.camera_to_world.size())) return std::nullopt;
     return truth.camera_to_world[line];
   }

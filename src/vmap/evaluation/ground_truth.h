@@ -37,6 +37,10 @@ struct GroundTruth {
   GroundTruthFormat format = GroundTruthFormat::kAuto;
   std::vector<double> timestamps;            // seconds, ascending; empty for kitti (indexed by image)
   std::vector<cv::Matx44d> camera_to_world;  // T_wc of the camera, one per line
+  // kitti: line N is the image whose file is numbered N (a KITTI sequence's image_0/000123.png, which stays right
+  // when an image is missing); otherwise the key image's position in the input. Only a KITTI sequence's file names
+  // are its frame numbers: an image folder numbered from 1 (ffmpeg's %06d) would be a frame off.
+  bool lines_by_file_number = true;
 };
 
 // The format of a ground-truth file, from its first data line: 12 numbers (kitti), 8 numbers separated by

@@ -155,8 +155,17 @@ TEST(LocalizeCli, RouteForwardsAndBackwards) {
   ASSERT_EQ(RunVmap("route " + Quote(LabMap()) + " --from 0 --to 3", &out), 0) << out;
   EXPECT_NE(out.find("keys            0 1 2 3\n"), std::string::npos) << out;
   EXPECT_NE(out.find("| forwards |"), std::string::npos) << out;
-  ASSERT_EQ(RunVmap("route " + Quote(LabMap()) + " --from 3 --to 1", &out), 0) << out;
+  const testing::ScopedTempDir tmp;
+  const fs::path route_json = tmp.path() / "route.json";
+  ASSERT_EQ(RunVmap("route " + Quote(LabMap()) + " --from 3 --to 1 --json " + Quote(route_json), &out), 0) << out;
   EXPECT_NE(out.find("keys            3 2 1\n"), std::string::npos) << out;
+  // The record names its layout and each step's frames, as the table does.
+  const nlohmann::json route = nlohmann::json::parse(std::ifstream(route_json));
+  EXPECT_EQ(route["format"], "vmap-route");
+  EXPECT_EQ(route["schema_version"], 1);
+  ASSERT_EQ(route["steps"].size(), 2u);
+  EXPECT_EQ(route["steps"][0]["from_frame"], map.key_images[3].frame_index);
+  EXPECT_EQ(route["steps"][0]["to_frame"], map.key_images[2].frame_index);
   EXPECT_NE(out.find("| backwards |"), std::string::npos) << out;
   // Each step says whether the link's translation can be trusted, backwards as forwards.
   EXPECT_NE(out.find("| translation |"), std::string::npos) << out;

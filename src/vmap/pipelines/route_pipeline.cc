@@ -20,6 +20,8 @@ nlohmann::json RouteJson(const RoutePipelineOptions& options, const RoutePipelin
     const Link& l = map.links[s.link];
     steps.push_back({{"from", s.from_key},
                      {"to", s.to_key},
+                     {"from_frame", map.key_images[s.from_key].frame_index},
+                     {"to_frame", map.key_images[s.to_key].frame_index},
                      {"link", s.link},
                      {"backwards", s.backwards},
                      {"unverified", s.unverified},
@@ -31,6 +33,8 @@ nlohmann::json RouteJson(const RoutePipelineOptions& options, const RoutePipelin
   }
   // The map's path percent-encoded where it is not UTF-8, as in map.json (file_name_encoding.h).
   return {{"format", "vmap-route"},
+          {"schema_version", 1},
+          {"vmap_version", VMAP_VERSION},
           {"map", EncodeFileName(options.map)},
           {"from", options.from},
           {"to", result.to},

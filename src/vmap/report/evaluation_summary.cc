@@ -24,7 +24,7 @@ std::string Percent(double share, int width) {
 std::string FormatEvaluationTable(const MapEvaluation& evaluation) {
   const double within = evaluation.options.sampson_threshold_px;
   std::string text = fmt::format(
-      "| link |   frames    |   S   | verified | ver. Sampson | ver. <{:g}px | rej. Sampson | rej. <{:g}px | rot. err "
+      "| link | input frames |   S   | verified | ver. Sampson | ver. <{:g}px | rej. Sampson | rej. <{:g}px | rot. err "
       "| transl. err | true parallax | t sigma | t known | pose        | usable |\n",
       within, within);
   text += "|---:|:---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|:---:|:---|:---:|\n";
@@ -33,9 +33,9 @@ std::string FormatEvaluationTable(const MapEvaluation& evaluation) {
     if (e.below_tau) notes += " below-tau";
     if (e.planar) notes += " planar";
     text += fmt::format(
-        "| {:>4} | {:>5}-{:<5} | {:.3f} | {:>8} | {} px | {} | {} px | {} | {} deg | {} deg | {} px | {} deg | {:^7} "
+        "| {:>4} | {:>6}-{:<5} | {:.3f} | {:>8} | {} px | {} | {} px | {} | {} deg | {} deg | {} px | {} deg | {:^7} "
         "| {:<11} | {:^6} |{}\n",
-        e.link, e.from_frame, e.to_frame, e.similarity, e.num_verified, Fixed(e.verified_sampson_median, 2, 9),
+        e.link, e.from_source, e.to_source, e.similarity, e.num_verified, Fixed(e.verified_sampson_median, 2, 9),
         Percent(e.verified_within, 10), Fixed(e.rejected_sampson_median, 2, 9), Percent(e.rejected_within, 10),
         Fixed(e.rotation_error_deg, 2, 4), Fixed(e.translation_error_deg, 1, 7), Fixed(e.true_parallax_px, 1, 10),
         Fixed(e.translation_sigma_deg, 1, 4), e.translation_known ? "yes" : "no", e.pose_source,
@@ -57,11 +57,13 @@ std::string FormatEvaluationSummary(const MapEvaluation& evaluation) {
   text += fmt::format("links           {} ({} with ground truth for both key images, {} with a pose)\n", s.links,
                       s.evaluated_links, s.links_with_pose);
   text += fmt::format(
-      "usable links    {} of {}{}  (rotation error < {:g} deg; translation error < {:g} deg where "
+      "usable links    {} of {}{}{}  (rotation error < {:g} deg; translation error < {:g} deg where "
       "the true parallax >= {:g} px)\n",
       s.usable_links, s.evaluated_links,
-      std::isfinite(s.usable_share) ? fmt::format(" = {:.1f}%", 100.0 * s.usable_share) : "", o.max_rotation_error_deg,
-      o.max_translation_error_deg, o.min_parallax_px);
+      std::isfinite(s.usable_share) ? fmt::format(" = {:.1f}%", 100.0 * s.usable_share) : "",
+      s.evaluated_links < s.links ? fmt::format(" with ground truth; {} links have none", s.links - s.evaluated_links)
+                                  : "",
+      o.max_rotation_error_deg, o.max_translation_error_deg, o.min_parallax_px);
   const auto of = [](int part, int whole, double share) {
     return fmt::format("{} of {}{}", part, whole, std::isfinite(share) ? fmt::format(" = {:.1f}%", 100.0 * share) : "");
   };

@@ -3,6 +3,7 @@
 #include <fstream>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "vmap/evaluation/evaluation_json.h"
 #include "vmap/report/html_report.h"
@@ -81,6 +82,15 @@ TEST(LinkTableTest, TheReportShowsTheEvaluationOfItsOwnLinksOnly) {
   EXPECT_EQ(report_test::ReadText(dir / kReportFileName).find("usable share"), std::string::npos);
   std::ofstream(dir / kEvaluationFileName) << "not json";
   EXPECT_FALSE(ReadMatchingEvaluation(dir, map));
+  // One of a later layout is not read as this one.
+  nlohmann::json later = nlohmann::json::parse(EvaluationToJson(evaluation));
+  ASSERT_EQ(later["schema_version"], 1);
+  later["schema_version"] = 2;
+  std::ofstream(dir / kEvaluationFileName) << later.dump();
+  EXPECT_FALSE(ReadMatchingEvaluation(dir, map));
+  later["schema_version"] = 1;
+  std::ofstream(dir / kEvaluationFileName) << later.dump();
+  EXPECT_TRUE(ReadMatchingEvaluation(dir, map));
 }
 
 }  // namespace
