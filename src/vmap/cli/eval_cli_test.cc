@@ -52,6 +52,7 @@ TEST(EvalCli, Kitti07LinksAreUsableAndTheReportShowsThem) {
   ASSERT_EQ(RunVmap("eval " + Quote(map) + " --json " + Quote(tmp.path() / "eval.json"), &out), 0) << out;
   EXPECT_NE(out.find("usable links"), std::string::npos) << out;
   EXPECT_NE(out.find("| link |"), std::string::npos) << out;
+  EXPECT_NE(out.find("written to      " + (tmp.path() / "eval.json").string() + "\n"), std::string::npos) << out;
   const nlohmann::json doc = ReadJson(tmp.path() / "eval.json");
   const nlohmann::json& summary = doc["summary"];
   for (const char* field : {"links", "usable_links", "rotation_error_deg_median", "translation_error_deg_median"}) {

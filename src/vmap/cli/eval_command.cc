@@ -5,6 +5,7 @@
 
 #include "vmap/cli/commands.h"
 #include "vmap/cli/option_binder.h"
+#include "vmap/core/output_file.h"
 #include "vmap/pipelines/eval_pipeline.h"
 #include "vmap/report/evaluation_summary.h"
 
@@ -23,6 +24,10 @@ void RunEval(const EvalCommand& command) {
   if (command.table) std::cout << FormatEvaluationTable(result.evaluation) << "\n";
   std::cout << FormatEvaluationSummary(result.evaluation);
   if (!result.saved_to.empty()) std::cout << "written to      " << result.saved_to << "\n";
+  // --json naming the map's own eval.json is that file, written once (RunEvalPipeline).
+  if (!command.options.json.empty() && !SameOutput(command.options.json, result.saved_to)) {
+    std::cout << "written to      " << command.options.json << "\n";
+  }
 }
 
 }  // namespace
