@@ -154,6 +154,7 @@ void BenchBuild(const std::string& shared, int frames, int reps) {
     for (auto& entry : entries) {
       auto source = vmap::OpenFrameSource(video, source_options);
       const auto directory = std::filesystem::temp_directory_path() / ("aliked_bench_" + std::to_string(getpid()));
+      std::filesystem::create_directories(directory);  // BuildMap writes into a folder that exists
       long n = 0;
       const double seconds = TimeSeconds([&] {
         const auto map = vmap::BuildMap(*source, *entry.matcher, options, directory);

@@ -86,6 +86,7 @@ int main(int argc, char** argv) {
       // Key images are written as in `vmap build`: that is part of the work.
       const std::filesystem::path directory =
           std::filesystem::temp_directory_path() / ("build_bench_" + std::to_string(getpid()));
+      std::filesystem::create_directories(directory);  // BuildMap writes into a folder that exists
       const vmap::VisualMap map = vmap::BuildMap(*source, *matcher, options, directory);
       std::filesystem::remove_all(directory);
       key_images = static_cast<long>(map.key_images.size());

@@ -28,6 +28,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "vmap/core/runtime.h"
 #include "vmap/evaluation/heading_labels.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/localization/add_experience.h"
@@ -232,6 +233,7 @@ void Run(const std::string& name, const Matcher& matcher, const std::vector<int>
 }  // namespace
 
 int main(int argc, char** argv) {
+  vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   std::string matchers = "orb,xfeat";
   std::vector<int> teach = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
   std::vector<int> ks = {0, 1, 2, 3};

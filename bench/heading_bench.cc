@@ -31,6 +31,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "vmap/core/numeric.h"
+#include "vmap/core/runtime.h"
 #include "vmap/evaluation/heading_labels.h"
 #include "vmap/features/matcher_registry.h"
 #include "vmap/features/orb_matcher.h"
@@ -235,6 +236,7 @@ void Report(const Dataset& data, const MatchedSet& set, const Estimator& estimat
 }  // namespace
 
 int main(int argc, char** argv) {
+  vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   std::string matchers = "orb,xfeat";
   bool sweep = false, verified = false;
   for (int i = 1; i < argc; ++i) {

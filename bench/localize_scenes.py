@@ -53,6 +53,11 @@ def build(vmap, matcher, scene, flags, directory):
     return directory
 
 
+def map_folder(parent, name, matcher, flags):
+    """A map's folder in --work, named by what it is built from: a reused folder never holds another matcher's map."""
+    return os.path.join(parent, "".join(c for c in "_".join([name, matcher] + flags) if c.isalnum() or c == "_"))
+
+
 def localize(vmap, map_directory, query, flags, rule, output):
     """`rule`: an acceptance rule, optionally followed by more localize flags ("chance --recheck-link-share 0")."""
     rule_flags = rule.split()
@@ -61,9 +66,13 @@ def localize(vmap, map_directory, query, flags, rule, output):
         return json.load(f)
 
 
+STEERED_BY = ("tracking", "relocalized")
+
+
 def forward_steps(frames):
-    """Localized frames, and those whose key image is behind the previous localized frame's."""
-    localized = [f for f in frames if f["status"] != "lost"]
+    """Localized frames (tracking or relocalized: an uncertain frame is not steered by), and those whose key image is
+    behind the previous localized frame's."""
+    localized = [f for f in frames if f["status"] in STEERED_BY]
     back = sum(1 for a, b in zip(localized, localized[1:]) if b["key"] < a["key"])
     return len(localized), back
 
@@ -97,19 +106,23 @@ def main():
                 if args.only and name not in args.only.split(";") and scene not in args.only.split(";"):
                     continue
                 map_directory = build(args.vmap, args.matcher, scene, build_flags,
-                                      os.path.join(tmp, "same_" + "".join(c for c in name if c.isalnum())))
+                                      map_folder(tmp, "same_" + name, args.matcher, build_flags))
                 for rule in rules:
                     doc = localize(args.vmap, map_directory, SCENES[scene][0], query_flags, rule,
                                    os.path.join(tmp, "run.json"))
                     frames = doc["frames"]
                     localized, back = forward_steps(frames)
-                    stretches, start = [], None
+                    # Stretches of 3 or more frames not localized (lost or uncertain), as the docs' tables list them.
+                    stretches, start, length = [], None, 0
                     for f in frames + [{"status": "end", "source_index": -1}]:
-                        if f["status"] == "lost" and start is None:
-                            start = f["source_index"]
-                        elif f["status"] != "lost" and start is not None:
-                            stretches.append("%d-%d" % (start, last))
+                        not_localized = f["status"] in ("lost", "uncertain")
+                        if not_localized and start is None:
+                            start, length = f["source_index"], 0
+                        elif not not_localized and start is not None:
+                            if length >= 3:
+                                stretches.append("%d-%d" % (start, last))
                             start = None
+                        length += 1
                         last = f["source_index"]
                     print("| %s | %s | %d | %d (%.1f %%) | %d | %s | %.1f |" % (
                         name, rule, len(frames), localized, 100.0 * localized / len(frames), back,
@@ -123,7 +136,8 @@ def main():
                 if args.maps and scene not in args.maps.split(";"):
                     continue
                 if build_flags is not None:
-                    maps[scene] = build(args.vmap, args.matcher, scene, build_flags, os.path.join(tmp, "map_" + scene))
+                    maps[scene] = build(args.vmap, args.matcher, scene, build_flags,
+                                        map_folder(tmp, "map_" + scene, args.matcher, build_flags))
             for query, (path, _, query_flags) in SCENES.items():
                 if args.only and query not in args.only.split(";"):
                     continue

@@ -40,9 +40,9 @@ side.
 Under each row, its frames confidently > 2 places off and its back-jumps are named, the first 8 (--named-frames N:
 the first N; 0: all of them).
 
-With --evidence-dir DIR, also every frame of each run against every key image of its map
-(build/bench/evidence_dump) into DIR/corridor_MATCHER.csv and DIR/michigan_MATCHER.csv, the input of
-bench/evidence_fit.py.
+With --evidence-dir DIR, also every frame of each run against every key image of its map (the evidence_dump of the
+binary's own build, BUILD/bench/evidence_dump) into DIR/corridor_MATCHER.csv and DIR/michigan_MATCHER.csv (DIR/binaryN/
+with several binaries), written anew by each invocation: the input of bench/evidence_fit.py.
 
 --start-key K (default 0): every run is localized with `vmap localize --start-key K`: a repeat run starts where its
 teach run started (corridor: repeat frame 0 at teach frame 0; michigan: frame 0 at key image 0), as a teach-and-repeat
@@ -143,19 +143,28 @@ HEADER = ("| run | frames | right | right, not uncertain | localized wrong | con
           "lost | frames/s | back-jumps |\n|---|---|---|---|---|---|---|---|---|---|")
 
 
-EVIDENCE_DUMP = "build/bench/evidence_dump"
+def evidence_dump_of(vmap):
+    """The evidence_dump of the build `vmap` is from (its bench/ folder): another build's would compare otherwise."""
+    dump = os.path.join(os.path.dirname(os.path.abspath(vmap)), "bench", "evidence_dump")
+    if not os.path.exists(dump):
+        sys.exit("--evidence-dir needs %s, the evidence_dump of %s's build" % (dump, vmap))
+    return dump
 
 
-def dump_evidence(map_directory, query, output, prefix=""):
-    """Appends evidence_dump's rows of `query` against the map to `output` (its header once), each row after
-    `prefix` (for michigan: the teach and repeat sessions)."""
-    text = run([EVIDENCE_DUMP, map_directory, query])
+STARTED_EVIDENCE = set()  # the evidence files this invocation has begun: each is written anew once, then appended to
+
+
+def dump_evidence(vmap, map_directory, query, output, prefix=""):
+    """Adds evidence_dump's rows of `query` against the map to `output` (replaced by the first call of this invocation,
+    with its header), each row after `prefix` (for michigan: the teach and repeat sessions)."""
+    text = run([evidence_dump_of(vmap), map_directory, query])
     lines = text.splitlines()
     header = [l for l in lines if l.startswith("frame,")]
     rows = [l for l in lines if l and l[0].isdigit()]
     os.makedirs(os.path.dirname(output) or ".", exist_ok=True)
-    new = not os.path.exists(output)
-    with open(output, "a") as f:
+    new = output not in STARTED_EVIDENCE
+    STARTED_EVIDENCE.add(output)
+    with open(output, "w" if new else "a") as f:
         if new:
             f.write(("teach,repeat," if prefix else "") + header[0] + "\n")
         for row in rows:
@@ -195,7 +204,7 @@ def corridor(vmap, matcher, tau_flags, localize_flags, stride, work, csv_dir, ev
         flags += ["--csv", os.path.join(csv_dir, "%s_%s.csv" % (label.replace(" ", "_"), matcher))]
     doc = localize(vmap, map_directory, repeat, flags, os.path.join(work, "run.json"))
     if evidence_dir:
-        dump_evidence(map_directory, repeat, os.path.join(evidence_dir, "corridor_%s.csv" % matcher))
+        dump_evidence(vmap, map_directory, repeat, os.path.join(evidence_dir, "corridor_%s.csv" % matcher))
 
     tally = tally or Tally()
     tally.add(doc, lambda f: corridor_right_keys(key_sources, f["source_index"]), label)
@@ -353,7 +362,7 @@ def michigan(vmap, matcher, localize_flags, work, evidence_dir=None, build_flags
             doc = localize(vmap, map_directory, folders[b], flags, os.path.join(work, "run.json"))
             tally.add(doc, lambda f: {f["source_index"]}, "%s->%s" % (b, a))
             if evidence_dir:
-                dump_evidence(map_directory, folders[b], os.path.join(evidence_dir, "michigan_%s.csv" % matcher),
+                dump_evidence(vmap, map_directory, folders[b], os.path.join(evidence_dir, "michigan_%s.csv" % matcher),
                               "%s,%s," % (a, b))
     return tally
 
@@ -422,6 +431,8 @@ def main():
             # Side by side, each binary's CSVs apart: they are compared frame by frame.
             binary_csv_dir = args.csv_dir and (os.path.join(args.csv_dir, "binary%d" % index) if len(binaries) > 1
                                                else args.csv_dir)
+            evidence_dir = args.evidence_dir and (os.path.join(args.evidence_dir, "binary%d" % index)
+                                                  if len(binaries) > 1 else args.evidence_dir)
 
             def runs(name, run_set):
                 """`run_set(flags, csv_dir)` once per seed (the map's alone: once, without the flag), reported."""
@@ -443,7 +454,7 @@ def main():
                     runs("%s: corridor, %s, %d key images%s" % (
                         vmap, matcher, keys, ", repeat stride %d" % args.repeat_stride if args.repeat_stride > 1
                         else ""), lambda flags, csv_dir: corridor(vmap, matcher, tau_flags, flags, args.repeat_stride,
-                                                                  work, csv_dir, args.evidence_dir)[0])
+                                                                  work, csv_dir, evidence_dir)[0])
                 if "places" in sets:
                     places_flags = PLACES_BUILD + build_flags
                     keys = len(corridor_map(vmap, matcher, places_flags, work)[1])
@@ -479,7 +490,7 @@ def main():
                         lambda flags, csv_dir: elsewhere(vmap, matcher, tau_flags, flags, work, csv_dir))
                 if "michigan" in sets:
                     runs("%s: michigan 132 routes, %s" % (vmap, matcher),
-                         lambda flags, csv_dir: michigan(vmap, matcher, flags, work, args.evidence_dir, build_flags,
+                         lambda flags, csv_dir: michigan(vmap, matcher, flags, work, evidence_dir, build_flags,
                                                          csv_dir))
 
 

@@ -27,6 +27,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "vmap/core/runtime.h"
 #include "vmap/localization/localizer.h"
 #include "vmap/mapping/key_image_selector.h"
 #include "vmap/neural/xfeat/xfeat_matcher.h"
@@ -167,6 +168,7 @@ void Run(const std::string& set, const std::vector<PairImages>& pairs, const vma
 }  // namespace
 
 int main(int argc, char** argv) {
+  vmap::InitializeRuntime();  // the process set up as the vmap binary has it (core/runtime.h)
   std::string set = "both";
   int every = 1, top_k = 4096;
   std::vector<std::pair<int, int>> bounded = {{1000, 512}};

@@ -115,6 +115,7 @@ void TimeBuilds(const std::string& weights, const std::string& video, const std:
     for (size_t m = 0; m < matchers.size(); ++m) {
       auto source = vmap::OpenFrameSource(video, source_options);
       const auto directory = std::filesystem::temp_directory_path() / ("xfeat_bench_" + std::to_string(getpid()));
+      std::filesystem::create_directories(directory);  // BuildMap writes into a folder that exists
       const auto start = Clock::now();
       const vmap::VisualMap map = vmap::BuildMap(*source, *matchers[m].second, options, directory);
       rates[m].push_back(map.num_frames / std::chrono::duration<double>(Clock::now() - start).count());
