@@ -319,3 +319,12 @@ def test_a_route_end_or_start_that_is_no_key_image_names_its_keyword(maps):
     for keyword in ("from", "to", "start_key"):
         with pytest.raises(vmap.Error, match=rf"{keyword} 99 is no key image: the map has key images 0 to {last}"):
             vmap.Localizer(m, no_cache=True, **{keyword: 99})
+
+
+def test_a_runs_weights_and_device_are_checked_by_their_keywords(maps, tmp_path):
+    # The run's own settings of the map's matcher, named as Python names them.
+    cli_dir, _, _ = maps
+    with pytest.raises(vmap.Error, match=r"weights '.*nowhere\.pt' is not a file"):
+        vmap.Localizer(cli_dir, weights=str(tmp_path / "nowhere.pt"))
+    with pytest.raises(vmap.Error, match="device 'gpu' is not a device"):
+        vmap.Localizer(cli_dir, device="gpu")

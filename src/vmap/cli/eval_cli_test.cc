@@ -97,9 +97,9 @@ TEST(EvalCli, GroundTruthIsMatchedToTheMapsOwnFramesOrSaidNotToFit) {
   fs::create_directories(folder);
   for (int i = 0; i <= 40; ++i) {
     char name[32];
-    std::snprintf(name, sizeof(name), "%06d.png", i);
+    std::snprintf(name, sizeof(name), "%06d.jpg", i);
     char link[32];
-    std::snprintf(link, sizeof(link), "%06d.png", i + 1);
+    std::snprintf(link, sizeof(link), "%06d.jpg", i + 1);
     fs::create_symlink(Shared() / "data/kitti07/image_0" / name, folder / link);
   }
   const std::string camera = " --camera 707.0912,707.0912,601.8873,183.1104";
@@ -110,6 +110,15 @@ TEST(EvalCli, GroundTruthIsMatchedToTheMapsOwnFramesOrSaidNotToFit) {
       << out;
   EXPECT_GE(ReadJson(map / "eval.json")["summary"]["verified_within_threshold_mean"].get<double>(), 0.9) << out;
   EXPECT_EQ(out.find("of the verified matches lie within"), std::string::npos) << out;
+  // vmap sweep --gt matches them alike: every link usable, as the map's eval finds.
+  ASSERT_EQ(RunVmap("sweep " + Quote(folder) + " --thresholds 0.5 --gt " + Quote(Shared() / "data/kitti07/poses.txt") +
+                        camera + " -q -o " + Quote(tmp.path() / "sweep"),
+                    &out),
+            0)
+      << out;
+  const nlohmann::json swept = ReadJson(tmp.path() / "sweep/sweep.json")["rows"][0];
+  EXPECT_EQ(swept["usable_links"], ReadJson(map / "eval.json")["summary"]["usable_links"]) << swept.dump();
+  EXPECT_GE(swept["usable_links"].get<int>(), 1) << swept.dump();
 
   const fs::path strided = tmp.path() / "strided";
   ASSERT_EQ(

@@ -53,6 +53,10 @@ void MatcherRunSettings::Check() const {
   if (!device.empty() && device != "cpu" && device != "cuda") {
     throw OptionError("device", "'" + device + "' is not a device; use cpu or cuda");
   }
+  std::error_code error;
+  if (!weights.empty() && !std::filesystem::is_regular_file(weights, error)) {
+    throw OptionError("weights", "'" + weights + "' is not a file; give the weights file of the map's model");
+  }
 }
 
 MatcherOptions MatcherOptionsFromJson(const std::string& matcher_json, const std::string& map_file,
@@ -111,8 +115,9 @@ MatcherOptions MatcherOptionsFromJson(const std::string& matcher_json, const std
   if (!run.device.empty() && !has_device && run.device != "cpu") {
     throw InputError("device " + run.device + ": the map's matcher " + options.type + " runs on the CPU only");
   }
+  // Said, not refused: nothing is read, and a robot's weights parameter may stay set for a map of another matcher.
   if (!run.weights.empty() && !has_weights) {
-    throw InputError("--weights " + run.weights + ": the map's matcher " + options.type + " reads no weights");
+    spdlog::warn("the weights '{}' are not read: the map's matcher {} reads none", run.weights, options.type);
   }
   options.Check();
   return options;

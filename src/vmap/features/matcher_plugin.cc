@@ -43,7 +43,10 @@ const MatcherPluginTable* OpenPlugin() {
   if (vmap_matcher_plugin_table) return vmap_matcher_plugin_table();
 #ifdef VMAP_WITH_TORCH
   const std::string path = PluginPath().string();
-  if (const std::string problem = IncompleteSharedLibraryProblem(path); !problem.empty()) {
+  // A missing file is dlopen's to say (with the fix below); one that is there must be whole before it is mapped.
+  std::error_code exists_error;
+  const bool exists = std::filesystem::exists(path, exists_error);
+  if (const std::string problem = exists ? IncompleteSharedLibraryProblem(path) : ""; !problem.empty()) {
     throw InputError("the deep matchers need LibTorch, through '" + path + "', which " + problem +
                      "; rebuild vmap (scripts/build.sh) or install it again");
   }
@@ -58,9 +61,12 @@ const MatcherPluginTable* OpenPlugin() {
   using Abi = const char* (*)();
   const auto entry = reinterpret_cast<Entry>(dlsym(library, "vmap_matcher_plugin_table"));
   const auto abi = reinterpret_cast<Abi>(dlsym(library, "vmap_matcher_plugin_abi"));
-  if (!entry || !abi) {
-    throw InputError("'" + path +
-                     "' is not a vmap LibTorch plugin (no vmap_matcher_plugin_table or ABI); rebuild vmap");
+  if (!entry) {
+    throw InputError("'" + path + "' is not a vmap LibTorch plugin (no vmap_matcher_plugin_table); rebuild vmap");
+  }
+  if (!abi) {
+    throw InputError("'" + path + "' was built by an older vmap (it names no ABI); rebuild vmap so that " +
+                     "libvmap_torch.so and the program that loads it come from one build");
   }
   if (const std::string theirs = abi(), ours = MatcherPluginAbi(); theirs != ours) {
     throw InputError("'" + path + "' was built for another vmap (" + theirs + ") than this one (" + ours +

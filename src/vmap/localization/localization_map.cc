@@ -48,12 +48,12 @@ std::unique_ptr<Matcher> CreateMapMatcher(const RecordedMap& read, const std::fi
   try {
     matcher = CreateMatcher(options);
   } catch (const InputError& error) {
-    if (run.weights.empty()) throw;
-    // The loader's fix may name another model; the map's is fixed, so the file is what must change.
-    throw InputError(
-        fmt::format("--weights {}: not weights of the map's {} ({}); pass weights of that model, or "
-                    "leave --weights out to read the map's",
-                    run.weights, options.type, error.what()));
+    // The loader names the file it refuses; its fix may name another model, but the map's is fixed, so the file is
+    // what must change. Other errors (a device without CUDA) are the matcher's own.
+    if (run.weights.empty() || std::string(error.what()).find(run.weights) == std::string::npos) throw;
+    throw OptionError("weights", fmt::format("'{}' are not weights of the map's {} ({}); give weights of that model, "
+                                             "or leave them out to read the map's",
+                                             run.weights, options.type, error.what()));
   }
   // The frames are extracted within the mask the key images were.
   if (read.map.camera_mask.empty()) return matcher;

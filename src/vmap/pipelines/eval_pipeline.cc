@@ -61,7 +61,10 @@ constexpr double kLeastPlausibleVerifiedWithin = 0.25;
 // Why ground truth gives no key image of `map` a pose, as far as the map tells.
 std::string WhyNoKeyImageHasAPose(const VisualMap& map, const GroundTruth& truth) {
   const std::string fix = "give the ground truth of the map's input '" + map.input.path + "'";
-  if (truth.format == GroundTruthFormat::kKitti) return fix + " (KITTI poses are matched by frame number)";
+  if (truth.format == GroundTruthFormat::kKitti) {
+    return fix + (truth.lines_by_file_number ? " (KITTI poses are matched by the number in each image's file name)"
+                                             : " (KITTI poses are matched by each key image's position in the input)");
+  }
   const bool timed =
       std::any_of(map.key_images.begin(), map.key_images.end(), [](const KeyImage& key) { return key.timestamp >= 0; });
   if (!timed) {

@@ -116,7 +116,7 @@ SweepResult RunSweepPipeline(const SweepPipelineOptions& options) {
   if (options.evaluate) {
     VisualMap input_only;
     input_only.input.path = options.input;
-    input_only.input.format = options.source.format;
+    input_only.input.format = source->info().format;  // as detected: KITTI poses go by file number in a KITTI sequence
     truth = MapGroundTruth(input_only, options.gt.path, options.gt.format);
   }
 

@@ -1,6 +1,7 @@
 #include "vmap/report/html_report.h"
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -13,6 +14,7 @@
 
 #include "vmap/core/atomic_output.h"
 #include "vmap/core/error.h"
+#include "vmap/core/numeric.h"
 #include "vmap/core/option_ranges.h"
 #include "vmap/core/output_file.h"
 #include "vmap/map/map_io.h"
@@ -241,20 +243,20 @@ std::string ExperiencesSection(const VisualMap& map) {
           "<th class=\"num\">views</th><th class=\"num\">median verified</th><th>key images without a view</th>"
           "</tr></thead><tbody>\n";
   for (const Experience& e : map.experiences) {
-    std::vector<int> verified;
+    std::vector<double> verified;
     std::vector<bool> has_view(map.key_images.size(), false);
     for (const ExperienceView& view : e.views) {
       verified.push_back(view.num_verified);
       has_view.at(view.key) = true;
     }
-    std::sort(verified.begin(), verified.end());
+    const double median_verified = MedianOrNan(verified);
     std::vector<int> without;
     for (size_t k = 0; k < has_view.size(); ++k) {
       if (!has_view[k]) without.push_back(static_cast<int>(k));
     }
     html << "<tr><td class=\"num\">" << e.id << "</td><td>" << HtmlEscape(Displayable(e.source))
          << "</td><td class=\"num\">" << e.views.size() << " of " << map.key_images.size() << "</td><td class=\"num\">"
-         << (verified.empty() ? "" : std::to_string(verified[verified.size() / 2])) << "</td><td>"
+         << (std::isfinite(median_verified) ? FormatExact(median_verified) : "") << "</td><td>"
          << (without.empty() ? "none" : HtmlEscape(fmt::format("{}", fmt::join(without, ", ")))) << "</td></tr>\n";
   }
   html << "</tbody></table>\n</section>\n";

@@ -80,7 +80,7 @@ class ImageListSource : public FrameSource {
       if (options_.decode_color) {
         frame.color = DecodeImageFile(*file, cv::IMREAD_COLOR, options_.max_frame_pixels, &why_not);
         if (frame.color.size() != frame.gray.size()) {
-          Skip(entry, "it decodes in colour other than in grey (" + why_not + ")");
+          Skip(entry, frame.color.empty() ? "it " + why_not + " in colour" : "it decodes in colour at another size");
           continue;
         }
       }
