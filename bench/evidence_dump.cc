@@ -137,7 +137,6 @@ int Dump(int argc, char** argv) {
   }
   // The relocalization's ranking of every key image, as the localizer ranks the route.
   const KeyImageRanking ranking(opened.keys.features, opened.keys.thumbnails, options.ranking);
-  query_options.decode_color = (orb_override ? *frame_matcher : *opened.matcher).reads_color();
   auto source = OpenFrameSource(query_path, query_options);
   std::printf(
       "frame,source_index,key,matched,accepted,tentative,verified,similarity,log10_nfa,link_verified,"

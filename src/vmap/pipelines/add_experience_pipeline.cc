@@ -7,7 +7,6 @@
 #include <spdlog/spdlog.h>
 
 #include "vmap/core/error.h"
-#include "vmap/localization/localization_map.h"
 #include "vmap/map/map_io.h"
 #include "vmap/mapping/recorded_options.h"
 
@@ -56,12 +55,8 @@ AddExperienceSummary RunAddExperiencePipeline(const AddExperiencePipelineOptions
                       {"matcher"});
   }
 
-  // 3. The repeat run, in colour where the map's matcher reads colour (as it reads the key images). Asked of the
-  // matcher itself, made here once more than the add makes it under the map's lock: a deep model's weights load twice
-  // (a fraction of a second of an offline add), and a file that does not fit is refused before the run is opened.
-  FrameSourceOptions source_options = options.source;
-  source_options.decode_color = CreateMapMatcher(header, options.map, options.matcher_run)->reads_color();
-  const std::unique_ptr<FrameSource> source = OpenFrameSource(options.input, source_options);
+  // 3. The repeat run.
+  const std::unique_ptr<FrameSource> source = OpenFrameSource(options.input, options.source);
 
   // 4. The experience.
   AddExperienceOptions experience = options.experience;

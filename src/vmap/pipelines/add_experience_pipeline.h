@@ -35,7 +35,7 @@ struct AddExperiencePipelineOptions {
 // Stages, in order:
 //   1. check the options;
 //   2. read the map's header: its matcher must be the one expected;
-//   3. open the repeat run, in colour where the map's matcher reads colour;
+//   3. open the repeat run;
 //   4. localize it against the map and add its best frames as the new experience (AddExperience).
 // Throws InputError (OptionError for an option) and leaves the map as it was on any failure.
 AddExperienceSummary RunAddExperiencePipeline(const AddExperiencePipelineOptions& options);

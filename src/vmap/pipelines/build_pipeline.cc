@@ -237,9 +237,8 @@ BuildPipelineResult RunBuildPipeline(const BuildPipelineOptions& pipeline, Frame
   // 3. The matcher (a deep model loads its weights here).
   const std::unique_ptr<Matcher> matcher = CreateMatcher(pipeline.matcher);
 
-  // 4. The input, in colour where the matcher reads colour (as it reads the key images at localize).
+  // 4. The input.
   FrameSourceOptions source_options = pipeline.source;
-  source_options.decode_color = matcher->reads_color();
   const EndInputOnSigintWhile live_end(pipeline.until_interrupted);
   if (pipeline.until_interrupted) source_options.stop_requested = [] { return InputEndRequested(); };
   std::unique_ptr<FrameSource> opened;

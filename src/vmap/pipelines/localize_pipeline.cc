@@ -177,25 +177,21 @@ LocalizationSession::LocalizationSession(const LocalizePipelineOptions& options)
   localizer.route = RouteOf(read.map, options.session, localizer.route);
   CheckStartKey(read.map, localizer);
 
-  // 5. The map's matcher (a deep model loads its weights here).
-  std::unique_ptr<Matcher> matcher = CreateMapMatcher(read, options.map, options.session.matcher_run);
-
-  // 6. The query: frames are compared with key images at the map's size unless told otherwise, in colour where the
-  // matcher reads the key images in colour.
+  // 5. The query: frames are compared with key images at the map's size unless told otherwise.
   query_options_ = options.source;
   query_options_.allow_single_image = true;
   query_options_.resize = QueryResize(read.map, query_options_.resize);
-  query_options_.decode_color = matcher->reads_color();
   if (!options.query.empty()) query_ = OpenFrameSource(options.query, query_options_);
 
-  // 7. The map's key images and experiences.
+  // 6. The map's matcher (a deep model loads its weights here), key images and experiences.
+  std::unique_ptr<Matcher> matcher = CreateMapMatcher(read, options.map, options.session.matcher_run);
   KeyImageStoreOptions store_options;
   store_options.use_cache = options.session.cache;
   store_options.thumbnail_width = localizer.ranking.thumbnail_width;
   opened_ = std::make_unique<LocalizationMap>(
       OpenLocalizationMap(std::move(read), options.map, store_options, std::move(matcher)));
 
-  // 8. The localizer, following the map: its verifier, definition of S, translation thresholds and camera.
+  // 7. The localizer, following the map: its verifier, definition of S, translation thresholds and camera.
   options_ = FollowMap(*opened_, localizer, query_options_.resize);
   options_.Check();
   localizer_ = std::make_unique<Localizer>(opened_->map, opened_->keys, *opened_->matcher, options_);
@@ -237,7 +233,7 @@ void LocalizationSession::Reset() { localizer_->Reset(); }
 
 LocalizePipelineResult RunLocalizePipeline(const LocalizePipelineOptions& options,
                                            const LocalizationCallback& on_frame) {
-  // 1-8. The set-up.
+  // 1-7. The set-up.
   if (options.query.empty())
     throw OptionError("query", "is empty; give a video, an image folder, a dataset or an image");
   LocalizationSession session(options);
@@ -245,12 +241,12 @@ LocalizePipelineResult RunLocalizePipeline(const LocalizePipelineOptions& option
   const LocalizationMap& opened = session.opened();
   const VisualMap& map = opened.map;
 
-  // 9. The odometry: with it, its columns come last on every row (CSV and JSON), and each frame's pose paces the
+  // 8. The odometry: with it, its columns come last on every row (CSV and JSON), and each frame's pose paces the
   // belief where the session has the teach odometry.
   std::optional<OdometryProgress> odometry = std::move(session.query_odometry_);
   nlohmann::json odometry_json = nlohmann::json::array();
 
-  // 10. Every frame.
+  // 9. Every frame.
   LocalizeSequenceOptions run_options = options.session.run;
   run_options.show_progress = run_options.show_progress && spdlog::should_log(spdlog::level::info);
   LocalizePipelineResult result;
@@ -295,7 +291,7 @@ LocalizePipelineResult RunLocalizePipeline(const LocalizePipelineOptions& option
       odometry_track);
   run.info.frame_size = query.info().frame_size;
 
-  // 11. The outputs: all written before any is put in place, so that a failure while writing one (a full disk)
+  // 10. The outputs: all written before any is put in place, so that a failure while writing one (a full disk)
   // leaves every output of an earlier run as it was. The report, the one most likely to be refused as it is put in
   // place (its folder changed meanwhile), goes first.
   std::optional<PendingFile> csv_file;

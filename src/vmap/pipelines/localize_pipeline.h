@@ -93,11 +93,10 @@ class LocalizationSession {
   //   3. read the map, once (ReadRecordedMap), the teach run's odometry, if any (ReadTeachOdometry), and the
   //      query's (`odometry`, a pipeline's: OpenQueryOdometry), so that a bad file is refused before any work;
   //   4. plan the route (from, to);
-  //   5. create the map's matcher (a deep model loads its weights);
-  //   6. open the query, at the map's frame size unless `source.resize` says otherwise, in colour where the matcher
-  //      reads colour;
-  //   7. load the map's key images and experiences (cached in the map directory);
-  //   8. make the localizer follow the map: its verifier, S, translation thresholds and camera, and its pace the
+  //   5. open the query, at the map's frame size unless `source.resize` says otherwise;
+  //   6. create the map's matcher (`matcher_run`: its device and weights in this run) and load its key images and
+  //      experiences (cached in the map directory);
+  //   7. make the localizer follow the map: its verifier, S, translation thresholds and camera, and its pace the
   //      teach odometry.
   // Throws InputError (OptionError for an option) naming what is wrong and how to fix it.
   explicit LocalizationSession(const LocalizePipelineOptions& options);
@@ -141,12 +140,12 @@ class LocalizationSession {
 
 // Localizes every frame of `options.query` (LocalizationSession, then LocalizeSequence) and writes the outputs
 // asked for. `on_frame` sees each frame and its result, in order, as soon as it is known. Stages, in order:
-//   1-8. the session's set-up (above);
-//   9. take the query's odometry the session read, if any (each frame's pose paces the belief, with the teach
+//   1-7. the session's set-up (above);
+//   8. take the query's odometry the session read, if any (each frame's pose paces the belief, with the teach
 //      odometry);
-//  10. localize every frame, keeping the CSV's rows (with the odometry's columns) and, for a report whose query
+//   9. localize every frame, keeping the CSV's rows (with the odometry's columns) and, for a report whose query
 //      cannot be read again, the last frames it shows;
-//  11. write the CSV, the JSON and the report.
+//  10. write the CSV, the JSON and the report.
 LocalizePipelineResult RunLocalizePipeline(const LocalizePipelineOptions& options,
                                            const LocalizationCallback& on_frame = {});
 

@@ -104,9 +104,7 @@ SweepResult RunSweepPipeline(const SweepPipelineOptions& options) {
 
   // 3. The matcher and the input.
   const std::unique_ptr<Matcher> matcher = CreateMatcher(options.matcher);
-  FrameSourceOptions source_options = options.source;
-  source_options.decode_color = matcher->reads_color();
-  const std::unique_ptr<FrameSource> source = OpenFrameSource(options.input, source_options);
+  const std::unique_ptr<FrameSource> source = OpenFrameSource(options.input, options.source);
   // A sweep compares every frame once for all taus, whatever the matcher: recorded as such.
   if (map_options.key_search == KeySearch::kAuto) map_options.key_search = KeySearch::kSequential;
   const std::string options_json = DescribeMapOptions(*matcher, map_options, options.source);

@@ -72,15 +72,10 @@ struct FrameSourceOptions {
   // topic's sibling camera_info, as image_transport pairs them).
   std::string topic;
   std::string camera_topic;
-  // Image files: each frame also decoded in colour (Frame::color), for a matcher that reads colour
-  // (Matcher::reads_color): the map's key images are read back in colour at localize, so a frame must be extracted
-  // from the same pixels at build. Videos, streams and recordings deliver colour anyway. Follows the matcher: not
-  // recorded.
-  bool decode_color = false;
 
   // Which frames of which input, as map.json records them: format, first, last, stride, resize, strict and
   // camera ("input" for the input's own intrinsics, the default ""), and topic and camera_topic when set. The
-  // rest are limits, callbacks and the matcher's needs of a run (stream_timeout_seconds has its flag).
+  // rest are limits and callbacks of a run (stream_timeout_seconds has its flag).
   void VisitFields(OptionFieldVisitor& visitor);
   void Check() const;  // throws OptionError naming the bad field
 };

@@ -166,31 +166,6 @@ TEST(ImageFolder, FirstLastStrideAndResize) {
   EXPECT_THROW(options.Check(), InputError);
 }
 
-// Colour is decoded only when asked (a matcher that reads it), from the file itself: the same pixels as the file read
-// in colour, resized with the grey frame; grey stays the decoder's grey either way.
-TEST(ImageFolder, ColourIsTheFilesOwnWhenAsked) {
-  testing::ScopedTempDir tmp;
-  cv::Mat colour(120, 160, CV_8UC3);
-  cv::randu(colour, 0, 255);
-  for (int i = 0; i < 2; ++i) cv::imwrite((tmp.path() / ("frame_" + std::to_string(i) + ".png")).string(), colour);
-  const cv::Mat decoder_grey = cv::imread((tmp.path() / "frame_0.png").string(), cv::IMREAD_GRAYSCALE);
-  FrameSourceOptions options;
-  const auto grey_only = ReadAll(*OpenFrameSource(tmp.path().string(), options));
-  ASSERT_EQ(grey_only.size(), 2u);
-  EXPECT_TRUE(grey_only[0].color.empty());
-  EXPECT_EQ(cv::norm(grey_only[0].gray, decoder_grey, cv::NORM_INF), 0.0);
-  options.decode_color = true;
-  const auto with_colour = ReadAll(*OpenFrameSource(tmp.path().string(), options));
-  ASSERT_EQ(with_colour.size(), 2u);
-  ASSERT_EQ(with_colour[1].color.type(), CV_8UC3);
-  EXPECT_EQ(cv::norm(with_colour[1].color, colour, cv::NORM_INF), 0.0);
-  EXPECT_EQ(cv::norm(with_colour[1].gray, decoder_grey, cv::NORM_INF), 0.0);
-  options.resize = "80";
-  const auto resized = ReadAll(*OpenFrameSource(tmp.path().string(), options));
-  EXPECT_EQ(resized[0].color.size(), cv::Size(80, 60));
-  EXPECT_EQ(resized[0].gray.size(), cv::Size(80, 60));
-}
-
 // A longest side is judged on the frames' own shape, not on an assumed 640x480: 12000 makes 800x100 frames 12000x1500
 // (18 megapixels, allowed), though it would make 640x480 ones 12000x9000 (more than the 64 allowed); 40 makes them
 // 40x5, refused naming their size.

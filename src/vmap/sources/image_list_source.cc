@@ -75,15 +75,6 @@ class ImageListSource : public FrameSource {
              "it is " + std::to_string(frame.gray.cols) + "x" + std::to_string(frame.gray.rows) + ", " + size_problem);
         continue;
       }
-      // The file's own colour, decoded from it as the map's key image file is at localize (KeyImageStore): a
-      // grey frame converted would be other pixels.
-      if (options_.decode_color) {
-        frame.color = DecodeImageFile(*file, cv::IMREAD_COLOR, options_.max_frame_pixels, &why_not);
-        if (frame.color.size() != frame.gray.size()) {
-          Skip(entry, frame.color.empty() ? "it " + why_not + " in colour" : "it decodes in colour at another size");
-          continue;
-        }
-      }
       frame.index = delivered_++;
       frame.source_index = static_cast<int>(index);
       frame.timestamp = entry.timestamp;

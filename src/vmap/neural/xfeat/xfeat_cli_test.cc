@@ -375,27 +375,5 @@ TEST(VmapXfeat, AFrameItsKeyImageHoldsFarBeyondChanceIsNotAskedAgain) {
       << "the test no longer reaches a right frame whose step on the question undid";
 }
 
-// XFeat reads colour: an image folder's frames are extracted from their colour at build as at localize, where the key
-// images are read from the map's copies of the same files. Each frame against its own key image then matches itself,
-// every keypoint verified (S 1); extracted from grey at build, the same frames gave S 0.95.
-TEST(VmapXfeat, AnImageFolderIsReadInColourAtBuildAsAtLocalize) {
-  SKIP_WITHOUT_SHARED();
-  TempDir dir;
-  const std::string input = SharedDir() + "/data/corridor_conditions/teach --last 3";
-  auto r = RunVmap("build " + input + " --tau 1 --matcher xfeat --weights " + FoldedWeights() + " -q -o " +
-                   (dir.path() / "map").string());
-  ASSERT_EQ(r.status, 0) << r.output;
-  const fs::path json = dir.path() / "run.json";
-  r = RunVmap("localize " + (dir.path() / "map").string() + " " + input + " --start-key 0 -q --json " + json.string());
-  ASSERT_EQ(r.status, 0) << r.output;
-  const nlohmann::json run = nlohmann::json::parse(std::ifstream(json));
-  ASSERT_EQ(run["frames"].size(), 4u);
-  for (const nlohmann::json& frame : run["frames"]) {
-    const int index = frame["frame"].get<int>();
-    EXPECT_EQ(frame["key"], index) << frame.dump();
-    EXPECT_DOUBLE_EQ(frame["similarity"].get<double>(), 1.0) << frame.dump();
-  }
-}
-
 }  // namespace
 }  // namespace vmap::neural
