@@ -76,13 +76,15 @@ struct ComparedImage {
   cv::Mat image;
   std::string label;  // " (experience 2)" for a view, "" for the key image
 };
-ComparedImage ReadComparedImage(const fs::path& map_directory, const VisualMap& map, const KeyComparison& c) {
-  KeyImage image = map.key_images.at(c.key);
+// `key`: the frame's key (or next key) image; `c`: its comparison with it, which a frame may lack (its key image
+// tracked without one: c.key -1), and then names no view.
+ComparedImage ReadComparedImage(const fs::path& map_directory, const VisualMap& map, int key, const KeyComparison& c) {
+  KeyImage image = map.key_images.at(key);
   std::string label;
   for (const Experience& e : map.experiences) {
-    if (e.id != c.experience) continue;
+    if (c.key != key || e.id != c.experience) continue;
     for (const ExperienceView& view : e.views) {
-      if (view.key != c.key) continue;
+      if (view.key != key) continue;
       image.image_file = view.image_file;
       label = fmt::format(" (experience {})", e.id);
     }
@@ -299,8 +301,9 @@ std::unique_ptr<AtomicOutputDirectory> PrepareLocalizationReport(const Localizat
     const LocalizationResult& r = run.frames[index];
     const bool known_key = r.key >= 0 && r.key < static_cast<int>(map.key_images.size());
     const bool known_next = r.next_key >= 0 && r.next_key < static_cast<int>(map.key_images.size());
-    const ComparedImage key = known_key ? ReadComparedImage(map_directory, map, r.to_key) : ComparedImage{};
-    const ComparedImage next_key = known_next ? ReadComparedImage(map_directory, map, r.to_next) : ComparedImage{};
+    const ComparedImage key = known_key ? ReadComparedImage(map_directory, map, r.key, r.to_key) : ComparedImage{};
+    const ComparedImage next_key =
+        known_next ? ReadComparedImage(map_directory, map, r.next_key, r.to_next) : ComparedImage{};
     const cv::Mat pair = DrawPair(frame_image, key, next_key, r, options.pair_width);
     report::WriteJpeg(assets / "frames" / report::Numbered(r.frame_index), pair, options.jpeg_quality);
     written.push_back({index, pair.size(), key.label, next_key.label});
