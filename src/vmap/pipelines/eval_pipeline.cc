@@ -121,7 +121,7 @@ EvalPipelineResult RunEvalPipeline(const EvalPipelineOptions& options) {
                  evaluation.summary.evaluated_links, evaluation.summary.links);
   }
   // Ground truth of another sequence, shifted in time or numbered from another frame still gives poses, but the
-  // matches do not lie on its epipolar lines: a map's verified matches do (89-100 % on kitti07 and redkitchen).
+  // matches do not lie on its epipolar lines, where a map's verified matches do (kLeastPlausibleVerifiedWithin).
   if (evaluation.summary.verified_within_mean < kLeastPlausibleVerifiedWithin) {
     spdlog::warn(
         "only {:.0f} % of the verified matches lie within {:g} px of the ground truth's epipolar lines (an ORB map's "

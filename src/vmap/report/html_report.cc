@@ -1,6 +1,5 @@
 #include "vmap/report/html_report.h"
 
-#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <sstream>

@@ -17,10 +17,12 @@
 #include "vmap/report/html_page.h"
 #include "vmap/report/html_report.h"
 #include "vmap/report/html_util.h"
+#include "vmap/report/localized_frame_figure.h"
 #include "vmap/report/svg_plot.h"
 
 namespace vmap {
 namespace fs = std::filesystem;
+using report::ComparedImage;
 using report::Displayable;
 using report::FormatFixed;
 using report::HtmlEscape;
@@ -29,6 +31,7 @@ using report::kGreen;
 using report::kOrange;
 using report::kRed;
 using report::PlotSeries;
+using report::ReadComparedImage;
 using report::SvgPlot;
 using report::UrlPath;
 
@@ -60,76 +63,6 @@ std::vector<int> ChooseFrames(const std::vector<LocalizationResult>& frames, int
   // Spread picks that fell on frames already chosen go to the first frames not shown yet.
   for (int i = 0; i < n && static_cast<int>(chosen.size()) < wanted; ++i) chosen.insert(i);
   return {chosen.begin(), chosen.end()};
-}
-
-cv::Mat ToHeight(const cv::Mat& image, int height) {
-  if (image.rows == height) return image;
-  cv::Mat scaled;
-  const int width = std::max(1, static_cast<int>(std::lround(static_cast<double>(image.cols) * height / image.rows)));
-  cv::resize(image, scaled, cv::Size(width, height), 0, 0, height < image.rows ? cv::INTER_AREA : cv::INTER_LINEAR);
-  return scaled;
-}
-
-// The image a frame was compared with at a key image, and its label: the teach run's key image, or the view of the
-// experience that fit best, which the frame's S was measured against.
-struct ComparedImage {
-  cv::Mat image;
-  std::string label;  // " (experience 2)" for a view, "" for the key image
-};
-// `key`: the frame's key (or next key) image; `c`: its comparison with it, which a frame may lack (its key image
-// tracked without one: c.key -1), and then names no view.
-ComparedImage ReadComparedImage(const fs::path& map_directory, const VisualMap& map, int key, const KeyComparison& c) {
-  KeyImage image = map.key_images.at(key);
-  std::string label;
-  for (const Experience& e : map.experiences) {
-    if (c.key != key || e.id != c.experience) continue;
-    for (const ExperienceView& view : e.views) {
-      if (view.key != key) continue;
-      image.image_file = view.image_file;
-      label = fmt::format(" (experience {})", e.id);
-    }
-  }
-  return {ReadKeyImage(map_directory, image), label};
-}
-
-// The frame, its key image and the next key image side by side, each labelled; red frame when lost.
-cv::Mat DrawPair(const cv::Mat& frame, const ComparedImage& key, const ComparedImage& next, const LocalizationResult& r,
-                 int width) {
-  const int height = frame.rows;
-  std::vector<cv::Mat> panels = {frame};
-  std::vector<std::string> labels = {fmt::format("frame {} ({})", r.frame_index, LocalizationStatusName(r.status))};
-  if (!key.image.empty()) {
-    panels.push_back(ToHeight(key.image, height));
-    labels.push_back(
-        fmt::format("key {}{}  S {:.2f}  {} verified", r.key, key.label, r.to_key.similarity, r.to_key.num_verified));
-  }
-  if (!next.image.empty()) {
-    panels.push_back(ToHeight(next.image, height));
-    labels.push_back(fmt::format("next {}{}  S {:.2f}  {} verified", r.next_key, next.label, r.to_next.similarity,
-                                 r.to_next.num_verified));
-  }
-  const int gap = 6;
-  int total = 0;
-  for (const cv::Mat& p : panels) total += p.cols + gap;
-  cv::Mat canvas(height, total - gap, CV_8UC3, cv::Scalar(255, 255, 255));
-  int x = 0;
-  for (size_t i = 0; i < panels.size(); ++i) {
-    cv::Mat roi = canvas(cv::Rect(x, 0, panels[i].cols, height));
-    if (panels[i].channels() == 1)
-      cv::cvtColor(panels[i], roi, cv::COLOR_GRAY2BGR);
-    else
-      panels[i].copyTo(roi);
-    const double scale = std::max(0.4, height / 600.0);
-    const int baseline_y = static_cast<int>(22 * scale) + 4;
-    cv::rectangle(canvas, cv::Rect(x, 0, panels[i].cols, baseline_y + 6), cv::Scalar(0, 0, 0), cv::FILLED);
-    cv::putText(canvas, labels[i], cv::Point(x + 6, baseline_y), cv::FONT_HERSHEY_SIMPLEX, 0.6 * scale,
-                cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
-    x += panels[i].cols + gap;
-  }
-  if (r.status == LocalizationStatus::kLost) {
-    cv::rectangle(canvas, cv::Rect(0, 0, canvas.cols, canvas.rows), cv::Scalar(40, 40, 214), 6);
-  }
-  return report::ScaledToWidth(canvas, width);
 }
 
 std::string KeyPlot(const LocalizationRun& run, int num_keys) {
@@ -304,7 +237,7 @@ std::unique_ptr<AtomicOutputDirectory> PrepareLocalizationReport(const Localizat
     const ComparedImage key = known_key ? ReadComparedImage(map_directory, map, r.key, r.to_key) : ComparedImage{};
     const ComparedImage next_key =
         known_next ? ReadComparedImage(map_directory, map, r.next_key, r.to_next) : ComparedImage{};
-    const cv::Mat pair = DrawPair(frame_image, key, next_key, r, options.pair_width);
+    const cv::Mat pair = report::DrawLocalizedFrame(frame_image, key, next_key, r, options.pair_width);
     report::WriteJpeg(assets / "frames" / report::Numbered(r.frame_index), pair, options.jpeg_quality);
     written.push_back({index, pair.size(), key.label, next_key.label});
   };

@@ -32,6 +32,24 @@ using TempDir = testing::ScopedTempDir;
 
 std::string FoldedWeights() { return SharedDir() + "/weights/xfeat/xfeat_folded.pt"; }
 
+// A localization CSV's cells, every row but its `seconds`, the time the frame took (the one column two runs differ by).
+std::vector<std::vector<std::string>> CsvWithoutSeconds(const fs::path& csv) {
+  std::ifstream in(csv);
+  std::vector<std::vector<std::string>> rows;
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> cells;
+    std::stringstream cells_of(line);
+    for (std::string cell; std::getline(cells_of, cell, ',');) cells.push_back(cell);
+    rows.push_back(std::move(cells));
+  }
+  if (rows.empty()) return rows;
+  const auto seconds = std::find(rows.front().begin(), rows.front().end(), "seconds") - rows.front().begin();
+  for (auto& row : rows) {
+    if (seconds < static_cast<long>(row.size())) row.erase(row.begin() + seconds);
+  }
+  return rows;
+}
+
 TEST(VmapXfeat, MatchWritesTheReferenceMatches) {
   SKIP_WITHOUT_SHARED();
   // KITTI is grey, so `vmap match` (which reads images as grey) sees the reference's input.
@@ -117,21 +135,7 @@ TEST(VmapXfeat, LocalizeReadsTheWeightsItIsGivenOfTheMapsModel) {
     const auto run = RunVmap("localize " + map + " " + input + " --no-cache --csv " + csv.string() + " " + flags);
     EXPECT_EQ(run.status, 0) << run.output;
     EXPECT_EQ(run.output.find("are not here"), std::string::npos) << run.output;
-    // Each row but its `seconds`, the time the frame took.
-    std::ifstream in(csv);
-    std::vector<std::vector<std::string>> rows;
-    for (std::string line; std::getline(in, line);) {
-      std::vector<std::string> cells;
-      std::stringstream cells_of(line);
-      for (std::string cell; std::getline(cells_of, cell, ',');) cells.push_back(cell);
-      rows.push_back(std::move(cells));
-    }
-    if (rows.empty()) return rows;
-    const auto seconds = std::find(rows.front().begin(), rows.front().end(), "seconds") - rows.front().begin();
-    for (auto& row : rows) {
-      if (seconds < static_cast<long>(row.size())) row.erase(row.begin() + seconds);
-    }
-    return rows;
+    return CsvWithoutSeconds(csv);
   };
   const auto with_map_weights = localize_csv("", "map.csv");
   ASSERT_GE(with_map_weights.size(), 6u);
@@ -217,21 +221,7 @@ TEST(VmapXfeat, AMapTaughtOnAGpuIsFollowedOnTheCpu) {
     const auto run =
         RunVmap("localize " + (dir.path() / map).string() + " " + input + " -q --csv " + csv.string() + " " + flags);
     EXPECT_EQ(run.status, 0) << run.output;
-    // Each row but its `seconds`, the time the frame took.
-    std::ifstream in(csv);
-    std::vector<std::vector<std::string>> rows;
-    for (std::string line; std::getline(in, line);) {
-      std::vector<std::string> cells;
-      std::stringstream cells_of(line);
-      for (std::string cell; std::getline(cells_of, cell, ',');) cells.push_back(cell);
-      rows.push_back(std::move(cells));
-    }
-    if (rows.empty()) return rows;
-    const auto seconds = std::find(rows.front().begin(), rows.front().end(), "seconds") - rows.front().begin();
-    for (auto& row : rows) {
-      if (seconds < static_cast<long>(row.size())) row.erase(row.begin() + seconds);
-    }
-    return rows;
+    return CsvWithoutSeconds(csv);
   };
   const auto on_cpu = localize("cpu", "");
   ASSERT_GE(on_cpu.size(), 7u);
